@@ -1,0 +1,242 @@
+//! Indexed triangle meshes: the form in which solids leave the kernel.
+
+use serde::{Deserialize, Serialize};
+
+/// An axis-aligned bounding box, mm.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Aabb {
+    pub min: [f64; 3],
+    pub max: [f64; 3],
+}
+
+impl Aabb {
+    /// Edge lengths along x, y, z, mm.
+    pub fn size(&self) -> [f64; 3] {
+        [
+            self.max[0] - self.min[0],
+            self.max[1] - self.min[1],
+            self.max[2] - self.min[2],
+        ]
+    }
+}
+
+/// A closed triangle mesh with shared vertices, mm.
+///
+/// `triangles` index into `vertices`; each triangle is counter-clockwise seen from outside
+/// (right-hand normal points out of the solid), the convention of STL, 3MF and Manifold.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mesh {
+    /// Vertex positions, shape (V, 3), mm.
+    pub vertices: Vec<[f64; 3]>,
+    /// Triangles as vertex indices, shape (T, 3).
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// What [`Mesh::check_closed_manifold`] found wrong.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum TopologyError {
+    #[error("mesh has no triangles")]
+    Empty,
+    #[error("triangle {0} indexes a vertex that does not exist")]
+    BadIndex(usize),
+    #[error("triangle {0} repeats a vertex (degenerate)")]
+    RepeatedVertex(usize),
+    #[error("{0} edges are not shared by exactly two triangles (open or non-manifold)")]
+    OpenOrNonManifoldEdges(usize),
+    #[error("{0} edges are used twice in the same direction (inconsistent winding)")]
+    InconsistentWinding(usize),
+    #[error("signed volume {0} mm^3 is not positive (inside-out)")]
+    NonPositiveVolume(f64),
+    #[error("vertex coordinate is not finite")]
+    NonFinite,
+}
+
+impl Mesh {
+    /// Enclosed volume by the divergence theorem, mm^3 (positive for outward winding).
+    pub fn signed_volume(&self) -> f64 {
+        let mut v = 0.0;
+        for t in &self.triangles {
+            let a = self.vertices[t[0] as usize];
+            let b = self.vertices[t[1] as usize];
+            let c = self.vertices[t[2] as usize];
+            v += a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+                + a[2] * (b[0] * c[1] - b[1] * c[0]);
+        }
+        v / 6.0
+    }
+
+    /// Total triangle area, mm^2.
+    pub fn surface_area(&self) -> f64 {
+        self.triangles
+            .iter()
+            .map(|t| {
+                let a = self.vertices[t[0] as usize];
+                let b = self.vertices[t[1] as usize];
+                let c = self.vertices[t[2] as usize];
+                let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+                let w = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+                let n = [
+                    u[1] * w[2] - u[2] * w[1],
+                    u[2] * w[0] - u[0] * w[2],
+                    u[0] * w[1] - u[1] * w[0],
+                ];
+                0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt()
+            })
+            .sum()
+    }
+
+    /// Bounding box of the vertices; `None` for an empty mesh.
+    pub fn bounding_box(&self) -> Option<Aabb> {
+        let first = *self.vertices.first()?;
+        let mut b = Aabb { min: first, max: first };
+        for v in &self.vertices {
+            for k in 0..3 {
+                b.min[k] = b.min[k].min(v[k]);
+                b.max[k] = b.max[k].max(v[k]);
+            }
+        }
+        Some(b)
+    }
+
+    /// Genus from the Euler characteristic of a closed, connected-per-shell mesh:
+    /// `genus = shells - chi / 2` where chi = V - E + F. A solid ball has genus 0, a ring 1.
+    pub fn genus(&self) -> i64 {
+        let v = self.vertices.len() as i64;
+        let f = self.triangles.len() as i64;
+        let e = 3 * f / 2;
+        let chi = v - e + f;
+        self.shell_count() as i64 - chi / 2
+    }
+
+    /// Number of edge-connected shells.
+    pub fn shell_count(&self) -> usize {
+        let n = self.vertices.len();
+        let mut parent: Vec<usize> = (0..n).collect();
+        fn find(p: &mut [usize], mut x: usize) -> usize {
+            while p[x] != x {
+                p[x] = p[p[x]];
+                x = p[x];
+            }
+            x
+        }
+        let mut used = vec![false; n];
+        for t in &self.triangles {
+            let a = t[0] as usize;
+            used[a] = true;
+            for &o in &t[1..] {
+                let o = o as usize;
+                used[o] = true;
+                let (ra, ro) = (find(&mut parent, a), find(&mut parent, o));
+                if ra != ro {
+                    parent[ra] = ro;
+                }
+            }
+        }
+        (0..n).filter(|&i| used[i] && find(&mut parent, i) == i).count()
+    }
+
+    /// Checks that the mesh is a closed, consistently oriented 2-manifold with positive volume:
+    /// every directed edge appears exactly once and its reverse exactly once.
+    ///
+    /// # Errors
+    /// The first [`TopologyError`] found.
+    pub fn check_closed_manifold(&self) -> Result<(), TopologyError> {
+        if self.triangles.is_empty() {
+            return Err(TopologyError::Empty);
+        }
+        if self.vertices.iter().flatten().any(|c| !c.is_finite()) {
+            return Err(TopologyError::NonFinite);
+        }
+        let nv = self.vertices.len() as u32;
+        let mut directed: Vec<(u32, u32)> = Vec::with_capacity(self.triangles.len() * 3);
+        for (i, t) in self.triangles.iter().enumerate() {
+            if t.iter().any(|&x| x >= nv) {
+                return Err(TopologyError::BadIndex(i));
+            }
+            if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
+                return Err(TopologyError::RepeatedVertex(i));
+            }
+            directed.extend([(t[0], t[1]), (t[1], t[2]), (t[2], t[0])]);
+        }
+        directed.sort_unstable();
+        let dup = directed.windows(2).filter(|w| w[0] == w[1]).count();
+        if dup > 0 {
+            return Err(TopologyError::InconsistentWinding(dup));
+        }
+        let unpaired = directed
+            .iter()
+            .filter(|&&(a, b)| directed.binary_search(&(b, a)).is_err())
+            .count();
+        if unpaired > 0 {
+            return Err(TopologyError::OpenOrNonManifoldEdges(unpaired));
+        }
+        let vol = self.signed_volume();
+        if vol.is_nan() || vol <= 0.0 {
+            return Err(TopologyError::NonPositiveVolume(vol));
+        }
+        Ok(())
+    }
+
+    /// The same mesh with every coordinate rounded to `f32`, as STL and most 3MF readers store it.
+    /// Statistics written beside a file are computed on this form so that they match the file.
+    pub fn rounded_to_f32(&self) -> Mesh {
+        Mesh {
+            vertices: self
+                .vertices
+                .iter()
+                .map(|v| v.map(|c| c as f32 as f64))
+                .collect(),
+            triangles: self.triangles.clone(),
+        }
+    }
+
+    /// Applies `f` to every vertex.
+    pub fn map_vertices(&self, f: impl Fn([f64; 3]) -> [f64; 3]) -> Mesh {
+        Mesh {
+            vertices: self.vertices.iter().map(|&v| f(v)).collect(),
+            triangles: self.triangles.clone(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tetra() -> Mesh {
+        Mesh {
+            vertices: vec![[0., 0., 0.], [1., 0., 0.], [0., 1., 0.], [0., 0., 1.]],
+            triangles: vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]],
+        }
+    }
+
+    #[test]
+    fn tetrahedron_volume_area_genus() {
+        let m = tetra();
+        assert!((m.signed_volume() - 1.0 / 6.0).abs() < 1e-15);
+        assert_eq!(m.genus(), 0);
+        assert!(m.check_closed_manifold().is_ok());
+        let a = 1.5 + 3f64.sqrt() / 2.0;
+        assert!((m.surface_area() - a).abs() < 1e-12);
+    }
+
+    #[test]
+    fn flipped_triangle_is_caught() {
+        let mut m = tetra();
+        m.triangles[0] = [0, 1, 2];
+        assert!(matches!(
+            m.check_closed_manifold(),
+            Err(TopologyError::InconsistentWinding(_))
+        ));
+    }
+
+    #[test]
+    fn missing_triangle_is_open() {
+        let mut m = tetra();
+        m.triangles.pop();
+        assert!(matches!(
+            m.check_closed_manifold(),
+            Err(TopologyError::OpenOrNonManifoldEdges(_))
+        ));
+    }
+}

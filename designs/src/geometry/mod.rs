@@ -1,0 +1,320 @@
+//! The geometry core: chord tolerance, the [`Solid`] wrapper over the boolean kernel
+//! (`manifold-rust`), primitives and the revolve of 2D profiles.
+//!
+//! Every constructor takes a [`ChordTolerance`] explicitly; there is no global quality state,
+//! so parallel builds with different tolerances can share a process.
+
+mod mesh;
+pub mod profile2d;
+mod solid;
+
+pub use mesh::{Aabb, Mesh, TopologyError};
+pub use profile2d::Polyline2;
+pub use solid::{GeometryError, Solid};
+
+use serde::{Deserialize, Serialize};
+use std::f64::consts::PI;
+
+/// The largest distance between a facet and the true surface it approximates, mm (> 0).
+///
+/// Primitives and revolves split it between the profile direction and the circumferential
+/// direction (half each), so a facet of a surface of revolution stays within the tolerance.
+#[derive(Debug, Clone, Copy, PartialEq, PartialOrd, Serialize, Deserialize)]
+#[serde(try_from = "f64", into = "f64")]
+pub struct ChordTolerance(f64);
+
+impl ChordTolerance {
+    /// The default, 0.01 mm: finer than FDM and SLA printer resolution.
+    pub const DEFAULT_MM: f64 = 0.01;
+
+    /// # Errors
+    /// When `mm` is not a finite number above zero.
+    pub fn new(mm: f64) -> Result<Self, String> {
+        if mm.is_finite() && mm > 0.0 {
+            Ok(Self(mm))
+        } else {
+            Err(format!("chord tolerance = {mm} mm: must be a finite number above 0"))
+        }
+    }
+
+    /// The tolerance in mm.
+    pub fn mm(self) -> f64 {
+        self.0
+    }
+
+    /// Number of segments of a full circle of radius `radius_mm` whose chords stay within
+    /// `self` of the circle: the smallest multiple of 4 (so that the planes x = 0 and y = 0
+    /// pass through vertices) with `r (1 - cos(pi / n)) <= tol`, and at least 8.
+    pub fn circle_segments(self, radius_mm: f64) -> usize {
+        if radius_mm <= self.0 {
+            return 8;
+        }
+        let half_angle = (1.0 - self.0 / radius_mm).acos();
+        let n = (PI / half_angle).ceil() as usize;
+        n.max(8).div_ceil(4) * 4
+    }
+
+    /// Half this tolerance (one share of the profile / circumferential split).
+    pub fn half(self) -> Self {
+        Self(self.0 / 2.0)
+    }
+}
+
+impl Default for ChordTolerance {
+    fn default() -> Self {
+        Self(Self::DEFAULT_MM)
+    }
+}
+
+impl TryFrom<f64> for ChordTolerance {
+    type Error = String;
+    fn try_from(v: f64) -> Result<Self, String> {
+        Self::new(v)
+    }
+}
+
+impl From<ChordTolerance> for f64 {
+    fn from(t: ChordTolerance) -> f64 {
+        t.0
+    }
+}
+
+/// Revolves a closed 2D profile about the z axis into a closed mesh.
+///
+/// `profile` is a closed polygon in the (r, z) half-plane, r >= 0, either winding; vertices with
+/// r == 0 lie on the axis and become single poles. The circumferential segment count follows
+/// from the largest radius and `tol.half()`; the profile itself must already honour the other
+/// half (see [`profile2d`]).
+///
+/// # Errors
+/// [`GeometryError::InvalidProfile`] for fewer than 3 points, negative r or a non-finite point.
+pub fn revolve(profile: &Polyline2, tol: ChordTolerance) -> Result<Mesh, GeometryError> {
+    let pts = &profile.points;
+    if pts.len() < 3 {
+        return Err(GeometryError::InvalidProfile("fewer than 3 points".into()));
+    }
+    if pts.iter().any(|p| !p[0].is_finite() || !p[1].is_finite() || p[0] < 0.0) {
+        return Err(GeometryError::InvalidProfile(
+            "points must be finite with r >= 0".into(),
+        ));
+    }
+    let r_max = pts.iter().map(|p| p[0]).fold(0.0, f64::max);
+    let n = tol.half().circle_segments(r_max);
+    let (sin, cos): (Vec<f64>, Vec<f64>) = (0..n)
+        .map(|j| (2.0 * PI * j as f64 / n as f64).sin_cos())
+        .unzip();
+    // Snap the quarter angles so that x = 0 and y = 0 hold exactly there.
+    let snap = |v: f64| if v.abs() < 1e-15 { 0.0 } else { v };
+
+    let mut vertices: Vec<[f64; 3]> = Vec::new();
+    // first vertex index of each profile point, and whether it is on the axis
+    let mut first: Vec<(u32, bool)> = Vec::with_capacity(pts.len());
+    for p in pts {
+        let start = vertices.len() as u32;
+        if p[0] == 0.0 {
+            vertices.push([0.0, 0.0, p[1]]);
+            first.push((start, true));
+        } else {
+            for j in 0..n {
+                vertices.push([snap(p[0] * cos[j]), snap(p[0] * sin[j]), p[1]]);
+            }
+            first.push((start, false));
+        }
+    }
+    let idx = |k: usize, j: usize| -> u32 {
+        let (s, axis) = first[k];
+        if axis {
+            s
+        } else {
+            s + (j % n) as u32
+        }
+    };
+    let mut triangles = Vec::new();
+    for k in 0..pts.len() {
+        let k2 = (k + 1) % pts.len();
+        let (a_axis, b_axis) = (first[k].1, first[k2].1);
+        if a_axis && b_axis {
+            continue;
+        }
+        for j in 0..n {
+            let (p0, p1, q0, q1) = (idx(k, j), idx(k, j + 1), idx(k2, j), idx(k2, j + 1));
+            if a_axis {
+                triangles.push([p0, q1, q0]);
+            } else if b_axis {
+                triangles.push([p0, p1, q0]);
+            } else {
+                triangles.push([p0, p1, q1]);
+                triangles.push([p0, q1, q0]);
+            }
+        }
+    }
+    let mut mesh = Mesh { vertices, triangles };
+    if mesh.signed_volume() < 0.0 {
+        for t in &mut mesh.triangles {
+            t.swap(1, 2);
+        }
+    }
+    Ok(mesh)
+}
+
+/// A sphere of radius `radius_mm` centred at the origin, within `tol` of the true sphere.
+///
+/// # Errors
+/// [`GeometryError::InvalidPrimitive`] for a radius that is not above zero.
+pub fn sphere(radius_mm: f64, tol: ChordTolerance) -> Result<Solid, GeometryError> {
+    if !(radius_mm > 0.0 && radius_mm.is_finite()) {
+        return Err(GeometryError::InvalidPrimitive(format!(
+            "sphere radius = {radius_mm} mm: must be above 0"
+        )));
+    }
+    let mut pl = Polyline2::default();
+    profile2d::push_arc(&mut pl, [0.0, 0.0], radius_mm, -PI / 2.0, PI / 2.0, tol.half());
+    Solid::from_mesh(&revolve(&pl, tol)?)
+}
+
+/// A cone frustum along +z from z = 0 to `height_mm`, radius `r_low_mm` at the bottom and
+/// `r_high_mm` at the top (either may be 0, not both).
+///
+/// # Errors
+/// [`GeometryError::InvalidPrimitive`] for a non-positive height or negative radii.
+pub fn cone(
+    height_mm: f64,
+    r_low_mm: f64,
+    r_high_mm: f64,
+    tol: ChordTolerance,
+) -> Result<Solid, GeometryError> {
+    if !(height_mm > 0.0 && r_low_mm >= 0.0 && r_high_mm >= 0.0 && r_low_mm.max(r_high_mm) > 0.0)
+    {
+        return Err(GeometryError::InvalidPrimitive(format!(
+            "cone height {height_mm} mm, radii {r_low_mm}/{r_high_mm} mm: need height > 0, radii >= 0, one radius > 0"
+        )));
+    }
+    let pl = Polyline2 {
+        points: vec![
+            [0.0, 0.0],
+            [r_low_mm, 0.0],
+            [r_high_mm, height_mm],
+            [0.0, height_mm],
+        ],
+    };
+    // Straight generators: the whole tolerance may go to the circumference.
+    Solid::from_mesh(&revolve(&dedup_axis(pl), ChordTolerance(tol.0 * 2.0))?)
+}
+
+fn dedup_axis(mut pl: Polyline2) -> Polyline2 {
+    pl.points.dedup();
+    if pl.points.len() > 1 && pl.points.first() == pl.points.last() {
+        pl.points.pop();
+    }
+    pl
+}
+
+/// A cylinder along +z from z = 0 to `height_mm` with radius `radius_mm`.
+///
+/// # Errors
+/// As [`cone`].
+pub fn cylinder(height_mm: f64, radius_mm: f64, tol: ChordTolerance) -> Result<Solid, GeometryError> {
+    cone(height_mm, radius_mm, radius_mm, tol)
+}
+
+/// A box with one corner at `min` and the opposite at `max`, mm.
+///
+/// # Errors
+/// [`GeometryError::InvalidPrimitive`] when any edge is not positive.
+pub fn cuboid(min: [f64; 3], max: [f64; 3]) -> Result<Solid, GeometryError> {
+    let size = [max[0] - min[0], max[1] - min[1], max[2] - min[2]];
+    if size.iter().any(|&s| !(s > 0.0 && s.is_finite())) {
+        return Err(GeometryError::InvalidPrimitive(format!(
+            "box from {min:?} to {max:?} mm: every edge must be above 0"
+        )));
+    }
+    let v = [
+        [min[0], min[1], min[2]],
+        [max[0], min[1], min[2]],
+        [max[0], max[1], min[2]],
+        [min[0], max[1], min[2]],
+        [min[0], min[1], max[2]],
+        [max[0], min[1], max[2]],
+        [max[0], max[1], max[2]],
+        [min[0], max[1], max[2]],
+    ];
+    let t = [
+        [0, 2, 1],
+        [0, 3, 2],
+        [4, 5, 6],
+        [4, 6, 7],
+        [0, 1, 5],
+        [0, 5, 4],
+        [1, 2, 6],
+        [1, 6, 5],
+        [2, 3, 7],
+        [2, 7, 6],
+        [3, 0, 4],
+        [3, 4, 7],
+    ];
+    Solid::from_mesh(&Mesh {
+        vertices: v.to_vec(),
+        triangles: t.to_vec(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn circle_segments_honour_tolerance() {
+        for &(r, tol) in &[(15.0, 0.01), (1.0, 0.001), (100.0, 0.05), (0.5, 0.01)] {
+            let t = ChordTolerance::new(tol).unwrap();
+            let n = t.circle_segments(r);
+            assert_eq!(n % 4, 0);
+            assert!(r * (1.0 - (PI / n as f64).cos()) <= tol * (1.0 + 1e-12));
+            // and not wastefully many: n - 4 segments would break the tolerance (or hit the floor of 8)
+            if n > 8 {
+                assert!(r * (1.0 - (PI / (n - 4) as f64).cos()) > tol);
+            }
+        }
+    }
+
+    #[test]
+    fn bad_tolerance_is_rejected() {
+        assert!(ChordTolerance::new(0.0).is_err());
+        assert!(ChordTolerance::new(-1.0).is_err());
+        assert!(ChordTolerance::new(f64::NAN).is_err());
+    }
+
+    #[test]
+    fn sphere_volume_within_chord_bound() {
+        let tol = ChordTolerance::new(0.01).unwrap();
+        let s = sphere(5.0, tol).unwrap();
+        let exact = 4.0 / 3.0 * PI * 125.0;
+        let bound = 4.0 * PI * 25.0 * tol.mm();
+        assert!(s.volume() <= exact && exact - s.volume() <= bound, "{}", s.volume());
+        assert_eq!(s.genus(), 0);
+    }
+
+    #[test]
+    fn cylinder_cone_box_volumes() {
+        let tol = ChordTolerance::new(0.01).unwrap();
+        let c = cylinder(10.0, 3.0, tol).unwrap();
+        let exact = PI * 9.0 * 10.0;
+        assert!(exact - c.volume() >= 0.0 && exact - c.volume() <= 2.0 * PI * 3.0 * 10.0 * 0.01);
+        let k = cone(6.0, 2.0, 0.0, tol).unwrap();
+        let exact = PI * 4.0 * 6.0 / 3.0;
+        assert!((exact - k.volume()).abs() <= 0.01 * 2.0 * PI * 2.0 * 7.0);
+        let b = cuboid([0.0, 0.0, 0.0], [1.0, 2.0, 3.0]).unwrap();
+        assert!((b.volume() - 6.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn difference_of_box_and_cylinder_is_a_ring() {
+        let tol = ChordTolerance::new(0.01).unwrap();
+        let b = cuboid([-5.0, -5.0, 0.0], [5.0, 5.0, 2.0]).unwrap();
+        let c = cylinder(4.0, 2.0, tol).unwrap().translate([0.0, 0.0, -1.0]);
+        let r = b.difference(&c).unwrap();
+        assert_eq!(r.genus(), 1);
+        // the removed polygonal prism is smaller than the cylinder by at most perimeter x tol x height
+        let exact = 200.0 - PI * 4.0 * 2.0;
+        assert!(r.volume() >= exact && r.volume() - exact <= 2.0 * PI * 2.0 * 0.01 * 2.0);
+    }
+}

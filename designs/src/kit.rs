@@ -1,0 +1,92 @@
+//! The output of a design build: printable parts and the numbers needed to cast.
+
+use crate::geometry::Solid;
+use serde::{Deserialize, Serialize};
+
+/// How a part is meant to be made.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum PrintTechnology {
+    /// Fused deposition modelling (filament).
+    #[serde(rename = "FDM")]
+    Fdm,
+    /// Stereolithography / masked SLA (resin).
+    #[serde(rename = "SLA")]
+    Sla,
+}
+
+impl std::fmt::Display for PrintTechnology {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Self::Fdm => "FDM",
+            Self::Sla => "SLA",
+        })
+    }
+}
+
+/// One printable part of a kit.
+#[derive(Debug, Clone)]
+pub struct Part {
+    /// File stem and 3MF object name, unique in the kit, `[a-z0-9_]+`.
+    pub name: String,
+    /// What the part is for, e.g. `mold_half`, `core_holder`, `master_pattern`, `mold_box`,
+    /// `casting_jig`, `shell_half`.
+    pub role: String,
+    /// Human description, one line.
+    pub description: String,
+    /// Material key in the materials table (e.g. `pla_black`, `sla_standard_resin`).
+    pub material: String,
+    pub print_technology: PrintTechnology,
+    /// The solid in print orientation: resting on the build plate z = 0, mm.
+    pub solid: Solid,
+    /// The resolved parameters the part was built from (for the manifest and twins).
+    pub params: serde_json::Value,
+}
+
+/// Casting numbers for one pour.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CastReport {
+    /// Order in which the pours are made, from 1.
+    pub step: u32,
+    /// What is cast: a layer name (`transparent_gel`) or `silicone_mold:<layer>` for a
+    /// Mold Star mold made from a master pattern.
+    pub cast: String,
+    /// Material key in the materials table.
+    pub material: String,
+    /// Names of the parts that hold this pour.
+    pub mold_parts: Vec<String>,
+    /// Volume to fill, mL (= cm^3).
+    pub cavity_volume_ml: f64,
+    /// Fraction added for losses in cups, sprue and vents (0.2 = 20 %).
+    pub waste_allowance: f64,
+    /// Mix ratio as written on the datasheet, e.g. `10:1 by weight`.
+    pub mix_ratio: String,
+    /// Mass of each component to weigh out, g, in datasheet order (Part A, Part B, ...).
+    pub components: Vec<CastComponent>,
+    /// Total mass to mix, g.
+    pub total_mass_g: f64,
+    /// Pot life, cure time and handling notes from the materials table.
+    pub notes: String,
+}
+
+/// One component of a mix.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CastComponent {
+    pub name: String,
+    pub mass_g: f64,
+}
+
+/// Everything one design build produces.
+#[derive(Debug, Clone)]
+pub struct Kit {
+    /// Design name, e.g. `rtac0`.
+    pub design: String,
+    pub parts: Vec<Part>,
+    /// Pours, in casting order.
+    pub casts: Vec<CastReport>,
+    /// Parts that are bought or cut rather than printed (tube, PCB, diffuser, screws), one
+    /// line each, for the fabrication sheet.
+    pub bought_items: Vec<String>,
+    /// Sensor-frame facts worth printing in the manifest (envelope, derived radii...).
+    pub summary: serde_json::Value,
+}
