@@ -1,4 +1,23 @@
 //! fabkit-designs: the geometry core, sensor body profiles, layer stacks, molds, housings and
 //! the YAML design schema of fabkit.
+//!
+//! Frames and units are defined in `docs/conventions.md`: millimetres, degrees at public
+//! boundaries, the sensor frame with z along the sensor axis through the pole.
+
+pub mod build;
+pub mod error;
 pub mod geometry;
+pub mod housing;
 pub mod kit;
+pub mod library;
+pub mod materials;
+pub mod molds;
+pub mod profile;
+pub mod schema;
+pub mod stack;
+
+pub use build::build_kit;
+pub use error::{DesignError, ParamError, ParamErrors};
+pub use geometry::{ChordTolerance, Mesh, Solid};
+pub use kit::{Kit, Part, PrintTechnology};
+pub use schema::Design;

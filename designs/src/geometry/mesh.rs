@@ -88,7 +88,10 @@ impl Mesh {
     /// Bounding box of the vertices; `None` for an empty mesh.
     pub fn bounding_box(&self) -> Option<Aabb> {
         let first = *self.vertices.first()?;
-        let mut b = Aabb { min: first, max: first };
+        let mut b = Aabb {
+            min: first,
+            max: first,
+        };
         for v in &self.vertices {
             for k in 0..3 {
                 b.min[k] = b.min[k].min(v[k]);
@@ -132,7 +135,9 @@ impl Mesh {
                 }
             }
         }
-        (0..n).filter(|&i| used[i] && find(&mut parent, i) == i).count()
+        (0..n)
+            .filter(|&i| used[i] && find(&mut parent, i) == i)
+            .count()
     }
 
     /// Checks that the mesh is a closed, consistently oriented 2-manifold with positive volume:

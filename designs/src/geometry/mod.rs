@@ -10,7 +10,7 @@ mod solid;
 
 pub use mesh::{Aabb, Mesh, TopologyError};
 pub use profile2d::Polyline2;
-pub use solid::{GeometryError, Solid};
+pub use solid::{csg_json, rotation_deg, Affine, CsgNode, GeometryError, Solid};
 
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
@@ -33,7 +33,9 @@ impl ChordTolerance {
         if mm.is_finite() && mm > 0.0 {
             Ok(Self(mm))
         } else {
-            Err(format!("chord tolerance = {mm} mm: must be a finite number above 0"))
+            Err(format!(
+                "chord tolerance = {mm} mm: must be a finite number above 0"
+            ))
         }
     }
 
@@ -93,7 +95,10 @@ pub fn revolve(profile: &Polyline2, tol: ChordTolerance) -> Result<Mesh, Geometr
     if pts.len() < 3 {
         return Err(GeometryError::InvalidProfile("fewer than 3 points".into()));
     }
-    if pts.iter().any(|p| !p[0].is_finite() || !p[1].is_finite() || p[0] < 0.0) {
+    if pts
+        .iter()
+        .any(|p| !p[0].is_finite() || !p[1].is_finite() || p[0] < 0.0)
+    {
         return Err(GeometryError::InvalidProfile(
             "points must be finite with r >= 0".into(),
         ));
@@ -148,7 +153,10 @@ pub fn revolve(profile: &Polyline2, tol: ChordTolerance) -> Result<Mesh, Geometr
             }
         }
     }
-    let mut mesh = Mesh { vertices, triangles };
+    let mut mesh = Mesh {
+        vertices,
+        triangles,
+    };
     if mesh.signed_volume() < 0.0 {
         for t in &mut mesh.triangles {
             t.swap(1, 2);
@@ -168,7 +176,14 @@ pub fn sphere(radius_mm: f64, tol: ChordTolerance) -> Result<Solid, GeometryErro
         )));
     }
     let mut pl = Polyline2::default();
-    profile2d::push_arc(&mut pl, [0.0, 0.0], radius_mm, -PI / 2.0, PI / 2.0, tol.half());
+    profile2d::push_arc(
+        &mut pl,
+        [0.0, 0.0],
+        radius_mm,
+        -PI / 2.0,
+        PI / 2.0,
+        tol.half(),
+    );
     Solid::from_mesh(&revolve(&pl, tol)?)
 }
 
@@ -183,8 +198,7 @@ pub fn cone(
     r_high_mm: f64,
     tol: ChordTolerance,
 ) -> Result<Solid, GeometryError> {
-    if !(height_mm > 0.0 && r_low_mm >= 0.0 && r_high_mm >= 0.0 && r_low_mm.max(r_high_mm) > 0.0)
-    {
+    if !(height_mm > 0.0 && r_low_mm >= 0.0 && r_high_mm >= 0.0 && r_low_mm.max(r_high_mm) > 0.0) {
         return Err(GeometryError::InvalidPrimitive(format!(
             "cone height {height_mm} mm, radii {r_low_mm}/{r_high_mm} mm: need height > 0, radii >= 0, one radius > 0"
         )));
@@ -213,7 +227,11 @@ fn dedup_axis(mut pl: Polyline2) -> Polyline2 {
 ///
 /// # Errors
 /// As [`cone`].
-pub fn cylinder(height_mm: f64, radius_mm: f64, tol: ChordTolerance) -> Result<Solid, GeometryError> {
+pub fn cylinder(
+    height_mm: f64,
+    radius_mm: f64,
+    tol: ChordTolerance,
+) -> Result<Solid, GeometryError> {
     cone(height_mm, radius_mm, radius_mm, tol)
 }
 
@@ -289,7 +307,11 @@ mod tests {
         let s = sphere(5.0, tol).unwrap();
         let exact = 4.0 / 3.0 * PI * 125.0;
         let bound = 4.0 * PI * 25.0 * tol.mm();
-        assert!(s.volume() <= exact && exact - s.volume() <= bound, "{}", s.volume());
+        assert!(
+            s.volume() <= exact && exact - s.volume() <= bound,
+            "{}",
+            s.volume()
+        );
         assert_eq!(s.genus(), 0);
     }
 

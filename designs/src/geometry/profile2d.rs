@@ -35,12 +35,23 @@ impl Polyline2 {
 /// Appends a circular arc about `center` of radius `radius` from angle `a0` to `a1` (radians,
 /// measured from the +r axis towards +z), endpoints included, with uniform segments whose
 /// sagitta is within `tol`.
-pub fn push_arc(pl: &mut Polyline2, center: [f64; 2], radius: f64, a0: f64, a1: f64, tol: ChordTolerance) {
+pub fn push_arc(
+    pl: &mut Polyline2,
+    center: [f64; 2],
+    radius: f64,
+    a0: f64,
+    a1: f64,
+    tol: ChordTolerance,
+) {
     let sweep = (a1 - a0).abs();
     let n_full = tol.circle_segments(radius) as f64;
     let n = ((sweep / (2.0 * std::f64::consts::PI) * n_full).ceil() as usize).max(1);
     for i in 0..=n {
-        let a = if i == n { a1 } else { a0 + (a1 - a0) * i as f64 / n as f64 };
+        let a = if i == n {
+            a1
+        } else {
+            a0 + (a1 - a0) * i as f64 / n as f64
+        };
         let (s, c) = a.sin_cos();
         let mut p = [center[0] + radius * c, center[1] + radius * s];
         // Points meant to be on the axis land there exactly.
@@ -57,8 +68,21 @@ pub fn push_arc(pl: &mut Polyline2, center: [f64; 2], radius: f64, a0: f64, a1: 
 /// `f` must be smooth on the interval; the check samples 8 interior points per chord, which
 /// bounds the error for curves whose curvature varies slowly across one chord (all the
 /// profiles here: arcs, ellipses and their offsets).
-pub fn push_curve(pl: &mut Polyline2, f: &dyn Fn(f64) -> [f64; 2], t0: f64, t1: f64, tol: ChordTolerance) {
-    fn rec(pl: &mut Polyline2, f: &dyn Fn(f64) -> [f64; 2], t0: f64, t1: f64, tol: f64, depth: u32) {
+pub fn push_curve(
+    pl: &mut Polyline2,
+    f: &dyn Fn(f64) -> [f64; 2],
+    t0: f64,
+    t1: f64,
+    tol: ChordTolerance,
+) {
+    fn rec(
+        pl: &mut Polyline2,
+        f: &dyn Fn(f64) -> [f64; 2],
+        t0: f64,
+        t1: f64,
+        tol: f64,
+        depth: u32,
+    ) {
         let (a, b) = (f(t0), f(t1));
         let d = [b[0] - a[0], b[1] - a[1]];
         let len = (d[0] * d[0] + d[1] * d[1]).sqrt();
@@ -95,7 +119,13 @@ pub fn push_curve(pl: &mut Polyline2, f: &dyn Fn(f64) -> [f64; 2], t0: f64, t1: 
 
 /// Largest distance from any point of the curve `f` on [t0, t1] (densely sampled) to the
 /// polyline `pl`; used by tests to verify tessellations.
-pub fn max_deviation(pl: &Polyline2, f: &dyn Fn(f64) -> [f64; 2], t0: f64, t1: f64, samples: usize) -> f64 {
+pub fn max_deviation(
+    pl: &Polyline2,
+    f: &dyn Fn(f64) -> [f64; 2],
+    t0: f64,
+    t1: f64,
+    samples: usize,
+) -> f64 {
     let mut worst: f64 = 0.0;
     for i in 0..=samples {
         let p = f(t0 + (t1 - t0) * i as f64 / samples as f64);

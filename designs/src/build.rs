@@ -1,0 +1,159 @@
+//! From a validated design to a [`Kit`]: mold parts per cast layer, the shell, and the pour
+//! numbers.
+
+use crate::error::{DesignError, GeometryContext};
+use crate::geometry::ChordTolerance;
+use crate::kit::Kit;
+use crate::materials::{pour, MaterialsTable};
+use crate::molds::{build_mold, cast_plans};
+use crate::schema::Design;
+use crate::stack::{validate, Stack};
+use serde_json::json;
+
+/// Validates `design` and builds every part of its kit at chord tolerance `tol`.
+///
+/// Mold parts come first (per cast layer, inner to outer), then the shell. Casts are listed in
+/// the order they are poured: silicone molds (master strategy) first, then the layers from the
+/// inside out.
+///
+/// # Errors
+/// [`DesignError::Params`] with every violated rule, or [`DesignError::Geometry`] if the kernel
+/// fails on valid parameters.
+pub fn build_kit(design: &Design, tol: ChordTolerance) -> Result<Kit, DesignError> {
+    let materials = MaterialsTable::embedded().map_err(DesignError::Yaml)?;
+    let stack = validate(design, &materials, tol)?;
+    let plans = cast_plans(design, &stack);
+    let mut parts = Vec::new();
+    let mut silicone = Vec::new();
+    let mut gel = Vec::new();
+    for plan in &plans {
+        let out = build_mold(design, &stack, plan, tol)?;
+        let layer = &stack.layers[plan.layer];
+        if let Some((v, holders)) = out.silicone_pour {
+            silicone.push((format!("silicone_mold:{}", layer.name), v, holders));
+        }
+        gel.push((
+            layer.name.clone(),
+            layer.material.clone(),
+            out.pour_volume_mm3,
+            out.pour_parts,
+            plan.sprayed.clone(),
+        ));
+        parts.extend(out.parts);
+    }
+    let mut bought = bought_items(design, &stack);
+    let mut summary = json!({
+        "body": design.body,
+        "base_z_mm": design.body.base_z_mm(),
+        "pole_z_mm": design.body.pole_z_mm(0.0),
+        "core": stack.core,
+        "layers": stack.layers,
+    });
+    if let Some(h) = &design.housing {
+        let (shell, levels) = crate::housing::build_shell(design, h, &stack, tol)?;
+        parts.extend(shell);
+        let r = design.body.rim_radius_mm(0.0);
+        let w = h.outer_width_mm.max(2.0 * r);
+        summary["shell_levels"] = json!(levels);
+        summary["envelope_mm"] = json!([w, w, levels.envelope_height_mm]);
+        bought.extend(housing_items(h));
+    }
+
+    let mut casts = Vec::new();
+    let waste = design.casting.waste_allowance;
+    let mut step = 1;
+    let mold_star = materials
+        .get("mold_star_30")
+        .ok_or_else(|| DesignError::Yaml("materials table lacks mold_star_30".into()))?;
+    for (what, v, holders) in silicone {
+        casts.push(
+            pour(step, &what, "mold_star_30", mold_star, holders, v, waste)
+                .map_err(DesignError::Yaml)?,
+        );
+        step += 1;
+    }
+    for (layer, material_key, v, holders, sprayed) in gel {
+        let m = materials
+            .get(&material_key)
+            .ok_or_else(|| DesignError::Yaml(format!("unknown material {material_key}")))?;
+        let mut r =
+            pour(step, &layer, &material_key, m, holders, v, waste).map_err(DesignError::Yaml)?;
+        for s in sprayed {
+            let sl = &stack.layers[s];
+            let sm = materials
+                .get(&sl.material)
+                .map(|m| m.notes.clone())
+                .unwrap_or_default();
+            r.notes = format!(
+                "First spray the {} layer ({}, {:.2} mm) onto the inner surface of the mold: {} Then: {}",
+                sl.name, sl.material, sl.thickness_mm, sm, r.notes
+            );
+        }
+        casts.push(r);
+        step += 1;
+    }
+    // Parts are named uniquely by construction; check anyway, the manifest relies on it.
+    let mut names: Vec<&str> = parts.iter().map(|p| p.name.as_str()).collect();
+    names.sort_unstable();
+    if names.windows(2).any(|w| w[0] == w[1]) {
+        return Err(crate::geometry::GeometryError::InvalidPrimitive(
+            "duplicate part names".into(),
+        ))
+        .part("kit");
+    }
+    Ok(Kit {
+        design: design.name.clone(),
+        parts,
+        casts,
+        bought_items: bought,
+        summary,
+    })
+}
+
+fn bought_items(design: &Design, stack: &Stack) -> Vec<String> {
+    let c = &stack.core;
+    let mut v = vec![match (c.outer_radius_mm, c.inner_radius_mm) {
+        (Some(ro), Some(ri)) => format!(
+            "Core ({}): {}, outer diameter {:.2} mm, wall {:.2} mm (inner diameter {:.2} mm), cut to {:.2} mm from the pole",
+            design.core.material, design.core.description, 2.0 * ro, ro - ri, 2.0 * ri, design.core.length_mm
+        ),
+        _ => format!(
+            "Core ({}): {}, wall {:.2} mm, {:.2} mm long from the pole",
+            design.core.material, design.core.description, design.core.wall_thickness_mm, design.core.length_mm
+        ),
+    }];
+    for l in &stack.layers {
+        if l.process == crate::schema::LayerProcess::Sprayed {
+            v.push(format!(
+                "Coating {} ({}), about {:.2} mm, sprayed into the mold",
+                l.name, l.material, l.thickness_mm
+            ));
+        }
+    }
+    v
+}
+
+fn housing_items(h: &crate::schema::HousingParams) -> Vec<String> {
+    vec![
+        format!(
+            "Camera: {} on a {:.1} mm square board, fixed with 4 self-tapping screws ({:.1} mm pilots, {:.1} mm square pattern)",
+            h.camera.module, h.camera.board_width_mm, h.camera.mount_pilot_diameter_mm, h.camera.mount_hole_spacing_mm
+        ),
+        format!(
+            "LED ring PCB: {} LEDs, outer diameter {:.1} mm, inner diameter {:.1} mm, {:.1} mm thick",
+            h.led_pcb.led_count, h.led_pcb.outer_diameter_mm, h.led_pcb.inner_diameter_mm, h.led_pcb.thickness_mm
+        ),
+        format!(
+            "Diffuser: laser-cut double-sided frosted acrylic ring, outer diameter {:.1} mm, inner diameter {:.1} mm, {:.1} mm thick, {:.1} mm above the PCB",
+            h.diffuser.outer_diameter_mm, h.diffuser.inner_diameter_mm, h.diffuser.thickness_mm, h.diffuser.gap_above_pcb_mm
+        ),
+        format!(
+            "2 joint screws: {:.1} mm clearance, {:.1} mm head, length about {:.0} mm (clamp {:.1} mm + pilot {:.1} mm)",
+            h.joint_screw.clearance_diameter_mm,
+            h.joint_screw.head_diameter_mm,
+            (h.joint_screw.clamp_length_mm + h.joint_screw.pilot_depth_mm - 0.5).floor(),
+            h.joint_screw.clamp_length_mm,
+            h.joint_screw.pilot_depth_mm
+        ),
+    ]
+}

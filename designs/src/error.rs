@@ -1,0 +1,86 @@
+//! Errors of design loading, validation and building.
+
+use crate::geometry::GeometryError;
+
+/// One violated rule of a design parameter: `path = value: rule`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ParamError {
+    /// Path of the parameter in the design, as in the YAML (`layers[2].thickness_mm`).
+    pub path: String,
+    /// The offending value, as written.
+    pub value: String,
+    /// The rule it breaks, with a hint where one helps.
+    pub rule: String,
+}
+
+impl ParamError {
+    pub fn new(
+        path: impl Into<String>,
+        value: impl std::fmt::Display,
+        rule: impl Into<String>,
+    ) -> Self {
+        Self {
+            path: path.into(),
+            value: value.to_string(),
+            rule: rule.into(),
+        }
+    }
+}
+
+impl std::fmt::Display for ParamError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} = {}: {}", self.path, self.value, self.rule)
+    }
+}
+
+/// Every violation found in a design, reported at once.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ParamErrors(pub Vec<ParamError>);
+
+impl std::fmt::Display for ParamErrors {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} invalid design parameter(s):", self.0.len())?;
+        for e in &self.0 {
+            write!(f, "\n  {e}")?;
+        }
+        Ok(())
+    }
+}
+
+impl std::error::Error for ParamErrors {}
+
+/// Why a design could not be loaded or built.
+#[derive(Debug, thiserror::Error)]
+pub enum DesignError {
+    /// The YAML does not parse or does not fit the schema; the message carries file:line:column.
+    #[error("{0}")]
+    Yaml(String),
+    /// The design parses but breaks geometric or printability rules.
+    #[error(transparent)]
+    Params(#[from] ParamErrors),
+    /// The geometry kernel failed on valid parameters (a fabkit defect: please report it).
+    #[error("building {part}: {source}")]
+    Geometry {
+        part: String,
+        #[source]
+        source: GeometryError,
+    },
+    #[error("reading {path}: {message}")]
+    Io { path: String, message: String },
+    #[error("no library design named '{0}' (see `fabkit designs`)")]
+    UnknownDesign(String),
+}
+
+/// Adds the part name to a geometry error.
+pub trait GeometryContext<T> {
+    fn part(self, part: &str) -> Result<T, DesignError>;
+}
+
+impl<T> GeometryContext<T> for Result<T, GeometryError> {
+    fn part(self, part: &str) -> Result<T, DesignError> {
+        self.map_err(|source| DesignError::Geometry {
+            part: part.to_string(),
+            source,
+        })
+    }
+}

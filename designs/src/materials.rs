@@ -1,0 +1,201 @@
+//! The materials table (`designs/materials.yaml`) and the pour calculator.
+
+use crate::kit::{CastComponent, CastReport};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// The materials table shipped with fabkit, embedded at build time.
+pub const MATERIALS_YAML: &str = include_str!("../materials.yaml");
+
+/// What a material is used for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum MaterialKind {
+    Cast,
+    Coating,
+    Print,
+    Bought,
+}
+
+/// Mixing by weight or by volume.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum MixBasis {
+    Weight,
+    Volume,
+}
+
+/// A multi-component mix ratio.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Mix {
+    pub components: Vec<String>,
+    pub ratio: Vec<f64>,
+    pub by: MixBasis,
+}
+
+/// One entry of the materials table.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Material {
+    pub name: String,
+    pub kind: MaterialKind,
+    /// Density of the mixed, uncured material, g/cm^3.
+    pub density_g_per_cm3: f64,
+    #[serde(default)]
+    pub mix: Option<Mix>,
+    #[serde(default)]
+    pub notes: String,
+    /// Where the numbers come from (datasheet, paper and section).
+    pub source: String,
+}
+
+/// The whole table, keyed by material key.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialsTable {
+    pub materials: BTreeMap<String, Material>,
+}
+
+impl MaterialsTable {
+    /// The embedded table.
+    ///
+    /// # Errors
+    /// Only if the embedded file is malformed (a build defect, covered by a test).
+    pub fn embedded() -> Result<Self, String> {
+        let t: Self = serde_saphyr::from_str(MATERIALS_YAML)
+            .map_err(|e| format!("designs/materials.yaml: {e}"))?;
+        t.check()?;
+        Ok(t)
+    }
+
+    fn check(&self) -> Result<(), String> {
+        for (k, m) in &self.materials {
+            if !(m.density_g_per_cm3 > 0.0) {
+                return Err(format!("materials.{k}.density_g_per_cm3 must be above 0"));
+            }
+            if m.source.trim().is_empty() {
+                return Err(format!("materials.{k}.source must name a source"));
+            }
+            if let Some(mix) = &m.mix {
+                if mix.components.len() != mix.ratio.len() || mix.ratio.iter().any(|r| !(*r > 0.0))
+                {
+                    return Err(format!(
+                        "materials.{k}.mix: one positive ratio per component is required"
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Looks up a material by key.
+    pub fn get(&self, key: &str) -> Option<&Material> {
+        self.materials.get(key)
+    }
+}
+
+/// Pour numbers for one cast: `cavity_volume_mm3` of `material`, plus `waste_allowance`
+/// (fraction, e.g. 0.2).
+///
+/// Total mass = volume x density x (1 + waste). For a mix by weight each component gets its
+/// share of the total mass; for a mix by volume each component gets its share of the volume at
+/// the mixed density.
+///
+/// # Errors
+/// When the material has no mix (it is not castable).
+pub fn pour(
+    step: u32,
+    cast: &str,
+    material_key: &str,
+    material: &Material,
+    mold_parts: Vec<String>,
+    cavity_volume_mm3: f64,
+    waste_allowance: f64,
+) -> Result<CastReport, String> {
+    let mix = material
+        .mix
+        .as_ref()
+        .ok_or_else(|| format!("material '{material_key}' has no mix ratio: it cannot be cast"))?;
+    let volume_ml = cavity_volume_mm3 / 1000.0;
+    let total = volume_ml * material.density_g_per_cm3 * (1.0 + waste_allowance);
+    let sum: f64 = mix.ratio.iter().sum();
+    let components = mix
+        .components
+        .iter()
+        .zip(&mix.ratio)
+        .map(|(name, r)| CastComponent {
+            name: name.clone(),
+            mass_g: total * r / sum,
+        })
+        .collect();
+    let ratio = mix
+        .ratio
+        .iter()
+        .map(|r| format!("{r}"))
+        .collect::<Vec<_>>()
+        .join(":");
+    Ok(CastReport {
+        step,
+        cast: cast.to_string(),
+        material: material_key.to_string(),
+        mold_parts,
+        cavity_volume_ml: volume_ml,
+        waste_allowance,
+        mix_ratio: format!(
+            "{ratio} by {}",
+            match mix.by {
+                MixBasis::Weight => "weight",
+                MixBasis::Volume => "volume",
+            }
+        ),
+        components,
+        total_mass_g: total,
+        notes: material.notes.clone(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn embedded_table_parses_and_has_the_required_entries() {
+        let t = MaterialsTable::embedded().unwrap();
+        let s = t.get("sylgard_184").unwrap();
+        assert_eq!(s.density_g_per_cm3, 1.03);
+        assert_eq!(s.mix.as_ref().unwrap().ratio, vec![10.0, 1.0]);
+        assert_eq!(t.get("ecoflex_00_30").unwrap().density_g_per_cm3, 1.07);
+        let ms = t.get("mold_star_30").unwrap();
+        assert_eq!(ms.density_g_per_cm3, 1.18);
+        assert_eq!(ms.mix.as_ref().unwrap().by, MixBasis::Volume);
+        for k in [
+            "ecoflex_00_50",
+            "ecoflex_00_10",
+            "solaris",
+            "solaris_thinner_40",
+            "ptg_501_black",
+        ] {
+            assert!(t.get(k).is_some(), "{k}");
+        }
+    }
+
+    #[test]
+    fn sylgard_pour_splits_ten_to_one() {
+        let t = MaterialsTable::embedded().unwrap();
+        let m = t.get("sylgard_184").unwrap();
+        // 10 mL with 20 % waste: 10 x 1.03 x 1.2 = 12.36 g, A = 11.236..., B = 1.1236...
+        let r = pour(1, "gel", "sylgard_184", m, vec![], 10_000.0, 0.2).unwrap();
+        assert!((r.total_mass_g - 12.36).abs() < 1e-9);
+        assert!((r.components[0].mass_g - 12.36 * 10.0 / 11.0).abs() < 1e-9);
+        assert!((r.components[1].mass_g - 12.36 / 11.0).abs() < 1e-9);
+        assert_eq!(r.mix_ratio, "10:1 by weight");
+    }
+
+    #[test]
+    fn uncastable_material_is_an_error() {
+        let t = MaterialsTable::embedded().unwrap();
+        let m = t.get("pla_black").unwrap();
+        assert!(pour(1, "x", "pla_black", m, vec![], 1.0, 0.1).is_err());
+    }
+}

@@ -1,0 +1,707 @@
+//! Molds for cast layers, in two strategies (R-Tac0 Sec. III-B1, Fig. 4):
+//!
+//! - `direct`: a printed block split on the parting plane y = 0 (through the axis), with
+//!   hemispherical registration keys, clamp bolt holes and a core holder that closes the open
+//!   end, keeps the core concentric and carries the sprue and vents.
+//! - `master`: a printed master pattern of the cavity and a drafted mold box, to cast a
+//!   Mold Star 30 silicone mold, plus the same core holder as casting jig.
+//!
+//! Both share the cavity: the offset surface of the layer's outermost sprayed coat (or of the
+//! layer itself) plus `cavity_clearance_mm`, opening on the base plane into a disc-shaped
+//! plinth recess. The core holder's spigot plugs into that recess (centring it) and leaves a
+//! reservoir ring between the spigot and the base plane. Casting is done pole-down, so the
+//! reservoir is the high point of the cavity: the sprue and the vents open into it.
+
+use crate::error::{DesignError, GeometryContext, ParamError};
+use crate::geometry::{cuboid, revolve, sphere, ChordTolerance, Polyline2, Solid};
+use crate::kit::{Part, PrintTechnology};
+use crate::schema::{Design, LayerProcess, MoldStrategy};
+use crate::stack::{ResolvedCore, Stack};
+use serde_json::json;
+
+/// Shoulder under the core's open end in the holder, mm.
+const SHOULDER_MM: f64 = 2.0;
+/// Radial margin of the holder flange beyond the plinth, mm.
+const FLANGE_MARGIN_MM: f64 = 3.0;
+/// Height of the master pattern's locating pin and its radius cap, mm.
+const LOCATING_PIN_HEIGHT_MM: f64 = 2.0;
+const LOCATING_PIN_RADIUS_MM: f64 = 3.0;
+/// Floor and wall of the mold box, mm.
+const BOX_FLOOR_MM: f64 = 2.0;
+const BOX_WALL_MM: f64 = 2.0;
+/// How far the box rim stands above the Mold Star fill level, mm.
+const BOX_FREEBOARD_MM: f64 = 2.0;
+
+/// Places a solid for printing: minimum z on the plate (z = 0), bounding box centred on x = y = 0.
+pub fn place_on_bed(s: &Solid) -> Solid {
+    match s.bounding_box() {
+        Some(b) => s.translate([
+            -(b.min[0] + b.max[0]) / 2.0,
+            -(b.min[1] + b.max[1]) / 2.0,
+            -b.min[2],
+        ]),
+        None => s.clone(),
+    }
+}
+
+/// One pour into a mold: which layer, the cavity surface, and the core under it.
+#[derive(Debug, Clone)]
+pub struct CastPlan {
+    /// Index of the cast layer.
+    pub layer: usize,
+    /// Sprayed layers coated into this mold before the pour (outermost first).
+    pub sprayed: Vec<usize>,
+    /// Offset of the cavity surface from the body surface, mm.
+    pub cavity_offset_mm: f64,
+    /// Offset of the surface the pour lands on (the layer's inner surface), mm.
+    pub core_offset_mm: f64,
+    pub strategy: MoldStrategy,
+}
+
+/// The pours of a design in casting order (inner layers first).
+pub fn cast_plans(design: &Design, stack: &Stack) -> Vec<CastPlan> {
+    let mut plans = Vec::new();
+    for (i, l) in stack.layers.iter().enumerate() {
+        if l.process != LayerProcess::Cast {
+            continue;
+        }
+        let mut sprayed = Vec::new();
+        let mut outer = l.outer_offset_mm;
+        for s in &stack.layers[i + 1..] {
+            if s.process != LayerProcess::Sprayed {
+                break;
+            }
+            sprayed.push(s.index);
+            outer = s.outer_offset_mm;
+        }
+        sprayed.reverse();
+        plans.push(CastPlan {
+            layer: i,
+            sprayed,
+            cavity_offset_mm: outer + design.mold.cavity_clearance_mm,
+            core_offset_mm: l.inner_offset_mm,
+            strategy: l.mold_strategy,
+        });
+    }
+    plans
+}
+
+/// Dimensions shared by the parts of one cast's mold, in the sensor frame, mm.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct MoldFrame {
+    pub base_z_mm: f64,
+    pub cavity_rim_radius_mm: f64,
+    pub cavity_pole_z_mm: f64,
+    pub plinth_radius_mm: f64,
+    /// Outer face of the plinth recess (the mold's open face), z.
+    pub open_face_z_mm: f64,
+    pub spigot_top_z_mm: f64,
+    pub core_outer_radius_mm: f64,
+    pub core_inner_radius_mm: f64,
+    pub core_end_z_mm: f64,
+}
+
+impl MoldFrame {
+    pub fn new(design: &Design, core: &ResolvedCore, cavity_offset_mm: f64) -> Self {
+        let b = &design.body;
+        let m = &design.mold;
+        let base_z = b.base_z_mm();
+        let rim = b.rim_radius_mm(cavity_offset_mm);
+        Self {
+            base_z_mm: base_z,
+            cavity_rim_radius_mm: rim,
+            cavity_pole_z_mm: b.pole_z_mm(cavity_offset_mm),
+            plinth_radius_mm: rim + m.plinth.margin_mm,
+            open_face_z_mm: base_z - m.plinth.height_mm,
+            spigot_top_z_mm: base_z - m.plinth.reservoir_depth_mm,
+            core_outer_radius_mm: b.rim_radius_mm(core.outer_offset_mm),
+            core_inner_radius_mm: b.rim_radius_mm(core.inner_offset_mm),
+            core_end_z_mm: base_z - core.below_base_mm,
+        }
+    }
+
+    /// Top of the centring pin: it must stay where the core's bore is still straight.
+    fn pin_top_z_mm(&self, design: &Design) -> f64 {
+        let straight_top = match design.body {
+            crate::profile::BodyProfile::HemisphereOnCylinder {
+                cylinder_length_mm, ..
+            } => self.base_z_mm + cylinder_length_mm,
+            _ => self.base_z_mm,
+        };
+        (self.core_end_z_mm + design.mold.core_holder.pin_length_mm).min(straight_top - 0.5)
+    }
+
+    /// Radial position of the sprue axis: centred in the room between the core groove and
+    /// the spigot edge.
+    fn sprue_radius_mm(&self, design: &Design) -> f64 {
+        let ch = &design.mold.core_holder;
+        let lo = self.core_outer_radius_mm + ch.fit_clearance_mm + ch.min_wall_mm;
+        let hi = self.plinth_radius_mm - ch.fit_clearance_mm - ch.min_wall_mm;
+        0.5 * (lo + hi)
+    }
+}
+
+/// Rules on mold parameters alone (sizes, printability).
+pub fn check_mold_params(design: &Design, errs: &mut Vec<ParamError>) {
+    let m = &design.mold;
+    let fix = design.printers.get(m.fixture_print_technology);
+    let cav = design.printers.get(m.cavity_print_technology);
+    let fixture = format!("{:?}", m.fixture_print_technology).to_lowercase();
+    let cavity = format!("{:?}", m.cavity_print_technology).to_lowercase();
+    let mut pos = |path: &str, v: f64| {
+        if !(v > 0.0 && v.is_finite()) {
+            errs.push(ParamError::new(path, v, "must be above 0"));
+            false
+        } else {
+            true
+        }
+    };
+    let checks = [
+        ("mold.wall_thickness_mm", m.wall_thickness_mm),
+        ("mold.flange_width_mm", m.flange_width_mm),
+        ("mold.plinth.margin_mm", m.plinth.margin_mm),
+        ("mold.plinth.height_mm", m.plinth.height_mm),
+        (
+            "mold.plinth.reservoir_depth_mm",
+            m.plinth.reservoir_depth_mm,
+        ),
+        (
+            "mold.registration_key.diameter_mm",
+            m.registration_key.diameter_mm,
+        ),
+        (
+            "mold.clamp_bolt.clearance_diameter_mm",
+            m.clamp_bolt.clearance_diameter_mm,
+        ),
+        ("mold.sprue.diameter_mm", m.sprue.diameter_mm),
+        ("mold.vent.diameter_mm", m.vent.diameter_mm),
+        (
+            "mold.core_holder.flange_thickness_mm",
+            m.core_holder.flange_thickness_mm,
+        ),
+        (
+            "mold.core_holder.pin_length_mm",
+            m.core_holder.pin_length_mm,
+        ),
+        ("mold.core_holder.min_wall_mm", m.core_holder.min_wall_mm),
+        ("mold.silicone_wall_mm", m.silicone_wall_mm),
+    ];
+    let all_positive = checks.iter().fold(true, |ok, (p, v)| pos(p, *v) && ok);
+    for (p, v) in [
+        ("mold.cavity_clearance_mm", m.cavity_clearance_mm),
+        (
+            "mold.registration_key.clearance_mm",
+            m.registration_key.clearance_mm,
+        ),
+        (
+            "mold.core_holder.fit_clearance_mm",
+            m.core_holder.fit_clearance_mm,
+        ),
+    ] {
+        if !(v >= 0.0 && v.is_finite()) {
+            errs.push(ParamError::new(p, v, "must be 0 or more"));
+        }
+    }
+    if !(0.0..10.0).contains(&m.draft_angle_deg) {
+        errs.push(ParamError::new(
+            "mold.draft_angle_deg",
+            m.draft_angle_deg,
+            "must be in [0, 10)",
+        ));
+    }
+    if !all_positive {
+        return;
+    }
+    if m.plinth.reservoir_depth_mm >= m.plinth.height_mm {
+        errs.push(ParamError::new(
+            "mold.plinth.reservoir_depth_mm",
+            m.plinth.reservoir_depth_mm,
+            format!(
+                "must be below mold.plinth.height_mm ({}) so the spigot can centre the holder",
+                m.plinth.height_mm
+            ),
+        ));
+    }
+    // Printability: every feature against the profile of the part that carries it.
+    let below =
+        |errs: &mut Vec<ParamError>, path: &str, v: f64, min: f64, what: &str, profile: &str| {
+            if v < min {
+                errs.push(ParamError::new(
+                    path,
+                    v,
+                    format!("below the {what} {min} mm of printer profile '{profile}'"),
+                ));
+            }
+        };
+    below(
+        errs,
+        "mold.sprue.diameter_mm",
+        m.sprue.diameter_mm,
+        fix.min_hole_diameter_mm,
+        "minimum hole",
+        &fixture,
+    );
+    below(
+        errs,
+        "mold.vent.diameter_mm",
+        m.vent.diameter_mm,
+        fix.min_hole_diameter_mm,
+        "minimum hole",
+        &fixture,
+    );
+    below(
+        errs,
+        "mold.core_holder.min_wall_mm",
+        m.core_holder.min_wall_mm,
+        fix.min_wall_mm,
+        "minimum wall",
+        &fixture,
+    );
+    below(
+        errs,
+        "mold.registration_key.diameter_mm",
+        m.registration_key.diameter_mm,
+        cav.min_feature_mm,
+        "minimum feature",
+        &cavity,
+    );
+    below(
+        errs,
+        "mold.clamp_bolt.clearance_diameter_mm",
+        m.clamp_bolt.clearance_diameter_mm,
+        cav.min_hole_diameter_mm,
+        "minimum hole",
+        &cavity,
+    );
+    below(
+        errs,
+        "mold.wall_thickness_mm",
+        m.wall_thickness_mm,
+        cav.min_wall_mm,
+        "minimum wall",
+        &cavity,
+    );
+    if m.registration_key.diameter_mm
+        + 2.0 * m.registration_key.clearance_mm
+        + 2.0 * cav.min_wall_mm
+        > m.flange_width_mm
+        || m.clamp_bolt.clearance_diameter_mm + 2.0 * cav.min_wall_mm > m.flange_width_mm
+    {
+        errs.push(ParamError::new(
+            "mold.flange_width_mm",
+            m.flange_width_mm,
+            "too narrow for the registration keys and clamp bolts with the printer's minimum wall around them",
+        ));
+    }
+}
+
+/// Rules that need the resolved core: does the holder fit between the core and the plinth.
+/// `first_cavity_offset_mm` is the cavity of the innermost cast, the tightest one.
+pub fn check_mold_fit(
+    design: &Design,
+    core: &ResolvedCore,
+    first_cavity_offset_mm: f64,
+    errs: &mut Vec<ParamError>,
+) {
+    let m = &design.mold;
+    let ch = &m.core_holder;
+    let f = MoldFrame::new(design, core, first_cavity_offset_mm + m.cavity_clearance_mm);
+    let room = f.plinth_radius_mm
+        - f.core_outer_radius_mm
+        - 2.0 * ch.fit_clearance_mm
+        - 2.0 * ch.min_wall_mm;
+    if m.sprue.diameter_mm > room {
+        errs.push(ParamError::new(
+            "mold.sprue.diameter_mm",
+            m.sprue.diameter_mm,
+            format!(
+                "does not fit between the core groove and the spigot edge of the core holder ({room:.2} mm of room); enlarge mold.plinth.margin_mm"
+            ),
+        ));
+    }
+    if m.vent.diameter_mm > room {
+        errs.push(ParamError::new(
+            "mold.vent.diameter_mm",
+            m.vent.diameter_mm,
+            format!("does not fit in the holder ({room:.2} mm of room)"),
+        ));
+    }
+    if f.core_end_z_mm > f.spigot_top_z_mm - 1.0 {
+        errs.push(ParamError::new(
+            "core.length_mm",
+            design.core.length_mm,
+            format!(
+                "the core must reach at least {:.3} mm below the base plane so the holder can seat it (1 mm below the spigot top)",
+                f.base_z_mm - (f.spigot_top_z_mm - 1.0)
+            ),
+        ));
+    }
+    if f.core_inner_radius_mm - ch.fit_clearance_mm
+        < design
+            .printers
+            .get(m.fixture_print_technology)
+            .min_feature_mm
+            / 2.0
+    {
+        errs.push(ParamError::new(
+            "core.wall_thickness_mm",
+            design.core.wall_thickness_mm,
+            "leaves no room for the holder's centring pin inside the core",
+        ));
+    }
+    if f.pin_top_z_mm(design) - f.core_end_z_mm < 1.0 {
+        errs.push(ParamError::new(
+            "mold.core_holder.pin_length_mm",
+            ch.pin_length_mm,
+            "the centring pin would be shorter than 1 mm inside the core's straight bore",
+        ));
+    }
+}
+
+/// The cavity solid with its plinth recess, and optionally the master pattern's locating pin,
+/// as one revolve.
+fn cavity_profile(
+    design: &Design,
+    f: &MoldFrame,
+    offset: f64,
+    with_pin: bool,
+    tol: ChordTolerance,
+) -> Polyline2 {
+    let mut pl = design.body.offset_polyline(offset, 0.0, tol.half());
+    pl.push([f.plinth_radius_mm, f.base_z_mm]);
+    pl.push([f.plinth_radius_mm, f.open_face_z_mm]);
+    if with_pin {
+        let r = LOCATING_PIN_RADIUS_MM.min(f.plinth_radius_mm / 3.0);
+        pl.push([r, f.open_face_z_mm]);
+        pl.push([r, f.open_face_z_mm - LOCATING_PIN_HEIGHT_MM]);
+        pl.push([0.0, f.open_face_z_mm - LOCATING_PIN_HEIGHT_MM]);
+    } else {
+        pl.push([0.0, f.open_face_z_mm]);
+    }
+    pl
+}
+
+/// The core holder / casting jig in the sensor frame (assembled position).
+fn core_holder(design: &Design, f: &MoldFrame, tol: ChordTolerance) -> Result<Solid, DesignError> {
+    let m = &design.mold;
+    let ch = &m.core_holder;
+    let fit = ch.fit_clearance_mm;
+    let r_f = f.plinth_radius_mm + FLANGE_MARGIN_MM;
+    let z_f0 = f.open_face_z_mm - ch.flange_thickness_mm;
+    let r_boss = f.core_outer_radius_mm + fit + ch.min_wall_mm;
+    let z_bottom = z_f0.min(f.core_end_z_mm - SHOULDER_MM);
+    let mut pl = Polyline2::default();
+    pl.push([0.0, z_bottom]);
+    if z_bottom < z_f0 {
+        pl.push([r_boss, z_bottom]);
+        pl.push([r_boss, z_f0]);
+    }
+    for p in [
+        [r_f, z_f0],
+        [r_f, f.open_face_z_mm],
+        [f.plinth_radius_mm - fit, f.open_face_z_mm],
+        [f.plinth_radius_mm - fit, f.spigot_top_z_mm],
+        [f.core_outer_radius_mm + fit, f.spigot_top_z_mm],
+        [f.core_outer_radius_mm + fit, f.core_end_z_mm],
+        [f.core_inner_radius_mm - fit, f.core_end_z_mm],
+        [f.core_inner_radius_mm - fit, f.pin_top_z_mm(design)],
+        [0.0, f.pin_top_z_mm(design)],
+    ] {
+        pl.push(p);
+    }
+    let body = Solid::from_mesh(&revolve(&pl, tol).part("core holder")?).part("core holder")?;
+    // Sprue at azimuth 0, vents spread over the rest of the circle.
+    let z0 = z_bottom - 1.0;
+    let h = f.spigot_top_z_mm + 1.0 - z0;
+    let mut holes = vec![crate::geometry::cylinder(h, m.sprue.diameter_mm / 2.0, tol)
+        .part("sprue")?
+        .translate([f.sprue_radius_mm(design), 0.0, z0])];
+    let r_v = f.plinth_radius_mm - fit - ch.min_wall_mm - m.vent.diameter_mm / 2.0;
+    for k in 1..=m.vent.count {
+        let a = 2.0 * std::f64::consts::PI * k as f64 / (m.vent.count + 1) as f64;
+        holes.push(
+            crate::geometry::cylinder(h, m.vent.diameter_mm / 2.0, tol)
+                .part("vent")?
+                .translate([r_v * a.cos(), r_v * a.sin(), z0]),
+        );
+    }
+    body.difference(&Solid::compose(&holes)).part("core holder")
+}
+
+fn holder_params(design: &Design, f: &MoldFrame) -> serde_json::Value {
+    let m = &design.mold;
+    json!({
+        "frame": f,
+        "fit_clearance_mm": m.core_holder.fit_clearance_mm,
+        "flange_thickness_mm": m.core_holder.flange_thickness_mm,
+        "flange_radius_mm": f.plinth_radius_mm + FLANGE_MARGIN_MM,
+        "pin_top_z_mm": f.pin_top_z_mm(design),
+        "sprue": {"diameter_mm": m.sprue.diameter_mm, "radius_mm": f.sprue_radius_mm(design), "azimuth_deg": 0.0},
+        "vent": {"diameter_mm": m.vent.diameter_mm, "count": m.vent.count},
+        "print_orientation": "sensor frame, translated so the flange (or boss) rests on z = 0",
+    })
+}
+
+/// What the mold builder returns for one cast.
+pub struct MoldOutput {
+    pub parts: Vec<Part>,
+    /// Volume the gel pour fills (cavity and reservoir minus core and holder), mm^3.
+    pub pour_volume_mm3: f64,
+    /// For the master strategy: (silicone mold volume mm^3, parts that hold the pour).
+    pub silicone_pour: Option<(f64, Vec<String>)>,
+    /// Names of the parts that hold the gel pour.
+    pub pour_parts: Vec<String>,
+}
+
+/// Builds the mold parts of one cast.
+///
+/// # Errors
+/// [`DesignError::Geometry`] if the kernel fails.
+pub fn build_mold(
+    design: &Design,
+    stack: &Stack,
+    plan: &CastPlan,
+    tol: ChordTolerance,
+) -> Result<MoldOutput, DesignError> {
+    let layer = &stack.layers[plan.layer];
+    let f = MoldFrame::new(design, &stack.core, plan.cavity_offset_mm);
+    let m = &design.mold;
+    let name = &layer.name;
+    let cavity_tech: PrintTechnology = m.cavity_print_technology.into();
+    let fixture_tech: PrintTechnology = m.fixture_print_technology.into();
+    let cavity_material = material_for(cavity_tech);
+    let fixture_material = material_for(fixture_tech);
+
+    let cavity = Solid::from_mesh(
+        &revolve(
+            &cavity_profile(design, &f, plan.cavity_offset_mm, false, tol),
+            tol,
+        )
+        .part(name)?,
+    )
+    .part(name)?;
+    let holder = core_holder(design, &f, tol)?;
+    // The pour fills the cavity, minus what is inside it (core and inner layers), minus the holder.
+    // What the pour lands on: the layers under it down to the base plane, and below it the
+    // core alone (its bore is closed by the holder's pin, so it counts as solid).
+    let mut inner_pl = design
+        .body
+        .offset_polyline(plan.core_offset_mm, 0.0, tol.half());
+    inner_pl.push([f.core_outer_radius_mm, f.base_z_mm]);
+    inner_pl.push([f.core_outer_radius_mm, f.core_end_z_mm]);
+    inner_pl.push([0.0, f.core_end_z_mm]);
+    let inner = Solid::from_mesh(&revolve(&inner_pl, tol).part(name)?).part(name)?;
+    let void = cavity
+        .difference(&holder.union(&inner).part(name)?)
+        .part(name)?;
+    let sprayed_volume: f64 = plan
+        .sprayed
+        .iter()
+        .map(|&i| stack.layer_solid(design, i, tol).map(|s| s.volume()))
+        .sum::<Result<f64, _>>()
+        .part(name)?;
+    let pour_volume = void.volume() - sprayed_volume;
+
+    let common = json!({
+        "layer": name,
+        "strategy": plan.strategy,
+        "cavity_offset_mm": plan.cavity_offset_mm,
+        "core_offset_mm": plan.core_offset_mm,
+        "body": design.body,
+        "frame": f,
+        "plinth": m.plinth,
+    });
+    let holder_name = match plan.strategy {
+        MoldStrategy::Direct => format!("{name}_core_holder"),
+        MoldStrategy::Master => format!("{name}_casting_jig"),
+    };
+    let holder_part = Part {
+        name: holder_name.clone(),
+        role: match plan.strategy {
+            MoldStrategy::Direct => "core_holder".into(),
+            MoldStrategy::Master => "casting_jig".into(),
+        },
+        description: format!(
+            "Closes the {name} mold, centres the core on its bore and carries the sprue and {} vents",
+            m.vent.count
+        ),
+        material: fixture_material.into(),
+        print_technology: fixture_tech,
+        solid: place_on_bed(&holder),
+        params: holder_params(design, &f),
+    };
+
+    match plan.strategy {
+        MoldStrategy::Direct => {
+            let (a, b) = direct_halves(design, &f, &cavity, tol).part(name)?;
+            let mut params = common.clone();
+            params["direct"] = json!({
+                "parting_plane": "y = 0 (through the sensor axis)",
+                "pull_direction": "+y for half a, -y for half b",
+                "half_width_mm": f.plinth_radius_mm + m.flange_width_mm,
+                "z_min_mm": f.open_face_z_mm,
+                "z_max_mm": f.cavity_pole_z_mm + m.wall_thickness_mm,
+                "registration_key": m.registration_key,
+                "clamp_bolt": m.clamp_bolt,
+                "feature_x_mm": f.plinth_radius_mm + m.flange_width_mm / 2.0,
+                "print_orientation": "parting face up",
+            });
+            let half = |s: Solid, tag: &str, keys: &str| Part {
+                name: format!("{name}_mold_half_{tag}"),
+                role: "mold_half".into(),
+                description: format!(
+                    "Two-piece mold for the {name} layer, half {tag} ({keys} registration keys)"
+                ),
+                material: cavity_material.into(),
+                print_technology: cavity_tech,
+                solid: s,
+                params: params.clone(),
+            };
+            let parts = vec![half(a, "a", "male"), half(b, "b", "female"), holder_part];
+            let pour_parts = parts.iter().map(|p| p.name.clone()).collect();
+            Ok(MoldOutput {
+                parts,
+                pour_volume_mm3: pour_volume,
+                silicone_pour: None,
+                pour_parts,
+            })
+        }
+        MoldStrategy::Master => {
+            let master = Solid::from_mesh(
+                &revolve(
+                    &cavity_profile(design, &f, plan.cavity_offset_mm, true, tol),
+                    tol,
+                )
+                .part(name)?,
+            )
+            .part(name)?;
+            let (mold_box, fill) = master_box(design, &f, tol).part(name)?;
+            let silicone = fill.difference(&master).part(name)?.volume();
+            let mut params = common.clone();
+            params["master"] = json!({
+                "silicone_wall_mm": m.silicone_wall_mm,
+                "draft_angle_deg": m.draft_angle_deg,
+                "locating_pin": {"radius_mm": LOCATING_PIN_RADIUS_MM.min(f.plinth_radius_mm / 3.0), "height_mm": LOCATING_PIN_HEIGHT_MM},
+                "box_floor_mm": BOX_FLOOR_MM, "box_wall_mm": BOX_WALL_MM,
+                "fill_z_mm": f.cavity_pole_z_mm + m.silicone_wall_mm,
+            });
+            let master_name = format!("{name}_master_pattern");
+            let box_name = format!("{name}_mold_box");
+            let parts = vec![
+                Part {
+                    name: master_name.clone(),
+                    role: "master_pattern".into(),
+                    description: format!("Positive of the {name} cavity with its plinth, to cast a Mold Star 30 mold"),
+                    material: cavity_material.into(),
+                    print_technology: cavity_tech,
+                    solid: place_on_bed(&master),
+                    params: params.clone(),
+                },
+                Part {
+                    name: box_name.clone(),
+                    role: "mold_box".into(),
+                    description: format!("Drafted cup that holds the {name} master pattern while Mold Star 30 cures"),
+                    material: fixture_material.into(),
+                    print_technology: fixture_tech,
+                    solid: place_on_bed(&mold_box),
+                    params,
+                },
+                holder_part,
+            ];
+            Ok(MoldOutput {
+                parts,
+                pour_volume_mm3: pour_volume,
+                silicone_pour: Some((silicone, vec![master_name, box_name])),
+                pour_parts: vec![format!("silicone_mold:{name}"), holder_name],
+            })
+        }
+    }
+}
+
+fn material_for(t: PrintTechnology) -> &'static str {
+    match t {
+        PrintTechnology::Fdm => "pla",
+        PrintTechnology::Sla => "sla_standard_resin",
+    }
+}
+
+/// The two halves of a direct mold, each in print orientation (parting face up).
+fn direct_halves(
+    design: &Design,
+    f: &MoldFrame,
+    cavity: &Solid,
+    tol: ChordTolerance,
+) -> Result<(Solid, Solid), crate::geometry::GeometryError> {
+    let m = &design.mold;
+    let b = f.plinth_radius_mm + m.flange_width_mm;
+    let z_lo = f.open_face_z_mm;
+    let z_hi = f.cavity_pole_z_mm + m.wall_thickness_mm;
+    let block = cuboid([-b, -b, z_lo], [b, b, z_hi])?.difference(cavity)?;
+    let (pos, neg) = block.split_by_plane([0.0, 1.0, 0.0], 0.0);
+    let x_f = f.plinth_radius_mm + m.flange_width_mm / 2.0;
+    let e = m.flange_width_mm / 2.0;
+    let z_mid = 0.5 * (z_lo + z_hi);
+    let r_key = m.registration_key.diameter_mm / 2.0;
+    let key_at = |r: f64| -> Result<Vec<Solid>, crate::geometry::GeometryError> {
+        let s = sphere(r, tol)?;
+        Ok(vec![
+            s.translate([x_f, 0.0, z_mid]),
+            s.translate([-x_f, 0.0, z_mid]),
+        ])
+    };
+    let bolt =
+        crate::geometry::cylinder(2.0 * b + 2.0, m.clamp_bolt.clearance_diameter_mm / 2.0, tol)?
+            .rotate_deg(-90.0, 0.0, 0.0);
+    let mut bolts = Vec::new();
+    for x in [x_f, -x_f] {
+        for z in [z_lo + e, z_hi - e] {
+            bolts.push(bolt.translate([x, -b - 1.0, z]));
+        }
+    }
+    let bolts = Solid::compose(&bolts);
+    let a = pos
+        .union(&Solid::compose(&key_at(r_key)?))?
+        .difference(&bolts)?;
+    let bh = neg
+        .difference(&Solid::compose(&key_at(
+            r_key + m.registration_key.clearance_mm,
+        )?))?
+        .difference(&bolts)?;
+    Ok((
+        place_on_bed(&a.rotate_deg(-90.0, 0.0, 0.0)),
+        place_on_bed(&bh.rotate_deg(90.0, 0.0, 0.0)),
+    ))
+}
+
+/// The mold box (sensor frame) and the solid the Mold Star fills up to its fill level.
+fn master_box(
+    design: &Design,
+    f: &MoldFrame,
+    tol: ChordTolerance,
+) -> Result<(Solid, Solid), crate::geometry::GeometryError> {
+    let m = &design.mold;
+    let z0 = f.open_face_z_mm;
+    let z_fill = f.cavity_pole_z_mm + m.silicone_wall_mm;
+    let z_top = z_fill + BOX_FREEBOARD_MM;
+    let r0 = f.plinth_radius_mm + m.silicone_wall_mm;
+    let slope = m.draft_angle_deg.to_radians().tan();
+    let r_at = |z: f64| r0 + slope * (z - z0);
+    let r_out = r_at(z_top) + BOX_WALL_MM;
+    let outer = crate::geometry::cylinder(z_top - (z0 - BOX_FLOOR_MM), r_out, tol)?.translate([
+        0.0,
+        0.0,
+        z0 - BOX_FLOOR_MM,
+    ]);
+    let inner = crate::geometry::cone(z_top + 1.0 - z0, r0, r_at(z_top + 1.0), tol)?
+        .translate([0.0, 0.0, z0]);
+    let pin_r =
+        LOCATING_PIN_RADIUS_MM.min(f.plinth_radius_mm / 3.0) + m.core_holder.fit_clearance_mm;
+    let socket = crate::geometry::cylinder(BOX_FLOOR_MM + 2.0, pin_r, tol)?.translate([
+        0.0,
+        0.0,
+        z0 - BOX_FLOOR_MM - 1.0,
+    ]);
+    let cup = outer.difference(&inner.union(&socket)?)?;
+    let fill = crate::geometry::cone(z_fill - z0, r0, r_at(z_fill), tol)?.translate([0.0, 0.0, z0]);
+    Ok((cup, fill))
+}

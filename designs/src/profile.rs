@@ -1,0 +1,379 @@
+//! Sensor body profiles: the outer surface of the sensor skin as a 2D curve in the (r, z)
+//! half-plane, revolved about the sensor axis z. Layers are true offsets of this curve along
+//! its normal (an ellipse's offset is not an ellipse).
+//!
+//! Frame (docs/conventions.md): z is the sensor axis, pointing out through the pole of the
+//! skin; the origin is the centre of curvature of the tip (sphere centre, or ellipsoid centre);
+//! the skin ends on the base plane z = `base_z_mm()`.
+
+use crate::geometry::profile2d::{push_arc, push_curve};
+use crate::geometry::{ChordTolerance, Polyline2};
+use serde::{Deserialize, Serialize};
+use std::f64::consts::FRAC_PI_2;
+
+/// The outer surface of a sensor skin.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "profile", rename_all = "snake_case", deny_unknown_fields)]
+pub enum BodyProfile {
+    /// A spherical cap: base circle of `base_diameter_mm` on the base plane, pole
+    /// `height_mm` above it (ShadowTac skin: 35 mm x 8 mm, ShadowTac Sec. III).
+    SphericalCap {
+        base_diameter_mm: f64,
+        height_mm: f64,
+    },
+    /// A hemisphere of `radius_mm` on a cylinder of the same radius and
+    /// `cylinder_length_mm` (the test-tube shape of R-Tac0, Sec. III-B1).
+    HemisphereOnCylinder {
+        radius_mm: f64,
+        cylinder_length_mm: f64,
+    },
+    /// Half an ellipsoid of revolution: `diameter_mm` across the base, `height_mm` from the
+    /// base plane to the pole (UVDtact, Sec. III).
+    HalfEllipsoid { diameter_mm: f64, height_mm: f64 },
+}
+
+impl BodyProfile {
+    /// Short name, as in the YAML `profile` tag.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Self::SphericalCap { .. } => "spherical_cap",
+            Self::HemisphereOnCylinder { .. } => "hemisphere_on_cylinder",
+            Self::HalfEllipsoid { .. } => "half_ellipsoid",
+        }
+    }
+
+    /// Every parameter violation as (path, value, rule).
+    pub fn violations(&self) -> Vec<(String, f64, String)> {
+        let mut v = Vec::new();
+        let mut pos = |name: &str, x: f64| {
+            if !(x > 0.0 && x.is_finite()) {
+                v.push((format!("body.{name}"), x, "must be above 0".to_string()));
+            }
+        };
+        match *self {
+            Self::SphericalCap {
+                base_diameter_mm,
+                height_mm,
+            } => {
+                pos("base_diameter_mm", base_diameter_mm);
+                pos("height_mm", height_mm);
+                if height_mm > base_diameter_mm / 2.0 {
+                    v.push((
+                        "body.height_mm".into(),
+                        height_mm,
+                        format!(
+                            "must not exceed half the base diameter ({} mm): a taller cap is not a cap",
+                            base_diameter_mm / 2.0
+                        ),
+                    ));
+                }
+            }
+            Self::HemisphereOnCylinder {
+                radius_mm,
+                cylinder_length_mm,
+            } => {
+                pos("radius_mm", radius_mm);
+                if !(cylinder_length_mm >= 0.0 && cylinder_length_mm.is_finite()) {
+                    v.push((
+                        "body.cylinder_length_mm".into(),
+                        cylinder_length_mm,
+                        "must be 0 or more".into(),
+                    ));
+                }
+            }
+            Self::HalfEllipsoid {
+                diameter_mm,
+                height_mm,
+            } => {
+                pos("diameter_mm", diameter_mm);
+                pos("height_mm", height_mm);
+            }
+        }
+        v
+    }
+
+    /// Whether the profile is a sphere (offsets are spheres, radii make sense).
+    pub fn sphere_radius_mm(&self) -> Option<f64> {
+        match *self {
+            Self::SphericalCap { .. } => Some(self.cap_sphere().0),
+            Self::HemisphereOnCylinder { radius_mm, .. } => Some(radius_mm),
+            Self::HalfEllipsoid { .. } => None,
+        }
+    }
+
+    /// (sphere radius, z of the base plane) of a spherical cap, origin at the sphere centre.
+    fn cap_sphere(&self) -> (f64, f64) {
+        match *self {
+            Self::SphericalCap {
+                base_diameter_mm,
+                height_mm,
+            } => {
+                let b = base_diameter_mm / 2.0;
+                let r = (b * b + height_mm * height_mm) / (2.0 * height_mm);
+                (r, r - height_mm)
+            }
+            _ => unreachable!("cap_sphere on a non-cap profile"),
+        }
+    }
+
+    /// z of the base plane, mm, in the sensor frame.
+    pub fn base_z_mm(&self) -> f64 {
+        match *self {
+            Self::SphericalCap { .. } => self.cap_sphere().1,
+            Self::HemisphereOnCylinder {
+                cylinder_length_mm, ..
+            } => -cylinder_length_mm,
+            Self::HalfEllipsoid { .. } => 0.0,
+        }
+    }
+
+    /// Smallest radius of curvature of the profile curve, mm. An inward offset must stay
+    /// below it or the offset curve folds over itself.
+    pub fn min_curvature_radius_mm(&self) -> f64 {
+        match *self {
+            Self::SphericalCap { .. } => self.cap_sphere().0,
+            Self::HemisphereOnCylinder { radius_mm, .. } => radius_mm,
+            Self::HalfEllipsoid {
+                diameter_mm,
+                height_mm,
+            } => {
+                let (a, c) = (diameter_mm / 2.0, height_mm);
+                (a * a / c).min(c * c / a)
+            }
+        }
+    }
+
+    /// The offset curve at signed normal distance `d` (negative inward), as a function of a
+    /// parameter t in [0, 1] from the pole (r = 0) to the rim on the base plane.
+    pub fn offset_point(&self, d: f64, t: f64) -> [f64; 2] {
+        match *self {
+            Self::HalfEllipsoid {
+                diameter_mm,
+                height_mm,
+            } => {
+                let (a, c) = (diameter_mm / 2.0, height_mm);
+                let th = FRAC_PI_2 * (1.0 - t);
+                let (s, co) = th.sin_cos();
+                let n = [c * co, a * s];
+                let nl = (n[0] * n[0] + n[1] * n[1]).sqrt();
+                let r = a * co + d * n[0] / nl;
+                [if t == 0.0 { 0.0 } else { r }, c * s + d * n[1] / nl]
+            }
+            _ => {
+                let (rho, a_end) = self.sphere_arc(d);
+                let a = FRAC_PI_2 + (a_end - FRAC_PI_2) * t;
+                [if t == 0.0 { 0.0 } else { rho * a.cos() }, rho * a.sin()]
+            }
+        }
+    }
+
+    /// (radius, end angle from +r axis) of the offset arc of a spherical profile.
+    fn sphere_arc(&self, d: f64) -> (f64, f64) {
+        match *self {
+            Self::HemisphereOnCylinder { radius_mm, .. } => (radius_mm + d, 0.0),
+            Self::SphericalCap { .. } => {
+                let (r, zb) = self.cap_sphere();
+                let rho = r + d;
+                (rho, (zb / rho).clamp(-1.0, 1.0).asin())
+            }
+            Self::HalfEllipsoid { .. } => unreachable!(),
+        }
+    }
+
+    /// Pole height (z of the point on the axis) of the offset surface at distance `d`.
+    pub fn pole_z_mm(&self, d: f64) -> f64 {
+        self.offset_point(d, 0.0)[1]
+    }
+
+    /// Radius where the offset surface meets the base plane, mm.
+    pub fn rim_radius_mm(&self, d: f64) -> f64 {
+        match *self {
+            Self::HemisphereOnCylinder { radius_mm, .. } => radius_mm + d,
+            Self::SphericalCap { .. } => {
+                let (r, zb) = self.cap_sphere();
+                ((r + d).powi(2) - zb * zb).max(0.0).sqrt()
+            }
+            Self::HalfEllipsoid { .. } => self.offset_point(d, 1.0)[0],
+        }
+    }
+
+    /// Whether the offset surface at `d` is a valid surface: it keeps a positive rim radius and
+    /// the pole above the base plane, and does not fold (d > -min curvature radius).
+    pub fn offset_is_valid(&self, d: f64) -> bool {
+        d > -self.min_curvature_radius_mm()
+            && self.rim_radius_mm(d) > 0.0
+            && self.pole_z_mm(d) > self.base_z_mm()
+    }
+
+    /// The offset curve at `d` from the pole to the rim, tessellated within `tol`, followed (for
+    /// the hemisphere on cylinder) by the cylinder down to the base plane, then straight down
+    /// by `below_base_mm`. Points run from the pole (r = 0) to the bottom of the rim.
+    pub fn offset_polyline(&self, d: f64, below_base_mm: f64, tol: ChordTolerance) -> Polyline2 {
+        let mut pl = Polyline2::default();
+        match *self {
+            Self::HalfEllipsoid { .. } => {
+                push_curve(&mut pl, &|t| self.offset_point(d, t), 0.0, 1.0, tol);
+            }
+            _ => {
+                let (rho, a_end) = self.sphere_arc(d);
+                push_arc(&mut pl, [0.0, 0.0], rho, FRAC_PI_2, a_end, tol);
+            }
+        }
+        let zb = self.base_z_mm();
+        let rim = self.rim_radius_mm(d);
+        if let Some(last) = pl.points.last_mut() {
+            // The arc or curve ends on the base plane exactly (or at the equator, z = 0, for the
+            // hemisphere on cylinder, which continues down the cylinder).
+            if !matches!(self, Self::HemisphereOnCylinder { .. }) {
+                *last = [rim, zb];
+            }
+        }
+        pl.push([rim, zb]);
+        if below_base_mm > 0.0 {
+            pl.push([rim, zb - below_base_mm]);
+        }
+        pl
+    }
+
+    /// The closed profile of the solid bounded by the offset surface at `d` and the plane
+    /// `below_base_mm` under the base plane.
+    pub fn solid_profile(&self, d: f64, below_base_mm: f64, tol: ChordTolerance) -> Polyline2 {
+        let mut pl = self.offset_polyline(d, below_base_mm, tol);
+        pl.push([0.0, self.base_z_mm() - below_base_mm]);
+        pl
+    }
+
+    /// The closed profile of the shell between the offset surfaces at `d_in` < `d_out`,
+    /// closed by the plane `below_base_mm` under the base plane.
+    pub fn shell_profile(
+        &self,
+        d_in: f64,
+        d_out: f64,
+        below_base_mm: f64,
+        tol: ChordTolerance,
+    ) -> Polyline2 {
+        let mut pl = self.offset_polyline(d_out, below_base_mm, tol);
+        pl.extend(&self.offset_polyline(d_in, below_base_mm, tol).reversed());
+        pl
+    }
+
+    /// Enclosed volume of the solid at offset `d` with `below_base_mm`, mm^3, from the exact
+    /// curve (closed form for spheres, 2000-point Gauss-Legendre for ellipse offsets).
+    pub fn analytic_solid_volume_mm3(&self, d: f64, below_base_mm: f64) -> f64 {
+        use std::f64::consts::PI;
+        let rim = self.rim_radius_mm(d);
+        let ext = PI * rim * rim * below_base_mm;
+        match *self {
+            Self::HemisphereOnCylinder {
+                radius_mm,
+                cylinder_length_mm,
+            } => {
+                let r = radius_mm + d;
+                2.0 / 3.0 * PI * r.powi(3) + PI * r * r * cylinder_length_mm + ext
+            }
+            Self::SphericalCap { .. } => {
+                let (r, zb) = self.cap_sphere();
+                let h = r + d - zb;
+                PI * h * h * (3.0 * (r + d) - h) / 3.0 + ext
+            }
+            Self::HalfEllipsoid { .. } => {
+                // V = integral of pi r^2 dz along the curve (z decreasing from pole to rim).
+                let n = 2000;
+                let mut v = 0.0;
+                for i in 0..n {
+                    let (t0, t1) = (i as f64 / n as f64, (i + 1) as f64 / n as f64);
+                    // 3-point Gauss on each panel
+                    let g = [
+                        (-0.774_596_669_241_483_4, 5.0 / 9.0),
+                        (0.0, 8.0 / 9.0),
+                        (0.774_596_669_241_483_4, 5.0 / 9.0),
+                    ];
+                    for (x, w) in g {
+                        let t = 0.5 * (t0 + t1) + 0.5 * (t1 - t0) * x;
+                        let h = 1e-6;
+                        let p = self.offset_point(d, t);
+                        let pa = self.offset_point(d, (t - h).max(0.0));
+                        let pb = self.offset_point(d, (t + h).min(1.0));
+                        let dz = (pb[1] - pa[1]) / ((t + h).min(1.0) - (t - h).max(0.0));
+                        v += -PI * p[0] * p[0] * dz * w * 0.5 * (t1 - t0);
+                    }
+                }
+                v + ext
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::profile2d::max_deviation;
+
+    #[test]
+    fn ellipse_offset_is_at_constant_distance() {
+        let p = BodyProfile::HalfEllipsoid {
+            diameter_mm: 18.0,
+            height_mm: 24.0,
+        };
+        for &d in &[-2.0, -0.5, 0.7] {
+            for i in 0..=50 {
+                let t = i as f64 / 50.0;
+                let q = p.offset_point(d, t);
+                // distance from q to the base ellipse, by dense search
+                let mut best = f64::INFINITY;
+                for k in 0..=20000 {
+                    let s = p.offset_point(0.0, k as f64 / 20000.0);
+                    best = best.min(((q[0] - s[0]).powi(2) + (q[1] - s[1]).powi(2)).sqrt());
+                }
+                assert!((best - d.abs()).abs() < 2e-3, "d={d} t={t} dist={best}");
+            }
+        }
+    }
+
+    #[test]
+    fn tessellation_honours_the_profile_tolerance() {
+        let tol = ChordTolerance::new(0.01).unwrap();
+        for p in [
+            BodyProfile::HalfEllipsoid {
+                diameter_mm: 18.0,
+                height_mm: 24.0,
+            },
+            BodyProfile::SphericalCap {
+                base_diameter_mm: 35.0,
+                height_mm: 8.0,
+            },
+            BodyProfile::HemisphereOnCylinder {
+                radius_mm: 15.1,
+                cylinder_length_mm: 6.0,
+            },
+        ] {
+            let d = -1.0;
+            let pl = p.offset_polyline(d, 0.0, tol);
+            let dev = max_deviation(&pl, &|t| p.offset_point(d, t), 0.0, 1.0, 4000);
+            assert!(dev <= tol.mm() * 1.0001, "{} deviates {dev}", p.kind());
+        }
+    }
+
+    #[test]
+    fn cap_geometry() {
+        let p = BodyProfile::SphericalCap {
+            base_diameter_mm: 35.0,
+            height_mm: 8.0,
+        };
+        assert!((p.pole_z_mm(0.0) - p.base_z_mm() - 8.0).abs() < 1e-12);
+        assert!((p.rim_radius_mm(0.0) - 17.5).abs() < 1e-12);
+        assert!(p.offset_is_valid(-2.0));
+        assert!(!p.offset_is_valid(-9.0));
+    }
+
+    #[test]
+    fn ellipsoid_offset_beyond_curvature_is_invalid() {
+        let p = BodyProfile::HalfEllipsoid {
+            diameter_mm: 18.0,
+            height_mm: 24.0,
+        };
+        assert!((p.min_curvature_radius_mm() - 81.0 / 24.0).abs() < 1e-12);
+        assert!(p.offset_is_valid(-3.0));
+        assert!(!p.offset_is_valid(-3.5));
+    }
+}

@@ -1,0 +1,404 @@
+//! The YAML design schema. Field names are the YAML keys; every length is mm, every angle
+//! degrees. Unknown keys are errors.
+
+use crate::error::DesignError;
+use crate::profile::BodyProfile;
+use serde::{Deserialize, Serialize};
+
+/// A sensor design: body profile, rigid core, layer stack, molds, housing, printers.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Design {
+    /// Short name, `[a-z0-9_]+`; names the output folder and the 3MF.
+    pub name: String,
+    #[serde(default)]
+    pub description: String,
+    /// The paper the design reproduces.
+    #[serde(default)]
+    pub source: String,
+    /// The outer surface of the skin (the reference surface).
+    pub body: BodyProfile,
+    /// The rigid transparent shell the skin is cast onto.
+    pub core: Core,
+    /// Skin layers from inner to outer.
+    pub layers: Vec<Layer>,
+    #[serde(default)]
+    pub mold: MoldParams,
+    #[serde(default)]
+    pub housing: Option<HousingParams>,
+    #[serde(default)]
+    pub printers: PrinterProfiles,
+    #[serde(default)]
+    pub casting: CastingParams,
+}
+
+/// The rigid transparent shell (R-Tac0: a glass test tube, Sec. III-B1). Its outer surface is
+/// the inner surface of the innermost layer; it is an offset of the body profile.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Core {
+    #[serde(default)]
+    pub description: String,
+    pub material: String,
+    /// Wall thickness, mm, > 0.
+    pub wall_thickness_mm: f64,
+    /// Length from the pole to the open end, mm; the part below the base plane is held by
+    /// the mold's core holder and seats in the housing.
+    pub length_mm: f64,
+    /// Outer diameter, mm (spherical profiles only). When given, it must equal the inner
+    /// diameter of the innermost layer; layers given by `outer_radius_mm` are measured from it.
+    #[serde(default)]
+    pub outer_diameter_mm: Option<f64>,
+}
+
+/// How a layer is made.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LayerProcess {
+    /// Poured into a mold around the core and the layers under it.
+    Cast,
+    /// Sprayed or brushed onto the mold's cavity before the next layer inward is poured
+    /// (R-Tac0's black coating, Sec. III-B1); it gets no mold of its own.
+    Sprayed,
+}
+
+/// One skin layer. Give exactly one of `thickness_mm` and `outer_radius_mm`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Layer {
+    /// `[a-z0-9_]+`, unique.
+    pub name: String,
+    /// Key in the materials table.
+    pub material: String,
+    pub process: LayerProcess,
+    /// Thickness along the surface normal, mm.
+    #[serde(default)]
+    pub thickness_mm: Option<f64>,
+    /// Radius of the layer's outer surface, mm (spherical profiles only).
+    #[serde(default)]
+    pub outer_radius_mm: Option<f64>,
+    /// Overrides `mold.strategy` for this layer.
+    #[serde(default)]
+    pub mold_strategy: Option<MoldStrategy>,
+}
+
+/// How a cast layer's mold is made.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MoldStrategy {
+    /// A printed two-piece mold split on a parting plane through the axis.
+    Direct,
+    /// A printed master pattern and mold box for a Mold Star 30 silicone mold, plus a casting
+    /// jig (R-Tac0 Sec. III-B1, UVDtact Sec. III).
+    Master,
+}
+
+/// Print technologies, as used in the design file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Technology {
+    Fdm,
+    Sla,
+}
+
+impl From<Technology> for crate::kit::PrintTechnology {
+    fn from(t: Technology) -> Self {
+        match t {
+            Technology::Fdm => Self::Fdm,
+            Technology::Sla => Self::Sla,
+        }
+    }
+}
+
+macro_rules! defaults {
+    ($t:ident { $($f:ident : $v:expr),* $(,)? }) => {
+        impl Default for $t {
+            fn default() -> Self { Self { $($f: $v),* } }
+        }
+    };
+}
+
+/// Mold parameters shared by every cast layer. Geometry: R-Tac0 Sec. III-B1 and Fig. 4.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct MoldParams {
+    pub strategy: MoldStrategy,
+    /// Added to the layer's outer surface to form the cavity, mm, >= 0.
+    pub cavity_clearance_mm: f64,
+    /// Material between the cavity and the outside of a mold half, mm.
+    pub wall_thickness_mm: f64,
+    /// Width of the mold-half flange that carries bolts and keys, mm.
+    pub flange_width_mm: f64,
+    /// Draft of the master-strategy mold box wall from the pull direction, degrees, [0, 10).
+    pub draft_angle_deg: f64,
+    pub plinth: Plinth,
+    pub registration_key: RegistrationKey,
+    pub clamp_bolt: ClampBolt,
+    pub sprue: Sprue,
+    pub vent: Vent,
+    pub core_holder: CoreHolderParams,
+    /// Mold Star thickness around the master pattern (master strategy), mm.
+    pub silicone_wall_mm: f64,
+    /// Technology of parts whose surface forms the skin (mold halves, master patterns).
+    pub cavity_print_technology: Technology,
+    /// Technology of holders, jigs and boxes.
+    pub fixture_print_technology: Technology,
+}
+defaults!(MoldParams {
+    strategy: MoldStrategy::Direct,
+    cavity_clearance_mm: 0.0,
+    wall_thickness_mm: 4.0,
+    flange_width_mm: 8.0,
+    draft_angle_deg: 2.0,
+    plinth: Plinth::default(),
+    registration_key: RegistrationKey::default(),
+    clamp_bolt: ClampBolt::default(),
+    sprue: Sprue::default(),
+    vent: Vent::default(),
+    core_holder: CoreHolderParams::default(),
+    silicone_wall_mm: 5.0,
+    cavity_print_technology: Technology::Sla,
+    fixture_print_technology: Technology::Fdm,
+});
+
+/// The disc-shaped recess at the open end of the cavity: it centres the core holder (its
+/// spigot plugs into it) and leaves a reservoir ring that feeds the cavity.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Plinth {
+    /// Radial margin beyond the cavity rim, mm.
+    pub margin_mm: f64,
+    /// Depth of the recess, mm.
+    pub height_mm: f64,
+    /// Depth left free under the holder's spigot as a reservoir, mm.
+    pub reservoir_depth_mm: f64,
+}
+defaults!(Plinth {
+    margin_mm: 5.0,
+    height_mm: 3.0,
+    reservoir_depth_mm: 1.5
+});
+
+/// Hemispherical registration keys on the parting plane: male on one half, female with
+/// clearance on the other.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RegistrationKey {
+    pub diameter_mm: f64,
+    /// Radial clearance of the female socket, mm.
+    pub clearance_mm: f64,
+}
+defaults!(RegistrationKey {
+    diameter_mm: 3.0,
+    clearance_mm: 0.15
+});
+
+/// Clamp bolts through both mold halves, perpendicular to the parting plane.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ClampBolt {
+    /// Through-hole diameter, mm (3.4 for M3).
+    pub clearance_diameter_mm: f64,
+}
+defaults!(ClampBolt {
+    clearance_diameter_mm: 3.4
+});
+
+/// The pour opening through the core holder.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Sprue {
+    pub diameter_mm: f64,
+}
+defaults!(Sprue { diameter_mm: 3.0 });
+
+/// Air vents through the core holder at the cavity's high points (cast pole-down).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Vent {
+    pub diameter_mm: f64,
+    pub count: u32,
+}
+defaults!(Vent {
+    diameter_mm: 1.2,
+    count: 2
+});
+
+/// The core holder (casting jig): keeps the core concentric with the cavity.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct CoreHolderParams {
+    /// Radial clearance between the centring pin and the core's bore, and around the core
+    /// wall, mm.
+    pub fit_clearance_mm: f64,
+    pub flange_thickness_mm: f64,
+    /// Length of the centring pin that enters the core's open end, mm.
+    pub pin_length_mm: f64,
+    /// Smallest wall left around holes in the holder, mm.
+    pub min_wall_mm: f64,
+}
+defaults!(CoreHolderParams {
+    fit_clearance_mm: 0.1,
+    flange_thickness_mm: 3.0,
+    pin_length_mm: 6.0,
+    min_wall_mm: 1.5,
+});
+
+/// Printer capabilities used to decide what can be printed.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PrinterProfile {
+    /// Nozzle diameter (FDM) or pixel size (SLA), mm.
+    pub xy_resolution_mm: f64,
+    pub layer_height_mm: f64,
+    /// Thinnest wall that prints reliably, mm.
+    pub min_wall_mm: f64,
+    /// Smallest hole that prints open, mm.
+    pub min_hole_diameter_mm: f64,
+    /// Smallest positive feature (pin, key), mm.
+    pub min_feature_mm: f64,
+}
+
+/// The FDM and SLA profiles.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct PrinterProfiles {
+    pub fdm: PrinterProfile,
+    pub sla: PrinterProfile,
+}
+defaults!(PrinterProfiles {
+    // 0.4 mm nozzle, 0.2 mm layers; two perimeters; holes below 1 mm close up.
+    fdm: PrinterProfile {
+        xy_resolution_mm: 0.4,
+        layer_height_mm: 0.2,
+        min_wall_mm: 0.8,
+        min_hole_diameter_mm: 1.0,
+        min_feature_mm: 0.8,
+    },
+    // Form 3 class: 25-50 um pixels and layers.
+    sla: PrinterProfile {
+        xy_resolution_mm: 0.05,
+        layer_height_mm: 0.05,
+        min_wall_mm: 0.4,
+        min_hole_diameter_mm: 0.5,
+        min_feature_mm: 0.3,
+    },
+});
+
+impl PrinterProfiles {
+    pub fn get(&self, t: Technology) -> &PrinterProfile {
+        match t {
+            Technology::Fdm => &self.fdm,
+            Technology::Sla => &self.sla,
+        }
+    }
+}
+
+/// Pour calculator settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct CastingParams {
+    /// Extra material mixed for losses in cups, sprue and vents, fraction in [0, 1].
+    pub waste_allowance: f64,
+}
+defaults!(CastingParams {
+    waste_allowance: 0.2
+});
+
+/// The two-piece sensor shell (R-Tac0 Sec. III-B4, Fig. 2): camera bay, LED ring seat,
+/// diffuser seat, contact-module seat; halves joined by screws across a parting plane
+/// through the axis.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HousingParams {
+    pub material: String,
+    /// Side of the square shell, mm (R-Tac0 envelope 30 x 30 x 43 mm, Sec. III-B).
+    pub outer_width_mm: f64,
+    pub camera: CameraBay,
+    pub bulkhead_thickness_mm: f64,
+    pub led_pcb: LedPcb,
+    pub diffuser: Diffuser,
+    /// Diameter of the light chamber between the LED PCB and the diffuser, mm.
+    pub light_chamber_diameter_mm: f64,
+    /// Radial clearance around seated parts, mm.
+    pub fit_clearance_mm: f64,
+    pub joint_screw: JointScrew,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraBay {
+    /// Camera module name, for the fabrication sheet.
+    pub module: String,
+    /// Side of the square camera board, mm.
+    pub board_width_mm: f64,
+    /// Height of the bay under the bulkhead (board + components), mm.
+    pub bay_height_mm: f64,
+    /// Hole in the bulkhead for the lens barrel, mm.
+    pub lens_hole_diameter_mm: f64,
+    /// Square pattern of the board's mounting holes, centre to centre, mm.
+    pub mount_hole_spacing_mm: f64,
+    /// Pilot hole for the self-tapping mounting screws, mm.
+    pub mount_pilot_diameter_mm: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LedPcb {
+    pub outer_diameter_mm: f64,
+    pub inner_diameter_mm: f64,
+    pub thickness_mm: f64,
+    pub led_count: u32,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Diffuser {
+    pub outer_diameter_mm: f64,
+    pub inner_diameter_mm: f64,
+    pub thickness_mm: f64,
+    /// Distance from the top of the LED PCB to the diffuser, mm (R-Tac0: 10 mm).
+    pub gap_above_pcb_mm: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JointScrew {
+    pub clearance_diameter_mm: f64,
+    pub pilot_diameter_mm: f64,
+    pub head_diameter_mm: f64,
+    /// Material clamped under the head, mm.
+    pub clamp_length_mm: f64,
+    /// Depth of the pilot hole in the other half, mm.
+    pub pilot_depth_mm: f64,
+}
+
+impl Design {
+    /// Parses a design from YAML text. `origin` names the file in error messages.
+    ///
+    /// # Errors
+    /// [`DesignError::Yaml`] with `origin:line:column` for syntax errors, unknown keys,
+    /// wrong types and missing fields.
+    pub fn from_yaml(text: &str, origin: &str) -> Result<Design, DesignError> {
+        serde_saphyr::from_str::<Design>(text)
+            .map_err(|e| DesignError::Yaml(yaml_error(origin, &e)))
+    }
+}
+
+/// Formats a serde-saphyr error as `file:line:column: message`.
+pub fn yaml_error(origin: &str, e: &serde_saphyr::Error) -> String {
+    let msg = e.to_string();
+    match e.location() {
+        Some(loc) => format!(
+            "{origin}:{}:{}: {}",
+            loc.line(),
+            loc.column(),
+            first_line(&msg)
+        ),
+        None => format!("{origin}: {msg}"),
+    }
+}
+
+fn first_line(s: &str) -> &str {
+    s.lines().next().unwrap_or(s)
+}

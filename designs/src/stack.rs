@@ -1,0 +1,373 @@
+//! The layer stack: each layer's inner and outer surfaces as signed offsets from the body
+//! surface (negative = inward), and the validation of a design.
+
+use crate::error::{ParamError, ParamErrors};
+use crate::geometry::{revolve, ChordTolerance, Solid};
+use crate::materials::{MaterialKind, MaterialsTable};
+use crate::schema::{Design, LayerProcess, MoldStrategy};
+use serde::Serialize;
+
+/// A layer with its surfaces resolved.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ResolvedLayer {
+    pub index: usize,
+    pub name: String,
+    pub material: String,
+    pub process: LayerProcess,
+    /// Offset of the inner surface from the body surface, mm (negative inward).
+    pub inner_offset_mm: f64,
+    /// Offset of the outer surface, mm.
+    pub outer_offset_mm: f64,
+    pub thickness_mm: f64,
+    pub mold_strategy: MoldStrategy,
+}
+
+/// The rigid core with its surfaces resolved.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ResolvedCore {
+    pub inner_offset_mm: f64,
+    pub outer_offset_mm: f64,
+    /// How far the core continues straight down below the base plane, mm.
+    pub below_base_mm: f64,
+    /// Outer radius for spherical profiles, mm.
+    pub outer_radius_mm: Option<f64>,
+    pub inner_radius_mm: Option<f64>,
+}
+
+/// A validated design with every surface placed.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Stack {
+    pub core: ResolvedCore,
+    pub layers: Vec<ResolvedLayer>,
+}
+
+impl Stack {
+    /// The solid of layer `i` (between its inner and outer surfaces, closed on the base plane).
+    ///
+    /// # Errors
+    /// Only on a kernel failure.
+    pub fn layer_solid(
+        &self,
+        design: &Design,
+        i: usize,
+        tol: ChordTolerance,
+    ) -> Result<Solid, crate::geometry::GeometryError> {
+        let l = &self.layers[i];
+        let pl = design
+            .body
+            .shell_profile(l.inner_offset_mm, l.outer_offset_mm, 0.0, tol.half());
+        Solid::from_mesh(&revolve(&pl, tol)?)
+    }
+
+    /// The solid of the rigid core (a hollow shell continued below the base plane).
+    ///
+    /// # Errors
+    /// Only on a kernel failure.
+    pub fn core_solid(
+        &self,
+        design: &Design,
+        tol: ChordTolerance,
+    ) -> Result<Solid, crate::geometry::GeometryError> {
+        let c = &self.core;
+        let pl = design.body.shell_profile(
+            c.inner_offset_mm,
+            c.outer_offset_mm,
+            c.below_base_mm,
+            tol.half(),
+        );
+        Solid::from_mesh(&revolve(&pl, tol)?)
+    }
+}
+
+fn is_identifier(s: &str) -> bool {
+    !s.is_empty()
+        && s.chars()
+            .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_')
+}
+
+/// Checks every rule of a design and resolves its stack. Reports every violation at once.
+///
+/// # Errors
+/// [`ParamErrors`] listing each violated rule with its parameter path and value.
+pub fn validate(
+    design: &Design,
+    materials: &MaterialsTable,
+    tol: ChordTolerance,
+) -> Result<Stack, ParamErrors> {
+    let mut errs: Vec<ParamError> = Vec::new();
+    let t = tol.mm();
+    if !is_identifier(&design.name) {
+        errs.push(ParamError::new(
+            "name",
+            format!("{:?}", design.name),
+            "must be lowercase letters, digits and _",
+        ));
+    }
+    for (path, value, rule) in design.body.violations() {
+        errs.push(ParamError::new(path, value, rule));
+    }
+    let body_ok = errs.iter().all(|e| !e.path.starts_with("body."));
+    let sphere_r = if body_ok {
+        design.body.sphere_radius_mm()
+    } else {
+        None
+    };
+
+    // Materials exist and fit their use.
+    let mut check_material =
+        |path: String, key: &str, kinds: &[MaterialKind]| match materials.get(key) {
+            None => errs.push(ParamError::new(
+                path,
+                key,
+                format!(
+                    "unknown material; known: {}",
+                    materials
+                        .materials
+                        .keys()
+                        .cloned()
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            )),
+            Some(m) if !kinds.contains(&m.kind) => errs.push(ParamError::new(
+                path,
+                key,
+                format!("is a {:?} material, expected one of {:?}", m.kind, kinds),
+            )),
+            Some(_) => {}
+        };
+    check_material(
+        "core.material".into(),
+        &design.core.material,
+        &[MaterialKind::Bought, MaterialKind::Print],
+    );
+    for (i, l) in design.layers.iter().enumerate() {
+        let kinds: &[MaterialKind] = match l.process {
+            LayerProcess::Cast => &[MaterialKind::Cast],
+            LayerProcess::Sprayed => &[MaterialKind::Coating, MaterialKind::Cast],
+        };
+        check_material(format!("layers[{i}].material"), &l.material, kinds);
+    }
+    if let Some(h) = &design.housing {
+        check_material(
+            "housing.material".into(),
+            &h.material,
+            &[MaterialKind::Print],
+        );
+    }
+
+    if design.layers.is_empty() {
+        errs.push(ParamError::new(
+            "layers",
+            "[]",
+            "at least one layer is required",
+        ));
+    }
+    let mut names = std::collections::BTreeSet::new();
+    for (i, l) in design.layers.iter().enumerate() {
+        if !is_identifier(&l.name) {
+            errs.push(ParamError::new(
+                format!("layers[{i}].name"),
+                format!("{:?}", l.name),
+                "must be lowercase letters, digits and _",
+            ));
+        } else if !names.insert(l.name.clone()) {
+            errs.push(ParamError::new(
+                format!("layers[{i}].name"),
+                &l.name,
+                "is used by another layer",
+            ));
+        }
+        match (l.thickness_mm, l.outer_radius_mm) {
+            (Some(_), Some(_)) | (None, None) => errs.push(ParamError::new(
+                format!("layers[{i}]"),
+                &l.name,
+                "give exactly one of thickness_mm and outer_radius_mm",
+            )),
+            (None, Some(_)) if sphere_r.is_none() && body_ok => errs.push(ParamError::new(
+                format!("layers[{i}].outer_radius_mm"),
+                l.outer_radius_mm.unwrap_or_default(),
+                format!(
+                    "radii only describe spherical profiles; the {} needs thickness_mm",
+                    design.body.kind()
+                ),
+            )),
+            _ => {}
+        }
+    }
+    if design
+        .layers
+        .iter()
+        .all(|l| l.process != LayerProcess::Cast)
+        && !design.layers.is_empty()
+    {
+        errs.push(ParamError::new(
+            "layers",
+            design.layers.len(),
+            "at least one layer must be cast",
+        ));
+    }
+    if design
+        .layers
+        .first()
+        .is_some_and(|l| l.process == LayerProcess::Sprayed)
+    {
+        errs.push(ParamError::new(
+            "layers[0].process",
+            "sprayed",
+            "the innermost layer must be cast: a sprayed layer coats the mold of the cast layer under it",
+        ));
+    }
+    if design.core.outer_diameter_mm.is_some() && sphere_r.is_none() && body_ok {
+        errs.push(ParamError::new(
+            "core.outer_diameter_mm",
+            design.core.outer_diameter_mm.unwrap_or_default(),
+            format!(
+                "a diameter only describes spherical profiles; remove it for the {}",
+                design.body.kind()
+            ),
+        ));
+    }
+    if !(design.core.wall_thickness_mm > 0.0) {
+        errs.push(ParamError::new(
+            "core.wall_thickness_mm",
+            design.core.wall_thickness_mm,
+            "must be above 0",
+        ));
+    }
+    if !(0.0..=1.0).contains(&design.casting.waste_allowance) {
+        errs.push(ParamError::new(
+            "casting.waste_allowance",
+            design.casting.waste_allowance,
+            "must be in [0, 1]",
+        ));
+    }
+
+    // Resolve the stack from the inside out, in "radius" units for spheres (r = R + offset).
+    let mut layers = Vec::new();
+    let mut core = None;
+    if body_ok && errs.iter().all(|e| !e.path.starts_with("layers[")) && !design.layers.is_empty() {
+        let total_t: Option<f64> = design.layers.iter().map(|l| l.thickness_mm).sum();
+        // Offset of the core's outer surface.
+        let core_out = match (sphere_r, design.core.outer_diameter_mm) {
+            (Some(r), Some(od)) => Some(od / 2.0 - r),
+            _ => total_t.map(|s| -s),
+        };
+        match core_out {
+            None => errs.push(ParamError::new(
+                "core.outer_diameter_mm",
+                "missing",
+                "layers given by outer_radius_mm are measured from the core: give core.outer_diameter_mm",
+            )),
+            Some(core_out) => {
+                let r_body = sphere_r.unwrap_or(0.0);
+                let mut below = core_out;
+                let mut below_name = "the core".to_string();
+                for (i, l) in design.layers.iter().enumerate() {
+                    let (out, path, value) = match (l.thickness_mm, l.outer_radius_mm) {
+                        (Some(th), _) => (below + th, format!("layers[{i}].thickness_mm"), th),
+                        (_, Some(ro)) => (ro - r_body, format!("layers[{i}].outer_radius_mm"), ro),
+                        _ => unreachable!("checked above"),
+                    };
+                    let th = out - below;
+                    if th < t {
+                        let rule = if i == 0 && l.outer_radius_mm.is_some() && th < 0.0 {
+                            format!(
+                                "the core (outer radius {:.3} mm) is larger than the cavity of layer '{}' (outer radius {:.3} mm)",
+                                r_body + below, l.name, r_body + out
+                            )
+                        } else if l.outer_radius_mm.is_some() && th < 0.0 {
+                            format!(
+                                "must be above the outer radius of {below_name} under it ({:.3} mm)",
+                                r_body + below
+                            )
+                        } else {
+                            format!(
+                                "leaves layer '{}' {:.4} mm thick, below the chord tolerance {} mm",
+                                l.name, th, t
+                            )
+                        };
+                        errs.push(ParamError::new(path, value, rule));
+                    }
+                    layers.push(ResolvedLayer {
+                        index: i,
+                        name: l.name.clone(),
+                        material: l.material.clone(),
+                        process: l.process,
+                        inner_offset_mm: below,
+                        outer_offset_mm: out,
+                        thickness_mm: th,
+                        mold_strategy: l.mold_strategy.unwrap_or(design.mold.strategy),
+                    });
+                    below = out;
+                    below_name = format!("layer '{}'", l.name);
+                }
+                if below.abs() > 1e-9 {
+                    let last = design.layers.len() - 1;
+                    errs.push(ParamError::new(
+                        if sphere_r.is_some() { "body.radius_mm" } else { "layers" },
+                        format!("{}", r_body),
+                        format!(
+                            "the outermost layer '{}' ends {:+.4} mm from the body surface; its outer surface must be the body surface{}",
+                            design.layers[last].name,
+                            below,
+                            if design.core.outer_diameter_mm.is_some() {
+                                " (check core.outer_diameter_mm and the layer radii)"
+                            } else {
+                                ""
+                            }
+                        ),
+                    ));
+                }
+                let core_in = core_out - design.core.wall_thickness_mm;
+                let pole_z = design.body.pole_z_mm(core_out);
+                let below_base = design.core.length_mm - (pole_z - design.body.base_z_mm());
+                if !(design.core.length_mm > 0.0) || below_base < 0.0 {
+                    errs.push(ParamError::new(
+                        "core.length_mm",
+                        design.core.length_mm,
+                        format!(
+                            "the core must reach the base plane: at least {:.3} mm from its pole",
+                            pole_z - design.body.base_z_mm()
+                        ),
+                    ));
+                }
+                for (what, d) in [("core outer surface", core_out), ("core inner surface", core_in)] {
+                    if !design.body.offset_is_valid(d) {
+                        errs.push(ParamError::new(
+                            if what.contains("inner") { "core.wall_thickness_mm" } else { "layers" },
+                            if what.contains("inner") { design.core.wall_thickness_mm } else { -core_out },
+                            format!(
+                                "the {what} lies {:.3} mm inside the body surface, beyond what the {} allows (smallest radius of curvature {:.3} mm, pole above the base plane): the offset surface would fold or vanish",
+                                -d,
+                                design.body.kind(),
+                                design.body.min_curvature_radius_mm()
+                            ),
+                        ));
+                    }
+                }
+                core = Some(ResolvedCore {
+                    inner_offset_mm: core_in,
+                    outer_offset_mm: core_out,
+                    below_base_mm: below_base.max(0.0),
+                    outer_radius_mm: sphere_r.map(|r| r + core_out),
+                    inner_radius_mm: sphere_r.map(|r| r + core_in),
+                });
+            }
+        }
+    }
+
+    crate::molds::check_mold_params(design, &mut errs);
+    if let Some(h) = &design.housing {
+        crate::housing::check_housing_params(design, h, core.as_ref(), &mut errs);
+    }
+    if let (Some(c), true) = (&core, errs.is_empty()) {
+        if let Some(first) = layers.iter().find(|l| l.process == LayerProcess::Cast) {
+            crate::molds::check_mold_fit(design, c, first.outer_offset_mm, &mut errs);
+        }
+    }
+    match (errs.is_empty(), core) {
+        (true, Some(core)) => Ok(Stack { core, layers }),
+        _ => Err(ParamErrors(errs)),
+    }
+}
