@@ -1,1 +1,404 @@
+//! fabkit-export: writes a built [`Kit`] to disk.
+//!
+//! [`write_kit`] produces, in one output directory:
+//! - `parts/<part>.stl`: binary STL per part, mm, provenance in the 80-byte header;
+//! - `<design>.3mf`: one named object per part, `unit="millimeter"`, laid out on one plate;
+//! - `manifest.json`: provenance and the numbers of every written solid ([`Manifest`]);
+//! - `FABRICATION.md`: the human fabrication sheet (print list, cast order, bought items).
+//!
+//! The export is all or nothing (a temporary sibling directory renamed into place) and
+//! reproducible (the same kit and options give byte-identical files: no timestamps, no hash-map
+//! order). Every written solid is checked to be a closed, consistently oriented 2-manifold.
 
+mod atomic;
+mod check;
+mod error;
+mod layout;
+mod manifest;
+mod sheet;
+mod stl;
+mod three_mf;
+
+pub use check::check_printable_mesh;
+pub use error::ExportError;
+pub use manifest::{Manifest, ManifestDesign, ManifestKit3mf, ManifestObject, ManifestPart, FRAME};
+
+use fabkit_designs::geometry::{Mesh, TopologyError};
+use fabkit_designs::kit::Kit;
+use sha2::{Digest, Sha256};
+use std::path::{Path, PathBuf};
+
+/// Which mesh formats to write. `manifest.json` and `FABRICATION.md` are always written.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Formats {
+    /// `parts/<part>.stl`, one binary STL per part.
+    pub stl: bool,
+    /// `<design>.3mf`, one 3MF for the whole kit.
+    pub threemf: bool,
+}
+
+impl Default for Formats {
+    /// Both formats.
+    fn default() -> Self {
+        Self {
+            stl: true,
+            threemf: true,
+        }
+    }
+}
+
+/// Everything [`write_kit`] needs besides the kit: formats and provenance.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ExportOptions {
+    pub formats: Formats,
+    /// The command line that produced the export, one argument per entry (recorded verbatim).
+    pub command_line: Vec<String>,
+    /// Path of the YAML design, or `embedded:<name>` for a built-in design.
+    pub design_source: String,
+    /// sha256 of the design text, 64 lowercase hex digits.
+    pub design_sha256: String,
+    /// Chord tolerance the kit was built with, mm (> 0); recorded, not applied.
+    pub chord_tolerance_mm: f64,
+    /// fabkit version, e.g. `0.1.0`; goes into every file.
+    pub fabkit_version: String,
+}
+
+/// What [`write_kit`] wrote.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ExportSummary {
+    /// The output directory, as given.
+    pub out_dir: PathBuf,
+    /// Every file written, as `out_dir` joined with its relative path, in order:
+    /// `parts/*.stl` (kit order), `<design>.3mf`, `manifest.json`, `FABRICATION.md`.
+    pub files: Vec<PathBuf>,
+    /// `out_dir` held a previous export (or was an empty directory) and was replaced.
+    pub replaced_previous_export: bool,
+    /// Non-fatal problems, e.g. a previous export that was moved aside but not deleted.
+    pub warnings: Vec<String>,
+    /// The manifest as written to `manifest.json`.
+    pub manifest: Manifest,
+}
+
+/// Writes `kit` into `out_dir`: STL per part and/or one 3MF (per `opts.formats`), plus
+/// `manifest.json` and `FABRICATION.md`. Parts must already be in print orientation, in mm.
+///
+/// Each part is meshed and rounded to f32 ([`Mesh::rounded_to_f32`]) once; that mesh is what
+/// every file holds and what every number in the manifest is computed from.
+///
+/// `out_dir` may be missing (parent directories are created), an empty directory, or a
+/// previous fabkit export (a directory with a fabkit `manifest.json`), which is replaced as a
+/// whole, including any file added to it by hand. Nothing is written under `out_dir` until
+/// every file is complete and synced in a temporary sibling directory.
+///
+/// # Errors
+/// - names, options and meshes are checked before anything touches the disk:
+///   [`ExportError::InvalidDesignName`], [`ExportError::NoParts`],
+///   [`ExportError::InvalidPartName`], [`ExportError::DuplicatePartName`],
+///   [`ExportError::InvalidOption`], [`ExportError::NotManifold`],
+///   [`ExportError::CoincidentVertices`], [`ExportError::TooManyTriangles`];
+/// - output path: [`ExportError::InvalidOutDir`], [`ExportError::NotADirectory`],
+///   [`ExportError::ForeignDirectory`] (a non-empty directory fabkit did not write);
+/// - [`ExportError::Io`], [`ExportError::ThreeMf`], [`ExportError::Json`].
+///
+/// On every error `out_dir` is left exactly as it was and no temporary directory remains.
+pub fn write_kit(
+    kit: &Kit,
+    out_dir: &Path,
+    opts: &ExportOptions,
+) -> Result<ExportSummary, ExportError> {
+    let meshes: Vec<Mesh> = kit
+        .parts
+        .iter()
+        .map(|p| p.solid.mesh().rounded_to_f32())
+        .collect();
+    write_kit_meshes(kit, &meshes, out_dir, opts)
+}
+
+/// [`write_kit`] with the written meshes given (one per part, in kit order), so that tests can
+/// hand in meshes no [`fabkit_designs::geometry::Solid`] can hold.
+fn write_kit_meshes(
+    kit: &Kit,
+    meshes: &[Mesh],
+    out_dir: &Path,
+    opts: &ExportOptions,
+) -> Result<ExportSummary, ExportError> {
+    check::check_options(opts)?;
+    check::check_names(kit)?;
+    for (part, mesh) in kit.parts.iter().zip(meshes) {
+        check_printable_mesh(&part.name, mesh)?;
+    }
+    let rendered = render(kit, meshes, opts)?;
+    let done = atomic::replace_dir(out_dir, |tmp| {
+        if opts.formats.stl {
+            let parts_dir = tmp.join(PARTS_DIR);
+            std::fs::create_dir(&parts_dir).map_err(ExportError::io("creating", &parts_dir))?;
+        }
+        for (rel, bytes) in &rendered.files {
+            atomic::write_file_synced(&join_rel(tmp, rel), bytes)?;
+        }
+        if opts.formats.stl {
+            atomic::sync_dir(&tmp.join(PARTS_DIR))?;
+        }
+        Ok(())
+    })?;
+    Ok(ExportSummary {
+        out_dir: out_dir.to_path_buf(),
+        files: rendered
+            .files
+            .iter()
+            .map(|(rel, _)| join_rel(out_dir, rel))
+            .collect(),
+        replaced_previous_export: done.replaced_previous,
+        warnings: done.warnings,
+        manifest: rendered.manifest,
+    })
+}
+
+const PARTS_DIR: &str = "parts";
+
+/// Every file of the export, in memory, with `/`-separated relative paths.
+struct Rendered {
+    files: Vec<(String, Vec<u8>)>,
+    manifest: Manifest,
+}
+
+fn render(kit: &Kit, meshes: &[Mesh], opts: &ExportOptions) -> Result<Rendered, ExportError> {
+    let mut files = Vec::new();
+    let mut parts = Vec::with_capacity(kit.parts.len());
+    for (part, mesh) in kit.parts.iter().zip(meshes) {
+        let bbox = mesh
+            .bounding_box()
+            .ok_or_else(|| ExportError::NotManifold {
+                part: part.name.clone(),
+                source: TopologyError::Empty,
+            })?;
+        let (file, sha256) = if opts.formats.stl {
+            let header = stl::header(
+                &opts.fabkit_version,
+                &kit.design,
+                &part.name,
+                &opts.design_sha256,
+            );
+            let bytes = stl::encode(&part.name, mesh, &header)?;
+            let rel = format!("{PARTS_DIR}/{}.stl", part.name);
+            let sha = sha256_hex(&bytes);
+            files.push((rel.clone(), bytes));
+            (Some(rel), Some(sha))
+        } else {
+            (None, None)
+        };
+        parts.push(ManifestPart {
+            name: part.name.clone(),
+            file,
+            role: part.role.clone(),
+            description: part.description.clone(),
+            material: part.material.clone(),
+            print_technology: part.print_technology,
+            volume_mm3: mesh.signed_volume(),
+            surface_area_mm2: mesh.surface_area(),
+            bbox_mm: bbox,
+            vertices: mesh.vertices.len(),
+            triangles: mesh.triangles.len(),
+            genus: mesh.genus(),
+            sha256,
+            params: part.params.clone(),
+        });
+    }
+
+    let kit_3mf = if opts.formats.threemf {
+        let boxes: Vec<_> = parts.iter().map(|p| p.bbox_mm).collect();
+        let translations = layout::shelf_pack(&boxes, layout::ROW_WIDTH_MM, layout::GAP_MM);
+        let objects: Vec<three_mf::Object<'_>> = kit
+            .parts
+            .iter()
+            .zip(meshes)
+            .zip(&translations)
+            .map(|((p, m), t)| three_mf::Object {
+                name: &p.name,
+                mesh: m,
+                translation_mm: *t,
+            })
+            .collect();
+        let metadata = [
+            ("Title", format!("fabkit kit {}", kit.design)),
+            ("Application", format!("fabkit {}", opts.fabkit_version)),
+            (
+                "Description",
+                format!(
+                    "design {} from {}, sha256:{}, chord tolerance {} mm; command line: {}",
+                    kit.design,
+                    opts.design_source,
+                    opts.design_sha256,
+                    opts.chord_tolerance_mm,
+                    sheet::shell_words(&opts.command_line)
+                ),
+            ),
+        ];
+        let bytes = three_mf::encode(&objects, &metadata)?;
+        let rel = format!("{}.3mf", kit.design);
+        let sha = sha256_hex(&bytes);
+        files.push((rel.clone(), bytes));
+        Some(ManifestKit3mf {
+            file: rel,
+            sha256: sha,
+            objects: objects
+                .iter()
+                .zip(1u32..)
+                .map(|(o, id)| ManifestObject {
+                    id,
+                    name: o.name.to_owned(),
+                    translation_mm: o.translation_mm,
+                })
+                .collect(),
+        })
+    } else {
+        None
+    };
+
+    let manifest = Manifest {
+        fabkit_version: opts.fabkit_version.clone(),
+        design: ManifestDesign {
+            name: kit.design.clone(),
+            source: opts.design_source.clone(),
+            sha256: opts.design_sha256.clone(),
+        },
+        chord_tolerance_mm: opts.chord_tolerance_mm,
+        command_line: opts.command_line.clone(),
+        frame: FRAME.to_owned(),
+        parts,
+        kit_3mf,
+        casts: kit.casts.clone(),
+        bought_items: kit.bought_items.clone(),
+        summary: kit.summary.clone(),
+    };
+    let mut json = serde_json::to_vec_pretty(&manifest)?;
+    json.push(b'\n');
+    files.push(("manifest.json".to_owned(), json));
+    files.push((
+        "FABRICATION.md".to_owned(),
+        sheet::render(&manifest).into_bytes(),
+    ));
+    Ok(Rendered { files, manifest })
+}
+
+fn join_rel(base: &Path, rel: &str) -> PathBuf {
+    rel.split('/').fold(base.to_path_buf(), |p, c| p.join(c))
+}
+
+fn sha256_hex(bytes: &[u8]) -> String {
+    Sha256::digest(bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use fabkit_designs::geometry::cuboid;
+    use fabkit_designs::kit::{Part, PrintTechnology};
+
+    fn kit() -> Kit {
+        let part = |name: &str, x: f64| Part {
+            name: name.into(),
+            role: "test".into(),
+            description: "a box".into(),
+            material: "pla_black".into(),
+            print_technology: PrintTechnology::Fdm,
+            solid: cuboid([x, 0.0, 0.0], [x + 10.0, 10.0, 5.0]).unwrap(),
+            params: serde_json::json!({}),
+        };
+        Kit {
+            design: "tiny".into(),
+            parts: vec![part("a", 0.0), part("lid", 20.0)],
+            casts: vec![],
+            bought_items: vec![],
+            summary: serde_json::json!({}),
+        }
+    }
+
+    fn opts() -> ExportOptions {
+        ExportOptions {
+            formats: Formats::default(),
+            command_line: vec!["fabkit".into()],
+            design_source: "embedded:tiny".into(),
+            design_sha256: "0".repeat(64),
+            chord_tolerance_mm: 0.01,
+            fabkit_version: "0.1.0".into(),
+        }
+    }
+
+    #[test]
+    fn open_mesh_refuses_export_and_leaves_nothing() {
+        let root = tempfile::tempdir().unwrap();
+        let out = root.path().join("nested").join("kit");
+        let k = kit();
+        let mut meshes: Vec<Mesh> = k
+            .parts
+            .iter()
+            .map(|p| p.solid.mesh().rounded_to_f32())
+            .collect();
+        meshes[1].triangles.pop();
+        let err = write_kit_meshes(&k, &meshes, &out, &opts()).unwrap_err();
+        assert!(
+            matches!(err, ExportError::NotManifold { ref part, .. } if part == "lid"),
+            "{err}"
+        );
+        assert!(err.to_string().contains("`lid`"));
+        assert_eq!(std::fs::read_dir(root.path()).unwrap().count(), 0);
+    }
+
+    #[test]
+    fn open_mesh_keeps_a_previous_export() {
+        let root = tempfile::tempdir().unwrap();
+        let out = root.path().join("kit");
+        let k = kit();
+        let first = write_kit(&k, &out, &opts()).unwrap();
+        let before: Vec<Vec<u8>> = first
+            .files
+            .iter()
+            .map(|f| std::fs::read(f).unwrap())
+            .collect();
+        let mut meshes: Vec<Mesh> = k
+            .parts
+            .iter()
+            .map(|p| p.solid.mesh().rounded_to_f32())
+            .collect();
+        meshes[0].triangles[0].swap(1, 2);
+        assert!(write_kit_meshes(&k, &meshes, &out, &opts()).is_err());
+        let after: Vec<Vec<u8>> = first
+            .files
+            .iter()
+            .map(|f| std::fs::read(f).unwrap())
+            .collect();
+        assert_eq!(before, after);
+        assert_eq!(std::fs::read_dir(root.path()).unwrap().count(), 1);
+    }
+
+    #[test]
+    fn bad_names_and_options_are_refused() {
+        let mut k = kit();
+        k.parts[1].name = "a".into();
+        let root = tempfile::tempdir().unwrap();
+        let out = root.path().join("kit");
+        assert!(matches!(
+            write_kit(&k, &out, &opts()),
+            Err(ExportError::DuplicatePartName { .. })
+        ));
+        k.parts[1].name = "../up".into();
+        assert!(matches!(
+            write_kit(&k, &out, &opts()),
+            Err(ExportError::InvalidPartName { .. })
+        ));
+        let mut o = opts();
+        o.design_sha256 = "abc".into();
+        assert!(matches!(
+            write_kit(&kit(), &out, &o),
+            Err(ExportError::InvalidOption {
+                field: "design_sha256",
+                ..
+            })
+        ));
+        assert!(!out.exists());
+    }
+}

@@ -1,0 +1,298 @@
+//! Replacing an output directory without ever leaving a mixed state under its name.
+//!
+//! Everything is written into a fresh sibling `.<name>.tmp-<pid>-<n>` and synced; then a
+//! previous export is renamed to `.<name>.old-<pid>-<n>`, the new directory is renamed into
+//! place and the old one deleted. Between the two renames the name is briefly absent (a POSIX
+//! rename cannot swap two directories), but it never holds a half-written export.
+
+use crate::ExportError;
+use std::ffi::OsString;
+use std::fs;
+use std::io::{ErrorKind, Write as _};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU32, Ordering};
+
+/// Sibling names from one process never repeat.
+static SIBLING_COUNTER: AtomicU32 = AtomicU32::new(0);
+
+/// What [`replace_dir`] did besides succeeding.
+#[derive(Debug)]
+pub(crate) struct Replaced {
+    /// An earlier export (or an empty directory) was replaced.
+    pub replaced_previous: bool,
+    /// Non-fatal problems (e.g. an old export that could not be deleted).
+    pub warnings: Vec<String>,
+}
+
+/// Fills a fresh temporary sibling of `out_dir` with `fill` and moves it into place.
+///
+/// `out_dir` may be missing (its parents are created), an empty directory, or a previous
+/// fabkit export (a directory with a fabkit `manifest.json`), which is replaced as a whole.
+///
+/// # Errors
+/// [`ExportError::InvalidOutDir`], [`ExportError::NotADirectory`],
+/// [`ExportError::ForeignDirectory`], [`ExportError::Io`], or `fill`'s error. On every error
+/// `out_dir` is as it was and the temporary directory is removed.
+pub(crate) fn replace_dir(
+    out_dir: &Path,
+    fill: impl FnOnce(&Path) -> Result<(), ExportError>,
+) -> Result<Replaced, ExportError> {
+    let (parent, name) = split(out_dir)?;
+    fs::create_dir_all(&parent).map_err(ExportError::io("creating parent directory", &parent))?;
+    let existing = inspect_existing(out_dir)?;
+
+    let tmp = create_unique_sibling(&parent, &name, "tmp")?;
+    if let Err(e) = fill(&tmp).and_then(|()| sync_dir(&tmp)) {
+        let _ = fs::remove_dir_all(&tmp);
+        return Err(e);
+    }
+
+    let mut warnings = Vec::new();
+    if existing {
+        let backup = unique_sibling_path(&parent, &name, "old");
+        if let Err(e) = fs::rename(out_dir, &backup) {
+            let _ = fs::remove_dir_all(&tmp);
+            return Err(ExportError::io(
+                "moving the previous export aside from",
+                out_dir,
+            )(e));
+        }
+        if let Err(e) = fs::rename(&tmp, out_dir) {
+            let restored = fs::rename(&backup, out_dir);
+            let _ = fs::remove_dir_all(&tmp);
+            if let Err(r) = restored {
+                warnings.push(format!(
+                    "could not move the previous export back from {}: {r}",
+                    backup.display()
+                ));
+            }
+            return Err(ExportError::io(
+                "moving the new export into place at",
+                out_dir,
+            )(e));
+        }
+        if let Err(e) = fs::remove_dir_all(&backup) {
+            warnings.push(format!(
+                "the previous export was moved to {} but could not be deleted ({e}); delete it by hand",
+                backup.display()
+            ));
+        }
+    } else if let Err(e) = fs::rename(&tmp, out_dir) {
+        let _ = fs::remove_dir_all(&tmp);
+        return Err(ExportError::io(
+            "moving the new export into place at",
+            out_dir,
+        )(e));
+    }
+    // Make the renames durable; a failure here does not undo a complete export.
+    if let Err(e) = sync_dir(&parent) {
+        let cause = std::error::Error::source(&e)
+            .map(ToString::to_string)
+            .unwrap_or_default();
+        warnings.push(format!("{e}: {cause}"));
+    }
+    Ok(Replaced {
+        replaced_previous: existing,
+        warnings,
+    })
+}
+
+/// Writes `bytes` to a new file at `path` and syncs it to disk.
+pub(crate) fn write_file_synced(path: &Path, bytes: &[u8]) -> Result<(), ExportError> {
+    let mut f = fs::OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(path)
+        .map_err(ExportError::io("creating", path))?;
+    f.write_all(bytes)
+        .map_err(ExportError::io("writing", path))?;
+    f.sync_all().map_err(ExportError::io("syncing", path))
+}
+
+/// Syncs a directory's entries to disk (Unix; elsewhere directories cannot be opened for it).
+pub(crate) fn sync_dir(dir: &Path) -> Result<(), ExportError> {
+    #[cfg(unix)]
+    {
+        fs::File::open(dir)
+            .and_then(|d| d.sync_all())
+            .map_err(ExportError::io("syncing directory", dir))?;
+    }
+    #[cfg(not(unix))]
+    let _ = dir;
+    Ok(())
+}
+
+/// (parent directory, final name) of `out_dir`; an empty parent means the current directory.
+fn split(out_dir: &Path) -> Result<(PathBuf, OsString), ExportError> {
+    let name = out_dir
+        .file_name()
+        .ok_or_else(|| ExportError::InvalidOutDir {
+            path: out_dir.to_path_buf(),
+            reason: "has no final directory name (hint: give a path such as `out/rtac0`)".into(),
+        })?;
+    let parent = match out_dir.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    Ok((parent, name.to_os_string()))
+}
+
+/// `Ok(true)` for a directory that may be replaced, `Ok(false)` when nothing is there.
+fn inspect_existing(out_dir: &Path) -> Result<bool, ExportError> {
+    let md = match fs::symlink_metadata(out_dir) {
+        Ok(md) => md,
+        Err(e) if e.kind() == ErrorKind::NotFound => return Ok(false),
+        Err(e) => return Err(ExportError::io("inspecting", out_dir)(e)),
+    };
+    if md.file_type().is_symlink() {
+        return Err(ExportError::InvalidOutDir {
+            path: out_dir.to_path_buf(),
+            reason: "is a symbolic link; replacing it would replace the link, not its target \
+                     (hint: pass the target directory itself)"
+                .into(),
+        });
+    }
+    if !md.is_dir() {
+        return Err(ExportError::NotADirectory {
+            path: out_dir.to_path_buf(),
+        });
+    }
+    let mut names: Vec<String> = fs::read_dir(out_dir)
+        .map_err(ExportError::io("listing", out_dir))?
+        .map(|e| e.map(|e| e.file_name().to_string_lossy().into_owned()))
+        .collect::<Result<_, _>>()
+        .map_err(ExportError::io("listing", out_dir))?;
+    if names.is_empty() || is_fabkit_manifest(&out_dir.join("manifest.json")) {
+        return Ok(true);
+    }
+    names.sort();
+    let entry = names
+        .iter()
+        .find(|n| n.as_str() != "manifest.json")
+        .or(names.first())
+        .cloned()
+        .unwrap_or_default();
+    Err(ExportError::ForeignDirectory {
+        path: out_dir.to_path_buf(),
+        entry,
+    })
+}
+
+/// A regular file holding a JSON object with a string `fabkit_version`.
+fn is_fabkit_manifest(path: &Path) -> bool {
+    let Ok(md) = fs::symlink_metadata(path) else {
+        return false;
+    };
+    if !md.is_file() {
+        return false;
+    }
+    let Ok(text) = fs::read(path) else {
+        return false;
+    };
+    serde_json::from_slice::<serde_json::Value>(&text)
+        .ok()
+        .and_then(|v| v.get("fabkit_version").map(serde_json::Value::is_string))
+        .unwrap_or(false)
+}
+
+fn unique_sibling_path(parent: &Path, name: &OsString, kind: &str) -> PathBuf {
+    loop {
+        let n = SIBLING_COUNTER.fetch_add(1, Ordering::Relaxed);
+        let mut s = OsString::from(".");
+        s.push(name);
+        s.push(format!(".{kind}-{}-{n}", std::process::id()));
+        let p = parent.join(s);
+        if fs::symlink_metadata(&p).is_err() {
+            return p;
+        }
+    }
+}
+
+fn create_unique_sibling(
+    parent: &Path,
+    name: &OsString,
+    kind: &str,
+) -> Result<PathBuf, ExportError> {
+    loop {
+        let p = unique_sibling_path(parent, name, kind);
+        match fs::create_dir(&p) {
+            Ok(()) => return Ok(p),
+            Err(e) if e.kind() == ErrorKind::AlreadyExists => continue,
+            Err(e) => return Err(ExportError::io("creating temporary directory", p)(e)),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn siblings(parent: &Path) -> Vec<String> {
+        let mut v: Vec<String> = fs::read_dir(parent)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    }
+
+    #[test]
+    fn failing_fill_leaves_nothing_behind() {
+        let root = tempfile::tempdir().unwrap();
+        let out = root.path().join("kit");
+        let r = replace_dir(&out, |tmp| {
+            write_file_synced(&tmp.join("half.stl"), b"x")?;
+            Err(ExportError::ThreeMf {
+                reason: "injected".into(),
+            })
+        });
+        assert!(matches!(r, Err(ExportError::ThreeMf { .. })));
+        assert!(siblings(root.path()).is_empty());
+    }
+
+    #[test]
+    fn failing_fill_keeps_the_previous_export() {
+        let root = tempfile::tempdir().unwrap();
+        let out = root.path().join("kit");
+        fs::create_dir(&out).unwrap();
+        fs::write(
+            out.join("manifest.json"),
+            "{\"fabkit_version\": \"0.0.1\"}\n",
+        )
+        .unwrap();
+        let r = replace_dir(&out, |_| {
+            Err(ExportError::ThreeMf {
+                reason: "injected".into(),
+            })
+        });
+        assert!(r.is_err());
+        assert_eq!(siblings(root.path()), vec!["kit"]);
+        assert_eq!(siblings(&out), vec!["manifest.json"]);
+    }
+
+    #[test]
+    fn root_and_dot_dot_are_refused() {
+        assert!(matches!(
+            split(Path::new("/")),
+            Err(ExportError::InvalidOutDir { .. })
+        ));
+        assert!(matches!(
+            split(Path::new("a/..")),
+            Err(ExportError::InvalidOutDir { .. })
+        ));
+        assert_eq!(split(Path::new("kit")).unwrap().0, PathBuf::from("."));
+    }
+
+    #[test]
+    fn foreign_manifest_is_not_a_previous_export() {
+        let root = tempfile::tempdir().unwrap();
+        let out = root.path().join("kit");
+        fs::create_dir(&out).unwrap();
+        fs::write(out.join("manifest.json"), "{\"name\": \"web app\"}").unwrap();
+        let r = replace_dir(&out, |_| Ok(()));
+        assert!(
+            matches!(r, Err(ExportError::ForeignDirectory { ref entry, .. }) if entry == "manifest.json")
+        );
+        assert_eq!(siblings(root.path()), vec!["kit"]);
+    }
+}

@@ -1,0 +1,99 @@
+//! [`ExportError`]: everything that can stop an export.
+
+use fabkit_designs::geometry::TopologyError;
+use std::path::PathBuf;
+
+/// Why an export was refused or failed. Whatever the variant, the output directory is left
+/// exactly as it was and no temporary directory is left behind.
+///
+/// Display messages do not repeat their `source`; print the cause chain to see it.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ExportError {
+    /// The part's f32-rounded mesh (the one that would be written) is open, non-manifold,
+    /// inconsistently wound or inside-out.
+    #[error(
+        "part `{part}` is not a closed, consistently oriented 2-manifold after rounding to f32"
+    )]
+    NotManifold {
+        part: String,
+        #[source]
+        source: TopologyError,
+    },
+    /// Distinct vertices of the part land on the same f32 position: a reader that merges
+    /// vertices by position (every STL reader) would see a pinched, non-manifold solid.
+    #[error(
+        "part `{part}`: {count} vertices share their position with another vertex after rounding \
+         to f32 (pinched or sliver geometry; a position-based reader would see a non-manifold \
+         solid)"
+    )]
+    CoincidentVertices { part: String, count: usize },
+    /// Binary STL stores the triangle count in 32 bits.
+    #[error("part `{part}` has {triangles} triangles; a binary STL holds at most 4294967295")]
+    TooManyTriangles { part: String, triangles: usize },
+    /// Part names become file names and 3MF object names.
+    #[error("part name `{name}`: must be non-empty and use only a-z, 0-9 and _ (it becomes a file name)")]
+    InvalidPartName { name: String },
+    #[error("two parts are named `{name}`: part names must be unique in a kit")]
+    DuplicatePartName { name: String },
+    /// The design name becomes the 3MF file name.
+    #[error(
+        "design name `{name}`: must be non-empty and use only A-Z, a-z, 0-9, _ and - \
+         (it becomes a file name)"
+    )]
+    InvalidDesignName { name: String },
+    #[error("kit `{design}` has no parts to export")]
+    NoParts { design: String },
+    /// A field of [`crate::ExportOptions`] breaks its rule.
+    #[error("export option {field} = {value:?}: {rule}")]
+    InvalidOption {
+        field: &'static str,
+        value: String,
+        rule: &'static str,
+    },
+    /// The output path cannot name a directory to replace (e.g. `/`, `..`, a symlink).
+    #[error("output directory {}: {reason}", path.display())]
+    InvalidOutDir { path: PathBuf, reason: String },
+    #[error(
+        "output path {} exists and is not a directory (hint: choose another path, or move the \
+         file away yourself)",
+        path.display()
+    )]
+    NotADirectory { path: PathBuf },
+    /// The output directory holds files but no fabkit `manifest.json`: it is not a previous
+    /// export, so it is not replaced.
+    #[error(
+        "output directory {} is not empty and holds no fabkit manifest.json (found `{entry}`): \
+         refusing to replace a folder fabkit did not write (hint: choose a new or empty \
+         directory, or move its contents away yourself)",
+        path.display()
+    )]
+    ForeignDirectory { path: PathBuf, entry: String },
+    /// A file-system operation failed; `action` says which (e.g. `writing`).
+    #[error("{action} {}", path.display())]
+    Io {
+        action: &'static str,
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    /// The in-memory 3MF (zip) archive could not be built.
+    #[error("building the 3MF archive: {reason}")]
+    ThreeMf { reason: String },
+    #[error("serializing manifest.json")]
+    Json(#[from] serde_json::Error),
+}
+
+impl ExportError {
+    pub(crate) fn io(
+        action: &'static str,
+        path: impl Into<PathBuf>,
+    ) -> impl FnOnce(std::io::Error) -> Self {
+        let path = path.into();
+        move |source| Self::Io {
+            action,
+            path,
+            source,
+        }
+    }
+}

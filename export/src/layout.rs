@@ -1,0 +1,79 @@
+//! Plate layout of the kit 3MF: deterministic shelf (row) packing by bounding box.
+
+use fabkit_designs::geometry::Aabb;
+
+/// Clear distance between neighbouring parts on the plate, mm.
+pub(crate) const GAP_MM: f64 = 5.0;
+
+/// A row is closed when the next part would end beyond this x, mm. 200 mm fits the common
+/// 220-250 mm beds; a part wider than this gets a row of its own.
+pub(crate) const ROW_WIDTH_MM: f64 = 200.0;
+
+/// Translations, mm, one per box in input order, that lay the boxes out in rows from the
+/// origin towards +x then +y, `gap_mm` apart, each resting on z = 0 (translation z = -min z).
+///
+/// Rows are filled in input order; a box starts a new row when it would end beyond
+/// `row_width_mm` and the row already holds a box. The xy footprints of the translated boxes
+/// are pairwise at least `gap_mm` apart.
+pub(crate) fn shelf_pack(boxes: &[Aabb], row_width_mm: f64, gap_mm: f64) -> Vec<[f64; 3]> {
+    let (mut x, mut y, mut row_depth) = (0.0_f64, 0.0_f64, 0.0_f64);
+    let mut row_len = 0usize;
+    boxes
+        .iter()
+        .map(|b| {
+            let [w, d, _] = b.size();
+            if row_len > 0 && x + w > row_width_mm {
+                y += row_depth + gap_mm;
+                x = 0.0;
+                row_depth = 0.0;
+                row_len = 0;
+            }
+            let t = [x - b.min[0], y - b.min[1], -b.min[2]].map(|c| if c == 0.0 { 0.0 } else { c });
+            x += w + gap_mm;
+            row_depth = row_depth.max(d);
+            row_len += 1;
+            t
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn b(min: [f64; 3], max: [f64; 3]) -> Aabb {
+        Aabb { min, max }
+    }
+
+    #[test]
+    fn footprints_do_not_overlap_and_rest_on_z0() {
+        let boxes = vec![
+            b([-20.0, -20.0, 0.0], [20.0, 20.0, 10.0]),
+            b([0.0, 0.0, 1.0], [160.0, 30.0, 5.0]),
+            b([-5.0, -5.0, 0.0], [5.0, 5.0, 3.0]),
+            b([0.0, 0.0, 0.0], [260.0, 10.0, 3.0]),
+            b([-1.0, -1.0, -2.0], [1.0, 1.0, 3.0]),
+        ];
+        let t = shelf_pack(&boxes, ROW_WIDTH_MM, GAP_MM);
+        let placed: Vec<Aabb> = boxes
+            .iter()
+            .zip(&t)
+            .map(|(b, t)| Aabb {
+                min: [b.min[0] + t[0], b.min[1] + t[1], b.min[2] + t[2]],
+                max: [b.max[0] + t[0], b.max[1] + t[1], b.max[2] + t[2]],
+            })
+            .collect();
+        for (i, p) in placed.iter().enumerate() {
+            assert_eq!(p.min[2], 0.0);
+            for q in &placed[i + 1..] {
+                let apart_x =
+                    p.max[0] + GAP_MM <= q.min[0] + 1e-9 || q.max[0] + GAP_MM <= p.min[0] + 1e-9;
+                let apart_y =
+                    p.max[1] + GAP_MM <= q.min[1] + 1e-9 || q.max[1] + GAP_MM <= p.min[1] + 1e-9;
+                assert!(apart_x || apart_y, "{p:?} {q:?}");
+            }
+        }
+        // the 160 mm box does not fit after the 40 mm one: second row
+        assert!(placed[1].min[1] > placed[0].max[1]);
+    }
+}

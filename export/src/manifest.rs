@@ -1,0 +1,101 @@
+//! `manifest.json`: what was exported, from what, and the numbers of every written solid.
+//!
+//! Keys are written in the field order of these structs (serde derives keep it), so the text
+//! is stable. Every number about a part is computed from the f32-rounded mesh that is written,
+//! so an independent reader of the STL or 3MF gets the same numbers.
+
+use fabkit_designs::geometry::Aabb;
+use fabkit_designs::kit::{CastReport, PrintTechnology};
+use serde::{Deserialize, Serialize};
+
+/// The `frame` string of every manifest.
+pub const FRAME: &str =
+    "sensor frame (docs/conventions.md); parts are in print orientation on z = 0";
+
+/// The whole `manifest.json`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Manifest {
+    /// fabkit version that wrote the export.
+    pub fabkit_version: String,
+    pub design: ManifestDesign,
+    /// Largest facet-to-true-surface distance the kit was tessellated with, mm.
+    pub chord_tolerance_mm: f64,
+    /// The command line that produced the export, one argument per entry.
+    pub command_line: Vec<String>,
+    /// The frame the part coordinates are given in; always [`FRAME`].
+    pub frame: String,
+    /// One entry per part, in kit order.
+    pub parts: Vec<ManifestPart>,
+    /// The kit 3MF, `null` when 3MF was not requested.
+    pub kit_3mf: Option<ManifestKit3mf>,
+    /// Pours in casting order, as the design computed them.
+    pub casts: Vec<CastReport>,
+    /// Parts that are bought or cut rather than printed, one line each.
+    pub bought_items: Vec<String>,
+    /// Sensor-frame facts from the design build (envelope, derived radii, ...).
+    pub summary: serde_json::Value,
+}
+
+/// Where the design came from.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ManifestDesign {
+    /// Design name, e.g. `rtac0`; also the stem of the 3MF file.
+    pub name: String,
+    /// A path to the YAML design, or `embedded:<name>` for a built-in design.
+    pub source: String,
+    /// sha256 of the design text, 64 lowercase hex digits.
+    pub sha256: String,
+}
+
+/// One printed part.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ManifestPart {
+    pub name: String,
+    /// Path of the part's STL relative to the export directory (`parts/<name>.stl`), `null`
+    /// when STL was not requested.
+    pub file: Option<String>,
+    pub role: String,
+    pub description: String,
+    /// Material key in the materials table.
+    pub material: String,
+    /// `"FDM"` or `"SLA"`.
+    pub print_technology: PrintTechnology,
+    /// Enclosed volume of the written mesh, mm^3.
+    pub volume_mm3: f64,
+    /// Surface area of the written mesh, mm^2.
+    pub surface_area_mm2: f64,
+    /// Bounding box of the written mesh in print orientation, mm: `{min: [x, y, z], max: [x, y, z]}`.
+    pub bbox_mm: Aabb,
+    /// Number of vertices of the indexed mesh (the 3MF object holds exactly these).
+    pub vertices: usize,
+    /// Number of triangles (the STL holds exactly these).
+    pub triangles: usize,
+    /// Genus of the solid (number of through-holes for a single shell).
+    pub genus: i64,
+    /// sha256 of the STL file bytes, `null` when STL was not requested.
+    pub sha256: Option<String>,
+    /// The resolved parameters the part was built from.
+    pub params: serde_json::Value,
+}
+
+/// The kit 3MF.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ManifestKit3mf {
+    /// Path relative to the export directory (`<design>.3mf`).
+    pub file: String,
+    /// sha256 of the 3MF file bytes.
+    pub sha256: String,
+    /// One entry per object, in kit order.
+    pub objects: Vec<ManifestObject>,
+}
+
+/// One object of the kit 3MF and where its build item puts it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ManifestObject {
+    /// 3MF object id (1, 2, ...).
+    pub id: u32,
+    /// Object name, the part name.
+    pub name: String,
+    /// Build-item translation from part coordinates to the plate, mm.
+    pub translation_mm: [f64; 3],
+}

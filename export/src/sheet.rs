@@ -1,0 +1,189 @@
+//! `FABRICATION.md`: the human fabrication sheet, rendered from the manifest alone.
+
+use crate::manifest::Manifest;
+use std::fmt::Write as _;
+
+/// Renders the sheet. Deterministic: only the manifest goes in.
+pub(crate) fn render(m: &Manifest) -> String {
+    let mut s = String::new();
+    // `write!` into a String cannot fail; the results are ignored on purpose.
+    let _ = writeln!(s, "# Fabrication sheet: {}\n", text(&m.design.name));
+    s.push_str(
+        "Written by fabkit with every export; regenerate it rather than edit it. \
+         Lengths in mm, volumes in mm³ unless stated.\n\n",
+    );
+
+    s.push_str("## Provenance\n\n");
+    let _ = writeln!(s, "- fabkit version: {}", code(&m.fabkit_version));
+    let _ = writeln!(
+        s,
+        "- design: {} from {}",
+        code(&m.design.name),
+        code(&m.design.source)
+    );
+    let _ = writeln!(s, "- design sha256: {}", code(&m.design.sha256));
+    let _ = writeln!(
+        s,
+        "- chord tolerance: {} mm (largest facet-to-surface distance)",
+        m.chord_tolerance_mm
+    );
+    let _ = writeln!(s, "- command line: {}", code(&shell_words(&m.command_line)));
+    let _ = writeln!(s, "- frame: {}", text(&m.frame));
+    if let Some(k) = &m.kit_3mf {
+        let _ = writeln!(
+            s,
+            "- kit 3MF: {} ({} objects laid out on one plate), sha256 {}",
+            code(&k.file),
+            k.objects.len(),
+            code(&k.sha256)
+        );
+    }
+    s.push_str("- file hashes and exact part numbers: `manifest.json`\n\n");
+
+    s.push_str("## Print list\n\n");
+    s.push_str(
+        "| # | Part | File | Technology | Material | Volume (mm³) | Size x × y × z (mm) |\n",
+    );
+    s.push_str(
+        "|---|------|------|------------|----------|-------------:|---------------------|\n",
+    );
+    for (i, p) in m.parts.iter().enumerate() {
+        let [sx, sy, sz] = p.bbox_mm.size();
+        let file = p
+            .file
+            .as_deref()
+            .map_or_else(|| "(in the 3MF only)".to_owned(), code);
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {} | {:.1} | {:.2} × {:.2} × {:.2} |",
+            i + 1,
+            code(&p.name),
+            file,
+            p.print_technology,
+            code(&p.material),
+            p.volume_mm3,
+            sx,
+            sy,
+            sz
+        );
+    }
+    s.push('\n');
+    for p in &m.parts {
+        let _ = writeln!(
+            s,
+            "- {} ({}): {}",
+            code(&p.name),
+            text(&p.role),
+            text(&p.description)
+        );
+    }
+    s.push('\n');
+
+    s.push_str("## Cast order\n\n");
+    if m.casts.is_empty() {
+        s.push_str("No pours in this kit.\n\n");
+    }
+    for c in &m.casts {
+        let _ = writeln!(s, "### Step {}: {}\n", c.step, text(&c.cast));
+        let _ = writeln!(s, "- material: {}", code(&c.material));
+        let _ = writeln!(s, "- mix ratio: {}", text(&c.mix_ratio));
+        if !c.mold_parts.is_empty() {
+            let parts: Vec<String> = c.mold_parts.iter().map(|p| code(p)).collect();
+            let _ = writeln!(s, "- held by: {}", parts.join(", "));
+        }
+        let _ = writeln!(s, "- cavity volume: {:.2} mL", c.cavity_volume_ml);
+        let _ = writeln!(
+            s,
+            "- waste allowance: {:.0} % (included in the masses below)",
+            c.waste_allowance * 100.0
+        );
+        s.push_str("- weigh out:\n");
+        for comp in &c.components {
+            let _ = writeln!(s, "  - {}: {:.2} g", text(&comp.name), comp.mass_g);
+        }
+        let _ = writeln!(s, "  - total: {:.2} g", c.total_mass_g);
+        if !c.notes.trim().is_empty() {
+            let _ = writeln!(s, "- notes: {}", text(&c.notes));
+        }
+        s.push('\n');
+    }
+
+    s.push_str("## Bought items\n\n");
+    if m.bought_items.is_empty() {
+        s.push_str("None.\n");
+    }
+    for b in &m.bought_items {
+        let _ = writeln!(s, "- {}", text(b));
+    }
+    s.push('\n');
+
+    s.push_str("## Checking the prints\n\n");
+    s.push_str(
+        "1. Files: `sha256sum` of each file must equal its `sha256` in `manifest.json` \
+         (`parts[].sha256`, `kit_3mf.sha256`).\n",
+    );
+    s.push_str(
+        "2. Before slicing: the slicer must report every object as manifold with no repaired \
+         errors (e.g. `prusa-slicer --info <file>`), and its volume must match the print list \
+         to within 0.1 %.\n",
+    );
+    s.push_str(
+        "3. After printing: measure the overall size with calipers against the print list \
+         (typically within ±0.2 mm for FDM, ±0.1 mm for SLA); mold halves must close without \
+         a gap and their registration keys must engage before any pour.\n",
+    );
+    s
+}
+
+/// Inline code span; falls back to plain text when `s` holds a backtick or a `|` (which a
+/// table would take for a cell border even inside a code span).
+fn code(s: &str) -> String {
+    if s.contains(['`', '|']) {
+        text(s)
+    } else {
+        format!("`{}`", one_line(s))
+    }
+}
+
+/// Plain text, safe inside a table cell: one line, `|` escaped.
+fn text(s: &str) -> String {
+    one_line(s).replace('|', "\\|")
+}
+
+fn one_line(s: &str) -> String {
+    s.split(['\n', '\r'])
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// Arguments joined by spaces, each quoted when it holds a space or quote (POSIX shell).
+pub(crate) fn shell_words(args: &[String]) -> String {
+    args.iter()
+        .map(|a| {
+            if !a.is_empty() && !a.contains([' ', '\'', '"', '\t']) {
+                a.clone()
+            } else {
+                format!("'{}'", a.replace('\'', "'\\''"))
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn table_cells_stay_in_their_column() {
+        assert_eq!(text("a|b\nc"), "a\\|b c");
+        assert_eq!(code("x`y"), "x`y");
+        assert_eq!(code("x|y"), "x\\|y");
+        assert_eq!(
+            shell_words(&["fabkit".into(), "a b".into()]),
+            "fabkit 'a b'"
+        );
+    }
+}

@@ -1,0 +1,528 @@
+//! write_kit end to end: files read back by independent readers (stl_io, threemf, zip),
+//! determinism, formats, and the output-directory rules.
+
+use fabkit_designs::geometry::{cuboid, cylinder, sphere, Aabb, ChordTolerance};
+use fabkit_designs::kit::{CastComponent, CastReport, Kit, Part, PrintTechnology};
+use fabkit_export::{write_kit, ExportError, ExportOptions, Formats, Manifest};
+use std::collections::BTreeSet;
+use std::fs;
+use std::path::{Path, PathBuf};
+
+fn part(name: &str, tech: PrintTechnology, solid: fabkit_designs::geometry::Solid) -> Part {
+    Part {
+        name: name.into(),
+        role: "test_part".into(),
+        description: format!("{name} for the export tests"),
+        material: "pla_black".into(),
+        print_technology: tech,
+        solid,
+        params: serde_json::json!({ "name": name, "size_mm": [1.0, 2.0], "zeta": true, "alpha": 1 }),
+    }
+}
+
+/// Five parts: a wide plate and a wide tray (they force a second row on the plate), a
+/// cylinder, a sphere resting on z = 0 and a ring (genus 1).
+fn test_kit() -> Kit {
+    let tol = ChordTolerance::new(0.05).unwrap();
+    let ring = cuboid([-10.0, -10.0, 0.0], [10.0, 10.0, 3.0])
+        .unwrap()
+        .difference(&cylinder(5.0, 5.0, tol).unwrap().translate([0.0, 0.0, -1.0]))
+        .unwrap();
+    Kit {
+        design: "tiny".into(),
+        parts: vec![
+            part(
+                "base_plate",
+                PrintTechnology::Fdm,
+                cuboid([-75.0, -15.0, 0.0], [75.0, 15.0, 4.0]).unwrap(),
+            ),
+            part(
+                "pillar",
+                PrintTechnology::Fdm,
+                cylinder(10.0, 6.0, tol).unwrap(),
+            ),
+            part(
+                "dome",
+                PrintTechnology::Sla,
+                sphere(8.0, tol).unwrap().translate([0.0, 0.0, 8.0]),
+            ),
+            part("ring", PrintTechnology::Sla, ring),
+            part(
+                "wide_tray",
+                PrintTechnology::Fdm,
+                cuboid([0.0, 0.0, 0.0], [120.0, 40.0, 2.0]).unwrap(),
+            ),
+        ],
+        casts: vec![CastReport {
+            step: 1,
+            cast: "transparent_gel".into(),
+            material: "solaris".into(),
+            mold_parts: vec!["ring".into(), "dome".into()],
+            cavity_volume_ml: 3.2109,
+            waste_allowance: 0.2,
+            mix_ratio: "1:1 by weight".into(),
+            components: vec![
+                CastComponent {
+                    name: "Part A".into(),
+                    mass_g: 1.9265,
+                },
+                CastComponent {
+                    name: "Part B".into(),
+                    mass_g: 1.9265,
+                },
+            ],
+            total_mass_g: 3.853,
+            notes: "pot life 15 min | degas 3 min".into(),
+        }],
+        bought_items: vec!["acrylic tube, 30 mm OD".into()],
+        summary: serde_json::json!({ "envelope_radius_mm": 15.0 }),
+    }
+}
+
+fn opts() -> ExportOptions {
+    ExportOptions {
+        formats: Formats::default(),
+        command_line: vec![
+            "fabkit".into(),
+            "build".into(),
+            "tiny.yaml".into(),
+            "--out".into(),
+            "out dir".into(),
+        ],
+        design_source: "designs/library/tiny.yaml".into(),
+        design_sha256: "0123456789abcdef".repeat(4),
+        chord_tolerance_mm: 0.05,
+        fabkit_version: "0.1.0".into(),
+    }
+}
+
+fn read_manifest(dir: &Path) -> Manifest {
+    serde_json::from_slice(&fs::read(dir.join("manifest.json")).unwrap()).unwrap()
+}
+
+fn sha256_hex(bytes: &[u8]) -> String {
+    use sha2::Digest;
+    sha2::Sha256::digest(bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
+}
+
+fn signed_volume(vertices: &[[f64; 3]], triangles: impl Iterator<Item = [usize; 3]>) -> f64 {
+    let mut v = 0.0;
+    for t in triangles {
+        let (a, b, c) = (vertices[t[0]], vertices[t[1]], vertices[t[2]]);
+        v += a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+            + a[2] * (b[0] * c[1] - b[1] * c[0]);
+    }
+    v / 6.0
+}
+
+fn bbox(points: impl Iterator<Item = [f64; 3]>) -> Aabb {
+    points.fold(
+        Aabb {
+            min: [f64::MAX; 3],
+            max: [f64::MIN; 3],
+        },
+        |b, p| Aabb {
+            min: [b.min[0].min(p[0]), b.min[1].min(p[1]), b.min[2].min(p[2])],
+            max: [b.max[0].max(p[0]), b.max[1].max(p[1]), b.max[2].max(p[2])],
+        },
+    )
+}
+
+fn assert_close(a: f64, b: f64, what: &str) {
+    assert!(
+        (a - b).abs() <= 1e-9 * b.abs().max(1.0),
+        "{what}: {a} vs {b}"
+    );
+}
+
+/// Relative paths of all files under `dir`, sorted.
+fn tree(dir: &Path) -> Vec<PathBuf> {
+    fn walk(base: &Path, dir: &Path, out: &mut Vec<PathBuf>) {
+        for e in fs::read_dir(dir).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                walk(base, &p, out);
+            } else {
+                out.push(p.strip_prefix(base).unwrap().to_path_buf());
+            }
+        }
+    }
+    let mut out = Vec::new();
+    walk(dir, dir, &mut out);
+    out.sort();
+    out
+}
+
+fn entries(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn stl_files_read_back_with_the_manifest_numbers() {
+    let root = tempfile::tempdir().unwrap();
+    let out = root.path().join("kit");
+    let kit = test_kit();
+    let summary = write_kit(&kit, &out, &opts()).unwrap();
+    let m = read_manifest(&out);
+    assert_eq!(m, summary.manifest);
+    assert_eq!(m.parts.len(), 5);
+    for (p, mp) in kit.parts.iter().zip(&m.parts) {
+        assert_eq!(p.name, mp.name);
+        let file = mp.file.as_deref().unwrap();
+        assert_eq!(file, format!("parts/{}.stl", p.name));
+        let bytes = fs::read(out.join(file)).unwrap();
+        assert_eq!(mp.sha256.as_deref(), Some(sha256_hex(&bytes).as_str()));
+        assert!(!bytes.starts_with(b"solid"));
+        let header = String::from_utf8_lossy(&bytes[..80]).into_owned();
+        assert!(
+            header.starts_with(&format!(
+                "fabkit 0.1.0 tiny {} sha256:0123456789abcdef mm",
+                p.name
+            )),
+            "{header}"
+        );
+
+        let stl = stl_io::read_stl(&mut std::io::Cursor::new(&bytes)).unwrap();
+        stl.validate().unwrap();
+        assert_eq!(stl.faces.len(), mp.triangles);
+        // No vertex is lost or duplicated by a position-merging reader.
+        assert_eq!(stl.vertices.len(), mp.vertices);
+        let verts: Vec<[f64; 3]> = stl.vertices.iter().map(|v| v.0.map(f64::from)).collect();
+        let vol = signed_volume(&verts, stl.faces.iter().map(|f| f.vertices));
+        assert_close(vol, mp.volume_mm3, &p.name);
+        assert!(vol > 0.0);
+        let bb = bbox(verts.iter().copied());
+        assert_eq!(bb, mp.bbox_mm, "{}", p.name);
+        assert_eq!(bb.min[2], 0.0);
+        // Stored normals point out: along the right-hand normal of the stored winding.
+        for f in &stl.faces {
+            let [a, b, c] = f.vertices.map(|i| verts[i]);
+            let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+            let w = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+            let n = [
+                u[1] * w[2] - u[2] * w[1],
+                u[2] * w[0] - u[0] * w[2],
+                u[0] * w[1] - u[1] * w[0],
+            ];
+            let dot: f64 = (0..3).map(|k| n[k] * f64::from(f.normal.0[k])).sum();
+            assert!(dot > 0.0);
+        }
+    }
+    let genus: Vec<i64> = m.parts.iter().map(|p| p.genus).collect();
+    assert_eq!(genus, vec![0, 0, 0, 1, 0]);
+    assert_close(
+        m.parts[0].volume_mm3,
+        150.0 * 30.0 * 4.0,
+        "base_plate volume",
+    );
+}
+
+#[test]
+fn threemf_reads_back_named_objects_in_millimetres_laid_out_apart() {
+    let root = tempfile::tempdir().unwrap();
+    let out = root.path().join("kit");
+    let kit = test_kit();
+    write_kit(&kit, &out, &opts()).unwrap();
+    let m = read_manifest(&out);
+    let k3 = m.kit_3mf.as_ref().unwrap();
+    assert_eq!(k3.file, "tiny.3mf");
+    let bytes = fs::read(out.join(&k3.file)).unwrap();
+    assert_eq!(k3.sha256, sha256_hex(&bytes));
+
+    let models = threemf::read(std::io::Cursor::new(&bytes)).unwrap();
+    assert_eq!(models.len(), 1);
+    let model = &models[0];
+    assert!(matches!(model.unit, threemf::model::Unit::Millimeter));
+    let title = model
+        .metadata
+        .iter()
+        .find(|md| md.name == "Application")
+        .and_then(|md| md.value.clone());
+    assert_eq!(title.as_deref(), Some("fabkit 0.1.0"));
+    let objects = &model.resources.object;
+    let names: Vec<&str> = objects.iter().map(|o| o.name.as_deref().unwrap()).collect();
+    let kit_names: Vec<&str> = kit.parts.iter().map(|p| p.name.as_str()).collect();
+    assert_eq!(names, kit_names);
+
+    let mut placed = Vec::new();
+    for (o, mp) in objects.iter().zip(&m.parts) {
+        let mesh = o.mesh.as_ref().unwrap();
+        let verts: Vec<[f64; 3]> = mesh
+            .vertices
+            .vertex
+            .iter()
+            .map(|v| [v.x, v.y, v.z])
+            .collect();
+        let unique: BTreeSet<[u64; 3]> = verts.iter().map(|v| v.map(f64::to_bits)).collect();
+        assert_eq!(
+            unique.len(),
+            verts.len(),
+            "{}: duplicated vertices",
+            mp.name
+        );
+        assert_eq!(verts.len(), mp.vertices);
+        assert_eq!(mesh.triangles.triangle.len(), mp.triangles);
+        let vol = signed_volume(
+            &verts,
+            mesh.triangles.triangle.iter().map(|t| [t.v1, t.v2, t.v3]),
+        );
+        assert_close(vol, mp.volume_mm3, &mp.name);
+
+        let item = model
+            .build
+            .item
+            .iter()
+            .find(|i| i.objectid == o.id)
+            .unwrap();
+        let t = item.transform.unwrap();
+        assert_eq!(&t[..9], &[1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]);
+        let tr = [t[9], t[10], t[11]];
+        let bb = bbox(
+            verts
+                .iter()
+                .map(|v| [v[0] + tr[0], v[1] + tr[1], v[2] + tr[2]]),
+        );
+        assert_eq!(bb.min[2], 0.0, "{}", mp.name);
+        assert!(
+            bb.min[0] >= -1e-9 && bb.min[1] >= -1e-9,
+            "{}: {bb:?}",
+            mp.name
+        );
+        placed.push((mp.name.clone(), bb));
+    }
+    for (i, (na, a)) in placed.iter().enumerate() {
+        for (nb, b) in &placed[i + 1..] {
+            let gap = 5.0 - 1e-6;
+            let apart = a.max[0] + gap <= b.min[0]
+                || b.max[0] + gap <= a.min[0]
+                || a.max[1] + gap <= b.min[1]
+                || b.max[1] + gap <= a.min[1];
+            assert!(apart, "{na} {a:?} and {nb} {b:?} overlap");
+        }
+    }
+}
+
+#[test]
+fn same_kit_gives_byte_identical_files() {
+    let root = tempfile::tempdir().unwrap();
+    let (a, b) = (root.path().join("a"), root.path().join("b"));
+    write_kit(&test_kit(), &a, &opts()).unwrap();
+    write_kit(&test_kit(), &b, &opts()).unwrap();
+    let files = tree(&a);
+    assert_eq!(files, tree(&b));
+    assert_eq!(files.len(), 5 + 3);
+    for f in &files {
+        assert_eq!(
+            fs::read(a.join(f)).unwrap(),
+            fs::read(b.join(f)).unwrap(),
+            "{}",
+            f.display()
+        );
+    }
+    // Identical bytes from one second could still hide a clock: the zip entries carry the
+    // fixed DOS epoch.
+    let mut zip = zip::ZipArchive::new(fs::File::open(a.join("tiny.3mf")).unwrap()).unwrap();
+    let mut names = Vec::new();
+    for i in 0..zip.len() {
+        let e = zip.by_index(i).unwrap();
+        assert_eq!(e.last_modified(), Some(zip::DateTime::default()));
+        names.push(e.name().unwrap().into_owned());
+    }
+    assert_eq!(
+        names,
+        ["[Content_Types].xml", "_rels/.rels", "3D/3dmodel.model"]
+    );
+}
+
+#[test]
+fn manifest_keys_are_in_schema_order_with_a_trailing_newline() {
+    let root = tempfile::tempdir().unwrap();
+    let out = root.path().join("kit");
+    write_kit(&test_kit(), &out, &opts()).unwrap();
+    let text = fs::read_to_string(out.join("manifest.json")).unwrap();
+    assert!(text.ends_with("}\n"));
+    let keys = [
+        "\"fabkit_version\"",
+        "\"design\"",
+        "\"chord_tolerance_mm\"",
+        "\"command_line\"",
+        "\"frame\"",
+        "\"parts\"",
+        "\"kit_3mf\"",
+        "\"casts\"",
+        "\"bought_items\"",
+        "\"summary\"",
+    ];
+    let pos: Vec<usize> = keys
+        .iter()
+        .map(|k| text.find(&format!("\n  {k}: ")).unwrap())
+        .collect();
+    assert!(pos.windows(2).all(|w| w[0] < w[1]), "{pos:?}");
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(v["parts"][2]["print_technology"], "SLA");
+    assert_eq!(
+        v["parts"][0]["bbox_mm"]["max"],
+        serde_json::json!([75.0, 15.0, 4.0])
+    );
+    assert_eq!(
+        v["frame"],
+        "sensor frame (docs/conventions.md); parts are in print orientation on z = 0"
+    );
+    assert_eq!(v["command_line"][4], "out dir");
+}
+
+#[test]
+fn fabrication_sheet_lists_provenance_parts_casts_and_checks() {
+    let root = tempfile::tempdir().unwrap();
+    let out = root.path().join("kit");
+    write_kit(&test_kit(), &out, &opts()).unwrap();
+    let s = fs::read_to_string(out.join("FABRICATION.md")).unwrap();
+    for needle in [
+        "# Fabrication sheet: tiny",
+        "0123456789abcdef0123456789abcdef0123456789abcdef0123456789abcdef",
+        "`fabkit build tiny.yaml --out 'out dir'`",
+        "| 1 | `base_plate` | `parts/base_plate.stl` | FDM | `pla_black` | 18000.0 | 150.00 × 30.00 × 4.00 |",
+        "### Step 1: transparent_gel",
+        "- cavity volume: 3.21 mL",
+        "- waste allowance: 20 %",
+        "  - Part A: 1.93 g",
+        "  - total: 3.85 g",
+        "pot life 15 min \\| degas 3 min",
+        "- acrylic tube, 30 mm OD",
+        "## Checking the prints",
+    ] {
+        assert!(s.contains(needle), "missing {needle:?} in\n{s}");
+    }
+}
+
+#[test]
+fn formats_select_the_mesh_files() {
+    let root = tempfile::tempdir().unwrap();
+    let (stl_only, mf_only) = (root.path().join("stl"), root.path().join("3mf"));
+    let mut o = opts();
+    o.formats = Formats {
+        stl: true,
+        threemf: false,
+    };
+    write_kit(&test_kit(), &stl_only, &o).unwrap();
+    assert!(!stl_only.join("tiny.3mf").exists());
+    assert!(stl_only.join("parts/ring.stl").exists());
+    assert!(read_manifest(&stl_only).kit_3mf.is_none());
+
+    o.formats = Formats {
+        stl: false,
+        threemf: true,
+    };
+    let s = write_kit(&test_kit(), &mf_only, &o).unwrap();
+    assert_eq!(
+        tree(&mf_only),
+        [
+            PathBuf::from("FABRICATION.md"),
+            "manifest.json".into(),
+            "tiny.3mf".into()
+        ]
+    );
+    assert_eq!(s.files.len(), 3);
+    let m = read_manifest(&mf_only);
+    assert!(m
+        .parts
+        .iter()
+        .all(|p| p.file.is_none() && p.sha256.is_none()));
+    assert!(fs::read_to_string(mf_only.join("FABRICATION.md"))
+        .unwrap()
+        .contains("(in the 3MF only)"));
+}
+
+#[test]
+fn unrelated_directory_is_refused_and_untouched() {
+    let root = tempfile::tempdir().unwrap();
+    let out = root.path().join("photos");
+    fs::create_dir(&out).unwrap();
+    fs::write(out.join("holiday.jpg"), b"not a kit").unwrap();
+    let err = write_kit(&test_kit(), &out, &opts()).unwrap_err();
+    assert!(
+        matches!(err, ExportError::ForeignDirectory { ref entry, .. } if entry == "holiday.jpg"),
+        "{err}"
+    );
+    assert!(err.to_string().contains("hint"));
+    assert_eq!(entries(&out), ["holiday.jpg"]);
+    assert_eq!(fs::read(out.join("holiday.jpg")).unwrap(), b"not a kit");
+    assert_eq!(entries(root.path()), ["photos"]);
+}
+
+#[test]
+fn file_in_place_of_the_directory_is_refused() {
+    let root = tempfile::tempdir().unwrap();
+    let out = root.path().join("kit");
+    fs::write(&out, b"a file").unwrap();
+    let err = write_kit(&test_kit(), &out, &opts()).unwrap_err();
+    assert!(matches!(err, ExportError::NotADirectory { .. }), "{err}");
+    assert_eq!(fs::read(&out).unwrap(), b"a file");
+    assert_eq!(entries(root.path()), ["kit"]);
+}
+
+#[test]
+fn reexport_replaces_the_previous_export() {
+    let root = tempfile::tempdir().unwrap();
+    let out = root.path().join("kit");
+    let first = write_kit(&test_kit(), &out, &opts()).unwrap();
+    assert!(!first.replaced_previous_export);
+    let mut smaller = test_kit();
+    smaller.parts.truncate(2);
+    let second = write_kit(&smaller, &out, &opts()).unwrap();
+    assert!(second.replaced_previous_export);
+    assert!(second.warnings.is_empty(), "{:?}", second.warnings);
+    assert_eq!(
+        entries(&out.join("parts")),
+        ["base_plate.stl", "pillar.stl"]
+    );
+    assert_eq!(read_manifest(&out).parts.len(), 2);
+    // no temporary or backup sibling is left
+    assert_eq!(entries(root.path()), ["kit"]);
+    for f in &second.files {
+        assert!(f.is_file(), "{}", f.display());
+    }
+}
+
+#[test]
+fn empty_directory_and_missing_parents_are_fine() {
+    let root = tempfile::tempdir().unwrap();
+    let empty = root.path().join("empty");
+    fs::create_dir(&empty).unwrap();
+    write_kit(&test_kit(), &empty, &opts()).unwrap();
+    assert!(empty.join("manifest.json").is_file());
+    let deep = root.path().join("a").join("b").join("kit");
+    write_kit(&test_kit(), &deep, &opts()).unwrap();
+    assert!(deep.join("tiny.3mf").is_file());
+    assert_eq!(entries(&root.path().join("a").join("b")), ["kit"]);
+}
+
+/// Needs PrusaSlicer on PATH: `cargo test -p fabkit-export -- --ignored`.
+#[test]
+#[ignore = "needs prusa-slicer on PATH"]
+fn prusa_slicer_reports_every_object_manifold() {
+    let root = tempfile::tempdir().unwrap();
+    let out = root.path().join("kit");
+    write_kit(&test_kit(), &out, &opts()).unwrap();
+    let o = std::process::Command::new("prusa-slicer")
+        .arg("--info")
+        .arg(out.join("tiny.3mf"))
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "{text}\n{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert_eq!(text.matches("manifold = yes").count(), 5, "{text}");
+    assert!(!text.contains("manifold = no"), "{text}");
+}
