@@ -8,6 +8,7 @@ use crate::materials::{pour, MaterialsTable};
 use crate::molds::{build_mold, cast_plans};
 use crate::schema::Design;
 use crate::stack::{validate, Stack};
+use rayon::prelude::*;
 use serde_json::json;
 
 /// Validates `design` and builds every part of its kit at chord tolerance `tol`.
@@ -26,8 +27,25 @@ pub fn build_kit(design: &Design, tol: ChordTolerance) -> Result<Kit, DesignErro
     let mut parts = Vec::new();
     let mut silicone = Vec::new();
     let mut gel = Vec::new();
-    for plan in &plans {
-        let out = build_mold(design, &stack, plan, tol)?;
+    // Casts and the shell are independent: build them in parallel. Each build is
+    // single-threaded and the results are collected in order, so the output does not depend
+    // on the thread count.
+    let (molds, shell) = rayon::join(
+        || {
+            plans
+                .par_iter()
+                .map(|plan| build_mold(design, &stack, plan, tol))
+                .collect::<Vec<_>>()
+        },
+        || {
+            design
+                .housing
+                .as_ref()
+                .map(|h| crate::housing::build_shell(design, h, &stack, tol))
+        },
+    );
+    for (plan, out) in plans.iter().zip(molds) {
+        let out = out?;
         let layer = &stack.layers[plan.layer];
         if let Some((v, holders)) = out.silicone_pour {
             silicone.push((format!("silicone_mold:{}", layer.name), v, holders));
@@ -49,8 +67,8 @@ pub fn build_kit(design: &Design, tol: ChordTolerance) -> Result<Kit, DesignErro
         "core": stack.core,
         "layers": stack.layers,
     });
-    if let Some(h) = &design.housing {
-        let (shell, levels) = crate::housing::build_shell(design, h, &stack, tol)?;
+    if let (Some(h), Some(shell)) = (&design.housing, shell) {
+        let (shell, levels) = shell?;
         parts.extend(shell);
         let r = design.body.rim_radius_mm(0.0);
         let w = h.outer_width_mm.max(2.0 * r);

@@ -75,6 +75,7 @@ pub fn check_housing_params(
     let fdm = &design.printers.fdm;
     let half = h.outer_width_mm / 2.0;
     let c = h.fit_clearance_mm;
+    let errors_before = errs.len();
     let mut pos = |path: &str, v: f64| {
         if !(v > 0.0 && v.is_finite()) {
             errs.push(ParamError::new(path, v, "must be above 0"));
@@ -108,6 +109,14 @@ pub fn check_housing_params(
         ),
         ("housing.diffuser.thickness_mm", h.diffuser.thickness_mm),
         (
+            "housing.diffuser.inner_diameter_mm",
+            h.diffuser.inner_diameter_mm,
+        ),
+        (
+            "housing.led_pcb.inner_diameter_mm",
+            h.led_pcb.inner_diameter_mm,
+        ),
+        (
             "housing.diffuser.gap_above_pcb_mm",
             h.diffuser.gap_above_pcb_mm,
         ),
@@ -138,7 +147,7 @@ pub fn check_housing_params(
     ] {
         pos(p, v);
     }
-    if !errs.iter().all(|e| !e.path.starts_with("housing.")) {
+    if errs.len() > errors_before {
         return;
     }
     let wall = |errs: &mut Vec<ParamError>, path: &str, value: f64, room: f64, what: &str| {
@@ -208,6 +217,26 @@ pub fn check_housing_params(
                 h.camera.lens_hole_diameter_mm
             ),
         ));
+    }
+    for (path, inner, outer) in [
+        (
+            "housing.led_pcb.inner_diameter_mm",
+            h.led_pcb.inner_diameter_mm,
+            h.led_pcb.outer_diameter_mm,
+        ),
+        (
+            "housing.diffuser.inner_diameter_mm",
+            h.diffuser.inner_diameter_mm,
+            h.diffuser.outer_diameter_mm,
+        ),
+    ] {
+        if inner >= outer {
+            errs.push(ParamError::new(
+                path,
+                inner,
+                format!("must be below the outer diameter ({outer} mm)"),
+            ));
+        }
     }
     if h.camera.mount_hole_spacing_mm > h.camera.board_width_mm {
         errs.push(ParamError::new(

@@ -202,6 +202,13 @@ pub fn check_mold_params(design: &Design, errs: &mut Vec<ParamError>) {
             errs.push(ParamError::new(p, v, "must be 0 or more"));
         }
     }
+    if m.vent.count == 0 {
+        errs.push(ParamError::new(
+            "mold.vent.count",
+            0,
+            "at least one vent is needed to let air out of the cavity",
+        ));
+    }
     if !(0.0..10.0).contains(&m.draft_angle_deg) {
         errs.push(ParamError::new(
             "mold.draft_angle_deg",

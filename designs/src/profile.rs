@@ -11,9 +11,10 @@ use crate::geometry::{ChordTolerance, Polyline2};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::FRAC_PI_2;
 
-/// The outer surface of a sensor skin.
+/// The outer surface of a sensor skin. In YAML: a mapping with `profile:` (the variant name in
+/// snake case) and that variant's fields.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "profile", rename_all = "snake_case", deny_unknown_fields)]
+#[serde(try_from = "BodyYaml", into = "BodyYaml")]
 pub enum BodyProfile {
     /// A spherical cap: base circle of `base_diameter_mm` on the base plane, pole
     /// `height_mm` above it (ShadowTac skin: 35 mm x 8 mm, ShadowTac Sec. III).
@@ -30,6 +31,130 @@ pub enum BodyProfile {
     /// Half an ellipsoid of revolution: `diameter_mm` across the base, `height_mm` from the
     /// base plane to the pole (UVDtact, Sec. III).
     HalfEllipsoid { diameter_mm: f64, height_mm: f64 },
+}
+
+/// The YAML form of [`BodyProfile`]: one flat mapping, so that an unknown key is reported at
+/// its own line and column (serde's internally tagged enums lose locations).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodyYaml {
+    pub profile: ProfileKind,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radius_mm: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cylinder_length_mm: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub base_diameter_mm: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub diameter_mm: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub height_mm: Option<f64>,
+}
+
+/// The profile names of the YAML `profile` key.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ProfileKind {
+    SphericalCap,
+    HemisphereOnCylinder,
+    HalfEllipsoid,
+}
+
+impl TryFrom<BodyYaml> for BodyProfile {
+    type Error = String;
+    fn try_from(y: BodyYaml) -> Result<Self, String> {
+        let fields = [
+            ("radius_mm", y.radius_mm),
+            ("cylinder_length_mm", y.cylinder_length_mm),
+            ("base_diameter_mm", y.base_diameter_mm),
+            ("diameter_mm", y.diameter_mm),
+            ("height_mm", y.height_mm),
+        ];
+        let (kind, wanted): (&str, &[&str]) = match y.profile {
+            ProfileKind::SphericalCap => ("spherical_cap", &["base_diameter_mm", "height_mm"]),
+            ProfileKind::HemisphereOnCylinder => (
+                "hemisphere_on_cylinder",
+                &["radius_mm", "cylinder_length_mm"],
+            ),
+            ProfileKind::HalfEllipsoid => ("half_ellipsoid", &["diameter_mm", "height_mm"]),
+        };
+        let mut problems = Vec::new();
+        for (name, v) in fields {
+            match (wanted.contains(&name), v) {
+                (true, None) => {
+                    problems.push(format!("body.{name} is required for profile {kind}"))
+                }
+                (false, Some(_)) => problems.push(format!(
+                    "body.{name} does not apply to profile {kind} (it takes {})",
+                    wanted.join(", ")
+                )),
+                _ => {}
+            }
+        }
+        if !problems.is_empty() {
+            return Err(problems.join("; "));
+        }
+        let g = |n: &str| {
+            fields
+                .iter()
+                .find(|(k, _)| *k == n)
+                .and_then(|(_, v)| *v)
+                .unwrap_or_default()
+        };
+        Ok(match y.profile {
+            ProfileKind::SphericalCap => Self::SphericalCap {
+                base_diameter_mm: g("base_diameter_mm"),
+                height_mm: g("height_mm"),
+            },
+            ProfileKind::HemisphereOnCylinder => Self::HemisphereOnCylinder {
+                radius_mm: g("radius_mm"),
+                cylinder_length_mm: g("cylinder_length_mm"),
+            },
+            ProfileKind::HalfEllipsoid => Self::HalfEllipsoid {
+                diameter_mm: g("diameter_mm"),
+                height_mm: g("height_mm"),
+            },
+        })
+    }
+}
+
+impl From<BodyProfile> for BodyYaml {
+    fn from(b: BodyProfile) -> Self {
+        let mut y = BodyYaml {
+            profile: ProfileKind::SphericalCap,
+            radius_mm: None,
+            cylinder_length_mm: None,
+            base_diameter_mm: None,
+            diameter_mm: None,
+            height_mm: None,
+        };
+        match b {
+            BodyProfile::SphericalCap {
+                base_diameter_mm,
+                height_mm,
+            } => {
+                y.base_diameter_mm = Some(base_diameter_mm);
+                y.height_mm = Some(height_mm);
+            }
+            BodyProfile::HemisphereOnCylinder {
+                radius_mm,
+                cylinder_length_mm,
+            } => {
+                y.profile = ProfileKind::HemisphereOnCylinder;
+                y.radius_mm = Some(radius_mm);
+                y.cylinder_length_mm = Some(cylinder_length_mm);
+            }
+            BodyProfile::HalfEllipsoid {
+                diameter_mm,
+                height_mm,
+            } => {
+                y.profile = ProfileKind::HalfEllipsoid;
+                y.diameter_mm = Some(diameter_mm);
+                y.height_mm = Some(height_mm);
+            }
+        }
+        y
+    }
 }
 
 impl BodyProfile {

@@ -388,17 +388,27 @@ impl Design {
 /// Formats a serde-saphyr error as `file:line:column: message`.
 pub fn yaml_error(origin: &str, e: &serde_saphyr::Error) -> String {
     let msg = e.to_string();
+    let first = msg.lines().next().unwrap_or(&msg);
     match e.location() {
         Some(loc) => format!(
             "{origin}:{}:{}: {}",
             loc.line(),
             loc.column(),
-            first_line(&msg)
+            strip_location(first)
         ),
-        None => format!("{origin}: {msg}"),
+        None => format!("{origin}: {first}"),
     }
 }
 
-fn first_line(s: &str) -> &str {
-    s.lines().next().unwrap_or(s)
+/// Drops serde-saphyr's own `error: line N column M: ` prefix (we print file:line:col).
+fn strip_location(s: &str) -> &str {
+    let s = s.strip_prefix("error: ").unwrap_or(s);
+    if s.starts_with("line ") {
+        if let Some(i) = s.find(": ") {
+            if s[..i].contains("column") {
+                return &s[i + 2..];
+            }
+        }
+    }
+    s
 }

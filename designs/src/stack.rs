@@ -164,6 +164,7 @@ pub fn validate(
         ));
     }
     let mut names = std::collections::BTreeSet::new();
+    let errors_before_layer_specs = errs.len();
     for (i, l) in design.layers.iter().enumerate() {
         if !is_identifier(&l.name) {
             errs.push(ParamError::new(
@@ -194,7 +195,20 @@ pub fn validate(
             )),
             _ => {}
         }
+        for (what, v) in [
+            ("thickness_mm", l.thickness_mm),
+            ("outer_radius_mm", l.outer_radius_mm),
+        ] {
+            if v.is_some_and(|v| !v.is_finite()) {
+                errs.push(ParamError::new(
+                    format!("layers[{i}].{what}"),
+                    v.unwrap_or_default(),
+                    "must be a finite number",
+                ));
+            }
+        }
     }
+    let layer_specs_ok = errs.len() == errors_before_layer_specs;
     if design
         .layers
         .iter()
@@ -246,14 +260,24 @@ pub fn validate(
     // Resolve the stack from the inside out, in "radius" units for spheres (r = R + offset).
     let mut layers = Vec::new();
     let mut core = None;
-    if body_ok && errs.iter().all(|e| !e.path.starts_with("layers[")) && !design.layers.is_empty() {
+    let mut stack_ok = false;
+    if body_ok && layer_specs_ok && !design.layers.is_empty() {
         let total_t: Option<f64> = design.layers.iter().map(|l| l.thickness_mm).sum();
         // Offset of the core's outer surface.
         let core_out = match (sphere_r, design.core.outer_diameter_mm) {
+            (_, Some(od)) if !(od > 0.0 && od.is_finite()) => {
+                errs.push(ParamError::new(
+                    "core.outer_diameter_mm",
+                    od,
+                    "must be above 0",
+                ));
+                None
+            }
             (Some(r), Some(od)) => Some(od / 2.0 - r),
             _ => total_t.map(|s| -s),
         };
         match core_out {
+            None if design.core.outer_diameter_mm.is_some() => {}
             None => errs.push(ParamError::new(
                 "core.outer_diameter_mm",
                 "missing",
@@ -263,6 +287,7 @@ pub fn validate(
                 let r_body = sphere_r.unwrap_or(0.0);
                 let mut below = core_out;
                 let mut below_name = "the core".to_string();
+                let errors_before_stack = errs.len();
                 for (i, l) in design.layers.iter().enumerate() {
                     let (out, path, value) = match (l.thickness_mm, l.outer_radius_mm) {
                         (Some(th), _) => (below + th, format!("layers[{i}].thickness_mm"), th),
@@ -270,7 +295,7 @@ pub fn validate(
                         _ => unreachable!("checked above"),
                     };
                     let th = out - below;
-                    if th < t {
+                    if !(th >= t) {
                         let rule = if i == 0 && l.outer_radius_mm.is_some() && th < 0.0 {
                             format!(
                                 "the core (outer radius {:.3} mm) is larger than the cavity of layer '{}' (outer radius {:.3} mm)",
@@ -302,7 +327,10 @@ pub fn validate(
                     below = out;
                     below_name = format!("layer '{}'", l.name);
                 }
-                if below.abs() > 1e-9 {
+                // A layer error already explains a stack that misses the body surface.
+                stack_ok = errs.len() == errors_before_stack;
+                if stack_ok && below.abs() > 1e-9 {
+                    stack_ok = false;
                     let last = design.layers.len() - 1;
                     errs.push(ParamError::new(
                         if sphere_r.is_some() { "body.radius_mm" } else { "layers" },
@@ -322,7 +350,7 @@ pub fn validate(
                 let core_in = core_out - design.core.wall_thickness_mm;
                 let pole_z = design.body.pole_z_mm(core_out);
                 let below_base = design.core.length_mm - (pole_z - design.body.base_z_mm());
-                if !(design.core.length_mm > 0.0) || below_base < 0.0 {
+                if stack_ok && (!(design.core.length_mm > 0.0) || below_base < 0.0) {
                     errs.push(ParamError::new(
                         "core.length_mm",
                         design.core.length_mm,
@@ -358,10 +386,13 @@ pub fn validate(
     }
 
     crate::molds::check_mold_params(design, &mut errs);
+    check_printers(design, &mut errs);
+    // Checks that use the core only make sense once the stack itself is sound.
+    let sound_core = core.as_ref().filter(|_| stack_ok);
     if let Some(h) = &design.housing {
-        crate::housing::check_housing_params(design, h, core.as_ref(), &mut errs);
+        crate::housing::check_housing_params(design, h, sound_core, &mut errs);
     }
-    if let (Some(c), true) = (&core, errs.is_empty()) {
+    if let (Some(c), true) = (sound_core, errs.is_empty()) {
         if let Some(first) = layers.iter().find(|l| l.process == LayerProcess::Cast) {
             crate::molds::check_mold_fit(design, c, first.outer_offset_mm, &mut errs);
         }
@@ -369,5 +400,25 @@ pub fn validate(
     match (errs.is_empty(), core) {
         (true, Some(core)) => Ok(Stack { core, layers }),
         _ => Err(ParamErrors(errs)),
+    }
+}
+
+fn check_printers(design: &Design, errs: &mut Vec<ParamError>) {
+    for (name, p) in [("fdm", &design.printers.fdm), ("sla", &design.printers.sla)] {
+        for (field, v) in [
+            ("xy_resolution_mm", p.xy_resolution_mm),
+            ("layer_height_mm", p.layer_height_mm),
+            ("min_wall_mm", p.min_wall_mm),
+            ("min_hole_diameter_mm", p.min_hole_diameter_mm),
+            ("min_feature_mm", p.min_feature_mm),
+        ] {
+            if !(v > 0.0 && v.is_finite()) {
+                errs.push(ParamError::new(
+                    format!("printers.{name}.{field}"),
+                    v,
+                    "must be above 0",
+                ));
+            }
+        }
     }
 }

@@ -1,0 +1,650 @@
+//! Validation tests (STYLE.md, "Tests" and "Errors"): the library design `rtac0` is a valid
+//! baseline that builds; one mutation yields exactly one error naming its parameter path, value
+//! and rule; several mutations yield all their errors at once; YAML errors point at
+//! file:line:column; a `ParamError` prints as `path = value: rule`.
+//!
+
+use fabkit_designs::materials::MaterialsTable;
+use fabkit_designs::stack::validate;
+use fabkit_designs::{build_kit, ChordTolerance, Design, DesignError, ParamError};
+
+const ORIGIN: &str = "x.yaml";
+
+fn text() -> &'static str {
+    fabkit_designs::library::yaml("rtac0").expect("rtac0 is in the library")
+}
+
+fn baseline() -> Design {
+    Design::from_yaml(text(), ORIGIN).expect("rtac0 parses")
+}
+
+/// Every error `validate` reports at tolerance `tol` (empty when the design is valid).
+fn errors_at(d: &Design, tol: ChordTolerance) -> Vec<ParamError> {
+    let materials = MaterialsTable::embedded().expect("embedded materials table");
+    match validate(d, &materials, tol) {
+        Ok(_) => Vec::new(),
+        Err(e) => e.0,
+    }
+}
+
+fn errors(d: &Design) -> Vec<ParamError> {
+    errors_at(d, ChordTolerance::default())
+}
+
+fn listing(errs: &[ParamError]) -> String {
+    errs.iter().map(|e| format!("\n  {e}")).collect()
+}
+
+/// What one expected error looks like: its path, its value as printed, and words its rule
+/// must contain.
+struct Expect {
+    path: &'static str,
+    value: &'static str,
+    rule: &'static [&'static str],
+}
+
+fn matches(e: &ParamError, x: &Expect) -> bool {
+    e.path == x.path && e.value == x.value && x.rule.iter().all(|w| e.rule.contains(w))
+}
+
+/// `errs` is exactly the expected errors, in any order.
+fn assert_exactly(errs: &[ParamError], expected: &[&Expect]) {
+    assert_eq!(
+        errs.len(),
+        expected.len(),
+        "expected {} error(s), got:{}",
+        expected.len(),
+        listing(errs)
+    );
+    for x in expected {
+        assert!(
+            errs.iter().any(|e| matches(e, x)),
+            "no error `{} = {}: ...{:?}...` among:{}",
+            x.path,
+            x.value,
+            x.rule,
+            listing(errs)
+        );
+    }
+}
+
+fn housing(d: &mut Design) -> &mut fabkit_designs::schema::HousingParams {
+    d.housing.as_mut().expect("rtac0 has a housing")
+}
+
+// ---------------------------------------------------------------------------------------------
+// The baseline.
+
+#[test]
+fn baseline_validates_and_builds() {
+    let d = baseline();
+    let materials = MaterialsTable::embedded().unwrap();
+    let stack = validate(&d, &materials, ChordTolerance::default())
+        .unwrap_or_else(|e| panic!("rtac0 does not validate: {e}"));
+    // The stack the YAML describes: core 20 mm (offset 10 - 15.1), layers to 13.5, 15.0, 15.1.
+    assert_eq!(stack.layers.len(), 3);
+    let outer: Vec<f64> = stack
+        .layers
+        .iter()
+        .map(|l| 15.1 + l.outer_offset_mm)
+        .collect();
+    for (got, want) in outer.iter().zip([13.5, 15.0, 15.1]) {
+        assert!((got - want).abs() < 1e-9, "outer radii {outer:?}");
+    }
+    assert!((stack.core.outer_offset_mm - (10.0 - 15.1)).abs() < 1e-9);
+    assert!(stack
+        .layers
+        .iter()
+        .all(|l| l.thickness_mm >= ChordTolerance::DEFAULT_MM));
+
+    let kit = build_kit(&d, ChordTolerance::default())
+        .unwrap_or_else(|e| panic!("rtac0 does not build: {e}"));
+    assert_eq!(kit.design, "rtac0");
+    assert!(!kit.parts.is_empty());
+    for p in &kit.parts {
+        p.solid
+            .mesh()
+            .check_closed_manifold()
+            .unwrap_or_else(|e| panic!("part {}: {e}", p.name));
+        assert!(p.solid.volume() > 0.0, "part {} is empty", p.name);
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// One mutation, one error.
+
+/// The single mutations of the baseline that each break exactly one rule, with that error.
+fn single_mutations() -> Vec<(&'static str, fn(&mut Design), Expect)> {
+    vec![
+        (
+            "translucent layer thinner than the chord tolerance",
+            |d| d.layers[1].outer_radius_mm = Some(13.505),
+            Expect {
+                path: "layers[1].outer_radius_mm",
+                value: "13.505",
+                rule: &["translucent_gel", "0.0050 mm thick", "below the chord tolerance 0.01 mm"],
+            },
+        ),
+        (
+            "vent below the fixture printer's minimum hole",
+            |d| d.mold.vent.diameter_mm = 0.3,
+            Expect {
+                path: "mold.vent.diameter_mm",
+                value: "0.3",
+                rule: &["minimum hole 1 mm", "printer profile 'fdm'"],
+            },
+        ),
+        (
+            "draft angle of 12 degrees",
+            |d| d.mold.draft_angle_deg = 12.0,
+            Expect {
+                path: "mold.draft_angle_deg",
+                value: "12",
+                rule: &["must be in [0, 10)"],
+            },
+        ),
+        (
+            "unknown layer material",
+            |d| d.layers[0].material = "unobtainium".into(),
+            Expect {
+                path: "layers[0].material",
+                value: "unobtainium",
+                rule: &["unknown material", "sylgard_184"],
+            },
+        ),
+        (
+            "printing filament as a cast layer",
+            |d| d.layers[1].material = "pla".into(),
+            Expect {
+                path: "layers[1].material",
+                value: "pla",
+                rule: &["Print material", "Cast"],
+            },
+        ),
+        (
+            "unknown housing material",
+            |d| housing(d).material = "unobtainium".into(),
+            Expect {
+                path: "housing.material",
+                value: "unobtainium",
+                rule: &["unknown material"],
+            },
+        ),
+        (
+            "negative core wall",
+            |d| d.core.wall_thickness_mm = -1.0,
+            Expect {
+                path: "core.wall_thickness_mm",
+                value: "-1",
+                rule: &["must be above 0"],
+            },
+        ),
+        (
+            "camera board wider than the shell allows",
+            |d| housing(d).camera.board_width_mm = 29.0,
+            Expect {
+                path: "housing.camera.board_width_mm",
+                value: "29",
+                rule: &["0.30 mm of wall", "beside the camera bay", "printer profile 'fdm'"],
+            },
+        ),
+        (
+            "diffuser wider than the shell allows",
+            |d| housing(d).diffuser.outer_diameter_mm = 29.5,
+            Expect {
+                path: "housing.diffuser.outer_diameter_mm",
+                value: "29.5",
+                rule: &["0.05 mm of wall", "around the diffuser seat", "minimum wall 0.8 mm"],
+            },
+        ),
+        (
+            // The translucent layer above the coating: the coating is then below the layer
+            // under it (a single error, as when lowering the coating; see
+            // `coating_below_the_layer_under_it_yields_one_error`).
+            "translucent layer above the coating",
+            |d| d.layers[1].outer_radius_mm = Some(15.2),
+            Expect {
+                path: "layers[2].outer_radius_mm",
+                value: "15.1",
+                rule: &["must be above the outer radius of layer 'translucent_gel' under it (15.200 mm)"],
+            },
+        ),
+        (
+            "waste allowance above 1",
+            |d| d.casting.waste_allowance = 1.5,
+            Expect {
+                path: "casting.waste_allowance",
+                value: "1.5",
+                rule: &["must be in [0, 1]"],
+            },
+        ),
+    ]
+}
+
+#[test]
+fn each_single_mutation_yields_exactly_its_one_error() {
+    for (what, mutate, expect) in single_mutations() {
+        let mut d = baseline();
+        mutate(&mut d);
+        let errs = errors(&d);
+        assert!(
+            errs.len() == 1 && matches(&errs[0], &expect),
+            "{what}: expected only `{} = {}: ...{:?}...`, got:{}",
+            expect.path,
+            expect.value,
+            expect.rule,
+            listing(&errs)
+        );
+    }
+}
+
+/// The same layer is fine at the default 0.01 mm tolerance and too thin at a coarse one: the
+/// rule uses the tolerance passed in, not a global.
+#[test]
+fn a_layer_thinner_than_a_coarse_tolerance_is_named() {
+    let d = baseline();
+    assert_exactly(&errors_at(&d, ChordTolerance::new(0.099).unwrap()), &[]);
+    let errs = errors_at(&d, ChordTolerance::new(0.2).unwrap());
+    assert_exactly(
+        &errs,
+        &[&Expect {
+            path: "layers[2].outer_radius_mm",
+            value: "15.1",
+            rule: &["black_coating", "below the chord tolerance 0.2 mm"],
+        }],
+    );
+}
+
+#[test]
+fn draft_angle_bounds_are_half_open() {
+    for (deg, ok) in [(0.0, true), (9.99, true), (10.0, false), (-0.1, false)] {
+        let mut d = baseline();
+        d.mold.draft_angle_deg = deg;
+        let errs = errors(&d);
+        if ok {
+            assert_exactly(&errs, &[]);
+        } else {
+            assert!(
+                errs.len() == 1 && errs[0].path == "mold.draft_angle_deg",
+                "draft {deg}:{}",
+                listing(&errs)
+            );
+        }
+    }
+}
+
+/// A mutation written into the YAML text gives the same error as the same mutation in Rust.
+#[test]
+fn a_mutation_in_the_yaml_text_is_reported_like_one_in_rust() {
+    let t = text().replacen("draft_angle_deg: 2.0", "draft_angle_deg: 12", 1);
+    assert_ne!(t, text());
+    let d = Design::from_yaml(&t, ORIGIN).unwrap();
+    let errs = errors(&d);
+    assert_eq!(errs.len(), 1, "{}", listing(&errs));
+    assert_eq!(
+        errs[0].to_string(),
+        "mold.draft_angle_deg = 12: must be in [0, 10)"
+    );
+}
+
+/// The LED PCB seat at 29.5 mm breaks two independent rules at once: it leaves a 0.05 mm wall
+/// and it covers the camera board's mounting holes (on a 20 mm square, at 14.14 mm from the
+/// axis). Every LED PCB wide enough to thin the wall below 0.8 mm (over 28 mm) also covers the
+/// holes (over 24.7 mm), so no value of this one parameter gives the wall error alone.
+#[test]
+fn led_pcb_too_wide_thins_the_wall_and_covers_the_mount_holes() {
+    let mut d = baseline();
+    housing(&mut d).led_pcb.outer_diameter_mm = 29.5;
+    assert_exactly(
+        &errors(&d),
+        &[
+            &Expect {
+                path: "housing.led_pcb.outer_diameter_mm",
+                value: "29.5",
+                rule: &[
+                    "0.05 mm of wall",
+                    "around the LED PCB seat",
+                    "printer profile 'fdm'",
+                ],
+            },
+            &Expect {
+                path: "housing.camera.mount_hole_spacing_mm",
+                value: "20",
+                rule: &["under the LED PCB seat"],
+            },
+        ],
+    );
+}
+
+/// The core-larger-than-cavity rule is named on the innermost layer with the radii.
+#[test]
+fn core_larger_than_its_cavity_is_named() {
+    let mut d = baseline();
+    d.core.outer_diameter_mm = Some(28.0);
+    let errs = errors(&d);
+    let want = Expect {
+        path: "layers[0].outer_radius_mm",
+        value: "13.5",
+        rule: &[
+            "the core (outer radius 14.000 mm) is larger than the cavity of layer 'transparent_gel' (outer radius 13.500 mm)",
+        ],
+    };
+    assert!(errs.iter().any(|e| matches(e, &want)), "{}", listing(&errs));
+}
+
+#[test]
+fn core_larger_than_its_cavity_yields_one_error() {
+    let mut d = baseline();
+    d.core.outer_diameter_mm = Some(28.0);
+    assert_exactly(
+        &errors(&d),
+        &[&Expect {
+            path: "layers[0].outer_radius_mm",
+            value: "13.5",
+            rule: &["larger than the cavity"],
+        }],
+    );
+}
+
+#[test]
+fn coating_below_the_layer_under_it_is_named() {
+    let mut d = baseline();
+    d.layers[2].outer_radius_mm = Some(14.9);
+    let errs = errors(&d);
+    let want = Expect {
+        path: "layers[2].outer_radius_mm",
+        value: "14.9",
+        rule: &["must be above the outer radius of layer 'translucent_gel' under it (15.000 mm)"],
+    };
+    assert!(errs.iter().any(|e| matches(e, &want)), "{}", listing(&errs));
+}
+
+#[test]
+fn coating_below_the_layer_under_it_yields_one_error() {
+    let mut d = baseline();
+    d.layers[2].outer_radius_mm = Some(14.9);
+    assert_exactly(
+        &errors(&d),
+        &[&Expect {
+            path: "layers[2].outer_radius_mm",
+            value: "14.9",
+            rule: &["must be above the outer radius of layer 'translucent_gel' under it"],
+        }],
+    );
+}
+
+/// A NaN radius (`outer_radius_mm: .nan` in YAML) passes every comparison in the stack
+/// check (`th < t` is false for NaN), so validation accepts it and the kernel rejects it later
+/// as a "fabkit defect" instead of a named parameter error.
+#[test]
+fn a_nan_layer_radius_is_a_named_error() {
+    let t = with_line(
+        29,
+        "    outer_radius_mm: 15.0",
+        &["    outer_radius_mm: .nan"],
+    );
+    let d = Design::from_yaml(&t, ORIGIN).expect("`.nan` is a YAML float");
+    assert!(d.layers[1].outer_radius_mm.unwrap().is_nan());
+    let errs = errors(&d);
+    assert!(
+        errs.iter().any(|e| e.path == "layers[1].outer_radius_mm"),
+        "no error names layers[1].outer_radius_mm:{}",
+        listing(&errs)
+    );
+}
+
+// ---------------------------------------------------------------------------------------------
+// Several mutations, every error at once.
+
+#[test]
+fn two_mutations_yield_both_errors() {
+    let mut d = baseline();
+    d.mold.vent.diameter_mm = 0.3;
+    d.mold.draft_angle_deg = 12.0;
+    d.layers[1].outer_radius_mm = Some(13.505);
+    housing(&mut d).camera.board_width_mm = 29.0;
+    let singles = single_mutations();
+    let find = |path: &str| &singles.iter().find(|(_, _, x)| x.path == path).unwrap().2;
+    assert_exactly(
+        &errors(&d),
+        &[
+            find("mold.vent.diameter_mm"),
+            find("mold.draft_angle_deg"),
+            find("layers[1].outer_radius_mm"),
+            find("housing.camera.board_width_mm"),
+        ],
+    );
+}
+
+#[test]
+fn every_pair_of_single_mutations_yields_both_errors() {
+    let singles = single_mutations();
+    for (i, (what_a, mutate_a, expect_a)) in singles.iter().enumerate() {
+        for (what_b, mutate_b, expect_b) in &singles[i + 1..] {
+            // two mutations of layers[1].outer_radius_mm overwrite each other
+            let radius = |p: &str| p.ends_with(".outer_radius_mm");
+            if radius(expect_a.path) && radius(expect_b.path) {
+                continue;
+            }
+            let mut d = baseline();
+            mutate_a(&mut d);
+            mutate_b(&mut d);
+            let errs = errors(&d);
+            assert!(
+                errs.len() == 2
+                    && errs.iter().any(|e| matches(e, expect_a))
+                    && errs.iter().any(|e| matches(e, expect_b)),
+                "{what_a} + {what_b}: got{}",
+                listing(&errs)
+            );
+        }
+    }
+}
+
+#[test]
+fn an_unknown_layer_material_does_not_hide_stack_errors() {
+    let mut d = baseline();
+    d.layers[0].material = "unobtainium".into();
+    d.layers[1].outer_radius_mm = Some(13.505);
+    let singles = single_mutations();
+    let find = |path: &str| &singles.iter().find(|(_, _, x)| x.path == path).unwrap().2;
+    assert_exactly(
+        &errors(&d),
+        &[
+            find("layers[0].material"),
+            find("layers[1].outer_radius_mm"),
+        ],
+    );
+}
+
+#[test]
+fn an_unknown_housing_material_does_not_hide_housing_errors() {
+    let mut d = baseline();
+    housing(&mut d).material = "unobtainium".into();
+    housing(&mut d).camera.board_width_mm = 29.0;
+    let singles = single_mutations();
+    let find = |path: &str| &singles.iter().find(|(_, _, x)| x.path == path).unwrap().2;
+    assert_exactly(
+        &errors(&d),
+        &[
+            find("housing.material"),
+            find("housing.camera.board_width_mm"),
+        ],
+    );
+}
+
+// ---------------------------------------------------------------------------------------------
+// YAML errors carry file:line:column.
+
+/// The text with `line` (1-based) replaced by `new` (several lines, or none, allowed).
+fn with_line(line: usize, old: &str, new: &[&str]) -> String {
+    let mut lines: Vec<&str> = text().lines().collect();
+    assert!(
+        lines[line - 1].starts_with(old),
+        "line {line} of rtac0.yaml is {:?}, expected it to start with {old:?}",
+        lines[line - 1]
+    );
+    lines.splice(line - 1..line, new.iter().copied());
+    lines.join("\n") + "\n"
+}
+
+/// (line, column, message) of a YAML error for `text`, asserting the `x.yaml:L:C: ` form.
+fn yaml_error(text: &str) -> (usize, usize, String) {
+    let msg = match Design::from_yaml(text, ORIGIN) {
+        Err(DesignError::Yaml(msg)) => msg,
+        Err(e) => panic!("expected a YAML error, got {e:?}"),
+        Ok(_) => panic!("expected a YAML error, the text parsed"),
+    };
+    let rest = msg
+        .strip_prefix("x.yaml:")
+        .unwrap_or_else(|| panic!("{msg:?} does not start with the file name"));
+    let mut it = rest.splitn(3, ':');
+    let line = it.next().and_then(|s| s.parse().ok());
+    let col = it.next().and_then(|s| s.parse().ok());
+    match (line, col, it.next()) {
+        (Some(l), Some(c), Some(m)) if m.starts_with(' ') => (l, c, m.to_string()),
+        _ => panic!("{msg:?} is not `x.yaml:LINE:COLUMN: message`"),
+    }
+}
+
+#[test]
+fn unknown_key_points_at_its_line() {
+    // line 15 is `  description: ...` under `core:`; the new key takes its place
+    let t = with_line(
+        15,
+        "  description:",
+        &["  colour: red", text().lines().nth(14).unwrap()],
+    );
+    let (line, col, msg) = yaml_error(&t);
+    assert_eq!((line, col), (15, 3), "{msg}");
+    assert!(msg.contains("unknown field `colour`"), "{msg}");
+
+    // a key in a layer (a sequence item) and one in a nested mold section
+    let t = with_line(
+        24,
+        "    process: cast",
+        &["    process: cast", "    colour: red"],
+    );
+    let (line, col, msg) = yaml_error(&t);
+    assert_eq!((line, col), (25, 5), "{msg}");
+    assert!(msg.contains("colour"), "{msg}");
+    let t = with_line(
+        38,
+        "  draft_angle_deg:",
+        &["  draft_angle_deg: 2.0", "  draft_angel_deg: 2.0"],
+    );
+    let (line, col, msg) = yaml_error(&t);
+    assert_eq!((line, col), (39, 3), "{msg}");
+    assert!(msg.contains("draft_angel_deg"), "{msg}");
+}
+
+#[test]
+fn wrong_type_points_at_the_value() {
+    // `  wall_thickness_mm: big`: the value starts in column 22
+    let t = with_line(
+        18,
+        "  wall_thickness_mm: 1.0",
+        &["  wall_thickness_mm: big"],
+    );
+    let (line, col, msg) = yaml_error(&t);
+    assert_eq!((line, col), (18, 22), "{msg}");
+    // `    outer_radius_mm: big` in a layer: column 22 as well
+    let t = with_line(
+        29,
+        "    outer_radius_mm: 15.0",
+        &["    outer_radius_mm: big"],
+    );
+    let (line, col, msg) = yaml_error(&t);
+    assert_eq!((line, col), (29, 22), "{msg}");
+    // an unknown enum variant
+    let t = with_line(24, "    process: cast", &["    process: poured"]);
+    let (line, col, msg) = yaml_error(&t);
+    assert_eq!(line, 24, "{msg}");
+    assert!((5..=14).contains(&col), "{msg}");
+    assert!(msg.contains("poured"), "{msg}");
+}
+
+#[test]
+fn missing_field_points_into_its_mapping() {
+    // remove `material:` (line 27) of layers[1], whose mapping then spans lines 26-28
+    let t = with_line(27, "    material: ecoflex_00_30", &[]);
+    let (line, col, msg) = yaml_error(&t);
+    assert!((26..=28).contains(&line), "{msg}");
+    assert!((3..=5).contains(&col), "{msg}");
+    assert!(msg.contains("missing field `material`"), "{msg}");
+}
+
+#[test]
+fn syntax_error_points_at_its_line() {
+    // a tab-indented key under `core:`
+    let t = with_line(16, "  material:", &["\tmaterial: borosilicate_glass"]);
+    let (line, _col, msg) = yaml_error(&t);
+    assert_eq!(line, 16, "{msg}");
+}
+
+#[test]
+fn errors_inside_body_point_at_their_line() {
+    // unknown key right under `body:` (new line 10)
+    let t = with_line(
+        10,
+        "  profile:",
+        &["  colour: red", "  profile: hemisphere_on_cylinder"],
+    );
+    let (line, col, msg) = yaml_error(&t);
+    assert_eq!((line, col), (10, 3), "{msg}");
+    assert!(msg.contains("unknown field `colour`"), "{msg}");
+    // wrong type: `  radius_mm: big`, the value starts in column 14
+    let t = with_line(11, "  radius_mm: 15.1", &["  radius_mm: big"]);
+    let (line, col, msg) = yaml_error(&t);
+    assert_eq!((line, col), (11, 14), "{msg}");
+    // an unknown profile: the value starts in column 12
+    let t = with_line(10, "  profile:", &["  profile: cone"]);
+    let (line, col, msg) = yaml_error(&t);
+    assert_eq!((line, col), (10, 12), "{msg}");
+    assert!(msg.contains("cone"), "{msg}");
+    // a key of another profile, and a missing one: inside the body mapping (lines 10-12)
+    let t = with_line(12, "  cylinder_length_mm:", &["  height_mm: 6.0"]);
+    let (line, _, msg) = yaml_error(&t);
+    assert!((10..=12).contains(&line), "{msg}");
+    assert!(
+        msg.contains("body.height_mm") && msg.contains("body.cylinder_length_mm"),
+        "{msg}"
+    );
+}
+
+// ---------------------------------------------------------------------------------------------
+// Display.
+
+#[test]
+fn param_error_displays_as_path_value_rule() {
+    let e = ParamError::new("mold.draft_angle_deg", 12.0, "must be below 10");
+    assert_eq!(e.to_string(), "mold.draft_angle_deg = 12: must be below 10");
+    let e = ParamError::new("layers[1].material", "unobtainium", "unknown material");
+    assert_eq!(
+        e.to_string(),
+        "layers[1].material = unobtainium: unknown material"
+    );
+
+    // and so does every error validate reports
+    let mut d = baseline();
+    d.layers[1].outer_radius_mm = Some(13.505);
+    d.mold.vent.diameter_mm = 0.3;
+    let errs = errors(&d);
+    assert_eq!(errs.len(), 2);
+    for e in &errs {
+        assert_eq!(
+            e.to_string(),
+            format!("{} = {}: {}", e.path, e.value, e.rule)
+        );
+    }
+    assert!(errs.iter().any(|e| e.to_string()
+        == "layers[1].outer_radius_mm = 13.505: leaves layer 'translucent_gel' 0.0050 mm thick, below the chord tolerance 0.01 mm"));
+    assert!(errs.iter().any(|e| e.to_string()
+        == "mold.vent.diameter_mm = 0.3: below the minimum hole 1 mm of printer profile 'fdm'"));
+    // the collection lists them all, one a line
+    let all = fabkit_designs::ParamErrors(errs.clone()).to_string();
+    assert!(all.starts_with("2 invalid design parameter(s):"), "{all}");
+    for e in &errs {
+        assert!(all.contains(&format!("\n  {e}")), "{all}");
+    }
+}

@@ -1,0 +1,258 @@
+//! The `fabkit` command line: argument parsing, dispatch, progress and error printing.
+//! No geometry here.
+
+use clap::{Parser, Subcommand, ValueEnum};
+use fabkit_designs::schema::MoldStrategy;
+use fabkit_designs::{build_kit, library, ChordTolerance, Design, DesignError};
+use fabkit_export::{write_kit, ExportOptions, Formats};
+use sha2::{Digest, Sha256};
+use std::error::Error;
+use std::path::{Path, PathBuf};
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "fabkit",
+    version,
+    about = "Parametric fabrication kits for vision-based tactile sensors"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Build a design's parts and write printer-ready STL + 3MF, manifest.json and FABRICATION.md.
+    Export(ExportArgs),
+    /// List the designs embedded in fabkit.
+    Designs,
+    /// Check a design and print its resolved layer stack, without writing anything.
+    Validate {
+        /// A design YAML file or the name of a library design (default: rtac0).
+        design: Option<String>,
+        #[arg(long, default_value_t = ChordTolerance::DEFAULT_MM)]
+        chord_tolerance_mm: f64,
+    },
+}
+
+#[derive(clap::Args, Debug)]
+struct ExportArgs {
+    /// A design YAML file or the name of a library design (default: rtac0).
+    design: Option<String>,
+    /// Output directory (default: out/<design name>). Replaced as a whole if it holds a
+    /// previous export; refused if it holds anything else.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Mesh formats, comma separated.
+    #[arg(long, value_delimiter = ',', default_value = "stl,3mf")]
+    format: Vec<Format>,
+    /// Largest distance between a facet and the true surface, mm.
+    #[arg(long, default_value_t = ChordTolerance::DEFAULT_MM)]
+    chord_tolerance_mm: f64,
+    /// Override the design's mold strategy for every cast layer.
+    #[arg(long)]
+    mold_strategy: Option<Strategy>,
+    /// Also write the CSG tree of every part (fabkit-csg/1 JSON) to this file, for
+    /// tests/oracles/replay_csg.py.
+    #[arg(long)]
+    csg: Option<PathBuf>,
+}
+
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq)]
+enum Format {
+    Stl,
+    #[value(name = "3mf")]
+    ThreeMf,
+}
+
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq)]
+enum Strategy {
+    Direct,
+    Master,
+}
+
+/// Runs the CLI; returns the process exit code (0 ok, 2 error).
+pub fn main() -> i32 {
+    let cli = match Cli::try_parse() {
+        Ok(c) => c,
+        Err(e) => {
+            let _ = e.print();
+            return if e.use_stderr() { 2 } else { 0 };
+        }
+    };
+    match run(cli) {
+        Ok(()) => 0,
+        Err(e) => {
+            eprintln!("error: {e}");
+            let mut src = e.source();
+            while let Some(s) = src {
+                eprintln!("  caused by: {s}");
+                src = s.source();
+            }
+            2
+        }
+    }
+}
+
+/// A design and where it came from.
+struct Loaded {
+    design: Design,
+    source: String,
+    sha256: String,
+}
+
+fn load_design(arg: Option<&str>) -> Result<Loaded, DesignError> {
+    let arg = arg.unwrap_or(library::DEFAULT_DESIGN);
+    let path = Path::new(arg);
+    let looks_like_file =
+        path.exists() || arg.ends_with(".yaml") || arg.ends_with(".yml") || arg.contains('/');
+    let (text, source) = if looks_like_file {
+        let text = std::fs::read_to_string(path).map_err(|e| DesignError::Io {
+            path: arg.to_string(),
+            message: e.to_string(),
+        })?;
+        (text, arg.to_string())
+    } else {
+        let text = library::yaml(arg).ok_or_else(|| DesignError::UnknownDesign(arg.to_string()))?;
+        (text.to_string(), format!("embedded:{arg}"))
+    };
+    let origin = if looks_like_file {
+        arg.to_string()
+    } else {
+        format!("designs/library/{arg}.yaml")
+    };
+    let design = Design::from_yaml(&text, &origin)?;
+    let sha256 = hex(&Sha256::digest(text.as_bytes()));
+    Ok(Loaded {
+        design,
+        source,
+        sha256,
+    })
+}
+
+fn hex(b: &[u8]) -> String {
+    b.iter().map(|x| format!("{x:02x}")).collect()
+}
+
+fn tolerance(mm: f64) -> Result<ChordTolerance, Box<dyn Error>> {
+    ChordTolerance::new(mm).map_err(|e| format!("--chord-tolerance-mm: {e}").into())
+}
+
+fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
+    match cli.command {
+        Command::Designs => {
+            for (name, _) in library::LIBRARY {
+                let d = library::load(name)?;
+                let default = if *name == library::DEFAULT_DESIGN {
+                    " (default)"
+                } else {
+                    ""
+                };
+                println!("{name}{default}\t{}\t[{}]", d.description, d.source);
+            }
+            Ok(())
+        }
+        Command::Validate {
+            design,
+            chord_tolerance_mm,
+        } => {
+            let tol = tolerance(chord_tolerance_mm)?;
+            let loaded = load_design(design.as_deref())?;
+            let materials = fabkit_designs::materials::MaterialsTable::embedded()?;
+            let stack = fabkit_designs::stack::validate(&loaded.design, &materials, tol)
+                .map_err(DesignError::from)?;
+            println!("{}: valid", loaded.source);
+            println!("{}", serde_json::to_string_pretty(&stack)?);
+            Ok(())
+        }
+        Command::Export(args) => export(args),
+    }
+}
+
+fn export(args: ExportArgs) -> Result<(), Box<dyn Error>> {
+    let tol = tolerance(args.chord_tolerance_mm)?;
+    let mut loaded = load_design(args.design.as_deref())?;
+    if let Some(s) = args.mold_strategy {
+        let s = match s {
+            Strategy::Direct => MoldStrategy::Direct,
+            Strategy::Master => MoldStrategy::Master,
+        };
+        loaded.design.mold.strategy = s;
+        for l in &mut loaded.design.layers {
+            l.mold_strategy = None;
+        }
+    }
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| Path::new("out").join(&loaded.design.name));
+    let spinner = indicatif::ProgressBar::new_spinner();
+    spinner.set_message(format!(
+        "building {} at {} mm chord tolerance",
+        loaded.design.name,
+        tol.mm()
+    ));
+    spinner.enable_steady_tick(std::time::Duration::from_millis(120));
+    let t0 = std::time::Instant::now();
+    let kit = build_kit(&loaded.design, tol);
+    spinner.finish_and_clear();
+    let kit = kit?;
+    let opts = ExportOptions {
+        formats: Formats {
+            stl: args.format.contains(&Format::Stl),
+            threemf: args.format.contains(&Format::ThreeMf),
+        },
+        command_line: std::env::args().collect(),
+        design_source: loaded.source.clone(),
+        design_sha256: loaded.sha256.clone(),
+        chord_tolerance_mm: tol.mm(),
+        fabkit_version: env!("CARGO_PKG_VERSION").to_string(),
+    };
+    if let Some(csg) = &args.csg {
+        let parts: Vec<(&str, &fabkit_designs::Solid)> = kit
+            .parts
+            .iter()
+            .map(|p| (p.name.as_str(), &p.solid))
+            .collect();
+        let json = fabkit_designs::geometry::csg_json(&parts);
+        std::fs::write(csg, serde_json::to_vec(&json)?)
+            .map_err(|e| format!("writing {}: {e}", csg.display()))?;
+    }
+    let summary = write_kit(&kit, &out, &opts)?;
+    for w in &summary.warnings {
+        eprintln!("warning: {w}");
+    }
+    println!(
+        "{}: {} parts, {} casts -> {} ({} files, {:.2} s)",
+        loaded.design.name,
+        kit.parts.len(),
+        kit.casts.len(),
+        out.display(),
+        summary.files.len(),
+        t0.elapsed().as_secs_f64()
+    );
+    for p in &summary.manifest.parts {
+        println!(
+            "  {:34} {:4} {:>10.1} mm3  {}",
+            p.name,
+            p.print_technology.to_string(),
+            p.volume_mm3,
+            p.file.as_deref().unwrap_or("(3MF only)")
+        );
+    }
+    for c in &kit.casts {
+        let comps: Vec<String> = c
+            .components
+            .iter()
+            .map(|x| format!("{} {:.2} g", x.name, x.mass_g))
+            .collect();
+        println!(
+            "  cast {}: {} {:.2} mL -> {}",
+            c.step,
+            c.cast,
+            c.cavity_volume_ml,
+            comps.join(", ")
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,10 @@
+//! fabkit: parametric fabrication kits for vision-based tactile sensors.
+//!
+//! This crate is the `fabkit` command line and a facade over the library crates:
+//! [`designs`] (geometry core, profiles, layer stacks, molds, housings, the YAML schema) and
+//! [`export`] (STL, 3MF, manifest, fabrication sheet).
+
+pub use fabkit_designs as designs;
+pub use fabkit_export as export;
+
+pub mod cli;

@@ -1,0 +1,119 @@
+//! Bad input: clear errors naming file:line:column or the parameter path, exit code 2, no
+//! panic, nothing half-written.
+
+mod common;
+use common::*;
+
+fn rtac0_yaml() -> String {
+    std::fs::read_to_string(repo_root().join("designs/library/rtac0.yaml")).unwrap()
+}
+
+#[test]
+fn unknown_key_reports_file_line_column_and_writes_nothing() {
+    let tmp = tempfile::tempdir().unwrap();
+    let yaml = rtac0_yaml().replace(
+        "  cylinder_length_mm: 6.0",
+        "  cylinder_length_mm: 6.0\n  colour: red",
+    );
+    let line = yaml
+        .lines()
+        .position(|l| l.starts_with("  colour: red"))
+        .unwrap()
+        + 1;
+    std::fs::write(tmp.path().join("bad.yaml"), &yaml).unwrap();
+    let o = run(tmp.path(), &["export", "bad.yaml", "--out", "out/bad"], &[]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = text(&o.stderr);
+    assert!(err.contains(&format!("bad.yaml:{line}:")), "{err}");
+    assert!(err.contains("colour"), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(!tmp.path().join("out").exists());
+}
+
+#[test]
+fn impossible_parameters_are_all_reported_with_their_paths() {
+    let tmp = tempfile::tempdir().unwrap();
+    let yaml = rtac0_yaml()
+        .replace("outer_radius_mm: 15.1 ", "outer_radius_mm: 14.9 ")
+        .replace("draft_angle_deg: 2.0", "draft_angle_deg: 12.0");
+    std::fs::write(tmp.path().join("bad.yaml"), &yaml).unwrap();
+    let o = run(tmp.path(), &["export", "bad.yaml", "--out", "out/bad"], &[]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = text(&o.stderr);
+    assert!(err.contains("layers[2].outer_radius_mm = 14.9"), "{err}");
+    assert!(
+        err.contains("mold.draft_angle_deg = 12: must be in [0, 10)"),
+        "{err}"
+    );
+    assert!(!tmp.path().join("out").exists());
+}
+
+#[test]
+fn bad_chord_tolerance_and_unknown_design_are_errors() {
+    let tmp = tempfile::tempdir().unwrap();
+    let o = run(tmp.path(), &["export", "--chord-tolerance-mm", "0"], &[]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        text(&o.stderr).contains("chord tolerance = 0 mm"),
+        "{}",
+        text(&o.stderr)
+    );
+    let o = run(tmp.path(), &["export", "nosuchsensor"], &[]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o.stderr).contains("no library design named 'nosuchsensor'"));
+    assert!(!tmp.path().join("out").exists());
+}
+
+#[test]
+fn failed_export_leaves_the_previous_export_untouched() {
+    let tmp = tempfile::tempdir().unwrap();
+    let o = run(tmp.path(), &["export", "--format", "stl"], &[]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let manifest = std::fs::read(tmp.path().join("out/rtac0/manifest.json")).unwrap();
+    let yaml = rtac0_yaml().replace("wall_thickness_mm: 1.0 ", "wall_thickness_mm: -1.0 ");
+    std::fs::write(tmp.path().join("bad.yaml"), yaml).unwrap();
+    let o = run(
+        tmp.path(),
+        &["export", "bad.yaml", "--out", "out/rtac0"],
+        &[],
+    );
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        text(&o.stderr).contains("core.wall_thickness_mm = -1"),
+        "{}",
+        text(&o.stderr)
+    );
+    assert_eq!(
+        std::fs::read(tmp.path().join("out/rtac0/manifest.json")).unwrap(),
+        manifest
+    );
+    let leftovers: Vec<_> = std::fs::read_dir(tmp.path().join("out"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(leftovers.len(), 1, "{leftovers:?}");
+}
+
+#[test]
+fn a_folder_fabkit_did_not_write_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    std::fs::create_dir_all(tmp.path().join("thesis")).unwrap();
+    std::fs::write(tmp.path().join("thesis/chapter1.tex"), "keep me").unwrap();
+    let o = run(tmp.path(), &["export", "--out", "thesis"], &[]);
+    assert_eq!(o.status.code(), Some(2));
+    assert_eq!(
+        std::fs::read_to_string(tmp.path().join("thesis/chapter1.tex")).unwrap(),
+        "keep me"
+    );
+}
+
+#[test]
+fn designs_lists_the_library() {
+    let o = run(&repo_root(), &["designs"], &[]);
+    assert!(o.status.success());
+    assert!(
+        text(&o.stdout).starts_with("rtac0 (default)"),
+        "{}",
+        text(&o.stdout)
+    );
+}
