@@ -4,6 +4,9 @@
 //! Frames and units are defined in `docs/conventions.md`: millimetres, degrees at public
 //! boundaries, the sensor frame with z along the sensor axis through the pole.
 
+// `!(x > 0.0)` is how the checks here reject NaN along with the out-of-range values.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 pub mod build;
 pub mod error;
 pub mod geometry;

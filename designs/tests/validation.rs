@@ -113,8 +113,11 @@ fn baseline_validates_and_builds() {
 // ---------------------------------------------------------------------------------------------
 // One mutation, one error.
 
+/// A named mutation of the baseline and the one error it must cause.
+type Mutation = (&'static str, fn(&mut Design), Expect);
+
 /// The single mutations of the baseline that each break exactly one rule, with that error.
-fn single_mutations() -> Vec<(&'static str, fn(&mut Design), Expect)> {
+fn single_mutations() -> Vec<Mutation> {
     vec![
         (
             "translucent layer thinner than the chord tolerance",

@@ -93,9 +93,9 @@ impl Mesh {
             max: first,
         };
         for v in &self.vertices {
-            for k in 0..3 {
-                b.min[k] = b.min[k].min(v[k]);
-                b.max[k] = b.max[k].max(v[k]);
+            for (k, &c) in v.iter().enumerate() {
+                b.min[k] = b.min[k].min(c);
+                b.max[k] = b.max[k].max(c);
             }
         }
         Some(b)
