@@ -142,16 +142,7 @@ enum Piece {
     Segment([f64; 2], [f64; 2]),
 }
 
-fn seg_dist(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
-    let d = [b[0] - a[0], b[1] - a[1]];
-    let l2 = d[0] * d[0] + d[1] * d[1];
-    let t = if l2 > 0.0 {
-        (((p[0] - a[0]) * d[0] + (p[1] - a[1]) * d[1]) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (a[0] + t * d[0] - p[0]).hypot(a[1] + t * d[1] - p[1])
-}
+use fabkit_designs::geometry::profile2d::point_segment_distance as seg_dist;
 
 /// Distance from `q` to the ellipse (r/a)^2 + (z/c)^2 = 1, by a scan for the nearest parameter
 /// and bisection of the foot-point condition (q - E(th)) . E'(th) = 0 to machine precision.

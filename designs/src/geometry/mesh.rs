@@ -51,6 +51,17 @@ pub enum TopologyError {
     NonFinite,
 }
 
+/// (b - a) x (c - a): the triangle's normal scaled by twice its area (outward for CCW winding).
+pub fn triangle_cross(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> [f64; 3] {
+    let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let w = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+    [
+        u[1] * w[2] - u[2] * w[1],
+        u[2] * w[0] - u[0] * w[2],
+        u[0] * w[1] - u[1] * w[0],
+    ]
+}
+
 impl Mesh {
     /// Enclosed volume by the divergence theorem, mm^3 (positive for outward winding).
     pub fn signed_volume(&self) -> f64 {
@@ -70,16 +81,11 @@ impl Mesh {
         self.triangles
             .iter()
             .map(|t| {
-                let a = self.vertices[t[0] as usize];
-                let b = self.vertices[t[1] as usize];
-                let c = self.vertices[t[2] as usize];
-                let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-                let w = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-                let n = [
-                    u[1] * w[2] - u[2] * w[1],
-                    u[2] * w[0] - u[0] * w[2],
-                    u[0] * w[1] - u[1] * w[0],
-                ];
+                let n = triangle_cross(
+                    self.vertices[t[0] as usize],
+                    self.vertices[t[1] as usize],
+                    self.vertices[t[2] as usize],
+                );
                 0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt()
             })
             .sum()

@@ -8,7 +8,7 @@ mod mesh;
 pub mod profile2d;
 mod solid;
 
-pub use mesh::{Aabb, Mesh, TopologyError};
+pub use mesh::{triangle_cross, Aabb, Mesh, TopologyError};
 pub use profile2d::Polyline2;
 pub use solid::{csg_json, rotation_deg, Affine, CsgNode, GeometryError, Solid};
 
