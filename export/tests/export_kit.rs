@@ -505,10 +505,17 @@ fn empty_directory_and_missing_parents_are_fine() {
     assert_eq!(entries(&root.path().join("a").join("b")), ["kit"]);
 }
 
-/// Needs PrusaSlicer on PATH: `cargo test -p fabkit-export -- --ignored`.
+/// Needs PrusaSlicer on PATH; scripts/test (FABKIT_REQUIRE_ORACLES=1) and CI fail without it,
+/// a plain `cargo test` skips with a message.
 #[test]
-#[ignore = "needs prusa-slicer on PATH"]
 fn prusa_slicer_reports_every_object_manifold() {
+    if std::process::Command::new("prusa-slicer").arg("--help").output().is_err() {
+        let required = std::env::var("FABKIT_REQUIRE_ORACLES").is_ok_and(|v| v == "1")
+            || std::env::var("CI").is_ok_and(|v| v == "true");
+        assert!(!required, "prusa-slicer is required here; run scripts/setup-system");
+        eprintln!("SKIPPED: prusa-slicer not on PATH");
+        return;
+    }
     let root = tempfile::tempdir().unwrap();
     let out = root.path().join("kit");
     write_kit(&test_kit(), &out, &opts()).unwrap();
