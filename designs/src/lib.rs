@@ -13,6 +13,7 @@ pub mod geometry;
 pub mod housing;
 pub mod kit;
 pub mod library;
+pub mod markers;
 pub mod materials;
 pub mod molds;
 pub mod profile;

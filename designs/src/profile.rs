@@ -292,6 +292,26 @@ impl BodyProfile {
         }
     }
 
+    /// Outward unit normal of the offset curve at distance `d` and parameter t (the point
+    /// [`Self::offset_point`] gives).
+    pub fn offset_normal(&self, d: f64, t: f64) -> [f64; 2] {
+        match *self {
+            Self::HalfEllipsoid { diameter_mm, height_mm } => {
+                let (a, c) = (diameter_mm / 2.0, height_mm);
+                let th = FRAC_PI_2 * (1.0 - t);
+                let (s, co) = th.sin_cos();
+                let n = [c * co, a * s];
+                let nl = (n[0] * n[0] + n[1] * n[1]).sqrt();
+                [n[0] / nl, n[1] / nl]
+            }
+            _ => {
+                let (_, a_end) = self.sphere_arc(d);
+                let a = FRAC_PI_2 + (a_end - FRAC_PI_2) * t;
+                [a.cos(), a.sin()]
+            }
+        }
+    }
+
     /// (radius, end angle from +r axis) of the offset arc of a spherical profile.
     fn sphere_arc(&self, d: f64) -> (f64, f64) {
         match *self {

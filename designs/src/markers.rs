@@ -1,0 +1,685 @@
+//! Marker patterns on surfaces of revolution, and marker features (a radial cylinder with a
+//! hemispherical end, raised or recessed).
+//!
+//! Sources: ShadowTac Sec. III-IV (dimples: cylinder with a hemispheric tip, 0.45 mm base,
+//! 0.5 mm height, concentric, 1.4 mm spacing); UVDtact Sec. III (slots and protrusions: 0.5 mm
+//! radius cylinder of 0.5 mm height ending in a 0.5 mm radius hemisphere); Pestell et al.
+//! Sec. III-A, III-D (TacTip pins ending in white dots, four layouts).
+//!
+//! Positions are on an offset surface of the body profile (sensor frame); a marker's
+//! arc length `s` is measured along the profile curve from the pole, its azimuth from +x
+//! towards +y. Its polar angle is the angle between +z and the direction from the origin to
+//! the marker (for spherical profiles: the usual polar angle).
+
+use crate::geometry::profile2d::push_arc;
+use crate::geometry::{revolve, ChordTolerance, GeometryError, Polyline2, Solid};
+use crate::profile::BodyProfile;
+use serde::{Deserialize, Serialize};
+use std::f64::consts::{FRAC_PI_2, PI};
+
+/// Which surface of a layer carries the markers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MarkerSurface {
+    Outer,
+    Inner,
+}
+
+/// Whether a feature stands out of the part's surface or is cut into it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Polarity {
+    Raised,
+    Recessed,
+}
+
+/// A radial cylinder ending in a hemisphere of the same diameter.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FeatureShape {
+    /// Cylinder (and hemisphere) diameter, mm.
+    pub diameter_mm: f64,
+    /// From the surface to the tip of the hemisphere, along the normal, mm (>= radius).
+    pub height_mm: f64,
+    pub polarity: Polarity,
+}
+
+impl FeatureShape {
+    pub fn radius_mm(&self) -> f64 {
+        self.diameter_mm / 2.0
+    }
+
+    /// Volume beyond the tangent plane: cylinder of height (height - radius) plus hemisphere, mm^3.
+    pub fn nominal_volume_mm3(&self) -> f64 {
+        let r = self.radius_mm();
+        PI * r * r * (self.height_mm - r) + 2.0 / 3.0 * PI * r.powi(3)
+    }
+}
+
+/// The layout of a pattern.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Layout {
+    /// A centre marker and rings k = 1..rings of 6k markers, ring k at arc length k x pitch
+    /// (the published ShadowTac mold: 12 rings, 469 markers, pitch 1.53 mm).
+    Concentric6k,
+    /// A centre marker and rings every `spacing_mm` of arc; round(circumference / spacing)
+    /// markers per ring.
+    Concentric,
+    /// A hexagonal lattice of pitch `spacing_mm`, wrapped onto the surface by arc length from
+    /// the pole (azimuthal equidistant).
+    HexGrid,
+    /// Equal-area golden-angle spiral: `count` markers, or as many as the area holds at
+    /// `spacing_mm` (hexagonal packing density).
+    GoldenSpiral,
+    /// Explicit (polar, azimuth) angles in degrees, from `points` or `csv_file`.
+    List,
+}
+
+/// A marker pattern on a surface. Which fields apply depends on `layout`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Pattern {
+    pub layout: Layout,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rings: Option<u32>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pitch_arc_mm: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spacing_mm: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub count: Option<u32>,
+    /// (polar_deg, azimuth_deg) pairs for `list`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub points: Option<Vec<[f64; 2]>>,
+    /// CSV file with columns `polar_deg, azimuth_deg` (a header line is allowed), relative to
+    /// the design file; read into `points` when the design is loaded.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub csv_file: Option<String>,
+    /// Whether concentric layouts put a marker on the pole (default true).
+    #[serde(default = "yes")]
+    pub center_marker: bool,
+    /// Limits of the patterned region, polar angle in degrees (default: the whole surface less
+    /// a margin of one feature diameter at the rim).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_polar_deg: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_polar_deg: Option<f64>,
+}
+
+fn yes() -> bool {
+    true
+}
+
+/// Markers of one surface of a layer.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MarkerSpec {
+    pub surface: MarkerSurface,
+    pub pattern: Pattern,
+    pub feature: FeatureShape,
+    /// For printed multi-material parts: the end of each feature (its hemisphere) is a
+    /// separate object of this material (TacTip white dots, Pestell et al. Sec. III-A).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tip_material: Option<String>,
+}
+
+/// One placed marker.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Marker {
+    pub id: usize,
+    /// Ring index for concentric layouts (0 = centre), else 0.
+    pub ring: u32,
+    /// Arc length from the pole along the profile, mm.
+    pub arc_mm: f64,
+    pub azimuth_deg: f64,
+    pub polar_deg: f64,
+    /// Position on the surface, sensor frame, mm.
+    pub position_mm: [f64; 3],
+    /// Outward unit normal of the surface there.
+    pub normal: [f64; 3],
+}
+
+/// Count and spacing of a placed pattern, distances measured on the surface.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PatternStats {
+    pub count: usize,
+    /// Smallest nearest-neighbour distance on the surface, mm (0 for fewer than 2 markers).
+    pub min_spacing_mm: f64,
+    pub median_spacing_mm: f64,
+    /// The pair with the smallest distance.
+    pub closest_pair: Option<(usize, usize)>,
+}
+
+/// An offset surface of a body profile, parametrised by arc length from the pole.
+#[derive(Debug, Clone)]
+pub struct Surface {
+    pub body: BodyProfile,
+    pub offset_mm: f64,
+    /// (t, s): profile parameter and arc length, increasing, for the curved part.
+    table: Vec<(f64, f64)>,
+    /// Arc length of the curved part (pole to the rim on the base plane, or to the equator
+    /// for the hemisphere on cylinder).
+    curved_arc_mm: f64,
+    /// Straight cylinder below the curved part (hemisphere on cylinder), mm.
+    cylinder_mm: f64,
+}
+
+const TABLE_SAMPLES: usize = 4096;
+
+impl Surface {
+    pub fn new(body: &BodyProfile, offset_mm: f64) -> Self {
+        let mut table = Vec::with_capacity(TABLE_SAMPLES + 1);
+        let mut s = 0.0;
+        let mut prev = body.offset_point(offset_mm, 0.0);
+        table.push((0.0, 0.0));
+        for i in 1..=TABLE_SAMPLES {
+            let t = i as f64 / TABLE_SAMPLES as f64;
+            let p = body.offset_point(offset_mm, t);
+            // Chord of a fine sample; for arcs the exact length follows below.
+            s += ((p[0] - prev[0]).powi(2) + (p[1] - prev[1]).powi(2)).sqrt();
+            table.push((t, s));
+            prev = p;
+        }
+        // Spherical profiles: exact arc length rho * angle (t is linear in angle).
+        if let Some(r) = body.sphere_radius_mm() {
+            let rho = r + offset_mm;
+            let a_end = body.offset_normal(offset_mm, 1.0)[1].atan2(body.offset_normal(offset_mm, 1.0)[0]);
+            let total = rho * (FRAC_PI_2 - a_end);
+            for e in &mut table {
+                e.1 = total * e.0;
+            }
+        }
+        let curved_arc_mm = table.last().map(|e| e.1).unwrap_or(0.0);
+        let cylinder_mm = match *body {
+            BodyProfile::HemisphereOnCylinder { cylinder_length_mm, .. } => cylinder_length_mm,
+            _ => 0.0,
+        };
+        Self { body: body.clone(), offset_mm, table, curved_arc_mm, cylinder_mm }
+    }
+
+    /// Arc length from the pole to the base plane, mm.
+    pub fn total_arc_mm(&self) -> f64 {
+        self.curved_arc_mm + self.cylinder_mm
+    }
+
+    fn t_of_s(&self, s: f64) -> f64 {
+        let s = s.clamp(0.0, self.curved_arc_mm);
+        let i = self.table.partition_point(|e| e.1 < s).clamp(1, self.table.len() - 1);
+        let (t0, s0) = self.table[i - 1];
+        let (t1, s1) = self.table[i];
+        if s1 > s0 {
+            t0 + (t1 - t0) * (s - s0) / (s1 - s0)
+        } else {
+            t0
+        }
+    }
+
+    /// (r, z) and the outward normal (nr, nz) at arc length `s`.
+    pub fn profile_at(&self, s: f64) -> ([f64; 2], [f64; 2]) {
+        if s > self.curved_arc_mm {
+            let p = self.body.offset_point(self.offset_mm, 1.0);
+            ([p[0], p[1] - (s - self.curved_arc_mm)], [1.0, 0.0])
+        } else {
+            let t = self.t_of_s(s);
+            (self.body.offset_point(self.offset_mm, t), self.body.offset_normal(self.offset_mm, t))
+        }
+    }
+
+    /// Position and outward normal in the sensor frame at (arc length, azimuth in radians).
+    pub fn point(&self, s: f64, azimuth: f64) -> ([f64; 3], [f64; 3]) {
+        let (p, n) = self.profile_at(s);
+        let (sa, ca) = azimuth.sin_cos();
+        ([p[0] * ca, p[0] * sa, p[1]], [n[0] * ca, n[0] * sa, n[1]])
+    }
+
+    /// Radius (distance from the axis) at arc length `s`.
+    pub fn radius_at(&self, s: f64) -> f64 {
+        self.profile_at(s).0[0]
+    }
+
+    /// Polar angle (degrees, from +z, seen from the origin) at arc length `s`.
+    pub fn polar_deg_at(&self, s: f64) -> f64 {
+        let p = self.profile_at(s).0;
+        p[0].atan2(p[1]).to_degrees()
+    }
+
+    /// Arc length where the polar angle is `polar_deg` (it grows monotonically with s).
+    pub fn s_at_polar_deg(&self, polar_deg: f64) -> f64 {
+        let (mut lo, mut hi) = (0.0, self.total_arc_mm());
+        for _ in 0..80 {
+            let mid = 0.5 * (lo + hi);
+            if self.polar_deg_at(mid) < polar_deg {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        0.5 * (lo + hi)
+    }
+
+    /// Surface area between the pole and arc length `s` (Pappus, trapezoid on 2000 panels), mm^2.
+    pub fn area_to(&self, s: f64) -> f64 {
+        let n = 2000;
+        let h = s / n as f64;
+        (0..n)
+            .map(|i| PI * (self.radius_at(i as f64 * h) + self.radius_at((i + 1) as f64 * h)) * h)
+            .sum()
+    }
+
+    /// Principal curvatures (meridian, parallel) at arc length `s`, 1/mm; positive for a
+    /// surface that curves away from its outward normal (convex).
+    pub fn curvatures_at(&self, s: f64) -> (f64, f64) {
+        let h = 1e-4;
+        let s0 = (s - h).max(0.0);
+        let s1 = (s + h).min(self.total_arc_mm());
+        let (n0, n1) = (self.profile_at(s0).1, self.profile_at(s1).1);
+        let a0 = n0[1].atan2(n0[0]);
+        let a1 = n1[1].atan2(n1[0]);
+        let k_meridian = if s1 > s0 { (a0 - a1) / (s1 - s0) } else { 0.0 };
+        let (p, n) = self.profile_at(s);
+        let k_parallel = if p[0] > 1e-9 { n[0] / p[0] } else { k_meridian };
+        (k_meridian, k_parallel)
+    }
+
+    /// Length of the straight chord between two surface points projected onto the surface
+    /// (16 segments), mm: the on-surface distance for nearby markers.
+    pub fn surface_distance(&self, a: &Marker, b: &Marker) -> f64 {
+        let steps = 16;
+        let mut prev = a.position_mm;
+        let mut len = 0.0;
+        for i in 1..=steps {
+            let f = i as f64 / steps as f64;
+            let q = if i == steps {
+                b.position_mm
+            } else {
+                let c = [
+                    a.position_mm[0] + f * (b.position_mm[0] - a.position_mm[0]),
+                    a.position_mm[1] + f * (b.position_mm[1] - a.position_mm[1]),
+                    a.position_mm[2] + f * (b.position_mm[2] - a.position_mm[2]),
+                ];
+                self.project(c, a.arc_mm + f * (b.arc_mm - a.arc_mm))
+            };
+            len += ((q[0] - prev[0]).powi(2) + (q[1] - prev[1]).powi(2) + (q[2] - prev[2]).powi(2)).sqrt();
+            prev = q;
+        }
+        len
+    }
+
+    /// The closest surface point to `c`, starting the search at arc length `s_guess`.
+    fn project(&self, c: [f64; 3], s_guess: f64) -> [f64; 3] {
+        let r = (c[0] * c[0] + c[1] * c[1]).sqrt();
+        let az = c[1].atan2(c[0]);
+        let mut s = s_guess;
+        for _ in 0..8 {
+            let (p, n) = self.profile_at(s);
+            // tangent (pointing to growing s) is the normal rotated by -90 degrees
+            let t = [n[1], -n[0]];
+            let step = (r - p[0]) * t[0] + (c[2] - p[1]) * t[1];
+            s = (s + step).clamp(0.0, self.total_arc_mm());
+            if step.abs() < 1e-12 {
+                break;
+            }
+        }
+        self.point(s, az).0
+    }
+}
+
+/// Places the markers of `pattern` on `surface`.
+///
+/// `rim_margin_mm` keeps marker centres that far (in arc length) from the base plane when no
+/// polar limit is given.
+///
+/// # Errors
+/// A message naming the missing or invalid field of the pattern (the caller adds the path).
+pub fn place(surface: &Surface, pattern: &Pattern, rim_margin_mm: f64) -> Result<Vec<Marker>, (String, String, String)> {
+    let err = |f: &str, v: String, rule: &str| Err((f.to_string(), v, rule.to_string()));
+    let s_max = match pattern.max_polar_deg {
+        Some(p) => surface.s_at_polar_deg(p),
+        None => surface.total_arc_mm() - rim_margin_mm,
+    };
+    let s_min = pattern.min_polar_deg.map(|p| surface.s_at_polar_deg(p)).unwrap_or(0.0);
+    if !(s_max > s_min) {
+        return err("max_polar_deg", format!("{:?}", pattern.max_polar_deg), "leaves no room for markers between the polar limits and the rim");
+    }
+    let positive = |f: &str, v: Option<f64>| -> Result<f64, (String, String, String)> {
+        match v {
+            Some(x) if x > 0.0 && x.is_finite() => Ok(x),
+            Some(x) => Err((f.to_string(), x.to_string(), "must be above 0".into())),
+            None => Err((f.to_string(), "missing".into(), format!("is required for layout {:?}", pattern.layout))),
+        }
+    };
+    // (s, azimuth radians, ring)
+    let mut raw: Vec<(f64, f64, u32)> = Vec::new();
+    let centre = pattern.center_marker && s_min == 0.0;
+    match pattern.layout {
+        Layout::Concentric6k => {
+            let rings = pattern.rings.ok_or_else(|| ("rings".to_string(), "missing".to_string(), "is required for concentric_6k".to_string()))?;
+            let pitch = positive("pitch_arc_mm", pattern.pitch_arc_mm)?;
+            if centre {
+                raw.push((0.0, 0.0, 0));
+            }
+            for k in 1..=rings {
+                let s = k as f64 * pitch;
+                if s > s_max + 1e-9 {
+                    return err("rings", rings.to_string(), &format!("ring {k} at {s:.3} mm of arc lies beyond the patterned region ({s_max:.3} mm)"));
+                }
+                let n = 6 * k;
+                for j in 0..n {
+                    raw.push((s, 2.0 * PI * j as f64 / n as f64, k));
+                }
+            }
+        }
+        Layout::Concentric => {
+            let sp = positive("spacing_mm", pattern.spacing_mm)?;
+            if centre {
+                raw.push((0.0, 0.0, 0));
+            }
+            let mut k = 1;
+            loop {
+                let s = if s_min > 0.0 { s_min + (k - 1) as f64 * sp } else { k as f64 * sp };
+                if s > s_max + 1e-9 {
+                    break;
+                }
+                let n = ((2.0 * PI * surface.radius_at(s) / sp).round() as usize).max(1);
+                for j in 0..n {
+                    raw.push((s, 2.0 * PI * j as f64 / n as f64, k));
+                }
+                k += 1;
+            }
+        }
+        Layout::HexGrid => {
+            let a = positive("spacing_mm", pattern.spacing_mm)?;
+            let m = (s_max / a).ceil() as i64 + 1;
+            for j in -m..=m {
+                for i in -m..=m {
+                    let x = a * (i as f64 + 0.5 * j as f64);
+                    let y = a * (3f64.sqrt() / 2.0) * j as f64;
+                    let s = (x * x + y * y).sqrt();
+                    if s >= s_min - 1e-12 && s <= s_max + 1e-12 {
+                        raw.push((s, y.atan2(x), 0));
+                    }
+                }
+            }
+            // deterministic order: by arc length, then azimuth
+            raw.sort_by(|p, q| (p.0, p.1).partial_cmp(&(q.0, q.1)).unwrap_or(std::cmp::Ordering::Equal));
+        }
+        Layout::GoldenSpiral => {
+            // cumulative area table from s_min to s_max, inverted by interpolation
+            let k = 4096;
+            let ss: Vec<f64> = (0..=k).map(|i| s_min + (s_max - s_min) * i as f64 / k as f64).collect();
+            let rs: Vec<f64> = ss.iter().map(|&x| surface.radius_at(x)).collect();
+            let mut area = vec![0.0; k + 1];
+            for i in 1..=k {
+                area[i] = area[i - 1] + PI * (rs[i - 1] + rs[i]) * (ss[i] - ss[i - 1]);
+            }
+            let a_total = area[k];
+            let n = match (pattern.count, pattern.spacing_mm) {
+                (Some(c), _) if c > 0 => c as usize,
+                (Some(c), _) => return err("count", c.to_string(), "must be above 0"),
+                (None, sp) => {
+                    let sp = positive("spacing_mm", sp)?;
+                    ((a_total / (sp * sp * 3f64.sqrt() / 2.0)).round() as usize).max(1)
+                }
+            };
+            let golden = PI * (3.0 - 5f64.sqrt());
+            for i in 0..n {
+                let target = (i as f64 + 0.5) / n as f64 * a_total;
+                let j = area.partition_point(|&a| a < target).clamp(1, k);
+                let f = (target - area[j - 1]) / (area[j] - area[j - 1]).max(f64::MIN_POSITIVE);
+                let s = ss[j - 1] + f * (ss[j] - ss[j - 1]);
+                raw.push((s, (i as f64 * golden).rem_euclid(2.0 * PI), 0));
+            }
+        }
+        Layout::List => {
+            let pts = pattern.points.as_ref().ok_or_else(|| {
+                ("points".to_string(), "missing".to_string(), "is required for layout list (or csv_file)".to_string())
+            })?;
+            for (i, p) in pts.iter().enumerate() {
+                if !(p[0] >= 0.0 && p[0].is_finite() && p[1].is_finite()) {
+                    return err(&format!("points[{i}]"), format!("{p:?}"), "polar angle must be >= 0 and both angles finite");
+                }
+                let s = surface.s_at_polar_deg(p[0]);
+                if s > s_max + 1e-9 || s < s_min - 1e-9 {
+                    return err(&format!("points[{i}]"), format!("{p:?}"), "lies outside the patterned region");
+                }
+                raw.push((s, p[1].to_radians(), 0));
+            }
+        }
+    }
+    Ok(raw
+        .into_iter()
+        .enumerate()
+        .map(|(id, (s, az, ring))| {
+            let (position_mm, normal) = surface.point(s, az);
+            Marker {
+                id,
+                ring,
+                arc_mm: s,
+                azimuth_deg: az.to_degrees(),
+                polar_deg: surface.polar_deg_at(s),
+                position_mm,
+                normal,
+            }
+        })
+        .collect())
+}
+
+/// Count and nearest-neighbour spacing on the surface.
+pub fn stats(surface: &Surface, markers: &[Marker]) -> PatternStats {
+    let n = markers.len();
+    if n < 2 {
+        return PatternStats { count: n, min_spacing_mm: 0.0, median_spacing_mm: 0.0, closest_pair: None };
+    }
+    // Bucket grid on chord distance for candidate neighbours.
+    let mut cell = 0.0f64;
+    {
+        // estimate a cell size from the bounding box and count
+        let (mut lo, mut hi) = ([f64::MAX; 3], [f64::MIN; 3]);
+        for m in markers {
+            for k in 0..3 {
+                lo[k] = lo[k].min(m.position_mm[k]);
+                hi[k] = hi[k].max(m.position_mm[k]);
+            }
+        }
+        let diag = ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2)).sqrt();
+        cell = cell.max(diag / (n as f64).sqrt()).max(1e-6);
+    }
+    let key = |p: [f64; 3]| [(p[0] / cell).floor() as i64, (p[1] / cell).floor() as i64, (p[2] / cell).floor() as i64];
+    let mut grid: std::collections::HashMap<[i64; 3], Vec<usize>> = std::collections::HashMap::new();
+    for (i, m) in markers.iter().enumerate() {
+        grid.entry(key(m.position_mm)).or_default().push(i);
+    }
+    let chord = |a: &Marker, b: &Marker| {
+        ((a.position_mm[0] - b.position_mm[0]).powi(2)
+            + (a.position_mm[1] - b.position_mm[1]).powi(2)
+            + (a.position_mm[2] - b.position_mm[2]).powi(2))
+        .sqrt()
+    };
+    let mut nn = Vec::with_capacity(n);
+    let mut best_pair = (0, 1, f64::INFINITY);
+    for (i, m) in markers.iter().enumerate() {
+        let k = key(m.position_mm);
+        let mut best = (usize::MAX, f64::INFINITY);
+        let mut radius = 1;
+        loop {
+            for dx in -radius..=radius {
+                for dy in -radius..=radius {
+                    for dz in -radius..=radius {
+                        if let Some(v) = grid.get(&[k[0] + dx, k[1] + dy, k[2] + dz]) {
+                            for &j in v {
+                                if j != i {
+                                    let d = chord(m, &markers[j]);
+                                    if d < best.1 {
+                                        best = (j, d);
+                                    }
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+            // a neighbour found within `radius` cells is the nearest if its distance is
+            // below radius x cell
+            if best.1 <= radius as f64 * cell || radius > 64 {
+                break;
+            }
+            radius *= 2;
+        }
+        let d = surface.surface_distance(m, &markers[best.0]);
+        if d < best_pair.2 {
+            best_pair = (i.min(best.0), i.max(best.0), d);
+        }
+        nn.push(d);
+    }
+    nn.sort_by(|a, b| a.partial_cmp(b).unwrap_or(std::cmp::Ordering::Equal));
+    let median = if n % 2 == 1 { nn[n / 2] } else { 0.5 * (nn[n / 2 - 1] + nn[n / 2]) };
+    PatternStats { count: n, min_spacing_mm: nn[0], median_spacing_mm: median, closest_pair: Some((best_pair.0, best_pair.1)) }
+}
+
+/// How deep a feature reaches behind the surface so that it joins the body without a gap:
+/// the sagitta of its base disc on the most curved direction, plus the chord tolerance, plus
+/// a margin.
+pub fn embed_depth_mm(shape: &FeatureShape, max_curvature: f64, tol: ChordTolerance) -> f64 {
+    let r = shape.radius_mm();
+    r * r * max_curvature.abs() + 2.0 * tol.mm() + 0.02
+}
+
+/// The solid of one feature along `dir` (unit) from `position`: from `embed_mm` behind the
+/// surface to `height_mm` beyond it. Built as a revolve about its own axis.
+///
+/// # Errors
+/// Only on a kernel failure.
+pub fn feature_solid(shape: &FeatureShape, position: [f64; 3], dir: [f64; 3], embed_mm: f64, tol: ChordTolerance) -> Result<Solid, GeometryError> {
+    let r = shape.radius_mm();
+    let hc = shape.height_mm - r;
+    let mut pl = Polyline2::default();
+    pl.push([0.0, -embed_mm]);
+    pl.push([r, -embed_mm]);
+    push_arc(&mut pl, [0.0, hc], r, 0.0, FRAC_PI_2, tol.half());
+    let local = Solid::from_mesh(&revolve(&pl, tol)?)?;
+    Ok(local.transform(&frame_to(position, dir)))
+}
+
+/// The affine map taking the local +z axis at the origin to `dir` at `position`.
+pub fn frame_to(position: [f64; 3], dir: [f64; 3]) -> crate::geometry::Affine {
+    let z = dir;
+    // any vector not parallel to z
+    let helper = if z[2].abs() < 0.9 { [0.0, 0.0, 1.0] } else { [1.0, 0.0, 0.0] };
+    let mut x = [
+        helper[1] * z[2] - helper[2] * z[1],
+        helper[2] * z[0] - helper[0] * z[2],
+        helper[0] * z[1] - helper[1] * z[0],
+    ];
+    let l = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+    x = [x[0] / l, x[1] / l, x[2] / l];
+    let y = [z[1] * x[2] - z[2] * x[1], z[2] * x[0] - z[0] * x[2], z[0] * x[1] - z[1] * x[0]];
+    [
+        [x[0], y[0], z[0], position[0]],
+        [x[1], y[1], z[1], position[1]],
+        [x[2], y[2], z[2], position[2]],
+    ]
+}
+
+/// Volume of the gap between the tangent plane and the surface over the feature's base disc,
+/// mm^3 (second order in the curvatures: pi r^4 (k1 + k2) / 8); positive for a convex surface.
+pub fn tangent_gap_volume_mm3(shape: &FeatureShape, k1: f64, k2: f64) -> f64 {
+    let r = shape.radius_mm();
+    PI * r.powi(4) * (k1 + k2) / 8.0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cap() -> BodyProfile {
+        BodyProfile::SphericalCap { base_diameter_mm: 35.0, height_mm: 8.0 }
+    }
+
+    #[test]
+    fn published_shadowtac_layout_has_469_markers() {
+        let s = Surface::new(&cap(), 0.0);
+        let p = Pattern {
+            layout: Layout::Concentric6k,
+            rings: Some(12),
+            pitch_arc_mm: Some(1.53),
+            spacing_mm: None,
+            count: None,
+            points: None,
+            csv_file: None,
+            center_marker: true,
+            max_polar_deg: None,
+            min_polar_deg: None,
+        };
+        let m = place(&s, &p, 0.5).unwrap();
+        assert_eq!(m.len(), 469);
+        let st = stats(&s, &m);
+        // ring pitch is 1.53 mm of arc; the neighbours on ring 1 are 2 pi 1.53 / 6 apart, on
+        // ring 12 about 2 pi r(18.36) / 72
+        assert!(st.min_spacing_mm > 1.2 && st.min_spacing_mm < 1.53, "{st:?}");
+        for mk in &m {
+            let r = (mk.position_mm[0].powi(2) + mk.position_mm[1].powi(2) + mk.position_mm[2].powi(2)).sqrt();
+            let rho = (17.5f64 * 17.5 + 64.0) / 16.0;
+            assert!((r - rho).abs() < 1e-9);
+        }
+    }
+
+    #[test]
+    fn arc_length_on_a_sphere_is_exact() {
+        let s = Surface::new(&cap(), -1.0);
+        let rho = (17.5f64 * 17.5 + 64.0) / 16.0 - 1.0;
+        let (p, n) = s.point(3.0, 0.3);
+        let polar = (p[0].hypot(p[1])).atan2(p[2]);
+        assert!((polar * rho - 3.0).abs() < 1e-9);
+        assert!((n[0] * p[0] + n[1] * p[1] + n[2] * p[2] - rho).abs() < 1e-9);
+    }
+
+    #[test]
+    fn golden_spiral_count_and_hex_grid_spacing() {
+        let body = BodyProfile::HalfEllipsoid { diameter_mm: 18.0, height_mm: 24.0 };
+        let s = Surface::new(&body, -0.9);
+        let mut p = Pattern {
+            layout: Layout::GoldenSpiral,
+            rings: None,
+            pitch_arc_mm: None,
+            spacing_mm: None,
+            count: Some(85),
+            points: None,
+            csv_file: None,
+            center_marker: true,
+            max_polar_deg: None,
+            min_polar_deg: None,
+        };
+        let m = place(&s, &p, 1.0).unwrap();
+        assert_eq!(m.len(), 85);
+        // equal areas: the median spacing matches hexagonal packing of 85 points on the area
+        let area = s.area_to(s.total_arc_mm() - 1.0);
+        let hex = (area / 85.0 / (3f64.sqrt() / 2.0)).sqrt();
+        let st = stats(&s, &m);
+        assert!((st.median_spacing_mm / hex - 1.0).abs() < 0.25, "{st:?} vs {hex}");
+        // A hex grid wrapped onto a cap (azimuthal equidistant) keeps its pitch along meridians
+        // and shrinks along parallels by at most sin(theta)/theta at the rim.
+        let s = Surface::new(&cap(), 0.0);
+        p.layout = Layout::HexGrid;
+        p.count = None;
+        p.spacing_mm = Some(2.0);
+        let m = place(&s, &p, 1.0).unwrap();
+        let st = stats(&s, &m);
+        let rho = (17.5f64 * 17.5 + 64.0) / 16.0;
+        let theta = (s.total_arc_mm() - 1.0) / rho;
+        assert!(st.min_spacing_mm >= 2.0 * theta.sin() / theta && st.min_spacing_mm <= 2.0 + 1e-6, "{st:?}");
+        assert!(st.median_spacing_mm > 1.85 && st.median_spacing_mm <= 2.0 + 1e-6, "{st:?}");
+    }
+
+    #[test]
+    fn feature_volume_on_a_plane_like_surface() {
+        let tol = ChordTolerance::new(0.001).unwrap();
+        let shape = FeatureShape { diameter_mm: 1.0, height_mm: 1.0, polarity: Polarity::Raised };
+        let f = feature_solid(&shape, [1.0, 2.0, 3.0], [0.0, 0.6, 0.8], 0.0, tol).unwrap();
+        let v = shape.nominal_volume_mm3();
+        assert!((f.volume() - v).abs() < 0.01 * v, "{} vs {v}", f.volume());
+        let b = f.bounding_box().unwrap();
+        // the hemisphere's centre is 0.5 mm along the direction, its top 0.5 mm above that
+        assert!((b.max[2] - (3.0 + 0.4 + 0.5)).abs() < 0.01, "{b:?}");
+    }
+}
