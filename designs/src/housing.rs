@@ -443,6 +443,7 @@ pub fn build_shell(
         print_technology: tech,
         solid,
         params: params.clone(),
+        group: None,
     }
     };
     let parts = vec![

@@ -13,6 +13,10 @@ pub enum PrintTechnology {
     /// Stereolithography / masked SLA (resin).
     #[serde(rename = "SLA")]
     Sla,
+    /// Material jetting of several materials in one print (Stratasys PolyJet: Tango Black+,
+    /// Vero White; Pestell et al. Sec. III-A).
+    #[serde(rename = "PolyJet")]
+    Polyjet,
 }
 
 impl std::fmt::Display for PrintTechnology {
@@ -20,6 +24,7 @@ impl std::fmt::Display for PrintTechnology {
         f.write_str(match self {
             Self::Fdm => "FDM",
             Self::Sla => "SLA",
+            Self::Polyjet => "PolyJet",
         })
     }
 }
@@ -41,6 +46,10 @@ pub struct Part {
     pub solid: Solid,
     /// The resolved parameters the part was built from (for the manifest and twins).
     pub params: serde_json::Value,
+    /// Parts of one multi-material print share a group name: they are built in the same
+    /// coordinates and the 3MF places them with one translation, so they stay registered
+    /// (TacTip skin and pin-tip dots). `None` for a part printed on its own.
+    pub group: Option<String>,
 }
 
 /// Casting numbers for one pour.

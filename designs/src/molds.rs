@@ -536,6 +536,7 @@ pub fn build_mold(
         print_technology: fixture_tech,
         solid: place_on_bed(&holder),
         params: holder_params(design, &f),
+        group: None,
     };
 
     match plan.strategy {
@@ -563,6 +564,7 @@ pub fn build_mold(
                 print_technology: cavity_tech,
                 solid: s,
                 params: params.clone(),
+                group: None,
             };
             let parts = vec![half(a, "a", "male"), half(b, "b", "female"), holder_part];
             let pour_parts = parts.iter().map(|p| p.name.clone()).collect();
@@ -603,6 +605,7 @@ pub fn build_mold(
                     print_technology: cavity_tech,
                     solid: place_on_bed(&master),
                     params: params.clone(),
+                    group: None,
                 },
                 Part {
                     name: box_name.clone(),
@@ -612,6 +615,7 @@ pub fn build_mold(
                     print_technology: fixture_tech,
                     solid: place_on_bed(&mold_box),
                     params,
+                    group: None,
                 },
                 holder_part,
             ];
@@ -629,6 +633,7 @@ fn material_for(t: PrintTechnology) -> &'static str {
     match t {
         PrintTechnology::Fdm => "pla",
         PrintTechnology::Sla => "sla_standard_resin",
+        PrintTechnology::Polyjet => "tango_black_plus",
     }
 }
 

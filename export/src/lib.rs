@@ -202,6 +202,7 @@ fn render(kit: &Kit, meshes: &[Mesh], opts: &ExportOptions) -> Result<Rendered, 
             genus: mesh.genus(),
             sha256,
             params: part.params.clone(),
+            group: None,
         });
     }
 
@@ -307,6 +308,7 @@ mod tests {
             print_technology: PrintTechnology::Fdm,
             solid: cuboid([x, 0.0, 0.0], [x + 10.0, 10.0, 5.0]).unwrap(),
             params: serde_json::json!({}),
+            group: None,
         };
         Kit {
             design: "tiny".into(),

@@ -17,6 +17,7 @@ fn part(name: &str, tech: PrintTechnology, solid: fabkit_designs::geometry::Soli
         print_technology: tech,
         solid,
         params: serde_json::json!({ "name": name, "size_mm": [1.0, 2.0], "zeta": true, "alpha": 1 }),
+        group: None,
     }
 }
 
