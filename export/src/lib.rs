@@ -202,7 +202,6 @@ fn render(kit: &Kit, meshes: &[Mesh], opts: &ExportOptions) -> Result<Rendered, 
             genus: mesh.genus(),
             sha256,
             params: part.params.clone(),
-            group: None,
         });
     }
 
