@@ -6,7 +6,7 @@ use crate::geometry::ChordTolerance;
 use crate::kit::Kit;
 use crate::materials::{pour, MaterialsTable};
 use crate::molds::{build_mold, cast_plans};
-use crate::schema::Design;
+use crate::schema::{Design, LayerProcess, MoldStrategy};
 use crate::stack::{validate, Stack};
 use rayon::prelude::*;
 use serde_json::json;
@@ -30,12 +30,27 @@ pub fn build_kit(design: &Design, tol: ChordTolerance) -> Result<Kit, DesignErro
     // Casts and the shell are independent: build them in parallel. Each build is
     // single-threaded and the results are collected in order, so the output does not depend
     // on the thread count.
-    let (molds, shell) = rayon::join(
+    // Layers built by crate::layers: printed layers and the open / boundary strategies.
+    let other: Vec<usize> = stack
+        .layers
+        .iter()
+        .filter(|l| {
+            l.process == LayerProcess::Printed
+                || (l.process == LayerProcess::Cast && matches!(l.mold_strategy, MoldStrategy::Open | MoldStrategy::Boundary))
+        })
+        .map(|l| l.index)
+        .collect();
+    let held: Vec<_> = plans
+        .iter()
+        .filter(|p| matches!(p.strategy, MoldStrategy::Direct | MoldStrategy::Master))
+        .cloned()
+        .collect();
+    let ((molds, others), shell) = rayon::join(
         || {
-            plans
-                .par_iter()
-                .map(|plan| build_mold(design, &stack, plan, tol))
-                .collect::<Vec<_>>()
+            rayon::join(
+                || held.par_iter().map(|plan| build_mold(design, &stack, plan, tol)).collect::<Vec<_>>(),
+                || other.par_iter().map(|&i| crate::layers::build_layer(design, &stack, i, tol)).collect::<Vec<_>>(),
+            )
         },
         || {
             design
@@ -44,13 +59,28 @@ pub fn build_kit(design: &Design, tol: ChordTolerance) -> Result<Kit, DesignErro
                 .map(|h| crate::housing::build_shell(design, h, &stack, tol))
         },
     );
-    for (plan, out) in plans.iter().zip(molds) {
+    let mut layer_markers = Vec::new();
+    for (&i, out) in other.iter().zip(others) {
+        let out = out?;
+        for (what, material, v, holders) in out.pours {
+            if material == "mold_star_30" {
+                silicone.push((what, v, holders));
+            } else {
+                let sprayed = plans.iter().find(|p| p.layer == i).map(|p| p.sprayed.clone()).unwrap_or_default();
+                gel.push((i, what, material, v, holders, sprayed));
+            }
+        }
+        layer_markers.extend(out.markers);
+        parts.extend(out.parts);
+    }
+    for (plan, out) in held.iter().zip(molds) {
         let out = out?;
         let layer = &stack.layers[plan.layer];
         if let Some((v, holders)) = out.silicone_pour {
             silicone.push((format!("silicone_mold:{}", layer.name), v, holders));
         }
         gel.push((
+            plan.layer,
             layer.name.clone(),
             layer.material.clone(),
             out.pour_volume_mm3,
@@ -66,6 +96,7 @@ pub fn build_kit(design: &Design, tol: ChordTolerance) -> Result<Kit, DesignErro
         "pole_z_mm": design.body.pole_z_mm(0.0),
         "core": stack.core,
         "layers": stack.layers,
+        "markers": layer_markers,
     });
     if let (Some(h), Some(shell)) = (&design.housing, shell) {
         let (shell, levels) = shell?;
@@ -90,7 +121,8 @@ pub fn build_kit(design: &Design, tol: ChordTolerance) -> Result<Kit, DesignErro
         );
         step += 1;
     }
-    for (layer, material_key, v, holders, sprayed) in gel {
+    gel.sort_by_key(|g| g.0);
+    for (_, layer, material_key, v, holders, sprayed) in gel {
         let m = materials
             .get(&material_key)
             .ok_or_else(|| DesignError::Yaml(format!("unknown material {material_key}")))?;
@@ -129,17 +161,25 @@ pub fn build_kit(design: &Design, tol: ChordTolerance) -> Result<Kit, DesignErro
 }
 
 fn bought_items(design: &Design, stack: &Stack) -> Vec<String> {
-    let c = &stack.core;
-    let mut v = vec![match (c.outer_radius_mm, c.inner_radius_mm) {
-        (Some(ro), Some(ri)) => format!(
-            "Core ({}): {}, outer diameter {:.2} mm, wall {:.2} mm (inner diameter {:.2} mm), cut to {:.2} mm from the pole",
-            design.core.material, design.core.description, 2.0 * ro, ro - ri, 2.0 * ri, design.core.length_mm
-        ),
-        _ => format!(
-            "Core ({}): {}, wall {:.2} mm, {:.2} mm long from the pole",
-            design.core.material, design.core.description, design.core.wall_thickness_mm, design.core.length_mm
-        ),
-    }];
+    let mut v = Vec::new();
+    if let (Some(c), Some(spec)) = (&stack.core, &design.core) {
+        v.push(match (c.outer_radius_mm, c.inner_radius_mm) {
+            (Some(ro), Some(ri)) => format!(
+                "Core ({}): {}, outer diameter {:.2} mm, wall {:.2} mm (inner diameter {:.2} mm), cut to {:.2} mm from the pole",
+                spec.material, spec.description, 2.0 * ro, ro - ri, 2.0 * ri, spec.length_mm
+            ),
+            _ => format!(
+                "Core ({}): {}, wall {:.2} mm along the normal, {:.2} mm long from the pole",
+                spec.material, spec.description, spec.wall_thickness_mm, spec.length_mm
+            ),
+        });
+    }
+    if let Some(b) = &design.backing {
+        v.push(format!(
+            "Backing ({}): {}, {:.1} mm diameter, {:.1} mm thick; glue the skin's base to it",
+            b.material, b.description, b.diameter_mm, b.thickness_mm
+        ));
+    }
     for l in &stack.layers {
         if l.process == crate::schema::LayerProcess::Sprayed {
             v.push(format!(

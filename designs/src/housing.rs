@@ -328,7 +328,7 @@ pub fn check_housing_params(
         if core.below_base_mm < 1.0 {
             errs.push(ParamError::new(
                 "core.length_mm",
-                design.core.length_mm,
+                design.core.as_ref().map_or(0.0, |c| c.length_mm),
                 "the core must reach at least 1 mm below the base plane to seat in the housing",
             ));
         }
@@ -345,10 +345,13 @@ pub fn build_shell(
     stack: &Stack,
     tol: ChordTolerance,
 ) -> Result<(Vec<Part>, ShellLevels), DesignError> {
-    let lv = levels(design, h, &stack.core);
+    let core = stack.core.as_ref().ok_or_else(|| {
+        DesignError::Params(crate::error::ParamErrors(vec![ParamError::new("housing", "given", "the housing seats a core")]))
+    })?;
+    let lv = levels(design, h, core);
     let w = h.outer_width_mm / 2.0;
     let c = h.fit_clearance_mm;
-    let r_core = design.body.rim_radius_mm(stack.core.outer_offset_mm);
+    let r_core = design.body.rim_radius_mm(core.outer_offset_mm);
     let g = |r: Result<Solid, _>| r.part("shell");
     let shell = g(cuboid([-w, -w, lv.bottom_z_mm], [w, w, lv.top_z_mm]))?;
     let bw = h.camera.board_width_mm / 2.0 + c;

@@ -12,6 +12,7 @@ pub mod error;
 pub mod geometry;
 pub mod housing;
 pub mod kit;
+pub mod layers;
 pub mod library;
 pub mod markers;
 pub mod materials;

@@ -336,7 +336,7 @@ pub fn check_mold_fit(
     if f.core_end_z_mm > f.spigot_top_z_mm - 1.0 {
         errs.push(ParamError::new(
             "core.length_mm",
-            design.core.length_mm,
+            design.core.as_ref().map_or(0.0, |c| c.length_mm),
             format!(
                 "the core must reach at least {:.3} mm below the base plane so the holder can seat it (1 mm below the spigot top)",
                 f.base_z_mm - (f.spigot_top_z_mm - 1.0)
@@ -352,7 +352,7 @@ pub fn check_mold_fit(
     {
         errs.push(ParamError::new(
             "core.wall_thickness_mm",
-            design.core.wall_thickness_mm,
+            design.core.as_ref().map_or(0.0, |c| c.wall_thickness_mm),
             "leaves no room for the holder's centring pin inside the core",
         ));
     }
@@ -471,7 +471,10 @@ pub fn build_mold(
     tol: ChordTolerance,
 ) -> Result<MoldOutput, DesignError> {
     let layer = &stack.layers[plan.layer];
-    let f = MoldFrame::new(design, &stack.core, plan.cavity_offset_mm);
+    let core = stack.core.as_ref().ok_or_else(|| {
+        DesignError::Params(crate::error::ParamErrors(vec![ParamError::new("core", "missing", "direct and master molds hold a core")]))
+    })?;
+    let f = MoldFrame::new(design, core, plan.cavity_offset_mm);
     let m = &design.mold;
     let name = &layer.name;
     let cavity_tech: PrintTechnology = m.cavity_print_technology.into();
@@ -518,16 +521,11 @@ pub fn build_mold(
         "frame": f,
         "plinth": m.plinth,
     });
-    let holder_name = match plan.strategy {
-        MoldStrategy::Direct => format!("{name}_core_holder"),
-        MoldStrategy::Master => format!("{name}_casting_jig"),
-    };
+    let direct = plan.strategy == MoldStrategy::Direct;
+    let holder_name = if direct { format!("{name}_core_holder") } else { format!("{name}_casting_jig") };
     let holder_part = Part {
         name: holder_name.clone(),
-        role: match plan.strategy {
-            MoldStrategy::Direct => "core_holder".into(),
-            MoldStrategy::Master => "casting_jig".into(),
-        },
+        role: if direct { "core_holder".into() } else { "casting_jig".into() },
         description: format!(
             "Closes the {name} mold, centres the core on its bore and carries the sprue and {} vents",
             m.vent.count
@@ -540,6 +538,7 @@ pub fn build_mold(
     };
 
     match plan.strategy {
+        MoldStrategy::Open | MoldStrategy::Boundary => unreachable!("built by crate::layers"),
         MoldStrategy::Direct => {
             let (a, b) = direct_halves(design, &f, &cavity, tol).part(name)?;
             let mut params = common.clone();
@@ -686,33 +685,28 @@ fn direct_halves(
 }
 
 /// The mold box (sensor frame) and the solid the Mold Star fills up to its fill level.
-fn master_box(
-    design: &Design,
-    f: &MoldFrame,
-    tol: ChordTolerance,
-) -> Result<(Solid, Solid), crate::geometry::GeometryError> {
+fn master_box(design: &Design, f: &MoldFrame, tol: ChordTolerance) -> Result<(Solid, Solid), crate::geometry::GeometryError> {
+    drafted_box(design, f.plinth_radius_mm, f.open_face_z_mm, f.cavity_pole_z_mm, tol)
+}
+
+/// A drafted cup standing on the plane `z0` (the master's plinth face) around a master of
+/// plinth radius `plinth_radius_mm` reaching up to `pole_z`, with a socket for the master's
+/// locating pin; and the solid the Mold Star fills up to `silicone_wall_mm` over the pole.
+///
+/// # Errors
+/// Only on a kernel failure.
+pub fn drafted_box(design: &Design, plinth_radius_mm: f64, z0: f64, pole_z: f64, tol: ChordTolerance) -> Result<(Solid, Solid), crate::geometry::GeometryError> {
     let m = &design.mold;
-    let z0 = f.open_face_z_mm;
-    let z_fill = f.cavity_pole_z_mm + m.silicone_wall_mm;
+    let z_fill = pole_z + m.silicone_wall_mm;
     let z_top = z_fill + BOX_FREEBOARD_MM;
-    let r0 = f.plinth_radius_mm + m.silicone_wall_mm;
+    let r0 = plinth_radius_mm + m.silicone_wall_mm;
     let slope = m.draft_angle_deg.to_radians().tan();
     let r_at = |z: f64| r0 + slope * (z - z0);
     let r_out = r_at(z_top) + BOX_WALL_MM;
-    let outer = crate::geometry::cylinder(z_top - (z0 - BOX_FLOOR_MM), r_out, tol)?.translate([
-        0.0,
-        0.0,
-        z0 - BOX_FLOOR_MM,
-    ]);
-    let inner = crate::geometry::cone(z_top + 1.0 - z0, r0, r_at(z_top + 1.0), tol)?
-        .translate([0.0, 0.0, z0]);
-    let pin_r =
-        LOCATING_PIN_RADIUS_MM.min(f.plinth_radius_mm / 3.0) + m.core_holder.fit_clearance_mm;
-    let socket = crate::geometry::cylinder(BOX_FLOOR_MM + 2.0, pin_r, tol)?.translate([
-        0.0,
-        0.0,
-        z0 - BOX_FLOOR_MM - 1.0,
-    ]);
+    let outer = crate::geometry::cylinder(z_top - (z0 - BOX_FLOOR_MM), r_out, tol)?.translate([0.0, 0.0, z0 - BOX_FLOOR_MM]);
+    let inner = crate::geometry::cone(z_top + 1.0 - z0, r0, r_at(z_top + 1.0), tol)?.translate([0.0, 0.0, z0]);
+    let pin_r = LOCATING_PIN_RADIUS_MM.min(plinth_radius_mm / 3.0) + m.core_holder.fit_clearance_mm;
+    let socket = crate::geometry::cylinder(BOX_FLOOR_MM + 2.0, pin_r, tol)?.translate([0.0, 0.0, z0 - BOX_FLOOR_MM - 1.0]);
     let cup = outer.difference(&inner.union(&socket)?)?;
     let fill = crate::geometry::cone(z_fill - z0, r0, r_at(z_fill), tol)?.translate([0.0, 0.0, z0]);
     Ok((cup, fill))

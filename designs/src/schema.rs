@@ -18,8 +18,13 @@ pub struct Design {
     pub source: String,
     /// The outer surface of the skin (the reference surface).
     pub body: BodyProfile,
-    /// The rigid transparent shell the skin is cast onto.
-    pub core: Core,
+    /// The rigid transparent shell the skin is cast onto or bonded to (none for a solid or
+    /// printed skin).
+    #[serde(default)]
+    pub core: Option<Core>,
+    /// A flat backing plate the skin is glued to (ShadowTac: PMMA disc, Sec. IV-A); bought.
+    #[serde(default)]
+    pub backing: Option<Backing>,
     /// Skin layers from inner to outer.
     pub layers: Vec<Layer>,
     #[serde(default)]
@@ -30,6 +35,21 @@ pub struct Design {
     pub printers: PrinterProfiles,
     #[serde(default)]
     pub casting: CastingParams,
+    /// Named variants: each maps parameter paths (`layers[0].markers[0].pattern.rings`) to the
+    /// values that replace them (`fabkit export DESIGN --preset NAME`).
+    #[serde(default)]
+    pub presets: std::collections::BTreeMap<String, std::collections::BTreeMap<String, serde_json::Value>>,
+}
+
+/// A flat plate the skin is glued to.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Backing {
+    pub material: String,
+    pub diameter_mm: f64,
+    pub thickness_mm: f64,
+    #[serde(default)]
+    pub description: String,
 }
 
 /// The rigid transparent shell (R-Tac0: a glass test tube, Sec. III-B1). Its outer surface is
@@ -60,6 +80,8 @@ pub enum LayerProcess {
     /// Sprayed or brushed onto the mold's cavity before the next layer inward is poured
     /// (R-Tac0's black coating, Sec. III-B1); it gets no mold of its own.
     Sprayed,
+    /// Printed directly (TacTip skin in Tango Black+, Pestell et al. Sec. III-A).
+    Printed,
 }
 
 /// One skin layer. Give exactly one of `thickness_mm` and `outer_radius_mm`.
@@ -80,6 +102,16 @@ pub struct Layer {
     /// Overrides `mold.strategy` for this layer.
     #[serde(default)]
     pub mold_strategy: Option<MoldStrategy>,
+    /// The layer fills the body down to the base plane (no inner surface; innermost layer of
+    /// a design without core). Give neither thickness_mm nor outer_radius_mm.
+    #[serde(default)]
+    pub solid: bool,
+    /// Marker features on this layer's surfaces.
+    #[serde(default)]
+    pub markers: Vec<crate::markers::MarkerSpec>,
+    /// Technology of a printed layer (default polyjet).
+    #[serde(default)]
+    pub print_technology: Option<Technology>,
 }
 
 /// How a cast layer's mold is made.
@@ -91,6 +123,12 @@ pub enum MoldStrategy {
     /// A printed master pattern and mold box for a Mold Star 30 silicone mold, plus a casting
     /// jig (R-Tac0 Sec. III-B1, UVDtact Sec. III).
     Master,
+    /// A one-piece printed mold open on the base plane, for a solid skin cast pole-down
+    /// (ShadowTac Sec. IV-A).
+    Open,
+    /// Printed negatives for Mold Star 30 silicone molds of the outer and of the inner boundary
+    /// of the layer; the layer is cast between the two silicone molds (UVDtact Sec. III).
+    Boundary,
 }
 
 /// Print technologies, as used in the design file.
@@ -99,6 +137,7 @@ pub enum MoldStrategy {
 pub enum Technology {
     Fdm,
     Sla,
+    Polyjet,
 }
 
 impl From<Technology> for crate::kit::PrintTechnology {
@@ -106,6 +145,7 @@ impl From<Technology> for crate::kit::PrintTechnology {
         match t {
             Technology::Fdm => Self::Fdm,
             Technology::Sla => Self::Sla,
+            Technology::Polyjet => Self::Polyjet,
         }
     }
 }
@@ -259,12 +299,13 @@ pub struct PrinterProfile {
     pub min_feature_mm: f64,
 }
 
-/// The FDM and SLA profiles.
+/// The FDM, SLA and PolyJet profiles.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct PrinterProfiles {
     pub fdm: PrinterProfile,
     pub sla: PrinterProfile,
+    pub polyjet: PrinterProfile,
 }
 defaults!(PrinterProfiles {
     // 0.4 mm nozzle, 0.2 mm layers; two perimeters; holes below 1 mm close up.
@@ -280,8 +321,16 @@ defaults!(PrinterProfiles {
         xy_resolution_mm: 0.05,
         layer_height_mm: 0.05,
         min_wall_mm: 0.4,
-        min_hole_diameter_mm: 0.5,
+        min_hole_diameter_mm: 0.4,
         min_feature_mm: 0.3,
+    },
+    // Stratasys PolyJet (Connex): 42 um pixels, 16-30 um layers; Tango features below ~0.6 mm tear.
+    polyjet: PrinterProfile {
+        xy_resolution_mm: 0.042,
+        layer_height_mm: 0.03,
+        min_wall_mm: 0.6,
+        min_hole_diameter_mm: 0.5,
+        min_feature_mm: 0.5,
     },
 });
 
@@ -290,6 +339,7 @@ impl PrinterProfiles {
         match t {
             Technology::Fdm => &self.fdm,
             Technology::Sla => &self.sla,
+            Technology::Polyjet => &self.polyjet,
         }
     }
 }

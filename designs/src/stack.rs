@@ -20,6 +20,8 @@ pub struct ResolvedLayer {
     pub outer_offset_mm: f64,
     pub thickness_mm: f64,
     pub mold_strategy: MoldStrategy,
+    /// The layer fills the body down to the base plane (`inner_offset_mm` is -infinity).
+    pub solid: bool,
 }
 
 /// The rigid core with its surfaces resolved.
@@ -37,7 +39,8 @@ pub struct ResolvedCore {
 /// A validated design with every surface placed.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Stack {
-    pub core: ResolvedCore,
+    /// `None` for a design without core.
+    pub core: Option<ResolvedCore>,
     pub layers: Vec<ResolvedLayer>,
 }
 
@@ -53,30 +56,14 @@ impl Stack {
         tol: ChordTolerance,
     ) -> Result<Solid, crate::geometry::GeometryError> {
         let l = &self.layers[i];
-        let pl = design
-            .body
-            .shell_profile(l.inner_offset_mm, l.outer_offset_mm, 0.0, tol.half());
+        let pl = if l.solid {
+            design.body.solid_profile(l.outer_offset_mm, 0.0, tol.half())
+        } else {
+            design.body.shell_profile(l.inner_offset_mm, l.outer_offset_mm, 0.0, tol.half())
+        };
         Solid::from_mesh(&revolve(&pl, tol)?)
     }
 
-    /// The solid of the rigid core (a hollow shell continued below the base plane).
-    ///
-    /// # Errors
-    /// Only on a kernel failure.
-    pub fn core_solid(
-        &self,
-        design: &Design,
-        tol: ChordTolerance,
-    ) -> Result<Solid, crate::geometry::GeometryError> {
-        let c = &self.core;
-        let pl = design.body.shell_profile(
-            c.inner_offset_mm,
-            c.outer_offset_mm,
-            c.below_base_mm,
-            tol.half(),
-        );
-        Solid::from_mesh(&revolve(&pl, tol)?)
-    }
 }
 
 fn is_identifier(s: &str) -> bool {
@@ -97,164 +84,140 @@ pub fn validate(
     let mut errs: Vec<ParamError> = Vec::new();
     let t = tol.mm();
     if !is_identifier(&design.name) {
-        errs.push(ParamError::new(
-            "name",
-            format!("{:?}", design.name),
-            "must be lowercase letters, digits and _",
-        ));
+        errs.push(ParamError::new("name", format!("{:?}", design.name), "must be lowercase letters, digits and _"));
     }
     for (path, value, rule) in design.body.violations() {
         errs.push(ParamError::new(path, value, rule));
     }
     let body_ok = errs.iter().all(|e| !e.path.starts_with("body."));
-    let sphere_r = if body_ok {
-        design.body.sphere_radius_mm()
-    } else {
-        None
-    };
+    let sphere_r = if body_ok { design.body.sphere_radius_mm() } else { None };
 
     // Materials exist and fit their use.
-    let mut check_material =
-        |path: String, key: &str, kinds: &[MaterialKind]| match materials.get(key) {
-            None => errs.push(ParamError::new(
-                path,
-                key,
-                format!(
-                    "unknown material; known: {}",
-                    materials
-                        .materials
-                        .keys()
-                        .cloned()
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                ),
-            )),
-            Some(m) if !kinds.contains(&m.kind) => errs.push(ParamError::new(
-                path,
-                key,
-                format!("is a {:?} material, expected one of {:?}", m.kind, kinds),
-            )),
-            Some(_) => {}
-        };
-    check_material(
-        "core.material".into(),
-        &design.core.material,
-        &[MaterialKind::Bought, MaterialKind::Print],
-    );
+    let mut check_material = |path: String, key: &str, kinds: &[MaterialKind]| match materials.get(key) {
+        None => errs.push(ParamError::new(
+            path,
+            key,
+            format!("unknown material; known: {}", materials.materials.keys().cloned().collect::<Vec<_>>().join(", ")),
+        )),
+        Some(m) if !kinds.contains(&m.kind) => {
+            errs.push(ParamError::new(path, key, format!("is a {:?} material, expected one of {:?}", m.kind, kinds)))
+        }
+        Some(_) => {}
+    };
+    if let Some(c) = &design.core {
+        check_material("core.material".into(), &c.material, &[MaterialKind::Bought, MaterialKind::Print]);
+    }
+    if let Some(b) = &design.backing {
+        check_material("backing.material".into(), &b.material, &[MaterialKind::Bought, MaterialKind::Print]);
+    }
     for (i, l) in design.layers.iter().enumerate() {
         let kinds: &[MaterialKind] = match l.process {
             LayerProcess::Cast => &[MaterialKind::Cast],
             LayerProcess::Sprayed => &[MaterialKind::Coating, MaterialKind::Cast],
+            LayerProcess::Printed => &[MaterialKind::Print],
         };
         check_material(format!("layers[{i}].material"), &l.material, kinds);
+        for (j, m) in l.markers.iter().enumerate() {
+            if let Some(tm) = &m.tip_material {
+                check_material(format!("layers[{i}].markers[{j}].tip_material"), tm, &[MaterialKind::Print]);
+            }
+        }
     }
     if let Some(h) = &design.housing {
-        check_material(
-            "housing.material".into(),
-            &h.material,
-            &[MaterialKind::Print],
-        );
+        check_material("housing.material".into(), &h.material, &[MaterialKind::Print]);
     }
 
     if design.layers.is_empty() {
-        errs.push(ParamError::new(
-            "layers",
-            "[]",
-            "at least one layer is required",
-        ));
+        errs.push(ParamError::new("layers", "[]", "at least one layer is required"));
     }
     let mut names = std::collections::BTreeSet::new();
     let errors_before_layer_specs = errs.len();
     for (i, l) in design.layers.iter().enumerate() {
         if !is_identifier(&l.name) {
-            errs.push(ParamError::new(
-                format!("layers[{i}].name"),
-                format!("{:?}", l.name),
-                "must be lowercase letters, digits and _",
-            ));
+            errs.push(ParamError::new(format!("layers[{i}].name"), format!("{:?}", l.name), "must be lowercase letters, digits and _"));
         } else if !names.insert(l.name.clone()) {
-            errs.push(ParamError::new(
-                format!("layers[{i}].name"),
-                &l.name,
-                "is used by another layer",
-            ));
+            errs.push(ParamError::new(format!("layers[{i}].name"), &l.name, "is used by another layer"));
         }
-        match (l.thickness_mm, l.outer_radius_mm) {
-            (Some(_), Some(_)) | (None, None) => errs.push(ParamError::new(
-                format!("layers[{i}]"),
-                &l.name,
-                "give exactly one of thickness_mm and outer_radius_mm",
-            )),
-            (None, Some(_)) if sphere_r.is_none() && body_ok => errs.push(ParamError::new(
-                format!("layers[{i}].outer_radius_mm"),
-                l.outer_radius_mm.unwrap_or_default(),
-                format!(
-                    "radii only describe spherical profiles; the {} needs thickness_mm",
-                    design.body.kind()
-                ),
-            )),
-            _ => {}
-        }
-        for (what, v) in [
-            ("thickness_mm", l.thickness_mm),
-            ("outer_radius_mm", l.outer_radius_mm),
-        ] {
-            if v.is_some_and(|v| !v.is_finite()) {
+        if l.solid {
+            if i != 0 || design.core.is_some() {
                 errs.push(ParamError::new(
-                    format!("layers[{i}].{what}"),
-                    v.unwrap_or_default(),
-                    "must be a finite number",
+                    format!("layers[{i}].solid"),
+                    true,
+                    "only the innermost layer of a design without core can be solid",
                 ));
+            }
+            if l.thickness_mm.is_some() || l.outer_radius_mm.is_some() {
+                errs.push(ParamError::new(
+                    format!("layers[{i}]"),
+                    &l.name,
+                    "a solid layer fills the body: give neither thickness_mm nor outer_radius_mm",
+                ));
+            }
+        } else {
+            match (l.thickness_mm, l.outer_radius_mm) {
+                (Some(_), Some(_)) | (None, None) => errs.push(ParamError::new(
+                    format!("layers[{i}]"),
+                    &l.name,
+                    "give exactly one of thickness_mm and outer_radius_mm",
+                )),
+                (None, Some(_)) if sphere_r.is_none() && body_ok => errs.push(ParamError::new(
+                    format!("layers[{i}].outer_radius_mm"),
+                    l.outer_radius_mm.unwrap_or_default(),
+                    format!("radii only describe spherical profiles; the {} needs thickness_mm", design.body.kind()),
+                )),
+                _ => {}
+            }
+        }
+        for (what, v) in [("thickness_mm", l.thickness_mm), ("outer_radius_mm", l.outer_radius_mm)] {
+            if v.is_some_and(|v| !v.is_finite()) {
+                errs.push(ParamError::new(format!("layers[{i}].{what}"), v.unwrap_or_default(), "must be a finite number"));
             }
         }
     }
     let layer_specs_ok = errs.len() == errors_before_layer_specs;
-    if design
-        .layers
-        .iter()
-        .all(|l| l.process != LayerProcess::Cast)
-        && !design.layers.is_empty()
-    {
-        errs.push(ParamError::new(
-            "layers",
-            design.layers.len(),
-            "at least one layer must be cast",
-        ));
+    if !design.layers.is_empty() && design.layers.iter().all(|l| l.process == LayerProcess::Sprayed) {
+        errs.push(ParamError::new("layers", design.layers.len(), "at least one layer must be cast or printed"));
     }
-    if design
-        .layers
-        .first()
-        .is_some_and(|l| l.process == LayerProcess::Sprayed)
-    {
+    if design.layers.first().is_some_and(|l| l.process == LayerProcess::Sprayed) {
         errs.push(ParamError::new(
             "layers[0].process",
             "sprayed",
-            "the innermost layer must be cast: a sprayed layer coats the mold of the cast layer under it",
+            "the innermost layer must be cast or printed: a sprayed layer coats the mold of the cast layer under it",
         ));
     }
-    if design.core.outer_diameter_mm.is_some() && sphere_r.is_none() && body_ok {
-        errs.push(ParamError::new(
-            "core.outer_diameter_mm",
-            design.core.outer_diameter_mm.unwrap_or_default(),
-            format!(
-                "a diameter only describes spherical profiles; remove it for the {}",
-                design.body.kind()
-            ),
-        ));
-    }
-    if !(design.core.wall_thickness_mm > 0.0) {
-        errs.push(ParamError::new(
-            "core.wall_thickness_mm",
-            design.core.wall_thickness_mm,
-            "must be above 0",
-        ));
+    if let Some(c) = &design.core {
+        if c.outer_diameter_mm.is_some() && sphere_r.is_none() && body_ok {
+            errs.push(ParamError::new(
+                "core.outer_diameter_mm",
+                c.outer_diameter_mm.unwrap_or_default(),
+                format!("a diameter only describes spherical profiles; remove it for the {}", design.body.kind()),
+            ));
+        }
+        if !(c.wall_thickness_mm > 0.0) {
+            errs.push(ParamError::new("core.wall_thickness_mm", c.wall_thickness_mm, "must be above 0"));
+        }
     }
     if !(0.0..=1.0).contains(&design.casting.waste_allowance) {
-        errs.push(ParamError::new(
-            "casting.waste_allowance",
-            design.casting.waste_allowance,
-            "must be in [0, 1]",
-        ));
+        errs.push(ParamError::new("casting.waste_allowance", design.casting.waste_allowance, "must be in [0, 1]"));
+    }
+    // Mold strategies that need a rigid core (a holder grips it) or a solid layer.
+    for (i, l) in design.layers.iter().enumerate() {
+        if l.process != LayerProcess::Cast {
+            continue;
+        }
+        let strategy = l.mold_strategy.unwrap_or(design.mold.strategy);
+        let path = if l.mold_strategy.is_some() { format!("layers[{i}].mold_strategy") } else { "mold.strategy".to_string() };
+        let needs_core = matches!(strategy, MoldStrategy::Direct | MoldStrategy::Master);
+        if needs_core && (design.core.is_none() || l.solid) {
+            errs.push(ParamError::new(
+                path.clone(),
+                format!("{strategy:?}").to_lowercase(),
+                format!("layer '{}' has no core to hold; use open (solid skins) or boundary", l.name),
+            ));
+        }
+        if strategy == MoldStrategy::Open && !l.solid {
+            errs.push(ParamError::new(path, "open", format!("an open mold casts a solid skin; layer '{}' is not solid (use boundary)", l.name)));
+        }
     }
 
     // Resolve the stack from the inside out, in "radius" units for spheres (r = R + offset).
@@ -262,33 +225,54 @@ pub fn validate(
     let mut core = None;
     let mut stack_ok = false;
     if body_ok && layer_specs_ok && !design.layers.is_empty() {
-        let total_t: Option<f64> = design.layers.iter().map(|l| l.thickness_mm).sum();
-        // Offset of the core's outer surface.
-        let core_out = match (sphere_r, design.core.outer_diameter_mm) {
+        let solid_first = design.layers[0].solid;
+        let shells = if solid_first { &design.layers[1..] } else { &design.layers[..] };
+        let total_t: Option<f64> = shells.iter().map(|l| l.thickness_mm).sum();
+        let core_od = design.core.as_ref().and_then(|c| c.outer_diameter_mm);
+        // Offset of the innermost shell layer's inner surface.
+        let start = match (sphere_r, core_od) {
             (_, Some(od)) if !(od > 0.0 && od.is_finite()) => {
-                errs.push(ParamError::new(
-                    "core.outer_diameter_mm",
-                    od,
-                    "must be above 0",
-                ));
+                errs.push(ParamError::new("core.outer_diameter_mm", od, "must be above 0"));
                 None
             }
             (Some(r), Some(od)) => Some(od / 2.0 - r),
             _ => total_t.map(|s| -s),
         };
-        match core_out {
-            None if design.core.outer_diameter_mm.is_some() => {}
+        match start {
+            None if core_od.is_some() => {}
             None => errs.push(ParamError::new(
-                "core.outer_diameter_mm",
+                if design.core.is_some() { "core.outer_diameter_mm" } else { "layers" },
                 "missing",
-                "layers given by outer_radius_mm are measured from the core: give core.outer_diameter_mm",
+                "layers given by outer_radius_mm are measured from the core: give core.outer_diameter_mm (or thickness_mm for every layer)",
             )),
-            Some(core_out) => {
+            Some(start) => {
                 let r_body = sphere_r.unwrap_or(0.0);
-                let mut below = core_out;
-                let mut below_name = "the core".to_string();
+                let mut below = start;
+                let mut below_name = if design.core.is_some() { "the core".to_string() } else { "the inner surface".to_string() };
                 let errors_before_stack = errs.len();
-                for (i, l) in design.layers.iter().enumerate() {
+                if solid_first {
+                    let l = &design.layers[0];
+                    if !design.body.offset_is_valid(start) {
+                        errs.push(ParamError::new(
+                            "layers[1].thickness_mm",
+                            -start,
+                            "the layers above the solid layer leave no room for it",
+                        ));
+                    }
+                    layers.push(ResolvedLayer {
+                        index: 0,
+                        name: l.name.clone(),
+                        material: l.material.clone(),
+                        process: l.process,
+                        inner_offset_mm: f64::NEG_INFINITY,
+                        outer_offset_mm: start,
+                        thickness_mm: design.body.pole_z_mm(start) - design.body.base_z_mm(),
+                        mold_strategy: l.mold_strategy.unwrap_or(design.mold.strategy),
+                        solid: true,
+                    });
+                    below_name = format!("layer '{}'", l.name);
+                }
+                for (i, l) in design.layers.iter().enumerate().skip(usize::from(solid_first)) {
                     let (out, path, value) = match (l.thickness_mm, l.outer_radius_mm) {
                         (Some(th), _) => (below + th, format!("layers[{i}].thickness_mm"), th),
                         (_, Some(ro)) => (ro - r_body, format!("layers[{i}].outer_radius_mm"), ro),
@@ -299,18 +283,14 @@ pub fn validate(
                         let rule = if i == 0 && l.outer_radius_mm.is_some() && th < 0.0 {
                             format!(
                                 "the core (outer radius {:.3} mm) is larger than the cavity of layer '{}' (outer radius {:.3} mm)",
-                                r_body + below, l.name, r_body + out
+                                r_body + below,
+                                l.name,
+                                r_body + out
                             )
                         } else if l.outer_radius_mm.is_some() && th < 0.0 {
-                            format!(
-                                "must be above the outer radius of {below_name} under it ({:.3} mm)",
-                                r_body + below
-                            )
+                            format!("must be above the outer radius of {below_name} under it ({:.3} mm)", r_body + below)
                         } else {
-                            format!(
-                                "leaves layer '{}' {:.4} mm thick, below the chord tolerance {} mm",
-                                l.name, th, t
-                            )
+                            format!("leaves layer '{}' {:.4} mm thick, below the chord tolerance {} mm", l.name, th, t)
                         };
                         errs.push(ParamError::new(path, value, rule));
                     }
@@ -323,6 +303,7 @@ pub fn validate(
                         outer_offset_mm: out,
                         thickness_mm: th,
                         mold_strategy: l.mold_strategy.unwrap_or(design.mold.strategy),
+                        solid: false,
                     });
                     below = out;
                     below_name = format!("layer '{}'", l.name);
@@ -339,72 +320,102 @@ pub fn validate(
                             "the outermost layer '{}' ends {:+.4} mm from the body surface; its outer surface must be the body surface{}",
                             design.layers[last].name,
                             below,
-                            if design.core.outer_diameter_mm.is_some() {
-                                " (check core.outer_diameter_mm and the layer radii)"
-                            } else {
-                                ""
-                            }
+                            if core_od.is_some() { " (check core.outer_diameter_mm and the layer radii)" } else { "" }
                         ),
                     ));
                 }
-                let core_in = core_out - design.core.wall_thickness_mm;
-                let pole_z = design.body.pole_z_mm(core_out);
-                let below_base = design.core.length_mm - (pole_z - design.body.base_z_mm());
-                if stack_ok && (!(design.core.length_mm > 0.0) || below_base < 0.0) {
-                    errs.push(ParamError::new(
-                        "core.length_mm",
-                        design.core.length_mm,
-                        format!(
-                            "the core must reach the base plane: at least {:.3} mm from its pole",
-                            pole_z - design.body.base_z_mm()
-                        ),
-                    ));
-                }
-                for (what, d) in [("core outer surface", core_out), ("core inner surface", core_in)] {
-                    if !design.body.offset_is_valid(d) {
-                        errs.push(ParamError::new(
-                            if what.contains("inner") { "core.wall_thickness_mm" } else { "layers" },
-                            if what.contains("inner") { design.core.wall_thickness_mm } else { -core_out },
-                            format!(
-                                "the {what} lies {:.3} mm inside the body surface, beyond what the {} allows (smallest radius of curvature {:.3} mm, pole above the base plane): the offset surface would fold or vanish",
-                                -d,
-                                design.body.kind(),
-                                design.body.min_curvature_radius_mm()
-                            ),
-                        ));
+                // Every shell surface must be a valid offset (no fold at high curvature).
+                if stack_ok {
+                    for l in &layers {
+                        if !l.solid && !design.body.offset_is_valid(l.inner_offset_mm) {
+                            stack_ok = false;
+                            errs.push(ParamError::new(
+                                format!("layers[{}]", l.index),
+                                &l.name,
+                                format!(
+                                    "its inner surface lies {:.3} mm inside the body surface, beyond what the {} allows (smallest radius of curvature {:.3} mm): the offset surface would fold",
+                                    -l.inner_offset_mm,
+                                    design.body.kind(),
+                                    design.body.min_curvature_radius_mm()
+                                ),
+                            ));
+                        }
                     }
                 }
-                core = Some(ResolvedCore {
-                    inner_offset_mm: core_in,
-                    outer_offset_mm: core_out,
-                    below_base_mm: below_base.max(0.0),
-                    outer_radius_mm: sphere_r.map(|r| r + core_out),
-                    inner_radius_mm: sphere_r.map(|r| r + core_in),
-                });
+                if let (Some(c), true) = (&design.core, stack_ok) {
+                    core = Some(resolve_core(design, c, start, sphere_r, &mut errs));
+                }
             }
         }
     }
 
     crate::molds::check_mold_params(design, &mut errs);
     check_printers(design, &mut errs);
+    if stack_ok {
+        crate::layers::check_markers(design, &layers, &mut errs);
+    }
     // Checks that use the core only make sense once the stack itself is sound.
     let sound_core = core.as_ref().filter(|_| stack_ok);
     if let Some(h) = &design.housing {
-        crate::housing::check_housing_params(design, h, sound_core, &mut errs);
+        match (sound_core, stack_ok) {
+            (Some(_), _) | (None, false) => crate::housing::check_housing_params(design, h, sound_core, &mut errs),
+            (None, true) => errs.push(ParamError::new("housing", "given", "the housing seats a core: give core: or remove housing:")),
+        }
     }
     if let (Some(c), true) = (sound_core, errs.is_empty()) {
-        if let Some(first) = layers.iter().find(|l| l.process == LayerProcess::Cast) {
+        if let Some(first) = layers
+            .iter()
+            .find(|l| l.process == LayerProcess::Cast && matches!(l.mold_strategy, MoldStrategy::Direct | MoldStrategy::Master))
+        {
             crate::molds::check_mold_fit(design, c, first.outer_offset_mm, &mut errs);
         }
     }
-    match (errs.is_empty(), core) {
-        (true, Some(core)) => Ok(Stack { core, layers }),
-        _ => Err(ParamErrors(errs)),
+    if errs.is_empty() && stack_ok {
+        Ok(Stack { core, layers })
+    } else {
+        Err(ParamErrors(errs))
+    }
+}
+
+/// The core's surfaces and the checks on its length. Its inner surface is only needed (and
+/// only checked) when a mold holds the core by its bore.
+fn resolve_core(design: &Design, c: &crate::schema::Core, core_out: f64, sphere_r: Option<f64>, errs: &mut Vec<ParamError>) -> ResolvedCore {
+    let core_in = core_out - c.wall_thickness_mm;
+    let pole_z = design.body.pole_z_mm(core_out);
+    let below_base = c.length_mm - (pole_z - design.body.base_z_mm());
+    let held = design.layers.iter().any(|l| {
+        l.process == LayerProcess::Cast && matches!(l.mold_strategy.unwrap_or(design.mold.strategy), MoldStrategy::Direct | MoldStrategy::Master)
+    });
+    if !(c.length_mm > 0.0) || below_base < 0.0 {
+        errs.push(ParamError::new(
+            "core.length_mm",
+            c.length_mm,
+            format!("the core must reach the base plane: at least {:.3} mm from its pole", pole_z - design.body.base_z_mm()),
+        ));
+    }
+    if held && c.wall_thickness_mm > 0.0 && !design.body.offset_is_valid(core_in) {
+        errs.push(ParamError::new(
+            "core.wall_thickness_mm",
+            c.wall_thickness_mm,
+            format!(
+                "the core inner surface lies {:.3} mm inside the body surface, beyond what the {} allows (smallest radius of curvature {:.3} mm): the offset surface would fold",
+                -core_in,
+                design.body.kind(),
+                design.body.min_curvature_radius_mm()
+            ),
+        ));
+    }
+    ResolvedCore {
+        inner_offset_mm: core_in,
+        outer_offset_mm: core_out,
+        below_base_mm: below_base.max(0.0),
+        outer_radius_mm: sphere_r.map(|r| r + core_out),
+        inner_radius_mm: sphere_r.map(|r| r + core_in),
     }
 }
 
 fn check_printers(design: &Design, errs: &mut Vec<ParamError>) {
-    for (name, p) in [("fdm", &design.printers.fdm), ("sla", &design.printers.sla)] {
+    for (name, p) in [("fdm", &design.printers.fdm), ("sla", &design.printers.sla), ("polyjet", &design.printers.polyjet)] {
         for (field, v) in [
             ("xy_resolution_mm", p.xy_resolution_mm),
             ("layer_height_mm", p.layer_height_mm),

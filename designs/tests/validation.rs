@@ -91,7 +91,7 @@ fn baseline_validates_and_builds() {
     for (got, want) in outer.iter().zip([13.5, 15.0, 15.1]) {
         assert!((got - want).abs() < 1e-9, "outer radii {outer:?}");
     }
-    assert!((stack.core.outer_offset_mm - (10.0 - 15.1)).abs() < 1e-9);
+    assert!((stack.core.as_ref().unwrap().outer_offset_mm - (10.0 - 15.1)).abs() < 1e-9);
     assert!(stack
         .layers
         .iter()
@@ -175,7 +175,7 @@ fn single_mutations() -> Vec<Mutation> {
         ),
         (
             "negative core wall",
-            |d| d.core.wall_thickness_mm = -1.0,
+            |d| d.core.as_mut().unwrap().wall_thickness_mm = -1.0,
             Expect {
                 path: "core.wall_thickness_mm",
                 value: "-1",
@@ -323,7 +323,7 @@ fn led_pcb_too_wide_thins_the_wall_and_covers_the_mount_holes() {
 #[test]
 fn core_larger_than_its_cavity_is_named() {
     let mut d = baseline();
-    d.core.outer_diameter_mm = Some(28.0);
+    d.core.as_mut().unwrap().outer_diameter_mm = Some(28.0);
     let errs = errors(&d);
     let want = Expect {
         path: "layers[0].outer_radius_mm",
@@ -338,7 +338,7 @@ fn core_larger_than_its_cavity_is_named() {
 #[test]
 fn core_larger_than_its_cavity_yields_one_error() {
     let mut d = baseline();
-    d.core.outer_diameter_mm = Some(28.0);
+    d.core.as_mut().unwrap().outer_diameter_mm = Some(28.0);
     assert_exactly(
         &errors(&d),
         &[&Expect {
