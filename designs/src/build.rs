@@ -36,7 +36,8 @@ pub fn build_kit(design: &Design, tol: ChordTolerance) -> Result<Kit, DesignErro
         .iter()
         .filter(|l| {
             l.process == LayerProcess::Printed
-                || (l.process == LayerProcess::Cast && matches!(l.mold_strategy, MoldStrategy::Open | MoldStrategy::Boundary))
+                || (l.process == LayerProcess::Cast
+                    && matches!(l.mold_strategy, MoldStrategy::Open | MoldStrategy::Boundary))
         })
         .map(|l| l.index)
         .collect();
@@ -48,8 +49,17 @@ pub fn build_kit(design: &Design, tol: ChordTolerance) -> Result<Kit, DesignErro
     let ((molds, others), shell) = rayon::join(
         || {
             rayon::join(
-                || held.par_iter().map(|plan| build_mold(design, &stack, plan, tol)).collect::<Vec<_>>(),
-                || other.par_iter().map(|&i| crate::layers::build_layer(design, &stack, i, tol)).collect::<Vec<_>>(),
+                || {
+                    held.par_iter()
+                        .map(|plan| build_mold(design, &stack, plan, tol))
+                        .collect::<Vec<_>>()
+                },
+                || {
+                    other
+                        .par_iter()
+                        .map(|&i| crate::layers::build_layer(design, &stack, i, tol))
+                        .collect::<Vec<_>>()
+                },
             )
         },
         || {
@@ -66,7 +76,11 @@ pub fn build_kit(design: &Design, tol: ChordTolerance) -> Result<Kit, DesignErro
             if material == "mold_star_30" {
                 silicone.push((what, v, holders));
             } else {
-                let sprayed = plans.iter().find(|p| p.layer == i).map(|p| p.sprayed.clone()).unwrap_or_default();
+                let sprayed = plans
+                    .iter()
+                    .find(|p| p.layer == i)
+                    .map(|p| p.sprayed.clone())
+                    .unwrap_or_default();
                 gel.push((i, what, material, v, holders, sprayed));
             }
         }

@@ -346,7 +346,11 @@ pub fn build_shell(
     tol: ChordTolerance,
 ) -> Result<(Vec<Part>, ShellLevels), DesignError> {
     let core = stack.core.as_ref().ok_or_else(|| {
-        DesignError::Params(crate::error::ParamErrors(vec![ParamError::new("housing", "given", "the housing seats a core")]))
+        DesignError::Params(crate::error::ParamErrors(vec![ParamError::new(
+            "housing",
+            "given",
+            "the housing seats a core",
+        )]))
     })?;
     let lv = levels(design, h, core);
     let w = h.outer_width_mm / 2.0;

@@ -39,7 +39,9 @@ fn surface_offset(l: &ResolvedLayer, s: MarkerSurface) -> f64 {
 
 fn direction(spec: &MarkerSpec) -> f64 {
     match (spec.surface, spec.feature.polarity) {
-        (MarkerSurface::Outer, Polarity::Raised) | (MarkerSurface::Inner, Polarity::Recessed) => 1.0,
+        (MarkerSurface::Outer, Polarity::Raised) | (MarkerSurface::Inner, Polarity::Recessed) => {
+            1.0
+        }
         _ => -1.0,
     }
 }
@@ -58,7 +60,11 @@ fn rim_margin(spec: &MarkerSpec, min_wall: f64) -> f64 {
 }
 
 /// Places every marker pattern of layer `i`.
-pub fn place_layer_markers(design: &Design, layer: &ResolvedLayer, tol: ChordTolerance) -> Vec<PlacedMarkers> {
+pub fn place_layer_markers(
+    design: &Design,
+    layer: &ResolvedLayer,
+    tol: ChordTolerance,
+) -> Vec<PlacedMarkers> {
     let spec_layer = &design.layers[layer.index];
     let profile = design.printers.get(feature_technology(design, spec_layer));
     spec_layer
@@ -67,7 +73,12 @@ pub fn place_layer_markers(design: &Design, layer: &ResolvedLayer, tol: ChordTol
         .filter_map(|spec| {
             let offset = surface_offset(layer, spec.surface);
             let surface = Surface::new(&design.body, offset);
-            let markers = markers::place(&surface, &spec.pattern, rim_margin(spec, profile.min_wall_mm)).ok()?;
+            let markers = markers::place(
+                &surface,
+                &spec.pattern,
+                rim_margin(spec, profile.min_wall_mm),
+            )
+            .ok()?;
             let stats = markers::stats(&surface, &markers);
             let max_k = (0..=64)
                 .map(|i| {
@@ -99,23 +110,37 @@ pub fn check_markers(design: &Design, layers: &[ResolvedLayer], errs: &mut Vec<P
             let path = format!("layers[{}].markers[{j}]", l.index);
             let f = &spec.feature;
             if !(f.diameter_mm > 0.0 && f.diameter_mm.is_finite()) {
-                errs.push(ParamError::new(format!("{path}.feature.diameter_mm"), f.diameter_mm, "must be above 0"));
+                errs.push(ParamError::new(
+                    format!("{path}.feature.diameter_mm"),
+                    f.diameter_mm,
+                    "must be above 0",
+                ));
                 continue;
             }
             if !(f.height_mm >= f.diameter_mm / 2.0 && f.height_mm.is_finite()) {
                 errs.push(ParamError::new(
                     format!("{path}.feature.height_mm"),
                     f.height_mm,
-                    format!("must be at least the radius {} mm (a cylinder ending in a hemisphere)", f.diameter_mm / 2.0),
+                    format!(
+                        "must be at least the radius {} mm (a cylinder ending in a hemisphere)",
+                        f.diameter_mm / 2.0
+                    ),
                 ));
                 continue;
             }
             if l.solid && spec.surface == MarkerSurface::Inner {
-                errs.push(ParamError::new(format!("{path}.surface"), "inner", "a solid layer has no inner surface"));
+                errs.push(ParamError::new(
+                    format!("{path}.surface"),
+                    "inner",
+                    "a solid layer has no inner surface",
+                ));
                 continue;
             }
             let molded = spec_layer.process == LayerProcess::Cast;
-            if molded && spec.surface == MarkerSurface::Inner && l.mold_strategy != MoldStrategy::Boundary {
+            if molded
+                && spec.surface == MarkerSurface::Inner
+                && l.mold_strategy != MoldStrategy::Boundary
+            {
                 errs.push(ParamError::new(
                     format!("{path}.surface"),
                     "inner",
@@ -126,7 +151,9 @@ pub fn check_markers(design: &Design, layers: &[ResolvedLayer], errs: &mut Vec<P
                 ));
                 continue;
             }
-            if spec.tip_material.is_some() && (spec_layer.process != LayerProcess::Printed || f.polarity != Polarity::Raised) {
+            if spec.tip_material.is_some()
+                && (spec_layer.process != LayerProcess::Printed || f.polarity != Polarity::Raised)
+            {
                 errs.push(ParamError::new(
                     format!("{path}.tip_material"),
                     spec.tip_material.clone().unwrap_or_default(),
@@ -135,7 +162,9 @@ pub fn check_markers(design: &Design, layers: &[ResolvedLayer], errs: &mut Vec<P
             }
             // Printability: in a mold, a raised feature is a hole and a recessed one a bump.
             let (what, min) = match (molded, f.polarity) {
-                (true, Polarity::Raised) | (false, Polarity::Recessed) => ("minimum hole", profile.min_hole_diameter_mm),
+                (true, Polarity::Raised) | (false, Polarity::Recessed) => {
+                    ("minimum hole", profile.min_hole_diameter_mm)
+                }
                 _ => ("minimum feature", profile.min_feature_mm),
             };
             if f.diameter_mm < min {
@@ -150,7 +179,7 @@ pub fn check_markers(design: &Design, layers: &[ResolvedLayer], errs: &mut Vec<P
                 continue;
             }
             // A feature cut into a shell layer must leave its minimum wall behind it.
-            let cut_in = (spec.surface == MarkerSurface::Outer) == (f.polarity == Polarity::Recessed);
+            let cut_in = f.polarity == Polarity::Recessed;
             if cut_in && !l.solid && f.height_mm > l.thickness_mm - profile.min_wall_mm {
                 errs.push(ParamError::new(
                     format!("{path}.feature.height_mm"),
@@ -163,15 +192,27 @@ pub fn check_markers(design: &Design, layers: &[ResolvedLayer], errs: &mut Vec<P
                 continue;
             }
             let surface = Surface::new(&design.body, surface_offset(l, spec.surface));
-            let placed = match markers::place(&surface, &spec.pattern, rim_margin(spec, profile.min_wall_mm)) {
+            let placed = match markers::place(
+                &surface,
+                &spec.pattern,
+                rim_margin(spec, profile.min_wall_mm),
+            ) {
                 Ok(m) => m,
                 Err((field, value, rule)) => {
-                    errs.push(ParamError::new(format!("{path}.pattern.{field}"), value, rule));
+                    errs.push(ParamError::new(
+                        format!("{path}.pattern.{field}"),
+                        value,
+                        rule,
+                    ));
                     continue;
                 }
             };
             if placed.is_empty() {
-                errs.push(ParamError::new(format!("{path}.pattern"), "0 markers", "places no marker"));
+                errs.push(ParamError::new(
+                    format!("{path}.pattern"),
+                    "0 markers",
+                    "places no marker",
+                ));
                 continue;
             }
             let st = markers::stats(&surface, &placed);
@@ -195,7 +236,11 @@ pub fn check_markers(design: &Design, layers: &[ResolvedLayer], errs: &mut Vec<P
     }
 }
 
-fn feature_solids(pm: &PlacedMarkers, tol: ChordTolerance, stems_only: bool) -> Result<Vec<Solid>, GeometryError> {
+fn feature_solids(
+    pm: &PlacedMarkers,
+    tol: ChordTolerance,
+    stems_only: bool,
+) -> Result<Vec<Solid>, GeometryError> {
     let mut shape = pm.spec.feature.clone();
     if stems_only {
         // the cylinder only: a hemisphere-free feature of height (height - radius)
@@ -215,10 +260,27 @@ fn feature_solids(pm: &PlacedMarkers, tol: ChordTolerance, stems_only: bool) -> 
 }
 
 /// A plain cylinder from `embed` behind the surface to `height` beyond it.
-fn stem_solid(shape: &markers::FeatureShape, position: [f64; 3], dir: [f64; 3], embed: f64, tol: ChordTolerance) -> Result<Solid, GeometryError> {
+fn stem_solid(
+    shape: &markers::FeatureShape,
+    position: [f64; 3],
+    dir: [f64; 3],
+    embed: f64,
+    tol: ChordTolerance,
+) -> Result<Solid, GeometryError> {
     let r = shape.radius_mm();
-    let pl = Polyline2 { points: vec![[0.0, -embed], [r, -embed], [r, shape.height_mm], [0.0, shape.height_mm]] };
-    Ok(Solid::from_mesh(&revolve(&pl, ChordTolerance::new(tol.mm() * 2.0).unwrap_or(tol))?)?.transform(&markers::frame_to(position, dir)))
+    let pl = Polyline2 {
+        points: vec![
+            [0.0, -embed],
+            [r, -embed],
+            [r, shape.height_mm],
+            [0.0, shape.height_mm],
+        ],
+    };
+    Ok(Solid::from_mesh(&revolve(
+        &pl,
+        ChordTolerance::new(tol.mm() * 2.0).unwrap_or(tol),
+    )?)?
+    .transform(&markers::frame_to(position, dir)))
 }
 
 /// The hemispherical tips (flat face at height - radius) of raised features.
@@ -227,20 +289,36 @@ fn tip_solids(pm: &PlacedMarkers, tol: ChordTolerance) -> Result<Vec<Solid>, Geo
     let hc = pm.spec.feature.height_mm - r;
     let mut pl = Polyline2::default();
     pl.push([0.0, 0.0]);
-    crate::geometry::profile2d::push_arc(&mut pl, [0.0, 0.0], r, 0.0, std::f64::consts::FRAC_PI_2, tol.half());
+    crate::geometry::profile2d::push_arc(
+        &mut pl,
+        [0.0, 0.0],
+        r,
+        0.0,
+        std::f64::consts::FRAC_PI_2,
+        tol.half(),
+    );
     let local = Solid::from_mesh(&revolve(&pl, tol)?)?;
     pm.markers
         .iter()
         .map(|m| {
             let dir = m.normal.map(|c| c * pm.direction);
-            let base = [m.position_mm[0] + hc * dir[0], m.position_mm[1] + hc * dir[1], m.position_mm[2] + hc * dir[2]];
+            let base = [
+                m.position_mm[0] + hc * dir[0],
+                m.position_mm[1] + hc * dir[1],
+                m.position_mm[2] + hc * dir[2],
+            ];
             Ok(local.transform(&markers::frame_to(base, dir)))
         })
         .collect()
 }
 
 /// Adds the outward features and removes the inward ones: one compose and one boolean each.
-fn apply_features(base: Solid, sets: &[&PlacedMarkers], tol: ChordTolerance, stems_only: bool) -> Result<Solid, GeometryError> {
+fn apply_features(
+    base: Solid,
+    sets: &[&PlacedMarkers],
+    tol: ChordTolerance,
+    stems_only: bool,
+) -> Result<Solid, GeometryError> {
     let mut out_f = Vec::new();
     let mut in_f = Vec::new();
     for pm in sets {
@@ -263,8 +341,20 @@ fn apply_features(base: Solid, sets: &[&PlacedMarkers], tol: ChordTolerance, ste
 
 /// The solid enclosed by a boundary surface (offset `offset_mm`), continued `below_base_mm`
 /// under the base plane, with the features carried by that surface.
-fn enclosed(design: &Design, offset_mm: f64, below_base_mm: f64, sets: &[&PlacedMarkers], tol: ChordTolerance, stems_only: bool) -> Result<Solid, GeometryError> {
-    let base = Solid::from_mesh(&revolve(&design.body.solid_profile(offset_mm, below_base_mm, tol.half()), tol)?)?;
+fn enclosed(
+    design: &Design,
+    offset_mm: f64,
+    below_base_mm: f64,
+    sets: &[&PlacedMarkers],
+    tol: ChordTolerance,
+    stems_only: bool,
+) -> Result<Solid, GeometryError> {
+    let base = Solid::from_mesh(&revolve(
+        &design
+            .body
+            .solid_profile(offset_mm, below_base_mm, tol.half()),
+        tol,
+    )?)?;
     apply_features(base, sets, tol, stems_only)
 }
 
@@ -273,12 +363,23 @@ fn enclosed(design: &Design, offset_mm: f64, below_base_mm: f64, sets: &[&Placed
 ///
 /// # Errors
 /// Only on a kernel failure.
-pub fn layer_solid(design: &Design, stack: &Stack, i: usize, tol: ChordTolerance) -> Result<Solid, GeometryError> {
+pub fn layer_solid(
+    design: &Design,
+    stack: &Stack,
+    i: usize,
+    tol: ChordTolerance,
+) -> Result<Solid, GeometryError> {
     let l = &stack.layers[i];
     let placed = place_layer_markers(design, l, tol);
     let stems_only = placed.iter().any(|p| p.spec.tip_material.is_some());
-    let outer: Vec<&PlacedMarkers> = placed.iter().filter(|p| p.spec.surface == MarkerSurface::Outer).collect();
-    let inner: Vec<&PlacedMarkers> = placed.iter().filter(|p| p.spec.surface == MarkerSurface::Inner).collect();
+    let outer: Vec<&PlacedMarkers> = placed
+        .iter()
+        .filter(|p| p.spec.surface == MarkerSurface::Outer)
+        .collect();
+    let inner: Vec<&PlacedMarkers> = placed
+        .iter()
+        .filter(|p| p.spec.surface == MarkerSurface::Inner)
+        .collect();
     let o = enclosed(design, l.outer_offset_mm, 0.0, &outer, tol, stems_only)?;
     if l.solid {
         return Ok(o);
@@ -295,17 +396,28 @@ pub struct LayerOutput {
     pub markers: Vec<serde_json::Value>,
 }
 
-fn marker_summary(l: &ResolvedLayer, placed: &[PlacedMarkers], tech: Technology, design: &Design) -> Vec<serde_json::Value> {
+fn marker_summary(
+    l: &ResolvedLayer,
+    placed: &[PlacedMarkers],
+    tech: Technology,
+    design: &Design,
+) -> Vec<serde_json::Value> {
     placed
         .iter()
         .map(|p| {
             // A feature prints on a profile when it is above both its smallest hole and its
             // smallest feature (it is one or the other in the part or in its mold).
-            let printable: Vec<&str> = [("FDM", &design.printers.fdm), ("SLA", &design.printers.sla), ("PolyJet", &design.printers.polyjet)]
-                .iter()
-                .filter(|(_, pr)| p.spec.feature.diameter_mm >= pr.min_hole_diameter_mm.max(pr.min_feature_mm))
-                .map(|(n, _)| *n)
-                .collect();
+            let printable: Vec<&str> = [
+                ("FDM", &design.printers.fdm),
+                ("SLA", &design.printers.sla),
+                ("PolyJet", &design.printers.polyjet),
+            ]
+            .iter()
+            .filter(|(_, pr)| {
+                p.spec.feature.diameter_mm >= pr.min_hole_diameter_mm.max(pr.min_feature_mm)
+            })
+            .map(|(n, _)| *n)
+            .collect();
             json!({
                 "layer": l.name,
                 "surface": p.spec.surface,
@@ -327,7 +439,12 @@ fn marker_summary(l: &ResolvedLayer, placed: &[PlacedMarkers], tech: Technology,
 ///
 /// # Errors
 /// [`DesignError::Geometry`] if the kernel fails.
-pub fn build_layer(design: &Design, stack: &Stack, i: usize, tol: ChordTolerance) -> Result<LayerOutput, DesignError> {
+pub fn build_layer(
+    design: &Design,
+    stack: &Stack,
+    i: usize,
+    tol: ChordTolerance,
+) -> Result<LayerOutput, DesignError> {
     let l = &stack.layers[i];
     let name = l.name.clone();
     let placed = place_layer_markers(design, l, tol);
@@ -337,8 +454,14 @@ pub fn build_layer(design: &Design, stack: &Stack, i: usize, tol: ChordTolerance
     let fixture_tech: PrintTechnology = design.mold.fixture_print_technology.into();
     let cavity_tech: PrintTechnology = design.mold.cavity_print_technology.into();
     let m = &design.mold;
-    let outer: Vec<&PlacedMarkers> = placed.iter().filter(|p| p.spec.surface == MarkerSurface::Outer).collect();
-    let inner: Vec<&PlacedMarkers> = placed.iter().filter(|p| p.spec.surface == MarkerSurface::Inner).collect();
+    let outer: Vec<&PlacedMarkers> = placed
+        .iter()
+        .filter(|p| p.spec.surface == MarkerSurface::Outer)
+        .collect();
+    let inner: Vec<&PlacedMarkers> = placed
+        .iter()
+        .filter(|p| p.spec.surface == MarkerSurface::Inner)
+        .collect();
     let base_params = json!({
         "layer": name, "body": design.body, "outer_offset_mm": l.outer_offset_mm,
         "inner_offset_mm": if l.solid { serde_json::Value::Null } else { json!(l.inner_offset_mm) },
@@ -348,10 +471,25 @@ pub fn build_layer(design: &Design, stack: &Stack, i: usize, tol: ChordTolerance
     match (l.process, l.mold_strategy) {
         (LayerProcess::Printed, _) => {
             let skin = g(layer_solid(design, stack, i, tol))?;
-            let tech: PrintTechnology = spec_layer.print_technology.unwrap_or(Technology::Polyjet).into();
-            let group = placed.iter().any(|p| p.spec.tip_material.is_some()).then(|| name.clone());
+            let tech: PrintTechnology = spec_layer
+                .print_technology
+                .unwrap_or(Technology::Polyjet)
+                .into();
+            let group = placed
+                .iter()
+                .any(|p| p.spec.tip_material.is_some())
+                .then(|| name.clone());
             // Skin and tips move together onto the plate (same translation).
-            let shift = skin.bounding_box().map(|b| [-(b.min[0] + b.max[0]) / 2.0, -(b.min[1] + b.max[1]) / 2.0, -b.min[2]]).unwrap_or([0.0; 3]);
+            let shift = skin
+                .bounding_box()
+                .map(|b| {
+                    [
+                        -(b.min[0] + b.max[0]) / 2.0,
+                        -(b.min[1] + b.max[1]) / 2.0,
+                        -b.min[2],
+                    ]
+                })
+                .unwrap_or([0.0; 3]);
             let mut parts = vec![Part {
                 name: name.clone(),
                 role: "printed_skin".into(),
@@ -367,7 +505,10 @@ pub fn build_layer(design: &Design, stack: &Stack, i: usize, tol: ChordTolerance
                 parts.push(Part {
                     name: format!("{name}_tips"),
                     role: "marker_tips".into(),
-                    description: format!("{} marker tips of {name}, printed in the second material with the skin", p.stats.count),
+                    description: format!(
+                        "{} marker tips of {name}, printed in the second material with the skin",
+                        p.stats.count
+                    ),
                     material: p.spec.tip_material.clone().unwrap_or_default(),
                     print_technology: tech,
                     solid: tips.translate(shift),
@@ -375,20 +516,32 @@ pub fn build_layer(design: &Design, stack: &Stack, i: usize, tol: ChordTolerance
                     group: group.clone(),
                 });
             }
-            Ok(LayerOutput { parts, pours: vec![], markers: markers_json })
+            Ok(LayerOutput {
+                parts,
+                pours: vec![],
+                markers: markers_json,
+            })
         }
         (_, MoldStrategy::Open) => {
             let cavity = g(enclosed(design, l.outer_offset_mm, 1.0, &outer, tol, false))?;
             let skin = g(enclosed(design, l.outer_offset_mm, 0.0, &outer, tol, false))?;
-            let b = cavity.bounding_box().unwrap_or(crate::geometry::Aabb { min: [0.0; 3], max: [0.0; 3] });
+            let b = cavity.bounding_box().unwrap_or(crate::geometry::Aabb {
+                min: [0.0; 3],
+                max: [0.0; 3],
+            });
             let half = b.max[0].max(-b.min[0]).max(b.max[1]).max(-b.min[1]) + m.wall_thickness_mm;
             let zb = design.body.base_z_mm();
-            let block = g(crate::geometry::cuboid([-half, -half, zb], [half, half, b.max[2] + m.wall_thickness_mm]))?;
+            let block = g(crate::geometry::cuboid(
+                [-half, -half, zb],
+                [half, half, b.max[2] + m.wall_thickness_mm],
+            ))?;
             let mold = g(block.difference(&cavity))?;
             let part = Part {
                 name: format!("{name}_open_mold"),
                 role: "open_mold".into(),
-                description: format!("One-piece mold for the solid {name} skin, open face up: pour to the brim"),
+                description: format!(
+                    "One-piece mold for the solid {name} skin, open face up: pour to the brim"
+                ),
                 material: material_for(cavity_tech).into(),
                 print_technology: cavity_tech,
                 solid: place_on_bed(&mold.rotate_deg(180.0, 0.0, 0.0)),
@@ -396,7 +549,11 @@ pub fn build_layer(design: &Design, stack: &Stack, i: usize, tol: ChordTolerance
                 group: None,
             };
             let pour_parts = vec![part.name.clone()];
-            Ok(LayerOutput { parts: vec![part], pours: vec![(name.clone(), l.material.clone(), skin.volume(), pour_parts)], markers: markers_json })
+            Ok(LayerOutput {
+                parts: vec![part],
+                pours: vec![(name.clone(), l.material.clone(), skin.volume(), pour_parts)],
+                markers: markers_json,
+            })
         }
         (_, MoldStrategy::Boundary) => {
             let zb = design.body.base_z_mm();
@@ -405,20 +562,31 @@ pub fn build_layer(design: &Design, stack: &Stack, i: usize, tol: ChordTolerance
             let z_lo = zb - m.plinth.height_mm;
             let fit = m.core_holder.fit_clearance_mm;
             // Outer boundary: master (positive) with plinth and locating pin, and a drafted box.
-            let mut pl = design.body.offset_polyline(l.outer_offset_mm, 0.0, tol.half());
+            let mut pl = design
+                .body
+                .offset_polyline(l.outer_offset_mm, 0.0, tol.half());
             let pin_r = 3.0f64.min(r_p / 3.0);
-            for p in [[r_p, zb], [r_p, z_lo], [pin_r, z_lo], [pin_r, z_lo - 2.0], [0.0, z_lo - 2.0]] {
+            for p in [
+                [r_p, zb],
+                [r_p, z_lo],
+                [pin_r, z_lo],
+                [pin_r, z_lo - 2.0],
+                [0.0, z_lo - 2.0],
+            ] {
                 pl.push(p);
             }
             let master_base = g(revolve(&pl, tol).and_then(|mesh| Solid::from_mesh(&mesh)))?;
             let master = g(apply_features(master_base, &outer, tol, false))?;
             let pole = master.bounding_box().map(|b| b.max[2]).unwrap_or(0.0);
-            let (mold_box, fill) = crate::molds::drafted_box(design, r_p, z_lo, pole, tol).part(&name)?;
+            let (mold_box, fill) =
+                crate::molds::drafted_box(design, r_p, z_lo, pole, tol).part(&name)?;
             let silicone_outer = g(fill.difference(&master))?.volume();
             // Inner boundary: a cup whose cavity casts the inner silicone core; the core's
             // plinth fits the outer mold's plinth recess (with clearance), which centres it.
             let inner_pl = {
-                let mut q = design.body.offset_polyline(l.inner_offset_mm, 0.0, tol.half());
+                let mut q = design
+                    .body
+                    .offset_polyline(l.inner_offset_mm, 0.0, tol.half());
                 for p in [[r_p - fit, zb], [r_p - fit, z_lo - 1.0], [0.0, z_lo - 1.0]] {
                     q.push(p);
                 }
@@ -427,13 +595,19 @@ pub fn build_layer(design: &Design, stack: &Stack, i: usize, tol: ChordTolerance
             let core_pos = g(revolve(&inner_pl, tol)
                 .and_then(|mesh| Solid::from_mesh(&mesh))
                 .and_then(|s| apply_features(s, &inner, tol, false)))?;
-            let top = core_pos.bounding_box().map(|b| b.max[2]).unwrap_or(0.0) + BOUNDARY_CUP_FLOOR_MM;
+            let top =
+                core_pos.bounding_box().map(|b| b.max[2]).unwrap_or(0.0) + BOUNDARY_CUP_FLOOR_MM;
             let cup_r = r_p + BOUNDARY_CUP_WALL_MM;
-            let cup = g(crate::geometry::cylinder(top - z_lo, cup_r, tol).map(|c| c.translate([0.0, 0.0, z_lo])))?;
+            let cup = g(crate::geometry::cylinder(top - z_lo, cup_r, tol)
+                .map(|c| c.translate([0.0, 0.0, z_lo])))?;
             let inner_negative = g(cup.difference(&core_pos))?;
             let silicone_inner = g(core_pos.intersection(&cup))?.volume();
             let gel = g(layer_solid(design, stack, i, tol))?.volume();
-            let mk = |suffix: &str, role: &str, desc: String, tech: PrintTechnology, solid: Solid| Part {
+            let mk = |suffix: &str,
+                      role: &str,
+                      desc: String,
+                      tech: PrintTechnology,
+                      solid: Solid| Part {
                 name: format!("{name}_{suffix}"),
                 role: role.into(),
                 description: desc,
@@ -452,9 +626,27 @@ pub fn build_layer(design: &Design, stack: &Stack, i: usize, tol: ChordTolerance
             Ok(LayerOutput {
                 parts,
                 pours: vec![
-                    (format!("silicone_mold:{name}:outer"), "mold_star_30".into(), silicone_outer, vec![names[0].clone(), names[1].clone()]),
-                    (format!("silicone_mold:{name}:inner"), "mold_star_30".into(), silicone_inner, vec![names[2].clone()]),
-                    (name.clone(), l.material.clone(), gel, vec![format!("silicone_mold:{name}:outer"), format!("silicone_mold:{name}:inner")]),
+                    (
+                        format!("silicone_mold:{name}:outer"),
+                        "mold_star_30".into(),
+                        silicone_outer,
+                        vec![names[0].clone(), names[1].clone()],
+                    ),
+                    (
+                        format!("silicone_mold:{name}:inner"),
+                        "mold_star_30".into(),
+                        silicone_inner,
+                        vec![names[2].clone()],
+                    ),
+                    (
+                        name.clone(),
+                        l.material.clone(),
+                        gel,
+                        vec![
+                            format!("silicone_mold:{name}:outer"),
+                            format!("silicone_mold:{name}:inner"),
+                        ],
+                    ),
                 ],
                 markers: markers_json,
             })

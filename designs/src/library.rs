@@ -4,7 +4,15 @@ use crate::error::DesignError;
 use crate::schema::Design;
 
 /// (name, YAML text) of every library design; the first is the default.
-pub const LIBRARY: &[(&str, &str)] = &[("rtac0", include_str!("../library/rtac0.yaml"))];
+pub const LIBRARY: &[(&str, &str)] = &[
+    ("rtac0", include_str!("../library/rtac0.yaml")),
+    ("shadowtac", include_str!("../library/shadowtac.yaml")),
+    ("uvdtact", include_str!("../library/uvdtact.yaml")),
+    (
+        "tactip_dualmodal",
+        include_str!("../library/tactip_dualmodal.yaml"),
+    ),
+];
 
 /// The default design of `fabkit export` without a design argument.
 pub const DEFAULT_DESIGN: &str = "rtac0";

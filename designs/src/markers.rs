@@ -184,7 +184,8 @@ impl Surface {
         // Spherical profiles: exact arc length rho * angle (t is linear in angle).
         if let Some(r) = body.sphere_radius_mm() {
             let rho = r + offset_mm;
-            let a_end = body.offset_normal(offset_mm, 1.0)[1].atan2(body.offset_normal(offset_mm, 1.0)[0]);
+            let a_end =
+                body.offset_normal(offset_mm, 1.0)[1].atan2(body.offset_normal(offset_mm, 1.0)[0]);
             let total = rho * (FRAC_PI_2 - a_end);
             for e in &mut table {
                 e.1 = total * e.0;
@@ -192,10 +193,18 @@ impl Surface {
         }
         let curved_arc_mm = table.last().map(|e| e.1).unwrap_or(0.0);
         let cylinder_mm = match *body {
-            BodyProfile::HemisphereOnCylinder { cylinder_length_mm, .. } => cylinder_length_mm,
+            BodyProfile::HemisphereOnCylinder {
+                cylinder_length_mm, ..
+            } => cylinder_length_mm,
             _ => 0.0,
         };
-        Self { body: body.clone(), offset_mm, table, curved_arc_mm, cylinder_mm }
+        Self {
+            body: body.clone(),
+            offset_mm,
+            table,
+            curved_arc_mm,
+            cylinder_mm,
+        }
     }
 
     /// Arc length from the pole to the base plane, mm.
@@ -205,7 +214,10 @@ impl Surface {
 
     fn t_of_s(&self, s: f64) -> f64 {
         let s = s.clamp(0.0, self.curved_arc_mm);
-        let i = self.table.partition_point(|e| e.1 < s).clamp(1, self.table.len() - 1);
+        let i = self
+            .table
+            .partition_point(|e| e.1 < s)
+            .clamp(1, self.table.len() - 1);
         let (t0, s0) = self.table[i - 1];
         let (t1, s1) = self.table[i];
         if s1 > s0 {
@@ -222,7 +234,10 @@ impl Surface {
             ([p[0], p[1] - (s - self.curved_arc_mm)], [1.0, 0.0])
         } else {
             let t = self.t_of_s(s);
-            (self.body.offset_point(self.offset_mm, t), self.body.offset_normal(self.offset_mm, t))
+            (
+                self.body.offset_point(self.offset_mm, t),
+                self.body.offset_normal(self.offset_mm, t),
+            )
         }
     }
 
@@ -300,7 +315,8 @@ impl Surface {
                 ];
                 self.project(c, a.arc_mm + f * (b.arc_mm - a.arc_mm))
             };
-            len += ((q[0] - prev[0]).powi(2) + (q[1] - prev[1]).powi(2) + (q[2] - prev[2]).powi(2)).sqrt();
+            len += ((q[0] - prev[0]).powi(2) + (q[1] - prev[1]).powi(2) + (q[2] - prev[2]).powi(2))
+                .sqrt();
             prev = q;
         }
         len
@@ -332,21 +348,36 @@ impl Surface {
 ///
 /// # Errors
 /// A message naming the missing or invalid field of the pattern (the caller adds the path).
-pub fn place(surface: &Surface, pattern: &Pattern, rim_margin_mm: f64) -> Result<Vec<Marker>, (String, String, String)> {
+pub fn place(
+    surface: &Surface,
+    pattern: &Pattern,
+    rim_margin_mm: f64,
+) -> Result<Vec<Marker>, (String, String, String)> {
     let err = |f: &str, v: String, rule: &str| Err((f.to_string(), v, rule.to_string()));
     let s_max = match pattern.max_polar_deg {
         Some(p) => surface.s_at_polar_deg(p),
         None => surface.total_arc_mm() - rim_margin_mm,
     };
-    let s_min = pattern.min_polar_deg.map(|p| surface.s_at_polar_deg(p)).unwrap_or(0.0);
+    let s_min = pattern
+        .min_polar_deg
+        .map(|p| surface.s_at_polar_deg(p))
+        .unwrap_or(0.0);
     if !(s_max > s_min) {
-        return err("max_polar_deg", format!("{:?}", pattern.max_polar_deg), "leaves no room for markers between the polar limits and the rim");
+        return err(
+            "max_polar_deg",
+            format!("{:?}", pattern.max_polar_deg),
+            "leaves no room for markers between the polar limits and the rim",
+        );
     }
     let positive = |f: &str, v: Option<f64>| -> Result<f64, (String, String, String)> {
         match v {
             Some(x) if x > 0.0 && x.is_finite() => Ok(x),
             Some(x) => Err((f.to_string(), x.to_string(), "must be above 0".into())),
-            None => Err((f.to_string(), "missing".into(), format!("is required for layout {:?}", pattern.layout))),
+            None => Err((
+                f.to_string(),
+                "missing".into(),
+                format!("is required for layout {:?}", pattern.layout),
+            )),
         }
     };
     // (s, azimuth radians, ring)
@@ -354,7 +385,13 @@ pub fn place(surface: &Surface, pattern: &Pattern, rim_margin_mm: f64) -> Result
     let centre = pattern.center_marker && s_min == 0.0;
     match pattern.layout {
         Layout::Concentric6k => {
-            let rings = pattern.rings.ok_or_else(|| ("rings".to_string(), "missing".to_string(), "is required for concentric_6k".to_string()))?;
+            let rings = pattern.rings.ok_or_else(|| {
+                (
+                    "rings".to_string(),
+                    "missing".to_string(),
+                    "is required for concentric_6k".to_string(),
+                )
+            })?;
             let pitch = positive("pitch_arc_mm", pattern.pitch_arc_mm)?;
             if centre {
                 raw.push((0.0, 0.0, 0));
@@ -377,7 +414,11 @@ pub fn place(surface: &Surface, pattern: &Pattern, rim_margin_mm: f64) -> Result
             }
             let mut k = 1;
             loop {
-                let s = if s_min > 0.0 { s_min + (k - 1) as f64 * sp } else { k as f64 * sp };
+                let s = if s_min > 0.0 {
+                    s_min + (k - 1) as f64 * sp
+                } else {
+                    k as f64 * sp
+                };
                 if s > s_max + 1e-9 {
                     break;
                 }
@@ -402,12 +443,18 @@ pub fn place(surface: &Surface, pattern: &Pattern, rim_margin_mm: f64) -> Result
                 }
             }
             // deterministic order: by arc length, then azimuth
-            raw.sort_by(|p, q| (p.0, p.1).partial_cmp(&(q.0, q.1)).unwrap_or(std::cmp::Ordering::Equal));
+            raw.sort_by(|p, q| {
+                (p.0, p.1)
+                    .partial_cmp(&(q.0, q.1))
+                    .unwrap_or(std::cmp::Ordering::Equal)
+            });
         }
         Layout::GoldenSpiral => {
             // cumulative area table from s_min to s_max, inverted by interpolation
             let k = 4096;
-            let ss: Vec<f64> = (0..=k).map(|i| s_min + (s_max - s_min) * i as f64 / k as f64).collect();
+            let ss: Vec<f64> = (0..=k)
+                .map(|i| s_min + (s_max - s_min) * i as f64 / k as f64)
+                .collect();
             let rs: Vec<f64> = ss.iter().map(|&x| surface.radius_at(x)).collect();
             let mut area = vec![0.0; k + 1];
             for i in 1..=k {
@@ -433,15 +480,27 @@ pub fn place(surface: &Surface, pattern: &Pattern, rim_margin_mm: f64) -> Result
         }
         Layout::List => {
             let pts = pattern.points.as_ref().ok_or_else(|| {
-                ("points".to_string(), "missing".to_string(), "is required for layout list (or csv_file)".to_string())
+                (
+                    "points".to_string(),
+                    "missing".to_string(),
+                    "is required for layout list (or csv_file)".to_string(),
+                )
             })?;
             for (i, p) in pts.iter().enumerate() {
                 if !(p[0] >= 0.0 && p[0].is_finite() && p[1].is_finite()) {
-                    return err(&format!("points[{i}]"), format!("{p:?}"), "polar angle must be >= 0 and both angles finite");
+                    return err(
+                        &format!("points[{i}]"),
+                        format!("{p:?}"),
+                        "polar angle must be >= 0 and both angles finite",
+                    );
                 }
                 let s = surface.s_at_polar_deg(p[0]);
                 if s > s_max + 1e-9 || s < s_min - 1e-9 {
-                    return err(&format!("points[{i}]"), format!("{p:?}"), "lies outside the patterned region");
+                    return err(
+                        &format!("points[{i}]"),
+                        format!("{p:?}"),
+                        "lies outside the patterned region",
+                    );
                 }
                 raw.push((s, p[1].to_radians(), 0));
             }
@@ -469,7 +528,12 @@ pub fn place(surface: &Surface, pattern: &Pattern, rim_margin_mm: f64) -> Result
 pub fn stats(surface: &Surface, markers: &[Marker]) -> PatternStats {
     let n = markers.len();
     if n < 2 {
-        return PatternStats { count: n, min_spacing_mm: 0.0, median_spacing_mm: 0.0, closest_pair: None };
+        return PatternStats {
+            count: n,
+            min_spacing_mm: 0.0,
+            median_spacing_mm: 0.0,
+            closest_pair: None,
+        };
     }
     // Bucket grid on chord distance for candidate neighbours.
     let mut cell = 0.0f64;
@@ -482,11 +546,19 @@ pub fn stats(surface: &Surface, markers: &[Marker]) -> PatternStats {
                 hi[k] = hi[k].max(m.position_mm[k]);
             }
         }
-        let diag = ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2)).sqrt();
+        let diag =
+            ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2)).sqrt();
         cell = cell.max(diag / (n as f64).sqrt()).max(1e-6);
     }
-    let key = |p: [f64; 3]| [(p[0] / cell).floor() as i64, (p[1] / cell).floor() as i64, (p[2] / cell).floor() as i64];
-    let mut grid: std::collections::HashMap<[i64; 3], Vec<usize>> = std::collections::HashMap::new();
+    let key = |p: [f64; 3]| {
+        [
+            (p[0] / cell).floor() as i64,
+            (p[1] / cell).floor() as i64,
+            (p[2] / cell).floor() as i64,
+        ]
+    };
+    let mut grid: std::collections::HashMap<[i64; 3], Vec<usize>> =
+        std::collections::HashMap::new();
     for (i, m) in markers.iter().enumerate() {
         grid.entry(key(m.position_mm)).or_default().push(i);
     }
@@ -533,8 +605,17 @@ pub fn stats(surface: &Surface, markers: &[Marker]) -> PatternStats {
         nn.push(d);
     }
     nn.sort_by(|a, b| a.partial_cmp(b).unwrap_or(std::cmp::Ordering::Equal));
-    let median = if n % 2 == 1 { nn[n / 2] } else { 0.5 * (nn[n / 2 - 1] + nn[n / 2]) };
-    PatternStats { count: n, min_spacing_mm: nn[0], median_spacing_mm: median, closest_pair: Some((best_pair.0, best_pair.1)) }
+    let median = if n % 2 == 1 {
+        nn[n / 2]
+    } else {
+        0.5 * (nn[n / 2 - 1] + nn[n / 2])
+    };
+    PatternStats {
+        count: n,
+        min_spacing_mm: nn[0],
+        median_spacing_mm: median,
+        closest_pair: Some((best_pair.0, best_pair.1)),
+    }
 }
 
 /// How deep a feature reaches behind the surface so that it joins the body without a gap:
@@ -550,7 +631,13 @@ pub fn embed_depth_mm(shape: &FeatureShape, max_curvature: f64, tol: ChordTolera
 ///
 /// # Errors
 /// Only on a kernel failure.
-pub fn feature_solid(shape: &FeatureShape, position: [f64; 3], dir: [f64; 3], embed_mm: f64, tol: ChordTolerance) -> Result<Solid, GeometryError> {
+pub fn feature_solid(
+    shape: &FeatureShape,
+    position: [f64; 3],
+    dir: [f64; 3],
+    embed_mm: f64,
+    tol: ChordTolerance,
+) -> Result<Solid, GeometryError> {
     let r = shape.radius_mm();
     let hc = shape.height_mm - r;
     let mut pl = Polyline2::default();
@@ -565,7 +652,11 @@ pub fn feature_solid(shape: &FeatureShape, position: [f64; 3], dir: [f64; 3], em
 pub fn frame_to(position: [f64; 3], dir: [f64; 3]) -> crate::geometry::Affine {
     let z = dir;
     // any vector not parallel to z
-    let helper = if z[2].abs() < 0.9 { [0.0, 0.0, 1.0] } else { [1.0, 0.0, 0.0] };
+    let helper = if z[2].abs() < 0.9 {
+        [0.0, 0.0, 1.0]
+    } else {
+        [1.0, 0.0, 0.0]
+    };
     let mut x = [
         helper[1] * z[2] - helper[2] * z[1],
         helper[2] * z[0] - helper[0] * z[2],
@@ -573,7 +664,11 @@ pub fn frame_to(position: [f64; 3], dir: [f64; 3]) -> crate::geometry::Affine {
     ];
     let l = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
     x = [x[0] / l, x[1] / l, x[2] / l];
-    let y = [z[1] * x[2] - z[2] * x[1], z[2] * x[0] - z[0] * x[2], z[0] * x[1] - z[1] * x[0]];
+    let y = [
+        z[1] * x[2] - z[2] * x[1],
+        z[2] * x[0] - z[0] * x[2],
+        z[0] * x[1] - z[1] * x[0],
+    ];
     [
         [x[0], y[0], z[0], position[0]],
         [x[1], y[1], z[1], position[1]],
@@ -593,7 +688,10 @@ mod tests {
     use super::*;
 
     fn cap() -> BodyProfile {
-        BodyProfile::SphericalCap { base_diameter_mm: 35.0, height_mm: 8.0 }
+        BodyProfile::SphericalCap {
+            base_diameter_mm: 35.0,
+            height_mm: 8.0,
+        }
     }
 
     #[test]
@@ -616,9 +714,14 @@ mod tests {
         let st = stats(&s, &m);
         // ring pitch is 1.53 mm of arc; the neighbours on ring 1 are 2 pi 1.53 / 6 apart, on
         // ring 12 about 2 pi r(18.36) / 72
-        assert!(st.min_spacing_mm > 1.2 && st.min_spacing_mm < 1.53, "{st:?}");
+        assert!(
+            st.min_spacing_mm > 1.2 && st.min_spacing_mm < 1.53,
+            "{st:?}"
+        );
         for mk in &m {
-            let r = (mk.position_mm[0].powi(2) + mk.position_mm[1].powi(2) + mk.position_mm[2].powi(2)).sqrt();
+            let r =
+                (mk.position_mm[0].powi(2) + mk.position_mm[1].powi(2) + mk.position_mm[2].powi(2))
+                    .sqrt();
             let rho = (17.5f64 * 17.5 + 64.0) / 16.0;
             assert!((r - rho).abs() < 1e-9);
         }
@@ -636,7 +739,10 @@ mod tests {
 
     #[test]
     fn golden_spiral_count_and_hex_grid_spacing() {
-        let body = BodyProfile::HalfEllipsoid { diameter_mm: 18.0, height_mm: 24.0 };
+        let body = BodyProfile::HalfEllipsoid {
+            diameter_mm: 18.0,
+            height_mm: 24.0,
+        };
         let s = Surface::new(&body, -0.9);
         let mut p = Pattern {
             layout: Layout::GoldenSpiral,
@@ -656,7 +762,10 @@ mod tests {
         let area = s.area_to(s.total_arc_mm() - 1.0);
         let hex = (area / 85.0 / (3f64.sqrt() / 2.0)).sqrt();
         let st = stats(&s, &m);
-        assert!((st.median_spacing_mm / hex - 1.0).abs() < 0.25, "{st:?} vs {hex}");
+        assert!(
+            (st.median_spacing_mm / hex - 1.0).abs() < 0.25,
+            "{st:?} vs {hex}"
+        );
         // A hex grid wrapped onto a cap (azimuthal equidistant) keeps its pitch along meridians
         // and shrinks along parallels by at most sin(theta)/theta at the rim.
         let s = Surface::new(&cap(), 0.0);
@@ -667,14 +776,24 @@ mod tests {
         let st = stats(&s, &m);
         let rho = (17.5f64 * 17.5 + 64.0) / 16.0;
         let theta = (s.total_arc_mm() - 1.0) / rho;
-        assert!(st.min_spacing_mm >= 2.0 * theta.sin() / theta && st.min_spacing_mm <= 2.0 + 1e-6, "{st:?}");
-        assert!(st.median_spacing_mm > 1.85 && st.median_spacing_mm <= 2.0 + 1e-6, "{st:?}");
+        assert!(
+            st.min_spacing_mm >= 2.0 * theta.sin() / theta && st.min_spacing_mm <= 2.0 + 1e-6,
+            "{st:?}"
+        );
+        assert!(
+            st.median_spacing_mm > 1.85 && st.median_spacing_mm <= 2.0 + 1e-6,
+            "{st:?}"
+        );
     }
 
     #[test]
     fn feature_volume_on_a_plane_like_surface() {
         let tol = ChordTolerance::new(0.001).unwrap();
-        let shape = FeatureShape { diameter_mm: 1.0, height_mm: 1.0, polarity: Polarity::Raised };
+        let shape = FeatureShape {
+            diameter_mm: 1.0,
+            height_mm: 1.0,
+            polarity: Polarity::Raised,
+        };
         let f = feature_solid(&shape, [1.0, 2.0, 3.0], [0.0, 0.6, 0.8], 0.0, tol).unwrap();
         let v = shape.nominal_volume_mm3();
         assert!((f.volume() - v).abs() < 0.01 * v, "{} vs {v}", f.volume());

@@ -472,7 +472,11 @@ pub fn build_mold(
 ) -> Result<MoldOutput, DesignError> {
     let layer = &stack.layers[plan.layer];
     let core = stack.core.as_ref().ok_or_else(|| {
-        DesignError::Params(crate::error::ParamErrors(vec![ParamError::new("core", "missing", "direct and master molds hold a core")]))
+        DesignError::Params(crate::error::ParamErrors(vec![ParamError::new(
+            "core",
+            "missing",
+            "direct and master molds hold a core",
+        )]))
     })?;
     let f = MoldFrame::new(design, core, plan.cavity_offset_mm);
     let m = &design.mold;
@@ -522,7 +526,11 @@ pub fn build_mold(
         "plinth": m.plinth,
     });
     let direct = plan.strategy == MoldStrategy::Direct;
-    let holder_name = if direct { format!("{name}_core_holder") } else { format!("{name}_casting_jig") };
+    let holder_name = if direct {
+        format!("{name}_core_holder")
+    } else {
+        format!("{name}_casting_jig")
+    };
     let holder_part = Part {
         name: holder_name.clone(),
         role: if direct { "core_holder".into() } else { "casting_jig".into() },
@@ -685,8 +693,18 @@ fn direct_halves(
 }
 
 /// The mold box (sensor frame) and the solid the Mold Star fills up to its fill level.
-fn master_box(design: &Design, f: &MoldFrame, tol: ChordTolerance) -> Result<(Solid, Solid), crate::geometry::GeometryError> {
-    drafted_box(design, f.plinth_radius_mm, f.open_face_z_mm, f.cavity_pole_z_mm, tol)
+fn master_box(
+    design: &Design,
+    f: &MoldFrame,
+    tol: ChordTolerance,
+) -> Result<(Solid, Solid), crate::geometry::GeometryError> {
+    drafted_box(
+        design,
+        f.plinth_radius_mm,
+        f.open_face_z_mm,
+        f.cavity_pole_z_mm,
+        tol,
+    )
 }
 
 /// A drafted cup standing on the plane `z0` (the master's plinth face) around a master of
@@ -695,7 +713,13 @@ fn master_box(design: &Design, f: &MoldFrame, tol: ChordTolerance) -> Result<(So
 ///
 /// # Errors
 /// Only on a kernel failure.
-pub fn drafted_box(design: &Design, plinth_radius_mm: f64, z0: f64, pole_z: f64, tol: ChordTolerance) -> Result<(Solid, Solid), crate::geometry::GeometryError> {
+pub fn drafted_box(
+    design: &Design,
+    plinth_radius_mm: f64,
+    z0: f64,
+    pole_z: f64,
+    tol: ChordTolerance,
+) -> Result<(Solid, Solid), crate::geometry::GeometryError> {
     let m = &design.mold;
     let z_fill = pole_z + m.silicone_wall_mm;
     let z_top = z_fill + BOX_FREEBOARD_MM;
@@ -703,10 +727,19 @@ pub fn drafted_box(design: &Design, plinth_radius_mm: f64, z0: f64, pole_z: f64,
     let slope = m.draft_angle_deg.to_radians().tan();
     let r_at = |z: f64| r0 + slope * (z - z0);
     let r_out = r_at(z_top) + BOX_WALL_MM;
-    let outer = crate::geometry::cylinder(z_top - (z0 - BOX_FLOOR_MM), r_out, tol)?.translate([0.0, 0.0, z0 - BOX_FLOOR_MM]);
-    let inner = crate::geometry::cone(z_top + 1.0 - z0, r0, r_at(z_top + 1.0), tol)?.translate([0.0, 0.0, z0]);
+    let outer = crate::geometry::cylinder(z_top - (z0 - BOX_FLOOR_MM), r_out, tol)?.translate([
+        0.0,
+        0.0,
+        z0 - BOX_FLOOR_MM,
+    ]);
+    let inner = crate::geometry::cone(z_top + 1.0 - z0, r0, r_at(z_top + 1.0), tol)?
+        .translate([0.0, 0.0, z0]);
     let pin_r = LOCATING_PIN_RADIUS_MM.min(plinth_radius_mm / 3.0) + m.core_holder.fit_clearance_mm;
-    let socket = crate::geometry::cylinder(BOX_FLOOR_MM + 2.0, pin_r, tol)?.translate([0.0, 0.0, z0 - BOX_FLOOR_MM - 1.0]);
+    let socket = crate::geometry::cylinder(BOX_FLOOR_MM + 2.0, pin_r, tol)?.translate([
+        0.0,
+        0.0,
+        z0 - BOX_FLOOR_MM - 1.0,
+    ]);
     let cup = outer.difference(&inner.union(&socket)?)?;
     let fill = crate::geometry::cone(z_fill - z0, r0, r_at(z_fill), tol)?.translate([0.0, 0.0, z0]);
     Ok((cup, fill))

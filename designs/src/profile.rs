@@ -296,7 +296,10 @@ impl BodyProfile {
     /// [`Self::offset_point`] gives).
     pub fn offset_normal(&self, d: f64, t: f64) -> [f64; 2] {
         match *self {
-            Self::HalfEllipsoid { diameter_mm, height_mm } => {
+            Self::HalfEllipsoid {
+                diameter_mm,
+                height_mm,
+            } => {
                 let (a, c) = (diameter_mm / 2.0, height_mm);
                 let th = FRAC_PI_2 * (1.0 - t);
                 let (s, co) = th.sin_cos();

@@ -38,7 +38,8 @@ pub struct Design {
     /// Named variants: each maps parameter paths (`layers[0].markers[0].pattern.rings`) to the
     /// values that replace them (`fabkit export DESIGN --preset NAME`).
     #[serde(default)]
-    pub presets: std::collections::BTreeMap<String, std::collections::BTreeMap<String, serde_json::Value>>,
+    pub presets:
+        std::collections::BTreeMap<String, std::collections::BTreeMap<String, serde_json::Value>>,
 }
 
 /// A flat plate the skin is glued to.
@@ -433,6 +434,81 @@ impl Design {
         serde_saphyr::from_str::<Design>(text)
             .map_err(|e| DesignError::Yaml(yaml_error(origin, &e)))
     }
+}
+
+impl Design {
+    /// The design with preset `name` applied: each path of the preset is set to its value and
+    /// the result is checked against the schema again; the design is renamed `<name>_<preset>`.
+    ///
+    /// # Errors
+    /// [`DesignError::Yaml`] naming `presets.<name>` and the path when the preset is unknown,
+    /// a path does not exist or a value has the wrong type.
+    pub fn with_preset(&self, preset: &str) -> Result<Design, DesignError> {
+        let overrides = self.presets.get(preset).ok_or_else(|| {
+            DesignError::Yaml(format!(
+                "no preset '{preset}' in design '{}'; its presets: {}",
+                self.name,
+                if self.presets.is_empty() {
+                    "none".to_string()
+                } else {
+                    self.presets.keys().cloned().collect::<Vec<_>>().join(", ")
+                }
+            ))
+        })?;
+        let mut v = serde_json::to_value(self).map_err(|e| DesignError::Yaml(e.to_string()))?;
+        for (path, value) in overrides {
+            let slot = value_at(&mut v, path).ok_or_else(|| {
+                DesignError::Yaml(format!(
+                    "presets.{preset}: '{path}' is not a parameter path of design '{}'",
+                    self.name
+                ))
+            })?;
+            *slot = value.clone();
+        }
+        let mut d: Design = serde_json::from_value(v)
+            .map_err(|e| DesignError::Yaml(format!("presets.{preset}: {e}")))?;
+        d.name = format!("{}_{preset}", self.name);
+        Ok(d)
+    }
+}
+
+/// The value at a parameter path like `layers[0].markers[0].pattern.rings` (also
+/// `layers.0.markers.0...`). A missing last key of an existing object is created (an optional
+/// field that was not written out).
+pub fn value_at<'a>(v: &'a mut serde_json::Value, path: &str) -> Option<&'a mut serde_json::Value> {
+    let mut keys: Vec<String> = Vec::new();
+    for part in path.split('.') {
+        let mut rest = part;
+        if let Some(i) = rest.find('[') {
+            keys.push(rest[..i].to_string());
+            rest = &rest[i..];
+            while let Some(stripped) = rest.strip_prefix('[') {
+                let j = stripped.find(']')?;
+                keys.push(stripped[..j].to_string());
+                rest = &stripped[j + 1..];
+            }
+            if !rest.is_empty() {
+                return None;
+            }
+        } else {
+            keys.push(rest.to_string());
+        }
+    }
+    let n = keys.len();
+    let mut cur = v;
+    for (k, key) in keys.iter().enumerate() {
+        cur = match cur {
+            serde_json::Value::Array(a) => a.get_mut(key.parse::<usize>().ok()?)?,
+            serde_json::Value::Object(o) => {
+                if k + 1 == n && !o.contains_key(key) {
+                    o.insert(key.clone(), serde_json::Value::Null);
+                }
+                o.get_mut(key)?
+            }
+            _ => return None,
+        };
+    }
+    Some(cur)
 }
 
 /// Formats a serde-saphyr error as `file:line:column: message`.

@@ -57,13 +57,16 @@ impl Stack {
     ) -> Result<Solid, crate::geometry::GeometryError> {
         let l = &self.layers[i];
         let pl = if l.solid {
-            design.body.solid_profile(l.outer_offset_mm, 0.0, tol.half())
+            design
+                .body
+                .solid_profile(l.outer_offset_mm, 0.0, tol.half())
         } else {
-            design.body.shell_profile(l.inner_offset_mm, l.outer_offset_mm, 0.0, tol.half())
+            design
+                .body
+                .shell_profile(l.inner_offset_mm, l.outer_offset_mm, 0.0, tol.half())
         };
         Solid::from_mesh(&revolve(&pl, tol)?)
     }
-
 }
 
 fn is_identifier(s: &str) -> bool {
@@ -84,31 +87,58 @@ pub fn validate(
     let mut errs: Vec<ParamError> = Vec::new();
     let t = tol.mm();
     if !is_identifier(&design.name) {
-        errs.push(ParamError::new("name", format!("{:?}", design.name), "must be lowercase letters, digits and _"));
+        errs.push(ParamError::new(
+            "name",
+            format!("{:?}", design.name),
+            "must be lowercase letters, digits and _",
+        ));
     }
     for (path, value, rule) in design.body.violations() {
         errs.push(ParamError::new(path, value, rule));
     }
     let body_ok = errs.iter().all(|e| !e.path.starts_with("body."));
-    let sphere_r = if body_ok { design.body.sphere_radius_mm() } else { None };
+    let sphere_r = if body_ok {
+        design.body.sphere_radius_mm()
+    } else {
+        None
+    };
 
     // Materials exist and fit their use.
-    let mut check_material = |path: String, key: &str, kinds: &[MaterialKind]| match materials.get(key) {
-        None => errs.push(ParamError::new(
-            path,
-            key,
-            format!("unknown material; known: {}", materials.materials.keys().cloned().collect::<Vec<_>>().join(", ")),
-        )),
-        Some(m) if !kinds.contains(&m.kind) => {
-            errs.push(ParamError::new(path, key, format!("is a {:?} material, expected one of {:?}", m.kind, kinds)))
-        }
-        Some(_) => {}
-    };
+    let mut check_material =
+        |path: String, key: &str, kinds: &[MaterialKind]| match materials.get(key) {
+            None => errs.push(ParamError::new(
+                path,
+                key,
+                format!(
+                    "unknown material; known: {}",
+                    materials
+                        .materials
+                        .keys()
+                        .cloned()
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            )),
+            Some(m) if !kinds.contains(&m.kind) => errs.push(ParamError::new(
+                path,
+                key,
+                format!("is a {:?} material, expected one of {:?}", m.kind, kinds),
+            )),
+            Some(_) => {}
+        };
     if let Some(c) = &design.core {
-        check_material("core.material".into(), &c.material, &[MaterialKind::Bought, MaterialKind::Print]);
+        check_material(
+            "core.material".into(),
+            &c.material,
+            &[MaterialKind::Bought, MaterialKind::Print],
+        );
     }
     if let Some(b) = &design.backing {
-        check_material("backing.material".into(), &b.material, &[MaterialKind::Bought, MaterialKind::Print]);
+        check_material(
+            "backing.material".into(),
+            &b.material,
+            &[MaterialKind::Bought, MaterialKind::Print],
+        );
     }
     for (i, l) in design.layers.iter().enumerate() {
         let kinds: &[MaterialKind] = match l.process {
@@ -119,24 +149,44 @@ pub fn validate(
         check_material(format!("layers[{i}].material"), &l.material, kinds);
         for (j, m) in l.markers.iter().enumerate() {
             if let Some(tm) = &m.tip_material {
-                check_material(format!("layers[{i}].markers[{j}].tip_material"), tm, &[MaterialKind::Print]);
+                check_material(
+                    format!("layers[{i}].markers[{j}].tip_material"),
+                    tm,
+                    &[MaterialKind::Print],
+                );
             }
         }
     }
     if let Some(h) = &design.housing {
-        check_material("housing.material".into(), &h.material, &[MaterialKind::Print]);
+        check_material(
+            "housing.material".into(),
+            &h.material,
+            &[MaterialKind::Print],
+        );
     }
 
     if design.layers.is_empty() {
-        errs.push(ParamError::new("layers", "[]", "at least one layer is required"));
+        errs.push(ParamError::new(
+            "layers",
+            "[]",
+            "at least one layer is required",
+        ));
     }
     let mut names = std::collections::BTreeSet::new();
     let errors_before_layer_specs = errs.len();
     for (i, l) in design.layers.iter().enumerate() {
         if !is_identifier(&l.name) {
-            errs.push(ParamError::new(format!("layers[{i}].name"), format!("{:?}", l.name), "must be lowercase letters, digits and _"));
+            errs.push(ParamError::new(
+                format!("layers[{i}].name"),
+                format!("{:?}", l.name),
+                "must be lowercase letters, digits and _",
+            ));
         } else if !names.insert(l.name.clone()) {
-            errs.push(ParamError::new(format!("layers[{i}].name"), &l.name, "is used by another layer"));
+            errs.push(ParamError::new(
+                format!("layers[{i}].name"),
+                &l.name,
+                "is used by another layer",
+            ));
         }
         if l.solid {
             if i != 0 || design.core.is_some() {
@@ -163,22 +213,45 @@ pub fn validate(
                 (None, Some(_)) if sphere_r.is_none() && body_ok => errs.push(ParamError::new(
                     format!("layers[{i}].outer_radius_mm"),
                     l.outer_radius_mm.unwrap_or_default(),
-                    format!("radii only describe spherical profiles; the {} needs thickness_mm", design.body.kind()),
+                    format!(
+                        "radii only describe spherical profiles; the {} needs thickness_mm",
+                        design.body.kind()
+                    ),
                 )),
                 _ => {}
             }
         }
-        for (what, v) in [("thickness_mm", l.thickness_mm), ("outer_radius_mm", l.outer_radius_mm)] {
+        for (what, v) in [
+            ("thickness_mm", l.thickness_mm),
+            ("outer_radius_mm", l.outer_radius_mm),
+        ] {
             if v.is_some_and(|v| !v.is_finite()) {
-                errs.push(ParamError::new(format!("layers[{i}].{what}"), v.unwrap_or_default(), "must be a finite number"));
+                errs.push(ParamError::new(
+                    format!("layers[{i}].{what}"),
+                    v.unwrap_or_default(),
+                    "must be a finite number",
+                ));
             }
         }
     }
     let layer_specs_ok = errs.len() == errors_before_layer_specs;
-    if !design.layers.is_empty() && design.layers.iter().all(|l| l.process == LayerProcess::Sprayed) {
-        errs.push(ParamError::new("layers", design.layers.len(), "at least one layer must be cast or printed"));
+    if !design.layers.is_empty()
+        && design
+            .layers
+            .iter()
+            .all(|l| l.process == LayerProcess::Sprayed)
+    {
+        errs.push(ParamError::new(
+            "layers",
+            design.layers.len(),
+            "at least one layer must be cast or printed",
+        ));
     }
-    if design.layers.first().is_some_and(|l| l.process == LayerProcess::Sprayed) {
+    if design
+        .layers
+        .first()
+        .is_some_and(|l| l.process == LayerProcess::Sprayed)
+    {
         errs.push(ParamError::new(
             "layers[0].process",
             "sprayed",
@@ -190,15 +263,26 @@ pub fn validate(
             errs.push(ParamError::new(
                 "core.outer_diameter_mm",
                 c.outer_diameter_mm.unwrap_or_default(),
-                format!("a diameter only describes spherical profiles; remove it for the {}", design.body.kind()),
+                format!(
+                    "a diameter only describes spherical profiles; remove it for the {}",
+                    design.body.kind()
+                ),
             ));
         }
         if !(c.wall_thickness_mm > 0.0) {
-            errs.push(ParamError::new("core.wall_thickness_mm", c.wall_thickness_mm, "must be above 0"));
+            errs.push(ParamError::new(
+                "core.wall_thickness_mm",
+                c.wall_thickness_mm,
+                "must be above 0",
+            ));
         }
     }
     if !(0.0..=1.0).contains(&design.casting.waste_allowance) {
-        errs.push(ParamError::new("casting.waste_allowance", design.casting.waste_allowance, "must be in [0, 1]"));
+        errs.push(ParamError::new(
+            "casting.waste_allowance",
+            design.casting.waste_allowance,
+            "must be in [0, 1]",
+        ));
     }
     // Mold strategies that need a rigid core (a holder grips it) or a solid layer.
     for (i, l) in design.layers.iter().enumerate() {
@@ -206,17 +290,31 @@ pub fn validate(
             continue;
         }
         let strategy = l.mold_strategy.unwrap_or(design.mold.strategy);
-        let path = if l.mold_strategy.is_some() { format!("layers[{i}].mold_strategy") } else { "mold.strategy".to_string() };
+        let path = if l.mold_strategy.is_some() {
+            format!("layers[{i}].mold_strategy")
+        } else {
+            "mold.strategy".to_string()
+        };
         let needs_core = matches!(strategy, MoldStrategy::Direct | MoldStrategy::Master);
         if needs_core && (design.core.is_none() || l.solid) {
             errs.push(ParamError::new(
                 path.clone(),
                 format!("{strategy:?}").to_lowercase(),
-                format!("layer '{}' has no core to hold; use open (solid skins) or boundary", l.name),
+                format!(
+                    "layer '{}' has no core to hold; use open (solid skins) or boundary",
+                    l.name
+                ),
             ));
         }
         if strategy == MoldStrategy::Open && !l.solid {
-            errs.push(ParamError::new(path, "open", format!("an open mold casts a solid skin; layer '{}' is not solid (use boundary)", l.name)));
+            errs.push(ParamError::new(
+                path,
+                "open",
+                format!(
+                    "an open mold casts a solid skin; layer '{}' is not solid (use boundary)",
+                    l.name
+                ),
+            ));
         }
     }
 
@@ -226,13 +324,21 @@ pub fn validate(
     let mut stack_ok = false;
     if body_ok && layer_specs_ok && !design.layers.is_empty() {
         let solid_first = design.layers[0].solid;
-        let shells = if solid_first { &design.layers[1..] } else { &design.layers[..] };
+        let shells = if solid_first {
+            &design.layers[1..]
+        } else {
+            &design.layers[..]
+        };
         let total_t: Option<f64> = shells.iter().map(|l| l.thickness_mm).sum();
         let core_od = design.core.as_ref().and_then(|c| c.outer_diameter_mm);
         // Offset of the innermost shell layer's inner surface.
         let start = match (sphere_r, core_od) {
             (_, Some(od)) if !(od > 0.0 && od.is_finite()) => {
-                errs.push(ParamError::new("core.outer_diameter_mm", od, "must be above 0"));
+                errs.push(ParamError::new(
+                    "core.outer_diameter_mm",
+                    od,
+                    "must be above 0",
+                ));
                 None
             }
             (Some(r), Some(od)) => Some(od / 2.0 - r),
@@ -358,15 +464,21 @@ pub fn validate(
     let sound_core = core.as_ref().filter(|_| stack_ok);
     if let Some(h) = &design.housing {
         match (sound_core, stack_ok) {
-            (Some(_), _) | (None, false) => crate::housing::check_housing_params(design, h, sound_core, &mut errs),
-            (None, true) => errs.push(ParamError::new("housing", "given", "the housing seats a core: give core: or remove housing:")),
+            (Some(_), _) | (None, false) => {
+                crate::housing::check_housing_params(design, h, sound_core, &mut errs)
+            }
+            (None, true) => errs.push(ParamError::new(
+                "housing",
+                "given",
+                "the housing seats a core: give core: or remove housing:",
+            )),
         }
     }
     if let (Some(c), true) = (sound_core, errs.is_empty()) {
-        if let Some(first) = layers
-            .iter()
-            .find(|l| l.process == LayerProcess::Cast && matches!(l.mold_strategy, MoldStrategy::Direct | MoldStrategy::Master))
-        {
+        if let Some(first) = layers.iter().find(|l| {
+            l.process == LayerProcess::Cast
+                && matches!(l.mold_strategy, MoldStrategy::Direct | MoldStrategy::Master)
+        }) {
             crate::molds::check_mold_fit(design, c, first.outer_offset_mm, &mut errs);
         }
     }
@@ -379,18 +491,31 @@ pub fn validate(
 
 /// The core's surfaces and the checks on its length. Its inner surface is only needed (and
 /// only checked) when a mold holds the core by its bore.
-fn resolve_core(design: &Design, c: &crate::schema::Core, core_out: f64, sphere_r: Option<f64>, errs: &mut Vec<ParamError>) -> ResolvedCore {
+fn resolve_core(
+    design: &Design,
+    c: &crate::schema::Core,
+    core_out: f64,
+    sphere_r: Option<f64>,
+    errs: &mut Vec<ParamError>,
+) -> ResolvedCore {
     let core_in = core_out - c.wall_thickness_mm;
     let pole_z = design.body.pole_z_mm(core_out);
     let below_base = c.length_mm - (pole_z - design.body.base_z_mm());
     let held = design.layers.iter().any(|l| {
-        l.process == LayerProcess::Cast && matches!(l.mold_strategy.unwrap_or(design.mold.strategy), MoldStrategy::Direct | MoldStrategy::Master)
+        l.process == LayerProcess::Cast
+            && matches!(
+                l.mold_strategy.unwrap_or(design.mold.strategy),
+                MoldStrategy::Direct | MoldStrategy::Master
+            )
     });
     if !(c.length_mm > 0.0) || below_base < 0.0 {
         errs.push(ParamError::new(
             "core.length_mm",
             c.length_mm,
-            format!("the core must reach the base plane: at least {:.3} mm from its pole", pole_z - design.body.base_z_mm()),
+            format!(
+                "the core must reach the base plane: at least {:.3} mm from its pole",
+                pole_z - design.body.base_z_mm()
+            ),
         ));
     }
     if held && c.wall_thickness_mm > 0.0 && !design.body.offset_is_valid(core_in) {
@@ -415,7 +540,11 @@ fn resolve_core(design: &Design, c: &crate::schema::Core, core_out: f64, sphere_
 }
 
 fn check_printers(design: &Design, errs: &mut Vec<ParamError>) {
-    for (name, p) in [("fdm", &design.printers.fdm), ("sla", &design.printers.sla), ("polyjet", &design.printers.polyjet)] {
+    for (name, p) in [
+        ("fdm", &design.printers.fdm),
+        ("sla", &design.printers.sla),
+        ("polyjet", &design.printers.polyjet),
+    ] {
         for (field, v) in [
             ("xy_resolution_mm", p.xy_resolution_mm),
             ("layer_height_mm", p.layer_height_mm),

@@ -50,7 +50,8 @@ pub fn check_printable_mesh(part: &str, mesh: &Mesh) -> Result<(), ExportError> 
     Ok(())
 }
 
-/// Part names `[a-z0-9_]+`, unique; design name `[A-Za-z0-9_-]+`; at least one part.
+/// Part names `[a-z0-9_]+`, unique; design name `[A-Za-z0-9_-]+`; at least one part; group
+/// names non-empty, one line, no surrounding spaces.
 pub(crate) fn check_names(kit: &Kit) -> Result<(), ExportError> {
     let design_ok = !kit.design.is_empty()
         && kit
@@ -83,6 +84,14 @@ pub(crate) fn check_names(kit: &Kit) -> Result<(), ExportError> {
             return Err(ExportError::DuplicatePartName {
                 name: part.name.clone(),
             });
+        }
+        if let Some(g) = &part.group {
+            if g.is_empty() || g.trim() != g || g.chars().any(char::is_control) {
+                return Err(ExportError::InvalidGroupName {
+                    part: part.name.clone(),
+                    group: g.clone(),
+                });
+            }
         }
     }
     Ok(())

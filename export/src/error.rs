@@ -36,6 +36,12 @@ pub enum ExportError {
     InvalidPartName { name: String },
     #[error("two parts are named `{name}`: part names must be unique in a kit")]
     DuplicatePartName { name: String },
+    /// A group name goes into the manifest and the fabrication sheet's print list.
+    #[error(
+        "part `{part}`: group {group:?}: must be non-empty and one line without surrounding \
+         spaces (or no group)"
+    )]
+    InvalidGroupName { part: String, group: String },
     /// The design name becomes the 3MF file name.
     #[error(
         "design name `{name}`: must be non-empty and use only A-Z, a-z, 0-9, _ and - \

@@ -1,6 +1,8 @@
-//! Plate layout of the kit 3MF: deterministic shelf (row) packing by bounding box.
+//! Plate layout of the kit 3MF: deterministic shelf (row) packing by bounding box, with the
+//! parts of one multi-material group packed as one unit.
 
 use fabkit_designs::geometry::Aabb;
+use std::collections::BTreeMap;
 
 /// Clear distance between neighbouring parts on the plate, mm.
 pub(crate) const GAP_MM: f64 = 5.0;
@@ -35,6 +37,55 @@ pub(crate) fn shelf_pack(boxes: &[Aabb], row_width_mm: f64, gap_mm: f64) -> Vec<
             t
         })
         .collect()
+}
+
+/// Translations, mm, one per part in input order: [`shelf_pack`] of units, where a unit is
+/// either one ungrouped part (`None`) or all parts with the same `Some(group)`.
+///
+/// A group's unit box is the union of its members' boxes and takes the place of the group's
+/// first member in the input order; every member gets the unit's translation, so the members
+/// keep their relative placement (they were built in shared coordinates and must stay
+/// registered). Units are `gap_mm` apart; members of one group may touch or overlap.
+///
+/// `groups` has one entry per box.
+pub(crate) fn group_pack(
+    boxes: &[Aabb],
+    groups: &[Option<&str>],
+    row_width_mm: f64,
+    gap_mm: f64,
+) -> Vec<[f64; 3]> {
+    debug_assert_eq!(boxes.len(), groups.len());
+    let mut unit_boxes: Vec<Aabb> = Vec::with_capacity(boxes.len());
+    let mut unit_of_group: BTreeMap<&str, usize> = BTreeMap::new();
+    let unit_of: Vec<usize> = boxes
+        .iter()
+        .zip(groups)
+        .map(
+            |(b, g)| match g.and_then(|g| unit_of_group.get(g).copied()) {
+                Some(u) => {
+                    unit_boxes[u] = union(&unit_boxes[u], b);
+                    u
+                }
+                None => {
+                    unit_boxes.push(*b);
+                    let u = unit_boxes.len() - 1;
+                    if let Some(g) = g {
+                        unit_of_group.insert(g, u);
+                    }
+                    u
+                }
+            },
+        )
+        .collect();
+    let t = shelf_pack(&unit_boxes, row_width_mm, gap_mm);
+    unit_of.iter().map(|&u| t[u]).collect()
+}
+
+fn union(a: &Aabb, b: &Aabb) -> Aabb {
+    Aabb {
+        min: [0, 1, 2].map(|k| a.min[k].min(b.min[k])),
+        max: [0, 1, 2].map(|k| a.max[k].max(b.max[k])),
+    }
 }
 
 #[cfg(test)]
@@ -75,5 +126,37 @@ mod tests {
         }
         // the 160 mm box does not fit after the 40 mm one: second row
         assert!(placed[1].min[1] > placed[0].max[1]);
+    }
+
+    #[test]
+    fn group_members_share_one_translation_and_clear_the_others() {
+        // A skin and its dots (touching, the dots above the skin's top), a plate between them
+        // in input order, and a second group of one part.
+        let boxes = vec![
+            b([-15.0, -15.0, 0.0], [15.0, 15.0, 10.0]),
+            b([0.0, 0.0, 0.0], [150.0, 30.0, 4.0]),
+            b([-5.0, -5.0, 10.0], [20.0, 5.0, 12.0]),
+            b([0.0, 0.0, 0.0], [10.0, 10.0, 10.0]),
+        ];
+        let groups = [Some("tactip"), None, Some("tactip"), Some("other")];
+        let t = group_pack(&boxes, &groups, ROW_WIDTH_MM, GAP_MM);
+        assert_eq!(t.len(), 4);
+        assert_eq!(t[0], t[2]);
+        // the group is packed first, as its union box [-15, 20] x [-15, 15] x [0, 12]
+        let units = [
+            b([-15.0, -15.0, 0.0], [20.0, 15.0, 12.0]),
+            boxes[1],
+            boxes[3],
+        ];
+        assert_eq!(
+            shelf_pack(&units, ROW_WIDTH_MM, GAP_MM),
+            vec![t[0], t[1], t[3]]
+        );
+        assert_eq!(t[0], [15.0, 15.0, 0.0]);
+        // no groups: the plain shelf packing
+        assert_eq!(
+            group_pack(&boxes, &[None; 4], ROW_WIDTH_MM, GAP_MM),
+            shelf_pack(&boxes, ROW_WIDTH_MM, GAP_MM)
+        );
     }
 }

@@ -1,8 +1,11 @@
 //! fabkit-export: writes a built [`Kit`] to disk.
 //!
 //! [`write_kit`] produces, in one output directory:
-//! - `parts/<part>.stl`: binary STL per part, mm, provenance in the 80-byte header;
+//! - `parts/<part>.stl`: binary STL per part, mm, provenance in the 80-byte header, in the
+//!   part's coordinates as given (never moved: grouped parts share coordinates);
 //! - `<design>.3mf`: one named object per part, `unit="millimeter"`, laid out on one plate;
+//!   the parts of one multi-material group ([`fabkit_designs::kit::Part::group`]) are moved
+//!   by one translation, so they stay registered;
 //! - `manifest.json`: provenance and the numbers of every written solid ([`Manifest`]);
 //! - `FABRICATION.md`: the human fabrication sheet (print list, cast order, bought items).
 //!
@@ -94,6 +97,7 @@ pub struct ExportSummary {
 /// - names, options and meshes are checked before anything touches the disk:
 ///   [`ExportError::InvalidDesignName`], [`ExportError::NoParts`],
 ///   [`ExportError::InvalidPartName`], [`ExportError::DuplicatePartName`],
+///   [`ExportError::InvalidGroupName`],
 ///   [`ExportError::InvalidOption`], [`ExportError::NotManifold`],
 ///   [`ExportError::CoincidentVertices`], [`ExportError::TooManyTriangles`];
 /// - output path: [`ExportError::InvalidOutDir`], [`ExportError::NotADirectory`],
@@ -194,6 +198,7 @@ fn render(kit: &Kit, meshes: &[Mesh], opts: &ExportOptions) -> Result<Rendered, 
             description: part.description.clone(),
             material: part.material.clone(),
             print_technology: part.print_technology,
+            group: part.group.clone(),
             volume_mm3: mesh.signed_volume(),
             surface_area_mm2: mesh.surface_area(),
             bbox_mm: bbox,
@@ -207,7 +212,9 @@ fn render(kit: &Kit, meshes: &[Mesh], opts: &ExportOptions) -> Result<Rendered, 
 
     let kit_3mf = if opts.formats.threemf {
         let boxes: Vec<_> = parts.iter().map(|p| p.bbox_mm).collect();
-        let translations = layout::shelf_pack(&boxes, layout::ROW_WIDTH_MM, layout::GAP_MM);
+        let groups: Vec<_> = parts.iter().map(|p| p.group.as_deref()).collect();
+        let translations =
+            layout::group_pack(&boxes, &groups, layout::ROW_WIDTH_MM, layout::GAP_MM);
         let objects: Vec<three_mf::Object<'_>> = kit
             .parts
             .iter()
@@ -391,6 +398,18 @@ mod tests {
             write_kit(&k, &out, &opts()),
             Err(ExportError::InvalidPartName { .. })
         ));
+        k.parts[1].name = "lid".into();
+        k.parts[1].group = Some(" ".into());
+        let err = write_kit(&k, &out, &opts()).unwrap_err();
+        assert!(
+            matches!(err, ExportError::InvalidGroupName { ref part, .. } if part == "lid"),
+            "{err}"
+        );
+        assert_eq!(
+            err.to_string(),
+            "part `lid`: group \" \": must be non-empty and one line without surrounding spaces \
+             (or no group)"
+        );
         let mut o = opts();
         o.design_sha256 = "abc".into();
         assert!(matches!(

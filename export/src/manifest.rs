@@ -58,8 +58,12 @@ pub struct ManifestPart {
     pub description: String,
     /// Material key in the materials table.
     pub material: String,
-    /// `"FDM"` or `"SLA"`.
+    /// `"FDM"`, `"SLA"` or `"PolyJet"`.
     pub print_technology: PrintTechnology,
+    /// Multi-material print group, `null` for a part printed on its own. Parts of one group
+    /// share coordinates and are printed together in one job (one material each); the kit
+    /// 3MF places them with one translation.
+    pub group: Option<String>,
     /// Enclosed volume of the written mesh, mm^3.
     pub volume_mm3: f64,
     /// Surface area of the written mesh, mm^2.

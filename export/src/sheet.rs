@@ -1,6 +1,6 @@
 //! `FABRICATION.md`: the human fabrication sheet, rendered from the manifest alone.
 
-use crate::manifest::Manifest;
+use crate::manifest::{Manifest, ManifestPart};
 use std::fmt::Write as _;
 
 /// Renders the sheet. Deterministic: only the manifest goes in.
@@ -42,10 +42,12 @@ pub(crate) fn render(m: &Manifest) -> String {
 
     s.push_str("## Print list\n\n");
     s.push_str(
-        "| # | Part | File | Technology | Material | Volume (mm³) | Size x × y × z (mm) |\n",
+        "| # | Part | File | Technology | Group | Material | Volume (mm³) | \
+         Size x × y × z (mm) |\n",
     );
     s.push_str(
-        "|---|------|------|------------|----------|-------------:|---------------------|\n",
+        "|---|------|------|------------|-------|----------|-------------:|\
+         ---------------------|\n",
     );
     for (i, p) in m.parts.iter().enumerate() {
         let [sx, sy, sz] = p.bbox_mm.size();
@@ -55,11 +57,12 @@ pub(crate) fn render(m: &Manifest) -> String {
             .map_or_else(|| "(in the 3MF only)".to_owned(), code);
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {} | {:.1} | {:.2} × {:.2} × {:.2} |",
+            "| {} | {} | {} | {} | {} | {} | {:.1} | {:.2} × {:.2} × {:.2} |",
             i + 1,
             code(&p.name),
             file,
             p.print_technology,
+            p.group.as_deref().map_or_else(|| "–".to_owned(), code),
             code(&p.material),
             p.volume_mm3,
             sx,
@@ -78,6 +81,7 @@ pub(crate) fn render(m: &Manifest) -> String {
         );
     }
     s.push('\n');
+    groups(&mut s, m);
 
     s.push_str("## Cast order\n\n");
     if m.casts.is_empty() {
@@ -133,6 +137,69 @@ pub(crate) fn render(m: &Manifest) -> String {
          a gap and their registration keys must engage before any pour.\n",
     );
     s
+}
+
+/// One note per multi-material group, in order of first appearance; nothing without groups.
+fn groups(s: &mut String, m: &Manifest) {
+    let mut groups: Vec<(&str, Vec<&ManifestPart>)> = Vec::new();
+    for p in &m.parts {
+        let Some(g) = p.group.as_deref() else {
+            continue;
+        };
+        match groups.iter_mut().find(|(name, _)| *name == g) {
+            Some((_, members)) => members.push(p),
+            None => groups.push((g, vec![p])),
+        }
+    }
+    if groups.is_empty() {
+        return;
+    }
+    s.push_str("### Multi-material groups\n\n");
+    s.push_str(
+        "The parts of a group were built in shared coordinates and touch where their \
+         materials meet: print them together as one multi-material job and never move one \
+         without the others.\n\n",
+    );
+    for (g, members) in groups {
+        let mut techs: Vec<String> = Vec::new();
+        for p in &members {
+            let t = p.print_technology.to_string();
+            if !techs.contains(&t) {
+                techs.push(t);
+            }
+        }
+        let names: Vec<String> = members.iter().map(|p| code(&p.name)).collect();
+        let load = match &m.kit_3mf {
+            Some(k) => format!(
+                "load objects {} of {} as they are placed (one shared translation)",
+                names.join(", "),
+                code(&k.file)
+            ),
+            None => {
+                let files: Vec<String> = members
+                    .iter()
+                    .map(|p| p.file.as_deref().map_or_else(|| code(&p.name), code))
+                    .collect();
+                format!(
+                    "load {} as parts of one object without moving them (shared coordinates)",
+                    files.join(", ")
+                )
+            }
+        };
+        let materials: Vec<String> = members
+            .iter()
+            .map(|p| format!("{} {}", code(&p.name), code(&p.material)))
+            .collect();
+        let _ = writeln!(
+            s,
+            "- group {} ({}): print together as one multi-material job: {}, assign materials: {}.",
+            code(g),
+            techs.join(", "),
+            load,
+            materials.join(", ")
+        );
+    }
+    s.push('\n');
 }
 
 /// Inline code span; falls back to plain text when `s` holds a backtick or a `|` (which a

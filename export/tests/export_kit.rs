@@ -343,6 +343,160 @@ fn same_kit_gives_byte_identical_files() {
     );
 }
 
+/// A TacTip-like group: a skin and its dots (two touching solids in shared coordinates, the
+/// dots on the skin's top and reaching past its edge), with an ungrouped plate between them
+/// in kit order.
+fn group_kit() -> Kit {
+    let mut skin = part(
+        "skin",
+        PrintTechnology::Polyjet,
+        cuboid([-15.0, -15.0, 0.0], [15.0, 15.0, 10.0]).unwrap(),
+    );
+    skin.material = "tango_black_plus".into();
+    skin.group = Some("tactip".into());
+    let mut dots = part(
+        "dots",
+        PrintTechnology::Polyjet,
+        cuboid([-5.0, -5.0, 10.0], [20.0, 5.0, 12.0]).unwrap(),
+    );
+    dots.material = "vero_white".into();
+    dots.group = Some("tactip".into());
+    let plate = part(
+        "plate",
+        PrintTechnology::Fdm,
+        cuboid([0.0, 0.0, 0.0], [150.0, 30.0, 4.0]).unwrap(),
+    );
+    Kit {
+        design: "grouped".into(),
+        parts: vec![skin, plate, dots],
+        casts: vec![],
+        bought_items: vec![],
+        summary: serde_json::json!({}),
+    }
+}
+
+fn offset(b: &Aabb, t: [f64; 3]) -> Aabb {
+    Aabb {
+        min: [0, 1, 2].map(|k| b.min[k] + t[k]),
+        max: [0, 1, 2].map(|k| b.max[k] + t[k]),
+    }
+}
+
+#[test]
+fn grouped_parts_move_together_in_the_3mf_and_stay_put_in_their_stls() {
+    let root = tempfile::tempdir().unwrap();
+    let (a, b) = (root.path().join("a"), root.path().join("b"));
+    let kit = group_kit();
+    write_kit(&kit, &a, &opts()).unwrap();
+    let m = read_manifest(&a);
+    let groups: Vec<Option<&str>> = m.parts.iter().map(|p| p.group.as_deref()).collect();
+    assert_eq!(groups, [Some("tactip"), None, Some("tactip")]);
+    let text = fs::read_to_string(a.join("manifest.json")).unwrap();
+    assert!(text.contains("\"print_technology\": \"PolyJet\",\n      \"group\": \"tactip\",\n"));
+    assert!(text.contains("\"print_technology\": \"FDM\",\n      \"group\": null,\n"));
+
+    // STLs: each part in its own (shared) coordinates, not moved.
+    for (p, mp) in kit.parts.iter().zip(&m.parts) {
+        let bytes = fs::read(a.join(mp.file.as_deref().unwrap())).unwrap();
+        let stl = stl_io::read_stl(&mut std::io::Cursor::new(&bytes)).unwrap();
+        let bb = bbox(stl.vertices.iter().map(|v| v.0.map(f64::from)));
+        assert_eq!(bb, p.solid.bounding_box().unwrap(), "{}", p.name);
+        assert_eq!(bb, mp.bbox_mm);
+    }
+
+    // 3MF: objects in kit order; skin and dots share one translation.
+    let k3 = m.kit_3mf.as_ref().unwrap();
+    let names: Vec<&str> = k3.objects.iter().map(|o| o.name.as_str()).collect();
+    assert_eq!(names, ["skin", "plate", "dots"]);
+    let bytes = fs::read(a.join(&k3.file)).unwrap();
+    let models = threemf::read(std::io::Cursor::new(&bytes)).unwrap();
+    let model = &models[0];
+    let mut placed = Vec::new();
+    for (o, mp) in model.resources.object.iter().zip(&m.parts) {
+        assert_eq!(o.name.as_deref(), Some(mp.name.as_str()));
+        let item = model
+            .build
+            .item
+            .iter()
+            .find(|i| i.objectid == o.id)
+            .unwrap();
+        let t = item.transform.unwrap();
+        assert_eq!(&t[..9], &[1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]);
+        let tr = [t[9], t[10], t[11]];
+        let mo = k3.objects.iter().find(|x| x.name == mp.name).unwrap();
+        assert_eq!(mo.translation_mm, tr, "{}", mp.name);
+        let verts = &o.mesh.as_ref().unwrap().vertices.vertex;
+        placed.push((
+            tr,
+            bbox(
+                verts
+                    .iter()
+                    .map(|v| [v.x + tr[0], v.y + tr[1], v.z + tr[2]]),
+            ),
+        ));
+    }
+    let [(t_skin, skin), (_, plate), (t_dots, dots)] = placed[..] else {
+        panic!("three objects expected");
+    };
+    assert_eq!(t_skin, t_dots);
+    // registration kept: the placed parts are the built parts moved by one vector
+    assert_eq!(skin, offset(&m.parts[0].bbox_mm, t_skin));
+    assert_eq!(dots, offset(&m.parts[2].bbox_mm, t_skin));
+    assert_eq!(skin.min[2], 0.0);
+    assert_eq!(dots.min[2], 10.0);
+    assert!(skin.min[0] >= 0.0 && skin.min[1] >= 0.0, "{skin:?}");
+    // the group, as a whole, clears the ungrouped plate by the gap
+    for member in [skin, dots] {
+        let gap = 5.0 - 1e-6;
+        let apart = member.max[0] + gap <= plate.min[0]
+            || plate.max[0] + gap <= member.min[0]
+            || member.max[1] + gap <= plate.min[1]
+            || plate.max[1] + gap <= member.min[1];
+        assert!(apart, "{member:?} and plate {plate:?} overlap");
+    }
+
+    let sheet = fs::read_to_string(a.join("FABRICATION.md")).unwrap();
+    for needle in [
+        "| 1 | `skin` | `parts/skin.stl` | PolyJet | `tactip` | `tango_black_plus` |",
+        "| 2 | `plate` | `parts/plate.stl` | FDM | – | `pla_black` |",
+        "### Multi-material groups",
+        "- group `tactip` (PolyJet): print together as one multi-material job: load objects \
+         `skin`, `dots` of `grouped.3mf` as they are placed (one shared translation), assign \
+         materials: `skin` `tango_black_plus`, `dots` `vero_white`.",
+    ] {
+        assert!(sheet.contains(needle), "missing {needle:?} in\n{sheet}");
+    }
+
+    // determinism with groups
+    write_kit(&group_kit(), &b, &opts()).unwrap();
+    let files = tree(&a);
+    assert_eq!(files, tree(&b));
+    for f in &files {
+        assert_eq!(
+            fs::read(a.join(f)).unwrap(),
+            fs::read(b.join(f)).unwrap(),
+            "{}",
+            f.display()
+        );
+    }
+
+    // without a 3MF the sheet names the STLs to load together
+    let stl_only = root.path().join("stl");
+    let mut o = opts();
+    o.formats = Formats {
+        stl: true,
+        threemf: false,
+    };
+    write_kit(&group_kit(), &stl_only, &o).unwrap();
+    let sheet = fs::read_to_string(stl_only.join("FABRICATION.md")).unwrap();
+    assert!(
+        sheet.contains(
+            "load `parts/skin.stl`, `parts/dots.stl` as parts of one object without moving them"
+        ),
+        "{sheet}"
+    );
+}
+
 #[test]
 fn manifest_keys_are_in_schema_order_with_a_trailing_newline() {
     let root = tempfile::tempdir().unwrap();
@@ -369,6 +523,15 @@ fn manifest_keys_are_in_schema_order_with_a_trailing_newline() {
     assert!(pos.windows(2).all(|w| w[0] < w[1]), "{pos:?}");
     let v: serde_json::Value = serde_json::from_str(&text).unwrap();
     assert_eq!(v["parts"][2]["print_technology"], "SLA");
+    assert_eq!(v["parts"][2]["group"], serde_json::Value::Null);
+    // `group` follows `print_technology` in every part
+    let part_keys = ["\"print_technology\"", "\"group\"", "\"volume_mm3\""];
+    let pos: Vec<usize> = part_keys
+        .iter()
+        .map(|k| text.find(&format!("\n      {k}: ")).unwrap())
+        .collect();
+    assert!(pos.windows(2).all(|w| w[0] < w[1]), "{pos:?}");
+    assert_eq!(text.matches("\n      \"group\": null,\n").count(), 5);
     assert_eq!(
         v["parts"][0]["bbox_mm"]["max"],
         serde_json::json!([75.0, 15.0, 4.0])
@@ -390,7 +553,7 @@ fn fabrication_sheet_lists_provenance_parts_casts_and_checks() {
         "# Fabrication sheet: tiny",
         "0123456789abcdef0123456789abcdef0123456789abcdef0123456789abcdef",
         "`fabkit build tiny.yaml --out 'out dir'`",
-        "| 1 | `base_plate` | `parts/base_plate.stl` | FDM | `pla_black` | 18000.0 | 150.00 × 30.00 × 4.00 |",
+        "| 1 | `base_plate` | `parts/base_plate.stl` | FDM | – | `pla_black` | 18000.0 | 150.00 × 30.00 × 4.00 |",
         "### Step 1: transparent_gel",
         "- cavity volume: 3.21 mL",
         "- waste allowance: 20 %",
@@ -402,6 +565,7 @@ fn fabrication_sheet_lists_provenance_parts_casts_and_checks() {
     ] {
         assert!(s.contains(needle), "missing {needle:?} in\n{s}");
     }
+    assert!(!s.contains("Multi-material"), "{s}");
 }
 
 #[test]
@@ -510,10 +674,17 @@ fn empty_directory_and_missing_parents_are_fine() {
 /// a plain `cargo test` skips with a message.
 #[test]
 fn prusa_slicer_reports_every_object_manifold() {
-    if std::process::Command::new("prusa-slicer").arg("--help").output().is_err() {
+    if std::process::Command::new("prusa-slicer")
+        .arg("--help")
+        .output()
+        .is_err()
+    {
         let required = std::env::var("FABKIT_REQUIRE_ORACLES").is_ok_and(|v| v == "1")
             || std::env::var("CI").is_ok_and(|v| v == "true");
-        assert!(!required, "prusa-slicer is required here; run scripts/setup-system");
+        assert!(
+            !required,
+            "prusa-slicer is required here; run scripts/setup-system"
+        );
         eprintln!("SKIPPED: prusa-slicer not on PATH");
         return;
     }

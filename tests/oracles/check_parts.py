@@ -12,12 +12,20 @@ two readers that share no code with fabkit:
   (built as float64 ``Mesh64`` where the installed manifold3d has it);
 * against the manifest: volume_mm3 (trimesh's and manifold3d's, within --vol-rel-tol relative plus
   1e-6 mm^3), surface_area_mm2 (same tolerance), bbox_mm (within --bbox-tol-mm), triangles (exact),
-  genus (exact, manifold3d's ``genus()`` = 1 - chi/2), sha256 of the file (exact).
+  genus (exact), sha256 of the file (exact), print_technology (FDM, SLA or PolyJet), group (a
+  string or null when present).
+
+genus is fabkit's: the sum of the genera of the shells, shells - chi/2, so a part made of N
+disjoint balls has genus 0 (manifold3d's ``genus()`` is 1 - chi/2 over the whole mesh, -1 for two
+balls). chi = V - E + F comes from manifold3d's vertex, edge and triangle counts; shells are the
+edge-connected components of trimesh's face adjacency, counted here.
 
 If the manifest has ``kit_3mf``, the 3MF is loaded as a trimesh Scene and must hold exactly one
 geometry per part, named as the parts, each placed once, each watertight, each with the part's
 volume (within --kit-vol-rel-tol relative); its sha256 and ``objects`` must match and its model
-must say unit="millimeter" (or no unit: the 3MF default).
+must say unit="millimeter" (or no unit: the 3MF default). Parts that share a ``group`` (one
+multi-material print, built in shared coordinates) must be placed by the same transform, in the
+3MF and in the manifest's ``objects[].translation_mm``, so they stay registered.
 
 STL is a triangle soup: vertices are welded only where their coordinates are bit-identical (what a
 float32 STL of a closed mesh has); nothing else is merged or repaired, so a gap of one float32 ulp
@@ -45,6 +53,10 @@ import numpy as np
 import trimesh
 
 VOL_ABS_TOL_MM3 = 1e-6
+PRINT_TECHNOLOGIES = ("FDM", "SLA", "PolyJet")
+# Members of a group must have the same placement; the transforms are parsed from the same
+# decimal text, so this only absorbs a reader that composes matrices.
+GROUP_PLACEMENT_TOL_MM = 1e-9
 
 
 class ManifestError(Exception):
@@ -92,6 +104,31 @@ def manifold_mesh_kind() -> str:
     return "Mesh64 (float64)" if hasattr(manifold3d, "Mesh64") else "Mesh (float32)"
 
 
+def shell_count(n_faces: int, face_pairs: np.ndarray) -> int:
+    """Number of edge-connected components of a mesh with n_faces faces, given the (P, 2) pairs
+    of faces that share an edge (trimesh's ``face_adjacency``).
+
+    Union-find by label hooking and pointer jumping, vectorised with numpy (networkx takes
+    seconds on a mesh of 10^5 faces)."""
+    label = np.arange(n_faces)
+    if n_faces == 0:
+        return 0
+    a = np.asarray(face_pairs, dtype=np.int64).reshape(-1, 2)
+    fa, fb = a[:, 0], a[:, 1]
+    while True:
+        la, lb = label[fa], label[fb]
+        if np.array_equal(la, lb):
+            break
+        # hook each root on the smaller root of a neighbour (labels only decrease: no cycle)
+        np.minimum.at(label, np.maximum(la, lb), np.minimum(la, lb))
+        while True:  # pointer jumping until every label is a root
+            jumped = label[label]
+            if np.array_equal(jumped, label):
+                break
+            label = jumped
+    return int(np.unique(label).size)
+
+
 def close(measured: float, expected: float, rel: float, abs_tol: float) -> bool:
     return math.isfinite(measured) and abs(measured - expected) <= rel * abs(expected) + abs_tol
 
@@ -113,8 +150,11 @@ def check_part(out_dir: Path, part: dict, args: argparse.Namespace) -> dict:
     if missing:
         reasons.append(f"manifest part lacks {', '.join(missing)}")
         return item
-    if part.get("print_technology") not in ("FDM", "SLA"):
-        reasons.append(f"print_technology = {part.get('print_technology')!r}: must be FDM or SLA")
+    if part.get("print_technology") not in PRINT_TECHNOLOGIES:
+        reasons.append(f"print_technology = {part.get('print_technology')!r}: must be one of "
+                       f"{', '.join(PRINT_TECHNOLOGIES)}")
+    if not isinstance(part.get("group"), (str, type(None))) or part.get("group") == "":
+        reasons.append(f"group = {part.get('group')!r}: must be a non-empty string or null")
     path = (out_dir / rel_file)
     if Path(rel_file).is_absolute() or ".." in Path(rel_file).parts:
         reasons.append(f"file = {rel_file!r}: must be a relative path inside OUT_DIR")
@@ -186,14 +226,21 @@ def check_part(out_dir: Path, part: dict, args: argparse.Namespace) -> dict:
         reasons.append(f"manifold3d: status {measured['manifold3d_status']}")
     else:
         mf_volume = float(m.volume())
-        mf_genus = int(m.genus())
-        measured.update(manifold3d_volume_mm3=mf_volume, manifold3d_triangles=int(m.num_tri()),
-                        genus=mf_genus)
+        n_vert, n_edge, n_tri = int(m.num_vert()), int(m.num_edge()), int(m.num_tri())
+        chi = n_vert - n_edge + n_tri
+        shells = shell_count(len(faces), tm.face_adjacency)
+        genus = shells - chi // 2
+        measured.update(manifold3d_volume_mm3=mf_volume, manifold3d_triangles=n_tri,
+                        manifold3d_genus=int(m.genus()), euler_characteristic=chi, shells=shells,
+                        genus=genus)
         if not close(mf_volume, exp_vol, args.vol_rel_tol, VOL_ABS_TOL_MM3):
             reasons.append(f"manifold3d volume {mf_volume:.12g} != manifest {exp_vol:.12g} "
                            f"(rel diff {rel_diff(mf_volume, exp_vol):.2e})")
-        if part.get("genus") is not None and mf_genus != int(part["genus"]):
-            reasons.append(f"genus {mf_genus} != manifest {part['genus']}")
+        if chi % 2:
+            reasons.append(f"Euler characteristic {chi} is odd: not a closed oriented surface")
+        elif part.get("genus") is not None and genus != int(part["genus"]):
+            reasons.append(f"genus {genus} ({shells} shells, chi {chi}) != manifest "
+                           f"{part['genus']}")
 
     item["ok"] = not reasons
     return item
@@ -282,8 +329,41 @@ def check_kit(out_dir: Path, kit: dict, parts: list[dict], args: argparse.Namesp
             reasons.append(f"{name}: volume {vol:.12g} != part's {exp:.12g} "
                            f"(rel diff {rel_diff(vol, exp):.2e})")
     measured["volume_mm3"] = vols
+    check_groups(scene, objects, parts, reasons)
     item["ok"] = not reasons
     return item
+
+
+def check_groups(scene, objects, parts: list[dict], reasons: list[str]) -> None:
+    """Members of one group have one placement: the same 3MF build transform and, where the
+    manifest lists objects with translation_mm, the same translation."""
+    groups: dict[str, list[str]] = {}
+    for p in parts:
+        if isinstance(p.get("group"), str):
+            groups.setdefault(p["group"], []).append(p.get("name"))
+    if not groups:
+        return
+    instances = scene.graph.geometry_nodes
+    manifest_t = {}
+    if isinstance(objects, list):
+        manifest_t = {o.get("name"): o.get("translation_mm") for o in objects
+                      if isinstance(o, dict) and "translation_mm" in o}
+    for g, names in groups.items():
+        placements = {}
+        for n in names:
+            nodes = instances.get(n, [])
+            if len(nodes) == 1:
+                placements[n] = np.asarray(scene.graph[nodes[0]][0], dtype=np.float64)
+        if len(placements) > 1:
+            first_name, first = next(iter(placements.items()))
+            for n, t in placements.items():
+                if not np.allclose(t, first, rtol=0.0, atol=GROUP_PLACEMENT_TOL_MM):
+                    reasons.append(f"group {g!r}: {n} is placed by {t[:3, 3].tolist()}, "
+                                   f"{first_name} by {first[:3, 3].tolist()} (transform "
+                                   f"differs): the group must keep its registration")
+        ts = {n: manifest_t[n] for n in names if n in manifest_t}
+        if len({json.dumps(t) for t in ts.values()}) > 1:
+            reasons.append(f"group {g!r}: manifest translations differ: {ts}")
 
 
 def run(out_dir: Path, args: argparse.Namespace) -> list[dict]:

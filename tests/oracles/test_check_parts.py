@@ -5,7 +5,9 @@ Usage: python tests/oracles/test_check_parts.py   (with the oracle venv's python
 
 Builds a fake fabkit output directory (a box and a 64-sided cylinder as binary STL written by our
 own writer, a kit 3MF written by trimesh, a manifest with analytic volumes, areas and bounding
-boxes), checks that it passes, then that each mutation fails with the named reason.
+boxes), checks that it passes, then that each mutation fails with the named reason. Further cases:
+a part made of two disjoint boxes (genus 0 as fabkit counts it: shells - chi/2), a PolyJet group
+placed by one translation (passes) or by two (fails).
 Prints one line per test and a last line `N passed, M failed`; exits 1 on any failure.
 """
 
@@ -82,29 +84,40 @@ def analytic() -> dict:
 
 
 def make_output(out: Path, stl_meshes: dict | None = None, kit_names=("box", "cylinder"),
-                with_kit: bool = True) -> dict:
-    """Write parts, kit and manifest; returns the manifest (already written)."""
-    meshes = {"box": box_mesh(), "cylinder": cyl_mesh()}
+                with_kit: bool = True, meshes: dict | None = None, expected: dict | None = None,
+                techs: dict | None = None, groups: dict | None = None,
+                kit_translations: dict | None = None) -> dict:
+    """Write parts, kit and manifest; returns the manifest (already written).
+
+    meshes/expected replace a part's geometry (STL and 3MF) and its manifest numbers;
+    stl_meshes replaces the STL only; techs and groups set print_technology and group per part;
+    kit_translations places a part's 3MF object by a translation (default: none)."""
+    meshes = {"box": box_mesh(), "cylinder": cyl_mesh(), **(meshes or {})}
     stl = {name: (m.vertices, m.faces) for name, m in meshes.items()}
     stl.update(stl_meshes or {})
-    exp = analytic()
+    exp = {**analytic(), **(expected or {})}
+    techs = {"box": "FDM", "cylinder": "SLA", **(techs or {})}
+    groups = groups or {}
     (out / "parts").mkdir(parents=True, exist_ok=True)
     parts = []
-    for name, tech in (("box", "FDM"), ("cylinder", "SLA")):
+    for name in ("box", "cylinder"):
         rel = f"parts/{name}.stl"
         v, f = stl[name]
         write_stl(out / rel, np.asarray(v, dtype=np.float64), np.asarray(f))
         parts.append({"name": name, "file": rel, "role": "test", "material": "PLA",
-                      "print_technology": tech, **exp[name], "sha256": sha256(out / rel),
-                      "params": {}})
+                      "print_technology": techs[name], "group": groups.get(name),
+                      **exp[name], "sha256": sha256(out / rel), "params": {}})
     manifest = {"fabkit_version": "0.0.0-selftest",
                 "design": {"name": "selftest", "source": "test_check_parts.py", "sha256": "0" * 64},
                 "chord_tolerance_mm": 0.01, "command_line": ["test_check_parts.py"],
                 "parts": parts, "casts": []}
     if with_kit:
         scene = trimesh.Scene()
+        translations = kit_translations or {}
         for name in kit_names:
-            scene.add_geometry(meshes[name], geom_name=name, node_name=name)
+            t = translations.get(name, (0.0, 0.0, 0.0))
+            scene.add_geometry(meshes[name], geom_name=name, node_name=name,
+                               transform=trimesh.transformations.translation_matrix(t))
         (out / "kit.3mf").write_bytes(scene.export(file_type="3mf"))
         manifest["kit_3mf"] = {"file": "kit.3mf", "sha256": sha256(out / "kit.3mf"),
                                "objects": len(kit_names)}
@@ -264,6 +277,64 @@ def test_wrong_genus_fails(tmp: Path) -> None:
     rc, res, _ = run_check(tmp)
     expect(rc == 1, f"exit {rc}")
     expect_only_failure(res, "cylinder", ["genus"])
+
+
+def two_boxes_mesh() -> tuple[trimesh.Trimesh, dict]:
+    """Two disjoint boxes in one mesh, and their manifest numbers (genus 0: two balls)."""
+    other = box_mesh()
+    other.apply_translation((0.0, 0.0, BOX_EXTENTS[2] + 5.0))
+    mesh = trimesh.util.concatenate([box_mesh(), other])
+    one = analytic()["box"]
+    exp = {"volume_mm3": 2 * one["volume_mm3"], "surface_area_mm2": 2 * one["surface_area_mm2"],
+           "bbox_mm": {"min": one["bbox_mm"]["min"],
+                       "max": [*one["bbox_mm"]["max"][:2],
+                               one["bbox_mm"]["max"][2] + BOX_EXTENTS[2] + 5.0]},
+           "triangles": 24, "genus": 0}
+    return mesh, exp
+
+
+def test_two_disjoint_boxes_have_genus_0(tmp: Path) -> None:
+    """fabkit's genus sums the shells' genera (manifold3d's whole-mesh genus() is -1 here)."""
+    mesh, exp = two_boxes_mesh()
+    make_output(tmp, meshes={"box": mesh}, expected={"box": exp})
+    rc, res, err = run_check(tmp)
+    expect(rc == 0, f"exit {rc}\n{err}")
+    m = items_by_name(res)["box"]["measured"]
+    expect(m["genus"] == 0 and m["shells"] == 2 and m["euler_characteristic"] == 4, f"{m}")
+    expect(m["manifold3d_genus"] == -1, f"{m}")
+
+
+def test_two_disjoint_boxes_with_whole_mesh_genus_fail(tmp: Path) -> None:
+    mesh, exp = two_boxes_mesh()
+    make_output(tmp, meshes={"box": mesh}, expected={"box": {**exp, "genus": -1}})
+    rc, res, _ = run_check(tmp)
+    expect(rc == 1, f"exit {rc}")
+    expect_only_failure(res, "box", ["genus 0 (2 shells, chi 4) != manifest -1"])
+
+
+def test_group_with_one_placement_passes(tmp: Path) -> None:
+    """A PolyJet group of two parts placed by the same translation, as fabkit lays it out."""
+    make_output(tmp, techs={"box": "PolyJet", "cylinder": "PolyJet"},
+                groups={"box": "g", "cylinder": "g"},
+                kit_translations={"box": (40.0, 7.5, 0.0), "cylinder": (40.0, 7.5, 0.0)})
+    rc, res, err = run_check(tmp)
+    expect(rc == 0, f"exit {rc}\n{err}")
+
+
+def test_group_with_two_placements_fails(tmp: Path) -> None:
+    make_output(tmp, groups={"box": "g", "cylinder": "g"},
+                kit_translations={"box": (40.0, 7.5, 0.0), "cylinder": (40.0, 7.5, 1e-3)})
+    rc, res, _ = run_check(tmp)
+    expect(rc == 1, f"exit {rc}")
+    expect_only_failure(res, "kit_3mf", ["group 'g': cylinder is placed by"])
+
+
+def test_unknown_print_technology_and_bad_group_fail(tmp: Path) -> None:
+    make_output(tmp, techs={"cylinder": "SLS"}, groups={"cylinder": ""})
+    rc, res, _ = run_check(tmp)
+    expect(rc == 1, f"exit {rc}")
+    expect_only_failure(res, "cylinder", ["print_technology = 'SLS'", "group = ''"])
+    expect(len(items_by_name(res)["cylinder"]["reasons"]) == 2, "two reasons")
 
 
 def test_kit_missing_part_fails(tmp: Path) -> None:
