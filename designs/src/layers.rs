@@ -241,22 +241,20 @@ fn feature_solids(
     tol: ChordTolerance,
     stems_only: bool,
 ) -> Result<Vec<Solid>, GeometryError> {
-    let mut shape = pm.spec.feature.clone();
-    if stems_only {
+    // One mesh in the feature's own frame, placed at every marker by a rigid transform.
+    let local = if stems_only {
         // the cylinder only: a hemisphere-free feature of height (height - radius)
+        let mut shape = pm.spec.feature.clone();
         shape.height_mm -= shape.radius_mm();
-    }
-    pm.markers
+        stem_solid(&shape, [0.0; 3], [0.0, 0.0, 1.0], pm.embed_mm, tol)?
+    } else {
+        markers::local_feature(&pm.spec.feature, pm.embed_mm, tol)?
+    };
+    Ok(pm
+        .markers
         .iter()
-        .map(|m| {
-            let dir = m.normal.map(|c| c * pm.direction);
-            if stems_only {
-                stem_solid(&shape, m.position_mm, dir, pm.embed_mm, tol)
-            } else {
-                markers::feature_solid(&shape, m.position_mm, dir, pm.embed_mm, tol)
-            }
-        })
-        .collect()
+        .map(|m| local.transform(&markers::frame_to(m.position_mm, m.normal.map(|c| c * pm.direction))))
+        .collect())
 }
 
 /// A plain cylinder from `embed` behind the surface to `height` beyond it.
@@ -319,22 +317,34 @@ fn apply_features(
     tol: ChordTolerance,
     stems_only: bool,
 ) -> Result<Solid, GeometryError> {
-    let mut out_f = Vec::new();
-    let mut in_f = Vec::new();
+    apply_features_signed(base, sets, tol, stems_only, 1.0)
+}
+
+/// As [`apply_features`] for `sign` = 1; with `sign` = -1 for the complement of the enclosed
+/// solid (a mold around it): outward features are cut, inward ones added.
+fn apply_features_signed(
+    base: Solid,
+    sets: &[&PlacedMarkers],
+    tol: ChordTolerance,
+    stems_only: bool,
+    sign: f64,
+) -> Result<Solid, GeometryError> {
+    let mut add = Vec::new();
+    let mut cut = Vec::new();
     for pm in sets {
         let f = feature_solids(pm, tol, stems_only)?;
-        if pm.direction > 0.0 {
-            out_f.extend(f);
+        if pm.direction * sign > 0.0 {
+            add.extend(f);
         } else {
-            in_f.extend(f);
+            cut.extend(f);
         }
     }
     let mut s = base;
-    if !out_f.is_empty() {
-        s = s.union(&Solid::compose(&out_f))?;
+    if !add.is_empty() {
+        s = s.union(&Solid::compose(&add))?;
     }
-    if !in_f.is_empty() {
-        s = s.difference(&Solid::compose(&in_f))?;
+    if !cut.is_empty() {
+        s = s.difference(&Solid::compose(&cut))?;
     }
     Ok(s)
 }
@@ -523,19 +533,18 @@ pub fn build_layer(
             })
         }
         (_, MoldStrategy::Open) => {
-            let cavity = g(enclosed(design, l.outer_offset_mm, 1.0, &outer, tol, false))?;
-            let skin = g(enclosed(design, l.outer_offset_mm, 0.0, &outer, tol, false))?;
-            let b = cavity.bounding_box().unwrap_or(crate::geometry::Aabb {
-                min: [0.0; 3],
-                max: [0.0; 3],
-            });
-            let half = b.max[0].max(-b.min[0]).max(b.max[1]).max(-b.min[1]) + m.wall_thickness_mm;
+            // mold = (block - plain cavity) with the features cut or added: one boolean with
+            // the features, and the skin's volume falls out as block - mold.
+            let plain = g(revolve(&design.body.solid_profile(l.outer_offset_mm, 1.0, tol.half()), tol)
+                .and_then(|mesh| Solid::from_mesh(&mesh)))?;
+            let rim = design.body.rim_radius_mm(l.outer_offset_mm);
+            let top = design.body.pole_z_mm(l.outer_offset_mm)
+                + outer.iter().map(|p| if p.direction > 0.0 { p.spec.feature.height_mm } else { 0.0 }).fold(0.0, f64::max);
+            let half = rim + m.wall_thickness_mm;
             let zb = design.body.base_z_mm();
-            let block = g(crate::geometry::cuboid(
-                [-half, -half, zb],
-                [half, half, b.max[2] + m.wall_thickness_mm],
-            ))?;
-            let mold = g(block.difference(&cavity))?;
+            let block = g(crate::geometry::cuboid([-half, -half, zb], [half, half, top + m.wall_thickness_mm]))?;
+            let mold = g(block.difference(&plain).and_then(|b| apply_features_signed(b, &outer, tol, false, -1.0)))?;
+            let skin_volume = block.volume() - mold.volume();
             let part = Part {
                 name: format!("{name}_open_mold"),
                 role: "open_mold".into(),
@@ -551,7 +560,7 @@ pub fn build_layer(
             let pour_parts = vec![part.name.clone()];
             Ok(LayerOutput {
                 parts: vec![part],
-                pours: vec![(name.clone(), l.material.clone(), skin.volume(), pour_parts)],
+                pours: vec![(name.clone(), l.material.clone(), skin_volume, pour_parts)],
                 markers: markers_json,
             })
         }

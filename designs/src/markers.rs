@@ -62,6 +62,7 @@ impl FeatureShape {
 pub enum Layout {
     /// A centre marker and rings k = 1..rings of 6k markers, ring k at arc length k x pitch
     /// (the published ShadowTac mold: 12 rings, 469 markers, pitch 1.53 mm).
+    #[serde(rename = "concentric_6k")]
     Concentric6k,
     /// A centre marker and rings every `spacing_mm` of arc; round(circumference / spacing)
     /// markers per ring.
@@ -638,14 +639,21 @@ pub fn feature_solid(
     embed_mm: f64,
     tol: ChordTolerance,
 ) -> Result<Solid, GeometryError> {
+    Ok(local_feature(shape, embed_mm, tol)?.transform(&frame_to(position, dir)))
+}
+
+/// The feature in its own frame: axis +z, the surface point at the origin.
+///
+/// # Errors
+/// Only on a kernel failure.
+pub fn local_feature(shape: &FeatureShape, embed_mm: f64, tol: ChordTolerance) -> Result<Solid, GeometryError> {
     let r = shape.radius_mm();
     let hc = shape.height_mm - r;
     let mut pl = Polyline2::default();
     pl.push([0.0, -embed_mm]);
     pl.push([r, -embed_mm]);
     push_arc(&mut pl, [0.0, hc], r, 0.0, FRAC_PI_2, tol.half());
-    let local = Solid::from_mesh(&revolve(&pl, tol)?)?;
-    Ok(local.transform(&frame_to(position, dir)))
+    Solid::from_mesh(&revolve(&pl, tol)?)
 }
 
 /// The affine map taking the local +z axis at the origin to `dir` at `position`.

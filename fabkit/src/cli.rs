@@ -7,6 +7,14 @@ use fabkit_designs::{build_kit, library, ChordTolerance, Design, DesignError};
 use fabkit_export::{write_kit, ExportOptions, Formats};
 use sha2::{Digest, Sha256};
 use std::error::Error;
+use std::io::Write;
+
+/// Prints a line on stdout; a closed pipe (`fabkit ... | head`) is not an error.
+macro_rules! out {
+    ($($arg:tt)*) => {{
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
+}
 use std::path::{Path, PathBuf};
 
 #[derive(Parser, Debug)]
@@ -32,6 +40,9 @@ enum Command {
         design: Option<String>,
         #[arg(long, default_value_t = ChordTolerance::DEFAULT_MM)]
         chord_tolerance_mm: f64,
+        /// Apply one of the design's presets.
+        #[arg(long)]
+        preset: Option<String>,
     },
 }
 
@@ -49,6 +60,10 @@ struct ExportArgs {
     /// Largest distance between a facet and the true surface, mm.
     #[arg(long, default_value_t = ChordTolerance::DEFAULT_MM)]
     chord_tolerance_mm: f64,
+    /// Apply one of the design's presets (see `fabkit designs`); the kit is named
+    /// <design>_<preset>.
+    #[arg(long)]
+    preset: Option<String>,
     /// Override the design's mold strategy for every cast layer.
     #[arg(long)]
     mold_strategy: Option<Strategy>,
@@ -148,21 +163,31 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
                 } else {
                     ""
                 };
-                println!("{name}{default}\t{}\t[{}]", d.description, d.source);
+                let presets = if d.presets.is_empty() {
+                    String::new()
+                } else {
+                    let names: Vec<&str> = d.presets.keys().map(String::as_str).collect();
+                    format!("\tpresets: {}", names.join(", "))
+                };
+                out!("{name}{default}\t{}\t[{}]{presets}", d.description, d.source);
             }
             Ok(())
         }
         Command::Validate {
             design,
             chord_tolerance_mm,
+            preset,
         } => {
             let tol = tolerance(chord_tolerance_mm)?;
-            let loaded = load_design(design.as_deref())?;
+            let mut loaded = load_design(design.as_deref())?;
+            if let Some(p) = &preset {
+                loaded.design = loaded.design.with_preset(p)?;
+            }
             let materials = fabkit_designs::materials::MaterialsTable::embedded()?;
             let stack = fabkit_designs::stack::validate(&loaded.design, &materials, tol)
                 .map_err(DesignError::from)?;
-            println!("{}: valid", loaded.source);
-            println!("{}", serde_json::to_string_pretty(&stack)?);
+            out!("{}: valid", loaded.source);
+            out!("{}", serde_json::to_string_pretty(&stack)?);
             Ok(())
         }
         Command::Export(args) => export(args),
@@ -172,6 +197,9 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
 fn export(args: ExportArgs) -> Result<(), Box<dyn Error>> {
     let tol = tolerance(args.chord_tolerance_mm)?;
     let mut loaded = load_design(args.design.as_deref())?;
+    if let Some(p) = &args.preset {
+        loaded.design = loaded.design.with_preset(p)?;
+    }
     if let Some(s) = args.mold_strategy {
         let s = match s {
             Strategy::Direct => MoldStrategy::Direct,
@@ -222,7 +250,7 @@ fn export(args: ExportArgs) -> Result<(), Box<dyn Error>> {
     for w in &summary.warnings {
         eprintln!("warning: {w}");
     }
-    println!(
+    out!(
         "{}: {} parts, {} casts -> {} ({} files, {:.2} s)",
         loaded.design.name,
         kit.parts.len(),
@@ -232,7 +260,7 @@ fn export(args: ExportArgs) -> Result<(), Box<dyn Error>> {
         t0.elapsed().as_secs_f64()
     );
     for p in &summary.manifest.parts {
-        println!(
+        out!(
             "  {:34} {:4} {:>10.1} mm3  {}",
             p.name,
             p.print_technology.to_string(),
@@ -246,7 +274,7 @@ fn export(args: ExportArgs) -> Result<(), Box<dyn Error>> {
             .iter()
             .map(|x| format!("{} {:.2} g", x.name, x.mass_g))
             .collect();
-        println!(
+        out!(
             "  cast {}: {} {:.2} mL -> {}",
             c.step,
             c.cast,
