@@ -253,7 +253,12 @@ fn feature_solids(
     Ok(pm
         .markers
         .iter()
-        .map(|m| local.transform(&markers::frame_to(m.position_mm, m.normal.map(|c| c * pm.direction))))
+        .map(|m| {
+            local.transform(&markers::frame_to(
+                m.position_mm,
+                m.normal.map(|c| c * pm.direction),
+            ))
+        })
         .collect())
 }
 
@@ -535,15 +540,34 @@ pub fn build_layer(
         (_, MoldStrategy::Open) => {
             // mold = (block - plain cavity) with the features cut or added: one boolean with
             // the features, and the skin's volume falls out as block - mold.
-            let plain = g(revolve(&design.body.solid_profile(l.outer_offset_mm, 1.0, tol.half()), tol)
-                .and_then(|mesh| Solid::from_mesh(&mesh)))?;
+            let plain = g(revolve(
+                &design
+                    .body
+                    .solid_profile(l.outer_offset_mm, 1.0, tol.half()),
+                tol,
+            )
+            .and_then(|mesh| Solid::from_mesh(&mesh)))?;
             let rim = design.body.rim_radius_mm(l.outer_offset_mm);
             let top = design.body.pole_z_mm(l.outer_offset_mm)
-                + outer.iter().map(|p| if p.direction > 0.0 { p.spec.feature.height_mm } else { 0.0 }).fold(0.0, f64::max);
+                + outer
+                    .iter()
+                    .map(|p| {
+                        if p.direction > 0.0 {
+                            p.spec.feature.height_mm
+                        } else {
+                            0.0
+                        }
+                    })
+                    .fold(0.0, f64::max);
             let half = rim + m.wall_thickness_mm;
             let zb = design.body.base_z_mm();
-            let block = g(crate::geometry::cuboid([-half, -half, zb], [half, half, top + m.wall_thickness_mm]))?;
-            let mold = g(block.difference(&plain).and_then(|b| apply_features_signed(b, &outer, tol, false, -1.0)))?;
+            let block = g(crate::geometry::cuboid(
+                [-half, -half, zb],
+                [half, half, top + m.wall_thickness_mm],
+            ))?;
+            let mold = g(block
+                .difference(&plain)
+                .and_then(|b| apply_features_signed(b, &outer, tol, false, -1.0)))?;
             let skin_volume = block.volume() - mold.volume();
             let part = Part {
                 name: format!("{name}_open_mold"),

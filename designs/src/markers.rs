@@ -646,7 +646,11 @@ pub fn feature_solid(
 ///
 /// # Errors
 /// Only on a kernel failure.
-pub fn local_feature(shape: &FeatureShape, embed_mm: f64, tol: ChordTolerance) -> Result<Solid, GeometryError> {
+pub fn local_feature(
+    shape: &FeatureShape,
+    embed_mm: f64,
+    tol: ChordTolerance,
+) -> Result<Solid, GeometryError> {
     let r = shape.radius_mm();
     let hc = shape.height_mm - r;
     let mut pl = Polyline2::default();

@@ -472,6 +472,64 @@ impl Design {
     }
 }
 
+impl Design {
+    /// Reads the marker point lists named by `csv_file` (relative to `base_dir`, the design
+    /// file's folder) into `points`. A CSV row is `polar_deg, azimuth_deg`; a first line that is
+    /// not numeric is a header; `#` starts a comment.
+    ///
+    /// # Errors
+    /// [`DesignError::Io`] when a file cannot be read, [`DesignError::Yaml`] naming
+    /// `file:line` for a malformed row.
+    pub fn load_marker_files(&mut self, base_dir: &std::path::Path) -> Result<(), DesignError> {
+        for (i, l) in self.layers.iter_mut().enumerate() {
+            for (j, m) in l.markers.iter_mut().enumerate() {
+                let Some(file) = m.pattern.csv_file.clone() else {
+                    continue;
+                };
+                if m.pattern.points.is_some() {
+                    return Err(DesignError::Yaml(format!(
+                        "layers[{i}].markers[{j}].pattern: give points or csv_file, not both"
+                    )));
+                }
+                let path = base_dir.join(&file);
+                let text = std::fs::read_to_string(&path).map_err(|e| DesignError::Io {
+                    path: path.display().to_string(),
+                    message: e.to_string(),
+                })?;
+                m.pattern.points = Some(parse_angle_csv(&text, &path.display().to_string())?);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Parses `polar_deg, azimuth_deg` rows.
+///
+/// # Errors
+/// [`DesignError::Yaml`] with `origin:line` and the rule.
+pub fn parse_angle_csv(text: &str, origin: &str) -> Result<Vec<[f64; 2]>, DesignError> {
+    let mut out = Vec::new();
+    for (n, line) in text.lines().enumerate() {
+        let line = line.split('#').next().unwrap_or("").trim();
+        if line.is_empty() {
+            continue;
+        }
+        let cols: Vec<&str> = line.split(',').map(str::trim).collect();
+        let nums: Vec<Option<f64>> = cols.iter().map(|c| c.parse::<f64>().ok()).collect();
+        match nums.as_slice() {
+            [Some(p), Some(a)] => out.push([*p, *a]),
+            _ if out.is_empty() && nums.iter().all(Option::is_none) => {} // header
+            _ => {
+                return Err(DesignError::Yaml(format!(
+                    "{origin}:{}: expected two numbers `polar_deg, azimuth_deg`, found `{line}`",
+                    n + 1
+                )))
+            }
+        }
+    }
+    Ok(out)
+}
+
 /// The value at a parameter path like `layers[0].markers[0].pattern.rings` (also
 /// `layers.0.markers.0...`). A missing last key of an existing object is created (an optional
 /// field that was not written out).

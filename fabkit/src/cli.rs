@@ -136,7 +136,11 @@ fn load_design(arg: Option<&str>) -> Result<Loaded, DesignError> {
     } else {
         format!("designs/library/{arg}.yaml")
     };
-    let design = Design::from_yaml(&text, &origin)?;
+    let mut design = Design::from_yaml(&text, &origin)?;
+    if looks_like_file {
+        let dir = path.parent().unwrap_or(Path::new("."));
+        design.load_marker_files(dir)?;
+    }
     let sha256 = hex(&Sha256::digest(text.as_bytes()));
     Ok(Loaded {
         design,
@@ -169,7 +173,11 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
                     let names: Vec<&str> = d.presets.keys().map(String::as_str).collect();
                     format!("\tpresets: {}", names.join(", "))
                 };
-                out!("{name}{default}\t{}\t[{}]{presets}", d.description, d.source);
+                out!(
+                    "{name}{default}\t{}\t[{}]{presets}",
+                    d.description,
+                    d.source
+                );
             }
             Ok(())
         }
@@ -267,6 +275,19 @@ fn export(args: ExportArgs) -> Result<(), Box<dyn Error>> {
             p.volume_mm3,
             p.file.as_deref().unwrap_or("(3MF only)")
         );
+    }
+    if let Some(markers) = kit.summary.get("markers").and_then(|m| m.as_array()) {
+        for m in markers {
+            out!(
+                "  markers on {} ({}): {} features, nearest-neighbour spacing on the surface min {:.3} mm, median {:.3} mm; printable with {}",
+                m["layer"].as_str().unwrap_or("?"),
+                m["surface"].as_str().unwrap_or("?"),
+                m["count"],
+                m["min_spacing_mm"].as_f64().unwrap_or(0.0),
+                m["median_spacing_mm"].as_f64().unwrap_or(0.0),
+                m["printable_with"].as_array().map(|a| a.iter().filter_map(|x| x.as_str()).collect::<Vec<_>>().join(", ")).unwrap_or_default()
+            );
+        }
     }
     for c in &kit.casts {
         let comps: Vec<String> = c
