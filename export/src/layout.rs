@@ -1,5 +1,5 @@
 //! Plate layout of the kit 3MF: deterministic shelf (row) packing by bounding box, with the
-//! parts of one multi-material group packed as one unit.
+//! parts of one multi-material group packed as one unit (one 3MF object).
 
 use fabkit_designs::geometry::Aabb;
 use std::collections::BTreeMap;
@@ -39,46 +39,52 @@ pub(crate) fn shelf_pack(boxes: &[Aabb], row_width_mm: f64, gap_mm: f64) -> Vec<
         .collect()
 }
 
-/// Translations, mm, one per part in input order: [`shelf_pack`] of units, where a unit is
-/// either one ungrouped part (`None`) or all parts with the same `Some(group)`.
+/// The plate units of a kit, in order of first appearance: each unit lists part indices in
+/// input order. A unit is either one ungrouped part (`None`) or all parts with the same
+/// `Some(group)`; a group takes the place of its first member. Every index appears once.
 ///
-/// A group's unit box is the union of its members' boxes and takes the place of the group's
-/// first member in the input order; every member gets the unit's translation, so the members
-/// keep their relative placement (they were built in shared coordinates and must stay
-/// registered). Units are `gap_mm` apart; members of one group may touch or overlap.
+/// ```text
+/// groups [Some("t"), None, Some("t"), Some("o")]  ->  [[0, 2], [1], [3]]
+/// ```
+pub(crate) fn units(groups: &[Option<&str>]) -> Vec<Vec<usize>> {
+    let mut units: Vec<Vec<usize>> = Vec::with_capacity(groups.len());
+    let mut unit_of_group: BTreeMap<&str, usize> = BTreeMap::new();
+    for (i, g) in groups.iter().enumerate() {
+        match g.and_then(|g| unit_of_group.get(g).copied()) {
+            Some(u) => units[u].push(i),
+            None => {
+                if let Some(g) = g {
+                    unit_of_group.insert(g, units.len());
+                }
+                units.push(vec![i]);
+            }
+        }
+    }
+    units
+}
+
+/// Translations, mm, one per unit: [`shelf_pack`] of the units' boxes, where a unit's box is
+/// the union of its members' boxes (`boxes` has one entry per part, `units` as from
+/// [`units`]).
 ///
-/// `groups` has one entry per box.
-pub(crate) fn group_pack(
+/// One translation moves all members of a unit, so they keep their relative placement (they
+/// were built in shared coordinates and must stay registered). Units are `gap_mm` apart;
+/// members of one unit may touch or overlap.
+pub(crate) fn pack_units(
     boxes: &[Aabb],
-    groups: &[Option<&str>],
+    units: &[Vec<usize>],
     row_width_mm: f64,
     gap_mm: f64,
 ) -> Vec<[f64; 3]> {
-    debug_assert_eq!(boxes.len(), groups.len());
-    let mut unit_boxes: Vec<Aabb> = Vec::with_capacity(boxes.len());
-    let mut unit_of_group: BTreeMap<&str, usize> = BTreeMap::new();
-    let unit_of: Vec<usize> = boxes
+    let unit_boxes: Vec<Aabb> = units
         .iter()
-        .zip(groups)
-        .map(
-            |(b, g)| match g.and_then(|g| unit_of_group.get(g).copied()) {
-                Some(u) => {
-                    unit_boxes[u] = union(&unit_boxes[u], b);
-                    u
-                }
-                None => {
-                    unit_boxes.push(*b);
-                    let u = unit_boxes.len() - 1;
-                    if let Some(g) = g {
-                        unit_of_group.insert(g, u);
-                    }
-                    u
-                }
-            },
-        )
+        .map(|members| {
+            members[1..]
+                .iter()
+                .fold(boxes[members[0]], |acc, &i| union(&acc, &boxes[i]))
+        })
         .collect();
-    let t = shelf_pack(&unit_boxes, row_width_mm, gap_mm);
-    unit_of.iter().map(|&u| t[u]).collect()
+    shelf_pack(&unit_boxes, row_width_mm, gap_mm)
 }
 
 fn union(a: &Aabb, b: &Aabb) -> Aabb {
@@ -129,7 +135,7 @@ mod tests {
     }
 
     #[test]
-    fn group_members_share_one_translation_and_clear_the_others() {
+    fn groups_form_one_unit_packed_by_its_union_box() {
         // A skin and its dots (touching, the dots above the skin's top), a plate between them
         // in input order, and a second group of one part.
         let boxes = vec![
@@ -139,24 +145,29 @@ mod tests {
             b([0.0, 0.0, 0.0], [10.0, 10.0, 10.0]),
         ];
         let groups = [Some("tactip"), None, Some("tactip"), Some("other")];
-        let t = group_pack(&boxes, &groups, ROW_WIDTH_MM, GAP_MM);
-        assert_eq!(t.len(), 4);
-        assert_eq!(t[0], t[2]);
+        let u = units(&groups);
+        assert_eq!(u, vec![vec![0, 2], vec![1], vec![3]]);
+        let t = pack_units(&boxes, &u, ROW_WIDTH_MM, GAP_MM);
         // the group is packed first, as its union box [-15, 20] x [-15, 15] x [0, 12]
-        let units = [
+        let unit_boxes = [
             b([-15.0, -15.0, 0.0], [20.0, 15.0, 12.0]),
             boxes[1],
             boxes[3],
         ];
-        assert_eq!(
-            shelf_pack(&units, ROW_WIDTH_MM, GAP_MM),
-            vec![t[0], t[1], t[3]]
-        );
+        assert_eq!(t, shelf_pack(&unit_boxes, ROW_WIDTH_MM, GAP_MM));
         assert_eq!(t[0], [15.0, 15.0, 0.0]);
-        // no groups: the plain shelf packing
+        // no groups: one unit per part, the plain shelf packing
+        let plain = units(&[None; 4]);
+        assert_eq!(plain, vec![vec![0], vec![1], vec![2], vec![3]]);
         assert_eq!(
-            group_pack(&boxes, &[None; 4], ROW_WIDTH_MM, GAP_MM),
+            pack_units(&boxes, &plain, ROW_WIDTH_MM, GAP_MM),
             shelf_pack(&boxes, ROW_WIDTH_MM, GAP_MM)
         );
+        // members need not be adjacent; the unit sits where its first member is
+        assert_eq!(
+            units(&[Some("a"), Some("b"), Some("a")]),
+            vec![vec![0, 2], vec![1]]
+        );
+        assert!(units(&[]).is_empty());
     }
 }

@@ -3,9 +3,11 @@
 //! [`write_kit`] produces, in one output directory:
 //! - `parts/<part>.stl`: binary STL per part, mm, provenance in the 80-byte header, in the
 //!   part's coordinates as given (never moved: grouped parts share coordinates);
-//! - `<design>.3mf`: one named object per part, `unit="millimeter"`, laid out on one plate;
-//!   the parts of one multi-material group ([`fabkit_designs::kit::Part::group`]) are moved
-//!   by one translation, so they stay registered;
+//! - `<design>.3mf`: `unit="millimeter"`, laid out on one plate: one named object per
+//!   ungrouped part, and one object per multi-material group
+//!   ([`fabkit_designs::kit::Part::group`]) holding its parts as named volumes in their shared
+//!   coordinates, so a slicer loads the group as one object (one material per volume) and the
+//!   parts stay registered (see the `three_mf` module);
 //! - `manifest.json`: provenance and the numbers of every written solid ([`Manifest`]);
 //! - `FABRICATION.md`: the human fabrication sheet (print list, cast order, bought items).
 //!
@@ -24,7 +26,9 @@ mod three_mf;
 
 pub use check::check_printable_mesh;
 pub use error::ExportError;
-pub use manifest::{Manifest, ManifestDesign, ManifestKit3mf, ManifestObject, ManifestPart, FRAME};
+pub use manifest::{
+    Manifest, ManifestDesign, ManifestKit3mf, ManifestObject, ManifestPart, ManifestVolume, FRAME,
+};
 
 use fabkit_designs::geometry::{Mesh, TopologyError};
 use fabkit_designs::kit::Kit;
@@ -213,17 +217,29 @@ fn render(kit: &Kit, meshes: &[Mesh], opts: &ExportOptions) -> Result<Rendered, 
     let kit_3mf = if opts.formats.threemf {
         let boxes: Vec<_> = parts.iter().map(|p| p.bbox_mm).collect();
         let groups: Vec<_> = parts.iter().map(|p| p.group.as_deref()).collect();
-        let translations =
-            layout::group_pack(&boxes, &groups, layout::ROW_WIDTH_MM, layout::GAP_MM);
-        let objects: Vec<three_mf::Object<'_>> = kit
-            .parts
+        let units = layout::units(&groups);
+        let translations = layout::pack_units(&boxes, &units, layout::ROW_WIDTH_MM, layout::GAP_MM);
+        let objects: Vec<three_mf::Object<'_>> = units
             .iter()
-            .zip(meshes)
             .zip(&translations)
-            .map(|((p, m), t)| three_mf::Object {
-                name: &p.name,
-                mesh: m,
-                translation_mm: *t,
+            .map(|(members, t)| {
+                let first = &kit.parts[members[0]];
+                three_mf::Object {
+                    name: members
+                        .iter()
+                        .map(|&i| kit.parts[i].name.as_str())
+                        .collect::<Vec<_>>()
+                        .join("+"),
+                    group: first.group.as_deref(),
+                    volumes: members
+                        .iter()
+                        .map(|&i| three_mf::Volume {
+                            name: &kit.parts[i].name,
+                            mesh: &meshes[i],
+                        })
+                        .collect(),
+                    translation_mm: *t,
+                }
             })
             .collect();
         let metadata = [
@@ -253,8 +269,21 @@ fn render(kit: &Kit, meshes: &[Mesh], opts: &ExportOptions) -> Result<Rendered, 
                 .zip(1u32..)
                 .map(|(o, id)| ManifestObject {
                     id,
-                    name: o.name.to_owned(),
+                    name: o.name.clone(),
+                    group: o.group.map(str::to_owned),
                     translation_mm: o.translation_mm,
+                    volumes: o
+                        .volumes
+                        .iter()
+                        .zip(o.triangle_ranges())
+                        .zip(1u32..)
+                        .map(|((v, (first, last)), extruder)| ManifestVolume {
+                            part: v.name.to_owned(),
+                            first_triangle: first,
+                            last_triangle: last,
+                            extruder,
+                        })
+                        .collect(),
                 })
                 .collect(),
         })

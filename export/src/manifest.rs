@@ -62,7 +62,7 @@ pub struct ManifestPart {
     pub print_technology: PrintTechnology,
     /// Multi-material print group, `null` for a part printed on its own. Parts of one group
     /// share coordinates and are printed together in one job (one material each); the kit
-    /// 3MF places them with one translation.
+    /// 3MF holds them as the volumes of one object.
     pub group: Option<String>,
     /// Enclosed volume of the written mesh, mm^3.
     pub volume_mm3: f64,
@@ -89,7 +89,7 @@ pub struct ManifestKit3mf {
     pub file: String,
     /// sha256 of the 3MF file bytes.
     pub sha256: String,
-    /// One entry per object, in kit order.
+    /// One entry per 3MF object, in kit order of each object's first part.
     pub objects: Vec<ManifestObject>,
 }
 
@@ -98,8 +98,27 @@ pub struct ManifestKit3mf {
 pub struct ManifestObject {
     /// 3MF object id (1, 2, ...).
     pub id: u32,
-    /// Object name, the part name.
+    /// Object name: the part name, or for a group its parts' names joined by `+`
+    /// (`skin+skin_tips`).
     pub name: String,
-    /// Build-item translation from part coordinates to the plate, mm.
+    /// The multi-material group the object holds, `null` for one ungrouped part.
+    pub group: Option<String>,
+    /// Build-item translation from part coordinates to the plate, mm (one for all volumes).
     pub translation_mm: [f64; 3],
+    /// The object's parts in mesh order: one volume per part (one for an ungrouped part).
+    pub volumes: Vec<ManifestVolume>,
+}
+
+/// One part of a 3MF object: a range of the object's triangles, in part coordinates.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ManifestVolume {
+    /// Part name; also the volume name in the PrusaSlicer config of a group object.
+    pub part: String,
+    /// First triangle of the part in the object's mesh, 0-based (PrusaSlicer's `firstid`).
+    pub first_triangle: usize,
+    /// Last triangle of the part in the object's mesh, 0-based, inclusive (`lastid`).
+    pub last_triangle: usize,
+    /// Extruder (1-based) the volume is assigned in the PrusaSlicer config: the part's
+    /// position in its group; 1 (PrusaSlicer's default, nothing written) for an ungrouped part.
+    pub extruder: u32,
 }

@@ -168,11 +168,17 @@ fn groups(s: &mut String, m: &Manifest) {
                 techs.push(t);
             }
         }
-        let names: Vec<String> = members.iter().map(|p| code(&p.name)).collect();
-        let load = match &m.kit_3mf {
-            Some(k) => format!(
-                "load objects {} of {} as they are placed (one shared translation)",
-                names.join(", "),
+        // The 3MF object holding the group, if a 3MF was written.
+        let object = m.kit_3mf.as_ref().and_then(|k| {
+            k.objects
+                .iter()
+                .find(|o| o.group.as_deref() == Some(g))
+                .map(|o| (k, o))
+        });
+        let load = match object {
+            Some((k, o)) => format!(
+                "object {} of {} holds them in place as its parts (one volume each)",
+                code(&o.name),
                 code(&k.file)
             ),
             None => {
@@ -188,7 +194,12 @@ fn groups(s: &mut String, m: &Manifest) {
         };
         let materials: Vec<String> = members
             .iter()
-            .map(|p| format!("{} {}", code(&p.name), code(&p.material)))
+            .map(|p| {
+                let extruder = object
+                    .and_then(|(_, o)| o.volumes.iter().find(|v| v.part == p.name))
+                    .map_or_else(String::new, |v| format!(" (extruder {})", v.extruder));
+                format!("{} {}{extruder}", code(&p.name), code(&p.material))
+            })
             .collect();
         let _ = writeln!(
             s,

@@ -1,4 +1,5 @@
-//! The kit 3MF: one named mesh object per part, laid out on the plate by build items.
+//! The kit 3MF: one named mesh object per plate unit (an ungrouped part, or all parts of one
+//! multi-material group as the volumes of one object), laid out on the plate by build items.
 //!
 //! Why our own writer rather than `threemf::write` (threemf 0.8.1):
 //! it starts every zip entry with `SimpleFileOptions::default()`, whose timestamp is the
@@ -12,9 +13,52 @@
 //! readers that parse f64 (trimesh, `threemf`) both get exactly the mesh the manifest describes.
 //!
 //! The XML follows the 3MF Core Specification 1.3: `model` in the 2015/02 core namespace,
-//! `unit="millimeter"`, well-known metadata names only, `type="model"` objects, and build
-//! items whose `transform` is `m00 m01 m02 m10 m11 m12 m20 m21 m22 m30 m31 m32` (row vectors,
-//! translation last).
+//! `unit="millimeter"`, well-known metadata names only (plus one namespaced name, below),
+//! `type="model"` objects, and build items whose `transform` is
+//! `m00 m01 m02 m10 m11 m12 m20 m21 m22 m30 m31 m32` (row vectors, translation last).
+//!
+//! # Multi-material groups: one object, one volume per part
+//!
+//! A slicer assigns materials (extruders) to the volumes of one object; separate objects are
+//! sliced separately, so pin-tip dots floating inside a skin would be an object with empty
+//! layers of its own (PrusaSlicer: "Empty layer between ..."). A group is therefore written as
+//! ONE mesh object whose mesh is its members' meshes one after the other (each member's
+//! vertices and triangles unchanged, in part coordinates, so the members stay registered),
+//! named after its members joined by `+` (`skin+skin_tips`; `+` is not allowed in a part
+//! name, so the names of a kit's objects are unique), with one build item.
+//!
+//! The core specification has no way to name a range of triangles, and its `<components>` do
+//! not help: PrusaSlicer turns every mesh object a component refers to into an object of its
+//! own (checked with 2.5.0; `_create_object_instance` in `src/libslic3r/Format/3mf.cpp` still
+//! does so). So the volumes are described where PrusaSlicer reads them, in
+//! `Metadata/Slic3r_PE_model.config`, as PrusaSlicer itself writes them:
+//!
+//! ```text
+//! <config>
+//!  <object id="1">
+//!   <metadata type="object" key="name" value="skin+skin_tips"/>
+//!   <volume firstid="0" lastid="21675">            (0-based triangle range in the mesh)
+//!    <metadata type="volume" key="name" value="skin"/>
+//!    <metadata type="volume" key="volume_type" value="ModelPart"/>
+//!    <metadata type="volume" key="extruder" value="1"/>
+//!   </volume>
+//!   <volume firstid="21676" lastid="52491"> ... value="skin_tips" ... value="2" ... </volume>
+//!  </object>
+//! </config>
+//! ```
+//!
+//! Volume `k` (0-based, in kit order) of a group gets extruder `k + 1`, so a multi-material
+//! printer profile prints each part from its own extruder; the material names are in the
+//! manifest and the fabrication sheet (PrusaSlicer 2.5.0 silently drops a per-volume key it
+//! does not know, so a material name has no place in this file). Ungrouped objects get no
+//! entry: PrusaSlicer loads them as one volume named after the object.
+//!
+//! When the file holds a group, the model also says `<metadata name="slic3rpe:Version3mf">1`
+//! (namespace `http://schemas.slic3r.org/3mf/2017/06`): PrusaSlicer treats a version-0 file
+//! (another application's) by baking the build transform into the first volume only and
+//! then resetting it, which would leave the other volumes of a moved object behind.
+//! Version 1 is the plain format (meshes in object coordinates, build item transforms kept);
+//! readers other than PrusaSlicer ignore both the metadata and the config.
 
 use crate::ExportError;
 use fabkit_designs::geometry::Mesh;
@@ -32,6 +76,21 @@ const CONTENT_TYPES: &str = concat!(
     "</Types>\n"
 );
 
+/// [`CONTENT_TYPES`] plus the type of the PrusaSlicer config part (OPC wants a content type
+/// for every part; PrusaSlicer itself declares none for it).
+const CONTENT_TYPES_WITH_CONFIG: &str = concat!(
+    r#"<?xml version="1.0" encoding="UTF-8"?>"#,
+    "\n",
+    r#"<Types xmlns="http://schemas.openxmlformats.org/package/2006/content-types">"#,
+    r#"<Default Extension="rels" ContentType="application/vnd.openxmlformats-package.relationships+xml"/>"#,
+    r#"<Default Extension="model" ContentType="application/vnd.ms-package.3dmanufacturing-3dmodel+xml"/>"#,
+    r#"<Default Extension="config" ContentType="application/xml"/>"#,
+    "</Types>\n"
+);
+
+/// Where PrusaSlicer reads the volumes of its objects.
+pub(crate) const PRUSA_CONFIG_PATH: &str = "Metadata/Slic3r_PE_model.config";
+
 const RELS: &str = concat!(
     r#"<?xml version="1.0" encoding="UTF-8"?>"#,
     "\n",
@@ -40,14 +99,41 @@ const RELS: &str = concat!(
     "</Relationships>\n"
 );
 
-/// One object of the 3MF and its build item.
-pub(crate) struct Object<'a> {
-    /// Object name (the part name).
+/// One part inside an object: a range of the object's triangles.
+pub(crate) struct Volume<'a> {
+    /// Volume name (the part name).
     pub name: &'a str,
     /// Mesh in part coordinates, f32-rounded, shared vertices, outward winding.
     pub mesh: &'a Mesh,
+}
+
+/// One object of the 3MF and its build item.
+pub(crate) struct Object<'a> {
+    /// Object name: the part name, or for a group its members' names joined by `+`.
+    pub name: String,
+    /// The multi-material group the object holds, `None` for one ungrouped part. Group objects
+    /// are described volume by volume in the PrusaSlicer config.
+    pub group: Option<&'a str>,
+    /// The object's parts, in mesh order (at least one).
+    pub volumes: Vec<Volume<'a>>,
     /// Build-item translation, mm.
     pub translation_mm: [f64; 3],
+}
+
+impl Object<'_> {
+    /// First and last triangle (0-based, inclusive) of each volume in the object's mesh.
+    pub(crate) fn triangle_ranges(&self) -> Vec<(usize, usize)> {
+        let mut first = 0;
+        self.volumes
+            .iter()
+            .map(|v| {
+                let n = v.mesh.triangles.len();
+                let range = (first, (first + n).saturating_sub(1));
+                first += n;
+                range
+            })
+            .collect()
+    }
 }
 
 /// The `3D/3dmodel.model` XML. Object ids are 1, 2, ... in input order.
@@ -55,10 +141,15 @@ pub(crate) fn model_xml(objects: &[Object<'_>], metadata: &[(&str, String)]) -> 
     let mut x = String::new();
     // `write!` into a String cannot fail; the results are ignored on purpose.
     x.push_str("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
+    let with_groups = objects.iter().any(|o| o.group.is_some());
     x.push_str(
         "<model unit=\"millimeter\" xml:lang=\"en-US\" \
-         xmlns=\"http://schemas.microsoft.com/3dmanufacturing/core/2015/02\">\n",
+         xmlns=\"http://schemas.microsoft.com/3dmanufacturing/core/2015/02\"",
     );
+    if with_groups {
+        x.push_str(" xmlns:slic3rpe=\"http://schemas.slic3r.org/3mf/2017/06\"");
+    }
+    x.push_str(">\n");
     for (name, value) in metadata {
         let _ = writeln!(
             x,
@@ -67,16 +158,19 @@ pub(crate) fn model_xml(objects: &[Object<'_>], metadata: &[(&str, String)]) -> 
             escape(value)
         );
     }
+    if with_groups {
+        x.push_str(" <metadata name=\"slic3rpe:Version3mf\">1</metadata>\n");
+    }
     x.push_str(" <resources>\n");
     for (i, o) in objects.iter().enumerate() {
         let _ = writeln!(
             x,
             "  <object id=\"{}\" name=\"{}\" type=\"model\">",
             i + 1,
-            escape(o.name)
+            escape(&o.name)
         );
         x.push_str("   <mesh>\n    <vertices>\n");
-        for v in &o.mesh.vertices {
+        for v in o.volumes.iter().flat_map(|v| &v.mesh.vertices) {
             let _ = writeln!(
                 x,
                 "     <vertex x=\"{}\" y=\"{}\" z=\"{}\"/>",
@@ -86,12 +180,13 @@ pub(crate) fn model_xml(objects: &[Object<'_>], metadata: &[(&str, String)]) -> 
             );
         }
         x.push_str("    </vertices>\n    <triangles>\n");
-        for t in &o.mesh.triangles {
-            let _ = writeln!(
-                x,
-                "     <triangle v1=\"{}\" v2=\"{}\" v3=\"{}\"/>",
-                t[0], t[1], t[2]
-            );
+        let mut base = 0usize;
+        for v in &o.volumes {
+            for t in &v.mesh.triangles {
+                let [a, b, c] = t.map(|i| i as usize + base);
+                let _ = writeln!(x, "     <triangle v1=\"{a}\" v2=\"{b}\" v3=\"{c}\"/>");
+            }
+            base += v.mesh.vertices.len();
         }
         x.push_str("    </triangles>\n   </mesh>\n  </object>\n");
     }
@@ -108,8 +203,48 @@ pub(crate) fn model_xml(objects: &[Object<'_>], metadata: &[(&str, String)]) -> 
     x
 }
 
-/// The whole 3MF package as bytes: `[Content_Types].xml`, `_rels/.rels`, `3D/3dmodel.model`,
-/// deflated at level 6, every entry dated 1980-01-01 00:00:00 with host system Unix and mode
+/// The PrusaSlicer config ([`PRUSA_CONFIG_PATH`]) describing the volumes of every group
+/// object (see the module docs), `None` when no object holds a group.
+pub(crate) fn prusa_config_xml(objects: &[Object<'_>]) -> Option<String> {
+    if objects.iter().all(|o| o.group.is_none()) {
+        return None;
+    }
+    let mut x = String::new();
+    // `write!` into a String cannot fail; the results are ignored on purpose.
+    x.push_str("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<config>\n");
+    for (i, o) in objects.iter().enumerate() {
+        if o.group.is_none() {
+            continue;
+        }
+        let _ = writeln!(x, " <object id=\"{}\" instances_count=\"1\">", i + 1);
+        let _ = writeln!(
+            x,
+            "  <metadata type=\"object\" key=\"name\" value=\"{}\"/>",
+            escape(&o.name)
+        );
+        for (k, (v, (first, last))) in o.volumes.iter().zip(o.triangle_ranges()).enumerate() {
+            let _ = writeln!(x, "  <volume firstid=\"{first}\" lastid=\"{last}\">");
+            let _ = writeln!(
+                x,
+                "   <metadata type=\"volume\" key=\"name\" value=\"{}\"/>",
+                escape(v.name)
+            );
+            x.push_str("   <metadata type=\"volume\" key=\"volume_type\" value=\"ModelPart\"/>\n");
+            let _ = writeln!(
+                x,
+                "   <metadata type=\"volume\" key=\"extruder\" value=\"{}\"/>",
+                k + 1
+            );
+            x.push_str("  </volume>\n");
+        }
+        x.push_str(" </object>\n");
+    }
+    x.push_str("</config>\n");
+    Some(x)
+}
+
+/// The whole 3MF package as bytes: `[Content_Types].xml`, `_rels/.rels`, `3D/3dmodel.model`
+/// and, when an object holds a group, [`PRUSA_CONFIG_PATH`]; deflated at level 6, every entry dated 1980-01-01 00:00:00 with host system Unix and mode
 /// 0644, so the bytes depend only on the input (and the deflate implementation).
 ///
 /// # Errors
@@ -119,6 +254,7 @@ pub(crate) fn encode(
     metadata: &[(&str, String)],
 ) -> Result<Vec<u8>, ExportError> {
     let model = model_xml(objects, metadata);
+    let config = prusa_config_xml(objects);
     let zip_err = |e: zip::result::ZipError| ExportError::ThreeMf {
         reason: e.to_string(),
     };
@@ -133,11 +269,20 @@ pub(crate) fn encode(
         .system(System::Unix)
         .unix_permissions(0o644)
         .large_file(model.len() as u64 >= u64::from(u32::MAX));
-    for (name, body) in [
-        ("[Content_Types].xml", CONTENT_TYPES),
+    let content_types = if config.is_some() {
+        CONTENT_TYPES_WITH_CONFIG
+    } else {
+        CONTENT_TYPES
+    };
+    let mut entries = vec![
+        ("[Content_Types].xml", content_types),
         ("_rels/.rels", RELS),
         ("3D/3dmodel.model", model.as_str()),
-    ] {
+    ];
+    if let Some(c) = &config {
+        entries.push((PRUSA_CONFIG_PATH, c.as_str()));
+    }
+    for (name, body) in entries {
         zip.start_file(name, opts).map_err(zip_err)?;
         zip.write_all(body.as_bytes()).map_err(io_err)?;
     }
@@ -191,6 +336,64 @@ mod tests {
         assert_eq!(coord_text(12.5), "12.5");
         assert_eq!(coord_text(1e-7).parse::<f32>().unwrap(), 1e-7f32);
         assert_eq!(f64_text(-0.0), "0");
+    }
+
+    fn tetra(x: f64) -> Mesh {
+        Mesh {
+            vertices: vec![[x, 0., 0.], [x + 1., 0., 0.], [x, 1., 0.], [x, 0., 1.]],
+            triangles: vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]],
+        }
+    }
+
+    #[test]
+    fn group_object_concatenates_its_volumes_and_is_described_for_prusaslicer() {
+        let (a, b, c) = (tetra(0.0), tetra(5.0), tetra(9.0));
+        let objects = [
+            Object {
+                name: "c".into(),
+                group: None,
+                volumes: vec![Volume {
+                    name: "c",
+                    mesh: &c,
+                }],
+                translation_mm: [1.0, 2.0, 0.0],
+            },
+            Object {
+                name: "a+b".into(),
+                group: Some("g"),
+                volumes: vec![
+                    Volume {
+                        name: "a",
+                        mesh: &a,
+                    },
+                    Volume {
+                        name: "b",
+                        mesh: &b,
+                    },
+                ],
+                translation_mm: [0.5, 0.0, 0.0],
+            },
+        ];
+        assert_eq!(objects[1].triangle_ranges(), [(0, 3), (4, 7)]);
+        assert_eq!(objects[0].triangle_ranges(), [(0, 3)]);
+        let x = model_xml(&objects, &[]);
+        // b's triangles follow a's, indices shifted by a's 4 vertices; one build item per object
+        assert!(x.contains("<object id=\"2\" name=\"a+b\" type=\"model\">"));
+        assert!(x.contains("     <triangle v1=\"4\" v2=\"6\" v3=\"5\"/>\n"));
+        assert_eq!(x.matches("<vertex ").count(), 12);
+        assert_eq!(x.matches("<item ").count(), 2);
+        assert!(x.contains("<item objectid=\"2\" transform=\"1 0 0 0 1 0 0 0 1 0.5 0 0\"/>"));
+        assert!(x.contains("<metadata name=\"slic3rpe:Version3mf\">1</metadata>"));
+        let config = prusa_config_xml(&objects).unwrap();
+        assert!(!config.contains("object id=\"1\""), "{config}");
+        assert!(config.contains(
+            "  <volume firstid=\"4\" lastid=\"7\">\n   \
+             <metadata type=\"volume\" key=\"name\" value=\"b\"/>\n"
+        ));
+        assert!(config.contains("<metadata type=\"volume\" key=\"extruder\" value=\"2\"/>"));
+        // without a group: neither the config nor the PrusaSlicer namespace
+        assert!(prusa_config_xml(&objects[..1]).is_none());
+        assert!(!model_xml(&objects[..1], &[]).contains("slic3rpe"));
     }
 
     #[test]

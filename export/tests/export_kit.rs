@@ -3,7 +3,7 @@
 
 use fabkit_designs::geometry::{cuboid, cylinder, sphere, Aabb, ChordTolerance};
 use fabkit_designs::kit::{CastComponent, CastReport, Kit, Part, PrintTechnology};
-use fabkit_export::{write_kit, ExportError, ExportOptions, Formats, Manifest};
+use fabkit_export::{write_kit, ExportError, ExportOptions, Formats, Manifest, ManifestVolume};
 use std::collections::BTreeSet;
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -382,8 +382,18 @@ fn offset(b: &Aabb, t: [f64; 3]) -> Aabb {
     }
 }
 
+/// The entry `name` of the zip `bytes`, as text.
+fn zip_text(bytes: &[u8], name: &str) -> Option<String> {
+    use std::io::Read;
+    let mut zip = zip::ZipArchive::new(std::io::Cursor::new(bytes)).unwrap();
+    let mut entry = zip.by_name(name).ok()?;
+    let mut text = String::new();
+    entry.read_to_string(&mut text).unwrap();
+    Some(text)
+}
+
 #[test]
-fn grouped_parts_move_together_in_the_3mf_and_stay_put_in_their_stls() {
+fn a_group_is_one_3mf_object_with_a_volume_per_part_and_stls_stay_put() {
     let root = tempfile::tempdir().unwrap();
     let (a, b) = (root.path().join("a"), root.path().join("b"));
     let kit = group_kit();
@@ -404,16 +414,47 @@ fn grouped_parts_move_together_in_the_3mf_and_stay_put_in_their_stls() {
         assert_eq!(bb, mp.bbox_mm);
     }
 
-    // 3MF: objects in kit order; skin and dots share one translation.
+    // Manifest: two objects, the group first (where its first part is in kit order).
     let k3 = m.kit_3mf.as_ref().unwrap();
     let names: Vec<&str> = k3.objects.iter().map(|o| o.name.as_str()).collect();
-    assert_eq!(names, ["skin", "plate", "dots"]);
+    assert_eq!(names, ["skin+dots", "plate"]);
+    let (skin, dots, plate) = (&m.parts[0], &m.parts[2], &m.parts[1]);
+    let group = &k3.objects[0];
+    assert_eq!((group.id, group.group.as_deref()), (1, Some("tactip")));
+    assert_eq!(
+        group.volumes,
+        [
+            ManifestVolume {
+                part: "skin".into(),
+                first_triangle: 0,
+                last_triangle: skin.triangles - 1,
+                extruder: 1,
+            },
+            ManifestVolume {
+                part: "dots".into(),
+                first_triangle: skin.triangles,
+                last_triangle: skin.triangles + dots.triangles - 1,
+                extruder: 2,
+            },
+        ]
+    );
+    assert_eq!(
+        (k3.objects[1].id, k3.objects[1].group.as_deref()),
+        (2, None)
+    );
+    assert_eq!(k3.objects[1].volumes.len(), 1);
+    assert_eq!(k3.objects[1].volumes[0].part, "plate");
+
+    // 3MF, read back by `threemf`: one mesh object per plate unit, one build item each.
     let bytes = fs::read(a.join(&k3.file)).unwrap();
     let models = threemf::read(std::io::Cursor::new(&bytes)).unwrap();
     let model = &models[0];
+    assert_eq!(model.resources.object.len(), 2);
+    assert_eq!(model.build.item.len(), 2);
     let mut placed = Vec::new();
-    for (o, mp) in model.resources.object.iter().zip(&m.parts) {
-        assert_eq!(o.name.as_deref(), Some(mp.name.as_str()));
+    for (o, mo) in model.resources.object.iter().zip(&k3.objects) {
+        assert_eq!(o.id as u32, mo.id);
+        assert_eq!(o.name.as_deref(), Some(mo.name.as_str()));
         let item = model
             .build
             .item
@@ -423,46 +464,107 @@ fn grouped_parts_move_together_in_the_3mf_and_stay_put_in_their_stls() {
         let t = item.transform.unwrap();
         assert_eq!(&t[..9], &[1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]);
         let tr = [t[9], t[10], t[11]];
-        let mo = k3.objects.iter().find(|x| x.name == mp.name).unwrap();
-        assert_eq!(mo.translation_mm, tr, "{}", mp.name);
-        let verts = &o.mesh.as_ref().unwrap().vertices.vertex;
-        placed.push((
-            tr,
-            bbox(
-                verts
-                    .iter()
-                    .map(|v| [v.x + tr[0], v.y + tr[1], v.z + tr[2]]),
-            ),
-        ));
+        assert_eq!(mo.translation_mm, tr, "{}", mo.name);
+        let mesh = o.mesh.as_ref().unwrap();
+        let verts: Vec<[f64; 3]> = mesh
+            .vertices
+            .vertex
+            .iter()
+            .map(|v| [v.x, v.y, v.z])
+            .collect();
+        let tris: Vec<[usize; 3]> = mesh
+            .triangles
+            .triangle
+            .iter()
+            .map(|t| [t.v1, t.v2, t.v3])
+            .collect();
+        assert_eq!(
+            tris.len(),
+            mo.volumes.last().unwrap().last_triangle + 1,
+            "{}",
+            mo.name
+        );
+        // Each volume is its part, unmoved in the object (so the group stays registered):
+        // its triangles hold exactly the part's volume and box.
+        for v in &mo.volumes {
+            let mp = m.parts.iter().find(|p| p.name == v.part).unwrap();
+            let range = &tris[v.first_triangle..=v.last_triangle];
+            assert_eq!(range.len(), mp.triangles);
+            assert_close(
+                signed_volume(&verts, range.iter().copied()),
+                mp.volume_mm3,
+                &mp.name,
+            );
+            let used: BTreeSet<usize> = range.iter().flatten().copied().collect();
+            assert_eq!(used.len(), mp.vertices, "{}", mp.name);
+            assert_eq!(
+                bbox(used.iter().map(|&i| verts[i])),
+                mp.bbox_mm,
+                "{}",
+                mp.name
+            );
+            placed.push((v.part.clone(), offset(&mp.bbox_mm, tr)));
+        }
     }
-    let [(t_skin, skin), (_, plate), (t_dots, dots)] = placed[..] else {
-        panic!("three objects expected");
-    };
-    assert_eq!(t_skin, t_dots);
-    // registration kept: the placed parts are the built parts moved by one vector
-    assert_eq!(skin, offset(&m.parts[0].bbox_mm, t_skin));
-    assert_eq!(dots, offset(&m.parts[2].bbox_mm, t_skin));
-    assert_eq!(skin.min[2], 0.0);
-    assert_eq!(dots.min[2], 10.0);
-    assert!(skin.min[0] >= 0.0 && skin.min[1] >= 0.0, "{skin:?}");
+    let placed_box = |name: &str| placed.iter().find(|(n, _)| n == name).unwrap().1;
+    let (skin_on_plate, dots_on_plate, plate_on_plate) =
+        (placed_box("skin"), placed_box("dots"), placed_box("plate"));
+    assert_eq!(skin_on_plate, offset(&skin.bbox_mm, group.translation_mm));
+    assert_eq!(skin_on_plate.min[2], 0.0);
+    assert_eq!(dots_on_plate.min[2], 10.0);
+    assert!(skin_on_plate.min[0] >= 0.0 && skin_on_plate.min[1] >= 0.0);
+    assert_eq!(plate_on_plate.min[2], 0.0);
+    assert_eq!(plate.name, "plate");
     // the group, as a whole, clears the ungrouped plate by the gap
-    for member in [skin, dots] {
+    for member in [skin_on_plate, dots_on_plate] {
         let gap = 5.0 - 1e-6;
-        let apart = member.max[0] + gap <= plate.min[0]
-            || plate.max[0] + gap <= member.min[0]
-            || member.max[1] + gap <= plate.min[1]
-            || plate.max[1] + gap <= member.min[1];
-        assert!(apart, "{member:?} and plate {plate:?} overlap");
+        let p = plate_on_plate;
+        let apart = member.max[0] + gap <= p.min[0]
+            || p.max[0] + gap <= member.min[0]
+            || member.max[1] + gap <= p.min[1]
+            || p.max[1] + gap <= member.min[1];
+        assert!(apart, "{member:?} and plate {p:?} overlap");
     }
+
+    // PrusaSlicer reads the volumes from its config (exact text) and, for a version-1 file,
+    // keeps the build transform for every volume.
+    let model_text = zip_text(&bytes, "3D/3dmodel.model").unwrap();
+    assert!(model_text.contains(" xmlns:slic3rpe=\"http://schemas.slic3r.org/3mf/2017/06\">\n"));
+    assert!(model_text.contains("\n <metadata name=\"slic3rpe:Version3mf\">1</metadata>\n"));
+    let config = zip_text(&bytes, "Metadata/Slic3r_PE_model.config").unwrap();
+    assert_eq!(
+        config,
+        format!(
+            "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<config>\n \
+             <object id=\"1\" instances_count=\"1\">\n  \
+             <metadata type=\"object\" key=\"name\" value=\"skin+dots\"/>\n  \
+             <volume firstid=\"0\" lastid=\"{}\">\n   \
+             <metadata type=\"volume\" key=\"name\" value=\"skin\"/>\n   \
+             <metadata type=\"volume\" key=\"volume_type\" value=\"ModelPart\"/>\n   \
+             <metadata type=\"volume\" key=\"extruder\" value=\"1\"/>\n  </volume>\n  \
+             <volume firstid=\"{}\" lastid=\"{}\">\n   \
+             <metadata type=\"volume\" key=\"name\" value=\"dots\"/>\n   \
+             <metadata type=\"volume\" key=\"volume_type\" value=\"ModelPart\"/>\n   \
+             <metadata type=\"volume\" key=\"extruder\" value=\"2\"/>\n  </volume>\n \
+             </object>\n</config>\n",
+            skin.triangles - 1,
+            skin.triangles,
+            skin.triangles + dots.triangles - 1
+        )
+    );
+    let types = zip_text(&bytes, "[Content_Types].xml").unwrap();
+    assert!(types.contains(r#"<Default Extension="config" ContentType="application/xml"/>"#));
 
     let sheet = fs::read_to_string(a.join("FABRICATION.md")).unwrap();
     for needle in [
         "| 1 | `skin` | `parts/skin.stl` | PolyJet | `tactip` | `tango_black_plus` |",
         "| 2 | `plate` | `parts/plate.stl` | FDM | – | `pla_black` |",
         "### Multi-material groups",
-        "- group `tactip` (PolyJet): print together as one multi-material job: load objects \
-         `skin`, `dots` of `grouped.3mf` as they are placed (one shared translation), assign \
-         materials: `skin` `tango_black_plus`, `dots` `vero_white`.",
+        "- group `tactip` (PolyJet): print together as one multi-material job: object \
+         `skin+dots` of `grouped.3mf` holds them in place as its parts (one volume each), \
+         assign materials: `skin` `tango_black_plus` (extruder 1), `dots` `vero_white` \
+         (extruder 2).",
+        "- kit 3MF: `grouped.3mf` (2 objects laid out on one plate)",
     ] {
         assert!(sheet.contains(needle), "missing {needle:?} in\n{sheet}");
     }
@@ -491,10 +593,41 @@ fn grouped_parts_move_together_in_the_3mf_and_stay_put_in_their_stls() {
     let sheet = fs::read_to_string(stl_only.join("FABRICATION.md")).unwrap();
     assert!(
         sheet.contains(
-            "load `parts/skin.stl`, `parts/dots.stl` as parts of one object without moving them"
+            "load `parts/skin.stl`, `parts/dots.stl` as parts of one object without moving \
+             them (shared coordinates), assign materials: `skin` `tango_black_plus`, `dots` \
+             `vero_white`."
         ),
         "{sheet}"
     );
+}
+
+#[test]
+fn a_kit_without_groups_has_no_prusaslicer_parts() {
+    let root = tempfile::tempdir().unwrap();
+    let out = root.path().join("kit");
+    write_kit(&test_kit(), &out, &opts()).unwrap();
+    let m = read_manifest(&out);
+    let k3 = m.kit_3mf.unwrap();
+    let bytes = fs::read(out.join(&k3.file)).unwrap();
+    assert!(zip_text(&bytes, "Metadata/Slic3r_PE_model.config").is_none());
+    let model_text = zip_text(&bytes, "3D/3dmodel.model").unwrap();
+    assert!(!model_text.contains("slic3rpe"));
+    // one object and one whole-mesh volume per part, in kit order
+    for ((o, p), id) in k3.objects.iter().zip(&m.parts).zip(1u32..) {
+        assert_eq!(
+            (o.id, o.name.as_str(), o.group.as_deref()),
+            (id, p.name.as_str(), None)
+        );
+        assert_eq!(
+            o.volumes,
+            [ManifestVolume {
+                part: p.name.clone(),
+                first_triangle: 0,
+                last_triangle: p.triangles - 1,
+                extruder: 1,
+            }]
+        );
+    }
 }
 
 #[test]
@@ -670,38 +803,104 @@ fn empty_directory_and_missing_parents_are_fine() {
     assert_eq!(entries(&root.path().join("a").join("b")), ["kit"]);
 }
 
-/// Needs PrusaSlicer on PATH; scripts/test (FABKIT_REQUIRE_ORACLES=1) and CI fail without it,
-/// a plain `cargo test` skips with a message.
-#[test]
-fn prusa_slicer_reports_every_object_manifold() {
+/// Whether `prusa-slicer` runs. Without it scripts/test (FABKIT_REQUIRE_ORACLES=1) and CI
+/// fail, a plain `cargo test` skips with a message.
+fn prusa_slicer_available() -> bool {
     if std::process::Command::new("prusa-slicer")
         .arg("--help")
         .output()
-        .is_err()
+        .is_ok()
     {
-        let required = std::env::var("FABKIT_REQUIRE_ORACLES").is_ok_and(|v| v == "1")
-            || std::env::var("CI").is_ok_and(|v| v == "true");
-        assert!(
-            !required,
-            "prusa-slicer is required here; run scripts/setup-system"
-        );
-        eprintln!("SKIPPED: prusa-slicer not on PATH");
-        return;
+        return true;
     }
-    let root = tempfile::tempdir().unwrap();
-    let out = root.path().join("kit");
-    write_kit(&test_kit(), &out, &opts()).unwrap();
+    let required = std::env::var("FABKIT_REQUIRE_ORACLES").is_ok_and(|v| v == "1")
+        || std::env::var("CI").is_ok_and(|v| v == "true");
+    assert!(
+        !required,
+        "prusa-slicer is required here; run scripts/setup-system"
+    );
+    eprintln!("SKIPPED: prusa-slicer not on PATH");
+    false
+}
+
+/// Runs `prusa-slicer` with `args`; panics with its output unless it succeeds. Returns stdout.
+fn prusa_slicer(args: &[&std::ffi::OsStr]) -> String {
     let o = std::process::Command::new("prusa-slicer")
-        .arg("--info")
-        .arg(out.join("tiny.3mf"))
+        .args(args)
         .output()
         .unwrap();
-    let text = String::from_utf8_lossy(&o.stdout);
+    let text = String::from_utf8_lossy(&o.stdout).into_owned();
     assert!(
         o.status.success(),
         "{text}\n{}",
         String::from_utf8_lossy(&o.stderr)
     );
+    text
+}
+
+#[test]
+fn prusa_slicer_reports_every_object_manifold() {
+    if !prusa_slicer_available() {
+        return;
+    }
+    let root = tempfile::tempdir().unwrap();
+    let out = root.path().join("kit");
+    write_kit(&test_kit(), &out, &opts()).unwrap();
+    let text = prusa_slicer(&["--info".as_ref(), out.join("tiny.3mf").as_os_str()]);
     assert_eq!(text.matches("manifold = yes").count(), 5, "{text}");
     assert!(!text.contains("manifold = no"), "{text}");
+}
+
+/// The regression behind the group layout: the dots of a TacTip skin written as an object of
+/// their own were sliced alone ("Empty layer between ..."). PrusaSlicer must load a group as
+/// ONE object whose volumes are the parts, named, with their extruders, in place.
+#[test]
+fn prusa_slicer_loads_a_group_as_one_object_with_named_volumes() {
+    if !prusa_slicer_available() {
+        return;
+    }
+    let root = tempfile::tempdir().unwrap();
+    let out = root.path().join("kit");
+    write_kit(&group_kit(), &out, &opts()).unwrap();
+    let m = read_manifest(&out);
+    let input = out.join("grouped.3mf");
+    let text = prusa_slicer(&["--info".as_ref(), input.as_os_str()]);
+    // one section per object: the group and the plate
+    assert_eq!(text.matches("[grouped.3mf]").count(), 2, "{text}");
+    assert_eq!(text.matches("manifold = yes").count(), 2, "{text}");
+    let facets = m.parts[0].triangles + m.parts[2].triangles;
+    assert!(
+        text.contains(&format!("number_of_facets = {facets}\n")),
+        "{text}"
+    );
+
+    // What PrusaSlicer loaded, as it saves it again: volumes, names and extruders.
+    let saved = root.path().join("saved.3mf");
+    prusa_slicer(&[
+        "--dont-arrange".as_ref(),
+        "--export-3mf".as_ref(),
+        "-o".as_ref(),
+        saved.as_os_str(),
+        input.as_os_str(),
+    ]);
+    let config = zip_text(
+        &fs::read(&saved).unwrap(),
+        "Metadata/Slic3r_PE_model.config",
+    )
+    .unwrap();
+    let objects: Vec<&str> = config.split("<object ").skip(1).collect();
+    assert_eq!(objects.len(), 2, "{config}");
+    let group = objects
+        .iter()
+        .find(|o| o.contains(r#"key="name" value="skin+dots""#))
+        .unwrap_or_else(|| panic!("no object skin+dots in\n{config}"));
+    let volumes: Vec<&str> = group.split("<volume ").skip(1).collect();
+    assert_eq!(volumes.len(), 2, "{config}");
+    for (v, (name, extruder)) in volumes.iter().zip([("skin", "1"), ("dots", "2")]) {
+        assert!(v.contains(&format!(r#"key="name" value="{name}""#)), "{v}");
+        assert!(
+            v.contains(&format!(r#"key="extruder" value="{extruder}""#)),
+            "{v}"
+        );
+    }
 }

@@ -20,12 +20,20 @@ disjoint balls has genus 0 (manifold3d's ``genus()`` is 1 - chi/2 over the whole
 balls). chi = V - E + F comes from manifold3d's vertex, edge and triangle counts; shells are the
 edge-connected components of trimesh's face adjacency, counted here.
 
-If the manifest has ``kit_3mf``, the 3MF is loaded as a trimesh Scene and must hold exactly one
-geometry per part, named as the parts, each placed once, each watertight, each with the part's
-volume (within --kit-vol-rel-tol relative); its sha256 and ``objects`` must match and its model
-must say unit="millimeter" (or no unit: the 3MF default). Parts that share a ``group`` (one
-multi-material print, built in shared coordinates) must be placed by the same transform, in the
-3MF and in the manifest's ``objects[].translation_mm``, so they stay registered.
+If the manifest has ``kit_3mf``, the 3MF is loaded as a trimesh Scene (the meshes) and read with
+ElementTree (units, object names and ids, build items, and PrusaSlicer's
+``Metadata/Slic3r_PE_model.config``). It must hold exactly one geometry per part, named as the part:
+an object of its own (object name = part name), or a volume of an object that the PrusaSlicer
+config splits into named triangle ranges (``<volume firstid lastid>`` with ``name`` metadata; the
+ranges must split the object's triangles exactly). Each part's object is placed by exactly one
+build item; each part is watertight, has the part's volume (within --kit-vol-rel-tol relative) and
+in its object's coordinates the bounding box of the part's STL (of bbox_mm without an STL; within
+--bbox-tol-mm: objects hold parts in part coordinates). The 3MF's sha256 must match, its model must say unit="millimeter" (or no unit: the
+3MF default), and ``objects`` must describe it (a count, or per object id, name, translation_mm of
+its build item and volumes: part, first_triangle, last_triangle). Parts that share a ``group``
+(one multi-material print, built in shared coordinates) must be the volumes of one object holding
+nothing else, so one build item places the whole group and it stays registered; parts of
+different groups or ungrouped parts never share an object.
 
 STL is a triangle soup: vertices are welded only where their coordinates are bit-identical (what a
 float32 STL of a closed mesh has); nothing else is merged or repaired, so a gap of one float32 ulp
@@ -54,9 +62,9 @@ import trimesh
 
 VOL_ABS_TOL_MM3 = 1e-6
 PRINT_TECHNOLOGIES = ("FDM", "SLA", "PolyJet")
-# Members of a group must have the same placement; the transforms are parsed from the same
-# decimal text, so this only absorbs a reader that composes matrices.
-GROUP_PLACEMENT_TOL_MM = 1e-9
+# The manifest's translation and the build item's are the same decimal text; this only absorbs a
+# reader that composes matrices.
+PLACEMENT_TOL_MM = 1e-9
 
 
 class ManifestError(Exception):
@@ -246,18 +254,57 @@ def check_part(out_dir: Path, part: dict, args: argparse.Namespace) -> dict:
     return item
 
 
-def model_units(path: Path) -> list[str | None]:
-    """The unit attribute of each .model part of a 3MF (None where absent)."""
-    units = []
+PRUSA_CONFIG = "Metadata/Slic3r_PE_model.config"
+
+
+def read_package(path: Path) -> dict:
+    """What the 3MF package says besides the meshes, read with ElementTree (not trimesh):
+    {"units": [unit of each .model part (None where absent)],
+     "objects": {id: name} of the root model, in file order,
+     "items": {objectid: [12 transform numbers or None], ...} (lists: one per build item),
+     "volumes": {object id: [{"name", "first", "last", "extruder"}]} from PrusaSlicer's
+                ``Metadata/Slic3r_PE_model.config`` ({} without one)}."""
+    out = {"units": [], "objects": {}, "items": {}, "volumes": {}}
     with zipfile.ZipFile(path) as z:
-        for info in z.infolist():
-            if info.filename.lower().endswith(".model"):
-                root = ET.fromstring(z.read(info))
-                units.append(root.get("unit"))
-    return units
+        names = {i.filename for i in z.infolist()}
+        for name in sorted(names):
+            if not name.lower().endswith(".model"):
+                continue
+            root = ET.fromstring(z.read(name))
+            out["units"].append(root.get("unit"))
+            if name.lower() != "3d/3dmodel.model":
+                continue
+            for obj in root.iter():
+                if obj.tag.endswith("}object"):
+                    out["objects"][obj.get("id")] = obj.get("name")
+                elif obj.tag.endswith("}item"):
+                    t = obj.get("transform")
+                    out["items"].setdefault(obj.get("objectid"), []).append(
+                        [float(x) for x in t.split()] if t else None)
+        if PRUSA_CONFIG in names:
+            root = ET.fromstring(z.read(PRUSA_CONFIG))
+            for obj in root.iter("object"):
+                vols = []
+                for v in obj.iter("volume"):
+                    meta = {m.get("key"): m.get("value") for m in v.iter("metadata")
+                            if m.get("type") == "volume"}
+                    vols.append({"name": meta.get("name"), "first": int(v.get("firstid")),
+                                 "last": int(v.get("lastid")), "extruder": meta.get("extruder")})
+                out["volumes"][obj.get("id")] = vols
+    return out
 
 
-def check_kit(out_dir: Path, kit: dict, parts: list[dict], args: argparse.Namespace) -> dict:
+def submesh(geom: trimesh.Trimesh, first: int, last: int) -> trimesh.Trimesh:
+    """Triangles first..last (inclusive) of geom with the vertices they use; nothing merged."""
+    faces = np.asarray(geom.faces)[first:last + 1]
+    used, inverse = np.unique(faces.reshape(-1), return_inverse=True)
+    return trimesh.Trimesh(vertices=np.asarray(geom.vertices)[used],
+                           faces=inverse.reshape(-1, 3), process=False, validate=False)
+
+
+def check_kit(out_dir: Path, kit: dict, parts: list[dict], args: argparse.Namespace,
+              stl_boxes: dict | None = None) -> dict:
+    """stl_boxes: {part name: {"min", "max"}} as measured on the STLs (check_part)."""
     rel_file = kit.get("file", "")
     item = {"kind": "kit_3mf", "name": "kit_3mf", "file": rel_file, "ok": False, "reasons": [],
             "measured": {}}
@@ -274,14 +321,15 @@ def check_kit(out_dir: Path, kit: dict, parts: list[dict], args: argparse.Namesp
         reasons.append(f"sha256 {digest} != manifest {kit['sha256']}")
 
     try:
-        units = model_units(path)
+        pkg = read_package(path)
+        units = pkg["units"]
         measured["units"] = units
         bad = [u for u in units if u not in (None, "millimeter")]
         if not units:
             reasons.append("no .model part in the 3MF package")
         elif bad:
             reasons.append(f"unit {bad[0]!r}: must be millimeter")
-    except (zipfile.BadZipFile, ET.ParseError) as e:
+    except (zipfile.BadZipFile, ET.ParseError, ValueError, TypeError, AttributeError) as e:
         reasons.append(f"not a readable 3MF package: {e}")
         return item
 
@@ -291,79 +339,165 @@ def check_kit(out_dir: Path, kit: dict, parts: list[dict], args: argparse.Namesp
         reasons.append(f"trimesh cannot read the 3MF: {e}")
         return item
 
-    part_names = [p.get("name") for p in parts]
     geoms = dict(scene.geometry)
+    instances = scene.graph.geometry_nodes
     measured["geometries"] = sorted(geoms)
-    objects = kit.get("objects")
-    if isinstance(objects, int) and objects != len(geoms):
-        reasons.append(f"manifest objects {objects} != {len(geoms)} geometries in the 3MF")
-    elif isinstance(objects, list):
-        names = [o.get("name") if isinstance(o, dict) else o for o in objects]
-        if sorted(map(str, names)) != sorted(geoms):
-            reasons.append(f"manifest objects {names} != 3MF geometries {sorted(geoms)}")
-    if len(geoms) != len(parts):
-        reasons.append(f"{len(geoms)} geometries, {len(parts)} parts")
-    missing = [n for n in part_names if n not in geoms]
-    extra = sorted(set(geoms) - set(part_names))
+    obj_names = list(pkg["objects"].values())
+    if len(set(obj_names)) != len(obj_names):
+        reasons.append(f"3MF object names are not unique: {obj_names}")
+        return item
+
+    # The parts the 3MF holds: one per object, or one per volume of an object that PrusaSlicer's
+    # config splits into volumes. name -> (mesh in object coordinates, object id).
+    held: dict[str, tuple[trimesh.Trimesh, str]] = {}
+    for oid, oname in pkg["objects"].items():
+        g = geoms.get(oname)
+        if g is None:
+            continue  # an object without a mesh (e.g. components): not a part
+        vols = pkg["volumes"].get(oid)
+        if not vols:
+            pieces = [(oname, g)]
+        else:
+            n_faces = len(g.faces)
+            spans = sorted((v["first"], v["last"]) for v in vols)
+            covered = [i for a, b in spans for i in (a, b)]
+            if (spans[0][0] != 0 or spans[-1][1] != n_faces - 1
+                    or any(b + 1 != c for (_, b), (c, _) in zip(spans, spans[1:]))
+                    or any(a > b for a, b in spans)):
+                reasons.append(f"object {oname}: volume triangle ranges {covered} do not split "
+                               f"its {n_faces} triangles")
+                continue
+            pieces = [(v["name"], submesh(g, v["first"], v["last"])) for v in vols]
+        for name, mesh in pieces:
+            if name in held:
+                reasons.append(f"part {name!r} appears twice in the 3MF")
+            held[name] = (mesh, oid)
+    measured["parts"] = sorted(held)
+    measured["objects"] = {oid: [n for n, (_, o) in held.items() if o == oid]
+                           for oid in pkg["objects"]}
+
+    part_names = [p.get("name") for p in parts]
+    if len(held) != len(parts):
+        reasons.append(f"{len(held)} parts in the 3MF, {len(parts)} in the manifest")
+    missing = [n for n in part_names if n not in held]
+    extra = sorted(set(held) - set(part_names))
     if missing:
         reasons.append(f"no geometry named {missing}")
     if extra:
         reasons.append(f"geometries not in the manifest: {extra}")
 
-    instances = scene.graph.geometry_nodes
     vols = {}
     for part in parts:
         name = part.get("name")
-        g = geoms.get(name)
-        if g is None:
+        if name not in held:
             continue
-        n_inst = len(instances.get(name, []))
-        if n_inst != 1:
-            reasons.append(f"{name}: placed {n_inst} times in the build")
-        if not g.is_watertight:
+        mesh, oid = held[name]
+        oname = pkg["objects"][oid]
+        n_inst = len(instances.get(oname, []))
+        n_items = len(pkg["items"].get(oid, []))
+        if n_inst != 1 or n_items != 1:
+            reasons.append(f"{name}: placed {n_inst} times in the scene ({n_items} build items)")
+        if not mesh.is_watertight:
             reasons.append(f"{name}: not watertight")
-        vol = float(g.volume)
+        vol = float(mesh.volume)
         vols[name] = vol
         exp = float(part.get("volume_mm3", float("nan")))
         if not close(vol, exp, args.kit_vol_rel_tol, 0.0):
             reasons.append(f"{name}: volume {vol:.12g} != part's {exp:.12g} "
                            f"(rel diff {rel_diff(vol, exp):.2e})")
+        # Objects hold parts in part coordinates (the build item moves them), so each part's
+        # box in its object is its STL's (the manifest's without an STL): this is what keeps
+        # the volumes of a group registered.
+        ref = (stl_boxes or {}).get(name) or part.get("bbox_mm")
+        try:
+            exp_min = np.asarray(ref["min"], dtype=np.float64)
+            exp_max = np.asarray(ref["max"], dtype=np.float64)
+            bounds = np.asarray(mesh.bounds, dtype=np.float64)
+            err = float(max(np.max(np.abs(bounds[0] - exp_min)),
+                            np.max(np.abs(bounds[1] - exp_max))))
+            if not err <= args.bbox_tol_mm:
+                src = "STL" if (stl_boxes or {}).get(name) else "manifest bbox_mm"
+                reasons.append(f"{name}: box in its object min {bounds[0].tolist()} max "
+                               f"{bounds[1].tolist()} != the part's {src} (max diff "
+                               f"{err:.2e} mm)")
+        except (KeyError, TypeError, ValueError):
+            pass  # the part's own item reports an unreadable bbox_mm
     measured["volume_mm3"] = vols
-    check_groups(scene, objects, parts, reasons)
+    check_groups(pkg, held, parts, reasons)
+    check_manifest_objects(pkg, held, kit.get("objects"), reasons)
     item["ok"] = not reasons
     return item
 
 
-def check_groups(scene, objects, parts: list[dict], reasons: list[str]) -> None:
-    """Members of one group have one placement: the same 3MF build transform and, where the
-    manifest lists objects with translation_mm, the same translation."""
+def check_groups(pkg: dict, held: dict, parts: list[dict], reasons: list[str]) -> None:
+    """The parts of one group are the volumes of one 3MF object, which holds nothing else (one
+    object, one build item: one placement for the whole group); an ungrouped part is an object
+    of its own."""
+    group_of = {p.get("name"): p.get("group") for p in parts}
     groups: dict[str, list[str]] = {}
     for p in parts:
         if isinstance(p.get("group"), str):
             groups.setdefault(p["group"], []).append(p.get("name"))
-    if not groups:
-        return
-    instances = scene.graph.geometry_nodes
-    manifest_t = {}
-    if isinstance(objects, list):
-        manifest_t = {o.get("name"): o.get("translation_mm") for o in objects
-                      if isinstance(o, dict) and "translation_mm" in o}
     for g, names in groups.items():
-        placements = {}
-        for n in names:
-            nodes = instances.get(n, [])
-            if len(nodes) == 1:
-                placements[n] = np.asarray(scene.graph[nodes[0]][0], dtype=np.float64)
-        if len(placements) > 1:
-            first_name, first = next(iter(placements.items()))
-            for n, t in placements.items():
-                if not np.allclose(t, first, rtol=0.0, atol=GROUP_PLACEMENT_TOL_MM):
-                    reasons.append(f"group {g!r}: {n} is placed by {t[:3, 3].tolist()}, "
-                                   f"{first_name} by {first[:3, 3].tolist()} (transform "
-                                   f"differs): the group must keep its registration")
-        ts = {n: manifest_t[n] for n in names if n in manifest_t}
-        if len({json.dumps(t) for t in ts.values()}) > 1:
-            reasons.append(f"group {g!r}: manifest translations differ: {ts}")
+        oids = sorted({held[n][1] for n in names if n in held}, key=int)
+        if len(oids) > 1:
+            where = ", ".join(f"{pkg['objects'][o]} (id {o})" for o in oids)
+            reasons.append(f"group {g!r}: its parts are in {len(oids)} objects: {where}; a "
+                           f"group must be one object so it keeps its registration")
+    for oid, oname in pkg["objects"].items():
+        inside = [n for n, (_, o) in held.items() if o == oid]
+        if len(inside) < 2:
+            continue
+        gs = {group_of.get(n) for n in inside}
+        if len(gs) != 1 or None in gs:
+            reasons.append(f"object {oname}: holds parts {inside} of groups "
+                           f"{sorted(map(str, gs))}: only one group's parts share an object")
+
+
+def check_manifest_objects(pkg: dict, held: dict, objects, reasons: list[str]) -> None:
+    """The manifest's ``kit_3mf.objects`` describe the 3MF: a count, or per object its id,
+    name, build translation and volumes (part and triangle range)."""
+    if isinstance(objects, int):
+        if objects != len(pkg["objects"]):
+            reasons.append(f"manifest objects {objects} != {len(pkg['objects'])} objects in "
+                           f"the 3MF")
+        return
+    if not isinstance(objects, list):
+        return
+    names = [o.get("name") if isinstance(o, dict) else o for o in objects]
+    if sorted(map(str, names)) != sorted(map(str, pkg["objects"].values())):
+        reasons.append(f"manifest objects {names} != 3MF objects "
+                       f"{list(pkg['objects'].values())}")
+        return
+    for o in objects:
+        if not isinstance(o, dict) or "id" not in o:
+            continue
+        oid = str(o["id"])
+        if pkg["objects"].get(oid) != o.get("name"):
+            reasons.append(f"manifest object {o.get('name')!r} has id {oid}, the 3MF's object "
+                           f"{oid} is {pkg['objects'].get(oid)!r}")
+            continue
+        t = o.get("translation_mm")
+        items = pkg["items"].get(oid, [])
+        if t is not None and len(items) == 1:
+            m = items[0] or [1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0]
+            if not np.allclose(m[9:12], t, rtol=0.0, atol=PLACEMENT_TOL_MM):
+                reasons.append(f"object {o['name']}: manifest translation {t} != build item "
+                               f"translation {m[9:12]}")
+        mvols = o.get("volumes")
+        if isinstance(mvols, list):
+            want = [(v.get("part"), v.get("first_triangle"), v.get("last_triangle"))
+                    for v in mvols]
+            cfg = pkg["volumes"].get(oid)
+            if cfg:
+                have = [(v["name"], v["first"], v["last"]) for v in cfg]
+            else:
+                name = o.get("name")
+                n = len(held[name][0].faces) if name in held else -1
+                have = [(name, 0, n - 1)]
+            if want != have:
+                reasons.append(f"object {o['name']}: manifest volumes {want} != 3MF volumes "
+                               f"{have}")
 
 
 def run(out_dir: Path, args: argparse.Namespace) -> list[dict]:
@@ -384,7 +518,9 @@ def run(out_dir: Path, args: argparse.Namespace) -> list[dict]:
             item["ok"] = False
         items.append(item)
     if manifest.get("kit_3mf"):
-        items.append(check_kit(out_dir, manifest["kit_3mf"], parts, args))
+        stl_boxes = {i["name"]: i["measured"]["bbox_mm"] for i in items
+                     if "bbox_mm" in i["measured"]}
+        items.append(check_kit(out_dir, manifest["kit_3mf"], parts, args, stl_boxes))
     return items
 
 
@@ -395,7 +531,8 @@ def describe(item: dict) -> str:
             detail = (f"volume_mm3={m.get('trimesh_volume_mm3', float('nan')):.6f} "
                       f"triangles={m.get('triangles')} genus={m.get('genus')}")
         else:
-            detail = f"geometries={len(m.get('geometries', []))}"
+            detail = (f"parts={len(m.get('parts', []))} "
+                      f"objects={len(m.get('objects', {}))}")
         return f"PASS {item['name']} ({item['file']}) {detail}"
     return f"FAIL {item['name']} ({item['file']}): " + "; ".join(item["reasons"])
 

@@ -6,8 +6,11 @@ Usage: python tests/oracles/test_check_parts.py   (with the oracle venv's python
 Builds a fake fabkit output directory (a box and a 64-sided cylinder as binary STL written by our
 own writer, a kit 3MF written by trimesh, a manifest with analytic volumes, areas and bounding
 boxes), checks that it passes, then that each mutation fails with the named reason. Further cases:
-a part made of two disjoint boxes (genus 0 as fabkit counts it: shells - chi/2), a PolyJet group
-placed by one translation (passes) or by two (fails).
+a part made of two disjoint boxes (genus 0 as fabkit counts it: shells - chi/2), and kit 3MFs laid
+out as fabkit writes them by a small writer here: a PolyJet group as one object with one volume per
+part in PrusaSlicer's Metadata/Slic3r_PE_model.config (passes), a group split over two objects,
+ungrouped parts sharing an object, a volume moved in its object, volume ranges that do not split
+the mesh and manifest objects that differ from the 3MF (each fails).
 Prints one line per test and a last line `N passed, M failed`; exits 1 on any failure.
 """
 
@@ -21,6 +24,7 @@ import subprocess
 import sys
 import tempfile
 import traceback
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -127,6 +131,76 @@ def make_output(out: Path, stl_meshes: dict | None = None, kit_names=("box", "cy
 
 def write_manifest(out: Path, manifest: dict) -> None:
     (out / "manifest.json").write_text(json.dumps(manifest, indent=1), encoding="utf-8")
+
+
+def write_kit_3mf(path: Path, objects: list) -> list[dict]:
+    """A 3MF laid out as fabkit writes it, by our own small writer (trimesh cannot write
+    PrusaSlicer's config): objects is [(name, group, [(part, mesh), ...], translation)]; each
+    object's mesh is its parts' meshes one after the other; objects with a group get volumes in
+    Metadata/Slic3r_PE_model.config. Returns the manifest's ``kit_3mf.objects``."""
+    ns = "http://schemas.microsoft.com/3dmanufacturing/core/2015/02"
+    model = [f'<?xml version="1.0" encoding="UTF-8"?>\n<model unit="millimeter" xmlns="{ns}">'
+             "<resources>"]
+    config = ['<?xml version="1.0" encoding="UTF-8"?>\n<config>']
+    build, listed = [], []
+    for oid, (name, group, volumes, t) in enumerate(objects, start=1):
+        verts, tris, ranges, base = [], [], [], 0
+        for part, mesh in volumes:
+            v = np.asarray(mesh.vertices, dtype=np.float64)
+            f = np.asarray(mesh.faces, dtype=np.int64)
+            verts += [f'<vertex x="{x!r}" y="{y!r}" z="{z!r}"/>' for x, y, z in v.tolist()]
+            first = len(tris)
+            tris += [f'<triangle v1="{a}" v2="{b}" v3="{c}"/>' for a, b, c in (f + base).tolist()]
+            ranges.append((part, first, len(tris) - 1))
+            base += len(v)
+        model.append(f'<object id="{oid}" name="{name}" type="model"><mesh><vertices>'
+                     + "".join(verts) + "</vertices><triangles>" + "".join(tris)
+                     + "</triangles></mesh></object>")
+        build.append(f'<item objectid="{oid}" transform="1 0 0 0 1 0 0 0 1 '
+                     f'{t[0]!r} {t[1]!r} {t[2]!r}"/>')
+        if group is not None:
+            config.append(f'<object id="{oid}"><metadata type="object" key="name" '
+                          f'value="{name}"/>')
+            for k, (part, first, last) in enumerate(ranges, start=1):
+                config.append(f'<volume firstid="{first}" lastid="{last}">'
+                              f'<metadata type="volume" key="name" value="{part}"/>'
+                              f'<metadata type="volume" key="extruder" value="{k}"/></volume>')
+            config.append("</object>")
+        listed.append({"id": oid, "name": name, "group": group, "translation_mm": list(t),
+                       "volumes": [{"part": part, "first_triangle": first,
+                                    "last_triangle": last, "extruder": k}
+                                   for k, (part, first, last) in enumerate(ranges, start=1)]})
+    model.append("</resources><build>" + "".join(build) + "</build></model>\n")
+    config.append("</config>\n")
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
+        z.writestr("[Content_Types].xml",
+                   '<?xml version="1.0" encoding="UTF-8"?>\n<Types xmlns="http://schemas.'
+                   'openxmlformats.org/package/2006/content-types"><Default Extension="rels" '
+                   'ContentType="application/vnd.openxmlformats-package.relationships+xml"/>'
+                   '<Default Extension="model" ContentType="application/vnd.ms-package.'
+                   '3dmanufacturing-3dmodel+xml"/></Types>\n')
+        z.writestr("_rels/.rels",
+                   '<?xml version="1.0" encoding="UTF-8"?>\n<Relationships xmlns="http://'
+                   'schemas.openxmlformats.org/package/2006/relationships"><Relationship '
+                   'Target="/3D/3dmodel.model" Id="rel0" Type="http://schemas.microsoft.com/'
+                   '3dmanufacturing/2013/01/3dmodel"/></Relationships>\n')
+        z.writestr("3D/3dmodel.model", "".join(model))
+        if any(o[1] is not None for o in objects):
+            z.writestr("Metadata/Slic3r_PE_model.config", "".join(config))
+    return listed
+
+
+def make_group_output(out: Path, objects: list, groups: dict) -> dict:
+    """make_output with PolyJet parts in `groups` and a kit 3MF from write_kit_3mf(objects)."""
+    manifest = make_output(out, techs={"box": "PolyJet", "cylinder": "PolyJet"}, groups=groups)
+    listed = write_kit_3mf(out / "kit.3mf", objects)
+    manifest["kit_3mf"] = {"file": "kit.3mf", "sha256": sha256(out / "kit.3mf"),
+                           "objects": listed}
+    write_manifest(out, manifest)
+    return manifest
+
+
+GROUP_T = (40.0, 7.5, 0.0)
 
 
 def run_check(out: Path, *extra: str) -> tuple[int, dict | None, str]:
@@ -312,21 +386,98 @@ def test_two_disjoint_boxes_with_whole_mesh_genus_fail(tmp: Path) -> None:
     expect_only_failure(res, "box", ["genus 0 (2 shells, chi 4) != manifest -1"])
 
 
-def test_group_with_one_placement_passes(tmp: Path) -> None:
-    """A PolyJet group of two parts placed by the same translation, as fabkit lays it out."""
-    make_output(tmp, techs={"box": "PolyJet", "cylinder": "PolyJet"},
-                groups={"box": "g", "cylinder": "g"},
-                kit_translations={"box": (40.0, 7.5, 0.0), "cylinder": (40.0, 7.5, 0.0)})
+def test_group_as_one_object_with_volumes_passes(tmp: Path) -> None:
+    """A PolyJet group as fabkit writes it: one object `box+cylinder`, one volume per part."""
+    make_group_output(tmp, [("box+cylinder", "g", [("box", box_mesh()), ("cylinder", cyl_mesh())],
+                             GROUP_T)], groups={"box": "g", "cylinder": "g"})
+    rc, res, err = run_check(tmp)
+    expect(rc == 0, f"exit {rc}\n{err}")
+    m = items_by_name(res)["kit_3mf"]["measured"]
+    expect(m["parts"] == ["box", "cylinder"] and m["objects"] == {"1": ["box", "cylinder"]},
+           f"{m}")
+
+
+def test_objects_of_fabkit_layout_without_groups_pass(tmp: Path) -> None:
+    """Our writer without groups: two objects, no PrusaSlicer config, moved by build items."""
+    manifest = make_output(tmp)
+    listed = write_kit_3mf(tmp / "kit.3mf", [("box", None, [("box", box_mesh())], (15.0, 1.0, 2.0)),
+                                             ("cylinder", None, [("cylinder", cyl_mesh())],
+                                              GROUP_T)])
+    manifest["kit_3mf"] = {"file": "kit.3mf", "sha256": sha256(tmp / "kit.3mf"), "objects": listed}
+    write_manifest(tmp, manifest)
     rc, res, err = run_check(tmp)
     expect(rc == 0, f"exit {rc}\n{err}")
 
 
-def test_group_with_two_placements_fails(tmp: Path) -> None:
-    make_output(tmp, groups={"box": "g", "cylinder": "g"},
-                kit_translations={"box": (40.0, 7.5, 0.0), "cylinder": (40.0, 7.5, 1e-3)})
+def test_objects_moved_by_trimesh_build_items_pass(tmp: Path) -> None:
+    """A 3MF written by trimesh with build transforms: parts stay in object coordinates."""
+    make_output(tmp, kit_translations={"box": (40.0, 7.5, 0.0), "cylinder": (0.0, 60.0, 1.0)})
+    rc, res, err = run_check(tmp)
+    expect(rc == 0, f"exit {rc}\n{err}")
+
+
+def test_group_split_over_two_objects_fails(tmp: Path) -> None:
+    """Two objects, even placed by one translation, are sliced as two objects."""
+    make_group_output(tmp, [("box", None, [("box", box_mesh())], GROUP_T),
+                            ("cylinder", None, [("cylinder", cyl_mesh())], GROUP_T)],
+                      groups={"box": "g", "cylinder": "g"})
     rc, res, _ = run_check(tmp)
     expect(rc == 1, f"exit {rc}")
-    expect_only_failure(res, "kit_3mf", ["group 'g': cylinder is placed by"])
+    expect_only_failure(res, "kit_3mf", ["group 'g': its parts are in 2 objects"])
+
+
+def test_ungrouped_parts_in_one_object_fail(tmp: Path) -> None:
+    make_group_output(tmp, [("box+cylinder", "g", [("box", box_mesh()), ("cylinder", cyl_mesh())],
+                             GROUP_T)], groups={})
+    rc, res, _ = run_check(tmp)
+    expect(rc == 1, f"exit {rc}")
+    expect_only_failure(res, "kit_3mf", ["object box+cylinder: holds parts ['box', 'cylinder']"])
+
+
+def test_group_volume_moved_in_its_object_fails(tmp: Path) -> None:
+    """The cylinder volume is shifted by 1e-3 mm against the box: registration lost."""
+    moved = cyl_mesh()
+    moved.apply_translation((0.0, 0.0, 1e-3))
+    make_group_output(tmp, [("box+cylinder", "g", [("box", box_mesh()), ("cylinder", moved)],
+                             GROUP_T)], groups={"box": "g", "cylinder": "g"})
+    rc, res, _ = run_check(tmp)
+    expect(rc == 1, f"exit {rc}")
+    expect_only_failure(res, "kit_3mf", ["cylinder: box in its object"])
+
+
+def test_volume_ranges_that_do_not_split_the_mesh_fail(tmp: Path) -> None:
+    make_group_output(tmp, [("box+cylinder", "g", [("box", box_mesh()), ("cylinder", cyl_mesh())],
+                             GROUP_T)], groups={"box": "g", "cylinder": "g"})
+    kit = tmp / "kit.3mf"
+    with zipfile.ZipFile(kit) as z:
+        files = {n: z.read(n) for n in z.namelist()}
+    cfg = files["Metadata/Slic3r_PE_model.config"].decode()
+    files["Metadata/Slic3r_PE_model.config"] = cfg.replace('lastid="11"', 'lastid="10"').encode()
+    with zipfile.ZipFile(kit, "w", zipfile.ZIP_DEFLATED) as z:
+        for n, b in files.items():
+            z.writestr(n, b)
+    manifest = json.loads((tmp / "manifest.json").read_text())
+    manifest["kit_3mf"]["sha256"] = sha256(kit)
+    write_manifest(tmp, manifest)
+    rc, res, _ = run_check(tmp)
+    expect(rc == 1, f"exit {rc}")
+    expect_only_failure(res, "kit_3mf", ["object box+cylinder: volume triangle ranges",
+                                         "no geometry named", "parts in the 3MF",
+                                         "manifest volumes"])
+
+
+def test_manifest_volumes_that_differ_from_the_3mf_fail(tmp: Path) -> None:
+    manifest = make_group_output(
+        tmp, [("box+cylinder", "g", [("box", box_mesh()), ("cylinder", cyl_mesh())], GROUP_T)],
+        groups={"box": "g", "cylinder": "g"})
+    manifest["kit_3mf"]["objects"][0]["volumes"][1]["first_triangle"] = 13
+    manifest["kit_3mf"]["objects"][0]["translation_mm"][2] = 1e-3
+    write_manifest(tmp, manifest)
+    rc, res, _ = run_check(tmp)
+    expect(rc == 1, f"exit {rc}")
+    expect_only_failure(res, "kit_3mf", ["object box+cylinder: manifest volumes",
+                                         "object box+cylinder: manifest translation"])
+    expect(len(items_by_name(res)["kit_3mf"]["reasons"]) == 2, "two reasons")
 
 
 def test_unknown_print_technology_and_bad_group_fail(tmp: Path) -> None:
@@ -341,7 +492,8 @@ def test_kit_missing_part_fails(tmp: Path) -> None:
     make_output(tmp, kit_names=("box",))
     rc, res, _ = run_check(tmp)
     expect(rc == 1, f"exit {rc}")
-    expect_only_failure(res, "kit_3mf", ["no geometry named", "geometries"])
+    expect_only_failure(res, "kit_3mf", ["no geometry named", "parts in the 3MF",
+                                         "manifest objects"])
 
 
 def test_kit_wrong_volume_fails(tmp: Path) -> None:
@@ -349,7 +501,9 @@ def test_kit_wrong_volume_fails(tmp: Path) -> None:
     make_output(tmp)
     scene = trimesh.Scene()
     scene.add_geometry(box_mesh(), geom_name="box", node_name="box")
-    coarse = trimesh.creation.cylinder(radius=CYL_RADIUS, height=CYL_HEIGHT, sections=32)
+    coarse = trimesh.creation.cylinder(
+        radius=CYL_RADIUS, height=CYL_HEIGHT, sections=32,
+        transform=trimesh.transformations.translation_matrix(CYL_CENTER))
     scene.add_geometry(coarse, geom_name="cylinder", node_name="cylinder")
     (tmp / "kit.3mf").write_bytes(scene.export(file_type="3mf"))
     manifest = json.loads((tmp / "manifest.json").read_text())
