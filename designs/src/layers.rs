@@ -231,6 +231,81 @@ pub fn check_markers(design: &Design, layers: &[ResolvedLayer], errs: &mut Vec<P
                         profile.min_wall_mm
                     ),
                 ));
+                continue;
+            }
+            // Features that converge (pointing into a concave side) must stay apart at their
+            // ends too: the hemisphere centres keep the same clearance as the bases.
+            let dir = direction(spec);
+            let ends: Vec<[f64; 3]> = placed
+                .iter()
+                .map(|m| {
+                    let h = f.height_mm - f.radius_mm();
+                    [0, 1, 2].map(|k| m.position_mm[k] + dir * h * m.normal[k])
+                })
+                .collect();
+            if ends.len() > 1 {
+                let nn = markers::nearest_neighbours(&ends);
+                if let Some((a, (b, d))) = nn.iter().enumerate().min_by(|x, y| {
+                    x.1 .1
+                        .partial_cmp(&y.1 .1)
+                        .unwrap_or(std::cmp::Ordering::Equal)
+                }) {
+                    if d - f.diameter_mm < profile.min_wall_mm {
+                        errs.push(ParamError::new(
+                            format!("{path}.feature.height_mm"),
+                            f.height_mm,
+                            format!(
+                                "features {a} and {b} converge: their ends are {d:.3} mm apart, closer than the diameter {} mm plus the minimum wall {} mm of printer profile '{tech_name}'",
+                                f.diameter_mm, profile.min_wall_mm
+                            ),
+                        ));
+                        continue;
+                    }
+                }
+            }
+            // A recess into a solid layer must not cut through its flat base.
+            if l.solid && f.polarity == Polarity::Recessed {
+                let zb = design.body.base_z_mm();
+                let worst = placed
+                    .iter()
+                    .map(|m| {
+                        let side =
+                            (1.0 - m.normal[2] * m.normal[2]).max(0.0).sqrt() * f.radius_mm();
+                        m.position_mm[2] - f.height_mm * m.normal[2] - side - zb
+                    })
+                    .fold(f64::INFINITY, f64::min);
+                if worst < profile.min_wall_mm {
+                    errs.push(ParamError::new(
+                        format!("{path}.feature.height_mm"),
+                        f.height_mm,
+                        format!(
+                            "recesses reach within {worst:.3} mm of the base plane, below the minimum wall {} mm of printer profile '{tech_name}'",
+                            profile.min_wall_mm
+                        ),
+                    ));
+                }
+            }
+        }
+        // Recesses from both surfaces of a shell must leave the minimum wall between them.
+        if !l.solid {
+            let depth = |surface: MarkerSurface| {
+                spec_layer
+                    .markers
+                    .iter()
+                    .filter(|m| m.surface == surface && m.feature.polarity == Polarity::Recessed)
+                    .map(|m| m.feature.height_mm)
+                    .fold(0.0, f64::max)
+            };
+            let (o, i) = (depth(MarkerSurface::Outer), depth(MarkerSurface::Inner));
+            if o > 0.0 && i > 0.0 && o + i > l.thickness_mm - profile.min_wall_mm {
+                errs.push(ParamError::new(
+                    format!("layers[{}].markers", l.index),
+                    format!("recesses {o} mm (outer) + {i} mm (inner)"),
+                    format!(
+                        "together cut through the {:.3} mm layer '{}' or leave less than the minimum wall {} mm of printer profile '{tech_name}'",
+                        l.thickness_mm, l.name, profile.min_wall_mm
+                    ),
+                ));
             }
         }
     }

@@ -433,8 +433,11 @@ pub fn place(
         Layout::HexGrid => {
             let a = positive("spacing_mm", pattern.spacing_mm)?;
             let m = (s_max / a).ceil() as i64 + 1;
-            for j in -m..=m {
-                for i in -m..=m {
+            // rows are (sqrt 3 / 2) a apart, and row j is shifted by j/2 pitches
+            let rows = (s_max / (a * 3f64.sqrt() / 2.0)).ceil() as i64 + 1;
+            for j in -rows..=rows {
+                let w = m + (j.abs() + 1) / 2;
+                for i in -w..=w {
                     let x = a * (i as f64 + 0.5 * j as f64);
                     let y = a * (3f64.sqrt() / 2.0) * j as f64;
                     let s = (x * x + y * y).sqrt();
@@ -525,6 +528,70 @@ pub fn place(
         .collect())
 }
 
+/// For each point, (index, chord distance) of its nearest other point, by a bucket grid.
+/// Needs at least two points.
+pub fn nearest_neighbours(points: &[[f64; 3]]) -> Vec<(usize, f64)> {
+    let n = points.len();
+    let (mut lo, mut hi) = ([f64::MAX; 3], [f64::MIN; 3]);
+    for p in points {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let diag = ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2)).sqrt();
+    let cell = (diag / (n as f64).sqrt()).max(1e-6);
+    let key = |p: [f64; 3]| {
+        [
+            (p[0] / cell).floor() as i64,
+            (p[1] / cell).floor() as i64,
+            (p[2] / cell).floor() as i64,
+        ]
+    };
+    let mut grid: std::collections::HashMap<[i64; 3], Vec<usize>> =
+        std::collections::HashMap::new();
+    for (i, p) in points.iter().enumerate() {
+        grid.entry(key(*p)).or_default().push(i);
+    }
+    let dist = |a: [f64; 3], b: [f64; 3]| {
+        ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+    };
+    points
+        .iter()
+        .enumerate()
+        .map(|(i, &p)| {
+            let k = key(p);
+            let mut best = (usize::MAX, f64::INFINITY);
+            let mut radius = 1;
+            loop {
+                for dx in -radius..=radius {
+                    for dy in -radius..=radius {
+                        for dz in -radius..=radius {
+                            if let Some(v) = grid.get(&[k[0] + dx, k[1] + dy, k[2] + dz]) {
+                                for &j in v {
+                                    if j != i {
+                                        let d = dist(p, points[j]);
+                                        if d < best.1 || (d == best.1 && j < best.0) {
+                                            best = (j, d);
+                                        }
+                                    }
+                                }
+                            }
+                        }
+                    }
+                }
+                // a neighbour found within `radius` cells is the nearest if its distance is
+                // below radius x cell
+                if best.1 <= radius as f64 * cell || radius > 1 << 20 {
+                    break;
+                }
+                radius *= 2;
+            }
+            best
+        })
+        .collect()
+}
+
 /// Count and nearest-neighbour spacing on the surface.
 pub fn stats(surface: &Surface, markers: &[Marker]) -> PatternStats {
     let n = markers.len();
@@ -536,69 +603,12 @@ pub fn stats(surface: &Surface, markers: &[Marker]) -> PatternStats {
             closest_pair: None,
         };
     }
-    // Bucket grid on chord distance for candidate neighbours.
-    let mut cell = 0.0f64;
-    {
-        // estimate a cell size from the bounding box and count
-        let (mut lo, mut hi) = ([f64::MAX; 3], [f64::MIN; 3]);
-        for m in markers {
-            for k in 0..3 {
-                lo[k] = lo[k].min(m.position_mm[k]);
-                hi[k] = hi[k].max(m.position_mm[k]);
-            }
-        }
-        let diag =
-            ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2)).sqrt();
-        cell = cell.max(diag / (n as f64).sqrt()).max(1e-6);
-    }
-    let key = |p: [f64; 3]| {
-        [
-            (p[0] / cell).floor() as i64,
-            (p[1] / cell).floor() as i64,
-            (p[2] / cell).floor() as i64,
-        ]
-    };
-    let mut grid: std::collections::HashMap<[i64; 3], Vec<usize>> =
-        std::collections::HashMap::new();
-    for (i, m) in markers.iter().enumerate() {
-        grid.entry(key(m.position_mm)).or_default().push(i);
-    }
-    let chord = |a: &Marker, b: &Marker| {
-        ((a.position_mm[0] - b.position_mm[0]).powi(2)
-            + (a.position_mm[1] - b.position_mm[1]).powi(2)
-            + (a.position_mm[2] - b.position_mm[2]).powi(2))
-        .sqrt()
-    };
+    let points: Vec<[f64; 3]> = markers.iter().map(|m| m.position_mm).collect();
+    let neighbours = nearest_neighbours(&points);
     let mut nn = Vec::with_capacity(n);
     let mut best_pair = (0, 1, f64::INFINITY);
     for (i, m) in markers.iter().enumerate() {
-        let k = key(m.position_mm);
-        let mut best = (usize::MAX, f64::INFINITY);
-        let mut radius = 1;
-        loop {
-            for dx in -radius..=radius {
-                for dy in -radius..=radius {
-                    for dz in -radius..=radius {
-                        if let Some(v) = grid.get(&[k[0] + dx, k[1] + dy, k[2] + dz]) {
-                            for &j in v {
-                                if j != i {
-                                    let d = chord(m, &markers[j]);
-                                    if d < best.1 {
-                                        best = (j, d);
-                                    }
-                                }
-                            }
-                        }
-                    }
-                }
-            }
-            // a neighbour found within `radius` cells is the nearest if its distance is
-            // below radius x cell
-            if best.1 <= radius as f64 * cell || radius > 64 {
-                break;
-            }
-            radius *= 2;
-        }
+        let best = neighbours[i];
         let d = surface.surface_distance(m, &markers[best.0]);
         if d < best_pair.2 {
             best_pair = (i.min(best.0), i.max(best.0), d);

@@ -120,7 +120,7 @@ fn load_design(arg: Option<&str>) -> Result<Loaded, DesignError> {
     let arg = arg.unwrap_or(library::DEFAULT_DESIGN);
     let path = Path::new(arg);
     let looks_like_file =
-        path.exists() || arg.ends_with(".yaml") || arg.ends_with(".yml") || arg.contains('/');
+        path.is_file() || arg.ends_with(".yaml") || arg.ends_with(".yml") || arg.contains('/');
     let (text, source) = if looks_like_file {
         let text = std::fs::read_to_string(path).map_err(|e| DesignError::Io {
             path: arg.to_string(),

@@ -1,0 +1,366 @@
+//! End-to-end: `fabkit export` of the marker designs (ShadowTac, UVDtact, the dual-modal
+//! TacTip) and their presets, checked by the independent Python oracle (every output
+//! directory), by PrusaSlicer through `printcheck --strict` (every STL and 3MF of the three
+//! base designs), and against the papers and the geometry through `manifest.json`.
+//!
+//! A part with role `marker_tips` (the TacTip dots) only prints together with its skin in one
+//! multi-material job, so it is not printchecked alone; the kit 3MF that holds its group is.
+
+mod common;
+use common::*;
+use fabkit_designs::library;
+use serde_json::Value;
+use std::f64::consts::PI;
+use std::path::{Path, PathBuf};
+use std::sync::{Condvar, Mutex};
+
+/// Exports library design `design` (with `preset`) into `<dir>/out/<kit>` from `dir`, and
+/// returns that directory and its manifest. (The output goes below `out/` so that no folder
+/// named like a design shadows the library design in the working directory.)
+fn export(dir: &Path, design: &str, preset: Option<&str>) -> (PathBuf, Value) {
+    let kit = match preset {
+        Some(p) => format!("{design}_{p}"),
+        None => design.to_string(),
+    };
+    let out = dir.join("out").join(&kit);
+    let mut args = vec!["export", design, "--out", out.to_str().unwrap()];
+    if let Some(p) = preset {
+        args.extend(["--preset", p]);
+    }
+    let o = run(dir, &args, &[]);
+    assert!(
+        o.status.success(),
+        "fabkit {} failed:\n{}",
+        args.join(" "),
+        text(&o.stderr)
+    );
+    let m: Value = serde_json::from_slice(&std::fs::read(out.join("manifest.json")).unwrap())
+        .expect("manifest.json parses");
+    assert_eq!(m["design"]["name"], kit.as_str());
+    (out, m)
+}
+
+fn parts(m: &Value) -> &Vec<Value> {
+    m["parts"].as_array().expect("parts")
+}
+
+fn part<'a>(m: &'a Value, name: &str) -> &'a Value {
+    parts(m)
+        .iter()
+        .find(|p| p["name"] == name)
+        .unwrap_or_else(|| panic!("no part {name}"))
+}
+
+fn markers_summary(m: &Value) -> &Vec<Value> {
+    m["summary"]["markers"].as_array().expect("summary.markers")
+}
+
+fn cast<'a>(m: &'a Value, name: &str) -> &'a Value {
+    m["casts"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["cast"] == name)
+        .unwrap_or_else(|| panic!("no cast {name}"))
+}
+
+fn oracle_check(dir: &Path) {
+    let Some(py) = oracle_python() else {
+        return missing("the oracle python (manifold3d + trimesh)");
+    };
+    let o = std::process::Command::new(py)
+        .arg(repo_root().join("tests/oracles/check_parts.py"))
+        .arg(dir)
+        .output()
+        .expect("python runs");
+    let out = text(&o.stdout);
+    assert!(
+        o.status.success() && out.contains(" 0 failed"),
+        "check_parts.py {}:\n{out}\n{}",
+        dir.display(),
+        text(&o.stderr)
+    );
+}
+
+/// Two slicer runs at a time across every test of this file (the machine has two cores).
+static SLICER_SLOTS: (Mutex<usize>, Condvar) = (Mutex::new(2), Condvar::new());
+
+struct SlicerSlot;
+
+impl SlicerSlot {
+    fn take() -> Self {
+        let (lock, cv) = &SLICER_SLOTS;
+        let mut free = lock.lock().unwrap_or_else(|e| e.into_inner());
+        while *free == 0 {
+            free = cv.wait(free).unwrap_or_else(|e| e.into_inner());
+        }
+        *free -= 1;
+        SlicerSlot
+    }
+}
+
+impl Drop for SlicerSlot {
+    fn drop(&mut self) {
+        let (lock, cv) = &SLICER_SLOTS;
+        *lock.lock().unwrap_or_else(|e| e.into_inner()) += 1;
+        cv.notify_one();
+    }
+}
+
+/// The files to printcheck: every part's STL but the `marker_tips`, and the kit 3MF.
+fn printable_files(dir: &Path, m: &Value) -> Vec<PathBuf> {
+    let mut files: Vec<PathBuf> = parts(m)
+        .iter()
+        .filter(|p| p["role"] != "marker_tips")
+        .map(|p| dir.join(p["file"].as_str().unwrap()))
+        .collect();
+    files.push(dir.join(m["kit_3mf"]["file"].as_str().expect("kit_3mf.file")));
+    files
+}
+
+/// `printcheck --strict` on each file, two at a time, every failure reported together.
+fn printcheck_all(files: &[PathBuf]) {
+    let Some(pc) = printcheck() else {
+        return missing("printcheck (prusa-slicer + admesh)");
+    };
+    let queue = Mutex::new(files.to_vec());
+    let results = Mutex::new(Vec::new());
+    std::thread::scope(|s| {
+        for _ in 0..2 {
+            s.spawn(|| loop {
+                let Some(f) = queue.lock().unwrap().pop() else {
+                    break;
+                };
+                let slot = SlicerSlot::take();
+                let o = std::process::Command::new("bash")
+                    .arg(&pc)
+                    .arg("--strict")
+                    .arg(&f)
+                    .output();
+                drop(slot);
+                results.lock().unwrap().push((f, o));
+            });
+        }
+    });
+    let failures: Vec<String> = results
+        .into_inner()
+        .unwrap()
+        .into_iter()
+        .filter_map(|(f, o)| match o {
+            Ok(o) if o.status.success() && text(&o.stdout).contains("result=PASS") => None,
+            Ok(o) => Some(format!(
+                "{}:\n{}{}",
+                f.display(),
+                text(&o.stdout),
+                text(&o.stderr)
+            )),
+            Err(e) => Some(format!("{}: printcheck did not run: {e}", f.display())),
+        })
+        .collect();
+    assert!(
+        failures.is_empty(),
+        "printcheck --strict failed on {} of {} files:\n{}",
+        failures.len(),
+        files.len(),
+        failures.join("\n")
+    );
+}
+
+/// ShadowTac (Sec. IV-A): one SLA open mold whose 0.45 mm recesses only SLA prints; the skin
+/// pour is the dome plus 543 dimples; the published preset has 469.
+#[test]
+fn shadowtac_kits() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (dir, m) = export(tmp.path(), "shadowtac", None);
+    let molds: Vec<&Value> = parts(&m)
+        .iter()
+        .filter(|p| p["role"] == "open_mold")
+        .collect();
+    assert_eq!(molds.len(), 1, "{:?}", parts(&m));
+    assert_eq!(molds[0]["print_technology"], "SLA");
+    assert_eq!(molds[0]["genus"], 0);
+    let mk = markers_summary(&m);
+    assert_eq!(mk.len(), 1);
+    assert_eq!(mk[0]["needs_sla_or_finer"], true, "{}", mk[0]);
+    assert_eq!(mk[0]["printable_with"], serde_json::json!(["SLA"]));
+    let n = mk[0]["count"].as_u64().unwrap() as f64;
+    assert!(mk[0]["min_spacing_mm"].as_f64().unwrap() >= 0.45 + 0.4);
+
+    // The skin pour fills the open mold to its base: the dome plus the raised dimples, each
+    // its nominal volume plus the slab between its tangent plane and the sphere.
+    let design = library::load("shadowtac").unwrap();
+    let tol = m["chord_tolerance_mm"].as_f64().unwrap();
+    let rho = design.body.sphere_radius_mm().unwrap();
+    let f = &design.layers[0].markers[0].feature;
+    let r = f.radius_mm();
+    let dome = design.body.analytic_solid_volume_mm3(0.0, 0.0);
+    let gap = PI * r.powi(4) * (2.0 / rho) / 8.0;
+    let expected = dome + n * (f.nominal_volume_mm3() + gap);
+    let area = 2.0 * PI * rho * 8.0
+        + n * (2.0 * PI * r * (f.height_mm - r) + 2.0 * PI * r * r + PI * r * r);
+    let pour = cast(&m, "skin")["cavity_volume_ml"].as_f64().unwrap() * 1000.0;
+    assert!(
+        (pour - expected).abs() <= area * tol + 1e-6 * dome,
+        "skin pour {pour} mm^3, expected {expected} within {}",
+        area * tol
+    );
+    assert!(
+        m["bought_items"].to_string().contains("pmma"),
+        "{}",
+        m["bought_items"]
+    );
+    oracle_check(&dir);
+    let files = printable_files(&dir, &m);
+    assert_eq!(files.len(), 2);
+
+    let (pdir, pm) = export(tmp.path(), "shadowtac", Some("published_469"));
+    let mk = markers_summary(&pm);
+    assert_eq!(mk[0]["count"], 469, "{}", mk[0]);
+    assert_eq!(mk[0]["pattern"]["layout"], "concentric_6k");
+    assert_eq!(mk[0]["pattern"]["rings"], 12);
+    assert_eq!(mk[0]["needs_sla_or_finer"], true);
+    oracle_check(&pdir);
+
+    printcheck_all(&files);
+}
+
+/// UVDtact (Sec. III): boundary molds for three layers (six Mold Star pours, then the three
+/// layers inside out); slots and protrusions of 85 (or 43) markers; the two mixed layers
+/// together fill the shell between offsets -2.4 and -0.4 mm.
+#[test]
+fn uvdtact_kits() {
+    let tmp = tempfile::tempdir().unwrap();
+    let design = library::load("uvdtact").unwrap();
+    let (dir, m) = export(tmp.path(), "uvdtact", None);
+    let casts: Vec<&str> = m["casts"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["cast"].as_str().unwrap())
+        .collect();
+    assert_eq!(casts.len(), 9, "{casts:?}");
+    assert!(
+        casts[..6].iter().all(|c| c.starts_with("silicone_mold:")),
+        "{casts:?}"
+    );
+    assert_eq!(casts[6..], ["inner_mixed", "outer_mixed", "black_gel"]);
+    for c in &casts[..6] {
+        assert_eq!(cast(&m, c)["material"], "mold_star_30");
+    }
+    let count = |role: &str| parts(&m).iter().filter(|p| p["role"] == role).count();
+    assert_eq!(
+        (
+            count("master_pattern"),
+            count("mold_box"),
+            count("negative_mold")
+        ),
+        (3, 3, 3)
+    );
+    for p in parts(&m) {
+        let want = if p["role"] == "mold_box" {
+            "FDM"
+        } else {
+            "SLA"
+        };
+        assert_eq!(p["print_technology"], want, "{}", p["name"]);
+    }
+    let tol = m["chord_tolerance_mm"].as_f64().unwrap();
+    let (v_out, v_in) = (
+        design.body.analytic_solid_volume_mm3(-0.4, 0.0),
+        design.body.analytic_solid_volume_mm3(-2.4, 0.0),
+    );
+    // curved areas of the two offset surfaces, within a few per cent (bounded by the
+    // circumscribing cylinder plus disc areas)
+    let shell_area = 2.0 * (PI * 9.0 * 9.0 + 2.0 * PI * 9.0 * 24.0);
+    let (dir43, m43) = export(tmp.path(), "uvdtact", Some("markers_43"));
+    for (mk_dir, mm, n) in [(&dir, &m, 85), (&dir43, &m43, 43)] {
+        let mk = markers_summary(mm);
+        assert_eq!(mk.len(), 2);
+        for x in mk {
+            assert_eq!(x["count"], n, "{x}");
+        }
+        assert_eq!(mk[0]["surface"], "outer");
+        assert_eq!(mk[0]["feature"]["polarity"], "recessed");
+        assert_eq!(mk[1]["surface"], "inner");
+        assert_eq!(mk[1]["feature"]["polarity"], "raised");
+        let mixed = (cast(mm, "inner_mixed")["cavity_volume_ml"]
+            .as_f64()
+            .unwrap()
+            + cast(mm, "outer_mixed")["cavity_volume_ml"]
+                .as_f64()
+                .unwrap())
+            * 1000.0;
+        assert!(
+            (mixed - (v_out - v_in)).abs() <= shell_area * tol,
+            "{}: the two mixed layers hold {mixed} mm^3, the shell {}",
+            mm["design"]["name"],
+            v_out - v_in
+        );
+        oracle_check(mk_dir);
+    }
+    printcheck_all(&printable_files(&dir, &m));
+}
+
+/// The dual-modal TacTip (Pestell et al. Sec. III-A, III-D): a PolyJet skin with pins and
+/// white pin tips, printed together as one multi-material group; layouts A to D.
+#[test]
+fn tactip_kits() {
+    let tmp = tempfile::tempdir().unwrap();
+    let mut base = None;
+    for (preset, spacing, diameter) in [
+        (None, 3.0, 1.0),
+        (Some("tip_b"), 4.0, 1.0),
+        (Some("tip_c"), 4.5, 1.0),
+        (Some("tip_d"), 4.5, 1.7),
+    ] {
+        let (dir, m) = export(tmp.path(), "tactip_dualmodal", preset);
+        let name = m["design"]["name"].as_str().unwrap().to_string();
+        let (skin, tips) = (part(&m, "skin"), part(&m, "skin_tips"));
+        assert_eq!(skin["role"], "printed_skin", "{name}");
+        assert_eq!(tips["role"], "marker_tips", "{name}");
+        assert!(skin["group"].is_string(), "{name}: group {}", skin["group"]);
+        assert_eq!(skin["group"], tips["group"], "{name}");
+        for p in [skin, tips] {
+            assert_eq!(p["print_technology"], "PolyJet", "{name}");
+        }
+        assert_eq!(skin["material"], "tango_black_plus");
+        assert_eq!(tips["material"], "vero_white");
+        let mk = markers_summary(&m);
+        assert_eq!(mk.len(), 1);
+        assert_eq!(mk[0]["pattern"]["spacing_mm"], spacing, "{name}");
+        assert_eq!(mk[0]["feature"]["diameter_mm"], diameter, "{name}");
+        // each tip is a hemisphere of the pin's radius
+        let n = mk[0]["count"].as_f64().unwrap();
+        let r: f64 = diameter / 2.0;
+        let v_tips = n * 2.0 / 3.0 * PI * r.powi(3);
+        let tol = m["chord_tolerance_mm"].as_f64().unwrap();
+        let v = tips["volume_mm3"].as_f64().unwrap();
+        assert!(
+            (v - v_tips).abs() <= n * 3.0 * PI * r * r * tol,
+            "{name}: tips {v} mm^3 vs {n} hemispheres {v_tips}"
+        );
+        // the group is one 3MF object with a volume per part
+        let objects = m["kit_3mf"]["objects"].as_array().unwrap();
+        let grouped: Vec<&Value> = objects
+            .iter()
+            .filter(|o| o["group"] == skin["group"])
+            .collect();
+        assert_eq!(grouped.len(), 1, "{name}: {objects:?}");
+        let volumes: Vec<&Value> = grouped[0]["volumes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| &v["part"])
+            .collect();
+        assert_eq!(volumes, ["skin", "skin_tips"], "{name}");
+        oracle_check(&dir);
+        if preset.is_none() {
+            base = Some((dir, m));
+        }
+    }
+    let (dir, m) = base.unwrap();
+    let files = printable_files(&dir, &m);
+    assert!(!files.iter().any(|f| f.ends_with("parts/skin_tips.stl")));
+    assert_eq!(files.len(), 2);
+    printcheck_all(&files);
+}
