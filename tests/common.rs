@@ -3,6 +3,7 @@
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
+use std::sync::{Condvar, Mutex};
 
 /// The fabkit binary built for this test run.
 pub fn fabkit() -> Command {
@@ -62,4 +63,96 @@ pub fn missing(what: &str) {
         panic!("{what} is required (FABKIT_REQUIRE_ORACLES=1 or CI=true) but missing; run scripts/setup-system and scripts/setup-oracles");
     }
     eprintln!("SKIPPED: {what} not available; run scripts/test to include it");
+}
+
+/// Runs tests/oracles/check_parts.py on an export folder; it must pass.
+pub fn oracle_check(dir: &Path) {
+    let Some(py) = oracle_python() else {
+        return missing("the oracle python (manifold3d + trimesh)");
+    };
+    let o = std::process::Command::new(py)
+        .arg(repo_root().join("tests/oracles/check_parts.py"))
+        .arg(dir)
+        .output()
+        .expect("python runs");
+    let out = text(&o.stdout);
+    assert!(
+        o.status.success() && out.contains(" 0 failed"),
+        "check_parts.py {}:\n{out}\n{}",
+        dir.display(),
+        text(&o.stderr)
+    );
+}
+
+/// Two slicer runs at a time across every test of this file (the machine has two cores).
+static SLICER_SLOTS: (Mutex<usize>, Condvar) = (Mutex::new(2), Condvar::new());
+
+struct SlicerSlot;
+
+impl SlicerSlot {
+    fn take() -> Self {
+        let (lock, cv) = &SLICER_SLOTS;
+        let mut free = lock.lock().unwrap_or_else(|e| e.into_inner());
+        while *free == 0 {
+            free = cv.wait(free).unwrap_or_else(|e| e.into_inner());
+        }
+        *free -= 1;
+        SlicerSlot
+    }
+}
+
+impl Drop for SlicerSlot {
+    fn drop(&mut self) {
+        let (lock, cv) = &SLICER_SLOTS;
+        *lock.lock().unwrap_or_else(|e| e.into_inner()) += 1;
+        cv.notify_one();
+    }
+}
+
+/// `printcheck --strict` on each file, two at a time, every failure reported together.
+pub fn printcheck_all(files: &[PathBuf]) {
+    let Some(pc) = printcheck() else {
+        return missing("printcheck (prusa-slicer + admesh)");
+    };
+    let queue = Mutex::new(files.to_vec());
+    let results = Mutex::new(Vec::new());
+    std::thread::scope(|s| {
+        for _ in 0..2 {
+            s.spawn(|| loop {
+                let Some(f) = queue.lock().unwrap().pop() else {
+                    break;
+                };
+                let slot = SlicerSlot::take();
+                let o = std::process::Command::new("bash")
+                    .arg(&pc)
+                    .arg("--strict")
+                    .arg(&f)
+                    .output();
+                drop(slot);
+                results.lock().unwrap().push((f, o));
+            });
+        }
+    });
+    let failures: Vec<String> = results
+        .into_inner()
+        .unwrap()
+        .into_iter()
+        .filter_map(|(f, o)| match o {
+            Ok(o) if o.status.success() && text(&o.stdout).contains("result=PASS") => None,
+            Ok(o) => Some(format!(
+                "{}:\n{}{}",
+                f.display(),
+                text(&o.stdout),
+                text(&o.stderr)
+            )),
+            Err(e) => Some(format!("{}: printcheck did not run: {e}", f.display())),
+        })
+        .collect();
+    assert!(
+        failures.is_empty(),
+        "printcheck --strict failed on {} of {} files:\n{}",
+        failures.len(),
+        files.len(),
+        failures.join("\n")
+    );
 }

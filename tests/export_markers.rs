@@ -12,7 +12,6 @@ use fabkit_designs::library;
 use serde_json::Value;
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
-use std::sync::{Condvar, Mutex};
 
 /// Exports library design `design` (with `preset`) into `<dir>/out/<kit>` from `dir`, and
 /// returns that directory and its manifest. (The output goes below `out/` so that no folder
@@ -64,49 +63,6 @@ fn cast<'a>(m: &'a Value, name: &str) -> &'a Value {
         .unwrap_or_else(|| panic!("no cast {name}"))
 }
 
-fn oracle_check(dir: &Path) {
-    let Some(py) = oracle_python() else {
-        return missing("the oracle python (manifold3d + trimesh)");
-    };
-    let o = std::process::Command::new(py)
-        .arg(repo_root().join("tests/oracles/check_parts.py"))
-        .arg(dir)
-        .output()
-        .expect("python runs");
-    let out = text(&o.stdout);
-    assert!(
-        o.status.success() && out.contains(" 0 failed"),
-        "check_parts.py {}:\n{out}\n{}",
-        dir.display(),
-        text(&o.stderr)
-    );
-}
-
-/// Two slicer runs at a time across every test of this file (the machine has two cores).
-static SLICER_SLOTS: (Mutex<usize>, Condvar) = (Mutex::new(2), Condvar::new());
-
-struct SlicerSlot;
-
-impl SlicerSlot {
-    fn take() -> Self {
-        let (lock, cv) = &SLICER_SLOTS;
-        let mut free = lock.lock().unwrap_or_else(|e| e.into_inner());
-        while *free == 0 {
-            free = cv.wait(free).unwrap_or_else(|e| e.into_inner());
-        }
-        *free -= 1;
-        SlicerSlot
-    }
-}
-
-impl Drop for SlicerSlot {
-    fn drop(&mut self) {
-        let (lock, cv) = &SLICER_SLOTS;
-        *lock.lock().unwrap_or_else(|e| e.into_inner()) += 1;
-        cv.notify_one();
-    }
-}
-
 /// The files to printcheck: every part's STL but the `marker_tips`, and the kit 3MF.
 fn printable_files(dir: &Path, m: &Value) -> Vec<PathBuf> {
     let mut files: Vec<PathBuf> = parts(m)
@@ -116,54 +72,6 @@ fn printable_files(dir: &Path, m: &Value) -> Vec<PathBuf> {
         .collect();
     files.push(dir.join(m["kit_3mf"]["file"].as_str().expect("kit_3mf.file")));
     files
-}
-
-/// `printcheck --strict` on each file, two at a time, every failure reported together.
-fn printcheck_all(files: &[PathBuf]) {
-    let Some(pc) = printcheck() else {
-        return missing("printcheck (prusa-slicer + admesh)");
-    };
-    let queue = Mutex::new(files.to_vec());
-    let results = Mutex::new(Vec::new());
-    std::thread::scope(|s| {
-        for _ in 0..2 {
-            s.spawn(|| loop {
-                let Some(f) = queue.lock().unwrap().pop() else {
-                    break;
-                };
-                let slot = SlicerSlot::take();
-                let o = std::process::Command::new("bash")
-                    .arg(&pc)
-                    .arg("--strict")
-                    .arg(&f)
-                    .output();
-                drop(slot);
-                results.lock().unwrap().push((f, o));
-            });
-        }
-    });
-    let failures: Vec<String> = results
-        .into_inner()
-        .unwrap()
-        .into_iter()
-        .filter_map(|(f, o)| match o {
-            Ok(o) if o.status.success() && text(&o.stdout).contains("result=PASS") => None,
-            Ok(o) => Some(format!(
-                "{}:\n{}{}",
-                f.display(),
-                text(&o.stdout),
-                text(&o.stderr)
-            )),
-            Err(e) => Some(format!("{}: printcheck did not run: {e}", f.display())),
-        })
-        .collect();
-    assert!(
-        failures.is_empty(),
-        "printcheck --strict failed on {} of {} files:\n{}",
-        failures.len(),
-        files.len(),
-        failures.join("\n")
-    );
 }
 
 /// ShadowTac (Sec. IV-A): one SLA open mold whose 0.45 mm recesses only SLA prints; the skin

@@ -25,24 +25,28 @@ const DENSE_SLA_MIN_HOLE_DIAMETER_MM: f64 = 0.15;
 const DENSE_SLA_MIN_WALL_MM: f64 = 0.1;
 
 /// The ShadowTac design with `n` features on an equal-area golden spiral over the skin's outer
-/// surface, for scaling runs. Feature diameter d = min(0.45, 0.55 s) rounded down to 0.01 mm,
-/// where s = sqrt(A / (n sqrt(3) / 2)) is the hexagonal pitch of n features on the patterned area
-/// A (pole to the rim less the 0.85 mm rim margin of the 0.45 mm feature, about 1100 mm^2); the
-/// height stays 0.5 mm. Where d is below the SLA minimum hole (0.4 mm), the SLA profile is
-/// lowered to a 0.15 mm minimum hole and a 0.1 mm minimum wall so that validation accepts it:
-/// those molds are not printable on the default profile. Same rule as
+/// surface, for scaling runs. With s = sqrt(A / (n sqrt(3) / 2)) the hexagonal pitch of n
+/// features on the patterned area A (pole to the rim less the 0.85 mm rim margin of the 0.45 mm
+/// feature, about 1100 mm^2) and 0.78 s a safe lower bound on the spiral's nearest-neighbour
+/// distance (0.80-0.82 s measured), the feature diameter is min(0.45, 0.78 s - 0.4) so that the
+/// default SLA minimum wall (0.4 mm) is left between features. When that is below the SLA
+/// minimum hole (0.4 mm; from about 1200 features), the SLA profile is lowered to a 0.15 mm
+/// minimum hole and a 0.1 mm minimum wall and the diameter is min(0.45, 0.5 s) (up to 13000
+/// features): those molds validate but are not printable on the default profile. Diameters are
+/// rounded down to 0.01 mm; the height stays 0.5 mm. Same rule as
 /// `tests/benches/markers.rs`.
 fn scaled_design(base: &Design, n: u32) -> Design {
     let mut d = base.clone();
     let surface = Surface::new(&d.body, 0.0);
     let area_mm2 = surface.area_to(surface.total_arc_mm() - (0.45 + 0.4));
     let pitch_mm = (area_mm2 / (n as f64 * 3f64.sqrt() / 2.0)).sqrt();
-    let diameter_mm = (0.55 * pitch_mm).min(0.45);
-    let diameter_mm = (diameter_mm * 100.0).floor() / 100.0;
+    let mut diameter_mm = (0.78 * pitch_mm - d.printers.sla.min_wall_mm).min(0.45);
     if diameter_mm < d.printers.sla.min_hole_diameter_mm {
         d.printers.sla.min_hole_diameter_mm = DENSE_SLA_MIN_HOLE_DIAMETER_MM;
         d.printers.sla.min_wall_mm = DENSE_SLA_MIN_WALL_MM;
+        diameter_mm = (0.5 * pitch_mm).min(0.45);
     }
+    let diameter_mm = (diameter_mm * 100.0).floor() / 100.0;
     let spec = &mut d.layers[0].markers[0];
     spec.feature.diameter_mm = diameter_mm;
     let p = &mut spec.pattern;
