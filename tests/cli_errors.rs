@@ -117,3 +117,55 @@ fn designs_lists_the_library() {
         text(&o.stdout)
     );
 }
+
+fn shadowtac_with_csv_list() -> String {
+    let yaml = std::fs::read_to_string(repo_root().join("designs/library/shadowtac.yaml")).unwrap();
+    let yaml = yaml[..yaml.find("presets:").unwrap()].to_string();
+    yaml.replace(
+        "          layout: concentric ",
+        "          csv_file: pts.csv\n          layout: list ",
+    )
+    .lines()
+    .filter(|l| !l.contains("spacing_mm: 1.4"))
+    .collect::<Vec<_>>()
+    .join("\n")
+}
+
+#[test]
+fn marker_list_from_csv_is_placed_and_hashed() {
+    let tmp = tempfile::tempdir().unwrap();
+    std::fs::write(tmp.path().join("d.yaml"), shadowtac_with_csv_list()).unwrap();
+    let hash = |pts: &str| {
+        std::fs::write(tmp.path().join("pts.csv"), pts).unwrap();
+        let o = run(
+            tmp.path(),
+            &["export", "d.yaml", "--out", "out/d", "--format", "stl"],
+            &[],
+        );
+        assert!(o.status.success(), "{}", text(&o.stderr));
+        let m: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(tmp.path().join("out/d/manifest.json")).unwrap())
+                .unwrap();
+        (
+            m["summary"]["markers"][0]["count"].as_u64().unwrap(),
+            m["design"]["sha256"].as_str().unwrap().to_string(),
+        )
+    };
+    let (n1, h1) = hash("polar_deg, azimuth_deg\n0, 0\n10, 0\n10, 90 # a comment\n");
+    let (n2, h2) = hash("polar_deg, azimuth_deg\n0, 0\n10, 0\n12, 90\n");
+    assert_eq!((n1, n2), (3, 3));
+    assert_ne!(h1, h2, "the design hash covers the CSV");
+    std::fs::write(
+        tmp.path().join("pts.csv"),
+        "polar_deg, azimuth_deg\n0, 0\n10, x\n",
+    )
+    .unwrap();
+    let o = run(tmp.path(), &["export", "d.yaml", "--out", "out/e"], &[]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        text(&o.stderr).contains("pts.csv:3:"),
+        "{}",
+        text(&o.stderr)
+    );
+    assert!(!tmp.path().join("out/e").exists());
+}

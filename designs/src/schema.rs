@@ -477,10 +477,16 @@ impl Design {
     /// file's folder) into `points`. A CSV row is `polar_deg, azimuth_deg`; a first line that is
     /// not numeric is a header; `#` starts a comment.
     ///
+    /// Returns the text of every file read, in order, so that provenance hashes can cover them.
+    ///
     /// # Errors
     /// [`DesignError::Io`] when a file cannot be read, [`DesignError::Yaml`] naming
     /// `file:line` for a malformed row.
-    pub fn load_marker_files(&mut self, base_dir: &std::path::Path) -> Result<(), DesignError> {
+    pub fn load_marker_files(
+        &mut self,
+        base_dir: &std::path::Path,
+    ) -> Result<Vec<String>, DesignError> {
+        let mut read = Vec::new();
         for (i, l) in self.layers.iter_mut().enumerate() {
             for (j, m) in l.markers.iter_mut().enumerate() {
                 let Some(file) = m.pattern.csv_file.clone() else {
@@ -497,9 +503,10 @@ impl Design {
                     message: e.to_string(),
                 })?;
                 m.pattern.points = Some(parse_angle_csv(&text, &path.display().to_string())?);
+                read.push(text);
             }
         }
-        Ok(())
+        Ok(read)
     }
 }
 

@@ -137,11 +137,16 @@ fn load_design(arg: Option<&str>) -> Result<Loaded, DesignError> {
         format!("designs/library/{arg}.yaml")
     };
     let mut design = Design::from_yaml(&text, &origin)?;
+    // The design hash covers the YAML and every marker CSV file it reads, in order.
+    let mut hasher = Sha256::new();
+    hasher.update(text.as_bytes());
     if looks_like_file {
         let dir = path.parent().unwrap_or(Path::new("."));
-        design.load_marker_files(dir)?;
+        for extra in design.load_marker_files(dir)? {
+            hasher.update(extra.as_bytes());
+        }
     }
-    let sha256 = hex(&Sha256::digest(text.as_bytes()));
+    let sha256 = hex(&hasher.finalize());
     Ok(Loaded {
         design,
         source,
