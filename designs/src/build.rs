@@ -142,6 +142,13 @@ pub fn build_kit(design: &Design, tol: ChordTolerance) -> Result<Kit, DesignErro
             .ok_or_else(|| DesignError::Yaml(format!("unknown material {material_key}")))?;
         let mut r =
             pour(step, &layer, &material_key, m, holders, v, waste).map_err(DesignError::Yaml)?;
+        if r.mold_parts.iter().any(|p| p.ends_with(":inner")) {
+            // boundary strategy (UVDtact Sec. III)
+            r.notes = format!(
+                "Pour into the outer silicone mold, then press the inner silicone mold in: its plinth centres it in the outer mold's recess. For a layer after the first, the layers already cast, still on their inner silicone mold, can take the inner mold's place (UVDtact Sec. III). {}",
+                r.notes
+            );
+        }
         for s in sprayed {
             let sl = &stack.layers[s];
             let sm = materials
