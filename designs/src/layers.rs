@@ -98,6 +98,14 @@ pub fn place_layer_markers(
         .collect()
 }
 
+/// The placed patterns that sit on `surface`.
+fn on_surface(placed: &[PlacedMarkers], surface: MarkerSurface) -> Vec<&PlacedMarkers> {
+    placed
+        .iter()
+        .filter(|p| p.spec.surface == surface)
+        .collect()
+}
+
 /// Rules on marker patterns: they place, do not overlap, leave the printer's minimum wall,
 /// and their features print on the technology that makes them.
 pub fn check_markers(design: &Design, layers: &[ResolvedLayer], errs: &mut Vec<ParamError>) {
@@ -462,14 +470,10 @@ pub fn layer_solid(
     let l = &stack.layers[i];
     let placed = place_layer_markers(design, l, tol);
     let stems_only = placed.iter().any(|p| p.spec.tip_material.is_some());
-    let outer: Vec<&PlacedMarkers> = placed
-        .iter()
-        .filter(|p| p.spec.surface == MarkerSurface::Outer)
-        .collect();
-    let inner: Vec<&PlacedMarkers> = placed
-        .iter()
-        .filter(|p| p.spec.surface == MarkerSurface::Inner)
-        .collect();
+    let (outer, inner) = (
+        on_surface(&placed, MarkerSurface::Outer),
+        on_surface(&placed, MarkerSurface::Inner),
+    );
     let o = enclosed(design, l.outer_offset_mm, 0.0, &outer, tol, stems_only)?;
     if l.solid {
         return Ok(o);
@@ -544,14 +548,10 @@ pub fn build_layer(
     let fixture_tech: PrintTechnology = design.mold.fixture_print_technology.into();
     let cavity_tech: PrintTechnology = design.mold.cavity_print_technology.into();
     let m = &design.mold;
-    let outer: Vec<&PlacedMarkers> = placed
-        .iter()
-        .filter(|p| p.spec.surface == MarkerSurface::Outer)
-        .collect();
-    let inner: Vec<&PlacedMarkers> = placed
-        .iter()
-        .filter(|p| p.spec.surface == MarkerSurface::Inner)
-        .collect();
+    let (outer, inner) = (
+        on_surface(&placed, MarkerSurface::Outer),
+        on_surface(&placed, MarkerSurface::Inner),
+    );
     let base_params = json!({
         "layer": name, "body": design.body, "outer_offset_mm": l.outer_offset_mm,
         "inner_offset_mm": if l.solid { serde_json::Value::Null } else { json!(l.inner_offset_mm) },
