@@ -32,6 +32,11 @@ struct Cli {
 enum Command {
     /// Build a design's parts and write printer-ready STL + 3MF, manifest.json and FABRICATION.md.
     Export(ExportArgs),
+    /// Build a design's calibration fixtures (pin-hole dome + point table, semi-domes, indenters).
+    Fixtures(crate::fixtures_cmd::FixturesArgs),
+    /// Camera calibration: extrinsics from pin-dome observations.
+    #[command(subcommand)]
+    Calibrate(crate::calibrate_cmd::CalibrateCommand),
     /// List the designs embedded in fabkit.
     Designs,
     /// Check a design and print its resolved layer stack, without writing anything.
@@ -204,6 +209,8 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
             Ok(())
         }
         Command::Export(args) => export(args),
+        Command::Fixtures(args) => crate::fixtures_cmd::run(args),
+        Command::Calibrate(cmd) => crate::calibrate_cmd::run(cmd),
     }
 }
 

@@ -5,6 +5,10 @@
 //! [`export`] (STL, 3MF, manifest, fabrication sheet).
 
 pub use fabkit_designs as designs;
+pub use fabkit_calibration as calibration;
 pub use fabkit_export as export;
+pub use fabkit_fixtures as fixtures;
 
+pub mod calibrate_cmd;
 pub mod cli;
+pub mod fixtures_cmd;
