@@ -65,6 +65,33 @@ fn screw_y_range(design: &Design, h: &HousingParams) -> (f64, f64) {
     )
 }
 
+/// The two blind dowel holes in the shell's top face that key calibration fixtures (pin dome,
+/// semi-dome holder) to the sensor in one orientation only: at two adjacent corners (azimuths
+/// 45 and 135 deg), so no rotation of a square fixture by 90, 180 or 270 deg fits.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct FixtureDowelHoles {
+    pub diameter_mm: f64,
+    pub depth_mm: f64,
+    /// Hole centres in the sensor frame (x, y), mm; the holes go down from the base plane.
+    pub positions_xy_mm: [[f64; 2]; 2],
+}
+
+/// Dowel hole diameter (a 2 mm printed peg with clearance), depth, and inset of the hole centre
+/// from the two outer faces at the corner, mm.
+const DOWEL_HOLE_DIAMETER_MM: f64 = 2.0;
+const DOWEL_HOLE_DEPTH_MM: f64 = 3.0;
+const DOWEL_INSET_MM: f64 = 2.0;
+
+/// Where the fixture dowel holes of a housing are.
+pub fn fixture_dowel_holes(h: &HousingParams) -> FixtureDowelHoles {
+    let a = h.outer_width_mm / 2.0 - DOWEL_INSET_MM;
+    FixtureDowelHoles {
+        diameter_mm: DOWEL_HOLE_DIAMETER_MM,
+        depth_mm: DOWEL_HOLE_DEPTH_MM,
+        positions_xy_mm: [[a, a], [-a, a]],
+    }
+}
+
 /// Rules on the housing: parts fit inside each other and the walls print.
 pub fn check_housing_params(
     design: &Design,
@@ -180,6 +207,18 @@ pub fn check_housing_params(
         half - (h.diffuser.outer_diameter_mm / 2.0 + c),
         "around the diffuser seat",
     );
+    let dowels = fixture_dowel_holes(h);
+    let [dx, dy] = dowels.positions_xy_mm[0];
+    let skin_r = design.body.rim_radius_mm(0.0);
+    if (dx * dx + dy * dy).sqrt() - dowels.diameter_mm / 2.0 < skin_r + c {
+        errs.push(ParamError::new(
+            "housing.outer_width_mm",
+            h.outer_width_mm,
+            format!(
+                "too narrow for the fixture dowel holes at the corners: they would cut into the skin's footprint (radius {skin_r:.2} mm)"
+            ),
+        ));
+    }
     let ledge =
         |errs: &mut Vec<ParamError>, path: &str, v: f64, inner: f64, outer: f64, what: &str| {
             if inner >= outer {
@@ -426,6 +465,16 @@ pub fn build_shell(
     for sy in [y, -y] {
         holes.push(screw.translate([0.0, sy, z]));
     }
+    // Fixture dowel holes, down from the top face.
+    let dowels = fixture_dowel_holes(h);
+    for [x, y] in dowels.positions_xy_mm {
+        holes.push(g(cyl(
+            dowels.diameter_mm / 2.0,
+            lv.top_z_mm - dowels.depth_mm,
+            lv.top_z_mm + 1.0,
+        )
+        .map(|p| p.translate([x, y, 0.0])))?);
+    }
     cut.push(Solid::compose(&holes));
     let body = shell
         .difference(&Solid::union_all(&cut).part("shell")?)
@@ -437,6 +486,7 @@ pub fn build_shell(
         "core_seat_radius_mm": r_core + c,
         "parting_plane": "x = 0 (through the sensor axis)",
         "joint_screws": {"y_mm": [y, -y], "z_mm": z, "axis": "x"},
+        "fixture_dowel_holes": dowels,
         "camera_mount_holes_xy_mm": [[s, s], [-s, s], [-s, -s], [s, -s]],
         "print_orientation": "parting face down",
     });
