@@ -9,6 +9,7 @@ use rand_chacha::rand_core::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use crate::camera::{CameraError, CameraModel};
+use crate::p3p::p3p;
 use crate::sqpnp::{nearest_rotation, sqpnp};
 
 /// Smallest number of point-pixel pairs the solver accepts.
@@ -43,8 +44,8 @@ pub enum PnpError {
     },
 }
 
-/// RANSAC settings. The first hypothesis is the all-points solution; minimal samples of 4 points
-/// (SQPnP) follow until the adaptive count for `confidence` is reached.
+/// RANSAC settings. The first hypothesis is the all-points solution; minimal samples of 3 points
+/// (P3P, each refined on its consensus set when it is the best so far) follow until the adaptive count for `confidence` is reached.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RansacOptions {
     /// A point is an inlier when its reprojection error is below this, px.
@@ -155,23 +156,21 @@ pub fn solve_pnp(
         if best_in.iter().filter(|&&b| b).count() < n {
             let mut rng = ChaCha8Rng::seed_from_u64(ro.seed);
             let mut needed = ro.max_hypotheses;
-            let mut sample = [0usize; MIN_POINTS];
-            let (mut sp, mut sb) = ([Vector3::zeros(); MIN_POINTS], [Vector3::zeros(); MIN_POINTS]);
+            let mut sample = [0usize; 3];
+            let mut poses = Vec::with_capacity(4);
             while hypotheses < needed.min(ro.max_hypotheses) {
                 hypotheses += 1;
                 draw(&mut rng, n, &mut sample);
-                for (k, &i) in sample.iter().enumerate() {
-                    sp[k] = points_mm[i];
-                    sb[k] = bearings[i];
-                }
-                if check_layout(&sp, &sb).is_err() {
-                    continue;
-                }
-                let Some(h) = sqpnp(&sp, &sb) else { continue };
-                let (inl, sc) = score(camera, points_mm, pixels_px, &h.rotation, &h.translation_mm, thr2);
-                if sc < best_score {
+                let sp = sample.map(|i| points_mm[i]);
+                let sb = sample.map(|i| bearings[i]);
+                p3p(&sp, &sb, &mut poses);
+                for (hr, ht) in &poses {
+                    let (inl, sc) = score(camera, points_mm, pixels_px, hr, ht, thr2);
+                    if sc >= best_score {
+                        continue;
+                    }
                     // Local optimisation on the consensus set.
-                    let (mut hr, mut ht, mut hin, mut hsc) = (h.rotation, h.translation_mm, inl, sc);
+                    let (mut hr, mut ht, mut hin, mut hsc) = (*hr, *ht, inl, sc);
                     let idx: Vec<usize> = (0..n).filter(|&i| hin[i]).collect();
                     if idx.len() >= MIN_POINTS {
                         if let Some((r1, t1, _)) =
@@ -185,7 +184,7 @@ pub fn solve_pnp(
                     }
                     (r, t, best_in, best_score) = (hr, ht, hin, hsc);
                     let w = best_in.iter().filter(|&&b| b).count() as f64 / n as f64;
-                    let denom = (1.0 - w.powi(MIN_POINTS as i32)).ln();
+                    let denom = (1.0 - w.powi(3)).ln();
                     needed = if denom < 0.0 {
                         ((1.0 - ro.confidence).ln() / denom).ceil().max(1.0) as usize
                     } else {
@@ -373,15 +372,21 @@ fn refine(
         let r1 = *Rotation3::new(w).matrix() * r;
         let t1 = t + Vector3::new(d[3], d[4], d[5]);
         match normal_equations(camera, pts, px, idx, &r1, &t1) {
-            Some((j1, e1, c1)) if c1 <= c => {
-                let small = c - c1 <= 1e-12 * c.max(1e-30) || d.norm() < 1e-12;
-                (r, t, jtj, jte, c) = (r1, t1, j1, e1, c1);
-                lambda = (lambda * 0.1).max(1e-12);
-                if small {
+            Some((j1, e1, c1)) => {
+                // Converged when the cost stops changing (relative 1e-8: a pose change far below the
+                // noise) or the step is negligible.
+                let done = (c - c1).abs() <= 1e-8 * c.max(1e-30) || d.norm() < 1e-10;
+                if c1 <= c {
+                    (r, t, jtj, jte, c) = (r1, t1, j1, e1, c1);
+                    lambda = (lambda * 0.1).max(1e-12);
+                } else {
+                    lambda *= 10.0;
+                }
+                if done || lambda > 1e8 {
                     break;
                 }
             }
-            _ => {
+            None => {
                 lambda *= 10.0;
                 if lambda > 1e8 {
                     break;

@@ -115,10 +115,18 @@ pub fn sqpnp(points_mm: &[Vector3<f64>], bearings: &[Vector3<f64>]) -> Option<Sq
             let r = if em.determinant() < 0.0 { -e } else { e };
             consider(r, best);
         } else {
-            for sign in [1.0, -1.0] {
-                let r0 = nearest_rotation(&(em * sign));
-                consider(run_sqp(&omega, r0), best);
-            }
+            // r and -r give mirrored poses (t = P r flips too): the depths b . (R M + t) change
+            // sign exactly, so only the sign that puts most points in front of their rays can
+            // lead to a valid solution. Run SQP from that one.
+            let t = p * e;
+            let ahead: f64 = points_mm
+                .iter()
+                .zip(bearings)
+                .map(|(m, b)| b.dot(&(em * (*m - c) + t)).signum())
+                .sum();
+            let sign = if ahead >= 0.0 { 1.0 } else { -1.0 };
+            let r0 = nearest_rotation(&(em * sign));
+            consider(run_sqp(&omega, r0), best);
         }
     };
     for i in 0..n_null {

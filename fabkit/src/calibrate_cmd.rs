@@ -1,6 +1,9 @@
 //! `fabkit calibrate ...`: argument parsing and dispatch over fabkit-calibration.
 
 use std::error::Error;
+use std::path::PathBuf;
+
+use fabkit_calibration::{run_extrinsics, ExtrinsicsJob, PointsFrom, RansacOptions};
 
 #[derive(clap::Subcommand, Debug)]
 pub enum CalibrateCommand {
@@ -8,11 +11,86 @@ pub enum CalibrateCommand {
     Extrinsics(ExtrinsicsArgs),
 }
 
+/// Which point of the fixtures point table the pins touch.
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+pub enum PointsFromArg {
+    /// The tip columns (tip_x_mm, ...).
+    Tip,
+    /// The contact columns (contact_x_mm, ...).
+    Contact,
+}
+
 #[derive(clap::Args, Debug)]
-pub struct ExtrinsicsArgs {}
+pub struct ExtrinsicsArgs {
+    /// Camera file: OpenCV FileStorage YAML, ROS camera_info YAML or fabkit JSON.
+    #[arg(long, value_name = "CAM")]
+    pub camera: PathBuf,
+    /// Point table: the one `fabkit fixtures` writes, or a CSV with id,x_mm,y_mm,z_mm (sensor frame, mm).
+    #[arg(long, value_name = "POINTS.csv")]
+    pub points: PathBuf,
+    /// Columns of a fixtures point table to use.
+    #[arg(long, value_enum, default_value = "tip")]
+    pub points_from: PointsFromArg,
+    /// Pixel observations, CSV id,u_px,v_px; several files (one per capture) may be given.
+    #[arg(long, value_name = "OBS.csv", num_args = 1.., required = true)]
+    pub observations: Vec<PathBuf>,
+    /// Output folder for extrinsics.json, extrinsics.yaml (and overlay.png).
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Capture image (PNG) for an overlay of observed and reprojected points.
+    #[arg(long, value_name = "IMG.png")]
+    pub image: Option<PathBuf>,
+    /// RANSAC inlier threshold on the reprojection error, px.
+    #[arg(long, default_value_t = 3.0)]
+    pub ransac_threshold_px: f64,
+    /// Use every observation (no outlier rejection).
+    #[arg(long)]
+    pub no_ransac: bool,
+    /// Seed of the RANSAC sampler.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+}
 
 pub fn run(cmd: CalibrateCommand) -> Result<(), Box<dyn Error>> {
     match cmd {
-        CalibrateCommand::Extrinsics(_) => Err("calibrate extrinsics: not built yet".into()),
+        CalibrateCommand::Extrinsics(a) => extrinsics(a),
     }
+}
+
+fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
+    if !(a.ransac_threshold_px.is_finite() && a.ransac_threshold_px > 0.0) {
+        return Err(format!("--ransac-threshold-px = {}: must be finite and > 0", a.ransac_threshold_px).into());
+    }
+    let job = ExtrinsicsJob {
+        camera: a.camera,
+        points: a.points,
+        points_from: match a.points_from {
+            PointsFromArg::Tip => PointsFrom::Tip,
+            PointsFromArg::Contact => PointsFrom::Contact,
+        },
+        observations: a.observations,
+        out_dir: a.out.clone(),
+        image: a.image,
+        ransac: (!a.no_ransac).then_some(RansacOptions {
+            threshold_px: a.ransac_threshold_px,
+            seed: a.seed,
+            ..Default::default()
+        }),
+        command_line: std::env::args().collect::<Vec<_>>().join(" "),
+    };
+    let r = run_extrinsics(&job)?;
+    let c = r.residuals.camera_centre_in_sensor_mm;
+    println!(
+        "extrinsics: {} of {} points, RMS reprojection error {:.3} px, worst {:.3} px (id {})",
+        r.residuals.inliers, r.residuals.observations, r.rms_reprojection_error_px, r.residuals.worst_px, r.residuals.worst_id
+    );
+    if !r.residuals.outlier_ids.is_empty() {
+        println!("outliers rejected: {}", r.residuals.outlier_ids.join(", "));
+    }
+    println!(
+        "rvec = [{:.6}, {:.6}, {:.6}] rad, tvec_mm = [{:.4}, {:.4}, {:.4}], camera centre in sensor frame = [{:.4}, {:.4}, {:.4}] mm",
+        r.rvec[0], r.rvec[1], r.rvec[2], r.tvec_mm[0], r.tvec_mm[1], r.tvec_mm[2], c[0], c[1], c[2]
+    );
+    println!("wrote {}", a.out.display());
+    Ok(())
 }

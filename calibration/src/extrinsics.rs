@@ -1,0 +1,146 @@
+//! `fabkit calibrate extrinsics` as a library call: read the camera file, the point table and the
+//! observations, solve T_cam_sensor (SQPnP, then Levenberg-Marquardt on the reprojection error,
+//! inside RANSAC), and write `extrinsics.json`, `extrinsics.yaml` and, given a capture image,
+//! `overlay.png`.
+//!
+//! Source: R-Tac0 paper, Sec. IV-A, Eq. (1) and Fig. 5 (pins inserted through a dome at known
+//! coordinates, their pixels recorded, the pose solved by PnP).
+
+use std::path::{Path, PathBuf};
+
+use crate::camera_file::{read_camera_file, CameraFileError};
+use crate::overlay::{read_png_rgb8, render_overlay, OverlayError};
+use crate::pnp::{solve_pnp, PnpError, PnpOptions, RansacOptions};
+use crate::report::{write_atomic, ExtrinsicsReport, Provenance};
+use crate::tables::{pair, read_observations, read_point_table, PointsFrom, TableError};
+
+/// Inputs of one extrinsics calibration.
+#[derive(Debug, Clone)]
+pub struct ExtrinsicsJob {
+    /// Camera file (OpenCV FileStorage YAML, ROS camera_info YAML or fabkit JSON).
+    pub camera: PathBuf,
+    /// Point table (fixtures table or `id,x_mm,y_mm,z_mm`), sensor frame, mm.
+    pub points: PathBuf,
+    pub points_from: PointsFrom,
+    /// Observation files `id,u_px,v_px`.
+    pub observations: Vec<PathBuf>,
+    /// Output folder (created if missing).
+    pub out_dir: PathBuf,
+    /// Capture image for the overlay.
+    pub image: Option<PathBuf>,
+    /// `None`: no outlier rejection.
+    pub ransac: Option<RansacOptions>,
+    /// Recorded in the report's provenance.
+    pub command_line: String,
+}
+
+/// Why an extrinsics calibration failed.
+#[derive(Debug, thiserror::Error)]
+pub enum ExtrinsicsError {
+    #[error(transparent)]
+    Camera(#[from] CameraFileError),
+    #[error(transparent)]
+    Table(#[from] TableError),
+    #[error("{context}: {source}")]
+    Pnp {
+        context: String,
+        #[source]
+        source: PnpError,
+    },
+    #[error(transparent)]
+    Overlay(#[from] OverlayError),
+    #[error("cannot write {path}: {source}")]
+    Write {
+        path: String,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("cannot serialise the report as YAML: {0}")]
+    Yaml(String),
+}
+
+/// Runs the calibration and writes the output folder; returns the report.
+///
+/// # Errors
+/// [`ExtrinsicsError`]: unreadable or invalid inputs (file:line and field), unmatched ids, fewer
+/// than 4 usable points, pixels outside the lens's field, degenerate layouts, points behind the
+/// camera at the solved pose, too few RANSAC inliers, unwritable output. Nothing is written
+/// unless the solve succeeds; each file is written through a temporary sibling and a rename.
+pub fn run_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsReport, ExtrinsicsError> {
+    let camera = read_camera_file(&job.camera)?;
+    let table = read_point_table(&job.points, job.points_from)?;
+    let obs_paths: Vec<&Path> = job.observations.iter().map(PathBuf::as_path).collect();
+    let obs = read_observations(&obs_paths)?;
+    let pairs = pair(&table, &obs)?;
+    let opts = PnpOptions {
+        ransac: job.ransac,
+        ..Default::default()
+    };
+    let sol = solve_pnp(&camera, &pairs.points_mm, &pairs.pixels_px, &opts).map_err(|source| {
+        let at = |index: usize| {
+            let (id, _, origin) = &obs.rows[index];
+            format!("id {id} ({origin})")
+        };
+        let context = match &source {
+            PnpError::NonFinite { index, .. }
+            | PnpError::Unprojectable { index, .. }
+            | PnpError::BehindCamera { index } => at(*index),
+            _ => format!(
+                "{} with {}",
+                table.file,
+                obs_paths.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ")
+            ),
+        };
+        ExtrinsicsError::Pnp { context, source }
+    })?;
+    let fixtures = std::fs::read_to_string(&job.points)
+        .map(|t| t.contains("tip_x_mm"))
+        .unwrap_or(false);
+    let provenance = Provenance {
+        fabkit_version: env!("CARGO_PKG_VERSION").into(),
+        command_line: job.command_line.clone(),
+        camera_file: job.camera.display().to_string(),
+        points_file: job.points.display().to_string(),
+        points_from: match (fixtures, job.points_from) {
+            (false, _) => "xyz".into(),
+            (true, PointsFrom::Tip) => "tip".into(),
+            (true, PointsFrom::Contact) => "contact".into(),
+        },
+        observation_files: obs_paths.iter().map(|p| p.display().to_string()).collect(),
+    };
+    let report = ExtrinsicsReport::new(&camera, &pairs, &sol, job.ransac.map(|r| r.threshold_px), provenance);
+    let json = report.to_json();
+    let yaml = report.to_yaml().map_err(ExtrinsicsError::Yaml)?;
+    let overlay = match &job.image {
+        Some(p) => {
+            let img = read_png_rgb8(p)?;
+            let i = camera.intrinsics();
+            if img.width != i.image_width_px || img.height != i.image_height_px {
+                return Err(OverlayError::Size {
+                    file: p.display().to_string(),
+                    width: img.width,
+                    height: img.height,
+                    cam_width: i.image_width_px,
+                    cam_height: i.image_height_px,
+                }
+                .into());
+            }
+            Some(render_overlay(img, &report)?)
+        }
+        None => None,
+    };
+    let write_err = |path: &Path| {
+        let path = path.display().to_string();
+        move |source| ExtrinsicsError::Write { path, source }
+    };
+    std::fs::create_dir_all(&job.out_dir).map_err(write_err(&job.out_dir))?;
+    let mut files = vec![("extrinsics.json", json.into_bytes()), ("extrinsics.yaml", yaml.into_bytes())];
+    if let Some(o) = overlay {
+        files.push(("overlay.png", o));
+    }
+    for (name, bytes) in files {
+        let path = job.out_dir.join(name);
+        write_atomic(&path, &bytes).map_err(write_err(&path))?;
+    }
+    Ok(report)
+}

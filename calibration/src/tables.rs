@@ -1,0 +1,298 @@
+//! Point tables and pixel observations (CSV).
+//!
+//! Point table: the table `fabkit fixtures` writes (`id,ring,tip_x_mm,tip_y_mm,tip_z_mm,
+//! contact_x_mm,...`; tip columns by default, contact columns on request) or any CSV with
+//! `id,x_mm,y_mm,z_mm`; sensor frame (`docs/conventions.md`), mm. Observations: `id,u_px,v_px`,
+//! px (pixel (0, 0) is the centre of the top-left pixel); several files may split the pins
+//! between captures. Lines starting with `#` and blank lines are skipped. Errors name
+//! file:line, the column, the value and the rule.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use nalgebra::{Vector2, Vector3};
+
+/// A table that cannot be read or paired.
+#[derive(Debug, thiserror::Error)]
+pub enum TableError {
+    #[error("{file}: cannot read: {source}")]
+    Io {
+        file: String,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{file}:{line}: {message}")]
+    Format { file: String, line: usize, message: String },
+    #[error("{file}:{line}: {column} = {value}: {rule}")]
+    Field {
+        file: String,
+        line: usize,
+        column: String,
+        value: String,
+        rule: String,
+    },
+    #[error("id {id} is given twice: {first} and {second}")]
+    Duplicate { id: String, first: String, second: String },
+    #[error("observed ids not in the point table {points}: {}", .ids.join(", "))]
+    UnknownIds { points: String, ids: Vec<String> },
+}
+
+/// Which point of a fixtures table to use.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PointsFrom {
+    /// `tip_*_mm` columns (where the pin tip touches the skin), the default.
+    Tip,
+    /// `contact_*_mm` columns.
+    Contact,
+}
+
+/// A row's source, `file:line`.
+pub type Origin = String;
+
+/// Sensor-frame points by id.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PointTable {
+    pub file: String,
+    /// (id, point mm, origin) in file order.
+    pub rows: Vec<(String, Vector3<f64>, Origin)>,
+}
+
+/// Pixel observations by id.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Observations {
+    /// (id, pixel px, origin) in file order, files in the order given.
+    pub rows: Vec<(String, Vector2<f64>, Origin)>,
+}
+
+/// Points and pixels paired by id, in observation order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Pairs {
+    pub ids: Vec<String>,
+    pub points_mm: Vec<Vector3<f64>>,
+    pub pixels_px: Vec<Vector2<f64>>,
+}
+
+struct Csv<'a> {
+    file: &'a str,
+    header: Vec<String>,
+    header_line: usize,
+    rows: Vec<(usize, Vec<&'a str>)>,
+}
+
+fn parse_csv<'a>(text: &'a str, file: &'a str) -> Result<Csv<'a>, TableError> {
+    let mut header: Option<(usize, Vec<String>)> = None;
+    let mut rows = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        let t = line.trim();
+        if t.is_empty() || t.starts_with('#') {
+            continue;
+        }
+        let cells: Vec<&str> = t.split(',').map(str::trim).collect();
+        match &header {
+            None => header = Some((i + 1, cells.iter().map(|c| c.to_string()).collect())),
+            Some((_, h)) => {
+                if cells.len() != h.len() {
+                    return Err(TableError::Format {
+                        file: file.into(),
+                        line: i + 1,
+                        message: format!("{} cells but the header has {} columns", cells.len(), h.len()),
+                    });
+                }
+                rows.push((i + 1, cells));
+            }
+        }
+    }
+    let (header_line, header) = header.ok_or_else(|| TableError::Format {
+        file: file.into(),
+        line: 1,
+        message: "no header line".into(),
+    })?;
+    Ok(Csv {
+        file,
+        header,
+        header_line,
+        rows,
+    })
+}
+
+impl Csv<'_> {
+    fn column(&self, name: &str, expected: &str) -> Result<usize, TableError> {
+        self.header.iter().position(|h| h == name).ok_or_else(|| TableError::Format {
+            file: self.file.into(),
+            line: self.header_line,
+            message: format!("no column '{name}' in the header (expected {expected})"),
+        })
+    }
+
+    fn number(&self, line: usize, cells: &[&str], col: usize) -> Result<f64, TableError> {
+        let s = cells[col];
+        let v: f64 = s.parse().map_err(|_| TableError::Field {
+            file: self.file.into(),
+            line,
+            column: self.header[col].clone(),
+            value: s.into(),
+            rule: "must be a number".into(),
+        })?;
+        if !v.is_finite() {
+            return Err(TableError::Field {
+                file: self.file.into(),
+                line,
+                column: self.header[col].clone(),
+                value: s.into(),
+                rule: "must be finite".into(),
+            });
+        }
+        Ok(v)
+    }
+
+    fn id(&self, line: usize, cells: &[&str], col: usize) -> Result<String, TableError> {
+        let s = cells[col];
+        if s.is_empty() {
+            return Err(TableError::Field {
+                file: self.file.into(),
+                line,
+                column: "id".into(),
+                value: String::new(),
+                rule: "must not be empty".into(),
+            });
+        }
+        Ok(s.to_string())
+    }
+}
+
+fn read(path: &Path) -> Result<(String, String), TableError> {
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|source| TableError::Io {
+        file: file.clone(),
+        source,
+    })?;
+    Ok((file, text))
+}
+
+/// Reads a point table file. See [`parse_point_table`].
+///
+/// # Errors
+/// [`TableError`] naming file:line and the column.
+pub fn read_point_table(path: &Path, from: PointsFrom) -> Result<PointTable, TableError> {
+    let (file, text) = read(path)?;
+    parse_point_table(&text, &file, from)
+}
+
+/// Parses a point table: the fixtures table (`tip_*_mm` or `contact_*_mm` by `from`) or a plain
+/// `id,x_mm,y_mm,z_mm` CSV (`from` does not apply to it).
+///
+/// # Errors
+/// [`TableError`]: no header or missing columns, a non-numeric or non-finite value, a duplicate id.
+pub fn parse_point_table(text: &str, file: &str, from: PointsFrom) -> Result<PointTable, TableError> {
+    let csv = parse_csv(text, file)?;
+    let expected = "id,x_mm,y_mm,z_mm or the fixtures table's id,ring,tip_x_mm,...";
+    let id = csv.column("id", expected)?;
+    let fixtures = csv.header.iter().any(|h| h == "tip_x_mm" || h == "contact_x_mm");
+    let prefix = match (fixtures, from) {
+        (false, _) => "",
+        (true, PointsFrom::Tip) => "tip_",
+        (true, PointsFrom::Contact) => "contact_",
+    };
+    let cols = [
+        csv.column(&format!("{prefix}x_mm"), expected)?,
+        csv.column(&format!("{prefix}y_mm"), expected)?,
+        csv.column(&format!("{prefix}z_mm"), expected)?,
+    ];
+    let mut rows = Vec::with_capacity(csv.rows.len());
+    let mut seen: BTreeMap<String, usize> = BTreeMap::new();
+    for (line, cells) in &csv.rows {
+        let i = csv.id(*line, cells, id)?;
+        if let Some(first) = seen.insert(i.clone(), *line) {
+            return Err(TableError::Duplicate {
+                id: i,
+                first: format!("{file}:{first}"),
+                second: format!("{file}:{line}"),
+            });
+        }
+        let p = Vector3::new(
+            csv.number(*line, cells, cols[0])?,
+            csv.number(*line, cells, cols[1])?,
+            csv.number(*line, cells, cols[2])?,
+        );
+        rows.push((i, p, format!("{file}:{line}")));
+    }
+    Ok(PointTable {
+        file: file.into(),
+        rows,
+    })
+}
+
+/// Reads observation files (`id,u_px,v_px`), in order. An id may appear once over all files.
+///
+/// # Errors
+/// [`TableError`] naming file:line and the column; a duplicate id names both places.
+pub fn read_observations(paths: &[&Path]) -> Result<Observations, TableError> {
+    let mut texts = Vec::new();
+    for p in paths {
+        texts.push(read(p)?);
+    }
+    let refs: Vec<(&str, &str)> = texts.iter().map(|(f, t)| (t.as_str(), f.as_str())).collect();
+    parse_observations(&refs)
+}
+
+/// Parses observation texts given as (text, file name) pairs. See [`read_observations`].
+///
+/// # Errors
+/// As [`read_observations`].
+pub fn parse_observations(texts: &[(&str, &str)]) -> Result<Observations, TableError> {
+    let mut rows = Vec::new();
+    let mut seen: BTreeMap<String, String> = BTreeMap::new();
+    for (text, file) in texts {
+        let csv = parse_csv(text, file)?;
+        let expected = "id,u_px,v_px";
+        let id = csv.column("id", expected)?;
+        let cu = csv.column("u_px", expected)?;
+        let cv = csv.column("v_px", expected)?;
+        for (line, cells) in &csv.rows {
+            let i = csv.id(*line, cells, id)?;
+            let origin = format!("{file}:{line}");
+            if let Some(first) = seen.insert(i.clone(), origin.clone()) {
+                return Err(TableError::Duplicate {
+                    id: i,
+                    first,
+                    second: origin,
+                });
+            }
+            let uv = Vector2::new(csv.number(*line, cells, cu)?, csv.number(*line, cells, cv)?);
+            rows.push((i, uv, origin));
+        }
+    }
+    Ok(Observations { rows })
+}
+
+/// Pairs observations with the table's points by id (observation order). Points without an
+/// observation are left out.
+///
+/// # Errors
+/// [`TableError::UnknownIds`] listing every observed id that the table does not have.
+pub fn pair(points: &PointTable, obs: &Observations) -> Result<Pairs, TableError> {
+    let by_id: BTreeMap<&str, &Vector3<f64>> = points.rows.iter().map(|(i, p, _)| (i.as_str(), p)).collect();
+    let unknown: Vec<String> = obs
+        .rows
+        .iter()
+        .filter(|(i, _, _)| !by_id.contains_key(i.as_str()))
+        .map(|(i, _, o)| format!("{i} ({o})"))
+        .collect();
+    if !unknown.is_empty() {
+        return Err(TableError::UnknownIds {
+            points: points.file.clone(),
+            ids: unknown,
+        });
+    }
+    let mut pairs = Pairs {
+        ids: Vec::new(),
+        points_mm: Vec::new(),
+        pixels_px: Vec::new(),
+    };
+    for (i, uv, _) in &obs.rows {
+        pairs.ids.push(i.clone());
+        pairs.points_mm.push(*by_id[i.as_str()]);
+        pairs.pixels_px.push(*uv);
+    }
+    Ok(pairs)
+}
