@@ -36,7 +36,7 @@ pub enum PnpError {
     NoSolution,
     #[error("point {index} is behind the camera or outside the lens's field at the solved pose")]
     BehindCamera { index: usize },
-    #[error("RANSAC found {inliers} inliers within {threshold_px} px: at least {needed} are needed")]
+    #[error("RANSAC found {inliers} inliers within {threshold_px} px: at least {needed} are needed (are the ids right?)")]
     TooFewInliers {
         inliers: usize,
         needed: usize,
@@ -56,6 +56,9 @@ pub struct RansacOptions {
     pub max_hypotheses: usize,
     /// Seed of the sampler (same seed and input, same result).
     pub seed: u64,
+    /// Smallest fraction of the points that must be inliers, in (0, 1]; below it the consensus
+    /// is a coincidence (e.g. observations labelled at random) and solving fails.
+    pub min_inlier_fraction: f64,
 }
 
 impl Default for RansacOptions {
@@ -65,6 +68,7 @@ impl Default for RansacOptions {
             confidence: 0.999,
             max_hypotheses: 1000,
             seed: 0,
+            min_inlier_fraction: 0.5,
         }
     }
 }
@@ -215,10 +219,11 @@ pub fn solve_pnp(
         }
         inliers = best_in;
         let count = inliers.iter().filter(|&&b| b).count();
-        if count < MIN_POINTS {
+        let needed = MIN_POINTS.max((ro.min_inlier_fraction * n as f64).ceil() as usize);
+        if count < needed {
             return Err(PnpError::TooFewInliers {
                 inliers: count,
-                needed: MIN_POINTS,
+                needed,
                 threshold_px: ro.threshold_px,
             });
         }
