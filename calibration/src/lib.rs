@@ -16,6 +16,7 @@ pub mod sqpnp;
 pub mod synthetic;
 pub mod tables;
 
+pub use nalgebra;
 pub use camera::{CameraError, CameraModel, Distortion, Intrinsics};
 pub use camera_file::{parse_camera, read_camera_file, write_camera, CameraFileError, CameraFileFormat};
 pub use extrinsics::{run_extrinsics, ExtrinsicsError, ExtrinsicsJob};
