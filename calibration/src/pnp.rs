@@ -152,6 +152,8 @@ pub fn solve_pnp(
     if let Some((r1, t1, _)) = refine(camera, points_mm, pixels_px, &all, r, t, opts.max_iterations) {
         (r, t) = (r1, t1);
     }
+    // The inlier set the current pose was refined on (skip refitting the same set).
+    let mut fitted_on: Option<Vec<bool>> = Some(vec![true; n]);
     let mut hypotheses = 0;
     let mut inliers = vec![true; n];
     if let Some(ro) = &opts.ransac {
@@ -187,6 +189,7 @@ pub fn solve_pnp(
                         }
                     }
                     (r, t, best_in, best_score) = (hr, ht, hin, hsc);
+                    fitted_on = None;
                     let w = best_in.iter().filter(|&&b| b).count() as f64 / n as f64;
                     let denom = (1.0 - w.powi(3)).ln();
                     needed = if denom < 0.0 {
@@ -207,9 +210,13 @@ pub fn solve_pnp(
                     threshold_px: ro.threshold_px,
                 });
             }
+            if fitted_on.as_ref() == Some(&best_in) {
+                break;
+            }
             if let Some((r1, t1, _)) = refine(camera, points_mm, pixels_px, &idx, r, t, opts.max_iterations) {
                 (r, t) = (r1, t1);
             }
+            fitted_on = Some(best_in.clone());
             let (inl, _) = score(camera, points_mm, pixels_px, &r, &t, thr2);
             let same = inl == best_in;
             best_in = inl;
@@ -373,6 +380,12 @@ fn refine(
             continue;
         };
         let d = ch.solve(&(-jte));
+        // Gauss-Newton's predicted decrease: below 1e-9 of the cost the pose is converged far
+        // below the noise; skip evaluating a step that cannot matter.
+        let predicted = -(d.dot(&jte)) - 0.5 * (d.transpose() * jtj * d)[0];
+        if predicted.abs() <= 1e-9 * c.max(1e-30) {
+            break;
+        }
         let w = Vector3::new(d[0], d[1], d[2]);
         let r1 = *Rotation3::new(w).matrix() * r;
         let t1 = t + Vector3::new(d[3], d[4], d[5]);
