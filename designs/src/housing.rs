@@ -80,7 +80,7 @@ pub struct FixtureDowelHoles {
 /// from the two outer faces at the corner, mm.
 const DOWEL_HOLE_DIAMETER_MM: f64 = 2.0;
 const DOWEL_HOLE_DEPTH_MM: f64 = 3.0;
-const DOWEL_INSET_MM: f64 = 2.0;
+const DOWEL_INSET_MM: f64 = 1.8;
 
 /// Where the fixture dowel holes of a housing are.
 pub fn fixture_dowel_holes(h: &HousingParams) -> FixtureDowelHoles {

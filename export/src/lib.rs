@@ -27,7 +27,7 @@ mod three_mf;
 pub use check::check_printable_mesh;
 pub use error::ExportError;
 pub use manifest::{
-    Manifest, ManifestDesign, ManifestKit3mf, ManifestObject, ManifestPart, ManifestVolume, FRAME,
+    Manifest, ManifestDataFile, ManifestDesign, ManifestKit3mf, ManifestObject, ManifestPart, ManifestVolume, FRAME,
 };
 
 use fabkit_designs::geometry::{Mesh, TopologyError};
@@ -114,12 +114,41 @@ pub fn write_kit(
     out_dir: &Path,
     opts: &ExportOptions,
 ) -> Result<ExportSummary, ExportError> {
+    write_kit_with_files(kit, &[], out_dir, opts)
+}
+
+/// [`write_kit`] plus data files (relative `/`-separated path, bytes) written beside the meshes
+/// and listed with their sha256 in the manifest's `data_files` (point tables, geometry
+/// descriptions). Same atomicity and errors as [`write_kit`]; a data file path must be
+/// relative, made of `[A-Za-z0-9_.-]` components, and must not collide with another file.
+pub fn write_kit_with_files(
+    kit: &Kit,
+    data_files: &[(String, Vec<u8>)],
+    out_dir: &Path,
+    opts: &ExportOptions,
+) -> Result<ExportSummary, ExportError> {
+    for (rel, _) in data_files {
+        let ok = !rel.is_empty()
+            && rel.split('/').all(|c| {
+                !c.is_empty()
+                    && c != "."
+                    && c != ".."
+                    && c.chars().all(|ch| ch.is_ascii_alphanumeric() || "_.-".contains(ch))
+            });
+        if !ok {
+            return Err(ExportError::InvalidOption {
+                field: "data_files",
+                value: rel.clone(),
+                rule: "must be a relative path of [A-Za-z0-9_.-] components",
+            });
+        }
+    }
     let meshes: Vec<Mesh> = kit
         .parts
         .iter()
         .map(|p| p.solid.mesh().rounded_to_f32())
         .collect();
-    write_kit_meshes(kit, &meshes, out_dir, opts)
+    write_kit_meshes(kit, &meshes, data_files, out_dir, opts)
 }
 
 /// [`write_kit`] with the written meshes given (one per part, in kit order), so that tests can
@@ -127,6 +156,7 @@ pub fn write_kit(
 fn write_kit_meshes(
     kit: &Kit,
     meshes: &[Mesh],
+    data_files: &[(String, Vec<u8>)],
     out_dir: &Path,
     opts: &ExportOptions,
 ) -> Result<ExportSummary, ExportError> {
@@ -135,14 +165,20 @@ fn write_kit_meshes(
     for (part, mesh) in kit.parts.iter().zip(meshes) {
         check_printable_mesh(&part.name, mesh)?;
     }
-    let rendered = render(kit, meshes, opts)?;
+    let rendered = render(kit, meshes, data_files, opts)?;
     let done = atomic::replace_dir(out_dir, |tmp| {
         if opts.formats.stl {
             let parts_dir = tmp.join(PARTS_DIR);
             std::fs::create_dir(&parts_dir).map_err(ExportError::io("creating", &parts_dir))?;
         }
         for (rel, bytes) in &rendered.files {
-            atomic::write_file_synced(&join_rel(tmp, rel), bytes)?;
+            let path = join_rel(tmp, rel);
+            if let Some(parent) = path.parent() {
+                if parent != tmp && !parent.exists() {
+                    std::fs::create_dir_all(parent).map_err(ExportError::io("creating", parent))?;
+                }
+            }
+            atomic::write_file_synced(&path, bytes)?;
         }
         if opts.formats.stl {
             atomic::sync_dir(&tmp.join(PARTS_DIR))?;
@@ -170,7 +206,12 @@ struct Rendered {
     manifest: Manifest,
 }
 
-fn render(kit: &Kit, meshes: &[Mesh], opts: &ExportOptions) -> Result<Rendered, ExportError> {
+fn render(
+    kit: &Kit,
+    meshes: &[Mesh],
+    data_files: &[(String, Vec<u8>)],
+    opts: &ExportOptions,
+) -> Result<Rendered, ExportError> {
     let mut files = Vec::new();
     let mut parts = Vec::with_capacity(kit.parts.len());
     for (part, mesh) in kit.parts.iter().zip(meshes) {
@@ -306,7 +347,24 @@ fn render(kit: &Kit, meshes: &[Mesh], opts: &ExportOptions) -> Result<Rendered, 
         casts: kit.casts.clone(),
         bought_items: kit.bought_items.clone(),
         summary: kit.summary.clone(),
+        data_files: data_files
+            .iter()
+            .map(|(rel, bytes)| ManifestDataFile {
+                file: rel.clone(),
+                sha256: sha256_hex(bytes),
+            })
+            .collect(),
     };
+    for (rel, bytes) in data_files {
+        if files.iter().any(|(f, _)| f == rel) || rel == "manifest.json" || rel == "FABRICATION.md" {
+            return Err(ExportError::InvalidOption {
+                field: "data_files",
+                value: rel.clone(),
+                rule: "collides with another file of the export",
+            });
+        }
+        files.push((rel.clone(), bytes.clone()));
+    }
     let mut json = serde_json::to_vec_pretty(&manifest)?;
     json.push(b'\n');
     files.push(("manifest.json".to_owned(), json));
@@ -376,7 +434,7 @@ mod tests {
             .map(|p| p.solid.mesh().rounded_to_f32())
             .collect();
         meshes[1].triangles.pop();
-        let err = write_kit_meshes(&k, &meshes, &out, &opts()).unwrap_err();
+        let err = write_kit_meshes(&k, &meshes, &[], &out, &opts()).unwrap_err();
         assert!(
             matches!(err, ExportError::NotManifold { ref part, .. } if part == "lid"),
             "{err}"
@@ -402,7 +460,7 @@ mod tests {
             .map(|p| p.solid.mesh().rounded_to_f32())
             .collect();
         meshes[0].triangles[0].swap(1, 2);
-        assert!(write_kit_meshes(&k, &meshes, &out, &opts()).is_err());
+        assert!(write_kit_meshes(&k, &meshes, &[], &out, &opts()).is_err());
         let after: Vec<Vec<u8>> = first
             .files
             .iter()

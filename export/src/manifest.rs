@@ -34,6 +34,17 @@ pub struct Manifest {
     pub bought_items: Vec<String>,
     /// Sensor-frame facts from the design build (envelope, derived radii, ...).
     pub summary: serde_json::Value,
+    /// Data files written beside the meshes (point tables, geometry descriptions), in order.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub data_files: Vec<ManifestDataFile>,
+}
+
+/// A data file of the export and its hash.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ManifestDataFile {
+    /// Path relative to the export directory, `/`-separated.
+    pub file: String,
+    pub sha256: String,
 }
 
 /// Where the design came from.

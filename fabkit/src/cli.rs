@@ -79,7 +79,7 @@ struct ExportArgs {
 }
 
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq)]
-enum Format {
+pub(crate) enum Format {
     Stl,
     #[value(name = "3mf")]
     ThreeMf,
@@ -115,13 +115,13 @@ pub fn main() -> i32 {
 }
 
 /// A design and where it came from.
-struct Loaded {
-    design: Design,
-    source: String,
-    sha256: String,
+pub(crate) struct Loaded {
+    pub(crate) design: Design,
+    pub(crate) source: String,
+    pub(crate) sha256: String,
 }
 
-fn load_design(arg: Option<&str>) -> Result<Loaded, DesignError> {
+pub(crate) fn load_design(arg: Option<&str>) -> Result<Loaded, DesignError> {
     let arg = arg.unwrap_or(library::DEFAULT_DESIGN);
     let path = Path::new(arg);
     let looks_like_file =
@@ -163,7 +163,7 @@ fn hex(b: &[u8]) -> String {
     b.iter().map(|x| format!("{x:02x}")).collect()
 }
 
-fn tolerance(mm: f64) -> Result<ChordTolerance, Box<dyn Error>> {
+pub(crate) fn tolerance(mm: f64) -> Result<ChordTolerance, Box<dyn Error>> {
     ChordTolerance::new(mm).map_err(|e| format!("--chord-tolerance-mm: {e}").into())
 }
 

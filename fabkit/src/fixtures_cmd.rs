@@ -1,10 +1,135 @@
 //! `fabkit fixtures`: argument parsing and dispatch over fabkit-fixtures.
 
+use crate::cli::{load_design, tolerance, Format};
+use fabkit_designs::ChordTolerance;
+use fabkit_export::{write_kit_with_files, ExportOptions, Formats};
+use fabkit_fixtures::params::{apply_pin_preset, from_yaml, FixtureParams};
 use std::error::Error;
+use std::io::Write;
+use std::path::{Path, PathBuf};
 
 #[derive(clap::Args, Debug)]
-pub struct FixturesArgs {}
+pub struct FixturesArgs {
+    /// A design YAML file or the name of a library design (default: rtac0).
+    design: Option<String>,
+    /// Output directory (default: out/<design>_fixtures). Replaced as a whole if it holds a
+    /// previous export; refused if it holds anything else.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Fixture parameters (YAML: pin_dome, semidomes, indenters); defaults where absent.
+    #[arg(long)]
+    params: Option<PathBuf>,
+    /// Replace the pin dome with an embedded preset (rtac0: the published R-Tac0 fixture).
+    #[arg(long)]
+    pins_preset: Option<String>,
+    /// Generate N protrusion semi-dome patterns (in addition to those in --params).
+    #[arg(long)]
+    semidomes: Option<u32>,
+    /// Seed of the pattern generator.
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Apply one of the design's presets.
+    #[arg(long)]
+    preset: Option<String>,
+    /// Mesh formats, comma separated.
+    #[arg(long, value_delimiter = ',', default_value = "stl,3mf")]
+    format: Vec<Format>,
+    /// Largest distance between a facet and the true surface, mm.
+    #[arg(long, default_value_t = ChordTolerance::DEFAULT_MM)]
+    chord_tolerance_mm: f64,
+}
 
-pub fn run(_args: FixturesArgs) -> Result<(), Box<dyn Error>> {
-    Err("fixtures: not built yet".into())
+macro_rules! out {
+    ($($arg:tt)*) => {{
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
+}
+
+pub fn run(args: FixturesArgs) -> Result<(), Box<dyn Error>> {
+    let tol = tolerance(args.chord_tolerance_mm)?;
+    let mut loaded = load_design(args.design.as_deref())?;
+    if let Some(p) = &args.preset {
+        loaded.design = loaded.design.with_preset(p)?;
+    }
+    let mut params = match &args.params {
+        Some(path) => {
+            let text = std::fs::read_to_string(path).map_err(|e| format!("reading {}: {e}", path.display()))?;
+            from_yaml(&text, &path.display().to_string())?
+        }
+        None => FixtureParams::default(),
+    };
+    if let Some(name) = &args.pins_preset {
+        apply_pin_preset(&mut params, name)?;
+    }
+    if let Some(n) = args.semidomes {
+        params.semidomes.generate = n;
+    }
+    if let Some(s) = args.seed {
+        params.semidomes.seed = s;
+    }
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| Path::new("out").join(format!("{}_fixtures", loaded.design.name)));
+    let provenance = format!(
+        "fabkit {}, design {} ({}, sha256 {})",
+        env!("CARGO_PKG_VERSION"),
+        loaded.design.name,
+        loaded.source,
+        loaded.sha256
+    );
+    let spinner = indicatif::ProgressBar::new_spinner();
+    spinner.set_message(format!("building the fixtures of {}", loaded.design.name));
+    spinner.enable_steady_tick(std::time::Duration::from_millis(120));
+    let t0 = std::time::Instant::now();
+    let set = fabkit_fixtures::build_fixtures(&loaded.design, &params, tol, &provenance);
+    spinner.finish_and_clear();
+    let set = set?;
+    let opts = ExportOptions {
+        formats: Formats {
+            stl: args.format.contains(&Format::Stl),
+            threemf: args.format.contains(&Format::ThreeMf),
+        },
+        command_line: std::env::args().collect(),
+        design_source: loaded.source.clone(),
+        design_sha256: loaded.sha256.clone(),
+        chord_tolerance_mm: tol.mm(),
+        fabkit_version: env!("CARGO_PKG_VERSION").to_string(),
+    };
+    let summary = write_kit_with_files(&set.kit, &set.files, &out, &opts)?;
+    for w in &summary.warnings {
+        eprintln!("warning: {w}");
+    }
+    out!(
+        "{}: {} parts, {} data files -> {} ({:.2} s)",
+        set.kit.design,
+        set.kit.parts.len(),
+        set.files.len(),
+        out.display(),
+        t0.elapsed().as_secs_f64()
+    );
+    let d = &set.pin_dome;
+    out!(
+        "  pin dome: {} holes in {} captures; pins {:.3} mm (head to tip), seat {:?}, indentation {:.3} mm",
+        d.table.len(),
+        d.capture_plan.len(),
+        d.pin_length_mm,
+        d.seat,
+        d.table.first().map(|r| r.indentation_depth_mm).unwrap_or(0.0)
+    );
+    for n in &d.notes {
+        out!("  note: {n}");
+    }
+    let n = set.semidomes.halves.len();
+    out!("  semi-domes: {n} patterns + the empty half -> {} stitched pairs", n * n);
+    for p in &summary.manifest.parts {
+        out!(
+            "  {:34} {:4} {:>10.1} mm3  {}",
+            p.name,
+            p.print_technology.to_string(),
+            p.volume_mm3,
+            p.file.as_deref().unwrap_or("(3MF only)")
+        );
+    }
+    Ok(())
 }

@@ -1,0 +1,137 @@
+//! `fabkit fixtures` end to end: files, point table, protrusion descriptions, determinism,
+//! oracle check and printcheck of every part, and bad parameters.
+
+mod common;
+use common::*;
+use std::path::{Path, PathBuf};
+
+fn files_under(dir: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else {
+                out.push(p);
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+fn fixtures(cwd: &Path, out: &str, threads: &str) -> std::process::Output {
+    run(
+        cwd,
+        &["fixtures", "rtac0", "--pins-preset", "rtac0", "--semidomes", "2", "--seed", "3", "--out", out],
+        &[("RAYON_NUM_THREADS", threads)],
+    )
+}
+
+/// The R-Tac0 fixtures: 29-point table (CSV = JSON), capture plan, protrusion descriptions for
+/// both orientations, manifest hashes; byte-identical with 1 and 2 threads; every part passes
+/// the oracle check and printcheck --strict.
+#[test]
+fn rtac0_fixtures_export_is_complete_deterministic_and_printable() {
+    // Same command line (it is recorded in the files) in two folders, 1 and 2 threads.
+    let (t1, t2) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    let o = fixtures(t1.path(), "fx", "1");
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let o2 = fixtures(t2.path(), "fx", "2");
+    assert!(o2.status.success(), "{}", text(&o2.stderr));
+    let (a, b) = (t1.path().join("fx"), t2.path().join("fx"));
+    let fa = files_under(&a);
+    assert_eq!(fa.len(), files_under(&b).len());
+    for f in &fa {
+        let rel = f.strip_prefix(&a).unwrap();
+        assert!(std::fs::read(f).unwrap() == std::fs::read(b.join(rel)).unwrap(), "{} differs between runs", rel.display());
+    }
+
+    // Point table: CSV with # header lines, 29 rows, ids 1..29, the same numbers as the JSON.
+    let csv = std::fs::read_to_string(a.join("points/point_table.csv")).unwrap();
+    assert!(csv.starts_with("# "));
+    assert!(csv.contains("frame: sensor frame"));
+    let rows: Vec<Vec<f64>> = csv
+        .lines()
+        .filter(|l| !l.starts_with('#') && !l.starts_with("id,"))
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 29);
+    let json: serde_json::Value = serde_json::from_slice(&std::fs::read(a.join("points/point_table.json")).unwrap()).unwrap();
+    let pts = json["points"].as_array().unwrap();
+    for (r, p) in rows.iter().zip(pts) {
+        assert_eq!(r[0] as u64, p["id"].as_u64().unwrap());
+        for k in 0..3 {
+            assert!((r[2 + k] - p["tip_mm"][k].as_f64().unwrap()).abs() < 1e-8);
+        }
+        // the tip lies on the axis through the contact point, indentation below it
+        let depth = r[11];
+        for k in 0..3 {
+            assert!((r[5 + k] - depth * r[8 + k] - r[2 + k]).abs() < 1e-8);
+        }
+    }
+    let plan = std::fs::read_to_string(a.join("points/capture_plan.csv")).unwrap();
+    assert_eq!(plan.lines().filter(|l| !l.starts_with('#') && !l.starts_with("capture")).count(), 8 * 5);
+
+    // Protrusions: orientation 180 is orientation 0 turned about z.
+    let idx: serde_json::Value = serde_json::from_slice(&std::fs::read(a.join("protrusions/index.json")).unwrap()).unwrap();
+    assert_eq!(idx["stitched_pairs"], 4);
+    for p in idx["patterns"].as_array().unwrap() {
+        let d: serde_json::Value = serde_json::from_slice(&std::fs::read(a.join(p["file"].as_str().unwrap())).unwrap()).unwrap();
+        let g0 = &d["orientations"][0]["geometry"]["primitives"];
+        let g180 = &d["orientations"][1]["geometry"]["primitives"];
+        assert!(!g0.as_array().unwrap().is_empty());
+        for (x, y) in g0.as_array().unwrap().iter().zip(g180.as_array().unwrap()) {
+            for (key, v) in x.as_object().unwrap() {
+                let is_point = ["centre_mm", "base_mm", "top_mm", "apex_mm", "p0_mm", "p1_mm", "origin_mm"].contains(&key.as_str());
+                if is_point {
+                    let (p0, p1) = (v.as_array().unwrap(), y[key].as_array().unwrap());
+                    assert!((p0[0].as_f64().unwrap() + p1[0].as_f64().unwrap()).abs() < 1e-9);
+                    assert!((p0[1].as_f64().unwrap() + p1[1].as_f64().unwrap()).abs() < 1e-9);
+                    assert!((p0[2].as_f64().unwrap() - p1[2].as_f64().unwrap()).abs() < 1e-9);
+                }
+            }
+        }
+    }
+
+    // The manifest lists every data file with its hash.
+    let m: serde_json::Value = serde_json::from_slice(&std::fs::read(a.join("manifest.json")).unwrap()).unwrap();
+    let data = m["data_files"].as_array().unwrap();
+    assert!(data.len() >= 3 + 3 + 6);
+    for d in data {
+        use sha2::Digest;
+        let bytes = std::fs::read(a.join(d["file"].as_str().unwrap())).unwrap();
+        let sha: String = sha2::Sha256::digest(&bytes).iter().map(|b| format!("{b:02x}")).collect();
+        assert_eq!(d["sha256"], sha.as_str());
+    }
+
+    oracle_check(&a);
+    let meshes: Vec<PathBuf> = fa.into_iter().filter(|f| f.extension().is_some_and(|e| e == "stl" || e == "3mf")).collect();
+    assert_eq!(meshes.len(), 2 + 4 + 6 + 1);
+    printcheck_all(&meshes);
+}
+
+/// Bad fixture parameters: an error naming the parameter and the rule, exit 2, nothing written;
+/// a YAML mistake names file:line:col.
+#[test]
+fn bad_fixture_parameters_name_the_parameter_and_write_nothing() {
+    let tmp = tempfile::tempdir().unwrap();
+    let cases = [
+        ("pin_dome:\n  rings:\n    - {polar_angle_deg: 20, count: 16}\n", "pin_dome.rings[0].count"),
+        ("pin_dome:\n  clearance_mm: -1\n", "pin_dome.clearance_mm"),
+        ("pin_dome:\n  pin:\n    length_mm: 2.0\n", "pin_dome.pin.length_mm"),
+        ("semidomes:\n  patterns:\n    - name: edge\n      protrusions:\n        - {polar_angle_deg: 40, azimuth_deg: 88, indentation_depth_mm: 1, shape: {type: sphere, radius_mm: 2}}\n", "semidomes.patterns[0].protrusions[0].azimuth_deg"),
+        ("pin_dome:\n  wall_thicknes_mm: 2\n", "params.yaml:2:"),
+    ];
+    for (yaml, expect) in cases {
+        let f = tmp.path().join("params.yaml");
+        std::fs::write(&f, yaml).unwrap();
+        let o = run(tmp.path(), &["fixtures", "rtac0", "--params", "params.yaml", "--out", "never"], &[]);
+        assert_eq!(o.status.code(), Some(2), "{yaml}");
+        let err = text(&o.stderr);
+        assert!(err.contains(expect), "{yaml}: {err}");
+        assert!(!tmp.path().join("never").exists());
+    }
+}
