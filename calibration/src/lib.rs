@@ -5,6 +5,9 @@
 //! intrinsics and distortion from a checkerboard (OpenCV), then the extrinsics `[R | T]`
 //! (here `T_cam_sensor`) from pin-dome points and their pixels by PnP.
 
+// Negated comparisons (`!(x > 0.0)`) are deliberate: they also reject NaN.
+#![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)]
+
 pub mod camera;
 pub mod camera_file;
 pub mod extrinsics;
