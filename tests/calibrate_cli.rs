@@ -36,7 +36,10 @@ fn pins() -> Vec<(usize, Vector3<f64>, Vector3<f64>)> {
     let mut out = Vec::new();
     for (polar, n) in rings {
         for k in 0..n {
-            let (p, a) = (f64::to_radians(polar), 2.0 * std::f64::consts::PI * k as f64 / n as f64);
+            let (p, a) = (
+                f64::to_radians(polar),
+                2.0 * std::f64::consts::PI * k as f64 / n as f64,
+            );
             let dir = Vector3::new(p.sin() * a.cos(), p.sin() * a.sin(), p.cos());
             out.push((out.len(), 16.65 * dir, 16.15 * dir));
         }
@@ -47,9 +50,15 @@ fn pins() -> Vec<(usize, Vector3<f64>, Vector3<f64>)> {
 fn write_table(path: &Path) {
     let mut s = String::from("# fabkit fixtures point table (synthetic, for the calibrate test)\n# frame: sensor (docs/conventions.md), mm\nid,ring,tip_x_mm,tip_y_mm,tip_z_mm,contact_x_mm,contact_y_mm,contact_z_mm,axis_x,axis_y,axis_z,indentation_depth_mm\n");
     for (id, tip, c) in pins() {
-        let ring = [0, 1, 1, 1, 1, 2, 2, 2, 2, 2, 2][..].get(id).copied().unwrap_or(3);
+        let ring = [0, 1, 1, 1, 1, 2, 2, 2, 2, 2, 2][..]
+            .get(id)
+            .copied()
+            .unwrap_or(3);
         let ax = tip.normalize();
-        s.push_str(&format!("{id},{ring},{},{},{},{},{},{},{},{},{},0.5\n", tip.x, tip.y, tip.z, c.x, c.y, c.z, ax.x, ax.y, ax.z));
+        s.push_str(&format!(
+            "{id},{ring},{},{},{},{},{},{},{},{},{},0.5\n",
+            tip.x, tip.y, tip.z, c.x, c.y, c.z, ax.x, ax.y, ax.z
+        ));
     }
     std::fs::write(path, s).unwrap();
 }
@@ -73,26 +82,57 @@ fn json(path: &Path) -> serde_json::Value {
 }
 
 fn pose_of(j: &serde_json::Value) -> Isometry3<f64> {
-    let r: Vec<f64> = j["rvec"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
-    let t: Vec<f64> = j["tvec_mm"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
-    Isometry3::from_parts(Translation3::new(t[0], t[1], t[2]), UnitQuaternion::from_scaled_axis(Vector3::new(r[0], r[1], r[2])))
+    let r: Vec<f64> = j["rvec"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    let t: Vec<f64> = j["tvec_mm"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    Isometry3::from_parts(
+        Translation3::new(t[0], t[1], t[2]),
+        UnitQuaternion::from_scaled_axis(Vector3::new(r[0], r[1], r[2])),
+    )
 }
 
 #[test]
 fn extrinsics_from_a_synthetic_capture_recover_the_pose_and_write_the_report() {
     let d = tempfile::tempdir().unwrap();
     let dir = d.path();
-    std::fs::write(dir.join("cam.yaml"), write_camera(&intrinsics(), CameraFileFormat::OpenCvYaml)).unwrap();
+    std::fs::write(
+        dir.join("cam.yaml"),
+        write_camera(&intrinsics(), CameraFileFormat::OpenCvYaml),
+    )
+    .unwrap();
     write_table(&dir.join("pins.csv"));
     std::fs::write(dir.join("obs.csv"), observe(false, 0..29)).unwrap();
-    let args = ["calibrate", "extrinsics", "--camera", "cam.yaml", "--points", "pins.csv", "--observations", "obs.csv", "--out", "out"];
+    let args = [
+        "calibrate",
+        "extrinsics",
+        "--camera",
+        "cam.yaml",
+        "--points",
+        "pins.csv",
+        "--observations",
+        "obs.csv",
+        "--out",
+        "out",
+    ];
     let o = run(dir, &args, &[]);
     assert!(o.status.success(), "{}{}", text(&o.stdout), text(&o.stderr));
     let j = json(&dir.join("out/extrinsics.json"));
     let pose = pose_of(&j);
     let rot_err = pose.rotation.angle_to(&truth().rotation).to_degrees();
     let t_err = (pose.translation.vector - truth().translation.vector).norm();
-    assert!(rot_err < 0.1 && t_err < 0.03, "rotation {rot_err} deg, translation {t_err} mm");
+    assert!(
+        rot_err < 0.1 && t_err < 0.03,
+        "rotation {rot_err} deg, translation {t_err} mm"
+    );
     // T_cam_sensor agrees with rvec/tvec; the camera centre is the inverse translation.
     let m = &j["T_cam_sensor"];
     let h = pose.to_homogeneous();
@@ -103,7 +143,10 @@ fn extrinsics_from_a_synthetic_capture_recover_the_pose_and_write_the_report() {
     }
     let c = pose.inverse() * Point3::origin();
     let jc = &j["residuals"]["camera_centre_in_sensor_mm"];
-    assert!((jc[2].as_f64().unwrap() - c.z).abs() < 1e-9 && c.z < -9.0, "{jc}");
+    assert!(
+        (jc[2].as_f64().unwrap() - c.z).abs() < 1e-9 && c.z < -9.0,
+        "{jc}"
+    );
     // The residuals are the injected +-0.3 px pattern (|e| = 0.335 px), all inliers.
     let rms = j["rms_reprojection_error_px"].as_f64().unwrap();
     assert!((0.2..0.4).contains(&rms), "rms {rms}");
@@ -112,19 +155,29 @@ fn extrinsics_from_a_synthetic_capture_recover_the_pose_and_write_the_report() {
     assert_eq!(j["provenance"]["points_from"], "tip");
     // The YAML twin holds the same numbers.
     let yaml = std::fs::read_to_string(dir.join("out/extrinsics.yaml")).unwrap();
-    assert!(yaml.contains("rms_reprojection_error_px: ") && yaml.contains("T_cam_sensor:"), "{yaml}");
+    assert!(
+        yaml.contains("rms_reprojection_error_px: ") && yaml.contains("T_cam_sensor:"),
+        "{yaml}"
+    );
     // Same input, same bytes.
     let first = std::fs::read(dir.join("out/extrinsics.json")).unwrap();
     let o = run(dir, &args, &[]);
     assert!(o.status.success());
-    assert_eq!(std::fs::read(dir.join("out/extrinsics.json")).unwrap(), first);
+    assert_eq!(
+        std::fs::read(dir.join("out/extrinsics.json")).unwrap(),
+        first
+    );
 }
 
 #[test]
 fn contact_columns_two_capture_files_a_swapped_pair_and_the_overlay() {
     let d = tempfile::tempdir().unwrap();
     let dir = d.path();
-    std::fs::write(dir.join("cam.json"), write_camera(&intrinsics(), CameraFileFormat::Json)).unwrap();
+    std::fs::write(
+        dir.join("cam.json"),
+        write_camera(&intrinsics(), CameraFileFormat::Json),
+    )
+    .unwrap();
     write_table(&dir.join("pins.csv"));
     // Two captures; pins 3 and 20 have their labels swapped in the second.
     std::fs::write(dir.join("a.csv"), observe(true, 0..15)).unwrap();
@@ -133,27 +186,60 @@ fn contact_columns_two_capture_files_a_swapped_pair_and_the_overlay() {
     let row3 = l3.lines().nth(1).unwrap().replacen("3,", "20,", 1);
     let row20 = l20.lines().nth(1).unwrap().replacen("20,", "3,", 1);
     let a = observe(true, (0..15).filter(|&i| i != 3)) + &row20 + "\n";
-    let b = b.lines().filter(|l| !l.starts_with("20,")).collect::<Vec<_>>().join("\n") + "\n" + &row3 + "\n";
+    let b = b
+        .lines()
+        .filter(|l| !l.starts_with("20,"))
+        .collect::<Vec<_>>()
+        .join("\n")
+        + "\n"
+        + &row3
+        + "\n";
     std::fs::write(dir.join("a.csv"), a).unwrap();
     std::fs::write(dir.join("b.csv"), b).unwrap();
     let img = vec![90u8; 640 * 480];
     std::fs::write(dir.join("img.png"), encode_gray8(640, 480, &img).unwrap()).unwrap();
     let o = run(
         dir,
-        &["calibrate", "extrinsics", "--camera", "cam.json", "--points", "pins.csv", "--points-from", "contact",
-          "--observations", "a.csv", "b.csv", "--out", "out", "--image", "img.png"],
+        &[
+            "calibrate",
+            "extrinsics",
+            "--camera",
+            "cam.json",
+            "--points",
+            "pins.csv",
+            "--points-from",
+            "contact",
+            "--observations",
+            "a.csv",
+            "b.csv",
+            "--out",
+            "out",
+            "--image",
+            "img.png",
+        ],
         &[],
     );
     assert!(o.status.success(), "{}{}", text(&o.stdout), text(&o.stderr));
-    assert!(text(&o.stdout).contains("outliers rejected: 3, 20"), "{}", text(&o.stdout));
+    assert!(
+        text(&o.stdout).contains("outliers rejected: 3, 20"),
+        "{}",
+        text(&o.stdout)
+    );
     let j = json(&dir.join("out/extrinsics.json"));
     let pose = pose_of(&j);
     assert!(pose.rotation.angle_to(&truth().rotation).to_degrees() < 0.1);
-    assert_eq!(j["residuals"]["outlier_ids"], serde_json::json!(["3", "20"]));
+    assert_eq!(
+        j["residuals"]["outlier_ids"],
+        serde_json::json!(["3", "20"])
+    );
     assert_eq!(j["provenance"]["points_from"], "contact");
     let ov = read_png_rgb8(&dir.join("out/overlay.png")).unwrap();
     assert_eq!((ov.width, ov.height), (640, 480));
-    let coloured = ov.data.chunks(3).filter(|p| p[0] != p[1] || p[1] != p[2]).count();
+    let coloured = ov
+        .data
+        .chunks(3)
+        .filter(|p| p[0] != p[1] || p[1] != p[2])
+        .count();
     assert!(coloured > 29 * 10, "{coloured} drawn pixels");
 }
 
@@ -161,26 +247,87 @@ fn contact_columns_two_capture_files_a_swapped_pair_and_the_overlay() {
 fn bad_inputs_exit_2_with_file_line_and_write_nothing() {
     let d = tempfile::tempdir().unwrap();
     let dir = d.path();
-    std::fs::write(dir.join("cam.yaml"), write_camera(&intrinsics(), CameraFileFormat::OpenCvYaml)).unwrap();
+    std::fs::write(
+        dir.join("cam.yaml"),
+        write_camera(&intrinsics(), CameraFileFormat::OpenCvYaml),
+    )
+    .unwrap();
     write_table(&dir.join("pins.csv"));
     let cases: Vec<(&str, String, &str)> = vec![
-        ("nan", observe(false, 0..29).replacen("\n0,", "\n0,NaN,1\n#", 1), "obs.csv:2: u_px = NaN: must be finite"),
-        ("unknown id", observe(false, 0..29) + "99,1,1\n", "observed ids not in the point table pins.csv: 99 (obs.csv:31)"),
-        ("too few", observe(false, 0..3), "3 usable point-pixel pairs: PnP needs at least 4"),
-        ("outside the lens", observe(false, 0..29).replacen("\n5,", "\n5,9000,9000\n#", 1), "id 5 (obs.csv:7): point 5: pixel (9000, 9000): outside the lens's field"),
+        (
+            "nan",
+            observe(false, 0..29).replacen("\n0,", "\n0,NaN,1\n#", 1),
+            "obs.csv:2: u_px = NaN: must be finite",
+        ),
+        (
+            "unknown id",
+            observe(false, 0..29) + "99,1,1\n",
+            "observed ids not in the point table pins.csv: 99 (obs.csv:31)",
+        ),
+        (
+            "too few",
+            observe(false, 0..3),
+            "3 usable point-pixel pairs: PnP needs at least 4",
+        ),
+        (
+            "outside the lens",
+            observe(false, 0..29).replacen("\n5,", "\n5,9000,9000\n#", 1),
+            "id 5 (obs.csv:7): point 5: pixel (9000, 9000): outside the lens's field",
+        ),
     ];
     for (what, obs, expect) in cases {
         std::fs::write(dir.join("obs.csv"), obs).unwrap();
-        let o = run(dir, &["calibrate", "extrinsics", "--camera", "cam.yaml", "--points", "pins.csv", "--observations", "obs.csv", "--out", "out"], &[]);
+        let o = run(
+            dir,
+            &[
+                "calibrate",
+                "extrinsics",
+                "--camera",
+                "cam.yaml",
+                "--points",
+                "pins.csv",
+                "--observations",
+                "obs.csv",
+                "--out",
+                "out",
+            ],
+            &[],
+        );
         assert_eq!(o.status.code(), Some(2), "{what}: {}", text(&o.stderr));
-        assert!(text(&o.stderr).contains(expect), "{what}: {}", text(&o.stderr));
+        assert!(
+            text(&o.stderr).contains(expect),
+            "{what}: {}",
+            text(&o.stderr)
+        );
         assert!(!dir.join("out").exists(), "{what}: output written");
     }
     // A camera file error names file:line and field.
     std::fs::write(dir.join("obs.csv"), observe(false, 0..29)).unwrap();
-    let bad = write_camera(&intrinsics(), CameraFileFormat::OpenCvYaml).replace("distortion_model: fisheye", "distortion_model: rational_polynomial");
+    let bad = write_camera(&intrinsics(), CameraFileFormat::OpenCvYaml).replace(
+        "distortion_model: fisheye",
+        "distortion_model: rational_polynomial",
+    );
     std::fs::write(dir.join("bad.yaml"), bad).unwrap();
-    let o = run(dir, &["calibrate", "extrinsics", "--camera", "bad.yaml", "--points", "pins.csv", "--observations", "obs.csv", "--out", "out"], &[]);
+    let o = run(
+        dir,
+        &[
+            "calibrate",
+            "extrinsics",
+            "--camera",
+            "bad.yaml",
+            "--points",
+            "pins.csv",
+            "--observations",
+            "obs.csv",
+            "--out",
+            "out",
+        ],
+        &[],
+    );
     assert_eq!(o.status.code(), Some(2));
-    assert!(text(&o.stderr).contains("bad.yaml:11: distortion_coefficients = "), "{}", text(&o.stderr));
+    assert!(
+        text(&o.stderr).contains("bad.yaml:11: distortion_coefficients = "),
+        "{}",
+        text(&o.stderr)
+    );
 }

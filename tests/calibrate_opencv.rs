@@ -25,7 +25,9 @@ fn cameras() -> Vec<Intrinsics> {
         base(Distortion::Fisheye([0.05, -0.02, 0.006, -0.0008])),
         // R-Tac0's published form: pinhole, k1 about -0.26.
         base(Distortion::PlumbBob([-0.26, 0.07, 0.0012, -0.0007, -0.009])),
-        base(Distortion::RationalPolynomial([0.5, -0.1, 0.001, 0.002, 0.01, 0.8, -0.05, 0.02])),
+        base(Distortion::RationalPolynomial([
+            0.5, -0.1, 0.001, 0.002, 0.01, 0.8, -0.05, 0.02,
+        ])),
     ]
 }
 
@@ -40,7 +42,11 @@ fn projection_agrees_with_opencv_to_1e_6_px_over_the_field_and_filestorage_reads
     for (k, intr) in cameras().iter().enumerate() {
         let cam = CameraModel::new(*intr).unwrap();
         let fisheye = matches!(intr.distortion, Distortion::Fisheye(_));
-        let max = if fisheye { 89.0f64.min(cam.max_field_angle_deg()) } else { 0.97 * cam.max_field_angle_deg() };
+        let max = if fisheye {
+            89.0f64.min(cam.max_field_angle_deg())
+        } else {
+            0.97 * cam.max_field_angle_deg()
+        };
         let mut pts = Vec::new();
         let mut px = Vec::new();
         for i in 0..60 {
@@ -63,7 +69,11 @@ fn projection_agrees_with_opencv_to_1e_6_px_over_the_field_and_filestorage_reads
         ours.push(px);
     }
     let input = d.path().join("cases.json");
-    std::fs::write(&input, serde_json::to_vec(&serde_json::json!({ "cases": cases })).unwrap()).unwrap();
+    std::fs::write(
+        &input,
+        serde_json::to_vec(&serde_json::json!({ "cases": cases })).unwrap(),
+    )
+    .unwrap();
     let o = std::process::Command::new(py)
         .arg(repo_root().join("tests/oracles/opencv_project.py"))
         .arg(&input)
@@ -72,12 +82,22 @@ fn projection_agrees_with_opencv_to_1e_6_px_over_the_field_and_filestorage_reads
     assert!(o.status.success(), "{}", text(&o.stderr));
     let res: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let mut worst = 0.0f64;
-    for (k, (case, px)) in res["cases"].as_array().unwrap().iter().zip(&ours).enumerate() {
+    for (k, (case, px)) in res["cases"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(&ours)
+        .enumerate()
+    {
         for (i, uv) in case["pixels"].as_array().unwrap().iter().enumerate() {
             let (u, v) = (uv[0].as_f64().unwrap(), uv[1].as_f64().unwrap());
             let e = (u - px[i][0]).hypot(v - px[i][1]);
             worst = worst.max(e);
-            assert!(e < 1e-6, "camera {k} point {i}: opencv ({u}, {v}) vs fabkit {:?}", px[i]);
+            assert!(
+                e < 1e-6,
+                "camera {k} point {i}: opencv ({u}, {v}) vs fabkit {:?}",
+                px[i]
+            );
         }
         let intr = &cameras()[k];
         let f = &case["file"];
@@ -86,8 +106,16 @@ fn projection_agrees_with_opencv_to_1e_6_px_over_the_field_and_filestorage_reads
         assert_eq!(f["model"], intr.distortion.name());
         assert_eq!(f["K"][0][0].as_f64().unwrap(), intr.fx_px);
         assert_eq!(f["K"][1][2].as_f64().unwrap(), intr.cy_px);
-        let dd: Vec<f64> = f["D"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+        let dd: Vec<f64> = f["D"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
         assert_eq!(dd, intr.distortion.coefficients(), "camera {k}");
     }
-    eprintln!("worst |fabkit - OpenCV| = {worst:.2e} px (OpenCV {})", res["opencv_version"]);
+    eprintln!(
+        "worst |fabkit - OpenCV| = {worst:.2e} px (OpenCV {})",
+        res["opencv_version"]
+    );
 }

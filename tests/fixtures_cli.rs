@@ -25,7 +25,18 @@ fn files_under(dir: &Path) -> Vec<PathBuf> {
 fn fixtures(cwd: &Path, out: &str, threads: &str) -> std::process::Output {
     run(
         cwd,
-        &["fixtures", "rtac0", "--pins-preset", "rtac0", "--semidomes", "2", "--seed", "3", "--out", out],
+        &[
+            "fixtures",
+            "rtac0",
+            "--pins-preset",
+            "rtac0",
+            "--semidomes",
+            "2",
+            "--seed",
+            "3",
+            "--out",
+            out,
+        ],
         &[("RAYON_NUM_THREADS", threads)],
     )
 }
@@ -46,7 +57,11 @@ fn rtac0_fixtures_export_is_complete_deterministic_and_printable() {
     assert_eq!(fa.len(), files_under(&b).len());
     for f in &fa {
         let rel = f.strip_prefix(&a).unwrap();
-        assert!(std::fs::read(f).unwrap() == std::fs::read(b.join(rel)).unwrap(), "{} differs between runs", rel.display());
+        assert!(
+            std::fs::read(f).unwrap() == std::fs::read(b.join(rel)).unwrap(),
+            "{} differs between runs",
+            rel.display()
+        );
     }
 
     // Point table: CSV with # header lines, 29 rows, ids 1..29, the same numbers as the JSON.
@@ -59,7 +74,8 @@ fn rtac0_fixtures_export_is_complete_deterministic_and_printable() {
         .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
         .collect();
     assert_eq!(rows.len(), 29);
-    let json: serde_json::Value = serde_json::from_slice(&std::fs::read(a.join("points/point_table.json")).unwrap()).unwrap();
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(a.join("points/point_table.json")).unwrap()).unwrap();
     let pts = json["points"].as_array().unwrap();
     for (r, p) in rows.iter().zip(pts) {
         assert_eq!(r[0] as u64, p["id"].as_u64().unwrap());
@@ -73,19 +89,36 @@ fn rtac0_fixtures_export_is_complete_deterministic_and_printable() {
         }
     }
     let plan = std::fs::read_to_string(a.join("points/capture_plan.csv")).unwrap();
-    assert_eq!(plan.lines().filter(|l| !l.starts_with('#') && !l.starts_with("capture")).count(), 8 * 5);
+    assert_eq!(
+        plan.lines()
+            .filter(|l| !l.starts_with('#') && !l.starts_with("capture"))
+            .count(),
+        8 * 5
+    );
 
     // Protrusions: orientation 180 is orientation 0 turned about z.
-    let idx: serde_json::Value = serde_json::from_slice(&std::fs::read(a.join("protrusions/index.json")).unwrap()).unwrap();
+    let idx: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(a.join("protrusions/index.json")).unwrap()).unwrap();
     assert_eq!(idx["stitched_pairs"], 4);
     for p in idx["patterns"].as_array().unwrap() {
-        let d: serde_json::Value = serde_json::from_slice(&std::fs::read(a.join(p["file"].as_str().unwrap())).unwrap()).unwrap();
+        let d: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(a.join(p["file"].as_str().unwrap())).unwrap())
+                .unwrap();
         let g0 = &d["orientations"][0]["geometry"]["primitives"];
         let g180 = &d["orientations"][1]["geometry"]["primitives"];
         assert!(!g0.as_array().unwrap().is_empty());
         for (x, y) in g0.as_array().unwrap().iter().zip(g180.as_array().unwrap()) {
             for (key, v) in x.as_object().unwrap() {
-                let is_point = ["centre_mm", "base_mm", "top_mm", "apex_mm", "p0_mm", "p1_mm", "origin_mm"].contains(&key.as_str());
+                let is_point = [
+                    "centre_mm",
+                    "base_mm",
+                    "top_mm",
+                    "apex_mm",
+                    "p0_mm",
+                    "p1_mm",
+                    "origin_mm",
+                ]
+                .contains(&key.as_str());
                 if is_point {
                     let (p0, p1) = (v.as_array().unwrap(), y[key].as_array().unwrap());
                     assert!((p0[0].as_f64().unwrap() + p1[0].as_f64().unwrap()).abs() < 1e-9);
@@ -97,18 +130,25 @@ fn rtac0_fixtures_export_is_complete_deterministic_and_printable() {
     }
 
     // The manifest lists every data file with its hash.
-    let m: serde_json::Value = serde_json::from_slice(&std::fs::read(a.join("manifest.json")).unwrap()).unwrap();
+    let m: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(a.join("manifest.json")).unwrap()).unwrap();
     let data = m["data_files"].as_array().unwrap();
     assert!(data.len() >= 3 + 3 + 6);
     for d in data {
         use sha2::Digest;
         let bytes = std::fs::read(a.join(d["file"].as_str().unwrap())).unwrap();
-        let sha: String = sha2::Sha256::digest(&bytes).iter().map(|b| format!("{b:02x}")).collect();
+        let sha: String = sha2::Sha256::digest(&bytes)
+            .iter()
+            .map(|b| format!("{b:02x}"))
+            .collect();
         assert_eq!(d["sha256"], sha.as_str());
     }
 
     oracle_check(&a);
-    let meshes: Vec<PathBuf> = fa.into_iter().filter(|f| f.extension().is_some_and(|e| e == "stl" || e == "3mf")).collect();
+    let meshes: Vec<PathBuf> = fa
+        .into_iter()
+        .filter(|f| f.extension().is_some_and(|e| e == "stl" || e == "3mf"))
+        .collect();
     assert_eq!(meshes.len(), 2 + 4 + 6 + 1);
     printcheck_all(&meshes);
 }
@@ -128,7 +168,18 @@ fn bad_fixture_parameters_name_the_parameter_and_write_nothing() {
     for (yaml, expect) in cases {
         let f = tmp.path().join("params.yaml");
         std::fs::write(&f, yaml).unwrap();
-        let o = run(tmp.path(), &["fixtures", "rtac0", "--params", "params.yaml", "--out", "never"], &[]);
+        let o = run(
+            tmp.path(),
+            &[
+                "fixtures",
+                "rtac0",
+                "--params",
+                "params.yaml",
+                "--out",
+                "never",
+            ],
+            &[],
+        );
         assert_eq!(o.status.code(), Some(2), "{yaml}");
         let err = text(&o.stderr);
         assert!(err.contains(expect), "{yaml}: {err}");

@@ -27,13 +27,28 @@ fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("extrinsics_300_trials");
     g.sample_size(20);
     g.bench_function("no_ransac", |b| {
-        b.iter(|| clean.iter().map(|(p, uv)| solve_pnp(&cam, p, uv, &plain).is_ok() as usize).sum::<usize>())
+        b.iter(|| {
+            clean
+                .iter()
+                .map(|(p, uv)| solve_pnp(&cam, p, uv, &plain).is_ok() as usize)
+                .sum::<usize>()
+        })
     });
     g.bench_function("ransac_clean", |b| {
-        b.iter(|| clean.iter().map(|(p, uv)| solve_pnp(&cam, p, uv, &ransac).is_ok() as usize).sum::<usize>())
+        b.iter(|| {
+            clean
+                .iter()
+                .map(|(p, uv)| solve_pnp(&cam, p, uv, &ransac).is_ok() as usize)
+                .sum::<usize>()
+        })
     });
     g.bench_function("ransac_3_swapped", |b| {
-        b.iter(|| swapped.iter().map(|(p, uv)| solve_pnp(&cam, p, uv, &ransac).is_ok() as usize).sum::<usize>())
+        b.iter(|| {
+            swapped
+                .iter()
+                .map(|(p, uv)| solve_pnp(&cam, p, uv, &ransac).is_ok() as usize)
+                .sum::<usize>()
+        })
     });
     g.finish();
 }

@@ -10,7 +10,9 @@
 use std::time::Instant;
 
 use fabkit_calibration::pnp::reprojection_normal_equations;
-use fabkit_calibration::synthetic::{benchmark_camera, benchmark_trial, rotation_error_deg, translation_error_mm, Trial};
+use fabkit_calibration::synthetic::{
+    benchmark_camera, benchmark_trial, rotation_error_deg, translation_error_mm, Trial,
+};
 use fabkit_calibration::{solve_pnp, PnpOptions};
 
 const TRIALS: u64 = 300;
@@ -22,7 +24,10 @@ fn rms(v: &[f64]) -> f64 {
 
 fn run(trials: &[Trial], opts: &PnpOptions, label: &str) -> (f64, f64, f64) {
     let cam = benchmark_camera();
-    let data: Vec<_> = trials.iter().map(|t| (t.points(), t.pixels(), t.t_cam_sensor())).collect();
+    let data: Vec<_> = trials
+        .iter()
+        .map(|t| (t.points(), t.pixels(), t.t_cam_sensor()))
+        .collect();
     let (mut er, mut et) = (Vec::new(), Vec::new());
     for (p, uv, truth) in &data {
         let s = solve_pnp(&cam, p, uv, opts).expect("solves");
@@ -47,16 +52,23 @@ fn run(trials: &[Trial], opts: &PnpOptions, label: &str) -> (f64, f64, f64) {
 
 fn main() {
     let cam = benchmark_camera();
-    let clean: Vec<Trial> = (0..TRIALS).map(|s| benchmark_trial(s, SIGMA_PX, 0)).collect();
-    let swapped: Vec<Trial> = (0..TRIALS).map(|s| benchmark_trial(s, SIGMA_PX, 3)).collect();
+    let clean: Vec<Trial> = (0..TRIALS)
+        .map(|s| benchmark_trial(s, SIGMA_PX, 0))
+        .collect();
+    let swapped: Vec<Trial> = (0..TRIALS)
+        .map(|s| benchmark_trial(s, SIGMA_PX, 3))
+        .collect();
 
     // Cramer-Rao bound of the rotation (left increment, rad) and translation at the truth.
     let (mut crb_r, mut crb_t) = (0.0, 0.0);
     for t in &clean {
         let truth = t.t_cam_sensor();
-        let (jtj, _, _) = reprojection_normal_equations(&cam, &t.points(), &t.pixels(), &truth).expect("projects");
+        let (jtj, _, _) = reprojection_normal_equations(&cam, &t.points(), &t.pixels(), &truth)
+            .expect("projects");
         let cov = jtj.try_inverse().expect("observable") * (SIGMA_PX * SIGMA_PX);
-        crb_r += (cov[(0, 0)] + cov[(1, 1)] + cov[(2, 2)]).to_degrees().to_degrees();
+        crb_r += (cov[(0, 0)] + cov[(1, 1)] + cov[(2, 2)])
+            .to_degrees()
+            .to_degrees();
         crb_t += cov[(3, 3)] + cov[(4, 4)] + cov[(5, 5)];
     }
     let n = clean.len() as f64;
@@ -66,7 +78,10 @@ fn main() {
         (crb_t / n).sqrt()
     );
 
-    let no_ransac = PnpOptions { ransac: None, ..Default::default() };
+    let no_ransac = PnpOptions {
+        ransac: None,
+        ..Default::default()
+    };
     let ransac = PnpOptions::default();
     let (r0, t0, us0) = run(&clean, &no_ransac, "fabkit, no RANSAC");
     let (_, _, us1) = run(&clean, &ransac, "fabkit, RANSAC");
@@ -89,8 +104,15 @@ fn main() {
     let intr = cam.intrinsics();
     let doc = serde_json::json!({ "intrinsics": intr, "trials": clean });
     std::fs::write(&trials_json, serde_json::to_vec(&doc).expect("json")).expect("write trials");
-    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/oracles/opencv_pnp_bench.py");
-    let out = std::process::Command::new(py).arg(script).arg(&trials_json).output().expect("python runs");
+    let script = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../tests/oracles/opencv_pnp_bench.py"
+    );
+    let out = std::process::Command::new(py)
+        .arg(script)
+        .arg(&trials_json)
+        .output()
+        .expect("python runs");
     let _ = std::fs::remove_dir_all(&dir);
     if !out.status.success() {
         println!("OpenCV: failed: {}", String::from_utf8_lossy(&out.stderr));

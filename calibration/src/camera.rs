@@ -163,7 +163,12 @@ impl CameraModel {
         if intr.image_height_px == 0 {
             return Err(bad("image_height", 0.0, "must be > 0"));
         }
-        if let Some(v) = intr.distortion.coefficients().iter().find(|v| !v.is_finite()) {
+        if let Some(v) = intr
+            .distortion
+            .coefficients()
+            .iter()
+            .find(|v| !v.is_finite())
+        {
             return Err(bad("distortion_coefficients", *v, "must be finite"));
         }
         let limit = match intr.distortion {
@@ -215,7 +220,10 @@ impl CameraModel {
 
     /// [`project`](Self::project) and its 2 x 3 Jacobian d(u, v)/d(x, y, z), px per mm.
     #[inline]
-    pub fn project_with_jacobian(&self, p: &Vector3<f64>) -> Option<(Vector2<f64>, Matrix2x3<f64>)> {
+    pub fn project_with_jacobian(
+        &self,
+        p: &Vector3<f64>,
+    ) -> Option<(Vector2<f64>, Matrix2x3<f64>)> {
         self.project_impl(p, true)
     }
 
@@ -320,7 +328,9 @@ impl CameraModel {
                 }
                 let td_max = kb_theta_d(k, self.limit).0;
                 if td > td_max {
-                    return Err(err("outside the lens's field (beyond the monotonic range of theta_d)"));
+                    return Err(err(
+                        "outside the lens's field (beyond the monotonic range of theta_d)",
+                    ));
                 }
                 let mut theta = td.min(self.limit);
                 let mut ok = false;
@@ -390,7 +400,8 @@ fn radial(d: &Distortion, r2: f64) -> f64 {
     match d {
         Distortion::PlumbBob(k) => 1.0 + r2 * (k[0] + r2 * (k[1] + r2 * k[4])),
         Distortion::RationalPolynomial(k) => {
-            (1.0 + r2 * (k[0] + r2 * (k[1] + r2 * k[4]))) / (1.0 + r2 * (k[5] + r2 * (k[6] + r2 * k[7])))
+            (1.0 + r2 * (k[0] + r2 * (k[1] + r2 * k[4])))
+                / (1.0 + r2 * (k[5] + r2 * (k[6] + r2 * k[7])))
         }
         Distortion::Fisheye(_) => 1.0,
     }

@@ -158,7 +158,12 @@ fn parse_json(text: &str, file: &str) -> Result<Intrinsics, CameraFileError> {
         file: file.into(),
         line: e.line(),
         column: e.column(),
-        message: e.to_string().split(" at line ").next().unwrap_or("").to_string(),
+        message: e
+            .to_string()
+            .split(" at line ")
+            .next()
+            .unwrap_or("")
+            .to_string(),
     })?;
     let field = |f: &str, v: String, rule: String| CameraFileError::Field {
         file: file.into(),
@@ -168,15 +173,20 @@ fn parse_json(text: &str, file: &str) -> Result<Intrinsics, CameraFileError> {
         rule,
     };
     if c.format != "fabkit-camera" {
-        return Err(field("format", c.format.clone(), "must be \"fabkit-camera\"".into()));
+        return Err(field(
+            "format",
+            c.format.clone(),
+            "must be \"fabkit-camera\"".into(),
+        ));
     }
-    let distortion = Distortion::from_name(&c.distortion_model, &c.distortion_coefficients).map_err(|rule| {
-        field(
-            "distortion_coefficients",
-            format!("{:?}", c.distortion_coefficients),
-            rule,
-        )
-    })?;
+    let distortion = Distortion::from_name(&c.distortion_model, &c.distortion_coefficients)
+        .map_err(|rule| {
+            field(
+                "distortion_coefficients",
+                format!("{:?}", c.distortion_coefficients),
+                rule,
+            )
+        })?;
     Ok(Intrinsics {
         image_width_px: c.image_width_px,
         image_height_px: c.image_height_px,
@@ -203,7 +213,9 @@ fn parse_yaml(text: &str, file: &str) -> Result<Intrinsics, CameraFileError> {
     let y: YamlCamera = serde_saphyr::from_str(&clean).map_err(|e| {
         let msg = e.to_string();
         let first = msg.lines().next().unwrap_or(&msg).to_string();
-        let (line, column) = e.location().map_or((0, 0), |l| (l.line() as usize, l.column() as usize));
+        let (line, column) = e
+            .location()
+            .map_or((0, 0), |l| (l.line() as usize, l.column() as usize));
         CameraFileError::Syntax {
             file: file.into(),
             line,
@@ -223,8 +235,12 @@ fn parse_yaml(text: &str, file: &str) -> Result<Intrinsics, CameraFileError> {
         field: f,
         hint,
     };
-    let w = y.image_width.ok_or_else(|| missing("image_width", "image width in px"))?;
-    let h = y.image_height.ok_or_else(|| missing("image_height", "image height in px"))?;
+    let w = y
+        .image_width
+        .ok_or_else(|| missing("image_width", "image width in px"))?;
+    let h = y
+        .image_height
+        .ok_or_else(|| missing("image_height", "image height in px"))?;
     let k = y
         .camera_matrix
         .ok_or_else(|| missing("camera_matrix", "3 x 3 [fx 0 cx; 0 fy cy; 0 0 1], px"))?;
@@ -232,13 +248,22 @@ fn parse_yaml(text: &str, file: &str) -> Result<Intrinsics, CameraFileError> {
         if m.rows * m.cols != m.data.len() {
             return Err(field(
                 name,
-                format!("rows {} x cols {} with {} data values", m.rows, m.cols, m.data.len()),
+                format!(
+                    "rows {} x cols {} with {} data values",
+                    m.rows,
+                    m.cols,
+                    m.data.len()
+                ),
                 "rows x cols must equal the number of data values".into(),
             ));
         }
         if let Some(dt) = &m.dt {
             if dt != "d" && dt != "f" {
-                return Err(field(name, format!("dt: {dt}"), "must be d (double) or f (float)".into()));
+                return Err(field(
+                    name,
+                    format!("dt: {dt}"),
+                    "must be d (double) or f (float)".into(),
+                ));
             }
         }
         Ok(())
@@ -259,9 +284,12 @@ fn parse_yaml(text: &str, file: &str) -> Result<Intrinsics, CameraFileError> {
             "must be [fx 0 cx; 0 fy cy; 0 0 1] (no skew)".into(),
         ));
     }
-    let d = y
-        .distortion_coefficients
-        .ok_or_else(|| missing("distortion_coefficients", "OpenCV order, e.g. k1, k2, k3, k4 for fisheye"))?;
+    let d = y.distortion_coefficients.ok_or_else(|| {
+        missing(
+            "distortion_coefficients",
+            "OpenCV order, e.g. k1, k2, k3, k4 for fisheye",
+        )
+    })?;
     check("distortion_coefficients", &d)?;
     if d.rows != 1 && d.cols != 1 {
         return Err(field(
@@ -366,7 +394,8 @@ pub fn write_camera(intr: &Intrinsics, format: CameraFileFormat) -> String {
                 other => other.name(),
             };
             let p = [
-                intr.fx_px, 0.0, intr.cx_px, 0.0, 0.0, intr.fy_px, intr.cy_px, 0.0, 0.0, 0.0, 1.0, 0.0,
+                intr.fx_px, 0.0, intr.cx_px, 0.0, 0.0, intr.fy_px, intr.cy_px, 0.0, 0.0, 0.0, 1.0,
+                0.0,
             ];
             format!(
                 "image_width: {}\nimage_height: {}\ncamera_name: fabkit\ncamera_matrix:\n  rows: 3\n  cols: 3\n  data: {}\n\

@@ -88,7 +88,11 @@ pub fn run_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsReport, Extrinsic
             _ => format!(
                 "{} with {}",
                 table.file,
-                obs_paths.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ")
+                obs_paths
+                    .iter()
+                    .map(|p| p.display().to_string())
+                    .collect::<Vec<_>>()
+                    .join(", ")
             ),
         };
         ExtrinsicsError::Pnp { context, source }
@@ -108,7 +112,13 @@ pub fn run_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsReport, Extrinsic
         },
         observation_files: obs_paths.iter().map(|p| p.display().to_string()).collect(),
     };
-    let report = ExtrinsicsReport::new(&camera, &pairs, &sol, job.ransac.map(|r| r.threshold_px), provenance);
+    let report = ExtrinsicsReport::new(
+        &camera,
+        &pairs,
+        &sol,
+        job.ransac.map(|r| r.threshold_px),
+        provenance,
+    );
     let json = report.to_json();
     let yaml = report.to_yaml().map_err(ExtrinsicsError::Yaml)?;
     let overlay = match &job.image {
@@ -134,7 +144,10 @@ pub fn run_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsReport, Extrinsic
         move |source| ExtrinsicsError::Write { path, source }
     };
     std::fs::create_dir_all(&job.out_dir).map_err(write_err(&job.out_dir))?;
-    let mut files = vec![("extrinsics.json", json.into_bytes()), ("extrinsics.yaml", yaml.into_bytes())];
+    let mut files = vec![
+        ("extrinsics.json", json.into_bytes()),
+        ("extrinsics.yaml", yaml.into_bytes()),
+    ];
     if let Some(o) = overlay {
         files.push(("overlay.png", o));
     }

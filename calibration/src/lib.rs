@@ -19,10 +19,12 @@ pub mod sqpnp;
 pub mod synthetic;
 pub mod tables;
 
-pub use nalgebra;
 pub use camera::{CameraError, CameraModel, Distortion, Intrinsics};
-pub use camera_file::{parse_camera, read_camera_file, write_camera, CameraFileError, CameraFileFormat};
+pub use camera_file::{
+    parse_camera, read_camera_file, write_camera, CameraFileError, CameraFileFormat,
+};
 pub use extrinsics::{run_extrinsics, ExtrinsicsError, ExtrinsicsJob};
+pub use nalgebra;
 pub use pnp::{solve_pnp, PnpError, PnpOptions, PnpSolution, RansacOptions};
 pub use report::ExtrinsicsReport;
 pub use tables::{PointsFrom, TableError};

@@ -64,7 +64,11 @@ impl Rgb8 {
         let n = (2.0 * std::f64::consts::PI * r).ceil() as i64 * 2;
         for k in 0..n {
             let a = 2.0 * std::f64::consts::PI * k as f64 / n as f64;
-            self.put((x + r * a.cos()).round() as i64, (y + r * a.sin()).round() as i64, c);
+            self.put(
+                (x + r * a.cos()).round() as i64,
+                (y + r * a.sin()).round() as i64,
+                c,
+            );
         }
     }
 }
@@ -86,10 +90,12 @@ pub fn read_png_rgb8(path: &Path) -> Result<Rgb8, OverlayError> {
     let mut dec = png::Decoder::new(BufReader::new(Cursor::new(bytes)));
     dec.set_transformations(png::Transformations::normalize_to_color8());
     let mut reader = dec.read_info().map_err(dec_err)?;
-    let size = reader.output_buffer_size().ok_or_else(|| OverlayError::Decode {
-        file: file.clone(),
-        message: "image too large".into(),
-    })?;
+    let size = reader
+        .output_buffer_size()
+        .ok_or_else(|| OverlayError::Decode {
+            file: file.clone(),
+            message: "image too large".into(),
+        })?;
     let mut buf = vec![0u8; size];
     let info = reader.next_frame(&mut buf).map_err(dec_err)?;
     let (w, h) = (info.width, info.height);
@@ -136,7 +142,13 @@ pub fn render_overlay(mut img: Rgb8, report: &ExtrinsicsReport) -> Result<Vec<u8
         if let Some([ru, rv]) = p.reprojected_px {
             img.line(ru - 3.0, rv, ru + 3.0, rv, RED);
             img.line(ru, rv - 3.0, ru, rv + 3.0, RED);
-            img.line(u, v, u + RESIDUAL_SCALE * (ru - u), v + RESIDUAL_SCALE * (rv - v), YELLOW);
+            img.line(
+                u,
+                v,
+                u + RESIDUAL_SCALE * (ru - u),
+                v + RESIDUAL_SCALE * (rv - v),
+                YELLOW,
+            );
         }
     }
     let mut out = Vec::new();
@@ -144,9 +156,13 @@ pub fn render_overlay(mut img: Rgb8, report: &ExtrinsicsReport) -> Result<Vec<u8
         let mut enc = png::Encoder::new(&mut out, img.width, img.height);
         enc.set_color(png::ColorType::Rgb);
         enc.set_depth(png::BitDepth::Eight);
-        let mut w = enc.write_header().map_err(|e| OverlayError::Encode(e.to_string()))?;
-        w.write_image_data(&img.data).map_err(|e| OverlayError::Encode(e.to_string()))?;
-        w.finish().map_err(|e| OverlayError::Encode(e.to_string()))?;
+        let mut w = enc
+            .write_header()
+            .map_err(|e| OverlayError::Encode(e.to_string()))?;
+        w.write_image_data(&img.data)
+            .map_err(|e| OverlayError::Encode(e.to_string()))?;
+        w.finish()
+            .map_err(|e| OverlayError::Encode(e.to_string()))?;
     }
     Ok(out)
 }
@@ -162,9 +178,13 @@ pub fn encode_gray8(width: u32, height: u32, data: &[u8]) -> Result<Vec<u8>, Ove
         let mut enc = png::Encoder::new(&mut out, width, height);
         enc.set_color(png::ColorType::Grayscale);
         enc.set_depth(png::BitDepth::Eight);
-        let mut w = enc.write_header().map_err(|e| OverlayError::Encode(e.to_string()))?;
-        w.write_image_data(data).map_err(|e| OverlayError::Encode(e.to_string()))?;
-        w.finish().map_err(|e| OverlayError::Encode(e.to_string()))?;
+        let mut w = enc
+            .write_header()
+            .map_err(|e| OverlayError::Encode(e.to_string()))?;
+        w.write_image_data(data)
+            .map_err(|e| OverlayError::Encode(e.to_string()))?;
+        w.finish()
+            .map_err(|e| OverlayError::Encode(e.to_string()))?;
     }
     Ok(out)
 }

@@ -7,7 +7,11 @@ use nalgebra::{Matrix3, Vector3};
 
 /// Up to four poses (R, t) with `s_i b_i = R P_i + t`, `s_i > 0`, for three sensor-frame points
 /// `p` (mm) seen along the unit bearings `b`.
-pub fn p3p(p: &[Vector3<f64>; 3], b: &[Vector3<f64>; 3], out: &mut Vec<(Matrix3<f64>, Vector3<f64>)>) {
+pub fn p3p(
+    p: &[Vector3<f64>; 3],
+    b: &[Vector3<f64>; 3],
+    out: &mut Vec<(Matrix3<f64>, Vector3<f64>)>,
+) {
     out.clear();
     let a2 = (p[1] - p[2]).norm_squared();
     let b2 = (p[0] - p[2]).norm_squared();
@@ -50,7 +54,9 @@ pub fn p3p(p: &[Vector3<f64>; 3], b: &[Vector3<f64>; 3], out: &mut Vec<(Matrix3<
         }
         let s1 = (b2 / q).sqrt();
         let x = [b[0] * s1, b[1] * (u * s1), b[2] * (v * s1)];
-        let (Some(fw), Some(fc)) = (frame(p), frame(&x)) else { continue };
+        let (Some(fw), Some(fc)) = (frame(p), frame(&x)) else {
+            continue;
+        };
         let r = fc * fw.transpose();
         out.push((r, x[0] - r * p[0]));
     }
@@ -170,7 +176,11 @@ mod tests {
     fn p3p_recovers_a_noise_free_pose_among_its_solutions() {
         let r = *Rotation3::from_scaled_axis(Vector3::new(0.1, -0.2, 0.3)).matrix();
         let t = Vector3::new(0.5, -0.3, 10.0);
-        let p = [Vector3::new(1.0, 2.0, 3.0), Vector3::new(-4.0, 1.0, 6.0), Vector3::new(2.0, -5.0, 4.0)];
+        let p = [
+            Vector3::new(1.0, 2.0, 3.0),
+            Vector3::new(-4.0, 1.0, 6.0),
+            Vector3::new(2.0, -5.0, 4.0),
+        ];
         let b = [0, 1, 2].map(|i| (r * p[i] + t).normalize());
         let mut out = Vec::new();
         p3p(&p, &b, &mut out);

@@ -4,7 +4,9 @@
 //! Source: R-Tac0 paper, Sec. IV-A, Eq. (1): the pin-dome points (x, y, z) and their pixels (u, v)
 //! give `[R | T]` by solving the Perspective-n-Point problem. Here `[R | T]` is `T_cam_sensor`.
 
-use nalgebra::{Isometry3, Matrix3, Matrix6, Rotation3, Translation3, UnitQuaternion, Vector2, Vector3, Vector6};
+use nalgebra::{
+    Isometry3, Matrix3, Matrix6, Rotation3, Translation3, UnitQuaternion, Vector2, Vector3, Vector6,
+};
 use rand_chacha::rand_core::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -134,10 +136,16 @@ pub fn solve_pnp(
     let mut bearings = Vec::with_capacity(n);
     for (index, (m, uv)) in points_mm.iter().zip(pixels_px).enumerate() {
         if !m.iter().all(|v| v.is_finite()) {
-            return Err(PnpError::NonFinite { index, what: "point" });
+            return Err(PnpError::NonFinite {
+                index,
+                what: "point",
+            });
         }
         if !uv.iter().all(|v| v.is_finite()) {
-            return Err(PnpError::NonFinite { index, what: "pixel" });
+            return Err(PnpError::NonFinite {
+                index,
+                what: "pixel",
+            });
         }
         bearings.push(
             camera
@@ -149,7 +157,15 @@ pub fn solve_pnp(
     let all: Vec<usize> = (0..n).collect();
     let start = sqpnp(points_mm, &bearings).ok_or(PnpError::NoSolution)?;
     let (mut r, mut t) = (start.rotation, start.translation_mm);
-    if let Some((r1, t1, _)) = refine(camera, points_mm, pixels_px, &all, r, t, opts.max_iterations) {
+    if let Some((r1, t1, _)) = refine(
+        camera,
+        points_mm,
+        pixels_px,
+        &all,
+        r,
+        t,
+        opts.max_iterations,
+    ) {
         (r, t) = (r1, t1);
     }
     // The inlier set the current pose was refined on (skip refitting the same set).
@@ -179,9 +195,15 @@ pub fn solve_pnp(
                     let (mut hr, mut ht, mut hin, mut hsc) = (*hr, *ht, inl, sc);
                     let idx: Vec<usize> = (0..n).filter(|&i| hin[i]).collect();
                     if idx.len() >= MIN_POINTS {
-                        if let Some((r1, t1, _)) =
-                            refine(camera, points_mm, pixels_px, &idx, hr, ht, opts.max_iterations)
-                        {
+                        if let Some((r1, t1, _)) = refine(
+                            camera,
+                            points_mm,
+                            pixels_px,
+                            &idx,
+                            hr,
+                            ht,
+                            opts.max_iterations,
+                        ) {
                             let (i1, s1) = score(camera, points_mm, pixels_px, &r1, &t1, thr2);
                             if s1 <= hsc {
                                 (hr, ht, hin, hsc) = (r1, t1, i1, s1);
@@ -213,7 +235,15 @@ pub fn solve_pnp(
             if fitted_on.as_ref() == Some(&best_in) {
                 break;
             }
-            if let Some((r1, t1, _)) = refine(camera, points_mm, pixels_px, &idx, r, t, opts.max_iterations) {
+            if let Some((r1, t1, _)) = refine(
+                camera,
+                points_mm,
+                pixels_px,
+                &idx,
+                r,
+                t,
+                opts.max_iterations,
+            ) {
                 (r, t) = (r1, t1);
             }
             fitted_on = Some(best_in.clone());
@@ -238,7 +268,9 @@ pub fn solve_pnp(
     let mut residuals_px = Vec::with_capacity(n);
     let (mut sum2, mut m) = (0.0, 0usize);
     for i in 0..n {
-        let res = camera.project(&(r * points_mm[i] + t)).map(|uv| uv - pixels_px[i]);
+        let res = camera
+            .project(&(r * points_mm[i] + t))
+            .map(|uv| uv - pixels_px[i]);
         if inliers[i] {
             match res {
                 Some(e) => {
@@ -250,7 +282,9 @@ pub fn solve_pnp(
         }
         residuals_px.push(res);
     }
-    let rot = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(nearest_rotation(&r)));
+    let rot = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(
+        nearest_rotation(&r),
+    ));
     Ok(PnpSolution {
         t_cam_sensor: Isometry3::from_parts(Translation3::from(t), rot),
         inliers,
@@ -264,7 +298,9 @@ pub fn solve_pnp(
 fn check_layout(points: &[Vector3<f64>], bearings: &[Vector3<f64>]) -> Result<(), PnpError> {
     let n = points.len() as f64;
     let c = points.iter().sum::<Vector3<f64>>() / n;
-    let cov = points.iter().fold(Matrix3::zeros(), |a, p| a + (p - c) * (p - c).transpose());
+    let cov = points
+        .iter()
+        .fold(Matrix3::zeros(), |a, p| a + (p - c) * (p - c).transpose());
     let mut ev = [0.0; 3];
     ev.copy_from_slice(cov.symmetric_eigenvalues().as_slice());
     ev.sort_by(f64::total_cmp);
@@ -322,7 +358,14 @@ fn score(
 }
 
 /// Sum of squared reprojection errors over `idx`, or `None` if a point does not project.
-fn cost(camera: &CameraModel, pts: &[Vector3<f64>], px: &[Vector2<f64>], idx: &[usize], r: &Matrix3<f64>, t: &Vector3<f64>) -> Option<f64> {
+fn cost(
+    camera: &CameraModel,
+    pts: &[Vector3<f64>],
+    px: &[Vector2<f64>],
+    idx: &[usize],
+    r: &Matrix3<f64>,
+    t: &Vector3<f64>,
+) -> Option<f64> {
     let mut s = 0.0;
     for &i in idx {
         s += (camera.project(&(r * pts[i] + t))? - px[i]).norm_squared();
@@ -350,7 +393,16 @@ pub(crate) fn normal_equations(
         s += e.norm_squared();
         // d(pc)/dw = -[q]x, d(pc)/dt = I.
         let jw = j * (-q.cross_matrix());
-        let row = |k: usize| Vector6::new(jw[(k, 0)], jw[(k, 1)], jw[(k, 2)], j[(k, 0)], j[(k, 1)], j[(k, 2)]);
+        let row = |k: usize| {
+            Vector6::new(
+                jw[(k, 0)],
+                jw[(k, 1)],
+                jw[(k, 2)],
+                j[(k, 0)],
+                j[(k, 1)],
+                j[(k, 2)],
+            )
+        };
         let (a, b) = (row(0), row(1));
         jtj += a * a.transpose() + b * b.transpose();
         jte += a * e.x + b * e.y;
@@ -424,7 +476,14 @@ pub fn reprojection_cost(
 ) -> Option<f64> {
     let idx: Vec<usize> = (0..points_mm.len()).collect();
     let r = *t_cam_sensor.rotation.to_rotation_matrix().matrix();
-    cost(camera, points_mm, pixels_px, &idx, &r, &t_cam_sensor.translation.vector)
+    cost(
+        camera,
+        points_mm,
+        pixels_px,
+        &idx,
+        &r,
+        &t_cam_sensor.translation.vector,
+    )
 }
 
 /// Normal equations at a pose (J^T J, J^T e, cost); used by the Jacobian test and the
@@ -437,5 +496,12 @@ pub fn reprojection_normal_equations(
 ) -> Option<(Matrix6<f64>, Vector6<f64>, f64)> {
     let idx: Vec<usize> = (0..points_mm.len()).collect();
     let r = *t_cam_sensor.rotation.to_rotation_matrix().matrix();
-    normal_equations(camera, points_mm, pixels_px, &idx, &r, &t_cam_sensor.translation.vector)
+    normal_equations(
+        camera,
+        points_mm,
+        pixels_px,
+        &idx,
+        &r,
+        &t_cam_sensor.translation.vector,
+    )
 }

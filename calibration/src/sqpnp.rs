@@ -78,7 +78,8 @@ pub fn sqpnp(points_mm: &[Vector3<f64>], bearings: &[Vector3<f64>]) -> Option<Sq
     // Eigenvalues to 1e-12 relative are plenty for choosing the start points (SQP and the
     // reprojection refinement polish the result).
     let eps = 1e-12 * omega.amax().max(1e-300);
-    let eig = nalgebra::SymmetricEigen::try_new(omega, eps, 0).unwrap_or_else(|| omega.symmetric_eigen());
+    let eig =
+        nalgebra::SymmetricEigen::try_new(omega, eps, 0).unwrap_or_else(|| omega.symmetric_eigen());
     let mut order: [usize; 9] = [0, 1, 2, 3, 4, 5, 6, 7, 8];
     order.sort_by(|&a, &b| eig.eigenvalues[a].total_cmp(&eig.eigenvalues[b]));
     let ev = |i: usize| eig.eigenvalues[order[i]];

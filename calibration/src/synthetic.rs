@@ -40,7 +40,11 @@ pub fn pin_layout(n: usize, radius_mm: f64, max_polar_deg: f64) -> Vec<Vector3<f
     let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
     (0..n)
         .map(|i| {
-            let f = if n > 1 { i as f64 / (n - 1) as f64 } else { 0.0 };
+            let f = if n > 1 {
+                i as f64 / (n - 1) as f64
+            } else {
+                0.0
+            };
             let polar = (1.0 - f * (1.0 - cmax)).acos();
             let az = i as f64 * golden;
             radius_mm * Vector3::new(polar.sin() * az.cos(), polar.sin() * az.sin(), polar.cos())
@@ -67,15 +71,25 @@ impl Trial {
     pub fn t_cam_sensor(&self) -> Isometry3<f64> {
         let r = nalgebra::Matrix3::from_fn(|i, j| self.rotation[i][j]);
         Isometry3::from_parts(
-            Translation3::new(self.translation_mm[0], self.translation_mm[1], self.translation_mm[2]),
+            Translation3::new(
+                self.translation_mm[0],
+                self.translation_mm[1],
+                self.translation_mm[2],
+            ),
             UnitQuaternion::from_matrix(&r),
         )
     }
     pub fn points(&self) -> Vec<Vector3<f64>> {
-        self.points_mm.iter().map(|p| Vector3::new(p[0], p[1], p[2])).collect()
+        self.points_mm
+            .iter()
+            .map(|p| Vector3::new(p[0], p[1], p[2]))
+            .collect()
     }
     pub fn pixels(&self) -> Vec<Vector2<f64>> {
-        self.pixels_px.iter().map(|p| Vector2::new(p[0], p[1])).collect()
+        self.pixels_px
+            .iter()
+            .map(|p| Vector2::new(p[0], p[1]))
+            .collect()
     }
 }
 
@@ -104,13 +118,19 @@ pub fn benchmark_trial(seed: u64, sigma_px: f64, n_swapped: usize) -> Trial {
     };
     let angle = (3.0f64).to_radians() * uniform(&mut rng);
     let rot = UnitQuaternion::from_scaled_axis(axis * angle);
-    let t = Vector3::new(0.0, 0.0, 10.0) + Vector3::from_fn(|_, _| 0.5 * (2.0 * uniform(&mut rng) - 1.0));
+    let t = Vector3::new(0.0, 0.0, 10.0)
+        + Vector3::from_fn(|_, _| 0.5 * (2.0 * uniform(&mut rng) - 1.0));
     let iso = Isometry3::from_parts(Translation3::from(t), rot);
     let mut pixels: Vec<[f64; 2]> = points
         .iter()
         .map(|p| {
-            let uv = camera.project(&(iso * nalgebra::Point3::from(*p)).coords).expect("pins are in view");
-            [uv.x + sigma_px * gaussian(&mut rng), uv.y + sigma_px * gaussian(&mut rng)]
+            let uv = camera
+                .project(&(iso * nalgebra::Point3::from(*p)).coords)
+                .expect("pins are in view");
+            [
+                uv.x + sigma_px * gaussian(&mut rng),
+                uv.y + sigma_px * gaussian(&mut rng),
+            ]
         })
         .collect();
     let mut swapped = Vec::new();

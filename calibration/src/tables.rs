@@ -22,7 +22,11 @@ pub enum TableError {
         source: std::io::Error,
     },
     #[error("{file}:{line}: {message}")]
-    Format { file: String, line: usize, message: String },
+    Format {
+        file: String,
+        line: usize,
+        message: String,
+    },
     #[error("{file}:{line}: {column} = {value}: {rule}")]
     Field {
         file: String,
@@ -32,7 +36,11 @@ pub enum TableError {
         rule: String,
     },
     #[error("id {id} is given twice: {first} and {second}")]
-    Duplicate { id: String, first: String, second: String },
+    Duplicate {
+        id: String,
+        first: String,
+        second: String,
+    },
     #[error("observed ids not in the point table {points}: {}", .ids.join(", "))]
     UnknownIds { points: String, ids: Vec<String> },
 }
@@ -95,7 +103,11 @@ fn parse_csv<'a>(text: &'a str, file: &'a str) -> Result<Csv<'a>, TableError> {
                     return Err(TableError::Format {
                         file: file.into(),
                         line: i + 1,
-                        message: format!("{} cells but the header has {} columns", cells.len(), h.len()),
+                        message: format!(
+                            "{} cells but the header has {} columns",
+                            cells.len(),
+                            h.len()
+                        ),
                     });
                 }
                 rows.push((i + 1, cells));
@@ -117,11 +129,14 @@ fn parse_csv<'a>(text: &'a str, file: &'a str) -> Result<Csv<'a>, TableError> {
 
 impl Csv<'_> {
     fn column(&self, name: &str, expected: &str) -> Result<usize, TableError> {
-        self.header.iter().position(|h| h == name).ok_or_else(|| TableError::Format {
-            file: self.file.into(),
-            line: self.header_line,
-            message: format!("no column '{name}' in the header (expected {expected})"),
-        })
+        self.header
+            .iter()
+            .position(|h| h == name)
+            .ok_or_else(|| TableError::Format {
+                file: self.file.into(),
+                line: self.header_line,
+                message: format!("no column '{name}' in the header (expected {expected})"),
+            })
     }
 
     fn number(&self, line: usize, cells: &[&str], col: usize) -> Result<f64, TableError> {
@@ -183,11 +198,18 @@ pub fn read_point_table(path: &Path, from: PointsFrom) -> Result<PointTable, Tab
 ///
 /// # Errors
 /// [`TableError`]: no header or missing columns, a non-numeric or non-finite value, a duplicate id.
-pub fn parse_point_table(text: &str, file: &str, from: PointsFrom) -> Result<PointTable, TableError> {
+pub fn parse_point_table(
+    text: &str,
+    file: &str,
+    from: PointsFrom,
+) -> Result<PointTable, TableError> {
     let csv = parse_csv(text, file)?;
     let expected = "id,x_mm,y_mm,z_mm or the fixtures table's id,ring,tip_x_mm,...";
     let id = csv.column("id", expected)?;
-    let fixtures = csv.header.iter().any(|h| h == "tip_x_mm" || h == "contact_x_mm");
+    let fixtures = csv
+        .header
+        .iter()
+        .any(|h| h == "tip_x_mm" || h == "contact_x_mm");
     let prefix = match (fixtures, from) {
         (false, _) => "",
         (true, PointsFrom::Tip) => "tip_",
@@ -231,7 +253,10 @@ pub fn read_observations(paths: &[&Path]) -> Result<Observations, TableError> {
     for p in paths {
         texts.push(read(p)?);
     }
-    let refs: Vec<(&str, &str)> = texts.iter().map(|(f, t)| (t.as_str(), f.as_str())).collect();
+    let refs: Vec<(&str, &str)> = texts
+        .iter()
+        .map(|(f, t)| (t.as_str(), f.as_str()))
+        .collect();
     parse_observations(&refs)
 }
 
@@ -271,7 +296,11 @@ pub fn parse_observations(texts: &[(&str, &str)]) -> Result<Observations, TableE
 /// # Errors
 /// [`TableError::UnknownIds`] listing every observed id that the table does not have.
 pub fn pair(points: &PointTable, obs: &Observations) -> Result<Pairs, TableError> {
-    let by_id: BTreeMap<&str, &Vector3<f64>> = points.rows.iter().map(|(i, p, _)| (i.as_str(), p)).collect();
+    let by_id: BTreeMap<&str, &Vector3<f64>> = points
+        .rows
+        .iter()
+        .map(|(i, p, _)| (i.as_str(), p))
+        .collect();
     let unknown: Vec<String> = obs
         .rows
         .iter()

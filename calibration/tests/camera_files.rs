@@ -17,16 +17,29 @@ fn intr(d: Distortion) -> Intrinsics {
 
 fn all() -> Vec<Intrinsics> {
     vec![
-        intr(Distortion::Fisheye([0.0312345678901234, -0.0123, 1e-5, -3.3e-7])),
-        intr(Distortion::PlumbBob([-0.26, 0.071, 0.0011, -0.00052, -0.0083])),
-        intr(Distortion::RationalPolynomial([0.5, -0.1, 0.001, 0.002, 0.01, 0.8, -0.05, 0.02])),
+        intr(Distortion::Fisheye([
+            0.0312345678901234,
+            -0.0123,
+            1e-5,
+            -3.3e-7,
+        ])),
+        intr(Distortion::PlumbBob([
+            -0.26, 0.071, 0.0011, -0.00052, -0.0083,
+        ])),
+        intr(Distortion::RationalPolynomial([
+            0.5, -0.1, 0.001, 0.002, 0.01, 0.8, -0.05, 0.02,
+        ])),
     ]
 }
 
 #[test]
 fn every_form_round_trips_exactly() {
     for i in all() {
-        for f in [CameraFileFormat::OpenCvYaml, CameraFileFormat::RosYaml, CameraFileFormat::Json] {
+        for f in [
+            CameraFileFormat::OpenCvYaml,
+            CameraFileFormat::RosYaml,
+            CameraFileFormat::Json,
+        ] {
             let text = write_camera(&i, f);
             let back = parse_camera(&text, "cam").unwrap_or_else(|e| panic!("{f:?}: {e}\n{text}"));
             assert_eq!(back.intrinsics(), &i, "{f:?}\n{text}");
@@ -73,14 +86,20 @@ fn opencv_calibrate_output_without_model_name_reads_as_plumb_bob() {
     let i = c.intrinsics();
     assert_eq!(i.fx_px, 300.12);
     assert_eq!(i.cy_px, 240.3);
-    assert_eq!(i.distortion, Distortion::PlumbBob([-0.26, 0.07, 0.001, -0.0005, -0.008]));
+    assert_eq!(
+        i.distortion,
+        Distortion::PlumbBob([-0.26, 0.07, 0.001, -0.0005, -0.008])
+    );
 }
 
 #[test]
 fn ros_equidistant_reads_as_fisheye() {
     let text = "image_width: 640\nimage_height: 480\ncamera_name: cam\ncamera_matrix:\n  rows: 3\n  cols: 3\n  data: [215, 0, 320, 0, 215, 240, 0, 0, 1]\ndistortion_model: equidistant\ndistortion_coefficients:\n  rows: 1\n  cols: 4\n  data: [0.1, 0.01, 0.001, 0.0001]\n";
     let c = parse_camera(text, "ros.yaml").unwrap();
-    assert_eq!(c.intrinsics().distortion, Distortion::Fisheye([0.1, 0.01, 0.001, 0.0001]));
+    assert_eq!(
+        c.intrinsics().distortion,
+        Distortion::Fisheye([0.1, 0.01, 0.001, 0.0001])
+    );
 }
 
 #[test]
@@ -89,20 +108,36 @@ fn errors_name_file_line_and_field() {
     // Wrong coefficient count for the model.
     let bad = ok.replace("distortion_model: plumb_bob", "distortion_model: fisheye");
     let e = parse_camera(&bad, "cam.yaml").unwrap_err().to_string();
-    assert!(e.starts_with("cam.yaml:11: distortion_coefficients = [-0.26,"), "{e}");
+    assert!(
+        e.starts_with("cam.yaml:11: distortion_coefficients = [-0.26,"),
+        "{e}"
+    );
     assert!(e.contains("model 'fisheye' takes 4"), "{e}");
     // Unknown model.
     let bad = ok.replace("distortion_model: plumb_bob", "distortion_model: kb8");
     let e = parse_camera(&bad, "cam.yaml").unwrap_err().to_string();
-    assert!(e.starts_with("cam.yaml:10: distortion_model = kb8: unknown distortion model"), "{e}");
+    assert!(
+        e.starts_with("cam.yaml:10: distortion_model = kb8: unknown distortion model"),
+        "{e}"
+    );
     // rows x cols disagree with data.
     let bad = ok.replacen("   cols: 3", "   cols: 4", 1);
     let e = parse_camera(&bad, "cam.yaml").unwrap_err().to_string();
-    assert!(e.starts_with("cam.yaml:5: camera_matrix = rows 3 x cols 4 with 9 data values"), "{e}");
+    assert!(
+        e.starts_with("cam.yaml:5: camera_matrix = rows 3 x cols 4 with 9 data values"),
+        "{e}"
+    );
     // Negative focal length.
-    let bad = ok.replacen("data: [ 3.0112345678901198e+02", "data: [ -3.0112345678901198e+02", 1);
+    let bad = ok.replacen(
+        "data: [ 3.0112345678901198e+02",
+        "data: [ -3.0112345678901198e+02",
+        1,
+    );
     let e = parse_camera(&bad, "cam.yaml").unwrap_err().to_string();
-    assert!(e.starts_with("cam.yaml:5: fx_px = -301.123456789012: must be finite and > 0"), "{e}");
+    assert!(
+        e.starts_with("cam.yaml:5: fx_px = -301.123456789012: must be finite and > 0"),
+        "{e}"
+    );
     // YAML syntax: file:line:column.
     let bad = ok.replace("image_height: 480", "image_height: [480");
     let e = parse_camera(&bad, "cam.yaml").unwrap_err().to_string();
@@ -114,9 +149,17 @@ fn errors_name_file_line_and_field() {
     // JSON: unknown field with line and column.
     let j = write_camera(&all()[0], CameraFileFormat::Json).replace("\"fx_px\"", "\"fx\"");
     let e = parse_camera(&j, "cam.json").unwrap_err().to_string();
-    assert!(e.starts_with("cam.json:6:6: ") && e.contains("unknown field `fx`"), "{e}");
+    assert!(
+        e.starts_with("cam.json:6:6: ") && e.contains("unknown field `fx`"),
+        "{e}"
+    );
     // Four coefficients without a model are ambiguous.
-    let bad = OPENCV_CALIBRATE_OUTPUT.replace("cols: 5", "cols: 4").replace(",\n       -8.0000000000000002e-03", "");
+    let bad = OPENCV_CALIBRATE_OUTPUT
+        .replace("cols: 5", "cols: 4")
+        .replace(",\n       -8.0000000000000002e-03", "");
     let e = parse_camera(&bad, "cal.yaml").unwrap_err().to_string();
-    assert!(e.contains("distortion_coefficients = 4 values") && e.contains("add distortion_model"), "{e}");
+    assert!(
+        e.contains("distortion_coefficients = 4 values") && e.contains("add distortion_model"),
+        "{e}"
+    );
 }

@@ -43,7 +43,9 @@ fn projection_jacobian_matches_central_differences() {
         let max = cam.max_field_angle_deg().min(100.0) * 0.9;
         for k in 0..40 {
             let p = ray(max * k as f64 / 39.0, 37.0 * k as f64);
-            let Some((_, j)) = cam.project_with_jacobian(&p) else { panic!("{p:?} projects") };
+            let Some((_, j)) = cam.project_with_jacobian(&p) else {
+                panic!("{p:?} projects")
+            };
             for c in 0..3 {
                 let h = 1e-6;
                 let mut a = p;
@@ -52,7 +54,12 @@ fn projection_jacobian_matches_central_differences() {
                 b[c] -= h;
                 let fd = (cam.project(&a).unwrap() - cam.project(&b).unwrap()) / (2.0 * h);
                 let err = (fd - j.column(c)).norm();
-                assert!(err < 1e-5 * (1.0 + j.column(c).norm()), "{:?} at {p:?} column {c}: fd {fd:?} vs {:?}", cam.intrinsics().distortion, j.column(c));
+                assert!(
+                    err < 1e-5 * (1.0 + j.column(c).norm()),
+                    "{:?} at {p:?} column {c}: fd {fd:?} vs {:?}",
+                    cam.intrinsics().distortion,
+                    j.column(c)
+                );
             }
         }
     }
@@ -70,7 +77,9 @@ fn pose_jacobian_gradient_matches_finite_differences_of_the_cost() {
         let rot = UnitQuaternion::from_scaled_axis(Vector3::new(d[0], d[1], d[2])) * pose.rotation;
         let tr = pose.translation.vector + Vector3::new(d[3], d[4], d[5]);
         let iso = Isometry3::from_parts(Translation3::from(tr), rot);
-        reprojection_normal_equations(&cam, &pts, &px, &iso).unwrap().2
+        reprojection_normal_equations(&cam, &pts, &px, &iso)
+            .unwrap()
+            .2
     };
     assert!((cost(&Vector6::zeros()) - c0).abs() < 1e-12);
     for k in 0..6 {
@@ -78,7 +87,11 @@ fn pose_jacobian_gradient_matches_finite_differences_of_the_cost() {
         let mut d = Vector6::zeros();
         d[k] = h;
         let fd = (cost(&d) - cost(&(-d))) / (2.0 * h);
-        assert!((fd - 2.0 * jte[k]).abs() < 1e-4 * (1.0 + fd.abs()), "parameter {k}: fd {fd} vs {}", 2.0 * jte[k]);
+        assert!(
+            (fd - 2.0 * jte[k]).abs() < 1e-4 * (1.0 + fd.abs()),
+            "parameter {k}: fd {fd} vs {}",
+            2.0 * jte[k]
+        );
     }
 }
 
@@ -89,7 +102,10 @@ fn fisheye_projects_rays_beyond_90_deg_and_unprojects_them() {
     for deg in [60.0, 90.0, 100.0, 110.0] {
         let p = ray(deg, 0.0);
         let uv = cam.project(&p).unwrap();
-        assert!((uv.x - 321.0 - 300.0 * f64::to_radians(deg)).abs() < 1e-9, "{deg}: {uv:?}");
+        assert!(
+            (uv.x - 321.0 - 300.0 * f64::to_radians(deg)).abs() < 1e-9,
+            "{deg}: {uv:?}"
+        );
         let b = cam.unproject(&uv).unwrap();
         assert!((b - p.normalize()).norm() < 1e-12);
     }
@@ -103,7 +119,9 @@ fn fisheye_projects_rays_beyond_90_deg_and_unprojects_them() {
 fn pixels_beyond_the_lens_field_are_a_named_error() {
     // k1 = -0.26 folds back near r = 1.1: a pixel further out has no ray.
     let cam = CameraModel::new(intr(Distortion::PlumbBob([-0.26, 0.0, 0.0, 0.0, 0.0]))).unwrap();
-    let e = cam.unproject(&Vector2::new(321.0 + 300.0 * 5.0, 238.0)).unwrap_err();
+    let e = cam
+        .unproject(&Vector2::new(321.0 + 300.0 * 5.0, 238.0))
+        .unwrap_err();
     assert!(matches!(e, CameraError::Unprojectable { .. }), "{e}");
     let e = cam.unproject(&Vector2::new(f64::NAN, 1.0)).unwrap_err();
     assert!(e.to_string().contains("not finite"), "{e}");
@@ -118,7 +136,10 @@ fn invalid_intrinsics_name_the_field() {
     let mut i = intr(Distortion::PlumbBob([f64::NAN, 0.0, 0.0, 0.0, 0.0]));
     i.fx_px = 300.0;
     let e = CameraModel::new(i).unwrap_err();
-    assert!(e.to_string().starts_with("distortion_coefficients = NaN"), "{e}");
+    assert!(
+        e.to_string().starts_with("distortion_coefficients = NaN"),
+        "{e}"
+    );
 }
 
 proptest! {

@@ -49,7 +49,10 @@ fn rotation_and_translation_rms_over_300_seeded_trials_meet_the_issue_bounds() {
     // RANSAC on clean data keeps every point and the same accuracy.
     let (r2, t2, sols) = errors(&trials, &PnpOptions::default());
     assert!(sols.iter().all(|s| s.inliers.iter().all(|&b| b)));
-    assert!((r2 - r).abs() < 1e-6 && (t2 - t).abs() < 1e-6, "{r2} vs {r}, {t2} vs {t}");
+    assert!(
+        (r2 - r).abs() < 1e-6 && (t2 - t).abs() < 1e-6,
+        "{r2} vs {r}, {t2} vs {t}"
+    );
 }
 
 #[test]
@@ -67,7 +70,13 @@ fn ransac_rejects_swapped_pins_and_keeps_rotation_rms_within_10_percent() {
         }
     }
     // Without RANSAC the swapped pins ruin the pose: the test would catch a no-op RANSAC.
-    let (rn, _, _) = errors(&swapped, &PnpOptions { ransac: None, ..Default::default() });
+    let (rn, _, _) = errors(
+        &swapped,
+        &PnpOptions {
+            ransac: None,
+            ..Default::default()
+        },
+    );
     assert!(rn > 3.0 * r0, "no-RANSAC rotation RMS {rn}");
 }
 
@@ -82,7 +91,9 @@ fn same_input_same_pose() {
 
 fn project_all(pose: &Isometry3<f64>, pts: &[Vector3<f64>]) -> Vec<Vector2<f64>> {
     let cam = benchmark_camera();
-    pts.iter().map(|p| cam.project(&(pose * Point3::from(*p)).coords).unwrap()).collect()
+    pts.iter()
+        .map(|p| cam.project(&(pose * Point3::from(*p)).coords).unwrap())
+        .collect()
 }
 
 #[test]
@@ -93,17 +104,37 @@ fn bad_input_is_a_named_error() {
     let o = PnpOptions::default();
     assert_eq!(
         solve_pnp(&cam, &p[..3], &uv[..3], &o).unwrap_err(),
-        PnpError::TooFewPoints { given: 3, needed: 4 }
+        PnpError::TooFewPoints {
+            given: 3,
+            needed: 4
+        }
     );
-    assert!(matches!(solve_pnp(&cam, &p, &uv[..10], &o), Err(PnpError::LengthMismatch { .. })));
+    assert!(matches!(
+        solve_pnp(&cam, &p, &uv[..10], &o),
+        Err(PnpError::LengthMismatch { .. })
+    ));
     let mut bad = uv.clone();
     bad[5].x = f64::NAN;
-    assert_eq!(solve_pnp(&cam, &p, &bad, &o).unwrap_err(), PnpError::NonFinite { index: 5, what: "pixel" });
+    assert_eq!(
+        solve_pnp(&cam, &p, &bad, &o).unwrap_err(),
+        PnpError::NonFinite {
+            index: 5,
+            what: "pixel"
+        }
+    );
     let mut badp = p.clone();
     badp[2].z = f64::INFINITY;
-    assert_eq!(solve_pnp(&cam, &badp, &uv, &o).unwrap_err(), PnpError::NonFinite { index: 2, what: "point" });
+    assert_eq!(
+        solve_pnp(&cam, &badp, &uv, &o).unwrap_err(),
+        PnpError::NonFinite {
+            index: 2,
+            what: "point"
+        }
+    );
     // Collinear points: the rotation about their line is free.
-    let line: Vec<Vector3<f64>> = (0..6).map(|i| Vector3::new(i as f64, 0.5 * i as f64, 5.0)).collect();
+    let line: Vec<Vector3<f64>> = (0..6)
+        .map(|i| Vector3::new(i as f64, 0.5 * i as f64, 5.0))
+        .collect();
     let pose = t.t_cam_sensor();
     let e = solve_pnp(&cam, &line, &project_all(&pose, &line), &o).unwrap_err();
     assert!(matches!(e, PnpError::Degenerate { .. }), "{e}");
@@ -111,19 +142,31 @@ fn bad_input_is_a_named_error() {
     // A pixel far outside the lens's image circle.
     let mut far = uv.clone();
     far[4] = Vector2::new(1e6, 1e6);
-    assert!(matches!(solve_pnp(&cam, &p, &far, &o), Err(PnpError::Unprojectable { index: 4, .. })));
+    assert!(matches!(
+        solve_pnp(&cam, &p, &far, &o),
+        Err(PnpError::Unprojectable { index: 4, .. })
+    ));
     // Garbage labels everywhere: RANSAC finds no consensus rather than a wrong pose.
     let mut shuffled = uv.clone();
     shuffled.reverse();
     let e = solve_pnp(&cam, &p, &shuffled, &o);
-    assert!(matches!(e, Err(PnpError::TooFewInliers { .. }) | Err(PnpError::NoSolution)), "{e:?}");
+    assert!(
+        matches!(
+            e,
+            Err(PnpError::TooFewInliers { .. }) | Err(PnpError::NoSolution)
+        ),
+        "{e:?}"
+    );
 }
 
 #[test]
 fn layout_of_the_benchmark_matches_the_issue() {
     let pts = pin_layout(30, 15.0, 75.0);
     assert_eq!(pts.len(), 30);
-    let polar: Vec<f64> = pts.iter().map(|p| (p.z / p.norm()).acos().to_degrees()).collect();
+    let polar: Vec<f64> = pts
+        .iter()
+        .map(|p| (p.z / p.norm()).acos().to_degrees())
+        .collect();
     assert!(polar[0].abs() < 1e-9 && (polar[29] - 75.0).abs() < 1e-9);
     assert!(pts.iter().all(|p| (p.norm() - 15.0).abs() < 1e-12));
 }

@@ -1,7 +1,9 @@
 //! Point tables (fixtures table and plain xyz) and observations: columns, pairing by id, errors
 //! naming file:line and the column.
 
-use fabkit_calibration::tables::{pair, parse_observations, parse_point_table, PointsFrom, TableError};
+use fabkit_calibration::tables::{
+    pair, parse_observations, parse_point_table, PointsFrom, TableError,
+};
 use nalgebra::Vector3;
 
 const FIXTURES: &str = "# frame: sensor (docs/conventions.md), mm\n# fabkit fixtures\nid,ring,tip_x_mm,tip_y_mm,tip_z_mm,contact_x_mm,contact_y_mm,contact_z_mm,axis_x,axis_y,axis_z,indentation_depth_mm\n0,0,0,0,16.65,0,0,16.15,0,0,1,0.5\n1,1,5.1,0,15.8,4.9,0,15.3,0.3,0,0.95,0.5\n";
@@ -19,14 +21,23 @@ fn fixtures_table_gives_tip_or_contact_columns() {
 
 #[test]
 fn plain_xyz_table_is_read() {
-    let t = parse_point_table("id,x_mm,y_mm,z_mm\na,1,2,3\nb,4,5,6\n", "p.csv", PointsFrom::Contact).unwrap();
+    let t = parse_point_table(
+        "id,x_mm,y_mm,z_mm\na,1,2,3\nb,4,5,6\n",
+        "p.csv",
+        PointsFrom::Contact,
+    )
+    .unwrap();
     assert_eq!(t.rows[1].1, Vector3::new(4.0, 5.0, 6.0));
 }
 
 #[test]
 fn observations_pair_by_id_across_capture_files() {
     let t = parse_point_table(FIXTURES, "pins.csv", PointsFrom::Tip).unwrap();
-    let o = parse_observations(&[("id,u_px,v_px\n1,10.5,20\n", "a.csv"), ("id,u_px,v_px\n0,1,2\n", "b.csv")]).unwrap();
+    let o = parse_observations(&[
+        ("id,u_px,v_px\n1,10.5,20\n", "a.csv"),
+        ("id,u_px,v_px\n0,1,2\n", "b.csv"),
+    ])
+    .unwrap();
     let p = pair(&t, &o).unwrap();
     assert_eq!(p.ids, ["1", "0"]);
     assert_eq!(p.points_mm[0], Vector3::new(5.1, 0.0, 15.8));
@@ -35,21 +46,42 @@ fn observations_pair_by_id_across_capture_files() {
 
 #[test]
 fn bad_tables_name_file_line_and_column() {
-    let e = parse_point_table("id,x_mm,y_mm,z_mm\n0,1,NaN,3\n", "p.csv", PointsFrom::Tip).unwrap_err();
+    let e =
+        parse_point_table("id,x_mm,y_mm,z_mm\n0,1,NaN,3\n", "p.csv", PointsFrom::Tip).unwrap_err();
     assert_eq!(e.to_string(), "p.csv:2: y_mm = NaN: must be finite");
-    let e = parse_point_table("id,x_mm,y_mm,z_mm\n0,1,abc,3\n", "p.csv", PointsFrom::Tip).unwrap_err();
+    let e =
+        parse_point_table("id,x_mm,y_mm,z_mm\n0,1,abc,3\n", "p.csv", PointsFrom::Tip).unwrap_err();
     assert_eq!(e.to_string(), "p.csv:2: y_mm = abc: must be a number");
     let e = parse_point_table("id,x_mm,y_mm\n0,1,2\n", "p.csv", PointsFrom::Tip).unwrap_err();
-    assert!(e.to_string().starts_with("p.csv:1: no column 'z_mm' in the header"), "{e}");
+    assert!(
+        e.to_string()
+            .starts_with("p.csv:1: no column 'z_mm' in the header"),
+        "{e}"
+    );
     let e = parse_point_table("id,x_mm,y_mm,z_mm\n0,1,2\n", "p.csv", PointsFrom::Tip).unwrap_err();
-    assert_eq!(e.to_string(), "p.csv:2: 3 cells but the header has 4 columns");
-    let e = parse_point_table("id,x_mm,y_mm,z_mm\n0,1,2,3\n0,1,2,3\n", "p.csv", PointsFrom::Tip).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "p.csv:2: 3 cells but the header has 4 columns"
+    );
+    let e = parse_point_table(
+        "id,x_mm,y_mm,z_mm\n0,1,2,3\n0,1,2,3\n",
+        "p.csv",
+        PointsFrom::Tip,
+    )
+    .unwrap_err();
     assert_eq!(e.to_string(), "id 0 is given twice: p.csv:2 and p.csv:3");
-    let e = parse_observations(&[("id,u_px,v_px\n1,2,3\n", "a.csv"), ("id,u_px,v_px\n1,5,6\n", "b.csv")]).unwrap_err();
+    let e = parse_observations(&[
+        ("id,u_px,v_px\n1,2,3\n", "a.csv"),
+        ("id,u_px,v_px\n1,5,6\n", "b.csv"),
+    ])
+    .unwrap_err();
     assert_eq!(e.to_string(), "id 1 is given twice: a.csv:2 and b.csv:2");
     let t = parse_point_table(FIXTURES, "pins.csv", PointsFrom::Tip).unwrap();
     let o = parse_observations(&[("id,u_px,v_px\n1,2,3\n7,1,1\n9,1,1\n", "a.csv")]).unwrap();
     let e = pair(&t, &o).unwrap_err();
     assert!(matches!(e, TableError::UnknownIds { .. }));
-    assert_eq!(e.to_string(), "observed ids not in the point table pins.csv: 7 (a.csv:3), 9 (a.csv:4)");
+    assert_eq!(
+        e.to_string(),
+        "observed ids not in the point table pins.csv: 7 (a.csv:3), 9 (a.csv:4)"
+    );
 }

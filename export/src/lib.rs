@@ -27,7 +27,8 @@ mod three_mf;
 pub use check::check_printable_mesh;
 pub use error::ExportError;
 pub use manifest::{
-    Manifest, ManifestDataFile, ManifestDesign, ManifestKit3mf, ManifestObject, ManifestPart, ManifestVolume, FRAME,
+    Manifest, ManifestDataFile, ManifestDesign, ManifestKit3mf, ManifestObject, ManifestPart,
+    ManifestVolume, FRAME,
 };
 
 use fabkit_designs::geometry::{Mesh, TopologyError};
@@ -133,7 +134,8 @@ pub fn write_kit_with_files(
                 !c.is_empty()
                     && c != "."
                     && c != ".."
-                    && c.chars().all(|ch| ch.is_ascii_alphanumeric() || "_.-".contains(ch))
+                    && c.chars()
+                        .all(|ch| ch.is_ascii_alphanumeric() || "_.-".contains(ch))
             });
         if !ok {
             return Err(ExportError::InvalidOption {
@@ -356,7 +358,8 @@ fn render(
             .collect(),
     };
     for (rel, bytes) in data_files {
-        if files.iter().any(|(f, _)| f == rel) || rel == "manifest.json" || rel == "FABRICATION.md" {
+        if files.iter().any(|(f, _)| f == rel) || rel == "manifest.json" || rel == "FABRICATION.md"
+        {
             return Err(ExportError::InvalidOption {
                 field: "data_files",
                 value: rel.clone(),

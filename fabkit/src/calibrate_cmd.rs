@@ -59,7 +59,11 @@ pub fn run(cmd: CalibrateCommand) -> Result<(), Box<dyn Error>> {
 
 fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
     if !(a.ransac_threshold_px.is_finite() && a.ransac_threshold_px > 0.0) {
-        return Err(format!("--ransac-threshold-px = {}: must be finite and > 0", a.ransac_threshold_px).into());
+        return Err(format!(
+            "--ransac-threshold-px = {}: must be finite and > 0",
+            a.ransac_threshold_px
+        )
+        .into());
     }
     let job = ExtrinsicsJob {
         camera: a.camera,
@@ -82,7 +86,11 @@ fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
     let c = r.residuals.camera_centre_in_sensor_mm;
     println!(
         "extrinsics: {} of {} points, RMS reprojection error {:.3} px, worst {:.3} px (id {})",
-        r.residuals.inliers, r.residuals.observations, r.rms_reprojection_error_px, r.residuals.worst_px, r.residuals.worst_id
+        r.residuals.inliers,
+        r.residuals.observations,
+        r.rms_reprojection_error_px,
+        r.residuals.worst_px,
+        r.residuals.worst_id
     );
     if !r.residuals.outlier_ids.is_empty() {
         println!("outliers rejected: {}", r.residuals.outlier_ids.join(", "));

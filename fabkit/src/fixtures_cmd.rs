@@ -53,7 +53,8 @@ pub fn run(args: FixturesArgs) -> Result<(), Box<dyn Error>> {
     }
     let mut params = match &args.params {
         Some(path) => {
-            let text = std::fs::read_to_string(path).map_err(|e| format!("reading {}: {e}", path.display()))?;
+            let text = std::fs::read_to_string(path)
+                .map_err(|e| format!("reading {}: {e}", path.display()))?;
             from_yaml(&text, &path.display().to_string())?
         }
         None => FixtureParams::default(),
@@ -121,7 +122,10 @@ pub fn run(args: FixturesArgs) -> Result<(), Box<dyn Error>> {
         out!("  note: {n}");
     }
     let n = set.semidomes.halves.len();
-    out!("  semi-domes: {n} patterns + the empty half -> {} stitched pairs", n * n);
+    out!(
+        "  semi-domes: {n} patterns + the empty half -> {} stitched pairs",
+        n * n
+    );
     for p in &summary.manifest.parts {
         out!(
             "  {:34} {:4} {:>10.1} mm3  {}",

@@ -4,8 +4,8 @@
 //! [`designs`] (geometry core, profiles, layer stacks, molds, housings, the YAML schema) and
 //! [`export`] (STL, 3MF, manifest, fabrication sheet).
 
-pub use fabkit_designs as designs;
 pub use fabkit_calibration as calibration;
+pub use fabkit_designs as designs;
 pub use fabkit_export as export;
 pub use fabkit_fixtures as fixtures;
 
