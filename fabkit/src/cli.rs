@@ -7,14 +7,7 @@ use fabkit_designs::{build_kit, library, ChordTolerance, Design, DesignError};
 use fabkit_export::{write_kit, ExportOptions, Formats};
 use sha2::{Digest, Sha256};
 use std::error::Error;
-use std::io::Write;
 
-/// Prints a line on stdout; a closed pipe (`fabkit ... | head`) is not an error.
-macro_rules! out {
-    ($($arg:tt)*) => {{
-        let _ = writeln!(std::io::stdout(), $($arg)*);
-    }};
-}
 use std::path::{Path, PathBuf};
 
 #[derive(Parser, Debug)]
@@ -163,6 +156,33 @@ fn hex(b: &[u8]) -> String {
     b.iter().map(|x| format!("{x:02x}")).collect()
 }
 
+/// The export options of this run: formats, provenance (command line, design, version).
+pub(crate) fn export_options(
+    loaded: &Loaded,
+    tol: ChordTolerance,
+    format: &[Format],
+) -> ExportOptions {
+    ExportOptions {
+        formats: Formats {
+            stl: format.contains(&Format::Stl),
+            threemf: format.contains(&Format::ThreeMf),
+        },
+        command_line: std::env::args().collect(),
+        design_source: loaded.source.clone(),
+        design_sha256: loaded.sha256.clone(),
+        chord_tolerance_mm: tol.mm(),
+        fabkit_version: env!("CARGO_PKG_VERSION").to_string(),
+    }
+}
+
+/// A ticking spinner on stderr for a build step (hidden when stderr is not a terminal).
+pub(crate) fn spinner(message: String) -> indicatif::ProgressBar {
+    let s = indicatif::ProgressBar::new_spinner();
+    s.set_message(message);
+    s.enable_steady_tick(std::time::Duration::from_millis(120));
+    s
+}
+
 pub(crate) fn tolerance(mm: f64) -> Result<ChordTolerance, Box<dyn Error>> {
     ChordTolerance::new(mm).map_err(|e| format!("--chord-tolerance-mm: {e}").into())
 }
@@ -234,28 +254,16 @@ fn export(args: ExportArgs) -> Result<(), Box<dyn Error>> {
         .out
         .clone()
         .unwrap_or_else(|| Path::new("out").join(&loaded.design.name));
-    let spinner = indicatif::ProgressBar::new_spinner();
-    spinner.set_message(format!(
+    let spinner = spinner(format!(
         "building {} at {} mm chord tolerance",
         loaded.design.name,
         tol.mm()
     ));
-    spinner.enable_steady_tick(std::time::Duration::from_millis(120));
     let t0 = std::time::Instant::now();
     let kit = build_kit(&loaded.design, tol);
     spinner.finish_and_clear();
     let kit = kit?;
-    let opts = ExportOptions {
-        formats: Formats {
-            stl: args.format.contains(&Format::Stl),
-            threemf: args.format.contains(&Format::ThreeMf),
-        },
-        command_line: std::env::args().collect(),
-        design_source: loaded.source.clone(),
-        design_sha256: loaded.sha256.clone(),
-        chord_tolerance_mm: tol.mm(),
-        fabkit_version: env!("CARGO_PKG_VERSION").to_string(),
-    };
+    let opts = export_options(&loaded, tol, &args.format);
     if let Some(csg) = &args.csg {
         let parts: Vec<(&str, &fabkit_designs::Solid)> = kit
             .parts

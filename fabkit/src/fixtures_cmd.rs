@@ -1,11 +1,10 @@
 //! `fabkit fixtures`: argument parsing and dispatch over fabkit-fixtures.
 
-use crate::cli::{load_design, tolerance, Format};
+use crate::cli::{export_options, load_design, spinner, tolerance, Format};
 use fabkit_designs::ChordTolerance;
-use fabkit_export::{write_kit_with_files, ExportOptions, Formats};
+use fabkit_export::write_kit_with_files;
 use fabkit_fixtures::params::{apply_pin_preset, from_yaml, FixtureParams};
 use std::error::Error;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args, Debug)]
@@ -37,12 +36,6 @@ pub struct FixturesArgs {
     /// Largest distance between a facet and the true surface, mm.
     #[arg(long, default_value_t = ChordTolerance::DEFAULT_MM)]
     chord_tolerance_mm: f64,
-}
-
-macro_rules! out {
-    ($($arg:tt)*) => {{
-        let _ = writeln!(std::io::stdout(), $($arg)*);
-    }};
 }
 
 pub fn run(args: FixturesArgs) -> Result<(), Box<dyn Error>> {
@@ -79,24 +72,12 @@ pub fn run(args: FixturesArgs) -> Result<(), Box<dyn Error>> {
         loaded.source,
         loaded.sha256
     );
-    let spinner = indicatif::ProgressBar::new_spinner();
-    spinner.set_message(format!("building the fixtures of {}", loaded.design.name));
-    spinner.enable_steady_tick(std::time::Duration::from_millis(120));
+    let spinner = spinner(format!("building the fixtures of {}", loaded.design.name));
     let t0 = std::time::Instant::now();
     let set = fabkit_fixtures::build_fixtures(&loaded.design, &params, tol, &provenance);
     spinner.finish_and_clear();
     let set = set?;
-    let opts = ExportOptions {
-        formats: Formats {
-            stl: args.format.contains(&Format::Stl),
-            threemf: args.format.contains(&Format::ThreeMf),
-        },
-        command_line: std::env::args().collect(),
-        design_source: loaded.source.clone(),
-        design_sha256: loaded.sha256.clone(),
-        chord_tolerance_mm: tol.mm(),
-        fabkit_version: env!("CARGO_PKG_VERSION").to_string(),
-    };
+    let opts = export_options(&loaded, tol, &args.format);
     let summary = write_kit_with_files(&set.kit, &set.files, &out, &opts)?;
     for w in &summary.warnings {
         eprintln!("warning: {w}");

@@ -2,7 +2,16 @@
 //!
 //! This crate is the `fabkit` command line and a facade over the library crates:
 //! [`designs`] (geometry core, profiles, layer stacks, molds, housings, the YAML schema) and
-//! [`export`] (STL, 3MF, manifest, fabrication sheet).
+//! [`export`] (STL, 3MF, manifest, fabrication sheet), [`fixtures`] (pin dome, semi-domes,
+//! indenters) and [`calibration`] (camera models, PnP extrinsics).
+
+/// Prints a line on stdout; a closed pipe (`fabkit ... | head`) is not an error.
+macro_rules! out {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
+}
 
 pub use fabkit_calibration as calibration;
 pub use fabkit_designs as designs;
