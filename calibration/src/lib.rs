@@ -11,6 +11,7 @@
 pub mod camera;
 pub mod camera_file;
 pub mod extrinsics;
+pub mod groundtruth;
 pub mod overlay;
 pub mod p3p;
 pub mod pnp;

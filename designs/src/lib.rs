@@ -17,6 +17,7 @@ pub mod library;
 pub mod markers;
 pub mod materials;
 pub mod molds;
+pub mod primitives;
 pub mod profile;
 pub mod schema;
 pub mod stack;

@@ -1,0 +1,221 @@
+//! Ground-truth depth for depth training: the reference (undeformed) surface and the surface
+//! indented by each protrusion semi-dome, rendered through the calibrated camera with the exact
+//! per-pixel ray of the camera model (no undistort approximation).
+//!
+//! Source: R-Tac0 paper (`shared/papers/rtac0-rounded-monochrome-vbts.txt`), Sec. IV-B and
+//! Fig. 6: semi-domes with known protrusions pressed onto the sensor give depth maps "derived
+//! using the known camera parameters and the protrusions geometry"; Eq. (2)-(3): the network
+//! learns the differential depth (indented minus reference) per pixel, and the complete depth
+//! is the reference surface depth plus that difference.
+//!
+//! Geometry: the reference surface is the outer skin surface (body profile at offset 0),
+//! intersected in closed form ([`surface`]); the indented surface is the skin pushed in by the
+//! protrusions, the boundary of (sensor body minus protrusion solids): along a ray, the nearer
+//! of the reference exit and the first entry into a protrusion ([`exact`] in closed form, or
+//! [`mesh`] for triangle meshes). Frames and units: `docs/conventions.md`.
+
+pub mod exact;
+pub mod inputs;
+pub mod mesh;
+pub mod rays;
+pub mod surface;
+pub mod synthetic;
+
+use exact::ExactPrimitives;
+use mesh::{MeshCaster, NO_HIT};
+use rays::PixelRays;
+use surface::ReferenceSurface;
+
+/// The surface seen along every ray of a frame, sensor frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SurfaceHits {
+    /// Distance along the ray (range), mm; NaN where the ray misses the skin.
+    pub t_mm: Vec<f64>,
+    /// Unit normal of the elastomer surface at the hit, pointing out of the elastomer (away
+    /// from the sensor's inside), sensor frame; NaN where the ray misses.
+    pub normal: Vec<[f64; 3]>,
+    /// The hit is on a protrusion (the skin is pushed in there).
+    pub contact: Vec<bool>,
+    /// Where the ray leaves the sensor body when it misses the skin (below the base plane),
+    /// mm, else equal to `t_mm`: the limit for protrusion hits.
+    pub t_exit_mm: Vec<f64>,
+}
+
+impl SurfaceHits {
+    /// Number of pixels that see the skin.
+    pub fn valid_count(&self) -> usize {
+        self.t_mm.iter().filter(|t| t.is_finite()).count()
+    }
+}
+
+/// The reference (undeformed) surface along every ray, in closed form.
+pub fn reference_hits(rays: &PixelRays, surface: &ReferenceSurface) -> SurfaceHits {
+    let n = rays.len();
+    let mut h = SurfaceHits {
+        t_mm: vec![f64::NAN; n],
+        normal: vec![[f64::NAN; 3]; n],
+        contact: vec![false; n],
+        t_exit_mm: vec![f64::NAN; n],
+    };
+    surface.exit_all(
+        rays.origin_mm,
+        &rays.dirs,
+        &mut h.t_exit_mm,
+        &mut h.t_mm,
+        &mut h.normal,
+    );
+    h
+}
+
+/// The indented surface: the reference pushed in by the exact protrusion primitives.
+pub fn indented_hits(
+    rays: &PixelRays,
+    reference: &SurfaceHits,
+    protrusions: &ExactPrimitives,
+    base_z_mm: f64,
+) -> SurfaceHits {
+    let mut h = reference.clone();
+    let o = rays.origin_mm;
+    for (p, d) in rays.dirs.iter().enumerate() {
+        let tmax = reference.t_exit_mm[p];
+        if !(tmax > 0.0) {
+            continue;
+        }
+        if let Some(c) = protrusions.first_crossing(o, *d, tmax) {
+            let z = o[2] + c.t_mm * d[2];
+            if z >= base_z_mm {
+                h.t_mm[p] = c.t_mm;
+                h.normal[p] = c.normal.map(|v| -v);
+                h.contact[p] = true;
+            }
+        }
+    }
+    h
+}
+
+/// The surface seen along every ray against triangle meshes: `skin` is the closed sensor body
+/// (outward winding), `protrusions` (optional) the protrusion solids (outward winding). A hit
+/// on `skin` below `base_z_mm` is a miss; a protrusion hit is a contact (normal reversed).
+pub fn mesh_hits(
+    rays: &PixelRays,
+    skin: &MeshCaster,
+    protrusions: Option<&MeshCaster>,
+    base_z_mm: f64,
+) -> SurfaceHits {
+    let n = rays.len();
+    let s = skin.cast(rays, &vec![f64::INFINITY; n]);
+    let mut h = SurfaceHits {
+        t_mm: vec![f64::NAN; n],
+        normal: vec![[f64::NAN; 3]; n],
+        contact: vec![false; n],
+        t_exit_mm: vec![f64::NAN; n],
+    };
+    let o = rays.origin_mm;
+    for p in 0..n {
+        if s.triangle[p] == NO_HIT {
+            continue;
+        }
+        h.t_exit_mm[p] = s.t_mm[p];
+        let z = o[2] + s.t_mm[p] * rays.dirs[p][2];
+        if z >= base_z_mm - 1e-9 {
+            h.t_mm[p] = s.t_mm[p];
+            h.normal[p] = s.normal[p];
+        }
+    }
+    if let Some(pc) = protrusions {
+        let limit: Vec<f64> = h
+            .t_exit_mm
+            .iter()
+            .map(|t| if t.is_finite() { *t } else { 0.0 })
+            .collect();
+        let q = pc.cast(rays, &limit);
+        for p in 0..n {
+            if q.triangle[p] != NO_HIT {
+                let z = o[2] + q.t_mm[p] * rays.dirs[p][2];
+                if z >= base_z_mm {
+                    h.t_mm[p] = q.t_mm[p];
+                    h.normal[p] = q.normal[p].map(|v| -v);
+                    h.contact[p] = true;
+                }
+            }
+        }
+    }
+    h
+}
+
+/// Camera-frame depth maps of one rendered surface (row-major, H * W).
+#[derive(Debug, Clone, PartialEq)]
+pub struct DepthFrame {
+    pub width: usize,
+    pub height: usize,
+    /// Distance along the ray from the camera centre, mm; NaN where the ray misses.
+    pub range_mm: Vec<f64>,
+    /// z of the hit in the camera frame, mm; NaN where the ray misses.
+    pub zdepth_mm: Vec<f64>,
+    /// Hit point in the camera frame, mm.
+    pub point_cam_mm: Vec<[f64; 3]>,
+    /// Unit normal out of the elastomer, camera frame.
+    pub normal_cam: Vec<[f64; 3]>,
+    /// The hit is on a protrusion.
+    pub contact: Vec<bool>,
+}
+
+impl DepthFrame {
+    /// The camera-frame maps of `hits`.
+    pub fn new(rays: &PixelRays, hits: &SurfaceHits) -> DepthFrame {
+        let n = rays.len();
+        let mut f = DepthFrame {
+            width: rays.width,
+            height: rays.height,
+            range_mm: hits.t_mm.clone(),
+            zdepth_mm: vec![f64::NAN; n],
+            point_cam_mm: vec![[f64::NAN; 3]; n],
+            normal_cam: vec![[f64::NAN; 3]; n],
+            contact: hits.contact.clone(),
+        };
+        for p in 0..n {
+            let t = hits.t_mm[p];
+            if !t.is_finite() {
+                continue;
+            }
+            let b = rays.bearings[p];
+            f.zdepth_mm[p] = t * b[2];
+            f.point_cam_mm[p] = [t * b[0], t * b[1], t * b[2]];
+            f.normal_cam[p] = rays.dir_to_camera(hits.normal[p]);
+        }
+        f
+    }
+
+    /// `self - reference` for range and z-depth (indented minus reference, Eq. (2)-(3) of the
+    /// R-Tac0 paper), mm: negative where the skin is pushed towards the camera, 0 elsewhere,
+    /// NaN where either misses.
+    pub fn delta(&self, reference: &DepthFrame) -> (Vec<f64>, Vec<f64>) {
+        let d = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x - y).collect();
+        (
+            d(&self.range_mm, &reference.range_mm),
+            d(&self.zdepth_mm, &reference.zdepth_mm),
+        )
+    }
+}
+
+/// Left and right half masks: the split plane x = 0 of the sensor frame projected into the
+/// image. A pixel whose ray hits the reference surface at x >= 0 is in the right mask (the +x
+/// half, where orientation 0 puts the pattern), at x < 0 in the left mask; a miss is in
+/// neither.
+pub fn half_masks(rays: &PixelRays, reference: &SurfaceHits) -> (Vec<bool>, Vec<bool>) {
+    let o = rays.origin_mm;
+    let mut left = vec![false; rays.len()];
+    let mut right = vec![false; rays.len()];
+    for p in 0..rays.len() {
+        let t = reference.t_mm[p];
+        if t.is_finite() {
+            let x = o[0] + t * rays.dirs[p][0];
+            if x >= 0.0 {
+                right[p] = true;
+            } else {
+                left[p] = true;
+            }
+        }
+    }
+    (left, right)
+}

@@ -1,0 +1,95 @@
+//! Per-pixel rays of a calibrated camera at a pose: the exact bearing of every pixel centre
+//! (no undistort approximation), expressed in the sensor frame.
+
+use nalgebra::{Isometry3, Point3, Vector2, Vector3};
+use rayon::prelude::*;
+
+use crate::camera::CameraModel;
+
+/// The rays of every pixel of one camera at one pose.
+///
+/// Pixel `(u, v)` (column, row; (0, 0) is the centre of the top-left pixel, OpenCV) is entry
+/// `v * width + u`. Rays start at the camera centre; a pixel that does not unproject (outside
+/// the lens's monotonic field) has NaN direction and bearing and never hits anything.
+#[derive(Debug, Clone)]
+pub struct PixelRays {
+    pub width: usize,
+    pub height: usize,
+    /// `T_cam_sensor`: sensor-frame points (mm) into the camera frame (mm).
+    pub t_cam_sensor: Isometry3<f64>,
+    /// Camera centre in the sensor frame, mm.
+    pub origin_mm: [f64; 3],
+    /// Unit ray directions in the sensor frame, (H * W, 3).
+    pub dirs: Vec<[f64; 3]>,
+    /// Unit bearings in the camera frame, (H * W, 3): `zdepth_mm = range_mm * bearing[2]`.
+    pub bearings: Vec<[f64; 3]>,
+    /// Tiles for mesh casts, made on first use.
+    tiles: std::sync::OnceLock<super::mesh::RayTiles>,
+}
+
+impl PixelRays {
+    /// Unprojects every pixel centre of `camera` (Newton iteration to 1e-15; see
+    /// [`CameraModel::unproject`]) and turns the bearings into the sensor frame with
+    /// `t_cam_sensor`. Rows are computed in parallel; the result does not depend on the
+    /// thread count.
+    pub fn new(camera: &CameraModel, t_cam_sensor: &Isometry3<f64>) -> PixelRays {
+        let i = camera.intrinsics();
+        let (w, h) = (i.image_width_px as usize, i.image_height_px as usize);
+        let rot_inv = t_cam_sensor.rotation.inverse();
+        let centre = t_cam_sensor.inverse() * Point3::origin();
+        let rows: Vec<Vec<([f64; 3], [f64; 3])>> = (0..h)
+            .into_par_iter()
+            .map(|v| {
+                (0..w)
+                    .map(
+                        |u| match camera.unproject(&Vector2::new(u as f64, v as f64)) {
+                            Ok(b) => {
+                                let d = rot_inv * b;
+                                ([d.x, d.y, d.z], [b.x, b.y, b.z])
+                            }
+                            Err(_) => ([f64::NAN; 3], [f64::NAN; 3]),
+                        },
+                    )
+                    .collect()
+            })
+            .collect();
+        let (dirs, bearings) = rows.into_iter().flatten().unzip();
+        PixelRays {
+            width: w,
+            height: h,
+            t_cam_sensor: *t_cam_sensor,
+            origin_mm: [centre.x, centre.y, centre.z],
+            dirs,
+            bearings,
+            tiles: std::sync::OnceLock::new(),
+        }
+    }
+
+    /// The frame's tiles for [`super::mesh::MeshCaster::cast`] (made once, on first use: a
+    /// per-camera cost like the unprojection).
+    pub fn tiles(&self) -> &super::mesh::RayTiles {
+        self.tiles.get_or_init(|| super::mesh::RayTiles::new(self))
+    }
+
+    /// Number of pixels, `width * height`.
+    pub fn len(&self) -> usize {
+        self.dirs.len()
+    }
+
+    /// Whether the frame has no pixel.
+    pub fn is_empty(&self) -> bool {
+        self.dirs.is_empty()
+    }
+
+    /// A sensor-frame point as a camera-frame point, mm.
+    pub fn to_camera(&self, p: [f64; 3]) -> [f64; 3] {
+        let q = self.t_cam_sensor * Point3::new(p[0], p[1], p[2]);
+        [q.x, q.y, q.z]
+    }
+
+    /// A sensor-frame direction as a camera-frame direction.
+    pub fn dir_to_camera(&self, n: [f64; 3]) -> [f64; 3] {
+        let q = self.t_cam_sensor.rotation * Vector3::new(n[0], n[1], n[2]);
+        [q.x, q.y, q.z]
+    }
+}

@@ -1,0 +1,318 @@
+//! The undeformed sensor surface, intersected in closed form.
+//!
+//! The surface rendered is the outer surface of the skin, the body profile at offset 0
+//! (`docs/conventions.md`, "The sensor frame"), from the pole down to the base plane
+//! `z = z_base`. The camera looks at it from inside: the **sensor body** is the region inside
+//! that surface, continued straight down below the base plane as a cylinder of the rim radius
+//! (where the housing is). It is convex for every profile, so a ray from a camera inside it
+//! leaves it exactly once; the ray hits the surface if it leaves above the base plane and
+//! misses (it sees the housing) if it leaves below.
+
+use fabkit_designs::profile::BodyProfile;
+
+/// The outer skin surface of one body profile, in closed form (sensor frame, mm).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ReferenceSurface {
+    /// Sphere of `radius_mm` about the origin, for z >= `base_z_mm` (spherical cap).
+    Cap { radius_mm: f64, base_z_mm: f64 },
+    /// Sphere of `radius_mm` about the origin for z >= 0 on a cylinder of the same radius down
+    /// to `base_z_mm` (R-Tac0, Sec. III-B1).
+    HemisphereOnCylinder { radius_mm: f64, base_z_mm: f64 },
+    /// Ellipsoid `(x^2 + y^2) / a^2 + z^2 / c^2 = 1` for z >= 0 (UVDtact).
+    HalfEllipsoid { a_mm: f64, c_mm: f64 },
+}
+
+/// A ray's exit from the sensor body: distance along the ray (mm), unit outward normal (sensor
+/// frame), and whether the exit is on the skin (above the base plane) rather than below it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Exit {
+    pub t_mm: f64,
+    pub normal: [f64; 3],
+    pub on_skin: bool,
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// Far root of `a t^2 + 2 b t + c = 0` (a > 0), or None without real roots.
+#[inline]
+fn far_root(a: f64, b: f64, c: f64) -> Option<f64> {
+    let disc = b * b - a * c;
+    if !(disc >= 0.0) {
+        return None;
+    }
+    let s = disc.sqrt();
+    // Stable form: the far root is (-b + s) / a; when b > 0 use c / (-b - s).
+    Some(if b <= 0.0 { (-b + s) / a } else { c / (-b - s) })
+}
+
+impl ReferenceSurface {
+    /// The outer skin surface (offset 0) of `body`.
+    pub fn of(body: &BodyProfile) -> ReferenceSurface {
+        match *body {
+            BodyProfile::SphericalCap { .. } => ReferenceSurface::Cap {
+                radius_mm: body.sphere_radius_mm().unwrap_or(0.0),
+                base_z_mm: body.base_z_mm(),
+            },
+            BodyProfile::HemisphereOnCylinder { radius_mm, .. } => {
+                ReferenceSurface::HemisphereOnCylinder {
+                    radius_mm,
+                    base_z_mm: body.base_z_mm(),
+                }
+            }
+            BodyProfile::HalfEllipsoid {
+                diameter_mm,
+                height_mm,
+            } => ReferenceSurface::HalfEllipsoid {
+                a_mm: diameter_mm / 2.0,
+                c_mm: height_mm,
+            },
+        }
+    }
+
+    /// z of the base plane, mm.
+    pub fn base_z_mm(&self) -> f64 {
+        match *self {
+            ReferenceSurface::Cap { base_z_mm, .. }
+            | ReferenceSurface::HemisphereOnCylinder { base_z_mm, .. } => base_z_mm,
+            ReferenceSurface::HalfEllipsoid { .. } => 0.0,
+        }
+    }
+
+    /// Radius of the rim (where the skin meets the base plane), mm.
+    pub fn rim_radius_mm(&self) -> f64 {
+        match *self {
+            ReferenceSurface::Cap {
+                radius_mm,
+                base_z_mm,
+            } => (radius_mm * radius_mm - base_z_mm * base_z_mm)
+                .max(0.0)
+                .sqrt(),
+            ReferenceSurface::HemisphereOnCylinder { radius_mm, .. } => radius_mm,
+            ReferenceSurface::HalfEllipsoid { a_mm, .. } => a_mm,
+        }
+    }
+
+    /// Whether `p` (sensor frame, mm) is strictly inside the sensor body (see the module
+    /// documentation), with a margin of `margin_mm`.
+    pub fn contains(&self, p: [f64; 3], margin_mm: f64) -> bool {
+        let rho = p[0].hypot(p[1]);
+        let zb = self.base_z_mm();
+        if p[2] < zb {
+            return rho < self.rim_radius_mm() - margin_mm;
+        }
+        match *self {
+            ReferenceSurface::Cap { radius_mm, .. } => dot(p, p).sqrt() < radius_mm - margin_mm,
+            ReferenceSurface::HemisphereOnCylinder { radius_mm, .. } => {
+                if p[2] <= 0.0 {
+                    rho < radius_mm - margin_mm
+                } else {
+                    dot(p, p).sqrt() < radius_mm - margin_mm
+                }
+            }
+            ReferenceSurface::HalfEllipsoid { a_mm, c_mm } => {
+                let (a, c) = (a_mm - margin_mm, c_mm - margin_mm);
+                a > 0.0 && c > 0.0 && (rho / a).powi(2) + (p[2] / c).powi(2) < 1.0
+            }
+        }
+    }
+
+    /// Where the ray `o + t d` (o inside the sensor body, d a unit vector; sensor frame, mm)
+    /// leaves the sensor body. `None` only for a non-finite direction.
+    #[inline]
+    pub fn exit(&self, o: [f64; 3], d: [f64; 3]) -> Option<Exit> {
+        if !(d[0].is_finite() && d[1].is_finite() && d[2].is_finite()) {
+            return None;
+        }
+        let zb = self.base_z_mm();
+        let at = |t: f64| [o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2]];
+        // The vertical wall below the base plane (and the cylinder of R-Tac0): r = radius.
+        let wall = |radius: f64| -> Option<(f64, [f64; 3])> {
+            let a = d[0] * d[0] + d[1] * d[1];
+            if !(a > 0.0) {
+                return None;
+            }
+            let b = o[0] * d[0] + o[1] * d[1];
+            let c = o[0] * o[0] + o[1] * o[1] - radius * radius;
+            let t = far_root(a, b, c)?;
+            let p = at(t);
+            Some((t, [p[0] / radius, p[1] / radius, 0.0]))
+        };
+        let below = |rim: f64| -> Option<Exit> {
+            // Leaves through the wall below the base plane (or, straight down, never: report
+            // the base plane itself as a miss).
+            match wall(rim) {
+                Some((t, n)) => Some(Exit {
+                    t_mm: t,
+                    normal: n,
+                    on_skin: false,
+                }),
+                None => Some(Exit {
+                    t_mm: f64::INFINITY,
+                    normal: [0.0, 0.0, -1.0],
+                    on_skin: false,
+                }),
+            }
+        };
+        match *self {
+            ReferenceSurface::Cap { radius_mm, .. } => {
+                let b = dot(o, d);
+                let c = dot(o, o) - radius_mm * radius_mm;
+                if let Some(t) = far_root(1.0, b, c) {
+                    let p = at(t);
+                    if p[2] >= zb {
+                        let r = radius_mm;
+                        return Some(Exit {
+                            t_mm: t,
+                            normal: [p[0] / r, p[1] / r, p[2] / r],
+                            on_skin: true,
+                        });
+                    }
+                }
+                below(self.rim_radius_mm())
+            }
+            ReferenceSurface::HemisphereOnCylinder { radius_mm, .. } => {
+                let b = dot(o, d);
+                let c = dot(o, o) - radius_mm * radius_mm;
+                if let Some(t) = far_root(1.0, b, c) {
+                    let p = at(t);
+                    if p[2] >= 0.0 {
+                        let r = radius_mm;
+                        return Some(Exit {
+                            t_mm: t,
+                            normal: [p[0] / r, p[1] / r, p[2] / r],
+                            on_skin: true,
+                        });
+                    }
+                }
+                match wall(radius_mm) {
+                    Some((t, n)) => Some(Exit {
+                        t_mm: t,
+                        normal: n,
+                        on_skin: at(t)[2] >= zb,
+                    }),
+                    None => below(radius_mm),
+                }
+            }
+            ReferenceSurface::HalfEllipsoid { a_mm, c_mm } => {
+                let (ia, ic) = (1.0 / (a_mm * a_mm), 1.0 / (c_mm * c_mm));
+                let qa = (d[0] * d[0] + d[1] * d[1]) * ia + d[2] * d[2] * ic;
+                let qb = (o[0] * d[0] + o[1] * d[1]) * ia + o[2] * d[2] * ic;
+                let qc = (o[0] * o[0] + o[1] * o[1]) * ia + o[2] * o[2] * ic - 1.0;
+                if let Some(t) = far_root(qa, qb, qc) {
+                    let p = at(t);
+                    if p[2] >= 0.0 {
+                        let g = [p[0] * ia, p[1] * ia, p[2] * ic];
+                        let l = dot(g, g).sqrt();
+                        return Some(Exit {
+                            t_mm: t,
+                            normal: [g[0] / l, g[1] / l, g[2] / l],
+                            on_skin: true,
+                        });
+                    }
+                }
+                below(a_mm)
+            }
+        }
+    }
+}
+
+impl ReferenceSurface {
+    /// [`exit`](Self::exit) for every direction of `dirs` from `o`: writes the exit distance
+    /// (`t_exit_mm`, NaN for a non-finite direction), the skin hit distance (`t_skin_mm`, NaN
+    /// where the ray leaves below the base plane) and the skin normal (written only on a skin
+    /// hit). The common case (the spherical or ellipsoidal part) runs without branches.
+    ///
+    /// # Panics
+    /// If the output slices are not as long as `dirs`.
+    pub fn exit_all(
+        &self,
+        o: [f64; 3],
+        dirs: &[[f64; 3]],
+        t_exit_mm: &mut [f64],
+        t_skin_mm: &mut [f64],
+        normal: &mut [[f64; 3]],
+    ) {
+        assert!(
+            t_exit_mm.len() == dirs.len()
+                && t_skin_mm.len() == dirs.len()
+                && normal.len() == dirs.len()
+        );
+        let (r, zmin) = match *self {
+            ReferenceSurface::Cap {
+                radius_mm,
+                base_z_mm,
+            } => (radius_mm, base_z_mm),
+            ReferenceSurface::HemisphereOnCylinder { radius_mm, .. } => (radius_mm, 0.0),
+            ReferenceSurface::HalfEllipsoid { .. } => {
+                for (p, d) in dirs.iter().enumerate() {
+                    let e = self.exit(o, *d);
+                    t_exit_mm[p] = e.map_or(f64::NAN, |e| e.t_mm);
+                    t_skin_mm[p] = match e {
+                        Some(e) if e.on_skin => {
+                            normal[p] = e.normal;
+                            e.t_mm
+                        }
+                        _ => f64::NAN,
+                    };
+                }
+                return;
+            }
+        };
+        let c = dot(o, o) - r * r;
+        let inv_r = 1.0 / r;
+        for (p, d) in dirs.iter().enumerate() {
+            // Far root of the sphere (o inside: c < 0, so the root is real and positive).
+            let b = dot(o, *d);
+            let s = (b * b - c).sqrt();
+            let t = if b <= 0.0 { s - b } else { -c / (b + s) };
+            let z = o[2] + t * d[2];
+            if z >= zmin {
+                t_exit_mm[p] = t;
+                t_skin_mm[p] = t;
+                normal[p] = [
+                    (o[0] + t * d[0]) * inv_r,
+                    (o[1] + t * d[1]) * inv_r,
+                    z * inv_r,
+                ];
+            } else {
+                let e = self.exit(o, *d);
+                t_exit_mm[p] = e.map_or(f64::NAN, |e| e.t_mm);
+                t_skin_mm[p] = match e {
+                    Some(e) if e.on_skin => {
+                        normal[p] = e.normal;
+                        e.t_mm
+                    }
+                    _ => f64::NAN,
+                };
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rtac0_rays_leave_through_sphere_cylinder_and_below_the_base() {
+        let s = ReferenceSurface::HemisphereOnCylinder {
+            radius_mm: 15.1,
+            base_z_mm: -6.0,
+        };
+        let o = [0.0, 0.0, -10.0];
+        assert!(s.contains(o, 0.0));
+        // Straight up: the pole.
+        let e = s.exit(o, [0.0, 0.0, 1.0]).unwrap();
+        assert!((e.t_mm - 25.1).abs() < 1e-12 && e.on_skin);
+        // Sideways: the wall below the base plane, a miss.
+        let e = s.exit(o, [1.0, 0.0, 0.0]).unwrap();
+        assert!((e.t_mm - 15.1).abs() < 1e-12 && !e.on_skin);
+        // Up at 45 deg: the cylinder at z = -10 + 15.1 = 5.1 > 0, so the sphere.
+        let q = std::f64::consts::FRAC_1_SQRT_2;
+        let e = s.exit(o, [q, 0.0, q]).unwrap();
+        let p = [e.t_mm * q, 0.0, -10.0 + e.t_mm * q];
+        assert!((dot(p, p).sqrt() - 15.1).abs() < 1e-12 && p[2] > 0.0);
+    }
+}
