@@ -47,19 +47,31 @@ pub(crate) fn replace_dir(
         return Err(e);
     }
 
+    move_into_place(out_dir, &parent, &name, &tmp, existing)
+}
+
+/// Moves the complete temporary sibling `tmp` to `out_dir` (moving a previous export aside and
+/// deleting it), then syncs the parent. On error `out_dir` is as it was and `tmp` is removed.
+fn move_into_place(
+    out_dir: &Path,
+    parent: &Path,
+    name: &OsString,
+    tmp: &Path,
+    existing: bool,
+) -> Result<Replaced, ExportError> {
     let mut warnings = Vec::new();
     if existing {
-        let backup = unique_sibling_path(&parent, &name, "old");
+        let backup = unique_sibling_path(parent, name, "old");
         if let Err(e) = fs::rename(out_dir, &backup) {
-            let _ = fs::remove_dir_all(&tmp);
+            let _ = fs::remove_dir_all(tmp);
             return Err(ExportError::io(
                 "moving the previous export aside from",
                 out_dir,
             )(e));
         }
-        if let Err(e) = fs::rename(&tmp, out_dir) {
+        if let Err(e) = fs::rename(tmp, out_dir) {
             let restored = fs::rename(&backup, out_dir);
-            let _ = fs::remove_dir_all(&tmp);
+            let _ = fs::remove_dir_all(tmp);
             if let Err(r) = restored {
                 warnings.push(format!(
                     "could not move the previous export back from {}: {r}",
@@ -77,15 +89,15 @@ pub(crate) fn replace_dir(
                 backup.display()
             ));
         }
-    } else if let Err(e) = fs::rename(&tmp, out_dir) {
-        let _ = fs::remove_dir_all(&tmp);
+    } else if let Err(e) = fs::rename(tmp, out_dir) {
+        let _ = fs::remove_dir_all(tmp);
         return Err(ExportError::io(
             "moving the new export into place at",
             out_dir,
         )(e));
     }
     // Make the renames durable; a failure here does not undo a complete export.
-    if let Err(e) = sync_dir(&parent) {
+    if let Err(e) = sync_dir(parent) {
         let cause = std::error::Error::source(&e)
             .map(ToString::to_string)
             .unwrap_or_default();
@@ -95,6 +107,112 @@ pub(crate) fn replace_dir(
         replaced_previous: existing,
         warnings,
     })
+}
+
+/// An output folder written file by file (e.g. a dataset too large to hold in memory): files go
+/// into a fresh temporary sibling of the folder; [`StagedDir::commit`] moves it into place
+/// exactly as [`crate::write_kit`] does (a missing folder, an empty one, or a previous fabkit
+/// output with a fabkit `manifest.json` is replaced; anything else is refused before writing).
+/// Dropped without a commit, the temporary folder is removed and the output is untouched.
+#[derive(Debug)]
+pub struct StagedDir {
+    out_dir: PathBuf,
+    parent: PathBuf,
+    name: OsString,
+    tmp: PathBuf,
+    existing: bool,
+    done: bool,
+}
+
+impl StagedDir {
+    /// Checks `out_dir` and creates the temporary sibling.
+    ///
+    /// # Errors
+    /// [`ExportError::InvalidOutDir`], [`ExportError::NotADirectory`],
+    /// [`ExportError::ForeignDirectory`], [`ExportError::Io`].
+    pub fn new(out_dir: &Path) -> Result<StagedDir, ExportError> {
+        let (parent, name) = split(out_dir)?;
+        fs::create_dir_all(&parent)
+            .map_err(ExportError::io("creating parent directory", &parent))?;
+        let existing = inspect_existing(out_dir)?;
+        let tmp = create_unique_sibling(&parent, &name, "tmp")?;
+        Ok(StagedDir {
+            out_dir: out_dir.to_path_buf(),
+            parent,
+            name,
+            tmp,
+            existing,
+            done: false,
+        })
+    }
+
+    /// Writes one file (relative `/`-separated path of `[A-Za-z0-9_.-]` components; parent
+    /// folders are created) and syncs it. Safe to call from several threads for different
+    /// files.
+    ///
+    /// # Errors
+    /// [`ExportError::InvalidOption`] for a bad path or one written twice, [`ExportError::Io`].
+    pub fn write(&self, rel: &str, bytes: &[u8]) -> Result<(), ExportError> {
+        let ok = !rel.is_empty()
+            && rel.split('/').all(|c| {
+                !c.is_empty()
+                    && c != "."
+                    && c != ".."
+                    && c.chars()
+                        .all(|ch| ch.is_ascii_alphanumeric() || "_.-".contains(ch))
+            });
+        if !ok {
+            return Err(ExportError::InvalidOption {
+                field: "file",
+                value: rel.to_string(),
+                rule: "must be a relative path of [A-Za-z0-9_.-] components",
+            });
+        }
+        let path = rel.split('/').fold(self.tmp.clone(), |p, c| p.join(c));
+        if let Some(dir) = path.parent() {
+            fs::create_dir_all(dir).map_err(ExportError::io("creating", dir))?;
+        }
+        write_file_synced(&path, bytes)
+    }
+
+    /// Syncs every folder and moves the finished output into place; returns warnings (e.g. a
+    /// previous output that could not be deleted).
+    ///
+    /// # Errors
+    /// [`ExportError::Io`]; the output is then as it was.
+    pub fn commit(mut self) -> Result<Vec<String>, ExportError> {
+        let mut dirs = vec![self.tmp.clone()];
+        let mut k = 0;
+        while k < dirs.len() {
+            for e in fs::read_dir(&dirs[k]).map_err(ExportError::io("listing", &dirs[k]))? {
+                let e = e.map_err(ExportError::io("listing", &dirs[k]))?;
+                if e.file_type().map(|t| t.is_dir()).unwrap_or(false) {
+                    dirs.push(e.path());
+                }
+            }
+            k += 1;
+        }
+        for d in dirs.iter().rev() {
+            sync_dir(d)?;
+        }
+        self.done = true;
+        let r = move_into_place(
+            &self.out_dir,
+            &self.parent,
+            &self.name,
+            &self.tmp,
+            self.existing,
+        )?;
+        Ok(r.warnings)
+    }
+}
+
+impl Drop for StagedDir {
+    fn drop(&mut self) {
+        if !self.done {
+            let _ = fs::remove_dir_all(&self.tmp);
+        }
+    }
 }
 
 /// Writes `bytes` to a new file at `path` and syncs it to disk.

@@ -86,6 +86,8 @@ pub enum ExportError {
     /// The in-memory 3MF (zip) archive could not be built.
     #[error("building the 3MF archive: {reason}")]
     ThreeMf { reason: String },
+    #[error("encoding {what}: {reason}")]
+    Encode { what: String, reason: String },
     #[error("serializing manifest.json")]
     Json(#[from] serde_json::Error),
 }

@@ -20,10 +20,12 @@ mod check;
 mod error;
 mod layout;
 mod manifest;
+pub mod raster;
 mod sheet;
 mod stl;
 mod three_mf;
 
+pub use atomic::StagedDir;
 pub use check::check_printable_mesh;
 pub use error::ExportError;
 pub use manifest::{

@@ -30,6 +30,8 @@ enum Command {
     /// Camera calibration: extrinsics from pin-dome observations.
     #[command(subcommand)]
     Calibrate(crate::calibrate_cmd::CalibrateCommand),
+    /// Ground-truth depth maps of the protrusion semi-domes through the calibrated camera.
+    Groundtruth(crate::groundtruth_cmd::GroundTruthArgs),
     /// List the designs embedded in fabkit.
     Designs,
     /// Check a design and print its resolved layer stack, without writing anything.
@@ -231,6 +233,7 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
         Command::Export(args) => export(args),
         Command::Fixtures(args) => crate::fixtures_cmd::run(args),
         Command::Calibrate(cmd) => crate::calibrate_cmd::run(cmd),
+        Command::Groundtruth(args) => crate::groundtruth_cmd::run(args),
     }
 }
 

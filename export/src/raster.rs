@@ -1,0 +1,273 @@
+//! Raster and point-cloud writers for ground-truth datasets: NPY (float32), 16-bit and 8-bit
+//! PNG, colour-mapped preview PNG and binary PLY. Every encoder is deterministic (same input,
+//! same bytes). Images are row-major, (H, W) or (H, W, C).
+
+use crate::ExportError;
+
+fn encode_err(what: &str) -> impl Fn(png::EncodingError) -> ExportError + '_ {
+    move |e| ExportError::Encode {
+        what: format!("PNG {what}"),
+        reason: e.to_string(),
+    }
+}
+
+/// A float32 array as an NPY file (format version 1.0, little endian `<f4`, C order): what
+/// `numpy.load` reads. `shape` is e.g. `[H, W]` or `[H, W, 3]`.
+///
+/// # Panics
+/// If `data.len()` is not the product of `shape`.
+pub fn npy_f32(shape: &[usize], data: &[f32]) -> Vec<u8> {
+    assert_eq!(
+        shape.iter().product::<usize>(),
+        data.len(),
+        "data matches the shape"
+    );
+    let dims: Vec<String> = shape.iter().map(|d| d.to_string()).collect();
+    let shape_txt = if dims.len() == 1 {
+        format!("({},)", dims[0])
+    } else {
+        format!("({})", dims.join(", "))
+    };
+    let mut header = format!("{{'descr': '<f4', 'fortran_order': False, 'shape': {shape_txt}, }}");
+    // magic (6) + version (2) + header length (2) + header + '\n' is a multiple of 64.
+    let total = 10 + header.len() + 1;
+    header.push_str(&" ".repeat(total.div_ceil(64) * 64 - total));
+    header.push('\n');
+    let mut out = Vec::with_capacity(10 + header.len() + 4 * data.len());
+    out.extend_from_slice(b"\x93NUMPY\x01\x00");
+    out.extend_from_slice(&(header.len() as u16).to_le_bytes());
+    out.extend_from_slice(header.as_bytes());
+    for v in data {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    out
+}
+
+fn png_bytes(
+    width: usize,
+    height: usize,
+    color: png::ColorType,
+    depth: png::BitDepth,
+    data: &[u8],
+    text: &[(&str, &str)],
+) -> Result<Vec<u8>, ExportError> {
+    let mut out = Vec::new();
+    {
+        let mut enc = png::Encoder::new(&mut out, width as u32, height as u32);
+        enc.set_color(color);
+        enc.set_depth(depth);
+        for (k, v) in text {
+            enc.add_text_chunk(k.to_string(), v.to_string())
+                .map_err(encode_err("text chunk"))?;
+        }
+        let mut w = enc.write_header().map_err(encode_err("header"))?;
+        w.write_image_data(data).map_err(encode_err("image data"))?;
+        w.finish().map_err(encode_err("finish"))?;
+    }
+    Ok(out)
+}
+
+/// A 16-bit greyscale PNG (`text`: tEXt chunks, e.g. the units and scale).
+///
+/// # Errors
+/// [`ExportError::Encode`] if the encoder fails.
+///
+/// # Panics
+/// If `data.len() != width * height`.
+pub fn png_gray16(
+    width: usize,
+    height: usize,
+    data: &[u16],
+    text: &[(&str, &str)],
+) -> Result<Vec<u8>, ExportError> {
+    assert_eq!(data.len(), width * height);
+    let bytes: Vec<u8> = data.iter().flat_map(|v| v.to_be_bytes()).collect();
+    png_bytes(
+        width,
+        height,
+        png::ColorType::Grayscale,
+        png::BitDepth::Sixteen,
+        &bytes,
+        text,
+    )
+}
+
+/// An 8-bit greyscale PNG.
+///
+/// # Errors
+/// [`ExportError::Encode`] if the encoder fails.
+///
+/// # Panics
+/// If `data.len() != width * height`.
+pub fn png_gray8(
+    width: usize,
+    height: usize,
+    data: &[u8],
+    text: &[(&str, &str)],
+) -> Result<Vec<u8>, ExportError> {
+    assert_eq!(data.len(), width * height);
+    png_bytes(
+        width,
+        height,
+        png::ColorType::Grayscale,
+        png::BitDepth::Eight,
+        data,
+        text,
+    )
+}
+
+/// An 8-bit RGB PNG; `rgb` holds `width * height * 3` bytes.
+///
+/// # Errors
+/// [`ExportError::Encode`] if the encoder fails.
+///
+/// # Panics
+/// If `rgb.len() != 3 * width * height`.
+pub fn png_rgb8(
+    width: usize,
+    height: usize,
+    rgb: &[u8],
+    text: &[(&str, &str)],
+) -> Result<Vec<u8>, ExportError> {
+    assert_eq!(rgb.len(), 3 * width * height);
+    png_bytes(
+        width,
+        height,
+        png::ColorType::Rgb,
+        png::BitDepth::Eight,
+        rgb,
+        text,
+    )
+}
+
+/// How a quantity is stored in a 16-bit PNG: `value = (count - offset_counts) * scale`,
+/// count 0 = no value.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Png16Encoding {
+    /// Units per count (for depth: 0.001 mm, one micrometre).
+    pub scale: f64,
+    pub offset_counts: u16,
+}
+
+impl Png16Encoding {
+    /// Counts of `values` (NaN -> 0); values that do not fit in 1..=65535 become 0 too. Returns
+    /// the counts and the number of finite values that did not fit.
+    pub fn encode(&self, values: &[f64]) -> (Vec<u16>, usize) {
+        let mut clipped = 0;
+        let counts = values
+            .iter()
+            .map(|v| {
+                if !v.is_finite() {
+                    return 0;
+                }
+                let c = (v / self.scale).round() + self.offset_counts as f64;
+                if (1.0..=65535.0).contains(&c) {
+                    c as u16
+                } else {
+                    clipped += 1;
+                    0
+                }
+            })
+            .collect();
+        (counts, clipped)
+    }
+}
+
+/// A colour-mapped preview (d3's Turbo map, `colorous`): `lo` maps to the dark blue end, `hi`
+/// to the dark red end; NaN is black. Returns RGB bytes.
+pub fn preview_rgb(values: &[f64], lo: f64, hi: f64) -> Vec<u8> {
+    let span = if hi > lo { hi - lo } else { 1.0 };
+    let mut out = Vec::with_capacity(3 * values.len());
+    for v in values {
+        if v.is_finite() {
+            let c = colorous::TURBO.eval_continuous((v - lo) / span);
+            out.extend_from_slice(&[c.r, c.g, c.b]);
+        } else {
+            out.extend_from_slice(&[0, 0, 0]);
+        }
+    }
+    out
+}
+
+/// Unit vectors as RGB (`(n + 1) / 2 * 255`), NaN black: the usual normal-map preview.
+pub fn normals_rgb(normals: &[[f64; 3]]) -> Vec<u8> {
+    let mut out = Vec::with_capacity(3 * normals.len());
+    for n in normals {
+        if n.iter().all(|c| c.is_finite()) {
+            out.extend(
+                n.iter()
+                    .map(|c| ((c + 1.0) * 127.5).round().clamp(0.0, 255.0) as u8),
+            );
+        } else {
+            out.extend_from_slice(&[0, 0, 0]);
+        }
+    }
+    out
+}
+
+/// One point of a PLY point cloud.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlyPoint {
+    pub xyz: [f32; 3],
+    pub normal: [f32; 3],
+    /// Pixel column and row.
+    pub u: u16,
+    pub v: u16,
+    /// 1 on a protrusion (contact), else 0.
+    pub contact: u8,
+}
+
+/// A binary little-endian PLY point cloud with per-point normal, pixel and contact flag;
+/// `comments` go into the header (one line each, no newlines).
+pub fn ply_points(points: &[PlyPoint], comments: &[String]) -> Vec<u8> {
+    let mut h = String::from("ply\nformat binary_little_endian 1.0\n");
+    for c in comments {
+        h.push_str(&format!("comment {}\n", c.replace(['\n', '\r'], " ")));
+    }
+    h.push_str(&format!(
+        "element vertex {}\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nproperty ushort u\nproperty ushort v\nproperty uchar contact\nend_header\n",
+        points.len()
+    ));
+    let mut out = h.into_bytes();
+    out.reserve(points.len() * 29);
+    for p in points {
+        for c in p.xyz.iter().chain(&p.normal) {
+            out.extend_from_slice(&c.to_le_bytes());
+        }
+        out.extend_from_slice(&p.u.to_le_bytes());
+        out.extend_from_slice(&p.v.to_le_bytes());
+        out.push(p.contact);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn npy_header_is_padded_to_64_bytes_and_holds_the_shape() {
+        let b = npy_f32(&[2, 3], &[0.0, 1.0, 2.0, 3.0, 4.0, 5.5]);
+        let hlen = u16::from_le_bytes([b[8], b[9]]) as usize;
+        assert_eq!((10 + hlen) % 64, 0);
+        let h = std::str::from_utf8(&b[10..10 + hlen]).unwrap();
+        assert!(h.contains("'shape': (2, 3)") && h.ends_with('\n'));
+        assert_eq!(&b[10 + hlen + 20..], &5.5f32.to_le_bytes());
+    }
+
+    #[test]
+    fn png16_encoding_rounds_and_marks_missing_and_clipped() {
+        let e = Png16Encoding {
+            scale: 0.001,
+            offset_counts: 0,
+        };
+        let (c, clipped) = e.encode(&[12.3456, f64::NAN, -1.0, 70.0]);
+        assert_eq!(c, vec![12346, 0, 0, 0]);
+        assert_eq!(clipped, 2);
+        let d = Png16Encoding {
+            scale: 0.001,
+            offset_counts: 32768,
+        };
+        assert_eq!(d.encode(&[-0.25]).0, vec![32518]);
+    }
+}

@@ -1,0 +1,408 @@
+//! `fabkit groundtruth`: argument parsing, dispatch over fabkit-calibration (rendering) and
+//! fabkit-export (file encoders, atomic output folder), progress.
+
+use std::error::Error;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use fabkit_calibration::groundtruth::inputs::{
+    pairs_csv, read_extrinsics, read_fixtures, read_with_hash, sha256_hex, Configuration,
+};
+use fabkit_calibration::groundtruth::rays::PixelRays;
+use fabkit_calibration::groundtruth::surface::ReferenceSurface;
+use fabkit_calibration::groundtruth::{half_masks, indented_hits, reference_hits, DepthFrame};
+use fabkit_calibration::read_camera_file;
+use fabkit_export::raster::{
+    normals_rgb, npy_f32, ply_points, png_gray16, png_gray8, png_rgb8, preview_rgb, PlyPoint,
+    Png16Encoding,
+};
+use fabkit_export::StagedDir;
+use rayon::prelude::*;
+use serde_json::{json, Value};
+
+use crate::cli::load_design;
+
+#[derive(clap::Args, Debug)]
+pub struct GroundTruthArgs {
+    /// A design YAML file or the name of a library design (default: rtac0); the fixtures must
+    /// have been built from it.
+    design: Option<String>,
+    /// Camera file (OpenCV FileStorage YAML, ROS camera_info YAML or fabkit JSON).
+    #[arg(long, value_name = "CAM")]
+    camera: PathBuf,
+    /// extrinsics.json of `fabkit calibrate extrinsics` (T_cam_sensor).
+    #[arg(long, value_name = "extrinsics.json")]
+    extrinsics: PathBuf,
+    /// Output folder of `fabkit fixtures` (reads protrusions/index.json and the pattern files).
+    #[arg(long, value_name = "FIXTURES_DIR")]
+    fixtures: PathBuf,
+    /// Output folder. Replaced as a whole if it holds a previous fabkit output; refused if it
+    /// holds anything else.
+    #[arg(long, value_name = "DIR")]
+    out: PathBuf,
+    /// Apply one of the design's presets.
+    #[arg(long)]
+    preset: Option<String>,
+}
+
+/// 16-bit PNG encodings: depth in micrometres; differences offset by 32768 counts.
+const DEPTH_PNG: Png16Encoding = Png16Encoding {
+    scale: 0.001,
+    offset_counts: 0,
+};
+const DELTA_PNG: Png16Encoding = Png16Encoding {
+    scale: 0.001,
+    offset_counts: 32768,
+};
+
+/// Files of one rendered frame: (relative path, bytes, manifest entry).
+type Files = Vec<(String, Vec<u8>, Value)>;
+
+fn f32s(v: &[f64]) -> Vec<f32> {
+    v.iter().map(|x| *x as f32).collect()
+}
+
+fn finite_range(v: &[f64]) -> Option<(f64, f64)> {
+    let (lo, hi) = v
+        .iter()
+        .filter(|x| x.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+            (a.min(*x), b.max(*x))
+        });
+    (lo <= hi).then_some((lo, hi))
+}
+
+/// A scalar map as `.npy` (float32 mm), 16-bit PNG (um) and preview PNG.
+#[allow(clippy::too_many_arguments)]
+fn scalar_files(
+    files: &mut Files,
+    dir: &str,
+    name: &str,
+    what: &str,
+    values: &[f64],
+    (w, h): (usize, usize),
+    enc: Png16Encoding,
+    preview: (f64, f64),
+) -> Result<(), Box<dyn Error>> {
+    let stem = name.trim_end_matches("_mm");
+    let npy = format!("{dir}/{name}.npy");
+    files.push((
+        npy.clone(),
+        npy_f32(&[h, w], &f32s(values)),
+        json!({"file": npy, "quantity": what, "units": "mm", "dtype": "float32", "shape": [h, w], "missing": "NaN"}),
+    ));
+    let (counts, clipped) = enc.encode(values);
+    let png = format!("{dir}/{stem}_um.png");
+    let text = format!(
+        "{what}; value_mm = (count - {}) * {}; count 0 = no value",
+        enc.offset_counts, enc.scale
+    );
+    files.push((
+        png.clone(),
+        png_gray16(w, h, &counts, &[("Description", &text)])?,
+        json!({"file": png, "quantity": what, "units": "um", "dtype": "uint16", "shape": [h, w],
+               "value_mm": format!("(count - {}) * {}", enc.offset_counts, enc.scale), "scale_mm_per_count": enc.scale,
+               "offset_counts": enc.offset_counts, "missing": 0, "clipped_pixels": clipped}),
+    ));
+    let pv = format!("{dir}/{stem}_preview.png");
+    files.push((
+        pv.clone(),
+        png_rgb8(w, h, &preview_rgb(values, preview.0, preview.1), &[])?,
+        json!({"file": pv, "quantity": format!("preview of {name}"), "colour_map": "turbo (d3, colorous)", "range_mm": [preview.0, preview.1], "missing": "black"}),
+    ));
+    Ok(())
+}
+
+/// Every file of a rendered frame (and of its difference to the reference, for a
+/// configuration).
+fn frame_files(
+    dir: &str,
+    f: &DepthFrame,
+    reference: Option<&DepthFrame>,
+    preview: (f64, f64),
+    provenance: &str,
+) -> Result<Files, Box<dyn Error>> {
+    let (w, h) = (f.width, f.height);
+    let mut files = Files::new();
+    scalar_files(
+        &mut files,
+        dir,
+        "range_mm",
+        "range: distance along the pixel's ray from the camera centre to the elastomer surface",
+        &f.range_mm,
+        (w, h),
+        DEPTH_PNG,
+        preview,
+    )?;
+    scalar_files(
+        &mut files,
+        dir,
+        "zdepth_mm",
+        "z-depth: z of the surface point in the camera frame",
+        &f.zdepth_mm,
+        (w, h),
+        DEPTH_PNG,
+        preview,
+    )?;
+    let normals: Vec<f32> = f
+        .normal_cam
+        .iter()
+        .flat_map(|n| n.map(|c| c as f32))
+        .collect();
+    let nf = format!("{dir}/normals.npy");
+    files.push((nf.clone(), npy_f32(&[h, w, 3], &normals), json!({"file": nf, "quantity": "unit normal of the elastomer surface, pointing out of the elastomer, camera frame", "units": "1", "dtype": "float32", "shape": [h, w, 3], "missing": "NaN"})));
+    let np = format!("{dir}/normals_preview.png");
+    files.push((np.clone(), png_rgb8(w, h, &normals_rgb(&f.normal_cam), &[])?, json!({"file": np, "quantity": "preview of normals.npy: rgb = (n + 1) / 2", "missing": "black"})));
+    let pts: Vec<PlyPoint> = (0..w * h)
+        .filter(|&p| f.range_mm[p].is_finite())
+        .map(|p| PlyPoint {
+            xyz: f.point_cam_mm[p].map(|c| c as f32),
+            normal: f.normal_cam[p].map(|c| c as f32),
+            u: (p % w) as u16,
+            v: (p / w) as u16,
+            contact: f.contact[p] as u8,
+        })
+        .collect();
+    let ply = format!("{dir}/points.ply");
+    let comments = vec![
+        "frame: camera (x right, y down, z forward; docs/conventions.md), mm".to_string(),
+        "properties: point, unit normal out of the elastomer, pixel (u column, v row), contact (1 on a protrusion)".to_string(),
+        provenance.to_string(),
+    ];
+    files.push((ply.clone(), ply_points(&pts, &comments), json!({"file": ply, "quantity": "surface points with normals, one per pixel that sees the surface", "frame": "camera", "units": "mm", "points": pts.len()})));
+    if let Some(r) = reference {
+        let (dr, dz) = f.delta(r);
+        let lo = finite_range(&dr)
+            .map(|x| x.0)
+            .unwrap_or(0.0)
+            .min(finite_range(&dz).map(|x| x.0).unwrap_or(0.0));
+        let pr = (if lo < 0.0 { lo } else { -0.001 }, 0.0);
+        scalar_files(&mut files, dir, "delta_range_mm", "differential range: indented minus reference (negative where the skin is pushed towards the camera)", &dr, (w, h), DELTA_PNG, pr)?;
+        scalar_files(
+            &mut files,
+            dir,
+            "delta_zdepth_mm",
+            "differential z-depth: indented minus reference",
+            &dz,
+            (w, h),
+            DELTA_PNG,
+            pr,
+        )?;
+        let mask: Vec<u8> = (0..w * h)
+            .map(|p| {
+                if f.contact[p] && r.range_mm[p].is_finite() {
+                    255
+                } else {
+                    0
+                }
+            })
+            .collect();
+        let cm = format!("{dir}/contact_mask.png");
+        files.push((cm.clone(), png_gray8(w, h, &mask, &[])?, json!({"file": cm, "quantity": "contact mask: 255 where a protrusion pushes the skin in (the surface seen is a protrusion), else 0", "dtype": "uint8", "shape": [h, w]})));
+    }
+    Ok(files)
+}
+
+pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
+    let t0 = std::time::Instant::now();
+    let mut loaded = load_design(args.design.as_deref())?;
+    if let Some(p) = &args.preset {
+        loaded.design = loaded.design.with_preset(p)?;
+    }
+    let design = &loaded.design;
+    let camera = read_camera_file(&args.camera)?;
+    let (_, camera_sha) = read_with_hash(&args.camera)?;
+    let (t_cam_sensor, extrinsics_sha) = read_extrinsics(&args.extrinsics)?;
+    let fixtures = read_fixtures(&args.fixtures, &design.name)?;
+    let surface = ReferenceSurface::of(&design.body);
+    let rays = PixelRays::new(&camera, &t_cam_sensor);
+    let c = rays.origin_mm;
+    if !surface.contains(c, 0.0) {
+        return Err(format!(
+            "{}: the camera centre [{:.3}, {:.3}, {:.3}] mm (sensor frame) is outside the sensor body of {} (skin surface, continued below the base plane z = {} mm at radius {:.3} mm): the camera must look at the skin from inside (hint: check that T_cam_sensor maps sensor-frame points into the camera frame)",
+            args.extrinsics.display(), c[0], c[1], c[2], design.name, surface.base_z_mm(), surface.rim_radius_mm()
+        )
+        .into());
+    }
+    if let Some(cfg) = fixtures
+        .configurations
+        .iter()
+        .find(|k| k.primitives.contains(c))
+    {
+        return Err(format!(
+            "{}: the camera centre is inside a protrusion of {} at {} deg",
+            args.extrinsics.display(),
+            cfg.pattern,
+            cfg.orientation_deg
+        )
+        .into());
+    }
+    let (w, h) = (rays.width, rays.height);
+    let n_cfg = fixtures.configurations.len();
+    let bar = indicatif::ProgressBar::new(n_cfg as u64 + 1);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{msg} [{bar:30}] {pos}/{len} frames, {elapsed}, eta {eta}",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    bar.set_message(format!("groundtruth {}", design.name));
+    let provenance = format!(
+        "fabkit {} groundtruth, design {} (sha256 {})",
+        env!("CARGO_PKG_VERSION"),
+        design.name,
+        loaded.sha256
+    );
+
+    let staged = StagedDir::new(&args.out)?;
+    let ref_hits = reference_hits(&rays, &surface);
+    let reference = DepthFrame::new(&rays, &ref_hits);
+    let preview = finite_range(&reference.range_mm)
+        .into_iter()
+        .chain(finite_range(&reference.zdepth_mm))
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), (lo, hi)| {
+            (a.min(lo), b.max(hi))
+        });
+    let preview = if preview.0 <= preview.1 {
+        preview
+    } else {
+        (0.0, 1.0)
+    };
+    let mut all: Vec<(String, String, usize)> = Vec::new();
+    let write = |files: Files,
+                 all: &mut Vec<(String, String, usize)>|
+     -> Result<Vec<Value>, Box<dyn Error>> {
+        let mut entries = Vec::new();
+        for (rel, bytes, mut e) in files {
+            staged.write(&rel, &bytes)?;
+            let sha = sha256_hex(&bytes);
+            e["sha256"] = json!(sha);
+            all.push((rel, sha, bytes.len()));
+            entries.push(e);
+        }
+        Ok(entries)
+    };
+    let ref_entries = write(
+        frame_files("reference", &reference, None, preview, &provenance)?,
+        &mut all,
+    )?;
+    bar.inc(1);
+
+    // Configurations in parallel; each writes its own folder. Entries are kept in index order.
+    let done = AtomicUsize::new(0);
+    let rendered: Vec<Result<(Value, Vec<(String, String, usize)>), String>> = fixtures
+        .configurations
+        .par_iter()
+        .map(|cfg: &Configuration| {
+            let hits = indented_hits(&rays, &ref_hits, &cfg.primitives, surface.base_z_mm());
+            let frame = DepthFrame::new(&rays, &hits);
+            let files = frame_files(&cfg.name, &frame, Some(&reference), preview, &provenance).map_err(|e| e.to_string())?;
+            let mut entries = Vec::new();
+            let mut list = Vec::new();
+            for (rel, bytes, mut e) in files {
+                staged.write(&rel, &bytes).map_err(|e| e.to_string())?;
+                let sha = sha256_hex(&bytes);
+                e["sha256"] = json!(sha);
+                list.push((rel, sha, bytes.len()));
+                entries.push(e);
+            }
+            let contact = (0..w * h).filter(|&p| frame.contact[p] && reference.range_mm[p].is_finite()).count();
+            let (dr, _) = frame.delta(&reference);
+            let deepest = finite_range(&dr).map(|x| -x.0).unwrap_or(0.0).max(0.0);
+            done.fetch_add(1, Ordering::Relaxed);
+            bar.inc(1);
+            Ok((
+                json!({
+                    "name": cfg.name, "dir": cfg.name, "pattern": cfg.pattern, "orientation_deg": cfg.orientation_deg,
+                    "pattern_side": if cfg.orientation_deg == 0 { "+x (right_mask.png)" } else { "-x (left_mask.png)" },
+                    "fixture_description": {"file": cfg.description_file, "sha256": cfg.description_sha256},
+                    "primitives": cfg.geometry.primitives.len(),
+                    "contact_pixels": contact, "max_range_decrease_mm": deepest,
+                    "files": entries,
+                }),
+                list,
+            ))
+        })
+        .collect();
+    let mut cfg_entries = Vec::new();
+    for r in rendered {
+        let (e, list) = r?;
+        cfg_entries.push(e);
+        all.extend(list);
+    }
+    bar.finish_and_clear();
+
+    let (left, right) = half_masks(&rays, &ref_hits);
+    let mut extra: Files = Vec::new();
+    for (name, m, side) in [
+        ("left_mask.png", &left, "x < 0 (the -x half)"),
+        ("right_mask.png", &right, "x >= 0 (the +x half)"),
+    ] {
+        let px: Vec<u8> = m.iter().map(|&b| if b { 255 } else { 0 }).collect();
+        let count = m.iter().filter(|&&b| b).count();
+        extra.push((name.into(), png_gray8(w, h, &px, &[])?, json!({"file": name, "quantity": format!("pixels whose ray meets the reference surface at sensor-frame {side}: 255, else 0"), "pixels": count})));
+    }
+    let pairs = pairs_csv(&fixtures.patterns);
+    let n_pairs = fixtures.patterns.len() * fixtures.patterns.len();
+    extra.push((
+        "pairs.csv".into(),
+        pairs.into_bytes(),
+        json!({"file": "pairs.csv", "pairs": n_pairs}),
+    ));
+    let extra_entries = write(extra, &mut all)?;
+    all.sort();
+
+    let i = camera.intrinsics();
+    let m = t_cam_sensor.to_homogeneous();
+    let manifest = json!({
+        "fabkit_version": env!("CARGO_PKG_VERSION"),
+        "command_line": std::env::args().collect::<Vec<_>>(),
+        "description": "Ground-truth depth of the sensor surface, reference (undeformed) and indented by each protrusion semi-dome configuration (R-Tac0 Sec. IV-B, Fig. 6, Eq. (2)-(3)): complete depth = reference + delta. Exact per-pixel rays of the camera model; surfaces in closed form.",
+        "design": {"name": design.name, "source": loaded.source, "sha256": loaded.sha256},
+        "camera": {"file": args.camera.display().to_string(), "sha256": camera_sha, "distortion_model": i.distortion.name(),
+                   "fx_px": i.fx_px, "fy_px": i.fy_px, "cx_px": i.cx_px, "cy_px": i.cy_px, "distortion_coefficients": i.distortion.coefficients(),
+                   "image_width_px": w, "image_height_px": h},
+        "extrinsics": {"file": args.extrinsics.display().to_string(), "sha256": extrinsics_sha,
+                       "T_cam_sensor": (0..4).map(|r| (0..4).map(|c| m[(r, c)]).collect::<Vec<_>>()).collect::<Vec<_>>(),
+                       "camera_centre_in_sensor_mm": c},
+        "fixtures": {"dir": fixtures.dir.display().to_string(), "index_sha256": fixtures.index_sha256, "patterns": fixtures.patterns},
+        "conventions": {
+            "pixels": "(u, v) = (column, row); (0, 0) is the centre of the top-left pixel; arrays are (H, W) row-major",
+            "camera_frame": "x right, y down, z forward (docs/conventions.md)",
+            "sensor_frame": "docs/conventions.md; split plane x = 0",
+            "range_mm": "distance along the pixel's ray from the camera centre to the surface, mm",
+            "zdepth_mm": "z of the surface point in the camera frame, mm (= range * bearing z)",
+            "delta": "indented minus reference, mm (negative where the skin is pushed towards the camera, 0 elsewhere)",
+            "surface": "outer skin surface (body profile at offset 0) from the pole to the base plane; indented: the skin minus the protrusion solids",
+            "missing": "a pixel whose ray misses the skin (or does not unproject) is NaN in float files, 0 in integer files, and in no mask",
+            "png16": {"depth": {"scale_mm_per_count": DEPTH_PNG.scale, "offset_counts": DEPTH_PNG.offset_counts},
+                      "delta": {"scale_mm_per_count": DELTA_PNG.scale, "offset_counts": DELTA_PNG.offset_counts},
+                      "value_mm": "(count - offset_counts) * scale_mm_per_count; count 0 = no value (also values that do not fit, counted as clipped_pixels)"},
+            "not_modelled": "refraction in the elastomer and the core; the skin's deformation around a protrusion (the indented surface is the skin minus the protrusion solids)",
+        },
+        "image": {"width_px": w, "height_px": h, "pixels_on_surface": ref_hits.valid_count()},
+        "reference": {"dir": "reference", "files": ref_entries},
+        "configurations": cfg_entries,
+        "masks_and_pairs": extra_entries,
+        "files": all.iter().map(|(f, s, b)| json!({"file": f, "sha256": s, "bytes": b})).collect::<Vec<_>>(),
+    });
+    let mut text = serde_json::to_vec_pretty(&manifest)?;
+    text.push(b'\n');
+    staged.write("manifest.json", &text)?;
+    for w in staged.commit()? {
+        eprintln!("warning: {w}");
+    }
+    out!(
+        "{}: reference + {} configurations ({} patterns x 2 orientations), {} stitched pairs, {} of {} pixels on the surface -> {} ({} files, {:.2} s)",
+        design.name,
+        n_cfg,
+        fixtures.patterns.len(),
+        n_pairs,
+        ref_hits.valid_count(),
+        w * h,
+        args.out.display(),
+        all.len() + 1,
+        t0.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
