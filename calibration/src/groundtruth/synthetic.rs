@@ -93,11 +93,11 @@ pub fn benchmark_protrusions() -> Vec<Primitive> {
 }
 
 /// The outer skin surface of `body` (offset 0, from the pole to the base plane) as an open
-/// triangle mesh within `tol`: the profile tessellated as `BodyProfile::offset_polyline` does
-/// and revolved with the segment count of `fabkit_designs::geometry::revolve`; every vertex on
+/// triangle mesh within `tol`: half of it for the profile (`BodyProfile::offset_polyline`),
+/// half for the circumference (the segment count of `fabkit_designs::geometry::revolve`); every vertex on
 /// the true surface, triangles wound counter-clockwise seen from outside.
 pub fn skin_mesh(body: &BodyProfile, tol: ChordTolerance) -> Mesh {
-    let pl = body.offset_polyline(0.0, 0.0, tol);
+    let pl = body.offset_polyline(0.0, 0.0, tol.half());
     let mut pts = pl.points;
     pts.dedup();
     let r_max = pts.iter().map(|p| p[0]).fold(0.0, f64::max);

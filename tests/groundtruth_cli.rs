@@ -1,0 +1,1 @@
+//! `fabkit groundtruth` end to end (filled in below).
