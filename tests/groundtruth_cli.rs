@@ -1,1 +1,359 @@
-//! `fabkit groundtruth` end to end (filled in below).
+//! `fabkit groundtruth` end to end on the output of `fabkit fixtures` (R-Tac0, 2 patterns):
+//! layout, byte-identical output with 1 and 2 threads, the manifest's hashes, the relations
+//! between the maps (delta = indented - reference, contact mask = pushed-in pixels, z-depth =
+//! range x bearing z, half masks partition the surface pixels, N x N pairs), the files read by
+//! numpy, OpenCV and Open3D, and input errors.
+
+mod common;
+
+use std::path::Path;
+
+use common::*;
+use fabkit_calibration::nalgebra::Vector2;
+use fabkit_calibration::synthetic::benchmark_intrinsics;
+use fabkit_calibration::{write_camera, CameraFileFormat, CameraModel};
+
+fn read_npy_f32(path: &Path) -> Vec<f32> {
+    let b = std::fs::read(path).unwrap();
+    assert_eq!(&b[..8], b"\x93NUMPY\x01\x00");
+    let hlen = u16::from_le_bytes([b[8], b[9]]) as usize;
+    b[10 + hlen..]
+        .chunks_exact(4)
+        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .collect()
+}
+
+fn setup(dir: &Path) {
+    let o = run(
+        dir,
+        &[
+            "fixtures",
+            "rtac0",
+            "--pins-preset",
+            "rtac0",
+            "--semidomes",
+            "2",
+            "--seed",
+            "3",
+            "--format",
+            "stl",
+            "--out",
+            "fx",
+        ],
+        &[],
+    );
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    std::fs::write(
+        dir.join("cam.yaml"),
+        write_camera(&benchmark_intrinsics(), CameraFileFormat::OpenCvYaml),
+    )
+    .unwrap();
+    // The form `fabkit calibrate extrinsics` writes: rvec, tvec_mm and the matrix.
+    let (rx, ry, rz) = (0.02f64, -0.015f64, 0.4f64);
+    let r = fabkit_calibration::nalgebra::Rotation3::from_scaled_axis(
+        fabkit_calibration::nalgebra::Vector3::new(rx, ry, rz),
+    );
+    let t = [0.3, -0.2, 10.4];
+    let m: Vec<Vec<f64>> = (0..4)
+        .map(|i| {
+            (0..4)
+                .map(|j| {
+                    if i == 3 {
+                        [0.0, 0.0, 0.0, 1.0][j]
+                    } else if j == 3 {
+                        t[i]
+                    } else {
+                        r[(i, j)]
+                    }
+                })
+                .collect()
+        })
+        .collect();
+    let ext = serde_json::json!({"rvec": [rx, ry, rz], "tvec_mm": t, "T_cam_sensor": m});
+    std::fs::write(
+        dir.join("extrinsics.json"),
+        serde_json::to_vec_pretty(&ext).unwrap(),
+    )
+    .unwrap();
+}
+
+fn groundtruth(dir: &Path, out: &str, threads: &str) -> std::process::Output {
+    run(
+        dir,
+        &[
+            "groundtruth",
+            "rtac0",
+            "--camera",
+            "cam.yaml",
+            "--extrinsics",
+            "extrinsics.json",
+            "--fixtures",
+            "fx",
+            "--out",
+            out,
+        ],
+        &[("RAYON_NUM_THREADS", threads)],
+    )
+}
+
+#[test]
+fn groundtruth_of_two_patterns_is_complete_consistent_and_deterministic() {
+    let (d1, d2) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    setup(d1.path());
+    setup(d2.path());
+    let o = groundtruth(d1.path(), "gt", "1");
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(
+        text(&o.stdout)
+            .contains("4 configurations (2 patterns x 2 orientations), 4 stitched pairs"),
+        "{}",
+        text(&o.stdout)
+    );
+    let o = groundtruth(d2.path(), "gt", "2");
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let (a, b) = (d1.path().join("gt"), d2.path().join("gt"));
+
+    let manifest: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(a.join("manifest.json")).unwrap()).unwrap();
+    let files = manifest["files"].as_array().unwrap();
+    // reference: range and zdepth (npy, 16-bit PNG, preview), normals (npy, preview), PLY;
+    // each configuration also the two deltas and the contact mask; 2 masks and pairs.csv.
+    assert_eq!(files.len(), 9 + 4 * 16 + 3);
+    for f in files {
+        let rel = f["file"].as_str().unwrap();
+        let bytes = std::fs::read(a.join(rel)).unwrap();
+        assert_eq!(
+            fabkit_calibration::groundtruth::inputs::sha256_hex(&bytes),
+            f["sha256"].as_str().unwrap(),
+            "{rel}"
+        );
+        assert!(
+            bytes == std::fs::read(b.join(rel)).unwrap(),
+            "{rel} differs between 1 and 2 threads"
+        );
+    }
+    assert!(
+        std::fs::read(a.join("manifest.json")).unwrap()
+            == std::fs::read(b.join("manifest.json")).unwrap()
+    );
+    let names: Vec<&str> = manifest["configurations"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["p001_0", "p001_180", "p002_0", "p002_180"]);
+    let pairs = std::fs::read_to_string(a.join("pairs.csv")).unwrap();
+    let rows: Vec<&str> = pairs
+        .lines()
+        .filter(|l| !l.starts_with('#') && !l.starts_with("pair,"))
+        .collect();
+    assert_eq!(
+        rows,
+        [
+            "0,p001,p001_0,p001,p001_180",
+            "1,p001,p001_0,p002,p002_180",
+            "2,p002,p002_0,p001,p001_180",
+            "3,p002,p002_0,p002,p002_180"
+        ]
+    );
+
+    // Relations between the maps.
+    let cam = CameraModel::new(benchmark_intrinsics()).unwrap();
+    let (w, h) = (640usize, 480usize);
+    let rref = read_npy_f32(&a.join("reference/range_mm.npy"));
+    let zref = read_npy_f32(&a.join("reference/zdepth_mm.npy"));
+    assert_eq!(rref.len(), w * h);
+    let mut surface = 0;
+    for p in (0..w * h).step_by(97) {
+        if rref[p].is_finite() {
+            surface += 1;
+            let bz = cam
+                .unproject(&Vector2::new((p % w) as f64, (p / w) as f64))
+                .unwrap()
+                .z;
+            assert!(
+                (zref[p] as f64 - rref[p] as f64 * bz).abs() < 1e-5,
+                "zdepth = range * bearing z at {p}"
+            );
+        } else {
+            assert!(zref[p].is_nan());
+        }
+    }
+    assert!(surface > 1000);
+    for c in &names {
+        let r = read_npy_f32(&a.join(c).join("range_mm.npy"));
+        let dr = read_npy_f32(&a.join(c).join("delta_range_mm.npy"));
+        let (mut contact, mut pushed) = (0, 0);
+        for p in 0..w * h {
+            if rref[p].is_finite() {
+                assert!((dr[p] - (r[p] - rref[p])).abs() < 1e-5, "{c}: delta at {p}");
+                assert!(
+                    dr[p] <= 0.0,
+                    "{c}: protrusions only push the skin towards the camera"
+                );
+                if dr[p] < 0.0 {
+                    pushed += 1;
+                }
+            } else {
+                assert!(dr[p].is_nan());
+            }
+        }
+        let cm = &manifest["configurations"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|x| x["name"] == *c)
+            .unwrap()["contact_pixels"];
+        contact += cm.as_u64().unwrap();
+        assert!(
+            pushed > 0 && (pushed as u64) <= contact,
+            "{c}: {pushed} pushed pixels, {contact} contact pixels"
+        );
+    }
+    let masks = &manifest["masks_and_pairs"];
+    let (l, r) = (
+        masks[0]["pixels"].as_u64().unwrap(),
+        masks[1]["pixels"].as_u64().unwrap(),
+    );
+    assert_eq!(
+        l + r,
+        manifest["image"]["pixels_on_surface"].as_u64().unwrap()
+    );
+    assert!(l > 1000 && r > 1000);
+
+    // numpy, OpenCV and Open3D read the files.
+    let Some(py) = oracle_python() else {
+        return missing("the oracle python (numpy, opencv, open3d)");
+    };
+    let script = r#"
+import sys, json, numpy as np, cv2, open3d as o3d
+d = sys.argv[1]
+m = json.load(open(f"{d}/manifest.json"))
+out = {}
+r = np.load(f"{d}/p001_0/range_mm.npy")
+png = cv2.imread(f"{d}/p001_0/range_um.png", cv2.IMREAD_UNCHANGED)
+ok = np.isfinite(r)
+out["shape"] = list(r.shape)
+out["dtype"] = str(png.dtype)
+out["png_err_um"] = float(np.abs(png[ok].astype(np.float64) - np.round(r[ok].astype(np.float64) * 1000)).max())
+out["png_zero_on_missing"] = bool((png[~ok] == 0).all())
+dr = np.load(f"{d}/p001_0/delta_range_mm.npy")
+dp = cv2.imread(f"{d}/p001_0/delta_range_um.png", cv2.IMREAD_UNCHANGED).astype(np.float64)
+ok = np.isfinite(dr)
+out["delta_png_err_um"] = float(np.abs((dp[ok] - 32768) - np.round(dr[ok].astype(np.float64) * 1000)).max())
+mask = cv2.imread(f"{d}/p001_0/contact_mask.png", cv2.IMREAD_UNCHANGED)
+out["mask_pixels"] = int((mask == 255).sum())
+pc = o3d.io.read_point_cloud(f"{d}/p001_0/points.ply")
+out["ply_points"] = len(pc.points)
+out["ply_vs_npy"] = int(np.isfinite(r).sum())
+n = np.load(f"{d}/reference/normals.npy")
+out["normals_shape"] = list(n.shape)
+print(json.dumps(out))
+"#;
+    let o = std::process::Command::new(py)
+        .arg("-c")
+        .arg(script)
+        .arg(&a)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["shape"], serde_json::json!([480, 640]));
+    assert_eq!(v["dtype"], "uint16");
+    assert!(v["png_err_um"].as_f64().unwrap() <= 1.0, "{v}");
+    assert!(v["delta_png_err_um"].as_f64().unwrap() <= 1.0, "{v}");
+    assert_eq!(v["png_zero_on_missing"], true);
+    assert_eq!(
+        v["mask_pixels"],
+        manifest["configurations"][0]["contact_pixels"]
+    );
+    assert_eq!(v["ply_points"], v["ply_vs_npy"]);
+    assert_eq!(v["normals_shape"], serde_json::json!([480, 640, 3]));
+}
+
+#[test]
+fn bad_inputs_name_the_file_and_the_rule_and_write_nothing() {
+    let d = tempfile::tempdir().unwrap();
+    setup(d.path());
+    // Fixtures of another design.
+    let o = run(
+        d.path(),
+        &[
+            "groundtruth",
+            "uvdtact",
+            "--camera",
+            "cam.yaml",
+            "--extrinsics",
+            "extrinsics.json",
+            "--fixtures",
+            "fx",
+            "--out",
+            "gt",
+        ],
+        &[],
+    );
+    assert_eq!(o.status.code(), Some(2));
+    let e = text(&o.stderr);
+    assert!(
+        e.contains("p001.json: design = rtac0") && e.contains("another design"),
+        "{e}"
+    );
+    // A camera outside the sensor body (extrinsics with the translation's sign flipped).
+    std::fs::write(
+        d.path().join("far.json"),
+        r#"{"T_cam_sensor": [[1,0,0,0],[0,1,0,0],[0,0,1,-40],[0,0,0,1]]}"#,
+    )
+    .unwrap();
+    let o = run(
+        d.path(),
+        &[
+            "groundtruth",
+            "rtac0",
+            "--camera",
+            "cam.yaml",
+            "--extrinsics",
+            "far.json",
+            "--fixtures",
+            "fx",
+            "--out",
+            "gt",
+        ],
+        &[],
+    );
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        text(&o.stderr).contains("far.json: the camera centre [0.000, 0.000, 40.000] mm"),
+        "{}",
+        text(&o.stderr)
+    );
+    // Not a rotation.
+    std::fs::write(
+        d.path().join("skew.json"),
+        r#"{"T_cam_sensor": [[1,0.1,0,0],[0,1,0,0],[0,0,1,10],[0,0,0,1]]}"#,
+    )
+    .unwrap();
+    let o = run(
+        d.path(),
+        &[
+            "groundtruth",
+            "rtac0",
+            "--camera",
+            "cam.yaml",
+            "--extrinsics",
+            "skew.json",
+            "--fixtures",
+            "fx",
+            "--out",
+            "gt",
+        ],
+        &[],
+    );
+    assert!(
+        text(&o.stderr).contains("skew.json: T_cam_sensor")
+            && text(&o.stderr).contains("must be a rotation"),
+        "{}",
+        text(&o.stderr)
+    );
+    assert!(!d.path().join("gt").exists());
+}
