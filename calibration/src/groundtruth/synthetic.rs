@@ -176,7 +176,7 @@ pub struct BenchScene {
 }
 
 impl BenchScene {
-    /// The scene at chord tolerance `tol_mm` (0.0015 mm gives about 200k triangles).
+    /// The scene at chord tolerance `tol_mm` (0.0006 mm gives about 200k triangles).
     ///
     /// # Panics
     /// On an invalid tolerance (benchmark code).
