@@ -138,7 +138,12 @@ fn main() {
         .arg(reps.to_string())
         .output()
         .unwrap();
-    let _ = std::fs::remove_dir_all(&d);
+    // FABKIT_GT_KEEP=1 keeps the scene files (vertices.npy, triangles.npy, rays.npy) for other tools.
+    if std::env::var("FABKIT_GT_KEEP").is_ok_and(|v| v == "1") {
+        println!("scene files kept in {}", d.display());
+    } else {
+        let _ = std::fs::remove_dir_all(&d);
+    }
     if !o.status.success() {
         println!("Open3D failed: {}", String::from_utf8_lossy(&o.stderr));
         return;
