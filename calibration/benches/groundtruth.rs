@@ -12,7 +12,7 @@
 
 use criterion::measurement::{Measurement, ValueFormatter};
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use fabkit_calibration::groundtruth::mesh::FrameHits;
+use fabkit_calibration::groundtruth::mesh::{FrameHits, Hit};
 use fabkit_calibration::groundtruth::synthetic::{thread_cpu_time_s, BenchScene};
 
 /// CPU time of the benchmark thread, ns.
@@ -94,18 +94,20 @@ fn bench(c: &mut Criterion<ThreadCpu>) {
     g.bench_function("full_cast", |b| {
         b.iter(|| all.cast_into(rays, &inf, &mut out))
     });
-    let (mut te, mut ts, mut nn) = (vec![0.0; n], vec![0.0; n], vec![[0.0; 3]; n]);
+    let (mut te, mut ts) = (vec![0.0; n], vec![0.0; n]);
+    let mut hits: Vec<Hit> = Vec::new();
     g.bench_function("analytic_reference_plus_protrusion_triangles", |b| {
         b.iter(|| {
             scene
                 .surface
-                .exit_all(rays.origin_mm, &rays.dirs, &mut te, &mut ts, &mut nn);
+                .exit_all(rays.origin_mm, &rays.dirs, &mut te, &mut ts, None);
             for t in te.iter_mut() {
                 if !t.is_finite() {
                     *t = 0.0;
                 }
             }
-            prot.cast_into(rays, &te, &mut out);
+            hits.clear();
+            prot.cast_each(rays, &te, &mut |h| hits.push(h));
         })
     });
     g.finish();

@@ -6,7 +6,7 @@
 //!
 //! Usage: cargo run --release -p fabkit-calibration --example groundtruth_benchmark [-- TOL_MM [REPS]]
 
-use fabkit_calibration::groundtruth::mesh::FrameHits;
+use fabkit_calibration::groundtruth::mesh::{FrameHits, Hit};
 use fabkit_calibration::groundtruth::synthetic::{thread_cpu_time_s as cpu, BenchScene};
 use std::path::PathBuf;
 
@@ -63,20 +63,22 @@ fn main() {
         all.cast_into(rays, &inf, &mut out);
         full = full.min(cpu() - t0);
     }
-    let (mut te, mut ts, mut nn) = (vec![0.0; n], vec![0.0; n], vec![[0.0; 3]; n]);
+    let (mut te, mut ts) = (vec![0.0; n], vec![0.0; n]);
+    let mut hits: Vec<Hit> = Vec::new();
     let (mut fast, mut reference) = (f64::INFINITY, f64::INFINITY);
     for _ in 0..reps {
         let t0 = cpu();
         scene
             .surface
-            .exit_all(rays.origin_mm, &rays.dirs, &mut te, &mut ts, &mut nn);
+            .exit_all(rays.origin_mm, &rays.dirs, &mut te, &mut ts, None);
         reference = reference.min(cpu() - t0);
         for t in te.iter_mut() {
             if !t.is_finite() {
                 *t = 0.0;
             }
         }
-        prot.cast_into(rays, &te, &mut out);
+        hits.clear();
+        prot.cast_each(rays, &te, &mut |h| hits.push(h));
         fast = fast.min(cpu() - t0);
     }
     println!(
@@ -89,6 +91,21 @@ fn main() {
         reference * 1e3,
         fast * 1e3
     );
+    if std::env::var("FABKIT_GT_PROFILE").is_ok() {
+        for _ in 0..300 {
+            scene
+                .surface
+                .exit_all(rays.origin_mm, &rays.dirs, &mut te, &mut ts, None);
+            for t in te.iter_mut() {
+                if !t.is_finite() {
+                    *t = 0.0;
+                }
+            }
+            hits.clear();
+            prot.cast_each(rays, &te, &mut |h| hits.push(h));
+        }
+        return;
+    }
     let py = std::env::var("FABKIT_ORACLE_PYTHON")
         .map(PathBuf::from)
         .ok()

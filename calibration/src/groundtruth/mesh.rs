@@ -75,6 +75,16 @@ pub struct MeshCaster {
 /// `t_max` where nothing was hit), the hit triangle's index in the input mesh ([`NO_HIT`]),
 /// and its unit normal (from the triangle's winding: outward for a mesh wound counter-clockwise
 /// seen from outside; zero where nothing was hit).
+/// One ray's nearest hit: pixel index, distance (mm), input triangle index, unit normal (from
+/// the winding).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Hit {
+    pub pixel: usize,
+    pub t_mm: f64,
+    pub triangle: u32,
+    pub normal: [f64; 3],
+}
+
 #[derive(Debug, Clone, PartialEq)]
 pub struct FrameHits {
     pub t_mm: Vec<f64>,
@@ -234,10 +244,24 @@ impl MeshCaster {
         out.triangle.clear();
         out.triangle.resize(rays.len(), NO_HIT);
         out.normal.resize(rays.len(), [0.0; 3]);
+        self.cast_each(rays, t_max_mm, &mut |h: Hit| {
+            out.t_mm[h.pixel] = h.t_mm;
+            out.triangle[h.pixel] = h.triangle;
+            out.normal[h.pixel] = h.normal;
+        });
+    }
+
+    /// Like [`cast`](Self::cast), but reports only the rays that hit, through `sink`, in tile
+    /// order (deterministic): cheaper when few rays hit.
+    ///
+    /// # Panics
+    /// If `t_max_mm.len() != rays.len()`.
+    pub fn cast_each(&self, rays: &PixelRays, t_max_mm: &[f64], sink: &mut dyn FnMut(Hit)) {
+        assert_eq!(t_max_mm.len(), rays.len(), "one t_max per ray");
         if self.nodes.is_empty() {
             return;
         }
-        let out = &mut *out;
+        let out = sink;
         let tiles = rays.tiles();
         #[cfg(target_arch = "x86_64")]
         {
@@ -259,13 +283,19 @@ impl MeshCaster {
         rays: &PixelRays,
         tiles: &RayTiles,
         t_max: &[f64],
-        out: &mut FrameHits,
+        out: &mut dyn FnMut(Hit),
     ) {
         self.cast_tiles(rays, tiles, t_max, out)
     }
 
     #[inline(always)]
-    fn cast_tiles(&self, rays: &PixelRays, tiles: &RayTiles, t_max: &[f64], out: &mut FrameHits) {
+    fn cast_tiles(
+        &self,
+        rays: &PixelRays,
+        tiles: &RayTiles,
+        t_max: &[f64],
+        out: &mut dyn FnMut(Hit),
+    ) {
         let o64 = rays.origin_mm;
         let o = tiles.origin;
         let mut stack: Vec<(u32, u32, f32)> = Vec::with_capacity(256);
@@ -312,10 +342,13 @@ impl MeshCaster {
                 let d = rays.dirs[p];
                 let tt = dot(n, sub(t[0], o64)) / dot(n, d);
                 if tt > 0.0 && tt < t_max[p] {
-                    out.t_mm[p] = tt;
-                    out.triangle[p] = self.index[k as usize];
-                    let l2 = dot(n, n).sqrt();
-                    out.normal[p] = [n[0] / l2, n[1] / l2, n[2] / l2];
+                    let il = 1.0 / dot(n, n).sqrt();
+                    out(Hit {
+                        pixel: p,
+                        t_mm: tt,
+                        triangle: self.index[k as usize],
+                        normal: [n[0] * il, n[1] * il, n[2] * il],
+                    });
                 }
             }
         }
@@ -338,11 +371,14 @@ impl MeshCaster {
                 continue;
             }
             if count > 0 {
+                let mut changed = false;
                 for k in ni as usize..(ni + count) as usize {
-                    self.test_triangle(pkt, tile, o, k);
+                    changed |= self.test_triangle(pkt, tile, o, k);
                 }
-                tmax = pkt.max_t() * 1.0001;
-                tmax2 = tmax * tmax;
+                if changed {
+                    tmax = pkt.max_t() * 1.0001;
+                    tmax2 = tmax * tmax;
+                }
                 continue;
             }
             let node = &self.nodes[ni as usize];
@@ -359,7 +395,8 @@ impl MeshCaster {
     }
 
     #[inline(always)]
-    fn test_triangle(&self, pkt: &mut Packet, tile: &Tile, o: [f32; 3], k: usize) {
+    /// Tests one triangle against the tile's rays; true if a ray's nearest hit changed.
+    fn test_triangle(&self, pkt: &mut Packet, tile: &Tile, o: [f32; 3], k: usize) -> bool {
         let t = &self.tri32[k];
         let a = sub32(t[0], o);
         let b = sub32(t[1], o);
@@ -384,7 +421,7 @@ impl MeshCaster {
                 let (ylo, yhi) = (ya.min(yb).min(yc) - MARGIN, ya.max(yb).max(yc) + MARGIN);
                 let (xlo, xhi) = (xa.min(xb).min(xc) - MARGIN, xa.max(xb).max(xc) + MARGIN);
                 if (xhi < tile.x_range[0]) | (xlo > tile.x_range[1]) {
-                    return;
+                    return false;
                 }
                 rows = 0;
                 for r in 0..TH {
@@ -392,7 +429,7 @@ impl MeshCaster {
                     rows |= (over as u32) << r;
                 }
                 if rows == 0 {
-                    return;
+                    return false;
                 }
             }
         }
@@ -402,6 +439,7 @@ impl MeshCaster {
         let n = cross32(sub32(b, a), sub32(c, a));
         let num = dot32(n, a);
         let kk = k as u32;
+        let mut changed = false;
         while rows != 0 {
             let r = rows.trailing_zeros() as usize;
             rows &= rows - 1;
@@ -414,8 +452,9 @@ impl MeshCaster {
             let (dx, dy, dz) = (row(&tile.dx), row(&tile.dy), row(&tile.dz));
             let tm: &mut [f32; TW] = (&mut pkt.tmax[base..base + TW]).try_into().expect("row");
             let hi: &mut [u32; TW] = (&mut pkt.hit[base..base + TW]).try_into().expect("row");
-            test_row(&dx, &dy, &dz, tm, hi, [nab, nbc, nca, n], num, kk);
+            changed |= test_row(&dx, &dy, &dz, tm, hi, [nab, nbc, nca, n], num, kk);
         }
+        changed
     }
 }
 
@@ -431,7 +470,7 @@ fn test_row(
     e: [[f32; 3]; 4],
     num: f32,
     k: u32,
-) {
+) -> bool {
     let [nab, nbc, nca, n] = e;
     // Fused multiply-adds keep the edge values of a shared edge exact negations of each other
     // (fma(a, -b, -c) = -fma(a, b, c)), so the test stays watertight.
@@ -450,15 +489,18 @@ fn test_row(
         any |= inside[i];
     }
     if !any {
-        return;
+        return false;
     }
+    let mut changed = false;
     for i in 0..TW {
         let den = dz[i].mul_add(n[2], dy[i].mul_add(n[1], dx[i] * n[0]));
         let tt = num / den;
         let h = inside[i] & (tt > 0.0) & (tt < tmax[i]);
         tmax[i] = if h { tt } else { tmax[i] };
         hit[i] = if h { k } else { hit[i] };
+        changed |= h;
     }
+    changed
 }
 
 /// Gnomonic-coordinate margin (tangent units) far above the f32 rounding of the tests.

@@ -62,7 +62,7 @@ pub fn reference_hits(rays: &PixelRays, surface: &ReferenceSurface) -> SurfaceHi
         &rays.dirs,
         &mut h.t_exit_mm,
         &mut h.t_mm,
-        &mut h.normal,
+        Some(&mut h.normal),
     );
     h
 }

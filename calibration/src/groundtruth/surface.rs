@@ -221,8 +221,9 @@ impl ReferenceSurface {
 impl ReferenceSurface {
     /// [`exit`](Self::exit) for every direction of `dirs` from `o`: writes the exit distance
     /// (`t_exit_mm`, NaN for a non-finite direction), the skin hit distance (`t_skin_mm`, NaN
-    /// where the ray leaves below the base plane) and the skin normal (written only on a skin
-    /// hit). The common case (the spherical or ellipsoidal part) runs without branches.
+    /// where the ray leaves below the base plane) and, if given, the skin normal (written only
+    /// on a skin hit). The common case (the spherical part) is one branch-free pass over the
+    /// rays; the rays that leave elsewhere are redone with [`exit`](Self::exit).
     ///
     /// # Panics
     /// If the output slices are not as long as `dirs`.
@@ -232,59 +233,91 @@ impl ReferenceSurface {
         dirs: &[[f64; 3]],
         t_exit_mm: &mut [f64],
         t_skin_mm: &mut [f64],
-        normal: &mut [[f64; 3]],
+        mut normal: Option<&mut [[f64; 3]]>,
     ) {
-        assert!(
-            t_exit_mm.len() == dirs.len()
-                && t_skin_mm.len() == dirs.len()
-                && normal.len() == dirs.len()
-        );
-        let (r, zmin) = match *self {
+        assert!(t_exit_mm.len() == dirs.len() && t_skin_mm.len() == dirs.len());
+        assert!(normal.as_ref().is_none_or(|n| n.len() == dirs.len()));
+        let slow = |p: usize,
+                    t_exit_mm: &mut [f64],
+                    t_skin_mm: &mut [f64],
+                    normal: &mut Option<&mut [[f64; 3]]>| {
+            let e = self.exit(o, dirs[p]);
+            t_exit_mm[p] = e.map_or(f64::NAN, |e| e.t_mm);
+            t_skin_mm[p] = match e {
+                Some(e) if e.on_skin => {
+                    if let Some(n) = normal.as_deref_mut() {
+                        n[p] = e.normal;
+                    }
+                    e.t_mm
+                }
+                _ => f64::NAN,
+            };
+        };
+        // Sphere radius, base plane, radius of the wall below (the rim; R-Tac0's cylinder
+        // starts at z = 0), and where the sphere stops being the surface.
+        let (r, zb, rw, zs) = match *self {
             ReferenceSurface::Cap {
                 radius_mm,
                 base_z_mm,
-            } => (radius_mm, base_z_mm),
-            ReferenceSurface::HemisphereOnCylinder { radius_mm, .. } => (radius_mm, 0.0),
+            } => (radius_mm, base_z_mm, self.rim_radius_mm(), base_z_mm),
+            ReferenceSurface::HemisphereOnCylinder {
+                radius_mm,
+                base_z_mm,
+            } => (radius_mm, base_z_mm, radius_mm, 0.0),
             ReferenceSurface::HalfEllipsoid { .. } => {
-                for (p, d) in dirs.iter().enumerate() {
-                    let e = self.exit(o, *d);
-                    t_exit_mm[p] = e.map_or(f64::NAN, |e| e.t_mm);
-                    t_skin_mm[p] = match e {
-                        Some(e) if e.on_skin => {
-                            normal[p] = e.normal;
-                            e.t_mm
-                        }
-                        _ => f64::NAN,
-                    };
+                for p in 0..dirs.len() {
+                    slow(p, t_exit_mm, t_skin_mm, &mut normal);
                 }
                 return;
             }
         };
         let c = dot(o, o) - r * r;
-        let inv_r = 1.0 / r;
-        for (p, d) in dirs.iter().enumerate() {
-            // Far root of the sphere (o inside: c < 0, so the root is real and positive).
-            let b = dot(o, *d);
-            let s = (b * b - c).sqrt();
-            let t = if b <= 0.0 { s - b } else { -c / (b + s) };
-            let z = o[2] + t * d[2];
-            if z >= zmin {
-                t_exit_mm[p] = t;
-                t_skin_mm[p] = t;
-                normal[p] = [
-                    (o[0] + t * d[0]) * inv_r,
-                    (o[1] + t * d[1]) * inv_r,
-                    z * inv_r,
-                ];
-            } else {
-                let e = self.exit(o, *d);
-                t_exit_mm[p] = e.map_or(f64::NAN, |e| e.t_mm);
-                t_skin_mm[p] = match e {
-                    Some(e) if e.on_skin => {
-                        normal[p] = e.normal;
-                        e.t_mm
-                    }
-                    _ => f64::NAN,
+        let cw = o[0] * o[0] + o[1] * o[1] - rw * rw;
+        // Pass 1, branch-free: the far roots of the sphere and of the wall (o inside both:
+        // c, cw < 0, the roots are real and positive). With the camera well inside (c, cw
+        // below -1 % of the radius squared) s - b loses at most a few ulp; otherwise, and for
+        // rays the pass cannot decide (NaN: a non-finite or vertical direction), pass 2 uses
+        // [`exit`](Self::exit).
+        let well_inside = c < -0.01 * r * r && cw < -0.01 * rw * rw;
+        if well_inside {
+            for (p, d) in dirs.iter().enumerate() {
+                let b = o[0] * d[0] + o[1] * d[1] + o[2] * d[2];
+                let ts = (b * b - c).sqrt() - b;
+                let z_s = o[2] + ts * d[2];
+                let aw = d[0] * d[0] + d[1] * d[1];
+                let bw = o[0] * d[0] + o[1] * d[1];
+                let tw = ((bw * bw - aw * cw).sqrt() - bw) / aw;
+                let z_w = o[2] + tw * d[2];
+                let on_sphere = z_s >= zs;
+                let exit = if on_sphere { ts } else { tw };
+                let skin = if on_sphere {
+                    ts
+                } else if z_w >= zb {
+                    tw
+                } else {
+                    f64::NAN
+                };
+                t_exit_mm[p] = if exit.is_finite() { exit } else { f64::NAN };
+                t_skin_mm[p] = skin;
+            }
+        } else {
+            t_exit_mm.fill(f64::NAN);
+        }
+        // Pass 2: the undecided rays, and the normals.
+        let (inv_r, inv_rw) = (1.0 / r, 1.0 / rw);
+        for p in 0..dirs.len() {
+            if t_exit_mm[p].is_nan() {
+                slow(p, t_exit_mm, t_skin_mm, &mut normal);
+                continue;
+            }
+            let t = t_skin_mm[p];
+            if let (Some(n), true) = (normal.as_deref_mut(), t.is_finite()) {
+                let d = dirs[p];
+                let q = [o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2]];
+                n[p] = if q[2] >= zs {
+                    [q[0] * inv_r, q[1] * inv_r, q[2] * inv_r]
+                } else {
+                    [q[0] * inv_rw, q[1] * inv_rw, 0.0]
                 };
             }
         }
@@ -314,5 +347,73 @@ mod tests {
         let e = s.exit(o, [q, 0.0, q]).unwrap();
         let p = [e.t_mm * q, 0.0, -10.0 + e.t_mm * q];
         assert!((dot(p, p).sqrt() - 15.1).abs() < 1e-12 && p[2] > 0.0);
+    }
+
+    /// The branch-free pass agrees with the per-ray exit for every profile, camera well inside
+    /// and near the surface, over directions in all of space.
+    #[test]
+    fn exit_all_agrees_with_exit() {
+        let surfaces = [
+            ReferenceSurface::HemisphereOnCylinder {
+                radius_mm: 15.1,
+                base_z_mm: -6.0,
+            },
+            ReferenceSurface::Cap {
+                radius_mm: 23.1,
+                base_z_mm: 15.1,
+            },
+            ReferenceSurface::HalfEllipsoid {
+                a_mm: 9.0,
+                c_mm: 24.0,
+            },
+        ];
+        let dirs: Vec<[f64; 3]> = (0..2000)
+            .map(|i| {
+                let z = 1.0 - 2.0 * (i as f64 + 0.5) / 2000.0;
+                let a = i as f64 * 2.399_963;
+                let s = (1.0 - z * z).sqrt();
+                [s * a.cos(), s * a.sin(), z]
+            })
+            .chain([[0.0, 0.0, 1.0], [0.0, 0.0, -1.0], [f64::NAN; 3]])
+            .collect();
+        for s in surfaces {
+            for o in [
+                [0.3, -0.2, s.base_z_mm() - 4.0],
+                [0.0, 0.0, s.base_z_mm() + 0.5],
+                [s.rim_radius_mm() - 0.05, 0.0, s.base_z_mm() - 1.0],
+            ] {
+                assert!(s.contains(o, 0.0), "{s:?} {o:?}");
+                let n = dirs.len();
+                let (mut te, mut ts, mut nn) = (vec![0.0; n], vec![0.0; n], vec![[9.0; 3]; n]);
+                s.exit_all(o, &dirs, &mut te, &mut ts, Some(&mut nn));
+                for (p, d) in dirs.iter().enumerate() {
+                    match s.exit(o, *d) {
+                        None => assert!(te[p].is_nan() && ts[p].is_nan()),
+                        Some(e) => {
+                            let close = |a: f64, b: f64| {
+                                a == b || (a - b).abs() <= 1e-12 * b.abs().max(1.0)
+                            };
+                            assert!(
+                                close(te[p], e.t_mm),
+                                "{s:?} {o:?} {d:?}: exit {} vs {}",
+                                te[p],
+                                e.t_mm
+                            );
+                            if e.on_skin {
+                                assert!(close(ts[p], e.t_mm));
+                                assert!(
+                                    (0..3).all(|k| (nn[p][k] - e.normal[k]).abs() < 1e-12),
+                                    "{:?} vs {:?}",
+                                    nn[p],
+                                    e.normal
+                                );
+                            } else {
+                                assert!(ts[p].is_nan());
+                            }
+                        }
+                    }
+                }
+            }
+        }
     }
 }
