@@ -403,7 +403,7 @@ impl MeshCaster {
         let c = sub32(t[2], o);
         // Rows of the tile the triangle may cover: in the tile's gnomonic coordinates the
         // triangle is a triangle (lines stay lines), so its y range bounds the rows.
-        let mut rows = 0xffu32;
+        let mut rows = (1u32 << TH) - 1;
         if tile.valid {
             let (fa, fb, fc) = (
                 dot32(tile.axis, a),
