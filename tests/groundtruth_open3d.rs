@@ -84,9 +84,9 @@ fn frame_cast_agrees_with_open3d_raycasting_scene_to_1_um_with_no_hit_mask_misma
     assert_eq!(theirs.len(), n);
 
     let (mut worst, mut worst_at, mut both, mut mismatch) = (0.0f64, 0, 0, Vec::new());
-    for p in 0..n {
+    for (p, th) in theirs.iter().enumerate() {
         let a = (ours.triangle[p] != NO_HIT).then_some(ours.t_mm[p]);
-        let b = theirs[p].is_finite().then_some(theirs[p] as f64);
+        let b = th.is_finite().then_some(*th as f64);
         match (a, b) {
             (Some(a), Some(b)) => {
                 both += 1;

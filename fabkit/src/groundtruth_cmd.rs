@@ -57,6 +57,8 @@ const DELTA_PNG: Png16Encoding = Png16Encoding {
 
 /// Files of one rendered frame: (relative path, bytes, manifest entry).
 type Files = Vec<(String, Vec<u8>, Value)>;
+/// Written files: (relative path, sha256, bytes).
+type Written = Vec<(String, String, usize)>;
 
 fn f32s(v: &[f64]) -> Vec<f32> {
     v.iter().map(|x| *x as f32).collect()
@@ -290,7 +292,7 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
 
     // Configurations in parallel; each writes its own folder. Entries are kept in index order.
     let done = AtomicUsize::new(0);
-    let rendered: Vec<Result<(Value, Vec<(String, String, usize)>), String>> = fixtures
+    let rendered: Vec<Result<(Value, Written), String>> = fixtures
         .configurations
         .par_iter()
         .map(|cfg: &Configuration| {

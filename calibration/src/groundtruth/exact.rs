@@ -578,7 +578,7 @@ mod tests {
     #[test]
     fn first_crossings_are_entries_with_outward_normals() {
         let t = fabkit_designs::primitives::unit([0.3, -0.5, 0.8]);
-        let prims = vec![
+        let prims = [
             Primitive::Sphere {
                 centre_mm: [0.0, 0.0, 5.0],
                 radius_mm: 1.2,
