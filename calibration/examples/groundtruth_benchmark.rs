@@ -5,6 +5,8 @@
 //! thread, best of N, CPU time. `scripts/bench-groundtruth` runs it.
 //!
 //! Usage: cargo run --release -p fabkit-calibration --example groundtruth_benchmark [-- TOL_MM [REPS]]
+//! FABKIT_GT_PROFILE=full (or =fast) only repeats one cast, for a profiler; FABKIT_GT_KEEP=1
+//! keeps the scene files given to Open3D (for tests/bvh_eval).
 
 use fabkit_calibration::groundtruth::mesh::{FrameHits, Hit};
 use fabkit_calibration::groundtruth::synthetic::{thread_cpu_time_s as cpu, BenchScene};
@@ -91,6 +93,12 @@ fn main() {
         reference * 1e3,
         fast * 1e3
     );
+    if std::env::var("FABKIT_GT_PROFILE").is_ok_and(|v| v == "full") {
+        for _ in 0..30 {
+            all.cast_into(rays, &inf, &mut out);
+        }
+        return;
+    }
     if std::env::var("FABKIT_GT_PROFILE").is_ok() {
         for _ in 0..300 {
             scene

@@ -383,9 +383,24 @@ impl MeshCaster {
             }
             let node = &self.nodes[ni as usize];
             let (ok, dist2) = tile.test4(node, o, tmax2);
-            // Push far to near so that the nearest child is visited first.
+            // Push far to near so that the nearest child is visited first (a 4-input sorting
+            // network on the distances, far first; culled children sort as infinitely far and
+            // are not pushed).
+            let mut key = [0.0f32; 4];
+            for k in 0..4 {
+                key[k] = if ok[k] { dist2[k] } else { f32::INFINITY };
+            }
             let mut order = [0usize, 1, 2, 3];
-            order.sort_unstable_by(|&a, &b| dist2[b].total_cmp(&dist2[a]));
+            let mut cs = |i: usize, j: usize| {
+                if key[order[i]] < key[order[j]] {
+                    order.swap(i, j);
+                }
+            };
+            cs(0, 1);
+            cs(2, 3);
+            cs(0, 2);
+            cs(1, 3);
+            cs(1, 2);
             for &k in &order {
                 if ok[k] {
                     stack.push((node.child[k], node.count[k], dist2[k]));
