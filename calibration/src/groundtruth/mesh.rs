@@ -62,8 +62,8 @@ pub struct MeshCaster {
     nodes: Vec<Node4>,
     /// Vertices in leaf order, f32 (a, b, c).
     tri32: Vec<[[f32; 3]; 3]>,
-    /// Vertices in leaf order, exact.
-    tri64: Vec<[[f64; 3]; 3]>,
+    /// First vertex and unit normal (from the winding) in leaf order, exact.
+    tri64: Vec<([f64; 3], [f64; 3])>,
     /// Input index of each triangle in leaf order.
     index: Vec<u32>,
     /// Bounds of the whole mesh.
@@ -192,10 +192,18 @@ impl MeshCaster {
             root_hi = bin[0].max;
             collapse(&bin, 0, &mut nodes);
         }
-        let tri64: Vec<[[f64; 3]; 3]> = order.iter().map(|&i| tris[i as usize]).collect();
-        let tri32 = tri64
+        let tri32 = order
             .iter()
-            .map(|t| t.map(|v| v.map(|c| c as f32)))
+            .map(|&i| tris[i as usize].map(|v| v.map(|c| c as f32)))
+            .collect();
+        let tri64 = order
+            .iter()
+            .map(|&i| {
+                let t = &tris[i as usize];
+                let n = cross(sub(t[1], t[0]), sub(t[2], t[0]));
+                let l = dot(n, n).sqrt();
+                (t[0], if l > 0.0 { scale(n, 1.0 / l) } else { [0.0; 3] })
+            })
             .collect();
         MeshCaster {
             nodes,
@@ -337,17 +345,14 @@ impl MeshCaster {
                     continue;
                 }
                 let p = tile.pix[l] as usize;
-                let t = &self.tri64[k as usize];
-                let n = cross(sub(t[1], t[0]), sub(t[2], t[0]));
-                let d = rays.dirs[p];
-                let tt = dot(n, sub(t[0], o64)) / dot(n, d);
+                let (a, n) = self.tri64[k as usize];
+                let tt = dot(n, sub(a, o64)) / dot(n, rays.dirs[p]);
                 if tt > 0.0 && tt < t_max[p] {
-                    let il = 1.0 / dot(n, n).sqrt();
                     out(Hit {
                         pixel: p,
                         t_mm: tt,
                         triangle: self.index[k as usize],
-                        normal: [n[0] * il, n[1] * il, n[2] * il],
+                        normal: n,
                     });
                 }
             }
