@@ -1,4 +1,5 @@
-//! fabkit-calibration: camera models, camera files, PnP extrinsics and residual reports.
+//! fabkit-calibration: camera models, camera files, PnP extrinsics and residual reports, and
+//! ground-truth depth rendering ([`groundtruth`], R-Tac0 Sec. IV-B).
 //! Conventions (pixels, camera frame, transform names): `docs/conventions.md`.
 //!
 //! Source: R-Tac0 paper (`shared/papers/rtac0-rounded-monochrome-vbts.txt`), Sec. IV-A, Eq. (1):

@@ -413,4 +413,37 @@ mod tests {
         );
         assert_eq!(siblings(root.path()), vec!["kit"]);
     }
+
+    #[test]
+    fn staged_dir_commits_whole_or_leaves_nothing() {
+        let root = tempfile::tempdir().unwrap();
+        let out = root.path().join("gt");
+        {
+            let st = StagedDir::new(&out).unwrap();
+            st.write("a/b.bin", b"x").unwrap();
+            assert!(st.write("../c", b"y").is_err());
+            // dropped without commit
+        }
+        assert!(siblings(root.path()).is_empty());
+        let st = StagedDir::new(&out).unwrap();
+        st.write("a/b.bin", b"x").unwrap();
+        st.write("manifest.json", b"{\"fabkit_version\": \"0\"}")
+            .unwrap();
+        assert!(st.commit().unwrap().is_empty());
+        assert_eq!(siblings(root.path()), vec!["gt"]);
+        assert_eq!(fs::read(out.join("a/b.bin")).unwrap(), b"x");
+        // A previous output is replaced; a foreign folder is refused.
+        let st = StagedDir::new(&out).unwrap();
+        st.write("manifest.json", b"{\"fabkit_version\": \"1\"}")
+            .unwrap();
+        st.commit().unwrap();
+        assert!(!out.join("a").exists());
+        let foreign = root.path().join("mine");
+        fs::create_dir(&foreign).unwrap();
+        fs::write(foreign.join("notes.txt"), "keep").unwrap();
+        assert!(matches!(
+            StagedDir::new(&foreign),
+            Err(ExportError::ForeignDirectory { .. })
+        ));
+    }
 }
