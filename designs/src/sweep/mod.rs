@@ -104,3 +104,6 @@ fn hint(nearest: &[String]) -> String {
         format!("; nearest: {}", nearest.join(", "))
     }
 }
+
+#[cfg(test)]
+mod tests;
