@@ -155,9 +155,15 @@ impl Progress {
             let b = indicatif::ProgressBar::new(0);
             b.set_style(
                 indicatif::ProgressStyle::with_template(
-                    "{spinner} sweep [{bar:30}] {pos}/{len} variants, {per_sec}, ETA {eta} {msg}",
+                    "{spinner} sweep [{bar:30}] {pos}/{len} variants, {rate}, ETA {eta} {msg}",
                 )
                 .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
+                .with_key(
+                    "rate",
+                    |s: &indicatif::ProgressState, w: &mut dyn std::fmt::Write| {
+                        let _ = write!(w, "{:.2} variants/s", s.per_sec());
+                    },
+                )
                 .progress_chars("=> "),
             );
             b.enable_steady_tick(std::time::Duration::from_millis(200));
@@ -185,7 +191,9 @@ impl Progress {
                 match &self.bar {
                     Some(b) => {
                         b.set_length((selected - complete) as u64);
-                        b.set_message(format!("({complete} complete, skipped)"));
+                        if complete > 0 {
+                            b.set_message(format!("({complete} already complete, skipped)"));
+                        }
                     }
                     None => eprintln!("sweep: {msg}"),
                 }
