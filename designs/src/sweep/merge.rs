@@ -124,7 +124,7 @@ pub fn merge(
             let row: VariantResult = serde_json::from_str(line)
                 .map_err(|e| err(format!("{}:{}: {e}", p.display(), k + 1)))?;
             let i = row.index;
-            let belongs = i < total && r.shard.map_or(true, |s| s.contains(i));
+            let belongs = i < total && r.shard.is_none_or(|s| s.contains(i));
             if !belongs {
                 return Err(err(format!(
                     "{}:{}: variant {i} does not belong to shard {}",

@@ -285,7 +285,7 @@ pub fn run(
     let selected: Vec<&Variant> = plan
         .variants
         .iter()
-        .filter(|v| opts.shard.map_or(true, |s| s.contains(v.index)))
+        .filter(|v| opts.shard.is_none_or(|s| s.contains(v.index)))
         .collect();
     let mut done: Vec<Option<VariantResult>> = selected
         .iter()

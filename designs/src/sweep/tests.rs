@@ -142,7 +142,7 @@ fn random_draws_distinct_grid_points_reproducibly() {
             .find(|g| g.params == v.params)
             .expect("a grid point");
         assert_eq!(g.id, v.id);
-        assert!(last.map_or(true, |l| l < g.index));
+        assert!(last.is_none_or(|l| l < g.index));
         last = Some(g.index);
     }
     assert_eq!(random(7, 6).variants, a.variants);
