@@ -137,55 +137,31 @@ fn merged_shards_equal_the_unsharded_table_byte_for_byte() {
         "{times:?}"
     );
 
-    // A missing shard, a shard given twice, an unfinished shard: refused, nothing written.
-    let o = run(
-        d,
-        &["sweep", "merge", "shard0", "shard2", "--out", "m2"],
-        &[],
-    );
-    assert_eq!(o.status.code(), Some(2));
-    assert!(
-        text(&o.stderr).contains("missing shard(s) 1/3"),
-        "{}",
-        text(&o.stderr)
-    );
-    let o = run(
-        d,
-        &[
-            "sweep", "merge", "shard0", "shard1", "shard1", "--out", "m3",
-        ],
-        &[],
-    );
-    assert!(
-        text(&o.stderr).contains("shards overlap"),
-        "{}",
-        text(&o.stderr)
-    );
-    let o = run(
-        d,
-        &["sweep", "merge", "shard0", "whole", "--out", "m4"],
-        &[],
-    );
-    assert!(
-        text(&o.stderr).contains("different splits"),
-        "{}",
-        text(&o.stderr)
-    );
-    std::fs::remove_file(d.join("shard1/results.jsonl")).unwrap();
-    let o = run(
-        d,
-        &[
-            "sweep", "merge", "shard0", "shard1", "shard2", "--out", "m5",
-        ],
-        &[],
-    );
-    assert!(
-        text(&o.stderr).contains("did not finish"),
-        "{}",
-        text(&o.stderr)
-    );
-    for m in ["m2", "m3", "m4", "m5"] {
-        assert!(!d.join(m).exists(), "{m} was written");
+    // A missing shard, a shard given twice, another split, an unfinished shard: refused with
+    // exit code 2, nothing written.
+    let refused: [(&[&str], &str, bool); 4] = [
+        (&["shard0", "shard2"], "missing shard(s) 1/3", false),
+        (&["shard0", "shard1", "shard1"], "shards overlap", false),
+        (&["shard0", "whole"], "different splits", false),
+        (&["shard0", "shard1", "shard2"], "did not finish", true),
+    ];
+    for (k, (dirs, want, unfinished)) in refused.into_iter().enumerate() {
+        if unfinished {
+            std::fs::remove_file(d.join("shard1/results.jsonl")).unwrap();
+        }
+        let out = format!("m{k}");
+        let o = run(
+            d,
+            &[&["sweep", "merge"], dirs, &["--out", &out]].concat(),
+            &[],
+        );
+        assert_eq!(o.status.code(), Some(2), "{dirs:?}");
+        assert!(
+            text(&o.stderr).contains(want),
+            "{dirs:?}: {}",
+            text(&o.stderr)
+        );
+        assert!(!d.join(&out).exists(), "{out} was written");
     }
 }
 

@@ -4,7 +4,9 @@
 
 use crate::build::build_kit;
 use crate::kit::{Kit, PrintTechnology};
-use crate::layers::{place_layer_markers, PlacedMarkers};
+use crate::layers::{
+    feature_end_centres, place_layer_markers, recess_clearance_to_base_mm, PlacedMarkers,
+};
 use crate::markers::{nearest_neighbours, MarkerSurface, Polarity};
 use crate::materials::MaterialsTable;
 use crate::schema::{Design, LayerProcess, Technology};
@@ -192,12 +194,7 @@ pub fn min_wall(
                     pm.stats.min_spacing_mm - f.diameter_mm,
                     format!("{path}: between neighbouring features at their bases"),
                 ));
-                let h = f.height_mm - f.radius_mm();
-                let ends: Vec<[f64; 3]> = pm
-                    .markers
-                    .iter()
-                    .map(|m| [0, 1, 2].map(|c| m.position_mm[c] + pm.direction * h * m.normal[c]))
-                    .collect();
+                let ends = feature_end_centres(&pm.markers, f, pm.direction);
                 let closest = nearest_neighbours(&ends)
                     .iter()
                     .map(|n| n.1)
@@ -209,16 +206,8 @@ pub fn min_wall(
             }
             if f.polarity == Polarity::Recessed {
                 if l.solid {
-                    let zb = design.body.base_z_mm();
-                    let worst = pm
-                        .markers
-                        .iter()
-                        .map(|m| {
-                            let side =
-                                (1.0 - m.normal[2] * m.normal[2]).max(0.0).sqrt() * f.radius_mm();
-                            m.position_mm[2] - f.height_mm * m.normal[2] - side - zb
-                        })
-                        .fold(f64::INFINITY, f64::min);
+                    let worst =
+                        recess_clearance_to_base_mm(&pm.markers, f, design.body.base_z_mm());
                     walls.push((
                         worst,
                         format!("{path}: between recesses and the base plane"),
