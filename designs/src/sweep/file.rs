@@ -258,6 +258,12 @@ impl SweepSpec {
                     nearest: nearest_paths(&base.design, &path, 3),
                 });
             }
+            if path.ends_with(".csv_file") {
+                return Err(file_err(
+                    here,
+                    format!("vary.{path}: marker CSV files are read once, when the base design loads; vary the pattern's `points` instead"),
+                ));
+            }
             let values = values_of(&spec.value)
                 .map_err(|m| file_err(at(origin, spec), format!("vary.{path}: {m}")))?;
             for (i, v) in values.iter().enumerate() {

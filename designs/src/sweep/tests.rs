@@ -243,6 +243,10 @@ fn malformed_sweeps_are_refused_before_anything_runs() {
             "base: shadowtac\nvray:\n  mold.wall_thickness_mm: [3]\n",
             "sweep.yaml:2:1: unknown field `vray`",
         ),
+        (
+            "base: shadowtac\nvary:\n  layers[0].markers[0].pattern.csv_file: [a.csv]\n",
+            "sweep.yaml:3:3: vary.layers[0].markers[0].pattern.csv_file: marker CSV files are read once",
+        ),
     ];
     for (text, want) in cases {
         let e = err(text);
