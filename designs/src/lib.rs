@@ -20,6 +20,7 @@ pub mod molds;
 pub mod profile;
 pub mod schema;
 pub mod stack;
+pub mod sweep;
 
 pub use build::build_kit;
 pub use error::{DesignError, ParamError, ParamErrors};

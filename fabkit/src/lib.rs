@@ -21,3 +21,4 @@ pub use fabkit_fixtures as fixtures;
 pub mod calibrate_cmd;
 pub mod cli;
 pub mod fixtures_cmd;
+pub mod sweep_cmd;
