@@ -1,7 +1,7 @@
 //! The sweep file: which design, which parameters take which values, how they combine and
 //! what to write. Every problem is reported before anything runs, at its `file:line:column`.
 
-use super::paths::{nearest_paths, path_exists, with_value};
+use super::paths::{expand_short_path, nearest_paths, path_exists, with_value};
 use super::SweepError;
 use crate::library::{load_source, LoadedDesign};
 use crate::schema::{yaml_error, Design};
@@ -248,8 +248,14 @@ impl SweepSpec {
         })?;
         let mut parameters = Vec::new();
         for (key, spec) in &raw.vary.value.0 {
-            let path = key.value.trim().to_string();
+            let mut path = key.value.trim().to_string();
             let here = at(origin, key);
+            if !path_exists(&base.design, &path) {
+                // A short path (`markers.spacing_mm`) stands for the one full path it fits.
+                if let Some(full) = expand_short_path(&base.design, &path) {
+                    path = full;
+                }
+            }
             if !path_exists(&base.design, &path) {
                 return Err(SweepError::UnknownPath {
                     at: here,

@@ -38,7 +38,7 @@ pub use metrics::{
     evaluate, min_wall, printability, CastMetrics, MarkerMetrics, Metrics, Outcome, PartMetrics,
     Verdict, PROFILES,
 };
-pub use paths::{canonical_json, nearest_paths, parameter_paths, path_exists};
+pub use paths::{canonical_json, expand_short_path, nearest_paths, parameter_paths, path_exists};
 pub use plan::{variant_id, Plan, Shard, Variant, ID_HEX_DIGITS, MAX_VARIANTS};
 pub use results::{render_csv, render_jsonl, Status, VariantResult};
 pub use run::{

@@ -102,6 +102,36 @@ pub fn path_exists(design: &Design, path: &str) -> bool {
     })
 }
 
+/// The one parameter path that a short path abbreviates, if there is exactly one: its keys
+/// appear in order in the full path and the last keys are equal, so the issue's
+/// `markers.spacing_mm` stands for `layers[0].markers[0].pattern.spacing_mm` on a design with
+/// one marker pattern. A path with a list index (`layers[1]...`) is never short. `None` when
+/// no path or several paths fit (then the path is an error whose hint lists the nearest ones).
+pub fn expand_short_path(design: &Design, path: &str) -> Option<String> {
+    if path.contains('[') {
+        return None;
+    }
+    let keys = |p: &str| -> Vec<String> {
+        p.split(['.', '[', ']'])
+            .filter(|k| !k.is_empty() && !k.chars().all(|c| c.is_ascii_digit()))
+            .map(str::to_owned)
+            .collect()
+    };
+    let asked = keys(path);
+    let last = asked.last()?;
+    let fits = |full: &str| {
+        let k = keys(full);
+        if k.last() != Some(last) {
+            return false;
+        }
+        let mut it = k.iter();
+        asked.iter().all(|a| it.any(|x| x == a))
+    };
+    let mut found = parameter_paths(design).into_iter().filter(|p| fits(p));
+    let first = found.next()?;
+    found.next().is_none().then_some(first)
+}
+
 /// Up to `n` valid paths nearest to the unknown `path`, best first: paths ending in the same
 /// key come first (`markers.spacing_mm` finds `layers[0].markers[0].pattern.spacing_mm`), then
 /// by similarity of the last key, then of the keys they share and of the whole string.
@@ -220,6 +250,26 @@ mod tests {
             nearest_paths(&d, "mold.wall_thicknes_mm", 1),
             vec!["mold.wall_thickness_mm".to_string()]
         );
+    }
+
+    #[test]
+    fn short_paths_expand_when_unambiguous() {
+        let d = crate::library::load("shadowtac").unwrap();
+        assert_eq!(
+            expand_short_path(&d, "markers.spacing_mm").as_deref(),
+            Some("layers[0].markers[0].pattern.spacing_mm")
+        );
+        assert_eq!(
+            expand_short_path(&d, "markers.feature.height_mm").as_deref(),
+            Some("layers[0].markers[0].feature.height_mm")
+        );
+        // No such key, or keys out of order.
+        assert_eq!(expand_short_path(&d, "markers.spacing"), None);
+        assert_eq!(expand_short_path(&d, "pattern.markers.spacing_mm"), None);
+        assert_eq!(expand_short_path(&d, "layers[1].markers.spacing_mm"), None);
+        // Several fits (every layer has a name).
+        let r = crate::library::load("rtac0").unwrap();
+        assert_eq!(expand_short_path(&r, "name"), None);
     }
 
     #[test]

@@ -168,16 +168,37 @@ fn random_draws_distinct_grid_points_reproducibly() {
     );
 }
 
+/// The issue's example file, with its short paths, plans the 5 x 4 grid on the full paths.
+#[test]
+fn the_issues_example_with_short_paths_plans_its_grid() {
+    let sweep = SweepSpec::parse(
+        "base: designs/library/shadowtac.yaml
+vary:
+  markers.spacing_mm: {range: [1.2, 2.0, 0.2]}
+  markers.feature.height_mm: [0.3, 0.4, 0.5, 0.6]
+mode: grid
+outputs: [metrics]
+",
+        "sweep.yaml",
+        Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap(),
+    )
+    .unwrap();
+    let plan = sweep.plan().unwrap();
+    assert_eq!(plan.variants.len(), 20);
+    let names: Vec<&str> = sweep.parameters.iter().map(|p| p.path.as_str()).collect();
+    assert_eq!(names, [SPACING, HEIGHT]);
+}
+
 #[test]
 fn unknown_paths_are_reported_with_the_nearest_and_the_line() {
-    // the issue's short form: not a path of this schema; the hint gives the full one
+    // a misspelt short form: no path fits it; the hint gives the full one
     let e = err("base: shadowtac
 vary:
   layers[0].markers[0].pattern.spacing_mm: [1.4]
-  markers.feature.height_mm: [0.3, 0.4]
+  markers.feature.height: [0.3, 0.4]
 ");
     assert!(
-        e.starts_with("sweep.yaml:4:3: vary: 'markers.feature.height_mm' is not a parameter path of design 'shadowtac'; nearest: layers[0].markers[0].feature.height_mm"),
+        e.starts_with("sweep.yaml:4:3: vary: 'markers.feature.height' is not a parameter path of design 'shadowtac'; nearest: layers[0].markers[0].feature.height_mm"),
         "{e}"
     );
     let e = err("base: shadowtac\nvary:\n  layers[1].thickness_mm: [1]\n");
