@@ -331,3 +331,114 @@ fn bad_inputs_exit_2_with_file_line_and_write_nothing() {
         text(&o.stderr)
     );
 }
+
+/// The end-to-end check: `fabkit fixtures rtac0 --pins-preset rtac0` writes the point
+/// table and capture plan; a synthetic capture per planned image (tips seen through the camera at
+/// a known pose, +-0.3 px) is calibrated with `--capture-plan`; the pose comes back. A pin
+/// observed in the wrong capture file, or a missing file, is an error naming the file and id.
+#[test]
+fn rtac0_fixture_table_and_capture_plan_end_to_end() {
+    use fabkit_calibration::tables::{read_capture_plan, read_point_table, PointsFrom};
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let o = run(
+        dir,
+        &["fixtures", "rtac0", "--pins-preset", "rtac0", "--out", "fx"],
+        &[],
+    );
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    std::fs::write(
+        dir.join("cam.yaml"),
+        write_camera(&intrinsics(), CameraFileFormat::OpenCvYaml),
+    )
+    .unwrap();
+    let table = read_point_table(&dir.join("fx/points/point_table.csv"), PointsFrom::Tip).unwrap();
+    let plan = read_capture_plan(&dir.join("fx/points/capture_plan.csv")).unwrap();
+    assert_eq!(table.rows.len(), 29);
+    let mut planned: Vec<&String> = plan.captures.iter().flatten().collect();
+    planned.sort();
+    planned.dedup();
+    assert_eq!(planned.len(), 29, "every pin is in the plan");
+    let cam = CameraModel::new(intrinsics()).unwrap();
+    let tip = |id: &str| table.rows.iter().find(|r| r.0 == id).unwrap().1;
+    let mut files = Vec::new();
+    for (k, ids) in plan.captures.iter().enumerate() {
+        let mut s = String::from("id,u_px,v_px\n");
+        for (j, id) in ids.iter().enumerate() {
+            let uv = cam
+                .project(&(truth() * Point3::from(tip(id))).coords)
+                .unwrap();
+            let n = if (k + j) % 2 == 0 { 0.3 } else { -0.3 };
+            s.push_str(&format!("{id},{},{}\n", uv.x + n, uv.y - 0.5 * n));
+        }
+        let name = format!("capture_{}.csv", k + 1);
+        std::fs::write(dir.join(&name), s).unwrap();
+        files.push(name);
+    }
+    let calibrate = |files: &[String], out: &str| {
+        let mut args = vec![
+            "calibrate",
+            "extrinsics",
+            "--camera",
+            "cam.yaml",
+            "--points",
+            "fx/points/point_table.csv",
+            "--capture-plan",
+            "fx/points/capture_plan.csv",
+            "--out",
+            out,
+            "--observations",
+        ];
+        args.extend(files.iter().map(String::as_str));
+        run(dir, &args, &[])
+    };
+    let o = calibrate(&files, "out");
+    assert!(o.status.success(), "{}{}", text(&o.stdout), text(&o.stderr));
+    let j = json(&dir.join("out/extrinsics.json"));
+    let pose = pose_of(&j);
+    assert!(pose.rotation.angle_to(&truth().rotation).to_degrees() < 0.1);
+    assert!((pose.translation.vector - truth().translation.vector).norm() < 0.03);
+    assert_eq!(
+        j["provenance"]["capture_plan"],
+        "fx/points/capture_plan.csv"
+    );
+    assert!(j["residuals"]["outlier_ids"].as_array().unwrap().is_empty());
+
+    // One file short of the plan.
+    let o = calibrate(&files[..files.len() - 1], "out2");
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        text(&o.stderr).contains(&format!(
+            "has {} captures but {} observation files",
+            files.len(),
+            files.len() - 1
+        )),
+        "{}",
+        text(&o.stderr)
+    );
+    // The last pin of capture 2 (outer ring, in no other capture) observed in capture 1's file.
+    let moved = plan.captures[1].last().unwrap();
+    let c2 = std::fs::read_to_string(dir.join(&files[1])).unwrap();
+    let row = c2
+        .lines()
+        .find(|l| l.starts_with(&format!("{moved},")))
+        .unwrap();
+    let c1 = std::fs::read_to_string(dir.join(&files[0])).unwrap() + row + "\n";
+    let c2: String = c2
+        .lines()
+        .filter(|l| *l != row)
+        .map(|l| format!("{l}\n"))
+        .collect();
+    std::fs::write(dir.join(&files[0]), c1).unwrap();
+    std::fs::write(dir.join(&files[1]), c2).unwrap();
+    let o = calibrate(&files, "out3");
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        text(&o.stderr).contains(&format!(
+            "id {moved} is not in capture 1 of fx/points/capture_plan.csv (the plan has it in capture 2)"
+        )),
+        "{}",
+        text(&o.stderr)
+    );
+    assert!(!dir.join("out3").exists());
+}

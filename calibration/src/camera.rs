@@ -239,7 +239,7 @@ impl CameraModel {
                 if !(n2 > 0.0) || !n2.is_finite() {
                     return None;
                 }
-                let theta = rho.atan2(z);
+                let theta = atan2_nonneg(rho, z);
                 if theta > self.limit {
                     return None;
                 }
@@ -385,6 +385,54 @@ impl CameraModel {
     }
 }
 
+/// `atan2(y, x)` for `y >= 0` (so the result is in [0, pi]), to about 2 ulp: Cephes' rational
+/// approximation of atan with its three-interval reduction (S. L. Moshier, Cephes Math Library,
+/// atan.c). About twice as fast as the C library's correctly rounded atan2, which dominated
+/// projection time in the PnP solver.
+#[inline]
+pub(crate) fn atan2_nonneg(y: f64, x: f64) -> f64 {
+    use std::f64::consts::{FRAC_PI_2, PI};
+    if x > 0.0 {
+        atan_nonneg(y / x)
+    } else if y > 0.0 {
+        FRAC_PI_2 + atan_nonneg(-x / y)
+    } else if x < 0.0 {
+        PI
+    } else {
+        0.0
+    }
+}
+
+/// `atan(x)` for `x >= 0` (Cephes atan.c).
+#[inline]
+fn atan_nonneg(x: f64) -> f64 {
+    use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
+    // tan(3 pi / 8) and the low bits of pi / 2.
+    const T3P8: f64 = 2.414_213_562_373_095;
+    const MOREBITS: f64 = 6.123_233_995_736_766e-17;
+    let (y0, xr, extra) = if x > T3P8 {
+        (FRAC_PI_2, -1.0 / x, MOREBITS)
+    } else if x > 0.66 {
+        (FRAC_PI_4, (x - 1.0) / (x + 1.0), 0.5 * MOREBITS)
+    } else {
+        (0.0, x, 0.0)
+    };
+    let z = xr * xr;
+    let p = (((-8.750_608_600_031_904e-1 * z - 1.615_753_718_733_365e1) * z
+        - 7.500_855_792_314_705e1)
+        * z
+        - 1.228_866_684_490_136e2)
+        * z
+        - 6.485_021_904_942_025e1;
+    let q = ((((z + 2.485_846_490_142_306e1) * z + 1.650_270_098_316_988e2) * z
+        + 4.328_810_604_912_902e2)
+        * z
+        + 4.853_903_996_359_137e2)
+        * z
+        + 1.945_506_571_482_614e2;
+    y0 + (xr * z * p / q + xr) + extra
+}
+
 /// Kannala-Brandt `theta_d(theta)` and its derivative.
 #[inline]
 fn kb_theta_d(k: &[f64; 4], t: f64) -> (f64, f64) {
@@ -484,5 +532,41 @@ mod tests {
             let b = c.unproject(&uv).unwrap();
             assert!((b - p.normalize()).norm() < 1e-12, "{deg}: {b:?} vs {p:?}");
         }
+    }
+}
+
+#[cfg(test)]
+mod atan_tests {
+    use super::atan2_nonneg;
+
+    /// Against the C library over the whole half plane y >= 0, including the reduction
+    /// boundaries and the axes.
+    #[test]
+    fn atan2_nonneg_matches_libm() {
+        let mut worst: f64 = 0.0;
+        for i in 0..=200_000 {
+            let a = std::f64::consts::PI * i as f64 / 200_000.0;
+            for r in [1e-9, 0.37, 1.0, 15.0, 3e7] {
+                let (y, x) = (r * a.sin().max(0.0), r * a.cos());
+                let want = y.atan2(x);
+                let got = atan2_nonneg(y, x);
+                worst = worst.max((got - want).abs() / want.abs().max(1e-300));
+            }
+        }
+        for (y, x) in [
+            (0.0, 1.0),
+            (0.0, -1.0),
+            (1.0, 0.0),
+            (0.0, 0.0),
+            (2.414_213_562_373_095, 1.0),
+            (0.66, 1.0),
+        ] {
+            let want = f64::atan2(y, x);
+            assert!(
+                (atan2_nonneg(y, x) - want).abs() <= 4.0 * f64::EPSILON * want.abs(),
+                "{y} {x}"
+            );
+        }
+        assert!(worst < 5e-16, "worst relative error {worst:e}");
     }
 }

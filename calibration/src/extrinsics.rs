@@ -12,7 +12,10 @@ use crate::camera_file::{read_camera_file, CameraFileError};
 use crate::overlay::{read_png_rgb8, render_overlay, OverlayError};
 use crate::pnp::{solve_pnp, PnpError, PnpOptions, RansacOptions};
 use crate::report::{write_atomic, ExtrinsicsReport, Provenance};
-use crate::tables::{pair, read_observations, read_point_table, PointsFrom, TableError};
+use crate::tables::{
+    pair, read_capture_plan, read_captures, read_observations, read_point_table, PointsFrom,
+    TableError,
+};
 
 /// Inputs of one extrinsics calibration.
 #[derive(Debug, Clone)]
@@ -24,6 +27,9 @@ pub struct ExtrinsicsJob {
     pub points_from: PointsFrom,
     /// Observation files `id,u_px,v_px`.
     pub observations: Vec<PathBuf>,
+    /// Capture plan (`capture,id,ring`) that the observation files follow, one file per capture
+    /// in capture order; each file's ids are checked against its capture.
+    pub capture_plan: Option<PathBuf>,
     /// Output folder (created if missing).
     pub out_dir: PathBuf,
     /// Capture image for the overlay.
@@ -70,7 +76,10 @@ pub fn run_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsReport, Extrinsic
     let camera = read_camera_file(&job.camera)?;
     let table = read_point_table(&job.points, job.points_from)?;
     let obs_paths: Vec<&Path> = job.observations.iter().map(PathBuf::as_path).collect();
-    let obs = read_observations(&obs_paths)?;
+    let (obs, unobserved_ids) = match &job.capture_plan {
+        Some(plan) => read_captures(&obs_paths, &read_capture_plan(plan)?)?,
+        None => (read_observations(&obs_paths)?, Vec::new()),
+    };
     let pairs = pair(&table, &obs)?;
     let opts = PnpOptions {
         ransac: job.ransac,
@@ -111,6 +120,8 @@ pub fn run_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsReport, Extrinsic
             (true, PointsFrom::Contact) => "contact".into(),
         },
         observation_files: obs_paths.iter().map(|p| p.display().to_string()).collect(),
+        capture_plan: job.capture_plan.as_ref().map(|p| p.display().to_string()),
+        unobserved_ids,
     };
     let report = ExtrinsicsReport::new(
         &camera,

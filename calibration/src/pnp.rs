@@ -12,7 +12,7 @@ use rand_chacha::ChaCha8Rng;
 
 use crate::camera::{CameraError, CameraModel};
 use crate::p3p::p3p;
-use crate::sqpnp::{nearest_rotation, sqpnp};
+use crate::sqpnp::sqpnp;
 
 /// Smallest number of point-pixel pairs the solver accepts.
 pub const MIN_POINTS: usize = 4;
@@ -156,123 +156,75 @@ pub fn solve_pnp(
     check_layout(points_mm, &bearings)?;
     let all: Vec<usize> = (0..n).collect();
     let start = sqpnp(points_mm, &bearings).ok_or(PnpError::NoSolution)?;
-    let (mut r, mut t) = (start.rotation, start.translation_mm);
-    if let Some((r1, t1, _)) = refine(
+    let mut fit = Fit::at(
         camera,
         points_mm,
         pixels_px,
         &all,
-        r,
-        t,
-        opts.max_iterations,
-    ) {
-        (r, t) = (r1, t1);
-    }
-    // The inlier set the current pose was refined on (skip refitting the same set).
-    let mut fitted_on: Option<Vec<bool>> = Some(vec![true; n]);
+        start.rotation,
+        start.translation_mm,
+    )
+    .ok_or(PnpError::NoSolution)?;
     let mut hypotheses = 0;
     let mut inliers = vec![true; n];
-    if let Some(ro) = &opts.ransac {
-        let thr2 = ro.threshold_px * ro.threshold_px;
-        let (mut best_in, mut best_score) = score(camera, points_mm, pixels_px, &r, &t, thr2);
-        if best_in.iter().filter(|&&b| b).count() < n {
-            let mut rng = ChaCha8Rng::seed_from_u64(ro.seed);
-            let mut needed = ro.max_hypotheses;
-            let mut sample = [0usize; 3];
-            let mut poses = Vec::with_capacity(4);
-            while hypotheses < needed.min(ro.max_hypotheses) {
-                hypotheses += 1;
-                draw(&mut rng, n, &mut sample);
-                let sp = sample.map(|i| points_mm[i]);
-                let sb = sample.map(|i| bearings[i]);
-                p3p(&sp, &sb, &mut poses);
-                for (hr, ht) in &poses {
-                    let (inl, sc) = score(camera, points_mm, pixels_px, hr, ht, thr2);
-                    if sc >= best_score {
-                        continue;
-                    }
-                    // Local optimisation on the consensus set.
-                    let (mut hr, mut ht, mut hin, mut hsc) = (*hr, *ht, inl, sc);
-                    let idx: Vec<usize> = (0..n).filter(|&i| hin[i]).collect();
-                    if idx.len() >= MIN_POINTS {
-                        if let Some((r1, t1, _)) = refine(
-                            camera,
-                            points_mm,
-                            pixels_px,
-                            &idx,
-                            hr,
-                            ht,
-                            opts.max_iterations,
-                        ) {
-                            let (i1, s1) = score(camera, points_mm, pixels_px, &r1, &t1, thr2);
-                            if s1 <= hsc {
-                                (hr, ht, hin, hsc) = (r1, t1, i1, s1);
-                            }
-                        }
-                    }
-                    (r, t, best_in, best_score) = (hr, ht, hin, hsc);
-                    fitted_on = None;
-                    let w = best_in.iter().filter(|&&b| b).count() as f64 / n as f64;
-                    let denom = (1.0 - w.powi(3)).ln();
-                    needed = if denom < 0.0 {
-                        ((1.0 - ro.confidence).ln() / denom).ceil().max(1.0) as usize
-                    } else {
-                        0
-                    };
-                }
-            }
-        }
-        // Final fit on the consensus set, repeated while the set changes.
-        for _ in 0..3 {
-            let idx: Vec<usize> = (0..n).filter(|&i| best_in[i]).collect();
-            if idx.len() < MIN_POINTS {
-                return Err(PnpError::TooFewInliers {
-                    inliers: idx.len(),
-                    needed: MIN_POINTS,
-                    threshold_px: ro.threshold_px,
-                });
-            }
-            if fitted_on.as_ref() == Some(&best_in) {
-                break;
-            }
-            if let Some((r1, t1, _)) = refine(
+    match &opts.ransac {
+        None => fit.refine(camera, points_mm, pixels_px, opts.max_iterations),
+        Some(ro) => {
+            let thr2 = ro.threshold_px * ro.threshold_px;
+            // The all-points SQPnP pose is the first hypothesis. When it explains every pair,
+            // the refinement on all of them is the answer unless it pushes a pair out.
+            let mut consensus = Consensus::new(n);
+            consensus.score(
                 camera,
                 points_mm,
                 pixels_px,
-                &idx,
-                r,
-                t,
-                opts.max_iterations,
-            ) {
-                (r, t) = (r1, t1);
+                &fit.r,
+                &fit.t,
+                thr2,
+                f64::INFINITY,
+            );
+            if consensus.count() == n {
+                fit.refine(camera, points_mm, pixels_px, opts.max_iterations);
+                consensus.from_fit(&fit, thr2);
             }
-            fitted_on = Some(best_in.clone());
-            let (inl, _) = score(camera, points_mm, pixels_px, &r, &t, thr2);
-            let same = inl == best_in;
-            best_in = inl;
-            if same {
-                break;
+            if consensus.count() < n {
+                hypotheses = ransac(
+                    camera,
+                    points_mm,
+                    pixels_px,
+                    &bearings,
+                    ro,
+                    opts,
+                    &mut fit,
+                    &mut consensus,
+                );
             }
-        }
-        inliers = best_in;
-        let count = inliers.iter().filter(|&&b| b).count();
-        let needed = MIN_POINTS.max((ro.min_inlier_fraction * n as f64).ceil() as usize);
-        if count < needed {
-            return Err(PnpError::TooFewInliers {
-                inliers: count,
-                needed,
-                threshold_px: ro.threshold_px,
-            });
+            inliers = consensus.inliers;
+            let count = inliers.iter().filter(|&&b| b).count();
+            let needed = MIN_POINTS.max((ro.min_inlier_fraction * n as f64).ceil() as usize);
+            if count < needed {
+                return Err(PnpError::TooFewInliers {
+                    inliers: count,
+                    needed,
+                    threshold_px: ro.threshold_px,
+                });
+            }
         }
     }
-    let mut residuals_px = Vec::with_capacity(n);
+    // Residuals: the fit's own for the pairs it was refined on, a projection for the others.
+    let mut residuals_px: Vec<Option<Vector2<f64>>> = vec![None; n];
+    for (k, &i) in fit.idx.iter().enumerate() {
+        residuals_px[i] = Some(fit.residuals[k]);
+    }
     let (mut sum2, mut m) = (0.0, 0usize);
     for i in 0..n {
-        let res = camera
-            .project(&(r * points_mm[i] + t))
-            .map(|uv| uv - pixels_px[i]);
+        if residuals_px[i].is_none() {
+            residuals_px[i] = camera
+                .project(&(fit.r * points_mm[i] + fit.t))
+                .map(|uv| uv - pixels_px[i]);
+        }
         if inliers[i] {
-            match res {
+            match residuals_px[i] {
                 Some(e) => {
                     sum2 += e.norm_squared();
                     m += 1;
@@ -280,18 +232,269 @@ pub fn solve_pnp(
                 None => return Err(PnpError::BehindCamera { index: i }),
             }
         }
-        residuals_px.push(res);
     }
-    let rot = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(
-        nearest_rotation(&r),
-    ));
+    // LM updates R by exact rotations, so R is orthonormal to rounding: the quaternion of R,
+    // renormalised, is the nearest rotation.
+    let q = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(fit.r));
+    let rot = UnitQuaternion::new_normalize(q.into_inner());
     Ok(PnpSolution {
-        t_cam_sensor: Isometry3::from_parts(Translation3::from(t), rot),
+        t_cam_sensor: Isometry3::from_parts(Translation3::from(fit.t), rot),
         inliers,
         residuals_px,
         rms_reprojection_error_px: (sum2 / m as f64).sqrt(),
         hypotheses,
     })
+}
+
+/// RANSAC with local optimisation: minimal samples of 3 (P3P), MSAC scores with early exit, a
+/// Levenberg-Marquardt refinement of every new best hypothesis on its consensus set, then a final
+/// refinement repeated while the consensus set changes. `fit` and `consensus` hold the best so
+/// far on entry and the result on return. Returns the number of hypotheses drawn.
+#[allow(clippy::too_many_arguments)]
+fn ransac(
+    camera: &CameraModel,
+    pts: &[Vector3<f64>],
+    px: &[Vector2<f64>],
+    bearings: &[Vector3<f64>],
+    ro: &RansacOptions,
+    opts: &PnpOptions,
+    fit: &mut Fit,
+    best: &mut Consensus,
+) -> usize {
+    let n = pts.len();
+    let thr2 = ro.threshold_px * ro.threshold_px;
+    // Local optimisation of the starting hypothesis.
+    let local_opt = |fit: &mut Fit, c: &mut Consensus| {
+        let idx = c.indices();
+        if idx.len() < MIN_POINTS {
+            return;
+        }
+        if let Some(mut f) = Fit::at(camera, pts, px, &idx, fit.r, fit.t) {
+            f.refine(camera, pts, px, opts.max_iterations);
+            let mut c1 = Consensus::new(n);
+            c1.score(camera, pts, px, &f.r, &f.t, thr2, c.score);
+            if c1.score <= c.score {
+                *fit = f;
+                *c = c1;
+            }
+        }
+    };
+    local_opt(fit, best);
+    let adaptive = |c: &Consensus| {
+        let w = c.count() as f64 / n as f64;
+        let denom = (1.0 - w.powi(3)).ln();
+        if denom < 0.0 {
+            ((1.0 - ro.confidence).ln() / denom).ceil().max(1.0) as usize
+        } else {
+            // No inlier yet: sample up to the limit.
+            usize::MAX
+        }
+    };
+    let mut needed = adaptive(best).min(ro.max_hypotheses);
+    let mut rng = ChaCha8Rng::seed_from_u64(ro.seed);
+    let mut sample = [0usize; 3];
+    let mut poses = Vec::with_capacity(4);
+    let mut trial = Consensus::new(n);
+    let mut hypotheses = 0;
+    while hypotheses < needed {
+        hypotheses += 1;
+        draw(&mut rng, n, &mut sample);
+        let sp = sample.map(|i| pts[i]);
+        let sb = sample.map(|i| bearings[i]);
+        p3p(&sp, &sb, &mut poses);
+        for (hr, ht) in &poses {
+            if !trial.score(camera, pts, px, hr, ht, thr2, best.score) {
+                continue;
+            }
+            let mut hfit = Fit {
+                r: *hr,
+                t: *ht,
+                ..Fit::default()
+            };
+            let mut hc = trial.clone();
+            local_opt(&mut hfit, &mut hc);
+            *fit = hfit;
+            *best = hc;
+            needed = adaptive(best).min(ro.max_hypotheses);
+        }
+    }
+    // Final fit on the consensus set, repeated while the set changes.
+    for _ in 0..3 {
+        let idx = best.indices();
+        if idx.len() < MIN_POINTS || fit.idx == idx {
+            break;
+        }
+        if let Some(mut f) = Fit::at(camera, pts, px, &idx, fit.r, fit.t) {
+            f.refine(camera, pts, px, opts.max_iterations);
+            *fit = f;
+        }
+        best.score(camera, pts, px, &fit.r, &fit.t, thr2, f64::INFINITY);
+    }
+    hypotheses
+}
+
+/// MSAC consensus of a pose: which pairs reproject within the threshold and the truncated score.
+#[derive(Debug, Clone)]
+struct Consensus {
+    inliers: Vec<bool>,
+    /// Sum over the pairs of min(squared reprojection error, threshold^2), px^2.
+    score: f64,
+}
+
+impl Consensus {
+    fn new(n: usize) -> Self {
+        Consensus {
+            inliers: vec![false; n],
+            score: f64::INFINITY,
+        }
+    }
+
+    fn count(&self) -> usize {
+        self.inliers.iter().filter(|&&b| b).count()
+    }
+
+    fn indices(&self) -> Vec<usize> {
+        (0..self.inliers.len())
+            .filter(|&i| self.inliers[i])
+            .collect()
+    }
+
+    /// Scores the pose; stops early (returning false, `self` then unspecified) as soon as the
+    /// partial score reaches `bound`. True when the whole score is below `bound`.
+    #[allow(clippy::too_many_arguments)]
+    fn score(
+        &mut self,
+        camera: &CameraModel,
+        pts: &[Vector3<f64>],
+        px: &[Vector2<f64>],
+        r: &Matrix3<f64>,
+        t: &Vector3<f64>,
+        thr2: f64,
+        bound: f64,
+    ) -> bool {
+        let mut s = 0.0;
+        for (k, (m, uv)) in pts.iter().zip(px).enumerate() {
+            let e2 = camera
+                .project(&(r * m + t))
+                .map_or(f64::INFINITY, |p| (p - uv).norm_squared());
+            self.inliers[k] = e2 < thr2;
+            s += e2.min(thr2);
+            if s >= bound {
+                self.score = f64::INFINITY;
+                return false;
+            }
+        }
+        self.score = s;
+        true
+    }
+
+    /// The consensus of a fit made on every pair, from its own residuals.
+    fn from_fit(&mut self, fit: &Fit, thr2: f64) {
+        let mut s = 0.0;
+        for (k, &i) in fit.idx.iter().enumerate() {
+            let e2 = fit.residuals[k].norm_squared();
+            self.inliers[i] = e2 < thr2;
+            s += e2.min(thr2);
+        }
+        self.score = s;
+    }
+}
+
+/// A pose with the normal equations and residuals of the reprojection error over `idx`.
+#[derive(Debug, Clone, Default)]
+struct Fit {
+    r: Matrix3<f64>,
+    t: Vector3<f64>,
+    idx: Vec<usize>,
+    jtj: Matrix6<f64>,
+    jte: Vector6<f64>,
+    /// Sum of squared reprojection errors over `idx`, px^2.
+    cost: f64,
+    /// Reprojected minus observed pixel per entry of `idx`, px.
+    residuals: Vec<Vector2<f64>>,
+}
+
+impl Fit {
+    /// `None` if a point of `idx` does not project at (r, t).
+    fn at(
+        camera: &CameraModel,
+        pts: &[Vector3<f64>],
+        px: &[Vector2<f64>],
+        idx: &[usize],
+        r: Matrix3<f64>,
+        t: Vector3<f64>,
+    ) -> Option<Fit> {
+        let mut residuals = Vec::with_capacity(idx.len());
+        let (jtj, jte, cost) = normal_equations(camera, pts, px, idx, &r, &t, &mut residuals)?;
+        Some(Fit {
+            r,
+            t,
+            idx: idx.to_vec(),
+            jtj,
+            jte,
+            cost,
+            residuals,
+        })
+    }
+
+    /// Levenberg-Marquardt on the reprojection error over `idx`, from the current pose.
+    fn refine(
+        &mut self,
+        camera: &CameraModel,
+        pts: &[Vector3<f64>],
+        px: &[Vector2<f64>],
+        max_iterations: usize,
+    ) {
+        let mut lambda = 1e-6;
+        let mut res1 = Vec::with_capacity(self.idx.len());
+        for _ in 0..max_iterations {
+            let mut a = self.jtj;
+            for k in 0..6 {
+                a[(k, k)] += lambda * self.jtj[(k, k)].max(1e-12);
+            }
+            let Some(ch) = a.cholesky() else {
+                lambda *= 10.0;
+                if lambda > 1e8 {
+                    break;
+                }
+                continue;
+            };
+            let d = ch.solve(&(-self.jte));
+            // Gauss-Newton's predicted decrease: below 1e-9 of the cost the pose is converged far
+            // below the noise; skip evaluating a step that cannot matter.
+            let predicted = -(d.dot(&self.jte)) - 0.5 * (d.transpose() * self.jtj * d)[0];
+            if predicted.abs() <= 1e-9 * self.cost.max(1e-30) {
+                break;
+            }
+            let w = Vector3::new(d[0], d[1], d[2]);
+            let r1 = *Rotation3::new(w).matrix() * self.r;
+            let t1 = self.t + Vector3::new(d[3], d[4], d[5]);
+            match normal_equations(camera, pts, px, &self.idx, &r1, &t1, &mut res1) {
+                Some((j1, e1, c1)) => {
+                    // Converged when the cost stops changing (relative 1e-8: a pose change far
+                    // below the noise) or the step is negligible.
+                    let done =
+                        (self.cost - c1).abs() <= 1e-8 * self.cost.max(1e-30) || d.norm() < 1e-10;
+                    if c1 <= self.cost {
+                        (self.r, self.t, self.jtj, self.jte, self.cost) = (r1, t1, j1, e1, c1);
+                        std::mem::swap(&mut self.residuals, &mut res1);
+                        lambda = (lambda * 0.1).max(1e-12);
+                    } else {
+                        lambda *= 10.0;
+                    }
+                    if done || lambda > 1e8 {
+                        break;
+                    }
+                }
+                None => {
+                    lambda *= 10.0;
+                    if lambda > 1e8 {
+                        break;
+                    }
+                }
+            }
+        }
+    }
 }
 
 /// Rejects collinear points (the pose has a free rotation) and parallel rays.
@@ -336,27 +539,6 @@ fn draw(rng: &mut ChaCha8Rng, n: usize, out: &mut [usize]) {
     }
 }
 
-/// Inliers and the MSAC score (sum of squared errors truncated at the threshold).
-fn score(
-    camera: &CameraModel,
-    pts: &[Vector3<f64>],
-    px: &[Vector2<f64>],
-    r: &Matrix3<f64>,
-    t: &Vector3<f64>,
-    thr2: f64,
-) -> (Vec<bool>, f64) {
-    let mut inl = Vec::with_capacity(pts.len());
-    let mut s = 0.0;
-    for (m, uv) in pts.iter().zip(px) {
-        let e2 = camera
-            .project(&(r * m + t))
-            .map_or(f64::INFINITY, |p| (p - uv).norm_squared());
-        inl.push(e2 < thr2);
-        s += e2.min(thr2);
-    }
-    (inl, s)
-}
-
 /// Sum of squared reprojection errors over `idx`, or `None` if a point does not project.
 fn cost(
     camera: &CameraModel,
@@ -374,7 +556,8 @@ fn cost(
 }
 
 /// Normal equations of the reprojection error at (r, t): J^T J and J^T e over `idx`, with the
-/// rotation perturbed on the left (R <- exp(w) R) and parameters (w, t).
+/// rotation perturbed on the left (R <- exp(w) R) and parameters (w, t); `residuals` gets the
+/// reprojected minus observed pixel per entry of `idx`.
 pub(crate) fn normal_equations(
     camera: &CameraModel,
     pts: &[Vector3<f64>],
@@ -382,7 +565,9 @@ pub(crate) fn normal_equations(
     idx: &[usize],
     r: &Matrix3<f64>,
     t: &Vector3<f64>,
+    residuals: &mut Vec<Vector2<f64>>,
 ) -> Option<(Matrix6<f64>, Vector6<f64>, f64)> {
+    residuals.clear();
     let mut jtj = Matrix6::zeros();
     let mut jte = Vector6::zeros();
     let mut s = 0.0;
@@ -390,6 +575,7 @@ pub(crate) fn normal_equations(
         let q = r * pts[i];
         let (uv, j) = camera.project_with_jacobian(&(q + t))?;
         let e = uv - px[i];
+        residuals.push(e);
         s += e.norm_squared();
         // d(pc)/dw = -[q]x, d(pc)/dt = I.
         let jw = j * (-q.cross_matrix());
@@ -408,63 +594,6 @@ pub(crate) fn normal_equations(
         jte += a * e.x + b * e.y;
     }
     Some((jtj, jte, s))
-}
-
-/// Levenberg-Marquardt on the reprojection error over `idx`; returns the refined pose and cost.
-fn refine(
-    camera: &CameraModel,
-    pts: &[Vector3<f64>],
-    px: &[Vector2<f64>],
-    idx: &[usize],
-    mut r: Matrix3<f64>,
-    mut t: Vector3<f64>,
-    max_iterations: usize,
-) -> Option<(Matrix3<f64>, Vector3<f64>, f64)> {
-    let (mut jtj, mut jte, mut c) = normal_equations(camera, pts, px, idx, &r, &t)?;
-    let mut lambda = 1e-6;
-    for _ in 0..max_iterations {
-        let mut a = jtj;
-        for k in 0..6 {
-            a[(k, k)] += lambda * jtj[(k, k)].max(1e-12);
-        }
-        let Some(ch) = a.cholesky() else {
-            lambda *= 10.0;
-            continue;
-        };
-        let d = ch.solve(&(-jte));
-        // Gauss-Newton's predicted decrease: below 1e-9 of the cost the pose is converged far
-        // below the noise; skip evaluating a step that cannot matter.
-        let predicted = -(d.dot(&jte)) - 0.5 * (d.transpose() * jtj * d)[0];
-        if predicted.abs() <= 1e-9 * c.max(1e-30) {
-            break;
-        }
-        let w = Vector3::new(d[0], d[1], d[2]);
-        let r1 = *Rotation3::new(w).matrix() * r;
-        let t1 = t + Vector3::new(d[3], d[4], d[5]);
-        match normal_equations(camera, pts, px, idx, &r1, &t1) {
-            Some((j1, e1, c1)) => {
-                // Converged when the cost stops changing (relative 1e-8: a pose change far below the
-                // noise) or the step is negligible.
-                let done = (c - c1).abs() <= 1e-8 * c.max(1e-30) || d.norm() < 1e-10;
-                if c1 <= c {
-                    (r, t, jtj, jte, c) = (r1, t1, j1, e1, c1);
-                    lambda = (lambda * 0.1).max(1e-12);
-                } else {
-                    lambda *= 10.0;
-                }
-                if done || lambda > 1e8 {
-                    break;
-                }
-            }
-            None => {
-                lambda *= 10.0;
-                if lambda > 1e8 {
-                    break;
-                }
-            }
-        }
-    }
-    Some((r, t, c))
 }
 
 /// Reprojection cost of a pose over all pairs, px^2 (for tests and reports).
@@ -503,5 +632,6 @@ pub fn reprojection_normal_equations(
         &idx,
         &r,
         &t_cam_sensor.translation.vector,
+        &mut Vec::new(),
     )
 }

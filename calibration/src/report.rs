@@ -20,6 +20,12 @@ pub struct Provenance {
     /// `tip` or `contact` (fixtures tables) or `xyz` (plain tables).
     pub points_from: String,
     pub observation_files: Vec<String>,
+    /// The capture plan the observation files were checked against (one file per capture).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub capture_plan: Option<String>,
+    /// Pins of the capture plan with no observation (not used in the solve), plan order.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub unobserved_ids: Vec<String>,
 }
 
 /// One observed point's residual.

@@ -174,12 +174,22 @@ pub fn nearest_rotation(m: &Matrix3<f64>) -> Matrix3<f64> {
 }
 
 /// SQP iterations on `min r^T Omega r` subject to R R^T = I, from the rotation `r0`.
+///
+/// SQPnP's SQP step ignores the curvature of the constraints, so it converges only linearly when
+/// the cost at the optimum is large (outliers among the points). Once the steps are small it
+/// hands over to Newton's method on the rotation manifold, which converges quadratically.
 fn run_sqp(omega: &M9, r0: Matrix3<f64>) -> V9 {
     let mut r = to_v9(&r0);
+    let mut polish = false;
     for _ in 0..15 {
         let delta = sqp_step(omega, &r);
         r += delta;
-        if delta.norm_squared() < 1e-10 {
+        let d2 = delta.norm_squared();
+        if d2 < 1e-10 {
+            break;
+        }
+        if d2 < 1e-4 {
+            polish = true;
             break;
         }
     }
@@ -193,7 +203,44 @@ fn run_sqp(omega: &M9, r0: Matrix3<f64>) -> V9 {
     if det > 1.001 || (rm * rm.transpose() - Matrix3::identity()).norm_squared() > 1e-12 {
         rm = nearest_rotation(&rm);
     }
+    if polish {
+        for _ in 0..8 {
+            match newton_step(omega, &rm) {
+                Some(w) => {
+                    rm = *nalgebra::Rotation3::new(w).matrix() * rm;
+                    if w.norm_squared() < 1e-16 {
+                        break;
+                    }
+                }
+                None => break,
+            }
+        }
+    }
     to_v9(&rm)
+}
+
+/// Newton step of `f(R) = vec(R)^T Omega vec(R)` over left increments `R <- exp([w]x) R`:
+/// with `A = d vec / dw` (9 x 3, columns `vec([e_k]x R)`) and `G = mat(Omega vec(R))`, the
+/// gradient is `2 A^T Omega r` and the Hessian `2 A^T Omega A + 2 (sym(R G^T) - tr(G^T R) I)`
+/// (the second term from `[w]x^2 = w w^T - |w|^2 I`). `None` when the Hessian is not positive
+/// definite (then the SQP result stands).
+fn newton_step(omega: &M9, rm: &Matrix3<f64>) -> Option<Vector3<f64>> {
+    let r = to_v9(rm);
+    let or = omega * r;
+    let mut a = SMatrix::<f64, 9, 3>::zeros();
+    for k in 0..3 {
+        let mut e = Vector3::zeros();
+        e[k] = 1.0;
+        a.set_column(k, &to_v9(&(e.cross_matrix() * rm)));
+    }
+    let g = a.transpose() * or;
+    let gm = Matrix3::new(
+        or[0], or[1], or[2], or[3], or[4], or[5], or[6], or[7], or[8],
+    );
+    let rg = rm * gm.transpose();
+    let s = (rg + rg.transpose()) * 0.5 - Matrix3::identity() * (gm.transpose() * rm).trace();
+    let h = a.transpose() * omega * a + s;
+    h.cholesky().map(|c| -c.solve(&g))
 }
 
 /// One SQP step: delta = H x + N y with H an orthonormal basis of the constraint gradients

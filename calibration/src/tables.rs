@@ -43,6 +43,20 @@ pub enum TableError {
     },
     #[error("observed ids not in the point table {points}: {}", .ids.join(", "))]
     UnknownIds { points: String, ids: Vec<String> },
+    #[error("{plan} has {captures} captures but {files} observation files were given (one per capture, in capture order)")]
+    CaptureCount {
+        plan: String,
+        captures: usize,
+        files: usize,
+    },
+    #[error("{origin}: id {id} is not in capture {capture} of {plan} ({where_})")]
+    NotInCapture {
+        origin: String,
+        id: String,
+        capture: usize,
+        plan: String,
+        where_: String,
+    },
 }
 
 /// Which point of a fixtures table to use.
@@ -324,4 +338,166 @@ pub fn pair(points: &PointTable, obs: &Observations) -> Result<Pairs, TableError
         pairs.pixels_px.push(*uv);
     }
     Ok(pairs)
+}
+
+/// The capture plan `fabkit fixtures` writes (`points/capture_plan.csv`: `capture,id,ring`):
+/// the ids of the pins inserted together for each capture, captures numbered from 1.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CapturePlan {
+    pub file: String,
+    /// Ids per capture, capture 1 first.
+    pub captures: Vec<Vec<String>>,
+}
+
+/// Reads a capture plan (`capture,id,ring`; captures numbered 1, 2, ... without gaps; a pin may
+/// stay in for several captures, once per capture).
+///
+/// # Errors
+/// [`TableError`] naming file:line: missing columns, a capture number that is not a positive
+/// integer or skips one, an id listed twice in one capture.
+pub fn read_capture_plan(path: &Path) -> Result<CapturePlan, TableError> {
+    let (file, text) = read(path)?;
+    parse_capture_plan(&text, &file)
+}
+
+/// Parses a capture plan's text. See [`read_capture_plan`].
+///
+/// # Errors
+/// As [`read_capture_plan`].
+pub fn parse_capture_plan(text: &str, file: &str) -> Result<CapturePlan, TableError> {
+    let csv = parse_csv(text, file)?;
+    let expected = "capture,id,ring";
+    let cc = csv.column("capture", expected)?;
+    let ci = csv.column("id", expected)?;
+    let mut captures: Vec<Vec<String>> = Vec::new();
+    let mut seen: BTreeMap<(usize, String), usize> = BTreeMap::new();
+    for (line, cells) in &csv.rows {
+        let raw = cells[cc];
+        let k: usize = raw
+            .parse()
+            .ok()
+            .filter(|&k| k >= 1)
+            .ok_or_else(|| TableError::Field {
+                file: file.into(),
+                line: *line,
+                column: "capture".into(),
+                value: raw.into(),
+                rule: "must be a positive integer".into(),
+            })?;
+        if k > captures.len() + 1 {
+            return Err(TableError::Field {
+                file: file.into(),
+                line: *line,
+                column: "capture".into(),
+                value: raw.into(),
+                rule: format!(
+                    "captures are numbered without gaps (next is {})",
+                    captures.len() + 1
+                ),
+            });
+        }
+        if k == captures.len() + 1 {
+            captures.push(Vec::new());
+        }
+        let id = csv.id(*line, cells, ci)?;
+        if let Some(first) = seen.insert((k, id.clone()), *line) {
+            return Err(TableError::Duplicate {
+                id,
+                first: format!("{file}:{first}"),
+                second: format!("{file}:{line}"),
+            });
+        }
+        captures[k - 1].push(id);
+    }
+    Ok(CapturePlan {
+        file: file.into(),
+        captures,
+    })
+}
+
+/// Reads observation files given one per capture, in capture order, and checks them against
+/// the plan: every id of file k must be a pin of capture k. A pin that stays in for several
+/// captures (the pole pin of a fixtures plan) may be observed in each of them; the camera does
+/// not move between captures, so its observations are averaged into one (origins joined by ` + `).
+/// Pins of the plan that were not observed are allowed (a pin the detector missed); they are
+/// returned, in plan order, with the merged observations (first-seen order).
+///
+/// # Errors
+/// [`TableError::CaptureCount`] when the number of files differs from the number of captures;
+/// [`TableError::NotInCapture`] naming the row of the first id observed in the wrong capture;
+/// the errors of [`read_observations`] for each file (a duplicate id within one file).
+pub fn read_captures(
+    paths: &[&Path],
+    plan: &CapturePlan,
+) -> Result<(Observations, Vec<String>), TableError> {
+    let mut texts = Vec::new();
+    for p in paths {
+        texts.push(read(p)?);
+    }
+    let refs: Vec<(&str, &str)> = texts
+        .iter()
+        .map(|(f, t)| (t.as_str(), f.as_str()))
+        .collect();
+    parse_captures(&refs, plan)
+}
+
+/// [`read_captures`] on (text, file name) pairs.
+///
+/// # Errors
+/// As [`read_captures`].
+pub fn parse_captures(
+    texts: &[(&str, &str)],
+    plan: &CapturePlan,
+) -> Result<(Observations, Vec<String>), TableError> {
+    if texts.len() != plan.captures.len() {
+        return Err(TableError::CaptureCount {
+            plan: plan.file.clone(),
+            captures: plan.captures.len(),
+            files: texts.len(),
+        });
+    }
+    // id -> (sum of pixels, count, origins), in first-seen order.
+    let mut merged: Vec<(String, Vector2<f64>, usize, Vec<Origin>)> = Vec::new();
+    for (k, pair) in texts.iter().enumerate() {
+        let obs = parse_observations(std::slice::from_ref(pair))?;
+        for (id, uv, origin) in obs.rows {
+            if !plan.captures[k].contains(&id) {
+                let home = plan.captures.iter().position(|c| c.contains(&id));
+                return Err(TableError::NotInCapture {
+                    origin,
+                    id,
+                    capture: k + 1,
+                    plan: plan.file.clone(),
+                    where_: match home {
+                        Some(c) => format!("the plan has it in capture {}", c + 1),
+                        None => "the plan does not list it".into(),
+                    },
+                });
+            }
+            match merged.iter_mut().find(|m| m.0 == id) {
+                Some(m) => {
+                    m.1 += uv;
+                    m.2 += 1;
+                    m.3.push(origin);
+                }
+                None => merged.push((id, uv, 1, vec![origin])),
+            }
+        }
+    }
+    let unobserved = plan
+        .captures
+        .iter()
+        .flatten()
+        .filter(|i| !merged.iter().any(|m| &m.0 == *i))
+        .fold(Vec::<String>::new(), |mut v, i| {
+            if !v.contains(i) {
+                v.push(i.clone());
+            }
+            v
+        });
+    let rows = merged
+        .into_iter()
+        .map(|(id, sum, n, origins)| (id, sum / n as f64, origins.join(" + ")))
+        .collect();
+    Ok((Observations { rows }, unobserved))
 }

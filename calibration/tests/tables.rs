@@ -85,3 +85,48 @@ fn bad_tables_name_file_line_and_column() {
         "observed ids not in the point table pins.csv: 7 (a.csv:3), 9 (a.csv:4)"
     );
 }
+
+const PLAN: &str = "# capture plan\ncapture,id,ring\n1,0,0\n1,1,1\n2,0,0\n2,2,1\n";
+
+#[test]
+fn capture_files_follow_the_plan_and_a_repeated_pin_is_averaged() {
+    use fabkit_calibration::tables::{parse_capture_plan, parse_captures};
+    let plan = parse_capture_plan(PLAN, "plan.csv").unwrap();
+    assert_eq!(plan.captures, vec![vec!["0", "1"], vec!["0", "2"]]);
+    let a = "id,u_px,v_px\n0,100,200\n1,150,210\n";
+    let b = "id,u_px,v_px\n0,102,201\n";
+    let (obs, unobserved) = parse_captures(&[(a, "a.csv"), (b, "b.csv")], &plan).unwrap();
+    assert_eq!(obs.rows.len(), 2);
+    assert_eq!(obs.rows[0].0, "0");
+    assert_eq!(obs.rows[0].1, nalgebra::Vector2::new(101.0, 200.5));
+    assert_eq!(obs.rows[0].2, "a.csv:2 + b.csv:2");
+    assert_eq!(unobserved, vec!["2"]);
+
+    let err = |texts: &[(&str, &str)]| parse_captures(texts, &plan).unwrap_err().to_string();
+    assert_eq!(
+        err(&[(a, "a.csv")]),
+        "plan.csv has 2 captures but 1 observation files were given (one per capture, in capture order)"
+    );
+    assert_eq!(
+        err(&[(a, "a.csv"), ("id,u_px,v_px\n1,1,1\n", "b.csv")]),
+        "b.csv:2: id 1 is not in capture 2 of plan.csv (the plan has it in capture 1)"
+    );
+    assert_eq!(
+        err(&[(a, "a.csv"), ("id,u_px,v_px\n7,1,1\n", "b.csv")]),
+        "b.csv:2: id 7 is not in capture 2 of plan.csv (the plan does not list it)"
+    );
+    let bad = |text: &str| {
+        parse_capture_plan(text, "plan.csv")
+            .unwrap_err()
+            .to_string()
+    };
+    assert_eq!(
+        bad("capture,id,ring\n1,0,0\n3,1,1\n"),
+        "plan.csv:3: capture = 3: captures are numbered without gaps (next is 2)"
+    );
+    assert_eq!(
+        bad("capture,id,ring\n0,0,0\n"),
+        "plan.csv:2: capture = 0: must be a positive integer"
+    );
+    assert!(bad("capture,id,ring\n1,0,0\n1,0,0\n").contains("id 0 is given twice"));
+}

@@ -52,6 +52,16 @@ pub struct Part {
     pub group: Option<String>,
 }
 
+impl Part {
+    /// The mesh that is written and measured: the solid's mesh with every coordinate rounded to
+    /// `f32` ([`crate::Mesh::rounded_to_f32`]). The export's files and manifest numbers
+    /// (volume, triangles, genus) and the sweep metrics are all computed from this form, so
+    /// that they agree with each other and with an independent reader of the STL or 3MF.
+    pub fn written_mesh(&self) -> crate::Mesh {
+        self.solid.mesh().rounded_to_f32()
+    }
+}
+
 /// Casting numbers for one pour.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CastReport {

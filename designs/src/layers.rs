@@ -106,6 +106,38 @@ fn on_surface(placed: &[PlacedMarkers], surface: MarkerSurface) -> Vec<&PlacedMa
         .collect()
 }
 
+/// Centres of the features' end hemispheres, sensor frame, mm: each marker's position moved
+/// (height - radius) along its normal, outward for `dir` = +1, inward for -1. The wall between
+/// converging features is their distance minus the diameter.
+pub fn feature_end_centres(
+    markers: &[Marker],
+    f: &markers::FeatureShape,
+    dir: f64,
+) -> Vec<[f64; 3]> {
+    let h = f.height_mm - f.radius_mm();
+    markers
+        .iter()
+        .map(|m| [0, 1, 2].map(|k| m.position_mm[k] + dir * h * m.normal[k]))
+        .collect()
+}
+
+/// The least material left between inward recesses of a solid layer and its base plane at
+/// `base_z_mm`, mm: the lowest point of each recess (its depth along the normal plus the
+/// cylinder's radius sideways) above the plane.
+pub fn recess_clearance_to_base_mm(
+    markers: &[Marker],
+    f: &markers::FeatureShape,
+    base_z_mm: f64,
+) -> f64 {
+    markers
+        .iter()
+        .map(|m| {
+            let side = (1.0 - m.normal[2] * m.normal[2]).max(0.0).sqrt() * f.radius_mm();
+            m.position_mm[2] - f.height_mm * m.normal[2] - side - base_z_mm
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
 /// Rules on marker patterns: they place, do not overlap, leave the printer's minimum wall,
 /// and their features print on the technology that makes them.
 pub fn check_markers(design: &Design, layers: &[ResolvedLayer], errs: &mut Vec<ParamError>) {
@@ -243,14 +275,7 @@ pub fn check_markers(design: &Design, layers: &[ResolvedLayer], errs: &mut Vec<P
             }
             // Features that converge (pointing into a concave side) must stay apart at their
             // ends too: the hemisphere centres keep the same clearance as the bases.
-            let dir = direction(spec);
-            let ends: Vec<[f64; 3]> = placed
-                .iter()
-                .map(|m| {
-                    let h = f.height_mm - f.radius_mm();
-                    [0, 1, 2].map(|k| m.position_mm[k] + dir * h * m.normal[k])
-                })
-                .collect();
+            let ends = feature_end_centres(&placed, f, direction(spec));
             if ends.len() > 1 {
                 let nn = markers::nearest_neighbours(&ends);
                 if let Some((a, (b, d))) = nn.iter().enumerate().min_by(|x, y| {
@@ -273,15 +298,7 @@ pub fn check_markers(design: &Design, layers: &[ResolvedLayer], errs: &mut Vec<P
             }
             // A recess into a solid layer must not cut through its flat base.
             if l.solid && f.polarity == Polarity::Recessed {
-                let zb = design.body.base_z_mm();
-                let worst = placed
-                    .iter()
-                    .map(|m| {
-                        let side =
-                            (1.0 - m.normal[2] * m.normal[2]).max(0.0).sqrt() * f.radius_mm();
-                        m.position_mm[2] - f.height_mm * m.normal[2] - side - zb
-                    })
-                    .fold(f64::INFINITY, f64::min);
+                let worst = recess_clearance_to_base_mm(&placed, f, design.body.base_z_mm());
                 if worst < profile.min_wall_mm {
                     errs.push(ParamError::new(
                         format!("{path}.feature.height_mm"),

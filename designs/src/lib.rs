@@ -21,6 +21,7 @@ pub mod primitives;
 pub mod profile;
 pub mod schema;
 pub mod stack;
+pub mod sweep;
 
 pub use build::build_kit;
 pub use error::{DesignError, ParamError, ParamErrors};

@@ -30,3 +30,64 @@ pub fn load(name: &str) -> Result<Design, DesignError> {
     let text = yaml(name).ok_or_else(|| DesignError::UnknownDesign(name.to_string()))?;
     Design::from_yaml(text, &format!("designs/library/{name}.yaml"))
 }
+
+/// A design read from a YAML file or the library, with where it came from.
+#[derive(Debug, Clone)]
+pub struct LoadedDesign {
+    /// The parsed design, marker CSV files read into their patterns.
+    pub design: Design,
+    /// The path as given, or `embedded:<name>` for a library design.
+    pub source: String,
+    /// sha256 of the YAML text followed by every marker CSV file it reads, in order; 64
+    /// lowercase hex digits.
+    pub sha256: String,
+}
+
+/// Reads the design named by `arg`: a YAML file when it names an existing file, ends in
+/// `.yaml` / `.yml` or contains a `/`, else the library design of that name. A relative file
+/// path is taken relative to `relative_to` (`""` for the current directory); marker CSV files
+/// relative to the design file's folder.
+///
+/// # Errors
+/// [`DesignError::Io`] for an unreadable file, [`DesignError::UnknownDesign`], or the
+/// design's own YAML errors (`file:line:column`).
+pub fn load_source(arg: &str, relative_to: &std::path::Path) -> Result<LoadedDesign, DesignError> {
+    use sha2::{Digest, Sha256};
+    let path = relative_to.join(arg);
+    let looks_like_file =
+        path.is_file() || arg.ends_with(".yaml") || arg.ends_with(".yml") || arg.contains('/');
+    let (text, source, origin) = if looks_like_file {
+        let text = std::fs::read_to_string(&path).map_err(|e| DesignError::Io {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        })?;
+        let shown = path.display().to_string();
+        (text, shown.clone(), shown)
+    } else {
+        let text = yaml(arg).ok_or_else(|| DesignError::UnknownDesign(arg.to_string()))?;
+        (
+            text.to_string(),
+            format!("embedded:{arg}"),
+            format!("designs/library/{arg}.yaml"),
+        )
+    };
+    let mut design = Design::from_yaml(&text, &origin)?;
+    let mut hasher = Sha256::new();
+    hasher.update(text.as_bytes());
+    if looks_like_file {
+        let dir = path.parent().unwrap_or(std::path::Path::new("."));
+        for extra in design.load_marker_files(dir)? {
+            hasher.update(extra.as_bytes());
+        }
+    }
+    let sha256 = hasher
+        .finalize()
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect();
+    Ok(LoadedDesign {
+        design,
+        source,
+        sha256,
+    })
+}

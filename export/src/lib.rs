@@ -147,11 +147,7 @@ pub fn write_kit_with_files(
             });
         }
     }
-    let meshes: Vec<Mesh> = kit
-        .parts
-        .iter()
-        .map(|p| p.solid.mesh().rounded_to_f32())
-        .collect();
+    let meshes: Vec<Mesh> = kit.parts.iter().map(|p| p.written_mesh()).collect();
     write_kit_meshes(kit, &meshes, data_files, out_dir, opts)
 }
 

@@ -34,6 +34,10 @@ pub struct ExtrinsicsArgs {
     /// Pixel observations, CSV id,u_px,v_px; several files (one per capture) may be given.
     #[arg(long, value_name = "OBS.csv", num_args = 1.., required = true)]
     pub observations: Vec<PathBuf>,
+    /// Capture plan (points/capture_plan.csv of `fabkit fixtures`): the observation files are one
+    /// per capture, in capture order, and each may hold only that capture's pins.
+    #[arg(long, value_name = "PLAN.csv")]
+    pub capture_plan: Option<PathBuf>,
     /// Output folder for extrinsics.json, extrinsics.yaml (and overlay.png).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
@@ -73,6 +77,7 @@ fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
             PointsFromArg::Contact => PointsFrom::Contact,
         },
         observations: a.observations,
+        capture_plan: a.capture_plan,
         out_dir: a.out.clone(),
         image: a.image,
         ransac: (!a.no_ransac).then_some(RansacOptions {

@@ -5,7 +5,6 @@ use clap::{Parser, Subcommand, ValueEnum};
 use fabkit_designs::schema::MoldStrategy;
 use fabkit_designs::{build_kit, library, ChordTolerance, Design, DesignError};
 use fabkit_export::{write_kit, ExportOptions, Formats};
-use sha2::{Digest, Sha256};
 use std::error::Error;
 
 use std::path::{Path, PathBuf};
@@ -32,6 +31,8 @@ enum Command {
     Calibrate(crate::calibrate_cmd::CalibrateCommand),
     /// Ground-truth depth maps of the protrusion semi-domes through the calibrated camera.
     Groundtruth(crate::groundtruth_cmd::GroundTruthArgs),
+    /// Build and measure many variants of a design over a parameter grid (results table).
+    Sweep(crate::sweep_cmd::SweepArgs),
     /// List the designs embedded in fabkit.
     Designs,
     /// Check a design and print its resolved layer stack, without writing anything.
@@ -118,44 +119,12 @@ pub(crate) struct Loaded {
 
 pub(crate) fn load_design(arg: Option<&str>) -> Result<Loaded, DesignError> {
     let arg = arg.unwrap_or(library::DEFAULT_DESIGN);
-    let path = Path::new(arg);
-    let looks_like_file =
-        path.is_file() || arg.ends_with(".yaml") || arg.ends_with(".yml") || arg.contains('/');
-    let (text, source) = if looks_like_file {
-        let text = std::fs::read_to_string(path).map_err(|e| DesignError::Io {
-            path: arg.to_string(),
-            message: e.to_string(),
-        })?;
-        (text, arg.to_string())
-    } else {
-        let text = library::yaml(arg).ok_or_else(|| DesignError::UnknownDesign(arg.to_string()))?;
-        (text.to_string(), format!("embedded:{arg}"))
-    };
-    let origin = if looks_like_file {
-        arg.to_string()
-    } else {
-        format!("designs/library/{arg}.yaml")
-    };
-    let mut design = Design::from_yaml(&text, &origin)?;
-    // The design hash covers the YAML and every marker CSV file it reads, in order.
-    let mut hasher = Sha256::new();
-    hasher.update(text.as_bytes());
-    if looks_like_file {
-        let dir = path.parent().unwrap_or(Path::new("."));
-        for extra in design.load_marker_files(dir)? {
-            hasher.update(extra.as_bytes());
-        }
-    }
-    let sha256 = hex(&hasher.finalize());
+    let l = library::load_source(arg, Path::new(""))?;
     Ok(Loaded {
-        design,
-        source,
-        sha256,
+        design: l.design,
+        source: l.source,
+        sha256: l.sha256,
     })
-}
-
-fn hex(b: &[u8]) -> String {
-    b.iter().map(|x| format!("{x:02x}")).collect()
 }
 
 /// The export options of this run: formats, provenance (command line, design, version).
@@ -234,6 +203,7 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
         Command::Fixtures(args) => crate::fixtures_cmd::run(args),
         Command::Calibrate(cmd) => crate::calibrate_cmd::run(cmd),
         Command::Groundtruth(args) => crate::groundtruth_cmd::run(args),
+        Command::Sweep(args) => crate::sweep_cmd::run(args),
     }
 }
 

@@ -22,3 +22,4 @@ pub mod calibrate_cmd;
 pub mod cli;
 pub mod fixtures_cmd;
 pub mod groundtruth_cmd;
+pub mod sweep_cmd;

@@ -1,0 +1,418 @@
+//! The sweep file: which design, which parameters take which values, how they combine and
+//! what to write. Every problem is reported before anything runs, at its `file:line:column`.
+
+use super::paths::{expand_short_path, nearest_paths, path_exists, with_value};
+use super::SweepError;
+use crate::library::{load_source, LoadedDesign};
+use crate::schema::{yaml_error, Design};
+use crate::ChordTolerance;
+use serde::de::{MapAccess, Visitor};
+use serde::{Deserialize, Deserializer, Serialize};
+use serde_json::Value;
+use serde_saphyr::Spanned;
+use std::path::Path;
+
+/// How the values of the varied parameters combine into variants.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Mode {
+    /// Every combination (cartesian product); the first parameter in the file varies slowest.
+    Grid,
+    /// The lists in step: variant k takes the k-th value of every parameter (equal lengths).
+    Zip,
+    /// `count` distinct combinations of the grid drawn without replacement, seeded by `seed`,
+    /// listed in grid order.
+    Random,
+}
+
+/// What a sweep writes for each variant.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Output {
+    /// The row of the results table (always written).
+    Metrics,
+    /// The files of `fabkit export` (STL per part and the kit 3MF, manifest, sheet).
+    Files,
+    /// As `files`, STL only.
+    Stl,
+    /// As `files`, 3MF only.
+    #[serde(rename = "3mf")]
+    ThreeMf,
+}
+
+/// One varied parameter and its values, in the order they are tried.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Parameter {
+    /// Path in the design, e.g. `layers[0].markers[0].pattern.spacing_mm`.
+    pub path: String,
+    /// The values, as JSON (numbers keep the integer / float distinction of the file).
+    pub values: Vec<Value>,
+    /// `file:line:column` of the parameter's key in the sweep file.
+    pub at: String,
+}
+
+/// Which formats the variant folders get, if any.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub struct FileOutputs {
+    pub stl: bool,
+    pub threemf: bool,
+}
+
+impl FileOutputs {
+    pub fn any(self) -> bool {
+        self.stl || self.threemf
+    }
+}
+
+/// A parsed and checked sweep file.
+#[derive(Debug, Clone)]
+pub struct SweepSpec {
+    /// Where the sweep file was read from (for messages and provenance).
+    pub origin: String,
+    /// sha256 of the sweep file's text.
+    pub sha256: String,
+    /// The base design (preset applied) and its source.
+    pub base: LoadedDesign,
+    /// The preset applied to the base, if any.
+    pub preset: Option<String>,
+    pub chord_tolerance: ChordTolerance,
+    pub parameters: Vec<Parameter>,
+    pub mode: Mode,
+    /// Seed of the random mode.
+    pub seed: u64,
+    /// Number of variants of the random mode.
+    pub count: Option<u64>,
+    pub files: FileOutputs,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawSweep {
+    base: Spanned<String>,
+    #[serde(default)]
+    preset: Option<Spanned<String>>,
+    #[serde(default)]
+    chord_tolerance_mm: Option<Spanned<f64>>,
+    vary: Spanned<RawVary>,
+    #[serde(default)]
+    mode: Option<Spanned<Mode>>,
+    #[serde(default)]
+    seed: Option<Spanned<u64>>,
+    #[serde(default)]
+    count: Option<Spanned<u64>>,
+    #[serde(default)]
+    outputs: Option<Spanned<Vec<Output>>>,
+}
+
+/// The `vary` map in file order, each key with its location.
+struct RawVary(Vec<(Spanned<String>, Spanned<Value>)>);
+
+impl<'de> Deserialize<'de> for RawVary {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = RawVary;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a map from parameter paths to values")
+            }
+            fn visit_map<A: MapAccess<'de>>(self, mut m: A) -> Result<RawVary, A::Error> {
+                let mut out: Vec<(Spanned<String>, Spanned<Value>)> = Vec::new();
+                while let Some(k) = m.next_key::<Spanned<String>>()? {
+                    if out.iter().any(|(o, _)| o.value == k.value) {
+                        return Err(serde::de::Error::custom(format!(
+                            "parameter `{}` is listed twice",
+                            k.value
+                        )));
+                    }
+                    let v = m.next_value::<Spanned<Value>>()?;
+                    out.push((k, v));
+                }
+                Ok(RawVary(out))
+            }
+        }
+        d.deserialize_map(V)
+    }
+}
+
+fn at<T>(origin: &str, s: &Spanned<T>) -> String {
+    format!("{origin}:{}:{}", s.referenced.line(), s.referenced.column())
+}
+
+impl SweepSpec {
+    /// Reads and checks the sweep file at `path`. The base design is read relative to the
+    /// sweep file's folder.
+    ///
+    /// # Errors
+    /// See [`SweepSpec::parse`]; [`SweepError::Io`] when the file cannot be read.
+    pub fn from_file(path: &Path) -> Result<SweepSpec, SweepError> {
+        let text = std::fs::read_to_string(path).map_err(|e| SweepError::Io {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        })?;
+        let dir = path.parent().unwrap_or(Path::new(""));
+        Self::parse(&text, &path.display().to_string(), dir)
+    }
+
+    /// Parses and checks a sweep file's text; `origin` names it in messages, `dir` is the folder
+    /// a relative `base` path is read from.
+    ///
+    /// Every value of every parameter is set into the base design and the design is checked
+    /// against the schema, so that a wrong type is found before anything runs. Whether a
+    /// combination of values makes a feasible design is not checked here: an infeasible
+    /// variant is a result.
+    ///
+    /// # Errors
+    /// [`SweepError::File`] (YAML syntax, unknown keys, bad `range`, zip lists of different
+    /// lengths, random mode without `count`, duplicate values...), [`SweepError::UnknownPath`]
+    /// with the nearest valid paths, [`SweepError::WrongValue`], [`SweepError::Design`] for a
+    /// base design that does not load; each with `file:line:column`.
+    pub fn parse(text: &str, origin: &str, dir: &Path) -> Result<SweepSpec, SweepError> {
+        use sha2::{Digest, Sha256};
+        let raw: RawSweep = serde_saphyr::from_str(text).map_err(|e| SweepError::File {
+            at: String::new(),
+            message: yaml_error(origin, &e),
+        })?;
+        let file_err = |s: String, message: String| SweepError::File { at: s, message };
+        let mut base = load_source(&raw.base.value, dir).map_err(|e| SweepError::Design {
+            at: at(origin, &raw.base),
+            error: e,
+        })?;
+        let preset = raw.preset.as_ref().map(|p| p.value.clone());
+        if let Some(p) = &raw.preset {
+            base.design = base
+                .design
+                .with_preset(&p.value)
+                .map_err(|e| SweepError::Design {
+                    at: at(origin, p),
+                    error: e,
+                })?;
+        }
+        let chord_tolerance = match &raw.chord_tolerance_mm {
+            None => ChordTolerance::default(),
+            Some(t) => ChordTolerance::new(t.value).map_err(|e| file_err(at(origin, t), e))?,
+        };
+        let mode = raw.mode.as_ref().map(|m| m.value).unwrap_or(Mode::Grid);
+        match (&raw.count, &raw.seed, mode) {
+            (None, _, Mode::Random) => {
+                return Err(file_err(
+                    raw.mode.as_ref().map(|m| at(origin, m)).unwrap_or_default(),
+                    "mode random needs `count` (and takes `seed`, default 0)".into(),
+                ))
+            }
+            (Some(c), _, m) if m != Mode::Random => {
+                return Err(file_err(
+                    at(origin, c),
+                    "`count` only applies to mode random".into(),
+                ))
+            }
+            (_, Some(s), m) if m != Mode::Random => {
+                return Err(file_err(
+                    at(origin, s),
+                    "`seed` only applies to mode random".into(),
+                ))
+            }
+            (Some(c), _, _) if c.value == 0 => {
+                return Err(file_err(at(origin, c), "`count` must be above 0".into()))
+            }
+            _ => {}
+        }
+        let mut files = FileOutputs::default();
+        if let Some(o) = &raw.outputs {
+            if !o.value.contains(&Output::Metrics) {
+                return Err(file_err(
+                    at(origin, o),
+                    "outputs must include metrics (the results table is always written): [metrics] or [metrics, files]".into(),
+                ));
+            }
+            for x in &o.value {
+                match x {
+                    Output::Metrics => {}
+                    Output::Files => {
+                        files.stl = true;
+                        files.threemf = true;
+                    }
+                    Output::Stl => files.stl = true,
+                    Output::ThreeMf => files.threemf = true,
+                }
+            }
+        }
+        if raw.vary.value.0.is_empty() {
+            return Err(file_err(
+                at(origin, &raw.vary),
+                "vary: give at least one parameter path and its values".into(),
+            ));
+        }
+        let base_json = serde_json::to_value(&base.design).map_err(|e| SweepError::File {
+            at: origin.to_string(),
+            message: e.to_string(),
+        })?;
+        let mut parameters = Vec::new();
+        for (key, spec) in &raw.vary.value.0 {
+            let mut path = key.value.trim().to_string();
+            let here = at(origin, key);
+            if !path_exists(&base.design, &path) {
+                // A short path (`markers.spacing_mm`) stands for the one full path it fits.
+                if let Some(full) = expand_short_path(&base.design, &path) {
+                    path = full;
+                }
+            }
+            if !path_exists(&base.design, &path) {
+                return Err(SweepError::UnknownPath {
+                    at: here,
+                    path: path.clone(),
+                    design: base.design.name.clone(),
+                    nearest: nearest_paths(&base.design, &path, 3),
+                });
+            }
+            if path.ends_with(".csv_file") {
+                return Err(file_err(
+                    here,
+                    format!("vary.{path}: marker CSV files are read once, when the base design loads; vary the pattern's `points` instead"),
+                ));
+            }
+            let values = values_of(&spec.value)
+                .map_err(|m| file_err(at(origin, spec), format!("vary.{path}: {m}")))?;
+            for (i, v) in values.iter().enumerate() {
+                if values[..i].contains(v) {
+                    return Err(file_err(
+                        at(origin, spec),
+                        format!("vary.{path}: the value {v} is listed twice"),
+                    ));
+                }
+                let replaced =
+                    with_value(&base_json, &path, v).ok_or_else(|| SweepError::UnknownPath {
+                        at: here.clone(),
+                        path: path.clone(),
+                        design: base.design.name.clone(),
+                        nearest: nearest_paths(&base.design, &path, 3),
+                    })?;
+                if let Err(e) = serde_json::from_value::<Design>(replaced) {
+                    return Err(SweepError::WrongValue {
+                        at: at(origin, spec),
+                        path: path.clone(),
+                        value: v.to_string(),
+                        message: e.to_string(),
+                    });
+                }
+            }
+            parameters.push(Parameter {
+                path,
+                values,
+                at: here,
+            });
+        }
+        if mode == Mode::Zip {
+            let n = parameters[0].values.len();
+            if let Some(p) = parameters.iter().find(|p| p.values.len() != n) {
+                return Err(file_err(
+                    p.at.clone(),
+                    format!(
+                        "mode zip takes the lists in step, but vary.{} has {} values and vary.{} has {n}",
+                        p.path,
+                        p.values.len(),
+                        parameters[0].path
+                    ),
+                ));
+            }
+        }
+        let sha256 = Sha256::digest(text.as_bytes())
+            .iter()
+            .map(|b| format!("{b:02x}"))
+            .collect();
+        Ok(SweepSpec {
+            origin: origin.to_string(),
+            sha256,
+            base,
+            preset,
+            chord_tolerance,
+            parameters,
+            mode,
+            seed: raw.seed.map(|s| s.value).unwrap_or(0),
+            count: raw.count.map(|c| c.value),
+            files,
+        })
+    }
+}
+
+/// The values a `vary` entry stands for: a list `[a, b, ...]`, `{list: [...]}` or
+/// `{range: [start, stop, step]}` (stop included when it falls on the grid; integers when all
+/// three are integers, else numbers rounded to the decimals written in the file).
+///
+/// # Errors
+/// A message naming the rule that the entry breaks.
+pub fn values_of(spec: &Value) -> Result<Vec<Value>, String> {
+    let values = match spec {
+        Value::Array(a) => a.clone(),
+        Value::Object(o) if o.len() == 1 && o.contains_key("list") => match &o["list"] {
+            Value::Array(a) => a.clone(),
+            other => return Err(format!("list must be a list of values, found {other}")),
+        },
+        Value::Object(o) if o.len() == 1 && o.contains_key("range") => range(&o["range"])?,
+        other => {
+            return Err(format!(
+                "expected a list of values, {{list: [...]}} or {{range: [start, stop, step]}}, found {other}"
+            ))
+        }
+    };
+    if values.is_empty() {
+        return Err("no values".into());
+    }
+    Ok(values)
+}
+
+/// Most values a single range may produce.
+const MAX_RANGE_VALUES: f64 = 1_000_000.0;
+
+fn range(r: &Value) -> Result<Vec<Value>, String> {
+    let a = r
+        .as_array()
+        .filter(|a| a.len() == 3 && a.iter().all(Value::is_number))
+        .ok_or_else(|| format!("range must be three numbers [start, stop, step], found {r}"))?;
+    let ints: Option<Vec<i64>> = a.iter().map(Value::as_i64).collect();
+    if let Some(i) = ints {
+        let (start, stop, step) = (i[0], i[1], i[2]);
+        if step <= 0 || stop < start {
+            return Err(format!(
+                "range [{start}, {stop}, {step}]: needs step > 0 and stop >= start"
+            ));
+        }
+        if ((stop - start) / step) as f64 + 1.0 > MAX_RANGE_VALUES {
+            return Err(format!("range {r} has more than {MAX_RANGE_VALUES} values"));
+        }
+        return Ok((0..)
+            .map(|k| start + k * step)
+            .take_while(|&v| v <= stop)
+            .map(Value::from)
+            .collect());
+    }
+    let f: Vec<f64> = a.iter().filter_map(Value::as_f64).collect();
+    let (start, stop, step) = (f[0], f[1], f[2]);
+    if !(step > 0.0 && stop >= start && start.is_finite() && stop.is_finite()) {
+        return Err(format!(
+            "range [{start}, {stop}, {step}]: needs step > 0 and stop >= start"
+        ));
+    }
+    let n = ((stop - start) / step + 1e-9).floor() + 1.0;
+    if n > MAX_RANGE_VALUES {
+        return Err(format!("range {r} has more than {MAX_RANGE_VALUES} values"));
+    }
+    // Values are start + k step rounded to the decimals written (0.2 -> 1 decimal), so that
+    // [1.2, 2.0, 0.2] gives 1.2, 1.4, 1.6, 1.8, 2.0 exactly as typed, not 1.5999999999999999.
+    let decimals = f
+        .iter()
+        .map(|x| {
+            let s = x.to_string();
+            s.split_once('.').map(|(_, d)| d.len()).unwrap_or(0)
+        })
+        .max()
+        .unwrap_or(0);
+    (0..n as usize)
+        .map(|k| {
+            let v = start + k as f64 * step;
+            format!("{v:.decimals$}")
+                .parse::<f64>()
+                .map_err(|e| e.to_string())
+                .map(Value::from)
+        })
+        .collect()
+}

@@ -1,0 +1,317 @@
+//! The numbers recorded for each variant: part volumes and triangles, pour volumes and
+//! masses, marker count and spacing, the thinnest wall, and a printability verdict per printer
+//! profile.
+
+use crate::build::build_kit;
+use crate::kit::{Kit, PrintTechnology};
+use crate::layers::{
+    feature_end_centres, place_layer_markers, recess_clearance_to_base_mm, PlacedMarkers,
+};
+use crate::markers::{nearest_neighbours, MarkerSurface, Polarity};
+use crate::materials::MaterialsTable;
+use crate::schema::{Design, LayerProcess, Technology};
+use crate::stack::{validate, ResolvedLayer, Stack};
+use crate::{ChordTolerance, DesignError};
+use serde::{Deserialize, Serialize};
+
+/// The numbers of one feasible variant.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Metrics {
+    /// Every part of the kit, in kit order.
+    pub parts: Vec<PartMetrics>,
+    /// Every pour, in casting order.
+    pub casts: Vec<CastMetrics>,
+    /// Every marker pattern, per layer from the inside out.
+    pub markers: Vec<MarkerMetrics>,
+    /// The thinnest wall of [`min_wall`], mm; `None` when the design has none of those walls.
+    pub min_wall_mm: Option<f64>,
+    /// Where that wall is (a parameter path and what it separates).
+    pub min_wall_at: Option<String>,
+    /// Triangles of all parts together.
+    pub triangles: usize,
+}
+
+/// One part, measured on the mesh that `fabkit export` writes ([`crate::kit::Part::written_mesh`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PartMetrics {
+    pub name: String,
+    pub print_technology: PrintTechnology,
+    /// Enclosed volume, mm^3 (the manifest's `volume_mm3`).
+    pub volume_mm3: f64,
+    pub triangles: usize,
+}
+
+/// One pour, as the kit computes it for the fabrication sheet.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CastMetrics {
+    /// A layer name, or `silicone_mold:<layer>`.
+    pub cast: String,
+    pub material: String,
+    /// Cavity volume, mL.
+    pub cavity_volume_ml: f64,
+    /// Mass to mix including the waste allowance, g (density from `designs/materials.yaml`).
+    pub total_mass_g: f64,
+}
+
+/// One marker pattern, distances measured on the surface ([`crate::markers::stats`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MarkerMetrics {
+    pub layer: String,
+    pub surface: MarkerSurface,
+    pub count: usize,
+    /// Smallest nearest-neighbour distance, mm (0 for fewer than two markers).
+    pub min_spacing_mm: f64,
+    pub median_spacing_mm: f64,
+}
+
+/// Whether the design can be made on one printer profile.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Verdict {
+    /// `fdm`, `sla` or `polyjet` (the keys of the design's `printers`).
+    pub profile: String,
+    pub printable: bool,
+    /// The rules broken on this profile (`path = value: rule`), empty when printable.
+    pub violations: Vec<String>,
+}
+
+/// The printer profiles a verdict is given for, in order.
+pub const PROFILES: [(&str, Technology); 3] = [
+    ("fdm", Technology::Fdm),
+    ("sla", Technology::Sla),
+    ("polyjet", Technology::Polyjet),
+];
+
+/// The outcome of building one variant.
+#[derive(Debug)]
+pub enum Outcome {
+    /// Built and measured.
+    Ok { metrics: Metrics, kit: Box<Kit> },
+    /// The design breaks rules: every violation, `path = value: rule`.
+    Infeasible(Vec<String>),
+    /// The build failed on valid parameters (a kernel failure: a fabkit defect).
+    Error(String),
+}
+
+/// Validates and builds `design`, then measures the kit.
+pub fn evaluate(design: &Design, materials: &MaterialsTable, tol: ChordTolerance) -> Outcome {
+    let stack = match validate(design, materials, tol) {
+        Ok(s) => s,
+        Err(e) => return Outcome::Infeasible(e.0.iter().map(ToString::to_string).collect()),
+    };
+    let kit = match build_kit(design, tol) {
+        Ok(k) => k,
+        Err(DesignError::Params(e)) => {
+            return Outcome::Infeasible(e.0.iter().map(ToString::to_string).collect())
+        }
+        Err(e) => return Outcome::Error(e.to_string()),
+    };
+    let parts: Vec<PartMetrics> = kit
+        .parts
+        .iter()
+        .map(|p| {
+            let mesh = p.written_mesh();
+            PartMetrics {
+                name: p.name.clone(),
+                print_technology: p.print_technology,
+                volume_mm3: mesh.signed_volume(),
+                triangles: mesh.triangles.len(),
+            }
+        })
+        .collect();
+    let casts = kit
+        .casts
+        .iter()
+        .map(|c| CastMetrics {
+            cast: c.cast.clone(),
+            material: c.material.clone(),
+            cavity_volume_ml: c.cavity_volume_ml,
+            total_mass_g: c.total_mass_g,
+        })
+        .collect();
+    let mut markers = Vec::new();
+    let mut placed_all = Vec::new();
+    for l in &stack.layers {
+        let placed = place_layer_markers(design, l, tol);
+        for p in &placed {
+            markers.push(MarkerMetrics {
+                layer: l.name.clone(),
+                surface: p.spec.surface,
+                count: p.stats.count,
+                min_spacing_mm: p.stats.min_spacing_mm,
+                median_spacing_mm: p.stats.median_spacing_mm,
+            });
+        }
+        placed_all.push((l, placed));
+    }
+    let (min_wall_mm, min_wall_at) = match min_wall(design, &stack, &placed_all) {
+        Some((w, at)) => (Some(w), Some(at)),
+        None => (None, None),
+    };
+    let triangles = parts.iter().map(|p| p.triangles).sum();
+    Outcome::Ok {
+        metrics: Metrics {
+            parts,
+            casts,
+            markers,
+            min_wall_mm,
+            min_wall_at,
+            triangles,
+        },
+        kit: Box::new(kit),
+    }
+}
+
+/// The thinnest of the walls that fabkit's printability rules measure, mm, and where it is:
+///
+/// - between neighbouring marker features, at their bases (nearest-neighbour spacing on the
+///   surface minus the feature diameter) and at their ends (distance between the hemisphere
+///   centres minus the diameter): mold material between recesses, or skin between pins;
+/// - behind a recessed feature: the layer thickness minus the feature height (shell layers),
+///   or the distance from the recess to the base plane (solid layers);
+/// - a printed layer's thickness;
+/// - `mold.wall_thickness_mm` when a layer is cast in a printed mold.
+///
+/// `None` when the design has none of these. The housing's walls are not included.
+pub fn min_wall(
+    design: &Design,
+    stack: &Stack,
+    placed: &[(&ResolvedLayer, Vec<PlacedMarkers>)],
+) -> Option<(f64, String)> {
+    let mut walls: Vec<(f64, String)> = Vec::new();
+    for (l, patterns) in placed {
+        let spec_layer = &design.layers[l.index];
+        let mut j = 0;
+        for (k, spec) in spec_layer.markers.iter().enumerate() {
+            // place_layer_markers skips patterns that do not place; keep indices aligned.
+            let Some(pm) = patterns.get(j).filter(|p| p.spec == *spec) else {
+                continue;
+            };
+            j += 1;
+            let path = format!("layers[{}].markers[{k}]", l.index);
+            let f = &pm.spec.feature;
+            if pm.markers.len() > 1 {
+                walls.push((
+                    pm.stats.min_spacing_mm - f.diameter_mm,
+                    format!("{path}: between neighbouring features at their bases"),
+                ));
+                let ends = feature_end_centres(&pm.markers, f, pm.direction);
+                let closest = nearest_neighbours(&ends)
+                    .iter()
+                    .map(|n| n.1)
+                    .fold(f64::INFINITY, f64::min);
+                walls.push((
+                    closest - f.diameter_mm,
+                    format!("{path}: between neighbouring features at their ends"),
+                ));
+            }
+            if f.polarity == Polarity::Recessed {
+                if l.solid {
+                    let worst =
+                        recess_clearance_to_base_mm(&pm.markers, f, design.body.base_z_mm());
+                    walls.push((
+                        worst,
+                        format!("{path}: between recesses and the base plane"),
+                    ));
+                } else {
+                    walls.push((
+                        l.thickness_mm - f.height_mm,
+                        format!("{path}: behind the recesses in layer '{}'", l.name),
+                    ));
+                }
+            }
+        }
+    }
+    for l in &stack.layers {
+        if l.process == LayerProcess::Printed && !l.solid {
+            walls.push((
+                l.thickness_mm,
+                format!("layers[{}]: printed layer '{}'", l.index, l.name),
+            ));
+        }
+    }
+    if stack.layers.iter().any(|l| l.process == LayerProcess::Cast) {
+        walls.push((
+            design.mold.wall_thickness_mm,
+            "mold.wall_thickness_mm: mold wall around the cavity".into(),
+        ));
+    }
+    walls
+        .into_iter()
+        .filter(|w| w.0.is_finite())
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+}
+
+/// A verdict per printer profile ([`PROFILES`]): the design validates when the parts that
+/// form the skin (mold cavities, master patterns, printed layers) are made on that profile.
+/// Holders, jigs, mold boxes and the housing keep the technology the design gives them.
+pub fn printability(
+    design: &Design,
+    materials: &MaterialsTable,
+    tol: ChordTolerance,
+) -> Vec<Verdict> {
+    PROFILES
+        .iter()
+        .map(|(name, tech)| {
+            let mut d = design.clone();
+            d.mold.cavity_print_technology = *tech;
+            for l in &mut d.layers {
+                if l.process == LayerProcess::Printed {
+                    l.print_technology = Some(*tech);
+                }
+            }
+            let violations = match validate(&d, materials, tol) {
+                Ok(_) => vec![],
+                Err(e) => e.0.iter().map(ToString::to_string).collect(),
+            };
+            Verdict {
+                profile: (*name).to_string(),
+                printable: violations.is_empty(),
+                violations,
+            }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shadowtac_metrics_match_the_design() {
+        let tol = ChordTolerance::new(0.05).unwrap();
+        let materials = MaterialsTable::embedded().unwrap();
+        let d = crate::library::load("shadowtac").unwrap();
+        let Outcome::Ok { metrics: m, kit } = evaluate(&d, &materials, tol) else {
+            panic!("shadowtac builds");
+        };
+        assert_eq!(m.parts.len(), kit.parts.len());
+        assert_eq!(
+            m.triangles,
+            kit.parts
+                .iter()
+                .map(|p| p.solid.triangle_count())
+                .sum::<usize>()
+        );
+        assert_eq!(m.markers.len(), 1);
+        let mk = &m.markers[0];
+        // concentric at 1.4 mm: every ring's neighbours are about 1.4 mm apart
+        assert!(mk.count > 400, "{mk:?}");
+        assert!(mk.median_spacing_mm > 1.3 && mk.median_spacing_mm < 1.45);
+        // the thinnest wall is between neighbouring dimples: spacing minus the 0.45 mm diameter
+        let w = m.min_wall_mm.unwrap();
+        assert!((w - (mk.min_spacing_mm - 0.45)).abs() < 1e-12, "{w} {mk:?}");
+        assert!(m.min_wall_at.unwrap().contains("layers[0].markers[0]"));
+        // one pour: the skin, its mass is the volume times the density plus the waste allowance
+        assert_eq!(m.casts.len(), 1);
+        let c = &m.casts[0];
+        let rho = materials.get(&c.material).unwrap().density_g_per_cm3;
+        assert!((c.total_mass_g - c.cavity_volume_ml * rho * 1.2).abs() < 1e-6 * c.total_mass_g);
+        // 0.45 mm dimples: SLA (0.4 mm holes) and PolyJet (0.5 mm features) differ, FDM cannot
+        let v = printability(&d, &materials, tol);
+        let by = |p: &str| v.iter().find(|x| x.profile == p).unwrap();
+        assert!(by("sla").printable);
+        assert!(!by("fdm").printable);
+        assert!(by("fdm").violations[0].contains("printer profile 'fdm'"));
+        assert!(!by("polyjet").printable);
+    }
+}

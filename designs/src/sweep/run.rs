@@ -1,0 +1,493 @@
+//! Running a sweep into its folder: parallel over variants, one result file per variant
+//! written atomically, resume, shards.
+
+use super::file::{FileOutputs, Mode, SweepSpec};
+use super::metrics::{evaluate, printability, Outcome};
+use super::paths::canonical_json;
+use super::plan::{hex, Plan, Shard, Variant};
+use super::results::{render_csv, render_jsonl, Status, VariantResult};
+use super::SweepError;
+use crate::kit::Kit;
+use crate::materials::MaterialsTable;
+use crate::schema::Design;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+
+/// Format tag of `sweep.json`.
+pub const FORMAT: &str = "fabkit-sweep/1";
+
+/// How to run a sweep.
+#[derive(Debug, Clone)]
+pub struct RunOptions {
+    /// The sweep folder: created if missing; a folder that holds something other than a
+    /// fabkit sweep is refused.
+    pub out_dir: PathBuf,
+    /// Worker threads (variants built at once); `None`: one per core.
+    pub jobs: Option<usize>,
+    /// Run only this shard's variants.
+    pub shard: Option<Shard>,
+    /// Write each variant's build time into `results.csv` / `results.jsonl`. Without it the
+    /// `build_time_s` cells are empty and the tables are the same bytes for the same sweep on
+    /// any machine, thread count or sharding (each `variants/<id>.json` keeps its time).
+    pub build_time: bool,
+    /// The command line, recorded in `sweep.json` and in exported files.
+    pub command_line: Vec<String>,
+    /// fabkit version, recorded with every result; results of another version are recomputed.
+    pub fabkit_version: String,
+}
+
+/// Writes the files of `fabkit export` for one variant (the CLI passes the export crate's
+/// writer: designs cannot depend on it).
+pub trait KitWriter: Sync {
+    /// Writes `kit` into `job.dir` (replacing a previous export there) with the formats of
+    /// `job.files`.
+    ///
+    /// # Errors
+    /// A message; the variant is recorded with status error.
+    fn write(&self, kit: &Kit, job: &FilesJob<'_>) -> Result<(), String>;
+}
+
+/// What a [`KitWriter`] gets besides the kit.
+#[derive(Debug)]
+pub struct FilesJob<'a> {
+    /// `<sweep folder>/variants/<id>`.
+    pub dir: PathBuf,
+    pub files: FileOutputs,
+    pub variant: &'a Variant,
+    pub design: &'a Design,
+    /// sha256 of the variant's resolved design (canonical JSON), 64 hex digits.
+    pub design_sha256: String,
+    /// `<base source> variant <id> of sweep <sweep file>`.
+    pub design_source: String,
+    pub chord_tolerance_mm: f64,
+}
+
+/// Progress of a run, reported from the worker threads.
+#[derive(Debug)]
+pub enum Event<'a> {
+    /// Before the first variant: `selected` variants in this shard (of `total`), of which
+    /// `complete` already have a result and are skipped.
+    Start {
+        total: usize,
+        selected: usize,
+        complete: usize,
+    },
+    /// A variant finished (in completion order, not index order).
+    Done(&'a VariantResult),
+}
+
+/// What a run did.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunSummary {
+    /// Variants in the sweep.
+    pub total: usize,
+    /// Variants in this shard (all of them without a shard).
+    pub selected: usize,
+    /// Variants skipped because their results were complete.
+    pub reused: usize,
+    /// Ids of the variants built by this run, in index order.
+    pub ran: Vec<String>,
+    pub ok: usize,
+    pub infeasible: usize,
+    pub errors: usize,
+    pub results_csv: PathBuf,
+    pub results_jsonl: PathBuf,
+}
+
+/// `sweep.json`: what a sweep folder holds and how it was made.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SweepRecord {
+    /// [`FORMAT`].
+    pub format: String,
+    pub fabkit_version: String,
+    pub sweep_file: String,
+    pub sweep_sha256: String,
+    pub base_source: String,
+    pub base_sha256: String,
+    pub preset: Option<String>,
+    pub chord_tolerance_mm: f64,
+    pub mode: Mode,
+    pub seed: Option<u64>,
+    pub count: Option<u64>,
+    /// The varied parameter paths, in order (the CSV's parameter columns).
+    pub parameters: Vec<String>,
+    pub files: FileOutputs,
+    /// Variants in the whole sweep.
+    pub variant_count: usize,
+    /// sha256 of the ids of the whole sweep, in order ([`Plan::plan_sha256`]).
+    pub plan_sha256: String,
+    /// The shard this folder holds; `None` for the whole sweep.
+    pub shard: Option<Shard>,
+    pub build_time: bool,
+    pub command_line: Vec<String>,
+    /// For a merged folder: the shard folders it was merged from.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub merged_from: Vec<String>,
+}
+
+pub(crate) const SWEEP_JSON: &str = "sweep.json";
+pub(crate) const RESULTS_CSV: &str = "results.csv";
+pub(crate) const RESULTS_JSONL: &str = "results.jsonl";
+const VARIANTS: &str = "variants";
+
+/// Writes `bytes` to `path` through a synced temporary sibling renamed into place, so that
+/// `path` holds either its old content or all of the new one, even if the process is killed.
+///
+/// # Errors
+/// [`SweepError::Io`].
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), SweepError> {
+    let io = |e: std::io::Error| SweepError::Io {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    };
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let mut tmp = tempfile::NamedTempFile::new_in(dir).map_err(io)?;
+    tmp.write_all(bytes).map_err(io)?;
+    tmp.as_file().sync_all().map_err(io)?;
+    tmp.persist(path).map_err(|e| io(e.error))?;
+    Ok(())
+}
+
+/// Prepares `dir` as a sweep folder: refuses a non-empty folder without `sweep.json`.
+pub(crate) fn claim_dir(dir: &Path) -> Result<(), SweepError> {
+    let io = |e: std::io::Error| SweepError::Io {
+        path: dir.display().to_string(),
+        message: e.to_string(),
+    };
+    if dir.exists() {
+        if !dir.is_dir() {
+            return Err(SweepError::ForeignDirectory(dir.display().to_string()));
+        }
+        let empty = std::fs::read_dir(dir).map_err(io)?.next().is_none();
+        if !empty && !dir.join(SWEEP_JSON).is_file() {
+            return Err(SweepError::ForeignDirectory(dir.display().to_string()));
+        }
+    }
+    std::fs::create_dir_all(dir).map_err(io)
+}
+
+pub(crate) fn read_record(dir: &Path) -> Result<SweepRecord, SweepError> {
+    let p = dir.join(SWEEP_JSON);
+    let text = std::fs::read_to_string(&p).map_err(|e| SweepError::Io {
+        path: p.display().to_string(),
+        message: e.to_string(),
+    })?;
+    let r: SweepRecord = serde_json::from_str(&text).map_err(|e| SweepError::Io {
+        path: p.display().to_string(),
+        message: format!("not a fabkit sweep record: {e}"),
+    })?;
+    if r.format != FORMAT {
+        return Err(SweepError::Io {
+            path: p.display().to_string(),
+            message: format!("format {:?}, expected {FORMAT:?}", r.format),
+        });
+    }
+    Ok(r)
+}
+
+pub(crate) fn json_pretty<T: Serialize>(v: &T) -> Vec<u8> {
+    let mut b = serde_json::to_vec_pretty(v).unwrap_or_default();
+    b.push(b'\n');
+    b
+}
+
+/// The record of `spec` run with `opts`.
+pub fn record(spec: &SweepSpec, plan: &Plan, opts: &RunOptions) -> SweepRecord {
+    SweepRecord {
+        format: FORMAT.into(),
+        fabkit_version: opts.fabkit_version.clone(),
+        sweep_file: spec.origin.clone(),
+        sweep_sha256: spec.sha256.clone(),
+        base_source: spec.base.source.clone(),
+        base_sha256: spec.base.sha256.clone(),
+        preset: spec.preset.clone(),
+        chord_tolerance_mm: spec.chord_tolerance.mm(),
+        mode: spec.mode,
+        seed: (spec.mode == Mode::Random).then_some(spec.seed),
+        count: spec.count,
+        parameters: spec.parameters.iter().map(|p| p.path.clone()).collect(),
+        files: spec.files,
+        variant_count: plan.variants.len(),
+        plan_sha256: plan.plan_sha256.clone(),
+        shard: opts.shard,
+        build_time: opts.build_time,
+        command_line: opts.command_line.clone(),
+        merged_from: vec![],
+    }
+}
+
+/// Runs the variants of `plan` (those of `opts.shard`) that have no complete result in
+/// `opts.out_dir`, then writes the results table of every selected variant.
+///
+/// Folder layout:
+/// - `sweep.json` ([`SweepRecord`]), written first;
+/// - `variants/<id>.json`: each variant's [`VariantResult`], written atomically as soon as the
+///   variant is done, after its files;
+/// - `variants/<id>/`: the files of `fabkit export`, when the sweep asks for them;
+/// - `results.csv` and `results.jsonl` ([`render_csv`], [`render_jsonl`]), in variant order,
+///   written atomically at the end (a table from an earlier run is removed at the start).
+///
+/// A result is complete, and its variant skipped, when `variants/<id>.json` reads back with
+/// the same id, status ok or infeasible, the same fabkit version and the files asked for.
+/// A killed run leaves complete results for the variants it finished and nothing for the
+/// others (temporary files are removed by the next run). Run one process per folder.
+///
+/// Variants are built in parallel on `opts.jobs` threads (rayon); each variant's numbers do
+/// not depend on the thread count and the tables are in variant order.
+///
+/// # Errors
+/// [`SweepError::ForeignDirectory`], [`SweepError::Io`], or a sweep that asks for files
+/// without a `writer` ([`SweepError::File`]). A variant's failure is not an error of the run:
+/// it is recorded with status error (and infeasible variants with their violations).
+pub fn run(
+    spec: &SweepSpec,
+    plan: &Plan,
+    opts: &RunOptions,
+    writer: Option<&dyn KitWriter>,
+    on_event: &(dyn Fn(Event<'_>) + Sync),
+) -> Result<RunSummary, SweepError> {
+    if spec.files.any() && writer.is_none() {
+        return Err(SweepError::File {
+            at: spec.origin.clone(),
+            message: "outputs ask for files but no file writer was given".into(),
+        });
+    }
+    let materials = MaterialsTable::embedded().map_err(|m| SweepError::File {
+        at: "designs/materials.yaml".into(),
+        message: m,
+    })?;
+    let dir = &opts.out_dir;
+    claim_dir(dir)?;
+    let vdir = dir.join(VARIANTS);
+    let io = |p: &Path| {
+        let p = p.display().to_string();
+        move |e: std::io::Error| SweepError::Io {
+            path: p.clone(),
+            message: e.to_string(),
+        }
+    };
+    std::fs::create_dir_all(&vdir).map_err(io(&vdir))?;
+    remove_leftovers(&vdir)?;
+    for t in [RESULTS_CSV, RESULTS_JSONL] {
+        let p = dir.join(t);
+        if p.exists() {
+            std::fs::remove_file(&p).map_err(io(&p))?;
+        }
+    }
+    write_atomic(
+        &dir.join(SWEEP_JSON),
+        &json_pretty(&record(spec, plan, opts)),
+    )?;
+
+    let selected: Vec<&Variant> = plan
+        .variants
+        .iter()
+        .filter(|v| opts.shard.is_none_or(|s| s.contains(v.index)))
+        .collect();
+    let mut done: Vec<Option<VariantResult>> = selected
+        .iter()
+        .map(|v| complete_result(&vdir, v, spec.files, &opts.fabkit_version))
+        .collect();
+    let reused = done.iter().filter(|d| d.is_some()).count();
+    on_event(Event::Start {
+        total: plan.variants.len(),
+        selected: selected.len(),
+        complete: reused,
+    });
+    let pending: Vec<(usize, &Variant)> = selected
+        .iter()
+        .enumerate()
+        .filter(|(k, _)| done[*k].is_none())
+        .map(|(k, v)| (k, *v))
+        .collect();
+    let work = || -> Result<Vec<(usize, VariantResult)>, SweepError> {
+        pending
+            .par_iter()
+            .map(|&(k, v)| {
+                let r = run_variant(spec, v, &vdir, &materials, opts, writer);
+                write_atomic(&vdir.join(format!("{}.json", v.id)), &json_pretty(&r))?;
+                on_event(Event::Done(&r));
+                Ok((k, r))
+            })
+            .collect()
+    };
+    let fresh = match opts.jobs {
+        Some(n) => rayon::ThreadPoolBuilder::new()
+            .num_threads(n.max(1))
+            .build()
+            .map_err(|e| SweepError::Io {
+                path: "thread pool".into(),
+                message: e.to_string(),
+            })?
+            .install(work)?,
+        None => work()?,
+    };
+    let ran: Vec<String> = fresh.iter().map(|(_, r)| r.id.clone()).collect();
+    for (k, r) in fresh {
+        done[k] = Some(r);
+    }
+    let rows: Vec<VariantResult> = done
+        .into_iter()
+        .flatten()
+        .map(|mut r| {
+            if !opts.build_time {
+                r.build_time_s = None;
+            }
+            r
+        })
+        .collect();
+    let count = |s: Status| rows.iter().filter(|r| r.status == s).count();
+    let parameters: Vec<String> = spec.parameters.iter().map(|p| p.path.clone()).collect();
+    let csv = dir.join(RESULTS_CSV);
+    let jsonl = dir.join(RESULTS_JSONL);
+    write_atomic(&jsonl, &render_jsonl(&rows))?;
+    write_atomic(&csv, &render_csv(&parameters, &rows))?;
+    Ok(RunSummary {
+        total: plan.variants.len(),
+        selected: selected.len(),
+        reused,
+        ran,
+        ok: count(Status::Ok),
+        infeasible: count(Status::Infeasible),
+        errors: count(Status::Error),
+        results_csv: csv,
+        results_jsonl: jsonl,
+    })
+}
+
+/// Removes temporary files and folders a killed run left in `variants/` (names starting with
+/// a dot: `tempfile`'s `.tmp*` files and the export's `.<id>.tmp-*` / `.<id>.old-*` folders).
+fn remove_leftovers(vdir: &Path) -> Result<(), SweepError> {
+    let entries = std::fs::read_dir(vdir).map_err(|e| SweepError::Io {
+        path: vdir.display().to_string(),
+        message: e.to_string(),
+    })?;
+    for e in entries.flatten() {
+        if e.file_name().to_string_lossy().starts_with('.') {
+            let p = e.path();
+            let _ = if p.is_dir() {
+                std::fs::remove_dir_all(&p)
+            } else {
+                std::fs::remove_file(&p)
+            };
+        }
+    }
+    Ok(())
+}
+
+/// The stored result of `v` when it is complete (see [`run`]), with this plan's index and
+/// parameters.
+fn complete_result(
+    vdir: &Path,
+    v: &Variant,
+    files: FileOutputs,
+    version: &str,
+) -> Option<VariantResult> {
+    let text = std::fs::read_to_string(vdir.join(format!("{}.json", v.id))).ok()?;
+    let mut r: VariantResult = serde_json::from_str(&text).ok()?;
+    let has_files = (!files.stl || r.files.stl) && (!files.threemf || r.files.threemf);
+    let ok = r.id == v.id
+        && r.status != Status::Error
+        && r.fabkit_version == version
+        && (!files.any()
+            || r.status != Status::Ok
+            || (has_files && vdir.join(&v.id).join("manifest.json").is_file()));
+    if !ok {
+        return None;
+    }
+    r.index = v.index;
+    r.params = v.params.iter().cloned().collect();
+    Some(r)
+}
+
+fn run_variant(
+    spec: &SweepSpec,
+    v: &Variant,
+    vdir: &Path,
+    materials: &MaterialsTable,
+    opts: &RunOptions,
+    writer: Option<&dyn KitWriter>,
+) -> VariantResult {
+    let t0 = std::time::Instant::now();
+    let tol = spec.chord_tolerance;
+    let mut result = VariantResult {
+        index: v.index,
+        id: v.id.clone(),
+        params: v.params.iter().cloned().collect(),
+        status: Status::Error,
+        errors: vec![],
+        metrics: None,
+        printability: vec![],
+        files: FileOutputs::default(),
+        build_time_s: None,
+        fabkit_version: opts.fabkit_version.clone(),
+    };
+    let design = match spec.resolve(&v.params) {
+        Ok(d) => d,
+        Err(e) => {
+            result.errors = vec![e.to_string()];
+            return result;
+        }
+    };
+    // A panic in the kernel must not end the sweep: record it as this variant's error.
+    let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        let outcome = evaluate(&design, materials, tol);
+        let verdicts = printability(&design, materials, tol);
+        (outcome, verdicts)
+    }));
+    match outcome {
+        Err(panic) => {
+            let msg = panic
+                .downcast_ref::<String>()
+                .cloned()
+                .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
+                .unwrap_or_default();
+            result.errors = vec![format!("the build panicked (a fabkit defect): {msg}")];
+        }
+        Ok((outcome, verdicts)) => {
+            result.printability = verdicts;
+            match outcome {
+                Outcome::Infeasible(e) => {
+                    result.status = Status::Infeasible;
+                    result.errors = e;
+                }
+                Outcome::Error(e) => result.errors = vec![e],
+                Outcome::Ok { metrics, kit } => {
+                    let written = match writer.filter(|_| spec.files.any()) {
+                        None => Ok(()),
+                        Some(w) => {
+                            let canon =
+                                canonical_json(&serde_json::to_value(&design).unwrap_or_default());
+                            let job = FilesJob {
+                                dir: vdir.join(&v.id),
+                                files: spec.files,
+                                variant: v,
+                                design: &design,
+                                design_sha256: hex(&Sha256::digest(canon.as_bytes())),
+                                design_source: format!(
+                                    "{} variant {} of sweep {}",
+                                    spec.base.source, v.id, spec.origin
+                                ),
+                                chord_tolerance_mm: tol.mm(),
+                            };
+                            w.write(&kit, &job)
+                        }
+                    };
+                    match written {
+                        Ok(()) => {
+                            result.status = Status::Ok;
+                            result.metrics = Some(metrics);
+                            result.files = spec.files;
+                        }
+                        Err(e) => result.errors = vec![format!("writing the files: {e}")],
+                    }
+                }
+            }
+        }
+    }
+    result.build_time_s = Some(t0.elapsed().as_secs_f64());
+    result
+}

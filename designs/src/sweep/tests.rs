@@ -1,0 +1,310 @@
+//! Expansion of sweep files: grid, zip and random modes, ids, and the errors reported before
+//! anything runs.
+
+use super::*;
+use crate::library;
+use serde_json::Value;
+use std::path::Path;
+
+const SPACING: &str = "layers[0].markers[0].pattern.spacing_mm";
+const HEIGHT: &str = "layers[0].markers[0].feature.height_mm";
+
+fn spec(text: &str) -> SweepSpec {
+    SweepSpec::parse(text, "sweep.yaml", Path::new("")).unwrap()
+}
+
+fn err(text: &str) -> String {
+    SweepSpec::parse(text, "sweep.yaml", Path::new(""))
+        .unwrap_err()
+        .to_string()
+}
+
+fn f(v: &Value) -> f64 {
+    v.as_f64().unwrap()
+}
+
+/// The id of the library design with the two parameters set directly on the typed design.
+fn id_of(spacing: f64, height: f64, tol: f64) -> String {
+    let mut d = library::load("shadowtac").unwrap();
+    d.layers[0].markers[0].pattern.spacing_mm = Some(spacing);
+    d.layers[0].markers[0].feature.height_mm = height;
+    variant_id(&d, tol)
+}
+
+const GRID: &str = "base: shadowtac
+vary:
+  layers[0].markers[0].pattern.spacing_mm: {range: [1.2, 2.0, 0.2]}
+  layers[0].markers[0].feature.height_mm: [0.3, 0.4, 0.5, 0.6]
+mode: grid
+outputs: [metrics]
+";
+
+#[test]
+fn grid_is_the_cartesian_product_with_the_first_parameter_slowest() {
+    let s = spec(GRID);
+    let spacing = [1.2, 1.4, 1.6, 1.8, 2.0];
+    let height = [0.3, 0.4, 0.5, 0.6];
+    // the range gives the decimals as typed, not 1.2 + 2 x 0.2 = 1.5999999999999999
+    let got: Vec<f64> = s.parameters[0].values.iter().map(f).collect();
+    assert_eq!(got, spacing);
+    let plan = s.plan().unwrap();
+    assert_eq!(plan.variants.len(), 20);
+    for (k, v) in plan.variants.iter().enumerate() {
+        assert_eq!(v.index, k);
+        assert_eq!(v.params[0].0, SPACING);
+        assert_eq!(v.params[1].0, HEIGHT);
+        assert_eq!(f(&v.params[0].1), spacing[k / 4]);
+        assert_eq!(f(&v.params[1].1), height[k % 4]);
+        // the id is the hash of the resolved design: the same as setting the fields directly
+        assert_eq!(v.id, id_of(spacing[k / 4], height[k % 4], 0.01));
+        assert_eq!(v.id.len(), ID_HEX_DIGITS);
+    }
+    let mut ids: Vec<&str> = plan.variants.iter().map(|v| v.id.as_str()).collect();
+    ids.sort_unstable();
+    ids.dedup();
+    assert_eq!(ids.len(), 20);
+    // stable: parsing and expanding again gives the same ids and plan hash
+    let again = spec(GRID).plan().unwrap();
+    assert_eq!(again.variants, plan.variants);
+    assert_eq!(again.plan_sha256, plan.plan_sha256);
+}
+
+#[test]
+fn ids_depend_on_the_design_and_tolerance_only() {
+    // the vary keys in the other order: other variant order, same ids per point
+    let swapped = spec(
+        "base: shadowtac
+vary:
+  layers[0].markers[0].feature.height_mm: [0.3, 0.4, 0.5, 0.6]
+  layers[0].markers[0].pattern.spacing_mm: {list: [1.2, 1.4, 1.6, 1.8, 2.0]}
+",
+    )
+    .plan()
+    .unwrap();
+    let grid = spec(GRID).plan().unwrap();
+    let mut a: Vec<String> = grid.variants.iter().map(|v| v.id.clone()).collect();
+    let mut b: Vec<String> = swapped.variants.iter().map(|v| v.id.clone()).collect();
+    assert_ne!(a, b);
+    assert_ne!(grid.plan_sha256, swapped.plan_sha256);
+    a.sort();
+    b.sort();
+    assert_eq!(a, b);
+    // another chord tolerance: other ids
+    let fine = spec(&format!("{GRID}chord_tolerance_mm: 0.005\n"))
+        .plan()
+        .unwrap();
+    assert_eq!(fine.variants[5].id, id_of(1.4, 0.4, 0.005));
+    assert_ne!(fine.variants[5].id, grid.variants[5].id);
+}
+
+#[test]
+fn zip_takes_the_lists_in_step() {
+    let s = spec(
+        "base: shadowtac
+vary:
+  layers[0].markers[0].pattern.spacing_mm: [1.4, 1.6, 1.8]
+  layers[0].markers[0].feature.height_mm: {range: [0.3, 0.5, 0.1]}
+mode: zip
+",
+    );
+    let plan = s.plan().unwrap();
+    assert_eq!(plan.variants.len(), 3);
+    for (k, (sp, h)) in [(1.4, 0.3), (1.6, 0.4), (1.8, 0.5)].into_iter().enumerate() {
+        let v = &plan.variants[k];
+        assert_eq!((f(&v.params[0].1), f(&v.params[1].1)), (sp, h));
+        assert_eq!(v.id, id_of(sp, h, 0.01));
+    }
+    let grid = spec(GRID).plan().unwrap();
+    // (1.4, 0.3) is grid point 4 (second spacing, first height)
+    assert_eq!(plan.variants[0].id, grid.variants[4].id);
+}
+
+#[test]
+fn random_draws_distinct_grid_points_reproducibly() {
+    let random = |seed: u64, count: u64| {
+        spec(&format!(
+            "{}mode: random\nseed: {seed}\ncount: {count}\n",
+            GRID.replace("mode: grid\n", "")
+        ))
+        .plan()
+        .unwrap()
+    };
+    let grid = spec(GRID).plan().unwrap();
+    let a = random(7, 6);
+    assert_eq!(a.variants.len(), 6);
+    let mut last = None;
+    for (k, v) in a.variants.iter().enumerate() {
+        assert_eq!(v.index, k);
+        // a grid point, with the grid point's id, listed in grid order, no repeats
+        let g = grid
+            .variants
+            .iter()
+            .find(|g| g.params == v.params)
+            .expect("a grid point");
+        assert_eq!(g.id, v.id);
+        assert!(last.is_none_or(|l| l < g.index));
+        last = Some(g.index);
+    }
+    assert_eq!(random(7, 6).variants, a.variants);
+    assert_ne!(random(8, 6).variants, a.variants);
+    // the whole grid when count is its size
+    let all = random(3, 20);
+    assert_eq!(all.variants, grid.variants);
+    let e = SweepSpec::parse(
+        &format!(
+            "{}mode: random\ncount: 21\n",
+            GRID.replace("mode: grid\n", "")
+        ),
+        "sweep.yaml",
+        Path::new(""),
+    )
+    .unwrap()
+    .plan()
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("count = 21: more than the 20 combinations"),
+        "{e}"
+    );
+}
+
+/// The issue's example file, with its short paths, plans the 5 x 4 grid on the full paths.
+#[test]
+fn the_issues_example_with_short_paths_plans_its_grid() {
+    let sweep = SweepSpec::parse(
+        "base: designs/library/shadowtac.yaml
+vary:
+  markers.spacing_mm: {range: [1.2, 2.0, 0.2]}
+  markers.feature.height_mm: [0.3, 0.4, 0.5, 0.6]
+mode: grid
+outputs: [metrics]
+",
+        "sweep.yaml",
+        Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap(),
+    )
+    .unwrap();
+    let plan = sweep.plan().unwrap();
+    assert_eq!(plan.variants.len(), 20);
+    let names: Vec<&str> = sweep.parameters.iter().map(|p| p.path.as_str()).collect();
+    assert_eq!(names, [SPACING, HEIGHT]);
+}
+
+#[test]
+fn unknown_paths_are_reported_with_the_nearest_and_the_line() {
+    // a misspelt short form: no path fits it; the hint gives the full one
+    let e = err("base: shadowtac
+vary:
+  layers[0].markers[0].pattern.spacing_mm: [1.4]
+  markers.feature.height: [0.3, 0.4]
+");
+    assert!(
+        e.starts_with("sweep.yaml:4:3: vary: 'markers.feature.height' is not a parameter path of design 'shadowtac'; nearest: layers[0].markers[0].feature.height_mm"),
+        "{e}"
+    );
+    let e = err("base: shadowtac\nvary:\n  layers[1].thickness_mm: [1]\n");
+    assert!(
+        e.starts_with("sweep.yaml:3:3: vary: 'layers[1].thickness_mm'"),
+        "{e}"
+    );
+    assert!(e.contains("nearest: "), "{e}");
+}
+
+#[test]
+fn values_of_the_wrong_type_are_reported_with_the_line() {
+    let e = err("base: shadowtac
+vary:
+  layers[0].markers[0].pattern.rings:
+    [3, 4.5]
+");
+    assert_eq!(
+        e,
+        "sweep.yaml:4:5: vary.layers[0].markers[0].pattern.rings = 4.5: invalid type: floating point `4.5`, expected u32"
+    );
+    let e = err("base: shadowtac\nvary:\n  mold.wall_thickness_mm: [3, thick]\n");
+    assert!(
+        e.starts_with(
+            "sweep.yaml:3:27: vary.mold.wall_thickness_mm = \"thick\": invalid type: string"
+        ),
+        "{e}"
+    );
+}
+
+#[test]
+fn malformed_sweeps_are_refused_before_anything_runs() {
+    let cases = [
+        (
+            "base: shadowtac\nvary:\n  mold.wall_thickness_mm: [3, 4]\n  mold.draft_angle_deg: [1, 2, 3]\nmode: zip\n",
+            "sweep.yaml:4:3: mode zip takes the lists in step",
+        ),
+        (
+            "base: shadowtac\nvary:\n  mold.wall_thickness_mm: {range: [4, 3, 1]}\n",
+            "sweep.yaml:3:27: vary.mold.wall_thickness_mm: range [4, 3, 1]: needs step > 0",
+        ),
+        (
+            "base: shadowtac\nvary:\n  mold.wall_thickness_mm: [3, 3]\n",
+            "the value 3 is listed twice",
+        ),
+        (
+            "base: shadowtac\nvary:\n  mold.wall_thickness_mm: [3]\nmode: random\n",
+            "sweep.yaml:4:7: mode random needs `count`",
+        ),
+        (
+            "base: shadowtac\nvary:\n  mold.wall_thickness_mm: [3]\ncount: 2\n",
+            "sweep.yaml:4:8: `count` only applies to mode random",
+        ),
+        (
+            "base: shadowtac\nvary:\n  mold.wall_thickness_mm: [3]\noutputs: [files]\n",
+            "outputs must include metrics",
+        ),
+        (
+            "base: nosuchdesign\nvary:\n  mold.wall_thickness_mm: [3]\n",
+            "sweep.yaml:1:7: base design: no library design named 'nosuchdesign'",
+        ),
+        (
+            "base: shadowtac\nvray:\n  mold.wall_thickness_mm: [3]\n",
+            "sweep.yaml:2:1: unknown field `vray`",
+        ),
+        (
+            "base: shadowtac\nvary:\n  layers[0].markers[0].pattern.csv_file: [a.csv]\n",
+            "sweep.yaml:3:3: vary.layers[0].markers[0].pattern.csv_file: marker CSV files are read once",
+        ),
+    ];
+    for (text, want) in cases {
+        let e = err(text);
+        assert!(e.contains(want), "{text}\n-> {e}\nwanted {want}");
+    }
+}
+
+#[test]
+fn integer_ranges_stay_integers_and_files_outputs_parse() {
+    let s = spec(
+        "base: shadowtac
+preset: published_469
+vary:
+  layers[0].markers[0].pattern.rings: {range: [8, 12, 2]}
+outputs: [metrics, files]
+",
+    );
+    assert_eq!(
+        s.parameters[0].values,
+        vec![Value::from(8), Value::from(10), Value::from(12)]
+    );
+    assert!(s.files.stl && s.files.threemf);
+    let plan = s.plan().unwrap();
+    let mut d = library::load("shadowtac")
+        .unwrap()
+        .with_preset("published_469")
+        .unwrap();
+    d.layers[0].markers[0].pattern.rings = Some(10);
+    assert_eq!(plan.variants[1].id, variant_id(&d, 0.01));
+}
+
+#[test]
+fn shards_split_every_nth_variant() {
+    let s: Shard = "1/3".parse().unwrap();
+    let picked: Vec<usize> = (0..10).filter(|&i| s.contains(i)).collect();
+    assert_eq!(picked, [1, 4, 7]);
+    for bad in ["3/3", "1", "a/2", "0/0"] {
+        assert!(bad.parse::<Shard>().is_err(), "{bad}");
+    }
+}

@@ -1,0 +1,245 @@
+//! `fabkit sweep` and `fabkit sweep merge`: argument parsing, progress and dispatch over
+//! `fabkit_designs::sweep`; the export crate writes variant files.
+
+use fabkit_designs::kit::Kit;
+use fabkit_designs::sweep::{
+    self, Event, FilesJob, KitWriter, RunOptions, Shard, Status, SweepSpec,
+};
+use fabkit_export::{write_kit, ExportOptions, Formats};
+use std::error::Error;
+use std::io::IsTerminal as _;
+use std::path::PathBuf;
+use std::sync::Mutex;
+use std::time::Instant;
+
+#[derive(clap::Args, Debug)]
+#[command(
+    args_conflicts_with_subcommands = true,
+    subcommand_negates_reqs = true,
+    after_help = "Sweep file (YAML):\n  base: shadowtac                 # library design, or a YAML path relative to the sweep file\n  preset: published_469           # optional\n  chord_tolerance_mm: 0.01        # optional\n  vary:\n    layers[0].markers[0].pattern.spacing_mm: {range: [1.2, 2.0, 0.2]}\n    layers[0].markers[0].feature.height_mm: [0.3, 0.4, 0.5, 0.6]\n  mode: grid                      # grid | zip | random (with count: N, seed: S)\n  outputs: [metrics]              # or [metrics, files] (also stl or 3mf alone)"
+)]
+pub struct SweepArgs {
+    #[command(subcommand)]
+    command: Option<SweepCommand>,
+    /// The sweep file.
+    #[arg(value_name = "SWEEP.yaml", required = true)]
+    sweep: Option<PathBuf>,
+    /// The sweep folder: results.csv, results.jsonl, sweep.json, variants/. Re-running into it
+    /// skips the variants whose results are complete.
+    #[arg(long, value_name = "DIR", required = true)]
+    out: Option<PathBuf>,
+    /// Variants built at once (default: one per core).
+    #[arg(long, value_name = "N")]
+    jobs: Option<usize>,
+    /// Run every N-th variant starting at I (0 <= I < N), e.g. --shard $SLURM_ARRAY_TASK_ID/8.
+    #[arg(long, value_name = "I/N")]
+    shard: Option<Shard>,
+    /// Leave build_time_s empty in results.csv / results.jsonl, so that the tables are the
+    /// same bytes on any machine, thread count or sharding (variants/<id>.json keeps it).
+    #[arg(long)]
+    no_build_time: bool,
+}
+
+#[derive(clap::Subcommand, Debug)]
+enum SweepCommand {
+    /// Join the results of the shards of one sweep (checks that none overlap or is missing).
+    Merge {
+        /// The shard folders (each the --out of one `fabkit sweep --shard I/N`).
+        #[arg(value_name = "DIR", required = true, num_args = 1..)]
+        dirs: Vec<PathBuf>,
+        /// Folder for the merged results.csv, results.jsonl and sweep.json.
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+        /// As for `fabkit sweep`: leave build_time_s empty.
+        #[arg(long)]
+        no_build_time: bool,
+    },
+}
+
+/// Writes a variant's files with `fabkit export`'s writer.
+struct ExportWriter {
+    command_line: Vec<String>,
+}
+
+impl KitWriter for ExportWriter {
+    fn write(&self, kit: &Kit, job: &FilesJob<'_>) -> Result<(), String> {
+        let opts = ExportOptions {
+            formats: Formats {
+                stl: job.files.stl,
+                threemf: job.files.threemf,
+            },
+            command_line: self.command_line.clone(),
+            design_source: job.design_source.clone(),
+            design_sha256: job.design_sha256.clone(),
+            chord_tolerance_mm: job.chord_tolerance_mm,
+            fabkit_version: env!("CARGO_PKG_VERSION").to_string(),
+        };
+        write_kit(kit, &job.dir, &opts)
+            .map(|_| ())
+            .map_err(|e| e.to_string())
+    }
+}
+
+pub fn run(args: SweepArgs) -> Result<(), Box<dyn Error>> {
+    if let Some(SweepCommand::Merge {
+        dirs,
+        out,
+        no_build_time,
+    }) = args.command
+    {
+        let m = sweep::merge(&dirs, &out, !no_build_time, std::env::args().collect())?;
+        out!(
+            "merged {} shards, {} variants -> {}",
+            m.shards,
+            m.variants,
+            m.results_csv.display()
+        );
+        return Ok(());
+    }
+    let (Some(file), Some(out)) = (args.sweep, args.out) else {
+        return Err("give a sweep file and --out DIR".into());
+    };
+    let spec = SweepSpec::from_file(&file)?;
+    let plan = spec.plan()?;
+    let opts = RunOptions {
+        out_dir: out.clone(),
+        jobs: args.jobs,
+        shard: args.shard,
+        build_time: !args.no_build_time,
+        command_line: std::env::args().collect(),
+        fabkit_version: env!("CARGO_PKG_VERSION").to_string(),
+    };
+    let writer = ExportWriter {
+        command_line: opts.command_line.clone(),
+    };
+    let progress = Progress::new(std::io::stderr().is_terminal());
+    let t0 = Instant::now();
+    let summary = sweep::run(&spec, &plan, &opts, Some(&writer), &|e| progress.event(e))?;
+    progress.finish();
+    let shard = args
+        .shard
+        .map(|s| format!(" (shard {s}: {} of them)", summary.selected))
+        .unwrap_or_default();
+    out!(
+        "sweep {}: {} variants{shard}: {} built, {} skipped (complete); {} ok, {} infeasible, {} errors -> {} ({:.1} s)",
+        file.display(),
+        summary.total,
+        summary.ran.len(),
+        summary.reused,
+        summary.ok,
+        summary.infeasible,
+        summary.errors,
+        summary.results_csv.display(),
+        t0.elapsed().as_secs_f64()
+    );
+    if summary.errors > 0 {
+        return Err(format!(
+            "{} variant(s) failed to build or write (status error in {}); re-running retries them",
+            summary.errors,
+            summary.results_csv.display()
+        )
+        .into());
+    }
+    Ok(())
+}
+
+/// A progress bar with rate and ETA on a terminal; one plain line per variant otherwise.
+struct Progress {
+    bar: Option<indicatif::ProgressBar>,
+    state: Mutex<(usize, usize, Instant)>,
+}
+
+impl Progress {
+    fn new(terminal: bool) -> Self {
+        let bar = terminal.then(|| {
+            let b = indicatif::ProgressBar::new(0);
+            b.set_style(
+                indicatif::ProgressStyle::with_template(
+                    "{spinner} sweep [{bar:30}] {pos}/{len} variants, {rate}, ETA {eta} {msg}",
+                )
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
+                .with_key(
+                    "rate",
+                    |s: &indicatif::ProgressState, w: &mut dyn std::fmt::Write| {
+                        let _ = write!(w, "{:.2} variants/s", s.per_sec());
+                    },
+                )
+                .progress_chars("=> "),
+            );
+            b.enable_steady_tick(std::time::Duration::from_millis(200));
+            b
+        });
+        Self {
+            bar,
+            state: Mutex::new((0, 0, Instant::now())),
+        }
+    }
+
+    fn event(&self, e: Event<'_>) {
+        let Ok(mut st) = self.state.lock() else {
+            return;
+        };
+        match e {
+            Event::Start {
+                total,
+                selected,
+                complete,
+            } => {
+                *st = (0, selected - complete, Instant::now());
+                let msg =
+                    format!("{selected} of {total} variants selected, {complete} already complete");
+                match &self.bar {
+                    Some(b) => {
+                        b.set_length((selected - complete) as u64);
+                        if complete > 0 {
+                            b.set_message(format!("({complete} already complete, skipped)"));
+                        }
+                    }
+                    None => eprintln!("sweep: {msg}"),
+                }
+            }
+            Event::Done(r) => {
+                st.0 += 1;
+                let (done, todo, t0) = *st;
+                let status = match r.status {
+                    Status::Ok => "ok".to_string(),
+                    Status::Infeasible => format!(
+                        "infeasible: {}",
+                        r.errors.first().map(String::as_str).unwrap_or("")
+                    ),
+                    Status::Error => {
+                        format!(
+                            "error: {}",
+                            r.errors.first().map(String::as_str).unwrap_or("")
+                        )
+                    }
+                };
+                match &self.bar {
+                    Some(b) => {
+                        if r.status != Status::Ok {
+                            b.println(format!("variant {} ({}): {status}", r.index, r.id));
+                        }
+                        b.inc(1);
+                    }
+                    None => {
+                        let s = t0.elapsed().as_secs_f64();
+                        let rate = done as f64 / s.max(1e-9);
+                        eprintln!(
+                            "sweep: [{done}/{todo}] variant {} ({}) {status} in {:.2} s; {rate:.2} variants/s, ETA {:.0} s",
+                            r.index,
+                            r.id,
+                            r.build_time_s.unwrap_or(0.0),
+                            (todo - done) as f64 / rate.max(1e-9)
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    fn finish(&self) {
+        if let Some(b) = &self.bar {
+            b.finish_and_clear();
+        }
+    }
+}
