@@ -1,0 +1,44 @@
+"""The CadQuery twin of one manifest part: dispatch on its role (and name) to the family's
+builder, then the recorded print placement."""
+
+from __future__ import annotations
+
+from . import cq_common as C
+from . import cq_fixtures, cq_housing, cq_layers, cq_molds
+from .families import family  # noqa: F401 (re-exported)
+
+
+def build(part: dict):
+    """The exact solid of `part` in print orientation (the manifest's placement applied)."""
+    role, name, p = part["role"], part["name"], part["params"]
+    if role == "master_pattern":
+        s = cq_molds.master_pattern(p) if "master" in p else cq_layers.boundary_master(p)
+    elif role == "mold_box":
+        s = cq_molds.mold_box(p) if "master" in p else cq_layers.boundary_box(p)
+    elif role in ("core_holder", "casting_jig"):
+        s = cq_molds.core_holder(p)
+    elif role == "mold_half":
+        s = cq_molds.mold_half(p, name.rsplit("_", 1)[1])
+    elif role == "open_mold":
+        s = cq_layers.open_mold(p)
+    elif role == "printed_skin":
+        s = cq_layers.printed_skin(p, tips=False)
+    elif role == "marker_tips":
+        s = cq_layers.printed_skin(p, tips=True)
+    elif role == "negative_mold":
+        s = cq_layers.boundary_negative(p)
+    elif role == "shell_half":
+        s = cq_housing.shell_half(p, name.rsplit("_", 1)[1])
+    elif role == "indenter":
+        return C.place(cq_fixtures.indenter(p), p, "T_print_indenter")
+    elif name == "pin_dome":
+        s = cq_fixtures.pin_dome(p)
+    elif role == "calibration pin":
+        s = cq_fixtures.pin(p)
+    elif name == "semidome_holder":
+        s = cq_fixtures.semidome_holder(p)
+    elif name.startswith("semidome_"):
+        s = cq_fixtures.semidome_half(p)
+    else:
+        raise C.TwinError(f"part {name!r} (role {role!r}): no CadQuery twin")
+    return C.place(s, p)
