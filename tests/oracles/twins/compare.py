@@ -52,13 +52,22 @@ def drop_degenerate(v: np.ndarray, f: np.ndarray):
 def edge_stats(f: np.ndarray):
     """(watertight and consistently oriented: every directed edge once and its reverse once,
     number of undirected edges)."""
-    e = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]])
+    e = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]).astype(np.int64)
     n = int(f.max()) + 1 if len(f) else 1
     key = e[:, 0] * n + e[:, 1]
     rkey = e[:, 1] * n + e[:, 0]
     uniq, counts = np.unique(key, return_counts=True)
     ok = bool(np.all(counts == 1)) and bool(np.all(np.isin(rkey, uniq)))
     return ok, len(uniq) // 2
+
+
+def closed_edges(f: np.ndarray):
+    """(watertight: every undirected edge shared by exactly two facets, number of edges). Used
+    for OCCT's tessellation, whose per-face winding is not checked here."""
+    e = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1).astype(np.int64)
+    n = int(f.max()) + 1 if len(f) else 1
+    _, counts = np.unique(e[:, 0] * n + e[:, 1], return_counts=True)
+    return bool(np.all(counts == 2)), len(counts)
 
 
 def genus_from(n_vertices: int, n_edges: int, n_faces: int, shells: int) -> int:
@@ -129,6 +138,8 @@ def occt_mesh(shape, lin_defl: float, ang_defl: float = 0.25):
     from OCP.TopLoc import TopLoc_Location
     from OCP.TopoDS import TopoDS
 
+    from OCP.BRepTools import BRepTools
+    BRepTools.Clean_s(shape.wrapped)  # no mesh left from another use of shared geometry
     BRepMesh_IncrementalMesh(shape.wrapped, lin_defl, False, ang_defl, True)
     verts, tris, fid, faces = [], [], [], []
     off = 0
@@ -175,7 +186,7 @@ def weld_close(v, f, eps: float):
     _, label = connected_components(g, directed=False)
     first = np.full(label.max() + 1, -1)
     first[label[::-1]] = np.arange(n)[::-1]
-    return v[first], label[f]
+    return v[first], label[f].astype(np.int64)
 
 
 class _ExactDistance:
@@ -232,7 +243,7 @@ def compare_exact(fv, ff, shape, tol: float, max_refine: int = 5000) -> dict:
     defl = tol / 4.0
     tv, tf, fid, faces = occt_mesh(shape, defl)
     tf_ok, dropped = drop_degenerate(tv, tf)
-    watertight, n_edges = edge_stats(tf_ok)
+    watertight, n_edges = closed_edges(tf_ok)
     g_exact = (genus_from(len(np.unique(tf_ok)), n_edges, len(tf_ok), _solids(shape))
                if watertight else None)
 

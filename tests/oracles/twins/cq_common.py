@@ -4,7 +4,7 @@ revolution, marker features, primitives, booleans and the print placement.
 Everything here is written from the parameters alone (docs/conventions.md: sensor frame, mm,
 z along the sensor axis through the pole, origin at the centre of the tip curvature), not from
 fabkit's code paths: surfaces are exact (circles, lines, and for the half ellipsoid an
-interpolating B-spline through exact points of the offset curve, within 1e-6 mm of it).
+B-spline approximating exact points of the offset curve, within 1e-6 mm of it).
 """
 
 from __future__ import annotations
@@ -129,36 +129,38 @@ class Body:
         return [self._ellipse_offset_spline(d)]
 
     def _ellipse_offset_spline(self, d: float):
+        # The fitted curve is cached, never the edge: parts must not share topology (OCCT keeps
+        # a mesh on the edge, which would then belong to two parts' faces).
+        from OCP.BRep import BRep_Tool
+        from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge
         key = (self.a, self.c, d)
         if key not in _SPLINES:
-            _SPLINES[key] = self._fit_ellipse_offset(d)
-        return _SPLINES[key]
+            _SPLINES[key] = BRep_Tool.Curve_s(self._fit_ellipse_offset(d).wrapped, 0.0, 1.0)
+        return cq.Edge(BRepBuilderAPI_MakeEdge(_SPLINES[key]).Edge())
 
     def _fit_ellipse_offset(self, d: float):
-        # Interpolating B-spline through exact points, uniform in the ellipse angle, with exact
-        # end tangents; refined until its mid-interval points are within SPLINE_TOL_MM.
-        n = 128
-        while True:
-            ths = [math.pi / 2 * (1.0 - i / n) for i in range(n + 1)]
-            pts = []
-            for i, th in enumerate(ths):
-                r, z, _, _ = self.ellipse_offset(d, th)
-                if i == 0:
-                    r = 0.0
-                if i == n:
-                    z = 0.0
-                pts.append(vec(r, z))
-            e = cq.Edge.makeSpline(pts, tangents=[cq.Vector(1, 0, 0), cq.Vector(0, 0, -1)],
-                                   scale=True)
-            worst = 0.0
-            for i in range(n):
-                r, z, _, _ = self.ellipse_offset(d, 0.5 * (ths[i] + ths[i + 1]))
-                worst = max(worst, _edge_distance(e, vec(r, z)))
-            if worst <= SPLINE_TOL_MM or n >= 4096:
-                if worst > SPLINE_TOL_MM:
-                    raise TwinError(f"ellipse offset {d} mm: spline fit {worst:.2e} mm")
-                return e
-            n *= 2
+        # A B-spline (degree <= 8) approximating 2001 exact points of the offset curve, uniform
+        # in the ellipse angle, within SPLINE_TOL_MM / 10 of them; then checked against 4000
+        # exact points in between. Few poles keep OCCT's booleans on it fast.
+        from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge
+        from OCP.GeomAbs import GeomAbs_C2
+        from OCP.GeomAPI import GeomAPI_PointsToBSpline
+        from OCP.gp import gp_Pnt
+        from OCP.TColgp import TColgp_Array1OfPnt
+        n = 2000
+        arr = TColgp_Array1OfPnt(1, n + 1)
+        for i in range(n + 1):
+            r, z, _, _ = self.ellipse_offset(d, math.pi / 2 * (1.0 - i / n))
+            arr.SetValue(i + 1, gp_Pnt(0.0 if i == 0 else r, 0.0, 0.0 if i == n else z))
+        curve = GeomAPI_PointsToBSpline(arr, 3, 8, GeomAbs_C2, SPLINE_TOL_MM / 10).Curve()
+        e = cq.Edge(BRepBuilderAPI_MakeEdge(curve).Edge())
+        worst = 0.0
+        for i in range(0, 4000, 7):
+            r, z, _, _ = self.ellipse_offset(d, math.pi / 2 * (1.0 - (i + 0.5) / 4000))
+            worst = max(worst, _edge_distance(e, vec(r, z)))
+        if worst > SPLINE_TOL_MM:
+            raise TwinError(f"ellipse offset {d} mm: B-spline fit {worst:.2e} mm")
+        return e
 
 
 def _edge_distance(edge, p: cq.Vector) -> float:

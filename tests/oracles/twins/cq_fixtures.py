@@ -117,25 +117,27 @@ def semidome_half(params: dict):
 def volute_plate(derived: dict, thickness: float):
     """The volute plate, exact: log spiral r = c exp(k phi), phi in [0, 2 pi] about the pole,
     closed by the radial step, in the indenter frame (origin at the outline's centroid)."""
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge
+    from OCP.GeomAbs import GeomAbs_C2
+    from OCP.GeomAPI import GeomAPI_PointsToBSpline
+    from OCP.gp import gp_Pnt
+    from OCP.TColgp import TColgp_Array1OfPnt
     k, c = derived["k"], derived["c_mm"]
     px, py = derived["pole_mm"]
-    n = 256
-    while True:
-        phis = [2 * math.pi * i / n for i in range(n + 1)]
-        pt = lambda f: C.vec(0, 0)  # placeholder (unused)
-        pts = [cq.Vector(px + c * math.exp(k * f) * math.cos(f),
-                         py + c * math.exp(k * f) * math.sin(f), 0.0) for f in phis]
-        e = cq.Edge.makeSpline(pts, scale=True)
-        worst = 0.0
-        for i in range(n):
-            f = 0.5 * (phis[i] + phis[i + 1])
-            q = cq.Vector(px + c * math.exp(k * f) * math.cos(f),
-                          py + c * math.exp(k * f) * math.sin(f), 0.0)
-            worst = max(worst, C._edge_distance(e, q))
-        if worst <= C.SPLINE_TOL_MM or n >= 8192:
-            break
-        n *= 2
-    wire = cq.Wire.assembleEdges([e, cq.Edge.makeLine(pts[-1], pts[0])])
+    spiral = lambda f: (px + c * math.exp(k * f) * math.cos(f), py + c * math.exp(k * f) * math.sin(f))
+    n = 4000
+    arr = TColgp_Array1OfPnt(1, n + 1)
+    for i in range(n + 1):
+        arr.SetValue(i + 1, gp_Pnt(*spiral(2 * math.pi * i / n), 0.0))
+    curve = GeomAPI_PointsToBSpline(arr, 3, 8, GeomAbs_C2, C.SPLINE_TOL_MM / 10).Curve()
+    e = cq.Edge(BRepBuilderAPI_MakeEdge(curve).Edge())
+    worst = max(C._edge_distance(e, cq.Vector(*spiral(2 * math.pi * (i + 0.5) / n), 0.0))
+                for i in range(0, n, 7))
+    if worst > C.SPLINE_TOL_MM:
+        raise C.TwinError(f"volute: B-spline fit {worst:.2e} mm")
+    pts = [e.startPoint(), e.endPoint()]
+    pts = [pts[1], pts[0]]
+    wire = cq.Wire.assembleEdges([e, cq.Edge.makeLine(pts[0], pts[1])])
     face = cq.Face.makeFromWires(wire)
     return cq.Solid.extrudeLinear(face, cq.Vector(0, 0, thickness))
 
