@@ -28,7 +28,7 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     import cadquery as cq
     from twins import compare as K
-    from twins import cq_twin
+    from twins import cq_common, cq_twin
     try:
         man = json.loads((args.export / "manifest.json").read_text())
     except (OSError, ValueError) as e:
@@ -37,7 +37,9 @@ def main(argv=None) -> int:
     exact = {}
     if args.exact_json:
         for r in json.loads(args.exact_json.read_text()):
-            if r.get("volume_exact_mm3") is not None and r["design"] == args.export.name:
+            # rows checked on a sample (cq_twin.sampling) hold the sample's volume, not the part's
+            if (r.get("volume_exact_mm3") is not None and r["design"] == args.export.name
+                    and not r.get("sample")):
                 exact[r["part"]] = r["volume_exact_mm3"]
     bad = 0
     for part in man["parts"]:
@@ -48,12 +50,12 @@ def main(argv=None) -> int:
             continue
         shape = cq.importers.importStep(str(args.export / part["step_file"])).val()
         ok_shape = shape.isValid()
-        v_step = shape.Volume()
+        v_step = cq_common.exact_volume(shape)
         if name in exact:
             v_exact, n_exact = exact[name], None
         else:
             twin = cq_twin.build(part)
-            v_exact, n_exact = twin.Volume(), K._solids(twin)
+            v_exact, n_exact = cq_common.exact_volume(twin), K._solids(twin)
         n_step = K._solids(shape)
         rel = abs(v_step - v_exact) / abs(v_exact)
         ok = ok_shape and rel <= 1e-6 and n_step >= 1 and (n_exact is None or n_step == n_exact)

@@ -230,12 +230,8 @@ def compare_exact(fv, ff, shape, tol: float, max_refine: int = 5000) -> dict:
     """fabkit's mesh (fv, ff) against the exact solid `shape` (both in print orientation)."""
     from OCP.Bnd import Bnd_Box
     from OCP.BRepBndLib import BRepBndLib
-    from OCP.BRepGProp import BRepGProp
-    from OCP.GProp import GProp_GProps
-
-    props = GProp_GProps()
-    BRepGProp.VolumeProperties_s(shape.wrapped, props)
-    v_exact = props.Mass()
+    from .cq_common import exact_volume
+    v_exact = exact_volume(shape)
     bb = Bnd_Box()
     BRepBndLib.AddOptimal_s(shape.wrapped, bb, False, False)
     xmin, ymin, zmin, xmax, ymax, zmax = bb.Get()

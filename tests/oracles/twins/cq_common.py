@@ -355,3 +355,13 @@ def place(shape, params: dict, key: str = "T_print_sensor"):
     if key not in params:
         raise TwinError(f"params.{key} is missing: the manifest must carry the print placement")
     return transformed(shape, params[key])
+
+
+def exact_volume(shape) -> float:
+    """Volume of an OCCT shape by adaptive integration to a relative error of 1e-9 (OCCT's
+    default integration is off by up to ~3e-5 relative on parts with many features)."""
+    from OCP.BRepGProp import BRepGProp
+    from OCP.GProp import GProp_GProps
+    g = GProp_GProps()
+    BRepGProp.VolumeProperties_s(shape.wrapped, g, 1e-9)
+    return g.Mass()

@@ -73,7 +73,7 @@ def main(argv=None) -> int:
         name = part["name"]
         try:
             shape = cq_twin.build(part)
-            v = shape.Volume()
+            v = cq_common.exact_volume(shape)
             bound = part["surface_area_mm2"] * tol + 1e-6 * abs(v)
             if not abs(v - part["volume_mm3"]) <= bound:
                 raise ValueError(f"the exact twin's volume {v:.4f} mm3 differs from fabkit's "
