@@ -11,7 +11,7 @@
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{cuboid, cylinder, ChordTolerance, Solid};
 use crate::kit::{Part, PrintTechnology};
-use crate::molds::place_on_bed;
+use crate::molds::{place_posed, with_pose};
 use crate::schema::{Design, HousingParams};
 use crate::stack::{ResolvedCore, Stack};
 use serde_json::json;
@@ -488,10 +488,13 @@ pub fn build_shell(
         "joint_screws": {"y_mm": [y, -y], "z_mm": z, "axis": "x"},
         "fixture_dowel_holes": dowels,
         "camera_mount_holes_xy_mm": [[s, s], [-s, s], [-s, -s], [s, -s]],
+        "camera_mount_pilot_z_mm": [lv.bulkhead_z_mm - 1.0, lv.bulkhead_z_mm + pilot_depth],
+        // Each internal cavity overlaps the next one up by this much (a hair, see above).
+        "overlap_mm": e,
         "print_orientation": "parting face down",
     });
     let tech = PrintTechnology::Fdm;
-    let part = |solid: Solid, tag: &str, what: &str| {
+    let part = |(solid, pose): (Solid, crate::geometry::Affine), tag: &str, what: &str| {
         Part {
         name: format!("shell_half_{tag}"),
         role: "shell_half".into(),
@@ -499,18 +502,18 @@ pub fn build_shell(
         material: h.material.clone(),
         print_technology: tech,
         solid,
-        params: params.clone(),
+        params: with_pose(params.clone(), &pose),
         group: None,
     }
     };
     let parts = vec![
         part(
-            place_on_bed(&pos.rotate_deg(0.0, -90.0, 0.0)),
+            place_posed(&pos, &crate::geometry::rotation_deg(0.0, -90.0, 0.0)),
             "a",
             "screw heads",
         ),
         part(
-            place_on_bed(&neg.rotate_deg(0.0, 90.0, 0.0)),
+            place_posed(&neg, &crate::geometry::rotation_deg(0.0, 90.0, 0.0)),
             "b",
             "screw pilots",
         ),

@@ -11,7 +11,7 @@ use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{revolve, ChordTolerance, GeometryError, Polyline2, Solid};
 use crate::kit::{Part, PrintTechnology};
 use crate::markers::{self, Marker, MarkerSpec, MarkerSurface, PatternStats, Polarity, Surface};
-use crate::molds::place_on_bed;
+use crate::molds::{place_posed, with_pose, IDENTITY};
 use crate::schema::{Design, LayerProcess, MoldStrategy, Technology};
 use crate::stack::{ResolvedLayer, Stack};
 use serde_json::json;
@@ -540,6 +540,13 @@ fn marker_summary(
                 "printed_with": format!("{tech:?}"),
                 "printable_with": printable,
                 "needs_sla_or_finer": !printable.contains(&"FDM"),
+                // Resolved placements for twins: the surface (normal offset of the body
+                // profile) and each marker's (polar, azimuth) angle in degrees, seen from the
+                // sensor-frame origin; +1 when features point along the outward normal.
+                "tip_material": p.spec.tip_material,
+                "surface_offset_mm": p.offset_mm,
+                "direction": p.direction,
+                "placements_deg": p.markers.iter().map(|m| [m.polar_deg, m.azimuth_deg]).collect::<Vec<_>>(),
             })
         })
         .collect()
@@ -597,6 +604,11 @@ pub fn build_layer(
                     ]
                 })
                 .unwrap_or([0.0; 3]);
+            let pose = [
+                [1.0, 0.0, 0.0, shift[0]],
+                [0.0, 1.0, 0.0, shift[1]],
+                [0.0, 0.0, 1.0, shift[2]],
+            ];
             let mut parts = vec![Part {
                 name: name.clone(),
                 role: "printed_skin".into(),
@@ -604,7 +616,7 @@ pub fn build_layer(
                 material: l.material.clone(),
                 print_technology: tech,
                 solid: skin.translate(shift),
-                params: base_params.clone(),
+                params: with_pose(base_params.clone(), &pose),
                 group: group.clone(),
             }];
             for p in placed.iter().filter(|p| p.spec.tip_material.is_some()) {
@@ -619,7 +631,7 @@ pub fn build_layer(
                     material: p.spec.tip_material.clone().unwrap_or_default(),
                     print_technology: tech,
                     solid: tips.translate(shift),
-                    params: base_params.clone(),
+                    params: with_pose(base_params.clone(), &pose),
                     group: group.clone(),
                 });
             }
@@ -661,6 +673,8 @@ pub fn build_layer(
                 .difference(&plain)
                 .and_then(|b| apply_features_signed(b, &outer, tol, false, -1.0)))?;
             let skin_volume = block.volume() - mold.volume();
+            let (mold_placed, mold_pose) =
+                place_posed(&mold, &crate::geometry::rotation_deg(180.0, 0.0, 0.0));
             let part = Part {
                 name: format!("{name}_open_mold"),
                 role: "open_mold".into(),
@@ -669,8 +683,12 @@ pub fn build_layer(
                 ),
                 material: material_for(cavity_tech).into(),
                 print_technology: cavity_tech,
-                solid: place_on_bed(&mold.rotate_deg(180.0, 0.0, 0.0)),
-                params: json!({"base": base_params, "open_face": "the base plane, printed face up", "wall_thickness_mm": m.wall_thickness_mm}),
+                solid: mold_placed,
+                params: with_pose(
+                    json!({"base": base_params, "open_face": "the base plane, printed face up", "wall_thickness_mm": m.wall_thickness_mm,
+                    "block_mm": {"min": [-half, -half, zb], "max": [half, half, top + m.wall_thickness_mm]}}),
+                    &mold_pose,
+                ),
                 group: None,
             };
             let pour_parts = vec![part.name.clone()];
@@ -728,24 +746,35 @@ pub fn build_layer(
             let inner_negative = g(cup.difference(&core_pos))?;
             let silicone_inner = g(core_pos.intersection(&cup))?.volume();
             let gel = g(layer_solid(design, stack, i, tol))?.volume();
+            let boundary = json!({
+                "locating_pin": {"radius_mm": pin_r, "height_mm": 2.0},
+                "master_top_z_mm": pole,
+                "inner_plinth_bottom_z_mm": z_lo - 1.0,
+                "cup": {"radius_mm": cup_r, "bottom_z_mm": z_lo, "top_z_mm": top},
+                "box_floor_mm": 2.0, "box_wall_mm": 2.0, "box_freeboard_mm": 2.0,
+                "pin_socket_radius_mm": pin_r + fit,
+            });
             let mk = |suffix: &str,
                       role: &str,
                       desc: String,
                       tech: PrintTechnology,
-                      solid: Solid| Part {
+                      (solid, pose): (Solid, crate::geometry::Affine)| Part {
                 name: format!("{name}_{suffix}"),
                 role: role.into(),
                 description: desc,
                 material: material_for(tech).into(),
                 print_technology: tech,
                 solid,
-                params: json!({"base": base_params, "plinth_radius_mm": r_p, "plinth_height_mm": m.plinth.height_mm, "fit_clearance_mm": fit, "draft_angle_deg": m.draft_angle_deg, "silicone_wall_mm": m.silicone_wall_mm}),
+                params: with_pose(
+                    json!({"base": base_params, "plinth_radius_mm": r_p, "plinth_height_mm": m.plinth.height_mm, "fit_clearance_mm": fit, "draft_angle_deg": m.draft_angle_deg, "silicone_wall_mm": m.silicone_wall_mm, "boundary": boundary}),
+                    &pose,
+                ),
                 group: None,
             };
             let parts = vec![
-                mk("outer_master", "master_pattern", format!("Positive of the outer boundary of {name} with its features, to cast the outer Mold Star 30 mold"), cavity_tech, place_on_bed(&master)),
-                mk("outer_mold_box", "mold_box", format!("Drafted cup for the outer Mold Star 30 mold of {name}"), fixture_tech, place_on_bed(&mold_box)),
-                mk("inner_negative", "negative_mold", format!("Negative of the inner boundary of {name} with its features: pour Mold Star 30 in it for the inner silicone mold"), cavity_tech, place_on_bed(&inner_negative.rotate_deg(180.0, 0.0, 0.0))),
+                mk("outer_master", "master_pattern", format!("Positive of the outer boundary of {name} with its features, to cast the outer Mold Star 30 mold"), cavity_tech, place_posed(&master, &IDENTITY)),
+                mk("outer_mold_box", "mold_box", format!("Drafted cup for the outer Mold Star 30 mold of {name}"), fixture_tech, place_posed(&mold_box, &IDENTITY)),
+                mk("inner_negative", "negative_mold", format!("Negative of the inner boundary of {name} with its features: pour Mold Star 30 in it for the inner silicone mold"), cavity_tech, place_posed(&inner_negative, &crate::geometry::rotation_deg(180.0, 0.0, 0.0))),
             ];
             let names: Vec<String> = parts.iter().map(|p| p.name.clone()).collect();
             Ok(LayerOutput {

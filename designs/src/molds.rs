@@ -13,7 +13,7 @@
 //! reservoir is the high point of the cavity: the sprue and the vents open into it.
 
 use crate::error::{DesignError, GeometryContext, ParamError};
-use crate::geometry::{cuboid, revolve, sphere, ChordTolerance, Polyline2, Solid};
+use crate::geometry::{cuboid, revolve, sphere, Affine, ChordTolerance, Polyline2, Solid};
 use crate::kit::{Part, PrintTechnology};
 use crate::schema::{Design, LayerProcess, MoldStrategy};
 use crate::stack::{ResolvedCore, Stack};
@@ -42,6 +42,59 @@ pub fn place_on_bed(s: &Solid) -> Solid {
         ]),
         None => s.clone(),
     }
+}
+
+/// The identity pose (sensor frame = print frame before the bed placement).
+pub const IDENTITY: Affine = [
+    [1.0, 0.0, 0.0, 0.0],
+    [0.0, 1.0, 0.0, 0.0],
+    [0.0, 0.0, 1.0, 0.0],
+];
+
+/// `a` after `b`: the affine map p -> a(b(p)).
+pub fn affine_then(a: &Affine, b: &Affine) -> Affine {
+    let mut m = [[0.0; 4]; 3];
+    for (i, row) in m.iter_mut().enumerate() {
+        for (j, v) in row.iter_mut().enumerate() {
+            *v =
+                (0..3).map(|k| a[i][k] * b[k][j]).sum::<f64>() + if j == 3 { a[i][3] } else { 0.0 };
+        }
+    }
+    m
+}
+
+/// `s` turned by the rigid map `pose` into its print orientation, then placed as
+/// [`place_on_bed`] does; with the whole map `T_print_sensor` (3x4 row-major, sensor frame to
+/// print frame, mm). Parts record it in `params.T_print_sensor` so that an independent twin
+/// (tests/oracles/twins) can rebuild them in the sensor frame and place them the same way.
+pub fn place_posed(s: &Solid, pose: &Affine) -> (Solid, Affine) {
+    let turned = if *pose == IDENTITY {
+        s.clone()
+    } else {
+        s.transform(pose)
+    };
+    let shift = match turned.bounding_box() {
+        Some(b) => [
+            -(b.min[0] + b.max[0]) / 2.0,
+            -(b.min[1] + b.max[1]) / 2.0,
+            -b.min[2],
+        ],
+        None => [0.0; 3],
+    };
+    let t = [
+        [1.0, 0.0, 0.0, shift[0]],
+        [0.0, 1.0, 0.0, shift[1]],
+        [0.0, 0.0, 1.0, shift[2]],
+    ];
+    (turned.translate(shift), affine_then(&t, pose))
+}
+
+/// `params` with `T_print_sensor` (see [`place_posed`]) added.
+pub fn with_pose(mut params: serde_json::Value, t: &Affine) -> serde_json::Value {
+    if let Some(o) = params.as_object_mut() {
+        o.insert("T_print_sensor".into(), json!(t));
+    }
+    params
 }
 
 /// One pour into a mold: which layer, the cavity surface, and the core under it.
@@ -437,7 +490,17 @@ fn core_holder(design: &Design, f: &MoldFrame, tol: ChordTolerance) -> Result<So
 
 fn holder_params(design: &Design, f: &MoldFrame) -> serde_json::Value {
     let m = &design.mold;
+    let ch = &m.core_holder;
+    let fit = ch.fit_clearance_mm;
+    let z_f0 = f.open_face_z_mm - ch.flange_thickness_mm;
+    let z_bottom = z_f0.min(f.core_end_z_mm - SHOULDER_MM);
+    let r_v = f.plinth_radius_mm - fit - ch.min_wall_mm - m.vent.diameter_mm / 2.0;
     json!({
+        "boss_radius_mm": f.core_outer_radius_mm + fit + ch.min_wall_mm,
+        "bottom_z_mm": z_bottom,
+        "holes_z_mm": [z_bottom - 1.0, f.spigot_top_z_mm + 1.0],
+        "vent_radius_mm": r_v,
+        "vent_azimuths_deg": (1..=m.vent.count).map(|k| 360.0 * k as f64 / (m.vent.count + 1) as f64).collect::<Vec<_>>(),
         "frame": f,
         "fit_clearance_mm": m.core_holder.fit_clearance_mm,
         "flange_thickness_mm": m.core_holder.flange_thickness_mm,
@@ -531,6 +594,7 @@ pub fn build_mold(
     } else {
         format!("{name}_casting_jig")
     };
+    let (holder_placed, holder_pose) = place_posed(&holder, &IDENTITY);
     let holder_part = Part {
         name: holder_name.clone(),
         role: if direct { "core_holder".into() } else { "casting_jig".into() },
@@ -540,15 +604,15 @@ pub fn build_mold(
         ),
         material: fixture_material.into(),
         print_technology: fixture_tech,
-        solid: place_on_bed(&holder),
-        params: holder_params(design, &f),
+        solid: holder_placed,
+        params: with_pose(holder_params(design, &f), &holder_pose),
         group: None,
     };
 
     match plan.strategy {
         MoldStrategy::Open | MoldStrategy::Boundary => unreachable!("built by crate::layers"),
         MoldStrategy::Direct => {
-            let (a, b) = direct_halves(design, &f, &cavity, tol).part(name)?;
+            let ((a, pose_a), (b, pose_b)) = direct_halves(design, &f, &cavity, tol).part(name)?;
             let mut params = common.clone();
             params["direct"] = json!({
                 "parting_plane": "y = 0 (through the sensor axis)",
@@ -561,7 +625,7 @@ pub fn build_mold(
                 "feature_x_mm": f.plinth_radius_mm + m.flange_width_mm / 2.0,
                 "print_orientation": "parting face up",
             });
-            let half = |s: Solid, tag: &str, keys: &str| Part {
+            let half = |s: Solid, pose: Affine, tag: &str, keys: &str| Part {
                 name: format!("{name}_mold_half_{tag}"),
                 role: "mold_half".into(),
                 description: format!(
@@ -570,10 +634,14 @@ pub fn build_mold(
                 material: cavity_material.into(),
                 print_technology: cavity_tech,
                 solid: s,
-                params: params.clone(),
+                params: with_pose(params.clone(), &pose),
                 group: None,
             };
-            let parts = vec![half(a, "a", "male"), half(b, "b", "female"), holder_part];
+            let parts = vec![
+                half(a, pose_a, "a", "male"),
+                half(b, pose_b, "b", "female"),
+                holder_part,
+            ];
             let pour_parts = parts.iter().map(|p| p.name.clone()).collect();
             Ok(MoldOutput {
                 parts,
@@ -598,9 +666,12 @@ pub fn build_mold(
                 "silicone_wall_mm": m.silicone_wall_mm,
                 "draft_angle_deg": m.draft_angle_deg,
                 "locating_pin": {"radius_mm": LOCATING_PIN_RADIUS_MM.min(f.plinth_radius_mm / 3.0), "height_mm": LOCATING_PIN_HEIGHT_MM},
-                "box_floor_mm": BOX_FLOOR_MM, "box_wall_mm": BOX_WALL_MM,
+                "box_floor_mm": BOX_FLOOR_MM, "box_wall_mm": BOX_WALL_MM, "box_freeboard_mm": BOX_FREEBOARD_MM,
+                "pin_socket_radius_mm": LOCATING_PIN_RADIUS_MM.min(f.plinth_radius_mm / 3.0) + m.core_holder.fit_clearance_mm,
                 "fill_z_mm": f.cavity_pole_z_mm + m.silicone_wall_mm,
             });
+            let (master_placed, master_pose) = place_posed(&master, &IDENTITY);
+            let (box_placed, box_pose) = place_posed(&mold_box, &IDENTITY);
             let master_name = format!("{name}_master_pattern");
             let box_name = format!("{name}_mold_box");
             let parts = vec![
@@ -610,8 +681,8 @@ pub fn build_mold(
                     description: format!("Positive of the {name} cavity with its plinth, to cast a Mold Star 30 mold"),
                     material: cavity_material.into(),
                     print_technology: cavity_tech,
-                    solid: place_on_bed(&master),
-                    params: params.clone(),
+                    solid: master_placed,
+                    params: with_pose(params.clone(), &master_pose),
                     group: None,
                 },
                 Part {
@@ -620,8 +691,8 @@ pub fn build_mold(
                     description: format!("Drafted cup that holds the {name} master pattern while Mold Star 30 cures"),
                     material: fixture_material.into(),
                     print_technology: fixture_tech,
-                    solid: place_on_bed(&mold_box),
-                    params,
+                    solid: box_placed,
+                    params: with_pose(params, &box_pose),
                     group: None,
                 },
                 holder_part,
@@ -650,7 +721,7 @@ fn direct_halves(
     f: &MoldFrame,
     cavity: &Solid,
     tol: ChordTolerance,
-) -> Result<(Solid, Solid), crate::geometry::GeometryError> {
+) -> Result<((Solid, Affine), (Solid, Affine)), crate::geometry::GeometryError> {
     let m = &design.mold;
     let b = f.plinth_radius_mm + m.flange_width_mm;
     let z_lo = f.open_face_z_mm;
@@ -687,8 +758,8 @@ fn direct_halves(
         )?))?
         .difference(&bolts)?;
     Ok((
-        place_on_bed(&a.rotate_deg(-90.0, 0.0, 0.0)),
-        place_on_bed(&bh.rotate_deg(90.0, 0.0, 0.0)),
+        place_posed(&a, &crate::geometry::rotation_deg(-90.0, 0.0, 0.0)),
+        place_posed(&bh, &crate::geometry::rotation_deg(90.0, 0.0, 0.0)),
     ))
 }
 

@@ -88,6 +88,12 @@ pub enum ExportError {
     ThreeMf { reason: String },
     #[error("encoding {what}: {reason}")]
     Encode { what: String, reason: String },
+    /// `--format step` needs the CadQuery twin's Python environment.
+    #[error("STEP export is not available: {reason} (hint: {hint})", hint = crate::step::INSTALL_HINT)]
+    StepUnavailable { reason: String },
+    /// The CadQuery twin could not build a part, or its exact solid disagrees with fabkit's.
+    #[error("STEP export of part `{part}` failed: {reason}")]
+    Step { part: String, reason: String },
     #[error("serializing manifest.json")]
     Json(#[from] serde_json::Error),
 }

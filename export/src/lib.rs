@@ -22,6 +22,7 @@ mod layout;
 mod manifest;
 pub mod raster;
 mod sheet;
+pub mod step;
 mod stl;
 mod three_mf;
 
@@ -45,6 +46,8 @@ pub struct Formats {
     pub stl: bool,
     /// `<design>.3mf`, one 3MF for the whole kit.
     pub threemf: bool,
+    /// `step/<part>.step`, exact B-rep per part through the CadQuery twin (see [`step`]).
+    pub step: bool,
 }
 
 impl Default for Formats {
@@ -53,6 +56,7 @@ impl Default for Formats {
         Self {
             stl: true,
             threemf: true,
+            step: false,
         }
     }
 }
@@ -199,6 +203,7 @@ fn write_kit_meshes(
 }
 
 const PARTS_DIR: &str = "parts";
+const STEP_DIR: &str = "step";
 
 /// Every file of the export, in memory, with `/`-separated relative paths.
 struct Rendered {
@@ -251,8 +256,19 @@ fn render(
             triangles: mesh.triangles.len(),
             genus: mesh.genus(),
             sha256,
+            step_file: None,
+            step_sha256: None,
             params: part.params.clone(),
         });
+    }
+    if opts.formats.step {
+        let steps = step::render(&parts, opts.chord_tolerance_mm)?;
+        for (p, bytes) in parts.iter_mut().zip(steps) {
+            let rel = format!("{STEP_DIR}/{}.step", p.name);
+            p.step_sha256 = Some(sha256_hex(&bytes));
+            p.step_file = Some(rel.clone());
+            files.push((rel, bytes));
+        }
     }
 
     let kit_3mf = if opts.formats.threemf {

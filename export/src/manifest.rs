@@ -89,6 +89,13 @@ pub struct ManifestPart {
     pub genus: i64,
     /// sha256 of the STL file bytes, `null` when STL was not requested.
     pub sha256: Option<String>,
+    /// Path of the part's STEP file (`step/<name>.step`, exact B-rep from the CadQuery twin),
+    /// absent when STEP was not requested.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub step_file: Option<String>,
+    /// sha256 of the STEP file bytes, absent when STEP was not requested.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub step_sha256: Option<String>,
     /// The resolved parameters the part was built from.
     pub params: serde_json::Value,
 }

@@ -55,7 +55,8 @@ struct ExportArgs {
     /// previous export; refused if it holds anything else.
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Mesh formats, comma separated.
+    /// Output formats, comma separated: stl, 3mf, step (exact B-rep through the CadQuery twin;
+    /// needs scripts/setup-cadquery or FABKIT_CADQUERY_PYTHON).
     #[arg(long, value_delimiter = ',', default_value = "stl,3mf")]
     format: Vec<Format>,
     /// Largest distance between a facet and the true surface, mm.
@@ -79,6 +80,8 @@ pub(crate) enum Format {
     Stl,
     #[value(name = "3mf")]
     ThreeMf,
+    /// STEP through the CadQuery twin (tests/oracles/twins).
+    Step,
 }
 
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq)]
@@ -137,6 +140,7 @@ pub(crate) fn export_options(
         formats: Formats {
             stl: format.contains(&Format::Stl),
             threemf: format.contains(&Format::ThreeMf),
+            step: format.contains(&Format::Step),
         },
         command_line: std::env::args().collect(),
         design_source: loaded.source.clone(),
@@ -144,6 +148,19 @@ pub(crate) fn export_options(
         chord_tolerance_mm: tol.mm(),
         fabkit_version: env!("CARGO_PKG_VERSION").to_string(),
     }
+}
+
+/// Writes the CSG tree of every part of `kit` (fabkit-csg/1 JSON) to `path`.
+pub(crate) fn write_csg(kit: &fabkit_designs::Kit, path: &Path) -> Result<(), Box<dyn Error>> {
+    let parts: Vec<(&str, &fabkit_designs::Solid)> = kit
+        .parts
+        .iter()
+        .map(|p| (p.name.as_str(), &p.solid))
+        .collect();
+    let json = fabkit_designs::geometry::csg_json(&parts);
+    std::fs::write(path, serde_json::to_vec(&json)?)
+        .map_err(|e| format!("writing {}: {e}", path.display()))?;
+    Ok(())
 }
 
 /// A ticking spinner on stderr for a build step (hidden when stderr is not a terminal).
@@ -238,14 +255,7 @@ fn export(args: ExportArgs) -> Result<(), Box<dyn Error>> {
     let kit = kit?;
     let opts = export_options(&loaded, tol, &args.format);
     if let Some(csg) = &args.csg {
-        let parts: Vec<(&str, &fabkit_designs::Solid)> = kit
-            .parts
-            .iter()
-            .map(|p| (p.name.as_str(), &p.solid))
-            .collect();
-        let json = fabkit_designs::geometry::csg_json(&parts);
-        std::fs::write(csg, serde_json::to_vec(&json)?)
-            .map_err(|e| format!("writing {}: {e}", csg.display()))?;
+        write_csg(&kit, csg)?;
     }
     let summary = write_kit(&kit, &out, &opts)?;
     for w in &summary.warnings {

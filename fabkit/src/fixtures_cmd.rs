@@ -36,6 +36,10 @@ pub struct FixturesArgs {
     /// Largest distance between a facet and the true surface, mm.
     #[arg(long, default_value_t = ChordTolerance::DEFAULT_MM)]
     chord_tolerance_mm: f64,
+    /// Also write the CSG tree of every part (fabkit-csg/1 JSON) to this file, for the
+    /// manifold3d twin (tests/oracles/twins).
+    #[arg(long)]
+    csg: Option<PathBuf>,
 }
 
 pub fn run(args: FixturesArgs) -> Result<(), Box<dyn Error>> {
@@ -78,6 +82,9 @@ pub fn run(args: FixturesArgs) -> Result<(), Box<dyn Error>> {
     spinner.finish_and_clear();
     let set = set?;
     let opts = export_options(&loaded, tol, &args.format);
+    if let Some(csg) = &args.csg {
+        crate::cli::write_csg(&set.kit, csg)?;
+    }
     let summary = write_kit_with_files(&set.kit, &set.files, &out, &opts)?;
     for w in &summary.warnings {
         eprintln!("warning: {w}");

@@ -1,0 +1,117 @@
+#!/usr/bin/env python3
+"""Self-test of tests/oracles/twins: the mesh measures with known answers (always), and with
+CadQuery importable, the exact building blocks and the exact comparison against closed forms.
+
+Usage: python tests/oracles/test_twins.py   (exit 0 when every check passes)
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import unittest
+from pathlib import Path
+
+import manifold3d
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from twins import compare as K  # noqa: E402
+
+try:
+    import cadquery  # noqa: F401
+    HAS_CQ = True
+except ImportError:
+    HAS_CQ = False
+
+
+def mesh_of(m: manifold3d.Manifold):
+    g = m.to_mesh()
+    return (np.asarray(g.vert_properties, dtype=np.float64)[:, :3],
+            np.asarray(g.tri_verts, dtype=np.int64))
+
+
+class MeshMeasures(unittest.TestCase):
+    def test_genus_watertight_volume_of_a_ring(self):
+        ring = manifold3d.Manifold.cube((10, 10, 2), True) - manifold3d.Manifold.cylinder(
+            4, 2, 2, 64, True)
+        v, f = mesh_of(ring)
+        ok, n_edges = K.edge_stats(f)
+        self.assertTrue(ok)
+        self.assertEqual(K.genus_from(len(v), n_edges, len(f), 1), 1)
+        self.assertAlmostEqual(K.mesh_volume(v, f), ring.volume(), places=6)
+        # an open mesh is caught
+        ok, _ = K.edge_stats(f[1:])
+        self.assertFalse(ok)
+
+    def test_degenerate_pole_facets_are_dropped(self):
+        v, f = mesh_of(manifold3d.Manifold.cube((1, 1, 1)))
+        v = np.vstack([v, v[f[0, 0]]])  # a duplicate of a vertex: a zero-area facet on it
+        f2 = np.vstack([f, [[f[0, 0], f[0, 1], len(v) - 1]]])
+        vw, fw = K.weld(v, f2)
+        kept, dropped = K.drop_degenerate(vw, fw)
+        self.assertEqual(dropped, 1)
+        self.assertEqual(len(kept), len(f))
+
+    def test_hausdorff_of_a_shifted_mesh(self):
+        v, f = mesh_of(manifold3d.Manifold.cube((2, 2, 2), True))
+        h = K.mesh_hausdorff(v, f, v + [0.0, 0.0, 0.01], f)
+        self.assertAlmostEqual(h, 0.01, places=9)
+
+
+@unittest.skipUnless(HAS_CQ, "CadQuery not installed (full tier)")
+class ExactTwins(unittest.TestCase):
+    def test_ellipse_offset_spline_and_surface_points(self):
+        from twins import cq_common as C
+        body = C.Body({"profile": "half_ellipsoid", "diameter_mm": 18.0, "height_mm": 24.0})
+        for d in (-2.4, 0.0, 0.5):
+            e = body.curve_edges(d)[0]
+            for polar in (0.0, 10.0, 45.0, 80.0):
+                r, z, nr, nz = body.surface_point(d, polar)
+                self.assertLess(C._edge_distance(e, C.vec(r, z)), 1e-6)
+                self.assertAlmostEqual(math.degrees(math.atan2(r, z)), polar, places=9)
+                self.assertAlmostEqual(math.hypot(nr, nz), 1.0, places=12)
+        cap = C.Body({"profile": "spherical_cap", "base_diameter_mm": 35.0, "height_mm": 8.0})
+        self.assertAlmostEqual(cap.rim_radius(0.0), 17.5, places=12)
+        self.assertAlmostEqual(cap.pole_z(0.0) - cap.base_z(), 8.0, places=12)
+
+    def test_exact_comparison_of_a_sphere_mesh(self):
+        from twins import cq_common as C
+        r, tol = 5.0, 0.01
+        # a UV sphere with its vertices on the sphere, each direction within tol / 2
+        n = 4 * math.ceil(math.pi / math.acos(1 - tol / 2 / r) / 4)
+        lat = [math.pi * i / (n // 2) for i in range(1, n // 2)]
+        v = [[0.0, 0.0, r]] + [[r * math.sin(a) * math.cos(2 * math.pi * j / n),
+                                 r * math.sin(a) * math.sin(2 * math.pi * j / n), r * math.cos(a)]
+                                for a in lat for j in range(n)] + [[0.0, 0.0, -r]]
+        f = []
+        rings = len(lat)
+        idx = lambda i, j: 1 + i * n + j % n
+        for j in range(n):
+            f.append([0, idx(0, j), idx(0, j + 1)])
+            f.append([len(v) - 1, idx(rings - 1, j + 1), idx(rings - 1, j)])
+        for i in range(rings - 1):
+            for j in range(n):
+                f.append([idx(i, j), idx(i + 1, j), idx(i + 1, j + 1)])
+                f.append([idx(i, j), idx(i + 1, j + 1), idx(i, j + 1)])
+        v, f = np.asarray(v), np.asarray(f, dtype=np.int64)
+        exact = C.primitive({"type": "sphere", "centre_mm": [0, 0, 0], "radius_mm": r})
+        e = K.compare_exact(v, f, exact, tol)
+        self.assertAlmostEqual(e["volume_exact_mm3"], 4 / 3 * math.pi * r ** 3, places=6)
+        self.assertLessEqual(abs(e["volume_diff_mm3"]), e["volume_bound_mm3"])
+        self.assertLessEqual(e["hausdorff_mm"], K.hausdorff_bound(tol))
+        self.assertGreater(e["hausdorff_mm"], 0.2 * tol)  # the facets do leave the sphere
+        self.assertEqual(e["genus_exact"], 0)
+        self.assertTrue(e["exact_mesh_watertight"])
+        self.assertGreater(e["exact_mesh_pole_facets_dropped"], 0)
+        # a mesh 3 tol too big is caught
+        e2 = K.compare_exact(v * (1 + 3 * tol / r), f, exact, tol)
+        self.assertGreater(e2["hausdorff_mm"], K.hausdorff_bound(tol))
+
+
+if __name__ == "__main__":
+    res = unittest.main(exit=False, verbosity=1).result
+    print(f"test_twins: {res.testsRun - len(res.failures) - len(res.errors)} passed, "
+          f"{len(res.failures) + len(res.errors)} failed, {len(res.skipped)} skipped")
+    sys.exit(0 if res.wasSuccessful() else 1)

@@ -1,0 +1,70 @@
+#!/usr/bin/env python3
+"""Read back the STEP files of a `fabkit export --format step` (CadQuery import) and check each
+against the exact solid (issue 7).
+
+Usage: python twins/check_step.py EXPORT_DIR [--exact-json TWINS.json]   (from tests/oracles)
+
+Per part with a `step_file` in manifest.json: the file imports into CadQuery as a valid shape
+with as many solids as the exact twin, and its volume equals the exact twin's within 1e-6
+relative (the same B-rep written and read back). The exact volumes come from `--exact-json`
+(the rows check_twins.py wrote in the same run) or, without it, from the twins built here.
+Exit status 0 when every part passes, 1 otherwise, 2 on unreadable input.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("export", type=Path)
+    ap.add_argument("--exact-json", type=Path)
+    args = ap.parse_args(argv)
+    import cadquery as cq
+    from twins import compare as K
+    from twins import cq_common, cq_twin
+    try:
+        man = json.loads((args.export / "manifest.json").read_text())
+    except (OSError, ValueError) as e:
+        print(f"check_step: {e}", file=sys.stderr)
+        return 2
+    exact = {}
+    if args.exact_json:
+        for r in json.loads(args.exact_json.read_text()):
+            # rows checked on a sample (cq_twin.sampling) hold the sample's volume, not the part's
+            if (r.get("volume_exact_mm3") is not None and r["design"] == args.export.name
+                    and not r.get("sample")):
+                exact[r["part"]] = r["volume_exact_mm3"]
+    bad = 0
+    for part in man["parts"]:
+        name = part["name"]
+        if not part.get("step_file"):
+            print(f"FAIL {name}: no step_file in the manifest")
+            bad += 1
+            continue
+        shape = cq.importers.importStep(str(args.export / part["step_file"])).val()
+        ok_shape = shape.isValid()
+        v_step = cq_common.exact_volume(shape)
+        if name in exact:
+            v_exact, n_exact = exact[name], None
+        else:
+            twin = cq_twin.build(part)
+            v_exact, n_exact = cq_common.exact_volume(twin), K._solids(twin)
+        n_step = K._solids(shape)
+        rel = abs(v_step - v_exact) / abs(v_exact)
+        ok = ok_shape and rel <= 1e-6 and n_step >= 1 and (n_exact is None or n_step == n_exact)
+        bad += not ok
+        print(f"{'PASS' if ok else 'FAIL'} {name}: STEP volume {v_step:.6f} mm3 vs exact "
+              f"{v_exact:.6f} (rel {rel:.1e}), {n_step} solid(s), valid {ok_shape}", flush=True)
+    print(f"check_step: {len(man['parts']) - bad} passed, {bad} failed")
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

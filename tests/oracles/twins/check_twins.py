@@ -1,0 +1,211 @@
+#!/usr/bin/env python3
+"""Cross-verify fabkit exports against their twins and write the Markdown report (issue 7).
+
+Usage: python -m twins.check_twins EXPORT_DIR... --report REPORT.md [--json OUT.json]
+                                   [--tier fast|full]   (run from tests/oracles)
+
+Each EXPORT_DIR is a `fabkit export` or `fabkit fixtures` output (manifest.json, parts/*.stl)
+with the CSG tree of its parts beside it as EXPORT_DIR.csg.json (`--csg`). Per part:
+- manifold3d twin (both tiers): the part's booleans redone from its primitives (the CSG leaf
+  meshes): status NoError, volume within 1e-6 relative of fabkit's, genus equal, bounding box
+  and symmetric Hausdorff distance to the written mesh within tol + 1 um;
+- CadQuery twin (full tier): the exact B-rep rebuilt from the manifest's params alone: volume
+  within the chord-tolerance bound, symmetric Hausdorff distance <= tol + 1 um, bounding box
+  within tol + 1 um, genus equal, its tessellation watertight once OCCT's zero-area pole facets
+  are dropped (see compare.py).
+The written mesh itself must be watertight and consistently oriented. One report row per part;
+exit status 1 when any row is out of bounds, 2 on unreadable input.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE.parent))
+
+from twins import compare as K  # noqa: E402
+from twins import m3d_twin  # noqa: E402
+
+
+def check_export(d: Path, tier: str, log) -> list[dict]:
+    man = json.loads((d / "manifest.json").read_text())
+    tol = float(man["chord_tolerance_mm"])
+    csg_path = Path(str(d) + ".csg.json")
+    m3d = m3d_twin.replay(csg_path) if csg_path.exists() else None
+    rows = []
+    for part in man["parts"]:
+        name = part["name"]
+        row = {"design": d.name, "design_name": man["design"]["name"], "part": name,
+               "role": part["role"],
+               "tol_mm": tol, "triangles": part["triangles"], "genus_fabkit": part["genus"],
+               "problems": []}
+        fv, ff = K.load_stl(d / part["file"])
+        ok, _ = K.edge_stats(ff)
+        if not ok:
+            row["problems"].append("written mesh not watertight / not consistently oriented")
+        hb = K.hausdorff_bound(tol)
+        # manifold3d twin
+        if m3d is None:
+            row["problems"].append(f"no CSG file {csg_path.name}")
+        else:
+            r = m3d.get(name)
+            if r is None:
+                row["problems"].append("part missing from the CSG file")
+            else:
+                row.update({"m3d_status": r["status"], "m3d_volume_rel_diff": r["volume_rel_diff"],
+                            "m3d_genus": r["genus"]})
+                mv, mf = r["mesh"]
+                placed = mv  # the CSG root is the part in print orientation
+                row["m3d_hausdorff_mm"] = K.mesh_hausdorff(placed, mf, fv, ff, dense=False)
+                row["m3d_bbox_dev_mm"] = K.bbox_dev(placed.min(axis=0), placed.max(axis=0),
+                                                    part["bbox_mm"]["min"], part["bbox_mm"]["max"])
+                if r["status"] != "NoError":
+                    row["problems"].append(f"manifold3d status {r['status']}")
+                if not r["volume_rel_diff"] <= 1e-6:
+                    row["problems"].append(f"manifold3d volume rel diff {r['volume_rel_diff']:.2e} > 1e-6")
+                if r["genus"] != part["genus"]:
+                    row["problems"].append(f"manifold3d genus {r['genus']} != {part['genus']}")
+                if not row["m3d_hausdorff_mm"] <= hb:
+                    row["problems"].append(f"manifold3d Hausdorff {row['m3d_hausdorff_mm']:.2e} mm > {hb}")
+                if not row["m3d_bbox_dev_mm"] <= hb:
+                    row["problems"].append(f"manifold3d bbox off by {row['m3d_bbox_dev_mm']:.2e} mm")
+        if tier == "full":
+            from twins import cq_twin
+            row["family"] = cq_twin.family(part)
+            t0 = time.perf_counter()
+            sample = cq_twin.sampling(part)
+            try:
+                shape = cq_twin.build(part, sample)
+                if sample is not None:
+                    # the same wedge cut from fabkit's written mesh (manifold3d: planar cuts,
+                    # no new facets off the surface)
+                    fv, ff, g_sample = m3d_twin.clip_to_wedge(fv, ff, sample,
+                                                              part["params"]["T_print_sensor"])
+                    row["sample"] = (f"wedge of azimuths {sample['wedge_deg'][0]:g}-"
+                                     f"{sample['wedge_deg'][1]:g} deg: {sample['features_kept']} of "
+                                     f"{sample['features_total']} features")
+                    row["genus_fabkit_sample"] = g_sample
+                row["cq_build_s"] = time.perf_counter() - t0
+                t1 = time.perf_counter()
+                e = K.compare_exact(fv, ff, shape, tol)
+                row["cq_compare_s"] = time.perf_counter() - t1
+                row.update(e)
+                if not abs(e["volume_diff_mm3"]) <= e["volume_bound_mm3"]:
+                    row["problems"].append(
+                        f"volume off the exact solid by {e['volume_diff_mm3']:.4g} mm3 "
+                        f"(bound {e['volume_bound_mm3']:.4g})")
+                if not e["hausdorff_mm"] <= hb:
+                    row["problems"].append(f"Hausdorff {e['hausdorff_mm']:.4g} mm > {hb:.4g}")
+                sb = K.seam_bound(tol)
+                if not e["hausdorff_seam_mm"] <= sb:
+                    row["problems"].append(
+                        f"Hausdorff at seams {e['hausdorff_seam_mm']:.4g} mm > {sb:.4g}")
+                if not e["bbox_dev_mm"] <= hb:
+                    row["problems"].append(f"bbox off by {e['bbox_dev_mm']:.4g} mm")
+                if not e["exact_mesh_watertight"]:
+                    row["problems"].append("exact twin's tessellation not watertight")
+                g_f = row.get("genus_fabkit_sample", part["genus"])
+                if e["genus_exact"] != g_f:
+                    row["problems"].append(f"genus {g_f} vs exact {e['genus_exact']}")
+            except Exception as ex:  # a twin that cannot be built is a failed row
+                row["cq_build_s"] = time.perf_counter() - t0
+                row["problems"].append(f"CadQuery twin failed: {type(ex).__name__}: {ex}")
+        else:
+            from twins.families import family
+            row["family"] = family(part)
+        row["ok"] = not row["problems"]
+        log(f"{'PASS' if row['ok'] else 'FAIL'} {row['design']}/{name}"
+            + ("" if row["ok"] else ": " + "; ".join(row["problems"])))
+        rows.append(row)
+    return rows
+
+
+def fmt(x, spec=".3g", scale=1.0):
+    return "n/a" if x is None else format(x * scale, spec)
+
+
+def report(rows: list[dict], tier: str, meta: dict) -> str:
+    out = ["# fabkit twin cross-verification", "",
+           f"Tier: {tier} ({'CadQuery exact twins and manifold3d' if tier == 'full' else 'manifold3d only'}). "
+           + ", ".join(f"{k} {v}" for k, v in meta.items()), "",
+           "Bounds: volume vs exact <= area x tol + 1e-6 V; vs manifold3d <= 1e-6 relative; "
+           "symmetric Hausdorff and bounding box <= tol + 1 um (at the exact solid's edges, "
+           "sqrt(2) tol + 1 um: see tests/oracles/twins/compare.py); genus equal.", ""]
+    if tier == "full":
+        out += ["| export | part | family | triangles | V fabkit mm3 | V exact mm3 | dV / bound | "
+                "V m3d rel diff | Hausdorff exact um (bound) | at seams um (bound) | Hausdorff m3d um | bbox dev um | "
+                "genus fabkit/exact/m3d | pole facets dropped | CadQuery s | result |",
+                "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---|"]
+        for r in rows:
+            ratio = (abs(r["volume_diff_mm3"]) / r["volume_bound_mm3"]
+                     if r.get("volume_bound_mm3") else None)
+            out.append(
+                f"| {r['design']} | {r['part']} | {r.get('family', '')} | {r['triangles']} | "
+                f"{fmt(r.get('volume_fabkit_mm3'), '.2f')} | {fmt(r.get('volume_exact_mm3'), '.2f')} | "
+                f"{fmt(ratio, '.2f')} | {fmt(r.get('m3d_volume_rel_diff'), '.1e')} | "
+                f"{fmt(r.get('hausdorff_mm'), '.2f', 1e3)} ({fmt(K.hausdorff_bound(r['tol_mm']), '.1f', 1e3)}) | "
+                f"{fmt(r.get('hausdorff_seam_mm'), '.2f', 1e3)} ({fmt(K.seam_bound(r['tol_mm']), '.1f', 1e3)}) | "
+                f"{fmt(r.get('m3d_hausdorff_mm'), '.3f', 1e3)} | {fmt(r.get('bbox_dev_mm'), '.2f', 1e3)} | "
+                f"{r['genus_fabkit']}/{r.get('genus_exact', 'n/a')}/{r.get('m3d_genus', 'n/a')} | "
+                f"{r.get('exact_mesh_pole_facets_dropped', 'n/a')} | "
+                f"{fmt((r.get('cq_build_s') or 0) + (r.get('cq_compare_s') or 0), '.1f')} | "
+                f"{'ok' if r['ok'] else 'FAIL: ' + '; '.join(r['problems'])}"
+                f"{' (sampled: ' + r['sample'] + ')' if r.get('sample') else ''} |")
+    else:
+        out += ["| export | part | family | triangles | V m3d rel diff | Hausdorff m3d um | "
+                "bbox dev um | genus fabkit/m3d | result |",
+                "|---|---|---|---:|---:|---:|---:|---|---|"]
+        for r in rows:
+            out.append(
+                f"| {r['design']} | {r['part']} | {r.get('family', '')} | {r['triangles']} | "
+                f"{fmt(r.get('m3d_volume_rel_diff'), '.1e')} | {fmt(r.get('m3d_hausdorff_mm'), '.3f', 1e3)} | "
+                f"{fmt(r.get('m3d_bbox_dev_mm'), '.3f', 1e3)} | {r['genus_fabkit']}/{r.get('m3d_genus', 'n/a')} | "
+                f"{'ok' if r['ok'] else 'FAIL: ' + '; '.join(r['problems'])} |")
+    bad = [r for r in rows if not r["ok"]]
+    out += ["", f"{len(rows) - len(bad)} passed, {len(bad)} failed", ""]
+    return "\n".join(out)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("exports", nargs="+", type=Path)
+    ap.add_argument("--report", type=Path, required=True, help="Markdown report to write")
+    ap.add_argument("--json", type=Path, help="also write the rows as JSON")
+    ap.add_argument("--tier", choices=["fast", "full"], default="full")
+    args = ap.parse_args(argv)
+    for d in args.exports:
+        if not (d / "manifest.json").is_file():
+            print(f"check_twins: {d}: no manifest.json", file=sys.stderr)
+            return 2
+    t0 = time.perf_counter()
+    rows = []
+    for d in args.exports:
+        rows += check_export(d, args.tier, lambda s: print(s, flush=True))
+    meta = {"seconds": f"{time.perf_counter() - t0:.1f}"}
+    try:
+        from importlib import metadata
+        meta["manifold3d"] = metadata.version("manifold3d")
+        if args.tier == "full":
+            meta["cadquery"] = metadata.version("cadquery")
+    except Exception:
+        pass
+    text = report(rows, args.tier, meta)
+    args.report.parent.mkdir(parents=True, exist_ok=True)
+    args.report.write_text(text)
+    if args.json:
+        clean = [{k: v for k, v in r.items()} for r in rows]
+        args.json.write_text(json.dumps(clean, indent=1, default=float))
+    bad = sum(not r["ok"] for r in rows)
+    print(f"check_twins: {len(rows) - bad} passed, {bad} failed; report {args.report}")
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,41 @@
+"""CadQuery twin of the two-piece sensor shell (R-Tac0 Sec. III-B2..B4, Fig. 2), from the
+shell half's manifest `params`: levels, housing parameters, seats, joint screws, dowels."""
+
+from __future__ import annotations
+
+from . import cq_common as C
+
+
+def shell_half(params: dict, half: str):
+    """Half `a` (x >= 0, screw heads) or `b` (x <= 0, pilots), sensor frame."""
+    lv, h = params["levels"], params["housing"]
+    w = h["outer_width_mm"] / 2.0
+    c = h["fit_clearance_mm"]
+    e = params["overlap_mm"]
+    bw = h["camera"]["board_width_mm"] / 2.0 + c
+    cyl = C.cylinder_z
+    cuts = [
+        C.box([-bw, -bw, lv["bottom_z_mm"] - 1.0], [bw, bw, lv["bulkhead_z_mm"]]),
+        cyl(h["camera"]["lens_hole_diameter_mm"] / 2.0, lv["bulkhead_z_mm"] - e, lv["pcb_z_mm"] + e),
+        cyl(h["led_pcb"]["outer_diameter_mm"] / 2.0 + c, lv["pcb_z_mm"], lv["chamber_z_mm"] + e),
+        cyl(h["light_chamber_diameter_mm"] / 2.0, lv["chamber_z_mm"], lv["diffuser_z_mm"] + e),
+        cyl(h["diffuser"]["outer_diameter_mm"] / 2.0 + c, lv["diffuser_z_mm"], lv["seat_z_mm"] + e),
+        cyl(params["core_seat_radius_mm"], lv["seat_z_mm"], lv["top_z_mm"] + 1.0),
+    ]
+    z0, z1 = params["camera_mount_pilot_z_mm"]
+    for x, y in params["camera_mount_holes_xy_mm"]:
+        cuts.append(cyl(h["camera"]["mount_pilot_diameter_mm"] / 2.0, z0, z1, x, y))
+    js = h["joint_screw"]
+    z = params["joint_screws"]["z_mm"]
+    for y in params["joint_screws"]["y_mm"]:
+        for r, x0, x1 in ((js["pilot_diameter_mm"] / 2.0, -js["pilot_depth_mm"], e),
+                          (js["clearance_diameter_mm"] / 2.0, 0.0, js["clamp_length_mm"] + e),
+                          (js["head_diameter_mm"] / 2.0, js["clamp_length_mm"], w + 1.0)):
+            cuts.append(C.cylinder_between((x0, y, z), (x1, y, z), r))
+    dw = params["fixture_dowel_holes"]
+    for x, y in dw["positions_xy_mm"]:
+        cuts.append(cyl(dw["diameter_mm"] / 2.0, lv["top_z_mm"] - dw["depth_mm"],
+                        lv["top_z_mm"] + 1.0, x, y))
+    lo = [0.0 if half == "a" else -w, -w, lv["bottom_z_mm"]]
+    hi = [w if half == "a" else 0.0, w, lv["top_z_mm"]]
+    return C.cut(C.box(lo, hi), cuts)

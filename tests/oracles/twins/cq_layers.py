@@ -1,0 +1,123 @@
+"""CadQuery twins of the parts built from a layer and its marker features (ShadowTac
+Sec. III-IV, UVDtact Sec. III, Pestell et al. Sec. III-A): one-piece open molds (dimples),
+printed skins with pins and their tips, and the boundary strategy's master, mold box and
+inner negative (slots and protrusions). From a part's manifest `params` alone: the body, the
+layer offsets, and per marker set the feature, direction and (polar, azimuth) placements."""
+
+from __future__ import annotations
+
+import math
+
+from . import cq_common as C
+from .cq_molds import drafted_box
+
+# How far a feature solid reaches behind its surface (into material it joins or into empty
+# space it does not touch): any depth above the sagitta of its base disc and below the wall
+# gives the same solid. mm.
+EMBED_MM = 0.1
+
+
+def placements(body: C.Body, ms: dict):
+    """(origin, unit direction) of every feature of the marker set `ms`."""
+    d = ms["surface_offset_mm"]
+    sign = ms["direction"]
+    out = []
+    for polar, az in ms["placements_deg"]:
+        r, z, nr, nz = body.surface_point(d, polar)
+        ca, sa = math.cos(math.radians(az)), math.sin(math.radians(az))
+        out.append(((r * ca, r * sa, z), (sign * nr * ca, sign * nr * sa, sign * nz)))
+    return out
+
+
+def feature_solids(body: C.Body, ms: dict, stems_only: bool):
+    f = ms["feature"]
+    local = (C.stem if stems_only else C.feature)(f["diameter_mm"], f["height_mm"], EMBED_MM)
+    return [C.place_along(local, o, u) for o, u in placements(body, ms)]
+
+
+def with_features(base, body: C.Body, sets: list, sign: float, stems_only: bool = False):
+    """Adds the features pointing out of `base` (direction x sign > 0) and cuts the others."""
+    add, sub = [], []
+    for ms in sets:
+        (add if ms["direction"] * sign > 0 else sub).extend(feature_solids(body, ms, stems_only))
+    s = C.fuse(base, add) if add else base
+    return C.cut(s, sub) if sub else s
+
+
+def enclosed(body: C.Body, d: float, below: float, extra=None):
+    """The solid enclosed by the offset surface `d`, closed `below` mm under the base plane (or
+    by the (r, z) points `extra` after the rim)."""
+    zb = body.base_z()
+    pts = [(body.rim_radius(d), zb)]
+    pts += extra if extra is not None else [(body.rim_radius(d), zb - below), (0.0, zb - below)]
+    return C.revolve(body.curve_edges(d), pts)
+
+
+def marker_sets(base: dict, surface: str) -> list:
+    return [m for m in base["markers"] if m["surface"] == surface]
+
+
+def open_mold(params: dict):
+    base = params["base"]
+    body = C.Body(base["body"])
+    b = params["block_mm"]
+    mold = C.cut(C.box(b["min"], b["max"]), [enclosed(body, base["outer_offset_mm"], 1.0)])
+    return with_features(mold, body, marker_sets(base, "outer"), -1.0)
+
+
+def printed_skin(params: dict, tips: bool):
+    """The printed layer (stems only when its features have separate tips) or its tips."""
+    body = C.Body(params["body"])
+    sets = params["markers"]
+    stems_only = any(m.get("tip_material") for m in sets)
+    if tips:
+        out = []
+        for ms in sets:
+            f = ms["feature"]
+            hc = f["height_mm"] - f["diameter_mm"] / 2.0
+            local = C.hemisphere_tip(f["diameter_mm"])
+            for (x, y, z), u in placements(body, ms):
+                out.append(C.place_along(local, (x + hc * u[0], y + hc * u[1], z + hc * u[2]), u))
+        import cadquery as cq
+        return cq.Compound.makeCompound(out)
+    outer = with_features(enclosed(body, params["outer_offset_mm"], 0.0), body,
+                          marker_sets(params, "outer"), 1.0, stems_only)
+    if params["solid"]:
+        return outer
+    inner = with_features(enclosed(body, params["inner_offset_mm"], 1.0), body,
+                          marker_sets(params, "inner"), 1.0, stems_only)
+    return C.cut(outer, [inner])
+
+
+def boundary_master(params: dict):
+    base, bd = params["base"], params["boundary"]
+    body = C.Body(base["body"])
+    zb = body.base_z()
+    r_p = params["plinth_radius_mm"]
+    z_lo = zb - params["plinth_height_mm"]
+    pin = bd["locating_pin"]
+    master = enclosed(body, base["outer_offset_mm"], 0.0,
+                      [(r_p, zb), (r_p, z_lo), (pin["radius_mm"], z_lo),
+                       (pin["radius_mm"], z_lo - pin["height_mm"]), (0.0, z_lo - pin["height_mm"])])
+    return with_features(master, body, marker_sets(base, "outer"), 1.0)
+
+
+def boundary_box(params: dict):
+    base, bd = params["base"], params["boundary"]
+    body = C.Body(base["body"])
+    z_lo = body.base_z() - params["plinth_height_mm"]
+    return drafted_box(params["plinth_radius_mm"], z_lo, bd["master_top_z_mm"],
+                       params["silicone_wall_mm"], params["draft_angle_deg"], bd["box_floor_mm"],
+                       bd["box_wall_mm"], bd["box_freeboard_mm"], bd["pin_socket_radius_mm"])
+
+
+def boundary_negative(params: dict):
+    base, bd = params["base"], params["boundary"]
+    body = C.Body(base["body"])
+    zb = body.base_z()
+    r = params["plinth_radius_mm"] - params["fit_clearance_mm"]
+    z_b = bd["inner_plinth_bottom_z_mm"]
+    core = with_features(enclosed(body, base["inner_offset_mm"], 0.0, [(r, zb), (r, z_b), (0.0, z_b)]),
+                         body, marker_sets(base, "inner"), 1.0)
+    cup = bd["cup"]
+    return C.cut(C.cylinder_z(cup["radius_mm"], cup["bottom_z_mm"], cup["top_z_mm"]), [core])

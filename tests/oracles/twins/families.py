@@ -1,0 +1,28 @@
+"""Part families of the report (no CadQuery needed)."""
+
+
+def family(part: dict) -> str:
+    """The part family the report groups rows by."""
+    role, name, params = part["role"], part["name"], part["params"]
+    if role in ("master_pattern", "mold_box"):
+        return "master patterns and mold boxes" if "master" in params else \
+            "master patterns and mold boxes (boundary)"
+    if role == "negative_mold":
+        return "slot molds (inner negatives)"
+    if role in ("mold_half", "core_holder", "casting_jig"):
+        return "two-piece molds" if role == "mold_half" else "core holders / casting jigs"
+    if role == "open_mold":
+        return "dimple molds"
+    if role == "printed_skin":
+        return "layer shells"
+    if role == "marker_tips":
+        return "pin tips"
+    if role == "shell_half":
+        return "housings"
+    if role == "indenter":
+        return "indenters"
+    if name == "pin_dome" or role == "calibration pin":
+        return "pin-hole domes and pins"
+    if name.startswith("semidome"):
+        return "semi-domes"
+    return role
