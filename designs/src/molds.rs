@@ -715,13 +715,16 @@ fn material_for(t: PrintTechnology) -> &'static str {
     }
 }
 
+/// A solid in print orientation with its `T_print_sensor`.
+type Posed = (Solid, Affine);
+
 /// The two halves of a direct mold, each in print orientation (parting face up).
 fn direct_halves(
     design: &Design,
     f: &MoldFrame,
     cavity: &Solid,
     tol: ChordTolerance,
-) -> Result<((Solid, Affine), (Solid, Affine)), crate::geometry::GeometryError> {
+) -> Result<(Posed, Posed), crate::geometry::GeometryError> {
     let m = &design.mold;
     let b = f.plinth_radius_mm + m.flange_width_mm;
     let z_lo = f.open_face_z_mm;
