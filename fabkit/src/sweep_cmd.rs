@@ -67,6 +67,7 @@ impl KitWriter for ExportWriter {
             formats: Formats {
                 stl: job.files.stl,
                 threemf: job.files.threemf,
+                step: false,
             },
             command_line: self.command_line.clone(),
             design_source: job.design_source.clone(),
