@@ -395,12 +395,12 @@ fn sweep_file_errors_stop_before_anything_is_written() {
     let s = write_sweep(
         d,
         "bad.yaml",
-        "base: shadowtac\nvary:\n  markers.spacing_mm: {range: [1.2, 2.0, 0.2]}\n",
+        "base: shadowtac\nvary:\n  markers.spacing: {range: [1.2, 2.0, 0.2]}\n",
     );
     let o = run(d, &["sweep", &s, "--out", "out"], &[]);
     assert_eq!(o.status.code(), Some(2));
     assert!(
-        text(&o.stderr).contains("bad.yaml:3:3: vary: 'markers.spacing_mm' is not a parameter path of design 'shadowtac'; nearest: layers[0].markers[0].pattern.spacing_mm"),
+        text(&o.stderr).contains("bad.yaml:3:3: vary: 'markers.spacing' is not a parameter path of design 'shadowtac'; nearest: layers[0].markers[0].pattern.spacing_mm"),
         "{}",
         text(&o.stderr)
     );
