@@ -263,15 +263,23 @@ pub fn parse_point_table(
 /// # Errors
 /// [`TableError`] naming file:line and the column; a duplicate id names both places.
 pub fn read_observations(paths: &[&Path]) -> Result<Observations, TableError> {
-    let mut texts = Vec::new();
-    for p in paths {
-        texts.push(read(p)?);
-    }
+    with_texts(paths, parse_observations)
+}
+
+/// Reads every file, then parses their (text, file name) pairs in order.
+fn with_texts<T>(
+    paths: &[&Path],
+    parse: impl FnOnce(&[(&str, &str)]) -> Result<T, TableError>,
+) -> Result<T, TableError> {
+    let texts = paths
+        .iter()
+        .map(|p| read(p))
+        .collect::<Result<Vec<_>, _>>()?;
     let refs: Vec<(&str, &str)> = texts
         .iter()
         .map(|(f, t)| (t.as_str(), f.as_str()))
         .collect();
-    parse_observations(&refs)
+    parse(&refs)
 }
 
 /// Parses observation texts given as (text, file name) pairs. See [`read_observations`].
@@ -430,15 +438,7 @@ pub fn read_captures(
     paths: &[&Path],
     plan: &CapturePlan,
 ) -> Result<(Observations, Vec<String>), TableError> {
-    let mut texts = Vec::new();
-    for p in paths {
-        texts.push(read(p)?);
-    }
-    let refs: Vec<(&str, &str)> = texts
-        .iter()
-        .map(|(f, t)| (t.as_str(), f.as_str()))
-        .collect();
-    parse_captures(&refs, plan)
+    with_texts(paths, |refs| parse_captures(refs, plan))
 }
 
 /// [`read_captures`] on (text, file name) pairs.

@@ -153,21 +153,7 @@ impl StagedDir {
     /// # Errors
     /// [`ExportError::InvalidOption`] for a bad path or one written twice, [`ExportError::Io`].
     pub fn write(&self, rel: &str, bytes: &[u8]) -> Result<(), ExportError> {
-        let ok = !rel.is_empty()
-            && rel.split('/').all(|c| {
-                !c.is_empty()
-                    && c != "."
-                    && c != ".."
-                    && c.chars()
-                        .all(|ch| ch.is_ascii_alphanumeric() || "_.-".contains(ch))
-            });
-        if !ok {
-            return Err(ExportError::InvalidOption {
-                field: "file",
-                value: rel.to_string(),
-                rule: "must be a relative path of [A-Za-z0-9_.-] components",
-            });
-        }
+        check_relative_path("file", rel)?;
         let path = rel.split('/').fold(self.tmp.clone(), |p, c| p.join(c));
         if let Some(dir) = path.parent() {
             fs::create_dir_all(dir).map_err(ExportError::io("creating", dir))?;
@@ -212,6 +198,31 @@ impl Drop for StagedDir {
         if !self.done {
             let _ = fs::remove_dir_all(&self.tmp);
         }
+    }
+}
+
+/// A file path inside an output folder: relative, `/`-separated, each component made of
+/// `[A-Za-z0-9_.-]` and neither `.` nor `..`.
+///
+/// # Errors
+/// [`ExportError::InvalidOption`] naming `field` and the path.
+pub(crate) fn check_relative_path(field: &'static str, rel: &str) -> Result<(), ExportError> {
+    let ok = !rel.is_empty()
+        && rel.split('/').all(|c| {
+            !c.is_empty()
+                && c != "."
+                && c != ".."
+                && c.chars()
+                    .all(|ch| ch.is_ascii_alphanumeric() || "_.-".contains(ch))
+        });
+    if ok {
+        Ok(())
+    } else {
+        Err(ExportError::InvalidOption {
+            field,
+            value: rel.to_string(),
+            rule: "must be a relative path of [A-Za-z0-9_.-] components",
+        })
     }
 }
 

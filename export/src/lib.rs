@@ -135,21 +135,7 @@ pub fn write_kit_with_files(
     opts: &ExportOptions,
 ) -> Result<ExportSummary, ExportError> {
     for (rel, _) in data_files {
-        let ok = !rel.is_empty()
-            && rel.split('/').all(|c| {
-                !c.is_empty()
-                    && c != "."
-                    && c != ".."
-                    && c.chars()
-                        .all(|ch| ch.is_ascii_alphanumeric() || "_.-".contains(ch))
-            });
-        if !ok {
-            return Err(ExportError::InvalidOption {
-                field: "data_files",
-                value: rel.clone(),
-                rule: "must be a relative path of [A-Za-z0-9_.-] components",
-            });
-        }
+        atomic::check_relative_path("data_files", rel)?;
     }
     let meshes: Vec<Mesh> = kit.parts.iter().map(|p| p.written_mesh()).collect();
     write_kit_meshes(kit, &meshes, data_files, out_dir, opts)
