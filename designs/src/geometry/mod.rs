@@ -15,10 +15,14 @@ pub use solid::{csg_json, rotation_deg, Affine, CsgNode, GeometryError, Solid};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
-/// The largest distance between a facet and the true surface it approximates, mm (> 0).
+/// The largest distance between an exported mesh and the exact solid it approximates, mm (> 0).
 ///
-/// Primitives and revolves split it between the profile direction and the circumferential
-/// direction (half each), so a facet of a surface of revolution stays within the tolerance.
+/// Every faceted surface is meshed to [`ChordTolerance::facet_mm`] = tol / sqrt(2), so that
+/// where two such surfaces meet at an edge (a boolean seam) with an angle of 90 deg or wider on
+/// either side, the mesh corner stays within tol of the exact edge: two facets each within d of
+/// their surfaces meet up to d / sin(beta / 2) from the exact edge, sqrt(2) d at beta = 90 deg.
+/// Primitives and revolves split the facet deviation between the profile direction and the
+/// circumferential direction (half each), so a facet of a surface of revolution stays within it.
 #[derive(Debug, Clone, Copy, PartialEq, PartialOrd, Serialize, Deserialize)]
 #[serde(try_from = "f64", into = "f64")]
 pub struct ChordTolerance(f64);
@@ -44,14 +48,21 @@ impl ChordTolerance {
         self.0
     }
 
+    /// The deviation each faceted surface is meshed to, mm: tol / sqrt(2) (see the type's doc:
+    /// it keeps boolean seams of 90 deg or wider within tol).
+    pub fn facet_mm(self) -> f64 {
+        self.0 * std::f64::consts::FRAC_1_SQRT_2
+    }
+
     /// Number of segments of a full circle of radius `radius_mm` whose chords stay within
-    /// `self` of the circle: the smallest multiple of 4 (so that the planes x = 0 and y = 0
-    /// pass through vertices) with `r (1 - cos(pi / n)) <= tol`, and at least 8.
+    /// [`Self::facet_mm`] of the circle: the smallest multiple of 4 (so that the planes x = 0
+    /// and y = 0 pass through vertices) with `r (1 - cos(pi / n)) <= facet_mm`, and at least 8.
     pub fn circle_segments(self, radius_mm: f64) -> usize {
-        if radius_mm <= self.0 {
+        let d = self.facet_mm();
+        if radius_mm <= d {
             return 8;
         }
-        let half_angle = (1.0 - self.0 / radius_mm).acos();
+        let half_angle = (1.0 - d / radius_mm).acos();
         let n = (PI / half_angle).ceil() as usize;
         n.max(8).div_ceil(4) * 4
     }
@@ -285,11 +296,12 @@ mod tests {
         for &(r, tol) in &[(15.0, 0.01), (1.0, 0.001), (100.0, 0.05), (0.5, 0.01)] {
             let t = ChordTolerance::new(tol).unwrap();
             let n = t.circle_segments(r);
+            let d = tol / 2f64.sqrt();
             assert_eq!(n % 4, 0);
-            assert!(r * (1.0 - (PI / n as f64).cos()) <= tol * (1.0 + 1e-12));
+            assert!(r * (1.0 - (PI / n as f64).cos()) <= d * (1.0 + 1e-12));
             // and not wastefully many: n - 4 segments would break the tolerance (or hit the floor of 8)
             if n > 8 {
-                assert!(r * (1.0 - (PI / (n - 4) as f64).cos()) > tol);
+                assert!(r * (1.0 - (PI / (n - 4) as f64).cos()) > d);
             }
         }
     }

@@ -34,7 +34,7 @@ impl Polyline2 {
 
 /// Appends a circular arc about `center` of radius `radius` from angle `a0` to `a1` (radians,
 /// measured from the +r axis towards +z), endpoints included, with uniform segments whose
-/// sagitta is within `tol`.
+/// sagitta is within `tol.facet_mm()`.
 pub fn push_arc(
     pl: &mut Polyline2,
     center: [f64; 2],
@@ -63,7 +63,8 @@ pub fn push_arc(
 }
 
 /// Appends the curve `f(t)` for t in [t0, t1], endpoints included, bisecting parameter intervals
-/// until every sampled point of a sub-curve is within `tol` of its chord. Deterministic.
+/// until every sampled point of a sub-curve is within `tol.facet_mm()` of its chord.
+/// Deterministic.
 ///
 /// `f` must be smooth on the interval; the check samples 8 interior points per chord, which
 /// bounds the error for curves whose curvature varies slowly across one chord (all the
@@ -113,7 +114,7 @@ pub fn push_curve(
     for i in 0..4 {
         let s0 = t0 + (t1 - t0) * i as f64 / 4.0;
         let s1 = t0 + (t1 - t0) * (i + 1) as f64 / 4.0;
-        rec(pl, f, s0, s1, tol.mm(), 0);
+        rec(pl, f, s0, s1, tol.facet_mm(), 0);
     }
 }
 

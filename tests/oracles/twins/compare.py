@@ -7,19 +7,16 @@ Bounds, for a part written at chord tolerance `tol` (mm):
   (every facet lies within tol of the true surface, so the enclosed volumes differ by at most the
   area times tol; the second term covers the f32 rounding of the written vertices);
 - volume vs manifold3d (same leaf meshes, same booleans): relative difference <= 1e-6;
-- symmetric Hausdorff distance <= tol + 1 um (0.001 mm), over the faces of the exact solid;
-  at its edges where faces meet (seams), <= sqrt(2) x tol + 1 um: two surfaces each meshed
-  within tol meet in a mesh corner up to tol / sin(beta / 2) from the exact edge, beta the
-  material-side angle between them (sqrt(2) tol for perpendicular faces); the seam distance is
-  reported separately and this wider bound is a documented limit of mesh booleans, not of the
-  twin;
+- symmetric Hausdorff distance <= tol + 1 um (0.001 mm), over the faces of the exact solid and
+  at its edges where faces meet (seams). fabkit meshes every surface to tol / sqrt(2) (see
+  `ChordTolerance::facet_mm`) because two surfaces each meshed within d meet in a mesh corner up
+  to d / sin(beta / 2) from the exact edge (beta the angle between them, sqrt(2) d for
+  perpendicular faces); the seam distance is reported in its own column, with the same bound;
 - bounding box: every face of the box within tol + 1 um;
 - genus: equal (exact solid: from its tessellation with OCCT's zero-area pole facets dropped).
 """
 
 from __future__ import annotations
-
-import math
 
 import numpy as np
 
@@ -28,10 +25,6 @@ UM = 1e-3  # mm
 
 def hausdorff_bound(tol: float) -> float:
     return tol + UM
-
-
-def seam_bound(tol: float) -> float:
-    return math.sqrt(2.0) * tol + UM
 
 
 def weld(v: np.ndarray, f: np.ndarray):
