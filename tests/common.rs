@@ -111,6 +111,11 @@ impl Drop for SlicerSlot {
 
 /// `printcheck --strict` on each file, two at a time, every failure reported together.
 pub fn printcheck_all(files: &[PathBuf]) {
+    printcheck_all_with(files, &[]);
+}
+
+/// [`printcheck_all`] with extra printcheck flags (e.g. `--no-fdm` for resin and PolyJet parts).
+pub fn printcheck_all_with(files: &[PathBuf], flags: &[&str]) {
     let Some(pc) = printcheck() else {
         return missing("printcheck (prusa-slicer + admesh)");
     };
@@ -126,6 +131,7 @@ pub fn printcheck_all(files: &[PathBuf]) {
                 let o = std::process::Command::new("bash")
                     .arg(&pc)
                     .arg("--strict")
+                    .args(flags)
                     .arg(&f)
                     .output();
                 drop(slot);
@@ -150,7 +156,8 @@ pub fn printcheck_all(files: &[PathBuf]) {
         .collect();
     assert!(
         failures.is_empty(),
-        "printcheck --strict failed on {} of {} files:\n{}",
+        "printcheck --strict {} failed on {} of {} files:\n{}",
+        flags.join(" "),
         failures.len(),
         files.len(),
         failures.join("\n")
