@@ -185,7 +185,7 @@ pub fn solve_pnp(
             );
             if consensus.count() == n {
                 fit.refine(camera, points_mm, pixels_px, opts.max_iterations);
-                consensus.from_fit(&fit, thr2);
+                consensus.set_from_fit(&fit, thr2);
             }
             if consensus.count() < n {
                 hypotheses = ransac(
@@ -389,7 +389,7 @@ impl Consensus {
     }
 
     /// The consensus of a fit made on every pair, from its own residuals.
-    fn from_fit(&mut self, fit: &Fit, thr2: f64) {
+    fn set_from_fit(&mut self, fit: &Fit, thr2: f64) {
         let mut s = 0.0;
         for (k, &i) in fit.idx.iter().enumerate() {
             let e2 = fit.residuals[k].norm_squared();

@@ -284,6 +284,45 @@ impl MeshCaster {
         self.cast_tiles(rays, tiles, t_max_mm, out);
     }
 
+    /// The pixels whose rays can reach the mesh: every active pixel (a finite direction) of the
+    /// tiles whose bounding planes meet one of the hierarchy's boxes three levels below the
+    /// root (up to 64 boxes, one per protrusion or tighter). Conservative: a ray outside this
+    /// set cannot hit the mesh. In tile order; the rest of a frame keeps its reference depth.
+    pub fn reachable_pixels(&self, rays: &PixelRays) -> Vec<u32> {
+        const DEPTH: u32 = 3;
+        let mut out = Vec::new();
+        if self.nodes.is_empty() {
+            return out;
+        }
+        let tiles = rays.tiles();
+        let o = tiles.origin;
+        let mut stack: Vec<(u32, u32)> = Vec::with_capacity(64);
+        for tile in &tiles.tiles {
+            let mut reach = !tile.valid;
+            if !reach && tile.overlaps(self.root_lo, self.root_hi, o) {
+                stack.clear();
+                stack.push((0, 1));
+                'walk: while let Some((ni, depth)) = stack.pop() {
+                    let node = &self.nodes[ni as usize];
+                    let (ok, _) = tile.test4(node, o, f32::INFINITY);
+                    for k in 0..4 {
+                        if ok[k] {
+                            if node.count[k] > 0 || depth >= DEPTH {
+                                reach = true;
+                                break 'walk;
+                            }
+                            stack.push((node.child[k], depth + 1));
+                        }
+                    }
+                }
+            }
+            if reach {
+                out.extend((0..LANES).filter(|&l| tile.active[l]).map(|l| tile.pix[l]));
+            }
+        }
+        out
+    }
+
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
     unsafe fn cast_tiles_avx2(
