@@ -1,4 +1,4 @@
-//! Cross-verification twins (issue 7): every part of every library design and of the R-Tac0
+//! Cross-verification twins (issue 7): every part of every library design and of its
 //! fixtures, against the manifold3d twin (fast tier, every test run) and the exact CadQuery
 //! twin (full tier: when `FABKIT_CADQUERY_PYTHON` is set, as `.ci/run` does after
 //! `scripts/setup-cadquery`), plus `fabkit export --format step` read back by CadQuery.
@@ -14,13 +14,14 @@ use std::process::Command;
 
 /// The exports the twins check: (output folder, fabkit arguments).
 const CASES: &[(&str, &[&str])] = &[
+    // the slowest first: check_twins spreads the exports over the CPUs in this order
+    ("shadowtac", &["export", "shadowtac"]),
+    ("uvdtact", &["export", "uvdtact"]),
     ("rtac0", &["export", "rtac0"]),
     (
         "rtac0_direct",
         &["export", "rtac0", "--mold-strategy", "direct"],
     ),
-    ("shadowtac", &["export", "shadowtac"]),
-    ("uvdtact", &["export", "uvdtact"]),
     ("tactip_dualmodal", &["export", "tactip_dualmodal"]),
     (
         "rtac0_fixtures",
@@ -32,6 +33,13 @@ const CASES: &[(&str, &[&str])] = &[
             "--semidomes",
             "3",
         ],
+    ),
+    // the default fixtures of the other bodies (spherical cap, half-ellipsoid, TacTip dome)
+    ("shadowtac_fixtures", &["fixtures", "shadowtac"]),
+    ("uvdtact_fixtures", &["fixtures", "uvdtact"]),
+    (
+        "tactip_dualmodal_fixtures",
+        &["fixtures", "tactip_dualmodal"],
     ),
 ];
 

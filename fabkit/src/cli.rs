@@ -59,7 +59,7 @@ struct ExportArgs {
     /// needs scripts/setup-cadquery or FABKIT_CADQUERY_PYTHON).
     #[arg(long, value_delimiter = ',', default_value = "stl,3mf")]
     format: Vec<Format>,
-    /// Largest distance between a facet and the true surface, mm.
+    /// Largest distance between the exported meshes and the exact solids, mm (seams included).
     #[arg(long, default_value_t = ChordTolerance::DEFAULT_MM)]
     chord_tolerance_mm: f64,
     /// Apply one of the design's presets (see `fabkit designs`); the kit is named

@@ -33,7 +33,7 @@ pub struct FixturesArgs {
     /// Mesh formats, comma separated.
     #[arg(long, value_delimiter = ',', default_value = "stl,3mf")]
     format: Vec<Format>,
-    /// Largest distance between a facet and the true surface, mm.
+    /// Largest distance between the exported meshes and the exact solids, mm (seams included).
     #[arg(long, default_value_t = ChordTolerance::DEFAULT_MM)]
     chord_tolerance_mm: f64,
     /// Also write the CSG tree of every part (fabkit-csg/1 JSON) to this file, for the

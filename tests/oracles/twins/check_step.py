@@ -37,9 +37,7 @@ def main(argv=None) -> int:
     exact = {}
     if args.exact_json:
         for r in json.loads(args.exact_json.read_text()):
-            # rows checked on a sample (cq_twin.sampling) hold the sample's volume, not the part's
-            if (r.get("volume_exact_mm3") is not None and r["design"] == args.export.name
-                    and not r.get("sample")):
+            if r.get("volume_exact_mm3") is not None and r["design"] == args.export.name:
                 exact[r["part"]] = r["volume_exact_mm3"]
     bad = 0
     for part in man["parts"]:

@@ -34,24 +34,3 @@ def replay(csg_path: Path) -> dict:
                           # fabkit counts genus as shells - chi / 2; manifold3d as 1 - chi / 2
                           "genus": int(m.genus()) + len(m.decompose()) - 1, "mesh": (v, f)}
     return out
-
-
-def clip_to_wedge(v, f, sample: dict, T_print_sensor):
-    """The mesh (print frame) cut to the sampled wedge of azimuths about the sensor axis
-    (cq_twin.sampling), by manifold3d: (vertices, triangles, genus as fabkit counts it)."""
-    import math
-    lo, hi = (math.radians(a) for a in sample["wedge_deg"])
-    size = 1000.0
-    mid = 0.5 * (lo + hi)
-    far = size / math.cos(0.5 * (hi - lo))
-    pts = [(0.0, 0.0), (far * math.cos(lo), far * math.sin(lo)),
-           (size * 2 * math.cos(mid), size * 2 * math.sin(mid)), (far * math.cos(hi), far * math.sin(hi))]
-    w = manifold3d.Manifold.extrude(manifold3d.CrossSection([pts]), 2 * size).translate((0, 0, -size))
-    w = w.transform(np.asarray(T_print_sensor, dtype=np.float64))
-    m = manifold3d.Manifold(manifold3d.Mesh64(vert_properties=np.ascontiguousarray(v, dtype=np.float64),
-                                              tri_verts=np.ascontiguousarray(f, dtype=np.uint64)))
-    c = m ^ w
-    g = c.to_mesh64()
-    genus = int(c.genus()) + len(c.decompose()) - 1
-    return (np.array(np.asarray(g.vert_properties, dtype=np.float64)[:, :3]),
-            np.array(g.tri_verts, dtype=np.int64), genus)
