@@ -102,6 +102,14 @@ pub fn path_exists(design: &Design, path: &str) -> bool {
     })
 }
 
+/// The keys of a parameter path without its list indices: `layers[0].markers` -> [layers, markers].
+fn path_keys(p: &str) -> Vec<String> {
+    p.split(['.', '[', ']'])
+        .filter(|k| !k.is_empty() && !k.chars().all(|c| c.is_ascii_digit()))
+        .map(str::to_owned)
+        .collect()
+}
+
 /// The one parameter path that a short path abbreviates, if there is exactly one: its keys
 /// appear in order in the full path and the last keys are equal, so the issue's
 /// `markers.spacing_mm` stands for `layers[0].markers[0].pattern.spacing_mm` on a design with
@@ -111,16 +119,10 @@ pub fn expand_short_path(design: &Design, path: &str) -> Option<String> {
     if path.contains('[') {
         return None;
     }
-    let keys = |p: &str| -> Vec<String> {
-        p.split(['.', '[', ']'])
-            .filter(|k| !k.is_empty() && !k.chars().all(|c| c.is_ascii_digit()))
-            .map(str::to_owned)
-            .collect()
-    };
-    let asked = keys(path);
+    let asked = path_keys(path);
     let last = asked.last()?;
     let fits = |full: &str| {
-        let k = keys(full);
+        let k = path_keys(full);
         if k.last() != Some(last) {
             return false;
         }
@@ -136,18 +138,12 @@ pub fn expand_short_path(design: &Design, path: &str) -> Option<String> {
 /// key come first (`markers.spacing_mm` finds `layers[0].markers[0].pattern.spacing_mm`), then
 /// by similarity of the last key, then of the keys they share and of the whole string.
 pub fn nearest_paths(design: &Design, path: &str, n: usize) -> Vec<String> {
-    let keys = |p: &str| -> Vec<String> {
-        p.split(['.', '[', ']'])
-            .filter(|k| !k.is_empty() && !k.chars().all(|c| c.is_ascii_digit()))
-            .map(str::to_owned)
-            .collect()
-    };
-    let asked = keys(path);
+    let asked = path_keys(path);
     let last = asked.last().cloned().unwrap_or_default();
     let mut scored: Vec<(f64, String)> = parameter_paths(design)
         .into_iter()
         .map(|p| {
-            let k = keys(&p);
+            let k = path_keys(&p);
             let l = k.last().cloned().unwrap_or_default();
             let last_sim = strsim::normalized_damerau_levenshtein(&last, &l);
             let shared =
