@@ -3,7 +3,9 @@
 //! camera against the R-Tac0 skin with six protrusions, about 200k triangles at 0.00085 mm chord
 //! tolerance. Measured in CPU time of the benchmark thread (the machine is shared), one thread.
 //!
-//! - `full_cast`: every ray against every triangle (skin and protrusions);
+//! - `full_cast`: every ray against every triangle (skin and protrusions; `cast_into`, which
+//!   visits the triangles in leaf order for a whole frame);
+//! - `full_cast_tile_order`: the same cast walking the hierarchy by 8 x 8 pixel tiles;
 //! - `analytic_reference_plus_protrusion_triangles`: the skin in closed form for every ray, then
 //!   the protrusion triangles (the cast skips the tiles that miss the protrusions' box);
 //! - `reachable_rays_only`: only the rays that can reach a protrusion's bounds (tiles meeting a
@@ -11,12 +13,13 @@
 //!   other pixels keep the reference depth, rendered once per camera
 //!   (`BenchScene::protrusion_frame`).
 //!
-//! Not timed: the hierarchy build and the rays and tiles of the camera (once per camera).
+//! Not timed: the hierarchy build and the rays, tiles and cube-face cells of the camera (once
+//! per camera).
 //! Figures and the Open3D comparison: README, "Ground truth: speed".
 
 use criterion::measurement::{Measurement, ValueFormatter};
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use fabkit_calibration::groundtruth::mesh::{FrameHits, Hit};
+use fabkit_calibration::groundtruth::mesh::{CastOrder, FrameHits, Hit};
 use fabkit_calibration::groundtruth::synthetic::{thread_cpu_time_s, BenchScene, FrameScratch};
 
 /// CPU time of the benchmark thread, ns.
@@ -79,6 +82,7 @@ fn bench(c: &mut Criterion<ThreadCpu>) {
     let (all, prot) = scene.casters();
     let rays = &scene.rays;
     rays.tiles();
+    rays.raster();
     let n = rays.len();
     eprintln!(
         "scene: {} triangles (skin {}, protrusions {}), {n} rays",
@@ -97,6 +101,9 @@ fn bench(c: &mut Criterion<ThreadCpu>) {
     g.throughput(Throughput::Elements(n as u64));
     g.bench_function("full_cast", |b| {
         b.iter(|| all.cast_into(rays, &inf, &mut out))
+    });
+    g.bench_function("full_cast_tile_order", |b| {
+        b.iter(|| all.cast_each_in(CastOrder::Tiles, rays, &inf, &mut |_| {}))
     });
     let mut scratch = FrameScratch::default();
     let mut hits: Vec<Hit> = Vec::new();

@@ -8,7 +8,7 @@
 //! FABKIT_GT_PROFILE=full (or =fast) only repeats one cast, for a profiler; FABKIT_GT_KEEP=1
 //! keeps the scene files given to Open3D (for tests/bvh_eval).
 
-use fabkit_calibration::groundtruth::mesh::{FrameHits, Hit};
+use fabkit_calibration::groundtruth::mesh::{CastOrder, FrameHits, Hit, MeshCaster};
 use fabkit_calibration::groundtruth::synthetic::{
     thread_cpu_time_s as cpu, BenchScene, FrameScratch,
 };
@@ -45,10 +45,11 @@ fn main() {
     let rays = &scene.rays;
     let t0 = cpu();
     rays.tiles();
+    rays.raster();
     let tiles = cpu() - t0;
     let n = rays.len();
     println!(
-        "scene: {} triangles (skin {}, protrusions {}) at {tol} mm, {n} rays; hierarchy build {:.0} ms, ray tiles {:.1} ms (once per camera)",
+        "scene: {} triangles (skin {}, protrusions {}) at {tol} mm, {n} rays; hierarchy build {:.0} ms, ray tiles and cube-face cells {:.1} ms (once per camera)",
         all.triangle_count(),
         scene.body_mesh.triangles.len(),
         scene.protrusion_mesh.triangles.len(),
@@ -67,6 +68,25 @@ fn main() {
         all.cast_into(rays, &inf, &mut out);
         full = full.min(cpu() - t0);
     }
+    let mut tiles_order = f64::INFINITY;
+    for _ in 0..reps.min(5) {
+        let t0 = cpu();
+        all.cast_each_in(CastOrder::Tiles, rays, &inf, &mut |_| {});
+        tiles_order = tiles_order.min(cpu() - t0);
+    }
+    let mut prot_orders = [f64::INFINITY; 2];
+    let skin = MeshCaster::new(&scene.body_mesh).cast(rays, &inf).t_mm;
+    for _ in 0..reps.min(5) {
+        for (k, order) in [CastOrder::Tiles, CastOrder::Triangles]
+            .into_iter()
+            .enumerate()
+        {
+            let t0 = cpu();
+            prot.cast_each_in(order, rays, &skin, &mut |_| {});
+            prot_orders[k] = prot_orders[k].min(cpu() - t0);
+        }
+    }
+    println!("orders: full cast in tiles {:.2} ms; protrusions up to the skin: tiles {:.2} ms, triangles {:.2} ms", tiles_order * 1e3, prot_orders[0] * 1e3, prot_orders[1] * 1e3);
     let mut scratch = FrameScratch::default();
     let mut hits: Vec<Hit> = Vec::new();
     let (mut all_rays, mut reachable, mut reference) =

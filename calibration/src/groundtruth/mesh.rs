@@ -11,7 +11,13 @@
 //! `d . (c x a)` have one sign; two triangles sharing an edge compute that edge's value with
 //! opposite signs exactly, so no ray slips between them. The tests run in f32; the distance
 //! of the winning triangle is then recomputed in f64 from the exact vertices (error well
-//! below 1 nm at sensor scale).
+//! below 1 nm at sensor scale). A ray keeps its nearest f32 hit, ties going to the lower
+//! triangle, so the result does not depend on the order of the tests.
+//!
+//! Whole frames go the other way round ([`super::raster`]): every triangle once, against the
+//! rays through it, found by central projection onto a cube face. Same test, same hits, about
+//! twice as fast when most of the frame sees the mesh; the tiles stay faster when it sees
+//! little of it ([`CastOrder`]).
 //!
 //! Why not a crate: see the README section "Ground truth: speed" (the `bvh` and `obvhs`
 //! crates measured on the same scene with single-ray traversal).
@@ -62,6 +68,9 @@ pub struct MeshCaster {
     nodes: Vec<Node4>,
     /// Vertices in leaf order, f32 (a, b, c).
     tri32: Vec<[[f32; 3]; 3]>,
+    /// The same vertices by blocks of eight triangles (a.x, a.y, a.z, b.x, ..., c.z), each
+    /// row one coordinate of the eight: the layout of the triangle-order cast.
+    blocks: Vec<[[f32; 8]; 9]>,
     /// First vertex and unit normal (from the winding) in leaf order, exact.
     tri64: Vec<([f64; 3], [f64; 3])>,
     /// Input index of each triangle in leaf order.
@@ -71,10 +80,6 @@ pub struct MeshCaster {
     root_hi: [f32; 3],
 }
 
-/// The result of a frame cast: per pixel, the distance to the nearest hit (mm; the pixel's
-/// `t_max` where nothing was hit), the hit triangle's index in the input mesh ([`NO_HIT`]),
-/// and its unit normal (from the triangle's winding: outward for a mesh wound counter-clockwise
-/// seen from outside; zero where nothing was hit).
 /// One ray's nearest hit: pixel index, distance (mm), input triangle index, unit normal (from
 /// the winding).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -85,6 +90,23 @@ pub struct Hit {
     pub normal: [f64; 3],
 }
 
+/// How a frame cast visits the mesh. Both orders find the same hits.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CastOrder {
+    /// Triangles when at least a quarter of the rays are cast, tiles otherwise.
+    Auto,
+    /// Tiles of 8 x 8 pixels walk the hierarchy nearest first (culls occluded triangles; best
+    /// when few rays are cast).
+    Tiles,
+    /// Every triangle once, against the rays through it ([`super::raster`]; best for whole
+    /// frames).
+    Triangles,
+}
+
+/// The result of a frame cast: per pixel, the distance to the nearest hit (mm; the pixel's
+/// `t_max` where nothing was hit), the hit triangle's index in the input mesh ([`NO_HIT`]),
+/// and its unit normal (from the triangle's winding: outward for a mesh wound counter-clockwise
+/// seen from outside; zero where nothing was hit).
 #[derive(Debug, Clone, PartialEq)]
 pub struct FrameHits {
     pub t_mm: Vec<f64>,
@@ -192,9 +214,21 @@ impl MeshCaster {
             root_hi = bin[0].max;
             collapse(&bin, 0, &mut nodes);
         }
-        let tri32 = order
+        let tri32: Vec<[[f32; 3]; 3]> = order
             .iter()
             .map(|&i| tris[i as usize].map(|v| v.map(|c| c as f32)))
+            .collect();
+        let blocks = tri32
+            .chunks(8)
+            .map(|ch| {
+                let mut b = [[0.0f32; 8]; 9];
+                for (l, t) in ch.iter().enumerate() {
+                    for (r, row) in b.iter_mut().enumerate() {
+                        row[l] = t[r / 3][r % 3];
+                    }
+                }
+                b
+            })
             .collect();
         let tri64 = order
             .iter()
@@ -208,11 +242,22 @@ impl MeshCaster {
         MeshCaster {
             nodes,
             tri32,
+            blocks,
             tri64,
             index: order,
             root_lo,
             root_hi,
         }
+    }
+
+    /// Vertices in leaf order, f32.
+    pub(super) fn tri32(&self) -> &[[[f32; 3]; 3]] {
+        &self.tri32
+    }
+
+    /// [`tri32`](Self::tri32) by blocks of eight.
+    pub(super) fn tri_blocks(&self) -> &[[[f32; 8]; 9]] {
+        &self.blocks
     }
 
     /// Number of triangles.
@@ -259,17 +304,45 @@ impl MeshCaster {
         });
     }
 
-    /// Like [`cast`](Self::cast), but reports only the rays that hit, through `sink`, in tile
-    /// order (deterministic): cheaper when few rays hit.
+    /// Like [`cast`](Self::cast), but reports only the rays that hit, through `sink`: cheaper
+    /// when few rays hit. The order of the reports is deterministic: by tile when the cast
+    /// walks tiles, by pixel when it visits triangles ([`CastOrder`]; `Auto` picks one from the
+    /// mesh and the rays, see [`cast_each_in`](Self::cast_each_in)).
     ///
     /// # Panics
     /// If `t_max_mm.len() != rays.len()`.
     pub fn cast_each(&self, rays: &PixelRays, t_max_mm: &[f64], sink: &mut dyn FnMut(Hit)) {
+        self.cast_each_in(CastOrder::Auto, rays, t_max_mm, sink);
+    }
+
+    /// [`cast_each`](Self::cast_each) in a given order. Every order gives the same hits
+    /// (distances, triangles and normals, bit for bit); only the order of the reports differs.
+    /// `Auto` visits triangles when the mesh has no more triangles than there are cast rays in
+    /// the tiles that meet the hierarchy's boxes two levels down, tiles otherwise.
+    ///
+    /// # Panics
+    /// If `t_max_mm.len() != rays.len()`.
+    pub fn cast_each_in(
+        &self,
+        order: CastOrder,
+        rays: &PixelRays,
+        t_max_mm: &[f64],
+        sink: &mut dyn FnMut(Hit),
+    ) {
         assert_eq!(t_max_mm.len(), rays.len(), "one t_max per ray");
         if self.nodes.is_empty() {
             return;
         }
         let out = sink;
+        let triangles = match order {
+            CastOrder::Tiles => false,
+            CastOrder::Triangles => true,
+            CastOrder::Auto => self.triangle_order_pays(rays, t_max_mm),
+        };
+        if triangles {
+            self.cast_raster(rays, t_max_mm, out);
+            return;
+        }
         let tiles = rays.tiles();
         #[cfg(target_arch = "x86_64")]
         {
@@ -284,15 +357,40 @@ impl MeshCaster {
         self.cast_tiles(rays, tiles, t_max_mm, out);
     }
 
+    /// Whether the triangle order is the faster one for this cast: when the mesh has no more
+    /// triangles than there are cast rays in the tiles that meet the hierarchy's boxes two
+    /// levels down (counted on four rays per tile). Tiles win when few rays are cast or the
+    /// mesh covers little of the frame (they skip the rest); triangles win on whole frames
+    /// (README, "Ground truth: speed").
+    fn triangle_order_pays(&self, rays: &PixelRays, t_max: &[f64]) -> bool {
+        let mut reach = 0usize;
+        self.for_reaching_tiles(rays, 2, &mut |tile| {
+            let cast = [0, 27, 36, 63]
+                .iter()
+                .filter(|&&l| tile.pix[l] != NO_HIT && t_max[tile.pix[l] as usize] > 0.0)
+                .count();
+            reach += cast * LANES / 4;
+        });
+        self.triangle_count() <= reach
+    }
+
     /// The pixels whose rays can reach the mesh: every active pixel (a finite direction) of the
     /// tiles whose bounding planes meet one of the hierarchy's boxes three levels below the
     /// root (up to 64 boxes, one per protrusion or tighter). Conservative: a ray outside this
     /// set cannot hit the mesh. In tile order; the rest of a frame keeps its reference depth.
     pub fn reachable_pixels(&self, rays: &PixelRays) -> Vec<u32> {
-        const DEPTH: u32 = 3;
         let mut out = Vec::new();
+        self.for_reaching_tiles(rays, 3, &mut |tile| {
+            out.extend((0..LANES).filter(|&l| tile.active[l]).map(|l| tile.pix[l]));
+        });
+        out
+    }
+
+    /// Calls `f` on every tile whose bounding planes meet one of the hierarchy's boxes
+    /// `depth` levels below the root (or a leaf above them), in tile order.
+    fn for_reaching_tiles(&self, rays: &PixelRays, depth: u32, f: &mut dyn FnMut(&Tile)) {
         if self.nodes.is_empty() {
-            return out;
+            return;
         }
         let tiles = rays.tiles();
         let o = tiles.origin;
@@ -302,25 +400,24 @@ impl MeshCaster {
             if !reach && tile.overlaps(self.root_lo, self.root_hi, o) {
                 stack.clear();
                 stack.push((0, 1));
-                'walk: while let Some((ni, depth)) = stack.pop() {
+                'walk: while let Some((ni, d)) = stack.pop() {
                     let node = &self.nodes[ni as usize];
                     let (ok, _) = tile.test4(node, o, f32::INFINITY);
                     for k in 0..4 {
                         if ok[k] {
-                            if node.count[k] > 0 || depth >= DEPTH {
+                            if node.count[k] > 0 || d >= depth {
                                 reach = true;
                                 break 'walk;
                             }
-                            stack.push((node.child[k], depth + 1));
+                            stack.push((node.child[k], d + 1));
                         }
                     }
                 }
             }
             if reach {
-                out.extend((0..LANES).filter(|&l| tile.active[l]).map(|l| tile.pix[l]));
+                f(tile);
             }
         }
-        out
     }
 
     #[cfg(target_arch = "x86_64")]
@@ -343,7 +440,6 @@ impl MeshCaster {
         t_max: &[f64],
         out: &mut dyn FnMut(Hit),
     ) {
-        let o64 = rays.origin_mm;
         let o = tiles.origin;
         let mut stack: Vec<(u32, u32, f32)> = Vec::with_capacity(256);
         let mut pkt = Packet {
@@ -379,23 +475,96 @@ impl MeshCaster {
             }
             self.traverse(&mut pkt, tile, o, &mut stack);
             for l in 0..LANES {
-                let k = pkt.hit[l];
-                if k == NO_HIT {
-                    continue;
+                self.emit(rays, tile.pix[l], pkt.hit[l], t_max, out);
+            }
+        }
+    }
+
+    /// Reports the hit of leaf-order triangle `k` (if any) on pixel `p`, with its distance
+    /// recomputed in f64 from the exact vertices, if it lies within `(0, t_max)`.
+    #[inline(always)]
+    fn emit(&self, rays: &PixelRays, p: u32, k: u32, t_max: &[f64], out: &mut dyn FnMut(Hit)) {
+        if k == NO_HIT {
+            return;
+        }
+        let p = p as usize;
+        let (a, n) = self.tri64[k as usize];
+        let tt = dot(n, sub(a, rays.origin_mm)) / dot(n, rays.dirs[p]);
+        if tt > 0.0 && tt < t_max[p] {
+            out(Hit {
+                pixel: p,
+                t_mm: tt,
+                triangle: self.index[k as usize],
+                normal: n,
+            });
+        }
+    }
+
+    /// The cast in triangle order ([`super::raster`]), reported by pixel. Triangles that the
+    /// raster leaves to the tiles are tested here, tile by tile.
+    fn cast_raster(&self, rays: &PixelRays, t_max: &[f64], out: &mut dyn FnMut(Hit)) {
+        let tiles = rays.tiles();
+        let o = tiles.origin;
+        let bound = t_max
+            .iter()
+            .map(|&tm| {
+                if tm > 0.0 {
+                    (tm * (1.0 + 1e-5)) as f32
+                } else {
+                    0.0
                 }
-                let p = tile.pix[l] as usize;
-                let (a, n) = self.tri64[k as usize];
-                let tt = dot(n, sub(a, o64)) / dot(n, rays.dirs[p]);
-                if tt > 0.0 && tt < t_max[p] {
-                    out(Hit {
-                        pixel: p,
-                        t_mm: tt,
-                        triangle: self.index[k as usize],
-                        normal: n,
-                    });
+            })
+            .collect();
+        let mut st = self.raster_triangles(rays.raster(), o, bound);
+        if !st.fallback.is_empty() {
+            let mut pkt = Packet {
+                tmax: [0.0; LANES],
+                hit: [NO_HIT; LANES],
+            };
+            for tile in &tiles.tiles {
+                let live = |l: usize| tile.pix[l] != NO_HIT && tile.active[l];
+                for l in 0..LANES {
+                    let p = tile.pix[l] as usize;
+                    (pkt.tmax[l], pkt.hit[l]) = if live(l) {
+                        (st.tmax[p], st.hit[p])
+                    } else {
+                        (0.0, NO_HIT)
+                    };
+                }
+                for &k in &st.fallback {
+                    self.test_triangle_dispatch(&mut pkt, tile, o, k as usize);
+                }
+                for l in (0..LANES).filter(|&l| live(l)) {
+                    let p = tile.pix[l] as usize;
+                    (st.tmax[p], st.hit[p]) = (pkt.tmax[l], pkt.hit[l]);
                 }
             }
         }
+        for (p, &k) in st.hit.iter().enumerate() {
+            self.emit(rays, p as u32, k, t_max, out);
+        }
+    }
+
+    /// [`test_triangle`](Self::test_triangle) with the CPU's fused multiply-add when it has one
+    /// (the same results either way).
+    fn test_triangle_dispatch(&self, pkt: &mut Packet, tile: &Tile, o: [f32; 3], k: usize) {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::arch::is_x86_feature_detected!("avx2")
+                && std::arch::is_x86_feature_detected!("fma")
+            {
+                // SAFETY: the CPU supports the features the function is compiled for.
+                unsafe { self.test_triangle_avx2(pkt, tile, o, k) };
+                return;
+            }
+        }
+        self.test_triangle(pkt, tile, o, k);
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn test_triangle_avx2(&self, pkt: &mut Packet, tile: &Tile, o: [f32; 3], k: usize) {
+        self.test_triangle(pkt, tile, o, k);
     }
 
     #[inline(always)]
@@ -554,7 +723,9 @@ fn test_row(
     for i in 0..TW {
         let den = dz[i].mul_add(n[2], dy[i].mul_add(n[1], dx[i] * n[0]));
         let tt = num / den;
-        let h = inside[i] & (tt > 0.0) & (tt < tmax[i]);
+        // Ties go to the lower triangle, so that the result does not depend on the order of
+        // the tests (the triangle-order cast of `raster` gives the same hits).
+        let h = inside[i] & (tt > 0.0) & ((tt < tmax[i]) | ((tt == tmax[i]) & (k < hit[i])));
         tmax[i] = if h { tt } else { tmax[i] };
         hit[i] = if h { k } else { hit[i] };
         changed |= h;
@@ -992,15 +1163,15 @@ fn fmax(a: f32, b: f32) -> f32 {
 }
 
 #[inline(always)]
-fn sub32(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+pub(super) fn sub32(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 #[inline(always)]
-fn dot32(a: [f32; 3], b: [f32; 3]) -> f32 {
+pub(super) fn dot32(a: [f32; 3], b: [f32; 3]) -> f32 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 #[inline(always)]
-fn cross32(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+pub(super) fn cross32(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
     [
         a[1] * b[2] - a[2] * b[1],
         a[2] * b[0] - a[0] * b[2],

@@ -17,6 +17,7 @@
 pub mod exact;
 pub mod inputs;
 pub mod mesh;
+pub mod raster;
 pub mod rays;
 pub mod surface;
 pub mod synthetic;

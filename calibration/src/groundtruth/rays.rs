@@ -25,6 +25,8 @@ pub struct PixelRays {
     pub bearings: Vec<[f64; 3]>,
     /// Tiles for mesh casts, made on first use.
     tiles: std::sync::OnceLock<super::mesh::RayTiles>,
+    /// Rays sorted by cube face and cell for casts in triangle order, made on first use.
+    raster: std::sync::OnceLock<super::raster::RayRaster>,
 }
 
 impl PixelRays {
@@ -62,6 +64,7 @@ impl PixelRays {
             dirs,
             bearings,
             tiles: std::sync::OnceLock::new(),
+            raster: std::sync::OnceLock::new(),
         }
     }
 
@@ -69,6 +72,13 @@ impl PixelRays {
     /// per-camera cost like the unprojection).
     pub fn tiles(&self) -> &super::mesh::RayTiles {
         self.tiles.get_or_init(|| super::mesh::RayTiles::new(self))
+    }
+
+    /// The frame's rays by cube face and cell for casts in triangle order (made once, on first
+    /// use; see [`super::raster`]).
+    pub fn raster(&self) -> &super::raster::RayRaster {
+        self.raster
+            .get_or_init(|| super::raster::RayRaster::new(self))
     }
 
     /// Number of pixels, `width * height`.
