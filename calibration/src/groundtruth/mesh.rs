@@ -297,11 +297,16 @@ impl MeshCaster {
         out.triangle.clear();
         out.triangle.resize(rays.len(), NO_HIT);
         out.normal.resize(rays.len(), [0.0; 3]);
-        self.cast_each(rays, t_max_mm, &mut |h: Hit| {
+        let mut put = |h: Hit| {
             out.t_mm[h.pixel] = h.t_mm;
             out.triangle[h.pixel] = h.triangle;
             out.normal[h.pixel] = h.normal;
-        });
+        };
+        if !self.nodes.is_empty() && self.triangle_order_pays(rays, t_max_mm) {
+            self.cast_raster(rays, t_max_mm, &mut put);
+        } else {
+            self.cast_each_in(CastOrder::Tiles, rays, t_max_mm, &mut put);
+        }
     }
 
     /// Like [`cast`](Self::cast), but reports only the rays that hit, through `sink`: cheaper
@@ -457,9 +462,7 @@ impl MeshCaster {
                 let p = tile.pix[l];
                 let tm = if p != NO_HIT { t_max[p as usize] } else { 0.0 };
                 if tm > 0.0 && tile.active[l] {
-                    // Slightly beyond t_max in f32 so that a hit just short of it is decided in
-                    // f64 below.
-                    pkt.tmax[l] = (tm * (1.0 + 1e-5)) as f32;
+                    pkt.tmax[l] = f32_bound(tm);
                     any = true;
                 } else {
                     pkt.tmax[l] = 0.0;
@@ -483,7 +486,14 @@ impl MeshCaster {
     /// Reports the hit of leaf-order triangle `k` (if any) on pixel `p`, with its distance
     /// recomputed in f64 from the exact vertices, if it lies within `(0, t_max)`.
     #[inline(always)]
-    fn emit(&self, rays: &PixelRays, p: u32, k: u32, t_max: &[f64], out: &mut dyn FnMut(Hit)) {
+    fn emit<F: FnMut(Hit) + ?Sized>(
+        &self,
+        rays: &PixelRays,
+        p: u32,
+        k: u32,
+        t_max: &[f64],
+        out: &mut F,
+    ) {
         if k == NO_HIT {
             return;
         }
@@ -502,20 +512,10 @@ impl MeshCaster {
 
     /// The cast in triangle order ([`super::raster`]), reported by pixel. Triangles that the
     /// raster leaves to the tiles are tested here, tile by tile.
-    fn cast_raster(&self, rays: &PixelRays, t_max: &[f64], out: &mut dyn FnMut(Hit)) {
+    fn cast_raster<F: FnMut(Hit) + ?Sized>(&self, rays: &PixelRays, t_max: &[f64], out: &mut F) {
         let tiles = rays.tiles();
         let o = tiles.origin;
-        let bound = t_max
-            .iter()
-            .map(|&tm| {
-                if tm > 0.0 {
-                    (tm * (1.0 + 1e-5)) as f32
-                } else {
-                    0.0
-                }
-            })
-            .collect();
-        let mut st = self.raster_triangles(rays.raster(), o, bound);
+        let mut st = self.raster_triangles(rays.raster(), o, t_max);
         if !st.fallback.is_empty() {
             let mut pkt = Packet {
                 tmax: [0.0; LANES],
@@ -525,10 +525,10 @@ impl MeshCaster {
                 let live = |l: usize| tile.pix[l] != NO_HIT && tile.active[l];
                 for l in 0..LANES {
                     let p = tile.pix[l] as usize;
-                    (pkt.tmax[l], pkt.hit[l]) = if live(l) {
-                        (st.tmax[p], st.hit[p])
-                    } else {
-                        (0.0, NO_HIT)
+                    (pkt.tmax[l], pkt.hit[l]) = match live(l) {
+                        true if st.hit[p] != NO_HIT => (st.tmax[p], st.hit[p]),
+                        true => (f32_bound(t_max[p]), NO_HIT),
+                        false => (0.0, NO_HIT),
                     };
                 }
                 for &k in &st.fallback {
@@ -541,7 +541,9 @@ impl MeshCaster {
             }
         }
         for (p, &k) in st.hit.iter().enumerate() {
-            self.emit(rays, p as u32, k, t_max, out);
+            if k != NO_HIT {
+                self.emit(rays, p as u32, k, t_max, out);
+            }
         }
     }
 
@@ -731,6 +733,17 @@ fn test_row(
         changed |= h;
     }
     changed
+}
+
+/// A ray's bound `t_max` (mm) for the f32 tests: slightly beyond it, so that a hit just short
+/// of it is decided in f64 afterwards; 0 (not cast) unless `t_max > 0`.
+#[inline(always)]
+pub(super) fn f32_bound(t_max: f64) -> f32 {
+    if t_max > 0.0 {
+        (t_max * (1.0 + 1e-5)) as f32
+    } else {
+        0.0
+    }
 }
 
 /// Gnomonic-coordinate margin (tangent units) far above the f32 rounding of the tests.
