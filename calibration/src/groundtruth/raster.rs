@@ -339,7 +339,7 @@ impl MeshCaster {
 /// The projected box of a triangle on face `code`, with the margin: `[ulo, uhi, vlo, vhi]`,
 /// or `None` when a vertex is not in front of the face (or the box is not finite).
 fn project(code: usize, p: [[f32; 3]; 3]) -> Option<[f32; 4]> {
-    let (w, sign) = (code / 2, if code % 2 == 0 { 1.0 } else { -1.0 });
+    let (w, sign) = (code / 2, if code & 1 == 0 { 1.0 } else { -1.0 });
     let (iu, iv) = face_axes(w);
     let mut bx = [
         f32::INFINITY,
@@ -422,7 +422,7 @@ fn border(
         let Some(fi) = raster.lookup[code] else {
             continue;
         };
-        let (w, sign) = (code / 2, if code % 2 == 0 { 1.0 } else { -1.0 });
+        let (w, sign) = (code / 2, if code & 1 == 0 { 1.0 } else { -1.0 });
         let (iu, iv) = face_axes(w);
         // Outside the pyramid when every vertex is beyond one of its four planes by more than
         // the edge test's rounding (the margin, scaled by the vertex's size).
