@@ -368,6 +368,11 @@ impl MeshCaster {
     /// mesh covers little of the frame (they skip the rest); triangles win on whole frames
     /// (README, "Ground truth: speed").
     fn triangle_order_pays(&self, rays: &PixelRays, t_max: &[f64]) -> bool {
+        // First the cast rays alone (every 16th counted): no walk when they are too few.
+        let cast = t_max.iter().step_by(16).filter(|&&t| t > 0.0).count() * 16;
+        if self.triangle_count() > cast {
+            return false;
+        }
         let mut reach = 0usize;
         self.for_reaching_tiles(rays, 2, &mut |tile| {
             let cast = [0, 27, 36, 63]

@@ -354,6 +354,10 @@ fn project(code: usize, p: [[f32; 3]; 3]) -> Option<[f32; 4]> {
         }
         let iw = 1.0 / dw;
         let (u, v) = (q[iu] * iw, q[iv] * iw);
+        // (min and max would skip a NaN.)
+        if !(u.is_finite() && v.is_finite()) {
+            return None;
+        }
         bx = [bx[0].min(u), bx[1].max(u), bx[2].min(v), bx[3].max(v)];
     }
     let bx = [
