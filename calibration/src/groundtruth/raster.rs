@@ -35,6 +35,8 @@ use super::rays::PixelRays;
 /// micrometre facets 10 mm away), and a small fraction of a cell (cells are about a pixel,
 /// 5e-3 here).
 const MARGIN: f32 = 3e-4;
+/// Rows of rays per row of cells (cells are one ray wide): fewer, fuller spans per triangle.
+const CELL_ROWS: f32 = 2.0;
 /// Lanes of one span test.
 const W: usize = 8;
 
@@ -57,7 +59,9 @@ pub struct RayRaster {
 struct Face {
     u0: f32,
     v0: f32,
-    inv_h: f32,
+    /// Cells per tangent unit across (u) and down (v).
+    inv_hu: f32,
+    inv_hv: f32,
     nu: usize,
     nv: usize,
     /// First slot of each cell, row by row (`nu * nv + 1` entries).
@@ -114,12 +118,12 @@ impl RayRaster {
             // Cells of about one ray each (the rays' mean spacing).
             let area = ((hi[0] - lo[0]) as f64 * (hi[1] - lo[1]) as f64).max(1e-12);
             let h = (area / reg.len() as f64).sqrt().max(1e-6) as f32;
-            let inv_h = 1.0 / h;
-            let nu = (((hi[0] - lo[0]) * inv_h).floor() as usize + 1).max(1);
-            let nv = (((hi[1] - lo[1]) * inv_h).floor() as usize + 1).max(1);
+            let (inv_hu, inv_hv) = (1.0 / h, 1.0 / (CELL_ROWS * h));
+            let nu = (((hi[0] - lo[0]) * inv_hu).floor() as usize + 1).max(1);
+            let nv = (((hi[1] - lo[1]) * inv_hv).floor() as usize + 1).max(1);
             let cell = |u: f32, v: f32| -> usize {
-                let cu = (((u - lo[0]) * inv_h).floor().max(0.0) as usize).min(nu - 1);
-                let cv = (((v - lo[1]) * inv_h).floor().max(0.0) as usize).min(nv - 1);
+                let cu = (((u - lo[0]) * inv_hu).floor().max(0.0) as usize).min(nu - 1);
+                let cv = (((v - lo[1]) * inv_hv).floor().max(0.0) as usize).min(nv - 1);
                 cv * nu + cu
             };
             let mut start = vec![0u32; nu * nv + 1];
@@ -146,7 +150,8 @@ impl RayRaster {
             faces.push(Face {
                 u0: lo[0],
                 v0: lo[1],
-                inv_h,
+                inv_hu,
+                inv_hv,
                 nu,
                 nv,
                 start,
@@ -390,10 +395,10 @@ fn scan(
     k: u32,
     span: SpanFn,
 ) {
-    let cu0 = ((bx[0] - f.u0) * f.inv_h).floor().max(0.0);
-    let cu1 = ((bx[1] - f.u0) * f.inv_h).floor().min((f.nu - 1) as f32);
-    let cv0 = ((bx[2] - f.v0) * f.inv_h).floor().max(0.0);
-    let cv1 = ((bx[3] - f.v0) * f.inv_h).floor().min((f.nv - 1) as f32);
+    let cu0 = ((bx[0] - f.u0) * f.inv_hu).floor().max(0.0);
+    let cu1 = ((bx[1] - f.u0) * f.inv_hu).floor().min((f.nu - 1) as f32);
+    let cv0 = ((bx[2] - f.v0) * f.inv_hv).floor().max(0.0);
+    let cv1 = ((bx[3] - f.v0) * f.inv_hv).floor().min((f.nv - 1) as f32);
     if !(cu0 <= cu1 && cv0 <= cv1) {
         return;
     }
@@ -493,7 +498,8 @@ mod avx2 {
     pub(super) struct FaceTable {
         u0: [f32; 8],
         v0: [f32; 8],
-        inv_h: [f32; 8],
+        inv_hu: [f32; 8],
+        inv_hv: [f32; 8],
         umax: [f32; 8],
         vmax: [f32; 8],
         /// All ones where the face has rays.
@@ -507,7 +513,8 @@ mod avx2 {
             let mut t = FaceTable {
                 u0: [0.0; 8],
                 v0: [0.0; 8],
-                inv_h: [0.0; 8],
+                inv_hu: [0.0; 8],
+                inv_hv: [0.0; 8],
                 umax: [0.0; 8],
                 vmax: [0.0; 8],
                 present: [0; 8],
@@ -518,7 +525,8 @@ mod avx2 {
                     let f = &r.faces[fi];
                     t.u0[code] = f.u0;
                     t.v0[code] = f.v0;
-                    t.inv_h[code] = f.inv_h;
+                    t.inv_hu[code] = f.inv_hu;
+                    t.inv_hv[code] = f.inv_hv;
                     t.umax[code] = (f.nu - 1) as f32;
                     t.vmax[code] = (f.nv - 1) as f32;
                     t.present[code] = u32::MAX;
@@ -613,12 +621,19 @@ mod avx2 {
             _mm256_castsi256_ps(_mm256_loadu_si256(t.present.as_ptr() as *const __m256i)),
             code,
         );
-        let (u0, v0, ih) = (pick(&t.u0), pick(&t.v0), pick(&t.inv_h));
+        let (u0, v0) = (pick(&t.u0), pick(&t.v0));
+        let (ihu, ihv) = (pick(&t.inv_hu), pick(&t.inv_hv));
         let fl = |x: __m256| _mm256_round_ps::<{ _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC }>(x);
-        let cu0 = _mm256_max_ps(fl(_mm256_mul_ps(_mm256_sub_ps(ulo, u0), ih)), z);
-        let cu1 = _mm256_min_ps(fl(_mm256_mul_ps(_mm256_sub_ps(uhi, u0), ih)), pick(&t.umax));
-        let cv0 = _mm256_max_ps(fl(_mm256_mul_ps(_mm256_sub_ps(vlo, v0), ih)), z);
-        let cv1 = _mm256_min_ps(fl(_mm256_mul_ps(_mm256_sub_ps(vhi, v0), ih)), pick(&t.vmax));
+        let cu0 = _mm256_max_ps(fl(_mm256_mul_ps(_mm256_sub_ps(ulo, u0), ihu)), z);
+        let cu1 = _mm256_min_ps(
+            fl(_mm256_mul_ps(_mm256_sub_ps(uhi, u0), ihu)),
+            pick(&t.umax),
+        );
+        let cv0 = _mm256_max_ps(fl(_mm256_mul_ps(_mm256_sub_ps(vlo, v0), ihv)), z);
+        let cv1 = _mm256_min_ps(
+            fl(_mm256_mul_ps(_mm256_sub_ps(vhi, v0), ihv)),
+            pick(&t.vmax),
+        );
         let cells = _mm256_and_ps(
             _mm256_cmp_ps::<_CMP_LE_OQ>(cu0, cu1),
             _mm256_cmp_ps::<_CMP_LE_OQ>(cv0, cv1),
