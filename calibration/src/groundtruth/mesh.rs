@@ -350,14 +350,10 @@ impl MeshCaster {
         }
         let tiles = rays.tiles();
         #[cfg(target_arch = "x86_64")]
-        {
-            if std::arch::is_x86_feature_detected!("avx2")
-                && std::arch::is_x86_feature_detected!("fma")
-            {
-                // SAFETY: the CPU supports the features the function is compiled for.
-                unsafe { self.cast_tiles_avx2(rays, tiles, t_max_mm, out) };
-                return;
-            }
+        if avx2_fma() {
+            // SAFETY: the CPU supports the features the function is compiled for.
+            unsafe { self.cast_tiles_avx2(rays, tiles, t_max_mm, out) };
+            return;
         }
         self.cast_tiles(rays, tiles, t_max_mm, out);
     }
@@ -562,14 +558,10 @@ impl MeshCaster {
     /// (the same results either way).
     fn test_triangle_dispatch(&self, pkt: &mut Packet, tile: &Tile, o: [f32; 3], k: usize) {
         #[cfg(target_arch = "x86_64")]
-        {
-            if std::arch::is_x86_feature_detected!("avx2")
-                && std::arch::is_x86_feature_detected!("fma")
-            {
-                // SAFETY: the CPU supports the features the function is compiled for.
-                unsafe { self.test_triangle_avx2(pkt, tile, o, k) };
-                return;
-            }
+        if avx2_fma() {
+            // SAFETY: the CPU supports the features the function is compiled for.
+            unsafe { self.test_triangle_avx2(pkt, tile, o, k) };
+            return;
         }
         self.test_triangle(pkt, tile, o, k);
     }
@@ -744,6 +736,13 @@ fn test_row(
         changed |= h;
     }
     changed
+}
+
+/// Whether the CPU has AVX2 and FMA (the vector paths; every path gives the same results).
+#[cfg(target_arch = "x86_64")]
+#[inline]
+pub(super) fn avx2_fma() -> bool {
+    std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
 }
 
 /// A ray's bound `t_max` (mm) for the f32 tests: slightly beyond it, so that a hit just short

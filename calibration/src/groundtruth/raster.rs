@@ -27,6 +27,8 @@
 //! frame of [`super::synthetic::BenchScene::protrusion_frame`]);
 //! [`super::mesh::MeshCaster::cast_each_in`] says how `CastOrder::Auto` chooses.
 
+#[cfg(target_arch = "x86_64")]
+use super::mesh::avx2_fma;
 use super::mesh::{cross32, dot32, f32_bound, sub32, MeshCaster, NO_HIT};
 use super::rays::PixelRays;
 
@@ -219,9 +221,7 @@ impl MeshCaster {
             .collect();
         let mut fallback = Vec::new();
         #[cfg(target_arch = "x86_64")]
-        let done = if std::arch::is_x86_feature_detected!("avx2")
-            && std::arch::is_x86_feature_detected!("fma")
-        {
+        let done = if avx2_fma() {
             // SAFETY: the CPU supports the features the function is compiled for.
             unsafe { self.raster_avx2(raster, o, &mut slots, &mut fallback) };
             true
@@ -844,8 +844,7 @@ mod tests {
         let (mut f1, mut f2) = (Vec::new(), Vec::new());
         all.raster_any(raster, o, &mut s1, &mut f1);
         #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
-        {
+        if avx2_fma() {
             // SAFETY: checked above.
             unsafe { all.raster_avx2(raster, o, &mut s2, &mut f2) };
             assert_eq!(f1, f2);
