@@ -364,8 +364,8 @@ impl MeshCaster {
     /// mesh covers little of the frame (they skip the rest); triangles win on whole frames
     /// (README, "Ground truth: speed").
     fn triangle_order_pays(&self, rays: &PixelRays, t_max: &[f64]) -> bool {
-        // First the cast rays alone (every 16th counted): no walk when they are too few.
-        let cast = t_max.iter().step_by(16).filter(|&&t| t > 0.0).count() * 16;
+        // First the cast rays alone (every 64th counted): no walk when they are too few.
+        let cast = t_max.iter().step_by(64).filter(|&&t| t > 0.0).count() * 64;
         if self.triangle_count() > cast {
             return false;
         }
