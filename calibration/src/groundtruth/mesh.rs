@@ -93,7 +93,8 @@ pub struct Hit {
 /// How a frame cast visits the mesh. Both orders find the same hits.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum CastOrder {
-    /// Triangles when at least a quarter of the rays are cast, tiles otherwise.
+    /// Triangles when the mesh has no more triangles than there are cast rays in its reach,
+    /// tiles otherwise (see [`MeshCaster::cast_each_in`]).
     Auto,
     /// Tiles of 8 x 8 pixels walk the hierarchy nearest first (culls occluded triangles; best
     /// when few rays are cast).
@@ -360,9 +361,9 @@ impl MeshCaster {
 
     /// Whether the triangle order is the faster one for this cast: when the mesh has no more
     /// triangles than there are cast rays in the tiles that meet the hierarchy's boxes two
-    /// levels down (estimated from every fourth tile and four rays per tile). Tiles win when few rays are cast or the
-    /// mesh covers little of the frame (they skip the rest); triangles win on whole frames
-    /// (README, "Ground truth: speed").
+    /// levels down (estimated from every fourth tile and four rays per tile). Tiles win when
+    /// few rays are cast or the mesh covers little of the frame (they skip the rest);
+    /// triangles win on whole frames (README, "Ground truth: speed").
     fn triangle_order_pays(&self, rays: &PixelRays, t_max: &[f64]) -> bool {
         // First the cast rays alone (every 64th counted): no walk when they are too few.
         let cast = t_max.iter().step_by(64).filter(|&&t| t > 0.0).count() * 64;
