@@ -294,17 +294,8 @@ impl MeshCaster {
                     [p.e[6][l], p.e[7][l], p.e[8][l]],
                     [p.e[9][l], p.e[10][l], p.e[11][l]],
                 ];
-                let [cu0, cu1, cv0, cv1] = p.cell.map(|c| c[l] as usize);
-                for cv in cv0..=cv1 {
-                    let row = cv * f.nu;
-                    let (s0, s1) = (f.start[row + cu0] as usize, f.start[row + cu1 + 1] as usize);
-                    let mut s = s0;
-                    while s < s1 {
-                        // SAFETY: as above.
-                        unsafe { avx2::span(f, ss, s, (s1 - s).min(W), &e, p.num[l], k) };
-                        s += W;
-                    }
-                }
+                let cells = p.cell.map(|c| c[l] as usize);
+                scan_cells(f, ss, cells, &e, p.num[l], k, avx2::span_safe);
             }
         }
     }
@@ -402,13 +393,28 @@ fn scan(
     if !(cu0 <= cu1 && cv0 <= cv1) {
         return;
     }
-    let (cu0, cu1, cv0, cv1) = (cu0 as usize, cu1 as usize, cv0 as usize, cv1 as usize);
+    let cells = [cu0, cu1, cv0, cv1].map(|c| c as usize);
+    scan_cells(f, ss, cells, e, *num, k, span);
+}
+
+/// Tests a triangle against the rays of face `f` in cell columns `cells[0]..=cells[1]` of rows
+/// `cells[2]..=cells[3]` (within the grid), a span of up to `W` rays at a time.
+#[inline(always)]
+fn scan_cells(
+    f: &Face,
+    ss: &mut SlotState,
+    [cu0, cu1, cv0, cv1]: [usize; 4],
+    e: &[[f32; 3]; 4],
+    num: f32,
+    k: u32,
+    span: SpanFn,
+) {
     for cv in cv0..=cv1 {
         let row = cv * f.nu;
         let (s0, s1) = (f.start[row + cu0] as usize, f.start[row + cu1 + 1] as usize);
         let mut s = s0;
         while s < s1 {
-            span(f, ss, s, (s1 - s).min(W), e, *num, k);
+            span(f, ss, s, (s1 - s).min(W), e, num, k);
             s += W;
         }
     }
@@ -684,7 +690,7 @@ mod avx2 {
         p
     }
 
-    /// [`span`] for the border triangles of the AVX2 loop (a plain `fn` pointer).
+    /// [`span`] as a plain `fn` pointer for the AVX2 loop's [`super::scan_cells`].
     pub(super) fn span_safe(
         f: &Face,
         ss: &mut SlotState,
