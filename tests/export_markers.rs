@@ -74,43 +74,55 @@ fn printable_files(dir: &Path, m: &Value) -> Vec<PathBuf> {
     files
 }
 
-/// ShadowTac (Sec. IV-A): one SLA open mold whose 0.45 mm recesses only SLA prints; the skin
-/// pour is the dome plus 543 dimples; the published preset has 469.
-#[test]
-fn shadowtac_kits() {
-    let tmp = tempfile::tempdir().unwrap();
-    let (dir, m) = export(tmp.path(), "shadowtac", None);
-    let molds: Vec<&Value> = parts(&m)
-        .iter()
-        .filter(|p| p["role"] == "open_mold")
-        .collect();
-    assert_eq!(molds.len(), 1, "{:?}", parts(&m));
-    assert_eq!(molds[0]["print_technology"], "SLA");
-    assert_eq!(molds[0]["genus"], 0);
-    let mk = markers_summary(&m);
-    assert_eq!(mk.len(), 1);
-    assert_eq!(mk[0]["needs_sla_or_finer"], true, "{}", mk[0]);
-    assert_eq!(mk[0]["printable_with"], serde_json::json!(["SLA"]));
-    let n = mk[0]["count"].as_u64().unwrap() as f64;
-    assert!(mk[0]["min_spacing_mm"].as_f64().unwrap() >= 0.45 + 0.4);
-
-    // The skin pour fills the open mold to its base: the dome plus the raised dimples, each
-    // its nominal volume plus the slab between its tangent plane and the sphere.
-    let design = library::load("shadowtac").unwrap();
-    let tol = m["chord_tolerance_mm"].as_f64().unwrap();
+/// The skin pour of a ShadowTac design: its solid cap less `n` dimples, each its nominal volume
+/// less the slab between its tangent plane and the sphere; and the tessellation bound (area of
+/// the cavity and the dimple walls x the chord tolerance).
+fn shadowtac_skin_pour(design: &fabkit_designs::schema::Design, n: f64, tol: f64) -> (f64, f64) {
     let rho = design.body.sphere_radius_mm().unwrap();
+    let &fabkit_designs::profile::BodyProfile::SphericalCap { height_mm, .. } = &design.body else {
+        panic!("a spherical cap")
+    };
     let f = &design.layers[0].markers[0].feature;
     let r = f.radius_mm();
     let dome = design.body.analytic_solid_volume_mm3(0.0, 0.0);
     let gap = PI * r.powi(4) * (2.0 / rho) / 8.0;
-    let expected = dome + n * (f.nominal_volume_mm3() + gap);
-    let area = 2.0 * PI * rho * 8.0
+    let area = 2.0 * PI * rho * height_mm
         + n * (2.0 * PI * r * (f.height_mm - r) + 2.0 * PI * r * r + PI * r * r);
+    (dome - n * (f.nominal_volume_mm3() - gap), area * tol)
+}
+
+/// ShadowTac (Sec. IV-A; authors' CAD, measured): the two-piece SLA mold (cavity block with
+/// 469 pins, top piece with the pour reservoir and 20 bolts) casts 469 dimples, which only SLA
+/// prints; the skin pour is the cap less the dimples. The preset `paper_text` (the paper's
+/// 35 x 8 mm cap, dimples concentric at 1.4 mm) casts in one open mold.
+#[test]
+fn shadowtac_kits() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (dir, m) = export(tmp.path(), "shadowtac", None);
+    let pieces: Vec<&Value> = parts(&m)
+        .iter()
+        .filter(|p| p["role"] == "open_mold_piece")
+        .collect();
+    assert_eq!(pieces.len(), 2, "{:?}", parts(&m));
+    for (p, genus) in pieces.iter().zip([20, 21]) {
+        assert_eq!(p["print_technology"], "SLA");
+        // one handle per bolt hole; the top piece's bore adds one
+        assert_eq!(p["genus"], genus, "{}", p["name"]);
+    }
+    let mk = markers_summary(&m);
+    assert_eq!(mk.len(), 1);
+    assert_eq!(mk[0]["count"], 469, "{}", mk[0]);
+    assert_eq!(mk[0]["needs_sla_or_finer"], true, "{}", mk[0]);
+    assert_eq!(mk[0]["printable_with"], serde_json::json!(["SLA"]));
+    assert!(mk[0]["min_spacing_mm"].as_f64().unwrap() >= 0.45 + 0.4);
+
+    let design = library::load("shadowtac").unwrap();
+    let tol = m["chord_tolerance_mm"].as_f64().unwrap();
+    let (expected, bound) = shadowtac_skin_pour(&design, 469.0, tol);
     let pour = cast(&m, "skin")["cavity_volume_ml"].as_f64().unwrap() * 1000.0;
     assert!(
-        (pour - expected).abs() <= area * tol + 1e-6 * dome,
-        "skin pour {pour} mm^3, expected {expected} within {}",
-        area * tol
+        (pour - expected).abs() <= bound,
+        "skin pour {pour} mm^3, expected {expected} within {bound}"
     );
     assert!(
         m["bought_items"].to_string().contains("pmma"),
@@ -119,14 +131,25 @@ fn shadowtac_kits() {
     );
     oracle_check(&dir);
     let files = printable_files(&dir, &m);
-    assert_eq!(files.len(), 2);
+    assert_eq!(files.len(), 3);
 
-    let (pdir, pm) = export(tmp.path(), "shadowtac", Some("published_469"));
+    let (pdir, pm) = export(tmp.path(), "shadowtac", Some("paper_text"));
+    let molds: Vec<&Value> = parts(&pm)
+        .iter()
+        .filter(|p| p["role"] == "open_mold")
+        .collect();
+    assert_eq!(molds.len(), 1, "{:?}", parts(&pm));
+    assert_eq!(molds[0]["genus"], 0);
     let mk = markers_summary(&pm);
-    assert_eq!(mk[0]["count"], 469, "{}", mk[0]);
-    assert_eq!(mk[0]["pattern"]["layout"], "concentric_6k");
-    assert_eq!(mk[0]["pattern"]["rings"], 12);
-    assert_eq!(mk[0]["needs_sla_or_finer"], true);
+    assert_eq!(mk[0]["pattern"]["layout"], "concentric");
+    let n = mk[0]["count"].as_u64().unwrap() as f64;
+    let design = design.with_preset("paper_text").unwrap();
+    let (expected, bound) = shadowtac_skin_pour(&design, n, tol);
+    let pour = cast(&pm, "skin")["cavity_volume_ml"].as_f64().unwrap() * 1000.0;
+    assert!(
+        (pour - expected).abs() <= bound,
+        "paper_text skin pour {pour} mm^3, expected {expected} within {bound}"
+    );
     oracle_check(&pdir);
 
     printcheck_all(&files);

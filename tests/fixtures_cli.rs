@@ -89,12 +89,79 @@ fn rtac0_fixtures_export_is_complete_deterministic_and_printable() {
         }
     }
     let plan = std::fs::read_to_string(a.join("points/capture_plan.csv")).unwrap();
-    assert_eq!(
-        plan.lines()
-            .filter(|l| !l.starts_with('#') && !l.starts_with("capture"))
-            .count(),
-        8 * 5
+    let plan_rows: Vec<Vec<u32>> = plan
+        .lines()
+        .filter(|l| !l.starts_with('#') && !l.starts_with("capture"))
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(plan_rows.len(), 8 * 5);
+
+    // The authors' numbering (authors' CAD and point table): pole id 1; each ring clockwise
+    // seen from +z from the hole at +x; the first capture is the authors' 01_02_06_14_22.png.
+    let mut expect = vec![(1u32, 0u32, None)];
+    for (k, az) in [0.0, 270.0, 180.0, 90.0].iter().enumerate() {
+        expect.push((2 + k as u32, 1, Some(*az)));
+    }
+    for (first, ring) in [(6u32, 2u32), (14, 3), (22, 4)] {
+        for k in 0..8u32 {
+            expect.push((first + k, ring, Some((360.0 - 45.0 * k as f64) % 360.0)));
+        }
+    }
+    for (r, (id, ring, az)) in rows.iter().zip(&expect) {
+        assert_eq!((r[0] as u32, r[1] as u32), (*id, *ring));
+        if let Some(az) = az {
+            let got = r[6].atan2(r[5]).to_degrees().rem_euclid(360.0);
+            let diff = (got - az).rem_euclid(360.0);
+            assert!(
+                diff.min(360.0 - diff) < 1e-6,
+                "id {id}: azimuth {got}, want {az}"
+            );
+        }
+        // Seated tips at R13.46 (authors' CAD, measured: head on the rim of the 2.5 mm
+        // counterbore in the R19.1 outer sphere, 5.6 mm from under the head to the tip).
+        let tip_r = (r[2] * r[2] + r[3] * r[3] + r[4] * r[4]).sqrt();
+        assert!(
+            (tip_r - 13.459_053).abs() < 1e-6,
+            "id {id}: tip at R{tip_r}"
+        );
+    }
+    let file_name = |capture: u32| {
+        let ids: Vec<String> = plan_rows
+            .iter()
+            .filter(|r| r[0] == capture)
+            .map(|r| format!("{:02}", r[1]))
+            .collect();
+        format!("{}.png", ids.join("_"))
+    };
+    assert_eq!(file_name(1), "01_02_06_14_22.png");
+    assert_eq!(file_name(2), "01_03_07_15_23.png");
+
+    // The exported meshes (authors' CAD, measured): the pin 8.8 mm long with a 3.0 mm head;
+    // the dome's two tabs 43 mm across, its outer sphere 38.2 mm across.
+    let size = |f: &str| {
+        let b = std::fs::read(a.join(f)).unwrap();
+        let n = u32::from_le_bytes(b[80..84].try_into().unwrap()) as usize;
+        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+        for t in 0..n {
+            for v in 0..3 {
+                for k in 0..3 {
+                    let o = 84 + 50 * t + 12 + 12 * v + 4 * k;
+                    let x = f32::from_le_bytes(b[o..o + 4].try_into().unwrap()) as f64;
+                    lo[k] = lo[k].min(x);
+                    hi[k] = hi[k].max(x);
+                }
+            }
+        }
+        [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]]
+    };
+    let pin = size("parts/pin.stl");
+    assert!(
+        (pin[2] - 8.8).abs() < 1e-4 && (pin[0] - 3.0).abs() < 0.02,
+        "pin {pin:?}"
     );
+    let dome = size("parts/pin_dome.stl");
+    assert!((dome[0] - 43.0).abs() < 1e-4, "dome {dome:?}");
+    assert!((dome[1] - 38.2).abs() < 0.02, "dome {dome:?}");
 
     // Protrusions: orientation 180 is orientation 0 turned about z.
     let idx: serde_json::Value =
@@ -164,6 +231,22 @@ fn bad_fixture_parameters_name_the_parameter_and_write_nothing() {
         ("pin_dome:\n  pin:\n    length_mm: 2.0\n", "pin_dome.pin.length_mm"),
         ("semidomes:\n  patterns:\n    - name: edge\n      protrusions:\n        - {polar_angle_deg: 40, azimuth_deg: 88, indentation_depth_mm: 1, shape: {type: sphere, radius_mm: 2}}\n", "semidomes.patterns[0].protrusions[0].azimuth_deg"),
         ("pin_dome:\n  wall_thicknes_mm: 2\n", "params.yaml:2:"),
+        (
+            "pin_dome:\n  hole_numbering: {direction: clockwise, start_azimuth_deg: 10}\n",
+            "pin_dome.hole_numbering.start_azimuth_deg = 10: must be the azimuth of a hole in every ring",
+        ),
+        (
+            "pin_dome:\n  clearance_mm: 1.5\n  inner_radius_mm: 16.65\n  outer_radius_mm: 19.1\n",
+            "pin_dome.clearance_mm = 1.5: give the shell either by",
+        ),
+        (
+            "pin_dome:\n  orientation_mark: {azimuth_range_deg: [65, 66], polar_range_deg: [5.6, 86.5], depth_mm: 3}\n",
+            "pin_dome.orientation_mark.depth_mm = 3",
+        ),
+        (
+            "pin_dome:\n  base_tabs: {span_mm: 43, width_mm: 6, height_mm: 4, azimuth_deg: 0}\n",
+            "pin_dome.keyed_dowels = true",
+        ),
     ];
     for (yaml, expect) in cases {
         let f = tmp.path().join("params.yaml");

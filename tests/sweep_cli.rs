@@ -6,7 +6,7 @@
 //! - variant folders hold the files of `fabkit export`, measured like the results table;
 //! - sweep file errors stop the run before anything is written.
 //!
-//! The ShadowTac open mold at 0.05 mm chord tolerance keeps each variant near 0.3 s.
+//! The ShadowTac `paper_text` open mold at 0.05 mm chord tolerance keeps each variant near 0.3 s.
 
 mod common;
 
@@ -16,13 +16,15 @@ use std::collections::BTreeSet;
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-/// 9 variants: spacing x feature diameter; the 0.3 mm diameter (the middle value) is below
-/// the SLA profile's 0.4 mm minimum hole, so variants 1, 4 and 7 are infeasible.
+/// 9 variants: spacing x feature diameter; the dimples are pins in the mold, and the 0.25 mm
+/// diameter (the middle value) is below the SLA profile's 0.3 mm minimum feature, so variants
+/// 1, 4 and 7 are infeasible.
 const SWEEP: &str = "base: shadowtac
+preset: paper_text
 chord_tolerance_mm: 0.05
 vary:
   layers[0].markers[0].pattern.spacing_mm: {range: [1.6, 2.0, 0.2]}
-  layers[0].markers[0].feature.diameter_mm: [0.45, 0.3, 0.5]
+  layers[0].markers[0].feature.diameter_mm: [0.45, 0.25, 0.5]
 mode: grid
 outputs: [metrics]
 ";
@@ -181,7 +183,7 @@ fn an_infeasible_variant_is_recorded_and_the_sweep_goes_on() {
     // reported as it happens (plain lines when stderr is not a terminal)
     let err = text(&o.stderr);
     assert!(
-        err.contains("variant 4 (") && err.contains("infeasible: layers[0].markers[0].feature.diameter_mm = 0.3: below the minimum hole 0.4 mm of printer profile 'sla'"),
+        err.contains("variant 4 (") && err.contains("infeasible: layers[0].markers[0].feature.diameter_mm = 0.25: below the minimum feature 0.3 mm of printer profile 'sla'"),
         "{err}"
     );
     let rows = jsonl(&d.join("out/results.jsonl"));
@@ -191,15 +193,17 @@ fn an_infeasible_variant_is_recorded_and_the_sweep_goes_on() {
         let diameter = r["params"]["layers[0].markers[0].feature.diameter_mm"]
             .as_f64()
             .unwrap();
-        if diameter == 0.3 {
+        if diameter == 0.25 {
             assert_eq!(r["status"], "infeasible");
             assert!(r["metrics"].is_null());
             assert_eq!(r["errors"].as_array().unwrap().len(), 1, "{r}");
         } else {
             assert_eq!(r["status"], "ok", "{r}");
             let m = &r["metrics"];
-            // the measured spacing follows the varied spacing, the wall between features is
-            // the spacing less the diameter, and only SLA makes sub-0.5 mm holes
+            // the measured spacing follows the varied spacing, the thinnest wall is at most the
+            // wall between the features' bases (the spacing less the diameter; dimples also
+            // converge inwards and near the base plane) and at least SLA's 0.4 mm, and only SLA
+            // makes sub-0.5 mm pins
             let spacing = r["params"]["layers[0].markers[0].pattern.spacing_mm"]
                 .as_f64()
                 .unwrap();
@@ -210,7 +214,11 @@ fn an_infeasible_variant_is_recorded_and_the_sweep_goes_on() {
                 "{median} vs {spacing}"
             );
             let min = mk["min_spacing_mm"].as_f64().unwrap();
-            assert_eq!(m["min_wall_mm"].as_f64().unwrap(), min - diameter);
+            let wall = m["min_wall_mm"].as_f64().unwrap();
+            assert!(
+                wall <= min - diameter + 1e-12 && wall >= 0.4,
+                "{wall} vs {min} - {diameter}"
+            );
             let verdict = |p: usize| r["printability"][p]["printable"].as_bool().unwrap();
             assert_eq!(
                 (verdict(0), verdict(1), verdict(2)),
@@ -244,10 +252,11 @@ fn a_killed_sweep_completes_only_the_missing_variants() {
         d,
         "sweep.yaml",
         "base: shadowtac
+preset: paper_text
 chord_tolerance_mm: 0.05
 vary:
-  layers[0].markers[0].pattern.spacing_mm: [1.6, 1.7, 1.8, 1.9, 2.0, 2.1]
-  layers[0].markers[0].feature.height_mm: [0.4, 0.5]
+  layers[0].markers[0].pattern.spacing_mm: [1.6, 1.65, 1.7, 1.8, 1.9, 2.0]
+  layers[0].markers[0].feature.height_mm: [0.25, 0.3]
 ",
     );
     let mut child = fabkit()
@@ -333,6 +342,7 @@ fn variant_folders_hold_the_export_files() {
         d,
         "sweep.yaml",
         "base: shadowtac
+preset: paper_text
 chord_tolerance_mm: 0.05
 vary:
   layers[0].markers[0].pattern.spacing_mm: [1.8, 2.0]
@@ -347,7 +357,7 @@ outputs: [metrics, files]
         let id = r["id"].as_str().unwrap();
         let v = out.join("variants").join(id);
         assert!(v.join("parts/skin_open_mold.stl").is_file());
-        assert!(v.join("shadowtac.3mf").is_file());
+        assert!(v.join("shadowtac_paper_text.3mf").is_file());
         let m: Value =
             serde_json::from_str(&std::fs::read_to_string(v.join("manifest.json")).unwrap())
                 .unwrap();

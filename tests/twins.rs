@@ -18,9 +18,17 @@ const CASES: &[(&str, &[&str])] = &[
     ("shadowtac", &["export", "shadowtac"]),
     ("uvdtact", &["export", "uvdtact"]),
     ("rtac0", &["export", "rtac0"]),
+    // the direct molds with the other housing arrangement (square split halves)
     (
         "rtac0_direct",
-        &["export", "rtac0", "--mold-strategy", "direct"],
+        &[
+            "export",
+            "rtac0",
+            "--mold-strategy",
+            "direct",
+            "--preset",
+            "square_split",
+        ],
     ),
     ("tactip_dualmodal", &["export", "tactip_dualmodal"]),
     (

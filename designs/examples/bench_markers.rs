@@ -1,8 +1,9 @@
-//! Times the ShadowTac one-piece open mold (`designs/library/shadowtac.yaml`, layer 0) at
+//! Times the ShadowTac one-piece open mold (`designs/library/shadowtac.yaml`, preset
+//! `open_mold`, layer 0) at
 //! 0.005 mm chord tolerance for one feature count, and writes the mold's CSG tree.
 //!
 //! Usage: `cargo run --release -p fabkit-designs --example bench_markers -- CASE [RUNS] [CSG]`
-//! - CASE: `published_469` (the preset: concentric_6k, 12 rings, 1.53 mm pitch) or a feature
+//! - CASE: `published_469` (the authors' layout: concentric_6k, 12 rings 3.9474 deg apart) or a feature
 //!   count N (the scaling variant of [`scaled_design`]: N features on a golden spiral).
 //! - RUNS (default 3): timed runs; each is `stack::validate` + `layers::build_layer`, the mold
 //!   only (nothing written). The YAML is parsed once, before the clock starts.
@@ -55,6 +56,8 @@ fn scaled_design(base: &Design, n: u32) -> Design {
     p.spacing_mm = None;
     p.rings = None;
     p.pitch_arc_mm = None;
+    p.polar_step_deg = None;
+    p.ring_azimuth_offset = None;
     d
 }
 
@@ -68,7 +71,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         None => 3,
     };
     let csg_path = args.get(2);
-    let base = library::load("shadowtac")?;
+    let base = library::load("shadowtac")?.with_preset("open_mold")?;
     let design = if case == "published_469" {
         base.with_preset("published_469")?
     } else {

@@ -37,7 +37,10 @@ pub fn build_kit(design: &Design, tol: ChordTolerance) -> Result<Kit, DesignErro
         .filter(|l| {
             l.process == LayerProcess::Printed
                 || (l.process == LayerProcess::Cast
-                    && matches!(l.mold_strategy, MoldStrategy::Open | MoldStrategy::Boundary))
+                    && matches!(
+                        l.mold_strategy,
+                        MoldStrategy::Open | MoldStrategy::TwoPieceOpen | MoldStrategy::Boundary
+                    ))
         })
         .map(|l| l.index)
         .collect();
@@ -227,7 +230,12 @@ fn housing_items(h: &crate::schema::HousingParams) -> Vec<String> {
             h.diffuser.outer_diameter_mm, h.diffuser.inner_diameter_mm, h.diffuser.thickness_mm, h.diffuser.gap_above_pcb_mm
         ),
         format!(
-            "2 joint screws: {:.1} mm clearance, {:.1} mm head, length about {:.0} mm (clamp {:.1} mm + pilot {:.1} mm)",
+            "2 joint screws{}: {:.1} mm clearance, {:.1} mm head, length about {:.0} mm (clamp {:.1} mm + pilot {:.1} mm)",
+            match h.style {
+                crate::schema::HousingStyle::RoundTube =>
+                    " (pan head), up through the base's flange into the tube wall",
+                crate::schema::HousingStyle::SquareSplit => " across the two halves",
+            },
             h.joint_screw.clearance_diameter_mm,
             h.joint_screw.head_diameter_mm,
             (h.joint_screw.clamp_length_mm + h.joint_screw.pilot_depth_mm - 0.5).floor(),

@@ -1,32 +1,52 @@
-//! The two-piece sensor shell (R-Tac0 Sec. III-B2..B4, Fig. 2).
+//! The sensor shell (R-Tac0 Sec. III-B2..B4, Fig. 2), in one of two arrangements
+//! (`housing.style`).
 //!
-//! From the bottom up, in the sensor frame: the camera bay (square, open at the bottom, the
-//! board screws up against the bulkhead), the bulkhead with the lens hole and the board's
-//! mounting pilot holes, the LED ring PCB seat on the bulkhead, the light chamber, the diffuser
-//! seat `gap_above_pcb_mm` above the PCB (10 mm in the paper), and the contact-module seat: a
-//! bore that takes the part of the core below the base plane, whose rim rests on the diffuser;
-//! the skin's base rests on the shell's top face (the base plane). The halves split on the
-//! plane x = 0 and are joined by two screws across it.
+//! Inside, from the top down in the sensor frame: the contact-module seat (a bore that takes
+//! the part of the core below the base plane; the skin's base rests on the shell's top face,
+//! the base plane), the diffuser seat whose floor carries the core's rim, the light chamber,
+//! the LED ring PCB seat `gap_above_pcb_mm` (10 mm in the paper) under the diffuser, and the
+//! camera under the PCB.
+//!
+//! - `round_tube` (the authors' CAD, measured: a round tube of 30 mm outer diameter, 21.65 mm
+//!   tall, closed by a separate base that carries the camera): below the PCB the tube is bored
+//!   out to the camera bay and the PCB rests on the ledge this leaves. The base is a flange
+//!   under the tube with a spigot that enters the bay; the camera board is screwed onto the
+//!   spigot, its cable leaves through a slot in the base, and two screws from below through
+//!   the flange hold the base to the tube wall (fabkit's layout: the authors' base and bolts
+//!   are not published).
+//! - `square_split`: a square shell with the camera bay open at the bottom (the board screws
+//!   up against a bulkhead with the lens hole); the shell splits on the plane x = 0 into two
+//!   halves joined by two screws across it.
 
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{cuboid, cylinder, ChordTolerance, Solid};
 use crate::kit::{Part, PrintTechnology};
 use crate::molds::{place_posed, with_pose};
-use crate::schema::{Design, HousingParams};
+use crate::schema::{Design, HousingParams, HousingStyle, RoundTube};
 use crate::stack::{ResolvedCore, Stack};
 use serde_json::json;
 
 /// z levels of the shell, sensor frame, mm (bottom to top).
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct ShellLevels {
+    /// Bottom of the sensor: of the shell (`square_split`) or of the base's flange
+    /// (`round_tube`).
     pub bottom_z_mm: f64,
+    /// Underside of the bulkhead (`square_split`); `round_tube` has no bulkhead (the PCB rests
+    /// on the bay's ledge) and this equals `pcb_z_mm`.
     pub bulkhead_z_mm: f64,
     pub pcb_z_mm: f64,
     pub chamber_z_mm: f64,
     pub diffuser_z_mm: f64,
     pub seat_z_mm: f64,
     pub top_z_mm: f64,
-    /// Overall sensor height from the shell bottom to the skin's pole, mm.
+    /// Bottom of the tube, where the base's flange meets it (`round_tube` only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tube_bottom_z_mm: Option<f64>,
+    /// Top of the base's spigot, on which the camera board rests (`round_tube` only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub base_top_z_mm: Option<f64>,
+    /// Overall sensor height from the bottom to the skin's pole, mm.
     pub envelope_height_mm: f64,
 }
 
@@ -36,8 +56,21 @@ fn levels(design: &Design, h: &HousingParams, core: &ResolvedCore) -> ShellLevel
     let diffuser = seat - h.diffuser.thickness_mm;
     let chamber = diffuser - h.diffuser.gap_above_pcb_mm;
     let pcb = chamber - h.led_pcb.thickness_mm;
-    let bulkhead = pcb - h.bulkhead_thickness_mm;
-    let bottom = bulkhead - h.camera.bay_height_mm;
+    let (bulkhead, bottom, tube_bottom, base_top) = match round_tube(h) {
+        Some(t) => {
+            let tb = top - t.height_mm;
+            (
+                pcb,
+                tb - h.joint_screw.clamp_length_mm,
+                Some(tb),
+                Some(tb + t.base_spigot_height_mm),
+            )
+        }
+        None => {
+            let b = pcb - h.bulkhead_thickness_mm;
+            (b, b - h.camera.bay_height_mm, None, None)
+        }
+    };
     ShellLevels {
         bottom_z_mm: bottom,
         bulkhead_z_mm: bulkhead,
@@ -46,8 +79,28 @@ fn levels(design: &Design, h: &HousingParams, core: &ResolvedCore) -> ShellLevel
         diffuser_z_mm: diffuser,
         seat_z_mm: seat,
         top_z_mm: top,
+        tube_bottom_z_mm: tube_bottom,
+        base_top_z_mm: base_top,
         envelope_height_mm: design.body.pole_z_mm(0.0) - bottom,
     }
+}
+
+/// The tube parameters when the housing is a round tube (and they are given).
+fn round_tube(h: &HousingParams) -> Option<&RoundTube> {
+    match h.style {
+        HousingStyle::RoundTube => h.round_tube.as_ref(),
+        HousingStyle::SquareSplit => None,
+    }
+}
+
+/// Cable slot through the round tube's base, under the camera board: 2 x 12 mm, long along y.
+/// ASSUMPTION: the camera's flat cable is at most 11 mm wide (measure yours).
+const CABLE_SLOT_XY_MM: [f64; 2] = [2.0, 12.0];
+
+/// Radius of the round tube's joint screws (parallel to z, at azimuths 0 and 180 deg): the
+/// middle of the tube wall around the camera bay, mm.
+fn round_screw_radius_mm(h: &HousingParams, t: &RoundTube) -> f64 {
+    0.5 * (t.bay_diameter_mm / 2.0 + h.outer_width_mm / 2.0)
 }
 
 /// y position of the joint screws (they run along x across the parting plane): centred
@@ -82,13 +135,21 @@ const DOWEL_HOLE_DIAMETER_MM: f64 = 2.0;
 const DOWEL_HOLE_DEPTH_MM: f64 = 3.0;
 const DOWEL_INSET_MM: f64 = 1.8;
 
-/// Where the fixture dowel holes of a housing are.
-pub fn fixture_dowel_holes(h: &HousingParams) -> FixtureDowelHoles {
-    let a = h.outer_width_mm / 2.0 - DOWEL_INSET_MM;
-    FixtureDowelHoles {
-        diameter_mm: DOWEL_HOLE_DIAMETER_MM,
-        depth_mm: DOWEL_HOLE_DEPTH_MM,
-        positions_xy_mm: [[a, a], [-a, a]],
+/// Where the fixture dowel holes of a housing are: at the square shell's corners
+/// (`square_split`), or `None` for the round tube, whose top face lies wholly under the skin
+/// (both are `outer_width_mm` across) and whose base is no wider, so it has no face to key a
+/// fixture to: a fixture is then keyed to the user's mount.
+pub fn fixture_dowel_holes(h: &HousingParams) -> Option<FixtureDowelHoles> {
+    match h.style {
+        HousingStyle::RoundTube => None,
+        HousingStyle::SquareSplit => {
+            let a = h.outer_width_mm / 2.0 - DOWEL_INSET_MM;
+            Some(FixtureDowelHoles {
+                diameter_mm: DOWEL_HOLE_DIAMETER_MM,
+                depth_mm: DOWEL_HOLE_DEPTH_MM,
+                positions_xy_mm: [[a, a], [-a, a]],
+            })
+        }
     }
 }
 
@@ -186,13 +247,15 @@ pub fn check_housing_params(
             ));
         }
     };
-    wall(
-        errs,
-        "housing.camera.board_width_mm",
-        h.camera.board_width_mm,
-        half - (h.camera.board_width_mm / 2.0 + c),
-        "beside the camera bay",
-    );
+    if h.style == HousingStyle::SquareSplit {
+        wall(
+            errs,
+            "housing.camera.board_width_mm",
+            h.camera.board_width_mm,
+            half - (h.camera.board_width_mm / 2.0 + c),
+            "beside the camera bay",
+        );
+    }
     wall(
         errs,
         "housing.led_pcb.outer_diameter_mm",
@@ -207,17 +270,18 @@ pub fn check_housing_params(
         half - (h.diffuser.outer_diameter_mm / 2.0 + c),
         "around the diffuser seat",
     );
-    let dowels = fixture_dowel_holes(h);
-    let [dx, dy] = dowels.positions_xy_mm[0];
-    let skin_r = design.body.rim_radius_mm(0.0);
-    if (dx * dx + dy * dy).sqrt() - dowels.diameter_mm / 2.0 < skin_r + c {
-        errs.push(ParamError::new(
-            "housing.outer_width_mm",
-            h.outer_width_mm,
-            format!(
-                "too narrow for the fixture dowel holes at the corners: they would cut into the skin's footprint (radius {skin_r:.2} mm)"
-            ),
-        ));
+    if let Some(dowels) = fixture_dowel_holes(h) {
+        let [dx, dy] = dowels.positions_xy_mm[0];
+        let skin_r = design.body.rim_radius_mm(0.0);
+        if (dx * dx + dy * dy).sqrt() - dowels.diameter_mm / 2.0 < skin_r + c {
+            errs.push(ParamError::new(
+                "housing.outer_width_mm",
+                h.outer_width_mm,
+                format!(
+                    "too narrow for the fixture dowel holes at the corners: they would cut into the skin's footprint (radius {skin_r:.2} mm)"
+                ),
+            ));
+        }
     }
     let ledge =
         |errs: &mut Vec<ParamError>, path: &str, v: f64, inner: f64, outer: f64, what: &str| {
@@ -239,14 +303,16 @@ pub fn check_housing_params(
         h.diffuser.outer_diameter_mm,
         "the diffuser",
     );
-    ledge(
-        errs,
-        "housing.camera.lens_hole_diameter_mm",
-        h.camera.lens_hole_diameter_mm,
-        h.camera.lens_hole_diameter_mm,
-        h.led_pcb.outer_diameter_mm,
-        "the LED PCB",
-    );
+    if h.style == HousingStyle::SquareSplit {
+        ledge(
+            errs,
+            "housing.camera.lens_hole_diameter_mm",
+            h.camera.lens_hole_diameter_mm,
+            h.camera.lens_hole_diameter_mm,
+            h.led_pcb.outer_diameter_mm,
+            "the LED PCB",
+        );
+    }
     if h.led_pcb.inner_diameter_mm < h.camera.lens_hole_diameter_mm {
         errs.push(ParamError::new(
             "housing.led_pcb.inner_diameter_mm",
@@ -284,17 +350,6 @@ pub fn check_housing_params(
             "must fit on the camera board",
         ));
     }
-    // Mount pilots stay in solid material beside the PCB seat and inside the outer wall.
-    let r_mount = h.camera.mount_hole_spacing_mm / 2.0 * std::f64::consts::SQRT_2;
-    if r_mount - h.camera.mount_pilot_diameter_mm / 2.0
-        < h.led_pcb.outer_diameter_mm / 2.0 + c + fdm.min_wall_mm
-    {
-        errs.push(ParamError::new(
-            "housing.camera.mount_hole_spacing_mm",
-            h.camera.mount_hole_spacing_mm,
-            "puts the board's mounting holes under the LED PCB seat",
-        ));
-    }
     if h.camera.mount_pilot_diameter_mm < fdm.min_hole_diameter_mm
         || h.joint_screw.pilot_diameter_mm < fdm.min_hole_diameter_mm
     {
@@ -309,44 +364,60 @@ pub fn check_housing_params(
             ),
         ));
     }
-    // Joint screws run along x at y = +-screw_y beside the light chamber.
-    let (lo, hi) = screw_y_range(design, h);
-    if lo > hi {
-        errs.push(ParamError::new(
-            "housing.joint_screw.head_diameter_mm",
-            h.joint_screw.head_diameter_mm,
-            format!(
-                "the joint screws do not fit between the light chamber and the outer wall with {} mm walls (short by {:.2} mm)",
-                fdm.min_wall_mm,
-                lo - hi
-            ),
-        ));
-    }
-    if h.joint_screw.clamp_length_mm + 1.0 > half {
-        errs.push(ParamError::new(
-            "housing.joint_screw.clamp_length_mm",
-            h.joint_screw.clamp_length_mm,
-            "leaves no room for the screw head counterbore",
-        ));
-    }
-    if h.joint_screw.pilot_depth_mm > half - fdm.min_wall_mm {
-        errs.push(ParamError::new(
-            "housing.joint_screw.pilot_depth_mm",
-            h.joint_screw.pilot_depth_mm,
-            "runs through the far wall of the shell",
-        ));
-    }
-    if h.diffuser.gap_above_pcb_mm
-        < h.joint_screw
-            .head_diameter_mm
-            .max(h.joint_screw.clearance_diameter_mm)
-            + 2.0 * fdm.min_wall_mm
-    {
-        errs.push(ParamError::new(
-            "housing.diffuser.gap_above_pcb_mm",
-            h.diffuser.gap_above_pcb_mm,
-            "leaves no height for the joint screws beside the light chamber",
-        ));
+    match h.style {
+        HousingStyle::SquareSplit => {
+            // Mount pilots stay in solid material beside the PCB seat and inside the outer wall.
+            let r_mount = h.camera.mount_hole_spacing_mm / 2.0 * std::f64::consts::SQRT_2;
+            if r_mount - h.camera.mount_pilot_diameter_mm / 2.0
+                < h.led_pcb.outer_diameter_mm / 2.0 + c + fdm.min_wall_mm
+            {
+                errs.push(ParamError::new(
+                    "housing.camera.mount_hole_spacing_mm",
+                    h.camera.mount_hole_spacing_mm,
+                    "puts the board's mounting holes under the LED PCB seat",
+                ));
+            }
+            // Joint screws run along x at y = +-screw_y beside the light chamber.
+            let (lo, hi) = screw_y_range(design, h);
+            if lo > hi {
+                errs.push(ParamError::new(
+                    "housing.joint_screw.head_diameter_mm",
+                    h.joint_screw.head_diameter_mm,
+                    format!(
+                        "the joint screws do not fit between the light chamber and the outer wall with {} mm walls (short by {:.2} mm)",
+                        fdm.min_wall_mm,
+                        lo - hi
+                    ),
+                ));
+            }
+            if h.joint_screw.clamp_length_mm + 1.0 > half {
+                errs.push(ParamError::new(
+                    "housing.joint_screw.clamp_length_mm",
+                    h.joint_screw.clamp_length_mm,
+                    "leaves no room for the screw head counterbore",
+                ));
+            }
+            if h.joint_screw.pilot_depth_mm > half - fdm.min_wall_mm {
+                errs.push(ParamError::new(
+                    "housing.joint_screw.pilot_depth_mm",
+                    h.joint_screw.pilot_depth_mm,
+                    "runs through the far wall of the shell",
+                ));
+            }
+            if h.diffuser.gap_above_pcb_mm
+                < h.joint_screw
+                    .head_diameter_mm
+                    .max(h.joint_screw.clearance_diameter_mm)
+                    + 2.0 * fdm.min_wall_mm
+            {
+                errs.push(ParamError::new(
+                    "housing.diffuser.gap_above_pcb_mm",
+                    h.diffuser.gap_above_pcb_mm,
+                    "leaves no height for the joint screws beside the light chamber",
+                ));
+            }
+        }
+        HousingStyle::RoundTube => check_round_tube(design, h, core, errs),
     }
     if let Some(core) = core {
         let r_core = design.body.rim_radius_mm(core.outer_offset_mm);
@@ -374,10 +445,166 @@ pub fn check_housing_params(
     }
 }
 
-/// Builds the two shell halves, in print orientation (parting face down).
+/// Rules on the round tube and its base (`housing.style: round_tube`).
+fn check_round_tube(
+    design: &Design,
+    h: &HousingParams,
+    core: Option<&ResolvedCore>,
+    errs: &mut Vec<ParamError>,
+) {
+    let Some(t) = &h.round_tube else {
+        errs.push(ParamError::new(
+            "housing.round_tube",
+            "missing",
+            "is required with housing.style = round_tube (height_mm, bay_diameter_mm, base_spigot_height_mm)",
+        ));
+        return;
+    };
+    let before = errs.len();
+    for (path, v) in [
+        ("housing.round_tube.height_mm", t.height_mm),
+        ("housing.round_tube.bay_diameter_mm", t.bay_diameter_mm),
+        (
+            "housing.round_tube.base_spigot_height_mm",
+            t.base_spigot_height_mm,
+        ),
+    ] {
+        if !(v > 0.0 && v.is_finite()) {
+            errs.push(ParamError::new(path, v, "must be above 0"));
+        }
+    }
+    if errs.len() > before {
+        return;
+    }
+    let fdm = &design.printers.fdm;
+    let c = h.fit_clearance_mm;
+    let r_out = h.outer_width_mm / 2.0;
+    let r_bay = t.bay_diameter_mm / 2.0;
+    let r_spigot = r_bay - c;
+    let js = &h.joint_screw;
+    // The PCB rests on the ledge between the bay and the PCB seat: at least one nozzle wide.
+    let ledge = h.led_pcb.outer_diameter_mm / 2.0 + c - r_bay;
+    if ledge < fdm.xy_resolution_mm {
+        errs.push(ParamError::new(
+            "housing.round_tube.bay_diameter_mm",
+            t.bay_diameter_mm,
+            format!(
+                "leaves a ledge of {ledge:.2} mm under the LED PCB (seat diameter {:.2} mm), below one nozzle width {} mm of printer profile 'fdm'",
+                h.led_pcb.outer_diameter_mm + 2.0 * c,
+                fdm.xy_resolution_mm
+            ),
+        ));
+    }
+    // The joint screw pilots go up into the tube wall around the bay.
+    let wall = r_out - r_bay;
+    let need = js.pilot_diameter_mm + 2.0 * fdm.min_wall_mm;
+    if wall < need {
+        errs.push(ParamError::new(
+            "housing.round_tube.bay_diameter_mm",
+            t.bay_diameter_mm,
+            format!(
+                "leaves {wall:.2} mm of tube wall around the camera bay; the joint screw pilots ({} mm) need {need:.2} mm with the minimum wall {} mm of printer profile 'fdm'",
+                js.pilot_diameter_mm, fdm.min_wall_mm
+            ),
+        ));
+    }
+    let half_diag = h.camera.board_width_mm / std::f64::consts::SQRT_2;
+    if half_diag + c > r_bay {
+        errs.push(ParamError::new(
+            "housing.camera.board_width_mm",
+            h.camera.board_width_mm,
+            format!(
+                "the square board (diagonal {:.2} mm) does not fit the camera bay (housing.round_tube.bay_diameter_mm = {}) with the fit clearance {c} mm",
+                2.0 * half_diag,
+                t.bay_diameter_mm
+            ),
+        ));
+    }
+    let s = h.camera.mount_hole_spacing_mm / 2.0;
+    let mp = h.camera.mount_pilot_diameter_mm / 2.0;
+    if s * std::f64::consts::SQRT_2 + mp + fdm.min_wall_mm > r_spigot {
+        errs.push(ParamError::new(
+            "housing.camera.mount_hole_spacing_mm",
+            h.camera.mount_hole_spacing_mm,
+            format!("puts the board's mounting holes outside the base's spigot (radius {r_spigot:.2} mm) with the minimum wall {} mm", fdm.min_wall_mm),
+        ));
+    } else if s - mp - fdm.min_wall_mm < CABLE_SLOT_XY_MM[0] / 2.0 {
+        errs.push(ParamError::new(
+            "housing.camera.mount_hole_spacing_mm",
+            h.camera.mount_hole_spacing_mm,
+            format!(
+                "puts the board's mounting holes into the base's cable slot ({} mm wide)",
+                CABLE_SLOT_XY_MM[0]
+            ),
+        ));
+    }
+    let r_js = round_screw_radius_mm(h, t);
+    if r_js + js.head_diameter_mm / 2.0 > r_out {
+        errs.push(ParamError::new(
+            "housing.joint_screw.head_diameter_mm",
+            js.head_diameter_mm,
+            format!(
+                "the joint screw heads under the base (at radius {r_js:.2} mm) reach past the tube's outer diameter {} mm",
+                h.outer_width_mm
+            ),
+        ));
+    }
+    if js.clamp_length_mm < fdm.min_wall_mm {
+        errs.push(ParamError::new(
+            "housing.joint_screw.clamp_length_mm",
+            js.clamp_length_mm,
+            format!(
+                "is the thickness of the base's flange: below the minimum wall {} mm of printer profile 'fdm'",
+                fdm.min_wall_mm
+            ),
+        ));
+    }
+    if js.pilot_depth_mm > t.height_mm - fdm.min_wall_mm {
+        errs.push(ParamError::new(
+            "housing.joint_screw.pilot_depth_mm",
+            js.pilot_depth_mm,
+            format!(
+                "runs through the tube's top face (tube height {} mm)",
+                t.height_mm
+            ),
+        ));
+    }
+    let depth = js.clamp_length_mm + t.base_spigot_height_mm - fdm.min_wall_mm;
+    if depth < h.camera.mount_pilot_diameter_mm {
+        errs.push(ParamError::new(
+            "housing.round_tube.base_spigot_height_mm",
+            t.base_spigot_height_mm,
+            format!(
+                "leaves {depth:.2} mm for the camera board's pilot holes in the base, less than their diameter {} mm",
+                h.camera.mount_pilot_diameter_mm
+            ),
+        ));
+    }
+    if let Some(core) = core {
+        let pcb_below_top = core.below_base_mm
+            + h.diffuser.thickness_mm
+            + h.diffuser.gap_above_pcb_mm
+            + h.led_pcb.thickness_mm;
+        let room = t.height_mm - pcb_below_top - t.base_spigot_height_mm;
+        if room < h.camera.bay_height_mm {
+            errs.push(ParamError::new(
+                "housing.round_tube.height_mm",
+                t.height_mm,
+                format!(
+                    "leaves {room:.2} mm between the base and the LED PCB, below housing.camera.bay_height_mm = {}",
+                    h.camera.bay_height_mm
+                ),
+            ));
+        }
+    }
+}
+
+/// Builds the shell in print orientation: the round tube (top face down) and its base
+/// (flange down) for `round_tube`, the two halves (parting face down) for `square_split`.
 ///
 /// # Errors
-/// [`DesignError::Geometry`] if the kernel fails.
+/// [`DesignError::Params`] when the design has no core to seat, [`DesignError::Geometry`]
+/// if the kernel fails.
 pub fn build_shell(
     design: &Design,
     h: &HousingParams,
@@ -392,6 +619,195 @@ pub fn build_shell(
         )]))
     })?;
     let lv = levels(design, h, core);
+    match (h.style, &h.round_tube) {
+        (HousingStyle::RoundTube, Some(t)) => build_round_tube(design, h, t, core, lv, tol),
+        (HousingStyle::RoundTube, None) => {
+            Err(DesignError::Params(crate::error::ParamErrors(vec![
+                ParamError::new(
+                    "housing.round_tube",
+                    "missing",
+                    "is required with housing.style = round_tube",
+                ),
+            ])))
+        }
+        (HousingStyle::SquareSplit, _) => build_square_split(design, h, core, lv, tol),
+    }
+}
+
+/// The bores above the camera that both shell styles share, from the LED PCB's level up: the
+/// PCB pocket, the light chamber, the diffuser's seat and the contact module's seat (radius
+/// `r_core_mm` plus the fit clearance), each overlapping the next by 0.01 mm so that their
+/// union is clean. Sensor frame, mm.
+fn upper_bores(
+    h: &HousingParams,
+    lv: &ShellLevels,
+    r_core_mm: f64,
+    tol: ChordTolerance,
+) -> Result<Vec<Solid>, crate::geometry::GeometryError> {
+    let c = h.fit_clearance_mm;
+    let e = 0.01;
+    let cyl =
+        |r: f64, z0: f64, z1: f64| cylinder(z1 - z0, r, tol).map(|s| s.translate([0.0, 0.0, z0]));
+    Ok(vec![
+        cyl(
+            h.led_pcb.outer_diameter_mm / 2.0 + c,
+            lv.pcb_z_mm,
+            lv.chamber_z_mm + e,
+        )?,
+        cyl(
+            h.light_chamber_diameter_mm / 2.0,
+            lv.chamber_z_mm,
+            lv.diffuser_z_mm + e,
+        )?,
+        cyl(
+            h.diffuser.outer_diameter_mm / 2.0 + c,
+            lv.diffuser_z_mm,
+            lv.seat_z_mm + e,
+        )?,
+        cyl(r_core_mm + c, lv.seat_z_mm, lv.top_z_mm + 1.0)?,
+    ])
+}
+
+/// The round tube and its base (see the module docs).
+fn build_round_tube(
+    design: &Design,
+    h: &HousingParams,
+    t: &RoundTube,
+    core: &ResolvedCore,
+    lv: ShellLevels,
+    tol: ChordTolerance,
+) -> Result<(Vec<Part>, ShellLevels), DesignError> {
+    let r_out = h.outer_width_mm / 2.0;
+    let c = h.fit_clearance_mm;
+    let r_core = design.body.rim_radius_mm(core.outer_offset_mm);
+    let r_bay = t.bay_diameter_mm / 2.0;
+    let tube_bottom = lv.tube_bottom_z_mm.unwrap_or(lv.bottom_z_mm);
+    let base_top = lv.base_top_z_mm.unwrap_or(tube_bottom);
+    let fdm = &design.printers.fdm;
+    let cyl =
+        |r: f64, z0: f64, z1: f64| cylinder(z1 - z0, r, tol).map(|s| s.translate([0.0, 0.0, z0]));
+    let e = 0.01;
+    let js = &h.joint_screw;
+    let r_js = round_screw_radius_mm(h, t);
+    let screws_xy = [[r_js, 0.0], [-r_js, 0.0]];
+
+    // The tube: stacked bores, each overlapping the next by a hair so the union is clean.
+    let g = |r: Result<Solid, _>| r.part("shell_tube");
+    let mut cut = vec![g(cyl(r_bay, tube_bottom - 1.0, lv.pcb_z_mm + e))?];
+    cut.extend(upper_bores(h, &lv, r_core, tol).part("shell_tube")?);
+    // Joint screw pilots, up into the tube wall from its bottom.
+    let mut pilots = Vec::new();
+    for [x, y] in screws_xy {
+        pilots.push(g(cyl(
+            js.pilot_diameter_mm / 2.0,
+            tube_bottom - 1.0,
+            tube_bottom + js.pilot_depth_mm,
+        )
+        .map(|p| p.translate([x, y, 0.0])))?);
+    }
+    cut.push(Solid::compose(&pilots));
+    let tube = g(cyl(r_out, tube_bottom, lv.top_z_mm))?
+        .difference(&Solid::union_all(&cut).part("shell_tube")?)
+        .part("shell_tube")?;
+
+    // The base: flange under the tube, spigot into the bay; camera pilots, cable slot and the
+    // joint screws' clearance holes.
+    let gb = |r: Result<Solid, _>| r.part("shell_base");
+    let base = Solid::union_all(&[
+        gb(cyl(r_out, lv.bottom_z_mm, tube_bottom))?,
+        gb(cyl(r_bay - c, tube_bottom - e, base_top))?,
+    ])
+    .part("shell_base")?;
+    let s = h.camera.mount_hole_spacing_mm / 2.0;
+    let mount_xy = [[s, s], [-s, s], [-s, -s], [s, -s]];
+    let mount_z = [lv.bottom_z_mm + fdm.min_wall_mm, base_top + 1.0];
+    let mut holes = Vec::new();
+    for [x, y] in mount_xy {
+        holes.push(gb(cyl(
+            h.camera.mount_pilot_diameter_mm / 2.0,
+            mount_z[0],
+            mount_z[1],
+        )
+        .map(|p| p.translate([x, y, 0.0])))?);
+    }
+    for [x, y] in screws_xy {
+        holes.push(gb(cyl(
+            js.clearance_diameter_mm / 2.0,
+            lv.bottom_z_mm - 1.0,
+            tube_bottom + 1.0,
+        )
+        .map(|p| p.translate([x, y, 0.0])))?);
+    }
+    let [sx, sy] = CABLE_SLOT_XY_MM;
+    holes.push(gb(cuboid(
+        [-sx / 2.0, -sy / 2.0, lv.bottom_z_mm - 1.0],
+        [sx / 2.0, sy / 2.0, base_top + 1.0],
+    ))?);
+    let base = base
+        .difference(&Solid::union_all(&holes).part("shell_base")?)
+        .part("shell_base")?;
+
+    let params = json!({
+        "style": h.style,
+        "levels": lv,
+        "housing": h,
+        "core_seat_radius_mm": r_core + c,
+        "bay_radius_mm": r_bay,
+        "spigot_radius_mm": r_bay - c,
+        "joint_screws": {"xy_mm": screws_xy, "axis": "z",
+            "pilot_z_mm": [tube_bottom - 1.0, tube_bottom + js.pilot_depth_mm],
+            "clearance_z_mm": [lv.bottom_z_mm - 1.0, tube_bottom + 1.0]},
+        "fixture_dowel_holes": null,
+        "camera_mount_holes_xy_mm": mount_xy,
+        "camera_mount_pilot_z_mm": mount_z,
+        "cable_slot_xy_mm": CABLE_SLOT_XY_MM,
+        // Each bore overlaps the next one up by this much (a hair, see above).
+        "overlap_mm": e,
+    });
+    let part = |(solid, pose): (Solid, crate::geometry::Affine),
+                name: &str,
+                description: &str,
+                orientation: &str| {
+        let mut p = params.clone();
+        if let Some(o) = p.as_object_mut() {
+            o.insert("print_orientation".into(), json!(orientation));
+        }
+        Part {
+            name: name.into(),
+            role: name.into(),
+            description: description.into(),
+            material: h.material.clone(),
+            print_technology: PrintTechnology::Fdm,
+            solid,
+            params: with_pose(p, &pose),
+            group: None,
+        }
+    };
+    let parts = vec![
+        part(
+            place_posed(&tube, &crate::geometry::rotation_deg(180.0, 0.0, 0.0)),
+            "shell_tube",
+            "Sensor shell: round tube with the contact-module, diffuser and LED PCB seats and the camera bay; the base screws up into its wall",
+            "top face down",
+        ),
+        part(
+            place_posed(&base, &crate::molds::IDENTITY),
+            "shell_base",
+            "Sensor base: closes the tube and carries the camera board (4 pilots on its spigot); the camera cable leaves through its slot; 2 joint screws up through its flange into the tube",
+            "flange down",
+        ),
+    ];
+    Ok((parts, lv))
+}
+
+/// The two square halves (see the module docs).
+fn build_square_split(
+    design: &Design,
+    h: &HousingParams,
+    core: &ResolvedCore,
+    lv: ShellLevels,
+    tol: ChordTolerance,
+) -> Result<(Vec<Part>, ShellLevels), DesignError> {
     let w = h.outer_width_mm / 2.0;
     let c = h.fit_clearance_mm;
     let r_core = design.body.rim_radius_mm(core.outer_offset_mm);
@@ -412,23 +828,8 @@ pub fn build_shell(
             lv.bulkhead_z_mm - e,
             lv.pcb_z_mm + e,
         ))?,
-        g(cyl(
-            h.led_pcb.outer_diameter_mm / 2.0 + c,
-            lv.pcb_z_mm,
-            lv.chamber_z_mm + e,
-        ))?,
-        g(cyl(
-            h.light_chamber_diameter_mm / 2.0,
-            lv.chamber_z_mm,
-            lv.diffuser_z_mm + e,
-        ))?,
-        g(cyl(
-            h.diffuser.outer_diameter_mm / 2.0 + c,
-            lv.diffuser_z_mm,
-            lv.seat_z_mm + e,
-        ))?,
-        g(cyl(r_core + c, lv.seat_z_mm, lv.top_z_mm + 1.0))?,
     ];
+    cut.extend(upper_bores(h, &lv, r_core, tol).part("shell")?);
     let mut holes = Vec::new();
     // Camera board mounting pilots, up from the bay through the bulkhead into solid material.
     let s = h.camera.mount_hole_spacing_mm / 2.0;
@@ -467,13 +868,15 @@ pub fn build_shell(
     }
     // Fixture dowel holes, down from the top face.
     let dowels = fixture_dowel_holes(h);
-    for [x, y] in dowels.positions_xy_mm {
-        holes.push(g(cyl(
-            dowels.diameter_mm / 2.0,
-            lv.top_z_mm - dowels.depth_mm,
-            lv.top_z_mm + 1.0,
-        )
-        .map(|p| p.translate([x, y, 0.0])))?);
+    if let Some(d) = &dowels {
+        for [x, y] in d.positions_xy_mm {
+            holes.push(g(cyl(
+                d.diameter_mm / 2.0,
+                lv.top_z_mm - d.depth_mm,
+                lv.top_z_mm + 1.0,
+            )
+            .map(|p| p.translate([x, y, 0.0])))?);
+        }
     }
     cut.push(Solid::compose(&holes));
     let body = shell
@@ -481,6 +884,7 @@ pub fn build_shell(
         .part("shell")?;
     let (pos, neg) = body.split_by_plane([1.0, 0.0, 0.0], 0.0);
     let params = json!({
+        "style": h.style,
         "levels": lv,
         "housing": h,
         "core_seat_radius_mm": r_core + c,

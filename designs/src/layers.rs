@@ -38,7 +38,7 @@ fn surface_offset(l: &ResolvedLayer, s: MarkerSurface) -> f64 {
 }
 
 fn direction(spec: &MarkerSpec) -> f64 {
-    match (spec.surface, spec.feature.polarity) {
+    match (spec.surface, spec.feature.side()) {
         (MarkerSurface::Outer, Polarity::Raised) | (MarkerSurface::Inner, Polarity::Recessed) => {
             1.0
         }
@@ -139,49 +139,87 @@ pub fn recess_clearance_to_base_mm(
 }
 
 /// Rules on marker patterns: they place, do not overlap, leave the printer's minimum wall,
-/// and their features print on the technology that makes them.
+/// and their features print on the technology that makes them (the mold's cavity printer for
+/// a cast layer, the layer's own for a printed one).
 pub fn check_markers(design: &Design, layers: &[ResolvedLayer], errs: &mut Vec<ParamError>) {
     for l in layers {
-        let spec_layer = &design.layers[l.index];
-        let tech = feature_technology(design, spec_layer);
-        let tech_name = format!("{tech:?}").to_lowercase();
-        let profile = design.printers.get(tech);
-        for (j, spec) in spec_layer.markers.iter().enumerate() {
-            let path = format!("layers[{}].markers[{j}]", l.index);
-            let f = &spec.feature;
-            if !(f.diameter_mm > 0.0 && f.diameter_mm.is_finite()) {
-                errs.push(ParamError::new(
-                    format!("{path}.feature.diameter_mm"),
-                    f.diameter_mm,
-                    "must be above 0",
-                ));
-                continue;
-            }
-            if !(f.height_mm >= f.diameter_mm / 2.0 && f.height_mm.is_finite()) {
-                errs.push(ParamError::new(
-                    format!("{path}.feature.height_mm"),
-                    f.height_mm,
-                    format!(
-                        "must be at least the radius {} mm (a cylinder ending in a hemisphere)",
-                        f.diameter_mm / 2.0
-                    ),
-                ));
-                continue;
-            }
-            if l.solid && spec.surface == MarkerSurface::Inner {
-                errs.push(ParamError::new(
-                    format!("{path}.surface"),
-                    "inner",
-                    "a solid layer has no inner surface",
-                ));
-                continue;
-            }
-            let molded = spec_layer.process == LayerProcess::Cast;
-            if molded
-                && spec.surface == MarkerSurface::Inner
-                && l.mold_strategy != MoldStrategy::Boundary
-            {
-                errs.push(ParamError::new(
+        let tech = feature_technology(design, &design.layers[l.index]);
+        errs.extend(marker_errors(design, l, tech));
+    }
+}
+
+/// The technologies that could make the features of marker pattern `j` of layer `l`: those
+/// for which [`marker_errors`], the rules that validate the design, report nothing on that
+/// pattern (nor on the layer's markers as a whole).
+pub fn printable_with(design: &Design, l: &ResolvedLayer, j: usize) -> Vec<Technology> {
+    let own = format!("layers[{}].markers[{j}]", l.index);
+    let shared = format!("layers[{}].markers", l.index);
+    [Technology::Fdm, Technology::Sla, Technology::Polyjet]
+        .into_iter()
+        .filter(|&t| {
+            marker_errors(design, l, t).iter().all(|e| {
+                !(e.path == own || e.path.starts_with(&format!("{own}.")) || e.path == shared)
+            })
+        })
+        .collect()
+}
+
+/// Every violation of the marker rules of layer `l` when its features are made by printer
+/// technology `tech` (its profile's minimum wall, hole and feature, and the rim margin that
+/// follows from them). [`check_markers`] applies it with the layer's own technology,
+/// [`printable_with`] with each.
+pub fn marker_errors(design: &Design, l: &ResolvedLayer, tech: Technology) -> Vec<ParamError> {
+    let mut errs = Vec::new();
+    let spec_layer = &design.layers[l.index];
+    let tech_name = format!("{tech:?}").to_lowercase();
+    let profile = design.printers.get(tech);
+    for (j, spec) in spec_layer.markers.iter().enumerate() {
+        let path = format!("layers[{}].markers[{j}]", l.index);
+        let f = &spec.feature;
+        if !(f.diameter_mm > 0.0 && f.diameter_mm.is_finite()) {
+            errs.push(ParamError::new(
+                format!("{path}.feature.diameter_mm"),
+                f.diameter_mm,
+                "must be above 0",
+            ));
+            continue;
+        }
+        if !(f.height_mm >= f.diameter_mm / 2.0 && f.height_mm.is_finite()) {
+            errs.push(ParamError::new(
+                format!("{path}.feature.height_mm"),
+                f.height_mm,
+                format!(
+                    "must be at least the radius {} mm (a cylinder ending in a hemisphere)",
+                    f.diameter_mm / 2.0
+                ),
+            ));
+            continue;
+        }
+        if let (Some(_), Some(_)) | (None, None) = (f.polarity, f.on_skin) {
+            errs.push(ParamError::new(
+                format!("{path}.feature"),
+                match (f.polarity, f.on_skin) {
+                    (Some(p), Some(s)) => format!("polarity: {p:?}, on_skin: {s:?}").to_lowercase(),
+                    _ => "neither on_skin nor polarity".to_string(),
+                },
+                "give exactly one of on_skin (dimple | bump) and polarity (raised | recessed)",
+            ));
+            continue;
+        }
+        if l.solid && spec.surface == MarkerSurface::Inner {
+            errs.push(ParamError::new(
+                format!("{path}.surface"),
+                "inner",
+                "a solid layer has no inner surface",
+            ));
+            continue;
+        }
+        let molded = spec_layer.process == LayerProcess::Cast;
+        if molded
+            && spec.surface == MarkerSurface::Inner
+            && l.mold_strategy != MoldStrategy::Boundary
+        {
+            errs.push(ParamError::new(
                     format!("{path}.surface"),
                     "inner",
                     format!(
@@ -189,39 +227,43 @@ pub fn check_markers(design: &Design, layers: &[ResolvedLayer], errs: &mut Vec<P
                         l.mold_strategy
                     ),
                 ));
-                continue;
+            continue;
+        }
+        if spec.tip_material.is_some()
+            && (spec_layer.process != LayerProcess::Printed || f.side() != Polarity::Raised)
+        {
+            errs.push(ParamError::new(
+                format!("{path}.tip_material"),
+                spec.tip_material.clone().unwrap_or_default(),
+                "separate tips need raised features on a printed layer",
+            ));
+        }
+        // Printability: in a mold, a raised feature is a hole and a recessed one a bump.
+        let (what, min) = match (molded, f.side()) {
+            (true, Polarity::Raised) | (false, Polarity::Recessed) => {
+                ("minimum hole", profile.min_hole_diameter_mm)
             }
-            if spec.tip_material.is_some()
-                && (spec_layer.process != LayerProcess::Printed || f.polarity != Polarity::Raised)
-            {
-                errs.push(ParamError::new(
-                    format!("{path}.tip_material"),
-                    spec.tip_material.clone().unwrap_or_default(),
-                    "separate tips need raised features on a printed layer",
-                ));
-            }
-            // Printability: in a mold, a raised feature is a hole and a recessed one a bump.
-            let (what, min) = match (molded, f.polarity) {
-                (true, Polarity::Raised) | (false, Polarity::Recessed) => {
-                    ("minimum hole", profile.min_hole_diameter_mm)
-                }
-                _ => ("minimum feature", profile.min_feature_mm),
-            };
-            if f.diameter_mm < min {
-                errs.push(ParamError::new(
-                    format!("{path}.feature.diameter_mm"),
-                    f.diameter_mm,
-                    format!(
-                        "below the {what} {min} mm of printer profile '{tech_name}' that {} this layer",
-                        if molded { "prints the mold of" } else { "prints" }
-                    ),
-                ));
-                continue;
-            }
-            // A feature cut into a shell layer must leave its minimum wall behind it.
-            let cut_in = f.polarity == Polarity::Recessed;
-            if cut_in && !l.solid && f.height_mm > l.thickness_mm - profile.min_wall_mm {
-                errs.push(ParamError::new(
+            _ => ("minimum feature", profile.min_feature_mm),
+        };
+        if f.diameter_mm < min {
+            errs.push(ParamError::new(
+                format!("{path}.feature.diameter_mm"),
+                f.diameter_mm,
+                format!(
+                    "below the {what} {min} mm of printer profile '{tech_name}' that {} this layer",
+                    if molded {
+                        "prints the mold of"
+                    } else {
+                        "prints"
+                    }
+                ),
+            ));
+            continue;
+        }
+        // A feature cut into a shell layer must leave its minimum wall behind it.
+        let cut_in = f.side() == Polarity::Recessed;
+        if cut_in && !l.solid && f.height_mm > l.thickness_mm - profile.min_wall_mm {
+            errs.push(ParamError::new(
                     format!("{path}.feature.height_mm"),
                     f.height_mm,
                     format!(
@@ -229,39 +271,50 @@ pub fn check_markers(design: &Design, layers: &[ResolvedLayer], errs: &mut Vec<P
                         f.height_mm, l.thickness_mm, profile.min_wall_mm
                     ),
                 ));
-                continue;
-            }
-            let surface = Surface::new(&design.body, surface_offset(l, spec.surface));
-            let placed = match markers::place(
-                &surface,
-                &spec.pattern,
-                rim_margin(spec, profile.min_wall_mm),
-            ) {
-                Ok(m) => m,
-                Err((field, value, rule)) => {
-                    errs.push(ParamError::new(
-                        format!("{path}.pattern.{field}"),
-                        value,
-                        rule,
-                    ));
-                    continue;
-                }
-            };
-            if placed.is_empty() {
+            continue;
+        }
+        let field_errs = spec.pattern.field_errors();
+        if !field_errs.is_empty() {
+            for (field, value, rule) in field_errs {
                 errs.push(ParamError::new(
-                    format!("{path}.pattern"),
-                    "0 markers",
-                    "places no marker",
+                    format!("{path}.pattern.{field}"),
+                    value,
+                    rule,
+                ));
+            }
+            continue;
+        }
+        let surface = Surface::new(&design.body, surface_offset(l, spec.surface));
+        let placed = match markers::place(
+            &surface,
+            &spec.pattern,
+            rim_margin(spec, profile.min_wall_mm),
+        ) {
+            Ok(m) => m,
+            Err((field, value, rule)) => {
+                errs.push(ParamError::new(
+                    format!("{path}.pattern.{field}"),
+                    value,
+                    rule,
                 ));
                 continue;
             }
-            let st = markers::stats(&surface, &placed);
-            let gap = st.min_spacing_mm - f.diameter_mm;
-            if placed.len() > 1 && gap < profile.min_wall_mm {
-                let (a, b) = st.closest_pair.unwrap_or((0, 0));
-                errs.push(ParamError::new(
+        };
+        if placed.is_empty() {
+            errs.push(ParamError::new(
+                format!("{path}.pattern"),
+                "0 markers",
+                "places no marker",
+            ));
+            continue;
+        }
+        let st = markers::stats(&surface, &placed);
+        let gap = st.min_spacing_mm - f.diameter_mm;
+        if placed.len() > 1 && gap < profile.min_wall_mm {
+            let (a, b) = st.closest_pair.unwrap_or((0, 0));
+            errs.push(ParamError::new(
                     format!("{path}.pattern"),
-                    format!("{:?}", spec.pattern.layout).to_lowercase(),
+                    markers::layout_name(spec.pattern.layout),
                     format!(
                         "markers {a} and {b} are {:.3} mm apart on the surface: features of {} mm {} (wall {:.3} mm, minimum {} mm of printer profile '{tech_name}')",
                         st.min_spacing_mm,
@@ -271,20 +324,20 @@ pub fn check_markers(design: &Design, layers: &[ResolvedLayer], errs: &mut Vec<P
                         profile.min_wall_mm
                     ),
                 ));
-                continue;
-            }
-            // Features that converge (pointing into a concave side) must stay apart at their
-            // ends too: the hemisphere centres keep the same clearance as the bases.
-            let ends = feature_end_centres(&placed, f, direction(spec));
-            if ends.len() > 1 {
-                let nn = markers::nearest_neighbours(&ends);
-                if let Some((a, (b, d))) = nn.iter().enumerate().min_by(|x, y| {
-                    x.1 .1
-                        .partial_cmp(&y.1 .1)
-                        .unwrap_or(std::cmp::Ordering::Equal)
-                }) {
-                    if d - f.diameter_mm < profile.min_wall_mm {
-                        errs.push(ParamError::new(
+            continue;
+        }
+        // Features that converge (pointing into a concave side) must stay apart at their
+        // ends too: the hemisphere centres keep the same clearance as the bases.
+        let ends = feature_end_centres(&placed, f, direction(spec));
+        if ends.len() > 1 {
+            let nn = markers::nearest_neighbours(&ends);
+            if let Some((a, (b, d))) = nn.iter().enumerate().min_by(|x, y| {
+                x.1 .1
+                    .partial_cmp(&y.1 .1)
+                    .unwrap_or(std::cmp::Ordering::Equal)
+            }) {
+                if d - f.diameter_mm < profile.min_wall_mm {
+                    errs.push(ParamError::new(
                             format!("{path}.feature.height_mm"),
                             f.height_mm,
                             format!(
@@ -292,15 +345,15 @@ pub fn check_markers(design: &Design, layers: &[ResolvedLayer], errs: &mut Vec<P
                                 f.diameter_mm, profile.min_wall_mm
                             ),
                         ));
-                        continue;
-                    }
+                    continue;
                 }
             }
-            // A recess into a solid layer must not cut through its flat base.
-            if l.solid && f.polarity == Polarity::Recessed {
-                let worst = recess_clearance_to_base_mm(&placed, f, design.body.base_z_mm());
-                if worst < profile.min_wall_mm {
-                    errs.push(ParamError::new(
+        }
+        // A recess into a solid layer must not cut through its flat base.
+        if l.solid && f.side() == Polarity::Recessed {
+            let worst = recess_clearance_to_base_mm(&placed, f, design.body.base_z_mm());
+            if worst < profile.min_wall_mm {
+                errs.push(ParamError::new(
                         format!("{path}.feature.height_mm"),
                         f.height_mm,
                         format!(
@@ -308,22 +361,22 @@ pub fn check_markers(design: &Design, layers: &[ResolvedLayer], errs: &mut Vec<P
                             profile.min_wall_mm
                         ),
                     ));
-                }
             }
         }
-        // Recesses from both surfaces of a shell must leave the minimum wall between them.
-        if !l.solid {
-            let depth = |surface: MarkerSurface| {
-                spec_layer
-                    .markers
-                    .iter()
-                    .filter(|m| m.surface == surface && m.feature.polarity == Polarity::Recessed)
-                    .map(|m| m.feature.height_mm)
-                    .fold(0.0, f64::max)
-            };
-            let (o, i) = (depth(MarkerSurface::Outer), depth(MarkerSurface::Inner));
-            if o > 0.0 && i > 0.0 && o + i > l.thickness_mm - profile.min_wall_mm {
-                errs.push(ParamError::new(
+    }
+    // Recesses from both surfaces of a shell must leave the minimum wall between them.
+    if !l.solid {
+        let depth = |surface: MarkerSurface| {
+            spec_layer
+                .markers
+                .iter()
+                .filter(|m| m.surface == surface && m.feature.side() == Polarity::Recessed)
+                .map(|m| m.feature.height_mm)
+                .fold(0.0, f64::max)
+        };
+        let (o, i) = (depth(MarkerSurface::Outer), depth(MarkerSurface::Inner));
+        if o > 0.0 && i > 0.0 && o + i > l.thickness_mm - profile.min_wall_mm {
+            errs.push(ParamError::new(
                     format!("layers[{}].markers", l.index),
                     format!("recesses {o} mm (outer) + {i} mm (inner)"),
                     format!(
@@ -331,9 +384,9 @@ pub fn check_markers(design: &Design, layers: &[ResolvedLayer], errs: &mut Vec<P
                         l.thickness_mm, l.name, profile.min_wall_mm
                     ),
                 ));
-            }
         }
     }
+    errs
 }
 
 fn feature_solids(
@@ -413,6 +466,32 @@ fn tip_solids(pm: &PlacedMarkers, tol: ChordTolerance) -> Result<Vec<Solid>, Geo
             Ok(local.transform(&markers::frame_to(base, dir)))
         })
         .collect()
+}
+
+/// The solid bounded by the body's surface at `offset_mm`, continued `extend_mm` below the
+/// base plane (see [`crate::profile::BodyProfile::solid_profile`]), revolved at `tol`.
+fn body_solid(
+    design: &Design,
+    offset_mm: f64,
+    extend_mm: f64,
+    tol: ChordTolerance,
+) -> Result<Solid, GeometryError> {
+    revolve(
+        &design.body.solid_profile(offset_mm, extend_mm, tol.half()),
+        tol,
+    )
+    .and_then(|mesh| Solid::from_mesh(&mesh))
+}
+
+/// The highest z of the surface at `offset_mm` with its outward features: the pole plus the
+/// tallest outward feature, mm (sensor frame).
+fn features_top_z_mm(design: &Design, offset_mm: f64, sets: &[&PlacedMarkers]) -> f64 {
+    design.body.pole_z_mm(offset_mm)
+        + sets
+            .iter()
+            .filter(|p| p.direction > 0.0)
+            .map(|p| p.spec.feature.height_mm)
+            .fold(0.0, f64::max)
 }
 
 /// Adds the outward features and removes the inward ones: one compose and one boolean each.
@@ -516,19 +595,21 @@ fn marker_summary(
     placed
         .iter()
         .map(|p| {
-            // A feature prints on a profile when it is above both its smallest hole and its
-            // smallest feature (it is one or the other in the part or in its mold).
-            let printable: Vec<&str> = [
-                ("FDM", &design.printers.fdm),
-                ("SLA", &design.printers.sla),
-                ("PolyJet", &design.printers.polyjet),
-            ]
-            .iter()
-            .filter(|(_, pr)| {
-                p.spec.feature.diameter_mm >= pr.min_hole_diameter_mm.max(pr.min_feature_mm)
-            })
-            .map(|(n, _)| *n)
-            .collect();
+            // The technologies whose printer profile passes the same marker rules that
+            // validate the design (feature or hole size, walls, rim margin).
+            let printable: Vec<&str> = design.layers[l.index]
+                .markers
+                .iter()
+                .position(|s| *s == p.spec)
+                .map(|j| printable_with(design, l, j))
+                .unwrap_or_default()
+                .into_iter()
+                .map(|t| match t {
+                    Technology::Fdm => "FDM",
+                    Technology::Sla => "SLA",
+                    Technology::Polyjet => "PolyJet",
+                })
+                .collect();
             json!({
                 "layer": l.name,
                 "surface": p.spec.surface,
@@ -644,25 +725,9 @@ pub fn build_layer(
         (_, MoldStrategy::Open) => {
             // mold = (block - plain cavity) with the features cut or added: one boolean with
             // the features, and the skin's volume falls out as block - mold.
-            let plain = g(revolve(
-                &design
-                    .body
-                    .solid_profile(l.outer_offset_mm, 1.0, tol.half()),
-                tol,
-            )
-            .and_then(|mesh| Solid::from_mesh(&mesh)))?;
+            let plain = g(body_solid(design, l.outer_offset_mm, 1.0, tol))?;
             let rim = design.body.rim_radius_mm(l.outer_offset_mm);
-            let top = design.body.pole_z_mm(l.outer_offset_mm)
-                + outer
-                    .iter()
-                    .map(|p| {
-                        if p.direction > 0.0 {
-                            p.spec.feature.height_mm
-                        } else {
-                            0.0
-                        }
-                    })
-                    .fold(0.0, f64::max);
+            let top = features_top_z_mm(design, l.outer_offset_mm, &outer);
             let half = rim + m.wall_thickness_mm;
             let zb = design.body.base_z_mm();
             let block = g(crate::geometry::cuboid(
@@ -694,6 +759,127 @@ pub fn build_layer(
             let pour_parts = vec![part.name.clone()];
             Ok(LayerOutput {
                 parts: vec![part],
+                pours: vec![(name.clone(), l.material.clone(), skin_volume, pour_parts)],
+                markers: markers_json,
+            })
+        }
+        (_, MoldStrategy::TwoPieceOpen) => {
+            // Cavity block: the outline from the parting face to the wall beyond the pole,
+            // less the cavity (continued 1 mm into the pocket), the pocket and the bolt holes,
+            // with the features: a dimple is a pin standing into the cavity.
+            let f = crate::molds::TwoPieceFrame::new(design);
+            let zb = f.base_z_mm;
+            let plain = g(body_solid(design, l.outer_offset_mm, 1.0, tol))?;
+            let cap = g(body_solid(design, l.outer_offset_mm, 0.0, tol))?;
+            let top = features_top_z_mm(design, l.outer_offset_mm, &outer);
+            let z_far = top + m.wall_thickness_mm;
+            let [ox, oy] = f.outer_half_mm;
+            let [px, py] = f.pocket_half_mm;
+            let [bx, by] = f.boss_half_mm;
+            let pocket = g(crate::geometry::cuboid(
+                [-px, -py, f.parting_z_mm - 1.0],
+                [px, py, zb],
+            ))?;
+            let hole = g(crate::geometry::cylinder(
+                z_far - f.top_z_mm + 2.0,
+                f.bolt_hole_diameter_mm / 2.0,
+                tol,
+            ))?;
+            let bolts = Solid::compose(
+                &f.bolts_xy_mm
+                    .iter()
+                    .map(|b| hole.translate([b[0], b[1], f.top_z_mm - 1.0]))
+                    .collect::<Vec<_>>(),
+            );
+            let block = g(crate::geometry::cuboid(
+                [-ox, -oy, f.parting_z_mm],
+                [ox, oy, z_far],
+            ))?;
+            let bare = g(block
+                .difference(&plain)
+                .and_then(|b| b.difference(&pocket))
+                .and_then(|b| b.difference(&bolts)))?;
+            let bottom = g(apply_features_signed(
+                bare.clone(),
+                &outer,
+                tol,
+                false,
+                -1.0,
+            ))?;
+            // The skin: the cap less what the features added to the block, plus what they cut.
+            let skin_volume = cap.volume() - (bottom.volume() - bare.volume());
+            // Top piece: plate and boss, less the reservoir bore and the bolt holes.
+            let plate = g(crate::geometry::cuboid(
+                [-ox, -oy, f.top_z_mm],
+                [ox, oy, f.parting_z_mm],
+            ))?;
+            let boss = g(crate::geometry::cuboid(
+                [-bx, -by, f.parting_z_mm],
+                [bx, by, zb],
+            ))?;
+            let bore =
+                g(
+                    crate::geometry::cylinder(zb - f.top_z_mm + 2.0, f.reservoir_radius_mm, tol)
+                        .map(|c| c.translate([0.0, 0.0, f.top_z_mm - 1.0])),
+                )?;
+            let top_piece = g(plate
+                .union(&boss)
+                .and_then(|t| t.difference(&Solid::compose(&[bore, bolts.clone()]))))?;
+            let reservoir_mm3 =
+                std::f64::consts::PI * f.reservoir_radius_mm.powi(2) * (zb - f.top_z_mm);
+            let params = json!({
+                "base": base_params,
+                "two_piece": m.two_piece,
+                "frame": f,
+                "cavity_block_z_mm": [f.parting_z_mm, z_far],
+                "bolt_holes_z_mm": [f.top_z_mm - 1.0, z_far + 1.0],
+                "bolt_grip_mm": z_far - f.top_z_mm,
+                "registration_clearance_mm": m.registration_key.clearance_mm,
+                "reservoir_volume_mm3": reservoir_mm3,
+                "pull_direction": "along the sensor axis: the top piece off the cavity block, then the skin out of the cavity",
+            });
+            let (bottom_placed, bottom_pose) =
+                place_posed(&bottom, &crate::geometry::rotation_deg(180.0, 0.0, 0.0));
+            let (top_placed, top_pose) = place_posed(&top_piece, &IDENTITY);
+            let piece = |suffix: &str, which: &str, desc: String, solid, pose| {
+                let mut p = params.clone();
+                p["piece"] = json!(which);
+                Part {
+                    name: format!("{name}_{suffix}"),
+                    role: "open_mold_piece".into(),
+                    description: desc,
+                    material: material_for(cavity_tech).into(),
+                    print_technology: cavity_tech,
+                    solid,
+                    params: with_pose(p, &pose),
+                    group: None,
+                }
+            };
+            let n_bolts = f.bolts_xy_mm.len();
+            let parts = vec![
+                piece(
+                    "cavity_block",
+                    "cavity_block",
+                    format!(
+                        "Bottom piece of the two-piece mold for the solid {name} skin: the cavity, printed parting face up, with the pocket for the top piece's boss and {n_bolts} bolt holes"
+                    ),
+                    bottom_placed,
+                    bottom_pose,
+                ),
+                piece(
+                    "reservoir_top",
+                    "reservoir_top",
+                    format!(
+                        "Top piece of the two-piece mold for the {name} skin: its {} mm bore is the pour reservoir that forms the skin's back; boss down into the cavity block's pocket, {n_bolts} bolts",
+                        2.0 * f.reservoir_radius_mm
+                    ),
+                    top_placed,
+                    top_pose,
+                ),
+            ];
+            let pour_parts = parts.iter().map(|p| p.name.clone()).collect();
+            Ok(LayerOutput {
+                parts,
                 pours: vec![(name.clone(), l.material.clone(), skin_volume, pour_parts)],
                 markers: markers_json,
             })

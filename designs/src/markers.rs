@@ -33,7 +33,28 @@ pub enum Polarity {
     Recessed,
 }
 
-/// A radial cylinder ending in a hemisphere of the same diameter.
+/// Which side of the skin a feature is on, in a maker's words: a `dimple` is cut into the
+/// skin (its mold carries a pin standing out of the cavity wall into the cavity), a `bump`
+/// stands out of the skin (its mold carries a recess). The same as [`Polarity::Recessed`] and
+/// [`Polarity::Raised`] of the surface that carries the feature.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum OnSkin {
+    Dimple,
+    Bump,
+}
+
+impl From<OnSkin> for Polarity {
+    fn from(s: OnSkin) -> Self {
+        match s {
+            OnSkin::Dimple => Polarity::Recessed,
+            OnSkin::Bump => Polarity::Raised,
+        }
+    }
+}
+
+/// A radial cylinder ending in a hemisphere of the same diameter. Give exactly one of
+/// `on_skin` and `polarity` (validation names `...feature` otherwise).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FeatureShape {
@@ -41,10 +62,47 @@ pub struct FeatureShape {
     pub diameter_mm: f64,
     /// From the surface to the tip of the hemisphere, along the normal, mm (>= radius).
     pub height_mm: f64,
-    pub polarity: Polarity,
+    /// Whether the feature stands out of the surface that carries it or is cut into it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub polarity: Option<Polarity>,
+    /// The same choice in a maker's words: `dimple` (cut into the skin) or `bump`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub on_skin: Option<OnSkin>,
 }
 
 impl FeatureShape {
+    /// A feature of the given polarity (given as `polarity`).
+    pub fn new(diameter_mm: f64, height_mm: f64, polarity: Polarity) -> Self {
+        Self {
+            diameter_mm,
+            height_mm,
+            polarity: Some(polarity),
+            on_skin: None,
+        }
+    }
+
+    /// The polarity the feature was given, as `polarity` or as `on_skin`. On a shape that
+    /// gives neither or both (validation rejects those), `on_skin` wins, then raised.
+    pub fn side(&self) -> Polarity {
+        match (self.on_skin, self.polarity) {
+            (Some(s), _) => s.into(),
+            (None, Some(p)) => p,
+            (None, None) => Polarity::Raised,
+        }
+    }
+
+    /// Sets the polarity, in the form (`on_skin` or `polarity`) the shape already uses.
+    pub fn set_side(&mut self, p: Polarity) {
+        if self.on_skin.is_some() {
+            self.on_skin = Some(match p {
+                Polarity::Raised => OnSkin::Bump,
+                Polarity::Recessed => OnSkin::Dimple,
+            });
+        } else {
+            self.polarity = Some(p);
+        }
+    }
+
     pub fn radius_mm(&self) -> f64 {
         self.diameter_mm / 2.0
     }
@@ -60,12 +118,14 @@ impl FeatureShape {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Layout {
-    /// A centre marker and rings k = 1..rings of 6k markers, ring k at arc length k x pitch
-    /// (the published ShadowTac mold: 12 rings, 469 markers, pitch 1.53 mm).
+    /// A centre marker and rings k = 1..rings of 6k markers, ring k at arc length
+    /// k x `pitch_arc_mm` or at polar angle k x `polar_step_deg` (exactly one of the two).
+    /// The ShadowTac authors' mold: 12 rings, 469 markers, 3.9474 deg apart; TacTipGenerator's
+    /// default: 8 rings, 217 pins, 9.3836 deg apart, odd rings turned by half a step.
     #[serde(rename = "concentric_6k")]
     Concentric6k,
-    /// A centre marker and rings every `spacing_mm` of arc; round(circumference / spacing)
-    /// markers per ring.
+    /// A centre marker and rings every `spacing_mm` of arc (or every `polar_step_deg` of polar
+    /// angle); round(circumference / spacing) markers per ring.
     Concentric,
     /// A hexagonal lattice of pitch `spacing_mm`, wrapped onto the surface by arc length from
     /// the pole (azimuthal equidistant).
@@ -106,6 +166,155 @@ pub struct Pattern {
     pub max_polar_deg: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub min_polar_deg: Option<f64>,
+    /// Concentric layouts: the polar angle between rings, degrees, finite and above 0. Ring k
+    /// sits at polar angle k x step seen from the sensor-frame origin (from `min_polar_deg`
+    /// on when that is set, for `concentric`). For `concentric_6k` it replaces
+    /// `pitch_arc_mm` (give exactly one); for `concentric` it replaces `spacing_mm` as the
+    /// ring pitch, and `spacing_mm` still sets the markers per ring.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub polar_step_deg: Option<f64>,
+    /// Concentric layouts: how far each ring is turned about the axis (default: none, every
+    /// ring has a marker at azimuth 0, on +x).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ring_azimuth_offset: Option<RingAzimuthOffset>,
+}
+
+/// Azimuth offset of the rings of a concentric pattern. Rings are numbered k = 1, 2, ... from
+/// the pole (the centre marker is ring 0); an offset turns a ring from +x towards +y.
+///
+/// YAML: `ring_azimuth_offset: {alternate: half_step}` or
+/// `ring_azimuth_offset: {per_ring_deg: [0.0, 30.0, ...]}`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum RingAzimuthOffset {
+    /// Every odd ring (k = 1, 3, 5, ...) turned by the given fraction of its own azimuth step
+    /// (360 / n_k degrees for a ring of n_k markers); even rings keep a marker on +x.
+    /// TacTipGenerator's layout (`pointsCalculator` in its skinGenerator.py) is `half_step`.
+    Alternate(AlternateOffset),
+    /// One offset per ring k = 1..rings, degrees, each finite; as many entries as the pattern
+    /// has rings.
+    PerRingDeg(Vec<f64>),
+}
+
+/// The turn of the odd rings of an alternating [`RingAzimuthOffset`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AlternateOffset {
+    /// Half the ring's own azimuth step: 180 / n_k degrees.
+    HalfStep,
+}
+
+/// A pattern error: (field below `pattern`, value, rule).
+pub type PatternError = (String, String, String);
+
+impl Pattern {
+    /// Whether the layout is one of the concentric ones.
+    pub fn is_concentric(&self) -> bool {
+        matches!(self.layout, Layout::Concentric | Layout::Concentric6k)
+    }
+
+    /// Checks of the pattern's own fields that need no surface: every violation, each as
+    /// (field below `pattern`, value, rule). [`place`] checks these first and the rest
+    /// (room on the surface, rings beyond the rim) while placing.
+    pub fn field_errors(&self) -> Vec<PatternError> {
+        let mut errs: Vec<PatternError> = Vec::new();
+        let mut push = |f: &str, v: String, rule: &str| {
+            errs.push((f.to_string(), v, rule.to_string()));
+        };
+        if let Some(x) = self.polar_step_deg {
+            if !self.is_concentric() {
+                push(
+                    "polar_step_deg",
+                    x.to_string(),
+                    &format!(
+                        "applies only to the concentric layouts (layout is {})",
+                        layout_name(self.layout)
+                    ),
+                );
+            } else if !(x > 0.0 && x.is_finite()) {
+                push(
+                    "polar_step_deg",
+                    x.to_string(),
+                    "must be a finite angle above 0",
+                );
+            }
+        }
+        if self.layout == Layout::Concentric6k {
+            if let Some(sp) = self.spacing_mm {
+                push(
+                    "spacing_mm",
+                    sp.to_string(),
+                    "has no effect on concentric_6k (ring k holds 6k markers; its pitch is pitch_arc_mm or polar_step_deg): remove it or use layout concentric",
+                );
+            }
+            match (self.pitch_arc_mm, self.polar_step_deg) {
+                (Some(p), Some(x)) => push(
+                    "polar_step_deg",
+                    x.to_string(),
+                    &format!("give exactly one of pitch_arc_mm and polar_step_deg for concentric_6k (pitch_arc_mm is {p} too)"),
+                ),
+                (None, None) => push(
+                    "pitch_arc_mm",
+                    "missing".into(),
+                    "concentric_6k needs exactly one of pitch_arc_mm and polar_step_deg",
+                ),
+                _ => {}
+            }
+        }
+        if let Some(off) = &self.ring_azimuth_offset {
+            if !self.is_concentric() {
+                push(
+                    "ring_azimuth_offset",
+                    format!("{off:?}"),
+                    &format!(
+                        "applies only to the concentric layouts (layout is {})",
+                        layout_name(self.layout)
+                    ),
+                );
+            } else if let RingAzimuthOffset::PerRingDeg(v) = off {
+                for (i, x) in v.iter().enumerate() {
+                    if !x.is_finite() {
+                        push(
+                            &format!("ring_azimuth_offset.per_ring_deg[{i}]"),
+                            x.to_string(),
+                            "must be a finite angle",
+                        );
+                    }
+                }
+                if let (Layout::Concentric6k, Some(r)) = (self.layout, self.rings) {
+                    if v.len() != r as usize {
+                        push(
+                            "ring_azimuth_offset.per_ring_deg",
+                            format!("{} entries", v.len()),
+                            &format!("needs one entry per ring (rings is {r})"),
+                        );
+                    }
+                }
+            }
+        }
+        errs
+    }
+
+    /// The azimuth offset of ring k (>= 1) of `n` markers, radians.
+    fn ring_offset_rad(&self, k: u32, n: usize) -> f64 {
+        match &self.ring_azimuth_offset {
+            Some(RingAzimuthOffset::Alternate(AlternateOffset::HalfStep)) if k % 2 == 1 => {
+                PI / n as f64
+            }
+            None | Some(RingAzimuthOffset::Alternate(_)) => 0.0,
+            Some(RingAzimuthOffset::PerRingDeg(v)) => {
+                v.get(k as usize - 1).copied().unwrap_or(0.0).to_radians()
+            }
+        }
+    }
+}
+
+/// The YAML name of a layout (`concentric_6k`, `hex_grid`, ...).
+pub fn layout_name(l: Layout) -> String {
+    serde_json::to_value(l)
+        .ok()
+        .and_then(|v| v.as_str().map(str::to_string))
+        .unwrap_or_else(|| format!("{l:?}"))
 }
 
 fn yes() -> bool {
@@ -348,12 +557,16 @@ impl Surface {
 /// polar limit is given.
 ///
 /// # Errors
-/// A message naming the missing or invalid field of the pattern (the caller adds the path).
+/// The first violation as (field below `pattern`, value, rule); the caller adds the path.
+/// [`Pattern::field_errors`] lists every violation of the fields themselves.
 pub fn place(
     surface: &Surface,
     pattern: &Pattern,
     rim_margin_mm: f64,
-) -> Result<Vec<Marker>, (String, String, String)> {
+) -> Result<Vec<Marker>, PatternError> {
+    if let Some(e) = pattern.field_errors().into_iter().next() {
+        return Err(e);
+    }
     let err = |f: &str, v: String, rule: &str| Err((f.to_string(), v, rule.to_string()));
     let s_max = match pattern.max_polar_deg {
         Some(p) => surface.s_at_polar_deg(p),
@@ -370,20 +583,35 @@ pub fn place(
             "leaves no room for markers between the polar limits and the rim",
         );
     }
-    let positive = |f: &str, v: Option<f64>| -> Result<f64, (String, String, String)> {
+    // The rule that bounds the patterned region, for messages.
+    let limit = || match pattern.max_polar_deg {
+        Some(p) => format!("max_polar_deg {p}"),
+        None => format!(
+            "the rim at {:.3} deg less a margin of {rim_margin_mm:.3} mm of arc",
+            surface.polar_deg_at(surface.total_arc_mm())
+        ),
+    };
+    let polar_max = surface.polar_deg_at(s_max);
+    let positive = |f: &str, v: Option<f64>| -> Result<f64, PatternError> {
         match v {
             Some(x) if x > 0.0 && x.is_finite() => Ok(x),
             Some(x) => Err((f.to_string(), x.to_string(), "must be above 0".into())),
             None => Err((
                 f.to_string(),
                 "missing".into(),
-                format!("is required for layout {:?}", pattern.layout),
+                format!("is required for layout {}", layout_name(pattern.layout)),
             )),
         }
     };
     // (s, azimuth radians, ring)
     let mut raw: Vec<(f64, f64, u32)> = Vec::new();
     let centre = pattern.center_marker && s_min == 0.0;
+    let push_ring = |raw: &mut Vec<(f64, f64, u32)>, s: f64, k: u32, n: usize| {
+        let off = pattern.ring_offset_rad(k, n);
+        for j in 0..n {
+            raw.push((s, off + 2.0 * PI * j as f64 / n as f64, k));
+        }
+    };
     match pattern.layout {
         Layout::Concentric6k => {
             let rings = pattern.rings.ok_or_else(|| {
@@ -393,18 +621,33 @@ pub fn place(
                     "is required for concentric_6k".to_string(),
                 )
             })?;
-            let pitch = positive("pitch_arc_mm", pattern.pitch_arc_mm)?;
             if centre {
                 raw.push((0.0, 0.0, 0));
             }
-            for k in 1..=rings {
-                let s = k as f64 * pitch;
-                if s > s_max + 1e-9 {
-                    return err("rings", rings.to_string(), &format!("ring {k} at {s:.3} mm of arc lies beyond the patterned region ({s_max:.3} mm)"));
+            if let Some(step) = pattern.polar_step_deg {
+                let last = rings as f64 * step;
+                if last > polar_max + 1e-9 {
+                    return err(
+                        "polar_step_deg",
+                        step.to_string(),
+                        &format!(
+                            "puts ring {rings} at {rings} x {step} = {last:.4} deg, beyond the patterned region (up to {polar_max:.4} deg: {})",
+                            limit()
+                        ),
+                    );
                 }
-                let n = 6 * k;
-                for j in 0..n {
-                    raw.push((s, 2.0 * PI * j as f64 / n as f64, k));
+                for k in 1..=rings {
+                    let s = surface.s_at_polar_deg(k as f64 * step);
+                    push_ring(&mut raw, s, k, 6 * k as usize);
+                }
+            } else {
+                let pitch = positive("pitch_arc_mm", pattern.pitch_arc_mm)?;
+                for k in 1..=rings {
+                    let s = k as f64 * pitch;
+                    if s > s_max + 1e-9 {
+                        return err("rings", rings.to_string(), &format!("ring {k} at {s:.3} mm of arc lies beyond the patterned region ({s_max:.3} mm: {})", limit()));
+                    }
+                    push_ring(&mut raw, s, k, 6 * k as usize);
                 }
             }
         }
@@ -413,21 +656,41 @@ pub fn place(
             if centre {
                 raw.push((0.0, 0.0, 0));
             }
+            // Ring k's arc length, or None beyond the region.
+            let ring_s = |k: u32| -> Option<f64> {
+                match pattern.polar_step_deg {
+                    Some(step) => {
+                        let p0 = pattern.min_polar_deg.filter(|_| s_min > 0.0);
+                        let polar = match p0 {
+                            Some(p0) => p0 + (k - 1) as f64 * step,
+                            None => k as f64 * step,
+                        };
+                        (polar <= polar_max + 1e-9).then(|| surface.s_at_polar_deg(polar))
+                    }
+                    None => {
+                        let s = if s_min > 0.0 {
+                            s_min + (k - 1) as f64 * sp
+                        } else {
+                            k as f64 * sp
+                        };
+                        (s <= s_max + 1e-9).then_some(s)
+                    }
+                }
+            };
             let mut k = 1;
-            loop {
-                let s = if s_min > 0.0 {
-                    s_min + (k - 1) as f64 * sp
-                } else {
-                    k as f64 * sp
-                };
-                if s > s_max + 1e-9 {
-                    break;
-                }
+            while let Some(s) = ring_s(k) {
                 let n = ((2.0 * PI * surface.radius_at(s) / sp).round() as usize).max(1);
-                for j in 0..n {
-                    raw.push((s, 2.0 * PI * j as f64 / n as f64, k));
-                }
+                push_ring(&mut raw, s, k, n);
                 k += 1;
+            }
+            if let Some(RingAzimuthOffset::PerRingDeg(v)) = &pattern.ring_azimuth_offset {
+                if v.len() != (k - 1) as usize {
+                    return err(
+                        "ring_azimuth_offset.per_ring_deg",
+                        format!("{} entries", v.len()),
+                        &format!("needs one entry per ring (the pattern has {} rings)", k - 1),
+                    );
+                }
             }
         }
         Layout::HexGrid => {
@@ -730,6 +993,8 @@ mod tests {
             center_marker: true,
             max_polar_deg: None,
             min_polar_deg: None,
+            polar_step_deg: None,
+            ring_azimuth_offset: None,
         };
         let m = place(&s, &p, 0.5).unwrap();
         assert_eq!(m.len(), 469);
@@ -777,6 +1042,8 @@ mod tests {
             center_marker: true,
             max_polar_deg: None,
             min_polar_deg: None,
+            polar_step_deg: None,
+            ring_azimuth_offset: None,
         };
         let m = place(&s, &p, 1.0).unwrap();
         assert_eq!(m.len(), 85);
@@ -811,11 +1078,7 @@ mod tests {
     #[test]
     fn feature_volume_on_a_plane_like_surface() {
         let tol = ChordTolerance::new(0.001).unwrap();
-        let shape = FeatureShape {
-            diameter_mm: 1.0,
-            height_mm: 1.0,
-            polarity: Polarity::Raised,
-        };
+        let shape = FeatureShape::new(1.0, 1.0, Polarity::Raised);
         let f = feature_solid(&shape, [1.0, 2.0, 3.0], [0.0, 0.6, 0.8], 0.0, tol).unwrap();
         let v = shape.nominal_volume_mm3();
         assert!((f.volume() - v).abs() < 0.01 * v, "{} vs {v}", f.volume());

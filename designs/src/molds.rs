@@ -610,7 +610,9 @@ pub fn build_mold(
     };
 
     match plan.strategy {
-        MoldStrategy::Open | MoldStrategy::Boundary => unreachable!("built by crate::layers"),
+        MoldStrategy::Open | MoldStrategy::TwoPieceOpen | MoldStrategy::Boundary => {
+            unreachable!("built by crate::layers")
+        }
         MoldStrategy::Direct => {
             let ((a, pose_a), (b, pose_b)) = direct_halves(design, &f, &cavity, tol).part(name)?;
             let mut params = common.clone();
@@ -817,4 +819,180 @@ pub fn drafted_box(
     let cup = outer.difference(&inner.union(&socket)?)?;
     let fill = crate::geometry::cone(z_fill - z0, r0, r_at(z_fill), tol)?.translate([0.0, 0.0, z0]);
     Ok((cup, fill))
+}
+
+/// Where the parts of a `two_piece_open` mold lie, in the sensor frame, mm (see
+/// [`crate::schema::TwoPieceOpenParams`]). The cavity opens on the rim plane `base_z_mm`; the
+/// top piece lies below it (beyond the rim, in casting orientation above it).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct TwoPieceFrame {
+    pub base_z_mm: f64,
+    /// Half sizes of the pocket in the cavity block (the boss plus its clearance), x and y.
+    pub pocket_half_mm: [f64; 2],
+    /// Half sizes of both pieces' outline (pocket plus flange), x and y.
+    pub outer_half_mm: [f64; 2],
+    /// The parting face: the cavity block's face and the top piece's plate face.
+    pub parting_z_mm: f64,
+    /// The top piece's outer face (the end of the reservoir).
+    pub top_z_mm: f64,
+    /// Half sizes of the boss, x and y; it spans parting_z_mm..base_z_mm.
+    pub boss_half_mm: [f64; 2],
+    pub reservoir_radius_mm: f64,
+    /// Bolt axes (x, y), parallel to z: corners first, then the sides.
+    pub bolts_xy_mm: Vec<[f64; 2]>,
+    pub bolt_hole_diameter_mm: f64,
+    /// Bolt pitch along the sides of the flange, x and y sides, mm.
+    pub bolt_pitch_mm: [f64; 2],
+}
+
+impl TwoPieceFrame {
+    /// The frame of a design's `two_piece_open` mold whose cavity opens on the base plane.
+    /// Needs an even `bolt_count` of at least 4 (validation checks it; fewer bolts give the
+    /// four corners only).
+    pub fn new(design: &Design) -> Self {
+        let m = &design.mold;
+        let t = &m.two_piece;
+        let c = m.registration_key.clearance_mm;
+        let zb = design.body.base_z_mm();
+        let boss = [t.boss.width_mm / 2.0, t.boss.length_mm / 2.0];
+        let pocket = [boss[0] + c, boss[1] + c];
+        let outer = [pocket[0] + m.flange_width_mm, pocket[1] + m.flange_width_mm];
+        // bolt rectangle on the flange's centre line
+        let h = [
+            pocket[0] + m.flange_width_mm / 2.0,
+            pocket[1] + m.flange_width_mm / 2.0,
+        ];
+        let (ax, ay) = (2.0 * h[0], 2.0 * h[1]);
+        let rest = (t.bolt_count.max(4) - 4) / 2;
+        let kx = (((rest as f64) * ax / (ax + ay)).round() as u32).min(rest);
+        let ky = rest - kx;
+        let mut bolts = vec![[h[0], h[1]], [-h[0], h[1]], [-h[0], -h[1]], [h[0], -h[1]]];
+        for sy in [1.0, -1.0] {
+            for i in 1..=kx {
+                bolts.push([-h[0] + ax * i as f64 / (kx + 1) as f64, sy * h[1]]);
+            }
+        }
+        for sx in [1.0, -1.0] {
+            for j in 1..=ky {
+                bolts.push([sx * h[0], -h[1] + ay * j as f64 / (ky + 1) as f64]);
+            }
+        }
+        Self {
+            base_z_mm: zb,
+            pocket_half_mm: pocket,
+            outer_half_mm: outer,
+            parting_z_mm: zb - t.boss.height_mm,
+            top_z_mm: zb - t.reservoir_height_mm,
+            boss_half_mm: boss,
+            reservoir_radius_mm: t.reservoir_diameter_mm / 2.0,
+            bolts_xy_mm: bolts,
+            bolt_hole_diameter_mm: m.clamp_bolt.clearance_diameter_mm,
+            bolt_pitch_mm: [ax / (kx + 1) as f64, ay / (ky + 1) as f64],
+        }
+    }
+}
+
+/// Rules of the `two_piece_open` strategy, for a cavity of rim radius `rim_radius_mm` (the
+/// widest cast layer's): sizes, the reservoir bore between the cavity rim and the boss, the
+/// bolts on the flange, the plate above the boss, the pocket fit.
+pub fn check_two_piece(design: &Design, rim_radius_mm: f64, errs: &mut Vec<ParamError>) {
+    let m = &design.mold;
+    let t = &m.two_piece;
+    let cav = design.printers.get(m.cavity_print_technology);
+    let cavity = format!("{:?}", m.cavity_print_technology).to_lowercase();
+    let mut ok = true;
+    for (p, v) in [
+        (
+            "mold.two_piece.reservoir_diameter_mm",
+            t.reservoir_diameter_mm,
+        ),
+        ("mold.two_piece.reservoir_height_mm", t.reservoir_height_mm),
+        ("mold.two_piece.boss.width_mm", t.boss.width_mm),
+        ("mold.two_piece.boss.length_mm", t.boss.length_mm),
+        ("mold.two_piece.boss.height_mm", t.boss.height_mm),
+    ] {
+        if !(v > 0.0 && v.is_finite()) {
+            errs.push(ParamError::new(p, v, "must be above 0"));
+            ok = false;
+        }
+    }
+    if t.bolt_count < 4 || t.bolt_count % 2 == 1 {
+        errs.push(ParamError::new(
+            "mold.two_piece.bolt_count",
+            t.bolt_count,
+            "must be even and at least 4: a bolt at each corner of the flange, the rest in pairs on opposite sides",
+        ));
+        ok = false;
+    }
+    let sizes_ok = [
+        m.flange_width_mm,
+        m.clamp_bolt.clearance_diameter_mm,
+        m.registration_key.clearance_mm,
+    ]
+    .iter()
+    .all(|v| v.is_finite() && *v >= 0.0);
+    if !ok || !sizes_ok {
+        return;
+    }
+    let rim_d = 2.0 * rim_radius_mm;
+    if t.reservoir_diameter_mm <= rim_d {
+        errs.push(ParamError::new(
+            "mold.two_piece.reservoir_diameter_mm",
+            t.reservoir_diameter_mm,
+            format!(
+                "must exceed the cavity's rim diameter {rim_d:.3} mm so the reservoir opens the whole cavity"
+            ),
+        ));
+    } else {
+        let (path, side) = if t.boss.width_mm <= t.boss.length_mm {
+            ("mold.two_piece.boss.width_mm", t.boss.width_mm)
+        } else {
+            ("mold.two_piece.boss.length_mm", t.boss.length_mm)
+        };
+        if side < t.reservoir_diameter_mm + 2.0 * cav.min_wall_mm {
+            errs.push(ParamError::new(
+                path,
+                side,
+                format!(
+                    "must hold the reservoir bore (mold.two_piece.reservoir_diameter_mm = {}) with the minimum wall {} mm of printer profile '{cavity}' on each side",
+                    t.reservoir_diameter_mm, cav.min_wall_mm
+                ),
+            ));
+        }
+    }
+    if t.reservoir_height_mm - t.boss.height_mm < cav.min_wall_mm {
+        errs.push(ParamError::new(
+            "mold.two_piece.reservoir_height_mm",
+            t.reservoir_height_mm,
+            format!(
+                "leaves a plate of {:.3} mm above the {} mm boss, below the minimum wall {} mm of printer profile '{cavity}'",
+                t.reservoir_height_mm - t.boss.height_mm,
+                t.boss.height_mm,
+                cav.min_wall_mm
+            ),
+        ));
+    }
+    if m.registration_key.clearance_mm < cav.xy_resolution_mm {
+        errs.push(ParamError::new(
+            "mold.registration_key.clearance_mm",
+            m.registration_key.clearance_mm,
+            format!(
+                "the boss of the two-piece mold fits its pocket with this clearance; it must be at least the xy resolution {} mm of printer profile '{cavity}'",
+                cav.xy_resolution_mm
+            ),
+        ));
+    }
+    let f = TwoPieceFrame::new(design);
+    let pitch = f.bolt_pitch_mm[0].min(f.bolt_pitch_mm[1]);
+    let need = m.clamp_bolt.clearance_diameter_mm + cav.min_wall_mm;
+    if pitch < need {
+        errs.push(ParamError::new(
+            "mold.two_piece.bolt_count",
+            t.bolt_count,
+            format!(
+                "bolts {pitch:.3} mm apart on the flange: closer than the hole {} mm (mold.clamp_bolt.clearance_diameter_mm) plus the minimum wall {} mm of printer profile '{cavity}'",
+                m.clamp_bolt.clearance_diameter_mm, cav.min_wall_mm
+            ),
+        ));
+    }
 }

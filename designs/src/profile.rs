@@ -17,7 +17,10 @@ use std::f64::consts::FRAC_PI_2;
 #[serde(try_from = "BodyYaml", into = "BodyYaml")]
 pub enum BodyProfile {
     /// A spherical cap: base circle of `base_diameter_mm` on the base plane, pole
-    /// `height_mm` above it (ShadowTac skin: 35 mm x 8 mm, ShadowTac Sec. III).
+    /// `height_mm` above it (ShadowTac skin: 35 mm x 8 mm, ShadowTac Sec. III). In YAML it may
+    /// instead be given by `sphere_radius_mm` and `rim_diameter_mm` (the authors' ShadowTac
+    /// CAD: R22.5 cut to a 35 mm rim), from which `height_mm` = R - sqrt(R^2 - (rim / 2)^2);
+    /// it is written back in the base/height form.
     SphericalCap {
         base_diameter_mm: f64,
         height_mm: f64,
@@ -49,6 +52,12 @@ pub struct BodyYaml {
     pub diameter_mm: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub height_mm: Option<f64>,
+    /// Spherical cap given by its sphere: radius, mm (with `rim_diameter_mm`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sphere_radius_mm: Option<f64>,
+    /// Spherical cap given by its sphere: diameter of the rim on the base plane, mm.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rim_diameter_mm: Option<f64>,
 }
 
 /// The profile names of the YAML `profile` key.
@@ -69,8 +78,22 @@ impl TryFrom<BodyYaml> for BodyProfile {
             ("base_diameter_mm", y.base_diameter_mm),
             ("diameter_mm", y.diameter_mm),
             ("height_mm", y.height_mm),
+            ("sphere_radius_mm", y.sphere_radius_mm),
+            ("rim_diameter_mm", y.rim_diameter_mm),
         ];
+        // A cap by its sphere: exactly this form or the base/height form.
+        let by_sphere = y.profile == ProfileKind::SphericalCap
+            && (y.sphere_radius_mm.is_some() || y.rim_diameter_mm.is_some());
+        if by_sphere && (y.base_diameter_mm.is_some() || y.height_mm.is_some()) {
+            return Err(
+                "body: give a spherical cap either by base_diameter_mm and height_mm or by sphere_radius_mm and rim_diameter_mm, not both forms"
+                    .to_string(),
+            );
+        }
         let (kind, wanted): (&str, &[&str]) = match y.profile {
+            ProfileKind::SphericalCap if by_sphere => {
+                ("spherical_cap", &["sphere_radius_mm", "rim_diameter_mm"])
+            }
             ProfileKind::SphericalCap => ("spherical_cap", &["base_diameter_mm", "height_mm"]),
             ProfileKind::HemisphereOnCylinder => (
                 "hemisphere_on_cylinder",
@@ -101,6 +124,28 @@ impl TryFrom<BodyYaml> for BodyProfile {
                 .and_then(|(_, v)| *v)
                 .unwrap_or_default()
         };
+        if by_sphere {
+            let (r, rim) = (g("sphere_radius_mm"), g("rim_diameter_mm"));
+            if !(r > 0.0 && r.is_finite()) {
+                problems.push(format!("body.sphere_radius_mm = {r}: must be above 0"));
+            }
+            if !(rim > 0.0 && rim.is_finite()) {
+                problems.push(format!("body.rim_diameter_mm = {rim}: must be above 0"));
+            } else if r > 0.0 && r.is_finite() && rim > 2.0 * r {
+                problems.push(format!(
+                    "body.rim_diameter_mm = {rim}: must not exceed the sphere's diameter 2 x body.sphere_radius_mm = {}",
+                    2.0 * r
+                ));
+            }
+            if !problems.is_empty() {
+                return Err(problems.join("; "));
+            }
+            let b = rim / 2.0;
+            return Ok(Self::SphericalCap {
+                base_diameter_mm: rim,
+                height_mm: r - ((r - b) * (r + b)).sqrt(),
+            });
+        }
         Ok(match y.profile {
             ProfileKind::SphericalCap => Self::SphericalCap {
                 base_diameter_mm: g("base_diameter_mm"),
@@ -127,6 +172,8 @@ impl From<BodyProfile> for BodyYaml {
             base_diameter_mm: None,
             diameter_mm: None,
             height_mm: None,
+            sphere_radius_mm: None,
+            rim_diameter_mm: None,
         };
         match b {
             BodyProfile::SphericalCap {
@@ -491,7 +538,7 @@ mod tests {
                 height_mm: 8.0,
             },
             BodyProfile::HemisphereOnCylinder {
-                radius_mm: 15.1,
+                radius_mm: 15.0,
                 cylinder_length_mm: 6.0,
             },
         ] {
@@ -512,6 +559,40 @@ mod tests {
         assert!((p.rim_radius_mm(0.0) - 17.5).abs() < 1e-12);
         assert!(p.offset_is_valid(-2.0));
         assert!(!p.offset_is_valid(-9.0));
+    }
+
+    /// The authors' ShadowTac cavity (authors' CAD, measured): a sphere of R22.500 cut to a
+    /// rim of 35.000 mm is 8.358 mm deep.
+    #[test]
+    fn cap_by_sphere_radius_and_rim() {
+        let y = "profile: spherical_cap\nsphere_radius_mm: 22.5\nrim_diameter_mm: 35.0\n";
+        let p: BodyProfile = serde_saphyr::from_str(y).unwrap();
+        assert!((p.sphere_radius_mm().unwrap() - 22.5).abs() < 1e-12);
+        assert!((p.rim_radius_mm(0.0) - 17.5).abs() < 1e-12);
+        let depth = p.pole_z_mm(0.0) - p.base_z_mm();
+        assert!((depth - 8.358).abs() < 5e-4, "{depth}");
+        assert!((depth - (22.5 - 200f64.sqrt())).abs() < 1e-12);
+        for (bad, words) in [
+            (
+                "profile: spherical_cap\nsphere_radius_mm: 22.5\nrim_diameter_mm: 35.0\nheight_mm: 8.0\n",
+                "not both forms",
+            ),
+            (
+                "profile: spherical_cap\nsphere_radius_mm: 17.0\nrim_diameter_mm: 35.0\n",
+                "body.rim_diameter_mm = 35: must not exceed",
+            ),
+            (
+                "profile: spherical_cap\nsphere_radius_mm: 22.5\n",
+                "body.rim_diameter_mm is required",
+            ),
+            (
+                "profile: spherical_cap\nsphere_radius_mm: -1\nrim_diameter_mm: 35.0\n",
+                "body.sphere_radius_mm = -1: must be above 0",
+            ),
+        ] {
+            let e = serde_saphyr::from_str::<BodyProfile>(bad).unwrap_err();
+            assert!(e.to_string().contains(words), "{bad}: {e}");
+        }
     }
 
     #[test]

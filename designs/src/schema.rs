@@ -127,6 +127,11 @@ pub enum MoldStrategy {
     /// A one-piece printed mold open on the base plane, for a solid skin cast pole-down
     /// (ShadowTac Sec. IV-A).
     Open,
+    /// A solid skin cast pole-down in two printed pieces (the authors' ShadowTac mold,
+    /// authors' CAD, measured): the cavity block, and a top piece whose bore is the pour
+    /// reservoir that forms the skin's back, registered by a boss in a pocket and joined by
+    /// clamp bolts around the flange (`mold.two_piece`).
+    TwoPieceOpen,
     /// Printed negatives for Mold Star 30 silicone molds of the outer and of the inner boundary
     /// of the layer; the layer is cast between the two silicone molds (UVDtact Sec. III).
     Boundary,
@@ -180,6 +185,8 @@ pub struct MoldParams {
     pub core_holder: CoreHolderParams,
     /// Mold Star thickness around the master pattern (master strategy), mm.
     pub silicone_wall_mm: f64,
+    /// The top piece and the flange of the `two_piece_open` strategy.
+    pub two_piece: TwoPieceOpenParams,
     /// Technology of parts whose surface forms the skin (mold halves, master patterns).
     pub cavity_print_technology: Technology,
     /// Technology of holders, jigs and boxes.
@@ -198,6 +205,7 @@ defaults!(MoldParams {
     vent: Vent::default(),
     core_holder: CoreHolderParams::default(),
     silicone_wall_mm: 5.0,
+    two_piece: TwoPieceOpenParams::default(),
     cavity_print_technology: Technology::Sla,
     fixture_print_technology: Technology::Fdm,
 });
@@ -243,6 +251,51 @@ pub struct ClampBolt {
 }
 defaults!(ClampBolt {
     clearance_diameter_mm: 3.4
+});
+
+/// The top piece of a `two_piece_open` mold and how it joins the cavity block. The cavity
+/// block's face lies `boss.height_mm` beyond the cavity's rim plane; a pocket in it (the boss
+/// plus `registration_key.clearance_mm` on every side) reaches down to the rim plane. The top
+/// piece stands `reservoir_height_mm` beyond the rim plane, its boss sits in the pocket, and a
+/// bore through it opens the whole cavity: the pour reservoir whose level forms the skin's
+/// back. `bolt_count` clamp bolts (`clamp_bolt.clearance_diameter_mm` holes through both
+/// pieces) stand on the centre line of the flange (`flange_width_mm` wide) around the pocket,
+/// one at each corner and the rest spread evenly over the sides.
+/// Defaults: the authors' ShadowTac mold (authors' CAD, measured).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct TwoPieceOpenParams {
+    /// Diameter of the reservoir bore, mm (authors: 45).
+    pub reservoir_diameter_mm: f64,
+    /// Height of the top piece above the cavity's rim plane, mm (authors: 14).
+    pub reservoir_height_mm: f64,
+    /// Clamp bolts through the flange, even, >= 4 (authors: 20).
+    pub bolt_count: u32,
+    pub boss: RegistrationBoss,
+}
+defaults!(TwoPieceOpenParams {
+    reservoir_diameter_mm: 45.0,
+    reservoir_height_mm: 14.0,
+    bolt_count: 20,
+    boss: RegistrationBoss::default(),
+});
+
+/// A rectangular boss on the top piece of a two-piece mold that registers it in a pocket of
+/// the cavity block (authors' ShadowTac mold: 60 x 65 x 2 mm).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RegistrationBoss {
+    /// Along x, mm.
+    pub width_mm: f64,
+    /// Along y, mm.
+    pub length_mm: f64,
+    /// Along the pull direction (the sensor axis), mm.
+    pub height_mm: f64,
+}
+defaults!(RegistrationBoss {
+    width_mm: 60.0,
+    length_mm: 65.0,
+    height_mm: 2.0
 });
 
 /// The pour opening through the core holder.
@@ -357,14 +410,22 @@ defaults!(CastingParams {
 });
 
 /// The two-piece sensor shell (R-Tac0 Sec. III-B4, Fig. 2): camera bay, LED ring seat,
-/// diffuser seat, contact-module seat; halves joined by screws across a parting plane
-/// through the axis.
+/// diffuser seat, contact-module seat. Two arrangements (`style`): a round tube closed by a
+/// separate base that carries the camera (the authors' CAD), or a square shell split into
+/// two halves on a plane through the axis.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct HousingParams {
     pub material: String,
-    /// Side of the square shell, mm (R-Tac0 envelope 30 x 30 x 43 mm, Sec. III-B).
+    /// The arrangement of the shell; `square_split` when not given.
+    #[serde(default)]
+    pub style: HousingStyle,
+    /// Side of the square shell (`square_split`) or outer diameter of the tube
+    /// (`round_tube`), mm (R-Tac0 envelope 30 x 30 x 43 mm, Sec. III-B).
     pub outer_width_mm: f64,
+    /// The tube and its base; required with `style: round_tube`, unused otherwise.
+    #[serde(default)]
+    pub round_tube: Option<RoundTube>,
     pub camera: CameraBay,
     pub bulkhead_thickness_mm: f64,
     pub led_pcb: LedPcb,
@@ -376,6 +437,37 @@ pub struct HousingParams {
     pub joint_screw: JointScrew,
 }
 
+/// How the sensor shell is arranged.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum HousingStyle {
+    /// A round tube (outer diameter `outer_width_mm`) holding the contact module, diffuser
+    /// and LED PCB, closed at the bottom by a separate base that carries the camera; the base
+    /// is screwed up into the tube wall (R-Tac0 authors' CAD, measured: a 30 mm tube 21.65 mm
+    /// tall; the paper, Sec. III-B3: "The camera module is secured to the sensor base").
+    RoundTube,
+    /// A square shell split on the plane x = 0 into two halves joined by two screws across it;
+    /// the camera bay is in the shell.
+    #[default]
+    SquareSplit,
+}
+
+/// The round tube and its base (`housing.style: round_tube`). The inner seats are those of
+/// every style (contact module, diffuser, light chamber, LED PCB); below the LED PCB the tube
+/// is bored out to `bay_diameter_mm`, and the PCB rests on the ledge this leaves. The base is a
+/// flange under the tube (as thick as `joint_screw.clamp_length_mm`) with a spigot that enters
+/// the bay; the camera board is screwed onto the spigot.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RoundTube {
+    /// Height of the tube from its bottom to the base plane, mm, > 0.
+    pub height_mm: f64,
+    /// Bore of the camera bay under the LED PCB, mm; smaller than the LED PCB seat.
+    pub bay_diameter_mm: f64,
+    /// Height of the base's spigot inside the bay (the camera board rests on it), mm, > 0.
+    pub base_spigot_height_mm: f64,
+}
+
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CameraBay {
@@ -383,7 +475,9 @@ pub struct CameraBay {
     pub module: String,
     /// Side of the square camera board, mm.
     pub board_width_mm: f64,
-    /// Height of the bay under the bulkhead (board + components), mm.
+    /// Height of the bay under the bulkhead (board + components), mm (`square_split`); with
+    /// `round_tube`, the least height the board with its components needs between the base
+    /// and the LED PCB.
     pub bay_height_mm: f64,
     /// Hole in the bulkhead for the lens barrel, mm.
     pub lens_hole_diameter_mm: f64,
@@ -418,9 +512,10 @@ pub struct JointScrew {
     pub clearance_diameter_mm: f64,
     pub pilot_diameter_mm: f64,
     pub head_diameter_mm: f64,
-    /// Material clamped under the head, mm.
+    /// Material clamped under the head, mm (`round_tube`: the thickness of the base's flange
+    /// under the tube).
     pub clamp_length_mm: f64,
-    /// Depth of the pilot hole in the other half, mm.
+    /// Depth of the pilot hole in the other half (`round_tube`: up into the tube wall), mm.
     pub pilot_depth_mm: f64,
 }
 

@@ -306,10 +306,14 @@ pub fn validate(
                 ),
             ));
         }
-        if strategy == MoldStrategy::Open && !l.solid {
+        if matches!(strategy, MoldStrategy::Open | MoldStrategy::TwoPieceOpen) && !l.solid {
             errs.push(ParamError::new(
                 path,
-                "open",
+                if strategy == MoldStrategy::Open {
+                    "open"
+                } else {
+                    "two_piece_open"
+                },
                 format!(
                     "an open mold casts a solid skin; layer '{}' is not solid (use boundary)",
                     l.name
@@ -459,6 +463,16 @@ pub fn validate(
     check_printers(design, &mut errs);
     if stack_ok {
         crate::layers::check_markers(design, &layers, &mut errs);
+        let two_piece_rim = layers
+            .iter()
+            .filter(|l| {
+                l.process == LayerProcess::Cast && l.mold_strategy == MoldStrategy::TwoPieceOpen
+            })
+            .map(|l| design.body.rim_radius_mm(l.outer_offset_mm))
+            .fold(None, |a: Option<f64>, r| Some(a.map_or(r, |a| a.max(r))));
+        if let Some(rim) = two_piece_rim {
+            crate::molds::check_two_piece(design, rim, &mut errs);
+        }
     }
     // Checks that use the core only make sense once the stack itself is sound.
     let sound_core = core.as_ref().filter(|_| stack_ok);

@@ -353,6 +353,8 @@ fn pattern(layout: Layout) -> Pattern {
         center_marker: true,
         max_polar_deg: None,
         min_polar_deg: None,
+        polar_step_deg: None,
+        ring_azimuth_offset: None,
     }
 }
 
@@ -551,11 +553,12 @@ fn pattern_case() -> impl Strategy<Value = PatternCase> {
                 let feature = FeatureShape {
                     diameter_mm: diameter,
                     height_mm: lerp(r, h_max, f[2]),
-                    polarity: if raised {
+                    polarity: Some(if raised {
                         Polarity::Raised
                     } else {
                         Polarity::Recessed
-                    },
+                    }),
+                    on_skin: None,
                 };
                 let surface = if inner {
                     MarkerSurface::Inner
@@ -820,7 +823,7 @@ fn predict(design: &Design, stack: &Stack, i: usize, tol: ChordTolerance) -> Pre
         let surface = Surface::new(body, pm.offset_mm);
         let mer = Meridian::new(body, pm.offset_mm);
         let k_max = mer.max_curvature(body, pm.offset_mm);
-        let sigma = match f.polarity {
+        let sigma = match f.side() {
             Polarity::Raised => 1.0,
             Polarity::Recessed => -1.0,
         };
@@ -934,11 +937,12 @@ fn feature(u_d: f64, u_h: f64, raised: bool, d_min: f64, h_cap: f64) -> Option<F
     (h_max >= r).then(|| FeatureShape {
         diameter_mm: diameter,
         height_mm: lerp(r, h_max, u_h),
-        polarity: if raised {
+        polarity: Some(if raised {
             Polarity::Raised
         } else {
             Polarity::Recessed
-        },
+        }),
+        on_skin: None,
     })
 }
 
@@ -1043,7 +1047,7 @@ fn check_layer_case(c: &LayerCase) -> Result<(), TestCaseError> {
 fn validation_rejects_recesses_through_the_base_and_converging_pins() {
     let tol = ChordTolerance::default();
     let mut d = library::load("shadowtac").unwrap();
-    d.layers[0].markers[0].feature.polarity = Polarity::Recessed;
+    d.layers[0].markers[0].feature.set_side(Polarity::Recessed);
     d.layers[0].markers[0].feature.height_mm = 2.0;
     let errs = validate(&d, &materials(), tol).unwrap_err().0;
     assert!(
@@ -1105,7 +1109,8 @@ fn feature_volume_signs_on_both_surfaces_of_a_shell() {
         let f = FeatureShape {
             diameter_mm: 2.0 * r,
             height_mm: height,
-            polarity,
+            polarity: Some(polarity),
+            on_skin: None,
         };
         let mut p = pattern(Layout::List);
         p.points = Some(vec![[0.0, 0.0]]);
@@ -1236,8 +1241,8 @@ fn uvdtact_slots_and_protrusions_fit_without_overlap_or_gap() {
     }
 }
 
-/// The published ShadowTac mold (Sec. IV-A; `presets.published_469`): a centre dimple and
-/// rings k = 1..12 of 6k dimples 1.53 mm of arc apart, 469 in all.
+/// The published ShadowTac mold (authors' CAD, measured; `presets.published_469`): a centre
+/// dimple and rings k = 1..12 of 6k dimples at polar angle k x 3.9474 deg, 469 in all.
 #[test]
 fn shadowtac_published_preset_places_469_markers_on_13_rings() {
     let tol = ChordTolerance::default();
@@ -1260,21 +1265,24 @@ fn shadowtac_published_preset_places_469_markers_on_13_rings() {
             "ring {k}"
         );
         for x in ring {
-            assert!((x.arc_mm - 1.53 * k as f64).abs() < 1e-9, "ring {k}: {x:?}");
+            assert!(
+                (x.polar_deg - 3.9474 * k as f64).abs() < 1e-9,
+                "ring {k}: {x:?}"
+            );
         }
     }
     check_layer(&d, &stack, 0, tol).unwrap();
 }
 
-/// The library skin as designed (543 raised dimples on concentric rings 1.4 mm apart) and the
-/// same skin with recessed dimples of the published size.
+/// The library skin as designed (469 dimples cut into it) and the same skin with raised bumps
+/// of the same size.
 #[test]
 fn shadowtac_skin_with_raised_and_recessed_dimples() {
     let tol = ChordTolerance::default();
     let base = library::load("shadowtac").unwrap();
     for polarity in [Polarity::Raised, Polarity::Recessed] {
         let mut d = base.clone();
-        d.layers[0].markers[0].feature.polarity = polarity;
+        d.layers[0].markers[0].feature.set_side(polarity);
         let stack = validate(&d, &materials(), tol).unwrap_or_else(|e| panic!("{e}"));
         check_layer(&d, &stack, 0, tol).unwrap();
     }
@@ -1332,7 +1340,11 @@ fn tactip_skin_and_tips_make_whole_pins() {
 
 #[test]
 fn shadowtac_is_valid_and_its_dimples_need_sla() {
-    let base = library::load("shadowtac").unwrap();
+    // the paper's text: one open mold (the default's two-piece mold adds the boss's fit rule)
+    let base = library::load("shadowtac")
+        .unwrap()
+        .with_preset("paper_text")
+        .unwrap();
     let tol = ChordTolerance::default();
     assert!(
         errors(&base, tol).is_empty(),
@@ -1356,7 +1368,11 @@ fn shadowtac_is_valid_and_its_dimples_need_sla() {
 fn features_closer_than_the_minimum_wall_are_rejected_on_the_pattern() {
     let tol = ChordTolerance::default();
     for (spacing, words) in [(0.5, "too thin a wall"), (0.4, "overlap")] {
-        let mut d = library::load("shadowtac").unwrap();
+        // the paper's text: concentric rings by spacing
+        let mut d = library::load("shadowtac")
+            .unwrap()
+            .with_preset("paper_text")
+            .unwrap();
         d.layers[0].markers[0].pattern.spacing_mm = Some(spacing);
         let errs = errors(&d, tol);
         assert_eq!(errs.len(), 1, "spacing {spacing}:{}", listing(&errs));
@@ -1414,7 +1430,7 @@ fn hex_grid_keeps_every_lattice_point_in_the_disc() {
 fn recessed_features_of_a_solid_skin_stay_inside_it() {
     let tol = ChordTolerance::default();
     let mut d = library::load("shadowtac").unwrap();
-    d.layers[0].markers[0].feature.polarity = Polarity::Recessed;
+    d.layers[0].markers[0].feature.set_side(Polarity::Recessed);
     d.layers[0].markers[0].feature.height_mm = 2.0;
     match validate(&d, &materials(), tol) {
         Err(e) => assert!(
@@ -1500,7 +1516,7 @@ fn recesses_from_both_surfaces_leave_a_wall() {
     let spec = &mut d.layers[0].markers[0];
     spec.tip_material = None;
     spec.feature.height_mm = 1.2;
-    spec.feature.polarity = Polarity::Recessed;
+    spec.feature.set_side(Polarity::Recessed);
     let mut outer = spec.clone();
     outer.surface = MarkerSurface::Outer;
     d.layers[0].markers.push(outer);

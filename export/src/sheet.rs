@@ -83,6 +83,8 @@ pub(crate) fn render(m: &Manifest) -> String {
     s.push('\n');
     groups(&mut s, m);
 
+    layer_stack(&mut s, m);
+
     s.push_str("## Cast order\n\n");
     if m.casts.is_empty() {
         s.push_str("No pours in this kit.\n\n");
@@ -137,6 +139,43 @@ pub(crate) fn render(m: &Manifest) -> String {
          a gap and their registration keys must engage before any pour.\n",
     );
     s
+}
+
+/// The skin's layers, inner to outer, with their thicknesses, from `summary.layers` (nothing
+/// when the summary has no layers). Outer surfaces are radii when the body has a
+/// `radius_mm`, offsets from the reference surface otherwise.
+fn layer_stack(s: &mut String, m: &Manifest) {
+    let Some(layers) = m.summary["layers"].as_array().filter(|l| !l.is_empty()) else {
+        return;
+    };
+    let radius = m.summary["body"]["radius_mm"].as_f64();
+    s.push_str("## Layer stack\n\n");
+    s.push_str(
+        "Inner to outer. The reference surface (`body` in `manifest.json`) is the cavity of \
+         the outermost mold; a sprayed layer lies inside it, so its thickness comes out of the \
+         cast layer under it.\n\n",
+    );
+    s.push_str("| Layer | Material | Process | Thickness (mm) | Outer surface (mm) |\n");
+    s.push_str("|-------|----------|---------|---------------:|-------------------:|\n");
+    for l in layers {
+        let name = l["name"].as_str().unwrap_or("?");
+        let material = l["material"].as_str().unwrap_or("?");
+        let process = l["process"].as_str().unwrap_or("?");
+        let thickness = l["thickness_mm"].as_f64().unwrap_or(f64::NAN);
+        let offset = l["outer_offset_mm"].as_f64().unwrap_or(f64::NAN);
+        let outer = match radius {
+            Some(r) => format!("R{:.3}", r + offset),
+            None => format!("offset {offset:+.3}"),
+        };
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {thickness:.3} | {outer} |",
+            code(name),
+            code(material),
+            text(process)
+        );
+    }
+    s.push('\n');
 }
 
 /// One note per multi-material group, in order of first appearance; nothing without groups.

@@ -88,6 +88,11 @@ pub(crate) enum Format {
 enum Strategy {
     Direct,
     Master,
+    /// One-piece open mold for a solid skin.
+    Open,
+    /// Cavity block and reservoir top piece for a solid skin.
+    #[value(name = "two_piece_open")]
+    TwoPieceOpen,
 }
 
 /// Runs the CLI; returns the process exit code (0 ok, 2 error).
@@ -234,6 +239,8 @@ fn export(args: ExportArgs) -> Result<(), Box<dyn Error>> {
         let s = match s {
             Strategy::Direct => MoldStrategy::Direct,
             Strategy::Master => MoldStrategy::Master,
+            Strategy::Open => MoldStrategy::Open,
+            Strategy::TwoPieceOpen => MoldStrategy::TwoPieceOpen,
         };
         loaded.design.mold.strategy = s;
         for l in &mut loaded.design.layers {

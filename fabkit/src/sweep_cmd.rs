@@ -16,7 +16,7 @@ use std::time::Instant;
 #[command(
     args_conflicts_with_subcommands = true,
     subcommand_negates_reqs = true,
-    after_help = "Sweep file (YAML):\n  base: shadowtac                 # library design, or a YAML path relative to the sweep file\n  preset: published_469           # optional\n  chord_tolerance_mm: 0.01        # optional\n  vary:\n    layers[0].markers[0].pattern.spacing_mm: {range: [1.2, 2.0, 0.2]}\n    layers[0].markers[0].feature.height_mm: [0.3, 0.4, 0.5, 0.6]\n  mode: grid                      # grid | zip | random (with count: N, seed: S)\n  outputs: [metrics]              # or [metrics, files] (also stl or 3mf alone)"
+    after_help = "Sweep file (YAML):\n  base: shadowtac                 # library design, or a YAML path relative to the sweep file\n  preset: paper_text              # optional\n  chord_tolerance_mm: 0.01        # optional\n  vary:\n    layers[0].markers[0].pattern.spacing_mm: {range: [1.2, 2.0, 0.2]}\n    layers[0].markers[0].feature.height_mm: [0.3, 0.4, 0.5, 0.6]\n  mode: grid                      # grid | zip | random (with count: N, seed: S)\n  outputs: [metrics]              # or [metrics, files] (also stl or 3mf alone)"
 )]
 pub struct SweepArgs {
     #[command(subcommand)]

@@ -1,14 +1,15 @@
-//! Benchmarks of the ShadowTac one-piece open mold (`designs/library/shadowtac.yaml`, layer 0,
-//! `mold_strategy: open`) at 0.005 mm chord tolerance: the marker features (cylinder +
-//! hemisphere) are cut into the mold with one `Solid::compose` of the features and one boolean.
+//! Benchmarks of the ShadowTac one-piece open mold (`designs/library/shadowtac.yaml` with the
+//! preset `open_mold`, layer 0) at 0.005 mm chord tolerance: the marker features (cylinder +
+//! hemisphere; pins standing into the cavity for the skin's dimples) join the mold with one
+//! `Solid::compose` of the features and one boolean.
 //!
 //! Every iteration is `stack::validate` + `layers::build_layer(.., 0, ..)`: the mold alone, every
 //! boolean evaluated (the kernel evaluates each boolean when the solid is made), nothing written.
 //! The YAML is parsed, and the design mutated, once outside the timed loop.
 //!
 //! Groups (ids `<group>/<id>`):
-//! - `markers/shadowtac_469_mold`: the `published_469` preset: 469 features of 0.45 mm diameter,
-//!   0.5 mm high, concentric_6k, 12 rings, 1.53 mm pitch.
+//! - `markers/shadowtac_469_mold`: the authors' layout: 469 features of 0.45 mm diameter,
+//!   0.5 mm high, concentric_6k, 12 rings 3.9474 deg apart on the R22.5 cap.
 //! - `markers_scaling/<N>` for N = 1000, 5000, 10000: N features on an equal-area golden spiral
 //!   ([`scaled_design`]); throughput in features (elements) per second. The feature diameter
 //!   shrinks with N so that features keep a wall between them: 0.45 mm at 1000, 0.24 mm at 5000,
@@ -74,6 +75,8 @@ fn scaled_design(base: &Design, n: u32) -> Design {
     p.spacing_mm = None;
     p.rings = None;
     p.pitch_arc_mm = None;
+    p.polar_step_deg = None;
+    p.ring_azimuth_offset = None;
     d
 }
 
@@ -111,7 +114,9 @@ fn configure(group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::W
 }
 
 fn setup() -> (Design, MaterialsTable, ChordTolerance) {
-    let base = library::load("shadowtac").expect("the library design parses");
+    let base = library::load("shadowtac")
+        .and_then(|d| d.with_preset("open_mold"))
+        .expect("the library design parses and its open_mold preset applies");
     let materials = MaterialsTable::embedded().expect("the embedded materials table parses");
     let tol = ChordTolerance::new(CHORD_TOLERANCE_MM).expect("0.005 mm is a valid tolerance");
     (base, materials, tol)

@@ -1,5 +1,5 @@
 //! The ground-truth benchmark scene (issue 6), shared by the tests, the criterion bench and the
-//! Open3D comparison: the R-Tac0 skin (hemisphere of 15.1 mm on a 6 mm cylinder, base plane
+//! Open3D comparison: the R-Tac0 skin (hemisphere of 15.0 mm on a 6 mm cylinder, base plane
 //! z = -6 mm), the R-Tac0-like Kannala-Brandt camera of [`crate::synthetic::benchmark_camera`]
 //! (f = 215 px, 640 x 480, 160 deg field) on the sensor axis 10 mm below the sphere centre
 //! looking along +z (`T_cam_sensor = [I | (0, 0, 10) mm]`), and six protrusions of every
@@ -15,10 +15,14 @@ use super::mesh::{Hit, MeshCaster};
 use super::rays::PixelRays;
 use super::surface::ReferenceSurface;
 
+/// R-Tac0's reference radius, mm: the outer casting mold's cavity (authors' CAD, measured;
+/// `body.radius_mm` of designs/library/rtac0.yaml).
+pub const RTAC0_RADIUS_MM: f64 = 15.0;
+
 /// R-Tac0's body profile (designs/library/rtac0.yaml).
 pub fn rtac0_body() -> BodyProfile {
     BodyProfile::HemisphereOnCylinder {
-        radius_mm: 15.1,
+        radius_mm: RTAC0_RADIUS_MM,
         cylinder_length_mm: 6.0,
     }
 }
@@ -35,7 +39,7 @@ pub fn benchmark_pose() -> Isometry3<f64> {
 fn surface_point(polar_deg: f64, azimuth_deg: f64) -> ([f64; 3], [f64; 3]) {
     let (p, a) = (polar_deg.to_radians(), azimuth_deg.to_radians());
     let n = [p.sin() * a.cos(), p.sin() * a.sin(), p.cos()];
-    (scale(n, 15.1), n)
+    (scale(n, RTAC0_RADIUS_MM), n)
 }
 
 /// Six protrusions (sensor frame, mm), indentation depths 0.3 to 0.9 mm.

@@ -10,7 +10,7 @@ use serde_json::Value;
 /// (`skip_serializing_if`): a path ending in one of them is valid on every pattern / marker
 /// even when the base design leaves it out. Taken from a fully populated value, so a field
 /// added to [`Pattern`] or [`MarkerSpec`] shows up here.
-fn optional_marker_keys() -> (Vec<String>, Vec<String>) {
+fn optional_marker_keys() -> (Vec<String>, Vec<String>, Vec<String>) {
     let pattern = Pattern {
         layout: Layout::List,
         rings: Some(1),
@@ -22,6 +22,8 @@ fn optional_marker_keys() -> (Vec<String>, Vec<String>) {
         center_marker: true,
         max_polar_deg: Some(1.0),
         min_polar_deg: Some(1.0),
+        polar_step_deg: Some(1.0),
+        ring_azimuth_offset: Some(crate::markers::RingAzimuthOffset::PerRingDeg(vec![])),
     };
     let spec = MarkerSpec {
         surface: crate::markers::MarkerSurface::Outer,
@@ -29,7 +31,8 @@ fn optional_marker_keys() -> (Vec<String>, Vec<String>) {
         feature: crate::markers::FeatureShape {
             diameter_mm: 1.0,
             height_mm: 1.0,
-            polarity: crate::markers::Polarity::Raised,
+            polarity: Some(crate::markers::Polarity::Raised),
+            on_skin: Some(crate::markers::OnSkin::Bump),
         },
         tip_material: Some(String::new()),
     };
@@ -40,6 +43,7 @@ fn optional_marker_keys() -> (Vec<String>, Vec<String>) {
     (
         keys(serde_json::to_value(&pattern).unwrap_or(Value::Null)),
         keys(serde_json::to_value(&spec).unwrap_or(Value::Null)),
+        keys(serde_json::to_value(&spec.feature).unwrap_or(Value::Null)),
     )
 }
 
@@ -49,13 +53,20 @@ fn optional_marker_keys() -> (Vec<String>, Vec<String>) {
 /// items, as in the YAML of presets.
 pub fn parameter_paths(design: &Design) -> Vec<String> {
     let v = serde_json::to_value(design).unwrap_or(Value::Null);
-    let (pattern_keys, spec_keys) = optional_marker_keys();
+    let (pattern_keys, spec_keys, feature_keys) = optional_marker_keys();
     let mut out = Vec::new();
-    walk(&v, String::new(), &mut out, &pattern_keys, &spec_keys);
+    walk(
+        &v,
+        String::new(),
+        &mut out,
+        &[&pattern_keys, &spec_keys, &feature_keys],
+    );
     out
 }
 
-fn walk(v: &Value, path: String, out: &mut Vec<String>, pk: &[String], sk: &[String]) {
+/// `keys`: the optional keys of a pattern, of a marker spec and of a feature.
+fn walk(v: &Value, path: String, out: &mut Vec<String>, keys: &[&Vec<String>; 3]) {
+    let [pk, sk, fk] = *keys;
     match v {
         Value::Object(o) => {
             if path == "presets" {
@@ -67,7 +78,7 @@ fn walk(v: &Value, path: String, out: &mut Vec<String>, pk: &[String], sk: &[Str
                 } else {
                     format!("{path}.{k}")
                 };
-                walk(x, p, out, pk, sk);
+                walk(x, p, out, keys);
             }
             let missing = |keys: &[String], out: &mut Vec<String>| {
                 for k in keys {
@@ -78,13 +89,15 @@ fn walk(v: &Value, path: String, out: &mut Vec<String>, pk: &[String], sk: &[Str
             };
             if path.ends_with("].pattern") {
                 missing(pk, out);
+            } else if path.ends_with("].feature") {
+                missing(fk, out);
             } else if o.contains_key("pattern") && o.contains_key("feature") {
                 missing(sk, out);
             }
         }
         Value::Array(a) if a.iter().any(|x| x.is_object() || x.is_array()) => {
             for (i, x) in a.iter().enumerate() {
-                walk(x, format!("{path}[{i}]"), out, pk, sk);
+                walk(x, format!("{path}[{i}]"), out, keys);
             }
         }
         _ => out.push(path),

@@ -43,14 +43,32 @@ def base_dowel_holes(base: dict):
             for x, y in base["dowel_xy_mm"]]
 
 
+def pyramid(corners):
+    """The pyramid with its apex at the origin and the base quad `corners` (mm)."""
+    o = cq.Vector(0.0, 0.0, 0.0)
+    c = [cq.Vector(*q) for q in corners]
+    polys = [[o, c[0], c[1]], [o, c[1], c[2]], [o, c[2], c[3]], [o, c[3], c[0]],
+             [c[0], c[3], c[2], c[1]]]
+    faces = [cq.Face.makeFromWires(cq.Wire.makePolygon(p + [p[0]])) for p in polys]
+    return cq.Solid.makeSolid(cq.Shell.makeShell(faces)).fix()
+
+
+def groove(body: C.Body, g: dict):
+    """The orientation groove: the band between two offsets of the body surface, within the
+    pyramid from the origin through the groove's corners."""
+    band = dome_shell(body, g["band_offsets_mm"][0], g["band_offsets_mm"][1])
+    return C.common(band, pyramid(g["pyramid_corners_mm"]))
+
+
 def pin_dome(params: dict):
     pd, base = params["pin_dome"], params["base"]
     body = C.Body(params["body"])
-    d_in = pd["clearance_mm"]
-    d_out = d_in + pd["wall_thickness_mm"]
-    shell = C.fuse(dome_shell(body, d_in, d_out),
-                   [ring(base["inner_radius_mm"], base["outer_radius_mm"], base["bottom_z_mm"],
-                         base["top_z_mm"])])
+    d_in, d_out = params["shell_offsets_mm"]
+    adds = [C.primitive(t) for t in base.get("tabs", [])]
+    if base.get("ring", True):
+        adds.append(ring(base["inner_radius_mm"], base["outer_radius_mm"], base["bottom_z_mm"],
+                         base["top_z_mm"]))
+    shell = C.fuse(dome_shell(body, d_in, d_out), adds)
     cuts = []
     hole_r = params["modelled_hole_diameter_mm"] / 2.0
     for polar, az in params["holes_deg"]:
@@ -65,6 +83,8 @@ def pin_dome(params: dict):
                                            pd["counterbore_diameter_mm"] / 2.0))
     cuts += [C.primitive(b) for b in params["label_boxes"]]
     cuts += base_dowel_holes(base)
+    if params.get("groove"):
+        cuts.append(groove(body, params["groove"]))
     return C.cut(shell, cuts)
 
 

@@ -1,5 +1,6 @@
-"""CadQuery twin of the two-piece sensor shell (R-Tac0 Sec. III-B2..B4, Fig. 2), from the
-shell half's manifest `params`: levels, housing parameters, seats, joint screws, dowels."""
+"""CadQuery twin of the sensor shell (R-Tac0 Sec. III-B2..B4, Fig. 2), from the part's manifest
+`params`: levels, housing parameters, seats, joint screws, dowels. Two arrangements: the round
+tube and its camera base (`shell_tube`, `shell_base`), the square split halves (`shell_half`)."""
 
 from __future__ import annotations
 
@@ -39,3 +40,53 @@ def shell_half(params: dict, half: str):
     lo = [0.0 if half == "a" else -w, -w, lv["bottom_z_mm"]]
     hi = [w if half == "a" else 0.0, w, lv["top_z_mm"]]
     return C.cut(C.box(lo, hi), cuts)
+
+
+def _bores(params: dict) -> list:
+    """The seats shared by both arrangements, from the LED PCB seat up to the top face."""
+    lv, h = params["levels"], params["housing"]
+    c = h["fit_clearance_mm"]
+    e = params["overlap_mm"]
+    cyl = C.cylinder_z
+    return [
+        cyl(h["led_pcb"]["outer_diameter_mm"] / 2.0 + c, lv["pcb_z_mm"], lv["chamber_z_mm"] + e),
+        cyl(h["light_chamber_diameter_mm"] / 2.0, lv["chamber_z_mm"], lv["diffuser_z_mm"] + e),
+        cyl(h["diffuser"]["outer_diameter_mm"] / 2.0 + c, lv["diffuser_z_mm"], lv["seat_z_mm"] + e),
+        cyl(params["core_seat_radius_mm"], lv["seat_z_mm"], lv["top_z_mm"] + 1.0),
+    ]
+
+
+def shell_tube(params: dict):
+    """The round tube: outer cylinder less the camera bay, the seats and the screw pilots."""
+    lv, h = params["levels"], params["housing"]
+    e = params["overlap_mm"]
+    r = h["outer_width_mm"] / 2.0
+    tb = lv["tube_bottom_z_mm"]
+    cyl = C.cylinder_z
+    cuts = [cyl(params["bay_radius_mm"], tb - 1.0, lv["pcb_z_mm"] + e)] + _bores(params)
+    js = params["joint_screws"]
+    z0, z1 = js["pilot_z_mm"]
+    for x, y in js["xy_mm"]:
+        cuts.append(cyl(h["joint_screw"]["pilot_diameter_mm"] / 2.0, z0, z1, x, y))
+    return C.cut(cyl(r, tb, lv["top_z_mm"]), cuts)
+
+
+def shell_base(params: dict):
+    """The base: flange under the tube and spigot into the bay, less the camera pilots, the
+    screws' clearance holes and the cable slot."""
+    lv, h = params["levels"], params["housing"]
+    e = params["overlap_mm"]
+    r = h["outer_width_mm"] / 2.0
+    tb, top, bottom = lv["tube_bottom_z_mm"], lv["base_top_z_mm"], lv["bottom_z_mm"]
+    cyl = C.cylinder_z
+    base = C.fuse(cyl(r, bottom, tb), [cyl(params["spigot_radius_mm"], tb - e, top)])
+    z0, z1 = params["camera_mount_pilot_z_mm"]
+    cuts = [cyl(h["camera"]["mount_pilot_diameter_mm"] / 2.0, z0, z1, x, y)
+            for x, y in params["camera_mount_holes_xy_mm"]]
+    js = params["joint_screws"]
+    c0, c1 = js["clearance_z_mm"]
+    cuts += [cyl(h["joint_screw"]["clearance_diameter_mm"] / 2.0, c0, c1, x, y)
+             for x, y in js["xy_mm"]]
+    sx, sy = params["cable_slot_xy_mm"]
+    cuts.append(C.box([-sx / 2.0, -sy / 2.0, bottom - 1.0], [sx / 2.0, sy / 2.0, top + 1.0]))
+    return C.cut(base, cuts)

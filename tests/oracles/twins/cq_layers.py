@@ -65,6 +65,31 @@ def open_mold(params: dict):
     return with_features(mold, body, marker_sets(base, "outer"), -1.0)
 
 
+def open_mold_piece(params: dict):
+    """A piece of the two_piece_open mold from its recorded frame: the cavity block (outline
+    from the parting face to the wall beyond the pole, less the cavity, the pocket and the bolt
+    holes, with the features) or the reservoir top (plate and boss, less the bore and the bolt
+    holes)."""
+    base, f = params["base"], params["frame"]
+    body = C.Body(base["body"])
+    zb, zp = f["base_z_mm"], f["parting_z_mm"]
+    ox, oy = f["outer_half_mm"]
+    z0, z1 = params["bolt_holes_z_mm"]
+    r_bolt = f["bolt_hole_diameter_mm"] / 2.0
+    bolts = [C.cylinder_z(r_bolt, z0, z1, x, y) for x, y in f["bolts_xy_mm"]]
+    if params["piece"] == "cavity_block":
+        zlo, zhi = params["cavity_block_z_mm"]
+        px, py = f["pocket_half_mm"]
+        block = C.box((-ox, -oy, zlo), (ox, oy, zhi))
+        pocket = C.box((-px, -py, zp - 1.0), (px, py, zb))
+        block = C.cut(block, [enclosed(body, base["outer_offset_mm"], 1.0), pocket] + bolts)
+        return with_features(block, body, marker_sets(base, "outer"), -1.0)
+    bx, by = f["boss_half_mm"]
+    top = C.fuse(C.box((-ox, -oy, f["top_z_mm"]), (ox, oy, zp)), [C.box((-bx, -by, zp), (bx, by, zb))])
+    bore = C.cylinder_z(f["reservoir_radius_mm"], f["top_z_mm"] - 1.0, zb + 1.0)
+    return C.cut(top, [bore] + bolts)
+
+
 def printed_skin(params: dict, tips: bool):
     """The printed layer (stems only when its features have separate tips) or its tips."""
     body = C.Body(params["body"])

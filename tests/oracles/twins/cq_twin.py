@@ -27,6 +27,8 @@ def _build_sensor(part: dict):
         s = cq_molds.mold_half(p, name.rsplit("_", 1)[1])
     elif role == "open_mold":
         s = cq_layers.open_mold(p)
+    elif role == "open_mold_piece":
+        s = cq_layers.open_mold_piece(p)
     elif role == "printed_skin":
         s = cq_layers.printed_skin(p, tips=False)
     elif role == "marker_tips":
@@ -35,6 +37,10 @@ def _build_sensor(part: dict):
         s = cq_layers.boundary_negative(p)
     elif role == "shell_half":
         s = cq_housing.shell_half(p, name.rsplit("_", 1)[1])
+    elif role == "shell_tube":
+        s = cq_housing.shell_tube(p)
+    elif role == "shell_base":
+        s = cq_housing.shell_base(p)
     elif role == "indenter":
         s = cq_fixtures.indenter(p)
     elif name == "pin_dome":

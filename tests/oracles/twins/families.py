@@ -13,11 +13,13 @@ def family(part: dict) -> str:
         return "two-piece molds" if role == "mold_half" else "core holders / casting jigs"
     if role == "open_mold":
         return "dimple molds"
+    if role == "open_mold_piece":
+        return "two-piece dimple molds"
     if role == "printed_skin":
         return "layer shells"
     if role == "marker_tips":
         return "pin tips"
-    if role == "shell_half":
+    if role in ("shell_half", "shell_tube", "shell_base"):
         return "housings"
     if role == "indenter":
         return "indenters"

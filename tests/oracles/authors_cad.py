@@ -1,0 +1,293 @@
+#!/usr/bin/env python3
+"""authors_cad.py - fabkit's seed presets measured against the authors' published CAD.
+
+Usage: authors_cad.py FABKIT_BINARY WORKDIR [--markdown]
+
+Runs `fabkit export` / `fabkit fixtures` into WORKDIR and measures fabkit's exported files (STL
+meshes mapped back into the sensor frame through each part's `T_print_sensor`, the manifest, the
+point table) with numpy/trimesh, independently of fabkit's own code. Each row compares one
+quantity with the authors' CAD (their STL/STEP files, measured: the ShadowTac repository's mold
+STEP, the R-Tac0 files of the PP-Tac repository) or TacTipGenerator's default layout, within a
+stated tolerance. Rows marked `differs` are known, documented differences (they are printed, not
+asserted). With --markdown the table is printed in the README's form.
+
+Exit status: 0 when every asserted row holds, 1 otherwise (each failure printed), 2 on a usage or
+run error.
+"""
+
+import csv
+import json
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import trimesh
+
+ROWS = []  # (sensor, quantity, authors, fabkit, ok or None)
+
+
+def row(sensor, quantity, authors, fabkit_value, fmt="{}", tol=None, want=None, note=""):
+    """Adds a row; asserted when `tol` is given (|fabkit - want| <= tol)."""
+    text = fmt.format(fabkit_value) if not isinstance(fabkit_value, str) else fabkit_value
+    ok = None
+    if tol is not None:
+        ok = bool(abs(fabkit_value - want) <= tol)
+    ROWS.append((sensor, quantity, authors, text + (f" ({note})" if note else ""), ok))
+
+
+def run(fabkit, args, cwd):
+    o = subprocess.run([fabkit, *args], cwd=cwd, capture_output=True, text=True)
+    if o.returncode != 0:
+        sys.stderr.write(f"fabkit {' '.join(args)} failed ({o.returncode}):\n{o.stderr}")
+        sys.exit(2)
+
+
+def manifest(d):
+    return json.loads((d / "manifest.json").read_text())
+
+
+def part(m, name):
+    for p in m["parts"]:
+        if p["name"] == name:
+            return p
+    sys.stderr.write(f"no part {name} in the manifest\n")
+    sys.exit(2)
+
+
+def sensor_vertices(d, p):
+    """The part's STL vertices in the sensor frame (T_print_sensor: 3x4 rows, sensor -> print)."""
+    mesh = trimesh.load(d / p["file"], force="mesh", process=False)
+    t = np.array(p["params"]["T_print_sensor"], dtype=float)
+    return (np.asarray(mesh.vertices, dtype=float) - t[:, 3]) @ t[:, :3]
+
+
+def print_mesh(d, p):
+    return trimesh.load(d / p["file"], force="mesh", process=False)
+
+
+def shadowtac(fabkit, work):
+    run(fabkit, ["export", "shadowtac", "--out", "out/shadowtac", "--chord-tolerance-mm", "0.005"], work)
+    d = work / "out/shadowtac"
+    m = manifest(d)
+    block, top = part(m, "skin_cavity_block"), part(m, "skin_reservoir_top")
+    v = sensor_vertices(d, block)
+    r = np.linalg.norm(v, axis=1)
+    rho = 22.5
+    z_rim = math.sqrt(rho * rho - 17.5 * 17.5)
+    # the cavity wall: vertices on a sphere about the origin, at or above the rim plane
+    wall = v[(np.abs(r - rho) < 0.05) & (v[:, 2] > z_rim - 1e-4)]
+    # least-squares sphere centred on the axis, |p - (0, 0, c)|^2 = R^2, refitted without the
+    # vertices inside the last fit: the booleans leave vertices on the facets where the pins
+    # meet the wall, up to the chord tolerance inside the sphere (never outside it)
+    keep = np.ones(len(wall), dtype=bool)
+    for _ in range(8):
+        a = np.c_[2 * wall[keep, 2], np.ones(keep.sum())]
+        b = (wall[keep] ** 2).sum(axis=1)
+        (c, k), *_ = np.linalg.lstsq(a, b, rcond=None)
+        radius = math.sqrt(k + c * c)
+        keep = np.linalg.norm(wall - [0, 0, c], axis=1) > radius - 1e-5
+    rim = wall[np.abs(wall[:, 2] - z_rim) < 1e-3]
+    rim_d = 2 * np.hypot(rim[:, 0], rim[:, 1]).max()
+    depth = c + radius - rim[:, 2].mean()
+    row("ShadowTac", "cavity sphere radius", "22.500 mm", radius, "{:.3f} mm", 0.002, 22.5)
+    row("ShadowTac", "cavity rim diameter", "35.000 mm", rim_d, "{:.3f} mm", 0.002, 35.0)
+    row("ShadowTac", "cavity depth", "8.358 mm", depth, "{:.3f} mm", 0.002, rho - z_rim)
+
+    # pins standing into the cavity: vertices inside the sphere, above the rim plane
+    pins = v[(r < rho - 0.01) & (v[:, 2] > z_rim + 0.01)]
+    pr = np.linalg.norm(pins, axis=1)
+    step = 3.9474
+    want = [(0.0, 0.0)] + [(k * step, j * 360.0 / (6 * k)) for k in range(1, 13) for j in range(6 * k)]
+    dirs = np.array([[math.sin(math.radians(p)) * math.cos(math.radians(a)),
+                      math.sin(math.radians(p)) * math.sin(math.radians(a)),
+                      math.cos(math.radians(p))] for p, a in want])
+    # each pin vertex belongs to the authors' position whose axis it lies nearest to
+    u = pins / pr[:, None]
+    owner = np.argmax(u @ dirs.T, axis=1)
+    lateral = np.linalg.norm(pins - (pins * dirs[owner]).sum(axis=1)[:, None] * dirs[owner], axis=1)
+    stray = int((lateral > 0.225 + 0.01).sum())
+    counts = np.bincount(owner, minlength=len(want))
+    deepest = np.full(len(want), np.inf)
+    np.minimum.at(deepest, owner, pr)
+    # a pin's axis: the mean direction of its vertices beyond the base of its cylinder
+    dev = 0.0
+    polar = np.full(len(want), np.nan)
+    for i in range(len(want)):
+        sel = owner == i
+        tipward = sel & (pr < rho - 0.3)
+        if tipward.sum() < 3:
+            continue
+        centre = pins[tipward].mean(axis=0)
+        off = centre - (centre @ dirs[i]) * dirs[i]
+        dev = max(dev, float(np.linalg.norm(off) * rho / np.linalg.norm(centre)))
+        polar[i] = math.degrees(math.acos(centre[2] / np.linalg.norm(centre)))
+    n_pins = int((counts > 0).sum())
+    row("ShadowTac", "pins in the cavity (dimples on the skin)", "469", float(n_pins), "{:.0f}", 0, 469)
+    row("ShadowTac", "pin vertices off every authors' pin axis", "0", float(stray), "{:.0f}", 0, 0)
+    height = rho - deepest[counts > 0]
+    row("ShadowTac", "pin height (dimple depth)", "0.500 mm", float(height.min()), "{:.3f} mm",
+        0.003, 0.5, note=f"max {height.max():.3f}")
+    row("ShadowTac", "pin axes from the authors' positions", "0", dev, "{:.4f} mm", 0.01, 0.0)
+    ring = np.array([0] + [k for k in range(1, 13) for _ in range(6 * k)])
+    outer = float(np.nanmean(polar[ring == 12]))
+    steps = [float(np.nanmean(polar[ring == k])) / k for k in range(1, 13)]
+    row("ShadowTac", "ring step / outer ring", "3.9474 / 47.37 deg",
+        f"{min(steps):.4f}-{max(steps):.4f} / {outer:.2f} deg", "{}")
+    ROWS[-1] = ROWS[-1][:4] + (bool(abs(outer - 47.37) < 0.005 and max(abs(x - step) for x in steps) < 1e-3),)
+    mk = m["summary"]["markers"][0]
+    row("ShadowTac", "dimples listed in the manifest", "469", float(mk["count"]), "{:.0f}", 0, 469)
+
+    # the top piece, in its print frame: 14 mm tall, 45 mm bore, boss 60 x 65 x 2
+    tm = print_mesh(d, top)
+    tv = np.asarray(tm.vertices, dtype=float)
+    lo, hi = tv.min(axis=0), tv.max(axis=0)
+    row("ShadowTac", "top piece height", "14.000 mm", hi[2] - lo[2], "{:.3f} mm", 1e-3, 14.0)
+    cxy = (lo[:2] + hi[:2]) / 2
+    rxy = np.hypot(tv[:, 0] - cxy[0], tv[:, 1] - cxy[1])
+    row("ShadowTac", "reservoir bore diameter", "45.000 mm", 2 * rxy.min(), "{:.3f} mm", 2e-3, 45.0)
+    bands = []
+    for band in (tv[:, 2] > hi[2] - 2.0 + 1e-4, tv[:, 2] < lo[2] + 2.0 - 1e-4):
+        ext = tv[band].max(axis=0) - tv[band].min(axis=0)
+        bands.append((ext[0] * ext[1], ext))
+    boss = min(bands, key=lambda b: b[0])[1]
+    row("ShadowTac", "registration boss", "60 x 65 x 2 mm", f"{boss[0]:.3f} x {boss[1]:.3f} x 2 mm",
+        "{}", None)
+    ok_boss = abs(boss[0] - 60.0) < 1e-3 and abs(boss[1] - 65.0) < 1e-3
+    ROWS[-1] = ROWS[-1][:4] + (bool(ok_boss),)
+    holes = int(top["genus"]) - 1
+    row("ShadowTac", "bolts", "20", float(holes), "{:.0f}", 0, 20)
+    fr = top["params"]["frame"]
+    row("ShadowTac", "bolt holes, bottom / top piece", "3.5 / 3.4 mm",
+        f"{fr['bolt_hole_diameter_mm']} / {fr['bolt_hole_diameter_mm']} mm", "{}",
+        note="differs: fabkit's M3 clearance from mold.clamp_bolt in both")
+
+
+def rtac0(fabkit, work):
+    run(fabkit, ["export", "rtac0", "--out", "out/rtac0"], work)
+    d = work / "out/rtac0"
+    m = manifest(d)
+    for name, want, what in [("translucent_gel_master_pattern", 15.0, "outer casting mold cavity"),
+                             ("transparent_gel_master_pattern", 13.5, "transparent-layer mold cavity")]:
+        v = sensor_vertices(d, part(m, name))
+        r = np.linalg.norm(v[v[:, 2] > 1.0], axis=1)
+        r = r[np.abs(r - want) < 0.5]
+        row("R-Tac0", what, f"R{want:.3f}", float(np.median(r)), "R{:.3f}", 1e-4, want,
+            note=f"{len(r)} vertices, at most {max(abs(r.max() - want), abs(r.min() - want)) * 1000:.1f} um off")
+    tube = part(m, "shell_tube")
+    v = sensor_vertices(d, tube)
+    row("R-Tac0", "shell: round tube, outer diameter", "30.000 mm",
+        2 * float(np.hypot(v[:, 0], v[:, 1]).max()), "{:.3f} mm", 2e-3, 30.0)
+    row("R-Tac0", "shell tube height", "21.650 mm", float(np.ptp(v[:, 2])), "{:.3f} mm", 1e-3, 21.65)
+    base = part(m, "shell_base")
+    row("R-Tac0", "shell material (tube + base)", "6,009 mm3",
+        f"{tube['volume_mm3'] + base['volume_mm3']:,.0f} mm3 (tube {tube['volume_mm3']:,.0f})", "{}",
+        note="differs: the tube's bay and seats and the base are fabkit's own")
+    sheet = (d / "FABRICATION.md").read_text()
+    ok = "| `translucent_gel` | `ecoflex_00_30` | cast | 1.400 | R14.900 |" in sheet and \
+        "| `black_coating` | `ptg_501_black` | sprayed | 0.100 | R15.000 |" in sheet
+    row("R-Tac0", "layers in FABRICATION.md", "(paper: 1.5 mm Ecoflex + coat)",
+        "Ecoflex 1.400 mm to R14.9, coat 0.100 mm to R15.0", "{}")
+    ROWS[-1] = ROWS[-1][:4] + (bool(ok),)
+
+
+def pin_dome(fabkit, work):
+    run(fabkit, ["fixtures", "rtac0", "--pins-preset", "rtac0", "--semidomes", "0",
+                 "--out", "out/rtac0_fixtures"], work)
+    d = work / "out/rtac0_fixtures"
+    m = manifest(d)
+    dome = part(m, "pin_dome")
+    v = sensor_vertices(d, dome)
+    r = np.linalg.norm(v, axis=1)
+    up = v[:, 2] > 2.0
+    # the median: vertices that booleans put on the facets (hole edges) sit up to the chord
+    # tolerance inside the sphere
+    inner = r[up & (r < 17.5)]
+    row("R-Tac0 pin dome", "inner radius", "16.650 mm", float(np.median(inner)), "{:.3f} mm", 1e-3, 16.65)
+    row("R-Tac0 pin dome", "outer radius", "19.100 mm", float(r[up].max()), "{:.3f} mm", 1e-3, 19.1)
+    # the pole hole's counterbore: vertices on its wall (2.5 mm across) below the outer surface
+    rxy = np.hypot(v[:, 0], v[:, 1])
+    cb = v[(np.abs(rxy - 1.25) < 0.01) & (v[:, 2] > 17.0)]
+    row("R-Tac0 pin dome", "counterbore depth on the hole axis", "0.350 mm",
+        19.1 - float(cb[:, 2].min()), "{:.3f} mm", 1e-3, 0.35)
+    # the groove: vertices on its floor sphere R18.5
+    # (vertices where the groove's end faces meet its floor lie on the floor's facets, up to the
+    # chord tolerance inside R18.5)
+    g = v[(np.abs(r - 18.5) < 0.01) & (np.hypot(v[:, 0], v[:, 1]) > 1.0)]
+    az = np.degrees(np.arctan2(g[:, 1], g[:, 0]))
+    pol = np.degrees(np.arccos(np.clip(g[:, 2] / np.linalg.norm(g, axis=1), -1, 1)))
+    row("R-Tac0 pin dome", "groove floor / azimuth / polar", "R18.50, 65-66 deg, 5.6-86.5 deg",
+        f"R18.50, {az.min():.1f}-{az.max():.1f} deg, {pol.min():.1f}-{pol.max():.1f} deg", "{}")
+    ok = len(g) > 10 and abs(az.min() - 65) < 0.05 and abs(az.max() - 66) < 0.05 \
+        and abs(pol.min() - 5.6) < 0.05 and abs(pol.max() - 86.5) < 0.05
+    ROWS[-1] = ROWS[-1][:4] + (bool(ok),)
+    span = float(max(np.ptp(v[:, 0]), np.ptp(v[:, 1])))
+    row("R-Tac0 pin dome", "base with two tabs, across", "43.000 mm", span, "{:.3f} mm", 1e-3, 43.0)
+
+    pin = print_mesh(d, part(m, "pin"))
+    pv = np.asarray(pin.vertices, dtype=float)
+    lo, hi = pv.min(axis=0), pv.max(axis=0)
+    c = (lo[:2] + hi[:2]) / 2
+    pr = np.hypot(pv[:, 0] - c[0], pv[:, 1] - c[1])
+    head = pv[pr > 1.49]
+    row("R-Tac0 pin", "length overall", "8.800 mm", hi[2] - lo[2], "{:.3f} mm", 1e-3, 8.8)
+    row("R-Tac0 pin", "head diameter x height", "3.000 x 3.200 mm",
+        f"{2 * pr.max():.3f} x {np.ptp(head[:, 2]):.3f} mm", "{}")
+    ROWS[-1] = ROWS[-1][:4] + (bool(abs(2 * pr.max() - 3.0) < 2e-3 and abs(np.ptp(head[:, 2]) - 3.2) < 1e-3),)
+    shaft = pr[pr < 1.4]
+    row("R-Tac0 pin", "shaft diameter", "1.600 mm", 2 * float(shaft.max()), "{:.3f} mm", 2e-3, 1.6)
+
+    lines = [ln for ln in (d / "points/point_table.csv").read_text().splitlines() if not ln.startswith("#")]
+    table = list(csv.DictReader(lines))
+    tips = np.array([[float(t["tip_x_mm"]), float(t["tip_y_mm"]), float(t["tip_z_mm"])] for t in table])
+    tr = np.linalg.norm(tips, axis=1)
+    row("R-Tac0 pin dome", "seated pin tips", "R14.50 (authors' hand-typed table)",
+        float(tr.mean()), "R{:.2f}", note="differs: the authors' own dome and pin seat the tips here, below their table")
+    ids = {int(t["id"]): tip for t, tip in zip(table, tips)}
+
+    def az_of(i):
+        return math.degrees(math.atan2(ids[i][1], ids[i][0])) % 360
+
+    numbering = [az_of(2), az_of(3), az_of(4), az_of(5)]
+    ok = all(abs(((a - w + 180) % 360) - 180) < 1e-6 for a, w in zip(numbering, [0, 270, 180, 90]))
+    for first in (6, 14, 22):
+        ok &= abs(((az_of(first) + 180) % 360) - 180) < 1e-6
+        ok &= abs(((az_of(first + 1) - 315 + 180) % 360) - 180) < 1e-6
+    row("R-Tac0 pin dome", "hole ids", "ring 1: 2 +x, 3 -y, 4 -x, 5 +y; 6, 14, 22 at +x, then -45 deg",
+        "the same", "{}")
+    ROWS[-1] = ROWS[-1][:4] + (bool(ok),)
+
+
+def tactip(fabkit, work):
+    run(fabkit, ["export", "tactip_dualmodal", "--preset", "tactipgenerator_217", "--out",
+                 "out/tactip_217"], work)
+    m = manifest(work / "out/tactip_217")
+    mk = m["summary"]["markers"][0]
+    row("TacTip", "TacTipGenerator default layout: pins", "217", float(mk["count"]), "{:.0f}", 0, 217)
+
+
+def main():
+    if len(sys.argv) < 3:
+        sys.stderr.write(__doc__)
+        sys.exit(2)
+    fabkit, work = str(Path(sys.argv[1]).resolve()), Path(sys.argv[2])
+    work.mkdir(parents=True, exist_ok=True)
+    for f in (shadowtac, rtac0, pin_dome, tactip):
+        f(fabkit, work)
+    failed = [r for r in ROWS if r[4] is False]
+    if "--markdown" in sys.argv:
+        print("| sensor | quantity | authors' CAD | fabkit |")
+        print("|---|---|---|---|")
+        for s, q, a, f, _ in ROWS:
+            print(f"| {s} | {q} | {a} | {f} |")
+    else:
+        for s, q, a, f, ok in ROWS:
+            mark = {True: "ok  ", False: "FAIL", None: "info"}[ok]
+            print(f"{mark} {s}: {q}: authors {a}, fabkit {f}")
+    print(f"authors_cad: {sum(1 for r in ROWS if r[4])} ok, {len(failed)} failed")
+    sys.exit(1 if failed else 0)
+
+
+if __name__ == "__main__":
+    main()
