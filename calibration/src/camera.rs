@@ -5,7 +5,7 @@
 //! Conventions (`docs/conventions.md`, "Camera and image conventions"): pixel (0, 0) is the centre
 //! of the top-left pixel; camera frame x right, y down, z forward; points in mm, pixels in px.
 //! Projection agrees with `cv2.fisheye.projectPoints` / `cv2.projectPoints` to 1e-6 px over the
-//! field of view (checked against opencv-python-headless in `tests/calibrate_opencv.rs`).
+//! field of view (checked against opencv-python-headless in `tests/e2e/calibrate_opencv.rs`).
 //!
 //! Source: R-Tac0 paper (`shared/papers/rtac0-rounded-monochrome-vbts.txt`), Sec. IV-A, Eq. (1):
 //! `(u, v) = M D [R | T] (x, y, z)`; `M` is the camera matrix (fx, fy, cx, cy), `D` the distortion.

@@ -4,11 +4,9 @@
 //! range x bearing z, half masks partition the surface pixels, N x N pairs), the files read by
 //! numpy, OpenCV and Open3D, and input errors.
 
-mod common;
-
 use std::path::Path;
 
-use common::*;
+use crate::common::*;
 use fabkit_calibration::nalgebra::Vector2;
 use fabkit_calibration::synthetic::benchmark_intrinsics;
 use fabkit_calibration::{write_camera, CameraFileFormat, CameraModel};

@@ -6,8 +6,7 @@
 //! A part with role `marker_tips` (the TacTip dots) only prints together with its skin in one
 //! multi-material job, so it is not printchecked alone; the kit 3MF that holds its group is.
 
-mod common;
-use common::*;
+use crate::common::*;
 use fabkit_designs::library;
 use serde_json::Value;
 use std::f64::consts::PI;

@@ -6,9 +6,7 @@
 //! The Markdown report (one row per part) goes to `$FABKIT_TWIN_REPORT_DIR` (default
 //! `<temp dir>/fabkit-twins`), outside the repository; any row out of bounds fails the test.
 
-mod common;
-
-use common::{missing, oracle_python, repo_root, run, text};
+use crate::common::{missing, oracle_python, repo_root, run, text};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 

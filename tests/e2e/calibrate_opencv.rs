@@ -3,9 +3,7 @@
 //! view (fisheye up to 89 deg off axis, where cv2.fisheye's z = 1 plane still holds), and
 //! cv2.FileStorage reads back exactly what fabkit writes.
 
-mod common;
-
-use common::{missing, oracle_python, repo_root, text};
+use crate::common::{missing, oracle_python, repo_root, text};
 use fabkit_calibration::nalgebra::Vector3;
 use fabkit_calibration::synthetic::benchmark_intrinsics;
 use fabkit_calibration::{write_camera, CameraFileFormat, CameraModel, Distortion, Intrinsics};

@@ -2,8 +2,7 @@
 //! Python oracles (manifold3d + trimesh), by PrusaSlicer through printcheck, for determinism,
 //! and for the pour numbers.
 
-mod common;
-use common::*;
+use crate::common::*;
 use std::collections::BTreeMap;
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
@@ -171,6 +170,9 @@ fn readme_first_command_writes_out_rtac0_with_provenance() {
     ] {
         assert!(sheet.contains(row), "no row {row} in:\n{sheet}");
     }
+    // The default design's parts read back by the manifold3d + trimesh oracle (the quick tier's
+    // end-to-end check: `scripts/test --quick`).
+    oracle_check(&dir);
 }
 
 #[test]

@@ -1,8 +1,7 @@
 //! `fabkit fixtures` end to end: files, point table, protrusion descriptions, determinism,
 //! oracle check and printcheck of every part, and bad parameters.
 
-mod common;
-use common::*;
+use crate::common::*;
 use std::path::{Path, PathBuf};
 
 fn files_under(dir: &Path) -> Vec<PathBuf> {

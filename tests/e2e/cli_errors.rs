@@ -1,8 +1,7 @@
 //! Bad input: clear errors naming file:line:column or the parameter path, exit code 2, no
 //! panic, nothing half-written.
 
-mod common;
-use common::*;
+use crate::common::*;
 
 fn rtac0_yaml() -> String {
     std::fs::read_to_string(repo_root().join("designs/library/rtac0.yaml")).unwrap()

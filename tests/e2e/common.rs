@@ -1,6 +1,8 @@
 //! Helpers shared by the end-to-end tests: run the fabkit binary, find the oracles.
 #![allow(dead_code)]
 
+use sha2::{Digest, Sha256};
+use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::{Condvar, Mutex};
@@ -84,7 +86,7 @@ pub fn oracle_check(dir: &Path) {
     );
 }
 
-/// Two slicer runs at a time across every test of this file (the machine has two cores).
+/// Two slicer runs at a time across every end-to-end test (the machine has two cores).
 static SLICER_SLOTS: (Mutex<usize>, Condvar) = (Mutex::new(2), Condvar::new());
 
 struct SlicerSlot;
@@ -109,9 +111,25 @@ impl Drop for SlicerSlot {
     }
 }
 
-/// `printcheck --strict` on each file, two at a time, every failure reported together.
+/// `printcheck --strict` on each file, two at a time, every failure reported together. The slicer
+/// runs once per distinct part: a file whose bytes (and flags) already passed in this test run
+/// passes again without slicing, since the slicer's verdict depends on nothing else.
 pub fn printcheck_all(files: &[PathBuf]) {
     printcheck_all_with(files, &[]);
+}
+
+/// Content hashes (sha256 of the file, then the flags) that passed printcheck in this run.
+static PRINTCHECK_PASSED: Mutex<BTreeSet<[u8; 32]>> = Mutex::new(BTreeSet::new());
+
+fn printcheck_key(file: &Path, flags: &[&str]) -> Option<[u8; 32]> {
+    let bytes = std::fs::read(file).ok()?;
+    let mut h = Sha256::new();
+    h.update(&bytes);
+    for f in flags {
+        h.update([0u8]);
+        h.update(f.as_bytes());
+    }
+    Some(h.finalize().into())
 }
 
 /// [`printcheck_all`] with extra printcheck flags (e.g. `--no-fdm` for resin and PolyJet parts).
@@ -119,7 +137,21 @@ pub fn printcheck_all_with(files: &[PathBuf], flags: &[&str]) {
     let Some(pc) = printcheck() else {
         return missing("printcheck (prusa-slicer + admesh)");
     };
-    let queue = Mutex::new(files.to_vec());
+    let passed = |f: &PathBuf| {
+        printcheck_key(f, flags).is_some_and(|k| {
+            PRINTCHECK_PASSED
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .contains(&k)
+        })
+    };
+    let queue = Mutex::new(
+        files
+            .iter()
+            .filter(|f| !passed(f))
+            .cloned()
+            .collect::<Vec<_>>(),
+    );
     let results = Mutex::new(Vec::new());
     std::thread::scope(|s| {
         for _ in 0..2 {
@@ -144,7 +176,15 @@ pub fn printcheck_all_with(files: &[PathBuf], flags: &[&str]) {
         .unwrap()
         .into_iter()
         .filter_map(|(f, o)| match o {
-            Ok(o) if o.status.success() && text(&o.stdout).contains("result=PASS") => None,
+            Ok(o) if o.status.success() && text(&o.stdout).contains("result=PASS") => {
+                if let Some(k) = printcheck_key(&f, flags) {
+                    PRINTCHECK_PASSED
+                        .lock()
+                        .unwrap_or_else(|e| e.into_inner())
+                        .insert(k);
+                }
+                None
+            }
             Ok(o) => Some(format!(
                 "{}:\n{}{}",
                 f.display(),

@@ -7,8 +7,7 @@
 //! orientation groove, 43 mm tabs, 8.8 mm pin with a 3.0 x 3.2 mm head, the published hole
 //! ids), and TacTipGenerator's 217-pin layout. The same script prints the README's table.
 
-mod common;
-use common::*;
+use crate::common::*;
 
 #[test]
 fn presets_match_the_authors_cad_on_the_exported_files() {

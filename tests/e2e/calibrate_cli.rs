@@ -2,11 +2,9 @@
 //! fixtures point table (29 pins: pole + rings of 4, 6, 8, 10 at polar 17.87, 35.74, 53.6,
 //! 71.5 deg on a 16.65 mm sphere), and its errors.
 
-mod common;
-
 use std::path::Path;
 
-use common::{run, text};
+use crate::common::{run, text};
 use fabkit_calibration::nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 use fabkit_calibration::overlay::{encode_gray8, read_png_rgb8};
 use fabkit_calibration::{write_camera, CameraFileFormat, CameraModel, Distortion, Intrinsics};

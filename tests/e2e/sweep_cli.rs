@@ -8,9 +8,7 @@
 //!
 //! The ShadowTac `paper_text` open mold at 0.05 mm chord tolerance keeps each variant near 0.3 s.
 
-mod common;
-
-use common::{fabkit, run, text};
+use crate::common::{fabkit, run, text};
 use serde_json::Value;
 use std::collections::BTreeSet;
 use std::path::Path;

@@ -3,9 +3,7 @@
 //! triangle mesh, the R-Tac0-like fisheye camera's 640 x 480 rays) cast by both; the distances
 //! agree to 1 um and the hit masks are identical.
 
-mod common;
-
-use common::{missing, oracle_python, repo_root, text};
+use crate::common::{missing, oracle_python, repo_root, text};
 use fabkit_calibration::groundtruth::mesh::{MeshCaster, NO_HIT};
 use fabkit_calibration::groundtruth::synthetic::BenchScene;
 use fabkit_export::raster::npy_f32;

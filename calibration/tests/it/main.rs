@@ -1,0 +1,8 @@
+//! The calibration crate's integration tests, one binary (one link) with a module per area.
+
+mod camera_files;
+mod camera_models;
+mod extrinsics_synthetic;
+mod groundtruth_closed_form;
+mod groundtruth_undistort;
+mod tables;

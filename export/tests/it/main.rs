@@ -1,0 +1,3 @@
+//! The export crate's integration tests, one binary (one link) with a module per area.
+
+mod export_kit;

@@ -1,0 +1,17 @@
+//! fabkit's end-to-end tests: the CLI binary run on real designs, its outputs read back by
+//! independent consumers (tests/oracles/, printcheck). One test binary (one link), a module per
+//! command or area; `common` holds the shared helpers.
+
+mod common;
+
+mod authors_cad;
+mod calibrate_cli;
+mod calibrate_opencv;
+mod cli_errors;
+mod export_markers;
+mod export_rtac0;
+mod fixtures_cli;
+mod groundtruth_cli;
+mod groundtruth_open3d;
+mod sweep_cli;
+mod twins;
