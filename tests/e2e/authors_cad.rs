@@ -1,4 +1,4 @@
-//! End to end: fabkit's seed presets against the authors' published CAD (issue 15), measured on
+//! End to end: fabkit's seed presets against the authors' published CAD, measured on
 //! the exported files by an independent oracle (`tests/oracles/authors_cad.py`, numpy + trimesh):
 //! the ShadowTac two-piece mold (cavity R22.500 cut to a 35.000 mm rim, 469 pins 0.500 mm tall
 //! on the authors' axes, 45 mm reservoir 14 mm tall, 60 x 65 x 2 mm boss, 20 bolts), the R-Tac0

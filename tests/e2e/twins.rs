@@ -1,4 +1,4 @@
-//! Cross-verification twins (issue 7): every part of every library design and of its
+//! Cross-verification twins: every part of every library design and of its
 //! fixtures, against the manifold3d twin (fast tier, every test run) and the exact CadQuery
 //! twin (full tier: when `FABKIT_CADQUERY_PYTHON` is set, as `.ci/run` does after
 //! `scripts/setup-cadquery`), plus `fabkit export --format step` read back by CadQuery.
