@@ -2,7 +2,7 @@
 #![allow(dead_code)]
 
 use sha2::{Digest, Sha256};
-use std::collections::BTreeSet;
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::{Condvar, Mutex};
@@ -112,14 +112,87 @@ impl Drop for SlicerSlot {
 }
 
 /// `printcheck --strict` on each file, two at a time, every failure reported together. The slicer
-/// runs once per distinct part: a file whose bytes (and flags) already passed in this test run
-/// passes again without slicing, since the slicer's verdict depends on nothing else.
+/// runs once per distinct part:
+/// - a file whose bytes (and flags) already passed in this test run passes again without
+///   slicing, since the slicer's verdict depends on nothing else; a file another test is
+///   slicing right now waits for that verdict;
+/// - a kit 3MF whose objects are single parts, each of them in `files` as its own STL, holds no
+///   print the STLs do not: PrusaSlicer loads it (`--no-fdm --no-sla`: manifold, nothing
+///   repaired, positive volume, units) rather than slicing it again, and its build items are
+///   checked not to overlap on the plate (what slicing the plate would catch). That the 3MF
+///   holds the very parts (volume to 1e-5, box) is `check_parts.py`'s check, which
+///   every export folder passes. A 3MF with a multi-part object (a multi-material group) is a
+///   print of its own and is sliced.
 pub fn printcheck_all(files: &[PathBuf]) {
     printcheck_all_with(files, &[]);
 }
 
-/// Content hashes (sha256 of the file, then the flags) that passed printcheck in this run.
-static PRINTCHECK_PASSED: Mutex<BTreeSet<[u8; 32]>> = Mutex::new(BTreeSet::new());
+/// A printcheck job: a file and its flags.
+type Job = (PathBuf, Vec<&'static str>);
+
+/// The flags of a kit 3MF in `files`: `--no-fdm --no-sla` when every object of it is one part
+/// whose STL is in `files` (after asserting the build items do not overlap), else none.
+fn kit_3mf_flags(kit: &Path, files: &[PathBuf]) -> Vec<&'static str> {
+    let Some(dir) = kit.parent() else {
+        return vec![];
+    };
+    let Ok(bytes) = std::fs::read(dir.join("manifest.json")) else {
+        return vec![];
+    };
+    let m: serde_json::Value = serde_json::from_slice(&bytes).expect("manifest.json parses");
+    let k = &m["kit_3mf"];
+    if k["file"].as_str().map(|f| dir.join(f)) != Some(kit.to_path_buf()) {
+        return vec![];
+    }
+    let Some(objects) = k["objects"].as_array() else {
+        return vec![];
+    };
+    let parts = m["parts"].as_array().expect("parts");
+    let part = |name: &str| parts.iter().find(|p| p["name"] == name);
+    let mut boxes = Vec::new();
+    for o in objects {
+        let vols = o["volumes"].as_array().map_or(0, Vec::len);
+        let Some(p) = (vols == 1).then(|| part(o["volumes"][0]["part"].as_str().unwrap_or("")))
+        else {
+            return vec![];
+        };
+        let Some(p) = p else { return vec![] };
+        let stl = dir.join(p["file"].as_str().unwrap_or(""));
+        if !files.contains(&stl) {
+            return vec![];
+        }
+        let f = |v: &serde_json::Value| v.as_f64().expect("a number");
+        let t = &o["translation_mm"];
+        let b = &p["bbox_mm"];
+        boxes.push((
+            o["name"].to_string(),
+            [0, 1].map(|i| f(&b["min"][i]) + f(&t[i])),
+            [0, 1].map(|i| f(&b["max"][i]) + f(&t[i])),
+        ));
+    }
+    for (i, (na, lo_a, hi_a)) in boxes.iter().enumerate() {
+        for (nb, lo_b, hi_b) in &boxes[i + 1..] {
+            let apart = (0..2).any(|j| hi_a[j] <= lo_b[j] || hi_b[j] <= lo_a[j]);
+            assert!(
+                apart,
+                "{}: objects {na} {lo_a:?}..{hi_a:?} and {nb} {lo_b:?}..{hi_b:?} overlap on the plate",
+                kit.display()
+            );
+        }
+    }
+    vec!["--no-fdm", "--no-sla"]
+}
+
+/// What this test run knows of a printcheck key.
+#[derive(Clone, Copy, PartialEq)]
+enum Verdict {
+    Running,
+    Passed,
+}
+
+/// Content hashes (sha256 of the file, then the flags) being checked or passed in this run.
+static PRINTCHECK: (Mutex<BTreeMap<[u8; 32], Verdict>>, Condvar) =
+    (Mutex::new(BTreeMap::new()), Condvar::new());
 
 fn printcheck_key(file: &Path, flags: &[&str]) -> Option<[u8; 32]> {
     let bytes = std::fs::read(file).ok()?;
@@ -132,42 +205,77 @@ fn printcheck_key(file: &Path, flags: &[&str]) -> Option<[u8; 32]> {
     Some(h.finalize().into())
 }
 
+/// Claims `key` for checking: false when it passed already (after waiting for a test that is
+/// checking the same bytes); true when the caller must check it (and then call [`settle`]).
+fn claim(key: Option<[u8; 32]>) -> bool {
+    let Some(key) = key else { return true };
+    let (lock, cv) = &PRINTCHECK;
+    let mut map = lock.lock().unwrap_or_else(|e| e.into_inner());
+    loop {
+        match map.get(&key) {
+            Some(Verdict::Passed) => return false,
+            Some(Verdict::Running) => map = cv.wait(map).unwrap_or_else(|e| e.into_inner()),
+            None => {
+                map.insert(key, Verdict::Running);
+                return true;
+            }
+        }
+    }
+}
+
+/// Records the verdict of a claimed key (a failure frees it: another test checks it again).
+fn settle(key: Option<[u8; 32]>, passed: bool) {
+    let Some(key) = key else { return };
+    let (lock, cv) = &PRINTCHECK;
+    let mut map = lock.lock().unwrap_or_else(|e| e.into_inner());
+    if passed {
+        map.insert(key, Verdict::Passed);
+    } else {
+        map.remove(&key);
+    }
+    cv.notify_all();
+}
+
 /// [`printcheck_all`] with extra printcheck flags (e.g. `--no-fdm` for resin and PolyJet parts).
-pub fn printcheck_all_with(files: &[PathBuf], flags: &[&str]) {
+pub fn printcheck_all_with(files: &[PathBuf], flags: &'static [&'static str]) {
     let Some(pc) = printcheck() else {
         return missing("printcheck (prusa-slicer + admesh)");
     };
-    let passed = |f: &PathBuf| {
-        printcheck_key(f, flags).is_some_and(|k| {
-            PRINTCHECK_PASSED
-                .lock()
-                .unwrap_or_else(|e| e.into_inner())
-                .contains(&k)
+    let jobs: Vec<Job> = files
+        .iter()
+        .map(|f| {
+            let mut fl = flags.to_vec();
+            if f.extension().is_some_and(|e| e == "3mf") && flags.is_empty() {
+                fl = kit_3mf_flags(f, files);
+            }
+            (f.clone(), fl)
         })
-    };
-    let queue = Mutex::new(
-        files
-            .iter()
-            .filter(|f| !passed(f))
-            .cloned()
-            .collect::<Vec<_>>(),
-    );
+        .collect();
+    let queue = Mutex::new(jobs);
     let results = Mutex::new(Vec::new());
     std::thread::scope(|s| {
         for _ in 0..2 {
             s.spawn(|| loop {
-                let Some(f) = queue.lock().unwrap().pop() else {
+                let Some((f, fl)) = queue.lock().unwrap().pop() else {
                     break;
                 };
+                let key = printcheck_key(&f, &fl);
+                if !claim(key) {
+                    continue;
+                }
                 let slot = SlicerSlot::take();
                 let o = std::process::Command::new("bash")
                     .arg(&pc)
                     .arg("--strict")
-                    .args(flags)
+                    .args(&fl)
                     .arg(&f)
                     .output();
                 drop(slot);
-                results.lock().unwrap().push((f, o));
+                let passed = o
+                    .as_ref()
+                    .is_ok_and(|o| o.status.success() && text(&o.stdout).contains("result=PASS"));
+                settle(key, passed);
+                results.lock().unwrap().push((f, fl, o));
             });
         }
     });
@@ -175,18 +283,11 @@ pub fn printcheck_all_with(files: &[PathBuf], flags: &[&str]) {
         .into_inner()
         .unwrap()
         .into_iter()
-        .filter_map(|(f, o)| match o {
-            Ok(o) if o.status.success() && text(&o.stdout).contains("result=PASS") => {
-                if let Some(k) = printcheck_key(&f, flags) {
-                    PRINTCHECK_PASSED
-                        .lock()
-                        .unwrap_or_else(|e| e.into_inner())
-                        .insert(k);
-                }
-                None
-            }
+        .filter_map(|(f, fl, o)| match o {
+            Ok(o) if o.status.success() && text(&o.stdout).contains("result=PASS") => None,
             Ok(o) => Some(format!(
-                "{}:\n{}{}",
+                "{} {}:\n{}{}",
+                fl.join(" "),
                 f.display(),
                 text(&o.stdout),
                 text(&o.stderr)
@@ -196,8 +297,7 @@ pub fn printcheck_all_with(files: &[PathBuf], flags: &[&str]) {
         .collect();
     assert!(
         failures.is_empty(),
-        "printcheck --strict {} failed on {} of {} files:\n{}",
-        flags.join(" "),
+        "printcheck --strict failed on {} of {} files:\n{}",
         failures.len(),
         files.len(),
         failures.join("\n")

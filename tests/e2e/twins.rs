@@ -49,25 +49,32 @@ const CASES: &[(&str, &[&str])] = &[
     ),
 ];
 
-/// Every case exported under `dir` with its CSG tree beside it (`<case>.csg.json`).
+/// Every case exported under `dir` with its CSG tree beside it (`<case>.csg.json`), two
+/// exports at a time (the machine has two cores; a STEP export waits on CadQuery).
 fn export_all(dir: &Path, extra: &[&str]) -> Vec<PathBuf> {
-    CASES
-        .iter()
-        .map(|(name, args)| {
-            let csg = format!("{name}.csg.json");
-            let mut a: Vec<&str> = args.to_vec();
-            a.extend(["--out", name, "--csg", &csg]);
-            a.extend(extra);
-            let o = run(dir, &a, &[]);
-            assert!(
-                o.status.success(),
-                "fabkit {a:?}:\n{}{}",
-                text(&o.stdout),
-                text(&o.stderr)
-            );
-            dir.join(name)
-        })
-        .collect()
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    std::thread::scope(|s| {
+        for _ in 0..2 {
+            s.spawn(|| loop {
+                let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                let Some((name, args)) = CASES.get(i) else {
+                    break;
+                };
+                let csg = format!("{name}.csg.json");
+                let mut a: Vec<&str> = args.to_vec();
+                a.extend(["--out", name, "--csg", &csg]);
+                a.extend(extra);
+                let o = run(dir, &a, &[]);
+                assert!(
+                    o.status.success(),
+                    "fabkit {a:?}:\n{}{}",
+                    text(&o.stdout),
+                    text(&o.stderr)
+                );
+            });
+        }
+    });
+    CASES.iter().map(|(name, _)| dir.join(name)).collect()
 }
 
 fn report_dir() -> PathBuf {
@@ -148,40 +155,64 @@ fn cadquery_twin_agrees_on_every_part_and_step_reads_back() {
     let t = tempfile::tempdir().unwrap();
     let exports = export_all(t.path(), &["--format", "stl,3mf,step"]);
     let json = check_twins(&py, "full", &exports);
+    // every folder's STEP files read back in one CadQuery start
+    let o = Command::new(&py)
+        .current_dir(repo_root().join("tests/oracles"))
+        .arg("twins/check_step.py")
+        .args(&exports)
+        .arg("--exact-json")
+        .arg(&json)
+        .output()
+        .expect("python runs");
+    let out = text(&o.stdout);
+    assert!(
+        o.status.success(),
+        "check_step.py:\n{out}\n{}",
+        text(&o.stderr)
+    );
     for d in &exports {
-        let o = Command::new(&py)
-            .current_dir(repo_root().join("tests/oracles"))
-            .arg("twins/check_step.py")
-            .arg(d)
-            .arg("--exact-json")
-            .arg(&json)
-            .output()
-            .expect("python runs");
-        let out = text(&o.stdout);
+        let name = d.file_name().unwrap().to_str().unwrap();
         assert!(
-            o.status.success() && out.contains(" 0 failed"),
-            "check_step.py {}:\n{out}\n{}",
-            d.display(),
-            text(&o.stderr)
+            out.contains(&format!("check_step: {name}: "))
+                && !out.contains(&format!("check_step: {name}: 0 passed")),
+            "check_step.py read no STEP file of {name}:\n{out}"
         );
     }
+    assert!(
+        out.lines()
+            .filter(|l| l.starts_with("check_step: "))
+            .all(|l| l.ends_with(" 0 failed")),
+        "check_step.py:\n{out}"
+    );
 }
 
-/// Without the CadQuery environment, `--format step` fails (exit 2), says how to install it,
-/// and writes nothing.
+/// Without the CadQuery environment (no such Python, or a Python without cadquery: the
+/// system's), `--format step` fails (exit 2), says how to install it, and writes nothing.
 #[test]
 fn step_without_cadquery_says_how_to_install() {
-    let t = tempfile::tempdir().unwrap();
-    let o = run(
-        t.path(),
-        &["export", "rtac0", "--format", "stl,step", "--out", "kit"],
-        &[("FABKIT_CADQUERY_PYTHON", "/nonexistent/python")],
-    );
-    assert_eq!(o.status.code(), Some(2));
-    let err = text(&o.stderr);
-    assert!(
-        err.contains("STEP export is not available") && err.contains("scripts/setup-cadquery"),
-        "{err}"
-    );
-    assert!(!t.path().join("kit").exists());
+    let no_cadquery = Command::new("python3")
+        .args(["-c", "import cadquery"])
+        .output()
+        .is_ok_and(|o| !o.status.success());
+    let mut cases = vec![("/nonexistent/python", "no Python at /nonexistent/python")];
+    if no_cadquery {
+        cases.push(("python3", "python3 cannot import cadquery"));
+    }
+    for (python, reason) in cases {
+        let t = tempfile::tempdir().unwrap();
+        let o = run(
+            t.path(),
+            &["export", "rtac0", "--format", "stl,step", "--out", "kit"],
+            &[("FABKIT_CADQUERY_PYTHON", python)],
+        );
+        assert_eq!(o.status.code(), Some(2), "{python}");
+        let err = text(&o.stderr);
+        assert!(
+            err.contains("STEP export is not available")
+                && err.contains(reason)
+                && err.contains("scripts/setup-cadquery"),
+            "{python}: {err}"
+        );
+        assert!(!t.path().join("kit").exists(), "{python}");
+    }
 }

@@ -2,13 +2,15 @@
 """Read back the STEP files of a `fabkit export --format step` (CadQuery import) and check each
 against the exact solid (issue 7).
 
-Usage: python twins/check_step.py EXPORT_DIR [--exact-json TWINS.json]   (from tests/oracles)
+Usage: python twins/check_step.py EXPORT_DIR [EXPORT_DIR ...] [--exact-json TWINS.json]
+       (from tests/oracles; one CadQuery start for every export folder)
 
 Per part with a `step_file` in manifest.json: the file imports into CadQuery as a valid shape
 with as many solids as the exact twin, and its volume equals the exact twin's within 1e-6
 relative (the same B-rep written and read back). The exact volumes come from `--exact-json`
 (the rows check_twins.py wrote in the same run) or, without it, from the twins built here.
-Exit status 0 when every part passes, 1 otherwise, 2 on unreadable input.
+Prints a line per part and, per folder, `check_step: DIR: N passed, M failed`.
+Exit status 0 when every part of every folder passes, 1 otherwise, 2 on unreadable input.
 """
 
 from __future__ import annotations
@@ -23,22 +25,29 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser()
-    ap.add_argument("export", type=Path)
+    ap.add_argument("exports", type=Path, nargs="+")
     ap.add_argument("--exact-json", type=Path)
     args = ap.parse_args(argv)
+    rows = json.loads(args.exact_json.read_text()) if args.exact_json else []
+    status = 0
+    for export in args.exports:
+        status = max(status, check_export(export, rows))
+    return status
+
+
+def check_export(export: Path, rows: list[dict]) -> int:
     import cadquery as cq
     from twins import compare as K
     from twins import cq_common, cq_twin
     try:
-        man = json.loads((args.export / "manifest.json").read_text())
+        man = json.loads((export / "manifest.json").read_text())
     except (OSError, ValueError) as e:
         print(f"check_step: {e}", file=sys.stderr)
         return 2
     exact = {}
-    if args.exact_json:
-        for r in json.loads(args.exact_json.read_text()):
-            if r.get("volume_exact_mm3") is not None and r["design"] == args.export.name:
-                exact[r["part"]] = r["volume_exact_mm3"]
+    for r in rows:
+        if r.get("volume_exact_mm3") is not None and r["design"] == export.name:
+            exact[r["part"]] = r["volume_exact_mm3"]
     bad = 0
     for part in man["parts"]:
         name = part["name"]
@@ -46,7 +55,7 @@ def main(argv=None) -> int:
             print(f"FAIL {name}: no step_file in the manifest")
             bad += 1
             continue
-        shape = cq.importers.importStep(str(args.export / part["step_file"])).val()
+        shape = cq.importers.importStep(str(export / part["step_file"])).val()
         ok_shape = shape.isValid()
         v_step = cq_common.exact_volume(shape)
         if name in exact:
@@ -60,7 +69,7 @@ def main(argv=None) -> int:
         bad += not ok
         print(f"{'PASS' if ok else 'FAIL'} {name}: STEP volume {v_step:.6f} mm3 vs exact "
               f"{v_exact:.6f} (rel {rel:.1e}), {n_step} solid(s), valid {ok_shape}", flush=True)
-    print(f"check_step: {len(man['parts']) - bad} passed, {bad} failed")
+    print(f"check_step: {export.name}: {len(man['parts']) - bad} passed, {bad} failed")
     return 1 if bad else 0
 
 
