@@ -151,12 +151,13 @@ fn kit_3mf_flags(kit: &Path, files: &[PathBuf]) -> Vec<&'static str> {
     let part = |name: &str| parts.iter().find(|p| p["name"] == name);
     let mut boxes = Vec::new();
     for o in objects {
-        let vols = o["volumes"].as_array().map_or(0, Vec::len);
-        let Some(p) = (vols == 1).then(|| part(o["volumes"][0]["part"].as_str().unwrap_or("")))
-        else {
+        // a multi-part object (a multi-material group) is a print of its own
+        if o["volumes"].as_array().map_or(0, Vec::len) != 1 {
+            return vec![];
+        }
+        let Some(p) = part(o["volumes"][0]["part"].as_str().unwrap_or("")) else {
             return vec![];
         };
-        let Some(p) = p else { return vec![] };
         let stl = dir.join(p["file"].as_str().unwrap_or(""));
         if !files.contains(&stl) {
             return vec![];
