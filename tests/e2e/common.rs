@@ -111,8 +111,16 @@ impl Drop for SlicerSlot {
     }
 }
 
-/// `printcheck --strict` on each file, two at a time, every failure reported together. The slicer
-/// runs once per distinct part:
+/// `printcheck --strict` on each file, two at a time, every failure reported together.
+/// - Every file is sliced for SLA, whose sliced volume must match the mesh's (printcheck's check
+///   for overlapping or inverted shells), with tests/printcheck/sla.ini (unless
+///   `PRINTCHECK_SLA_INI` is set): printcheck's own settings with smaller layer images, which
+///   nothing reads.
+/// - A file is sliced for FDM when a part in it is printed by FDM (`print_technology` in the
+///   manifest), or when the manifest does not say: an FDM slice of a resin or PolyJet part
+///   checks a print nobody makes (no bed adhesion, no empty-layer rule there).
+///
+/// The slicer runs once per distinct part:
 /// - a file whose bytes (and flags) already passed in this test run passes again without
 ///   slicing, since the slicer's verdict depends on nothing else; a file another test is
 ///   slicing right now waits for that verdict;
@@ -151,9 +159,13 @@ fn kit_3mf_flags(kit: &Path, files: &[PathBuf]) -> Vec<&'static str> {
     let part = |name: &str| parts.iter().find(|p| p["name"] == name);
     let mut boxes = Vec::new();
     for o in objects {
-        // a multi-part object (a multi-material group) is a print of its own
+        // a multi-part object (a multi-material group) is a print of its own: sliced, on the FDM
+        // slicer too unless no part of the 3MF is printed by FDM
         if o["volumes"].as_array().map_or(0, Vec::len) != 1 {
-            return vec![];
+            return match technologies(kit) {
+                Some(t) if !t.iter().any(|t| t == "FDM") => vec!["--no-fdm"],
+                _ => vec![],
+            };
         }
         let Some(p) = part(o["volumes"][0]["part"].as_str().unwrap_or("")) else {
             return vec![];
@@ -182,6 +194,27 @@ fn kit_3mf_flags(kit: &Path, files: &[PathBuf]) -> Vec<&'static str> {
         }
     }
     vec!["--no-fdm", "--no-sla"]
+}
+
+/// The print technologies (`print_technology` in manifest.json: FDM, SLA, PolyJet) of the parts
+/// in an exported file: the part whose `file` it is, or every part of the kit 3MF. None when the
+/// file is not listed in a manifest.json of its export folder.
+fn technologies(file: &Path) -> Option<Vec<String>> {
+    let dir = file.ancestors().skip(1).take(2).find(|d| d.join("manifest.json").is_file())?;
+    let bytes = std::fs::read(dir.join("manifest.json")).ok()?;
+    let m: serde_json::Value = serde_json::from_slice(&bytes).expect("manifest.json parses");
+    let parts = m["parts"].as_array()?;
+    let is = |f: &serde_json::Value| f.as_str().is_some_and(|f| dir.join(f) == file);
+    let chosen: Vec<&serde_json::Value> = if is(&m["kit_3mf"]["file"]) {
+        parts.iter().collect()
+    } else {
+        parts.iter().filter(|p| is(&p["file"])).collect()
+    };
+    let t: Option<Vec<String>> = chosen
+        .iter()
+        .map(|p| p["print_technology"].as_str().map(str::to_owned))
+        .collect();
+    t.filter(|t| !t.is_empty())
 }
 
 /// What this test run knows of a printcheck key.
@@ -246,8 +279,12 @@ pub fn printcheck_all_with(files: &[PathBuf], flags: &'static [&'static str]) {
         .iter()
         .map(|f| {
             let mut fl = flags.to_vec();
-            if f.extension().is_some_and(|e| e == "3mf") && flags.is_empty() {
-                fl = kit_3mf_flags(f, files);
+            if flags.is_empty() {
+                if f.extension().is_some_and(|e| e == "3mf") {
+                    fl = kit_3mf_flags(f, files);
+                } else if technologies(f).is_some_and(|t| !t.iter().any(|t| t == "FDM")) {
+                    fl = vec!["--no-fdm"];
+                }
             }
             (f.clone(), fl)
         })
@@ -265,7 +302,11 @@ pub fn printcheck_all_with(files: &[PathBuf], flags: &'static [&'static str]) {
                     continue;
                 }
                 let slot = SlicerSlot::take();
-                let o = std::process::Command::new("bash")
+                let mut c = std::process::Command::new("bash");
+                if std::env::var_os("PRINTCHECK_SLA_INI").is_none() {
+                    c.env("PRINTCHECK_SLA_INI", repo_root().join("tests/printcheck/sla.ini"));
+                }
+                let o = c
                     .arg(&pc)
                     .arg("--strict")
                     .args(&fl)

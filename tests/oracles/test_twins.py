@@ -54,6 +54,24 @@ class MeshMeasures(unittest.TestCase):
         self.assertEqual(dropped, 1)
         self.assertEqual(len(kept), len(f))
 
+    def test_point_mesh_distance_of_slivers_is_exact_with_the_right_triangle(self):
+        # a 100 x 0.2 mm face in long slivers (two triangles) and points above it, beside its
+        # long edge and past its ends: distances in closed form, the nearest triangle as given
+        v = np.array([[0, 0, 0], [100, 0, 0], [100, 0.2, 0], [0, 0.2, 0]], dtype=np.float64)
+        f = np.array([[0, 1, 2], [0, 2, 3]], dtype=np.int64)
+        sv, sf, parent = K.split_long_edges(v, f, 4.0)
+        self.assertGreater(len(sf), 2 * 25)
+        e = np.linalg.norm(sv[sf] - sv[np.roll(sf, 1, axis=1)], axis=2)
+        self.assertLessEqual(e.max(), 4.0)
+        self.assertAlmostEqual(sum(K.mesh_area(sv, sf[parent == i]) for i in (0, 1)),
+                               K.mesh_area(v, f), places=9)
+        p = np.array([[37.3, 0.15, 0.5], [61.0, -0.3, 0.0], [103.0, 0.1, 4.0],
+                      [10.0, 0.01, -0.01]])
+        d, tri = K.point_mesh_distance(p, v, f)
+        np.testing.assert_allclose(d, [0.5, 0.3, 5.0, 0.01], rtol=0, atol=1e-12)
+        self.assertEqual(tri[3], 0)  # below the diagonal y = 0.002 x: the first triangle
+        self.assertEqual(tri[0], 1)  # above it: the second
+
     def test_hausdorff_of_a_shifted_mesh(self):
         v, f = mesh_of(manifold3d.Manifold.cube((2, 2, 2), True))
         h = K.mesh_hausdorff(v, f, v + [0.0, 0.0, 0.01], f)

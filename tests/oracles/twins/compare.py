@@ -87,13 +87,49 @@ def samples(v, f):
                            v[f].mean(axis=1)])
 
 
+# Longest edge, mm, of the triangles libigl's AABB tree is given (see point_mesh_distance).
+SPLIT_EDGE_MM = 4.0
+
+
+def split_long_edges(v, f, max_edge_mm: float = SPLIT_EDGE_MM):
+    """The same surface with no edge longer than `max_edge_mm`: each longer triangle is cut in
+    two at the midpoint of its longest edge, until none is left. Returns (vertices, faces,
+    parent) with parent[i] the index in `f` of the triangle that face i is a piece of. The
+    pieces of a triangle cover exactly it (the midpoints lie on its edges to 1 ulp), so the
+    distance from any point to the surface is unchanged; T-junctions do not matter to it."""
+    v = np.asarray(v, dtype=np.float64)
+    f = np.asarray(f, dtype=np.int64)
+    parent = np.arange(len(f))
+    while len(f):
+        a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
+        lens = np.stack([np.linalg.norm(b - a, axis=1), np.linalg.norm(c - b, axis=1),
+                         np.linalg.norm(a - c, axis=1)], axis=1)
+        k = lens.argmax(axis=1)
+        big = lens[np.arange(len(f)), k] > max_edge_mm
+        if not big.any():
+            break
+        # rotate each long triangle so that its longest edge is its first: (r0, r1), opposite r2
+        r = np.stack([np.take_along_axis(f[big], ((k[big] + j) % 3)[:, None], axis=1)[:, 0]
+                      for j in range(3)], axis=1)
+        mid = np.arange(len(v), len(v) + len(r))
+        v = np.concatenate([v, 0.5 * (v[r[:, 0]] + v[r[:, 1]])])
+        f = np.concatenate([f[~big], np.stack([r[:, 0], mid, r[:, 2]], axis=1),
+                            np.stack([mid, r[:, 1], r[:, 2]], axis=1)])
+        parent = np.concatenate([parent[~big], parent[big], parent[big]])
+    return v, f, parent
+
+
 def point_mesh_distance(p, v, f):
-    """(distances, nearest triangle) of points p to the mesh (exact, libigl's AABB tree)."""
+    """(distances, nearest triangle) of points p to the mesh (exact, libigl's AABB tree).
+    The tree is built on the mesh's long triangles cut to at most SPLIT_EDGE_MM (the same
+    surface): slivers that span a part (fans of a holed face) overlap every box on their way
+    and made each query visit most of the tree (seconds to minutes on large parts)."""
     import igl
+    sv, sf, parent = split_long_edges(v, f)
     d2, tri, _ = igl.point_mesh_squared_distance(np.ascontiguousarray(p, dtype=np.float64),
-                                                 np.ascontiguousarray(v, dtype=np.float64),
-                                                 np.ascontiguousarray(f, dtype=np.int64))
-    return np.sqrt(np.maximum(d2, 0.0)), tri
+                                                 np.ascontiguousarray(sv, dtype=np.float64),
+                                                 np.ascontiguousarray(sf, dtype=np.int64))
+    return np.sqrt(np.maximum(d2, 0.0)), parent[tri]
 
 
 def mesh_hausdorff(va, fa, vb, fb, dense: bool = True) -> float:
