@@ -10,7 +10,7 @@
 //!   directory under a temporary parent, replaced by every iteration. This is what `fabkit export`
 //!   does minus process start, YAML parsing, the CSG dump and printing.
 //!
-//! Run: `cargo bench -p fabkit --bench export_rtac0` (about a minute on 2 cores). Every iteration
+//! Run: `cargo bench -p fabkit-benches --bench export_rtac0` (about a minute on 2 cores). Every iteration
 //! takes a sizeable fraction of a second, so sampling is flat: 10 samples of one or a few
 //! iterations each; the numbers are per iteration. `scripts/bench-compare` times the whole command against
 //! the same booleans replayed in manifold3d.
@@ -45,7 +45,7 @@ fn export_options(tol: ChordTolerance) -> ExportOptions {
         .collect();
     ExportOptions {
         formats: Formats::default(),
-        command_line: vec!["cargo bench -p fabkit --bench export_rtac0".to_string()],
+        command_line: vec!["cargo bench -p fabkit-benches --bench export_rtac0".to_string()],
         design_source: format!("embedded:{DESIGN}"),
         design_sha256,
         chord_tolerance_mm: tol.mm(),

@@ -19,11 +19,11 @@
 //!   chord tolerance, so the mold's triangle count grows slower than N (173k, 356k, 842k and
 //!   1.66M triangles for 469, 1000, 5000 and 10000 features).
 //!
-//! Run: `cargo bench -p fabkit --bench markers`: about 4 minutes on 2 idle cores after the build
+//! Run: `cargo bench -p fabkit-benches --bench markers`: about 4 minutes on 2 idle cores after the build
 //! (measured 3 min 50 s at load average 0.4-1.1). An iteration takes 0.8 to 11 s, so sampling is
 //! flat with criterion's minimum: 10 samples of one iteration each after one warm-up iteration,
 //! 11 iterations per case; the 11 at 10000 features alone take about 2 minutes, so the whole bench
-//! cannot fit in 2. `cargo bench -p fabkit --bench markers -- shadowtac_469` runs the published
+//! cannot fit in 2. `cargo bench -p fabkit-benches --bench markers -- shadowtac_469` runs the published
 //! mold alone in about 10 s. The numbers are per iteration.
 //! Feature counts actually placed are printed to stderr before each group.
 //! `scripts/bench-markers` times the same molds as a table against manifold3d replaying their

@@ -2,7 +2,8 @@
 """Cross-verify fabkit exports against their twins and write the Markdown report (issue 7).
 
 Usage: python -m twins.check_twins EXPORT_DIR... --report REPORT.md [--json OUT.json]
-                                   [--tier fast|full]   (run from tests/oracles)
+                                   [--tier fast|full] [--skip-manifold3d]
+                                   (run from tests/oracles)
 
 Each EXPORT_DIR is a `fabkit export` or `fabkit fixtures` output (manifest.json, parts/*.stl)
 with the CSG tree of its parts beside it as EXPORT_DIR.csg.json (`--csg`). Per part:
@@ -13,7 +14,8 @@ with the CSG tree of its parts beside it as EXPORT_DIR.csg.json (`--csg`). Per p
   within the chord-tolerance bound, symmetric Hausdorff distance <= tol + 1 um, bounding box
   within tol + 1 um, genus equal, its tessellation watertight once OCCT's zero-area pole facets
   are dropped (see compare.py).
-The written mesh itself must be watertight and consistently oriented. One report row per part;
+--skip-manifold3d leaves the manifold3d twin out of the full tier (for exports whose manifold3d
+twin a fast-tier run checks). The written mesh itself must be watertight and consistently oriented. One report row per part;
 exit status 1 when any row is out of bounds, 2 on unreadable input.
 """
 
@@ -36,11 +38,11 @@ from twins import compare as K  # noqa: E402
 from twins import m3d_twin  # noqa: E402
 
 
-def check_export(d: Path, tier: str, log) -> list[dict]:
+def check_export(d: Path, tier: str, log, manifold3d: bool = True) -> list[dict]:
     man = json.loads((d / "manifest.json").read_text())
     tol = float(man["chord_tolerance_mm"])
     csg_path = Path(str(d) + ".csg.json")
-    m3d = m3d_twin.replay(csg_path) if csg_path.exists() else None
+    m3d = m3d_twin.replay(csg_path) if manifold3d and csg_path.exists() else None
     rows = []
     for part in man["parts"]:
         name = part["name"]
@@ -54,7 +56,9 @@ def check_export(d: Path, tier: str, log) -> list[dict]:
             row["problems"].append("written mesh not watertight / not consistently oriented")
         hb = K.hausdorff_bound(tol)
         # manifold3d twin
-        if m3d is None:
+        if not manifold3d:
+            pass
+        elif m3d is None:
             row["problems"].append(f"no CSG file {csg_path.name}")
         else:
             r = m3d.get(name)
@@ -122,9 +126,11 @@ def fmt(x, spec=".3g", scale=1.0):
     return "n/a" if x is None else format(x * scale, spec)
 
 
-def report(rows: list[dict], tier: str, meta: dict) -> str:
+def report(rows: list[dict], tier: str, meta: dict, manifold3d: bool = True) -> str:
+    what = ("manifold3d only" if tier != "full" else "CadQuery exact twins and manifold3d"
+            if manifold3d else "CadQuery exact twins; manifold3d not checked here")
     out = ["# fabkit twin cross-verification", "",
-           f"Tier: {tier} ({'CadQuery exact twins and manifold3d' if tier == 'full' else 'manifold3d only'}). "
+           f"Tier: {tier} ({what}). "
            + ", ".join(f"{k} {v}" for k, v in meta.items()), "",
            "Bounds: volume vs exact <= area x tol + 1e-6 V; vs manifold3d <= 1e-6 relative; "
            "symmetric Hausdorff (over faces and at the exact solid's edges) and bounding box "
@@ -168,8 +174,8 @@ def _log(s: str) -> None:
     print(s, flush=True)
 
 
-def _check_export_logged(d: Path, tier: str) -> list[dict]:
-    return check_export(d, tier, _log)
+def _check_export_logged(d: Path, tier: str, manifold3d: bool) -> list[dict]:
+    return check_export(d, tier, _log, manifold3d)
 
 
 def main(argv=None) -> int:
@@ -178,6 +184,9 @@ def main(argv=None) -> int:
     ap.add_argument("--report", type=Path, required=True, help="Markdown report to write")
     ap.add_argument("--json", type=Path, help="also write the rows as JSON")
     ap.add_argument("--tier", choices=["fast", "full"], default="full")
+    ap.add_argument("--skip-manifold3d", action="store_true",
+                    help="full tier: the CadQuery twin only (for exports whose manifold3d twin "
+                         "another run of the fast tier checks)")
     ap.add_argument("--jobs", type=int, default=0,
                     help="exports checked in parallel processes (default: one per CPU)")
     args = ap.parse_args(argv)
@@ -187,14 +196,19 @@ def main(argv=None) -> int:
             return 2
     t0 = time.perf_counter()
     jobs = min(len(args.exports), args.jobs if args.jobs > 0 else (os.cpu_count() or 1))
+    if args.skip_manifold3d and args.tier != "full":
+        print("check_twins: --skip-manifold3d leaves the fast tier nothing to check", file=sys.stderr)
+        return 2
+    m3d = not args.skip_manifold3d
     rows = []
     if jobs <= 1:
         for d in args.exports:
-            rows += check_export(d, args.tier, _log)
+            rows += check_export(d, args.tier, _log, m3d)
     else:
         # one export per task, in the given order; the rows keep that order
+        n = len(args.exports)
         with ProcessPoolExecutor(max_workers=jobs) as pool:
-            for r in pool.map(_check_export_logged, args.exports, [args.tier] * len(args.exports)):
+            for r in pool.map(_check_export_logged, args.exports, [args.tier] * n, [m3d] * n):
                 rows += r
     meta = {"seconds": f"{time.perf_counter() - t0:.1f}"}
     try:
@@ -204,7 +218,7 @@ def main(argv=None) -> int:
             meta["cadquery"] = metadata.version("cadquery")
     except Exception:
         pass
-    text = report(rows, args.tier, meta)
+    text = report(rows, args.tier, meta, m3d)
     args.report.parent.mkdir(parents=True, exist_ok=True)
     args.report.write_text(text)
     if args.json:
