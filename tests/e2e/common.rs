@@ -200,7 +200,11 @@ fn kit_3mf_flags(kit: &Path, files: &[PathBuf]) -> Vec<&'static str> {
 /// in an exported file: the part whose `file` it is, or every part of the kit 3MF. None when the
 /// file is not listed in a manifest.json of its export folder.
 fn technologies(file: &Path) -> Option<Vec<String>> {
-    let dir = file.ancestors().skip(1).take(2).find(|d| d.join("manifest.json").is_file())?;
+    let dir = file
+        .ancestors()
+        .skip(1)
+        .take(2)
+        .find(|d| d.join("manifest.json").is_file())?;
     let bytes = std::fs::read(dir.join("manifest.json")).ok()?;
     let m: serde_json::Value = serde_json::from_slice(&bytes).expect("manifest.json parses");
     let parts = m["parts"].as_array()?;
@@ -304,14 +308,12 @@ pub fn printcheck_all_with(files: &[PathBuf], flags: &'static [&'static str]) {
                 let slot = SlicerSlot::take();
                 let mut c = std::process::Command::new("bash");
                 if std::env::var_os("PRINTCHECK_SLA_INI").is_none() {
-                    c.env("PRINTCHECK_SLA_INI", repo_root().join("tests/printcheck/sla.ini"));
+                    c.env(
+                        "PRINTCHECK_SLA_INI",
+                        repo_root().join("tests/printcheck/sla.ini"),
+                    );
                 }
-                let o = c
-                    .arg(&pc)
-                    .arg("--strict")
-                    .args(&fl)
-                    .arg(&f)
-                    .output();
+                let o = c.arg(&pc).arg("--strict").args(&fl).arg(&f).output();
                 drop(slot);
                 let passed = o
                     .as_ref()
