@@ -162,9 +162,10 @@ fn kit_3mf_flags(kit: &Path, files: &[PathBuf]) -> Vec<&'static str> {
         // a multi-part object (a multi-material group) is a print of its own: sliced, on the FDM
         // slicer too unless no part of the 3MF is printed by FDM
         if o["volumes"].as_array().map_or(0, Vec::len) != 1 {
-            return match technologies(kit) {
-                Some(t) if !t.iter().any(|t| t == "FDM") => vec!["--no-fdm"],
-                _ => vec![],
+            return if no_fdm_part(kit) {
+                vec!["--no-fdm"]
+            } else {
+                vec![]
             };
         }
         let Some(p) = part(o["volumes"][0]["part"].as_str().unwrap_or("")) else {
@@ -194,6 +195,12 @@ fn kit_3mf_flags(kit: &Path, files: &[PathBuf]) -> Vec<&'static str> {
         }
     }
     vec!["--no-fdm", "--no-sla"]
+}
+
+/// Whether the manifest says that no part in an exported file is printed by FDM (its
+/// `print_technology` is SLA or PolyJet): false when it does not say.
+fn no_fdm_part(file: &Path) -> bool {
+    technologies(file).is_some_and(|t| !t.iter().any(|t| t == "FDM"))
 }
 
 /// The print technologies (`print_technology` in manifest.json: FDM, SLA, PolyJet) of the parts
@@ -286,7 +293,7 @@ pub fn printcheck_all_with(files: &[PathBuf], flags: &'static [&'static str]) {
             if flags.is_empty() {
                 if f.extension().is_some_and(|e| e == "3mf") {
                     fl = kit_3mf_flags(f, files);
-                } else if technologies(f).is_some_and(|t| !t.iter().any(|t| t == "FDM")) {
+                } else if no_fdm_part(f) {
                     fl = vec!["--no-fdm"];
                 }
             }
