@@ -15,8 +15,9 @@ with the CSG tree of its parts beside it as EXPORT_DIR.csg.json (`--csg`). Per p
   within tol + 1 um, genus equal, its tessellation watertight once OCCT's zero-area pole facets
   are dropped (see compare.py).
 --skip-manifold3d leaves the manifold3d twin out of the full tier (for exports whose manifold3d
-twin a fast-tier run checks). The written mesh itself must be watertight and consistently oriented. One report row per part;
-exit status 1 when any row is out of bounds, 2 on unreadable input.
+twin a fast-tier run checks). The written mesh itself must be watertight and consistently
+oriented. One report row per part; exit status 1 when any row is out of bounds, 2 on unreadable
+input.
 """
 
 from __future__ import annotations
@@ -56,11 +57,9 @@ def check_export(d: Path, tier: str, log, manifold3d: bool = True) -> list[dict]
             row["problems"].append("written mesh not watertight / not consistently oriented")
         hb = K.hausdorff_bound(tol)
         # manifold3d twin
-        if not manifold3d:
-            pass
-        elif m3d is None:
+        if manifold3d and m3d is None:
             row["problems"].append(f"no CSG file {csg_path.name}")
-        else:
+        elif manifold3d:
             r = m3d.get(name)
             if r is None:
                 row["problems"].append("part missing from the CSG file")
