@@ -105,5 +105,3 @@ fn hint(nearest: &[String]) -> String {
     }
 }
 
-#[cfg(test)]
-mod tests;

@@ -1,7 +1,16 @@
 //! The designs crate's integration tests, one binary (one link) with a module per area.
 
+mod geometry;
+mod marker_layout;
 mod markers;
+mod materials;
+mod mesh;
 mod patterns;
+mod primitives;
+mod profile;
 mod properties;
 mod shadowtac;
+mod sweep;
+mod sweep_metrics;
+mod sweep_paths;
 mod validation;

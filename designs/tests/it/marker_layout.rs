@@ -1,0 +1,118 @@
+use fabkit_designs::markers::*;
+use fabkit_designs::profile::BodyProfile;
+use fabkit_designs::ChordTolerance;
+
+fn cap() -> BodyProfile {
+    BodyProfile::SphericalCap {
+        base_diameter_mm: 35.0,
+        height_mm: 8.0,
+    }
+}
+
+#[test]
+fn published_shadowtac_layout_has_469_markers() {
+    let s = Surface::new(&cap(), 0.0);
+    let p = Pattern {
+        layout: Layout::Concentric6k,
+        rings: Some(12),
+        pitch_arc_mm: Some(1.53),
+        spacing_mm: None,
+        count: None,
+        points: None,
+        csv_file: None,
+        center_marker: true,
+        max_polar_deg: None,
+        min_polar_deg: None,
+        polar_step_deg: None,
+        ring_azimuth_offset: None,
+    };
+    let m = place(&s, &p, 0.5).unwrap();
+    assert_eq!(m.len(), 469);
+    let st = stats(&s, &m);
+    // ring pitch is 1.53 mm of arc; the neighbours on ring 1 are 2 pi 1.53 / 6 apart, on
+    // ring 12 about 2 pi r(18.36) / 72
+    assert!(
+        st.min_spacing_mm > 1.2 && st.min_spacing_mm < 1.53,
+        "{st:?}"
+    );
+    for mk in &m {
+        let r =
+            (mk.position_mm[0].powi(2) + mk.position_mm[1].powi(2) + mk.position_mm[2].powi(2))
+                .sqrt();
+        let rho = (17.5f64 * 17.5 + 64.0) / 16.0;
+        assert!((r - rho).abs() < 1e-9);
+    }
+}
+
+#[test]
+fn arc_length_on_a_sphere_is_exact() {
+    let s = Surface::new(&cap(), -1.0);
+    let rho = (17.5f64 * 17.5 + 64.0) / 16.0 - 1.0;
+    let (p, n) = s.point(3.0, 0.3);
+    let polar = (p[0].hypot(p[1])).atan2(p[2]);
+    assert!((polar * rho - 3.0).abs() < 1e-9);
+    assert!((n[0] * p[0] + n[1] * p[1] + n[2] * p[2] - rho).abs() < 1e-9);
+}
+
+#[test]
+fn golden_spiral_count_and_hex_grid_spacing() {
+    let body = BodyProfile::HalfEllipsoid {
+        diameter_mm: 18.0,
+        height_mm: 24.0,
+    };
+    let s = Surface::new(&body, -0.9);
+    let mut p = Pattern {
+        layout: Layout::GoldenSpiral,
+        rings: None,
+        pitch_arc_mm: None,
+        spacing_mm: None,
+        count: Some(85),
+        points: None,
+        csv_file: None,
+        center_marker: true,
+        max_polar_deg: None,
+        min_polar_deg: None,
+        polar_step_deg: None,
+        ring_azimuth_offset: None,
+    };
+    let m = place(&s, &p, 1.0).unwrap();
+    assert_eq!(m.len(), 85);
+    // equal areas: the median spacing matches hexagonal packing of 85 points on the area
+    let area = s.area_to(s.total_arc_mm() - 1.0);
+    let hex = (area / 85.0 / (3f64.sqrt() / 2.0)).sqrt();
+    let st = stats(&s, &m);
+    assert!(
+        (st.median_spacing_mm / hex - 1.0).abs() < 0.25,
+        "{st:?} vs {hex}"
+    );
+    // A hex grid wrapped onto a cap (azimuthal equidistant) keeps its pitch along meridians
+    // and shrinks along parallels by at most sin(theta)/theta at the rim.
+    let s = Surface::new(&cap(), 0.0);
+    p.layout = Layout::HexGrid;
+    p.count = None;
+    p.spacing_mm = Some(2.0);
+    let m = place(&s, &p, 1.0).unwrap();
+    let st = stats(&s, &m);
+    let rho = (17.5f64 * 17.5 + 64.0) / 16.0;
+    let theta = (s.total_arc_mm() - 1.0) / rho;
+    assert!(
+        st.min_spacing_mm >= 2.0 * theta.sin() / theta && st.min_spacing_mm <= 2.0 + 1e-6,
+        "{st:?}"
+    );
+    assert!(
+        st.median_spacing_mm > 1.85 && st.median_spacing_mm <= 2.0 + 1e-6,
+        "{st:?}"
+    );
+}
+
+#[test]
+fn feature_volume_on_a_plane_like_surface() {
+    let tol = ChordTolerance::new(0.001).unwrap();
+    let shape = FeatureShape::new(1.0, 1.0, Polarity::Raised);
+    let f = feature_solid(&shape, [1.0, 2.0, 3.0], [0.0, 0.6, 0.8], 0.0, tol).unwrap();
+    let v = shape.nominal_volume_mm3();
+    assert!((f.volume() - v).abs() < 0.01 * v, "{} vs {v}", f.volume());
+    let b = f.bounding_box().unwrap();
+    // the hemisphere's centre is 0.5 mm along the direction, its top 0.5 mm above that
+    assert!((b.max[2] - (3.0 + 0.4 + 0.5)).abs() < 0.01, "{b:?}");
+}
