@@ -104,4 +104,3 @@ fn hint(nearest: &[String]) -> String {
         format!("; nearest: {}", nearest.join(", "))
     }
 }
-

@@ -36,9 +36,8 @@ fn published_shadowtac_layout_has_469_markers() {
         "{st:?}"
     );
     for mk in &m {
-        let r =
-            (mk.position_mm[0].powi(2) + mk.position_mm[1].powi(2) + mk.position_mm[2].powi(2))
-                .sqrt();
+        let r = (mk.position_mm[0].powi(2) + mk.position_mm[1].powi(2) + mk.position_mm[2].powi(2))
+            .sqrt();
         let rho = (17.5f64 * 17.5 + 64.0) / 16.0;
         assert!((r - rho).abs() < 1e-9);
     }

@@ -100,7 +100,10 @@ fn json_round_trip_and_unknown_fields() {
     let s = serde_json::to_string(&g).unwrap();
     assert!(s.contains("\"type\":\"sphere\""));
     assert_eq!(serde_json::from_str::<Geometry>(&s).unwrap(), g);
-    assert!(serde_json::from_str::<Geometry>(r#"{"frame":"x","primitives":[{"type":"sphere","centre_mm":[0,0,0],"radius_mm":1,"r":2}]}"#).is_err());
+    assert!(serde_json::from_str::<Geometry>(
+        r#"{"frame":"x","primitives":[{"type":"sphere","centre_mm":[0,0,0],"radius_mm":1,"r":2}]}"#
+    )
+    .is_err());
 }
 
 /// A rigid move keeps the volume and moves a sphere's centre.

@@ -1,6 +1,6 @@
+use fabkit_designs::geometry::profile2d::max_deviation;
 use fabkit_designs::profile::*;
 use fabkit_designs::ChordTolerance;
-use fabkit_designs::geometry::profile2d::max_deviation;
 
 #[test]
 fn ellipse_offset_is_at_constant_distance() {

@@ -1,8 +1,8 @@
 //! Expansion of sweep files: grid, zip and random modes, ids, and the errors reported before
 //! anything runs.
 
-use fabkit_designs::sweep::*;
 use fabkit_designs::library;
+use fabkit_designs::sweep::*;
 use serde_json::Value;
 use std::path::Path;
 
