@@ -19,12 +19,14 @@ from __future__ import annotations
 import hashlib
 import json
 import math
+import os
 import struct
 import subprocess
 import sys
 import tempfile
 import traceback
 import zipfile
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -536,21 +538,32 @@ def test_unreadable_manifest_exits_2(tmp: Path) -> None:
     expect("manifest.json" in err, f"stderr: {err!r}")
 
 
+def run_one(name: str, fn) -> tuple[bool, list[str]]:
+    """One test in its own temporary folder: (passed, traceback lines)."""
+    with tempfile.TemporaryDirectory(prefix="fabkit-check-parts-") as d:
+        try:
+            fn(Path(d))
+        except Exception:
+            return False, traceback.format_exc().splitlines()
+    return True, []
+
+
 def main() -> int:
     tests = [(n, f) for n, f in globals().items() if n.startswith("test_") and callable(f)]
     passed = failed = 0
-    for name, fn in tests:
-        with tempfile.TemporaryDirectory(prefix="fabkit-check-parts-") as d:
-            try:
-                fn(Path(d))
-            except Exception:
-                failed += 1
-                print(f"FAIL {name}")
-                for line in traceback.format_exc().splitlines():
-                    print(f"  | {line}")
-            else:
+    # Each test waits on its check_parts.py subprocess: one test per CPU at a time; the lines
+    # keep the tests' order.
+    jobs = max(1, min(len(tests), os.cpu_count() or 1))
+    with ThreadPoolExecutor(max_workers=jobs) as pool:
+        for (name, _), (ok, tb) in zip(tests, pool.map(lambda t: run_one(*t), tests)):
+            if ok:
                 passed += 1
                 print(f"ok   {name}")
+            else:
+                failed += 1
+                print(f"FAIL {name}")
+                for line in tb:
+                    print(f"  | {line}")
     print(f"{passed} passed, {failed} failed")
     return 0 if failed == 0 else 1
 
