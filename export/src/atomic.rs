@@ -4,6 +4,11 @@
 //! previous export is renamed to `.<name>.old-<pid>-<n>`, the new directory is renamed into
 //! place and the old one deleted. Between the two renames the name is briefly absent (a POSIX
 //! rename cannot swap two directories), but it never holds a half-written export.
+//!
+//! Every folder written here carries a marker, [`OUTPUT_MARKER`]: the list of the folder's
+//! files with their sizes. A folder is replaced only when it is empty or when its marker lists
+//! every file in it (at its listed size): a folder a user made, or a fabkit output a user added
+//! to or edited, is refused whole and left untouched.
 
 use crate::ExportError;
 use std::ffi::OsString;
@@ -14,6 +19,78 @@ use std::sync::atomic::{AtomicU32, Ordering};
 
 /// Sibling names from one process never repeat.
 static SIBLING_COUNTER: AtomicU32 = AtomicU32::new(0);
+
+/// Name of the marker file in every output folder fabkit writes (JSON: `format` and `files`,
+/// each file's `/`-separated path and size in bytes, sorted by path; the marker itself is not
+/// listed). Its bytes depend only on the folder's files: same input, same bytes.
+pub const OUTPUT_MARKER: &str = ".fabkit-output";
+const MARKER_FORMAT: &str = "fabkit-output/1";
+
+/// One file of an output folder as the marker lists it.
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MarkedFile {
+    path: String,
+    bytes: u64,
+}
+
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Marker {
+    format: String,
+    files: Vec<MarkedFile>,
+}
+
+/// Every regular file under `dir` (relative `/`-separated path and size, sorted), or the first
+/// entry that is neither a regular file nor a folder (a symlink, a FIFO, ...) as `Err`.
+fn list_tree(dir: &Path) -> Result<Result<Vec<MarkedFile>, String>, ExportError> {
+    let mut files = Vec::new();
+    let mut stack = vec![(dir.to_path_buf(), String::new())];
+    while let Some((d, prefix)) = stack.pop() {
+        for e in fs::read_dir(&d).map_err(ExportError::io("listing", &d))? {
+            let e = e.map_err(ExportError::io("listing", &d))?;
+            let rel = format!("{prefix}{}", e.file_name().to_string_lossy());
+            let md =
+                fs::symlink_metadata(e.path()).map_err(ExportError::io("inspecting", e.path()))?;
+            if md.is_dir() {
+                stack.push((e.path(), format!("{rel}/")));
+            } else if md.is_file() {
+                files.push(MarkedFile {
+                    path: rel,
+                    bytes: md.len(),
+                });
+            } else {
+                return Ok(Err(rel));
+            }
+        }
+    }
+    files.sort_by(|a, b| a.path.cmp(&b.path));
+    Ok(Ok(files))
+}
+
+/// Writes the marker of the finished folder `dir` (every file in it, see [`OUTPUT_MARKER`]).
+fn write_marker(dir: &Path) -> Result<(), ExportError> {
+    let files = match list_tree(dir)? {
+        Ok(f) => f,
+        Err(entry) => {
+            return Err(ExportError::Io {
+                action: "listing (not a regular file)",
+                path: dir.join(entry),
+                source: std::io::Error::from(ErrorKind::InvalidData),
+            })
+        }
+    };
+    let marker = Marker {
+        format: MARKER_FORMAT.into(),
+        files,
+    };
+    let mut bytes = serde_json::to_vec_pretty(&marker).map_err(|e| ExportError::Encode {
+        what: OUTPUT_MARKER.into(),
+        reason: e.to_string(),
+    })?;
+    bytes.push(b'\n');
+    write_file_synced(&dir.join(OUTPUT_MARKER), &bytes)
+}
 
 /// What [`replace_dir`] did besides succeeding.
 #[derive(Debug)]
@@ -42,7 +119,10 @@ pub(crate) fn replace_dir(
     let existing = inspect_existing(out_dir)?;
 
     let tmp = create_unique_sibling(&parent, &name, "tmp")?;
-    if let Err(e) = fill(&tmp).and_then(|()| sync_dir(&tmp)) {
+    if let Err(e) = fill(&tmp)
+        .and_then(|()| write_marker(&tmp))
+        .and_then(|()| sync_dir(&tmp))
+    {
         let _ = fs::remove_dir_all(&tmp);
         return Err(e);
     }
@@ -167,6 +247,7 @@ impl StagedDir {
     /// # Errors
     /// [`ExportError::Io`]; the output is then as it was.
     pub fn commit(mut self) -> Result<Vec<String>, ExportError> {
+        write_marker(&self.tmp)?;
         let mut dirs = vec![self.tmp.clone()];
         let mut k = 0;
         while k < dirs.len() {
@@ -286,43 +367,83 @@ fn inspect_existing(out_dir: &Path) -> Result<bool, ExportError> {
             path: out_dir.to_path_buf(),
         });
     }
-    let mut names: Vec<String> = fs::read_dir(out_dir)
+    let empty = fs::read_dir(out_dir)
         .map_err(ExportError::io("listing", out_dir))?
-        .map(|e| e.map(|e| e.file_name().to_string_lossy().into_owned()))
-        .collect::<Result<_, _>>()
-        .map_err(ExportError::io("listing", out_dir))?;
-    if names.is_empty() || is_fabkit_manifest(&out_dir.join("manifest.json")) {
+        .next()
+        .is_none();
+    if empty {
         return Ok(true);
     }
-    names.sort();
-    let entry = names
-        .iter()
-        .find(|n| n.as_str() != "manifest.json")
-        .or(names.first())
-        .cloned()
-        .unwrap_or_default();
-    Err(ExportError::ForeignDirectory {
-        path: out_dir.to_path_buf(),
-        entry,
-    })
+    match foreign_entry(out_dir)? {
+        None => Ok(true),
+        Some((entry, why)) => Err(ExportError::ForeignDirectory {
+            path: out_dir.to_path_buf(),
+            entry,
+            why,
+        }),
+    }
 }
 
-/// A regular file holding a JSON object with a string `fabkit_version`.
-fn is_fabkit_manifest(path: &Path) -> bool {
-    let Ok(md) = fs::symlink_metadata(path) else {
-        return false;
+/// `None` when the non-empty folder `dir` is an output fabkit wrote and nobody changed: its
+/// marker lists every file in it at its size (files the user deleted do not matter). Otherwise
+/// the first entry that shows it is not, and why.
+fn foreign_entry(dir: &Path) -> Result<Option<(String, String)>, ExportError> {
+    let files = match list_tree(dir)? {
+        Ok(f) => f,
+        Err(entry) => return Ok(Some((entry, "is neither a file nor a folder".into()))),
     };
-    if !md.is_file() {
-        return false;
-    }
-    let Ok(text) = fs::read(path) else {
-        return false;
-    };
-    serde_json::from_slice::<serde_json::Value>(&text)
+    let marker_path = dir.join(OUTPUT_MARKER);
+    let marker: Option<Marker> = fs::symlink_metadata(&marker_path)
         .ok()
-        .and_then(|v| v.get("fabkit_version").map(serde_json::Value::is_string))
-        .unwrap_or(false)
+        .filter(|m| m.is_file() && m.len() <= MAX_MARKER_BYTES)
+        .and_then(|_| fs::read(&marker_path).ok())
+        .and_then(|b| serde_json::from_slice(&b).ok())
+        .filter(|m: &Marker| m.format == MARKER_FORMAT);
+    let Some(marker) = marker else {
+        // The user's first file (not a look-alike manifest.json), for the message.
+        let first = files
+            .iter()
+            .find(|f| f.path != "manifest.json" && f.path != OUTPUT_MARKER)
+            .or(files.first())
+            .map(|f| f.path.clone())
+            .unwrap_or_default();
+        let why = if files.iter().any(|f| f.path == OUTPUT_MARKER) {
+            format!("is there, and the folder's {OUTPUT_MARKER} is not a fabkit marker")
+        } else {
+            format!("is there, and the folder has no {OUTPUT_MARKER} marker (an output of an older fabkit has none: delete it yourself)")
+        };
+        return Ok(Some((first, why)));
+    };
+    let listed: std::collections::BTreeMap<&str, u64> = marker
+        .files
+        .iter()
+        .map(|f| (f.path.as_str(), f.bytes))
+        .collect();
+    for f in files.iter().filter(|f| f.path != OUTPUT_MARKER) {
+        match listed.get(f.path.as_str()) {
+            None => {
+                return Ok(Some((
+                    f.path.clone(),
+                    format!("is not one of the files fabkit wrote there (not in {OUTPUT_MARKER})"),
+                )))
+            }
+            Some(&n) if n != f.bytes => {
+                return Ok(Some((
+                    f.path.clone(),
+                    format!(
+                        "was changed after fabkit wrote it ({} bytes, written {n})",
+                        f.bytes
+                    ),
+                )))
+            }
+            Some(_) => {}
+        }
+    }
+    Ok(None)
 }
+
+/// Largest marker file read back, bytes (a list of files, not a dataset).
+const MAX_MARKER_BYTES: u64 = 64 << 20;
 
 fn unique_sibling_path(parent: &Path, name: &OsString, kind: &str) -> PathBuf {
     loop {
@@ -383,11 +504,12 @@ mod tests {
     fn failing_fill_keeps_the_previous_export() {
         let root = tempfile::tempdir().unwrap();
         let out = root.path().join("kit");
-        fs::create_dir(&out).unwrap();
-        fs::write(
-            out.join("manifest.json"),
-            "{\"fabkit_version\": \"0.0.1\"}\n",
-        )
+        replace_dir(&out, |tmp| {
+            write_file_synced(
+                &tmp.join("manifest.json"),
+                b"{\"fabkit_version\": \"0.0.1\"}\n",
+            )
+        })
         .unwrap();
         let r = replace_dir(&out, |_| {
             Err(ExportError::ThreeMf {
@@ -396,7 +518,7 @@ mod tests {
         });
         assert!(r.is_err());
         assert_eq!(siblings(root.path()), vec!["kit"]);
-        assert_eq!(siblings(&out), vec!["manifest.json"]);
+        assert_eq!(siblings(&out), vec![OUTPUT_MARKER, "manifest.json"]);
     }
 
     #[test]

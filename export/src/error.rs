@@ -66,15 +66,18 @@ pub enum ExportError {
         path.display()
     )]
     NotADirectory { path: PathBuf },
-    /// The output directory holds files but no fabkit `manifest.json`: it is not a previous
-    /// export, so it is not replaced.
+    /// The output directory is not empty and is not an output fabkit wrote, unchanged since
+    /// (see [`crate::OUTPUT_MARKER`]): it is not replaced, and nothing in it is touched.
     #[error(
-        "output directory {} is not empty and holds no fabkit manifest.json (found `{entry}`): \
-         refusing to replace a folder fabkit did not write (hint: choose a new or empty \
-         directory, or move its contents away yourself)",
+        "output directory {} is not a folder fabkit wrote: `{entry}` {why}; refusing to \
+         replace it (hint: choose a new or empty directory, or move its contents away yourself)",
         path.display()
     )]
-    ForeignDirectory { path: PathBuf, entry: String },
+    ForeignDirectory {
+        path: PathBuf,
+        entry: String,
+        why: String,
+    },
     /// A file-system operation failed; `action` says which (e.g. `writing`).
     #[error("{action} {}", path.display())]
     Io {

@@ -26,7 +26,7 @@ pub mod step;
 mod stl;
 mod three_mf;
 
-pub use atomic::StagedDir;
+pub use atomic::{StagedDir, OUTPUT_MARKER};
 pub use check::check_printable_mesh;
 pub use error::ExportError;
 pub use manifest::{

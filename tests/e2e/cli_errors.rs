@@ -104,6 +104,34 @@ fn a_folder_fabkit_did_not_write_is_refused() {
         std::fs::read_to_string(tmp.path().join("thesis/chapter1.tex")).unwrap(),
         "keep me"
     );
+    // A look-alike manifest.json (a string fabkit_version) does not make it fabkit's folder.
+    let look_alike = "{\"fabkit_version\": \"0.1.0\"}\n";
+    std::fs::write(tmp.path().join("thesis/manifest.json"), look_alike).unwrap();
+    for cmd in [&["export"][..], &["fixtures", "rtac0"]] {
+        let mut args = cmd.to_vec();
+        args.extend(["--out", "thesis"]);
+        let o = run(tmp.path(), &args, &[]);
+        assert_eq!(o.status.code(), Some(2), "{args:?}");
+        let err = text(&o.stderr);
+        assert!(
+            err.contains("chapter1.tex") && err.contains(".fabkit-output"),
+            "{args:?}: {err}"
+        );
+    }
+    assert_eq!(
+        std::fs::read_to_string(tmp.path().join("thesis/chapter1.tex")).unwrap(),
+        "keep me"
+    );
+    assert_eq!(
+        std::fs::read_to_string(tmp.path().join("thesis/manifest.json")).unwrap(),
+        look_alike
+    );
+    let mut names: Vec<_> = std::fs::read_dir(tmp.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    names.sort();
+    assert_eq!(names, ["thesis"]);
 }
 
 #[test]

@@ -3,7 +3,9 @@
 
 use fabkit_designs::geometry::{cuboid, cylinder, sphere, Aabb, ChordTolerance};
 use fabkit_designs::kit::{CastComponent, CastReport, Kit, Part, PrintTechnology};
-use fabkit_export::{write_kit, ExportError, ExportOptions, Formats, Manifest, ManifestVolume};
+use fabkit_export::{
+    write_kit, ExportError, ExportOptions, Formats, Manifest, ManifestVolume, OUTPUT_MARKER,
+};
 use std::collections::BTreeSet;
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -319,7 +321,7 @@ fn same_kit_gives_byte_identical_files() {
     write_kit(&test_kit(), &b, &opts()).unwrap();
     let files = tree(&a);
     assert_eq!(files, tree(&b));
-    assert_eq!(files.len(), 5 + 3);
+    assert_eq!(files.len(), 5 + 3 + 1); // parts, manifest, 3MF, FABRICATION.md, the marker
     for f in &files {
         assert_eq!(
             fs::read(a.join(f)).unwrap(),
@@ -726,7 +728,8 @@ fn formats_select_the_mesh_files() {
     assert_eq!(
         tree(&mf_only),
         [
-            PathBuf::from("FABRICATION.md"),
+            PathBuf::from(".fabkit-output"),
+            "FABRICATION.md".into(),
             "manifest.json".into(),
             "tiny.3mf".into()
         ]
@@ -906,4 +909,100 @@ fn prusa_slicer_loads_a_group_as_one_object_with_named_volumes() {
             "{v}"
         );
     }
+}
+
+/// The marker lists every other file of the output with its size, sorted, and nothing else.
+#[test]
+fn marker_lists_every_file_of_the_output() {
+    let root = tempfile::tempdir().unwrap();
+    let out = root.path().join("kit");
+    write_kit(&test_kit(), &out, &opts()).unwrap();
+    let marker: serde_json::Value =
+        serde_json::from_slice(&fs::read(out.join(OUTPUT_MARKER)).unwrap()).unwrap();
+    assert_eq!(marker["format"], "fabkit-output/1");
+    let listed: Vec<(PathBuf, u64)> = marker["files"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| {
+            (
+                PathBuf::from(f["path"].as_str().unwrap()),
+                f["bytes"].as_u64().unwrap(),
+            )
+        })
+        .collect();
+    let on_disk: Vec<(PathBuf, u64)> = tree(&out)
+        .into_iter()
+        .filter(|p| p != Path::new(OUTPUT_MARKER))
+        .map(|p| {
+            let n = fs::metadata(out.join(&p)).unwrap().len();
+            (p, n)
+        })
+        .collect();
+    assert!(on_disk.len() >= 3, "{on_disk:?}");
+    assert_eq!(listed, on_disk);
+}
+
+/// A user's folder holding a look-alike fabkit manifest.json is not taken for an output:
+/// refused, and none of its files touched.
+#[test]
+fn look_alike_manifest_folder_is_refused_and_untouched() {
+    let root = tempfile::tempdir().unwrap();
+    let out = root.path().join("notes");
+    fs::create_dir(&out).unwrap();
+    let manifest = b"{\"fabkit_version\": \"0.1.0\", \"parts\": []}\n";
+    fs::write(out.join("manifest.json"), manifest).unwrap();
+    fs::write(out.join("thesis.tex"), b"keep me").unwrap();
+    let err = write_kit(&test_kit(), &out, &opts()).unwrap_err();
+    assert!(
+        matches!(err, ExportError::ForeignDirectory { ref entry, .. } if entry == "thesis.tex"),
+        "{err}"
+    );
+    assert!(err.to_string().contains(OUTPUT_MARKER), "{err}");
+    assert_eq!(entries(&out), ["manifest.json", "thesis.tex"]);
+    assert_eq!(fs::read(out.join("manifest.json")).unwrap(), manifest);
+    assert_eq!(fs::read(out.join("thesis.tex")).unwrap(), b"keep me");
+    assert_eq!(entries(root.path()), ["notes"]);
+    // A copied marker does not make the folder fabkit's: it lists neither file.
+    let kit = root.path().join("kit");
+    write_kit(&test_kit(), &kit, &opts()).unwrap();
+    fs::copy(kit.join(OUTPUT_MARKER), out.join(OUTPUT_MARKER)).unwrap();
+    let err = write_kit(&test_kit(), &out, &opts()).unwrap_err();
+    assert!(matches!(err, ExportError::ForeignDirectory { .. }), "{err}");
+    assert_eq!(fs::read(out.join("thesis.tex")).unwrap(), b"keep me");
+}
+
+/// A previous output is replaced only as fabkit wrote it: a file added to it or a file edited
+/// in it (another size) makes it the user's, refused and untouched; a deleted file does not.
+#[test]
+fn previous_output_changed_by_the_user_is_refused_and_untouched() {
+    let root = tempfile::tempdir().unwrap();
+    let out = root.path().join("kit");
+    write_kit(&test_kit(), &out, &opts()).unwrap();
+    let before = tree(&out);
+
+    fs::write(out.join("parts/notes.txt"), b"mine").unwrap();
+    let err = write_kit(&test_kit(), &out, &opts()).unwrap_err();
+    assert!(
+        matches!(err, ExportError::ForeignDirectory { ref entry, .. } if entry == "parts/notes.txt"),
+        "{err}"
+    );
+    assert_eq!(fs::read(out.join("parts/notes.txt")).unwrap(), b"mine");
+    fs::remove_file(out.join("parts/notes.txt")).unwrap();
+    assert_eq!(tree(&out), before);
+
+    let mut md = fs::read(out.join("FABRICATION.md")).unwrap();
+    md.extend_from_slice(b"\nmy notes\n");
+    fs::write(out.join("FABRICATION.md"), &md).unwrap();
+    let err = write_kit(&test_kit(), &out, &opts()).unwrap_err();
+    assert!(
+        matches!(err, ExportError::ForeignDirectory { ref entry, .. } if entry == "FABRICATION.md"),
+        "{err}"
+    );
+    assert_eq!(fs::read(out.join("FABRICATION.md")).unwrap(), md);
+
+    fs::remove_file(out.join("FABRICATION.md")).unwrap();
+    write_kit(&test_kit(), &out, &opts()).unwrap();
+    assert_eq!(tree(&out), before);
+    assert_eq!(entries(root.path()), ["kit"]);
 }
