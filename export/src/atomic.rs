@@ -176,6 +176,7 @@ fn move_into_place(
             out_dir,
         )(e));
     }
+    remove_stale_siblings(parent, name, &mut warnings);
     // Make the renames durable; a failure here does not undo a complete export.
     if let Err(e) = sync_dir(parent) {
         let cause = std::error::Error::source(&e)
@@ -445,6 +446,55 @@ fn foreign_entry(dir: &Path) -> Result<Option<(String, String)>, ExportError> {
 /// Largest marker file read back, bytes (a list of files, not a dataset).
 const MAX_MARKER_BYTES: u64 = 64 << 20;
 
+/// After a complete output is in place: removes the temporary siblings of the same output
+/// (`.<name>.tmp-<pid>-<n>`, `.<name>.old-<pid>-<n>`) that a killed run left behind, those of
+/// processes that are no longer running, and says so in `warnings`. Siblings of live
+/// processes (another fabkit writing the same folder now) and anything that is not a folder
+/// are left alone; where running processes cannot be listed (no `/proc`), nothing is removed.
+fn remove_stale_siblings(parent: &Path, name: &OsString, warnings: &mut Vec<String>) {
+    let proc_fs = Path::new("/proc/self").exists();
+    if !proc_fs {
+        return;
+    }
+    let prefix = format!(".{}.", name.to_string_lossy());
+    let Ok(entries) = fs::read_dir(parent) else {
+        return;
+    };
+    let me = std::process::id();
+    let mut stale: Vec<(PathBuf, u32)> = entries
+        .filter_map(Result::ok)
+        .filter_map(|e| {
+            let file_name = e.file_name();
+            let rest = file_name.to_str()?.strip_prefix(&prefix)?.to_string();
+            let rest = rest
+                .strip_prefix("tmp-")
+                .or_else(|| rest.strip_prefix("old-"))?;
+            let (pid, n) = rest.split_once('-')?;
+            let pid: u32 = pid.parse().ok()?;
+            n.parse::<u32>().ok()?;
+            Some((e.path(), pid))
+        })
+        .filter(|(p, pid)| {
+            *pid != me
+                && !Path::new("/proc").join(pid.to_string()).exists()
+                && fs::symlink_metadata(p).is_ok_and(|m| m.is_dir())
+        })
+        .collect();
+    stale.sort();
+    for (p, pid) in stale {
+        match fs::remove_dir_all(&p) {
+            Ok(()) => warnings.push(format!(
+                "removed {}, a temporary folder left by an interrupted fabkit run (process {pid}, no longer running)",
+                p.display()
+            )),
+            Err(e) => warnings.push(format!(
+                "could not remove {}, a temporary folder left by an interrupted fabkit run ({e}); delete it by hand",
+                p.display()
+            )),
+        }
+    }
+}
+
 fn unique_sibling_path(parent: &Path, name: &OsString, kind: &str) -> PathBuf {
     loop {
         let n = SIBLING_COUNTER.fetch_add(1, Ordering::Relaxed);
@@ -519,6 +569,43 @@ mod tests {
         assert!(r.is_err());
         assert_eq!(siblings(root.path()), vec!["kit"]);
         assert_eq!(siblings(&out), vec![OUTPUT_MARKER, "manifest.json"]);
+    }
+
+    /// Siblings left by a killed run (a process no longer running) are removed by the next
+    /// complete output, which says so; those of a live process and look-alike names are kept.
+    #[test]
+    fn stale_siblings_of_dead_processes_are_removed_and_reported() {
+        let root = tempfile::tempdir().unwrap();
+        let out = root.path().join("kit");
+        let mut child = std::process::Command::new("true").spawn().unwrap();
+        let dead = child.id();
+        child.wait().unwrap();
+        let live = std::process::Command::new("sleep")
+            .arg("30")
+            .spawn()
+            .unwrap();
+        let stale_tmp = root.path().join(format!(".kit.tmp-{dead}-0"));
+        let stale_old = root.path().join(format!(".kit.old-{dead}-3"));
+        let busy = root.path().join(format!(".kit.tmp-{}-0", live.id()));
+        let other = root.path().join(format!(".kits.tmp-{dead}-0"));
+        let odd = root.path().join(format!(".kit.tmp-{dead}-x"));
+        for d in [&stale_tmp, &stale_old, &busy, &other, &odd] {
+            fs::create_dir(d).unwrap();
+            fs::write(d.join("half.stl"), b"x").unwrap();
+        }
+        let r = replace_dir(&out, |tmp| write_file_synced(&tmp.join("a.stl"), b"a")).unwrap();
+        let mut live = live;
+        let _ = live.kill();
+        let _ = live.wait();
+        assert!(!stale_tmp.exists() && !stale_old.exists());
+        assert!(busy.exists() && other.exists() && odd.exists());
+        assert_eq!(r.warnings.len(), 2, "{:?}", r.warnings);
+        for (w, p) in r.warnings.iter().zip([&stale_old, &stale_tmp]) {
+            assert!(
+                w.contains(&p.display().to_string()) && w.contains(&dead.to_string()),
+                "{w}"
+            );
+        }
     }
 
     #[test]

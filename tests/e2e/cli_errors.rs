@@ -197,3 +197,53 @@ fn marker_list_from_csv_is_placed_and_hashed() {
     );
     assert!(!tmp.path().join("out/e").exists());
 }
+
+/// A run killed with SIGKILL while writing leaves its temporary sibling (`.<name>.tmp-<pid>-<n>`);
+/// the next complete run into the same folder removes it and says so.
+#[test]
+fn a_run_after_a_sigkill_mid_write_removes_the_stale_sibling_and_says_so() {
+    let tmp = tempfile::tempdir().unwrap();
+    std::fs::create_dir(tmp.path().join("out")).unwrap();
+    let mut child = crate::common::fabkit()
+        .current_dir(tmp.path())
+        .args(["export", "uvdtact", "--out", "out/u"])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let prefix = format!(".u.tmp-{}-", child.id());
+    let sibling = || {
+        std::fs::read_dir(tmp.path().join("out"))
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .find(|n| n.starts_with(&prefix))
+    };
+    // the temporary sibling exists once the parts are being written
+    let t0 = std::time::Instant::now();
+    while sibling().is_none() && child.try_wait().unwrap().is_none() {
+        assert!(
+            t0.elapsed().as_secs() < 120,
+            "no temporary sibling appeared"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    child.kill().unwrap(); // SIGKILL: no chance to clean up
+    child.wait().unwrap();
+    let Some(stale) = sibling() else {
+        panic!("the export finished before it could be killed");
+    };
+    assert!(!tmp.path().join("out/u").exists());
+
+    let o = run(tmp.path(), &["export", "rtac0", "--out", "out/u"], &[]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let err = text(&o.stderr);
+    assert!(
+        err.contains("removed") && err.contains(&stale) && err.contains("interrupted"),
+        "{err}"
+    );
+    let names: Vec<String> = std::fs::read_dir(tmp.path().join("out"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(names, ["u"]);
+}
