@@ -27,7 +27,7 @@ pub const OUTPUT_MARKER: &str = ".fabkit-output";
 const MARKER_FORMAT: &str = "fabkit-output/1";
 
 /// One file of an output folder as the marker lists it.
-#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 struct MarkedFile {
     path: String,
