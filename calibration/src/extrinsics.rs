@@ -1,7 +1,8 @@
 //! `fabkit calibrate extrinsics` as a library call: read the camera file, the point table and the
 //! observations, solve T_cam_sensor (SQPnP, then Levenberg-Marquardt on the reprojection error,
-//! inside RANSAC), and write `extrinsics.json`, `extrinsics.yaml` and, given a capture image,
-//! `overlay.png`.
+//! inside RANSAC), and render the output files `extrinsics.json`, `extrinsics.yaml` and, given a
+//! capture image, `overlay.png` (the caller writes them: `fabkit calibrate extrinsics` stages them
+//! in one output folder, moved into place whole).
 //!
 //! Source: R-Tac0 paper, Sec. IV-A, Eq. (1) and Fig. 5 (pins inserted through a dome at known
 //! coordinates, their pixels recorded, the pose solved by PnP).
@@ -11,7 +12,7 @@ use std::path::{Path, PathBuf};
 use crate::camera_file::{read_camera_file, CameraFileError};
 use crate::overlay::{read_png_rgb8, render_overlay, OverlayError};
 use crate::pnp::{solve_pnp, PnpError, PnpOptions, RansacOptions};
-use crate::report::{write_atomic, ExtrinsicsReport, Provenance};
+use crate::report::{ExtrinsicsReport, Provenance};
 use crate::tables::{
     pair, read_capture_plan, read_captures, read_observations, read_point_table, PointsFrom,
     TableError,
@@ -30,8 +31,6 @@ pub struct ExtrinsicsJob {
     /// Capture plan (`capture,id,ring`) that the observation files follow, one file per capture
     /// in capture order; each file's ids are checked against its capture.
     pub capture_plan: Option<PathBuf>,
-    /// Output folder (created if missing).
-    pub out_dir: PathBuf,
     /// Capture image for the overlay.
     pub image: Option<PathBuf>,
     /// `None`: no outlier rejection.
@@ -55,24 +54,27 @@ pub enum ExtrinsicsError {
     },
     #[error(transparent)]
     Overlay(#[from] OverlayError),
-    #[error("cannot write {path}: {source}")]
-    Write {
-        path: String,
-        #[source]
-        source: std::io::Error,
-    },
     #[error("cannot serialise the report as YAML: {0}")]
     Yaml(String),
 }
 
-/// Runs the calibration and writes the output folder; returns the report.
+/// The result of one extrinsics calibration: the report and the files of its output folder.
+#[derive(Debug, Clone)]
+pub struct ExtrinsicsOutput {
+    pub report: ExtrinsicsReport,
+    /// (file name, bytes): `extrinsics.json`, `extrinsics.yaml` and, given a capture image,
+    /// `overlay.png`, in that order.
+    pub files: Vec<(&'static str, Vec<u8>)>,
+}
+
+/// Runs the calibration; returns the report and the output files. Reads only the job's input
+/// files and writes nothing.
 ///
 /// # Errors
 /// [`ExtrinsicsError`]: unreadable or invalid inputs (file:line and field), unmatched ids, fewer
 /// than 4 usable points, pixels outside the lens's field, degenerate layouts, points behind the
-/// camera at the solved pose, too few RANSAC inliers, unwritable output. Nothing is written
-/// unless the solve succeeds; each file is written through a temporary sibling and a rename.
-pub fn run_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsReport, ExtrinsicsError> {
+/// camera at the solved pose, too few RANSAC inliers, a capture image of the wrong size.
+pub fn calibrate_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsOutput, ExtrinsicsError> {
     let camera = read_camera_file(&job.camera)?;
     let table = read_point_table(&job.points, job.points_from)?;
     let obs_paths: Vec<&Path> = job.observations.iter().map(PathBuf::as_path).collect();
@@ -150,11 +152,6 @@ pub fn run_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsReport, Extrinsic
         }
         None => None,
     };
-    let write_err = |path: &Path| {
-        let path = path.display().to_string();
-        move |source| ExtrinsicsError::Write { path, source }
-    };
-    std::fs::create_dir_all(&job.out_dir).map_err(write_err(&job.out_dir))?;
     let mut files = vec![
         ("extrinsics.json", json.into_bytes()),
         ("extrinsics.yaml", yaml.into_bytes()),
@@ -162,9 +159,5 @@ pub fn run_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsReport, Extrinsic
     if let Some(o) = overlay {
         files.push(("overlay.png", o));
     }
-    for (name, bytes) in files {
-        let path = job.out_dir.join(name);
-        write_atomic(&path, &bytes).map_err(write_err(&path))?;
-    }
-    Ok(report)
+    Ok(ExtrinsicsOutput { report, files })
 }

@@ -25,7 +25,7 @@ pub use camera::{CameraError, CameraModel, Distortion, Intrinsics};
 pub use camera_file::{
     parse_camera, read_camera_file, write_camera, CameraFileError, CameraFileFormat,
 };
-pub use extrinsics::{run_extrinsics, ExtrinsicsError, ExtrinsicsJob};
+pub use extrinsics::{calibrate_extrinsics, ExtrinsicsError, ExtrinsicsJob, ExtrinsicsOutput};
 pub use nalgebra;
 pub use pnp::{solve_pnp, PnpError, PnpOptions, PnpSolution, RansacOptions};
 pub use report::ExtrinsicsReport;

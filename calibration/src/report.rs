@@ -1,7 +1,4 @@
-//! The extrinsics result and residual report (`extrinsics.json` / `extrinsics.yaml`), and
-//! writing an output folder without half-written files.
-
-use std::path::{Path, PathBuf};
+//! The extrinsics result and residual report (`extrinsics.json` / `extrinsics.yaml`).
 
 use nalgebra::Point3;
 use serde::Serialize;
@@ -159,23 +156,4 @@ impl ExtrinsicsReport {
     pub fn to_yaml(&self) -> Result<String, String> {
         serde_saphyr::to_string(self).map_err(|e| e.to_string())
     }
-}
-
-/// Writes `bytes` to `path` through a temporary sibling and a rename, so that `path` never holds
-/// a half-written file.
-///
-/// # Errors
-/// The I/O error, with the path.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), std::io::Error> {
-    let dir = path.parent().unwrap_or(Path::new("."));
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp: PathBuf = dir.join(format!(".{name}.tmp-{}", std::process::id()));
-    let r = std::fs::write(&tmp, bytes).and_then(|_| std::fs::rename(&tmp, path));
-    if r.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    r.map_err(|e| std::io::Error::new(e.kind(), format!("{}: {e}", path.display())))
 }

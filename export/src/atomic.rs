@@ -103,8 +103,8 @@ pub(crate) struct Replaced {
 
 /// Fills a fresh temporary sibling of `out_dir` with `fill` and moves it into place.
 ///
-/// `out_dir` may be missing (its parents are created), an empty directory, or a previous
-/// fabkit export (a directory with a fabkit `manifest.json`), which is replaced as a whole.
+/// `out_dir` may be missing (its parents are created), an empty directory, or an earlier
+/// fabkit output that its [`OUTPUT_MARKER`] lists whole, which is replaced as a whole.
 ///
 /// # Errors
 /// [`ExportError::InvalidOutDir`], [`ExportError::NotADirectory`],
@@ -192,8 +192,9 @@ fn move_into_place(
 
 /// An output folder written file by file (e.g. a dataset too large to hold in memory): files go
 /// into a fresh temporary sibling of the folder; [`StagedDir::commit`] moves it into place
-/// exactly as [`crate::write_kit`] does (a missing folder, an empty one, or a previous fabkit
-/// output with a fabkit `manifest.json` is replaced; anything else is refused before writing).
+/// exactly as [`crate::write_kit`] does (a missing folder, an empty one, or an earlier fabkit
+/// output whose [`OUTPUT_MARKER`] lists every file in it is replaced; anything else, a symbolic
+/// link included, is refused before writing).
 /// Dropped without a commit, the temporary folder is removed and the output is untouched.
 #[derive(Debug)]
 pub struct StagedDir {

@@ -3,7 +3,8 @@
 use std::error::Error;
 use std::path::PathBuf;
 
-use fabkit_calibration::{run_extrinsics, ExtrinsicsJob, PointsFrom, RansacOptions};
+use fabkit_calibration::{calibrate_extrinsics, ExtrinsicsJob, PointsFrom, RansacOptions};
+use fabkit_export::StagedDir;
 
 #[derive(clap::Subcommand, Debug)]
 pub enum CalibrateCommand {
@@ -38,7 +39,8 @@ pub struct ExtrinsicsArgs {
     /// per capture, in capture order, and each may hold only that capture's pins.
     #[arg(long, value_name = "PLAN.csv")]
     pub capture_plan: Option<PathBuf>,
-    /// Output folder for extrinsics.json, extrinsics.yaml (and overlay.png).
+    /// Output folder for extrinsics.json, extrinsics.yaml (and overlay.png): missing, empty, or an
+    /// earlier fabkit output (replaced whole, never a folder of the user's own files).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
     /// Capture image (PNG) for an overlay of observed and reprojected points.
@@ -78,7 +80,6 @@ fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
         },
         observations: a.observations,
         capture_plan: a.capture_plan,
-        out_dir: a.out.clone(),
         image: a.image,
         ransac: (!a.no_ransac).then_some(RansacOptions {
             threshold_px: a.ransac_threshold_px,
@@ -87,7 +88,15 @@ fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
         }),
         command_line: std::env::args().collect::<Vec<_>>().join(" "),
     };
-    let r = run_extrinsics(&job)?;
+    // The output folder is checked (and its temporary sibling made) before the solve; nothing
+    // appears under --out unless every file is written.
+    let staged = StagedDir::new(&a.out)?;
+    let out = calibrate_extrinsics(&job)?;
+    for (name, bytes) in &out.files {
+        staged.write(name, bytes)?;
+    }
+    let warnings = staged.commit()?;
+    let r = out.report;
     let c = r.residuals.camera_centre_in_sensor_mm;
     println!(
         "extrinsics: {} of {} points, RMS reprojection error {:.3} px, worst {:.3} px (id {})",
@@ -105,5 +114,8 @@ fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
         r.rvec[0], r.rvec[1], r.rvec[2], r.tvec_mm[0], r.tvec_mm[1], r.tvec_mm[2], c[0], c[1], c[2]
     );
     println!("wrote {}", a.out.display());
+    for w in warnings {
+        eprintln!("warning: {w}");
+    }
     Ok(())
 }

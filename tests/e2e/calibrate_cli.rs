@@ -440,3 +440,116 @@ fn rtac0_fixture_table_and_capture_plan_end_to_end() {
     );
     assert!(!dir.join("out3").exists());
 }
+
+/// Every file of the folder `d` (relative paths, sorted), hidden files included.
+fn listing(d: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(d)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+/// `--out` is an output folder written whole: a user's folder (here one holding their own
+/// `extrinsics.json`) is refused and left byte for byte as it was, a symlinked `--out` is not
+/// followed, and a second run without `--image` leaves no `overlay.png` of the first behind.
+#[test]
+fn extrinsics_out_is_written_whole_and_never_takes_a_users_folder() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    std::fs::write(
+        dir.join("cam.yaml"),
+        write_camera(&intrinsics(), CameraFileFormat::OpenCvYaml),
+    )
+    .unwrap();
+    write_table(&dir.join("pins.csv"));
+    std::fs::write(dir.join("obs.csv"), observe(false, 0..29)).unwrap();
+    let img = vec![90u8; 640 * 480];
+    std::fs::write(dir.join("img.png"), encode_gray8(640, 480, &img).unwrap()).unwrap();
+    let calibrate = |out: &str, image: bool| {
+        let mut a = vec![
+            "calibrate",
+            "extrinsics",
+            "--camera",
+            "cam.yaml",
+            "--points",
+            "pins.csv",
+            "--observations",
+            "obs.csv",
+            "--out",
+            out,
+        ];
+        if image {
+            a.extend(["--image", "img.png"]);
+        }
+        run(dir, &a, &[])
+    };
+
+    // A user's folder with their own extrinsics.json (and another file): refused, untouched.
+    std::fs::create_dir(dir.join("mine")).unwrap();
+    std::fs::write(dir.join("mine/extrinsics.json"), "{\"mine\": true}\n").unwrap();
+    std::fs::write(dir.join("mine/notes.txt"), "calibration day 1\n").unwrap();
+    let before = listing(dir);
+    let o = calibrate("mine", true);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o.stdout));
+    let err = text(&o.stderr);
+    assert!(
+        err.contains("is not a folder fabkit wrote") && err.contains("mine"),
+        "{err}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(dir.join("mine/extrinsics.json")).unwrap(),
+        "{\"mine\": true}\n"
+    );
+    assert_eq!(listing(&dir.join("mine")), ["extrinsics.json", "notes.txt"]);
+    assert_eq!(listing(dir), before, "a temporary sibling was left behind");
+
+    // A symlinked --out (to an empty folder, and to the user's folder) is not followed.
+    std::fs::create_dir(dir.join("empty")).unwrap();
+    for target in ["empty", "mine"] {
+        let link = format!("link_to_{target}");
+        std::os::unix::fs::symlink(dir.join(target), dir.join(&link)).unwrap();
+        let o = calibrate(&link, false);
+        assert_eq!(o.status.code(), Some(2), "{link}");
+        assert!(
+            text(&o.stderr).contains("is a symbolic link"),
+            "{link}: {}",
+            text(&o.stderr)
+        );
+        assert!(std::fs::symlink_metadata(dir.join(&link))
+            .unwrap()
+            .file_type()
+            .is_symlink());
+    }
+    assert!(listing(&dir.join("empty")).is_empty());
+    assert_eq!(listing(&dir.join("mine")), ["extrinsics.json", "notes.txt"]);
+
+    // With --image, then without: the second output has no overlay.png of the first.
+    let o = calibrate("out", true);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert_eq!(
+        listing(&dir.join("out")),
+        [
+            fabkit_export::OUTPUT_MARKER,
+            "extrinsics.json",
+            "extrinsics.yaml",
+            "overlay.png"
+        ]
+    );
+    let o = calibrate("out", false);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert_eq!(
+        listing(&dir.join("out")),
+        [
+            fabkit_export::OUTPUT_MARKER,
+            "extrinsics.json",
+            "extrinsics.yaml"
+        ]
+    );
+    // A file the user adds to the output makes it theirs: the next run refuses it.
+    std::fs::write(dir.join("out/residuals_plot.svg"), "<svg/>").unwrap();
+    let o = calibrate("out", false);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(dir.join("out/residuals_plot.svg").exists());
+}
