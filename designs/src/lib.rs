@@ -11,6 +11,7 @@ pub mod build;
 pub mod error;
 pub mod geometry;
 pub mod housing;
+pub mod input_files;
 pub mod kit;
 pub mod layers;
 pub mod library;

@@ -1,6 +1,7 @@
 //! The designs shipped inside fabkit (`designs/library/*.yaml`), embedded at build time.
 
 use crate::error::DesignError;
+use crate::input_files::DataFileRules;
 use crate::schema::Design;
 
 /// (name, YAML text) of every library design; the first is the default.
@@ -52,15 +53,26 @@ pub struct LoadedDesign {
 /// [`DesignError::Io`] for an unreadable file, [`DesignError::UnknownDesign`], or the
 /// design's own YAML errors (`file:line:column`).
 pub fn load_source(arg: &str, relative_to: &std::path::Path) -> Result<LoadedDesign, DesignError> {
+    load_source_with(arg, relative_to, &DataFileRules::default())
+}
+
+/// [`load_source`] with the rules for the data files the design reads (its marker CSV files):
+/// see [`crate::input_files`]. A design file must be a regular file of at most
+/// [`crate::input_files::MAX_DESIGN_FILE_BYTES`].
+///
+/// # Errors
+/// As [`load_source`]; a refused data file is a [`DesignError::Params`] naming its parameter.
+pub fn load_source_with(
+    arg: &str,
+    relative_to: &std::path::Path,
+    rules: &DataFileRules,
+) -> Result<LoadedDesign, DesignError> {
     use sha2::{Digest, Sha256};
     let path = relative_to.join(arg);
     let looks_like_file =
         path.is_file() || arg.ends_with(".yaml") || arg.ends_with(".yml") || arg.contains('/');
     let (text, source, origin) = if looks_like_file {
-        let text = std::fs::read_to_string(&path).map_err(|e| DesignError::Io {
-            path: path.display().to_string(),
-            message: e.to_string(),
-        })?;
+        let text = crate::input_files::read_design_file(&path)?;
         let shown = path.display().to_string();
         (text, shown.clone(), shown)
     } else {
@@ -76,7 +88,7 @@ pub fn load_source(arg: &str, relative_to: &std::path::Path) -> Result<LoadedDes
     hasher.update(text.as_bytes());
     if looks_like_file {
         let dir = path.parent().unwrap_or(std::path::Path::new("."));
-        for extra in design.load_marker_files(dir)? {
+        for extra in design.load_marker_files(dir, rules)? {
             hasher.update(extra.as_bytes());
         }
     }

@@ -570,16 +570,20 @@ impl Design {
 impl Design {
     /// Reads the marker point lists named by `csv_file` (relative to `base_dir`, the design
     /// file's folder) into `points`. A CSV row is `polar_deg, azimuth_deg`; a first line that is
-    /// not numeric is a header; `#` starts a comment.
+    /// not numeric is a header; `#` starts a comment. Each file must be a regular file inside
+    /// `base_dir` or a folder `rules` allows, of at most `rules.max_bytes`
+    /// ([`crate::input_files`]).
     ///
     /// Returns the text of every file read, in order, so that provenance hashes can cover them.
     ///
     /// # Errors
-    /// [`DesignError::Io`] when a file cannot be read, [`DesignError::Yaml`] naming
+    /// [`DesignError::Params`] naming `layers[i].markers[j].pattern.csv_file`, its value and the
+    /// rule for a file that is refused or cannot be read; [`DesignError::Yaml`] naming
     /// `file:line` for a malformed row.
     pub fn load_marker_files(
         &mut self,
         base_dir: &std::path::Path,
+        rules: &crate::input_files::DataFileRules,
     ) -> Result<Vec<String>, DesignError> {
         let mut read = Vec::new();
         for (i, l) in self.layers.iter_mut().enumerate() {
@@ -592,11 +596,9 @@ impl Design {
                         "layers[{i}].markers[{j}].pattern: give points or csv_file, not both"
                     )));
                 }
+                let param = format!("layers[{i}].markers[{j}].pattern.csv_file");
+                let text = crate::input_files::read_data_file(base_dir, &param, &file, rules)?;
                 let path = base_dir.join(&file);
-                let text = std::fs::read_to_string(&path).map_err(|e| DesignError::Io {
-                    path: path.display().to_string(),
-                    message: e.to_string(),
-                })?;
                 m.pattern.points = Some(parse_angle_csv(&text, &path.display().to_string())?);
                 read.push(text);
             }
@@ -622,10 +624,13 @@ pub fn parse_angle_csv(text: &str, origin: &str) -> Result<Vec<[f64; 2]>, Design
             [Some(p), Some(a)] => out.push([*p, *a]),
             _ if out.is_empty() && nums.iter().all(Option::is_none) => {} // header
             _ => {
+                // At most 40 characters of the row: enough to see the mistake.
+                let shown: String = line.chars().take(40).collect();
+                let more = if shown.len() < line.len() { "..." } else { "" };
                 return Err(DesignError::Yaml(format!(
-                    "{origin}:{}: expected two numbers `polar_deg, azimuth_deg`, found `{line}`",
+                    "{origin}:{}: expected two numbers `polar_deg, azimuth_deg`, found `{shown}{more}`",
                     n + 1
-                )))
+                )));
             }
         }
     }

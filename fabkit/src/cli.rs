@@ -2,6 +2,7 @@
 //! No geometry here.
 
 use clap::{Parser, Subcommand, ValueEnum};
+use fabkit_designs::input_files::DataFileRules;
 use fabkit_designs::schema::MoldStrategy;
 use fabkit_designs::{build_kit, library, ChordTolerance, Design, DesignError};
 use fabkit_export::{write_kit, ExportOptions, Formats};
@@ -44,6 +45,8 @@ enum Command {
         /// Apply one of the design's presets.
         #[arg(long)]
         preset: Option<String>,
+        #[command(flatten)]
+        data_files: DataFileArgs,
     },
 }
 
@@ -73,6 +76,38 @@ struct ExportArgs {
     /// tests/oracles/replay_csg.py.
     #[arg(long)]
     csg: Option<PathBuf>,
+    #[command(flatten)]
+    data_files: DataFileArgs,
+}
+
+/// Which data files (a pattern's `csv_file`) a design file may read.
+#[derive(clap::Args, Debug, Clone, Default)]
+pub(crate) struct DataFileArgs {
+    /// Also read data files (a marker pattern's csv_file) from this folder and its subfolders;
+    /// by default only the design file's own folder is read. May be given more than once.
+    #[arg(long, value_name = "DIR", value_parser = parse_allow_data_dir)]
+    pub allow_data_dir: Vec<PathBuf>,
+    /// Largest data file, bytes (1 to 67108864).
+    #[arg(long, value_name = "BYTES", default_value_t = fabkit_designs::input_files::DEFAULT_MAX_DATA_FILE_BYTES, value_parser = parse_max_data_file_bytes,
+        allow_negative_numbers = true)]
+    pub max_data_file_bytes: u64,
+}
+
+impl DataFileArgs {
+    pub(crate) fn rules(&self) -> DataFileRules {
+        DataFileRules {
+            allowed_dirs: self.allow_data_dir.clone(),
+            max_bytes: self.max_data_file_bytes,
+        }
+    }
+}
+
+fn parse_allow_data_dir(s: &str) -> Result<PathBuf, String> {
+    DataFileRules::allow_dir(Path::new(s))
+}
+
+fn parse_max_data_file_bytes(s: &str) -> Result<u64, String> {
+    DataFileRules::parse_max_bytes(s)
 }
 
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq)]
@@ -125,9 +160,9 @@ pub(crate) struct Loaded {
     pub(crate) sha256: String,
 }
 
-pub(crate) fn load_design(arg: Option<&str>) -> Result<Loaded, DesignError> {
+pub(crate) fn load_design(arg: Option<&str>, data: &DataFileArgs) -> Result<Loaded, DesignError> {
     let arg = arg.unwrap_or(library::DEFAULT_DESIGN);
-    let l = library::load_source(arg, Path::new(""))?;
+    let l = library::load_source_with(arg, Path::new(""), &data.rules())?;
     Ok(Loaded {
         design: l.design,
         source: l.source,
@@ -208,9 +243,10 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
             design,
             chord_tolerance_mm,
             preset,
+            data_files,
         } => {
             let tol = tolerance(chord_tolerance_mm)?;
-            let mut loaded = load_design(design.as_deref())?;
+            let mut loaded = load_design(design.as_deref(), &data_files)?;
             if let Some(p) = &preset {
                 loaded.design = loaded.design.with_preset(p)?;
             }
@@ -231,7 +267,7 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
 
 fn export(args: ExportArgs) -> Result<(), Box<dyn Error>> {
     let tol = tolerance(args.chord_tolerance_mm)?;
-    let mut loaded = load_design(args.design.as_deref())?;
+    let mut loaded = load_design(args.design.as_deref(), &args.data_files)?;
     if let Some(p) = &args.preset {
         loaded.design = loaded.design.with_preset(p)?;
     }

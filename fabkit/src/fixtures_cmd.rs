@@ -1,6 +1,6 @@
 //! `fabkit fixtures`: argument parsing and dispatch over fabkit-fixtures.
 
-use crate::cli::{export_options, load_design, spinner, tolerance, Format};
+use crate::cli::{export_options, load_design, spinner, tolerance, DataFileArgs, Format};
 use fabkit_designs::ChordTolerance;
 use fabkit_export::write_kit_with_files;
 use fabkit_fixtures::params::{apply_pin_preset, from_yaml, FixtureParams};
@@ -40,18 +40,20 @@ pub struct FixturesArgs {
     /// manifold3d twin (tests/oracles/twins).
     #[arg(long)]
     csg: Option<PathBuf>,
+    #[command(flatten)]
+    data_files: DataFileArgs,
 }
 
 pub fn run(args: FixturesArgs) -> Result<(), Box<dyn Error>> {
     let tol = tolerance(args.chord_tolerance_mm)?;
-    let mut loaded = load_design(args.design.as_deref())?;
+    let mut loaded = load_design(args.design.as_deref(), &args.data_files)?;
     if let Some(p) = &args.preset {
         loaded.design = loaded.design.with_preset(p)?;
     }
     let mut params = match &args.params {
         Some(path) => {
-            let text = std::fs::read_to_string(path)
-                .map_err(|e| format!("reading {}: {e}", path.display()))?;
+            // A regular file of bounded size, as a design file.
+            let text = fabkit_designs::input_files::read_design_file(path)?;
             from_yaml(&text, &path.display().to_string())?
         }
         None => FixtureParams::default(),

@@ -20,7 +20,7 @@ use fabkit_export::StagedDir;
 use rayon::prelude::*;
 use serde_json::{json, Value};
 
-use crate::cli::load_design;
+use crate::cli::{load_design, DataFileArgs};
 
 #[derive(clap::Args, Debug)]
 pub struct GroundTruthArgs {
@@ -43,6 +43,8 @@ pub struct GroundTruthArgs {
     /// Apply one of the design's presets.
     #[arg(long)]
     preset: Option<String>,
+    #[command(flatten)]
+    data_files: DataFileArgs,
 }
 
 /// 16-bit PNG encodings: depth in micrometres; differences offset by 32768 counts.
@@ -207,7 +209,7 @@ fn frame_files(
 
 pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
     let t0 = std::time::Instant::now();
-    let mut loaded = load_design(args.design.as_deref())?;
+    let mut loaded = load_design(args.design.as_deref(), &args.data_files)?;
     if let Some(p) = &args.preset {
         loaded.design = loaded.design.with_preset(p)?;
     }

@@ -38,6 +38,8 @@ pub struct SweepArgs {
     /// same bytes on any machine, thread count or sharding (variants/<id>.json keeps it).
     #[arg(long)]
     no_build_time: bool,
+    #[command(flatten)]
+    data_files: crate::cli::DataFileArgs,
 }
 
 #[derive(clap::Subcommand, Debug)]
@@ -100,7 +102,7 @@ pub fn run(args: SweepArgs) -> Result<(), Box<dyn Error>> {
     let (Some(file), Some(out)) = (args.sweep, args.out) else {
         return Err("give a sweep file and --out DIR".into());
     };
-    let spec = SweepSpec::from_file(&file)?;
+    let spec = SweepSpec::from_file_with(&file, &args.data_files.rules())?;
     let plan = spec.plan()?;
     let opts = RunOptions {
         out_dir: out.clone(),

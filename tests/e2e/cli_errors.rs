@@ -159,6 +159,255 @@ fn shadowtac_with_csv_list() -> String {
     .join("\n")
 }
 
+/// A design's data file (`pattern.csv_file`) is read only from the design's folder (or a folder
+/// `--allow-data-dir` allows), only when it is a regular file within the size bound; a refused
+/// file's lines are never quoted, and nothing is written.
+#[test]
+fn marker_csv_file_is_confined_to_the_design_folder_regular_and_bounded() {
+    let tmp = tempfile::tempdir().unwrap();
+    let root = tmp.path();
+    std::fs::create_dir_all(root.join("designs/data")).unwrap();
+    std::fs::create_dir_all(root.join("elsewhere")).unwrap();
+    let pts = "polar_deg, azimuth_deg\n0, 0\n10, 0\n10, 90\n";
+    // Outside the design's folder: a valid table whose comment must never be echoed.
+    let secret = format!("{pts}# SECRET-LINE\n");
+    std::fs::write(root.join("elsewhere/pts.csv"), &secret).unwrap();
+    std::fs::write(root.join("designs/data/pts.csv"), pts).unwrap();
+    std::os::unix::fs::symlink(
+        root.join("elsewhere/pts.csv"),
+        root.join("designs/link_out.csv"),
+    )
+    .unwrap();
+    std::os::unix::fs::symlink("data/pts.csv", root.join("designs/link_in.csv")).unwrap();
+    let fifo = std::process::Command::new("mkfifo")
+        .arg(root.join("designs/pipe.csv"))
+        .status()
+        .unwrap();
+    assert!(fifo.success());
+    let design = |csv: &str| {
+        std::fs::write(
+            root.join("designs/d.yaml"),
+            shadowtac_with_csv_list().replace("csv_file: pts.csv", &format!("csv_file: {csv:?}")),
+        )
+        .unwrap();
+    };
+    let param = "layers[0].markers[0].pattern.csv_file";
+    let outside = root.join("elsewhere/pts.csv").display().to_string();
+    let refused: Vec<(&str, String, Vec<&str>, &str)> = vec![
+        (
+            "absolute",
+            outside.clone(),
+            vec![],
+            "outside the design's folder",
+        ),
+        (
+            "dot-dot",
+            "../elsewhere/pts.csv".into(),
+            vec![],
+            "outside the design's folder",
+        ),
+        (
+            "symlink",
+            "link_out.csv".into(),
+            vec![],
+            "outside the design's folder",
+        ),
+        (
+            "device",
+            "/dev/zero".into(),
+            vec![],
+            "outside the design's folder",
+        ),
+        (
+            "device allowed",
+            "/dev/zero".into(),
+            vec!["--allow-data-dir", "/dev"],
+            "is a character device; a data file must be a regular file",
+        ),
+        (
+            "fifo",
+            "pipe.csv".into(),
+            vec![],
+            "is a FIFO (named pipe); a data file must be a regular file",
+        ),
+        (
+            "folder",
+            "data".into(),
+            vec![],
+            "is a folder; a data file must be a regular file",
+        ),
+        (
+            "size",
+            "data/pts.csv".into(),
+            vec!["--max-data-file-bytes", "20"],
+            "over the data file limit of 20 bytes",
+        ),
+    ];
+    for (what, csv, extra, rule) in refused {
+        design(&csv);
+        let mut args = vec!["export", "designs/d.yaml", "--out", "out/d"];
+        args.extend(extra);
+        let o = run(root, &args, &[]);
+        let err = text(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{what}: {err}");
+        assert!(
+            err.contains(&format!("{param} = {csv:?}: ")) && err.contains(rule),
+            "{what}: {err}"
+        );
+        assert!(
+            !err.contains("SECRET") && !err.contains("10, 90"),
+            "{what} quotes the file: {err}"
+        );
+        assert!(!root.join("out").exists(), "{what}: output written");
+    }
+    // A sweep over such a design refuses it the same way.
+    std::fs::write(
+        root.join("sweep.yaml"),
+        "base: designs/d.yaml\nvary:\n  layers[0].markers[0].feature.height_mm: [0.3, 0.4]\n",
+    )
+    .unwrap();
+    design("../elsewhere/pts.csv");
+    let o = run(root, &["sweep", "sweep.yaml", "--out", "out/sweep"], &[]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        text(&o.stderr).contains("outside the design's folder"),
+        "{}",
+        text(&o.stderr)
+    );
+    assert!(!root.join("out").exists());
+
+    // Inside the folder (also through a symlink that stays inside), or in an allowed folder.
+    let ok: Vec<(&str, Vec<&str>)> = vec![
+        ("data/pts.csv", vec![]),
+        ("link_in.csv", vec![]),
+        (
+            "../elsewhere/pts.csv",
+            vec!["--allow-data-dir", "elsewhere"],
+        ),
+        (
+            &outside,
+            vec![
+                "--allow-data-dir",
+                "elsewhere",
+                "--max-data-file-bytes",
+                "4096",
+            ],
+        ),
+    ];
+    for (csv, extra) in ok {
+        design(csv);
+        let mut args = vec!["validate", "designs/d.yaml"];
+        args.extend(extra.iter().copied());
+        let o = run(root, &args, &[]);
+        assert!(o.status.success(), "{csv} {extra:?}: {}", text(&o.stderr));
+    }
+
+    // Bad values of the new options: the option, the value and the rule; nothing written.
+    design("data/pts.csv");
+    std::fs::write(root.join("a_file"), "x").unwrap();
+    let bad: &[(&[&str], &str, &str)] = &[
+        (
+            &["--max-data-file-bytes", "0"],
+            "'0'",
+            "must be a whole number of bytes from 1 to 67108864",
+        ),
+        (
+            &["--max-data-file-bytes", "-5"],
+            "'-5'",
+            "must be a whole number of bytes from 1 to 67108864",
+        ),
+        (
+            &["--max-data-file-bytes", "1e6"],
+            "'1e6'",
+            "must be a whole number of bytes from 1 to 67108864",
+        ),
+        (
+            &["--max-data-file-bytes", "67108865"],
+            "'67108865'",
+            "must be a whole number of bytes from 1 to 67108864",
+        ),
+        (
+            &["--allow-data-dir", "no_such_dir"],
+            "'no_such_dir'",
+            "must name an existing folder",
+        ),
+        (
+            &["--allow-data-dir", "a_file"],
+            "'a_file'",
+            "must name an existing folder",
+        ),
+        (
+            &["--allow-data-dir", ""],
+            "''",
+            "must name an existing folder",
+        ),
+    ];
+    for (extra, value, rule) in bad {
+        for cmd in [
+            &["export", "designs/d.yaml", "--out", "out/d"][..],
+            &["fixtures", "designs/d.yaml", "--out", "out/f"],
+        ] {
+            let mut args = cmd.to_vec();
+            args.extend(extra.iter().copied());
+            let o = run(root, &args, &[]);
+            let err = text(&o.stderr);
+            assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+            assert!(
+                err.contains(extra[0]) && err.contains(value) && err.contains(rule),
+                "{args:?}: {err}"
+            );
+            assert!(!root.join("out").exists(), "{args:?}: output written");
+        }
+    }
+}
+
+/// The YAML files a user names (design, sweep file, fixture parameters) are read only when they
+/// are regular files of at most 16 MiB: a FIFO or a device is refused at once, never read.
+#[test]
+fn yaml_inputs_must_be_regular_files_within_the_size_bound() {
+    let tmp = tempfile::tempdir().unwrap();
+    let root = tmp.path();
+    let fifo = std::process::Command::new("mkfifo")
+        .arg(root.join("pipe.yaml"))
+        .status()
+        .unwrap();
+    assert!(fifo.success());
+    let big = std::fs::File::create(root.join("big.yaml")).unwrap();
+    big.set_len((16 << 20) + 1).unwrap();
+    let cases: &[(&[&str], &str)] = &[
+        (
+            &["export", "./pipe.yaml", "--out", "out/a"],
+            "pipe.yaml: is a FIFO (named pipe); only regular files are read",
+        ),
+        (
+            &["export", "/dev/zero", "--out", "out/a"],
+            "/dev/zero: is a character device; only regular files are read",
+        ),
+        (
+            &["validate", "big.yaml"],
+            "big.yaml: is 16777217 bytes, over the limit of 16777216 bytes",
+        ),
+        (
+            &["sweep", "pipe.yaml", "--out", "out/s"],
+            "pipe.yaml: is a FIFO (named pipe)",
+        ),
+        (
+            &["fixtures", "--params", "pipe.yaml", "--out", "out/f"],
+            "pipe.yaml: is a FIFO (named pipe)",
+        ),
+    ];
+    for (args, expect) in cases {
+        let o = run(root, args, &[]);
+        assert_eq!(o.status.code(), Some(2), "{args:?}");
+        assert!(
+            text(&o.stderr).contains(expect),
+            "{args:?}: {}",
+            text(&o.stderr)
+        );
+        assert!(!root.join("out").exists(), "{args:?}: output written");
+    }
+}
+
 #[test]
 fn marker_list_from_csv_is_placed_and_hashed() {
     let tmp = tempfile::tempdir().unwrap();

@@ -3,7 +3,9 @@
 
 use super::paths::{expand_short_path, nearest_paths, path_exists, with_value};
 use super::SweepError;
-use crate::library::{load_source, LoadedDesign};
+use crate::error::DesignError;
+use crate::input_files::{read_design_file, DataFileRules};
+use crate::library::{load_source_with, LoadedDesign};
 use crate::schema::{yaml_error, Design};
 use crate::ChordTolerance;
 use serde::de::{MapAccess, Visitor};
@@ -145,12 +147,25 @@ impl SweepSpec {
     /// # Errors
     /// See [`SweepSpec::parse`]; [`SweepError::Io`] when the file cannot be read.
     pub fn from_file(path: &Path) -> Result<SweepSpec, SweepError> {
-        let text = std::fs::read_to_string(path).map_err(|e| SweepError::Io {
-            path: path.display().to_string(),
-            message: e.to_string(),
+        Self::from_file_with(path, &DataFileRules::default())
+    }
+
+    /// [`SweepSpec::from_file`] with the rules for the data files the base design reads (see
+    /// [`crate::input_files`]). The sweep file must be a regular file of at most
+    /// [`crate::input_files::MAX_DESIGN_FILE_BYTES`].
+    ///
+    /// # Errors
+    /// As [`SweepSpec::from_file`].
+    pub fn from_file_with(path: &Path, rules: &DataFileRules) -> Result<SweepSpec, SweepError> {
+        let text = read_design_file(path).map_err(|e| match e {
+            DesignError::Io { path, message } => SweepError::Io { path, message },
+            other => SweepError::Io {
+                path: path.display().to_string(),
+                message: other.to_string(),
+            },
         })?;
         let dir = path.parent().unwrap_or(Path::new(""));
-        Self::parse(&text, &path.display().to_string(), dir)
+        Self::parse_with(&text, &path.display().to_string(), dir, rules)
     }
 
     /// Parses and checks a sweep file's text; `origin` names it in messages, `dir` is the folder
@@ -167,16 +182,30 @@ impl SweepSpec {
     /// with the nearest valid paths, [`SweepError::WrongValue`], [`SweepError::Design`] for a
     /// base design that does not load; each with `file:line:column`.
     pub fn parse(text: &str, origin: &str, dir: &Path) -> Result<SweepSpec, SweepError> {
+        Self::parse_with(text, origin, dir, &DataFileRules::default())
+    }
+
+    /// [`SweepSpec::parse`] with the rules for the data files the base design reads.
+    ///
+    /// # Errors
+    /// As [`SweepSpec::parse`].
+    pub fn parse_with(
+        text: &str,
+        origin: &str,
+        dir: &Path,
+        rules: &DataFileRules,
+    ) -> Result<SweepSpec, SweepError> {
         use sha2::{Digest, Sha256};
         let raw: RawSweep = serde_saphyr::from_str(text).map_err(|e| SweepError::File {
             at: String::new(),
             message: yaml_error(origin, &e),
         })?;
         let file_err = |s: String, message: String| SweepError::File { at: s, message };
-        let mut base = load_source(&raw.base.value, dir).map_err(|e| SweepError::Design {
-            at: at(origin, &raw.base),
-            error: e,
-        })?;
+        let mut base =
+            load_source_with(&raw.base.value, dir, rules).map_err(|e| SweepError::Design {
+                at: at(origin, &raw.base),
+                error: e,
+            })?;
         let preset = raw.preset.as_ref().map(|p| p.value.clone());
         if let Some(p) = &raw.preset {
             base.design = base
