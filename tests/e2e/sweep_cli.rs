@@ -425,4 +425,40 @@ fn sweep_file_errors_stop_before_anything_is_written() {
         text(&o.stderr)
     );
     assert_eq!(std::fs::read_dir(d.join("mine")).unwrap().count(), 1);
+    // A look-alike sweep.json does not make a folder a sweep's: nothing in it is touched.
+    std::fs::write(d.join("mine/sweep.json"), "{\"mine\": 1}\n").unwrap();
+    std::fs::write(d.join("mine/results.csv"), "my,data\n").unwrap();
+    let o = run(d, &["sweep", &s, "--out", "mine"], &[]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        text(&o.stderr).contains("sweep.json is not a fabkit sweep record"),
+        "{}",
+        text(&o.stderr)
+    );
+    assert_eq!(
+        std::fs::read_to_string(d.join("mine/sweep.json")).unwrap(),
+        "{\"mine\": 1}\n"
+    );
+    assert_eq!(
+        std::fs::read_to_string(d.join("mine/results.csv")).unwrap(),
+        "my,data\n"
+    );
+    assert_eq!(std::fs::read_dir(d.join("mine")).unwrap().count(), 3);
+    // A sweep folder a user added a file to is theirs too (also under variants/).
+    let o = run(d, &["sweep", &s, "--out", "ours"], &[]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    for extra in ["ours/plot.png", "ours/variants/.notes"] {
+        std::fs::write(d.join(extra), "keep").unwrap();
+        let o = run(d, &["sweep", &s, "--out", "ours"], &[]);
+        assert_eq!(o.status.code(), Some(2), "{extra}");
+        assert!(
+            text(&o.stderr).contains("is not a file a sweep writes"),
+            "{extra}: {}",
+            text(&o.stderr)
+        );
+        assert_eq!(std::fs::read_to_string(d.join(extra)).unwrap(), "keep");
+        std::fs::remove_file(d.join(extra)).unwrap();
+    }
+    let o = run(d, &["sweep", &s, "--out", "ours"], &[]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
 }

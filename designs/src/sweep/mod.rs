@@ -82,8 +82,16 @@ pub enum SweepError {
     #[error("{path}: {message}")]
     Io { path: String, message: String },
     /// The output folder holds something that is not a fabkit sweep.
-    #[error("{0} is not empty and holds no fabkit sweep (sweep.json); choose another folder")]
-    ForeignDirectory(String),
+    #[error(
+        "sweep folder {path} is not a folder a fabkit sweep wrote: {}{why}; refusing to write \
+         into it (hint: choose a new or empty folder)",
+        if entry.is_empty() { String::new() } else { format!("`{entry}` ") }
+    )]
+    ForeignDirectory {
+        path: String,
+        entry: String,
+        why: String,
+    },
     /// Shards that cannot be merged.
     #[error("merge: {0}")]
     Merge(String),

@@ -151,19 +151,129 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), SweepError> {
     Ok(())
 }
 
-/// Prepares `dir` as a sweep folder: refuses a non-empty folder without `sweep.json`.
+/// Whether `name` is a variant id (16 lowercase hex digits).
+fn is_variant_id(name: &str) -> bool {
+    name.len() == crate::sweep::plan::ID_HEX_DIGITS
+        && name
+            .bytes()
+            .all(|b| b.is_ascii_digit() || (b'a'..=b'f').contains(&b))
+}
+
+/// Whether `name` in `variants/` is a temporary a killed run left: `tempfile`'s `.tmp*` file of
+/// an atomic write, or an export's `.<id>.tmp-*` / `.<id>.old-*` folder.
+fn is_leftover(name: &str) -> bool {
+    if name.starts_with(".tmp") {
+        return true;
+    }
+    let Some(rest) = name.strip_prefix('.') else {
+        return false;
+    };
+    rest.split_once('.').is_some_and(|(id, tail)| {
+        is_variant_id(id) && (tail.starts_with("tmp-") || tail.starts_with("old-"))
+    })
+}
+
+/// The first entry of the non-empty folder `dir` that a sweep does not write, and why; `None`
+/// when `dir` holds a fabkit sweep record (`sweep.json`) and nothing but what a sweep writes:
+/// `sweep.json`, `results.csv`, `results.jsonl`, a `.tmp*` file of an interrupted atomic write,
+/// and `variants/` with `<id>.json` files, `<id>/` export folders and a killed run's temporaries.
+fn foreign_entry(dir: &Path) -> Result<Option<(String, &'static str)>, SweepError> {
+    let io = |p: &Path| {
+        let p = p.display().to_string();
+        move |e: std::io::Error| SweepError::Io {
+            path: p.clone(),
+            message: e.to_string(),
+        }
+    };
+    let record = dir.join(SWEEP_JSON);
+    let is_record =
+        std::fs::symlink_metadata(&record).is_ok_and(|m| m.is_file()) && read_record(dir).is_ok();
+    if !is_record {
+        let why = if record.exists() {
+            "is there, and the folder's sweep.json is not a fabkit sweep record"
+        } else {
+            "is there, and the folder holds no fabkit sweep (sweep.json)"
+        };
+        let mut names: Vec<String> = std::fs::read_dir(dir)
+            .map_err(io(dir))?
+            .flatten()
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .collect();
+        names.sort();
+        let first = names
+            .iter()
+            .find(|n| n.as_str() != SWEEP_JSON)
+            .or(names.first())
+            .cloned()
+            .unwrap_or_default();
+        return Ok(Some((first, why)));
+    }
+    for e in std::fs::read_dir(dir).map_err(io(dir))? {
+        let e = e.map_err(io(dir))?;
+        let name = e.file_name().to_string_lossy().into_owned();
+        let t = e.file_type().map_err(io(&e.path()))?;
+        let ok = match name.as_str() {
+            SWEEP_JSON | RESULTS_CSV | RESULTS_JSONL => t.is_file(),
+            VARIANTS => t.is_dir(),
+            n => n.starts_with(".tmp") && t.is_file(),
+        };
+        if !ok {
+            return Ok(Some((name, "is not a file a sweep writes")));
+        }
+    }
+    let vdir = dir.join(VARIANTS);
+    if vdir.is_dir() {
+        for e in std::fs::read_dir(&vdir).map_err(io(&vdir))? {
+            let e = e.map_err(io(&vdir))?;
+            let name = e.file_name().to_string_lossy().into_owned();
+            let t = e.file_type().map_err(io(&e.path()))?;
+            let ok = if let Some(id) = name.strip_suffix(".json") {
+                is_variant_id(id) && t.is_file()
+            } else {
+                (is_variant_id(&name) && t.is_dir()) || (is_leftover(&name) && !t.is_symlink())
+            };
+            if !ok {
+                return Ok(Some((
+                    format!("{VARIANTS}/{name}"),
+                    "is not a file a sweep writes",
+                )));
+            }
+        }
+    }
+    Ok(None)
+}
+
+/// Prepares `dir` as a sweep folder: a missing or empty folder, or one that holds a fabkit sweep
+/// and nothing else (see [`foreign_entry`]). A folder of the user's, even one with a
+/// `sweep.json` of its own, is refused and left untouched.
 pub(crate) fn claim_dir(dir: &Path) -> Result<(), SweepError> {
     let io = |e: std::io::Error| SweepError::Io {
         path: dir.display().to_string(),
         message: e.to_string(),
     };
-    if dir.exists() {
-        if !dir.is_dir() {
-            return Err(SweepError::ForeignDirectory(dir.display().to_string()));
+    let foreign = |entry: String, why: &str| SweepError::ForeignDirectory {
+        path: dir.display().to_string(),
+        entry,
+        why: why.to_string(),
+    };
+    match std::fs::symlink_metadata(dir) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+        Err(e) => return Err(io(e)),
+        Ok(md) if md.file_type().is_symlink() || !md.is_dir() => {
+            let what = if md.file_type().is_symlink() {
+                "is a symbolic link (hint: pass the target folder itself)"
+            } else {
+                "is not a folder"
+            };
+            return Err(foreign(String::new(), what));
         }
-        let empty = std::fs::read_dir(dir).map_err(io)?.next().is_none();
-        if !empty && !dir.join(SWEEP_JSON).is_file() {
-            return Err(SweepError::ForeignDirectory(dir.display().to_string()));
+        Ok(_) => {
+            let empty = std::fs::read_dir(dir).map_err(io)?.next().is_none();
+            if !empty {
+                if let Some((entry, why)) = foreign_entry(dir)? {
+                    return Err(foreign(entry, why));
+                }
+            }
         }
     }
     std::fs::create_dir_all(dir).map_err(io)
@@ -358,15 +468,15 @@ pub fn run(
     })
 }
 
-/// Removes temporary files and folders a killed run left in `variants/` (names starting with
-/// a dot: `tempfile`'s `.tmp*` files and the export's `.<id>.tmp-*` / `.<id>.old-*` folders).
+/// Removes temporary files and folders a killed run left in `variants/` (`tempfile`'s `.tmp*`
+/// files and the export's `.<id>.tmp-*` / `.<id>.old-*` folders; see [`is_leftover`]).
 fn remove_leftovers(vdir: &Path) -> Result<(), SweepError> {
     let entries = std::fs::read_dir(vdir).map_err(|e| SweepError::Io {
         path: vdir.display().to_string(),
         message: e.to_string(),
     })?;
     for e in entries.flatten() {
-        if e.file_name().to_string_lossy().starts_with('.') {
+        if is_leftover(&e.file_name().to_string_lossy()) {
             let p = e.path();
             let _ = if p.is_dir() {
                 std::fs::remove_dir_all(&p)
