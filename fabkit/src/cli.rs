@@ -190,16 +190,65 @@ pub(crate) fn export_options(
     }
 }
 
-/// Writes the CSG tree of every part of `kit` (fabkit-csg/1 JSON) to `path`.
+/// The first bytes of every CSG file fabkit writes (`serde_json` orders the keys).
+const CSG_HEADER: &[u8] = b"{\"format\":\"fabkit-csg/1\"";
+
+/// Checks that `--csg PATH` may be written: missing, or a regular file that is an earlier
+/// fabkit CSG file. A user's own file (a design, anything else) and a symbolic link are refused.
+pub(crate) fn check_csg_path(path: &Path) -> Result<(), Box<dyn Error>> {
+    use std::io::Read as _;
+    let refuse = |why: &str| -> Box<dyn Error> {
+        format!(
+            "--csg {}: {why}; refusing to overwrite it (hint: name a new file)",
+            path.display()
+        )
+        .into()
+    };
+    let md = match std::fs::symlink_metadata(path) {
+        Ok(md) => md,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
+        Err(e) => return Err(format!("--csg {}: {e}", path.display()).into()),
+    };
+    if md.file_type().is_symlink() {
+        return Err(refuse("is a symbolic link"));
+    }
+    if !md.is_file() {
+        return Err(refuse("exists and is not a regular file"));
+    }
+    let mut head = Vec::new();
+    std::fs::File::open(path)
+        .and_then(|f| f.take(CSG_HEADER.len() as u64).read_to_end(&mut head))
+        .map_err(|e| format!("--csg {}: {e}", path.display()))?;
+    if head != CSG_HEADER {
+        return Err(refuse("exists and is not a CSG file fabkit wrote"));
+    }
+    Ok(())
+}
+
+/// Writes the CSG tree of every part of `kit` (fabkit-csg/1 JSON) to `path` (checked by
+/// [`check_csg_path`]) through a temporary sibling and a rename.
 pub(crate) fn write_csg(kit: &fabkit_designs::Kit, path: &Path) -> Result<(), Box<dyn Error>> {
+    check_csg_path(path)?;
     let parts: Vec<(&str, &fabkit_designs::Solid)> = kit
         .parts
         .iter()
         .map(|p| (p.name.as_str(), &p.solid))
         .collect();
-    let json = fabkit_designs::geometry::csg_json(&parts);
-    std::fs::write(path, serde_json::to_vec(&json)?)
-        .map_err(|e| format!("writing {}: {e}", path.display()))?;
+    let json = serde_json::to_vec(&fabkit_designs::geometry::csg_json(&parts))?;
+    debug_assert!(json.starts_with(CSG_HEADER));
+    let name = path
+        .file_name()
+        .ok_or_else(|| format!("--csg {}: names no file", path.display()))?;
+    let tmp = path.with_file_name(format!(
+        ".{}.tmp-{}",
+        name.to_string_lossy(),
+        std::process::id()
+    ));
+    let r = std::fs::write(&tmp, &json).and_then(|()| std::fs::rename(&tmp, path));
+    if let Err(e) = r {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(format!("writing {}: {e}", path.display()).into());
+    }
     Ok(())
 }
 
@@ -287,6 +336,9 @@ fn export(args: ExportArgs) -> Result<(), Box<dyn Error>> {
         .out
         .clone()
         .unwrap_or_else(|| Path::new("out").join(&loaded.design.name));
+    if let Some(csg) = &args.csg {
+        check_csg_path(csg)?;
+    }
     let spinner = spinner(format!(
         "building {} at {} mm chord tolerance",
         loaded.design.name,
@@ -297,10 +349,10 @@ fn export(args: ExportArgs) -> Result<(), Box<dyn Error>> {
     spinner.finish_and_clear();
     let kit = kit?;
     let opts = export_options(&loaded, tol, &args.format);
+    let summary = write_kit(&kit, &out, &opts)?;
     if let Some(csg) = &args.csg {
         write_csg(&kit, csg)?;
     }
-    let summary = write_kit(&kit, &out, &opts)?;
     for w in &summary.warnings {
         eprintln!("warning: {w}");
     }

@@ -78,16 +78,19 @@ pub fn run(args: FixturesArgs) -> Result<(), Box<dyn Error>> {
         loaded.source,
         loaded.sha256
     );
+    if let Some(csg) = &args.csg {
+        crate::cli::check_csg_path(csg)?;
+    }
     let spinner = spinner(format!("building the fixtures of {}", loaded.design.name));
     let t0 = std::time::Instant::now();
     let set = fabkit_fixtures::build_fixtures(&loaded.design, &params, tol, &provenance);
     spinner.finish_and_clear();
     let set = set?;
     let opts = export_options(&loaded, tol, &args.format);
+    let summary = write_kit_with_files(&set.kit, &set.files, &out, &opts)?;
     if let Some(csg) = &args.csg {
         crate::cli::write_csg(&set.kit, csg)?;
     }
-    let summary = write_kit_with_files(&set.kit, &set.files, &out, &opts)?;
     for w in &summary.warnings {
         eprintln!("warning: {w}");
     }

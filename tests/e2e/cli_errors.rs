@@ -408,6 +408,61 @@ fn yaml_inputs_must_be_regular_files_within_the_size_bound() {
     }
 }
 
+/// `--csg FILE` writes a new file or replaces an earlier CSG file of fabkit's; a user's file (here
+/// the design itself) or a symbolic link is refused before anything is built or written.
+#[test]
+fn csg_never_overwrites_a_users_file() {
+    let tmp = tempfile::tempdir().unwrap();
+    let root = tmp.path();
+    std::fs::write(root.join("d.yaml"), rtac0_yaml()).unwrap();
+    std::fs::write(root.join("target.json"), "{}").unwrap();
+    std::os::unix::fs::symlink("target.json", root.join("link.json")).unwrap();
+    for (csg, why) in [
+        ("d.yaml", "exists and is not a CSG file fabkit wrote"),
+        ("link.json", "is a symbolic link"),
+    ] {
+        for cmd in ["export", "fixtures"] {
+            let o = run(root, &[cmd, "d.yaml", "--out", "out", "--csg", csg], &[]);
+            assert_eq!(o.status.code(), Some(2), "{cmd} {csg}");
+            assert!(
+                text(&o.stderr).contains(&format!("--csg {csg}: {why}")),
+                "{cmd} {csg}: {}",
+                text(&o.stderr)
+            );
+            assert!(!root.join("out").exists(), "{cmd} {csg}");
+        }
+    }
+    assert_eq!(
+        std::fs::read_to_string(root.join("d.yaml")).unwrap(),
+        rtac0_yaml()
+    );
+    assert_eq!(
+        std::fs::read_to_string(root.join("target.json")).unwrap(),
+        "{}"
+    );
+    // A new file, then the same file again (fabkit's own): both written.
+    for _ in 0..2 {
+        let o = run(
+            root,
+            &[
+                "fixtures",
+                "d.yaml",
+                "--out",
+                "out",
+                "--csg",
+                "fx.csg.json",
+                "--format",
+                "stl",
+            ],
+            &[],
+        );
+        assert!(o.status.success(), "{}", text(&o.stderr));
+        let j: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(root.join("fx.csg.json")).unwrap()).unwrap();
+        assert_eq!(j["format"], "fabkit-csg/1");
+    }
+}
+
 #[test]
 fn marker_list_from_csv_is_placed_and_hashed() {
     let tmp = tempfile::tempdir().unwrap();
