@@ -57,6 +57,38 @@ fn bad_chord_tolerance_and_unknown_design_are_errors() {
         "{}",
         text(&o.stderr)
     );
+    // Below the floor (1e-9 mm once aborted on a 6 GB allocation): refused by every command that
+    // meshes, and by validate and sweep files, before anything is built.
+    for args in [
+        &["export", "--chord-tolerance-mm", "1e-9"][..],
+        &["fixtures", "--chord-tolerance-mm", "0.0001"],
+        &["validate", "--chord-tolerance-mm", "1e-9"],
+    ] {
+        let o = run(tmp.path(), args, &[]);
+        assert_eq!(o.status.code(), Some(2), "{args:?}");
+        assert!(
+            text(&o.stderr).contains(&format!(
+                "--chord-tolerance-mm: chord tolerance = {} mm: must be at least 0.001 mm",
+                args[2].parse::<f64>().unwrap()
+            )),
+            "{args:?}: {}",
+            text(&o.stderr)
+        );
+    }
+    std::fs::write(
+        tmp.path().join("sweep.yaml"),
+        "base: rtac0\nchord_tolerance_mm: 1e-9\nvary:\n  layers[0].thickness_mm: [1.5, 2.0]\n",
+    )
+    .unwrap();
+    let o = run(tmp.path(), &["sweep", "sweep.yaml", "--out", "out/s"], &[]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        text(&o.stderr).contains(
+            "sweep.yaml:2:21: chord tolerance = 0.000000001 mm: must be at least 0.001 mm"
+        ),
+        "{}",
+        text(&o.stderr)
+    );
     let o = run(tmp.path(), &["export", "nosuchsensor"], &[]);
     assert_eq!(o.status.code(), Some(2));
     assert!(text(&o.stderr).contains("no library design named 'nosuchsensor'"));

@@ -31,14 +31,27 @@ impl ChordTolerance {
     /// The default, 0.01 mm: finer than FDM and SLA printer resolution.
     pub const DEFAULT_MM: f64 = 0.01;
 
+    /// The finest tolerance accepted, 0.001 mm: 25 times finer than the finest SLA layer, and
+    /// already 10 times the triangles of the default (the triangle count grows as 1 / tol).
+    /// A finer tolerance only costs time and memory: 1e-4 mm took 20-48 s and 3.5 GB for one
+    /// library design, 1e-9 mm aborted on a 6 GB allocation.
+    pub const MIN_MM: f64 = 0.001;
+
     /// # Errors
-    /// When `mm` is not a finite number above zero.
+    /// When `mm` is not a finite number of at least [`Self::MIN_MM`].
     pub fn new(mm: f64) -> Result<Self, String> {
-        if mm.is_finite() && mm > 0.0 {
+        if mm.is_finite() && mm >= Self::MIN_MM {
             Ok(Self(mm))
+        } else if mm.is_finite() && mm > 0.0 {
+            Err(format!(
+                "chord tolerance = {mm} mm: must be at least {} mm (finer than any printer \
+                 resolves; the mesh grows as 1 / tolerance)",
+                Self::MIN_MM
+            ))
         } else {
             Err(format!(
-                "chord tolerance = {mm} mm: must be a finite number above 0"
+                "chord tolerance = {mm} mm: must be a finite number of at least {} mm",
+                Self::MIN_MM
             ))
         }
     }

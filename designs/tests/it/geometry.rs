@@ -21,6 +21,14 @@ fn bad_tolerance_is_rejected() {
     assert!(ChordTolerance::new(0.0).is_err());
     assert!(ChordTolerance::new(-1.0).is_err());
     assert!(ChordTolerance::new(f64::NAN).is_err());
+    // The floor: finer tolerances only cost time and memory (the mesh grows as 1 / tol).
+    assert!(ChordTolerance::new(ChordTolerance::MIN_MM).is_ok());
+    let e = ChordTolerance::new(1e-9).unwrap_err();
+    assert!(
+        e.contains("= 0.000000001 mm: must be at least 0.001 mm"),
+        "{e}"
+    );
+    assert!(ChordTolerance::new(0.000999).is_err());
 }
 
 #[test]
