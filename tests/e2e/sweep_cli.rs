@@ -163,6 +163,76 @@ fn merged_shards_equal_the_unsharded_table_byte_for_byte() {
         );
         assert!(!d.join(&out).exists(), "{out} was written");
     }
+
+    // Records edited by hand (a shard index past its count, a count of 0, counts that would
+    // size a huge allocation): refused as records fabkit did not write, nothing written.
+    let record = std::fs::read_to_string(d.join("shard0/sweep.json")).unwrap();
+    let json: serde_json::Value = serde_json::from_str(&record).unwrap();
+    let tampered: [(&str, serde_json::Value, &str); 3] = [
+        (
+            "shard",
+            serde_json::json!({"index": 5, "count": 3}),
+            "shard = 5/3: needs 0 <= I < N",
+        ),
+        (
+            "shard",
+            serde_json::json!({"index": 0, "count": 0}),
+            "shard = 0/0: needs 0 <= I < N",
+        ),
+        (
+            "variant_count",
+            serde_json::json!(u64::MAX / 2),
+            "variant_count = 9223372036854775807: must be at most 10000000",
+        ),
+    ];
+    for (k, (field, value, want)) in tampered.into_iter().enumerate() {
+        let mut j = json.clone();
+        j[field] = value;
+        std::fs::write(d.join("shard0/sweep.json"), serde_json::to_vec(&j).unwrap()).unwrap();
+        let out = format!("t{k}");
+        let o = run(
+            d,
+            &["sweep", "merge", "shard0", "shard1", "--out", &out],
+            &[],
+        );
+        assert_eq!(o.status.code(), Some(2), "{field}");
+        assert!(
+            text(&o.stderr).contains(want),
+            "{field}: {}",
+            text(&o.stderr)
+        );
+        assert!(!d.join(&out).exists(), "{out} was written");
+    }
+    std::fs::write(d.join("shard0/sweep.json"), record).unwrap();
+
+    // --jobs past 4 x the CPUs (or 0), and a shard count past the most variants a sweep has.
+    let cpus = std::thread::available_parallelism().map_or(1, usize::from);
+    let many = (4 * cpus + 1).to_string();
+    for (args, want) in [
+        (
+            vec!["--jobs", many.as_str()],
+            format!("jobs = {many}: must be from 1 to {}", 4 * cpus),
+        ),
+        (
+            vec!["--jobs", "0"],
+            format!("jobs = 0: must be from 1 to {}", 4 * cpus),
+        ),
+        (
+            vec!["--shard", "0/99999999999"],
+            "N must be at most 10000000".to_string(),
+        ),
+    ] {
+        let mut a = vec!["sweep", s.as_str(), "--out", "j"];
+        a.extend(args.iter().copied());
+        let o = run(d, &a, &[]);
+        assert_eq!(o.status.code(), Some(2), "{args:?}");
+        assert!(
+            text(&o.stderr).contains(&want),
+            "{args:?}: {}",
+            text(&o.stderr)
+        );
+        assert!(!d.join("j").exists(), "{args:?}: output written");
+    }
 }
 
 #[test]

@@ -405,13 +405,15 @@ fn range(r: &Value) -> Result<Vec<Value>, String> {
                 "range [{start}, {stop}, {step}]: needs step > 0 and stop >= start"
             ));
         }
-        if ((stop - start) / step) as f64 + 1.0 > MAX_RANGE_VALUES {
-            return Err(format!("range {r} has more than {MAX_RANGE_VALUES} values"));
+        // In i128: neither the count nor any value can overflow (start + k step <= stop).
+        let n = (i128::from(stop) - i128::from(start)) / i128::from(step) + 1;
+        if n as f64 > MAX_RANGE_VALUES {
+            return Err(format!(
+                "range {r} has {n} values, more than {MAX_RANGE_VALUES}"
+            ));
         }
-        return Ok((0..)
-            .map(|k| start + k * step)
-            .take_while(|&v| v <= stop)
-            .map(Value::from)
+        return Ok((0..n)
+            .map(|k| Value::from((i128::from(start) + k * i128::from(step)) as i64))
             .collect());
     }
     let f: Vec<f64> = a.iter().filter_map(Value::as_f64).collect();

@@ -92,6 +92,16 @@ pub enum SweepError {
         entry: String,
         why: String,
     },
+    /// More worker threads than the machine can use (or none).
+    #[error(
+        "jobs = {jobs}: must be from 1 to {max} (4 x the {cpus} CPUs of this machine; each job \
+         builds one variant at a time)"
+    )]
+    Jobs {
+        jobs: usize,
+        max: usize,
+        cpus: usize,
+    },
     /// Shards that cannot be merged.
     #[error("merge: {0}")]
     Merge(String),

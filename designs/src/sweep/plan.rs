@@ -220,6 +220,11 @@ impl std::str::FromStr for Shard {
         if count == 0 || index >= count {
             return Err(format!("shard `{s}`: needs 0 <= I < N"));
         }
+        if count as u64 > MAX_VARIANTS {
+            return Err(format!(
+                "shard `{s}`: N must be at most {MAX_VARIANTS} (the most variants a sweep has)"
+            ));
+        }
         Ok(Shard { index, count })
     }
 }

@@ -295,6 +295,28 @@ pub(crate) fn read_record(dir: &Path) -> Result<SweepRecord, SweepError> {
             message: format!("format {:?}, expected {FORMAT:?}", r.format),
         });
     }
+    // A record is read back from disk: its numbers are checked before anything is sized by
+    // them (a merge allocates one slot per variant and per shard).
+    let bad = |field: &str, value: String, rule: String| SweepError::Io {
+        path: p.display().to_string(),
+        message: format!("{field} = {value}: {rule}; not a record fabkit wrote"),
+    };
+    if r.variant_count as u64 > crate::sweep::plan::MAX_VARIANTS {
+        return Err(bad(
+            "variant_count",
+            r.variant_count.to_string(),
+            format!("must be at most {}", crate::sweep::plan::MAX_VARIANTS),
+        ));
+    }
+    if let Some(s) = r.shard {
+        if s.count == 0 || s.index >= s.count || s.count as u64 > crate::sweep::plan::MAX_VARIANTS {
+            return Err(bad(
+                "shard",
+                format!("{}/{}", s.index, s.count),
+                format!("needs 0 <= I < N <= {}", crate::sweep::plan::MAX_VARIANTS),
+            ));
+        }
+    }
     Ok(r)
 }
 
@@ -345,8 +367,9 @@ pub fn record(spec: &SweepSpec, plan: &Plan, opts: &RunOptions) -> SweepRecord {
 /// A killed run leaves complete results for the variants it finished and nothing for the
 /// others (temporary files are removed by the next run). Run one process per folder.
 ///
-/// Variants are built in parallel on `opts.jobs` threads (rayon); each variant's numbers do
-/// not depend on the thread count and the tables are in variant order.
+/// Variants are built in parallel on `opts.jobs` threads (rayon; 1 to 4 x the CPUs, else
+/// [`SweepError::Jobs`] before anything is written); each variant's numbers do not depend on
+/// the thread count and the tables are in variant order.
 ///
 /// # Errors
 /// [`SweepError::ForeignDirectory`], [`SweepError::Io`], or a sweep that asks for files
@@ -369,6 +392,13 @@ pub fn run(
         at: "designs/materials.yaml".into(),
         message: m,
     })?;
+    if let Some(jobs) = opts.jobs {
+        let cpus = std::thread::available_parallelism().map_or(1, usize::from);
+        let max = 4 * cpus;
+        if !(1..=max).contains(&jobs) {
+            return Err(SweepError::Jobs { jobs, max, cpus });
+        }
+    }
     let dir = &opts.out_dir;
     claim_dir(dir)?;
     let vdir = dir.join(VARIANTS);
@@ -426,7 +456,7 @@ pub fn run(
     };
     let fresh = match opts.jobs {
         Some(n) => rayon::ThreadPoolBuilder::new()
-            .num_threads(n.max(1))
+            .num_threads(n)
             .build()
             .map_err(|e| SweepError::Io {
                 path: "thread pool".into(),

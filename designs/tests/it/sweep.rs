@@ -268,6 +268,16 @@ fn malformed_sweeps_are_refused_before_anything_runs() {
             "base: shadowtac\nvary:\n  layers[0].markers[0].pattern.csv_file: [a.csv]\n",
             "sweep.yaml:3:3: vary.layers[0].markers[0].pattern.csv_file: marker CSV files are read once",
         ),
+        // An integer range whose next value overflows i64 (it once looped forever): one value,
+        // which a u32 parameter then refuses.
+        (
+            "base: shadowtac\nvary:\n  layers[0].markers[0].pattern.rings: {range: [9223372036854775806, 9223372036854775807, 10]}\n",
+            "vary.layers[0].markers[0].pattern.rings = 9223372036854775806",
+        ),
+        (
+            "base: shadowtac\nvary:\n  layers[0].markers[0].pattern.rings: {range: [-9223372036854775808, 9223372036854775807, 1]}\n",
+            "has 18446744073709551616 values, more than 1000000",
+        ),
     ];
     for (text, want) in cases {
         let e = err(text);
