@@ -135,6 +135,10 @@ const FISHEYE_MAX_THETA: f64 = std::f64::consts::PI * 0.999;
 /// Largest normalised pinhole radius considered (about 84 deg off axis).
 const PINHOLE_MAX_RADIUS: f64 = 10.0;
 
+/// Largest image width or height a camera model accepts, px (16384: beyond any camera a
+/// tactile sensor carries; every per-pixel array is sized by it).
+pub const MAX_IMAGE_SIDE_PX: u32 = 16384;
+
 impl CameraModel {
     /// Validates the intrinsics (finite, positive focal lengths and image size, no NaN
     /// coefficients) and finds the monotonic range of the distortion.
@@ -157,11 +161,13 @@ impl CameraModel {
                 return Err(bad(field, v, "must be finite"));
             }
         }
-        if intr.image_width_px == 0 {
-            return Err(bad("image_width", 0.0, "must be > 0"));
-        }
-        if intr.image_height_px == 0 {
-            return Err(bad("image_height", 0.0, "must be > 0"));
+        for (field, v) in [
+            ("image_width", intr.image_width_px),
+            ("image_height", intr.image_height_px),
+        ] {
+            if !(1..=MAX_IMAGE_SIDE_PX).contains(&v) {
+                return Err(bad(field, f64::from(v), "must be from 1 to 16384 px"));
+            }
         }
         if let Some(v) = intr
             .distortion

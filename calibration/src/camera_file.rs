@@ -99,7 +99,7 @@ struct YamlCamera {
 /// [`CameraFileError`] naming the file, the line and the field.
 pub fn read_camera_file(path: &Path) -> Result<CameraModel, CameraFileError> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|source| CameraFileError::Io {
+    let text = crate::read_text(path).map_err(|source| CameraFileError::Io {
         file: file.clone(),
         source,
     })?;

@@ -10,7 +10,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::camera_file::{read_camera_file, CameraFileError};
-use crate::overlay::{read_png_rgb8, render_overlay, OverlayError};
+use crate::overlay::{read_png_rgb8_sized, render_overlay, OverlayError};
 use crate::pnp::{solve_pnp, PnpError, PnpOptions, RansacOptions};
 use crate::report::{ExtrinsicsReport, Provenance};
 use crate::tables::{
@@ -108,7 +108,7 @@ pub fn calibrate_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsOutput, Ext
         };
         ExtrinsicsError::Pnp { context, source }
     })?;
-    let fixtures = std::fs::read_to_string(&job.points)
+    let fixtures = crate::read_text(&job.points)
         .map(|t| t.contains("tip_x_mm"))
         .unwrap_or(false);
     let provenance = Provenance {
@@ -136,18 +136,8 @@ pub fn calibrate_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsOutput, Ext
     let yaml = report.to_yaml().map_err(ExtrinsicsError::Yaml)?;
     let overlay = match &job.image {
         Some(p) => {
-            let img = read_png_rgb8(p)?;
             let i = camera.intrinsics();
-            if img.width != i.image_width_px || img.height != i.image_height_px {
-                return Err(OverlayError::Size {
-                    file: p.display().to_string(),
-                    width: img.width,
-                    height: img.height,
-                    cam_width: i.image_width_px,
-                    cam_height: i.image_height_px,
-                }
-                .into());
-            }
+            let img = read_png_rgb8_sized(p, (i.image_width_px, i.image_height_px))?;
             Some(render_overlay(img, &report)?)
         }
         None => None,

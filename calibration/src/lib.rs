@@ -30,3 +30,21 @@ pub use nalgebra;
 pub use pnp::{solve_pnp, PnpError, PnpOptions, PnpSolution, RansacOptions};
 pub use report::ExtrinsicsReport;
 pub use tables::{PointsFrom, TableError};
+
+/// Largest text input (camera file, point table, observations, capture plan, fixture index),
+/// bytes: 64 MiB. Only regular files are read (a FIFO or a device is refused at once).
+pub const MAX_TEXT_INPUT_BYTES: u64 = 64 << 20;
+/// Largest binary input (capture PNG, fixture meshes), bytes: 1 GiB.
+pub const MAX_BINARY_INPUT_BYTES: u64 = 1 << 30;
+
+/// A regular file of at most [`MAX_TEXT_INPUT_BYTES`] as UTF-8 text.
+pub(crate) fn read_text(path: &std::path::Path) -> std::io::Result<String> {
+    let bytes = fabkit_designs::input_files::read_regular_file(path, MAX_TEXT_INPUT_BYTES)?;
+    String::from_utf8(bytes)
+        .map_err(|_| std::io::Error::new(std::io::ErrorKind::InvalidData, "is not UTF-8 text"))
+}
+
+/// A regular file of at most [`MAX_BINARY_INPUT_BYTES`].
+pub(crate) fn read_binary(path: &std::path::Path) -> std::io::Result<Vec<u8>> {
+    fabkit_designs::input_files::read_regular_file(path, MAX_BINARY_INPUT_BYTES)
+}

@@ -78,8 +78,22 @@ impl Rgb8 {
 /// # Errors
 /// [`OverlayError::Io`] or [`OverlayError::Decode`] naming the file.
 pub fn read_png_rgb8(path: &Path) -> Result<Rgb8, OverlayError> {
+    read_png_rgb8_checked(path, None)
+}
+
+/// [`read_png_rgb8`] of an image that must be `expect_px` = (width, height): the size in the
+/// PNG header is compared before any pixel is decoded or allocated (a 69-byte PNG can declare
+/// 200000 x 200000 px).
+///
+/// # Errors
+/// [`OverlayError::Size`] for another size, else as [`read_png_rgb8`].
+pub fn read_png_rgb8_sized(path: &Path, expect_px: (u32, u32)) -> Result<Rgb8, OverlayError> {
+    read_png_rgb8_checked(path, Some(expect_px))
+}
+
+fn read_png_rgb8_checked(path: &Path, expect_px: Option<(u32, u32)>) -> Result<Rgb8, OverlayError> {
     let file = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|source| OverlayError::Io {
+    let bytes = crate::read_binary(path).map_err(|source| OverlayError::Io {
         file: file.clone(),
         source,
     })?;
@@ -90,6 +104,18 @@ pub fn read_png_rgb8(path: &Path) -> Result<Rgb8, OverlayError> {
     let mut dec = png::Decoder::new(BufReader::new(Cursor::new(bytes)));
     dec.set_transformations(png::Transformations::normalize_to_color8());
     let mut reader = dec.read_info().map_err(dec_err)?;
+    if let Some((cam_width, cam_height)) = expect_px {
+        let (width, height) = (reader.info().width, reader.info().height);
+        if (width, height) != (cam_width, cam_height) {
+            return Err(OverlayError::Size {
+                file,
+                width,
+                height,
+                cam_width,
+                cam_height,
+            });
+        }
+    }
     let size = reader
         .output_buffer_size()
         .ok_or_else(|| OverlayError::Decode {

@@ -191,7 +191,7 @@ impl Csv<'_> {
 
 fn read(path: &Path) -> Result<(String, String), TableError> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|source| TableError::Io {
+    let text = crate::read_text(path).map_err(|source| TableError::Io {
         file: file.clone(),
         source,
     })?;

@@ -117,6 +117,10 @@ pub(crate) enum Refusal {
 /// without blocking (a FIFO does not wait for a writer) and checked through the open handle,
 /// so a file swapped after the check is caught too.
 pub(crate) fn read_bounded(path: &Path, max_bytes: u64) -> Result<String, Refusal> {
+    String::from_utf8(read_bounded_bytes(path, max_bytes)?).map_err(|_| Refusal::NotText)
+}
+
+fn read_bounded_bytes(path: &Path, max_bytes: u64) -> Result<Vec<u8>, Refusal> {
     let mut opts = std::fs::OpenOptions::new();
     opts.read(true);
     #[cfg(unix)]
@@ -144,7 +148,32 @@ pub(crate) fn read_bounded(path: &Path, max_bytes: u64) -> Result<String, Refusa
     if bytes.len() as u64 > max_bytes {
         return Err(Refusal::TooLarge(None));
     }
-    String::from_utf8(bytes).map_err(|_| Refusal::NotText)
+    Ok(bytes)
+}
+
+/// Reads the regular file at `path`, of at most `max_bytes`: the bounded read behind every input
+/// file fabkit takes (camera files, point tables, observations, images, fixture outputs).
+///
+/// # Errors
+/// The OS's error, or one of kind `InvalidInput` whose message is the rule broken (`is a FIFO
+/// (named pipe); only regular files are read`, `is N bytes, over the limit of M bytes`). The
+/// message never quotes the file.
+pub fn read_regular_file(path: &Path, max_bytes: u64) -> std::io::Result<Vec<u8>> {
+    read_bounded_bytes(path, max_bytes).map_err(|r| match r {
+        Refusal::Io(e) => e,
+        Refusal::NotRegular(k) => std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            format!("is {k}; only regular files are read"),
+        ),
+        Refusal::TooLarge(n) => std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            format!(
+                "is {}over the limit of {max_bytes} bytes for this input",
+                n.map(|n| format!("{n} bytes, ")).unwrap_or_default()
+            ),
+        ),
+        Refusal::NotText => std::io::Error::from(std::io::ErrorKind::InvalidData),
+    })
 }
 
 /// Reads a YAML input file the user named: a design, a sweep file, fixture parameters (regular

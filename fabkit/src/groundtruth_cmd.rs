@@ -43,8 +43,27 @@ pub struct GroundTruthArgs {
     /// Apply one of the design's presets.
     #[arg(long)]
     preset: Option<String>,
+    /// Largest camera image, pixels (width x height; 1 to 268435456): every per-pixel array of
+    /// a frame (rays, hits, depth maps) is sized by it.
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_MAX_PIXELS,
+          value_parser = parse_max_pixels, allow_negative_numbers = true)]
+    max_pixels: u64,
     #[command(flatten)]
     data_files: DataFileArgs,
+}
+
+/// Default bound of `--max-pixels`: 4096 x 4096 (a 4K camera has 8.3 million pixels).
+const DEFAULT_MAX_PIXELS: u64 = 4096 * 4096;
+/// Largest `--max-pixels`: 16384 x 16384, the largest camera image a camera file may give.
+const MAX_PIXELS_LIMIT: u64 = 16384 * 16384;
+
+fn parse_max_pixels(s: &str) -> Result<u64, String> {
+    match s.trim().parse::<u64>() {
+        Ok(n) if (1..=MAX_PIXELS_LIMIT).contains(&n) => Ok(n),
+        _ => Err(format!(
+            "must be a whole number of pixels from 1 to {MAX_PIXELS_LIMIT} (16384 x 16384)"
+        )),
+    }
 }
 
 /// 16-bit PNG encodings: depth in micrometres; differences offset by 32768 counts.
@@ -215,6 +234,21 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
     }
     let design = &loaded.design;
     let camera = read_camera_file(&args.camera)?;
+    let (cw, ch) = (
+        camera.intrinsics().image_width_px,
+        camera.intrinsics().image_height_px,
+    );
+    let pixels = u64::from(cw) * u64::from(ch);
+    if pixels > args.max_pixels {
+        return Err(format!(
+            "{}: the camera image is {cw} x {ch} = {pixels} pixels, over the ground-truth limit of \
+             {} pixels (every per-pixel array of a frame is sized by it; raise the limit with \
+             --max-pixels, up to {MAX_PIXELS_LIMIT})",
+            args.camera.display(),
+            args.max_pixels
+        )
+        .into());
+    }
     let (_, camera_sha) = read_with_hash(&args.camera)?;
     let (t_cam_sensor, extrinsics_sha) = read_extrinsics(&args.extrinsics)?;
     let fixtures = read_fixtures(&args.fixtures, &design.name)?;

@@ -553,3 +553,92 @@ fn extrinsics_out_is_written_whole_and_never_takes_a_users_folder() {
     assert_eq!(o.status.code(), Some(2));
     assert!(dir.join("out/residuals_plot.svg").exists());
 }
+
+/// CRC-32 (ISO-HDLC, as PNG chunks use).
+fn crc32(bytes: &[u8]) -> u32 {
+    let mut c = 0xffff_ffffu32;
+    for &b in bytes {
+        c ^= u32::from(b);
+        for _ in 0..8 {
+            c = if c & 1 == 1 {
+                0xedb8_8320 ^ (c >> 1)
+            } else {
+                c >> 1
+            };
+        }
+    }
+    !c
+}
+
+/// A PNG whose header declares 200000 x 200000 px (about 70 bytes on disk) is refused by
+/// `--image` from its header, before any pixel is allocated (it once allocated 40 GB); a FIFO
+/// as the image or the camera file is refused at once.
+#[test]
+fn an_image_is_checked_from_its_header_and_inputs_are_regular_files() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    std::fs::write(
+        dir.join("cam.yaml"),
+        write_camera(&intrinsics(), CameraFileFormat::OpenCvYaml),
+    )
+    .unwrap();
+    write_table(&dir.join("pins.csv"));
+    std::fs::write(dir.join("obs.csv"), observe(false, 0..29)).unwrap();
+    // A valid 1 x 1 PNG, its IHDR width and height patched to 200000 and its CRC redone.
+    let mut png = encode_gray8(1, 1, &[0]).unwrap();
+    assert_eq!(&png[12..16], b"IHDR");
+    png[16..20].copy_from_slice(&200_000u32.to_be_bytes());
+    png[20..24].copy_from_slice(&200_000u32.to_be_bytes());
+    let crc = crc32(&png[12..29]);
+    png[29..33].copy_from_slice(&crc.to_be_bytes());
+    std::fs::write(dir.join("bomb.png"), &png).unwrap();
+    let fifo = std::process::Command::new("mkfifo")
+        .arg(dir.join("pipe"))
+        .status()
+        .unwrap();
+    assert!(fifo.success());
+    let cases = [
+        (
+            "cam.yaml",
+            "bomb.png",
+            "bomb.png: image is 200000 x 200000 px but the camera file says 640 x 480 px",
+        ),
+        (
+            "cam.yaml",
+            "pipe",
+            "pipe: cannot read: is a FIFO (named pipe); only regular files are read",
+        ),
+        (
+            "pipe",
+            "bomb.png",
+            "pipe: cannot read: is a FIFO (named pipe); only regular files are read",
+        ),
+    ];
+    for (camera, image, want) in cases {
+        let o = run(
+            dir,
+            &[
+                "calibrate",
+                "extrinsics",
+                "--camera",
+                camera,
+                "--points",
+                "pins.csv",
+                "--observations",
+                "obs.csv",
+                "--out",
+                "out",
+                "--image",
+                image,
+            ],
+            &[],
+        );
+        assert_eq!(o.status.code(), Some(2), "{camera} {image}");
+        assert!(
+            text(&o.stderr).contains(want),
+            "{camera} {image}: {}",
+            text(&o.stderr)
+        );
+        assert!(!dir.join("out").exists());
+    }
+}

@@ -354,4 +354,74 @@ fn bad_inputs_name_the_file_and_the_rule_and_write_nothing() {
         text(&o.stderr)
     );
     assert!(!d.path().join("gt").exists());
+
+    // Bounded work: the camera image against --max-pixels (checked before any per-pixel array),
+    // bad --max-pixels values, a camera image side past 16384 px, a FIFO as the camera file.
+    let groundtruth = |camera: &str, extra: &[&str]| {
+        let mut a = vec![
+            "groundtruth",
+            "rtac0",
+            "--camera",
+            camera,
+            "--extrinsics",
+            "extrinsics.json",
+            "--fixtures",
+            "fx",
+            "--out",
+            "gt",
+        ];
+        a.extend(extra);
+        run(d.path(), &a, &[])
+    };
+    let i = benchmark_intrinsics();
+    let (w, h) = (i.image_width_px, i.image_height_px);
+    let o = groundtruth("cam.yaml", &["--max-pixels", "1000"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        text(&o.stderr).contains(&format!(
+            "cam.yaml: the camera image is {w} x {h} = {} pixels, over the ground-truth limit of 1000 pixels",
+            w * h
+        )) && text(&o.stderr).contains("--max-pixels"),
+        "{}",
+        text(&o.stderr)
+    );
+    for bad in ["0", "-1", "268435457", "lots"] {
+        let o = groundtruth("cam.yaml", &["--max-pixels", bad]);
+        assert_eq!(o.status.code(), Some(2), "{bad}");
+        assert!(
+            text(&o.stderr).contains(&format!("invalid value '{bad}' for '--max-pixels"))
+                && text(&o.stderr).contains("must be a whole number of pixels from 1 to 268435456"),
+            "{bad}: {}",
+            text(&o.stderr)
+        );
+    }
+    let mut huge = benchmark_intrinsics();
+    huge.image_width_px = 200_000;
+    std::fs::write(
+        d.path().join("huge.yaml"),
+        write_camera(&huge, CameraFileFormat::OpenCvYaml),
+    )
+    .unwrap();
+    let o = groundtruth("huge.yaml", &[]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        text(&o.stderr).contains("image_width = 200000: must be from 1 to 16384 px"),
+        "{}",
+        text(&o.stderr)
+    );
+    let fifo = std::process::Command::new("mkfifo")
+        .arg(d.path().join("pipe.yaml"))
+        .status()
+        .unwrap();
+    assert!(fifo.success());
+    let o = groundtruth("pipe.yaml", &[]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        text(&o.stderr).contains(
+            "pipe.yaml: cannot read: is a FIFO (named pipe); only regular files are read"
+        ),
+        "{}",
+        text(&o.stderr)
+    );
+    assert!(!d.path().join("gt").exists());
 }

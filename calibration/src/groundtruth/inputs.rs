@@ -46,7 +46,7 @@ pub enum InputError {
 
 /// A file's bytes and sha256 (hex).
 pub fn read_with_hash(path: &Path) -> Result<(Vec<u8>, String), InputError> {
-    let bytes = std::fs::read(path).map_err(|source| InputError::Io {
+    let bytes = crate::read_binary(path).map_err(|source| InputError::Io {
         file: path.display().to_string(),
         source,
     })?;
