@@ -386,6 +386,32 @@ pub fn check_mold_fit(
             format!("does not fit in the holder ({room:.2} mm of room)"),
         ));
     }
+    // The sprue (azimuth 0) and the vents share the circle at equal steps of 360 / (count + 1)
+    // deg; neighbouring holes must keep the holder's minimum wall between them. This also
+    // bounds the count before any vent is built (10,000 vents once ran a minute into a mesh
+    // error naming no parameter).
+    let r_v = f.plinth_radius_mm - ch.fit_clearance_mm - ch.min_wall_mm - m.vent.diameter_mm / 2.0;
+    let need = m.vent.diameter_mm.max(m.sprue.diameter_mm) + ch.min_wall_mm;
+    if r_v > 0.0 && need > 0.0 && m.vent.count > 0 {
+        // Most holes on the circle: a chord of `need` between neighbours.
+        let max_holes = if need >= 2.0 * r_v {
+            1.0
+        } else {
+            (std::f64::consts::PI / (need / (2.0 * r_v)).asin()).floor()
+        };
+        let max_vents = (max_holes - 1.0).max(0.0);
+        if f64::from(m.vent.count) > max_vents {
+            errs.push(ParamError::new(
+                "mold.vent.count",
+                m.vent.count,
+                format!(
+                    "at most {max_vents:.0} vents fit beside the sprue on the holder's vent circle ({:.2} mm across) with mold.core_holder.min_wall_mm ({}) between neighbouring holes",
+                    2.0 * r_v,
+                    ch.min_wall_mm
+                ),
+            ));
+        }
+    }
     if f.core_end_z_mm > f.spigot_top_z_mm - 1.0 {
         errs.push(ParamError::new(
             "core.length_mm",

@@ -267,4 +267,22 @@ fn bad_fixture_parameters_name_the_parameter_and_write_nothing() {
         assert!(err.contains(expect), "{yaml}: {err}");
         assert!(!tmp.path().join("never").exists());
     }
+    // The semi-dome count is bounded before any pattern is generated (--semidomes 4294967295
+    // once aborted; 1000 took 4 GB).
+    for n in ["101", "4294967295"] {
+        let o = run(
+            tmp.path(),
+            &["fixtures", "rtac0", "--semidomes", n, "--out", "never"],
+            &[],
+        );
+        assert_eq!(o.status.code(), Some(2), "{n}");
+        let err = text(&o.stderr);
+        assert!(
+            err.contains(&format!(
+                "semidomes.generate = {n}: with 0 listed patterns makes {n} semi-domes, more than the 100"
+            )),
+            "{n}: {err}"
+        );
+        assert!(!tmp.path().join("never").exists());
+    }
 }

@@ -115,3 +115,107 @@ fn feature_volume_on_a_plane_like_surface() {
     // the hemisphere's centre is 0.5 mm along the direction, its top 0.5 mm above that
     assert!((b.max[2] - (3.0 + 0.4 + 0.5)).abs() < 0.01, "{b:?}");
 }
+
+/// Marker counts are bounded from the parameters before any marker is placed: each of these
+/// returns at once with the parameter that drives the count (a golden spiral of 1e8 once
+/// aborted on an 8.8 GB allocation; a concentric spacing of 0.01 mm ran 90 s at 2 GB).
+#[test]
+fn marker_counts_are_bounded_before_placing() {
+    let s = Surface::new(&cap(), 0.0);
+    let base = Pattern {
+        layout: Layout::GoldenSpiral,
+        rings: None,
+        pitch_arc_mm: None,
+        spacing_mm: None,
+        count: None,
+        points: None,
+        csv_file: None,
+        center_marker: true,
+        max_polar_deg: None,
+        min_polar_deg: None,
+        polar_step_deg: None,
+        ring_azimuth_offset: None,
+    };
+    let cases = [
+        (
+            Pattern {
+                count: Some(100_000_000),
+                ..base.clone()
+            },
+            "count",
+            "places about 100000000 markers",
+        ),
+        (
+            Pattern {
+                spacing_mm: Some(0.001),
+                ..base.clone()
+            },
+            "spacing_mm",
+            "more than the 100000 one pattern may have",
+        ),
+        (
+            Pattern {
+                layout: Layout::Concentric6k,
+                rings: Some(400_000),
+                pitch_arc_mm: Some(1e-5),
+                ..base.clone()
+            },
+            "rings",
+            "places about 480001200001 markers",
+        ),
+        (
+            Pattern {
+                layout: Layout::Concentric,
+                spacing_mm: Some(0.01),
+                ..base.clone()
+            },
+            "spacing_mm",
+            "places more than 100000 markers",
+        ),
+        (
+            Pattern {
+                layout: Layout::Concentric,
+                spacing_mm: Some(1.4),
+                polar_step_deg: Some(1e-6),
+                ..base.clone()
+            },
+            "polar_step_deg",
+            "places more than 100000 markers",
+        ),
+        (
+            Pattern {
+                layout: Layout::HexGrid,
+                spacing_mm: Some(0.01),
+                ..base.clone()
+            },
+            "spacing_mm",
+            "more than the 100000 one pattern may have",
+        ),
+        (
+            Pattern {
+                layout: Layout::List,
+                points: Some(vec![[1.0, 0.0]; MAX_MARKERS_PER_PATTERN + 1]),
+                ..base.clone()
+            },
+            "points",
+            "places about 100001 markers",
+        ),
+    ];
+    for (p, field, rule) in cases {
+        let (f, _, r) = place(&s, &p, 0.5).unwrap_err();
+        assert_eq!(f, field, "{p:?}: {r}");
+        assert!(r.contains(rule), "{field}: {r}");
+    }
+    // At the bound a pattern is placed.
+    let n = place(
+        &s,
+        &Pattern {
+            count: Some(MAX_MARKERS_PER_PATTERN as u32),
+            ..base
+        },
+        0.5,
+    )
+    .unwrap()
+    .len();
+    assert_eq!(n, MAX_MARKERS_PER_PATTERN);
+}

@@ -147,6 +147,15 @@ fn single_mutations() -> Vec<Mutation> {
             },
         ),
         (
+            "more vents than fit on the holder's vent circle (once a minute of booleans)",
+            |d| d.mold.vent.count = 10_000,
+            Expect {
+                path: "mold.vent.count",
+                value: "10000",
+                rule: &["at most 21 vents fit beside the sprue", "min_wall_mm (1.5)"],
+            },
+        ),
+        (
             "draft angle of 12 degrees",
             |d| d.mold.draft_angle_deg = 12.0,
             Expect {
