@@ -21,8 +21,25 @@ use serde_json::json;
 /// [`DesignError::Params`] with every violated rule, or [`DesignError::Geometry`] if the kernel
 /// fails on valid parameters.
 pub fn build_kit(design: &Design, tol: ChordTolerance) -> Result<Kit, DesignError> {
+    build_kit_bounded(design, tol, u64::MAX)
+}
+
+/// [`build_kit`], refused before anything is built when the kit's estimated triangles pass
+/// `max_triangles` ([`crate::estimate::check_work`]; `fabkit export --max-triangles`).
+///
+/// # Errors
+/// As [`build_kit`], and [`DesignError::WorkLimit`] with the estimate, the limit and how to
+/// raise it.
+pub fn build_kit_bounded(
+    design: &Design,
+    tol: ChordTolerance,
+    max_triangles: u64,
+) -> Result<Kit, DesignError> {
     let materials = MaterialsTable::embedded().map_err(DesignError::Yaml)?;
     let stack = validate(design, &materials, tol)?;
+    if max_triangles < u64::MAX {
+        crate::estimate::check_work(design, &stack, tol, max_triangles)?;
+    }
     let plans = cast_plans(design, &stack);
     let mut parts = Vec::new();
     let mut silicone = Vec::new();

@@ -67,6 +67,10 @@ pub enum DesignError {
     },
     #[error("reading {path}: {message}")]
     Io { path: String, message: String },
+    /// The estimated work of a build is past its limit ([`crate::estimate`]); the message gives
+    /// the estimate, the limit and how to raise it.
+    #[error("{0}")]
+    WorkLimit(String),
     #[error("no library design named '{0}' (see `fabkit designs`)")]
     UnknownDesign(String),
 }

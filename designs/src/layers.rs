@@ -59,6 +59,28 @@ fn rim_margin(spec: &MarkerSpec, min_wall: f64) -> f64 {
     spec.feature.diameter_mm + min_wall
 }
 
+/// The marker count and feature radius (mm) of every pattern of `layer` that places (a pattern
+/// that does not is the validation's to report), without the spacing statistics of
+/// [`place_layer_markers`]: the work estimate's input.
+pub fn count_layer_markers(design: &Design, layer: &ResolvedLayer) -> Vec<(usize, f64)> {
+    let spec_layer = &design.layers[layer.index];
+    let profile = design.printers.get(feature_technology(design, spec_layer));
+    spec_layer
+        .markers
+        .iter()
+        .filter_map(|spec| {
+            let surface = Surface::new(&design.body, surface_offset(layer, spec.surface));
+            let markers = markers::place(
+                &surface,
+                &spec.pattern,
+                rim_margin(spec, profile.min_wall_mm),
+            )
+            .ok()?;
+            Some((markers.len(), spec.feature.radius_mm()))
+        })
+        .collect()
+}
+
 /// Places every marker pattern of layer `i`.
 pub fn place_layer_markers(
     design: &Design,

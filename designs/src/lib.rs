@@ -9,6 +9,7 @@
 
 pub mod build;
 pub mod error;
+pub mod estimate;
 pub mod geometry;
 pub mod housing;
 pub mod input_files;
@@ -24,7 +25,7 @@ pub mod schema;
 pub mod stack;
 pub mod sweep;
 
-pub use build::build_kit;
+pub use build::{build_kit, build_kit_bounded};
 pub use error::{DesignError, ParamError, ParamErrors};
 pub use geometry::{ChordTolerance, Mesh, Solid};
 pub use kit::{Kit, Part, PrintTechnology};

@@ -4,7 +4,7 @@
 use clap::{Parser, Subcommand, ValueEnum};
 use fabkit_designs::input_files::DataFileRules;
 use fabkit_designs::schema::MoldStrategy;
-use fabkit_designs::{build_kit, library, ChordTolerance, Design, DesignError};
+use fabkit_designs::{build_kit_bounded, library, ChordTolerance, Design, DesignError};
 use fabkit_export::{write_kit, ExportOptions, Formats};
 use std::error::Error;
 
@@ -76,6 +76,11 @@ struct ExportArgs {
     /// tests/oracles/replay_csg.py.
     #[arg(long)]
     csg: Option<PathBuf>,
+    /// Refuse a kit estimated (before building) at more triangles than this (about 1 KB of
+    /// memory each; 1 to 100000000).
+    #[arg(long, value_name = "N", default_value_t = fabkit_designs::estimate::DEFAULT_MAX_TRIANGLES,
+          value_parser = fabkit_designs::estimate::parse_max_triangles, allow_negative_numbers = true)]
+    max_triangles: u64,
     #[command(flatten)]
     data_files: DataFileArgs,
 }
@@ -345,7 +350,8 @@ fn export(args: ExportArgs) -> Result<(), Box<dyn Error>> {
         tol.mm()
     ));
     let t0 = std::time::Instant::now();
-    let kit = build_kit(&loaded.design, tol);
+    // The work is estimated and bounded before anything is built.
+    let kit = build_kit_bounded(&loaded.design, tol, args.max_triangles);
     spinner.finish_and_clear();
     let kit = kit?;
     let opts = export_options(&loaded, tol, &args.format);

@@ -38,6 +38,11 @@ pub struct SweepArgs {
     /// same bytes on any machine, thread count or sharding (variants/<id>.json keeps it).
     #[arg(long)]
     no_build_time: bool,
+    /// Record a variant estimated (before building) at more triangles than this as an error
+    /// (about 1 KB of memory each, per variant built at once; 1 to 100000000).
+    #[arg(long, value_name = "N", default_value_t = fabkit_designs::estimate::DEFAULT_MAX_TRIANGLES,
+          value_parser = fabkit_designs::estimate::parse_max_triangles, allow_negative_numbers = true)]
+    max_triangles: u64,
     #[command(flatten)]
     data_files: crate::cli::DataFileArgs,
 }
@@ -111,6 +116,7 @@ pub fn run(args: SweepArgs) -> Result<(), Box<dyn Error>> {
         build_time: !args.no_build_time,
         command_line: std::env::args().collect(),
         fabkit_version: env!("CARGO_PKG_VERSION").to_string(),
+        max_triangles: args.max_triangles,
     };
     let writer = ExportWriter {
         command_line: opts.command_line.clone(),

@@ -495,6 +495,82 @@ fn csg_never_overwrites_a_users_file() {
     }
 }
 
+/// The work of a build is estimated before anything is built: past `--max-triangles` an export
+/// is refused (the estimate, the limit, how to raise it; nothing written) and a sweep variant
+/// is recorded as an error while the sweep writes its table.
+#[test]
+fn work_past_max_triangles_is_refused_before_building() {
+    let tmp = tempfile::tempdir().unwrap();
+    let root = tmp.path();
+    let o = run(
+        root,
+        &[
+            "export",
+            "shadowtac",
+            "--max-triangles",
+            "100000",
+            "--out",
+            "out/s",
+        ],
+        &[],
+    );
+    assert_eq!(o.status.code(), Some(2));
+    let err = text(&o.stderr);
+    assert!(
+        err.contains("shadowtac: the kit would have about ")
+            && err.contains("469 marker features), more than the limit of 100000")
+            && err.contains("raise it with --max-triangles"),
+        "{err}"
+    );
+    assert!(!root.join("out").exists());
+    for bad in ["0", "-3", "100000001", "1e6"] {
+        for cmd in ["export", "sweep"] {
+            let args = if cmd == "export" {
+                vec!["export", "--max-triangles", bad]
+            } else {
+                vec!["sweep", "s.yaml", "--out", "out/w", "--max-triangles", bad]
+            };
+            let o = run(root, &args, &[]);
+            assert_eq!(o.status.code(), Some(2), "{args:?}");
+            assert!(
+                text(&o.stderr).contains(&format!("invalid value '{bad}' for '--max-triangles"))
+                    && text(&o.stderr)
+                        .contains("must be a whole number of triangles from 1 to 100000000"),
+                "{args:?}: {}",
+                text(&o.stderr)
+            );
+        }
+    }
+    assert!(!root.join("out").exists());
+    std::fs::write(
+        root.join("s.yaml"),
+        "base: shadowtac\nvary:\n  layers[0].markers[0].feature.height_mm: [0.4, 0.5]\n",
+    )
+    .unwrap();
+    let o = run(
+        root,
+        &[
+            "sweep",
+            "s.yaml",
+            "--out",
+            "out/w",
+            "--max-triangles",
+            "100000",
+        ],
+        &[],
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o.stderr));
+    let csv = std::fs::read_to_string(root.join("out/w/results.csv")).unwrap();
+    let rows: Vec<&str> = csv.lines().skip(1).collect();
+    assert_eq!(rows.len(), 2, "{csv}");
+    for r in rows {
+        assert!(
+            r.contains(",error,") && r.contains("more than the limit of 100000"),
+            "{r}"
+        );
+    }
+}
+
 #[test]
 fn marker_list_from_csv_is_placed_and_hashed() {
     let tmp = tempfile::tempdir().unwrap();

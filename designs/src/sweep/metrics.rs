@@ -94,10 +94,30 @@ pub enum Outcome {
 
 /// Validates and builds `design`, then measures the kit.
 pub fn evaluate(design: &Design, materials: &MaterialsTable, tol: ChordTolerance) -> Outcome {
+    evaluate_bounded(
+        design,
+        materials,
+        tol,
+        crate::estimate::DEFAULT_MAX_TRIANGLES,
+    )
+}
+
+/// [`evaluate`] with a bound on the estimated triangles ([`crate::estimate::check_work`]): a
+/// variant past it is an [`Outcome::Error`] naming the estimate and the limit, before its kit
+/// is built.
+pub fn evaluate_bounded(
+    design: &Design,
+    materials: &MaterialsTable,
+    tol: ChordTolerance,
+    max_triangles: u64,
+) -> Outcome {
     let stack = match validate(design, materials, tol) {
         Ok(s) => s,
         Err(e) => return Outcome::Infeasible(e.0.iter().map(ToString::to_string).collect()),
     };
+    if let Err(e) = crate::estimate::check_work(design, &stack, tol, max_triangles) {
+        return Outcome::Error(e.to_string());
+    }
     let kit = match build_kit(design, tol) {
         Ok(k) => k,
         Err(DesignError::Params(e)) => {

@@ -35,8 +35,8 @@ mod run;
 pub use file::{values_of, FileOutputs, Mode, Output, Parameter, SweepSpec};
 pub use merge::{merge, MergeSummary};
 pub use metrics::{
-    evaluate, min_wall, printability, CastMetrics, MarkerMetrics, Metrics, Outcome, PartMetrics,
-    Verdict, PROFILES,
+    evaluate, evaluate_bounded, min_wall, printability, CastMetrics, MarkerMetrics, Metrics,
+    Outcome, PartMetrics, Verdict, PROFILES,
 };
 pub use paths::{canonical_json, expand_short_path, nearest_paths, parameter_paths, path_exists};
 pub use plan::{variant_id, Plan, Shard, Variant, ID_HEX_DIGITS, MAX_VARIANTS};

@@ -2,7 +2,7 @@
 //! written atomically, resume, shards.
 
 use super::file::{FileOutputs, Mode, SweepSpec};
-use super::metrics::{evaluate, printability, Outcome};
+use super::metrics::{evaluate_bounded, printability, Outcome};
 use super::paths::canonical_json;
 use super::plan::{hex, Plan, Shard, Variant};
 use super::results::{render_csv, render_jsonl, Status, VariantResult};
@@ -37,6 +37,9 @@ pub struct RunOptions {
     pub command_line: Vec<String>,
     /// fabkit version, recorded with every result; results of another version are recomputed.
     pub fabkit_version: String,
+    /// Bound on each variant's estimated triangles ([`crate::estimate::check_work`]); a variant
+    /// past it is recorded with status error, before its kit is built.
+    pub max_triangles: u64,
 }
 
 /// Writes the files of `fabkit export` for one variant (the CLI passes the export crate's
@@ -574,7 +577,7 @@ fn run_variant(
     };
     // A panic in the kernel must not end the sweep: record it as this variant's error.
     let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        let outcome = evaluate(&design, materials, tol);
+        let outcome = evaluate_bounded(&design, materials, tol, opts.max_triangles);
         let verdicts = printability(&design, materials, tol);
         (outcome, verdicts)
     }));

@@ -1,5 +1,6 @@
 //! The designs crate's integration tests, one binary (one link) with a module per area.
 
+mod estimate;
 mod geometry;
 mod marker_layout;
 mod markers;

@@ -1,0 +1,126 @@
+//! The work of a build estimated from the parameters, before any solid is built: the triangles
+//! of the kit's meshes, which set its time and memory (about 1 KB of peak memory per triangle
+//! of the written meshes, measured on the library designs).
+//!
+//! The estimate counts the facets the tessellation will make (the same segment counts as
+//! [`crate::geometry::revolve`] and the feature primitives) for every layer surface and every
+//! marker feature, times the number of parts each kind appears in (calibrated on the library
+//! designs: from 0.9 to 2.2 times the built kits, checked by a test).
+
+use crate::error::DesignError;
+use crate::geometry::ChordTolerance;
+use crate::layers::count_layer_markers;
+use crate::schema::Design;
+use crate::stack::Stack;
+
+/// Default bound on the estimated triangles of one build: 4,000,000 (about 4 GB of peak memory;
+/// the library's kits have 40,000 to 170,000 at the default tolerance).
+pub const DEFAULT_MAX_TRIANGLES: u64 = 4_000_000;
+/// Largest bound a user may set (`--max-triangles`): 100,000,000.
+pub const MAX_TRIANGLES_LIMIT: u64 = 100_000_000;
+
+/// Parts a layer surface appears in (the layer's mold or master, the mold box, the casting
+/// jig or the shell), calibrated on the library designs.
+const PARTS_PER_SURFACE: f64 = 1.0;
+/// Parts a marker feature appears in (master or mold cavity, and the skin's negative).
+const PARTS_PER_FEATURE: f64 = 1.0;
+
+/// The estimated work of building a design's kit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WorkEstimate {
+    /// Estimated triangles of all parts.
+    pub triangles: u64,
+    /// Of which from marker features.
+    pub marker_triangles: u64,
+    /// Markers placed by every pattern.
+    pub markers: u64,
+}
+
+/// Triangles of one revolved surface at `offset_mm` from the body surface.
+fn surface_triangles(design: &Design, offset_mm: f64, tol: ChordTolerance) -> f64 {
+    let b = &design.body;
+    if !b.offset_is_valid(offset_mm) {
+        return 0.0;
+    }
+    let profile = b.offset_polyline(offset_mm, 0.0, tol.half()).points.len() as f64;
+    let around = tol.half().circle_segments(b.rim_radius_mm(offset_mm)) as f64;
+    2.0 * profile * around
+}
+
+/// Triangles of one marker feature (a cylinder ending in a hemisphere of `radius_mm`).
+fn feature_triangles(radius_mm: f64, tol: ChordTolerance) -> f64 {
+    let n = tol.half().circle_segments(radius_mm) as f64;
+    // the hemisphere's n / 4 latitude bands, the cylinder's band and the closing cap
+    2.0 * n * (n / 4.0 + 2.0)
+}
+
+/// Estimates the triangles of the kit of `design` at `tol` from its validated `stack`. Costs
+/// one placement of every marker pattern (bounded by
+/// [`crate::markers::MAX_MARKERS_PER_PATTERN`]) and the 1D profiles of the layer surfaces.
+pub fn estimate(design: &Design, stack: &Stack, tol: ChordTolerance) -> WorkEstimate {
+    let mut surfaces = 0.0;
+    for l in &stack.layers {
+        surfaces += surface_triangles(design, l.outer_offset_mm, tol);
+        if !l.solid {
+            surfaces += surface_triangles(design, l.inner_offset_mm, tol);
+        }
+    }
+    if let Some(c) = &stack.core {
+        surfaces += surface_triangles(design, c.outer_offset_mm, tol);
+        surfaces += surface_triangles(design, c.inner_offset_mm, tol);
+    }
+    let (mut markers, mut feature_tris) = (0u64, 0.0);
+    for l in &stack.layers {
+        for (n, radius_mm) in count_layer_markers(design, l) {
+            markers += n as u64;
+            feature_tris += n as f64 * feature_triangles(radius_mm, tol);
+        }
+    }
+    let marker_triangles = PARTS_PER_FEATURE * feature_tris;
+    WorkEstimate {
+        triangles: (PARTS_PER_SURFACE * surfaces + marker_triangles).round() as u64,
+        marker_triangles: marker_triangles.round() as u64,
+        markers,
+    }
+}
+
+/// [`estimate`], refused past `max_triangles`.
+///
+/// # Errors
+/// [`DesignError::WorkLimit`] giving the estimate (and the part of it from marker features),
+/// the limit and how to raise it, before anything is built.
+pub fn check_work(
+    design: &Design,
+    stack: &Stack,
+    tol: ChordTolerance,
+    max_triangles: u64,
+) -> Result<WorkEstimate, DesignError> {
+    let e = estimate(design, stack, tol);
+    if e.triangles > max_triangles {
+        return Err(DesignError::WorkLimit(format!(
+            "{}: the kit would have about {} triangles at chord tolerance {} mm ({} of them in \
+             {} marker features), more than the limit of {max_triangles} (about 1 KB of memory \
+             each; raise it with --max-triangles, up to {MAX_TRIANGLES_LIMIT}, or coarsen \
+             --chord-tolerance-mm)",
+            design.name,
+            e.triangles,
+            tol.mm(),
+            e.marker_triangles,
+            e.markers
+        )));
+    }
+    Ok(e)
+}
+
+/// Checks a `--max-triangles` value given as text.
+///
+/// # Errors
+/// The rule, for a value that is not a whole number from 1 to [`MAX_TRIANGLES_LIMIT`].
+pub fn parse_max_triangles(value: &str) -> Result<u64, String> {
+    match value.trim().parse::<u64>() {
+        Ok(n) if (1..=MAX_TRIANGLES_LIMIT).contains(&n) => Ok(n),
+        _ => Err(format!(
+            "must be a whole number of triangles from 1 to {MAX_TRIANGLES_LIMIT}"
+        )),
+    }
+}

@@ -1,0 +1,74 @@
+//! The work estimate ([`fabkit_designs::estimate`]) against the kits it estimates.
+
+use fabkit_designs::estimate::{check_work, estimate, MAX_TRIANGLES_LIMIT};
+use fabkit_designs::materials::MaterialsTable;
+use fabkit_designs::{build_kit, library, stack, ChordTolerance, DesignError};
+
+/// Every library design and preset, at two tolerances: the estimate, made from the parameters
+/// before anything is built, is within 0.8 to 2.5 times the triangles of the built kit, and its
+/// marker count is the kit's.
+#[test]
+fn estimate_is_within_a_small_factor_of_every_library_kit() {
+    let materials = MaterialsTable::embedded().unwrap();
+    let mut checked = 0;
+    for (name, _) in library::LIBRARY {
+        let base = library::load(name).unwrap();
+        let mut designs = vec![base.clone()];
+        for p in base.presets.keys() {
+            designs.push(base.with_preset(p).unwrap());
+        }
+        for d in designs {
+            for mm in [0.01, 0.05] {
+                let tol = ChordTolerance::new(mm).unwrap();
+                let st = stack::validate(&d, &materials, tol).unwrap();
+                let e = estimate(&d, &st, tol);
+                let kit = build_kit(&d, tol).unwrap();
+                let actual: usize = kit.parts.iter().map(|p| p.solid.triangle_count()).sum();
+                let ratio = e.triangles as f64 / actual as f64;
+                assert!(
+                    (0.8..=2.5).contains(&ratio),
+                    "{} at {mm} mm: estimate {} vs {actual} triangles ({ratio:.2})",
+                    d.name,
+                    e.triangles
+                );
+                let placed: u64 = kit.summary["markers"]
+                    .as_array()
+                    .map_or(0, |a| a.iter().map(|m| m["count"].as_u64().unwrap()).sum());
+                assert_eq!(e.markers, placed, "{}", d.name);
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked >= 20, "{checked} kits");
+}
+
+/// Past the limit the estimate is refused with the estimate, the limit and how to raise it;
+/// the estimate grows about as 1 / tolerance (a little slower: small circles keep their
+/// minimum of 8 segments).
+#[test]
+fn check_work_refuses_past_the_limit_and_names_the_remedy() {
+    let materials = MaterialsTable::embedded().unwrap();
+    let d = library::load("shadowtac").unwrap();
+    let coarse = ChordTolerance::new(0.01).unwrap();
+    let fine = ChordTolerance::new(0.001).unwrap();
+    let st = stack::validate(&d, &materials, coarse).unwrap();
+    let e_coarse = estimate(&d, &st, coarse).triangles as f64;
+    let e_fine = estimate(&d, &st, fine).triangles as f64;
+    assert!(
+        (6.0..11.0).contains(&(e_fine / e_coarse)),
+        "{e_fine} / {e_coarse}"
+    );
+    let ok = check_work(&d, &st, coarse, MAX_TRIANGLES_LIMIT).unwrap();
+    match check_work(&d, &st, coarse, ok.triangles - 1) {
+        Err(DesignError::WorkLimit(m)) => {
+            assert!(
+                m.contains(&format!("about {} triangles", ok.triangles))
+                    && m.contains(&format!("more than the limit of {}", ok.triangles - 1))
+                    && m.contains("469 marker features")
+                    && m.contains("--max-triangles"),
+                "{m}"
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+}
