@@ -227,6 +227,11 @@ fn bad_fixture_parameters_name_the_parameter_and_write_nothing() {
     let cases = [
         ("pin_dome:\n  rings:\n    - {polar_angle_deg: 20, count: 16}\n", "pin_dome.rings[0].count"),
         ("pin_dome:\n  clearance_mm: -1\n", "pin_dome.clearance_mm"),
+        // once aborted on a 32 GB allocation
+        (
+            "pin_dome:\n  rings:\n    - {polar_angle_deg: 20, count: 4000000000}\n",
+            "pin_dome.rings[0].count = 4000000000: must be at most 1000 holes on one ring",
+        ),
         ("pin_dome:\n  pin:\n    length_mm: 2.0\n", "pin_dome.pin.length_mm"),
         ("semidomes:\n  patterns:\n    - name: edge\n      protrusions:\n        - {polar_angle_deg: 40, azimuth_deg: 88, indentation_depth_mm: 1, shape: {type: sphere, radius_mm: 2}}\n", "semidomes.patterns[0].protrusions[0].azimuth_deg"),
         ("pin_dome:\n  wall_thicknes_mm: 2\n", "params.yaml:2:"),
