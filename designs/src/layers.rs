@@ -802,17 +802,22 @@ pub fn build_layer(
                 [-px, -py, f.parting_z_mm - 1.0],
                 [px, py, zb],
             ))?;
-            let hole = g(crate::geometry::cylinder(
-                z_far - f.top_z_mm + 2.0,
-                f.bolt_hole_diameter_mm / 2.0,
-                tol,
-            ))?;
-            let bolts = Solid::compose(
-                &f.bolts_xy_mm
-                    .iter()
-                    .map(|b| hole.translate([b[0], b[1], f.top_z_mm - 1.0]))
-                    .collect::<Vec<_>>(),
-            );
+            // The bolt holes of one piece: through both, each piece with its own diameter.
+            let bolt_holes = |diameter_mm: f64| -> Result<Solid, DesignError> {
+                let hole = g(crate::geometry::cylinder(
+                    z_far - f.top_z_mm + 2.0,
+                    diameter_mm / 2.0,
+                    tol,
+                ))?;
+                Ok(Solid::compose(
+                    &f.bolts_xy_mm
+                        .iter()
+                        .map(|b| hole.translate([b[0], b[1], f.top_z_mm - 1.0]))
+                        .collect::<Vec<_>>(),
+                ))
+            };
+            let bolts = bolt_holes(f.cavity_block_bolt_hole_mm)?;
+            let top_bolts = bolt_holes(f.top_piece_bolt_hole_mm)?;
             let block = g(crate::geometry::cuboid(
                 [-ox, -oy, f.parting_z_mm],
                 [ox, oy, z_far],
@@ -846,7 +851,7 @@ pub fn build_layer(
                 )?;
             let top_piece = g(plate
                 .union(&boss)
-                .and_then(|t| t.difference(&Solid::compose(&[bore, bolts.clone()]))))?;
+                .and_then(|t| t.difference(&Solid::compose(&[bore, top_bolts]))))?;
             let reservoir_mm3 =
                 std::f64::consts::PI * f.reservoir_radius_mm.powi(2) * (zb - f.top_z_mm);
             let params = json!({

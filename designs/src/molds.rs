@@ -866,7 +866,9 @@ pub struct TwoPieceFrame {
     pub reservoir_radius_mm: f64,
     /// Bolt axes (x, y), parallel to z: corners first, then the sides.
     pub bolts_xy_mm: Vec<[f64; 2]>,
-    pub bolt_hole_diameter_mm: f64,
+    /// Bolt hole diameters, mm: in the cavity block and in the top piece.
+    pub cavity_block_bolt_hole_mm: f64,
+    pub top_piece_bolt_hole_mm: f64,
     /// Bolt pitch along the sides of the flange, x and y sides, mm.
     pub bolt_pitch_mm: [f64; 2],
 }
@@ -912,7 +914,8 @@ impl TwoPieceFrame {
             boss_half_mm: boss,
             reservoir_radius_mm: t.reservoir_diameter_mm / 2.0,
             bolts_xy_mm: bolts,
-            bolt_hole_diameter_mm: m.clamp_bolt.clearance_diameter_mm,
+            cavity_block_bolt_hole_mm: t.bolt_holes_mm(m.clamp_bolt.clearance_diameter_mm).0,
+            top_piece_bolt_hole_mm: t.bolt_holes_mm(m.clamp_bolt.clearance_diameter_mm).1,
             bolt_pitch_mm: [ax / (kx + 1) as f64, ay / (ky + 1) as f64],
         }
     }
@@ -950,6 +953,32 @@ pub fn check_two_piece(design: &Design, rim_radius_mm: f64, errs: &mut Vec<Param
         ));
         ok = false;
     }
+    for (p, v) in [
+        (
+            "mold.two_piece.cavity_block_bolt_hole_mm",
+            t.cavity_block_bolt_hole_mm,
+        ),
+        (
+            "mold.two_piece.top_piece_bolt_hole_mm",
+            t.top_piece_bolt_hole_mm,
+        ),
+    ] {
+        let Some(v) = v else { continue };
+        if !(v > 0.0 && v.is_finite()) {
+            errs.push(ParamError::new(p, v, "must be above 0"));
+            ok = false;
+        } else if v < cav.min_hole_diameter_mm {
+            errs.push(ParamError::new(
+                p,
+                v,
+                format!(
+                    "below the minimum hole {} mm of printer profile '{cavity}'",
+                    cav.min_hole_diameter_mm
+                ),
+            ));
+            ok = false;
+        }
+    }
     let sizes_ok = [
         m.flange_width_mm,
         m.clamp_bolt.clearance_diameter_mm,
@@ -959,6 +988,29 @@ pub fn check_two_piece(design: &Design, rim_radius_mm: f64, errs: &mut Vec<Param
     .all(|v| v.is_finite() && *v >= 0.0);
     if !ok || !sizes_ok {
         return;
+    }
+    // The widest bolt hole of the two pieces, and the parameter that sets it.
+    let (hole_block, hole_top) = t.bolt_holes_mm(m.clamp_bolt.clearance_diameter_mm);
+    let (hole_path, hole) = if hole_block >= hole_top {
+        match t.cavity_block_bolt_hole_mm {
+            Some(_) => ("mold.two_piece.cavity_block_bolt_hole_mm", hole_block),
+            None => ("mold.clamp_bolt.clearance_diameter_mm", hole_block),
+        }
+    } else {
+        match t.top_piece_bolt_hole_mm {
+            Some(_) => ("mold.two_piece.top_piece_bolt_hole_mm", hole_top),
+            None => ("mold.clamp_bolt.clearance_diameter_mm", hole_top),
+        }
+    };
+    if hole + 2.0 * cav.min_wall_mm > m.flange_width_mm {
+        errs.push(ParamError::new(
+            hole_path,
+            hole,
+            format!(
+                "does not fit the flange (mold.flange_width_mm = {}) with the minimum wall {} mm of printer profile '{cavity}' on each side",
+                m.flange_width_mm, cav.min_wall_mm
+            ),
+        ));
     }
     let rim_d = 2.0 * rim_radius_mm;
     if t.reservoir_diameter_mm <= rim_d {
@@ -1010,14 +1062,14 @@ pub fn check_two_piece(design: &Design, rim_radius_mm: f64, errs: &mut Vec<Param
     }
     let f = TwoPieceFrame::new(design);
     let pitch = f.bolt_pitch_mm[0].min(f.bolt_pitch_mm[1]);
-    let need = m.clamp_bolt.clearance_diameter_mm + cav.min_wall_mm;
+    let need = hole + cav.min_wall_mm;
     if pitch < need {
         errs.push(ParamError::new(
             "mold.two_piece.bolt_count",
             t.bolt_count,
             format!(
-                "bolts {pitch:.3} mm apart on the flange: closer than the hole {} mm (mold.clamp_bolt.clearance_diameter_mm) plus the minimum wall {} mm of printer profile '{cavity}'",
-                m.clamp_bolt.clearance_diameter_mm, cav.min_wall_mm
+                "bolts {pitch:.3} mm apart on the flange: closer than the hole {hole} mm ({hole_path}) plus the minimum wall {} mm of printer profile '{cavity}'",
+                cav.min_wall_mm
             ),
         ));
     }

@@ -271,14 +271,35 @@ pub struct TwoPieceOpenParams {
     pub reservoir_height_mm: f64,
     /// Clamp bolts through the flange, even, >= 4 (authors: 20).
     pub bolt_count: u32,
+    /// Bolt hole diameter in the cavity block, mm (authors: 3.5); default
+    /// `mold.clamp_bolt.clearance_diameter_mm`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cavity_block_bolt_hole_mm: Option<f64>,
+    /// Bolt hole diameter in the top piece, mm (authors: 3.4); default
+    /// `mold.clamp_bolt.clearance_diameter_mm`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub top_piece_bolt_hole_mm: Option<f64>,
     pub boss: RegistrationBoss,
 }
 defaults!(TwoPieceOpenParams {
     reservoir_diameter_mm: 45.0,
     reservoir_height_mm: 14.0,
     bolt_count: 20,
+    cavity_block_bolt_hole_mm: None,
+    top_piece_bolt_hole_mm: None,
     boss: RegistrationBoss::default(),
 });
+
+impl TwoPieceOpenParams {
+    /// (cavity block, top piece) bolt hole diameters, mm: the per-piece values, else
+    /// `clearance_mm` (`mold.clamp_bolt.clearance_diameter_mm`).
+    pub fn bolt_holes_mm(&self, clearance_mm: f64) -> (f64, f64) {
+        (
+            self.cavity_block_bolt_hole_mm.unwrap_or(clearance_mm),
+            self.top_piece_bolt_hole_mm.unwrap_or(clearance_mm),
+        )
+    }
+}
 
 /// A rectangular boss on the top piece of a two-piece mold that registers it in a pocket of
 /// the cavity block (authors' ShadowTac mold: 60 x 65 x 2 mm).

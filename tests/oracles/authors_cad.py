@@ -158,10 +158,25 @@ def shadowtac(fabkit, work):
     ROWS[-1] = ROWS[-1][:4] + (bool(ok_boss),)
     holes = int(top["genus"]) - 1
     row("ShadowTac", "bolts", "20", float(holes), "{:.0f}", 0, 20)
-    fr = top["params"]["frame"]
+    # bolt hole diameters measured on each piece's mesh: the wall vertices within 2.5 mm of each
+    # bolt axis (the flange's edges are 4 mm away) lie on the hole's circle
+    axes = np.asarray(top["params"]["frame"]["bolts_xy_mm"], dtype=float)
+
+    def hole_diameters(p):
+        pv = sensor_vertices(d, p)
+        out = []
+        for x, y in axes:
+            rr = np.hypot(pv[:, 0] - x, pv[:, 1] - y)
+            near = rr[rr < 2.5]
+            out.append(2.0 * float(near.max()) if len(near) else float("nan"))
+        return np.array(out)
+
+    hb, ht = hole_diameters(block), hole_diameters(top)
     row("ShadowTac", "bolt holes, bottom / top piece", "3.5 / 3.4 mm",
-        f"{fr['bolt_hole_diameter_mm']} / {fr['bolt_hole_diameter_mm']} mm", "{}",
-        note="differs: fabkit's M3 clearance from mold.clamp_bolt in both")
+        f"{hb.min():.3f}-{hb.max():.3f} / {ht.min():.3f}-{ht.max():.3f} mm", "{}")
+    ok_holes = bool(np.all(np.abs(hb - 3.5) < 1e-3) and np.all(np.abs(ht - 3.4) < 1e-3)
+                    and len(hb) == 20)
+    ROWS[-1] = ROWS[-1][:4] + (ok_holes,)
 
 
 def rtac0(fabkit, work):

@@ -232,7 +232,9 @@ fn two_piece_mold_pieces_match_the_authors() {
     assert!((num(&fr["pocket_half_mm"][1]) - (32.5 + 0.15)).abs() < 1e-12);
     assert!((outer[0] - 38.15).abs() < 1e-12 && (outer[1] - 40.65).abs() < 1e-12);
     assert_eq!(fr["bolts_xy_mm"].as_array().unwrap().len(), 20);
-    assert_eq!(num(&fr["bolt_hole_diameter_mm"]), 3.4);
+    // authors' CAD, measured: 3.5 mm bolt holes in the bottom piece, 3.4 mm in the top piece
+    assert_eq!(num(&fr["cavity_block_bolt_hole_mm"]), 3.5);
+    assert_eq!(num(&fr["top_piece_bolt_hole_mm"]), 3.4);
     // genus: one handle per bolt hole, plus the bore in the top piece
     assert_eq!(block.solid.genus(), 20);
     assert_eq!(top.solid.genus(), 21);
@@ -344,6 +346,31 @@ fn each_single_mutation_yields_exactly_its_one_error() {
             "mold.flange_width_mm",
             "8",
             &["too narrow", "clamp bolts"],
+        ),
+        (
+            "cavity block bolt holes wider than the flange holds",
+            |d| d.mold.two_piece.cavity_block_bolt_hole_mm = Some(7.5),
+            "mold.two_piece.cavity_block_bolt_hole_mm",
+            "7.5",
+            &[
+                "does not fit the flange",
+                "mold.flange_width_mm = 8",
+                "minimum wall",
+            ],
+        ),
+        (
+            "top piece bolt holes below the printer's smallest hole",
+            |d| d.mold.two_piece.top_piece_bolt_hole_mm = Some(0.1),
+            "mold.two_piece.top_piece_bolt_hole_mm",
+            "0.1",
+            &["below the minimum hole"],
+        ),
+        (
+            "negative cavity block bolt hole",
+            |d| d.mold.two_piece.cavity_block_bolt_hole_mm = Some(-3.5),
+            "mold.two_piece.cavity_block_bolt_hole_mm",
+            "-3.5",
+            &["must be above 0"],
         ),
         (
             "bore inside the rim",

@@ -75,9 +75,10 @@ def open_mold_piece(params: dict):
     zb, zp = f["base_z_mm"], f["parting_z_mm"]
     ox, oy = f["outer_half_mm"]
     z0, z1 = params["bolt_holes_z_mm"]
-    r_bolt = f["bolt_hole_diameter_mm"] / 2.0
+    piece = params["piece"]
+    r_bolt = f[f"{'cavity_block' if piece == 'cavity_block' else 'top_piece'}_bolt_hole_mm"] / 2.0
     bolts = [C.cylinder_z(r_bolt, z0, z1, x, y) for x, y in f["bolts_xy_mm"]]
-    if params["piece"] == "cavity_block":
+    if piece == "cavity_block":
         zlo, zhi = params["cavity_block_z_mm"]
         px, py = f["pocket_half_mm"]
         block = C.box((-ox, -oy, zlo), (ox, oy, zhi))
