@@ -59,34 +59,12 @@ fn rim_margin(spec: &MarkerSpec, min_wall: f64) -> f64 {
     spec.feature.diameter_mm + min_wall
 }
 
-/// The marker count and feature radius (mm) of every pattern of `layer` that places (a pattern
-/// that does not is the validation's to report), without the spacing statistics of
-/// [`place_layer_markers`]: the work estimate's input.
-pub fn count_layer_markers(design: &Design, layer: &ResolvedLayer) -> Vec<(usize, f64)> {
-    let spec_layer = &design.layers[layer.index];
-    let profile = design.printers.get(feature_technology(design, spec_layer));
-    spec_layer
-        .markers
-        .iter()
-        .filter_map(|spec| {
-            let surface = Surface::new(&design.body, surface_offset(layer, spec.surface));
-            let markers = markers::place(
-                &surface,
-                &spec.pattern,
-                rim_margin(spec, profile.min_wall_mm),
-            )
-            .ok()?;
-            Some((markers.len(), spec.feature.radius_mm()))
-        })
-        .collect()
-}
-
-/// Places every marker pattern of layer `i`.
-pub fn place_layer_markers(
-    design: &Design,
+/// Every pattern of `layer` that places (a pattern that does not is the validation's to
+/// report): the spec, its surface offset, the surface and the markers.
+fn placed_patterns<'a>(
+    design: &'a Design,
     layer: &ResolvedLayer,
-    tol: ChordTolerance,
-) -> Vec<PlacedMarkers> {
+) -> Vec<(&'a MarkerSpec, f64, Surface, Vec<markers::Marker>)> {
     let spec_layer = &design.layers[layer.index];
     let profile = design.printers.get(feature_technology(design, spec_layer));
     spec_layer
@@ -101,6 +79,29 @@ pub fn place_layer_markers(
                 rim_margin(spec, profile.min_wall_mm),
             )
             .ok()?;
+            Some((spec, offset, surface, markers))
+        })
+        .collect()
+}
+
+/// The marker count and feature radius (mm) of every pattern of `layer` that places, without
+/// the spacing statistics of [`place_layer_markers`]: the work estimate's input.
+pub fn count_layer_markers(design: &Design, layer: &ResolvedLayer) -> Vec<(usize, f64)> {
+    placed_patterns(design, layer)
+        .into_iter()
+        .map(|(spec, _, _, m)| (m.len(), spec.feature.radius_mm()))
+        .collect()
+}
+
+/// Places every marker pattern of layer `i`.
+pub fn place_layer_markers(
+    design: &Design,
+    layer: &ResolvedLayer,
+    tol: ChordTolerance,
+) -> Vec<PlacedMarkers> {
+    placed_patterns(design, layer)
+        .into_iter()
+        .map(|(spec, offset, surface, markers)| {
             let stats = markers::stats(&surface, &markers);
             let max_k = (0..=64)
                 .map(|i| {
@@ -108,14 +109,14 @@ pub fn place_layer_markers(
                     a.abs().max(b.abs())
                 })
                 .fold(0.0, f64::max);
-            Some(PlacedMarkers {
+            PlacedMarkers {
                 spec: spec.clone(),
                 markers,
                 stats,
                 offset_mm: offset,
                 direction: direction(spec),
                 embed_mm: markers::embed_depth_mm(&spec.feature, max_k, tol),
-            })
+            }
         })
         .collect()
 }
