@@ -39,9 +39,7 @@ pub const MAX_BINARY_INPUT_BYTES: u64 = 1 << 30;
 
 /// A regular file of at most [`MAX_TEXT_INPUT_BYTES`] as UTF-8 text.
 pub(crate) fn read_text(path: &std::path::Path) -> std::io::Result<String> {
-    let bytes = fabkit_designs::input_files::read_regular_file(path, MAX_TEXT_INPUT_BYTES)?;
-    String::from_utf8(bytes)
-        .map_err(|_| std::io::Error::new(std::io::ErrorKind::InvalidData, "is not UTF-8 text"))
+    fabkit_designs::input_files::read_text_file(path, MAX_TEXT_INPUT_BYTES)
 }
 
 /// A regular file of at most [`MAX_BINARY_INPUT_BYTES`].

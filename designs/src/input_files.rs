@@ -102,25 +102,24 @@ fn kind(md: &std::fs::Metadata) -> &'static str {
 
 /// Why [`read_bounded`] refused or failed; the message is a rule, not file contents.
 #[derive(Debug)]
-pub(crate) enum Refusal {
+enum Refusal {
     /// The file cannot be opened or read (the OS's message).
     Io(std::io::Error),
     /// Not a regular file (what it is).
     NotRegular(&'static str),
     /// Over the bound (size in bytes, or `None` when it grew while being read).
     TooLarge(Option<u64>),
-    /// Not UTF-8 text.
-    NotText,
 }
 
-/// Reads the regular file at `path` as UTF-8 text of at most `max_bytes`. The file is opened
-/// without blocking (a FIFO does not wait for a writer) and checked through the open handle,
-/// so a file swapped after the check is caught too.
-pub(crate) fn read_bounded(path: &Path, max_bytes: u64) -> Result<String, Refusal> {
-    String::from_utf8(read_bounded_bytes(path, max_bytes)?).map_err(|_| Refusal::NotText)
+/// "N bytes, " when the size is known.
+fn size_prefix(n: Option<u64>) -> String {
+    n.map(|n| format!("{n} bytes, ")).unwrap_or_default()
 }
 
-fn read_bounded_bytes(path: &Path, max_bytes: u64) -> Result<Vec<u8>, Refusal> {
+/// Reads the regular file at `path` of at most `max_bytes`. The file is opened without
+/// blocking (a FIFO does not wait for a writer) and checked through the open handle, so a file
+/// swapped after the check is caught too.
+fn read_bounded(path: &Path, max_bytes: u64) -> Result<Vec<u8>, Refusal> {
     let mut opts = std::fs::OpenOptions::new();
     opts.read(true);
     #[cfg(unix)]
@@ -152,14 +151,15 @@ fn read_bounded_bytes(path: &Path, max_bytes: u64) -> Result<Vec<u8>, Refusal> {
 }
 
 /// Reads the regular file at `path`, of at most `max_bytes`: the bounded read behind every input
-/// file fabkit takes (camera files, point tables, observations, images, fixture outputs).
+/// file fabkit takes (design and sweep files, camera files, point tables, observations, images,
+/// fixture outputs).
 ///
 /// # Errors
 /// The OS's error, or one of kind `InvalidInput` whose message is the rule broken (`is a FIFO
 /// (named pipe); only regular files are read`, `is N bytes, over the limit of M bytes`). The
 /// message never quotes the file.
 pub fn read_regular_file(path: &Path, max_bytes: u64) -> std::io::Result<Vec<u8>> {
-    read_bounded_bytes(path, max_bytes).map_err(|r| match r {
+    read_bounded(path, max_bytes).map_err(|r| match r {
         Refusal::Io(e) => e,
         Refusal::NotRegular(k) => std::io::Error::new(
             std::io::ErrorKind::InvalidInput,
@@ -169,11 +169,19 @@ pub fn read_regular_file(path: &Path, max_bytes: u64) -> std::io::Result<Vec<u8>
             std::io::ErrorKind::InvalidInput,
             format!(
                 "is {}over the limit of {max_bytes} bytes for this input",
-                n.map(|n| format!("{n} bytes, ")).unwrap_or_default()
+                size_prefix(n)
             ),
         ),
-        Refusal::NotText => std::io::Error::from(std::io::ErrorKind::InvalidData),
     })
+}
+
+/// [`read_regular_file`] as UTF-8 text.
+///
+/// # Errors
+/// As [`read_regular_file`], and one of kind `InvalidData` (`is not UTF-8 text`).
+pub fn read_text_file(path: &Path, max_bytes: u64) -> std::io::Result<String> {
+    String::from_utf8(read_regular_file(path, max_bytes)?)
+        .map_err(|_| std::io::Error::new(std::io::ErrorKind::InvalidData, "is not UTF-8 text"))
 }
 
 /// Reads a YAML input file the user named: a design, a sweep file, fixture parameters (regular
@@ -182,17 +190,9 @@ pub fn read_regular_file(path: &Path, max_bytes: u64) -> std::io::Result<Vec<u8>
 /// # Errors
 /// [`DesignError::Io`] naming the path and the rule broken.
 pub fn read_design_file(path: &Path) -> Result<String, DesignError> {
-    read_bounded(path, MAX_DESIGN_FILE_BYTES).map_err(|r| DesignError::Io {
+    read_text_file(path, MAX_DESIGN_FILE_BYTES).map_err(|e| DesignError::Io {
         path: path.display().to_string(),
-        message: match r {
-            Refusal::Io(e) => e.to_string(),
-            Refusal::NotRegular(k) => format!("is {k}; only regular files are read"),
-            Refusal::TooLarge(n) => format!(
-                "is {}over the limit of {MAX_DESIGN_FILE_BYTES} bytes (16 MiB) for a YAML input file",
-                n.map(|n| format!("{n} bytes, ")).unwrap_or_default()
-            ),
-            Refusal::NotText => "is not UTF-8 text".into(),
-        },
+        message: e.to_string(),
     })
 }
 
@@ -245,7 +245,7 @@ pub(crate) fn read_data_file(
             root.display()
         )));
     }
-    read_bounded(&resolved, rules.max_bytes).map_err(|r| {
+    let bytes = read_bounded(&resolved, rules.max_bytes).map_err(|r| {
         refuse(match r {
             Refusal::Io(e) => format!("cannot be read: {e}"),
             Refusal::NotRegular(k) => {
@@ -254,10 +254,11 @@ pub(crate) fn read_data_file(
             Refusal::TooLarge(n) => format!(
                 "is {}over the data file limit of {} bytes (hint: --max-data-file-bytes, up to \
                  {MAX_DATA_FILE_BYTES_LIMIT})",
-                n.map(|n| format!("{n} bytes, ")).unwrap_or_default(),
+                size_prefix(n),
                 rules.max_bytes
             ),
-            Refusal::NotText => "is not UTF-8 text; a data file is a CSV text file".into(),
         })
-    })
+    })?;
+    String::from_utf8(bytes)
+        .map_err(|_| refuse("is not UTF-8 text; a data file is a CSV text file".into()))
 }

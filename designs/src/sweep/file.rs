@@ -3,8 +3,7 @@
 
 use super::paths::{expand_short_path, nearest_paths, path_exists, with_value};
 use super::SweepError;
-use crate::error::DesignError;
-use crate::input_files::{read_design_file, DataFileRules};
+use crate::input_files::{read_text_file, DataFileRules, MAX_DESIGN_FILE_BYTES};
 use crate::library::{load_source_with, LoadedDesign};
 use crate::schema::{yaml_error, Design};
 use crate::ChordTolerance;
@@ -157,12 +156,9 @@ impl SweepSpec {
     /// # Errors
     /// As [`SweepSpec::from_file`].
     pub fn from_file_with(path: &Path, rules: &DataFileRules) -> Result<SweepSpec, SweepError> {
-        let text = read_design_file(path).map_err(|e| match e {
-            DesignError::Io { path, message } => SweepError::Io { path, message },
-            other => SweepError::Io {
-                path: path.display().to_string(),
-                message: other.to_string(),
-            },
+        let text = read_text_file(path, MAX_DESIGN_FILE_BYTES).map_err(|e| SweepError::Io {
+            path: path.display().to_string(),
+            message: e.to_string(),
         })?;
         let dir = path.parent().unwrap_or(Path::new(""));
         Self::parse_with(&text, &path.display().to_string(), dir, rules)
