@@ -697,8 +697,7 @@ pub fn place(
                     }
                 }
             };
-            // Count first (each ring costs O(1)), place after.
-            let mut rings: Vec<(f64, usize)> = Vec::new();
+            // Each ring is counted before it is placed.
             let mut total = usize::from(centre);
             let mut k = 1;
             while let Some(s) = ring_s(k) {
@@ -721,11 +720,8 @@ pub fn place(
                         ),
                     ));
                 }
-                rings.push((s, n));
+                push_ring(&mut raw, s, k, n);
                 k += 1;
-            }
-            for (i, (s, n)) in rings.into_iter().enumerate() {
-                push_ring(&mut raw, s, i as u32 + 1, n);
             }
             if let Some(RingAzimuthOffset::PerRingDeg(v)) = &pattern.ring_azimuth_offset {
                 if v.len() != (k - 1) as usize {
