@@ -4,8 +4,8 @@
 //!
 //! The estimate counts the facets the tessellation will make (the same segment counts as
 //! [`crate::geometry::revolve`] and the feature primitives) for every layer surface and every
-//! marker feature, times the number of parts each kind appears in (calibrated on the library
-//! designs: from 0.9 to 2.2 times the built kits, checked by a test).
+//! marker feature, each counted once: on the library designs and presets that is 0.9 to 2.2
+//! times the built kits (measured; a test keeps it within 0.8 to 2.5).
 
 use crate::error::DesignError;
 use crate::geometry::ChordTolerance;
@@ -18,12 +18,6 @@ use crate::stack::Stack;
 pub const DEFAULT_MAX_TRIANGLES: u64 = 4_000_000;
 /// Largest bound a user may set (`--max-triangles`): 100,000,000.
 pub const MAX_TRIANGLES_LIMIT: u64 = 100_000_000;
-
-/// Parts a layer surface appears in (the layer's mold or master, the mold box, the casting
-/// jig or the shell), calibrated on the library designs.
-const PARTS_PER_SURFACE: f64 = 1.0;
-/// Parts a marker feature appears in (master or mold cavity, and the skin's negative).
-const PARTS_PER_FEATURE: f64 = 1.0;
 
 /// The estimated work of building a design's kit.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -76,9 +70,9 @@ pub fn estimate(design: &Design, stack: &Stack, tol: ChordTolerance) -> WorkEsti
             feature_tris += n as f64 * feature_triangles(radius_mm, tol);
         }
     }
-    let marker_triangles = PARTS_PER_FEATURE * feature_tris;
+    let marker_triangles = feature_tris;
     WorkEstimate {
-        triangles: (PARTS_PER_SURFACE * surfaces + marker_triangles).round() as u64,
+        triangles: (surfaces + marker_triangles).round() as u64,
         marker_triangles: marker_triangles.round() as u64,
         markers,
     }
