@@ -30,6 +30,19 @@ pub struct WorkEstimate {
     pub markers: u64,
 }
 
+/// Triangles of a closed profile of `points` points revolved about z with its largest radius
+/// `r_max_mm` (as [`crate::geometry::revolve`]: two per profile edge and circumferential
+/// segment, at `tol.half()` around).
+pub fn revolved_triangles(points: usize, r_max_mm: f64, tol: ChordTolerance) -> f64 {
+    2.0 * points as f64 * tol.half().circle_segments(r_max_mm) as f64
+}
+
+/// Triangles of the revolved surface at `offset_mm` from the body surface (one side of a
+/// layer or a shell); 0 where the body has no such offset.
+pub fn offset_surface_triangles(design: &Design, offset_mm: f64, tol: ChordTolerance) -> f64 {
+    surface_triangles(design, offset_mm, tol)
+}
+
 /// Triangles of one revolved surface at `offset_mm` from the body surface.
 fn surface_triangles(design: &Design, offset_mm: f64, tol: ChordTolerance) -> f64 {
     let b = &design.body;

@@ -129,6 +129,29 @@ fn placed(
 }
 
 impl Primitive {
+    /// The triangles [`Self::solid`] makes at `tol`, computed from the dimensions alone (the
+    /// same segment counts, nothing tessellated): for a work estimate before a build.
+    pub fn estimated_triangles(&self, tol: ChordTolerance) -> f64 {
+        // a full circle's segments at the tolerance of the profile arcs and of the revolution
+        let around = |r: f64| tol.half().circle_segments(r) as f64;
+        match self {
+            // n / 2 arc points revolved at n segments
+            Primitive::Sphere { radius_mm, .. } => around(*radius_mm).powi(2),
+            // straight generators: 4 profile points (caps and side) at the whole tolerance
+            Primitive::Cylinder { radius_mm, .. } => 4.0 * tol.circle_segments(*radius_mm) as f64,
+            Primitive::Cone { base_radius_mm, .. } => {
+                3.0 * tol.circle_segments(*base_radius_mm) as f64
+            }
+            // two quarter arcs and the side
+            Primitive::Capsule { radius_mm, .. } => {
+                let n = around(*radius_mm);
+                n * (n / 2.0 + 4.0)
+            }
+            Primitive::Box { .. } => 12.0,
+            Primitive::Prism { polygon_mm, .. } => 4.0 * polygon_mm.len() as f64,
+        }
+    }
+
     /// The primitive as a closed solid within `tol` of the exact surface.
     ///
     /// # Errors
@@ -296,6 +319,15 @@ fn ear_clip(poly: &[[f64; 2]]) -> Option<Vec<[u32; 3]>> {
 }
 
 impl Geometry {
+    /// The triangles of [`Self::solid`] before the union: the sum of
+    /// [`Primitive::estimated_triangles`].
+    pub fn estimated_triangles(&self, tol: ChordTolerance) -> f64 {
+        self.primitives
+            .iter()
+            .map(|p| p.estimated_triangles(tol))
+            .sum()
+    }
+
     /// The union of the primitives as one solid (disjoint or overlapping).
     ///
     /// # Errors

@@ -40,6 +40,11 @@ pub struct FixturesArgs {
     /// manifold3d twin (tests/oracles/twins).
     #[arg(long)]
     csg: Option<PathBuf>,
+    /// Refuse fixtures estimated (before building) at more triangles than this (about 1 KB of
+    /// memory each; 1 to 100000000).
+    #[arg(long, value_name = "N", default_value_t = fabkit_designs::estimate::DEFAULT_MAX_TRIANGLES,
+          value_parser = fabkit_designs::estimate::parse_max_triangles, allow_negative_numbers = true)]
+    max_triangles: u64,
     #[command(flatten)]
     data_files: DataFileArgs,
 }
@@ -83,7 +88,13 @@ pub fn run(args: FixturesArgs) -> Result<(), Box<dyn Error>> {
     }
     let spinner = spinner(format!("building the fixtures of {}", loaded.design.name));
     let t0 = std::time::Instant::now();
-    let set = fabkit_fixtures::build_fixtures(&loaded.design, &params, tol, &provenance);
+    let set = fabkit_fixtures::build_fixtures(
+        &loaded.design,
+        &params,
+        tol,
+        args.max_triangles,
+        &provenance,
+    );
     spinner.finish_and_clear();
     let set = set?;
     let opts = export_options(&loaded, tol, &args.format);

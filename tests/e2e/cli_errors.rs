@@ -496,7 +496,7 @@ fn csg_never_overwrites_a_users_file() {
 }
 
 /// The work of a build is estimated before anything is built: past `--max-triangles` an export
-/// is refused (the estimate, the limit, how to raise it; nothing written) and a sweep variant
+/// or a fixture set is refused (the estimate, the limit, how to raise it; nothing written) and a sweep variant
 /// is recorded as an error while the sweep writes its table.
 #[test]
 fn work_past_max_triangles_is_refused_before_building() {
@@ -523,12 +523,36 @@ fn work_past_max_triangles_is_refused_before_building() {
         "{err}"
     );
     assert!(!root.join("out").exists());
+    // fixtures: 100 semi-domes at the finest tolerance (once 9 GB and 80 s) are refused
+    let o = run(
+        root,
+        &[
+            "fixtures",
+            "--semidomes",
+            "100",
+            "--chord-tolerance-mm",
+            "0.001",
+            "--out",
+            "out/f",
+        ],
+        &[],
+    );
+    assert_eq!(o.status.code(), Some(2));
+    let err = text(&o.stderr);
+    assert!(
+        err.contains("rtac0: the fixtures would have about ")
+            && err.contains("100 semi-dome patterns")
+            && err.contains("more than the limit of 4000000")
+            && err.contains("raise it with --max-triangles"),
+        "{err}"
+    );
+    assert!(!root.join("out").exists());
     for bad in ["0", "-3", "100000001", "1e6"] {
-        for cmd in ["export", "sweep"] {
-            let args = if cmd == "export" {
-                vec!["export", "--max-triangles", bad]
-            } else {
-                vec!["sweep", "s.yaml", "--out", "out/w", "--max-triangles", bad]
+        for cmd in ["export", "sweep", "fixtures"] {
+            let args = match cmd {
+                "export" => vec!["export", "--max-triangles", bad],
+                "fixtures" => vec!["fixtures", "--max-triangles", bad],
+                _ => vec!["sweep", "s.yaml", "--out", "out/w", "--max-triangles", bad],
             };
             let o = run(root, &args, &[]);
             assert_eq!(o.status.code(), Some(2), "{args:?}");
