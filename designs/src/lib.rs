@@ -24,6 +24,7 @@ pub mod profile;
 pub mod schema;
 pub mod stack;
 pub mod sweep;
+pub mod values;
 
 pub use build::{build_kit, build_kit_bounded};
 pub use error::{DesignError, ParamError, ParamErrors};

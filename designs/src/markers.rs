@@ -221,6 +221,31 @@ impl Pattern {
         let mut push = |f: &str, v: String, rule: &str| {
             errs.push((f.to_string(), v, rule.to_string()));
         };
+        // The polar limits: angles from the sensor axis, min below max.
+        if let Some(x) = self.max_polar_deg {
+            if !(x > 0.0 && x <= 180.0) {
+                push(
+                    "max_polar_deg",
+                    x.to_string(),
+                    "must be a polar angle above 0 and at most 180 deg",
+                );
+            }
+        }
+        if let Some(x) = self.min_polar_deg {
+            if !(0.0..180.0).contains(&x) {
+                push(
+                    "min_polar_deg",
+                    x.to_string(),
+                    "must be a polar angle from 0 to below 180 deg",
+                );
+            } else if let Some(m) = self.max_polar_deg.filter(|&m| !(x < m)) {
+                push(
+                    "min_polar_deg",
+                    x.to_string(),
+                    &format!("must be below max_polar_deg ({m} deg)"),
+                );
+            }
+        }
         if let Some(x) = self.polar_step_deg {
             if !self.is_concentric() {
                 push(
@@ -573,6 +598,16 @@ pub fn place(
         return Err(e);
     }
     let err = |f: &str, v: String, rule: &str| Err((f.to_string(), v, rule.to_string()));
+    let surface_max_deg = surface.polar_deg_at(surface.total_arc_mm());
+    if let Some(p) = pattern.max_polar_deg.filter(|&p| p > surface_max_deg) {
+        return err(
+            "max_polar_deg",
+            p.to_string(),
+            &format!(
+                "must be at most the surface's polar range, {surface_max_deg:.3} deg at its rim"
+            ),
+        );
+    }
     let s_max = match pattern.max_polar_deg {
         Some(p) => surface.s_at_polar_deg(p),
         None => surface.total_arc_mm() - rim_margin_mm,
@@ -582,11 +617,26 @@ pub fn place(
         .map(|p| surface.s_at_polar_deg(p))
         .unwrap_or(0.0);
     if !(s_max > s_min) {
-        return err(
-            "max_polar_deg",
-            format!("{:?}", pattern.max_polar_deg),
-            "leaves no room for markers between the polar limits and the rim",
-        );
+        // name the limit that was given: the minimum when only it is (the maximum is the rim)
+        return match (pattern.max_polar_deg, pattern.min_polar_deg) {
+            (Some(p), _) => err(
+                "max_polar_deg",
+                p.to_string(),
+                "leaves no room for markers between the polar limits and the rim",
+            ),
+            (None, Some(p)) => err(
+                "min_polar_deg",
+                p.to_string(),
+                &format!(
+                    "leaves no room for markers between it and the rim margin ({rim_margin_mm:.3} mm of arc below {surface_max_deg:.3} deg)"
+                ),
+            ),
+            (None, None) => err(
+                "feature.diameter_mm",
+                format!("{rim_margin_mm}"),
+                "leaves no room for markers: the rim margin (one feature diameter) covers the surface",
+            ),
+        };
     }
     // The rule that bounds the patterned region, for messages.
     let limit = || match pattern.max_polar_deg {

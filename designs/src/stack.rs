@@ -75,6 +75,9 @@ fn is_identifier(s: &str) -> bool {
             .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_')
 }
 
+/// Lengths of a design that may be negative ([`crate::values::check_numbers`]): none.
+pub const DESIGN_SIGNED_MM: &[&str] = &[];
+
 /// Checks every rule of a design and resolves its stack. Reports every violation at once.
 ///
 /// # Errors
@@ -84,6 +87,12 @@ pub fn validate(
     materials: &MaterialsTable,
     tol: ChordTolerance,
 ) -> Result<Stack, ParamErrors> {
+    // Every number finite and within its unit's magnitude first: the rules below compare and
+    // compute with them. Negative lengths are reported with the rules below.
+    let numbers = crate::values::check_numbers(design, "", DESIGN_SIGNED_MM);
+    if !numbers.unusable.is_empty() {
+        return Err(ParamErrors(numbers.unusable));
+    }
     let mut errs: Vec<ParamError> = Vec::new();
     let t = tol.mm();
     if !is_identifier(&design.name) {
@@ -102,6 +111,18 @@ pub fn validate(
     } else {
         None
     };
+
+    // The bought backing plate (its sheet gives its size).
+    if let Some(b) = &design.backing {
+        for (path, v) in [
+            ("backing.diameter_mm", b.diameter_mm),
+            ("backing.thickness_mm", b.thickness_mm),
+        ] {
+            if !(v > 0.0) {
+                errs.push(ParamError::new(path, v, "must be above 0"));
+            }
+        }
+    }
 
     // Materials exist and fit their use.
     let mut check_material =
@@ -496,6 +517,7 @@ pub fn validate(
             crate::molds::check_mold_fit(design, c, first.outer_offset_mm, &mut errs);
         }
     }
+    let errs = numbers.merge_negative(errs);
     if errs.is_empty() && stack_ok {
         Ok(Stack { core, layers })
     } else {

@@ -2,6 +2,7 @@
 
 mod estimate;
 mod geometry;
+mod hostile_values;
 mod marker_layout;
 mod markers;
 mod materials;

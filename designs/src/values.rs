@@ -1,0 +1,189 @@
+//! Every number of a design or fixture file checked in one place, by the unit its name carries
+//! (`docs/conventions.md`: `_mm`, `_deg`), so that no field can be forgotten: a new field is
+//! checked by its name alone.
+//!
+//! The rules, for every floating-point value (integers are typed `u32` / `u64` by the schema
+//! and refused by the parser when out of range):
+//!
+//! - every value is finite (YAML `.nan`, `.inf` and numbers past `f64` are refused);
+//! - a length (`_mm`, or an element or field of a `_mm` parameter such as
+//!   `hole_compensation_mm.fdm`) is at most [`MAX_LENGTH_MM`] and not negative, except the few
+//!   lengths a caller names as signed;
+//! - an angle (`_deg`) is from -[`MAX_ANGLE_DEG`] to [`MAX_ANGLE_DEG`];
+//! - any other number (a ratio such as `waste_allowance`) is within +-[`MAX_PLAIN`].
+//!
+//! Each parameter's own range (above 0, below a radius, within a body's polar range) is checked
+//! after these by the validation of the part it builds ([`crate::stack::validate`]).
+
+use crate::error::ParamError;
+use serde::Serialize;
+use serde_value::Value;
+
+/// Largest length of any parameter, mm: larger than any print bed, mold or sensor.
+pub const MAX_LENGTH_MM: f64 = 1000.0;
+/// Largest magnitude of any angle, degrees (one full turn).
+pub const MAX_ANGLE_DEG: f64 = 360.0;
+/// Largest magnitude of any other number.
+pub const MAX_PLAIN: f64 = 1e6;
+
+/// The unit a parameter name carries.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Unit {
+    Mm,
+    Deg,
+    Plain,
+}
+
+fn unit_of(key: &str) -> Option<Unit> {
+    if key.ends_with("_mm") {
+        Some(Unit::Mm)
+    } else if key.ends_with("_deg") {
+        Some(Unit::Deg)
+    } else {
+        None
+    }
+}
+
+/// What [`check_numbers`] found, in two kinds.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct NumberErrors {
+    /// Values no rule can compute with: not finite, or past the unit's magnitude. The caller
+    /// reports these alone, before any other rule.
+    pub unusable: Vec<ParamError>,
+    /// Negative lengths. The caller reports these beside its own rules, except where one of its
+    /// rules already names the same parameter (its rule is the more specific).
+    pub negative: Vec<ParamError>,
+}
+
+impl NumberErrors {
+    /// Whether every number is in range.
+    pub fn is_empty(&self) -> bool {
+        self.unusable.is_empty() && self.negative.is_empty()
+    }
+
+    /// `errs` (the caller's own rules) with the negative lengths they do not already name.
+    pub fn merge_negative(self, mut errs: Vec<ParamError>) -> Vec<ParamError> {
+        for n in self.negative {
+            if !errs.iter().any(|e| e.path == n.path) {
+                errs.push(n);
+            }
+        }
+        errs
+    }
+}
+
+/// Checks every floating-point number of `value` (a design, fixture parameters or any part of
+/// them, as serialized) against the rules of the module documentation. `prefix` is the path of
+/// `value` in its file (empty for a whole file); `signed_mm` names the length parameters (by
+/// their last key) that may be negative.
+///
+/// Each error names the value's path (`layers[0].thickness_mm`, `hole_compensation_mm.fdm`),
+/// the value and the rule.
+pub fn check_numbers<T: Serialize + ?Sized>(
+    value: &T,
+    prefix: &str,
+    signed_mm: &[&str],
+) -> NumberErrors {
+    let mut errs = NumberErrors::default();
+    match serde_value::to_value(value) {
+        Ok(v) => walk(&v, prefix, None, false, signed_mm, &mut errs),
+        // Serialize of a schema type does not fail; say so rather than pass silently.
+        Err(e) => errs.unusable.push(ParamError::new(
+            if prefix.is_empty() { "(file)" } else { prefix },
+            "?",
+            format!("cannot be read as numbers: {e}"),
+        )),
+    }
+    errs
+}
+
+fn join(prefix: &str, key: &str) -> String {
+    if prefix.is_empty() {
+        key.to_string()
+    } else if key.starts_with('[') {
+        format!("{prefix}{key}")
+    } else {
+        format!("{prefix}.{key}")
+    }
+}
+
+fn walk(
+    v: &Value,
+    path: &str,
+    unit: Option<Unit>,
+    signed: bool,
+    signed_mm: &[&str],
+    errs: &mut NumberErrors,
+) {
+    match v {
+        Value::F64(x) => check_one(*x, path, unit.unwrap_or(Unit::Plain), signed, errs),
+        Value::F32(x) => check_one(
+            f64::from(*x),
+            path,
+            unit.unwrap_or(Unit::Plain),
+            signed,
+            errs,
+        ),
+        Value::Option(Some(inner)) | Value::Newtype(inner) => {
+            walk(inner, path, unit, signed, signed_mm, errs)
+        }
+        Value::Seq(items) => {
+            for (i, x) in items.iter().enumerate() {
+                walk(x, &format!("{path}[{i}]"), unit, signed, signed_mm, errs);
+            }
+        }
+        Value::Map(m) => {
+            for (k, x) in m {
+                let key = match k {
+                    Value::String(s) => s.clone(),
+                    other => format!("{other:?}"),
+                };
+                // A key with a unit sets it for everything under it; one without keeps the
+                // parent's (`hole_compensation_mm.fdm`, `bed_size_mm[0]`).
+                let (u, s) = match unit_of(&key) {
+                    Some(u) => (Some(u), signed_mm.contains(&key.as_str())),
+                    None => (unit, signed),
+                };
+                walk(x, &join(path, &key), u, s, signed_mm, errs);
+            }
+        }
+        _ => {}
+    }
+}
+
+/// A value as a reader wants it in an error: `1e300`, not 301 digits.
+fn shown(x: f64) -> String {
+    if x.is_finite() && x != 0.0 && !(1e-4..1e9).contains(&x.abs()) {
+        format!("{x:e}")
+    } else {
+        x.to_string()
+    }
+}
+
+fn check_one(x: f64, path: &str, unit: Unit, signed: bool, errs: &mut NumberErrors) {
+    let path = if path.is_empty() { "(value)" } else { path };
+    if !x.is_finite() {
+        errs.unusable
+            .push(ParamError::new(path, shown(x), "must be a finite number"));
+        return;
+    }
+    let rule = match unit {
+        Unit::Mm if x.abs() > MAX_LENGTH_MM => {
+            format!("must be a length of at most {MAX_LENGTH_MM} mm")
+        }
+        Unit::Deg if x.abs() > MAX_ANGLE_DEG => {
+            format!("must be an angle from -{MAX_ANGLE_DEG} to {MAX_ANGLE_DEG} deg")
+        }
+        Unit::Plain if x.abs() > MAX_PLAIN => format!("must be from -{MAX_PLAIN} to {MAX_PLAIN}"),
+        Unit::Mm if x < 0.0 && !signed => {
+            errs.negative.push(ParamError::new(
+                path,
+                shown(x),
+                "must not be negative (a length, mm)",
+            ));
+            return;
+        }
+        _ => return,
+    };
+    errs.unusable.push(ParamError::new(path, shown(x), rule));
+}

@@ -1,0 +1,296 @@
+//! Hostile values in every numeric field of every library design (the schema walked as the
+//! design serializes): NaN, infinity, a negative and a huge value each give an error naming the
+//! field, or a design that validates and builds into closed, consistently oriented 2-manifolds.
+//! Never a panic, an abort or a silent success with a broken mesh.
+
+use fabkit_designs::materials::MaterialsTable;
+use fabkit_designs::values::{check_numbers, MAX_LENGTH_MM};
+use fabkit_designs::{build_kit_bounded, library, stack, ChordTolerance, Design, ParamError};
+use serde::Deserialize;
+use serde_value::Value;
+
+/// One step of a path into a serialized value.
+#[derive(Debug, Clone)]
+enum Step {
+    Key(String),
+    Index(usize),
+}
+
+/// The path as the errors print it: `layers[0].markers[0].pattern.spacing_mm`.
+fn shown(path: &[Step]) -> String {
+    let mut s = String::new();
+    for st in path {
+        match st {
+            Step::Key(k) if s.is_empty() => s.push_str(k),
+            Step::Key(k) => {
+                s.push('.');
+                s.push_str(k);
+            }
+            Step::Index(i) => s.push_str(&format!("[{i}]")),
+        }
+    }
+    s
+}
+
+/// Every floating-point leaf of `v`, with its path (presets left out: they are paths into the
+/// same fields, checked when applied).
+fn float_paths(v: &Value, path: &mut Vec<Step>, out: &mut Vec<Vec<Step>>) {
+    match v {
+        Value::F64(_) | Value::F32(_) => out.push(path.clone()),
+        Value::Option(Some(x)) | Value::Newtype(x) => float_paths(x, path, out),
+        Value::Seq(items) => {
+            for (i, x) in items.iter().enumerate() {
+                path.push(Step::Index(i));
+                float_paths(x, path, out);
+                path.pop();
+            }
+        }
+        Value::Map(m) => {
+            for (k, x) in m {
+                let Value::String(k) = k else { continue };
+                if path.is_empty() && k == "presets" {
+                    continue;
+                }
+                path.push(Step::Key(k.clone()));
+                float_paths(x, path, out);
+                path.pop();
+            }
+        }
+        _ => {}
+    }
+}
+
+fn leaf<'a>(v: &'a mut Value, path: &[Step]) -> &'a mut Value {
+    let Some((first, rest)) = path.split_first() else {
+        return v;
+    };
+    let v = match v {
+        Value::Option(Some(x)) | Value::Newtype(x) => return leaf(x, path),
+        v => v,
+    };
+    match (first, v) {
+        (Step::Key(k), Value::Map(m)) => leaf(m.get_mut(&Value::String(k.clone())).unwrap(), rest),
+        (Step::Index(i), Value::Seq(items)) => leaf(&mut items[*i], rest),
+        (s, v) => panic!("no {s:?} in {v:?}"),
+    }
+}
+
+/// `design` with the number at `path` set to `x`.
+fn with_value(design: &Design, path: &[Step], x: f64) -> Design {
+    let mut v = serde_value::to_value(design).unwrap();
+    *leaf(&mut v, path) = Value::F64(x);
+    Design::deserialize(v).unwrap()
+}
+
+fn listing(errs: &[ParamError]) -> String {
+    errs.iter().map(|e| format!("\n  {e}")).collect()
+}
+
+const HOSTILE: [f64; 4] = [f64::NAN, f64::INFINITY, -1.0, 1e300];
+
+#[test]
+fn every_numeric_field_of_every_library_design_refuses_hostile_values_by_name() {
+    let materials = MaterialsTable::embedded().unwrap();
+    let tol = ChordTolerance::new(0.05).unwrap();
+    let (mut fields, mut refused, mut built) = (0, 0, Vec::new());
+    for (name, _) in library::LIBRARY {
+        let d = library::load(name).unwrap();
+        assert!(check_numbers(&d, "", &[]).is_empty(), "{name}");
+        let mut paths = Vec::new();
+        float_paths(
+            &serde_value::to_value(&d).unwrap(),
+            &mut Vec::new(),
+            &mut paths,
+        );
+        assert!(paths.len() >= 20, "{name}: {} numeric fields", paths.len());
+        fields += paths.len();
+        for path in &paths {
+            let p = shown(path);
+            let is_length = p.ends_with("_mm") || p.contains("_mm[") || p.contains("_mm.");
+            for x in HOSTILE {
+                let m = with_value(&d, path, x);
+                match stack::validate(&m, &materials, tol) {
+                    Err(e) => {
+                        // NaN, infinity, 1e300 and a negative length are refused by name;
+                        // any other refusal names some parameter with its rule
+                        if !x.is_finite() || x.abs() > MAX_LENGTH_MM || is_length {
+                            assert!(
+                                e.0.iter().any(|e| e.path == p),
+                                "{name}: {p} = {x}: no error names it:{}",
+                                listing(&e.0)
+                            );
+                        }
+                        assert!(e.0.iter().all(|e| !e.path.is_empty() && !e.rule.is_empty()));
+                        refused += 1;
+                    }
+                    Ok(_) => {
+                        assert!(
+                            x == -1.0 && !is_length,
+                            "{name}: {p} = {x} passes validation"
+                        );
+                        // a negative that is valid (an angle, a signed offset) builds closed
+                        // 2-manifolds or is refused by name
+                        match build_kit_bounded(&m, tol, 4_000_000) {
+                            Ok(kit) => {
+                                for part in &kit.parts {
+                                    part.solid
+                                        .mesh()
+                                        .check_closed_manifold()
+                                        .unwrap_or_else(|e| {
+                                            panic!("{name}: {p} = {x}: {}: {e}", part.name)
+                                        });
+                                }
+                                built.push(format!("{name}: {p} = {x}"));
+                            }
+                            Err(e) => panic!("{name}: {p} = {x} validates but fails: {e}"),
+                        }
+                    }
+                }
+            }
+        }
+    }
+    eprintln!(
+        "{fields} numeric fields, {refused} hostile values refused, {} built:\n{}",
+        built.len(),
+        built.join("\n")
+    );
+    assert!(fields >= 100, "{fields}");
+}
+
+/// The errors of `validate` for `d` at the default tolerance (empty when valid).
+fn errors(d: &Design) -> Vec<ParamError> {
+    let materials = MaterialsTable::embedded().unwrap();
+    match stack::validate(d, &materials, ChordTolerance::default()) {
+        Ok(_) => Vec::new(),
+        Err(e) => e.0,
+    }
+}
+
+/// `d` is refused with an error on `path` whose value prints as `value` and whose rule holds
+/// `words`.
+#[track_caller]
+fn assert_refused(d: &Design, path: &str, value: &str, words: &str) {
+    let errs = errors(d);
+    assert!(
+        errs.iter()
+            .any(|e| e.path == path && e.value == value && e.rule.contains(words)),
+        "expected `{path} = {value}: ...{words}...`, got:{}",
+        listing(&errs)
+    );
+}
+
+/// The values that once passed: a ShadowTac backing of NaN, infinite, negative, zero or 1e300
+/// mm (which reached the fabrication sheet), an infinite core, and marker polar limits that are
+/// NaN, negative, beyond the surface or crossed (a bad minimum was reported as a maximum).
+#[test]
+fn values_that_once_passed_are_refused_by_name() {
+    let shadowtac = library::load("shadowtac").unwrap();
+    for (x, value, words) in [
+        (f64::NAN, "NaN", "must be a finite number"),
+        (f64::INFINITY, "inf", "must be a finite number"),
+        (-3.0, "-3", "must be above 0"),
+        (0.0, "0", "must be above 0"),
+        (1e300, "1e300", "at most 1000 mm"),
+    ] {
+        let mut d = shadowtac.clone();
+        d.backing.as_mut().unwrap().thickness_mm = x;
+        assert_refused(&d, "backing.thickness_mm", value, words);
+        let mut d = shadowtac.clone();
+        d.backing.as_mut().unwrap().diameter_mm = x;
+        assert_refused(&d, "backing.diameter_mm", value, words);
+    }
+
+    let rtac0 = library::load("rtac0").unwrap();
+    let mut d = rtac0.clone();
+    d.core.as_mut().unwrap().wall_thickness_mm = f64::INFINITY;
+    assert_refused(
+        &d,
+        "core.wall_thickness_mm",
+        "inf",
+        "must be a finite number",
+    );
+    let mut d = rtac0.clone();
+    d.core.as_mut().unwrap().length_mm = f64::INFINITY;
+    assert_refused(&d, "core.length_mm", "inf", "must be a finite number");
+
+    // the dual-modal TacTip's pattern has max_polar_deg 85 on a hemisphere on a cylinder
+    let tactip = library::load("tactip_dualmodal").unwrap();
+    let pat = "layers[0].markers[0].pattern";
+    let with = |max: Option<f64>, min: Option<f64>| {
+        let mut d = tactip.clone();
+        let p = &mut d.layers[0].markers[0].pattern;
+        p.max_polar_deg = max;
+        p.min_polar_deg = min;
+        d
+    };
+    assert!(errors(&with(Some(85.0), None)).is_empty());
+    for (max, min, field, value, words) in [
+        (
+            Some(f64::NAN),
+            None,
+            "max_polar_deg",
+            "NaN",
+            "must be a finite number",
+        ),
+        (
+            Some(720.0),
+            None,
+            "max_polar_deg",
+            "720",
+            "from -360 to 360 deg",
+        ),
+        (
+            Some(-1.0),
+            None,
+            "max_polar_deg",
+            "-1",
+            "above 0 and at most 180 deg",
+        ),
+        (
+            Some(0.0),
+            None,
+            "max_polar_deg",
+            "0",
+            "above 0 and at most 180 deg",
+        ),
+        (
+            Some(200.0),
+            None,
+            "max_polar_deg",
+            "200",
+            "above 0 and at most 180 deg",
+        ),
+        (
+            Some(85.0),
+            Some(-5.0),
+            "min_polar_deg",
+            "-5",
+            "from 0 to below 180 deg",
+        ),
+        (
+            Some(40.0),
+            Some(60.0),
+            "min_polar_deg",
+            "60",
+            "must be below max_polar_deg (40 deg)",
+        ),
+        (
+            None,
+            Some(179.0),
+            "min_polar_deg",
+            "179",
+            "leaves no room for markers",
+        ),
+    ] {
+        assert_refused(&with(max, min), &format!("{pat}.{field}"), value, words);
+    }
+    // beyond the polar range of the surface (a hemisphere on a cylinder ends below 90 deg)
+    let errs = errors(&with(Some(170.0), None));
+    assert!(
+        errs.iter().any(|e| e.path == format!("{pat}.max_polar_deg")
+            && e.value == "170"
+            && e.rule.contains("must be at most the surface's polar range")),
+        "{}",
+        listing(&errs)
+    );
+}
