@@ -14,6 +14,7 @@ use crate::markers::{self, Marker, MarkerSpec, MarkerSurface, PatternStats, Pola
 use crate::molds::{place_posed, with_pose, IDENTITY};
 use crate::schema::{Design, LayerProcess, MoldStrategy, Technology};
 use crate::stack::{ResolvedLayer, Stack};
+use crate::values::MAX_LENGTH_MM;
 use serde_json::json;
 
 /// Markers placed on one surface of a layer.
@@ -52,6 +53,26 @@ fn feature_technology(design: &Design, layer: &crate::schema::Layer) -> Technolo
         LayerProcess::Printed => layer.print_technology.unwrap_or(Technology::Polyjet),
         _ => design.mold.cavity_print_technology,
     }
+}
+
+/// How far inward from the offset surface at `off` a feature may reach before the offset
+/// surface at its end stops being valid ([`crate::profile::BodyProfile::offset_is_valid`]), mm
+/// (bisection; 0 when the surface itself is not valid).
+fn max_inward_reach(design: &Design, off: f64) -> f64 {
+    let body = &design.body;
+    if !body.offset_is_valid(off) {
+        return 0.0;
+    }
+    let (mut lo, mut hi) = (0.0, MAX_LENGTH_MM);
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if body.offset_is_valid(off - mid) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    lo
 }
 
 /// The rim margin of a pattern: one feature diameter plus the printer's minimum wall.
@@ -250,6 +271,24 @@ pub fn marker_errors(design: &Design, l: &ResolvedLayer, tech: Technology) -> Ve
                         l.mold_strategy
                     ),
                 ));
+            continue;
+        }
+        // Features pointing inward must end before the body's centre of curvature: past it
+        // they cross each other and the axis (the offset surface at their ends folds).
+        let off = surface_offset(l, spec.surface);
+        if direction(spec) < 0.0 && !design.body.offset_is_valid(off - f.height_mm) {
+            errs.push(ParamError::new(
+                format!("{path}.feature.height_mm"),
+                f.height_mm,
+                format!(
+                    "must be below {:.3} mm: the features point inward from the {} surface (offset {off:.3} mm) and must end before the body's centre of curvature, its axis and its base plane",
+                    max_inward_reach(design, off),
+                    match spec.surface {
+                        MarkerSurface::Outer => "outer",
+                        MarkerSurface::Inner => "inner",
+                    }
+                ),
+            ));
             continue;
         }
         if spec.tip_material.is_some()

@@ -294,3 +294,33 @@ fn values_that_once_passed_are_refused_by_name() {
         listing(&errs)
     );
 }
+
+/// Inward features once crossed the axis (30 mm: a mesh error naming no parameter at export) or
+/// passed at 1e20 mm (the exported negative lost its feature holes): each is refused by name,
+/// with the deepest reach the body allows.
+#[test]
+fn inward_features_end_before_the_centre_of_curvature() {
+    // the dual-modal TacTip's pins point inward from the skin's inner surface (R12.5)
+    let tactip = library::load("tactip_dualmodal").unwrap();
+    let path = "layers[0].markers[0].feature.height_mm";
+    for (h, value, words) in [
+        (
+            30.0,
+            "30",
+            "must be below 12.500 mm: the features point inward from the inner surface",
+        ),
+        (12.5, "12.5", "must be below 12.500 mm"),
+        (1e20, "1e20", "at most 1000 mm"),
+    ] {
+        let mut d = tactip.clone();
+        d.layers[0].markers[0].feature.height_mm = h;
+        assert_refused(&d, path, value, words);
+    }
+    let mut d = tactip.clone();
+    d.layers[0].markers[0].feature.height_mm = 6.0;
+    assert!(
+        errors(&d).iter().all(|e| e.path != path),
+        "{}",
+        listing(&errors(&d))
+    );
+}

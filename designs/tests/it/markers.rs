@@ -1452,13 +1452,13 @@ fn converging_pins() -> Design {
     };
     d.layers[0].thickness_mm = Some(1.0);
     d.layers[0].markers[0].tip_material = None;
-    d.layers[0].markers[0].feature.height_mm = 5.0;
+    d.layers[0].markers[0].feature.height_mm = 4.0;
     d.layers[0].markers[0].pattern.spacing_mm = Some(1.7);
     d
 }
 
-/// Features pointing into a convex surface converge. Pins 5 mm long on the 5 mm inner
-/// surface of a small TacTip-like shell meet at the axis; `validate` accepts them (it checks
+/// Features pointing into a convex surface converge. Pins 4 mm long on the 5 mm inner
+/// surface of a small TacTip-like shell meet near the axis (1 mm short of the centre); `validate` accepts them (it checks
 /// their spacing on the surface only), and `layers.rs` puts them into one `Solid::compose`,
 /// which requires disjoint solids: the result double-counts the overlaps instead of
 /// uniting them.
