@@ -187,3 +187,95 @@ fn check_one(x: f64, path: &str, unit: Unit, signed: bool, errs: &mut NumberErro
     };
     errs.unusable.push(ParamError::new(path, shown(x), rule));
 }
+
+/// One step into a serialized value: a field or map key, or a list index.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Step {
+    Key(String),
+    Index(usize),
+}
+
+/// Where one number sits in a serialized value; prints as the error paths do
+/// (`layers[0].markers[0].pattern.spacing_mm`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct NumberPath(pub Vec<Step>);
+
+impl std::fmt::Display for NumberPath {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        for (i, st) in self.0.iter().enumerate() {
+            match st {
+                Step::Key(k) if i == 0 => write!(f, "{k}")?,
+                Step::Key(k) => write!(f, ".{k}")?,
+                Step::Index(n) => write!(f, "[{n}]")?,
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The path of every floating-point number of `value` as serialized (the numbers
+/// [`check_numbers`] checks), leaving out the top-level maps named in `skip` (a design's
+/// `presets`, paths into its own fields). For tools and tests that vary every parameter.
+///
+/// # Errors
+/// The serializer's message (a schema type does not fail).
+pub fn number_paths<T: Serialize + ?Sized>(
+    value: &T,
+    skip: &[&str],
+) -> Result<Vec<NumberPath>, String> {
+    fn walk(v: &Value, path: &mut Vec<Step>, skip: &[&str], out: &mut Vec<NumberPath>) {
+        match v {
+            Value::F64(_) | Value::F32(_) => out.push(NumberPath(path.clone())),
+            Value::Option(Some(x)) | Value::Newtype(x) => walk(x, path, skip, out),
+            Value::Seq(items) => {
+                for (i, x) in items.iter().enumerate() {
+                    path.push(Step::Index(i));
+                    walk(x, path, skip, out);
+                    path.pop();
+                }
+            }
+            Value::Map(m) => {
+                for (k, x) in m {
+                    let Value::String(k) = k else { continue };
+                    if path.is_empty() && skip.contains(&k.as_str()) {
+                        continue;
+                    }
+                    path.push(Step::Key(k.clone()));
+                    walk(x, path, skip, out);
+                    path.pop();
+                }
+            }
+            _ => {}
+        }
+    }
+    let v = serde_value::to_value(value).map_err(|e| e.to_string())?;
+    let mut out = Vec::new();
+    walk(&v, &mut Vec::new(), skip, &mut out);
+    Ok(out)
+}
+
+/// `value` with the number at `path` (from [`number_paths`]) set to `x`, any `f64` (NaN
+/// included), read back through the type's own deserializer.
+///
+/// # Errors
+/// A path that does not lead to a value, or the deserializer's message.
+pub fn with_number<T: Serialize + serde::de::DeserializeOwned>(
+    value: &T,
+    path: &NumberPath,
+    x: f64,
+) -> Result<T, String> {
+    fn leaf<'a>(v: &'a mut Value, path: &[Step]) -> Option<&'a mut Value> {
+        let Some((first, rest)) = path.split_first() else {
+            return Some(v);
+        };
+        match (first, v) {
+            (_, Value::Option(Some(x))) | (_, Value::Newtype(x)) => leaf(x, path),
+            (Step::Key(k), Value::Map(m)) => leaf(m.get_mut(&Value::String(k.clone()))?, rest),
+            (Step::Index(i), Value::Seq(items)) => leaf(items.get_mut(*i)?, rest),
+            _ => None,
+        }
+    }
+    let mut v = serde_value::to_value(value).map_err(|e| e.to_string())?;
+    *leaf(&mut v, &path.0).ok_or_else(|| format!("no number at {path}"))? = Value::F64(x);
+    T::deserialize(v).map_err(|e| e.to_string())
+}
