@@ -102,6 +102,8 @@ struct Csv<'a> {
 }
 
 fn parse_csv<'a>(text: &'a str, file: &'a str) -> Result<Csv<'a>, TableError> {
+    // a spreadsheet's "CSV UTF-8" starts with a byte order mark
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut header: Option<(usize, Vec<String>)> = None;
     let mut rows = Vec::new();
     for (i, line) in text.lines().enumerate() {

@@ -350,19 +350,27 @@ pub fn check_housing_params(
             "must fit on the camera board",
         ));
     }
-    if h.camera.mount_pilot_diameter_mm < fdm.min_hole_diameter_mm
-        || h.joint_screw.pilot_diameter_mm < fdm.min_hole_diameter_mm
-    {
-        errs.push(ParamError::new(
+    // each printed pilot hole under its own path
+    for (path, d) in [
+        (
+            "housing.camera.mount_pilot_diameter_mm",
+            h.camera.mount_pilot_diameter_mm,
+        ),
+        (
             "housing.joint_screw.pilot_diameter_mm",
-            h.joint_screw
-                .pilot_diameter_mm
-                .min(h.camera.mount_pilot_diameter_mm),
-            format!(
-                "below the minimum hole {} mm of printer profile 'fdm'",
-                fdm.min_hole_diameter_mm
-            ),
-        ));
+            h.joint_screw.pilot_diameter_mm,
+        ),
+    ] {
+        if d < fdm.min_hole_diameter_mm {
+            errs.push(ParamError::new(
+                path,
+                d,
+                format!(
+                    "below the minimum hole {} mm of printer profile 'fdm'",
+                    fdm.min_hole_diameter_mm
+                ),
+            ));
+        }
     }
     match h.style {
         HousingStyle::SquareSplit => {

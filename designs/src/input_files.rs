@@ -175,13 +175,18 @@ pub fn read_regular_file(path: &Path, max_bytes: u64) -> std::io::Result<Vec<u8>
     })
 }
 
-/// [`read_regular_file`] as UTF-8 text.
+/// [`read_regular_file`] as UTF-8 text, without the byte order mark a spreadsheet's "CSV
+/// UTF-8" or an editor may put first (the same text as without one).
 ///
 /// # Errors
 /// As [`read_regular_file`], and one of kind `InvalidData` (`is not UTF-8 text`).
 pub fn read_text_file(path: &Path, max_bytes: u64) -> std::io::Result<String> {
-    String::from_utf8(read_regular_file(path, max_bytes)?)
-        .map_err(|_| std::io::Error::new(std::io::ErrorKind::InvalidData, "is not UTF-8 text"))
+    let mut text = String::from_utf8(read_regular_file(path, max_bytes)?)
+        .map_err(|_| std::io::Error::new(std::io::ErrorKind::InvalidData, "is not UTF-8 text"))?;
+    if text.starts_with('\u{feff}') {
+        text.drain(..'\u{feff}'.len_utf8());
+    }
+    Ok(text)
 }
 
 /// Reads a YAML input file the user named: a design, a sweep file, fixture parameters (regular

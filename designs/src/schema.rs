@@ -628,12 +628,17 @@ impl Design {
     }
 }
 
-/// Parses `polar_deg, azimuth_deg` rows.
+/// Parses `polar_deg, azimuth_deg` rows. A first line that is not numeric is a header, `#`
+/// starts a comment, and a UTF-8 byte order mark (spreadsheet "CSV UTF-8") is skipped.
 ///
 /// # Errors
-/// [`DesignError::Yaml`] with `origin:line` and the rule.
+/// [`DesignError::Yaml`] with `origin:line` and the rule for every malformed row (the first
+/// [`MAX_REPORTED_ROWS`] listed, then how many more).
 pub fn parse_angle_csv(text: &str, origin: &str) -> Result<Vec<[f64; 2]>, DesignError> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut out = Vec::new();
+    let mut bad = Vec::new();
+    let mut seen_row = false;
     for (n, line) in text.lines().enumerate() {
         let line = line.split('#').next().unwrap_or("").trim();
         if line.is_empty() {
@@ -643,20 +648,35 @@ pub fn parse_angle_csv(text: &str, origin: &str) -> Result<Vec<[f64; 2]>, Design
         let nums: Vec<Option<f64>> = cols.iter().map(|c| c.parse::<f64>().ok()).collect();
         match nums.as_slice() {
             [Some(p), Some(a)] => out.push([*p, *a]),
-            _ if out.is_empty() && nums.iter().all(Option::is_none) => {} // header
+            _ if !seen_row && nums.iter().all(Option::is_none) => {} // header
             _ => {
                 // At most 40 characters of the row: enough to see the mistake.
                 let shown: String = line.chars().take(40).collect();
                 let more = if shown.len() < line.len() { "..." } else { "" };
-                return Err(DesignError::Yaml(format!(
+                bad.push(format!(
                     "{origin}:{}: expected two numbers `polar_deg, azimuth_deg`, found `{shown}{more}`",
                     n + 1
-                )));
+                ));
             }
         }
+        seen_row = true;
     }
-    Ok(out)
+    if bad.is_empty() {
+        return Ok(out);
+    }
+    let n_bad = bad.len();
+    bad.truncate(MAX_REPORTED_ROWS);
+    if n_bad > MAX_REPORTED_ROWS {
+        bad.push(format!(
+            "{origin}: and {} more malformed rows",
+            n_bad - MAX_REPORTED_ROWS
+        ));
+    }
+    Err(DesignError::Yaml(bad.join("\n")))
 }
+
+/// Malformed rows of a table listed in one error; the rest are counted.
+pub const MAX_REPORTED_ROWS: usize = 20;
 
 /// The value at a parameter path like `layers[0].markers[0].pattern.rings` (also
 /// `layers.0.markers.0...`). A missing last key of an existing object is created (an optional

@@ -130,3 +130,38 @@ fn capture_files_follow_the_plan_and_a_repeated_pin_is_averaged() {
     );
     assert!(bad("capture,id,ring\n1,0,0\n1,0,0\n").contains("id 0 is given twice"));
 }
+
+/// A point table and an observation table saved as spreadsheet "CSV UTF-8" (a byte order mark
+/// first) read like the same tables without one (they failed with "no column 'id'").
+#[test]
+fn tables_with_a_byte_order_mark_read_as_without() {
+    use fabkit_calibration::tables::{read_observations, read_point_table};
+    let dir = tempfile::tempdir().unwrap();
+    let obs = "id,u_px,v_px\n0,320.5,240.25\n1,400,250\n";
+    for (name, text) in [
+        ("pins.csv", FIXTURES),
+        ("pins_bom.csv", &format!("\u{feff}{FIXTURES}")),
+        ("obs.csv", obs),
+        ("obs_bom.csv", &format!("\u{feff}{obs}")),
+    ] {
+        std::fs::write(dir.path().join(name), text).unwrap();
+    }
+    let p = |n: &str| dir.path().join(n);
+    let plain = read_point_table(&p("pins.csv"), PointsFrom::Tip).unwrap();
+    let bom = read_point_table(&p("pins_bom.csv"), PointsFrom::Tip).unwrap();
+    assert_eq!(plain.rows.len(), 2);
+    assert_eq!(
+        plain.rows.iter().map(|r| (&r.0, r.1)).collect::<Vec<_>>(),
+        bom.rows.iter().map(|r| (&r.0, r.1)).collect::<Vec<_>>()
+    );
+    let plain = read_observations(&[p("obs.csv").as_path()]).unwrap();
+    let bom = read_observations(&[p("obs_bom.csv").as_path()]).unwrap();
+    assert_eq!(plain.rows.len(), 2);
+    assert_eq!(
+        plain.rows.iter().map(|r| (&r.0, r.1)).collect::<Vec<_>>(),
+        bom.rows.iter().map(|r| (&r.0, r.1)).collect::<Vec<_>>()
+    );
+    // parsed from text too
+    let t = parse_point_table(&format!("\u{feff}{FIXTURES}"), "x.csv", PointsFrom::Tip).unwrap();
+    assert_eq!(t.rows.len(), 2);
+}
