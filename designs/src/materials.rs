@@ -63,7 +63,7 @@ impl MaterialsTable {
     /// # Errors
     /// Only if the embedded file is malformed (a build defect, covered by a test).
     pub fn embedded() -> Result<Self, String> {
-        let t: Self = serde_saphyr::from_str(MATERIALS_YAML)
+        let t: Self = crate::schema::yaml_from_str(MATERIALS_YAML)
             .map_err(|e| format!("designs/materials.yaml: {e}"))?;
         t.check()?;
         Ok(t)

@@ -545,10 +545,13 @@ impl Design {
     ///
     /// # Errors
     /// [`DesignError::Yaml`] with `origin:line:column` for syntax errors, unknown keys,
-    /// wrong types and missing fields.
+    /// wrong types, missing fields, a number or boolean where text is expected and unknown tags
+    /// ([`yaml_options`]); naming the parameter path of a number written quoted.
     pub fn from_yaml(text: &str, origin: &str) -> Result<Design, DesignError> {
-        serde_saphyr::from_str::<Design>(text)
-            .map_err(|e| DesignError::Yaml(yaml_error(origin, &e)))
+        let d =
+            yaml_from_str::<Design>(text).map_err(|e| DesignError::Yaml(yaml_error(origin, &e)))?;
+        refuse_quoted_numbers(&d, text, origin)?;
+        Ok(d)
     }
 }
 
@@ -715,6 +718,51 @@ pub fn value_at<'a>(v: &'a mut serde_json::Value, path: &str) -> Option<&'a mut 
         };
     }
     Some(cur)
+}
+
+/// The YAML reading rules of every fabkit input file (designs, sweeps, fixture parameters): a
+/// scalar is taken as what it is written as, never converted. A number or a boolean where text
+/// is expected (`name: 25`, `description: true`) is refused (quote it); so are YAML 1.1
+/// booleans (`yes`, `on`) and tags fabkit does not know (`!!python/object/apply:...`).
+pub fn yaml_options() -> serde_saphyr::Options {
+    let mut o = serde_saphyr::Options::default();
+    o.no_schema = true;
+    o.strict_booleans = true;
+    o.reject_unsupported_tags = true;
+    o
+}
+
+/// Parses YAML `text` into `T` under [`yaml_options`].
+///
+/// # Errors
+/// The parser's error (with its location; see [`yaml_error`]).
+pub fn yaml_from_str<T: serde::de::DeserializeOwned>(text: &str) -> Result<T, serde_saphyr::Error> {
+    serde_saphyr::from_str_with_options(text, yaml_options())
+}
+
+/// Refuses a number written quoted in `text` (`radius_mm: "15.0"`), which the parser would
+/// convert ([`crate::values::quoted_numbers`]).
+///
+/// # Errors
+/// [`DesignError::Yaml`] naming `origin`, every such parameter path and its text.
+pub fn refuse_quoted_numbers<T: serde::Serialize + ?Sized>(
+    typed: &T,
+    text: &str,
+    origin: &str,
+) -> Result<(), DesignError> {
+    let quoted = crate::values::quoted_numbers(typed, text);
+    if quoted.is_empty() {
+        return Ok(());
+    }
+    Err(DesignError::Yaml(
+        quoted
+            .iter()
+            .map(|(path, s)| {
+                format!("{origin}: {path} = \"{s}\": a number must be written without quotes")
+            })
+            .collect::<Vec<_>>()
+            .join("\n"),
+    ))
 }
 
 /// Formats a serde-saphyr error as `file:line:column: message`.

@@ -75,7 +75,7 @@ fn is_identifier(s: &str) -> bool {
             .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_')
 }
 
-/// Lengths of a design that may be negative ([`crate::values::check_numbers`]): none.
+/// Lengths of a design that may be negative ([`crate::values::check_values`]): none.
 pub const DESIGN_SIGNED_MM: &[&str] = &[];
 
 /// Checks every rule of a design and resolves its stack. Reports every violation at once.
@@ -89,7 +89,7 @@ pub fn validate(
 ) -> Result<Stack, ParamErrors> {
     // Every number finite and within its unit's magnitude first: the rules below compare and
     // compute with them. Negative lengths are reported with the rules below.
-    let numbers = crate::values::check_numbers(design, "", DESIGN_SIGNED_MM);
+    let numbers = crate::values::check_values(design, "", DESIGN_SIGNED_MM);
     if !numbers.unusable.is_empty() {
         return Err(ParamErrors(numbers.unusable));
     }

@@ -1,6 +1,6 @@
-//! Every number of a design or fixture file checked in one place, by the unit its name carries
-//! (`docs/conventions.md`: `_mm`, `_deg`), so that no field can be forgotten: a new field is
-//! checked by its name alone.
+//! Every number and text of a design or fixture file checked in one place, numbers by the unit
+//! their names carry (`docs/conventions.md`: `_mm`, `_deg`), so that no field can be forgotten:
+//! a new field is checked by its name alone.
 //!
 //! The rules, for every floating-point value (integers are typed `u32` / `u64` by the schema
 //! and refused by the parser when out of range):
@@ -10,7 +10,8 @@
 //!   `hole_compensation_mm.fdm`) is at most [`MAX_LENGTH_MM`] and not negative, except the few
 //!   lengths a caller names as signed;
 //! - an angle (`_deg`) is from -[`MAX_ANGLE_DEG`] to [`MAX_ANGLE_DEG`];
-//! - any other number (a ratio such as `waste_allowance`) is within +-[`MAX_PLAIN`].
+//! - any other number (a ratio such as `waste_allowance`) is within +-[`MAX_PLAIN`];
+//! - text (names, descriptions, keys) holds no control characters but line breaks and tabs.
 //!
 //! Each parameter's own range (above 0, below a radius, within a body's polar range) is checked
 //! after these by the validation of the part it builds ([`crate::stack::validate`]).
@@ -44,18 +45,18 @@ fn unit_of(key: &str) -> Option<Unit> {
     }
 }
 
-/// What [`check_numbers`] found, in two kinds.
+/// What [`check_values`] found, in two kinds.
 #[derive(Debug, Clone, Default, PartialEq)]
-pub struct NumberErrors {
-    /// Values no rule can compute with: not finite, or past the unit's magnitude. The caller
-    /// reports these alone, before any other rule.
+pub struct ValueErrors {
+    /// Values no rule can compute with: not finite, or past the unit's magnitude; text with
+    /// control characters. The caller reports these alone, before any other rule.
     pub unusable: Vec<ParamError>,
     /// Negative lengths. The caller reports these beside its own rules, except where one of its
     /// rules already names the same parameter (its rule is the more specific).
     pub negative: Vec<ParamError>,
 }
 
-impl NumberErrors {
+impl ValueErrors {
     /// Whether every number is in range.
     pub fn is_empty(&self) -> bool {
         self.unusable.is_empty() && self.negative.is_empty()
@@ -72,19 +73,19 @@ impl NumberErrors {
     }
 }
 
-/// Checks every floating-point number of `value` (a design, fixture parameters or any part of
-/// them, as serialized) against the rules of the module documentation. `prefix` is the path of
+/// Checks every floating-point number and every text of `value` (a design, fixture parameters
+/// or any part of them, as serialized) against the rules of the module documentation. `prefix` is the path of
 /// `value` in its file (empty for a whole file); `signed_mm` names the length parameters (by
 /// their last key) that may be negative.
 ///
 /// Each error names the value's path (`layers[0].thickness_mm`, `hole_compensation_mm.fdm`),
 /// the value and the rule.
-pub fn check_numbers<T: Serialize + ?Sized>(
+pub fn check_values<T: Serialize + ?Sized>(
     value: &T,
     prefix: &str,
     signed_mm: &[&str],
-) -> NumberErrors {
-    let mut errs = NumberErrors::default();
+) -> ValueErrors {
+    let mut errs = ValueErrors::default();
     match serde_value::to_value(value) {
         Ok(v) => walk(&v, prefix, None, false, signed_mm, &mut errs),
         // Serialize of a schema type does not fail; say so rather than pass silently.
@@ -113,9 +114,10 @@ fn walk(
     unit: Option<Unit>,
     signed: bool,
     signed_mm: &[&str],
-    errs: &mut NumberErrors,
+    errs: &mut ValueErrors,
 ) {
     match v {
+        Value::String(t) => check_text(t, path, errs),
         Value::F64(x) => check_one(*x, path, unit.unwrap_or(Unit::Plain), signed, errs),
         Value::F32(x) => check_one(
             f64::from(*x),
@@ -138,6 +140,7 @@ fn walk(
                     Value::String(s) => s.clone(),
                     other => format!("{other:?}"),
                 };
+                check_text(&key, &join(path, "(key)"), errs);
                 // A key with a unit sets it for everything under it; one without keeps the
                 // parent's (`hole_compensation_mm.fdm`, `bed_size_mm[0]`).
                 let (u, s) = match unit_of(&key) {
@@ -151,6 +154,19 @@ fn walk(
     }
 }
 
+/// Text holds no control characters other than line breaks and tabs: an escape sequence in a
+/// name or a description would reach the fabrication sheet and the terminal.
+fn check_text(t: &str, path: &str, errs: &mut ValueErrors) {
+    if t.chars().any(|c| c.is_control() && c != '\n' && c != '\t') {
+        let path = if path.is_empty() { "(value)" } else { path };
+        errs.unusable.push(ParamError::new(
+            path,
+            format!("{t:?}"),
+            "must not hold control characters (such as terminal escape sequences)",
+        ));
+    }
+}
+
 /// A value as a reader wants it in an error: `1e300`, not 301 digits.
 fn shown(x: f64) -> String {
     if x.is_finite() && x != 0.0 && !(1e-4..1e9).contains(&x.abs()) {
@@ -160,7 +176,7 @@ fn shown(x: f64) -> String {
     }
 }
 
-fn check_one(x: f64, path: &str, unit: Unit, signed: bool, errs: &mut NumberErrors) {
+fn check_one(x: f64, path: &str, unit: Unit, signed: bool, errs: &mut ValueErrors) {
     let path = if path.is_empty() { "(value)" } else { path };
     if !x.is_finite() {
         errs.unusable
@@ -214,7 +230,7 @@ impl std::fmt::Display for NumberPath {
 }
 
 /// The path of every floating-point number of `value` as serialized (the numbers
-/// [`check_numbers`] checks), leaving out the top-level maps named in `skip` (a design's
+/// [`check_values`] checks), leaving out the top-level maps named in `skip` (a design's
 /// `presets`, paths into its own fields). For tools and tests that vary every parameter.
 ///
 /// # Errors
@@ -278,4 +294,57 @@ pub fn with_number<T: Serialize + serde::de::DeserializeOwned>(
     let mut v = serde_value::to_value(value).map_err(|e| e.to_string())?;
     *leaf(&mut v, &path.0).ok_or_else(|| format!("no number at {path}"))? = Value::F64(x);
     T::deserialize(v).map_err(|e| e.to_string())
+}
+
+/// The paths where `typed` (a value as parsed into its schema type) holds a number that its
+/// YAML `text` wrote quoted (`radius_mm: "15.0"`): the parser converts a quoted scalar to the
+/// number the schema expects, which hides a value meant as text or typed in a spreadsheet.
+/// Empty when `text` does not parse as YAML (the schema parse reports that).
+pub fn quoted_numbers<T: Serialize + ?Sized>(typed: &T, text: &str) -> Vec<(String, String)> {
+    // The untyped reading keeps quoted scalars as strings.
+    let Ok(untyped) = serde_saphyr::from_str::<Value>(text) else {
+        return Vec::new();
+    };
+    let Ok(typed) = serde_value::to_value(typed) else {
+        return Vec::new();
+    };
+    fn unwrap(v: &Value) -> &Value {
+        match v {
+            Value::Option(Some(x)) | Value::Newtype(x) => unwrap(x),
+            v => v,
+        }
+    }
+    fn walk(t: &Value, u: &Value, path: &str, out: &mut Vec<(String, String)>) {
+        match (unwrap(t), unwrap(u)) {
+            (
+                Value::F64(_)
+                | Value::F32(_)
+                | Value::U8(_)
+                | Value::U16(_)
+                | Value::U32(_)
+                | Value::U64(_)
+                | Value::I8(_)
+                | Value::I16(_)
+                | Value::I32(_)
+                | Value::I64(_),
+                Value::String(s),
+            ) => out.push((path.to_string(), s.clone())),
+            (Value::Seq(a), Value::Seq(b)) => {
+                for (i, (x, y)) in a.iter().zip(b).enumerate() {
+                    walk(x, y, &format!("{path}[{i}]"), out);
+                }
+            }
+            (Value::Map(a), Value::Map(b)) => {
+                for (k, x) in a {
+                    if let (Value::String(name), Some(y)) = (k, b.get(k)) {
+                        walk(x, y, &join(path, name), out);
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    let mut out = Vec::new();
+    walk(&typed, &untyped, "", &mut out);
+    out
 }

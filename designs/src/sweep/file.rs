@@ -192,7 +192,7 @@ impl SweepSpec {
         rules: &DataFileRules,
     ) -> Result<SweepSpec, SweepError> {
         use sha2::{Digest, Sha256};
-        let raw: RawSweep = serde_saphyr::from_str(text).map_err(|e| SweepError::File {
+        let raw: RawSweep = crate::schema::yaml_from_str(text).map_err(|e| SweepError::File {
             at: String::new(),
             message: yaml_error(origin, &e),
         })?;

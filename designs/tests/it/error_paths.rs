@@ -67,3 +67,96 @@ fn every_bad_row_of_a_point_list_is_reported() {
         parse_angle_csv(plain, "plain.csv").unwrap()
     );
 }
+
+/// Scalars are taken as written: a number or a boolean where text is expected, a quoted number
+/// where a number is expected, a YAML 1.1 boolean and an unknown tag are refused by location or
+/// by path (an integer layer name, a boolean description and a quoted "25" were converted, and
+/// a `!!python/object/apply` tag was ignored).
+#[test]
+fn lenient_scalars_and_unknown_tags_are_refused() {
+    let text = library::yaml("rtac0").unwrap();
+    let first = |from: &str, to: &str| {
+        assert!(text.contains(from), "{from}");
+        text.replacen(from, to, 1)
+    };
+    let layer = text
+        .lines()
+        .find(|l| l.trim_start().starts_with("- name: "))
+        .unwrap();
+    let description = text
+        .lines()
+        .find(|l| l.starts_with("description: "))
+        .unwrap();
+    let radius = text
+        .lines()
+        .find(|l| l.trim_start().starts_with("radius_mm: "))
+        .unwrap();
+    let value = radius.split_whitespace().nth(1).unwrap();
+    for (case, yaml, words) in [
+        (
+            "an integer layer name",
+            first(layer, "  - name: 25"),
+            "The string value [25] must be quoted".to_string(),
+        ),
+        (
+            "a boolean description",
+            first(description, "description: true"),
+            "x.yaml:6:14: The string value [true] must be quoted".into(),
+        ),
+        (
+            "a quoted number",
+            first(radius, &radius.replacen(value, "\"25\"", 1)),
+            "x.yaml: body.radius_mm = \"25\": a number must be written without quotes".into(),
+        ),
+        (
+            "an unknown tag",
+            first(
+                description,
+                "description: !!python/object/apply:os.system [\"ls\"]",
+            ),
+            "unsupported tag `!!python/object/apply:os.system`".into(),
+        ),
+    ] {
+        let e = Design::from_yaml(&yaml, "x.yaml").unwrap_err().to_string();
+        assert!(
+            e.starts_with("x.yaml:") && e.contains(&words),
+            "{case}: {e}"
+        );
+    }
+    // quoted, the same texts are text
+    let quoted = first(layer, "  - name: \"gel25\"");
+    assert!(Design::from_yaml(&quoted, "x.yaml").is_ok());
+}
+
+/// Terminal escape sequences (and any control character but line breaks and tabs) in a text
+/// field are refused by path before anything is built, so they never reach FABRICATION.md.
+#[test]
+fn control_characters_in_text_are_refused_by_path() {
+    let text = library::yaml("rtac0").unwrap();
+    let description = text
+        .lines()
+        .find(|l| l.starts_with("description: "))
+        .unwrap();
+    let yaml = text.replacen(description, "description: \"\\e[2J\\e[31mred\"", 1);
+    let d = Design::from_yaml(&yaml, "x.yaml").unwrap();
+    assert_eq!(d.description, "\u{1b}[2J\u{1b}[31mred");
+    let errs = errors(&d);
+    assert!(
+        errs.len() == 1
+            && errs[0].path == "description"
+            && errs[0].value == "\"\\u{1b}[2J\\u{1b}[31mred\""
+            && errs[0].rule.contains("control characters"),
+        "{errs:?}"
+    );
+    // in a layer's material name too; line breaks are text
+    let mut d = library::load("rtac0").unwrap();
+    d.layers[1].name = "gel\u{7}".into();
+    assert!(
+        errors(&d).iter().any(|e| e.path == "layers[1].name"),
+        "{:?}",
+        errors(&d)
+    );
+    let mut d = library::load("rtac0").unwrap();
+    d.description = "two\nlines\tand a tab".into();
+    assert!(errors(&d).is_empty(), "{:?}", errors(&d));
+}

@@ -4,7 +4,7 @@
 //! Never a panic, an abort or a silent success with a broken mesh.
 
 use fabkit_designs::materials::MaterialsTable;
-use fabkit_designs::values::{check_numbers, number_paths, with_number, MAX_LENGTH_MM};
+use fabkit_designs::values::{check_values, number_paths, with_number, MAX_LENGTH_MM};
 use fabkit_designs::{build_kit_bounded, library, stack, ChordTolerance, Design, ParamError};
 
 fn listing(errs: &[ParamError]) -> String {
@@ -20,7 +20,7 @@ fn every_numeric_field_of_every_library_design_refuses_hostile_values_by_name() 
     let (mut fields, mut refused, mut built) = (0, 0, Vec::new());
     for (name, _) in library::LIBRARY {
         let d = library::load(name).unwrap();
-        assert!(check_numbers(&d, "", &[]).is_empty(), "{name}");
+        assert!(check_values(&d, "", &[]).is_empty(), "{name}");
         // presets are paths into the same fields, checked when applied
         let paths = number_paths(&d, &["presets"]).unwrap();
         assert!(paths.len() >= 20, "{name}: {} numeric fields", paths.len());
