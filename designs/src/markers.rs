@@ -252,7 +252,7 @@ impl Pattern {
                     "polar_step_deg",
                     x.to_string(),
                     &format!(
-                        "applies only to the concentric layouts (layout is {})",
+                        "{NO_EFFECT} on layout {}: it applies only to the concentric layouts",
                         layout_name(self.layout)
                     ),
                 );
@@ -269,7 +269,7 @@ impl Pattern {
                 push(
                     "spacing_mm",
                     sp.to_string(),
-                    "has no effect on concentric_6k (ring k holds 6k markers; its pitch is pitch_arc_mm or polar_step_deg): remove it or use layout concentric",
+                    &format!("{NO_EFFECT} on concentric_6k (ring k holds 6k markers; its pitch is pitch_arc_mm or polar_step_deg): remove it or use layout concentric"),
                 );
             }
             match (self.pitch_arc_mm, self.polar_step_deg) {
@@ -292,7 +292,7 @@ impl Pattern {
                     "ring_azimuth_offset",
                     format!("{off:?}"),
                     &format!(
-                        "applies only to the concentric layouts (layout is {})",
+                        "{NO_EFFECT} on layout {}: it applies only to the concentric layouts",
                         layout_name(self.layout)
                     ),
                 );
@@ -580,6 +580,10 @@ impl Surface {
 /// marker is placed (a golden spiral of 1e8 markers once aborted on an 8.8 GB allocation);
 /// the library's patterns have 85 to 627 markers.
 pub const MAX_MARKERS_PER_PATTERN: usize = 100_000;
+
+/// How the rule of a parameter that the rest of the design ignores begins (a sweep refuses to
+/// vary such a parameter: every variant would be the same).
+pub const NO_EFFECT: &str = "has no effect";
 
 /// Places the markers of `pattern` on `surface`.
 ///

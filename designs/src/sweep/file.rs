@@ -271,7 +271,12 @@ impl SweepSpec {
             at: origin.to_string(),
             message: e.to_string(),
         })?;
-        let mut parameters = Vec::new();
+        let materials =
+            crate::materials::MaterialsTable::embedded().map_err(|e| SweepError::File {
+                at: origin.to_string(),
+                message: e,
+            })?;
+        let mut parameters: Vec<Parameter> = Vec::new();
         for (key, spec) in &raw.vary.value.0 {
             let mut path = key.value.trim().to_string();
             let here = at(origin, key);
@@ -288,6 +293,16 @@ impl SweepSpec {
                     design: base.design.name.clone(),
                     nearest: nearest_paths(&base.design, &path, 3),
                 });
+            }
+            if let Some(other) = parameters.iter().find(|p: &&Parameter| p.path == path) {
+                return Err(file_err(
+                    here,
+                    format!(
+                        "vary: '{}' names {path}, which is varied already (at {}): give each parameter once",
+                        key.value.trim(),
+                        other.at
+                    ),
+                ));
             }
             if path.ends_with(".csv_file") {
                 return Err(file_err(
@@ -311,13 +326,33 @@ impl SweepSpec {
                         design: base.design.name.clone(),
                         nearest: nearest_paths(&base.design, &path, 3),
                     })?;
-                if let Err(e) = serde_json::from_value::<Design>(replaced) {
-                    return Err(SweepError::WrongValue {
-                        at: at(origin, spec),
-                        path: path.clone(),
-                        value: v.to_string(),
-                        message: e.to_string(),
-                    });
+                let variant = match serde_json::from_value::<Design>(replaced) {
+                    Ok(d) => d,
+                    Err(e) => {
+                        return Err(SweepError::WrongValue {
+                            at: at(origin, spec),
+                            path: path.clone(),
+                            value: v.to_string(),
+                            message: e.to_string(),
+                        })
+                    }
+                };
+                // A parameter the rest of the design ignores would give identical variants.
+                if i == 0 {
+                    if let Err(errs) = crate::stack::validate(&variant, &materials, chord_tolerance)
+                    {
+                        if let Some(e) = errs.0.iter().find(|e| {
+                            e.path == path && e.rule.starts_with(crate::markers::NO_EFFECT)
+                        }) {
+                            return Err(file_err(
+                                here.clone(),
+                                format!(
+                                    "vary.{path}: {} (every variant would be the same design)",
+                                    e.rule
+                                ),
+                            ));
+                        }
+                    }
                 }
             }
             parameters.push(Parameter {

@@ -251,7 +251,7 @@ fn polar_step_errors_name_the_path_the_value_and_the_rule() {
             },
             "polar_step_deg",
             "3.9474",
-            &["applies only to the concentric layouts (layout is hex_grid)"],
+            &["has no effect on layout hex_grid: it applies only to the concentric layouts"],
         ),
     ];
     for (what, mutate, field, value, words) in cases {
@@ -443,7 +443,7 @@ fn ring_azimuth_offset_errors_name_the_path_the_value_and_the_rule() {
             },
             "ring_azimuth_offset",
             "Alternate(HalfStep)",
-            &["applies only to the concentric layouts (layout is golden_spiral)"],
+            &["has no effect on layout golden_spiral: it applies only to the concentric layouts"],
         ),
     ];
     for (what, mutate, field, value, words) in cases {

@@ -23,15 +23,20 @@ fn f(v: &Value) -> f64 {
     v.as_f64().unwrap()
 }
 
-/// The id of the library design with the two parameters set directly on the typed design.
+/// The id of the library design (preset `paper_text`: concentric rings by spacing) with the
+/// two parameters set directly on the typed design.
 fn id_of(spacing: f64, height: f64, tol: f64) -> String {
-    let mut d = library::load("shadowtac").unwrap();
+    let mut d = library::load("shadowtac")
+        .unwrap()
+        .with_preset("paper_text")
+        .unwrap();
     d.layers[0].markers[0].pattern.spacing_mm = Some(spacing);
     d.layers[0].markers[0].feature.height_mm = height;
     variant_id(&d, tol)
 }
 
 const GRID: &str = "base: shadowtac
+preset: paper_text
 vary:
   layers[0].markers[0].pattern.spacing_mm: {range: [1.2, 2.0, 0.2]}
   layers[0].markers[0].feature.height_mm: [0.3, 0.4, 0.5, 0.6]
@@ -74,6 +79,7 @@ fn ids_depend_on_the_design_and_tolerance_only() {
     // the vary keys in the other order: other variant order, same ids per point
     let swapped = spec(
         "base: shadowtac
+preset: paper_text
 vary:
   layers[0].markers[0].feature.height_mm: [0.3, 0.4, 0.5, 0.6]
   layers[0].markers[0].pattern.spacing_mm: {list: [1.2, 1.4, 1.6, 1.8, 2.0]}
@@ -101,6 +107,7 @@ vary:
 fn zip_takes_the_lists_in_step() {
     let s = spec(
         "base: shadowtac
+preset: paper_text
 vary:
   layers[0].markers[0].pattern.spacing_mm: [1.4, 1.6, 1.8]
   layers[0].markers[0].feature.height_mm: {range: [0.3, 0.5, 0.1]}
@@ -173,6 +180,7 @@ fn random_draws_distinct_grid_points_reproducibly() {
 fn the_issues_example_with_short_paths_plans_its_grid() {
     let sweep = SweepSpec::parse(
         "base: designs/library/shadowtac.yaml
+preset: paper_text
 vary:
   markers.spacing_mm: {range: [1.2, 2.0, 0.2]}
   markers.feature.height_mm: [0.3, 0.4, 0.5, 0.6]
@@ -193,12 +201,13 @@ outputs: [metrics]
 fn unknown_paths_are_reported_with_the_nearest_and_the_line() {
     // a misspelt short form: no path fits it; the hint gives the full one
     let e = err("base: shadowtac
+preset: paper_text
 vary:
   layers[0].markers[0].pattern.spacing_mm: [1.4]
   markers.feature.height: [0.3, 0.4]
 ");
     assert!(
-        e.starts_with("sweep.yaml:4:3: vary: 'markers.feature.height' is not a parameter path of design 'shadowtac'; nearest: layers[0].markers[0].feature.height_mm"),
+        e.starts_with("sweep.yaml:5:3: vary: 'markers.feature.height' is not a parameter path of design 'shadowtac_paper_text'; nearest: layers[0].markers[0].feature.height_mm"),
         "{e}"
     );
     let e = err("base: shadowtac\nvary:\n  layers[1].thickness_mm: [1]\n");
@@ -317,4 +326,68 @@ fn shards_split_every_nth_variant() {
     for bad in ["3/3", "1", "a/2", "0/0"] {
         assert!(bad.parse::<Shard>().is_err(), "{bad}");
     }
+}
+
+/// A parameter given by its full and by its short path is refused (one of its value lists was
+/// dropped), naming both places in the file.
+#[test]
+fn a_parameter_given_twice_is_refused() {
+    let e = err(
+        "base: shadowtac\nvary:\n  layers[0].markers[0].feature.height_mm: [0.4, 0.5]\n  markers.feature.height_mm: [0.3]\n",
+    );
+    assert!(
+        e.contains("sweep.yaml:4:3: vary: 'markers.feature.height_mm' names layers[0].markers[0].feature.height_mm, which is varied already (at sweep.yaml:3:3)"),
+        "{e}"
+    );
+}
+
+/// A swept parameter that the design ignores is refused before anything runs: ShadowTac's
+/// pattern is concentric_6k, on which `spacing_mm` has no effect (every variant was the same).
+#[test]
+fn a_parameter_the_design_ignores_is_refused() {
+    let e = err("base: shadowtac\nvary:\n  layers[0].markers[0].pattern.spacing_mm: [1.2, 1.4]\n");
+    assert!(
+        e.contains("sweep.yaml:3:3: vary.layers[0].markers[0].pattern.spacing_mm: has no effect on concentric_6k")
+            && e.contains("every variant would be the same design"),
+        "{e}"
+    );
+    // under the preset that lays the pattern out by spacing, it is swept
+    let s = spec(
+        "base: shadowtac\npreset: paper_text\nvary:\n  layers[0].markers[0].pattern.spacing_mm: [1.2, 1.4]\n",
+    );
+    assert_eq!(s.plan().unwrap().variants.len(), 2);
+}
+
+/// The README's sweep example parses, and every parameter it varies changes the design the
+/// variants build: its variants' marker counts differ with the spacing.
+#[test]
+fn the_readme_sweep_example_varies_effective_parameters() {
+    let readme =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../README.md"))
+            .unwrap();
+    let start = readme
+        .find("# dimples.yaml\n")
+        .expect("README sweep example");
+    let end = start + readme[start..].find("```").unwrap();
+    let s = spec(&readme[start..end]);
+    let plan = s.plan().unwrap();
+    let materials = fabkit_designs::materials::MaterialsTable::embedded().unwrap();
+    let spacing = "layers[0].markers[0].pattern.spacing_mm";
+    let mut counts = std::collections::BTreeMap::new();
+    for v in &plan.variants {
+        let d = s.resolve(&v.params).unwrap();
+        let st = fabkit_designs::stack::validate(&d, &materials, s.chord_tolerance).unwrap();
+        let n = fabkit_designs::estimate::estimate(&d, &st, s.chord_tolerance).markers;
+        let at = v
+            .params
+            .iter()
+            .find(|(p, _)| p == spacing)
+            .unwrap()
+            .1
+            .to_string();
+        counts.insert(at, n);
+    }
+    assert!(counts.len() >= 3, "{counts:?}");
+    let distinct: std::collections::BTreeSet<_> = counts.values().collect();
+    assert_eq!(distinct.len(), counts.len(), "{counts:?}");
 }
