@@ -27,7 +27,9 @@ pub use camera_file::{
 };
 pub use extrinsics::{calibrate_extrinsics, ExtrinsicsError, ExtrinsicsJob, ExtrinsicsOutput};
 pub use nalgebra;
-pub use pnp::{solve_pnp, PnpError, PnpOptions, PnpSolution, RansacOptions};
+pub use pnp::{
+    pose_uncertainty, solve_pnp, PnpError, PnpOptions, PnpSolution, PoseUncertainty, RansacOptions,
+};
 pub use report::ExtrinsicsReport;
 pub use tables::{PointsFrom, TableError};
 

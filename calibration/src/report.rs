@@ -78,6 +78,25 @@ pub struct ExtrinsicsReport {
     /// RMS reprojection error over the inliers, px.
     pub rms_reprojection_error_px: f64,
     pub residuals: ResidualReport,
+    /// How well the inliers' geometry fixes the pose ([`crate::pose_uncertainty`]); absent when
+    /// it does not.
+    pub pose_uncertainty: Option<PoseUncertaintyReport>,
+    /// What the user should know about the solution (a weak geometry); empty when nothing.
+    pub warnings: Vec<String>,
+}
+
+/// [`crate::PoseUncertainty`] as reported.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PoseUncertaintyReport {
+    /// What the numbers mean.
+    pub description: String,
+    /// Standard deviation of the rotation about the camera's x, y, z axes per px of pixel
+    /// noise, degrees.
+    pub rotation_std_deg_per_px: [f64; 3],
+    /// Standard deviation of the translation along x, y, z per px of pixel noise, mm.
+    pub translation_std_mm_per_px: [f64; 3],
+    /// Covariance of (rotation perturbation w, rad; translation t, mm) for 1 px of noise, 6 x 6.
+    pub covariance_per_px2: [[f64; 6]; 6],
 }
 
 impl ExtrinsicsReport {
@@ -120,7 +139,54 @@ impl ExtrinsicsReport {
                 inlier: sol.inliers[k],
             });
         }
+        let uncertainty = crate::pose_uncertainty(
+            camera,
+            &pairs.points_mm,
+            &pairs.pixels_px,
+            &sol.inliers,
+            iso,
+        );
+        let mut warnings = Vec::new();
+        let inlier_polar_deg = || {
+            pairs
+                .points_mm
+                .iter()
+                .zip(&sol.inliers)
+                .filter(|(_, &b)| b)
+                .map(|(p, _)| {
+                    (p.z / p.norm().max(1e-12))
+                        .clamp(-1.0, 1.0)
+                        .acos()
+                        .to_degrees()
+                })
+                .fold(0.0f64, f64::max)
+        };
+        match &uncertainty {
+            Some(u) => {
+                let r = u.rotation_std_deg_per_px.iter().copied().fold(0.0, f64::max);
+                let t = u.translation_std_mm_per_px.iter().copied().fold(0.0, f64::max);
+                if r > crate::pnp::WEAK_POSE_DEG_PER_PX || t > crate::pnp::WEAK_POSE_MM_PER_PX {
+                    warnings.push(format!(
+                        "weak geometry: the pose is uncertain by up to {r:.2} deg and {t:.3} mm per px of pixel noise (above {} deg or {} mm; {} pins, the farthest {:.1} deg from the sensor axis): a low RMS does not make it accurate; observe more pins, spread farther from the pole",
+                        crate::pnp::WEAK_POSE_DEG_PER_PX,
+                        crate::pnp::WEAK_POSE_MM_PER_PX,
+                        sol.inliers.iter().filter(|&&b| b).count(),
+                        inlier_polar_deg()
+                    ));
+                }
+            }
+            None => warnings.push(
+                "weak geometry: the pins do not determine the pose (its covariance is singular); observe more pins, spread farther from the pole".into(),
+            ),
+        }
         ExtrinsicsReport {
+            pose_uncertainty: uncertainty.map(|u| PoseUncertaintyReport {
+                description: "First-order covariance of the pose from the reprojection error's Jacobian at the solution, for a pixel noise of 1 px in u and v: multiply the standard deviations by the noise in px (the RMS reprojection error is an estimate of it). w is the rotation of T_cam_sensor perturbed on the left, about the camera axes, rad; t its translation, mm.".into(),
+                rotation_std_deg_per_px: u.rotation_std_deg_per_px,
+                translation_std_mm_per_px: u.translation_std_mm_per_px,
+                covariance_per_px2: u.covariance_per_px2,
+            }),
+            warnings,
             description: "T_cam_sensor maps sensor-frame points (mm; docs/conventions.md) into the camera frame (mm; x right, y down, z forward). rvec/tvec_mm follow OpenCV's solvePnP convention: x_cam = R(rvec) x_sensor + tvec_mm. Pixels: (0, 0) is the centre of the top-left pixel.".into(),
             provenance,
             distortion_model: camera.intrinsics().distortion.name().into(),

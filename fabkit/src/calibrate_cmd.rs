@@ -113,8 +113,15 @@ fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
         "rvec = [{:.6}, {:.6}, {:.6}] rad, tvec_mm = [{:.4}, {:.4}, {:.4}], camera centre in sensor frame = [{:.4}, {:.4}, {:.4}] mm",
         r.rvec[0], r.rvec[1], r.rvec[2], r.tvec_mm[0], r.tvec_mm[1], r.tvec_mm[2], c[0], c[1], c[2]
     );
+    if let Some(u) = &r.pose_uncertainty {
+        let [rx, ry, rz] = u.rotation_std_deg_per_px;
+        let [tx, ty, tz] = u.translation_std_mm_per_px;
+        println!(
+            "pose standard deviation per px of pixel noise: rotation [{rx:.3}, {ry:.3}, {rz:.3}] deg, translation [{tx:.4}, {ty:.4}, {tz:.4}] mm"
+        );
+    }
     println!("wrote {}", a.out.display());
-    for w in warnings {
+    for w in r.warnings.iter().chain(&warnings) {
         eprintln!("warning: {w}");
     }
     Ok(())
