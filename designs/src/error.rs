@@ -59,9 +59,12 @@ pub enum DesignError {
     #[error(transparent)]
     Params(#[from] ParamErrors),
     /// The geometry kernel failed on valid parameters (a fabkit defect: please report it).
-    #[error("building {part}: {source}")]
+    /// `params` are the parameter paths the failing solid was built from (`layers[2]`, `mold`),
+    /// so that the design can be changed around the failure.
+    #[error("building {part}{}: {source}", from_params(params))]
     Geometry {
         part: String,
+        params: Vec<String>,
         #[source]
         source: GeometryError,
     },
@@ -75,6 +78,33 @@ pub enum DesignError {
     UnknownDesign(String),
 }
 
+fn from_params(params: &[String]) -> String {
+    if params.is_empty() {
+        String::new()
+    } else {
+        format!(" (from the parameters {})", params.join(", "))
+    }
+}
+
+impl DesignError {
+    /// The error with the parameter paths the failing solid was built from, when it is a
+    /// kernel error that names none yet; any other error unchanged.
+    pub fn from_params(self, params: &[String]) -> Self {
+        match self {
+            DesignError::Geometry {
+                part,
+                params: p,
+                source,
+            } if p.is_empty() => DesignError::Geometry {
+                part,
+                params: params.to_vec(),
+                source,
+            },
+            e => e,
+        }
+    }
+}
+
 /// Adds the part name to a geometry error.
 pub trait GeometryContext<T> {
     fn part(self, part: &str) -> Result<T, DesignError>;
@@ -84,6 +114,7 @@ impl<T> GeometryContext<T> for Result<T, GeometryError> {
     fn part(self, part: &str) -> Result<T, DesignError> {
         self.map_err(|source| DesignError::Geometry {
             part: part.to_string(),
+            params: Vec::new(),
             source,
         })
     }

@@ -619,6 +619,15 @@ pub fn build_shell(
     stack: &Stack,
     tol: ChordTolerance,
 ) -> Result<(Vec<Part>, ShellLevels), DesignError> {
+    build_shell_parts(design, h, stack, tol).map_err(|e| e.from_params(&["housing".to_string()]))
+}
+
+fn build_shell_parts(
+    design: &Design,
+    h: &HousingParams,
+    stack: &Stack,
+    tol: ChordTolerance,
+) -> Result<(Vec<Part>, ShellLevels), DesignError> {
     let core = stack.core.as_ref().ok_or_else(|| {
         DesignError::Params(crate::error::ParamErrors(vec![ParamError::new(
             "housing",

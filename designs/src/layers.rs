@@ -695,12 +695,31 @@ fn marker_summary(
         .collect()
 }
 
+/// The parameter paths a layer's parts are built from: the layer, and the mold for a cast one.
+fn layer_params(design: &Design, i: usize) -> Vec<String> {
+    let mut p = vec![format!("layers[{i}]")];
+    if design.layers[i].process == LayerProcess::Cast {
+        p.push("mold".into());
+    }
+    p
+}
+
 /// Builds the parts of a cast layer with the `open` or `boundary` strategy, or of a printed
 /// layer.
 ///
 /// # Errors
-/// [`DesignError::Geometry`] if the kernel fails.
+/// [`DesignError::Geometry`] if the kernel fails, naming the parameters (`layers[i]`, and
+/// `mold` for a cast layer).
 pub fn build_layer(
+    design: &Design,
+    stack: &Stack,
+    i: usize,
+    tol: ChordTolerance,
+) -> Result<LayerOutput, DesignError> {
+    build_layer_parts(design, stack, i, tol).map_err(|e| e.from_params(&layer_params(design, i)))
+}
+
+fn build_layer_parts(
     design: &Design,
     stack: &Stack,
     i: usize,

@@ -559,6 +559,21 @@ pub fn build_mold(
     plan: &CastPlan,
     tol: ChordTolerance,
 ) -> Result<MoldOutput, DesignError> {
+    build_mold_parts(design, stack, plan, tol).map_err(|e| {
+        e.from_params(&[
+            format!("layers[{}]", plan.layer),
+            "mold".into(),
+            "core".into(),
+        ])
+    })
+}
+
+fn build_mold_parts(
+    design: &Design,
+    stack: &Stack,
+    plan: &CastPlan,
+    tol: ChordTolerance,
+) -> Result<MoldOutput, DesignError> {
     let layer = &stack.layers[plan.layer];
     let core = stack.core.as_ref().ok_or_else(|| {
         DesignError::Params(crate::error::ParamErrors(vec![ParamError::new(

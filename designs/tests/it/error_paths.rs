@@ -160,3 +160,48 @@ fn control_characters_in_text_are_refused_by_path() {
     d.description = "two\nlines\tand a tab".into();
     assert!(errors(&d).is_empty(), "{:?}", errors(&d));
 }
+
+/// A kernel error names the parameters its solid was built from. Built from designs changed
+/// after validation (the one way to reach the kernel with values it refuses): a printed
+/// layer's features of diameter 0 (spheres of radius 0) and molds with walls drafted 90 deg
+/// (no cavity block left).
+#[test]
+fn kernel_errors_name_the_parameters_of_the_failing_solid() {
+    use fabkit_designs::{layers, molds, DesignError};
+    let tol = ChordTolerance::default();
+    let materials = MaterialsTable::embedded().unwrap();
+    let mut d = library::load("tactip_dualmodal").unwrap();
+    let st = stack::validate(&d, &materials, tol).unwrap();
+    d.layers[0].markers[0].feature.diameter_mm = 0.0;
+    match layers::build_layer(&d, &st, 0, tol) {
+        Err(e @ DesignError::Geometry { .. }) => {
+            let DesignError::Geometry { params, .. } = &e else {
+                unreachable!()
+            };
+            assert_eq!(params, &["layers[0]"]);
+            assert!(
+                e.to_string().contains("(from the parameters layers[0]): "),
+                "{e}"
+            );
+        }
+        other => panic!("{:?}", other.map(|o| o.parts.len())),
+    }
+    let mut d = library::load("rtac0").unwrap();
+    let st = stack::validate(&d, &materials, tol).unwrap();
+    d.mold.draft_angle_deg = 90.0;
+    let plans = molds::cast_plans(&d, &st);
+    let errs: Vec<DesignError> = plans
+        .iter()
+        .filter_map(|p| molds::build_mold(&d, &st, p, tol).err())
+        .collect();
+    assert!(!errs.is_empty());
+    for e in errs {
+        match &e {
+            DesignError::Geometry { params, .. } => {
+                assert!(params.iter().any(|p| p == "mold"), "{e}");
+                assert!(params.iter().any(|p| p.starts_with("layers[")), "{e}");
+            }
+            other => panic!("{other}"),
+        }
+    }
+}
