@@ -5,11 +5,7 @@ use fabkit_designs::materials::MaterialsTable;
 use fabkit_designs::{library, stack, ChordTolerance, Design, ParamError};
 
 fn errors(d: &Design) -> Vec<ParamError> {
-    let materials = MaterialsTable::embedded().unwrap();
-    match stack::validate(d, &materials, ChordTolerance::default()) {
-        Ok(_) => Vec::new(),
-        Err(e) => e.0,
-    }
+    crate::common::validation_errors(d)
 }
 
 /// The camera's mount pilots and the joint screw's pilots are separate holes: a camera pilot

@@ -11,32 +11,25 @@ use fabkit_designs::{build_kit, library, stack, ChordTolerance, DesignError};
 fn estimate_is_within_a_small_factor_of_every_library_kit() {
     let materials = MaterialsTable::embedded().unwrap();
     let mut checked = 0;
-    for (name, _) in library::LIBRARY {
-        let base = library::load(name).unwrap();
-        let mut designs = vec![base.clone()];
-        for p in base.presets.keys() {
-            designs.push(base.with_preset(p).unwrap());
-        }
-        for d in designs {
-            for mm in [0.01, 0.05] {
-                let tol = ChordTolerance::new(mm).unwrap();
-                let st = stack::validate(&d, &materials, tol).unwrap();
-                let e = estimate(&d, &st, tol);
-                let kit = build_kit(&d, tol).unwrap();
-                let actual: usize = kit.parts.iter().map(|p| p.solid.triangle_count()).sum();
-                let ratio = e.triangles as f64 / actual as f64;
-                assert!(
-                    (0.8..=2.5).contains(&ratio),
-                    "{} at {mm} mm: estimate {} vs {actual} triangles ({ratio:.2})",
-                    d.name,
-                    e.triangles
-                );
-                let placed: u64 = kit.summary["markers"]
-                    .as_array()
-                    .map_or(0, |a| a.iter().map(|m| m["count"].as_u64().unwrap()).sum());
-                assert_eq!(e.markers, placed, "{}", d.name);
-                checked += 1;
-            }
+    for d in crate::common::library_designs_and_presets() {
+        for mm in [0.01, 0.05] {
+            let tol = ChordTolerance::new(mm).unwrap();
+            let st = stack::validate(&d, &materials, tol).unwrap();
+            let e = estimate(&d, &st, tol);
+            let kit = build_kit(&d, tol).unwrap();
+            let actual: usize = kit.parts.iter().map(|p| p.solid.triangle_count()).sum();
+            let ratio = e.triangles as f64 / actual as f64;
+            assert!(
+                (0.8..=2.5).contains(&ratio),
+                "{} at {mm} mm: estimate {} vs {actual} triangles ({ratio:.2})",
+                d.name,
+                e.triangles
+            );
+            let placed: u64 = kit.summary["markers"]
+                .as_array()
+                .map_or(0, |a| a.iter().map(|m| m["count"].as_u64().unwrap()).sum());
+            assert_eq!(e.markers, placed, "{}", d.name);
+            checked += 1;
         }
     }
     assert!(checked >= 20, "{checked} kits");

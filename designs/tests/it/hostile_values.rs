@@ -80,11 +80,7 @@ fn every_numeric_field_of_every_library_design_refuses_hostile_values_by_name() 
 
 /// The errors of `validate` for `d` at the default tolerance (empty when valid).
 fn errors(d: &Design) -> Vec<ParamError> {
-    let materials = MaterialsTable::embedded().unwrap();
-    match stack::validate(d, &materials, ChordTolerance::default()) {
-        Ok(_) => Vec::new(),
-        Err(e) => e.0,
-    }
+    crate::common::validation_errors(d)
 }
 
 /// `d` is refused with an error on `path` whose value prints as `value` and whose rule holds

@@ -565,48 +565,39 @@ fn printable_with_and_validation_agree_on_every_library_design() {
     let tol = ChordTolerance::default();
     let materials = MaterialsTable::embedded().unwrap();
     let mut checked = 0;
-    for (name, _) in library::LIBRARY {
-        let base = library::load(name).unwrap();
-        let mut designs = vec![base.clone()];
-        for p in base.presets.keys() {
-            designs.push(base.with_preset(p).unwrap());
-        }
-        for d in designs {
-            let stack = validate(&d, &materials, tol).unwrap();
-            for l in &stack.layers {
-                for j in 0..d.layers[l.index].markers.len() {
-                    let listed = fabkit_designs::layers::printable_with(&d, l, j);
-                    let own = format!("layers[{}].markers[{j}]", l.index);
-                    let shared = format!("layers[{}].markers", l.index);
-                    for tech in [Technology::Fdm, Technology::Sla, Technology::Polyjet] {
-                        let mut m = d.clone();
-                        match m.layers[l.index].process {
-                            LayerProcess::Printed => {
-                                m.layers[l.index].print_technology = Some(tech)
-                            }
-                            _ => m.mold.cavity_print_technology = tech,
-                        }
-                        let pattern_errors: Vec<ParamError> = match validate(&m, &materials, tol) {
-                            Ok(_) => Vec::new(),
-                            Err(e) => {
-                                e.0.into_iter()
-                                    .filter(|e| {
-                                        e.path == own
-                                            || e.path.starts_with(&format!("{own}."))
-                                            || e.path == shared
-                                    })
-                                    .collect()
-                            }
-                        };
-                        assert_eq!(
-                            listed.contains(&tech),
-                            pattern_errors.is_empty(),
-                            "{} {own} on {tech:?}: printable_with {listed:?}, validation:{}",
-                            d.name,
-                            listing(&pattern_errors)
-                        );
-                        checked += 1;
+    for d in crate::common::library_designs_and_presets() {
+        let stack = validate(&d, &materials, tol).unwrap();
+        for l in &stack.layers {
+            for j in 0..d.layers[l.index].markers.len() {
+                let listed = fabkit_designs::layers::printable_with(&d, l, j);
+                let own = format!("layers[{}].markers[{j}]", l.index);
+                let shared = format!("layers[{}].markers", l.index);
+                for tech in [Technology::Fdm, Technology::Sla, Technology::Polyjet] {
+                    let mut m = d.clone();
+                    match m.layers[l.index].process {
+                        LayerProcess::Printed => m.layers[l.index].print_technology = Some(tech),
+                        _ => m.mold.cavity_print_technology = tech,
                     }
+                    let pattern_errors: Vec<ParamError> = match validate(&m, &materials, tol) {
+                        Ok(_) => Vec::new(),
+                        Err(e) => {
+                            e.0.into_iter()
+                                .filter(|e| {
+                                    e.path == own
+                                        || e.path.starts_with(&format!("{own}."))
+                                        || e.path == shared
+                                })
+                                .collect()
+                        }
+                    };
+                    assert_eq!(
+                        listed.contains(&tech),
+                        pattern_errors.is_empty(),
+                        "{} {own} on {tech:?}: printable_with {listed:?}, validation:{}",
+                        d.name,
+                        listing(&pattern_errors)
+                    );
+                    checked += 1;
                 }
             }
         }
