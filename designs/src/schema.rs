@@ -758,11 +758,39 @@ pub fn refuse_quoted_numbers<T: serde::Serialize + ?Sized>(
         quoted
             .iter()
             .map(|(path, s)| {
-                format!("{origin}: {path} = \"{s}\": a number must be written without quotes")
+                let at = quoted_at(text, path, s)
+                    .map(|(l, c)| format!(":{l}:{c}"))
+                    .unwrap_or_default();
+                format!("{origin}{at}: {path} = \"{s}\": a number must be written without quotes")
             })
             .collect::<Vec<_>>()
             .join("\n"),
     ))
+}
+
+/// Line and column (from 1) of the quoted value `s` of the last key of `path` in `text`, when
+/// exactly one line writes that key with that quoted value.
+fn quoted_at(text: &str, path: &str, s: &str) -> Option<(usize, usize)> {
+    let last = path.rsplit('.').next()?;
+    let key = last.split('[').next()?;
+    let hits: Vec<(usize, usize)> = text
+        .lines()
+        .enumerate()
+        .filter_map(|(n, line)| {
+            let t = line.trim_start().trim_start_matches("- ");
+            let rest = t.strip_prefix(key)?.trim_start().strip_prefix(':')?;
+            let value = rest.trim_start();
+            let quoted = [format!("\"{s}\""), format!("'{s}'")];
+            quoted
+                .iter()
+                .any(|q| value.starts_with(q.as_str()))
+                .then(|| (n + 1, line.len() - value.len() + 1))
+        })
+        .collect();
+    match hits.as_slice() {
+        [one] => Some(*one),
+        _ => None,
+    }
 }
 
 /// Formats a serde-saphyr error as `file:line:column: message`.

@@ -102,7 +102,7 @@ fn lenient_scalars_and_unknown_tags_are_refused() {
         (
             "a quoted number",
             first(radius, &radius.replacen(value, "\"25\"", 1)),
-            "x.yaml: body.radius_mm = \"25\": a number must be written without quotes".into(),
+            "x.yaml:11:14: body.radius_mm = \"25\": a number must be written without quotes".into(),
         ),
         (
             "an unknown tag",
