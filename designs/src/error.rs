@@ -61,7 +61,7 @@ pub enum DesignError {
     /// The geometry kernel failed on valid parameters (a fabkit defect: please report it).
     /// `params` are the parameter paths the failing solid was built from (`layers[2]`, `mold`),
     /// so that the design can be changed around the failure.
-    #[error("building {part}{}: {source}", from_params(params))]
+    #[error("building {part}{}: {source}", params_suffix(params))]
     Geometry {
         part: String,
         params: Vec<String>,
@@ -78,7 +78,7 @@ pub enum DesignError {
     UnknownDesign(String),
 }
 
-fn from_params(params: &[String]) -> String {
+fn params_suffix(params: &[String]) -> String {
     if params.is_empty() {
         String::new()
     } else {

@@ -89,7 +89,7 @@ pub fn validate(
 ) -> Result<Stack, ParamErrors> {
     // Every number finite and within its unit's magnitude first: the rules below compare and
     // compute with them. Negative lengths are reported with the rules below.
-    let numbers = crate::values::check_values(design, "", DESIGN_SIGNED_MM);
+    let numbers = crate::values::check_values(design, DESIGN_SIGNED_MM);
     if !numbers.unusable.is_empty() {
         return Err(ParamErrors(numbers.unusable));
     }

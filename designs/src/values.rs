@@ -73,24 +73,19 @@ impl ValueErrors {
     }
 }
 
-/// Checks every floating-point number and every text of `value` (a design, fixture parameters
-/// or any part of them, as serialized) against the rules of the module documentation. `prefix` is the path of
-/// `value` in its file (empty for a whole file); `signed_mm` names the length parameters (by
-/// their last key) that may be negative.
+/// Checks every floating-point number and every text of `value` (a whole design or fixture
+/// parameter file, as serialized) against the rules of the module documentation. `signed_mm`
+/// names the length parameters (by their last key) that may be negative.
 ///
 /// Each error names the value's path (`layers[0].thickness_mm`, `hole_compensation_mm.fdm`),
 /// the value and the rule.
-pub fn check_values<T: Serialize + ?Sized>(
-    value: &T,
-    prefix: &str,
-    signed_mm: &[&str],
-) -> ValueErrors {
+pub fn check_values<T: Serialize + ?Sized>(value: &T, signed_mm: &[&str]) -> ValueErrors {
     let mut errs = ValueErrors::default();
     match serde_value::to_value(value) {
-        Ok(v) => walk(&v, prefix, None, false, signed_mm, &mut errs),
+        Ok(v) => walk(&v, "", None, false, signed_mm, &mut errs),
         // Serialize of a schema type does not fail; say so rather than pass silently.
         Err(e) => errs.unusable.push(ParamError::new(
-            if prefix.is_empty() { "(file)" } else { prefix },
+            "(file)",
             "?",
             format!("cannot be read as numbers: {e}"),
         )),

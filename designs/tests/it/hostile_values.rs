@@ -20,7 +20,7 @@ fn every_numeric_field_of_every_library_design_refuses_hostile_values_by_name() 
     let (mut fields, mut refused, mut built) = (0, 0, Vec::new());
     for (name, _) in library::LIBRARY {
         let d = library::load(name).unwrap();
-        assert!(check_values(&d, "", &[]).is_empty(), "{name}");
+        assert!(check_values(&d, &[]).is_empty(), "{name}");
         // presets are paths into the same fields, checked when applied
         let paths = number_paths(&d, &["presets"]).unwrap();
         assert!(paths.len() >= 20, "{name}: {} numeric fields", paths.len());
