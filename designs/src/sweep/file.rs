@@ -170,7 +170,8 @@ impl SweepSpec {
     /// Every value of every parameter is set into the base design and the design is checked
     /// against the schema, so that a wrong type is found before anything runs. Whether a
     /// combination of values makes a feasible design is not checked here: an infeasible
-    /// variant is a result.
+    /// variant is a result. A parameter the design ignores is refused
+    /// ([`SweepSpec::refuse_ignored_parameters`]: a few of its values are built).
     ///
     /// # Errors
     /// [`SweepError::File`] (YAML syntax, unknown keys, bad `range`, zip lists of different
@@ -379,7 +380,7 @@ impl SweepSpec {
             .iter()
             .map(|b| format!("{b:02x}"))
             .collect();
-        Ok(SweepSpec {
+        let spec = SweepSpec {
             origin: origin.to_string(),
             sha256,
             base,
@@ -390,7 +391,9 @@ impl SweepSpec {
             seed: raw.seed.map(|s| s.value).unwrap_or(0),
             count: raw.count.map(|c| c.value),
             files,
-        })
+        };
+        spec.refuse_ignored_parameters(&materials)?;
+        Ok(spec)
     }
 }
 

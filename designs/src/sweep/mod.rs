@@ -24,6 +24,7 @@
 //! The export crate depends on this one, so files are written through a [`KitWriter`] that
 //! the caller (the CLI) provides.
 
+mod effect;
 mod file;
 mod merge;
 mod metrics;
@@ -32,6 +33,7 @@ mod plan;
 mod results;
 mod run;
 
+pub use effect::{MAX_CONTEXT_VALUES, MAX_PROBED_VALUES, PROBE_CHORD_TOLERANCE_MM};
 pub use file::{values_of, FileOutputs, Mode, Output, Parameter, SweepSpec};
 pub use merge::{merge, MergeSummary};
 pub use metrics::{

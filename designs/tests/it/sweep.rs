@@ -391,3 +391,66 @@ fn the_readme_sweep_example_varies_effective_parameters() {
     let distinct: std::collections::BTreeSet<_> = counts.values().collect();
     assert_eq!(distinct.len(), counts.len(), "{counts:?}");
 }
+
+/// Any swept parameter whose values all build the same kit is refused, with the reason when it
+/// is a known switch: the round tube under the square housing, the mold of a printed skin, the
+/// draft of a master-strategy mold box on a two-piece mold, the top piece of a two-piece mold
+/// on an open one. Where the design uses it, or under a swept switch that turns it on, the
+/// parameter is accepted.
+#[test]
+fn a_parameter_no_value_of_which_changes_the_kit_is_refused() {
+    let e =
+        err("base: rtac0\npreset: square_split\nvary:\n  housing.round_tube.height_mm: [24, 26]\n");
+    assert!(
+        e.starts_with("sweep.yaml:4:3: vary.housing.round_tube.height_mm: has no effect on design 'rtac0_square_split' (it applies only with housing.style: round_tube): the values 24, 26 give the same parts"),
+        "{e}"
+    );
+    assert!(e.contains("every variant would be the same design"), "{e}");
+    let e = err("base: tactip_dualmodal\nvary:\n  mold.wall_thickness_mm: [3, 4, 5]\n");
+    assert!(
+        e.contains("sweep.yaml:3:3: vary.mold.wall_thickness_mm: has no effect on design 'tactip_dualmodal' (no layer is cast, so no mold is built): the values 3, 4, 5"),
+        "{e}"
+    );
+    let e = err("base: shadowtac\nvary:\n  mold.draft_angle_deg: [1, 3]\n");
+    assert!(
+        e.contains("sweep.yaml:3:3: vary.mold.draft_angle_deg: has no effect on design 'shadowtac': the values 1, 3"),
+        "{e}"
+    );
+    // the same parameters where the design uses them
+    // (each variant builds, so the probes did not accept them for want of a result)
+    let s = spec("base: rtac0\nvary:\n  housing.round_tube.height_mm: [24, 26]\n");
+    let v = volumes(&s);
+    assert!((v[0] - v[1]).abs() > 1.0, "{v:?}");
+    let s = spec(
+        "base: shadowtac\npreset: open_mold\nvary:\n  mold.strategy: [open, two_piece_open]\n  mold.two_piece.reservoir_height_mm: [14, 16]\n",
+    );
+    let v = volumes(&s);
+    assert_eq!(v.len(), 4);
+    assert!(
+        (v[0] - v[1]).abs() < 1e-9 && (v[2] - v[3]).abs() > 1.0,
+        "{v:?}"
+    );
+    let e = err("base: shadowtac\npreset: open_mold\nvary:\n  mold.two_piece.reservoir_height_mm: [14, 16]\n");
+    assert!(
+        e.contains("sweep.yaml:4:3: vary.mold.two_piece.reservoir_height_mm: has no effect on design 'shadowtac_open_mold' (it applies only to layers cast with mold strategy two_piece_open)"),
+        "{e}"
+    );
+}
+
+/// The total part volume of each variant of `s`, mm^3, built at 0.05 mm; panics unless every
+/// variant builds.
+fn volumes(s: &SweepSpec) -> Vec<f64> {
+    let materials = fabkit_designs::materials::MaterialsTable::embedded().unwrap();
+    let tol = fabkit_designs::ChordTolerance::new(0.05).unwrap();
+    s.plan()
+        .unwrap()
+        .variants
+        .iter()
+        .map(
+            |v| match evaluate(&s.resolve(&v.params).unwrap(), &materials, tol) {
+                Outcome::Ok { metrics, .. } => metrics.parts.iter().map(|p| p.volume_mm3).sum(),
+                other => panic!("{:?}: {other:?}", v.params),
+            },
+        )
+        .collect()
+}
