@@ -744,7 +744,8 @@ pub fn yaml_from_str<T: serde::de::DeserializeOwned>(text: &str) -> Result<T, se
 /// convert ([`crate::values::quoted_numbers`]).
 ///
 /// # Errors
-/// [`DesignError::Yaml`] naming `origin`, every such parameter path and its text.
+/// [`DesignError::Yaml`] naming every such value at its `origin:line:column`
+/// ([`yaml_location`]), with its parameter path and text.
 pub fn refuse_quoted_numbers<T: serde::Serialize + ?Sized>(
     typed: &T,
     text: &str,
@@ -758,7 +759,7 @@ pub fn refuse_quoted_numbers<T: serde::Serialize + ?Sized>(
         quoted
             .iter()
             .map(|(path, s)| {
-                let at = quoted_at(text, path, s)
+                let at = yaml_location(text, path)
                     .map(|(l, c)| format!(":{l}:{c}"))
                     .unwrap_or_default();
                 format!("{origin}{at}: {path} = \"{s}\": a number must be written without quotes")
@@ -768,28 +769,101 @@ pub fn refuse_quoted_numbers<T: serde::Serialize + ?Sized>(
     ))
 }
 
-/// Line and column (from 1) of the quoted value `s` of the last key of `path` in `text`, when
-/// exactly one line writes that key with that quoted value.
-fn quoted_at(text: &str, path: &str, s: &str) -> Option<(usize, usize)> {
-    let last = path.rsplit('.').next()?;
-    let key = last.split('[').next()?;
-    let hits: Vec<(usize, usize)> = text
-        .lines()
-        .enumerate()
-        .filter_map(|(n, line)| {
-            let t = line.trim_start().trim_start_matches("- ");
-            let rest = t.strip_prefix(key)?.trim_start().strip_prefix(':')?;
-            let value = rest.trim_start();
-            let quoted = [format!("\"{s}\""), format!("'{s}'")];
-            quoted
-                .iter()
-                .any(|q| value.starts_with(q.as_str()))
-                .then(|| (n + 1, line.len() - value.len() + 1))
-        })
-        .collect();
-    match hits.as_slice() {
-        [one] => Some(*one),
-        _ => None,
+/// Line and column (from 1) where the YAML node at parameter path `path` (`a.b[2].c`: `.`
+/// between keys, `[i]` for list items) starts in `text`; `None` when the text does not parse
+/// or has no such node.
+pub fn yaml_location(text: &str, path: &str) -> Option<(u64, u64)> {
+    let root: serde_saphyr::Spanned<Node> = serde_saphyr::from_str(text).ok()?;
+    let mut cur = &root;
+    for step in path_steps(path)? {
+        cur = match (&cur.value, step) {
+            (Node::Map(entries), Step::Key(k)) => &entries.iter().find(|(name, _)| *name == k)?.1,
+            (Node::Seq(items), Step::Index(i)) => items.get(i)?,
+            _ => return None,
+        };
+    }
+    Some((cur.referenced.line(), cur.referenced.column()))
+}
+
+enum Step<'a> {
+    Key(&'a str),
+    Index(usize),
+}
+
+/// `a.b[2].c` as keys and indices; `None` for a malformed path.
+fn path_steps(path: &str) -> Option<Vec<Step<'_>>> {
+    let mut out = Vec::new();
+    for part in path.split('.') {
+        let (key, mut rest) = part.split_once('[').map_or((part, ""), |(k, r)| (k, r));
+        if key.is_empty() && out.is_empty() {
+            return None;
+        }
+        if !key.is_empty() {
+            out.push(Step::Key(key));
+        }
+        while !rest.is_empty() {
+            let (i, r) = rest.split_once(']')?;
+            out.push(Step::Index(i.parse().ok()?));
+            rest = r.strip_prefix('[').unwrap_or(r);
+            if !r.is_empty() && !r.starts_with('[') {
+                return None;
+            }
+        }
+    }
+    Some(out)
+}
+
+/// A YAML document with the location of every node: maps keep their keys in order.
+enum Node {
+    Map(Vec<(String, serde_saphyr::Spanned<Node>)>),
+    Seq(Vec<serde_saphyr::Spanned<Node>>),
+    Scalar,
+}
+
+impl<'de> Deserialize<'de> for Node {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        macro_rules! scalar {
+            ($($f:ident: $t:ty),*) => {
+                $(fn $f<E: serde::de::Error>(self, _: $t) -> Result<Node, E> { Ok(Node::Scalar) })*
+            };
+        }
+        impl<'de> serde::de::Visitor<'de> for V {
+            type Value = Node;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("any YAML node")
+            }
+            scalar!(visit_bool: bool, visit_i64: i64, visit_u64: u64, visit_i128: i128,
+                visit_u128: u128, visit_f64: f64, visit_str: &str, visit_bytes: &[u8]);
+            fn visit_unit<E: serde::de::Error>(self) -> Result<Node, E> {
+                Ok(Node::Scalar)
+            }
+            fn visit_none<E: serde::de::Error>(self) -> Result<Node, E> {
+                Ok(Node::Scalar)
+            }
+            fn visit_some<D: serde::Deserializer<'de>>(self, d: D) -> Result<Node, D::Error> {
+                Node::deserialize(d)
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut a: A) -> Result<Node, A::Error> {
+                let mut items = Vec::new();
+                while let Some(x) = a.next_element()? {
+                    items.push(x);
+                }
+                Ok(Node::Seq(items))
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(self, mut m: A) -> Result<Node, A::Error> {
+                let mut entries = Vec::new();
+                while let Some(k) = m.next_key::<serde_json::Value>()? {
+                    let key = match k {
+                        serde_json::Value::String(s) => s,
+                        other => other.to_string(),
+                    };
+                    entries.push((key, m.next_value()?));
+                }
+                Ok(Node::Map(entries))
+            }
+        }
+        d.deserialize_any(V)
     }
 }
 

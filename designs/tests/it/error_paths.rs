@@ -124,6 +124,38 @@ fn lenient_scalars_and_unknown_tags_are_refused() {
     assert!(Design::from_yaml(&quoted, "x.yaml").is_ok());
 }
 
+/// A quoted number is refused at its own file:line:column wherever it is written: the same key
+/// with the same quoted value on several lines (each layer's `thickness_mm: "1.5"`), and in a
+/// flow mapping.
+#[test]
+fn each_quoted_number_is_refused_at_its_own_location() {
+    let text = library::yaml("uvdtact").unwrap();
+    let yaml = text
+        .lines()
+        .map(|l| match l.find("  thickness_mm: ") {
+            Some(i) if l.starts_with("    ") => format!("{}thickness_mm: \"1.5\"", &l[..i + 2]),
+            _ => l.to_string(),
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+        .replace(
+            "  silicone_wall_mm: 4.0",
+            "  silicone_wall_mm: 4.0\n  sprue: {diameter_mm: \"3\"}",
+        );
+    let e = Design::from_yaml(&yaml, "x.yaml").unwrap_err().to_string();
+    let lines: Vec<&str> = e.lines().collect();
+    assert_eq!(
+        lines,
+        [
+            "x.yaml:23:19: layers[0].thickness_mm = \"1.5\": a number must be written without quotes",
+            "x.yaml:37:19: layers[1].thickness_mm = \"1.5\": a number must be written without quotes",
+            "x.yaml:50:19: layers[2].thickness_mm = \"1.5\": a number must be written without quotes",
+            "x.yaml:57:24: mold.sprue.diameter_mm = \"3\": a number must be written without quotes",
+        ],
+        "{e}"
+    );
+}
+
 /// Terminal escape sequences (and any control character but line breaks and tabs) in a text
 /// field are refused by path before anything is built, so they never reach FABRICATION.md.
 #[test]
