@@ -347,18 +347,23 @@ pub fn marker_errors(design: &Design, l: &ResolvedLayer, tech: Technology) -> Ve
             continue;
         }
         let surface = Surface::new(&design.body, surface_offset(l, spec.surface));
-        let placed = match markers::place(
-            &surface,
-            &spec.pattern,
-            rim_margin(spec, profile.min_wall_mm),
-        ) {
+        let margin = rim_margin(spec, profile.min_wall_mm);
+        let placed = match markers::place(&surface, &spec.pattern, margin) {
             Ok(m) => m,
-            Err((field, value, rule)) => {
-                errs.push(ParamError::new(
-                    format!("{path}.pattern.{field}"),
-                    value,
-                    rule,
-                ));
+            Err(first) => {
+                // a point list reports every point that cannot be placed
+                let all = if first.0.starts_with("points[") {
+                    markers::point_errors(&surface, &spec.pattern, margin)
+                } else {
+                    vec![first]
+                };
+                for (field, value, rule) in all {
+                    errs.push(ParamError::new(
+                        format!("{path}.pattern.{field}"),
+                        value,
+                        rule,
+                    ));
+                }
                 continue;
             }
         };

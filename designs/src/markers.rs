@@ -585,22 +585,16 @@ pub const MAX_MARKERS_PER_PATTERN: usize = 100_000;
 /// vary such a parameter: every variant would be the same).
 pub const NO_EFFECT: &str = "has no effect";
 
-/// Places the markers of `pattern` on `surface`.
-///
-/// `rim_margin_mm` keeps marker centres that far (in arc length) from the base plane when no
-/// polar limit is given.
+/// The arc lengths (mm, from the pole) between which `pattern` places its markers on
+/// `surface`: its polar limits, else the pole and the rim less `rim_margin_mm`.
 ///
 /// # Errors
-/// The first violation as (field below `pattern`, value, rule); the caller adds the path.
-/// [`Pattern::field_errors`] lists every violation of the fields themselves.
-pub fn place(
+/// A polar limit beyond the surface, or limits that leave no room.
+fn patterned_arc(
     surface: &Surface,
     pattern: &Pattern,
     rim_margin_mm: f64,
-) -> Result<Vec<Marker>, PatternError> {
-    if let Some(e) = pattern.field_errors().into_iter().next() {
-        return Err(e);
-    }
+) -> Result<(f64, f64), PatternError> {
     let err = |f: &str, v: String, rule: &str| Err((f.to_string(), v, rule.to_string()));
     let surface_max_deg = surface.polar_deg_at(surface.total_arc_mm());
     if let Some(p) = pattern.max_polar_deg.filter(|&p| p > surface_max_deg) {
@@ -642,6 +636,58 @@ pub fn place(
             ),
         };
     }
+    Ok((s_min, s_max))
+}
+
+/// Every point of a `list` pattern that cannot be placed on `surface`, as (`points[i]`, value,
+/// rule), in list order; empty for other layouts or when the polar limits are themselves wrong
+/// ([`place`] reports those).
+pub fn point_errors(surface: &Surface, pattern: &Pattern, rim_margin_mm: f64) -> Vec<PatternError> {
+    let (Some(pts), Ok((s_min, s_max))) = (
+        pattern.points.as_ref(),
+        patterned_arc(surface, pattern, rim_margin_mm),
+    ) else {
+        return Vec::new();
+    };
+    bad_points(surface, pts, s_min, s_max)
+}
+
+fn bad_points(surface: &Surface, pts: &[[f64; 2]], s_min: f64, s_max: f64) -> Vec<PatternError> {
+    let mut out = Vec::new();
+    for (i, p) in pts.iter().enumerate() {
+        let rule = if !(p[0] >= 0.0 && p[0].is_finite() && p[1].is_finite()) {
+            "polar angle must be >= 0 and both angles finite"
+        } else {
+            let s = surface.s_at_polar_deg(p[0]);
+            if s > s_max + 1e-9 || s < s_min - 1e-9 {
+                "lies outside the patterned region"
+            } else {
+                continue;
+            }
+        };
+        out.push((format!("points[{i}]"), format!("{p:?}"), rule.to_string()));
+    }
+    out
+}
+
+/// Places the markers of `pattern` on `surface`.
+///
+/// `rim_margin_mm` keeps marker centres that far (in arc length) from the base plane when no
+/// polar limit is given.
+///
+/// # Errors
+/// The first violation as (field below `pattern`, value, rule); the caller adds the path.
+/// [`Pattern::field_errors`] lists every violation of the fields themselves.
+pub fn place(
+    surface: &Surface,
+    pattern: &Pattern,
+    rim_margin_mm: f64,
+) -> Result<Vec<Marker>, PatternError> {
+    if let Some(e) = pattern.field_errors().into_iter().next() {
+        return Err(e);
+    }
+    let err = |f: &str, v: String, rule: &str| Err((f.to_string(), v, rule.to_string()));
+    let (s_min, s_max) = patterned_arc(surface, pattern, rim_margin_mm)?;
     // The rule that bounds the patterned region, for messages.
     let limit = || match pattern.max_polar_deg {
         Some(p) => format!("max_polar_deg {p}"),
@@ -866,23 +912,11 @@ pub fn place(
                     pts.len() as f64,
                 ));
             }
-            for (i, p) in pts.iter().enumerate() {
-                if !(p[0] >= 0.0 && p[0].is_finite() && p[1].is_finite()) {
-                    return err(
-                        &format!("points[{i}]"),
-                        format!("{p:?}"),
-                        "polar angle must be >= 0 and both angles finite",
-                    );
-                }
-                let s = surface.s_at_polar_deg(p[0]);
-                if s > s_max + 1e-9 || s < s_min - 1e-9 {
-                    return err(
-                        &format!("points[{i}]"),
-                        format!("{p:?}"),
-                        "lies outside the patterned region",
-                    );
-                }
-                raw.push((s, p[1].to_radians(), 0));
+            if let Some(e) = bad_points(surface, pts, s_min, s_max).into_iter().next() {
+                return Err(e);
+            }
+            for p in pts {
+                raw.push((surface.s_at_polar_deg(p[0]), p[1].to_radians(), 0));
             }
         }
     }

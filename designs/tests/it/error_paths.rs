@@ -64,6 +64,52 @@ fn every_bad_row_of_a_point_list_is_reported() {
     );
 }
 
+/// A `list` pattern reports every point that cannot be placed, each under its own index (the
+/// first was reported only).
+#[test]
+fn every_bad_point_of_a_list_pattern_is_reported() {
+    let mut d = library::load("tactip_dualmodal").unwrap();
+    let p = &mut d.layers[0].markers[0].pattern;
+    p.layout = fabkit_designs::markers::Layout::List;
+    p.spacing_mm = None;
+    p.rings = None;
+    p.polar_step_deg = None;
+    p.points = Some(vec![
+        [0.0, 0.0],
+        [-5.0, 0.0],
+        [20.0, 90.0],
+        [170.0, 0.0],
+        [-0.5, 10.0],
+        [30.0, 180.0],
+        [95.0, 0.0],
+    ]);
+    let errs = errors(&d);
+    let bad: Vec<(&str, &str)> = errs
+        .iter()
+        .filter_map(|e| {
+            e.path
+                .strip_prefix("layers[0].markers[0].pattern.")
+                .map(|f| (f, e.rule.as_str()))
+        })
+        .collect();
+    assert_eq!(
+        bad,
+        [
+            (
+                "points[1]",
+                "polar angle must be >= 0 and both angles finite"
+            ),
+            ("points[3]", "lies outside the patterned region"),
+            (
+                "points[4]",
+                "polar angle must be >= 0 and both angles finite"
+            ),
+            ("points[6]", "lies outside the patterned region"),
+        ],
+        "{errs:?}"
+    );
+}
+
 /// Scalars are taken as written: a number or a boolean where text is expected, a quoted number
 /// where a number is expected, a YAML 1.1 boolean and an unknown tag are refused by location or
 /// by path (an integer layer name, a boolean description and a quoted "25" were converted, and
