@@ -115,19 +115,57 @@ pub(crate) fn replace_dir(
     fill: impl FnOnce(&Path) -> Result<(), ExportError>,
 ) -> Result<Replaced, ExportError> {
     let (parent, name) = split(out_dir)?;
-    fs::create_dir_all(&parent).map_err(ExportError::io("creating parent directory", &parent))?;
-    let existing = inspect_existing(out_dir)?;
-
-    let tmp = create_unique_sibling(&parent, &name, "tmp")?;
-    if let Err(e) = fill(&tmp)
-        .and_then(|()| write_marker(&tmp))
-        .and_then(|()| sync_dir(&tmp))
-    {
-        let _ = fs::remove_dir_all(&tmp);
-        return Err(e);
+    let created = create_parents(&parent)?;
+    let result = (|| {
+        let existing = inspect_existing(out_dir)?;
+        let tmp = create_unique_sibling(&parent, &name, "tmp")?;
+        if let Err(e) = fill(&tmp)
+            .and_then(|()| write_marker(&tmp))
+            .and_then(|()| sync_dir(&tmp))
+        {
+            let _ = fs::remove_dir_all(&tmp);
+            return Err(e);
+        }
+        move_into_place(out_dir, &parent, &name, &tmp, existing)
+    })();
+    if result.is_err() {
+        remove_created(&created);
     }
+    result
+}
 
-    move_into_place(out_dir, &parent, &name, &tmp, existing)
+/// Creates `dir` and its missing ancestors; returns the folders it created, outermost first.
+///
+/// # Errors
+/// [`ExportError::Io`]; the folders created so far are removed again.
+fn create_parents(dir: &Path) -> Result<Vec<PathBuf>, ExportError> {
+    let mut missing = Vec::new();
+    let mut d = Some(dir);
+    while let Some(p) = d.filter(|p| !p.as_os_str().is_empty() && fs::symlink_metadata(p).is_err())
+    {
+        missing.push(p.to_path_buf());
+        d = p.parent();
+    }
+    missing.reverse();
+    for (k, p) in missing.iter().enumerate() {
+        if let Err(e) = fs::create_dir(p) {
+            if !(e.kind() == std::io::ErrorKind::AlreadyExists && p.is_dir()) {
+                remove_created(&missing[..k]);
+                return Err(ExportError::io("creating parent directory", p)(e));
+            }
+        }
+    }
+    Ok(missing)
+}
+
+/// Removes the folders [`create_parents`] created, innermost first, as long as they are empty:
+/// a failed run leaves no folder behind.
+fn remove_created(created: &[PathBuf]) {
+    for p in created.iter().rev() {
+        if fs::remove_dir(p).is_err() {
+            break;
+        }
+    }
 }
 
 /// Moves the complete temporary sibling `tmp` to `out_dir` (moving a previous export aside and
@@ -204,6 +242,8 @@ pub struct StagedDir {
     tmp: PathBuf,
     existing: bool,
     done: bool,
+    /// The parent folders this output created, removed again if it is dropped uncommitted.
+    created: Vec<PathBuf>,
 }
 
 impl StagedDir {
@@ -214,10 +254,16 @@ impl StagedDir {
     /// [`ExportError::ForeignDirectory`], [`ExportError::Io`].
     pub fn new(out_dir: &Path) -> Result<StagedDir, ExportError> {
         let (parent, name) = split(out_dir)?;
-        fs::create_dir_all(&parent)
-            .map_err(ExportError::io("creating parent directory", &parent))?;
-        let existing = inspect_existing(out_dir)?;
-        let tmp = create_unique_sibling(&parent, &name, "tmp")?;
+        let created = create_parents(&parent)?;
+        let staged = inspect_existing(out_dir)
+            .and_then(|existing| Ok((existing, create_unique_sibling(&parent, &name, "tmp")?)));
+        let (existing, tmp) = match staged {
+            Ok(x) => x,
+            Err(e) => {
+                remove_created(&created);
+                return Err(e);
+            }
+        };
         Ok(StagedDir {
             out_dir: out_dir.to_path_buf(),
             parent,
@@ -225,6 +271,7 @@ impl StagedDir {
             tmp,
             existing,
             done: false,
+            created,
         })
     }
 
@@ -265,14 +312,19 @@ impl StagedDir {
             sync_dir(d)?;
         }
         self.done = true;
-        let r = move_into_place(
+        match move_into_place(
             &self.out_dir,
             &self.parent,
             &self.name,
             &self.tmp,
             self.existing,
-        )?;
-        Ok(r.warnings)
+        ) {
+            Ok(r) => Ok(r.warnings),
+            Err(e) => {
+                remove_created(&self.created);
+                Err(e)
+            }
+        }
     }
 }
 
@@ -280,6 +332,7 @@ impl Drop for StagedDir {
     fn drop(&mut self) {
         if !self.done {
             let _ = fs::remove_dir_all(&self.tmp);
+            remove_created(&self.created);
         }
     }
 }

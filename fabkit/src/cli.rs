@@ -147,15 +147,25 @@ pub fn main() -> i32 {
     match run(cli) {
         Ok(()) => 0,
         Err(e) => {
-            eprintln!("error: {e}");
-            let mut src = e.source();
-            while let Some(s) = src {
-                eprintln!("  caused by: {s}");
-                src = s.source();
-            }
+            eprint!("{}", error_report(e.as_ref()));
             2
         }
     }
+}
+
+/// `error: <e>` and each cause on its own `  caused by:` line, except a cause whose text the
+/// lines above already state (an I/O error that the message quotes is said once).
+pub fn error_report(e: &(dyn std::error::Error + 'static)) -> String {
+    let mut out = format!("error: {e}\n");
+    let mut src = e.source();
+    while let Some(s) = src {
+        let text = s.to_string();
+        if !out.contains(&text) {
+            out.push_str(&format!("  caused by: {text}\n"));
+        }
+        src = s.source();
+    }
+    out
 }
 
 /// A design and where it came from.

@@ -683,3 +683,53 @@ fn a_run_after_a_sigkill_mid_write_removes_the_stale_sibling_and_says_so() {
         .collect();
     assert_eq!(names, ["u"]);
 }
+
+/// A file that does not exist is named with its cause once, by every command that reads one
+/// (the calibration files said "No such file or directory" twice), and nothing is written.
+#[test]
+fn a_missing_file_states_its_cause_once() {
+    let tmp = tempfile::tempdir().unwrap();
+    let cases: [&[&str]; 5] = [
+        &["export", "nope.yaml", "--out", "out/x"],
+        &["fixtures", "--params", "nope.yaml", "--out", "out/x"],
+        &["sweep", "nope.yaml", "--out", "out/x"],
+        &[
+            "calibrate",
+            "extrinsics",
+            "--camera",
+            "nocam.yaml",
+            "--points",
+            "p.csv",
+            "--observations",
+            "o.csv",
+            "--out",
+            "out/x",
+        ],
+        &[
+            "groundtruth",
+            "--camera",
+            "nocam.yaml",
+            "--extrinsics",
+            "e.json",
+            "--fixtures",
+            "fx",
+            "--out",
+            "out/x",
+        ],
+    ];
+    for args in cases {
+        let o = run(tmp.path(), args, &[]);
+        let err = text(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(
+            err.contains("nope.yaml") || err.contains("nocam.yaml"),
+            "{args:?}: {err}"
+        );
+        assert_eq!(
+            err.matches("No such file or directory").count(),
+            1,
+            "{args:?}: {err}"
+        );
+        assert!(!tmp.path().join("out").exists(), "{args:?}");
+    }
+}
