@@ -130,6 +130,28 @@ pub fn run(args: FixturesArgs) -> Result<(), Box<dyn Error>> {
         "  semi-domes: {n} patterns + the empty half -> {} stitched pairs",
         n * n
     );
+    if params.indenters.is_none() {
+        let names: Vec<String> = params
+            .indenters_for(&loaded.design)
+            .iter()
+            .map(|p| p.name.clone())
+            .collect();
+        let paper = fabkit_fixtures::indenters::paper_of(&loaded.design).and_then(|d| {
+            fabkit_fixtures::indenters::PAPER_INDENTERS
+                .iter()
+                .find(|p| p.0 == d)
+                .map(|p| p.1)
+        });
+        match paper {
+            Some(paper) => out!(
+                "  indenters: those of the {paper} paper ({}); list others under `indenters:` in --params",
+                names.join(", ")
+            ),
+            None => out!(
+                "  indenters: none (the design reproduces none of the library's papers); list them under `indenters:` in --params"
+            ),
+        }
+    }
     for p in &summary.manifest.parts {
         out!(
             "  {:34} {:4} {:>10.1} mm3  {}",

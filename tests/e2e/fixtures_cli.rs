@@ -41,8 +41,8 @@ fn fixtures(cwd: &Path, out: &str, threads: &str) -> std::process::Output {
 }
 
 /// The R-Tac0 fixtures: 29-point table (CSV = JSON), capture plan, protrusion descriptions for
-/// both orientations, manifest hashes; byte-identical with 1 and 2 threads; every part passes
-/// the oracle check and printcheck --strict.
+/// both orientations, manifest hashes, the indenters of the R-Tac0 paper only; byte-identical
+/// with 1 and 2 threads; every part passes the oracle check and printcheck --strict.
 #[test]
 fn rtac0_fixtures_export_is_complete_deterministic_and_printable() {
     // Same command line (it is recorded in the files) in two folders, 1 and 2 threads.
@@ -199,7 +199,26 @@ fn rtac0_fixtures_export_is_complete_deterministic_and_printable() {
     let m: serde_json::Value =
         serde_json::from_slice(&std::fs::read(a.join("manifest.json")).unwrap()).unwrap();
     let data = m["data_files"].as_array().unwrap();
-    assert!(data.len() >= 3 + 3 + 6);
+    assert!(data.len() > 3 + 3);
+    // Only the indenters of the R-Tac0 paper (the TacTip's 107 mm disc was among them).
+    let indenter_parts: Vec<&str> = m["parts"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|p| p["name"].as_str().filter(|n| n.starts_with("indenter_")))
+        .collect();
+    assert_eq!(indenter_parts, ["indenter_sphere_8mm_rtac0"]);
+    let indenter_files: Vec<&str> = data
+        .iter()
+        .filter_map(|d| d["file"].as_str().filter(|f| f.starts_with("indenters/")))
+        .collect();
+    assert_eq!(indenter_files.len(), 1, "{indenter_files:?}");
+    assert!(
+        String::from_utf8_lossy(&o.stdout)
+            .contains("indenters: those of the R-Tac0 paper (sphere_8mm_rtac0)"),
+        "{}",
+        text(&o.stdout)
+    );
     for d in data {
         use sha2::Digest;
         let bytes = std::fs::read(a.join(d["file"].as_str().unwrap())).unwrap();
@@ -215,8 +234,30 @@ fn rtac0_fixtures_export_is_complete_deterministic_and_printable() {
         .into_iter()
         .filter(|f| f.extension().is_some_and(|e| e == "stl" || e == "3mf"))
         .collect();
-    assert_eq!(meshes.len(), 2 + 4 + 6 + 1);
+    assert_eq!(meshes.len(), 2 + 4 + 1 + 1);
     printcheck_all(&meshes);
+
+    // The other papers' indenters, from their own designs' fixtures, slice too.
+    let mut others = Vec::new();
+    for (design, n) in [("shadowtac", 3), ("tactip_dualmodal", 2), ("uvdtact", 1)] {
+        let out = format!("fx_{design}");
+        let o = run(
+            t1.path(),
+            &["fixtures", design, "--format", "stl", "--out", &out],
+            &[],
+        );
+        assert!(o.status.success(), "{design}: {}", text(&o.stderr));
+        let found: Vec<PathBuf> = files_under(&t1.path().join(&out).join("parts"))
+            .into_iter()
+            .filter(|f| {
+                f.file_name()
+                    .is_some_and(|n| n.to_string_lossy().starts_with("indenter_"))
+            })
+            .collect();
+        assert_eq!(found.len(), n, "{design}: {found:?}");
+        others.extend(found);
+    }
+    printcheck_all(&others);
 }
 
 /// Bad fixture parameters: an error naming the parameter and the rule, exit 2, nothing written;
