@@ -69,9 +69,14 @@ struct ExportArgs {
     /// <design>_<preset>.
     #[arg(long)]
     preset: Option<String>,
-    /// Override the design's mold strategy for every cast layer.
+    /// Override the design's mold strategy for every cast layer; when that changes the design,
+    /// the kit is named <design>_mold_<strategy> (and so is its default output folder).
     #[arg(long)]
     mold_strategy: Option<Strategy>,
+    /// Replace an earlier export in --out made with other options (another design, preset,
+    /// mold strategy or chord tolerance); without it that export is kept and this one refused.
+    #[arg(long)]
+    force: bool,
     /// Also write the CSG tree of every part (fabkit-csg/1 JSON) to this file, for
     /// tests/oracles/replay_csg.py.
     #[arg(long)]
@@ -151,6 +156,43 @@ pub fn main() -> i32 {
             2
         }
     }
+}
+
+/// Refuses to replace an earlier export in `out` whose kit (`design.name` in its manifest: the
+/// design, its preset and mold strategy) or chord tolerance differ from this one's, unless
+/// `force`. A folder without a readable manifest is left to the writer's own rules.
+///
+/// # Errors
+/// Naming `--out`, the earlier kit and tolerance, this one's and the remedy.
+pub(crate) fn check_replacing(
+    out: &Path,
+    kit: &str,
+    tol: ChordTolerance,
+    force: bool,
+) -> Result<(), Box<dyn Error>> {
+    let Ok(text) = std::fs::read(out.join("manifest.json")) else {
+        return Ok(());
+    };
+    let Ok(m) = serde_json::from_slice::<serde_json::Value>(&text) else {
+        return Ok(());
+    };
+    let (Some(prev), Some(prev_tol)) = (
+        m["design"]["name"].as_str(),
+        m["chord_tolerance_mm"].as_f64(),
+    ) else {
+        return Ok(());
+    };
+    if force || (prev == kit && prev_tol == tol.mm()) {
+        return Ok(());
+    }
+    Err(format!(
+        "--out {}: holds the kit '{prev}' at chord tolerance {prev_tol} mm, made with other \
+         options than this export ('{kit}' at {} mm): refusing to replace it (hint: choose \
+         another --out, or give --force to replace it)",
+        out.display(),
+        tol.mm()
+    )
+    .into())
 }
 
 /// `error: <e>` and each cause on its own `  caused by:` line, except a cause whose text the
@@ -342,15 +384,25 @@ fn export(args: ExportArgs) -> Result<(), Box<dyn Error>> {
             Strategy::Open => MoldStrategy::Open,
             Strategy::TwoPieceOpen => MoldStrategy::TwoPieceOpen,
         };
+        let before = loaded.design.clone();
         loaded.design.mold.strategy = s;
         for l in &mut loaded.design.layers {
             l.mold_strategy = None;
+        }
+        if loaded.design != before {
+            let key = serde_json::to_value(s)?;
+            loaded.design.name = format!(
+                "{}_mold_{}",
+                loaded.design.name,
+                key.as_str().unwrap_or("other")
+            );
         }
     }
     let out = args
         .out
         .clone()
         .unwrap_or_else(|| Path::new("out").join(&loaded.design.name));
+    check_replacing(&out, &loaded.design.name, tol, args.force)?;
     if let Some(csg) = &args.csg {
         check_csg_path(csg)?;
     }

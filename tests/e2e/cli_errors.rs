@@ -733,3 +733,55 @@ fn a_missing_file_states_its_cause_once() {
         assert!(!tmp.path().join("out").exists(), "{args:?}");
     }
 }
+
+/// `--mold-strategy direct` writes its own kit (`rtac0_mold_direct`, in its own default folder)
+/// and never silently replaces the default kit: into the same `--out` it is refused, naming both
+/// kits and `--force`, as is another chord tolerance; `--force` replaces. The design's own
+/// strategy keeps the kit's name.
+#[test]
+fn a_mold_strategy_export_never_silently_replaces_the_default_kit() {
+    let tmp = tempfile::tempdir().unwrap();
+    let export = |extra: &[&str]| {
+        let mut args = vec!["export", "rtac0", "--format", "stl"];
+        args.extend_from_slice(extra);
+        if !extra.contains(&"--chord-tolerance-mm") {
+            args.extend_from_slice(&["--chord-tolerance-mm", "0.05"]);
+        }
+        run(tmp.path(), &args, &[])
+    };
+    let manifest = |dir: &str| std::fs::read(tmp.path().join(dir).join("manifest.json")).unwrap();
+    let name = |dir: &str| {
+        serde_json::from_slice::<serde_json::Value>(&manifest(dir)).unwrap()["design"]["name"]
+            .as_str()
+            .unwrap()
+            .to_string()
+    };
+    assert!(export(&[]).status.success());
+    let default_kit = manifest("out/rtac0");
+    let o = export(&["--mold-strategy", "direct"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert_eq!(name("out/rtac0_mold_direct"), "rtac0_mold_direct");
+    assert!(tmp.path().join("out/rtac0_mold_direct/parts").is_dir());
+    assert_eq!(manifest("out/rtac0"), default_kit);
+    for (extra, words) in [
+        (
+            &["--mold-strategy", "direct", "--out", "out/rtac0"][..],
+            "--out out/rtac0: holds the kit 'rtac0' at chord tolerance 0.05 mm, made with other options than this export ('rtac0_mold_direct' at 0.05 mm): refusing to replace it (hint: choose another --out, or give --force to replace it)",
+        ),
+        (
+            &["--chord-tolerance-mm", "0.06"][..],
+            "holds the kit 'rtac0' at chord tolerance 0.05 mm, made with other options than this export ('rtac0' at 0.06 mm)",
+        ),
+    ] {
+        let o = export(extra);
+        assert_eq!(o.status.code(), Some(2), "{extra:?}");
+        assert!(text(&o.stderr).contains(words), "{extra:?}: {}", text(&o.stderr));
+        assert_eq!(manifest("out/rtac0"), default_kit, "{extra:?}");
+    }
+    // the design's own strategy is the same kit
+    assert!(export(&["--mold-strategy", "master"]).status.success());
+    assert_eq!(name("out/rtac0"), "rtac0");
+    let o = export(&["--mold-strategy", "direct", "--out", "out/rtac0", "--force"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert_eq!(name("out/rtac0"), "rtac0_mold_direct");
+}

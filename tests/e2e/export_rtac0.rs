@@ -46,7 +46,10 @@ fn files_of(dir: &Path) -> Vec<PathBuf> {
         .map(|e| e.unwrap().path())
         .collect();
     v.sort();
-    v.push(dir.join("rtac0.3mf"));
+    // the kit 3MF is named after the kit (`rtac0`, `rtac0_mold_direct`)
+    let m: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("manifest.json")).unwrap()).unwrap();
+    v.push(dir.join(m["kit_3mf"]["file"].as_str().unwrap()));
     v
 }
 
