@@ -36,7 +36,17 @@ enum Command {
     Sweep(crate::sweep_cmd::SweepArgs),
     /// List the designs embedded in fabkit.
     Designs,
-    /// Check a design and print its resolved layer stack, without writing anything.
+    /// Print a library design's YAML (with its comments), a template to start a design from.
+    Show {
+        /// The name of a library design (`fabkit designs` lists them).
+        design: String,
+        /// Write the template to this file instead of printing it (an existing file is never
+        /// replaced).
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+    /// Check a design and print every parameter path with its resolved value (the paths a
+    /// preset or a sweep can set) and the resolved layer stack, without writing anything.
     Validate {
         /// A design YAML file or the name of a library design (default: rtac0).
         design: Option<String>,
@@ -193,6 +203,23 @@ pub(crate) fn check_replacing(
         tol.mm()
     )
     .into())
+}
+
+/// `v` with every number that is not an integer rounded to 1e-9 (float noise such as
+/// `-1.5999999999999996` or `1.1e-16` printed as `-1.6` and `0`).
+fn rounded(v: &serde_json::Value) -> serde_json::Value {
+    use serde_json::Value;
+    match v {
+        Value::Number(n) if !(n.is_i64() || n.is_u64()) => {
+            let x = n.as_f64().unwrap_or(0.0);
+            let r = (x * 1e9).round() / 1e9;
+            let r = if r == 0.0 { 0.0 } else { r };
+            serde_json::Number::from_f64(r).map_or(Value::Null, Value::Number)
+        }
+        Value::Array(a) => Value::Array(a.iter().map(rounded).collect()),
+        Value::Object(o) => Value::Object(o.iter().map(|(k, x)| (k.clone(), rounded(x))).collect()),
+        other => other.clone(),
+    }
 }
 
 /// `error: <e>` and each cause on its own `  caused by:` line, except a cause whose text the
@@ -360,7 +387,67 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
             let stack = fabkit_designs::stack::validate(&loaded.design, &materials, tol)
                 .map_err(DesignError::from)?;
             out!("{}: valid", loaded.source);
-            out!("{}", serde_json::to_string_pretty(&stack)?);
+            out!(
+                "\nparameters of {} (each path can be set by a preset or varied by `fabkit sweep`; numbers rounded to 1e-9):",
+                loaded.design.name
+            );
+            let json = serde_json::to_value(&loaded.design)?;
+            for path in fabkit_designs::sweep::parameter_paths(&loaded.design) {
+                let mut v = json.clone();
+                let value = fabkit_designs::schema::value_at(&mut v, &path)
+                    .map(|x| rounded(x))
+                    .unwrap_or(serde_json::Value::Null);
+                let shown = if value.is_null() {
+                    "(not set)".to_string()
+                } else {
+                    serde_json::to_string(&value)?
+                };
+                out!("  {path} = {shown}");
+            }
+            out!("\nresolved layer stack (mm, inner to outer):");
+            out!(
+                "{}",
+                serde_json::to_string_pretty(&rounded(&serde_json::to_value(&stack)?))?
+            );
+            Ok(())
+        }
+        Command::Show { design, out } => {
+            let text = library::yaml(&design).ok_or_else(|| {
+                let names: Vec<&str> = library::LIBRARY.iter().map(|(n, _)| *n).collect();
+                format!(
+                    "show: '{design}' is not a library design (they are: {})",
+                    names.join(", ")
+                )
+            })?;
+            match out {
+                None => {
+                    use std::io::Write as _;
+                    std::io::stdout().write_all(text.as_bytes())?;
+                }
+                Some(path) => {
+                    // create_new: a file of the user's is never replaced
+                    let mut f = std::fs::OpenOptions::new()
+                        .write(true)
+                        .create_new(true)
+                        .open(&path)
+                        .map_err(|e| {
+                            format!(
+                                "--out {}: {e} (the template is written to a new file only; choose another name)",
+                                path.display()
+                            )
+                        })?;
+                    use std::io::Write as _;
+                    if let Err(e) = f.write_all(text.as_bytes()).and_then(|()| f.sync_all()) {
+                        drop(f);
+                        let _ = std::fs::remove_file(&path);
+                        return Err(format!("--out {}: {e}", path.display()).into());
+                    }
+                    out!(
+                        "{design}: template written to {} (rename `name:` before exporting)",
+                        path.display()
+                    );
+                }
+            }
             Ok(())
         }
         Command::Export(args) => export(args),

@@ -13,5 +13,6 @@ mod export_rtac0;
 mod fixtures_cli;
 mod groundtruth_cli;
 mod groundtruth_open3d;
+mod maker_path;
 mod sweep_cli;
 mod twins;
