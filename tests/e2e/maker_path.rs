@@ -94,3 +94,64 @@ fn validate_lists_every_path_without_noise_and_show_gives_a_template() {
         text(&o.stderr)
     );
 }
+
+/// The README's first command installs `fabkit` onto the PATH (`cargo install`, which builds
+/// the same binary as this test's), and with `fabkit` on the PATH every `fabkit` command of the
+/// README's first two command blocks runs as written, from a folder that holds the repository's
+/// `designs/`.
+#[test]
+fn the_readmes_commands_run_as_written_after_its_install_step() {
+    let readme = std::fs::read_to_string(repo_root().join("README.md")).unwrap();
+    let blocks: Vec<&str> = readme
+        .split("```sh\n")
+        .skip(1)
+        .map(|b| b.split("```").next().unwrap())
+        .take(2)
+        .collect();
+    let first = blocks[0].lines().next().unwrap();
+    assert!(
+        first.starts_with("cargo install --locked --path fabkit && fabkit export "),
+        "{first}"
+    );
+    let bin = std::path::PathBuf::from(env!("CARGO_BIN_EXE_fabkit"));
+    assert_eq!(bin.file_name().unwrap(), "fabkit");
+    let path = format!(
+        "{}:{}",
+        bin.parent().unwrap().display(),
+        std::env::var("PATH").unwrap_or_default()
+    );
+    let tmp = tempfile::tempdir().unwrap();
+    std::os::unix::fs::symlink(repo_root().join("designs"), tmp.path().join("designs")).unwrap();
+    let mut commands: Vec<String> = vec![first
+        .split("&& ")
+        .nth(1)
+        .unwrap()
+        .split('#')
+        .next()
+        .unwrap()
+        .trim()
+        .to_string()];
+    commands.extend(
+        blocks[1]
+            .lines()
+            .filter(|l| l.starts_with("fabkit "))
+            .map(|l| l.split(" # ").next().unwrap().trim().to_string()),
+    );
+    assert!(commands.len() >= 6, "{commands:?}");
+    for c in &commands {
+        let o = std::process::Command::new("sh")
+            .arg("-c")
+            .arg(c)
+            .current_dir(tmp.path())
+            .env("PATH", &path)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "`{c}`: {}", text(&o.stderr));
+    }
+    for dir in ["out/rtac0", "out/rtac0_mold_direct"] {
+        assert!(
+            tmp.path().join(dir).join("manifest.json").is_file(),
+            "{dir}"
+        );
+    }
+}
