@@ -1,9 +1,11 @@
 //! `fabkit fixtures`: argument parsing and dispatch over fabkit-fixtures.
 
-use crate::cli::{export_options, load_design, spinner, tolerance, DataFileArgs, Format};
+use crate::cli::{export_options, load_design, tolerance, DataFileArgs, Format};
+use crate::progress::Progress;
 use fabkit_designs::ChordTolerance;
 use fabkit_export::write_kit_with_files;
 use fabkit_fixtures::params::{apply_pin_preset, from_yaml, FixtureParams};
+use fabkit_fixtures::FixtureProgress;
 use std::error::Error;
 use std::path::{Path, PathBuf};
 
@@ -86,19 +88,58 @@ pub fn run(args: FixturesArgs) -> Result<(), Box<dyn Error>> {
     if let Some(csg) = &args.csg {
         crate::cli::check_csg_path(csg)?;
     }
-    let spinner = spinner(format!("building the fixtures of {}", loaded.design.name));
     let t0 = std::time::Instant::now();
-    let set = fabkit_fixtures::build_fixtures(
+    let progress: std::sync::OnceLock<Progress> = std::sync::OnceLock::new();
+    let set = fabkit_fixtures::build_fixtures_reporting(
         &loaded.design,
         &params,
         tol,
         args.max_triangles,
         &provenance,
+        &|p| match p {
+            FixtureProgress::Started { parts, triangles } => {
+                progress.get_or_init(|| {
+                    Progress::new(
+                        "fixtures",
+                        &format!(
+                            "building the {parts} parts of {} (about {triangles} triangles)",
+                            loaded.design.name
+                        ),
+                        parts as u64,
+                    )
+                });
+            }
+            FixtureProgress::Built { done, parts } => {
+                if let Some(r) = progress.get() {
+                    r.set(done as u64, parts as u64);
+                }
+            }
+        },
     );
-    spinner.finish_and_clear();
-    let set = set?;
+    let progress = progress.into_inner();
+    let set = match set {
+        Ok(s) => s,
+        Err(e) => {
+            if let Some(p) = progress {
+                p.finish();
+            }
+            return Err(e.into());
+        }
+    };
+    if let Some(p) = &progress {
+        p.stage(&format!(
+            "writing {} parts and {} data files to {}",
+            set.kit.parts.len(),
+            set.files.len(),
+            out.display()
+        ));
+    }
     let opts = export_options(&loaded, tol, &args.format);
-    let summary = write_kit_with_files(&set.kit, &set.files, &out, &opts)?;
+    let summary = write_kit_with_files(&set.kit, &set.files, &out, &opts);
+    if let Some(p) = progress {
+        p.finish();
+    }
+    let summary = summary?;
     if let Some(csg) = &args.csg {
         crate::cli::write_csg(&set.kit, csg)?;
     }

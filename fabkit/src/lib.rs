@@ -22,4 +22,5 @@ pub mod calibrate_cmd;
 pub mod cli;
 pub mod fixtures_cmd;
 pub mod groundtruth_cmd;
+mod progress;
 pub mod sweep_cmd;

@@ -155,3 +155,39 @@ fn the_readmes_commands_run_as_written_after_its_install_step() {
         );
     }
 }
+
+/// `fixtures` reports its work on stderr as it goes, also when stderr is not a terminal (a log
+/// or CI): the parts and the estimated triangles first, then parts built, then the writing.
+#[test]
+fn fixtures_show_progress_off_a_terminal() {
+    let tmp = tempfile::tempdir().unwrap();
+    let o = run(
+        tmp.path(),
+        &[
+            "fixtures",
+            "rtac0",
+            "--semidomes",
+            "3",
+            "--chord-tolerance-mm",
+            "0.05",
+            "--format",
+            "stl",
+            "--out",
+            "fx",
+        ],
+        &[],
+    );
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let err = text(&o.stderr);
+    let lines: Vec<&str> = err.lines().collect();
+    let at = |prefix: &str| {
+        lines
+            .iter()
+            .position(|l| l.starts_with(prefix))
+            .unwrap_or_else(|| panic!("no `{prefix}` line: {err}"))
+    };
+    let start = at("fixtures: building the 8 parts of rtac0 (about ");
+    let built = at("fixtures: 8/8");
+    let writing = at("fixtures: writing 8 parts and ");
+    assert!(start < built && built < writing, "{err}");
+}
