@@ -1,4 +1,4 @@
-//! Raster and point-cloud writers for ground-truth datasets: NPY (float32), 16-bit and 8-bit
+//! Raster and point-cloud writers for ground-truth datasets: NPY (float32), NPZ, 16-bit and 8-bit
 //! PNG, colour-mapped preview PNG and binary PLY. Every encoder is deterministic (same input,
 //! same bytes). Images are row-major, (H, W) or (H, W, C).
 
@@ -9,6 +9,46 @@ fn encode_err(what: &str) -> impl Fn(png::EncodingError) -> ExportError + '_ {
         what: format!("PNG {what}"),
         reason: e.to_string(),
     }
+}
+
+/// Several NPY arrays (e.g. from [`npy_f32`]) as one compressed NPZ file: a zip of
+/// `<name>.npy` entries, deflated, fixed timestamps (what `numpy.savez_compressed` writes and
+/// `numpy.load` reads as a mapping from `name` to array). `arrays` is (name, NPY bytes), in the
+/// order of the entries.
+///
+/// # Errors
+/// [`ExportError::Encode`] if the zip writer fails, or a name is not `[A-Za-z0-9_]+` or
+/// repeats.
+pub fn npz(arrays: &[(&str, &[u8])]) -> Result<Vec<u8>, ExportError> {
+    use std::io::Write as _;
+    use zip::write::SimpleFileOptions;
+    use zip::{CompressionMethod, DateTime, System, ZipWriter};
+    let err = |reason: String| ExportError::Encode {
+        what: "NPZ".into(),
+        reason,
+    };
+    let mut zip = ZipWriter::new(std::io::Cursor::new(Vec::new()));
+    for (k, (name, bytes)) in arrays.iter().enumerate() {
+        if name.is_empty()
+            || !name.bytes().all(|c| c.is_ascii_alphanumeric() || c == b'_')
+            || arrays[..k].iter().any(|(n, _)| n == name)
+        {
+            return Err(err(format!(
+                "array name '{name}' must be [A-Za-z0-9_]+ and unique"
+            )));
+        }
+        let opts = SimpleFileOptions::default()
+            .compression_method(CompressionMethod::Deflated)
+            .compression_level(Some(6))
+            .last_modified_time(DateTime::default())
+            .system(System::Unix)
+            .unix_permissions(0o644)
+            .large_file(bytes.len() as u64 >= u64::from(u32::MAX));
+        zip.start_file(format!("{name}.npy"), opts)
+            .map_err(|e| err(e.to_string()))?;
+        zip.write_all(bytes).map_err(|e| err(e.to_string()))?;
+    }
+    Ok(zip.finish().map_err(|e| err(e.to_string()))?.into_inner())
 }
 
 /// A float32 array as an NPY file (format version 1.0, little endian `<f4`, C order): what

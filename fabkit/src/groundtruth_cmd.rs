@@ -13,8 +13,8 @@ use fabkit_calibration::groundtruth::surface::ReferenceSurface;
 use fabkit_calibration::groundtruth::{half_masks, indented_hits, reference_hits, DepthFrame};
 use fabkit_calibration::read_camera_file;
 use fabkit_export::raster::{
-    normals_rgb, npy_f32, ply_points, png_gray16, png_gray8, png_rgb8, preview_rgb, PlyPoint,
-    Png16Encoding,
+    normals_rgb, npy_f32, npz as npz_file, ply_points, png_gray16, png_gray8, png_rgb8,
+    preview_rgb, PlyPoint, Png16Encoding,
 };
 use fabkit_export::StagedDir;
 use rayon::prelude::*;
@@ -48,8 +48,47 @@ pub struct GroundTruthArgs {
     #[arg(long, value_name = "N", default_value_t = DEFAULT_MAX_PIXELS,
           value_parser = parse_max_pixels, allow_negative_numbers = true)]
     max_pixels: u64,
+    /// What the arrays are written as: `npy` (one float32 .npy per map, and points.ply), `npz`
+    /// (the maps of a frame in one compressed arrays.npz, no PLY) or `png` (the 16-bit PNGs
+    /// and previews only). The 16-bit PNGs, previews and masks are written in every format.
+    #[arg(long, value_enum, default_value_t = DataFormat::Npy)]
+    format: DataFormat,
+    /// Refuse, before rendering, output estimated at more than this many bytes (an upper bound
+    /// printed first; 1 to 10^15) unless --yes is given.
+    #[arg(long, value_name = "BYTES", default_value_t = DEFAULT_MAX_OUTPUT_BYTES,
+          value_parser = parse_max_output_bytes, allow_negative_numbers = true)]
+    max_output_bytes: u64,
+    /// Write output estimated above --max-output-bytes (never more than the free space of the
+    /// output's file system).
+    #[arg(long)]
+    yes: bool,
     #[command(flatten)]
     data_files: DataFileArgs,
+}
+
+/// How the ground-truth arrays are written (`--format`).
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DataFormat {
+    /// float32 `.npy` per map and `points.ply` (numpy.load, Open3D).
+    Npy,
+    /// The float32 maps of each frame in one compressed `arrays.npz` (numpy.load); no PLY.
+    Npz,
+    /// 16-bit PNGs (micrometres), previews and masks only.
+    Png,
+}
+
+/// Default `--max-output-bytes`: 1 GB.
+const DEFAULT_MAX_OUTPUT_BYTES: u64 = 1_000_000_000;
+/// Largest `--max-output-bytes`: 1 PB.
+const MAX_OUTPUT_BYTES_LIMIT: u64 = 1_000_000_000_000_000;
+
+fn parse_max_output_bytes(s: &str) -> Result<u64, String> {
+    match s.trim().parse::<u64>() {
+        Ok(n) if (1..=MAX_OUTPUT_BYTES_LIMIT).contains(&n) => Ok(n),
+        _ => Err(format!(
+            "must be a whole number of bytes from 1 to {MAX_OUTPUT_BYTES_LIMIT} (10^15)"
+        )),
+    }
 }
 
 /// Default bound of `--max-pixels`: 4096 x 4096 (a 4K camera has 8.3 million pixels).
@@ -95,10 +134,40 @@ fn finite_range(v: &[f64]) -> Option<(f64, f64)> {
     (lo <= hi).then_some((lo, hi))
 }
 
-/// A scalar map as `.npy` (float32 mm), 16-bit PNG (um) and preview PNG.
+/// The float32 maps of a frame bound for its `arrays.npz`: (name, NPY bytes, description).
+type NpzArrays = Vec<(String, Vec<u8>, Value)>;
+
+/// A float32 map as a `.npy` file (`npy`), an entry of the frame's `arrays.npz` (`npz`) or
+/// nothing (`png`).
+#[allow(clippy::too_many_arguments)]
+fn array_file(
+    files: &mut Files,
+    npz: &mut NpzArrays,
+    format: DataFormat,
+    dir: &str,
+    name: &str,
+    shape: &[usize],
+    data: &[f32],
+    meta: Value,
+) {
+    match format {
+        DataFormat::Npy => {
+            let file = format!("{dir}/{name}.npy");
+            let mut e = meta;
+            e["file"] = json!(file);
+            files.push((file, npy_f32(shape, data), e));
+        }
+        DataFormat::Npz => npz.push((name.to_string(), npy_f32(shape, data), meta)),
+        DataFormat::Png => {}
+    }
+}
+
+/// A scalar map as float32 mm ([`array_file`]), 16-bit PNG (um) and preview PNG.
 #[allow(clippy::too_many_arguments)]
 fn scalar_files(
     files: &mut Files,
+    npz: &mut NpzArrays,
+    format: DataFormat,
     dir: &str,
     name: &str,
     what: &str,
@@ -108,12 +177,16 @@ fn scalar_files(
     preview: (f64, f64),
 ) -> Result<(), Box<dyn Error>> {
     let stem = name.trim_end_matches("_mm");
-    let npy = format!("{dir}/{name}.npy");
-    files.push((
-        npy.clone(),
-        npy_f32(&[h, w], &f32s(values)),
-        json!({"file": npy, "quantity": what, "units": "mm", "dtype": "float32", "shape": [h, w], "missing": "NaN"}),
-    ));
+    array_file(
+        files,
+        npz,
+        format,
+        dir,
+        name,
+        &[h, w],
+        &f32s(values),
+        json!({"quantity": what, "units": "mm", "dtype": "float32", "shape": [h, w], "missing": "NaN"}),
+    );
     let (counts, clipped) = enc.encode(values);
     let png = format!("{dir}/{stem}_um.png");
     let text = format!(
@@ -144,11 +217,15 @@ fn frame_files(
     reference: Option<&DepthFrame>,
     preview: (f64, f64),
     provenance: &str,
+    format: DataFormat,
 ) -> Result<Files, Box<dyn Error>> {
     let (w, h) = (f.width, f.height);
     let mut files = Files::new();
+    let mut npz = NpzArrays::new();
     scalar_files(
         &mut files,
+        &mut npz,
+        format,
         dir,
         "range_mm",
         "range: distance along the pixel's ray from the camera centre to the elastomer surface",
@@ -159,6 +236,8 @@ fn frame_files(
     )?;
     scalar_files(
         &mut files,
+        &mut npz,
+        format,
         dir,
         "zdepth_mm",
         "z-depth: z of the surface point in the camera frame",
@@ -172,27 +251,21 @@ fn frame_files(
         .iter()
         .flat_map(|n| n.map(|c| c as f32))
         .collect();
-    let nf = format!("{dir}/normals.npy");
-    files.push((nf.clone(), npy_f32(&[h, w, 3], &normals), json!({"file": nf, "quantity": "unit normal of the elastomer surface, pointing out of the elastomer, camera frame", "units": "1", "dtype": "float32", "shape": [h, w, 3], "missing": "NaN"})));
+    array_file(
+        &mut files,
+        &mut npz,
+        format,
+        dir,
+        "normals",
+        &[h, w, 3],
+        &normals,
+        json!({"quantity": "unit normal of the elastomer surface, pointing out of the elastomer, camera frame", "units": "1", "dtype": "float32", "shape": [h, w, 3], "missing": "NaN"}),
+    );
     let np = format!("{dir}/normals_preview.png");
-    files.push((np.clone(), png_rgb8(w, h, &normals_rgb(&f.normal_cam), &[])?, json!({"file": np, "quantity": "preview of normals.npy: rgb = (n + 1) / 2", "missing": "black"})));
-    let pts: Vec<PlyPoint> = (0..w * h)
-        .filter(|&p| f.range_mm[p].is_finite())
-        .map(|p| PlyPoint {
-            xyz: f.point_cam_mm[p].map(|c| c as f32),
-            normal: f.normal_cam[p].map(|c| c as f32),
-            u: (p % w) as u16,
-            v: (p / w) as u16,
-            contact: f.contact[p] as u8,
-        })
-        .collect();
-    let ply = format!("{dir}/points.ply");
-    let comments = vec![
-        "frame: camera (x right, y down, z forward; docs/conventions.md), mm".to_string(),
-        "properties: point, unit normal out of the elastomer, pixel (u column, v row), contact (1 on a protrusion)".to_string(),
-        provenance.to_string(),
-    ];
-    files.push((ply.clone(), ply_points(&pts, &comments), json!({"file": ply, "quantity": "surface points with normals, one per pixel that sees the surface", "frame": "camera", "units": "mm", "points": pts.len()})));
+    files.push((np.clone(), png_rgb8(w, h, &normals_rgb(&f.normal_cam), &[])?, json!({"file": np, "quantity": "preview of the unit normals: rgb = (n + 1) / 2", "missing": "black"})));
+    if format == DataFormat::Npy {
+        ply_file(&mut files, dir, f, provenance);
+    }
     if let Some(r) = reference {
         let (dr, dz) = f.delta(r);
         let lo = finite_range(&dr)
@@ -200,9 +273,11 @@ fn frame_files(
             .unwrap_or(0.0)
             .min(finite_range(&dz).map(|x| x.0).unwrap_or(0.0));
         let pr = (if lo < 0.0 { lo } else { -0.001 }, 0.0);
-        scalar_files(&mut files, dir, "delta_range_mm", "differential range: indented minus reference (negative where the skin is pushed towards the camera)", &dr, (w, h), DELTA_PNG, pr)?;
+        scalar_files(&mut files, &mut npz, format, dir, "delta_range_mm", "differential range: indented minus reference (negative where the skin is pushed towards the camera)", &dr, (w, h), DELTA_PNG, pr)?;
         scalar_files(
             &mut files,
+            &mut npz,
+            format,
             dir,
             "delta_zdepth_mm",
             "differential z-depth: indented minus reference",
@@ -223,7 +298,123 @@ fn frame_files(
         let cm = format!("{dir}/contact_mask.png");
         files.push((cm.clone(), png_gray8(w, h, &mask, &[])?, json!({"file": cm, "quantity": "contact mask: 255 where a protrusion pushes the skin in (the surface seen is a protrusion), else 0", "dtype": "uint8", "shape": [h, w]})));
     }
+    if format == DataFormat::Npz {
+        let file = format!("{dir}/arrays.npz");
+        let bytes = npz_file(
+            &npz.iter()
+                .map(|(n, b, _)| (n.as_str(), b.as_slice()))
+                .collect::<Vec<_>>(),
+        )?;
+        let arrays: serde_json::Map<String, Value> =
+            npz.into_iter().map(|(n, _, m)| (n, m)).collect();
+        files.push((
+            file.clone(),
+            bytes,
+            json!({"file": file, "quantity": "the float32 maps of this frame (numpy.load: a mapping from name to array)", "arrays": arrays}),
+        ));
+    }
     Ok(files)
+}
+
+/// The surface points of a frame with their normals as binary PLY.
+fn ply_file(files: &mut Files, dir: &str, f: &DepthFrame, provenance: &str) {
+    let w = f.width;
+    let pts: Vec<PlyPoint> = (0..w * f.height)
+        .filter(|&p| f.range_mm[p].is_finite())
+        .map(|p| PlyPoint {
+            xyz: f.point_cam_mm[p].map(|c| c as f32),
+            normal: f.normal_cam[p].map(|c| c as f32),
+            u: (p % w) as u16,
+            v: (p / w) as u16,
+            contact: f.contact[p] as u8,
+        })
+        .collect();
+    let ply = format!("{dir}/points.ply");
+    let comments = vec![
+        "frame: camera (x right, y down, z forward; docs/conventions.md), mm".to_string(),
+        "properties: point, unit normal out of the elastomer, pixel (u column, v row), contact (1 on a protrusion)".to_string(),
+        provenance.to_string(),
+    ];
+    files.push((ply.clone(), ply_points(&pts, &comments), json!({"file": ply, "quantity": "surface points with normals, one per pixel that sees the surface", "frame": "camera", "units": "mm", "points": pts.len()})));
+}
+
+/// A bound on the size of a PNG of `raw` pixel bytes in `rows` rows: the filter byte of each
+/// row, deflate's stored-block worst case (5 bytes per 16 KiB) and the chunks around it.
+fn png_bound(raw: u64, rows: u64) -> u64 {
+    let filtered = raw + rows;
+    filtered + filtered / 16_384 * 5 + 1024
+}
+
+/// Files and bytes of the output, (files, bytes): the files exactly, the bytes as an upper
+/// bound (float arrays and PLY at their exact sizes, PNG and NPZ at deflate's worst case, the
+/// manifest and pairs.csv generously), for a `w` x `h` camera, `n_cfg` configurations and
+/// `n_patterns` patterns.
+pub fn output_bound(w: u64, h: u64, n_cfg: u64, n_patterns: u64, format: DataFormat) -> (u64, u64) {
+    let px = w * h;
+    let frame = |delta: bool| -> (u64, u64) {
+        let (mut files, mut bytes, mut arrays) = (0u64, 0u64, Vec::new());
+        let maps = if delta { 4 } else { 2 };
+        for _ in 0..maps {
+            arrays.push(4 * px + 128);
+            files += 2;
+            bytes += png_bound(2 * px, h) + png_bound(3 * px, h);
+        }
+        arrays.push(12 * px + 128);
+        files += 1;
+        bytes += png_bound(3 * px, h);
+        if delta {
+            files += 1;
+            bytes += png_bound(px, h);
+        }
+        match format {
+            DataFormat::Npy => {
+                files += arrays.len() as u64 + 1;
+                bytes += arrays.iter().sum::<u64>() + 29 * px + 4096;
+            }
+            DataFormat::Npz => {
+                files += 1;
+                bytes += arrays.iter().map(|a| a + a / 16_384 * 5 + 256).sum::<u64>() + 1024;
+            }
+            DataFormat::Png => {}
+        }
+        (files, bytes)
+    };
+    let (rf, rb) = frame(false);
+    let (cf, cb) = frame(true);
+    // two half masks, pairs.csv and the manifest
+    let files = rf + n_cfg * cf + 4;
+    let pairs = 128 * (n_patterns * n_patterns + 1);
+    let bytes = rb + n_cfg * cb + 2 * png_bound(px, h) + pairs + 65_536 + 4096 * files;
+    (files, bytes)
+}
+
+/// `n` bytes for people: `1.2 GB`, `340 MB`, `12 kB`.
+fn shown_bytes(n: u64) -> String {
+    let x = n as f64;
+    if x >= 1e9 {
+        format!("{:.1} GB", x / 1e9)
+    } else if x >= 1e6 {
+        format!("{:.0} MB", x / 1e6)
+    } else {
+        format!("{:.0} kB", (x / 1e3).ceil())
+    }
+}
+
+/// Free bytes for an unprivileged user on the file system that would hold `out` (its nearest
+/// existing ancestor); `None` where that cannot be told.
+fn free_bytes(out: &std::path::Path) -> Option<u64> {
+    let abs = std::path::absolute(out).ok()?;
+    let dir = abs.ancestors().find(|a| a.exists())?;
+    #[cfg(unix)]
+    {
+        let s = rustix::fs::statvfs(dir).ok()?;
+        Some(s.f_bavail.saturating_mul(s.f_frsize))
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = dir;
+        None
+    }
 }
 
 pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
@@ -277,14 +468,67 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
     }
     let (w, h) = (rays.width, rays.height);
     let n_cfg = fixtures.configurations.len();
-    let bar = indicatif::ProgressBar::new(n_cfg as u64 + 1);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template(
-            "{msg} [{bar:30}] {pos}/{len} frames, {elapsed}, eta {eta}",
-        )
-        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    // The output is bounded before anything is rendered or written.
+    let (n_files, bound) = output_bound(
+        w as u64,
+        h as u64,
+        n_cfg as u64,
+        fixtures.patterns.len() as u64,
+        args.format,
     );
-    bar.set_message(format!("groundtruth {}", design.name));
+    let format_name = |f: DataFormat| match f {
+        DataFormat::Npy => "npy",
+        DataFormat::Npz => "npz",
+        DataFormat::Png => "png",
+    };
+    eprintln!(
+        "groundtruth: reference + {n_cfg} configurations of {w} x {h} pixels -> {} files, at most {} (--format {})",
+        n_files,
+        shown_bytes(bound),
+        format_name(args.format)
+    );
+    let alternatives = [DataFormat::Npz, DataFormat::Png]
+        .into_iter()
+        .filter(|f| *f != args.format)
+        .map(|f| {
+            let (_, b) = output_bound(
+                w as u64,
+                h as u64,
+                n_cfg as u64,
+                fixtures.patterns.len() as u64,
+                f,
+            );
+            format!("--format {} (at most {})", format_name(f), shown_bytes(b))
+        })
+        .collect::<Vec<_>>()
+        .join(" or ");
+    if bound > args.max_output_bytes && !args.yes {
+        return Err(format!(
+            "--out {}: the ground truth would take up to {} ({bound} bytes, {n_files} files), over --max-output-bytes {} ({}): refusing before rendering (hint: give --yes to write it, use {alternatives}, or build fewer semi-dome patterns)",
+            args.out.display(),
+            shown_bytes(bound),
+            args.max_output_bytes,
+            shown_bytes(args.max_output_bytes)
+        )
+        .into());
+    }
+    if let Some(free) = free_bytes(&args.out) {
+        if bound > free {
+            return Err(format!(
+                "--out {}: the ground truth may take up to {} ({bound} bytes, {n_files} files), more than the {} ({free} bytes) free on its file system: refusing before rendering (hint: use {alternatives}, free space, or write elsewhere)",
+                args.out.display(),
+                shown_bytes(bound),
+                shown_bytes(free)
+            )
+            .into());
+        }
+    }
+    let frames = n_cfg as u64 + 1;
+    let bar = crate::progress::Progress::new(
+        "groundtruth",
+        &format!("rendering {frames} frames of {}", design.name),
+        frames,
+    );
     let provenance = format!(
         "fabkit {} groundtruth, design {} (sha256 {})",
         env!("CARGO_PKG_VERSION"),
@@ -321,10 +565,17 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
         Ok(entries)
     };
     let ref_entries = write(
-        frame_files("reference", &reference, None, preview, &provenance)?,
+        frame_files(
+            "reference",
+            &reference,
+            None,
+            preview,
+            &provenance,
+            args.format,
+        )?,
         &mut all,
     )?;
-    bar.inc(1);
+    bar.set(1, frames);
 
     // Configurations in parallel; each writes its own folder. Entries are kept in index order.
     let done = AtomicUsize::new(0);
@@ -334,7 +585,7 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
         .map(|cfg: &Configuration| {
             let hits = indented_hits(&rays, &ref_hits, &cfg.primitives, surface.base_z_mm());
             let frame = DepthFrame::new(&rays, &hits);
-            let files = frame_files(&cfg.name, &frame, Some(&reference), preview, &provenance).map_err(|e| e.to_string())?;
+            let files = frame_files(&cfg.name, &frame, Some(&reference), preview, &provenance, args.format).map_err(|e| e.to_string())?;
             let mut entries = Vec::new();
             let mut list = Vec::new();
             for (rel, bytes, mut e) in files {
@@ -347,8 +598,8 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
             let contact = (0..w * h).filter(|&p| frame.contact[p] && reference.range_mm[p].is_finite()).count();
             let (dr, _) = frame.delta(&reference);
             let deepest = finite_range(&dr).map(|x| -x.0).unwrap_or(0.0).max(0.0);
-            done.fetch_add(1, Ordering::Relaxed);
-            bar.inc(1);
+            let k = done.fetch_add(1, Ordering::Relaxed) + 2;
+            bar.set(k as u64, frames);
             Ok((
                 json!({
                     "name": cfg.name, "dir": cfg.name, "pattern": cfg.pattern, "orientation_deg": cfg.orientation_deg,
@@ -368,7 +619,7 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
         cfg_entries.push(e);
         all.extend(list);
     }
-    bar.finish_and_clear();
+    bar.finish();
 
     let (left, right) = half_masks(&rays, &ref_hits);
     let mut extra: Files = Vec::new();

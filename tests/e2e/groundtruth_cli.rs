@@ -395,6 +395,26 @@ fn bad_inputs_name_the_file_and_the_rule_and_write_nothing() {
             text(&o.stderr)
         );
     }
+    for bad in ["0", "-1", "1000000000000001", "1GB"] {
+        let o = groundtruth("cam.yaml", &["--max-output-bytes", bad]);
+        assert_eq!(o.status.code(), Some(2), "{bad}");
+        assert!(
+            text(&o.stderr).contains(&format!("invalid value '{bad}' for '--max-output-bytes"))
+                && text(&o.stderr)
+                    .contains("must be a whole number of bytes from 1 to 1000000000000000 (10^15)"),
+            "{bad}: {}",
+            text(&o.stderr)
+        );
+    }
+    let o = groundtruth("cam.yaml", &["--format", "tiff"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        text(&o.stderr).contains("invalid value 'tiff' for '--format <FORMAT>'")
+            && text(&o.stderr).contains("[possible values: npy, npz, png]"),
+        "{}",
+        text(&o.stderr)
+    );
+    assert!(!d.path().join("gt").exists());
     let mut huge = benchmark_intrinsics();
     huge.image_width_px = 200_000;
     std::fs::write(
@@ -424,4 +444,133 @@ fn bad_inputs_name_the_file_and_the_rule_and_write_nothing() {
         text(&o.stderr)
     );
     assert!(!d.path().join("gt").exists());
+}
+
+/// The size of the output is printed first and bounded before anything is rendered: above
+/// `--max-output-bytes` the run is refused (naming the bound, the limit and the smaller
+/// formats) unless `--yes`; the printed file count is exact and the byte bound holds for every
+/// `--format`; `npz` holds the same arrays as the `.npy` files (numpy), `png` writes no arrays.
+#[test]
+fn groundtruth_bounds_its_output_first_and_writes_npz_or_png_on_request() {
+    let d = tempfile::tempdir().unwrap();
+    setup(d.path());
+    let gt = |out: &str, extra: &[&str]| {
+        let mut args = vec![
+            "groundtruth",
+            "rtac0",
+            "--camera",
+            "cam.yaml",
+            "--extrinsics",
+            "extrinsics.json",
+            "--fixtures",
+            "fx",
+            "--out",
+            out,
+        ];
+        args.extend_from_slice(extra);
+        run(d.path(), &args, &[])
+    };
+    let o = gt("refused", &["--max-output-bytes", "1000"]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = text(&o.stderr);
+    assert!(
+        err.starts_with("groundtruth: reference + 4 configurations of "),
+        "{err}"
+    );
+    assert!(
+        err.contains("over --max-output-bytes 1000 (1 kB): refusing before rendering (hint: give --yes to write it, use --format npz (at most ")
+            && err.contains(" or --format png (at most "),
+        "{err}"
+    );
+    assert!(!d.path().join("refused").exists());
+    for (out, format) in [("gt", "npy"), ("gtz", "npz"), ("gtp", "png")] {
+        let o = gt(
+            out,
+            &["--format", format, "--max-output-bytes", "1000", "--yes"],
+        );
+        assert!(o.status.success(), "{format}: {}", text(&o.stderr));
+        let m: serde_json::Value = serde_json::from_slice(
+            &std::fs::read(d.path().join(out).join("manifest.json")).unwrap(),
+        )
+        .unwrap();
+        let files = m["files"].as_array().unwrap();
+        let bytes: u64 = files
+            .iter()
+            .map(|f| f["bytes"].as_u64().unwrap())
+            .sum::<u64>()
+            + std::fs::metadata(d.path().join(out).join("manifest.json"))
+                .unwrap()
+                .len();
+        let (w, h) = (
+            m["image"]["width_px"].as_u64().unwrap(),
+            m["image"]["height_px"].as_u64().unwrap(),
+        );
+        let f = match format {
+            "npy" => fabkit::groundtruth_cmd::DataFormat::Npy,
+            "npz" => fabkit::groundtruth_cmd::DataFormat::Npz,
+            _ => fabkit::groundtruth_cmd::DataFormat::Png,
+        };
+        let (n_files, bound) = fabkit::groundtruth_cmd::output_bound(w, h, 4, 2, f);
+        assert_eq!(files.len() as u64 + 1, n_files, "{format}");
+        assert!(
+            bytes <= bound,
+            "{format}: {bytes} bytes over the bound {bound}"
+        );
+        // the float arrays are written at their size; PNG (all of `png`) at deflate's worst case
+        if format != "png" {
+            assert!(
+                bound <= 4 * bytes,
+                "{format}: the bound {bound} is loose for {bytes} bytes"
+            );
+        }
+        let line = format!(
+            "groundtruth: reference + 4 configurations of {w} x {h} pixels -> {n_files} files, at most "
+        );
+        assert!(
+            text(&o.stderr).lines().next().unwrap().starts_with(&line),
+            "{}",
+            text(&o.stderr)
+        );
+        let names: Vec<&str> = files.iter().map(|f| f["file"].as_str().unwrap()).collect();
+        let arrays = names
+            .iter()
+            .filter(|n| n.ends_with(".npy") || n.ends_with(".npz") || n.ends_with(".ply"))
+            .count();
+        match format {
+            // reference: range, z-depth, normals, PLY; each configuration also the two deltas
+            "npy" => assert_eq!(arrays, 4 + 4 * 6, "{names:?}"),
+            "npz" => assert_eq!(arrays, 5, "{names:?}"),
+            _ => assert_eq!(arrays, 0, "{names:?}"),
+        }
+    }
+    let Some(py) = oracle_python() else {
+        return missing("the oracle python (numpy)");
+    };
+    let m: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.path().join("gt/manifest.json")).unwrap()).unwrap();
+    let cfg = m["configurations"][0]["dir"].as_str().unwrap().to_string();
+    let script = r#"
+import sys, numpy as np
+d, cfg = sys.argv[1], sys.argv[2]
+for frame, names in [("reference", ["normals", "range_mm", "zdepth_mm"]),
+                     (cfg, ["delta_range_mm", "delta_zdepth_mm", "normals", "range_mm", "zdepth_mm"])]:
+    z = np.load(d + "/gtz/" + frame + "/arrays.npz")
+    assert sorted(z.files) == names, (frame, z.files)
+    for n in names:
+        a = np.load(d + "/gt/" + frame + "/" + n + ".npy")
+        assert a.dtype == np.float32 and np.array_equal(a, z[n], equal_nan=True), (frame, n)
+print("ok")
+"#;
+    let o = std::process::Command::new(py)
+        .arg("-c")
+        .arg(script)
+        .arg(d.path())
+        .arg(&cfg)
+        .output()
+        .unwrap();
+    assert!(
+        o.status.success() && text(&o.stdout).contains("ok"),
+        "{}",
+        text(&o.stderr)
+    );
 }
