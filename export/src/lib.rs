@@ -134,11 +134,25 @@ pub fn write_kit_with_files(
     out_dir: &Path,
     opts: &ExportOptions,
 ) -> Result<ExportSummary, ExportError> {
+    write_kit_reporting(kit, data_files, out_dir, opts, None)
+}
+
+/// [`write_kit_with_files`] that reports the progress of STEP export (about 3 s a part, when
+/// `opts.formats.step`) to `step_progress`: called on this thread as the CadQuery twin starts
+/// each part, with (part number from 1, number of parts, part name), in kit order. Same files,
+/// atomicity and errors as [`write_kit_with_files`].
+pub fn write_kit_reporting(
+    kit: &Kit,
+    data_files: &[(String, Vec<u8>)],
+    out_dir: &Path,
+    opts: &ExportOptions,
+    step_progress: Option<step::StepProgress<'_>>,
+) -> Result<ExportSummary, ExportError> {
     for (rel, _) in data_files {
         atomic::check_relative_path("data_files", rel)?;
     }
     let meshes: Vec<Mesh> = kit.parts.iter().map(|p| p.written_mesh()).collect();
-    write_kit_meshes(kit, &meshes, data_files, out_dir, opts)
+    write_kit_meshes(kit, &meshes, data_files, out_dir, opts, step_progress)
 }
 
 /// [`write_kit`] with the written meshes given (one per part, in kit order), so that tests can
@@ -149,13 +163,14 @@ fn write_kit_meshes(
     data_files: &[(String, Vec<u8>)],
     out_dir: &Path,
     opts: &ExportOptions,
+    step_progress: Option<step::StepProgress<'_>>,
 ) -> Result<ExportSummary, ExportError> {
     check::check_options(opts)?;
     check::check_names(kit)?;
     for (part, mesh) in kit.parts.iter().zip(meshes) {
         check_printable_mesh(&part.name, mesh)?;
     }
-    let rendered = render(kit, meshes, data_files, opts)?;
+    let rendered = render(kit, meshes, data_files, opts, step_progress)?;
     let done = atomic::replace_dir(out_dir, |tmp| {
         if opts.formats.stl {
             let parts_dir = tmp.join(PARTS_DIR);
@@ -202,6 +217,7 @@ fn render(
     meshes: &[Mesh],
     data_files: &[(String, Vec<u8>)],
     opts: &ExportOptions,
+    step_progress: Option<step::StepProgress<'_>>,
 ) -> Result<Rendered, ExportError> {
     let mut files = Vec::new();
     let mut parts = Vec::with_capacity(kit.parts.len());
@@ -248,7 +264,7 @@ fn render(
         });
     }
     if opts.formats.step {
-        let steps = step::render(&parts, opts.chord_tolerance_mm)?;
+        let steps = step::render(&parts, opts.chord_tolerance_mm, step_progress)?;
         for (p, bytes) in parts.iter_mut().zip(steps) {
             let rel = format!("{STEP_DIR}/{}.step", p.name);
             p.step_sha256 = Some(sha256_hex(&bytes));
@@ -437,7 +453,7 @@ mod tests {
             .map(|p| p.solid.mesh().rounded_to_f32())
             .collect();
         meshes[1].triangles.pop();
-        let err = write_kit_meshes(&k, &meshes, &[], &out, &opts()).unwrap_err();
+        let err = write_kit_meshes(&k, &meshes, &[], &out, &opts(), None).unwrap_err();
         assert!(
             matches!(err, ExportError::NotManifold { ref part, .. } if part == "lid"),
             "{err}"
@@ -463,7 +479,7 @@ mod tests {
             .map(|p| p.solid.mesh().rounded_to_f32())
             .collect();
         meshes[0].triangles[0].swap(1, 2);
-        assert!(write_kit_meshes(&k, &meshes, &[], &out, &opts()).is_err());
+        assert!(write_kit_meshes(&k, &meshes, &[], &out, &opts(), None).is_err());
         let after: Vec<Vec<u8>> = first
             .files
             .iter()

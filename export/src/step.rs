@@ -1,96 +1,195 @@
 //! STEP files through the CadQuery twin (issue 7): each part is rebuilt as an exact B-rep
 //! (planes, cylinders, cones, spheres, tori and B-spline surfaces of revolution) from its
-//! resolved parameters by `tests/oracles/twins` and written by OpenCASCADE, so CAD users get
-//! editable surfaces instead of facets.
+//! resolved parameters by the twin package `export/python/twins` and written by OpenCASCADE,
+//! so CAD users get editable surfaces instead of facets.
 //!
-//! The twin scripts are compiled into fabkit and run by a Python that has CadQuery: the
-//! `FABKIT_CADQUERY_PYTHON` environment variable, else `<repo>/.venv-cadquery/bin/python`
-//! (what `scripts/setup-cadquery` builds). Before a file is written the twin's exact volume
-//! must agree with fabkit's mesh within the chord-tolerance bound (surface area x tolerance)
-//! and its bounding box within the tolerance; otherwise the export fails naming the part.
+//! The twin modules are compiled into fabkit and run by a Python that has CadQuery, found by
+//! [`cadquery_python`]: the `FABKIT_CADQUERY_PYTHON` environment variable, else the venv that
+//! `scripts/setup-cadquery` installs in the user's data directory,
+//! `$XDG_DATA_HOME/fabkit/venv-cadquery/bin/python` (`XDG_DATA_HOME` defaulting to
+//! `$HOME/.local/share`), so an installed `fabkit` finds it from any directory. Before a file
+//! is written the twin's exact volume must agree with fabkit's mesh within the chord-tolerance
+//! bound (surface area x tolerance) and its bounding box within the tolerance; otherwise the
+//! export fails naming the part. The twin reports each part as it starts it (about 3 s a part),
+//! which [`render`] passes on to an optional [`StepProgress`] callback.
 
 use crate::{ExportError, ManifestPart};
+use std::ffi::OsString;
+use std::io::BufRead as _;
 use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::process::{Command, Stdio};
 
 /// The twin package, embedded: (file name, text).
 const TWINS: &[(&str, &str)] = &[
-    (
-        "__init__.py",
-        include_str!("../../tests/oracles/twins/__init__.py"),
-    ),
-    (
-        "cq_common.py",
-        include_str!("../../tests/oracles/twins/cq_common.py"),
-    ),
-    (
-        "cq_molds.py",
-        include_str!("../../tests/oracles/twins/cq_molds.py"),
-    ),
-    (
-        "cq_layers.py",
-        include_str!("../../tests/oracles/twins/cq_layers.py"),
-    ),
+    ("__init__.py", include_str!("../python/twins/__init__.py")),
+    ("cq_common.py", include_str!("../python/twins/cq_common.py")),
+    ("cq_molds.py", include_str!("../python/twins/cq_molds.py")),
+    ("cq_layers.py", include_str!("../python/twins/cq_layers.py")),
     (
         "cq_housing.py",
-        include_str!("../../tests/oracles/twins/cq_housing.py"),
+        include_str!("../python/twins/cq_housing.py"),
     ),
     (
         "cq_fixtures.py",
-        include_str!("../../tests/oracles/twins/cq_fixtures.py"),
+        include_str!("../python/twins/cq_fixtures.py"),
     ),
-    (
-        "cq_twin.py",
-        include_str!("../../tests/oracles/twins/cq_twin.py"),
-    ),
-    (
-        "families.py",
-        include_str!("../../tests/oracles/twins/families.py"),
-    ),
+    ("cq_twin.py", include_str!("../python/twins/cq_twin.py")),
+    ("families.py", include_str!("../python/twins/families.py")),
     (
         "step_export.py",
-        include_str!("../../tests/oracles/twins/step_export.py"),
+        include_str!("../python/twins/step_export.py"),
     ),
 ];
 
+/// The environment variable that names the CadQuery Python explicitly.
+pub const PYTHON_VAR: &str = "FABKIT_CADQUERY_PYTHON";
+
+/// Where `scripts/setup-cadquery` installs the venv's Python, relative to the XDG data
+/// directory (`$XDG_DATA_HOME`, default `$HOME/.local/share`).
+pub const DATA_HOME_PYTHON: &str = "fabkit/venv-cadquery/bin/python";
+
 /// How to get the CadQuery environment, for error messages.
-pub const INSTALL_HINT: &str = "STEP export runs the CadQuery twin (tests/oracles/twins) in a \
-     Python with CadQuery 2.8: run `scripts/setup-cadquery` in the fabkit repository (builds \
-     .venv-cadquery, about 2.4 GB, from tests/oracles/requirements-cadquery.txt), or set \
+pub const INSTALL_HINT: &str = "STEP export runs fabkit's CadQuery twin in a Python with \
+     CadQuery 2.8: run `scripts/setup-cadquery` from a clone of the fabkit repository (installs \
+     the venv at $XDG_DATA_HOME/fabkit/venv-cadquery, XDG_DATA_HOME defaulting to \
+     ~/.local/share; about 2.4 GB, from tests/oracles/requirements-cadquery.txt), or set \
      FABKIT_CADQUERY_PYTHON to a python that can `import cadquery`";
 
-/// The Python that runs the twins: `FABKIT_CADQUERY_PYTHON`, else the repository's
-/// `.venv-cadquery`. Whether cadquery imports there is told by `step_export.py` itself (exit
-/// status 4), so it is imported once per export, not twice.
+/// The rule for `FABKIT_CADQUERY_PYTHON`, for error messages.
+const PYTHON_VAR_RULE: &str = "it must name an executable Python with CadQuery: a path \
+     (relative ones from the current directory) or a command on PATH; unset or empty for \
+     $XDG_DATA_HOME/fabkit/venv-cadquery/bin/python";
+
+/// Called while STEP files are built: `(part, parts, name)` when the CadQuery twin starts on
+/// part number `part` (1 to `parts`) of `parts`, named `name`; parts come in kit order.
+pub type StepProgress<'a> = &'a dyn Fn(usize, usize, &str);
+
+/// The Python that runs the twins: `FABKIT_CADQUERY_PYTHON` when set and not empty (a path,
+/// made absolute from the current directory, or a command looked up on `PATH`), else
+/// `$XDG_DATA_HOME/fabkit/venv-cadquery/bin/python`, where `XDG_DATA_HOME` defaults to
+/// `$HOME/.local/share` and, per the XDG Base Directory specification, is ignored unless it
+/// is an absolute path. Whether cadquery imports there is told by `step_export.py` itself
+/// (exit status 4), so it is imported once per export, not twice.
 ///
 /// # Errors
-/// [`ExportError::StepUnavailable`] when that Python does not exist.
+/// [`ExportError::StepUnavailable`] when `FABKIT_CADQUERY_PYTHON` names no executable file
+/// (the message names the variable, its value and the rule), when the default Python does
+/// not exist or is not executable, or when neither `XDG_DATA_HOME` nor `HOME` is absolute.
 pub fn cadquery_python() -> Result<PathBuf, ExportError> {
-    let python = match std::env::var_os("FABKIT_CADQUERY_PYTHON") {
-        Some(p) if !p.is_empty() => PathBuf::from(p),
-        _ => Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("..")
-            .join(".venv-cadquery/bin/python"),
-    };
-    if python.components().count() > 1 && !python.exists() {
-        return Err(ExportError::StepUnavailable {
-            reason: format!("no Python at {}", python.display()),
-        });
+    locate_python(&|k| std::env::var_os(k)).map(|(python, _)| python)
+}
+
+/// [`cadquery_python`] with the environment read through `var`; also returns how the Python
+/// was found, for messages (`FABKIT_CADQUERY_PYTHON=...` or the default location).
+fn locate_python(var: &dyn Fn(&str) -> Option<OsString>) -> Result<(PathBuf, String), ExportError> {
+    let unavailable = |reason: String| ExportError::StepUnavailable { reason };
+    if let Some(value) = var(PYTHON_VAR).filter(|v| !v.is_empty()) {
+        let shown = format!("{PYTHON_VAR}={}", Path::new(&value).display());
+        let given = PathBuf::from(&value);
+        let python = if given.components().count() > 1 || given.is_absolute() {
+            let python = std::path::absolute(&given)
+                .map_err(|e| unavailable(format!("{shown}: {e} ({PYTHON_VAR_RULE})")))?;
+            if let Err(why) = executable_file(&python) {
+                return Err(unavailable(format!("{shown}: {why} ({PYTHON_VAR_RULE})")));
+            }
+            python
+        } else {
+            var("PATH")
+                .iter()
+                .flat_map(std::env::split_paths)
+                .filter(|dir| dir.is_absolute())
+                .map(|dir| dir.join(&given))
+                .find(|p| executable_file(p).is_ok())
+                .ok_or_else(|| {
+                    unavailable(format!(
+                        "{shown}: no executable of that name on PATH ({PYTHON_VAR_RULE})"
+                    ))
+                })?
+        };
+        return Ok((python, shown));
     }
-    Ok(python)
+    let absolute = |k: &str| var(k).map(PathBuf::from).filter(|p| p.is_absolute());
+    let ignored = match var("XDG_DATA_HOME") {
+        Some(v) if !v.is_empty() && !Path::new(&v).is_absolute() => format!(
+            "; XDG_DATA_HOME={} is ignored: the XDG Base Directory specification requires an \
+             absolute path",
+            Path::new(&v).display()
+        ),
+        _ => String::new(),
+    };
+    let data_home = absolute("XDG_DATA_HOME")
+        .or_else(|| absolute("HOME").map(|h| h.join(".local/share")))
+        .ok_or_else(|| {
+            unavailable(format!(
+                "{PYTHON_VAR} is not set, and without an absolute XDG_DATA_HOME or HOME there is \
+                 no default location ($XDG_DATA_HOME/{DATA_HOME_PYTHON}, XDG_DATA_HOME \
+                 defaulting to $HOME/.local/share){ignored}"
+            ))
+        })?;
+    let python = data_home.join(DATA_HOME_PYTHON);
+    let shown = format!(
+        "{PYTHON_VAR} is not set (or empty); the default is $XDG_DATA_HOME/{DATA_HOME_PYTHON}, XDG_DATA_HOME \
+         defaulting to $HOME/.local/share{ignored}"
+    );
+    if let Err(why) = executable_file(&python) {
+        let why = if python.exists() {
+            why
+        } else {
+            "no CadQuery Python there".to_string()
+        };
+        return Err(unavailable(format!(
+            "{}: {why} ({shown})",
+            python.display()
+        )));
+    }
+    Ok((python, shown))
+}
+
+/// Ok when `path` (symbolic links followed) is a file that can be executed.
+fn executable_file(path: &Path) -> Result<(), String> {
+    let meta = std::fs::metadata(path).map_err(|e| match e.kind() {
+        std::io::ErrorKind::NotFound => "no such file".to_string(),
+        _ => e.to_string(),
+    })?;
+    if !meta.is_file() {
+        return Err("not a file".to_string());
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt as _;
+        if meta.permissions().mode() & 0o111 == 0 {
+            return Err("not executable (no execute permission)".to_string());
+        }
+    }
+    Ok(())
 }
 
 /// One STEP file per part (same order as `parts`), built by the CadQuery twin from the parts'
-/// params. `chord_tolerance_mm` sets the agreement bound checked before writing.
+/// params. `chord_tolerance_mm` sets the agreement bound checked before writing. `progress`,
+/// if given, is called as the twin starts each part (see [`StepProgress`]), on this thread.
 ///
 /// # Errors
-/// [`ExportError::StepUnavailable`] without CadQuery; [`ExportError::Step`] when a twin fails
-/// or disagrees with fabkit's part; [`ExportError::Io`] for the scratch directory.
+/// [`ExportError::StepUnavailable`] without CadQuery (see [`cadquery_python`]);
+/// [`ExportError::Step`] when a twin fails or disagrees with fabkit's part (the part is the
+/// one the twin's last message names, else the one it was building); [`ExportError::Io`] for
+/// the scratch directory.
 pub fn render(
     parts: &[ManifestPart],
     chord_tolerance_mm: f64,
+    progress: Option<StepProgress<'_>>,
 ) -> Result<Vec<Vec<u8>>, ExportError> {
-    let python = cadquery_python()?;
+    let (python, found) = locate_python(&|k| std::env::var_os(k))?;
+    render_with(&python, &found, parts, chord_tolerance_mm, progress)
+}
+
+/// [`render`] by `python`, found as `found` says (for messages).
+fn render_with(
+    python: &Path,
+    found: &str,
+    parts: &[ManifestPart],
+    chord_tolerance_mm: f64,
+    progress: Option<StepProgress<'_>>,
+) -> Result<Vec<Vec<u8>>, ExportError> {
     let scratch = Scratch::new()?;
     let pkg = scratch.0.join("twins");
     std::fs::create_dir(&pkg).map_err(ExportError::io("creating", &pkg))?;
@@ -103,37 +202,60 @@ pub fn render(
     std::fs::write(&input, serde_json::to_vec(&doc)?)
         .map_err(ExportError::io("writing", &input))?;
     let out_dir = scratch.0.join("step");
-    let out = Command::new(&python)
+    let mut child = Command::new(python)
         .current_dir(&scratch.0)
         .args(["-m", "twins.step_export"])
         .arg(&input)
         .arg(&out_dir)
         .env("PYTHONDONTWRITEBYTECODE", "1")
-        .output()
+        .env("PYTHONUNBUFFERED", "1")
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
         .map_err(|e| ExportError::StepUnavailable {
-            reason: format!("no Python at {} ({e})", python.display()),
+            reason: format!("{} does not run ({e}; {found})", python.display()),
         })?;
-    if out.status.code() == Some(4) {
+    // stderr line by line: progress as it comes, the last message for errors
+    let mut last = String::new();
+    let mut current: Option<String> = None;
+    if let Some(stderr) = child.stderr.take() {
+        for line in std::io::BufReader::new(stderr).split(b'\n') {
+            let Ok(line) = line else { break };
+            let line = String::from_utf8_lossy(&line).trim_end().to_string();
+            if let Some((i, n, name)) = parse_progress(&line) {
+                current = Some(name.to_string());
+                if let Some(f) = progress {
+                    f(i, n, name);
+                }
+            } else if !line.trim().is_empty() {
+                last = line;
+            }
+        }
+    }
+    let status = child
+        .wait()
+        .map_err(ExportError::io("waiting for", python))?;
+    if status.code() == Some(4) {
         return Err(ExportError::StepUnavailable {
-            reason: format!("{} cannot import cadquery", python.display()),
+            reason: format!("{} cannot import cadquery ({found})", python.display()),
         });
     }
-    if !out.status.success() {
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        let last = stderr
-            .lines()
-            .rev()
-            .find(|l| !l.trim().is_empty())
-            .unwrap_or("(no message)");
-        let part = last
+    if !status.success() {
+        let named = last
             .strip_prefix("step_export: part ")
             .and_then(|r| r.split(':').next())
-            .unwrap_or("?")
-            .to_string();
-        return Err(ExportError::Step {
-            part,
-            reason: last.to_string(),
-        });
+            .map(str::to_string);
+        let part = named.or(current).unwrap_or_else(|| "?".to_string());
+        let reason = if last.is_empty() {
+            format!(
+                "{} exited with {status} without a message",
+                python.display()
+            )
+        } else {
+            last
+        };
+        return Err(ExportError::Step { part, reason });
     }
     parts
         .iter()
@@ -142,6 +264,14 @@ pub fn render(
             std::fs::read(&f).map_err(ExportError::io("reading", &f))
         })
         .collect()
+}
+
+/// `step_export: I/N NAME` (the twin starts part I of N) as (I, N, NAME).
+fn parse_progress(line: &str) -> Option<(usize, usize, &str)> {
+    let rest = line.strip_prefix("step_export: ")?;
+    let (count, name) = rest.split_once(' ')?;
+    let (i, n) = count.split_once('/')?;
+    Some((i.parse().ok()?, n.parse().ok()?, name))
 }
 
 /// A scratch directory removed on drop.
@@ -162,5 +292,175 @@ impl Scratch {
 impl Drop for Scratch {
     fn drop(&mut self) {
         let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::collections::HashMap;
+
+    fn env<'a>(pairs: &'a [(&'a str, &'a str)]) -> impl Fn(&str) -> Option<OsString> + 'a {
+        let m: HashMap<&str, &str> = pairs.iter().copied().collect();
+        move |k| m.get(k).map(OsString::from)
+    }
+
+    fn reason(r: Result<(PathBuf, String), ExportError>) -> String {
+        match r {
+            Err(ExportError::StepUnavailable { reason }) => reason,
+            other => panic!("expected StepUnavailable, got {other:?}"),
+        }
+    }
+
+    /// An executable file and a plain one in a fresh directory.
+    fn files() -> (tempfile::TempDir, PathBuf, PathBuf) {
+        use std::os::unix::fs::PermissionsExt as _;
+        let t = tempfile::tempdir().unwrap();
+        let exe = t.path().join("python");
+        std::fs::write(&exe, "#!/bin/sh\n").unwrap();
+        std::fs::set_permissions(&exe, std::fs::Permissions::from_mode(0o755)).unwrap();
+        let plain = t.path().join("plain");
+        std::fs::write(&plain, "").unwrap();
+        std::fs::set_permissions(&plain, std::fs::Permissions::from_mode(0o644)).unwrap();
+        (t, exe, plain)
+    }
+
+    #[test]
+    fn the_variable_wins_and_bad_values_name_it_its_value_and_the_rule() {
+        let (t, exe, plain) = files();
+        let exe_s = exe.to_str().unwrap();
+        let (p, how) =
+            locate_python(&env(&[(PYTHON_VAR, exe_s), ("HOME", "/nonexistent")])).unwrap();
+        assert_eq!(p, exe);
+        assert_eq!(how, format!("FABKIT_CADQUERY_PYTHON={exe_s}"));
+        let dir = t.path().to_str().unwrap();
+        for (value, why) in [
+            ("/nonexistent/python", "no such file"),
+            (plain.to_str().unwrap(), "not executable"),
+            (dir, "not a file"),
+            (
+                "no-such-python-anywhere",
+                "no executable of that name on PATH",
+            ),
+        ] {
+            let r = reason(locate_python(&env(&[(PYTHON_VAR, value), ("PATH", dir)])));
+            assert!(
+                r.starts_with(&format!("FABKIT_CADQUERY_PYTHON={value}: {why}"))
+                    && r.contains("it must name an executable Python with CadQuery"),
+                "{value}: {r}"
+            );
+        }
+        // a bare name is looked up on PATH (absolute entries only)
+        let (p, _) = locate_python(&env(&[
+            (PYTHON_VAR, "python"),
+            ("PATH", &format!("rel:{dir}")),
+        ]))
+        .unwrap();
+        assert_eq!(p, exe);
+    }
+
+    #[test]
+    fn the_default_is_in_the_xdg_data_home_and_a_relative_one_is_ignored() {
+        let (t, exe, _) = files();
+        let data = t.path().join("data");
+        let py = data.join(DATA_HOME_PYTHON);
+        std::fs::create_dir_all(py.parent().unwrap()).unwrap();
+        std::fs::copy(&exe, &py).unwrap();
+        let data_s = data.to_str().unwrap();
+        // XDG_DATA_HOME absolute: used; an empty FABKIT_CADQUERY_PYTHON counts as unset
+        let (p, _) = locate_python(&env(&[
+            ("XDG_DATA_HOME", data_s),
+            (PYTHON_VAR, ""),
+            ("HOME", "/nonexistent"),
+        ]))
+        .unwrap();
+        assert_eq!(p, py);
+        // unset: $HOME/.local/share
+        let home = t.path().join("home");
+        let home_py = home.join(".local/share").join(DATA_HOME_PYTHON);
+        std::fs::create_dir_all(home_py.parent().unwrap()).unwrap();
+        std::fs::copy(&exe, &home_py).unwrap();
+        let home_s = home.to_str().unwrap();
+        let (p, _) = locate_python(&env(&[("HOME", home_s)])).unwrap();
+        assert_eq!(p, home_py);
+        // relative: ignored, and said so when nothing is found
+        let (p, _) = locate_python(&env(&[("HOME", home_s), ("XDG_DATA_HOME", "data")])).unwrap();
+        assert_eq!(p, home_py);
+        let r = reason(locate_python(&env(&[
+            ("HOME", "/nonexistent"),
+            ("XDG_DATA_HOME", "data"),
+        ])));
+        assert!(
+            r.starts_with("/nonexistent/.local/share/fabkit/venv-cadquery/bin/python: no CadQuery Python there")
+                && r.contains("FABKIT_CADQUERY_PYTHON is not set")
+                && r.contains("XDG_DATA_HOME=data is ignored"),
+            "{r}"
+        );
+        let r = reason(locate_python(&env(&[("HOME", "relative")])));
+        assert!(
+            r.contains("without an absolute XDG_DATA_HOME or HOME"),
+            "{r}"
+        );
+    }
+
+    /// A stand-in for the CadQuery Python: a shell script that ignores its arguments.
+    fn fake_python(dir: &Path, script: &str) -> PathBuf {
+        use std::os::unix::fs::PermissionsExt as _;
+        let p = dir.join("python");
+        std::fs::write(&p, format!("#!/bin/sh\n{script}")).unwrap();
+        std::fs::set_permissions(&p, std::fs::Permissions::from_mode(0o755)).unwrap();
+        p
+    }
+
+    #[test]
+    fn progress_is_passed_on_and_a_failure_names_its_part() {
+        let t = tempfile::tempdir().unwrap();
+        let seen = std::cell::RefCell::new(Vec::new());
+        let record =
+            |i: usize, n: usize, name: &str| seen.borrow_mut().push(format!("{i}/{n} {name}"));
+        // the twin names the failing part in its last line
+        let py = fake_python(
+            t.path(),
+            "echo 'step_export: 1/2 a' >&2\necho 'step_export: 2/2 b' >&2\n\
+             echo 'step_export: part b: ValueError: off' >&2\nexit 3\n",
+        );
+        match render_with(&py, "test", &[], 0.01, Some(&record)) {
+            Err(ExportError::Step { part, reason }) => {
+                assert_eq!(part, "b");
+                assert_eq!(reason, "step_export: part b: ValueError: off");
+            }
+            other => panic!("{other:?}"),
+        }
+        assert_eq!(*seen.borrow(), ["1/2 a", "2/2 b"]);
+        // a crash without a message: the part it was building
+        let py = fake_python(t.path(), "echo 'step_export: 1/2 a' >&2\nkill -9 $$\n");
+        match render_with(&py, "test", &[], 0.01, None) {
+            Err(ExportError::Step { part, reason }) => {
+                assert_eq!(part, "a");
+                assert!(reason.contains("without a message"), "{reason}");
+            }
+            other => panic!("{other:?}"),
+        }
+        // exit status 4: no cadquery there
+        let py = fake_python(t.path(), "exit 4\n");
+        match render_with(&py, "FABKIT_CADQUERY_PYTHON=x", &[], 0.01, None) {
+            Err(ExportError::StepUnavailable { reason }) => {
+                assert!(
+                    reason.ends_with("cannot import cadquery (FABKIT_CADQUERY_PYTHON=x)"),
+                    "{reason}"
+                );
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn progress_lines_are_parsed_and_others_are_not() {
+        assert_eq!(
+            parse_progress("step_export: 3/8 skin_mold_top"),
+            Some((3, 8, "skin_mold_top"))
+        );
+        assert_eq!(parse_progress("step_export: part a: ValueError: x"), None);
+        assert_eq!(parse_progress("Traceback (most recent call last):"), None);
     }
 }

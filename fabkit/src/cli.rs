@@ -5,7 +5,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 use fabkit_designs::input_files::DataFileRules;
 use fabkit_designs::schema::MoldStrategy;
 use fabkit_designs::{build_kit_bounded, library, ChordTolerance, Design, DesignError};
-use fabkit_export::{write_kit, ExportOptions, Formats};
+use fabkit_export::{write_kit_reporting, ExportOptions, Formats};
 use std::error::Error;
 
 use std::path::{Path, PathBuf};
@@ -135,7 +135,7 @@ pub(crate) enum Format {
     Stl,
     #[value(name = "3mf")]
     ThreeMf,
-    /// STEP through the CadQuery twin (tests/oracles/twins).
+    /// STEP through the CadQuery twin (export/python/twins).
     Step,
 }
 
@@ -504,7 +504,9 @@ fn export(args: ExportArgs) -> Result<(), Box<dyn Error>> {
     spinner.finish_and_clear();
     let kit = kit?;
     let opts = export_options(&loaded, tol, &args.format);
-    let summary = write_kit(&kit, &out, &opts)?;
+    // STEP export takes seconds a part: one plain line per part (a terminal, a log or a pipe)
+    let step_progress = |i: usize, n: usize, part: &str| eprintln!("STEP {i}/{n}: {part}");
+    let summary = write_kit_reporting(&kit, &[], &out, &opts, Some(&step_progress))?;
     if let Some(csg) = &args.csg {
         write_csg(&kit, csg)?;
     }

@@ -3,7 +3,7 @@
 use crate::cli::{export_options, load_design, tolerance, DataFileArgs, Format};
 use crate::progress::Progress;
 use fabkit_designs::ChordTolerance;
-use fabkit_export::write_kit_with_files;
+use fabkit_export::write_kit_reporting;
 use fabkit_fixtures::params::{apply_pin_preset, from_yaml, FixtureParams};
 use fabkit_fixtures::FixtureProgress;
 use std::error::Error;
@@ -135,7 +135,15 @@ pub fn run(args: FixturesArgs) -> Result<(), Box<dyn Error>> {
         ));
     }
     let opts = export_options(&loaded, tol, &args.format);
-    let summary = write_kit_with_files(&set.kit, &set.files, &out, &opts);
+    // STEP export takes seconds a part: each part as the CadQuery twin starts it
+    let step_progress = |i: usize, n: usize, part: &str| {
+        let what = format!("STEP {i}/{n}: {part}");
+        match &progress {
+            Some(p) => p.stage(&what),
+            None => eprintln!("{what}"),
+        }
+    };
+    let summary = write_kit_reporting(&set.kit, &set.files, &out, &opts, Some(&step_progress));
     if let Some(p) = progress {
         p.finish();
     }

@@ -50,6 +50,19 @@ pub fn oracle_python() -> Option<PathBuf> {
     p.exists().then_some(p)
 }
 
+/// The CadQuery python of the full twin tier and of STEP export tests: $FABKIT_CADQUERY_PYTHON
+/// (scripts/setup-cadquery prints it; .ci/run sets it), or None (the test skips). Panics when
+/// it is unset but FABKIT_REQUIRE_CADQUERY=1.
+pub fn cadquery_python() -> Option<PathBuf> {
+    let p = std::env::var_os("FABKIT_CADQUERY_PYTHON")
+        .filter(|p| !p.is_empty())
+        .map(PathBuf::from);
+    if p.is_none() && std::env::var("FABKIT_REQUIRE_CADQUERY").is_ok_and(|v| v == "1") {
+        panic!("FABKIT_REQUIRE_CADQUERY=1 but FABKIT_CADQUERY_PYTHON is not set (scripts/setup-cadquery)");
+    }
+    p
+}
+
 /// printcheck: $FABKIT_PRINTCHECK or <root>/../shared/tools/printcheck, if prusa-slicer is on PATH.
 pub fn printcheck() -> Option<PathBuf> {
     let p = std::env::var("FABKIT_PRINTCHECK")

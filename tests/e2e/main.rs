@@ -14,5 +14,6 @@ mod fixtures_cli;
 mod groundtruth_cli;
 mod groundtruth_open3d;
 mod maker_path;
+mod step_install;
 mod sweep_cli;
 mod twins;

@@ -6,7 +6,7 @@
 //! The Markdown report (one row per part) goes to `$FABKIT_TWIN_REPORT_DIR` (default
 //! `<temp dir>/fabkit-twins`), outside the repository; any row out of bounds fails the test.
 
-use crate::common::{missing, oracle_python, repo_root, run, text};
+use crate::common::{cadquery_python, fabkit, missing, oracle_python, repo_root, run, text};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -89,8 +89,7 @@ fn check_twins(py: &Path, tier: &str, extra: &[&str], exports: &[PathBuf]) -> Pa
     let report = report_dir().join(format!("twins-{tier}.md"));
     let json = report_dir().join(format!("twins-{tier}.json"));
     let o = Command::new(py)
-        .current_dir(repo_root().join("tests/oracles"))
-        .arg("twins/check_twins.py")
+        .arg(repo_root().join("export/python/twins/check_twins.py"))
         .args(exports)
         .args(["--tier", tier])
         .args(extra)
@@ -136,15 +135,6 @@ fn manifold3d_twin_agrees_on_every_part() {
     check_twins(&py, "fast", &[], &exports);
 }
 
-/// The CadQuery python of the full tier, if configured.
-fn cadquery_python() -> Option<PathBuf> {
-    let p = std::env::var_os("FABKIT_CADQUERY_PYTHON").map(PathBuf::from);
-    if p.is_none() && std::env::var("FABKIT_REQUIRE_CADQUERY").is_ok_and(|v| v == "1") {
-        panic!("FABKIT_REQUIRE_CADQUERY=1 but FABKIT_CADQUERY_PYTHON is not set (scripts/setup-cadquery)");
-    }
-    p
-}
-
 /// Full tier: the exact CadQuery twin of every part (volume within the chord bound, Hausdorff
 /// distance, bounding box, genus), and STEP export of every part read back by CadQuery with
 /// the exact solid's volume.
@@ -184,8 +174,7 @@ fn cadquery_twin_agrees_on_every_part_and_step_reads_back() {
     let json = check_twins(&py, "full", &["--skip-manifold3d"], &exports);
     // every folder's STEP files read back in one CadQuery start
     let o = Command::new(&py)
-        .current_dir(repo_root().join("tests/oracles"))
-        .arg("twins/check_step.py")
+        .arg(repo_root().join("export/python/twins/check_step.py"))
         .args(&exports)
         .arg("--exact-json")
         .arg(&json)
@@ -213,33 +202,91 @@ fn cadquery_twin_agrees_on_every_part_and_step_reads_back() {
     );
 }
 
-/// Without the CadQuery environment (no such Python, or a Python without cadquery: the
-/// system's), `--format step` fails (exit 2), says how to install it, and writes nothing.
+/// Without the CadQuery environment, `--format step` fails (exit 2), says why (naming the
+/// variable, its value and the rule, or the default location it looked in), says how to
+/// install it, and writes nothing: FABKIT_CADQUERY_PYTHON naming no file, a file that is not
+/// executable, a Python without cadquery (the system's), or unset with no venv in the XDG data
+/// directory (absolute XDG_DATA_HOME, or HOME when XDG_DATA_HOME is relative). The data
+/// directories are temporary ones, so the result depends on neither the repository nor the
+/// user's own installation.
 #[test]
 fn step_without_cadquery_says_how_to_install() {
     let no_cadquery = Command::new("python3")
         .args(["-c", "import cadquery"])
         .output()
         .is_ok_and(|o| !o.status.success());
-    let mut cases = vec![("/nonexistent/python", "no Python at /nonexistent/python")];
+    let t = tempfile::tempdir().unwrap();
+    let data = t.path().join("data");
+    let home = t.path().join("home");
+    let plain = t.path().join("plain-file");
+    std::fs::write(&plain, "").unwrap();
+    let (data_s, home_s, plain_s) = (
+        data.to_str().unwrap(),
+        home.to_str().unwrap(),
+        plain.to_str().unwrap(),
+    );
+    let default_py = format!("{data_s}/fabkit/venv-cadquery/bin/python");
+    let home_py = format!("{home_s}/.local/share/fabkit/venv-cadquery/bin/python");
+    let unset = "FABKIT_CADQUERY_PYTHON is not set";
+    // (FABKIT_CADQUERY_PYTHON, XDG_DATA_HOME, what the message must hold)
+    let mut cases: Vec<(Option<&str>, &str, Vec<String>)> = vec![
+        (
+            Some("/nonexistent/python"),
+            data_s,
+            vec![
+                "FABKIT_CADQUERY_PYTHON=/nonexistent/python: no such file".into(),
+                "it must name an executable Python with CadQuery".into(),
+            ],
+        ),
+        (
+            Some(plain_s),
+            data_s,
+            vec![format!("FABKIT_CADQUERY_PYTHON={plain_s}: not executable")],
+        ),
+        (
+            None,
+            data_s,
+            vec![
+                format!("{default_py}: no CadQuery Python there"),
+                unset.into(),
+            ],
+        ),
+        (
+            None,
+            "relative/data",
+            vec![
+                format!("{home_py}: no CadQuery Python there"),
+                "XDG_DATA_HOME=relative/data is ignored".into(),
+            ],
+        ),
+    ];
     if no_cadquery {
-        cases.push(("python3", "python3 cannot import cadquery"));
+        cases.push((
+            Some("python3"),
+            data_s,
+            vec!["cannot import cadquery (FABKIT_CADQUERY_PYTHON=python3)".into()],
+        ));
     }
-    for (python, reason) in cases {
-        let t = tempfile::tempdir().unwrap();
-        let o = run(
-            t.path(),
-            &["export", "rtac0", "--format", "stl,step", "--out", "kit"],
-            &[("FABKIT_CADQUERY_PYTHON", python)],
-        );
-        assert_eq!(o.status.code(), Some(2), "{python}");
+    for (python, xdg, reasons) in cases {
+        let mut c = fabkit();
+        c.current_dir(t.path())
+            .args(["export", "rtac0", "--format", "stl,step", "--out", "kit"])
+            .env("XDG_DATA_HOME", xdg)
+            .env("HOME", home_s)
+            .env_remove("FABKIT_CADQUERY_PYTHON");
+        if let Some(p) = python {
+            c.env("FABKIT_CADQUERY_PYTHON", p);
+        }
+        let o = c.output().expect("fabkit runs");
+        assert_eq!(o.status.code(), Some(2), "{python:?}");
         let err = text(&o.stderr);
         assert!(
             err.contains("STEP export is not available")
-                && err.contains(reason)
-                && err.contains("scripts/setup-cadquery"),
-            "{python}: {err}"
+                && reasons.iter().all(|r| err.contains(r.as_str()))
+                && err.contains("scripts/setup-cadquery")
+                && err.contains("$XDG_DATA_HOME/fabkit/venv-cadquery"),
+            "{python:?}, XDG_DATA_HOME={xdg}: {err}"
         );
-        assert!(!t.path().join("kit").exists(), "{python}");
+        assert!(!t.path().join("kit").exists(), "{python:?}");
     }
 }

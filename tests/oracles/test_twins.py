@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Self-test of tests/oracles/twins: the mesh measures with known answers (always), and with
+"""Self-test of the twins (export/python/twins): the mesh measures with known answers (always), and with
 CadQuery importable, the exact building blocks and the exact comparison against closed forms.
 
 Usage: python tests/oracles/test_twins.py   (exit 0 when every check passes)
@@ -15,7 +15,8 @@ from pathlib import Path
 import manifold3d
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+# the twins package: <repo>/export/python/twins (this file: <repo>/tests/oracles)
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "export" / "python"))
 
 from twins import compare as K  # noqa: E402
 

@@ -9,7 +9,8 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+# replay_csg lives with the other oracles: <repo>/tests/oracles (this file: <repo>/export/python/twins)
+sys.path.insert(0, str(Path(__file__).resolve().parents[3] / "tests" / "oracles"))
 
 import manifold3d  # noqa: E402
 import replay_csg  # noqa: E402

@@ -8,4 +8,9 @@
   genus) and its bounds;
 - check_twins.py: the command line that runs both twins on exports and writes the report;
 - step_export.py: STEP files of an export through the CadQuery twins (`fabkit export --format step`).
+
+fabkit embeds the modules STEP export runs (this file, cq_*.py, families.py, step_export.py;
+see export/src/step.rs); the others are the test tools of tests/e2e/twins.rs, run as scripts
+(`python export/python/twins/check_twins.py ...`), and m3d_twin.py imports
+tests/oracles/replay_csg.py.
 """

@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
 """Cross-verify fabkit exports against their twins and write the Markdown report (issue 7).
 
-Usage: python -m twins.check_twins EXPORT_DIR... --report REPORT.md [--json OUT.json]
-                                   [--tier fast|full] [--skip-manifold3d]
-                                   (run from tests/oracles)
+Usage: python export/python/twins/check_twins.py EXPORT_DIR... --report REPORT.md
+                                   [--json OUT.json] [--tier fast|full] [--skip-manifold3d]
+                                   (from any directory)
 
 Each EXPORT_DIR is a `fabkit export` or `fabkit fixtures` output (manifest.json, parts/*.stl)
 with the CSG tree of its parts beside it as EXPORT_DIR.csg.json (`--csg`). Per part:
@@ -133,7 +133,7 @@ def report(rows: list[dict], tier: str, meta: dict, manifold3d: bool = True) -> 
            + ", ".join(f"{k} {v}" for k, v in meta.items()), "",
            "Bounds: volume vs exact <= area x tol + 1e-6 V; vs manifold3d <= 1e-6 relative; "
            "symmetric Hausdorff (over faces and at the exact solid's edges) and bounding box "
-           "<= tol + 1 um (see tests/oracles/twins/compare.py); genus equal.", ""]
+           "<= tol + 1 um (see export/python/twins/compare.py); genus equal.", ""]
     if tier == "full":
         out += ["| export | part | family | triangles | V fabkit mm3 | V exact mm3 | dV / bound | "
                 "V m3d rel diff | Hausdorff exact um (bound) | at seams um (bound) | Hausdorff m3d um | bbox dev um | "

@@ -9,8 +9,10 @@ bound of fabkit's (|dV| <= area x tol + 1e-6 V) and its bounding box within tol 
 that disagrees with fabkit's part would write a wrong STEP file.
 
 The STEP header carries no time stamp (fixed fields), and booleans run single-threaded, so the
-same parts give the same bytes. Exit status: 0 written; 2 unreadable input; 3 a twin failed or
-disagreed (the last stderr line names the part: `step_export: part NAME: ...`); 4 no CadQuery.
+same parts give the same bytes. Progress goes to stderr, one line as each part starts:
+`step_export: I/N NAME` (part I of N, in the input's order). Exit status: 0 written; 2 unreadable
+input; 3 a twin failed or disagreed (the last stderr line names the part:
+`step_export: part NAME: ...`); 4 no CadQuery.
 """
 
 from __future__ import annotations
@@ -69,8 +71,9 @@ def main(argv=None) -> int:
         return 2
     out = Path(argv[1])
     out.mkdir(parents=True, exist_ok=True)
-    for part in parts:
+    for i, part in enumerate(parts, start=1):
         name = part["name"]
+        print(f"step_export: {i}/{len(parts)} {name}", file=sys.stderr, flush=True)
         try:
             shape = cq_twin.build(part)
             v = cq_common.exact_volume(shape)

@@ -2,7 +2,7 @@
 """Time the CadQuery twin of a whole export: build every part's exact solid from the manifest
 and write its STEP file (the work `fabkit export --format step` adds), best of N runs.
 
-Usage: python twins/bench.py EXPORT_DIR [--repeat N]   (from tests/oracles); prints JSON
+Usage: python export/python/twins/bench.py EXPORT_DIR [--repeat N]   (from any directory); prints JSON
 {"design", "parts", "build_s_best", "step_s_best", "total_s_best", "runs": [...]}.
 """
 

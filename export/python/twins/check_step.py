@@ -2,8 +2,8 @@
 """Read back the STEP files of a `fabkit export --format step` (CadQuery import) and check each
 against the exact solid (issue 7).
 
-Usage: python twins/check_step.py EXPORT_DIR [EXPORT_DIR ...] [--exact-json TWINS.json]
-       (from tests/oracles; one CadQuery start for every export folder)
+Usage: python export/python/twins/check_step.py EXPORT_DIR [EXPORT_DIR ...]
+       [--exact-json TWINS.json]   (from any directory; one CadQuery start for every export folder)
 
 Per part with a `step_file` in manifest.json: the file imports into CadQuery as a valid shape
 with as many solids as the exact twin, and its volume equals the exact twin's within 1e-6
