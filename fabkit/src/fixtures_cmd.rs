@@ -39,7 +39,7 @@ pub struct FixturesArgs {
     #[arg(long, default_value_t = ChordTolerance::DEFAULT_MM)]
     chord_tolerance_mm: f64,
     /// Also write the CSG tree of every part (fabkit-csg/1 JSON) to this file, for the
-    /// manifold3d twin (tests/oracles/twins).
+    /// manifold3d twin (export/python/twins).
     #[arg(long)]
     csg: Option<PathBuf>,
     /// Refuse fixtures estimated (before building) at more triangles than this (about 1 KB of
