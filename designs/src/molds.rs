@@ -66,7 +66,7 @@ pub fn affine_then(a: &Affine, b: &Affine) -> Affine {
 /// `s` turned by the rigid map `pose` into its print orientation, then placed as
 /// [`place_on_bed`] does; with the whole map `T_print_sensor` (3x4 row-major, sensor frame to
 /// print frame, mm). Parts record it in `params.T_print_sensor` so that an independent twin
-/// (tests/oracles/twins) can rebuild them in the sensor frame and place them the same way.
+/// (export/python/twins) can rebuild them in the sensor frame and place them the same way.
 pub fn place_posed(s: &Solid, pose: &Affine) -> (Solid, Affine) {
     let turned = if *pose == IDENTITY {
         s.clone()
