@@ -162,6 +162,11 @@ pub fn build_kit_bounded(
             .ok_or_else(|| DesignError::Yaml(format!("unknown material {material_key}")))?;
         let mut r =
             pour(step, &layer, &material_key, m, holders, v, waste).map_err(DesignError::Yaml)?;
+        r.layer_volume_ml = stack
+            .layers
+            .iter()
+            .find(|l| l.name == layer)
+            .map(|l| layer_volume_mm3(&design.body, l) / 1000.0);
         if r.mold_parts.iter().any(|p| p.ends_with(":inner")) {
             // boundary strategy (UVDtact Sec. III)
             r.notes = format!(
@@ -260,4 +265,19 @@ fn housing_items(h: &crate::schema::HousingParams) -> Vec<String> {
             h.joint_screw.pilot_depth_mm
         ),
     ]
+}
+
+/// Volume of `layer` alone, mm^3: the solid under its outer surface down to the base plane,
+/// less the solid under its inner surface (nothing for a solid layer), from the exact profile
+/// ([`crate::profile::BodyProfile::analytic_solid_volume_mm3`]); marker features not counted.
+pub fn layer_volume_mm3(
+    body: &crate::profile::BodyProfile,
+    layer: &crate::stack::ResolvedLayer,
+) -> f64 {
+    let outer = body.analytic_solid_volume_mm3(layer.outer_offset_mm, 0.0);
+    if layer.solid {
+        outer
+    } else {
+        outer - body.analytic_solid_volume_mm3(layer.inner_offset_mm, 0.0)
+    }
 }

@@ -72,10 +72,17 @@ pub struct CastReport {
     pub cast: String,
     /// Material key in the materials table.
     pub material: String,
+    /// The material's product name (the table's `name`), for the fabrication sheet.
+    pub material_name: String,
     /// Names of the parts that hold this pour.
     pub mold_parts: Vec<String>,
-    /// Volume to fill, mL (= cm^3).
+    /// Volume to fill, mL (= cm^3): the cavity with its reservoir and sprue (the pour).
     pub cavity_volume_ml: f64,
+    /// Volume of the cast layer itself, mL: the solid between its inner and outer surfaces
+    /// down to the base plane, from the exact profile (marker features not counted); `None`
+    /// for a silicone mold.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub layer_volume_ml: Option<f64>,
     /// Fraction added for losses in cups, sprue and vents (0.2 = 20 %).
     pub waste_allowance: f64,
     /// Mix ratio as written on the datasheet, e.g. `10:1 by weight`.
@@ -93,6 +100,10 @@ pub struct CastReport {
 pub struct CastComponent {
     pub name: String,
     pub mass_g: f64,
+    /// Volume to measure out, mL, for a mix by volume (Mold Star 30 is mixed 1A:1B by volume);
+    /// `None` for a mix by weight.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub volume_ml: Option<f64>,
 }
 
 /// Everything one design build produces.

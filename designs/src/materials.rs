@@ -120,6 +120,8 @@ pub fn pour(
     let volume_ml = cavity_volume_mm3 / 1000.0;
     let total = volume_ml * material.density_g_per_cm3 * (1.0 + waste_allowance);
     let sum: f64 = mix.ratio.iter().sum();
+    let by_volume = matches!(mix.by, MixBasis::Volume);
+    let total_ml = volume_ml * (1.0 + waste_allowance);
     let components = mix
         .components
         .iter()
@@ -127,6 +129,7 @@ pub fn pour(
         .map(|(name, r)| CastComponent {
             name: name.clone(),
             mass_g: total * r / sum,
+            volume_ml: by_volume.then(|| total_ml * r / sum),
         })
         .collect();
     let ratio = mix
@@ -139,8 +142,10 @@ pub fn pour(
         step,
         cast: cast.to_string(),
         material: material_key.to_string(),
+        material_name: material.name.clone(),
         mold_parts,
         cavity_volume_ml: volume_ml,
+        layer_volume_ml: None,
         waste_allowance,
         mix_ratio: format!(
             "{ratio} by {}",

@@ -91,23 +91,55 @@ pub(crate) fn render(m: &Manifest) -> String {
     }
     for c in &m.casts {
         let _ = writeln!(s, "### Step {}: {}\n", c.step, text(&c.cast));
-        let _ = writeln!(s, "- material: {}", code(&c.material));
+        let _ = writeln!(s, "- material: {}", text(&c.material_name));
         let _ = writeln!(s, "- mix ratio: {}", text(&c.mix_ratio));
         if !c.mold_parts.is_empty() {
             let parts: Vec<String> = c.mold_parts.iter().map(|p| code(p)).collect();
             let _ = writeln!(s, "- held by: {}", parts.join(", "));
         }
-        let _ = writeln!(s, "- cavity volume: {:.2} mL", c.cavity_volume_ml);
+        if let Some(v) = c.layer_volume_ml {
+            let _ = writeln!(
+                s,
+                "- layer volume: {v:.2} mL (the cast layer alone, from the exact profile)"
+            );
+        }
+        let _ = writeln!(
+            s,
+            "- pour volume: {:.2} mL (the cavity with its reservoir and sprue)",
+            c.cavity_volume_ml
+        );
         let _ = writeln!(
             s,
             "- waste allowance: {:.0} % (included in the masses below)",
             c.waste_allowance * 100.0
         );
-        s.push_str("- weigh out:\n");
+        let by_volume = c.components.iter().any(|x| x.volume_ml.is_some());
+        s.push_str(if by_volume {
+            "- measure out (mixed by volume):\n"
+        } else {
+            "- weigh out:\n"
+        });
         for comp in &c.components {
-            let _ = writeln!(s, "  - {}: {:.2} g", text(&comp.name), comp.mass_g);
+            match comp.volume_ml {
+                Some(v) => {
+                    let _ = writeln!(
+                        s,
+                        "  - {}: {v:.2} mL ({:.2} g)",
+                        text(&comp.name),
+                        comp.mass_g
+                    );
+                }
+                None => {
+                    let _ = writeln!(s, "  - {}: {:.2} g", text(&comp.name), comp.mass_g);
+                }
+            }
         }
-        let _ = writeln!(s, "  - total: {:.2} g", c.total_mass_g);
+        if by_volume {
+            let ml: f64 = c.components.iter().filter_map(|x| x.volume_ml).sum();
+            let _ = writeln!(s, "  - total: {ml:.2} mL ({:.2} g)", c.total_mass_g);
+        } else {
+            let _ = writeln!(s, "  - total: {:.2} g", c.total_mass_g);
+        }
         if !c.notes.trim().is_empty() {
             let _ = writeln!(s, "- notes: {}", text(&c.notes));
         }

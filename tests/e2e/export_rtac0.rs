@@ -79,6 +79,44 @@ fn master_strategy_kit_passes_oracles_and_printcheck() {
             "translucent_gel"
         ]
     );
+    // Mold Star 30 is mixed by volume: the sheet gives millilitres (and grams), and product
+    // names, never the table's keys.
+    let mold_star = m["casts"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["material"] == "mold_star_30")
+        .unwrap();
+    let ml: Vec<f64> = mold_star["components"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["volume_ml"].as_f64().unwrap())
+        .collect();
+    let pour = mold_star["cavity_volume_ml"].as_f64().unwrap();
+    assert!(
+        (ml[0] - ml[1]).abs() < 1e-12 && (ml[0] + ml[1] - pour * 1.2).abs() < 1e-9,
+        "{ml:?}"
+    );
+    let sheet = std::fs::read_to_string(tmp.path().join("rtac0/FABRICATION.md")).unwrap();
+    assert!(
+        sheet.contains("- material: Smooth-On Mold Star 30"),
+        "{sheet}"
+    );
+    assert!(
+        sheet.contains("- measure out (mixed by volume):"),
+        "{sheet}"
+    );
+    assert!(
+        sheet.contains(&format!("  - Part A: {:.2} mL (", ml[0])),
+        "{sheet}"
+    );
+    for key in ["mold_star_30", "sylgard_184", "ecoflex_00_30"] {
+        assert!(
+            !sheet.contains(&format!("- material: `{key}`")),
+            "{key} named by its key"
+        );
+    }
     oracle_check(&tmp.path().join("rtac0"));
     printcheck_all(&files_of(&tmp.path().join("rtac0")));
 }
@@ -220,6 +258,26 @@ fn pour_numbers_follow_from_the_cavity_and_the_materials_table() {
         "pour {v2}, layer {layer2}"
     );
     assert!(eco["notes"].as_str().unwrap().contains("black_coating"));
+    // Each layer's own volume is stated beside its pour (analytic: the shells above).
+    for (c, want) in [(pdms, layer), (eco, layer2)] {
+        let got = c["layer_volume_ml"].as_f64().unwrap() * 1000.0;
+        assert!((got - want).abs() < 1e-6, "{}: {got} vs {want}", c["cast"]);
+    }
+    let sheet = std::fs::read_to_string(tmp.path().join("rtac0/FABRICATION.md")).unwrap();
+    for line in [
+        format!(
+            "- layer volume: {:.2} mL (the cast layer alone, from the exact profile)",
+            layer2 / 1000.0
+        ),
+        format!(
+            "- pour volume: {:.2} mL (the cavity with its reservoir and sprue)",
+            v2 / 1000.0
+        ),
+        "- material: Smooth-On Ecoflex 00-30".to_string(),
+        "- material: Dow SYLGARD 184 silicone elastomer (PDMS)".to_string(),
+    ] {
+        assert!(sheet.contains(&line), "no `{line}` in the sheet");
+    }
 }
 
 /// A part's STL vertices mapped back into the sensor frame through its `T_print_sensor`

@@ -39,3 +39,44 @@ fn uncastable_material_is_an_error() {
     let m = t.get("pla_black").unwrap();
     assert!(pour(1, "x", "pla_black", m, vec![], 1.0, 0.1).is_err());
 }
+
+/// A mix by volume (Mold Star 30, 1A:1B) gives each component in millilitres, the pour plus
+/// the waste allowance split by the ratio, and the grams at the mixed density; a mix by weight
+/// gives grams only. The material's product name goes with every pour.
+#[test]
+fn mixes_by_volume_are_measured_in_millilitres() {
+    use fabkit_designs::materials::{pour, MaterialsTable};
+    let t = MaterialsTable::embedded().unwrap();
+    let ms = &t.materials["mold_star_30"];
+    let r = pour(
+        1,
+        "silicone_mold:x",
+        "mold_star_30",
+        ms,
+        vec![],
+        10_000.0,
+        0.2,
+    )
+    .unwrap();
+    assert_eq!(r.material_name, "Smooth-On Mold Star 30");
+    let ml: Vec<f64> = r.components.iter().map(|c| c.volume_ml.unwrap()).collect();
+    assert!(
+        (ml[0] - 6.0).abs() < 1e-12 && (ml[1] - 6.0).abs() < 1e-12,
+        "{ml:?}"
+    );
+    for c in &r.components {
+        assert!((c.mass_g - c.volume_ml.unwrap() * ms.density_g_per_cm3).abs() < 1e-9);
+    }
+    let s = pour(
+        1,
+        "x",
+        "sylgard_184",
+        &t.materials["sylgard_184"],
+        vec![],
+        10_000.0,
+        0.2,
+    )
+    .unwrap();
+    assert!(s.components.iter().all(|c| c.volume_ml.is_none()));
+    assert!(s.layer_volume_ml.is_none());
+}
