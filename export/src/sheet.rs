@@ -167,10 +167,45 @@ pub(crate) fn render(m: &Manifest) -> String {
     );
     s.push_str(
         "3. After printing: measure the overall size with calipers against the print list \
-         (typically within ±0.2 mm for FDM, ±0.1 mm for SLA); mold halves must close without \
-         a gap and their registration keys must engage before any pour.\n",
+         (typically within ±0.2 mm for FDM, ±0.1 mm for SLA).\n",
     );
+    for check in fit_checks(m) {
+        let _ = writeln!(s, "   - {check}");
+    }
     s
+}
+
+/// The fit checks of the kit's own parts, by role, before any pour: only what the kit has.
+fn fit_checks(m: &Manifest) -> Vec<&'static str> {
+    let count = |role: &str| m.parts.iter().filter(|p| p.role == role).count();
+    let mut out = Vec::new();
+    if count("mold_half") > 0 {
+        out.push(
+            "mold halves: they close without a gap and their registration keys engage; the \
+             clamp bolts pass through both halves",
+        );
+    }
+    if count("open_mold_piece") > 1 {
+        out.push(
+            "two-piece mold: the top piece's boss seats in the cavity block's pocket without a \
+             gap and the clamp bolts pass through both pieces",
+        );
+    }
+    if count("mold_box") > 0 {
+        out.push(
+            "master patterns: each seats in its mold box, plinth in the recess, with no gap the \
+             Mold Star could run under",
+        );
+    }
+    if count("core_holder") + count("casting_jig") > 0 {
+        out.push(
+            "core holders and casting jigs: the core slides onto the centring pin without play",
+        );
+    }
+    if count("shell_tube") + count("shell_base") + count("shell_half") > 0 {
+        out.push("shell: the parts fit together and their screw holes line up");
+    }
+    out
 }
 
 /// The skin's layers, inner to outer, with their thicknesses, from `summary.layers` (nothing

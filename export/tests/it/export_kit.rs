@@ -1012,3 +1012,47 @@ fn previous_output_changed_by_the_user_is_refused_and_untouched() {
     assert_eq!(tree(&out), before);
     assert_eq!(entries(root.path()), ["kit"]);
 }
+
+/// The sheet's "checking the prints" list names only what the kit has: registration keys for
+/// the halves of a direct mold, the boss and pocket of a two-piece open mold, the mold boxes of
+/// master patterns (ShadowTac's two-piece mold and the printed TacTip skin have no registration
+/// keys, and the sheet once told their makers to check them).
+#[test]
+fn checking_the_prints_lists_only_the_kits_own_fits() {
+    use fabkit_designs::schema::MoldStrategy;
+    let tol = ChordTolerance::new(0.05).unwrap();
+    let mut designs: Vec<fabkit_designs::Design> = fabkit_designs::library::LIBRARY
+        .iter()
+        .map(|(n, _)| fabkit_designs::library::load(n).unwrap())
+        .collect();
+    let mut direct = fabkit_designs::library::load("rtac0").unwrap();
+    direct.mold.strategy = MoldStrategy::Direct;
+    direct.name = "rtac0_mold_direct".into();
+    designs.push(direct);
+    let root = tempfile::tempdir().unwrap();
+    let mut seen_keys = 0;
+    for d in &designs {
+        let kit = fabkit_designs::build_kit(d, tol).unwrap();
+        let out = root.path().join(&d.name);
+        write_kit(&kit, &out, &opts()).unwrap();
+        let sheet = fs::read_to_string(out.join("FABRICATION.md")).unwrap();
+        let checks = &sheet[sheet.find("## Checking the prints").unwrap()..];
+        let roles = |r: &str| kit.parts.iter().filter(|p| p.role == r).count();
+        let keys = checks.contains("registration keys");
+        assert_eq!(keys, roles("mold_half") > 0, "{}: {checks}", d.name);
+        assert_eq!(
+            checks.contains("boss"),
+            roles("open_mold_piece") > 1,
+            "{}: {checks}",
+            d.name
+        );
+        assert_eq!(
+            checks.contains("mold box"),
+            roles("mold_box") > 0,
+            "{}: {checks}",
+            d.name
+        );
+        seen_keys += usize::from(keys);
+    }
+    assert_eq!(seen_keys, 1, "only the direct kit has registration keys");
+}
