@@ -221,6 +221,8 @@ fn render(
 ) -> Result<Rendered, ExportError> {
     let mut files = Vec::new();
     let mut parts = Vec::with_capacity(kit.parts.len());
+    // product names and densities of the printed materials
+    let materials = fabkit_designs::materials::MaterialsTable::embedded().ok();
     for (part, mesh) in kit.parts.iter().zip(meshes) {
         let bbox = mesh
             .bounding_box()
@@ -249,6 +251,14 @@ fn render(
             role: part.role.clone(),
             description: part.description.clone(),
             material: part.material.clone(),
+            material_name: materials
+                .as_ref()
+                .and_then(|t| t.materials.get(&part.material))
+                .map_or_else(|| part.material.clone(), |m| m.name.clone()),
+            mass_g: materials
+                .as_ref()
+                .and_then(|t| t.materials.get(&part.material))
+                .map_or(0.0, |m| mesh.signed_volume() / 1000.0 * m.density_g_per_cm3),
             print_technology: part.print_technology,
             group: part.group.clone(),
             volume_mm3: mesh.signed_volume(),

@@ -69,6 +69,14 @@ pub struct ManifestPart {
     pub description: String,
     /// Material key in the materials table.
     pub material: String,
+    /// The material's product name (the materials table's `name`; the key when the table has
+    /// no such material).
+    #[serde(default)]
+    pub material_name: String,
+    /// Printed mass, g: the volume times the material's density (0 when the table has no
+    /// such material).
+    #[serde(default)]
+    pub mass_g: f64,
     /// `"FDM"`, `"SLA"` or `"PolyJet"`.
     pub print_technology: PrintTechnology,
     /// Multi-material print group, `null` for a part printed on its own. Parts of one group

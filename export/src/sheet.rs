@@ -63,7 +63,7 @@ pub(crate) fn render(m: &Manifest) -> String {
             file,
             p.print_technology,
             p.group.as_deref().map_or_else(|| "–".to_owned(), code),
-            code(&p.material),
+            text(&p.material_name),
             p.volume_mm3,
             sx,
             sy,
@@ -146,6 +146,8 @@ pub(crate) fn render(m: &Manifest) -> String {
         s.push('\n');
     }
 
+    shopping_list(&mut s, m);
+
     s.push_str("## Bought items\n\n");
     if m.bought_items.is_empty() {
         s.push_str("None.\n");
@@ -173,6 +175,55 @@ pub(crate) fn render(m: &Manifest) -> String {
         let _ = writeln!(s, "   - {check}");
     }
     s
+}
+
+/// The consumables to buy, per product, with the amounts this kit uses: each cast material's
+/// mix (grams, or millilitres and grams for a mix by volume; waste allowance included) and each
+/// print material's grams (part volumes times density, before supports and purge).
+fn shopping_list(s: &mut String, m: &Manifest) {
+    // (product, grams, millilitres when mixed by volume)
+    let mut items: Vec<(String, f64, Option<f64>)> = Vec::new();
+    let mut add =
+        |name: &str, g: f64, ml: Option<f64>| match items.iter_mut().find(|(n, _, _)| n == name) {
+            Some((_, tg, tml)) => {
+                *tg += g;
+                if let (Some(a), Some(b)) = (tml.as_mut(), ml) {
+                    *a += b;
+                }
+            }
+            None => items.push((name.to_string(), g, ml)),
+        };
+    for c in &m.casts {
+        let ml = c
+            .components
+            .iter()
+            .all(|x| x.volume_ml.is_some())
+            .then(|| c.components.iter().filter_map(|x| x.volume_ml).sum());
+        add(&c.material_name, c.total_mass_g, ml);
+    }
+    for p in &m.parts {
+        if p.mass_g > 0.0 {
+            add(&p.material_name, p.mass_g, None);
+        }
+    }
+    if items.is_empty() {
+        return;
+    }
+    s.push_str("## Shopping list\n\n");
+    s.push_str(
+        "What this kit uses, per product: cast materials as mixed (waste allowance included), \
+         prints as the parts' volume times the material's density (add supports, purge and \
+         failed prints).\n\n",
+    );
+    s.push_str("| Product | Amount |\n|---------|-------:|\n");
+    for (name, g, ml) in items {
+        let amount = match ml {
+            Some(ml) => format!("{ml:.1} mL ({g:.1} g)"),
+            None => format!("{g:.1} g"),
+        };
+        let _ = writeln!(s, "| {} | {amount} |", text(&name));
+    }
+    s.push('\n');
 }
 
 /// The fit checks of the kit's own parts, by role, before any pour: only what the kit has.
@@ -234,11 +285,16 @@ fn layer_stack(s: &mut String, m: &Manifest) {
             Some(r) => format!("R{:.3}", r + offset),
             None => format!("offset {offset:+.3}"),
         };
+        // the product name where a cast of this material gives it
+        let material = m
+            .casts
+            .iter()
+            .find(|c| c.material == material)
+            .map_or_else(|| code(material), |c| text(&c.material_name));
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {thickness:.3} | {outer} |",
+            "| {} | {material} | {} | {thickness:.3} | {outer} |",
             code(name),
-            code(material),
             text(process)
         );
     }
@@ -304,7 +360,7 @@ fn groups(s: &mut String, m: &Manifest) {
                 let extruder = object
                     .and_then(|(_, o)| o.volumes.iter().find(|v| v.part == p.name))
                     .map_or_else(String::new, |v| format!(" (extruder {})", v.extruder));
-                format!("{} {}{extruder}", code(&p.name), code(&p.material))
+                format!("{} {}{extruder}", code(&p.name), text(&p.material_name))
             })
             .collect();
         let _ = writeln!(

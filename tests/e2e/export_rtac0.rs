@@ -111,9 +111,24 @@ fn master_strategy_kit_passes_oracles_and_printcheck() {
         sheet.contains(&format!("  - Part A: {:.2} mL (", ml[0])),
         "{sheet}"
     );
+    // the shopping list: both Mold Star pours together, in mL and g
+    let all_ml: f64 = m["casts"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|c| c["material"] == "mold_star_30")
+        .flat_map(|c| c["components"].as_array().unwrap().iter())
+        .map(|x| x["volume_ml"].as_f64().unwrap())
+        .sum();
+    assert!(sheet.contains("## Shopping list"), "{sheet}");
+    assert!(
+        sheet.contains(&format!("| Smooth-On Mold Star 30 | {all_ml:.1} mL (")),
+        "{sheet}"
+    );
+    assert!(sheet.contains("| PLA filament | "), "{sheet}");
     for key in ["mold_star_30", "sylgard_184", "ecoflex_00_30"] {
         assert!(
-            !sheet.contains(&format!("- material: `{key}`")),
+            !sheet.contains(&format!("`{key}`")),
             "{key} named by its key"
         );
     }

@@ -563,13 +563,13 @@ fn a_group_is_one_3mf_object_with_a_volume_per_part_and_stls_stay_put() {
 
     let sheet = fs::read_to_string(a.join("FABRICATION.md")).unwrap();
     for needle in [
-        "| 1 | `skin` | `parts/skin.stl` | PolyJet | `tactip` | `tango_black_plus` |",
-        "| 2 | `plate` | `parts/plate.stl` | FDM | – | `pla_black` |",
+        "| 1 | `skin` | `parts/skin.stl` | PolyJet | `tactip` | Stratasys Tango Black+ (PolyJet, Shore A 26-28) |",
+        "| 2 | `plate` | `parts/plate.stl` | FDM | – | Black PLA filament |",
         "### Multi-material groups",
         "- group `tactip` (PolyJet): print together as one multi-material job: object \
          `skin+dots` of `grouped.3mf` holds them in place as its parts (one volume each), \
-         assign materials: `skin` `tango_black_plus` (extruder 1), `dots` `vero_white` \
-         (extruder 2).",
+         assign materials: `skin` Stratasys Tango Black+ (PolyJet, Shore A 26-28) (extruder 1), \
+         `dots` Stratasys Vero White (PolyJet, rigid) (extruder 2).",
         "- kit 3MF: `grouped.3mf` (2 objects laid out on one plate)",
     ] {
         assert!(sheet.contains(needle), "missing {needle:?} in\n{sheet}");
@@ -601,8 +601,8 @@ fn a_group_is_one_3mf_object_with_a_volume_per_part_and_stls_stay_put() {
     assert!(
         sheet.contains(
             "load `parts/skin.stl`, `parts/dots.stl` as parts of one object without moving \
-             them (shared coordinates), assign materials: `skin` `tango_black_plus`, `dots` \
-             `vero_white`."
+             them (shared coordinates), assign materials: `skin` Stratasys Tango Black+ \
+             (PolyJet, Shore A 26-28), `dots` Stratasys Vero White (PolyJet, rigid)."
         ),
         "{sheet}"
     );
@@ -693,7 +693,9 @@ fn fabrication_sheet_lists_provenance_parts_casts_and_checks() {
         "# Fabrication sheet: tiny",
         "0123456789abcdef0123456789abcdef0123456789abcdef0123456789abcdef",
         "`fabkit build tiny.yaml --out 'out dir'`",
-        "| 1 | `base_plate` | `parts/base_plate.stl` | FDM | – | `pla_black` | 18000.0 | 150.00 × 30.00 × 4.00 |",
+        "| 1 | `base_plate` | `parts/base_plate.stl` | FDM | – | Black PLA filament | 18000.0 | 150.00 × 30.00 × 4.00 |",
+        "## Shopping list",
+        "| Smooth-On Solaris | 3.9 g |",
         "### Step 1: transparent_gel",
         "- material: Smooth-On Solaris",
         "- layer volume: 2.50 mL (the cast layer alone, from the exact profile)",
@@ -707,6 +709,26 @@ fn fabrication_sheet_lists_provenance_parts_casts_and_checks() {
     ] {
         assert!(s.contains(needle), "missing {needle:?} in\n{s}");
     }
+    // the printed grams: each part's volume times the PLA density (1.24 g/cm3)
+    let m = read_manifest(&out);
+    let pla: f64 = m
+        .parts
+        .iter()
+        .filter(|p| p.material == "pla_black")
+        .map(|p| {
+            assert!(
+                (p.mass_g - p.volume_mm3 / 1000.0 * 1.24).abs() < 1e-9,
+                "{}",
+                p.name
+            );
+            p.mass_g
+        })
+        .sum();
+    assert!(pla > 0.0);
+    assert!(
+        s.contains(&format!("| Black PLA filament | {pla:.1} g |")),
+        "{s}"
+    );
     assert!(!s.contains("Multi-material"), "{s}");
 }
 
