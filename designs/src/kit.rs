@@ -93,6 +93,25 @@ pub struct CastReport {
     pub total_mass_g: f64,
     /// Pot life, cure time and handling notes from the materials table.
     pub notes: String,
+    /// The smallest batch that can be weighed by hand when a component of `components` is
+    /// below [`MIN_WEIGHABLE_G`]: every component scaled up until the smallest is that much;
+    /// `None` when the pour's own amounts can be weighed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_batch: Option<MinBatch>,
+}
+
+/// Least mass of one component that a kitchen scale weighs to about 10 % (0.1 g resolution), g.
+pub const MIN_WEIGHABLE_G: f64 = 1.0;
+
+/// A batch larger than the pour needs, so that every component can be weighed.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MinBatch {
+    /// Each component, in datasheet order; the smallest is [`MIN_WEIGHABLE_G`].
+    pub components: Vec<CastComponent>,
+    /// Total mass to mix, g.
+    pub total_mass_g: f64,
+    /// What is left over after the pour (waste allowance included), g.
+    pub leftover_g: f64,
 }
 
 /// One component of a mix.

@@ -122,7 +122,7 @@ pub fn pour(
     let sum: f64 = mix.ratio.iter().sum();
     let by_volume = matches!(mix.by, MixBasis::Volume);
     let total_ml = volume_ml * (1.0 + waste_allowance);
-    let components = mix
+    let components: Vec<CastComponent> = mix
         .components
         .iter()
         .zip(&mix.ratio)
@@ -154,8 +154,36 @@ pub fn pour(
                 MixBasis::Volume => "volume",
             }
         ),
+        min_batch: min_batch(&components, total),
         components,
         total_mass_g: total,
         notes: material.notes.clone(),
+    })
+}
+
+/// The smallest weighable batch of a mix whose smallest component is below
+/// [`crate::kit::MIN_WEIGHABLE_G`] ([`crate::kit::MinBatch`]); `None` otherwise.
+fn min_batch(components: &[CastComponent], total_g: f64) -> Option<crate::kit::MinBatch> {
+    let smallest = components
+        .iter()
+        .map(|c| c.mass_g)
+        .fold(f64::INFINITY, f64::min);
+    if !(smallest > 0.0 && smallest < crate::kit::MIN_WEIGHABLE_G) {
+        return None;
+    }
+    let k = crate::kit::MIN_WEIGHABLE_G / smallest;
+    let scaled: Vec<CastComponent> = components
+        .iter()
+        .map(|c| CastComponent {
+            name: c.name.clone(),
+            mass_g: c.mass_g * k,
+            volume_ml: c.volume_ml.map(|v| v * k),
+        })
+        .collect();
+    let total = total_g * k;
+    Some(crate::kit::MinBatch {
+        components: scaled,
+        total_mass_g: total,
+        leftover_g: total - total_g,
     })
 }

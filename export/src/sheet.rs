@@ -140,6 +140,22 @@ pub(crate) fn render(m: &Manifest) -> String {
         } else {
             let _ = writeln!(s, "  - total: {:.2} g", c.total_mass_g);
         }
+        if let Some(b) = &c.min_batch {
+            let parts: Vec<String> = b
+                .components
+                .iter()
+                .map(|x| format!("{} {:.1} g", text(&x.name), x.mass_g))
+                .collect();
+            let _ = writeln!(
+                s,
+                "- too little to weigh by hand: mix at least {} = {:.1} g (the smallest component \
+                 {:.1} g, about 10 % on a 0.1 g scale), pour what the step needs, {:.1} g is left over",
+                parts.join(" + "),
+                b.total_mass_g,
+                fabkit_designs::kit::MIN_WEIGHABLE_G,
+                b.leftover_g
+            );
+        }
         if !c.notes.trim().is_empty() {
             let _ = writeln!(s, "- notes: {}", text(&c.notes));
         }

@@ -80,3 +80,48 @@ fn mixes_by_volume_are_measured_in_millilitres() {
     assert!(s.components.iter().all(|c| c.volume_ml.is_none()));
     assert!(s.layer_volume_ml.is_none());
 }
+
+/// UVDtact's black gel (0.56 g, of which 0.05 g pigment) cannot be weighed by hand: the cast
+/// gives the smallest batch whose every component is at least 1 g, in the mix ratio, and what
+/// is left over; a pour whose amounts can be weighed gives none.
+#[test]
+fn a_pour_too_small_to_weigh_gives_the_smallest_weighable_batch() {
+    use fabkit_designs::kit::MIN_WEIGHABLE_G;
+    let d = fabkit_designs::library::load("uvdtact").unwrap();
+    let kit =
+        fabkit_designs::build_kit(&d, fabkit_designs::ChordTolerance::new(0.05).unwrap()).unwrap();
+    let black = kit
+        .casts
+        .iter()
+        .find(|c| c.material == "ecoflex_00_30_silc_pig_black")
+        .unwrap();
+    assert!(black.total_mass_g < 1.0, "{}", black.total_mass_g);
+    let b = black.min_batch.as_ref().unwrap();
+    let smallest = b
+        .components
+        .iter()
+        .map(|c| c.mass_g)
+        .fold(f64::INFINITY, f64::min);
+    assert!((smallest - MIN_WEIGHABLE_G).abs() < 1e-12);
+    let k = b.components[0].mass_g / black.components[0].mass_g;
+    for (x, y) in b.components.iter().zip(&black.components) {
+        assert!((x.mass_g - k * y.mass_g).abs() < 1e-9, "{}", x.name);
+    }
+    assert!((b.total_mass_g - b.components.iter().map(|c| c.mass_g).sum::<f64>()).abs() < 1e-9);
+    assert!((b.leftover_g - (b.total_mass_g - black.total_mass_g)).abs() < 1e-9);
+    // 11 g of the 5:5:1 mix: 1 g of pigment
+    assert!((b.total_mass_g - 11.0).abs() < 1e-9, "{}", b.total_mass_g);
+    // 10 mL of Sylgard 184 (10:1, 20 % waste): the curing agent is 1.12 g, weighable
+    let t = fabkit_designs::materials::MaterialsTable::embedded().unwrap();
+    let p = fabkit_designs::materials::pour(
+        1,
+        "x",
+        "sylgard_184",
+        &t.materials["sylgard_184"],
+        vec![],
+        10_000.0,
+        0.2,
+    )
+    .unwrap();
+    assert!(p.components[1].mass_g > MIN_WEIGHABLE_G && p.min_batch.is_none());
+}
