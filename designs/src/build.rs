@@ -176,6 +176,17 @@ pub fn build_kit_bounded(
         }
         for s in sprayed {
             let sl = &stack.layers[s];
+            if let Some(cm) = materials.get(&sl.material) {
+                if let Ok(c) = crate::materials::coat(
+                    &sl.name,
+                    &sl.material,
+                    cm,
+                    sl.thickness_mm,
+                    layer_volume_mm3(&design.body, sl),
+                ) {
+                    r.coats.push(c);
+                }
+            }
             let sm = materials
                 .get(&sl.material)
                 .map(|m| m.notes.clone())

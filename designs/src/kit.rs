@@ -98,6 +98,34 @@ pub struct CastReport {
     /// `None` when the pour's own amounts can be weighed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub min_batch: Option<MinBatch>,
+    /// Coats sprayed into the mold before this pour (R-Tac0's black coating), in order.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub coats: Vec<CoatReport>,
+}
+
+/// A layer sprayed or brushed into a mold before a pour: its mix and amount.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CoatReport {
+    /// The sprayed layer's name.
+    pub layer: String,
+    /// Material key in the materials table, and its product name.
+    pub material: String,
+    pub material_name: String,
+    pub thickness_mm: f64,
+    /// Volume of the coat itself, mL (the layer's own volume from the exact profile).
+    pub coat_volume_ml: f64,
+    /// Mix ratio as on the datasheet or in the paper, e.g. `100:3:500 by weight`.
+    pub mix_ratio: String,
+    /// Components that evaporate (a thinner).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub evaporates: Vec<String>,
+    /// The mix that leaves the coat's mass once the thinner is gone, g, per component (no
+    /// spray loss included).
+    pub components: Vec<CastComponent>,
+    pub total_mass_g: f64,
+    /// The smallest batch weighable by hand, when a component is below [`MIN_WEIGHABLE_G`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_batch: Option<MinBatch>,
 }
 
 /// Least mass of one component that a kitchen scale weighs to about 10 % (0.1 g resolution), g.

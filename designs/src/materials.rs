@@ -32,6 +32,10 @@ pub struct Mix {
     pub components: Vec<String>,
     pub ratio: Vec<f64>,
     pub by: MixBasis,
+    /// Components that evaporate after spraying or brushing (a thinner): they are mixed but
+    /// leave no material in the coat. Each must name a component, and one must stay.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub evaporates: Vec<String>,
 }
 
 /// One entry of the materials table.
@@ -63,9 +67,19 @@ impl MaterialsTable {
     /// # Errors
     /// Only if the embedded file is malformed (a build defect, covered by a test).
     pub fn embedded() -> Result<Self, String> {
-        let t: Self = crate::schema::yaml_from_str(MATERIALS_YAML)
-            .map_err(|e| format!("designs/materials.yaml: {e}"))?;
-        t.check()?;
+        Self::from_yaml(MATERIALS_YAML, "designs/materials.yaml")
+    }
+
+    /// Parses and checks a materials table (the form of `designs/materials.yaml`); `origin`
+    /// names it in messages.
+    ///
+    /// # Errors
+    /// The YAML error at `origin:line:column`, or the first rule broken, naming its path
+    /// (`materials.<key>.mix.evaporates[0]`), value and rule.
+    pub fn from_yaml(text: &str, origin: &str) -> Result<Self, String> {
+        let t: Self = crate::schema::yaml_from_str(text)
+            .map_err(|e| crate::schema::yaml_error(origin, &e))?;
+        t.check().map_err(|e| format!("{origin}: {e}"))?;
         Ok(t)
     }
 
@@ -82,6 +96,19 @@ impl MaterialsTable {
                 {
                     return Err(format!(
                         "materials.{k}.mix: one positive ratio per component is required"
+                    ));
+                }
+                for (i, e) in mix.evaporates.iter().enumerate() {
+                    if !mix.components.contains(e) {
+                        return Err(format!(
+                            "materials.{k}.mix.evaporates[{i}] = {e:?}: must name one of the components {:?}",
+                            mix.components
+                        ));
+                    }
+                }
+                if mix.components.iter().all(|c| mix.evaporates.contains(c)) {
+                    return Err(format!(
+                        "materials.{k}.mix.evaporates: at least one component must stay in the material"
                     ));
                 }
             }
@@ -158,6 +185,7 @@ pub fn pour(
         components,
         total_mass_g: total,
         notes: material.notes.clone(),
+        coats: Vec::new(),
     })
 }
 
@@ -185,5 +213,69 @@ fn min_batch(components: &[CastComponent], total_g: f64) -> Option<crate::kit::M
         components: scaled,
         total_mass_g: total,
         leftover_g: total - total_g,
+    })
+}
+
+/// The mix for a sprayed or brushed coat of `coat_volume_mm3` (the layer's own volume) of
+/// `material`: the components that stay in the coat make up its mass (volume x density), the
+/// evaporating ones ([`Mix::evaporates`]) are added in the mix ratio; no spray loss is
+/// included. With the smallest batch weighable by hand ([`crate::kit::MinBatch`]).
+///
+/// # Errors
+/// When the material has no mix.
+pub fn coat(
+    layer: &str,
+    material_key: &str,
+    material: &Material,
+    thickness_mm: f64,
+    coat_volume_mm3: f64,
+) -> Result<crate::kit::CoatReport, String> {
+    let mix = material
+        .mix
+        .as_ref()
+        .ok_or_else(|| format!("material '{material_key}' has no mix ratio"))?;
+    let coat_g = coat_volume_mm3 / 1000.0 * material.density_g_per_cm3;
+    let sum: f64 = mix.ratio.iter().sum();
+    let staying: f64 = mix
+        .components
+        .iter()
+        .zip(&mix.ratio)
+        .filter(|(c, _)| !mix.evaporates.contains(c))
+        .map(|(_, r)| r)
+        .sum();
+    let total = coat_g * sum / staying;
+    let components: Vec<CastComponent> = mix
+        .components
+        .iter()
+        .zip(&mix.ratio)
+        .map(|(name, r)| CastComponent {
+            name: name.clone(),
+            mass_g: total * r / sum,
+            volume_ml: None,
+        })
+        .collect();
+    let ratio = mix
+        .ratio
+        .iter()
+        .map(|r| format!("{r}"))
+        .collect::<Vec<_>>()
+        .join(":");
+    Ok(crate::kit::CoatReport {
+        layer: layer.to_string(),
+        material: material_key.to_string(),
+        material_name: material.name.clone(),
+        thickness_mm,
+        coat_volume_ml: coat_volume_mm3 / 1000.0,
+        mix_ratio: format!(
+            "{ratio} by {}",
+            match mix.by {
+                MixBasis::Weight => "weight",
+                MixBasis::Volume => "volume",
+            }
+        ),
+        evaporates: mix.evaporates.clone(),
+        min_batch: min_batch(&components, total),
+        components,
+        total_mass_g: total,
     })
 }

@@ -140,6 +140,42 @@ pub(crate) fn render(m: &Manifest) -> String {
         } else {
             let _ = writeln!(s, "  - total: {:.2} g", c.total_mass_g);
         }
+        for k in &c.coats {
+            let parts: Vec<String> = k
+                .components
+                .iter()
+                .map(|x| format!("{} {:.2} g", text(&x.name), x.mass_g))
+                .collect();
+            let gone = if k.evaporates.is_empty() {
+                String::new()
+            } else {
+                format!(", {} evaporating", k.evaporates.join(", "))
+            };
+            let _ = writeln!(
+                s,
+                "- coat {} first: {}, {:.2} mm, {:.3} mL on the mold's surface; mix {}{gone}: {} = {:.2} g for the coat itself (spraying loses more)",
+                code(&k.layer),
+                text(&k.material_name),
+                k.thickness_mm,
+                k.coat_volume_ml,
+                text(&k.mix_ratio),
+                parts.join(" + "),
+                k.total_mass_g
+            );
+            if let Some(b) = &k.min_batch {
+                let parts: Vec<String> = b
+                    .components
+                    .iter()
+                    .map(|x| format!("{} {:.1} g", text(&x.name), x.mass_g))
+                    .collect();
+                let _ = writeln!(
+                    s,
+                    "  - smallest batch weighable by hand: {} = {:.1} g",
+                    parts.join(" + "),
+                    b.total_mass_g
+                );
+            }
+        }
         if let Some(b) = &c.min_batch {
             let parts: Vec<String> = b
                 .components

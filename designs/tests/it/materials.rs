@@ -125,3 +125,51 @@ fn a_pour_too_small_to_weigh_gives_the_smallest_weighable_batch() {
     .unwrap();
     assert!(p.components[1].mass_g > MIN_WEIGHABLE_G && p.min_batch.is_none());
 }
+
+/// R-Tac0's black coating: the mix (100:3:500 by weight, the thinner evaporating) for the coat
+/// itself is the coat's volume (0.1 mm from R14.9 to R15, analytic) of oil and catalyst plus
+/// the thinner in ratio, with the smallest batch weighable by hand; an `evaporates` entry that
+/// names no component, or all of them, is refused by path.
+#[test]
+fn the_black_coating_has_its_mix_and_amount() {
+    use std::f64::consts::PI;
+    let d = fabkit_designs::library::load("rtac0").unwrap();
+    let kit =
+        fabkit_designs::build_kit(&d, fabkit_designs::ChordTolerance::new(0.05).unwrap()).unwrap();
+    let coats: Vec<_> = kit.casts.iter().flat_map(|c| c.coats.iter()).collect();
+    assert_eq!(coats.len(), 1);
+    let c = coats[0];
+    assert_eq!(c.layer, "black_coating");
+    let v = 2.0 / 3.0 * PI * (15f64.powi(3) - 14.9f64.powi(3))
+        + PI * (15f64.powi(2) - 14.9f64.powi(2)) * 6.0;
+    assert!(
+        (c.coat_volume_ml * 1000.0 - v).abs() < 1e-9,
+        "{}",
+        c.coat_volume_ml
+    );
+    let m: Vec<f64> = c.components.iter().map(|x| x.mass_g).collect();
+    // density 1.0 g/cm3 (materials table): the oil and the catalyst are the coat's mass
+    assert!((m[0] + m[1] - v / 1000.0).abs() < 1e-12, "{m:?}");
+    assert!((m[0] / m[1] - 100.0 / 3.0).abs() < 1e-9 && (m[2] / m[0] - 5.0).abs() < 1e-9);
+    let b = c.min_batch.as_ref().unwrap();
+    assert!((b.components[1].mass_g - 1.0).abs() < 1e-12);
+    use fabkit_designs::materials::MaterialsTable;
+    let text = |evaporates: &str| {
+        format!(
+            "materials:\n  c:\n    name: C\n    kind: coating\n    density_g_per_cm3: 1.0\n    mix: {{components: [A, B], ratio: [1, 2], by: weight, evaporates: {evaporates}}}\n    source: test\n"
+        )
+    };
+    assert!(MaterialsTable::from_yaml(&text("[B]"), "m.yaml").is_ok());
+    let e = MaterialsTable::from_yaml(&text("[Water]"), "m.yaml").unwrap_err();
+    assert!(
+        e.starts_with(
+            "m.yaml: materials.c.mix.evaporates[0] = \"Water\": must name one of the components"
+        ),
+        "{e}"
+    );
+    let e = MaterialsTable::from_yaml(&text("[A, B]"), "m.yaml").unwrap_err();
+    assert!(
+        e.contains("materials.c.mix.evaporates: at least one component must stay"),
+        "{e}"
+    );
+}

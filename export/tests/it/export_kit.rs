@@ -81,6 +81,7 @@ fn test_kit() -> Kit {
             total_mass_g: 3.853,
             notes: "pot life 15 min | degas 3 min".into(),
             min_batch: None,
+            coats: vec![],
         }],
         bought_items: vec!["acrylic tube, 30 mm OD".into()],
         summary: serde_json::json!({ "envelope_radius_mm": 15.0 }),
