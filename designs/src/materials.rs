@@ -146,25 +146,10 @@ pub fn pour(
         .ok_or_else(|| format!("material '{material_key}' has no mix ratio: it cannot be cast"))?;
     let volume_ml = cavity_volume_mm3 / 1000.0;
     let total = volume_ml * material.density_g_per_cm3 * (1.0 + waste_allowance);
-    let sum: f64 = mix.ratio.iter().sum();
     let by_volume = matches!(mix.by, MixBasis::Volume);
     let total_ml = volume_ml * (1.0 + waste_allowance);
-    let components: Vec<CastComponent> = mix
-        .components
-        .iter()
-        .zip(&mix.ratio)
-        .map(|(name, r)| CastComponent {
-            name: name.clone(),
-            mass_g: total * r / sum,
-            volume_ml: by_volume.then(|| total_ml * r / sum),
-        })
-        .collect();
-    let ratio = mix
-        .ratio
-        .iter()
-        .map(|r| format!("{r}"))
-        .collect::<Vec<_>>()
-        .join(":");
+    let components = split(mix, total, by_volume.then_some(total_ml));
+
     Ok(CastReport {
         step,
         cast: cast.to_string(),
@@ -174,13 +159,7 @@ pub fn pour(
         cavity_volume_ml: volume_ml,
         layer_volume_ml: None,
         waste_allowance,
-        mix_ratio: format!(
-            "{ratio} by {}",
-            match mix.by {
-                MixBasis::Weight => "weight",
-                MixBasis::Volume => "volume",
-            }
-        ),
+        mix_ratio: ratio_text(mix),
         min_batch: min_batch(&components, total),
         components,
         total_mass_g: total,
@@ -244,38 +223,48 @@ pub fn coat(
         .map(|(_, r)| r)
         .sum();
     let total = coat_g * sum / staying;
-    let components: Vec<CastComponent> = mix
-        .components
-        .iter()
-        .zip(&mix.ratio)
-        .map(|(name, r)| CastComponent {
-            name: name.clone(),
-            mass_g: total * r / sum,
-            volume_ml: None,
-        })
-        .collect();
-    let ratio = mix
-        .ratio
-        .iter()
-        .map(|r| format!("{r}"))
-        .collect::<Vec<_>>()
-        .join(":");
+    let components = split(mix, total, None);
+
     Ok(crate::kit::CoatReport {
         layer: layer.to_string(),
         material: material_key.to_string(),
         material_name: material.name.clone(),
         thickness_mm,
         coat_volume_ml: coat_volume_mm3 / 1000.0,
-        mix_ratio: format!(
-            "{ratio} by {}",
-            match mix.by {
-                MixBasis::Weight => "weight",
-                MixBasis::Volume => "volume",
-            }
-        ),
+        mix_ratio: ratio_text(mix),
         evaporates: mix.evaporates.clone(),
         min_batch: min_batch(&components, total),
         components,
         total_mass_g: total,
     })
+}
+
+/// `total_g` (and `total_ml`, for a mix by volume) split over the components of `mix` in its
+/// ratio.
+fn split(mix: &Mix, total_g: f64, total_ml: Option<f64>) -> Vec<CastComponent> {
+    let sum: f64 = mix.ratio.iter().sum();
+    mix.components
+        .iter()
+        .zip(&mix.ratio)
+        .map(|(name, r)| CastComponent {
+            name: name.clone(),
+            mass_g: total_g * r / sum,
+            volume_ml: total_ml.map(|v| v * r / sum),
+        })
+        .collect()
+}
+
+/// The ratio as written, e.g. `10:1 by weight`.
+fn ratio_text(mix: &Mix) -> String {
+    let ratio = mix
+        .ratio
+        .iter()
+        .map(|r| format!("{r}"))
+        .collect::<Vec<_>>()
+        .join(":");
+    let by = match mix.by {
+        MixBasis::Weight => "weight",
+        MixBasis::Volume => "volume",
+    };
+    format!("{ratio} by {by}")
 }

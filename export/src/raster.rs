@@ -21,8 +21,7 @@ fn encode_err(what: &str) -> impl Fn(png::EncodingError) -> ExportError + '_ {
 /// repeats.
 pub fn npz(arrays: &[(&str, &[u8])]) -> Result<Vec<u8>, ExportError> {
     use std::io::Write as _;
-    use zip::write::SimpleFileOptions;
-    use zip::{CompressionMethod, DateTime, System, ZipWriter};
+    use zip::ZipWriter;
     let err = |reason: String| ExportError::Encode {
         what: "NPZ".into(),
         reason,
@@ -37,13 +36,7 @@ pub fn npz(arrays: &[(&str, &[u8])]) -> Result<Vec<u8>, ExportError> {
                 "array name '{name}' must be [A-Za-z0-9_]+ and unique"
             )));
         }
-        let opts = SimpleFileOptions::default()
-            .compression_method(CompressionMethod::Deflated)
-            .compression_level(Some(6))
-            .last_modified_time(DateTime::default())
-            .system(System::Unix)
-            .unix_permissions(0o644)
-            .large_file(bytes.len() as u64 >= u64::from(u32::MAX));
+        let opts = crate::three_mf::zip_entry_options(bytes.len());
         zip.start_file(format!("{name}.npy"), opts)
             .map_err(|e| err(e.to_string()))?;
         zip.write_all(bytes).map_err(|e| err(e.to_string()))?;

@@ -163,30 +163,20 @@ pub(crate) fn render(m: &Manifest) -> String {
                 k.total_mass_g
             );
             if let Some(b) = &k.min_batch {
-                let parts: Vec<String> = b
-                    .components
-                    .iter()
-                    .map(|x| format!("{} {:.1} g", text(&x.name), x.mass_g))
-                    .collect();
                 let _ = writeln!(
                     s,
                     "  - smallest batch weighable by hand: {} = {:.1} g",
-                    parts.join(" + "),
+                    batch_parts(b),
                     b.total_mass_g
                 );
             }
         }
         if let Some(b) = &c.min_batch {
-            let parts: Vec<String> = b
-                .components
-                .iter()
-                .map(|x| format!("{} {:.1} g", text(&x.name), x.mass_g))
-                .collect();
             let _ = writeln!(
                 s,
                 "- too little to weigh by hand: mix at least {} = {:.1} g (the smallest component \
                  {:.1} g, about 10 % on a 0.1 g scale), pour what the step needs, {:.1} g is left over",
-                parts.join(" + "),
+                batch_parts(b),
                 b.total_mass_g,
                 fabkit_designs::kit::MIN_WEIGHABLE_G,
                 b.leftover_g
@@ -278,6 +268,15 @@ fn shopping_list(s: &mut String, m: &Manifest) {
     s.push('\n');
 }
 
+/// A batch's components: `Part A 10.0 g + Part B 10.0 g + ...`.
+fn batch_parts(b: &fabkit_designs::kit::MinBatch) -> String {
+    b.components
+        .iter()
+        .map(|x| format!("{} {:.1} g", text(&x.name), x.mass_g))
+        .collect::<Vec<_>>()
+        .join(" + ")
+}
+
 /// The fit checks of the kit's own parts, by role, before any pour: only what the kit has.
 fn fit_checks(m: &Manifest) -> Vec<&'static str> {
     let count = |role: &str| m.parts.iter().filter(|p| p.role == role).count();
@@ -337,12 +336,18 @@ fn layer_stack(s: &mut String, m: &Manifest) {
             Some(r) => format!("R{:.3}", r + offset),
             None => format!("offset {offset:+.3}"),
         };
-        // the product name where a cast of this material gives it
+        // the product name where a cast or a coat of this material gives it
         let material = m
             .casts
             .iter()
-            .find(|c| c.material == material)
-            .map_or_else(|| code(material), |c| text(&c.material_name));
+            .map(|c| (&c.material, &c.material_name))
+            .chain(
+                m.casts
+                    .iter()
+                    .flat_map(|c| c.coats.iter().map(|k| (&k.material, &k.material_name))),
+            )
+            .find(|(key, _)| *key == material)
+            .map_or_else(|| code(material), |(_, name)| text(name));
         let _ = writeln!(
             s,
             "| {} | {material} | {} | {thickness:.3} | {outer} |",

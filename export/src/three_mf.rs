@@ -262,13 +262,7 @@ pub(crate) fn encode(
         reason: e.to_string(),
     };
     let mut zip = ZipWriter::new(Cursor::new(Vec::new()));
-    let opts = SimpleFileOptions::default()
-        .compression_method(CompressionMethod::Deflated)
-        .compression_level(Some(6))
-        .last_modified_time(DateTime::default())
-        .system(System::Unix)
-        .unix_permissions(0o644)
-        .large_file(model.len() as u64 >= u64::from(u32::MAX));
+    let opts = zip_entry_options(model.len());
     let content_types = if config.is_some() {
         CONTENT_TYPES_WITH_CONFIG
     } else {
@@ -320,6 +314,19 @@ fn escape(s: &str) -> String {
         }
     }
     out
+}
+
+/// The options of every zip entry fabkit writes (3MF, NPZ): deflated at level 6, a fixed
+/// timestamp and Unix mode 0644, so the same bytes go in and come out; ZIP64 when an entry of
+/// `len` bytes needs it.
+pub(crate) fn zip_entry_options(len: usize) -> SimpleFileOptions {
+    SimpleFileOptions::default()
+        .compression_method(CompressionMethod::Deflated)
+        .compression_level(Some(6))
+        .last_modified_time(DateTime::default())
+        .system(System::Unix)
+        .unix_permissions(0o644)
+        .large_file(len as u64 >= u64::from(u32::MAX))
 }
 
 #[cfg(test)]

@@ -214,15 +214,15 @@ fn readme_first_command_writes_out_rtac0_with_provenance() {
     }
     let sheet = std::fs::read_to_string(dir.join("FABRICATION.md")).unwrap();
     assert!(
-        sheet.contains("Sylgard") || sheet.contains("sylgard"),
+        sheet.contains("Dow SYLGARD 184"),
         "{sheet}"
     );
     // The layer thicknesses: the sprayed coat (0.1 mm, fabkit's assumption) lies inside the
     // R15.000 cavity (authors' CAD, measured) and comes out of the translucent layer.
     for row in [
-        "| `transparent_gel` | `sylgard_184` | cast | 3.500 | R13.500 |",
-        "| `translucent_gel` | `ecoflex_00_30` | cast | 1.400 | R14.900 |",
-        "| `black_coating` | `ptg_501_black` | sprayed | 0.100 | R15.000 |",
+        "| `transparent_gel` | Dow SYLGARD 184 silicone elastomer (PDMS) | cast | 3.500 | R13.500 |",
+        "| `translucent_gel` | Smooth-On Ecoflex 00-30 | cast | 1.400 | R14.900 |",
+        "| `black_coating` | Yonglihua PTG-501 black mill-resistant coating mixture | sprayed | 0.100 | R15.000 |",
     ] {
         assert!(sheet.contains(row), "no row {row} in:\n{sheet}");
     }

@@ -200,8 +200,8 @@ def rtac0(fabkit, work):
         f"{tube['volume_mm3'] + base['volume_mm3']:,.0f} mm3 (tube {tube['volume_mm3']:,.0f})", "{}",
         note="differs: the tube's bay and seats and the base are fabkit's own")
     sheet = (d / "FABRICATION.md").read_text()
-    ok = "| `translucent_gel` | `ecoflex_00_30` | cast | 1.400 | R14.900 |" in sheet and \
-        "| `black_coating` | `ptg_501_black` | sprayed | 0.100 | R15.000 |" in sheet
+    ok = "| `translucent_gel` | Smooth-On Ecoflex 00-30 | cast | 1.400 | R14.900 |" in sheet and \
+        "| `black_coating` | Yonglihua PTG-501 black mill-resistant coating mixture | sprayed | 0.100 | R15.000 |" in sheet
     row("R-Tac0", "layers in FABRICATION.md", "(paper: 1.5 mm Ecoflex + coat)",
         "Ecoflex 1.400 mm to R14.9, coat 0.100 mm to R15.0", "{}")
     ROWS[-1] = ROWS[-1][:4] + (bool(ok),)
