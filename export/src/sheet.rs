@@ -82,6 +82,7 @@ pub(crate) fn render(m: &Manifest) -> String {
     }
     s.push('\n');
     groups(&mut s, m);
+    print_settings(&mut s, m);
 
     layer_stack(&mut s, m);
 
@@ -264,6 +265,49 @@ fn shopping_list(s: &mut String, m: &Manifest) {
             None => format!("{g:.1} g"),
         };
         let _ = writeln!(s, "| {} | {amount} |", text(&name));
+    }
+    s.push('\n');
+}
+
+/// The print settings that matter for the kit's own parts, by role: no supports on surfaces
+/// that form the skin, leak-tight mold boxes; nothing for a kit without such parts.
+fn print_settings(s: &mut String, m: &Manifest) {
+    let named = |roles: &[&str]| -> Vec<String> {
+        m.parts
+            .iter()
+            .filter(|p| roles.contains(&p.role.as_str()))
+            .map(|p| code(&p.name))
+            .collect()
+    };
+    let forming = named(&[
+        "master_pattern",
+        "mold_half",
+        "open_mold_piece",
+        "negative_mold",
+    ]);
+    let boxes = named(&["mold_box"]);
+    if forming.is_empty() && boxes.is_empty() {
+        return;
+    }
+    s.push_str("### Print settings that matter\n\n");
+    if !forming.is_empty() {
+        let _ = writeln!(
+            s,
+            "- Surfaces that form the skin ({}): print each part as it is placed in its file, with \
+             no supports touching the cavity or pattern surface (a support mark is cast into the \
+             skin); put supports, where the slicer needs them, only under flanges, plinths and \
+             outer walls. Finest layer height of the profile.",
+            forming.join(", ")
+        );
+    }
+    if !boxes.is_empty() {
+        let _ = writeln!(
+            s,
+            "- Mold boxes ({}): they hold liquid Mold Star, so the walls must be leak-tight: at \
+             least 3 perimeters and 4 top and bottom layers, no gaps at the seam; seal a leak with \
+             tape or hot glue on the outside before pouring.",
+            boxes.join(", ")
+        );
     }
     s.push('\n');
 }

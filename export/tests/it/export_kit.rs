@@ -1037,7 +1037,8 @@ fn previous_output_changed_by_the_user_is_refused_and_untouched() {
     assert_eq!(entries(root.path()), ["kit"]);
 }
 
-/// The sheet's "checking the prints" list names only what the kit has: registration keys for
+/// The sheet's print settings and its "checking the prints" list name only what the kit has:
+/// supports kept off the surfaces that form the skin, leak-tight mold boxes; registration keys for
 /// the halves of a direct mold, the boss and pocket of a two-piece open mold, the mold boxes of
 /// master patterns (ShadowTac's two-piece mold and the printed TacTip skin have no registration
 /// keys, and the sheet once told their makers to check them).
@@ -1074,6 +1075,28 @@ fn checking_the_prints_lists_only_the_kits_own_fits() {
             checks.contains("mold box"),
             roles("mold_box") > 0,
             "{}: {checks}",
+            d.name
+        );
+        // print settings: no supports on skin-forming surfaces, leak-tight mold boxes
+        let forming = [
+            "master_pattern",
+            "mold_half",
+            "open_mold_piece",
+            "negative_mold",
+        ]
+        .iter()
+        .map(|r| roles(r))
+        .sum::<usize>();
+        assert_eq!(
+            sheet.contains("- Surfaces that form the skin ("),
+            forming > 0,
+            "{}",
+            d.name
+        );
+        assert_eq!(
+            sheet.contains("the walls must be leak-tight"),
+            roles("mold_box") > 0,
+            "{}",
             d.name
         );
         seen_keys += usize::from(keys);
