@@ -251,8 +251,14 @@ fn bought_items(design: &Design, stack: &Stack) -> Vec<String> {
 fn housing_items(h: &crate::schema::HousingParams) -> Vec<String> {
     vec![
         format!(
-            "Camera: {} on a {:.1} mm square board, fixed with 4 self-tapping screws ({:.1} mm pilots, {:.1} mm square pattern)",
-            h.camera.module, h.camera.board_width_mm, h.camera.mount_pilot_diameter_mm, h.camera.mount_hole_spacing_mm
+            "Camera: {} on a {:.1} mm square board, fixed with 4 self-tapping screws{} ({:.1} mm pilots, {:.1} mm square pattern)",
+            h.camera.module,
+            h.camera.board_width_mm,
+            metric_from_pilot(h.camera.mount_pilot_diameter_mm)
+                .map(|d| format!(" {}", metric_name(d)))
+                .unwrap_or_default(),
+            h.camera.mount_pilot_diameter_mm,
+            h.camera.mount_hole_spacing_mm
         ),
         format!(
             "LED ring PCB: {} LEDs, outer diameter {:.1} mm, inner diameter {:.1} mm, {:.1} mm thick",
@@ -263,7 +269,13 @@ fn housing_items(h: &crate::schema::HousingParams) -> Vec<String> {
             h.diffuser.outer_diameter_mm, h.diffuser.inner_diameter_mm, h.diffuser.thickness_mm, h.diffuser.gap_above_pcb_mm
         ),
         format!(
-            "2 joint screws{}: {:.1} mm clearance, {:.1} mm head, length about {:.0} mm (clamp {:.1} mm + pilot {:.1} mm)",
+            "2 joint screws{}{}: {:.1} mm clearance, {:.1} mm head, length about {:.0} mm (clamp {:.1} mm + pilot {:.1} mm)",
+            screw_name(
+                h.joint_screw.clearance_diameter_mm,
+                h.joint_screw.clamp_length_mm + h.joint_screw.pilot_depth_mm - 0.5
+            )
+            .map(|n| format!(" {n}"))
+            .unwrap_or_default(),
             match h.style {
                 crate::schema::HousingStyle::RoundTube =>
                     " (pan head), up through the base's flange into the tube wall",
@@ -276,6 +288,50 @@ fn housing_items(h: &crate::schema::HousingParams) -> Vec<String> {
             h.joint_screw.pilot_depth_mm
         ),
     ]
+}
+
+/// ISO metric screw sizes (nominal diameter, mm) the bought-items list names.
+pub const METRIC_SIZES_MM: [f64; 9] = [1.6, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0];
+
+/// Standard screw lengths, mm (ISO 4762 / ISO 7045 preferred lengths up to 40 mm).
+pub const SCREW_LENGTHS_MM: [f64; 14] = [
+    3.0, 4.0, 5.0, 6.0, 8.0, 10.0, 12.0, 14.0, 16.0, 20.0, 25.0, 30.0, 35.0, 40.0,
+];
+
+/// The metric screw a through hole of `clearance_mm` is for: the largest size below it with at
+/// most 0.7 mm of clearance (ISO 273 fine to coarse: M2 2.2-2.6, M3 3.2-3.6 mm).
+pub fn metric_from_clearance(clearance_mm: f64) -> Option<f64> {
+    METRIC_SIZES_MM
+        .iter()
+        .copied()
+        .rev()
+        .find(|d| *d < clearance_mm && clearance_mm - d <= 0.7 + 1e-9)
+}
+
+/// The self-tapping screw a pilot hole of `pilot_mm` is for: the size whose 0.75-0.85 x
+/// diameter the pilot is (a 1.6 mm pilot takes an M2 / 2.0 mm screw).
+pub fn metric_from_pilot(pilot_mm: f64) -> Option<f64> {
+    METRIC_SIZES_MM
+        .iter()
+        .copied()
+        .find(|d| (0.75 * d - 1e-9..=0.85 * d + 1e-9).contains(&pilot_mm))
+}
+
+/// `M2`, `M2.5`.
+fn metric_name(d: f64) -> String {
+    format!("M{d}")
+}
+
+/// `M2 x 6`: the screw for a `clearance_mm` hole, in the longest standard length that is at
+/// most `max_length_mm`; `None` when no standard size or length fits.
+pub fn screw_name(clearance_mm: f64, max_length_mm: f64) -> Option<String> {
+    let d = metric_from_clearance(clearance_mm)?;
+    let l = SCREW_LENGTHS_MM
+        .iter()
+        .copied()
+        .rev()
+        .find(|l| *l <= max_length_mm + 1e-9)?;
+    Some(format!("{} x {l}", metric_name(d)))
 }
 
 /// Volume of `layer` alone, mm^3: the solid under its outer surface down to the base plane,

@@ -173,3 +173,43 @@ fn the_black_coating_has_its_mix_and_amount() {
         "{e}"
     );
 }
+
+/// Screws are named by standard size and length: a 2.2 mm clearance hole takes M2, a 3.4 mm one
+/// M3; the joint screws get the longest standard length within clamp + pilot (R-Tac0's round
+/// tube: M2 x 6; the square halves: M2 x 10); a 1.6 mm pilot takes an M2 self-tapping screw.
+#[test]
+fn screws_are_named_by_standard_size_and_length() {
+    use fabkit_designs::build::{metric_from_clearance, metric_from_pilot, screw_name};
+    assert_eq!(metric_from_clearance(2.2), Some(2.0));
+    assert_eq!(metric_from_clearance(3.4), Some(3.0));
+    assert_eq!(metric_from_clearance(3.5), Some(3.0));
+    assert_eq!(metric_from_clearance(1.0), None);
+    assert_eq!(metric_from_pilot(1.6), Some(2.0));
+    assert_eq!(metric_from_pilot(2.5), Some(3.0));
+    assert_eq!(screw_name(2.2, 7.0).as_deref(), Some("M2 x 6"));
+    assert_eq!(screw_name(3.4, 25.0).as_deref(), Some("M3 x 25"));
+    assert_eq!(screw_name(2.2, 2.0), None);
+    let tol = fabkit_designs::ChordTolerance::new(0.05).unwrap();
+    let d = fabkit_designs::library::load("rtac0").unwrap();
+    for (design, want) in [
+        (d.clone(), "2 joint screws M2 x 6 (pan head)"),
+        (
+            d.with_preset("square_split").unwrap(),
+            "2 joint screws M2 x 10 across",
+        ),
+    ] {
+        let kit = fabkit_designs::build_kit(&design, tol).unwrap();
+        assert!(
+            kit.bought_items.iter().any(|b| b.starts_with(want)),
+            "{:?}",
+            kit.bought_items
+        );
+        assert!(
+            kit.bought_items
+                .iter()
+                .any(|b| b.contains("4 self-tapping screws M2 (1.6 mm pilots")),
+            "{:?}",
+            kit.bought_items
+        );
+    }
+}
