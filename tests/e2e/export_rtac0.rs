@@ -213,10 +213,7 @@ fn readme_first_command_writes_out_rtac0_with_provenance() {
         );
     }
     let sheet = std::fs::read_to_string(dir.join("FABRICATION.md")).unwrap();
-    assert!(
-        sheet.contains("Dow SYLGARD 184"),
-        "{sheet}"
-    );
+    assert!(sheet.contains("Dow SYLGARD 184"), "{sheet}");
     // The layer thicknesses: the sprayed coat (0.1 mm, fabkit's assumption) lies inside the
     // R15.000 cavity (authors' CAD, measured) and comes out of the translucent layer.
     for row in [
