@@ -391,10 +391,11 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
                 "\nparameters of {} (each path can be set by a preset or varied by `fabkit sweep`; numbers rounded to 1e-9):",
                 loaded.design.name
             );
-            let json = serde_json::to_value(&loaded.design)?;
+            // one copy for every lookup: value_at adds a null for an unset optional key,
+            // which only reads as unset
+            let mut json = serde_json::to_value(&loaded.design)?;
             for path in fabkit_designs::sweep::parameter_paths(&loaded.design) {
-                let mut v = json.clone();
-                let value = fabkit_designs::schema::value_at(&mut v, &path)
+                let value = fabkit_designs::schema::value_at(&mut json, &path)
                     .map(|x| rounded(x))
                     .unwrap_or(serde_json::Value::Null);
                 let shown = if value.is_null() {
