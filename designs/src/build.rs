@@ -123,7 +123,7 @@ pub fn build_kit_bounded(
         ));
         parts.extend(out.parts);
     }
-    let mut bought = bought_items(design, &stack);
+    let mut bought = bought_items(design, &stack, &materials);
     let mut summary = json!({
         "body": design.body,
         "base_z_mm": design.body.base_z_mm(),
@@ -156,6 +156,8 @@ pub fn build_kit_bounded(
         step += 1;
     }
     gel.sort_by_key(|g| g.0);
+    let mut primed = false;
+    let mut inner_released = false;
     for (_, layer, material_key, v, holders, sprayed) in gel {
         let m = materials
             .get(&material_key)
@@ -174,6 +176,15 @@ pub fn build_kit_bounded(
                 r.notes
             );
         }
+        r.treatments = treatments(
+            design,
+            &stack,
+            &materials,
+            &layer,
+            &sprayed,
+            &r.mold_parts,
+            (&mut primed, &mut inner_released),
+        );
         for s in sprayed {
             let sl = &stack.layers[s];
             if let Some(cm) = materials.get(&sl.material) {
@@ -187,13 +198,13 @@ pub fn build_kit_bounded(
                     r.coats.push(c);
                 }
             }
-            let sm = materials
+            let (product, sm) = materials
                 .get(&sl.material)
-                .map(|m| m.notes.clone())
-                .unwrap_or_default();
+                .map(|m| (m.name.clone(), m.notes.clone()))
+                .unwrap_or_else(|| (sl.material.clone(), String::new()));
             r.notes = format!(
-                "First spray the {} layer ({}, {:.2} mm) onto the inner surface of the mold: {} Then: {}",
-                sl.name, sl.material, sl.thickness_mm, sm, r.notes
+                "First spray the {} layer ({product}, {:.2} mm) onto the inner surface of the mold: {sm} Then: {}",
+                sl.name, sl.thickness_mm, r.notes
             );
         }
         casts.push(r);
@@ -208,40 +219,122 @@ pub fn build_kit_bounded(
         ))
         .part("kit");
     }
+    let bolts = crate::procedure::clamp_bolts(design, &parts);
+    bought.extend(crate::procedure::clamp_bolt_items(&bolts));
+    let procedure = crate::procedure::procedure(design, &parts, &casts, &bolts);
     Ok(Kit {
         design: design.name.clone(),
         parts,
         casts,
         bought_items: bought,
+        procedure,
         summary,
     })
 }
 
-fn bought_items(design: &Design, stack: &Stack) -> Vec<String> {
+/// The primer and release agent applied before the pour of `layer` (with the `sprayed` layers
+/// coated into its mold first), held by `mold_parts`: the core's primer before the first
+/// layer cast on the core (`primed` records it), and the release agent on the cavity (the
+/// outermost of the layer and its coats) and, for the boundary strategy, on the inner silicone
+/// mold (the layer's inner surface) of the first such pour only: the later layers are cast
+/// onto the layers before them (UVDtact Sec. III), which they must bond to. Areas from the
+/// exact profile.
+fn treatments(
+    design: &Design,
+    stack: &Stack,
+    materials: &MaterialsTable,
+    layer: &str,
+    sprayed: &[usize],
+    mold_parts: &[String],
+    (primed, inner_released): (&mut bool, &mut bool),
+) -> Vec<crate::kit::TreatmentReport> {
+    let Some(l) = stack.layers.iter().find(|l| l.name == layer) else {
+        return Vec::new();
+    };
+    let report = |key: &str, surface: String, offset_mm: f64| {
+        let m = materials.get(key)?;
+        let area_cm2 = design.body.surface_area_mm2(offset_mm) / 100.0;
+        Some(crate::kit::TreatmentReport {
+            material: key.to_string(),
+            material_name: m.name.clone(),
+            kind: m.kind,
+            surface,
+            area_cm2,
+            amount_ml: area_cm2 * m.applied_ml_per_cm2.unwrap_or(0.0),
+        })
+    };
+    let mut out = Vec::new();
+    let on_core = mold_parts
+        .iter()
+        .any(|p| p.ends_with("_core_holder") || p.ends_with("_casting_jig"));
+    if let (Some(core), true, false) = (&design.core, on_core, *primed) {
+        *primed = true;
+        if let Some(p) = &core.primer {
+            out.extend(report(
+                p,
+                "the core's outer surface".into(),
+                l.inner_offset_mm,
+            ));
+        }
+    }
+    if let Some(rel) = &design.casting.mold_release {
+        let cavity = sprayed
+            .iter()
+            .map(|&i| stack.layers[i].outer_offset_mm)
+            .fold(l.outer_offset_mm, f64::max);
+        out.extend(report(
+            rel,
+            format!("the cavity of the {layer} mold"),
+            cavity,
+        ));
+        if mold_parts.iter().any(|p| p.ends_with(":inner")) && !l.solid && !*inner_released {
+            // later layers are cast onto the layers before them, which they must bond to
+            *inner_released = true;
+            out.extend(report(
+                rel,
+                format!("the inner silicone mold of {layer}"),
+                l.inner_offset_mm,
+            ));
+        }
+    }
+    out
+}
+
+fn bought_items(design: &Design, stack: &Stack, materials: &MaterialsTable) -> Vec<String> {
+    let product = |key: &str| {
+        materials
+            .get(key)
+            .map_or_else(|| key.to_string(), |m| m.name.clone())
+    };
     let mut v = Vec::new();
     if let (Some(c), Some(spec)) = (&stack.core, &design.core) {
         v.push(match (c.outer_radius_mm, c.inner_radius_mm) {
             (Some(ro), Some(ri)) => format!(
                 "Core ({}): {}, outer diameter {:.2} mm, wall {:.2} mm (inner diameter {:.2} mm), cut to {:.2} mm from the pole",
-                spec.material, spec.description, 2.0 * ro, ro - ri, 2.0 * ri, spec.length_mm
+                product(&spec.material), spec.description, 2.0 * ro, ro - ri, 2.0 * ri, spec.length_mm
             ),
             _ => format!(
                 "Core ({}): {}, wall {:.2} mm along the normal, {:.2} mm long from the pole",
-                spec.material, spec.description, spec.wall_thickness_mm, spec.length_mm
+                product(&spec.material), spec.description, spec.wall_thickness_mm, spec.length_mm
             ),
         });
     }
     if let Some(b) = &design.backing {
         v.push(format!(
             "Backing ({}): {}, {:.1} mm diameter, {:.1} mm thick; glue the skin's base to it",
-            b.material, b.description, b.diameter_mm, b.thickness_mm
+            product(&b.material),
+            b.description,
+            b.diameter_mm,
+            b.thickness_mm
         ));
     }
     for l in &stack.layers {
         if l.process == crate::schema::LayerProcess::Sprayed {
             v.push(format!(
                 "Coating {} ({}), about {:.2} mm, sprayed into the mold",
-                l.name, l.material, l.thickness_mm
+                l.name,
+                product(&l.material),
+                l.thickness_mm
             ));
         }
     }
@@ -293,9 +386,10 @@ fn housing_items(h: &crate::schema::HousingParams) -> Vec<String> {
 /// ISO metric screw sizes (nominal diameter, mm) the bought-items list names.
 pub const METRIC_SIZES_MM: [f64; 9] = [1.6, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0];
 
-/// Standard screw lengths, mm (ISO 4762 / ISO 7045 preferred lengths up to 40 mm).
-pub const SCREW_LENGTHS_MM: [f64; 14] = [
-    3.0, 4.0, 5.0, 6.0, 8.0, 10.0, 12.0, 14.0, 16.0, 20.0, 25.0, 30.0, 35.0, 40.0,
+/// Standard screw lengths, mm (ISO 4762 / ISO 7045 preferred lengths up to 100 mm).
+pub const SCREW_LENGTHS_MM: [f64; 23] = [
+    3.0, 4.0, 5.0, 6.0, 8.0, 10.0, 12.0, 14.0, 16.0, 20.0, 25.0, 30.0, 35.0, 40.0, 45.0, 50.0,
+    55.0, 60.0, 65.0, 70.0, 80.0, 90.0, 100.0,
 ];
 
 /// The metric screw a through hole of `clearance_mm` is for: the largest size below it with at

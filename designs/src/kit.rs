@@ -101,6 +101,66 @@ pub struct CastReport {
     /// Coats sprayed into the mold before this pour (R-Tac0's black coating), in order.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub coats: Vec<CoatReport>,
+    /// Primer and release agent applied before this pour, in order (the core primed before
+    /// the first layer cast on it, the mold's surfaces released).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub treatments: Vec<TreatmentReport>,
+}
+
+/// A primer or release agent applied to a surface before a pour, with its amount.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TreatmentReport {
+    /// Material key in the materials table (kind `primer` or `release`), and its product name.
+    pub material: String,
+    pub material_name: String,
+    /// `primer` or `release`.
+    pub kind: crate::materials::MaterialKind,
+    /// What is treated, e.g. `the core's outer surface`, `the cavity of transparent_gel`.
+    pub surface: String,
+    /// Area treated, cm^2 (the exact profile's surface, features not counted).
+    pub area_cm2: f64,
+    /// Amount used, mL: `area_cm2` x the material's `applied_ml_per_cm2`.
+    pub amount_ml: f64,
+}
+
+/// What a step of the procedure does; the steps of a kit come in a fixed order per pour.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ProcedureAction {
+    /// Print and check the parts.
+    Print,
+    /// Seat a master pattern in its mold box (or a negative mold level) for a Mold Star pour.
+    SeatMaster,
+    /// Pour Mold Star 30 around a master, up to the fill height.
+    FillMoldStar,
+    /// Take a cured silicone mold off its master or out of its negative.
+    DemoldSiliconeMold,
+    /// Wipe primer onto the core.
+    PrimeCore,
+    /// Mount the core on its holder or jig.
+    MountCore,
+    /// Move the core with the layers cast so far to the next layer's mold.
+    MoveCore,
+    /// Spray release agent into the mold.
+    SprayRelease,
+    /// Spray a coat into the mold before the pour.
+    SprayCoat,
+    /// Close the mold: halves or pieces together, clamp bolts in.
+    CloseMold,
+    /// Mix, degas and pour, mold pole-down, through the sprue.
+    Pour,
+    /// Cure and take the cast layer out of the mold.
+    Demold,
+    /// Assemble the sensor.
+    Assemble,
+}
+
+/// One step of the fabrication procedure.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ProcedureStep {
+    pub action: ProcedureAction,
+    /// The instruction, with the parts by name and the numbers it needs.
+    pub text: String,
 }
 
 /// A layer sprayed or brushed into a mold before a pour: its mix and amount.
@@ -164,6 +224,8 @@ pub struct Kit {
     /// Parts that are bought or cut rather than printed (tube, PCB, diffuser, screws), one
     /// line each, for the fabrication sheet.
     pub bought_items: Vec<String>,
+    /// The fabrication procedure, in order ([`crate::procedure::procedure`]).
+    pub procedure: Vec<ProcedureStep>,
     /// Sensor-frame facts worth printing in the manifest (envelope, derived radii...).
     pub summary: serde_json::Value,
 }

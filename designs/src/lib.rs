@@ -20,6 +20,7 @@ pub mod markers;
 pub mod materials;
 pub mod molds;
 pub mod primitives;
+pub mod procedure;
 pub mod profile;
 pub mod schema;
 pub mod stack;

@@ -15,6 +15,12 @@ pub enum MaterialKind {
     Coating,
     Print,
     Bought,
+    /// Wiped or brushed onto a part so that silicone bonds to it (Dow PR-1200 on R-Tac0's
+    /// glass tube, Sec. III-B1); needs `applied_ml_per_cm2`.
+    Primer,
+    /// Sprayed into a mold so that the cast skin comes out (Mann Ease Release 200, R-Tac0
+    /// Sec. III-B1, ShadowTac Sec. III); needs `applied_ml_per_cm2`.
+    Release,
 }
 
 /// Mixing by weight or by volume.
@@ -50,6 +56,10 @@ pub struct Material {
     pub mix: Option<Mix>,
     #[serde(default)]
     pub notes: String,
+    /// Amount used per cm^2 of treated surface, mL, losses included (primer and release only,
+    /// where it is required), in (0, 0.1].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub applied_ml_per_cm2: Option<f64>,
     /// Where the numbers come from (datasheet, paper and section).
     pub source: String,
 }
@@ -90,6 +100,26 @@ impl MaterialsTable {
             }
             if m.source.trim().is_empty() {
                 return Err(format!("materials.{k}.source must name a source"));
+            }
+            let treatment = matches!(m.kind, MaterialKind::Primer | MaterialKind::Release);
+            match m.applied_ml_per_cm2 {
+                None if treatment => {
+                    return Err(format!(
+                        "materials.{k}.applied_ml_per_cm2 is required for a {:?} material (mL per cm² of treated surface)",
+                        m.kind
+                    ))
+                }
+                Some(a) if !treatment => {
+                    return Err(format!(
+                        "materials.{k}.applied_ml_per_cm2 = {a}: only primer and release materials take it"
+                    ))
+                }
+                Some(a) if !(a > 0.0 && a <= 0.1) => {
+                    return Err(format!(
+                        "materials.{k}.applied_ml_per_cm2 = {a}: must be above 0 and at most 0.1 mL per cm² (a 1 mm film)"
+                    ))
+                }
+                _ => {}
             }
             if let Some(mix) = &m.mix {
                 if mix.components.len() != mix.ratio.len() || mix.ratio.iter().any(|r| !(*r > 0.0))
@@ -165,6 +195,7 @@ pub fn pour(
         total_mass_g: total,
         notes: material.notes.clone(),
         coats: Vec::new(),
+        treatments: Vec::new(),
     })
 }
 

@@ -27,10 +27,10 @@ const FLANGE_MARGIN_MM: f64 = 3.0;
 const LOCATING_PIN_HEIGHT_MM: f64 = 2.0;
 const LOCATING_PIN_RADIUS_MM: f64 = 3.0;
 /// Floor and wall of the mold box, mm.
-const BOX_FLOOR_MM: f64 = 2.0;
+pub(crate) const BOX_FLOOR_MM: f64 = 2.0;
 const BOX_WALL_MM: f64 = 2.0;
 /// How far the box rim stands above the Mold Star fill level, mm.
-const BOX_FREEBOARD_MM: f64 = 2.0;
+pub(crate) const BOX_FREEBOARD_MM: f64 = 2.0;
 
 /// Places a solid for printing: minimum z on the plate (z = 0), bounding box centred on x = y = 0.
 pub fn place_on_bed(s: &Solid) -> Solid {

@@ -452,6 +452,24 @@ impl BodyProfile {
         pl
     }
 
+    /// Area of the offset surface at `d` from the pole down to the base plane, mm^2: the
+    /// surface of revolution of [`Self::offset_polyline`] at a 1 µm chord tolerance (Pappus;
+    /// the inscribed polyline comes out short by about the chord tolerance over the radius of
+    /// curvature, under 1e-4 relative for radii of 10 mm and more). The surface a release
+    /// agent or a primer covers.
+    pub fn surface_area_mm2(&self, d: f64) -> f64 {
+        let tol =
+            ChordTolerance::new(ChordTolerance::MIN_MM).expect("the minimum tolerance is valid");
+        let pl = self.offset_polyline(d, 0.0, tol);
+        pl.points
+            .windows(2)
+            .map(|w| {
+                let ([r0, z0], [r1, z1]) = (w[0], w[1]);
+                std::f64::consts::PI * (r0 + r1) * (r1 - r0).hypot(z1 - z0)
+            })
+            .sum()
+    }
+
     /// Enclosed volume of the solid at offset `d` with `below_base_mm`, mm^3, from the exact
     /// curve (closed form for spheres, 2000-point Gauss-Legendre for ellipse offsets).
     pub fn analytic_solid_volume_mm3(&self, d: f64, below_base_mm: f64) -> f64 {

@@ -70,6 +70,11 @@ pub struct Core {
     /// diameter of the innermost layer; layers given by `outer_radius_mm` are measured from it.
     #[serde(default)]
     pub outer_diameter_mm: Option<f64>,
+    /// Primer wiped onto the core's outer surface before the first layer is cast on it, so
+    /// that the layer bonds to it: a `primer` key of the materials table (R-Tac0: `pr_1200_rtv`,
+    /// Sec. III-B1); none when not given.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub primer: Option<String>,
 }
 
 /// How a layer is made.
@@ -425,9 +430,14 @@ impl PrinterProfiles {
 pub struct CastingParams {
     /// Extra material mixed for losses in cups, sprue and vents, fraction in [0, 1].
     pub waste_allowance: f64,
+    /// Release agent sprayed into each mold before a skin layer is poured: a `release` key of
+    /// the materials table; `null` for none. Default `ease_release_200` (R-Tac0 Sec. III-B1,
+    /// ShadowTac Sec. III).
+    pub mold_release: Option<String>,
 }
 defaults!(CastingParams {
-    waste_allowance: 0.2
+    waste_allowance: 0.2,
+    mold_release: Some("ease_release_200".into())
 });
 
 /// The two-piece sensor shell (R-Tac0 Sec. III-B4, Fig. 2): camera bay, LED ring seat,

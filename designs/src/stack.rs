@@ -153,6 +153,12 @@ pub fn validate(
             &c.material,
             &[MaterialKind::Bought, MaterialKind::Print],
         );
+        if let Some(p) = &c.primer {
+            check_material("core.primer".into(), p, &[MaterialKind::Primer]);
+        }
+    }
+    if let Some(r) = &design.casting.mold_release {
+        check_material("casting.mold_release".into(), r, &[MaterialKind::Release]);
     }
     if let Some(b) = &design.backing {
         check_material(

@@ -374,6 +374,7 @@ fn render(
         kit_3mf,
         casts: kit.casts.clone(),
         bought_items: kit.bought_items.clone(),
+        procedure: kit.procedure.clone(),
         summary: kit.summary.clone(),
         data_files: data_files
             .iter()
@@ -437,6 +438,7 @@ mod tests {
             parts: vec![part("a", 0.0), part("lid", 20.0)],
             casts: vec![],
             bought_items: vec![],
+            procedure: vec![],
             summary: serde_json::json!({}),
         }
     }

@@ -32,6 +32,9 @@ pub struct Manifest {
     pub casts: Vec<CastReport>,
     /// Parts that are bought or cut rather than printed, one line each.
     pub bought_items: Vec<String>,
+    /// The fabrication procedure in order (`action`, `text`), as the design derived it.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub procedure: Vec<fabkit_designs::kit::ProcedureStep>,
     /// Sensor-frame facts from the design build (envelope, derived radii, ...).
     pub summary: serde_json::Value,
     /// Data files written beside the meshes (point tables, geometry descriptions), in order.

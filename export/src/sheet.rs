@@ -190,6 +190,7 @@ pub(crate) fn render(m: &Manifest) -> String {
     }
 
     shopping_list(&mut s, m);
+    procedure(&mut s, m);
 
     s.push_str("## Bought items\n\n");
     if m.bought_items.is_empty() {
@@ -236,6 +237,15 @@ fn shopping_list(s: &mut String, m: &Manifest) {
             }
             None => items.push((name.to_string(), g, ml)),
         };
+    // treatments are measured in millilitres only (grams 0); coats and pours come first
+    for c in &m.casts {
+        for k in &c.coats {
+            add(&k.material_name, k.total_mass_g, None);
+        }
+        for t in &c.treatments {
+            add(&t.material_name, 0.0, Some(t.amount_ml));
+        }
+    }
     for c in &m.casts {
         let ml = c
             .components
@@ -261,10 +271,28 @@ fn shopping_list(s: &mut String, m: &Manifest) {
     s.push_str("| Product | Amount |\n|---------|-------:|\n");
     for (name, g, ml) in items {
         let amount = match ml {
+            Some(ml) if g == 0.0 => format!("about {ml:.2} mL"),
             Some(ml) => format!("{ml:.1} mL ({g:.1} g)"),
+            // two decimals where a 0.01 g scale matters, one above 10 g
+            None if g < 10.0 => format!("{g:.2} g"),
             None => format!("{g:.1} g"),
         };
         let _ = writeln!(s, "| {} | {amount} |", text(&name));
+    }
+    s.push('\n');
+}
+
+/// The procedure in order, numbered, from `manifest.procedure`; nothing when it is empty.
+fn procedure(s: &mut String, m: &Manifest) {
+    if m.procedure.is_empty() {
+        return;
+    }
+    s.push_str("## Procedure\n\n");
+    s.push_str(
+        "In this order; \"Step N\" is the pour of the cast order with its amounts and notes.\n\n",
+    );
+    for (i, p) in m.procedure.iter().enumerate() {
+        let _ = writeln!(s, "{}. {}", i + 1, text(&p.text));
     }
     s.push('\n');
 }
@@ -390,6 +418,7 @@ fn layer_stack(s: &mut String, m: &Manifest) {
                     .iter()
                     .flat_map(|c| c.coats.iter().map(|k| (&k.material, &k.material_name))),
             )
+            .chain(m.parts.iter().map(|p| (&p.material, &p.material_name)))
             .find(|(key, _)| *key == material)
             .map_or_else(|| code(material), |(_, name)| text(name));
         let _ = writeln!(

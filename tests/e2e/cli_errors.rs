@@ -34,7 +34,8 @@ fn impossible_parameters_are_all_reported_with_their_paths() {
     let tmp = tempfile::tempdir().unwrap();
     let yaml = rtac0_yaml()
         .replace("outer_radius_mm: 15.0 ", "outer_radius_mm: 14.8 ")
-        .replace("draft_angle_deg: 2.0", "draft_angle_deg: 12.0");
+        .replace("draft_angle_deg: 2.0", "draft_angle_deg: 12.0")
+        .replace("primer: pr_1200_rtv", "primer: ease_release_200");
     std::fs::write(tmp.path().join("bad.yaml"), &yaml).unwrap();
     let o = run(tmp.path(), &["export", "bad.yaml", "--out", "out/bad"], &[]);
     assert_eq!(o.status.code(), Some(2));
@@ -42,6 +43,12 @@ fn impossible_parameters_are_all_reported_with_their_paths() {
     assert!(err.contains("layers[2].outer_radius_mm = 14.8"), "{err}");
     assert!(
         err.contains("mold.draft_angle_deg = 12: must be in [0, 10)"),
+        "{err}"
+    );
+    assert!(
+        err.contains(
+            "core.primer = ease_release_200: is a Release material, expected one of [Primer]"
+        ),
         "{err}"
     );
     assert!(!tmp.path().join("out").exists());

@@ -124,7 +124,9 @@ fn shadowtac_kits() {
         "skin pour {pour} mm^3, expected {expected} within {bound}"
     );
     assert!(
-        m["bought_items"].to_string().contains("pmma"),
+        m["bought_items"]
+            .to_string()
+            .contains("Backing (PMMA (acrylic) sheet or machined part)"),
         "{}",
         m["bought_items"]
     );

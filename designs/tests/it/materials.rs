@@ -213,3 +213,80 @@ fn screws_are_named_by_standard_size_and_length() {
         );
     }
 }
+
+/// Primer and release agents carry the amount one coat uses per cm²; the table refuses one
+/// without it, a non-positive or film-thick amount, and the amount on any other kind.
+#[test]
+fn treatments_carry_a_checked_amount_per_area() {
+    let t = MaterialsTable::embedded().unwrap();
+    for (key, kind) in [
+        ("pr_1200_rtv", MaterialKind::Primer),
+        ("ease_release_200", MaterialKind::Release),
+    ] {
+        let m = t.get(key).unwrap();
+        assert_eq!(m.kind, kind, "{key}");
+        assert!(m.applied_ml_per_cm2.unwrap() > 0.0, "{key}");
+    }
+    let text = |kind: &str, amount: &str| {
+        format!(
+            "materials:\n  r:\n    name: R\n    kind: {kind}\n    density_g_per_cm3: 0.7\n{amount}    source: test\n"
+        )
+    };
+    assert!(MaterialsTable::from_yaml(
+        &text("release", "    applied_ml_per_cm2: 0.005\n"),
+        "m.yaml"
+    )
+    .is_ok());
+    for (kind, amount, want) in [
+        (
+            "release",
+            "",
+            "m.yaml: materials.r.applied_ml_per_cm2 is required for a Release material",
+        ),
+        (
+            "primer",
+            "    applied_ml_per_cm2: 0\n",
+            "m.yaml: materials.r.applied_ml_per_cm2 = 0: must be above 0 and at most 0.1",
+        ),
+        (
+            "release",
+            "    applied_ml_per_cm2: 0.5\n",
+            "m.yaml: materials.r.applied_ml_per_cm2 = 0.5: must be above 0 and at most 0.1",
+        ),
+        (
+            "print",
+            "    applied_ml_per_cm2: 0.005\n",
+            "m.yaml: materials.r.applied_ml_per_cm2 = 0.005: only primer and release materials take it",
+        ),
+    ] {
+        let e = MaterialsTable::from_yaml(&text(kind, amount), "m.yaml").unwrap_err();
+        assert!(e.starts_with(want), "{kind} {amount:?}: {e}");
+    }
+}
+
+/// A clamp bolt is the shortest standard length that passes the grip and an ISO 4032 nut
+/// (0.8 d) by 1 mm: M3 through 53 mm needs 56.4 mm, so M3 x 60; through 25.4 mm, M3 x 30.
+/// R-Tac0's direct mold halves take 4 such bolts each, across both halves (grip 2 x (plinth
+/// radius + flange width)).
+#[test]
+fn clamp_bolts_are_named_by_standard_size_and_length() {
+    use fabkit_designs::procedure::bolt_name;
+    assert_eq!(bolt_name(3.4, 53.0).as_deref(), Some("M3 x 60"));
+    assert_eq!(bolt_name(3.4, 25.4).as_deref(), Some("M3 x 30"));
+    assert_eq!(bolt_name(3.4, 26.6).as_deref(), Some("M3 x 30"));
+    assert_eq!(bolt_name(3.4, 26.61).as_deref(), Some("M3 x 35"));
+    assert_eq!(bolt_name(1.0, 10.0), None);
+    assert_eq!(bolt_name(3.4, 200.0), None);
+    let tol = fabkit_designs::ChordTolerance::new(0.05).unwrap();
+    let mut d = fabkit_designs::library::load("rtac0").unwrap();
+    d.mold.strategy = fabkit_designs::schema::MoldStrategy::Direct;
+    let kit = fabkit_designs::build_kit(&d, tol).unwrap();
+    // transparent_gel: cavity rim 13.5 mm + plinth margin 5 + flange 8 = 26.5 mm half width
+    let want =
+        "4 clamp bolts M3 x 60 with nuts for the transparent_gel mold: 3.4 mm holes, 53.0 mm grip";
+    assert!(
+        kit.bought_items.iter().any(|b| b == want),
+        "{:?}",
+        kit.bought_items
+    );
+}

@@ -222,6 +222,24 @@ fn single_mutations() -> Vec<Mutation> {
             },
         ),
         (
+            "a release agent as the core's primer",
+            |d| d.core.as_mut().unwrap().primer = Some("ease_release_200".into()),
+            Expect {
+                path: "core.primer",
+                value: "ease_release_200",
+                rule: &["is a Release material, expected one of [Primer]"],
+            },
+        ),
+        (
+            "an unknown mold release",
+            |d| d.casting.mold_release = Some("soap".into()),
+            Expect {
+                path: "casting.mold_release",
+                value: "soap",
+                rule: &["unknown material; known:", "ease_release_200"],
+            },
+        ),
+        (
             "waste allowance above 1",
             |d| d.casting.waste_allowance = 1.5,
             Expect {

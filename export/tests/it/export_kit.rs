@@ -82,8 +82,10 @@ fn test_kit() -> Kit {
             notes: "pot life 15 min | degas 3 min".into(),
             min_batch: None,
             coats: vec![],
+            treatments: vec![],
         }],
         bought_items: vec!["acrylic tube, 30 mm OD".into()],
+        procedure: vec![],
         summary: serde_json::json!({ "envelope_radius_mm": 15.0 }),
     }
 }
@@ -379,6 +381,7 @@ fn group_kit() -> Kit {
         parts: vec![skin, plate, dots],
         casts: vec![],
         bought_items: vec![],
+        procedure: vec![],
         summary: serde_json::json!({}),
     }
 }
@@ -697,7 +700,7 @@ fn fabrication_sheet_lists_provenance_parts_casts_and_checks() {
         "`fabkit build tiny.yaml --out 'out dir'`",
         "| 1 | `base_plate` | `parts/base_plate.stl` | FDM | – | Black PLA filament | 18000.0 | 150.00 × 30.00 × 4.00 |",
         "## Shopping list",
-        "| Smooth-On Solaris | 3.9 g |",
+        "| Smooth-On Solaris | 3.85 g |",
         "### Step 1: transparent_gel",
         "- material: Smooth-On Solaris",
         "- layer volume: 2.50 mL (the cast layer alone, from the exact profile)",

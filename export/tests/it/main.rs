@@ -1,3 +1,4 @@
 //! The export crate's integration tests, one binary (one link) with a module per area.
 
 mod export_kit;
+mod library_sheets;

@@ -1,0 +1,540 @@
+//! The fabrication procedure in order, and the clamp bolts the molds need: what the
+//! fabrication sheet tells a maker at the bench, derived from the kit's parts and pours.
+//!
+//! Sources: R-Tac0 Sec. III-B1 (Mold Star molds from printed masters, primed tube press-fitted,
+//! release sprayed, black coat sprayed before the next pour); UVDtact Sec. III (outer and inner
+//! silicone molds, layers cast inside out on the first inner mold, acrylic shell attached with
+//! clear silicone sealant); ShadowTac Sec. III (release sprayed, poured, degassed, cured 24 h,
+//! glued to the PMMA plate).
+
+use crate::kit::{CastReport, Part, ProcedureAction, ProcedureStep};
+use crate::materials::MaterialKind;
+use crate::schema::Design;
+
+/// The clamp bolts of one mold: `count` bolts of `name` (e.g. `M3 x 60`) through `grip_mm`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ClampBolts {
+    /// The layer the mold casts.
+    pub layer: String,
+    pub count: usize,
+    /// Standard size and length, e.g. `M3 x 60`; `None` when no standard bolt fits the hole.
+    pub name: Option<String>,
+    /// Thickness the bolt clamps (both mold parts), mm.
+    pub grip_mm: f64,
+    pub clearance_mm: f64,
+}
+
+/// ISO 4032 hexagon nut height, as a fraction of the nominal diameter.
+const NUT_HEIGHT_PER_D: f64 = 0.8;
+/// Thread left beyond the nut, mm.
+const BOLT_PROTRUSION_MM: f64 = 1.0;
+
+/// The bolt for a through hole of `clearance_mm` clamping `grip_mm` with a nut: the shortest
+/// standard length ([`crate::build::SCREW_LENGTHS_MM`]) that passes the grip and the nut
+/// (0.8 d, ISO 4032) by [`BOLT_PROTRUSION_MM`]; `None` when no standard size or length fits.
+pub fn bolt_name(clearance_mm: f64, grip_mm: f64) -> Option<String> {
+    let d = crate::build::metric_from_clearance(clearance_mm)?;
+    let need = grip_mm + NUT_HEIGHT_PER_D * d + BOLT_PROTRUSION_MM;
+    let l = crate::build::SCREW_LENGTHS_MM
+        .iter()
+        .copied()
+        .find(|l| *l >= need - 1e-9)?;
+    Some(format!("M{d} x {l}"))
+}
+
+/// The clamp bolts of every bolted mold of the kit, from the parts' parameters: the direct
+/// strategy's halves (4 bolts across both halves, perpendicular to the parting plane) and the
+/// two-piece open mold (`two_piece.bolt_count` bolts through both pieces).
+pub fn clamp_bolts(design: &Design, parts: &[Part]) -> Vec<ClampBolts> {
+    let mut out = Vec::new();
+    for p in parts {
+        let layer = p.params["layer"]
+            .as_str()
+            .or_else(|| p.params["base"]["layer"].as_str())
+            .unwrap_or(&p.name)
+            .to_string();
+        if p.role == "mold_half" && p.name.ends_with("_a") {
+            let Some(half_width) = p.params["direct"]["half_width_mm"].as_f64() else {
+                continue;
+            };
+            let c = design.mold.clamp_bolt.clearance_diameter_mm;
+            let grip = 2.0 * half_width;
+            out.push(ClampBolts {
+                layer,
+                count: 4,
+                name: bolt_name(c, grip),
+                grip_mm: grip,
+                clearance_mm: c,
+            });
+        } else if p.role == "open_mold_piece" && p.params["piece"] == "cavity_block" {
+            let (Some(grip), Some(n)) = (
+                p.params["bolt_grip_mm"].as_f64(),
+                p.params["frame"]["bolts_xy_mm"].as_array().map(Vec::len),
+            ) else {
+                continue;
+            };
+            let (a, b) = design
+                .mold
+                .two_piece
+                .bolt_holes_mm(design.mold.clamp_bolt.clearance_diameter_mm);
+            let c = a.min(b);
+            out.push(ClampBolts {
+                layer,
+                count: n,
+                name: bolt_name(c, grip),
+                grip_mm: grip,
+                clearance_mm: c,
+            });
+        }
+    }
+    out
+}
+
+/// The bought-items lines of [`clamp_bolts`].
+pub fn clamp_bolt_items(bolts: &[ClampBolts]) -> Vec<String> {
+    bolts
+        .iter()
+        .map(|b| {
+            format!(
+                "{} clamp bolts{} with nuts for the {} mold: {:.1} mm holes, {:.1} mm grip",
+                b.count,
+                b.name
+                    .as_deref()
+                    .map(|n| format!(" {n}"))
+                    .unwrap_or_default(),
+                b.layer,
+                b.clearance_mm,
+                b.grip_mm
+            )
+        })
+        .collect()
+}
+
+fn part<'a>(parts: &'a [Part], name: &str) -> Option<&'a Part> {
+    parts.iter().find(|p| p.name == name)
+}
+
+fn with_role<'a>(parts: &'a [Part], names: &[String], roles: &[&str]) -> Vec<&'a Part> {
+    names
+        .iter()
+        .filter_map(|n| part(parts, n))
+        .filter(|p| roles.contains(&p.role.as_str()))
+        .collect()
+}
+
+fn step(action: ProcedureAction, text: String) -> ProcedureStep {
+    ProcedureStep { action, text }
+}
+
+/// How the mix of a pour is measured: `12.36 g of Dow SYLGARD 184 (10:1 by weight)`.
+fn mix_text(c: &CastReport) -> String {
+    let by_volume = c.components.iter().all(|x| x.volume_ml.is_some());
+    if by_volume {
+        let ml: f64 = c.components.iter().filter_map(|x| x.volume_ml).sum();
+        format!("{ml:.1} mL of {} ({})", c.material_name, c.mix_ratio)
+    } else {
+        format!(
+            "{:.2} g of {} ({})",
+            c.total_mass_g, c.material_name, c.mix_ratio
+        )
+    }
+}
+
+/// The procedure of a kit in order, from its parts (roles, names, parameters), its pours
+/// ([`CastReport`], with their coats and treatments) and its clamp bolts. Every kit starts with
+/// printing and ends with assembly; each pour brings the steps its mold needs.
+pub fn procedure(
+    design: &Design,
+    parts: &[Part],
+    casts: &[CastReport],
+    bolts: &[ClampBolts],
+) -> Vec<ProcedureStep> {
+    use ProcedureAction as A;
+    let mut out = Vec::new();
+    if !parts.is_empty() {
+        out.push(step(
+            A::Print,
+            format!(
+                "Print every part of the print list with the print settings of this sheet, and \
+                 check each one as in \"Checking the prints\"{}.",
+                if casts.is_empty() {
+                    ""
+                } else {
+                    " before the first pour"
+                }
+            ),
+        ));
+    }
+    let mut core_mounted = false;
+    let mut boundary_cast = false;
+    for c in casts {
+        let n = c.step;
+        if c.cast.starts_with("silicone_mold:") {
+            mold_star_steps(&mut out, design, parts, c);
+            continue;
+        }
+        let holder = with_role(parts, &c.mold_parts, &["core_holder", "casting_jig"]);
+        let halves = with_role(parts, &c.mold_parts, &["mold_half"]);
+        let pieces = with_role(parts, &c.mold_parts, &["open_mold_piece", "open_mold"]);
+        let silicone: Vec<&String> = c
+            .mold_parts
+            .iter()
+            .filter(|m| m.starts_with("silicone_mold:"))
+            .collect();
+        let boundary = silicone.iter().any(|m| m.ends_with(":inner"));
+        let bolt = bolts.iter().find(|b| b.layer == c.cast);
+        let bolt_text = bolt.map_or_else(String::new, |b| {
+            format!(
+                " and tighten the {} clamp bolts{}",
+                b.count,
+                b.name
+                    .as_deref()
+                    .map(|n| format!(" ({n}, with nuts)"))
+                    .unwrap_or_default()
+            )
+        });
+
+        treatment_steps(&mut out, c, MaterialKind::Primer);
+        if let Some(h) = holder.first() {
+            if core_mounted {
+                out.push(step(
+                    A::MoveCore,
+                    format!(
+                        "Step {n}: take the core with the layers cast so far off the previous \
+                         holder and slide it onto the centring pin of `{}`, down to the shoulder.",
+                        h.name
+                    ),
+                ));
+            } else {
+                out.push(step(
+                    A::MountCore,
+                    format!(
+                        "Step {n}: slide the core's open end onto the centring pin of `{}`, down \
+                         to the shoulder.",
+                        h.name
+                    ),
+                ));
+            }
+            core_mounted = true;
+        }
+        if boundary && boundary_cast {
+            out.push(step(
+                A::MoveCore,
+                format!(
+                    "Step {n}: the layers cast so far, still on the first inner silicone mold, \
+                     take the place of `{}` (UVDtact Sec. III).",
+                    silicone
+                        .iter()
+                        .find(|m| m.ends_with(":inner"))
+                        .map_or("the inner silicone mold", |s| s.as_str())
+                ),
+            ));
+        }
+        treatment_steps(&mut out, c, MaterialKind::Release);
+        for k in &c.coats {
+            out.push(step(
+                A::SprayCoat,
+                format!(
+                    "Step {n}: mix the {} coat ({}, {}) and spray it evenly onto the cavity's \
+                     surface, about {:.2} mm thick; pour the next mix straight after.",
+                    k.layer, k.material_name, k.mix_ratio, k.thickness_mm
+                ),
+            ));
+        }
+        let mix = mix_text(c);
+        if !halves.is_empty() {
+            let (a, b) = (
+                &halves[0].name,
+                halves.get(1).map_or("", |p| p.name.as_str()),
+            );
+            let h = holder
+                .first()
+                .map_or("the core holder", |p| p.name.as_str());
+            out.push(step(
+                A::CloseMold,
+                format!(
+                    "Step {n}: set the plinth of `{h}` into the recess of `{a}`, close `{b}` over \
+                     it on the registration keys{bolt_text}."
+                ),
+            ));
+            out.push(step(
+                A::Pour,
+                sprue_pour_text(n, &mix, holder.first().copied()),
+            ));
+        } else if let Some(h) = holder.first() {
+            // master strategy: the silicone mold, then the core pressed in on its jig
+            out.push(step(
+                A::Pour,
+                format!(
+                    "Step {n}: stand the silicone mold pole-down in its mold box, mix and degas \
+                     {mix} and pour it in, then press the core on `{}` in until its flange rests \
+                     on the mold: the surplus rises through the sprue ({}) and the vents.",
+                    h.name,
+                    sprue_text(h)
+                ),
+            ));
+        } else if boundary {
+            let inner = if boundary_cast {
+                "the layers cast so far, on the first inner silicone mold,"
+            } else {
+                "the inner silicone mold"
+            };
+            out.push(step(
+                A::Pour,
+                format!(
+                    "Step {n}: stand the outer silicone mold pole-down, mix and degas {mix}, pour \
+                     it in, then press {inner} in until the plinth seats in the outer mold's \
+                     recess."
+                ),
+            ));
+            boundary_cast = true;
+        } else if pieces.len() > 1 {
+            let top = pieces.iter().find(|p| p.params["piece"] == "reservoir_top");
+            let block = pieces.iter().find(|p| p.params["piece"] == "cavity_block");
+            if let (Some(t), Some(b)) = (top, block) {
+                out.push(step(
+                    A::CloseMold,
+                    format!(
+                        "Step {n}: set `{}` on `{}`, boss down into the pocket{bolt_text}.",
+                        t.name, b.name
+                    ),
+                ));
+            }
+            out.push(step(
+                A::Pour,
+                format!(
+                    "Step {n}: with the cavity down and the reservoir bore up, mix and degas {mix} \
+                     and pour it into the bore to its top face; degas the filled mold again."
+                ),
+            ));
+        } else if let Some(p) = pieces.first() {
+            out.push(step(
+                A::Pour,
+                format!(
+                    "Step {n}: stand `{}` level, open face up, mix and degas {mix} and pour it to \
+                     the brim.",
+                    p.name
+                ),
+            ));
+        }
+        let what = if core_mounted {
+            format!("the core with `{}`", c.cast)
+        } else {
+            format!("`{}`", c.cast)
+        };
+        let last_boundary = boundary
+            && !casts
+                .iter()
+                .any(|d| d.step > c.step && d.mold_parts.iter().any(|m| m.ends_with(":inner")));
+        let text = if boundary && !last_boundary {
+            format!(
+                "Step {n}: let it cure ({}) and remove the outer silicone mold; keep `{}` on the \
+                 inner silicone mold for the next pour.",
+                cure_text(&c.notes),
+                c.cast
+            )
+        } else if boundary {
+            format!(
+                "Step {n}: let it cure ({}) and take the skin out of the outer silicone mold and \
+                 off the inner one.",
+                cure_text(&c.notes)
+            )
+        } else {
+            format!(
+                "Step {n}: let it cure ({}), open the mold and take {what} out.",
+                cure_text(&c.notes)
+            )
+        };
+        out.push(step(A::Demold, text));
+    }
+    out.push(step(
+        A::Assemble,
+        assembly_text(design, parts, core_mounted),
+    ));
+    out
+}
+
+/// The primer (`PrimeCore`, wiped) or release agent (`SprayRelease`, sprayed) steps of a pour.
+fn treatment_steps(out: &mut Vec<ProcedureStep>, c: &CastReport, kind: MaterialKind) {
+    let (action, verb) = match kind {
+        MaterialKind::Primer => (ProcedureAction::PrimeCore, "wipe"),
+        _ => (ProcedureAction::SprayRelease, "spray"),
+    };
+    for t in c.treatments.iter().filter(|t| t.kind == kind) {
+        out.push(step(
+            action,
+            format!(
+                "Step {}: {verb} {} onto {} ({:.1} cm², about {:.2} mL) and let it dry.",
+                c.step, t.material_name, t.surface, t.area_cm2, t.amount_ml
+            ),
+        ));
+    }
+}
+
+/// The Mold Star steps of a `silicone_mold:` pour: seating the master (or levelling the
+/// negative), pouring to the fill height, demolding.
+fn mold_star_steps(out: &mut Vec<ProcedureStep>, design: &Design, parts: &[Part], c: &CastReport) {
+    use ProcedureAction as A;
+    let n = c.step;
+    let mix = mix_text(c);
+    let master = with_role(parts, &c.mold_parts, &["master_pattern"]);
+    let boxes = with_role(parts, &c.mold_parts, &["mold_box"]);
+    let negative = with_role(parts, &c.mold_parts, &["negative_mold"]);
+    if let (Some(m), Some(b)) = (master.first(), boxes.first()) {
+        out.push(step(
+            A::SeatMaster,
+            format!(
+                "Step {n}: seat `{}` in `{}`: its locating pin in the socket of the box floor, \
+                 the plinth flat on the floor.",
+                m.name, b.name
+            ),
+        ));
+        let height = b
+            .solid
+            .bounding_box()
+            .map(|bb| bb.max[2] - bb.min[2])
+            .unwrap_or(0.0);
+        let fill = height - crate::molds::BOX_FLOOR_MM - crate::molds::BOX_FREEBOARD_MM;
+        out.push(step(
+            A::FillMoldStar,
+            format!(
+                "Step {n}: mix {mix}, and pour it in a thin stream beside the master, not onto \
+                 it, up to {fill:.1} mm above the box floor: {:.1} mm over the master's top, \
+                 {:.1} mm below the rim.",
+                design.mold.silicone_wall_mm,
+                crate::molds::BOX_FREEBOARD_MM
+            ),
+        ));
+        out.push(step(
+            A::DemoldSiliconeMold,
+            format!(
+                "Step {n}: let it cure ({}), push the silicone out of `{}` and peel it off `{}`: \
+                 its cavity is the {}.",
+                cure_text(&c.notes),
+                b.name,
+                m.name,
+                mold_of(&c.cast)
+            ),
+        ));
+    } else if let Some(neg) = negative.first() {
+        out.push(step(
+            A::SeatMaster,
+            format!(
+                "Step {n}: stand `{}` level on a flat surface, cavity up.",
+                neg.name
+            ),
+        ));
+        out.push(step(
+            A::FillMoldStar,
+            format!(
+                "Step {n}: mix {mix} and pour it into `{}` up to the brim.",
+                neg.name
+            ),
+        ));
+        out.push(step(
+            A::DemoldSiliconeMold,
+            format!(
+                "Step {n}: let it cure ({}) and pull the silicone out of `{}`.",
+                cure_text(&c.notes),
+                neg.name
+            ),
+        ));
+    }
+}
+
+/// `silicone_mold:x` -> `mold of x`, `silicone_mold:x:outer` -> `outer mold of x`.
+fn mold_of(cast: &str) -> String {
+    let rest = cast.trim_start_matches("silicone_mold:");
+    match rest.rsplit_once(':') {
+        Some((layer, side)) => format!("{side} mold of {layer}"),
+        None => format!("mold of {rest}"),
+    }
+}
+
+/// `the 3.0 mm hole 12.5 mm from the axis, nearest it; the 3 vents are the 2.0 mm holes at
+/// 17.0 mm`, from the holder's parameters.
+fn sprue_text(holder: &Part) -> String {
+    let p = &holder.params;
+    let (Some(d), Some(r)) = (
+        p["sprue"]["diameter_mm"].as_f64(),
+        p["sprue"]["radius_mm"].as_f64(),
+    ) else {
+        return "the sprue".into();
+    };
+    let rv = p["vent_radius_mm"].as_f64().unwrap_or(f64::NAN);
+    let dv = p["vent"]["diameter_mm"].as_f64().unwrap_or(f64::NAN);
+    let nv = p["vent"]["count"].as_u64().unwrap_or(0);
+    let nearest = if r < rv {
+        ", the one nearest the axis"
+    } else {
+        ""
+    };
+    format!(
+        "the {d:.1} mm hole {r:.1} mm from the axis{nearest}; the {nv} vents are the {dv:.1} mm \
+         holes {rv:.1} mm from it"
+    )
+}
+
+fn sprue_pour_text(n: u32, mix: &str, holder: Option<&Part>) -> String {
+    let sprue = holder.map_or_else(|| "the sprue".to_string(), sprue_text);
+    format!(
+        "Step {n}: stand the mold pole-down, the holder's flange on top. Mix and degas {mix} and \
+         pour it slowly through the sprue ({sprue}) until it shows in every vent."
+    )
+}
+
+/// The cure time from a material's notes (`cure 4 h at 23 C`), or the notes' pointer.
+fn cure_text(notes: &str) -> String {
+    let lower = notes.to_lowercase();
+    lower
+        .find("cure")
+        .and_then(|i| {
+            let rest = &notes[i..];
+            let end = rest.find(['.', ';', '(']).unwrap_or(rest.len());
+            let t = rest[..end].trim();
+            (t.len() > "cure".len()).then(|| t.to_string())
+        })
+        .unwrap_or_else(|| "see the step's notes".into())
+}
+
+fn assembly_text(design: &Design, parts: &[Part], cast_on_core: bool) -> String {
+    let mut s = String::from("Assemble: ");
+    let mut items: Vec<String> = Vec::new();
+    if let (Some(_), false) = (&design.core, cast_on_core) {
+        if design
+            .layers
+            .iter()
+            .any(|l| l.process == crate::schema::LayerProcess::Cast)
+        {
+            items.push(
+                "bond the core (see Bought items) into the skin's inner surface with clear \
+                 silicone sealant (UVDtact Sec. III)"
+                    .into(),
+            );
+        }
+    }
+    if design.backing.is_some() {
+        items.push(
+            "glue the skin's base to the backing plate (ShadowTac: Smooth-On SilPoxy)".into(),
+        );
+    }
+    let shell: Vec<String> = parts
+        .iter()
+        .filter(|p| ["shell_tube", "shell_base", "shell_half"].contains(&p.role.as_str()))
+        .map(|p| format!("`{}`", p.name))
+        .collect();
+    if !shell.is_empty() {
+        items.push(format!(
+            "screw the camera into the shell ({}), seat the LED ring PCB and the diffuser, push \
+             the contact module into its seat and join the shell with the joint screws (see \
+             Bought items)",
+            shell.join(", ")
+        ));
+    }
+    if items.is_empty() {
+        items.push("put the printed parts and the bought items together".into());
+    }
+    s.push_str(&items.join("; "));
+    s.push('.');
+    s
+}

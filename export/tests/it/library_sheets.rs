@@ -1,0 +1,466 @@
+//! The manifest and `FABRICATION.md` of every library kit, read as a maker reads them at the
+//! bench: product names rather than material keys, a shopping list with amounts, the procedure
+//! in order, cast layer and pour volumes, mixes that can be weighed, screws and bolts by
+//! standard size and length, and checks that fit the kit.
+
+use fabkit_designs::kit::ProcedureAction as A;
+use fabkit_designs::materials::MaterialsTable;
+use fabkit_designs::schema::MoldStrategy;
+use fabkit_designs::{build_kit, ChordTolerance};
+use fabkit_export::{write_kit, ExportOptions, Formats};
+use serde_json::Value;
+use std::f64::consts::PI;
+
+const TOL_MM: f64 = 0.05;
+
+struct Exported {
+    manifest: Value,
+    sheet: String,
+}
+
+fn export(design: &str, strategy: Option<MoldStrategy>) -> Exported {
+    let mut d = fabkit_designs::library::load(design).unwrap();
+    if let Some(s) = strategy {
+        d.mold.strategy = s;
+    }
+    let kit = build_kit(&d, ChordTolerance::new(TOL_MM).unwrap()).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join(design);
+    let opts = ExportOptions {
+        formats: Formats {
+            stl: true,
+            threemf: false,
+            step: false,
+        },
+        command_line: vec!["fabkit".into(), "export".into(), design.into()],
+        design_source: format!("library:{design}"),
+        design_sha256: "0".repeat(64),
+        chord_tolerance_mm: TOL_MM,
+        fabkit_version: "test".into(),
+    };
+    write_kit(&kit, &out, &opts).unwrap();
+    let exported = Exported {
+        manifest: serde_json::from_slice(&std::fs::read(out.join("manifest.json")).unwrap())
+            .unwrap(),
+        sheet: std::fs::read_to_string(out.join("FABRICATION.md")).unwrap(),
+    };
+    common_checks(design, &exported);
+    exported
+}
+
+/// The lines of the sheet's section `## title`, up to the next `## `.
+fn section<'a>(sheet: &'a str, title: &str) -> Vec<&'a str> {
+    let head = format!("## {title}");
+    sheet
+        .lines()
+        .skip_while(|l| *l != head)
+        .skip(1)
+        .take_while(|l| !l.starts_with("## "))
+        .collect()
+}
+
+fn arr<'a>(v: &'a Value, key: &str) -> &'a Vec<Value> {
+    v[key]
+        .as_array()
+        .unwrap_or_else(|| panic!("{key} is not an array"))
+}
+
+fn actions(e: &Exported) -> Vec<A> {
+    arr(&e.manifest, "procedure")
+        .iter()
+        .map(|s| serde_json::from_value(s["action"].clone()).unwrap())
+        .collect()
+}
+
+fn cast<'a>(e: &'a Exported, name: &str) -> &'a Value {
+    arr(&e.manifest, "casts")
+        .iter()
+        .find(|c| c["cast"] == name)
+        .unwrap_or_else(|| panic!("no cast {name}"))
+}
+
+fn close(a: f64, b: f64, tol: f64, what: &str) {
+    assert!((a - b).abs() <= tol, "{what}: {a} vs {b}");
+}
+
+/// What every kit's sheet must hold.
+fn common_checks(design: &str, e: &Exported) {
+    let s = &e.sheet;
+    let m = &e.manifest;
+    // Product names, not keys: no material key of the table appears anywhere in the sheet
+    // (the keys with an underscore cannot be mistaken for words).
+    let table = MaterialsTable::embedded().unwrap();
+    for key in table.materials.keys().filter(|k| k.contains('_')) {
+        assert!(
+            !s.contains(key.as_str()),
+            "{design}: key {key} in the sheet\n{s}"
+        );
+    }
+    // The shopping list: one row per product used, each with an amount in g or mL.
+    let rows: Vec<(String, String)> = section(s, "Shopping list")
+        .iter()
+        .filter(|l| l.starts_with("| ") && !l.starts_with("| Product"))
+        .map(|l| {
+            let cells: Vec<&str> = l.split('|').map(str::trim).collect();
+            (cells[1].to_string(), cells[2].to_string())
+        })
+        .collect();
+    for (product, amount) in &rows {
+        let number = amount
+            .trim_start_matches("about ")
+            .split(' ')
+            .next()
+            .and_then(|n| n.parse::<f64>().ok());
+        assert!(
+            number.is_some_and(|n| n > 0.0) && (amount.contains(" g") || amount.contains(" mL")),
+            "{design}: {product}: amount {amount:?}"
+        );
+    }
+    let listed = |name: &str| rows.iter().any(|(p, _)| p == name);
+    for c in arr(m, "casts") {
+        assert!(
+            listed(c["material_name"].as_str().unwrap()),
+            "{design}: {c}"
+        );
+        for k in c["coats"].as_array().into_iter().flatten() {
+            assert!(listed(k["material_name"].as_str().unwrap()), "{design}");
+        }
+        for t in c["treatments"].as_array().into_iter().flatten() {
+            assert!(listed(t["material_name"].as_str().unwrap()), "{design}");
+        }
+    }
+    for p in arr(m, "parts") {
+        assert!(
+            listed(p["material_name"].as_str().unwrap()),
+            "{design}: {p}"
+        );
+    }
+    // The procedure: printing first, assembly last, and the sheet lists it numbered in order.
+    let a = actions(e);
+    assert_eq!(a.first(), Some(&A::Print), "{design}");
+    assert_eq!(a.last(), Some(&A::Assemble), "{design}");
+    let listed_steps: Vec<&str> = section(s, "Procedure")
+        .into_iter()
+        .filter(|l| l.chars().next().is_some_and(|c| c.is_ascii_digit()))
+        .collect();
+    assert_eq!(listed_steps.len(), a.len(), "{design}");
+    for (i, (line, step)) in listed_steps.iter().zip(arr(m, "procedure")).enumerate() {
+        assert_eq!(
+            *line,
+            format!("{}. {}", i + 1, step["text"].as_str().unwrap()),
+            "{design}"
+        );
+    }
+    // Each pour's layer volume and pour volume are stated.
+    for c in arr(m, "casts") {
+        let pour = c["cavity_volume_ml"].as_f64().unwrap();
+        assert!(
+            s.contains(&format!("- pour volume: {pour:.2} mL")),
+            "{design}: {}",
+            c["cast"]
+        );
+        if let Some(v) = c["layer_volume_ml"].as_f64() {
+            assert!(
+                s.contains(&format!("- layer volume: {v:.2} mL")),
+                "{design}"
+            );
+        }
+    }
+    // The checks fit the kit: no registration keys or clamp bolts that the kit lacks.
+    let checks = section(s, "Checking the prints").join("\n");
+    let roles: Vec<&str> = arr(m, "parts")
+        .iter()
+        .map(|p| p["role"].as_str().unwrap())
+        .collect();
+    if checks.contains("registration keys") {
+        assert!(roles.contains(&"mold_half"), "{design}: {checks}");
+    }
+    let bought = arr(m, "bought_items");
+    if checks.contains("clamp bolts") {
+        assert!(
+            bought
+                .iter()
+                .any(|b| b.as_str().unwrap().contains("clamp bolts M3 x ")),
+            "{design}: {bought:?}"
+        );
+    }
+    // Print settings for the parts whose surface forms the skin, and for mold boxes.
+    if roles
+        .iter()
+        .any(|r| ["master_pattern", "mold_half", "open_mold_piece", "mold_box"].contains(r))
+    {
+        assert!(s.contains("### Print settings that matter"), "{design}");
+    }
+}
+
+/// R-Tac0 (master strategy): the translucent layer's own volume and its pour volume; Mold Star
+/// in mL; the black coat's mix and amount; the primer and release agent with their areas from
+/// the exact profile; the Mold Star fill height from the master's own height; screws by
+/// standard size and length; the procedure in order.
+#[test]
+fn rtac0_sheet_states_volumes_coats_treatments_and_the_procedure() {
+    let e = export("rtac0", None);
+    let s = &e.sheet;
+    // layer volume 13.5 -> 14.9 mm: hemisphere shell plus the 6 mm cylinder
+    let (r0, r1, l) = (13.5f64, 14.9f64, 6.0);
+    let v = (2.0 / 3.0 * PI * (r1.powi(3) - r0.powi(3)) + PI * (r1 * r1 - r0 * r0) * l) / 1000.0;
+    let t = cast(&e, "translucent_gel");
+    close(
+        t["layer_volume_ml"].as_f64().unwrap(),
+        v,
+        1e-9,
+        "layer volume",
+    );
+    assert!(t["cavity_volume_ml"].as_f64().unwrap() > v, "{t}");
+    // Mold Star 30 is measured out in mL
+    let ms = cast(&e, "silicone_mold:transparent_gel");
+    let part_a = ms["components"][0]["volume_ml"].as_f64().unwrap();
+    assert!(s.contains(&format!("  - Part A: {part_a:.2} mL (")), "{s}");
+    // the black coat: its mix and amount
+    let k = &t["coats"][0];
+    assert_eq!(k["mix_ratio"], "100:3:500 by weight");
+    assert!(
+        s.contains(&format!(
+            "mix 100:3:500 by weight, Thinner evaporating: Silicone oil {:.2} g",
+            k["components"][0]["mass_g"].as_f64().unwrap()
+        )),
+        "{s}"
+    );
+    // primer on the tube (r = 10, down to the base plane 6 mm under the equator) before the
+    // first layer only; release on each cavity (r = 13.5, then the coat's r = 15)
+    let area = |r: f64| (2.0 * PI * r * r + 2.0 * PI * r * l) / 100.0;
+    let first = cast(&e, "transparent_gel");
+    let tr = arr(first, "treatments");
+    assert_eq!(tr.len(), 2, "{first}");
+    assert_eq!(tr[0]["material"], "pr_1200_rtv");
+    // (the area comes from a 1 µm polyline: within 1e-4 relative)
+    close(
+        tr[0]["area_cm2"].as_f64().unwrap(),
+        area(10.0),
+        1e-3,
+        "primer area",
+    );
+    close(
+        tr[0]["amount_ml"].as_f64().unwrap(),
+        area(10.0) * 0.002,
+        1e-5,
+        "primer amount",
+    );
+    assert_eq!(tr[1]["material"], "ease_release_200");
+    close(
+        tr[1]["area_cm2"].as_f64().unwrap(),
+        area(13.5),
+        1e-3,
+        "release area",
+    );
+    let tr = arr(t, "treatments");
+    assert_eq!(tr.len(), 1, "{t}");
+    close(
+        tr[0]["area_cm2"].as_f64().unwrap(),
+        area(15.0),
+        1e-3,
+        "release area",
+    );
+    let release_ml = (area(13.5) + area(15.0)) * 0.005;
+    assert!(
+        s.contains(&format!(
+            "| Mann Ease Release 200 (aerosol) | about {release_ml:.2} mL |"
+        )),
+        "{s}"
+    );
+    assert!(
+        s.contains("| Dow PR-1200 RTV Prime Coat (clear) | about 0.02 mL |"),
+        "{s}"
+    );
+    // screws by standard size and length
+    let bought = arr(&e.manifest, "bought_items");
+    assert!(
+        bought
+            .iter()
+            .any(|b| b.as_str().unwrap().starts_with("2 joint screws M2 x 6 ")),
+        "{bought:?}"
+    );
+    // the procedure in order
+    assert_eq!(
+        actions(&e),
+        [
+            A::Print,
+            A::SeatMaster,
+            A::FillMoldStar,
+            A::DemoldSiliconeMold,
+            A::SeatMaster,
+            A::FillMoldStar,
+            A::DemoldSiliconeMold,
+            A::PrimeCore,
+            A::MountCore,
+            A::SprayRelease,
+            A::Pour,
+            A::Demold,
+            A::MoveCore,
+            A::SprayRelease,
+            A::SprayCoat,
+            A::Pour,
+            A::Demold,
+            A::Assemble,
+        ]
+    );
+    // the fill height: the master's height over its plinth face (its 2 mm locating pin stands
+    // in the floor's socket) plus the 5 mm Mold Star wall over its top
+    let master = arr(&e.manifest, "parts")
+        .iter()
+        .find(|p| p["name"] == "transparent_gel_master_pattern")
+        .unwrap();
+    let (lo, hi) = (
+        master["bbox_mm"]["min"][2].as_f64().unwrap(),
+        master["bbox_mm"]["max"][2].as_f64().unwrap(),
+    );
+    let fill = hi - lo - 2.0 + 5.0;
+    assert!(
+        s.contains(&format!(
+            "up to {fill:.1} mm above the box floor: 5.0 mm over the master's top"
+        )),
+        "{fill}\n{s}"
+    );
+    assert!(s.contains("pole-down"), "{s}");
+}
+
+/// R-Tac0 with the direct strategy: the clamp bolts by size and length (4 per mold across
+/// both halves: 2 x (cavity rim + plinth margin 5 + flange 8)), the sprue told from the vents,
+/// the mold closed before the pour.
+#[test]
+fn rtac0_direct_sheet_names_the_clamp_bolts_and_the_sprue() {
+    let e = export("rtac0", Some(MoldStrategy::Direct));
+    let s = &e.sheet;
+    let bought = arr(&e.manifest, "bought_items");
+    for (layer, grip) in [
+        ("transparent_gel", 2.0 * (13.5 + 13.0)),
+        ("translucent_gel", 2.0 * (15.0 + 13.0)),
+    ] {
+        let want = format!(
+            "4 clamp bolts M3 x 60 with nuts for the {layer} mold: 3.4 mm holes, {grip:.1} mm grip"
+        );
+        assert!(
+            bought.iter().any(|b| b == &want),
+            "{want} not in {bought:?}"
+        );
+    }
+    assert!(
+        s.contains("tighten the 4 clamp bolts (M3 x 60, with nuts)"),
+        "{s}"
+    );
+    assert!(
+        s.contains("pour it slowly through the sprue (the 3.0 mm hole ")
+            && s.contains(
+                "from the axis, the one nearest the axis; the 2 vents are the 1.2 mm holes"
+            ),
+        "{s}"
+    );
+    assert_eq!(
+        actions(&e),
+        [
+            A::Print,
+            A::PrimeCore,
+            A::MountCore,
+            A::SprayRelease,
+            A::CloseMold,
+            A::Pour,
+            A::Demold,
+            A::MoveCore,
+            A::SprayRelease,
+            A::SprayCoat,
+            A::CloseMold,
+            A::Pour,
+            A::Demold,
+            A::Assemble,
+        ]
+    );
+    assert!(section(s, "Checking the prints")
+        .join("\n")
+        .contains("registration keys"));
+}
+
+/// ShadowTac: the two-piece mold's 20 bolts by size and length, no registration keys in the
+/// checks (a boss and pocket register its pieces), release then pour into the reservoir.
+#[test]
+fn shadowtac_sheet_names_its_bolts_and_pours_into_the_reservoir() {
+    let e = export("shadowtac", None);
+    let bought = arr(&e.manifest, "bought_items");
+    assert!(
+        bought.iter().any(|b| b
+            .as_str()
+            .unwrap()
+            .starts_with("20 clamp bolts M3 x 30 with nuts for the skin mold")),
+        "{bought:?}"
+    );
+    assert!(!section(&e.sheet, "Checking the prints")
+        .join("\n")
+        .contains("registration keys"));
+    assert_eq!(
+        actions(&e),
+        [
+            A::Print,
+            A::SprayRelease,
+            A::CloseMold,
+            A::Pour,
+            A::Demold,
+            A::Assemble
+        ]
+    );
+}
+
+/// UVDtact: the black gel (0.56 g) cannot be weighed by hand; the sheet gives the smallest
+/// batch whose every component weighs at least 1 g, and what is left over. The layers are cast
+/// inside out onto the first inner silicone mold, released once.
+#[test]
+fn uvdtact_sheet_gives_a_weighable_batch_and_casts_inside_out() {
+    let e = export("uvdtact", None);
+    let black = cast(&e, "black_gel");
+    let total = black["total_mass_g"].as_f64().unwrap();
+    assert!(total < 1.0, "{black}");
+    let b = &black["min_batch"];
+    let masses: Vec<f64> = arr(b, "components")
+        .iter()
+        .map(|c| c["mass_g"].as_f64().unwrap())
+        .collect();
+    close(
+        masses.iter().copied().fold(f64::INFINITY, f64::min),
+        1.0,
+        1e-9,
+        "smallest",
+    );
+    close(masses[0] / masses[2], 5.0, 1e-9, "ratio 5:5:1");
+    let batch = b["total_mass_g"].as_f64().unwrap();
+    close(
+        b["leftover_g"].as_f64().unwrap(),
+        batch - total,
+        1e-9,
+        "leftover",
+    );
+    assert!(
+        e.sheet.contains(&format!(
+            "- too little to weigh by hand: mix at least Ecoflex 00-30 Part A 5.0 g + Ecoflex 00-30 Part B 5.0 g + Silc Pig black 1.0 g = {batch:.1} g"
+        )) && e.sheet.contains(&format!("{:.1} g is left over", batch - total)),
+        "{}",
+        e.sheet
+    );
+    let mold_star = [A::SeatMaster, A::FillMoldStar, A::DemoldSiliconeMold];
+    let mut want = vec![A::Print];
+    for _ in 0..6 {
+        want.extend(mold_star);
+    }
+    want.extend([A::SprayRelease, A::SprayRelease, A::Pour, A::Demold]);
+    for _ in 0..2 {
+        want.extend([A::MoveCore, A::SprayRelease, A::Pour, A::Demold]);
+    }
+    want.push(A::Assemble);
+    assert_eq!(actions(&e), want);
+}
+
+/// The dual-modal TacTip is printed: no pours, and the procedure is printing and assembly.
+#[test]
+fn tactip_sheet_has_no_pours() {
+    let e = export("tactip_dualmodal", None);
+    assert!(arr(&e.manifest, "casts").is_empty());
+    assert_eq!(actions(&e), [A::Print, A::Assemble]);
+    assert!(!e.sheet.contains("Step 1"), "{}", e.sheet);
+}
