@@ -132,14 +132,16 @@ pub fn build_kit_bounded(
         "layers": stack.layers,
         "markers": layer_markers,
     });
+    let mut shell_levels = None;
     if let (Some(h), Some(shell)) = (&design.housing, shell) {
         let (shell, levels) = shell?;
         parts.extend(shell);
         let r = design.body.rim_radius_mm(0.0);
         let w = h.outer_width_mm.max(2.0 * r);
-        summary["shell_levels"] = json!(levels);
+        summary["shell_levels"] = json!(&levels);
         summary["envelope_mm"] = json!([w, w, levels.envelope_height_mm]);
         bought.extend(housing_items(h));
+        shell_levels = Some(levels);
     }
 
     let mut casts = Vec::new();
@@ -219,6 +221,12 @@ pub fn build_kit_bounded(
         ))
         .part("kit");
     }
+    // The assembled sensor and its fit check: no file is written when parts overlap.
+    let assembly = crate::assembly::members(design, &stack, &parts, shell_levels.as_ref(), tol)?;
+    let found = crate::assembly::interferences(&assembly, tol)?;
+    if let Some(e) = crate::assembly::fit_errors(design, &found) {
+        return Err(e);
+    }
     let bolts = crate::procedure::clamp_bolts(design, &parts);
     bought.extend(crate::procedure::clamp_bolt_items(&bolts));
     let procedure = crate::procedure::procedure(design, &parts, &casts, &bolts);
@@ -228,6 +236,7 @@ pub fn build_kit_bounded(
         casts,
         bought_items: bought,
         procedure,
+        assembly,
         summary,
     })
 }

@@ -226,6 +226,10 @@ pub struct Kit {
     pub bought_items: Vec<String>,
     /// The fabrication procedure, in order ([`crate::procedure::procedure`]).
     pub procedure: Vec<ProcedureStep>,
+    /// The assembled sensor: every printed, cast and bought part in the sensor frame
+    /// ([`crate::assembly::members`]), fit-checked; empty for a kit that is not a sensor
+    /// (fixtures).
+    pub assembly: Vec<crate::assembly::Member>,
     /// Sensor-frame facts worth printing in the manifest (envelope, derived radii...).
     pub summary: serde_json::Value,
 }

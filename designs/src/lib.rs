@@ -7,6 +7,7 @@
 // `!(x > 0.0)` is how the checks here reject NaN along with the out-of-range values.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod assembly;
 pub mod build;
 pub mod error;
 pub mod estimate;

@@ -30,8 +30,8 @@ pub use atomic::{StagedDir, OUTPUT_MARKER};
 pub use check::check_printable_mesh;
 pub use error::ExportError;
 pub use manifest::{
-    Manifest, ManifestDataFile, ManifestDesign, ManifestKit3mf, ManifestObject, ManifestPart,
-    ManifestVolume, FRAME,
+    Manifest, ManifestAssembly, ManifestDataFile, ManifestDesign, ManifestKit3mf, ManifestMember,
+    ManifestObject, ManifestPart, ManifestVolume, FRAME,
 };
 
 use fabkit_designs::geometry::{Mesh, TopologyError};
@@ -203,6 +203,72 @@ fn write_kit_meshes(
     })
 }
 
+/// `assembly.3mf`: the kit's assembled sensor, one object per member, in the sensor frame;
+/// every member a closed 2-manifold.
+fn assembly_3mf(
+    kit: &Kit,
+    opts: &ExportOptions,
+) -> Result<(ManifestAssembly, Vec<u8>), ExportError> {
+    let meshes: Vec<Mesh> = kit
+        .assembly
+        .iter()
+        .map(|m| m.solid.mesh().rounded_to_f32())
+        .collect();
+    let mut members = Vec::with_capacity(meshes.len());
+    for (m, mesh) in kit.assembly.iter().zip(&meshes) {
+        check_printable_mesh(&m.name, mesh)?;
+        members.push(ManifestMember {
+            name: m.name.clone(),
+            kind: m.kind,
+            description: m.description.clone(),
+            volume_mm3: mesh.signed_volume(),
+            bbox_mm: mesh
+                .bounding_box()
+                .ok_or_else(|| ExportError::NotManifold {
+                    part: m.name.clone(),
+                    source: TopologyError::Empty,
+                })?,
+        });
+    }
+    let objects: Vec<three_mf::Object<'_>> = kit
+        .assembly
+        .iter()
+        .zip(&meshes)
+        .map(|(m, mesh)| three_mf::Object {
+            name: m.name.clone(),
+            group: None,
+            volumes: vec![three_mf::Volume {
+                name: &m.name,
+                mesh,
+            }],
+            translation_mm: [0.0; 3],
+        })
+        .collect();
+    let metadata = [
+        ("Title", format!("fabkit assembly {}", kit.design)),
+        ("Application", format!("fabkit {}", opts.fabkit_version)),
+        (
+            "Description",
+            format!(
+                "the assembled sensor in the sensor frame (docs/conventions.md); bought parts are envelopes; design {} sha256:{}",
+                kit.design, opts.design_sha256
+            ),
+        ),
+    ];
+    let bytes = three_mf::encode(&objects, &metadata)?;
+    Ok((
+        ManifestAssembly {
+            file: ASSEMBLY_3MF.into(),
+            sha256: sha256_hex(&bytes),
+            members,
+        },
+        bytes,
+    ))
+}
+
+/// The assembly model's file name.
+pub const ASSEMBLY_3MF: &str = "assembly.3mf";
+
 const PARTS_DIR: &str = "parts";
 const STEP_DIR: &str = "step";
 
@@ -359,6 +425,13 @@ fn render(
     } else {
         None
     };
+    let assembly_3mf = if opts.formats.threemf && !kit.assembly.is_empty() {
+        let (manifest_assembly, bytes) = assembly_3mf(kit, opts)?;
+        files.push((manifest_assembly.file.clone(), bytes));
+        Some(manifest_assembly)
+    } else {
+        None
+    };
 
     let manifest = Manifest {
         fabkit_version: opts.fabkit_version.clone(),
@@ -372,6 +445,7 @@ fn render(
         frame: FRAME.to_owned(),
         parts,
         kit_3mf,
+        assembly_3mf,
         casts: kit.casts.clone(),
         bought_items: kit.bought_items.clone(),
         procedure: kit.procedure.clone(),
@@ -439,6 +513,7 @@ mod tests {
             casts: vec![],
             bought_items: vec![],
             procedure: vec![],
+            assembly: vec![],
             summary: serde_json::json!({}),
         }
     }

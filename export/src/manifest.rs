@@ -28,6 +28,10 @@ pub struct Manifest {
     pub parts: Vec<ManifestPart>,
     /// The kit 3MF, `null` when 3MF was not requested.
     pub kit_3mf: Option<ManifestKit3mf>,
+    /// The assembled sensor (`assembly.3mf`, every part in the sensor frame), when 3MF was
+    /// requested and the kit is a sensor.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub assembly_3mf: Option<ManifestAssembly>,
     /// Pours in casting order, as the design computed them.
     pub casts: Vec<CastReport>,
     /// Parts that are bought or cut rather than printed, one line each.
@@ -109,6 +113,29 @@ pub struct ManifestPart {
     pub step_sha256: Option<String>,
     /// The resolved parameters the part was built from.
     pub params: serde_json::Value,
+}
+
+/// The assembly 3MF: one object per member, in the sensor frame (no build-item translation).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ManifestAssembly {
+    /// `assembly.3mf`, relative to the export directory.
+    pub file: String,
+    pub sha256: String,
+    /// One entry per member, in the 3MF's object order (ids 1, 2, ...).
+    pub members: Vec<ManifestMember>,
+}
+
+/// One member of the assembly.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ManifestMember {
+    /// 3MF object name: the kit part's or layer's name; bought envelopes end in `_envelope`.
+    pub name: String,
+    /// `printed`, `cast` or `bought` (a simple envelope).
+    pub kind: fabkit_designs::assembly::MemberKind,
+    pub description: String,
+    /// Volume of the written mesh, mm^3, and its box in the sensor frame, mm.
+    pub volume_mm3: f64,
+    pub bbox_mm: Aabb,
 }
 
 /// The kit 3MF.

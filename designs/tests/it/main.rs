@@ -1,5 +1,6 @@
 //! The designs crate's integration tests, one binary (one link) with a module per area.
 
+mod assembly;
 mod common;
 mod error_paths;
 mod estimate;

@@ -86,6 +86,7 @@ fn test_kit() -> Kit {
         }],
         bought_items: vec!["acrylic tube, 30 mm OD".into()],
         procedure: vec![],
+        assembly: vec![],
         summary: serde_json::json!({ "envelope_radius_mm": 15.0 }),
     }
 }
@@ -382,6 +383,7 @@ fn group_kit() -> Kit {
         casts: vec![],
         bought_items: vec![],
         procedure: vec![],
+        assembly: vec![],
         summary: serde_json::json!({}),
     }
 }

@@ -19,6 +19,15 @@ struct Exported {
 }
 
 fn export(design: &str, strategy: Option<MoldStrategy>) -> Exported {
+    export_as(design, strategy, false).0
+}
+
+/// The export, and with `threemf` the bytes of `assembly.3mf`.
+fn export_as(
+    design: &str,
+    strategy: Option<MoldStrategy>,
+    threemf: bool,
+) -> (Exported, Option<Vec<u8>>) {
     let mut d = fabkit_designs::library::load(design).unwrap();
     if let Some(s) = strategy {
         d.mold.strategy = s;
@@ -29,7 +38,7 @@ fn export(design: &str, strategy: Option<MoldStrategy>) -> Exported {
     let opts = ExportOptions {
         formats: Formats {
             stl: true,
-            threemf: false,
+            threemf,
             step: false,
         },
         command_line: vec!["fabkit".into(), "export".into(), design.into()],
@@ -45,7 +54,8 @@ fn export(design: &str, strategy: Option<MoldStrategy>) -> Exported {
         sheet: std::fs::read_to_string(out.join("FABRICATION.md")).unwrap(),
     };
     common_checks(design, &exported);
-    exported
+    let assembly = threemf.then(|| std::fs::read(out.join("assembly.3mf")).unwrap());
+    (exported, assembly)
 }
 
 /// The lines of the sheet's section `## title`, up to the next `## `.
@@ -463,4 +473,92 @@ fn tactip_sheet_has_no_pours() {
     assert!(arr(&e.manifest, "casts").is_empty());
     assert_eq!(actions(&e), [A::Print, A::Assemble]);
     assert!(!e.sheet.contains("Step 1"), "{}", e.sheet);
+}
+
+/// `assembly.3mf` holds every member of the assembled sensor as one named object in the sensor
+/// frame (no build-item translation), each as the manifest describes it (volume, box), the
+/// bought parts as envelopes: read back with the `threemf` crate.
+#[test]
+fn rtac0_assembly_3mf_holds_every_member_in_the_sensor_frame() {
+    let (e, bytes) = export_as("rtac0", None, true);
+    let bytes = bytes.unwrap();
+    let a = &e.manifest["assembly_3mf"];
+    assert_eq!(a["file"], "assembly.3mf");
+    use sha2::Digest;
+    let sha: String = sha2::Sha256::digest(&bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect();
+    assert_eq!(a["sha256"], sha.as_str());
+    let models = threemf::read(std::io::Cursor::new(&bytes)).unwrap();
+    let model = &models[0];
+    let members = arr(a, "members");
+    let names: Vec<&str> = model
+        .resources
+        .object
+        .iter()
+        .map(|o| o.name.as_deref().unwrap())
+        .collect();
+    let listed: Vec<&str> = members
+        .iter()
+        .map(|m| m["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, listed);
+    for name in [
+        "shell_tube",
+        "shell_base",
+        "transparent_gel",
+        "core_envelope",
+        "camera_board_envelope",
+    ] {
+        assert!(names.contains(&name), "{name} missing from {names:?}");
+    }
+    for (o, m) in model.resources.object.iter().zip(members) {
+        let mesh = o.mesh.as_ref().unwrap();
+        let v: Vec<[f64; 3]> = mesh
+            .vertices
+            .vertex
+            .iter()
+            .map(|v| [v.x, v.y, v.z])
+            .collect();
+        let vol: f64 = mesh
+            .triangles
+            .triangle
+            .iter()
+            .map(|t| {
+                let (a, b, c) = (v[t.v1], v[t.v2], v[t.v3]);
+                (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+                    + a[2] * (b[0] * c[1] - b[1] * c[0]))
+                    / 6.0
+            })
+            .sum();
+        let want = m["volume_mm3"].as_f64().unwrap();
+        close(vol, want, 1e-6 * want, m["name"].as_str().unwrap());
+        let zmax = v.iter().map(|p| p[2]).fold(f64::NEG_INFINITY, f64::max);
+        close(zmax, m["bbox_mm"]["max"][2].as_f64().unwrap(), 1e-9, "box");
+        let item = model
+            .build
+            .item
+            .iter()
+            .find(|i| i.objectid == o.id)
+            .unwrap();
+        if let Some(t) = item.transform {
+            assert_eq!(
+                t,
+                [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]
+            );
+        }
+    }
+    // the shell's top face is the base plane, z = -6 mm, in the sensor frame
+    let tube = members.iter().find(|m| m["name"] == "shell_tube").unwrap();
+    close(
+        tube["bbox_mm"]["max"][2].as_f64().unwrap(),
+        -6.0,
+        1e-6,
+        "tube top",
+    );
+    assert!(members
+        .iter()
+        .filter(|m| m["kind"] == "bought")
+        .all(|m| m["name"].as_str().unwrap().ends_with("_envelope")));
 }

@@ -1,0 +1,338 @@
+//! The assembled sensor: every part that is printed, cast or bought, in the sensor frame
+//! (docs/conventions.md), and the fit check between them.
+//!
+//! Printed sensor parts (shell, printed skin) come from the kit, turned back from their print
+//! pose (`params.T_print_sensor`); cast and sprayed layers are the layer solids with their
+//! features; bought items are simple envelopes, named as such: the core (tube or shell), the
+//! backing plate, the camera board, the LED ring PCB and the diffuser (R-Tac0 Sec. III-B,
+//! Fig. 2; ShadowTac Sec. IV-A).
+//!
+//! The fit check intersects every pair of members with the boolean kernel. Parts that are
+//! designed to touch share a surface, and two tessellations of one surface cross each other
+//! by up to the chord tolerance; an overlap counts as an interference when it is thicker than
+//! that: its mean thickness (2 x volume / surface area, for a thin slab) passes the chord
+//! tolerance and its volume passes [`MIN_OVERLAP_MM3`].
+
+use crate::error::{DesignError, GeometryContext, ParamError, ParamErrors};
+use crate::geometry::{cuboid, cylinder, revolve, Affine, ChordTolerance, Solid};
+use crate::housing::ShellLevels;
+use crate::kit::Part;
+use crate::schema::{Design, HousingStyle, LayerProcess};
+use crate::stack::Stack;
+use serde::{Deserialize, Serialize};
+
+/// Where a member of the assembly comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MemberKind {
+    /// A printed part of the kit.
+    Printed,
+    /// A cast or sprayed layer of the skin.
+    Cast,
+    /// A bought part, modelled as a simple envelope.
+    Bought,
+}
+
+/// One part of the assembled sensor.
+#[derive(Debug, Clone)]
+pub struct Member {
+    /// The kit part's or layer's name; bought envelopes end in `_envelope`.
+    pub name: String,
+    pub kind: MemberKind,
+    pub description: String,
+    /// The solid in the sensor frame, mm.
+    pub solid: Solid,
+    /// The parameter paths that size or place this member: what a fit-check error suggests
+    /// changing.
+    pub fix: Vec<String>,
+    /// The member is a surface of revolution between two offsets of the body profile with
+    /// nothing on it (a cast layer without markers, the core): the stack's validation already
+    /// nests such members without overlap, so the fit check skips pairs of them.
+    pub nested_by_stack: bool,
+}
+
+/// Roles of kit parts that are part of the sensor (the rest are molds and tooling).
+pub const SENSOR_ROLES: [&str; 5] = [
+    "shell_tube",
+    "shell_base",
+    "shell_half",
+    "printed_skin",
+    "marker_tips",
+];
+
+/// Overlaps smaller than this are not interferences, mm^3.
+pub const MIN_OVERLAP_MM3: f64 = 1e-3;
+
+/// The inverse of a rigid map (rotation and translation, 3x4 row-major).
+fn rigid_inverse(t: &Affine) -> Affine {
+    let mut m = [[0.0; 4]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            m[i][j] = t[j][i];
+        }
+        m[i][3] = -(0..3).map(|k| t[k][i] * t[k][3]).sum::<f64>();
+    }
+    m
+}
+
+/// A kit part in the sensor frame: its solid moved back by the inverse of
+/// `params.T_print_sensor`; `None` when the part records no pose.
+pub fn in_sensor_frame(part: &Part) -> Option<Solid> {
+    let t: Affine = serde_json::from_value(part.params.get("T_print_sensor")?.clone()).ok()?;
+    Some(part.solid.transform(&rigid_inverse(&t)))
+}
+
+/// The members of the assembled sensor, in order: printed sensor parts, cast layers (inner to
+/// outer), then the bought envelopes.
+///
+/// # Errors
+/// [`DesignError::Geometry`] if the kernel fails.
+pub fn members(
+    design: &Design,
+    stack: &Stack,
+    parts: &[Part],
+    levels: Option<&ShellLevels>,
+    tol: ChordTolerance,
+) -> Result<Vec<Member>, DesignError> {
+    let mut out = Vec::new();
+    for p in parts
+        .iter()
+        .filter(|p| SENSOR_ROLES.contains(&p.role.as_str()))
+    {
+        if let Some(solid) = in_sensor_frame(p) {
+            out.push(Member {
+                name: p.name.clone(),
+                kind: MemberKind::Printed,
+                description: p.description.clone(),
+                solid,
+                fix: vec!["housing".into()],
+                nested_by_stack: false,
+            });
+        }
+    }
+    for (i, l) in stack.layers.iter().enumerate() {
+        if l.process == LayerProcess::Printed {
+            continue;
+        }
+        let solid = crate::layers::layer_solid(design, stack, i, tol).part(&l.name)?;
+        out.push(Member {
+            name: l.name.clone(),
+            kind: MemberKind::Cast,
+            description: format!("{} layer, {:.2} mm", l.name, l.thickness_mm),
+            solid,
+            fix: vec![format!("layers[{i}]")],
+            nested_by_stack: design.layers[i].markers.is_empty(),
+        });
+    }
+    let g = |name: &str, r: Result<Solid, crate::geometry::GeometryError>| r.part(name);
+    if let (Some(c), Some(spec)) = (&stack.core, &design.core) {
+        // A normal offset folds where the wall passes the surface's radius of curvature
+        // (UVDtact's 2 mm acrylic shell inside a 3.375 mm pole radius): the envelope is then
+        // the solid under the core's outer surface.
+        let hollow = design.body.offset_is_valid(c.inner_offset_mm);
+        let pl = if hollow {
+            design.body.shell_profile(
+                c.inner_offset_mm,
+                c.outer_offset_mm,
+                c.below_base_mm,
+                tol.half(),
+            )
+        } else {
+            design
+                .body
+                .solid_profile(c.outer_offset_mm, c.below_base_mm, tol.half())
+        };
+        let solid = g(
+            "core_envelope",
+            revolve(&pl, tol).and_then(|m| Solid::from_mesh(&m)),
+        )?;
+        out.push(Member {
+            name: "core_envelope".into(),
+            kind: MemberKind::Bought,
+            description: format!("Core (bought): {}", spec.description),
+            solid,
+            fix: vec!["core.wall_thickness_mm".into(), "core.length_mm".into()],
+            nested_by_stack: true,
+        });
+    }
+    let zb = design.body.base_z_mm();
+    let disc =
+        |r: f64, z0: f64, z1: f64| cylinder(z1 - z0, r, tol).map(|s| s.translate([0.0, 0.0, z0]));
+    let ring =
+        |ro: f64, ri: f64, z0: f64, z1: f64| -> Result<Solid, crate::geometry::GeometryError> {
+            // the inner cut passes both faces so that the difference is clean
+            disc(ro, z0, z1)?.difference(&disc(ri, z0 - 1.0, z1 + 1.0)?)
+        };
+    if let Some(b) = &design.backing {
+        out.push(Member {
+            name: "backing_envelope".into(),
+            kind: MemberKind::Bought,
+            description: format!("Backing plate (bought): {}", b.description),
+            solid: g(
+                "backing_envelope",
+                disc(b.diameter_mm / 2.0, zb - b.thickness_mm, zb),
+            )?,
+            fix: vec!["backing.diameter_mm".into(), "backing.thickness_mm".into()],
+            nested_by_stack: false,
+        });
+    }
+    if let (Some(h), Some(lv)) = (&design.housing, levels) {
+        let bw = h.camera.board_width_mm / 2.0;
+        let (z0, z1) = match (h.style, lv.base_top_z_mm) {
+            (HousingStyle::RoundTube, Some(top)) => (top, top + h.camera.bay_height_mm),
+            _ => (lv.bulkhead_z_mm - h.camera.bay_height_mm, lv.bulkhead_z_mm),
+        };
+        out.push(Member {
+            name: "camera_board_envelope".into(),
+            kind: MemberKind::Bought,
+            description: format!(
+                "Camera board with its components (bought): {}",
+                h.camera.module
+            ),
+            solid: g(
+                "camera_board_envelope",
+                cuboid([-bw, -bw, z0], [bw, bw, z1]),
+            )?,
+            fix: vec![
+                "housing.camera.board_width_mm".into(),
+                "housing.camera.bay_height_mm".into(),
+            ],
+            nested_by_stack: false,
+        });
+        out.push(Member {
+            name: "led_pcb_envelope".into(),
+            kind: MemberKind::Bought,
+            description: format!("LED ring PCB (bought), {} LEDs", h.led_pcb.led_count),
+            solid: g(
+                "led_pcb_envelope",
+                ring(
+                    h.led_pcb.outer_diameter_mm / 2.0,
+                    h.led_pcb.inner_diameter_mm / 2.0,
+                    lv.pcb_z_mm,
+                    lv.pcb_z_mm + h.led_pcb.thickness_mm,
+                ),
+            )?,
+            fix: vec![
+                "housing.led_pcb.outer_diameter_mm".into(),
+                "housing.led_pcb.thickness_mm".into(),
+            ],
+            nested_by_stack: false,
+        });
+        out.push(Member {
+            name: "diffuser_envelope".into(),
+            kind: MemberKind::Bought,
+            description: "Diffuser ring (laser-cut acrylic)".into(),
+            solid: g(
+                "diffuser_envelope",
+                ring(
+                    h.diffuser.outer_diameter_mm / 2.0,
+                    h.diffuser.inner_diameter_mm / 2.0,
+                    lv.diffuser_z_mm,
+                    lv.diffuser_z_mm + h.diffuser.thickness_mm,
+                ),
+            )?,
+            fix: vec![
+                "housing.diffuser.outer_diameter_mm".into(),
+                "housing.diffuser.thickness_mm".into(),
+            ],
+            nested_by_stack: false,
+        });
+    }
+    Ok(out)
+}
+
+/// Two members that overlap.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Interference {
+    pub a: String,
+    pub b: String,
+    /// Volume of the overlap, mm^3.
+    pub volume_mm3: f64,
+    /// Mean thickness of the overlap (2 x volume / surface area), mm.
+    pub thickness_mm: f64,
+    /// The parameter paths of both members.
+    pub fix: Vec<String>,
+}
+
+/// Every pair of members that overlaps by more than a tessellation can: thicker than
+/// `tol` and larger than [`MIN_OVERLAP_MM3`]. Pairs whose boxes do not meet, and pairs that
+/// the stack nests ([`Member::nested_by_stack`]), are skipped; the rest are intersected in
+/// parallel, the result in pair order.
+///
+/// # Errors
+/// [`DesignError::Geometry`] if the kernel fails.
+pub fn interferences(
+    members: &[Member],
+    tol: ChordTolerance,
+) -> Result<Vec<Interference>, DesignError> {
+    use rayon::prelude::*;
+    let boxes: Vec<_> = members.iter().map(|m| m.solid.bounding_box()).collect();
+    let mut pairs = Vec::new();
+    for i in 0..members.len() {
+        for j in i + 1..members.len() {
+            let (Some(a), Some(b)) = (&boxes[i], &boxes[j]) else {
+                continue;
+            };
+            let apart = (0..3).any(|k| a.max[k] <= b.min[k] || b.max[k] <= a.min[k]);
+            let nested = members[i].nested_by_stack && members[j].nested_by_stack;
+            if !apart && !nested {
+                pairs.push((i, j));
+            }
+        }
+    }
+    let found: Vec<Option<Interference>> = pairs
+        .par_iter()
+        .map(|&(i, j)| {
+            let (ma, mb) = (&members[i], &members[j]);
+            let overlap = ma
+                .solid
+                .intersection(&mb.solid)
+                .part(&format!("fit check {} / {}", ma.name, mb.name))?;
+            let v = overlap.volume();
+            let thickness = 2.0 * v / overlap.surface_area().max(f64::MIN_POSITIVE);
+            Ok(
+                (v > MIN_OVERLAP_MM3 && thickness > tol.mm()).then(|| Interference {
+                    a: ma.name.clone(),
+                    b: mb.name.clone(),
+                    volume_mm3: v,
+                    thickness_mm: thickness,
+                    // the later member first: the envelopes and layers come after the shell
+                    fix: mb.fix.iter().chain(&ma.fix).cloned().collect(),
+                }),
+            )
+        })
+        .collect::<Result<_, DesignError>>()?;
+    Ok(found.into_iter().flatten().collect())
+}
+
+/// [`interferences`] as parameter errors, one per overlapping pair: the path is the first
+/// parameter that sizes either part (with its value in `design`), the rule names both parts,
+/// the overlap and every parameter that would fix it.
+pub fn fit_errors(design: &Design, found: &[Interference]) -> Option<DesignError> {
+    if found.is_empty() {
+        return None;
+    }
+    let json = serde_json::to_value(design).unwrap_or_default();
+    Some(DesignError::Params(ParamErrors(
+        found
+            .iter()
+            .map(|f| {
+                let path = f.fix.first().cloned().unwrap_or_default();
+                let value = crate::schema::value_at(&mut json.clone(), &path)
+                    .map_or_else(|| "?".to_string(), |v| v.to_string());
+                ParamError::new(
+                    path,
+                    value,
+                    format!(
+                        "fit check: `{}` and `{}` overlap by {:.3} mm³ (about {:.3} mm deep); change {}",
+                        f.a,
+                        f.b,
+                        f.volume_mm3,
+                        f.thickness_mm,
+                        f.fix.join(" or ")
+                    ),
+                )
+            })
+            .collect(),
+    )))
+}

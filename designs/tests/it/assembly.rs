@@ -1,0 +1,153 @@
+//! The assembled sensor and its fit check: members in the sensor frame with their analytic
+//! volumes, designed contacts that are not interferences, and one fit broken at a time giving
+//! one named interference with its analytic overlap.
+
+use fabkit_designs::assembly::{fit_errors, interferences, Member, MemberKind};
+use fabkit_designs::{build_kit, ChordTolerance, Kit};
+use std::f64::consts::PI;
+use std::sync::OnceLock;
+
+fn tol() -> ChordTolerance {
+    ChordTolerance::new(0.01).unwrap()
+}
+
+/// R-Tac0's kit at 0.01 mm, built once for the tests of this module.
+fn rtac0() -> &'static Kit {
+    static KIT: OnceLock<Kit> = OnceLock::new();
+    KIT.get_or_init(|| build_kit(&fabkit_designs::library::load("rtac0").unwrap(), tol()).unwrap())
+}
+
+fn member<'a>(members: &'a [Member], name: &str) -> &'a Member {
+    members
+        .iter()
+        .find(|m| m.name == name)
+        .unwrap_or_else(|| panic!("no member {name}"))
+}
+
+fn rel_close(a: f64, b: f64, rel: f64, what: &str) {
+    assert!((a - b).abs() <= rel * b.abs(), "{what}: {a} vs {b}");
+}
+
+/// Every part of the sensor in the sensor frame: the printed shell turned back from its print
+/// pose (the tube's top face on the base plane z = -6 mm, 30 mm across), the cast layers and
+/// the bought envelopes with their analytic volumes (hemisphere of radius r on a 6 mm cylinder
+/// down to the base plane; the tube continues 3 mm below it).
+#[test]
+fn rtac0_members_are_in_the_sensor_frame_with_their_volumes() {
+    let a = &rtac0().assembly;
+    let names: Vec<(&str, MemberKind)> = a.iter().map(|m| (m.name.as_str(), m.kind)).collect();
+    assert_eq!(
+        names,
+        [
+            ("shell_tube", MemberKind::Printed),
+            ("shell_base", MemberKind::Printed),
+            ("transparent_gel", MemberKind::Cast),
+            ("translucent_gel", MemberKind::Cast),
+            ("black_coating", MemberKind::Cast),
+            ("core_envelope", MemberKind::Bought),
+            ("camera_board_envelope", MemberKind::Bought),
+            ("led_pcb_envelope", MemberKind::Bought),
+            ("diffuser_envelope", MemberKind::Bought),
+        ]
+    );
+    let tube = member(a, "shell_tube").solid.bounding_box().unwrap();
+    assert!((tube.max[2] - -6.0).abs() < 1e-9, "{tube:?}");
+    assert!((tube.max[0] - 15.0).abs() < 1e-6 && (tube.min[0] + 15.0).abs() < 1e-6);
+    let printed = rtac0()
+        .parts
+        .iter()
+        .find(|p| p.name == "shell_tube")
+        .unwrap();
+    rel_close(
+        member(a, "shell_tube").solid.volume(),
+        printed.solid.volume(),
+        1e-9,
+        "tube",
+    );
+    let shell = |ri: f64, ro: f64, below: f64| {
+        2.0 / 3.0 * PI * (ro.powi(3) - ri.powi(3)) + PI * (ro * ro - ri * ri) * (6.0 + below)
+    };
+    for (name, v) in [
+        ("transparent_gel", shell(10.0, 13.5, 0.0)),
+        ("translucent_gel", shell(13.5, 14.9, 0.0)),
+        ("black_coating", shell(14.9, 15.0, 0.0)),
+        ("core_envelope", shell(9.0, 10.0, 3.0)),
+    ] {
+        // the inscribed tessellation at 0.01 mm loses at most about 2 x 0.01 / wall of a shell
+        let wall = match name {
+            "black_coating" => 0.1,
+            _ => 1.0,
+        };
+        rel_close(member(a, name).solid.volume(), v, 2.0 * 0.01 / wall, name);
+    }
+    // the camera board: 15 mm square, 4 mm of board and components, on the base's spigot
+    let board = member(a, "camera_board_envelope").solid.volume();
+    rel_close(board, 15.0 * 15.0 * 4.0, 1e-9, "camera board");
+}
+
+/// Parts that are designed to touch (the skin's base on the shell's top face, the tube's rim
+/// on the diffuser, the board on the base's spigot) are not interferences, however their
+/// tessellations cross; layers without markers and the core are nested by the stack and not
+/// intersected. (UVDtact's layers, whose slots and protrusions interlock, are intersected in
+/// every build of its kit.)
+#[test]
+fn designed_contacts_are_not_interferences() {
+    assert_eq!(interferences(&rtac0().assembly, tol()).unwrap(), vec![]);
+}
+
+/// One fit broken at a time gives one interference naming both parts, with the overlap's
+/// analytic volume, and an error naming a parameter that sizes them, its value and the rule.
+#[test]
+fn each_broken_fit_is_one_named_interference() {
+    let base = &rtac0().assembly;
+    let moved = |name: &str, dz: f64| -> Vec<Member> {
+        base.iter()
+            .map(|m| {
+                let mut m = m.clone();
+                if m.name == name {
+                    m.solid = m.solid.translate([0.0, 0.0, dz]);
+                }
+                m
+            })
+            .collect()
+    };
+    // the board 1 mm up into the LED PCB: the board's square less the PCB's 7.5 mm bore, over
+    // the 0.95 mm the board now reaches past the PCB's underside (0.05 mm gap)
+    let board_into_pcb = (225.0 - PI * 7.5 * 7.5) * 0.95;
+    // the tube 0.5 mm down into the diffuser ring (11.5 / 6 mm radii): the tube's wall ring
+    // (9 to 10 mm) over the diffuser
+    let tube_into_diffuser = PI * (10.0f64.powi(2) - 9.0f64.powi(2)) * 0.5;
+    for (name, dz, other, v) in [
+        (
+            "camera_board_envelope",
+            1.0,
+            "led_pcb_envelope",
+            board_into_pcb,
+        ),
+        (
+            "core_envelope",
+            -0.5,
+            "diffuser_envelope",
+            tube_into_diffuser,
+        ),
+    ] {
+        let found = interferences(&moved(name, dz), tol()).unwrap();
+        let pairs: Vec<(&str, &str)> = found.iter().map(|f| (f.a.as_str(), f.b.as_str())).collect();
+        let one = found.iter().find(|f| f.a == name || f.b == name);
+        assert!(
+            found.len() == 1 && one.is_some_and(|f| f.a == other || f.b == other),
+            "{name}: {pairs:?}"
+        );
+        rel_close(found[0].volume_mm3, v, 0.01, name);
+        let e = fit_errors(&fabkit_designs::library::load("rtac0").unwrap(), &found)
+            .unwrap()
+            .to_string();
+        assert!(
+            e.contains(&format!(
+                "`{}` and `{}` overlap by {:.3} mm³",
+                found[0].a, found[0].b, found[0].volume_mm3
+            )) && e.contains("change housing."),
+            "{e}"
+        );
+    }
+}
