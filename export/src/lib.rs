@@ -21,6 +21,7 @@ mod error;
 mod layout;
 mod manifest;
 pub mod raster;
+pub mod section;
 mod sheet;
 pub mod step;
 mod stl;
@@ -266,6 +267,9 @@ fn assembly_3mf(
     ))
 }
 
+/// The section view's file name ([`section`]).
+pub const SECTION_PNG: &str = "section.png";
+
 /// The assembly model's file name.
 pub const ASSEMBLY_3MF: &str = "assembly.3mf";
 
@@ -425,6 +429,35 @@ fn render(
     } else {
         None
     };
+    let section_view = if kit.assembly.is_empty() {
+        None
+    } else {
+        let meshes: Vec<Mesh> = kit
+            .assembly
+            .iter()
+            .map(|m| m.solid.mesh().rounded_to_f32())
+            .collect();
+        let members: Vec<_> = kit
+            .assembly
+            .iter()
+            .zip(&meshes)
+            .map(|(m, mesh)| (m.name.as_str(), m.kind, mesh))
+            .collect();
+        let (rgb, mut view) = section::render(&members);
+        let bytes = raster::png_rgb8(
+            view.width_px,
+            view.height_px,
+            &rgb,
+            &[(
+                "Description",
+                "fabkit section view: the assembled sensor cut by the plane y = 0, x right, z up",
+            )],
+        )?;
+        view.file = SECTION_PNG.into();
+        view.sha256 = sha256_hex(&bytes);
+        files.push((SECTION_PNG.into(), bytes));
+        Some(view)
+    };
     let assembly_3mf = if opts.formats.threemf && !kit.assembly.is_empty() {
         let (manifest_assembly, bytes) = assembly_3mf(kit, opts)?;
         files.push((manifest_assembly.file.clone(), bytes));
@@ -446,6 +479,7 @@ fn render(
         parts,
         kit_3mf,
         assembly_3mf,
+        section_view,
         casts: kit.casts.clone(),
         bought_items: kit.bought_items.clone(),
         procedure: kit.procedure.clone(),

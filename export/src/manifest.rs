@@ -32,6 +32,10 @@ pub struct Manifest {
     /// requested and the kit is a sensor.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub assembly_3mf: Option<ManifestAssembly>,
+    /// `section.png`, the assembled sensor cut through its axis, and its legend; for a kit
+    /// that is a sensor.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub section_view: Option<crate::section::SectionView>,
     /// Pours in casting order, as the design computed them.
     pub casts: Vec<CastReport>,
     /// Parts that are bought or cut rather than printed, one line each.

@@ -85,6 +85,7 @@ pub(crate) fn render(m: &Manifest) -> String {
     print_settings(&mut s, m);
 
     layer_stack(&mut s, m);
+    section_view(&mut s, m);
 
     s.push_str("## Cast order\n\n");
     if m.casts.is_empty() {
@@ -278,6 +279,37 @@ fn shopping_list(s: &mut String, m: &Manifest) {
             None => format!("{g:.1} g"),
         };
         let _ = writeln!(s, "| {} | {amount} |", text(&name));
+    }
+    s.push('\n');
+}
+
+/// The section view with its legend; nothing for a kit that is not a sensor.
+fn section_view(s: &mut String, m: &Manifest) {
+    let Some(v) = &m.section_view else {
+        return;
+    };
+    s.push_str("## Section view\n\n");
+    let _ = writeln!(
+        s,
+        "![The assembled sensor cut through its axis]({})\n\nThe sensor cut by the plane y = 0 \
+         through its axis (x to the right, z up, {:.0} px per mm); bought parts are envelopes. \
+         Check it first: the layers on the core, the seats in the shell.\n",
+        v.file, v.px_per_mm
+    );
+    s.push_str("| Colour | Part | Kind | Section area (mm²) |\n|--------|------|------|-------------------:|\n");
+    for l in &v.legend {
+        let kind = match l.kind {
+            fabkit_designs::assembly::MemberKind::Printed => "printed",
+            fabkit_designs::assembly::MemberKind::Cast => "cast",
+            fabkit_designs::assembly::MemberKind::Bought => "bought (envelope)",
+        };
+        let _ = writeln!(
+            s,
+            "| `{}` | {} | {kind} | {:.1} |",
+            l.colour,
+            code(&l.name),
+            l.area_mm2
+        );
     }
     s.push('\n');
 }

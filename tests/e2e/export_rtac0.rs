@@ -168,6 +168,8 @@ fn same_input_same_bytes_whatever_the_thread_count() {
     let mut names = vec![
         PathBuf::from("manifest.json"),
         PathBuf::from("FABRICATION.md"),
+        PathBuf::from("assembly.3mf"),
+        PathBuf::from("section.png"),
     ];
     names.extend(
         files_of(&second)

@@ -22,12 +22,12 @@ fn export(design: &str, strategy: Option<MoldStrategy>) -> Exported {
     export_as(design, strategy, false).0
 }
 
-/// The export, and with `threemf` the bytes of `assembly.3mf`.
+/// The export, and the bytes of `assembly.3mf` (with `threemf`) and `section.png` when written.
 fn export_as(
     design: &str,
     strategy: Option<MoldStrategy>,
     threemf: bool,
-) -> (Exported, Option<Vec<u8>>) {
+) -> (Exported, [Option<Vec<u8>>; 2]) {
     let mut d = fabkit_designs::library::load(design).unwrap();
     if let Some(s) = strategy {
         d.mold.strategy = s;
@@ -54,8 +54,8 @@ fn export_as(
         sheet: std::fs::read_to_string(out.join("FABRICATION.md")).unwrap(),
     };
     common_checks(design, &exported);
-    let assembly = threemf.then(|| std::fs::read(out.join("assembly.3mf")).unwrap());
-    (exported, assembly)
+    let read = |f: &str| std::fs::read(out.join(f)).ok();
+    (exported, [read("assembly.3mf"), read("section.png")])
 }
 
 /// The lines of the sheet's section `## title`, up to the next `## `.
@@ -480,7 +480,7 @@ fn tactip_sheet_has_no_pours() {
 /// bought parts as envelopes: read back with the `threemf` crate.
 #[test]
 fn rtac0_assembly_3mf_holds_every_member_in_the_sensor_frame() {
-    let (e, bytes) = export_as("rtac0", None, true);
+    let (e, [bytes, _]) = export_as("rtac0", None, true);
     let bytes = bytes.unwrap();
     let a = &e.manifest["assembly_3mf"];
     assert_eq!(a["file"], "assembly.3mf");
@@ -561,4 +561,45 @@ fn rtac0_assembly_3mf_holds_every_member_in_the_sensor_frame() {
         .iter()
         .filter(|m| m["kind"] == "bought")
         .all(|m| m["name"].as_str().unwrap().ends_with("_envelope")));
+}
+
+/// `section.png` cuts the assembled sensor through its axis: each member's colour covers its
+/// section's area (R-Tac0's transparent gel: two quarter annuli of radii 10 and 13.5 mm on
+/// 3.5 x 6 mm rectangles; the tube's envelope likewise with radii 9 and 10 mm, 9 mm down; the
+/// camera board 15 x 4 mm), both in the legend (from the outline) and in the pixels.
+#[test]
+fn rtac0_section_view_shows_each_member_with_its_section_area() {
+    let (e, [_, png_bytes]) = export_as("rtac0", None, false);
+    let png_bytes = png_bytes.unwrap();
+    let v = &e.manifest["section_view"];
+    assert_eq!(v["file"], "section.png");
+    let px = v["px_per_mm"].as_f64().unwrap();
+    let quarter = |ri: f64, ro: f64, below: f64| {
+        2.0 * (PI / 4.0 * (ro * ro - ri * ri) + (ro - ri) * (6.0 + below))
+    };
+    let decoder = png::Decoder::new(std::io::Cursor::new(&png_bytes));
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    assert_eq!(info.width as u64, v["width_px"].as_u64().unwrap());
+    let rgb = &buf[..info.buffer_size()];
+    let count = |hex: &str| {
+        let c: Vec<u8> = (0..3)
+            .map(|i| u8::from_str_radix(&hex[1 + 2 * i..3 + 2 * i], 16).unwrap())
+            .collect();
+        rgb.chunks_exact(3).filter(|p| *p == &c[..]).count() as f64
+    };
+    for (name, area) in [
+        ("transparent_gel", quarter(10.0, 13.5, 0.0)),
+        ("core_envelope", quarter(9.0, 10.0, 3.0)),
+        ("camera_board_envelope", 15.0 * 4.0),
+    ] {
+        let l = arr(v, "legend").iter().find(|l| l["name"] == name).unwrap();
+        close(l["area_mm2"].as_f64().unwrap(), area, 0.002 * area, name);
+        let pixels = count(l["colour"].as_str().unwrap()) / (px * px);
+        close(pixels, area, 0.03 * area, name);
+    }
+    assert!(e
+        .sheet
+        .contains("![The assembled sensor cut through its axis](section.png)"));
 }
