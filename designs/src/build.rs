@@ -372,10 +372,7 @@ fn housing_items(h: &crate::schema::HousingParams) -> Vec<String> {
         ),
         format!(
             "2 joint screws{}{}: {:.1} mm clearance, {:.1} mm head, length about {:.0} mm (clamp {:.1} mm + pilot {:.1} mm)",
-            screw_name(
-                h.joint_screw.clearance_diameter_mm,
-                h.joint_screw.clamp_length_mm + h.joint_screw.pilot_depth_mm - 0.5
-            )
+            joint_screw_name(h)
             .map(|n| format!(" {n}"))
             .unwrap_or_default(),
             match h.style {
@@ -390,6 +387,15 @@ fn housing_items(h: &crate::schema::HousingParams) -> Vec<String> {
             h.joint_screw.pilot_depth_mm
         ),
     ]
+}
+
+/// The joint screws of a housing by standard size and length (`M2 x 6`): the longest standard
+/// length within the clamp length plus the pilot depth, less 0.5 mm.
+pub fn joint_screw_name(h: &crate::schema::HousingParams) -> Option<String> {
+    screw_name(
+        h.joint_screw.clearance_diameter_mm,
+        h.joint_screw.clamp_length_mm + h.joint_screw.pilot_depth_mm - 0.5,
+    )
 }
 
 /// ISO metric screw sizes (nominal diameter, mm) the bought-items list names.

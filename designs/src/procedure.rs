@@ -347,10 +347,9 @@ pub fn procedure(
         };
         out.push(step(A::Demold, text));
     }
-    out.push(step(
-        A::Assemble,
-        assembly_text(design, parts, core_mounted),
-    ));
+    for text in assembly_steps(design, parts, core_mounted) {
+        out.push(step(A::Assemble, format!("Assemble: {text}")));
+    }
     out
 }
 
@@ -497,44 +496,102 @@ fn cure_text(notes: &str) -> String {
         .unwrap_or_else(|| "see the step's notes".into())
 }
 
-fn assembly_text(design: &Design, parts: &[Part], cast_on_core: bool) -> String {
-    let mut s = String::from("Assemble: ");
-    let mut items: Vec<String> = Vec::new();
-    if let (Some(_), false) = (&design.core, cast_on_core) {
-        if design
-            .layers
-            .iter()
-            .any(|l| l.process == crate::schema::LayerProcess::Cast)
-        {
-            items.push(
-                "bond the core (see Bought items) into the skin's inner surface with clear \
-                 silicone sealant (UVDtact Sec. III)"
-                    .into(),
-            );
-        }
-    }
-    if design.backing.is_some() {
-        items.push(
-            "glue the skin's base to the backing plate (ShadowTac: Smooth-On SilPoxy)".into(),
+/// The assembly steps in order, each with its screws or glue: the contact module's own
+/// bonding (core into the skin, skin onto its backing), then the shell from the inside out:
+/// LED PCB, diffuser, contact module, camera, the shell joined (R-Tac0 Sec. III-B2..B4;
+/// UVDtact Sec. III; ShadowTac Sec. III).
+fn assembly_steps(design: &Design, parts: &[Part], cast_on_core: bool) -> Vec<String> {
+    let mut out: Vec<String> = Vec::new();
+    let cast = design
+        .layers
+        .iter()
+        .any(|l| l.process == crate::schema::LayerProcess::Cast);
+    if design.core.is_some() && !cast_on_core && cast {
+        out.push(
+            "Bond the core (see Bought items) into the skin's inner surface with clear \
+             silicone sealant (UVDtact Sec. III)."
+                .into(),
         );
     }
-    let shell: Vec<String> = parts
-        .iter()
-        .filter(|p| ["shell_tube", "shell_base", "shell_half"].contains(&p.role.as_str()))
-        .map(|p| format!("`{}`", p.name))
-        .collect();
-    if !shell.is_empty() {
-        items.push(format!(
-            "screw the camera into the shell ({}), seat the LED ring PCB and the diffuser, push \
-             the contact module into its seat and join the shell with the joint screws (see \
-             Bought items)",
-            shell.join(", ")
+    if design.backing.is_some() {
+        out.push(
+            "Glue the skin's base to the backing plate with Smooth-On Sil-Poxy (ShadowTac \
+             Sec. III)."
+                .into(),
+        );
+    }
+    let named = |role: &str| -> Vec<String> {
+        parts
+            .iter()
+            .filter(|p| p.role == role)
+            .map(|p| format!("`{}`", p.name))
+            .collect()
+    };
+    if let Some(h) = &design.housing {
+        let joint = crate::build::joint_screw_name(h).map_or_else(
+            || "the joint screws".to_string(),
+            |n| format!("the 2 joint screws {n}"),
+        );
+        let camera = crate::build::metric_from_pilot(h.camera.mount_pilot_diameter_mm)
+            .map_or_else(String::new, |d| format!(" M{d}"));
+        let tube = named("shell_tube");
+        let base = named("shell_base");
+        let halves = named("shell_half");
+        let (into, module_seat) = match (tube.first(), halves.first()) {
+            (Some(t), _) => (
+                t.clone(),
+                format!("the contact-module seat at the top of {t}"),
+            ),
+            (None, Some(a)) => (a.clone(), format!("the contact-module seat of {a}")),
+            (None, None) => ("the shell".into(), "its seat".into()),
+        };
+        out.push(format!(
+            "Press the LED ring PCB ({} LEDs, facing up) into its seat in {into} (R-Tac0 \
+             Sec. III-B2: press-fitted), its wires down through the camera bay.",
+            h.led_pcb.led_count
         ));
+        out.push(format!(
+            "Lay the diffuser ring into its seat, {:.1} mm above the PCB.",
+            h.diffuser.gap_above_pcb_mm
+        ));
+        out.push(format!(
+            "Push the contact module (the core with its layers) into {module_seat} until its \
+             rim rests on the diffuser."
+        ));
+        match (base.first(), halves.get(1)) {
+            (Some(b), _) => {
+                out.push(format!(
+                    "Screw the camera board onto the spigot of {b} with 4 self-tapping \
+                     screws{camera} ({:.1} mm pilots), its cable through the slot.",
+                    h.camera.mount_pilot_diameter_mm
+                ));
+                out.push(format!(
+                    "Set {b} under {into}, spigot into the bay, and join them with {joint} up \
+                     through the flange."
+                ));
+            }
+            (None, Some(b)) => {
+                // the bulkhead spans both halves: close them before the camera goes on
+                out.push(format!(
+                    "Close {b} onto {into} and join the halves with {joint} across them."
+                ));
+                out.push(format!(
+                    "Screw the camera board up against the bulkhead with 4 self-tapping \
+                     screws{camera} ({:.1} mm pilots), lens through the lens hole.",
+                    h.camera.mount_pilot_diameter_mm
+                ));
+            }
+            _ => {}
+        }
     }
-    if items.is_empty() {
-        items.push("put the printed parts and the bought items together".into());
+    if out.is_empty() {
+        out.push(if parts.iter().any(|p| p.role == "printed_skin") {
+            "Nothing to put together: the printed skin comes off the printer with its marker \
+             tips in place."
+                .into()
+        } else {
+            "Put the printed parts and the bought items together.".into()
+        });
     }
-    s.push_str(&items.join("; "));
-    s.push('.');
-    s
+    out
 }

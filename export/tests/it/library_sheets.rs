@@ -312,8 +312,33 @@ fn rtac0_sheet_states_volumes_coats_treatments_and_the_procedure() {
             A::Pour,
             A::Demold,
             A::Assemble,
+            A::Assemble,
+            A::Assemble,
+            A::Assemble,
+            A::Assemble,
         ]
     );
+    // the assembly order, with the screws at each step
+    let steps: Vec<&str> = arr(&e.manifest, "procedure")
+        .iter()
+        .filter(|p| p["action"] == "assemble")
+        .map(|p| p["text"].as_str().unwrap())
+        .collect();
+    for (step, words) in steps.iter().zip([
+        ["LED ring PCB", "`shell_tube`"],
+        ["diffuser ring", "10.0 mm above the PCB"],
+        ["contact module", "rests on the diffuser"],
+        [
+            "camera board onto the spigot of `shell_base`",
+            "4 self-tapping screws M2 (1.6 mm pilots)",
+        ],
+        [
+            "`shell_base` under `shell_tube`",
+            "the 2 joint screws M2 x 6",
+        ],
+    ]) {
+        assert!(words.iter().all(|w| step.contains(w)), "{step}");
+    }
     // the fill height: the master's height over its plinth face (its 2 mm locating pin stands
     // in the floor's socket) plus the 5 mm Mold Star wall over its top
     let master = arr(&e.manifest, "parts")
@@ -381,6 +406,10 @@ fn rtac0_direct_sheet_names_the_clamp_bolts_and_the_sprue() {
             A::CloseMold,
             A::Pour,
             A::Demold,
+            A::Assemble,
+            A::Assemble,
+            A::Assemble,
+            A::Assemble,
             A::Assemble,
         ]
     );
