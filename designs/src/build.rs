@@ -237,6 +237,7 @@ pub fn build_kit_bounded(
         bought_items: bought,
         procedure,
         assembly,
+        cut_parts: crate::cut::cut_parts(design),
         summary,
     })
 }

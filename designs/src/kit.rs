@@ -230,6 +230,8 @@ pub struct Kit {
     /// ([`crate::assembly::members`]), fit-checked; empty for a kit that is not a sensor
     /// (fixtures).
     pub assembly: Vec<crate::assembly::Member>,
+    /// Parts cut from sheet stock, as outlines for DXF and SVG ([`crate::cut::cut_parts`]).
+    pub cut_parts: Vec<crate::cut::CutPart>,
     /// Sensor-frame facts worth printing in the manifest (envelope, derived radii...).
     pub summary: serde_json::Value,
 }

@@ -9,6 +9,7 @@
 
 pub mod assembly;
 pub mod build;
+pub mod cut;
 pub mod error;
 pub mod estimate;
 pub mod geometry;

@@ -26,13 +26,14 @@ mod sheet;
 pub mod step;
 mod stl;
 mod three_mf;
+pub mod two_d;
 
 pub use atomic::{StagedDir, OUTPUT_MARKER};
 pub use check::check_printable_mesh;
 pub use error::ExportError;
 pub use manifest::{
-    Manifest, ManifestAssembly, ManifestDataFile, ManifestDesign, ManifestKit3mf, ManifestMember,
-    ManifestObject, ManifestPart, ManifestVolume, FRAME,
+    Manifest, ManifestAssembly, ManifestCutPart, ManifestDataFile, ManifestDesign, ManifestKit3mf,
+    ManifestMember, ManifestObject, ManifestPart, ManifestVolume, FRAME,
 };
 
 use fabkit_designs::geometry::{Mesh, TopologyError};
@@ -274,6 +275,8 @@ pub const SECTION_PNG: &str = "section.png";
 pub const ASSEMBLY_3MF: &str = "assembly.3mf";
 
 const PARTS_DIR: &str = "parts";
+/// Folder of the laser-cut parts' DXF and SVG files.
+const CUT_DIR: &str = "cut";
 const STEP_DIR: &str = "step";
 
 /// Every file of the export, in memory, with `/`-separated relative paths.
@@ -458,6 +461,32 @@ fn render(
         files.push((SECTION_PNG.into(), bytes));
         Some(view)
     };
+    let mut cut_parts = Vec::with_capacity(kit.cut_parts.len());
+    for c in &kit.cut_parts {
+        let (dxf, svg) = (
+            format!("{CUT_DIR}/{}.dxf", c.name),
+            format!("{CUT_DIR}/{}.svg", c.name),
+        );
+        let dxf_bytes = two_d::dxf_bytes(c)?;
+        let svg_bytes = two_d::svg_text(c).into_bytes();
+        cut_parts.push(ManifestCutPart {
+            name: c.name.clone(),
+            description: c.description.clone(),
+            material: c.material.clone(),
+            material_name: materials
+                .as_ref()
+                .and_then(|t| t.materials.get(&c.material))
+                .map_or_else(|| c.material.clone(), |m| m.name.clone()),
+            thickness_mm: c.thickness_mm,
+            area_mm2: c.area_mm2(),
+            dxf_sha256: sha256_hex(&dxf_bytes),
+            svg_sha256: sha256_hex(&svg_bytes),
+            dxf: dxf.clone(),
+            svg: svg.clone(),
+        });
+        files.push((dxf, dxf_bytes));
+        files.push((svg, svg_bytes));
+    }
     let assembly_3mf = if opts.formats.threemf && !kit.assembly.is_empty() {
         let (manifest_assembly, bytes) = assembly_3mf(kit, opts)?;
         files.push((manifest_assembly.file.clone(), bytes));
@@ -480,6 +509,7 @@ fn render(
         kit_3mf,
         assembly_3mf,
         section_view,
+        cut_parts,
         casts: kit.casts.clone(),
         bought_items: kit.bought_items.clone(),
         procedure: kit.procedure.clone(),
@@ -548,6 +578,7 @@ mod tests {
             bought_items: vec![],
             procedure: vec![],
             assembly: vec![],
+            cut_parts: vec![],
             summary: serde_json::json!({}),
         }
     }

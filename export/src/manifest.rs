@@ -36,6 +36,9 @@ pub struct Manifest {
     /// that is a sensor.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub section_view: Option<crate::section::SectionView>,
+    /// Laser-cut parts with their DXF and SVG files.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub cut_parts: Vec<ManifestCutPart>,
     /// Pours in casting order, as the design computed them.
     pub casts: Vec<CastReport>,
     /// Parts that are bought or cut rather than printed, one line each.
@@ -140,6 +143,24 @@ pub struct ManifestMember {
     /// Volume of the written mesh, mm^3, and its box in the sensor frame, mm.
     pub volume_mm3: f64,
     pub bbox_mm: Aabb,
+}
+
+/// A part cut from sheet stock and its 2D files.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ManifestCutPart {
+    pub name: String,
+    pub description: String,
+    /// Material key and product name.
+    pub material: String,
+    pub material_name: String,
+    pub thickness_mm: f64,
+    /// Area of the part's face (outer outline less the holes), mm^2.
+    pub area_mm2: f64,
+    /// `cut/<name>.dxf` (R2000, mm, layers `cut` and `engrave`) and `cut/<name>.svg` (mm).
+    pub dxf: String,
+    pub dxf_sha256: String,
+    pub svg: String,
+    pub svg_sha256: String,
 }
 
 /// The kit 3MF.

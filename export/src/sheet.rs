@@ -191,6 +191,7 @@ pub(crate) fn render(m: &Manifest) -> String {
     }
 
     shopping_list(&mut s, m);
+    laser_cut(&mut s, m);
     procedure(&mut s, m);
 
     s.push_str("## Bought items\n\n");
@@ -279,6 +280,31 @@ fn shopping_list(s: &mut String, m: &Manifest) {
             None => format!("{g:.1} g"),
         };
         let _ = writeln!(s, "| {} | {amount} |", text(&name));
+    }
+    s.push('\n');
+}
+
+/// The laser-cut parts and their files; nothing when the kit has none.
+fn laser_cut(s: &mut String, m: &Manifest) {
+    if m.cut_parts.is_empty() {
+        return;
+    }
+    s.push_str("## Laser cutting\n\n");
+    s.push_str(
+        "DXF (R2000, mm, layer `cut`) and SVG (mm, cut lines red) of each part, centred on the \
+         sensor axis.\n\n",
+    );
+    for c in &m.cut_parts {
+        let _ = writeln!(
+            s,
+            "- {} and {}: {} from {}, {:.1} mm sheet, {:.1} mm² of face",
+            code(&c.dxf),
+            code(&c.svg),
+            text(&c.description),
+            text(&c.material_name),
+            c.thickness_mm,
+            c.area_mm2
+        );
     }
     s.push('\n');
 }

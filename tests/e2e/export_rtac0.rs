@@ -170,6 +170,8 @@ fn same_input_same_bytes_whatever_the_thread_count() {
         PathBuf::from("FABRICATION.md"),
         PathBuf::from("assembly.3mf"),
         PathBuf::from("section.png"),
+        PathBuf::from("cut/diffuser.dxf"),
+        PathBuf::from("cut/diffuser.svg"),
     ];
     names.extend(
         files_of(&second)
@@ -488,4 +490,72 @@ fn round_shell_and_camera_base_match_the_authors_cad() {
         "two screw holes and the cable slot through the base"
     );
     assert_eq!(tube["genus"], 1);
+}
+
+/// The laser-cut diffuser's DXF passes ezdxf's audit with nothing to fix (R2000 or later, mm,
+/// its outlines on the `cut` layer), and its face (outer circle less the bore) has the area the
+/// manifest states, which is the 3D diffuser envelope's section (volume / thickness) within
+/// the tessellation. The SVG is in mm with the same circles.
+#[test]
+fn laser_cut_diffuser_passes_ezdxf_audit_and_matches_its_3d_section() {
+    let tmp = tempfile::tempdir().unwrap();
+    let m = export(tmp.path(), "master", "2");
+    let dir = tmp.path().join("rtac0");
+    let cut = &m["cut_parts"][0];
+    assert_eq!(cut["name"], "diffuser");
+    let area = cut["area_mm2"].as_f64().unwrap();
+    assert!(
+        (area - PI * (11.5f64.powi(2) - 6.0f64.powi(2))).abs() < 1e-9,
+        "{cut}"
+    );
+    let envelope = m["assembly_3mf"]["members"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|x| x["name"] == "diffuser_envelope")
+        .unwrap();
+    let section = envelope["volume_mm3"].as_f64().unwrap() / cut["thickness_mm"].as_f64().unwrap();
+    assert!((section - area).abs() < 0.005 * area, "{section} vs {area}");
+    let svg = std::fs::read_to_string(dir.join(cut["svg"].as_str().unwrap())).unwrap();
+    assert!(
+        svg.contains(r#"width="25mm""#) && svg.contains(r#"r="11.5""#) && svg.contains(r#"r="6""#),
+        "{svg}"
+    );
+
+    let Some(py) = oracle_python() else {
+        return missing("the oracle python (ezdxf)");
+    };
+    let script = r#"
+import sys, json, math, ezdxf
+doc = ezdxf.readfile(sys.argv[1])
+a = doc.audit()
+circles = sorted((e.dxf.radius for e in doc.modelspace().query('CIRCLE[layer=="cut"]')), reverse=True)
+print(json.dumps({
+    "version": doc.dxfversion, "units": doc.units, "errors": len(a.errors), "fixes": len(a.fixes),
+    "layers": sorted(l.dxf.name for l in doc.layers),
+    "area": math.pi * circles[0] ** 2 - sum(math.pi * r ** 2 for r in circles[1:]),
+    "entities": len(doc.modelspace()),
+}))
+"#;
+    let o = std::process::Command::new(py)
+        .arg("-c")
+        .arg(script)
+        .arg(dir.join(cut["dxf"].as_str().unwrap()))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(v["version"].as_str().unwrap() >= "AC1015", "{v}");
+    assert_eq!(v["units"], 4, "{v}"); // millimetres
+    assert_eq!(
+        (v["errors"].as_u64(), v["fixes"].as_u64()),
+        (Some(0), Some(0)),
+        "{v}"
+    );
+    assert!(
+        v["layers"].as_array().unwrap().contains(&"cut".into()),
+        "{v}"
+    );
+    assert_eq!(v["entities"], 2, "{v}");
+    assert!((v["area"].as_f64().unwrap() - area).abs() < 1e-9, "{v}");
 }

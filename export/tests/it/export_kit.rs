@@ -87,6 +87,7 @@ fn test_kit() -> Kit {
         bought_items: vec!["acrylic tube, 30 mm OD".into()],
         procedure: vec![],
         assembly: vec![],
+        cut_parts: vec![],
         summary: serde_json::json!({ "envelope_radius_mm": 15.0 }),
     }
 }
@@ -384,6 +385,7 @@ fn group_kit() -> Kit {
         bought_items: vec![],
         procedure: vec![],
         assembly: vec![],
+        cut_parts: vec![],
         summary: serde_json::json!({}),
     }
 }

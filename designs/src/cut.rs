@@ -1,0 +1,102 @@
+//! Laser-cut parts: their outlines in the plane, for DXF and SVG (export crate).
+//!
+//! R-Tac0's diffuser is laser-cut from double-sided frosted acrylic (Sec. III-B2); ShadowTac's
+//! skin is glued to a PMMA plate (Sec. IV-A). Each part is drawn in its own plane, in mm, centred
+//! on the sensor axis (x and y of the sensor frame).
+
+use crate::schema::Design;
+use serde::{Deserialize, Serialize};
+
+/// What the laser does along an outline.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Operation {
+    /// Cut through the sheet.
+    Cut,
+    /// Mark the surface only.
+    Engrave,
+}
+
+/// One closed outline.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Outline {
+    /// A circle, centre (x, y) and radius, mm.
+    Circle { centre_mm: [f64; 2], radius_mm: f64 },
+}
+
+impl Outline {
+    /// Enclosed area, mm^2.
+    pub fn area_mm2(&self) -> f64 {
+        match self {
+            Self::Circle { radius_mm, .. } => std::f64::consts::PI * radius_mm * radius_mm,
+        }
+    }
+}
+
+/// A part cut from sheet stock.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CutPart {
+    /// File stem, `[a-z0-9_]+`.
+    pub name: String,
+    pub description: String,
+    /// Material key in the materials table.
+    pub material: String,
+    /// Sheet thickness, mm.
+    pub thickness_mm: f64,
+    /// The outlines with their operation: the first is the part's outer outline, the others
+    /// holes in it.
+    pub outlines: Vec<(Operation, Outline)>,
+}
+
+impl CutPart {
+    /// Area of the part's face, mm^2: the outer outline less the holes.
+    pub fn area_mm2(&self) -> f64 {
+        let mut cuts = self
+            .outlines
+            .iter()
+            .filter(|(op, _)| *op == Operation::Cut)
+            .map(|(_, o)| o.area_mm2());
+        let outer = cuts.next().unwrap_or(0.0);
+        outer - cuts.sum::<f64>()
+    }
+}
+
+/// The laser-cut parts of a design: the housing's diffuser ring, the backing plate.
+pub fn cut_parts(design: &Design) -> Vec<CutPart> {
+    let circle = |r: f64| Outline::Circle {
+        centre_mm: [0.0, 0.0],
+        radius_mm: r,
+    };
+    let mut out = Vec::new();
+    if let Some(h) = &design.housing {
+        let d = &h.diffuser;
+        out.push(CutPart {
+            name: "diffuser".into(),
+            description: format!(
+                "Diffuser ring: double-sided frosted acrylic, {:.1} mm thick, outer diameter \
+                 {:.1} mm, inner diameter {:.1} mm (R-Tac0 Sec. III-B2)",
+                d.thickness_mm, d.outer_diameter_mm, d.inner_diameter_mm
+            ),
+            material: "pmma".into(),
+            thickness_mm: d.thickness_mm,
+            outlines: vec![
+                (Operation::Cut, circle(d.outer_diameter_mm / 2.0)),
+                (Operation::Cut, circle(d.inner_diameter_mm / 2.0)),
+            ],
+        });
+    }
+    if let Some(b) = &design.backing {
+        out.push(CutPart {
+            name: "backing".into(),
+            description: format!(
+                "Backing plate: {}, {:.1} mm thick, diameter {:.1} mm",
+                b.description, b.thickness_mm, b.diameter_mm
+            ),
+            material: b.material.clone(),
+            thickness_mm: b.thickness_mm,
+            outlines: vec![(Operation::Cut, circle(b.diameter_mm / 2.0))],
+        });
+    }
+    out
+}
