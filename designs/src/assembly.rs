@@ -63,6 +63,18 @@ pub const SENSOR_ROLES: [&str; 5] = [
 /// Overlaps smaller than this are not interferences, mm^3.
 pub const MIN_OVERLAP_MM3: f64 = 1e-3;
 
+/// A bought part's envelope as a member: never nested by the stack.
+fn bought(name: &str, description: String, solid: Solid, fix: &[&str]) -> Member {
+    Member {
+        name: name.into(),
+        kind: MemberKind::Bought,
+        description,
+        solid,
+        fix: fix.iter().map(|f| (*f).to_string()).collect(),
+        nested_by_stack: false,
+    }
+}
+
 /// The inverse of a rigid map (rotation and translation, 3x4 row-major).
 fn rigid_inverse(t: &Affine) -> Affine {
     let mut m = [[0.0; 4]; 3];
@@ -147,12 +159,13 @@ pub fn members(
             revolve(&pl, tol).and_then(|m| Solid::from_mesh(&m)),
         )?;
         out.push(Member {
-            name: "core_envelope".into(),
-            kind: MemberKind::Bought,
-            description: format!("Core (bought): {}", spec.description),
-            solid,
-            fix: vec!["core.wall_thickness_mm".into(), "core.length_mm".into()],
             nested_by_stack: true,
+            ..bought(
+                "core_envelope",
+                format!("Core (bought): {}", spec.description),
+                solid,
+                &["core.wall_thickness_mm", "core.length_mm"],
+            )
         });
     }
     let zb = design.body.base_z_mm();
@@ -164,17 +177,15 @@ pub fn members(
             disc(ro, z0, z1)?.difference(&disc(ri, z0 - 1.0, z1 + 1.0)?)
         };
     if let Some(b) = &design.backing {
-        out.push(Member {
-            name: "backing_envelope".into(),
-            kind: MemberKind::Bought,
-            description: format!("Backing plate (bought): {}", b.description),
-            solid: g(
+        out.push(bought(
+            "backing_envelope",
+            format!("Backing plate (bought): {}", b.description),
+            g(
                 "backing_envelope",
                 disc(b.diameter_mm / 2.0, zb - b.thickness_mm, zb),
             )?,
-            fix: vec!["backing.diameter_mm".into(), "backing.thickness_mm".into()],
-            nested_by_stack: false,
-        });
+            &["backing.diameter_mm", "backing.thickness_mm"],
+        ));
     }
     if let (Some(h), Some(lv)) = (&design.housing, levels) {
         let bw = h.camera.board_width_mm / 2.0;
@@ -182,28 +193,25 @@ pub fn members(
             (HousingStyle::RoundTube, Some(top)) => (top, top + h.camera.bay_height_mm),
             _ => (lv.bulkhead_z_mm - h.camera.bay_height_mm, lv.bulkhead_z_mm),
         };
-        out.push(Member {
-            name: "camera_board_envelope".into(),
-            kind: MemberKind::Bought,
-            description: format!(
+        out.push(bought(
+            "camera_board_envelope",
+            format!(
                 "Camera board with its components (bought): {}",
                 h.camera.module
             ),
-            solid: g(
+            g(
                 "camera_board_envelope",
                 cuboid([-bw, -bw, z0], [bw, bw, z1]),
             )?,
-            fix: vec![
-                "housing.camera.board_width_mm".into(),
-                "housing.camera.bay_height_mm".into(),
+            &[
+                "housing.camera.board_width_mm",
+                "housing.camera.bay_height_mm",
             ],
-            nested_by_stack: false,
-        });
-        out.push(Member {
-            name: "led_pcb_envelope".into(),
-            kind: MemberKind::Bought,
-            description: format!("LED ring PCB (bought), {} LEDs", h.led_pcb.led_count),
-            solid: g(
+        ));
+        out.push(bought(
+            "led_pcb_envelope",
+            format!("LED ring PCB (bought), {} LEDs", h.led_pcb.led_count),
+            g(
                 "led_pcb_envelope",
                 ring(
                     h.led_pcb.outer_diameter_mm / 2.0,
@@ -212,17 +220,15 @@ pub fn members(
                     lv.pcb_z_mm + h.led_pcb.thickness_mm,
                 ),
             )?,
-            fix: vec![
-                "housing.led_pcb.outer_diameter_mm".into(),
-                "housing.led_pcb.thickness_mm".into(),
+            &[
+                "housing.led_pcb.outer_diameter_mm",
+                "housing.led_pcb.thickness_mm",
             ],
-            nested_by_stack: false,
-        });
-        out.push(Member {
-            name: "diffuser_envelope".into(),
-            kind: MemberKind::Bought,
-            description: "Diffuser ring (laser-cut acrylic)".into(),
-            solid: g(
+        ));
+        out.push(bought(
+            "diffuser_envelope",
+            "Diffuser ring (laser-cut acrylic)".into(),
+            g(
                 "diffuser_envelope",
                 ring(
                     h.diffuser.outer_diameter_mm / 2.0,
@@ -231,12 +237,11 @@ pub fn members(
                     lv.diffuser_z_mm + h.diffuser.thickness_mm,
                 ),
             )?,
-            fix: vec![
-                "housing.diffuser.outer_diameter_mm".into(),
-                "housing.diffuser.thickness_mm".into(),
+            &[
+                "housing.diffuser.outer_diameter_mm",
+                "housing.diffuser.thickness_mm",
             ],
-            nested_by_stack: false,
-        });
+        ));
     }
     Ok(out)
 }

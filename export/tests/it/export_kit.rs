@@ -121,7 +121,10 @@ fn sha256_hex(bytes: &[u8]) -> String {
         .collect()
 }
 
-fn signed_volume(vertices: &[[f64; 3]], triangles: impl Iterator<Item = [usize; 3]>) -> f64 {
+pub(crate) fn signed_volume(
+    vertices: &[[f64; 3]],
+    triangles: impl Iterator<Item = [usize; 3]>,
+) -> f64 {
     let mut v = 0.0;
     for t in triangles {
         let (a, b, c) = (vertices[t[0]], vertices[t[1]], vertices[t[2]]);

@@ -550,17 +550,10 @@ fn rtac0_assembly_3mf_holds_every_member_in_the_sensor_frame() {
             .iter()
             .map(|v| [v.x, v.y, v.z])
             .collect();
-        let vol: f64 = mesh
-            .triangles
-            .triangle
-            .iter()
-            .map(|t| {
-                let (a, b, c) = (v[t.v1], v[t.v2], v[t.v3]);
-                (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
-                    + a[2] * (b[0] * c[1] - b[1] * c[0]))
-                    / 6.0
-            })
-            .sum();
+        let vol = crate::export_kit::signed_volume(
+            &v,
+            mesh.triangles.triangle.iter().map(|t| [t.v1, t.v2, t.v3]),
+        );
         let want = m["volume_mm3"].as_f64().unwrap();
         close(vol, want, 1e-6 * want, m["name"].as_str().unwrap());
         let zmax = v.iter().map(|p| p[2]).fold(f64::NEG_INFINITY, f64::max);
