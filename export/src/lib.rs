@@ -205,20 +205,15 @@ fn write_kit_meshes(
     })
 }
 
-/// `assembly.3mf`: the kit's assembled sensor, one object per member, in the sensor frame;
-/// every member a closed 2-manifold.
+/// `assembly.3mf`: the kit's assembled sensor, one object per member (`meshes`, checked closed
+/// 2-manifolds, in kit order), in the sensor frame.
 fn assembly_3mf(
     kit: &Kit,
+    meshes: &[Mesh],
     opts: &ExportOptions,
 ) -> Result<(ManifestAssembly, Vec<u8>), ExportError> {
-    let meshes: Vec<Mesh> = kit
-        .assembly
-        .iter()
-        .map(|m| m.solid.mesh().rounded_to_f32())
-        .collect();
     let mut members = Vec::with_capacity(meshes.len());
-    for (m, mesh) in kit.assembly.iter().zip(&meshes) {
-        check_printable_mesh(&m.name, mesh)?;
+    for (m, mesh) in kit.assembly.iter().zip(meshes) {
         members.push(ManifestMember {
             name: m.name.clone(),
             kind: m.kind,
@@ -235,7 +230,7 @@ fn assembly_3mf(
     let objects: Vec<three_mf::Object<'_>> = kit
         .assembly
         .iter()
-        .zip(&meshes)
+        .zip(meshes)
         .map(|(m, mesh)| three_mf::Object {
             name: m.name.clone(),
             group: None,
@@ -266,6 +261,16 @@ fn assembly_3mf(
         },
         bytes,
     ))
+}
+
+/// The product name of a material key (the key itself when the table lacks it).
+fn product_name(
+    materials: Option<&fabkit_designs::materials::MaterialsTable>,
+    key: &str,
+) -> String {
+    materials
+        .and_then(|t| t.materials.get(key))
+        .map_or_else(|| key.to_owned(), |m| m.name.clone())
 }
 
 /// The section view's file name ([`section`]).
@@ -324,10 +329,7 @@ fn render(
             role: part.role.clone(),
             description: part.description.clone(),
             material: part.material.clone(),
-            material_name: materials
-                .as_ref()
-                .and_then(|t| t.materials.get(&part.material))
-                .map_or_else(|| part.material.clone(), |m| m.name.clone()),
+            material_name: product_name(materials.as_ref(), &part.material),
             mass_g: materials
                 .as_ref()
                 .and_then(|t| t.materials.get(&part.material))
@@ -432,18 +434,22 @@ fn render(
     } else {
         None
     };
+    // The assembled sensor's meshes, made and checked once for the section view and the 3MF.
+    let assembly_meshes: Vec<Mesh> = kit
+        .assembly
+        .iter()
+        .map(|m| m.solid.mesh().rounded_to_f32())
+        .collect();
+    for (m, mesh) in kit.assembly.iter().zip(&assembly_meshes) {
+        check_printable_mesh(&m.name, mesh)?;
+    }
     let section_view = if kit.assembly.is_empty() {
         None
     } else {
-        let meshes: Vec<Mesh> = kit
-            .assembly
-            .iter()
-            .map(|m| m.solid.mesh().rounded_to_f32())
-            .collect();
         let members: Vec<_> = kit
             .assembly
             .iter()
-            .zip(&meshes)
+            .zip(&assembly_meshes)
             .map(|(m, mesh)| (m.name.as_str(), m.kind, mesh))
             .collect();
         let (rgb, mut view) = section::render(&members);
@@ -473,10 +479,7 @@ fn render(
             name: c.name.clone(),
             description: c.description.clone(),
             material: c.material.clone(),
-            material_name: materials
-                .as_ref()
-                .and_then(|t| t.materials.get(&c.material))
-                .map_or_else(|| c.material.clone(), |m| m.name.clone()),
+            material_name: product_name(materials.as_ref(), &c.material),
             thickness_mm: c.thickness_mm,
             area_mm2: c.area_mm2(),
             dxf_sha256: sha256_hex(&dxf_bytes),
@@ -488,7 +491,7 @@ fn render(
         files.push((svg, svg_bytes));
     }
     let assembly_3mf = if opts.formats.threemf && !kit.assembly.is_empty() {
-        let (manifest_assembly, bytes) = assembly_3mf(kit, opts)?;
+        let (manifest_assembly, bytes) = assembly_3mf(kit, &assembly_meshes, opts)?;
         files.push((manifest_assembly.file.clone(), bytes));
         Some(manifest_assembly)
     } else {

@@ -227,25 +227,29 @@ pub(crate) fn render(m: &Manifest) -> String {
 /// mix (grams, or millilitres and grams for a mix by volume; waste allowance included) and each
 /// print material's grams (part volumes times density, before supports and purge).
 fn shopping_list(s: &mut String, m: &Manifest) {
-    // (product, grams, millilitres when mixed by volume)
-    let mut items: Vec<(String, f64, Option<f64>)> = Vec::new();
-    let mut add =
-        |name: &str, g: f64, ml: Option<f64>| match items.iter_mut().find(|(n, _, _)| n == name) {
+    // (product, grams, millilitres): grams for what is weighed, millilitres for a mix by
+    // volume (with its grams) and for primer and release (millilitres only)
+    let mut items: Vec<(String, Option<f64>, Option<f64>)> = Vec::new();
+    let mut add = |name: &str, g: Option<f64>, ml: Option<f64>| {
+        let sum = |a: Option<f64>, b: Option<f64>| match (a, b) {
+            (Some(a), Some(b)) => Some(a + b),
+            (a, b) => a.or(b),
+        };
+        match items.iter_mut().find(|(n, _, _)| n == name) {
             Some((_, tg, tml)) => {
-                *tg += g;
-                if let (Some(a), Some(b)) = (tml.as_mut(), ml) {
-                    *a += b;
-                }
+                *tg = sum(*tg, g);
+                *tml = sum(*tml, ml);
             }
             None => items.push((name.to_string(), g, ml)),
-        };
-    // treatments are measured in millilitres only (grams 0); coats and pours come first
+        }
+    };
+    // coats and treatments first: they are applied before their pour
     for c in &m.casts {
         for k in &c.coats {
-            add(&k.material_name, k.total_mass_g, None);
+            add(&k.material_name, Some(k.total_mass_g), None);
         }
         for t in &c.treatments {
-            add(&t.material_name, 0.0, Some(t.amount_ml));
+            add(&t.material_name, None, Some(t.amount_ml));
         }
     }
     for c in &m.casts {
@@ -254,11 +258,11 @@ fn shopping_list(s: &mut String, m: &Manifest) {
             .iter()
             .all(|x| x.volume_ml.is_some())
             .then(|| c.components.iter().filter_map(|x| x.volume_ml).sum());
-        add(&c.material_name, c.total_mass_g, ml);
+        add(&c.material_name, Some(c.total_mass_g), ml);
     }
     for p in &m.parts {
         if p.mass_g > 0.0 {
-            add(&p.material_name, p.mass_g, None);
+            add(&p.material_name, Some(p.mass_g), None);
         }
     }
     if items.is_empty() {
@@ -272,12 +276,13 @@ fn shopping_list(s: &mut String, m: &Manifest) {
     );
     s.push_str("| Product | Amount |\n|---------|-------:|\n");
     for (name, g, ml) in items {
-        let amount = match ml {
-            Some(ml) if g == 0.0 => format!("about {ml:.2} mL"),
-            Some(ml) => format!("{ml:.1} mL ({g:.1} g)"),
+        let amount = match (g, ml) {
+            (None, Some(ml)) => format!("about {ml:.2} mL"),
+            (Some(g), Some(ml)) => format!("{ml:.1} mL ({g:.1} g)"),
             // two decimals where a 0.01 g scale matters, one above 10 g
-            None if g < 10.0 => format!("{g:.2} g"),
-            None => format!("{g:.1} g"),
+            (Some(g), None) if g < 10.0 => format!("{g:.2} g"),
+            (Some(g), None) => format!("{g:.1} g"),
+            (None, None) => continue,
         };
         let _ = writeln!(s, "| {} | {amount} |", text(&name));
     }

@@ -121,6 +121,15 @@ fn sha256_hex(bytes: &[u8]) -> String {
         .collect()
 }
 
+/// The vertices of a 3MF mesh as read back, mm.
+pub(crate) fn vertices_of(mesh: &threemf::model::Mesh) -> Vec<[f64; 3]> {
+    mesh.vertices
+        .vertex
+        .iter()
+        .map(|v| [v.x, v.y, v.z])
+        .collect()
+}
+
 pub(crate) fn signed_volume(
     vertices: &[[f64; 3]],
     triangles: impl Iterator<Item = [usize; 3]>,
@@ -271,12 +280,7 @@ fn threemf_reads_back_named_objects_in_millimetres_laid_out_apart() {
     let mut placed = Vec::new();
     for (o, mp) in objects.iter().zip(&m.parts) {
         let mesh = o.mesh.as_ref().unwrap();
-        let verts: Vec<[f64; 3]> = mesh
-            .vertices
-            .vertex
-            .iter()
-            .map(|v| [v.x, v.y, v.z])
-            .collect();
+        let verts = vertices_of(mesh);
         let unique: BTreeSet<[u64; 3]> = verts.iter().map(|v| v.map(f64::to_bits)).collect();
         assert_eq!(
             unique.len(),
@@ -484,12 +488,7 @@ fn a_group_is_one_3mf_object_with_a_volume_per_part_and_stls_stay_put() {
         let tr = [t[9], t[10], t[11]];
         assert_eq!(mo.translation_mm, tr, "{}", mo.name);
         let mesh = o.mesh.as_ref().unwrap();
-        let verts: Vec<[f64; 3]> = mesh
-            .vertices
-            .vertex
-            .iter()
-            .map(|v| [v.x, v.y, v.z])
-            .collect();
+        let verts = vertices_of(mesh);
         let tris: Vec<[usize; 3]> = mesh
             .triangles
             .triangle

@@ -544,12 +544,7 @@ fn rtac0_assembly_3mf_holds_every_member_in_the_sensor_frame() {
     }
     for (o, m) in model.resources.object.iter().zip(members) {
         let mesh = o.mesh.as_ref().unwrap();
-        let v: Vec<[f64; 3]> = mesh
-            .vertices
-            .vertex
-            .iter()
-            .map(|v| [v.x, v.y, v.z])
-            .collect();
+        let v = crate::export_kit::vertices_of(mesh);
         let vol = crate::export_kit::signed_volume(
             &v,
             mesh.triangles.triangle.iter().map(|t| [t.v1, t.v2, t.v3]),
