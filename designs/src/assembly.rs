@@ -52,7 +52,8 @@ pub struct Member {
 }
 
 /// Roles of kit parts that are part of the sensor (the rest are molds and tooling).
-pub const SENSOR_ROLES: [&str; 5] = [
+pub const SENSOR_ROLES: [&str; 6] = [
+    "shell_collar",
     "shell_tube",
     "shell_base",
     "shell_half",
@@ -167,6 +168,29 @@ pub fn members(
                 &["core.wall_thickness_mm", "core.length_mm"],
             )
         });
+    }
+    if let (Some(h), Some(lv), Some(c)) = (&design.housing, levels, &stack.core) {
+        if let Some(f) = &h.filling_gel {
+            let pl = crate::housing::filling_gel_profile(design, h, c, lv, tol);
+            let solid = g(
+                crate::procedure::FILLING_GEL,
+                revolve(&pl, tol).and_then(|m| Solid::from_mesh(&m)),
+            )?;
+            out.push(Member {
+                name: crate::procedure::FILLING_GEL.into(),
+                kind: MemberKind::Cast,
+                description: format!(
+                    "Internal filling gel ({}): the core, the diffuser's opening and the light chamber",
+                    f.material
+                ),
+                solid,
+                fix: vec![
+                    "housing.light_chamber_diameter_mm".into(),
+                    "housing.diffuser.inner_diameter_mm".into(),
+                ],
+                nested_by_stack: false,
+            });
+        }
     }
     let zb = design.body.base_z_mm();
     let disc =

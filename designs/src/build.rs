@@ -212,6 +212,36 @@ pub fn build_kit_bounded(
         casts.push(r);
         step += 1;
     }
+    // The filling gel, poured into the assembled shell (R-Tac0 Sec. III-B1).
+    if let (Some(h), Some(lv), Some(core)) = (&design.housing, &shell_levels, &stack.core) {
+        if let Some(f) = &h.filling_gel {
+            let m = materials
+                .get(&f.material)
+                .ok_or_else(|| DesignError::Yaml(format!("unknown material {}", f.material)))?;
+            let v = crate::housing::filling_gel_volume_mm3(design, h, core, lv);
+            let shell: Vec<String> = parts
+                .iter()
+                .filter(|p| ["shell_collar", "shell_tube", "shell_half"].contains(&p.role.as_str()))
+                .map(|p| p.name.clone())
+                .collect();
+            let mut r = pour(
+                step,
+                crate::procedure::FILLING_GEL,
+                &f.material,
+                m,
+                shell,
+                v,
+                waste,
+            )
+            .map_err(DesignError::Yaml)?;
+            r.layer_volume_ml = Some(v / 1000.0);
+            r.notes = format!(
+                "Poured into the assembled shell, pole-down, before the camera goes on: it fills the core, the diffuser's opening and the light chamber up to the LED PCB's face (R-Tac0 Sec. III-B1). {}",
+                r.notes
+            );
+            casts.push(r);
+        }
+    }
     // Parts are named uniquely by construction; check anyway, the manifest relies on it.
     let mut names: Vec<&str> = parts.iter().map(|p| p.name.as_str()).collect();
     names.sort_unstable();
@@ -352,7 +382,7 @@ fn bought_items(design: &Design, stack: &Stack, materials: &MaterialsTable) -> V
 }
 
 fn housing_items(h: &crate::schema::HousingParams) -> Vec<String> {
-    vec![
+    let mut v = vec![
         format!(
             "Camera: {} on a {:.1} mm square board, fixed with 4 self-tapping screws{} ({:.1} mm pilots, {:.1} mm square pattern)",
             h.camera.module,
@@ -368,7 +398,7 @@ fn housing_items(h: &crate::schema::HousingParams) -> Vec<String> {
             h.led_pcb.led_count, h.led_pcb.outer_diameter_mm, h.led_pcb.inner_diameter_mm, h.led_pcb.thickness_mm
         ),
         format!(
-            "Diffuser: laser-cut double-sided frosted acrylic ring, outer diameter {:.1} mm, inner diameter {:.1} mm, {:.1} mm thick, {:.1} mm above the PCB",
+            "Diffuser: laser-cut double-sided frosted acrylic (cut/diffuser.dxf), outer diameter {:.1} mm, inner diameter {:.1} mm, {:.1} mm thick, {:.1} mm above the PCB",
             h.diffuser.outer_diameter_mm, h.diffuser.inner_diameter_mm, h.diffuser.thickness_mm, h.diffuser.gap_above_pcb_mm
         ),
         format!(
@@ -387,7 +417,15 @@ fn housing_items(h: &crate::schema::HousingParams) -> Vec<String> {
             h.joint_screw.clamp_length_mm,
             h.joint_screw.pilot_depth_mm
         ),
-    ]
+    ];
+    if h.style == crate::schema::HousingStyle::RoundTube {
+        v.push(
+            "Cyanoacrylate glue (gel): the diffuser disc onto the tube's top face, the collar \
+             onto the diffuser"
+                .into(),
+        );
+    }
+    v
 }
 
 /// The joint screws of a housing by standard size and length (`M2 x 6`): the longest standard

@@ -7,13 +7,17 @@
 //! the LED ring PCB seat `gap_above_pcb_mm` (10 mm in the paper) under the diffuser, and the
 //! camera under the PCB.
 //!
-//! - `round_tube` (the authors' CAD, measured: a round tube of 30 mm outer diameter, 21.65 mm
-//!   tall, closed by a separate base that carries the camera): below the PCB the tube is bored
-//!   out to the camera bay and the PCB rests on the ledge this leaves. The base is a flange
-//!   under the tube with a spigot that enters the bay; the camera board is screwed onto the
-//!   spigot, its cable leaves through a slot in the base, and two screws from below through
-//!   the flange hold the base to the tube wall (fabkit's layout: the authors' base and bolts
-//!   are not published).
+//! - `round_tube` (the authors' CAD, measured: a round shell of 30 mm outer diameter, 21.65 mm
+//!   from the base plane to its bottom, closed by a separate base that carries the camera; the
+//!   diffuser is a 30 mm disc with a 19.6 mm opening): from the top, a collar that takes the
+//!   core's end below the base plane, the diffuser disc (the core's rim rests on its inner edge),
+//!   and the tube. The tube's light chamber is wide enough for the LED PCB to go in from the
+//!   top; below the PCB the tube is bored out to the camera bay and the PCB rests on the ledge
+//!   this leaves. The base is a flange under the tube with a spigot that enters the bay; the
+//!   camera board is screwed onto the spigot, its cable leaves through a slot in the base, and
+//!   two screws from below through the flange hold the base to the tube wall. The collar and
+//!   the diffuser are glued onto the tube (fabkit's layout: the authors' base, bolts and
+//!   collar are not published).
 //! - `square_split`: a square shell with the camera bay open at the bottom (the board screws
 //!   up against a bulkhead with the lens hole); the shell splits on the plane x = 0 into two
 //!   halves joined by two screws across it.
@@ -263,13 +267,24 @@ pub fn check_housing_params(
         half - (h.led_pcb.outer_diameter_mm / 2.0 + c),
         "around the LED PCB seat",
     );
-    wall(
-        errs,
-        "housing.diffuser.outer_diameter_mm",
-        h.diffuser.outer_diameter_mm,
-        half - (h.diffuser.outer_diameter_mm / 2.0 + c),
-        "around the diffuser seat",
-    );
+    if h.style == HousingStyle::SquareSplit {
+        wall(
+            errs,
+            "housing.diffuser.outer_diameter_mm",
+            h.diffuser.outer_diameter_mm,
+            half - (h.diffuser.outer_diameter_mm / 2.0 + c),
+            "around the diffuser seat",
+        );
+    } else if h.diffuser.outer_diameter_mm > h.outer_width_mm {
+        errs.push(ParamError::new(
+            "housing.diffuser.outer_diameter_mm",
+            h.diffuser.outer_diameter_mm,
+            format!(
+                "must not exceed the shell's diameter (housing.outer_width_mm = {}): the disc lies between the tube and the collar",
+                h.outer_width_mm
+            ),
+        ));
+    }
     if let Some(dowels) = fixture_dowel_holes(h) {
         let [dx, dy] = dowels.positions_xy_mm[0];
         let skin_r = design.body.rim_radius_mm(0.0);
@@ -436,11 +451,25 @@ pub fn check_housing_params(
                 format!("must exceed the core's outer diameter ({:.2} mm): the core's rim rests on the diffuser", 2.0 * r_core),
             ));
         }
+        if h.diffuser.inner_diameter_mm >= 2.0 * r_core {
+            errs.push(ParamError::new(
+                "housing.diffuser.inner_diameter_mm",
+                h.diffuser.inner_diameter_mm,
+                format!("must be below the core's outer diameter ({:.2} mm): the core's rim rests on the diffuser", 2.0 * r_core),
+            ));
+        }
         if r_core + c + fdm.min_wall_mm > half {
             errs.push(ParamError::new(
                 "housing.outer_width_mm",
                 h.outer_width_mm,
                 "does not fit around the core",
+            ));
+        }
+        if h.filling_gel.is_some() && !design.body.offset_is_valid(core.inner_offset_mm) {
+            errs.push(ParamError::new(
+                "housing.filling_gel",
+                "given",
+                "needs a hollow core: the core's inner surface (its wall inside the outer surface) folds or vanishes",
             ));
         }
         if core.below_base_mm < 1.0 {
@@ -500,6 +529,17 @@ fn check_round_tube(
                 "leaves a ledge of {ledge:.2} mm under the LED PCB (seat diameter {:.2} mm), below one nozzle width {} mm of printer profile 'fdm'",
                 h.led_pcb.outer_diameter_mm + 2.0 * c,
                 fdm.xy_resolution_mm
+            ),
+        ));
+    }
+    // The LED PCB goes in from the tube's top, down the light chamber.
+    if h.light_chamber_diameter_mm < h.led_pcb.outer_diameter_mm + 2.0 * c {
+        errs.push(ParamError::new(
+            "housing.light_chamber_diameter_mm",
+            h.light_chamber_diameter_mm,
+            format!(
+                "must pass the LED PCB (housing.led_pcb.outer_diameter_mm = {}) with the fit clearance {c} mm: the PCB goes in from the tube's top",
+                h.led_pcb.outer_diameter_mm
             ),
         ));
     }
@@ -567,13 +607,13 @@ fn check_round_tube(
             ),
         ));
     }
-    if js.pilot_depth_mm > t.height_mm - fdm.min_wall_mm {
+    let tube_height = t.height_mm - core.map_or(0.0, |k| k.below_base_mm) - h.diffuser.thickness_mm;
+    if js.pilot_depth_mm > tube_height - fdm.min_wall_mm {
         errs.push(ParamError::new(
             "housing.joint_screw.pilot_depth_mm",
             js.pilot_depth_mm,
             format!(
-                "runs through the tube's top face (tube height {} mm)",
-                t.height_mm
+                "runs through the tube's top face (tube height {tube_height:.2} mm under the diffuser and the collar)"
             ),
         ));
     }
@@ -651,7 +691,7 @@ fn build_shell_parts(
     }
 }
 
-/// The bores above the camera that both shell styles share, from the LED PCB's level up: the
+/// The square shell's bores above the camera, from the LED PCB's level up: the
 /// PCB pocket, the light chamber, the diffuser's seat and the contact module's seat (radius
 /// `r_core_mm` plus the fit clearance), each overlapping the next by 0.01 mm so that their
 /// union is clean. Sensor frame, mm.
@@ -708,10 +748,17 @@ fn build_round_tube(
     let r_js = round_screw_radius_mm(h, t);
     let screws_xy = [[r_js, 0.0], [-r_js, 0.0]];
 
-    // The tube: stacked bores, each overlapping the next by a hair so the union is clean.
+    // The tube, from its bottom up to the diffuser on its top face: the camera bay, then the
+    // light chamber that the LED PCB goes down (overlapping by a hair so the union is clean).
     let g = |r: Result<Solid, _>| r.part("shell_tube");
-    let mut cut = vec![g(cyl(r_bay, tube_bottom - 1.0, lv.pcb_z_mm + e))?];
-    cut.extend(upper_bores(h, &lv, r_core, tol).part("shell_tube")?);
+    let mut cut = vec![
+        g(cyl(r_bay, tube_bottom - 1.0, lv.pcb_z_mm + e))?,
+        g(cyl(
+            h.light_chamber_diameter_mm / 2.0,
+            lv.pcb_z_mm,
+            lv.diffuser_z_mm + 1.0,
+        ))?,
+    ];
     // Joint screw pilots, up into the tube wall from its bottom.
     let mut pilots = Vec::new();
     for [x, y] in screws_xy {
@@ -723,9 +770,15 @@ fn build_round_tube(
         .map(|p| p.translate([x, y, 0.0])))?);
     }
     cut.push(Solid::compose(&pilots));
-    let tube = g(cyl(r_out, tube_bottom, lv.top_z_mm))?
+    let tube = g(cyl(r_out, tube_bottom, lv.diffuser_z_mm))?
         .difference(&Solid::union_all(&cut).part("shell_tube")?)
         .part("shell_tube")?;
+
+    // The collar on the diffuser: the seat of the core's end below the base plane.
+    let gc = |r: Result<Solid, _>| r.part("shell_collar");
+    let collar = gc(cyl(r_out, lv.seat_z_mm, lv.top_z_mm))?
+        .difference(&gc(cyl(r_core + c, lv.seat_z_mm - 1.0, lv.top_z_mm + 1.0))?)
+        .part("shell_collar")?;
 
     // The base: flange under the tube, spigot into the bay; camera pilots, cable slot and the
     // joint screws' clearance holes.
@@ -802,9 +855,15 @@ fn build_round_tube(
     };
     let parts = vec![
         part(
+            place_posed(&collar, &crate::geometry::rotation_deg(180.0, 0.0, 0.0)),
+            "shell_collar",
+            "Sensor shell: collar on the diffuser disc; the contact module's core seats in it and the skin rests on its top face",
+            "top face down",
+        ),
+        part(
             place_posed(&tube, &crate::geometry::rotation_deg(180.0, 0.0, 0.0)),
             "shell_tube",
-            "Sensor shell: round tube with the contact-module, diffuser and LED PCB seats and the camera bay; the base screws up into its wall",
+            "Sensor shell: round tube with the light chamber, the LED PCB's ledge and the camera bay; the diffuser disc lies on its top face and the base screws up into its wall",
             "top face down",
         ),
         part(
@@ -940,4 +999,59 @@ fn build_square_split(
         ),
     ];
     Ok((parts, lv))
+}
+
+/// The internal filling gel's region (R-Tac0 Sec. III-B1; [`crate::schema::FillingGel`]) as a
+/// closed profile in the (r, z) half-plane of the sensor frame, mm: the inside of the core
+/// down to its open end, the diffuser's opening under it, then the light chamber down to the
+/// LED PCB's face, closed on the axis. The core's inner surface is tessellated as the core's
+/// own (`tol` halved, as in the assembly), so the two share it.
+pub fn filling_gel_profile(
+    design: &Design,
+    h: &HousingParams,
+    core: &ResolvedCore,
+    lv: &ShellLevels,
+    tol: ChordTolerance,
+) -> crate::geometry::Polyline2 {
+    let mut pl = design
+        .body
+        .offset_polyline(core.inner_offset_mm, core.below_base_mm, tol.half());
+    let (r_open, r_chamber) = (
+        h.diffuser.inner_diameter_mm / 2.0,
+        h.light_chamber_diameter_mm / 2.0,
+    );
+    for p in [
+        [r_open, lv.seat_z_mm],
+        [r_open, lv.diffuser_z_mm],
+        [r_chamber, lv.diffuser_z_mm],
+        [r_chamber, lv.chamber_z_mm],
+        [0.0, lv.chamber_z_mm],
+    ] {
+        pl.push(p);
+    }
+    pl
+}
+
+/// The filling gel's volume from the exact surfaces, mm^3: the solid inside the core's inner
+/// surface down to its open end, plus the cylinders of the diffuser's opening and of the light
+/// chamber. LEDs and wires inside the chamber are not subtracted (about 60 mm^3 for eight
+/// 2835 LEDs, covered by the pour's waste allowance).
+pub fn filling_gel_volume_mm3(
+    design: &Design,
+    h: &HousingParams,
+    core: &ResolvedCore,
+    lv: &ShellLevels,
+) -> f64 {
+    let disc = |d: f64, height: f64| std::f64::consts::PI * d * d / 4.0 * height;
+    design
+        .body
+        .analytic_solid_volume_mm3(core.inner_offset_mm, core.below_base_mm)
+        + disc(
+            h.diffuser.inner_diameter_mm,
+            lv.seat_z_mm - lv.diffuser_z_mm,
+        )
+        + disc(
+            h.light_chamber_diameter_mm,
+            lv.diffuser_z_mm - lv.chamber_z_mm,
+        )
 }

@@ -26,6 +26,10 @@ pub struct ClampBolts {
 
 /// ISO 4032 hexagon nut height, as a fraction of the nominal diameter.
 const NUT_HEIGHT_PER_D: f64 = 0.8;
+
+/// The cast name of the internal filling gel ([`crate::schema::FillingGel`]): poured during the
+/// assembly, not in a mold.
+pub const FILLING_GEL: &str = "filling_gel";
 /// Thread left beyond the nut, mm.
 const BOLT_PROTRUSION_MM: f64 = 1.0;
 
@@ -171,6 +175,10 @@ pub fn procedure(
         let n = c.step;
         if c.cast.starts_with("silicone_mold:") {
             mold_star_steps(&mut out, design, parts, c);
+            continue;
+        }
+        if c.cast == FILLING_GEL {
+            // poured into the assembled shell: among the assembly steps
             continue;
         }
         let holder = with_role(parts, &c.mold_parts, &["core_holder", "casting_jig"]);
@@ -347,9 +355,8 @@ pub fn procedure(
         };
         out.push(step(A::Demold, text));
     }
-    for text in assembly_steps(design, parts, core_mounted) {
-        out.push(step(A::Assemble, format!("Assemble: {text}")));
-    }
+    let filling = casts.iter().find(|c| c.cast == FILLING_GEL);
+    out.extend(assembly_steps(design, parts, core_mounted, filling));
     out
 }
 
@@ -500,8 +507,14 @@ fn cure_text(notes: &str) -> String {
 /// bonding (core into the skin, skin onto its backing), then the shell from the inside out:
 /// LED PCB, diffuser, contact module, camera, the shell joined (R-Tac0 Sec. III-B2..B4;
 /// UVDtact Sec. III; ShadowTac Sec. III).
-fn assembly_steps(design: &Design, parts: &[Part], cast_on_core: bool) -> Vec<String> {
+fn assembly_steps(
+    design: &Design,
+    parts: &[Part],
+    cast_on_core: bool,
+    filling: Option<&CastReport>,
+) -> Vec<ProcedureStep> {
     let mut out: Vec<String> = Vec::new();
+    let mut filled = None;
     let cast = design
         .layers
         .iter()
@@ -535,29 +548,60 @@ fn assembly_steps(design: &Design, parts: &[Part], cast_on_core: bool) -> Vec<St
         let camera = crate::build::metric_from_pilot(h.camera.mount_pilot_diameter_mm)
             .map_or_else(String::new, |d| format!(" M{d}"));
         let tube = named("shell_tube");
+        let collar = named("shell_collar");
         let base = named("shell_base");
         let halves = named("shell_half");
-        let (into, module_seat) = match (tube.first(), halves.first()) {
-            (Some(t), _) => (
-                t.clone(),
-                format!("the contact-module seat at the top of {t}"),
-            ),
-            (None, Some(a)) => (a.clone(), format!("the contact-module seat of {a}")),
-            (None, None) => ("the shell".into(), "its seat".into()),
-        };
-        out.push(format!(
-            "Press the LED ring PCB ({} LEDs, facing up) into its seat in {into} (R-Tac0 \
-             Sec. III-B2: press-fitted), its wires down through the camera bay.",
-            h.led_pcb.led_count
-        ));
-        out.push(format!(
-            "Lay the diffuser ring into its seat, {:.1} mm above the PCB.",
-            h.diffuser.gap_above_pcb_mm
-        ));
-        out.push(format!(
-            "Push the contact module (the core with its layers) into {module_seat} until its \
-             rim rests on the diffuser."
-        ));
+        match (tube.first(), collar.first(), halves.first()) {
+            (Some(t), Some(k), _) => {
+                out.push(format!(
+                    "Drop the LED ring PCB ({} LEDs, facing up) down the light chamber of {t} \
+                     onto the ledge above the camera bay (R-Tac0 Sec. III-B2: press-fitted), \
+                     its wires down through the bay.",
+                    h.led_pcb.led_count
+                ));
+                out.push(format!(
+                    "Glue the diffuser disc onto the top face of {t} with cyanoacrylate gel, \
+                     {:.1} mm above the PCB and centred on the chamber; then glue {k} onto the \
+                     diffuser, flush with the tube's outside.",
+                    h.diffuser.gap_above_pcb_mm
+                ));
+                out.push(format!(
+                    "Push the contact module (the core with its layers) into {k} until the \
+                     core's rim rests on the diffuser's inner edge."
+                ));
+                if let Some(c) = filling {
+                    filled = Some((out.len(), filling_step(c)));
+                }
+            }
+            (t, _, a) => {
+                let (into, module_seat) = match (t, a) {
+                    (Some(t), _) => (
+                        t.clone(),
+                        format!("the contact-module seat at the top of {t}"),
+                    ),
+                    (None, Some(a)) => (a.clone(), format!("the contact-module seat of {a}")),
+                    (None, None) => ("the shell".into(), "its seat".into()),
+                };
+                out.push(format!(
+                    "Press the LED ring PCB ({} LEDs, facing up) into its seat in {into} \
+                     (R-Tac0 Sec. III-B2: press-fitted), its wires down through the camera bay.",
+                    h.led_pcb.led_count
+                ));
+                out.push(format!(
+                    "Lay the diffuser ring into its seat, {:.1} mm above the PCB.",
+                    h.diffuser.gap_above_pcb_mm
+                ));
+                out.push(format!(
+                    "Push the contact module (the core with its layers) into {module_seat} \
+                     until its rim rests on the diffuser."
+                ));
+            }
+        }
+        let into = tube
+            .first()
+            .or(halves.first())
+            .cloned()
+            .unwrap_or_else(|| "the shell".into());
         match (base.first(), halves.get(1)) {
             (Some(b), _) => {
                 out.push(format!(
@@ -575,6 +619,9 @@ fn assembly_steps(design: &Design, parts: &[Part], cast_on_core: bool) -> Vec<St
                 out.push(format!(
                     "Close {b} onto {into} and join the halves with {joint} across them."
                 ));
+                if let Some(c) = filling {
+                    filled = Some((out.len(), filling_step(c)));
+                }
                 out.push(format!(
                     "Screw the camera board up against the bulkhead with 4 self-tapping \
                      screws{camera} ({:.1} mm pilots), lens through the lens hole.",
@@ -584,7 +631,7 @@ fn assembly_steps(design: &Design, parts: &[Part], cast_on_core: bool) -> Vec<St
             _ => {}
         }
     }
-    if out.is_empty() {
+    if out.is_empty() && filled.is_none() {
         out.push(if parts.iter().any(|p| p.role == "printed_skin") {
             "Nothing to put together: the printed skin comes off the printer with its marker \
              tips in place."
@@ -593,5 +640,32 @@ fn assembly_steps(design: &Design, parts: &[Part], cast_on_core: bool) -> Vec<St
             "Put the printed parts and the bought items together.".into()
         });
     }
-    out
+    let mut steps: Vec<ProcedureStep> = out
+        .into_iter()
+        .map(|t| step(ProcedureAction::Assemble, format!("Assemble: {t}")))
+        .collect();
+    // the filling gel's pour goes in after the assembly step it follows
+    if let Some((at, s)) = filled {
+        steps.insert(at, s);
+    }
+    steps
+}
+
+/// The filling gel's pour and cure, with the sensor pole-down and the camera not yet on
+/// (R-Tac0 Sec. III-B1).
+fn filling_step(c: &CastReport) -> ProcedureStep {
+    step(
+        ProcedureAction::Pour,
+        format!(
+            "Step {}: stand the shell pole-down (the contact module in its seat, the camera not \
+             yet on), mix and degas {} and pour it through the LED PCB's bore until it wets \
+             the PCB's underside all round ({:.2} mL to fill): it fills the core, the diffuser's \
+             opening and the light chamber and glues the core to the shell (R-Tac0 \
+             Sec. III-B1). Let it cure ({}) before the camera goes on.",
+            c.step,
+            mix_text(c),
+            c.layer_volume_ml.unwrap_or(c.cavity_volume_ml),
+            cure_text(&c.notes)
+        ),
+    )
 }

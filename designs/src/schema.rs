@@ -461,10 +461,14 @@ pub struct HousingParams {
     pub bulkhead_thickness_mm: f64,
     pub led_pcb: LedPcb,
     pub diffuser: Diffuser,
-    /// Diameter of the light chamber between the LED PCB and the diffuser, mm.
+    /// Diameter of the light chamber between the LED PCB and the diffuser, mm (`round_tube`:
+    /// at least the LED PCB's seat, since the PCB goes in through it).
     pub light_chamber_diameter_mm: f64,
     /// Radial clearance around seated parts, mm.
     pub fit_clearance_mm: f64,
+    /// The internal filling gel, cast into the assembled shell; none when not given.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub filling_gel: Option<FillingGel>,
     pub joint_screw: JointScrew,
 }
 
@@ -483,15 +487,17 @@ pub enum HousingStyle {
     SquareSplit,
 }
 
-/// The round tube and its base (`housing.style: round_tube`). The inner seats are those of
-/// every style (contact module, diffuser, light chamber, LED PCB); below the LED PCB the tube
-/// is bored out to `bay_diameter_mm`, and the PCB rests on the ledge this leaves. The base is a
-/// flange under the tube (as thick as `joint_screw.clamp_length_mm`) with a spigot that enters
-/// the bay; the camera board is screwed onto the spigot.
+/// The round shell (`housing.style: round_tube`), from the top down: a collar that takes the
+/// core's end below the base plane, the diffuser disc, the tube (light chamber, LED PCB, camera
+/// bay) and the base. Below the LED PCB the tube is bored out to `bay_diameter_mm`, and the PCB
+/// rests on the ledge this leaves; the light chamber above is wide enough for the PCB to go in
+/// from the tube's top. The base is a flange under the tube (as thick as
+/// `joint_screw.clamp_length_mm`) with a spigot that enters the bay; the camera board is
+/// screwed onto the spigot.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RoundTube {
-    /// Height of the tube from its bottom to the base plane, mm, > 0.
+    /// Height from the tube's bottom to the base plane (tube, diffuser and collar), mm, > 0.
     pub height_mm: f64,
     /// Bore of the camera bay under the LED PCB, mm; smaller than the LED PCB seat.
     pub bay_diameter_mm: f64,
@@ -527,6 +533,20 @@ pub struct LedPcb {
     pub led_count: u32,
 }
 
+/// The internal filling gel (R-Tac0 Sec. III-B1): poured into the assembled shell with the
+/// sensor pole-down, before the camera goes on. It fills the core, the diffuser's opening and
+/// the light chamber up to the LED PCB's face, which is the flat window the camera looks
+/// through; it diffuses the LEDs' light and, cured, glues the core to the shell.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FillingGel {
+    /// Material key in the materials table; a cast material (R-Tac0: `solaris`).
+    pub material: String,
+}
+
+/// The laser-cut diffuser (R-Tac0 Sec. III-B2): a ring whose inner edge carries the core's rim.
+/// `round_tube`: a disc between the tube's top face and the collar, at most the shell's
+/// diameter; `square_split`: a ring in a seat inside the shell.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Diffuser {

@@ -190,6 +190,13 @@ pub fn validate(
             &h.material,
             &[MaterialKind::Print],
         );
+        if let Some(f) = &h.filling_gel {
+            check_material(
+                "housing.filling_gel.material".into(),
+                &f.material,
+                &[MaterialKind::Cast],
+            );
+        }
     }
 
     if design.layers.is_empty() {

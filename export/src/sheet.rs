@@ -439,7 +439,7 @@ fn fit_checks(m: &Manifest) -> Vec<&'static str> {
             "core holders and casting jigs: the core slides onto the centring pin without play",
         );
     }
-    if count("shell_tube") + count("shell_base") + count("shell_half") > 0 {
+    if count("shell_collar") + count("shell_tube") + count("shell_base") + count("shell_half") > 0 {
         out.push("shell: the parts fit together and their screw holes line up");
     }
     out

@@ -194,11 +194,20 @@ def rtac0(fabkit, work):
     v = sensor_vertices(d, tube)
     row("R-Tac0", "shell: round tube, outer diameter", "30.000 mm",
         2 * float(np.hypot(v[:, 0], v[:, 1]).max()), "{:.3f} mm", 2e-3, 30.0)
-    row("R-Tac0", "shell tube height", "21.650 mm", float(np.ptp(v[:, 2])), "{:.3f} mm", 1e-3, 21.65)
+    collar = part(m, "shell_collar")
+    cv = sensor_vertices(d, collar)
+    row("R-Tac0", "shell height (collar, diffuser disc, tube)", "21.650 mm",
+        float(cv[:, 2].max() - v[:, 2].min()), "{:.3f} mm", 1e-3, 21.65)
     base = part(m, "shell_base")
     row("R-Tac0", "shell material (tube + base)", "6,009 mm3",
-        f"{tube['volume_mm3'] + base['volume_mm3']:,.0f} mm3 (tube {tube['volume_mm3']:,.0f})", "{}",
-        note="differs: the tube's bay and seats and the base are fabkit's own")
+        f"{tube['volume_mm3'] + collar['volume_mm3'] + base['volume_mm3']:,.0f} mm3 "
+        f"(tube {tube['volume_mm3']:,.0f}, collar {collar['volume_mm3']:,.0f})", "{}",
+        note="differs: the tube's bay and chamber, the collar and the base are fabkit's own")
+    cut = next(c for c in m["cut_parts"] if c["name"] == "diffuser")
+    row("R-Tac0", "diffuser disc (laser-cut)", "30 x 2 mm, 19.6 mm opening",
+        f"{cut['thickness_mm']:g} mm, area {cut['area_mm2']:.2f} mm2", "{}")
+    want = np.pi * (15.0 ** 2 - 9.8 ** 2)
+    ROWS[-1] = ROWS[-1][:4] + (bool(abs(cut["area_mm2"] - want) < 1e-6 * want and cut["thickness_mm"] == 2.0),)
     sheet = (d / "FABRICATION.md").read_text()
     ok = "| `translucent_gel` | Smooth-On Ecoflex 00-30 | cast | 1.400 | R14.900 |" in sheet and \
         "| `black_coating` | Yonglihua PTG-501 black mill-resistant coating mixture | sprayed | 0.100 | R15.000 |" in sheet

@@ -29,7 +29,7 @@ fn rel_close(a: f64, b: f64, rel: f64, what: &str) {
 }
 
 /// Every part of the sensor in the sensor frame: the printed shell turned back from its print
-/// pose (the tube's top face on the base plane z = -6 mm, 30 mm across), the cast layers and
+/// pose (the collar's top face on the base plane z = -6 mm, 30 mm across), the cast layers and
 /// the bought envelopes with their analytic volumes (hemisphere of radius r on a 6 mm cylinder
 /// down to the base plane; the tube continues 3 mm below it).
 #[test]
@@ -39,19 +39,28 @@ fn rtac0_members_are_in_the_sensor_frame_with_their_volumes() {
     assert_eq!(
         names,
         [
+            ("shell_collar", MemberKind::Printed),
             ("shell_tube", MemberKind::Printed),
             ("shell_base", MemberKind::Printed),
             ("transparent_gel", MemberKind::Cast),
             ("translucent_gel", MemberKind::Cast),
             ("black_coating", MemberKind::Cast),
             ("core_envelope", MemberKind::Bought),
+            ("filling_gel", MemberKind::Cast),
             ("camera_board_envelope", MemberKind::Bought),
             ("led_pcb_envelope", MemberKind::Bought),
             ("diffuser_envelope", MemberKind::Bought),
         ]
     );
+    // the collar from the base plane down to the diffuser (3 mm), the 2 mm diffuser disc, then
+    // the tube
+    let collar = member(a, "shell_collar").solid.bounding_box().unwrap();
+    assert!(
+        (collar.max[2] - -6.0).abs() < 1e-9 && (collar.min[2] - -9.0).abs() < 1e-9,
+        "{collar:?}"
+    );
     let tube = member(a, "shell_tube").solid.bounding_box().unwrap();
-    assert!((tube.max[2] - -6.0).abs() < 1e-9, "{tube:?}");
+    assert!((tube.max[2] - -11.0).abs() < 1e-9, "{tube:?}");
     assert!((tube.max[0] - 15.0).abs() < 1e-6 && (tube.min[0] + 15.0).abs() < 1e-6);
     let printed = rtac0()
         .parts
@@ -80,9 +89,34 @@ fn rtac0_members_are_in_the_sensor_frame_with_their_volumes() {
         };
         rel_close(member(a, name).solid.volume(), v, 2.0 * 0.01 / wall, name);
     }
-    // the camera board: 15 mm square, 4 mm of board and components, on the base's spigot
+    // the camera board: 15 mm square, 3 mm of board and components, on the base's spigot
     let board = member(a, "camera_board_envelope").solid.volume();
-    rel_close(board, 15.0 * 15.0 * 4.0, 1e-9, "camera board");
+    rel_close(board, 15.0 * 15.0 * 3.0, 1e-9, "camera board");
+    // rings of 3 mm (collar: 30 mm across, bored to the core's 20 mm + 2 x 0.2 mm) and of 2 mm
+    // (the diffuser disc, 30 mm with its 19.6 mm opening, authors' CAD, measured); the
+    // inscribed bore's polygon adds at most 2 x 0.01 / 4.8 of the collar's volume
+    let ring = |ro: f64, ri: f64, h: f64| PI * (ro * ro - ri * ri) * h;
+    rel_close(
+        member(a, "shell_collar").solid.volume(),
+        ring(15.0, 10.2, 3.0),
+        2.0 * 0.01 / 4.8,
+        "collar",
+    );
+    // the filling gel (R-Tac0 Sec. III-B1): the core's inside (radius 9 mm, hemisphere on
+    // 6 + 3 mm of cylinder), the diffuser's opening (9.8 mm, 2 mm) and the light chamber
+    // (11.7 mm, 10 mm down to the LED PCB)
+    rel_close(
+        member(a, "filling_gel").solid.volume(),
+        shell(0.0, 9.0, 3.0) + ring(9.8, 0.0, 2.0) + ring(11.7, 0.0, 10.0),
+        2.0 * 0.01 / 9.0,
+        "filling gel",
+    );
+    rel_close(
+        member(a, "diffuser_envelope").solid.volume(),
+        ring(15.0, 9.8, 2.0),
+        2.0 * 0.01 / 5.2,
+        "diffuser",
+    );
 }
 
 /// Parts that are designed to touch (the skin's base on the shell's top face, the tube's rim
@@ -114,21 +148,23 @@ fn each_broken_fit_is_one_named_interference() {
     // the board 1 mm up into the LED PCB: the board's square less the PCB's 7.5 mm bore, over
     // the 0.95 mm the board now reaches past the PCB's underside (0.05 mm gap)
     let board_into_pcb = (225.0 - PI * 7.5 * 7.5) * 0.95;
-    // the tube 0.5 mm down into the diffuser ring (11.5 / 6 mm radii): the tube's wall ring
-    // (9 to 10 mm) over the diffuser
-    let tube_into_diffuser = PI * (10.0f64.powi(2) - 9.0f64.powi(2)) * 0.5;
-    for (name, dz, other, v) in [
+    // the collar 0.5 mm down into the diffuser disc (15 / 9.8 mm radii): the collar's ring
+    // (10.2 to 15 mm) over the disc
+    let collar_into_diffuser = PI * (15.0f64.powi(2) - 10.2f64.powi(2)) * 0.5;
+    for (name, dz, other, v, rel) in [
         (
             "camera_board_envelope",
             1.0,
             "led_pcb_envelope",
             board_into_pcb,
+            0.01,
         ),
         (
-            "core_envelope",
+            "shell_collar",
             -0.5,
             "diffuser_envelope",
-            tube_into_diffuser,
+            collar_into_diffuser,
+            0.01,
         ),
     ] {
         let found = interferences(&moved(name, dz), tol()).unwrap();
@@ -138,7 +174,7 @@ fn each_broken_fit_is_one_named_interference() {
             found.len() == 1 && one.is_some_and(|f| f.a == other || f.b == other),
             "{name}: {pairs:?}"
         );
-        rel_close(found[0].volume_mm3, v, 0.01, name);
+        rel_close(found[0].volume_mm3, v, rel, name);
         let e = fit_errors(&fabkit_designs::library::load("rtac0").unwrap(), &found)
             .unwrap()
             .to_string();

@@ -183,6 +183,15 @@ fn single_mutations() -> Vec<Mutation> {
             },
         ),
         (
+            "printing filament as the filling gel",
+            |d| housing(d).filling_gel.as_mut().unwrap().material = "pla".into(),
+            Expect {
+                path: "housing.filling_gel.material",
+                value: "pla",
+                rule: &["is a Print material", "expected one of [Cast]"],
+            },
+        ),
+        (
             "negative core wall",
             |d| d.core.as_mut().unwrap().wall_thickness_mm = -1.0,
             Expect {
@@ -201,12 +210,12 @@ fn single_mutations() -> Vec<Mutation> {
             },
         ),
         (
-            "diffuser wider than the shell allows",
-            |d| housing(d).diffuser.outer_diameter_mm = 29.5,
+            "diffuser wider than the shell",
+            |d| housing(d).diffuser.outer_diameter_mm = 30.5,
             Expect {
                 path: "housing.diffuser.outer_diameter_mm",
-                value: "29.5",
-                rule: &["0.05 mm of wall", "around the diffuser seat", "minimum wall 0.8 mm"],
+                value: "30.5",
+                rule: &["must not exceed the shell's diameter", "outer_width_mm = 30", "between the tube and the collar"],
             },
         ),
         (
@@ -682,9 +691,23 @@ fn param_error_displays_as_path_value_rule() {
 // ---------------------------------------------------------------------------------------------
 // The shell arrangements.
 
-/// The square split shell keeps its own rule on the camera bay wall.
+/// The square split shell keeps its own rules on the camera bay's and the diffuser seat's walls.
 #[test]
 fn square_split_camera_board_wider_than_the_shell_allows() {
+    let mut d = square_split();
+    housing(&mut d).diffuser.outer_diameter_mm = 29.5;
+    assert_exactly(
+        &errors(&d),
+        &[&Expect {
+            path: "housing.diffuser.outer_diameter_mm",
+            value: "29.5",
+            rule: &[
+                "0.05 mm of wall",
+                "around the diffuser seat",
+                "minimum wall 0.8 mm",
+            ],
+        }],
+    );
     let mut d = square_split();
     housing(&mut d).camera.board_width_mm = 29.0;
     assert_exactly(
@@ -718,8 +741,9 @@ fn round_tube_without_its_parameters_is_named() {
 
 /// A bay wider than the LED PCB seat leaves no ledge under the PCB and too thin a wall for the
 /// base screws' pilots (both named on the bay diameter), and moves the screws out so far that
-/// their heads pass the outline. A short tube leaves no room for the
-/// camera; a non-positive spigot is named on its own.
+/// their heads pass the outline. A short tube leaves no room for the camera; a light chamber
+/// narrower than the LED PCB's seat does not let the PCB in from the top; a diffuser opening as
+/// wide as the core lets the core through; a non-positive spigot is named on its own.
 #[test]
 fn round_tube_rules_name_their_parameters() {
     let mut d = baseline();
@@ -753,8 +777,37 @@ fn round_tube_rules_name_their_parameters() {
             path: "housing.round_tube.height_mm",
             value: "19",
             rule: &[
-                "leaves 1.40 mm between the base and the LED PCB",
-                "bay_height_mm = 4",
+                "leaves 0.40 mm between the base and the LED PCB",
+                "bay_height_mm = 3",
+            ],
+        }],
+    );
+    // The LED PCB goes in from the tube's top, down the light chamber.
+    let mut d = baseline();
+    housing(&mut d).light_chamber_diameter_mm = 23.0;
+    assert_exactly(
+        &errors(&d),
+        &[&Expect {
+            path: "housing.light_chamber_diameter_mm",
+            value: "23",
+            rule: &[
+                "must pass the LED PCB",
+                "outer_diameter_mm = 23",
+                "fit clearance 0.2 mm",
+            ],
+        }],
+    );
+    // The core's rim rests on the diffuser's inner edge.
+    let mut d = baseline();
+    housing(&mut d).diffuser.inner_diameter_mm = 20.0;
+    assert_exactly(
+        &errors(&d),
+        &[&Expect {
+            path: "housing.diffuser.inner_diameter_mm",
+            value: "20",
+            rule: &[
+                "below the core's outer diameter (20.00 mm)",
+                "rests on the diffuser",
             ],
         }],
     );

@@ -314,9 +314,44 @@ fn rtac0_sheet_states_volumes_coats_treatments_and_the_procedure() {
             A::Assemble,
             A::Assemble,
             A::Assemble,
+            A::Pour,
             A::Assemble,
             A::Assemble,
         ]
+    );
+    // the filling gel (R-Tac0 Sec. III-B1), poured into the assembled shell: the core's inside
+    // (radius 9 mm: hemisphere on 6 + 3 mm of cylinder), the diffuser's opening (radius 9.8 mm,
+    // 2 mm) and the light chamber (radius 11.7 mm, 10 mm); Solaris 1.02 g/cm3, 1:1 by weight,
+    // 20 % waste
+    let gel = cast(&e, "filling_gel");
+    let v_ml = (2.0 / 3.0 * PI * 9.0f64.powi(3)
+        + PI * 81.0 * 9.0
+        + PI * 9.8 * 9.8 * 2.0
+        + PI * 11.7 * 11.7 * 10.0)
+        / 1000.0;
+    close(
+        gel["layer_volume_ml"].as_f64().unwrap(),
+        v_ml,
+        1e-9,
+        "filling gel",
+    );
+    close(
+        gel["total_mass_g"].as_f64().unwrap(),
+        v_ml * 1.02 * 1.2,
+        1e-9,
+        "filling gel mass",
+    );
+    assert_eq!(gel["material"], "solaris");
+    let pour = arr(&e.manifest, "procedure")
+        .iter()
+        .rfind(|p| p["action"] == "pour")
+        .unwrap()["text"]
+        .as_str()
+        .unwrap();
+    assert!(
+        pour.contains(&format!("{v_ml:.2} mL to fill"))
+            && pour.contains("before the camera goes on"),
+        "{pour}"
     );
     // the assembly order, with the screws at each step
     let steps: Vec<&str> = arr(&e.manifest, "procedure")
@@ -324,15 +359,24 @@ fn rtac0_sheet_states_volumes_coats_treatments_and_the_procedure() {
         .filter(|p| p["action"] == "assemble")
         .map(|p| p["text"].as_str().unwrap())
         .collect();
-    for (step, words) in steps.iter().zip([
-        ["LED ring PCB", "`shell_tube`"],
-        ["diffuser ring", "10.0 mm above the PCB"],
-        ["contact module", "rests on the diffuser"],
-        [
+    assert_eq!(steps.len(), 5, "{steps:?}");
+    for (step, words) in steps.iter().zip::<[&[&str]; 5]>([
+        &["LED ring PCB", "down the light chamber of `shell_tube`"],
+        &[
+            "diffuser disc onto the top face of `shell_tube`",
+            "10.0 mm above the PCB",
+            "then glue `shell_collar`",
+        ],
+        &[
+            "contact module",
+            "into `shell_collar`",
+            "rests on the diffuser's inner edge",
+        ],
+        &[
             "camera board onto the spigot of `shell_base`",
             "4 self-tapping screws M2 (1.6 mm pilots)",
         ],
-        [
+        &[
             "`shell_base` under `shell_tube`",
             "the 2 joint screws M2 x 6",
         ],
@@ -409,6 +453,7 @@ fn rtac0_direct_sheet_names_the_clamp_bolts_and_the_sprue() {
             A::Assemble,
             A::Assemble,
             A::Assemble,
+            A::Pour,
             A::Assemble,
             A::Assemble,
         ]
@@ -534,6 +579,7 @@ fn rtac0_assembly_3mf_holds_every_member_in_the_sensor_frame() {
         .collect();
     assert_eq!(names, listed);
     for name in [
+        "shell_collar",
         "shell_tube",
         "shell_base",
         "transparent_gel",
@@ -566,14 +612,12 @@ fn rtac0_assembly_3mf_holds_every_member_in_the_sensor_frame() {
             );
         }
     }
-    // the shell's top face is the base plane, z = -6 mm, in the sensor frame
-    let tube = members.iter().find(|m| m["name"] == "shell_tube").unwrap();
-    close(
-        tube["bbox_mm"]["max"][2].as_f64().unwrap(),
-        -6.0,
-        1e-6,
-        "tube top",
-    );
+    // the shell's top face (the collar's) is the base plane, z = -6 mm, in the sensor frame;
+    // the tube's top face is 5 mm under it (3 mm collar, 2 mm diffuser disc)
+    for (name, top) in [("shell_collar", -6.0), ("shell_tube", -11.0)] {
+        let p = members.iter().find(|m| m["name"] == name).unwrap();
+        close(p["bbox_mm"]["max"][2].as_f64().unwrap(), top, 1e-6, name);
+    }
     assert!(members
         .iter()
         .filter(|m| m["kind"] == "bought")
@@ -583,7 +627,7 @@ fn rtac0_assembly_3mf_holds_every_member_in_the_sensor_frame() {
 /// `section.png` cuts the assembled sensor through its axis: each member's colour covers its
 /// section's area (R-Tac0's transparent gel: two quarter annuli of radii 10 and 13.5 mm on
 /// 3.5 x 6 mm rectangles; the tube's envelope likewise with radii 9 and 10 mm, 9 mm down; the
-/// camera board 15 x 4 mm), both in the legend (from the outline) and in the pixels.
+/// camera board 15 x 3 mm; the diffuser disc, two 5.2 x 2 mm rectangles), both in the legend (from the outline) and in the pixels.
 #[test]
 fn rtac0_section_view_shows_each_member_with_its_section_area() {
     let (e, [_, png_bytes]) = export_as("rtac0", None, false);
@@ -609,7 +653,8 @@ fn rtac0_section_view_shows_each_member_with_its_section_area() {
     for (name, area) in [
         ("transparent_gel", quarter(10.0, 13.5, 0.0)),
         ("core_envelope", quarter(9.0, 10.0, 3.0)),
-        ("camera_board_envelope", 15.0 * 4.0),
+        ("camera_board_envelope", 15.0 * 3.0),
+        ("diffuser_envelope", 2.0 * (15.0 - 9.8) * 2.0),
     ] {
         let l = arr(v, "legend").iter().find(|l| l["name"] == name).unwrap();
         close(l["area_mm2"].as_f64().unwrap(), area, 0.002 * area, name);
