@@ -607,6 +607,25 @@ fn check_round_tube(
             ),
         ));
     }
+    // Above the PCB's level the tube is bored out to the light chamber: a pilot that reaches
+    // up there needs its wall to the chamber too.
+    let pilot_top = t.height_mm - js.pilot_depth_mm;
+    let pcb_below_top = core.map_or(0.0, |k| k.below_base_mm)
+        + h.diffuser.thickness_mm
+        + h.diffuser.gap_above_pcb_mm
+        + h.led_pcb.thickness_mm;
+    let to_chamber = r_js - js.pilot_diameter_mm / 2.0 - h.light_chamber_diameter_mm / 2.0;
+    if pilot_top < pcb_below_top && to_chamber < fdm.min_wall_mm {
+        errs.push(ParamError::new(
+            "housing.joint_screw.pilot_depth_mm",
+            js.pilot_depth_mm,
+            format!(
+                "reaches {:.2} mm above the LED PCB's underside, where {to_chamber:.2} mm of wall is left to the light chamber, below the minimum wall {} mm of printer profile 'fdm'",
+                pcb_below_top - pilot_top,
+                fdm.min_wall_mm
+            ),
+        ));
+    }
     let tube_height = t.height_mm - core.map_or(0.0, |k| k.below_base_mm) - h.diffuser.thickness_mm;
     if js.pilot_depth_mm > tube_height - fdm.min_wall_mm {
         errs.push(ParamError::new(

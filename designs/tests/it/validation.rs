@@ -771,16 +771,25 @@ fn round_tube_rules_name_their_parameters() {
     );
     let mut d = baseline();
     housing(&mut d).round_tube.as_mut().unwrap().height_mm = 19.0;
+    // (and the base's screw pilots, 5 mm up from the tube's bottom, now reach beside the light
+    // chamber)
     assert_exactly(
         &errors(&d),
-        &[&Expect {
-            path: "housing.round_tube.height_mm",
-            value: "19",
-            rule: &[
-                "leaves 0.40 mm between the base and the LED PCB",
-                "bay_height_mm = 3",
-            ],
-        }],
+        &[
+            &Expect {
+                path: "housing.round_tube.height_mm",
+                value: "19",
+                rule: &[
+                    "leaves 0.40 mm between the base and the LED PCB",
+                    "bay_height_mm = 3",
+                ],
+            },
+            &Expect {
+                path: "housing.joint_screw.pilot_depth_mm",
+                value: "5",
+                rule: &["reaches 2.60 mm above the LED PCB's underside"],
+            },
+        ],
     );
     // The LED PCB goes in from the tube's top, down the light chamber.
     let mut d = baseline();
@@ -794,6 +803,21 @@ fn round_tube_rules_name_their_parameters() {
                 "must pass the LED PCB",
                 "outer_diameter_mm = 23",
                 "fit clearance 0.2 mm",
+            ],
+        }],
+    );
+    // A pilot that reaches up beside the light chamber needs its wall there too.
+    let mut d = baseline();
+    housing(&mut d).joint_screw.pilot_depth_mm = 6.0;
+    assert_exactly(
+        &errors(&d),
+        &[&Expect {
+            path: "housing.joint_screw.pilot_depth_mm",
+            value: "6",
+            rule: &[
+                "reaches 0.95 mm above the LED PCB's underside",
+                "0.60 mm of wall is left to the light chamber",
+                "minimum wall 0.8 mm",
             ],
         }],
     );
