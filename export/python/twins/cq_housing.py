@@ -1,6 +1,7 @@
 """CadQuery twin of the sensor shell (R-Tac0 Sec. III-B2..B4, Fig. 2), from the part's manifest
 `params`: levels, housing parameters, seats, joint screws, dowels. Two arrangements: the round
-tube and its camera base (`shell_tube`, `shell_base`), the square split halves (`shell_half`)."""
+tube with its collar and camera base (`shell_collar`, `shell_tube`, `shell_base`), the square
+split halves (`shell_half`)."""
 
 from __future__ import annotations
 
@@ -43,7 +44,7 @@ def shell_half(params: dict, half: str):
 
 
 def _bores(params: dict) -> list:
-    """The seats shared by both arrangements, from the LED PCB seat up to the top face."""
+    """The square shell's seats, from the LED PCB seat up to the top face."""
     lv, h = params["levels"], params["housing"]
     c = h["fit_clearance_mm"]
     e = params["overlap_mm"]
@@ -57,18 +58,30 @@ def _bores(params: dict) -> list:
 
 
 def shell_tube(params: dict):
-    """The round tube: outer cylinder less the camera bay, the seats and the screw pilots."""
+    """The round tube, from its bottom up to the diffuser disc on its top face: outer cylinder
+    less the camera bay, the light chamber (the LED PCB goes down it) and the screw pilots."""
     lv, h = params["levels"], params["housing"]
     e = params["overlap_mm"]
     r = h["outer_width_mm"] / 2.0
-    tb = lv["tube_bottom_z_mm"]
+    tb, dz = lv["tube_bottom_z_mm"], lv["diffuser_z_mm"]
     cyl = C.cylinder_z
-    cuts = [cyl(params["bay_radius_mm"], tb - 1.0, lv["pcb_z_mm"] + e)] + _bores(params)
+    cuts = [cyl(params["bay_radius_mm"], tb - 1.0, lv["pcb_z_mm"] + e),
+            cyl(h["light_chamber_diameter_mm"] / 2.0, lv["pcb_z_mm"], dz + 1.0)]
     js = params["joint_screws"]
     z0, z1 = js["pilot_z_mm"]
     for x, y in js["xy_mm"]:
         cuts.append(cyl(h["joint_screw"]["pilot_diameter_mm"] / 2.0, z0, z1, x, y))
-    return C.cut(cyl(r, tb, lv["top_z_mm"]), cuts)
+    return C.cut(cyl(r, tb, dz), cuts)
+
+
+def shell_collar(params: dict):
+    """The collar on the diffuser disc: a ring from the disc up to the base plane, bored to the
+    core's seat."""
+    lv, h = params["levels"], params["housing"]
+    r = h["outer_width_mm"] / 2.0
+    seat, top = lv["seat_z_mm"], lv["top_z_mm"]
+    cyl = C.cylinder_z
+    return C.cut(cyl(r, seat, top), [cyl(params["core_seat_radius_mm"], seat - 1.0, top + 1.0)])
 
 
 def shell_base(params: dict):

@@ -39,6 +39,8 @@ def _build_sensor(part: dict):
         s = cq_housing.shell_half(p, name.rsplit("_", 1)[1])
     elif role == "shell_tube":
         s = cq_housing.shell_tube(p)
+    elif role == "shell_collar":
+        s = cq_housing.shell_collar(p)
     elif role == "shell_base":
         s = cq_housing.shell_base(p)
     elif role == "indenter":

@@ -19,7 +19,7 @@ def family(part: dict) -> str:
         return "layer shells"
     if role == "marker_tips":
         return "pin tips"
-    if role in ("shell_half", "shell_tube", "shell_base"):
+    if role in ("shell_half", "shell_collar", "shell_tube", "shell_base"):
         return "housings"
     if role == "indenter":
         return "indenters"
