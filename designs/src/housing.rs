@@ -54,7 +54,9 @@ pub struct ShellLevels {
     pub envelope_height_mm: f64,
 }
 
-fn levels(design: &Design, h: &HousingParams, core: &ResolvedCore) -> ShellLevels {
+/// The shell's z levels for `design` with its housing `h` and resolved core (sensor frame, mm):
+/// what fixtures that hold the sensor (the pin dome's holder ring) are sized from.
+pub fn levels(design: &Design, h: &HousingParams, core: &ResolvedCore) -> ShellLevels {
     let top = design.body.base_z_mm();
     let seat = top - core.below_base_mm;
     let diffuser = seat - h.diffuser.thickness_mm;
@@ -99,11 +101,11 @@ fn round_tube(h: &HousingParams) -> Option<&RoundTube> {
 
 /// Cable slot through the round tube's base, under the camera board: 2 x 12 mm, long along y.
 /// ASSUMPTION: the camera's flat cable is at most 11 mm wide (measure yours).
-const CABLE_SLOT_XY_MM: [f64; 2] = [2.0, 12.0];
+pub const CABLE_SLOT_XY_MM: [f64; 2] = [2.0, 12.0];
 
 /// Radius of the round tube's joint screws (parallel to z, at azimuths 0 and 180 deg): the
 /// middle of the tube wall around the camera bay, mm.
-fn round_screw_radius_mm(h: &HousingParams, t: &RoundTube) -> f64 {
+pub fn round_screw_radius_mm(h: &HousingParams, t: &RoundTube) -> f64 {
     0.5 * (t.bay_diameter_mm / 2.0 + h.outer_width_mm / 2.0)
 }
 

@@ -234,7 +234,9 @@ fn rtac0_fixtures_export_is_complete_deterministic_and_printable() {
         .into_iter()
         .filter(|f| f.extension().is_some_and(|e| e == "stl" || e == "3mf"))
         .collect();
-    assert_eq!(meshes.len(), 2 + 4 + 1 + 1);
+    // dome, pin and the dome's holder ring; holder, empty half and two halves; the indenter;
+    // the 3MF
+    assert_eq!(meshes.len(), 3 + 4 + 1 + 1);
     printcheck_all(&meshes);
 
     // The other papers' indenters, from their own designs' fixtures, slice too.
@@ -291,6 +293,14 @@ fn bad_fixture_parameters_name_the_parameter_and_write_nothing() {
         (
             "pin_dome:\n  base_tabs: {span_mm: 43, width_mm: 6, height_mm: 4, azimuth_deg: 0}\n",
             "pin_dome.keyed_dowels = true",
+        ),
+        (
+            "pin_dome:\n  holder_ring: {outer_diameter_mm: 42.3, floor_thickness_mm: 1, clearance_mm: 0.2}\n",
+            "pin_dome.holder_ring = given: needs pin_dome.base_tabs",
+        ),
+        (
+            "pin_dome:\n  keyed_dowels: false\n  base_tabs: {span_mm: 43, width_mm: 6, height_mm: 4, azimuth_deg: 0}\n  holder_ring: {outer_diameter_mm: 39, floor_thickness_mm: 1, clearance_mm: 0.2}\n",
+            "pin_dome.holder_ring.outer_diameter_mm = 39: leaves 0.40 mm of upstand",
         ),
     ];
     for (yaml, expect) in cases {

@@ -282,6 +282,13 @@ def pin_dome(fabkit, work):
         "the same", "{}")
     ROWS[-1] = ROWS[-1][:4] + (bool(ok),)
 
+    ring = part(m, "pin_dome_ring")
+    rv = sensor_vertices(d, ring)
+    ext = rv.max(axis=0) - rv.min(axis=0)
+    row("R-Tac0 calibration ring", "outer diameter", "42.300 mm", float(max(ext[0], ext[1])),
+        "{:.3f} mm", 2e-3, 42.3, note="the dome's tabs make the authors' 43 mm across")
+    row("R-Tac0 calibration ring", "height", "28.150 mm", float(ext[2]), "{:.3f} mm", 1e-3, 28.15)
+
 
 def tactip(fabkit, work):
     run(fabkit, ["export", "tactip_dualmodal", "--preset", "tactipgenerator_217", "--out",

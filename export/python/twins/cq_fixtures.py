@@ -103,6 +103,27 @@ def pin(params: dict):
     return C.revolve([arc], pts)
 
 
+def pin_dome_ring(params: dict):
+    """The pin dome's holder ring (fixtures/src/ring.rs), sensor frame: the outer cylinder less
+    the bore over the floor, the upstand's bore over the seat, the tab notches, the cable
+    channel and the screw pockets."""
+    r = params["ring"]
+    cyl = C.cylinder_z
+    ro, zb, zf, zs, zt = (r["outer_radius_mm"], r["bottom_z_mm"], r["floor_top_z_mm"],
+                          r["seat_z_mm"], r["top_z_mm"])
+    e = 0.01
+    cuts = [cyl(r["bore_radius_mm"], zf, zt + 1.0), cyl(r["upstand_inner_radius_mm"], zs, zt + 1.0)]
+    w = r["notch_width_mm"] / 2.0
+    for a in r["notch_azimuths_deg"]:
+        cuts.append(C.box([0.0, -w, zs], [ro + 1.0, w, zt + 1.0])
+                    .rotate(cq.Vector(0, 0, 0), cq.Vector(0, 0, 1), a))
+    cw = r["cable_channel_width_mm"] / 2.0
+    cuts.append(C.box([r["cable_channel_start_x_mm"], -cw, zb - 1.0], [ro + 1.0, cw, zf + e]))
+    cuts += [cyl(r["screw_pocket_radius_mm"], zb - 1.0, zf + e, x, y)
+             for x, y in r["screw_pockets_xy_mm"]]
+    return C.cut(cyl(ro, zb, zt), cuts)
+
+
 def semidome_holder(params: dict):
     base = params["base"]
     zt = params["holder_top_z_mm"]

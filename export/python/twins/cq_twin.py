@@ -47,6 +47,8 @@ def _build_sensor(part: dict):
         s = cq_fixtures.indenter(p)
     elif name == "pin_dome":
         s = cq_fixtures.pin_dome(p)
+    elif name == "pin_dome_ring":
+        s = cq_fixtures.pin_dome_ring(p)
     elif role == "calibration pin":
         s = cq_fixtures.pin(p)
     elif name == "semidome_holder":

@@ -23,7 +23,7 @@ def family(part: dict) -> str:
         return "housings"
     if role == "indenter":
         return "indenters"
-    if name == "pin_dome" or role == "calibration pin":
+    if name in ("pin_dome", "pin_dome_ring") or role == "calibration pin":
         return "pin-hole domes and pins"
     if name.startswith("semidome"):
         return "semi-domes"
