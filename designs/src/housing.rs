@@ -253,6 +253,19 @@ pub fn check_housing_params(
             ));
         }
     };
+    // Every seated part (core, LED PCB, camera board, the base's spigot) fits with this radial
+    // clearance: together the two sides must pass one nozzle width.
+    if c < fdm.xy_resolution_mm / 2.0 {
+        errs.push(ParamError::new(
+            "housing.fit_clearance_mm",
+            c,
+            format!(
+                "the seated parts fit with this radial clearance; it must be at least half the nozzle width {} mm of printer profile 'fdm' ({} mm)",
+                fdm.xy_resolution_mm,
+                fdm.xy_resolution_mm / 2.0
+            ),
+        ));
+    }
     if h.style == HousingStyle::SquareSplit {
         wall(
             errs,

@@ -183,6 +183,15 @@ fn single_mutations() -> Vec<Mutation> {
             },
         ),
         (
+            "seats tighter than the nozzle allows",
+            |d| housing(d).fit_clearance_mm = 0.1,
+            Expect {
+                path: "housing.fit_clearance_mm",
+                value: "0.1",
+                rule: &["at least half the nozzle width 0.4 mm", "printer profile 'fdm' (0.2 mm)"],
+            },
+        ),
+        (
             "printing filament as the filling gel",
             |d| housing(d).filling_gel.as_mut().unwrap().material = "pla".into(),
             Expect {
