@@ -257,6 +257,11 @@ pub fn build_kit_bounded(
     if let Some(e) = crate::assembly::fit_errors(design, &found) {
         return Err(e);
     }
+    let paths = crate::insertion::paths(design, &stack, shell_levels.as_ref(), tol)?;
+    let blocked = crate::insertion::blocked(&assembly, &paths, tol)?;
+    if let Some(e) = crate::insertion::errors(design, &blocked) {
+        return Err(e);
+    }
     let bolts = crate::procedure::clamp_bolts(design, &parts);
     bought.extend(crate::procedure::clamp_bolt_items(&bolts));
     let procedure = crate::procedure::procedure(design, &parts, &casts, &bolts);

@@ -15,6 +15,7 @@ pub mod estimate;
 pub mod geometry;
 pub mod housing;
 pub mod input_files;
+pub mod insertion;
 pub mod kit;
 pub mod layers;
 pub mod library;

@@ -6,6 +6,7 @@ mod error_paths;
 mod estimate;
 mod geometry;
 mod hostile_values;
+mod insertion;
 mod marker_layout;
 mod markers;
 mod materials;

@@ -1,0 +1,148 @@
+//! Insertion paths: a part that goes into the shell along the sensor axis must pass every
+//! printed part on its way, not only fit where it ends up (the fit check, [`crate::assembly`]).
+//! In the round shell (R-Tac0 Sec. III-B2, B4) the LED ring PCB goes down the tube's light
+//! chamber onto its ledge before the diffuser disc and the collar go on, and the contact
+//! module's core goes down the collar onto the diffuser; each path is the part's outer
+//! cylinder swept from its seat up past the top of the part it passes.
+//!
+//! A path that overlaps the part it passes by more than the fit check's thresholds
+//! ([`crate::assembly::MIN_OVERLAP_MM3`], thicker than the chord tolerance) is an error naming
+//! both, the overlap and the parameters that would clear it.
+
+use crate::assembly::{Interference, Member, MIN_OVERLAP_MM3};
+use crate::error::{DesignError, GeometryContext, ParamError, ParamErrors};
+use crate::geometry::{cylinder, ChordTolerance, Solid};
+use crate::housing::ShellLevels;
+use crate::schema::{Design, HousingStyle};
+use crate::stack::Stack;
+
+/// The swept path of one member through one printed part, sensor frame, mm.
+#[derive(Debug, Clone)]
+pub struct InsertionPath {
+    /// The member that moves (an assembly member's name).
+    pub member: String,
+    /// The printed part it passes (an assembly member's name).
+    pub through: String,
+    /// The member's outer cylinder from its seat up past the part's top.
+    pub solid: Solid,
+    /// The parameters that size the passage, for the error.
+    pub fix: Vec<String>,
+}
+
+/// The insertion paths of `design`'s assembly: the round shell's LED PCB through the tube and
+/// core through the collar (the square shell's halves close around their parts: no paths).
+///
+/// # Errors
+/// [`DesignError::Geometry`] if the kernel fails.
+pub fn paths(
+    design: &Design,
+    stack: &Stack,
+    levels: Option<&ShellLevels>,
+    tol: ChordTolerance,
+) -> Result<Vec<InsertionPath>, DesignError> {
+    let (Some(h), Some(lv), Some(core)) = (&design.housing, levels, &stack.core) else {
+        return Ok(Vec::new());
+    };
+    if h.style != HousingStyle::RoundTube {
+        return Ok(Vec::new());
+    }
+    let cyl = |name: &str, r: f64, z0: f64, z1: f64| {
+        cylinder(z1 - z0, r, tol)
+            .map(|s| s.translate([0.0, 0.0, z0]))
+            .part(name)
+    };
+    Ok(vec![
+        InsertionPath {
+            member: "led_pcb_envelope".into(),
+            through: "shell_tube".into(),
+            solid: cyl(
+                "led_pcb_envelope",
+                h.led_pcb.outer_diameter_mm / 2.0,
+                lv.pcb_z_mm,
+                lv.diffuser_z_mm + 1.0,
+            )?,
+            fix: vec![
+                "housing.light_chamber_diameter_mm".into(),
+                "housing.led_pcb.outer_diameter_mm".into(),
+            ],
+        },
+        InsertionPath {
+            member: "core_envelope".into(),
+            through: "shell_collar".into(),
+            solid: cyl(
+                "core_envelope",
+                design.body.rim_radius_mm(core.outer_offset_mm),
+                lv.seat_z_mm,
+                lv.top_z_mm + 1.0,
+            )?,
+            fix: vec![
+                "housing.fit_clearance_mm".into(),
+                "core.outer_diameter_mm".into(),
+            ],
+        },
+    ])
+}
+
+/// The paths that overlap the part they pass (`member` as `a`, the part as `b`), with the
+/// overlap's volume and mean thickness; a path whose part is not among `members` is skipped.
+///
+/// # Errors
+/// [`DesignError::Geometry`] if the kernel fails.
+pub fn blocked(
+    members: &[Member],
+    paths: &[InsertionPath],
+    tol: ChordTolerance,
+) -> Result<Vec<Interference>, DesignError> {
+    let mut out = Vec::new();
+    for p in paths {
+        let Some(part) = members.iter().find(|m| m.name == p.through) else {
+            continue;
+        };
+        let overlap = p
+            .solid
+            .intersection(&part.solid)
+            .part(&format!("insertion of {} through {}", p.member, p.through))?;
+        let v = overlap.volume();
+        let thickness = 2.0 * v / overlap.surface_area().max(f64::MIN_POSITIVE);
+        if v > MIN_OVERLAP_MM3 && thickness > tol.mm() {
+            out.push(Interference {
+                a: p.member.clone(),
+                b: p.through.clone(),
+                volume_mm3: v,
+                thickness_mm: thickness,
+                fix: p.fix.clone(),
+            });
+        }
+    }
+    Ok(out)
+}
+
+/// [`blocked`] paths as parameter errors: the path is the first parameter that sizes the
+/// passage (with its value in `design`), the rule names the member, the part and the overlap.
+pub fn errors(design: &Design, found: &[Interference]) -> Option<DesignError> {
+    if found.is_empty() {
+        return None;
+    }
+    let json = serde_json::to_value(design).unwrap_or_default();
+    Some(DesignError::Params(ParamErrors(
+        found
+            .iter()
+            .map(|f| {
+                let path = f.fix.first().cloned().unwrap_or_default();
+                let value = crate::schema::value_at(&mut json.clone(), &path)
+                    .map_or_else(|| "?".to_string(), |v| v.to_string());
+                ParamError::new(
+                    path,
+                    value,
+                    format!(
+                        "insertion check: `{}` cannot go in from the top: on its way it overlaps `{}` by {:.3} mm³; change {}",
+                        f.a,
+                        f.b,
+                        f.volume_mm3,
+                        f.fix.join(" or ")
+                    ),
+                )
+            })
+            .collect(),
+    )))
+}
