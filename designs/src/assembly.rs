@@ -49,6 +49,42 @@ pub struct Member {
     /// nothing on it (a cast layer without markers, the core): the stack's validation already
     /// nests such members without overlap, so the fit check skips pairs of them.
     pub nested_by_stack: bool,
+    /// What an exact B-rep of the member is built from (STEP export, `export/src/step.rs`),
+    /// in the sensor frame, mm; `None` for a printed member (its kit part's own parameters
+    /// describe it) and for a member that has no exact description (STEP export then sews its
+    /// mesh).
+    pub exact: Option<ExactShape>,
+}
+
+/// The exact shape of a non-printed assembly member, from which the CadQuery twin
+/// (`export/python/twins/step_export.py`) builds its B-rep. Sensor frame, mm; serialized with a
+/// `shape` tag (`layer`, `revolved`, `cylinder`, `ring`, `box`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "shape", rename_all = "snake_case", deny_unknown_fields)]
+pub enum ExactShape {
+    /// A cast or sprayed layer: the same parameters as its printed or molded parts carry
+    /// (`layer`, `body`, `outer_offset_mm`, `inner_offset_mm`, `solid`, `markers`, see
+    /// [`crate::layers::layer_twin_params`]), built exactly by the twin.
+    Layer { params: serde_json::Value },
+    /// The solid of revolution about z of a closed (r, z) polygon, mm (r >= 0): exact for the
+    /// polygon (planes, cylinders, cones), which itself lies within half the chord tolerance
+    /// of the true profile.
+    Revolved { profile_rz_mm: Vec<[f64; 2]> },
+    /// A disc about the z axis from `z0_mm` to `z1_mm`.
+    Cylinder {
+        radius_mm: f64,
+        z0_mm: f64,
+        z1_mm: f64,
+    },
+    /// A flat ring about the z axis from `z0_mm` to `z1_mm`.
+    Ring {
+        outer_radius_mm: f64,
+        inner_radius_mm: f64,
+        z0_mm: f64,
+        z1_mm: f64,
+    },
+    /// An axis-aligned box.
+    Box { min_mm: [f64; 3], max_mm: [f64; 3] },
 }
 
 /// Roles of kit parts that are part of the sensor (the rest are molds and tooling).
@@ -65,7 +101,12 @@ pub const SENSOR_ROLES: [&str; 6] = [
 pub const MIN_OVERLAP_MM3: f64 = 1e-3;
 
 /// A bought part's envelope as a member: never nested by the stack.
-fn bought(name: &str, description: String, solid: Solid, fix: &[&str]) -> Member {
+fn bought(
+    name: &str,
+    description: String,
+    (solid, exact): (Solid, ExactShape),
+    fix: &[&str],
+) -> Member {
     Member {
         name: name.into(),
         kind: MemberKind::Bought,
@@ -73,6 +114,7 @@ fn bought(name: &str, description: String, solid: Solid, fix: &[&str]) -> Member
         solid,
         fix: fix.iter().map(|f| (*f).to_string()).collect(),
         nested_by_stack: false,
+        exact: Some(exact),
     }
 }
 
@@ -120,6 +162,7 @@ pub fn members(
                 solid,
                 fix: vec!["housing".into()],
                 nested_by_stack: false,
+                exact: None,
             });
         }
     }
@@ -135,6 +178,9 @@ pub fn members(
             solid,
             fix: vec![format!("layers[{i}]")],
             nested_by_stack: design.layers[i].markers.is_empty(),
+            exact: Some(ExactShape::Layer {
+                params: crate::layers::layer_twin_params(design, stack, i, tol),
+            }),
         });
     }
     let g = |name: &str, r: Result<Solid, crate::geometry::GeometryError>| r.part(name);
@@ -159,12 +205,15 @@ pub fn members(
             "core_envelope",
             revolve(&pl, tol).and_then(|m| Solid::from_mesh(&m)),
         )?;
+        let exact = ExactShape::Revolved {
+            profile_rz_mm: pl.points.clone(),
+        };
         out.push(Member {
             nested_by_stack: true,
             ..bought(
                 "core_envelope",
                 format!("Core (bought): {}", spec.description),
-                solid,
+                (solid, exact),
                 &["core.wall_thickness_mm", "core.length_mm"],
             )
         });
@@ -189,17 +238,39 @@ pub fn members(
                     "housing.diffuser.inner_diameter_mm".into(),
                 ],
                 nested_by_stack: false,
+                exact: Some(ExactShape::Revolved {
+                    profile_rz_mm: pl.points.clone(),
+                }),
             });
         }
     }
     let zb = design.body.base_z_mm();
-    let disc =
-        |r: f64, z0: f64, z1: f64| cylinder(z1 - z0, r, tol).map(|s| s.translate([0.0, 0.0, z0]));
-    let ring =
-        |ro: f64, ri: f64, z0: f64, z1: f64| -> Result<Solid, crate::geometry::GeometryError> {
-            // the inner cut passes both faces so that the difference is clean
-            disc(ro, z0, z1)?.difference(&disc(ri, z0 - 1.0, z1 + 1.0)?)
+    type Exact = Result<(Solid, ExactShape), crate::geometry::GeometryError>;
+    let disc = |r: f64, z0: f64, z1: f64| -> Exact {
+        let solid = cylinder(z1 - z0, r, tol)?.translate([0.0, 0.0, z0]);
+        let exact = ExactShape::Cylinder {
+            radius_mm: r,
+            z0_mm: z0,
+            z1_mm: z1,
         };
+        Ok((solid, exact))
+    };
+    let ring = |ro: f64, ri: f64, z0: f64, z1: f64| -> Exact {
+        // the inner cut passes both faces so that the difference is clean
+        let (outer, _) = disc(ro, z0, z1)?;
+        let (inner, _) = disc(ri, z0 - 1.0, z1 + 1.0)?;
+        let exact = ExactShape::Ring {
+            outer_radius_mm: ro,
+            inner_radius_mm: ri,
+            z0_mm: z0,
+            z1_mm: z1,
+        };
+        Ok((outer.difference(&inner)?, exact))
+    };
+    let block = |min_mm: [f64; 3], max_mm: [f64; 3]| -> Exact {
+        Ok((cuboid(min_mm, max_mm)?, ExactShape::Box { min_mm, max_mm }))
+    };
+    let g = |name: &str, r: Exact| r.part(name);
     if let Some(b) = &design.backing {
         out.push(bought(
             "backing_envelope",
@@ -223,10 +294,7 @@ pub fn members(
                 "Camera board with its components (bought): {}",
                 h.camera.module
             ),
-            g(
-                "camera_board_envelope",
-                cuboid([-bw, -bw, z0], [bw, bw, z1]),
-            )?,
+            g("camera_board_envelope", block([-bw, -bw, z0], [bw, bw, z1]))?,
             &[
                 "housing.camera.board_width_mm",
                 "housing.camera.bay_height_mm",

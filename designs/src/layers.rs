@@ -724,6 +724,35 @@ pub fn build_layer(
     build_layer_parts(design, stack, i, tol).map_err(|e| e.from_params(&layer_params(design, i)))
 }
 
+/// The parameters of layer `i` that its parts carry and the CadQuery twin builds the layer
+/// from (`export/python/twins/cq_layers.py`): `layer`, `body`, `outer_offset_mm`,
+/// `inner_offset_mm` (`null` for a solid layer), `solid` and `markers` (one entry per marker
+/// set with its feature, surface, direction and placements, degrees). Sensor frame, mm.
+/// `i` must index `stack.layers` (panics otherwise, as [`layer_solid`]).
+pub fn layer_twin_params(
+    design: &Design,
+    stack: &Stack,
+    i: usize,
+    tol: ChordTolerance,
+) -> serde_json::Value {
+    let l = &stack.layers[i];
+    let placed = place_layer_markers(design, l, tol);
+    let tech = feature_technology(design, &design.layers[i]);
+    twin_params(design, l, json!(marker_summary(l, &placed, tech, design)))
+}
+
+fn twin_params(
+    design: &Design,
+    l: &ResolvedLayer,
+    markers: serde_json::Value,
+) -> serde_json::Value {
+    json!({
+        "layer": l.name, "body": design.body, "outer_offset_mm": l.outer_offset_mm,
+        "inner_offset_mm": if l.solid { serde_json::Value::Null } else { json!(l.inner_offset_mm) },
+        "solid": l.solid, "markers": markers,
+    })
+}
+
 fn build_layer_parts(
     design: &Design,
     stack: &Stack,
@@ -743,11 +772,7 @@ fn build_layer_parts(
         on_surface(&placed, MarkerSurface::Outer),
         on_surface(&placed, MarkerSurface::Inner),
     );
-    let base_params = json!({
-        "layer": name, "body": design.body, "outer_offset_mm": l.outer_offset_mm,
-        "inner_offset_mm": if l.solid { serde_json::Value::Null } else { json!(l.inner_offset_mm) },
-        "solid": l.solid, "markers": markers_json,
-    });
+    let base_params = twin_params(design, l, json!(markers_json));
     let g = |r: Result<Solid, GeometryError>| r.part(&name);
     match (l.process, l.mold_strategy) {
         (LayerProcess::Printed, _) => {

@@ -97,6 +97,10 @@ pub enum ExportError {
     /// The CadQuery twin could not build a part, or its exact solid disagrees with fabkit's.
     #[error("STEP export of part `{part}` failed: {reason}")]
     Step { part: String, reason: String },
+    /// The CadQuery twin could not build a member of `assembly.step`, or it is not a valid
+    /// closed solid, or it disagrees with fabkit's mesh of the member.
+    #[error("STEP export of assembly member `{member}` (assembly.step) failed: {reason}")]
+    StepAssembly { member: String, reason: String },
     #[error("serializing manifest.json")]
     Json(#[from] serde_json::Error),
 }

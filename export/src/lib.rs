@@ -8,6 +8,9 @@
 //!   ([`fabkit_designs::kit::Part::group`]) holding its parts as named volumes in their shared
 //!   coordinates, so a slicer loads the group as one object (one material per volume) and the
 //!   parts stay registered (see the `three_mf` module);
+//! - with STEP, `step/<part>.step` per part (print orientation) and `assembly.step`, the
+//!   assembled sensor as exact B-reps in the sensor frame, one named solid per member (see the
+//!   `step` module);
 //! - `manifest.json`: provenance and the numbers of every written solid ([`Manifest`]);
 //! - `FABRICATION.md`: the human fabrication sheet (print list, cast order, bought items).
 //!
@@ -32,10 +35,12 @@ pub use atomic::{StagedDir, OUTPUT_MARKER};
 pub use check::check_printable_mesh;
 pub use error::ExportError;
 pub use manifest::{
-    Manifest, ManifestAssembly, ManifestCutPart, ManifestDataFile, ManifestDesign, ManifestKit3mf,
-    ManifestMember, ManifestObject, ManifestPart, ManifestVolume, FRAME,
+    Manifest, ManifestAssembly, ManifestAssemblyStep, ManifestCutPart, ManifestDataFile,
+    ManifestDesign, ManifestKit3mf, ManifestMember, ManifestObject, ManifestPart,
+    ManifestStepMember, ManifestVolume, StepGeometry, FRAME,
 };
 
+use fabkit_designs::assembly::{ExactShape, MemberKind};
 use fabkit_designs::geometry::{Mesh, TopologyError};
 use fabkit_designs::kit::Kit;
 use sha2::{Digest, Sha256};
@@ -48,7 +53,8 @@ pub struct Formats {
     pub stl: bool,
     /// `<design>.3mf`, one 3MF for the whole kit.
     pub threemf: bool,
-    /// `step/<part>.step`, exact B-rep per part through the CadQuery twin (see [`step`]).
+    /// `step/<part>.step`, exact B-rep per part through the CadQuery twin, and for a sensor
+    /// `assembly.step`, the assembly's members in the sensor frame (see [`step`]).
     pub step: bool,
 }
 
@@ -85,7 +91,9 @@ pub struct ExportSummary {
     /// The output directory, as given.
     pub out_dir: PathBuf,
     /// Every file written, as `out_dir` joined with its relative path, in order:
-    /// `parts/*.stl` (kit order), `<design>.3mf`, `manifest.json`, `FABRICATION.md`.
+    /// `parts/*.stl` (kit order), `<design>.3mf`, `step/*.step` (kit order), `assembly.step`,
+    /// `section.png`, `cut/*`, `assembly.3mf`, data files, `manifest.json`, `FABRICATION.md`
+    /// (each when written).
     pub files: Vec<PathBuf>,
     /// `out_dir` held a previous export (or was an empty directory) and was replaced.
     pub replaced_previous_export: bool,
@@ -205,6 +213,89 @@ fn write_kit_meshes(
     })
 }
 
+/// The STEP files of the parts and, for a sensor, of the assembly (`assembly.step`), from the
+/// CadQuery twin in one run (see [`step::render`]): `meshes` are the assembly members' written
+/// meshes (checked closed 2-manifolds, in `kit.assembly` order). Returns the files and the
+/// assembly's manifest entry, its `sha256` still empty.
+fn step_files(
+    kit: &Kit,
+    parts: &[ManifestPart],
+    meshes: &[Mesh],
+    opts: &ExportOptions,
+    step_progress: Option<step::StepProgress<'_>>,
+) -> Result<(step::StepFiles, Option<ManifestAssemblyStep>), ExportError> {
+    if kit.assembly.is_empty() {
+        let files = step::render(parts, None, opts.chord_tolerance_mm, step_progress)?;
+        return Ok((files, None));
+    }
+    let mut members = Vec::with_capacity(meshes.len());
+    let mut entries = Vec::with_capacity(meshes.len());
+    for (m, mesh) in kit.assembly.iter().zip(meshes) {
+        let printed = kit
+            .parts
+            .iter()
+            .find(|p| m.kind == MemberKind::Printed && p.name == m.name);
+        let (source, geometry) = match (printed, &m.exact) {
+            (Some(p), _) => (step::StepSource::Part(&p.name), StepGeometry::ExactPart),
+            (None, Some(e)) => (
+                step::StepSource::Exact(e),
+                match e {
+                    ExactShape::Layer { .. } => StepGeometry::ExactLayer,
+                    ExactShape::Revolved { .. } => StepGeometry::RevolvedProfile,
+                    ExactShape::Cylinder { .. }
+                    | ExactShape::Ring { .. }
+                    | ExactShape::Box { .. } => StepGeometry::ExactEnvelope,
+                },
+            ),
+            (None, None) => (step::StepSource::Mesh(mesh), StepGeometry::SewnMesh),
+        };
+        let bbox_mm = mesh
+            .bounding_box()
+            .ok_or_else(|| ExportError::NotManifold {
+                part: m.name.clone(),
+                source: TopologyError::Empty,
+            })?;
+        let (volume_mm3, surface_area_mm2) = (mesh.signed_volume(), mesh.surface_area());
+        let shells = mesh.shell_count();
+        members.push(step::StepMember {
+            name: &m.name,
+            kind: m.kind,
+            volume_mm3,
+            surface_area_mm2,
+            bbox_mm,
+            shells,
+            source,
+        });
+        entries.push(ManifestStepMember {
+            name: m.name.clone(),
+            kind: m.kind,
+            geometry,
+            volume_mm3,
+            surface_area_mm2,
+            bbox_mm,
+            shells,
+        });
+    }
+    let assembly = step::StepAssembly {
+        name: &kit.design,
+        members,
+    };
+    let files = step::render(
+        parts,
+        Some(&assembly),
+        opts.chord_tolerance_mm,
+        step_progress,
+    )?;
+    Ok((
+        files,
+        Some(ManifestAssemblyStep {
+            file: ASSEMBLY_STEP.into(),
+            sha256: String::new(),
+            members: entries,
+        }),
+    ))
+}
+
 /// `assembly.3mf`: the kit's assembled sensor, one object per member (`meshes`, checked closed
 /// 2-manifolds, in kit order), in the sensor frame.
 fn assembly_3mf(
@@ -279,6 +370,10 @@ pub const SECTION_PNG: &str = "section.png";
 /// The assembly model's file name.
 pub const ASSEMBLY_3MF: &str = "assembly.3mf";
 
+/// The assembly's STEP file name, beside [`ASSEMBLY_3MF`] (the top level holds the whole-kit
+/// and whole-sensor files; `step/` holds the parts in print orientation).
+pub const ASSEMBLY_STEP: &str = "assembly.step";
+
 const PARTS_DIR: &str = "parts";
 /// Folder of the laser-cut parts' DXF and SVG files.
 const CUT_DIR: &str = "cut";
@@ -347,15 +442,6 @@ fn render(
             step_sha256: None,
             params: part.params.clone(),
         });
-    }
-    if opts.formats.step {
-        let steps = step::render(&parts, opts.chord_tolerance_mm, step_progress)?;
-        for (p, bytes) in parts.iter_mut().zip(steps) {
-            let rel = format!("{STEP_DIR}/{}.step", p.name);
-            p.step_sha256 = Some(sha256_hex(&bytes));
-            p.step_file = Some(rel.clone());
-            files.push((rel, bytes));
-        }
     }
 
     let kit_3mf = if opts.formats.threemf {
@@ -443,6 +529,25 @@ fn render(
     for (m, mesh) in kit.assembly.iter().zip(&assembly_meshes) {
         check_printable_mesh(&m.name, mesh)?;
     }
+    let assembly_step = if opts.formats.step {
+        let (steps, assembly) = step_files(kit, &parts, &assembly_meshes, opts, step_progress)?;
+        for (p, bytes) in parts.iter_mut().zip(steps.parts) {
+            let rel = format!("{STEP_DIR}/{}.step", p.name);
+            p.step_sha256 = Some(sha256_hex(&bytes));
+            p.step_file = Some(rel.clone());
+            files.push((rel, bytes));
+        }
+        match (assembly, steps.assembly) {
+            (Some(mut a), Some(bytes)) => {
+                a.sha256 = sha256_hex(&bytes);
+                files.push((a.file.clone(), bytes));
+                Some(a)
+            }
+            _ => None,
+        }
+    } else {
+        None
+    };
     let section_view = if kit.assembly.is_empty() {
         None
     } else {
@@ -511,6 +616,7 @@ fn render(
         parts,
         kit_3mf,
         assembly_3mf,
+        assembly_step,
         section_view,
         cut_parts,
         casts: kit.casts.clone(),

@@ -32,6 +32,10 @@ pub struct Manifest {
     /// requested and the kit is a sensor.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub assembly_3mf: Option<ManifestAssembly>,
+    /// The assembled sensor as exact B-reps (`assembly.step`, one named solid per member, in
+    /// the sensor frame), when STEP was requested and the kit is a sensor.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub assembly_step: Option<ManifestAssemblyStep>,
     /// `section.png`, the assembled sensor cut through its axis, and its legend; for a kit
     /// that is a sensor.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -143,6 +147,58 @@ pub struct ManifestMember {
     /// Volume of the written mesh, mm^3, and its box in the sensor frame, mm.
     pub volume_mm3: f64,
     pub bbox_mm: Aabb,
+}
+
+/// The assembly STEP file: one STEP assembly named after the design, one component (a named
+/// solid, or a compound of solids for a member of separate pieces) per member, in the sensor
+/// frame, mm.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ManifestAssemblyStep {
+    /// `assembly.step`, relative to the export directory.
+    pub file: String,
+    pub sha256: String,
+    /// One entry per member, in the file's component order (the assembly's member order).
+    pub members: Vec<ManifestStepMember>,
+}
+
+/// One solid of the assembly STEP file and the mesh numbers it was checked against: its
+/// exact volume is within surface area x chord tolerance (+ 1e-6 relative) of `volume_mm3`
+/// and its box within the chord tolerance + 1 um of `bbox_mm`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ManifestStepMember {
+    /// The solid's name (its STEP product and component): the member's name.
+    pub name: String,
+    /// `printed`, `cast` or `bought`.
+    pub kind: fabkit_designs::assembly::MemberKind,
+    /// What the solid was built from.
+    pub geometry: StepGeometry,
+    /// Volume of fabkit's written mesh of the member, mm^3.
+    pub volume_mm3: f64,
+    /// Surface area of that mesh, mm^2.
+    pub surface_area_mm2: f64,
+    /// Its box in the sensor frame, mm.
+    pub bbox_mm: Aabb,
+    /// Number of shells of that mesh and of the STEP solids: 1 for a member in one piece, one
+    /// per piece (a compound of solids under the member's name) for marker tips.
+    pub shells: usize,
+}
+
+/// How a solid of the assembly STEP file was built.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StepGeometry {
+    /// The printed part's exact twin (the B-rep of its `step/<part>.step`), moved back by the
+    /// inverse of its `T_print_sensor`.
+    ExactPart,
+    /// The layer's exact twin, from the same parameters as its parts.
+    ExactLayer,
+    /// The exact solid of revolution of the member's (r, z) profile polygon (planes, cylinders,
+    /// cones); the polygon is within half the chord tolerance of the true profile.
+    RevolvedProfile,
+    /// An exact cylinder, ring or box (a bought part's envelope).
+    ExactEnvelope,
+    /// The member's mesh, its triangles sewn by OCCT into a closed shell (faceted).
+    SewnMesh,
 }
 
 /// A part cut from sheet stock and its 2D files.

@@ -12,8 +12,20 @@
 //! bound (surface area x tolerance) and its bounding box within the tolerance; otherwise the
 //! export fails naming the part. The twin reports each part as it starts it (about 3 s a part),
 //! which [`render`] passes on to an optional [`StepProgress`] callback.
+//!
+//! In the same run the twin writes `assembly.step`, the assembled sensor in the sensor frame
+//! (one STEP assembly named after the design, one named solid per member, see
+//! [`StepMember`]): printed members are their parts' twins moved back by the inverse of
+//! `params.T_print_sensor`, the other members are built from their
+//! [`fabkit_designs::assembly::ExactShape`] or, without one, sewn from their mesh. Each member
+//! passes the same volume and box checks against fabkit's mesh, must be valid and closed, and
+//! must have as many shells as the mesh (a member of separate pieces, such as marker tips, is
+//! one named compound of solids).
 
 use crate::{ExportError, ManifestPart};
+use fabkit_designs::assembly::{ExactShape, MemberKind};
+use fabkit_designs::geometry::{Aabb, Mesh};
+use serde::{Serialize, Serializer};
 use std::ffi::OsString;
 use std::io::BufRead as _;
 use std::path::{Path, PathBuf};
@@ -164,22 +176,101 @@ fn executable_file(path: &Path) -> Result<(), String> {
     Ok(())
 }
 
+/// One member of `assembly.step` as the twin gets it: fabkit's numbers of the member's written
+/// mesh (sensor frame, mm) for the checks, and what the exact solid is built from.
+#[derive(Debug, Clone, Serialize)]
+pub struct StepMember<'a> {
+    /// The member's name; it names the solid (its product and component) in the STEP file.
+    pub name: &'a str,
+    pub kind: MemberKind,
+    /// Enclosed volume of the member's written mesh, mm^3.
+    pub volume_mm3: f64,
+    /// Surface area of the member's written mesh, mm^2.
+    pub surface_area_mm2: f64,
+    /// Bounding box of the member's written mesh in the sensor frame, mm.
+    pub bbox_mm: Aabb,
+    /// Number of shells (connected components) of the member's written mesh: the exact
+    /// solids must have as many (1 for a member in one piece; marker tips have one each).
+    pub shells: usize,
+    /// What the solid is built from.
+    #[serde(flatten)]
+    pub source: StepSource<'a>,
+}
+
+/// Where the exact solid of a [`StepMember`] comes from.
+#[derive(Debug, Clone)]
+pub enum StepSource<'a> {
+    /// The twin of the printed part of this name (one of the parts given to [`render`]), moved
+    /// back into the sensor frame by the inverse of its `params.T_print_sensor`.
+    Part(&'a str),
+    /// An exact shape in the sensor frame.
+    Exact(&'a ExactShape),
+    /// A mesh in the sensor frame (a closed 2-manifold), sewn into a solid by OCCT.
+    Mesh(&'a Mesh),
+}
+
+impl Serialize for StepSource<'_> {
+    /// `{"part": name}`, `{"exact": shape}` or `{"mesh": {"vertices", "triangles"}}`, for
+    /// flattening into [`StepMember`].
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap as _;
+        let mut map = s.serialize_map(Some(1))?;
+        match self {
+            Self::Part(name) => map.serialize_entry("part", name)?,
+            Self::Exact(shape) => map.serialize_entry("exact", shape)?,
+            Self::Mesh(mesh) => map.serialize_entry(
+                "mesh",
+                &serde_json::json!({"vertices": mesh.vertices, "triangles": mesh.triangles}),
+            )?,
+        }
+        map.end()
+    }
+}
+
+/// The assembly to write as `assembly.step`: its name (the design's) and members in order.
+#[derive(Debug, Clone)]
+pub struct StepAssembly<'a> {
+    pub name: &'a str,
+    pub members: Vec<StepMember<'a>>,
+}
+
+/// What [`render`] built: the STEP file bytes per part, in the order given, and of the
+/// assembly when one was given.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StepFiles {
+    pub parts: Vec<Vec<u8>>,
+    pub assembly: Option<Vec<u8>>,
+}
+
 /// One STEP file per part (same order as `parts`), built by the CadQuery twin from the parts'
-/// params. `chord_tolerance_mm` sets the agreement bound checked before writing. `progress`,
-/// if given, is called as the twin starts each part (see [`StepProgress`]), on this thread.
+/// params, and with `assembly` the assembly's STEP file (see the module docs).
+/// `chord_tolerance_mm` sets the agreement bound checked before writing. `progress`, if given,
+/// is called as the twin starts each part (see [`StepProgress`]), on this thread; assembly
+/// members are not reported (the printed ones reuse their parts' twins, the others take well
+/// under a second each).
 ///
 /// # Errors
 /// [`ExportError::StepUnavailable`] without CadQuery (see [`cadquery_python`]);
 /// [`ExportError::Step`] when a twin fails or disagrees with fabkit's part (the part is the
-/// one the twin's last message names, else the one it was building); [`ExportError::Io`] for
-/// the scratch directory.
+/// one the twin's last message names, else the one it was building);
+/// [`ExportError::StepAssembly`] when an assembly member cannot be built, is not a valid
+/// closed solid, or disagrees with fabkit's mesh of it (named likewise);
+/// [`ExportError::Io`] for the scratch directory.
 pub fn render(
     parts: &[ManifestPart],
+    assembly: Option<&StepAssembly<'_>>,
     chord_tolerance_mm: f64,
     progress: Option<StepProgress<'_>>,
-) -> Result<Vec<Vec<u8>>, ExportError> {
+) -> Result<StepFiles, ExportError> {
     let (python, found) = locate_python(&|k| std::env::var_os(k))?;
-    render_with(&python, &found, parts, chord_tolerance_mm, progress)
+    render_with(
+        &python,
+        &found,
+        parts,
+        assembly,
+        chord_tolerance_mm,
+        progress,
+    )
 }
 
 /// [`render`] by `python`, found as `found` says (for messages).
@@ -187,9 +278,10 @@ fn render_with(
     python: &Path,
     found: &str,
     parts: &[ManifestPart],
+    assembly: Option<&StepAssembly<'_>>,
     chord_tolerance_mm: f64,
     progress: Option<StepProgress<'_>>,
-) -> Result<Vec<Vec<u8>>, ExportError> {
+) -> Result<StepFiles, ExportError> {
     let scratch = Scratch::new()?;
     let pkg = scratch.0.join("twins");
     std::fs::create_dir(&pkg).map_err(ExportError::io("creating", &pkg))?;
@@ -198,15 +290,22 @@ fn render_with(
         std::fs::write(&p, text).map_err(ExportError::io("writing", &p))?;
     }
     let input = scratch.0.join("parts.json");
-    let doc = serde_json::json!({"chord_tolerance_mm": chord_tolerance_mm, "parts": parts});
+    let mut doc = serde_json::json!({"chord_tolerance_mm": chord_tolerance_mm, "parts": parts});
+    if let Some(a) = assembly {
+        doc["design"] = serde_json::json!(a.name);
+        doc["assembly"] = serde_json::to_value(&a.members)?;
+    }
     std::fs::write(&input, serde_json::to_vec(&doc)?)
         .map_err(ExportError::io("writing", &input))?;
     let out_dir = scratch.0.join("step");
+    // beside the parts' folder, so that no part name can collide with it
+    let assembly_file = scratch.0.join("assembly.step");
     let mut child = Command::new(python)
         .current_dir(&scratch.0)
         .args(["-m", "twins.step_export"])
         .arg(&input)
         .arg(&out_dir)
+        .args(assembly.map(|_| &assembly_file))
         .env("PYTHONDONTWRITEBYTECODE", "1")
         .env("PYTHONUNBUFFERED", "1")
         .stdin(Stdio::null())
@@ -219,6 +318,7 @@ fn render_with(
     // stderr line by line: progress as it comes, the last message for errors
     let mut last = String::new();
     let mut current: Option<String> = None;
+    let mut member: Option<String> = None;
     if let Some(stderr) = child.stderr.take() {
         for line in std::io::BufReader::new(stderr).split(b'\n') {
             let Ok(line) = line else { break };
@@ -228,6 +328,11 @@ fn render_with(
                 if let Some(f) = progress {
                     f(i, n, name);
                 }
+            } else if let Some(name) = line
+                .strip_prefix("step_export: member ")
+                .filter(|r| !r.contains(':'))
+            {
+                member = Some(name.to_string());
             } else if !line.trim().is_empty() {
                 last = line;
             }
@@ -242,6 +347,22 @@ fn render_with(
         });
     }
     if !status.success() {
+        if let Some(rest) = last.strip_prefix("step_export: member ") {
+            let named = rest.split(':').next().map(str::to_string);
+            return Err(ExportError::StepAssembly {
+                member: named.or(member).unwrap_or_else(|| "?".to_string()),
+                reason: last.clone(),
+            });
+        }
+        if let (Some(m), true) = (&member, last.is_empty()) {
+            return Err(ExportError::StepAssembly {
+                member: m.clone(),
+                reason: format!(
+                    "{} exited with {status} without a message",
+                    python.display()
+                ),
+            });
+        }
         let named = last
             .strip_prefix("step_export: part ")
             .and_then(|r| r.split(':').next())
@@ -257,13 +378,20 @@ fn render_with(
         };
         return Err(ExportError::Step { part, reason });
     }
-    parts
+    let parts = parts
         .iter()
         .map(|p| {
             let f = out_dir.join(format!("{}.step", p.name));
             std::fs::read(&f).map_err(ExportError::io("reading", &f))
         })
-        .collect()
+        .collect::<Result<_, _>>()?;
+    let assembly = match assembly {
+        Some(_) => Some(
+            std::fs::read(&assembly_file).map_err(ExportError::io("reading", &assembly_file))?,
+        ),
+        None => None,
+    };
+    Ok(StepFiles { parts, assembly })
 }
 
 /// `step_export: I/N NAME` (the twin starts part I of N) as (I, N, NAME).
@@ -424,7 +552,7 @@ mod tests {
             "echo 'step_export: 1/2 a' >&2\necho 'step_export: 2/2 b' >&2\n\
              echo 'step_export: part b: ValueError: off' >&2\nexit 3\n",
         );
-        match render_with(&py, "test", &[], 0.01, Some(&record)) {
+        match render_with(&py, "test", &[], None, 0.01, Some(&record)) {
             Err(ExportError::Step { part, reason }) => {
                 assert_eq!(part, "b");
                 assert_eq!(reason, "step_export: part b: ValueError: off");
@@ -434,16 +562,29 @@ mod tests {
         assert_eq!(*seen.borrow(), ["1/2 a", "2/2 b"]);
         // a crash without a message: the part it was building
         let py = fake_python(t.path(), "echo 'step_export: 1/2 a' >&2\nkill -9 $$\n");
-        match render_with(&py, "test", &[], 0.01, None) {
+        match render_with(&py, "test", &[], None, 0.01, None) {
             Err(ExportError::Step { part, reason }) => {
                 assert_eq!(part, "a");
                 assert!(reason.contains("without a message"), "{reason}");
             }
             other => panic!("{other:?}"),
         }
+        // an assembly member is named as such
+        let py = fake_python(
+            t.path(),
+            "echo 'step_export: 1/1 a' >&2\necho 'step_export: member gel' >&2\n\
+             echo 'step_export: member gel: ValueError: off' >&2\nexit 3\n",
+        );
+        match render_with(&py, "test", &[], None, 0.01, None) {
+            Err(ExportError::StepAssembly { member, reason }) => {
+                assert_eq!(member, "gel");
+                assert_eq!(reason, "step_export: member gel: ValueError: off");
+            }
+            other => panic!("{other:?}"),
+        }
         // exit status 4: no cadquery there
         let py = fake_python(t.path(), "exit 4\n");
-        match render_with(&py, "FABKIT_CADQUERY_PYTHON=x", &[], 0.01, None) {
+        match render_with(&py, "FABKIT_CADQUERY_PYTHON=x", &[], None, 0.01, None) {
             Err(ExportError::StepUnavailable { reason }) => {
                 assert!(
                     reason.ends_with("cannot import cadquery (FABKIT_CADQUERY_PYTHON=x)"),

@@ -4,6 +4,7 @@
 
 mod common;
 
+mod assembly_step;
 mod authors_cad;
 mod calibrate_cli;
 mod calibrate_opencv;

@@ -2,7 +2,7 @@
 //! volumes, designed contacts that are not interferences, and one fit broken at a time giving
 //! one named interference with its analytic overlap.
 
-use fabkit_designs::assembly::{fit_errors, interferences, Member, MemberKind};
+use fabkit_designs::assembly::{fit_errors, interferences, ExactShape, Member, MemberKind};
 use fabkit_designs::{build_kit, ChordTolerance, Kit};
 use std::f64::consts::PI;
 use std::sync::OnceLock;
@@ -124,6 +124,72 @@ fn rtac0_members_are_in_the_sensor_frame_with_their_volumes() {
 /// tessellations cross; layers without markers and the core are nested by the stack and not
 /// intersected. (UVDtact's layers, whose slots and protrusions interlock, are intersected in
 /// every build of its kit.)
+/// Each non-printed member carries the exact shape STEP export builds it from, and that shape
+/// is the member: envelopes' analytic volumes and boxes match the solids within the chord
+/// bound, revolved profiles are closed (r, z) polygons with r >= 0 spanning the solid's z
+/// range, layers carry their offsets; printed members carry none (their parts' params do).
+#[test]
+fn rtac0_members_carry_their_exact_shapes() {
+    for m in &rtac0().assembly {
+        let bb = m.solid.bounding_box().unwrap();
+        let bound = m.solid.surface_area() * tol().mm();
+        let exact_volume = match (&m.kind, &m.exact) {
+            (MemberKind::Printed, None) => continue,
+            (
+                _,
+                Some(ExactShape::Cylinder {
+                    radius_mm,
+                    z0_mm,
+                    z1_mm,
+                }),
+            ) => PI * radius_mm * radius_mm * (z1_mm - z0_mm),
+            (
+                _,
+                Some(ExactShape::Ring {
+                    outer_radius_mm: ro,
+                    inner_radius_mm: ri,
+                    z0_mm,
+                    z1_mm,
+                }),
+            ) => PI * (ro * ro - ri * ri) * (z1_mm - z0_mm),
+            (_, Some(ExactShape::Box { min_mm, max_mm })) => {
+                (0..3).map(|k| max_mm[k] - min_mm[k]).product()
+            }
+            (_, Some(ExactShape::Revolved { profile_rz_mm })) => {
+                assert!(profile_rz_mm.len() >= 3 && profile_rz_mm.iter().all(|p| p[0] >= 0.0));
+                let (zlo, zhi) = profile_rz_mm
+                    .iter()
+                    .fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p[1]), b.max(p[1])));
+                assert!(
+                    (zlo - bb.min[2]).abs() < 1e-9 && (zhi - bb.max[2]).abs() < 1e-9,
+                    "{}",
+                    m.name
+                );
+                // Pappus: the volume of revolution of the polygon (shoelace centroid)
+                let n = profile_rz_mm.len();
+                let mut v = 0.0;
+                for i in 0..n {
+                    let (p, q) = (profile_rz_mm[i], profile_rz_mm[(i + 1) % n]);
+                    v += (p[0] * q[1] - q[0] * p[1]) * (p[0] + q[0]);
+                }
+                (PI * v / 3.0).abs()
+            }
+            (_, Some(ExactShape::Layer { params })) => {
+                assert_eq!(params["layer"], m.name.as_str());
+                assert!(params["outer_offset_mm"].is_f64());
+                continue;
+            }
+            (kind, exact) => panic!("{}: {kind:?} with {exact:?}", m.name),
+        };
+        assert!(
+            (exact_volume - m.solid.volume()).abs() <= bound,
+            "{}: exact {exact_volume} mm3, solid {} mm3, bound {bound}",
+            m.name,
+            m.solid.volume()
+        );
+    }
+}
+
 #[test]
 fn designed_contacts_are_not_interferences() {
     assert_eq!(interferences(&rtac0().assembly, tol()).unwrap(), vec![]);

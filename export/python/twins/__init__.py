@@ -7,7 +7,8 @@
 - compare.py: the per-part comparison (volume, symmetric Hausdorff distance, bounding box,
   genus) and its bounds;
 - check_twins.py: the command line that runs both twins on exports and writes the report;
-- step_export.py: STEP files of an export through the CadQuery twins (`fabkit export --format step`).
+- step_export.py: STEP files of an export through the CadQuery twins (`fabkit export --format step`):
+  one per part and the sensor-frame `assembly.step`.
 
 fabkit embeds the modules STEP export runs (this file, cq_*.py, families.py, step_export.py;
 see export/src/step.rs); the others are the test tools of tests/e2e/twins.rs, run as scripts
