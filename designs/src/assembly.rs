@@ -289,18 +289,6 @@ pub fn members(
             _ => (lv.bulkhead_z_mm - h.camera.bay_height_mm, lv.bulkhead_z_mm),
         };
         out.push(bought(
-            "camera_board_envelope",
-            format!(
-                "Camera board with its components (bought): {}",
-                h.camera.module
-            ),
-            g("camera_board_envelope", block([-bw, -bw, z0], [bw, bw, z1]))?,
-            &[
-                "housing.camera.board_width_mm",
-                "housing.camera.bay_height_mm",
-            ],
-        ));
-        out.push(bought(
             "led_pcb_envelope",
             format!("LED ring PCB (bought), {} LEDs", h.led_pcb.led_count),
             g(
@@ -315,6 +303,20 @@ pub fn members(
             &[
                 "housing.led_pcb.outer_diameter_mm",
                 "housing.led_pcb.thickness_mm",
+            ],
+        ));
+        // after the LED PCB: an overlap names the later member's parameters first, and the
+        // board's height is what a board that reaches the PCB needs changed
+        out.push(bought(
+            "camera_board_envelope",
+            format!(
+                "Camera board with its components (bought): {}",
+                h.camera.module
+            ),
+            g("camera_board_envelope", block([-bw, -bw, z0], [bw, bw, z1]))?,
+            &[
+                "housing.camera.bay_height_mm",
+                "housing.camera.board_width_mm",
             ],
         ));
         out.push(bought(

@@ -54,6 +54,38 @@ fn impossible_parameters_are_all_reported_with_their_paths() {
     assert!(!tmp.path().join("out").exists());
 }
 
+/// One fit broken at a time, through the CLI: a camera board taller than its bay overlaps the
+/// LED PCB (the fit check), a tube whose light chamber keeps a ledge under the diffuser cannot
+/// take the PCB from the top (here a validation rule, which the insertion check backs); each
+/// is exit 2 with the error naming the parameter, its value, both parts and the overlap, and
+/// nothing written.
+#[test]
+fn a_broken_fit_is_a_named_interference_and_writes_nothing() {
+    let tmp = tempfile::tempdir().unwrap();
+    for (from, to, expect) in [
+        (
+            "    bay_height_mm: 3.0 ",
+            "    bay_height_mm: 3.5 ",
+            "housing.camera.bay_height_mm = 3.5: fit check: `led_pcb_envelope` and `camera_board_envelope` overlap by 21.",
+        ),
+        (
+            "  light_chamber_diameter_mm: 23.4 ",
+            "  light_chamber_diameter_mm: 20.0 ",
+            "housing.light_chamber_diameter_mm = 20: must pass the LED PCB",
+        ),
+    ] {
+        let yaml = rtac0_yaml().replace(from, to);
+        assert!(yaml.contains(to), "{to}");
+        std::fs::write(tmp.path().join("bad.yaml"), &yaml).unwrap();
+        let o = run(tmp.path(), &["export", "bad.yaml", "--out", "out/bad"], &[]);
+        assert_eq!(o.status.code(), Some(2), "{to}");
+        let err = text(&o.stderr);
+        assert!(err.contains(expect), "{err}");
+        assert!(!err.contains("panicked"), "{err}");
+        assert!(!tmp.path().join("out").exists());
+    }
+}
+
 #[test]
 fn bad_chord_tolerance_and_unknown_design_are_errors() {
     let tmp = tempfile::tempdir().unwrap();

@@ -47,8 +47,8 @@ fn rtac0_members_are_in_the_sensor_frame_with_their_volumes() {
             ("black_coating", MemberKind::Cast),
             ("core_envelope", MemberKind::Bought),
             ("filling_gel", MemberKind::Cast),
-            ("camera_board_envelope", MemberKind::Bought),
             ("led_pcb_envelope", MemberKind::Bought),
+            ("camera_board_envelope", MemberKind::Bought),
             ("diffuser_envelope", MemberKind::Bought),
         ]
     );
@@ -252,4 +252,38 @@ fn each_broken_fit_is_one_named_interference() {
             "{e}"
         );
     }
+}
+
+/// A camera board taller than the room between the base and the LED PCB (3.5 mm where 3.05 mm
+/// are left) is not a validation rule but the fit check's: one error naming the board's height
+/// with its value, both parts and the overlap (the board's square less the PCB's 7.5 mm bore,
+/// over the 0.45 mm it reaches past the PCB's underside; the bore's polygon lies inside its
+/// circle, so the overlap is up to 1 % more), and no kit.
+#[test]
+fn a_camera_board_too_tall_for_its_bay_is_a_named_fit_error() {
+    let mut d = fabkit_designs::library::load("rtac0").unwrap();
+    d.housing.as_mut().unwrap().camera.bay_height_mm = 3.5;
+    let e = match build_kit(&d, tol()) {
+        Err(fabkit_designs::DesignError::Params(e)) => e,
+        other => panic!("{:?}", other.map(|k| k.design)),
+    };
+    assert_eq!(e.0.len(), 1, "{e}");
+    let want = (225.0 - PI * 7.5 * 7.5) * 0.45;
+    let got: f64 = e.0[0]
+        .rule
+        .split("overlap by ")
+        .nth(1)
+        .and_then(|r| r.split(' ').next())
+        .and_then(|v| v.parse().ok())
+        .unwrap();
+    assert!(
+        e.0[0].path == "housing.camera.bay_height_mm"
+            && e.0[0].value == "3.5"
+            && e.0[0]
+                .rule
+                .contains("`led_pcb_envelope` and `camera_board_envelope` overlap by")
+            && got >= want * 0.999
+            && got <= want * 1.01,
+        "{e} (analytic {want})"
+    );
 }
