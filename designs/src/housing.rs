@@ -662,8 +662,25 @@ fn check_round_tube(
             ),
         ));
     }
-    // Whether the camera board with its components fits between the base and the LED PCB
-    // (housing.camera.bay_height_mm) is the fit check's: it names both parts and the overlap.
+    // The bay must exist for the shell to be built; whether the camera board with its
+    // components fits in it (housing.camera.bay_height_mm) is the fit check's, which names both
+    // parts and the overlap.
+    if let Some(core) = core {
+        let pcb_below_top = core.below_base_mm
+            + h.diffuser.thickness_mm
+            + h.diffuser.gap_above_pcb_mm
+            + h.led_pcb.thickness_mm;
+        let room = t.height_mm - pcb_below_top - t.base_spigot_height_mm;
+        if room <= 0.0 {
+            errs.push(ParamError::new(
+                "housing.round_tube.height_mm",
+                t.height_mm,
+                format!(
+                    "leaves no camera bay between the base's spigot and the LED PCB ({room:.2} mm)"
+                ),
+            ));
+        }
+    }
 }
 
 /// Builds the shell in print orientation: the round tube (top face down) and its base

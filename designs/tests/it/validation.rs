@@ -791,6 +791,19 @@ fn round_tube_rules_name_their_parameters() {
             rule: &["reaches 2.60 mm above the LED PCB's underside"],
         }],
     );
+    // A tube too short for any camera bay.
+    let mut d = baseline();
+    housing(&mut d).round_tube.as_mut().unwrap().height_mm = 18.0;
+    assert!(
+        errors(&d)
+            .iter()
+            .any(|e| e.path == "housing.round_tube.height_mm"
+                && e.rule.contains(
+                    "leaves no camera bay between the base's spigot and the LED PCB (-0.60 mm)"
+                )),
+        "{}",
+        listing(&errors(&d))
+    );
     // The LED PCB goes in from the tube's top, down the light chamber.
     let mut d = baseline();
     housing(&mut d).light_chamber_diameter_mm = 23.0;
