@@ -408,6 +408,26 @@ pub fn interferences(
 /// parameter that sizes either part (with its value in `design`), the rule names both parts,
 /// the overlap and every parameter that would fix it.
 pub fn fit_errors(design: &Design, found: &[Interference]) -> Option<DesignError> {
+    overlap_errors(design, found, |f| {
+        format!(
+            "fit check: `{}` and `{}` overlap by {:.3} mm³ (about {:.3} mm deep); change {}",
+            f.a,
+            f.b,
+            f.volume_mm3,
+            f.thickness_mm,
+            f.fix.join(" or ")
+        )
+    })
+}
+
+/// Overlaps as parameter errors, one each: the path is the overlap's first `fix` parameter
+/// with its value in `design` (`?` when the design has none there), the rule `rule`'s text;
+/// `None` when there are none.
+pub fn overlap_errors(
+    design: &Design,
+    found: &[Interference],
+    rule: impl Fn(&Interference) -> String,
+) -> Option<DesignError> {
     if found.is_empty() {
         return None;
     }
@@ -419,18 +439,7 @@ pub fn fit_errors(design: &Design, found: &[Interference]) -> Option<DesignError
                 let path = f.fix.first().cloned().unwrap_or_default();
                 let value = crate::schema::value_at(&mut json.clone(), &path)
                     .map_or_else(|| "?".to_string(), |v| v.to_string());
-                ParamError::new(
-                    path,
-                    value,
-                    format!(
-                        "fit check: `{}` and `{}` overlap by {:.3} mm³ (about {:.3} mm deep); change {}",
-                        f.a,
-                        f.b,
-                        f.volume_mm3,
-                        f.thickness_mm,
-                        f.fix.join(" or ")
-                    ),
-                )
+                ParamError::new(path, value, rule(f))
             })
             .collect(),
     )))

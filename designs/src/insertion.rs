@@ -10,7 +10,7 @@
 //! both, the overlap and the parameters that would clear it.
 
 use crate::assembly::{Interference, Member, MIN_OVERLAP_MM3};
-use crate::error::{DesignError, GeometryContext, ParamError, ParamErrors};
+use crate::error::{DesignError, GeometryContext};
 use crate::geometry::{cylinder, ChordTolerance, Solid};
 use crate::housing::ShellLevels;
 use crate::schema::{Design, HousingStyle};
@@ -117,32 +117,17 @@ pub fn blocked(
     Ok(out)
 }
 
-/// [`blocked`] paths as parameter errors: the path is the first parameter that sizes the
-/// passage (with its value in `design`), the rule names the member, the part and the overlap.
+/// [`blocked`] paths as parameter errors ([`crate::assembly::overlap_errors`]): the path is
+/// the first parameter that sizes the passage (with its value in `design`), the rule names the
+/// member, the part and the overlap.
 pub fn errors(design: &Design, found: &[Interference]) -> Option<DesignError> {
-    if found.is_empty() {
-        return None;
-    }
-    let json = serde_json::to_value(design).unwrap_or_default();
-    Some(DesignError::Params(ParamErrors(
-        found
-            .iter()
-            .map(|f| {
-                let path = f.fix.first().cloned().unwrap_or_default();
-                let value = crate::schema::value_at(&mut json.clone(), &path)
-                    .map_or_else(|| "?".to_string(), |v| v.to_string());
-                ParamError::new(
-                    path,
-                    value,
-                    format!(
-                        "insertion check: `{}` cannot go in from the top: on its way it overlaps `{}` by {:.3} mm³; change {}",
-                        f.a,
-                        f.b,
-                        f.volume_mm3,
-                        f.fix.join(" or ")
-                    ),
-                )
-            })
-            .collect(),
-    )))
+    crate::assembly::overlap_errors(design, found, |f| {
+        format!(
+            "insertion check: `{}` cannot go in from the top: on its way it overlaps `{}` by {:.3} mm³; change {}",
+            f.a,
+            f.b,
+            f.volume_mm3,
+            f.fix.join(" or ")
+        )
+    })
 }
