@@ -46,8 +46,9 @@ pub struct Member {
     /// changing.
     pub fix: Vec<String>,
     /// The member is a surface of revolution between two offsets of the body profile with
-    /// nothing on it (a cast layer without markers, the core): the stack's validation already
-    /// nests such members without overlap, so the fit check skips pairs of them.
+    /// nothing on it (a cast layer without markers, the core), or the filling gel inside the
+    /// core's inner surface: the stack's validation already nests such members without
+    /// overlap, so the fit check skips pairs of them.
     pub nested_by_stack: bool,
     /// What an exact B-rep of the member is built from (STEP export, `export/src/step.rs`),
     /// in the sensor frame, mm; `None` for a printed member (its kit part's own parameters
@@ -166,11 +167,18 @@ pub fn members(
             });
         }
     }
-    for (i, l) in stack.layers.iter().enumerate() {
-        if l.process == LayerProcess::Printed {
-            continue;
-        }
-        let solid = crate::layers::layer_solid(design, stack, i, tol).part(&l.name)?;
+    // The layers' solids in parallel (each single-threaded, collected in order: the same
+    // members whatever the thread count).
+    use rayon::prelude::*;
+    let cast: Vec<usize> = (0..stack.layers.len())
+        .filter(|&i| stack.layers[i].process != LayerProcess::Printed)
+        .collect();
+    let solids = cast
+        .par_iter()
+        .map(|&i| crate::layers::layer_solid(design, stack, i, tol).part(&stack.layers[i].name))
+        .collect::<Result<Vec<_>, _>>()?;
+    for (&i, solid) in cast.iter().zip(solids) {
+        let l = &stack.layers[i];
         out.push(Member {
             name: l.name.clone(),
             kind: MemberKind::Cast,
@@ -237,7 +245,9 @@ pub fn members(
                     "housing.light_chamber_diameter_mm".into(),
                     "housing.diffuser.inner_diameter_mm".into(),
                 ],
-                nested_by_stack: false,
+                // inside the core's inner surface above the core's end, and under it only
+                // where no layer is: nested with the layers and the core by construction
+                nested_by_stack: true,
                 exact: Some(ExactShape::Revolved {
                     profile_rz_mm: pl.points.clone(),
                 }),
