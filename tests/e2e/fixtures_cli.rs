@@ -241,7 +241,7 @@ fn rtac0_fixtures_export_is_complete_deterministic_and_printable() {
 
     // The other papers' indenters, from their own designs' fixtures, slice too.
     let mut others = Vec::new();
-    for (design, n) in [("shadowtac", 3), ("tactip_dualmodal", 2), ("uvdtact", 1)] {
+    for (design, n) in [("shadowtac", 3), ("tactip_dualmodal", 4), ("uvdtact", 1)] {
         let out = format!("fx_{design}");
         let o = run(
             t1.path(),
