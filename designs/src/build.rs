@@ -234,7 +234,6 @@ pub fn build_kit_bounded(
                 waste,
             )
             .map_err(DesignError::Yaml)?;
-            r.layer_volume_ml = Some(v / 1000.0);
             r.notes = format!(
                 "Poured into the assembled shell, pole-down, before the camera goes on: it fills the core, the diffuser's opening and the light chamber up to the LED PCB's face (R-Tac0 Sec. III-B1). {}",
                 r.notes

@@ -107,8 +107,14 @@ pub(crate) fn render(m: &Manifest) -> String {
         }
         let _ = writeln!(
             s,
-            "- pour volume: {:.2} mL (the cavity with its reservoir and sprue)",
-            c.cavity_volume_ml
+            "- pour volume: {:.2} mL ({})",
+            c.cavity_volume_ml,
+            if c.cast == fabkit_designs::procedure::FILLING_GEL {
+                // poured into the assembled shell: no mold, no reservoir
+                "the space it fills in the assembled shell, from the exact surfaces"
+            } else {
+                "the cavity with its reservoir and sprue"
+            }
         );
         let _ = writeln!(
             s,

@@ -330,11 +330,12 @@ fn rtac0_sheet_states_volumes_coats_treatments_and_the_procedure() {
         + PI * 11.7 * 11.7 * 10.0)
         / 1000.0;
     close(
-        gel["layer_volume_ml"].as_f64().unwrap(),
+        gel["cavity_volume_ml"].as_f64().unwrap(),
         v_ml,
         1e-9,
         "filling gel",
     );
+    assert!(gel.get("layer_volume_ml").is_none(), "not a layer: {gel}");
     close(
         gel["total_mass_g"].as_f64().unwrap(),
         v_ml * 1.02 * 1.2,
@@ -342,6 +343,13 @@ fn rtac0_sheet_states_volumes_coats_treatments_and_the_procedure() {
         "filling gel mass",
     );
     assert_eq!(gel["material"], "solaris");
+    assert!(
+        e.sheet.contains(&format!(
+            "- pour volume: {v_ml:.2} mL (the space it fills in the assembled shell"
+        )),
+        "{}",
+        e.sheet
+    );
     let pour = arr(&e.manifest, "procedure")
         .iter()
         .rfind(|p| p["action"] == "pour")
