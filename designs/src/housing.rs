@@ -665,11 +665,7 @@ fn check_round_tube(
     // The bay must exist for the shell to be built; whether the camera board with its
     // components fits in it (housing.camera.bay_height_mm) is the fit check's, which names both
     // parts and the overlap.
-    if let Some(core) = core {
-        let pcb_below_top = core.below_base_mm
-            + h.diffuser.thickness_mm
-            + h.diffuser.gap_above_pcb_mm
-            + h.led_pcb.thickness_mm;
+    if core.is_some() {
         let room = t.height_mm - pcb_below_top - t.base_spigot_height_mm;
         if room <= 0.0 {
             errs.push(ParamError::new(
