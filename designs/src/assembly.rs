@@ -89,14 +89,32 @@ pub enum ExactShape {
 }
 
 /// Roles of kit parts that are part of the sensor (the rest are molds and tooling).
-pub const SENSOR_ROLES: [&str; 6] = [
+pub const SENSOR_ROLES: [&str; 8] = [
     "shell_collar",
     "shell_tube",
     "shell_base",
     "shell_half",
     "printed_skin",
     "marker_tips",
+    "tip_fitting",
+    "shaft_body",
 ];
+
+/// The parameter paths that size a printed member of `role`.
+fn printed_fix(role: &str) -> Vec<String> {
+    match role {
+        "tip_fitting" => vec![
+            "shaft_body.bayonet.lug_width_mm".into(),
+            "shaft_body.tip_fitting".into(),
+        ],
+        "shaft_body" => vec![
+            "shaft_body.bayonet.groove_width_mm".into(),
+            "shaft_body".into(),
+        ],
+        "printed_skin" | "marker_tips" => vec!["layers".into()],
+        _ => vec!["housing".into()],
+    }
+}
 
 /// Overlaps smaller than this are not interferences, mm^3.
 pub const MIN_OVERLAP_MM3: f64 = 1e-3;
@@ -161,7 +179,7 @@ pub fn members(
                 kind: MemberKind::Printed,
                 description: p.description.clone(),
                 solid,
-                fix: vec!["housing".into()],
+                fix: printed_fix(&p.role),
                 nested_by_stack: false,
                 exact: None,
             });

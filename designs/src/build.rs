@@ -83,12 +83,23 @@ pub fn build_kit_bounded(
             )
         },
         || {
-            design
-                .housing
-                .as_ref()
-                .map(|h| crate::housing::build_shell(design, h, &stack, tol))
+            rayon::join(
+                || {
+                    design
+                        .housing
+                        .as_ref()
+                        .map(|h| crate::housing::build_shell(design, h, &stack, tol))
+                },
+                || {
+                    design
+                        .shaft_body
+                        .as_ref()
+                        .map(|sb| crate::parts::shaft_body::build_body(design, sb, &stack, tol))
+                },
+            )
         },
     );
+    let (shell, shaft_body) = shell;
     let mut layer_markers = Vec::new();
     for (&i, out) in other.iter().zip(others) {
         let out = out?;
@@ -142,6 +153,24 @@ pub fn build_kit_bounded(
         summary["envelope_mm"] = json!([w, w, levels.envelope_height_mm]);
         bought.extend(housing_items(h));
         shell_levels = Some(levels);
+    }
+
+    if let (Some(sb), Some(body)) = (&design.shaft_body, shaft_body) {
+        parts.push(body?);
+        let lv = crate::parts::shaft_body::levels(design, sb);
+        let r = design.body.rim_radius_mm(0.0);
+        let w = sb.base.outer_diameter_mm.max(2.0 * r);
+        summary["shaft_levels"] = json!(&lv);
+        summary["envelope_mm"] = json!([w, w, lv.envelope_height_mm]);
+        summary["camera_view"] = json!({
+            "tip_inner_surface_fraction_seen":
+                crate::parts::shaft_body::view_fraction(design, sb, &stack, tol),
+            "lens_z_mm": lv.lens_z_mm,
+            "view_angle_deg": sb.camera.view_angle_deg,
+            "focal_length_mm": sb.camera.focal_length_mm,
+            "rule": "area fraction of the skin's inner surface above the base plane inside the lens's view cone whose ray passes the lip's opening, the LED ring's bore and the shaft's bore (the pins' shadows and the gel's refraction ignored)",
+        });
+        bought.extend(crate::parts::shaft_body::bought_items(sb));
     }
 
     let mut casts = Vec::new();
@@ -241,6 +270,38 @@ pub fn build_kit_bounded(
             casts.push(r);
         }
     }
+    // The clear gel between the skin and the lens window (Pestell et al. Sec. III-A).
+    let mut tip_gel = None;
+    if let Some(sb) = &design.shaft_body {
+        if let Some(f) = &sb.filling_gel {
+            let m = materials
+                .get(&f.material)
+                .ok_or_else(|| DesignError::Yaml(format!("unknown material {}", f.material)))?;
+            let gel = crate::parts::shaft_body::filling_gel_solid(design, sb, &stack, tol)
+                .part(crate::procedure::FILLING_GEL)?;
+            let holders: Vec<String> = parts
+                .iter()
+                .filter(|p| ["printed_skin", "tip_fitting"].contains(&p.role.as_str()))
+                .map(|p| p.name.clone())
+                .collect();
+            let mut r = pour(
+                step,
+                crate::procedure::FILLING_GEL,
+                &f.material,
+                m,
+                holders,
+                gel.volume(),
+                waste,
+            )
+            .map_err(DesignError::Yaml)?;
+            r.notes = format!(
+                "Poured into the tip, pole-down, round the pins and up into the lip's opening; the lens window is then laid on (Pestell et al. Sec. III-A). {}",
+                r.notes
+            );
+            casts.push(r);
+            tip_gel = Some((gel, f.material.clone()));
+        }
+    }
     // Parts are named uniquely by construction; check anyway, the manifest relies on it.
     let mut names: Vec<&str> = parts.iter().map(|p| p.name.as_str()).collect();
     names.sort_unstable();
@@ -251,7 +312,24 @@ pub fn build_kit_bounded(
         .part("kit");
     }
     // The assembled sensor and its fit check: no file is written when parts overlap.
-    let assembly = crate::assembly::members(design, &stack, &parts, shell_levels.as_ref(), tol)?;
+    let mut assembly =
+        crate::assembly::members(design, &stack, &parts, shell_levels.as_ref(), tol)?;
+    if let Some(sb) = &design.shaft_body {
+        assembly.extend(crate::parts::shaft_body::members(design, sb, tol)?);
+        if let Some((solid, material)) = tip_gel {
+            assembly.push(crate::assembly::Member {
+                name: crate::procedure::FILLING_GEL.into(),
+                kind: crate::assembly::MemberKind::Cast,
+                description: format!(
+                    "Clear gel ({material}) between the skin and the lens window, round the pins"
+                ),
+                solid,
+                fix: vec!["shaft_body.tip_fitting.lip_width_mm".into()],
+                nested_by_stack: false,
+                exact: None,
+            });
+        }
+    }
     let found = crate::assembly::interferences(&assembly, tol)?;
     if let Some(e) = crate::assembly::fit_errors(design, &found) {
         return Err(e);

@@ -62,7 +62,8 @@ impl CutPart {
     }
 }
 
-/// The laser-cut parts of a design: the housing's diffuser ring, the backing plate.
+/// The laser-cut parts of a design: the housing's diffuser ring, the shaft body's lens window,
+/// the backing plate.
 pub fn cut_parts(design: &Design) -> Vec<CutPart> {
     let circle = |r: f64| Outline::Circle {
         centre_mm: [0.0, 0.0],
@@ -84,6 +85,20 @@ pub fn cut_parts(design: &Design) -> Vec<CutPart> {
                 (Operation::Cut, circle(d.outer_diameter_mm / 2.0)),
                 (Operation::Cut, circle(d.inner_diameter_mm / 2.0)),
             ],
+        });
+    }
+    if let Some(sb) = &design.shaft_body {
+        let w = &sb.lens_window;
+        out.push(CutPart {
+            name: "lens_window".into(),
+            description: format!(
+                "Lens window: clear acrylic, {:.1} mm thick, diameter {:.1} mm (Pestell et al. \
+                 Sec. III-A: the acrylic lens the gel is filled against)",
+                w.thickness_mm, w.diameter_mm
+            ),
+            material: "pmma".into(),
+            thickness_mm: w.thickness_mm,
+            outlines: vec![(Operation::Cut, circle(w.diameter_mm / 2.0))],
         });
     }
     if let Some(b) = &design.backing {

@@ -76,6 +76,13 @@ pub fn estimate(design: &Design, stack: &Stack, tol: ChordTolerance) -> WorkEsti
         surfaces += surface_triangles(design, c.outer_offset_mm, tol);
         surfaces += surface_triangles(design, c.inner_offset_mm, tol);
     }
+    if let Some(sb) = &design.shaft_body {
+        // the body's and the fitting's cylinders, seats and bayonet bands: about 30 and 27
+        // circles of their outer radius
+        let r = crate::parts::shaft_body::radii(design, sb, stack);
+        surfaces += 30.0 * tol.circle_segments(r.base_outer_mm) as f64
+            + 27.0 * tol.circle_segments(r.fitting_outer_mm) as f64;
+    }
     let (mut markers, mut feature_tris) = (0u64, 0.0);
     for l in &stack.layers {
         for (n, radius_mm) in count_layer_markers(design, l) {

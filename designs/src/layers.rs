@@ -645,6 +645,26 @@ pub fn layer_solid(
     o.difference(&inn)
 }
 
+/// The space inside layer `i` above the base plane, sensor frame, mm: the solid under its
+/// inner surface with its inner features (stems and tips) taken out (what the clear gel of a
+/// printed TacTip tip fills, Pestell et al. Sec. III-A). Its surfaces are the layer's own
+/// (the same tessellation), so that it meets the layer without slivers.
+///
+/// # Errors
+/// [`GeometryError`] if the kernel fails.
+pub fn inner_cavity(
+    design: &Design,
+    stack: &Stack,
+    i: usize,
+    tol: ChordTolerance,
+) -> Result<Solid, GeometryError> {
+    let l = &stack.layers[i];
+    let placed = place_layer_markers(design, l, tol);
+    let inner = on_surface(&placed, MarkerSurface::Inner);
+    // whole features (stems and tips as one solid each): no seam where a tip meets its stem
+    enclosed(design, l.inner_offset_mm, 0.0, &inner, tol, false)
+}
+
 /// Parts and pour numbers of one cast or printed layer built here.
 pub struct LayerOutput {
     pub parts: Vec<Part>,
@@ -781,12 +801,22 @@ fn build_layer_parts(
                 .print_technology
                 .unwrap_or(Technology::Polyjet)
                 .into();
-            let group = placed
-                .iter()
-                .any(|p| p.spec.tip_material.is_some())
+            // The tip's fitting of a shaft body prints with the outermost (printed) layer, as
+            // a further volume of its object (Pestell et al. Sec. III-A).
+            let fitting = match &design.shaft_body {
+                Some(sb) if i + 1 == stack.layers.len() => Some(g(
+                    crate::parts::shaft_body::tip_fitting_solid(design, sb, stack, tol),
+                )?),
+                _ => None,
+            };
+            let group = (placed.iter().any(|p| p.spec.tip_material.is_some()) || fitting.is_some())
                 .then(|| name.clone());
-            // Skin and tips move together onto the plate (same translation).
-            let shift = skin
+            // Skin, tips and fitting move together onto the plate (same translation).
+            let extent = match &fitting {
+                Some(f) => Solid::compose(&[skin.clone(), f.clone()]),
+                None => skin.clone(),
+            };
+            let shift = extent
                 .bounding_box()
                 .map(|b| {
                     [
@@ -824,6 +854,23 @@ fn build_layer_parts(
                     print_technology: tech,
                     solid: tips.translate(shift),
                     params: with_pose(base_params.clone(), &pose),
+                    group: group.clone(),
+                });
+            }
+            if let (Some(f), Some(sb)) = (fitting, &design.shaft_body) {
+                parts.push(Part {
+                    name: "tip_fitting".into(),
+                    role: "tip_fitting".into(),
+                    description: format!(
+                        "The tip's rigid bayonet fitting, printed in the second material with {name} (Pestell et al. Sec. III-A)"
+                    ),
+                    material: sb.tip_fitting.material.clone(),
+                    print_technology: tech,
+                    solid: f.translate(shift),
+                    params: with_pose(
+                        crate::parts::shaft_body::twin_params(design, sb, stack),
+                        &pose,
+                    ),
                     group: group.clone(),
                 });
             }

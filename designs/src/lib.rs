@@ -22,6 +22,7 @@ pub mod library;
 pub mod markers;
 pub mod materials;
 pub mod molds;
+pub mod parts;
 pub mod primitives;
 pub mod procedure;
 pub mod profile;

@@ -631,6 +631,44 @@ fn assembly_steps(
             _ => {}
         }
     }
+    if let Some(sb) = &design.shaft_body {
+        let body = named("shaft_body")
+            .first()
+            .cloned()
+            .unwrap_or_else(|| "the body".into());
+        let fitting = named("tip_fitting")
+            .first()
+            .cloned()
+            .unwrap_or_else(|| "the tip's fitting".into());
+        let screws = crate::build::metric_from_pilot(sb.camera.mount_pilot_diameter_mm)
+            .map_or_else(String::new, |d| format!(" M{d}"));
+        let bayonet = &design.printers.fdm.bayonet;
+        out.push(format!(
+            "Press the LED ring PCB ({} LEDs, facing up) into its seat at the top of {body}, its \
+             wires down the bore, through the ceiling's hole beside the lens and out through the \
+             cable slot (Pestell et al. Sec. III-A).",
+            sb.led_ring.led_count
+        ));
+        out.push(format!(
+            "Screw the camera board into the pocket under {body}, up against the ceiling, with 4 \
+             self-tapping screws{screws} ({:.1} mm pilots), the lens up through the ceiling's \
+             hole and the cable out through the slot; focus the adjustable lens on the pins once \
+             the tip is on (Pestell et al. Sec. III-A2).",
+            sb.camera.mount_pilot_diameter_mm
+        ));
+        if let Some(c) = filling {
+            filled = Some((out.len(), tip_filling_step(c, &fitting)));
+        }
+        out.push(format!(
+            "Twist the tip onto {body}: the {n} lugs of {fitting} down the {n} entry grooves, \
+             push it home, then turn it {:.0} deg counter-clockwise (seen from the tip's pole) \
+             until the lugs stop at the grooves' closed ends; the {:.0} deg ramp draws it down \
+             onto the shaft (Pestell et al. Sec. III-A: a bayonet mount for replacing tips).",
+            sb.bayonet.lock_angle_deg,
+            bayonet.ramp_deg,
+            n = bayonet.lug_count
+        ));
+    }
     if out.is_empty() && filled.is_none() {
         out.push(if parts.iter().any(|p| p.role == "printed_skin") {
             "Nothing to put together: the printed skin comes off the printer with its marker \
@@ -649,6 +687,25 @@ fn assembly_steps(
         steps.insert(at, s);
     }
     steps
+}
+
+/// The filling gel's pour into the printed tip, pole-down, closed by the lens window
+/// (Pestell et al. Sec. III-A).
+fn tip_filling_step(c: &CastReport, fitting: &str) -> ProcedureStep {
+    step(
+        ProcedureAction::Pour,
+        format!(
+            "Step {}: stand the tip pole-down, {fitting} up, mix and degas {} and pour it into \
+             the tip round the pins until it is level with the top of the lip's opening \
+             ({:.2} mL to fill); lay the lens window into its seat in {fitting} on the lip, \
+             sliding it on from one side so that no air is caught (Pestell et al. Sec. III-A). \
+             Let it cure ({}) before the tip goes on the body.",
+            c.step,
+            mix_text(c),
+            c.layer_volume_ml.unwrap_or(c.cavity_volume_ml),
+            cure_text(&c.notes)
+        ),
+    )
 }
 
 /// The filling gel's pour and cure, with the sensor pole-down and the camera not yet on

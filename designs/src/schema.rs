@@ -31,6 +31,10 @@ pub struct Design {
     pub mold: MoldParams,
     #[serde(default)]
     pub housing: Option<HousingParams>,
+    /// The tip's fitting and the shaft body it locks onto by a bayonet (the dual-modal
+    /// TacTip, Pestell et al. Sec. III-A, Fig. 1); none when not given.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shaft_body: Option<crate::parts::shaft_body::ShaftBodyParams>,
     #[serde(default)]
     pub printers: PrinterProfiles,
     #[serde(default)]
@@ -377,6 +381,9 @@ pub struct PrinterProfile {
     pub min_hole_diameter_mm: f64,
     /// Smallest positive feature (pin, key), mm.
     pub min_feature_mm: f64,
+    /// Lug count, ramp and clearance of a bayonet printed on this printer.
+    #[serde(default)]
+    pub bayonet: crate::parts::bayonet::BayonetProfile,
 }
 
 /// The FDM, SLA and PolyJet profiles.
@@ -395,6 +402,7 @@ defaults!(PrinterProfiles {
         min_wall_mm: 0.8,
         min_hole_diameter_mm: 1.0,
         min_feature_mm: 0.8,
+        bayonet: crate::parts::bayonet::BayonetProfile::default(),
     },
     // Form 3 class: 25-50 um pixels and layers.
     sla: PrinterProfile {
@@ -403,6 +411,10 @@ defaults!(PrinterProfiles {
         min_wall_mm: 0.4,
         min_hole_diameter_mm: 0.4,
         min_feature_mm: 0.3,
+        bayonet: crate::parts::bayonet::BayonetProfile {
+            clearance_mm: 0.1,
+            ..crate::parts::bayonet::BayonetProfile::default()
+        },
     },
     // Stratasys PolyJet (Connex): 42 um pixels, 16-30 um layers; Tango features below ~0.6 mm tear.
     polyjet: PrinterProfile {
@@ -411,6 +423,10 @@ defaults!(PrinterProfiles {
         min_wall_mm: 0.6,
         min_hole_diameter_mm: 0.5,
         min_feature_mm: 0.5,
+        bayonet: crate::parts::bayonet::BayonetProfile {
+            clearance_mm: 0.1,
+            ..crate::parts::bayonet::BayonetProfile::default()
+        },
     },
 });
 

@@ -522,6 +522,13 @@ pub fn validate(
             )),
         }
     }
+    if let (Some(sb), true) = (&design.shaft_body, stack_ok) {
+        let st = Stack {
+            core: core.clone(),
+            layers: layers.clone(),
+        };
+        crate::parts::shaft_body::check_params(design, sb, &st, &mut errs);
+    }
     if let (Some(c), true) = (sound_core, errs.is_empty()) {
         if let Some(first) = layers.iter().find(|l| {
             l.process == LayerProcess::Cast

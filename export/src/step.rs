@@ -42,6 +42,10 @@ const TWINS: &[(&str, &str)] = &[
         include_str!("../python/twins/cq_housing.py"),
     ),
     (
+        "cq_shaft_body.py",
+        include_str!("../python/twins/cq_shaft_body.py"),
+    ),
+    (
         "cq_fixtures.py",
         include_str!("../python/twins/cq_fixtures.py"),
     ),

@@ -86,6 +86,52 @@ fn a_broken_fit_is_a_named_interference_and_writes_nothing() {
     }
 }
 
+/// The TacTip's body, through the CLI: a lug 1 mm too wide for its pinned groove and an LED
+/// ring seat 0.3 mm under the ring's diameter are each one named interference; a bayonet
+/// profile of one lug on a 20 deg ramp is refused on both counts. Exit 2, the error naming the
+/// parameter path, its value and the rule, nothing written.
+#[test]
+fn tactip_body_fits_and_bayonet_profile_are_checked_and_write_nothing() {
+    let tmp = tempfile::tempdir().unwrap();
+    let yaml =
+        std::fs::read_to_string(repo_root().join("designs/library/tactip_dualmodal.yaml")).unwrap();
+    let profile = "printers:\n  fdm:\n    xy_resolution_mm: 0.4\n    layer_height_mm: 0.2\n    \
+        min_wall_mm: 0.8\n    min_hole_diameter_mm: 1.0\n    min_feature_mm: 0.8\n    \
+        bayonet: {lug_count: 1, ramp_deg: 20.0, clearance_mm: 0.2}\n";
+    for (from, to, expect) in [
+        (
+            "    lug_width_mm: 3.0 ",
+            "    groove_width_mm: 3.4\n    lug_width_mm: 4.0 ",
+            vec!["shaft_body.bayonet.groove_width_mm = 3.4: fit check: `tip_fitting` and `shaft_body` overlap by 1."],
+        ),
+        (
+            "    outer_diameter_mm: 18.0 ",
+            "    seat_diameter_mm: 17.7\n    outer_diameter_mm: 18.0 ",
+            vec!["shaft_body.led_ring.seat_diameter_mm = 17.7: fit check: `shaft_body` and `led_ring_envelope` overlap by 21."],
+        ),
+        (
+            "shaft_body:\n",
+            &format!("{profile}shaft_body:\n"),
+            vec![
+                "printers.fdm.bayonet.lug_count = 1: must be 2 to 8",
+                "printers.fdm.bayonet.ramp_deg = 20: must be at least 0 and below 15",
+            ],
+        ),
+    ] {
+        let bad = yaml.replacen(from, to, 1);
+        assert!(bad.contains(to), "{to}");
+        std::fs::write(tmp.path().join("bad.yaml"), &bad).unwrap();
+        let o = run(tmp.path(), &["export", "bad.yaml", "--out", "out/bad"], &[]);
+        assert_eq!(o.status.code(), Some(2), "{to}");
+        let err = text(&o.stderr);
+        for e in expect {
+            assert!(err.contains(e), "{e}: {err}");
+        }
+        assert!(!err.contains("panicked"), "{err}");
+        assert!(!tmp.path().join("out").exists());
+    }
+}
+
 #[test]
 fn bad_chord_tolerance_and_unknown_design_are_errors() {
     let tmp = tempfile::tempdir().unwrap();

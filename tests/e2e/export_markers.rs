@@ -233,8 +233,9 @@ fn uvdtact_kits() {
     printcheck_all(&printable_files(&dir, &m));
 }
 
-/// The dual-modal TacTip (Pestell et al. Sec. III-A, III-D): a PolyJet skin with pins and
-/// white pin tips, printed together as one multi-material group; layouts A to D.
+/// The dual-modal TacTip (Pestell et al. Sec. III-A, III-D): a PolyJet skin with pins, white
+/// pin tips and the bayonet fitting, printed together as one multi-material group, and the ABS
+/// body on FDM; layouts A to D.
 #[test]
 fn tactip_kits() {
     let tmp = tempfile::tempdir().unwrap();
@@ -284,7 +285,14 @@ fn tactip_kits() {
             .iter()
             .map(|v| &v["part"])
             .collect();
-        assert_eq!(volumes, ["skin", "skin_tips"], "{name}");
+        // the bayonet fitting (Vero White) prints with them, a third volume of the object
+        assert_eq!(volumes, ["skin", "skin_tips", "tip_fitting"], "{name}");
+        let (fitting, body) = (part(&m, "tip_fitting"), part(&m, "shaft_body"));
+        assert_eq!(fitting["group"], skin["group"], "{name}");
+        assert_eq!(fitting["print_technology"], "PolyJet", "{name}");
+        assert_eq!(fitting["material"], "vero_white", "{name}");
+        assert_eq!(body["print_technology"], "FDM", "{name}");
+        assert_eq!(body["material"], "abs", "{name}");
         oracle_check(&dir);
         if preset.is_none() {
             base = Some((dir, m));
@@ -293,7 +301,8 @@ fn tactip_kits() {
     let (dir, m) = base.unwrap();
     let files = printable_files(&dir, &m);
     assert!(!files.iter().any(|f| f.ends_with("parts/skin_tips.stl")));
-    assert_eq!(files.len(), 2);
+    // skin, fitting, body and the kit's 3MF
+    assert_eq!(files.len(), 4);
     printcheck_all(&files);
     // The tips alone are 107 separate islands that only a layered multi-material process (PolyJet,
     // like SLA: no FDM bed adhesion, no empty-layer rule) prints, beside the skin: checked with the

@@ -19,4 +19,5 @@ mod shadowtac;
 mod sweep;
 mod sweep_metrics;
 mod sweep_paths;
+mod tactip_body;
 mod validation;

@@ -503,6 +503,8 @@ struct PatternCase {
 impl PatternCase {
     fn design(&self) -> Design {
         let mut d = library::load("tactip_dualmodal").expect("library design");
+        // the body round the shaft is sized for the library's tip
+        d.shaft_body = None;
         d.body = self.body.clone();
         d.layers[0].thickness_mm = Some(self.thickness_mm);
         d.layers[0].markers = vec![self.spec.clone()];
@@ -1101,6 +1103,7 @@ fn feature_volume_signs_on_both_surfaces_of_a_shell() {
     for (surface, polarity, height, sigma, delta) in cases {
         let what = format!("{surface:?} {polarity:?}");
         let mut d = library::load("tactip_dualmodal").unwrap();
+        d.shaft_body = None;
         d.body = BodyProfile::HemisphereOnCylinder {
             radius_mm: radius,
             cylinder_length_mm: 3.0,
@@ -1298,7 +1301,9 @@ fn tactip_skin_and_tips_make_whole_pins() {
     let stack = validate(&d, &materials(), tol).unwrap_or_else(|e| panic!("{e}"));
     let out = layers::build_layer(&d, &stack, 0, tol).unwrap();
     let names: Vec<&str> = out.parts.iter().map(|p| p.name.as_str()).collect();
-    assert_eq!(names, ["skin", "skin_tips"]);
+    // the outermost layer also prints the bayonet fitting, in the same 3MF object
+    assert_eq!(names, ["skin", "skin_tips", "tip_fitting"]);
+    assert_eq!(out.parts[2].group, out.parts[0].group);
     let (skin, tips) = (&out.parts[0].solid, &out.parts[1].solid);
     assert_eq!(out.parts[0].group.as_deref(), Some("skin"));
     assert_eq!(out.parts[0].group, out.parts[1].group);
@@ -1446,6 +1451,7 @@ fn recessed_features_of_a_solid_skin_stay_inside_it() {
 /// 5 mm pins 1.7 mm apart on the 5 mm inner surface of a small TacTip-like shell.
 fn converging_pins() -> Design {
     let mut d = library::load("tactip_dualmodal").unwrap();
+    d.shaft_body = None;
     d.body = BodyProfile::HemisphereOnCylinder {
         radius_mm: 6.0,
         cylinder_length_mm: 2.0,

@@ -526,6 +526,7 @@ fn printable_with_follows_the_validation_rules() {
         .unwrap()
         .with_preset("tactipgenerator_217")
         .unwrap();
+    d.shaft_body = None;
     d.body = BodyProfile::HemisphereOnCylinder {
         radius_mm: GEN_R_MM,
         cylinder_length_mm: 4.0,

@@ -4,7 +4,7 @@ builder, then the recorded print placement."""
 from __future__ import annotations
 
 from . import cq_common as C
-from . import cq_fixtures, cq_housing, cq_layers, cq_molds
+from . import cq_fixtures, cq_housing, cq_layers, cq_molds, cq_shaft_body
 from .families import family  # noqa: F401 (re-exported)
 
 
@@ -43,6 +43,10 @@ def _build_sensor(part: dict):
         s = cq_housing.shell_collar(p)
     elif role == "shell_base":
         s = cq_housing.shell_base(p)
+    elif role == "tip_fitting":
+        s = cq_shaft_body.tip_fitting(p)
+    elif role == "shaft_body":
+        s = cq_shaft_body.shaft_body(p)
     elif role == "indenter":
         s = cq_fixtures.indenter(p)
     elif name == "pin_dome":

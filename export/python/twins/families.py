@@ -21,6 +21,8 @@ def family(part: dict) -> str:
         return "pin tips"
     if role in ("shell_half", "shell_collar", "shell_tube", "shell_base"):
         return "housings"
+    if role in ("tip_fitting", "shaft_body"):
+        return "bayonet bodies and fittings"
     if role == "indenter":
         return "indenters"
     if name in ("pin_dome", "pin_dome_ring") or role == "calibration pin":

@@ -548,13 +548,27 @@ fn uvdtact_sheet_gives_a_weighable_batch_and_casts_inside_out() {
     assert_eq!(actions(&e), want);
 }
 
-/// The dual-modal TacTip is printed: no pours, and the procedure is printing and assembly.
+/// The dual-modal TacTip is printed; its one pour is the filling gel, poured into the tip
+/// among the assembly steps: LED ring and camera into the body, the gel and the window into
+/// the tip, the tip twisted onto the body's bayonet.
 #[test]
-fn tactip_sheet_has_no_pours() {
+fn tactip_sheet_pours_the_gel_between_the_assembly_steps() {
     let e = export("tactip_dualmodal", None);
-    assert!(arr(&e.manifest, "casts").is_empty());
-    assert_eq!(actions(&e), [A::Print, A::Assemble]);
-    assert!(!e.sheet.contains("Step 1"), "{}", e.sheet);
+    let casts = arr(&e.manifest, "casts");
+    assert_eq!(casts.len(), 1);
+    assert_eq!(casts[0]["cast"], "filling_gel");
+    assert_eq!(
+        actions(&e),
+        [A::Print, A::Assemble, A::Assemble, A::Pour, A::Assemble]
+    );
+    for text in [
+        "Step 1: stand the tip pole-down",
+        "lay the lens window into its seat in `tip_fitting`",
+        "the 3 lugs of `tip_fitting` down the 3 entry grooves",
+        "turn it 30 deg counter-clockwise",
+    ] {
+        assert!(e.sheet.contains(text), "{text}: {}", e.sheet);
+    }
 }
 
 /// `assembly.3mf` holds every member of the assembled sensor as one named object in the sensor

@@ -1,0 +1,195 @@
+//! The bayonet joint: a socket (the outer part, a skirt with inward lugs) that goes axially
+//! over a spigot (the inner part, a round end with one L-shaped groove per lug in its outer
+//! surface) and locks by a turn (Pestell et al. Sec. III-A: the TacTip's tip and body
+//! "interlock via a bayonet fitting"; Sec. III-C: the body is attached to the robot's mount
+//! "via a bayonet mechanism").
+//!
+//! Each groove is an entry groove, axial from the spigot's end down to the lug's level, and a
+//! locking groove that runs on round the spigot by the lock angle. The locking groove's faces
+//! fall by the ramp angle along the turn, so turning the socket home draws it down onto the
+//! spigot (the lug's top face rides on the groove's upper face). The lugs and the grooves are
+//! built in the locked position: lug `k`'s centre at azimuth `first_lug_deg + k 360 / n`,
+//! its entry groove `lock_angle_deg` before it (clockwise seen from +z; the socket turns
+//! counter-clockwise to lock).
+//!
+//! The lug count, the ramp and the clearance come from the printer profile of the part that
+//! carries the grooves ([`BayonetProfile`], `printers.<technology>.bayonet`): how fine a
+//! lug prints and how loose a printed fit must be are properties of the printer.
+
+use crate::geometry::{ChordTolerance, GeometryError, Mesh, Solid};
+use serde::{Deserialize, Serialize};
+use std::f64::consts::PI;
+
+/// A printer's bayonet settings (`printers.<technology>.bayonet`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct BayonetProfile {
+    /// Lugs round the joint, 2..=8 (and they must fit round the spigot with their grooves).
+    pub lug_count: u32,
+    /// Fall of the locking groove along the turn, degrees from the horizontal, in [0, 15).
+    pub ramp_deg: f64,
+    /// Clearance between a lug and its groove on every side, mm, at least half the nozzle
+    /// (`xy_resolution_mm`).
+    pub clearance_mm: f64,
+}
+
+impl Default for BayonetProfile {
+    /// Three lugs, a 2 deg ramp and 0.2 mm clearance: a twist-lock that prints on a 0.4 mm
+    /// nozzle and holds without a tool (fabkit's choice).
+    fn default() -> Self {
+        Self {
+            lug_count: 3,
+            ramp_deg: 2.0,
+            clearance_mm: 0.2,
+        }
+    }
+}
+
+/// One bayonet joint, resolved: sizes and levels in the sensor frame, mm.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Bayonet {
+    /// Outer radius of the spigot (the grooved part), mm.
+    pub spigot_radius_mm: f64,
+    pub lug_count: u32,
+    /// Lug width, measured along the spigot's circumference, mm.
+    pub lug_width_mm: f64,
+    /// Lug height along z, mm.
+    pub lug_height_mm: f64,
+    /// How far a lug reaches in from the spigot's surface, mm.
+    pub lug_depth_mm: f64,
+    /// Width of the entry and locking grooves along the circumference, mm (by default the
+    /// lug's width plus the clearance on each side).
+    pub groove_width_mm: f64,
+    pub clearance_mm: f64,
+    /// Turn from the entry groove to the locked position, degrees.
+    pub lock_angle_deg: f64,
+    pub ramp_deg: f64,
+    /// Azimuth of the first lug's centre, locked, degrees.
+    pub first_lug_deg: f64,
+    /// z of the lugs' centres, locked, mm.
+    pub lug_z_mm: f64,
+    /// z of the spigot's end where the entry grooves open, mm.
+    pub spigot_end_z_mm: f64,
+}
+
+impl Bayonet {
+    /// Azimuths of the lugs' centres, locked, degrees.
+    pub fn lug_azimuths_deg(&self) -> Vec<f64> {
+        (0..self.lug_count)
+            .map(|k| self.first_lug_deg + f64::from(k) * 360.0 / f64::from(self.lug_count))
+            .collect()
+    }
+
+    /// The rise of the locking groove from the locked end to the entry, mm: the socket sits
+    /// this much higher when its lugs come down the entry grooves.
+    pub fn rise_mm(&self) -> f64 {
+        self.lock_angle_deg.to_radians() * self.spigot_radius_mm * self.ramp_deg.to_radians().tan()
+    }
+
+    /// The lugs in the locked position, each from `lug_depth_mm` inside the spigot's surface
+    /// out to `outer_radius_mm` (into the socket's wall, so that their union with it is clean).
+    ///
+    /// # Errors
+    /// [`GeometryError`] on a degenerate size.
+    pub fn lugs(&self, outer_radius_mm: f64, tol: ChordTolerance) -> Result<Solid, GeometryError> {
+        let r = self.spigot_radius_mm;
+        let half = self.lug_width_mm / 2.0 / r;
+        let z0 = self.lug_z_mm - self.lug_height_mm / 2.0;
+        let mut out = Vec::new();
+        for a in self.lug_azimuths_deg() {
+            let a = a.to_radians();
+            out.push(Solid::from_mesh(&band(
+                (r - self.lug_depth_mm, outer_radius_mm),
+                (a - half, a + half),
+                (z0, z0 + self.lug_height_mm),
+                0.0,
+                tol,
+            ))?);
+        }
+        Ok(Solid::compose(&out))
+    }
+
+    /// The grooves, to be cut from the spigot: per lug the entry groove from the spigot's end
+    /// down and the ramped locking groove, `clearance_mm` round the lug on every side, out to
+    /// 1 mm past the spigot's surface.
+    ///
+    /// # Errors
+    /// [`GeometryError`] on a degenerate size.
+    pub fn grooves(&self, tol: ChordTolerance) -> Result<Solid, GeometryError> {
+        let r = self.spigot_radius_mm;
+        let c = self.clearance_mm;
+        let radial = (r - self.lug_depth_mm - c, r + 1.0);
+        let half = (self.groove_width_mm / 2.0) / r;
+        let lock = self.lock_angle_deg.to_radians();
+        let h = self.lug_height_mm / 2.0 + c;
+        // the locking groove's centre falls by tan(ramp) per mm of turn towards the lock
+        let slope = -r * self.ramp_deg.to_radians().tan();
+        let rise = self.rise_mm();
+        let mut out = Vec::new();
+        for a in self.lug_azimuths_deg() {
+            let a = a.to_radians();
+            let entry = a - lock;
+            // locking groove: from the entry groove's far side to past the locked lug
+            let a0 = entry - half;
+            let a1 = a + half;
+            let z_at_a0 = self.lug_z_mm + rise + slope * (a0 - entry);
+            let lock_groove = band(radial, (a0, a1), (z_at_a0 - h, z_at_a0 + h), slope, tol);
+            // entry groove: from the spigot's end down to the locking groove's floor there
+            let floor = self.lug_z_mm + rise - h;
+            let entry_groove = band(
+                radial,
+                (entry - half, entry + half),
+                (floor, self.spigot_end_z_mm + 1.0),
+                0.0,
+                tol,
+            );
+            out.push(Solid::from_mesh(&lock_groove)?.union(&Solid::from_mesh(&entry_groove)?)?);
+        }
+        Solid::union_all(&out)
+    }
+}
+
+/// A closed annular sector `r0 <= r <= r1`, `a0 <= azimuth <= a1` (radians), whose z range
+/// `[z0, z1]` at `a0` moves by `slope_mm_per_rad` per radian of azimuth (a helical band; flat
+/// for slope 0), tessellated so that its arcs stay within the chord tolerance.
+pub fn band(
+    (r0, r1): (f64, f64),
+    (a0, a1): (f64, f64),
+    (z0, z1): (f64, f64),
+    slope_mm_per_rad: f64,
+    tol: ChordTolerance,
+) -> Mesh {
+    let n = ((tol.circle_segments(r1) as f64) * (a1 - a0) / (2.0 * PI))
+        .ceil()
+        .max(1.0) as usize;
+    let mut vertices = Vec::with_capacity(4 * (n + 1));
+    for i in 0..=n {
+        let a = a0 + (a1 - a0) * i as f64 / n as f64;
+        let dz = slope_mm_per_rad * (a - a0);
+        let (s, c) = a.sin_cos();
+        // 0: inner bottom, 1: outer bottom, 2: outer top, 3: inner top
+        vertices.push([r0 * c, r0 * s, z0 + dz]);
+        vertices.push([r1 * c, r1 * s, z0 + dz]);
+        vertices.push([r1 * c, r1 * s, z1 + dz]);
+        vertices.push([r0 * c, r0 * s, z1 + dz]);
+    }
+    let mut triangles = Vec::with_capacity(8 * n + 4);
+    let v = |i: usize, k: usize| (4 * i + k) as u32;
+    for i in 0..n {
+        let j = i + 1;
+        // bottom (normal -z), outer (+r), top (+z), inner (-r); azimuth grows from i to j
+        for (k0, k1) in [(0, 1), (1, 2), (2, 3), (3, 0)] {
+            triangles.push([v(i, k0), v(j, k1), v(i, k1)]);
+            triangles.push([v(i, k0), v(j, k0), v(j, k1)]);
+        }
+    }
+    // end caps: at a0 facing -azimuth, at a1 facing +azimuth
+    triangles.push([v(0, 0), v(0, 1), v(0, 2)]);
+    triangles.push([v(0, 0), v(0, 2), v(0, 3)]);
+    triangles.push([v(n, 0), v(n, 2), v(n, 1)]);
+    triangles.push([v(n, 0), v(n, 3), v(n, 2)]);
+    Mesh {
+        vertices,
+        triangles,
+    }
+}

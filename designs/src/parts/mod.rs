@@ -1,0 +1,5 @@
+//! Part families that any sensor design can use, one module per family (../shared/STYLE.md):
+//! each with its parameters, its rules and its solids.
+
+pub mod bayonet;
+pub mod shaft_body;

@@ -1,0 +1,310 @@
+//! The dual-modal TacTip's body and its tip's bayonet fitting (Pestell et al. Sec. III-A,
+//! Fig. 1): the bayonet's bands against their analytic volumes, the locked lugs clear of the
+//! grooves, the assembled sensor free of interferences, one fit broken at a time giving one
+//! named interference with its analytic overlap, and one bad value per rule refused by path.
+
+use fabkit_designs::assembly::{interferences, MemberKind};
+use fabkit_designs::materials::MaterialsTable;
+use fabkit_designs::parts::bayonet::band;
+use fabkit_designs::parts::shaft_body::tip_bayonet;
+use fabkit_designs::{build_kit, library, stack, ChordTolerance, Design, DesignError, Kit, Solid};
+use std::f64::consts::PI;
+use std::sync::OnceLock;
+
+fn tol() -> ChordTolerance {
+    ChordTolerance::new(0.01).unwrap()
+}
+
+fn tactip() -> Design {
+    library::load("tactip_dualmodal").unwrap()
+}
+
+/// The TacTip's kit at 0.01 mm, built once for the tests of this module.
+fn kit() -> &'static Kit {
+    static KIT: OnceLock<Kit> = OnceLock::new();
+    KIT.get_or_init(|| build_kit(&tactip(), tol()).unwrap())
+}
+
+fn rel_close(a: f64, b: f64, rel: f64, what: &str) {
+    assert!((a - b).abs() <= rel * b.abs(), "{what}: {a} vs {b}");
+}
+
+/// A band's volume is the annular sector's, whatever its ramp (the ramp shears it along z):
+/// (r1^2 - r0^2) / 2 x span x height, less the polygon's shortfall (within 0.2 % at 0.01 mm);
+/// it is a closed 2-manifold of genus 0 either way.
+#[test]
+fn bayonet_bands_have_the_sectors_volume_ramped_or_flat() {
+    let (r0, r1, a0, a1, z0, z1) = (10.0, 12.0, 0.2, 0.9, -3.0, -1.0);
+    let exact = (r1 * r1 - r0 * r0) / 2.0 * (a1 - a0) * (z1 - z0);
+    for slope in [0.0, 0.3, -0.4] {
+        let s = Solid::from_mesh(&band((r0, r1), (a0, a1), (z0, z1), slope, tol())).unwrap();
+        let v = s.volume();
+        assert!(
+            v <= exact * (1.0 + 1e-9) && v >= exact * 0.998,
+            "slope {slope}: {v} vs {exact}"
+        );
+        assert_eq!(s.genus(), 0, "slope {slope}");
+        let b = s.bounding_box().unwrap();
+        let rise = slope * (a1 - a0);
+        rel_close(b.min[2], z0 + rise.min(0.0), 1e-9, "bottom");
+        rel_close(b.max[2], z1 + rise.max(0.0), 1e-9, "top");
+    }
+}
+
+/// The locked lugs: `lug_count` of them (from the printer profile), each the sector of the
+/// lug's width and height from `lug_depth_mm` inside the spigot out to the given radius, and
+/// none of them touches the spigot less its grooves (the clearance all round).
+#[test]
+fn locked_lugs_sit_clear_inside_their_grooves() {
+    let d = tactip();
+    let sb = d.shaft_body.as_ref().unwrap();
+    let b = tip_bayonet(&d, sb);
+    assert_eq!(b.lug_count, d.printers.fdm.bayonet.lug_count);
+    assert_eq!(b.lug_count, 3);
+    let r = b.spigot_radius_mm;
+    let outer = r + 0.2;
+    let lugs = b.lugs(outer, tol()).unwrap();
+    let exact = f64::from(b.lug_count) * (outer * outer - (r - b.lug_depth_mm).powi(2)) / 2.0
+        * (b.lug_width_mm / r)
+        * b.lug_height_mm;
+    let v = lugs.volume();
+    assert!(
+        v <= exact * (1.0 + 1e-9) && v >= exact * 0.998,
+        "{v} vs {exact}"
+    );
+    let spigot = fabkit_designs::geometry::cylinder(20.0, r, tol())
+        .unwrap()
+        .translate([0.0, 0.0, b.spigot_end_z_mm - 20.0]);
+    let grooved = spigot.difference(&b.grooves(tol()).unwrap()).unwrap();
+    assert!(grooved.volume() < spigot.volume());
+    let touching = grooved.intersection(&lugs).unwrap().volume();
+    assert!(
+        touching < 1e-9,
+        "lugs overlap the grooved spigot by {touching} mm3"
+    );
+    // the entry grooves lie `lock_angle_deg` before the lugs and rise by the ramp over the turn
+    rel_close(
+        b.rise_mm(),
+        b.lock_angle_deg.to_radians() * r * b.ramp_deg.to_radians().tan(),
+        1e-12,
+        "rise",
+    );
+}
+
+/// The kit prints the fitting with the skin (same 3MF object) and the ABS body on FDM; the
+/// assembly holds them with the window, the LED ring, the camera board and lens and the cast
+/// gel, without an interference; the manifest's view fraction is the share of the skin's inner
+/// surface the lens sees, between 0 and 1.
+#[test]
+fn tactip_kit_has_the_body_and_an_assembly_without_interferences() {
+    let k = kit();
+    let parts: Vec<(&str, &str)> = k
+        .parts
+        .iter()
+        .map(|p| (p.name.as_str(), p.material.as_str()))
+        .collect();
+    assert_eq!(
+        parts,
+        [
+            ("skin", "tango_black_plus"),
+            ("skin_tips", "vero_white"),
+            ("tip_fitting", "vero_white"),
+            ("shaft_body", "abs"),
+        ]
+    );
+    assert_eq!(k.parts[2].group, k.parts[0].group);
+    let names: Vec<(&str, MemberKind)> = k
+        .assembly
+        .iter()
+        .map(|m| (m.name.as_str(), m.kind))
+        .collect();
+    for want in [
+        ("tip_fitting", MemberKind::Printed),
+        ("shaft_body", MemberKind::Printed),
+        ("filling_gel", MemberKind::Cast),
+        ("lens_window_envelope", MemberKind::Bought),
+        ("led_ring_envelope", MemberKind::Bought),
+        ("camera_board_envelope", MemberKind::Bought),
+        ("camera_lens_envelope", MemberKind::Bought),
+    ] {
+        assert!(names.contains(&want), "{want:?} not in {names:?}");
+    }
+    assert_eq!(interferences(&k.assembly, tol()).unwrap(), vec![]);
+    let f = k.summary["camera_view"]["tip_inner_surface_fraction_seen"]
+        .as_f64()
+        .unwrap();
+    assert!(f > 0.0 && f <= 1.0, "{f}");
+    // a wider LED ring bore shades less of the tip
+    let mut d = tactip();
+    d.shaft_body.as_mut().unwrap().led_ring.inner_diameter_mm = 10.0;
+    let materials = MaterialsTable::embedded().unwrap();
+    let st = stack::validate(&d, &materials, tol()).unwrap();
+    let narrow = fabkit_designs::parts::shaft_body::view_fraction(
+        &d,
+        d.shaft_body.as_ref().unwrap(),
+        &st,
+        tol(),
+    );
+    assert!(narrow < f, "{narrow} vs {f}");
+}
+
+/// The error of a kit that does not build.
+fn build_error(d: &Design) -> fabkit_designs::ParamErrors {
+    match build_kit(d, tol()) {
+        Err(DesignError::Params(e)) => e,
+        other => panic!("{:?}", other.map(|k| k.design)),
+    }
+}
+
+/// The overlap's volume in an error's rule ("overlap by V mm³").
+fn overlap(rule: &str) -> f64 {
+    rule.split("overlap by ")
+        .nth(1)
+        .and_then(|r| r.split(' ').next())
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("{rule}"))
+}
+
+/// The LED ring's seat bored 0.3 mm under the ring's diameter: one error naming the seat's
+/// diameter with its value, both parts and the overlap, the ring of 18 / 17.7 mm over the
+/// ring's thickness and its LEDs' height (2.6 mm); no kit.
+#[test]
+fn a_seat_too_small_for_the_led_ring_is_a_named_interference() {
+    let mut d = tactip();
+    d.shaft_body.as_mut().unwrap().led_ring.seat_diameter_mm = Some(17.7);
+    let e = build_error(&d);
+    assert_eq!(e.0.len(), 1, "{e}");
+    let want = PI * (9.0f64.powi(2) - 8.85f64.powi(2)) * 2.6;
+    let got = overlap(&e.0[0].rule);
+    assert!(
+        e.0[0].path == "shaft_body.led_ring.seat_diameter_mm"
+            && e.0[0].value == "17.7"
+            && e.0[0]
+                .rule
+                .contains("`shaft_body` and `led_ring_envelope` overlap by")
+            && (got - want).abs() <= 0.02 * want,
+        "{e} (analytic {want})"
+    );
+}
+
+/// A lug 1 mm wider than designed with its groove's width pinned (3.4 mm): each of the three
+/// lugs reaches 0.3 mm past the locking groove's closed end, into the spigot between the
+/// groove's floor (lug depth 0.8 mm) and the spigot's surface (11.5 mm), over the lug's
+/// 1.5 mm height. One error naming the groove's width, both parts and the overlap; no kit.
+#[test]
+fn a_lug_too_wide_for_its_groove_is_a_named_interference() {
+    let mut d = tactip();
+    let b = &mut d.shaft_body.as_mut().unwrap().bayonet;
+    b.groove_width_mm = Some(b.lug_width_mm + 0.4);
+    b.lug_width_mm += 1.0;
+    let e = build_error(&d);
+    assert_eq!(e.0.len(), 1, "{e}");
+    let r: f64 = 11.5;
+    let want = 3.0 * (0.3 / r) * (r * r - (r - 0.8f64).powi(2)) / 2.0 * 1.5;
+    let got = overlap(&e.0[0].rule);
+    assert!(
+        e.0[0].path == "shaft_body.bayonet.groove_width_mm"
+            && e.0[0].value == "3.4"
+            && e.0[0]
+                .rule
+                .contains("`tip_fitting` and `shaft_body` overlap by")
+            && e.0[0].rule.contains("shaft_body.bayonet.lug_width_mm")
+            && (got - want).abs() <= 0.03 * want,
+        "{e} (analytic {want})"
+    );
+}
+
+/// One bad value per rule of the body and the printer's bayonet profile: validation names the
+/// parameter's path (among any others the value breaks) with its value and a rule.
+#[test]
+fn each_rule_of_the_body_names_its_parameter() {
+    type Mutation = fn(&mut Design);
+    let cases: &[(&str, Mutation)] = &[
+        ("printers.fdm.bayonet.lug_count", |d| {
+            d.printers.fdm.bayonet.lug_count = 1
+        }),
+        ("printers.fdm.bayonet.lug_count", |d| {
+            d.printers.fdm.bayonet.lug_count = 9
+        }),
+        ("printers.fdm.bayonet.ramp_deg", |d| {
+            d.printers.fdm.bayonet.ramp_deg = 20.0
+        }),
+        ("printers.fdm.bayonet.ramp_deg", |d| {
+            d.printers.fdm.bayonet.ramp_deg = -1.0
+        }),
+        ("printers.fdm.bayonet.clearance_mm", |d| {
+            d.printers.fdm.bayonet.clearance_mm = 0.05
+        }),
+        ("shaft_body.bayonet.lock_angle_deg", |d| {
+            sb(d).bayonet.lock_angle_deg = 95.0
+        }),
+        ("shaft_body.bayonet.lock_angle_deg", |d| {
+            d.printers.fdm.bayonet.lug_count = 8;
+            sb(d).bayonet.lock_angle_deg = 45.0;
+        }),
+        ("shaft_body.camera.view_angle_deg", |d| {
+            sb(d).camera.view_angle_deg = 180.0
+        }),
+        ("shaft_body.fit_clearance_mm", |d| {
+            sb(d).fit_clearance_mm = 0.05
+        }),
+        ("shaft_body.bayonet.lug_depth_mm", |d| {
+            sb(d).bayonet.lug_depth_mm = 2.5
+        }),
+        ("shaft_body.bayonet.groove_width_mm", |d| {
+            sb(d).bayonet.groove_width_mm = Some(0.0)
+        }),
+        ("shaft_body.led_ring.inner_diameter_mm", |d| {
+            sb(d).led_ring.inner_diameter_mm = 19.0
+        }),
+        ("shaft_body.wall_thickness_mm", |d| {
+            sb(d).wall_thickness_mm = 0.5
+        }),
+        ("shaft_body.base.outer_diameter_mm", |d| {
+            sb(d).base.outer_diameter_mm = 40.0
+        }),
+        ("shaft_body.camera.mount_hole_spacing_mm", |d| {
+            sb(d).camera.mount_hole_spacing_mm = 30.0
+        }),
+        ("shaft_body.camera.mount_pilot_depth_mm", |d| {
+            sb(d).camera.mount_pilot_depth_mm = 40.0
+        }),
+        ("shaft_body.camera.lens_height_mm", |d| {
+            sb(d).camera.lens_height_mm = 40.0
+        }),
+        ("shaft_body.shaft_diameter_mm", |d| {
+            sb(d).shaft_diameter_mm = 30.0
+        }),
+        ("shaft_body.lens_window.diameter_mm", |d| {
+            sb(d).lens_window.diameter_mm = 28.0
+        }),
+        ("shaft_body.tip_fitting.lip_width_mm", |d| {
+            sb(d).tip_fitting.lip_width_mm = 12.0
+        }),
+        ("shaft_body.led_ring.seat_diameter_mm", |d| {
+            sb(d).led_ring.seat_diameter_mm = Some(f64::NAN)
+        }),
+    ];
+    let materials = MaterialsTable::embedded().unwrap();
+    for (path, mutate) in cases {
+        let mut d = tactip();
+        mutate(&mut d);
+        let e = match stack::validate(&d, &materials, tol()) {
+            Err(e) => e,
+            Ok(_) => panic!("{path}: validates"),
+        };
+        assert!(
+            e.0.iter()
+                .any(|x| x.path == *path && !x.rule.is_empty() && !x.value.is_empty()),
+            "{path}: {e}"
+        );
+        assert!(
+            matches!(build_kit(&d, tol()), Err(DesignError::Params(_))),
+            "{path}"
+        );
+    }
+}
+
+fn sb(d: &mut Design) -> &mut fabkit_designs::parts::shaft_body::ShaftBodyParams {
+    d.shaft_body.as_mut().unwrap()
+}
