@@ -89,7 +89,7 @@ pub enum ExactShape {
 }
 
 /// Roles of kit parts that are part of the sensor (the rest are molds and tooling).
-pub const SENSOR_ROLES: [&str; 8] = [
+pub const SENSOR_ROLES: [&str; 9] = [
     "shell_collar",
     "shell_tube",
     "shell_base",
@@ -98,6 +98,7 @@ pub const SENSOR_ROLES: [&str; 8] = [
     "marker_tips",
     "tip_fitting",
     "shaft_body",
+    "robot_mount",
 ];
 
 /// The parameter paths that size a printed member of `role`.
@@ -110,6 +111,10 @@ fn printed_fix(role: &str) -> Vec<String> {
         "shaft_body" => vec![
             "shaft_body.bayonet.groove_width_mm".into(),
             "shaft_body".into(),
+        ],
+        "robot_mount" => vec![
+            "shaft_body.robot_mount.bayonet.groove_width_mm".into(),
+            "shaft_body.robot_mount".into(),
         ],
         "printed_skin" | "marker_tips" => vec!["layers".into()],
         _ => vec!["housing".into()],

@@ -94,7 +94,17 @@ pub fn build_kit_bounded(
                     design
                         .shaft_body
                         .as_ref()
-                        .map(|sb| crate::parts::shaft_body::build_body(design, sb, &stack, tol))
+                        .map(|sb| -> Result<Vec<crate::Part>, DesignError> {
+                            let mut out = vec![crate::parts::shaft_body::build_body(
+                                design, sb, &stack, tol,
+                            )?];
+                            if let Some(m) = &sb.robot_mount {
+                                out.push(crate::parts::robot_mount::build_mount(
+                                    design, sb, m, tol,
+                                )?);
+                            }
+                            Ok(out)
+                        })
                 },
             )
         },
@@ -156,7 +166,7 @@ pub fn build_kit_bounded(
     }
 
     if let (Some(sb), Some(body)) = (&design.shaft_body, shaft_body) {
-        parts.push(body?);
+        parts.extend(body?);
         let lv = crate::parts::shaft_body::levels(design, sb);
         let r = design.body.rim_radius_mm(0.0);
         let w = sb.base.outer_diameter_mm.max(2.0 * r);
@@ -171,6 +181,9 @@ pub fn build_kit_bounded(
             "rule": "area fraction of the skin's inner surface above the base plane inside the lens's view cone whose ray passes the lip's opening, the LED ring's bore and the shaft's bore (the pins' shadows and the gel's refraction ignored)",
         });
         bought.extend(crate::parts::shaft_body::bought_items(sb));
+        if let Some(m) = &sb.robot_mount {
+            bought.extend(crate::parts::robot_mount::bought_items(m));
+        }
     }
 
     let mut casts = Vec::new();

@@ -659,6 +659,20 @@ fn assembly_steps(
         if let Some(c) = filling {
             filled = Some((out.len(), tip_filling_step(c, &fitting)));
         }
+        if let Some(m) = &sb.robot_mount {
+            out.push(format!(
+                "Bolt `robot_mount` to the tool flange of the {} with {} socket head cap \
+                 screws, its locating pin in the flange's pin hole; set the base of {body} into \
+                 its cup, the {n} lugs down the entry grooves and the camera's cable out through \
+                 the window, and turn {body} {:.0} deg clockwise (seen from the tip's pole) \
+                 until it stops (Pestell et al. Sec. III-A3: the body attaches to the robot's \
+                 mount by a bayonet).",
+                m.robot,
+                m.bolt_count,
+                m.bayonet.lock_angle_deg,
+                n = bayonet.lug_count
+            ));
+        }
         out.push(format!(
             "Twist the tip onto {body}: the {n} lugs of {fitting} down the {n} entry grooves, \
              push it home, then turn it {:.0} deg counter-clockwise (seen from the tip's pole) \

@@ -301,8 +301,8 @@ fn tactip_kits() {
     let (dir, m) = base.unwrap();
     let files = printable_files(&dir, &m);
     assert!(!files.iter().any(|f| f.ends_with("parts/skin_tips.stl")));
-    // skin, fitting, body and the kit's 3MF
-    assert_eq!(files.len(), 4);
+    // skin, fitting, body, robot mount and the kit's 3MF
+    assert_eq!(files.len(), 5);
     printcheck_all(&files);
     // The tips alone are 107 separate islands that only a layered multi-material process (PolyJet,
     // like SLA: no FDM bed adhesion, no empty-layer rule) prints, beside the skin: checked with the

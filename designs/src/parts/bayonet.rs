@@ -9,8 +9,13 @@
 //! fall by the ramp angle along the turn, so turning the socket home draws it down onto the
 //! spigot (the lug's top face rides on the groove's upper face). The lugs and the grooves are
 //! built in the locked position: lug `k`'s centre at azimuth `first_lug_deg + k 360 / n`,
-//! its entry groove `lock_angle_deg` before it (clockwise seen from +z; the socket turns
-//! counter-clockwise to lock).
+//! its entry groove `lock_angle_deg` before it along the turn that locks (counter-clockwise
+//! seen from +z unless `clockwise`).
+//!
+//! Inward (the tip on the shaft): the lugs reach in from the socket's skirt into grooves in
+//! the spigot's outer surface. Outward (the body in the robot's mount): the lugs stand out
+//! from the inner part into grooves in the bore of a cup; `groove_radius_mm` is then the
+//! bore's radius.
 //!
 //! The lug count, the ramp and the clearance come from the printer profile of the part that
 //! carries the grooves ([`BayonetProfile`], `printers.<technology>.bayonet`): how fine a
@@ -48,8 +53,13 @@ impl Default for BayonetProfile {
 /// One bayonet joint, resolved: sizes and levels in the sensor frame, mm.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Bayonet {
-    /// Outer radius of the spigot (the grooved part), mm.
+    /// Radius of the grooved surface, mm: the spigot's outer surface (inward lugs) or the
+    /// cup's bore (outward lugs).
     pub spigot_radius_mm: f64,
+    /// Lugs stand out from the inner part into grooves in a cup's bore.
+    pub outward: bool,
+    /// The lugs' part turns clockwise (seen from +z) to lock.
+    pub clockwise: bool,
     pub lug_count: u32,
     /// Lug width, measured along the spigot's circumference, mm.
     pub lug_width_mm: f64,
@@ -86,20 +96,26 @@ impl Bayonet {
         self.lock_angle_deg.to_radians() * self.spigot_radius_mm * self.ramp_deg.to_radians().tan()
     }
 
-    /// The lugs in the locked position, each from `lug_depth_mm` inside the spigot's surface
-    /// out to `outer_radius_mm` (into the socket's wall, so that their union with it is clean).
+    /// The lugs in the locked position, each from `lug_depth_mm` past the grooved surface
+    /// (inside the spigot, or out into the cup's wall) back to `attach_radius_mm` (into the
+    /// part that carries them, so that their union with it is clean).
     ///
     /// # Errors
     /// [`GeometryError`] on a degenerate size.
-    pub fn lugs(&self, outer_radius_mm: f64, tol: ChordTolerance) -> Result<Solid, GeometryError> {
+    pub fn lugs(&self, attach_radius_mm: f64, tol: ChordTolerance) -> Result<Solid, GeometryError> {
         let r = self.spigot_radius_mm;
         let half = self.lug_width_mm / 2.0 / r;
         let z0 = self.lug_z_mm - self.lug_height_mm / 2.0;
+        let radial = if self.outward {
+            (attach_radius_mm, r + self.lug_depth_mm)
+        } else {
+            (r - self.lug_depth_mm, attach_radius_mm)
+        };
         let mut out = Vec::new();
         for a in self.lug_azimuths_deg() {
             let a = a.to_radians();
             out.push(Solid::from_mesh(&band(
-                (r - self.lug_depth_mm, outer_radius_mm),
+                radial,
                 (a - half, a + half),
                 (z0, z0 + self.lug_height_mm),
                 0.0,
@@ -109,33 +125,38 @@ impl Bayonet {
         Ok(Solid::compose(&out))
     }
 
-    /// The grooves, to be cut from the spigot: per lug the entry groove from the spigot's end
-    /// down and the ramped locking groove, `clearance_mm` round the lug on every side, out to
-    /// 1 mm past the spigot's surface.
+    /// The grooves, to be cut from the grooved part: per lug the entry groove from the
+    /// spigot's end (or the cup's rim) down and the ramped locking groove, `clearance_mm`
+    /// round the lug on every side, reaching 1 mm out of the grooved surface.
     ///
     /// # Errors
     /// [`GeometryError`] on a degenerate size.
     pub fn grooves(&self, tol: ChordTolerance) -> Result<Solid, GeometryError> {
         let r = self.spigot_radius_mm;
         let c = self.clearance_mm;
-        let radial = (r - self.lug_depth_mm - c, r + 1.0);
+        let radial = if self.outward {
+            (r - 1.0, r + self.lug_depth_mm + c)
+        } else {
+            (r - self.lug_depth_mm - c, r + 1.0)
+        };
         let half = (self.groove_width_mm / 2.0) / r;
         let lock = self.lock_angle_deg.to_radians();
         let h = self.lug_height_mm / 2.0 + c;
+        // +1 when the lugs turn counter-clockwise to lock
+        let turn = if self.clockwise { -1.0 } else { 1.0 };
+        let tan = self.ramp_deg.to_radians().tan();
         // the locking groove's centre falls by tan(ramp) per mm of turn towards the lock
-        let slope = -r * self.ramp_deg.to_radians().tan();
-        let rise = self.rise_mm();
+        let slope = -turn * r * tan;
         let mut out = Vec::new();
         for a in self.lug_azimuths_deg() {
             let a = a.to_radians();
-            let entry = a - lock;
-            // locking groove: from the entry groove's far side to past the locked lug
-            let a0 = entry - half;
-            let a1 = a + half;
-            let z_at_a0 = self.lug_z_mm + rise + slope * (a0 - entry);
-            let lock_groove = band(radial, (a0, a1), (z_at_a0 - h, z_at_a0 + h), slope, tol);
+            let entry = a - turn * lock;
+            let z_at = |az: f64| self.lug_z_mm + turn * r * tan * (a - az);
+            let a0 = entry.min(a) - half;
+            let a1 = entry.max(a) + half;
+            let lock_groove = band(radial, (a0, a1), (z_at(a0) - h, z_at(a0) + h), slope, tol);
             // entry groove: from the spigot's end down to the locking groove's floor there
-            let floor = self.lug_z_mm + rise - h;
+            let floor = z_at(entry) - h;
             let entry_groove = band(
                 radial,
                 (entry - half, entry + half),

@@ -2,4 +2,5 @@
 //! each with its parameters, its rules and its solids.
 
 pub mod bayonet;
+pub mod robot_mount;
 pub mod shaft_body;

@@ -60,6 +60,9 @@ pub struct ShaftBodyParams {
     /// The clear gel between the skin and the lens window; none when not given.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub filling_gel: Option<FillingGel>,
+    /// The mount that holds the body on a robot by a bayonet; none when not given.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub robot_mount: Option<crate::parts::robot_mount::RobotMount>,
 }
 
 /// The tip's rigid fitting, printed with the skin (Sec. III-A: "a rigid bayonet fitting (Vero
@@ -275,6 +278,8 @@ pub fn tip_bayonet(design: &Design, sb: &ShaftBodyParams) -> Bayonet {
     let b = &sb.bayonet;
     Bayonet {
         spigot_radius_mm: sb.shaft_diameter_mm / 2.0,
+        outward: false,
+        clockwise: false,
         lug_count: p.lug_count,
         lug_width_mm: b.lug_width_mm,
         lug_height_mm: b.lug_height_mm,
@@ -595,6 +600,9 @@ pub fn check_params(
             cam.view_angle_deg, r.lip_inner_mm
         ),
     );
+    if let Some(m) = &sb.robot_mount {
+        crate::parts::robot_mount::check_params(design, sb, m, errs);
+    }
 }
 
 /// The fitting's profile of revolution (r, z), closed, counter-clockwise.
@@ -642,6 +650,10 @@ pub fn twin_params(design: &Design, sb: &ShaftBodyParams, stack: &Stack) -> serd
         "cable_slot_mm": CABLE_SLOT_MM,
         "overlap_mm": OVERLAP_MM,
         "shaft_body": sb,
+        "mount": sb
+            .robot_mount
+            .as_ref()
+            .map(|m| crate::parts::robot_mount::twin_params(design, sb, m)),
     })
 }
 
@@ -704,6 +716,13 @@ pub fn build_body(
         )
         .map(|s| s.translate([x, y, 0.0])))?);
     }
+    // the lugs that lock the base into the robot's mount
+    let outer = match &sb.robot_mount {
+        Some(m) => g(outer.union(&g(crate::parts::robot_mount::base_lugs(
+            design, sb, m, tol,
+        ))?))?,
+        None => outer,
+    };
     let body = g(outer.difference(&g(Solid::union_all(&cuts))?))?;
     let (placed, pose) = place_posed(&body, &crate::molds::IDENTITY);
     let fdm_tech = PrintTechnology::Fdm;

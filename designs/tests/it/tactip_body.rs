@@ -110,6 +110,7 @@ fn tactip_kit_has_the_body_and_an_assembly_without_interferences() {
             ("skin_tips", "vero_white"),
             ("tip_fitting", "vero_white"),
             ("shaft_body", "abs"),
+            ("robot_mount", "abs"),
         ]
     );
     assert_eq!(k.parts[2].group, k.parts[0].group);
@@ -121,6 +122,7 @@ fn tactip_kit_has_the_body_and_an_assembly_without_interferences() {
     for want in [
         ("tip_fitting", MemberKind::Printed),
         ("shaft_body", MemberKind::Printed),
+        ("robot_mount", MemberKind::Printed),
         ("filling_gel", MemberKind::Cast),
         ("lens_window_envelope", MemberKind::Bought),
         ("led_ring_envelope", MemberKind::Bought),
@@ -284,6 +286,28 @@ fn each_rule_of_the_body_names_its_parameter() {
         ("shaft_body.led_ring.seat_diameter_mm", |d| {
             sb(d).led_ring.seat_diameter_mm = Some(f64::NAN)
         }),
+        ("shaft_body.robot_mount.bolt_count", |d| {
+            mount(d).bolt_count = 1
+        }),
+        ("shaft_body.robot_mount.bolt_head_diameter_mm", |d| {
+            mount(d).bolt_head_diameter_mm = 5.0
+        }),
+        ("shaft_body.robot_mount.plate_thickness_mm", |d| {
+            mount(d).plate_thickness_mm = 8.0
+        }),
+        ("shaft_body.robot_mount.bolt_circle_diameter_mm", |d| {
+            mount(d).bolt_circle_diameter_mm = 50.0
+        }),
+        ("shaft_body.robot_mount.cup_height_mm", |d| {
+            mount(d).cup_height_mm = 3.0
+        }),
+        ("shaft_body.robot_mount.cup_wall_mm", |d| {
+            mount(d).cup_wall_mm = 0.5
+        }),
+        // the grooves over a 80 deg turn run into the cable window
+        ("shaft_body.robot_mount.bayonet.lock_angle_deg", |d| {
+            mount(d).bayonet.lock_angle_deg = 80.0
+        }),
     ];
     let materials = MaterialsTable::embedded().unwrap();
     for (path, mutate) in cases {
@@ -305,6 +329,92 @@ fn each_rule_of_the_body_names_its_parameter() {
     }
 }
 
+fn mount(d: &mut Design) -> &mut fabkit_designs::parts::robot_mount::RobotMount {
+    sb(d).robot_mount.as_mut().unwrap()
+}
+
 fn sb(d: &mut Design) -> &mut fabkit_designs::parts::shaft_body::ShaftBodyParams {
     d.shaft_body.as_mut().unwrap()
+}
+
+/// A mount lug 1 mm wider than designed with its groove's width pinned: the three lugs on the
+/// base's foot reach 0.3 mm past their locking grooves' closed ends into the cup's wall, from
+/// the bore (23.2 mm) out to the lug's depth (0.8 mm), over its 1.5 mm height: one error
+/// naming the mount's groove width, both parts and the overlap; no kit.
+#[test]
+fn a_mount_lug_too_wide_for_its_groove_is_a_named_interference() {
+    let mut d = tactip();
+    let b = &mut mount(&mut d).bayonet;
+    b.groove_width_mm = Some(b.lug_width_mm + 0.4);
+    b.lug_width_mm += 1.0;
+    let e = build_error(&d);
+    assert_eq!(e.0.len(), 1, "{e}");
+    let r: f64 = 23.2;
+    let want = 3.0 * (0.3 / r) * ((r + 0.8f64).powi(2) - r * r) / 2.0 * 1.5;
+    let got = overlap(&e.0[0].rule);
+    assert!(
+        e.0[0].path == "shaft_body.robot_mount.bayonet.groove_width_mm"
+            && e.0[0].value == "4.4"
+            && e.0[0]
+                .rule
+                .contains("`shaft_body` and `robot_mount` overlap by")
+            && (got - want).abs() <= 0.03 * want,
+        "{e} (analytic {want})"
+    );
+}
+
+/// The turn that locks: the tip's lugs go in counter-clockwise (seen from +z), the body's
+/// into the mount clockwise, so that twisting a tip off does not loosen the body. Turned back
+/// by the lock angle along their own direction and raised by the ramp's rise, the lugs sit in
+/// the entry grooves, clear of the grooved part; turned the other way they cut into it.
+#[test]
+fn each_bayonet_unlocks_only_back_along_its_own_turn() {
+    let d = tactip();
+    let sb = d.shaft_body.as_ref().unwrap();
+    let m = sb.robot_mount.as_ref().unwrap();
+    let tip = tip_bayonet(&d, sb);
+    let base = fabkit_designs::parts::robot_mount::mount_bayonet(&d, sb, m);
+    assert!(!tip.clockwise && base.clockwise && base.outward && !tip.outward);
+    let rot = |s: &Solid, deg: f64, dz: f64| {
+        let (sn, cs) = deg.to_radians().sin_cos();
+        s.transform(&[[cs, -sn, 0.0, 0.0], [sn, cs, 0.0, 0.0], [0.0, 0.0, 1.0, dz]])
+    };
+    for b in [&tip, &base] {
+        let r = b.spigot_radius_mm;
+        // the grooved part: a tube round the grooved surface, from under the lugs up to the
+        // open end
+        let (r0, r1) = if b.outward {
+            (r, r + 3.0)
+        } else {
+            (r - 3.0, r)
+        };
+        let z0 = b.lug_z_mm - b.lug_height_mm - 1.0;
+        let h = b.spigot_end_z_mm - z0;
+        let tube = fabkit_designs::geometry::cylinder(h, r1, tol())
+            .unwrap()
+            .difference(
+                &fabkit_designs::geometry::cylinder(h + 2.0, r0, tol())
+                    .unwrap()
+                    .translate([0.0, 0.0, -1.0]),
+            )
+            .unwrap()
+            .translate([0.0, 0.0, z0]);
+        let grooved = tube.difference(&b.grooves(tol()).unwrap()).unwrap();
+        let attach = if b.outward { r - 0.5 } else { r + 0.5 };
+        let lugs = b.lugs(attach, tol()).unwrap();
+        let back = if b.clockwise { 1.0 } else { -1.0 } * b.lock_angle_deg;
+        let clear = grooved
+            .intersection(&rot(&lugs, back, b.rise_mm()))
+            .unwrap()
+            .volume();
+        let wrong = grooved
+            .intersection(&rot(&lugs, -back, b.rise_mm()))
+            .unwrap()
+            .volume();
+        assert!(
+            clear < 1e-6 && wrong > 0.1,
+            "outward {}: {clear} / {wrong}",
+            b.outward
+        );
+    }
 }

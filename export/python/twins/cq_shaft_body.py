@@ -11,6 +11,10 @@ import cadquery as cq
 
 from . import cq_common as C
 
+# how far a solid reaches into the one it is united with or cut from (OVERLAP_MM in
+# designs/src/parts/shaft_body.rs; the parts' params also carry it)
+OVERLAP_MM = 0.01
+
 
 def _sector(r0: float, r1: float, a0: float, span: float, z0: float, z1: float):
     """The flat annular sector r0..r1, azimuth a0..a0 + span (radians), z0..z1."""
@@ -48,34 +52,41 @@ def band(r0: float, r1: float, a0: float, a1: float, z0: float, z1: float, slope
     return C.common(sector, slab)
 
 
-def lugs(b: dict, azimuths_deg: list, outer_radius_mm: float) -> list:
-    """The lugs, locked, from lug_depth inside the spigot out to `outer_radius_mm`."""
+def lugs(b: dict, azimuths_deg: list, attach_radius_mm: float) -> list:
+    """The lugs, locked, from lug_depth past the grooved surface back to `attach_radius_mm`."""
     r = b["spigot_radius_mm"]
     half = b["lug_width_mm"] / 2.0 / r
     z0 = b["lug_z_mm"] - b["lug_height_mm"] / 2.0
-    return [band(r - b["lug_depth_mm"], outer_radius_mm, math.radians(a) - half,
-                 math.radians(a) + half, z0, z0 + b["lug_height_mm"], 0.0) for a in azimuths_deg]
+    r0, r1 = ((attach_radius_mm, r + b["lug_depth_mm"]) if b["outward"]
+              else (r - b["lug_depth_mm"], attach_radius_mm))
+    return [band(r0, r1, math.radians(a) - half, math.radians(a) + half, z0,
+                 z0 + b["lug_height_mm"], 0.0) for a in azimuths_deg]
 
 
 def grooves(b: dict, azimuths_deg: list) -> list:
-    """Per lug the entry groove from the spigot's end down and the ramped locking groove."""
+    """Per lug the entry groove from the spigot's end (the cup's rim) down and the ramped
+    locking groove."""
     r, c = b["spigot_radius_mm"], b["clearance_mm"]
-    r0, r1 = r - b["lug_depth_mm"] - c, r + 1.0
+    r0, r1 = ((r - 1.0, r + b["lug_depth_mm"] + c) if b["outward"]
+              else (r - b["lug_depth_mm"] - c, r + 1.0))
     half = b["groove_width_mm"] / 2.0 / r
     lock = math.radians(b["lock_angle_deg"])
     h = b["lug_height_mm"] / 2.0 + c
-    tan_ramp = math.tan(math.radians(b["ramp_deg"]))
-    slope = -r * tan_ramp
-    rise = lock * r * tan_ramp
+    turn = -1.0 if b["clockwise"] else 1.0
+    tan = math.tan(math.radians(b["ramp_deg"]))
+    slope = -turn * r * tan
     out = []
     for a in azimuths_deg:
         a = math.radians(a)
-        entry = a - lock
-        a0, a1 = entry - half, a + half
-        z = b["lug_z_mm"] + rise + slope * (a0 - entry)
-        out.append(band(r0, r1, a0, a1, z - h, z + h, slope))
-        floor = b["lug_z_mm"] + rise - h
-        out.append(band(r0, r1, entry - half, entry + half, floor, b["spigot_end_z_mm"] + 1.0, 0.0))
+        entry = a - turn * lock
+
+        def z_at(az):
+            return b["lug_z_mm"] + turn * r * tan * (a - az)
+
+        a0, a1 = min(entry, a) - half, max(entry, a) + half
+        out.append(band(r0, r1, a0, a1, z_at(a0) - h, z_at(a0) + h, slope))
+        out.append(band(r0, r1, entry - half, entry + half, z_at(entry) - h,
+                        b["spigot_end_z_mm"] + 1.0, 0.0))
     return out
 
 
@@ -97,13 +108,18 @@ def tip_fitting(params: dict):
 
 
 def shaft_body(params: dict):
-    """The body, sensor frame: base and shaft less the LED ring's seat, the bore, the lens's
+    """The body, sensor frame: base and shaft (with the mount's lugs on the base) less the LED ring's seat, the bore, the lens's
     hole, the board's pocket, the cable slot, the bayonet's grooves and the camera's pilots."""
     lv, r, sb = params["levels"], params["radii"], params["shaft_body"]
     e = params["overlap_mm"]
     cyl = C.cylinder_z
     body = C.fuse(cyl(r["base_outer_mm"], lv["bottom_z_mm"], lv["base_top_z_mm"]),
                   [cyl(r["shaft_outer_mm"], lv["base_top_z_mm"] - e, lv["shaft_top_z_mm"])])
+    mp = params.get("mount")
+    if mp:
+        # the lugs that lock the base into the robot's mount
+        body = C.fuse(body, lugs(mp["bayonet"], mp["lug_azimuths_deg"],
+                                 mp["lug_attach_radius_mm"]))
     p = r["board_pocket_half_mm"]
     sw, sh = params["cable_slot_mm"][0] / 2.0, params["cable_slot_mm"][1]
     bottom = lv["bottom_z_mm"]
@@ -120,3 +136,30 @@ def shaft_body(params: dict):
         cuts.append(cyl(cam["mount_pilot_diameter_mm"] / 2.0, lv["ceiling_z_mm"] - e,
                         lv["ceiling_z_mm"] + cam["mount_pilot_depth_mm"], x, y))
     return C.cut(body, cuts)
+
+
+def robot_mount(params: dict):
+    """The robot mount, sensor frame: the plate with its counterbored bolt holes and locating
+    pin hole, and the cup over it less its cable window and the bayonet's grooves."""
+    mp, lv = params["mount"], params["levels"]
+    m = mp["robot_mount"]
+    e = OVERLAP_MM
+    cyl = C.cylinder_z
+    zb = lv["bottom_z_mm"]
+    z0 = zb - m["plate_thickness_mm"]
+    bore, outside = mp["bore_radius_mm"], mp["outside_radius_mm"]
+    top = zb + m["cup_height_mm"]
+    cup = C.cut(cyl(outside, zb - e, top), [cyl(bore, zb - 2.0 * e, top + 1.0)])
+    w0, w1 = mp["window_azimuths_rad"]
+    window = band(bore - 1.0, outside + 1.0, w0, w1, zb - 1.0, top + 1.0, 0.0)
+    cup = C.cut(cup, [window] + grooves(mp["bayonet"], mp["lug_azimuths_deg"]))
+    mount = C.fuse(cyl(outside, z0, zb), [cup])
+    cuts = []
+    for x, y in mp["bolt_xy_mm"]:
+        cuts.append(cyl(m["bolt_clearance_diameter_mm"] / 2.0, z0 - 1.0, zb + 1.0, x, y))
+        cuts.append(cyl(m["bolt_head_diameter_mm"] / 2.0, zb - m["bolt_head_depth_mm"], zb + 1.0,
+                        x, y))
+    px, py = mp["pin_xy_mm"]
+    cuts.append(cyl(m["pin_hole_diameter_mm"] / 2.0, z0 - 1.0, z0 + m["pin_hole_depth_mm"],
+                    px, py))
+    return C.cut(mount, cuts)

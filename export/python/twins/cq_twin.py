@@ -47,6 +47,8 @@ def _build_sensor(part: dict):
         s = cq_shaft_body.tip_fitting(p)
     elif role == "shaft_body":
         s = cq_shaft_body.shaft_body(p)
+    elif role == "robot_mount":
+        s = cq_shaft_body.robot_mount(p)
     elif role == "indenter":
         s = cq_fixtures.indenter(p)
     elif name == "pin_dome":

@@ -21,7 +21,7 @@ def family(part: dict) -> str:
         return "pin tips"
     if role in ("shell_half", "shell_collar", "shell_tube", "shell_base"):
         return "housings"
-    if role in ("tip_fitting", "shaft_body"):
+    if role in ("tip_fitting", "shaft_body", "robot_mount"):
         return "bayonet bodies and fittings"
     if role == "indenter":
         return "indenters"

@@ -550,7 +550,7 @@ fn uvdtact_sheet_gives_a_weighable_batch_and_casts_inside_out() {
 
 /// The dual-modal TacTip is printed; its one pour is the filling gel, poured into the tip
 /// among the assembly steps: LED ring and camera into the body, the gel and the window into
-/// the tip, the tip twisted onto the body's bayonet.
+/// the tip, the body locked into the robot's mount, the tip twisted onto the body's bayonet.
 #[test]
 fn tactip_sheet_pours_the_gel_between_the_assembly_steps() {
     let e = export("tactip_dualmodal", None);
@@ -559,13 +559,22 @@ fn tactip_sheet_pours_the_gel_between_the_assembly_steps() {
     assert_eq!(casts[0]["cast"], "filling_gel");
     assert_eq!(
         actions(&e),
-        [A::Print, A::Assemble, A::Assemble, A::Pour, A::Assemble]
+        [
+            A::Print,
+            A::Assemble,
+            A::Assemble,
+            A::Pour,
+            A::Assemble,
+            A::Assemble
+        ]
     );
     for text in [
         "Step 1: stand the tip pole-down",
         "lay the lens window into its seat in `tip_fitting`",
         "the 3 lugs of `tip_fitting` down the 3 entry grooves",
         "turn it 30 deg counter-clockwise",
+        "Bolt `robot_mount` to the tool flange of the ABB IRB 120",
+        "turn `shaft_body` 30 deg clockwise",
     ] {
         assert!(e.sheet.contains(text), "{text}: {}", e.sheet);
     }
