@@ -83,6 +83,30 @@ pub struct Bayonet {
 }
 
 impl Bayonet {
+    /// The sizes of a joint from its lugs and the printer's profile (the groove's width
+    /// defaults to the lug's plus the clearance on each side); the placement (radius, turn,
+    /// levels) left at zero, for the caller to set.
+    pub fn sized(p: &BayonetProfile, b: &crate::parts::shaft_body::BayonetLugs) -> Self {
+        Self {
+            spigot_radius_mm: 0.0,
+            outward: false,
+            clockwise: false,
+            lug_count: p.lug_count,
+            lug_width_mm: b.lug_width_mm,
+            lug_height_mm: b.lug_height_mm,
+            lug_depth_mm: b.lug_depth_mm,
+            groove_width_mm: b
+                .groove_width_mm
+                .unwrap_or(b.lug_width_mm + 2.0 * p.clearance_mm),
+            clearance_mm: p.clearance_mm,
+            lock_angle_deg: b.lock_angle_deg,
+            ramp_deg: p.ramp_deg,
+            first_lug_deg: 0.0,
+            lug_z_mm: 0.0,
+            spigot_end_z_mm: 0.0,
+        }
+    }
+
     /// Azimuths of the lugs' centres, locked, degrees.
     pub fn lug_azimuths_deg(&self) -> Vec<f64> {
         (0..self.lug_count)

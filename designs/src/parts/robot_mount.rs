@@ -70,26 +70,15 @@ pub fn cup_radii(sb: &ShaftBodyParams, m: &RobotMount, design: &Design) -> (f64,
 
 /// The body-to-mount bayonet, locked.
 pub fn mount_bayonet(design: &Design, sb: &ShaftBodyParams, m: &RobotMount) -> Bayonet {
-    let p = &design.printers.fdm.bayonet;
     let zb = levels(design, sb).bottom_z_mm;
-    let b = &m.bayonet;
     Bayonet {
         spigot_radius_mm: cup_radii(sb, m, design).0,
         outward: true,
         clockwise: true,
-        lug_count: p.lug_count,
-        lug_width_mm: b.lug_width_mm,
-        lug_height_mm: b.lug_height_mm,
-        lug_depth_mm: b.lug_depth_mm,
-        groove_width_mm: b
-            .groove_width_mm
-            .unwrap_or(b.lug_width_mm + 2.0 * p.clearance_mm),
-        clearance_mm: p.clearance_mm,
-        lock_angle_deg: b.lock_angle_deg,
-        ramp_deg: p.ramp_deg,
         first_lug_deg: FIRST_LUG_DEG,
-        lug_z_mm: zb + LUG_LIFT_MM + b.lug_height_mm / 2.0,
+        lug_z_mm: zb + LUG_LIFT_MM + m.bayonet.lug_height_mm / 2.0,
         spigot_end_z_mm: zb + m.cup_height_mm,
+        ..Bayonet::sized(&design.printers.fdm.bayonet, &m.bayonet)
     }
 }
 

@@ -273,28 +273,36 @@ pub fn radii(design: &Design, sb: &ShaftBodyParams, stack: &Stack) -> ShaftRadii
 
 /// The tip-to-shaft bayonet, locked.
 pub fn tip_bayonet(design: &Design, sb: &ShaftBodyParams) -> Bayonet {
-    let p = &design.printers.fdm.bayonet;
     let lv = levels(design, sb);
-    let b = &sb.bayonet;
     Bayonet {
         spigot_radius_mm: sb.shaft_diameter_mm / 2.0,
         outward: false,
         clockwise: false,
-        lug_count: p.lug_count,
-        lug_width_mm: b.lug_width_mm,
-        lug_height_mm: b.lug_height_mm,
-        lug_depth_mm: b.lug_depth_mm,
-        groove_width_mm: b
-            .groove_width_mm
-            .unwrap_or(b.lug_width_mm + 2.0 * p.clearance_mm),
-        clearance_mm: p.clearance_mm,
-        lock_angle_deg: b.lock_angle_deg,
-        ramp_deg: p.ramp_deg,
         // the first lug on +x, locked
         first_lug_deg: 0.0,
         // lugs flush with the skirt's bottom
-        lug_z_mm: lv.fitting_bottom_z_mm + b.lug_height_mm / 2.0,
+        lug_z_mm: lv.fitting_bottom_z_mm + sb.bayonet.lug_height_mm / 2.0,
         spigot_end_z_mm: lv.shaft_top_z_mm,
+        ..Bayonet::sized(&design.printers.fdm.bayonet, &sb.bayonet)
+    }
+}
+
+/// A printed fit's clearance: at least half the FDM nozzle, or the parts fuse or jam.
+fn half_nozzle(
+    path: &str,
+    v: f64,
+    fdm: &crate::schema::PrinterProfile,
+    errs: &mut Vec<ParamError>,
+) {
+    if !(v >= fdm.xy_resolution_mm / 2.0 && v.is_finite()) {
+        errs.push(ParamError::new(
+            path,
+            v,
+            format!(
+                "must be at least half the nozzle (printers.fdm.xy_resolution_mm / 2 = {:.2} mm): a tighter printed fit fuses or jams",
+                fdm.xy_resolution_mm / 2.0
+            ),
+        ));
     }
 }
 
@@ -376,16 +384,12 @@ pub fn check_params(
             "must be at least 0 and below 15 (steeper, the lug slips back out of its groove)",
         ));
     }
-    if !(bp.clearance_mm >= fdm.xy_resolution_mm / 2.0 && bp.clearance_mm.is_finite()) {
-        errs.push(ParamError::new(
-            "printers.fdm.bayonet.clearance_mm",
-            bp.clearance_mm,
-            format!(
-                "must be at least half the nozzle (printers.fdm.xy_resolution_mm / 2 = {:.2} mm): a tighter printed fit fuses or jams",
-                fdm.xy_resolution_mm / 2.0
-            ),
-        ));
-    }
+    half_nozzle(
+        "printers.fdm.bayonet.clearance_mm",
+        bp.clearance_mm,
+        fdm,
+        errs,
+    );
     if !(sb.bayonet.lock_angle_deg > 0.0 && sb.bayonet.lock_angle_deg < 90.0) {
         errs.push(ParamError::new(
             "shaft_body.bayonet.lock_angle_deg",
@@ -400,16 +404,12 @@ pub fn check_params(
             "must be above 0 and below 180",
         ));
     }
-    if !(sb.fit_clearance_mm >= fdm.xy_resolution_mm / 2.0 && sb.fit_clearance_mm.is_finite()) {
-        errs.push(ParamError::new(
-            "shaft_body.fit_clearance_mm",
-            sb.fit_clearance_mm,
-            format!(
-                "must be at least half the nozzle (printers.fdm.xy_resolution_mm / 2 = {:.2} mm)",
-                fdm.xy_resolution_mm / 2.0
-            ),
-        ));
-    }
+    half_nozzle(
+        "shaft_body.fit_clearance_mm",
+        sb.fit_clearance_mm,
+        fdm,
+        errs,
+    );
     if skin_layer(stack).is_none() {
         errs.push(ParamError::new(
             format!("layers[{}].process", stack.layers.len().saturating_sub(1)),

@@ -167,6 +167,21 @@ fn overlap(rule: &str) -> f64 {
         .unwrap_or_else(|| panic!("{rule}"))
 }
 
+/// `d` does not build: one error naming `path` = `value` and the interference of `pair`,
+/// whose overlap is within `rel` of the analytic `want` mm³.
+fn assert_one_interference(d: &Design, path: &str, value: &str, pair: &str, want: f64, rel: f64) {
+    let e = build_error(d);
+    assert_eq!(e.0.len(), 1, "{e}");
+    let got = overlap(&e.0[0].rule);
+    assert!(
+        e.0[0].path == path
+            && e.0[0].value == value
+            && e.0[0].rule.contains(&format!("{pair} overlap by"))
+            && (got - want).abs() <= rel * want,
+        "{e} (analytic {want})"
+    );
+}
+
 /// The LED ring's seat bored 0.3 mm under the ring's diameter: one error naming the seat's
 /// diameter with its value, both parts and the overlap, the ring of 18 / 17.7 mm over the
 /// ring's thickness and its LEDs' height (2.6 mm); no kit.
@@ -174,18 +189,13 @@ fn overlap(rule: &str) -> f64 {
 fn a_seat_too_small_for_the_led_ring_is_a_named_interference() {
     let mut d = tactip();
     d.shaft_body.as_mut().unwrap().led_ring.seat_diameter_mm = Some(17.7);
-    let e = build_error(&d);
-    assert_eq!(e.0.len(), 1, "{e}");
-    let want = PI * (9.0f64.powi(2) - 8.85f64.powi(2)) * 2.6;
-    let got = overlap(&e.0[0].rule);
-    assert!(
-        e.0[0].path == "shaft_body.led_ring.seat_diameter_mm"
-            && e.0[0].value == "17.7"
-            && e.0[0]
-                .rule
-                .contains("`shaft_body` and `led_ring_envelope` overlap by")
-            && (got - want).abs() <= 0.02 * want,
-        "{e} (analytic {want})"
+    assert_one_interference(
+        &d,
+        "shaft_body.led_ring.seat_diameter_mm",
+        "17.7",
+        "`shaft_body` and `led_ring_envelope`",
+        PI * (9.0f64.powi(2) - 8.85f64.powi(2)) * 2.6,
+        0.02,
     );
 }
 
@@ -199,21 +209,19 @@ fn a_lug_too_wide_for_its_groove_is_a_named_interference() {
     let b = &mut d.shaft_body.as_mut().unwrap().bayonet;
     b.groove_width_mm = Some(b.lug_width_mm + 0.4);
     b.lug_width_mm += 1.0;
-    let e = build_error(&d);
-    assert_eq!(e.0.len(), 1, "{e}");
     let r: f64 = 11.5;
-    let want = 3.0 * (0.3 / r) * (r * r - (r - 0.8f64).powi(2)) / 2.0 * 1.5;
-    let got = overlap(&e.0[0].rule);
-    assert!(
-        e.0[0].path == "shaft_body.bayonet.groove_width_mm"
-            && e.0[0].value == "3.4"
-            && e.0[0]
-                .rule
-                .contains("`tip_fitting` and `shaft_body` overlap by")
-            && e.0[0].rule.contains("shaft_body.bayonet.lug_width_mm")
-            && (got - want).abs() <= 0.03 * want,
-        "{e} (analytic {want})"
+    assert_one_interference(
+        &d,
+        "shaft_body.bayonet.groove_width_mm",
+        "3.4",
+        "`tip_fitting` and `shaft_body`",
+        3.0 * (0.3 / r) * (r * r - (r - 0.8f64).powi(2)) / 2.0 * 1.5,
+        0.03,
     );
+    // the error names the lug's width too
+    assert!(build_error(&d).0[0]
+        .rule
+        .contains("shaft_body.bayonet.lug_width_mm"));
 }
 
 /// One bad value per rule of the body and the printer's bayonet profile: validation names the
@@ -347,19 +355,14 @@ fn a_mount_lug_too_wide_for_its_groove_is_a_named_interference() {
     let b = &mut mount(&mut d).bayonet;
     b.groove_width_mm = Some(b.lug_width_mm + 0.4);
     b.lug_width_mm += 1.0;
-    let e = build_error(&d);
-    assert_eq!(e.0.len(), 1, "{e}");
     let r: f64 = 23.2;
-    let want = 3.0 * (0.3 / r) * ((r + 0.8f64).powi(2) - r * r) / 2.0 * 1.5;
-    let got = overlap(&e.0[0].rule);
-    assert!(
-        e.0[0].path == "shaft_body.robot_mount.bayonet.groove_width_mm"
-            && e.0[0].value == "4.4"
-            && e.0[0]
-                .rule
-                .contains("`shaft_body` and `robot_mount` overlap by")
-            && (got - want).abs() <= 0.03 * want,
-        "{e} (analytic {want})"
+    assert_one_interference(
+        &d,
+        "shaft_body.robot_mount.bayonet.groove_width_mm",
+        "4.4",
+        "`shaft_body` and `robot_mount`",
+        3.0 * (0.3 / r) * ((r + 0.8f64).powi(2) - r * r) / 2.0 * 1.5,
+        0.03,
     );
 }
 
