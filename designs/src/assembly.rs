@@ -47,7 +47,9 @@ pub struct Member {
     pub fix: Vec<String>,
     /// The member is a surface of revolution between two offsets of the body profile with
     /// nothing on it (a cast layer without markers, the core), or the filling gel inside the
-    /// core's inner surface: the stack's validation already nests such members without
+    /// core's inner surface, or a printed skin, its marker tips and the gel filling it (the
+    /// gel is the skin's cavity less the very pin and tip solids the skin and tips are made
+    /// of): the stack's validation and their construction already nest such members without
     /// overlap, so the fit check skips pairs of them.
     pub nested_by_stack: bool,
     /// What an exact B-rep of the member is built from (STEP export, `export/src/step.rs`),
@@ -185,7 +187,9 @@ pub fn members(
                 description: p.description.clone(),
                 solid,
                 fix: printed_fix(&p.role),
-                nested_by_stack: false,
+                // a printed skin and its tips are made from the same placed features, and a
+                // tip's filling gel is their cavity less those features
+                nested_by_stack: matches!(p.role.as_str(), "printed_skin" | "marker_tips"),
                 exact: None,
             });
         }

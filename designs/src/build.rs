@@ -338,7 +338,8 @@ pub fn build_kit_bounded(
                 ),
                 solid,
                 fix: vec!["shaft_body.tip_fitting.lip_width_mm".into()],
-                nested_by_stack: false,
+                // the skin's cavity less its pins and tips: nested with them by construction
+                nested_by_stack: true,
                 exact: None,
             });
         }
