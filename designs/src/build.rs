@@ -436,6 +436,13 @@ fn treatments(
     out
 }
 
+/// `text` with its first letter upper-case.
+fn capitalized(text: &str) -> String {
+    let mut c = text.chars();
+    c.next()
+        .map_or_else(String::new, |f| f.to_uppercase().chain(c).collect())
+}
+
 fn bought_items(design: &Design, stack: &Stack, materials: &MaterialsTable) -> Vec<String> {
     let product = |key: &str| {
         materials
@@ -463,6 +470,16 @@ fn bought_items(design: &Design, stack: &Stack, materials: &MaterialsTable) -> V
             b.diameter_mm,
             b.thickness_mm
         ));
+    }
+    for l in &design.layers {
+        if let Some(coat) = &l.brushed_coat {
+            v.push(format!(
+                "{} brushed onto `{}`: {}",
+                capitalized(&coat.purpose),
+                l.name,
+                coat.components.join(", ")
+            ));
+        }
     }
     for l in &stack.layers {
         if l.process == crate::schema::LayerProcess::Sprayed {

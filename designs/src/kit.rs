@@ -151,6 +151,8 @@ pub enum ProcedureAction {
     Pour,
     /// Cure and take the cast layer out of the mold.
     Demold,
+    /// Brush a coat onto the demolded layer.
+    BrushCoat,
     /// Assemble the sensor.
     Assemble,
 }

@@ -354,6 +354,27 @@ pub fn procedure(
             )
         };
         out.push(step(A::Demold, text));
+        let coat = design
+            .layers
+            .iter()
+            .find(|l| l.name == c.cast)
+            .and_then(|l| l.brushed_coat.as_ref());
+        if let Some(coat) = coat {
+            out.push(step(
+                A::BrushCoat,
+                format!(
+                    "Step {n}: brush a thin {} onto `{}`: {}, mixed.{}",
+                    coat.purpose,
+                    c.cast,
+                    coat.components.join(", "),
+                    if coat.notes.is_empty() {
+                        String::new()
+                    } else {
+                        format!(" {}", coat.notes)
+                    }
+                ),
+            ));
+        }
     }
     let filling = casts.iter().find(|c| c.cast == FILLING_GEL);
     out.extend(assembly_steps(design, parts, core_mounted, filling));

@@ -57,6 +57,21 @@ pub struct Backing {
     pub description: String,
 }
 
+/// A coat brushed onto a cast layer after demolding (ShadowTac Sec. IV-A: the reflective layer
+/// of Smooth-On PsychoPaint with aluminium powder, Silc Pig white and a silicone solvent). Its
+/// amounts are the maker's: the sheet lists the components and the step.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BrushedCoat {
+    /// What the coat does, for the sheet (e.g. "reflective layer").
+    pub purpose: String,
+    /// The products mixed into it, at least one.
+    pub components: Vec<String>,
+    /// Where the coat goes and how, for the sheet.
+    #[serde(default)]
+    pub notes: String,
+}
+
 /// The rigid transparent shell (R-Tac0: a glass test tube, Sec. III-B1). Its outer surface is
 /// the inner surface of the innermost layer; it is an offset of the body profile.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -122,6 +137,9 @@ pub struct Layer {
     /// Technology of a printed layer (default polyjet).
     #[serde(default)]
     pub print_technology: Option<Technology>,
+    /// A coat brushed onto the layer once it is out of its mold; none when not given.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub brushed_coat: Option<BrushedCoat>,
 }
 
 /// How a cast layer's mold is made.

@@ -112,6 +112,26 @@ pub fn validate(
         None
     };
 
+    // Brushed coats name what they are and what goes into them.
+    for (i, l) in design.layers.iter().enumerate() {
+        if let Some(coat) = &l.brushed_coat {
+            if coat.purpose.trim().is_empty() {
+                errs.push(ParamError::new(
+                    format!("layers[{i}].brushed_coat.purpose"),
+                    "\"\"",
+                    "must say what the coat is for",
+                ));
+            }
+            if coat.components.is_empty() || coat.components.iter().any(|c| c.trim().is_empty()) {
+                errs.push(ParamError::new(
+                    format!("layers[{i}].brushed_coat.components"),
+                    format!("{:?}", coat.components),
+                    "must name at least one product, none of them empty",
+                ));
+            }
+        }
+    }
+
     // The bought backing plate (its sheet gives its size).
     if let Some(b) = &design.backing {
         for (path, v) in [
@@ -121,6 +141,15 @@ pub fn validate(
             if !(v > 0.0) {
                 errs.push(ParamError::new(path, v, "must be above 0"));
             }
+        }
+        // the skin is glued onto the plate by its base: the plate must carry its whole rim
+        let rim_mm = 2.0 * design.body.rim_radius_mm(0.0);
+        if b.diameter_mm > 0.0 && b.diameter_mm < rim_mm {
+            errs.push(ParamError::new(
+                "backing.diameter_mm",
+                b.diameter_mm,
+                format!("must carry the skin's rim: at least its diameter at the base plane ({rim_mm:.3} mm)"),
+            ));
         }
     }
 

@@ -452,3 +452,57 @@ fn a_cap_given_in_both_forms_is_a_yaml_error() {
     let e = Design::from_yaml(&text, "x.yaml").unwrap_err().to_string();
     assert!(e.contains("groove"), "{e}");
 }
+
+/// The PMMA plate carries the skin: the library's plate is at least the skin's 35.000 mm rim
+/// across, and a plate under it (the former 34 mm disc) is one error naming the plate's
+/// diameter, its value and the rim.
+#[test]
+fn the_pmma_plate_carries_the_35_mm_skin() {
+    let d = shadowtac();
+    let rim = 2.0 * d.body.rim_radius_mm(0.0);
+    assert!((rim - 35.0).abs() < 1e-9, "{rim}");
+    let plate = d.backing.as_ref().unwrap().diameter_mm;
+    assert!(plate >= rim, "{plate}");
+    let tol = ChordTolerance::default();
+    assert!(validate(&d, &materials(), tol).is_ok());
+    let mut small = d.clone();
+    small.backing.as_mut().unwrap().diameter_mm = 34.0;
+    let e: Vec<ParamError> = validate(&small, &materials(), tol).unwrap_err().0;
+    assert!(
+        e.len() == 1
+            && e[0].path == "backing.diameter_mm"
+            && e[0].value == "34"
+            && e[0].rule.contains("the skin's rim")
+            && e[0].rule.contains("35.000 mm"),
+        "{e:?}"
+    );
+}
+
+/// The reflective layer's options: a brushed coat with no purpose or no product (or an empty
+/// product name) is an error naming its path.
+#[test]
+fn a_brushed_coat_names_its_purpose_and_products() {
+    let tol = ChordTolerance::default();
+    let d = shadowtac();
+    let coat = d.layers[0].brushed_coat.as_ref().unwrap();
+    assert_eq!(coat.purpose, "reflective layer");
+    assert!(coat.components.iter().any(|c| c.contains("Psycho Paint")));
+    for (path, mutate) in [
+        (
+            "layers[0].brushed_coat.purpose",
+            (|c: &mut fabkit_designs::schema::BrushedCoat| c.purpose = " ".into())
+                as fn(&mut fabkit_designs::schema::BrushedCoat),
+        ),
+        ("layers[0].brushed_coat.components", |c| {
+            c.components.clear()
+        }),
+        ("layers[0].brushed_coat.components", |c| {
+            c.components.push(String::new())
+        }),
+    ] {
+        let mut m = d.clone();
+        mutate(m.layers[0].brushed_coat.as_mut().unwrap());
+        let e = validate(&m, &materials(), tol).unwrap_err().0;
+        assert!(e.len() == 1 && e[0].path == path, "{path}: {e:?}");
+    }
+}

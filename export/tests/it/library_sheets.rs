@@ -472,7 +472,8 @@ fn rtac0_direct_sheet_names_the_clamp_bolts_and_the_sprue() {
 }
 
 /// ShadowTac: the two-piece mold's 20 bolts by size and length, no registration keys in the
-/// checks (a boss and pocket register its pieces), release then pour into the reservoir.
+/// checks (a boss and pocket register its pieces), release then pour into the reservoir, then
+/// the reflective layer brushed on.
 #[test]
 fn shadowtac_sheet_names_its_bolts_and_pours_into_the_reservoir() {
     let e = export("shadowtac", None);
@@ -495,9 +496,22 @@ fn shadowtac_sheet_names_its_bolts_and_pours_into_the_reservoir() {
             A::CloseMold,
             A::Pour,
             A::Demold,
+            A::BrushCoat,
             A::Assemble
         ]
     );
+    // the reflective layer (Sec. IV-A), brushed on after demolding, before the plate
+    assert!(
+        e.sheet.contains(
+            "Step 1: brush a thin reflective layer onto `skin`: Smooth-On Psycho Paint, aluminium powder, Silc Pig white"
+        ) && e.sheet.contains("silicone solvent"),
+        "{}",
+        e.sheet
+    );
+    assert!(bought.iter().any(|b| b
+        .as_str()
+        .unwrap()
+        .starts_with("Reflective layer brushed onto `skin`: Smooth-On Psycho Paint")));
 }
 
 /// UVDtact: the black gel (0.56 g) cannot be weighed by hand; the sheet gives the smallest
