@@ -257,61 +257,31 @@ pub fn build_kit_bounded(
     // The filling gel, poured into the assembled shell (R-Tac0 Sec. III-B1).
     if let (Some(h), Some(lv), Some(core)) = (&design.housing, &shell_levels, &stack.core) {
         if let Some(f) = &h.filling_gel {
-            let m = materials
-                .get(&f.material)
-                .ok_or_else(|| DesignError::Yaml(format!("unknown material {}", f.material)))?;
             let v = crate::housing::filling_gel_volume_mm3(design, h, core, lv);
-            let shell: Vec<String> = parts
-                .iter()
-                .filter(|p| ["shell_collar", "shell_tube", "shell_half"].contains(&p.role.as_str()))
-                .map(|p| p.name.clone())
-                .collect();
-            let mut r = pour(
-                step,
-                crate::procedure::FILLING_GEL,
-                &f.material,
-                m,
-                shell,
+            casts.push(filling_gel_cast(
+                &materials,
+                f,
+                (step, waste),
+                holders(&parts, &["shell_collar", "shell_tube", "shell_half"]),
                 v,
-                waste,
-            )
-            .map_err(DesignError::Yaml)?;
-            r.notes = format!(
-                "Poured into the assembled shell, pole-down, before the camera goes on: it fills the core, the diffuser's opening and the light chamber up to the LED PCB's face (R-Tac0 Sec. III-B1). {}",
-                r.notes
-            );
-            casts.push(r);
+                "Poured into the assembled shell, pole-down, before the camera goes on: it fills the core, the diffuser's opening and the light chamber up to the LED PCB's face (R-Tac0 Sec. III-B1).",
+            )?);
         }
     }
     // The clear gel between the skin and the lens window (Pestell et al. Sec. III-A).
     let mut tip_gel = None;
     if let Some(sb) = &design.shaft_body {
         if let Some(f) = &sb.filling_gel {
-            let m = materials
-                .get(&f.material)
-                .ok_or_else(|| DesignError::Yaml(format!("unknown material {}", f.material)))?;
             let gel = crate::parts::shaft_body::filling_gel_solid(design, sb, &stack, tol)
                 .part(crate::procedure::FILLING_GEL)?;
-            let holders: Vec<String> = parts
-                .iter()
-                .filter(|p| ["printed_skin", "tip_fitting"].contains(&p.role.as_str()))
-                .map(|p| p.name.clone())
-                .collect();
-            let mut r = pour(
-                step,
-                crate::procedure::FILLING_GEL,
-                &f.material,
-                m,
-                holders,
+            casts.push(filling_gel_cast(
+                &materials,
+                f,
+                (step, waste),
+                holders(&parts, &["printed_skin", "tip_fitting"]),
                 gel.volume(),
-                waste,
-            )
-            .map_err(DesignError::Yaml)?;
-            r.notes = format!(
-                "Poured into the tip, pole-down, round the pins and up into the lip's opening; the lens window is then laid on (Pestell et al. Sec. III-A). {}",
-                r.notes
-            );
-            casts.push(r);
+                "Poured into the tip, pole-down, round the pins and up into the lip's opening; the lens window is then laid on (Pestell et al. Sec. III-A).",
+            )?);
             tip_gel = Some((gel, f.material.clone()));
         }
     }
@@ -434,6 +404,45 @@ fn treatments(
         }
     }
     out
+}
+
+/// The names of the parts of `roles`.
+fn holders(parts: &[crate::Part], roles: &[&str]) -> Vec<String> {
+    parts
+        .iter()
+        .filter(|p| roles.contains(&p.role.as_str()))
+        .map(|p| p.name.clone())
+        .collect()
+}
+
+/// The filling gel's cast: `volume_mm3` of `gel`'s material poured as cast `step` (with the
+/// kit's waste allowance) into `holders`, `how` before the material's own notes.
+///
+/// # Errors
+/// [`DesignError::Yaml`] for a material that is unknown or has no mix ratio.
+fn filling_gel_cast(
+    materials: &MaterialsTable,
+    gel: &crate::schema::FillingGel,
+    (step, waste): (u32, f64),
+    holders: Vec<String>,
+    volume_mm3: f64,
+    how: &str,
+) -> Result<crate::kit::CastReport, DesignError> {
+    let m = materials
+        .get(&gel.material)
+        .ok_or_else(|| DesignError::Yaml(format!("unknown material {}", gel.material)))?;
+    let mut r = pour(
+        step,
+        crate::procedure::FILLING_GEL,
+        &gel.material,
+        m,
+        holders,
+        volume_mm3,
+        waste,
+    )
+    .map_err(DesignError::Yaml)?;
+    r.notes = format!("{how} {}", r.notes);
+    Ok(r)
 }
 
 /// `text` with its first letter upper-case.
