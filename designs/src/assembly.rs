@@ -91,7 +91,7 @@ pub enum ExactShape {
 }
 
 /// Roles of kit parts that are part of the sensor (the rest are molds and tooling).
-pub const SENSOR_ROLES: [&str; 9] = [
+pub const SENSOR_ROLES: [&str; 11] = [
     "shell_collar",
     "shell_tube",
     "shell_base",
@@ -101,6 +101,8 @@ pub const SENSOR_ROLES: [&str; 9] = [
     "tip_fitting",
     "shaft_body",
     "robot_mount",
+    "casing",
+    "gripper_base",
 ];
 
 /// The parameter paths that size a printed member of `role`.
@@ -118,6 +120,12 @@ fn printed_fix(role: &str) -> Vec<String> {
             "shaft_body.robot_mount.bayonet.groove_width_mm".into(),
             "shaft_body.robot_mount".into(),
         ],
+        "casing" => vec![
+            "casing.wall_thickness_mm".into(),
+            "casing.bay_height_mm".into(),
+            "casing.window_diameter_mm".into(),
+        ],
+        "gripper_base" => vec!["casing.gripper_base".into()],
         "printed_skin" | "marker_tips" => vec!["layers".into()],
         _ => vec!["housing".into()],
     }

@@ -91,25 +91,29 @@ pub fn build_kit_bounded(
                         .map(|h| crate::housing::build_shell(design, h, &stack, tol))
                 },
                 || {
-                    design
-                        .shaft_body
-                        .as_ref()
-                        .map(|sb| -> Result<Vec<crate::Part>, DesignError> {
-                            let mut out = vec![crate::parts::shaft_body::build_body(
-                                design, sb, &stack, tol,
-                            )?];
-                            if let Some(m) = &sb.robot_mount {
-                                out.push(crate::parts::robot_mount::build_mount(
-                                    design, sb, m, tol,
-                                )?);
-                            }
-                            Ok(out)
-                        })
+                    rayon::join(
+                        || {
+                            design.shaft_body.as_ref().map(
+                                |sb| -> Result<Vec<crate::Part>, DesignError> {
+                                    let mut out = vec![crate::parts::shaft_body::build_body(
+                                        design, sb, &stack, tol,
+                                    )?];
+                                    if let Some(m) = &sb.robot_mount {
+                                        out.push(crate::parts::robot_mount::build_mount(
+                                            design, sb, m, tol,
+                                        )?);
+                                    }
+                                    Ok(out)
+                                },
+                            )
+                        },
+                        || design.casing.as_ref().map(build_casing_parts(design, tol)),
+                    )
                 },
             )
         },
     );
-    let (shell, shaft_body) = shell;
+    let (shell, (shaft_body, casing)) = shell;
     let mut layer_markers = Vec::new();
     for (&i, out) in other.iter().zip(others) {
         let out = out?;
@@ -184,6 +188,18 @@ pub fn build_kit_bounded(
         if let Some(m) = &sb.robot_mount {
             bought.extend(crate::parts::robot_mount::bought_items(m));
         }
+    }
+
+    if let (Some(c), Some(parts_c)) = (&design.casing, casing) {
+        parts.extend(parts_c?);
+        let lv = crate::parts::casing::levels(design, c);
+        let w = c
+            .gripper_base
+            .as_ref()
+            .map_or([c.outer_width_mm; 2], |g| [g.width_mm, g.length_mm]);
+        summary["casing_levels"] = json!(&lv);
+        summary["envelope_mm"] = json!([w[0], w[1], lv.envelope_height_mm]);
+        bought.extend(crate::parts::casing::bought_items(c));
     }
 
     let mut casts = Vec::new();
@@ -313,6 +329,9 @@ pub fn build_kit_bounded(
                 exact: None,
             });
         }
+    }
+    if let Some(c) = &design.casing {
+        assembly.extend(crate::parts::casing::members(design, c, tol)?);
     }
     let found = crate::assembly::interferences(&assembly, tol)?;
     if let Some(e) = crate::assembly::fit_errors(design, &found) {
@@ -548,6 +567,20 @@ fn housing_items(h: &crate::schema::HousingParams) -> Vec<String> {
         );
     }
     v
+}
+
+/// The casing and, with one, its gripper base (ShadowTac Sec. IV-B).
+fn build_casing_parts(
+    design: &Design,
+    tol: ChordTolerance,
+) -> impl Fn(&crate::parts::casing::CasingParams) -> Result<Vec<crate::Part>, DesignError> + '_ {
+    move |c| {
+        let mut out = vec![crate::parts::casing::build_casing(design, c, tol)?];
+        if let Some(g) = &c.gripper_base {
+            out.push(crate::parts::casing::build_base(design, c, g, tol)?);
+        }
+        Ok(out)
+    }
 }
 
 /// The joint screws of a housing by standard size and length (`M2 x 6`): the longest standard

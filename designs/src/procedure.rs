@@ -527,7 +527,7 @@ fn cure_text(notes: &str) -> String {
 /// The assembly steps in order, each with its screws or glue: the contact module's own
 /// bonding (core into the skin, skin onto its backing), then the shell from the inside out:
 /// LED PCB, diffuser, contact module, camera, the shell joined (R-Tac0 Sec. III-B2..B4;
-/// UVDtact Sec. III; ShadowTac Sec. III).
+/// UVDtact Sec. III; ShadowTac Sec. IV-A, IV-B).
 fn assembly_steps(
     design: &Design,
     parts: &[Part],
@@ -550,7 +550,7 @@ fn assembly_steps(
     if design.backing.is_some() {
         out.push(
             "Glue the skin's base to the backing plate with Smooth-On Sil-Poxy (ShadowTac \
-             Sec. III)."
+             Sec. IV-A)."
                 .into(),
         );
     }
@@ -703,6 +703,35 @@ fn assembly_steps(
             bayonet.ramp_deg,
             n = bayonet.lug_count
         ));
+    }
+    if let Some(c) = &design.casing {
+        let casing = named("casing")
+            .first()
+            .cloned()
+            .unwrap_or_else(|| "the casing".into());
+        let azimuths = crate::parts::casing::led_azimuths_deg(c)
+            .iter()
+            .map(|a| format!("{a:.0}"))
+            .collect::<Vec<_>>()
+            .join(", ");
+        out.push(format!(
+            "Cut {n} single-LED segments from the strip ({}) and push one into each slot in the light chamber's wall of {casing} (at {azimuths} deg from +x), LED facing the axis and its top end flush with the casing's top face, close under the plate; lead the wires down the slot, across the chamber's floor and through the ledge's hole into the camera bay (ShadowTac Sec. IV-B: red, green and blue at 120 deg, close to the acrylic plate).",
+            c.leds.description,
+            n = c.leds.count
+        ));
+        out.push(format!(
+            "Glue the backing plate, the skin up, onto the top face of {casing} with cyanoacrylate, centred over the window (ShadowTac Sec. IV-B)."
+        ));
+        out.push(format!(
+            "Set the camera board ({}) into the bay of {casing} from below, the lens up through the ledge's bore, the LEDs' wires beside it.",
+            c.camera.module
+        ));
+        if let Some(g) = &c.gripper_base {
+            out.push(format!(
+                "Set {casing} into the socket of `gripper_base`, the camera's cable out through the slot on +y, and fasten it with 4 screws up through the base's counterbored holes into the casing's pilots; bolt the base to the {} with 4 bolts (ShadowTac Sec. IV-B: a base to mount the sensor on a robotic gripper).",
+                g.gripper
+            ));
+        }
     }
     if out.is_empty() && filled.is_none() {
         out.push(if parts.iter().any(|p| p.role == "printed_skin") {

@@ -35,6 +35,10 @@ pub struct Design {
     /// TacTip, Pestell et al. Sec. III-A, Fig. 1); none when not given.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shaft_body: Option<crate::parts::shaft_body::ShaftBodyParams>,
+    /// The casing that holds the camera, the LEDs and the skin's backing plate, and the base
+    /// that mounts it on a gripper (ShadowTac Sec. IV-B, Fig. 5); none when not given.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub casing: Option<crate::parts::casing::CasingParams>,
     #[serde(default)]
     pub printers: PrinterProfiles,
     #[serde(default)]

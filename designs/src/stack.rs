@@ -227,6 +227,20 @@ pub fn validate(
             );
         }
     }
+    if let Some(c) = &design.casing {
+        check_material(
+            "casing.material".into(),
+            &c.material,
+            &[MaterialKind::Print],
+        );
+        if let Some(g) = &c.gripper_base {
+            check_material(
+                "casing.gripper_base.material".into(),
+                &g.material,
+                &[MaterialKind::Print],
+            );
+        }
+    }
 
     if design.layers.is_empty() {
         errs.push(ParamError::new(
@@ -557,6 +571,9 @@ pub fn validate(
             layers: layers.clone(),
         };
         crate::parts::shaft_body::check_params(design, sb, &st, &mut errs);
+    }
+    if let (Some(c), true) = (&design.casing, stack_ok) {
+        crate::parts::casing::check_params(design, c, &mut errs);
     }
     if let (Some(c), true) = (sound_core, errs.is_empty()) {
         if let Some(first) = layers.iter().find(|l| {

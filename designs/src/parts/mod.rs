@@ -2,5 +2,6 @@
 //! each with its parameters, its rules and its solids.
 
 pub mod bayonet;
+pub mod casing;
 pub mod robot_mount;
 pub mod shaft_body;

@@ -288,7 +288,7 @@ pub fn tip_bayonet(design: &Design, sb: &ShaftBodyParams) -> Bayonet {
 }
 
 /// A printed fit's clearance: at least half the FDM nozzle, or the parts fuse or jam.
-fn half_nozzle(
+pub(crate) fn half_nozzle(
     path: &str,
     v: f64,
     fdm: &crate::schema::PrinterProfile,

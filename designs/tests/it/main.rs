@@ -16,6 +16,7 @@ mod primitives;
 mod profile;
 mod properties;
 mod shadowtac;
+mod shadowtac_casing;
 mod sweep;
 mod sweep_metrics;
 mod sweep_paths;

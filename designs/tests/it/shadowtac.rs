@@ -220,7 +220,9 @@ fn two_piece_mold_pieces_match_the_authors() {
         roles,
         [
             ("skin_cavity_block", "open_mold_piece"),
-            ("skin_reservoir_top", "open_mold_piece")
+            ("skin_reservoir_top", "open_mold_piece"),
+            ("casing", "casing"),
+            ("gripper_base", "gripper_base")
         ]
     );
     let (block, top) = (&kit.parts[0], &kit.parts[1]);
@@ -279,8 +281,8 @@ fn open_mold_stays_available() {
     let d = shadowtac().with_preset("open_mold").unwrap();
     let tol = ChordTolerance::default();
     let kit = build_kit(&d, tol).unwrap_or_else(|e| panic!("{e}"));
-    assert_eq!(kit.parts.len(), 1);
-    assert_eq!(kit.parts[0].role, "open_mold");
+    let roles: Vec<&str> = kit.parts.iter().map(|p| p.role.as_str()).collect();
+    assert_eq!(roles, ["open_mold", "casing", "gripper_base"]);
     let stack = validate(&d, &materials(), tol).unwrap();
     let skin = fabkit_designs::layers::layer_solid(&d, &stack, 0, tol)
         .unwrap()
