@@ -45,6 +45,7 @@ const TWINS: &[(&str, &str)] = &[
         "cq_shaft_body.py",
         include_str!("../python/twins/cq_shaft_body.py"),
     ),
+    ("cq_casing.py", include_str!("../python/twins/cq_casing.py")),
     (
         "cq_fixtures.py",
         include_str!("../python/twins/cq_fixtures.py"),

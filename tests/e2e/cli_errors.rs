@@ -132,6 +132,43 @@ fn tactip_body_fits_and_bayonet_profile_are_checked_and_write_nothing() {
     }
 }
 
+/// ShadowTac's casing (Sec. IV-B): a 30 mm camera board in the 29.4 mm bay is one named
+/// interference; a 24 mm window that does not pass the camera's view of the skin's rim and a
+/// gripper base narrower than its bolt pattern are refused by path. Exit 2, the error naming
+/// the parameter path, its value and the rule, nothing written.
+#[test]
+fn shadowtac_casing_fits_and_rules_are_checked_and_write_nothing() {
+    let tmp = tempfile::tempdir().unwrap();
+    let yaml = std::fs::read_to_string(repo_root().join("designs/library/shadowtac.yaml")).unwrap();
+    for (from, to, expect) in [
+        (
+            "    board_width_mm: 29.0 ",
+            "    board_width_mm: 30.0 ",
+            "casing.camera.board_width_mm = 30.0: fit check: `casing` and `camera_board_envelope` overlap by 213.8",
+        ),
+        (
+            "  window_diameter_mm: 31.0 ",
+            "  window_diameter_mm: 24.0 ",
+            "casing.window_diameter_mm = 24: the camera's view of the skin's rim (radius 17.50 mm, the lens's front 4.00 mm under the plate) crosses the casing's top 14.95 mm from the axis: the window must pass it",
+        ),
+        (
+            "    width_mm: 82.6 ",
+            "    width_mm: 60.0 ",
+            "casing.gripper_base.width_mm = 60: the bolts' counterbores (8.00 mm on a 70.00 mm spacing) must stay 0.80 mm inside the base",
+        ),
+    ] {
+        let bad = yaml.replacen(from, to, 1);
+        assert!(bad.contains(to), "{to}");
+        std::fs::write(tmp.path().join("bad.yaml"), &bad).unwrap();
+        let o = run(tmp.path(), &["export", "bad.yaml", "--out", "out/bad"], &[]);
+        assert_eq!(o.status.code(), Some(2), "{to}");
+        let err = text(&o.stderr);
+        assert!(err.contains(expect), "{expect}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+        assert!(!tmp.path().join("out").exists());
+    }
+}
+
 #[test]
 fn bad_chord_tolerance_and_unknown_design_are_errors() {
     let tmp = tempfile::tempdir().unwrap();

@@ -131,8 +131,24 @@ fn shadowtac_kits() {
         m["bought_items"]
     );
     oracle_check(&dir);
+    // the casing and the gripper base (Sec. IV-B: "two filament-printed components")
+    for name in ["casing", "gripper_base"] {
+        let p = part(&m, name);
+        assert_eq!(p["print_technology"], "FDM", "{name}");
+        assert_eq!(p["material"], "pla", "{name}");
+        assert_eq!(p["genus"], if name == "casing" { 4 } else { 9 }, "{name}");
+    }
+    // the envelope: the base's 82.6 mm square, from its bottom to the skin's pole (10 mm of
+    // the base under the casing's 24.5 mm, the 3 mm plate, the 8.358 mm skin)
+    let env = &m["summary"]["envelope_mm"];
+    let h = 10.0 + 24.5 + 3.0 + (22.5 - 200f64.sqrt());
+    assert!(
+        env[0] == 82.6 && env[1] == 82.6 && (env[2].as_f64().unwrap() - h).abs() < 1e-9,
+        "{env}"
+    );
+    // the two mold pieces, the casing, the base and the kit's 3MF
     let files = printable_files(&dir, &m);
-    assert_eq!(files.len(), 3);
+    assert_eq!(files.len(), 5);
 
     let (pdir, pm) = export(tmp.path(), "shadowtac", Some("paper_text"));
     let molds: Vec<&Value> = parts(&pm)

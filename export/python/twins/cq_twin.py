@@ -4,7 +4,7 @@ builder, then the recorded print placement."""
 from __future__ import annotations
 
 from . import cq_common as C
-from . import cq_fixtures, cq_housing, cq_layers, cq_molds, cq_shaft_body
+from . import cq_casing, cq_fixtures, cq_housing, cq_layers, cq_molds, cq_shaft_body
 from .families import family  # noqa: F401 (re-exported)
 
 
@@ -49,6 +49,10 @@ def _build_sensor(part: dict):
         s = cq_shaft_body.shaft_body(p)
     elif role == "robot_mount":
         s = cq_shaft_body.robot_mount(p)
+    elif role == "casing":
+        s = cq_casing.casing(p)
+    elif role == "gripper_base":
+        s = cq_casing.gripper_base(p)
     elif role == "indenter":
         s = cq_fixtures.indenter(p)
     elif name == "pin_dome":

@@ -497,9 +497,33 @@ fn shadowtac_sheet_names_its_bolts_and_pours_into_the_reservoir() {
             A::Pour,
             A::Demold,
             A::BrushCoat,
+            A::Assemble,
+            A::Assemble,
+            A::Assemble,
+            A::Assemble,
             A::Assemble
         ]
     );
+    // Sec. IV: the skin onto its plate, the LEDs into the casing before the plate closes it,
+    // the plate onto the casing, the camera from below, the casing onto the gripper base
+    let steps: Vec<String> = arr(&e.manifest, "procedure")
+        .iter()
+        .filter(|s| s["action"] == "assemble")
+        .map(|s| s["text"].as_str().unwrap().to_string())
+        .collect();
+    for (i, begins) in [
+        "Assemble: Glue the skin's base to the backing plate with Smooth-On Sil-Poxy",
+        "Assemble: Cut 3 single-LED segments from the strip",
+        "Assemble: Glue the backing plate, the skin up, onto the top face of `casing` with cyanoacrylate",
+        "Assemble: Set the camera board (Basler dart daA1920-160uc",
+        "Assemble: Set `casing` into the socket of `gripper_base`",
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        assert!(steps[i].starts_with(begins), "{i}: {}", steps[i]);
+    }
+    assert!(steps[1].contains("at 90, 210, 330 deg from +x"), "{}", steps[1]);
     // the reflective layer (Sec. IV-A), brushed on after demolding, before the plate
     assert!(
         e.sheet.contains(
