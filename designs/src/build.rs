@@ -198,6 +198,19 @@ pub fn build_kit_bounded(
             .as_ref()
             .map_or([c.outer_width_mm; 2], |g| [g.width_mm, g.length_mm]);
         summary["casing_levels"] = json!(&lv);
+        if let Some(b) = &design.backing {
+            summary["camera_view"] = json!({
+                "rim_crossing_radius_mm": crate::parts::casing::plate_crossing_radius_mm(
+                    design.body.rim_radius_mm(0.0),
+                    lv.top_z_mm - lv.lens_z_mm,
+                    b.thickness_mm,
+                    crate::parts::casing::PMMA_REFRACTIVE_INDEX,
+                ),
+                "window_radius_mm": c.window_diameter_mm / 2.0,
+                "lens_z_mm": lv.lens_z_mm,
+                "rule": "the ray from the lens's front (on the axis) to the skin's rim, refracted by the backing plate, crosses the casing's top inside the window",
+            });
+        }
         summary["envelope_mm"] = json!([w[0], w[1], lv.envelope_height_mm]);
         bought.extend(crate::parts::casing::bought_items(c));
     }

@@ -18,8 +18,10 @@
 use criterion::{criterion_group, criterion_main, Criterion, SamplingMode};
 use fabkit::designs::schema::MoldStrategy;
 use fabkit::designs::{build_kit, library, ChordTolerance, Design};
-use fabkit::export::{write_kit, ExportOptions, Formats};
-use sha2::{Digest, Sha256};
+use fabkit::export::{write_kit, ExportOptions};
+
+#[path = "common_kit.rs"]
+mod common_kit;
 use std::hint::black_box;
 use std::time::Duration;
 
@@ -38,19 +40,7 @@ fn design_with(strategy: MoldStrategy) -> Design {
 
 /// The options `fabkit export` would pass, with this benchmark as the recorded command line.
 fn export_options(tol: ChordTolerance) -> ExportOptions {
-    let text = library::yaml(DESIGN).expect("the library design exists");
-    let design_sha256 = Sha256::digest(text.as_bytes())
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect();
-    ExportOptions {
-        formats: Formats::default(),
-        command_line: vec!["cargo bench -p fabkit-benches --bench export_rtac0".to_string()],
-        design_source: format!("embedded:{DESIGN}"),
-        design_sha256,
-        chord_tolerance_mm: tol.mm(),
-        fabkit_version: env!("CARGO_PKG_VERSION").to_string(),
-    }
+    common_kit::export_options(DESIGN, "export_rtac0", tol)
 }
 
 const STRATEGIES: [(&str, MoldStrategy); 2] = [

@@ -146,6 +146,13 @@ fn shadowtac_kits() {
         env[0] == 82.6 && env[1] == 82.6 && (env[2].as_f64().unwrap() - h).abs() < 1e-9,
         "{env}"
     );
+    // the camera sees the skin's rim through the window (ShadowTac: 14.95 < 15.5 mm)
+    let view = &m["summary"]["camera_view"];
+    let cross = view["rim_crossing_radius_mm"].as_f64().unwrap();
+    assert!(
+        (cross - 14.945).abs() < 1e-3 && cross < view["window_radius_mm"].as_f64().unwrap(),
+        "{view}"
+    );
     // the two mold pieces, the casing, the base and the kit's 3MF
     let files = printable_files(&dir, &m);
     assert_eq!(files.len(), 5);
