@@ -523,7 +523,11 @@ fn shadowtac_sheet_names_its_bolts_and_pours_into_the_reservoir() {
     {
         assert!(steps[i].starts_with(begins), "{i}: {}", steps[i]);
     }
-    assert!(steps[1].contains("at 90, 210, 330 deg from +x"), "{}", steps[1]);
+    assert!(
+        steps[1].contains("at 90, 210, 330 deg from +x"),
+        "{}",
+        steps[1]
+    );
     // the reflective layer (Sec. IV-A), brushed on after demolding, before the plate
     assert!(
         e.sheet.contains(
