@@ -118,18 +118,29 @@ fn tactip_body_fits_and_bayonet_profile_are_checked_and_write_nothing() {
             ],
         ),
     ] {
-        let bad = yaml.replacen(from, to, 1);
-        assert!(bad.contains(to), "{to}");
-        std::fs::write(tmp.path().join("bad.yaml"), &bad).unwrap();
-        let o = run(tmp.path(), &["export", "bad.yaml", "--out", "out/bad"], &[]);
-        assert_eq!(o.status.code(), Some(2), "{to}");
-        let err = text(&o.stderr);
-        for e in expect {
-            assert!(err.contains(e), "{e}: {err}");
-        }
-        assert!(!err.contains("panicked"), "{err}");
-        assert!(!tmp.path().join("out").exists());
+        refused_writing_nothing(tmp.path(), &yaml, (from, to), &expect);
     }
+}
+
+/// `yaml` with `from` replaced by `to` (once) is refused by `fabkit export`: exit 2, stderr
+/// holding each of `expect` and no panic, no output folder.
+fn refused_writing_nothing(
+    tmp: &std::path::Path,
+    yaml: &str,
+    (from, to): (&str, &str),
+    expect: &[&str],
+) {
+    let bad = yaml.replacen(from, to, 1);
+    assert!(bad.contains(to), "{to}");
+    std::fs::write(tmp.join("bad.yaml"), &bad).unwrap();
+    let o = run(tmp, &["export", "bad.yaml", "--out", "out/bad"], &[]);
+    assert_eq!(o.status.code(), Some(2), "{to}");
+    let err = text(&o.stderr);
+    for e in expect {
+        assert!(err.contains(e), "{e}: {err}");
+    }
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(!tmp.join("out").exists());
 }
 
 /// ShadowTac's casing (Sec. IV-B): a 30 mm camera board in the 29.4 mm bay is one named
@@ -157,15 +168,7 @@ fn shadowtac_casing_fits_and_rules_are_checked_and_write_nothing() {
             "casing.gripper_base.width_mm = 60: the bolts' counterbores (8.00 mm on a 70.00 mm spacing) must stay 0.80 mm inside the base",
         ),
     ] {
-        let bad = yaml.replacen(from, to, 1);
-        assert!(bad.contains(to), "{to}");
-        std::fs::write(tmp.path().join("bad.yaml"), &bad).unwrap();
-        let o = run(tmp.path(), &["export", "bad.yaml", "--out", "out/bad"], &[]);
-        assert_eq!(o.status.code(), Some(2), "{to}");
-        let err = text(&o.stderr);
-        assert!(err.contains(expect), "{expect}: {err}");
-        assert!(!err.contains("panicked"), "{err}");
-        assert!(!tmp.path().join("out").exists());
+        refused_writing_nothing(tmp.path(), &yaml, (from, to), &[expect]);
     }
 }
 

@@ -3,10 +3,10 @@
 //! one fit broken at a time giving one named interference with its analytic overlap, and one
 //! bad value per rule refused by path.
 
+use crate::common::{assert_each_rule_names_its_path, assert_one_interference, RuleCase};
 use fabkit_designs::assembly::MemberKind;
-use fabkit_designs::materials::MaterialsTable;
 use fabkit_designs::parts::casing::{plate_crossing_radius_mm, CasingParams};
-use fabkit_designs::{build_kit, library, stack, ChordTolerance, Design, DesignError, Kit};
+use fabkit_designs::{build_kit, library, ChordTolerance, Design, Kit};
 use std::f64::consts::PI;
 use std::sync::OnceLock;
 
@@ -139,45 +139,6 @@ fn the_window_passes_the_view_of_the_skins_rim_through_the_plate() {
     assert!(r1 < 15.5, "inside the window: {r1}");
 }
 
-fn build_error(d: &Design) -> fabkit_designs::ParamErrors {
-    match build_kit(d, tol()) {
-        Err(DesignError::Params(e)) => e,
-        other => panic!("{:?}", other.map(|k| k.design)),
-    }
-}
-
-/// The overlap's volume in an error's rule ("overlap by V mm³").
-fn overlap(rule: &str) -> f64 {
-    rule.split("overlap by ")
-        .nth(1)
-        .and_then(|r| r.split(' ').next())
-        .and_then(|v| v.parse().ok())
-        .unwrap_or_else(|| panic!("{rule}"))
-}
-
-/// `d` does not build: one error naming `path` = `value` and the interference of `pair`,
-/// whose overlap is within `rel` of the analytic `want` mm³, its rule naming `also`.
-fn assert_one_interference(
-    d: &Design,
-    (path, value): (&str, &str),
-    pair: &str,
-    also: &str,
-    want: f64,
-    rel: f64,
-) {
-    let e = build_error(d);
-    assert_eq!(e.0.len(), 1, "{e}");
-    let got = overlap(&e.0[0].rule);
-    assert!(
-        e.0[0].path == path
-            && e.0[0].value == value
-            && e.0[0].rule.contains(&format!("{pair} overlap by"))
-            && e.0[0].rule.contains(also)
-            && (got - want).abs() <= rel * want,
-        "{e} (analytic {want})"
-    );
-}
-
 /// A 30 mm board in the 29.4 mm bay: it overlaps the casing's wall by the square ring
 /// 30^2 - 29.4^2 over its 6 mm height.
 #[test]
@@ -188,7 +149,7 @@ fn a_board_wider_than_the_bay_is_a_named_interference() {
         &d,
         ("casing.camera.board_width_mm", "30.0"),
         "`casing` and `camera_board_envelope`",
-        "casing.wall_thickness_mm",
+        &["casing.wall_thickness_mm"],
         (30.0f64.powi(2) - 29.4f64.powi(2)) * 6.0,
         0.005,
     );
@@ -204,7 +165,7 @@ fn a_board_taller_than_the_bay_is_a_named_interference() {
         &d,
         ("casing.camera.board_width_mm", "29.0"),
         "`casing` and `camera_board_envelope`",
-        "casing.camera.board_height_mm or casing.wall_thickness_mm or casing.bay_height_mm",
+        &["casing.camera.board_height_mm or casing.wall_thickness_mm or casing.bay_height_mm"],
         0.8 * (29.0f64.powi(2) - PI * 8.2f64.powi(2) - 3.0 * PI * 0.7f64.powi(2)),
         0.005,
     );
@@ -220,7 +181,7 @@ fn a_lens_reaching_the_plate_is_a_named_interference() {
         &d,
         ("casing.camera.lens_height_mm", "19.5"),
         "`backing_envelope` and `camera_lens_envelope`",
-        "backing.thickness_mm",
+        &["backing.thickness_mm"],
         PI * 64.0,
         0.005,
     );
@@ -230,8 +191,7 @@ fn a_lens_reaching_the_plate_is_a_named_interference() {
 /// (among any others the value breaks) with its value and a rule, and no kit is built.
 #[test]
 fn each_rule_of_the_casing_names_its_parameter() {
-    type Mutation = fn(&mut Design);
-    let cases: &[(&str, Mutation)] = &[
+    let cases: &[RuleCase] = &[
         ("casing.material", |d| casing(d).material = "solaris".into()),
         ("casing.outer_width_mm", |d| casing(d).outer_width_mm = 0.0),
         ("casing.camera.board_width_mm", |d| {
@@ -318,22 +278,5 @@ fn each_rule_of_the_casing_names_its_parameter() {
             casing(d).gripper_base.as_mut().unwrap().cable_slot_depth_mm = f64::INFINITY
         }),
     ];
-    let materials = MaterialsTable::embedded().unwrap();
-    for (path, mutate) in cases {
-        let mut d = shadowtac();
-        mutate(&mut d);
-        let e = match stack::validate(&d, &materials, tol()) {
-            Err(e) => e,
-            Ok(_) => panic!("{path}: validates"),
-        };
-        assert!(
-            e.0.iter()
-                .any(|x| x.path == *path && !x.rule.is_empty() && !x.value.is_empty()),
-            "{path}: {e}"
-        );
-        assert!(
-            matches!(build_kit(&d, tol()), Err(DesignError::Params(_))),
-            "{path}"
-        );
-    }
+    assert_each_rule_names_its_path(shadowtac, cases);
 }
