@@ -91,7 +91,7 @@ pub enum ExactShape {
 }
 
 /// Roles of kit parts that are part of the sensor (the rest are molds and tooling).
-pub const SENSOR_ROLES: [&str; 11] = [
+pub const SENSOR_ROLES: [&str; 15] = [
     "shell_collar",
     "shell_tube",
     "shell_base",
@@ -103,6 +103,10 @@ pub const SENSOR_ROLES: [&str; 11] = [
     "robot_mount",
     "casing",
     "gripper_base",
+    "shell_holder",
+    "sensor_base",
+    "camera_holder",
+    "diffusion_ring",
 ];
 
 /// The parameter paths that size a printed member of `role`.
@@ -126,6 +130,9 @@ fn printed_fix(role: &str) -> Vec<String> {
             "casing.window_diameter_mm".into(),
         ],
         "gripper_base" => vec!["casing.gripper_base".into()],
+        "shell_holder" | "sensor_base" => vec!["fingertip_base.fit_clearance_mm".into()],
+        "camera_holder" => vec!["fingertip_base.camera_holder.outer_diameter_mm".into()],
+        "diffusion_ring" => vec!["fingertip_base.diffusion_ring.inner_diameter_mm".into()],
         "printed_skin" | "marker_tips" => vec!["layers".into()],
         _ => vec!["housing".into()],
     }

@@ -107,13 +107,24 @@ pub fn build_kit_bounded(
                                 },
                             )
                         },
-                        || design.casing.as_ref().map(build_casing_parts(design, tol)),
+                        || {
+                            rayon::join(
+                                || design.casing.as_ref().map(build_casing_parts(design, tol)),
+                                || {
+                                    design.fingertip_base.as_ref().map(|f| {
+                                        crate::parts::fingertip_base::build_parts(
+                                            design, f, &stack, tol,
+                                        )
+                                    })
+                                },
+                            )
+                        },
                     )
                 },
             )
         },
     );
-    let (shell, (shaft_body, casing)) = shell;
+    let (shell, (shaft_body, (casing, fingertip))) = shell;
     let mut layer_markers = Vec::new();
     for (&i, out) in other.iter().zip(others) {
         let out = out?;
@@ -213,6 +224,17 @@ pub fn build_kit_bounded(
         }
         summary["envelope_mm"] = json!([w[0], w[1], lv.envelope_height_mm]);
         bought.extend(crate::parts::casing::bought_items(c));
+    }
+
+    if let (Some(f), Some(parts_f)) = (&design.fingertip_base, fingertip) {
+        parts.extend(parts_f?);
+        let lv = crate::parts::fingertip_base::levels(design, f, &stack);
+        let w = f
+            .outer_diameter_mm
+            .max(2.0 * design.body.rim_radius_mm(0.0));
+        summary["fingertip_levels"] = json!(&lv);
+        summary["envelope_mm"] = json!([w, w, lv.envelope_height_mm]);
+        bought.extend(crate::parts::fingertip_base::bought_items(f));
     }
 
     let mut casts = Vec::new();
@@ -345,6 +367,11 @@ pub fn build_kit_bounded(
     }
     if let Some(c) = &design.casing {
         assembly.extend(crate::parts::casing::members(design, c, tol)?);
+    }
+    if let Some(f) = &design.fingertip_base {
+        assembly.extend(crate::parts::fingertip_base::members(
+            design, f, &stack, tol,
+        )?);
     }
     let found = crate::assembly::interferences(&assembly, tol)?;
     if let Some(e) = crate::assembly::fit_errors(design, &found) {

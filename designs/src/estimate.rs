@@ -83,6 +83,16 @@ pub fn estimate(design: &Design, stack: &Stack, tol: ChordTolerance) -> WorkEsti
         surfaces += 30.0 * tol.circle_segments(r.base_outer_mm) as f64
             + 27.0 * tol.circle_segments(r.fitting_outer_mm) as f64;
     }
+    if let Some(c) = &design.casing {
+        // the casing's and the gripper base's holes, bores and pockets: about 36 circles of
+        // the casing's half-width
+        surfaces += 36.0 * tol.circle_segments(c.outer_width_mm / 2.0) as f64;
+    }
+    if let Some(f) = &design.fingertip_base {
+        // the shell holder, sensor base, camera holder and diffusion ring: about 40 circles
+        // of the base's outer radius
+        surfaces += 40.0 * tol.circle_segments(f.outer_diameter_mm / 2.0) as f64;
+    }
     let (mut markers, mut feature_tris) = (0u64, 0.0);
     for l in &stack.layers {
         for (n, radius_mm) in count_layer_markers(design, l) {

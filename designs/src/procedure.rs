@@ -733,6 +733,34 @@ fn assembly_steps(
             ));
         }
     }
+    if let Some(f) = &design.fingertip_base {
+        out.push(format!(
+            "Glue the camera ({}) into `camera_holder` with instant adhesive, its front flush \
+             with the holder's top and its wire down the bore; glue the holder onto the floor of \
+             the pocket of `sensor_base`, over the centre hole, the wire down through the floor \
+             (UVDtact Sec. III-C).",
+            f.camera.module
+        ));
+        out.push(
+            "Lead the lighting PCB's wires down through the floor's wire hole and glue the PCB, \
+             LEDs up and the first white LED on +x, onto the pocket's floor round the camera \
+             holder; glue `diffusion_ring` on top, flush with the base's top, its holes over the \
+             UV LEDs (UVDtact Sec. III-C)."
+                .into(),
+        );
+        out.push(
+            "Glue the acrylic shell's foot, with the elastomer on it, into `shell_holder` with \
+             instant adhesive, the shell's end flush with the holder's bottom (UVDtact \
+             Sec. III-C)."
+                .into(),
+        );
+        out.push(format!(
+            "Set `shell_holder` on `sensor_base` and fasten them with {} bolts up through the \
+             base's counterbored holes; to replace the elastomer, undo them (UVDtact Sec. III-C: \
+             three M1.2 bolts).",
+            f.bolts.count
+        ));
+    }
     if out.is_empty() && filled.is_none() {
         out.push(if parts.iter().any(|p| p.role == "printed_skin") {
             "Nothing to put together: the printed skin comes off the printer with its marker \

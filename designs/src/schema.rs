@@ -39,6 +39,10 @@ pub struct Design {
     /// that mounts it on a gripper (ShadowTac Sec. IV-B, Fig. 5); none when not given.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub casing: Option<crate::parts::casing::CasingParams>,
+    /// The shell holder, sensor base, camera holder and diffusion ring of a fingertip whose
+    /// skin is cast onto a rigid shell (UVDtact Sec. III-C, Fig. 2); none when not given.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fingertip_base: Option<crate::parts::fingertip_base::FingertipBase>,
     #[serde(default)]
     pub printers: PrinterProfiles,
     #[serde(default)]

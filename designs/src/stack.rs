@@ -241,6 +241,18 @@ pub fn validate(
             );
         }
     }
+    if let Some(f) = &design.fingertip_base {
+        check_material(
+            "fingertip_base.material".into(),
+            &f.material,
+            &[MaterialKind::Print],
+        );
+        check_material(
+            "fingertip_base.diffusion_ring.material".into(),
+            &f.diffusion_ring.material,
+            &[MaterialKind::Print],
+        );
+    }
 
     if design.layers.is_empty() {
         errs.push(ParamError::new(
@@ -574,6 +586,13 @@ pub fn validate(
     }
     if let (Some(c), true) = (&design.casing, stack_ok) {
         crate::parts::casing::check_params(design, c, &mut errs);
+    }
+    if let (Some(f), true) = (&design.fingertip_base, stack_ok) {
+        let st = Stack {
+            core: core.clone(),
+            layers: layers.clone(),
+        };
+        crate::parts::fingertip_base::check_params(design, f, &st, &mut errs);
     }
     if let (Some(c), true) = (sound_core, errs.is_empty()) {
         if let Some(first) = layers.iter().find(|l| {

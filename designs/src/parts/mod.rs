@@ -3,5 +3,6 @@
 
 pub mod bayonet;
 pub mod casing;
+pub mod fingertip_base;
 pub mod robot_mount;
 pub mod shaft_body;

@@ -176,12 +176,15 @@ fn lenient_scalars_and_unknown_tags_are_refused() {
 #[test]
 fn each_quoted_number_is_refused_at_its_own_location() {
     let text = library::yaml("uvdtact").unwrap();
-    let yaml = text
+    // the layers' lines, before the fingertip's base (whose PCB and ring have a thickness too)
+    let layers_end = text.find("\nfingertip_base:").unwrap();
+    let yaml = text[..layers_end]
         .lines()
         .map(|l| match l.find("  thickness_mm: ") {
             Some(i) if l.starts_with("    ") => format!("{}thickness_mm: \"1.5\"", &l[..i + 2]),
             _ => l.to_string(),
         })
+        .chain(text[layers_end..].lines().map(str::to_string))
         .collect::<Vec<_>>()
         .join("\n")
         .replace(

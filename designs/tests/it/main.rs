@@ -21,4 +21,5 @@ mod sweep;
 mod sweep_metrics;
 mod sweep_paths;
 mod tactip_body;
+mod uvdtact_base;
 mod validation;
