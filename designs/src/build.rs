@@ -393,6 +393,7 @@ pub fn build_kit_bounded(
         procedure,
         assembly,
         cut_parts: crate::cut::cut_parts(design),
+        pcb_outlines: crate::cut::pcb_outlines(design),
         summary,
     })
 }

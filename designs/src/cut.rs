@@ -115,3 +115,40 @@ pub fn cut_parts(design: &Design) -> Vec<CutPart> {
     }
     out
 }
+
+/// The printed circuit boards' outlines of a design, for PCB tools: the fingertip's lighting
+/// PCB (UVDtact Sec. III-C): its edge and bore on `cut`, a circle the LED's length across at
+/// each LED's place on `engrave` (white on +x, then UV and white alternating every 45 deg).
+pub fn pcb_outlines(design: &Design) -> Vec<CutPart> {
+    let circle = |[x, y]: [f64; 2], r: f64| Outline::Circle {
+        centre_mm: [x, y],
+        radius_mm: r,
+    };
+    let mut out = Vec::new();
+    if let Some(f) = &design.fingertip_base {
+        let p = &f.led_pcb;
+        let mut outlines = vec![
+            (Operation::Cut, circle([0.0; 2], p.outer_diameter_mm / 2.0)),
+            (Operation::Cut, circle([0.0; 2], p.inner_diameter_mm / 2.0)),
+        ];
+        let r = p.led_circle_diameter_mm / 2.0;
+        for (a, _) in crate::parts::fingertip_base::leds() {
+            let (s, c) = a.to_radians().sin_cos();
+            outlines.push((
+                Operation::Engrave,
+                circle([r * c, r * s], p.led_length_mm / 2.0),
+            ));
+        }
+        out.push(CutPart {
+            name: "lighting_pcb".into(),
+            description: format!(
+                "Lighting PCB outline: {:.1} mm board with a {:.1} mm bore, {:.1} mm thick; 8 LED places on a {:.1} mm circle, white on +x then UV and white alternating every 45 deg (UVDtact Sec. III-C)",
+                p.outer_diameter_mm, p.inner_diameter_mm, p.thickness_mm, p.led_circle_diameter_mm
+            ),
+            material: "fr4".into(),
+            thickness_mm: p.thickness_mm,
+            outlines,
+        });
+    }
+    out
+}

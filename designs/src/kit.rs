@@ -234,6 +234,9 @@ pub struct Kit {
     pub assembly: Vec<crate::assembly::Member>,
     /// Parts cut from sheet stock, as outlines for DXF and SVG ([`crate::cut::cut_parts`]).
     pub cut_parts: Vec<crate::cut::CutPart>,
+    /// Printed circuit boards' outlines, for PCB tools as DXF ([`crate::cut::pcb_outlines`]):
+    /// the board's edge and holes on `cut`, its components' places on `engrave`.
+    pub pcb_outlines: Vec<crate::cut::CutPart>,
     /// Sensor-frame facts worth printing in the manifest (envelope, derived radii...).
     pub summary: serde_json::Value,
 }

@@ -37,7 +37,7 @@ pub use error::ExportError;
 pub use manifest::{
     Manifest, ManifestAssembly, ManifestAssemblyStep, ManifestCutPart, ManifestDataFile,
     ManifestDesign, ManifestKit3mf, ManifestMember, ManifestObject, ManifestPart,
-    ManifestStepMember, ManifestVolume, StepGeometry, FRAME,
+    ManifestPcbOutline, ManifestStepMember, ManifestVolume, StepGeometry, FRAME,
 };
 
 use fabkit_designs::assembly::{ExactShape, MemberKind};
@@ -377,6 +377,8 @@ pub const ASSEMBLY_STEP: &str = "assembly.step";
 const PARTS_DIR: &str = "parts";
 /// Folder of the laser-cut parts' DXF and SVG files.
 const CUT_DIR: &str = "cut";
+/// Folder of the PCB outlines' DXF files.
+const PCB_DIR: &str = "pcb";
 const STEP_DIR: &str = "step";
 
 /// Every file of the export, in memory, with `/`-separated relative paths.
@@ -595,6 +597,20 @@ fn render(
         files.push((dxf, dxf_bytes));
         files.push((svg, svg_bytes));
     }
+    let mut pcb_outlines = Vec::with_capacity(kit.pcb_outlines.len());
+    for c in &kit.pcb_outlines {
+        let dxf = format!("{PCB_DIR}/{}.dxf", c.name);
+        let dxf_bytes = two_d::dxf_bytes(c)?;
+        pcb_outlines.push(ManifestPcbOutline {
+            name: c.name.clone(),
+            description: c.description.clone(),
+            thickness_mm: c.thickness_mm,
+            area_mm2: c.area_mm2(),
+            dxf_sha256: sha256_hex(&dxf_bytes),
+            dxf: dxf.clone(),
+        });
+        files.push((dxf, dxf_bytes));
+    }
     let assembly_3mf = if opts.formats.threemf && !kit.assembly.is_empty() {
         let (manifest_assembly, bytes) = assembly_3mf(kit, &assembly_meshes, opts)?;
         files.push((manifest_assembly.file.clone(), bytes));
@@ -619,6 +635,7 @@ fn render(
         assembly_step,
         section_view,
         cut_parts,
+        pcb_outlines,
         casts: kit.casts.clone(),
         bought_items: kit.bought_items.clone(),
         procedure: kit.procedure.clone(),
@@ -688,6 +705,7 @@ mod tests {
             procedure: vec![],
             assembly: vec![],
             cut_parts: vec![],
+            pcb_outlines: vec![],
             summary: serde_json::json!({}),
         }
     }

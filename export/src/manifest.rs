@@ -43,6 +43,9 @@ pub struct Manifest {
     /// Laser-cut parts with their DXF and SVG files.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub cut_parts: Vec<ManifestCutPart>,
+    /// Printed circuit boards' outlines with their DXF files, for PCB tools.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub pcb_outlines: Vec<ManifestPcbOutline>,
     /// Pours in casting order, as the design computed them.
     pub casts: Vec<CastReport>,
     /// Parts that are bought or cut rather than printed, one line each.
@@ -217,6 +220,19 @@ pub struct ManifestCutPart {
     pub dxf_sha256: String,
     pub svg: String,
     pub svg_sha256: String,
+}
+
+/// A printed circuit board's outline (`pcb/<name>.dxf`: R2000, mm, the edge and holes on
+/// layer `cut`, component places on `engrave`), for a PCB tool's board edge.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ManifestPcbOutline {
+    pub name: String,
+    pub description: String,
+    pub thickness_mm: f64,
+    /// Area of the board (outer edge less the holes), mm^2.
+    pub area_mm2: f64,
+    pub dxf: String,
+    pub dxf_sha256: String,
 }
 
 /// The kit 3MF.

@@ -198,6 +198,7 @@ pub(crate) fn render(m: &Manifest) -> String {
 
     shopping_list(&mut s, m);
     laser_cut(&mut s, m);
+    pcb_outlines(&mut s, m);
     procedure(&mut s, m);
 
     s.push_str("## Bought items\n\n");
@@ -313,6 +314,29 @@ fn laser_cut(s: &mut String, m: &Manifest) {
             code(&c.svg),
             text(&c.description),
             text(&c.material_name),
+            c.thickness_mm,
+            c.area_mm2
+        );
+    }
+    s.push('\n');
+}
+
+/// The PCB outlines and their files; nothing when the kit has none.
+fn pcb_outlines(s: &mut String, m: &Manifest) {
+    if m.pcb_outlines.is_empty() {
+        return;
+    }
+    s.push_str("## PCB outlines\n\n");
+    s.push_str(
+        "DXF (R2000, mm) of each board, centred on the sensor axis: import layer `cut` as the \
+         board's edge and holes in the PCB tool; `engrave` marks the components' places.\n\n",
+    );
+    for c in &m.pcb_outlines {
+        let _ = writeln!(
+            s,
+            "- {}: {}, {:.1} mm board, {:.1} mm² of face",
+            code(&c.dxf),
+            text(&c.description),
             c.thickness_mm,
             c.area_mm2
         );

@@ -65,7 +65,7 @@ pub fn dxf_bytes(part: &CutPart) -> Result<Vec<u8>, ExportError> {
     }
     let mut out = Vec::new();
     let encode = |reason: String| ExportError::Encode {
-        what: format!("cut/{}.dxf", part.name),
+        what: format!("{}.dxf", part.name),
         reason,
     };
     d.save(&mut out).map_err(|e| encode(e.to_string()))?;

@@ -211,6 +211,17 @@ fn uvdtact_kits() {
         ),
         (3, 3, 3)
     );
+    // the fingertip's base (Sec. III-C: "the camera holder, shell holder, and sensor base are
+    // fabricated using an SLA 3D printer"; the white SLA diffusion ring)
+    for role in [
+        "shell_holder",
+        "sensor_base",
+        "camera_holder",
+        "diffusion_ring",
+    ] {
+        assert_eq!(count(role), 1, "{role}");
+    }
+    assert_eq!(part(&m, "diffusion_ring")["material"], "sla_white_resin");
     for p in parts(&m) {
         let want = if p["role"] == "mold_box" {
             "FDM"
@@ -254,6 +265,67 @@ fn uvdtact_kits() {
         oracle_check(mk_dir);
     }
     printcheck_all(&printable_files(&dir, &m));
+    lighting_pcb_outline_passes_ezdxf(&dir, &m);
+}
+
+/// UVDtact's lighting PCB outline (Sec. III-C: 4 white and 4 UV LEDs alternating every
+/// 45 deg): `pcb/lighting_pcb.dxf` passes ezdxf's audit with nothing to fix (R2000 or later,
+/// mm); on `cut` the 12 mm board less its 3.2 mm bore, on `engrave` the 8 LED places on the
+/// 8 mm circle, 45 deg apart from +x.
+fn lighting_pcb_outline_passes_ezdxf(dir: &Path, m: &Value) {
+    let pcb = &m["pcb_outlines"][0];
+    assert_eq!(pcb["name"], "lighting_pcb");
+    let area = PI * (6.0f64.powi(2) - 1.6f64.powi(2));
+    assert!(
+        (pcb["area_mm2"].as_f64().unwrap() - area).abs() < 1e-9,
+        "{pcb}"
+    );
+    let Some(py) = oracle_python() else {
+        return missing("the oracle python (ezdxf)");
+    };
+    let script = r#"
+import sys, json, math, ezdxf
+doc = ezdxf.readfile(sys.argv[1])
+a = doc.audit()
+msp = doc.modelspace()
+cut = sorted((e.dxf.radius for e in msp.query('CIRCLE[layer=="cut"]')), reverse=True)
+leds = [e.dxf.center for e in msp.query('CIRCLE[layer=="engrave"]')]
+print(json.dumps({
+    "version": doc.dxfversion, "units": doc.units, "errors": len(a.errors), "fixes": len(a.fixes),
+    "area": math.pi * cut[0] ** 2 - sum(math.pi * r ** 2 for r in cut[1:]),
+    "led_radii": [math.hypot(c.x, c.y) for c in leds],
+    "led_deg": sorted(round(math.degrees(math.atan2(c.y, c.x)) % 360.0, 9) for c in leds),
+}))
+"#;
+    let o = std::process::Command::new(py)
+        .arg("-c")
+        .arg(script)
+        .arg(dir.join(pcb["dxf"].as_str().unwrap()))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let v: Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(v["version"].as_str().unwrap() >= "AC1015", "{v}");
+    assert_eq!(v["units"], 4, "{v}"); // millimetres
+    assert_eq!(
+        (v["errors"].as_u64(), v["fixes"].as_u64()),
+        (Some(0), Some(0)),
+        "{v}"
+    );
+    assert!((v["area"].as_f64().unwrap() - area).abs() < 1e-9, "{v}");
+    let radii = v["led_radii"].as_array().unwrap();
+    assert_eq!(radii.len(), 8, "{v}");
+    assert!(
+        radii
+            .iter()
+            .all(|r| (r.as_f64().unwrap() - 4.0).abs() < 1e-9),
+        "{v}"
+    );
+    for (k, a) in v["led_deg"].as_array().unwrap().iter().enumerate() {
+        let a = a.as_f64().unwrap();
+        let d = (a - 45.0 * k as f64).abs();
+        assert!(d < 1e-6 || (360.0 - d).abs() < 1e-6, "{v}");
+    }
 }
 
 /// The dual-modal TacTip (Pestell et al. Sec. III-A, III-D): a PolyJet skin with pins, white

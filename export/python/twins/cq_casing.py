@@ -1,6 +1,8 @@
-"""CadQuery twin of ShadowTac's casing and gripper base (Sec. IV-B, Fig. 5), from the part's
-manifest `params`: the casing's parameters, its levels, the LEDs' azimuths, the slots' and wire
-holes' radii, the corner pilots and the gripper bolts."""
+"""CadQuery twins of the sensors' casings and bases, from the part's manifest `params`:
+ShadowTac's casing and gripper base (Sec. IV-B, Fig. 5: the casing's parameters, its levels, the
+LEDs' azimuths, the slots' and wire holes' radii, the corner pilots and the gripper bolts) and
+UVDtact's fingertip base (Sec. III-C, Fig. 2: shell holder, sensor base, camera holder,
+diffusion ring)."""
 
 from __future__ import annotations
 
@@ -68,3 +70,44 @@ def gripper_base(params: dict):
         cuts.append(cyl(g["bolt_head_diameter_mm"] / 2.0, top - g["bolt_head_depth_mm"],
                         top + 1.0, bx, by))
     return C.cut(C.box([-x, -y, bottom], [x, y, top]), cuts)
+
+
+def _ring(ri: float, ro: float, z0: float, z1: float):
+    return C.cut(C.cylinder_z(ro, z0, z1), [C.cylinder_z(ri, z0 - 1.0, z1 + 1.0)])
+
+
+def fingertip_part(params: dict, role: str):
+    """UVDtact's shell holder, sensor base, camera holder or diffusion ring (Sec. III-C,
+    Fig. 2), sensor frame (designs/src/parts/fingertip_base.rs)."""
+    f, lv, r = params["fingertip_base"], params["levels"], params["radii"]
+    e = params["overlap_mm"]
+    b = f["bolts"]
+    end, floor, bottom = lv["shell_end_z_mm"], lv["pocket_floor_z_mm"], lv["bottom_z_mm"]
+    cyl = C.cylinder_z
+    if role == "shell_holder":
+        cuts = [cyl(b["pilot_diameter_mm"] / 2.0, end - 1.0, end + b["pilot_depth_mm"], x, y)
+                for x, y in params["bolt_xy_mm"]]
+        return C.cut(_ring(r["holder_bore_mm"], r["outside_mm"], end, 0.0), cuts)
+    if role == "sensor_base":
+        wx, wy = params["pcb_wire_xy_mm"]
+        cuts = [
+            cyl(r["pocket_mm"], floor, end + 1.0),
+            cyl(f["camera"]["wire_hole_diameter_mm"] / 2.0, bottom - 1.0, floor + e),
+            cyl(f["led_pcb"]["wire_hole_diameter_mm"] / 2.0, bottom - 1.0, floor + e, wx, wy),
+        ]
+        for x, y in params["bolt_xy_mm"]:
+            cuts.append(cyl(b["clearance_diameter_mm"] / 2.0, bottom - 1.0, end + 1.0, x, y))
+            cuts.append(cyl(b["head_diameter_mm"] / 2.0, bottom - 1.0, bottom + b["head_depth_mm"],
+                            x, y))
+        return C.cut(cyl(r["outside_mm"], bottom, end), cuts)
+    if role == "camera_holder":
+        return _ring(f["camera"]["diameter_mm"] / 2.0 + f["fit_clearance_mm"],
+                     f["camera_holder"]["outer_diameter_mm"] / 2.0, floor, end)
+    # the diffusion ring, a hole over each UV LED
+    rl = f["led_pcb"]["led_circle_diameter_mm"] / 2.0
+    holes = [cyl(f["diffusion_ring"]["uv_hole_diameter_mm"] / 2.0, lv["ring_bottom_z_mm"] - 1.0,
+                 end + 1.0, rl * math.cos(math.radians(a)), rl * math.sin(math.radians(a)))
+             for a, uv in params["leds"] if uv]
+    ring = _ring(f["diffusion_ring"]["inner_diameter_mm"] / 2.0,
+                 f["led_pcb"]["outer_diameter_mm"] / 2.0, lv["ring_bottom_z_mm"], end)
+    return C.cut(ring, holes)

@@ -53,6 +53,8 @@ def _build_sensor(part: dict):
         s = cq_casing.casing(p)
     elif role == "gripper_base":
         s = cq_casing.gripper_base(p)
+    elif role in ("shell_holder", "sensor_base", "camera_holder", "diffusion_ring"):
+        s = cq_casing.fingertip_part(p, role)
     elif role == "indenter":
         s = cq_fixtures.indenter(p)
     elif name == "pin_dome":

@@ -23,8 +23,9 @@ def family(part: dict) -> str:
         return "housings"
     if role in ("tip_fitting", "shaft_body", "robot_mount"):
         return "bayonet bodies and fittings"
-    if role in ("casing", "gripper_base"):
-        return "casings and gripper bases"
+    if role in ("casing", "gripper_base", "shell_holder", "sensor_base", "camera_holder",
+                "diffusion_ring"):
+        return "casings and bases"
     if role == "indenter":
         return "indenters"
     if name in ("pin_dome", "pin_dome_ring") or role == "calibration pin":

@@ -88,6 +88,7 @@ fn test_kit() -> Kit {
         procedure: vec![],
         assembly: vec![],
         cut_parts: vec![],
+        pcb_outlines: vec![],
         summary: serde_json::json!({ "envelope_radius_mm": 15.0 }),
     }
 }
@@ -393,6 +394,7 @@ fn group_kit() -> Kit {
         procedure: vec![],
         assembly: vec![],
         cut_parts: vec![],
+        pcb_outlines: vec![],
         summary: serde_json::json!({}),
     }
 }

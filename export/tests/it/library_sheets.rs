@@ -586,8 +586,27 @@ fn uvdtact_sheet_gives_a_weighable_batch_and_casts_inside_out() {
     for _ in 0..2 {
         want.extend([A::MoveCore, A::SprayRelease, A::Pour, A::Demold]);
     }
-    want.push(A::Assemble);
+    // the core bonded into the skin, then the fingertip's base: camera into its holder and
+    // onto the base, PCB and ring, the shell into its holder, the holder bolted to the base
+    want.extend([A::Assemble; 5]);
     assert_eq!(actions(&e), want);
+    let steps: Vec<&str> = arr(&e.manifest, "procedure")
+        .iter()
+        .filter(|s| s["action"] == "assemble")
+        .map(|s| s["text"].as_str().unwrap())
+        .collect();
+    for (i, begins) in [
+        "Assemble: Bond the core",
+        "Assemble: Glue the camera (COMedia muC103P",
+        "Assemble: Lead the lighting PCB's wires",
+        "Assemble: Glue the acrylic shell's foot",
+        "Assemble: Set `shell_holder` on `sensor_base` and fasten them with 3 bolts",
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        assert!(steps[i].starts_with(begins), "{i}: {}", steps[i]);
+    }
 }
 
 /// The dual-modal TacTip is printed; its one pour is the filling gel, poured into the tip
