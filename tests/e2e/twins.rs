@@ -15,6 +15,11 @@ const CASES: &[(&str, &[&str])] = &[
     // the slowest first: check_twins spreads the exports over the CPUs in this order
     ("shadowtac", &["export", "shadowtac"]),
     ("uvdtact", &["export", "uvdtact"]),
+    // the no-marker variant: one mixed layer cast at once (Sec. V-B)
+    (
+        "uvdtact_no_markers",
+        &["export", "uvdtact", "--preset", "no_markers"],
+    ),
     ("rtac0", &["export", "rtac0"]),
     // the direct molds with the other housing arrangement (square split halves)
     (

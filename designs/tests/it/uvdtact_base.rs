@@ -209,3 +209,35 @@ fn each_rule_of_the_fingertip_base_names_its_parameter() {
     ];
     assert_each_rule_names_its_path(uvdtact, cases);
 }
+
+/// The preset `no_markers` (Sec. V-B: the inner and outer mixed elastomers cast at once with
+/// red UV ink): one 2 mm mixed layer without markers, then the black gel, on the same shell and
+/// base. Its mixed pour is the shell between the offsets -0.4 and -2.4 mm, the two marked
+/// layers' volume together (within the chord tolerance over both surfaces).
+#[test]
+fn the_no_marker_variant_casts_both_mixed_layers_at_once() {
+    let d = uvdtact().with_preset("no_markers").unwrap();
+    let tol = ChordTolerance::new(0.01).unwrap();
+    let k = build_kit(&d, tol).unwrap();
+    let casts: Vec<&str> = k.casts.iter().map(|c| c.cast.as_str()).collect();
+    assert_eq!(
+        casts[casts.len() - 2..],
+        ["mixed", "black_gel"],
+        "{casts:?}"
+    );
+    assert!(k.summary["markers"].as_array().unwrap().is_empty());
+    for role in [
+        "shell_holder",
+        "sensor_base",
+        "camera_holder",
+        "diffusion_ring",
+    ] {
+        assert!(k.parts.iter().any(|p| p.role == role), "{role}");
+    }
+    let mixed = k.casts.iter().find(|c| c.cast == "mixed").unwrap();
+    let want =
+        d.body.analytic_solid_volume_mm3(-0.4, 0.0) - d.body.analytic_solid_volume_mm3(-2.4, 0.0);
+    let area = 2.0 * (PI * 81.0 + 2.0 * PI * 9.0 * 24.0);
+    let got = mixed.cavity_volume_ml * 1000.0;
+    assert!((got - want).abs() <= area * tol.mm(), "{got} vs {want}");
+}
