@@ -26,10 +26,11 @@
 
 use crate::assembly::{ExactShape, Member, MemberKind};
 use crate::error::{DesignError, GeometryContext, ParamError};
-use crate::geometry::{cuboid, cylinder, ChordTolerance, GeometryError, Solid};
+use crate::geometry::{cuboid, ChordTolerance, GeometryError, Solid};
 use crate::kit::{Part, PrintTechnology};
 use crate::molds::{place_posed, with_pose};
 use crate::parts::shaft_body::{half_nozzle, OVERLAP_MM};
+use crate::parts::z_cylinder;
 use crate::schema::Design;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
@@ -303,11 +304,7 @@ pub fn check_params(design: &Design, c: &CasingParams, errs: &mut Vec<ParamError
             ("gripper_base.bolt_head_depth_mm", g.bolt_head_depth_mm),
         ]);
     }
-    for (p, v) in numbers {
-        if !(v > 0.0 && v.is_finite()) {
-            errs.push(ParamError::new(path(p), v, "must be above 0"));
-        }
-    }
+    crate::parts::check_positive("casing.", &numbers, errs);
     if !led.first_azimuth_deg.is_finite() {
         errs.push(ParamError::new(
             path("leds.first_azimuth_deg"),
@@ -558,16 +555,6 @@ pub fn twin_params(design: &Design, c: &CasingParams) -> serde_json::Value {
         "bolt_xy_mm": c.gripper_base.as_ref().map(bolt_xy),
         "overlap_mm": OVERLAP_MM,
     })
-}
-
-fn z_cylinder(
-    r: f64,
-    z0: f64,
-    z1: f64,
-    [x, y]: [f64; 2],
-    tol: ChordTolerance,
-) -> Result<Solid, GeometryError> {
-    cylinder(z1 - z0, r, tol).map(|s| s.translate([x, y, z0]))
 }
 
 /// The casing, printed standing on its bottom (the ledge bridges the bay).

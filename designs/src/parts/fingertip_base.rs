@@ -23,10 +23,11 @@
 
 use crate::assembly::{ExactShape, Member, MemberKind};
 use crate::error::{DesignError, GeometryContext, ParamError};
-use crate::geometry::{cylinder, ChordTolerance, GeometryError, Solid};
+use crate::geometry::{ChordTolerance, GeometryError, Solid};
 use crate::kit::{Part, PrintTechnology};
 use crate::molds::{place_posed, with_pose};
 use crate::parts::shaft_body::OVERLAP_MM;
+use crate::parts::z_cylinder;
 use crate::schema::Design;
 use crate::stack::Stack;
 use serde::{Deserialize, Serialize};
@@ -213,40 +214,40 @@ pub fn check_params(design: &Design, f: &FingertipBase, stack: &Stack, errs: &mu
     let before = errs.len();
     let path = |p: &str| format!("fingertip_base.{p}");
     let (pcb, ring, cam, b) = (&f.led_pcb, &f.diffusion_ring, &f.camera, &f.bolts);
-    for (p, v) in [
-        ("outer_diameter_mm", f.outer_diameter_mm),
-        ("pocket_depth_mm", f.pocket_depth_mm),
-        ("floor_thickness_mm", f.floor_thickness_mm),
-        ("led_pcb.outer_diameter_mm", pcb.outer_diameter_mm),
-        ("led_pcb.inner_diameter_mm", pcb.inner_diameter_mm),
-        ("led_pcb.thickness_mm", pcb.thickness_mm),
-        ("led_pcb.led_circle_diameter_mm", pcb.led_circle_diameter_mm),
-        ("led_pcb.led_length_mm", pcb.led_length_mm),
-        ("led_pcb.led_height_mm", pcb.led_height_mm),
-        ("led_pcb.wire_hole_diameter_mm", pcb.wire_hole_diameter_mm),
-        ("diffusion_ring.inner_diameter_mm", ring.inner_diameter_mm),
-        ("diffusion_ring.thickness_mm", ring.thickness_mm),
-        (
-            "diffusion_ring.uv_hole_diameter_mm",
-            ring.uv_hole_diameter_mm,
-        ),
-        ("camera.diameter_mm", cam.diameter_mm),
-        ("camera.length_mm", cam.length_mm),
-        ("camera.wire_hole_diameter_mm", cam.wire_hole_diameter_mm),
-        (
-            "camera_holder.outer_diameter_mm",
-            f.camera_holder.outer_diameter_mm,
-        ),
-        ("bolts.pilot_diameter_mm", b.pilot_diameter_mm),
-        ("bolts.pilot_depth_mm", b.pilot_depth_mm),
-        ("bolts.clearance_diameter_mm", b.clearance_diameter_mm),
-        ("bolts.head_diameter_mm", b.head_diameter_mm),
-        ("bolts.head_depth_mm", b.head_depth_mm),
-    ] {
-        if !(v > 0.0 && v.is_finite()) {
-            errs.push(ParamError::new(path(p), v, "must be above 0"));
-        }
-    }
+    crate::parts::check_positive(
+        "fingertip_base.",
+        &[
+            ("outer_diameter_mm", f.outer_diameter_mm),
+            ("pocket_depth_mm", f.pocket_depth_mm),
+            ("floor_thickness_mm", f.floor_thickness_mm),
+            ("led_pcb.outer_diameter_mm", pcb.outer_diameter_mm),
+            ("led_pcb.inner_diameter_mm", pcb.inner_diameter_mm),
+            ("led_pcb.thickness_mm", pcb.thickness_mm),
+            ("led_pcb.led_circle_diameter_mm", pcb.led_circle_diameter_mm),
+            ("led_pcb.led_length_mm", pcb.led_length_mm),
+            ("led_pcb.led_height_mm", pcb.led_height_mm),
+            ("led_pcb.wire_hole_diameter_mm", pcb.wire_hole_diameter_mm),
+            ("diffusion_ring.inner_diameter_mm", ring.inner_diameter_mm),
+            ("diffusion_ring.thickness_mm", ring.thickness_mm),
+            (
+                "diffusion_ring.uv_hole_diameter_mm",
+                ring.uv_hole_diameter_mm,
+            ),
+            ("camera.diameter_mm", cam.diameter_mm),
+            ("camera.length_mm", cam.length_mm),
+            ("camera.wire_hole_diameter_mm", cam.wire_hole_diameter_mm),
+            (
+                "camera_holder.outer_diameter_mm",
+                f.camera_holder.outer_diameter_mm,
+            ),
+            ("bolts.pilot_diameter_mm", b.pilot_diameter_mm),
+            ("bolts.pilot_depth_mm", b.pilot_depth_mm),
+            ("bolts.clearance_diameter_mm", b.clearance_diameter_mm),
+            ("bolts.head_diameter_mm", b.head_diameter_mm),
+            ("bolts.head_depth_mm", b.head_depth_mm),
+        ],
+        errs,
+    );
     if !(cam.view_angle_deg > 0.0 && cam.view_angle_deg < 180.0) {
         errs.push(ParamError::new(
             path("camera.view_angle_deg"),
@@ -434,16 +435,6 @@ pub fn twin_params(design: &Design, f: &FingertipBase, stack: &Stack) -> serde_j
         "pcb_wire_xy_mm": pcb_wire_xy(f),
         "overlap_mm": OVERLAP_MM,
     })
-}
-
-fn z_cylinder(
-    r: f64,
-    z0: f64,
-    z1: f64,
-    [x, y]: [f64; 2],
-    tol: ChordTolerance,
-) -> Result<Solid, GeometryError> {
-    cylinder(z1 - z0, r, tol).map(|s| s.translate([x, y, z0]))
 }
 
 /// A ring about the z axis, radii `ri` < `ro`, from `z0` to `z1`.
