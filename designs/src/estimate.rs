@@ -72,6 +72,19 @@ pub fn estimate(design: &Design, stack: &Stack, tol: ChordTolerance) -> WorkEsti
             surfaces += surface_triangles(design, l.inner_offset_mm, tol);
         }
     }
+    for l in &stack.layers {
+        if l.process == crate::schema::LayerProcess::Cast
+            && l.mold_strategy == crate::schema::MoldStrategy::Boundary
+        {
+            // the drafted Mold Star box round the outer master: about 14 circles of the
+            // layer's rim
+            surfaces += 14.0
+                * tol
+                    .half()
+                    .circle_segments(design.body.rim_radius_mm(l.outer_offset_mm))
+                    as f64;
+        }
+    }
     if let Some(c) = &stack.core {
         surfaces += surface_triangles(design, c.outer_offset_mm, tol);
         surfaces += surface_triangles(design, c.inner_offset_mm, tol);
