@@ -61,7 +61,7 @@ pub struct Member {
 
 /// The exact shape of a non-printed assembly member, from which the CadQuery twin
 /// (`export/python/twins/step_export.py`) builds its B-rep. Sensor frame, mm; serialized with a
-/// `shape` tag (`layer`, `revolved`, `cylinder`, `ring`, `box`).
+/// `shape` tag (`layer`, `revolved`, `cylinder`, `ring`, `box`, `core_shell`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "shape", rename_all = "snake_case", deny_unknown_fields)]
 pub enum ExactShape {
@@ -88,6 +88,11 @@ pub enum ExactShape {
     },
     /// An axis-aligned box.
     Box { min_mm: [f64; 3], max_mm: [f64; 3] },
+    /// A core with a bore ([`crate::parts::core_shell::exact_shape`]): `body`,
+    /// `outer_offset_mm`, `wall_thickness_mm`, `below_base_mm`; the twin builds its outer
+    /// surface exactly and its inner surface by the rule of
+    /// [`crate::profile::BodyProfile::shell_inner_surface`].
+    CoreShell { params: serde_json::Value },
 }
 
 /// Roles of kit parts that are part of the sensor (the rest are molds and tooling).
@@ -235,29 +240,16 @@ pub fn members(
     }
     let g = |name: &str, r: Result<Solid, crate::geometry::GeometryError>| r.part(name);
     if let (Some(c), Some(spec)) = (&stack.core, &design.core) {
-        // A normal offset folds where the wall passes the surface's radius of curvature
-        // (UVDtact's 2 mm acrylic shell inside a 3.375 mm pole radius): the envelope is then
-        // the solid under the core's outer surface.
-        let hollow = design.body.offset_is_valid(c.inner_offset_mm);
-        let pl = if hollow {
-            design.body.shell_profile(
-                c.inner_offset_mm,
-                c.outer_offset_mm,
-                c.below_base_mm,
-                tol.half(),
-            )
-        } else {
-            design
-                .body
-                .solid_profile(c.outer_offset_mm, c.below_base_mm, tol.half())
-        };
+        let pl = crate::parts::core_shell::profile(design, c, spec, tol);
         let solid = g(
             "core_envelope",
             revolve(&pl, tol).and_then(|m| Solid::from_mesh(&m)),
         )?;
-        let exact = ExactShape::Revolved {
-            profile_rz_mm: pl.points.clone(),
-        };
+        let exact = crate::parts::core_shell::exact_shape(design, c, spec).unwrap_or(
+            ExactShape::Revolved {
+                profile_rz_mm: pl.points.clone(),
+            },
+        );
         out.push(Member {
             nested_by_stack: true,
             ..bought(

@@ -385,6 +385,24 @@ pub fn build_kit_bounded(
     let bolts = crate::procedure::clamp_bolts(design, &parts);
     bought.extend(crate::procedure::clamp_bolt_items(&bolts));
     let procedure = crate::procedure::procedure(design, &parts, &casts, &bolts);
+    let machined_parts = match (&stack.core, &design.core) {
+        (Some(c), Some(spec)) => crate::parts::core_shell::machined_part(design, c, spec, tol)?
+            .into_iter()
+            .collect(),
+        _ => Vec::new(),
+    };
+    if let Some(m) = machined_parts
+        .iter()
+        .find(|m| parts.iter().any(|p| p.name == m.name))
+    {
+        return Err(DesignError::Params(crate::ParamErrors(vec![
+            crate::ParamError::new(
+                "core.machining.part_name",
+                m.name.as_str(),
+                "must differ from every part of the kit (it names the drawing and the STEP file)",
+            ),
+        ])));
+    }
     Ok(Kit {
         design: design.name.clone(),
         parts,
@@ -394,6 +412,7 @@ pub fn build_kit_bounded(
         assembly,
         cut_parts: crate::cut::cut_parts(design),
         pcb_outlines: crate::cut::pcb_outlines(design),
+        machined_parts,
         summary,
     })
 }
@@ -526,8 +545,12 @@ fn bought_items(design: &Design, stack: &Stack, materials: &MaterialsTable) -> V
                 product(&spec.material), spec.description, 2.0 * ro, ro - ri, 2.0 * ri, spec.length_mm
             ),
             _ => format!(
-                "Core ({}): {}, wall {:.2} mm along the normal, {:.2} mm long from the pole",
-                product(&spec.material), spec.description, spec.wall_thickness_mm, spec.length_mm
+                "Core ({}): {}, wall {:.2} mm at the pole and the rim, {:.2} mm long from the pole{}",
+                product(&spec.material), spec.description, spec.wall_thickness_mm, spec.length_mm,
+                spec.machining.as_ref().map_or(String::new(), |m| format!(
+                    "; made to order by its drawing machined/{}.svg (see Machined parts)",
+                    m.part_name
+                ))
             ),
         });
     }

@@ -237,6 +237,9 @@ pub struct Kit {
     /// Printed circuit boards' outlines, for PCB tools as DXF ([`crate::cut::pcb_outlines`]):
     /// the board's edge and holes on `cut`, its components' places on `engrave`.
     pub pcb_outlines: Vec<crate::cut::CutPart>,
+    /// Parts made to order by a machine shop (UVDtact's acrylic shell), each with its
+    /// dimensioned drawing and exact shape ([`crate::parts::core_shell::machined_part`]).
+    pub machined_parts: Vec<crate::parts::core_shell::MachinedPart>,
     /// Sensor-frame facts worth printing in the manifest (envelope, derived radii...).
     pub summary: serde_json::Value,
 }

@@ -102,6 +102,25 @@ pub struct Core {
     /// Sec. III-B1); none when not given.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub primer: Option<String>,
+    /// A core made to order by a machine shop (UVDtact's acrylic shell, CNC machined and
+    /// vapour polished, Sec. III): `fabkit export` writes its dimensioned drawing, and with
+    /// `--format step` its STEP file, to order it. None for a bought core (a test tube).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub machining: Option<CoreMachining>,
+}
+
+/// How a core made to order is described to the shop ([`Core::machining`]). Its inner surface
+/// is [`crate::profile::BodyProfile::shell_inner_surface`] of the core's outer surface and
+/// wall.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CoreMachining {
+    /// File stem of its drawing and STEP file, `[a-z0-9_]+`, unique among the kit's parts.
+    pub part_name: String,
+    /// Surface finish the shop is asked for, printed on the drawing.
+    pub finish: String,
+    /// General tolerance of the drawing's dimensions (+/-), mm, > 0.
+    pub general_tolerance_mm: f64,
 }
 
 /// How a layer is made.

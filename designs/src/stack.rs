@@ -365,6 +365,9 @@ pub fn validate(
                 "must be above 0",
             ));
         }
+        if let Some(m) = &c.machining {
+            check_machining(m, &mut errs);
+        }
     }
     if !(0.0..=1.0).contains(&design.casting.waste_allowance) {
         errs.push(ParamError::new(
@@ -610,6 +613,35 @@ pub fn validate(
     }
 }
 
+/// The drawing's fields of a core made to order (the bore is checked with the core's surfaces).
+fn check_machining(m: &crate::schema::CoreMachining, errs: &mut Vec<ParamError>) {
+    let name_ok = !m.part_name.is_empty()
+        && m.part_name
+            .bytes()
+            .all(|b| b.is_ascii_lowercase() || b.is_ascii_digit() || b == b'_');
+    if !name_ok {
+        errs.push(ParamError::new(
+            "core.machining.part_name",
+            m.part_name.as_str(),
+            "must be [a-z0-9_]+ (it names the drawing and the STEP file)",
+        ));
+    }
+    if m.finish.trim().is_empty() {
+        errs.push(ParamError::new(
+            "core.machining.finish",
+            m.finish.as_str(),
+            "must name the surface finish the shop is asked for",
+        ));
+    }
+    if !(m.general_tolerance_mm > 0.0 && m.general_tolerance_mm.is_finite()) {
+        errs.push(ParamError::new(
+            "core.machining.general_tolerance_mm",
+            m.general_tolerance_mm,
+            "must be above 0",
+        ));
+    }
+}
+
 /// The core's surfaces and the checks on its length. Its inner surface is only needed (and
 /// only checked) when a mold holds the core by its bore.
 fn resolve_core(
@@ -635,6 +667,23 @@ fn resolve_core(
             c.length_mm,
             format!(
                 "the core must reach the base plane: at least {:.3} mm from its pole",
+                pole_z - design.body.base_z_mm()
+            ),
+        ));
+    }
+    if c.machining.is_some()
+        && c.wall_thickness_mm > 0.0
+        && design
+            .body
+            .shell_inner_surface(core_out, c.wall_thickness_mm)
+            .is_none()
+    {
+        errs.push(ParamError::new(
+            "core.wall_thickness_mm",
+            c.wall_thickness_mm,
+            format!(
+                "a core made to order needs a bore: the wall must be below its rim radius ({:.3} mm) and its height above the base plane ({:.3} mm)",
+                design.body.rim_radius_mm(core_out),
                 pole_z - design.body.base_z_mm()
             ),
         ));

@@ -94,6 +94,22 @@ pub(crate) fn check_names(kit: &Kit) -> Result<(), ExportError> {
             }
         }
     }
+    for m in &kit.machined_parts {
+        let ok = !m.name.is_empty()
+            && m.name
+                .chars()
+                .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_');
+        if !ok {
+            return Err(ExportError::InvalidPartName {
+                name: m.name.clone(),
+            });
+        }
+        if !seen.insert(m.name.as_str()) {
+            return Err(ExportError::DuplicatePartName {
+                name: m.name.clone(),
+            });
+        }
+    }
     Ok(())
 }
 

@@ -36,8 +36,8 @@ pub use check::check_printable_mesh;
 pub use error::ExportError;
 pub use manifest::{
     Manifest, ManifestAssembly, ManifestAssemblyStep, ManifestCutPart, ManifestDataFile,
-    ManifestDesign, ManifestKit3mf, ManifestMember, ManifestObject, ManifestPart,
-    ManifestPcbOutline, ManifestStepMember, ManifestVolume, StepGeometry, FRAME,
+    ManifestDesign, ManifestKit3mf, ManifestMachinedPart, ManifestMember, ManifestObject,
+    ManifestPart, ManifestPcbOutline, ManifestStepMember, ManifestVolume, StepGeometry, FRAME,
 };
 
 use fabkit_designs::assembly::{ExactShape, MemberKind};
@@ -224,8 +224,36 @@ fn step_files(
     opts: &ExportOptions,
     step_progress: Option<step::StepProgress<'_>>,
 ) -> Result<(step::StepFiles, Option<ManifestAssemblyStep>), ExportError> {
+    let machined_meshes: Vec<Mesh> = kit
+        .machined_parts
+        .iter()
+        .map(|m| m.solid.mesh().rounded_to_f32())
+        .collect();
+    let mut machined = Vec::with_capacity(machined_meshes.len());
+    for (m, mesh) in kit.machined_parts.iter().zip(&machined_meshes) {
+        machined.push(step::StepMember {
+            name: &m.name,
+            kind: MemberKind::Bought,
+            volume_mm3: mesh.signed_volume(),
+            surface_area_mm2: mesh.surface_area(),
+            bbox_mm: mesh
+                .bounding_box()
+                .ok_or_else(|| ExportError::NotManifold {
+                    part: m.name.clone(),
+                    source: TopologyError::Empty,
+                })?,
+            shells: mesh.shell_count(),
+            source: step::StepSource::Exact(&m.exact),
+        });
+    }
     if kit.assembly.is_empty() {
-        let files = step::render(parts, None, opts.chord_tolerance_mm, step_progress)?;
+        let files = step::render(
+            parts,
+            &machined,
+            None,
+            opts.chord_tolerance_mm,
+            step_progress,
+        )?;
         return Ok((files, None));
     }
     let mut members = Vec::with_capacity(meshes.len());
@@ -241,6 +269,7 @@ fn step_files(
                 step::StepSource::Exact(e),
                 match e {
                     ExactShape::Layer { .. } => StepGeometry::ExactLayer,
+                    ExactShape::CoreShell { .. } => StepGeometry::ExactCoreShell,
                     ExactShape::Revolved { .. } => StepGeometry::RevolvedProfile,
                     ExactShape::Cylinder { .. }
                     | ExactShape::Ring { .. }
@@ -282,6 +311,7 @@ fn step_files(
     };
     let files = step::render(
         parts,
+        &machined,
         Some(&assembly),
         opts.chord_tolerance_mm,
         step_progress,
@@ -379,6 +409,8 @@ const PARTS_DIR: &str = "parts";
 const CUT_DIR: &str = "cut";
 /// Folder of the PCB outlines' DXF files.
 const PCB_DIR: &str = "pcb";
+/// Folder of the parts made to order by a machine shop (drawings, meshes).
+const MACHINED_DIR: &str = "machined";
 const STEP_DIR: &str = "step";
 
 /// Every file of the export, in memory, with `/`-separated relative paths.
@@ -531,9 +563,66 @@ fn render(
     for (m, mesh) in kit.assembly.iter().zip(&assembly_meshes) {
         check_printable_mesh(&m.name, mesh)?;
     }
+    let mut machined_parts = Vec::with_capacity(kit.machined_parts.len());
+    for m in &kit.machined_parts {
+        let mesh = m.solid.mesh().rounded_to_f32();
+        check_printable_mesh(&m.name, &mesh)?;
+        let bbox = mesh
+            .bounding_box()
+            .ok_or_else(|| ExportError::NotManifold {
+                part: m.name.clone(),
+                source: TopologyError::Empty,
+            })?;
+        let drawing = format!("{MACHINED_DIR}/{}.svg", m.name);
+        let drawing_bytes = two_d::drawing_svg(&m.drawing).into_bytes();
+        let (file, sha256) = if opts.formats.stl {
+            let header = stl::header(
+                &opts.fabkit_version,
+                &kit.design,
+                &m.name,
+                &opts.design_sha256,
+            );
+            let bytes = stl::encode(&m.name, &mesh, &header)?;
+            let rel = format!("{MACHINED_DIR}/{}.stl", m.name);
+            let sha = sha256_hex(&bytes);
+            files.push((rel.clone(), bytes));
+            (Some(rel), Some(sha))
+        } else {
+            (None, None)
+        };
+        machined_parts.push(ManifestMachinedPart {
+            name: m.name.clone(),
+            description: m.description.clone(),
+            material: m.material.clone(),
+            material_name: product_name(materials.as_ref(), &m.material),
+            finish: m.finish.clone(),
+            volume_mm3: mesh.signed_volume(),
+            mass_g: materials
+                .as_ref()
+                .and_then(|t| t.materials.get(&m.material))
+                .map_or(0.0, |t| mesh.signed_volume() / 1000.0 * t.density_g_per_cm3),
+            bbox_mm: bbox,
+            drawing_sha256: sha256_hex(&drawing_bytes),
+            drawing: drawing.clone(),
+            dimensions: m.drawing.dimensions.clone(),
+            params: m.params.clone(),
+            exact: m.exact.clone(),
+            file,
+            sha256,
+            step_file: None,
+            step_sha256: None,
+        });
+        files.push((drawing, drawing_bytes));
+    }
     let assembly_step = if opts.formats.step {
         let (steps, assembly) = step_files(kit, &parts, &assembly_meshes, opts, step_progress)?;
         for (p, bytes) in parts.iter_mut().zip(steps.parts) {
+            let rel = format!("{STEP_DIR}/{}.step", p.name);
+            p.step_sha256 = Some(sha256_hex(&bytes));
+            p.step_file = Some(rel.clone());
+            files.push((rel, bytes));
+        }
+        for (p, bytes) in machined_parts.iter_mut().zip(steps.machined) {
             let rel = format!("{STEP_DIR}/{}.step", p.name);
             p.step_sha256 = Some(sha256_hex(&bytes));
             p.step_file = Some(rel.clone());
@@ -636,6 +725,7 @@ fn render(
         section_view,
         cut_parts,
         pcb_outlines,
+        machined_parts,
         casts: kit.casts.clone(),
         bought_items: kit.bought_items.clone(),
         procedure: kit.procedure.clone(),
@@ -706,6 +796,7 @@ mod tests {
             assembly: vec![],
             cut_parts: vec![],
             pcb_outlines: vec![],
+            machined_parts: Vec::new(),
             summary: serde_json::json!({}),
         }
     }

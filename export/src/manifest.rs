@@ -46,6 +46,9 @@ pub struct Manifest {
     /// Printed circuit boards' outlines with their DXF files, for PCB tools.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub pcb_outlines: Vec<ManifestPcbOutline>,
+    /// Parts made to order by a machine shop, with their drawings (and STEP files).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub machined_parts: Vec<ManifestMachinedPart>,
     /// Pours in casting order, as the design computed them.
     pub casts: Vec<CastReport>,
     /// Parts that are bought or cut rather than printed, one line each.
@@ -195,6 +198,9 @@ pub enum StepGeometry {
     ExactPart,
     /// The layer's exact twin, from the same parameters as its parts.
     ExactLayer,
+    /// The core's exact shell: its outer offset surface and inner surface (a machined core's
+    /// `step/<name>.step` holds the same solid).
+    ExactCoreShell,
     /// The exact solid of revolution of the member's (r, z) profile polygon (planes, cylinders,
     /// cones); the polygon is within half the chord tolerance of the true profile.
     RevolvedProfile,
@@ -233,6 +239,40 @@ pub struct ManifestPcbOutline {
     pub area_mm2: f64,
     pub dxf: String,
     pub dxf_sha256: String,
+}
+
+/// A part made to order by a machine shop (`machined/<name>.svg`: its dimensioned drawing, a
+/// section through its axis; `machined/<name>.stl` with STL, `step/<name>.step` with STEP:
+/// its solid in the sensor frame, mm).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ManifestMachinedPart {
+    pub name: String,
+    pub description: String,
+    pub material: String,
+    pub material_name: String,
+    pub finish: String,
+    /// Enclosed volume of the written mesh, mm^3.
+    pub volume_mm3: f64,
+    pub mass_g: f64,
+    /// Bounding box in the sensor frame, mm.
+    pub bbox_mm: Aabb,
+    /// The drawing, `machined/<name>.svg`.
+    pub drawing: String,
+    pub drawing_sha256: String,
+    /// The drawing's dimensions (what a shop measures), mm.
+    pub dimensions: Vec<fabkit_designs::parts::core_shell::Dimension>,
+    /// The part's numbers: diameters, pole heights, wall and least wall, tolerance.
+    pub params: serde_json::Value,
+    /// Its exact shape (the CadQuery twin builds the STEP solid from it).
+    pub exact: fabkit_designs::assembly::ExactShape,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub file: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sha256: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub step_file: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub step_sha256: Option<String>,
 }
 
 /// The kit 3MF.

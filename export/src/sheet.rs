@@ -199,6 +199,7 @@ pub(crate) fn render(m: &Manifest) -> String {
     shopping_list(&mut s, m);
     laser_cut(&mut s, m);
     pcb_outlines(&mut s, m);
+    machined_parts(&mut s, m);
     procedure(&mut s, m);
 
     s.push_str("## Bought items\n\n");
@@ -316,6 +317,39 @@ fn laser_cut(s: &mut String, m: &Manifest) {
             text(&c.material_name),
             c.thickness_mm,
             c.area_mm2
+        );
+    }
+    s.push('\n');
+}
+
+/// The parts made to order by a machine shop, their drawings and files; nothing when the kit
+/// has none.
+fn machined_parts(s: &mut String, m: &Manifest) {
+    if m.machined_parts.is_empty() {
+        return;
+    }
+    s.push_str("## Machined parts (order from a shop)\n\n");
+    s.push_str(
+        "Send the shop the drawing (SVG: a section through the axis with the dimensions, \
+         material, finish and tolerance) and the STEP file (`--format step`; the STL is the \
+         same solid meshed), in the sensor frame, mm.\n\n",
+    );
+    for p in &m.machined_parts {
+        let files: Vec<String> = [Some(&p.drawing), p.step_file.as_ref(), p.file.as_ref()]
+            .into_iter()
+            .flatten()
+            .map(|f| code(f))
+            .collect();
+        let least = p.params["least_wall_mm"].as_f64();
+        let _ = writeln!(
+            s,
+            "- {}: {} ({}), {}; {:.2} g{}",
+            files.join(", "),
+            text(&p.description),
+            text(&p.material_name),
+            text(&p.finish),
+            p.mass_g,
+            least.map_or(String::new(), |w| format!("; least wall {w:.2} mm"))
         );
     }
     s.push('\n');

@@ -245,10 +245,13 @@ pub struct StepAssembly<'a> {
 pub struct StepFiles {
     pub parts: Vec<Vec<u8>>,
     pub assembly: Option<Vec<u8>>,
+    /// Per machined part, in the order given.
+    pub machined: Vec<Vec<u8>>,
 }
 
 /// One STEP file per part (same order as `parts`), built by the CadQuery twin from the parts'
-/// params, and with `assembly` the assembly's STEP file (see the module docs).
+/// params, one per machined part (`machined`, exact shapes in the sensor frame, checked as
+/// assembly members are), and with `assembly` the assembly's STEP file (see the module docs).
 /// `chord_tolerance_mm` sets the agreement bound checked before writing. `progress`, if given,
 /// is called as the twin starts each part (see [`StepProgress`]), on this thread; assembly
 /// members are not reported (the printed ones reuse their parts' twins, the others take well
@@ -263,6 +266,7 @@ pub struct StepFiles {
 /// [`ExportError::Io`] for the scratch directory.
 pub fn render(
     parts: &[ManifestPart],
+    machined: &[StepMember<'_>],
     assembly: Option<&StepAssembly<'_>>,
     chord_tolerance_mm: f64,
     progress: Option<StepProgress<'_>>,
@@ -272,6 +276,7 @@ pub fn render(
         &python,
         &found,
         parts,
+        machined,
         assembly,
         chord_tolerance_mm,
         progress,
@@ -283,6 +288,7 @@ fn render_with(
     python: &Path,
     found: &str,
     parts: &[ManifestPart],
+    machined: &[StepMember<'_>],
     assembly: Option<&StepAssembly<'_>>,
     chord_tolerance_mm: f64,
     progress: Option<StepProgress<'_>>,
@@ -295,7 +301,8 @@ fn render_with(
         std::fs::write(&p, text).map_err(ExportError::io("writing", &p))?;
     }
     let input = scratch.0.join("parts.json");
-    let mut doc = serde_json::json!({"chord_tolerance_mm": chord_tolerance_mm, "parts": parts});
+    let mut doc = serde_json::json!({"chord_tolerance_mm": chord_tolerance_mm, "parts": parts,
+        "machined": serde_json::to_value(machined)?});
     if let Some(a) = assembly {
         doc["design"] = serde_json::json!(a.name);
         doc["assembly"] = serde_json::to_value(&a.members)?;
@@ -390,13 +397,24 @@ fn render_with(
             std::fs::read(&f).map_err(ExportError::io("reading", &f))
         })
         .collect::<Result<_, _>>()?;
+    let machined = machined
+        .iter()
+        .map(|m| {
+            let f = out_dir.join(format!("{}.step", m.name));
+            std::fs::read(&f).map_err(ExportError::io("reading", &f))
+        })
+        .collect::<Result<_, _>>()?;
     let assembly = match assembly {
         Some(_) => Some(
             std::fs::read(&assembly_file).map_err(ExportError::io("reading", &assembly_file))?,
         ),
         None => None,
     };
-    Ok(StepFiles { parts, assembly })
+    Ok(StepFiles {
+        parts,
+        assembly,
+        machined,
+    })
 }
 
 /// `step_export: I/N NAME` (the twin starts part I of N) as (I, N, NAME).
@@ -557,7 +575,7 @@ mod tests {
             "echo 'step_export: 1/2 a' >&2\necho 'step_export: 2/2 b' >&2\n\
              echo 'step_export: part b: ValueError: off' >&2\nexit 3\n",
         );
-        match render_with(&py, "test", &[], None, 0.01, Some(&record)) {
+        match render_with(&py, "test", &[], &[], None, 0.01, Some(&record)) {
             Err(ExportError::Step { part, reason }) => {
                 assert_eq!(part, "b");
                 assert_eq!(reason, "step_export: part b: ValueError: off");
@@ -567,7 +585,7 @@ mod tests {
         assert_eq!(*seen.borrow(), ["1/2 a", "2/2 b"]);
         // a crash without a message: the part it was building
         let py = fake_python(t.path(), "echo 'step_export: 1/2 a' >&2\nkill -9 $$\n");
-        match render_with(&py, "test", &[], None, 0.01, None) {
+        match render_with(&py, "test", &[], &[], None, 0.01, None) {
             Err(ExportError::Step { part, reason }) => {
                 assert_eq!(part, "a");
                 assert!(reason.contains("without a message"), "{reason}");
@@ -580,7 +598,7 @@ mod tests {
             "echo 'step_export: 1/1 a' >&2\necho 'step_export: member gel' >&2\n\
              echo 'step_export: member gel: ValueError: off' >&2\nexit 3\n",
         );
-        match render_with(&py, "test", &[], None, 0.01, None) {
+        match render_with(&py, "test", &[], &[], None, 0.01, None) {
             Err(ExportError::StepAssembly { member, reason }) => {
                 assert_eq!(member, "gel");
                 assert_eq!(reason, "step_export: member gel: ValueError: off");
@@ -589,7 +607,7 @@ mod tests {
         }
         // exit status 4: no cadquery there
         let py = fake_python(t.path(), "exit 4\n");
-        match render_with(&py, "FABKIT_CADQUERY_PYTHON=x", &[], None, 0.01, None) {
+        match render_with(&py, "FABKIT_CADQUERY_PYTHON=x", &[], &[], None, 0.01, None) {
             Err(ExportError::StepUnavailable { reason }) => {
                 assert!(
                     reason.ends_with("cannot import cadquery (FABKIT_CADQUERY_PYTHON=x)"),

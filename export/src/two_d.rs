@@ -157,3 +157,210 @@ pub fn svg_text(part: &CutPart) -> String {
     }
     doc.to_string()
 }
+
+/// The SVG of a dimensioned drawing ([`fabkit_designs::parts::core_shell::Drawing`]): the
+/// section through the axis hatched, the axis as a chain line, each dimension with its
+/// extension lines, arrowed dimension line and value, then the title and notes. Paper units
+/// are mm (`width`/`height` in mm), the drawing at a scale of 1, 2, 4, 5 or 10 to 1 (the
+/// largest that keeps it under 170 mm high), given in the title line.
+pub fn drawing_svg(d: &fabkit_designs::parts::core_shell::Drawing) -> String {
+    use fabkit_designs::parts::core_shell::DimensionAxis;
+    use svg::node::element::{
+        Definitions, Group, Line, Marker, Path, Pattern, Polygon, Text, Title,
+    };
+    // model extents, dimensions included
+    let (mut x0, mut x1, mut z0, mut z1) = (0.0f64, 0.0f64, f64::INFINITY, f64::NEG_INFINITY);
+    for &[r, z] in &d.section_rz_mm {
+        x1 = x1.max(r);
+        z0 = z0.min(z);
+        z1 = z1.max(z);
+    }
+    x0 = x0.min(-x1);
+    for dim in &d.dimensions {
+        match dim.axis {
+            DimensionAxis::Horizontal => {
+                z0 = z0.min(dim.at_mm);
+                z1 = z1.max(dim.at_mm);
+            }
+            DimensionAxis::Vertical => {
+                x0 = x0.min(dim.at_mm);
+                x1 = x1.max(dim.at_mm);
+            }
+        }
+    }
+    let height = (z1 - z0).max(1e-3);
+    let k = [10.0, 5.0, 4.0, 2.0, 1.0]
+        .into_iter()
+        .find(|k| k * height <= 170.0)
+        .unwrap_or(1.0);
+    let font = 3.0;
+    let margin = 12.0;
+    let (px, pz) = (|x: f64| k * x, |z: f64| -k * z);
+    let left = px(x0) - margin;
+    let top = pz(z1) - margin;
+    // the title line and the notes, wrapped at 95 characters (under 0.6 em each in a
+    // sans-serif font)
+    let heading = format!("{}: section through the axis, scale {k}:1, mm", d.title);
+    let lines: Vec<String> = std::iter::once(&heading)
+        .chain(&d.notes)
+        .flat_map(|n| wrap(n, 95))
+        .collect();
+    let notes_h = (lines.len() as f64 + 2.0) * font * 1.5;
+    let longest = lines.iter().map(|n| n.chars().count()).max().unwrap_or(0);
+    let width = (px(x1) - px(x0) + 2.0 * margin).max(longest as f64 * 0.6 * font + 8.0);
+    let paper_h = pz(z0) - pz(z1) + 2.0 * margin + notes_h;
+    let fmt = |v: f64| format!("{v:.3}");
+    let points = |sign: f64| {
+        d.section_rz_mm
+            .iter()
+            .map(|&[r, z]| format!("{},{}", fmt(px(sign * r)), fmt(pz(z))))
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    let hatch = Pattern::new()
+        .set("id", "hatch")
+        .set("patternUnits", "userSpaceOnUse")
+        .set("width", 1.5)
+        .set("height", 1.5)
+        .set("patternTransform", "rotate(45)")
+        .add(
+            Line::new()
+                .set("x1", 0)
+                .set("y1", 0)
+                .set("x2", 0)
+                .set("y2", 1.5)
+                .set("stroke", "#000000")
+                .set("stroke-width", 0.18),
+        );
+    let arrow = Marker::new()
+        .set("id", "arrow")
+        .set("viewBox", "0 0 10 10")
+        .set("refX", 10)
+        .set("refY", 5)
+        .set("markerUnits", "userSpaceOnUse")
+        .set("markerWidth", 3)
+        .set("markerHeight", 3)
+        .set("orient", "auto-start-reverse")
+        .add(
+            Path::new()
+                .set("d", "M 0 2 L 10 5 L 0 8 z")
+                .set("fill", "#000000"),
+        );
+    let mut doc = svg::Document::new()
+        .set("width", format!("{}mm", fmt(width)))
+        .set("height", format!("{}mm", fmt(paper_h)))
+        .set("viewBox", (fmt(left), fmt(top), fmt(width), fmt(paper_h)))
+        .add(Title::new(d.title.clone()))
+        .add(Definitions::new().add(hatch).add(arrow));
+    let mut section = Group::new()
+        .set("id", "section")
+        .set("fill", "url(#hatch)")
+        .set("stroke", "#000000")
+        .set("stroke-width", 0.35);
+    for sign in [1.0, -1.0] {
+        section = section.add(Polygon::new().set("points", points(sign)));
+    }
+    doc = doc.add(section).add(
+        Line::new()
+            .set("id", "axis")
+            .set("x1", 0)
+            .set("y1", fmt(pz(z1) - 3.0))
+            .set("x2", 0)
+            .set("y2", fmt(pz(z0) + 3.0))
+            .set("stroke", "#000000")
+            .set("stroke-width", 0.18)
+            .set("stroke-dasharray", "6 1.5 1 1.5"),
+    );
+    let mut dims = Group::new()
+        .set("id", "dimensions")
+        .set("stroke", "#000000")
+        .set("stroke-width", 0.18)
+        .set("font-family", "sans-serif")
+        .set("font-size", font);
+    let line = |a: [f64; 2], b: [f64; 2]| {
+        Line::new()
+            .set("x1", fmt(a[0]))
+            .set("y1", fmt(a[1]))
+            .set("x2", fmt(b[0]))
+            .set("y2", fmt(b[1]))
+    };
+    for dim in &d.dimensions {
+        let (f, t) = (
+            [px(dim.from_mm[0]), pz(dim.from_mm[1])],
+            [px(dim.to_mm[0]), pz(dim.to_mm[1])],
+        );
+        let (a, b, label_at, rotate) = match dim.axis {
+            DimensionAxis::Horizontal => {
+                let y = pz(dim.at_mm);
+                let a = [f[0], y];
+                let b = [t[0], y];
+                let ext = if y > f[1] { 1.5 } else { -1.5 };
+                dims = dims
+                    .add(line([f[0], f[1]], [f[0], y + ext]))
+                    .add(line([t[0], t[1]], [t[0], y + ext]));
+                (a, b, [(a[0] + b[0]) / 2.0, y - 0.8], false)
+            }
+            DimensionAxis::Vertical => {
+                let x = px(dim.at_mm);
+                let a = [x, f[1]];
+                let b = [x, t[1]];
+                let ext = if x > f[0] { 1.5 } else { -1.5 };
+                dims = dims
+                    .add(line([f[0], f[1]], [x + ext, f[1]]))
+                    .add(line([t[0], t[1]], [x + ext, t[1]]));
+                (a, b, [x - 0.8, (a[1] + b[1]) / 2.0], true)
+            }
+        };
+        dims = dims.add(
+            line(a, b)
+                .set("marker-start", "url(#arrow)")
+                .set("marker-end", "url(#arrow)"),
+        );
+        let mut text = Text::new(dim.label.clone())
+            .set("x", fmt(label_at[0]))
+            .set("y", fmt(label_at[1]))
+            .set("text-anchor", "middle")
+            .set("stroke", "none")
+            .set("fill", "#000000");
+        if rotate {
+            text = text.set(
+                "transform",
+                format!("rotate(-90 {} {})", fmt(label_at[0]), fmt(label_at[1])),
+            );
+        }
+        dims = dims.add(text);
+    }
+    doc = doc.add(dims);
+    let mut notes = Group::new()
+        .set("id", "notes")
+        .set("font-family", "sans-serif")
+        .set("font-size", font)
+        .set("fill", "#000000");
+    let y0 = pz(z0) + margin;
+    for (i, n) in lines.iter().enumerate() {
+        notes = notes.add(
+            Text::new(n.clone())
+                .set("x", fmt(left + 4.0))
+                .set("y", fmt(y0 + (i as f64 + 1.0) * font * 1.5)),
+        );
+    }
+    doc.add(notes).to_string()
+}
+
+/// `text` broken at spaces into lines of at most `width` characters (a longer word keeps its
+/// own line).
+fn wrap(text: &str, width: usize) -> Vec<String> {
+    let mut lines: Vec<String> = Vec::new();
+    let mut cur = String::new();
+    for word in text.split(' ') {
+        if !cur.is_empty() && cur.chars().count() + 1 + word.chars().count() > width {
+            lines.push(std::mem::take(&mut cur));
+        }
+        if !cur.is_empty() {
+            cur.push(' ');
+        }
+        cur.push_str(word);
+    }
+    lines.push(cur);
+    lines
+}

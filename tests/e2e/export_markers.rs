@@ -266,6 +266,96 @@ fn uvdtact_kits() {
     }
     printcheck_all(&printable_files(&dir, &m));
     lighting_pcb_outline_passes_ezdxf(&dir, &m);
+    acrylic_shell_drawing_reads_back(&dir, &m);
+}
+
+/// UVDtact's acrylic shell (Sec. III: CNC machined, vapour polished, 2 mm wall), made to
+/// order: `machined/acrylic_shell.svg` parses as XML with its size in mm; each dimension of
+/// the manifest is written once with an arrowed dimension line of its value times the
+/// drawing's scale; the hatched section's two halves, revolved (Pappus), hold the volume of
+/// `machined/acrylic_shell.stl` (read with numpy) less the revolution's chords (under 0.5 %);
+/// and the STL's own volume is the manifest's.
+fn acrylic_shell_drawing_reads_back(dir: &Path, m: &Value) {
+    let shell = &m["machined_parts"][0];
+    assert_eq!(shell["name"], "acrylic_shell");
+    assert_eq!(shell["material"], "pmma");
+    let labels: Vec<&str> = shell["dimensions"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|d| d["label"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        labels,
+        ["26.60", "Ø13.20", "Ø9.20", "24.60", "2.00", "5.00"],
+        "{shell}"
+    );
+    let Some(py) = oracle_python() else {
+        return missing("the oracle python (numpy)");
+    };
+    let script = r#"
+import sys, json, math, re
+import xml.etree.ElementTree as ET
+import numpy as np
+ns = {"s": "http://www.w3.org/2000/svg"}
+root = ET.parse(sys.argv[1]).getroot()
+texts = ["".join(t.itertext()).strip() for t in root.iter("{http://www.w3.org/2000/svg}text")]
+scale = float(re.search(r"scale (\d+):1", " ".join(texts)).group(1))
+dims = root.find(".//s:g[@id='dimensions']", ns)
+lines = [math.hypot(float(l.get("x2")) - float(l.get("x1")), float(l.get("y2")) - float(l.get("y1"))) / scale
+         for l in dims.findall("s:line", ns) if l.get("marker-start")]
+labels = ["".join(t.itertext()).strip() for t in dims.findall("s:text", ns)]
+vols = []
+for poly in root.find(".//s:g[@id='section']", ns).findall("s:polygon", ns):
+    p = np.array([[float(v) for v in xy.split(",")] for xy in poly.get("points").split()]) / scale
+    x, z = np.abs(p[:, 0]), -p[:, 1]
+    x1, z1 = np.roll(x, -1), np.roll(z, -1)
+    cross = x * z1 - x1 * z
+    area = cross.sum() / 2.0
+    cx = ((x + x1) * cross).sum() / (6.0 * area)
+    vols.append(abs(2.0 * math.pi * cx * area))
+data = open(sys.argv[2], "rb").read()
+n = int.from_bytes(data[80:84], "little")
+tri = np.frombuffer(data[84:84 + 50 * n], dtype=np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")]))["v"].astype(float)
+stl = np.einsum("ij,ij->i", tri[:, 0], np.cross(tri[:, 1], tri[:, 2])).sum() / 6.0
+print(json.dumps({"width": root.get("width"), "height": root.get("height"), "lines": lines,
+                  "labels": labels, "section_volumes": vols, "stl_volume": stl}))
+"#;
+    let o = std::process::Command::new(py)
+        .arg("-c")
+        .arg(script)
+        .arg(dir.join(shell["drawing"].as_str().unwrap()))
+        .arg(dir.join(shell["file"].as_str().unwrap()))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let v: Value = serde_json::from_slice(&o.stdout).unwrap();
+    for k in ["width", "height"] {
+        assert!(v[k].as_str().unwrap().ends_with("mm"), "{v}");
+    }
+    let got: Vec<&str> = v["labels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|l| l.as_str().unwrap())
+        .collect();
+    assert_eq!(got, labels, "{v}");
+    for (d, line) in shell["dimensions"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(v["lines"].as_array().unwrap())
+    {
+        let (want, got) = (d["value_mm"].as_f64().unwrap(), line.as_f64().unwrap());
+        assert!((want - got).abs() < 2e-3, "{d}: drawn {got} mm");
+    }
+    let vol = shell["volume_mm3"].as_f64().unwrap();
+    let stl = v["stl_volume"].as_f64().unwrap();
+    assert!((stl - vol).abs() < 1e-6 * vol, "{stl} vs {vol}");
+    for s in v["section_volumes"].as_array().unwrap() {
+        let s = s.as_f64().unwrap();
+        assert!(s >= vol && s < 1.005 * vol, "section {s} vs {vol}");
+    }
 }
 
 /// UVDtact's lighting PCB outline (Sec. III-C: 4 white and 4 UV LEDs alternating every

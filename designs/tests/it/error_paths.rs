@@ -196,10 +196,10 @@ fn each_quoted_number_is_refused_at_its_own_location() {
     assert_eq!(
         lines,
         [
-            "x.yaml:23:19: layers[0].thickness_mm = \"1.5\": a number must be written without quotes",
-            "x.yaml:37:19: layers[1].thickness_mm = \"1.5\": a number must be written without quotes",
-            "x.yaml:50:19: layers[2].thickness_mm = \"1.5\": a number must be written without quotes",
-            "x.yaml:57:24: mold.sprue.diameter_mm = \"3\": a number must be written without quotes",
+            "x.yaml:27:19: layers[0].thickness_mm = \"1.5\": a number must be written without quotes",
+            "x.yaml:41:19: layers[1].thickness_mm = \"1.5\": a number must be written without quotes",
+            "x.yaml:54:19: layers[2].thickness_mm = \"1.5\": a number must be written without quotes",
+            "x.yaml:61:24: mold.sprue.diameter_mm = \"3\": a number must be written without quotes",
         ],
         "{e}"
     );

@@ -22,4 +22,5 @@ mod sweep_metrics;
 mod sweep_paths;
 mod tactip_body;
 mod uvdtact_base;
+mod uvdtact_shell;
 mod validation;

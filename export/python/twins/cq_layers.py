@@ -147,3 +147,39 @@ def boundary_negative(params: dict):
                          body, marker_sets(base, "inner"), 1.0)
     cup = bd["cup"]
     return C.cut(C.cylinder_z(cup["radius_mm"], cup["bottom_z_mm"], cup["top_z_mm"]), [core])
+
+
+def core_shell(params: dict):
+    """The core with a bore (designs/src/parts/core_shell.rs), sensor frame: between the body's
+    offset at `outer_offset_mm` and the inner surface, both continued straight down
+    `below_base_mm` under the base plane to the open end. The inner surface, by the rule of
+    BodyProfile::shell_inner_surface: on a half ellipsoid, the half ellipsoid of the outer
+    surface's rim radius and pole height less `wall_thickness_mm` (exact points, B-spline fit);
+    on spherical profiles, the concentric sphere."""
+    import cadquery as cq
+
+    body = C.Body(params["body"])
+    d = float(params["outer_offset_mm"])
+    w = float(params["wall_thickness_mm"])
+    below = float(params["below_base_mm"])
+    zb = body.base_z()
+    rim_out = body.rim_radius(d)
+    if body.kind == "half_ellipsoid":
+        rim_in = rim_out - w
+        height_in = body.pole_z(d) - w - zb
+        if rim_in <= 0 or height_in <= 0:
+            raise C.TwinError(f"a {w} mm wall leaves no bore")
+        inner, d_in = C.Body({"profile": "half_ellipsoid", "diameter_mm": 2.0 * rim_in,
+                              "height_mm": height_in}), 0.0
+    else:
+        inner, d_in = body, d - w
+        rim_in = inner.rim_radius(d_in)
+    outer_edges = body.curve_edges(d)
+    inner_edges = inner.curve_edges(d_in)
+    corners = [(rim_out, zb), (rim_out, zb - below), (rim_in, zb - below), (rim_in, zb)]
+    lines = [cq.Edge.makeLine(C.vec(*a), C.vec(*b)) for a, b in zip(corners, corners[1:])
+             if math.dist(a, b) > 1e-12]
+    axis = cq.Edge.makeLine(C.vec(0.0, inner.pole_z(d_in)), C.vec(0.0, body.pole_z(d)))
+    wire = cq.Wire.assembleEdges(outer_edges + lines + list(reversed(inner_edges)) + [axis])
+    face = cq.Face.makeFromWires(wire)
+    return cq.Solid.revolve(face, 360.0, cq.Vector(0, 0, 0), cq.Vector(0, 0, 1))

@@ -19,6 +19,10 @@ separate pieces, such as marker tips), in the sensor frame, mm; each member pass
 volume and box checks, must be valid (BRepCheck) with closed shells, and must have as many
 shells as fabkit's mesh.
 
+PARTS.json's "machined" (may be absent): parts made to order by a shop, each as an assembly
+member with "exact"; each is written to OUT_DIR/<name>.step in the sensor frame, after the
+member checks below.
+
 The STEP header carries no time stamp (fixed fields), and booleans run single-threaded, so the
 same parts give the same bytes. Progress goes to stderr, one line as each part starts:
 `step_export: I/N NAME` (part I of N, in the input's order), then `step_export: member NAME`
@@ -109,6 +113,8 @@ def exact_member(e: dict):
                      [C.cylinder_z(e["inner_radius_mm"], z0 - 1.0, z1 + 1.0)])
     if shape == "box":
         return C.box(e["min_mm"], e["max_mm"])
+    if shape == "core_shell":
+        return cq_layers.core_shell(e["params"])
     raise C.TwinError(f"exact shape {shape!r}: no twin")
 
 
@@ -244,6 +250,17 @@ def main(argv=None) -> int:
             shapes[name] = (shape, part["params"])
         except Exception as e:  # reported with the part's name, exit 3
             print(f"step_export: part {name}: {type(e).__name__}: {e}", file=sys.stderr)
+            return 3
+    for m in doc.get("machined", []):
+        name = m["name"]
+        print(f"step_export: member {name}", file=sys.stderr, flush=True)
+        try:
+            shape = member_solids(exact_member(m["exact"]), m["shells"])
+            check_against(shape, m, tol)
+            check_closed_valid(shape)
+            write_step(shape, out / f"{name}.step", name)
+        except Exception as e:  # reported with the member's name, exit 3
+            print(f"step_export: member {name}: {type(e).__name__}: {e}", file=sys.stderr)
             return 3
     if assembly is None:
         return 0

@@ -89,6 +89,7 @@ fn test_kit() -> Kit {
         assembly: vec![],
         cut_parts: vec![],
         pcb_outlines: vec![],
+        machined_parts: Vec::new(),
         summary: serde_json::json!({ "envelope_radius_mm": 15.0 }),
     }
 }
@@ -395,6 +396,7 @@ fn group_kit() -> Kit {
         assembly: vec![],
         cut_parts: vec![],
         pcb_outlines: vec![],
+        machined_parts: Vec::new(),
         summary: serde_json::json!({}),
     }
 }
