@@ -31,9 +31,28 @@ pub fn export_options(design: &str, bench: &str, tol: ChordTolerance) -> ExportO
 /// Groups `build_kit/<design>` and `export/<design>` of one library design at
 /// `chord_tolerance_mm`: flat sampling, 10 samples, the export replaced by every iteration.
 pub fn bench_kit(c: &mut Criterion, design_name: &str, bench: &str, chord_tolerance_mm: f64) {
+    bench_kit_preset(c, design_name, None, bench, chord_tolerance_mm);
+}
+
+/// [`bench_kit`] of the design with `preset` applied; ids `<group>/<design>_<preset>`.
+pub fn bench_kit_preset(
+    c: &mut Criterion,
+    design_name: &str,
+    preset: Option<&str>,
+    bench: &str,
+    chord_tolerance_mm: f64,
+) {
     let tol = ChordTolerance::new(chord_tolerance_mm).expect("a valid tolerance");
-    let design = library::load(design_name).expect("the library design parses");
+    let mut design = library::load(design_name).expect("the library design parses");
+    let id = match preset {
+        Some(p) => {
+            design = design.with_preset(p).expect("the preset applies");
+            format!("{design_name}_{p}")
+        }
+        None => design_name.to_string(),
+    };
     let opts = export_options(design_name, bench, tol);
+    let design_name = id.as_str();
     let parent = tempfile::tempdir().expect("a temporary directory");
     let out_dir = parent.path().join(design_name);
     for (group_name, seconds) in [("build_kit", 4), ("export", 7)] {

@@ -143,6 +143,40 @@ fn refused_writing_nothing(
     assert!(!tmp.join("out").exists());
 }
 
+/// UVDtact's fingertip base (Sec. III-C) and acrylic shell (Sec. III): one fit broken at a time
+/// (a camera holder wider than the PCB's bore, LEDs taller than the pocket leaves them, a
+/// diffusion ring tight on the camera holder) is one named interference; a shell drawing
+/// without a tolerance is refused by path. Exit 2, nothing written.
+#[test]
+fn uvdtact_fits_and_shell_drawing_are_checked_and_write_nothing() {
+    let tmp = tempfile::tempdir().unwrap();
+    let yaml = std::fs::read_to_string(repo_root().join("designs/library/uvdtact.yaml")).unwrap();
+    for (from, to, expect) in [
+        (
+            "    outer_diameter_mm: 2.6 ",
+            "    outer_diameter_mm: 3.6 ",
+            "fingertip_base.led_pcb.inner_diameter_mm = 3.2: fit check: `camera_holder` and `led_pcb_envelope` overlap by",
+        ),
+        (
+            "    led_height_mm: 0.6 ",
+            "    led_height_mm: 1.4 ",
+            "fingertip_base.pocket_depth_mm = 3.0: fit check: `diffusion_ring` and `leds_envelope` overlap by",
+        ),
+        (
+            "    inner_diameter_mm: 4.0 ",
+            "    inner_diameter_mm: 2.0 ",
+            "fingertip_base.diffusion_ring.inner_diameter_mm = 2.0: fit check: `camera_holder` and `diffusion_ring` overlap by",
+        ),
+        (
+            "  general_tolerance_mm: 0.05 ",
+            "  general_tolerance_mm: 0 ",
+            "core.machining.general_tolerance_mm = 0: must be above 0",
+        ),
+    ] {
+        refused_writing_nothing(tmp.path(), &yaml, (from, to), &[expect]);
+    }
+}
+
 /// ShadowTac's casing (Sec. IV-B): a 30 mm camera board in the 29.4 mm bay is one named
 /// interference; a 24 mm window that does not pass the camera's view of the skin's rim and a
 /// gripper base narrower than its bolt pattern are refused by path. Exit 2, the error naming
