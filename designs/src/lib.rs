@@ -12,6 +12,7 @@ pub mod build;
 pub mod cut;
 pub mod error;
 pub mod estimate;
+pub mod flat;
 pub mod geometry;
 pub mod housing;
 pub mod input_files;

@@ -299,3 +299,41 @@ pub fn cuboid(min: [f64; 3], max: [f64; 3]) -> Result<Solid, GeometryError> {
         triangles: t.to_vec(),
     })
 }
+
+/// The right prism over a convex polygon (counter-clockwise (x, y) vertices, mm) from `z0_mm`
+/// up to `z1_mm`: both caps fanned from their first vertex, one quad per side.
+///
+/// # Errors
+/// [`GeometryError::InvalidPrimitive`] for fewer than 3 vertices, a non-finite coordinate,
+/// `z1_mm <= z0_mm`, or a polygon that is not convex and counter-clockwise.
+pub fn prism(polygon: &[[f64; 2]], z0_mm: f64, z1_mm: f64) -> Result<Solid, GeometryError> {
+    let n = polygon.len();
+    let finite = polygon.iter().flatten().all(|v| v.is_finite());
+    let convex = n >= 3
+        && (0..n).all(|i| {
+            let (a, b, c) = (polygon[i], polygon[(i + 1) % n], polygon[(i + 2) % n]);
+            (b[0] - a[0]) * (c[1] - b[1]) - (b[1] - a[1]) * (c[0] - b[0]) > 0.0
+        });
+    if !(finite && convex && z1_mm > z0_mm && z0_mm.is_finite() && z1_mm.is_finite()) {
+        return Err(GeometryError::InvalidPrimitive(format!(
+            "prism of {n} vertices from z = {z0_mm} to {z1_mm} mm: needs 3 or more finite vertices of a convex counter-clockwise polygon and z1 above z0"
+        )));
+    }
+    let mut vertices: Vec<[f64; 3]> = polygon.iter().map(|p| [p[0], p[1], z0_mm]).collect();
+    vertices.extend(polygon.iter().map(|p| [p[0], p[1], z1_mm]));
+    let n32 = n as u32;
+    let mut triangles = Vec::with_capacity(4 * n);
+    for i in 1..n32 - 1 {
+        triangles.push([0, i + 1, i]); // bottom, facing -z
+        triangles.push([n32, n32 + i, n32 + i + 1]); // top, facing +z
+    }
+    for i in 0..n32 {
+        let j = (i + 1) % n32;
+        triangles.push([i, j, n32 + j]);
+        triangles.push([i, n32 + j, n32 + i]);
+    }
+    Solid::from_mesh(&Mesh {
+        vertices,
+        triangles,
+    })
+}
