@@ -36,6 +36,9 @@ pub fn build_kit_bounded(
     max_triangles: u64,
 ) -> Result<Kit, DesignError> {
     let materials = MaterialsTable::embedded().map_err(DesignError::Yaml)?;
+    if design.body.flat_outline().is_some() {
+        return crate::flat::build_kit(design, &materials, tol, max_triangles);
+    }
     let stack = validate(design, &materials, tol)?;
     if max_triangles < u64::MAX {
         crate::estimate::check_work(design, &stack, tol, max_triangles)?;

@@ -422,7 +422,7 @@ impl MarkerGrid {
 }
 
 /// One layer of a flat skin: from `z0_mm` up to `z1_mm`, with its channels and marker grid.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FlatLayer {
     pub name: String,
     pub z0_mm: f64,
@@ -479,4 +479,484 @@ pub fn layer_solid(
         s = s.union(&Solid::compose(&markers))?;
     }
     Ok(s)
+}
+
+/// The tray a flat layer is cast in (print orientation: floor on the plate, z up): a box
+/// `wall` mm round the outline and `floor` mm under the layer, its cavity the outline's prism
+/// as deep as the layer (poured to the brim and scraped level, the poured face the layer's
+/// top). For a channel layer, ribs on the floor form the grooves and run into the near wall,
+/// so that the channels open at the near edge; for a marker layer, holes in the floor form the
+/// markers.
+///
+/// # Errors
+/// [`GeometryError`] on a kernel failure.
+pub fn tray_solid(
+    outline: &FlatOutline,
+    layer: &FlatLayer,
+    wall_mm: f64,
+    floor_mm: f64,
+    tol: ChordTolerance,
+) -> Result<Solid, GeometryError> {
+    let (hw, hl) = (outline.width_mm / 2.0, outline.length_mm / 2.0);
+    let depth = layer.z1_mm - layer.z0_mm;
+    let block = cuboid(
+        [-hw - wall_mm, -hl - wall_mm, 0.0],
+        [hw + wall_mm, hl + wall_mm, floor_mm + depth],
+    )?;
+    let cavity = prism(&outline.polygon(tol), floor_mm, floor_mm + depth + 1.0)?;
+    let mut tray = block.difference(&cavity)?;
+    if let Some(ch) = &layer.channels {
+        let ribs = ch
+            .centres_x_mm()
+            .into_iter()
+            .map(|x| {
+                cuboid(
+                    [x - ch.width_mm / 2.0, -hl - wall_mm / 2.0, floor_mm - 0.5],
+                    [
+                        x + ch.width_mm / 2.0,
+                        -hl + ch.length_mm,
+                        floor_mm + ch.height_mm,
+                    ],
+                )
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        tray = tray.union(&Solid::compose(&ribs))?;
+    }
+    if let Some(g) = &layer.marker_grid {
+        let holes = g
+            .positions_mm()
+            .into_iter()
+            .map(|[x, y]| feature_solid(&g.feature, [x, y, floor_mm], [0.0, 0.0, -1.0], 1.0, tol))
+            .collect::<Result<Vec<_>, _>>()?;
+        tray = tray.difference(&Solid::compose(&holes))?;
+    }
+    Ok(tray)
+}
+
+/// The layers of a flat design, inner (camera side, from the base plane) to outer, with
+/// their z ranges; `None` for a design that is not flat or whose thicknesses are not given.
+pub fn flat_layers(design: &crate::schema::Design) -> Option<Vec<FlatLayer>> {
+    let crate::profile::BodyProfile::Flat { thickness_mm, .. } = design.body else {
+        return None;
+    };
+    let given: f64 = design.layers.iter().filter_map(|l| l.thickness_mm).sum();
+    let mut z = 0.0;
+    let mut out = Vec::with_capacity(design.layers.len());
+    for (i, l) in design.layers.iter().enumerate() {
+        let t = match (l.thickness_mm, l.solid && i == 0) {
+            (Some(t), _) => t,
+            (None, true) => thickness_mm - given,
+            (None, false) => return None,
+        };
+        out.push(FlatLayer {
+            name: l.name.clone(),
+            z0_mm: z,
+            z1_mm: z + t,
+            channels: l.channels.clone(),
+            marker_grid: l.marker_grid.clone(),
+        });
+        z += t;
+    }
+    Some(out)
+}
+
+/// Every rule of a flat design, by path (see [`build_kit`]).
+pub fn validate(
+    design: &crate::schema::Design,
+    materials: &crate::materials::MaterialsTable,
+) -> Result<Vec<FlatLayer>, crate::ParamErrors> {
+    use crate::materials::MaterialKind;
+    use crate::schema::LayerProcess;
+    let numbers = crate::values::check_values(design, crate::stack::DESIGN_SIGNED_MM);
+    if !numbers.unusable.is_empty() {
+        return Err(crate::ParamErrors(numbers.unusable));
+    }
+    let mut errs = Vec::new();
+    if !crate::stack::is_identifier(&design.name) {
+        errs.push(ParamError::new(
+            "name",
+            format!("{:?}", design.name),
+            "must be lowercase letters, digits and _",
+        ));
+    }
+    for (path, value, rule) in design.body.violations() {
+        errs.push(ParamError::new(path, value, rule));
+    }
+    let body_ok = errs.is_empty();
+    let curved_only = [
+        ("core", design.core.is_some()),
+        ("backing", design.backing.is_some()),
+        ("housing", design.housing.is_some()),
+        ("shaft_body", design.shaft_body.is_some()),
+        ("casing", design.casing.is_some()),
+        ("fingertip_base", design.fingertip_base.is_some()),
+    ];
+    for (path, given) in curved_only {
+        if given {
+            errs.push(ParamError::new(
+                path,
+                "given",
+                "does not apply to a flat skin (body.profile: flat)",
+            ));
+        }
+    }
+    if design.layers.is_empty() {
+        errs.push(ParamError::new("layers", "[]", "give at least one layer"));
+    }
+    let mut names = std::collections::BTreeSet::new();
+    for (i, l) in design.layers.iter().enumerate() {
+        let p = |f: &str| format!("layers[{i}].{f}");
+        if !crate::stack::is_identifier(&l.name) || !names.insert(l.name.as_str()) {
+            errs.push(ParamError::new(
+                p("name"),
+                format!("{:?}", l.name),
+                "must be lowercase letters, digits and _, and unique",
+            ));
+        }
+        if l.process != LayerProcess::Cast {
+            errs.push(ParamError::new(
+                p("process"),
+                format!("{:?}", l.process).to_lowercase(),
+                "a flat skin's layers are cast (each in its tray)",
+            ));
+        }
+        match materials.get(&l.material) {
+            Some(m) if m.kind == MaterialKind::Cast => {}
+            Some(_) => errs.push(ParamError::new(
+                p("material"),
+                &l.material,
+                "must be a cast material",
+            )),
+            None => errs.push(ParamError::new(
+                p("material"),
+                &l.material,
+                "unknown material",
+            )),
+        }
+        if !l.markers.is_empty() {
+            errs.push(ParamError::new(
+                p("markers"),
+                "given",
+                "curved skins' marker patterns do not apply to a flat skin: use marker_grid",
+            ));
+        }
+        if l.outer_radius_mm.is_some() || l.mold_strategy.is_some() || l.brushed_coat.is_some() {
+            errs.push(ParamError::new(
+                p("outer_radius_mm"),
+                "given",
+                "outer_radius_mm, mold_strategy and brushed_coat do not apply to a flat skin's layers",
+            ));
+        }
+        match (l.thickness_mm, l.solid) {
+            (Some(t), false) if t > 0.0 => {}
+            (None, true) if i == 0 => {}
+            (t, _) => errs.push(ParamError::new(
+                p("thickness_mm"),
+                t.map_or("none".to_string(), |t| t.to_string()),
+                "give a thickness above 0 (or solid: true on the innermost layer, which fills down to the base plane)",
+            )),
+        }
+        if i == 0 && l.channels.is_some() {
+            errs.push(ParamError::new(
+                p("channels"),
+                "given",
+                "the innermost layer cannot hold channels: their grooves are closed by the layer under them",
+            ));
+        }
+        if i != 0 && l.marker_grid.is_some() {
+            errs.push(ParamError::new(
+                p("marker_grid"),
+                "given",
+                "markers stand on the innermost layer's bottom face (towards the camera)",
+            ));
+        }
+    }
+    let Some(outline) = design.body.flat_outline() else {
+        return Err(crate::ParamErrors(errs));
+    };
+    let layers = if errs.is_empty() {
+        flat_layers(design)
+    } else {
+        None
+    };
+    if let (Some(layers), crate::profile::BodyProfile::Flat { thickness_mm, .. }) =
+        (&layers, &design.body)
+    {
+        let top = layers.last().map_or(0.0, |l| l.z1_mm);
+        if (top - thickness_mm).abs() > 1e-9 || layers.first().is_some_and(|l| l.z1_mm <= 0.0) {
+            errs.push(ParamError::new(
+                "layers",
+                format!("{top} mm in all"),
+                format!(
+                    "the layers' thicknesses must add up to body.thickness_mm ({thickness_mm} mm)"
+                ),
+            ));
+        }
+        for (i, l) in layers.iter().enumerate() {
+            if !body_ok {
+                break;
+            }
+            if let Some(c) = &l.channels {
+                errs.extend(c.errors(
+                    &format!("layers[{i}].channels."),
+                    l.z1_mm - l.z0_mm,
+                    &outline,
+                ));
+            }
+            if let Some(g) = &l.marker_grid {
+                errs.extend(g.errors(&format!("layers[{i}].marker_grid."), &outline));
+            }
+        }
+    }
+    match layers {
+        Some(l) if errs.is_empty() => Ok(l),
+        _ => Err(crate::ParamErrors(errs)),
+    }
+}
+
+/// About how many triangles a flat kit has at `tol` (both trays and the layers): the
+/// outline's prisms, 12 per channel groove or rib, and per marker (in its layer and its
+/// tray's hole) a revolved feature of `circle_segments` by a quarter as many profile points.
+fn estimated_triangles(outline: &FlatOutline, layers: &[FlatLayer], tol: ChordTolerance) -> f64 {
+    let prism_tris = 4.0 * outline.polygon(tol).len() as f64;
+    layers
+        .iter()
+        .map(|l| {
+            let ch = l
+                .channels
+                .as_ref()
+                .map_or(0.0, |c| 2.0 * 24.0 * c.count as f64);
+            let mk = l.marker_grid.as_ref().map_or(0.0, |g| {
+                let n = tol.circle_segments(g.feature.radius_mm()) as f64;
+                2.0 * (g.rows * g.columns) as f64 * 2.0 * n * (n / 4.0 + 3.0)
+            });
+            3.0 * prism_tris + ch + mk
+        })
+        .sum()
+}
+
+/// Validates a flat design ([`validate`]) and builds its kit at `tol`: one tray per layer
+/// (FDM or as `mold.fixture_print_technology` says; Soter et al. laser-cut theirs), the pours
+/// in order (the channel layers first, then the marker layer the channel layer is laid onto
+/// while it is tacky: Sec. II-A casts the top layer first), the tubes and liquid, the
+/// procedure, and the skin's layers as the assembly (for the section view).
+///
+/// # Errors
+/// [`crate::DesignError::Params`] with every violated rule; [`crate::DesignError::WorkLimit`]
+/// past `max_triangles`; [`crate::DesignError::Geometry`] on a kernel failure.
+pub fn build_kit(
+    design: &crate::schema::Design,
+    materials: &crate::materials::MaterialsTable,
+    tol: ChordTolerance,
+    max_triangles: u64,
+) -> Result<crate::Kit, crate::DesignError> {
+    use crate::assembly::{Member, MemberKind};
+    use crate::error::GeometryContext as _;
+    use crate::kit::{Part, ProcedureAction, ProcedureStep};
+    use crate::DesignError;
+    let layers = validate(design, materials).map_err(DesignError::Params)?;
+    let Some(outline) = design.body.flat_outline() else {
+        return Err(DesignError::Yaml("not a flat design".into()));
+    };
+    let est = estimated_triangles(&outline, &layers, tol);
+    if est > max_triangles as f64 {
+        return Err(DesignError::WorkLimit(format!(
+            "{}: the kit would have about {:.0} triangles at chord tolerance {} mm, more than the limit of {max_triangles} (about 1 KB of memory each; raise it with --max-triangles, up to {}, or coarsen --chord-tolerance-mm)",
+            design.name,
+            est,
+            tol.mm(),
+            crate::estimate::MAX_TRIANGLES_LIMIT
+        )));
+    }
+    let m = &design.mold;
+    let tech: crate::kit::PrintTechnology = m.fixture_print_technology.into();
+    let wall = m.wall_thickness_mm;
+    let mut parts = Vec::new();
+    let mut assembly = Vec::new();
+    let mut volumes = Vec::new();
+    for (i, l) in layers.iter().enumerate() {
+        let floor = wall + l.marker_grid.as_ref().map_or(0.0, |g| g.feature.height_mm);
+        let name = format!("{}_tray", l.name);
+        let tray = tray_solid(&outline, l, wall, floor, tol).part(&name)?;
+        let skin = layer_solid(&outline, l, tol).part(&l.name)?;
+        let t = l.z1_mm - l.z0_mm;
+        // the cast layer's own volume, exact: the outline's prism, less the grooves, plus the
+        // markers beyond the face
+        let v = outline.area_mm2() * t
+            - l.channels
+                .as_ref()
+                .map_or(0.0, |c| c.count as f64 * c.channel_volume_mm3())
+            + l.marker_grid.as_ref().map_or(0.0, |g| {
+                (g.rows * g.columns) as f64 * g.feature.nominal_volume_mm3()
+            });
+        volumes.push(v);
+        let what = match (&l.channels, &l.marker_grid) {
+            (Some(c), _) => format!(", {} ribs forming the channels' grooves", c.count),
+            (_, Some(g)) => format!(", {} x {} holes forming the markers", g.rows, g.columns),
+            _ => String::new(),
+        };
+        parts.push(Part {
+            name: name.clone(),
+            role: "casting_tray".into(),
+            description: format!(
+                "Open tray of layer {} ({t:.2} mm deep{what}); pour to the brim and scrape level",
+                l.name
+            ),
+            material: crate::molds::material_for(tech).into(),
+            print_technology: tech,
+            solid: tray,
+            params: serde_json::json!({
+                "layer": l.name, "layer_index": i, "outline": outline, "depth_mm": t,
+                "wall_mm": wall, "floor_mm": floor, "channels": l.channels, "marker_grid": l.marker_grid,
+            }),
+            group: None,
+        });
+        assembly.push(Member {
+            name: l.name.clone(),
+            kind: MemberKind::Cast,
+            description: format!("{} layer, {t:.2} mm", l.name),
+            solid: skin,
+            fix: vec![format!("layers[{i}]")],
+            nested_by_stack: true,
+            exact: None,
+        });
+    }
+    // pours: channel layers (outer) first, the innermost (marker) layer last
+    let order: Vec<usize> = (1..layers.len()).chain(std::iter::once(0)).collect();
+    let mut casts = Vec::new();
+    for (step, &i) in order.iter().enumerate() {
+        let l = &design.layers[i];
+        let mat = materials
+            .get(&l.material)
+            .ok_or_else(|| DesignError::Yaml(format!("unknown material {}", l.material)))?;
+        casts.push(
+            crate::materials::pour(
+                step as u32 + 1,
+                &l.name,
+                &l.material,
+                mat,
+                vec![parts[i].name.clone()],
+                volumes[i],
+                design.casting.waste_allowance,
+            )
+            .map_err(DesignError::Yaml)?,
+        );
+    }
+    let channel_sets: Vec<(&FlatLayer, &ChannelSet)> = layers
+        .iter()
+        .filter_map(|l| l.channels.as_ref().map(|c| (l, c)))
+        .collect();
+    let mut bought = Vec::new();
+    let mut liquid_ml = 0.0;
+    for (l, c) in &channel_sets {
+        let t = &c.tube;
+        liquid_ml += c.count as f64 * c.liquid_per_channel_ml();
+        bought.push(format!(
+            "{} x silicone tube {:.1} mm OD, {:.1} mm ID, {:.0} mm long (one per channel of layer {}, from the skin to the display)",
+            c.count, t.outer_diameter_mm, t.inner_diameter_mm, t.length_mm, l.name
+        ));
+    }
+    if !channel_sets.is_empty() {
+        bought.push(
+            "Smooth-On Sil-Poxy silicone adhesive (glues the tubes into the channels' mouths)"
+                .into(),
+        );
+        bought.push(format!(
+            "Coloured liquid (water with food dye), {:.1} mL in the channels and tubes, and a tank deep enough to submerge the skin and tubes in it",
+            liquid_ml
+        ));
+    }
+    if layers.iter().any(|l| l.marker_grid.is_some()) {
+        bought.push("White silicone paint (Silc Pig white in a little uncured Ecoflex) for the markers' ends".into());
+    }
+    let step = |action, text: String| ProcedureStep { action, text };
+    let mut procedure = vec![step(
+        ProcedureAction::Print,
+        format!(
+            "Print the trays ({}); check that each is flat and its cavity clean.",
+            parts
+                .iter()
+                .map(|p| p.name.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    )];
+    for c in &casts {
+        let l = layers.iter().find(|l| l.name == c.cast);
+        let last = c.step as usize == casts.len() && casts.len() > 1;
+        procedure.push(step(
+            ProcedureAction::Pour,
+            format!(
+                "Pour {} ({:.2} mL, {:.2} g mixed) into {}: degas the mix in a vacuum chamber, pour to the brim and scrape level{}.",
+                c.cast,
+                c.cavity_volume_ml,
+                c.total_mass_g,
+                c.mold_parts.join(", "),
+                if last {
+                    "; when it has gelled until tacky (about half its pot life), lay the cured layers on it, grooves down, square to the tray's walls with the channels' mouths over the near wall, and weigh them down evenly: the tacky layer closes the grooves into channels"
+                } else {
+                    ""
+                }
+            ),
+        ));
+        let markers = l.and_then(|l| l.marker_grid.as_ref());
+        procedure.push(step(
+            ProcedureAction::Demold,
+            format!(
+                "Cure and take {} out of its tray{}.",
+                c.cast,
+                if markers.is_some() {
+                    "; paint the markers' ends white"
+                } else {
+                    ""
+                }
+            ),
+        ));
+    }
+    for (l, c) in &channel_sets {
+        let t = &c.tube;
+        procedure.push(step(
+            ProcedureAction::Assemble,
+            format!(
+                "Push a tube {:.1} mm into each of the {} channels' mouths of {} at the near edge and glue it with Sil-Poxy; lead the tubes to the display.",
+                t.insertion_mm, c.count, l.name
+            ),
+        ));
+        procedure.push(step(
+            ProcedureAction::Assemble,
+            format!(
+                "Fill the channels: submerge the skin and the tubes in the tank of coloured liquid and squeeze each channel until no more air leaves it (a channel closed at its far end cannot be filled by a syringe; Soter et al. Sec. II-A): {:.3} mL per channel and its tube{}.",
+                c.liquid_per_channel_ml(),
+                match c.ends {
+                    ChannelEnds::BothClosed => "; close each tube's display end while still under the liquid, so that the liquid always returns to its place",
+                    ChannelEnds::OneClosed => "; the tubes' display ends stay open",
+                }
+            ),
+        ));
+    }
+    let summary = serde_json::json!({
+        "flat": {
+            "outline": outline,
+            "area_mm2": outline.area_mm2(),
+            "layers": layers.iter().map(|l| serde_json::json!({"name": l.name, "z0_mm": l.z0_mm, "z1_mm": l.z1_mm})).collect::<Vec<_>>(),
+            "channels": channel_sets.iter().map(|(l, c)| serde_json::json!({
+                "layer": l.name, "count": c.count, "channel_volume_mm3": c.channel_volume_mm3(),
+                "liquid_per_channel_ml": c.liquid_per_channel_ml(), "ends": c.ends,
+                "centres_x_mm": c.centres_x_mm()})).collect::<Vec<_>>(),
+            "markers": layers.iter().filter_map(|l| l.marker_grid.as_ref()).map(|g| g.rows * g.columns).sum::<usize>(),
+            "liquid_ml": liquid_ml,
+        }
+    });
+    Ok(crate::Kit {
+        design: design.name.clone(),
+        parts,
+        casts,
+        bought_items: bought,
+        procedure,
+        assembly,
+        cut_parts: Vec::new(),
+        pcb_outlines: Vec::new(),
+        machined_parts: Vec::new(),
+        summary,
+    })
 }

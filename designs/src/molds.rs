@@ -750,7 +750,7 @@ fn build_mold_parts(
     }
 }
 
-fn material_for(t: PrintTechnology) -> &'static str {
+pub(crate) fn material_for(t: PrintTechnology) -> &'static str {
     match t {
         PrintTechnology::Fdm => "pla",
         PrintTechnology::Sla => "sla_standard_resin",

@@ -34,6 +34,16 @@ pub enum BodyProfile {
     /// Half an ellipsoid of revolution: `diameter_mm` across the base, `height_mm` from the
     /// base plane to the pole (UVDtact, Sec. III).
     HalfEllipsoid { diameter_mm: f64, height_mm: f64 },
+    /// A flat skin (Soter et al. Sec. II-A; GelSight, DIGIT): a rounded rectangle
+    /// `width_mm` (x) by `length_mm` (y), corners rounded to `corner_radius_mm`, its contact
+    /// face `thickness_mm` above the base plane z = 0 ([`crate::flat`]). Offsets move the face
+    /// along z; the (r, z) forms below give its section through the x axis.
+    Flat {
+        width_mm: f64,
+        length_mm: f64,
+        corner_radius_mm: f64,
+        thickness_mm: f64,
+    },
 }
 
 /// The YAML form of [`BodyProfile`]: one flat mapping, so that an unknown key is reported at
@@ -58,6 +68,18 @@ pub struct BodyYaml {
     /// Spherical cap given by its sphere: diameter of the rim on the base plane, mm.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rim_diameter_mm: Option<f64>,
+    /// Flat skin: across x, mm.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub width_mm: Option<f64>,
+    /// Flat skin: along y, mm.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub length_mm: Option<f64>,
+    /// Flat skin: corner radius of the outline, mm (0 when not given).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub corner_radius_mm: Option<f64>,
+    /// Flat skin: from the base plane to the contact face, mm.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub thickness_mm: Option<f64>,
 }
 
 /// The profile names of the YAML `profile` key.
@@ -67,6 +89,7 @@ pub enum ProfileKind {
     SphericalCap,
     HemisphereOnCylinder,
     HalfEllipsoid,
+    Flat,
 }
 
 impl TryFrom<BodyYaml> for BodyProfile {
@@ -80,7 +103,13 @@ impl TryFrom<BodyYaml> for BodyProfile {
             ("height_mm", y.height_mm),
             ("sphere_radius_mm", y.sphere_radius_mm),
             ("rim_diameter_mm", y.rim_diameter_mm),
+            ("width_mm", y.width_mm),
+            ("length_mm", y.length_mm),
+            ("thickness_mm", y.thickness_mm),
         ];
+        if y.corner_radius_mm.is_some() && y.profile != ProfileKind::Flat {
+            return Err("body.corner_radius_mm applies to profile flat only".to_string());
+        }
         // A cap by its sphere: exactly this form or the base/height form.
         let by_sphere = y.profile == ProfileKind::SphericalCap
             && (y.sphere_radius_mm.is_some() || y.rim_diameter_mm.is_some());
@@ -100,6 +129,7 @@ impl TryFrom<BodyYaml> for BodyProfile {
                 &["radius_mm", "cylinder_length_mm"],
             ),
             ProfileKind::HalfEllipsoid => ("half_ellipsoid", &["diameter_mm", "height_mm"]),
+            ProfileKind::Flat => ("flat", &["width_mm", "length_mm", "thickness_mm"]),
         };
         let mut problems = Vec::new();
         for (name, v) in fields {
@@ -159,6 +189,12 @@ impl TryFrom<BodyYaml> for BodyProfile {
                 diameter_mm: g("diameter_mm"),
                 height_mm: g("height_mm"),
             },
+            ProfileKind::Flat => Self::Flat {
+                width_mm: g("width_mm"),
+                length_mm: g("length_mm"),
+                corner_radius_mm: y.corner_radius_mm.unwrap_or(0.0),
+                thickness_mm: g("thickness_mm"),
+            },
         })
     }
 }
@@ -174,6 +210,10 @@ impl From<BodyProfile> for BodyYaml {
             height_mm: None,
             sphere_radius_mm: None,
             rim_diameter_mm: None,
+            width_mm: None,
+            length_mm: None,
+            corner_radius_mm: None,
+            thickness_mm: None,
         };
         match b {
             BodyProfile::SphericalCap {
@@ -199,6 +239,18 @@ impl From<BodyProfile> for BodyYaml {
                 y.diameter_mm = Some(diameter_mm);
                 y.height_mm = Some(height_mm);
             }
+            BodyProfile::Flat {
+                width_mm,
+                length_mm,
+                corner_radius_mm,
+                thickness_mm,
+            } => {
+                y.profile = ProfileKind::Flat;
+                y.width_mm = Some(width_mm);
+                y.length_mm = Some(length_mm);
+                y.corner_radius_mm = Some(corner_radius_mm);
+                y.thickness_mm = Some(thickness_mm);
+            }
         }
         y
     }
@@ -211,6 +263,7 @@ impl BodyProfile {
             Self::SphericalCap { .. } => "spherical_cap",
             Self::HemisphereOnCylinder { .. } => "hemisphere_on_cylinder",
             Self::HalfEllipsoid { .. } => "half_ellipsoid",
+            Self::Flat { .. } => "flat",
         }
     }
 
@@ -260,8 +313,43 @@ impl BodyProfile {
                 pos("diameter_mm", diameter_mm);
                 pos("height_mm", height_mm);
             }
+            Self::Flat {
+                width_mm,
+                length_mm,
+                corner_radius_mm,
+                thickness_mm,
+            } => {
+                pos("width_mm", width_mm);
+                pos("length_mm", length_mm);
+                pos("thickness_mm", thickness_mm);
+                let half = width_mm.min(length_mm) / 2.0;
+                if !(corner_radius_mm >= 0.0 && corner_radius_mm < half) && half > 0.0 {
+                    v.push((
+                        "body.corner_radius_mm".into(),
+                        corner_radius_mm,
+                        format!("must be 0 or more and below half the shorter side ({half} mm)"),
+                    ));
+                }
+            }
         }
         v
+    }
+
+    /// The outline of a flat body; `None` for the other profiles.
+    pub fn flat_outline(&self) -> Option<crate::flat::FlatOutline> {
+        match *self {
+            Self::Flat {
+                width_mm,
+                length_mm,
+                corner_radius_mm,
+                ..
+            } => Some(crate::flat::FlatOutline {
+                width_mm,
+                length_mm,
+                corner_radius_mm,
+            }),
+            _ => None,
+        }
     }
 
     /// Whether the profile is a sphere (offsets are spheres, radii make sense).
@@ -269,7 +357,7 @@ impl BodyProfile {
         match *self {
             Self::SphericalCap { .. } => Some(self.cap_sphere().0),
             Self::HemisphereOnCylinder { radius_mm, .. } => Some(radius_mm),
-            Self::HalfEllipsoid { .. } => None,
+            Self::HalfEllipsoid { .. } | Self::Flat { .. } => None,
         }
     }
 
@@ -295,7 +383,7 @@ impl BodyProfile {
             Self::HemisphereOnCylinder {
                 cylinder_length_mm, ..
             } => -cylinder_length_mm,
-            Self::HalfEllipsoid { .. } => 0.0,
+            Self::HalfEllipsoid { .. } | Self::Flat { .. } => 0.0,
         }
     }
 
@@ -312,6 +400,7 @@ impl BodyProfile {
                 let (a, c) = (diameter_mm / 2.0, height_mm);
                 (a * a / c).min(c * c / a)
             }
+            Self::Flat { .. } => f64::INFINITY,
         }
     }
 
@@ -331,6 +420,11 @@ impl BodyProfile {
                 let r = a * co + d * n[0] / nl;
                 [if t == 0.0 { 0.0 } else { r }, c * s + d * n[1] / nl]
             }
+            Self::Flat {
+                width_mm,
+                thickness_mm,
+                ..
+            } => [t * width_mm / 2.0, thickness_mm + d],
             _ => {
                 let (rho, a_end) = self.sphere_arc(d);
                 let a = FRAC_PI_2 + (a_end - FRAC_PI_2) * t;
@@ -354,6 +448,7 @@ impl BodyProfile {
                 let nl = (n[0] * n[0] + n[1] * n[1]).sqrt();
                 [n[0] / nl, n[1] / nl]
             }
+            Self::Flat { .. } => [0.0, 1.0],
             _ => {
                 let (_, a_end) = self.sphere_arc(d);
                 let a = FRAC_PI_2 + (a_end - FRAC_PI_2) * t;
@@ -371,7 +466,7 @@ impl BodyProfile {
                 let rho = r + d;
                 (rho, (zb / rho).clamp(-1.0, 1.0).asin())
             }
-            Self::HalfEllipsoid { .. } => unreachable!(),
+            Self::HalfEllipsoid { .. } | Self::Flat { .. } => (0.0, FRAC_PI_2),
         }
     }
 
@@ -388,7 +483,7 @@ impl BodyProfile {
                 let (r, zb) = self.cap_sphere();
                 ((r + d).powi(2) - zb * zb).max(0.0).sqrt()
             }
-            Self::HalfEllipsoid { .. } => self.offset_point(d, 1.0)[0],
+            Self::HalfEllipsoid { .. } | Self::Flat { .. } => self.offset_point(d, 1.0)[0],
         }
     }
 
@@ -408,6 +503,10 @@ impl BodyProfile {
         match *self {
             Self::HalfEllipsoid { .. } => {
                 push_curve(&mut pl, &|t| self.offset_point(d, t), 0.0, 1.0, tol);
+            }
+            Self::Flat { .. } => {
+                pl.push(self.offset_point(d, 0.0));
+                pl.push(self.offset_point(d, 1.0));
             }
             _ => {
                 let (rho, a_end) = self.sphere_arc(d);
@@ -528,6 +627,9 @@ impl BodyProfile {
     /// curvature, under 1e-4 relative for radii of 10 mm and more). The surface a release
     /// agent or a primer covers.
     pub fn surface_area_mm2(&self, d: f64) -> f64 {
+        if let Some(o) = self.flat_outline() {
+            return o.area_mm2();
+        }
         let tol =
             ChordTolerance::new(ChordTolerance::MIN_MM).expect("the minimum tolerance is valid");
         let pl = self.offset_polyline(d, 0.0, tol);
@@ -547,6 +649,10 @@ impl BodyProfile {
         let rim = self.rim_radius_mm(d);
         let ext = PI * rim * rim * below_base_mm;
         match *self {
+            Self::Flat { thickness_mm, .. } => {
+                let area = self.flat_outline().map_or(0.0, |o| o.area_mm2());
+                area * (thickness_mm + d + below_base_mm)
+            }
             Self::HemisphereOnCylinder {
                 radius_mm,
                 cylinder_length_mm,

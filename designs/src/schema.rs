@@ -167,6 +167,12 @@ pub struct Layer {
     /// A coat brushed onto the layer once it is out of its mold; none when not given.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub brushed_coat: Option<BrushedCoat>,
+    /// Liquid channels in the layer (flat skins only; Soter et al. Sec. II-A).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub channels: Option<crate::flat::ChannelSet>,
+    /// A grid of markers on the layer's bottom face (flat skins only; Soter et al. Sec. II-A).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub marker_grid: Option<crate::flat::MarkerGrid>,
 }
 
 /// How a cast layer's mold is made.

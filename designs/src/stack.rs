@@ -69,7 +69,7 @@ impl Stack {
     }
 }
 
-fn is_identifier(s: &str) -> bool {
+pub(crate) fn is_identifier(s: &str) -> bool {
     !s.is_empty()
         && s.chars()
             .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_')
@@ -102,8 +102,32 @@ pub fn validate(
             "must be lowercase letters, digits and _",
         ));
     }
+    if design.body.flat_outline().is_some() {
+        return Err(ParamErrors(vec![ParamError::new(
+            "body.profile",
+            "flat",
+            "fixtures, ground truth and sweeps handle curved skins only (spherical_cap, hemisphere_on_cylinder, half_ellipsoid) for now; a flat skin is exported and validated (fabkit export, fabkit validate)",
+        )]));
+    }
     for (path, value, rule) in design.body.violations() {
         errs.push(ParamError::new(path, value, rule));
+    }
+    for (i, l) in design.layers.iter().enumerate() {
+        for (field, given) in [
+            ("channels", l.channels.is_some()),
+            ("marker_grid", l.marker_grid.is_some()),
+        ] {
+            if given {
+                errs.push(ParamError::new(
+                    format!("layers[{i}].{field}"),
+                    "given",
+                    format!(
+                        "applies to flat skins only (body.profile: flat); this body is {}",
+                        design.body.kind()
+                    ),
+                ));
+            }
+        }
     }
     let body_ok = errs.iter().all(|e| !e.path.starts_with("body."));
     let sphere_r = if body_ok {

@@ -384,8 +384,16 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
                 loaded.design = loaded.design.with_preset(p)?;
             }
             let materials = fabkit_designs::materials::MaterialsTable::embedded()?;
-            let stack = fabkit_designs::stack::validate(&loaded.design, &materials, tol)
-                .map_err(DesignError::from)?;
+            let stack = if loaded.design.body.flat_outline().is_some() {
+                let layers = fabkit_designs::flat::validate(&loaded.design, &materials)
+                    .map_err(DesignError::from)?;
+                serde_json::json!({ "flat_layers": layers })
+            } else {
+                serde_json::to_value(
+                    fabkit_designs::stack::validate(&loaded.design, &materials, tol)
+                        .map_err(DesignError::from)?,
+                )?
+            };
             out!("{}: valid", loaded.source);
             out!(
                 "\nparameters of {} (each path can be set by a preset or varied by `fabkit sweep`; numbers rounded to 1e-9):",
@@ -406,10 +414,7 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
                 out!("  {path} = {shown}");
             }
             out!("\nresolved layer stack (mm, inner to outer):");
-            out!(
-                "{}",
-                serde_json::to_string_pretty(&rounded(&serde_json::to_value(&stack)?))?
-            );
+            out!("{}", serde_json::to_string_pretty(&rounded(&stack))?);
             Ok(())
         }
         Command::Show { design, out } => {

@@ -443,7 +443,12 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
     let (_, camera_sha) = read_with_hash(&args.camera)?;
     let (t_cam_sensor, extrinsics_sha) = read_extrinsics(&args.extrinsics)?;
     let fixtures = read_fixtures(&args.fixtures, &design.name)?;
-    let surface = ReferenceSurface::of(&design.body);
+    let surface = ReferenceSurface::of(&design.body).ok_or_else(|| {
+        format!(
+            "body.profile = {}: ground truth is rendered for curved skins only (spherical_cap, hemisphere_on_cylinder, half_ellipsoid); flat skins are not supported by fabkit groundtruth yet",
+            design.body.kind()
+        )
+    })?;
     let rays = PixelRays::new(&camera, &t_cam_sensor);
     let c = rays.origin_mm;
     if !surface.contains(c, 0.0) {

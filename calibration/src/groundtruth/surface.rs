@@ -48,9 +48,10 @@ fn far_root(a: f64, b: f64, c: f64) -> Option<f64> {
 }
 
 impl ReferenceSurface {
-    /// The outer skin surface (offset 0) of `body`.
-    pub fn of(body: &BodyProfile) -> ReferenceSurface {
-        match *body {
+    /// The outer skin surface (offset 0) of `body`; `None` for a flat body (its plane is not
+    /// a reference surface here yet).
+    pub fn of(body: &BodyProfile) -> Option<ReferenceSurface> {
+        Some(match *body {
             BodyProfile::SphericalCap { .. } => ReferenceSurface::Cap {
                 radius_mm: body.sphere_radius_mm().unwrap_or(0.0),
                 base_z_mm: body.base_z_mm(),
@@ -68,7 +69,8 @@ impl ReferenceSurface {
                 a_mm: diameter_mm / 2.0,
                 c_mm: height_mm,
             },
-        }
+            BodyProfile::Flat { .. } => return None,
+        })
     }
 
     /// z of the base plane, mm.

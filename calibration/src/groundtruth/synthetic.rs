@@ -190,7 +190,7 @@ impl BenchScene {
         let primitives = benchmark_protrusions();
         BenchScene {
             rays: PixelRays::new(&crate::synthetic::benchmark_camera(), &benchmark_pose()),
-            surface: ReferenceSurface::of(&body),
+            surface: ReferenceSurface::of(&body).expect("R-Tac0's body is curved"),
             exact: ExactPrimitives::new(&primitives).expect("valid primitives"),
             body_mesh: skin_mesh(&body, tol),
             protrusion_mesh: primitives_mesh(&primitives, tol).expect("protrusion mesh"),

@@ -113,7 +113,7 @@ fn check(
 
 #[test]
 fn sphere_through_both_camera_models_matches_the_closed_form_to_1_um() {
-    let surface = ReferenceSurface::of(&rtac0_body());
+    let surface = ReferenceSurface::of(&rtac0_body()).unwrap();
     let r = RTAC0_RADIUS_MM;
     for (name, cam) in cameras() {
         let rays = PixelRays::new(&cam, &pose());
@@ -155,7 +155,7 @@ fn tessellated_sphere_is_within_1_um_plus_the_chord_tolerance() {
         let hits = caster.cast(&rays, &vec![f64::INFINITY; rays.len()]);
         let mut frame = DepthFrame::new(
             &rays,
-            &reference_hits(&rays, &ReferenceSurface::of(&rtac0_body())),
+            &reference_hits(&rays, &ReferenceSurface::of(&rtac0_body()).unwrap()),
         );
         for p in 0..rays.len() {
             frame.range_mm[p] = if hits.triangle[p] == NO_HIT {
@@ -227,7 +227,7 @@ fn plane_through_both_camera_models_matches_the_closed_form_exact_and_meshed() {
         triangles: vec![[0, 2, 1], [0, 3, 2]],
     };
     let caster = MeshCaster::new(&quad);
-    let surface = ReferenceSurface::of(&rtac0_body());
+    let surface = ReferenceSurface::of(&rtac0_body()).unwrap();
     for (name, cam) in cameras() {
         let rays = PixelRays::new(&cam, &pose());
         let reference = reference_hits(&rays, &surface);

@@ -33,7 +33,7 @@ fn percentile(v: &mut [f64], q: f64) -> f64 {
 #[test]
 fn pinhole_render_plus_undistort_differs_from_the_exact_render_on_the_rtac0_camera() {
     let scene = BenchScene::new(0.01);
-    let surface = ReferenceSurface::of(&rtac0_body());
+    let surface = ReferenceSurface::of(&rtac0_body()).unwrap();
     let intr = benchmark_intrinsics();
     let real = CameraModel::new(intr).unwrap();
     let pinhole = CameraModel::new(Intrinsics {

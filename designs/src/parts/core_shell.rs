@@ -215,6 +215,12 @@ fn surface_words(body: &BodyProfile, d: f64) -> String {
             radius_mm,
             cylinder_length_mm,
         } => format!("the hemisphere R{radius_mm:.2} on a {cylinder_length_mm:.2} mm cylinder"),
+        BodyProfile::Flat {
+            width_mm,
+            length_mm,
+            thickness_mm,
+            ..
+        } => format!("the flat face {width_mm:.2} x {length_mm:.2} mm, {thickness_mm:.2} mm above the base plane"),
     };
     if d == 0.0 {
         shape

@@ -239,3 +239,118 @@ fn bad_flat_values_are_refused_by_path() {
     g.pitch_mm = 8.2;
     assert!(g.errors("g.", &o).is_empty());
 }
+
+/// The test design: an 80 x 80 x 5 mm skin (r 5 mm corners), a 2 mm marker layer with the
+/// 10 x 10 grid and a 3 mm channel layer with the 16 channels above (the values above).
+const FLAT_YAML: &str = include_str!("data/flat_channels.yaml");
+
+fn flat_design() -> fabkit_designs::Design {
+    fabkit_designs::Design::from_yaml(FLAT_YAML, "flat_channels.yaml").unwrap()
+}
+
+/// Its kit: a tray per layer, each a closed solid of the analytic volume (a 4 mm walled box
+/// less the cavity; the channel tray plus its 16 ribs inside the cavity, the marker tray less
+/// its 100 holes within their chords), the channel layer poured first, each pour the layer's
+/// exact volume (the outline's area, less the grooves, plus the markers), and the liquid per
+/// channel in the summary.
+#[test]
+fn flat_kit_has_its_trays_and_pours() {
+    let k = fabkit_designs::build_kit(&flat_design(), tol()).unwrap();
+    let names: Vec<&str> = k.parts.iter().map(|p| p.name.as_str()).collect();
+    assert_eq!(names, ["marker_layer_tray", "channel_layer_tray"]);
+    let area_poly = polygon_area(&outline().polygon(tol()));
+    let block = |h: f64| 88.0 * 88.0 * h;
+    let ch = &k.parts[1].solid;
+    let want = block(4.0 + 3.0) - area_poly * 3.0 + 16.0 * 1.5 * 1.5 * 70.0;
+    assert!(
+        (ch.volume() - want).abs() < 1e-6 * want,
+        "{} vs {want}",
+        ch.volume()
+    );
+    assert_eq!((ch.shell_count(), ch.genus()), (1, 0));
+    let mk = &k.parts[0].solid;
+    let hole = grid().feature.nominal_volume_mm3();
+    let want = block(4.0 + 2.0 + 2.0) - area_poly * 2.0 - 100.0 * hole;
+    let bound = mk.surface_area() * 0.01;
+    assert!(
+        (mk.volume() - want).abs() <= bound,
+        "{} vs {want}",
+        mk.volume()
+    );
+    assert_eq!(mk.shell_count(), 1);
+    let area = outline().area_mm2();
+    let casts: Vec<(&str, f64)> = k
+        .casts
+        .iter()
+        .map(|c| (c.cast.as_str(), c.cavity_volume_ml))
+        .collect();
+    assert_eq!(casts[0].0, "channel_layer");
+    assert_eq!(casts[1].0, "marker_layer");
+    assert!((casts[0].1 - (area * 3.0 - 16.0 * 157.5) / 1000.0).abs() < 1e-12);
+    assert!((casts[1].1 - (area * 2.0 + 100.0 * hole) / 1000.0).abs() < 1e-12);
+    let per = k.summary["flat"]["channels"][0]["liquid_per_channel_ml"]
+        .as_f64()
+        .unwrap();
+    assert!((per - channels().liquid_per_channel_ml()).abs() < 1e-15);
+    assert_eq!(k.summary["flat"]["markers"], 100);
+    assert_eq!(k.assembly.len(), 2);
+}
+
+/// Bad values of a flat design are refused by path, with nothing built; flat-only keys on a
+/// curved design and curved-only sections on a flat one too.
+#[test]
+fn bad_flat_designs_are_refused_by_path() {
+    let cases = [
+        (
+            "      width_mm: 1.5",
+            "      width_mm: 3.8",
+            "layers[1].channels.width_mm",
+        ),
+        (
+            "      height_mm: 1.5",
+            "      height_mm: 2.8",
+            "layers[1].channels.height_mm",
+        ),
+        (
+            "      pitch_mm: 6.5",
+            "      pitch_mm: 8.5",
+            "layers[0].marker_grid.pitch_mm",
+        ),
+        ("    thickness_mm: 3.0", "    thickness_mm: 2.5", "layers"),
+        (
+            "  corner_radius_mm: 5.0",
+            "  corner_radius_mm: 45.0",
+            "body.corner_radius_mm",
+        ),
+        (
+            "    material: ecoflex_00_10\n    process: cast\n    thickness_mm: 3.0",
+            "    material: pla_black\n    process: cast\n    thickness_mm: 3.0",
+            "layers[1].material",
+        ),
+        (
+            "layers:\n",
+            "core: {material: pmma, wall_thickness_mm: 1.0, length_mm: 5.0}\nlayers:\n",
+            "core",
+        ),
+    ];
+    for (from, to, path) in cases {
+        assert!(FLAT_YAML.contains(from), "{from}");
+        let d =
+            fabkit_designs::Design::from_yaml(&FLAT_YAML.replacen(from, to, 1), "x.yaml").unwrap();
+        match fabkit_designs::build_kit(&d, tol()) {
+            Err(fabkit_designs::DesignError::Params(e)) => {
+                assert!(e.0.iter().any(|x| x.path == path), "{path}: {e}")
+            }
+            other => panic!("{path}: {:?}", other.map(|k| k.parts.len())),
+        }
+    }
+    // channels on a curved skin
+    let mut d = fabkit_designs::library::load("uvdtact").unwrap();
+    d.layers[1].channels = Some(channels());
+    match fabkit_designs::build_kit(&d, ChordTolerance::new(0.05).unwrap()) {
+        Err(fabkit_designs::DesignError::Params(e)) => {
+            assert!(e.0.iter().any(|x| x.path == "layers[1].channels"), "{e}")
+        }
+        other => panic!("{:?}", other.map(|k| k.parts.len())),
+    }
+}

@@ -109,6 +109,7 @@ enum Meridian {
 impl Meridian {
     fn new(body: &BodyProfile, d: f64) -> Self {
         match *body {
+            BodyProfile::Flat { .. } => panic!("curved bodies only"),
             BodyProfile::SphericalCap {
                 base_diameter_mm,
                 height_mm,

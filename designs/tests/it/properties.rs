@@ -212,6 +212,7 @@ fn piece_distance(q: [f64; 2], piece: &Piece) -> f64 {
 /// surface at `d` continued `below` under the base plane, rim radius, pole z).
 fn offset_surface(body: &BodyProfile, d: f64, below: f64) -> (f64, Vec<Piece>, f64, f64) {
     match *body {
+        BodyProfile::Flat { .. } => panic!("curved bodies only"),
         BodyProfile::HemisphereOnCylinder {
             radius_mm,
             cylinder_length_mm,
