@@ -807,7 +807,10 @@ pub fn build_kit(
             solid: tray,
             params: serde_json::json!({
                 "layer": l.name, "layer_index": i, "outline": outline, "depth_mm": t,
-                "wall_mm": wall, "floor_mm": floor, "channels": l.channels, "marker_grid": l.marker_grid,
+                "z0_mm": l.z0_mm, "wall_mm": wall, "floor_mm": floor,
+                "channels": l.channels, "marker_grid": l.marker_grid,
+                // the layer's bottom face (sensor z0) on the tray's floor (print z = floor)
+                "T_print_sensor": [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, floor - l.z0_mm]],
             }),
             group: None,
         });

@@ -46,6 +46,7 @@ const TWINS: &[(&str, &str)] = &[
         include_str!("../python/twins/cq_shaft_body.py"),
     ),
     ("cq_casing.py", include_str!("../python/twins/cq_casing.py")),
+    ("cq_flat.py", include_str!("../python/twins/cq_flat.py")),
     (
         "cq_fixtures.py",
         include_str!("../python/twins/cq_fixtures.py"),

@@ -4,7 +4,7 @@ builder, then the recorded print placement."""
 from __future__ import annotations
 
 from . import cq_common as C
-from . import cq_casing, cq_fixtures, cq_housing, cq_layers, cq_molds, cq_shaft_body
+from . import cq_casing, cq_fixtures, cq_flat, cq_housing, cq_layers, cq_molds, cq_shaft_body
 from .families import family  # noqa: F401 (re-exported)
 
 
@@ -55,6 +55,8 @@ def _build_sensor(part: dict):
         s = cq_casing.gripper_base(p)
     elif role in ("shell_holder", "sensor_base", "camera_holder", "diffusion_ring"):
         s = cq_casing.fingertip_part(p, role)
+    elif role == "casting_tray":
+        s = cq_flat.casting_tray(p)
     elif role == "indenter":
         s = cq_fixtures.indenter(p)
     elif name == "pin_dome":

@@ -26,6 +26,8 @@ def family(part: dict) -> str:
     if role in ("casing", "gripper_base", "shell_holder", "sensor_base", "camera_holder",
                 "diffusion_ring"):
         return "casings and bases"
+    if role == "casting_tray":
+        return "casting trays (flat skins)"
     if role == "indenter":
         return "indenters"
     if name in ("pin_dome", "pin_dome_ring") or role == "calibration pin":

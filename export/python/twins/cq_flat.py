@@ -1,0 +1,56 @@
+"""CadQuery twins of flat skins' parts (designs/src/flat.rs): the open casting tray of a layer,
+with the ribs that form its channels' grooves or the holes that form its markers.
+
+Built from the parameters alone, in the sensor frame (x across the outline's width, y along its
+length, the layer's bottom face at z0_mm); the outline's corners are exact fillets.
+"""
+
+from __future__ import annotations
+
+import cadquery as cq
+
+from . import cq_common as C
+
+
+def outline_prism(o: dict, z0: float, z1: float) -> cq.Solid:
+    """The rounded rectangle `o` (width_mm, length_mm, corner_radius_mm) from z0 up to z1."""
+    w, l, r = float(o["width_mm"]), float(o["length_mm"]), float(o.get("corner_radius_mm", 0.0))
+    s = cq.Workplane("XY", origin=(0, 0, z0)).rect(w, l).extrude(z1 - z0)
+    if r > 0:
+        s = s.edges("|Z").fillet(r)
+    return s.val()
+
+
+def casting_tray(p: dict) -> cq.Solid:
+    """The tray of one layer: a block `wall_mm` round the outline and `floor_mm` under the
+    layer's bottom face (z0_mm), its cavity the outline `depth_mm` deep; ribs of the channels
+    from inside the near wall to the closed far end, or holes of the markers below the floor."""
+    o = p["outline"]
+    z0, t = float(p["z0_mm"]), float(p["depth_mm"])
+    wall, floor = float(p["wall_mm"]), float(p["floor_mm"])
+    hw, hl = float(o["width_mm"]) / 2.0, float(o["length_mm"]) / 2.0
+    tray = C.cut(C.box([-hw - wall, -hl - wall, z0 - floor], [hw + wall, hl + wall, z0 + t]),
+                 [outline_prism(o, z0, z0 + t + 1.0)])
+    ch = p.get("channels")
+    if ch:
+        n, pitch = int(ch["count"]), float(ch["pitch_mm"])
+        w, h, length = float(ch["width_mm"]), float(ch["height_mm"]), float(ch["length_mm"])
+        ribs = []
+        for i in range(n):
+            x = (i - (n - 1) / 2.0) * pitch
+            ribs.append(C.box([x - w / 2.0, -hl - wall / 2.0, z0 - 0.5],
+                              [x + w / 2.0, -hl + length, z0 + h]))
+        tray = C.fuse(tray, ribs)
+    g = p.get("marker_grid")
+    if g:
+        rows, cols, pitch = int(g["rows"]), int(g["columns"]), float(g["pitch_mm"])
+        f = g["feature"]
+        holes = []
+        for r in range(rows):
+            for c in range(cols):
+                x, y = (c - (cols - 1) / 2.0) * pitch, (r - (rows - 1) / 2.0) * pitch
+                holes.append(C.place_along(
+                    C.feature(float(f["diameter_mm"]), float(f["height_mm"]), 1.0),
+                    (x, y, z0), (0.0, 0.0, -1.0)))
+        tray = C.cut(tray, holes)
+    return tray
