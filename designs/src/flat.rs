@@ -603,6 +603,16 @@ pub fn validate(
     if design.layers.is_empty() {
         errs.push(ParamError::new("layers", "[]", "give at least one layer"));
     }
+    // the trays' walls and printers, the pours' waste (the curved skins' rules)
+    crate::molds::check_mold_params(design, &mut errs);
+    crate::stack::check_printers(design, &mut errs);
+    if !(0.0..=1.0).contains(&design.casting.waste_allowance) {
+        errs.push(ParamError::new(
+            "casting.waste_allowance",
+            design.casting.waste_allowance,
+            "must be in [0, 1]",
+        ));
+    }
     let mut names = std::collections::BTreeSet::new();
     for (i, l) in design.layers.iter().enumerate() {
         let p = |f: &str| format!("layers[{i}].{f}");
@@ -672,7 +682,7 @@ pub fn validate(
         }
     }
     let Some(outline) = design.body.flat_outline() else {
-        return Err(crate::ParamErrors(errs));
+        return Err(crate::ParamErrors(numbers.merge_negative(errs)));
     };
     let layers = if errs.is_empty() {
         flat_layers(design)
@@ -708,6 +718,7 @@ pub fn validate(
             }
         }
     }
+    let errs = numbers.merge_negative(errs);
     match layers {
         Some(l) if errs.is_empty() => Ok(l),
         _ => Err(crate::ParamErrors(errs)),
@@ -717,7 +728,11 @@ pub fn validate(
 /// About how many triangles a flat kit has at `tol` (both trays and the layers): the
 /// outline's prisms, 12 per channel groove or rib, and per marker (in its layer and its
 /// tray's hole) a revolved feature of `circle_segments` by a quarter as many profile points.
-fn estimated_triangles(outline: &FlatOutline, layers: &[FlatLayer], tol: ChordTolerance) -> f64 {
+pub fn estimated_triangles(
+    outline: &FlatOutline,
+    layers: &[FlatLayer],
+    tol: ChordTolerance,
+) -> f64 {
     let prism_tris = 4.0 * outline.polygon(tol).len() as f64;
     layers
         .iter()

@@ -13,6 +13,10 @@ pub const LIBRARY: &[(&str, &str)] = &[
         "tactip_dualmodal",
         include_str!("../library/tactip_dualmodal.yaml"),
     ),
+    (
+        "soter_channels",
+        include_str!("../library/soter_channels.yaml"),
+    ),
 ];
 
 /// The default design of `fabkit export` without a design argument.

@@ -733,7 +733,7 @@ fn resolve_core(
     }
 }
 
-fn check_printers(design: &Design, errs: &mut Vec<ParamError>) {
+pub(crate) fn check_printers(design: &Design, errs: &mut Vec<ParamError>) {
     for (name, p) in [
         ("fdm", &design.printers.fdm),
         ("sla", &design.printers.sla),

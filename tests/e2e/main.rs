@@ -9,6 +9,7 @@ mod authors_cad;
 mod calibrate_cli;
 mod calibrate_opencv;
 mod cli_errors;
+mod export_flat;
 mod export_markers;
 mod export_rtac0;
 mod fixtures_cli;

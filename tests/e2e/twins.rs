@@ -1,5 +1,5 @@
 //! Cross-verification twins: every part of every library design and of its
-//! fixtures, against the manifold3d twin (fast tier, every test run) and the exact CadQuery
+//! fixtures (curved skins), against the manifold3d twin (fast tier, every test run) and the exact CadQuery
 //! twin (full tier: when `FABKIT_CADQUERY_PYTHON` is set, as `.ci/run` does after
 //! `scripts/setup-cadquery`), plus `fabkit export --format step` read back by CadQuery.
 //!
@@ -34,6 +34,8 @@ const CASES: &[(&str, &[&str])] = &[
         ],
     ),
     ("tactip_dualmodal", &["export", "tactip_dualmodal"]),
+    // the flat skin's casting trays (Soter et al. Sec. II-A)
+    ("soter_channels", &["export", "soter_channels"]),
     (
         "rtac0_fixtures",
         &[

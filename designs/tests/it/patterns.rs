@@ -566,7 +566,11 @@ fn printable_with_and_validation_agree_on_every_library_design() {
     let tol = ChordTolerance::default();
     let materials = MaterialsTable::embedded().unwrap();
     let mut checked = 0;
-    for d in crate::common::library_designs_and_presets() {
+    // curved designs: a flat skin's marker grid has no pattern rules
+    for d in crate::common::library_designs_and_presets()
+        .into_iter()
+        .filter(|d| d.body.flat_outline().is_none())
+    {
         let stack = validate(&d, &materials, tol).unwrap();
         for l in &stack.layers {
             for j in 0..d.layers[l.index].markers.len() {
