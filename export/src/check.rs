@@ -68,23 +68,23 @@ pub(crate) fn check_names(kit: &Kit) -> Result<(), ExportError> {
             design: kit.design.clone(),
         });
     }
+    // printed and machined parts share the file stems (parts/, machined/, step/)
     let mut seen = BTreeSet::new();
-    for part in &kit.parts {
-        let ok = !part.name.is_empty()
-            && part
-                .name
+    let mut unique = |name: &str| {
+        let ok = !name.is_empty()
+            && name
                 .chars()
                 .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_');
         if !ok {
-            return Err(ExportError::InvalidPartName {
-                name: part.name.clone(),
-            });
+            return Err(ExportError::InvalidPartName { name: name.into() });
         }
-        if !seen.insert(part.name.as_str()) {
-            return Err(ExportError::DuplicatePartName {
-                name: part.name.clone(),
-            });
+        if !seen.insert(name.to_string()) {
+            return Err(ExportError::DuplicatePartName { name: name.into() });
         }
+        Ok(())
+    };
+    for part in &kit.parts {
+        unique(&part.name)?;
         if let Some(g) = &part.group {
             if g.is_empty() || g.trim() != g || g.chars().any(char::is_control) {
                 return Err(ExportError::InvalidGroupName {
@@ -95,20 +95,7 @@ pub(crate) fn check_names(kit: &Kit) -> Result<(), ExportError> {
         }
     }
     for m in &kit.machined_parts {
-        let ok = !m.name.is_empty()
-            && m.name
-                .chars()
-                .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_');
-        if !ok {
-            return Err(ExportError::InvalidPartName {
-                name: m.name.clone(),
-            });
-        }
-        if !seen.insert(m.name.as_str()) {
-            return Err(ExportError::DuplicatePartName {
-                name: m.name.clone(),
-            });
-        }
+        unique(&m.name)?;
     }
     Ok(())
 }

@@ -437,21 +437,7 @@ fn render(
                 part: part.name.clone(),
                 source: TopologyError::Empty,
             })?;
-        let (file, sha256) = if opts.formats.stl {
-            let header = stl::header(
-                &opts.fabkit_version,
-                &kit.design,
-                &part.name,
-                &opts.design_sha256,
-            );
-            let bytes = stl::encode(&part.name, mesh, &header)?;
-            let rel = format!("{PARTS_DIR}/{}.stl", part.name);
-            let sha = sha256_hex(&bytes);
-            files.push((rel.clone(), bytes));
-            (Some(rel), Some(sha))
-        } else {
-            (None, None)
-        };
+        let (file, sha256) = stl_file(kit, opts, PARTS_DIR, &part.name, mesh, &mut files)?;
         parts.push(ManifestPart {
             name: part.name.clone(),
             file,
@@ -575,21 +561,7 @@ fn render(
             })?;
         let drawing = format!("{MACHINED_DIR}/{}.svg", m.name);
         let drawing_bytes = two_d::drawing_svg(&m.drawing).into_bytes();
-        let (file, sha256) = if opts.formats.stl {
-            let header = stl::header(
-                &opts.fabkit_version,
-                &kit.design,
-                &m.name,
-                &opts.design_sha256,
-            );
-            let bytes = stl::encode(&m.name, &mesh, &header)?;
-            let rel = format!("{MACHINED_DIR}/{}.stl", m.name);
-            let sha = sha256_hex(&bytes);
-            files.push((rel.clone(), bytes));
-            (Some(rel), Some(sha))
-        } else {
-            (None, None)
-        };
+        let (file, sha256) = stl_file(kit, opts, MACHINED_DIR, &m.name, &mesh, &mut files)?;
         machined_parts.push(ManifestMachinedPart {
             name: m.name.clone(),
             description: m.description.clone(),
@@ -757,6 +729,27 @@ fn render(
         sheet::render(&manifest).into_bytes(),
     ));
     Ok(Rendered { files, manifest })
+}
+
+/// With STL on, `<dir>/<name>.stl` of `mesh` (provenance in its header) pushed onto `files`,
+/// and its relative path and sha256; `(None, None)` otherwise.
+fn stl_file(
+    kit: &Kit,
+    opts: &ExportOptions,
+    dir: &str,
+    name: &str,
+    mesh: &Mesh,
+    files: &mut Vec<(String, Vec<u8>)>,
+) -> Result<(Option<String>, Option<String>), ExportError> {
+    if !opts.formats.stl {
+        return Ok((None, None));
+    }
+    let header = stl::header(&opts.fabkit_version, &kit.design, name, &opts.design_sha256);
+    let bytes = stl::encode(name, mesh, &header)?;
+    let rel = format!("{dir}/{name}.stl");
+    let sha = sha256_hex(&bytes);
+    files.push((rel.clone(), bytes));
+    Ok((Some(rel), Some(sha)))
 }
 
 fn join_rel(base: &Path, rel: &str) -> PathBuf {
