@@ -443,9 +443,16 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
     let (_, camera_sha) = read_with_hash(&args.camera)?;
     let (t_cam_sensor, extrinsics_sha) = read_extrinsics(&args.extrinsics)?;
     let fixtures = read_fixtures(&args.fixtures, &design.name)?;
+    if design.body.flat_outline().is_some() {
+        return Err(format!(
+            "body.profile = {}: fabkit groundtruth renders the protrusion semi-domes of curved skins; flat skins have no protrusion fixtures yet",
+            design.body.kind()
+        )
+        .into());
+    }
     let surface = ReferenceSurface::of(&design.body).ok_or_else(|| {
         format!(
-            "body.profile = {}: ground truth is rendered for curved skins only (spherical_cap, hemisphere_on_cylinder, half_ellipsoid); flat skins are not supported by fabkit groundtruth yet",
+            "body.profile = {}: no reference surface for this profile",
             design.body.kind()
         )
     })?;

@@ -20,6 +20,15 @@ pub enum ReferenceSurface {
     HemisphereOnCylinder { radius_mm: f64, base_z_mm: f64 },
     /// Ellipsoid `(x^2 + y^2) / a^2 + z^2 / c^2 = 1` for z >= 0 (UVDtact).
     HalfEllipsoid { a_mm: f64, c_mm: f64 },
+    /// A flat skin (Soter et al. Sec. II-A): the plane `z = top_z_mm` over a rounded
+    /// rectangle (half sizes along x and y, corner radius) centred on the z axis; its side
+    /// walls continue below the base plane z = 0 (docs/conventions.md, flat skins).
+    Flat {
+        half_width_mm: f64,
+        half_length_mm: f64,
+        corner_radius_mm: f64,
+        top_z_mm: f64,
+    },
 }
 
 /// A ray's exit from the sensor body: distance along the ray (mm), unit outward normal (sensor
@@ -48,8 +57,8 @@ fn far_root(a: f64, b: f64, c: f64) -> Option<f64> {
 }
 
 impl ReferenceSurface {
-    /// The outer skin surface (offset 0) of `body`; `None` for a flat body (its plane is not
-    /// a reference surface here yet).
+    /// The outer skin surface (offset 0) of `body`. Always `Some` for the profiles there are;
+    /// `None` is kept for a profile without a reference surface.
     pub fn of(body: &BodyProfile) -> Option<ReferenceSurface> {
         Some(match *body {
             BodyProfile::SphericalCap { .. } => ReferenceSurface::Cap {
@@ -69,7 +78,17 @@ impl ReferenceSurface {
                 a_mm: diameter_mm / 2.0,
                 c_mm: height_mm,
             },
-            BodyProfile::Flat { .. } => return None,
+            BodyProfile::Flat {
+                width_mm,
+                length_mm,
+                corner_radius_mm,
+                thickness_mm,
+            } => ReferenceSurface::Flat {
+                half_width_mm: width_mm / 2.0,
+                half_length_mm: length_mm / 2.0,
+                corner_radius_mm,
+                top_z_mm: thickness_mm,
+            },
         })
     }
 
@@ -78,7 +97,7 @@ impl ReferenceSurface {
         match *self {
             ReferenceSurface::Cap { base_z_mm, .. }
             | ReferenceSurface::HemisphereOnCylinder { base_z_mm, .. } => base_z_mm,
-            ReferenceSurface::HalfEllipsoid { .. } => 0.0,
+            ReferenceSurface::HalfEllipsoid { .. } | ReferenceSurface::Flat { .. } => 0.0,
         }
     }
 
@@ -93,12 +112,43 @@ impl ReferenceSurface {
                 .sqrt(),
             ReferenceSurface::HemisphereOnCylinder { radius_mm, .. } => radius_mm,
             ReferenceSurface::HalfEllipsoid { a_mm, .. } => a_mm,
+            // the largest circle inside the outline
+            ReferenceSurface::Flat {
+                half_width_mm,
+                half_length_mm,
+                ..
+            } => half_width_mm.min(half_length_mm),
+        }
+    }
+
+    /// A flat skin's outline: distance from (x, y) to its edge (negative outside) and the
+    /// outward unit normal of the nearest edge point, in the xy plane.
+    fn flat_inset(hw: f64, hl: f64, r: f64, x: f64, y: f64) -> (f64, [f64; 2]) {
+        let (dx, dy) = (x.abs() - (hw - r), y.abs() - (hl - r));
+        if dx > 0.0 && dy > 0.0 {
+            let l = dx.hypot(dy);
+            (r - l, [dx / l * x.signum(), dy / l * y.signum()])
+        } else if hw - x.abs() <= hl - y.abs() {
+            (hw - x.abs(), [x.signum(), 0.0])
+        } else {
+            (hl - y.abs(), [0.0, y.signum()])
         }
     }
 
     /// Whether `p` (sensor frame, mm) is strictly inside the sensor body (see the module
     /// documentation), with a margin of `margin_mm`.
     pub fn contains(&self, p: [f64; 3], margin_mm: f64) -> bool {
+        if let ReferenceSurface::Flat {
+            half_width_mm,
+            half_length_mm,
+            corner_radius_mm,
+            top_z_mm,
+        } = *self
+        {
+            let (inset, _) =
+                Self::flat_inset(half_width_mm, half_length_mm, corner_radius_mm, p[0], p[1]);
+            return inset > margin_mm && p[2] < top_z_mm - margin_mm;
+        }
         let rho = p[0].hypot(p[1]);
         let zb = self.base_z_mm();
         if p[2] < zb {
@@ -117,6 +167,7 @@ impl ReferenceSurface {
                 let (a, c) = (a_mm - margin_mm, c_mm - margin_mm);
                 a > 0.0 && c > 0.0 && (rho / a).powi(2) + (p[2] / c).powi(2) < 1.0
             }
+            ReferenceSurface::Flat { .. } => unreachable!("handled above"),
         }
     }
 
@@ -216,6 +267,59 @@ impl ReferenceSurface {
                 }
                 below(a_mm)
             }
+            ReferenceSurface::Flat {
+                half_width_mm: hw,
+                half_length_mm: hl,
+                corner_radius_mm: r,
+                top_z_mm,
+            } => {
+                // the contact face
+                if d[2] > 0.0 {
+                    let t = (top_z_mm - o[2]) / d[2];
+                    let p = at(t);
+                    if Self::flat_inset(hw, hl, r, p[0], p[1]).0 >= 0.0 {
+                        return Some(Exit {
+                            t_mm: t,
+                            normal: [0.0, 0.0, 1.0],
+                            on_skin: true,
+                        });
+                    }
+                }
+                // the side walls: the far end of the ray's chord through the outline's prism
+                let (ax, ay) = (d[0], d[1]);
+                if !(ax * ax + ay * ay > 0.0) {
+                    return Some(Exit {
+                        t_mm: f64::INFINITY,
+                        normal: [0.0, 0.0, -1.0],
+                        on_skin: false,
+                    });
+                }
+                let mut t = f64::INFINITY;
+                for (dd, oo, h) in [(ax, o[0], hw), (ay, o[1], hl)] {
+                    if dd != 0.0 {
+                        t = t.min((h * dd.signum() - oo) / dd);
+                    }
+                }
+                let p = at(t);
+                let (cx, cy) = (hw - r, hl - r);
+                let t = if r > 0.0 && p[0].abs() > cx && p[1].abs() > cy {
+                    // past a straight edge's end: the corner's circle (the far root)
+                    let (ccx, ccy) = (cx * p[0].signum(), cy * p[1].signum());
+                    let a = ax * ax + ay * ay;
+                    let b = (o[0] - ccx) * ax + (o[1] - ccy) * ay;
+                    let c = (o[0] - ccx).powi(2) + (o[1] - ccy).powi(2) - r * r;
+                    far_root(a, b, c).unwrap_or(t)
+                } else {
+                    t
+                };
+                let p = at(t);
+                let (_, n) = Self::flat_inset(hw, hl, r, p[0], p[1]);
+                Some(Exit {
+                    t_mm: t,
+                    normal: [n[0], n[1], 0.0],
+                    on_skin: p[2] >= 0.0,
+                })
+            }
         }
     }
 }
@@ -266,7 +370,7 @@ impl ReferenceSurface {
                 radius_mm,
                 base_z_mm,
             } => (radius_mm, base_z_mm, radius_mm, 0.0),
-            ReferenceSurface::HalfEllipsoid { .. } => {
+            ReferenceSurface::HalfEllipsoid { .. } | ReferenceSurface::Flat { .. } => {
                 for p in 0..dirs.len() {
                     slow(p, t_exit_mm, t_skin_mm, &mut normal);
                 }
@@ -351,6 +455,32 @@ mod tests {
         assert!((dot(p, p).sqrt() - 15.0).abs() < 1e-12 && p[2] > 0.0);
     }
 
+    /// A flat skin 80 x 80 mm with 5 mm corners, its face 5 mm up: straight up through the
+    /// face, sideways through a wall below the base plane (a miss), along the diagonal through
+    /// the corner's arc (35 sqrt 2 + 5 mm out, normal along the diagonal), and up at 45 deg
+    /// through the face.
+    #[test]
+    fn flat_rays_leave_through_face_walls_and_corner_arcs() {
+        let s = ReferenceSurface::Flat {
+            half_width_mm: 40.0,
+            half_length_mm: 40.0,
+            corner_radius_mm: 5.0,
+            top_z_mm: 5.0,
+        };
+        let e = s.exit([0.0, 0.0, -10.0], [0.0, 0.0, 1.0]).unwrap();
+        assert!((e.t_mm - 15.0).abs() < 1e-12 && e.on_skin && e.normal == [0.0, 0.0, 1.0]);
+        let e = s.exit([0.0, 0.0, -10.0], [1.0, 0.0, 0.0]).unwrap();
+        assert!((e.t_mm - 40.0).abs() < 1e-12 && !e.on_skin && e.normal == [1.0, 0.0, 0.0]);
+        let q = std::f64::consts::FRAC_1_SQRT_2;
+        let e = s.exit([0.0, 0.0, 2.0], [q, q, 0.0]).unwrap();
+        assert!((e.t_mm - (35.0 * 2f64.sqrt() + 5.0)).abs() < 1e-9, "{e:?}");
+        assert!(e.on_skin && (e.normal[0] - q).abs() < 1e-12 && (e.normal[1] - q).abs() < 1e-12);
+        let e = s.exit([0.0, 0.0, 0.0], [q, 0.0, q]).unwrap();
+        assert!((e.t_mm - 5.0 * 2f64.sqrt()).abs() < 1e-12 && e.on_skin);
+        assert!(s.contains([39.0, 0.0, -50.0], 0.5) && !s.contains([39.0, 39.0, 0.0], 0.0));
+        assert!(!s.contains([0.0, 0.0, 5.0], 0.0));
+    }
+
     /// The branch-free pass agrees with the per-ray exit for every profile, camera well inside
     /// and near the surface, over directions in all of space.
     #[test]
@@ -367,6 +497,12 @@ mod tests {
             ReferenceSurface::HalfEllipsoid {
                 a_mm: 9.0,
                 c_mm: 24.0,
+            },
+            ReferenceSurface::Flat {
+                half_width_mm: 40.0,
+                half_length_mm: 30.0,
+                corner_radius_mm: 5.0,
+                top_z_mm: 5.0,
             },
         ];
         let dirs: Vec<[f64; 3]> = (0..2000)
