@@ -106,7 +106,7 @@ pub fn validate(
         return Err(ParamErrors(vec![ParamError::new(
             "body.profile",
             "flat",
-            "fixtures, ground truth and sweeps handle curved skins only (spherical_cap, hemisphere_on_cylinder, half_ellipsoid) for now; a flat skin is exported and validated (fabkit export, fabkit validate)",
+            "this step handles curved skins only (spherical_cap, hemisphere_on_cylinder, half_ellipsoid) for now, as do sweeps and ground truth; a flat skin is exported, validated and given its grid plate (fabkit export, validate, fixtures)",
         )]));
     }
     for (path, value, rule) in design.body.violations() {

@@ -162,23 +162,35 @@ pub fn run(args: FixturesArgs) -> Result<(), Box<dyn Error>> {
         out.display(),
         t0.elapsed().as_secs_f64()
     );
-    let d = &set.pin_dome;
-    out!(
-        "  pin dome: {} holes in {} captures; pins {:.3} mm (head to tip), seat {:?}, indentation {:.3} mm",
-        d.table.len(),
-        d.capture_plan.len(),
-        d.pin_length_mm,
-        d.seat,
-        d.table.first().map(|r| r.indentation_depth_mm).unwrap_or(0.0)
-    );
-    for n in &d.notes {
-        out!("  note: {n}");
+    if let Some(d) = &set.pin_dome {
+        out!(
+            "  pin dome: {} holes in {} captures; pins {:.3} mm (head to tip), seat {:?}, indentation {:.3} mm",
+            d.table.len(),
+            d.capture_plan.len(),
+            d.pin_length_mm,
+            d.seat,
+            d.table.first().map(|r| r.indentation_depth_mm).unwrap_or(0.0)
+        );
+        for n in &d.notes {
+            out!("  note: {n}");
+        }
     }
-    let n = set.semidomes.halves.len();
-    out!(
-        "  semi-domes: {n} patterns + the empty half -> {} stitched pairs",
-        n * n
-    );
+    if let Some(s) = &set.semidomes {
+        let n = s.halves.len();
+        out!(
+            "  semi-domes: {n} patterns + the empty half -> {} stitched pairs",
+            n * n
+        );
+    }
+    if let Some(g) = &set.grid_plate {
+        out!(
+            "  grid plate: {} holes in {} captures; pins {:.3} mm (head to tip), indentation {:.3} mm",
+            g.table.len(),
+            g.capture_plan.len(),
+            g.pin_length_mm,
+            g.table.first().map(|r| r.indentation_depth_mm).unwrap_or(0.0)
+        );
+    }
     if params.indenters.is_none() {
         let names: Vec<String> = params
             .indenters_for(&loaded.design)

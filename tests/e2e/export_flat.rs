@@ -1,7 +1,8 @@
-//! End-to-end: `fabkit export soter_channels`, the flat skin of Soter et al. (Sec. II-A): its
-//! two casting trays read back by the independent oracle and sliced by PrusaSlicer, its pours
+//! End-to-end: `fabkit export soter_channels` and `fabkit fixtures soter_channels`, the flat
+//! skin of Soter et al. (Sec. II-A): its two casting trays read back by the independent oracle and sliced by PrusaSlicer, its pours
 //! against the layers' exact volumes, the filling procedure on the sheet, and bad channel and
-//! grid values refused by path with nothing written.
+//! grid values refused by path with nothing written; its indenter grid plate, pin, point table
+//! and capture plan.
 
 use crate::common::*;
 use serde_json::Value;
@@ -111,4 +112,60 @@ fn bad_flat_values_write_nothing() {
         assert!(!err.contains("panicked"), "{err}");
         assert!(!tmp.path().join("out").exists());
     }
+}
+
+/// `fabkit fixtures soter_channels`: the indenter grid plate and its pin, closed and
+/// printable, and the point table (49 holes on the 10 mm grid, their contact points on the
+/// face 5 mm up and the tips 1 mm under it) with the capture plan covering every pin once,
+/// read back as CSV by pandas.
+#[test]
+fn soter_channels_grid_plate() {
+    let tmp = tempfile::tempdir().unwrap();
+    let o = run(
+        tmp.path(),
+        &["fixtures", "soter_channels", "--out", "fx"],
+        &[],
+    );
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(
+        text(&o.stdout).contains("grid plate: 49 holes in 13 captures"),
+        "{}",
+        text(&o.stdout)
+    );
+    let dir = tmp.path().join("fx");
+    oracle_check(&dir);
+    printcheck_all(&[dir.join("parts/grid_plate.stl"), dir.join("parts/pin.stl")]);
+    let Some(py) = oracle_python() else {
+        return missing("the oracle python (pandas)");
+    };
+    let script = r##"
+import sys, json
+import pandas as pd
+t = pd.read_csv(sys.argv[1] + "/points/point_table.csv", comment="#")
+c = pd.read_csv(sys.argv[1] + "/points/capture_plan.csv")
+print(json.dumps({"n": len(t), "contact_z": sorted(set(t.contact_z_mm)), "tip_z": sorted(set(t.tip_z_mm)),
+    "xs": sorted(set(t.contact_x_mm)), "ids": sorted(c.id.tolist()), "captures": int(c.capture.max())}))
+"##;
+    let o = std::process::Command::new(py)
+        .arg("-c")
+        .arg(script)
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let v: Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["n"], 49, "{v}");
+    assert_eq!(v["contact_z"], serde_json::json!([5.0]), "{v}");
+    assert_eq!(v["tip_z"], serde_json::json!([4.0]), "{v}");
+    assert_eq!(
+        v["xs"],
+        serde_json::json!([-30.0, -20.0, -10.0, 0.0, 10.0, 20.0, 30.0]),
+        "{v}"
+    );
+    assert_eq!(
+        v["ids"],
+        serde_json::json!((1..=49).collect::<Vec<_>>()),
+        "{v}"
+    );
+    assert_eq!(v["captures"], 13, "{v}");
 }

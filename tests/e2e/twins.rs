@@ -1,5 +1,5 @@
 //! Cross-verification twins: every part of every library design and of its
-//! fixtures (curved skins), against the manifold3d twin (fast tier, every test run) and the exact CadQuery
+//! fixtures, against the manifold3d twin (fast tier, every test run) and the exact CadQuery
 //! twin (full tier: when `FABKIT_CADQUERY_PYTHON` is set, as `.ci/run` does after
 //! `scripts/setup-cadquery`), plus `fabkit export --format step` read back by CadQuery.
 //!
@@ -54,6 +54,8 @@ const CASES: &[(&str, &[&str])] = &[
         "tactip_dualmodal_fixtures",
         &["fixtures", "tactip_dualmodal"],
     ),
+    // the flat skin's indenter grid plate and pin
+    ("soter_channels_fixtures", &["fixtures", "soter_channels"]),
 ];
 
 /// Every case exported under `dir` with its CSG tree beside it (`<case>.csg.json`), two

@@ -210,3 +210,24 @@ def indenter(params: dict):
     else:
         cutter = C.cylinder_z(mount["diameter_mm"] / 2.0, z_end - mount["depth_mm"], z_end + 1.0)
     return C.cut(s, [cutter])
+
+
+def grid_plate(params: dict):
+    """The indenter grid plate of a flat skin (fixtures/src/gridplate.rs), sensor frame: the
+    outline grown by the clearance and the wall from the base plane to the plate's top, less
+    the outline grown by the clearance up to the plate's underside, less a bore per hole."""
+    from . import cq_flat
+    g, o = params["grid_plate"], params["outline"]
+    face, top = float(params["face_z_mm"]), float(params["top_z_mm"])
+    under = face + float(g["standoff_mm"])
+
+    def grown(d):
+        return {"width_mm": o["width_mm"] + 2 * d, "length_mm": o["length_mm"] + 2 * d,
+                "corner_radius_mm": o.get("corner_radius_mm", 0.0) + d}
+
+    c, w = float(g["skin_clearance_mm"]), float(g["wall_mm"])
+    r = (float(g["pin"]["shaft_diameter_mm"]) + float(g["hole_clearance_mm"])) / 2.0
+    bores = [C.cylinder_z(r, under - 1.0, top + 1.0, x, y)
+             for x, y in params["holes_xy_mm"]]
+    return C.cut(cq_flat.outline_prism(grown(c + w), 0.0, top),
+                 [cq_flat.outline_prism(grown(c), -1.0, under)] + bores)

@@ -59,6 +59,8 @@ def _build_sensor(part: dict):
         s = cq_flat.casting_tray(p)
     elif role == "indenter":
         s = cq_fixtures.indenter(p)
+    elif name == "grid_plate":
+        s = cq_fixtures.grid_plate(p)
     elif name == "pin_dome":
         s = cq_fixtures.pin_dome(p)
     elif name == "pin_dome_ring":

@@ -30,6 +30,8 @@ def family(part: dict) -> str:
         return "casting trays (flat skins)"
     if role == "indenter":
         return "indenters"
+    if name == "grid_plate":
+        return "indenter grid plates (flat skins)"
     if name in ("pin_dome", "pin_dome_ring") or role == "calibration pin":
         return "pin-hole domes and pins"
     if name.startswith("semidome"):
