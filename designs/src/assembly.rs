@@ -245,11 +245,12 @@ pub fn members(
             "core_envelope",
             revolve(&pl, tol).and_then(|m| Solid::from_mesh(&m)),
         )?;
-        let exact = crate::parts::core_shell::exact_shape(design, c, spec).unwrap_or(
-            ExactShape::Revolved {
-                profile_rz_mm: pl.points.clone(),
-            },
-        );
+        // the profile polygon revolved (planes, cones, cylinders): OCCT writes it with the same
+        // bytes every run; the exact shell (spheres, B-splines) goes to a machined core's own
+        // STEP file
+        let exact = ExactShape::Revolved {
+            profile_rz_mm: pl.points.clone(),
+        };
         out.push(Member {
             nested_by_stack: true,
             ..bought(

@@ -127,7 +127,7 @@ fn rtac0_members_are_in_the_sensor_frame_with_their_volumes() {
 /// Each non-printed member carries the exact shape STEP export builds it from, and that shape
 /// is the member: envelopes' analytic volumes and boxes match the solids within the chord
 /// bound, revolved profiles are closed (r, z) polygons with r >= 0 spanning the solid's z
-/// range, the core's shell holds the tube's analytic volume, layers carry their offsets; printed members carry none (their parts' params do).
+/// range, layers carry their offsets; printed members carry none (their parts' params do).
 #[test]
 fn rtac0_members_carry_their_exact_shapes() {
     for m in &rtac0().assembly {
@@ -173,16 +173,6 @@ fn rtac0_members_carry_their_exact_shapes() {
                     v += (p[0] * q[1] - q[0] * p[1]) * (p[0] + q[0]);
                 }
                 (PI * v / 3.0).abs()
-            }
-            (_, Some(ExactShape::CoreShell { params })) => {
-                // the glass tube: a hemispherical shell on a cylinder, radii R + d and less the wall
-                let f = |k: &str| params[k].as_f64().unwrap();
-                let b = &params["body"];
-                assert_eq!(b["profile"], "hemisphere_on_cylinder");
-                let ro = b["radius_mm"].as_f64().unwrap() + f("outer_offset_mm");
-                let ri = ro - f("wall_thickness_mm");
-                let len = b["cylinder_length_mm"].as_f64().unwrap() + f("below_base_mm");
-                2.0 / 3.0 * PI * (ro.powi(3) - ri.powi(3)) + PI * (ro * ro - ri * ri) * len
             }
             (_, Some(ExactShape::Layer { params })) => {
                 assert_eq!(params["layer"], m.name.as_str());

@@ -156,8 +156,6 @@ def core_shell(params: dict):
     BodyProfile::shell_inner_surface: on a half ellipsoid, the half ellipsoid of the outer
     surface's rim radius and pole height less `wall_thickness_mm` (exact points, B-spline fit);
     on spherical profiles, the concentric sphere."""
-    import cadquery as cq
-
     body = C.Body(params["body"])
     d = float(params["outer_offset_mm"])
     w = float(params["wall_thickness_mm"])
@@ -173,13 +171,6 @@ def core_shell(params: dict):
                               "height_mm": height_in}), 0.0
     else:
         inner, d_in = body, d - w
-        rim_in = inner.rim_radius(d_in)
-    outer_edges = body.curve_edges(d)
-    inner_edges = inner.curve_edges(d_in)
-    corners = [(rim_out, zb), (rim_out, zb - below), (rim_in, zb - below), (rim_in, zb)]
-    lines = [cq.Edge.makeLine(C.vec(*a), C.vec(*b)) for a, b in zip(corners, corners[1:])
-             if math.dist(a, b) > 1e-12]
-    axis = cq.Edge.makeLine(C.vec(0.0, inner.pole_z(d_in)), C.vec(0.0, body.pole_z(d)))
-    wire = cq.Wire.assembleEdges(outer_edges + lines + list(reversed(inner_edges)) + [axis])
-    face = cq.Face.makeFromWires(wire)
-    return cq.Solid.revolve(face, 360.0, cq.Vector(0, 0, 0), cq.Vector(0, 0, 1))
+    # the solid under the outer surface less the solid under the inner one (run 1 mm past the
+    # open end): booleans, as the other twins, so that the same parameters give the same B-rep
+    return C.cut(enclosed(body, d, below), [enclosed(inner, d_in, below + 1.0)])
