@@ -17,13 +17,15 @@ pub struct FixturesArgs {
     /// previous export; refused if it holds anything else.
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Fixture parameters (YAML: pin_dome, semidomes, indenters); defaults where absent.
+    /// Fixture parameters (YAML: pin_dome, semidomes, grid_plate, semiplates, indenters);
+    /// defaults where absent.
     #[arg(long)]
     params: Option<PathBuf>,
     /// Replace the pin dome with an embedded preset (rtac0: the published R-Tac0 fixture).
     #[arg(long)]
     pins_preset: Option<String>,
-    /// Generate N protrusion semi-dome patterns (in addition to those in --params).
+    /// Generate N protrusion semi-dome patterns (semi-plate patterns on a flat skin), in
+    /// addition to those in --params.
     #[arg(long)]
     semidomes: Option<u32>,
     /// Seed of the pattern generator.
@@ -68,11 +70,14 @@ pub fn run(args: FixturesArgs) -> Result<(), Box<dyn Error>> {
     if let Some(name) = &args.pins_preset {
         apply_pin_preset(&mut params, name)?;
     }
+    // curved skins: semi-domes; flat skins: semi-plates
     if let Some(n) = args.semidomes {
         params.semidomes.generate = n;
+        params.semiplates.generate = n;
     }
     if let Some(s) = args.seed {
         params.semidomes.seed = s;
+        params.semiplates.seed = s;
     }
     let out = args
         .out
@@ -189,6 +194,13 @@ pub fn run(args: FixturesArgs) -> Result<(), Box<dyn Error>> {
             g.capture_plan.len(),
             g.pin_length_mm,
             g.table.first().map(|r| r.indentation_depth_mm).unwrap_or(0.0)
+        );
+    }
+    if let Some(s) = &set.semiplates {
+        let n = s.halves.len();
+        out!(
+            "  semi-plates: {n} patterns + the empty half -> {} stitched pairs",
+            n * n
         );
     }
     if params.indenters.is_none() {

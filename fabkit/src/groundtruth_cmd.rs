@@ -443,25 +443,36 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
     let (_, camera_sha) = read_with_hash(&args.camera)?;
     let (t_cam_sensor, extrinsics_sha) = read_extrinsics(&args.extrinsics)?;
     let fixtures = read_fixtures(&args.fixtures, &design.name)?;
-    if design.body.flat_outline().is_some() {
-        return Err(format!(
-            "body.profile = {}: fabkit groundtruth renders the protrusion semi-domes of curved skins; flat skins have no protrusion fixtures yet",
-            design.body.kind()
-        )
-        .into());
-    }
     let surface = ReferenceSurface::of(&design.body).ok_or_else(|| {
         format!(
             "body.profile = {}: no reference surface for this profile",
             design.body.kind()
         )
     })?;
+    let (fixture_kind, surface_text) = if design.body.flat_outline().is_some() {
+        ("semi-plate", "the flat skin's contact face over its outline (its edges continued below the base plane bound the body); indented: the skin minus the protrusion solids")
+    } else {
+        ("semi-dome", "outer skin surface (body profile at offset 0) from the pole to the base plane; indented: the skin minus the protrusion solids")
+    };
     let rays = PixelRays::new(&camera, &t_cam_sensor);
     let c = rays.origin_mm;
     if !surface.contains(c, 0.0) {
+        let body = match design.body.flat_outline() {
+            Some(o) => format!(
+                "the {} x {} mm skin's contact face z = {} mm and its edges, continued below the base plane",
+                o.width_mm,
+                o.length_mm,
+                design.body.pole_z_mm(0.0)
+            ),
+            None => format!(
+                "skin surface, continued below the base plane z = {} mm at radius {:.3} mm",
+                surface.base_z_mm(),
+                surface.rim_radius_mm()
+            ),
+        };
         return Err(format!(
-            "{}: the camera centre [{:.3}, {:.3}, {:.3}] mm (sensor frame) is outside the sensor body of {} (skin surface, continued below the base plane z = {} mm at radius {:.3} mm): the camera must look at the skin from inside (hint: check that T_cam_sensor maps sensor-frame points into the camera frame)",
-            args.extrinsics.display(), c[0], c[1], c[2], design.name, surface.base_z_mm(), surface.rim_radius_mm()
+            "{}: the camera centre [{:.3}, {:.3}, {:.3}] mm (sensor frame) is outside the sensor body of {} ({body}): the camera must look at the skin from inside (hint: check that T_cam_sensor maps sensor-frame points into the camera frame)",
+            args.extrinsics.display(), c[0], c[1], c[2], design.name
         )
         .into());
     }
@@ -516,7 +527,7 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
         .join(" or ");
     if bound > args.max_output_bytes && !args.yes {
         return Err(format!(
-            "--out {}: the ground truth would take up to {} ({bound} bytes, {n_files} files), over --max-output-bytes {} ({}): refusing before rendering (hint: give --yes to write it, use {alternatives}, or build fewer semi-dome patterns)",
+            "--out {}: the ground truth would take up to {} ({bound} bytes, {n_files} files), over --max-output-bytes {} ({}): refusing before rendering (hint: give --yes to write it, use {alternatives}, or build fewer protrusion patterns)",
             args.out.display(),
             shown_bytes(bound),
             args.max_output_bytes,
@@ -658,7 +669,7 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
     let manifest = json!({
         "fabkit_version": env!("CARGO_PKG_VERSION"),
         "command_line": std::env::args().collect::<Vec<_>>(),
-        "description": "Ground-truth depth of the sensor surface, reference (undeformed) and indented by each protrusion semi-dome configuration (R-Tac0 Sec. IV-B, Fig. 6, Eq. (2)-(3)): complete depth = reference + delta. Exact per-pixel rays of the camera model; surfaces in closed form.",
+        "description": format!("Ground-truth depth of the sensor surface, reference (undeformed) and indented by each protrusion {} configuration (R-Tac0 Sec. IV-B, Fig. 6, Eq. (2)-(3)): complete depth = reference + delta. Exact per-pixel rays of the camera model; surfaces in closed form.", fixture_kind),
         "design": {"name": design.name, "source": loaded.source, "sha256": loaded.sha256},
         "camera": {"file": args.camera.display().to_string(), "sha256": camera_sha, "distortion_model": i.distortion.name(),
                    "fx_px": i.fx_px, "fy_px": i.fy_px, "cx_px": i.cx_px, "cy_px": i.cy_px, "distortion_coefficients": i.distortion.coefficients(),
@@ -674,7 +685,7 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
             "range_mm": "distance along the pixel's ray from the camera centre to the surface, mm",
             "zdepth_mm": "z of the surface point in the camera frame, mm (= range * bearing z)",
             "delta": "indented minus reference, mm (negative where the skin is pushed towards the camera, 0 elsewhere)",
-            "surface": "outer skin surface (body profile at offset 0) from the pole to the base plane; indented: the skin minus the protrusion solids",
+            "surface": surface_text,
             "missing": "a pixel whose ray misses the skin (or does not unproject) is NaN in float files, 0 in integer files, and in no mask",
             "png16": {"depth": {"scale_mm_per_count": DEPTH_PNG.scale, "offset_counts": DEPTH_PNG.offset_counts},
                       "delta": {"scale_mm_per_count": DELTA_PNG.scale, "offset_counts": DELTA_PNG.offset_counts},

@@ -11,16 +11,6 @@ use fabkit_calibration::nalgebra::Vector2;
 use fabkit_calibration::synthetic::benchmark_intrinsics;
 use fabkit_calibration::{write_camera, CameraFileFormat, CameraModel};
 
-fn read_npy_f32(path: &Path) -> Vec<f32> {
-    let b = std::fs::read(path).unwrap();
-    assert_eq!(&b[..8], b"\x93NUMPY\x01\x00");
-    let hlen = u16::from_le_bytes([b[8], b[9]]) as usize;
-    b[10 + hlen..]
-        .chunks_exact(4)
-        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-        .collect()
-}
-
 fn setup(dir: &Path) {
     let o = run(
         dir,

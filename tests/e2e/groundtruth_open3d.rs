@@ -3,26 +3,10 @@
 //! triangle mesh, the R-Tac0-like fisheye camera's 640 x 480 rays) cast by both; the distances
 //! agree to 1 um and the hit masks are identical.
 
-use crate::common::{missing, oracle_python, repo_root, text};
+use crate::common::{missing, oracle_python, read_npy_f32, repo_root, text};
 use fabkit_calibration::groundtruth::mesh::{MeshCaster, NO_HIT};
 use fabkit_calibration::groundtruth::synthetic::BenchScene;
 use fabkit_export::raster::npy_f32;
-
-/// Reads a float32 NPY file (C order) as its values.
-fn read_npy_f32(path: &std::path::Path) -> Vec<f32> {
-    let b = std::fs::read(path).unwrap();
-    assert_eq!(&b[..6], b"\x93NUMPY");
-    let (hlen, start) = match b[6] {
-        1 => (u16::from_le_bytes([b[8], b[9]]) as usize, 10),
-        _ => (u32::from_le_bytes([b[8], b[9], b[10], b[11]]) as usize, 12),
-    };
-    let header = std::str::from_utf8(&b[start..start + hlen]).unwrap();
-    assert!(header.contains("'<f4'"), "{header}");
-    b[start + hlen..]
-        .chunks_exact(4)
-        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-        .collect()
-}
 
 #[test]
 fn frame_cast_agrees_with_open3d_raycasting_scene_to_1_um_with_no_hit_mask_mismatch() {

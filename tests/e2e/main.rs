@@ -14,6 +14,7 @@ mod export_markers;
 mod export_rtac0;
 mod fixtures_cli;
 mod groundtruth_cli;
+mod groundtruth_flat;
 mod groundtruth_open3d;
 mod maker_path;
 mod step_install;

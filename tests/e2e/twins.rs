@@ -54,8 +54,11 @@ const CASES: &[(&str, &[&str])] = &[
         "tactip_dualmodal_fixtures",
         &["fixtures", "tactip_dualmodal"],
     ),
-    // the flat skin's indenter grid plate and pin
-    ("soter_channels_fixtures", &["fixtures", "soter_channels"]),
+    // the flat skin's indenter grid plate and pin, semi-plate holder and halves
+    (
+        "soter_channels_fixtures",
+        &["fixtures", "soter_channels", "--semidomes", "3"],
+    ),
 ];
 
 /// Every case exported under `dir` with its CSG tree beside it (`<case>.csg.json`), two

@@ -222,8 +222,7 @@ def grid_plate(params: dict):
     under = face + float(g["standoff_mm"])
 
     def grown(d):
-        return {"width_mm": o["width_mm"] + 2 * d, "length_mm": o["length_mm"] + 2 * d,
-                "corner_radius_mm": o.get("corner_radius_mm", 0.0) + d}
+        return _grown(o, d)
 
     c, w = float(g["skin_clearance_mm"]), float(g["wall_mm"])
     r = (float(g["pin"]["shaft_diameter_mm"]) + float(g["hole_clearance_mm"])) / 2.0
@@ -231,3 +230,48 @@ def grid_plate(params: dict):
              for x, y in params["holes_xy_mm"]]
     return C.cut(cq_flat.outline_prism(grown(c + w), 0.0, top),
                  [cq_flat.outline_prism(grown(c), -1.0, under)] + bores)
+
+
+def _grown(o: dict, d: float) -> dict:
+    """The outline `o` grown by `d` all round (corner radius grown too)."""
+    return {"width_mm": o["width_mm"] + 2 * d, "length_mm": o["length_mm"] + 2 * d,
+            "corner_radius_mm": o.get("corner_radius_mm", 0.0) + d}
+
+
+SEMIPLATE_DOWEL_HOLE_DEPTH_MM = 3.0  # fixtures/src/semiplate.rs DOWEL_HOLE_DEPTH_MM
+
+
+def semiplate_holder(params: dict):
+    """The semi-plates' holder frame of a flat skin (fixtures/src/semiplate.rs), sensor frame:
+    the outline grown by the clearance and the wall from the base plane to the contact face,
+    less the outline grown by the clearance, less two dowel holes in its top."""
+    from . import cq_flat
+    sp, o = params["semiplates"], params["outline"]
+    face = float(params["face_z_mm"])
+    c, w = float(sp["skin_clearance_mm"]), float(sp["wall_mm"])
+    r = float(sp["dowel_diameter_mm"]) / 2.0
+    dowels = [C.cylinder_z(r, face - SEMIPLATE_DOWEL_HOLE_DEPTH_MM, face + 1.0, x, y)
+              for x, y in params["dowels_xy_mm"]]
+    return C.cut(cq_flat.outline_prism(_grown(o, c + w), 0.0, face),
+                 [cq_flat.outline_prism(_grown(o, c), -1.0, face + 1.0)] + dowels)
+
+
+def semiplate_half(params: dict):
+    """A semi-plate half (+x side), sensor frame: the plate over the grown outline on its
+    flange, cut at x = 0, less its dowel hole, with the pattern's protrusions."""
+    from . import cq_flat
+    sp, o = params["semiplates"], params["outline"]
+    face, top = float(params["face_z_mm"]), float(params["top_z_mm"])
+    under = face + float(sp["clearance_mm"])
+    c, w = float(sp["skin_clearance_mm"]), float(sp["wall_mm"])
+    big = 2.0 * (o["width_mm"] + o["length_mm"]) + 4.0 * w + 10.0
+    s = C.cut(cq_flat.outline_prism(_grown(o, c + w), face, top),
+              [cq_flat.outline_prism(_grown(o, c), face - 1.0, under)])
+    s = C.common(s, C.box([0.0, -big, face - 1.0], [big, big, top + 1.0]))
+    x, y = params["dowel_xy_mm"]
+    s = C.cut(s, [C.cylinder_z(float(sp["dowel_diameter_mm"]) / 2.0, face - 1.0,
+                               face + SEMIPLATE_DOWEL_HOLE_DEPTH_MM, x, y)])
+    g = params.get("protrusions")
+    if g:
+        s = C.fuse(s, [C.primitive(p) for p in g["primitives"]])
+    return s

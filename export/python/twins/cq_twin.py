@@ -67,6 +67,10 @@ def _build_sensor(part: dict):
         s = cq_fixtures.pin_dome_ring(p)
     elif role == "calibration pin":
         s = cq_fixtures.pin(p)
+    elif name == "semiplate_holder":
+        s = cq_fixtures.semiplate_holder(p)
+    elif name.startswith("semiplate_"):
+        s = cq_fixtures.semiplate_half(p)
     elif name == "semidome_holder":
         s = cq_fixtures.semidome_holder(p)
     elif name.startswith("semidome_"):

@@ -36,4 +36,6 @@ def family(part: dict) -> str:
         return "pin-hole domes and pins"
     if name.startswith("semidome"):
         return "semi-domes"
+    if name.startswith("semiplate"):
+        return "semi-plates (flat skins)"
     return role
