@@ -718,6 +718,21 @@ pub fn validate(
             }
         }
     }
+    // laser-cut trays: the stock and registration, then every tray's sheets
+    if let (Some(lc), Some(layers), true) = (&design.mold.laser_cut, &layers, errs.is_empty()) {
+        let wall = design.mold.wall_thickness_mm;
+        let lc_errs = crate::lasercut::check_params(lc, wall, materials);
+        if lc_errs.is_empty() {
+            let tol =
+                ChordTolerance::new(ChordTolerance::DEFAULT_MM).expect("the default is valid");
+            for (i, l) in layers.iter().enumerate() {
+                if let Err(e) = crate::lasercut::tray_sheets(&outline, l, i, wall, lc, tol) {
+                    errs.extend(e);
+                }
+            }
+        }
+        errs.extend(lc_errs);
+    }
     let errs = numbers.merge_negative(errs);
     match layers {
         Some(l) if errs.is_empty() => Ok(l),
@@ -726,11 +741,14 @@ pub fn validate(
 }
 
 /// About how many triangles a flat kit has at `tol` (both trays and the layers): the
-/// outline's prisms, 12 per channel groove or rib, and per marker (in its layer and its
-/// tray's hole) a revolved feature of `circle_segments` by a quarter as many profile points.
+/// outline's prisms, 12 per channel groove or rib, and per marker a revolved feature of
+/// `circle_segments` by a quarter as many profile points (and its seam with the face) in its
+/// layer, and in its tray's hole
+/// another (printed trays) or a straight hole of 4 triangles a segment (`laser_cut` trays).
 pub fn estimated_triangles(
     outline: &FlatOutline,
     layers: &[FlatLayer],
+    laser_cut: bool,
     tol: ChordTolerance,
 ) -> f64 {
     let prism_tris = 4.0 * outline.polygon(tol).len() as f64;
@@ -743,7 +761,9 @@ pub fn estimated_triangles(
                 .map_or(0.0, |c| 2.0 * 24.0 * c.count as f64);
             let mk = l.marker_grid.as_ref().map_or(0.0, |g| {
                 let n = tol.circle_segments(g.feature.radius_mm()) as f64;
-                2.0 * (g.rows * g.columns) as f64 * 2.0 * n * (n / 4.0 + 3.0)
+                let revolved = 4.0 * n * (n / 4.0 + 3.0);
+                let hole = if laser_cut { 4.0 * n } else { revolved };
+                (g.rows * g.columns) as f64 * (revolved + hole)
             });
             3.0 * prism_tris + ch + mk
         })
@@ -773,7 +793,7 @@ pub fn build_kit(
     let Some(outline) = design.body.flat_outline() else {
         return Err(DesignError::Yaml("not a flat design".into()));
     };
-    let est = estimated_triangles(&outline, &layers, tol);
+    let est = estimated_triangles(&outline, &layers, design.mold.laser_cut.is_some(), tol);
     if est > max_triangles as f64 {
         return Err(DesignError::WorkLimit(format!(
             "{}: the kit would have about {:.0} triangles at chord tolerance {} mm, more than the limit of {max_triangles} (about 1 KB of memory each; raise it with --max-triangles, up to {}, or coarsen --chord-tolerance-mm)",
@@ -789,20 +809,64 @@ pub fn build_kit(
     let mut parts = Vec::new();
     let mut assembly = Vec::new();
     let mut volumes = Vec::new();
+    let mut cut_parts = Vec::new();
+    let laser = design.mold.laser_cut.as_ref();
     for (i, l) in layers.iter().enumerate() {
-        let floor = wall + l.marker_grid.as_ref().map_or(0.0, |g| g.feature.height_mm);
         let name = format!("{}_tray", l.name);
-        let tray = tray_solid(&outline, l, wall, floor, tol).part(&name)?;
+        // a laser-cut tray: its sheets, their union the printable tray; the layer's bottom face
+        // on the base sheet (and the marker sheet)
+        let (tray, floor, sheets) = match laser {
+            Some(lc) => {
+                let sheets = crate::lasercut::tray_sheets(&outline, l, i, wall, lc, tol)
+                    .map_err(|e| DesignError::Params(crate::ParamErrors(e)))?;
+                for s in &sheets {
+                    cut_parts.push(
+                        crate::lasercut::cut_part(
+                            s,
+                            &format!("{} tray, sheet {}: {}", l.name, s.name, s.role),
+                            tol,
+                        )
+                        .map_err(DesignError::Yaml)?,
+                    );
+                }
+                let floor = sheets
+                    .iter()
+                    .filter(|s| s.role == "base" || s.role == "markers")
+                    .map(|s| s.level_mm())
+                    .sum::<f64>();
+                (
+                    crate::lasercut::tray_union(&sheets).part(&name)?,
+                    floor,
+                    Some(sheets),
+                )
+            }
+            None => {
+                let floor = wall + l.marker_grid.as_ref().map_or(0.0, |g| g.feature.height_mm);
+                (
+                    tray_solid(&outline, l, wall, floor, tol).part(&name)?,
+                    floor,
+                    None,
+                )
+            }
+        };
         let skin = layer_solid(&outline, l, tol).part(&l.name)?;
         let t = l.z1_mm - l.z0_mm;
         // the cast layer's own volume, exact: the outline's prism, less the grooves, plus the
-        // markers beyond the face
+        // markers beyond the face (flat-ended in a laser-cut tray: its holes go straight
+        // through their sheet)
         let v = outline.area_mm2() * t
             - l.channels
                 .as_ref()
                 .map_or(0.0, |c| c.count as f64 * c.channel_volume_mm3())
             + l.marker_grid.as_ref().map_or(0.0, |g| {
-                (g.rows * g.columns) as f64 * g.feature.nominal_volume_mm3()
+                let one = if laser.is_some() {
+                    std::f64::consts::PI
+                        * (g.feature.diameter_mm / 2.0).powi(2)
+                        * g.feature.height_mm
+                } else {
+                    g.feature.nominal_volume_mm3()
+                };
+                (g.rows * g.columns) as f64 * one
             });
         volumes.push(v);
         let what = match (&l.channels, &l.marker_grid) {
@@ -810,11 +874,19 @@ pub fn build_kit(
             (_, Some(g)) => format!(", {} x {} holes forming the markers", g.rows, g.columns),
             _ => String::new(),
         };
+        let made = match &sheets {
+            Some(s) => format!(
+                "; the union of its {} laser-cut sheets (cut/{}_*), or print it",
+                s.iter().map(|s| s.quantity).sum::<u32>(),
+                name
+            ),
+            None => String::new(),
+        };
         parts.push(Part {
             name: name.clone(),
             role: "casting_tray".into(),
             description: format!(
-                "Open tray of layer {} ({t:.2} mm deep{what}); pour to the brim and scrape level",
+                "Open tray of layer {} ({t:.2} mm deep{what}); pour to the brim and scrape level{made}",
                 l.name
             ),
             material: crate::molds::material_for(tech).into(),
@@ -824,6 +896,13 @@ pub fn build_kit(
                 "layer": l.name, "layer_index": i, "outline": outline, "depth_mm": t,
                 "z0_mm": l.z0_mm, "wall_mm": wall, "floor_mm": floor,
                 "channels": l.channels, "marker_grid": l.marker_grid,
+                "laser_cut": sheets.as_ref().map(|sh| serde_json::json!({
+                    "sheets": sh.iter().map(|s| serde_json::json!({"name": s.name, "role": s.role, "stock": s.stock,
+                        "quantity": s.quantity, "z0_mm": s.z0_mm, "level_mm": s.level_mm(), "area_mm2": s.region.area_mm2()})).collect::<Vec<_>>(),
+                    "registration_xy_mm": crate::lasercut::registration_xy_mm(&outline, wall),
+                    "registration_diameter_mm": laser.map(|lc| lc.registration.diameter_mm),
+                    "markers": "flat-ended, straight through their sheet",
+                })),
                 // the layer's bottom face (sensor z0) on the tray's floor (print z = floor)
                 "T_print_sensor": [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, floor - l.z0_mm]],
             }),
@@ -884,21 +963,45 @@ pub fn build_kit(
             liquid_ml
         ));
     }
+    if let Some(lc) = laser {
+        bought.push(format!(
+            "{} x steel dowel pin {} mm diameter, as long as the thickest tray's stack (registration of each tray's sheets); {}",
+            4 * layers.len(),
+            lc.registration.diameter_mm,
+            {
+                let mut used: Vec<String> = Vec::new();
+                for c in &cut_parts {
+                    let s = format!("{} mm {}", c.thickness_mm, c.material);
+                    if !used.contains(&s) {
+                        used.push(s);
+                    }
+                }
+                format!("sheet stock: {}", used.join(", "))
+            }
+        ));
+    }
     if layers.iter().any(|l| l.marker_grid.is_some()) {
         bought.push("White silicone paint (Silc Pig white in a little uncured Ecoflex) for the markers' ends".into());
     }
     let step = |action, text: String| ProcedureStep { action, text };
-    let mut procedure = vec![step(
-        ProcedureAction::Print,
-        format!(
-            "Print the trays ({}); check that each is flat and its cavity clean.",
-            parts
-                .iter()
-                .map(|p| p.name.as_str())
-                .collect::<Vec<_>>()
-                .join(", ")
+    let trays = parts
+        .iter()
+        .map(|p| p.name.as_str())
+        .collect::<Vec<_>>()
+        .join(", ");
+    let mut procedure = vec![match laser {
+        Some(lc) => step(
+            ProcedureAction::Print,
+            format!(
+                "Laser-cut the trays' sheets (cut/*.dxf or cut/*.svg: each sheet's paths already offset for its stock's kerf; the quantity of each is in its description), or print the trays ({trays}) instead. Stack each tray's sheets in order (base at the bottom) on four {} mm dowel pins through the registration holes, bond them (acrylic cement for acrylic, wood glue for plywood) and seal the cavity's inside edges with a thin bead of silicone; check that the tray is flat and its cavity clean.",
+                lc.registration.diameter_mm
+            ),
         ),
-    )];
+        None => step(
+            ProcedureAction::Print,
+            format!("Print the trays ({trays}); check that each is flat and its cavity clean."),
+        ),
+    }];
     for c in &casts {
         let l = layers.iter().find(|l| l.name == c.cast);
         let last = c.step as usize == casts.len() && casts.len() > 1;
@@ -972,7 +1075,7 @@ pub fn build_kit(
         bought_items: bought,
         procedure,
         assembly,
-        cut_parts: Vec::new(),
+        cut_parts,
         pcb_outlines: Vec::new(),
         machined_parts: Vec::new(),
         summary,

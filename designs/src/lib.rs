@@ -18,6 +18,7 @@ pub mod housing;
 pub mod input_files;
 pub mod insertion;
 pub mod kit;
+pub mod lasercut;
 pub mod layers;
 pub mod library;
 pub mod markers;

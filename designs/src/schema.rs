@@ -251,7 +251,69 @@ pub struct MoldParams {
     pub cavity_print_technology: Technology,
     /// Technology of holders, jigs and boxes.
     pub fixture_print_technology: Technology,
+    /// Flat skins: make each casting tray as a stack of laser-cut sheets (DXF and SVG per
+    /// sheet) whose union is also written as the printable tray ([`crate::lasercut`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub laser_cut: Option<LaserCutParams>,
 }
+
+/// Laser-cut molds of a flat skin (Soter et al. Sec. II-A: the molds are laser-cut): the sheet
+/// stock and the registration holes that align a stack of sheets.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct LaserCutParams {
+    /// The sheet stock, in the order fabkit picks from: each level of a tray is made of the
+    /// first stock whose thickness, taken 1 to 8 times, equals the level's; the base sheet is
+    /// the first stock.
+    pub stock: Vec<SheetStock>,
+    /// Dowel holes through every sheet of a stack, one in each corner of the tray's wall.
+    pub registration: SheetRegistration,
+}
+defaults!(LaserCutParams {
+    stock: vec![
+        SheetStock {
+            name: "acrylic_3mm".into(),
+            material: "pmma".into(),
+            thickness_mm: 3.0,
+            kerf_mm: 0.15,
+        },
+        SheetStock {
+            name: "acrylic_2mm".into(),
+            material: "pmma".into(),
+            thickness_mm: 2.0,
+            kerf_mm: 0.12,
+        },
+        SheetStock {
+            name: "acrylic_1_5mm".into(),
+            material: "pmma".into(),
+            thickness_mm: 1.5,
+            kerf_mm: 0.1,
+        },
+    ],
+    registration: SheetRegistration::default(),
+});
+
+/// One sheet material profile: what the sheet is and what the laser takes out of it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SheetStock {
+    /// `[a-z0-9_]+`, for file names and the bill of materials.
+    pub name: String,
+    /// Material key in the materials table (designs/materials.yaml).
+    pub material: String,
+    pub thickness_mm: f64,
+    /// Width of the laser's cut in this sheet, mm: every path is offset by half of it.
+    pub kerf_mm: f64,
+}
+
+/// Registration (dowel) holes through a stack of sheets.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SheetRegistration {
+    /// Hole diameter, mm (a dowel pin of this diameter, a sliding fit after the kerf).
+    pub diameter_mm: f64,
+}
+defaults!(SheetRegistration { diameter_mm: 3.0 });
 defaults!(MoldParams {
     strategy: MoldStrategy::Direct,
     cavity_clearance_mm: 0.0,
@@ -268,6 +330,7 @@ defaults!(MoldParams {
     two_piece: TwoPieceOpenParams::default(),
     cavity_print_technology: Technology::Sla,
     fixture_print_technology: Technology::Fdm,
+    laser_cut: None,
 });
 
 /// The disc-shaped recess at the open end of the cavity: it centres the core holder (its

@@ -106,11 +106,21 @@ pub fn validate(
         return Err(ParamErrors(vec![ParamError::new(
             "body.profile",
             "flat",
-            "this step handles curved skins only (spherical_cap, hemisphere_on_cylinder, half_ellipsoid) for now, as do sweeps and ground truth; a flat skin is exported, validated and given its grid plate (fabkit export, validate, fixtures)",
+            "this step handles curved skins only (spherical_cap, hemisphere_on_cylinder, half_ellipsoid) for now, as do sweeps; a flat skin is exported, validated, given its fixtures and rendered (fabkit export, validate, fixtures, groundtruth)",
         )]));
     }
     for (path, value, rule) in design.body.violations() {
         errs.push(ParamError::new(path, value, rule));
+    }
+    if design.mold.laser_cut.is_some() {
+        errs.push(ParamError::new(
+            "mold.laser_cut",
+            "given",
+            format!(
+                "applies to flat skins only (body.profile: flat; their trays are stacks of sheets); this body is {}",
+                design.body.kind()
+            ),
+        ));
     }
     for (i, l) in design.layers.iter().enumerate() {
         for (field, given) in [

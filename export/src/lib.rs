@@ -643,17 +643,35 @@ fn render(
         );
         let dxf_bytes = two_d::dxf_bytes(c)?;
         let svg_bytes = two_d::svg_text(c).into_bytes();
+        // a polygonal sheet also as a solid: the nominal part extruded by its thickness
+        let (stl, stl_sha256) =
+            match &c.nominal_rings_mm {
+                Some(rings) => {
+                    let solid = fabkit_designs::geometry::extrude(rings, 0.0, c.thickness_mm)
+                        .map_err(|e| ExportError::Encode {
+                            what: format!("{CUT_DIR}/{}.stl", c.name),
+                            reason: e.to_string(),
+                        })?;
+                    stl_file(kit, opts, CUT_DIR, &c.name, &solid.mesh(), &mut files)?
+                }
+                None => (None, None),
+            };
         cut_parts.push(ManifestCutPart {
             name: c.name.clone(),
             description: c.description.clone(),
             material: c.material.clone(),
             material_name: product_name(materials.as_ref(), &c.material),
             thickness_mm: c.thickness_mm,
+            quantity: c.quantity,
+            kerf_mm: c.kerf_mm,
             area_mm2: c.area_mm2(),
+            nominal_area_mm2: c.nominal_area_mm2(),
             dxf_sha256: sha256_hex(&dxf_bytes),
             svg_sha256: sha256_hex(&svg_bytes),
             dxf: dxf.clone(),
             svg: svg.clone(),
+            stl,
+            stl_sha256,
         });
         files.push((dxf, dxf_bytes));
         files.push((svg, svg_bytes));

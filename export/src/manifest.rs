@@ -219,13 +219,25 @@ pub struct ManifestCutPart {
     pub material: String,
     pub material_name: String,
     pub thickness_mm: f64,
-    /// Area of the part's face (outer outline less the holes), mm^2.
+    /// How many to cut.
+    pub quantity: u32,
+    /// The laser's kerf the paths are offset for (half of it away from the part), mm.
+    pub kerf_mm: f64,
+    /// Area enclosed by the paths in the files (outer outline less the holes), mm^2.
     pub area_mm2: f64,
+    /// Area of the part as it comes off the laser, mm^2 (= `area_mm2` with no kerf).
+    pub nominal_area_mm2: f64,
     /// `cut/<name>.dxf` (R2000, mm, layers `cut` and `engrave`) and `cut/<name>.svg` (mm).
     pub dxf: String,
     pub dxf_sha256: String,
     pub svg: String,
     pub svg_sha256: String,
+    /// `cut/<name>.stl`: one sheet as a solid (the nominal part extruded by its thickness,
+    /// from z = 0), for a sheet with polygonal outlines.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stl: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stl_sha256: Option<String>,
 }
 
 /// A printed circuit board's outline (`pcb/<name>.dxf`: R2000, mm, the edge and holes on

@@ -305,18 +305,32 @@ fn laser_cut(s: &mut String, m: &Manifest) {
     s.push_str("## Laser cutting\n\n");
     s.push_str(
         "DXF (R2000, mm, layer `cut`) and SVG (mm, cut lines red) of each part, centred on the \
-         sensor axis.\n\n",
+         sensor axis. Where a kerf is given, the paths are offset by half of it away from the \
+         part: set the cutter's kerf compensation to 0.\n\n",
     );
     for c in &m.cut_parts {
         let _ = writeln!(
             s,
-            "- {} and {}: {} from {}, {:.1} mm sheet, {:.1} mm² of face",
+            "- {}{} and {}{}: {} from {}, {:.1} mm sheet, {:.1} mm² of face{}",
+            if c.quantity > 1 {
+                format!("{} x ", c.quantity)
+            } else {
+                String::new()
+            },
             code(&c.dxf),
             code(&c.svg),
+            c.stl
+                .as_ref()
+                .map_or(String::new(), |f| format!(" (solid: {})", code(f))),
             text(&c.description),
             text(&c.material_name),
             c.thickness_mm,
-            c.area_mm2
+            c.nominal_area_mm2,
+            if c.kerf_mm > 0.0 {
+                format!("; paths for a {:.2} mm kerf", c.kerf_mm)
+            } else {
+                String::new()
+            }
         );
     }
     s.push('\n');

@@ -59,6 +59,19 @@ pub fn dxf_bytes(part: &CutPart) -> Result<Vec<u8>, ExportError> {
                 dxf::Point::new(centre_mm[0], centre_mm[1], 0.0),
                 *radius_mm,
             ))),
+            Outline::Polygon { points_mm } => {
+                let mut poly = dxf::entities::LwPolyline::default();
+                poly.set_is_closed(true);
+                poly.vertices = points_mm
+                    .iter()
+                    .map(|p| dxf::LwPolylineVertex {
+                        x: p[0],
+                        y: p[1],
+                        ..Default::default()
+                    })
+                    .collect();
+                Entity::new(EntityType::LwPolyline(poly))
+            }
         };
         e.common.layer = layer(*op).into();
         d.add_entity(e);
@@ -112,16 +125,11 @@ fn with_table_handles(text: &str) -> String {
 
 /// The SVG of `part`: a `width`/`height` in mm with a viewBox in mm, one group per operation.
 pub fn svg_text(part: &CutPart) -> String {
-    use svg::node::element::{Circle, Group};
+    use svg::node::element::{Circle, Group, Path};
     let extent = part
         .outlines
         .iter()
-        .map(|(_, o)| match o {
-            Outline::Circle {
-                centre_mm,
-                radius_mm,
-            } => centre_mm[0].abs().max(centre_mm[1].abs()) + radius_mm,
-        })
+        .map(|(_, o)| o.extent_mm())
         .fold(0.0, f64::max)
         + 1.0;
     let size = 2.0 * extent;
@@ -148,7 +156,22 @@ pub fn svg_text(part: &CutPart) -> String {
                 } => Circle::new()
                     .set("cx", centre_mm[0])
                     .set("cy", -centre_mm[1])
-                    .set("r", *radius_mm),
+                    .set("r", *radius_mm)
+                    .into(),
+                // a closed path of straight segments, y flipped as the circles'
+                Outline::Polygon { points_mm } => {
+                    let d = points_mm
+                        .iter()
+                        .enumerate()
+                        .map(|(i, p)| {
+                            format!("{}{},{}", if i == 0 { "M" } else { "L" }, p[0], -p[1])
+                        })
+                        .collect::<Vec<_>>()
+                        .join(" ")
+                        + " Z";
+                    let node: Box<dyn svg::Node> = Box::new(Path::new().set("d", d));
+                    node
+                }
             });
         }
         if any {

@@ -1,8 +1,9 @@
 //! End-to-end: `fabkit export soter_channels` and `fabkit fixtures soter_channels`, the flat
-//! skin of Soter et al. (Sec. II-A): its two casting trays read back by the independent oracle and sliced by PrusaSlicer, its pours
-//! against the layers' exact volumes, the filling procedure on the sheet, and bad channel and
-//! grid values refused by path with nothing written; its indenter grid plate, pin, point table
-//! and capture plan.
+//! skin of Soter et al. (Sec. II-A): its two casting trays read back by the independent oracle
+//! and sliced by PrusaSlicer, its pours against the layers' exact volumes, the filling
+//! procedure on the sheet, the trays' laser-cut sheets read back by ezdxf (DXF), as SVG and as
+//! STL, and bad channel, grid and sheet values refused by path with nothing written; its
+//! indenter grid plate, pin, point table and capture plan.
 
 use crate::common::*;
 use serde_json::Value;
@@ -28,11 +29,13 @@ fn soter_channels_kit() {
     let parts = m["parts"].as_array().unwrap();
     let names: Vec<&str> = parts.iter().map(|p| p["name"].as_str().unwrap()).collect();
     assert_eq!(names, ["marker_layer_tray", "channel_layer_tray"]);
+    // laser-cut trays (the library default): a registration hole in each corner
     assert!(parts
         .iter()
-        .all(|p| p["role"] == "casting_tray" && p["genus"] == 0));
+        .all(|p| p["role"] == "casting_tray" && p["genus"] == 4));
     let area = 80.0 * 80.0 - (4.0 - PI) * 25.0;
-    let marker = PI * 0.75f64.powi(2) * (2.0 - 0.75) + 2.0 / 3.0 * PI * 0.75f64.powi(3);
+    // flat-ended markers: straight through their sheet
+    let marker = PI * 0.75f64.powi(2) * 2.0;
     let casts = m["casts"].as_array().unwrap();
     assert_eq!(casts[0]["cast"], "channel_layer");
     assert_eq!(casts[1]["cast"], "marker_layer");
@@ -76,10 +79,179 @@ fn soter_channels_kit() {
         sheet.contains("the tubes' display ends stay open"),
         "{sheet}"
     );
+
+    // printed trays: no sheets, the markers ending in hemispheres
+    let o = run(
+        tmp.path(),
+        &[
+            "export",
+            "soter_channels",
+            "--preset",
+            "printed",
+            "--out",
+            "out/p",
+        ],
+        &[],
+    );
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let m: Value =
+        serde_json::from_slice(&std::fs::read(tmp.path().join("out/p/manifest.json")).unwrap())
+            .unwrap();
+    assert!(m["parts"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .all(|p| p["genus"] == 0));
+    assert_eq!(m["cut_parts"].as_array().map_or(0, Vec::len), 0);
+    let marker = PI * 0.75f64.powi(2) * (2.0 - 0.75) + 2.0 / 3.0 * PI * 0.75f64.powi(3);
+    let ml = m["casts"][1]["cavity_volume_ml"].as_f64().unwrap();
+    assert!((ml - (area * 2.0 + 100.0 * marker) / 1000.0).abs() < 1e-9);
 }
 
-/// Channels wider than their pitch allows, channels that break through the skin's face and a
-/// marker grid that does not fit the outline are refused by path (exit 2), nothing written.
+/// Reads every laser-cut sheet of an export with ezdxf (audit), the SVG (its `cut` group's
+/// paths) and the sheet's STL: (name, DXF area, SVG area, STL volume, audit errors and fixes,
+/// DXF version and units) per sheet, areas as the outer path less the holes, mm^2.
+fn read_sheets(dir: &std::path::Path) -> Option<Vec<Value>> {
+    let py = oracle_python()?;
+    let script = r#"
+import sys, json, struct, pathlib, xml.etree.ElementTree as ET
+import numpy as np, ezdxf
+d = pathlib.Path(sys.argv[1])
+m = json.loads((d / "manifest.json").read_text())
+def shoelace(p):
+    p = np.asarray(p, float)
+    return 0.5 * float(np.sum(p[:, 0] * np.roll(p[:, 1], -1) - np.roll(p[:, 0], -1) * p[:, 1]))
+def region(areas):
+    areas = sorted((abs(a) for a in areas), reverse=True)
+    return areas[0] - sum(areas[1:])
+out = []
+for c in m["cut_parts"]:
+    doc = ezdxf.readfile(d / c["dxf"])
+    a = doc.audit()
+    polys = [[(x, y) for x, y, *_ in e.get_points()] for e in doc.modelspace().query('LWPOLYLINE[layer=="cut"]')]
+    closed = all(e.closed for e in doc.modelspace().query('LWPOLYLINE'))
+    ns = {"s": "http://www.w3.org/2000/svg"}
+    svg = ET.parse(d / c["svg"]).getroot()
+    rings = []
+    for g in svg.findall("s:g", ns):
+        if g.get("id") != "cut":
+            continue
+        for path in g.findall("s:path", ns):
+            toks = path.get("d").replace("Z", "").split()
+            rings.append([tuple(float(v) for v in t[1:].split(",")) for t in toks])
+    raw = (d / c["stl"]).read_bytes()
+    n = struct.unpack("<I", raw[80:84])[0]
+    tri = np.frombuffer(raw[84:84 + 50 * n], dtype=np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")]))["v"].astype(float)
+    vol = float(np.sum(np.einsum("ij,ij->i", tri[:, 0], np.cross(tri[:, 1], tri[:, 2])))) / 6.0
+    out.append({"name": c["name"], "dxf_area": region([shoelace(p) for p in polys]),
+                "svg_area": region([shoelace(r) for r in rings]), "stl_volume": vol,
+                "errors": len(a.errors), "fixes": len(a.fixes), "closed": closed,
+                "version": doc.dxfversion, "units": doc.units, "rings": len(polys)})
+print(json.dumps(out))
+"#;
+    let o = std::process::Command::new(py)
+        .arg("-c")
+        .arg(script)
+        .arg(dir)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    Some(serde_json::from_slice(&o.stdout).unwrap())
+}
+
+/// The laser-cut trays' sheets (Soter et al. Sec. II-A: laser-cut molds): each sheet's DXF
+/// passes ezdxf's audit with nothing to fix (R2000 or later, mm, closed polylines on `cut`);
+/// its DXF area equals its SVG area and the manifest's; its STL is one sheet, whose section
+/// (volume / thickness) is the nominal sheet's area; the paths enclose more than the sheet (the
+/// kerf taken outside it). With every kerf 0, the DXF and SVG areas equal the STL's section
+/// area within 1e-6. Every sheet's STL is closed and printable.
+#[test]
+fn soter_laser_cut_sheets_read_back() {
+    let tmp = tempfile::tempdir().unwrap();
+    let yaml =
+        std::fs::read_to_string(repo_root().join("designs/library/soter_channels.yaml")).unwrap();
+    let zero = yaml
+        .replace("kerf_mm: 0.15", "kerf_mm: 0.0")
+        .replace("kerf_mm: 0.12", "kerf_mm: 0.0")
+        .replace("kerf_mm: 0.10", "kerf_mm: 0.0");
+    assert_eq!(zero.matches("kerf_mm: 0.0").count(), 3);
+    std::fs::write(tmp.path().join("zero_kerf.yaml"), zero).unwrap();
+    for (design, out) in [("soter_channels", "out/k"), ("zero_kerf.yaml", "out/z")] {
+        let o = run(tmp.path(), &["export", design, "--out", out], &[]);
+        assert!(o.status.success(), "{}", text(&o.stderr));
+        let dir = tmp.path().join(out);
+        let m: Value =
+            serde_json::from_slice(&std::fs::read(dir.join("manifest.json")).unwrap()).unwrap();
+        let cut = m["cut_parts"].as_array().unwrap();
+        let names: Vec<&str> = cut.iter().map(|c| c["name"].as_str().unwrap()).collect();
+        assert_eq!(
+            names,
+            [
+                "marker_layer_tray_1_base",
+                "marker_layer_tray_2_markers",
+                "marker_layer_tray_3_wall",
+                "channel_layer_tray_1_base",
+                "channel_layer_tray_2_ribs",
+                "channel_layer_tray_3_wall"
+            ]
+        );
+        let stls: Vec<std::path::PathBuf> = cut
+            .iter()
+            .map(|c| dir.join(c["stl"].as_str().unwrap()))
+            .collect();
+        printcheck_all(&stls);
+        let Some(read) = read_sheets(&dir) else {
+            return missing("the oracle python (ezdxf, numpy)");
+        };
+        for (c, r) in cut.iter().zip(&read) {
+            let name = c["name"].as_str().unwrap();
+            assert!(r["version"].as_str().unwrap() >= "AC1015", "{r}");
+            assert_eq!(r["units"], 4, "{r}"); // millimetres
+            assert_eq!(
+                (r["errors"].as_u64(), r["fixes"].as_u64()),
+                (Some(0), Some(0)),
+                "{r}"
+            );
+            assert_eq!(r["closed"], true, "{r}");
+            let f = |k: &str| r[k].as_f64().unwrap();
+            let (dxf, svg) = (f("dxf_area"), f("svg_area"));
+            let section = f("stl_volume") / c["thickness_mm"].as_f64().unwrap();
+            let nominal = c["nominal_area_mm2"].as_f64().unwrap();
+            assert!(
+                (dxf - svg).abs() <= 1e-9 * dxf,
+                "{name}: DXF {dxf} vs SVG {svg}"
+            );
+            assert!(
+                (dxf - c["area_mm2"].as_f64().unwrap()).abs() <= 1e-9 * dxf,
+                "{name}: DXF {dxf} vs manifest {}",
+                c["area_mm2"]
+            );
+            // float32 STL vertices: the section within 1e-6
+            assert!(
+                (section - nominal).abs() <= 1e-6 * nominal,
+                "{name}: STL section {section} vs {nominal}"
+            );
+            if out == "out/z" {
+                assert!(
+                    (dxf - section).abs() <= 1e-6 * dxf,
+                    "{name}: DXF {dxf} vs STL section {section}"
+                );
+            } else {
+                assert!(
+                    dxf > nominal,
+                    "{name}: the path encloses the kerf: {dxf} vs {nominal}"
+                );
+            }
+        }
+        let sheet = std::fs::read_to_string(dir.join("FABRICATION.md")).unwrap();
+        assert!(sheet.contains("Laser-cut the trays' sheets"), "{sheet}");
+    }
+}
+
+/// Channels wider than their pitch allows, channels that break through the skin's face, a
+/// marker grid that does not fit the outline, a kerf wider than a slot, registration holes
+/// too wide for the wall and a sheet no stock makes are refused by path (exit 2), nothing
+/// written.
 #[test]
 fn bad_flat_values_write_nothing() {
     let tmp = tempfile::tempdir().unwrap();
@@ -101,9 +273,26 @@ fn bad_flat_values_write_nothing() {
             "      pitch_mm: 8.5 ",
             "layers[0].marker_grid.pitch_mm = 8.5: a 10 x 10 grid at this pitch does not fit the 80 x 80 mm outline",
         ),
+        // laser-cut sheets: a kerf wider than the 1.5 mm marker holes, registration holes
+        // too wide for the 6 mm wall, no stock for the 1.5 mm rib sheet
+        (
+            "thickness_mm: 2.0, kerf_mm: 0.12}",
+            "thickness_mm: 2.0, kerf_mm: 1.6}",
+            "mold.laser_cut.stock[1].kerf_mm = 1.6: is wider than a slot of sheet marker_layer_tray_2_markers",
+        ),
+        (
+            "registration: {diameter_mm: 3.0}",
+            "registration: {diameter_mm: 4.5}",
+            "mold.laser_cut.registration.diameter_mm = 4.5: must be above 0 and leave 1 mm of the 6 mm wall",
+        ),
+        (
+            "      - {name: acrylic_1_5mm, material: pmma, thickness_mm: 1.5, kerf_mm: 0.10}\n",
+            "",
+            "layers[1].channels.height_mm = 1.5: the ribs sheets of channel_layer's tray must be made of mold.laser_cut.stock",
+        ),
     ] {
+        assert!(yaml.contains(from), "{from}");
         let bad = yaml.replacen(from, to, 1);
-        assert!(bad.contains(to), "{to}");
         std::fs::write(tmp.path().join("bad.yaml"), &bad).unwrap();
         let o = run(tmp.path(), &["export", "bad.yaml", "--out", "out/bad"], &[]);
         assert_eq!(o.status.code(), Some(2), "{to}");

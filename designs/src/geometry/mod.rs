@@ -300,6 +300,62 @@ pub fn cuboid(min: [f64; 3], max: [f64; 3]) -> Result<Solid, GeometryError> {
     })
 }
 
+/// The region bounded by `rings` (each a closed polygon without its closing vertex: the
+/// outer boundaries counter-clockwise, the holes in them clockwise; none crossing another)
+/// extruded from `z0_mm` up to `z1_mm`: a laser-cut sheet. The kernel triangulates the faces.
+///
+/// # Errors
+/// [`GeometryError::InvalidPrimitive`] for a ring of fewer than 3 vertices, a non-finite
+/// vertex, z1 not above z0, or a region of no area; [`GeometryError::Topology`] /
+/// [`GeometryError::Kernel`] if the kernel's mesh is not a closed 2-manifold.
+pub fn extrude(rings: &[Vec<[f64; 2]>], z0_mm: f64, z1_mm: f64) -> Result<Solid, GeometryError> {
+    let ok = !rings.is_empty()
+        && rings
+            .iter()
+            .all(|r| r.len() >= 3 && r.iter().flatten().all(|v| v.is_finite()))
+        && z1_mm > z0_mm
+        && z0_mm.is_finite()
+        && z1_mm.is_finite();
+    if !ok {
+        return Err(GeometryError::InvalidPrimitive(format!(
+            "extrusion of {} rings from z = {z0_mm} to {z1_mm} mm: needs rings of 3 or more finite vertices and z1 above z0",
+            rings.len()
+        )));
+    }
+    let polys: manifold_rust::types::Polygons = rings
+        .iter()
+        .map(|r| {
+            r.iter()
+                .map(|p| manifold_rust::linalg::Vec2::new(p[0], p[1]))
+                .collect()
+        })
+        .collect();
+    let m = manifold_rust::manifold::Manifold::extrude(
+        &polys,
+        z1_mm - z0_mm,
+        0,
+        0.0,
+        manifold_rust::linalg::Vec2::new(1.0, 1.0),
+    );
+    let gl = m.get_mesh_glp::<f64, u32>(0);
+    if gl.tri_verts.is_empty() {
+        return Err(GeometryError::InvalidPrimitive(format!(
+            "extrusion of {} rings: the region has no area",
+            rings.len()
+        )));
+    }
+    let np = gl.num_prop as usize;
+    let mesh = Mesh {
+        vertices: gl
+            .vert_properties
+            .chunks(np)
+            .map(|c| [c[0], c[1], c[2] + z0_mm])
+            .collect(),
+        triangles: gl.tri_verts.chunks(3).map(|c| [c[0], c[1], c[2]]).collect(),
+    };
+    Solid::from_mesh(&mesh)
+}
+
 /// The right prism over a convex polygon (counter-clockwise (x, y) vertices, mm) from `z0_mm`
 /// up to `z1_mm`: both caps fanned from their first vertex, one quad per side.
 ///

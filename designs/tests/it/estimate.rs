@@ -17,9 +17,21 @@ fn estimate_is_within_a_small_factor_of_every_library_kit() {
             let kit = build_kit(&d, tol).unwrap();
             let actual: usize = kit.parts.iter().map(|p| p.solid.triangle_count()).sum();
             if let Some(outline) = d.body.flat_outline() {
-                // a flat skin's trays: their own estimate (prisms, ribs, marker holes)
+                // a flat skin's trays and layers: their own estimate (prisms, ribs, markers
+                // and their holes)
                 let layers = fabkit_designs::flat::validate(&d, &materials).unwrap();
-                let e = fabkit_designs::flat::estimated_triangles(&outline, &layers, tol);
+                let e = fabkit_designs::flat::estimated_triangles(
+                    &outline,
+                    &layers,
+                    d.mold.laser_cut.is_some(),
+                    tol,
+                );
+                let actual = actual
+                    + kit
+                        .assembly
+                        .iter()
+                        .map(|m| m.solid.triangle_count())
+                        .sum::<usize>();
                 let ratio = e / actual as f64;
                 assert!(
                     (0.8..=2.5).contains(&ratio),

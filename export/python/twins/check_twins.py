@@ -118,6 +118,79 @@ def check_export(d: Path, tier: str, log, manifold3d: bool = True) -> list[dict]
         log(f"{'PASS' if row['ok'] else 'FAIL'} {row['design']}/{name}"
             + ("" if row["ok"] else ": " + "; ".join(row["problems"])))
         rows.append(row)
+    rows += _check_sheets(d, man, tol, tier, log, m3d)
+    return rows
+
+
+def _check_sheets(d: Path, man: dict, tol: float, tier: str, log, m3d) -> list[dict]:
+    """The laser-cut sheets of the trays (`cut/<sheet>.stl`; designs/src/lasercut.rs): each is
+    its tray (the union of the sheets) between the planes of its faces, so the twins are the
+    tray's twins cut there: manifold3d (the tray's replayed booleans, both tiers) and CadQuery
+    (the tray's exact twin, full tier), with the parts' bounds."""
+    sheets = {s["name"]: (p, s) for p in man["parts"]
+              for s in ((p.get("params") or {}).get("laser_cut") or {}).get("sheets", [])}
+    rows = []
+    for c in man.get("cut_parts", []):
+        if "stl" not in c:
+            continue
+        name = c["name"]
+        row = {"design": d.name, "design_name": man["design"]["name"], "part": name,
+               "role": "laser_cut_sheet", "family": "laser-cut sheets (flat skins)",
+               "tol_mm": tol, "problems": []}
+        fv, ff = K.load_stl(d / c["stl"])
+        row["triangles"] = len(ff)
+        ok, _ = K.edge_stats(ff)
+        if not ok:
+            row["problems"].append("written mesh not watertight / not consistently oriented")
+        hb = K.hausdorff_bound(tol)
+        found = sheets.get(name)
+        if found is None:
+            row["problems"].append("no tray lists this sheet")
+            row["genus_fabkit"] = None
+        else:
+            tray, s = found
+            z0, z1 = float(s["z0_mm"]), float(s["z0_mm"]) + float(s["stock"]["thickness_mm"])
+            if m3d is not None and tray["name"] in m3d:
+                status, vol, genus, (mv, mf) = m3d_twin.slab(m3d[tray["name"]]["manifold"], z0, z1)
+                v_f = K.mesh_volume(fv, ff)
+                row.update({"m3d_status": status, "m3d_genus": genus,
+                            "m3d_volume_rel_diff": abs(vol - v_f) / abs(v_f),
+                            "m3d_hausdorff_mm": K.mesh_hausdorff(mv, mf, fv, ff, dense=False)})
+                # the STL's float32 vertices: its volume within 1e-6
+                if not row["m3d_volume_rel_diff"] <= 1e-6:
+                    row["problems"].append(f"manifold3d volume rel diff {row['m3d_volume_rel_diff']:.2e} > 1e-6")
+                if not row["m3d_hausdorff_mm"] <= hb:
+                    row["problems"].append(f"manifold3d Hausdorff {row['m3d_hausdorff_mm']:.2e} mm > {hb}")
+            elif m3d is not None:
+                row["problems"].append(f"tray {tray['name']} missing from the CSG file")
+            row["genus_fabkit"] = row.get("m3d_genus")
+            if tier == "full":
+                from twins import cq_twin
+                import cadquery as cq
+                t0 = time.perf_counter()
+                try:
+                    t = cq_twin.build(tray)
+                    bb = t.BoundingBox()
+                    box = cq.Solid.makeBox(bb.xlen + 2.0, bb.ylen + 2.0, z1 - z0,
+                                           cq.Vector(bb.xmin - 1.0, bb.ymin - 1.0, z0))
+                    shape = t.intersect(box).translate(cq.Vector(0.0, 0.0, -z0))
+                    row["cq_build_s"] = time.perf_counter() - t0
+                    e = K.compare_exact(fv, ff, shape, tol)
+                    row.update(e)
+                    if not abs(e["volume_diff_mm3"]) <= e["volume_bound_mm3"]:
+                        row["problems"].append(f"volume off the exact solid by {e['volume_diff_mm3']:.4g} mm3")
+                    if not e["hausdorff_mm"] <= hb or not e["hausdorff_seam_mm"] <= hb:
+                        row["problems"].append(f"Hausdorff {e['hausdorff_mm']:.4g} / {e['hausdorff_seam_mm']:.4g} mm > {hb:.4g}")
+                    if not e["bbox_dev_mm"] <= hb:
+                        row["problems"].append(f"bbox off by {e['bbox_dev_mm']:.4g} mm")
+                    if row["genus_fabkit"] is not None and e["genus_exact"] != row["genus_fabkit"]:
+                        row["problems"].append(f"genus {row['genus_fabkit']} vs exact {e['genus_exact']}")
+                except Exception as ex:  # a twin that cannot be built is a failed row
+                    row["problems"].append(f"CadQuery twin failed: {type(ex).__name__}: {ex}")
+        row["ok"] = not row["problems"]
+        log(f"{'PASS' if row['ok'] else 'FAIL'} {row['design']}/{name}"
+            + ("" if row["ok"] else ": " + "; ".join(row["problems"])))
+        rows.append(row)
     return rows
 
 

@@ -24,10 +24,14 @@ def outline_prism(o: dict, z0: float, z1: float) -> cq.Solid:
 def casting_tray(p: dict) -> cq.Solid:
     """The tray of one layer: a block `wall_mm` round the outline and `floor_mm` under the
     layer's bottom face (z0_mm), its cavity the outline `depth_mm` deep; ribs of the channels
-    from inside the near wall to the closed far end, or holes of the markers below the floor."""
+    from inside the near wall to the closed far end, or holes of the markers below the floor;
+    for a laser-cut tray also its registration holes."""
     o = p["outline"]
     z0, t = float(p["z0_mm"]), float(p["depth_mm"])
     wall, floor = float(p["wall_mm"]), float(p["floor_mm"])
+    # a laser-cut tray (designs/src/lasercut.rs): the union of its sheets is this tray with
+    # flat-ended marker holes and a registration hole through each corner of the wall
+    laser = p.get("laser_cut")
     hw, hl = float(o["width_mm"]) / 2.0, float(o["length_mm"]) / 2.0
     tray = C.cut(C.box([-hw - wall, -hl - wall, z0 - floor], [hw + wall, hl + wall, z0 + t]),
                  [outline_prism(o, z0, z0 + t + 1.0)])
@@ -45,12 +49,21 @@ def casting_tray(p: dict) -> cq.Solid:
     if g:
         rows, cols, pitch = int(g["rows"]), int(g["columns"]), float(g["pitch_mm"])
         f = g["feature"]
+        d, h = float(f["diameter_mm"]), float(f["height_mm"])
         holes = []
         for r in range(rows):
             for c in range(cols):
                 x, y = (c - (cols - 1) / 2.0) * pitch, (r - (rows - 1) / 2.0) * pitch
-                holes.append(C.place_along(
-                    C.feature(float(f["diameter_mm"]), float(f["height_mm"]), 1.0),
-                    (x, y, z0), (0.0, 0.0, -1.0)))
+                if laser:
+                    # straight through the marker sheet: flat-ended
+                    holes.append(C.cylinder_z(d / 2.0, z0 - h, z0 + 1.0, x, y))
+                else:
+                    holes.append(C.place_along(C.feature(d, h, 1.0), (x, y, z0),
+                                               (0.0, 0.0, -1.0)))
         tray = C.cut(tray, holes)
+    if laser:
+        # the registration holes through the whole stack
+        r = float(laser["registration_diameter_mm"]) / 2.0
+        tray = C.cut(tray, [C.cylinder_z(r, z0 - floor - 1.0, z0 + t + 1.0, x, y)
+                            for x, y in laser["registration_xy_mm"]])
     return tray

@@ -1,0 +1,454 @@
+//! Laser-cut molds of a flat skin (Soter et al. Sec. II-A: "the first mold is laser-cut", the
+//! second of wood): each casting tray as a stack of sheets, bottom to top
+//!
+//! - `base`: the tray's floor, the first sheet stock, the tray's rectangle;
+//! - `markers` (a marker layer): a sheet as thick as the markers are tall, a hole per marker
+//!   (straight through: the markers come out flat-ended, their full height);
+//! - `ribs` (a channel layer): a sheet as thick as the channels are tall, the outline cut out
+//!   but for the ribs that form the channels' grooves, joined to the wall at the near edge;
+//! - `wall`: the rest of the layer's depth, the outline cut out;
+//!
+//! every sheet with a registration (dowel) hole in each corner of the wall. A level is made of
+//! the first stock whose thickness, taken 1 to 8 times, is the level's. The laser's paths are
+//! the sheet's outline offset by half the stock's kerf away from the part (out of its outer
+//! boundary, into its holes) by `geo`'s buffer (i_overlay), with round joins: cut with that
+//! kerf, the path leaves the nominal sheet (inside corners rounded to half the kerf, which no
+//! laser avoids). The printable tray is the union of the extruded sheets.
+//!
+//! Frame: the tray frame, x and y of the flat skin's frame (docs/conventions.md), z = 0 on the
+//! base sheet's underside, z up through the stack.
+
+use crate::cut::{ring_area_mm2, CutPart, Operation, Outline};
+use crate::error::ParamError;
+use crate::flat::{FlatLayer, FlatOutline};
+use crate::geometry::{extrude, ChordTolerance, GeometryError, Solid};
+use crate::schema::{LaserCutParams, SheetStock};
+use serde::Serialize;
+
+/// Most sheets of one stock a level may take.
+pub const MAX_SHEETS_PER_LEVEL: u32 = 8;
+
+/// A region of the plane: its outer boundary counter-clockwise and its holes clockwise, mm
+/// (no closing vertex).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Region {
+    pub outer: Vec<[f64; 2]>,
+    pub holes: Vec<Vec<[f64; 2]>>,
+}
+
+impl Region {
+    /// Area, mm^2: the outer boundary less the holes.
+    pub fn area_mm2(&self) -> f64 {
+        ring_area_mm2(&self.outer).abs()
+            - self
+                .holes
+                .iter()
+                .map(|h| ring_area_mm2(h).abs())
+                .sum::<f64>()
+    }
+
+    /// The boundary rings, outer first.
+    pub fn rings(&self) -> Vec<Vec<[f64; 2]>> {
+        std::iter::once(self.outer.clone())
+            .chain(self.holes.iter().cloned())
+            .collect()
+    }
+
+    fn to_geo(&self) -> geo::Polygon<f64> {
+        let ring = |r: &[[f64; 2]]| {
+            geo::LineString::from(r.iter().map(|p| (p[0], p[1])).collect::<Vec<_>>())
+        };
+        geo::Polygon::new(
+            ring(&self.outer),
+            self.holes.iter().map(|h| ring(h)).collect(),
+        )
+    }
+
+    fn from_geo(p: &geo::Polygon<f64>) -> Self {
+        // geo closes its rings; drop the closing vertex and orient outer CCW, holes CW
+        let ring = |r: &geo::LineString<f64>, ccw: bool| {
+            let mut v: Vec<[f64; 2]> = r.0.iter().map(|c| [c.x, c.y]).collect();
+            if v.len() > 1 && v.first() == v.last() {
+                v.pop();
+            }
+            if (ring_area_mm2(&v) > 0.0) != ccw {
+                v.reverse();
+            }
+            v
+        };
+        Self {
+            outer: ring(p.exterior(), true),
+            holes: p.interiors().iter().map(|h| ring(h, false)).collect(),
+        }
+    }
+}
+
+/// One level of a tray's stack: `quantity` identical sheets of `stock`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Sheet {
+    /// `<layer>_tray_<level>_<role>`: the file stem of its DXF, SVG and STL.
+    pub name: String,
+    /// `base`, `markers`, `ribs` or `wall`.
+    pub role: &'static str,
+    /// Index in `mold.laser_cut.stock`, and the stock.
+    pub stock_index: usize,
+    pub stock: SheetStock,
+    pub quantity: u32,
+    /// z of the level's underside in the tray frame, mm.
+    pub z0_mm: f64,
+    /// The nominal sheet (what the laser leaves).
+    pub region: Region,
+}
+
+impl Sheet {
+    /// The level's thickness (all its sheets), mm.
+    pub fn level_mm(&self) -> f64 {
+        self.quantity as f64 * self.stock.thickness_mm
+    }
+}
+
+/// A circle of radius `r` about `c` as a polygon of `tol`'s segment count, vertices on the
+/// circle (the first at angle 0), counter-clockwise.
+fn circle(c: [f64; 2], r: f64, tol: ChordTolerance) -> Vec<[f64; 2]> {
+    let n = tol.circle_segments(r).max(8);
+    (0..n)
+        .map(|i| {
+            let a = std::f64::consts::TAU * i as f64 / n as f64;
+            [c[0] + r * a.cos(), c[1] + r * a.sin()]
+        })
+        .collect()
+}
+
+fn reversed(mut v: Vec<[f64; 2]>) -> Vec<[f64; 2]> {
+    v.reverse();
+    v
+}
+
+/// Centres of the registration holes, (x, y) mm: the middle of the wall at each corner.
+pub fn registration_xy_mm(outline: &FlatOutline, wall_mm: f64) -> [[f64; 2]; 4] {
+    let (x, y) = (
+        outline.width_mm / 2.0 + wall_mm / 2.0,
+        outline.length_mm / 2.0 + wall_mm / 2.0,
+    );
+    [[-x, -y], [x, -y], [x, y], [-x, y]]
+}
+
+/// The stock a level of `thickness_mm` is made of: the first whose thickness, 1 to
+/// [`MAX_SHEETS_PER_LEVEL`] times, equals it (to 1 um); (index, count).
+fn stock_for(stock: &[SheetStock], thickness_mm: f64) -> Option<(usize, u32)> {
+    stock.iter().enumerate().find_map(|(i, s)| {
+        let n = (thickness_mm / s.thickness_mm).round();
+        (s.thickness_mm > 0.0
+            && (1.0..=MAX_SHEETS_PER_LEVEL as f64).contains(&n)
+            && (n * s.thickness_mm - thickness_mm).abs() <= 1e-3)
+            .then_some((i, n as u32))
+    })
+}
+
+/// Every rule on `mold.laser_cut` alone, by path: stock names, materials, thicknesses and
+/// kerfs, and the registration holes against the tray's wall.
+pub fn check_params(
+    lc: &LaserCutParams,
+    wall_mm: f64,
+    materials: &crate::materials::MaterialsTable,
+) -> Vec<ParamError> {
+    let mut errs = Vec::new();
+    if lc.stock.is_empty() {
+        errs.push(ParamError::new(
+            "mold.laser_cut.stock",
+            "[]",
+            "must list at least one sheet stock",
+        ));
+    }
+    let mut names = std::collections::BTreeSet::new();
+    for (i, s) in lc.stock.iter().enumerate() {
+        let p = format!("mold.laser_cut.stock[{i}]");
+        let good_name = !s.name.is_empty()
+            && s.name
+                .chars()
+                .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_');
+        if !good_name || !names.insert(s.name.clone()) {
+            errs.push(ParamError::new(
+                format!("{p}.name"),
+                &s.name,
+                "must be [a-z0-9_]+ and unique",
+            ));
+        }
+        if materials.get(&s.material).is_none() {
+            errs.push(ParamError::new(
+                format!("{p}.material"),
+                &s.material,
+                "must be a key of the materials table (designs/materials.yaml), e.g. pmma or plywood",
+            ));
+        }
+        if !(s.thickness_mm > 0.0 && s.thickness_mm <= 25.0) {
+            errs.push(ParamError::new(
+                format!("{p}.thickness_mm"),
+                s.thickness_mm,
+                "must be above 0 and at most 25 mm (a laser cutter's sheet)",
+            ));
+        }
+        if !(s.kerf_mm >= 0.0 && s.kerf_mm < 2.0) {
+            errs.push(ParamError::new(
+                format!("{p}.kerf_mm"),
+                s.kerf_mm,
+                "must be 0 or more and below 2 mm (a laser's cut is a few tenths of a mm wide)",
+            ));
+        }
+    }
+    let d = lc.registration.diameter_mm;
+    if !(d > 0.0 && d <= wall_mm - 2.0) {
+        errs.push(ParamError::new(
+            "mold.laser_cut.registration.diameter_mm",
+            d,
+            format!(
+                "must be above 0 and leave 1 mm of the {wall_mm} mm wall (mold.wall_thickness_mm) either side: at most {} mm",
+                wall_mm - 2.0
+            ),
+        ));
+    }
+    errs
+}
+
+/// A level of a stack before its stock is chosen: its role, thickness, the path of the
+/// parameter that sets the thickness, and its holes besides the registration holes.
+type Level = (&'static str, f64, String, Vec<Vec<[f64; 2]>>);
+
+/// The sheets of the tray of `layer` (index `li`) of a flat skin of `outline`, bottom to top,
+/// with checked `mold.laser_cut` parameters ([`check_params`]).
+///
+/// # Errors
+/// The violated rules, by path: a level no stock makes (the channels' or markers' height, the
+/// layer's thickness), and a sheet whose cut-out closes when its path is offset by half its
+/// stock's kerf (a slot narrower than the kerf).
+pub fn tray_sheets(
+    outline: &FlatOutline,
+    layer: &FlatLayer,
+    li: usize,
+    wall_mm: f64,
+    lc: &LaserCutParams,
+    tol: ChordTolerance,
+) -> Result<Vec<Sheet>, Vec<ParamError>> {
+    let (hw, hl) = (
+        outline.width_mm / 2.0 + wall_mm,
+        outline.length_mm / 2.0 + wall_mm,
+    );
+    let rect = vec![[-hw, -hl], [hw, -hl], [hw, hl], [-hw, hl]];
+    let r_reg = lc.registration.diameter_mm / 2.0;
+    let reg: Vec<Vec<[f64; 2]>> = registration_xy_mm(outline, wall_mm)
+        .into_iter()
+        .map(|c| reversed(circle(c, r_reg, tol)))
+        .collect();
+    let cavity = reversed(outline.polygon(tol));
+    let depth = layer.z1_mm - layer.z0_mm;
+    let name = &layer.name;
+    let mut levels: Vec<Level> = Vec::new();
+    levels.push((
+        "base",
+        lc.stock.first().map_or(0.0, |s| s.thickness_mm),
+        "mold.laser_cut.stock[0].thickness_mm".into(),
+        Vec::new(),
+    ));
+    let mut wall_depth = depth;
+    if let Some(g) = &layer.marker_grid {
+        let r = g.feature.diameter_mm / 2.0;
+        levels.push((
+            "markers",
+            g.feature.height_mm,
+            format!("layers[{li}].marker_grid.feature.height_mm"),
+            g.positions_mm()
+                .into_iter()
+                .map(|c| reversed(circle(c, r, tol)))
+                .collect(),
+        ));
+    }
+    if let Some(ch) = &layer.channels {
+        // the cavity less the ribs, which join the wall at the near edge (y = -length / 2):
+        // the outline's polygon with a notch per rib in its near edge (the polygon's closing
+        // edge, from its last vertex to its first, along +x), on the outline's own vertices
+        let y_near = -outline.length_mm / 2.0;
+        let mut open = outline.polygon(tol);
+        let mut xs = ch.centres_x_mm();
+        xs.sort_by(f64::total_cmp);
+        for x in xs {
+            let (x0, x1) = (x - ch.width_mm / 2.0, x + ch.width_mm / 2.0);
+            let y1 = y_near + ch.length_mm;
+            open.extend([[x0, y_near], [x0, y1], [x1, y1], [x1, y_near]]);
+        }
+        levels.push((
+            "ribs",
+            ch.height_mm,
+            format!("layers[{li}].channels.height_mm"),
+            vec![reversed(open)],
+        ));
+        wall_depth -= ch.height_mm;
+    }
+    if layer.channels.is_none() {
+        levels.push((
+            "wall",
+            wall_depth,
+            format!("layers[{li}].thickness_mm"),
+            vec![cavity.clone()],
+        ));
+    } else if wall_depth > 1e-9 {
+        levels.push((
+            "wall",
+            wall_depth,
+            format!("layers[{li}].thickness_mm"),
+            vec![cavity],
+        ));
+    }
+    let mut errs = Vec::new();
+    let mut sheets = Vec::new();
+    let mut z = 0.0;
+    for (k, (role, t, path, holes)) in levels.into_iter().enumerate() {
+        let Some((si, n)) = stock_for(&lc.stock, t) else {
+            errs.push(ParamError::new(
+                path,
+                t,
+                format!(
+                    "the {role} sheets of {name}'s tray must be made of mold.laser_cut.stock: no stock ({}) makes {t} mm in 1 to {MAX_SHEETS_PER_LEVEL} sheets",
+                    lc.stock
+                        .iter()
+                        .map(|s| format!("{} mm", s.thickness_mm))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            ));
+            continue;
+        };
+        let mut all_holes = reg.clone();
+        all_holes.extend(holes);
+        let sheet = Sheet {
+            name: format!("{name}_tray_{}_{role}", k + 1),
+            role,
+            stock_index: si,
+            stock: lc.stock[si].clone(),
+            quantity: n,
+            z0_mm: z,
+            region: Region {
+                outer: rect.clone(),
+                holes: all_holes,
+            },
+        };
+        if cut_path(&sheet.region, sheet.stock.kerf_mm, tol).is_none() {
+            errs.push(ParamError::new(
+                format!("mold.laser_cut.stock[{si}].kerf_mm"),
+                sheet.stock.kerf_mm,
+                format!(
+                    "is wider than a slot of sheet {}: a cut-out closes when the laser's path is offset by half the kerf",
+                    sheet.name
+                ),
+            ));
+        }
+        z += sheet.level_mm();
+        sheets.push(sheet);
+    }
+    if errs.is_empty() {
+        Ok(sheets)
+    } else {
+        Err(errs)
+    }
+}
+
+/// The laser's path round `region` for a kerf of `kerf_mm`: the region offset by half the
+/// kerf (round joins within `tol`); `None` when the offset changes its topology (a hole closes
+/// or splits, the region splits): a slot narrower than the kerf.
+pub fn cut_path(region: &Region, kerf_mm: f64, tol: ChordTolerance) -> Option<Region> {
+    use geo::algorithm::buffer::{Buffer, BufferStyle, LineJoin};
+    if kerf_mm == 0.0 {
+        return Some(region.clone());
+    }
+    let r = kerf_mm / 2.0;
+    // the largest step of a round join whose chords stay within the chord tolerance
+    let step = if tol.mm() < r {
+        (2.0 * (1.0 - tol.mm() / r).acos()).min(0.5)
+    } else {
+        0.5
+    };
+    let out = region
+        .to_geo()
+        .buffer_with_style(BufferStyle::new(r).line_join(LineJoin::Round(step)));
+    match out.0.as_slice() {
+        [p] if p.interiors().len() == region.holes.len() => Some(Region::from_geo(p)),
+        _ => None,
+    }
+}
+
+/// What the laser leaves of a path cut with a kerf of `kerf_mm` (the path offset back by half
+/// the kerf; inside corners come out rounded to half the kerf): for checking kerf compensation.
+pub fn cut_result(path: &Region, kerf_mm: f64) -> Vec<Region> {
+    use geo::algorithm::buffer::{Buffer, BufferStyle, LineJoin};
+    if kerf_mm == 0.0 {
+        return vec![path.clone()];
+    }
+    path.to_geo()
+        .buffer_with_style(BufferStyle::new(-kerf_mm / 2.0).line_join(LineJoin::Round(0.05)))
+        .0
+        .iter()
+        .map(Region::from_geo)
+        .collect()
+}
+
+/// One sheet of a level as a solid, tray frame (from its underside at z = 0).
+///
+/// # Errors
+/// [`GeometryError`] on a kernel failure.
+pub fn sheet_solid(sheet: &Sheet) -> Result<Solid, GeometryError> {
+    extrude(&sheet.region.rings(), 0.0, sheet.stock.thickness_mm)
+}
+
+/// The printable tray: the union of every sheet extruded and stacked, tray frame.
+///
+/// # Errors
+/// [`GeometryError`] on a kernel failure.
+pub fn tray_union(sheets: &[Sheet]) -> Result<Solid, GeometryError> {
+    let mut solids = Vec::new();
+    for s in sheets {
+        let one = sheet_solid(s)?;
+        for k in 0..s.quantity {
+            solids.push(one.translate([0.0, 0.0, s.z0_mm + k as f64 * s.stock.thickness_mm]));
+        }
+    }
+    Solid::union_all(&solids)
+}
+
+/// The sheet as a part to cut: its kerf-compensated paths on `cut` ([`cut_path`]).
+///
+/// # Errors
+/// The sheet's name when its path cannot be offset (checked by [`tray_sheets`] before).
+pub fn cut_part(sheet: &Sheet, what: &str, tol: ChordTolerance) -> Result<CutPart, String> {
+    let path = cut_path(&sheet.region, sheet.stock.kerf_mm, tol)
+        .ok_or_else(|| format!("{}: the kerf closes a cut-out", sheet.name))?;
+    let polygon = |r: &Vec<[f64; 2]>| {
+        (
+            Operation::Cut,
+            Outline::Polygon {
+                points_mm: r.clone(),
+            },
+        )
+    };
+    Ok(CutPart {
+        name: sheet.name.clone(),
+        description: format!(
+            "{what}: {} sheet{} of {} ({} mm), {:.2} to {:.2} mm of the stack; paths offset {:.3} mm for a {:.2} mm kerf; a registration hole in each corner",
+            sheet.quantity,
+            if sheet.quantity == 1 { "" } else { "s" },
+            sheet.stock.name,
+            sheet.stock.thickness_mm,
+            sheet.z0_mm,
+            sheet.z0_mm + sheet.level_mm(),
+            sheet.stock.kerf_mm / 2.0,
+            sheet.stock.kerf_mm,
+        ),
+        material: sheet.stock.material.clone(),
+        thickness_mm: sheet.stock.thickness_mm,
+        outlines: std::iter::once(&path.outer)
+            .chain(&path.holes)
+            .map(polygon)
+            .collect(),
+        kerf_mm: sheet.stock.kerf_mm,
+        quantity: sheet.quantity,
+        nominal_rings_mm: Some(sheet.region.rings()),
+    })
+}
