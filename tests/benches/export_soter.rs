@@ -1,6 +1,7 @@
 //! Benchmarks of the flat skin of Soter et al. (`designs/library/soter_channels.yaml`: the
-//! channel layer's tray with its 16 ribs, the marker layer's tray with its 100 holes, the two
-//! layers as the assembly, the pours and the procedure) at 0.01 mm chord tolerance.
+//! channel layer's tray with its 16 ribs, the marker layer's tray with its 100 holes, each the
+//! union of its laser-cut sheets, whose DXF, SVG and STL are written too; the two layers as
+//! the assembly, the pours and the procedure) at 0.01 mm chord tolerance.
 //!
 //! Groups (ids `<group>/soter_channels`):
 //! - `build_kit`: `build_kit` only: validation and every boolean of both trays and layers.
