@@ -189,7 +189,8 @@ fn a_path_offset_by_half_the_kerf_cuts_the_nominal_sheet() {
 
 /// Bad laser-cut values are refused by path before anything is built: a kerf wider than the
 /// marker holes, no stock for the 1.5 mm rib sheet, registration holes too wide for the wall,
-/// an unknown sheet material, a negative kerf; and laser_cut on a curved skin.
+/// an unknown sheet material, a negative kerf, no stock, a sheet thicker than a laser cuts, a
+/// repeated stock name; and laser_cut on a curved skin.
 #[test]
 fn bad_laser_cut_values_are_refused_by_path() {
     type Case = (&'static str, fn(&mut Design));
@@ -211,6 +212,12 @@ fn bad_laser_cut_values_are_refused_by_path() {
         }),
         ("mold.laser_cut.stock", |d| {
             d.mold.laser_cut.as_mut().unwrap().stock.clear()
+        }),
+        ("mold.laser_cut.stock[0].thickness_mm", |d| {
+            d.mold.laser_cut.as_mut().unwrap().stock[0].thickness_mm = 30.0
+        }),
+        ("mold.laser_cut.stock[2].name", |d| {
+            d.mold.laser_cut.as_mut().unwrap().stock[2].name = "acrylic_3mm".into()
         }),
     ];
     for (path, mutate) in cases {
