@@ -13,6 +13,7 @@ pub mod camera;
 pub mod camera_file;
 pub mod extrinsics;
 pub mod groundtruth;
+pub mod imprints;
 pub mod overlay;
 pub mod p3p;
 pub mod pnp;

@@ -5,4 +5,5 @@ mod camera_models;
 mod extrinsics_synthetic;
 mod groundtruth_closed_form;
 mod groundtruth_undistort;
+mod imprints;
 mod tables;

@@ -1,0 +1,466 @@
+//! Pin-imprint detection (R-Tac0 Sec. IV-A): a calibration pin pressing the skin shows in the
+//! capture as a spot that differs from the reference image of the unloaded skin (darker for
+//! R-Tac0). The detector works on the difference image (reference minus capture, so that a
+//! darkening is positive), smoothed by a small Gaussian, inside a mask of the pixels that can
+//! be skin; it thresholds at a multiple of the noise (estimated robustly from the difference
+//! itself), grows each spot by hysteresis down to a lower threshold, and reports each spot's
+//! sub-pixel centre as the centroid of the smoothed difference over the spot (weights above
+//! the lower threshold), with a score (peak over noise). Spots brighter than the reference (LED
+//! reflections) are never candidates.
+//!
+//! Images are grey levels as `f32`, row-major, (0, 0) the centre of the top-left pixel
+//! (docs/conventions.md).
+
+/// A grey image: `data[v * width + u]`, grey levels (any scale; 8-bit images 0..255).
+#[derive(Debug, Clone, PartialEq)]
+pub struct GrayImage {
+    pub width: usize,
+    pub height: usize,
+    pub data: Vec<f32>,
+}
+
+impl GrayImage {
+    /// A `width` x `height` image of `value`.
+    pub fn filled(width: usize, height: usize, value: f32) -> Self {
+        Self {
+            width,
+            height,
+            data: vec![value; width * height],
+        }
+    }
+}
+
+/// The detector's settings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DetectParams {
+    /// Sigma of the Gaussian that smooths the difference, px.
+    pub smooth_sigma_px: f64,
+    /// A spot starts where the smoothed difference exceeds this many noise sigmas.
+    pub threshold_sigma: f64,
+    /// ... and grows over its neighbours above this many.
+    pub grow_sigma: f64,
+    /// Spots of fewer pixels (after growing) are noise.
+    pub min_area_px: usize,
+}
+
+impl Default for DetectParams {
+    fn default() -> Self {
+        Self {
+            smooth_sigma_px: 1.0,
+            threshold_sigma: 8.0,
+            grow_sigma: 2.0,
+            min_area_px: 12,
+        }
+    }
+}
+
+/// One detected imprint.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Spot {
+    /// Sub-pixel centre, px.
+    pub u_px: f64,
+    pub v_px: f64,
+    /// Peak of the smoothed difference over the noise sigma.
+    pub score: f64,
+    /// Pixels in the spot.
+    pub area_px: usize,
+}
+
+/// Errors of [`detect`].
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum DetectError {
+    #[error("the capture is {0} x {1} px and the reference {2} x {3} px: they must match")]
+    SizeMismatch(usize, usize, usize, usize),
+    #[error("the mask holds {0} values for {1} pixels")]
+    MaskSize(usize, usize),
+}
+
+/// A 1D Gaussian kernel of `sigma`, radius 3 sigma, normalised.
+fn kernel(sigma: f64) -> Vec<f32> {
+    let r = (3.0 * sigma).ceil().max(1.0) as i64;
+    let k: Vec<f64> = (-r..=r)
+        .map(|i| (-(i * i) as f64 / (2.0 * sigma * sigma)).exp())
+        .collect();
+    let s: f64 = k.iter().sum();
+    k.iter().map(|x| (x / s) as f32).collect()
+}
+
+/// `img` smoothed by a separable Gaussian of `sigma` px (edges clamped).
+pub fn gaussian_blur(img: &GrayImage, sigma: f64) -> GrayImage {
+    if !(sigma > 0.0) {
+        return img.clone();
+    }
+    let k = kernel(sigma);
+    let r = (k.len() / 2) as i64;
+    let (w, h) = (img.width as i64, img.height as i64);
+    let mut tmp = vec![0f32; img.data.len()];
+    for v in 0..h {
+        for u in 0..w {
+            let mut s = 0f32;
+            for (j, kv) in k.iter().enumerate() {
+                let uu = (u + j as i64 - r).clamp(0, w - 1);
+                s += kv * img.data[(v * w + uu) as usize];
+            }
+            tmp[(v * w + u) as usize] = s;
+        }
+    }
+    let mut out = vec![0f32; img.data.len()];
+    for v in 0..h {
+        for u in 0..w {
+            let mut s = 0f32;
+            for (j, kv) in k.iter().enumerate() {
+                let vv = (v + j as i64 - r).clamp(0, h - 1);
+                s += kv * tmp[(vv * w + u) as usize];
+            }
+            out[(v * w + u) as usize] = s;
+        }
+    }
+    GrayImage {
+        width: img.width,
+        height: img.height,
+        data: out,
+    }
+}
+
+/// Median of `v` (reordered).
+fn median(v: &mut [f32]) -> f32 {
+    if v.is_empty() {
+        return 0.0;
+    }
+    let m = v.len() / 2;
+    *v.select_nth_unstable_by(m, f32::total_cmp).1
+}
+
+/// The imprints in `capture` against `reference` (same size; grey levels), within `mask` (true:
+/// a pixel that can be skin; `None`: every pixel), strongest first.
+///
+/// # Errors
+/// [`DetectError`] when the sizes differ.
+pub fn detect(
+    reference: &GrayImage,
+    capture: &GrayImage,
+    mask: Option<&[bool]>,
+    p: &DetectParams,
+) -> Result<Vec<Spot>, DetectError> {
+    let (w, h) = (capture.width, capture.height);
+    if (reference.width, reference.height) != (w, h) {
+        return Err(DetectError::SizeMismatch(
+            w,
+            h,
+            reference.width,
+            reference.height,
+        ));
+    }
+    if let Some(m) = mask {
+        if m.len() != w * h {
+            return Err(DetectError::MaskSize(m.len(), w * h));
+        }
+    }
+    let inside = |i: usize| mask.is_none_or(|m| m[i]);
+    let diff = GrayImage {
+        width: w,
+        height: h,
+        data: reference
+            .data
+            .iter()
+            .zip(&capture.data)
+            .map(|(r, c)| r - c)
+            .collect(),
+    };
+    let d = gaussian_blur(&diff, p.smooth_sigma_px);
+    // noise: the median absolute deviation of the smoothed difference over the mask
+    let mut vals: Vec<f32> = (0..w * h)
+        .filter(|&i| inside(i))
+        .map(|i| d.data[i])
+        .collect();
+    let med = median(&mut vals);
+    let mut dev: Vec<f32> = vals.iter().map(|x| (x - med).abs()).collect();
+    let sigma = (1.4826 * median(&mut dev)).max(1e-6) as f64;
+    let hi = med as f64 + p.threshold_sigma * sigma;
+    let lo = med as f64 + p.grow_sigma * sigma;
+    let mut label = vec![0u32; w * h];
+    let mut spots = Vec::new();
+    let mut stack = Vec::new();
+    for start in 0..w * h {
+        if label[start] != 0 || !inside(start) || (d.data[start] as f64) <= hi {
+            continue;
+        }
+        // grow by hysteresis over 8-neighbours above `lo`
+        let id = spots.len() as u32 + 1;
+        label[start] = id;
+        stack.push(start);
+        let (mut sw, mut su, mut sv, mut peak, mut area) = (0f64, 0f64, 0f64, 0f64, 0usize);
+        while let Some(i) = stack.pop() {
+            let (u, v) = (i % w, i / w);
+            let x = d.data[i] as f64 - lo;
+            sw += x;
+            su += x * u as f64;
+            sv += x * v as f64;
+            peak = peak.max(d.data[i] as f64 - med as f64);
+            area += 1;
+            for dv in -1i64..=1 {
+                for du in -1i64..=1 {
+                    let (uu, vv) = (u as i64 + du, v as i64 + dv);
+                    if uu < 0 || vv < 0 || uu >= w as i64 || vv >= h as i64 {
+                        continue;
+                    }
+                    let j = vv as usize * w + uu as usize;
+                    if label[j] == 0 && inside(j) && d.data[j] as f64 > lo {
+                        label[j] = id;
+                        stack.push(j);
+                    }
+                }
+            }
+        }
+        spots.push(Spot {
+            u_px: su / sw,
+            v_px: sv / sw,
+            score: peak / sigma,
+            area_px: area,
+        });
+    }
+    let mut spots: Vec<Spot> = spots
+        .into_iter()
+        .filter(|s| s.area_px >= p.min_area_px)
+        .collect();
+    spots.sort_by(|a, b| b.score.total_cmp(&a.score));
+    Ok(spots)
+}
+
+/// The pixels that can hold an imprint, from the reference image: skin (brighter than a
+/// quarter of the median grey) and not an LED reflection (at most halfway from the median to
+/// `white`), the reflections grown by `margin_px`.
+pub fn reference_mask(reference: &GrayImage, white: f32, margin_px: usize) -> Vec<bool> {
+    let (w, h) = (reference.width, reference.height);
+    let mut all = reference.data.clone();
+    let med = median(&mut all);
+    let bright = 0.5 * (med + white);
+    let mut mask: Vec<bool> = reference.data.iter().map(|&g| g > 0.25 * med).collect();
+    let m = margin_px as i64;
+    for v in 0..h as i64 {
+        for u in 0..w as i64 {
+            if reference.data[v as usize * w + u as usize] <= bright {
+                continue;
+            }
+            for dv in -m..=m {
+                for du in -m..=m {
+                    let (uu, vv) = (u + du, v + dv);
+                    if uu >= 0 && vv >= 0 && uu < w as i64 && vv < h as i64 {
+                        mask[vv as usize * w + uu as usize] = false;
+                    }
+                }
+            }
+        }
+    }
+    mask
+}
+
+/// Synthetic captures for the tests and benchmarks: the skin rendered through a camera with the
+/// ground-truth caster ([`crate::groundtruth`]), each pin's imprint shaded as a darkening
+/// proportional to its indentation depth along the pixel's ray, blurred by a Gaussian
+/// point-spread function, with vignetting, bright LED reflections near the rim (a little
+/// brighter or dimmer in each image) and Gaussian noise.
+pub mod synthetic {
+    use super::{gaussian_blur, GrayImage};
+    use crate::groundtruth::exact::ExactPrimitives;
+    use crate::groundtruth::rays::PixelRays;
+    use crate::groundtruth::surface::ReferenceSurface;
+    use crate::groundtruth::{indented_hits, reference_hits};
+    use crate::CameraModel;
+    use fabkit_designs::primitives::Primitive;
+    use nalgebra::Isometry3;
+    use rand_chacha::rand_core::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    /// How the images are shaded.
+    #[derive(Debug, Clone, Copy, PartialEq)]
+    pub struct Shading {
+        /// Grey of the skin at the image centre.
+        pub skin_grey: f32,
+        /// Grey outside the skin.
+        pub background_grey: f32,
+        /// Darkening per mm of indentation depth along the ray.
+        pub grey_per_mm: f32,
+        /// Sigma of the point-spread function, px.
+        pub psf_sigma_px: f64,
+        /// Sigma of the noise, grey levels.
+        pub noise_sigma: f64,
+        /// Fraction of the grey lost at the image's corners (quadratic in the radius).
+        pub vignetting: f32,
+        /// LED reflections: count, peak grey above the skin, sigma px, and how much each image's
+        /// peak varies (fraction).
+        pub leds: usize,
+        pub led_grey: f32,
+        pub led_sigma_px: f64,
+        pub led_flicker: f32,
+    }
+
+    impl Default for Shading {
+        fn default() -> Self {
+            Self {
+                skin_grey: 160.0,
+                background_grey: 12.0,
+                grey_per_mm: 120.0,
+                psf_sigma_px: 1.2,
+                noise_sigma: 2.0,
+                vignetting: 0.35,
+                leds: 6,
+                led_grey: 90.0,
+                led_sigma_px: 3.0,
+                led_flicker: 0.3,
+            }
+        }
+    }
+
+    /// A pin of a capture: a sphere of `radius_mm` about `centre_mm` (sensor frame), pressing
+    /// the skin.
+    #[derive(Debug, Clone, Copy, PartialEq)]
+    pub struct Pin {
+        pub centre_mm: [f64; 3],
+        pub radius_mm: f64,
+    }
+
+    /// A rendered capture and its reference.
+    #[derive(Debug, Clone)]
+    pub struct Rendered {
+        pub reference: GrayImage,
+        pub capture: GrayImage,
+        /// Each pin's true centre, px: the centroid of its noise-free imprint (the darkening
+        /// before blur), in the order given; `None` for a pin the camera does not see press.
+        pub centres_px: Vec<Option<[f64; 2]>>,
+    }
+
+    /// Uniform in [0, 1).
+    fn unit(rng: &mut ChaCha8Rng) -> f64 {
+        (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    fn led_image(
+        w: usize,
+        h: usize,
+        base: &[f32],
+        leds: &[[f64; 2]],
+        s: &Shading,
+        rng: &mut ChaCha8Rng,
+    ) -> Vec<f32> {
+        let mut img = base.to_vec();
+        for c in leds {
+            let k = 1.0 + s.led_flicker * (2.0 * unit(rng) as f32 - 1.0);
+            let r = (4.0 * s.led_sigma_px).ceil() as i64;
+            for dv in -r..=r {
+                for du in -r..=r {
+                    let (u, v) = (c[0].round() as i64 + du, c[1].round() as i64 + dv);
+                    if u < 0 || v < 0 || u >= w as i64 || v >= h as i64 {
+                        continue;
+                    }
+                    let d2 = (u as f64 - c[0]).powi(2) + (v as f64 - c[1]).powi(2);
+                    img[v as usize * w + u as usize] += k
+                        * s.led_grey
+                        * (-d2 / (2.0 * s.led_sigma_px * s.led_sigma_px)).exp() as f32;
+                }
+            }
+        }
+        img
+    }
+
+    fn noisy(img: Vec<f32>, sigma: f64, rng: &mut ChaCha8Rng) -> Vec<f32> {
+        img.into_iter()
+            .map(|g| {
+                // Box-Muller
+                let (a, b): (f64, f64) = (unit(rng).max(1e-300), unit(rng));
+                let n = (-2.0 * a.ln()).sqrt() * (std::f64::consts::TAU * b).cos();
+                (g as f64 + sigma * n).clamp(0.0, 255.0) as f32
+            })
+            .collect()
+    }
+
+    /// Renders the reference and the capture of `pins` seen by `camera` at `t_cam_sensor`
+    /// (seeded noise and flicker).
+    pub fn render(
+        camera: &CameraModel,
+        t_cam_sensor: &Isometry3<f64>,
+        surface: &ReferenceSurface,
+        pins: &[Pin],
+        s: &Shading,
+        seed: u64,
+    ) -> Rendered {
+        let rays = PixelRays::new(camera, t_cam_sensor);
+        let (w, h) = (rays.width, rays.height);
+        let refh = reference_hits(&rays, surface);
+        let (cx, cy) = (0.5 * (w as f64 - 1.0), 0.5 * (h as f64 - 1.0));
+        let rmax = cx.hypot(cy);
+        let mut base = vec![s.background_grey; w * h];
+        let mut skin_r: f64 = 0.0;
+        for p in 0..w * h {
+            if refh.t_mm[p].is_finite() {
+                let r = ((p % w) as f64 - cx).hypot((p / w) as f64 - cy) / rmax;
+                base[p] = s.skin_grey * (1.0 - s.vignetting * (r * r) as f32);
+                skin_r = skin_r.max(r * rmax);
+            }
+        }
+        // LED reflections on a circle at 90 % of the skin's extent in the image
+        let leds: Vec<[f64; 2]> = (0..s.leds)
+            .map(|k| {
+                let a = std::f64::consts::TAU * (k as f64 + 0.5) / s.leds as f64;
+                let r = 0.9 * skin_r.min(cy);
+                [cx + r * a.cos(), cy + r * a.sin()]
+            })
+            .collect();
+        // each pin's imprint: the depth it pushes the skin in along each ray
+        let mut dent = vec![0f32; w * h];
+        let mut centres = Vec::with_capacity(pins.len());
+        for pin in pins {
+            let prim = ExactPrimitives::new(&[Primitive::Sphere {
+                centre_mm: pin.centre_mm,
+                radius_mm: pin.radius_mm,
+            }])
+            .expect("a sphere of positive radius");
+            let hits = indented_hits(&rays, &refh, &prim, surface.base_z_mm());
+            let (mut sw, mut su, mut sv) = (0f64, 0f64, 0f64);
+            for p in 0..w * h {
+                if hits.contact[p] && refh.t_mm[p].is_finite() {
+                    let depth = refh.t_mm[p] - hits.t_mm[p];
+                    dent[p] += depth as f32;
+                    sw += depth;
+                    su += depth * (p % w) as f64;
+                    sv += depth * (p / w) as f64;
+                }
+            }
+            centres.push((sw > 0.0).then(|| [su / sw, sv / sw]));
+        }
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let blur = |img: Vec<f32>| {
+            gaussian_blur(
+                &GrayImage {
+                    width: w,
+                    height: h,
+                    data: img,
+                },
+                s.psf_sigma_px,
+            )
+            .data
+        };
+        let reference = led_image(w, h, &blur(base.clone()), &leds, s, &mut rng);
+        let pressed: Vec<f32> = base
+            .iter()
+            .zip(&dent)
+            .map(|(b, d)| b - s.grey_per_mm * d)
+            .collect();
+        let capture = led_image(w, h, &blur(pressed), &leds, s, &mut rng);
+        let reference = noisy(reference, s.noise_sigma, &mut rng);
+        let capture = noisy(capture, s.noise_sigma, &mut rng);
+        Rendered {
+            reference: GrayImage {
+                width: w,
+                height: h,
+                data: reference,
+            },
+            capture: GrayImage {
+                width: w,
+                height: h,
+                data: capture,
+            },
+            centres_px: centres,
+        }
+    }
+}
