@@ -227,6 +227,214 @@ pub fn detect(
     Ok(spots)
 }
 
+/// One capture's detected spots and the pins planned for it (the capture plan's row, or the
+/// ids its file name lists).
+#[derive(Debug, Clone, PartialEq)]
+pub struct CaptureSpots {
+    pub name: String,
+    pub planned_ids: Vec<u32>,
+    pub spots: Vec<Spot>,
+}
+
+/// A pin's pixel in a capture.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Observation {
+    pub capture: String,
+    pub id: u32,
+    pub u_px: f64,
+    pub v_px: f64,
+    pub score: f64,
+}
+
+/// The ids given to the spots of every capture.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Assignment {
+    pub observations: Vec<Observation>,
+    /// Captures left out, each with why and what was found.
+    pub rejected: Vec<String>,
+    /// The pose the final assignment was made with (`None` with fewer than 4 pins).
+    pub t_cam_sensor: Option<nalgebra::Isometry3<f64>>,
+}
+
+/// Most pins of one capture (the assignment tries every matching of its spots).
+pub const MAX_PINS_PER_CAPTURE: usize = 8;
+
+/// Gives each capture's spots the ids of its planned pins: first by ring, the spots ordered by
+/// their distance from the principal point against the pins ordered by their polar angle
+/// about the sensor axis (`points`: id to sensor-frame point, mm); then by the pose solved from
+/// all of them, each capture's matching of spots to its pins' projections that moves the spots
+/// least. A capture whose spots do not match its plan in number (a pin missing, an extra spot),
+/// holds more than [`MAX_PINS_PER_CAPTURE`] pins or plans a pin the table lacks is left out and
+/// reported by name with what was found; it is never assigned silently.
+pub fn assign_ids(
+    camera: &crate::CameraModel,
+    points: &std::collections::BTreeMap<u32, nalgebra::Vector3<f64>>,
+    captures: &[CaptureSpots],
+) -> Assignment {
+    use nalgebra::{Vector2, Vector3};
+    let i = camera.intrinsics();
+    let (cx, cy) = (i.cx_px, i.cy_px);
+    let mut rejected = Vec::new();
+    let mut usable: Vec<&CaptureSpots> = Vec::new();
+    for c in captures {
+        let found = || {
+            c.spots
+                .iter()
+                .map(|s| format!("({:.1}, {:.1})", s.u_px, s.v_px))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        if let Some(id) = c.planned_ids.iter().find(|id| !points.contains_key(id)) {
+            rejected.push(format!(
+                "{}: pin {id} is planned but not in the point table; left out",
+                c.name
+            ));
+        } else if c.spots.len() != c.planned_ids.len() {
+            rejected.push(format!(
+                "{}: {} spots for the {} planned pins {:?} ({}): {}; left out",
+                c.name,
+                c.spots.len(),
+                c.planned_ids.len(),
+                c.planned_ids,
+                if c.spots.len() < c.planned_ids.len() {
+                    "a pin missing"
+                } else {
+                    "an extra spot"
+                },
+                if c.spots.is_empty() {
+                    "none found".to_string()
+                } else {
+                    format!("found at {}", found())
+                }
+            ));
+        } else if c.planned_ids.len() > MAX_PINS_PER_CAPTURE {
+            rejected.push(format!(
+                "{}: {} pins in one capture, more than the {MAX_PINS_PER_CAPTURE} told apart; left out",
+                c.name,
+                c.planned_ids.len()
+            ));
+        } else {
+            usable.push(c);
+        }
+    }
+    let polar = |id: &u32| {
+        let p = points[id];
+        p.xy().norm().atan2(p.z)
+    };
+    // by ring: spots from the centre outwards, pins from the pole outwards
+    let mut assigned: Vec<Vec<(u32, Spot)>> = usable
+        .iter()
+        .map(|c| {
+            let mut ids = c.planned_ids.clone();
+            ids.sort_by(|a, b| polar(a).total_cmp(&polar(b)));
+            let mut spots = c.spots.clone();
+            spots.sort_by(|a, b| {
+                (a.u_px - cx)
+                    .hypot(a.v_px - cy)
+                    .total_cmp(&(b.u_px - cx).hypot(b.v_px - cy))
+            });
+            ids.into_iter().zip(spots).collect()
+        })
+        .collect();
+    let solve = |assigned: &[Vec<(u32, Spot)>]| {
+        let (pts, px): (Vec<Vector3<f64>>, Vec<Vector2<f64>>) = assigned
+            .iter()
+            .flatten()
+            .map(|(id, s)| (points[id], Vector2::new(s.u_px, s.v_px)))
+            .unzip();
+        crate::solve_pnp(camera, &pts, &px, &crate::PnpOptions::default())
+            .ok()
+            .map(|s| s.t_cam_sensor)
+    };
+    let mut pose = solve(&assigned);
+    if let Some(t) = pose {
+        // by the pose: the matching of each capture's spots to its pins' projections that
+        // moves them least
+        for (c, a) in usable.iter().zip(assigned.iter_mut()) {
+            let proj: Vec<Option<Vector2<f64>>> = c
+                .planned_ids
+                .iter()
+                .map(|id| camera.project(&(t * nalgebra::Point3::from(points[id])).coords))
+                .collect();
+            if proj.iter().any(Option::is_none) {
+                continue;
+            }
+            let n = c.spots.len();
+            let mut best: Option<(f64, Vec<usize>)> = None;
+            let mut perm: Vec<usize> = (0..n).collect();
+            permutations(&mut perm, 0, &mut |p| {
+                let cost: f64 = p
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &j)| {
+                        let q = proj[k].expect("checked");
+                        (q.x - c.spots[j].u_px).powi(2) + (q.y - c.spots[j].v_px).powi(2)
+                    })
+                    .sum();
+                if best.as_ref().is_none_or(|b| cost < b.0) {
+                    best = Some((cost, p.to_vec()));
+                }
+            });
+            if let Some((_, p)) = best {
+                *a = c
+                    .planned_ids
+                    .iter()
+                    .zip(p)
+                    .map(|(id, j)| (*id, c.spots[j]))
+                    .collect();
+            }
+        }
+        pose = solve(&assigned).or(pose);
+    }
+    let observations = usable
+        .iter()
+        .zip(&assigned)
+        .flat_map(|(c, a)| {
+            let mut a = a.clone();
+            a.sort_by_key(|(id, _)| *id);
+            a.into_iter().map(|(id, s)| Observation {
+                capture: c.name.clone(),
+                id,
+                u_px: s.u_px,
+                v_px: s.v_px,
+                score: s.score,
+            })
+        })
+        .collect();
+    Assignment {
+        observations,
+        rejected,
+        t_cam_sensor: pose,
+    }
+}
+
+/// Calls `f` with every permutation of `v[k..]` (Heap-free recursive swap order).
+fn permutations(v: &mut Vec<usize>, k: usize, f: &mut dyn FnMut(&[usize])) {
+    if k == v.len() {
+        f(v);
+        return;
+    }
+    for i in k..v.len() {
+        v.swap(k, i);
+        permutations(v, k + 1, f);
+        v.swap(k, i);
+    }
+}
+
+/// The ids a capture's file name lists in ring order (the R-Tac0 authors' convention:
+/// `01_02_06_14_22.png` holds pins 1, 2, 6, 14 and 22): the stem's `_`-separated numbers;
+/// `None` when the stem is not such a list.
+pub fn ids_from_file_name(path: &std::path::Path) -> Option<Vec<u32>> {
+    let stem = path.file_stem()?.to_str()?;
+    stem.split('_')
+        .map(|t| {
+            (!t.is_empty() && t.chars().all(|c| c.is_ascii_digit()))
+                .then(|| t.parse::<u32>().ok())
+                .flatten()
+        })
+        .collect()
+}
+
 /// The pixels that can hold an imprint, from the reference image: skin (brighter than a
 /// quarter of the median grey) and not an LED reflection (at most halfway from the median to
 /// `white`), the reflections grown by `margin_px`.

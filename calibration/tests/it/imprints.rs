@@ -93,3 +93,140 @@ fn imprints_are_found_alone_and_centred_within_a_tenth_of_a_pixel() {
     let rms = (sq / n as f64).sqrt();
     assert!(rms < 0.1, "centroid error {rms:.4} px RMS over {n} pins");
 }
+
+/// Ids and pose from the detections: six captures of one pin per ring (ids 1 for the pole pin,
+/// then 10 k + ring), their ids given in any order: every spot gets its pin's id; the pose
+/// solved from the detected centres is as good as the one solved from the true centroids
+/// (within 1.1 x, both against the true pose, the pins' tips as the points); a capture with a
+/// pin missing and one with an extra spot are reported by name and left out.
+#[test]
+fn ids_follow_the_plan_and_the_pose_is_as_good_as_from_true_centres() {
+    use fabkit_calibration::imprints::{assign_ids, CaptureSpots};
+    use fabkit_calibration::nalgebra::{Vector2, Vector3};
+    use std::collections::BTreeMap;
+    let design = fabkit_designs::library::load("rtac0").unwrap();
+    let surface = ReferenceSurface::of(&design.body).unwrap();
+    let cam = benchmark_camera();
+    let depth = 1.0;
+    let mut points: BTreeMap<u32, Vector3<f64>> = BTreeMap::new();
+    let mut captures = Vec::new();
+    let mut truth: BTreeMap<u32, [f64; 2]> = BTreeMap::new();
+    let turns = [0.0, 45.0, 90.0, 135.0, 200.0, 290.0];
+    for (k, turn) in turns.into_iter().enumerate() {
+        let mut pins = capture_pins(turn, depth);
+        let mut ids: Vec<u32> = (0..pins.len() as u32)
+            .map(|ring| {
+                if ring == 0 {
+                    1
+                } else {
+                    10 * (k as u32 + 1) + ring
+                }
+            })
+            .collect();
+        for (id, p) in ids.iter().zip(&pins) {
+            // the tip: the ball's lowest point along the normal
+            let c = Vector3::from(p.centre_mm);
+            points.insert(*id, c - c.normalize() * p.radius_mm);
+        }
+        let name = match k {
+            4 => {
+                pins.pop(); // pressed one pin fewer than planned
+                "capture_missing.png".to_string()
+            }
+            5 => {
+                // an extra press the plan does not list
+                let mut extra = capture_pins(turn + 180.0, depth)[2];
+                extra.radius_mm = 1.5;
+                pins.push(extra);
+                "capture_extra.png".to_string()
+            }
+            _ => format!("capture_{k}.png"),
+        };
+        let r = render(
+            &cam,
+            &pose(),
+            &surface,
+            &pins,
+            &Shading::default(),
+            10 + k as u64,
+        );
+        if k < 4 {
+            for (id, c) in ids.iter().zip(&r.centres_px) {
+                if *id != 1 || k == 0 {
+                    truth.insert(*id, c.unwrap());
+                }
+            }
+        }
+        let mask = reference_mask(&r.reference, 255.0, 4);
+        let spots = detect(
+            &r.reference,
+            &r.capture,
+            Some(&mask),
+            &DetectParams::default(),
+        )
+        .unwrap();
+        ids.reverse(); // the plan's order does not matter
+        captures.push(CaptureSpots {
+            name,
+            planned_ids: ids,
+            spots,
+        });
+    }
+    let a = assign_ids(&cam, &points, &captures);
+    assert_eq!(a.rejected.len(), 2, "{:?}", a.rejected);
+    assert!(
+        a.rejected[0].starts_with("capture_missing.png: 4 spots for the 5 planned pins")
+            && a.rejected[0].contains("a pin missing"),
+        "{}",
+        a.rejected[0]
+    );
+    assert!(
+        a.rejected[1].starts_with("capture_extra.png: 6 spots for the 5 planned pins")
+            && a.rejected[1].contains("an extra spot"),
+        "{}",
+        a.rejected[1]
+    );
+    assert_eq!(a.observations.len(), 20);
+    for o in &a.observations {
+        // the pole pin is pressed in every capture: its true centre is the same
+        let t = truth[&o.id];
+        let e = (o.u_px - t[0]).hypot(o.v_px - t[1]);
+        assert!(
+            e < 0.5,
+            "{} pin {}: {e} px from its own imprint",
+            o.capture,
+            o.id
+        );
+    }
+    // pose from the detected centres against the pose from the true centroids
+    let solve = |px: Vec<Vector2<f64>>, pts: Vec<Vector3<f64>>| {
+        fabkit_calibration::solve_pnp(&cam, &pts, &px, &Default::default())
+            .unwrap()
+            .t_cam_sensor
+    };
+    let pts: Vec<Vector3<f64>> = a.observations.iter().map(|o| points[&o.id]).collect();
+    let detected = solve(
+        a.observations
+            .iter()
+            .map(|o| Vector2::new(o.u_px, o.v_px))
+            .collect(),
+        pts.clone(),
+    );
+    let from_truth = solve(
+        a.observations
+            .iter()
+            .map(|o| Vector2::new(truth[&o.id][0], truth[&o.id][1]))
+            .collect(),
+        pts,
+    );
+    let err = |t: &fabkit_calibration::nalgebra::Isometry3<f64>| {
+        let d = pose().inverse() * t;
+        (d.rotation.angle().to_degrees(), d.translation.vector.norm())
+    };
+    let (rd, td) = err(&detected);
+    let (rt, tt) = err(&from_truth);
+    assert!(
+        rd <= 1.1 * rt + 1e-3 && td <= 1.1 * tt + 1e-4,
+        "detected: {rd:.4} deg, {td:.4} mm; true centroids: {rt:.4} deg, {tt:.4} mm"
+    );
+}
