@@ -230,3 +230,18 @@ fn ids_follow_the_plan_and_the_pose_is_as_good_as_from_true_centres() {
         "detected: {rd:.4} deg, {td:.4} mm; true centroids: {rt:.4} deg, {tt:.4} mm"
     );
 }
+
+/// The authors' file names list a capture's ids in ring order.
+#[test]
+fn ids_are_read_from_the_authors_file_names() {
+    use fabkit_calibration::imprints::ids_from_file_name;
+    use std::path::Path;
+    assert_eq!(
+        ids_from_file_name(Path::new("caps/01_02_06_14_22.png")),
+        Some(vec![1, 2, 6, 14, 22])
+    );
+    assert_eq!(ids_from_file_name(Path::new("7.jpg")), Some(vec![7]));
+    for bad in ["capture_1.png", "01__02.png", "x.png", "01-02.png"] {
+        assert_eq!(ids_from_file_name(Path::new(bad)), None, "{bad}");
+    }
+}
