@@ -545,6 +545,29 @@ pub mod synthetic {
         pub radius_mm: f64,
     }
 
+    /// One pin per ring of an R-Tac0-like dome (polar 0, 18, 34, 50 and 64 deg, azimuths 0, 30,
+    /// 150, 250 and 330 deg turned by `turn_deg`), each a ball of 1.5 mm radius pressed
+    /// `depth_mm` into the R = 15 mm skin along its normal: the test and benchmark captures.
+    pub fn ring_pins(turn_deg: f64, depth_mm: f64) -> Vec<Pin> {
+        [
+            (0.0, 0.0),
+            (18.0, 30.0),
+            (34.0, 150.0),
+            (50.0, 250.0),
+            (64.0, 330.0),
+        ]
+        .iter()
+        .map(|&(polar, az): &(f64, f64)| {
+            let (p, a) = (polar.to_radians(), (az + turn_deg).to_radians());
+            let c = 15.0 + 1.5 - depth_mm;
+            Pin {
+                centre_mm: [c * p.sin() * a.cos(), c * p.sin() * a.sin(), c * p.cos()],
+                radius_mm: 1.5,
+            }
+        })
+        .collect()
+    }
+
     /// A rendered capture and its reference.
     #[derive(Debug, Clone)]
     pub struct Rendered {

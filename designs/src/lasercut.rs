@@ -283,14 +283,9 @@ pub fn tray_sheets(
         ));
         wall_depth -= ch.height_mm;
     }
-    if layer.channels.is_none() {
-        levels.push((
-            "wall",
-            wall_depth,
-            format!("layers[{li}].thickness_mm"),
-            vec![cavity.clone()],
-        ));
-    } else if wall_depth > 1e-9 {
+    // a channel layer may be all channel height (no wall sheet); validation keeps every
+    // layer's thickness above 0
+    if wall_depth > 1e-9 {
         levels.push((
             "wall",
             wall_depth,

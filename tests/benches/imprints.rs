@@ -7,7 +7,7 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use fabkit_calibration::groundtruth::surface::ReferenceSurface;
-use fabkit_calibration::imprints::synthetic::{render, Pin, Shading};
+use fabkit_calibration::imprints::synthetic::{render, ring_pins, Shading};
 use fabkit_calibration::imprints::{detect, reference_mask, DetectParams};
 use fabkit_calibration::nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use fabkit_calibration::synthetic::benchmark_camera;
@@ -19,23 +19,7 @@ fn bench(c: &mut Criterion) {
         Translation3::new(0.3, -0.2, 10.4),
         UnitQuaternion::from_scaled_axis(Vector3::new(0.02, -0.015, 0.4)),
     );
-    let pins: Vec<Pin> = [
-        (0.0, 0.0),
-        (18.0, 30.0),
-        (34.0, 150.0),
-        (50.0, 250.0),
-        (64.0, 330.0),
-    ]
-    .iter()
-    .map(|&(polar, az): &(f64, f64)| {
-        let (p, a) = (polar.to_radians(), az.to_radians());
-        let c = 15.0 + 1.5 - 1.0;
-        Pin {
-            centre_mm: [c * p.sin() * a.cos(), c * p.sin() * a.sin(), c * p.cos()],
-            radius_mm: 1.5,
-        }
-    })
-    .collect();
+    let pins = ring_pins(0.0, 1.0);
     let r = render(
         &benchmark_camera(),
         &pose,

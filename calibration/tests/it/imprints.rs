@@ -6,7 +6,7 @@
 //! centroids of the imprints.
 
 use fabkit_calibration::groundtruth::surface::ReferenceSurface;
-use fabkit_calibration::imprints::synthetic::{render, Pin, Shading};
+use fabkit_calibration::imprints::synthetic::{render, ring_pins as capture_pins, Shading};
 use fabkit_calibration::imprints::{detect, reference_mask, DetectParams};
 use fabkit_calibration::nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use fabkit_calibration::synthetic::benchmark_camera;
@@ -16,29 +16,6 @@ fn pose() -> Isometry3<f64> {
         Translation3::new(0.3, -0.2, 10.4),
         UnitQuaternion::from_scaled_axis(Vector3::new(0.02, -0.015, 0.4)),
     )
-}
-
-/// One pin per ring (polar 0, 18, 34, 50 and 64 deg), turned by `turn_deg` between captures,
-/// pressed `depth_mm` into the R = 15 mm skin along its normal by a ball of 1.5 mm radius.
-fn capture_pins(turn_deg: f64, depth_mm: f64) -> Vec<Pin> {
-    [
-        (0.0, 0.0),
-        (18.0, 30.0),
-        (34.0, 150.0),
-        (50.0, 250.0),
-        (64.0, 330.0),
-    ]
-    .iter()
-    .map(|&(polar, az)| {
-        let (p, a) = (f64::to_radians(polar), f64::to_radians(az + turn_deg));
-        let n = [p.sin() * a.cos(), p.sin() * a.sin(), p.cos()];
-        let c = 15.0 + 1.5 - depth_mm;
-        Pin {
-            centre_mm: n.map(|x| c * x),
-            radius_mm: 1.5,
-        }
-    })
-    .collect()
 }
 
 #[test]
