@@ -1,7 +1,7 @@
 //! `fabkit calibrate extrinsics` as a library call: read the camera file, the point table and the
-//! observations, solve T_cam_sensor (SQPnP, then Levenberg-Marquardt on the reprojection error,
+//! observations (or find them in capture images, [`crate::capture_images`]), solve T_cam_sensor (SQPnP, then Levenberg-Marquardt on the reprojection error,
 //! inside RANSAC), and render the output files `extrinsics.json`, `extrinsics.yaml` and, given a
-//! capture image, `overlay.png` (the caller writes them: `fabkit calibrate extrinsics` stages them
+//! capture image, `overlay.png`; from images also `observations.csv` and `overlays/*.png` (the caller writes them: `fabkit calibrate extrinsics` stages them
 //! in one output folder, moved into place whole).
 //!
 //! Source: R-Tac0 paper, Sec. IV-A, Eq. (1) and Fig. 5 (pins inserted through a dome at known
@@ -10,6 +10,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::camera_file::{read_camera_file, CameraFileError};
+use crate::capture_images::{observe_images, CaptureImages, ImageError};
 use crate::overlay::{read_png_rgb8_sized, render_overlay, OverlayError};
 use crate::pnp::{solve_pnp, PnpError, PnpOptions, RansacOptions};
 use crate::report::{ExtrinsicsReport, Provenance};
@@ -26,10 +27,10 @@ pub struct ExtrinsicsJob {
     /// Point table (fixtures table or `id,x_mm,y_mm,z_mm`), sensor frame, mm.
     pub points: PathBuf,
     pub points_from: PointsFrom,
-    /// Observation files `id,u_px,v_px`.
-    pub observations: Vec<PathBuf>,
-    /// Capture plan (`capture,id,ring`) that the observation files follow, one file per capture
-    /// in capture order; each file's ids are checked against its capture.
+    /// Observation files, or capture images to find them in.
+    pub observations: Observed,
+    /// Capture plan (`capture,id,ring`) that the observation files (or capture images) follow,
+    /// one per capture in capture order; each file's ids are checked against its capture.
     pub capture_plan: Option<PathBuf>,
     /// Capture image for the overlay.
     pub image: Option<PathBuf>,
@@ -37,6 +38,15 @@ pub struct ExtrinsicsJob {
     pub ransac: Option<RansacOptions>,
     /// Recorded in the report's provenance.
     pub command_line: String,
+}
+
+/// Where the pixels of the pins come from.
+#[derive(Debug, Clone)]
+pub enum Observed {
+    /// Observation files `id,u_px,v_px`.
+    Files(Vec<PathBuf>),
+    /// Capture images and the reference image ([`crate::capture_images`]).
+    Images(CaptureImages),
 }
 
 /// Why an extrinsics calibration failed.
@@ -54,6 +64,8 @@ pub enum ExtrinsicsError {
     },
     #[error(transparent)]
     Overlay(#[from] OverlayError),
+    #[error(transparent)]
+    Image(#[from] ImageError),
     #[error("cannot serialise the report as YAML: {0}")]
     Yaml(String),
 }
@@ -62,9 +74,10 @@ pub enum ExtrinsicsError {
 #[derive(Debug, Clone)]
 pub struct ExtrinsicsOutput {
     pub report: ExtrinsicsReport,
-    /// (file name, bytes): `extrinsics.json`, `extrinsics.yaml` and, given a capture image,
-    /// `overlay.png`, in that order.
-    pub files: Vec<(&'static str, Vec<u8>)>,
+    /// (file name, bytes): `extrinsics.json`, `extrinsics.yaml`, given a capture image
+    /// `overlay.png`, and from capture images `observations.csv` and `overlays/<capture>.png`,
+    /// in that order.
+    pub files: Vec<(String, Vec<u8>)>,
 }
 
 /// Runs the calibration; returns the report and the output files. Reads only the job's input
@@ -73,14 +86,32 @@ pub struct ExtrinsicsOutput {
 /// # Errors
 /// [`ExtrinsicsError`]: unreadable or invalid inputs (file:line and field), unmatched ids, fewer
 /// than 4 usable points, pixels outside the lens's field, degenerate layouts, points behind the
-/// camera at the solved pose, too few RANSAC inliers, a capture image of the wrong size.
+/// camera at the solved pose, too few RANSAC inliers, a capture image of the wrong size; from
+/// images, also the errors of [`observe_images`] (an unreadable image, file names without ids,
+/// a plan of another length).
 pub fn calibrate_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsOutput, ExtrinsicsError> {
     let camera = read_camera_file(&job.camera)?;
     let table = read_point_table(&job.points, job.points_from)?;
-    let obs_paths: Vec<&Path> = job.observations.iter().map(PathBuf::as_path).collect();
-    let (obs, unobserved_ids) = match &job.capture_plan {
-        Some(plan) => read_captures(&obs_paths, &read_capture_plan(plan)?)?,
-        None => (read_observations(&obs_paths)?, Vec::new()),
+    let plan = job
+        .capture_plan
+        .as_deref()
+        .map(read_capture_plan)
+        .transpose()?;
+    let (obs_paths, from_images): (Vec<&Path>, _) = match &job.observations {
+        Observed::Files(f) => (f.iter().map(PathBuf::as_path).collect(), None),
+        Observed::Images(i) => {
+            let camera_file = job.camera.display().to_string();
+            let found = observe_images(&camera, &camera_file, &table, plan.as_ref(), i)?;
+            (
+                i.captures.iter().map(PathBuf::as_path).collect(),
+                Some(found),
+            )
+        }
+    };
+    let (obs, unobserved_ids) = match (&from_images, &plan) {
+        (Some(found), _) => (found.observations.clone(), found.unobserved_ids.clone()),
+        (None, Some(plan)) => read_captures(&obs_paths, plan)?,
+        (None, None) => (read_observations(&obs_paths)?, Vec::new()),
     };
     let pairs = pair(&table, &obs)?;
     let opts = PnpOptions {
@@ -124,14 +155,21 @@ pub fn calibrate_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsOutput, Ext
         observation_files: obs_paths.iter().map(|p| p.display().to_string()).collect(),
         capture_plan: job.capture_plan.as_ref().map(|p| p.display().to_string()),
         unobserved_ids,
+        reference_image: match &job.observations {
+            Observed::Images(i) => Some(i.reference.display().to_string()),
+            Observed::Files(_) => None,
+        },
     };
-    let report = ExtrinsicsReport::new(
+    let mut report = ExtrinsicsReport::new(
         &camera,
         &pairs,
         &sol,
         job.ransac.map(|r| r.threshold_px),
         provenance,
     );
+    if let Some(found) = &from_images {
+        report.warnings.extend(found.rejected.iter().cloned());
+    }
     let json = report.to_json();
     let yaml = report.to_yaml().map_err(ExtrinsicsError::Yaml)?;
     let overlay = match &job.image {
@@ -143,11 +181,15 @@ pub fn calibrate_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsOutput, Ext
         None => None,
     };
     let mut files = vec![
-        ("extrinsics.json", json.into_bytes()),
-        ("extrinsics.yaml", yaml.into_bytes()),
+        ("extrinsics.json".to_string(), json.into_bytes()),
+        ("extrinsics.yaml".to_string(), yaml.into_bytes()),
     ];
     if let Some(o) = overlay {
-        files.push(("overlay.png", o));
+        files.push(("overlay.png".into(), o));
+    }
+    if let Some(found) = &from_images {
+        files.push(("observations.csv".into(), found.csv.clone().into_bytes()));
+        files.extend(found.overlays(&camera, &table, &sol.t_cam_sensor)?);
     }
     Ok(ExtrinsicsOutput { report, files })
 }

@@ -11,6 +11,7 @@
 
 pub mod camera;
 pub mod camera_file;
+pub mod capture_images;
 pub mod extrinsics;
 pub mod groundtruth;
 pub mod imprints;
@@ -26,7 +27,9 @@ pub use camera::{CameraError, CameraModel, Distortion, Intrinsics};
 pub use camera_file::{
     parse_camera, read_camera_file, write_camera, CameraFileError, CameraFileFormat,
 };
-pub use extrinsics::{calibrate_extrinsics, ExtrinsicsError, ExtrinsicsJob, ExtrinsicsOutput};
+pub use extrinsics::{
+    calibrate_extrinsics, ExtrinsicsError, ExtrinsicsJob, ExtrinsicsOutput, Observed,
+};
 pub use nalgebra;
 pub use pnp::{
     pose_uncertainty, solve_pnp, PnpError, PnpOptions, PnpSolution, PoseUncertainty, RansacOptions,

@@ -41,14 +41,14 @@ pub struct Rgb8 {
 }
 
 impl Rgb8 {
-    fn put(&mut self, x: i64, y: i64, c: [u8; 3]) {
+    pub(crate) fn put(&mut self, x: i64, y: i64, c: [u8; 3]) {
         if x >= 0 && y >= 0 && (x as u32) < self.width && (y as u32) < self.height {
             let i = 3 * (y as usize * self.width as usize + x as usize);
             self.data[i..i + 3].copy_from_slice(&c);
         }
     }
 
-    fn line(&mut self, x0: f64, y0: f64, x1: f64, y1: f64, c: [u8; 3]) {
+    pub(crate) fn line(&mut self, x0: f64, y0: f64, x1: f64, y1: f64, c: [u8; 3]) {
         let n = ((x1 - x0).abs().max((y1 - y0).abs()).ceil() as i64).clamp(1, 10_000);
         for k in 0..=n {
             let t = k as f64 / n as f64;
@@ -60,7 +60,7 @@ impl Rgb8 {
         }
     }
 
-    fn circle(&mut self, x: f64, y: f64, r: f64, c: [u8; 3]) {
+    pub(crate) fn circle(&mut self, x: f64, y: f64, r: f64, c: [u8; 3]) {
         let n = (2.0 * std::f64::consts::PI * r).ceil() as i64 * 2;
         for k in 0..n {
             let a = 2.0 * std::f64::consts::PI * k as f64 / n as f64;
@@ -70,6 +70,70 @@ impl Rgb8 {
                 c,
             );
         }
+    }
+
+    /// Writes `text` (digits, `?` and `-`; other characters as blanks) with its top-left corner
+    /// at (`x`, `y`) px, in a 3 x 5 pixel font scaled `scale` times.
+    pub(crate) fn text(&mut self, x: f64, y: f64, text: &str, scale: i64, c: [u8; 3]) {
+        for (k, ch) in text.chars().enumerate() {
+            let rows = glyph(ch);
+            for (r, bits) in rows.iter().enumerate() {
+                for col in 0..3 {
+                    if bits & (0b100 >> col) == 0 {
+                        continue;
+                    }
+                    for dy in 0..scale {
+                        for dx in 0..scale {
+                            self.put(
+                                x.round() as i64 + (4 * k as i64 + col) * scale + dx,
+                                y.round() as i64 + r as i64 * scale + dy,
+                                c,
+                            );
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// The image encoded as an 8-bit RGB PNG.
+    ///
+    /// # Errors
+    /// [`OverlayError::Encode`].
+    pub fn to_png(&self) -> Result<Vec<u8>, OverlayError> {
+        let mut out = Vec::new();
+        {
+            let mut enc = png::Encoder::new(&mut out, self.width, self.height);
+            enc.set_color(png::ColorType::Rgb);
+            enc.set_depth(png::BitDepth::Eight);
+            let mut w = enc
+                .write_header()
+                .map_err(|e| OverlayError::Encode(e.to_string()))?;
+            w.write_image_data(&self.data)
+                .map_err(|e| OverlayError::Encode(e.to_string()))?;
+            w.finish()
+                .map_err(|e| OverlayError::Encode(e.to_string()))?;
+        }
+        Ok(out)
+    }
+}
+
+/// Rows (top first, 3 bits each, high bit left) of a 3 x 5 pixel glyph.
+fn glyph(c: char) -> [u8; 5] {
+    match c {
+        '0' => [0b111, 0b101, 0b101, 0b101, 0b111],
+        '1' => [0b010, 0b110, 0b010, 0b010, 0b111],
+        '2' => [0b111, 0b001, 0b111, 0b100, 0b111],
+        '3' => [0b111, 0b001, 0b111, 0b001, 0b111],
+        '4' => [0b101, 0b101, 0b111, 0b001, 0b001],
+        '5' => [0b111, 0b100, 0b111, 0b001, 0b111],
+        '6' => [0b111, 0b100, 0b111, 0b101, 0b111],
+        '7' => [0b111, 0b001, 0b010, 0b010, 0b010],
+        '8' => [0b111, 0b101, 0b111, 0b101, 0b111],
+        '9' => [0b111, 0b101, 0b111, 0b001, 0b111],
+        '?' => [0b111, 0b001, 0b011, 0b000, 0b010],
+        '-' => [0b000, 0b000, 0b111, 0b000, 0b000],
+        _ => [0; 5],
     }
 }
 
@@ -177,20 +241,7 @@ pub fn render_overlay(mut img: Rgb8, report: &ExtrinsicsReport) -> Result<Vec<u8
             );
         }
     }
-    let mut out = Vec::new();
-    {
-        let mut enc = png::Encoder::new(&mut out, img.width, img.height);
-        enc.set_color(png::ColorType::Rgb);
-        enc.set_depth(png::BitDepth::Eight);
-        let mut w = enc
-            .write_header()
-            .map_err(|e| OverlayError::Encode(e.to_string()))?;
-        w.write_image_data(&img.data)
-            .map_err(|e| OverlayError::Encode(e.to_string()))?;
-        w.finish()
-            .map_err(|e| OverlayError::Encode(e.to_string()))?;
-    }
-    Ok(out)
+    img.to_png()
 }
 
 /// Encodes an 8-bit grey image (row-major, `width * height` bytes) as PNG, e.g. for synthetic

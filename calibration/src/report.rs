@@ -23,6 +23,10 @@ pub struct Provenance {
     /// Pins of the capture plan with no observation (not used in the solve), plan order.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub unobserved_ids: Vec<String>,
+    /// The reference image the capture images were compared with (observations found in
+    /// images; `observation_files` are then the capture images).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reference_image: Option<String>,
 }
 
 /// One observed point's residual.

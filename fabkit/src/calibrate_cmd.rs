@@ -3,7 +3,10 @@
 use std::error::Error;
 use std::path::PathBuf;
 
-use fabkit_calibration::{calibrate_extrinsics, ExtrinsicsJob, PointsFrom, RansacOptions};
+use fabkit_calibration::capture_images::CaptureImages;
+use fabkit_calibration::{
+    calibrate_extrinsics, ExtrinsicsJob, Observed, PointsFrom, RansacOptions,
+};
 use fabkit_export::StagedDir;
 
 #[derive(clap::Subcommand, Debug)]
@@ -33,13 +36,25 @@ pub struct ExtrinsicsArgs {
     #[arg(long, value_enum, default_value = "tip")]
     pub points_from: PointsFromArg,
     /// Pixel observations, CSV id,u_px,v_px; several files (one per capture) may be given.
-    #[arg(long, value_name = "OBS.csv", num_args = 1.., required = true)]
+    #[arg(long, value_name = "OBS.csv", num_args = 1.., required_unless_present = "images", conflicts_with = "images")]
     pub observations: Vec<PathBuf>,
-    /// Capture plan (points/capture_plan.csv of `fabkit fixtures`): the observation files are one
-    /// per capture, in capture order, and each may hold only that capture's pins.
+    /// Capture images (PNG or JPEG, 8- or 16-bit, grey or RGB, the camera's size), one per
+    /// capture: the pins' imprints are found against --reference, written to observations.csv
+    /// with an overlay per capture (overlays/), and the pose solved from them. Pin ids come from
+    /// --capture-plan (images in capture order) or from the file names, which list the
+    /// capture's pins in ring order (01_02_06_14_22.png: pins 1, 2, 6, 14 and 22).
+    #[arg(long, value_name = "CAPTURE.png", num_args = 1.., requires = "reference")]
+    pub images: Vec<PathBuf>,
+    /// Reference image of the unloaded skin (same camera and lighting as --images).
+    #[arg(long, value_name = "REF.png", requires = "images")]
+    pub reference: Option<PathBuf>,
+    /// Capture plan (points/capture_plan.csv of `fabkit fixtures`): the observation files (or
+    /// capture images) are one per capture, in capture order, and each may hold only that
+    /// capture's pins.
     #[arg(long, value_name = "PLAN.csv")]
     pub capture_plan: Option<PathBuf>,
-    /// Output folder for extrinsics.json, extrinsics.yaml (and overlay.png): missing, empty, or an
+    /// Output folder for extrinsics.json, extrinsics.yaml (overlay.png; from images
+    /// observations.csv and overlays/): missing, empty, or an
     /// earlier fabkit output (replaced whole, never a folder of the user's own files).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
@@ -78,7 +93,13 @@ fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
             PointsFromArg::Tip => PointsFrom::Tip,
             PointsFromArg::Contact => PointsFrom::Contact,
         },
-        observations: a.observations,
+        observations: match a.reference {
+            Some(reference) => Observed::Images(CaptureImages {
+                captures: a.images,
+                reference,
+            }),
+            None => Observed::Files(a.observations),
+        },
         capture_plan: a.capture_plan,
         image: a.image,
         ransac: (!a.no_ransac).then_some(RansacOptions {

@@ -9,7 +9,7 @@ use fabkit_calibration::nalgebra::{Isometry3, Point3, Translation3, UnitQuaterni
 use fabkit_calibration::overlay::{encode_gray8, read_png_rgb8};
 use fabkit_calibration::{write_camera, CameraFileFormat, CameraModel, Distortion, Intrinsics};
 
-fn intrinsics() -> Intrinsics {
+pub(crate) fn intrinsics() -> Intrinsics {
     Intrinsics {
         image_width_px: 640,
         image_height_px: 480,
@@ -21,7 +21,7 @@ fn intrinsics() -> Intrinsics {
     }
 }
 
-fn truth() -> Isometry3<f64> {
+pub(crate) fn truth() -> Isometry3<f64> {
     Isometry3::from_parts(
         Translation3::new(0.3, -0.2, 10.4),
         UnitQuaternion::from_scaled_axis(Vector3::new(0.02, -0.015, 0.4)),
@@ -75,11 +75,11 @@ fn observe(contact: bool, ids: impl Iterator<Item = usize>) -> String {
     s
 }
 
-fn json(path: &Path) -> serde_json::Value {
+pub(crate) fn json(path: &Path) -> serde_json::Value {
     serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap()
 }
 
-fn pose_of(j: &serde_json::Value) -> Isometry3<f64> {
+pub(crate) fn pose_of(j: &serde_json::Value) -> Isometry3<f64> {
     let r: Vec<f64> = j["rvec"]
         .as_array()
         .unwrap()

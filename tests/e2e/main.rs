@@ -7,6 +7,7 @@ mod common;
 mod assembly_step;
 mod authors_cad;
 mod calibrate_cli;
+mod calibrate_images;
 mod calibrate_opencv;
 mod cli_errors;
 mod export_flat;

@@ -275,6 +275,7 @@ fn four_pins_near_the_pole_report_their_covariance_and_warn() {
             observation_files: Vec::new(),
             capture_plan: None,
             unobserved_ids: Vec::new(),
+            reference_image: None,
         };
         (
             s.clone(),

@@ -1,0 +1,397 @@
+//! From capture photos to pin observations (R-Tac0 Sec. IV-A, Fig. 5): each capture image is
+//! compared with one reference image of the unloaded skin ([`crate::imprints::detect`] inside
+//! [`crate::imprints::reference_mask`]), each capture's spots get the ids of the pins planned
+//! for it ([`crate::imprints::assign_ids`]: the capture plan's row, or the ids the file name
+//! lists in ring order), and the result is the observations the solve uses, the
+//! `observations.csv` table (capture, id, u_px, v_px, score) and an overlay per capture.
+//!
+//! Images: PNG or JPEG, 8- or 16-bit, grey or RGB (converted to grey, 0..255 grey levels), of
+//! the camera file's size (checked from the header, before any pixel is decoded).
+
+use std::collections::BTreeMap;
+use std::io::Cursor;
+use std::path::{Path, PathBuf};
+
+use nalgebra::{Isometry3, Point3, Vector2, Vector3};
+use rayon::prelude::*;
+
+use crate::imprints::{
+    assign_ids, detect, ids_from_file_name, reference_mask, CaptureSpots, DetectParams, GrayImage,
+};
+use crate::overlay::{OverlayError, Rgb8};
+use crate::tables::{CapturePlan, Observations, PointTable};
+use crate::CameraModel;
+
+/// Capture images and the reference image they are compared with.
+#[derive(Debug, Clone)]
+pub struct CaptureImages {
+    /// One image per capture: in the capture plan's order, or named by the ids they hold in
+    /// ring order (`01_02_06_14_22.png`).
+    pub captures: Vec<PathBuf>,
+    /// The unloaded skin, same camera and lighting.
+    pub reference: PathBuf,
+}
+
+/// LED reflections in the reference are masked with this margin, px.
+pub const REFLECTION_MARGIN_PX: usize = 4;
+
+/// A capture or reference image that cannot be used; `option` is the command-line option that
+/// gave the file (`--images`, `--reference`).
+#[derive(Debug, thiserror::Error)]
+pub enum ImageError {
+    #[error("{option} = {file}: cannot read: {source}")]
+    Io {
+        option: &'static str,
+        file: String,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{option} = {file}: not a readable PNG or JPEG image: {message}")]
+    Decode {
+        option: &'static str,
+        file: String,
+        message: String,
+    },
+    #[error("{option} = {file}: the image is {width} x {height} px but the camera file {camera} says {camera_width} x {camera_height} px; they must match")]
+    Size {
+        option: &'static str,
+        file: String,
+        width: u32,
+        height: u32,
+        camera: String,
+        camera_width: u32,
+        camera_height: u32,
+    },
+    #[error("--images = {file}: {rule}")]
+    Ids { file: String, rule: String },
+    #[error("--images: {images} images but the capture plan {plan} has {captures} captures; give one image per capture, in capture order")]
+    Count {
+        images: usize,
+        plan: String,
+        captures: usize,
+    },
+    #[error("--images = {file}: given twice")]
+    Twice { file: String },
+}
+
+/// Reads `path` (PNG or JPEG, any depth, grey or colour) as grey levels 0..255, checking its
+/// size against the camera's (`expect_px`, from the camera file `camera`) before decoding.
+///
+/// # Errors
+/// [`ImageError`] naming `option` and the file.
+pub fn read_gray(
+    path: &Path,
+    option: &'static str,
+    expect_px: (u32, u32),
+    camera: &str,
+) -> Result<GrayImage, ImageError> {
+    let file = path.display().to_string();
+    let bytes = crate::read_binary(path).map_err(|source| ImageError::Io {
+        option,
+        file: file.clone(),
+        source,
+    })?;
+    let decode = |message: String| ImageError::Decode {
+        option,
+        file: file.clone(),
+        message,
+    };
+    let reader = || {
+        image::ImageReader::new(Cursor::new(&bytes[..]))
+            .with_guessed_format()
+            .map_err(|e| decode(e.to_string()))
+    };
+    match reader()?.format() {
+        Some(image::ImageFormat::Png | image::ImageFormat::Jpeg) => {}
+        Some(f) => return Err(decode(format!("{f:?} images are not read"))),
+        None => return Err(decode("the content is neither PNG nor JPEG".into())),
+    }
+    let (width, height) = reader()?
+        .into_dimensions()
+        .map_err(|e| decode(e.to_string()))?;
+    if (width, height) != expect_px {
+        return Err(ImageError::Size {
+            option,
+            file,
+            width,
+            height,
+            camera: camera.into(),
+            camera_width: expect_px.0,
+            camera_height: expect_px.1,
+        });
+    }
+    let img = reader()?.decode().map_err(|e| decode(e.to_string()))?;
+    // 16 bits per grey level: 8-bit images come back as g * 257, exactly g after the division
+    let luma = img.into_luma16();
+    Ok(GrayImage {
+        width: width as usize,
+        height: height as usize,
+        data: luma.as_raw().iter().map(|&g| g as f32 / 257.0).collect(),
+    })
+}
+
+/// One capture after detection.
+#[derive(Debug, Clone)]
+struct Capture {
+    image: GrayImage,
+    spots: CaptureSpots,
+    /// (spot index, id) of the assigned spots; empty for a capture left out.
+    ids: Vec<(usize, u32)>,
+}
+
+/// The captures' observations.
+#[derive(Debug, Clone)]
+pub struct ImageObservations {
+    /// One row per pin id (a pin seen in several captures, the pole pin, averaged), first-seen
+    /// order; ids spelled as in the point table.
+    pub observations: Observations,
+    /// Planned pins with no observation (in a capture left out, or not in the table), plan
+    /// order.
+    pub unobserved_ids: Vec<String>,
+    /// `observations.csv`: capture, id, u_px, v_px, score, one row per detection.
+    pub csv: String,
+    /// Each capture left out, with why and what was found.
+    pub rejected: Vec<String>,
+    captures: Vec<Capture>,
+}
+
+fn csv_cell(s: &str) -> String {
+    if s.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.into()
+    }
+}
+
+/// Finds the pins in every capture of `input` and gives them their ids: from `plan` (one image
+/// per capture, in order) or, without a plan, from each image's file name. `camera_file` names
+/// the camera file in size errors.
+///
+/// # Errors
+/// [`ImageError`]: an unreadable image or one of another size than the camera's, an image
+/// given twice, a file name that lists no ids (without a plan), a plan id that is not a
+/// number, a plan with another number of captures.
+pub fn observe_images(
+    camera: &CameraModel,
+    camera_file: &str,
+    table: &PointTable,
+    plan: Option<&CapturePlan>,
+    input: &CaptureImages,
+) -> Result<ImageObservations, ImageError> {
+    let intr = camera.intrinsics();
+    let size = (intr.image_width_px, intr.image_height_px);
+    for (k, p) in input.captures.iter().enumerate() {
+        if input.captures[..k].contains(p) {
+            return Err(ImageError::Twice {
+                file: p.display().to_string(),
+            });
+        }
+    }
+    let planned: Vec<Vec<u32>> = match plan {
+        Some(plan) => {
+            if plan.captures.len() != input.captures.len() {
+                return Err(ImageError::Count {
+                    images: input.captures.len(),
+                    plan: plan.file.clone(),
+                    captures: plan.captures.len(),
+                });
+            }
+            plan.captures
+                .iter()
+                .zip(&input.captures)
+                .map(|(ids, p)| {
+                    ids.iter()
+                        .map(|id| {
+                            id.parse::<u32>().map_err(|_| ImageError::Ids {
+                                file: p.display().to_string(),
+                                rule: format!(
+                                    "its pins in the capture plan {} include id '{id}', not a pin number",
+                                    plan.file
+                                ),
+                            })
+                        })
+                        .collect()
+                })
+                .collect::<Result<_, _>>()?
+        }
+        None => input
+            .captures
+            .iter()
+            .map(|p| {
+                ids_from_file_name(p).ok_or_else(|| ImageError::Ids {
+                    file: p.display().to_string(),
+                    rule: "the file name does not list the capture's pin ids in ring order (as 01_02_06_14_22.png for pins 1, 2, 6, 14 and 22); name the images so, or give --capture-plan".into(),
+                })
+            })
+            .collect::<Result<_, _>>()?,
+    };
+    let reference = read_gray(&input.reference, "--reference", size, camera_file)?;
+    let mask = reference_mask(&reference, 255.0, REFLECTION_MARGIN_PX);
+    let params = DetectParams::default();
+    // read and detect in parallel; the first error in capture order is reported
+    let captures: Vec<Result<Capture, ImageError>> = input
+        .captures
+        .par_iter()
+        .zip(planned.par_iter())
+        .map(|(p, ids)| {
+            let image = read_gray(p, "--images", size, camera_file)?;
+            let spots = detect(&reference, &image, Some(&mask), &params)
+                .expect("sizes checked against the camera's");
+            Ok(Capture {
+                image,
+                spots: CaptureSpots {
+                    name: p.display().to_string(),
+                    planned_ids: ids.clone(),
+                    spots,
+                },
+                ids: Vec::new(),
+            })
+        })
+        .collect();
+    let mut captures: Vec<Capture> = captures.into_iter().collect::<Result<_, _>>()?;
+    // the table's ids by number
+    let by_number: BTreeMap<u32, (&String, Vector3<f64>)> = table
+        .rows
+        .iter()
+        .filter_map(|(id, p, _)| id.parse::<u32>().ok().map(|n| (n, (id, *p))))
+        .collect();
+    let points: BTreeMap<u32, Vector3<f64>> =
+        by_number.iter().map(|(n, (_, p))| (*n, *p)).collect();
+    let spots: Vec<CaptureSpots> = captures.iter().map(|c| c.spots.clone()).collect();
+    let assignment = assign_ids(camera, &points, &spots);
+    let mut csv = String::from(
+        "# fabkit pin-imprint observations: pixel of each pin's imprint (sub-pixel centroid; (0, 0) the centre of the top-left pixel, docs/conventions.md); score: the imprint's peak over the noise sigma\ncapture,id,u_px,v_px,score\n",
+    );
+    // id -> (sum of pixels, count, captures), first-seen order
+    let mut merged: Vec<(String, Vector2<f64>, usize, Vec<String>)> = Vec::new();
+    for o in &assignment.observations {
+        csv.push_str(&format!(
+            "{},{},{:.4},{:.4},{:.2}\n",
+            csv_cell(&o.capture),
+            o.id,
+            o.u_px,
+            o.v_px,
+            o.score
+        ));
+        let c = captures
+            .iter_mut()
+            .find(|c| c.spots.name == o.capture)
+            .expect("an observation's capture is one of the captures");
+        if let Some(j) = c
+            .spots
+            .spots
+            .iter()
+            .position(|s| s.u_px == o.u_px && s.v_px == o.v_px)
+        {
+            c.ids.push((j, o.id));
+        }
+        let id = by_number[&o.id].0.clone();
+        let uv = Vector2::new(o.u_px, o.v_px);
+        match merged.iter_mut().find(|m| m.0 == id) {
+            Some(m) => {
+                m.1 += uv;
+                m.2 += 1;
+                m.3.push(o.capture.clone());
+            }
+            None => merged.push((id, uv, 1, vec![o.capture.clone()])),
+        }
+    }
+    let rows: Vec<(String, Vector2<f64>, String)> = merged
+        .into_iter()
+        .map(|(id, sum, n, caps)| {
+            let origin = format!("detected in {}", caps.join(" + "));
+            (id, sum / n as f64, origin)
+        })
+        .collect();
+    let mut unobserved_ids: Vec<String> = Vec::new();
+    for n in planned.iter().flatten() {
+        let id = by_number
+            .get(n)
+            .map_or_else(|| n.to_string(), |(id, _)| (*id).clone());
+        if !rows.iter().any(|r| r.0 == id) && !unobserved_ids.contains(&id) {
+            unobserved_ids.push(id);
+        }
+    }
+    Ok(ImageObservations {
+        observations: Observations { rows },
+        unobserved_ids,
+        csv,
+        rejected: assignment.rejected,
+        captures,
+    })
+}
+
+impl ImageObservations {
+    /// An overlay per capture, `overlays/<file stem>.png` (a stem used twice gets `-2`, `-3`,
+    /// ...): the capture with each assigned spot circled in green and labelled with its id,
+    /// the spots of a capture left out circled in magenta and labelled `?`, and each planned
+    /// pin's point of the table projected at `t_cam_sensor` as a red cross.
+    ///
+    /// # Errors
+    /// [`OverlayError::Encode`].
+    pub fn overlays(
+        &self,
+        camera: &CameraModel,
+        table: &PointTable,
+        t_cam_sensor: &Isometry3<f64>,
+    ) -> Result<Vec<(String, Vec<u8>)>, OverlayError> {
+        const GREEN: [u8; 3] = [0, 220, 0];
+        const RED: [u8; 3] = [255, 40, 40];
+        const YELLOW: [u8; 3] = [255, 220, 0];
+        const MAGENTA: [u8; 3] = [255, 0, 255];
+        let mut names: Vec<String> = Vec::new();
+        let mut out = Vec::new();
+        for c in &self.captures {
+            let stem = Path::new(&c.spots.name)
+                .file_stem()
+                .map_or_else(|| "capture".into(), |s| s.to_string_lossy().into_owned());
+            let mut name = stem.clone();
+            let mut k = 1;
+            while names.contains(&name) {
+                k += 1;
+                name = format!("{stem}-{k}");
+            }
+            names.push(name.clone());
+            let mut img = Rgb8 {
+                width: c.image.width as u32,
+                height: c.image.height as u32,
+                data: c
+                    .image
+                    .data
+                    .iter()
+                    .flat_map(|&g| [g.round().clamp(0.0, 255.0) as u8; 3])
+                    .collect(),
+            };
+            for id in &c.spots.planned_ids {
+                let Some((_, p, _)) = table
+                    .rows
+                    .iter()
+                    .find(|r| r.0.parse::<u32>().ok() == Some(*id))
+                else {
+                    continue;
+                };
+                if let Some(q) = camera.project(&(t_cam_sensor * Point3::from(*p)).coords) {
+                    img.line(q.x - 3.0, q.y, q.x + 3.0, q.y, RED);
+                    img.line(q.x, q.y - 3.0, q.x, q.y + 3.0, RED);
+                }
+            }
+            for (j, s) in c.spots.spots.iter().enumerate() {
+                let r = (s.area_px as f64 / std::f64::consts::PI).sqrt() + 2.0;
+                let (colour, label) = match c.ids.iter().find(|(k, _)| *k == j) {
+                    Some((_, id)) => (GREEN, id.to_string()),
+                    None => (MAGENTA, "?".to_string()),
+                };
+                img.circle(s.u_px, s.v_px, r, colour);
+                img.text(
+                    s.u_px + r + 2.0,
+                    s.v_px - 5.0,
+                    &label,
+                    2,
+                    if colour == GREEN { YELLOW } else { MAGENTA },
+                );
+            }
+            out.push((format!("overlays/{name}.png"), img.to_png()?));
+        }
+        Ok(out)
+    }
+}

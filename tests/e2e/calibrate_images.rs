@@ -1,0 +1,473 @@
+//! `fabkit calibrate extrinsics --images ... --reference ...` end to end: the R-Tac0 pin dome's
+//! point table and capture plan (`fabkit fixtures rtac0 --pins-preset rtac0`: 29 pins, eight
+//! captures of one pin per ring), each capture rendered with the ground-truth caster
+//! (`imprints::synthetic`: imprint darkening, PSF, vignetting, flickering LED reflections,
+//! noise) through the e2e fisheye at a known pose, and written as the photos a user has: grey
+//! 8-bit and 16-bit PNG, RGB PNG and JPEG. The pins are found, given the plan's ids (or the ids
+//! their file names list), written to observations.csv with an overlay per capture, and the
+//! pose solved from them is as good as the pose solved from the imprints' true centroids.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use crate::calibrate_cli::{intrinsics, json, pose_of, truth};
+use crate::common::{run, text};
+use fabkit_calibration::groundtruth::surface::ReferenceSurface;
+use fabkit_calibration::imprints::synthetic::{render, Pin, Shading};
+use fabkit_calibration::imprints::GrayImage;
+use fabkit_calibration::nalgebra::{Isometry3, Vector2, Vector3};
+use fabkit_calibration::tables::{read_capture_plan, read_point_table, PointsFrom};
+use fabkit_calibration::{solve_pnp, write_camera, CameraFileFormat, CameraModel, PnpOptions};
+
+/// The tip radius of the fixtures' default pin, mm.
+const TIP_RADIUS_MM: f64 = 0.8;
+
+/// How a capture is saved.
+#[derive(Clone, Copy)]
+enum Kind {
+    Gray8,
+    Gray16,
+    Rgb8,
+    Jpeg,
+}
+
+fn save(img: &GrayImage, path: &Path, kind: Kind) {
+    let (w, h) = (img.width as u32, img.height as u32);
+    let g8: Vec<u8> = img
+        .data
+        .iter()
+        .map(|g| g.round().clamp(0.0, 255.0) as u8)
+        .collect();
+    match kind {
+        Kind::Gray8 => image::GrayImage::from_raw(w, h, g8)
+            .unwrap()
+            .save(path)
+            .unwrap(),
+        Kind::Gray16 => {
+            let g16: Vec<u16> = img
+                .data
+                .iter()
+                .map(|g| (g.clamp(0.0, 255.0) * 257.0).round() as u16)
+                .collect();
+            image::ImageBuffer::<image::Luma<u16>, _>::from_raw(w, h, g16)
+                .unwrap()
+                .save(path)
+                .unwrap()
+        }
+        Kind::Rgb8 => {
+            let rgb: Vec<u8> = g8.iter().flat_map(|&g| [g, g, g]).collect();
+            image::RgbImage::from_raw(w, h, rgb)
+                .unwrap()
+                .save(path)
+                .unwrap()
+        }
+        Kind::Jpeg => {
+            let f = std::fs::File::create(path).unwrap();
+            image::codecs::jpeg::JpegEncoder::new_with_quality(f, 95)
+                .encode(&g8, w, h, image::ExtendedColorType::L8)
+                .unwrap()
+        }
+    }
+}
+
+/// The fixtures' table and plan, and a renderer of captures of their pins.
+struct Scene {
+    dir: tempfile::TempDir,
+    camera: CameraModel,
+    surface: ReferenceSurface,
+    tips: BTreeMap<String, Vector3<f64>>,
+    plan: Vec<Vec<String>>,
+}
+
+impl Scene {
+    fn new() -> Scene {
+        let dir = tempfile::tempdir().unwrap();
+        let o = run(
+            dir.path(),
+            &["fixtures", "rtac0", "--pins-preset", "rtac0", "--out", "fx"],
+            &[],
+        );
+        assert!(o.status.success(), "{}", text(&o.stderr));
+        std::fs::write(
+            dir.path().join("cam.yaml"),
+            write_camera(&intrinsics(), CameraFileFormat::OpenCvYaml),
+        )
+        .unwrap();
+        let table = read_point_table(
+            &dir.path().join("fx/points/point_table.csv"),
+            PointsFrom::Tip,
+        )
+        .unwrap();
+        let plan = read_capture_plan(&dir.path().join("fx/points/capture_plan.csv")).unwrap();
+        let design = fabkit_designs::library::load("rtac0").unwrap();
+        Scene {
+            dir,
+            camera: CameraModel::new(intrinsics()).unwrap(),
+            surface: ReferenceSurface::of(&design.body).unwrap(),
+            tips: table.rows.into_iter().map(|(id, p, _)| (id, p)).collect(),
+            plan: plan.captures,
+        }
+    }
+
+    fn path(&self, rel: &str) -> std::path::PathBuf {
+        self.dir.path().join(rel)
+    }
+
+    /// The reference and the capture of `ids` pressed (balls of the pin's tip radius, their
+    /// lowest points at the table's tips), and each pin's true imprint centroid.
+    fn render(&self, ids: &[String], seed: u64) -> (GrayImage, GrayImage, Vec<[f64; 2]>) {
+        let pins: Vec<Pin> = ids
+            .iter()
+            .map(|id| {
+                let tip = self.tips[id];
+                let c = tip + tip.normalize() * TIP_RADIUS_MM;
+                Pin {
+                    centre_mm: [c.x, c.y, c.z],
+                    radius_mm: TIP_RADIUS_MM,
+                }
+            })
+            .collect();
+        let shading = Shading {
+            grey_per_mm: 60.0,
+            ..Shading::default()
+        };
+        let r = render(&self.camera, &truth(), &self.surface, &pins, &shading, seed);
+        let centres = r.centres_px.iter().map(|c| c.unwrap()).collect();
+        (r.reference, r.capture, centres)
+    }
+}
+
+fn pose_errors(pose: &Isometry3<f64>) -> (f64, f64) {
+    (
+        pose.rotation.angle_to(&truth().rotation).to_degrees(),
+        (pose.translation.vector - truth().translation.vector).norm(),
+    )
+}
+
+/// observations.csv rows: (capture, id) -> (u_px, v_px).
+fn observations(path: &Path) -> BTreeMap<(String, String), [f64; 2]> {
+    let t = std::fs::read_to_string(path).unwrap();
+    let mut lines = t.lines().filter(|l| !l.starts_with('#'));
+    assert_eq!(lines.next(), Some("capture,id,u_px,v_px,score"));
+    lines
+        .map(|l| {
+            let c: Vec<&str> = l.split(',').collect();
+            assert_eq!(c.len(), 5, "{l}");
+            assert!(c[4].parse::<f64>().unwrap() > 8.0, "score of {l}");
+            (
+                (c[0].to_string(), c[1].to_string()),
+                [c[2].parse().unwrap(), c[3].parse().unwrap()],
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn pins_found_in_photos_get_the_plans_ids_and_give_the_pose() {
+    let s = Scene::new();
+    let kinds = [Kind::Rgb8, Kind::Gray16, Kind::Jpeg];
+    let mut names = Vec::new();
+    let mut true_centres: BTreeMap<(String, String), [f64; 2]> = BTreeMap::new();
+    for (k, ids) in s.plan.iter().enumerate() {
+        let (reference, capture, centres) = s.render(ids, 100 + k as u64);
+        if k == 0 {
+            save(&reference, &s.path("reference.png"), Kind::Gray16);
+        }
+        let kind = kinds.get(k).copied().unwrap_or(Kind::Gray8);
+        let name = format!(
+            "capture_{}.{}",
+            k + 1,
+            if matches!(kind, Kind::Jpeg) {
+                "jpg"
+            } else {
+                "png"
+            }
+        );
+        save(&capture, &s.path(&name), kind);
+        for (id, c) in ids.iter().zip(centres) {
+            true_centres.insert((name.clone(), id.clone()), c);
+        }
+        names.push(name);
+    }
+    let calibrate = |out: &str, threads: &str| {
+        let mut args = vec![
+            "calibrate",
+            "extrinsics",
+            "--camera",
+            "cam.yaml",
+            "--points",
+            "fx/points/point_table.csv",
+            "--capture-plan",
+            "fx/points/capture_plan.csv",
+            "--reference",
+            "reference.png",
+            "--out",
+            out,
+            "--images",
+        ];
+        args.extend(names.iter().map(String::as_str));
+        run(s.dir.path(), &args, &[("RAYON_NUM_THREADS", threads)])
+    };
+    let o = calibrate("out", "2");
+    assert!(o.status.success(), "{}{}", text(&o.stdout), text(&o.stderr));
+    assert!(!text(&o.stderr).contains("warning"), "{}", text(&o.stderr));
+
+    // Every planned pin of every capture found, with its id, at its imprint's centroid.
+    let found = observations(&s.path("out/observations.csv"));
+    assert_eq!(
+        found.keys().collect::<Vec<_>>(),
+        true_centres.keys().collect::<Vec<_>>()
+    );
+    let (mut sq, mut worst) = (0.0, 0.0f64);
+    for (key, t) in &true_centres {
+        let f = found[key];
+        let e = (f[0] - t[0]).hypot(f[1] - t[1]);
+        sq += e * e;
+        worst = worst.max(e);
+    }
+    let rms = (sq / true_centres.len() as f64).sqrt();
+    assert!(
+        rms < 0.1 && worst < 0.3,
+        "centroid error {rms:.4} px RMS, worst {worst:.4} px"
+    );
+
+    // The pose as good as the pose from the true centroids (the pole pin's averaged over its
+    // captures, as the command does), both against the true pose.
+    let mut by_id: BTreeMap<&String, (Vector2<f64>, f64)> = BTreeMap::new();
+    for ((_, id), c) in &true_centres {
+        let e = by_id.entry(id).or_insert((Vector2::zeros(), 0.0));
+        e.0 += Vector2::new(c[0], c[1]);
+        e.1 += 1.0;
+    }
+    let (pts, px): (Vec<Vector3<f64>>, Vec<Vector2<f64>>) = by_id
+        .iter()
+        .map(|(id, (sum, n))| (s.tips[*id], sum / *n))
+        .unzip();
+    let from_true = solve_pnp(&s.camera, &pts, &px, &PnpOptions::default()).unwrap();
+    let (rot_true, t_true) = pose_errors(&from_true.t_cam_sensor);
+    let j = json(&s.path("out/extrinsics.json"));
+    let (rot, t) = pose_errors(&pose_of(&j));
+    assert!(
+        rot <= 1.1 * rot_true && t <= 1.1 * t_true,
+        "from the images: {rot:.4} deg, {t:.4} mm; from the true centroids: {rot_true:.4} deg, {t_true:.4} mm"
+    );
+    assert_eq!(j["residuals"]["observations"], 29);
+    assert_eq!(j["provenance"]["reference_image"], "reference.png");
+    assert_eq!(j["provenance"]["observation_files"][2], "capture_3.jpg");
+
+    // An overlay per capture, the camera's size, each spot circled in green.
+    for (k, name) in names.iter().enumerate() {
+        let stem = name.split('.').next().unwrap();
+        let img = image::open(s.path(&format!("out/overlays/{stem}.png")))
+            .unwrap()
+            .into_rgb8();
+        assert_eq!(img.dimensions(), (640, 480));
+        let green = img.pixels().filter(|p| p.0 == [0, 220, 0]).count();
+        assert!(green > 5 * 20, "capture {}: {green} green pixels", k + 1);
+    }
+
+    // Same input, same bytes, whatever the thread count.
+    let o = calibrate("out1", "1");
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    for f in ["observations.csv", "overlays/capture_2.png"] {
+        assert_eq!(
+            std::fs::read(s.path("out").join(f)).unwrap(),
+            std::fs::read(s.path("out1").join(f)).unwrap(),
+            "{f}"
+        );
+    }
+    let j1 = json(&s.path("out1/extrinsics.json"));
+    assert_eq!(
+        (&j["rvec"], &j["tvec_mm"], &j["residuals"]),
+        (&j1["rvec"], &j1["tvec_mm"], &j1["residuals"])
+    );
+}
+
+#[test]
+fn ids_from_file_names_and_captures_with_a_pin_missing_or_an_extra_spot_left_out() {
+    let s = Scene::new();
+    let mut names = Vec::new();
+    let last = s.plan.len() - 1;
+    for (k, ids) in s.plan.iter().enumerate() {
+        let mut pressed = ids.clone();
+        if k == last {
+            pressed.pop(); // one pin fewer than its name says
+        }
+        if k == last - 1 {
+            pressed.push(s.plan[0][2].clone()); // one more than its name says
+        }
+        let (reference, capture, _) = s.render(&pressed, 200 + k as u64);
+        if k == 0 {
+            save(&reference, &s.path("reference.png"), Kind::Gray8);
+        }
+        let name = ids
+            .iter()
+            .map(|id| format!("{:02}", id.parse::<u32>().unwrap()))
+            .collect::<Vec<_>>()
+            .join("_")
+            + ".png";
+        save(&capture, &s.path(&name), Kind::Gray8);
+        names.push(name);
+    }
+    let mut args = vec![
+        "calibrate",
+        "extrinsics",
+        "--camera",
+        "cam.yaml",
+        "--points",
+        "fx/points/point_table.csv",
+        "--reference",
+        "reference.png",
+        "--out",
+        "out",
+        "--images",
+    ];
+    args.extend(names.iter().map(String::as_str));
+    let o = run(s.dir.path(), &args, &[]);
+    let err = text(&o.stderr);
+    assert!(o.status.success(), "{}{err}", text(&o.stdout));
+    assert!(
+        err.contains(&format!(
+            "warning: {}: 4 spots for the 5 planned pins",
+            names[last]
+        )) && err.contains("(a pin missing): found at ("),
+        "{err}"
+    );
+    assert!(
+        err.contains(&format!(
+            "warning: {}: 6 spots for the 5 planned pins",
+            names[last - 1]
+        )) && err.contains("(an extra spot): found at ("),
+        "{err}"
+    );
+    let found = observations(&s.path("out/observations.csv"));
+    assert_eq!(found.len(), 5 * (s.plan.len() - 2));
+    for (capture, id) in found.keys() {
+        let k = names.iter().position(|n| n == capture).unwrap();
+        assert!(s.plan[k].contains(id), "{capture} {id}");
+    }
+    // the pins of the two captures left out that no other capture holds
+    let j = json(&s.path("out/extrinsics.json"));
+    let mut left: Vec<&String> = s.plan[last - 1..]
+        .iter()
+        .flatten()
+        .filter(|id| !s.plan[..last - 1].iter().flatten().any(|i| i == *id))
+        .collect();
+    left.sort_by_key(|id| id.parse::<u32>().unwrap());
+    let mut unobserved: Vec<String> = j["provenance"]["unobserved_ids"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_str().unwrap().to_string())
+        .collect();
+    unobserved.sort_by_key(|id| id.parse::<u32>().unwrap());
+    assert_eq!(unobserved.iter().collect::<Vec<_>>(), left);
+    assert!(
+        j["warnings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|w| w.as_str().unwrap().contains("(a pin missing)")),
+        "{}",
+        j["warnings"]
+    );
+}
+
+#[test]
+fn bad_images_and_reference_exit_2_naming_the_option_and_write_nothing() {
+    let s = Scene::new();
+    let blank = GrayImage::filled(640, 480, 120.0);
+    save(&blank, &s.path("ref.png"), Kind::Gray8);
+    save(&blank, &s.path("01_02_06_14_22.png"), Kind::Gray8);
+    save(&blank, &s.path("capture.png"), Kind::Gray8);
+    save(
+        &GrayImage::filled(320, 240, 120.0),
+        &s.path("01_05_09_17_25.png"),
+        Kind::Gray8,
+    );
+    std::fs::copy(s.path("01_05_09_17_25.png"), s.path("small.png")).unwrap();
+    std::fs::write(s.path("01_04_08_16_24.png"), "not an image\n").unwrap();
+    std::fs::write(s.path("obs.csv"), "id,u_px,v_px\n").unwrap();
+    let base = [
+        "calibrate",
+        "extrinsics",
+        "--camera",
+        "cam.yaml",
+        "--points",
+        "fx/points/point_table.csv",
+        "--out",
+        "out",
+    ];
+    let cases: &[(&[&str], &str)] = &[
+        (
+            &["--reference", "ref.png", "--images", "01_03_07_15_23.png"],
+            "--images = 01_03_07_15_23.png: cannot read",
+        ),
+        (
+            &["--reference", "ref.png", "--images", "01_04_08_16_24.png"],
+            "--images = 01_04_08_16_24.png: not a readable PNG or JPEG image",
+        ),
+        (
+            &["--reference", "ref.png", "--images", "01_05_09_17_25.png"],
+            "--images = 01_05_09_17_25.png: the image is 320 x 240 px but the camera file cam.yaml says 640 x 480 px",
+        ),
+        (
+            &["--reference", "small.png", "--images", "01_02_06_14_22.png"],
+            "--reference = small.png: the image is 320 x 240 px",
+        ),
+        (
+            &["--reference", "missing.png", "--images", "01_02_06_14_22.png"],
+            "--reference = missing.png: cannot read",
+        ),
+        (
+            &["--reference", "ref.png", "--images", "capture.png"],
+            "--images = capture.png: the file name does not list the capture's pin ids",
+        ),
+        (
+            &[
+                "--reference",
+                "ref.png",
+                "--capture-plan",
+                "fx/points/capture_plan.csv",
+                "--images",
+                "capture.png",
+            ],
+            "--images: 1 images but the capture plan fx/points/capture_plan.csv has 8 captures",
+        ),
+        (
+            &[
+                "--reference",
+                "ref.png",
+                "--images",
+                "01_02_06_14_22.png",
+                "01_02_06_14_22.png",
+            ],
+            "--images = 01_02_06_14_22.png: given twice",
+        ),
+        (&["--reference", "ref.png"], "--images"),
+        (&["--images", "01_02_06_14_22.png"], "--reference"),
+        (
+            &[
+                "--reference",
+                "ref.png",
+                "--images",
+                "01_02_06_14_22.png",
+                "--observations",
+                "obs.csv",
+            ],
+            "cannot be used with",
+        ),
+    ];
+    for (extra, message) in cases {
+        let mut args = base.to_vec();
+        args.extend_from_slice(extra);
+        let o = run(s.dir.path(), &args, &[]);
+        assert_eq!(o.status.code(), Some(2), "{extra:?}: {}", text(&o.stderr));
+        assert!(
+            text(&o.stderr).contains(message),
+            "{extra:?}: wanted {message:?} in {}",
+            text(&o.stderr)
+        );
+        assert!(!s.path("out").exists(), "{extra:?}");
+    }
+}
