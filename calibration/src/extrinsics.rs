@@ -78,6 +78,18 @@ pub struct ExtrinsicsOutput {
     /// `overlay.png`, and from capture images `observations.csv` and `overlays/<capture>.png`,
     /// in that order.
     pub files: Vec<(String, Vec<u8>)>,
+    /// From capture images: what was found.
+    pub found: Option<FoundInImages>,
+}
+
+/// What the detector found in the capture images.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FoundInImages {
+    pub captures: usize,
+    /// Captures left out (a pin missing, an extra spot; reported in the warnings).
+    pub captures_left_out: usize,
+    /// Rows of `observations.csv` (a pin in several captures once per capture).
+    pub detections: usize,
 }
 
 /// Runs the calibration; returns the report and the output files. Reads only the job's input
@@ -191,5 +203,14 @@ pub fn calibrate_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsOutput, Ext
         files.push(("observations.csv".into(), found.csv.clone().into_bytes()));
         files.extend(found.overlays(&camera, &table, &sol.t_cam_sensor)?);
     }
-    Ok(ExtrinsicsOutput { report, files })
+    let found = from_images.as_ref().map(|f| FoundInImages {
+        captures: obs_paths.len(),
+        captures_left_out: f.rejected.len(),
+        detections: f.csv.lines().filter(|l| !l.starts_with('#')).count() - 1,
+    });
+    Ok(ExtrinsicsOutput {
+        report,
+        files,
+        found,
+    })
 }

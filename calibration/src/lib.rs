@@ -28,7 +28,7 @@ pub use camera_file::{
     parse_camera, read_camera_file, write_camera, CameraFileError, CameraFileFormat,
 };
 pub use extrinsics::{
-    calibrate_extrinsics, ExtrinsicsError, ExtrinsicsJob, ExtrinsicsOutput, Observed,
+    calibrate_extrinsics, ExtrinsicsError, ExtrinsicsJob, ExtrinsicsOutput, FoundInImages, Observed,
 };
 pub use nalgebra;
 pub use pnp::{

@@ -106,6 +106,10 @@ impl Rgb8 {
             let mut enc = png::Encoder::new(&mut out, self.width, self.height);
             enc.set_color(png::ColorType::Rgb);
             enc.set_depth(png::BitDepth::Eight);
+            // fdeflate's fast mode: an eighth of the default's time for a noisy 640 x 480
+            // capture (the whole calibration from images 0.32 s -> 0.04 s), files nearly twice
+            // zlib level 6's (450 kB against 240 kB)
+            enc.set_compression(png::Compression::Fast);
             let mut w = enc
                 .write_header()
                 .map_err(|e| OverlayError::Encode(e.to_string()))?;

@@ -117,6 +117,19 @@ fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
         staged.write(name, bytes)?;
     }
     let warnings = staged.commit()?;
+    if let Some(f) = out.found {
+        println!(
+            "imprints: {} pins found in {} of {} captures (observations.csv; overlays/){}",
+            f.detections,
+            f.captures - f.captures_left_out,
+            f.captures,
+            if f.captures_left_out > 0 {
+                "; the captures left out are named below"
+            } else {
+                ""
+            }
+        );
+    }
     let r = out.report;
     let c = r.residuals.camera_centre_in_sensor_mm;
     println!(

@@ -211,6 +211,11 @@ fn pins_found_in_photos_get_the_plans_ids_and_give_the_pose() {
     let o = calibrate("out", "2");
     assert!(o.status.success(), "{}{}", text(&o.stdout), text(&o.stderr));
     assert!(!text(&o.stderr).contains("warning"), "{}", text(&o.stderr));
+    assert!(
+        text(&o.stdout).contains("imprints: 40 pins found in 8 of 8 captures"),
+        "{}",
+        text(&o.stdout)
+    );
 
     // Every planned pin of every capture found, with its id, at its imprint's centroid.
     let found = observations(&s.path("out/observations.csv"));
@@ -326,6 +331,11 @@ fn ids_from_file_names_and_captures_with_a_pin_missing_or_an_extra_spot_left_out
     let o = run(s.dir.path(), &args, &[]);
     let err = text(&o.stderr);
     assert!(o.status.success(), "{}{err}", text(&o.stdout));
+    assert!(
+        text(&o.stdout).contains("imprints: 30 pins found in 6 of 8 captures"),
+        "{}",
+        text(&o.stdout)
+    );
     assert!(
         err.contains(&format!(
             "warning: {}: 4 spots for the 5 planned pins",
