@@ -1,12 +1,19 @@
-//! Camera files: OpenCV FileStorage YAML (`%YAML:1.0`, `!!opencv-matrix`), ROS `camera_info`
-//! YAML and fabkit's JSON form. Reading detects the form; errors name the file, line and field.
+//! Camera files: OpenCV FileStorage YAML (`%YAML:1.0` or `%YAML 1.2`, `!!opencv-matrix`) and XML
+//! (`<opencv_storage>`, `type_id="opencv-matrix"`), ROS `camera_info` YAML and fabkit's JSON form.
+//! Reading detects the form; errors name the file, line and field.
 //!
 //! Keys (OpenCV and ROS share them): `image_width`, `image_height`, `camera_matrix` (3 x 3,
 //! `[fx 0 cx; 0 fy cy; 0 0 1]`, px), `distortion_model` (`fisheye` or `equidistant`, `plumb_bob`,
 //! `rational_polynomial`) and `distortion_coefficients` (OpenCV order). A file without
 //! `distortion_model` is read as `plumb_bob` for 5 coefficients and `rational_polynomial` for 8
-//! (what `cv2.calibrateCamera` writes); 4 coefficients without a model name are refused as
-//! ambiguous.
+//! (what `cv2.calibrateCamera` writes), or for 12 or 14 (`CALIB_THIN_PRISM_MODEL`,
+//! `CALIB_RATIONAL_MODEL` in OpenCV 5) whose thin-prism and tilt coefficients s1..s4, tauX, tauY
+//! are all 0 (they are not modelled: any other value is an error). 4 coefficients
+//! (`cv2.fisheye.calibrate`'s D) are read as fisheye when the file has `fisheye_model: 1` (the key
+//! OpenCV's camera_calibration sample writes) or the caller gives [`DistortionModelHint::Fisheye`]
+//! (`--camera-model fisheye`); otherwise they are refused as ambiguous. A hint applies only to a
+//! file that names no model: a file naming another model, or a coefficient count the hinted model
+//! does not take, is an error.
 
 use std::path::Path;
 
@@ -46,6 +53,45 @@ pub enum CameraFileError {
     },
 }
 
+/// The distortion model a caller gives for a camera file that names none (`fabkit calibrate
+/// extrinsics --camera-model`), e.g. the 4 coefficients of `cv2.fisheye.calibrate`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum DistortionModelHint {
+    /// [`Distortion::Fisheye`] (Kannala-Brandt, k1..k4).
+    Fisheye,
+    /// [`Distortion::PlumbBob`] (k1, k2, p1, p2, k3; 4 coefficients: k3 = 0).
+    PlumbBob,
+    /// [`Distortion::RationalPolynomial`] (k1, k2, p1, p2, k3..k6).
+    RationalPolynomial,
+}
+
+impl DistortionModelHint {
+    /// The model's name as camera files and `--camera-model` spell it.
+    pub fn name(self) -> &'static str {
+        match self {
+            DistortionModelHint::Fisheye => "fisheye",
+            DistortionModelHint::PlumbBob => "plumb_bob",
+            DistortionModelHint::RationalPolynomial => "rational_polynomial",
+        }
+    }
+
+    /// The model a file's `distortion_model` names (the names [`Distortion::from_name`] takes).
+    fn of_name(name: &str) -> Option<DistortionModelHint> {
+        match name {
+            "fisheye" | "equidistant" | "kannala_brandt" => Some(DistortionModelHint::Fisheye),
+            "plumb_bob" | "radtan" => Some(DistortionModelHint::PlumbBob),
+            "rational_polynomial" => Some(DistortionModelHint::RationalPolynomial),
+            _ => None,
+        }
+    }
+}
+
+impl std::fmt::Display for DistortionModelHint {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 /// The written forms of a camera file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum CameraFileFormat {
@@ -55,6 +101,8 @@ pub enum CameraFileFormat {
     RosYaml,
     /// fabkit's JSON form ([`CameraJson`]).
     Json,
+    /// OpenCV FileStorage XML, as `cv::FileStorage` writes it.
+    OpenCvXml,
 }
 
 /// fabkit's JSON camera file.
@@ -90,6 +138,8 @@ struct YamlCamera {
     image_height: Option<u32>,
     camera_matrix: Option<YamlMatrix>,
     distortion_model: Option<String>,
+    /// OpenCV's camera_calibration sample: 1 for `cv::fisheye`, 0 otherwise.
+    fisheye_model: Option<i64>,
     distortion_coefficients: Option<YamlMatrix>,
 }
 
@@ -98,12 +148,25 @@ struct YamlCamera {
 /// # Errors
 /// [`CameraFileError`] naming the file, the line and the field.
 pub fn read_camera_file(path: &Path) -> Result<CameraModel, CameraFileError> {
+    read_camera_file_as(path, None)
+}
+
+/// [`read_camera_file`] with the distortion model to assume when the file names none
+/// ([`DistortionModelHint`]; `None`: infer it from the coefficient count as [`read_camera_file`]).
+///
+/// # Errors
+/// [`CameraFileError`] naming the file, the line and the field; also a file that names a model
+/// other than `model`, or whose coefficient count `model` does not take.
+pub fn read_camera_file_as(
+    path: &Path,
+    model: Option<DistortionModelHint>,
+) -> Result<CameraModel, CameraFileError> {
     let file = path.display().to_string();
     let text = crate::read_text(path).map_err(|source| CameraFileError::Io {
         file: file.clone(),
         source,
     })?;
-    parse_camera(&text, &file)
+    parse_camera_as(&text, &file, model)
 }
 
 /// Parses and validates camera-file text; `file` names it in errors.
@@ -111,10 +174,26 @@ pub fn read_camera_file(path: &Path) -> Result<CameraModel, CameraFileError> {
 /// # Errors
 /// [`CameraFileError`] naming the file, the line and the field.
 pub fn parse_camera(text: &str, file: &str) -> Result<CameraModel, CameraFileError> {
-    let intr = if text.trim_start().starts_with('{') {
-        parse_json(text, file)?
+    parse_camera_as(text, file, None)
+}
+
+/// [`parse_camera`] with the distortion model to assume when the file names none
+/// ([`read_camera_file_as`]).
+///
+/// # Errors
+/// [`CameraFileError`] naming the file, the line and the field.
+pub fn parse_camera_as(
+    text: &str,
+    file: &str,
+    model: Option<DistortionModelHint>,
+) -> Result<CameraModel, CameraFileError> {
+    let start = text.trim_start_matches('\u{feff}').trim_start();
+    let intr = if start.starts_with('{') {
+        parse_json(text, file, model)?
+    } else if start.starts_with('<') {
+        parse_xml(text, file, model)?
     } else {
-        parse_yaml(text, file)?
+        parse_yaml(text, file, model)?
     };
     CameraModel::new(intr).map_err(|e| match e {
         crate::camera::CameraError::Invalid { field, value, rule } => CameraFileError::Field {
@@ -141,19 +220,159 @@ fn key_of_field(field: &str) -> &str {
     }
 }
 
-/// 1-based line of the first `key:` (YAML) or `"key"` (JSON) in `text`, or 0.
+/// 1-based line of the first `key:` (YAML), `"key"` (JSON) or `<key>` (XML) in `text`, or 0.
 fn line_of(text: &str, key: &str) -> usize {
     let yaml = format!("{key}:");
     let json = format!("\"{key}\"");
+    let xml = format!("<{key}");
     text.lines()
         .position(|l| {
             let t = l.trim_start();
-            t.starts_with(&yaml) || t.starts_with(&json)
+            t.starts_with(&yaml)
+                || t.starts_with(&json)
+                || (t.starts_with(&xml)
+                    && t[xml.len()..].starts_with(|c: char| c == '>' || c.is_whitespace()))
         })
         .map_or(0, |i| i + 1)
 }
 
-fn parse_json(text: &str, file: &str) -> Result<Intrinsics, CameraFileError> {
+/// 1-based line and column of byte `pos` of `text`.
+fn line_column(text: &str, pos: usize) -> (usize, usize) {
+    let before = &text.as_bytes()[..pos.min(text.len())];
+    let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
+    let start = before
+        .iter()
+        .rposition(|&b| b == b'\n')
+        .map_or(0, |i| i + 1);
+    (
+        line,
+        String::from_utf8_lossy(&before[start..]).chars().count() + 1,
+    )
+}
+
+/// Names of the coefficients after the rational model's eight (OpenCV order).
+const PRISM_AND_TILT: [&str; 6] = ["s1", "s2", "s3", "s4", "tauX", "tauY"];
+
+/// The distortion of a file from what it says about its model (`distortion_model`, OpenCV's
+/// camera_calibration `fisheye_model`), the caller's hint and the coefficients (OpenCV order).
+/// `err(field, value, rule)` makes a [`CameraFileError::Field`] at the field's line.
+fn resolve_distortion(
+    named: Option<&str>,
+    fisheye_model: Option<i64>,
+    hint: Option<DistortionModelHint>,
+    coefficients: &[f64],
+    err: &dyn Fn(&str, String, String) -> CameraFileError,
+) -> Result<Distortion, CameraFileError> {
+    use DistortionModelHint as M;
+    let flag = match fisheye_model {
+        None => None,
+        Some(0) => Some(false),
+        Some(1) => Some(true),
+        Some(v) => {
+            return Err(err(
+                "fisheye_model",
+                v.to_string(),
+                "must be 0 or 1 (1: cv::fisheye, as OpenCV's camera_calibration sample writes)"
+                    .into(),
+            ))
+        }
+    };
+    let file_model = match named {
+        Some(n) => Some(M::of_name(n).ok_or_else(|| {
+            err(
+                "distortion_model",
+                n.to_string(),
+                format!("unknown distortion model '{n}': must be fisheye (or equidistant), plumb_bob or rational_polynomial"),
+            )
+        })?),
+        None => None,
+    };
+    if let (Some(m), Some(n), Some(f)) = (file_model, named, flag) {
+        if (m == M::Fisheye) != f {
+            return Err(err(
+                "fisheye_model",
+                u8::from(f).to_string(),
+                format!("contradicts the file's distortion_model: {n}"),
+            ));
+        }
+    }
+    if let Some(h) = hint {
+        if let (Some(m), Some(n)) = (file_model, named) {
+            if m != h {
+                return Err(err(
+                    "distortion_model",
+                    n.to_string(),
+                    format!("the file names this model but --camera-model {h} was given (it is for files that name none): drop --camera-model or give --camera-model {m}"),
+                ));
+            }
+        } else if let Some(f) = flag {
+            if f != (h == M::Fisheye) {
+                return Err(err(
+                    "fisheye_model",
+                    u8::from(f).to_string(),
+                    format!("the file's fisheye_model: {} contradicts --camera-model {h}: drop --camera-model or fix the file", u8::from(f)),
+                ));
+            }
+        }
+    }
+    let n = coefficients.len();
+    let (model, from) = match (file_model, flag, hint) {
+        (Some(m), _, _) => (m, None),
+        (None, Some(true), _) => (M::Fisheye, Some("fisheye_model: 1".to_string())),
+        (None, _, Some(h)) => (h, Some(format!("--camera-model {h}"))),
+        (None, flag, None) => match n {
+            5 => (M::PlumbBob, None),
+            4 if flag == Some(false) => (M::PlumbBob, Some("fisheye_model: 0".to_string())),
+            8 | 12 | 14 => (M::RationalPolynomial, None),
+            4 => {
+                return Err(err(
+                    "distortion_coefficients",
+                    "4 values".into(),
+                    "without a model name 4 coefficients are ambiguous (fisheye k1..k4, as cv2.fisheye.calibrate writes, or plumb_bob k1, k2, p1, p2): add `fisheye_model: 1` (as OpenCV's camera_calibration sample writes) or `distortion_model: fisheye` to the file, or give `--camera-model fisheye`".into(),
+                ))
+            }
+            n => {
+                return Err(err(
+                    "distortion_coefficients",
+                    format!("{n} values"),
+                    "without distortion_model only 5 (plumb_bob) or 8, 12, 14 (rational_polynomial) coefficients are unambiguous; add distortion_model: fisheye, plumb_bob or rational_polynomial, or give --camera-model".into(),
+                ))
+            }
+        },
+    };
+    // calibrateCamera's 12 (thin prism) or 14 (tilted sensor) coefficients: the rational
+    // model's eight when the rest are 0.
+    let mut k = coefficients;
+    if model == M::RationalPolynomial && (n == 12 || n == 14) {
+        let extra: Vec<String> = coefficients[8..]
+            .iter()
+            .zip(PRISM_AND_TILT)
+            .filter(|(v, _)| **v != 0.0)
+            .map(|(v, name)| format!("{name} = {v:?}"))
+            .collect();
+        if !extra.is_empty() {
+            return Err(err(
+                "distortion_coefficients",
+                format!("{n} values with {}", extra.join(", ")),
+                "thin-prism and tilt coefficients s1..s4, tauX, tauY are not modelled, must be 0 (rational_polynomial is k1, k2, p1, p2, k3, k4, k5, k6)".into(),
+            ));
+        }
+        k = &coefficients[..8];
+    }
+    Distortion::from_name(named.unwrap_or(model.name()), k).map_err(|rule| {
+        let rule = match from {
+            Some(from) => format!("{rule} (the model is from {from}; the file names none)"),
+            None => rule,
+        };
+        err("distortion_coefficients", format!("{coefficients:?}"), rule)
+    })
+}
+
+fn parse_json(
+    text: &str,
+    file: &str,
+    hint: Option<DistortionModelHint>,
+) -> Result<Intrinsics, CameraFileError> {
     let c: CameraJson = serde_json::from_str(text).map_err(|e| CameraFileError::Syntax {
         file: file.into(),
         line: e.line(),
@@ -179,14 +398,13 @@ fn parse_json(text: &str, file: &str) -> Result<Intrinsics, CameraFileError> {
             "must be \"fabkit-camera\"".into(),
         ));
     }
-    let distortion = Distortion::from_name(&c.distortion_model, &c.distortion_coefficients)
-        .map_err(|rule| {
-            field(
-                "distortion_coefficients",
-                format!("{:?}", c.distortion_coefficients),
-                rule,
-            )
-        })?;
+    let distortion = resolve_distortion(
+        Some(&c.distortion_model),
+        None,
+        hint,
+        &c.distortion_coefficients,
+        &field,
+    )?;
     Ok(Intrinsics {
         image_width_px: c.image_width_px,
         image_height_px: c.image_height_px,
@@ -198,7 +416,11 @@ fn parse_json(text: &str, file: &str) -> Result<Intrinsics, CameraFileError> {
     })
 }
 
-fn parse_yaml(text: &str, file: &str) -> Result<Intrinsics, CameraFileError> {
+fn parse_yaml(
+    text: &str,
+    file: &str,
+    hint: Option<DistortionModelHint>,
+) -> Result<Intrinsics, CameraFileError> {
     // OpenCV FileStorage: a `%YAML:1.0` directive (not YAML 1.2 syntax) and `!!opencv-matrix`
     // tags. Blank the directive line and the tags, keeping every line and column in place.
     let mut clean = String::with_capacity(text.len());
@@ -223,9 +445,19 @@ fn parse_yaml(text: &str, file: &str) -> Result<Intrinsics, CameraFileError> {
             message: first,
         }
     })?;
+    camera_of(y, file, hint, &|key| line_of(text, key))
+}
+
+/// Intrinsics from the keys of an OpenCV or ROS file; `line(key)` is the key's 1-based line.
+fn camera_of(
+    y: YamlCamera,
+    file: &str,
+    hint: Option<DistortionModelHint>,
+    line: &dyn Fn(&str) -> usize,
+) -> Result<Intrinsics, CameraFileError> {
     let field = |f: &str, v: String, rule: String| CameraFileError::Field {
         file: file.into(),
-        line: line_of(text, f),
+        line: line(f),
         field: f.into(),
         value: v,
         rule,
@@ -298,27 +530,13 @@ fn parse_yaml(text: &str, file: &str) -> Result<Intrinsics, CameraFileError> {
             "must be a row or a column".into(),
         ));
     }
-    let model = match y.distortion_model.as_deref() {
-        Some(m) => m.to_string(),
-        None => match d.data.len() {
-            5 => "plumb_bob".into(),
-            8 => "rational_polynomial".into(),
-            n => {
-                return Err(field(
-                    "distortion_coefficients",
-                    format!("{n} values"),
-                    "without distortion_model only 5 (plumb_bob) or 8 (rational_polynomial) coefficients are unambiguous; add distortion_model: fisheye, plumb_bob or rational_polynomial".into(),
-                ))
-            }
-        },
-    };
-    let distortion = Distortion::from_name(&model, &d.data).map_err(|rule| {
-        if y.distortion_model.is_some() && rule.starts_with("unknown") {
-            field("distortion_model", model.clone(), rule)
-        } else {
-            field("distortion_coefficients", format!("{:?}", d.data), rule)
-        }
-    })?;
+    let distortion = resolve_distortion(
+        y.distortion_model.as_deref(),
+        y.fisheye_model,
+        hint,
+        &d.data,
+        &field,
+    )?;
     Ok(Intrinsics {
         image_width_px: w,
         image_height_px: h,
@@ -328,6 +546,224 @@ fn parse_yaml(text: &str, file: &str) -> Result<Intrinsics, CameraFileError> {
         cy_px: km[5],
         distortion,
     })
+}
+
+/// One element of an XML file: name, 1-based line of its start tag, text, child elements.
+struct XmlElement {
+    name: String,
+    line: usize,
+    text: String,
+    children: Vec<XmlElement>,
+}
+
+/// The element tree of an XML file (quick-xml events; entities resolved, comments dropped).
+fn xml_tree(text: &str, file: &str) -> Result<XmlElement, CameraFileError> {
+    use quick_xml::events::Event;
+    let syntax = |pos: usize, message: String| {
+        let (line, column) = line_column(text, pos);
+        CameraFileError::Syntax {
+            file: file.into(),
+            line,
+            column,
+            message,
+        }
+    };
+    let mut reader = quick_xml::Reader::from_str(text);
+    let mut open: Vec<XmlElement> = Vec::new();
+    let mut root: Option<XmlElement> = None;
+    let mut close = |el: XmlElement, open: &mut Vec<XmlElement>, pos: usize| match open.last_mut() {
+        Some(parent) => {
+            parent.children.push(el);
+            Ok(())
+        }
+        None if root.is_none() => {
+            root = Some(el);
+            Ok(())
+        }
+        None => Err(syntax(pos, format!("a second root element <{}>", el.name))),
+    };
+    loop {
+        let pos = reader.buffer_position() as usize;
+        let event = reader
+            .read_event()
+            .map_err(|e| syntax(reader.error_position() as usize, e.to_string()))?;
+        let element = |name: &str| XmlElement {
+            name: name.to_string(),
+            line: line_column(text, pos).0,
+            text: String::new(),
+            children: Vec::new(),
+        };
+        match event {
+            Event::Start(s) => open.push(element(s.name().as_ref())),
+            Event::Empty(s) => close(element(s.name().as_ref()), &mut open, pos)?,
+            Event::End(_) => {
+                if let Some(el) = open.pop() {
+                    close(el, &mut open, pos)?;
+                }
+            }
+            Event::Text(t) => {
+                if let Some(el) = open.last_mut() {
+                    el.text.push_str(&t.xml10_content());
+                }
+            }
+            Event::CData(t) => {
+                if let Some(el) = open.last_mut() {
+                    el.text.push_str(&t.xml10_content());
+                }
+            }
+            Event::GeneralRef(r) => {
+                let resolved = match r.resolve_char_ref() {
+                    Ok(Some(c)) => Some(c.to_string()),
+                    Ok(None) => {
+                        quick_xml::escape::resolve_predefined_entity(&r).map(str::to_string)
+                    }
+                    Err(_) => None,
+                };
+                let Some(s) = resolved else {
+                    return Err(syntax(pos, format!("unknown entity &{};", &*r)));
+                };
+                if let Some(el) = open.last_mut() {
+                    el.text.push_str(&s);
+                }
+            }
+            Event::Eof => break,
+            _ => {}
+        }
+    }
+    if let Some(el) = open.last() {
+        return Err(syntax(text.len(), format!("<{}> is not closed", el.name)));
+    }
+    root.ok_or_else(|| syntax(text.len(), "no root element".into()))
+}
+
+/// OpenCV FileStorage XML: `<opencv_storage>` holding the same keys as the YAML form, matrices
+/// as `<rows>`, `<cols>`, `<dt>`, `<data>` (numbers separated by white space).
+fn parse_xml(
+    text: &str,
+    file: &str,
+    hint: Option<DistortionModelHint>,
+) -> Result<Intrinsics, CameraFileError> {
+    let root = xml_tree(text, file)?;
+    let field = |line: usize, f: &str, v: String, rule: &str| CameraFileError::Field {
+        file: file.into(),
+        line,
+        field: f.into(),
+        value: v,
+        rule: rule.into(),
+    };
+    if root.name != "opencv_storage" {
+        return Err(field(
+            root.line,
+            "root element",
+            format!("<{}>", root.name),
+            "must be <opencv_storage> (OpenCV FileStorage XML)",
+        ));
+    }
+    let mut seen: Vec<(&str, usize)> = Vec::new();
+    for el in &root.children {
+        if let Some((_, first)) = seen.iter().find(|(n, _)| *n == el.name) {
+            return Err(field(
+                el.line,
+                &el.name,
+                "given twice".into(),
+                &format!("must be given once (first on line {first})"),
+            ));
+        }
+        seen.push((&el.name, el.line));
+    }
+    let get = |name: &str| root.children.iter().find(|el| el.name == name);
+    // OpenCV writes strings with spaces in double quotes inside the element.
+    let string = |el: &XmlElement| {
+        let t = el.text.trim();
+        t.strip_prefix('"')
+            .and_then(|t| t.strip_suffix('"'))
+            .unwrap_or(t)
+            .to_string()
+    };
+    let whole = |el: &XmlElement, what: &str| -> Result<i64, CameraFileError> {
+        let t = el.text.trim();
+        t.parse::<i64>()
+            .map_err(|_| field(el.line, what, t.to_string(), "must be a whole number"))
+    };
+    let size = |name: &str| -> Result<Option<u32>, CameraFileError> {
+        get(name)
+            .map(|el| {
+                let v = whole(el, name)?;
+                u32::try_from(v).map_err(|_| {
+                    field(
+                        el.line,
+                        name,
+                        v.to_string(),
+                        "must be a whole number of px >= 0",
+                    )
+                })
+            })
+            .transpose()
+    };
+    let matrix = |name: &str| -> Result<Option<YamlMatrix>, CameraFileError> {
+        let Some(m) = get(name) else {
+            return Ok(None);
+        };
+        let part = |p: &str| {
+            m.children.iter().find(|c| c.name == p).ok_or_else(|| {
+                field(
+                    m.line,
+                    name,
+                    format!("no <{p}>"),
+                    "an opencv-matrix has <rows>, <cols>, <dt> and <data>",
+                )
+            })
+        };
+        let count = |p: &str| -> Result<usize, CameraFileError> {
+            let el = part(p)?;
+            let v = whole(el, &format!("{name}.{p}"))?;
+            usize::try_from(v).map_err(|_| {
+                field(
+                    el.line,
+                    &format!("{name}.{p}"),
+                    v.to_string(),
+                    "must be >= 0",
+                )
+            })
+        };
+        let data = part("data")?;
+        let values = data
+            .text
+            .split_whitespace()
+            .map(|v| {
+                v.parse::<f64>().map_err(|_| {
+                    field(
+                        data.line,
+                        &format!("{name}.data"),
+                        v.to_string(),
+                        "must be numbers separated by white space",
+                    )
+                })
+            })
+            .collect::<Result<Vec<f64>, _>>()?;
+        Ok(Some(YamlMatrix {
+            rows: count("rows")?,
+            cols: count("cols")?,
+            dt: m
+                .children
+                .iter()
+                .find(|c| c.name == "dt")
+                .map(|el| el.text.trim().to_string()),
+            data: values,
+        }))
+    };
+    let y = YamlCamera {
+        image_width: size("image_width")?,
+        image_height: size("image_height")?,
+        camera_matrix: matrix("camera_matrix")?,
+        distortion_model: get("distortion_model").map(string),
+        fisheye_model: get("fisheye_model")
+            .map(|el| whole(el, "fisheye_model"))
+            .transpose()?,
+        distortion_coefficients: matrix("distortion_coefficients")?,
+    };
+    let line = |key: &str| get(key).map_or(0, |el| el.line);
+    camera_of(y, file, hint, &line)
 }
 
 /// A double as OpenCV FileStorage writes it: `215.` for integral values, else `%.16e`
@@ -408,6 +844,27 @@ pub fn write_camera(intr: &Intrinsics, format: CameraFileFormat) -> String {
                 d.len(),
                 plain_list(d),
                 plain_list(&p)
+            )
+        }
+        CameraFileFormat::OpenCvXml => {
+            let matrix = |name: &str, rows: usize, cols: usize, data: &[f64]| {
+                let vals: Vec<String> = data.iter().map(|v| cv_double(*v)).collect();
+                format!(
+                    "<{name} type_id=\"opencv-matrix\">\n  <rows>{rows}</rows>\n  <cols>{cols}</cols>\n  <dt>d</dt>\n  <data>\n    {}</data></{name}>\n",
+                    vals.join(" ")
+                )
+            };
+            let (r, c) = match intr.distortion {
+                Distortion::Fisheye(_) => (4, 1),
+                _ => (1, d.len()),
+            };
+            format!(
+                "<?xml version=\"1.0\"?>\n<opencv_storage>\n<image_width>{}</image_width>\n<image_height>{}</image_height>\n{}<distortion_model>{}</distortion_model>\n{}</opencv_storage>\n",
+                intr.image_width_px,
+                intr.image_height_px,
+                matrix("camera_matrix", 3, 3, &k),
+                intr.distortion.name(),
+                matrix("distortion_coefficients", r, c, d)
             )
         }
         CameraFileFormat::Json => {

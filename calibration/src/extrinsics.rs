@@ -9,10 +9,13 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::camera_file::{read_camera_file, CameraFileError};
+use crate::camera_file::{read_camera_file_as, CameraFileError, DistortionModelHint};
 use crate::capture_images::{observe_images, CaptureImages, ImageError};
 use crate::overlay::{read_png_rgb8_sized, render_overlay, OverlayError};
 use crate::pnp::{solve_pnp, PnpError, PnpOptions, RansacOptions};
+use crate::refine::{
+    refine_intrinsics, solution_at, RefineError, RefineParameters, RefinementReport,
+};
 use crate::report::{ExtrinsicsReport, Provenance};
 use crate::tables::{
     pair, read_capture_plan, read_captures, read_observations, read_point_table, PointsFrom,
@@ -22,8 +25,11 @@ use crate::tables::{
 /// Inputs of one extrinsics calibration.
 #[derive(Debug, Clone)]
 pub struct ExtrinsicsJob {
-    /// Camera file (OpenCV FileStorage YAML, ROS camera_info YAML or fabkit JSON).
+    /// Camera file (OpenCV FileStorage YAML or XML, ROS camera_info YAML or fabkit JSON).
     pub camera: PathBuf,
+    /// Distortion model of a camera file that names none ([`DistortionModelHint`]); `None`:
+    /// inferred from the coefficient count.
+    pub camera_model: Option<DistortionModelHint>,
     /// Point table (fixtures table or `id,x_mm,y_mm,z_mm`), sensor frame, mm.
     pub points: PathBuf,
     pub points_from: PointsFrom,
@@ -36,6 +42,10 @@ pub struct ExtrinsicsJob {
     pub image: Option<PathBuf>,
     /// `None`: no outlier rejection.
     pub ransac: Option<RansacOptions>,
+    /// Refine the intrinsics jointly with the pose ([`crate::refine`]) over the inliers of the
+    /// pose solve, and write the refined camera file in the form read; `None`: the camera
+    /// file's intrinsics are used as they are.
+    pub refine_intrinsics: Option<RefineParameters>,
     /// Recorded in the report's provenance.
     pub command_line: String,
 }
@@ -66,6 +76,8 @@ pub enum ExtrinsicsError {
     Overlay(#[from] OverlayError),
     #[error(transparent)]
     Image(#[from] ImageError),
+    #[error(transparent)]
+    Refine(#[from] RefineError),
     #[error("cannot serialise the report as YAML: {0}")]
     Yaml(String),
 }
@@ -102,7 +114,7 @@ pub struct FoundInImages {
 /// images, also the errors of [`observe_images`] (an unreadable image, file names without ids,
 /// a plan of another length).
 pub fn calibrate_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsOutput, ExtrinsicsError> {
-    let camera = read_camera_file(&job.camera)?;
+    let camera = read_camera_file_as(&job.camera, job.camera_model)?;
     let table = read_point_table(&job.points, job.points_from)?;
     let plan = job
         .capture_plan
@@ -151,6 +163,28 @@ pub fn calibrate_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsOutput, Ext
         };
         ExtrinsicsError::Pnp { context, source }
     })?;
+    let (camera, sol, refinement) = match &job.refine_intrinsics {
+        None => (camera, sol, None),
+        Some(which) => {
+            let (pts, px): (Vec<_>, Vec<_>) = pairs
+                .points_mm
+                .iter()
+                .zip(&pairs.pixels_px)
+                .zip(&sol.inliers)
+                .filter(|(_, &inlier)| inlier)
+                .map(|((p, q), _)| (*p, *q))
+                .unzip();
+            let r = refine_intrinsics(&camera, &pts, &px, &sol.t_cam_sensor, which)?;
+            let sol = solution_at(
+                &r.camera,
+                &pairs.points_mm,
+                &pairs.pixels_px,
+                &sol,
+                r.t_cam_sensor,
+            );
+            (r.camera, sol, Some(r))
+        }
+    };
     let fixtures = crate::read_text(&job.points)
         .map(|t| t.contains("tip_x_mm"))
         .unwrap_or(false);
@@ -182,6 +216,18 @@ pub fn calibrate_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsOutput, Ext
     if let Some(found) = &from_images {
         report.warnings.extend(found.rejected.iter().cloned());
     }
+    let refined_file = match &refinement {
+        Some(r) => {
+            let text = crate::read_text(&job.camera).unwrap_or_default();
+            let (name, format) = crate::refine::refined_camera_file(&text);
+            report.intrinsics_refinement = Some(RefinementReport::new(r, name));
+            Some((
+                name.to_string(),
+                crate::write_camera(r.camera.intrinsics(), format).into_bytes(),
+            ))
+        }
+        None => None,
+    };
     let json = report.to_json();
     let yaml = report.to_yaml().map_err(ExtrinsicsError::Yaml)?;
     let overlay = match &job.image {
@@ -199,6 +245,7 @@ pub fn calibrate_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsOutput, Ext
     if let Some(o) = overlay {
         files.push(("overlay.png".into(), o));
     }
+    files.extend(refined_file);
     if let Some(found) = &from_images {
         files.push(("observations.csv".into(), found.csv.clone().into_bytes()));
         files.extend(found.overlays(&camera, &table, &sol.t_cam_sensor)?);

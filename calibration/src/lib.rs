@@ -18,6 +18,7 @@ pub mod imprints;
 pub mod overlay;
 pub mod p3p;
 pub mod pnp;
+pub mod refine;
 pub mod report;
 pub mod sqpnp;
 pub mod synthetic;
@@ -25,7 +26,8 @@ pub mod tables;
 
 pub use camera::{CameraError, CameraModel, Distortion, Intrinsics};
 pub use camera_file::{
-    parse_camera, read_camera_file, write_camera, CameraFileError, CameraFileFormat,
+    parse_camera, parse_camera_as, read_camera_file, read_camera_file_as, write_camera,
+    CameraFileError, CameraFileFormat, DistortionModelHint,
 };
 pub use extrinsics::{
     calibrate_extrinsics, ExtrinsicsError, ExtrinsicsJob, ExtrinsicsOutput, FoundInImages, Observed,

@@ -87,6 +87,9 @@ pub struct ExtrinsicsReport {
     pub pose_uncertainty: Option<PoseUncertaintyReport>,
     /// What the user should know about the solution (a weak geometry); empty when nothing.
     pub warnings: Vec<String>,
+    /// The intrinsics refined with the pose (`--refine-intrinsics`); absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub intrinsics_refinement: Option<crate::refine::RefinementReport>,
 }
 
 /// [`crate::PoseUncertainty`] as reported.
@@ -191,6 +194,7 @@ impl ExtrinsicsReport {
                 covariance_per_px2: u.covariance_per_px2,
             }),
             warnings,
+            intrinsics_refinement: None,
             description: "T_cam_sensor maps sensor-frame points (mm; docs/conventions.md) into the camera frame (mm; x right, y down, z forward). rvec/tvec_mm follow OpenCV's solvePnP convention: x_cam = R(rvec) x_sensor + tvec_mm. Pixels: (0, 0) is the centre of the top-left pixel.".into(),
             provenance,
             distortion_model: camera.intrinsics().distortion.name().into(),
@@ -219,11 +223,22 @@ impl ExtrinsicsReport {
         s
     }
 
-    /// The same content as YAML.
+    /// The same content as YAML that `cv::FileStorage` reads too (OpenCV's reader is not a full
+    /// YAML parser): a `%YAML 1.2` directive first (OpenCV 4 tells the format from a leading
+    /// `%YAML` and takes any 1.x; PyYAML takes it too), every sequence indented under its key,
+    /// and every string on one line (a multi-line command line double-quoted with `\n`), as
+    /// OpenCV reads neither indentless sequences nor block scalars. OpenCV reads strings of up
+    /// to 4095 bytes.
     ///
     /// # Errors
     /// The YAML serialiser's message.
     pub fn to_yaml(&self) -> Result<String, String> {
-        serde_saphyr::to_string(self).map_err(|e| e.to_string())
+        let options = serde_saphyr::ser_options! {
+            prefer_block_scalars: false,
+            compact_list_indent: false,
+        };
+        let body =
+            serde_saphyr::to_string_with_options(self, options).map_err(|e| e.to_string())?;
+        Ok(format!("%YAML 1.2\n---\n{body}"))
     }
 }

@@ -4,8 +4,9 @@ use std::error::Error;
 use std::path::PathBuf;
 
 use fabkit_calibration::capture_images::CaptureImages;
+use fabkit_calibration::refine::RefineParameters;
 use fabkit_calibration::{
-    calibrate_extrinsics, ExtrinsicsJob, Observed, PointsFrom, RansacOptions,
+    calibrate_extrinsics, DistortionModelHint, ExtrinsicsJob, Observed, PointsFrom, RansacOptions,
 };
 use fabkit_export::StagedDir;
 
@@ -24,11 +25,39 @@ pub enum PointsFromArg {
     Contact,
 }
 
+/// `--camera-model`: the distortion model names of ROS and OpenCV.
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+pub enum CameraModelArg {
+    /// Kannala-Brandt, k1..k4 (cv2.fisheye).
+    #[value(name = "fisheye")]
+    Fisheye,
+    /// k1, k2, p1, p2[, k3] (cv2.calibrateCamera).
+    #[value(name = "plumb_bob")]
+    PlumbBob,
+    /// k1, k2, p1, p2, k3..k6 (cv2.calibrateCamera with CALIB_RATIONAL_MODEL).
+    #[value(name = "rational_polynomial")]
+    RationalPolynomial,
+}
+
+impl From<CameraModelArg> for DistortionModelHint {
+    fn from(a: CameraModelArg) -> DistortionModelHint {
+        match a {
+            CameraModelArg::Fisheye => DistortionModelHint::Fisheye,
+            CameraModelArg::PlumbBob => DistortionModelHint::PlumbBob,
+            CameraModelArg::RationalPolynomial => DistortionModelHint::RationalPolynomial,
+        }
+    }
+}
+
 #[derive(clap::Args, Debug)]
 pub struct ExtrinsicsArgs {
-    /// Camera file: OpenCV FileStorage YAML, ROS camera_info YAML or fabkit JSON.
+    /// Camera file: OpenCV FileStorage YAML or XML, ROS camera_info YAML or fabkit JSON.
     #[arg(long, value_name = "CAM")]
     pub camera: PathBuf,
+    /// Distortion model of a camera file that does not name one (e.g. the 4 coefficients of
+    /// cv2.fisheye.calibrate)
+    #[arg(long, value_enum, value_name = "MODEL")]
+    pub camera_model: Option<CameraModelArg>,
     /// Point table: the one `fabkit fixtures` writes, or a CSV with id,x_mm,y_mm,z_mm (sensor frame, mm).
     #[arg(long, value_name = "POINTS.csv")]
     pub points: PathBuf,
@@ -67,6 +96,14 @@ pub struct ExtrinsicsArgs {
     /// Use every observation (no outlier rejection).
     #[arg(long)]
     pub no_ransac: bool,
+    /// Refine the intrinsics with the pose, by Levenberg-Marquardt on the reprojection error,
+    /// and write the refined camera file (camera_refined.yaml or .json, the form read). Alone:
+    /// every parameter the captures constrain (the others, such as the focal length seen from
+    /// near the dome's axis, are held at the camera file's values and the report says why);
+    /// or a list, e.g. cx,cy,k1,k2 (names: fx fy cx cy and the model's k1 k2 [p1 p2] k3 ...),
+    /// refused if the captures do not constrain it.
+    #[arg(long, value_name = "PARAMS", num_args = 0..=1, default_missing_value = "")]
+    pub refine_intrinsics: Option<String>,
     /// Seed of the RANSAC sampler.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
@@ -88,6 +125,7 @@ fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
     }
     let job = ExtrinsicsJob {
         camera: a.camera,
+        camera_model: a.camera_model.map(Into::into),
         points: a.points,
         points_from: match a.points_from {
             PointsFromArg::Tip => PointsFrom::Tip,
@@ -102,6 +140,13 @@ fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
         },
         capture_plan: a.capture_plan,
         image: a.image,
+        refine_intrinsics: match a.refine_intrinsics.as_deref() {
+            None => None,
+            Some("") => Some(RefineParameters::Constrained),
+            Some(list) => Some(RefineParameters::Only(
+                list.split(',').map(|s| s.trim().to_string()).collect(),
+            )),
+        },
         ransac: (!a.no_ransac).then_some(RansacOptions {
             threshold_px: a.ransac_threshold_px,
             seed: a.seed,
@@ -147,6 +192,22 @@ fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
         "rvec = [{:.6}, {:.6}, {:.6}] rad, tvec_mm = [{:.4}, {:.4}, {:.4}], camera centre in sensor frame = [{:.4}, {:.4}, {:.4}] mm",
         r.rvec[0], r.rvec[1], r.rvec[2], r.tvec_mm[0], r.tvec_mm[1], r.tvec_mm[2], c[0], c[1], c[2]
     );
+    if let Some(ir) = &r.intrinsics_refinement {
+        println!(
+            "intrinsics: RMS reprojection error {:.3} px with the camera file's, {:.3} px refined (condition number {:.0}); {}",
+            ir.rms_before_px, ir.rms_after_px, ir.condition_number, ir.camera_file
+        );
+        for p in &ir.parameters {
+            match (&p.held, p.std) {
+                (None, Some(sd)) => println!(
+                    "  {} = {:.6} +- {:.6} (camera file {:.6})",
+                    p.name, p.value, sd, p.initial
+                ),
+                (Some(why), _) => println!("  {} = {:.6} held: {why}", p.name, p.value),
+                (None, None) => println!("  {} = {:.6}", p.name, p.value),
+            }
+        }
+    }
     if let Some(u) = &r.pose_uncertainty {
         let [rx, ry, rz] = u.rotation_std_deg_per_px;
         let [tx, ty, tz] = u.translation_std_mm_per_px;

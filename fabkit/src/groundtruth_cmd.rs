@@ -11,7 +11,7 @@ use fabkit_calibration::groundtruth::inputs::{
 use fabkit_calibration::groundtruth::rays::PixelRays;
 use fabkit_calibration::groundtruth::surface::ReferenceSurface;
 use fabkit_calibration::groundtruth::{half_masks, indented_hits, reference_hits, DepthFrame};
-use fabkit_calibration::read_camera_file;
+use fabkit_calibration::read_camera_file_as;
 use fabkit_export::raster::{
     normals_rgb, npy_f32, npz as npz_file, ply_points, png_gray16, png_gray8, png_rgb8,
     preview_rgb, PlyPoint, Png16Encoding,
@@ -27,9 +27,13 @@ pub struct GroundTruthArgs {
     /// A design YAML file or the name of a library design (default: rtac0); the fixtures must
     /// have been built from it.
     design: Option<String>,
-    /// Camera file (OpenCV FileStorage YAML, ROS camera_info YAML or fabkit JSON).
+    /// Camera file (OpenCV FileStorage YAML or XML, ROS camera_info YAML or fabkit JSON).
     #[arg(long, value_name = "CAM")]
     camera: PathBuf,
+    /// Distortion model of a camera file that does not name one (e.g. the 4 coefficients of
+    /// cv2.fisheye.calibrate)
+    #[arg(long, value_enum, value_name = "MODEL")]
+    camera_model: Option<crate::calibrate_cmd::CameraModelArg>,
     /// extrinsics.json of `fabkit calibrate extrinsics` (T_cam_sensor).
     #[arg(long, value_name = "extrinsics.json")]
     extrinsics: PathBuf,
@@ -424,7 +428,7 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
         loaded.design = loaded.design.with_preset(p)?;
     }
     let design = &loaded.design;
-    let camera = read_camera_file(&args.camera)?;
+    let camera = read_camera_file_as(&args.camera, args.camera_model.map(Into::into))?;
     let (cw, ch) = (
         camera.intrinsics().image_width_px,
         camera.intrinsics().image_height_px,

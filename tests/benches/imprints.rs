@@ -134,6 +134,7 @@ fn bench_calibration(c: &mut Criterion) {
     let captures = calibration_inputs(dir);
     let job = ExtrinsicsJob {
         camera: dir.join("cam.yaml"),
+        camera_model: None,
         points: dir.join("points/point_table.csv"),
         points_from: PointsFrom::Tip,
         observations: Observed::Images(CaptureImages {
@@ -143,6 +144,7 @@ fn bench_calibration(c: &mut Criterion) {
         capture_plan: Some(dir.join("points/capture_plan.csv")),
         image: None,
         ransac: Some(Default::default()),
+        refine_intrinsics: None,
         command_line: "bench".into(),
     };
     let out = calibrate_extrinsics(&job).unwrap();

@@ -45,7 +45,7 @@ fn pins() -> Vec<(usize, Vector3<f64>, Vector3<f64>)> {
     out
 }
 
-fn write_table(path: &Path) {
+pub(crate) fn write_table(path: &Path) {
     let mut s = String::from("# fabkit fixtures point table (synthetic, for the calibrate test)\n# frame: sensor (docs/conventions.md), mm\nid,ring,tip_x_mm,tip_y_mm,tip_z_mm,contact_x_mm,contact_y_mm,contact_z_mm,axis_x,axis_y,axis_z,indentation_depth_mm\n");
     for (id, tip, c) in pins() {
         let ring = [0, 1, 1, 1, 1, 2, 2, 2, 2, 2, 2][..]
@@ -62,7 +62,7 @@ fn write_table(path: &Path) {
 }
 
 /// Observations of the tip (or contact) points at the true pose, with a fixed +-0.3 px pattern.
-fn observe(contact: bool, ids: impl Iterator<Item = usize>) -> String {
+pub(crate) fn observe(contact: bool, ids: impl Iterator<Item = usize>) -> String {
     let cam = CameraModel::new(intrinsics()).unwrap();
     let pins = pins();
     let mut s = String::from("id,u_px,v_px\n");
@@ -641,4 +641,107 @@ fn an_image_is_checked_from_its_header_and_inputs_are_regular_files() {
         );
         assert!(!dir.join("out").exists());
     }
+}
+
+/// `--camera-model` (calibrate extrinsics and groundtruth): an unknown value is clap's usage
+/// error naming the option and its values; a model that contradicts the file's is an error naming
+/// both; a 4-coefficient file without a model name reads with `--camera-model fisheye` (the same
+/// pose as the file that names it) and is refused without it, naming both ways out. Nothing is
+/// written on an error.
+#[test]
+fn camera_model_option_bad_value_mismatch_and_hint() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let named = write_camera(&intrinsics(), CameraFileFormat::OpenCvYaml);
+    std::fs::write(dir.join("cam.yaml"), &named).unwrap();
+    std::fs::write(
+        dir.join("bare.yaml"),
+        named.replace("distortion_model: fisheye\n", ""),
+    )
+    .unwrap();
+    write_table(&dir.join("pins.csv"));
+    std::fs::write(dir.join("obs.csv"), observe(false, 0..29)).unwrap();
+    let calibrate = |camera: &str, model: Option<&str>, out: &str| {
+        let mut args = vec![
+            "calibrate",
+            "extrinsics",
+            "--camera",
+            camera,
+            "--points",
+            "pins.csv",
+            "--observations",
+            "obs.csv",
+            "--out",
+            out,
+        ];
+        if let Some(m) = model {
+            args.extend(["--camera-model", m]);
+        }
+        run(dir, &args, &[])
+    };
+    // clap refuses an unknown model with its usage error.
+    let o = calibrate("cam.yaml", Some("kb8"), "out");
+    let e = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(
+        e.contains("'kb8'")
+            && e.contains("--camera-model <MODEL>")
+            && e.contains("[possible values: fisheye, plumb_bob, rational_polynomial]"),
+        "{e}"
+    );
+    assert!(!dir.join("out").exists());
+    let o = run(
+        dir,
+        &[
+            "groundtruth",
+            "--camera",
+            "cam.yaml",
+            "--camera-model",
+            "equidistant",
+            "--extrinsics",
+            "x.json",
+            "--fixtures",
+            "fx",
+            "--out",
+            "out",
+        ],
+        &[],
+    );
+    let e = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(
+        e.contains("--camera-model <MODEL>") && e.contains("plumb_bob, rational_polynomial"),
+        "{e}"
+    );
+    // The file names fisheye: another model is an error naming both.
+    let o = calibrate("cam.yaml", Some("rational_polynomial"), "out");
+    let e = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(
+        e.contains("cam.yaml:10: distortion_model = fisheye: the file names this model but --camera-model rational_polynomial was given"),
+        "{e}"
+    );
+    assert!(!dir.join("out").exists());
+    // No model name, 4 coefficients: refused without the option, read with it.
+    let o = calibrate("bare.yaml", None, "out");
+    let e = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(
+        e.contains("bare.yaml:10: distortion_coefficients = 4 values")
+            && e.contains("`fisheye_model: 1`")
+            && e.contains("`--camera-model fisheye`"),
+        "{e}"
+    );
+    assert!(!dir.join("out").exists());
+    let o = calibrate("bare.yaml", Some("fisheye"), "hinted");
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let o = calibrate("cam.yaml", None, "named");
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let (hinted, named) = (
+        json(&dir.join("hinted/extrinsics.json")),
+        json(&dir.join("named/extrinsics.json")),
+    );
+    assert_eq!(hinted["distortion_model"], "fisheye");
+    assert_eq!(hinted["rvec"], named["rvec"]);
+    assert_eq!(hinted["tvec_mm"], named["tvec_mm"]);
 }

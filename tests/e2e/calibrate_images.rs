@@ -481,3 +481,146 @@ fn bad_images_and_reference_exit_2_naming_the_option_and_write_nothing() {
         assert!(!s.path("out").exists(), "{extra:?}");
     }
 }
+
+#[test]
+fn refine_intrinsics_from_photos_writes_the_camera_file_in_the_form_read() {
+    use fabkit_calibration::{read_camera_file, Distortion};
+    let s = Scene::new();
+    let mut names = Vec::new();
+    for (k, ids) in s.plan.iter().enumerate() {
+        let (reference, capture, _) = s.render(ids, 300 + k as u64);
+        if k == 0 {
+            save(&reference, &s.path("reference.png"), Kind::Gray8);
+        }
+        let name = format!("capture_{}.png", k + 1);
+        save(&capture, &s.path(&name), Kind::Gray8);
+        names.push(name);
+    }
+    // the camera file: the principal point 3 and 2 px off, k1 half the true value
+    let mut off = intrinsics();
+    off.cx_px += 3.0;
+    off.cy_px -= 2.0;
+    off.distortion = Distortion::Fisheye([-0.01, 0.004, -0.0015, 0.0002]);
+    std::fs::write(
+        s.path("cam_off.json"),
+        write_camera(&off, CameraFileFormat::Json),
+    )
+    .unwrap();
+    std::fs::write(
+        s.path("cam_off.yaml"),
+        write_camera(&off, CameraFileFormat::OpenCvYaml),
+    )
+    .unwrap();
+    let calibrate = |camera: &str, refine: &str, out: &str| {
+        let mut args = vec![
+            "calibrate",
+            "extrinsics",
+            "--camera",
+            camera,
+            "--points",
+            "fx/points/point_table.csv",
+            "--capture-plan",
+            "fx/points/capture_plan.csv",
+            "--reference",
+            "reference.png",
+            "--out",
+            out,
+        ];
+        if refine.is_empty() {
+            args.push("--refine-intrinsics");
+        } else {
+            args.extend(["--refine-intrinsics", refine]);
+        }
+        args.push("--images");
+        args.extend(names.iter().map(String::as_str));
+        run(s.dir.path(), &args, &[])
+    };
+    let o = calibrate("cam_off.json", "", "out");
+    assert!(o.status.success(), "{}{}", text(&o.stdout), text(&o.stderr));
+    let j = json(&s.path("out/extrinsics.json"));
+    let ir = &j["intrinsics_refinement"];
+    assert_eq!(ir["camera_file"], "camera_refined.json");
+    assert!(ir["rms_after_px"].as_f64().unwrap() < ir["rms_before_px"].as_f64().unwrap());
+    let truth = intrinsics();
+    let true_values = [
+        ("fx", truth.fx_px),
+        ("fy", truth.fy_px),
+        ("cx", truth.cx_px),
+        ("cy", truth.cy_px),
+        ("k1", -0.02),
+    ];
+    let params = ir["parameters"].as_array().unwrap();
+    let param = |n: &str| params.iter().find(|p| p["name"] == n).unwrap();
+    for n in ["fx", "fy"] {
+        assert!(
+            param(n)["held"]
+                .as_str()
+                .unwrap()
+                .contains("the focal length (fx and fy together)"),
+            "{}",
+            param(n)
+        );
+    }
+    for (n, tv) in &true_values[2..] {
+        let p = param(n);
+        let (v, sd) = (p["value"].as_f64().unwrap(), p["std"].as_f64().unwrap());
+        assert!(
+            (v - tv).abs() < 3.0 * sd
+                && (v - tv).abs() < (p["initial"].as_f64().unwrap() - tv).abs(),
+            "{n} = {v} +- {sd}, true {tv}"
+        );
+    }
+    // the refined camera file, in the form read, holds the reported values
+    let refined = read_camera_file(&s.path("out/camera_refined.json")).unwrap();
+    let r = refined.intrinsics();
+    let got = [
+        r.fx_px,
+        r.fy_px,
+        r.cx_px,
+        r.cy_px,
+        r.distortion.coefficients()[0],
+    ];
+    for ((n, _), g) in true_values.iter().zip(got) {
+        assert!(
+            (param(n)["value"].as_f64().unwrap() - g).abs() < 1e-9,
+            "{n}: {g} in the file"
+        );
+    }
+    let o = calibrate("cam_off.yaml", "cx,cy,k1,k2", "out_yaml");
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let y = std::fs::read_to_string(s.path("out_yaml/camera_refined.yaml")).unwrap();
+    assert!(y.starts_with("%YAML:1.0"), "{y}");
+    assert!(read_camera_file(&s.path("out_yaml/camera_refined.yaml")).is_ok());
+    std::fs::write(
+        s.path("cam_off.xml"),
+        write_camera(&off, CameraFileFormat::OpenCvXml),
+    )
+    .unwrap();
+    let o = calibrate("cam_off.xml", "cx,cy,k1,k2", "out_xml");
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let from_xml = read_camera_file(&s.path("out_xml/camera_refined.xml")).unwrap();
+    let from_yaml = read_camera_file(&s.path("out_yaml/camera_refined.yaml")).unwrap();
+    assert_eq!(from_xml.intrinsics(), from_yaml.intrinsics());
+
+    // parameters the model lacks, or the captures do not constrain: exit 2, nothing written
+    for (refine, message) in [
+        (
+            "cx,k9",
+            "--refine-intrinsics cx,k9: 'k9' is not a parameter of the fisheye model (its parameters: fx, fy, cx, cy, k1, k2, k3, k4)",
+        ),
+        (
+            "fx,fy,cx,cy,k1",
+            "--refine-intrinsics fx,fy,cx,cy,k1: the captures do not constrain f",
+        ),
+        ("cx,cx", "--refine-intrinsics cx,cx: 'cx' is named twice"),
+    ] {
+        let o = calibrate("cam_off.json", refine, "bad");
+        assert_eq!(o.status.code(), Some(2), "{refine}: {}", text(&o.stderr));
+        assert!(
+            text(&o.stderr).contains(message),
+            "{refine}: wanted {message:?} in {}",
+            text(&o.stderr)
+        );
+        assert!(!s.path("bad").exists(), "{refine}");
+    }
+}

@@ -1,12 +1,22 @@
 //! OpenCV (opencv-python-headless, tests/oracles/opencv_project.py) as the oracle for the camera
 //! models and the OpenCV FileStorage camera file: projection agrees to 1e-6 px over the field of
 //! view (fisheye up to 89 deg off axis, where cv2.fisheye's z = 1 plane still holds), and
-//! cv2.FileStorage reads back exactly what fabkit writes.
+//! cv2.FileStorage reads back exactly what fabkit writes. OpenCV (tests/oracles/
+//! opencv_camera_files.py) also writes the camera files users already have, in every layout
+//! (YAML and XML; calibrateCamera's 5, 12 and 14 coefficients, cv2.fisheye.calibrate's 4 with and
+//! without `fisheye_model: 1`), which fabkit reads to exactly OpenCV's numbers, and reads the
+//! `extrinsics.yaml` fabkit writes.
 
-use crate::common::{missing, oracle_python, repo_root, text};
+use std::path::Path;
+
+use crate::calibrate_cli::{intrinsics, json, observe, write_table};
+use crate::common::{missing, oracle_python, repo_root, run, text};
 use fabkit_calibration::nalgebra::Vector3;
 use fabkit_calibration::synthetic::benchmark_intrinsics;
-use fabkit_calibration::{write_camera, CameraFileFormat, CameraModel, Distortion, Intrinsics};
+use fabkit_calibration::{
+    read_camera_file_as, write_camera, CameraFileError, CameraFileFormat, CameraModel, Distortion,
+    DistortionModelHint, Intrinsics,
+};
 
 fn cameras() -> Vec<Intrinsics> {
     let base = |d| Intrinsics {
@@ -55,8 +65,26 @@ fn projection_agrees_with_opencv_to_1e_6_px_over_the_field_and_filestorage_reads
             pts.push([p.x, p.y, p.z]);
             px.push([uv.x, uv.y]);
         }
-        let file = d.path().join(format!("cam{k}.yaml"));
-        std::fs::write(&file, write_camera(intr, CameraFileFormat::OpenCvYaml)).unwrap();
+        // every other camera as XML
+        let (file, format) = if k % 2 == 0 {
+            (
+                d.path().join(format!("cam{k}.xml")),
+                CameraFileFormat::OpenCvXml,
+            )
+        } else {
+            (
+                d.path().join(format!("cam{k}.yaml")),
+                CameraFileFormat::OpenCvYaml,
+            )
+        };
+        std::fs::write(&file, write_camera(intr, format)).unwrap();
+        // and fabkit reads its own file back to the same camera
+        assert_eq!(
+            fabkit_calibration::read_camera_file(&file)
+                .unwrap()
+                .intrinsics(),
+            intr
+        );
         cases.push(serde_json::json!({
             "model": intr.distortion.name(),
             "K": [[intr.fx_px, 0.0, intr.cx_px], [0.0, intr.fy_px, intr.cy_px], [0.0, 0.0, 1.0]],
@@ -116,4 +144,284 @@ fn projection_agrees_with_opencv_to_1e_6_px_over_the_field_and_filestorage_reads
         "worst |fabkit - OpenCV| = {worst:.2e} px (OpenCV {})",
         res["opencv_version"]
     );
+}
+
+/// tests/oracles/opencv_camera_files.py with `args`: its JSON output.
+fn camera_files_oracle(py: &Path, args: &[&std::ffi::OsStr]) -> serde_json::Value {
+    let o = std::process::Command::new(py)
+        .arg(repo_root().join("tests/oracles/opencv_camera_files.py"))
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    serde_json::from_slice(&o.stdout).unwrap()
+}
+
+fn floats(v: &serde_json::Value) -> Vec<f64> {
+    v.as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect()
+}
+
+/// 1-based line of the YAML key or XML element `key` in `text`.
+fn line_of(text: &str, key: &str) -> usize {
+    text.lines()
+        .position(|l| l.starts_with(&format!("{key}:")) || l.starts_with(&format!("<{key} ")))
+        .unwrap()
+        + 1
+}
+
+#[test]
+fn camera_files_opencv_writes_in_every_layout_read_to_opencvs_numbers() {
+    let Some(py) = oracle_python() else {
+        return missing("the oracle python (opencv-python-headless)");
+    };
+    let d = tempfile::tempdir().unwrap();
+    let res = camera_files_oracle(&py, &["write".as_ref(), d.path().as_os_str()]);
+    let files = res["files"].as_array().unwrap();
+    assert_eq!(files.len(), 12, "{res}");
+    let prism_rule =
+        "thin-prism and tilt coefficients s1..s4, tauX, tauY are not modelled, must be 0";
+    let mut seen = Vec::new();
+    for f in files {
+        let name = f["name"].as_str().unwrap();
+        let layout = f["layout"].as_str().unwrap();
+        let path = d.path().join(name);
+        let file_text = std::fs::read_to_string(&path).unwrap();
+        let k: Vec<Vec<f64>> = f["K"].as_array().unwrap().iter().map(floats).collect();
+        let dd = floats(&f["D"]);
+        let opencv = |distortion| Intrinsics {
+            image_width_px: f["width"].as_u64().unwrap() as u32,
+            image_height_px: f["height"].as_u64().unwrap() as u32,
+            fx_px: k[0][0],
+            fy_px: k[1][1],
+            cx_px: k[0][2],
+            cy_px: k[1][2],
+            distortion,
+        };
+        let read = |hint| read_camera_file_as(&path, hint).map(|c| *c.intrinsics());
+        let at = |e: &CameraFileError| e.to_string();
+        match layout {
+            "plumb_bob_5" => {
+                assert_eq!(dd.len(), 5);
+                let want = opencv(Distortion::PlumbBob(dd[..5].try_into().unwrap()));
+                assert_eq!(read(None).unwrap(), want, "{name}");
+                assert_eq!(
+                    read(Some(DistortionModelHint::PlumbBob)).unwrap(),
+                    want,
+                    "{name}"
+                );
+            }
+            "rational_14" => {
+                assert_eq!((dd.len(), &dd[8..]), (14, &[0.0; 6][..]), "{name}");
+                let want = opencv(Distortion::RationalPolynomial(dd[..8].try_into().unwrap()));
+                assert_eq!(read(None).unwrap(), want, "{name}");
+                assert_eq!(
+                    read(Some(DistortionModelHint::RationalPolynomial)).unwrap(),
+                    want,
+                    "{name}"
+                );
+            }
+            "fisheye_4" => {
+                assert_eq!(f["D_shape"], serde_json::json!([4, 1]));
+                let want = opencv(Distortion::Fisheye(dd[..].try_into().unwrap()));
+                assert_eq!(read(None).unwrap(), want, "{name}");
+            }
+            "fisheye_4_bare" => {
+                let e = at(&read(None).unwrap_err());
+                assert!(
+                    e.starts_with(&format!(
+                        "{}:{}: distortion_coefficients = 4 values",
+                        path.display(),
+                        line_of(&file_text, "distortion_coefficients")
+                    )) && e.contains("`fisheye_model: 1`")
+                        && e.contains("`--camera-model fisheye`"),
+                    "{e}"
+                );
+                let want = opencv(Distortion::Fisheye(dd[..].try_into().unwrap()));
+                assert_eq!(
+                    read(Some(DistortionModelHint::Fisheye)).unwrap(),
+                    want,
+                    "{name}"
+                );
+            }
+            "thin_prism_12" | "tilted_14" => {
+                let nonzero: Vec<String> = dd[8..]
+                    .iter()
+                    .zip(["s1", "s2", "s3", "s4", "tauX", "tauY"])
+                    .filter(|(v, _)| **v != 0.0)
+                    .map(|(v, n)| format!("{n} = {v:?}"))
+                    .collect();
+                assert!(!nonzero.is_empty(), "{name}: {dd:?}");
+                match read(None).unwrap_err() {
+                    CameraFileError::Field {
+                        file,
+                        line,
+                        field,
+                        value,
+                        rule,
+                    } => {
+                        assert_eq!(file, path.display().to_string());
+                        assert_eq!(line, line_of(&file_text, "distortion_coefficients"));
+                        assert_eq!(field, "distortion_coefficients");
+                        assert_eq!(
+                            value,
+                            format!("{} values with {}", dd.len(), nonzero.join(", "))
+                        );
+                        assert!(rule.starts_with(prism_rule), "{rule}");
+                    }
+                    other => panic!("{name}: {other:?}"),
+                }
+            }
+            other => panic!("unexpected layout {other}"),
+        }
+        seen.push(name.to_string());
+    }
+    seen.sort();
+    let mut want: Vec<String> = [
+        "fisheye_4",
+        "fisheye_4_bare",
+        "plumb_bob_5",
+        "rational_14",
+        "thin_prism_12",
+        "tilted_14",
+    ]
+    .iter()
+    .flat_map(|l| [format!("{l}.xml"), format!("{l}.yaml")])
+    .collect();
+    want.sort();
+    assert_eq!(seen, want);
+    eprintln!("camera files of OpenCV {} read", res["opencv_version"]);
+}
+
+/// `fabkit calibrate extrinsics` on cv2.fisheye.calibrate's files as OpenCV wrote them (XML with
+/// `fisheye_model: 1`; YAML without a model name and `--camera-model fisheye`) solves the same
+/// pose as with fabkit's own camera file; a contradicting `--camera-model` is refused.
+#[test]
+fn calibrate_extrinsics_reads_opencvs_fisheye_files() {
+    let Some(py) = oracle_python() else {
+        return missing("the oracle python (opencv-python-headless)");
+    };
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    camera_files_oracle(&py, &["write".as_ref(), dir.as_os_str()]);
+    std::fs::write(
+        dir.join("cam.json"),
+        write_camera(&intrinsics(), CameraFileFormat::Json),
+    )
+    .unwrap();
+    write_table(&dir.join("pins.csv"));
+    std::fs::write(dir.join("obs.csv"), observe(false, 0..29)).unwrap();
+    let calibrate = |camera: &str, model: &[&str], out: &str| {
+        let mut args = vec![
+            "calibrate",
+            "extrinsics",
+            "--camera",
+            camera,
+            "--points",
+            "pins.csv",
+            "--observations",
+            "obs.csv",
+            "--out",
+            out,
+        ];
+        args.extend(model);
+        run(dir, &args, &[])
+    };
+    let o = calibrate("cam.json", &[], "ours");
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let ours = json(&dir.join("ours/extrinsics.json"));
+    for (camera, model, out) in [
+        ("fisheye_4.xml", &[][..], "xml"),
+        ("fisheye_4.yaml", &["--camera-model", "fisheye"][..], "yaml"),
+        (
+            "fisheye_4_bare.yaml",
+            &["--camera-model", "fisheye"][..],
+            "bare",
+        ),
+    ] {
+        let o = calibrate(camera, model, out);
+        assert!(o.status.success(), "{camera}: {}", text(&o.stderr));
+        let j = json(&dir.join(out).join("extrinsics.json"));
+        assert_eq!(j["distortion_model"], "fisheye");
+        // OpenCV's intrinsics are the truth to 1e-12: the same pose.
+        for key in ["rvec", "tvec_mm"] {
+            for (a, b) in floats(&j[key]).iter().zip(floats(&ours[key])) {
+                assert!((a - b).abs() < 1e-9, "{camera} {key}: {a} vs {b}");
+            }
+        }
+    }
+    let o = calibrate("fisheye_4.xml", &["--camera-model", "plumb_bob"], "out");
+    let e = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(
+        e.contains("fisheye_4.xml:7: fisheye_model = 1: the file's fisheye_model: 1 contradicts --camera-model plumb_bob"),
+        "{e}"
+    );
+    assert!(!dir.join("out").exists());
+}
+
+/// cv2.FileStorage (and PyYAML) read `extrinsics.yaml` whose command line holds a newline (an
+/// `--out` folder named with one): the same rvec, tvec, RMS, T_cam_sensor and command line as
+/// extrinsics.json. (A block scalar, which serde-saphyr writes for multi-line strings, and an
+/// unindented sequence are parse errors for OpenCV.)
+#[test]
+fn opencv_filestorage_reads_extrinsics_yaml_with_a_multi_line_command_line() {
+    let Some(py) = oracle_python() else {
+        return missing("the oracle python (opencv-python-headless)");
+    };
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    std::fs::write(
+        dir.join("cam.yaml"),
+        write_camera(&intrinsics(), CameraFileFormat::OpenCvYaml),
+    )
+    .unwrap();
+    write_table(&dir.join("pins.csv"));
+    std::fs::write(dir.join("obs.csv"), observe(false, 0..29)).unwrap();
+    let out = "out\n  \"two\" \\ lines: # not a comment";
+    let o = run(
+        dir,
+        &[
+            "calibrate",
+            "extrinsics",
+            "--camera",
+            "cam.yaml",
+            "--points",
+            "pins.csv",
+            "--observations",
+            "obs.csv",
+            "--out",
+            out,
+        ],
+        &[],
+    );
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    // (cv::FileStorage refuses such a path itself: read a copy.)
+    let yaml = dir.join("extrinsics.yaml");
+    std::fs::copy(dir.join(out).join("extrinsics.yaml"), &yaml).unwrap();
+    let j = json(&dir.join(out).join("extrinsics.json"));
+    let cv = camera_files_oracle(&py, &["read-extrinsics".as_ref(), yaml.as_os_str()]);
+    for key in ["rvec", "tvec_mm"] {
+        assert_eq!(floats(&cv[key]), floats(&j[key]), "{key}");
+    }
+    assert_eq!(
+        cv["rms_reprojection_error_px"].as_f64(),
+        j["rms_reprojection_error_px"].as_f64()
+    );
+    for i in 0..4 {
+        assert_eq!(
+            floats(&cv["T_cam_sensor"][i]),
+            floats(&j["T_cam_sensor"][i])
+        );
+    }
+    let command_line = j["provenance"]["command_line"].as_str().unwrap();
+    assert!(
+        command_line.ends_with(&format!("--out {out}")),
+        "{command_line}"
+    );
+    assert_eq!(cv["command_line"], command_line);
+    assert_eq!(cv["pyyaml_command_line"], command_line);
 }

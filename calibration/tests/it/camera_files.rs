@@ -1,7 +1,10 @@
 //! Camera files: every form round-trips exactly; OpenCV FileStorage text as OpenCV writes it is
 //! read; errors name file:line and the field.
 
-use fabkit_calibration::{parse_camera, write_camera, CameraFileFormat, Distortion, Intrinsics};
+use fabkit_calibration::{
+    parse_camera, parse_camera_as, write_camera, CameraFileError, CameraFileFormat, Distortion,
+    DistortionModelHint as Hint, Intrinsics,
+};
 
 fn intr(d: Distortion) -> Intrinsics {
     Intrinsics {
@@ -159,7 +162,417 @@ fn errors_name_file_line_and_field() {
         .replace(",\n       -8.0000000000000002e-03", "");
     let e = parse_camera(&bad, "cal.yaml").unwrap_err().to_string();
     assert!(
-        e.contains("distortion_coefficients = 4 values") && e.contains("add distortion_model"),
+        e.starts_with("cal.yaml:12: distortion_coefficients = 4 values")
+            && e.contains("`fisheye_model: 1`")
+            && e.contains("`--camera-model fisheye`"),
+        "{e}"
+    );
+}
+
+/// What OpenCV's camera_calibration sample writes for `cv::fisheye` (Settings `Calibrate_UseFisheyeModel`):
+/// no distortion_model, `fisheye_model: 1`, D as 4 x 1.
+const OPENCV_FISHEYE_SAMPLE_OUTPUT: &str = "%YAML:1.0
+---
+calibration_time: \"Thu 01 Feb 2024\"
+nr_of_frames: 25
+image_width: 640
+image_height: 480
+board_width: 9
+board_height: 6
+square_size: 50.
+flags: 0
+fisheye_model: 1
+camera_matrix: !!opencv-matrix
+   rows: 3
+   cols: 3
+   dt: d
+   data: [ 2.1500000000000000e+02, 0., 3.2200000000000000e+02, 0.,
+       2.1450000000000000e+02, 2.3800000000000000e+02, 0., 0., 1. ]
+distortion_coefficients: !!opencv-matrix
+   rows: 4
+   cols: 1
+   dt: d
+   data: [ -2.0000000000000000e-02, 4.0000000000000001e-03,
+       -1.5000000000000000e-03, 2.0000000000000001e-04 ]
+avg_reprojection_error: 2.1000000000000001e-01
+";
+
+const FISHEYE_K: [f64; 4] = [-0.02, 0.004, -0.0015, 0.0002];
+
+#[test]
+fn fisheye_model_key_of_the_opencv_sample_reads_four_coefficients_as_fisheye() {
+    let c = parse_camera(OPENCV_FISHEYE_SAMPLE_OUTPUT, "sample.yaml").unwrap();
+    assert_eq!(c.intrinsics().distortion, Distortion::Fisheye(FISHEYE_K));
+    assert_eq!(c.intrinsics().fx_px, 215.0);
+    // fisheye_model: 0 (the sample's pinhole case): 4 coefficients are k1, k2, p1, p2.
+    let pinhole = OPENCV_FISHEYE_SAMPLE_OUTPUT.replace("fisheye_model: 1", "fisheye_model: 0");
+    assert_eq!(
+        parse_camera(&pinhole, "sample.yaml")
+            .unwrap()
+            .intrinsics()
+            .distortion,
+        Distortion::PlumbBob([-0.02, 0.004, -0.0015, 0.0002, 0.0])
+    );
+    // The key with a model name that agrees is fine; one that disagrees is an error.
+    let named = OPENCV_FISHEYE_SAMPLE_OUTPUT.replace(
+        "fisheye_model: 1\n",
+        "fisheye_model: 1\ndistortion_model: equidistant\n",
+    );
+    assert_eq!(
+        parse_camera(&named, "s.yaml")
+            .unwrap()
+            .intrinsics()
+            .distortion,
+        Distortion::Fisheye(FISHEYE_K)
+    );
+    let e = parse_camera(&named.replace("equidistant", "plumb_bob"), "s.yaml")
+        .unwrap_err()
+        .to_string();
+    assert_eq!(
+        e,
+        "s.yaml:11: fisheye_model = 1: contradicts the file's distortion_model: plumb_bob"
+    );
+    // Only 0 or 1.
+    let e = parse_camera(
+        &OPENCV_FISHEYE_SAMPLE_OUTPUT.replace("fisheye_model: 1", "fisheye_model: 2"),
+        "s.yaml",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.starts_with("s.yaml:11: fisheye_model = 2: must be 0 or 1"),
+        "{e}"
+    );
+    // fisheye_model: 1 with 5 coefficients: the count error says where the model came from.
+    let five = OPENCV_CALIBRATE_OUTPUT.replace("image_width", "fisheye_model: 1\nimage_width");
+    let e = parse_camera(&five, "s.yaml").unwrap_err().to_string();
+    assert!(
+        e.starts_with("s.yaml:13: distortion_coefficients = [-0.26,")
+            && e.contains("model 'fisheye' takes 4")
+            && e.contains("the model is from fisheye_model: 1"),
+        "{e}"
+    );
+}
+
+/// cv2.fisheye.calibrate's D written with cv2.FileStorage: 4 x 1, no model name.
+fn fisheye_without_name() -> String {
+    OPENCV_FISHEYE_SAMPLE_OUTPUT.replace("fisheye_model: 1\n", "")
+}
+
+#[test]
+fn model_hint_reads_a_file_that_names_no_model() {
+    let text = fisheye_without_name();
+    assert!(parse_camera(&text, "cam.yaml").is_err());
+    let c = parse_camera_as(&text, "cam.yaml", Some(Hint::Fisheye)).unwrap();
+    assert_eq!(c.intrinsics().distortion, Distortion::Fisheye(FISHEYE_K));
+    let c = parse_camera_as(&text, "cam.yaml", Some(Hint::PlumbBob)).unwrap();
+    assert_eq!(
+        c.intrinsics().distortion,
+        Distortion::PlumbBob([-0.02, 0.004, -0.0015, 0.0002, 0.0])
+    );
+    // A hint that agrees with the file's own name (ROS `equidistant`) changes nothing.
+    let ros = write_camera(&all()[0], CameraFileFormat::RosYaml);
+    assert!(ros.contains("distortion_model: equidistant"));
+    assert_eq!(
+        parse_camera_as(&ros, "ros.yaml", Some(Hint::Fisheye))
+            .unwrap()
+            .intrinsics(),
+        &all()[0]
+    );
+    // The hint does not override a coefficient count: 5 values are not fisheye.
+    let e = parse_camera_as(OPENCV_CALIBRATE_OUTPUT, "cal.yaml", Some(Hint::Fisheye))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("cal.yaml:12: distortion_coefficients = [-0.26,")
+            && e.contains("5 coefficients: model 'fisheye' takes 4")
+            && e.contains("the model is from --camera-model fisheye"),
+        "{e}"
+    );
+    let e = parse_camera_as(
+        OPENCV_CALIBRATE_OUTPUT,
+        "cal.yaml",
+        Some(Hint::RationalPolynomial),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("model 'rational_polynomial' takes 8"), "{e}");
+}
+
+#[test]
+fn model_hint_that_contradicts_the_file_names_both() {
+    let plumb = write_camera(&all()[1], CameraFileFormat::OpenCvYaml);
+    let e = parse_camera_as(&plumb, "cam.yaml", Some(Hint::Fisheye)).unwrap_err();
+    match &e {
+        CameraFileError::Field {
+            file,
+            line,
+            field,
+            value,
+            ..
+        } => assert_eq!(
+            (file.as_str(), *line, field.as_str(), value.as_str()),
+            ("cam.yaml", 10, "distortion_model", "plumb_bob")
+        ),
+        other => panic!("{other:?}"),
+    }
+    let e = e.to_string();
+    assert!(
+        e.contains("--camera-model fisheye") && e.contains("give --camera-model plumb_bob"),
+        "{e}"
+    );
+    // fisheye_model: 1 against a pinhole hint.
+    let e = parse_camera_as(OPENCV_FISHEYE_SAMPLE_OUTPUT, "s.yaml", Some(Hint::PlumbBob))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("s.yaml:11: fisheye_model = 1: the file's fisheye_model: 1 contradicts --camera-model plumb_bob"),
+        "{e}"
+    );
+    // The JSON form always names its model.
+    let j = write_camera(&all()[2], CameraFileFormat::Json);
+    let e = parse_camera_as(&j, "cam.json", Some(Hint::PlumbBob))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("cam.json:3: distortion_model = rational_polynomial: ")
+            && e.contains("--camera-model plumb_bob"),
+        "{e}"
+    );
+}
+
+/// `cv2.calibrateCamera(..., flags=cv2.CALIB_RATIONAL_MODEL)` in OpenCV 5 returns D as 1 x 14
+/// (k1 k2 p1 p2 k3 k4 k5 k6 s1 s2 s3 s4 tauX tauY); written by cv2.FileStorage.
+const OPENCV_RATIONAL_14: &str = "%YAML 1.2
+---
+calibration_time: Thu 01 Feb 2024
+image_width: 640
+image_height: 480
+camera_matrix: !!opencv-matrix
+   rows: 3
+   cols: 3
+   dt: d
+   data: [ 299.99996577805354, 0., 319.99996233788482, 0.,
+       299.99996050416121, 239.99998916883675, 0., 0., 1. ]
+distortion_coefficients: !!opencv-matrix
+   rows: 1
+   cols: 14
+   dt: d
+   data: [ -0.077330799632288852, -0.1011988593255983,
+       0.00099999357915455506, -0.0005000148599361594,
+       0.023831349686126158, 0.22266879018921973, -0.10437941172205673,
+       -0.027302944192948462, 0., 0., 0., 0., 0., 0. ]
+avg_reprojection_error: 9.9964626221629396e-06
+";
+
+const RATIONAL_8: [f64; 8] = [
+    -0.07733079963228885,
+    -0.1011988593255983,
+    0.000999993579154555,
+    -0.0005000148599361594,
+    0.023831349686126158,
+    0.22266879018921973,
+    -0.10437941172205673,
+    -0.027302944192948462,
+];
+
+#[test]
+fn rational_model_14_or_12_coefficients_with_zero_extras_read_as_the_8_coefficient_file() {
+    let eight = OPENCV_RATIONAL_14
+        .replace("cols: 14", "cols: 8")
+        .replace(", 0., 0., 0., 0., 0., 0. ]", " ]");
+    let want = parse_camera(&eight, "r8.yaml").unwrap();
+    assert_eq!(
+        want.intrinsics().distortion,
+        Distortion::RationalPolynomial(RATIONAL_8)
+    );
+    let twelve = OPENCV_RATIONAL_14
+        .replace("cols: 14", "cols: 12")
+        .replace(", 0., 0., 0., 0., 0., 0. ]", ", 0., 0., 0., 0. ]");
+    for (text, hint) in [
+        (OPENCV_RATIONAL_14.to_string(), None),
+        (
+            OPENCV_RATIONAL_14.to_string(),
+            Some(Hint::RationalPolynomial),
+        ),
+        (
+            OPENCV_RATIONAL_14.replace(
+                "image_width",
+                "distortion_model: rational_polynomial\nimage_width",
+            ),
+            None,
+        ),
+        (twelve, None),
+    ] {
+        let c = parse_camera_as(&text, "r.yaml", hint).unwrap_or_else(|e| panic!("{e}\n{text}"));
+        assert_eq!(c.intrinsics(), want.intrinsics(), "{text}");
+    }
+    // 14 values are not a plumb_bob's.
+    let e = parse_camera_as(OPENCV_RATIONAL_14, "r.yaml", Some(Hint::PlumbBob))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("14 coefficients: model 'plumb_bob' takes 5"),
+        "{e}"
+    );
+}
+
+#[test]
+fn nonzero_thin_prism_or_tilt_coefficients_are_a_named_error() {
+    let rule = "thin-prism and tilt coefficients s1..s4, tauX, tauY are not modelled, must be 0";
+    let tilted = OPENCV_RATIONAL_14.replace(", 0., 0. ]", ", 1.5e-3, 0. ]");
+    let prism12 = OPENCV_RATIONAL_14
+        .replace("cols: 14", "cols: 12")
+        .replace(", 0., 0., 0., 0., 0., 0. ]", ", -2.2e-8, 0., 7.9e-7, 0. ]");
+    for (text, want_value) in [
+        (tilted, "14 values with tauX = 0.0015"),
+        (prism12, "12 values with s1 = -2.2e-8, s3 = 7.9e-7"),
+    ] {
+        match parse_camera(&text, "r.yaml").unwrap_err() {
+            CameraFileError::Field {
+                file,
+                line,
+                field,
+                value,
+                rule: r,
+            } => {
+                assert_eq!(
+                    (file.as_str(), line, field.as_str(), value.as_str()),
+                    ("r.yaml", 12, "distortion_coefficients", want_value)
+                );
+                assert!(r.starts_with(rule), "{r}");
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+}
+
+/// The OpenCV FileStorage XML twin of [`OPENCV_CALIBRATE_OUTPUT`] as cv2.FileStorage writes it
+/// (plus a comment and an entity in a string).
+const OPENCV_XML: &str = "<?xml version=\"1.0\"?>
+<opencv_storage>
+<calibration_time>\"Thu 01 Feb 2024 &amp; later\"</calibration_time>
+<image_width>640</image_width>
+<image_height>480</image_height>
+<!-- flags: +fix_k3 -->
+<camera_matrix type_id=\"opencv-matrix\">
+  <rows>3</rows>
+  <cols>3</cols>
+  <dt>d</dt>
+  <data>
+    3.0012000000000000e+02 0. 3.2010000000000000e+02 0.
+    2.9988000000000000e+02 2.4030000000000000e+02 0. 0. 1.</data></camera_matrix>
+<distortion_coefficients type_id=\"opencv-matrix\">
+  <rows>1</rows>
+  <cols>5</cols>
+  <dt>d</dt>
+  <data>
+    -2.6000000000000001e-01 7.0000000000000007e-02 1.0000000000000000e-03
+    -5.0000000000000001e-04 -8.0000000000000002e-03</data></distortion_coefficients>
+<avg_reprojection_error>2.1000000000000001e-01</avg_reprojection_error>
+</opencv_storage>
+";
+
+#[test]
+fn opencv_xml_reads_as_the_yaml_form() {
+    let yaml = parse_camera(OPENCV_CALIBRATE_OUTPUT, "cal.yaml").unwrap();
+    let xml = parse_camera(OPENCV_XML, "cal.xml").unwrap();
+    assert_eq!(xml.intrinsics(), yaml.intrinsics());
+    // Fisheye: fisheye_model 1 or distortion_model, and the hint, as in YAML.
+    let fisheye = OPENCV_XML
+        .replace("<cols>5</cols>", "<cols>4</cols>")
+        .replace(" -8.0000000000000002e-03", "");
+    let e = parse_camera(&fisheye, "f.xml").unwrap_err().to_string();
+    assert!(
+        e.starts_with("f.xml:14: distortion_coefficients = 4 values"),
+        "{e}"
+    );
+    let want = Distortion::Fisheye([-0.26, 0.07, 0.001, -0.0005]);
+    for (text, hint) in [
+        (
+            fisheye.replace(
+                "<image_width>",
+                "<fisheye_model>1</fisheye_model>\n<image_width>",
+            ),
+            None,
+        ),
+        (
+            fisheye.replace(
+                "<image_width>",
+                "<distortion_model>fisheye</distortion_model><image_width>",
+            ),
+            None,
+        ),
+        (fisheye.clone(), Some(Hint::Fisheye)),
+    ] {
+        let c = parse_camera_as(&text, "f.xml", hint).unwrap_or_else(|e| panic!("{e}\n{text}"));
+        assert_eq!(c.intrinsics().distortion, want);
+    }
+    // A model name in double quotes (OpenCV quotes strings with spaces or punctuation).
+    let quoted = OPENCV_XML.replace(
+        "<image_width>",
+        "<distortion_model>\"plumb_bob\"</distortion_model>\n<image_width>",
+    );
+    assert_eq!(
+        parse_camera(&quoted, "q.xml").unwrap().intrinsics(),
+        yaml.intrinsics()
+    );
+}
+
+#[test]
+fn xml_errors_name_file_and_line() {
+    let err = |text: &str| parse_camera(text, "cal.xml").unwrap_err().to_string();
+    // Not well-formed: file:line:column.
+    let e = err(&OPENCV_XML.replace("</image_height>", "</image_width>"));
+    assert!(
+        e.starts_with("cal.xml:5:18: ") && e.contains("expected `</image_height>`"),
+        "{e}"
+    );
+    let e = err(&OPENCV_XML.replace("</opencv_storage>\n", ""));
+    assert_eq!(e, "cal.xml:22:1: <opencv_storage> is not closed");
+    // rows x cols disagree with data.
+    let e = err(&OPENCV_XML.replacen("<cols>3</cols>", "<cols>4</cols>", 1));
+    assert_eq!(
+        e,
+        "cal.xml:7: camera_matrix = rows 3 x cols 4 with 9 data values: rows x cols must equal the number of data values"
+    );
+    // A value that is not a number: the line of <data>.
+    let e = err(&OPENCV_XML.replace("3.2010000000000000e+02", "3.2010000000000000e+O2"));
+    assert_eq!(
+        e,
+        "cal.xml:11: camera_matrix.data = 3.2010000000000000e+O2: must be numbers separated by white space"
+    );
+    let e = err(&OPENCV_XML.replace("<image_width>640<", "<image_width>640 px<"));
+    assert_eq!(e, "cal.xml:4: image_width = 640 px: must be a whole number");
+    // Negative focal length (checked by the camera model): the line of <camera_matrix>.
+    let e = err(&OPENCV_XML.replace("3.0012000000000000e+02 0.", "-3.0012000000000000e+02 0."));
+    assert!(
+        e.starts_with("cal.xml:7: fx_px = -300.12: must be finite and > 0"),
+        "{e}"
+    );
+    // An unknown model, a missing key, a key given twice, another root.
+    let e = err(&OPENCV_XML.replace(
+        "<image_width>",
+        "<distortion_model>kb8</distortion_model>\n<image_width>",
+    ));
+    assert!(
+        e.starts_with("cal.xml:4: distortion_model = kb8: unknown distortion model"),
+        "{e}"
+    );
+    let e = err(&OPENCV_XML.replace("<image_height>480</image_height>\n", ""));
+    assert_eq!(e, "cal.xml: image_height: missing (image height in px)");
+    let e = err(&OPENCV_XML.replace(
+        "<image_height>480</image_height>\n",
+        "<image_width>640</image_width>\n",
+    ));
+    assert!(
+        e.starts_with("cal.xml:5: image_width = given twice: must be given once (first on line 4)"),
+        "{e}"
+    );
+    let e = err(&OPENCV_XML.replace("opencv_storage>", "storage>"));
+
+    assert!(
+        e.starts_with("cal.xml:2: root element = <storage>: must be <opencv_storage>"),
         "{e}"
     );
 }

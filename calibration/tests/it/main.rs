@@ -6,4 +6,5 @@ mod extrinsics_synthetic;
 mod groundtruth_closed_form;
 mod groundtruth_undistort;
 mod imprints;
+mod refine;
 mod tables;

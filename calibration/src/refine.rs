@@ -1,0 +1,577 @@
+//! Intrinsics refinement from the pin captures (R-Tac0 Sec. IV-A: the authors can refine the
+//! camera matrix and distortion from the same pin captures, their `calibrateCamera` path):
+//! fx, fy, cx, cy and the distortion coefficients of the camera file's model, jointly with the
+//! pose, by Levenberg-Marquardt on the reprojection error; each parameter's standard deviation
+//! from the covariance at the solution (sigma^2 (J^T J)^-1, sigma^2 the residual variance;
+//! Hartley & Zisserman, Multiple View Geometry, 2nd ed., Ch. 5).
+//!
+//! Not every parameter is fixed by one camera's view of pins on a dome: seen from near the
+//! sphere's axis, the focal length trades against the camera's distance along the axis (with
+//! every parameter free the Jacobian's condition number is about 1e16). Before the fit, the
+//! Jacobian's columns are scaled to unit length and its condition number taken; while it is
+//! above [`MAX_CONDITION`], the parameter that weighs most in the least-determined direction
+//! (the right singular vector of the smallest singular value) is held at the camera file's
+//! value, and the report says which and with what it trades. Parameters named by the user are
+//! never held: a list that the captures do not constrain is refused.
+
+use nalgebra::{
+    DMatrix, DVector, Isometry3, Rotation3, Translation3, UnitQuaternion, Vector2, Vector3,
+};
+
+use crate::camera::{CameraModel, Distortion, Intrinsics};
+use crate::pnp::PnpSolution;
+
+/// Largest condition number of the column-scaled Jacobian (pose and free intrinsics) that is
+/// refined; a parameter beyond it is not constrained by the captures.
+pub const MAX_CONDITION: f64 = 300.0;
+
+/// The names of a model's intrinsic parameters, in order: fx, fy, cx, cy, then the distortion
+/// coefficients in OpenCV's order.
+pub fn parameter_names(d: &Distortion) -> &'static [&'static str] {
+    match d {
+        Distortion::Fisheye(_) => &["fx", "fy", "cx", "cy", "k1", "k2", "k3", "k4"],
+        Distortion::PlumbBob(_) => &["fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3"],
+        Distortion::RationalPolynomial(_) => &[
+            "fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3", "k4", "k5", "k6",
+        ],
+    }
+}
+
+const POSE_NAMES: [&str; 6] = [
+    "the camera's rotation about x",
+    "the camera's rotation about y",
+    "the camera's rotation about z",
+    "the camera's offset along x",
+    "the camera's offset along y",
+    "the camera's distance along its axis (tz)",
+];
+
+/// Which parameters to refine.
+#[derive(Debug, Clone, PartialEq)]
+pub enum RefineParameters {
+    /// Every parameter the captures constrain; the others are held and reported.
+    Constrained,
+    /// Exactly these (names of [`parameter_names`]); refused if the captures do not constrain
+    /// them.
+    Only(Vec<String>),
+}
+
+/// Why the intrinsics cannot be refined.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum RefineError {
+    #[error("--refine-intrinsics {value}: '{name}' is not a parameter of the {model} model (its parameters: {known})")]
+    UnknownParameter {
+        value: String,
+        name: String,
+        model: &'static str,
+        known: String,
+    },
+    #[error("--refine-intrinsics {value}: '{name}' is named twice")]
+    Twice { value: String, name: String },
+    #[error("--refine-intrinsics {value}: the captures do not constrain {name} (it trades against {with}): the condition number is {condition:.1e}, above {limit:.0e}; leave it out (it is then held at the camera file's value), or observe pins over more of the field")]
+    Unconstrained {
+        value: String,
+        name: String,
+        with: String,
+        condition: f64,
+        limit: f64,
+    },
+    #[error("--refine-intrinsics: {observations} observations for {parameters} parameters (the pose's 6 and {intrinsics} intrinsics): too few to refine and estimate the noise; observe more pins")]
+    TooFewObservations {
+        observations: usize,
+        parameters: usize,
+        intrinsics: usize,
+    },
+    #[error("--refine-intrinsics: the captures constrain none of the intrinsics (every one trades against the pose: condition number {condition:.1e} with only {first} free); the camera file's values are kept")]
+    NothingConstrained { first: String, condition: f64 },
+    #[error("--refine-intrinsics: a point does not project at the camera file's intrinsics and the solved pose")]
+    Unprojectable,
+}
+
+/// One intrinsic parameter after refinement.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct RefinedParameter {
+    pub name: String,
+    /// The camera file's value.
+    pub initial: f64,
+    /// The refined value (the initial one when held).
+    pub value: f64,
+    /// Standard deviation from the covariance, same unit as the value (`null` when held).
+    pub std: Option<f64>,
+    /// Why it was held at the camera file's value (`null` when refined).
+    pub held: Option<String>,
+}
+
+/// The result of [`refine_intrinsics`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Refinement {
+    pub camera: CameraModel,
+    pub t_cam_sensor: Isometry3<f64>,
+    pub parameters: Vec<RefinedParameter>,
+    /// Condition number of the column-scaled Jacobian over the pose and the refined
+    /// parameters, at the solution.
+    pub condition_number: f64,
+    /// RMS reprojection error before (camera file's intrinsics, solved pose) and after, px.
+    pub rms_before_px: f64,
+    pub rms_after_px: f64,
+    pub iterations: usize,
+}
+
+/// The intrinsic parameter vector of a camera: fx, fy, cx, cy, distortion coefficients.
+fn intrinsic_vector(i: &Intrinsics) -> Vec<f64> {
+    let mut v = vec![i.fx_px, i.fy_px, i.cx_px, i.cy_px];
+    v.extend_from_slice(i.distortion.coefficients());
+    v
+}
+
+fn with_vector(i: &Intrinsics, v: &[f64]) -> Intrinsics {
+    let d = match i.distortion {
+        Distortion::Fisheye(_) => Distortion::Fisheye(std::array::from_fn(|k| v[4 + k])),
+        Distortion::PlumbBob(_) => Distortion::PlumbBob(std::array::from_fn(|k| v[4 + k])),
+        Distortion::RationalPolynomial(_) => {
+            Distortion::RationalPolynomial(std::array::from_fn(|k| v[4 + k]))
+        }
+    };
+    Intrinsics {
+        fx_px: v[0],
+        fy_px: v[1],
+        cx_px: v[2],
+        cy_px: v[3],
+        distortion: d,
+        ..*i
+    }
+}
+
+/// The problem: which intrinsics are free, the fixed data.
+struct Problem<'a> {
+    base: Intrinsics,
+    free: Vec<usize>,
+    points: &'a [Vector3<f64>],
+    pixels: &'a [Vector2<f64>],
+}
+
+/// A state: the full intrinsic vector and the pose (R, t).
+#[derive(Clone)]
+struct State {
+    intr: Vec<f64>,
+    r: Rotation3<f64>,
+    t: Vector3<f64>,
+}
+
+impl Problem<'_> {
+    fn n_params(&self) -> usize {
+        self.free.len() + 6
+    }
+
+    /// Residuals (reprojected minus observed, u then v per point), or `None` when a point
+    /// does not project or the intrinsics are not a camera.
+    fn residuals(&self, s: &State) -> Option<DVector<f64>> {
+        let cam = CameraModel::new(with_vector(&self.base, &s.intr)).ok()?;
+        let mut e = DVector::zeros(2 * self.points.len());
+        for (k, (p, px)) in self.points.iter().zip(self.pixels).enumerate() {
+            let uv = cam.project(&(s.r * p + s.t))?;
+            e[2 * k] = uv.x - px.x;
+            e[2 * k + 1] = uv.y - px.y;
+        }
+        Some(e)
+    }
+
+    /// `s` moved by `d` (free intrinsics, then the rotation increment on the left, then t).
+    fn step(&self, s: &State, d: &[f64]) -> State {
+        let mut n = s.clone();
+        for (k, &i) in self.free.iter().enumerate() {
+            n.intr[i] += d[k];
+        }
+        let m = self.free.len();
+        n.r = Rotation3::new(Vector3::new(d[m], d[m + 1], d[m + 2])) * s.r;
+        n.t += Vector3::new(d[m + 3], d[m + 4], d[m + 5]);
+        n
+    }
+
+    /// Central-difference Jacobian of the residuals.
+    fn jacobian(&self, s: &State) -> Option<DMatrix<f64>> {
+        let p = self.n_params();
+        let mut j = DMatrix::zeros(2 * self.points.len(), p);
+        let m = self.free.len();
+        for c in 0..p {
+            let h = if c < m {
+                1e-6 * (s.intr[self.free[c]].abs() + 1e-2)
+            } else if c < m + 3 {
+                1e-7
+            } else {
+                1e-6
+            };
+            let mut d = vec![0.0; p];
+            d[c] = h;
+            let plus = self.residuals(&self.step(s, &d))?;
+            d[c] = -h;
+            let minus = self.residuals(&self.step(s, &d))?;
+            j.set_column(c, &((plus - minus) / (2.0 * h)));
+        }
+        Some(j)
+    }
+}
+
+/// Condition number of `j` with its columns scaled to unit length, and the right singular
+/// vector of its smallest singular value.
+fn scaled_condition(j: &DMatrix<f64>) -> (f64, DVector<f64>) {
+    let mut js = j.clone();
+    for mut c in js.column_iter_mut() {
+        let n = c.norm();
+        if n > 0.0 {
+            c /= n;
+        }
+    }
+    let svd = js.svd(false, true);
+    let sv = &svd.singular_values;
+    let (mut imax, mut imin) = (0, 0);
+    for k in 0..sv.len() {
+        if sv[k] > sv[imax] {
+            imax = k;
+        }
+        if sv[k] < sv[imin] {
+            imin = k;
+        }
+    }
+    let cond = if sv[imin] > 0.0 {
+        sv[imax] / sv[imin]
+    } else {
+        f64::INFINITY
+    };
+    let v_t = svd.v_t.expect("asked for V^T");
+    (cond, v_t.row(imin).transpose())
+}
+
+/// A distortion coefficient's rank: radial terms by their power, tangential ones below k3.
+fn distortion_order(name: &str) -> u32 {
+    match name {
+        "k1" => 1,
+        "k2" => 2,
+        "p1" | "p2" => 3,
+        "k3" => 4,
+        "k4" => 5,
+        "k5" => 6,
+        "k6" => 7,
+        _ => 0,
+    }
+}
+
+/// The names of the columns that weigh in `v` (|component| at least a third of the largest),
+/// but `except`, largest first.
+fn trading(v: &DVector<f64>, names: &[String], except: &[usize]) -> String {
+    let big = v.amax();
+    let mut w: Vec<(usize, f64)> = (0..v.len())
+        .filter(|&k| !except.contains(&k) && v[k].abs() >= big / 3.0)
+        .map(|k| (k, v[k].abs()))
+        .collect();
+    w.sort_by(|a, b| b.1.total_cmp(&a.1));
+    let list: Vec<&str> = w.iter().map(|(k, _)| names[*k].as_str()).collect();
+    if list.is_empty() {
+        "nothing else: no capture moves it".into()
+    } else {
+        list.join(", ")
+    }
+}
+
+/// Refines the intrinsics of `camera` jointly with the pose `t_cam_sensor` over the pairs
+/// (`points_mm` sensor frame, mm; `pixels_px` observed, px; the inliers of the pose solve).
+///
+/// # Errors
+/// [`RefineError`]: a name that is not a parameter of the model, a named parameter the
+/// captures do not constrain, too few observations, none of the intrinsics constrained.
+pub fn refine_intrinsics(
+    camera: &CameraModel,
+    points_mm: &[Vector3<f64>],
+    pixels_px: &[Vector2<f64>],
+    t_cam_sensor: &Isometry3<f64>,
+    which: &RefineParameters,
+) -> Result<Refinement, RefineError> {
+    let base = *camera.intrinsics();
+    let names = parameter_names(&base.distortion);
+    let model = base.distortion.name();
+    let mut held: Vec<(usize, String)> = Vec::new();
+    let mut free: Vec<usize> = match which {
+        RefineParameters::Constrained => (0..names.len()).collect(),
+        RefineParameters::Only(list) => {
+            let value = list.join(",");
+            let mut v = Vec::new();
+            for n in list {
+                let k = names.iter().position(|x| x == n).ok_or_else(|| {
+                    RefineError::UnknownParameter {
+                        value: value.clone(),
+                        name: n.clone(),
+                        model,
+                        known: names.join(", "),
+                    }
+                })?;
+                if v.contains(&k) {
+                    return Err(RefineError::Twice {
+                        value: value.clone(),
+                        name: n.clone(),
+                    });
+                }
+                v.push(k);
+            }
+            v.sort_unstable();
+            for k in 0..names.len() {
+                if !v.contains(&k) {
+                    held.push((k, "not in the --refine-intrinsics list".into()));
+                }
+            }
+            v
+        }
+    };
+    let n_obs = 2 * points_mm.len();
+    if n_obs <= free.len() + 6 {
+        return Err(RefineError::TooFewObservations {
+            observations: points_mm.len(),
+            parameters: free.len() + 6,
+            intrinsics: free.len(),
+        });
+    }
+    let start = State {
+        intr: intrinsic_vector(&base),
+        r: t_cam_sensor.rotation.to_rotation_matrix(),
+        t: t_cam_sensor.translation.vector,
+    };
+    // hold what the captures do not constrain
+    loop {
+        let pb = Problem {
+            base,
+            free: free.clone(),
+            points: points_mm,
+            pixels: pixels_px,
+        };
+        let j = pb.jacobian(&start).ok_or(RefineError::Unprojectable)?;
+        let (cond, v) = scaled_condition(&j);
+        if cond <= MAX_CONDITION {
+            break;
+        }
+        let col_names: Vec<String> = free
+            .iter()
+            .map(|&k| names[k].to_string())
+            .chain(POSE_NAMES.iter().map(|s| s.to_string()))
+            .collect();
+        // the intrinsic that weighs most in the least-determined direction
+        let Some(c) = (0..free.len()).max_by(|&a, &b| v[a].abs().total_cmp(&v[b].abs())) else {
+            return Err(RefineError::NothingConstrained {
+                first: String::new(),
+                condition: cond,
+            });
+        };
+        if let RefineParameters::Only(list) = which {
+            let with = trading(&v, &col_names, &[c]);
+            return Err(RefineError::Unconstrained {
+                value: list.join(","),
+                name: names[free[c]].into(),
+                with,
+                condition: cond,
+                limit: MAX_CONDITION,
+            });
+        }
+        // what to hold, of the intrinsics weighing in that direction (at least a third of the
+        // largest): the focal length as a whole (fx and fy trade together against the camera's
+        // distance), else the highest-order distortion coefficient, else the principal point's
+        // coordinate that weighs most
+        let weighing: Vec<usize> = (0..free.len())
+            .filter(|&k| v[k].abs() >= v[c].abs() / 3.0)
+            .collect();
+        let is_focal = |k: &usize| matches!(names[free[*k]], "fx" | "fy");
+        let hold: Vec<usize> = if weighing.iter().any(is_focal) {
+            (0..free.len()).filter(is_focal).collect()
+        } else if let Some(k) = weighing
+            .iter()
+            .filter(|&&k| free[k] >= 4)
+            .max_by_key(|&&k| distortion_order(names[free[k]]))
+        {
+            vec![*k]
+        } else {
+            vec![c]
+        };
+        if hold.len() >= free.len() {
+            return Err(RefineError::NothingConstrained {
+                first: names[free[c]].into(),
+                condition: cond,
+            });
+        }
+        let what = if hold.len() == 2 {
+            "the focal length (fx and fy together)".to_string()
+        } else {
+            names[free[hold[0]]].to_string()
+        };
+        let with = trading(&v, &col_names, &hold);
+        for &k in &hold {
+            held.push((
+                free[k],
+                format!(
+                    "the captures do not constrain {what}; it trades against {with} (condition number {cond:.1e} with it free, above {MAX_CONDITION:.0e})"
+                ),
+            ));
+        }
+        free = (0..free.len())
+            .filter(|k| !hold.contains(k))
+            .map(|k| free[k])
+            .collect();
+    }
+    let pb = Problem {
+        base,
+        free: free.clone(),
+        points: points_mm,
+        pixels: pixels_px,
+    };
+    let e0 = pb.residuals(&start).ok_or(RefineError::Unprojectable)?;
+    let rms = |e: &DVector<f64>| (e.norm_squared() / points_mm.len() as f64).sqrt();
+    let rms_before_px = rms(&e0);
+    // Levenberg-Marquardt, Marquardt's scaling by the diagonal
+    let (mut s, mut e, mut lambda) = (start.clone(), e0, 1e-3);
+    let mut iterations = 0;
+    for _ in 0..100 {
+        iterations += 1;
+        let Some(j) = pb.jacobian(&s) else { break };
+        let a = j.transpose() * &j;
+        let g = j.transpose() * &e;
+        let cost = e.norm_squared();
+        let mut improved = false;
+        while lambda < 1e12 {
+            let mut m = a.clone();
+            for k in 0..m.nrows() {
+                m[(k, k)] += lambda * a[(k, k)].max(1e-12);
+            }
+            let Some(d) = m.cholesky().map(|c| c.solve(&(-&g))) else {
+                lambda *= 10.0;
+                continue;
+            };
+            let cand = pb.step(&s, d.as_slice());
+            match pb.residuals(&cand) {
+                Some(ec) if ec.norm_squared() < cost => {
+                    let gain = cost - ec.norm_squared();
+                    s = cand;
+                    e = ec;
+                    lambda = (lambda / 10.0).max(1e-12);
+                    improved = gain > 1e-14 * cost.max(1e-300);
+                    break;
+                }
+                _ => lambda *= 10.0,
+            }
+        }
+        if !improved {
+            break;
+        }
+    }
+    let j = pb.jacobian(&s).ok_or(RefineError::Unprojectable)?;
+    let (condition_number, _) = scaled_condition(&j);
+    let dof = (n_obs - pb.n_params()) as f64;
+    let sigma2 = e.norm_squared() / dof;
+    let cov = (j.transpose() * &j).try_inverse().map(|c| c * sigma2);
+    let initial = intrinsic_vector(&base);
+    let parameters = names
+        .iter()
+        .enumerate()
+        .map(|(k, n)| {
+            let col = free.iter().position(|&f| f == k);
+            RefinedParameter {
+                name: (*n).into(),
+                initial: initial[k],
+                value: s.intr[k],
+                std: col.and_then(|c| cov.as_ref().map(|m| m[(c, c)].max(0.0).sqrt())),
+                held: held.iter().find(|(h, _)| *h == k).map(|(_, r)| r.clone()),
+            }
+        })
+        .collect();
+    let camera =
+        CameraModel::new(with_vector(&base, &s.intr)).map_err(|_| RefineError::Unprojectable)?;
+    Ok(Refinement {
+        camera,
+        t_cam_sensor: Isometry3::from_parts(
+            Translation3::from(s.t),
+            UnitQuaternion::from_rotation_matrix(&s.r),
+        ),
+        parameters,
+        condition_number,
+        rms_before_px,
+        rms_after_px: rms(&e),
+        iterations,
+    })
+}
+
+/// The refinement as `extrinsics.json` reports it.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct RefinementReport {
+    /// What the numbers mean.
+    pub description: String,
+    /// The refined camera file in the output folder, in the form the camera file was read.
+    pub camera_file: String,
+    /// fx, fy, cx, cy (px) and the distortion coefficients, each with the camera file's value,
+    /// the refined one and its standard deviation, or why it was held.
+    pub parameters: Vec<RefinedParameter>,
+    /// Condition number of the column-scaled Jacobian over the pose and the refined parameters.
+    pub condition_number: f64,
+    /// RMS reprojection error over the inliers with the camera file's intrinsics (at the pose
+    /// solved with them) and after the refinement, px.
+    pub rms_before_px: f64,
+    pub rms_after_px: f64,
+}
+
+impl RefinementReport {
+    pub fn new(r: &Refinement, camera_file: &str) -> RefinementReport {
+        RefinementReport {
+            description: format!("Intrinsics refined jointly with the pose by Levenberg-Marquardt on the reprojection error; standard deviations from the covariance sigma^2 (J^T J)^-1 at the solution, sigma^2 the residual variance. A parameter the captures do not constrain (the column-scaled Jacobian's condition number above {MAX_CONDITION:.0e} with it free) is held at the camera file's value, and says why."),
+            camera_file: camera_file.into(),
+            parameters: r.parameters.clone(),
+            condition_number: r.condition_number,
+            rms_before_px: r.rms_before_px,
+            rms_after_px: r.rms_after_px,
+        }
+    }
+}
+
+/// The name and form of the refined camera file, from the camera file's text: fabkit JSON
+/// (`camera_refined.json`), OpenCV FileStorage XML (`camera_refined.xml`), OpenCV FileStorage
+/// YAML or ROS `camera_info` YAML (`camera_refined.yaml`).
+pub fn refined_camera_file(text: &str) -> (&'static str, crate::CameraFileFormat) {
+    use crate::CameraFileFormat as F;
+    let t = text.trim_start_matches('\u{feff}').trim_start();
+    if t.starts_with('{') {
+        ("camera_refined.json", F::Json)
+    } else if t.starts_with('<') {
+        ("camera_refined.xml", F::OpenCvXml)
+    } else if t.starts_with("%YAML") || t.contains("opencv-matrix") {
+        ("camera_refined.yaml", F::OpenCvYaml)
+    } else {
+        ("camera_refined.yaml", F::RosYaml)
+    }
+}
+
+/// The pose solution `sol` re-evaluated at `camera` and `t_cam_sensor` (same inliers): the
+/// residuals of every pair and the inliers' RMS.
+pub fn solution_at(
+    camera: &CameraModel,
+    points_mm: &[Vector3<f64>],
+    pixels_px: &[Vector2<f64>],
+    sol: &PnpSolution,
+    t_cam_sensor: Isometry3<f64>,
+) -> PnpSolution {
+    let residuals_px: Vec<Option<Vector2<f64>>> = points_mm
+        .iter()
+        .zip(pixels_px)
+        .map(|(p, px)| {
+            camera
+                .project(&(t_cam_sensor * nalgebra::Point3::from(*p)).coords)
+                .map(|uv| uv - px)
+        })
+        .collect();
+    let (mut sq, mut n) = (0.0, 0usize);
+    for (r, &inl) in residuals_px.iter().zip(&sol.inliers) {
+        if let (Some(r), true) = (r, inl) {
+            sq += r.norm_squared();
+            n += 1;
+        }
+    }
+    PnpSolution {
+        t_cam_sensor,
+        inliers: sol.inliers.clone(),
+        residuals_px,
+        rms_reprojection_error_px: (sq / n.max(1) as f64).sqrt(),
+        hypotheses: sol.hypotheses,
+    }
+}

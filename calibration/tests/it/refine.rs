@@ -1,0 +1,187 @@
+//! Intrinsics refinement (`fabkit_calibration::refine`, R-Tac0 Sec. IV-A) on synthetic pin
+//! observations: the benchmark scene (30 pins to 75 deg, the 160 deg Kannala-Brandt lens, a
+//! camera tilted up to 3 deg; noise 0.2 px) with a camera file whose principal point and first
+//! distortion terms are off; and pins seen from near the sphere's axis, where the focal length
+//! trades against the camera's distance.
+
+use fabkit_calibration::nalgebra::{
+    Isometry3, Point3, Translation3, UnitQuaternion, Vector2, Vector3,
+};
+use fabkit_calibration::refine::{refine_intrinsics, RefineError, RefineParameters};
+use fabkit_calibration::synthetic::{benchmark_intrinsics, benchmark_trial, pin_layout};
+use fabkit_calibration::{solve_pnp, CameraModel, Distortion, Intrinsics, PnpOptions};
+
+/// The camera file: the true lens with the principal point 3 and 2 px off and k1, k2 wrong.
+fn camera_file() -> CameraModel {
+    let mut file = benchmark_intrinsics();
+    file.cx_px += 3.0;
+    file.cy_px -= 2.0;
+    file.distortion = Distortion::Fisheye([-0.01, 0.0, -0.0015, 0.0002]);
+    CameraModel::new(file).unwrap()
+}
+
+fn truth_vector(i: &Intrinsics) -> Vec<f64> {
+    let mut v = vec![i.fx_px, i.fy_px, i.cx_px, i.cy_px];
+    v.extend_from_slice(i.distortion.coefficients());
+    v
+}
+
+#[test]
+fn refined_intrinsics_recover_the_truth_within_3_sigma() {
+    let truth = truth_vector(&benchmark_intrinsics());
+    let cam = camera_file();
+    let (mut z2, mut nz) = (0.0, 0);
+    for seed in 1..=10 {
+        let t = benchmark_trial(seed, 0.2, 0);
+        let sol = solve_pnp(&cam, &t.points(), &t.pixels(), &PnpOptions::default()).unwrap();
+        let r = refine_intrinsics(
+            &cam,
+            &t.points(),
+            &t.pixels(),
+            &sol.t_cam_sensor,
+            &RefineParameters::Constrained,
+        )
+        .unwrap();
+        assert!(
+            r.rms_after_px < r.rms_before_px && r.rms_after_px < 0.3,
+            "seed {seed}: rms {} -> {} px",
+            r.rms_before_px,
+            r.rms_after_px
+        );
+        let refined: Vec<&str> = r
+            .parameters
+            .iter()
+            .filter(|p| p.held.is_none())
+            .map(|p| p.name.as_str())
+            .collect();
+        for n in ["cx", "cy", "k1", "k2"] {
+            assert!(refined.contains(&n), "seed {seed}: {n} not refined");
+        }
+        for (p, tv) in r.parameters.iter().zip(&truth) {
+            match (&p.held, p.std) {
+                (Some(_), None) => assert_eq!(p.value, p.initial, "seed {seed}: {}", p.name),
+                (None, Some(sd)) => {
+                    let z = (p.value - tv) / sd;
+                    assert!(
+                        z.abs() < 3.0,
+                        "seed {seed}: {} = {} +- {sd}, true {tv} ({z:.2} sigma)",
+                        p.name,
+                        p.value
+                    );
+                    z2 += z * z;
+                    nz += 1;
+                }
+                other => panic!("seed {seed}: {}: {other:?}", p.name),
+            }
+        }
+        // the pose follows the intrinsics to the truth
+        let dt = (r.t_cam_sensor.translation.vector - t.t_cam_sensor().translation.vector).norm();
+        assert!(dt < 0.5, "seed {seed}: pose off by {dt} mm");
+    }
+    // the standard deviations are the spread of the errors (not 10 x too small or too large)
+    let z_rms = (z2 / nz as f64).sqrt();
+    assert!(
+        (0.4..1.7).contains(&z_rms),
+        "errors over standard deviations: RMS {z_rms:.2} over {nz}"
+    );
+}
+
+/// 29 pins on a 13.46 mm sphere up to 72 deg, the camera 10.4 mm below its centre on the axis
+/// (tilted 1.4 deg), noise 0.2 px (seeded).
+fn near_axis() -> (Vec<Vector3<f64>>, Vec<Vector2<f64>>) {
+    let pose = Isometry3::from_parts(
+        Translation3::new(0.3, -0.2, 10.4),
+        UnitQuaternion::from_scaled_axis(Vector3::new(0.02, -0.015, 0.4)),
+    );
+    let cam = CameraModel::new(benchmark_intrinsics()).unwrap();
+    let pts = pin_layout(29, 13.46, 72.0);
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut unit = || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let px = pts
+        .iter()
+        .map(|p| {
+            let (a, b) = (unit().max(1e-300), unit());
+            let g = (-2.0 * a.ln()).sqrt();
+            let tau = std::f64::consts::TAU * b;
+            cam.project(&(pose * Point3::from(*p)).coords).unwrap()
+                + 0.2 * Vector2::new(g * tau.cos(), g * tau.sin())
+        })
+        .collect();
+    (pts, px)
+}
+
+#[test]
+fn near_the_axis_the_focal_length_is_held_and_the_report_says_why() {
+    let (pts, px) = near_axis();
+    let cam = camera_file();
+    let sol = solve_pnp(&cam, &pts, &px, &PnpOptions::default()).unwrap();
+    let r = refine_intrinsics(
+        &cam,
+        &pts,
+        &px,
+        &sol.t_cam_sensor,
+        &RefineParameters::Constrained,
+    )
+    .unwrap();
+    for p in &r.parameters[..2] {
+        let why = p
+            .held
+            .as_deref()
+            .unwrap_or_else(|| panic!("{} refined", p.name));
+        assert!(
+            why.contains("the focal length (fx and fy together)")
+                && why.contains("the camera's distance along its axis (tz)")
+                && why.contains("condition number"),
+            "{}: {why}",
+            p.name
+        );
+        assert_eq!((p.value, p.std), (p.initial, None));
+    }
+    assert!(r.condition_number <= fabkit_calibration::refine::MAX_CONDITION);
+    assert!(r.parameters[2..4].iter().all(|p| p.held.is_none()));
+
+    // naming the focal length is refused, naming what trades against it
+    let only = |s: &str| RefineParameters::Only(s.split(',').map(String::from).collect());
+    let e =
+        refine_intrinsics(&cam, &pts, &px, &sol.t_cam_sensor, &only("fx,fy,cx,cy,k1")).unwrap_err();
+    match &e {
+        RefineError::Unconstrained { name, with, .. } => {
+            assert!(name == "fx" || name == "fy", "{e}");
+            assert!(with.contains("(tz)"), "{e}");
+        }
+        other => panic!("{other}"),
+    }
+    assert!(e
+        .to_string()
+        .starts_with("--refine-intrinsics fx,fy,cx,cy,k1: the captures do not constrain f"));
+    // cx, cy, k1, k2 alone are well conditioned
+    let r = refine_intrinsics(&cam, &pts, &px, &sol.t_cam_sensor, &only("cx,cy,k1,k2")).unwrap();
+    let held: Vec<&str> = r
+        .parameters
+        .iter()
+        .filter(|p| p.held.is_some())
+        .map(|p| p.name.as_str())
+        .collect();
+    assert_eq!(held, ["fx", "fy", "k3", "k4"]);
+
+    // names the model does not have, and a name twice
+    let e = refine_intrinsics(&cam, &pts, &px, &sol.t_cam_sensor, &only("cx,p1")).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "--refine-intrinsics cx,p1: 'p1' is not a parameter of the fisheye model (its parameters: fx, fy, cx, cy, k1, k2, k3, k4)"
+    );
+    let e = refine_intrinsics(&cam, &pts, &px, &sol.t_cam_sensor, &only("cx,cx")).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "--refine-intrinsics cx,cx: 'cx' is named twice"
+    );
+    // fewer observations than the fit needs
+    let e = refine_intrinsics(&cam, &pts[..4], &px[..4], &sol.t_cam_sensor, &only("cx,cy"))
+        .unwrap_err();
+    assert!(matches!(e, RefineError::TooFewObservations { .. }), "{e}");
+}
