@@ -498,6 +498,80 @@ pub struct PrinterProfile {
     /// Lug count, ramp and clearance of a bayonet printed on this printer.
     #[serde(default)]
     pub bayonet: crate::parts::bayonet::BayonetProfile,
+    /// The printer's build volume, which the plates are laid out in; `None`: the technology's
+    /// shipped printer ([`shipped_printers`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bed: Option<Bed>,
+}
+
+/// A printer's build volume: what one plate holds.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Bed {
+    /// The printer's name, in messages and the manifest (`[a-z0-9_]+`).
+    pub name: String,
+    /// Build volume: x and y of the plate, z the height, mm.
+    pub size_mm: [f64; 3],
+    /// Border kept clear on every side of the plate, mm: an FDM slicer's skirt (PrusaSlicer
+    /// lays it 6 mm out, 6.4 mm with its line), an SLA support pad's rim.
+    pub margin_mm: f64,
+}
+
+/// A user's own printer (`--printer FILE.yaml`): its technology and bed.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PrinterFile {
+    pub technology: Technology,
+    pub name: String,
+    pub size_mm: [f64; 3],
+    pub margin_mm: f64,
+}
+
+impl Bed {
+    /// The plate's usable x and y (the bed less its margin on both sides), mm.
+    pub fn usable_xy_mm(&self) -> [f64; 2] {
+        [
+            self.size_mm[0] - 2.0 * self.margin_mm,
+            self.size_mm[1] - 2.0 * self.margin_mm,
+        ]
+    }
+}
+
+/// The printers fabkit ships, each with its technology: a common FDM printer (Prusa MK4-class,
+/// 250 x 210 x 220 mm; PrusaSlicer's skirt needs the 10 mm margin), a common SLA printer
+/// (Formlabs Form 2-class, 145 x 145 x 175 mm) and a PolyJet printer (Stratasys J750-class
+/// tray, 490 x 390 x 200 mm). The first of each technology is its default.
+pub fn shipped_printers() -> Vec<(Technology, Bed)> {
+    let bed = |name: &str, size_mm: [f64; 3], margin_mm: f64| Bed {
+        name: name.into(),
+        size_mm,
+        margin_mm,
+    };
+    vec![
+        (
+            Technology::Fdm,
+            bed("prusa_mk4", [250.0, 210.0, 220.0], 10.0),
+        ),
+        (
+            Technology::Sla,
+            bed("formlabs_form2", [145.0, 145.0, 175.0], 5.0),
+        ),
+        (
+            Technology::Polyjet,
+            bed("stratasys_j750", [490.0, 390.0, 200.0], 10.0),
+        ),
+    ]
+}
+
+impl Technology {
+    /// The key of the technology in the design file (`fdm`, `sla`, `polyjet`).
+    pub fn key(self) -> &'static str {
+        match self {
+            Technology::Fdm => "fdm",
+            Technology::Sla => "sla",
+            Technology::Polyjet => "polyjet",
+        }
+    }
 }
 
 /// The FDM, SLA and PolyJet profiles.
@@ -517,6 +591,7 @@ defaults!(PrinterProfiles {
         min_hole_diameter_mm: 1.0,
         min_feature_mm: 0.8,
         bayonet: crate::parts::bayonet::BayonetProfile::default(),
+        bed: None,
     },
     // Form 3 class: 25-50 um pixels and layers.
     sla: PrinterProfile {
@@ -529,6 +604,7 @@ defaults!(PrinterProfiles {
             clearance_mm: 0.1,
             ..crate::parts::bayonet::BayonetProfile::default()
         },
+        bed: None,
     },
     // Stratasys PolyJet (Connex): 42 um pixels, 16-30 um layers; Tango features below ~0.6 mm tear.
     polyjet: PrinterProfile {
@@ -541,6 +617,7 @@ defaults!(PrinterProfiles {
             clearance_mm: 0.1,
             ..crate::parts::bayonet::BayonetProfile::default()
         },
+        bed: None,
     },
 });
 
@@ -551,6 +628,25 @@ impl PrinterProfiles {
             Technology::Sla => &self.sla,
             Technology::Polyjet => &self.polyjet,
         }
+    }
+
+    pub fn get_mut(&mut self, t: Technology) -> &mut PrinterProfile {
+        match t {
+            Technology::Fdm => &mut self.fdm,
+            Technology::Sla => &mut self.sla,
+            Technology::Polyjet => &mut self.polyjet,
+        }
+    }
+
+    /// The bed of technology `t`: the profile's, else the shipped printer's.
+    pub fn bed(&self, t: Technology) -> Bed {
+        self.get(t).bed.clone().unwrap_or_else(|| {
+            shipped_printers()
+                .into_iter()
+                .find(|(tech, _)| *tech == t)
+                .map(|(_, b)| b)
+                .expect("a shipped printer per technology")
+        })
     }
 }
 

@@ -764,5 +764,59 @@ pub(crate) fn check_printers(design: &Design, errs: &mut Vec<ParamError>) {
                 ));
             }
         }
+        if let Some(bed) = &p.bed {
+            check_bed(bed, &format!("printers.{name}.bed"), errs);
+        }
+    }
+}
+
+/// Largest bed side accepted, mm (a 10 m printer is a typo).
+pub const MAX_BED_MM: f64 = 10_000.0;
+
+/// The rules of a printer's bed, errors named under `path` (`printers.fdm.bed`, or a
+/// `--printer` file's own keys).
+pub fn check_bed(bed: &crate::schema::Bed, path: &str, errs: &mut Vec<ParamError>) {
+    let at = |k: &str| {
+        if path.is_empty() {
+            k.to_string()
+        } else {
+            format!("{path}.{k}")
+        }
+    };
+    if bed.name.is_empty()
+        || !bed
+            .name
+            .chars()
+            .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_')
+    {
+        errs.push(ParamError::new(
+            at("name"),
+            format!("'{}'", bed.name),
+            "must be a name of a-z, 0-9 and _ (it names the plates in the manifest)",
+        ));
+    }
+    for (k, v) in bed.size_mm.iter().enumerate() {
+        if !(v.is_finite() && *v > 0.0 && *v <= MAX_BED_MM) {
+            errs.push(ParamError::new(
+                format!("{}[{k}]", at("size_mm")),
+                *v,
+                "must be above 0 and at most 10000 mm",
+            ));
+        }
+    }
+    let m = bed.margin_mm;
+    if !(m.is_finite() && m >= 0.0) {
+        errs.push(ParamError::new(at("margin_mm"), m, "must be 0 or more"));
+    } else if bed.size_mm[..2].iter().all(|v| v.is_finite() && *v > 0.0)
+        && 2.0 * m >= bed.size_mm[0].min(bed.size_mm[1])
+    {
+        errs.push(ParamError::new(
+            at("margin_mm"),
+            m,
+            format!(
+                "must leave room on the plate: twice the margin is below its smaller side ({} mm)",
+                bed.size_mm[0].min(bed.size_mm[1])
+            ),
+        ));
     }
 }

@@ -48,6 +48,15 @@ pub enum ExportError {
          (it becomes a file name)"
     )]
     InvalidDesignName { name: String },
+    #[error("part `{part}` ({technology}, {:.1} x {:.1} x {:.1} mm) does not fit the {printer} bed ({} x {} x {} mm, {} x {} mm inside its {margin} mm margin, either way round); give a larger printer: --printer FILE.yaml or printers.{key}.bed in the design", size_mm[0], size_mm[1], size_mm[2], bed_mm[0], bed_mm[1], bed_mm[2], bed_mm[0] - 2.0 * margin, bed_mm[1] - 2.0 * margin, key = technology.to_string().to_lowercase())]
+    TooLargeForBed {
+        part: String,
+        technology: fabkit_designs::kit::PrintTechnology,
+        size_mm: [f64; 3],
+        printer: String,
+        bed_mm: [f64; 3],
+        margin: f64,
+    },
     #[error("kit `{design}` has no parts to export")]
     NoParts { design: String },
     /// A field of [`crate::ExportOptions`] breaks its rule.

@@ -1,7 +1,10 @@
 //! Plate layout of the kit 3MF: deterministic shelf (row) packing by bounding box, with the
 //! parts of one multi-material group packed as one unit (one 3MF object).
 
+use crate::ExportError;
 use fabkit_designs::geometry::Aabb;
+use fabkit_designs::kit::PrintTechnology;
+use fabkit_designs::schema::{Bed, PrinterProfiles, Technology};
 use std::collections::BTreeMap;
 
 /// Clear distance between neighbouring parts on the plate, mm.
@@ -87,6 +90,163 @@ pub(crate) fn pack_units(
     shelf_pack(&unit_boxes, row_width_mm, gap_mm)
 }
 
+/// One unit on a plate.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct PlateItem {
+    /// Index into the units.
+    pub unit: usize,
+    /// Turned 90 deg about z (counter-clockwise seen from above) before the translation.
+    pub turned: bool,
+    /// Build-item translation, mm (after the turn).
+    pub translation_mm: [f64; 3],
+}
+
+/// One print plate: units of one technology and material inside one printer's bed.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Plate {
+    pub technology: PrintTechnology,
+    /// The material key, or a group's keys joined by `+`.
+    pub material: String,
+    pub bed: Bed,
+    /// 1, 2, ... within its technology and material.
+    pub number: usize,
+    pub items: Vec<PlateItem>,
+}
+
+/// Packing resolution: footprints in units of 0.01 mm.
+const PACK_UNITS_PER_MM: f64 = 100.0;
+
+/// Splits the units into plates: by technology and material (a multi-material group is one
+/// unit, its materials joined by `+`), each set packed first-fit-decreasing into as many of its
+/// technology's beds as it needs (`rectangle_pack`), every footprint inside the bed less its
+/// margin and `gap_mm` from its neighbours, resting on z = 0. A unit that fits only turned by
+/// 90 deg is turned.
+///
+/// `parts`: (technology, material, box) per part; `units` as from [`units`] (the first
+/// member's technology counts).
+///
+/// # Errors
+/// [`ExportError::TooLargeForBed`] naming the unit's first part, its size and the bed.
+pub(crate) fn plates(
+    parts: &[(PrintTechnology, &str, Aabb)],
+    names: &[&str],
+    units: &[Vec<usize>],
+    printers: &PrinterProfiles,
+    gap_mm: f64,
+) -> Result<Vec<Plate>, ExportError> {
+    use rectangle_pack::{
+        contains_smallest_box, pack_rects, volume_heuristic, GroupedRectsToPlace, RectToInsert,
+        TargetBin,
+    };
+    // units by (technology, material), in order of first appearance
+    let mut sets: Vec<(PrintTechnology, String, Vec<usize>)> = Vec::new();
+    for (u, members) in units.iter().enumerate() {
+        let tech = parts[members[0]].0;
+        let mut materials: Vec<&str> = Vec::new();
+        for &i in members {
+            if !materials.contains(&parts[i].1) {
+                materials.push(parts[i].1);
+            }
+        }
+        let material = materials.join("+");
+        match sets.iter_mut().find(|s| s.0 == tech && s.1 == material) {
+            Some(s) => s.2.push(u),
+            None => sets.push((tech, material, vec![u])),
+        }
+    }
+    let to_units = |mm: f64| (mm * PACK_UNITS_PER_MM).ceil().max(1.0) as u32;
+    let mut plates = Vec::new();
+    for (tech, material, members) in sets {
+        let bed = printers.bed(technology_key(tech));
+        let [ux, uy] = bed.usable_xy_mm();
+        // each unit's box, turned when it fits only so
+        let mut boxes: Vec<(usize, bool, Aabb)> = Vec::with_capacity(members.len());
+        for &u in &members {
+            let b = units[u][1..]
+                .iter()
+                .fold(parts[units[u][0]].2, |acc, &i| union(&acc, &parts[i].2));
+            let [w, d, h] = b.size();
+            let turned = if w <= ux && d <= uy && h <= bed.size_mm[2] {
+                false
+            } else if d <= ux && w <= uy && h <= bed.size_mm[2] {
+                true
+            } else {
+                return Err(ExportError::TooLargeForBed {
+                    part: names[units[u][0]].to_string(),
+                    technology: tech,
+                    size_mm: [w, d, h],
+                    printer: bed.name.clone(),
+                    bed_mm: bed.size_mm,
+                    margin: bed.margin_mm,
+                });
+            };
+            let b = if turned {
+                // (x, y) -> (-y, x)
+                Aabb {
+                    min: [-b.max[1], b.min[0], b.min[2]],
+                    max: [-b.min[1], b.max[0], b.max[2]],
+                }
+            } else {
+                b
+            };
+            boxes.push((u, turned, b));
+        }
+        let mut rects: GroupedRectsToPlace<usize, ()> = GroupedRectsToPlace::new();
+        for (k, (_, _, b)) in boxes.iter().enumerate() {
+            let [w, d, _] = b.size();
+            rects.push_rect(
+                k,
+                None,
+                RectToInsert::new(to_units(w + gap_mm), to_units(d + gap_mm), 1),
+            );
+        }
+        // as many beds as units: the packer fills them in order and leaves the rest empty
+        let bin_x = ((ux + gap_mm) * PACK_UNITS_PER_MM).floor() as u32;
+        let bin_y = ((uy + gap_mm) * PACK_UNITS_PER_MM).floor() as u32;
+        let mut bins: BTreeMap<usize, TargetBin> = (0..boxes.len())
+            .map(|k| (k, TargetBin::new(bin_x, bin_y, 1)))
+            .collect();
+        let packed = pack_rects(&rects, &mut bins, &volume_heuristic, &contains_smallest_box)
+            .expect("every unit fits a bed of its own (checked above)");
+        let mut by_bin: BTreeMap<usize, Vec<PlateItem>> = BTreeMap::new();
+        for (k, (u, turned, b)) in boxes.iter().enumerate() {
+            let (bin, loc) = &packed.packed_locations()[&k];
+            let x = bed.margin_mm + loc.x() as f64 / PACK_UNITS_PER_MM;
+            let y = bed.margin_mm + loc.y() as f64 / PACK_UNITS_PER_MM;
+            by_bin.entry(*bin).or_default().push(PlateItem {
+                unit: *u,
+                turned: *turned,
+                translation_mm: [x - b.min[0], y - b.min[1], -b.min[2]].map(|c| {
+                    if c == 0.0 {
+                        0.0
+                    } else {
+                        c
+                    }
+                }),
+            });
+        }
+        for (number, (_, mut items)) in by_bin.into_iter().enumerate() {
+            items.sort_by_key(|i| i.unit);
+            plates.push(Plate {
+                technology: tech,
+                material: material.clone(),
+                bed: bed.clone(),
+                number: number + 1,
+                items,
+            });
+        }
+    }
+    Ok(plates)
+}
+
+fn technology_key(t: PrintTechnology) -> Technology {
+    match t {
+        PrintTechnology::Fdm => Technology::Fdm,
+        PrintTechnology::Sla => Technology::Sla,
+        PrintTechnology::Polyjet => Technology::Polyjet,
+    }
+}
+
 fn union(a: &Aabb, b: &Aabb) -> Aabb {
     Aabb {
         min: [0, 1, 2].map(|k| a.min[k].min(b.min[k])),
@@ -100,6 +260,97 @@ mod tests {
 
     fn b(min: [f64; 3], max: [f64; 3]) -> Aabb {
         Aabb { min, max }
+    }
+
+    /// Plates: one technology and material each, every unit once, footprints inside the bed
+    /// less its margin and a gap apart, a unit too long for the bed turned, one too large for
+    /// either way round an error naming it.
+    #[test]
+    fn plates_split_by_technology_and_material_and_fit_their_beds() {
+        use fabkit_designs::schema::PrinterProfiles;
+        let printers = PrinterProfiles::default(); // prusa_mk4 230 x 190 usable, form2 135 x 135
+        let fdm = PrintTechnology::Fdm;
+        let sla = PrintTechnology::Sla;
+        let mut parts = Vec::new();
+        for k in 0..12 {
+            parts.push((
+                fdm,
+                "pla",
+                b([0.0, 0.0, 0.0], [60.0, 50.0, 20.0 + k as f64]),
+            ));
+        }
+        parts.push((sla, "resin", b([-10.0, -10.0, 0.0], [10.0, 10.0, 5.0])));
+        parts.push((fdm, "tpu", b([0.0, 0.0, 0.0], [20.0, 20.0, 5.0])));
+        // 200 mm long in y: fits the 190 mm only along x
+        parts.push((fdm, "pla", b([0.0, -100.0, 0.0], [30.0, 100.0, 10.0])));
+        let names: Vec<String> = (0..parts.len()).map(|k| format!("p{k}")).collect();
+        let names: Vec<&str> = names.iter().map(String::as_str).collect();
+        let units: Vec<Vec<usize>> = (0..parts.len()).map(|k| vec![k]).collect();
+        let laid = plates(&parts, &names, &units, &printers, GAP_MM).unwrap();
+        let mut seen = vec![0; parts.len()];
+        for p in &laid {
+            let [ux, uy] = p.bed.usable_xy_mm();
+            let m = p.bed.margin_mm;
+            let mut placed: Vec<Aabb> = Vec::new();
+            for it in &p.items {
+                seen[it.unit] += 1;
+                let (tech, mat, bx) = parts[it.unit];
+                assert_eq!((tech, mat), (p.technology, p.material.as_str()));
+                let bx = if it.turned {
+                    Aabb {
+                        min: [-bx.max[1], bx.min[0], bx.min[2]],
+                        max: [-bx.min[1], bx.max[0], bx.max[2]],
+                    }
+                } else {
+                    bx
+                };
+                let t = it.translation_mm;
+                let q = Aabb {
+                    min: [bx.min[0] + t[0], bx.min[1] + t[1], bx.min[2] + t[2]],
+                    max: [bx.max[0] + t[0], bx.max[1] + t[1], bx.max[2] + t[2]],
+                };
+                assert!(q.min[0] >= m - 1e-9 && q.min[1] >= m - 1e-9, "{q:?}");
+                assert!(
+                    q.max[0] <= m + ux + 1e-9 && q.max[1] <= m + uy + 1e-9,
+                    "{q:?}"
+                );
+                assert_eq!(q.min[2], 0.0);
+                for o in &placed {
+                    let apart = q.max[0] + GAP_MM <= o.min[0] + 1e-6
+                        || o.max[0] + GAP_MM <= q.min[0] + 1e-6
+                        || q.max[1] + GAP_MM <= o.min[1] + 1e-6
+                        || o.max[1] + GAP_MM <= q.min[1] + 1e-6;
+                    assert!(apart, "{q:?} {o:?}");
+                }
+                placed.push(q);
+            }
+        }
+        assert!(seen.iter().all(|&n| n == 1), "{seen:?}");
+        // 12 boxes of 60 x 50 (65 x 55 with the gap) and the long one: 3 x 3 per 230 x 190
+        // plate, so two PLA plates
+        let pla: Vec<&Plate> = laid.iter().filter(|p| p.material == "pla").collect();
+        assert_eq!(pla.len(), 2);
+        assert_eq!(pla.iter().map(|p| p.number).collect::<Vec<_>>(), [1, 2]);
+        let long = laid
+            .iter()
+            .flat_map(|p| &p.items)
+            .find(|it| it.unit == 14)
+            .unwrap();
+        assert!(long.turned);
+        assert_eq!(laid.len(), 4);
+
+        // too large either way round
+        parts.push((sla, "resin", b([0.0, 0.0, 0.0], [150.0, 20.0, 5.0])));
+        let names: Vec<String> = (0..parts.len()).map(|k| format!("p{k}")).collect();
+        let names: Vec<&str> = names.iter().map(String::as_str).collect();
+        let units: Vec<Vec<usize>> = (0..parts.len()).map(|k| vec![k]).collect();
+        let e = plates(&parts, &names, &units, &printers, GAP_MM).unwrap_err();
+        assert!(
+            e.to_string().starts_with(
+                "part `p15` (SLA, 150.0 x 20.0 x 5.0 mm) does not fit the formlabs_form2 bed"
+            ),
+            "{e}"
+        );
     }
 
     #[test]

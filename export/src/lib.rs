@@ -37,7 +37,8 @@ pub use error::ExportError;
 pub use manifest::{
     Manifest, ManifestAssembly, ManifestAssemblyStep, ManifestCutPart, ManifestDataFile,
     ManifestDesign, ManifestKit3mf, ManifestMachinedPart, ManifestMember, ManifestObject,
-    ManifestPart, ManifestPcbOutline, ManifestStepMember, ManifestVolume, StepGeometry, FRAME,
+    ManifestPart, ManifestPcbOutline, ManifestPlate, ManifestPlateObject, ManifestStepMember,
+    ManifestVolume, StepGeometry, FRAME,
 };
 
 use fabkit_designs::assembly::{ExactShape, MemberKind};
@@ -83,6 +84,9 @@ pub struct ExportOptions {
     pub chord_tolerance_mm: f64,
     /// fabkit version, e.g. `0.1.0`; goes into every file.
     pub fabkit_version: String,
+    /// The printers whose beds the plates are laid out in (the design's `printers`, with any
+    /// `--printer` applied); a technology without a bed gets its shipped printer.
+    pub printers: fabkit_designs::schema::PrinterProfiles,
 }
 
 /// What [`write_kit`] wrote.
@@ -360,6 +364,14 @@ fn assembly_3mf(
                 mesh,
             }],
             translation_mm: [0.0; 3],
+            turned: false,
+            metadata: vec![
+                (
+                    "role",
+                    format!("assembly member ({:?})", m.kind).to_lowercase(),
+                ),
+                ("description", m.description.clone()),
+            ],
         })
         .collect();
     let metadata = [
@@ -393,6 +405,9 @@ fn product_name(
         .and_then(|t| t.materials.get(key))
         .map_or_else(|| key.to_owned(), |m| m.name.clone())
 }
+
+/// The folder of the print plates.
+pub const PLATES_DIR: &str = "plates";
 
 /// The section view's file name ([`section`]).
 pub const SECTION_PNG: &str = "section.png";
@@ -464,33 +479,64 @@ fn render(
         });
     }
 
+    let groups: Vec<_> = parts.iter().map(|p| p.group.as_deref()).collect();
+    let units = layout::units(&groups);
+    // a unit's 3MF object: its parts as volumes, with their role, material and technology
+    let object = |members: &[usize], t: [f64; 3], turned: bool| {
+        let first = &kit.parts[members[0]];
+        let joined = |f: &dyn Fn(&fabkit_designs::kit::Part) -> String| {
+            let mut v: Vec<String> = Vec::new();
+            for &i in members {
+                let s = f(&kit.parts[i]);
+                if !v.contains(&s) {
+                    v.push(s);
+                }
+            }
+            v.join("+")
+        };
+        three_mf::Object {
+            name: members
+                .iter()
+                .map(|&i| kit.parts[i].name.as_str())
+                .collect::<Vec<_>>()
+                .join("+"),
+            group: first.group.as_deref(),
+            volumes: members
+                .iter()
+                .map(|&i| three_mf::Volume {
+                    name: &kit.parts[i].name,
+                    mesh: &meshes[i],
+                })
+                .collect(),
+            translation_mm: t,
+            turned,
+            metadata: vec![
+                ("role", joined(&|p| p.role.clone())),
+                ("material", joined(&|p| p.material.clone())),
+                ("technology", joined(&|p| p.print_technology.to_string())),
+            ],
+        }
+    };
+    // the plates first: a part larger than its bed stops the export before anything is made
+    let plates = if opts.formats.threemf {
+        let keyed: Vec<_> = kit
+            .parts
+            .iter()
+            .zip(&parts)
+            .map(|(p, m)| (p.print_technology, p.material.as_str(), m.bbox_mm))
+            .collect();
+        let names: Vec<&str> = kit.parts.iter().map(|p| p.name.as_str()).collect();
+        layout::plates(&keyed, &names, &units, &opts.printers, layout::GAP_MM)?
+    } else {
+        Vec::new()
+    };
     let kit_3mf = if opts.formats.threemf {
         let boxes: Vec<_> = parts.iter().map(|p| p.bbox_mm).collect();
-        let groups: Vec<_> = parts.iter().map(|p| p.group.as_deref()).collect();
-        let units = layout::units(&groups);
         let translations = layout::pack_units(&boxes, &units, layout::ROW_WIDTH_MM, layout::GAP_MM);
         let objects: Vec<three_mf::Object<'_>> = units
             .iter()
             .zip(&translations)
-            .map(|(members, t)| {
-                let first = &kit.parts[members[0]];
-                three_mf::Object {
-                    name: members
-                        .iter()
-                        .map(|&i| kit.parts[i].name.as_str())
-                        .collect::<Vec<_>>()
-                        .join("+"),
-                    group: first.group.as_deref(),
-                    volumes: members
-                        .iter()
-                        .map(|&i| three_mf::Volume {
-                            name: &kit.parts[i].name,
-                            mesh: &meshes[i],
-                        })
-                        .collect(),
-                    translation_mm: *t,
-                }
-            })
+            .map(|(members, t)| object(members, *t, false))
             .collect();
         let metadata = [
             ("Title", format!("fabkit kit {}", kit.design)),
@@ -540,6 +586,102 @@ fn render(
     } else {
         None
     };
+    let mut manifest_plates = Vec::with_capacity(plates.len());
+    for plate in &plates {
+        let objects: Vec<three_mf::Object<'_>> = plate
+            .items
+            .iter()
+            .map(|it| object(&units[it.unit], it.translation_mm, it.turned))
+            .collect();
+        let tech = plate.technology.to_string().to_lowercase();
+        let material: String = plate
+            .material
+            .chars()
+            .map(|c| {
+                if c.is_ascii_alphanumeric() || c == '_' || c == '+' || c == '-' {
+                    c.to_ascii_lowercase()
+                } else {
+                    '_'
+                }
+            })
+            .collect();
+        // numbers padded to the set's count, so that the files list in plate order
+        let count = plates
+            .iter()
+            .filter(|p| p.technology == plate.technology && p.material == plate.material)
+            .count();
+        let rel = format!(
+            "{PLATES_DIR}/{}_{tech}_{material}_{:0w$}.3mf",
+            kit.design,
+            plate.number,
+            w = count.to_string().len()
+        );
+        let metadata = [
+            (
+                "Title",
+                format!(
+                    "fabkit plate {} {} {} {}",
+                    kit.design, plate.technology, plate.material, plate.number
+                ),
+            ),
+            ("Application", format!("fabkit {}", opts.fabkit_version)),
+            (
+                "Description",
+                format!(
+                    "{} plate {} of design {} (sha256:{}) for the {} ({} x {} x {} mm, {} mm margin), parts in print orientation",
+                    plate.technology,
+                    plate.number,
+                    kit.design,
+                    opts.design_sha256,
+                    plate.bed.name,
+                    plate.bed.size_mm[0],
+                    plate.bed.size_mm[1],
+                    plate.bed.size_mm[2],
+                    plate.bed.margin_mm
+                ),
+            ),
+        ];
+        let bytes = three_mf::encode(&objects, &metadata)?;
+        let sha = sha256_hex(&bytes);
+        files.push((rel.clone(), bytes));
+        manifest_plates.push(ManifestPlate {
+            file: rel,
+            sha256: sha,
+            print_technology: plate.technology,
+            material: plate.material.clone(),
+            printer: plate.bed.name.clone(),
+            bed_mm: plate.bed.size_mm,
+            margin_mm: plate.bed.margin_mm,
+            objects: plate
+                .items
+                .iter()
+                .zip(&objects)
+                .map(|(it, o)| {
+                    let t = it.translation_mm;
+                    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+                    for &i in &units[it.unit] {
+                        let b = parts[i].bbox_mm;
+                        for (x, y) in [
+                            (b.min[0], b.min[1]),
+                            (b.max[0], b.min[1]),
+                            (b.min[0], b.max[1]),
+                            (b.max[0], b.max[1]),
+                        ] {
+                            let (x, y) = if it.turned { (-y, x) } else { (x, y) };
+                            lo = [lo[0].min(x + t[0]), lo[1].min(y + t[1])];
+                            hi = [hi[0].max(x + t[0]), hi[1].max(y + t[1])];
+                        }
+                    }
+                    ManifestPlateObject {
+                        name: o.name.clone(),
+                        turn_deg: if it.turned { 90.0 } else { 0.0 },
+                        translation_mm: t,
+                        footprint_mm: [lo[0], lo[1], hi[0], hi[1]],
+                    }
+                })
+                .collect(),
+        });
+    }
     // The assembled sensor's meshes, made and checked once for the section view and the 3MF.
     let assembly_meshes: Vec<Mesh> = kit
         .assembly
@@ -710,6 +852,7 @@ fn render(
         frame: FRAME.to_owned(),
         parts,
         kit_3mf,
+        plates: manifest_plates,
         assembly_3mf,
         assembly_step,
         section_view,
@@ -820,6 +963,7 @@ mod tests {
             design_sha256: "0".repeat(64),
             chord_tolerance_mm: 0.01,
             fabkit_version: "0.1.0".into(),
+            printers: Default::default(),
         }
     }
 

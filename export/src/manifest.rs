@@ -28,6 +28,10 @@ pub struct Manifest {
     pub parts: Vec<ManifestPart>,
     /// The kit 3MF, `null` when 3MF was not requested.
     pub kit_3mf: Option<ManifestKit3mf>,
+    /// The print plates (`plates/<design>_<technology>_<material>_<n>.3mf`), when 3MF was
+    /// requested: every part on exactly one, inside its printer's bed.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub plates: Vec<ManifestPlate>,
     /// The assembled sensor (`assembly.3mf`, every part in the sensor frame), when 3MF was
     /// requested and the kit is a sensor.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -296,6 +300,37 @@ pub struct ManifestKit3mf {
     pub sha256: String,
     /// One entry per 3MF object, in kit order of each object's first part.
     pub objects: Vec<ManifestObject>,
+}
+
+/// One print plate: parts of one technology and material inside one printer's bed.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ManifestPlate {
+    /// Path relative to the export directory.
+    pub file: String,
+    /// sha256 of the 3MF file bytes.
+    pub sha256: String,
+    pub print_technology: fabkit_designs::kit::PrintTechnology,
+    /// Material key (a multi-material group's keys joined by `+`).
+    pub material: String,
+    /// The printer: its name, build volume (x, y, z, mm) and the margin kept clear (mm).
+    pub printer: String,
+    pub bed_mm: [f64; 3],
+    pub margin_mm: f64,
+    /// The plate's objects, each with its translation (and turn) from part coordinates.
+    pub objects: Vec<ManifestPlateObject>,
+}
+
+/// One object of a plate.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ManifestPlateObject {
+    /// The part name, or a group's part names joined by `+`.
+    pub name: String,
+    /// Turn about z before the translation, degrees (0 or 90, counter-clockwise from above).
+    pub turn_deg: f64,
+    /// Build-item translation, mm.
+    pub translation_mm: [f64; 3],
+    /// The object's footprint on the plate, mm: [x_min, y_min, x_max, y_max].
+    pub footprint_mm: [f64; 4],
 }
 
 /// One object of the kit 3MF and where its build item puts it.

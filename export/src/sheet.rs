@@ -32,7 +32,7 @@ pub(crate) fn render(m: &Manifest) -> String {
     if let Some(k) = &m.kit_3mf {
         let _ = writeln!(
             s,
-            "- kit 3MF: {} ({} objects laid out on one plate), sha256 {}",
+            "- kit 3MF: {} ({} objects in one file, for viewing the whole kit; print from the plates below), sha256 {}",
             code(&k.file),
             k.objects.len(),
             code(&k.sha256)
@@ -81,6 +81,40 @@ pub(crate) fn render(m: &Manifest) -> String {
         );
     }
     s.push('\n');
+    if !m.plates.is_empty() {
+        s.push_str("### Plates
+
+One 3MF per printer plate, parts of one technology and material inside the printer's bed less its margin, already placed: open it in the slicer without arranging.
+
+");
+        s.push_str(
+            "| Plate | Printer | Bed x × y × z (mm) | Margin (mm) | Parts |
+",
+        );
+        s.push_str(
+            "|-------|---------|--------------------|------------:|-------|
+",
+        );
+        for p in &m.plates {
+            let _ = writeln!(
+                s,
+                "| {} | {} ({}) | {} × {} × {} | {} | {} |",
+                code(&p.file),
+                code(&p.printer),
+                p.print_technology,
+                p.bed_mm[0],
+                p.bed_mm[1],
+                p.bed_mm[2],
+                p.margin_mm,
+                p.objects
+                    .iter()
+                    .map(|o| code(&o.name))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            );
+        }
+        s.push('\n');
+    }
     groups(&mut s, m);
     print_settings(&mut s, m);
 

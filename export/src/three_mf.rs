@@ -118,7 +118,16 @@ pub(crate) struct Object<'a> {
     pub volumes: Vec<Volume<'a>>,
     /// Build-item translation, mm.
     pub translation_mm: [f64; 3],
+    /// Turned 90 deg about z (counter-clockwise from above) before the translation.
+    pub turned: bool,
+    /// Object metadata in the `fabkit:` namespace ([`FABKIT_NS`]): (key, value), e.g.
+    /// (`role`, `mold_half`); keys unique.
+    pub metadata: Vec<(&'static str, String)>,
 }
+
+/// The namespace of fabkit's object metadata (`fabkit:role`, `fabkit:material`,
+/// `fabkit:technology`), declared on the model.
+pub(crate) const FABKIT_NS: &str = "http://schemas.fabkit.org/3mf/2026";
 
 impl Object<'_> {
     /// First and last triangle (0-based, inclusive) of each volume in the object's mesh.
@@ -149,6 +158,9 @@ pub(crate) fn model_xml(objects: &[Object<'_>], metadata: &[(&str, String)]) -> 
     if with_groups {
         x.push_str(" xmlns:slic3rpe=\"http://schemas.slic3r.org/3mf/2017/06\"");
     }
+    if objects.iter().any(|o| !o.metadata.is_empty()) {
+        let _ = write!(x, " xmlns:fabkit=\"{FABKIT_NS}\"");
+    }
     x.push_str(">\n");
     for (name, value) in metadata {
         let _ = writeln!(
@@ -169,6 +181,18 @@ pub(crate) fn model_xml(objects: &[Object<'_>], metadata: &[(&str, String)]) -> 
             i + 1,
             escape(&o.name)
         );
+        if !o.metadata.is_empty() {
+            x.push_str("   <metadatagroup>\n");
+            for (k, v) in &o.metadata {
+                let _ = writeln!(
+                    x,
+                    "    <metadata name=\"fabkit:{}\" preserve=\"1\">{}</metadata>",
+                    escape(k),
+                    escape(v)
+                );
+            }
+            x.push_str("   </metadatagroup>\n");
+        }
         x.push_str("   <mesh>\n    <vertices>\n");
         for v in o.volumes.iter().flat_map(|v| &v.mesh.vertices) {
             let _ = writeln!(
@@ -193,9 +217,15 @@ pub(crate) fn model_xml(objects: &[Object<'_>], metadata: &[(&str, String)]) -> 
     x.push_str(" </resources>\n <build>\n");
     for (i, o) in objects.iter().enumerate() {
         let [tx, ty, tz] = o.translation_mm.map(f64_text);
+        // row vectors times the matrix: turned, (x, y) -> (-y, x)
+        let r = if o.turned {
+            "0 1 0 -1 0 0 0 0 1"
+        } else {
+            "1 0 0 0 1 0 0 0 1"
+        };
         let _ = writeln!(
             x,
-            "  <item objectid=\"{}\" transform=\"1 0 0 0 1 0 0 0 1 {tx} {ty} {tz}\"/>",
+            "  <item objectid=\"{}\" transform=\"{r} {tx} {ty} {tz}\"/>",
             i + 1
         );
     }
@@ -364,6 +394,8 @@ mod tests {
                     mesh: &c,
                 }],
                 translation_mm: [1.0, 2.0, 0.0],
+                turned: false,
+                metadata: Vec::new(),
             },
             Object {
                 name: "a+b".into(),
@@ -379,6 +411,8 @@ mod tests {
                     },
                 ],
                 translation_mm: [0.5, 0.0, 0.0],
+                turned: false,
+                metadata: Vec::new(),
             },
         ];
         assert_eq!(objects[1].triangle_ranges(), [(0, 3), (4, 7)]);

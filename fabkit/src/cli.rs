@@ -72,6 +72,8 @@ struct ExportArgs {
     /// needs scripts/setup-cadquery or FABKIT_CADQUERY_PYTHON).
     #[arg(long, value_delimiter = ',', default_value = "stl,3mf")]
     format: Vec<Format>,
+    #[command(flatten)]
+    printer: crate::printers::PrinterArgs,
     /// Largest distance between the exported meshes and the exact solids, mm (seams included).
     #[arg(long, default_value_t = ChordTolerance::DEFAULT_MM)]
     chord_tolerance_mm: f64,
@@ -260,6 +262,7 @@ pub(crate) fn export_options(
     tol: ChordTolerance,
     format: &[Format],
 ) -> ExportOptions {
+    let printers = loaded.design.printers.clone();
     ExportOptions {
         formats: Formats {
             stl: format.contains(&Format::Stl),
@@ -271,6 +274,7 @@ pub(crate) fn export_options(
         design_sha256: loaded.sha256.clone(),
         chord_tolerance_mm: tol.mm(),
         fabkit_version: env!("CARGO_PKG_VERSION").to_string(),
+        printers,
     }
 }
 
@@ -470,6 +474,7 @@ fn export(args: ExportArgs) -> Result<(), Box<dyn Error>> {
     if let Some(p) = &args.preset {
         loaded.design = loaded.design.with_preset(p)?;
     }
+    crate::printers::apply(&args.printer, &mut loaded.design.printers)?;
     if let Some(s) = args.mold_strategy {
         let s = match s {
             Strategy::Direct => MoldStrategy::Direct,

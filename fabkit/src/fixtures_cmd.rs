@@ -37,6 +37,8 @@ pub struct FixturesArgs {
     /// Mesh formats, comma separated.
     #[arg(long, value_delimiter = ',', default_value = "stl,3mf")]
     format: Vec<Format>,
+    #[command(flatten)]
+    printer: crate::printers::PrinterArgs,
     /// Largest distance between the exported meshes and the exact solids, mm (seams included).
     #[arg(long, default_value_t = ChordTolerance::DEFAULT_MM)]
     chord_tolerance_mm: f64,
@@ -59,6 +61,7 @@ pub fn run(args: FixturesArgs) -> Result<(), Box<dyn Error>> {
     if let Some(p) = &args.preset {
         loaded.design = loaded.design.with_preset(p)?;
     }
+    crate::printers::apply(&args.printer, &mut loaded.design.printers)?;
     let mut params = match &args.params {
         Some(path) => {
             // A regular file of bounded size, as a design file.

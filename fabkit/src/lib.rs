@@ -22,5 +22,6 @@ pub mod calibrate_cmd;
 pub mod cli;
 pub mod fixtures_cmd;
 pub mod groundtruth_cmd;
+pub mod printers;
 mod progress;
 pub mod sweep_cmd;

@@ -81,6 +81,8 @@ impl KitWriter for ExportWriter {
             design_sha256: job.design_sha256.clone(),
             chord_tolerance_mm: job.chord_tolerance_mm,
             fabkit_version: env!("CARGO_PKG_VERSION").to_string(),
+            // the shipped printers: a sweep's variants are laid out for the default beds
+            printers: Default::default(),
         };
         write_kit(kit, &job.dir, &opts)
             .map(|_| ())

@@ -25,6 +25,7 @@ pub fn export_options(design: &str, bench: &str, tol: ChordTolerance) -> ExportO
         design_sha256,
         chord_tolerance_mm: tol.mm(),
         fabkit_version: env!("CARGO_PKG_VERSION").to_string(),
+        printers: Default::default(),
     }
 }
 

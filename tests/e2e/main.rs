@@ -18,6 +18,7 @@ mod groundtruth_cli;
 mod groundtruth_flat;
 mod groundtruth_open3d;
 mod maker_path;
+mod plates;
 mod step_install;
 mod sweep_cli;
 mod twins;

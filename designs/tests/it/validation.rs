@@ -258,6 +258,51 @@ fn single_mutations() -> Vec<Mutation> {
             },
         ),
         (
+            "a printer bed of no width",
+            |d| {
+                d.printers.fdm.bed = Some(fabkit_designs::schema::Bed {
+                    name: "flat".into(),
+                    size_mm: [0.0, 200.0, 200.0],
+                    margin_mm: 5.0,
+                })
+            },
+            Expect {
+                path: "printers.fdm.bed.size_mm[0]",
+                value: "0",
+                rule: &["must be above 0 and at most 10000 mm"],
+            },
+        ),
+        (
+            "a printer bed all margin",
+            |d| {
+                d.printers.sla.bed = Some(fabkit_designs::schema::Bed {
+                    name: "small".into(),
+                    size_mm: [100.0, 150.0, 100.0],
+                    margin_mm: 50.0,
+                })
+            },
+            Expect {
+                path: "printers.sla.bed.margin_mm",
+                value: "50",
+                rule: &["must leave room on the plate", "100 mm"],
+            },
+        ),
+        (
+            "a printer named with spaces",
+            |d| {
+                d.printers.polyjet.bed = Some(fabkit_designs::schema::Bed {
+                    name: "My Printer".into(),
+                    size_mm: [200.0, 200.0, 200.0],
+                    margin_mm: 5.0,
+                })
+            },
+            Expect {
+                path: "printers.polyjet.bed.name",
+                value: "'My Printer'",
+                rule: &["a-z, 0-9 and _"],
+            },
+        ),
+        (
             "waste allowance above 1",
             |d| d.casting.waste_allowance = 1.5,
             Expect {

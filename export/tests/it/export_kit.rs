@@ -108,6 +108,7 @@ fn opts() -> ExportOptions {
         design_sha256: "0123456789abcdef".repeat(4),
         chord_tolerance_mm: 0.05,
         fabkit_version: "0.1.0".into(),
+        printers: Default::default(),
     }
 }
 
@@ -340,7 +341,8 @@ fn same_kit_gives_byte_identical_files() {
     write_kit(&test_kit(), &b, &opts()).unwrap();
     let files = tree(&a);
     assert_eq!(files, tree(&b));
-    assert_eq!(files.len(), 5 + 3 + 1); // parts, manifest, 3MF, FABRICATION.md, the marker
+    // parts, manifest, 3MF, FABRICATION.md, the marker, the FDM and SLA plates
+    assert_eq!(files.len(), 5 + 3 + 1 + 2);
     for f in &files {
         assert_eq!(
             fs::read(a.join(f)).unwrap(),
@@ -550,7 +552,9 @@ fn a_group_is_one_3mf_object_with_a_volume_per_part_and_stls_stay_put() {
     // PrusaSlicer reads the volumes from its config (exact text) and, for a version-1 file,
     // keeps the build transform for every volume.
     let model_text = zip_text(&bytes, "3D/3dmodel.model").unwrap();
-    assert!(model_text.contains(" xmlns:slic3rpe=\"http://schemas.slic3r.org/3mf/2017/06\">\n"));
+    assert!(model_text.contains(
+        " xmlns:slic3rpe=\"http://schemas.slic3r.org/3mf/2017/06\" xmlns:fabkit=\"http://schemas.fabkit.org/3mf/2026\">\n"
+    ));
     assert!(model_text.contains("\n <metadata name=\"slic3rpe:Version3mf\">1</metadata>\n"));
     let config = zip_text(&bytes, "Metadata/Slic3r_PE_model.config").unwrap();
     assert_eq!(
@@ -774,10 +778,12 @@ fn formats_select_the_mesh_files() {
             PathBuf::from(".fabkit-output"),
             "FABRICATION.md".into(),
             "manifest.json".into(),
+            "plates/tiny_fdm_pla_black_1.3mf".into(),
+            "plates/tiny_sla_pla_black_1.3mf".into(),
             "tiny.3mf".into()
         ]
     );
-    assert_eq!(s.files.len(), 3);
+    assert_eq!(s.files.len(), 5);
     let m = read_manifest(&mf_only);
     assert!(m
         .parts

@@ -46,6 +46,7 @@ fn export_as(
         design_sha256: "0".repeat(64),
         chord_tolerance_mm: TOL_MM,
         fabkit_version: "test".into(),
+        printers: Default::default(),
     };
     write_kit(&kit, &out, &opts).unwrap();
     let exported = Exported {
