@@ -4,6 +4,8 @@
 //! for it ([`crate::imprints::assign_ids`]: the capture plan's row, or the ids the file name
 //! lists in ring order), and the result is the observations the solve uses, the
 //! `observations.csv` table (capture, id, u_px, v_px, score) and an overlay per capture.
+//! `observations.csv` starts with its header row; what its columns mean ([`OBSERVATIONS_NOTES`])
+//! is in the sidecar `observations.json` written beside it.
 //!
 //! Images: PNG or JPEG, 8- or 16-bit, grey or RGB (converted to grey, 0..255 grey levels), of
 //! the camera file's size (checked from the header, before any pixel is decoded).
@@ -139,6 +141,9 @@ struct Capture {
     ids: Vec<(usize, u32)>,
 }
 
+/// What `observations.csv` holds: the `notes` of its sidecar `observations.json`.
+pub const OBSERVATIONS_NOTES: &str = "fabkit pin-imprint observations: pixel of each pin's imprint (sub-pixel centroid; (0, 0) the centre of the top-left pixel, docs/conventions.md); score: the imprint's peak over the noise sigma";
+
 /// The captures' observations.
 #[derive(Debug, Clone)]
 pub struct ImageObservations {
@@ -259,9 +264,7 @@ pub fn observe_images(
         by_number.iter().map(|(n, (_, p))| (*n, *p)).collect();
     let spots: Vec<CaptureSpots> = captures.iter().map(|c| c.spots.clone()).collect();
     let assignment = assign_ids(camera, &points, &spots);
-    let mut csv = String::from(
-        "# fabkit pin-imprint observations: pixel of each pin's imprint (sub-pixel centroid; (0, 0) the centre of the top-left pixel, docs/conventions.md); score: the imprint's peak over the noise sigma\ncapture,id,u_px,v_px,score\n",
-    );
+    let mut csv = String::from("capture,id,u_px,v_px,score\n");
     // id -> (sum of pixels, count, captures), first-seen order
     let mut merged: Vec<(String, Vector2<f64>, usize, Vec<String>)> = Vec::new();
     for o in &assignment.observations {

@@ -86,9 +86,11 @@ pub enum ExtrinsicsError {
 #[derive(Debug, Clone)]
 pub struct ExtrinsicsOutput {
     pub report: ExtrinsicsReport,
-    /// (file name, bytes): `extrinsics.json`, `extrinsics.yaml`, given a capture image
-    /// `overlay.png`, and from capture images `observations.csv` and `overlays/<capture>.png`,
-    /// in that order.
+    /// (file name, bytes), in this order: `extrinsics.json`, `extrinsics.yaml`, given a capture
+    /// image `overlay.png`, `residuals.png` (a histogram of the reprojection errors), with
+    /// `--refine-intrinsics` the refined camera file, and from capture images
+    /// `observations.csv`, its sidecar `observations.json` (what the columns mean) and
+    /// `overlays/<capture>.png`.
     pub files: Vec<(String, Vec<u8>)>,
     /// From capture images: what was found.
     pub found: Option<FoundInImages>,
@@ -245,9 +247,22 @@ pub fn calibrate_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsOutput, Ext
     if let Some(o) = overlay {
         files.push(("overlay.png".into(), o));
     }
+    files.push((
+        "residuals.png".into(),
+        crate::overlay::render_residual_histogram(&report)?,
+    ));
     files.extend(refined_file);
     if let Some(found) = &from_images {
         files.push(("observations.csv".into(), found.csv.clone().into_bytes()));
+        let sidecar = serde_json::json!({
+            "file": "observations.csv",
+            "columns": ["capture", "id", "u_px", "v_px", "score"],
+            "notes": crate::capture_images::OBSERVATIONS_NOTES,
+        });
+        files.push((
+            "observations.json".into(),
+            format!("{sidecar:#}\n").into_bytes(),
+        ));
         files.extend(found.overlays(&camera, &table, &sol.t_cam_sensor)?);
     }
     let found = from_images.as_ref().map(|f| FoundInImages {

@@ -72,28 +72,16 @@ impl Rgb8 {
         }
     }
 
-    /// Writes `text` (digits, `?` and `-`; other characters as blanks) with its top-left corner
-    /// at (`x`, `y`) px, in a 3 x 5 pixel font scaled `scale` times.
+    /// Writes `text` ([`fabkit_designs::glyphs`]: digits, `?`, `-`; others blank) with its
+    /// top-left corner at (`x`, `y`) px, in a 3 x 5 pixel font scaled `scale` times.
     pub(crate) fn text(&mut self, x: f64, y: f64, text: &str, scale: i64, c: [u8; 3]) {
-        for (k, ch) in text.chars().enumerate() {
-            let rows = glyph(ch);
-            for (r, bits) in rows.iter().enumerate() {
-                for col in 0..3 {
-                    if bits & (0b100 >> col) == 0 {
-                        continue;
-                    }
-                    for dy in 0..scale {
-                        for dx in 0..scale {
-                            self.put(
-                                x.round() as i64 + (4 * k as i64 + col) * scale + dx,
-                                y.round() as i64 + r as i64 * scale + dy,
-                                c,
-                            );
-                        }
-                    }
-                }
-            }
-        }
+        fabkit_designs::glyphs::draw_text(
+            x.round() as i64,
+            y.round() as i64,
+            text,
+            scale,
+            |px, py| self.put(px, py, c),
+        );
     }
 
     /// The image encoded as an 8-bit RGB PNG.
@@ -119,25 +107,6 @@ impl Rgb8 {
                 .map_err(|e| OverlayError::Encode(e.to_string()))?;
         }
         Ok(out)
-    }
-}
-
-/// Rows (top first, 3 bits each, high bit left) of a 3 x 5 pixel glyph.
-fn glyph(c: char) -> [u8; 5] {
-    match c {
-        '0' => [0b111, 0b101, 0b101, 0b101, 0b111],
-        '1' => [0b010, 0b110, 0b010, 0b010, 0b111],
-        '2' => [0b111, 0b001, 0b111, 0b100, 0b111],
-        '3' => [0b111, 0b001, 0b111, 0b001, 0b111],
-        '4' => [0b101, 0b101, 0b111, 0b001, 0b001],
-        '5' => [0b111, 0b100, 0b111, 0b001, 0b111],
-        '6' => [0b111, 0b100, 0b111, 0b101, 0b111],
-        '7' => [0b111, 0b001, 0b010, 0b010, 0b010],
-        '8' => [0b111, 0b101, 0b111, 0b101, 0b111],
-        '9' => [0b111, 0b101, 0b111, 0b001, 0b111],
-        '?' => [0b111, 0b001, 0b011, 0b000, 0b010],
-        '-' => [0b000, 0b000, 0b111, 0b000, 0b000],
-        _ => [0; 5],
     }
 }
 
@@ -245,6 +214,61 @@ pub fn render_overlay(mut img: Rgb8, report: &ExtrinsicsReport) -> Result<Vec<u8
             );
         }
     }
+    img.to_png()
+}
+
+/// `residuals.png`: a histogram of the inliers' reprojection errors (20 bins from 0 to the
+/// largest, px; bar heights the counts), the axis labelled with the bins' edges in px and the
+/// tallest bar's count. 480 x 260 px.
+///
+/// # Errors
+/// [`OverlayError::Encode`].
+pub fn render_residual_histogram(report: &ExtrinsicsReport) -> Result<Vec<u8>, OverlayError> {
+    const W: u32 = 480;
+    const H: u32 = 260;
+    const BINS: usize = 20;
+    let (left, right, top, bottom) = (40.0, 460.0, 30.0, 220.0);
+    let mut img = Rgb8 {
+        width: W,
+        height: H,
+        data: vec![255; (3 * W * H) as usize],
+    };
+    let errors: Vec<f64> = report
+        .residuals
+        .points
+        .iter()
+        .filter(|p| p.inlier)
+        .filter_map(|p| p.reprojection_error_px)
+        .collect();
+    let max = errors.iter().copied().fold(0.0f64, f64::max).max(1e-3);
+    let mut counts = [0usize; BINS];
+    for e in &errors {
+        counts[((e / max * BINS as f64) as usize).min(BINS - 1)] += 1;
+    }
+    let tallest = counts.iter().copied().max().unwrap_or(0).max(1);
+    let bar_w = (right - left) / BINS as f64;
+    for (k, &n) in counts.iter().enumerate() {
+        let h = (bottom - top) * n as f64 / tallest as f64;
+        let x0 = left + k as f64 * bar_w;
+        for x in (x0 + 1.0) as i64..(x0 + bar_w - 1.0) as i64 {
+            for y in (bottom - h) as i64..bottom as i64 {
+                img.put(x, y, [60, 110, 200]);
+            }
+        }
+    }
+    const BLACK: [u8; 3] = [0, 0, 0];
+    img.line(left, bottom, right, bottom, BLACK);
+    img.line(left, top, left, bottom, BLACK);
+    img.text(left - 4.0, bottom + 8.0, "0", 2, BLACK);
+    img.text(right - 60.0, bottom + 8.0, &format!("{max:.3}px"), 2, BLACK);
+    img.text(
+        left + 0.5 * (right - left) - 30.0,
+        bottom + 8.0,
+        &format!("{:.3}", 0.5 * max),
+        2,
+        BLACK,
+    );
+    img.text(left + 6.0, top - 20.0, &tallest.to_string(), 2, BLACK);
     img.to_png()
 }
 

@@ -4,7 +4,9 @@
 //! contact_x_mm,...`; tip columns by default, contact columns on request) or any CSV with
 //! `id,x_mm,y_mm,z_mm`; sensor frame (`docs/conventions.md`), mm. Observations: `id,u_px,v_px`,
 //! px (pixel (0, 0) is the centre of the top-left pixel); several files may split the pins
-//! between captures. Lines starting with `#` and blank lines are skipped. Errors name
+//! between captures. Lines starting with `#` and blank lines are skipped: fabkit's own tables
+//! start with their header row (their notes are in JSON sidecars), and tables of older fabkit
+//! versions, which began with `#` lines, still read. Errors name
 //! file:line, the column, the value and the rule.
 
 use std::collections::BTreeMap;

@@ -14,6 +14,7 @@ pub mod error;
 pub mod estimate;
 pub mod flat;
 pub mod geometry;
+pub mod glyphs;
 pub mod housing;
 pub mod input_files;
 pub mod insertion;

@@ -11,6 +11,9 @@
 //! - with STEP, `step/<part>.step` per part (print orientation) and `assembly.step`, the
 //!   assembled sensor as exact B-reps in the sensor frame, one named solid per member (see the
 //!   `step` module);
+//! - with STL or 3MF, `previews/<part>.png`, a shaded picture of each part from two sides, and
+//!   with 3MF `previews/plate_<plate>.png`, each plate as placed on its bed (also the plate
+//!   3MF's thumbnail; the kit 3MF's thumbnail shows its layout); see the `preview` module;
 //! - `manifest.json`: provenance and the numbers of every written solid ([`Manifest`]);
 //! - `FABRICATION.md`: the human fabrication sheet (print list, cast order, bought items).
 //!
@@ -21,8 +24,10 @@
 mod atomic;
 mod check;
 mod error;
+mod html;
 mod layout;
 mod manifest;
+pub mod preview;
 pub mod raster;
 pub mod section;
 mod sheet;
@@ -95,7 +100,8 @@ pub struct ExportSummary {
     /// The output directory, as given.
     pub out_dir: PathBuf,
     /// Every file written, as `out_dir` joined with its relative path, in order:
-    /// `parts/*.stl` (kit order), `<design>.3mf`, `step/*.step` (kit order), `assembly.step`,
+    /// `parts/*.stl` (kit order), `<design>.3mf`, `plates/*.3mf`, `previews/*.png` (parts in
+    /// kit order, then plates), `step/*.step` (kit order), `assembly.step`,
     /// `section.png`, `cut/*`, `assembly.3mf`, data files, `manifest.json`, `FABRICATION.md`
     /// (each when written).
     pub files: Vec<PathBuf>,
@@ -385,7 +391,7 @@ fn assembly_3mf(
             ),
         ),
     ];
-    let bytes = three_mf::encode(&objects, &metadata)?;
+    let bytes = three_mf::encode(&objects, &metadata, None)?;
     Ok((
         ManifestAssembly {
             file: ASSEMBLY_3MF.into(),
@@ -408,6 +414,9 @@ fn product_name(
 
 /// The folder of the print plates.
 pub const PLATES_DIR: &str = "plates";
+
+/// The folder of the pictures of the parts and plates ([`preview`]).
+pub const PREVIEWS_DIR: &str = "previews";
 
 /// The section view's file name ([`section`]).
 pub const SECTION_PNG: &str = "section.png";
@@ -475,6 +484,8 @@ fn render(
             sha256,
             step_file: None,
             step_sha256: None,
+            preview: None,
+            preview_sha256: None,
             params: part.params.clone(),
         });
     }
@@ -553,7 +564,11 @@ fn render(
                 ),
             ),
         ];
-        let bytes = three_mf::encode(&objects, &metadata)?;
+        let thumbnail = preview::render_plate(&placed_objects(&objects), None).png(&format!(
+            "fabkit kit {}: the kit 3MF's layout seen from above-front",
+            kit.design
+        ))?;
+        let bytes = three_mf::encode(&objects, &metadata, Some(&thumbnail))?;
         let rel = format!("{}.3mf", kit.design);
         let sha = sha256_hex(&bytes);
         files.push((rel.clone(), bytes));
@@ -586,8 +601,48 @@ fn render(
     } else {
         None
     };
+    // pictures whenever a mesh format is written: every part's preview, every plate's picture
+    // (also its 3MF's thumbnail)
+    let pictures = opts.formats.stl || opts.formats.threemf;
+    let part_pngs = if pictures {
+        let named: Vec<(&str, &Mesh)> = kit
+            .parts
+            .iter()
+            .zip(meshes)
+            .map(|(p, m)| (p.name.as_str(), m))
+            .collect();
+        preview::part_pngs(&named)?
+    } else {
+        Vec::new()
+    };
+    let plate_pngs: Vec<Vec<u8>> = {
+        use rayon::prelude::*;
+        plates
+            .par_iter()
+            .map(|plate| {
+                let objects: Vec<preview::PlacedObject<'_>> = plate
+                    .items
+                    .iter()
+                    .map(|it| preview::PlacedObject {
+                        meshes: units[it.unit].iter().map(|&i| &meshes[i]).collect(),
+                        turned: it.turned,
+                        translation_mm: it.translation_mm,
+                    })
+                    .collect();
+                let bed = preview::BedOutline {
+                    size_xy_mm: [plate.bed.size_mm[0], plate.bed.size_mm[1]],
+                    margin_mm: plate.bed.margin_mm,
+                };
+                preview::render_plate(&objects, Some(bed)).png(&format!(
+                    "fabkit {} plate {} of design {} ({}) on the {} bed, seen from above-front",
+                    plate.technology, plate.number, kit.design, plate.material, plate.bed.name
+                ))
+            })
+            .collect::<Result<_, _>>()?
+    };
+    let mut plate_picture_files = Vec::with_capacity(plates.len());
     let mut manifest_plates = Vec::with_capacity(plates.len());
-    for plate in &plates {
+    for (plate, png) in plates.iter().zip(plate_pngs) {
         let objects: Vec<three_mf::Object<'_>> = plate
             .items
             .iter()
@@ -641,12 +696,21 @@ fn render(
                 ),
             ),
         ];
-        let bytes = three_mf::encode(&objects, &metadata)?;
+        let bytes = three_mf::encode(&objects, &metadata, Some(&png))?;
         let sha = sha256_hex(&bytes);
+        let picture = format!(
+            "{PREVIEWS_DIR}/plate_{}.png",
+            rel.trim_start_matches(&format!("{PLATES_DIR}/"))
+                .trim_end_matches(".3mf")
+        );
+        let picture_sha = sha256_hex(&png);
         files.push((rel.clone(), bytes));
+        plate_picture_files.push((picture.clone(), png));
         manifest_plates.push(ManifestPlate {
             file: rel,
             sha256: sha,
+            preview: Some(picture),
+            preview_sha256: Some(picture_sha),
             print_technology: plate.technology,
             material: plate.material.clone(),
             printer: plate.bed.name.clone(),
@@ -682,6 +746,13 @@ fn render(
                 .collect(),
         });
     }
+    for (p, png) in parts.iter_mut().zip(part_pngs) {
+        let rel = format!("{PREVIEWS_DIR}/{}.png", p.name);
+        p.preview_sha256 = Some(sha256_hex(&png));
+        p.preview = Some(rel.clone());
+        files.push((rel, png));
+    }
+    files.extend(plate_picture_files);
     // The assembled sensor's meshes, made and checked once for the section view and the 3MF.
     let assembly_meshes: Vec<Mesh> = kit
         .assembly
@@ -885,10 +956,14 @@ fn render(
     let mut json = serde_json::to_vec_pretty(&manifest)?;
     json.push(b'\n');
     files.push(("manifest.json".to_owned(), json));
-    files.push((
-        "FABRICATION.md".to_owned(),
-        sheet::render(&manifest).into_bytes(),
-    ));
+    let sheet_md = sheet::render(&manifest);
+    let sheet_html = html::render(
+        &sheet_md,
+        &format!("fabkit {}: fabrication", kit.design),
+        &files,
+    );
+    files.push(("FABRICATION.md".to_owned(), sheet_md.into_bytes()));
+    files.push(("FABRICATION.html".to_owned(), sheet_html.into_bytes()));
     Ok(Rendered { files, manifest })
 }
 
@@ -911,6 +986,19 @@ fn stl_file(
     let sha = sha256_hex(&bytes);
     files.push((rel.clone(), bytes));
     Ok((Some(rel), Some(sha)))
+}
+
+/// The objects of a 3MF as the preview draws them: their volumes' meshes under their build
+/// items' turn and translation.
+fn placed_objects<'a>(objects: &[three_mf::Object<'a>]) -> Vec<preview::PlacedObject<'a>> {
+    objects
+        .iter()
+        .map(|o| preview::PlacedObject {
+            meshes: o.volumes.iter().map(|v| v.mesh).collect(),
+            turned: o.turned,
+            translation_mm: o.translation_mm,
+        })
+        .collect()
 }
 
 fn join_rel(base: &Path, rel: &str) -> PathBuf {

@@ -132,6 +132,14 @@ pub struct ManifestPart {
     /// sha256 of the STEP file bytes, absent when STEP was not requested.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub step_sha256: Option<String>,
+    /// Path of the part's picture (`previews/<name>.png`: shaded, isometric from
+    /// above-front-right and from below-back-left, side by side), present when STL or 3MF
+    /// was written.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub preview: Option<String>,
+    /// sha256 of the picture's bytes.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub preview_sha256: Option<String>,
     /// The resolved parameters the part was built from.
     pub params: serde_json::Value,
 }
@@ -316,6 +324,12 @@ pub struct ManifestPlate {
     pub printer: String,
     pub bed_mm: [f64; 3],
     pub margin_mm: f64,
+    /// The plate's picture (`previews/plate_<plate file stem>.png`: the objects on the bed seen
+    /// from above-front; also the 3MF's `Metadata/thumbnail.png`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub preview: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub preview_sha256: Option<String>,
     /// The plate's objects, each with its translation (and turn) from part coordinates.
     pub objects: Vec<ManifestPlateObject>,
 }

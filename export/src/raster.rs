@@ -222,6 +222,59 @@ pub fn preview_rgb(values: &[f64], lo: f64, hi: f64) -> Vec<u8> {
     out
 }
 
+/// Width of the colour-bar panel [`with_colour_bar`] adds, px.
+pub const COLOUR_BAR_PANEL_PX: usize = 100;
+
+/// `rgb` (`width` x `height`, from [`preview_rgb`] of `lo`..`hi` mm) with a white panel of
+/// [`COLOUR_BAR_PANEL_PX`] at its right: the Turbo scale as a bar, `hi` at the top and `lo` at
+/// the bottom, each labelled in mm (and the middle). Returns the new width and the RGB bytes.
+pub fn with_colour_bar(
+    width: usize,
+    height: usize,
+    rgb: &[u8],
+    lo: f64,
+    hi: f64,
+) -> (usize, Vec<u8>) {
+    let w2 = width + COLOUR_BAR_PANEL_PX;
+    let mut out = vec![255u8; 3 * w2 * height];
+    for y in 0..height {
+        out[3 * y * w2..3 * y * w2 + 3 * width]
+            .copy_from_slice(&rgb[3 * y * width..3 * (y + 1) * width]);
+    }
+    let (top, bottom) = (
+        10usize.min(height / 4),
+        height.saturating_sub(10.min(height / 4)),
+    );
+    let x0 = width + 8;
+    let mut put = |x: i64, y: i64, c: [u8; 3]| {
+        if x >= 0 && y >= 0 && (x as usize) < w2 && (y as usize) < height {
+            let i = 3 * (y as usize * w2 + x as usize);
+            out[i..i + 3].copy_from_slice(&c);
+        }
+    };
+    for y in top..bottom {
+        let t = if bottom - 1 > top {
+            (bottom - 1 - y) as f64 / (bottom - 1 - top) as f64
+        } else {
+            0.5
+        };
+        let c = colorous::TURBO.eval_continuous(t);
+        for x in x0..x0 + 14 {
+            put(x as i64, y as i64, [c.r, c.g, c.b]);
+        }
+    }
+    let label = |v: f64| format!("{v:.2}mm");
+    let tx = (x0 + 18) as i64;
+    for (v, y) in [
+        (hi, top as i64),
+        (0.5 * (lo + hi), ((top + bottom) / 2) as i64 - 5),
+        (lo, bottom as i64 - 10),
+    ] {
+        fabkit_designs::glyphs::draw_text(tx, y, &label(v), 2, |x, y| put(x, y, [0, 0, 0]));
+    }
+    (w2, out)
+}
+
 /// Unit vectors as RGB (`(n + 1) / 2 * 255`), NaN black: the usual normal-map preview.
 pub fn normals_rgb(normals: &[[f64; 3]]) -> Vec<u8> {
     let mut out = Vec::with_capacity(3 * normals.len());
@@ -243,7 +296,7 @@ pub fn normals_rgb(normals: &[[f64; 3]]) -> Vec<u8> {
 pub struct PlyPoint {
     pub xyz: [f32; 3],
     pub normal: [f32; 3],
-    /// Pixel column and row.
+    /// Pixel column and row (written as PLY `int`, see [`ply_points`]).
     pub u: u16,
     pub v: u16,
     /// 1 on a protrusion (contact), else 0.
@@ -252,23 +305,29 @@ pub struct PlyPoint {
 
 /// A binary little-endian PLY point cloud with per-point normal, pixel and contact flag;
 /// `comments` go into the header (one line each, no newlines).
+///
+/// Properties: `float` x, y, z, nx, ny, nz; `int` u, v (pixel column, row); `uchar` contact.
+/// u and v are `int`, not `ushort`: Open3D's tensor reader (`open3d.t.io.read_point_cloud`)
+/// skips `char`, `short`, `ushort`, `uint` (and their `int8`/`int16`/`uint32` spellings) and
+/// keeps `uchar`, `int`, `float`, `double` (and `uint8`/`uint16`/`int32`/`float32`/`float64`),
+/// found by experiment with open3d 0.19; `int` is the classic PLY name every reader knows.
 pub fn ply_points(points: &[PlyPoint], comments: &[String]) -> Vec<u8> {
     let mut h = String::from("ply\nformat binary_little_endian 1.0\n");
     for c in comments {
         h.push_str(&format!("comment {}\n", c.replace(['\n', '\r'], " ")));
     }
     h.push_str(&format!(
-        "element vertex {}\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nproperty ushort u\nproperty ushort v\nproperty uchar contact\nend_header\n",
+        "element vertex {}\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nproperty int u\nproperty int v\nproperty uchar contact\nend_header\n",
         points.len()
     ));
     let mut out = h.into_bytes();
-    out.reserve(points.len() * 29);
+    out.reserve(points.len() * 33);
     for p in points {
         for c in p.xyz.iter().chain(&p.normal) {
             out.extend_from_slice(&c.to_le_bytes());
         }
-        out.extend_from_slice(&p.u.to_le_bytes());
-        out.extend_from_slice(&p.v.to_le_bytes());
+        out.extend_from_slice(&i32::from(p.u).to_le_bytes());
+        out.extend_from_slice(&i32::from(p.v).to_le_bytes());
         out.push(p.contact);
     }
     out

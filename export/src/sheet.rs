@@ -114,6 +114,32 @@ One 3MF per printer plate, parts of one technology and material inside the print
             );
         }
         s.push('\n');
+        for p in m.plates.iter().filter(|p| p.preview.is_some()) {
+            let _ = writeln!(
+                s,
+                "![Plate {}]({})\n",
+                text(&p.file),
+                p.preview.as_deref().unwrap_or_default()
+            );
+        }
+    }
+    if m.parts.iter().any(|p| p.preview.is_some()) {
+        s.push_str(
+            "### Part previews
+
+Each part in print orientation, from above-front-right and from below-back-left.
+
+",
+        );
+        for p in m.parts.iter().filter(|p| p.preview.is_some()) {
+            let _ = writeln!(
+                s,
+                "{}\n\n![{}]({})\n",
+                code(&p.name),
+                text(&p.name),
+                p.preview.as_deref().unwrap_or_default()
+            );
+        }
     }
     groups(&mut s, m);
     print_settings(&mut s, m);

@@ -10,24 +10,44 @@ use fabkit_designs::geometry::Mesh;
 pub(crate) const HEADER_LEN: usize = 80;
 
 /// The 80-byte header: `fabkit <version> <design> <part> sha256:<first 16 hex> mm`, non-ASCII
-/// bytes replaced by `?`, padded with spaces or truncated to 80 bytes. It starts with `fabkit`,
-/// never with `solid` (which makes some readers take the file for ASCII STL).
+/// bytes replaced by `?`, padded with spaces to 80 bytes. It starts with `fabkit`, never with
+/// `solid` (which makes some readers take the file for ASCII STL), and always ends in the unit
+/// word `mm`: a text too long for 80 bytes loses the end of the part name first (cut names end
+/// in `~`), then, if still too long, the end of what comes before the unit.
 pub(crate) fn header(
     version: &str,
     design: &str,
     part: &str,
     design_sha256: &str,
 ) -> [u8; HEADER_LEN] {
+    let ascii = |s: &str| -> Vec<u8> {
+        s.bytes()
+            .map(|c| {
+                if c.is_ascii() && !c.is_ascii_control() {
+                    c
+                } else {
+                    b'?'
+                }
+            })
+            .collect()
+    };
     let hash16: String = design_sha256.chars().take(16).collect();
-    let text = format!("fabkit {version} {design} {part} sha256:{hash16} mm");
-    let mut out = [b' '; HEADER_LEN];
-    for (o, c) in out.iter_mut().zip(text.bytes()) {
-        *o = if c.is_ascii() && !c.is_ascii_control() {
-            c
-        } else {
-            b'?'
-        };
+    let head = ascii(&format!("fabkit {version} {design} "));
+    let tail = ascii(&format!(" sha256:{hash16}"));
+    const UNIT: &[u8] = b" mm";
+    let mut part = ascii(part);
+    let room = HEADER_LEN.saturating_sub(head.len() + tail.len() + UNIT.len());
+    if part.len() > room {
+        part.truncate(room.saturating_sub(1));
+        if room > 0 {
+            part.push(b'~');
+        }
     }
+    let mut text = [head, part, tail].concat();
+    text.truncate(HEADER_LEN - UNIT.len());
+    text.extend_from_slice(UNIT);
+    let mut out = [b' '; HEADER_LEN];
+    out[..text.len()].copy_from_slice(&text);
     out
 }
 
@@ -94,6 +114,28 @@ mod tests {
         assert!(!h.starts_with(b"solid"));
         let long = header(&"é".repeat(60), "d", "p", &"0".repeat(64));
         assert!(long.iter().all(|b| b.is_ascii()));
+    }
+
+    /// The unit word survives a long part name: the part name is cut, not `mm`.
+    #[test]
+    fn long_part_name_is_shortened_and_the_unit_kept() {
+        let part = "semidome_pattern_with_a_very_long_name_that_does_not_fit_in_eighty_bytes";
+        let h = header("0.1.0", "rtac0", part, &"ab".repeat(32));
+        let text = std::str::from_utf8(&h).unwrap().trim_end();
+        assert_eq!(text.len(), 80);
+        assert!(text.starts_with("fabkit 0.1.0 rtac0 semidome_pattern_with"));
+        assert!(text.ends_with("~ sha256:abababababababab mm"), "{text}");
+        // A fitting name is kept whole.
+        let h = header("0.1.0", "rtac0", "core_holder", &"ab".repeat(32));
+        assert!(std::str::from_utf8(&h)
+            .unwrap()
+            .trim_end()
+            .ends_with("core_holder sha256:abababababababab mm"));
+        // Even when the version and design alone overflow, the unit stays last.
+        let h = header(&"9".repeat(70), "d", "p", &"0".repeat(64));
+        assert!(std::str::from_utf8(&h).unwrap().ends_with(" mm"));
+        let h = header(&"é".repeat(60), "d", "p", &"0".repeat(64));
+        assert!(h.ends_with(b" mm") && h.iter().all(|b| b.is_ascii()));
     }
 
     #[test]

@@ -88,6 +88,23 @@ const CONTENT_TYPES_WITH_CONFIG: &str = concat!(
     "</Types>\n"
 );
 
+/// The content type line of the package thumbnail (OPC wants one for every part).
+const PNG_CONTENT_TYPE: &str = r#"<Default Extension="png" ContentType="image/png"/>"#;
+
+/// Where the package thumbnail goes (PrusaSlicer reads and writes it there).
+pub(crate) const THUMBNAIL_PATH: &str = "Metadata/thumbnail.png";
+
+/// [`RELS`] plus the package thumbnail: the OPC relationship of the 3MF core specification
+/// (Sec. 6.1, "Package Thumbnail"), from the package root to [`THUMBNAIL_PATH`].
+const RELS_WITH_THUMBNAIL: &str = concat!(
+    r#"<?xml version="1.0" encoding="UTF-8"?>"#,
+    "\n",
+    r#"<Relationships xmlns="http://schemas.openxmlformats.org/package/2006/relationships">"#,
+    r#"<Relationship Target="/3D/3dmodel.model" Id="rel0" Type="http://schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel"/>"#,
+    r#"<Relationship Target="/Metadata/thumbnail.png" Id="rel1" Type="http://schemas.openxmlformats.org/package/2006/relationships/metadata/thumbnail"/>"#,
+    "</Relationships>\n"
+);
+
 /// Where PrusaSlicer reads the volumes of its objects.
 pub(crate) const PRUSA_CONFIG_PATH: &str = "Metadata/Slic3r_PE_model.config";
 
@@ -274,7 +291,9 @@ pub(crate) fn prusa_config_xml(objects: &[Object<'_>]) -> Option<String> {
 }
 
 /// The whole 3MF package as bytes: `[Content_Types].xml`, `_rels/.rels`, `3D/3dmodel.model`
-/// and, when an object holds a group, [`PRUSA_CONFIG_PATH`]; deflated at level 6, every entry dated 1980-01-01 00:00:00 with host system Unix and mode
+/// and, when an object holds a group, [`PRUSA_CONFIG_PATH`], and with `thumbnail` (PNG bytes)
+/// the package thumbnail [`THUMBNAIL_PATH`] (its root relationship in `_rels/.rels`, the `png`
+/// content type declared); deflated at level 6, every entry dated 1980-01-01 00:00:00 with host system Unix and mode
 /// 0644, so the bytes depend only on the input (and the deflate implementation).
 ///
 /// # Errors
@@ -282,6 +301,7 @@ pub(crate) fn prusa_config_xml(objects: &[Object<'_>]) -> Option<String> {
 pub(crate) fn encode(
     objects: &[Object<'_>],
     metadata: &[(&str, String)],
+    thumbnail: Option<&[u8]>,
 ) -> Result<Vec<u8>, ExportError> {
     let model = model_xml(objects, metadata);
     let config = prusa_config_xml(objects);
@@ -298,17 +318,29 @@ pub(crate) fn encode(
     } else {
         CONTENT_TYPES
     };
+    let content_types = match thumbnail {
+        Some(_) => content_types.replace("</Types>", &format!("{PNG_CONTENT_TYPE}</Types>")),
+        None => content_types.to_owned(),
+    };
+    let rels = if thumbnail.is_some() {
+        RELS_WITH_THUMBNAIL
+    } else {
+        RELS
+    };
     let mut entries = vec![
-        ("[Content_Types].xml", content_types),
-        ("_rels/.rels", RELS),
-        ("3D/3dmodel.model", model.as_str()),
+        ("[Content_Types].xml", content_types.as_bytes()),
+        ("_rels/.rels", rels.as_bytes()),
+        ("3D/3dmodel.model", model.as_bytes()),
     ];
     if let Some(c) = &config {
-        entries.push((PRUSA_CONFIG_PATH, c.as_str()));
+        entries.push((PRUSA_CONFIG_PATH, c.as_bytes()));
+    }
+    if let Some(png) = thumbnail {
+        entries.push((THUMBNAIL_PATH, png));
     }
     for (name, body) in entries {
         zip.start_file(name, opts).map_err(zip_err)?;
-        zip.write_all(body.as_bytes()).map_err(io_err)?;
+        zip.write_all(body).map_err(io_err)?;
     }
     Ok(zip.finish().map_err(zip_err)?.into_inner())
 }

@@ -7,6 +7,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use fabkit_calibration::groundtruth::inputs::{
     pairs_csv, read_extrinsics, read_fixtures, read_with_hash, sha256_hex, Configuration,
+    PAIRS_NOTES,
 };
 use fabkit_calibration::groundtruth::rays::PixelRays;
 use fabkit_calibration::groundtruth::surface::ReferenceSurface;
@@ -205,10 +206,18 @@ fn scalar_files(
                "offset_counts": enc.offset_counts, "missing": 0, "clipped_pixels": clipped}),
     ));
     let pv = format!("{dir}/{stem}_preview.png");
+    let (w2, rgb) = fabkit_export::raster::with_colour_bar(
+        w,
+        h,
+        &preview_rgb(values, preview.0, preview.1),
+        preview.0,
+        preview.1,
+    );
     files.push((
         pv.clone(),
-        png_rgb8(w, h, &preview_rgb(values, preview.0, preview.1), &[])?,
-        json!({"file": pv, "quantity": format!("preview of {name}"), "colour_map": "turbo (d3, colorous)", "range_mm": [preview.0, preview.1], "missing": "black"}),
+        png_rgb8(w2, h, &rgb, &[])?,
+        json!({"file": pv, "quantity": format!("preview of {name}"), "colour_map": "turbo (d3, colorous)", "range_mm": [preview.0, preview.1], "missing": "black",
+               "colour_bar": {"columns_px": [w, w2], "top_mm": preview.1, "bottom_mm": preview.0}}),
     ));
     Ok(())
 }
@@ -373,7 +382,7 @@ pub fn output_bound(w: u64, h: u64, n_cfg: u64, n_patterns: u64, format: DataFor
         match format {
             DataFormat::Npy => {
                 files += arrays.len() as u64 + 1;
-                bytes += arrays.iter().sum::<u64>() + 29 * px + 4096;
+                bytes += arrays.iter().sum::<u64>() + 33 * px + 4096;
             }
             DataFormat::Npz => {
                 files += 1;
@@ -663,7 +672,7 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
     extra.push((
         "pairs.csv".into(),
         pairs.into_bytes(),
-        json!({"file": "pairs.csv", "pairs": n_pairs}),
+        json!({"file": "pairs.csv", "pairs": n_pairs, "notes": PAIRS_NOTES}),
     ));
     let extra_entries = write(extra, &mut all)?;
     all.sort();

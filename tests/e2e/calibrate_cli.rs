@@ -534,7 +534,8 @@ fn extrinsics_out_is_written_whole_and_never_takes_a_users_folder() {
             fabkit_export::OUTPUT_MARKER,
             "extrinsics.json",
             "extrinsics.yaml",
-            "overlay.png"
+            "overlay.png",
+            "residuals.png"
         ]
     );
     let o = calibrate("out", false);
@@ -544,7 +545,8 @@ fn extrinsics_out_is_written_whole_and_never_takes_a_users_folder() {
         [
             fabkit_export::OUTPUT_MARKER,
             "extrinsics.json",
-            "extrinsics.yaml"
+            "extrinsics.yaml",
+            "residuals.png"
         ]
     );
     // A file the user adds to the output makes it theirs: the next run refuses it.

@@ -217,6 +217,24 @@ fn pins_found_in_photos_get_the_plans_ids_and_give_the_pose() {
         text(&o.stdout)
     );
 
+    // observations.csv starts with its header row (its notes in observations.json) and opens
+    // in pandas, csv and numpy with default arguments.
+    let obs_csv = s.path("out/observations.csv");
+    assert!(std::fs::read_to_string(&obs_csv)
+        .unwrap()
+        .starts_with("capture,id,u_px,v_px,score\n"));
+    let side: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(s.path("out/observations.json")).unwrap()).unwrap();
+    assert_eq!(side["file"], "observations.csv");
+    crate::default_readers::default_readers_check(
+        s.dir.path(),
+        &serde_json::json!({"csv": [crate::default_readers::csv_spec(
+            &obs_csv,
+            &["capture", "id", "u_px", "v_px", "score"],
+            Some(40),
+        )]}),
+    );
+
     // Every planned pin of every capture found, with its id, at its imprint's centroid.
     let found = observations(&s.path("out/observations.csv"));
     assert_eq!(
@@ -259,6 +277,13 @@ fn pins_found_in_photos_get_the_plans_ids_and_give_the_pose() {
     assert_eq!(j["residuals"]["observations"], 29);
     assert_eq!(j["provenance"]["reference_image"], "reference.png");
     assert_eq!(j["provenance"]["observation_files"][2], "capture_3.jpg");
+
+    // The residual histogram: bars for the 29 inliers' errors.
+    let hist = image::open(s.path("out/residuals.png"))
+        .unwrap()
+        .into_rgb8();
+    assert_eq!(hist.dimensions(), (480, 260));
+    assert!(hist.pixels().filter(|p| p.0 == [60, 110, 200]).count() > 29 * 10);
 
     // An overlay per capture, the camera's size, each spot circled in green.
     for (k, name) in names.iter().enumerate() {

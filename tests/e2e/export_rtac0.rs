@@ -182,6 +182,14 @@ fn same_input_same_bytes_whatever_the_thread_count() {
             .iter()
             .map(|f| f.strip_prefix(&second).unwrap().to_path_buf()),
     );
+    // the pictures of the parts and plates (rendered in parallel)
+    let mut previews: Vec<PathBuf> = std::fs::read_dir(second.join("previews"))
+        .unwrap()
+        .map(|e| PathBuf::from("previews").join(e.unwrap().file_name()))
+        .collect();
+    previews.sort();
+    assert_eq!(previews.len(), 9 + 3, "{previews:?}");
+    names.extend(previews);
     for n in names {
         let a = std::fs::read(first.join(&n)).unwrap();
         let b = std::fs::read(second.join(&n)).unwrap();

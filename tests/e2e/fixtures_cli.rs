@@ -63,10 +63,11 @@ fn rtac0_fixtures_export_is_complete_deterministic_and_printable() {
         );
     }
 
-    // Point table: CSV with # header lines, 29 rows, ids 1..29, the same numbers as the JSON.
+    // Point table: CSV starting with its header row (the notes, frame and provenance are in
+    // point_table.json), 29 rows, ids 1..29, the same numbers as the JSON.
     let csv = std::fs::read_to_string(a.join("points/point_table.csv")).unwrap();
-    assert!(csv.starts_with("# "));
-    assert!(csv.contains("frame: sensor frame"));
+    assert!(csv.starts_with("id,ring,"));
+    assert!(!csv.contains('#'));
     let rows: Vec<Vec<f64>> = csv
         .lines()
         .filter(|l| !l.starts_with('#') && !l.starts_with("id,"))
@@ -75,6 +76,10 @@ fn rtac0_fixtures_export_is_complete_deterministic_and_printable() {
     assert_eq!(rows.len(), 29);
     let json: serde_json::Value =
         serde_json::from_slice(&std::fs::read(a.join("points/point_table.json")).unwrap()).unwrap();
+    assert!(json["notes"][1]
+        .as_str()
+        .unwrap()
+        .contains("frame: sensor frame"));
     let pts = json["points"].as_array().unwrap();
     for (r, p) in rows.iter().zip(pts) {
         assert_eq!(r[0] as u64, p["id"].as_u64().unwrap());
@@ -88,6 +93,7 @@ fn rtac0_fixtures_export_is_complete_deterministic_and_printable() {
         }
     }
     let plan = std::fs::read_to_string(a.join("points/capture_plan.csv")).unwrap();
+    assert!(plan.starts_with("capture,id,ring\n"));
     let plan_rows: Vec<Vec<u32>> = plan
         .lines()
         .filter(|l| !l.starts_with('#') && !l.starts_with("capture"))

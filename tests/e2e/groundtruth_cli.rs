@@ -11,7 +11,7 @@ use fabkit_calibration::nalgebra::Vector2;
 use fabkit_calibration::synthetic::benchmark_intrinsics;
 use fabkit_calibration::{write_camera, CameraFileFormat, CameraModel};
 
-fn setup(dir: &Path) {
+pub(crate) fn setup(dir: &Path) {
     let o = run(
         dir,
         &[
@@ -65,7 +65,7 @@ fn setup(dir: &Path) {
     .unwrap();
 }
 
-fn groundtruth(dir: &Path, out: &str, threads: &str) -> std::process::Output {
+pub(crate) fn groundtruth(dir: &Path, out: &str, threads: &str) -> std::process::Output {
     run(
         dir,
         &[

@@ -112,6 +112,11 @@ fn lib3mf_check(files: &[PathBuf]) {
     for f in j["files"].as_array().unwrap() {
         assert_eq!(f["ok"], true, "{f}");
         assert_eq!(f["warnings"].as_array().unwrap().len(), 0, "{f}");
+        // the kit and plate 3MFs carry their picture as the package thumbnail
+        if !f["file"].as_str().unwrap().ends_with("assembly.3mf") {
+            assert_eq!(f["thumbnail"]["path"], "/Metadata/thumbnail.png", "{f}");
+            assert!(f["thumbnail"]["bytes"].as_u64().unwrap() > 1000, "{f}");
+        }
         for obj in f["objects"].as_array().unwrap() {
             for key in ["role", "material", "technology"] {
                 if f["file"].as_str().unwrap().ends_with("assembly.3mf") && key != "role" {

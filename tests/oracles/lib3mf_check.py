@@ -15,7 +15,8 @@ whole model part was read. Prints ONE JSON document on stdout:
                            "triangles": N | null, "vertices": N | null, "components": N | null,
                            "bbox_mm": [[minx, miny, minz], [maxx, maxy, maxz]] | null}],
               "build_items": [{"object_id": int, "object_name": str, "transform": [12 numbers],
-                               "metadata": {KEY: value}, "bbox_mm": [[...], [...]] | null}]}]}
+                               "metadata": {KEY: value}, "bbox_mm": [[...], [...]] | null}],
+              "thumbnail": null | {"path": "/Metadata/thumbnail.png", "bytes": N}}]}
 
 - Metadata keys: lib3mf gives a metadatum's namespace URI and local name, never the prefix the file
   used, so a namespaced key is written in Clark notation, "{URI}name" (the fabkit role is
@@ -29,6 +30,8 @@ whole model part was read. Prints ONE JSON document on stdout:
   vectors [x y z 1] times the item's 4x3 matrix (the 3MF convention). Both are scaled from the
   model's unit to mm. `triangles`/`vertices` are null for a components object, `components` is null
   for a mesh object.
+- `thumbnail`: the package thumbnail lib3mf found (the root relationship of type .../metadata/
+  thumbnail), its part name and size; null when the package has none.
 Exit status: 0 when every file is ok with no warnings, 1 otherwise (the JSON is printed either
 way), 2 on a usage error.
 """
@@ -112,7 +115,7 @@ def object_points(model, obj, cache: dict, depth: int = 0) -> np.ndarray:
 
 def check(wrapper, path: str) -> dict:
     res = {"file": path, "ok": False, "error": None, "warnings": [], "unit": None,
-           "model_metadata": {}, "objects": [], "build_items": []}
+           "model_metadata": {}, "objects": [], "build_items": [], "thumbnail": None}
     model = wrapper.CreateModel()
     reader = model.QueryReader("3mf")
     reader.SetStrictModeActive(True)
@@ -161,6 +164,9 @@ def check(wrapper, path: str) -> dict:
                 "metadata": metadata(item.GetMetaDataGroup()),
                 "bbox_mm": bbox(apply(object_points(model, obj, cache), m), scale_mm),
             })
+        if model.HasPackageThumbnailAttachment():
+            a = model.GetPackageThumbnailAttachment()
+            res["thumbnail"] = {"path": a.GetPath(), "bytes": a.GetStreamSize()}
     except (lib3mf.ELib3MFException, RecursionError) as e:
         name = getattr(e, "error_name", type(e).__name__)
         res["error"] = f"{name}: {getattr(e, 'error_message', None) or e}"

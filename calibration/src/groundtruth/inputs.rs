@@ -326,13 +326,16 @@ pub fn read_fixtures(dir: &Path, design_name: &str) -> Result<Fixtures, InputErr
     })
 }
 
+/// What `pairs.csv` holds: the `notes` of its entry in the ground truth's manifest.
+pub const PAIRS_NOTES: &str = "stitched pairs: depth = right_dir/* on right_mask.png, left_dir/* on left_mask.png (R-Tac0 Sec. IV-B)";
+
 /// `pairs.csv`: every stitched left/right pair (R-Tac0 Sec. IV-B, Fig. 6 right): the right
 /// (+x) half of `<right_pattern>_0` (pattern on +x, empty half on -x) with the left (-x) half
 /// of `<left_pattern>_180` (pattern on -x). N patterns give N x N rows, right pattern major.
+/// The header row comes first; what the columns mean ([`PAIRS_NOTES`]) is in the manifest's
+/// `pairs.csv` entry.
 pub fn pairs_csv(patterns: &[String]) -> String {
-    let mut s = String::from(
-        "# stitched pairs: depth = right_dir/* on right_mask.png, left_dir/* on left_mask.png (R-Tac0 Sec. IV-B)\npair,right_pattern,right_dir,left_pattern,left_dir\n",
-    );
+    let mut s = String::from("pair,right_pattern,right_dir,left_pattern,left_dir\n");
     let mut k = 0;
     for r in patterns {
         for l in patterns {

@@ -19,6 +19,36 @@ fn fixtures_table_gives_tip_or_contact_columns() {
     assert_eq!(c.rows[0].1, Vector3::new(0.0, 0.0, 16.15));
 }
 
+/// Tables written before the header row came first (leading `#` lines, users' old files) and
+/// the current header-first ones read the same rows; only the cited lines move.
+#[test]
+fn header_first_and_old_comment_headed_tables_read_the_same() {
+    use fabkit_calibration::tables::parse_capture_plan;
+    let header_first: String = FIXTURES
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    assert!(header_first.starts_with("id,ring,"));
+    for from in [PointsFrom::Tip, PointsFrom::Contact] {
+        let old = parse_point_table(FIXTURES, "pins.csv", from).unwrap();
+        let new = parse_point_table(&header_first, "pins.csv", from).unwrap();
+        let strip = |t: &fabkit_calibration::tables::PointTable| {
+            t.rows
+                .iter()
+                .map(|r| (r.0.clone(), r.1))
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(strip(&old), strip(&new));
+        assert_eq!(new.rows[1].2, "pins.csv:3");
+    }
+    let new_plan = parse_capture_plan("capture,id,ring\n1,0,0\n1,1,1\n2,0,0\n2,2,1\n", "p.csv");
+    assert_eq!(
+        new_plan.unwrap().captures,
+        parse_capture_plan(PLAN, "p.csv").unwrap().captures
+    );
+}
+
 #[test]
 fn plain_xyz_table_is_read() {
     let t = parse_point_table(

@@ -3,8 +3,8 @@
 Usage: python -m twins.step_export PARTS.json OUT_DIR [ASSEMBLY.step]
 
 PARTS.json: {"chord_tolerance_mm": tol, "parts": [manifest part, ...]} (name, role, params,
-volume_mm3, surface_area_mm2, bbox_mm as in manifest.json). Writes OUT_DIR/<name>.step per part,
-in print orientation, mm. Before writing, the exact solid's volume must be within the chord
+volume_mm3, surface_area_mm2, bbox_mm as in manifest.json). Writes OUT_DIR/<name>.step per part
+(its one PRODUCT named <name>), in print orientation, mm. Before writing, the exact solid's volume must be within the chord
 bound of fabkit's (|dV| <= area x tol + 1e-6 V) and its bounding box within tol + 1 um: a twin
 that disagrees with fabkit's part would write a wrong STEP file.
 
@@ -45,12 +45,26 @@ def write_step(shape, path: Path, name: str) -> None:
 
     Interface_Static.SetCVal_s("write.step.schema", "AP214IS")
     Interface_Static.SetCVal_s("write.step.unit", "MM")
-    Interface_Static.SetCVal_s("write.step.product.name", name)
     w = STEPControl_Writer()
     w.Transfer(shape.wrapped, STEPControl_AsIs)
+    name_products(w.Model(), name)
     write_header(w.Model(), name)
     if w.Write(str(path)) != IFSelect_RetDone:
         raise RuntimeError(f"OCCT could not write {path}")
+
+
+def name_products(model, name: str) -> None:
+    """Names the file's PRODUCT (id and name) `name`, the part's name. OCCT 7.9 names it
+    "Open CASCADE STEP translator 7.9 1" and ignores `write.step.product.name` set before the
+    writer is made (set after, it gives "name 1"), so the transferred entity is renamed."""
+    from OCP.StepBasic import StepBasic_Product
+    from OCP.TCollection import TCollection_HAsciiString
+
+    for i in range(1, model.NbEntities() + 1):
+        e = model.Value(i)
+        if isinstance(e, StepBasic_Product):
+            e.SetId(TCollection_HAsciiString(name))
+            e.SetName(TCollection_HAsciiString(name))
 
 
 def write_header(model, name: str) -> None:

@@ -341,8 +341,9 @@ fn same_kit_gives_byte_identical_files() {
     write_kit(&test_kit(), &b, &opts()).unwrap();
     let files = tree(&a);
     assert_eq!(files, tree(&b));
-    // parts, manifest, 3MF, FABRICATION.md, the marker, the FDM and SLA plates
-    assert_eq!(files.len(), 5 + 3 + 1 + 2);
+    // parts, manifest, 3MF, FABRICATION.md, the marker, the FDM and SLA plates, the parts'
+    // and plates' pictures, FABRICATION.html
+    assert_eq!(files.len(), 5 + 3 + 1 + 2 + 5 + 2 + 1);
     for f in &files {
         assert_eq!(
             fs::read(a.join(f)).unwrap(),
@@ -362,7 +363,12 @@ fn same_kit_gives_byte_identical_files() {
     }
     assert_eq!(
         names,
-        ["[Content_Types].xml", "_rels/.rels", "3D/3dmodel.model"]
+        [
+            "[Content_Types].xml",
+            "_rels/.rels",
+            "3D/3dmodel.model",
+            "Metadata/thumbnail.png"
+        ]
     );
 }
 
@@ -589,7 +595,7 @@ fn a_group_is_one_3mf_object_with_a_volume_per_part_and_stls_stay_put() {
          `skin+dots` of `grouped.3mf` holds them in place as its parts (one volume each), \
          assign materials: `skin` Stratasys Tango Black+ (PolyJet, Shore A 26-28) (extruder 1), \
          `dots` Stratasys Vero White (PolyJet, rigid) (extruder 2).",
-        "- kit 3MF: `grouped.3mf` (2 objects laid out on one plate)",
+        "- kit 3MF: `grouped.3mf` (2 objects in one file, for viewing the whole kit; print from the plates below)",
     ] {
         assert!(sheet.contains(needle), "missing {needle:?} in\n{sheet}");
     }
@@ -764,7 +770,15 @@ fn formats_select_the_mesh_files() {
     write_kit(&test_kit(), &stl_only, &o).unwrap();
     assert!(!stl_only.join("tiny.3mf").exists());
     assert!(stl_only.join("parts/ring.stl").exists());
-    assert!(read_manifest(&stl_only).kit_3mf.is_none());
+    let m = read_manifest(&stl_only);
+    assert!(m.kit_3mf.is_none());
+    // pictures of the parts with any mesh format; no plates, so no plate pictures
+    assert!(m
+        .parts
+        .iter()
+        .all(|p| p.preview.as_deref() == Some(&format!("previews/{}.png", p.name))));
+    assert!(stl_only.join("previews/ring.png").exists());
+    assert_eq!(fs::read_dir(stl_only.join("previews")).unwrap().count(), 5);
 
     o.formats = Formats {
         stl: false,
@@ -776,15 +790,56 @@ fn formats_select_the_mesh_files() {
         tree(&mf_only),
         [
             PathBuf::from(".fabkit-output"),
+            "FABRICATION.html".into(),
             "FABRICATION.md".into(),
             "manifest.json".into(),
             "plates/tiny_fdm_pla_black_1.3mf".into(),
             "plates/tiny_sla_pla_black_1.3mf".into(),
+            "previews/base_plate.png".into(),
+            "previews/dome.png".into(),
+            "previews/pillar.png".into(),
+            "previews/plate_tiny_fdm_pla_black_1.png".into(),
+            "previews/plate_tiny_sla_pla_black_1.png".into(),
+            "previews/ring.png".into(),
+            "previews/wide_tray.png".into(),
             "tiny.3mf".into()
         ]
     );
-    assert_eq!(s.files.len(), 5);
+    assert_eq!(s.files.len(), 13);
     let m = read_manifest(&mf_only);
+    assert_eq!(
+        m.plates
+            .iter()
+            .map(|p| (
+                p.preview.clone().unwrap(),
+                p.preview_sha256.clone().unwrap()
+            ))
+            .collect::<Vec<_>>(),
+        ["tiny_fdm_pla_black_1", "tiny_sla_pla_black_1"].map(|stem| {
+            let rel = format!("previews/plate_{stem}.png");
+            let sha = sha256_hex(&fs::read(mf_only.join(&rel)).unwrap());
+            (rel, sha)
+        })
+    );
+    // each plate's picture is its 3MF's package thumbnail, related from the package root
+    let plate = fs::read(mf_only.join("plates/tiny_fdm_pla_black_1.3mf")).unwrap();
+    let mut zip = zip::ZipArchive::new(std::io::Cursor::new(&plate[..])).unwrap();
+    let mut thumbnail = Vec::new();
+    std::io::Read::read_to_end(
+        &mut zip.by_name("Metadata/thumbnail.png").unwrap(),
+        &mut thumbnail,
+    )
+    .unwrap();
+    assert_eq!(
+        thumbnail,
+        fs::read(mf_only.join("previews/plate_tiny_fdm_pla_black_1.png")).unwrap()
+    );
+    assert!(zip_text(&plate, "_rels/.rels").unwrap().contains(
+        r#"<Relationship Target="/Metadata/thumbnail.png" Id="rel1" Type="http://schemas.openxmlformats.org/package/2006/relationships/metadata/thumbnail"/>"#
+    ));
+    assert!(zip_text(&plate, "[Content_Types].xml")
+        .unwrap()
+        .contains(r#"<Default Extension="png" ContentType="image/png"/>"#));
     assert!(m
         .parts
         .iter()
