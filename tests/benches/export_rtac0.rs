@@ -10,6 +10,8 @@
 //!   directory under a temporary parent, replaced by every iteration. This is what `fabkit export`
 //!   does minus process start, YAML parsing, the CSG dump and printing.
 //!
+//! - `pictures`: the part previews and a plate picture alone (see [`bench_pictures`]).
+//!
 //! Run: `cargo bench -p fabkit-benches --bench export_rtac0` (about a minute on 2 cores). Every iteration
 //! takes a sizeable fraction of a second, so sampling is flat: 10 samples of one or a few
 //! iterations each; the numbers are per iteration. `scripts/bench-compare` times the whole command against
@@ -94,5 +96,49 @@ fn bench_export(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench_build_kit, bench_export);
+/// `pictures/<strategy>`: the pictures alone, as the export makes them: every part's preview
+/// ([`part_pngs`]) and, for the plates, one picture of every part on a bed plus a thumbnail
+/// copy (rtac0 has three plates of fewer parts: an upper bound). `export - pictures` is the
+/// export without them.
+fn bench_pictures(c: &mut Criterion) {
+    use fabkit::export::preview::{part_pngs, render_plate, BedOutline, PlacedObject};
+    let tol = ChordTolerance::new(CHORD_TOLERANCE_MM).expect("0.01 mm is a valid tolerance");
+    let mut group = c.benchmark_group("pictures");
+    configure(&mut group, 4);
+    for (name, strategy) in STRATEGIES {
+        let kit = build_kit(&design_with(strategy), tol).expect("the library design builds");
+        let meshes: Vec<_> = kit.parts.iter().map(|p| p.written_mesh()).collect();
+        let named: Vec<(&str, &fabkit::designs::Mesh)> = kit
+            .parts
+            .iter()
+            .zip(&meshes)
+            .map(|(p, m)| (p.name.as_str(), m))
+            .collect();
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                let parts = part_pngs(black_box(&named)).expect("previews encode");
+                let placed: Vec<PlacedObject<'_>> = meshes
+                    .iter()
+                    .enumerate()
+                    .map(|(k, m)| PlacedObject {
+                        meshes: vec![m],
+                        turned: false,
+                        translation_mm: [60.0 * (k % 4) as f64, 60.0 * (k / 4) as f64, 0.0],
+                    })
+                    .collect();
+                let plate = render_plate(
+                    &placed,
+                    Some(BedOutline {
+                        size_xy_mm: [250.0, 210.0],
+                        margin_mm: 10.0,
+                    }),
+                );
+                (parts, plate.png("plate").expect("plate encodes"))
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench_build_kit, bench_export, bench_pictures);
 criterion_main!(benches);
