@@ -206,6 +206,17 @@ pub enum Technology {
     Polyjet,
 }
 
+impl From<crate::kit::PrintTechnology> for Technology {
+    fn from(t: crate::kit::PrintTechnology) -> Self {
+        use crate::kit::PrintTechnology as P;
+        match t {
+            P::Fdm => Self::Fdm,
+            P::Sla => Self::Sla,
+            P::Polyjet => Self::Polyjet,
+        }
+    }
+}
+
 impl From<Technology> for crate::kit::PrintTechnology {
     fn from(t: Technology) -> Self {
         match t {

@@ -157,7 +157,7 @@ pub(crate) fn plates(
     let to_units = |mm: f64| (mm * PACK_UNITS_PER_MM).ceil().max(1.0) as u32;
     let mut plates = Vec::new();
     for (tech, material, members) in sets {
-        let bed = printers.bed(technology_key(tech));
+        let bed = printers.bed(Technology::from(tech));
         let [ux, uy] = bed.usable_xy_mm();
         // each unit's box, turned when it fits only so
         let mut boxes: Vec<(usize, bool, Aabb)> = Vec::with_capacity(members.len());
@@ -237,14 +237,6 @@ pub(crate) fn plates(
         }
     }
     Ok(plates)
-}
-
-fn technology_key(t: PrintTechnology) -> Technology {
-    match t {
-        PrintTechnology::Fdm => Technology::Fdm,
-        PrintTechnology::Sla => Technology::Sla,
-        PrintTechnology::Polyjet => Technology::Polyjet,
-    }
 }
 
 fn union(a: &Aabb, b: &Aabb) -> Aabb {
