@@ -24,6 +24,27 @@ pub fn build_kit(design: &Design, tol: ChordTolerance) -> Result<Kit, DesignErro
     build_kit_bounded(design, tol, u64::MAX)
 }
 
+/// Validates `design` as `fabkit validate` does and returns its resolved layer stack: for a
+/// curved skin the [`Stack`] ([`crate::stack::validate`]) as JSON, for a flat skin
+/// `{"flat_layers": [...]}` ([`crate::flat::validate`]); mm, inner to outer.
+///
+/// # Errors
+/// [`DesignError::Params`] with every violated rule at once (parameter path, value, rule);
+/// [`DesignError::Yaml`] if the embedded materials table does not load (a defect).
+pub fn validate_design(
+    design: &Design,
+    tol: ChordTolerance,
+) -> Result<serde_json::Value, DesignError> {
+    let materials = MaterialsTable::embedded().map_err(DesignError::Yaml)?;
+    if design.body.flat_outline().is_some() {
+        let layers = crate::flat::validate(design, &materials)?;
+        Ok(json!({ "flat_layers": layers }))
+    } else {
+        let stack = validate(design, &materials, tol)?;
+        serde_json::to_value(stack).map_err(|e| DesignError::Yaml(e.to_string()))
+    }
+}
+
 /// [`build_kit`], refused before anything is built when the kit's estimated triangles pass
 /// `max_triangles` ([`crate::estimate::check_work`]; `fabkit export --max-triangles`).
 ///

@@ -34,7 +34,7 @@ pub mod stack;
 pub mod sweep;
 pub mod values;
 
-pub use build::{build_kit, build_kit_bounded};
+pub use build::{build_kit, build_kit_bounded, validate_design};
 pub use error::{DesignError, ParamError, ParamErrors};
 pub use geometry::{ChordTolerance, Mesh, Solid};
 pub use kit::{Kit, Part, PrintTechnology};

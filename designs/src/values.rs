@@ -291,6 +291,93 @@ pub fn with_number<T: Serialize + serde::de::DeserializeOwned>(
     T::deserialize(v).map_err(|e| e.to_string())
 }
 
+impl NumberPath {
+    /// Parses a parameter path as presets and sweeps write it: keys joined by `.`, list items
+    /// as `[i]` (`layers[1].outer_radius_mm`; `layers.1.outer_radius_mm` also reads). `None`
+    /// for an empty path, an empty key or a malformed index.
+    pub fn parse(path: &str) -> Option<NumberPath> {
+        let mut steps = Vec::new();
+        for part in path.split('.') {
+            let (key, mut rest) = match part.find('[') {
+                Some(i) => (&part[..i], &part[i..]),
+                None => (part, ""),
+            };
+            if key.is_empty() && steps.is_empty() {
+                return None;
+            }
+            if !key.is_empty() {
+                match key.parse::<usize>() {
+                    Ok(i) if !steps.is_empty() => steps.push(Step::Index(i)),
+                    _ => steps.push(Step::Key(key.to_string())),
+                }
+            } else if rest.is_empty() {
+                return None;
+            }
+            while let Some(s) = rest.strip_prefix('[') {
+                let j = s.find(']')?;
+                steps.push(Step::Index(s[..j].parse().ok()?));
+                rest = &s[j + 1..];
+            }
+            if !rest.is_empty() {
+                return None;
+            }
+        }
+        Some(NumberPath(steps))
+    }
+}
+
+/// The value at `path` in `value`'s serialized form (NaN kept); `None` when the path leads
+/// nowhere. An optional field that is unset reads as `Value::Option(None)`.
+pub fn value_at_path<T: Serialize>(value: &T, path: &NumberPath) -> Option<Value> {
+    fn find<'a>(v: &'a Value, path: &[Step]) -> Option<&'a Value> {
+        let Some((first, rest)) = path.split_first() else {
+            return Some(v);
+        };
+        match (first, v) {
+            (_, Value::Option(Some(x))) | (_, Value::Newtype(x)) => find(x, path),
+            (Step::Key(k), Value::Map(m)) => find(m.get(&Value::String(k.clone()))?, rest),
+            (Step::Index(i), Value::Seq(items)) => find(items.get(*i)?, rest),
+            _ => None,
+        }
+    }
+    let v = serde_value::to_value(value).ok()?;
+    find(&v, &path.0).cloned()
+}
+
+/// `value` with the value at `path` replaced by `new` (any value: NaN kept, a list, a whole
+/// object), read back through the type's own deserializer. The last key may name an optional
+/// field the value leaves unset.
+///
+/// # Errors
+/// `Err(None)` when the path leads nowhere; `Err(Some(message))` with the deserializer's
+/// message when `new` does not fit the schema there.
+pub fn with_value_at<T: Serialize + serde::de::DeserializeOwned>(
+    value: &T,
+    path: &NumberPath,
+    new: Value,
+) -> Result<T, Option<String>> {
+    fn slot<'a>(v: &'a mut Value, path: &[Step]) -> Option<&'a mut Value> {
+        let Some((first, rest)) = path.split_first() else {
+            return Some(v);
+        };
+        match (first, v) {
+            (_, Value::Option(Some(x))) | (_, Value::Newtype(x)) => slot(x, path),
+            (Step::Key(k), Value::Map(m)) => {
+                let key = Value::String(k.clone());
+                if rest.is_empty() && !m.contains_key(&key) {
+                    m.insert(key.clone(), Value::Option(None));
+                }
+                slot(m.get_mut(&key)?, rest)
+            }
+            (Step::Index(i), Value::Seq(items)) => slot(items.get_mut(*i)?, rest),
+            _ => None,
+        }
+    }
+    let mut v = serde_value::to_value(value).map_err(|e| Some(e.to_string()))?;
+    *slot(&mut v, &path.0).ok_or(None)? = new;
+    T::deserialize(v).map_err(|e| Some(e.to_string()))
+}
+
 /// The paths where `typed` (a value as parsed into its schema type) holds a number that its
 /// YAML `text` wrote quoted (`radius_mm: "15.0"`): the parser converts a quoted scalar to the
 /// number the schema expects, which hides a value meant as text or typed in a spreadsheet.

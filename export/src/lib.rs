@@ -94,6 +94,69 @@ pub struct ExportOptions {
     pub printers: fabkit_designs::schema::PrinterProfiles,
 }
 
+impl ExportOptions {
+    /// The options of an export of the design read from `design_source` (its path, or
+    /// `embedded:<name>`) whose text hashes to `design_sha256`, built at `chord_tolerance_mm`,
+    /// by `command_line`, onto the beds of `printers`; this fabkit's version.
+    pub fn for_design(
+        formats: Formats,
+        command_line: Vec<String>,
+        design_source: &str,
+        design_sha256: &str,
+        chord_tolerance_mm: f64,
+        printers: fabkit_designs::schema::PrinterProfiles,
+    ) -> ExportOptions {
+        ExportOptions {
+            formats,
+            command_line,
+            design_source: design_source.to_string(),
+            design_sha256: design_sha256.to_string(),
+            chord_tolerance_mm,
+            fabkit_version: env!("CARGO_PKG_VERSION").to_string(),
+            printers,
+        }
+    }
+}
+
+/// Refuses to replace an earlier export in `out` whose kit (`design.name` in its manifest: the
+/// design, its preset and mold strategy) or chord tolerance differ from this one's (`kit`,
+/// `chord_tolerance_mm`), unless `force`. A folder without a readable manifest is left to the
+/// writer's own rules. `out_name` and `force_name` name the output and the override where the
+/// caller takes them (`--out` and `--force` on the command line).
+///
+/// # Errors
+/// The message names the output, the earlier kit and tolerance, this one's and the remedy.
+pub fn check_replacing(
+    out: &Path,
+    kit: &str,
+    chord_tolerance_mm: f64,
+    force: bool,
+    out_name: &str,
+    force_name: &str,
+) -> Result<(), String> {
+    let Ok(text) = std::fs::read(out.join("manifest.json")) else {
+        return Ok(());
+    };
+    let Ok(m) = serde_json::from_slice::<serde_json::Value>(&text) else {
+        return Ok(());
+    };
+    let (Some(prev), Some(prev_tol)) = (
+        m["design"]["name"].as_str(),
+        m["chord_tolerance_mm"].as_f64(),
+    ) else {
+        return Ok(());
+    };
+    if force || (prev == kit && prev_tol == chord_tolerance_mm) {
+        return Ok(());
+    }
+    Err(format!(
+        "{out_name} {}: holds the kit '{prev}' at chord tolerance {prev_tol} mm, made with other \
+         options than this export ('{kit}' at {chord_tolerance_mm} mm): refusing to replace it \
+         (hint: choose another {out_name}, or give {force_name} to replace it)",
+        out.display(),
+    ))
+}
+
 /// What [`write_kit`] wrote.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ExportSummary {
@@ -443,6 +506,52 @@ struct Rendered {
     manifest: Manifest,
 }
 
+/// The manifest's numbers of `part` whose written mesh ([`fabkit_designs::Part::written_mesh`])
+/// is `mesh`: volume (mm³), mass (g, from the density in `materials`; 0 when absent), surface
+/// area (mm²), bounding box (mm, print orientation), vertex and triangle counts, genus, and the
+/// part's role, material and parameters. `file` and `sha256` are `None`: what a written
+/// file adds.
+///
+/// # Errors
+/// [`ExportError::NotManifold`] for a mesh without triangles.
+pub fn part_entry(
+    part: &fabkit_designs::kit::Part,
+    mesh: &Mesh,
+    materials: Option<&fabkit_designs::materials::MaterialsTable>,
+) -> Result<ManifestPart, ExportError> {
+    let bbox = mesh
+        .bounding_box()
+        .ok_or_else(|| ExportError::NotManifold {
+            part: part.name.clone(),
+            source: TopologyError::Empty,
+        })?;
+    Ok(ManifestPart {
+        name: part.name.clone(),
+        file: None,
+        role: part.role.clone(),
+        description: part.description.clone(),
+        material: part.material.clone(),
+        material_name: product_name(materials, &part.material),
+        mass_g: materials
+            .and_then(|t| t.materials.get(&part.material))
+            .map_or(0.0, |m| mesh.signed_volume() / 1000.0 * m.density_g_per_cm3),
+        print_technology: part.print_technology,
+        group: part.group.clone(),
+        volume_mm3: mesh.signed_volume(),
+        surface_area_mm2: mesh.surface_area(),
+        bbox_mm: bbox,
+        vertices: mesh.vertices.len(),
+        triangles: mesh.triangles.len(),
+        genus: mesh.genus(),
+        sha256: None,
+        step_file: None,
+        step_sha256: None,
+        preview: None,
+        preview_sha256: None,
+        params: part.params.clone(),
+    })
+}
+
 fn render(
     kit: &Kit,
     meshes: &[Mesh],
@@ -455,39 +564,11 @@ fn render(
     // product names and densities of the printed materials
     let materials = fabkit_designs::materials::MaterialsTable::embedded().ok();
     for (part, mesh) in kit.parts.iter().zip(meshes) {
-        let bbox = mesh
-            .bounding_box()
-            .ok_or_else(|| ExportError::NotManifold {
-                part: part.name.clone(),
-                source: TopologyError::Empty,
-            })?;
+        let mut entry = part_entry(part, mesh, materials.as_ref())?;
         let (file, sha256) = stl_file(kit, opts, PARTS_DIR, &part.name, mesh, &mut files)?;
-        parts.push(ManifestPart {
-            name: part.name.clone(),
-            file,
-            role: part.role.clone(),
-            description: part.description.clone(),
-            material: part.material.clone(),
-            material_name: product_name(materials.as_ref(), &part.material),
-            mass_g: materials
-                .as_ref()
-                .and_then(|t| t.materials.get(&part.material))
-                .map_or(0.0, |m| mesh.signed_volume() / 1000.0 * m.density_g_per_cm3),
-            print_technology: part.print_technology,
-            group: part.group.clone(),
-            volume_mm3: mesh.signed_volume(),
-            surface_area_mm2: mesh.surface_area(),
-            bbox_mm: bbox,
-            vertices: mesh.vertices.len(),
-            triangles: mesh.triangles.len(),
-            genus: mesh.genus(),
-            sha256,
-            step_file: None,
-            step_sha256: None,
-            preview: None,
-            preview_sha256: None,
-            params: part.params.clone(),
-        });
+        entry.file = file;
+        entry.sha256 = sha256;
+        parts.push(entry);
     }
 
     let groups: Vec<_> = parts.iter().map(|p| p.group.as_deref()).collect();

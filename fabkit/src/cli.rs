@@ -182,29 +182,8 @@ pub(crate) fn check_replacing(
     tol: ChordTolerance,
     force: bool,
 ) -> Result<(), Box<dyn Error>> {
-    let Ok(text) = std::fs::read(out.join("manifest.json")) else {
-        return Ok(());
-    };
-    let Ok(m) = serde_json::from_slice::<serde_json::Value>(&text) else {
-        return Ok(());
-    };
-    let (Some(prev), Some(prev_tol)) = (
-        m["design"]["name"].as_str(),
-        m["chord_tolerance_mm"].as_f64(),
-    ) else {
-        return Ok(());
-    };
-    if force || (prev == kit && prev_tol == tol.mm()) {
-        return Ok(());
-    }
-    Err(format!(
-        "--out {}: holds the kit '{prev}' at chord tolerance {prev_tol} mm, made with other \
-         options than this export ('{kit}' at {} mm): refusing to replace it (hint: choose \
-         another --out, or give --force to replace it)",
-        out.display(),
-        tol.mm()
-    )
-    .into())
+    fabkit_export::check_replacing(out, kit, tol.mm(), force, "--out", "--force")
+        .map_err(Into::into)
 }
 
 /// `v` with every number that is not an integer rounded to 1e-9 (float noise such as
@@ -262,20 +241,18 @@ pub(crate) fn export_options(
     tol: ChordTolerance,
     format: &[Format],
 ) -> ExportOptions {
-    let printers = loaded.design.printers.clone();
-    ExportOptions {
-        formats: Formats {
+    ExportOptions::for_design(
+        Formats {
             stl: format.contains(&Format::Stl),
             threemf: format.contains(&Format::ThreeMf),
             step: format.contains(&Format::Step),
         },
-        command_line: std::env::args().collect(),
-        design_source: loaded.source.clone(),
-        design_sha256: loaded.sha256.clone(),
-        chord_tolerance_mm: tol.mm(),
-        fabkit_version: env!("CARGO_PKG_VERSION").to_string(),
-        printers,
-    }
+        std::env::args().collect(),
+        &loaded.source,
+        &loaded.sha256,
+        tol.mm(),
+        loaded.design.printers.clone(),
+    )
 }
 
 /// The first bytes of every CSG file fabkit writes (`serde_json` orders the keys).
@@ -387,17 +364,7 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
             if let Some(p) = &preset {
                 loaded.design = loaded.design.with_preset(p)?;
             }
-            let materials = fabkit_designs::materials::MaterialsTable::embedded()?;
-            let stack = if loaded.design.body.flat_outline().is_some() {
-                let layers = fabkit_designs::flat::validate(&loaded.design, &materials)
-                    .map_err(DesignError::from)?;
-                serde_json::json!({ "flat_layers": layers })
-            } else {
-                serde_json::to_value(
-                    fabkit_designs::stack::validate(&loaded.design, &materials, tol)
-                        .map_err(DesignError::from)?,
-                )?
-            };
+            let stack = fabkit_designs::validate_design(&loaded.design, tol)?;
             out!("{}: valid", loaded.source);
             out!(
                 "\nparameters of {} (each path can be set by a preset or varied by `fabkit sweep`; numbers rounded to 1e-9):",

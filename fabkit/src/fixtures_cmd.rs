@@ -4,7 +4,7 @@ use crate::cli::{export_options, load_design, tolerance, DataFileArgs, Format};
 use crate::progress::Progress;
 use fabkit_designs::ChordTolerance;
 use fabkit_export::write_kit_reporting;
-use fabkit_fixtures::params::{apply_pin_preset, from_yaml, FixtureParams};
+use fabkit_fixtures::params::{from_yaml, resolve};
 use fabkit_fixtures::FixtureProgress;
 use std::error::Error;
 use std::path::{Path, PathBuf};
@@ -62,37 +62,22 @@ pub fn run(args: FixturesArgs) -> Result<(), Box<dyn Error>> {
         loaded.design = loaded.design.with_preset(p)?;
     }
     crate::printers::apply(&args.printer, &mut loaded.design.printers)?;
-    let mut params = match &args.params {
+    let base = match &args.params {
         Some(path) => {
             // A regular file of bounded size, as a design file.
             let text = fabkit_designs::input_files::read_design_file(path)?;
-            from_yaml(&text, &path.display().to_string())?
+            Some(from_yaml(&text, &path.display().to_string())?)
         }
-        None => FixtureParams::default(),
+        None => None,
     };
-    if let Some(name) = &args.pins_preset {
-        apply_pin_preset(&mut params, name)?;
-    }
     // curved skins: semi-domes; flat skins: semi-plates
-    if let Some(n) = args.semidomes {
-        params.semidomes.generate = n;
-        params.semiplates.generate = n;
-    }
-    if let Some(s) = args.seed {
-        params.semidomes.seed = s;
-        params.semiplates.seed = s;
-    }
+    let params = resolve(base, args.pins_preset.as_deref(), args.semidomes, args.seed)?;
     let out = args
         .out
         .clone()
         .unwrap_or_else(|| Path::new("out").join(format!("{}_fixtures", loaded.design.name)));
-    let provenance = format!(
-        "fabkit {}, design {} ({}, sha256 {})",
-        env!("CARGO_PKG_VERSION"),
-        loaded.design.name,
-        loaded.source,
-        loaded.sha256
-    );
+    let provenance =
+        fabkit_fixtures::provenance(&loaded.design.name, &loaded.source, &loaded.sha256);
     if let Some(csg) = &args.csg {
         crate::cli::check_csg_path(csg)?;
     }

@@ -9,9 +9,9 @@ use fabkit_calibration::groundtruth::inputs::{
     pairs_csv, read_extrinsics, read_fixtures, read_with_hash, sha256_hex, Configuration,
     PAIRS_NOTES,
 };
-use fabkit_calibration::groundtruth::rays::PixelRays;
-use fabkit_calibration::groundtruth::surface::ReferenceSurface;
-use fabkit_calibration::groundtruth::{half_masks, indented_hits, reference_hits, DepthFrame};
+use fabkit_calibration::groundtruth::{
+    half_masks, indented_hits, reference_hits, DepthFrame, Scene,
+};
 use fabkit_calibration::read_camera_file_as;
 use fabkit_export::raster::{
     normals_rgb, npy_f32, npz as npz_file, ply_points, png_gray16, png_gray8, png_rgb8,
@@ -299,14 +299,10 @@ fn frame_files(
             DELTA_PNG,
             pr,
         )?;
-        let mask: Vec<u8> = (0..w * h)
-            .map(|p| {
-                if f.contact[p] && r.range_mm[p].is_finite() {
-                    255
-                } else {
-                    0
-                }
-            })
+        let mask: Vec<u8> = f
+            .contact_mask(r)
+            .iter()
+            .map(|&c| if c { 255 } else { 0 })
             .collect();
         let cm = format!("{dir}/contact_mask.png");
         files.push((cm.clone(), png_gray8(w, h, &mask, &[])?, json!({"file": cm, "quantity": "contact mask: 255 where a protrusion pushes the skin in (the surface seen is a protrusion), else 0", "dtype": "uint8", "shape": [h, w]})));
@@ -456,52 +452,16 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
     let (_, camera_sha) = read_with_hash(&args.camera)?;
     let (t_cam_sensor, extrinsics_sha) = read_extrinsics(&args.extrinsics)?;
     let fixtures = read_fixtures(&args.fixtures, &design.name)?;
-    let surface = ReferenceSurface::of(&design.body).ok_or_else(|| {
-        format!(
-            "body.profile = {}: no reference surface for this profile",
-            design.body.kind()
-        )
-    })?;
     let (fixture_kind, surface_text) = if design.body.flat_outline().is_some() {
         ("semi-plate", "the flat skin's contact face over its outline (its edges continued below the base plane bound the body); indented: the skin minus the protrusion solids")
     } else {
         ("semi-dome", "outer skin surface (body profile at offset 0) from the pole to the base plane; indented: the skin minus the protrusion solids")
     };
-    let rays = PixelRays::new(&camera, &t_cam_sensor);
+    let pose_name = args.extrinsics.display().to_string();
+    let scene = Scene::new(design, &camera, &t_cam_sensor, &pose_name)?;
+    scene.check_outside(&fixtures.configurations, &pose_name)?;
+    let Scene { surface, rays } = scene;
     let c = rays.origin_mm;
-    if !surface.contains(c, 0.0) {
-        let body = match design.body.flat_outline() {
-            Some(o) => format!(
-                "the {} x {} mm skin's contact face z = {} mm and its edges, continued below the base plane",
-                o.width_mm,
-                o.length_mm,
-                design.body.pole_z_mm(0.0)
-            ),
-            None => format!(
-                "skin surface, continued below the base plane z = {} mm at radius {:.3} mm",
-                surface.base_z_mm(),
-                surface.rim_radius_mm()
-            ),
-        };
-        return Err(format!(
-            "{}: the camera centre [{:.3}, {:.3}, {:.3}] mm (sensor frame) is outside the sensor body of {} ({body}): the camera must look at the skin from inside (hint: check that T_cam_sensor maps sensor-frame points into the camera frame)",
-            args.extrinsics.display(), c[0], c[1], c[2], design.name
-        )
-        .into());
-    }
-    if let Some(cfg) = fixtures
-        .configurations
-        .iter()
-        .find(|k| k.primitives.contains(c))
-    {
-        return Err(format!(
-            "{}: the camera centre is inside a protrusion of {} at {} deg",
-            args.extrinsics.display(),
-            cfg.pattern,
-            cfg.orientation_deg
-        )
-        .into());
-    }
     let (w, h) = (rays.width, rays.height);
     let n_cfg = fixtures.configurations.len();
     // The output is bounded before anything is rendered or written.

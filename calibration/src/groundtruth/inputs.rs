@@ -98,32 +98,7 @@ pub fn read_extrinsics(path: &Path) -> Result<(Isometry3<f64>, String), InputErr
         rule: rule.into(),
     };
     let from_matrix = match e.t_cam_sensor {
-        Some(m) => {
-            if m.iter().flatten().any(|v| !v.is_finite()) {
-                return Err(field("T_cam_sensor", format!("{m:?}"), "must be finite"));
-            }
-            if m[3] != [0.0, 0.0, 0.0, 1.0] {
-                return Err(field(
-                    "T_cam_sensor[3]",
-                    format!("{:?}", m[3]),
-                    "must be [0, 0, 0, 1]",
-                ));
-            }
-            let r = Matrix3::from_fn(|i, j| m[i][j]);
-            let err = (r.transpose() * r - Matrix3::identity()).abs().max();
-            if err > 1e-6 || (r.determinant() - 1.0).abs() > 1e-6 {
-                return Err(field(
-                    "T_cam_sensor",
-                    format!("{m:?}"),
-                    "the 3 x 3 block must be a rotation (orthonormal, determinant +1, to 1e-6)",
-                ));
-            }
-            let rot = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(r));
-            Some(Isometry3::from_parts(
-                Translation3::new(m[0][3], m[1][3], m[2][3]),
-                rot,
-            ))
-        }
+        Some(m) => Some(isometry_of(&m).map_err(|(f, v, rule)| field(&f, v, rule))?),
         None => None,
     };
     let from_vecs = match (e.rvec, e.tvec_mm) {
@@ -162,6 +137,38 @@ pub fn read_extrinsics(path: &Path) -> Result<(Isometry3<f64>, String), InputErr
             "give the 4 x 4 T_cam_sensor or rvec and tvec_mm (what `fabkit calibrate extrinsics` writes)",
         )),
     }
+}
+
+/// The rigid transform of a 4 x 4 matrix `m` (rows), such as `T_cam_sensor`.
+///
+/// # Errors
+/// (field, value, rule): a non-finite entry, a last row other than `[0, 0, 0, 1]`, or a 3 x 3
+/// block that is not a rotation (orthonormal, determinant +1, to 1e-6).
+pub fn isometry_of(m: &[[f64; 4]; 4]) -> Result<Isometry3<f64>, (String, String, &'static str)> {
+    if m.iter().flatten().any(|v| !v.is_finite()) {
+        return Err(("T_cam_sensor".into(), format!("{m:?}"), "must be finite"));
+    }
+    if m[3] != [0.0, 0.0, 0.0, 1.0] {
+        return Err((
+            "T_cam_sensor[3]".into(),
+            format!("{:?}", m[3]),
+            "must be [0, 0, 0, 1]",
+        ));
+    }
+    let r = Matrix3::from_fn(|i, j| m[i][j]);
+    let err = (r.transpose() * r - Matrix3::identity()).abs().max();
+    if err > 1e-6 || (r.determinant() - 1.0).abs() > 1e-6 {
+        return Err((
+            "T_cam_sensor".into(),
+            format!("{m:?}"),
+            "the 3 x 3 block must be a rotation (orthonormal, determinant +1, to 1e-6)",
+        ));
+    }
+    let rot = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(r));
+    Ok(Isometry3::from_parts(
+        Translation3::new(m[0][3], m[1][3], m[2][3]),
+        rot,
+    ))
 }
 
 #[derive(Deserialize)]

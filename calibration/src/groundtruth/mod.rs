@@ -27,6 +27,80 @@ use mesh::{MeshCaster, NO_HIT};
 use rays::PixelRays;
 use surface::ReferenceSurface;
 
+/// What the camera sees of a design's skin: its reference surface and the camera's per-pixel
+/// rays in the sensor frame, with the camera centre checked to be inside the sensor body.
+#[derive(Debug, Clone)]
+pub struct Scene {
+    pub surface: ReferenceSurface,
+    pub rays: PixelRays,
+}
+
+impl Scene {
+    /// The scene of `design` seen through `camera` at the pose `t_cam_sensor` (sensor frame ->
+    /// camera frame, mm). `pose_name` names where the pose came from in errors (the
+    /// extrinsics file).
+    ///
+    /// # Errors
+    /// A message naming the body profile when it has no reference surface, or naming
+    /// `pose_name`, the camera centre and the body when the centre is outside the sensor body
+    /// (the camera must look at the skin from inside).
+    pub fn new(
+        design: &fabkit_designs::Design,
+        camera: &crate::CameraModel,
+        t_cam_sensor: &nalgebra::Isometry3<f64>,
+        pose_name: &str,
+    ) -> Result<Scene, String> {
+        let surface = ReferenceSurface::of(&design.body).ok_or_else(|| {
+            format!(
+                "body.profile = {}: no reference surface for this profile",
+                design.body.kind()
+            )
+        })?;
+        let rays = PixelRays::new(camera, t_cam_sensor);
+        let c = rays.origin_mm;
+        if !surface.contains(c, 0.0) {
+            let body = match design.body.flat_outline() {
+                Some(o) => format!(
+                    "the {} x {} mm skin's contact face z = {} mm and its edges, continued below the base plane",
+                    o.width_mm,
+                    o.length_mm,
+                    design.body.pole_z_mm(0.0)
+                ),
+                None => format!(
+                    "skin surface, continued below the base plane z = {} mm at radius {:.3} mm",
+                    surface.base_z_mm(),
+                    surface.rim_radius_mm()
+                ),
+            };
+            return Err(format!(
+                "{pose_name}: the camera centre [{:.3}, {:.3}, {:.3}] mm (sensor frame) is outside the sensor body of {} ({body}): the camera must look at the skin from inside (hint: check that T_cam_sensor maps sensor-frame points into the camera frame)",
+                c[0], c[1], c[2], design.name
+            ));
+        }
+        Ok(Scene { surface, rays })
+    }
+
+    /// Checks that the camera centre is inside none of the protrusions of `configurations`.
+    ///
+    /// # Errors
+    /// A message naming `pose_name` and the first configuration (pattern and orientation)
+    /// whose protrusion holds the camera centre.
+    pub fn check_outside(
+        &self,
+        configurations: &[inputs::Configuration],
+        pose_name: &str,
+    ) -> Result<(), String> {
+        let c = self.rays.origin_mm;
+        match configurations.iter().find(|k| k.primitives.contains(c)) {
+            Some(cfg) => Err(format!(
+                "{pose_name}: the camera centre is inside a protrusion of {} at {} deg",
+                cfg.pattern, cfg.orientation_deg
+            )),
+            None => Ok(()),
+        }
+    }
+}
+
 /// The surface seen along every ray of a frame, sensor frame.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SurfaceHits {
@@ -185,6 +259,16 @@ impl DepthFrame {
             f.normal_cam[p] = rays.dir_to_camera(hits.normal[p]);
         }
         f
+    }
+
+    /// The contact mask of an indented frame: the pixels where a protrusion pushes the skin in
+    /// (the surface seen is a protrusion) and the ray meets the `reference` surface.
+    pub fn contact_mask(&self, reference: &DepthFrame) -> Vec<bool> {
+        self.contact
+            .iter()
+            .zip(&reference.range_mm)
+            .map(|(c, r)| *c && r.is_finite())
+            .collect()
     }
 
     /// `self - reference` for range and z-depth (indented minus reference, Eq. (2)-(3) of the

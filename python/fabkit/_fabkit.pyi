@@ -1,0 +1,283 @@
+"""Type stubs of fabkit's native module (PyO3). Units: mm, degrees, px; frames: docs/conventions.md.
+
+Every call that builds, renders or solves releases the GIL. Every error is a FabkitError subclass
+whose message is what the ``fabkit`` command line prints after ``error:`` for the same failure; a
+Rust panic is raised as InternalError, never passed to the interpreter.
+"""
+
+from os import PathLike
+from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+#: The library design `Design.load()` loads by default (`rtac0`).
+DEFAULT_DESIGN: str
+#: The default chord tolerance of every build, mm (0.01).
+DEFAULT_CHORD_TOLERANCE_MM: float
+
+StrPath = Union[str, PathLike]
+#: progress(done, total, message), called as long work advances (from any thread, GIL held).
+Progress = Callable[[int, int, str], Any]
+
+class FabkitError(Exception):
+    """Base class of every fabkit error."""
+
+class DesignError(FabkitError):
+    """A design or fixture parameters that do not load or break their rules.
+
+    ``errors`` lists every violated rule at once (empty for a YAML error, whose message gives
+    file:line:column)."""
+
+    errors: List[ParamError]
+
+class ExportError(FabkitError):
+    """An export that cannot be written; nothing is written then."""
+
+class CalibrationError(FabkitError):
+    """A camera, point set or observation set that cannot be read, or a pose that cannot be solved."""
+
+class GroundTruthError(FabkitError):
+    """Ground-truth inputs that cannot be read or rendered."""
+
+class InternalError(FabkitError):
+    """A defect in fabkit (a Rust panic caught at the boundary): please report it."""
+
+class ParamError:
+    """One violated rule: ``path = value: rule``."""
+
+    path: str
+    value: str
+    rule: str
+
+class Design:
+    """A parametric sensor design (the YAML schema of designs/library/*.yaml).
+
+    Parameters are read and set by the paths presets and sweep files use
+    (``design["layers[1].outer_radius_mm"] = 12.5``); a short path naming one parameter
+    (``markers.spacing_mm``) works too. Setting checks the value's type at once (DesignError);
+    the rules between parameters are checked by ``validate()`` and by every build."""
+
+    @staticmethod
+    def load(
+        source: Optional[StrPath] = None,
+        *,
+        allow_data_dirs: Sequence[StrPath] = ...,
+        max_data_file_bytes: Optional[int] = None,
+    ) -> Design:
+        """A library design by name (default ``rtac0``) or a YAML file (marker CSV files read
+        relative to it). Raises DesignError (file:line:column), TypeError."""
+    @staticmethod
+    def from_yaml(text: str, origin: str = "<yaml>") -> Design: ...
+    @staticmethod
+    def from_dict(data: Mapping[str, Any]) -> Design:
+        """A design from the YAML's form as a dict (what ``to_dict()`` returns)."""
+    def to_dict(self) -> Dict[str, Any]: ...
+    def to_json(self) -> str: ...
+    @property
+    def name(self) -> str: ...
+    @property
+    def source(self) -> str:
+        """The path, ``embedded:<name>``, ``<yaml>`` or ``<dict>``."""
+    @property
+    def sha256(self) -> str:
+        """sha256 of the design's text as loaded, as in an export's manifest."""
+    @property
+    def presets(self) -> List[str]: ...
+    def parameter_paths(self) -> List[str]: ...
+    def __getitem__(self, path: str) -> Any:
+        """The value at a parameter path; KeyError (with the nearest paths) for an unknown one."""
+    def __setitem__(self, path: str, value: Any) -> None:
+        """KeyError for an unknown path; DesignError (path, value, rule) for a value of the
+        wrong type."""
+    def with_values(self, values: Mapping[str, Any]) -> Design: ...
+    def with_preset(self, name: str) -> Design:
+        """The design with a preset applied (as ``--preset``), renamed ``<name>_<preset>``."""
+    def validate(self, chord_tolerance_mm: float = 0.01) -> Dict[str, Any]:
+        """Every rule at once, as ``fabkit validate``; returns the resolved layer stack (mm,
+        inner to outer). Raises DesignError whose ``errors`` lists every violation."""
+
+def library_designs() -> List[Tuple[str, str]]:
+    """(name, description) of every library design, as ``fabkit designs``."""
+
+class Part:
+    """One printable part, in print orientation (resting on z = 0), mm."""
+
+    @property
+    def name(self) -> str: ...
+    @property
+    def role(self) -> str: ...
+    @property
+    def material(self) -> str: ...
+    @property
+    def technology(self) -> str:
+        """``FDM`` or ``SLA``."""
+    def mesh(self) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.uint32]]:
+        """(vertices (n, 3) float64 mm, triangles (m, 3) uint32): the mesh ``fabkit export``
+        writes (float32-rounded coordinates, shared vertices, counter-clockwise from outside)."""
+    def numbers(self) -> Dict[str, Any]:
+        """The manifest's parts[] entry without file and sha256: volume_mm3, mass_g,
+        surface_area_mm2, bbox_mm, vertices, triangles, genus, role, material, params..."""
+
+class Kit:
+    """A built kit: the printable parts of a design and its pours."""
+
+    @property
+    def name(self) -> str: ...
+    @property
+    def design(self) -> Design: ...
+    @property
+    def chord_tolerance_mm(self) -> float: ...
+    @property
+    def parts(self) -> List[Part]: ...
+    def part(self, name: str) -> Part: ...
+    def casts(self) -> List[Dict[str, Any]]:
+        """The pour table in casting order, as the manifest's casts[]."""
+    def summary(self) -> Dict[str, Any]: ...
+    def export(
+        self,
+        out: StrPath,
+        *,
+        formats: Sequence[str] = ("stl", "3mf"),
+        force: bool = False,
+        command_line: Optional[Sequence[str]] = None,
+        progress: Optional[Progress] = None,
+    ) -> Dict[str, Any]:
+        """Writes the folder ``fabkit export`` (or ``fabkit fixtures``) writes, byte for byte
+        for the same options and ``command_line``; returns the manifest. Raises ExportError;
+        nothing is written then."""
+    def __len__(self) -> int: ...
+
+def build_kit(
+    design: Design,
+    *,
+    chord_tolerance_mm: float = 0.01,
+    max_triangles: int = ...,
+    progress: Optional[Progress] = None,
+) -> Kit:
+    """Validates and builds the kit (as ``fabkit export``), refused before building when
+    estimated over ``max_triangles``. Raises DesignError, ValueError."""
+
+class Fixtures:
+    """A design's calibration fixtures: printable parts and data files."""
+
+    @property
+    def kit(self) -> Kit: ...
+    @property
+    def point_table(self) -> Dict[str, np.ndarray]:
+        """point_table.csv as arrays, sensor frame, mm: id (n,) uint32, ring (n,) uint32,
+        tip_mm (n, 3), contact_mm (n, 3), axis (n, 3) unit, indentation_depth_mm (n,)."""
+    @property
+    def capture_plan(self) -> List[List[int]]: ...
+    @property
+    def files(self) -> Dict[str, bytes]: ...
+
+def build_fixtures(
+    design: Design,
+    *,
+    params: Union[None, Mapping[str, Any], StrPath] = None,
+    pins_preset: Optional[str] = None,
+    semidomes: Optional[int] = None,
+    seed: Optional[int] = None,
+    chord_tolerance_mm: float = 0.01,
+    max_triangles: int = ...,
+    progress: Optional[Progress] = None,
+) -> Fixtures:
+    """As ``fabkit fixtures`` (``--params``, ``--pins-preset``, ``--semidomes``, ``--seed``)."""
+
+class Camera:
+    """Intrinsics (px), image size and lens distortion (``fisheye``, ``plumb_bob``,
+    ``rational_polynomial`` as OpenCV). Camera frame x right, y down, z forward."""
+
+    def __init__(
+        self,
+        fx_px: float,
+        fy_px: float,
+        cx_px: float,
+        cy_px: float,
+        width_px: int,
+        height_px: int,
+        distortion_model: str = "plumb_bob",
+        coefficients: Sequence[float] = (0.0, 0.0, 0.0, 0.0, 0.0),
+    ) -> None: ...
+    @staticmethod
+    def from_file(path: StrPath, model: Optional[str] = None) -> Camera:
+        """OpenCV YAML/XML, ROS camera_info YAML or fabkit JSON (as ``--camera``, with
+        ``--camera-model`` ``model``). Raises CalibrationError naming file, line and field."""
+    @property
+    def intrinsics(self) -> Dict[str, Any]: ...
+    @property
+    def shape(self) -> Tuple[int, int]:
+        """(height, width), px."""
+    def project(self, points_mm: npt.ArrayLike) -> npt.NDArray[np.float64]:
+        """Camera-frame points (n, 3) mm to pixels (n, 2) px; NaN where not imaged."""
+
+def solve_extrinsics(
+    points_mm: npt.ArrayLike,
+    pixels_px: npt.ArrayLike,
+    camera: Union[Camera, StrPath],
+    *,
+    ids: Optional[Sequence[str]] = None,
+    ransac: bool = True,
+    threshold_px: float = 3.0,
+    seed: int = 0,
+) -> Dict[str, Any]:
+    """The camera pose from sensor-frame points (n, 3) mm and pixels (n, 2) px, as ``fabkit
+    calibrate extrinsics``. Returns T_cam_sensor (4, 4) (sensor -> camera, mm), residuals_px
+    (n, 2) (NaN where a point does not project), inliers and outliers (n,) bool,
+    rms_reprojection_error_px and report (extrinsics.json's content). Raises CalibrationError
+    (a non-finite entry: ``points_mm[i, j] = nan: must be finite``), ValueError (shapes)."""
+
+class ProtrusionSet:
+    """One semi-dome (semi-plate) configuration: a pattern at 0 deg (+x half) or 180 deg."""
+
+    @property
+    def name(self) -> str:
+        """``<pattern>_<orientation_deg>``, the frame's folder in a ground-truth output."""
+    @property
+    def pattern(self) -> str: ...
+    @property
+    def orientation_deg(self) -> int: ...
+    def __len__(self) -> int: ...
+
+def read_protrusions(fixtures_dir: StrPath, design: Design) -> List[ProtrusionSet]:
+    """The configurations of a ``fabkit fixtures`` folder (protrusions/index.json), two per
+    pattern in index order. Raises GroundTruthError naming the file."""
+
+class DepthRenderer:
+    """Ground-truth depth of a design's skin through a calibrated camera (R-Tac0 Sec. IV-B,
+    Eq. (2)-(3)), the frames ``fabkit groundtruth`` writes, as arrays: (H, W) row-major
+    float32, NaN where the pixel's ray misses the skin."""
+
+    def __init__(
+        self,
+        design: Design,
+        camera: Union[Camera, StrPath],
+        T_cam_sensor: npt.ArrayLike,
+        *,
+        max_pixels: int = 4096 * 4096,
+    ) -> None:
+        """T_cam_sensor (4, 4): sensor frame -> camera frame, mm; the camera centre must be
+        inside the sensor body. Raises GroundTruthError."""
+    @property
+    def shape(self) -> Tuple[int, int]: ...
+    @property
+    def camera_centre_mm(self) -> Tuple[float, float, float]: ...
+    def reference(self) -> Dict[str, np.ndarray]:
+        """range_mm, zdepth_mm (H, W) float32 mm; normals (H, W, 3) float32, camera frame,
+        out of the elastomer."""
+    def indented(self, protrusions: ProtrusionSet) -> Dict[str, np.ndarray]:
+        """As reference() for the skin pushed in by the protrusions, plus delta_range_mm,
+        delta_zdepth_mm (indented minus reference, mm) and contact (H, W) bool."""
+    def indented_all(
+        self, protrusions: Sequence[ProtrusionSet], *, progress: Optional[Progress] = None
+    ) -> List[Dict[str, np.ndarray]]: ...
+    def masks(self) -> Tuple[npt.NDArray[np.bool_], npt.NDArray[np.bool_]]:
+        """(left, right) half masks (H, W): rays meeting the reference surface at sensor-frame
+        x < 0 / x >= 0."""
+
+def _library_build_seconds(
+    design: Design, repeats: int, *, chord_tolerance_mm: float = 0.01
+) -> List[float]:
+    """Benchmark hook: wall times, s, of the library's kit build alone."""

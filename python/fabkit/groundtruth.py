@@ -1,0 +1,586 @@
+"""Reader for the output folder of ``fabkit groundtruth``.
+
+``fabkit groundtruth --out DIR`` renders the elastomer surface of a sensor through a calibrated
+camera: a *reference* frame (undeformed skin) and one frame per protrusion configuration
+``<pattern>_0`` (pattern on the sensor's +x half) and ``<pattern>_180`` (pattern on the -x
+half). N patterns give N x N *stitched pairs* (R-Tac0 Sec. IV-B, Fig. 6): pair ``k`` of
+``pairs.csv`` takes the right (+x) half of ``<right_pattern>_0`` on ``right_mask.png`` and the
+left (-x) half of ``<left_pattern>_180`` on ``left_mask.png``.
+
+:class:`GroundTruth` is a plain Python sequence of :class:`StitchedPair` (``len``, indexing,
+iteration), loading frames lazily from disk, so it can back a PyTorch ``Dataset`` without this
+module importing torch. Only numpy and the standard library are used (the 8- and 16-bit PNGs
+are decoded with :mod:`zlib`).
+
+Conventions (from the folder's ``manifest.json``, ``conventions``):
+
+* arrays are ``(H, W)`` row-major, ``H = image_height_px``, ``W = image_width_px``; pixel
+  ``(u, v) = (column, row)``, ``(0, 0)`` the centre of the top-left pixel;
+* camera frame: x right, y down, z forward; sensor frame: ``docs/conventions.md``, split plane
+  ``x = 0``;
+* ``range_mm``: distance along the pixel's ray from the camera centre to the surface, mm;
+  ``zdepth_mm``: z of the surface point in the camera frame, mm;
+* ``delta_*``: indented minus reference, mm (negative where the skin is pushed towards the
+  camera, 0 elsewhere on the surface);
+* a pixel whose ray misses the skin is NaN in float arrays and in neither half mask.
+
+Example::
+
+    from fabkit import GroundTruth
+    gt = GroundTruth("out/gt")
+    for pair in gt:
+        depth = pair.zdepth_mm          # (H, W) float32, mm, NaN off the skin
+        target = pair.delta_zdepth_mm   # (H, W) float32, mm
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+import struct
+import zlib
+from collections import OrderedDict
+from typing import Dict, List, NamedTuple, Optional, Tuple
+
+import numpy as np
+
+__all__ = ["GroundTruth", "StitchedPair"]
+
+#: Header row of ``pairs.csv``.
+PAIRS_HEADER = ["pair", "right_pattern", "right_dir", "left_pattern", "left_dir"]
+#: Keys every ``fabkit groundtruth`` manifest has.
+_MANIFEST_KEYS = ("reference", "configurations", "masks_and_pairs", "image", "camera", "extrinsics")
+#: Scalar maps of a configuration frame; the reference has only the first two.
+_SCALARS = ("range_mm", "zdepth_mm", "delta_range_mm", "delta_zdepth_mm")
+_PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+
+class StitchedPair(NamedTuple):
+    """One stitched pair: right (+x) half of ``<right_pattern>_0``, left (-x) half of
+    ``<left_pattern>_180``.
+
+    A :class:`~typing.NamedTuple`, so ``torch.utils.data.default_collate`` batches it field by
+    field (when ``normals`` is not ``None``). Every array is newly allocated (safe to modify)
+    and has shape ``(H, W)`` (``normals``: ``(H, W, 3)``). Pixels on ``right_mask.png`` come
+    from the right frame, pixels on ``left_mask.png`` from the left frame, all other pixels
+    (rays that miss the skin) are NaN (``contact``: False).
+
+    Attributes:
+        index: the pair's row ``pair`` in ``pairs.csv`` (0 .. N*N - 1; right pattern major).
+        right_pattern: pattern name on the +x half (frame folder ``right_dir``).
+        left_pattern: pattern name on the -x half (frame folder ``left_dir``).
+        right_dir: frame folder of the right half, ``<right_pattern>_0``.
+        left_dir: frame folder of the left half, ``<left_pattern>_180``.
+        range_mm: float32, mm: complete range of the indented skin along each pixel's ray
+            from the camera centre.
+        zdepth_mm: float32, mm: complete z-depth (camera frame z) of the indented skin.
+        delta_range_mm: float32, mm: indented minus reference range (<= 0).
+        delta_zdepth_mm: float32, mm: indented minus reference z-depth.
+        contact: bool: True where a protrusion pushes the skin in (the surface seen is a
+            protrusion), from each frame's ``contact_mask.png``.
+        normals: float32 ``(H, W, 3)``, unit normals of the surface pointing out of the
+            elastomer, camera frame; NaN off the skin. ``None`` for a ``--format png``
+            folder, which holds no normal arrays.
+    """
+
+    index: int
+    right_pattern: str
+    left_pattern: str
+    right_dir: str
+    left_dir: str
+    range_mm: np.ndarray
+    zdepth_mm: np.ndarray
+    delta_range_mm: np.ndarray
+    delta_zdepth_mm: np.ndarray
+    contact: np.ndarray
+    normals: Optional[np.ndarray]
+
+
+class GroundTruth:
+    """The stitched pairs of a ``fabkit groundtruth`` output folder, as a read-only sequence.
+
+    ``len(gt)`` is N*N (N patterns); ``gt[i]`` (negative ``i`` counts from the end; a slice
+    gives a list) loads and stitches pair ``i`` (:class:`StitchedPair`); ``for pair in gt``
+    iterates them in ``pairs.csv`` order. Frames are read from disk when first needed and the
+    last ``cache_frames`` frames are kept.
+
+    Supported ``--format``:
+
+    * ``npy``: ``<frame>/<name>.npy`` float32 maps (exact values);
+    * ``npz``: ``<frame>/arrays.npz`` holding the same float32 maps (exact values);
+    * ``png``: the 16-bit PNGs ``<frame>/<stem>_um.png`` decoded as
+      ``value_mm = (count - offset_counts) * scale_mm_per_count`` (count 0 -> NaN), i.e.
+      quantised to 1 micrometre, and without normals (``normals`` is ``None``).
+
+    Args:
+        folder: the ``--out`` folder of ``fabkit groundtruth``.
+        cache_frames: how many decoded frames to keep in memory (>= 0); 4 by default. Pairs
+            are in right-pattern-major order, so the right frame is reused N times in a row.
+
+    Attributes:
+        folder: the folder (``str``).
+        manifest: ``manifest.json`` as a dict.
+        format: ``"npy"``, ``"npz"`` or ``"png"`` (found from the reference frame's files).
+        shape: ``(H, W)`` of every map.
+        patterns: the pattern names, in ``manifest.json`` order (N of them).
+        pairs: the rows of ``pairs.csv``: ``(index, right_pattern, right_dir, left_pattern,
+            left_dir)``.
+        camera: the manifest's ``camera`` dict (intrinsics: ``fx_px``, ``fy_px``, ``cx_px``,
+            ``cy_px``, ``distortion_model``, ``distortion_coefficients``,
+            ``image_width_px``, ``image_height_px``, the camera file and its sha256).
+        T_cam_sensor: ``(4, 4)`` float64, homogeneous transform mapping sensor-frame points
+            (mm) to camera-frame points (mm).
+        masks: ``(left, right)``, ``(H, W)`` bool arrays (read-only): pixels whose ray meets
+            the reference surface at sensor-frame x < 0, resp. x >= 0. Disjoint; their union
+            is the pixels that see the skin.
+        reference: dict of the reference (undeformed) frame's arrays (read-only):
+            ``range_mm``, ``zdepth_mm`` (``(H, W)`` float32, mm, NaN off the skin) and, for
+            ``npy``/``npz`` folders, ``normals`` (``(H, W, 3)`` float32, camera frame).
+
+    Raises:
+        FileNotFoundError: ``folder``, ``manifest.json``, ``pairs.csv``, a mask or a frame
+            file is missing (the message names the path). Frame files are checked when the
+            folder is opened and again when read.
+        ValueError: the folder is not a ``fabkit groundtruth`` folder or is inconsistent: the
+            manifest is not JSON or is of another kind (no ``configurations``,
+            ``reference``, ...), ``pairs.csv`` has another header, rows out of order, unknown
+            frame folders or not N*N rows, an array or PNG has the wrong shape or dtype or
+            cannot be decoded. The message names the file and the rule.
+    """
+
+    def __init__(self, folder, cache_frames: int = 4):
+        self.folder = os.fspath(folder)
+        if not os.path.isdir(self.folder):
+            raise FileNotFoundError(
+                f"{self.folder}: no such folder (expected the --out folder of `fabkit groundtruth`)"
+            )
+        if int(cache_frames) < 0:
+            raise ValueError(f"cache_frames = {cache_frames}: must be >= 0")
+        self._cache_size = int(cache_frames)
+        self._cache: "OrderedDict[str, Dict[str, np.ndarray]]" = OrderedDict()
+
+        self.manifest = self._read_manifest()
+        m = self.manifest
+        try:
+            h = int(m["image"]["height_px"])
+            w = int(m["image"]["width_px"])
+        except (KeyError, TypeError, ValueError):
+            raise ValueError(
+                f"{self._path('manifest.json')}: image = {m.get('image')!r}: must hold "
+                "width_px and height_px"
+            ) from None
+        self.shape: Tuple[int, int] = (h, w)
+        if not isinstance(m["camera"], dict) or not isinstance(m["extrinsics"], dict):
+            raise ValueError(
+                f"{self._path('manifest.json')}: camera and extrinsics must be JSON objects"
+            )
+        self.camera: dict = dict(m["camera"])
+        try:
+            t = np.asarray(m["extrinsics"].get("T_cam_sensor"), dtype=np.float64)
+        except (TypeError, ValueError):
+            t = np.zeros(0)
+        if t.shape != (4, 4):
+            raise ValueError(
+                f"{self._path('manifest.json')}: extrinsics.T_cam_sensor: must be a 4 x 4 matrix"
+            )
+        self.T_cam_sensor: np.ndarray = t
+        self.patterns: List[str] = list((m.get("fixtures") or {}).get("patterns") or [])
+
+        self._frames: Dict[str, dict] = {}  # frame dir -> {"files": {rel path: entry}}
+        ref_dir = m["reference"].get("dir", "reference")
+        self._reference_dir = ref_dir
+        self._frames[ref_dir] = self._frame_entry(m["reference"])
+        for c in m["configurations"]:
+            if "dir" not in c:
+                raise ValueError(
+                    f"{self._path('manifest.json')}: configurations: an entry has no 'dir'"
+                )
+            self._frames[c["dir"]] = self._frame_entry(c)
+        self.format: str = self._detect_format(ref_dir)
+
+        self.pairs: List[Tuple[int, str, str, str, str]] = self._read_pairs()
+        for d in [ref_dir] + sorted({p[2] for p in self.pairs} | {p[4] for p in self.pairs}):
+            for rel in self._frame_files(d, reference=(d == ref_dir)):
+                p = self._path(rel)
+                if not os.path.isfile(p):
+                    raise FileNotFoundError(
+                        f"{p}: missing: manifest.json lists it for frame {d!r} "
+                        f"(--format {self.format}); the folder is incomplete"
+                    )
+
+        left = self._read_mask("left_mask.png")
+        right = self._read_mask("right_mask.png")
+        if (left & right).any():
+            raise ValueError(
+                f"{self._path('left_mask.png')}: overlaps right_mask.png: the half masks must be disjoint"
+            )
+        left.flags.writeable = False
+        right.flags.writeable = False
+        self.masks: Tuple[np.ndarray, np.ndarray] = (left, right)
+        self._reference: Optional[Dict[str, np.ndarray]] = None
+
+    # ----------------------------------------------------------------- sequence protocol
+
+    def __len__(self) -> int:
+        return len(self.pairs)
+
+    def __getitem__(self, i):
+        """Pair ``i`` (:class:`StitchedPair`), or a list of pairs for a slice.
+
+        Raises:
+            IndexError: ``i`` outside ``-len(self) .. len(self) - 1``.
+            TypeError: ``i`` is neither an integer nor a slice.
+            FileNotFoundError, ValueError: a frame file is missing or malformed (named).
+        """
+        if isinstance(i, slice):
+            return [self[k] for k in range(*i.indices(len(self)))]
+        try:
+            k = int(i.__index__())
+        except AttributeError:
+            raise TypeError(
+                f"GroundTruth indices must be integers or slices, not {type(i).__name__}"
+            ) from None
+        n = len(self)
+        if k < 0:
+            k += n
+        if not 0 <= k < n:
+            raise IndexError(f"pair index {i} out of range for {n} stitched pairs")
+        return self._stitch(k)
+
+    def __iter__(self):
+        for k in range(len(self)):
+            yield self._stitch(k)
+
+    def __repr__(self) -> str:
+        h, w = self.shape
+        return (
+            f"GroundTruth({self.folder!r}: {len(self)} stitched pairs of {len(self.patterns)} "
+            f"patterns, {w} x {h} px, --format {self.format})"
+        )
+
+    # ----------------------------------------------------------------- public accessors
+
+    @property
+    def reference(self) -> Dict[str, np.ndarray]:
+        """The reference (undeformed skin) frame: ``range_mm``, ``zdepth_mm`` ((H, W) float32,
+        mm, NaN off the skin) and ``normals`` ((H, W, 3) float32, camera frame; not in a
+        ``--format png`` folder). Read-only arrays, loaded on first access.
+
+        Raises:
+            FileNotFoundError, ValueError: as :class:`GroundTruth`.
+        """
+        if self._reference is None:
+            arrays = dict(self._load_frame(self._reference_dir, reference=True))
+            for a in arrays.values():
+                a.flags.writeable = False
+            self._reference = arrays
+        return self._reference
+
+    # ----------------------------------------------------------------- internals
+
+    def _path(self, rel: str) -> str:
+        return os.path.join(self.folder, *rel.split("/"))
+
+    def _read_manifest(self) -> dict:
+        p = self._path("manifest.json")
+        if not os.path.isfile(p):
+            raise FileNotFoundError(
+                f"{p}: missing: not a `fabkit groundtruth` output folder "
+                "(it writes manifest.json, pairs.csv, left_mask.png, right_mask.png and a folder per frame)"
+            )
+        try:
+            with open(p, "rb") as f:
+                m = json.loads(f.read().decode("utf-8"))
+        except json.JSONDecodeError as e:
+            raise ValueError(f"{p}:{e.lineno}:{e.colno}: not JSON: {e.msg}") from None
+        except UnicodeDecodeError as e:
+            raise ValueError(f"{p}: not UTF-8 text: {e}") from None
+        if not isinstance(m, dict):
+            raise ValueError(f"{p}: must be a JSON object (the manifest of `fabkit groundtruth`)")
+        missing = [k for k in _MANIFEST_KEYS if k not in m]
+        if missing:
+            raise ValueError(
+                f"{p}: no {', '.join(repr(k) for k in missing)}: not the manifest of "
+                "`fabkit groundtruth` (a manifest of another fabkit command?); "
+                f"a ground-truth manifest has {', '.join(_MANIFEST_KEYS)}"
+            )
+        if not isinstance(m["configurations"], list) or not isinstance(m["reference"], dict):
+            raise ValueError(
+                f"{p}: configurations must be a list and reference an object "
+                "(the manifest of `fabkit groundtruth`)"
+            )
+        return m
+
+    def _frame_entry(self, entry: dict) -> dict:
+        files = {}
+        for f in entry.get("files") or []:
+            if isinstance(f, dict) and isinstance(f.get("file"), str):
+                files[f["file"]] = f
+        return {"files": files}
+
+    def _detect_format(self, ref_dir: str) -> str:
+        files = self._frames[ref_dir]["files"]
+        if f"{ref_dir}/arrays.npz" in files:
+            return "npz"
+        if f"{ref_dir}/range_mm.npy" in files:
+            return "npy"
+        if f"{ref_dir}/range_um.png" in files:
+            return "png"
+        raise ValueError(
+            f"{self._path('manifest.json')}: reference.files lists none of {ref_dir}/arrays.npz, "
+            f"{ref_dir}/range_mm.npy, {ref_dir}/range_um.png: cannot tell the --format"
+        )
+
+    def _frame_files(self, d: str, reference: bool) -> List[str]:
+        """Relative paths of the files read for frame ``d``."""
+        names = _SCALARS[:2] if reference else _SCALARS
+        if self.format == "npy":
+            files = [f"{d}/{n}.npy" for n in names] + [f"{d}/normals.npy"]
+        elif self.format == "npz":
+            files = [f"{d}/arrays.npz"]
+        else:
+            files = [f"{d}/{n[:-3]}_um.png" for n in names]
+        if not reference:
+            files.append(f"{d}/contact_mask.png")
+        return files
+
+    def _read_pairs(self) -> List[Tuple[int, str, str, str, str]]:
+        p = self._path("pairs.csv")
+        if not os.path.isfile(p):
+            raise FileNotFoundError(f"{p}: missing: a `fabkit groundtruth` folder lists its stitched pairs there")
+        with open(p, newline="", encoding="utf-8") as f:
+            rows = [r for r in csv.reader(f) if r and not r[0].startswith("#")]
+        if not rows or rows[0] != PAIRS_HEADER:
+            got = ",".join(rows[0]) if rows else "(empty)"
+            raise ValueError(f"{p}:1: header = {got}: must be {','.join(PAIRS_HEADER)}")
+        cfg_dirs = set(self._frames) - {self._reference_dir}
+        pairs = []
+        for k, r in enumerate(rows[1:]):
+            line = k + 2
+            if len(r) != 5:
+                raise ValueError(f"{p}:{line}: {len(r)} columns: must be 5 ({','.join(PAIRS_HEADER)})")
+            if r[0] != str(k):
+                raise ValueError(f"{p}:{line}: pair = {r[0]}: must be {k} (rows numbered from 0 in order)")
+            for col, side in ((2, "right_dir"), (4, "left_dir")):
+                if r[col] not in cfg_dirs:
+                    raise ValueError(
+                        f"{p}:{line}: {side} = {r[col]}: not a configuration of manifest.json"
+                    )
+            pairs.append((k, r[1], r[2], r[3], r[4]))
+        n = len(self.patterns)
+        if n and len(pairs) != n * n:
+            raise ValueError(
+                f"{p}: {len(pairs)} pairs: must be N x N = {n * n} for the manifest's {n} patterns"
+            )
+        return pairs
+
+    def _read_mask(self, rel: str) -> np.ndarray:
+        a = _read_png(self._path(rel))
+        if a.shape != self.shape or a.dtype != np.uint8:
+            raise ValueError(
+                f"{self._path(rel)}: {a.dtype} {a.shape}: must be 8-bit greyscale of shape {self.shape}"
+            )
+        return a != 0
+
+    def _check(self, path: str, a: np.ndarray, shape: tuple) -> np.ndarray:
+        if a.dtype != np.float32 or a.shape != shape:
+            raise ValueError(f"{path}: {a.dtype} {a.shape}: must be float32 of shape {shape}")
+        return a
+
+    def _load_frame(self, d: str, reference: bool) -> Dict[str, np.ndarray]:
+        if d in self._cache:
+            self._cache.move_to_end(d)
+            return self._cache[d]
+        h, w = self.shape
+        names = _SCALARS[:2] if reference else _SCALARS
+        out: Dict[str, np.ndarray] = {}
+        if self.format == "npy":
+            for n in names + ("normals",):
+                p = self._path(f"{d}/{n}.npy")
+                shape = (h, w, 3) if n == "normals" else (h, w)
+                out[n] = self._check(p, _np_load(p), shape)
+        elif self.format == "npz":
+            p = self._path(f"{d}/arrays.npz")
+            try:
+                with np.load(p, allow_pickle=False) as z:
+                    for n in names + ("normals",):
+                        if n not in z.files:
+                            raise ValueError(f"{p}: no array {n!r} (holds {sorted(z.files)})")
+                        shape = (h, w, 3) if n == "normals" else (h, w)
+                        out[n] = self._check(f"{p}[{n}]", z[n], shape)
+            except FileNotFoundError:
+                raise FileNotFoundError(f"{p}: missing (frame {d!r})") from None
+            except (OSError, zlib.error) as e:
+                raise ValueError(f"{p}: cannot read as .npz: {e}") from None
+        else:
+            entries = self._frames[d]["files"]
+            for n in names:
+                rel = f"{d}/{n[:-3]}_um.png"
+                p = self._path(rel)
+                e = entries.get(rel, {})
+                scale = float(e.get("scale_mm_per_count", 0.001))
+                offset = int(e.get("offset_counts", 32768 if n.startswith("delta") else 0))
+                counts = _read_png(p)
+                if counts.dtype != np.uint16 or counts.shape != (h, w):
+                    raise ValueError(
+                        f"{p}: {counts.dtype} {counts.shape}: must be 16-bit greyscale of shape {(h, w)}"
+                    )
+                v = ((counts.astype(np.float64) - offset) * scale).astype(np.float32)
+                v[counts == 0] = np.nan
+                out[n] = v
+        if not reference:
+            p = self._path(f"{d}/contact_mask.png")
+            c = _read_png(p)
+            if c.dtype != np.uint8 or c.shape != (h, w):
+                raise ValueError(f"{p}: {c.dtype} {c.shape}: must be 8-bit greyscale of shape {(h, w)}")
+            out["contact"] = c != 0
+        if self._cache_size:
+            self._cache[d] = out
+            while len(self._cache) > self._cache_size:
+                self._cache.popitem(last=False)
+        return out
+
+    def _stitch(self, k: int) -> StitchedPair:
+        index, rp, rdir, lp, ldir = self.pairs[k]
+        right = self._load_frame(rdir, reference=False)
+        left = self._load_frame(ldir, reference=False)
+        lm, rm = self.masks
+        h, w = self.shape
+
+        def stitch(name, fill, dtype, extra=()):
+            a = np.full((h, w) + extra, fill, dtype=dtype)
+            a[rm] = right[name][rm]
+            a[lm] = left[name][lm]
+            return a
+
+        maps = {n: stitch(n, np.nan, np.float32) for n in _SCALARS}
+        normals = stitch("normals", np.nan, np.float32, (3,)) if "normals" in right else None
+        return StitchedPair(
+            index=index,
+            right_pattern=rp,
+            left_pattern=lp,
+            right_dir=rdir,
+            left_dir=ldir,
+            range_mm=maps["range_mm"],
+            zdepth_mm=maps["zdepth_mm"],
+            delta_range_mm=maps["delta_range_mm"],
+            delta_zdepth_mm=maps["delta_zdepth_mm"],
+            contact=stitch("contact", False, bool),
+            normals=normals,
+        )
+
+
+def _np_load(path: str) -> np.ndarray:
+    try:
+        a = np.load(path, allow_pickle=False)
+    except FileNotFoundError:
+        raise FileNotFoundError(f"{path}: missing") from None
+    except (OSError, ValueError) as e:
+        raise ValueError(f"{path}: cannot read as .npy: {e}") from None
+    if not isinstance(a, np.ndarray):
+        raise ValueError(f"{path}: not a single .npy array")
+    return a
+
+
+def _read_png(path: str) -> np.ndarray:
+    """Decodes a non-interlaced 8- or 16-bit greyscale / RGB / grey+alpha / RGBA PNG.
+
+    Returns ``(H, W)`` (one channel) or ``(H, W, C)`` uint8 / uint16 (native byte order).
+
+    Raises:
+        FileNotFoundError: ``path`` is missing.
+        ValueError: not a PNG, a bad CRC, or a form this decoder does not read (palette, bit
+            depth below 8, interlaced); the message names the file.
+    """
+    try:
+        with open(path, "rb") as f:
+            data = f.read()
+    except FileNotFoundError:
+        raise FileNotFoundError(f"{path}: missing") from None
+    if not data.startswith(_PNG_SIGNATURE):
+        raise ValueError(f"{path}: not a PNG file (bad signature)")
+    pos, ihdr, idat = 8, None, []
+    while pos + 12 <= len(data):
+        (n,) = struct.unpack(">I", data[pos : pos + 4])
+        kind = data[pos + 4 : pos + 8]
+        body = data[pos + 8 : pos + 8 + n]
+        if len(body) != n or pos + 12 + n > len(data):
+            raise ValueError(f"{path}: truncated PNG chunk {kind!r}")
+        (crc,) = struct.unpack(">I", data[pos + 8 + n : pos + 12 + n])
+        if zlib.crc32(kind + body) & 0xFFFFFFFF != crc:
+            raise ValueError(f"{path}: PNG chunk {kind!r}: bad CRC")
+        if kind == b"IHDR":
+            ihdr = struct.unpack(">IIBBBBB", body)
+        elif kind == b"IDAT":
+            idat.append(body)
+        elif kind == b"IEND":
+            break
+        pos += 12 + n
+    if ihdr is None or not idat:
+        raise ValueError(f"{path}: PNG without IHDR or IDAT")
+    w, h, depth, colour, _, _, interlace = ihdr
+    channels = {0: 1, 2: 3, 4: 2, 6: 4}.get(colour)
+    if channels is None or depth not in (8, 16) or interlace != 0:
+        raise ValueError(
+            f"{path}: PNG colour type {colour}, bit depth {depth}, interlace {interlace}: "
+            "only non-interlaced 8/16-bit grey, grey+alpha, RGB or RGBA PNGs are read"
+        )
+    try:
+        raw = zlib.decompress(b"".join(idat))
+    except zlib.error as e:
+        raise ValueError(f"{path}: PNG image data does not inflate: {e}") from None
+    bpp = channels * depth // 8
+    stride = w * bpp
+    if len(raw) < h * (stride + 1):
+        raise ValueError(f"{path}: PNG image data holds {len(raw)} bytes, {h * (stride + 1)} expected")
+    pixels = _unfilter(raw, h, stride, bpp, path)
+    a = np.frombuffer(pixels, dtype=np.uint8 if depth == 8 else ">u2")
+    a = a.astype(np.uint8 if depth == 8 else np.uint16)
+    return a.reshape((h, w) if channels == 1 else (h, w, channels))
+
+
+def _unfilter(raw: bytes, h: int, stride: int, bpp: int, path: str) -> bytes:
+    """Undoes the PNG row filters (None, Sub, Up, Average, Paeth)."""
+    out = bytearray(h * stride)
+    prior = np.zeros(stride, dtype=np.uint8)
+    for y in range(h):
+        start = y * (stride + 1)
+        ftype = raw[start]
+        row = np.frombuffer(raw, dtype=np.uint8, count=stride, offset=start + 1)
+        if ftype == 0:
+            cur = row.copy()
+        elif ftype == 1:  # Sub: running sum with stride bpp, modulo 256
+            cur = np.cumsum(row.reshape(-1, bpp), axis=0, dtype=np.uint8).reshape(-1)
+        elif ftype == 2:  # Up
+            cur = row + prior
+        elif ftype in (3, 4):  # Average, Paeth: sequential along the row
+            r = row.tolist()
+            b = prior.tolist()
+            c = r  # reconstructed in place
+            if ftype == 3:
+                for i in range(stride):
+                    a_ = c[i - bpp] if i >= bpp else 0
+                    c[i] = (r[i] + ((a_ + b[i]) >> 1)) & 0xFF
+            else:
+                for i in range(stride):
+                    if i >= bpp:
+                        a_, c_ = c[i - bpp], b[i - bpp]
+                    else:
+                        a_ = c_ = 0
+                    b_ = b[i]
+                    p = a_ + b_ - c_
+                    pa, pb, pc = abs(p - a_), abs(p - b_), abs(p - c_)
+                    if pa <= pb and pa <= pc:
+                        pr = a_
+                    elif pb <= pc:
+                        pr = b_
+                    else:
+                        pr = c_
+                    c[i] = (r[i] + pr) & 0xFF
+            cur = np.array(c, dtype=np.uint8)
+        else:
+            raise ValueError(f"{path}: PNG row {y}: unknown filter type {ftype}")
+        out[y * stride : (y + 1) * stride] = cur.tobytes()
+        prior = cur
+    return bytes(out)

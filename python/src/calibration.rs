@@ -1,0 +1,347 @@
+//! `fabkit.Camera` and `fabkit.solve_extrinsics`: camera models and the PnP extrinsics solve of
+//! `fabkit calibrate extrinsics`, from numpy arrays.
+
+use fabkit_calibration::nalgebra::{Vector2, Vector3};
+use fabkit_calibration::report::Provenance;
+use fabkit_calibration::tables::Pairs;
+use fabkit_calibration::{
+    read_camera_file_as, solve_pnp, CameraModel, Distortion, DistortionModelHint, ExtrinsicsReport,
+    Intrinsics, PnpOptions, RansacOptions,
+};
+use numpy::ndarray::{Array1, Array2};
+use numpy::{IntoPyArray, PyArray2, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::errors::{err, CalibrationError};
+
+/// `model` (`fisheye`, `plumb_bob`, `rational_polynomial`) as the CLI's `--camera-model`.
+fn model_hint(model: Option<&str>) -> PyResult<Option<DistortionModelHint>> {
+    Ok(match model {
+        None => None,
+        Some("fisheye") => Some(DistortionModelHint::Fisheye),
+        Some("plumb_bob") => Some(DistortionModelHint::PlumbBob),
+        Some("rational_polynomial") => Some(DistortionModelHint::RationalPolynomial),
+        Some(other) => {
+            let models = "fisheye, plumb_bob, rational_polynomial";
+            return Err(PyValueError::new_err(format!(
+                "model: '{other}' is not a distortion model ({models})"
+            )));
+        }
+    })
+}
+
+/// A camera model: intrinsics (fx, fy, cx, cy in px), image size and lens distortion
+/// (`fisheye` Kannala-Brandt k1..k4, `plumb_bob` k1 k2 p1 p2 [k3], `rational_polynomial`
+/// k1 k2 p1 p2 k3..k6, as OpenCV). Pixel (0, 0) is the centre of the top-left pixel; camera
+/// frame x right, y down, z forward (docs/conventions.md).
+#[pyclass(module = "fabkit", frozen)]
+#[derive(Clone)]
+pub struct Camera {
+    pub(crate) model: CameraModel,
+    /// The camera file it was read from (`<arrays>` when built from numbers).
+    pub(crate) source: String,
+}
+
+impl Camera {
+    /// Reads a camera file (as `--camera`, with `--camera-model` `model`).
+    pub(crate) fn read(path: std::path::PathBuf, model: Option<&str>) -> PyResult<Camera> {
+        let hint = model_hint(model)?;
+        let model = read_camera_file_as(&path, hint).map_err(|e| err::<CalibrationError>(&e))?;
+        Ok(Camera {
+            model,
+            source: path.display().to_string(),
+        })
+    }
+
+    /// A Camera, or the camera file (whose model it names) at the path `obj`.
+    pub(crate) fn of(obj: &Bound<'_, PyAny>) -> PyResult<Camera> {
+        match obj.cast::<Camera>() {
+            Ok(c) => Ok(c.get().clone()),
+            Err(_) => Camera::read(obj.extract()?, None),
+        }
+    }
+}
+
+#[pymethods]
+impl Camera {
+    /// A camera from its numbers. Raises CalibrationError for a model that does not hold
+    /// (non-positive focal length, wrong coefficient count, ...).
+    #[new]
+    #[pyo3(signature = (fx_px, fy_px, cx_px, cy_px, width_px, height_px, distortion_model="plumb_bob", coefficients=vec![0.0; 5]))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        fx_px: f64,
+        fy_px: f64,
+        cx_px: f64,
+        cy_px: f64,
+        width_px: u32,
+        height_px: u32,
+        distortion_model: &str,
+        coefficients: Vec<f64>,
+    ) -> PyResult<Camera> {
+        let distortion = Distortion::from_name(distortion_model, &coefficients).map_err(|e| {
+            CalibrationError::new_err(format!("distortion_model {distortion_model}: {e}"))
+        })?;
+        let model = CameraModel::new(Intrinsics {
+            image_width_px: width_px,
+            image_height_px: height_px,
+            fx_px,
+            fy_px,
+            cx_px,
+            cy_px,
+            distortion,
+        })
+        .map_err(|e| err::<CalibrationError>(&e))?;
+        Ok(Camera {
+            model,
+            source: "<arrays>".into(),
+        })
+    }
+
+    /// Reads a camera file (OpenCV FileStorage YAML or XML, ROS camera_info YAML or fabkit
+    /// JSON), as `--camera`; `model` as `--camera-model` for a file that names no distortion
+    /// model. Raises CalibrationError naming the file, line and field.
+    #[staticmethod]
+    #[pyo3(signature = (path, model=None))]
+    fn from_file(path: std::path::PathBuf, model: Option<&str>) -> PyResult<Camera> {
+        Camera::read(path, model)
+    }
+
+    /// The intrinsics as a dict: image_width_px, image_height_px, fx_px, fy_px, cx_px, cy_px,
+    /// distortion_model, distortion_coefficients.
+    #[getter]
+    fn intrinsics(&self, py: Python<'_>) -> PyResult<Py<PyDict>> {
+        let i = self.model.intrinsics();
+        let d = PyDict::new(py);
+        d.set_item("image_width_px", i.image_width_px)?;
+        d.set_item("image_height_px", i.image_height_px)?;
+        d.set_item("fx_px", i.fx_px)?;
+        d.set_item("fy_px", i.fy_px)?;
+        d.set_item("cx_px", i.cx_px)?;
+        d.set_item("cy_px", i.cy_px)?;
+        d.set_item("distortion_model", i.distortion.name())?;
+        d.set_item(
+            "distortion_coefficients",
+            i.distortion.coefficients().to_vec(),
+        )?;
+        Ok(d.unbind())
+    }
+
+    /// (height, width) of the image, px.
+    #[getter]
+    fn shape(&self) -> (u32, u32) {
+        let i = self.model.intrinsics();
+        (i.image_height_px, i.image_width_px)
+    }
+
+    /// Projects camera-frame points (n, 3) mm to pixels (n, 2) px; NaN for a point the lens
+    /// does not image (behind the camera, past the field of view).
+    fn project<'py>(
+        &self,
+        py: Python<'py>,
+        points_mm: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let p = rows::<3>(points_mm, "points_mm")?;
+        let out: Vec<f64> = p
+            .iter()
+            .flat_map(|q| match self.model.project(&Vector3::from(*q)) {
+                Some(uv) => [uv.x, uv.y],
+                None => [f64::NAN, f64::NAN],
+            })
+            .collect();
+        Ok(Array2::from_shape_vec((p.len(), 2), out)
+            .map_err(|e| PyValueError::new_err(e.to_string()))?
+            .into_pyarray(py))
+    }
+
+    fn __repr__(&self) -> String {
+        let i = self.model.intrinsics();
+        format!(
+            "Camera({} x {} px, fx={}, fy={}, cx={}, cy={}, {} {:?}, source={:?})",
+            i.image_width_px,
+            i.image_height_px,
+            i.fx_px,
+            i.fy_px,
+            i.cx_px,
+            i.cy_px,
+            i.distortion.name(),
+            i.distortion.coefficients(),
+            self.source
+        )
+    }
+}
+
+/// `obj` (an array-like of numbers) as a float64 numpy array, `numpy.asarray(obj, float64)`;
+/// ValueError naming `name` when it does not convert.
+pub(crate) fn float64_array<'py>(
+    obj: &Bound<'py, PyAny>,
+    name: &str,
+) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    let np = obj.py().import("numpy")?;
+    let a = np
+        .call_method1("asarray", (obj, "float64"))
+        .map_err(|e| PyValueError::new_err(format!("{name}: {e}")))?;
+    Ok(a.cast_into::<PyArrayDyn<f64>>()?)
+}
+
+/// A numpy shape as Python prints it: `(5, 2)`, `(3,)`, `()`.
+pub(crate) fn shape_text(shape: &[usize]) -> String {
+    match shape {
+        [n] => format!("({n},)"),
+        _ => format!(
+            "({})",
+            shape
+                .iter()
+                .map(|n| n.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    }
+}
+
+/// The rows of an (n, N) array-like; ValueError for another shape, CalibrationError naming the
+/// first non-finite entry as `name[i, j] = value: must be finite` (the rule of the CLI's tables).
+pub(crate) fn rows<const N: usize>(a: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<[f64; N]>> {
+    let a = float64_array(a, name)?;
+    if a.ndim() != 2 || a.shape()[1] != N {
+        return Err(PyValueError::new_err(format!(
+            "{name}: shape {} where (n, {N}) is needed",
+            shape_text(a.shape())
+        )));
+    }
+    let a = a.readonly();
+    let v = a.as_array();
+    let mut out = Vec::with_capacity(v.shape()[0]);
+    for (i, r) in v.outer_iter().enumerate() {
+        let mut row = [0.0; N];
+        for (j, x) in r.iter().enumerate() {
+            if !x.is_finite() {
+                return Err(CalibrationError::new_err(format!(
+                    "{name}[{i}, {j}] = {x}: must be finite"
+                )));
+            }
+            row[j] = *x;
+        }
+        out.push(row);
+    }
+    Ok(out)
+}
+
+/// Solves the camera pose T_cam_sensor from sensor-frame points (n, 3) mm and their observed
+/// pixels (n, 2) px through `camera` (a Camera or a camera file path), as `fabkit calibrate
+/// extrinsics` does (SQPnP + Levenberg-Marquardt; with `ransac`, outliers rejected at
+/// `threshold_px`, reproducible by `seed`).
+///
+/// Returns a dict: `T_cam_sensor` (4, 4) float64 (sensor frame -> camera frame, mm),
+/// `residuals_px` (n, 2) (reprojected minus observed, NaN where a point does not project),
+/// `inliers` and `outliers` (n,) bool, `rms_reprojection_error_px`, and `report`: the dict
+/// `extrinsics.json` holds (rvec, tvec, pose uncertainty, per-point residuals by id; ids are
+/// `ids` or the row numbers). Raises CalibrationError with the CLI's message (fewer than 4
+/// points, a non-finite value, a degenerate layout, too few inliers, ...).
+#[pyfunction]
+#[pyo3(signature = (points_mm, pixels_px, camera, *, ids=None, ransac=true, threshold_px=3.0, seed=0))]
+#[allow(clippy::too_many_arguments)]
+pub fn solve_extrinsics<'py>(
+    py: Python<'py>,
+    points_mm: &Bound<'py, PyAny>,
+    pixels_px: &Bound<'py, PyAny>,
+    camera: &Bound<'py, PyAny>,
+    ids: Option<Vec<String>>,
+    ransac: bool,
+    threshold_px: f64,
+    seed: u64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let camera = Camera::of(camera)?;
+    let points = rows::<3>(points_mm, "points_mm")?;
+    let pixels = rows::<2>(pixels_px, "pixels_px")?;
+    let n = points.len();
+    if pixels.len() != n {
+        return Err(PyValueError::new_err(format!(
+            "pixels_px: {} rows for {n} points (points_mm (n, 3) and pixels_px (n, 2) pair up by row)",
+            pixels.len()
+        )));
+    }
+    let ids = match ids {
+        Some(ids) if ids.len() != n => {
+            return Err(PyValueError::new_err(format!(
+                "ids: {} ids for {n} points",
+                ids.len()
+            )))
+        }
+        Some(ids) => ids,
+        None => (0..n).map(|i| i.to_string()).collect(),
+    };
+    let pairs = Pairs {
+        ids,
+        points_mm: points.iter().map(|p| Vector3::from(*p)).collect(),
+        pixels_px: pixels.iter().map(|p| Vector2::from(*p)).collect(),
+    };
+    let ransac = ransac.then(|| RansacOptions {
+        threshold_px,
+        seed,
+        ..RansacOptions::default()
+    });
+    let opts = PnpOptions {
+        ransac,
+        ..PnpOptions::default()
+    };
+    let model = &camera.model;
+    let sol = crate::work(py, || {
+        solve_pnp(model, &pairs.points_mm, &pairs.pixels_px, &opts)
+    })?
+    .map_err(|e| err::<CalibrationError>(&e))?;
+    let provenance = Provenance {
+        fabkit_version: env!("CARGO_PKG_VERSION").into(),
+        command_line: "fabkit.solve_extrinsics".into(),
+        camera_file: camera.source.clone(),
+        points_file: "<arrays>".into(),
+        points_from: "xyz".into(),
+        observation_files: vec!["<arrays>".into()],
+        capture_plan: None,
+        unobserved_ids: Vec::new(),
+        reference_image: None,
+    };
+    let report = ExtrinsicsReport::new(
+        model,
+        &pairs,
+        &sol,
+        ransac.map(|r| r.threshold_px),
+        provenance,
+    );
+    let report: serde_json::Value = serde_json::from_str(&report.to_json())
+        .map_err(|e| CalibrationError::new_err(e.to_string()))?;
+    let h = sol.t_cam_sensor.to_homogeneous();
+    let t = Array2::from_shape_fn((4, 4), |(r, c)| h[(r, c)]);
+    let res: Vec<f64> = sol
+        .residuals_px
+        .iter()
+        .flat_map(|r| r.map_or([f64::NAN, f64::NAN], |v| [v.x, v.y]))
+        .collect();
+    let out = PyDict::new(py);
+    out.set_item("T_cam_sensor", t.into_pyarray(py))?;
+    out.set_item(
+        "residuals_px",
+        Array2::from_shape_vec((n, 2), res)
+            .map_err(|e| PyValueError::new_err(e.to_string()))?
+            .into_pyarray(py),
+    )?;
+    out.set_item(
+        "inliers",
+        Array1::from_vec(sol.inliers.clone()).into_pyarray(py),
+    )?;
+    out.set_item(
+        "outliers",
+        Array1::from_iter(sol.inliers.iter().map(|x| !x)).into_pyarray(py),
+    )?;
+    out.set_item("rms_reprojection_error_px", sol.rms_reprojection_error_px)?;
+    out.set_item("report", crate::to_py(py, &report)?)?;
+    Ok(out)
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<Camera>()?;
+    m.add_function(wrap_pyfunction!(solve_extrinsics, m)?)?;
+    Ok(())
+}

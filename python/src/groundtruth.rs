@@ -1,0 +1,260 @@
+//! `fabkit.DepthRenderer` and `fabkit.read_protrusions`: ground-truth depth of the reference
+//! and indented skin rendered straight into numpy arrays, as `fabkit groundtruth` renders the
+//! frames it writes (R-Tac0 Sec. IV-B, Fig. 6, Eq. (2)-(3)).
+
+use std::sync::Arc;
+
+use fabkit_calibration::groundtruth::inputs::{isometry_of, read_fixtures, Configuration};
+use fabkit_calibration::groundtruth::{
+    half_masks, indented_hits, reference_hits, DepthFrame, Scene, SurfaceHits,
+};
+use numpy::ndarray::{Array2, Array3};
+use numpy::{IntoPyArray, PyArrayMethods, PyUntypedArrayMethods};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::calibration::Camera;
+use crate::design::Design;
+use crate::errors::{err, GroundTruthError};
+use crate::kit::report_progress;
+
+/// Largest camera image by default, pixels: 4096 x 4096 (`fabkit groundtruth --max-pixels`).
+const DEFAULT_MAX_PIXELS: u64 = 4096 * 4096;
+
+/// The protrusions of one semi-dome (or semi-plate) configuration of a fixtures folder: a
+/// pattern at orientation 0 deg (on the +x half) or 180 deg (on the -x half).
+#[pyclass(module = "fabkit", frozen)]
+pub struct ProtrusionSet {
+    cfg: Arc<Configuration>,
+}
+
+#[pymethods]
+impl ProtrusionSet {
+    /// `<pattern>_<orientation_deg>`, the frame's folder name in a ground-truth output.
+    #[getter]
+    fn name(&self) -> String {
+        self.cfg.name.clone()
+    }
+    #[getter]
+    fn pattern(&self) -> String {
+        self.cfg.pattern.clone()
+    }
+    #[getter]
+    fn orientation_deg(&self) -> u32 {
+        self.cfg.orientation_deg
+    }
+    /// Number of primitives (spheres, cylinders, ridges) in the set.
+    fn __len__(&self) -> usize {
+        self.cfg.geometry.primitives.len()
+    }
+    fn __repr__(&self) -> String {
+        format!(
+            "ProtrusionSet({:?}, {} primitives)",
+            self.cfg.name,
+            self.cfg.geometry.primitives.len()
+        )
+    }
+}
+
+/// The protrusion configurations of a `fabkit fixtures` output folder built from `design`
+/// (`protrusions/index.json` and its pattern files): two per pattern (0 and 180 deg), in index
+/// order. Raises GroundTruthError naming the file and the rule.
+#[pyfunction]
+pub fn read_protrusions(
+    py: Python<'_>,
+    fixtures_dir: std::path::PathBuf,
+    design: &Design,
+) -> PyResult<Vec<ProtrusionSet>> {
+    let f = crate::work(py, || read_fixtures(&fixtures_dir, &design.design.name))?
+        .map_err(|e| err::<GroundTruthError>(&e))?;
+    Ok(f.configurations
+        .into_iter()
+        .map(|c| ProtrusionSet { cfg: Arc::new(c) })
+        .collect())
+}
+
+/// Renders ground-truth depth of a design's skin seen through a calibrated camera.
+///
+/// `DepthRenderer(design, camera, T_cam_sensor)`: `camera` a Camera or a camera file path,
+/// `T_cam_sensor` (4, 4) (sensor frame -> camera frame, mm; rotation block orthonormal). The
+/// camera centre must be inside the sensor body. Arrays are (H, W) row-major, float32 as the
+/// files `fabkit groundtruth` writes, NaN where the pixel's ray misses the skin.
+#[pyclass(module = "fabkit", frozen)]
+pub struct DepthRenderer {
+    scene: Scene,
+    reference_hits: SurfaceHits,
+    reference: DepthFrame,
+}
+
+fn f32_map(v: &[f64], h: usize, w: usize) -> Array2<f32> {
+    Array2::from_shape_vec((h, w), v.iter().map(|x| *x as f32).collect()).expect("h x w")
+}
+
+/// A (H, W) bool numpy array.
+type BoolMap<'py> = Bound<'py, numpy::PyArray2<bool>>;
+
+fn bool_map(v: &[bool], h: usize, w: usize) -> Array2<bool> {
+    Array2::from_shape_vec((h, w), v.to_vec()).expect("h x w")
+}
+
+/// The arrays of a frame: range_mm, zdepth_mm (H, W) float32, normals (H, W, 3) float32
+/// (camera frame, out of the elastomer).
+fn frame_dict<'py>(py: Python<'py>, f: &DepthFrame) -> PyResult<Bound<'py, PyDict>> {
+    let (h, w) = (f.height, f.width);
+    let d = PyDict::new(py);
+    d.set_item("range_mm", f32_map(&f.range_mm, h, w).into_pyarray(py))?;
+    d.set_item("zdepth_mm", f32_map(&f.zdepth_mm, h, w).into_pyarray(py))?;
+    let n: Vec<f32> = f
+        .normal_cam
+        .iter()
+        .flat_map(|n| n.map(|c| c as f32))
+        .collect();
+    d.set_item(
+        "normals",
+        Array3::from_shape_vec((h, w, 3), n)
+            .expect("h x w x 3")
+            .into_pyarray(py),
+    )?;
+    Ok(d)
+}
+
+#[pymethods]
+impl DepthRenderer {
+    #[new]
+    #[pyo3(signature = (design, camera, T_cam_sensor, *, max_pixels=DEFAULT_MAX_PIXELS))]
+    #[allow(non_snake_case)]
+    fn new(
+        py: Python<'_>,
+        design: &Design,
+        camera: &Bound<'_, PyAny>,
+        T_cam_sensor: &Bound<'_, PyAny>,
+        max_pixels: u64,
+    ) -> PyResult<DepthRenderer> {
+        let camera = Camera::of(camera)?;
+        let t = crate::calibration::float64_array(T_cam_sensor, "T_cam_sensor")?;
+        if t.shape() != [4, 4] {
+            return Err(PyValueError::new_err(format!(
+                "T_cam_sensor: shape {} where (4, 4) is needed",
+                crate::calibration::shape_text(t.shape())
+            )));
+        }
+        let t = t.readonly();
+        let t = t.as_array();
+        let m: [[f64; 4]; 4] = std::array::from_fn(|r| std::array::from_fn(|c| t[[r, c]]));
+        let pose = isometry_of(&m).map_err(|(field, value, rule)| {
+            GroundTruthError::new_err(format!("{field} = {value}: {rule}"))
+        })?;
+        let i = camera.model.intrinsics();
+        let pixels = u64::from(i.image_width_px) * u64::from(i.image_height_px);
+        if pixels > max_pixels {
+            return Err(GroundTruthError::new_err(format!(
+                "{}: the camera image is {} x {} = {pixels} pixels, over the ground-truth limit of {max_pixels} pixels (every per-pixel array of a frame is sized by it; raise max_pixels)",
+                camera.source, i.image_width_px, i.image_height_px
+            )));
+        }
+        let design = &design.design;
+        let model = &camera.model;
+        crate::work(py, || {
+            let scene = Scene::new(design, model, &pose, "T_cam_sensor")?;
+            let hits = reference_hits(&scene.rays, &scene.surface);
+            let reference = DepthFrame::new(&scene.rays, &hits);
+            Ok(DepthRenderer {
+                scene,
+                reference_hits: hits,
+                reference,
+            })
+        })?
+        .map_err(|e: String| GroundTruthError::new_err(e))
+    }
+
+    /// (height, width) of every map, px.
+    #[getter]
+    fn shape(&self) -> (usize, usize) {
+        (self.scene.rays.height, self.scene.rays.width)
+    }
+
+    /// The camera centre in the sensor frame, mm.
+    #[getter]
+    fn camera_centre_mm(&self) -> [f64; 3] {
+        self.scene.rays.origin_mm
+    }
+
+    /// The reference (undeformed) skin: dict of `range_mm`, `zdepth_mm` (H, W) float32 mm and
+    /// `normals` (H, W, 3) float32, as the ground truth's `reference/` folder.
+    fn reference<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        frame_dict(py, &self.reference)
+    }
+
+    /// The skin indented by the protrusions of `protrusions` (a ProtrusionSet): as `reference`
+    /// plus `delta_range_mm`, `delta_zdepth_mm` (indented minus reference, mm: negative where
+    /// the skin is pushed towards the camera) and `contact` (H, W) bool (the surface seen is a
+    /// protrusion), as a configuration folder of the ground truth. Raises GroundTruthError
+    /// when the camera centre is inside a protrusion.
+    fn indented<'py>(
+        &self,
+        py: Python<'py>,
+        protrusions: &ProtrusionSet,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let cfg = &protrusions.cfg;
+        self.scene
+            .check_outside(std::slice::from_ref(cfg.as_ref()), "T_cam_sensor")
+            .map_err(GroundTruthError::new_err)?;
+        let frame = crate::work(py, || {
+            let hits = indented_hits(
+                &self.scene.rays,
+                &self.reference_hits,
+                &cfg.primitives,
+                self.scene.surface.base_z_mm(),
+            );
+            DepthFrame::new(&self.scene.rays, &hits)
+        })?;
+        let (h, w) = (frame.height, frame.width);
+        let d = frame_dict(py, &frame)?;
+        let (dr, dz) = frame.delta(&self.reference);
+        d.set_item("delta_range_mm", f32_map(&dr, h, w).into_pyarray(py))?;
+        d.set_item("delta_zdepth_mm", f32_map(&dz, h, w).into_pyarray(py))?;
+        d.set_item(
+            "contact",
+            bool_map(&frame.contact_mask(&self.reference), h, w).into_pyarray(py),
+        )?;
+        Ok(d)
+    }
+
+    /// Every configuration of `protrusions` (a list of ProtrusionSet) rendered with
+    /// `indented`, in order; `progress(done, total, message)` after each.
+    #[pyo3(signature = (protrusions, *, progress=None))]
+    fn indented_all<'py>(
+        &self,
+        py: Python<'py>,
+        protrusions: Vec<PyRef<'py, ProtrusionSet>>,
+        progress: Option<Py<PyAny>>,
+    ) -> PyResult<Vec<Bound<'py, PyDict>>> {
+        let n = protrusions.len();
+        let mut out = Vec::with_capacity(n);
+        for (k, p) in protrusions.iter().enumerate() {
+            out.push(self.indented(py, p)?);
+            report_progress(&progress, k + 1, n, &p.cfg.name);
+        }
+        Ok(out)
+    }
+
+    /// The half masks (left, right), (H, W) bool: pixels whose ray meets the reference
+    /// surface at sensor-frame x < 0 (left) or x >= 0 (right), as left_mask.png and
+    /// right_mask.png.
+    fn masks<'py>(&self, py: Python<'py>) -> PyResult<(BoolMap<'py>, BoolMap<'py>)> {
+        let (h, w) = (self.scene.rays.height, self.scene.rays.width);
+        let (l, r) = half_masks(&self.scene.rays, &self.reference_hits);
+        Ok((
+            bool_map(&l, h, w).into_pyarray(py),
+            bool_map(&r, h, w).into_pyarray(py),
+        ))
+    }
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<ProtrusionSet>()?;
+    m.add_class::<DepthRenderer>()?;
+    m.add_function(wrap_pyfunction!(read_protrusions, m)?)?;
+    Ok(())
+}

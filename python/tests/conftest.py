@@ -1,0 +1,58 @@
+"""Shared fixtures of the `fabkit` Python package's tests.
+
+The tests compare the package with the `fabkit` command line: FABKIT_BIN names the CLI binary
+(scripts/test sets it to the one `cargo test` built). Without it the tests that need it are
+skipped, unless FABKIT_REQUIRE_ORACLES=1 (scripts/test), where they fail.
+"""
+
+import os
+import subprocess
+
+import pytest
+
+
+def _require():
+    return os.environ.get("FABKIT_REQUIRE_ORACLES") == "1"
+
+
+@pytest.fixture(scope="session")
+def fabkit_bin():
+    """Path of the `fabkit` CLI binary (FABKIT_BIN)."""
+    binary = os.environ.get("FABKIT_BIN")
+    why = None
+    if not binary:
+        why = "FABKIT_BIN is not set (path of a built `fabkit` CLI binary)"
+    elif not (os.path.isfile(binary) and os.access(binary, os.X_OK)):
+        why = f"FABKIT_BIN = {binary}: not an executable file"
+    if why:
+        if _require():
+            pytest.fail(why)
+        pytest.skip(why)
+    return binary
+
+
+@pytest.fixture(scope="session")
+def run_cli(fabkit_bin):
+    """run_cli(cwd, *args, ok=True) -> CompletedProcess of `fabkit args...` in cwd (text)."""
+
+    def run(cwd, *args, ok=True):
+        p = subprocess.run(
+            [fabkit_bin, *map(str, args)], cwd=cwd, capture_output=True, text=True, timeout=600
+        )
+        if ok:
+            assert p.returncode == 0, f"fabkit {' '.join(map(str, args))} failed:\n{p.stderr}"
+        else:
+            assert p.returncode != 0, f"fabkit {' '.join(map(str, args))} succeeded"
+        return p
+
+    return run
+
+
+def cli_message(stderr):
+    """The message the CLI printed after `error: ` (with its `caused by:` lines), as the Python
+    exception carries it."""
+    lines = stderr.rstrip("\n").split("\n")
+    start = next(i for i, l in enumerate(lines) if l.startswith("error: "))
+    lines = lines[start:]
+    lines[0] = lines[0][len("error: "):]
+    return "\n".join(lines)

@@ -1,0 +1,297 @@
+"""Tests of fabkit.DepthRenderer and fabkit.read_protrusions against `fabkit groundtruth`.
+
+A 160 x 120 fisheye camera (ROS camera_info YAML), R-Tac0 with 2 protrusion patterns
+(`fabkit fixtures --semidomes 2`), a pose inside the dome given to the CLI as the 4 x 4
+T_cam_sensor of an extrinsics.json; the CLI writes --format npy, and the arrays rendered in
+Python from the same camera file, the same matrix and the same fixtures folder must equal its
+files exactly.
+"""
+
+import json
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import fabkit
+from conftest import cli_message
+from fabkit.groundtruth import _read_png
+
+W, H = 160, 120
+KB = [-0.02, 0.004, -0.0015, 0.0002]
+CAMERA_YAML = f"""image_width: {W}
+image_height: {H}
+camera_name: fabkit
+camera_matrix:
+  rows: 3
+  cols: 3
+  data: [53.75, 0.0, 79.5, 0.0, 53.75, 59.5, 0.0, 0.0, 1.0]
+distortion_model: equidistant
+distortion_coefficients:
+  rows: 1
+  cols: 4
+  data: [{', '.join(map(str, KB))}]
+"""
+FRAME_ARRAYS = ("range_mm", "zdepth_mm", "delta_range_mm", "delta_zdepth_mm", "normals")
+
+
+def rodrigues(r):
+    r = np.asarray(r, float)
+    th = np.linalg.norm(r)
+    k = r / th
+    K = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+    return np.eye(3) + np.sin(th) * K + (1 - np.cos(th)) * K @ K
+
+
+def pose(rvec=(0.02, -0.015, 0.4), tvec=(0.3, -0.2, 10.4)):
+    """The camera inside the dome, about 10.4 mm under the pole, slightly rotated."""
+    t = np.eye(4)
+    t[:3, :3] = rodrigues(rvec)
+    t[:3, 3] = tvec
+    return t
+
+
+def write_extrinsics(path, t):
+    # json writes floats with repr: the CLI reads back the same doubles
+    path.write_text(json.dumps({"T_cam_sensor": np.asarray(t).tolist()}))
+
+
+@pytest.fixture(scope="module")
+def scene(tmp_path_factory, run_cli):
+    d = tmp_path_factory.mktemp("render")
+    (d / "cam.yaml").write_text(CAMERA_YAML)
+    write_extrinsics(d / "extrinsics.json", pose())
+    run_cli(d, "fixtures", "rtac0", "--semidomes", "2", "--seed", "3", "--format", "stl",
+            "--out", "fx")
+    run_cli(d, "groundtruth", "rtac0", "--camera", "cam.yaml", "--extrinsics",
+            "extrinsics.json", "--fixtures", "fx", "--out", "gt", "--format", "npy")
+    t = np.array(json.loads((d / "extrinsics.json").read_text())["T_cam_sensor"])
+    design = fabkit.Design.load("rtac0")
+    return {
+        "dir": d,
+        "gt": d / "gt",
+        "design": design,
+        "T": t,
+        "sets": fabkit.read_protrusions(d / "fx", design),
+        "renderer": fabkit.DepthRenderer(design, str(d / "cam.yaml"), t),
+    }
+
+
+def _mask(path):
+    m = _read_png(str(path))
+    assert m.dtype == np.uint8 and m.shape == (H, W)
+    return m > 0
+
+
+def test_read_protrusions_lists_the_configurations_the_cli_renders(scene):
+    sets = scene["sets"]
+    manifest = json.loads((scene["gt"] / "manifest.json").read_text())
+    patterns = manifest["fixtures"]["patterns"]
+    assert len(patterns) == 2
+    assert [(s.pattern, s.orientation_deg) for s in sets] == [
+        (p, o) for p in patterns for o in (0, 180)
+    ]
+    assert [s.name for s in sets] == [c["dir"] for c in manifest["configurations"]]
+    assert all(s.name == f"{s.pattern}_{s.orientation_deg}" for s in sets)
+    assert all(len(s) >= 1 for s in sets)
+    assert all((scene["gt"] / s.name).is_dir() for s in sets)
+
+
+def test_reference_equals_the_cli_files(scene):
+    r = scene["renderer"]
+    assert r.shape == (H, W)
+    ref = r.reference()
+    assert sorted(ref) == ["normals", "range_mm", "zdepth_mm"]
+    for name, a in ref.items():
+        f = np.load(scene["gt"] / "reference" / f"{name}.npy")
+        assert a.dtype == np.float32 and a.shape == f.shape, name
+        np.testing.assert_array_equal(a, f, err_msg=name)
+    ok = np.isfinite(ref["range_mm"])
+    manifest = json.loads((scene["gt"] / "manifest.json").read_text())
+    assert ok.sum() == sum(m["pixels"] for m in manifest["masks_and_pairs"][:2]) > 5000
+    assert not ok.all()  # the fisheye's corners see past the skin
+    n = ref["normals"][ok]
+    assert np.allclose(np.linalg.norm(n, axis=1), 1.0, atol=1e-5)
+    # the camera centre is the inverse of the pose's translation
+    t = scene["T"]
+    np.testing.assert_allclose(r.camera_centre_mm, -t[:3, :3].T @ t[:3, 3], atol=1e-9)
+
+
+def test_every_configuration_equals_the_cli_files(scene):
+    r = scene["renderer"]
+    ref = r.reference()
+    for s in scene["sets"]:
+        frame = r.indented(s)
+        assert sorted(frame) == sorted(FRAME_ARRAYS + ("contact",))
+        folder = scene["gt"] / s.name
+        for name in FRAME_ARRAYS:
+            f = np.load(folder / f"{name}.npy")
+            a = frame[name]
+            assert a.dtype == np.float32 and a.shape == f.shape, (s.name, name)
+            np.testing.assert_array_equal(a, f, err_msg=f"{s.name}/{name}")
+        c = frame["contact"]
+        assert c.dtype == bool and c.shape == (H, W)
+        np.testing.assert_array_equal(c, _mask(folder / "contact_mask.png"), err_msg=s.name)
+        # the protrusions are seen, and the skin is pushed towards the camera where they are
+        assert c.any(), s.name
+        d = frame["delta_range_mm"]
+        assert np.nanmin(d) < 0 and (d[np.isfinite(d)] <= 0).all(), s.name
+        assert not ((np.nan_to_num(d) < 0) & ~c).any(), s.name
+        np.testing.assert_array_equal(np.isnan(d), np.isnan(ref["range_mm"]))
+        # a 0-deg pattern is on the +x half, its 180-deg twin on the -x half
+        left, right = r.masks()
+        half = right if s.orientation_deg == 0 else left
+        assert c[half].sum() == c.sum(), s.name
+
+
+def test_indented_all_is_indented_in_order_with_progress(scene):
+    r, sets = scene["renderer"], scene["sets"]
+    calls = []
+    frames = r.indented_all(sets, progress=lambda *a: calls.append(a))
+    assert calls == [(k + 1, len(sets), s.name) for k, s in enumerate(sets)]
+    assert len(frames) == len(sets)
+    for s, f in zip(sets, frames):
+        one = r.indented(s)
+        for name in FRAME_ARRAYS + ("contact",):
+            np.testing.assert_array_equal(f[name], one[name], err_msg=f"{s.name}/{name}")
+    assert r.indented_all([]) == []
+
+
+def test_masks_equal_the_cli_pngs(scene):
+    left, right = scene["renderer"].masks()
+    for m, name in ((left, "left_mask.png"), (right, "right_mask.png")):
+        assert m.dtype == bool and m.shape == (H, W)
+        np.testing.assert_array_equal(m, _mask(scene["gt"] / name), err_msg=name)
+    assert not (left & right).any()
+    np.testing.assert_array_equal(left | right,
+                                  np.isfinite(scene["renderer"].reference()["range_mm"]))
+    assert left.sum() > 1000 and right.sum() > 1000
+
+
+def test_camera_object_and_array_likes_render_the_same(scene):
+    cam = fabkit.Camera.from_file(scene["dir"] / "cam.yaml")
+    r2 = fabkit.DepthRenderer(scene["design"], cam, scene["T"].tolist())
+    ref1, ref2 = scene["renderer"].reference(), r2.reference()
+    for name in ref1:
+        np.testing.assert_array_equal(ref1[name], ref2[name], err_msg=name)
+    # another pose renders another image (the comparison above can fail)
+    r3 = fabkit.DepthRenderer(scene["design"], cam, pose(tvec=(0.3, -0.2, 9.0)))
+    assert not np.array_equal(r3.reference()["range_mm"], ref1["range_mm"], equal_nan=True)
+
+
+def test_camera_outside_the_body_is_the_cli_message(scene, run_cli):
+    d = scene["dir"]
+    far = np.eye(4)
+    far[2, 3] = -40.0  # the camera centre 40 mm above the pole
+    write_extrinsics(d / "far.json", far)
+    out = run_cli(d, "groundtruth", "rtac0", "--camera", "cam.yaml", "--extrinsics",
+                  "far.json", "--fixtures", "fx", "--out", "gt_far", ok=False)
+    cli = cli_message(out.stderr)
+    with pytest.raises(fabkit.GroundTruthError) as e:
+        fabkit.DepthRenderer(scene["design"], str(d / "cam.yaml"), far)
+    py = str(e.value)
+    assert isinstance(e.value, fabkit.FabkitError)
+    # the CLI names the extrinsics file, Python the argument; the rest is the same
+    assert cli.startswith("far.json: the camera centre [0.000, 0.000, 40.000] mm"), cli
+    assert py.startswith("T_cam_sensor: ")
+    assert cli[len("far.json"):] == py[len("T_cam_sensor"):]
+    assert not (d / "gt_far").exists()
+
+
+def test_a_non_rigid_pose_names_the_rule_as_the_cli(scene, run_cli, monkeypatch):
+    d = scene["dir"]
+    monkeypatch.chdir(d)
+    skew = np.eye(4)
+    skew[0, 1] = 0.1
+    skew[2, 3] = 10.0
+    write_extrinsics(d / "skew.json", skew)
+    out = run_cli(d, "groundtruth", "rtac0", "--camera", "cam.yaml", "--extrinsics",
+                  "skew.json", "--fixtures", "fx", "--out", "gt_skew", ok=False)
+    with pytest.raises(fabkit.GroundTruthError) as e:
+        fabkit.DepthRenderer(scene["design"], "cam.yaml", skew)
+    py = str(e.value)
+    assert py.startswith("T_cam_sensor = ")
+    assert py.endswith(": the 3 x 3 block must be a rotation (orthonormal, determinant +1, to 1e-6)")
+    assert cli_message(out.stderr) == "skew.json: " + py
+    # a last row other than [0, 0, 0, 1]
+    bad = pose()
+    bad[3, 0] = 0.5
+    with pytest.raises(fabkit.GroundTruthError, match=r"^T_cam_sensor\[3\] = .*: must be \[0, 0, 0, 1\]$"):
+        fabkit.DepthRenderer(scene["design"], str(d / "cam.yaml"), bad)
+
+
+def test_a_non_finite_pose_and_wrong_shapes(scene):
+    cam = str(scene["dir"] / "cam.yaml")
+    t = pose()
+    t[1, 3] = np.nan
+    with pytest.raises(fabkit.GroundTruthError, match=r"^T_cam_sensor = .*: must be finite$"):
+        fabkit.DepthRenderer(scene["design"], cam, t)
+    with pytest.raises(ValueError, match=r"T_cam_sensor: shape \(3, 4\) where \(4, 4\) is needed"):
+        fabkit.DepthRenderer(scene["design"], cam, pose()[:3])
+    with pytest.raises(ValueError, match=r"T_cam_sensor: shape \(16,\)"):
+        fabkit.DepthRenderer(scene["design"], cam, pose().ravel())
+
+
+def test_max_pixels_is_the_cli_limit(scene, run_cli, monkeypatch):
+    d = scene["dir"]
+    monkeypatch.chdir(d)  # the camera file named as the CLI names it
+    out = run_cli(d, "groundtruth", "rtac0", "--camera", "cam.yaml", "--extrinsics",
+                  "extrinsics.json", "--fixtures", "fx", "--out", "gt_small",
+                  "--max-pixels", str(W * H - 1), ok=False)
+    with pytest.raises(fabkit.GroundTruthError) as e:
+        fabkit.DepthRenderer(scene["design"], "cam.yaml", scene["T"], max_pixels=W * H - 1)
+    # the same message but for the hint (a keyword argument, not a command-line option)
+    cli, py = cli_message(out.stderr), str(e.value)
+    stem = f"cam.yaml: the camera image is {W} x {H} = {W * H} pixels, over the ground-truth limit of {W * H - 1} pixels"
+    assert cli.startswith(stem) and py.startswith(stem), (cli, py)
+    assert py.endswith("raise max_pixels)")
+    assert fabkit.DepthRenderer(scene["design"], "cam.yaml", scene["T"], max_pixels=W * H).shape == (H, W)
+
+
+def _progress_during(call):
+    """Runs call() in a thread while this thread counts; returns (result, stamps of the count
+    taken while the call ran, the call's start and end times)."""
+    box = {}
+    done = threading.Event()
+
+    def worker():
+        box["t0"] = time.perf_counter()
+        box["out"] = call()
+        box["t1"] = time.perf_counter()
+        done.set()
+
+    th = threading.Thread(target=worker)
+    stamps = []
+    n = 0
+    th.start()
+    while not done.is_set():
+        n += 1
+        if n % 200 == 0:
+            stamps.append(time.perf_counter())
+    th.join()
+    return box["out"], np.array(stamps), box["t0"], box["t1"]
+
+
+def test_renders_release_the_gil(scene):
+    # a larger camera (1280 x 960, the same lens) so that each render takes a while
+    s = 8
+    cam = fabkit.Camera(53.75 * s, 53.75 * s, (W * s - 1) / 2, (H * s - 1) / 2, W * s, H * s,
+                        "fisheye", KB)
+    design, t, sets = scene["design"], scene["T"], scene["sets"]
+    holder = {}
+
+    def construct():
+        holder["r"] = fabkit.DepthRenderer(design, cam, t)
+
+    for what, call in (("DepthRenderer()", construct),
+                       ("indented()", lambda: holder["r"].indented(sets[0])),
+                       ("indented_all()", lambda: holder["r"].indented_all(sets[:2]))):
+        _, stamps, t0, t1 = _progress_during(call)
+        dur = t1 - t0
+        assert dur > 0.02, (what, dur)
+        # the counting thread ran in the first half of the call (not only before and after it):
+        # with the GIL held by the render it could not run at all in between
+        inside = ((stamps > t0 + 0.1 * dur) & (stamps < t0 + 0.5 * dur)).sum()
+        assert inside >= 10, (what, dur, inside)
+    assert holder["r"].shape == (H * s, W * s)
