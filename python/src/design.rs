@@ -115,6 +115,43 @@ fn value_at_depth(obj: &Bound<'_, PyAny>, at: &str, depth: usize) -> PyResult<Va
     )))
 }
 
+/// `v` read as a `T` (a design, fixture parameters). A value that does not fit is a DesignError
+/// whose one ParamError names its path (`layers[1].thickness_mm`), the value and the rule:
+/// `<origin>: path = value: rule`.
+pub(crate) fn typed_from<T: serde::de::DeserializeOwned>(v: Value, origin: &str) -> PyResult<T> {
+    let kept = v.clone();
+    serde_path_to_error::deserialize::<_, T>(v).map_err(|e| {
+        let path = e.path().to_string();
+        let rule = e.inner().to_string();
+        let value = NumberPath::parse(&path)
+            .and_then(|p| value_at_path(&kept, &p))
+            .map_or_else(|| "(missing)".to_string(), |x| shown(&x));
+        let item = ParamError {
+            path: path.clone(),
+            value: value.clone(),
+            rule: rule.clone(),
+        };
+        param_errors(format!("{origin}: {path} = {value}: {rule}"), vec![item])
+    })
+}
+
+/// A value as an error shows it: text quoted, numbers and booleans as written, lists and maps
+/// in brief.
+fn shown(v: &Value) -> String {
+    match v {
+        Value::String(s) => format!("{s:?}"),
+        Value::F64(x) => x.to_string(),
+        Value::I64(x) => x.to_string(),
+        Value::U64(x) => x.to_string(),
+        Value::Bool(b) => b.to_string(),
+        Value::Option(None) | Value::Unit => "null".into(),
+        Value::Option(Some(x)) | Value::Newtype(x) => shown(x),
+        Value::Seq(items) => format!("a list of {}", items.len()),
+        Value::Map(_) => "a mapping".into(),
+        other => format!("{other:?}"),
+    }
+}
+
 /// A serialized value as the Python value it reads as.
 pub(crate) fn py_of(py: Python<'_>, v: &Value) -> PyResult<Py<PyAny>> {
     Ok(match v {
@@ -224,8 +261,7 @@ impl Design {
     fn from_dict(data: &Bound<'_, PyAny>) -> PyResult<Design> {
         let v = value_of(data, "")?;
         let text = format!("{:?}", v);
-        let d = DesignData::deserialize_value(v)
-            .map_err(|e| param_errors(format!("<dict>: {e}"), Vec::new()))?;
+        let d: DesignData = typed_from(v, "<dict>")?;
         Ok(Design::of(d, "<dict>".into(), sha256_hex(&text)))
     }
 
@@ -371,15 +407,4 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(library_designs, m)?)?;
     m.add("DEFAULT_DESIGN", library::DEFAULT_DESIGN)?;
     Ok(())
-}
-
-trait DeserializeValue: Sized {
-    fn deserialize_value(v: Value) -> Result<Self, serde_value::DeserializerError>;
-}
-
-impl DeserializeValue for DesignData {
-    fn deserialize_value(v: Value) -> Result<Self, serde_value::DeserializerError> {
-        use serde::Deserialize as _;
-        DesignData::deserialize(v)
-    }
 }

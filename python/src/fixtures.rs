@@ -12,8 +12,8 @@ use numpy::IntoPyArray;
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyString};
 
-use crate::design::{value_of, Design};
-use crate::errors::{design_error, param_errors};
+use crate::design::{typed_from, value_of, Design};
+use crate::errors::design_error;
 use crate::kit::{report_progress, Kit};
 
 /// A design's fixtures: the printable parts (`kit`, written by `export` as `fabkit fixtures`
@@ -120,12 +120,7 @@ pub fn build_fixtures(
     let base: Option<FixtureParams> = match params {
         None => None,
         Some(p) if p.is_instance_of::<PyDict>() => {
-            use serde::Deserialize as _;
-            let v = value_of(p, "")?;
-            Some(
-                FixtureParams::deserialize(v)
-                    .map_err(|e| param_errors(format!("params: {e}"), Vec::new()))?,
-            )
+            Some(typed_from::<FixtureParams>(value_of(p, "")?, "params")?)
         }
         Some(p) => {
             let path: std::path::PathBuf = if p.is_instance_of::<PyString>() {

@@ -55,15 +55,18 @@ def test_wrong_type_argument_is_type_error():
 
 
 def test_wrong_type_in_dict_is_design_error():
-    """A dict whose value has the wrong type: DesignError naming the offending value and the
-    expected type; a dict missing a required field: DesignError naming it."""
+    """A dict whose value has the wrong type: DesignError naming the parameter path, the
+    offending value and the expected type (`<dict>: path = value: rule`); a dict missing a
+    required field: DesignError naming it."""
     d = fabkit.Design.load("rtac0").to_dict()
-    d["body"]["radius_mm"] = "fifteen"
+    d["layers"][1]["thickness_mm"] = "fifteen"
     with pytest.raises(fabkit.DesignError) as e:
         fabkit.Design.from_dict(d)
-    assert str(e.value).startswith("<dict>: ")
-    assert "fifteen" in str(e.value) and "f64" in str(e.value)
-    assert e.value.errors == []
+    assert str(e.value).startswith('<dict>: layers[1].thickness_mm = "fifteen": ')
+    assert "f64" in str(e.value)
+    [item] = e.value.errors
+    assert (item.path, item.value) == ("layers[1].thickness_mm", '"fifteen"')
+    assert str(e.value) == f"<dict>: {item}"
     with pytest.raises(fabkit.DesignError, match="name"):
         fabkit.Design.from_dict({})
     with pytest.raises(TypeError, match="key must be text"):
