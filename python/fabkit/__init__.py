@@ -37,3 +37,4 @@ from ._fabkit import (  # noqa: F401
     read_protrusions,
 )
 from .groundtruth import GroundTruth, StitchedPair  # noqa: F401
+from .sweep import SweepTables, sweep  # noqa: F401

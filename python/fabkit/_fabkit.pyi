@@ -281,3 +281,18 @@ def _library_build_seconds(
     design: Design, repeats: int, *, chord_tolerance_mm: float = 0.01
 ) -> List[float]:
     """Benchmark hook: wall times, s, of the library's kit build alone."""
+
+# The native side of fabkit.sweep (python/fabkit/sweep.py); not a public interface.
+def _sweep_plan(
+    design: Design, variants: Any, chord_tolerance_mm: float
+) -> Tuple[List[str], List[Tuple[int, str, str]]]: ...
+def _sweep_base(design: Design) -> str: ...
+def _sweep_evaluate(
+    base_json: str, chord_tolerance_mm: float, max_triangles: int, index: int, id: str,
+    params_json: str,
+) -> str: ...
+def _sweep_run_threads(
+    base_json: str, chord_tolerance_mm: float, max_triangles: int,
+    variants: List[Tuple[int, str, str]], jobs: int, progress: Optional[Progress] = None,
+) -> List[str]: ...
+def _sweep_tables(parameters: List[str], results: List[str], build_time: bool) -> Tuple[str, str]: ...

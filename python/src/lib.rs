@@ -19,6 +19,7 @@ mod errors;
 mod fixtures;
 mod groundtruth;
 mod kit;
+mod sweep;
 
 pub(crate) use errors::internal;
 
@@ -49,5 +50,6 @@ fn _fabkit(m: &Bound<'_, PyModule>) -> PyResult<()> {
     calibration::register(m)?;
     groundtruth::register(m)?;
     bench::register(m)?;
+    sweep::register(m)?;
     Ok(())
 }

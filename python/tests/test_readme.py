@@ -1,4 +1,4 @@
-"""The README's "From Python" example runs as written, on inputs the CLI makes: a camera file
+"""The README's first "From Python" example (arrays) runs as written, on inputs the CLI makes: a camera file
 (cam.yaml), a calibration (calib/extrinsics.json), the R-Tac0 fixtures (out/rtac0_fixtures) and
 a ground-truth folder (gt), in a fresh folder."""
 
@@ -20,7 +20,7 @@ def readme_example():
     section = text[text.index("\n## From Python\n"):]
     section = section[: section.index("\n## ", 1)]
     blocks = re.findall(r"```python\n(.*?)```", section, re.S)
-    assert len(blocks) == 1, "the section has one Python example"
+    assert len(blocks) == 2, "the section has two Python examples: arrays, then a sweep"
     return blocks[0]
 
 

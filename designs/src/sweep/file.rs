@@ -1,11 +1,11 @@
 //! The sweep file: which design, which parameters take which values, how they combine and
 //! what to write. Every problem is reported before anything runs, at its `file:line:column`.
 
-use super::paths::{expand_short_path, nearest_paths, path_exists, with_value};
+use super::variants::{checked_path, checked_value};
 use super::SweepError;
 use crate::input_files::{read_text_file, DataFileRules, MAX_DESIGN_FILE_BYTES};
 use crate::library::{load_source_with, LoadedDesign};
-use crate::schema::{yaml_error, Design};
+use crate::schema::yaml_error;
 use crate::ChordTolerance;
 use serde::de::{MapAccess, Visitor};
 use serde::{Deserialize, Deserializer, Serialize};
@@ -279,22 +279,9 @@ impl SweepSpec {
             })?;
         let mut parameters: Vec<Parameter> = Vec::new();
         for (key, spec) in &raw.vary.value.0 {
-            let mut path = key.value.trim().to_string();
             let here = at(origin, key);
-            if !path_exists(&base.design, &path) {
-                // A short path (`markers.spacing_mm`) stands for the one full path it fits.
-                if let Some(full) = expand_short_path(&base.design, &path) {
-                    path = full;
-                }
-            }
-            if !path_exists(&base.design, &path) {
-                return Err(SweepError::UnknownPath {
-                    at: here,
-                    path: path.clone(),
-                    design: base.design.name.clone(),
-                    nearest: nearest_paths(&base.design, &path, 3),
-                });
-            }
+            // A short path (`markers.spacing_mm`) stands for the one full path it fits.
+            let path = checked_path(&base.design, &key.value, &here)?;
             if let Some(other) = parameters.iter().find(|p: &&Parameter| p.path == path) {
                 return Err(file_err(
                     here,
@@ -303,12 +290,6 @@ impl SweepSpec {
                         key.value.trim(),
                         other.at
                     ),
-                ));
-            }
-            if path.ends_with(".csv_file") {
-                return Err(file_err(
-                    here,
-                    format!("vary.{path}: marker CSV files are read once, when the base design loads; vary the pattern's `points` instead"),
                 ));
             }
             let values = values_of(&spec.value)
@@ -320,24 +301,7 @@ impl SweepSpec {
                         format!("vary.{path}: the value {v} is listed twice"),
                     ));
                 }
-                let replaced =
-                    with_value(&base_json, &path, v).ok_or_else(|| SweepError::UnknownPath {
-                        at: here.clone(),
-                        path: path.clone(),
-                        design: base.design.name.clone(),
-                        nearest: nearest_paths(&base.design, &path, 3),
-                    })?;
-                let variant = match serde_json::from_value::<Design>(replaced) {
-                    Ok(d) => d,
-                    Err(e) => {
-                        return Err(SweepError::WrongValue {
-                            at: at(origin, spec),
-                            path: path.clone(),
-                            value: v.to_string(),
-                            message: e.to_string(),
-                        })
-                    }
-                };
+                let variant = checked_value(&base.design, &base_json, &path, v, &at(origin, spec))?;
                 // A parameter the rest of the design ignores would give identical variants.
                 if i == 0 {
                     if let Err(errs) = crate::stack::validate(&variant, &materials, chord_tolerance)

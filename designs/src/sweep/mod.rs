@@ -32,6 +32,7 @@ mod paths;
 mod plan;
 mod results;
 mod run;
+mod variants;
 
 pub use effect::{MAX_CONTEXT_VALUES, MAX_PROBED_VALUES, PROBE_CHORD_TOLERANCE_MM};
 pub use file::{values_of, FileOutputs, Mode, Output, Parameter, SweepSpec};
@@ -46,6 +47,9 @@ pub use results::{render_csv, render_jsonl, Status, VariantResult};
 pub use run::{
     record, run, write_atomic, Event, FilesJob, KitWriter, RunOptions, RunSummary, SweepRecord,
     FORMAT,
+};
+pub use variants::{
+    checked_path, checked_value, evaluate_variant, plan_variants, resolve_variant, VariantList,
 };
 
 use crate::error::DesignError;

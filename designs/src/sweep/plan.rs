@@ -2,7 +2,7 @@
 //! shards.
 
 use super::file::{Mode, SweepSpec};
-use super::paths::{canonical_json, with_value};
+use super::paths::canonical_json;
 use super::SweepError;
 use crate::schema::Design;
 use rand_chacha::rand_core::SeedableRng;
@@ -58,29 +58,7 @@ impl SweepSpec {
     /// [`SweepError::WrongValue`] if a value does not fit the schema (checked per value when
     /// the file was parsed, so only a defect reaches this).
     pub fn resolve(&self, params: &[(String, Value)]) -> Result<Design, SweepError> {
-        let mut v = serde_json::to_value(&self.base.design).unwrap_or(Value::Null);
-        for (path, value) in params {
-            v = with_value(&v, path, value).ok_or_else(|| SweepError::UnknownPath {
-                at: self.origin.clone(),
-                path: path.clone(),
-                design: self.base.design.name.clone(),
-                nearest: vec![],
-            })?;
-        }
-        serde_json::from_value(v).map_err(|e| SweepError::WrongValue {
-            at: self.origin.clone(),
-            path: params
-                .iter()
-                .map(|p| p.0.as_str())
-                .collect::<Vec<_>>()
-                .join(", "),
-            value: params
-                .iter()
-                .map(|p| p.1.to_string())
-                .collect::<Vec<_>>()
-                .join(", "),
-            message: e.to_string(),
-        })
+        super::variants::resolve_variant(&self.base.design, &self.origin, params)
     }
 
     /// Expands the sweep into its variants.

@@ -2,10 +2,10 @@
 //! written atomically, resume, shards.
 
 use super::file::{FileOutputs, Mode, SweepSpec};
-use super::metrics::{evaluate_bounded, printability, Outcome};
 use super::paths::canonical_json;
 use super::plan::{hex, Plan, Shard, Variant};
 use super::results::{render_csv, render_jsonl, Status, VariantResult};
+use super::variants::evaluate_variant;
 use super::SweepError;
 use crate::kit::Kit;
 use crate::materials::MaterialsTable;
@@ -554,83 +554,40 @@ fn run_variant(
     opts: &RunOptions,
     writer: Option<&dyn KitWriter>,
 ) -> VariantResult {
-    let t0 = std::time::Instant::now();
     let tol = spec.chord_tolerance;
-    let mut result = VariantResult {
-        index: v.index,
-        id: v.id.clone(),
-        params: v.params.iter().cloned().collect(),
-        status: Status::Error,
-        errors: vec![],
-        metrics: None,
-        printability: vec![],
-        files: FileOutputs::default(),
-        build_time_s: None,
-        fabkit_version: opts.fabkit_version.clone(),
-    };
-    let design = match spec.resolve(&v.params) {
-        Ok(d) => d,
-        Err(e) => {
-            result.errors = vec![e.to_string()];
-            return result;
+    let write = |design: &Design, kit: &Kit| -> Result<(), String> {
+        let canon = canonical_json(&serde_json::to_value(design).unwrap_or_default());
+        let job = FilesJob {
+            dir: vdir.join(&v.id),
+            files: spec.files,
+            variant: v,
+            design,
+            design_sha256: hex(&Sha256::digest(canon.as_bytes())),
+            design_source: format!(
+                "{} variant {} of sweep {}",
+                spec.base.source, v.id, spec.origin
+            ),
+            chord_tolerance_mm: tol.mm(),
+        };
+        match writer {
+            Some(w) => w.write(kit, &job),
+            None => Ok(()),
         }
     };
-    // A panic in the kernel must not end the sweep: record it as this variant's error.
-    let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        let outcome = evaluate_bounded(&design, materials, tol, opts.max_triangles);
-        let verdicts = printability(&design, materials, tol);
-        (outcome, verdicts)
-    }));
-    match outcome {
-        Err(panic) => {
-            let msg = panic
-                .downcast_ref::<String>()
-                .cloned()
-                .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
-                .unwrap_or_default();
-            result.errors = vec![format!("the build panicked (a fabkit defect): {msg}")];
-        }
-        Ok((outcome, verdicts)) => {
-            result.printability = verdicts;
-            match outcome {
-                Outcome::Infeasible(e) => {
-                    result.status = Status::Infeasible;
-                    result.errors = e;
-                }
-                Outcome::Error(e) => result.errors = vec![e],
-                Outcome::Ok { metrics, kit } => {
-                    let written = match writer.filter(|_| spec.files.any()) {
-                        None => Ok(()),
-                        Some(w) => {
-                            let canon =
-                                canonical_json(&serde_json::to_value(&design).unwrap_or_default());
-                            let job = FilesJob {
-                                dir: vdir.join(&v.id),
-                                files: spec.files,
-                                variant: v,
-                                design: &design,
-                                design_sha256: hex(&Sha256::digest(canon.as_bytes())),
-                                design_source: format!(
-                                    "{} variant {} of sweep {}",
-                                    spec.base.source, v.id, spec.origin
-                                ),
-                                chord_tolerance_mm: tol.mm(),
-                            };
-                            w.write(&kit, &job)
-                        }
-                    };
-                    match written {
-                        Ok(()) => {
-                            result.status = Status::Ok;
-                            result.metrics = Some(metrics);
-                            result.files = spec.files;
-                        }
-                        Err(e) => result.errors = vec![format!("writing the files: {e}")],
-                    }
-                }
-            }
-        }
-    }
-    result.build_time_s = Some(t0.elapsed().as_secs_f64());
-    result
+    let write: Option<&dyn Fn(&Design, &Kit) -> Result<(), String>> =
+        if writer.is_some() && spec.files.any() {
+            Some(&write)
+        } else {
+            None
+        };
+    evaluate_variant(
+        v,
+        spec.resolve(&v.params).map_err(|e| e.to_string()),
+        materials,
+        tol,
+        opts.max_triangles,
+        &opts.fabkit_version,
+        spec.files,
+        write,
+    )
 }

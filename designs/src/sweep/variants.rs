@@ -1,0 +1,294 @@
+//! Sweeps given as a list of variants, each a list of (parameter path, value), rather than a
+//! sweep file: what the Python package's `fabkit.sweep` runs on any executor. The checks, the
+//! ids and the results are those of a sweep file ([`super::SweepSpec`]), so the same variants
+//! give the same results table as `fabkit sweep`.
+
+use super::file::FileOutputs;
+use super::metrics::{evaluate_bounded, printability, Outcome};
+use super::paths::{expand_short_path, nearest_paths, path_exists, with_value};
+use super::plan::{variant_id, Variant, MAX_VARIANTS};
+use super::results::{Status, VariantResult};
+use super::SweepError;
+use crate::geometry::ChordTolerance;
+use crate::kit::Kit;
+use crate::materials::MaterialsTable;
+use crate::schema::Design;
+use serde_json::Value;
+
+/// The full parameter path of `design` that `given` names: itself, or the one path a short
+/// path (`markers.spacing_mm`) stands for. `at` locates `given` in errors.
+///
+/// # Errors
+/// [`SweepError::UnknownPath`] with the nearest paths; [`SweepError::File`] for a marker CSV
+/// file path (read once, when the base design loads).
+pub fn checked_path(design: &Design, given: &str, at: &str) -> Result<String, SweepError> {
+    let mut path = given.trim().to_string();
+    if !path_exists(design, &path) {
+        if let Some(full) = expand_short_path(design, &path) {
+            path = full;
+        }
+    }
+    if !path_exists(design, &path) {
+        return Err(SweepError::UnknownPath {
+            at: at.to_string(),
+            path,
+            design: design.name.clone(),
+            nearest: nearest_paths(design, given.trim(), 3),
+        });
+    }
+    if path.ends_with(".csv_file") {
+        return Err(SweepError::File {
+            at: at.to_string(),
+            message: format!("vary.{path}: marker CSV files are read once, when the base design loads; vary the pattern's `points` instead"),
+        });
+    }
+    Ok(path)
+}
+
+/// The design `base_json` (a design's JSON form, of `design`) with `value` at the full path
+/// `path`. `at` locates the value in errors.
+///
+/// # Errors
+/// [`SweepError::WrongValue`] with the path, the value and the schema's rule.
+pub fn checked_value(
+    design: &Design,
+    base_json: &Value,
+    path: &str,
+    value: &Value,
+    at: &str,
+) -> Result<Design, SweepError> {
+    let replaced = with_value(base_json, path, value).ok_or_else(|| SweepError::UnknownPath {
+        at: at.to_string(),
+        path: path.to_string(),
+        design: design.name.clone(),
+        nearest: nearest_paths(design, path, 3),
+    })?;
+    serde_json::from_value::<Design>(replaced).map_err(|e| SweepError::WrongValue {
+        at: at.to_string(),
+        path: path.to_string(),
+        value: value.to_string(),
+        message: e.to_string(),
+    })
+}
+
+/// A sweep given as variants: its parameters (the union of the variants' paths, full paths in
+/// order of first appearance: the results table's parameter columns) and its variants (index,
+/// id, values by full path).
+#[derive(Debug, Clone, PartialEq)]
+pub struct VariantList {
+    pub parameters: Vec<String>,
+    pub variants: Vec<Variant>,
+}
+
+/// Checks and plans the variants `given` of `base` built at `tol`: every path a parameter path
+/// (short paths expanded), every value of the parameter's type, no path twice in a variant, no
+/// two variants the same design. `origin` names the list in errors: variant `i` is at
+/// `<origin>[i]` (`variants[3]`).
+///
+/// # Errors
+/// [`SweepError::UnknownPath`], [`SweepError::WrongValue`] naming the variant, the path and
+/// the value; [`SweepError::File`] for an empty list, more than [`MAX_VARIANTS`] variants, a
+/// variant without parameters, a path given twice or two variants that resolve to the same
+/// design.
+pub fn plan_variants(
+    base: &Design,
+    origin: &str,
+    given: &[Vec<(String, Value)>],
+    tol: ChordTolerance,
+) -> Result<VariantList, SweepError> {
+    let file_err = |at: String, message: String| SweepError::File { at, message };
+    if given.is_empty() {
+        return Err(file_err(
+            origin.to_string(),
+            "no variants: give at least one {parameter path: value}".into(),
+        ));
+    }
+    if given.len() as u64 > MAX_VARIANTS {
+        return Err(file_err(
+            origin.to_string(),
+            format!(
+                "the sweep has {} variants, more than the {MAX_VARIANTS} allowed",
+                given.len()
+            ),
+        ));
+    }
+    let base_json = serde_json::to_value(base).map_err(|e| SweepError::File {
+        at: origin.to_string(),
+        message: e.to_string(),
+    })?;
+    let mut parameters: Vec<String> = Vec::new();
+    let mut variants = Vec::with_capacity(given.len());
+    let mut seen: std::collections::HashMap<String, usize> = Default::default();
+    for (index, values) in given.iter().enumerate() {
+        let at = format!("{origin}[{index}]");
+        if values.is_empty() {
+            return Err(file_err(
+                at,
+                "a variant without parameters: give at least one {parameter path: value}".into(),
+            ));
+        }
+        let mut json = base_json.clone();
+        let mut params: Vec<(String, Value)> = Vec::with_capacity(values.len());
+        for (given_path, value) in values {
+            let path = checked_path(base, given_path, &at)?;
+            if params.iter().any(|(p, _)| *p == path) {
+                return Err(file_err(
+                    at,
+                    format!("'{given_path}' names {path}, which this variant sets already: give each parameter once"),
+                ));
+            }
+            // each value checked on its own against the base, as a sweep file's values are
+            checked_value(base, &base_json, &path, value, &at)?;
+            json = with_value(&json, &path, value).unwrap_or(json);
+            params.push((path, value.clone()));
+        }
+        let design: Design = serde_json::from_value(json).map_err(|e| SweepError::WrongValue {
+            at: at.clone(),
+            path: params
+                .iter()
+                .map(|p| p.0.as_str())
+                .collect::<Vec<_>>()
+                .join(", "),
+            value: params
+                .iter()
+                .map(|p| p.1.to_string())
+                .collect::<Vec<_>>()
+                .join(", "),
+            message: e.to_string(),
+        })?;
+        let id = variant_id(&design, tol.mm());
+        if let Some(other) = seen.insert(id.clone(), index) {
+            return Err(file_err(
+                origin.to_string(),
+                format!(
+                    "variants {other} and {index} resolve to the same design (id {id}); remove the duplicate value"
+                ),
+            ));
+        }
+        for (p, _) in &params {
+            if !parameters.contains(p) {
+                parameters.push(p.clone());
+            }
+        }
+        variants.push(Variant { index, id, params });
+    }
+    Ok(VariantList {
+        parameters,
+        variants,
+    })
+}
+
+/// The base design `base_json` (JSON form) with the values of `params` set.
+///
+/// # Errors
+/// [`SweepError::UnknownPath`] or [`SweepError::WrongValue`] (checked when the variants were
+/// planned, so only a defect reaches this), located at `origin`.
+pub fn resolve_variant(
+    base: &Design,
+    origin: &str,
+    params: &[(String, Value)],
+) -> Result<Design, SweepError> {
+    let mut v = serde_json::to_value(base).unwrap_or(Value::Null);
+    for (path, value) in params {
+        v = with_value(&v, path, value).ok_or_else(|| SweepError::UnknownPath {
+            at: origin.to_string(),
+            path: path.clone(),
+            design: base.name.clone(),
+            nearest: vec![],
+        })?;
+    }
+    serde_json::from_value(v).map_err(|e| SweepError::WrongValue {
+        at: origin.to_string(),
+        path: params
+            .iter()
+            .map(|p| p.0.as_str())
+            .collect::<Vec<_>>()
+            .join(", "),
+        value: params
+            .iter()
+            .map(|p| p.1.to_string())
+            .collect::<Vec<_>>()
+            .join(", "),
+        message: e.to_string(),
+    })
+}
+
+/// Builds and measures one variant (`design`: the base with `v`'s values set, or why it could
+/// not be resolved), as `fabkit sweep` does: status, violations or failure, metrics and
+/// printability verdicts; a kernel panic is this variant's error, not the sweep's end. `write`
+/// writes the files of an ok variant (`None`: metrics only); its error is the variant's.
+/// `build_time_s` is the wall time of it all.
+#[allow(clippy::too_many_arguments)]
+pub fn evaluate_variant(
+    v: &Variant,
+    design: Result<Design, String>,
+    materials: &MaterialsTable,
+    tol: ChordTolerance,
+    max_triangles: u64,
+    fabkit_version: &str,
+    files: FileOutputs,
+    write: Option<&dyn Fn(&Design, &Kit) -> Result<(), String>>,
+) -> VariantResult {
+    let t0 = std::time::Instant::now();
+    let mut result = VariantResult {
+        index: v.index,
+        id: v.id.clone(),
+        params: v.params.iter().cloned().collect(),
+        status: Status::Error,
+        errors: vec![],
+        metrics: None,
+        printability: vec![],
+        files: FileOutputs::default(),
+        build_time_s: None,
+        fabkit_version: fabkit_version.to_string(),
+    };
+    let design = match design {
+        Ok(d) => d,
+        Err(e) => {
+            result.errors = vec![e];
+            return result;
+        }
+    };
+    // A panic in the kernel must not end the sweep: record it as this variant's error.
+    let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        let outcome = evaluate_bounded(&design, materials, tol, max_triangles);
+        let verdicts = printability(&design, materials, tol);
+        (outcome, verdicts)
+    }));
+    match outcome {
+        Err(panic) => {
+            let msg = panic
+                .downcast_ref::<String>()
+                .cloned()
+                .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
+                .unwrap_or_default();
+            result.errors = vec![format!("the build panicked (a fabkit defect): {msg}")];
+        }
+        Ok((outcome, verdicts)) => {
+            result.printability = verdicts;
+            match outcome {
+                Outcome::Infeasible(e) => {
+                    result.status = Status::Infeasible;
+                    result.errors = e;
+                }
+                Outcome::Error(e) => result.errors = vec![e],
+                Outcome::Ok { metrics, kit } => {
+                    let written = match write {
+                        None => Ok(()),
+                        Some(w) => w(&design, &kit),
+                    };
+                    match written {
+                        Ok(()) => {
+                            result.status = Status::Ok;
+                            result.metrics = Some(metrics);
+                            result.files = files;
+                        }
+                        Err(e) => result.errors = vec![format!("writing the files: {e}")],
+                    }
+                }
+            }
+        }
+    }
+    result.build_time_s = Some(t0.elapsed().as_secs_f64());
+    result
+}
