@@ -50,6 +50,7 @@ pub use run::{
 };
 pub use variants::{
     checked_path, checked_value, evaluate_variant, plan_variants, resolve_variant, VariantList,
+    WriteFiles,
 };
 
 use crate::error::DesignError;

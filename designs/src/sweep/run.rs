@@ -5,7 +5,7 @@ use super::file::{FileOutputs, Mode, SweepSpec};
 use super::paths::canonical_json;
 use super::plan::{hex, Plan, Shard, Variant};
 use super::results::{render_csv, render_jsonl, Status, VariantResult};
-use super::variants::evaluate_variant;
+use super::variants::{evaluate_variant, WriteFiles};
 use super::SweepError;
 use crate::kit::Kit;
 use crate::materials::MaterialsTable;
@@ -574,12 +574,11 @@ fn run_variant(
             None => Ok(()),
         }
     };
-    let write: Option<&dyn Fn(&Design, &Kit) -> Result<(), String>> =
-        if writer.is_some() && spec.files.any() {
-            Some(&write)
-        } else {
-            None
-        };
+    let write: Option<WriteFiles<'_>> = if writer.is_some() && spec.files.any() {
+        Some(&write)
+    } else {
+        None
+    };
     evaluate_variant(
         v,
         spec.resolve(&v.params).map_err(|e| e.to_string()),

@@ -213,6 +213,9 @@ pub fn resolve_variant(
     })
 }
 
+/// Writes the files of an ok variant (its resolved design and kit); the error is the variant's.
+pub type WriteFiles<'a> = &'a dyn Fn(&Design, &Kit) -> Result<(), String>;
+
 /// Builds and measures one variant (`design`: the base with `v`'s values set, or why it could
 /// not be resolved), as `fabkit sweep` does: status, violations or failure, metrics and
 /// printability verdicts; a kernel panic is this variant's error, not the sweep's end. `write`
@@ -227,7 +230,7 @@ pub fn evaluate_variant(
     max_triangles: u64,
     fabkit_version: &str,
     files: FileOutputs,
-    write: Option<&dyn Fn(&Design, &Kit) -> Result<(), String>>,
+    write: Option<WriteFiles<'_>>,
 ) -> VariantResult {
     let t0 = std::time::Instant::now();
     let mut result = VariantResult {
