@@ -127,7 +127,6 @@ pub fn plan_variants(
                 "a variant without parameters: give at least one {parameter path: value}".into(),
             ));
         }
-        let mut json = base_json.clone();
         let mut params: Vec<(String, Value)> = Vec::with_capacity(values.len());
         for (given_path, value) in values {
             let path = checked_path(base, given_path, &at)?;
@@ -139,23 +138,9 @@ pub fn plan_variants(
             }
             // each value checked on its own against the base, as a sweep file's values are
             checked_value(base, &base_json, &path, value, &at)?;
-            json = with_value(&json, &path, value).unwrap_or(json);
             params.push((path, value.clone()));
         }
-        let design: Design = serde_json::from_value(json).map_err(|e| SweepError::WrongValue {
-            at: at.clone(),
-            path: params
-                .iter()
-                .map(|p| p.0.as_str())
-                .collect::<Vec<_>>()
-                .join(", "),
-            value: params
-                .iter()
-                .map(|p| p.1.to_string())
-                .collect::<Vec<_>>()
-                .join(", "),
-            message: e.to_string(),
-        })?;
+        let design = resolve_variant(base, &at, &params)?;
         let id = variant_id(&design, tol.mm());
         if let Some(other) = seen.insert(id.clone(), index) {
             return Err(file_err(
