@@ -56,3 +56,23 @@ def cli_message(stderr):
     lines = lines[start:]
     lines[0] = lines[0][len("error: "):]
     return "\n".join(lines)
+
+
+# The test camera of the Python tests: the benchmark lens of fabkit's tests (f = 215 px at
+# 640 x 480, Kannala-Brandt) scaled to 160 x 120, as a ROS camera_info YAML.
+W, H = 160, 120
+FX, FY, CX, CY = 53.75, 53.75, 79.5, 59.5
+KB = [-0.02, 0.004, -0.0015, 0.0002]
+CAMERA_YAML = f"""image_width: {W}
+image_height: {H}
+camera_name: fabkit
+camera_matrix:
+  rows: 3
+  cols: 3
+  data: [{FX}, 0.0, {CX}, 0.0, {FY}, {CY}, 0.0, 0.0, 1.0]
+distortion_model: equidistant
+distortion_coefficients:
+  rows: 1
+  cols: 4
+  data: [{', '.join(map(str, KB))}]
+"""

@@ -14,24 +14,8 @@ import numpy as np
 import pytest
 
 import fabkit
-from conftest import cli_message
+from conftest import CAMERA_YAML, CX, CY, FX, FY, H, KB, W, cli_message
 
-W, H = 160, 120
-FX, FY, CX, CY = 53.75, 53.75, 79.5, 59.5
-KB = [-0.02, 0.004, -0.0015, 0.0002]
-CAMERA_YAML = f"""image_width: {W}
-image_height: {H}
-camera_name: fabkit
-camera_matrix:
-  rows: 3
-  cols: 3
-  data: [{FX}, 0.0, {CX}, 0.0, {FY}, {CY}, 0.0, 0.0, 1.0]
-distortion_model: equidistant
-distortion_coefficients:
-  rows: 1
-  cols: 4
-  data: [{', '.join(map(str, KB))}]
-"""
 RVEC = [0.02, -0.015, 0.4]
 TVEC = [0.3, -0.2, 10.4]
 

@@ -36,24 +36,11 @@ def _load_reader():
     return mod
 
 
+from conftest import CAMERA_YAML, H, W  # noqa: E402
+
 gtr = _load_reader()
 GroundTruth, StitchedPair = gtr.GroundTruth, gtr.StitchedPair
 
-W, H = 160, 120
-# The benchmark lens of fabkit's tests (f = 215 px at 640 x 480) scaled to 160 x 120, ROS form.
-CAMERA_YAML = f"""image_width: {W}
-image_height: {H}
-camera_name: fabkit
-camera_matrix:
-  rows: 3
-  cols: 3
-  data: [53.75, 0.0, 79.5, 0.0, 53.75, 59.5, 0.0, 0.0, 1.0]
-distortion_model: equidistant
-distortion_coefficients:
-  rows: 1
-  cols: 4
-  data: [-0.02, 0.004, -0.0015, 0.0002]
-"""
 # The camera inside the dome, 10.4 mm under the pole, slightly rotated (as tests/e2e).
 EXTRINSICS = {"rvec": [0.02, -0.015, 0.4], "tvec_mm": [0.3, -0.2, 10.4]}
 SCALARS = ("range_mm", "zdepth_mm", "delta_range_mm", "delta_zdepth_mm")

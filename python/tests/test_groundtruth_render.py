@@ -15,24 +15,9 @@ import numpy as np
 import pytest
 
 import fabkit
-from conftest import cli_message
+from conftest import CAMERA_YAML, H, KB, W, cli_message
 from fabkit.groundtruth import _read_png
 
-W, H = 160, 120
-KB = [-0.02, 0.004, -0.0015, 0.0002]
-CAMERA_YAML = f"""image_width: {W}
-image_height: {H}
-camera_name: fabkit
-camera_matrix:
-  rows: 3
-  cols: 3
-  data: [53.75, 0.0, 79.5, 0.0, 53.75, 59.5, 0.0, 0.0, 1.0]
-distortion_model: equidistant
-distortion_coefficients:
-  rows: 1
-  cols: 4
-  data: [{', '.join(map(str, KB))}]
-"""
 FRAME_ARRAYS = ("range_mm", "zdepth_mm", "delta_range_mm", "delta_zdepth_mm", "normals")
 
 
