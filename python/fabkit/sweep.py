@@ -17,6 +17,7 @@ import csv
 import io
 import os
 import queue
+from concurrent.futures import ProcessPoolExecutor
 from typing import Any, Callable, Dict, Iterable, List, Mapping, Optional
 
 from . import _fabkit
@@ -66,6 +67,20 @@ def _evaluate(base_json: str, chord_tolerance_mm: float, max_triangles: int, ind
                                    variant_id, params_json)
 
 
+def _check_start_method(executor) -> None:
+    """A ProcessPoolExecutor that forks its workers would hang: refused before any task."""
+    if not isinstance(executor, ProcessPoolExecutor):
+        return
+    context = getattr(executor, "_mp_context", None)
+    method = context.get_start_method() if context is not None else None
+    if method == "fork":
+        raise ValueError(
+            "executor: a ProcessPoolExecutor that starts its workers with 'fork' would hang "
+            "(a forked child inherits fabkit's thread pool without its threads); use "
+            "ProcessPoolExecutor(n, mp_context=multiprocessing.get_context(\"spawn\")) "
+            "or \"forkserver\"")
+
+
 def sweep(
     design,
     variants: Iterable[Mapping[str, Any]],
@@ -91,8 +106,9 @@ def sweep(
     ``dask.distributed.Client``), one task per variant. A ProcessPoolExecutor must start its
     workers with ``spawn`` or ``forkserver``
     (``mp_context=multiprocessing.get_context("spawn")``): a child forked from a process whose
-    fabkit threads have run inherits their pool without its threads and waits forever. ``progress(done, total, variant_id)``
-    is called as variants finish. ``build_time``: False leaves the build_time_s cells empty,
+    fabkit threads have run inherits their pool without its threads and would wait forever, so
+    one that forks (Linux's default before Python 3.14) raises ValueError.
+    ``progress(done, total, variant_id)`` is called as variants finish. ``build_time``: False leaves the build_time_s cells empty,
     as ``fabkit sweep --no-build-time`` (tables equal on any machine and executor).
 
     ``table``: ``"auto"`` returns a pandas DataFrame if pandas is installed, else
@@ -105,10 +121,11 @@ def sweep(
     violations; a failed build, status ``error``. Raises DesignError with the message of
     ``fabkit sweep`` for an unknown path or a value of the wrong type (``variants[3]:
     vary.<path> = <value>: <rule>``) or a non-finite number, before anything is built;
-    ValueError for a bad option.
+    ValueError for a bad option or a ProcessPoolExecutor that forks.
     """
     if table not in ("auto", "records", "pandas", "tables"):
         raise ValueError(f"table: '{table}' is not one of auto, records, pandas, tables")
+    _check_start_method(executor)
     parameters, planned = _fabkit._sweep_plan(design, variants, chord_tolerance_mm)
     base = _fabkit._sweep_base(design)
     total = len(planned)

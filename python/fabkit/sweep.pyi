@@ -29,4 +29,5 @@ def sweep(
     """Variants: dicts {parameter path: value}. Returns results.csv's rows (pandas DataFrame
     when installed with table="auto", list of dicts with "records", SweepTables with "tables").
     Raises DesignError (the CLI's message for an unknown path, a wrong-typed or non-finite
-    value), TypeError (a variant that is not a dict), ValueError (bad jobs or table)."""
+    value), TypeError (a variant that is not a dict), ValueError (bad jobs or table, a
+    ProcessPoolExecutor that forks its workers: use spawn or forkserver)."""

@@ -121,3 +121,12 @@ def test_bad_calls():
         fabkit.sweep(d, [{"core.wall_thickness_mm": 1.1}], jobs=0)
     with pytest.raises(ValueError, match="table"):
         fabkit.sweep(d, [{"core.wall_thickness_mm": 1.1}], table="xlsx")
+
+
+def test_a_forking_process_pool_is_refused_before_any_task():
+    # a forked worker would inherit fabkit's thread pool without its threads and hang
+    with ProcessPoolExecutor(2, mp_context=multiprocessing.get_context("fork")) as pool:
+        with pytest.raises(ValueError, match="'fork' would hang.*spawn"):
+            fabkit.sweep(fabkit.Design.load("rtac0"), [{"core.wall_thickness_mm": 1.1}],
+                         executor=pool)
+        assert not pool._processes  # no worker was started
