@@ -1,4 +1,4 @@
-//! The ground-truth speed figures of the README ("Ground truth: speed") in one run: fabkit's
+//! The ground-truth speed figures of the user guide (docs/src/benchmarks.md, "Ground truth") in one run: fabkit's
 //! frame casts on the issue-6 scene (640 x 480 fisheye frame, R-Tac0 skin with six
 //! protrusions, about 200k triangles) and, with the oracle venv (`FABKIT_ORACLE_PYTHON` or
 //! `.venv-oracles`), Open3D's RaycastingScene on the same triangles and rays, both on one

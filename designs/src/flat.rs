@@ -12,12 +12,13 @@
 use crate::error::ParamError;
 use crate::geometry::{cuboid, prism, ChordTolerance, GeometryError, Solid};
 use crate::markers::{feature_solid, FeatureShape, Polarity};
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::{FRAC_PI_2, PI};
 
 /// The outline of a flat skin: a rectangle `width_mm` (x) by `length_mm` (y) with corners
 /// rounded to `corner_radius_mm`, centred on the z axis.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct FlatOutline {
     /// Across x, mm, > 0.
@@ -111,7 +112,7 @@ impl FlatOutline {
 /// "the internal chambers are closed on one end", which is why they are filled in a tank).
 /// The channel in the skin is the same either way: closed at its far end, open at the near
 /// edge into its tube.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema, Default)]
 #[serde(rename_all = "snake_case")]
 pub enum ChannelEnds {
     /// The tube's display end is sealed once filled: the liquid cannot leave the circuit.
@@ -122,40 +123,50 @@ pub enum ChannelEnds {
 }
 
 /// The silicone tube glued into a channel's open end (Sil-Poxy, Soter et al. Sec. II-A).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ChannelTube {
     /// Outer diameter, mm: at least the channel's width and height, so that it seals the
     /// channel's mouth by stretching it.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub outer_diameter_mm: f64,
     /// Inner diameter, mm, below the outer.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub inner_diameter_mm: f64,
     /// From the skin to the display, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub length_mm: f64,
     /// How far it is pushed into the channel, mm, below the channel's length.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub insertion_mm: f64,
 }
 
 /// Straight channels of rectangular section in one layer, along y, side by side across x at
 /// `pitch_mm`, centred on the axis: grooves in the layer's bottom face, closed by the layer
 /// under it, open at the near edge for their tubes and closed `length_mm` from it.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ChannelSet {
+    #[schemars(extend("minimum" = 1))]
     pub count: usize,
     /// Across x, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub width_mm: f64,
     /// Up z from the layer's bottom face, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub height_mm: f64,
     /// Centre to centre, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub pitch_mm: f64,
     /// From the near edge to the closed far end, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub length_mm: f64,
     #[serde(default)]
     pub ends: ChannelEnds,
     /// Least silicone between two channels, over a channel (to the contact face), beyond its
     /// far end and to the outline's side, mm.
     #[serde(default = "default_min_wall")]
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub min_wall_mm: f64,
     pub tube: ChannelTube,
 }
@@ -308,11 +319,14 @@ impl ChannelSet {
 /// Markers on a grid, `rows` along y by `columns` along x at `pitch_mm`, centred on the axis,
 /// standing on a layer's bottom face towards the camera (Soter et al. Sec. II-A: a 10 x 10
 /// grid of 3D markers whose ends are painted white).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct MarkerGrid {
+    #[schemars(extend("minimum" = 1))]
     pub rows: usize,
+    #[schemars(extend("minimum" = 1))]
     pub columns: usize,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub pitch_mm: f64,
     /// A cylinder ending in a hemisphere (`polarity: raised`: it stands out of the face).
     pub feature: FeatureShape,

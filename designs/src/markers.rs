@@ -14,11 +14,12 @@
 use crate::geometry::profile2d::push_arc;
 use crate::geometry::{revolve, ChordTolerance, GeometryError, Polyline2, Solid};
 use crate::profile::BodyProfile;
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::{FRAC_PI_2, PI};
 
 /// Which surface of a layer carries the markers.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum MarkerSurface {
     Outer,
@@ -26,7 +27,7 @@ pub enum MarkerSurface {
 }
 
 /// Whether a feature stands out of the part's surface or is cut into it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum Polarity {
     Raised,
@@ -37,7 +38,7 @@ pub enum Polarity {
 /// skin (its mold carries a pin standing out of the cavity wall into the cavity), a `bump`
 /// stands out of the skin (its mold carries a recess). The same as [`Polarity::Recessed`] and
 /// [`Polarity::Raised`] of the surface that carries the feature.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum OnSkin {
     Dimple,
@@ -55,12 +56,14 @@ impl From<OnSkin> for Polarity {
 
 /// A radial cylinder ending in a hemisphere of the same diameter. Give exactly one of
 /// `on_skin` and `polarity` (validation names `...feature` otherwise).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct FeatureShape {
     /// Cylinder (and hemisphere) diameter, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub diameter_mm: f64,
     /// From the surface to the tip of the hemisphere, along the normal, mm (>= radius).
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub height_mm: f64,
     /// Whether the feature stands out of the surface that carries it or is cut into it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -115,7 +118,7 @@ impl FeatureShape {
 }
 
 /// The layout of a pattern.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum Layout {
     /// A centre marker and rings k = 1..rings of 6k markers, ring k at arc length
@@ -138,7 +141,7 @@ pub enum Layout {
 }
 
 /// A marker pattern on a surface. Which fields apply depends on `layout`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Pattern {
     pub layout: Layout,
@@ -163,8 +166,10 @@ pub struct Pattern {
     /// Limits of the patterned region, polar angle in degrees (default: the whole surface less
     /// a margin of one feature diameter at the rim).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schemars(extend("exclusiveMinimum" = 0, "maximum" = 180))]
     pub max_polar_deg: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schemars(extend("minimum" = 0, "exclusiveMaximum" = 180))]
     pub min_polar_deg: Option<f64>,
     /// Concentric layouts: the polar angle between rings, degrees, finite and above 0. Ring k
     /// sits at polar angle k x step seen from the sensor-frame origin (from `min_polar_deg`
@@ -172,6 +177,7 @@ pub struct Pattern {
     /// `pitch_arc_mm` (give exactly one); for `concentric` it replaces `spacing_mm` as the
     /// ring pitch, and `spacing_mm` still sets the markers per ring.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub polar_step_deg: Option<f64>,
     /// Concentric layouts: how far each ring is turned about the axis (default: none, every
     /// ring has a marker at azimuth 0, on +x).
@@ -184,7 +190,7 @@ pub struct Pattern {
 ///
 /// YAML: `ring_azimuth_offset: {alternate: half_step}` or
 /// `ring_azimuth_offset: {per_ring_deg: [0.0, 30.0, ...]}`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum RingAzimuthOffset {
     /// Every odd ring (k = 1, 3, 5, ...) turned by the given fraction of its own azimuth step
@@ -197,7 +203,7 @@ pub enum RingAzimuthOffset {
 }
 
 /// The turn of the odd rings of an alternating [`RingAzimuthOffset`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum AlternateOffset {
     /// Half the ring's own azimuth step: 180 / n_k degrees.
@@ -347,7 +353,7 @@ fn yes() -> bool {
 }
 
 /// Markers of one surface of a layer.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct MarkerSpec {
     pub surface: MarkerSurface,

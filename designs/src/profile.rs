@@ -46,6 +46,110 @@ pub enum BodyProfile {
     },
 }
 
+/// The JSON Schema of the YAML form ([`BodyYaml`]), written by hand because the form is checked
+/// by [`TryFrom`]: one branch per profile (and two for a spherical cap: base/height or
+/// sphere/rim), each with exactly the keys [`BodyProfile::try_from`] accepts for it. Bounds that
+/// the validation checks on one key alone (above 0, 0 or more) are given; those between keys
+/// (a cap no taller than half its base, the corner radius below half the shorter side) are
+/// not. Every length is mm.
+impl schemars::JsonSchema for BodyProfile {
+    fn schema_name() -> std::borrow::Cow<'static, str> {
+        "BodyProfile".into()
+    }
+
+    fn json_schema(_: &mut schemars::SchemaGenerator) -> schemars::Schema {
+        use serde_json::{json, Map, Value};
+        let above0 = |d: &str| json!({"type": "number", "exclusiveMinimum": 0, "description": d});
+        let at_least0 = |d: &str| json!({"type": "number", "minimum": 0, "description": d});
+        let branch = |profile: &str, d: &str, keys: Vec<(&str, Value)>, required: &[&str]| {
+            let mut props = Map::new();
+            props.insert(
+                "profile".into(),
+                json!({"const": profile, "description": "The profile's name."}),
+            );
+            for (k, v) in keys {
+                props.insert(k.into(), v);
+            }
+            let mut req = vec![Value::from("profile")];
+            req.extend(required.iter().map(|k| Value::from(*k)));
+            json!({
+                "description": d,
+                "type": "object",
+                "properties": props,
+                "required": req,
+                "additionalProperties": false,
+            })
+        };
+        let corner = json!({
+            "type": ["number", "null"],
+            "minimum": 0,
+            "description": "Corner radius of the outline, mm (0 when not given), below half the shorter side.",
+        });
+        let branches = vec![
+            branch(
+                "spherical_cap",
+                "A spherical cap by its base circle and height (ShadowTac skin: 35 mm x 8 mm).",
+                vec![
+                    ("base_diameter_mm", above0("Diameter of the base circle on the base plane, mm, > 0.")),
+                    ("height_mm", above0("From the base plane to the pole, mm, > 0, at most half the base diameter.")),
+                ],
+                &["base_diameter_mm", "height_mm"],
+            ),
+            branch(
+                "spherical_cap",
+                "A spherical cap by its sphere (the authors' ShadowTac CAD: R22.5 cut to a 35 mm rim).",
+                vec![
+                    ("sphere_radius_mm", above0("Radius of the sphere, mm, > 0.")),
+                    ("rim_diameter_mm", above0("Diameter of the rim on the base plane, mm, > 0, at most the sphere's diameter.")),
+                ],
+                &["sphere_radius_mm", "rim_diameter_mm"],
+            ),
+            branch(
+                "hemisphere_on_cylinder",
+                "A hemisphere on a cylinder of the same radius (the test-tube shape of R-Tac0).",
+                vec![
+                    ("radius_mm", above0("Radius of the hemisphere and the cylinder, mm, > 0.")),
+                    ("cylinder_length_mm", at_least0("Length of the cylinder below the hemisphere, mm, >= 0.")),
+                ],
+                &["radius_mm", "cylinder_length_mm"],
+            ),
+            branch(
+                "half_ellipsoid",
+                "Half an ellipsoid of revolution (UVDtact).",
+                vec![
+                    ("diameter_mm", above0("Diameter across the base, mm, > 0.")),
+                    ("height_mm", above0("From the base plane to the pole, mm, > 0.")),
+                ],
+                &["diameter_mm", "height_mm"],
+            ),
+            branch(
+                "flat",
+                "A flat skin: a rounded rectangle, its contact face `thickness_mm` above the base plane.",
+                vec![
+                    ("width_mm", above0("Across x, mm, > 0.")),
+                    ("length_mm", above0("Along y, mm, > 0.")),
+                    ("corner_radius_mm", corner),
+                    ("thickness_mm", above0("From the base plane to the contact face, mm, > 0.")),
+                ],
+                &["width_mm", "length_mm", "thickness_mm"],
+            ),
+        ];
+        let mut schema = json!({
+            "description": "The outer surface of the skin: a mapping with `profile` and that profile's keys (lengths in mm).",
+            "type": "object",
+            "required": ["profile"],
+            "oneOf": branches,
+        });
+        if let Value::Object(m) = &mut schema {
+            m.insert(
+                "properties".into(),
+                json!({"profile": {"enum": ["spherical_cap", "hemisphere_on_cylinder", "half_ellipsoid", "flat"]}}),
+            );
+        }
+        schemars::Schema::try_from(schema).unwrap_or_default()
+    }
+}
+
 /// The YAML form of [`BodyProfile`]: one flat mapping, so that an unknown key is reported at
 /// its own line and column (serde's internally tagged enums lose locations).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -3,13 +3,15 @@
 
 use crate::error::DesignError;
 use crate::profile::BodyProfile;
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 /// A sensor design: body profile, rigid core, layer stack, molds, housing, printers.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Design {
     /// Short name, `[a-z0-9_]+`; names the output folder and the 3MF.
+    #[schemars(extend("pattern" = "^[a-z0-9_]+$"))]
     pub name: String,
     #[serde(default)]
     pub description: String,
@@ -55,11 +57,13 @@ pub struct Design {
 }
 
 /// A flat plate the skin is glued to.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Backing {
     pub material: String,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub diameter_mm: f64,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub thickness_mm: f64,
     #[serde(default)]
     pub description: String,
@@ -68,7 +72,7 @@ pub struct Backing {
 /// A coat brushed onto a cast layer after demolding (ShadowTac Sec. IV-A: the reflective layer
 /// of Smooth-On PsychoPaint with aluminium powder, Silc Pig white and a silicone solvent). Its
 /// amounts are the maker's: the sheet lists the components and the step.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct BrushedCoat {
     /// What the coat does, for the sheet (e.g. "reflective layer").
@@ -82,13 +86,14 @@ pub struct BrushedCoat {
 
 /// The rigid transparent shell (R-Tac0: a glass test tube, Sec. III-B1). Its outer surface is
 /// the inner surface of the innermost layer; it is an offset of the body profile.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Core {
     #[serde(default)]
     pub description: String,
     pub material: String,
     /// Wall thickness, mm, > 0.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub wall_thickness_mm: f64,
     /// Length from the pole to the open end, mm; the part below the base plane is held by
     /// the mold's core holder and seats in the housing.
@@ -96,6 +101,7 @@ pub struct Core {
     /// Outer diameter, mm (spherical profiles only). When given, it must equal the inner
     /// diameter of the innermost layer; layers given by `outer_radius_mm` are measured from it.
     #[serde(default)]
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub outer_diameter_mm: Option<f64>,
     /// Primer wiped onto the core's outer surface before the first layer is cast on it, so
     /// that the layer bonds to it: a `primer` key of the materials table (R-Tac0: `pr_1200_rtv`,
@@ -112,19 +118,21 @@ pub struct Core {
 /// How a core made to order is described to the shop ([`Core::machining`]). Its inner surface
 /// is [`crate::profile::BodyProfile::shell_inner_surface`] of the core's outer surface and
 /// wall.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct CoreMachining {
     /// File stem of its drawing and STEP file, `[a-z0-9_]+`, unique among the kit's parts.
+    #[schemars(extend("pattern" = "^[a-z0-9_]+$"))]
     pub part_name: String,
     /// Surface finish the shop is asked for, printed on the drawing.
     pub finish: String,
     /// General tolerance of the drawing's dimensions (+/-), mm, > 0.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub general_tolerance_mm: f64,
 }
 
 /// How a layer is made.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum LayerProcess {
     /// Poured into a mold around the core and the layers under it.
@@ -137,10 +145,11 @@ pub enum LayerProcess {
 }
 
 /// One skin layer. Give exactly one of `thickness_mm` and `outer_radius_mm`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Layer {
     /// `[a-z0-9_]+`, unique.
+    #[schemars(extend("pattern" = "^[a-z0-9_]+$"))]
     pub name: String,
     /// Key in the materials table.
     pub material: String,
@@ -176,7 +185,7 @@ pub struct Layer {
 }
 
 /// How a cast layer's mold is made.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum MoldStrategy {
     /// A printed two-piece mold split on a parting plane through the axis.
@@ -198,7 +207,7 @@ pub enum MoldStrategy {
 }
 
 /// Print technologies, as used in the design file.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "lowercase")]
 pub enum Technology {
     Fdm,
@@ -236,17 +245,20 @@ macro_rules! defaults {
 }
 
 /// Mold parameters shared by every cast layer. Geometry: R-Tac0 Sec. III-B1 and Fig. 4.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields, default)]
 pub struct MoldParams {
     pub strategy: MoldStrategy,
     /// Added to the layer's outer surface to form the cavity, mm, >= 0.
     pub cavity_clearance_mm: f64,
     /// Material between the cavity and the outside of a mold half, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub wall_thickness_mm: f64,
     /// Width of the mold-half flange that carries bolts and keys, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub flange_width_mm: f64,
     /// Draft of the master-strategy mold box wall from the pull direction, degrees, [0, 10).
+    #[schemars(extend("minimum" = 0, "exclusiveMaximum" = 10))]
     pub draft_angle_deg: f64,
     pub plinth: Plinth,
     pub registration_key: RegistrationKey,
@@ -255,6 +267,7 @@ pub struct MoldParams {
     pub vent: Vent,
     pub core_holder: CoreHolderParams,
     /// Mold Star thickness around the master pattern (master strategy), mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub silicone_wall_mm: f64,
     /// The top piece and the flange of the `two_piece_open` strategy.
     pub two_piece: TwoPieceOpenParams,
@@ -270,12 +283,13 @@ pub struct MoldParams {
 
 /// Laser-cut molds of a flat skin (Soter et al. Sec. II-A: the molds are laser-cut): the sheet
 /// stock and the registration holes that align a stack of sheets.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields, default)]
 pub struct LaserCutParams {
     /// The sheet stock, in the order fabkit picks from: each level of a tray is made of the
     /// first stock whose thickness, taken 1 to 8 times, equals the level's; the base sheet is
     /// the first stock.
+    #[schemars(extend("minItems" = 1))]
     pub stock: Vec<SheetStock>,
     /// Dowel holes through every sheet of a stack, one in each corner of the tray's wall.
     pub registration: SheetRegistration,
@@ -305,23 +319,27 @@ defaults!(LaserCutParams {
 });
 
 /// One sheet material profile: what the sheet is and what the laser takes out of it.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SheetStock {
     /// `[a-z0-9_]+`, for file names and the bill of materials.
+    #[schemars(extend("pattern" = "^[a-z0-9_]+$"))]
     pub name: String,
     /// Material key in the materials table (designs/materials.yaml).
     pub material: String,
+    #[schemars(extend("exclusiveMinimum" = 0, "maximum" = 25))]
     pub thickness_mm: f64,
     /// Width of the laser's cut in this sheet, mm: every path is offset by half of it.
+    #[schemars(extend("minimum" = 0, "exclusiveMaximum" = 2))]
     pub kerf_mm: f64,
 }
 
 /// Registration (dowel) holes through a stack of sheets.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields, default)]
 pub struct SheetRegistration {
     /// Hole diameter, mm (a dowel pin of this diameter, a sliding fit after the kerf).
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub diameter_mm: f64,
 }
 defaults!(SheetRegistration { diameter_mm: 3.0 });
@@ -346,14 +364,17 @@ defaults!(MoldParams {
 
 /// The disc-shaped recess at the open end of the cavity: it centres the core holder (its
 /// spigot plugs into it) and leaves a reservoir ring that feeds the cavity.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields, default)]
 pub struct Plinth {
     /// Radial margin beyond the cavity rim, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub margin_mm: f64,
     /// Depth of the recess, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub height_mm: f64,
     /// Depth left free under the holder's spigot as a reservoir, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub reservoir_depth_mm: f64,
 }
 defaults!(Plinth {
@@ -364,9 +385,10 @@ defaults!(Plinth {
 
 /// Hemispherical registration keys on the parting plane: male on one half, female with
 /// clearance on the other.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields, default)]
 pub struct RegistrationKey {
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub diameter_mm: f64,
     /// Radial clearance of the female socket, mm.
     pub clearance_mm: f64,
@@ -377,10 +399,11 @@ defaults!(RegistrationKey {
 });
 
 /// Clamp bolts through both mold halves, perpendicular to the parting plane.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields, default)]
 pub struct ClampBolt {
     /// Through-hole diameter, mm (3.4 for M3).
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub clearance_diameter_mm: f64,
 }
 defaults!(ClampBolt {
@@ -396,7 +419,7 @@ defaults!(ClampBolt {
 /// pieces) stand on the centre line of the flange (`flange_width_mm` wide) around the pocket,
 /// one at each corner and the rest spread evenly over the sides.
 /// Defaults: the authors' ShadowTac mold (authors' CAD, measured).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields, default)]
 pub struct TwoPieceOpenParams {
     /// Diameter of the reservoir bore, mm (authors: 45).
@@ -437,7 +460,7 @@ impl TwoPieceOpenParams {
 
 /// A rectangular boss on the top piece of a two-piece mold that registers it in a pocket of
 /// the cavity block (authors' ShadowTac mold: 60 x 65 x 2 mm).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields, default)]
 pub struct RegistrationBoss {
     /// Along x, mm.
@@ -454,18 +477,21 @@ defaults!(RegistrationBoss {
 });
 
 /// The pour opening through the core holder.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields, default)]
 pub struct Sprue {
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub diameter_mm: f64,
 }
 defaults!(Sprue { diameter_mm: 3.0 });
 
 /// Air vents through the core holder at the cavity's high points (cast pole-down).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields, default)]
 pub struct Vent {
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub diameter_mm: f64,
+    #[schemars(extend("minimum" = 1))]
     pub count: u32,
 }
 defaults!(Vent {
@@ -474,16 +500,19 @@ defaults!(Vent {
 });
 
 /// The core holder (casting jig): keeps the core concentric with the cavity.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields, default)]
 pub struct CoreHolderParams {
     /// Radial clearance between the centring pin and the core's bore, and around the core
     /// wall, mm.
     pub fit_clearance_mm: f64,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub flange_thickness_mm: f64,
     /// Length of the centring pin that enters the core's open end, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub pin_length_mm: f64,
     /// Smallest wall left around holes in the holder, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub min_wall_mm: f64,
 }
 defaults!(CoreHolderParams {
@@ -494,17 +523,22 @@ defaults!(CoreHolderParams {
 });
 
 /// Printer capabilities used to decide what can be printed.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct PrinterProfile {
     /// Nozzle diameter (FDM) or pixel size (SLA), mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub xy_resolution_mm: f64,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub layer_height_mm: f64,
     /// Thinnest wall that prints reliably, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub min_wall_mm: f64,
     /// Smallest hole that prints open, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub min_hole_diameter_mm: f64,
     /// Smallest positive feature (pin, key), mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub min_feature_mm: f64,
     /// Lug count, ramp and clearance of a bayonet printed on this printer.
     #[serde(default)]
@@ -516,12 +550,14 @@ pub struct PrinterProfile {
 }
 
 /// A printer's build volume: what one plate holds.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Bed {
     /// The printer's name, in messages and the manifest (`[a-z0-9_]+`).
+    #[schemars(extend("pattern" = "^[a-z0-9_]+$"))]
     pub name: String,
     /// Build volume: x and y of the plate, z the height, mm.
+    #[schemars(extend("items" = {"type": "number", "exclusiveMinimum": 0}))]
     pub size_mm: [f64; 3],
     /// Border kept clear on every side of the plate, mm: an FDM slicer's skirt (PrusaSlicer
     /// lays it 6 mm out, 6.4 mm with its line), an SLA support pad's rim.
@@ -586,7 +622,7 @@ impl Technology {
 }
 
 /// The FDM, SLA and PolyJet profiles.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields, default)]
 pub struct PrinterProfiles {
     pub fdm: PrinterProfile,
@@ -662,10 +698,11 @@ impl PrinterProfiles {
 }
 
 /// Pour calculator settings.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields, default)]
 pub struct CastingParams {
     /// Extra material mixed for losses in cups, sprue and vents, fraction in [0, 1].
+    #[schemars(extend("minimum" = 0, "maximum" = 1))]
     pub waste_allowance: f64,
     /// Release agent sprayed into each mold before a skin layer is poured: a `release` key of
     /// the materials table; `null` for none. Default `ease_release_200` (R-Tac0 Sec. III-B1,
@@ -681,7 +718,7 @@ defaults!(CastingParams {
 /// diffuser seat, contact-module seat. Two arrangements (`style`): a round tube closed by a
 /// separate base that carries the camera (the authors' CAD), or a square shell split into
 /// two halves on a plane through the axis.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct HousingParams {
     pub material: String,
@@ -690,16 +727,19 @@ pub struct HousingParams {
     pub style: HousingStyle,
     /// Side of the square shell (`square_split`) or outer diameter of the tube
     /// (`round_tube`), mm (R-Tac0 envelope 30 x 30 x 43 mm, Sec. III-B).
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub outer_width_mm: f64,
     /// The tube and its base; required with `style: round_tube`, unused otherwise.
     #[serde(default)]
     pub round_tube: Option<RoundTube>,
     pub camera: CameraBay,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub bulkhead_thickness_mm: f64,
     pub led_pcb: LedPcb,
     pub diffuser: Diffuser,
     /// Diameter of the light chamber between the LED PCB and the diffuser, mm (`round_tube`:
     /// at least the LED PCB's seat, since the PCB goes in through it).
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub light_chamber_diameter_mm: f64,
     /// Radial clearance around seated parts, mm.
     pub fit_clearance_mm: f64,
@@ -710,7 +750,7 @@ pub struct HousingParams {
 }
 
 /// How the sensor shell is arranged.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum HousingStyle {
     /// A round tube (outer diameter `outer_width_mm`) holding the contact module, diffuser
@@ -731,7 +771,7 @@ pub enum HousingStyle {
 /// from the tube's top. The base is a flange under the tube (as thick as
 /// `joint_screw.clamp_length_mm`) with a spigot that enters the bay; the camera board is
 /// screwed onto the spigot.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct RoundTube {
     /// Height from the tube's bottom to the base plane (tube, diffuser and collar), mm, > 0.
@@ -742,30 +782,38 @@ pub struct RoundTube {
     pub base_spigot_height_mm: f64,
 }
 
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct CameraBay {
     /// Camera module name, for the fabrication sheet.
     pub module: String,
     /// Side of the square camera board, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub board_width_mm: f64,
     /// Height of the bay under the bulkhead (board + components), mm (`square_split`); with
     /// `round_tube`, the least height the board with its components needs between the base
     /// and the LED PCB.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub bay_height_mm: f64,
     /// Hole in the bulkhead for the lens barrel, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub lens_hole_diameter_mm: f64,
     /// Square pattern of the board's mounting holes, centre to centre, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub mount_hole_spacing_mm: f64,
     /// Pilot hole for the self-tapping mounting screws, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub mount_pilot_diameter_mm: f64,
 }
 
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct LedPcb {
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub outer_diameter_mm: f64,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub inner_diameter_mm: f64,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub thickness_mm: f64,
     pub led_count: u32,
 }
@@ -774,7 +822,7 @@ pub struct LedPcb {
 /// sensor pole-down, before the camera goes on. It fills the core, the diffuser's opening and
 /// the light chamber up to the LED PCB's face, which is the flat window the camera looks
 /// through; it diffuses the LEDs' light and, cured, glues the core to the shell.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct FillingGel {
     /// Material key in the materials table; a cast material (R-Tac0: `solaris`).
@@ -784,27 +832,146 @@ pub struct FillingGel {
 /// The laser-cut diffuser (R-Tac0 Sec. III-B2): a ring whose inner edge carries the core's rim.
 /// `round_tube`: a disc between the tube's top face and the collar, at most the shell's
 /// diameter; `square_split`: a ring in a seat inside the shell.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Diffuser {
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub outer_diameter_mm: f64,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub inner_diameter_mm: f64,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub thickness_mm: f64,
     /// Distance from the top of the LED PCB to the diffuser, mm (R-Tac0: 10 mm).
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub gap_above_pcb_mm: f64,
 }
 
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct JointScrew {
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub clearance_diameter_mm: f64,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub pilot_diameter_mm: f64,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub head_diameter_mm: f64,
     /// Material clamped under the head, mm (`round_tube`: the thickness of the base's flange
     /// under the tube).
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub clamp_length_mm: f64,
     /// Depth of the pilot hole in the other half (`round_tube`: up into the tube wall), mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub pilot_depth_mm: f64,
+}
+
+/// `$id` of the design file's JSON Schema ([`design_json_schema`]).
+pub const DESIGN_SCHEMA_ID: &str = "urn:fabkit:design";
+
+/// Title of the design file's JSON Schema.
+pub const DESIGN_SCHEMA_TITLE: &str = "fabkit design";
+
+/// The JSON Schema (draft 2020-12) of a design file, generated from [`Design`] and the types it
+/// holds: every key with its type and its doc comment as description, unknown keys refused
+/// (`additionalProperties: false`), optional keys not required, defaults given.
+///
+/// Bounds: the range every number gets from its unit by [`crate::values::check_values`]
+/// (`_mm`: 0 to [`crate::values::MAX_LENGTH_MM`] mm; `_deg`: +-[`crate::values::MAX_ANGLE_DEG`]
+/// degrees; any other number +-[`crate::values::MAX_PLAIN`]), and the bounds the validation
+/// checks on single keys (above 0, `[a-z0-9_]+` names). Rules between keys (a marker spacing
+/// above the feature diameter, a layer stack the core can hold) are left to
+/// [`crate::build::validate_design`]. The output is deterministic.
+pub fn design_json_schema() -> serde_json::Value {
+    let generator = schemars::generate::SchemaSettings::draft2020_12().into_generator();
+    let mut v = generator.into_root_schema_for::<Design>().to_value();
+    unit_bounds(&mut v, None);
+    if let serde_json::Value::Object(m) = &mut v {
+        m.insert("$id".into(), DESIGN_SCHEMA_ID.into());
+        m.insert("title".into(), DESIGN_SCHEMA_TITLE.into());
+    }
+    v
+}
+
+/// [`design_json_schema`] as pretty-printed JSON with a final newline: the bytes of
+/// `designs/design.schema.json` and of `fabkit schema`.
+pub fn design_json_schema_text() -> String {
+    let mut s = serde_json::to_string_pretty(&design_json_schema())
+        .unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}"));
+    s.push('\n');
+    s
+}
+
+/// The unit a key names, as [`crate::values`] reads it.
+#[derive(Clone, Copy)]
+enum SchemaUnit {
+    Mm,
+    Deg,
+}
+
+/// Adds the ranges of [`crate::values::check_values`] to every number of the schema `v`
+/// under `unit` (a key ending `_mm` or `_deg` sets the unit for everything under it, as there),
+/// leaving bounds already given alone, and the unit as description of a key that has none.
+fn unit_bounds(v: &mut serde_json::Value, unit: Option<SchemaUnit>) {
+    use crate::values::{MAX_ANGLE_DEG, MAX_LENGTH_MM, MAX_PLAIN};
+    use serde_json::Value;
+    let Value::Object(m) = v else { return };
+    let is_number = match m.get("type") {
+        Some(Value::String(t)) => t == "number",
+        Some(Value::Array(ts)) => ts.iter().any(|t| t == "number"),
+        _ => false,
+    };
+    if is_number {
+        let (lo, hi) = match unit {
+            Some(SchemaUnit::Mm) => (0.0, MAX_LENGTH_MM),
+            Some(SchemaUnit::Deg) => (-MAX_ANGLE_DEG, MAX_ANGLE_DEG),
+            None => (-MAX_PLAIN, MAX_PLAIN),
+        };
+        if !m.contains_key("minimum") && !m.contains_key("exclusiveMinimum") {
+            m.insert("minimum".into(), lo.into());
+        }
+        if !m.contains_key("maximum") && !m.contains_key("exclusiveMaximum") {
+            m.insert("maximum".into(), hi.into());
+        }
+    }
+    if let Some(Value::Object(props)) = m.get_mut("properties") {
+        for (key, sub) in props.iter_mut() {
+            let u = if key.ends_with("_mm") {
+                Some(SchemaUnit::Mm)
+            } else if key.ends_with("_deg") {
+                Some(SchemaUnit::Deg)
+            } else {
+                unit
+            };
+            if let (Value::Object(sm), Some(u)) = (&mut *sub, u) {
+                if key.ends_with("_mm") || key.ends_with("_deg") {
+                    sm.entry("description").or_insert_with(|| {
+                        match u {
+                            SchemaUnit::Mm => "Length, mm.",
+                            SchemaUnit::Deg => "Angle, degrees.",
+                        }
+                        .into()
+                    });
+                }
+            }
+            unit_bounds(sub, u);
+        }
+    }
+    for key in ["items", "additionalProperties"] {
+        if let Some(sub) = m.get_mut(key) {
+            unit_bounds(sub, unit);
+        }
+    }
+    for key in ["prefixItems", "anyOf", "oneOf", "allOf"] {
+        if let Some(Value::Array(subs)) = m.get_mut(key) {
+            for sub in subs {
+                unit_bounds(sub, unit);
+            }
+        }
+    }
+    if let Some(Value::Object(defs)) = m.get_mut("$defs") {
+        for sub in defs.values_mut() {
+            unit_bounds(sub, None);
+        }
+    }
 }
 
 impl Design {
@@ -813,10 +980,19 @@ impl Design {
     /// # Errors
     /// [`DesignError::Yaml`] with `origin:line:column` for syntax errors, unknown keys,
     /// wrong types, missing fields, a number or boolean where text is expected and unknown tags
-    /// ([`yaml_options`]); naming the parameter path of a number written quoted.
+    /// ([`yaml_options`]); naming the parameter path of a number written quoted, and of a value
+    /// of the wrong type (`... (at core.wall_thickness_mm)`).
     pub fn from_yaml(text: &str, origin: &str) -> Result<Design, DesignError> {
-        let d =
-            yaml_from_str::<Design>(text).map_err(|e| DesignError::Yaml(yaml_error(origin, &e)))?;
+        let d = yaml_from_str::<Design>(text).map_err(|e| {
+            let mut msg = yaml_error(origin, &e);
+            let path = e
+                .location()
+                .and_then(|loc| yaml_scalar_path_at(text, loc.line(), loc.column()));
+            if let Some(path) = path {
+                msg.push_str(&format!(" (at {path})"));
+            }
+            DesignError::Yaml(msg)
+        })?;
         refuse_quoted_numbers(&d, text, origin)?;
         Ok(d)
     }
@@ -1050,6 +1226,41 @@ pub fn yaml_location(text: &str, path: &str) -> Option<(u64, u64)> {
         };
     }
     Some((cur.referenced.line(), cur.referenced.column()))
+}
+
+/// The parameter path (`core.wall_thickness_mm`, `layers[1].name`) of the scalar value that
+/// starts at `line`, `column` (from 1) of `text`; `None` when the text does not parse or no
+/// scalar value starts there (a key, a mapping, a list).
+pub fn yaml_scalar_path_at(text: &str, line: u64, column: u64) -> Option<String> {
+    fn find(n: &serde_saphyr::Spanned<Node>, at: (u64, u64), path: &mut String) -> bool {
+        match &n.value {
+            Node::Scalar => (n.referenced.line(), n.referenced.column()) == at,
+            Node::Map(entries) => entries.iter().any(|(k, v)| {
+                let len = path.len();
+                if !path.is_empty() {
+                    path.push('.');
+                }
+                path.push_str(k);
+                let hit = find(v, at, path);
+                if !hit {
+                    path.truncate(len);
+                }
+                hit
+            }),
+            Node::Seq(items) => items.iter().enumerate().any(|(i, v)| {
+                let len = path.len();
+                path.push_str(&format!("[{i}]"));
+                let hit = find(v, at, path);
+                if !hit {
+                    path.truncate(len);
+                }
+                hit
+            }),
+        }
+    }
+    let root: serde_saphyr::Spanned<Node> = serde_saphyr::from_str(text).ok()?;
+    let mut path = String::new();
+    (find(&root, (line, column), &mut path) && !path.is_empty()).then_some(path)
 }
 
 enum Step<'a> {

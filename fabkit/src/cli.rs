@@ -37,6 +37,8 @@ enum Command {
     /// List the designs embedded in fabkit.
     Designs,
     /// Print a library design's YAML (with its comments), a template to start a design from.
+    /// Its first line points editors at `design.schema.json` beside the file (write it with
+    /// `fabkit schema > design.schema.json`).
     Show {
         /// The name of a library design (`fabkit designs` lists them).
         design: String,
@@ -58,6 +60,11 @@ enum Command {
         #[command(flatten)]
         data_files: DataFileArgs,
     },
+    /// Print the JSON Schema (draft 2020-12) of a design file as pretty JSON: every key with
+    /// its type, unit and bounds (lengths in mm, angles in degrees), generated from the design
+    /// types. Editors use it to complete and check design YAML (designs/design.schema.json is
+    /// this output); rules between keys are checked by `fabkit validate` only.
+    Schema,
 }
 
 #[derive(clap::Args, Debug)]
@@ -151,6 +158,18 @@ enum Strategy {
     #[value(name = "two_piece_open")]
     TwoPieceOpen,
 }
+
+/// The command line's definition (every command, argument and help text), for generated
+/// documentation: the user guide's command reference is rendered from it.
+pub fn command() -> clap::Command {
+    <Cli as clap::CommandFactory>::command()
+}
+
+/// The first line of every library design: editors with a YAML language server check the
+/// file against the schema in designs/.
+const LIBRARY_MODELINE: &str = "# yaml-language-server: $schema=../design.schema.json\n";
+/// The same line in a template written by `fabkit show`: the schema beside the file.
+const TEMPLATE_MODELINE: &str = "# yaml-language-server: $schema=design.schema.json\n";
 
 /// Runs the CLI; returns the process exit code (0 ok, 2 error).
 pub fn main() -> i32 {
@@ -389,13 +408,19 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
             Ok(())
         }
         Command::Show { design, out } => {
-            let text = library::yaml(&design).ok_or_else(|| {
+            let library_text = library::yaml(&design).ok_or_else(|| {
                 let names: Vec<&str> = library::LIBRARY.iter().map(|(n, _)| *n).collect();
                 format!(
                     "show: '{design}' is not a library design (they are: {})",
                     names.join(", ")
                 )
             })?;
+            // The library's modeline names the schema relative to designs/library/; a
+            // template lives wherever the user saves it, with the schema beside it.
+            let text = match library_text.strip_prefix(LIBRARY_MODELINE) {
+                Some(rest) => format!("{TEMPLATE_MODELINE}{rest}"),
+                None => library_text.to_string(),
+            };
             match out {
                 None => {
                     use std::io::Write as _;
@@ -420,11 +445,19 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
                         return Err(format!("--out {}: {e}", path.display()).into());
                     }
                     out!(
-                        "{design}: template written to {} (rename `name:` before exporting)",
+                        "{design}: template written to {} (rename `name:` before exporting; \
+                         `fabkit schema > design.schema.json` beside it lets an editor complete \
+                         and check it)",
                         path.display()
                     );
                 }
             }
+            Ok(())
+        }
+        Command::Schema => {
+            use std::io::Write as _;
+            let text = fabkit_designs::schema::design_json_schema_text();
+            std::io::stdout().write_all(text.as_bytes())?;
             Ok(())
         }
         Command::Export(args) => export(args),

@@ -1,7 +1,7 @@
 //! Criterion benchmark of the extrinsics solve on the issue-5 synthetic scene
 //! (`fabkit_calibration::synthetic`: 30 pins, Kannala-Brandt f = 215 px, sigma 0.5 px):
 //! one solve without RANSAC, with RANSAC on clean data, and with RANSAC and 3 swapped pins.
-//! Figures and the OpenCV comparison: README, "Calibration: extrinsics accuracy and speed".
+//! Figures and the OpenCV comparison: docs/src/benchmarks.md, "Extrinsics: accuracy and speed".
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use fabkit_calibration::synthetic::{benchmark_camera, benchmark_trial};

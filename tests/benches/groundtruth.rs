@@ -15,7 +15,7 @@
 //!
 //! Not timed: the hierarchy build and the rays, tiles and cube-face cells of the camera (once
 //! per camera).
-//! Figures and the Open3D comparison: README, "Ground truth: speed".
+//! Figures and the Open3D comparison: docs/src/benchmarks.md, "Ground truth".
 
 use criterion::measurement::{Measurement, ValueFormatter};
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};

@@ -10,7 +10,7 @@
 //! folder): the R-Tac0 pin dome's point table and capture plan (`--pins-preset rtac0`), its
 //! eight captures rendered (one pin per ring, pressed to the table's tips) and saved as 8-bit
 //! PNG, the reference too; timed: reading the nine PNGs, detection, ids, the solve, the report
-//! and the overlays. Figures: README, "Calibration: extrinsics accuracy and speed".
+//! and the overlays. Figures: docs/src/benchmarks.md, "Extrinsics: accuracy and speed".
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use fabkit_calibration::groundtruth::surface::ReferenceSurface;

@@ -5,7 +5,7 @@
 //! mold cavities (R15.000, R13.500), round shell tube (30.000 x 21.650 mm) and layer
 //! thicknesses, the R-Tac0 pin dome and pin (R16.650 / R19.100, 0.350 mm counterbores, the
 //! orientation groove, 43 mm tabs, 8.8 mm pin with a 3.0 x 3.2 mm head, the published hole
-//! ids), and TacTipGenerator's 217-pin layout. The same script prints the README's table.
+//! ids), and TacTipGenerator's 217-pin layout. The same script prints the validation chapter's table (docs/src/validation.md).
 
 use crate::common::*;
 

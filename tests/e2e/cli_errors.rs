@@ -19,7 +19,8 @@ fn unknown_key_reports_file_line_column_and_writes_nothing() {
         .position(|l| l.starts_with("  colour: red"))
         .unwrap()
         + 1;
-    std::fs::write(tmp.path().join("bad.yaml"), &yaml).unwrap();
+    // an unknown key: the schema refuses it too
+    write_design(&tmp.path().join("bad.yaml"), &yaml, SchemaVerdict::Rejects);
     let o = run(tmp.path(), &["export", "bad.yaml", "--out", "out/bad"], &[]);
     assert_eq!(o.status.code(), Some(2));
     let err = text(&o.stderr);
@@ -36,7 +37,8 @@ fn impossible_parameters_are_all_reported_with_their_paths() {
         .replace("outer_radius_mm: 15.0 ", "outer_radius_mm: 14.8 ")
         .replace("draft_angle_deg: 2.0", "draft_angle_deg: 12.0")
         .replace("primer: pr_1200_rtv", "primer: ease_release_200");
-    std::fs::write(tmp.path().join("bad.yaml"), &yaml).unwrap();
+    // the draft angle is past its bound [0, 10) in the schema too
+    write_design(&tmp.path().join("bad.yaml"), &yaml, SchemaVerdict::Rejects);
     let o = run(tmp.path(), &["export", "bad.yaml", "--out", "out/bad"], &[]);
     assert_eq!(o.status.code(), Some(2));
     let err = text(&o.stderr);
@@ -76,7 +78,8 @@ fn a_broken_fit_is_a_named_interference_and_writes_nothing() {
     ] {
         let yaml = rtac0_yaml().replace(from, to);
         assert!(yaml.contains(to), "{to}");
-        std::fs::write(tmp.path().join("bad.yaml"), &yaml).unwrap();
+        // a fit is a rule between parameters: the schema accepts the design
+        write_design(&tmp.path().join("bad.yaml"), &yaml, SchemaVerdict::Accepts);
         let o = run(tmp.path(), &["export", "bad.yaml", "--out", "out/bad"], &[]);
         assert_eq!(o.status.code(), Some(2), "{to}");
         let err = text(&o.stderr);
@@ -118,21 +121,25 @@ fn tactip_body_fits_and_bayonet_profile_are_checked_and_write_nothing() {
             ],
         ),
     ] {
-        refused_writing_nothing(tmp.path(), &yaml, (from, to), &expect);
+        // fits are rules between parameters, and the bayonet profile's bounds apply only to a
+        // design with a shaft body: the schema accepts each
+        refused_writing_nothing(tmp.path(), &yaml, (from, to), &expect, SchemaVerdict::Accepts);
     }
 }
 
 /// `yaml` with `from` replaced by `to` (once) is refused by `fabkit export`: exit 2, stderr
-/// holding each of `expect` and no panic, no output folder.
+/// holding each of `expect` and no panic, no output folder; the design schema says of it what
+/// `schema` says ([`write_design`]).
 fn refused_writing_nothing(
     tmp: &std::path::Path,
     yaml: &str,
     (from, to): (&str, &str),
     expect: &[&str],
+    schema: SchemaVerdict,
 ) {
     let bad = yaml.replacen(from, to, 1);
     assert!(bad.contains(to), "{to}");
-    std::fs::write(tmp.join("bad.yaml"), &bad).unwrap();
+    write_design(&tmp.join("bad.yaml"), &bad, schema);
     let o = run(tmp, &["export", "bad.yaml", "--out", "out/bad"], &[]);
     assert_eq!(o.status.code(), Some(2), "{to}");
     let err = text(&o.stderr);
@@ -151,29 +158,34 @@ fn refused_writing_nothing(
 fn uvdtact_fits_and_shell_drawing_are_checked_and_write_nothing() {
     let tmp = tempfile::tempdir().unwrap();
     let yaml = std::fs::read_to_string(repo_root().join("designs/library/uvdtact.yaml")).unwrap();
-    for (from, to, expect) in [
+    for (from, to, expect, schema) in [
         (
             "    outer_diameter_mm: 2.6 ",
             "    outer_diameter_mm: 3.6 ",
             "fingertip_base.led_pcb.inner_diameter_mm = 3.2: fit check: `camera_holder` and `led_pcb_envelope` overlap by",
+            SchemaVerdict::Accepts,
         ),
         (
             "    led_height_mm: 0.6 ",
             "    led_height_mm: 1.4 ",
             "fingertip_base.pocket_depth_mm = 3.0: fit check: `diffusion_ring` and `leds_envelope` overlap by",
+            SchemaVerdict::Accepts,
         ),
         (
             "    inner_diameter_mm: 4.0 ",
             "    inner_diameter_mm: 2.0 ",
             "fingertip_base.diffusion_ring.inner_diameter_mm = 2.0: fit check: `camera_holder` and `diffusion_ring` overlap by",
+            SchemaVerdict::Accepts,
         ),
         (
             "  general_tolerance_mm: 0.05 ",
             "  general_tolerance_mm: 0 ",
             "core.machining.general_tolerance_mm = 0: must be above 0",
+            // a bound on the parameter alone: exclusiveMinimum 0 in the schema
+            SchemaVerdict::Rejects,
         ),
     ] {
-        refused_writing_nothing(tmp.path(), &yaml, (from, to), &[expect]);
+        refused_writing_nothing(tmp.path(), &yaml, (from, to), &[expect], schema);
     }
 }
 
@@ -202,7 +214,14 @@ fn shadowtac_casing_fits_and_rules_are_checked_and_write_nothing() {
             "casing.gripper_base.width_mm = 60: the bolts' counterbores (8.00 mm on a 70.00 mm spacing) must stay 0.80 mm inside the base",
         ),
     ] {
-        refused_writing_nothing(tmp.path(), &yaml, (from, to), &[expect]);
+        // fits and rules between parameters: the schema accepts each
+        refused_writing_nothing(
+            tmp.path(),
+            &yaml,
+            (from, to),
+            &[expect],
+            SchemaVerdict::Accepts,
+        );
     }
 }
 
@@ -261,7 +280,8 @@ fn failed_export_leaves_the_previous_export_untouched() {
     assert!(o.status.success(), "{}", text(&o.stderr));
     let manifest = std::fs::read(tmp.path().join("out/rtac0/manifest.json")).unwrap();
     let yaml = rtac0_yaml().replace("wall_thickness_mm: 1.0 ", "wall_thickness_mm: -1.0 ");
-    std::fs::write(tmp.path().join("bad.yaml"), yaml).unwrap();
+    // a negative wall: below the schema's bound too
+    write_design(&tmp.path().join("bad.yaml"), &yaml, SchemaVerdict::Rejects);
     let o = run(
         tmp.path(),
         &["export", "bad.yaml", "--out", "out/rtac0"],
@@ -375,12 +395,13 @@ fn marker_csv_file_is_confined_to_the_design_folder_regular_and_bounded() {
         .status()
         .unwrap();
     assert!(fifo.success());
+    // the file name is refused by fabkit when it reads it, not by the schema (any text)
     let design = |csv: &str| {
-        std::fs::write(
-            root.join("designs/d.yaml"),
-            shadowtac_with_csv_list().replace("csv_file: pts.csv", &format!("csv_file: {csv:?}")),
-        )
-        .unwrap();
+        write_design(
+            &root.join("designs/d.yaml"),
+            &shadowtac_with_csv_list().replace("csv_file: pts.csv", &format!("csv_file: {csv:?}")),
+            SchemaVerdict::Accepts,
+        );
     };
     let param = "layers[0].markers[0].pattern.csv_file";
     let outside = root.join("elsewhere/pts.csv").display().to_string();
@@ -605,7 +626,7 @@ fn yaml_inputs_must_be_regular_files_within_the_size_bound() {
 fn csg_never_overwrites_a_users_file() {
     let tmp = tempfile::tempdir().unwrap();
     let root = tmp.path();
-    std::fs::write(root.join("d.yaml"), rtac0_yaml()).unwrap();
+    write_design(&root.join("d.yaml"), &rtac0_yaml(), SchemaVerdict::Accepts);
     std::fs::write(root.join("target.json"), "{}").unwrap();
     std::os::unix::fs::symlink("target.json", root.join("link.json")).unwrap();
     for (csg, why) in [
@@ -757,7 +778,11 @@ fn work_past_max_triangles_is_refused_before_building() {
 #[test]
 fn marker_list_from_csv_is_placed_and_hashed() {
     let tmp = tempfile::tempdir().unwrap();
-    std::fs::write(tmp.path().join("d.yaml"), shadowtac_with_csv_list()).unwrap();
+    write_design(
+        &tmp.path().join("d.yaml"),
+        &shadowtac_with_csv_list(),
+        SchemaVerdict::Accepts,
+    );
     let hash = |pts: &str| {
         std::fs::write(tmp.path().join("pts.csv"), pts).unwrap();
         let o = run(

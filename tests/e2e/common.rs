@@ -383,3 +383,84 @@ pub fn read_npy_f32(path: &std::path::Path) -> Vec<f32> {
         .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
         .collect()
 }
+
+/// What the design JSON Schema (designs/design.schema.json, `fabkit schema`) must say of a
+/// design file a test writes ([`write_design`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SchemaVerdict {
+    /// The schema accepts the file: every design fabkit accepts, and a design fabkit refuses
+    /// only by a rule between parameters (a fit, a layer stack, a rule that depends on another
+    /// section), which the schema leaves to `fabkit validate`.
+    Accepts,
+    /// The schema refuses the file too: an unknown key, a wrong type, a value out of the bounds
+    /// fabkit checks on that parameter alone.
+    Rejects,
+}
+
+/// The committed design JSON Schema.
+pub fn design_schema_path() -> PathBuf {
+    repo_root().join("designs/design.schema.json")
+}
+
+/// Runs tests/oracles/schema_check.py (the `jsonschema` package, draft 2020-12) on `designs`
+/// against the committed schema: (exit status 0, its stdout and stderr); None when the oracle
+/// python is missing (after [`missing`]).
+pub fn schema_check(designs: &[PathBuf]) -> Option<(bool, String)> {
+    let Some(py) = oracle_python() else {
+        missing("the oracle python (jsonschema + PyYAML)");
+        return None;
+    };
+    let o = Command::new(py)
+        .arg(repo_root().join("tests/oracles/schema_check.py"))
+        .arg(design_schema_path())
+        .args(designs)
+        .output()
+        .expect("python runs");
+    assert!(
+        matches!(o.status.code(), Some(0 | 1)),
+        "schema_check.py did not run: {}{}",
+        text(&o.stdout),
+        text(&o.stderr)
+    );
+    Some((
+        o.status.success(),
+        format!("{}{}", text(&o.stdout), text(&o.stderr)),
+    ))
+}
+
+/// Design texts whose schema verdict this test run has checked already (sha256 of the text).
+static SCHEMA_CHECKED: Mutex<BTreeMap<[u8; 32], bool>> = Mutex::new(BTreeMap::new());
+
+/// Writes the design YAML `text` to `path` and checks that the design JSON Schema says of it
+/// what `verdict` says (with the oracle, [`schema_check`]; each distinct text once per test
+/// run), so that the schema editors use and fabkit cannot silently disagree: every design the
+/// end-to-end tests write goes through here. Panics, naming the schema's errors, when the
+/// schema disagrees; skips the check as [`missing`] does without the oracle.
+pub fn write_design(path: &Path, text: &str, verdict: SchemaVerdict) {
+    std::fs::write(path, text).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let key: [u8; 32] = Sha256::digest(text.as_bytes()).into();
+    let accepts = verdict == SchemaVerdict::Accepts;
+    if SCHEMA_CHECKED
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .get(&key)
+        == Some(&accepts)
+    {
+        return;
+    }
+    let Some((valid, out)) = schema_check(&[path.to_path_buf()]) else {
+        return;
+    };
+    assert_eq!(
+        valid,
+        accepts,
+        "design.schema.json {} {} but the test says it should {}:\n{out}",
+        if valid { "accepts" } else { "rejects" },
+        path.display(),
+        if accepts { "accept it" } else { "reject it" },
+    );
+    SCHEMA_CHECKED
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .insert(key, accepts);
+}

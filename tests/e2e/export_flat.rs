@@ -175,7 +175,11 @@ fn soter_laser_cut_sheets_read_back() {
         .replace("kerf_mm: 0.12", "kerf_mm: 0.0")
         .replace("kerf_mm: 0.10", "kerf_mm: 0.0");
     assert_eq!(zero.matches("kerf_mm: 0.0").count(), 3);
-    std::fs::write(tmp.path().join("zero_kerf.yaml"), zero).unwrap();
+    write_design(
+        &tmp.path().join("zero_kerf.yaml"),
+        &zero,
+        SchemaVerdict::Accepts,
+    );
     for (design, out) in [("soter_channels", "out/k"), ("zero_kerf.yaml", "out/z")] {
         let o = run(tmp.path(), &["export", design, "--out", out], &[]);
         assert!(o.status.success(), "{}", text(&o.stderr));
@@ -293,7 +297,8 @@ fn bad_flat_values_write_nothing() {
     ] {
         assert!(yaml.contains(from), "{from}");
         let bad = yaml.replacen(from, to, 1);
-        std::fs::write(tmp.path().join("bad.yaml"), &bad).unwrap();
+        // each a rule between parameters (the pitch, the wall, the sheets): the schema accepts it
+        write_design(&tmp.path().join("bad.yaml"), &bad, SchemaVerdict::Accepts);
         let o = run(tmp.path(), &["export", "bad.yaml", "--out", "out/bad"], &[]);
         assert_eq!(o.status.code(), Some(2), "{to}");
         let err = text(&o.stderr);

@@ -38,9 +38,17 @@ fn validate_lists_every_path_without_noise_and_show_gives_a_template() {
                 );
             }
         }
+        // the library text, but for the schema modeline: it names the schema beside the
+        // template (`fabkit schema > design.schema.json`) rather than designs/'s
         let o = run(tmp.path(), &["show", name], &[]);
         assert!(o.status.success(), "{name}: {}", text(&o.stderr));
-        assert_eq!(text(&o.stdout), *yaml);
+        let library_rest = yaml
+            .strip_prefix("# yaml-language-server: $schema=../design.schema.json\n")
+            .expect("the library design starts with its modeline");
+        assert_eq!(
+            text(&o.stdout),
+            format!("# yaml-language-server: $schema=design.schema.json\n{library_rest}")
+        );
         let file = format!("{name}.yaml");
         let o = run(tmp.path(), &["show", name, "--out", &file], &[]);
         assert!(o.status.success(), "{name}: {}", text(&o.stderr));

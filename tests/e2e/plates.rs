@@ -1,4 +1,4 @@
-//! Print plates (`plates/<design>_<technology>_<material>_<n>.3mf`): the README's examples
+//! Print plates (`plates/<design>_<technology>_<material>_<n>.3mf`): the guide's examples
 //! give plates that fit their printers (every part on exactly one plate, inside the bed less its
 //! margin, no plate mixing technologies or materials); PrusaSlicer slices the plates of
 //! `fabkit export rtac0` and `fabkit fixtures rtac0 --semidomes 100` with `--dont-arrange` for
@@ -320,7 +320,7 @@ fn readme_examples_give_plates_that_fit_and_slice_on_their_printers() {
     if !prusa_slicer() {
         return;
     }
-    // the plates of the README's first examples, sliced two at a time
+    // the plates of the guide's first examples, sliced two at a time
     let mut jobs = Vec::new();
     for name in ["rtac0", "fx"] {
         let out = dir.join(name);

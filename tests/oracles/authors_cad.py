@@ -9,7 +9,7 @@ point table) with numpy/trimesh, independently of fabkit's own code. Each row co
 quantity with the authors' CAD (their STL/STEP files, measured: the ShadowTac repository's mold
 STEP, the R-Tac0 files of the PP-Tac repository) or TacTipGenerator's default layout, within a
 stated tolerance. Rows marked `differs` are known, documented differences (they are printed, not
-asserted). With --markdown the table is printed in the README's form.
+asserted). With --markdown the table is printed in the form of docs/src/validation.md.
 
 Exit status: 0 when every asserted row holds, 1 otherwise (each failure printed), 2 on a usage or
 run error.

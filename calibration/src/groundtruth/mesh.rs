@@ -19,7 +19,7 @@
 //! twice as fast when most of the frame sees the mesh; the tiles stay faster when it sees
 //! little of it ([`CastOrder`]).
 //!
-//! Why not a crate: see the README section "Ground truth: speed" (the `bvh` and `obvhs`
+//! Why not a crate: see the user guide, docs/src/benchmarks.md, "Ground truth" (the `bvh` and `obvhs`
 //! crates measured on the same scene with single-ray traversal).
 
 use fabkit_designs::geometry::Mesh;
@@ -363,7 +363,7 @@ impl MeshCaster {
     /// triangles than there are cast rays in the tiles that meet the hierarchy's boxes two
     /// levels down (estimated from every fourth tile and four rays per tile). Tiles win when
     /// few rays are cast or the mesh covers little of the frame (they skip the rest);
-    /// triangles win on whole frames (README, "Ground truth: speed").
+    /// triangles win on whole frames (docs/src/benchmarks.md, "Ground truth").
     fn triangle_order_pays(&self, rays: &PixelRays, t_max: &[f64]) -> bool {
         // First the cast rays alone (every 64th counted): no walk when they are too few.
         let cast = t_max.iter().step_by(64).filter(|&&t| t > 0.0).count() * 64;

@@ -22,11 +22,12 @@
 //! lug prints and how loose a printed fit must be are properties of the printer.
 
 use crate::geometry::{ChordTolerance, GeometryError, Mesh, Solid};
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
 /// A printer's bayonet settings (`printers.<technology>.bayonet`).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields, default)]
 pub struct BayonetProfile {
     /// Lugs round the joint, 2..=8 (and they must fit round the spigot with their grooves).

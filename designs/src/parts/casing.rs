@@ -32,27 +32,34 @@ use crate::molds::{place_posed, with_pose};
 use crate::parts::shaft_body::{half_nozzle, OVERLAP_MM};
 use crate::parts::z_cylinder;
 use crate::schema::Design;
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 
 /// The casing (see the module docs). Lengths in mm.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct CasingParams {
     /// Material key (printed FDM), e.g. `pla`.
     pub material: String,
     /// Width of the square casing, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub outer_width_mm: f64,
     /// From the casing's bottom to its top face (under the backing plate), mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub height_mm: f64,
     /// Wall round the camera bay, mm; the bay is `outer_width_mm - 2 x wall_thickness_mm`
     /// square.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub wall_thickness_mm: f64,
     /// The round opening in the top face, under the plate: the light chamber's diameter, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub window_diameter_mm: f64,
     /// From the casing's bottom up to the ledge, mm: holds the camera board.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub bay_height_mm: f64,
     /// The ledge between the bay and the light chamber, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub ledge_thickness_mm: f64,
     /// Clearance round seated parts (the lens in its bore, the LEDs in their slots, the
     /// casing in the base's socket), mm, at least half the FDM nozzle.
@@ -66,55 +73,69 @@ pub struct CasingParams {
 }
 
 /// The camera: a square board with the lens standing on it (bought).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct CasingCamera {
     /// The camera and lens, for the sheet.
     pub module: String,
     /// The board's side, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub board_width_mm: f64,
     /// The board with its components and connector, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub board_height_mm: f64,
     /// The lens with its holder: the cylinder round it, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub lens_diameter_mm: f64,
     /// From the board's top to the lens's front, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub lens_height_mm: f64,
 }
 
 /// The LEDs: segments cut from an LED strip (bought).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct CasingLeds {
     /// The strip, for the sheet.
     pub description: String,
     /// LEDs round the chamber at equal angles, 1..=8 (Sec. IV-B: 3).
+    #[schemars(extend("minimum" = 1, "maximum" = 8))]
     pub count: u32,
     /// Azimuth of the first LED from +x, degrees.
     pub first_azimuth_deg: f64,
     /// One segment: width across the strip, length along it (standing up), thickness with
     /// its LED, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub width_mm: f64,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub length_mm: f64,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub thickness_mm: f64,
     /// Hole through the ledge for each segment's wires, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub wire_hole_diameter_mm: f64,
 }
 
 /// The screws that hold the casing on its base: self-tapping into pilots in the casing's
 /// corners, from below through counterbored holes in the base.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct CasingScrews {
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub pilot_diameter_mm: f64,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub pilot_depth_mm: f64,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub clearance_diameter_mm: f64,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub head_diameter_mm: f64,
     /// Counterbore for the head, from the base's bottom, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub head_depth_mm: f64,
 }
 
 /// The gripper base (see the module docs). Lengths in mm.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct GripperBase {
     /// The gripper and its finger's fastening, for the sheet.
@@ -122,19 +143,29 @@ pub struct GripperBase {
     /// Material key (printed FDM), e.g. `pla`.
     pub material: String,
     /// Along x and y, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub width_mm: f64,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub length_mm: f64,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub thickness_mm: f64,
     /// Depth of the socket that takes the casing's foot, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub socket_depth_mm: f64,
     /// The camera's cable slot under the socket's floor, out on +y: width and depth, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub cable_slot_width_mm: f64,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub cable_slot_depth_mm: f64,
     /// Bolts to the gripper on a rectangle centred on the axis: its sides along x and y, mm.
+    #[schemars(extend("items" = {"type": "number", "exclusiveMinimum": 0}))]
     pub bolt_spacing_mm: [f64; 2],
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub bolt_clearance_diameter_mm: f64,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub bolt_head_diameter_mm: f64,
     /// Counterbore for the bolts' heads, from the base's top, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub bolt_head_depth_mm: f64,
 }
 

@@ -30,23 +30,27 @@ use crate::parts::shaft_body::OVERLAP_MM;
 use crate::parts::z_cylinder;
 use crate::schema::Design;
 use crate::stack::Stack;
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 
 /// The fingertip's base (see the module docs). Lengths in mm.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct FingertipBase {
     /// Material key of the shell holder, the sensor base and the camera holder (printed SLA).
     pub material: String,
     /// Outer diameter of the shell holder and the sensor base, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub outer_diameter_mm: f64,
     /// Radial clearance round seated parts (the shell in its holder, the PCB and the ring in
     /// the pocket, the camera in its holder), mm, at least the SLA printer's xy resolution.
     pub fit_clearance_mm: f64,
     /// Depth of the sensor base's pocket: the PCB with its LEDs and the diffusion ring, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub pocket_depth_mm: f64,
     /// The sensor base's floor under the pocket, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub floor_thickness_mm: f64,
     pub led_pcb: LightingPcb,
     pub diffusion_ring: DiffusionRing,
@@ -57,65 +61,86 @@ pub struct FingertipBase {
 
 /// The lighting PCB (bought): a ring with 4 white and 4 UV LEDs alternating every 45 deg, the
 /// first white LED on +x (UVDtact Sec. III-C).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct LightingPcb {
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub outer_diameter_mm: f64,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub inner_diameter_mm: f64,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub thickness_mm: f64,
     /// The circle the LEDs' centres are on, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub led_circle_diameter_mm: f64,
     /// One LED: its length (radial) and height over the board, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub led_length_mm: f64,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub led_height_mm: f64,
     /// Hole in the base's floor under the board for its wires, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub wire_hole_diameter_mm: f64,
 }
 
 /// The white SLA diffusion ring over the LEDs, with a hole over each UV LED.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct DiffusionRing {
     /// Material key (printed SLA, white).
     pub material: String,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub inner_diameter_mm: f64,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub thickness_mm: f64,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub uv_hole_diameter_mm: f64,
 }
 
 /// The endoscopic camera (bought).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct MiniCamera {
     /// The camera, for the sheet.
     pub module: String,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub diameter_mm: f64,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub length_mm: f64,
     /// Full field of view, degrees.
+    #[schemars(extend("exclusiveMinimum" = 0, "exclusiveMaximum" = 180))]
     pub view_angle_deg: f64,
     /// Hole in the base's floor for its wire, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub wire_hole_diameter_mm: f64,
 }
 
 /// The camera holder: a tube round the camera.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct CameraHolder {
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub outer_diameter_mm: f64,
 }
 
 /// The bolts that fasten the sensor base to the shell holder: up through counterbored holes
 /// in the base into pilots in the holder, on a circle between the shell and the outside.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct HolderBolts {
     /// 2..=6, at equal angles, the first on +y.
+    #[schemars(extend("minimum" = 2, "maximum" = 6))]
     pub count: u32,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub pilot_diameter_mm: f64,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub pilot_depth_mm: f64,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub clearance_diameter_mm: f64,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub head_diameter_mm: f64,
     /// Counterbore for the head, from the base's bottom, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub head_depth_mm: f64,
 }
 

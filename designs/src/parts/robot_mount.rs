@@ -20,33 +20,44 @@ use crate::molds::{place_posed, with_pose};
 use crate::parts::bayonet::{band, Bayonet};
 use crate::parts::shaft_body::{levels, BayonetLugs, ShaftBodyParams, CABLE_SLOT_MM, OVERLAP_MM};
 use crate::schema::Design;
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 use std::f64::consts::PI;
 
 /// The robot mount (see the module docs). Lengths in mm.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct RobotMount {
     /// The robot and its tool flange, for the fabrication sheet.
     pub robot: String,
     /// Material key of the mount (printed FDM), e.g. `abs`.
     pub material: String,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub plate_thickness_mm: f64,
     /// Wall of the cup outside its grooves, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub cup_wall_mm: f64,
     /// Height of the cup over the plate, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub cup_height_mm: f64,
     /// Pitch circle of the flange's bolts, mm (ISO 9409-1 d1).
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub bolt_circle_diameter_mm: f64,
     /// Bolts on the pitch circle, 2..=8; the first at 45 deg from +x.
+    #[schemars(extend("minimum" = 2, "maximum" = 8))]
     pub bolt_count: u32,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub bolt_clearance_diameter_mm: f64,
     /// Counterbore for the bolt's head, from the plate's top, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub bolt_head_diameter_mm: f64,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub bolt_head_depth_mm: f64,
     /// Locating pin hole on the pitch circle at +x, from the plate's bottom, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub pin_hole_diameter_mm: f64,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub pin_hole_depth_mm: f64,
     /// The bayonet's lugs on the base's foot (count, ramp and clearance from
     /// `printers.fdm.bayonet`).

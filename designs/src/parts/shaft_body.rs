@@ -32,21 +32,25 @@ use crate::molds::{place_posed, with_pose};
 use crate::parts::bayonet::Bayonet;
 use crate::schema::{Design, FillingGel, LayerProcess};
 use crate::stack::Stack;
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 
 /// The shaft body and the tip's fitting (see the module docs). Lengths in mm.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ShaftBodyParams {
     /// Material key of the body (printed FDM), e.g. `abs`.
     pub material: String,
     /// Outer diameter of the shaft, mm (Sec. III-A: about 23 mm).
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub shaft_diameter_mm: f64,
     /// From the shaft's top face (under the lens window) down to the base, mm (Sec. III-A:
     /// about 38 mm, chosen for the lens's focal length and view angle).
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub shaft_length_mm: f64,
     /// Wall of the shaft round its bore, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub wall_thickness_mm: f64,
     /// Radial clearance round seated parts (window, LED ring, lens, camera board), mm, at
     /// least half the FDM nozzle.
@@ -67,94 +71,120 @@ pub struct ShaftBodyParams {
 
 /// The tip's rigid fitting, printed with the skin (Sec. III-A: "a rigid bayonet fitting (Vero
 /// White). Both elements are printed as a single part").
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct TipFitting {
     /// Material key, a PolyJet material printed with the skin (`vero_white`).
     pub material: String,
     /// How far the skirt reaches down over the shaft, below the window, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub skirt_length_mm: f64,
     /// How far the lip reaches in over the window's rim, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub lip_width_mm: f64,
     /// Thickness of the lip, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub lip_thickness_mm: f64,
 }
 
 /// The bayonet's lugs (on the tip's skirt) and grooves (round the shaft's top); the lug
 /// count, ramp and clearance come from `printers.fdm.bayonet`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct BayonetLugs {
     /// Lug width along the shaft's circumference, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub lug_width_mm: f64,
     /// Lug height, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub lug_height_mm: f64,
     /// How far a lug reaches into the shaft, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub lug_depth_mm: f64,
     /// Turn from entry to locked, degrees, in (0, 90).
+    #[schemars(extend("exclusiveMinimum" = 0, "exclusiveMaximum" = 90))]
     pub lock_angle_deg: f64,
     /// Groove width along the circumference, mm; the lug's width plus the clearance on each
     /// side when not given.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub groove_width_mm: Option<f64>,
 }
 
 /// The acrylic lens window (Sec. III-A: "an inserted acrylic lens"), laser-cut.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct LensWindow {
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub diameter_mm: f64,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub thickness_mm: f64,
 }
 
 /// The LED ring PCB (Sec. III-A: "a PCB ring of six LEDs"), seated in the shaft's top.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct LedRing {
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub outer_diameter_mm: f64,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub inner_diameter_mm: f64,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub thickness_mm: f64,
     pub led_count: u32,
     /// Height of the LEDs over the PCB, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub led_height_mm: f64,
     /// Diameter of the seat in the shaft's top, mm; the PCB's plus the fit clearance on each
     /// side when not given.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub seat_diameter_mm: Option<f64>,
 }
 
 /// The camera board in the base, its lens up the shaft (Sec. III-A2: an ADNS-3080 on a
 /// breakout board with an adjustable lens, focal length 4.2 mm, view angle 86 deg).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ShaftCamera {
     /// Module name, for the fabrication sheet.
     pub module: String,
     /// Side of the square board, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub board_width_mm: f64,
     /// Height of the pocket under the base's ceiling: the board and what hangs under it, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub bay_height_mm: f64,
     /// Diameter of the lens holder, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub lens_diameter_mm: f64,
     /// Height of the lens's front over the board's top face, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub lens_height_mm: f64,
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub focal_length_mm: f64,
     /// Full view angle of the lens, degrees, in (0, 180).
+    #[schemars(extend("exclusiveMinimum" = 0, "exclusiveMaximum" = 180))]
     pub view_angle_deg: f64,
     /// Square pattern of the board's mounting holes, centre to centre, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub mount_hole_spacing_mm: f64,
     /// Pilot for the self-tapping mounting screws, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub mount_pilot_diameter_mm: f64,
     /// Depth of the pilots up into the ceiling, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub mount_pilot_depth_mm: f64,
 }
 
 /// The base under the shaft that holds the camera board.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ShaftBase {
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub outer_diameter_mm: f64,
     /// Thickness of the ceiling over the board's pocket, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub ceiling_thickness_mm: f64,
 }
 

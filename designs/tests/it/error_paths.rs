@@ -143,12 +143,12 @@ fn lenient_scalars_and_unknown_tags_are_refused() {
         (
             "a boolean description",
             first(description, "description: true"),
-            "x.yaml:6:14: The string value [true] must be quoted".into(),
+            "x.yaml:7:14: The string value [true] must be quoted".into(),
         ),
         (
             "a quoted number",
             first(radius, &radius.replacen(value, "\"25\"", 1)),
-            "x.yaml:11:14: body.radius_mm = \"25\": a number must be written without quotes".into(),
+            "x.yaml:12:14: body.radius_mm = \"25\": a number must be written without quotes".into(),
         ),
         (
             "an unknown tag",
@@ -196,10 +196,10 @@ fn each_quoted_number_is_refused_at_its_own_location() {
     assert_eq!(
         lines,
         [
-            "x.yaml:27:19: layers[0].thickness_mm = \"1.5\": a number must be written without quotes",
-            "x.yaml:41:19: layers[1].thickness_mm = \"1.5\": a number must be written without quotes",
-            "x.yaml:54:19: layers[2].thickness_mm = \"1.5\": a number must be written without quotes",
-            "x.yaml:61:24: mold.sprue.diameter_mm = \"3\": a number must be written without quotes",
+            "x.yaml:28:19: layers[0].thickness_mm = \"1.5\": a number must be written without quotes",
+            "x.yaml:42:19: layers[1].thickness_mm = \"1.5\": a number must be written without quotes",
+            "x.yaml:55:19: layers[2].thickness_mm = \"1.5\": a number must be written without quotes",
+            "x.yaml:62:24: mold.sprue.diameter_mm = \"3\": a number must be written without quotes",
         ],
         "{e}"
     );

@@ -8,6 +8,7 @@ mod flat_skin;
 mod geometry;
 mod hostile_values;
 mod insertion;
+mod json_schema;
 mod lasercut;
 mod marker_layout;
 mod markers;

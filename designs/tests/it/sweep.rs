@@ -358,16 +358,17 @@ fn a_parameter_the_design_ignores_is_refused() {
     assert_eq!(s.plan().unwrap().variants.len(), 2);
 }
 
-/// The README's sweep example parses, and every parameter it varies changes the design the
+/// The user guide's sweep example (docs/src/guide/sweeps.md) parses, and every parameter it varies changes the design the
 /// variants build: its variants' marker counts differ with the spacing.
 #[test]
-fn the_readme_sweep_example_varies_effective_parameters() {
-    let readme =
-        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../README.md"))
-            .unwrap();
+fn the_guide_sweep_example_varies_effective_parameters() {
+    let readme = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/src/guide/sweeps.md"),
+    )
+    .unwrap();
     let start = readme
         .find("# dimples.yaml\n")
-        .expect("README sweep example");
+        .expect("the guide's sweep example");
     let end = start + readme[start..].find("```").unwrap();
     let s = spec(&readme[start..end]);
     let plan = s.plan().unwrap();

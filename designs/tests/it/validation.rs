@@ -472,7 +472,7 @@ fn coating_below_the_layer_under_it_yields_one_error() {
 #[test]
 fn a_nan_layer_radius_is_a_named_error() {
     let t = with_line(
-        29,
+        30,
         "    outer_radius_mm: 14.9",
         &["    outer_radius_mm: .nan"],
     );
@@ -602,32 +602,32 @@ fn yaml_error(text: &str) -> (usize, usize, String) {
 
 #[test]
 fn unknown_key_points_at_its_line() {
-    // line 15 is `  description: ...` under `core:`; the new key takes its place
+    // line 16 is `  description: ...` under `core:`; the new key takes its place
     let t = with_line(
-        15,
+        16,
         "  description:",
-        &["  colour: red", text().lines().nth(14).unwrap()],
+        &["  colour: red", text().lines().nth(15).unwrap()],
     );
     let (line, col, msg) = yaml_error(&t);
-    assert_eq!((line, col), (15, 3), "{msg}");
+    assert_eq!((line, col), (16, 3), "{msg}");
     assert!(msg.contains("unknown field `colour`"), "{msg}");
 
     // a key in a layer (a sequence item) and one in a nested mold section
     let t = with_line(
-        24,
+        25,
         "    process: cast",
         &["    process: cast", "    colour: red"],
     );
     let (line, col, msg) = yaml_error(&t);
-    assert_eq!((line, col), (25, 5), "{msg}");
+    assert_eq!((line, col), (26, 5), "{msg}");
     assert!(msg.contains("colour"), "{msg}");
     let t = with_line(
-        38,
+        39,
         "  draft_angle_deg:",
         &["  draft_angle_deg: 2.0", "  draft_angel_deg: 2.0"],
     );
     let (line, col, msg) = yaml_error(&t);
-    assert_eq!((line, col), (39, 3), "{msg}");
+    assert_eq!((line, col), (40, 3), "{msg}");
     assert!(msg.contains("draft_angel_deg"), "{msg}");
 }
 
@@ -635,34 +635,37 @@ fn unknown_key_points_at_its_line() {
 fn wrong_type_points_at_the_value() {
     // `  wall_thickness_mm: big`: the value starts in column 22
     let t = with_line(
-        18,
+        19,
         "  wall_thickness_mm: 1.0",
         &["  wall_thickness_mm: big"],
     );
     let (line, col, msg) = yaml_error(&t);
-    assert_eq!((line, col), (18, 22), "{msg}");
+    assert_eq!((line, col), (19, 22), "{msg}");
+    // and names the parameter path of the value
+    assert!(msg.ends_with(" (at core.wall_thickness_mm)"), "{msg}");
     // `    outer_radius_mm: big` in a layer: column 22 as well
     let t = with_line(
-        29,
+        30,
         "    outer_radius_mm: 14.9",
         &["    outer_radius_mm: big"],
     );
     let (line, col, msg) = yaml_error(&t);
-    assert_eq!((line, col), (29, 22), "{msg}");
+    assert_eq!((line, col), (30, 22), "{msg}");
+    assert!(msg.ends_with(" (at layers[1].outer_radius_mm)"), "{msg}");
     // an unknown enum variant
-    let t = with_line(24, "    process: cast", &["    process: poured"]);
+    let t = with_line(25, "    process: cast", &["    process: poured"]);
     let (line, col, msg) = yaml_error(&t);
-    assert_eq!(line, 24, "{msg}");
+    assert_eq!(line, 25, "{msg}");
     assert!((5..=14).contains(&col), "{msg}");
     assert!(msg.contains("poured"), "{msg}");
 }
 
 #[test]
 fn missing_field_points_into_its_mapping() {
-    // remove `material:` (line 27) of layers[1], whose mapping then spans lines 26-28
-    let t = with_line(27, "    material: ecoflex_00_30", &[]);
+    // remove `material:` (line 28) of layers[1], whose mapping then spans lines 27-29
+    let t = with_line(28, "    material: ecoflex_00_30", &[]);
     let (line, col, msg) = yaml_error(&t);
-    assert!((26..=28).contains(&line), "{msg}");
+    assert!((27..=29).contains(&line), "{msg}");
     assert!((3..=5).contains(&col), "{msg}");
     assert!(msg.contains("missing field `material`"), "{msg}");
 }
@@ -670,35 +673,35 @@ fn missing_field_points_into_its_mapping() {
 #[test]
 fn syntax_error_points_at_its_line() {
     // a tab-indented key under `core:`
-    let t = with_line(16, "  material:", &["\tmaterial: borosilicate_glass"]);
+    let t = with_line(17, "  material:", &["\tmaterial: borosilicate_glass"]);
     let (line, _col, msg) = yaml_error(&t);
-    assert_eq!(line, 16, "{msg}");
+    assert_eq!(line, 17, "{msg}");
 }
 
 #[test]
 fn errors_inside_body_point_at_their_line() {
-    // unknown key right under `body:` (new line 10)
+    // unknown key right under `body:` (new line 11)
     let t = with_line(
-        10,
+        11,
         "  profile:",
         &["  colour: red", "  profile: hemisphere_on_cylinder"],
     );
     let (line, col, msg) = yaml_error(&t);
-    assert_eq!((line, col), (10, 3), "{msg}");
+    assert_eq!((line, col), (11, 3), "{msg}");
     assert!(msg.contains("unknown field `colour`"), "{msg}");
     // wrong type: `  radius_mm: big`, the value starts in column 14
-    let t = with_line(11, "  radius_mm: 15.0", &["  radius_mm: big"]);
+    let t = with_line(12, "  radius_mm: 15.0", &["  radius_mm: big"]);
     let (line, col, msg) = yaml_error(&t);
-    assert_eq!((line, col), (11, 14), "{msg}");
+    assert_eq!((line, col), (12, 14), "{msg}");
     // an unknown profile: the value starts in column 12
-    let t = with_line(10, "  profile:", &["  profile: cone"]);
+    let t = with_line(11, "  profile:", &["  profile: cone"]);
     let (line, col, msg) = yaml_error(&t);
-    assert_eq!((line, col), (10, 12), "{msg}");
+    assert_eq!((line, col), (11, 12), "{msg}");
     assert!(msg.contains("cone"), "{msg}");
-    // a key of another profile, and a missing one: inside the body mapping (lines 10-12)
-    let t = with_line(12, "  cylinder_length_mm:", &["  height_mm: 6.0"]);
+    // a key of another profile, and a missing one: inside the body mapping (lines 11-13)
+    let t = with_line(13, "  cylinder_length_mm:", &["  height_mm: 6.0"]);
     let (line, _, msg) = yaml_error(&t);
-    assert!((10..=12).contains(&line), "{msg}");
+    assert!((11..=13).contains(&line), "{msg}");
     assert!(
         msg.contains("body.height_mm") && msg.contains("body.cylinder_length_mm"),
         "{msg}"

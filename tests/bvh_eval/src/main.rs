@@ -1,5 +1,5 @@
 //! Single-thread rays per CPU-second of the `obvhs` and `bvh` crates on fabkit's ground-truth
-//! benchmark scene, for the README's choice of ray caster. Not part of the workspace or CI.
+//! benchmark scene, for the ray caster's choice (docs/src/benchmarks.md). Not part of the workspace or CI.
 //!
 //! FABKIT_GT_KEEP=1 scripts/bench-groundtruth     # prints "scene files kept in DIR"
 //! cargo run --release --manifest-path tests/bvh_eval/Cargo.toml -- DIR

@@ -1,4 +1,4 @@
-"""The README's first "From Python" example (arrays) runs as written, on inputs the CLI makes: a camera file
+"""The user guide's first "From Python" example (arrays, docs/src/guide/python.md) runs as written, on inputs the CLI makes: a camera file
 (cam.yaml), a calibration (calib/extrinsics.json), the R-Tac0 fixtures (out/rtac0_fixtures) and
 a ground-truth folder (gt), in a fresh folder."""
 
@@ -12,19 +12,16 @@ import numpy as np
 
 from test_groundtruth_render import CAMERA_YAML, pose
 
-README = Path(__file__).resolve().parents[2] / "README.md"
+GUIDE = Path(__file__).resolve().parents[2] / "docs" / "src" / "guide" / "python.md"
 
 
-def readme_example():
-    text = README.read_text()
-    section = text[text.index("\n## From Python\n"):]
-    section = section[: section.index("\n## ", 1)]
-    blocks = re.findall(r"```python\n(.*?)```", section, re.S)
-    assert len(blocks) == 2, "the section has two Python examples: arrays, then a sweep"
+def guide_example():
+    blocks = re.findall(r"```python\n(.*?)```", GUIDE.read_text(), re.S)
+    assert len(blocks) == 2, "the chapter has two Python examples: arrays, then a sweep"
     return blocks[0]
 
 
-def test_readme_example_runs(tmp_path, run_cli, monkeypatch):
+def test_guide_example_runs(tmp_path, run_cli, monkeypatch):
     (tmp_path / "cam.yaml").write_text(CAMERA_YAML)
     (tmp_path / "calib").mkdir()
     (tmp_path / "calib" / "extrinsics.json").write_text(
@@ -38,7 +35,7 @@ def test_readme_example_runs(tmp_path, run_cli, monkeypatch):
     printed = io.StringIO()
     scope = {}
     with contextlib.redirect_stdout(printed):
-        exec(compile(readme_example(), str(README), "exec"), scope)
+        exec(compile(guide_example(), str(GUIDE), "exec"), scope)
     # what the example made is what it says
     lines = printed.getvalue().splitlines()
     assert (tmp_path / "out" / "rtac0_py" / "manifest.json").is_file()

@@ -1,0 +1,132 @@
+//! The design JSON Schema generated from the design types ([`design_json_schema`], `fabkit
+//! schema`): unknown keys refused everywhere, every length and angle bounded as
+//! `values::check_values` bounds it, deterministic text. Validating designs against it is the
+//! end-to-end tests' part (tests/e2e/schema.rs, with an independent validator).
+
+use fabkit_designs::schema::{design_json_schema, design_json_schema_text};
+use fabkit_designs::values::{MAX_ANGLE_DEG, MAX_LENGTH_MM};
+use serde_json::Value;
+
+/// A visitor of subschemas: (the property name that leads to the schema, the nearest one above
+/// for list items and branches, "" at the top and for definitions; whether the schema is the
+/// property's own; the schema).
+type Visit<'a> = &'a mut dyn FnMut(&str, bool, &serde_json::Map<String, Value>);
+
+/// Calls `f` for every subschema of `v`.
+fn each_schema(v: &Value, key: &str, own: bool, f: Visit) {
+    let Value::Object(m) = v else { return };
+    f(key, own, m);
+    if let Some(Value::Object(props)) = m.get("properties") {
+        for (k, sub) in props {
+            each_schema(sub, k, true, f);
+        }
+    }
+    for k in ["items", "additionalProperties"] {
+        if let Some(sub) = m.get(k) {
+            each_schema(sub, key, false, f);
+        }
+    }
+    for k in ["prefixItems", "anyOf", "oneOf", "allOf"] {
+        if let Some(Value::Array(subs)) = m.get(k) {
+            for sub in subs {
+                each_schema(sub, key, false, f);
+            }
+        }
+    }
+    if let Some(Value::Object(defs)) = m.get("$defs") {
+        for sub in defs.values() {
+            each_schema(sub, "", false, f);
+        }
+    }
+}
+
+fn is_number(m: &serde_json::Map<String, Value>) -> bool {
+    match m.get("type") {
+        Some(Value::String(t)) => t == "number",
+        Some(Value::Array(ts)) => ts.iter().any(|t| t == "number"),
+        _ => false,
+    }
+}
+
+fn num(m: &serde_json::Map<String, Value>, k: &str) -> Option<f64> {
+    m.get(k).and_then(Value::as_f64)
+}
+
+#[test]
+fn the_schema_is_draft_2020_12_with_its_id_and_deterministic() {
+    let v = design_json_schema();
+    assert_eq!(v["$schema"], "https://json-schema.org/draft/2020-12/schema");
+    assert_eq!(v["$id"], "urn:fabkit:design");
+    assert_eq!(v["title"], "fabkit design");
+    let text = design_json_schema_text();
+    assert_eq!(text, design_json_schema_text());
+    assert!(text.ends_with("}\n"));
+    assert_eq!(serde_json::from_str::<Value>(&text).unwrap(), v);
+}
+
+/// Every section of a design refuses unknown keys (`deny_unknown_fields` on every design type),
+/// except the presets' maps of parameter paths, which take any path.
+#[test]
+fn every_section_refuses_unknown_keys() {
+    let v = design_json_schema();
+    let mut sections = 0;
+    each_schema(&v, "", false, &mut |key, _, m| {
+        // a section given as branches (the body's profiles) is closed by each branch
+        let branches_closed = m.get("oneOf").and_then(Value::as_array).is_some_and(|b| {
+            b.iter()
+                .all(|b| b.get("additionalProperties") == Some(&Value::Bool(false)))
+        });
+        if m.contains_key("properties") && !branches_closed {
+            sections += 1;
+            assert_eq!(
+                m.get("additionalProperties"),
+                Some(&Value::Bool(false)),
+                "the section under `{key}` takes unknown keys: {m:?}"
+            );
+        }
+    });
+    assert!(sections > 50, "{sections} sections");
+    assert_eq!(
+        v["properties"]["presets"]["additionalProperties"]["additionalProperties"],
+        true
+    );
+}
+
+/// Every number under a `_mm` key is a length from 0 (or above 0) to 1000 mm, every number
+/// under a `_deg` key an angle within +-360 deg, as `values::check_values` refuses otherwise.
+#[test]
+fn every_length_and_angle_is_bounded_as_the_validator_bounds_it() {
+    let v = design_json_schema();
+    let (mut lengths, mut angles) = (0, 0);
+    each_schema(&v, "", false, &mut |key, own, m| {
+        if !is_number(m) {
+            return;
+        }
+        let lo = num(m, "minimum").or(num(m, "exclusiveMinimum"));
+        let hi = num(m, "maximum").or(num(m, "exclusiveMaximum"));
+        let (Some(lo), Some(hi)) = (lo, hi) else {
+            panic!("`{key}` is not bounded: {m:?}");
+        };
+        if key.ends_with("_mm") {
+            lengths += 1;
+            assert!(lo >= 0.0 && hi <= MAX_LENGTH_MM, "`{key}`: {m:?}");
+            assert!(
+                !own || m
+                    .get("description")
+                    .and_then(Value::as_str)
+                    .is_some_and(|d| d.contains("mm")),
+                "`{key}` does not say its unit: {m:?}"
+            );
+        } else if key.ends_with("_deg") {
+            angles += 1;
+            assert!(
+                lo >= -MAX_ANGLE_DEG && hi <= MAX_ANGLE_DEG,
+                "`{key}`: {m:?}"
+            );
+        }
+    });
+    assert!(
+        lengths > 100 && angles > 5,
+        "{lengths} lengths, {angles} angles"
+    );
+}

@@ -1,0 +1,170 @@
+//! The user guide's tutorial (docs/src/tutorial.md) runs as written: every `sh` block, in
+//! order, in one empty folder, with `fabkit` on the PATH. Where the tutorial's reader works in
+//! the lab (a camera file and the pins' pixels in each capture), a marker comment
+//! `<!-- tutorial-test: lab-inputs ... -->` makes the test write those files: the capture
+//! plan's pins seen by a known camera pose. The results are then checked: the design the
+//! tutorial writes has its markers, the calibration recovers the pose, the ground truth and
+//! the sweep are complete.
+
+use crate::calibrate_cli::{intrinsics, truth};
+use crate::common::{design_schema_path, repo_root, schema_check, text};
+use fabkit_calibration::nalgebra::Point3;
+use fabkit_calibration::tables::{read_capture_plan, read_point_table, PointsFrom};
+use fabkit_calibration::{write_camera, CameraFileFormat, CameraModel};
+use std::path::Path;
+
+enum Step {
+    Shell(String),
+    LabInputs,
+}
+
+fn steps(markdown: &str) -> Vec<Step> {
+    let mut steps = Vec::new();
+    let mut block: Option<String> = None;
+    for line in markdown.lines() {
+        match &mut block {
+            Some(b) if line.starts_with("```") => {
+                steps.push(Step::Shell(std::mem::take(b)));
+                block = None;
+            }
+            Some(b) => {
+                b.push_str(line);
+                b.push('\n');
+            }
+            None if line == "```sh" => block = Some(String::new()),
+            None if line.starts_with("<!-- tutorial-test: lab-inputs") => {
+                steps.push(Step::LabInputs)
+            }
+            None => {}
+        }
+    }
+    steps
+}
+
+/// The camera file and one observation file per capture of the plan (`capture_<k>.csv`,
+/// `id,u_px,v_px`): the pins' tips projected at the known pose, with +-0.3 px of alternating
+/// noise.
+fn write_lab_inputs(dir: &Path) {
+    let points = dir.join("out/my_sensor_fixtures/points");
+    assert!(
+        points.is_dir(),
+        "the tutorial builds the fixtures into out/my_sensor_fixtures before calibrating"
+    );
+    std::fs::write(
+        dir.join("cam.yaml"),
+        write_camera(&intrinsics(), CameraFileFormat::OpenCvYaml),
+    )
+    .unwrap();
+    let table = read_point_table(&points.join("point_table.csv"), PointsFrom::Tip).unwrap();
+    let plan = read_capture_plan(&points.join("capture_plan.csv")).unwrap();
+    let cam = CameraModel::new(intrinsics()).unwrap();
+    for (k, ids) in plan.captures.iter().enumerate() {
+        let mut s = String::from("id,u_px,v_px\n");
+        for (j, id) in ids.iter().enumerate() {
+            let tip = table.rows.iter().find(|r| &r.0 == id).unwrap().1;
+            let uv = cam.project(&(truth() * Point3::from(tip)).coords).unwrap();
+            let n = if (k + j) % 2 == 0 { 0.3 } else { -0.3 };
+            s.push_str(&format!("{id},{},{}\n", uv.x + n, uv.y - 0.5 * n));
+        }
+        std::fs::write(dir.join(format!("capture_{}.csv", k + 1)), s).unwrap();
+    }
+}
+
+fn json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+#[test]
+fn the_tutorial_runs_as_written() {
+    let markdown = std::fs::read_to_string(repo_root().join("docs/src/tutorial.md")).unwrap();
+    let steps = steps(&markdown);
+    let shells = steps.iter().filter(|s| matches!(s, Step::Shell(_))).count();
+    assert!(shells >= 10, "{shells} sh blocks");
+    assert_eq!(
+        steps
+            .iter()
+            .filter(|s| matches!(s, Step::LabInputs))
+            .count(),
+        1
+    );
+    let bin = Path::new(env!("CARGO_BIN_EXE_fabkit"));
+    let path = format!(
+        "{}:{}",
+        bin.parent().unwrap().display(),
+        std::env::var("PATH").unwrap_or_default()
+    );
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    for step in &steps {
+        match step {
+            Step::LabInputs => write_lab_inputs(dir),
+            Step::Shell(script) => {
+                let o = std::process::Command::new("bash")
+                    .args(["-euo", "pipefail", "-c", script])
+                    .current_dir(dir)
+                    .env("PATH", &path)
+                    .output()
+                    .unwrap();
+                assert!(
+                    o.status.success(),
+                    "tutorial block failed:\n{script}\nstdout:\n{}\nstderr:\n{}",
+                    text(&o.stdout),
+                    text(&o.stderr)
+                );
+            }
+        }
+    }
+
+    // Steps 2 and 3: the design is the tutorial's, with 1 + 6 (1 + 2 + ... + 6) = 127 dimples.
+    let manifest = json(&dir.join("out/my_sensor/manifest.json"));
+    let design = std::fs::read_to_string(dir.join("my_sensor.yaml")).unwrap();
+    assert!(design.contains("name: my_sensor\n"), "{design}");
+    // Step 1: the template's modeline names the schema written beside it, which is the
+    // committed one, and the edited design is valid under it.
+    assert!(design.starts_with("# yaml-language-server: $schema=design.schema.json\n"));
+    assert_eq!(
+        std::fs::read(dir.join("design.schema.json")).unwrap(),
+        std::fs::read(design_schema_path()).unwrap()
+    );
+    if let Some((valid, out)) = schema_check(&[dir.join("my_sensor.yaml")]) {
+        assert!(valid, "{out}");
+    }
+    assert!(manifest.to_string().contains("my_sensor"));
+    // Step 8: the pose of the lab inputs is recovered.
+    let e = json(&dir.join("calib/extrinsics.json"));
+    let m: Vec<f64> = e["T_cam_sensor"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|row| row.as_array().unwrap().iter().map(|v| v.as_f64().unwrap()))
+        .collect();
+    let t = truth().to_homogeneous();
+    for (i, v) in m.iter().enumerate() {
+        let want = t[(i / 4, i % 4)];
+        let bound = if i % 4 == 3 { 0.05 } else { 0.002 };
+        assert!(
+            (v - want).abs() < bound,
+            "T_cam_sensor[{}][{}] = {v}, want {want}",
+            i / 4,
+            i % 4
+        );
+    }
+    // Step 9: ground truth for both semi-domes' protrusions.
+    assert!(dir.join("gt").is_dir());
+    let gt_files = std::fs::read_dir(dir.join("gt")).unwrap().count();
+    assert!(gt_files >= 3, "{gt_files} entries in gt/");
+    // Step 10: four variants, all built, each with the 127 dimples.
+    let csv = std::fs::read_to_string(dir.join("out/depths/results.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = csv.lines().map(|l| l.split(',').collect()).collect();
+    let col = |name: &str| {
+        rows[0]
+            .iter()
+            .position(|c| *c == name)
+            .unwrap_or_else(|| panic!("no column {name} in {:?}", rows[0]))
+    };
+    let (status, count) = (col("status"), col("markers.translucent_gel.outer.count"));
+    assert_eq!(rows.len(), 5, "{csv}");
+    for r in &rows[1..] {
+        assert_eq!((r[status], r[count]), ("ok", "127"), "{csv}");
+    }
+}
