@@ -39,19 +39,25 @@ fn escape_angle_brackets(markdown: &str) -> String {
         .collect()
 }
 
-#[test]
-fn the_command_reference_is_rendered_from_the_cli() {
-    let path = repo_root().join("docs/src/reference/cli.md");
-    let want = reference();
+/// The committed generated page `file` (under docs/src/reference/) equals `want`; with
+/// FABKIT_BLESS=1 it is written first. Returns the page.
+fn committed_page(file: &str, want: &str, test: &str) -> String {
+    let path = repo_root().join("docs/src/reference").join(file);
     if std::env::var("FABKIT_BLESS").is_ok_and(|v| v == "1") {
-        std::fs::write(&path, &want).unwrap();
+        std::fs::write(&path, want).unwrap();
     }
     let got = std::fs::read_to_string(&path).unwrap_or_default();
     assert!(
         got == want,
-        "docs/src/reference/cli.md is not the reference of this CLI; regenerate it with \
-         `FABKIT_BLESS=1 cargo test --profile quick -p fabkit --test e2e -- the_command_reference`"
+        "docs/src/reference/{file} is not what fabkit generates; regenerate it with \
+         `FABKIT_BLESS=1 cargo test --profile quick -p fabkit --test e2e -- {test}`"
     );
+    got
+}
+
+#[test]
+fn the_command_reference_is_rendered_from_the_cli() {
+    let got = committed_page("cli.md", &reference(), "the_command_reference");
     for command in [
         "export",
         "fixtures",
@@ -323,16 +329,10 @@ and angles degrees.\n",
 
 #[test]
 fn the_design_reference_is_rendered_from_the_schema() {
-    let path = repo_root().join("docs/src/reference/design-fields.md");
-    let want = design_reference();
-    if std::env::var("FABKIT_BLESS").is_ok_and(|v| v == "1") {
-        std::fs::write(&path, &want).unwrap();
-    }
-    let got = std::fs::read_to_string(&path).unwrap_or_default();
-    assert!(
-        got == want,
-        "docs/src/reference/design-fields.md is not the reference of this schema; regenerate it \
-         with `FABKIT_BLESS=1 cargo test --profile quick -p fabkit --test e2e -- the_design_reference`"
+    let got = committed_page(
+        "design-fields.md",
+        &design_reference(),
+        "the_design_reference",
     );
     // every parameter path `fabkit validate` lists for the default design is in the reference
     let o = crate::common::run(&repo_root(), &["validate", "rtac0"], &[]);
