@@ -147,6 +147,8 @@ pub struct ChannelTube {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ChannelSet {
+    /// Number of channels, at least 1 (Soter et al. Sec. II-A: 16); their mouths together
+    /// must fit on the near edge's straight part less `min_wall_mm` at each corner.
     #[schemars(extend("minimum" = 1))]
     pub count: usize,
     /// Across x, mm.
@@ -322,10 +324,16 @@ impl ChannelSet {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct MarkerGrid {
+    /// Number of rows, stacked along y, at least 1 (Soter et al. Sec. II-A: a 10 x 10 grid).
     #[schemars(extend("minimum" = 1))]
     pub rows: usize,
+    /// Number of columns, side by side along x, at least 1 (Soter et al. Sec. II-A: a 10 x 10
+    /// grid).
     #[schemars(extend("minimum" = 1))]
     pub columns: usize,
+    /// Centre-to-centre distance between neighbouring markers along x and along y, mm, > 0:
+    /// above the markers' diameter (with more than one row or column), and the outermost
+    /// markers must keep `edge_margin_mm` inside the outline.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub pitch_mm: f64,
     /// A cylinder ending in a hemisphere (`polarity: raised`: it stands out of the face).

@@ -145,12 +145,28 @@ pub enum Layout {
 #[serde(deny_unknown_fields)]
 pub struct Pattern {
     pub layout: Layout,
+    /// `concentric_6k`: the rings round the centre marker, ring k = 1..rings holding 6k
+    /// markers (ShadowTac authors' mold: 12); required there, ignored by the other layouts.
+    /// The last ring must lie in the patterned region.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rings: Option<u32>,
+    /// `concentric_6k`: the arc length between rings along the surface, mm, > 0; ring k lies
+    /// k x pitch from the pole. Give exactly one of it and `polar_step_deg`; ignored by the
+    /// other layouts.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pitch_arc_mm: Option<f64>,
+    /// Marker spacing measured on the surface, mm, > 0, for `concentric`, `hex_grid` and
+    /// `golden_spiral`; refused on `concentric_6k`, ignored by `list`.
+    ///
+    /// `concentric`: the arc length between rings (unless `polar_step_deg` is given) and the
+    /// spacing along each ring (round(circumference / spacing) markers, at least 1);
+    /// `hex_grid`: the lattice's pitch; `golden_spiral` without `count`: the count is the
+    /// patterned area over that of one marker at this spacing in hexagonal packing. However
+    /// laid out, neighbouring features must keep the printer's minimum wall between them.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spacing_mm: Option<f64>,
+    /// `golden_spiral`: the number of markers, 1 to 100,000; when given it decides the count
+    /// instead of `spacing_mm`. Ignored by the other layouts.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub count: Option<u32>,
     /// (polar_deg, azimuth_deg) pairs for `list`.
@@ -168,6 +184,10 @@ pub struct Pattern {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schemars(extend("exclusiveMinimum" = 0, "maximum" = 180))]
     pub max_polar_deg: Option<f64>,
+    /// Lower limit of the patterned region, polar angle seen from the sensor-frame origin,
+    /// degrees, in [0, 180) and below `max_polar_deg` (default: the pole). When given, the
+    /// concentric layouts place no centre marker and `concentric` puts its first ring on the
+    /// limit; `concentric_6k` still counts its rings from the pole.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schemars(extend("minimum" = 0, "exclusiveMaximum" = 180))]
     pub min_polar_deg: Option<f64>,
@@ -199,7 +219,12 @@ pub enum RingAzimuthOffset {
     Alternate(AlternateOffset),
     /// One offset per ring k = 1..rings, degrees, each finite; as many entries as the pattern
     /// has rings.
-    PerRingDeg(Vec<f64>),
+    PerRingDeg(
+        /// The turn of each ring k = 1, 2, ... in order, degrees from +x towards +y, each
+        /// finite: one entry per ring (`rings` of `concentric_6k`; the rings `concentric`
+        /// places).
+        Vec<f64>,
+    ),
 }
 
 /// The turn of the odd rings of an alternating [`RingAzimuthOffset`].

@@ -13,6 +13,8 @@ pub struct Design {
     /// Short name, `[a-z0-9_]+`; names the output folder and the 3MF.
     #[schemars(extend("pattern" = "^[a-z0-9_]+$"))]
     pub name: String,
+    /// One line saying what the design is, for people (`fabkit designs` lists it beside the
+    /// name of each library design); empty when not given.
     #[serde(default)]
     pub description: String,
     /// The paper the design reproduces.
@@ -60,11 +62,26 @@ pub struct Design {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Backing {
+    /// Material key in the materials table (designs/materials.yaml), a bought or a printed
+    /// material (ShadowTac: `pmma`, Sec. IV-A).
     pub material: String,
+    /// Diameter of the disc, mm, > 0; at least the skin's diameter on the base plane, since
+    /// the skin is glued onto it by its whole base.
+    ///
+    /// With a `casing`, the plate must also cover the casing's window with a 1 mm glue land
+    /// all round (`casing.window_diameter_mm`).
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub diameter_mm: f64,
+    /// Thickness of the disc along the axis, from the base plane (its top face, under the
+    /// skin) down, mm, > 0.
+    ///
+    /// With a `casing`, the camera's view of the skin's rim is refracted through it (PMMA,
+    /// index 1.49) on its way to the casing's window.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub thickness_mm: f64,
+    /// What the plate is and how the skin is fixed to it, for the bought-items list and the
+    /// cut list (ShadowTac: "PMMA acrylic disc, glued with Smooth-On Sil-Poxy"); empty when
+    /// not given.
     #[serde(default)]
     pub description: String,
 }
@@ -89,8 +106,12 @@ pub struct BrushedCoat {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Core {
+    /// What the core is, for the bought-items list (R-Tac0: "borosilicate glass test tube,
+    /// round bottom", Sec. III-B1); empty when not given.
     #[serde(default)]
     pub description: String,
+    /// Material key in the materials table (designs/materials.yaml), a bought or a printed
+    /// material (R-Tac0: `borosilicate_glass`; UVDtact: `pmma`).
     pub material: String,
     /// Wall thickness, mm, > 0.
     #[schemars(extend("exclusiveMinimum" = 0))]
@@ -327,6 +348,9 @@ pub struct SheetStock {
     pub name: String,
     /// Material key in the materials table (designs/materials.yaml).
     pub material: String,
+    /// Thickness of the sheet, mm, above 0 and at most 25 (a laser cutter's sheet). Every
+    /// level of a tray is 1 to 8 sheets of the first stock whose thickness makes it; the
+    /// tray's base sheet is one sheet of the first stock.
     #[schemars(extend("exclusiveMinimum" = 0, "maximum" = 25))]
     pub thickness_mm: f64,
     /// Width of the laser's cut in this sheet, mm: every path is offset by half of it.
@@ -388,6 +412,10 @@ defaults!(Plinth {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields, default)]
 pub struct RegistrationKey {
+    /// Diameter of the keys' spheres, mm, > 0: one key each side of the cavity, in the middle
+    /// of the flange and half-way up the mold, on the parting plane of a `direct` mold's two
+    /// halves. At least the cavity printer's `min_feature_mm`; with twice `clearance_mm` and
+    /// twice the cavity printer's `min_wall_mm` at most `mold.flange_width_mm`.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub diameter_mm: f64,
     /// Radial clearance of the female socket, mm.
@@ -480,6 +508,10 @@ defaults!(RegistrationBoss {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields, default)]
 pub struct Sprue {
+    /// Diameter of the pour hole, mm, > 0: through the core holder parallel to the axis, at
+    /// azimuth 0, centred between the core's groove and the spigot's edge. At least the
+    /// fixture printer's `min_hole_diameter_mm`, and it must fit that room, which
+    /// `mold.plinth.margin_mm` widens.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub diameter_mm: f64,
 }
@@ -489,8 +521,15 @@ defaults!(Sprue { diameter_mm: 3.0 });
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields, default)]
 pub struct Vent {
+    /// Diameter of each vent hole, mm, > 0: through the core holder parallel to the axis, on a
+    /// circle that leaves `core_holder.min_wall_mm` between the holes and the spigot's edge.
+    /// At least the fixture printer's `min_hole_diameter_mm`, and it must fit in the holder
+    /// beside the core, as the sprue.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub diameter_mm: f64,
+    /// Number of vents, at least 1, spread round the axis with the sprue at equal steps of
+    /// 360 / (count + 1) degrees, the sprue at azimuth 0; at most as many as keep
+    /// `core_holder.min_wall_mm` between neighbouring holes.
     #[schemars(extend("minimum" = 1))]
     pub count: u32,
 }
@@ -506,6 +545,8 @@ pub struct CoreHolderParams {
     /// Radial clearance between the centring pin and the core's bore, and around the core
     /// wall, mm.
     pub fit_clearance_mm: f64,
+    /// Thickness along the axis of the holder's flange, the disc that lies on the mold's open
+    /// face (the outer face of the plinth recess) and reaches 3 mm beyond the plinth, mm, > 0.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub flange_thickness_mm: f64,
     /// Length of the centring pin that enters the core's open end, mm.
@@ -529,6 +570,8 @@ pub struct PrinterProfile {
     /// Nozzle diameter (FDM) or pixel size (SLA), mm.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub xy_resolution_mm: f64,
+    /// Layer height the printer prints at, mm, > 0. Only that bound is checked: no rule or
+    /// part uses it.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub layer_height_mm: f64,
     /// Thinnest wall that prints reliably, mm.
@@ -721,6 +764,8 @@ defaults!(CastingParams {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct HousingParams {
+    /// Material key of the printed shell parts (printed FDM), a print material of the
+    /// materials table (R-Tac0: black PLA, `pla_black`, Sec. III-B4).
     pub material: String,
     /// The arrangement of the shell; `square_split` when not given.
     #[serde(default)]
@@ -732,9 +777,16 @@ pub struct HousingParams {
     /// The tube and its base; required with `style: round_tube`, unused otherwise.
     #[serde(default)]
     pub round_tube: Option<RoundTube>,
+    /// The camera board and its bay under the LED PCB (R-Tac0 Sec. III-B3).
     pub camera: CameraBay,
+    /// `square_split`: thickness along the axis of the bulkhead between the camera bay and the
+    /// LED PCB's seat, mm, > 0; the lens hole goes through it and the board's mounting pilots
+    /// go up into it. Unused with `round_tube` (the PCB rests on the bay's ledge), but still
+    /// checked above 0.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub bulkhead_thickness_mm: f64,
+    /// The LED ring PCB (bought; R-Tac0 Sec. III-B2), LEDs up, its top face
+    /// `diffuser.gap_above_pcb_mm` under the diffuser.
     pub led_pcb: LedPcb,
     pub diffuser: Diffuser,
     /// Diameter of the light chamber between the LED PCB and the diffuser, mm (`round_tube`:
@@ -746,6 +798,9 @@ pub struct HousingParams {
     /// The internal filling gel, cast into the assembled shell; none when not given.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub filling_gel: Option<FillingGel>,
+    /// The two screws that join the shell: across the parting plane along x
+    /// (`square_split`), or up through the base's flange into the tube wall (`round_tube`)
+    /// (R-Tac0 Sec. III-B4: "small bolts").
     pub joint_screw: JointScrew,
 }
 
@@ -809,12 +864,25 @@ pub struct CameraBay {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct LedPcb {
+    /// Outer diameter of the ring PCB, mm, > 0; its seat is this plus `fit_clearance_mm` on
+    /// each side and must keep the FDM minimum wall inside the shell.
+    ///
+    /// `round_tube`: the light chamber must pass it (the PCB goes in from the tube's top) and
+    /// its seat must overhang the camera bay by at least one nozzle width, the ledge it rests
+    /// on. `square_split`: above the lens hole, and the board's mounting pilots must lie
+    /// outside its seat.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub outer_diameter_mm: f64,
+    /// Diameter of the PCB's bore, mm, > 0: below the outer diameter and at least
+    /// `camera.lens_hole_diameter_mm`, to pass the lens barrel.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub inner_diameter_mm: f64,
+    /// Thickness of the PCB along the axis, mm, > 0: the height of its seat under the light
+    /// chamber.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub thickness_mm: f64,
+    /// LEDs on the ring, for the bought-items list and the assembly steps (R-Tac0 Sec.
+    /// III-B2: eight LUXEON 2835 white LEDs); no part's shape depends on it.
     pub led_count: u32,
 }
 
@@ -835,10 +903,21 @@ pub struct FillingGel {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Diffuser {
+    /// Outer diameter of the diffuser, mm, > 0: above the core's outer diameter plus twice
+    /// `fit_clearance_mm` (the core's rim rests on it) and above `light_chamber_diameter_mm`.
+    ///
+    /// `round_tube`: at most `outer_width_mm` (R-Tac0 authors' CAD, measured: 30 mm, the
+    /// shell's full diameter). `square_split`: its seat (this plus `fit_clearance_mm` on each
+    /// side) must keep the FDM minimum wall inside the shell.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub outer_diameter_mm: f64,
+    /// Diameter of the diffuser's opening, mm, > 0: below its outer diameter and below the
+    /// core's outer diameter, since the core's rim rests on its edge (R-Tac0 authors' CAD,
+    /// measured: 19.6 mm under the 20 mm core). The filling gel, when given, fills it.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub inner_diameter_mm: f64,
+    /// Thickness of the diffuser along the axis (the frosted acrylic sheet it is laser-cut
+    /// from), mm, > 0 (R-Tac0 authors' CAD, measured: 2 mm).
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub thickness_mm: f64,
     /// Distance from the top of the LED PCB to the diffuser, mm (R-Tac0: 10 mm).
@@ -849,10 +928,21 @@ pub struct Diffuser {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct JointScrew {
+    /// Diameter of the screw's clearance hole, mm, > 0: through the +x half (`square_split`)
+    /// or the base's flange (`round_tube`). It names the screw's size in the bought-items
+    /// list (R-Tac0: 2.2 mm for M2).
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub clearance_diameter_mm: f64,
+    /// Diameter of the pilot hole the screw is driven into, mm, at least the FDM printer's
+    /// `min_hole_diameter_mm`: in the -x half (`square_split`) or up into the tube wall round
+    /// the camera bay (`round_tube`, where the wall must hold it between two FDM minimum
+    /// walls).
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub pilot_diameter_mm: f64,
+    /// Diameter of the screw's head, mm, > 0. `square_split`: its counterbore in the +x half,
+    /// which with the clearance hole must fit between the light chamber and the outer wall
+    /// with FDM minimum walls; `round_tube`: the heads under the base's flange must stay
+    /// inside the tube's outer diameter.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub head_diameter_mm: f64,
     /// Material clamped under the head, mm (`round_tube`: the thickness of the base's flange

@@ -211,14 +211,26 @@ fn walk(
         return row(format!("one of {}", values.join(", ")), rows);
     }
     if let Some(branches) = def.get("oneOf").and_then(Value::as_array) {
-        // a mapping in one of several forms (the body profile): each form's keys
-        row("mapping, one of the forms below".to_string(), rows);
         let mut forms: Vec<String> = branches
             .iter()
             .filter_map(|b| b["properties"]["profile"]["const"].as_str())
             .map(|c| format!("`{c}`"))
             .collect();
         forms.dedup();
+        if forms.is_empty() {
+            // a mapping of exactly one of its keys (an enum of forms): each form's key
+            row(
+                "mapping with exactly one of the keys below".to_string(),
+                rows,
+            );
+            for b in branches {
+                let note = one_line(b["description"].as_str().unwrap_or(""));
+                walk_properties(root, path, b, None, &format!(" ({note})"), rows);
+            }
+            return;
+        }
+        // a mapping in one of several forms named by `profile` (the body): each form's keys
+        row("mapping, one of the forms below".to_string(), rows);
         rows.push(Field {
             path: format!("{path}.profile"),
             kind: format!("one of {}", forms.join(", ")),

@@ -107,8 +107,14 @@ pub struct CasingLeds {
     /// its LED, mm.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub width_mm: f64,
+    /// Length of one segment along the strip, standing up in its slot from the casing's top
+    /// face down, mm, > 0; the casing's height must hold the bay, the ledge and the LEDs over
+    /// it with `fit_clearance_mm`.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub length_mm: f64,
+    /// Thickness of one segment with its LED, radially, mm, > 0: its slot reaches this plus
+    /// `fit_clearance_mm` out from the window's edge and must keep the FDM minimum wall inside
+    /// the casing's side.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub thickness_mm: f64,
     /// Hole through the ledge for each segment's wires, mm.
@@ -121,12 +127,21 @@ pub struct CasingLeds {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct CasingScrews {
+    /// Diameter of the pilots the screws cut their thread in, mm, > 0: up from the casing's
+    /// bottom in the middle of the wall at each corner, each keeping the FDM minimum wall to
+    /// the bay and to the outside.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub pilot_diameter_mm: f64,
+    /// Depth of the pilots up from the casing's bottom, mm, > 0; they must stay the FDM
+    /// minimum wall under the casing's top.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub pilot_depth_mm: f64,
+    /// Diameter of the screws' clearance holes through the gripper base's floor, mm, above
+    /// the pilot's diameter; it names the screw's size in the bought-items list.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub clearance_diameter_mm: f64,
+    /// Diameter of the counterbores for the screws' heads in the gripper base's bottom, mm,
+    /// above the clearance hole's diameter.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub head_diameter_mm: f64,
     /// Counterbore for the head, from the base's bottom, mm.
@@ -142,11 +157,17 @@ pub struct GripperBase {
     pub gripper: String,
     /// Material key (printed FDM), e.g. `pla`.
     pub material: String,
-    /// Along x and y, mm.
+    /// Side of the plate along x, mm, > 0; the bolts' counterbores must stay the FDM minimum
+    /// wall inside it.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub width_mm: f64,
+    /// Side of the plate along y (the cable slot's side), mm, > 0; the bolts' counterbores
+    /// must stay the FDM minimum wall inside it.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub length_mm: f64,
+    /// Thickness of the plate along the axis, mm, > 0: its top face stands `socket_depth_mm`
+    /// over the socket's floor, and the floor under the socket must hold the cable slot and
+    /// the casing screws' counterbores, each over the FDM minimum wall.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub thickness_mm: f64,
     /// Depth of the socket that takes the casing's foot, mm.
@@ -155,13 +176,19 @@ pub struct GripperBase {
     /// The camera's cable slot under the socket's floor, out on +y: width and depth, mm.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub cable_slot_width_mm: f64,
+    /// Depth of the cable slot down from the socket's floor, mm, > 0; the base must keep the
+    /// FDM minimum wall under it.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub cable_slot_depth_mm: f64,
     /// Bolts to the gripper on a rectangle centred on the axis: its sides along x and y, mm.
     #[schemars(extend("items" = {"type": "number", "exclusiveMinimum": 0}))]
     pub bolt_spacing_mm: [f64; 2],
+    /// Diameter of the holes for the bolts to the gripper, through the plate, mm, > 0.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub bolt_clearance_diameter_mm: f64,
+    /// Diameter of the counterbores for the bolts' heads, down from the plate's top, mm,
+    /// above the clearance hole's; they must stay the FDM minimum wall inside the plate and
+    /// outside the casing's socket.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub bolt_head_diameter_mm: f64,
     /// Counterbore for the bolts' heads, from the base's top, mm.

@@ -64,10 +64,16 @@ pub struct FingertipBase {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct LightingPcb {
+    /// Outer diameter of the PCB, mm, > 0: the sensor base's pocket is this plus
+    /// `fit_clearance_mm` on each side and must keep the SLA minimum wall to the bolts'
+    /// counterbores; the diffusion ring has the same outer diameter.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub outer_diameter_mm: f64,
+    /// Diameter of the PCB's bore, through which the camera holder stands, mm, > 0; below the
+    /// outer diameter, the LEDs between the two.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub inner_diameter_mm: f64,
+    /// Thickness of the board along the axis, mm, > 0; it lies on the pocket's floor.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub thickness_mm: f64,
     /// The circle the LEDs' centres are on, mm.
@@ -76,6 +82,7 @@ pub struct LightingPcb {
     /// One LED: its length (radial) and height over the board, mm.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub led_length_mm: f64,
+    /// Height of the LEDs over the board's top face, mm, > 0.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub led_height_mm: f64,
     /// Hole in the base's floor under the board for its wires, mm.
@@ -89,10 +96,17 @@ pub struct LightingPcb {
 pub struct DiffusionRing {
     /// Material key (printed SLA, white).
     pub material: String,
+    /// Diameter of the ring's bore, through which the camera holder stands, mm, > 0; its
+    /// outer diameter is the lighting PCB's.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub inner_diameter_mm: f64,
+    /// Thickness of the ring along the axis, from the shell's end (flush with the sensor
+    /// base's top) down, mm: at least the SLA minimum wall and below `pocket_depth_mm`.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub thickness_mm: f64,
+    /// Diameter of the holes through the ring over the 4 UV LEDs (UV light does not pass the
+    /// white ring), mm, > 0; centred on `led_pcb.led_circle_diameter_mm`, each keeps the SLA
+    /// minimum wall to the ring's bore and to its edge.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub uv_hole_diameter_mm: f64,
 }
@@ -103,8 +117,13 @@ pub struct DiffusionRing {
 pub struct MiniCamera {
     /// The camera, for the sheet.
     pub module: String,
+    /// Outer diameter of the camera, mm, > 0 (UVDtact Sec. III-C: 1.5 mm); its holder's bore
+    /// is this plus `fit_clearance_mm` on each side.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub diameter_mm: f64,
+    /// Length of the camera along the axis, from its back up to its front, which is flush
+    /// with the diffusion ring's top, mm, > 0; at most `pocket_depth_mm` (UVDtact Sec. III-C:
+    /// 3 mm).
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub length_mm: f64,
     /// Full field of view, degrees.
@@ -119,6 +138,8 @@ pub struct MiniCamera {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct CameraHolder {
+    /// Outer diameter of the tube, which stands on the pocket's floor up to the shell's end,
+    /// mm, > 0; it must leave the SLA minimum wall round the camera's bore.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub outer_diameter_mm: f64,
 }
@@ -131,12 +152,23 @@ pub struct HolderBolts {
     /// 2..=6, at equal angles, the first on +y.
     #[schemars(extend("minimum" = 2, "maximum" = 6))]
     pub count: u32,
+    /// Diameter of the pilots in the shell holder that the bolts thread into, mm, > 0, below
+    /// the clearance hole's (UVDtact Sec. III-C: M1.2 bolts). The bolt circle lies midway
+    /// between the holder's bore and the outside; pilots and counterbores must keep the SLA
+    /// minimum wall on both sides.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub pilot_diameter_mm: f64,
+    /// Depth of the pilots up into the shell holder from its bottom (the shell's end), mm,
+    /// above 0; the SLA minimum wall must remain above them in the core's foot below the base
+    /// plane (`core.length_mm`).
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub pilot_depth_mm: f64,
+    /// Diameter of the bolts' holes through the sensor base, mm, > 0; between the pilot's and
+    /// the head's diameters.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub clearance_diameter_mm: f64,
+    /// Diameter of the counterbores for the bolts' heads in the sensor base's bottom, mm,
+    /// above the clearance hole's.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub head_diameter_mm: f64,
     /// Counterbore for the head, from the base's bottom, mm.

@@ -33,6 +33,9 @@ pub struct RobotMount {
     pub robot: String,
     /// Material key of the mount (printed FDM), e.g. `abs`.
     pub material: String,
+    /// Thickness of the plate along the axis, from its bottom face (on the robot's tool
+    /// flange) up to the base's bottom, mm, > 0; it must hold the bolts' counterbores and the
+    /// pin hole with the FDM minimum wall between them.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub plate_thickness_mm: f64,
     /// Wall of the cup outside its grooves, mm.
@@ -47,16 +50,22 @@ pub struct RobotMount {
     /// Bolts on the pitch circle, 2..=8; the first at 45 deg from +x.
     #[schemars(extend("minimum" = 2, "maximum" = 8))]
     pub bolt_count: u32,
+    /// Diameter of the bolts' holes through the plate, mm, > 0; below the counterbore's.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub bolt_clearance_diameter_mm: f64,
     /// Counterbore for the bolt's head, from the plate's top, mm.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub bolt_head_diameter_mm: f64,
+    /// Depth of the counterbores down from the plate's top, mm, > 0; with the pin hole and
+    /// the FDM minimum wall between them it must fit in `plate_thickness_mm`.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub bolt_head_depth_mm: f64,
     /// Locating pin hole on the pitch circle at +x, from the plate's bottom, mm.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub pin_hole_diameter_mm: f64,
+    /// Depth of the locating pin hole up from the plate's bottom, mm, > 0; with the
+    /// counterbores and the FDM minimum wall between them it must fit in
+    /// `plate_thickness_mm`.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub pin_hole_depth_mm: f64,
     /// The bayonet's lugs on the base's foot (count, ramp and clearance from

@@ -115,8 +115,14 @@ pub struct BayonetLugs {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct LensWindow {
+    /// Diameter of the acrylic disc, mm: it rests on the shaft's top face, so above the LED
+    /// ring's seat (and the shaft's bore) and at most `shaft_diameter_mm`; its seat in the
+    /// tip's fitting (this plus `fit_clearance_mm` on each side) must keep the PolyJet minimum
+    /// wall inside the fitting.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub diameter_mm: f64,
+    /// Thickness of the disc along the axis (the acrylic sheet it is cut from), mm, > 0: from
+    /// the shaft's top face up to the underside of the fitting's lip.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub thickness_mm: f64,
 }
@@ -125,12 +131,20 @@ pub struct LensWindow {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct LedRing {
+    /// Outer diameter of the ring PCB, mm, > 0; its seat in the shaft's top is this plus
+    /// `fit_clearance_mm` on each side unless `seat_diameter_mm` is given.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub outer_diameter_mm: f64,
+    /// Diameter of the PCB's bore, mm: below the outer diameter and at most the seat's. The
+    /// camera looks through it (the manifest's view fraction counts the rays it passes).
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub inner_diameter_mm: f64,
+    /// Thickness of the PCB along the axis, mm, > 0: it sits on the seat's floor, the tops of
+    /// its LEDs (`led_height_mm` over it) flush with the shaft's top face.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub thickness_mm: f64,
+    /// LEDs on the ring, for the bought-items list and the assembly (Pestell et al. Sec.
+    /// III-A: six); no part's shape depends on it.
     pub led_count: u32,
     /// Height of the LEDs over the PCB, mm.
     #[schemars(extend("exclusiveMinimum" = 0))]
@@ -161,6 +175,9 @@ pub struct ShaftCamera {
     /// Height of the lens's front over the board's top face, mm.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub lens_height_mm: f64,
+    /// Focal length of the lens, mm, > 0 (Pestell et al. Sec. III-A2: 4.2 mm); stated in the
+    /// bought-items list and the manifest's camera view. No shape or rule uses it: the view
+    /// is checked with `view_angle_deg`.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub focal_length_mm: f64,
     /// Full view angle of the lens, degrees, in (0, 180).
@@ -181,6 +198,9 @@ pub struct ShaftCamera {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ShaftBase {
+    /// Outer diameter of the base, mm: at least `shaft_diameter_mm`, and the board's square
+    /// pocket must keep the FDM minimum wall inside it at its corners. With a `robot_mount`,
+    /// the mount's cup takes it and its lugs stand out of it.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub outer_diameter_mm: f64,
     /// Thickness of the ceiling over the board's pocket, mm.
