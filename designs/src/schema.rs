@@ -3,6 +3,7 @@
 
 use crate::error::DesignError;
 use crate::profile::BodyProfile;
+use crate::values::{unit_of, Unit};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
@@ -973,7 +974,7 @@ pub const DESIGN_SCHEMA_TITLE: &str = "fabkit design";
 pub fn design_json_schema() -> serde_json::Value {
     let generator = schemars::generate::SchemaSettings::draft2020_12().into_generator();
     let mut v = generator.into_root_schema_for::<Design>().to_value();
-    unit_bounds(&mut v, None);
+    unit_bounds(&mut v, Unit::Plain);
     if let serde_json::Value::Object(m) = &mut v {
         m.insert("$id".into(), DESIGN_SCHEMA_ID.into());
         m.insert("title".into(), DESIGN_SCHEMA_TITLE.into());
@@ -990,17 +991,10 @@ pub fn design_json_schema_text() -> String {
     s
 }
 
-/// The unit a key names, as [`crate::values`] reads it.
-#[derive(Clone, Copy)]
-enum SchemaUnit {
-    Mm,
-    Deg,
-}
-
 /// Adds the ranges of [`crate::values::check_values`] to every number of the schema `v`
 /// under `unit` (a key ending `_mm` or `_deg` sets the unit for everything under it, as there),
 /// leaving bounds already given alone, and the unit as description of a key that has none.
-fn unit_bounds(v: &mut serde_json::Value, unit: Option<SchemaUnit>) {
+fn unit_bounds(v: &mut serde_json::Value, unit: Unit) {
     use crate::values::{MAX_ANGLE_DEG, MAX_LENGTH_MM, MAX_PLAIN};
     use serde_json::Value;
     let Value::Object(m) = v else { return };
@@ -1011,9 +1005,9 @@ fn unit_bounds(v: &mut serde_json::Value, unit: Option<SchemaUnit>) {
     };
     if is_number {
         let (lo, hi) = match unit {
-            Some(SchemaUnit::Mm) => (0.0, MAX_LENGTH_MM),
-            Some(SchemaUnit::Deg) => (-MAX_ANGLE_DEG, MAX_ANGLE_DEG),
-            None => (-MAX_PLAIN, MAX_PLAIN),
+            Unit::Mm => (0.0, MAX_LENGTH_MM),
+            Unit::Deg => (-MAX_ANGLE_DEG, MAX_ANGLE_DEG),
+            Unit::Plain => (-MAX_PLAIN, MAX_PLAIN),
         };
         if !m.contains_key("minimum") && !m.contains_key("exclusiveMinimum") {
             m.insert("minimum".into(), lo.into());
@@ -1024,25 +1018,16 @@ fn unit_bounds(v: &mut serde_json::Value, unit: Option<SchemaUnit>) {
     }
     if let Some(Value::Object(props)) = m.get_mut("properties") {
         for (key, sub) in props.iter_mut() {
-            let u = if key.ends_with("_mm") {
-                Some(SchemaUnit::Mm)
-            } else if key.ends_with("_deg") {
-                Some(SchemaUnit::Deg)
-            } else {
-                unit
-            };
-            if let (Value::Object(sm), Some(u)) = (&mut *sub, u) {
-                if key.ends_with("_mm") || key.ends_with("_deg") {
-                    sm.entry("description").or_insert_with(|| {
-                        match u {
-                            SchemaUnit::Mm => "Length, mm.",
-                            SchemaUnit::Deg => "Angle, degrees.",
-                        }
-                        .into()
-                    });
-                }
+            let own = unit_of(key);
+            if let (Value::Object(sm), Some(u)) = (&mut *sub, own) {
+                let said = if u == Unit::Mm {
+                    "Length, mm."
+                } else {
+                    "Angle, degrees."
+                };
+                sm.entry("description").or_insert_with(|| said.into());
             }
-            unit_bounds(sub, u);
+            unit_bounds(sub, own.unwrap_or(unit));
         }
     }
     for key in ["items", "additionalProperties"] {
@@ -1059,7 +1044,7 @@ fn unit_bounds(v: &mut serde_json::Value, unit: Option<SchemaUnit>) {
     }
     if let Some(Value::Object(defs)) = m.get_mut("$defs") {
         for sub in defs.values_mut() {
-            unit_bounds(sub, None);
+            unit_bounds(sub, Unit::Plain);
         }
     }
 }

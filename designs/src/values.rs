@@ -29,13 +29,13 @@ pub const MAX_PLAIN: f64 = 1e6;
 
 /// The unit a parameter name carries.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Unit {
+pub(crate) enum Unit {
     Mm,
     Deg,
     Plain,
 }
 
-fn unit_of(key: &str) -> Option<Unit> {
+pub(crate) fn unit_of(key: &str) -> Option<Unit> {
     if key.ends_with("_mm") {
         Some(Unit::Mm)
     } else if key.ends_with("_deg") {

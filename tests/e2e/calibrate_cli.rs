@@ -357,22 +357,7 @@ fn rtac0_fixture_table_and_capture_plan_end_to_end() {
     planned.sort();
     planned.dedup();
     assert_eq!(planned.len(), 29, "every pin is in the plan");
-    let cam = CameraModel::new(intrinsics()).unwrap();
-    let tip = |id: &str| table.rows.iter().find(|r| r.0 == id).unwrap().1;
-    let mut files = Vec::new();
-    for (k, ids) in plan.captures.iter().enumerate() {
-        let mut s = String::from("id,u_px,v_px\n");
-        for (j, id) in ids.iter().enumerate() {
-            let uv = cam
-                .project(&(truth() * Point3::from(tip(id))).coords)
-                .unwrap();
-            let n = if (k + j) % 2 == 0 { 0.3 } else { -0.3 };
-            s.push_str(&format!("{id},{},{}\n", uv.x + n, uv.y - 0.5 * n));
-        }
-        let name = format!("capture_{}.csv", k + 1);
-        std::fs::write(dir.join(&name), s).unwrap();
-        files.push(name);
-    }
+    let files = write_plan_observations(dir, &table, &plan);
     let calibrate = |files: &[String], out: &str| {
         let mut args = vec![
             "calibrate",
@@ -439,6 +424,33 @@ fn rtac0_fixture_table_and_capture_plan_end_to_end() {
         text(&o.stderr)
     );
     assert!(!dir.join("out3").exists());
+}
+
+/// One observation file per capture of `plan` in `dir` (`capture_<k>.csv`, `id,u_px,v_px`):
+/// the pins' points of `table` projected by [`intrinsics`] at the pose [`truth`], with +-0.3 px
+/// of alternating noise. Returns the file names in capture order.
+pub(crate) fn write_plan_observations(
+    dir: &Path,
+    table: &fabkit_calibration::tables::PointTable,
+    plan: &fabkit_calibration::tables::CapturePlan,
+) -> Vec<String> {
+    let cam = CameraModel::new(intrinsics()).unwrap();
+    let tip = |id: &str| table.rows.iter().find(|r| r.0 == id).unwrap().1;
+    let mut files = Vec::new();
+    for (k, ids) in plan.captures.iter().enumerate() {
+        let mut s = String::from("id,u_px,v_px\n");
+        for (j, id) in ids.iter().enumerate() {
+            let uv = cam
+                .project(&(truth() * Point3::from(tip(id))).coords)
+                .unwrap();
+            let n = if (k + j) % 2 == 0 { 0.3 } else { -0.3 };
+            s.push_str(&format!("{id},{},{}\n", uv.x + n, uv.y - 0.5 * n));
+        }
+        let name = format!("capture_{}.csv", k + 1);
+        std::fs::write(dir.join(&name), s).unwrap();
+        files.push(name);
+    }
+    files
 }
 
 /// Every file of the folder `d` (relative paths, sorted), hidden files included.

@@ -6,11 +6,10 @@
 //! tutorial writes has its markers, the calibration recovers the pose, the ground truth and
 //! the sweep are complete.
 
-use crate::calibrate_cli::{intrinsics, truth};
+use crate::calibrate_cli::{intrinsics, truth, write_plan_observations};
 use crate::common::{design_schema_path, repo_root, schema_check, text};
-use fabkit_calibration::nalgebra::Point3;
 use fabkit_calibration::tables::{read_capture_plan, read_point_table, PointsFrom};
-use fabkit_calibration::{write_camera, CameraFileFormat, CameraModel};
+use fabkit_calibration::{write_camera, CameraFileFormat};
 use std::path::Path;
 
 enum Step {
@@ -57,17 +56,7 @@ fn write_lab_inputs(dir: &Path) {
     .unwrap();
     let table = read_point_table(&points.join("point_table.csv"), PointsFrom::Tip).unwrap();
     let plan = read_capture_plan(&points.join("capture_plan.csv")).unwrap();
-    let cam = CameraModel::new(intrinsics()).unwrap();
-    for (k, ids) in plan.captures.iter().enumerate() {
-        let mut s = String::from("id,u_px,v_px\n");
-        for (j, id) in ids.iter().enumerate() {
-            let tip = table.rows.iter().find(|r| &r.0 == id).unwrap().1;
-            let uv = cam.project(&(truth() * Point3::from(tip)).coords).unwrap();
-            let n = if (k + j) % 2 == 0 { 0.3 } else { -0.3 };
-            s.push_str(&format!("{id},{},{}\n", uv.x + n, uv.y - 0.5 * n));
-        }
-        std::fs::write(dir.join(format!("capture_{}.csv", k + 1)), s).unwrap();
-    }
+    write_plan_observations(dir, &table, &plan);
 }
 
 fn json(path: &Path) -> serde_json::Value {
