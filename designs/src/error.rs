@@ -21,10 +21,37 @@ impl ParamError {
     ) -> Self {
         Self {
             path: path.into(),
-            value: value.to_string(),
-            rule: rule.into(),
+            value: compact_numbers(&value.to_string()),
+            rule: compact_numbers(&rule.into()),
         }
     }
+}
+
+/// `text` with every decimal number of more than 24 characters (`1e300` printed by `{}` is
+/// 301 digits, `5e-324` 327) rewritten in scientific notation, so that an extreme value reads
+/// as the reader wrote it; an integer up to 2^64 (20 digits) keeps its digits.
+pub fn compact_numbers(text: &str) -> String {
+    const LONG: usize = 24;
+    if text.len() <= LONG {
+        return text.to_string();
+    }
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text;
+    while let Some(start) = rest.find(|c: char| c.is_ascii_digit()) {
+        let (head, tail) = rest.split_at(start);
+        let len = tail
+            .find(|c: char| !(c.is_ascii_digit() || c == '.'))
+            .unwrap_or(tail.len());
+        let number = &tail[..len];
+        out.push_str(head);
+        match number.parse::<f64>() {
+            Ok(x) if len > LONG && x.is_finite() => out.push_str(&format!("{x:e}")),
+            _ => out.push_str(number),
+        }
+        rest = &tail[len..];
+    }
+    out.push_str(rest);
+    out
 }
 
 impl std::fmt::Display for ParamError {

@@ -375,6 +375,23 @@ impl MarkerGrid {
                 errs.push(ParamError::new(p(f), 0, "must be 1 or more"));
             }
         }
+        // bounded before positions_mm allocates one position per marker
+        let max = crate::markers::MAX_MARKERS_PER_PATTERN;
+        if self.rows.checked_mul(self.columns).is_none_or(|n| n > max) {
+            let (f, n) = if self.rows >= self.columns {
+                ("rows", self.rows)
+            } else {
+                ("columns", self.columns)
+            };
+            errs.push(ParamError::new(
+                p(f),
+                n,
+                format!(
+                    "a {} x {} grid has more than the {max} markers one grid may have",
+                    self.rows, self.columns
+                ),
+            ));
+        }
         crate::parts::check_positive(
             prefix,
             &[
@@ -598,7 +615,7 @@ pub fn validate(
         errs.push(ParamError::new(
             "name",
             format!("{:?}", design.name),
-            "must be lowercase letters, digits and _",
+            "must be 1 to 64 lowercase letters, digits and _",
         ));
     }
     for (path, value, rule) in design.body.violations() {
@@ -642,7 +659,7 @@ pub fn validate(
             errs.push(ParamError::new(
                 p("name"),
                 format!("{:?}", l.name),
-                "must be lowercase letters, digits and _, and unique",
+                "must be 1 to 64 lowercase letters, digits and _, and unique",
             ));
         }
         if l.process != LayerProcess::Cast {

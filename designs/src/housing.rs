@@ -244,6 +244,13 @@ pub fn check_housing_params(
     if errs.len() > errors_before {
         return;
     }
+    crate::parts::check_led_count(
+        "housing.led_pcb.led_count",
+        h.led_pcb.led_count,
+        h.led_pcb.outer_diameter_mm,
+        h.led_pcb.inner_diameter_mm,
+        errs,
+    );
     let wall = |errs: &mut Vec<ParamError>, path: &str, value: f64, room: f64, what: &str| {
         if room < fdm.min_wall_mm {
             errs.push(ParamError::new(

@@ -163,15 +163,12 @@ pub fn check_params(
     let mut names = std::collections::BTreeSet::new();
     for (i, s) in lc.stock.iter().enumerate() {
         let p = format!("mold.laser_cut.stock[{i}]");
-        let good_name = !s.name.is_empty()
-            && s.name
-                .chars()
-                .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_');
+        let good_name = crate::values::is_file_stem(&s.name);
         if !good_name || !names.insert(s.name.clone()) {
             errs.push(ParamError::new(
                 format!("{p}.name"),
                 &s.name,
-                "must be [a-z0-9_]+ and unique",
+                "must be [a-z0-9_]+, at most 64 characters, and unique",
             ));
         }
         if materials.get(&s.material).is_none() {

@@ -46,6 +46,21 @@ pub struct LoadedDesign {
     /// sha256 of the YAML text followed by every marker CSV file it reads, in order; 64
     /// lowercase hex digits.
     pub sha256: String,
+    /// The YAML text and the name its errors give (`file` or `designs/library/<name>.yaml`),
+    /// for errors that point into it after loading.
+    yaml: (String, String),
+}
+
+impl LoadedDesign {
+    /// Applies preset `name` to the design ([`Design::with_preset_in`]): an error names the
+    /// preset value's `file:line:column`.
+    ///
+    /// # Errors
+    /// As [`Design::with_preset_in`].
+    pub fn apply_preset(&mut self, name: &str) -> Result<(), DesignError> {
+        self.design = self.design.with_preset_in(name, &self.yaml.0, &self.yaml.1)?;
+        Ok(())
+    }
 }
 
 /// Reads the design named by `arg`: a YAML file when it names an existing file, ends in
@@ -105,5 +120,6 @@ pub fn load_source_with(
         design,
         source,
         sha256,
+        yaml: (text, origin),
     })
 }

@@ -895,20 +895,16 @@ impl TwoPieceFrame {
     pub fn new(design: &Design) -> Self {
         let m = &design.mold;
         let t = &m.two_piece;
-        let c = m.registration_key.clearance_mm;
         let zb = design.body.base_z_mm();
-        let boss = [t.boss.width_mm / 2.0, t.boss.length_mm / 2.0];
-        let pocket = [boss[0] + c, boss[1] + c];
-        let outer = [pocket[0] + m.flange_width_mm, pocket[1] + m.flange_width_mm];
-        // bolt rectangle on the flange's centre line
-        let h = [
-            pocket[0] + m.flange_width_mm / 2.0,
-            pocket[1] + m.flange_width_mm / 2.0,
-        ];
+        let BoltLayout {
+            boss,
+            pocket,
+            h,
+            kx,
+            ky,
+        } = BoltLayout::new(design);
         let (ax, ay) = (2.0 * h[0], 2.0 * h[1]);
-        let rest = (t.bolt_count.max(4) - 4) / 2;
-        let kx = (((rest as f64) * ax / (ax + ay)).round() as u32).min(rest);
-        let ky = rest - kx;
+        let outer = [pocket[0] + m.flange_width_mm, pocket[1] + m.flange_width_mm];
         let mut bolts = vec![[h[0], h[1]], [-h[0], h[1]], [-h[0], -h[1]], [h[0], -h[1]]];
         for sy in [1.0, -1.0] {
             for i in 1..=kx {
@@ -933,6 +929,51 @@ impl TwoPieceFrame {
             top_piece_bolt_hole_mm: t.bolt_holes_mm(m.clamp_bolt.clearance_diameter_mm).1,
             bolt_pitch_mm: [ax / (kx + 1) as f64, ay / (ky + 1) as f64],
         }
+    }
+}
+
+/// Where the bolts of a two-piece frame go, computed without placing them (validation bounds
+/// `bolt_count` by the pitch this gives before [`TwoPieceFrame::new`] allocates a position per
+/// bolt).
+struct BoltLayout {
+    boss: [f64; 2],
+    pocket: [f64; 2],
+    /// Half sides of the bolt rectangle on the flange's centre line, mm.
+    h: [f64; 2],
+    /// Bolts between the corners on each x side and each y side.
+    kx: u32,
+    ky: u32,
+}
+
+impl BoltLayout {
+    fn new(design: &Design) -> Self {
+        let m = &design.mold;
+        let t = &m.two_piece;
+        let c = m.registration_key.clearance_mm;
+        let boss = [t.boss.width_mm / 2.0, t.boss.length_mm / 2.0];
+        let pocket = [boss[0] + c, boss[1] + c];
+        let h = [
+            pocket[0] + m.flange_width_mm / 2.0,
+            pocket[1] + m.flange_width_mm / 2.0,
+        ];
+        let (ax, ay) = (2.0 * h[0], 2.0 * h[1]);
+        let rest = (t.bolt_count.max(4) - 4) / 2;
+        let kx = (((rest as f64) * ax / (ax + ay)).round() as u32).min(rest);
+        Self {
+            boss,
+            pocket,
+            h,
+            kx,
+            ky: rest - kx,
+        }
+    }
+
+    /// Bolt pitch along the x and y sides, mm.
+    fn pitch_mm(&self) -> [f64; 2] {
+        [
+            2.0 * self.h[0] / f64::from(self.kx + 1),
+            2.0 * self.h[1] / f64::from(self.ky + 1),
+        ]
     }
 }
 
@@ -1075,8 +1116,8 @@ pub fn check_two_piece(design: &Design, rim_radius_mm: f64, errs: &mut Vec<Param
             ),
         ));
     }
-    let f = TwoPieceFrame::new(design);
-    let pitch = f.bolt_pitch_mm[0].min(f.bolt_pitch_mm[1]);
+    let [px, py] = BoltLayout::new(design).pitch_mm();
+    let pitch = px.min(py);
     let need = hole + cav.min_wall_mm;
     if pitch < need {
         errs.push(ParamError::new(

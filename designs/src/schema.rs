@@ -12,7 +12,7 @@ use serde::{Deserialize, Serialize};
 #[serde(deny_unknown_fields)]
 pub struct Design {
     /// Short name, `[a-z0-9_]+`; names the output folder and the 3MF.
-    #[schemars(extend("pattern" = "^[a-z0-9_]+$"))]
+    #[schemars(extend("pattern" = "^[a-z0-9_]+$", "maxLength" = 64))]
     pub name: String,
     /// One line saying what the design is, for people (`fabkit designs` lists it beside the
     /// name of each library design); empty when not given.
@@ -144,7 +144,7 @@ pub struct Core {
 #[serde(deny_unknown_fields)]
 pub struct CoreMachining {
     /// File stem of its drawing and STEP file, `[a-z0-9_]+`, unique among the kit's parts.
-    #[schemars(extend("pattern" = "^[a-z0-9_]+$"))]
+    #[schemars(extend("pattern" = "^[a-z0-9_]+$", "maxLength" = 64))]
     pub part_name: String,
     /// Surface finish the shop is asked for, printed on the drawing.
     pub finish: String,
@@ -171,7 +171,7 @@ pub enum LayerProcess {
 #[serde(deny_unknown_fields)]
 pub struct Layer {
     /// `[a-z0-9_]+`, unique.
-    #[schemars(extend("pattern" = "^[a-z0-9_]+$"))]
+    #[schemars(extend("pattern" = "^[a-z0-9_]+$", "maxLength" = 64))]
     pub name: String,
     /// Key in the materials table.
     pub material: String,
@@ -345,7 +345,7 @@ defaults!(LaserCutParams {
 #[serde(deny_unknown_fields)]
 pub struct SheetStock {
     /// `[a-z0-9_]+`, for file names and the bill of materials.
-    #[schemars(extend("pattern" = "^[a-z0-9_]+$"))]
+    #[schemars(extend("pattern" = "^[a-z0-9_]+$", "maxLength" = 64))]
     pub name: String,
     /// Material key in the materials table (designs/materials.yaml).
     pub material: String,
@@ -598,7 +598,7 @@ pub struct PrinterProfile {
 #[serde(deny_unknown_fields)]
 pub struct Bed {
     /// The printer's name, in messages and the manifest (`[a-z0-9_]+`).
-    #[schemars(extend("pattern" = "^[a-z0-9_]+$"))]
+    #[schemars(extend("pattern" = "^[a-z0-9_]+$", "maxLength" = 64))]
     pub name: String,
     /// Build volume: x and y of the plate, z the height, mm.
     #[schemars(extend("items" = {"type": "number", "exclusiveMinimum": 0}))]
@@ -1058,16 +1058,8 @@ impl Design {
     /// ([`yaml_options`]); naming the parameter path of a number written quoted, and of a value
     /// of the wrong type (`... (at core.wall_thickness_mm)`).
     pub fn from_yaml(text: &str, origin: &str) -> Result<Design, DesignError> {
-        let d = yaml_from_str::<Design>(text).map_err(|e| {
-            let mut msg = yaml_error(origin, &e);
-            let path = e
-                .location()
-                .and_then(|loc| yaml_scalar_path_at(text, loc.line(), loc.column()));
-            if let Some(path) = path {
-                msg.push_str(&format!(" (at {path})"));
-            }
-            DesignError::Yaml(msg)
-        })?;
+        let d = yaml_from_str::<Design>(text)
+            .map_err(|e| DesignError::Yaml(yaml_error_in(origin, text, &e)))?;
         refuse_quoted_numbers(&d, text, origin)?;
         Ok(d)
     }
@@ -1081,6 +1073,30 @@ impl Design {
     /// [`DesignError::Yaml`] naming `presets.<name>` and the path when the preset is unknown,
     /// a path does not exist or a value has the wrong type.
     pub fn with_preset(&self, preset: &str) -> Result<Design, DesignError> {
+        self.with_preset_from(preset, None)
+    }
+
+    /// [`Self::with_preset`], with the design's YAML `text` and its `origin` (the file name)
+    /// so that an error names the `file:line:column` of the preset's value.
+    ///
+    /// # Errors
+    /// As [`Self::with_preset`]; a value of the wrong type or range is reported as
+    /// `file:line:column: presets.<name>: <path> = <value>: <rule>`, like the same value
+    /// written directly.
+    pub fn with_preset_in(
+        &self,
+        preset: &str,
+        text: &str,
+        origin: &str,
+    ) -> Result<Design, DesignError> {
+        self.with_preset_from(preset, Some((text, origin)))
+    }
+
+    fn with_preset_from(
+        &self,
+        preset: &str,
+        source: Option<(&str, &str)>,
+    ) -> Result<Design, DesignError> {
         let overrides = self.presets.get(preset).ok_or_else(|| {
             DesignError::Yaml(format!(
                 "no preset '{preset}' in design '{}'; its presets: {}",
@@ -1102,10 +1118,39 @@ impl Design {
             })?;
             *slot = value.clone();
         }
-        let mut d: Design = serde_json::from_value(v)
-            .map_err(|e| DesignError::Yaml(format!("presets.{preset}: {e}")))?;
+        let mut d: Design = serde_json::from_value(v).map_err(|e| {
+            DesignError::Yaml(self.preset_value_errors(preset, source).unwrap_or_else(|| {
+                format!("presets.{preset}: {e}")
+            }))
+        })?;
         d.name = format!("{}_{preset}", self.name);
         Ok(d)
+    }
+
+    /// Each value of preset `preset` that the schema refuses on its own, as
+    /// `[file:line:column: ]presets.<name>: <path> = <value>: <rule>`, one per line; `None`
+    /// when each value alone fits (only their combination does not).
+    fn preset_value_errors(&self, preset: &str, source: Option<(&str, &str)>) -> Option<String> {
+        let base = serde_json::to_value(self).ok()?;
+        let mut lines = Vec::new();
+        for (path, value) in self.presets.get(preset)? {
+            let mut v = base.clone();
+            let Some(slot) = value_at(&mut v, path) else {
+                continue;
+            };
+            *slot = value.clone();
+            let Err(e) = serde_json::from_value::<Design>(v) else {
+                continue;
+            };
+            let at = source
+                .and_then(|(text, origin)| {
+                    preset_value_location(text, preset, path).map(|(l, c)| format!("{origin}:{l}:{c}: "))
+                })
+                .unwrap_or_default();
+            let shown = crate::error::compact_numbers(&value.to_string());
+            lines.push(format!("{at}presets.{preset}: {path} = {shown}: {e}"));
+        }
+        (!lines.is_empty()).then(|| lines.join("\n"))
     }
 }
 
@@ -1303,6 +1348,20 @@ pub fn yaml_location(text: &str, path: &str) -> Option<(u64, u64)> {
     Some((cur.referenced.line(), cur.referenced.column()))
 }
 
+/// Line and column (from 1) in `text` of the value that preset `preset` gives parameter `path`
+/// (a key of `presets.<preset>`, dots and brackets included).
+fn preset_value_location(text: &str, preset: &str, path: &str) -> Option<(u64, u64)> {
+    let root: serde_saphyr::Spanned<Node> = serde_saphyr::from_str(text).ok()?;
+    let mut cur = &root;
+    for key in ["presets", preset, path] {
+        let Node::Map(entries) = &cur.value else {
+            return None;
+        };
+        cur = &entries.iter().find(|(name, _)| name == key)?.1;
+    }
+    Some((cur.referenced.line(), cur.referenced.column()))
+}
+
 /// The parameter path (`core.wall_thickness_mm`, `layers[1].name`) of the scalar value that
 /// starts at `line`, `column` (from 1) of `text`; `None` when the text does not parse or no
 /// scalar value starts there (a key, a mapping, a list).
@@ -1418,6 +1477,19 @@ impl<'de> Deserialize<'de> for Node {
         }
         d.deserialize_any(V)
     }
+}
+
+/// [`yaml_error`] followed by ` (at <parameter path>)` when the error points at a scalar of
+/// `text` (the parsed YAML).
+pub fn yaml_error_in(origin: &str, text: &str, e: &serde_saphyr::Error) -> String {
+    let mut msg = yaml_error(origin, e);
+    let path = e
+        .location()
+        .and_then(|loc| yaml_scalar_path_at(text, loc.line(), loc.column()));
+    if let Some(path) = path {
+        msg.push_str(&format!(" (at {path})"));
+    }
+    msg
 }
 
 /// Formats a serde-saphyr error as `file:line:column: message`.

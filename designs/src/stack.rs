@@ -70,9 +70,7 @@ impl Stack {
 }
 
 pub(crate) fn is_identifier(s: &str) -> bool {
-    !s.is_empty()
-        && s.chars()
-            .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_')
+    crate::values::is_file_stem(s)
 }
 
 /// Lengths of a design that may be negative ([`crate::values::check_values`]): none.
@@ -99,7 +97,7 @@ pub fn validate(
         errs.push(ParamError::new(
             "name",
             format!("{:?}", design.name),
-            "must be lowercase letters, digits and _",
+            "must be 1 to 64 lowercase letters, digits and _",
         ));
     }
     if design.body.flat_outline().is_some() {
@@ -302,7 +300,7 @@ pub fn validate(
             errs.push(ParamError::new(
                 format!("layers[{i}].name"),
                 format!("{:?}", l.name),
-                "must be lowercase letters, digits and _",
+                "must be 1 to 64 lowercase letters, digits and _",
             ));
         } else if !names.insert(l.name.clone()) {
             errs.push(ParamError::new(
@@ -649,15 +647,12 @@ pub fn validate(
 
 /// The drawing's fields of a core made to order (the bore is checked with the core's surfaces).
 fn check_machining(m: &crate::schema::CoreMachining, errs: &mut Vec<ParamError>) {
-    let name_ok = !m.part_name.is_empty()
-        && m.part_name
-            .bytes()
-            .all(|b| b.is_ascii_lowercase() || b.is_ascii_digit() || b == b'_');
+    let name_ok = crate::values::is_file_stem(&m.part_name);
     if !name_ok {
         errs.push(ParamError::new(
             "core.machining.part_name",
             m.part_name.as_str(),
-            "must be [a-z0-9_]+ (it names the drawing and the STEP file)",
+            "must be [a-z0-9_]+, at most 64 characters (it names the drawing and the STEP file)",
         ));
     }
     if m.finish.trim().is_empty() {
@@ -783,16 +778,11 @@ pub fn check_bed(bed: &crate::schema::Bed, path: &str, errs: &mut Vec<ParamError
             format!("{path}.{k}")
         }
     };
-    if bed.name.is_empty()
-        || !bed
-            .name
-            .chars()
-            .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_')
-    {
+    if !crate::values::is_file_stem(&bed.name) {
         errs.push(ParamError::new(
             at("name"),
             format!("'{}'", bed.name),
-            "must be a name of a-z, 0-9 and _ (it names the plates in the manifest)",
+            "must be a name of a-z, 0-9 and _, at most 64 characters (it names the plates in the manifest)",
         ));
     }
     for (k, v) in bed.size_mm.iter().enumerate() {

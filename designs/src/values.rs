@@ -8,8 +8,9 @@
 //! - every value is finite (YAML `.nan`, `.inf` and numbers past `f64` are refused);
 //! - a length (`_mm`, or an element or field of a `_mm` parameter such as
 //!   `hole_compensation_mm.fdm`) is at most [`MAX_LENGTH_MM`] and not negative, except the few
-//!   lengths a caller names as signed;
-//! - an angle (`_deg`) is from -[`MAX_ANGLE_DEG`] to [`MAX_ANGLE_DEG`];
+//!   lengths a caller names as signed, and 0 or at least [`MIN_LENGTH_MM`] in magnitude;
+//! - an angle (`_deg`) is from -[`MAX_ANGLE_DEG`] to [`MAX_ANGLE_DEG`], and 0 or at least
+//!   [`MIN_ANGLE_DEG`] in magnitude;
 //! - any other number (a ratio such as `waste_allowance`) is within +-[`MAX_PLAIN`];
 //! - text (names, descriptions, keys) holds no control characters but line breaks and tabs.
 //!
@@ -22,6 +23,28 @@ use serde_value::Value;
 
 /// Largest length of any parameter, mm: larger than any print bed, mold or sensor.
 pub const MAX_LENGTH_MM: f64 = 1000.0;
+/// Smallest magnitude of a length that is not 0, mm: the finest chord tolerance
+/// ([`crate::ChordTolerance::MIN_MM`]), 25 times finer than the finest SLA layer. A nonzero
+/// length below it is below anything a printer, a mold or a camera resolves, and the geometry
+/// kernel cannot build it.
+pub const MIN_LENGTH_MM: f64 = 0.001;
+/// Longest name that becomes part of a file name (a design, layer, part, stock, printer bed
+/// or pattern name), characters: with the design's name and a suffix, a file name stays well
+/// inside the 255 bytes file systems allow.
+pub const MAX_NAME_CHARS: usize = 64;
+
+/// Whether `s` can name a file: 1 to [`MAX_NAME_CHARS`] characters of `[a-z0-9_]`.
+pub fn is_file_stem(s: &str) -> bool {
+    !s.is_empty()
+        && s.len() <= MAX_NAME_CHARS
+        && s.bytes()
+            .all(|b| b.is_ascii_lowercase() || b.is_ascii_digit() || b == b'_')
+}
+
+/// Smallest magnitude of an angle that is not 0, degrees: [`MIN_LENGTH_MM`] /
+/// [`MAX_LENGTH_MM`] radians (5.7e-5 deg), rounded down. A smaller nonzero angle moves no point
+/// of a part by as much as the smallest length, so it can only be a typing error (or 0).
+pub const MIN_ANGLE_DEG: f64 = 5e-5;
 /// Largest magnitude of any angle, degrees (one full turn).
 pub const MAX_ANGLE_DEG: f64 = 360.0;
 /// Largest magnitude of any other number.
@@ -185,7 +208,13 @@ fn check_one(x: f64, path: &str, unit: Unit, signed: bool, errs: &mut ValueError
         Unit::Deg if x.abs() > MAX_ANGLE_DEG => {
             format!("must be an angle from -{MAX_ANGLE_DEG} to {MAX_ANGLE_DEG} deg")
         }
+        Unit::Deg if x != 0.0 && x.abs() < MIN_ANGLE_DEG => format!(
+            "must be 0 or an angle of at least {MIN_ANGLE_DEG:e} deg (smaller moves no point of a part by {MIN_LENGTH_MM} mm)"
+        ),
         Unit::Plain if x.abs() > MAX_PLAIN => format!("must be from -{MAX_PLAIN} to {MAX_PLAIN}"),
+        Unit::Mm if x != 0.0 && x.abs() < MIN_LENGTH_MM => format!(
+            "must be 0 or a length of at least {MIN_LENGTH_MM} mm (finer than any printer, mold or camera resolves)"
+        ),
         Unit::Mm if x < 0.0 && !signed => {
             errs.negative.push(ParamError::new(
                 path,
@@ -234,14 +263,54 @@ pub fn number_paths<T: Serialize + ?Sized>(
     value: &T,
     skip: &[&str],
 ) -> Result<Vec<NumberPath>, String> {
-    fn walk(v: &Value, path: &mut Vec<Step>, skip: &[&str], out: &mut Vec<NumberPath>) {
+    paths_where(value, skip, |v| matches!(v, Value::F64(_) | Value::F32(_)))
+}
+
+/// The path of every integer of `value` as serialized (counts, seeds), leaving out the
+/// top-level maps named in `skip`, like [`number_paths`] for floating-point numbers.
+///
+/// # Errors
+/// The serializer's message (a schema type does not fail).
+pub fn integer_paths<T: Serialize + ?Sized>(
+    value: &T,
+    skip: &[&str],
+) -> Result<Vec<NumberPath>, String> {
+    paths_where(value, skip, |v| {
+        matches!(
+            v,
+            Value::U8(_)
+                | Value::U16(_)
+                | Value::U32(_)
+                | Value::U64(_)
+                | Value::I8(_)
+                | Value::I16(_)
+                | Value::I32(_)
+                | Value::I64(_)
+        )
+    })
+}
+
+/// The path of every leaf of `value` (as serialized) for which `leaf` holds, leaving out the
+/// top-level maps named in `skip`.
+fn paths_where<T: Serialize + ?Sized>(
+    value: &T,
+    skip: &[&str],
+    leaf: fn(&Value) -> bool,
+) -> Result<Vec<NumberPath>, String> {
+    fn walk(
+        v: &Value,
+        path: &mut Vec<Step>,
+        skip: &[&str],
+        leaf: fn(&Value) -> bool,
+        out: &mut Vec<NumberPath>,
+    ) {
         match v {
-            Value::F64(_) | Value::F32(_) => out.push(NumberPath(path.clone())),
-            Value::Option(Some(x)) | Value::Newtype(x) => walk(x, path, skip, out),
+            v if leaf(v) => out.push(NumberPath(path.clone())),
+            Value::Option(Some(x)) | Value::Newtype(x) => walk(x, path, skip, leaf, out),
             Value::Seq(items) => {
                 for (i, x) in items.iter().enumerate() {
                     path.push(Step::Index(i));
-                    walk(x, path, skip, out);
+                    walk(x, path, skip, leaf, out);
                     path.pop();
                 }
             }
@@ -252,7 +321,7 @@ pub fn number_paths<T: Serialize + ?Sized>(
                         continue;
                     }
                     path.push(Step::Key(k.clone()));
-                    walk(x, path, skip, out);
+                    walk(x, path, skip, leaf, out);
                     path.pop();
                 }
             }
@@ -261,7 +330,7 @@ pub fn number_paths<T: Serialize + ?Sized>(
     }
     let v = serde_value::to_value(value).map_err(|e| e.to_string())?;
     let mut out = Vec::new();
-    walk(&v, &mut Vec::new(), skip, &mut out);
+    walk(&v, &mut Vec::new(), skip, leaf, &mut out);
     Ok(out)
 }
 

@@ -4,7 +4,7 @@
 use clap::{Parser, Subcommand, ValueEnum};
 use fabkit_designs::input_files::DataFileRules;
 use fabkit_designs::schema::MoldStrategy;
-use fabkit_designs::{build_kit_bounded, library, ChordTolerance, Design, DesignError};
+use fabkit_designs::{build_kit_bounded, library, ChordTolerance, DesignError};
 use fabkit_export::{write_kit_reporting, ExportOptions, Formats};
 use std::error::Error;
 
@@ -238,20 +238,11 @@ pub fn error_report(e: &(dyn std::error::Error + 'static)) -> String {
 }
 
 /// A design and where it came from.
-pub(crate) struct Loaded {
-    pub(crate) design: Design,
-    pub(crate) source: String,
-    pub(crate) sha256: String,
-}
+pub(crate) type Loaded = library::LoadedDesign;
 
 pub(crate) fn load_design(arg: Option<&str>, data: &DataFileArgs) -> Result<Loaded, DesignError> {
     let arg = arg.unwrap_or(library::DEFAULT_DESIGN);
-    let l = library::load_source_with(arg, Path::new(""), &data.rules())?;
-    Ok(Loaded {
-        design: l.design,
-        source: l.source,
-        sha256: l.sha256,
-    })
+    library::load_source_with(arg, Path::new(""), &data.rules())
 }
 
 /// The export options of this run: formats, provenance (command line, design, version).
@@ -381,7 +372,7 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
             let tol = tolerance(chord_tolerance_mm)?;
             let mut loaded = load_design(design.as_deref(), &data_files)?;
             if let Some(p) = &preset {
-                loaded.design = loaded.design.with_preset(p)?;
+                loaded.apply_preset(p)?;
             }
             let stack = fabkit_designs::validate_design(&loaded.design, tol)?;
             out!("{}: valid", loaded.source);
@@ -472,7 +463,7 @@ fn export(args: ExportArgs) -> Result<(), Box<dyn Error>> {
     let tol = tolerance(args.chord_tolerance_mm)?;
     let mut loaded = load_design(args.design.as_deref(), &args.data_files)?;
     if let Some(p) = &args.preset {
-        loaded.design = loaded.design.with_preset(p)?;
+        loaded.apply_preset(p)?;
     }
     crate::printers::apply(&args.printer, &mut loaded.design.printers)?;
     if let Some(s) = args.mold_strategy {

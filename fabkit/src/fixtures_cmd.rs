@@ -59,7 +59,7 @@ pub fn run(args: FixturesArgs) -> Result<(), Box<dyn Error>> {
     let tol = tolerance(args.chord_tolerance_mm)?;
     let mut loaded = load_design(args.design.as_deref(), &args.data_files)?;
     if let Some(p) = &args.preset {
-        loaded.design = loaded.design.with_preset(p)?;
+        loaded.apply_preset(p)?;
     }
     crate::printers::apply(&args.printer, &mut loaded.design.printers)?;
     let base = match &args.params {

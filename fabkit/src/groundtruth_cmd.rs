@@ -430,7 +430,7 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
     let t0 = std::time::Instant::now();
     let mut loaded = load_design(args.design.as_deref(), &args.data_files)?;
     if let Some(p) = &args.preset {
-        loaded.design = loaded.design.with_preset(p)?;
+        loaded.apply_preset(p)?;
     }
     let design = &loaded.design;
     let camera = read_camera_file_as(&args.camera, args.camera_model.map(Into::into))?;

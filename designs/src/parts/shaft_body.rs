@@ -427,6 +427,15 @@ pub fn check_params(
             "must be 2 to 8",
         ));
     }
+    if sb.led_ring.outer_diameter_mm > 0.0 && sb.led_ring.inner_diameter_mm > 0.0 {
+        crate::parts::check_led_count(
+            "shaft_body.led_ring.led_count",
+            sb.led_ring.led_count,
+            sb.led_ring.outer_diameter_mm,
+            sb.led_ring.inner_diameter_mm,
+            errs,
+        );
+    }
     if !(bp.ramp_deg >= 0.0 && bp.ramp_deg < 15.0) {
         errs.push(ParamError::new(
             "printers.fdm.bayonet.ramp_deg",

@@ -205,9 +205,7 @@ impl SweepSpec {
             })?;
         let preset = raw.preset.as_ref().map(|p| p.value.clone());
         if let Some(p) = &raw.preset {
-            base.design = base
-                .design
-                .with_preset(&p.value)
+            base.apply_preset(&p.value)
                 .map_err(|e| SweepError::Design {
                     at: at(origin, p),
                     error: e,

@@ -246,3 +246,174 @@ fn inward_features_end_before_the_centre_of_curvature() {
         listing(&errors(&d))
     );
 }
+
+/// A concentric spacing of 1e-300 mm made a ring's marker count (a float cast to usize) past
+/// `usize::MAX`, and the placement allocated until it was killed: the count is compared with
+/// the cap before the cast, whatever rule runs first.
+#[test]
+fn a_vanishing_concentric_spacing_is_refused_before_placing() {
+    use fabkit_designs::markers::{place, Layout, Pattern, MAX_MARKERS_PER_PATTERN};
+    let d = library::load("shadowtac").unwrap();
+    let s = fabkit_designs::markers::Surface::new(&d.body, 0.0);
+    for spacing in [1e-20, 1e-100, 1e-300, 5e-324] {
+        let p = Pattern {
+            layout: Layout::Concentric,
+            spacing_mm: Some(spacing),
+            ..d.layers[0].markers[0].pattern.clone()
+        };
+        let (field, _, rule) = place(&s, &p, 0.5).unwrap_err();
+        assert_eq!(field, "spacing_mm", "{spacing}: {rule}");
+        assert!(
+            rule.contains(&format!("more than {MAX_MARKERS_PER_PATTERN} markers")),
+            "{spacing}: {rule}"
+        );
+    }
+}
+
+/// Counts that once allocated before their rule: 2e8 clamp bolts (a position per bolt), a flat
+/// marker grid of 1e8 columns or 2^63 rows (rows x columns positions), 2^31 LEDs on a ring
+/// PCB (which reached the shopping list).
+#[test]
+fn counts_that_once_allocated_or_passed_are_refused_by_name() {
+    let mut d = library::load("shadowtac").unwrap();
+    d.mold.two_piece.bolt_count = 200_000_000;
+    assert_refused(&d, "mold.two_piece.bolt_count", "200000000", "bolts");
+
+    let soter = library::load("soter_channels").unwrap();
+    let i = soter
+        .layers
+        .iter()
+        .position(|l| l.marker_grid.is_some())
+        .unwrap();
+    for (rows, columns, path, value) in [
+        (1, 100_000_000, "columns", "100000000"),
+        (1 << 31, 10, "rows", "2147483648"),
+        (1 << 63, 10, "rows", "9223372036854775808"),
+        (1 << 63, 1 << 63, "rows", "9223372036854775808"),
+    ] {
+        let mut d = soter.clone();
+        let g = d.layers[i].marker_grid.as_mut().unwrap();
+        g.rows = rows;
+        g.columns = columns;
+        let errs = fabkit_designs::flat::validate(&d, &MaterialsTable::embedded().unwrap())
+            .err()
+            .map(|e| e.0)
+            .unwrap_or_default();
+        let path = format!("layers[{i}].marker_grid.{path}");
+        assert!(
+            errs.iter().any(|e| e.path == path
+                && e.value == value
+                && e.rule.contains("more than the 100000 markers")),
+            "{path}:{}",
+            listing(&errs)
+        );
+    }
+
+    let mut d = library::load("rtac0").unwrap();
+    d.housing.as_mut().unwrap().led_pcb.led_count = 1 << 31;
+    assert_refused(
+        &d,
+        "housing.led_pcb.led_count",
+        "2147483648",
+        "LEDs fit around the ring",
+    );
+    // the published eight fit; one per millimetre of the mid-line is the most
+    let ring = &library::load("rtac0").unwrap().housing.unwrap().led_pcb;
+    let fit = (std::f64::consts::PI * (ring.outer_diameter_mm + ring.inner_diameter_mm) / 2.0)
+        .floor() as u32;
+    d.housing.as_mut().unwrap().led_pcb.led_count = fit;
+    assert!(errors(&d).is_empty(), "{}", listing(&errors(&d)));
+    d.housing.as_mut().unwrap().led_pcb.led_count = fit + 1;
+    assert_refused(&d, "housing.led_pcb.led_count", &(fit + 1).to_string(), "fit");
+    let mut d = library::load("tactip_dualmodal").unwrap();
+    d.shaft_body.as_mut().unwrap().led_ring.led_count = 1 << 31;
+    assert_refused(
+        &d,
+        "shaft_body.led_ring.led_count",
+        "2147483648",
+        "LEDs fit around the ring",
+    );
+}
+
+/// Tiny positive lengths (1e-300 to 1e-12 mm) of housing, casing and core dimensions passed
+/// validation and failed in the kernel with a message naming a part but not the parameter.
+#[test]
+fn tiny_lengths_are_refused_by_name_before_the_kernel() {
+    let cases: [(&str, fn(&mut Design, f64)); 4] = [
+        ("housing.camera.bay_height_mm", |d, x| {
+            d.housing.as_mut().unwrap().camera.bay_height_mm = x
+        }),
+        ("housing.joint_screw.clearance_diameter_mm", |d, x| {
+            d.housing.as_mut().unwrap().joint_screw.clearance_diameter_mm = x
+        }),
+        ("core.wall_thickness_mm", |d, x| {
+            d.core.as_mut().unwrap().wall_thickness_mm = x
+        }),
+        ("casing.leds.width_mm", |d, x| {
+            d.casing.as_mut().unwrap().leds.width_mm = x
+        }),
+    ];
+    for (path, set) in cases {
+        let name = if path.starts_with("casing") { "shadowtac" } else { "rtac0" };
+        for (x, shown) in [(1e-300, "1e-300"), (1e-12, "1e-12"), (5e-4, "0.0005")] {
+            let mut d = library::load(name).unwrap();
+            set(&mut d, x);
+            assert_refused(&d, path, shown, "must be 0 or a length of at least 0.001 mm");
+        }
+    }
+}
+
+/// A 300-character layer name passed validation and failed export with "File name too long".
+#[test]
+fn names_that_become_file_names_are_bounded() {
+    let mut d = library::load("rtac0").unwrap();
+    d.layers[0].name = "a".repeat(300);
+    let errs = errors(&d);
+    assert!(
+        errs.iter()
+            .any(|e| e.path == "layers[0].name" && e.rule.contains("1 to 64")),
+        "{}",
+        listing(&errs)
+    );
+    d.layers[0].name = "a".repeat(64);
+    assert!(errors(&d).is_empty(), "{}", listing(&errors(&d)));
+}
+
+/// Extreme values printed as 300-digit decimals in error messages.
+#[test]
+fn extreme_values_print_in_scientific_notation() {
+    let e = ParamError::new("a_mm", 1e300, format!("must be below {}", 1e-300));
+    assert_eq!(e.to_string(), "a_mm = 1e300: must be below 1e-300");
+    // integers up to 2^64 keep their digits, ordinary decimals are untouched
+    let e = ParamError::new("count", u64::MAX, "must be at most 0.125 of 12345678.5");
+    assert_eq!(
+        e.to_string(),
+        "count = 18446744073709551615: must be at most 0.125 of 12345678.5"
+    );
+}
+
+/// A preset value of the wrong type or range was reported as `presets.<name>: invalid value`,
+/// without its parameter path or its place in the file.
+#[test]
+fn preset_values_are_reported_like_direct_ones() {
+    // the first `rings: null` is paper_text's
+    let text = library::yaml("shadowtac").unwrap().replacen(
+        "    layers[0].markers[0].pattern.rings: null\n",
+        "    layers[0].markers[0].pattern.rings: 9223372036854775808\n",
+        1,
+    );
+    let line = text
+        .lines()
+        .position(|l| l.contains("rings: 9223372036854775808"))
+        .unwrap()
+        + 1;
+    let d = Design::from_yaml(&text, "shadowtac.yaml").unwrap();
+    let e = d
+        .with_preset_in("paper_text", &text, "shadowtac.yaml")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with(&format!("shadowtac.yaml:{line}:41: presets.paper_text: layers[0].markers[0].pattern.rings = 9223372036854775808: ")),
+        "{e}"
+    );
+}
