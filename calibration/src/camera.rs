@@ -138,22 +138,36 @@ const PINHOLE_MAX_RADIUS: f64 = 10.0;
 /// Largest image width or height a camera model accepts, px (16384: beyond any camera a
 /// tactile sensor carries; every per-pixel array is sized by it).
 pub const MAX_IMAGE_SIDE_PX: u32 = 16384;
+/// Smallest focal length a camera model accepts, px: below it the whole field of view falls
+/// on a few pixels.
+pub const MIN_FOCAL_PX: f64 = 1.0;
+/// Largest focal length a camera model accepts, px: a 16384 px image then spans under 1 deg.
+pub const MAX_FOCAL_PX: f64 = 1e6;
 
 impl CameraModel {
-    /// Validates the intrinsics (finite, positive focal lengths and image size, no NaN
-    /// coefficients) and finds the monotonic range of the distortion.
+    /// Validates the intrinsics (focal lengths from [`MIN_FOCAL_PX`] to [`MAX_FOCAL_PX`], image
+    /// sides from 1 to [`MAX_IMAGE_SIDE_PX`], the principal point within the image or at most
+    /// one image width or height outside it, no NaN coefficients) and finds the monotonic range
+    /// of the distortion.
     ///
     /// # Errors
     /// [`CameraError::Invalid`] naming the field, its value and the rule.
     pub fn new(intr: Intrinsics) -> Result<CameraModel, CameraError> {
         let bad = |field, value: f64, rule| CameraError::Invalid {
             field,
-            value: format!("{value}"),
+            value: crate::shown_f64(value),
             rule,
         };
         for (field, v) in [("fx_px", intr.fx_px), ("fy_px", intr.fy_px)] {
             if !(v.is_finite() && v > 0.0) {
                 return Err(bad(field, v, "must be finite and > 0"));
+            }
+            if !(MIN_FOCAL_PX..=MAX_FOCAL_PX).contains(&v) {
+                return Err(bad(
+                    field,
+                    v,
+                    "must be from 1 to 1e6 px (a lens maps about one radian onto that many pixels)",
+                ));
             }
         }
         for (field, v) in [("cx_px", intr.cx_px), ("cy_px", intr.cy_px)] {
@@ -167,6 +181,19 @@ impl CameraModel {
         ] {
             if !(1..=MAX_IMAGE_SIDE_PX).contains(&v) {
                 return Err(bad(field, f64::from(v), "must be from 1 to 16384 px"));
+            }
+        }
+        for (field, v, side) in [
+            ("cx_px", intr.cx_px, intr.image_width_px),
+            ("cy_px", intr.cy_px, intr.image_height_px),
+        ] {
+            let side = f64::from(side);
+            if !(-side..=2.0 * side).contains(&v) {
+                return Err(bad(
+                    field,
+                    v,
+                    "the principal point must lie within the image or at most one image width (cx) or height (cy) outside it",
+                ));
             }
         }
         if let Some(v) = intr

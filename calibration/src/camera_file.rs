@@ -187,7 +187,9 @@ pub fn parse_camera_as(
     file: &str,
     model: Option<DistortionModelHint>,
 ) -> Result<CameraModel, CameraFileError> {
-    let start = text.trim_start_matches('\u{feff}').trim_start();
+    // a file saved by an editor as "UTF-8 with BOM" reads as the same file without one
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let start = text.trim_start();
     let intr = if start.starts_with('{') {
         parse_json(text, file, model)?
     } else if start.starts_with('<') {

@@ -18,8 +18,8 @@ use crate::refine::{
 };
 use crate::report::{ExtrinsicsReport, Provenance};
 use crate::tables::{
-    pair, read_capture_plan, read_captures, read_observations, read_point_table, PointsFrom,
-    TableError,
+    check_inside_image, pair, read_capture_plan, read_captures, read_observations,
+    read_point_table, PointsFrom, TableError,
 };
 
 /// Inputs of one extrinsics calibration.
@@ -110,7 +110,8 @@ pub struct FoundInImages {
 /// files and writes nothing.
 ///
 /// # Errors
-/// [`ExtrinsicsError`]: unreadable or invalid inputs (file:line and field), unmatched ids, fewer
+/// [`ExtrinsicsError`]: unreadable or invalid inputs (file:line and field; every bad row of a
+/// table), observations outside the camera file's image (every such row), unmatched ids, fewer
 /// than 4 usable points, pixels outside the lens's field, degenerate layouts, points behind the
 /// camera at the solved pose, too few RANSAC inliers, a capture image of the wrong size; from
 /// images, also the errors of [`observe_images`] (an unreadable image, file names without ids,
@@ -139,6 +140,13 @@ pub fn calibrate_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsOutput, Ext
         (None, Some(plan)) => read_captures(&obs_paths, plan)?,
         (None, None) => (read_observations(&obs_paths)?, Vec::new()),
     };
+    let i = camera.intrinsics();
+    check_inside_image(
+        &obs,
+        i.image_width_px,
+        i.image_height_px,
+        &job.camera.display().to_string(),
+    )?;
     let pairs = pair(&table, &obs)?;
     let opts = PnpOptions {
         ransac: job.ransac,

@@ -45,6 +45,17 @@ pub const MAX_TEXT_INPUT_BYTES: u64 = 64 << 20;
 /// Largest binary input (capture PNG, fixture meshes), bytes: 1 GiB.
 pub const MAX_BINARY_INPUT_BYTES: u64 = 1 << 30;
 
+/// `x` as a reader would write it: `{}` where that is short, scientific notation (`1e300`,
+/// `5e-324`) where `{}` would print hundreds of digits.
+pub fn shown_f64(x: f64) -> String {
+    let s = format!("{x}");
+    if s.len() > 24 {
+        format!("{x:e}")
+    } else {
+        s
+    }
+}
+
 /// A regular file of at most [`MAX_TEXT_INPUT_BYTES`] as UTF-8 text.
 pub(crate) fn read_text(path: &std::path::Path) -> std::io::Result<String> {
     fabkit_designs::input_files::read_text_file(path, MAX_TEXT_INPUT_BYTES)

@@ -43,6 +43,18 @@ pub enum TableError {
         first: String,
         second: String,
     },
+    /// Every bad row of a table (more than one), each on its own line; past
+    /// [`MAX_REPORTED_ROWS`] the rest are counted.
+    #[error("{}", shown_rows(.0))]
+    Rows(Vec<TableError>),
+    #[error("{camera}: the image is {width} x {height} px (u from -0.5 to {} px, v from -0.5 to {} px, pixel (0, 0) the centre of the top-left pixel), but {} outside it:\n{}", *.width as f64 - 0.5, *.height as f64 - 0.5, if .rows.len() == 1 { "this observation is".to_string() } else { format!("these {} observations are", .rows.len()) }, shown_lines(.rows))]
+    OutsideImage {
+        camera: String,
+        width: u32,
+        height: u32,
+        /// `file:line: id <id>: u_px = .., v_px = ..`, one per row.
+        rows: Vec<String>,
+    },
     #[error("observed ids not in the point table {points}: {}", .ids.join(", "))]
     UnknownIds { points: String, ids: Vec<String> },
     #[error("{plan} has {captures} captures but {files} observation files were given (one per capture, in capture order)")]
@@ -59,6 +71,30 @@ pub enum TableError {
         plan: String,
         where_: String,
     },
+}
+
+/// Bad rows listed in one error; the rest are counted.
+pub const MAX_REPORTED_ROWS: usize = 20;
+
+fn shown_lines(lines: &[String]) -> String {
+    let mut out: Vec<String> = lines.iter().take(MAX_REPORTED_ROWS).cloned().collect();
+    if lines.len() > MAX_REPORTED_ROWS {
+        out.push(format!("and {} more rows", lines.len() - MAX_REPORTED_ROWS));
+    }
+    out.join("\n")
+}
+
+fn shown_rows(errors: &[TableError]) -> String {
+    shown_lines(&errors.iter().map(ToString::to_string).collect::<Vec<_>>())
+}
+
+/// `Ok` for no error, the error itself for one, [`TableError::Rows`] for several.
+fn all_rows(mut errors: Vec<TableError>) -> Result<(), TableError> {
+    match errors.len() {
+        0 => Ok(()),
+        1 => Err(errors.remove(0)),
+        _ => Err(TableError::Rows(errors)),
+    }
 }
 
 /// Which point of a fixtures table to use.
@@ -101,6 +137,8 @@ struct Csv<'a> {
     header: Vec<String>,
     header_line: usize,
     rows: Vec<(usize, Vec<&'a str>)>,
+    /// Rows whose cell count differs from the header's (left out of `rows`).
+    bad: Vec<TableError>,
 }
 
 fn parse_csv<'a>(text: &'a str, file: &'a str) -> Result<Csv<'a>, TableError> {
@@ -108,6 +146,7 @@ fn parse_csv<'a>(text: &'a str, file: &'a str) -> Result<Csv<'a>, TableError> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut header: Option<(usize, Vec<String>)> = None;
     let mut rows = Vec::new();
+    let mut bad = Vec::new();
     for (i, line) in text.lines().enumerate() {
         let t = line.trim();
         if t.is_empty() || t.starts_with('#') {
@@ -118,7 +157,7 @@ fn parse_csv<'a>(text: &'a str, file: &'a str) -> Result<Csv<'a>, TableError> {
             None => header = Some((i + 1, cells.iter().map(|c| c.to_string()).collect())),
             Some((_, h)) => {
                 if cells.len() != h.len() {
-                    return Err(TableError::Format {
+                    bad.push(TableError::Format {
                         file: file.into(),
                         line: i + 1,
                         message: format!(
@@ -127,6 +166,7 @@ fn parse_csv<'a>(text: &'a str, file: &'a str) -> Result<Csv<'a>, TableError> {
                             h.len()
                         ),
                     });
+                    continue;
                 }
                 rows.push((i + 1, cells));
             }
@@ -142,6 +182,7 @@ fn parse_csv<'a>(text: &'a str, file: &'a str) -> Result<Csv<'a>, TableError> {
         header,
         header_line,
         rows,
+        bad,
     })
 }
 
@@ -193,6 +234,55 @@ impl Csv<'_> {
     }
 }
 
+/// The line an error of one table names (its second place for a duplicate id), for ordering.
+fn line_of(e: &TableError) -> usize {
+    match e {
+        TableError::Format { line, .. } | TableError::Field { line, .. } => *line,
+        TableError::Duplicate { second, .. } => second
+            .rsplit(':')
+            .next()
+            .and_then(|l| l.parse().ok())
+            .unwrap_or(usize::MAX),
+        _ => usize::MAX,
+    }
+}
+
+/// Checks every observation against the camera's image: `u_px` from -0.5 to `width - 0.5`,
+/// `v_px` from -0.5 to `height - 0.5` (pixel (0, 0) is the centre of the top-left pixel, so
+/// these are the outer edges of the image). `camera` names the camera file in the error.
+///
+/// # Errors
+/// [`TableError::OutsideImage`] listing every row outside the image (file:line, id, values).
+pub fn check_inside_image(
+    obs: &Observations,
+    width: u32,
+    height: u32,
+    camera: &str,
+) -> Result<(), TableError> {
+    let (umax, vmax) = (f64::from(width) - 0.5, f64::from(height) - 0.5);
+    let rows: Vec<String> = obs
+        .rows
+        .iter()
+        .filter(|(_, uv, _)| !((-0.5..=umax).contains(&uv.x) && (-0.5..=vmax).contains(&uv.y)))
+        .map(|(id, uv, origin)| {
+            format!(
+                "{origin}: id {id}: u_px = {}, v_px = {}",
+                crate::shown_f64(uv.x),
+                crate::shown_f64(uv.y)
+            )
+        })
+        .collect();
+    if rows.is_empty() {
+        return Ok(());
+    }
+    Err(TableError::OutsideImage {
+        camera: camera.into(),
+        width,
+        height,
+        rows,
+    })
+}
+
 fn read(path: &Path) -> Result<(String, String), TableError> {
     let file = path.display().to_string();
     let text = crate::read_text(path).map_err(|source| TableError::Io {
@@ -215,13 +305,15 @@ pub fn read_point_table(path: &Path, from: PointsFrom) -> Result<PointTable, Tab
 /// `id,x_mm,y_mm,z_mm` CSV (`from` does not apply to it).
 ///
 /// # Errors
-/// [`TableError`]: no header or missing columns, a non-numeric or non-finite value, a duplicate id.
+/// [`TableError`]: no header or missing columns; for the rows, a wrong cell count, a non-numeric
+/// or non-finite value, an empty or duplicate id, every bad row in one
+/// [`TableError::Rows`] (a single one as itself).
 pub fn parse_point_table(
     text: &str,
     file: &str,
     from: PointsFrom,
 ) -> Result<PointTable, TableError> {
-    let csv = parse_csv(text, file)?;
+    let mut csv = parse_csv(text, file)?;
     let expected = "id,x_mm,y_mm,z_mm or the fixtures table's id,ring,tip_x_mm,...";
     let id = csv.column("id", expected)?;
     let fixtures = csv
@@ -240,22 +332,30 @@ pub fn parse_point_table(
     ];
     let mut rows = Vec::with_capacity(csv.rows.len());
     let mut seen: BTreeMap<String, usize> = BTreeMap::new();
+    // every bad row, in line order (cell counts first: they are known before the columns)
+    let mut bad = std::mem::take(&mut csv.bad);
     for (line, cells) in &csv.rows {
-        let i = csv.id(*line, cells, id)?;
-        if let Some(first) = seen.insert(i.clone(), *line) {
-            return Err(TableError::Duplicate {
-                id: i,
-                first: format!("{file}:{first}"),
-                second: format!("{file}:{line}"),
-            });
+        let mut errs = Vec::new();
+        let i = csv.id(*line, cells, id).map_err(|e| errs.push(e)).ok();
+        let xyz = cols.map(|c| csv.number(*line, cells, c).map_err(|e| errs.push(e)).ok());
+        if let Some(i) = &i {
+            if let Some(first) = seen.insert(i.clone(), *line) {
+                errs.push(TableError::Duplicate {
+                    id: i.clone(),
+                    first: format!("{file}:{first}"),
+                    second: format!("{file}:{line}"),
+                });
+            }
         }
-        let p = Vector3::new(
-            csv.number(*line, cells, cols[0])?,
-            csv.number(*line, cells, cols[1])?,
-            csv.number(*line, cells, cols[2])?,
-        );
-        rows.push((i, p, format!("{file}:{line}")));
+        match (i, xyz) {
+            (Some(i), [Some(x), Some(y), Some(z)]) if errs.is_empty() => {
+                rows.push((i, Vector3::new(x, y, z), format!("{file}:{line}")))
+            }
+            _ => bad.extend(errs),
+        }
     }
+    bad.sort_by_key(line_of);
+    all_rows(bad)?;
     Ok(PointTable {
         file: file.into(),
         rows,
@@ -265,7 +365,8 @@ pub fn parse_point_table(
 /// Reads observation files (`id,u_px,v_px`), in order. An id may appear once over all files.
 ///
 /// # Errors
-/// [`TableError`] naming file:line and the column; a duplicate id names both places.
+/// [`TableError`] naming file:line and the column; a duplicate id names both places. Every bad
+/// row of every file is listed in one [`TableError::Rows`] (a single one as itself).
 pub fn read_observations(paths: &[&Path]) -> Result<Observations, TableError> {
     with_texts(paths, parse_observations)
 }
@@ -293,26 +394,41 @@ fn with_texts<T>(
 pub fn parse_observations(texts: &[(&str, &str)]) -> Result<Observations, TableError> {
     let mut rows = Vec::new();
     let mut seen: BTreeMap<String, String> = BTreeMap::new();
+    // every bad row of every file, files in order, lines in order within a file
+    let mut bad = Vec::new();
     for (text, file) in texts {
-        let csv = parse_csv(text, file)?;
+        let mut csv = parse_csv(text, file)?;
         let expected = "id,u_px,v_px";
         let id = csv.column("id", expected)?;
         let cu = csv.column("u_px", expected)?;
         let cv = csv.column("v_px", expected)?;
+        let mut in_file = std::mem::take(&mut csv.bad);
         for (line, cells) in &csv.rows {
-            let i = csv.id(*line, cells, id)?;
+            let mut errs = Vec::new();
+            let i = csv.id(*line, cells, id).map_err(|e| errs.push(e)).ok();
+            let u = csv.number(*line, cells, cu).map_err(|e| errs.push(e)).ok();
+            let v = csv.number(*line, cells, cv).map_err(|e| errs.push(e)).ok();
             let origin = format!("{file}:{line}");
-            if let Some(first) = seen.insert(i.clone(), origin.clone()) {
-                return Err(TableError::Duplicate {
-                    id: i,
-                    first,
-                    second: origin,
-                });
+            if let Some(i) = &i {
+                if let Some(first) = seen.insert(i.clone(), origin.clone()) {
+                    errs.push(TableError::Duplicate {
+                        id: i.clone(),
+                        first,
+                        second: origin.clone(),
+                    });
+                }
             }
-            let uv = Vector2::new(csv.number(*line, cells, cu)?, csv.number(*line, cells, cv)?);
-            rows.push((i, uv, origin));
+            match (i, u, v) {
+                (Some(i), Some(u), Some(v)) if errs.is_empty() => {
+                    rows.push((i, Vector2::new(u, v), origin))
+                }
+                _ => in_file.extend(errs),
+            }
         }
+        in_file.sort_by_key(line_of);
+        bad.extend(in_file);
     }
+    all_rows(bad)?;
     Ok(Observations { rows })
 }
 
@@ -377,7 +493,8 @@ pub fn read_capture_plan(path: &Path) -> Result<CapturePlan, TableError> {
 /// # Errors
 /// As [`read_capture_plan`].
 pub fn parse_capture_plan(text: &str, file: &str) -> Result<CapturePlan, TableError> {
-    let csv = parse_csv(text, file)?;
+    let mut csv = parse_csv(text, file)?;
+    all_rows(std::mem::take(&mut csv.bad))?;
     let expected = "capture,id,ring";
     let cc = csv.column("capture", expected)?;
     let ci = csv.column("id", expected)?;

@@ -1142,12 +1142,19 @@ impl Design {
             let Err(e) = serde_json::from_value::<Design>(v) else {
                 continue;
             };
-            let at = source
-                .and_then(|(text, origin)| {
-                    preset_value_location(text, preset, path).map(|(l, c)| format!("{origin}:{l}:{c}: "))
-                })
-                .unwrap_or_default();
-            let shown = crate::error::compact_numbers(&value.to_string());
+            let located = source.and_then(|(text, origin)| {
+                let (l, c) = preset_value_location(text, preset, path)?;
+                Some((format!("{origin}:{l}:{c}: "), written_scalar(text, l, c)))
+            });
+            // the value as written where it is found (2^64 reads back as a float)
+            let (at, shown) = match located {
+                Some((at, Some(written))) => (at, written),
+                Some((at, None)) => (at, crate::error::compact_numbers(&value.to_string())),
+                None => (
+                    String::new(),
+                    crate::error::compact_numbers(&value.to_string()),
+                ),
+            };
             lines.push(format!("{at}presets.{preset}: {path} = {shown}: {e}"));
         }
         (!lines.is_empty()).then(|| lines.join("\n"))
@@ -1346,6 +1353,18 @@ pub fn yaml_location(text: &str, path: &str) -> Option<(u64, u64)> {
         };
     }
     Some((cur.referenced.line(), cur.referenced.column()))
+}
+
+/// The plain scalar that starts at `line`, `column` (from 1) of `text`, as written: up to the
+/// end of the line or a comment; `None` for a quoted, flow or block value.
+fn written_scalar(text: &str, line: u64, column: u64) -> Option<String> {
+    let l = text.lines().nth(usize::try_from(line).ok()?.checked_sub(1)?)?;
+    let rest = l.get(usize::try_from(column).ok()?.checked_sub(1)?..)?;
+    let scalar = rest.split(" #").next()?.trim_end();
+    let plain = !scalar.is_empty()
+        && !scalar.starts_with(['"', '\'', '[', '{', '|', '>', '&', '*', '!'])
+        && !scalar.contains(": ");
+    plain.then(|| scalar.to_string())
 }
 
 /// Line and column (from 1) in `text` of the value that preset `preset` gives parameter `path`

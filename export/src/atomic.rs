@@ -387,6 +387,27 @@ pub(crate) fn sync_dir(dir: &Path) -> Result<(), ExportError> {
     Ok(())
 }
 
+/// Checks `out_dir` as an output folder before any work is done, creating nothing: it must
+/// have a final name (not `/` or `..`), its nearest existing ancestor must be a folder, and it
+/// must be missing, an empty folder, or an earlier fabkit output (the rules [`StagedDir::new`]
+/// and [`crate::write_kit`] apply when they write it). A command runs this first, so that a
+/// folder it would refuse is refused before building or rendering for seconds.
+///
+/// # Errors
+/// [`ExportError::InvalidOutDir`], [`ExportError::NotADirectory`],
+/// [`ExportError::ForeignDirectory`], [`ExportError::Io`].
+pub fn check_out_dir(out_dir: &Path) -> Result<(), ExportError> {
+    let (parent, _) = split(out_dir)?;
+    if let Some(existing) = parent.ancestors().find(|a| fs::symlink_metadata(a).is_ok()) {
+        if !existing.is_dir() {
+            return Err(ExportError::NotADirectory {
+                path: existing.to_path_buf(),
+            });
+        }
+    }
+    inspect_existing(out_dir).map(|_| ())
+}
+
 /// (parent directory, final name) of `out_dir`; an empty parent means the current directory.
 fn split(out_dir: &Path) -> Result<(PathBuf, OsString), ExportError> {
     let name = out_dir

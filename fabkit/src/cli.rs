@@ -491,6 +491,8 @@ fn export(args: ExportArgs) -> Result<(), Box<dyn Error>> {
         .out
         .clone()
         .unwrap_or_else(|| Path::new("out").join(&loaded.design.name));
+    // The output folder is checked before anything is built.
+    fabkit_export::check_out_dir(&out)?;
     check_replacing(&out, &loaded.design.name, tol, args.force)?;
     if let Some(csg) = &args.csg {
         check_csg_path(csg)?;

@@ -76,6 +76,8 @@ pub fn run(args: FixturesArgs) -> Result<(), Box<dyn Error>> {
         .out
         .clone()
         .unwrap_or_else(|| Path::new("out").join(format!("{}_fixtures", loaded.design.name)));
+    // The output folder is checked before anything is built, as `fabkit export` checks it.
+    fabkit_export::check_out_dir(&out)?;
     let provenance =
         fabkit_fixtures::provenance(&loaded.design.name, &loaded.source, &loaded.sha256);
     if let Some(csg) = &args.csg {

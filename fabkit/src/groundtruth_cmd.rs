@@ -48,8 +48,9 @@ pub struct GroundTruthArgs {
     /// Apply one of the design's presets.
     #[arg(long)]
     preset: Option<String>,
-    /// Largest camera image, pixels (width x height; 1 to 268435456): every per-pixel array of
-    /// a frame (rays, hits, depth maps) is sized by it.
+    /// Largest camera image, pixels (width x height; 1 to 4194304, what the render's memory
+    /// budget of 2 GiB holds): every per-pixel array of a frame (rays, hits, depth maps, the
+    /// files of a frame) is sized by it.
     #[arg(long, value_name = "N", default_value_t = DEFAULT_MAX_PIXELS,
           value_parser = parse_max_pixels, allow_negative_numbers = true)]
     max_pixels: u64,
@@ -96,19 +97,60 @@ fn parse_max_output_bytes(s: &str) -> Result<u64, String> {
     }
 }
 
-/// Default bound of `--max-pixels`: 4096 x 4096 (a 4K camera has 8.3 million pixels).
-const DEFAULT_MAX_PIXELS: u64 = 4096 * 4096;
-/// Largest `--max-pixels`: 16384 x 16384, the largest camera image a camera file may give.
-const MAX_PIXELS_LIMIT: u64 = 16384 * 16384;
+/// Memory the render may take, bytes: 2 GiB. Every per-pixel buffer of a run is estimated
+/// ([`render_memory`]) and a camera image whose render would need more is refused before
+/// anything is allocated; configurations are rendered as many at a time as fit in it.
+pub const MEMORY_BUDGET_BYTES: u64 = 2 << 30;
+
+/// Bytes per pixel that stay allocated while the configurations are rendered: the rays
+/// (sensor-frame directions and camera-frame bearings, 48), the reference hits (range, normal,
+/// contact, exit: 41) and the reference frame (range, z-depth, point, normal, contact: 65),
+/// rounded up; the rays' construction briefly holds them twice (+48), before any frame.
+pub const FIXED_BYTES_PER_PIXEL: u64 = 160;
+
+/// Bytes per pixel of one frame being rendered and encoded: its hits (41) and depth frame
+/// (65), the differences to the reference (16, twice), the float32 arrays, the 16-bit and
+/// preview PNGs, the normals, the PLY points and their encoded bytes (about 130 at the peak),
+/// and the PNG and deflate encoders' working copies, rounded up.
+pub const FRAME_BYTES_PER_PIXEL: u64 = 320;
+
+/// Bytes besides the per-pixel buffers: the program, thread stacks, the fixtures and the
+/// manifest.
+pub const BASE_MEMORY_BYTES: u64 = 128 << 20;
+
+/// Largest `--max-pixels`: the largest image whose render, one frame at a time, fits in
+/// [`MEMORY_BUDGET_BYTES`] (4194304 = 2048 x 2048; a 2 MP camera, 1920 x 1080, and a
+/// 2048 x 1536 one fit).
+pub const MAX_PIXELS_LIMIT: u64 = 2048 * 2048;
+
+/// Default bound of `--max-pixels`: its largest value.
+const DEFAULT_MAX_PIXELS: u64 = MAX_PIXELS_LIMIT;
+
+/// Memory a render of `pixels` pixels takes with `frames_at_once` frames rendered at a time,
+/// bytes (an upper bound; see [`FIXED_BYTES_PER_PIXEL`], [`FRAME_BYTES_PER_PIXEL`]).
+pub fn render_memory(pixels: u64, frames_at_once: u64) -> u64 {
+    pixels
+        .saturating_mul(
+            FIXED_BYTES_PER_PIXEL
+                .saturating_add(FRAME_BYTES_PER_PIXEL.saturating_mul(frames_at_once)),
+        )
+        .saturating_add(BASE_MEMORY_BYTES)
+}
 
 fn parse_max_pixels(s: &str) -> Result<u64, String> {
     match s.trim().parse::<u64>() {
         Ok(n) if (1..=MAX_PIXELS_LIMIT).contains(&n) => Ok(n),
         _ => Err(format!(
-            "must be a whole number of pixels from 1 to {MAX_PIXELS_LIMIT} (16384 x 16384)"
+            "must be a whole number of pixels from 1 to {MAX_PIXELS_LIMIT} (2048 x 2048, what the \
+             render's memory budget of {} GiB holds)",
+            MEMORY_BUDGET_BYTES >> 30
         )),
     }
 }
+
+/// Smallest fraction of the image's pixels that must see the skin: a camera that sees less
+/// (focal length, principal point or pose far off) would give a dataset of empty maps.
+pub const MIN_SKIN_FRACTION: f64 = 0.01;
 
 /// 16-bit PNG encodings: depth in micrometres; differences offset by 32768 counts.
 const DEPTH_PNG: Png16Encoding = Png16Encoding {
@@ -426,8 +468,71 @@ fn free_bytes(out: &std::path::Path) -> Option<u64> {
     }
 }
 
+/// How many frames of `pixels` pixels to render at a time: at most `threads`, and as many as
+/// fit in [`MEMORY_BUDGET_BYTES`] besides the fixed buffers (at least 1: `--max-pixels`
+/// guarantees that one fits).
+pub fn frames_at_once(pixels: u64, threads: u64) -> usize {
+    let fit = (1..=threads.max(1))
+        .take_while(|&k| render_memory(pixels, k) <= MEMORY_BUDGET_BYTES)
+        .last()
+        .unwrap_or(1);
+    fit as usize
+}
+
+/// Checks that the camera sees the skin in at least [`MIN_SKIN_FRACTION`] of its pixels.
+/// `seen` pixels see it; `file` and `text` are the camera file's name and text (its form names
+/// the fields in the error), `pose` the extrinsics file.
+///
+/// # Errors
+/// Naming the camera file, the pixels seen, the rule, and the camera file's fields as it names
+/// them (`camera_matrix` of an OpenCV or ROS file, `fx_px`... of a fabkit JSON file) with
+/// their values in scientific notation where long.
+pub fn check_skin_seen(
+    seen: usize,
+    camera: &fabkit_calibration::CameraModel,
+    file: &str,
+    text: &str,
+    pose: &str,
+) -> Result<(), String> {
+    let i = camera.intrinsics();
+    let pixels = u64::from(i.image_width_px) * u64::from(i.image_height_px);
+    let needed = (MIN_SKIN_FRACTION * pixels as f64).ceil().max(1.0) as u64;
+    if seen as u64 >= needed {
+        return Ok(());
+    }
+    let v = fabkit_calibration::shown_f64;
+    let fields = match fabkit_calibration::refine::refined_camera_file(text).1 {
+        fabkit_calibration::CameraFileFormat::Json => format!(
+            "fx_px = {}, fy_px = {}, cx_px = {}, cy_px = {}",
+            v(i.fx_px),
+            v(i.fy_px),
+            v(i.cx_px),
+            v(i.cy_px)
+        ),
+        _ => format!(
+            "camera_matrix: fx = {}, fy = {}, cx = {}, cy = {}",
+            v(i.fx_px),
+            v(i.fy_px),
+            v(i.cx_px),
+            v(i.cy_px)
+        ),
+    };
+    Err(format!(
+        "{file}: {fields} px, image {} x {} px: the camera sees the skin in {seen} of its {pixels} pixels, \
+         fewer than the {needed} ({}% of the image) ground truth needs (hint: check the focal \
+         lengths and the principal point against the image size, the distortion model, and that \
+         {pose} (T_cam_sensor) points the camera at the skin)",
+        i.image_width_px,
+        i.image_height_px,
+        MIN_SKIN_FRACTION * 100.0
+    ))
+}
+
 pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
     let t0 = std::time::Instant::now();
+    // The output folder is checked before anything is read or rendered, as `fabkit export`
+    // checks it.
+    fabkit_export::check_out_dir(&args.out)?;
     let mut loaded = load_design(args.design.as_deref(), &args.data_files)?;
     if let Some(p) = &args.preset {
         loaded.apply_preset(p)?;
@@ -439,17 +544,30 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
         camera.intrinsics().image_height_px,
     );
     let pixels = u64::from(cw) * u64::from(ch);
+    // The memory of every per-pixel buffer is bounded before any is allocated.
     if pixels > args.max_pixels {
+        let remedy = if args.max_pixels < MAX_PIXELS_LIMIT {
+            format!("raise the limit with --max-pixels, up to {MAX_PIXELS_LIMIT}")
+        } else {
+            format!(
+                "--max-pixels is at its largest value, what the render's memory budget of {} GiB \
+                 holds (about {} bytes a pixel)",
+                MEMORY_BUDGET_BYTES >> 30,
+                FIXED_BYTES_PER_PIXEL + FRAME_BYTES_PER_PIXEL
+            )
+        };
         return Err(format!(
             "{}: the camera image is {cw} x {ch} = {pixels} pixels, over the ground-truth limit of \
-             {} pixels (every per-pixel array of a frame is sized by it; raise the limit with \
-             --max-pixels, up to {MAX_PIXELS_LIMIT})",
+             {} pixels (image_width x image_height against --max-pixels; the render would need \
+             about {} of memory, every per-pixel array of a frame being sized by it; {remedy}; \
+             hint: calibrate the camera at a lower resolution or crop its image)",
             args.camera.display(),
-            args.max_pixels
+            args.max_pixels,
+            shown_bytes(render_memory(pixels, 1)),
         )
         .into());
     }
-    let (_, camera_sha) = read_with_hash(&args.camera)?;
+    let (camera_bytes, camera_sha) = read_with_hash(&args.camera)?;
     let (t_cam_sensor, extrinsics_sha) = read_extrinsics(&args.extrinsics)?;
     let fixtures = read_fixtures(&args.fixtures, &design.name)?;
     let (fixture_kind, surface_text) = if design.body.flat_outline().is_some() {
@@ -519,6 +637,15 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
             .into());
         }
     }
+    // A camera that sees (almost) none of the skin is refused before anything is written.
+    let ref_hits = reference_hits(&rays, &surface);
+    check_skin_seen(
+        ref_hits.valid_count(),
+        &camera,
+        &args.camera.display().to_string(),
+        &String::from_utf8_lossy(&camera_bytes),
+        &pose_name,
+    )?;
     let frames = n_cfg as u64 + 1;
     let bar = crate::progress::Progress::new(
         "groundtruth",
@@ -533,7 +660,6 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
     );
 
     let staged = StagedDir::new(&args.out)?;
-    let ref_hits = reference_hits(&rays, &surface);
     let reference = DepthFrame::new(&rays, &ref_hits);
     let preview = finite_range(&reference.range_mm)
         .into_iter()
@@ -573,41 +699,54 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
     )?;
     bar.set(1, frames);
 
-    // Configurations in parallel; each writes its own folder. Entries are kept in index order.
+    // Configurations in parallel, as many at a time as the memory budget holds; each writes
+    // its own folder. Entries are kept in index order.
+    let at_once = frames_at_once(w as u64 * h as u64, rayon::current_num_threads() as u64);
     let done = AtomicUsize::new(0);
+    let render = |cfg: &Configuration| -> Result<(Value, Written), String> {
+        let hits = indented_hits(&rays, &ref_hits, &cfg.primitives, surface.base_z_mm());
+        let frame = DepthFrame::new(&rays, &hits);
+        let files = frame_files(
+            &cfg.name,
+            &frame,
+            Some(&reference),
+            preview,
+            &provenance,
+            args.format,
+        )
+        .map_err(|e| e.to_string())?;
+        let mut entries = Vec::new();
+        let mut list = Vec::new();
+        for (rel, bytes, mut e) in files {
+            staged.write(&rel, &bytes).map_err(|e| e.to_string())?;
+            let sha = sha256_hex(&bytes);
+            e["sha256"] = json!(sha);
+            list.push((rel, sha, bytes.len()));
+            entries.push(e);
+        }
+        let contact = (0..w * h)
+            .filter(|&p| frame.contact[p] && reference.range_mm[p].is_finite())
+            .count();
+        let (dr, _) = frame.delta(&reference);
+        let deepest = finite_range(&dr).map(|x| -x.0).unwrap_or(0.0).max(0.0);
+        let k = done.fetch_add(1, Ordering::Relaxed) + 2;
+        bar.set(k as u64, frames);
+        Ok((
+            json!({
+                "name": cfg.name, "dir": cfg.name, "pattern": cfg.pattern, "orientation_deg": cfg.orientation_deg,
+                "pattern_side": if cfg.orientation_deg == 0 { "+x (right_mask.png)" } else { "-x (left_mask.png)" },
+                "fixture_description": {"file": cfg.description_file, "sha256": cfg.description_sha256},
+                "primitives": cfg.geometry.primitives.len(),
+                "contact_pixels": contact, "max_range_decrease_mm": deepest,
+                "files": entries,
+            }),
+            list,
+        ))
+    };
     let rendered: Vec<Result<(Value, Written), String>> = fixtures
         .configurations
-        .par_iter()
-        .map(|cfg: &Configuration| {
-            let hits = indented_hits(&rays, &ref_hits, &cfg.primitives, surface.base_z_mm());
-            let frame = DepthFrame::new(&rays, &hits);
-            let files = frame_files(&cfg.name, &frame, Some(&reference), preview, &provenance, args.format).map_err(|e| e.to_string())?;
-            let mut entries = Vec::new();
-            let mut list = Vec::new();
-            for (rel, bytes, mut e) in files {
-                staged.write(&rel, &bytes).map_err(|e| e.to_string())?;
-                let sha = sha256_hex(&bytes);
-                e["sha256"] = json!(sha);
-                list.push((rel, sha, bytes.len()));
-                entries.push(e);
-            }
-            let contact = (0..w * h).filter(|&p| frame.contact[p] && reference.range_mm[p].is_finite()).count();
-            let (dr, _) = frame.delta(&reference);
-            let deepest = finite_range(&dr).map(|x| -x.0).unwrap_or(0.0).max(0.0);
-            let k = done.fetch_add(1, Ordering::Relaxed) + 2;
-            bar.set(k as u64, frames);
-            Ok((
-                json!({
-                    "name": cfg.name, "dir": cfg.name, "pattern": cfg.pattern, "orientation_deg": cfg.orientation_deg,
-                    "pattern_side": if cfg.orientation_deg == 0 { "+x (right_mask.png)" } else { "-x (left_mask.png)" },
-                    "fixture_description": {"file": cfg.description_file, "sha256": cfg.description_sha256},
-                    "primitives": cfg.geometry.primitives.len(),
-                    "contact_pixels": contact, "max_range_decrease_mm": deepest,
-                    "files": entries,
-                }),
-                list,
-            ))
-        })
+        .chunks(at_once)
+        .flat_map(|chunk| chunk.par_iter().map(&render).collect::<Vec<_>>())
         .collect();
     let mut cfg_entries = Vec::new();
     for r in rendered {

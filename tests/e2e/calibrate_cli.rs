@@ -270,7 +270,7 @@ fn bad_inputs_exit_2_with_file_line_and_write_nothing() {
         (
             "outside the lens",
             observe(false, 0..29).replacen("\n5,", "\n5,9000,9000\n#", 1),
-            "id 5 (obs.csv:7): point 5: pixel (9000, 9000): outside the lens's field",
+            "cam.yaml: the image is 640 x 480 px (u from -0.5 to 639.5 px, v from -0.5 to 479.5 px, pixel (0, 0) the centre of the top-left pixel), but this observation is outside it:\nobs.csv:7: id 5: u_px = 9000, v_px = 9000",
         ),
     ];
     for (what, obs, expect) in cases {
@@ -758,4 +758,89 @@ fn camera_model_option_bad_value_mismatch_and_hint() {
     assert_eq!(hinted["distortion_model"], "fisheye");
     assert_eq!(hinted["rvec"], named["rvec"]);
     assert_eq!(hinted["tvec_mm"], named["tvec_mm"]);
+}
+
+/// Observations outside the camera file's image are an error listing every such row (a
+/// 1 x 1 px camera file took observations at u 183-465 px and exited 0), and a table with a
+/// NaN row and other bad rows lists them all (the NaN row alone was listed).
+#[test]
+fn observations_outside_the_image_and_every_bad_row_are_listed() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let mut one = intrinsics();
+    (
+        one.image_width_px,
+        one.image_height_px,
+        one.cx_px,
+        one.cy_px,
+    ) = (1, 1, 0.0, 0.0);
+    std::fs::write(
+        dir.join("one.yaml"),
+        write_camera(&one, CameraFileFormat::OpenCvYaml),
+    )
+    .unwrap();
+    write_table(&dir.join("pins.csv"));
+    let obs = observe(false, 0..29);
+    std::fs::write(dir.join("obs.csv"), &obs).unwrap();
+    let calibrate = |camera: &str| {
+        run(
+            dir,
+            &[
+                "calibrate",
+                "extrinsics",
+                "--camera",
+                camera,
+                "--points",
+                "pins.csv",
+                "--observations",
+                "obs.csv",
+                "--out",
+                "out",
+            ],
+            &[],
+        )
+    };
+    let o = calibrate("one.yaml");
+    let e = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(
+        e.contains("one.yaml: the image is 1 x 1 px (u from -0.5 to 0.5 px, v from -0.5 to 0.5 px, pixel (0, 0) the centre of the top-left pixel), but these 29 observations are outside it:"),
+        "{e}"
+    );
+    // every row by file:line and id, the first 20 listed and the rest counted
+    for (k, line) in obs.lines().skip(1).take(20).enumerate() {
+        let mut cells = line.split(',');
+        let (id, u) = (cells.next().unwrap(), cells.next().unwrap());
+        assert!(
+            e.contains(&format!("obs.csv:{}: id {id}: u_px = {u}, v_px = ", k + 2)),
+            "{line}: {e}"
+        );
+    }
+    assert!(e.contains("and 9 more rows"), "{e}");
+    assert!(!dir.join("out").exists());
+    // within a 640 x 480 image the same observations solve
+    std::fs::write(
+        dir.join("cam.yaml"),
+        write_camera(&intrinsics(), CameraFileFormat::OpenCvYaml),
+    )
+    .unwrap();
+    let o = calibrate("cam.yaml");
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    std::fs::remove_dir_all(dir.join("out")).unwrap();
+    // a NaN row and other bad rows: all listed, in line order
+    let bad = obs
+        .replacen("\n3,", "\n3,NaN,1\n#", 1)
+        .replacen("\n5,", "\n5,abc,1\n#", 1)
+        .replacen("\n7,", "\n7,1\n#", 1);
+    std::fs::write(dir.join("obs.csv"), bad).unwrap();
+    let o = calibrate("cam.yaml");
+    let e = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(
+        e.contains(
+            "obs.csv:5: u_px = NaN: must be finite\nobs.csv:8: u_px = abc: must be a number\nobs.csv:11: 2 cells but the header has 3 columns"
+        ),
+        "{e}"
+    );
+    assert!(!dir.join("out").exists());
 }

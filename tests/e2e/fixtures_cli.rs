@@ -349,3 +349,52 @@ fn bad_fixture_parameters_name_the_parameter_and_write_nothing() {
         assert!(!tmp.path().join("never").exists());
     }
 }
+
+/// The output folder is checked before anything is built, as `fabkit export` checks it:
+/// `--out /` and a folder of the user's own files are refused first, even for fixtures the
+/// triangle bound would refuse (`fixtures --out /` built for seconds before refusing it).
+#[test]
+fn fixtures_and_export_refuse_an_unusable_out_folder_before_building() {
+    let tmp = tempfile::tempdir().unwrap();
+    std::fs::create_dir(tmp.path().join("mine")).unwrap();
+    std::fs::write(tmp.path().join("mine/notes.txt"), "mine").unwrap();
+    for (out, want) in [
+        ("/", "output directory /: has no final directory name"),
+        (
+            "mine",
+            "output directory mine is not a folder fabkit wrote: `notes.txt`",
+        ),
+    ] {
+        // refused by the triangle bound were the folder checked later
+        let fixtures = [
+            "fixtures",
+            "--semidomes",
+            "100",
+            "--chord-tolerance-mm",
+            "0.001",
+            "--out",
+            out,
+        ];
+        let export = [
+            "export",
+            "shadowtac",
+            "--max-triangles",
+            "100000",
+            "--out",
+            out,
+        ];
+        for args in [&fixtures[..], &export[..]] {
+            let o = run(tmp.path(), args, &[]);
+            assert_eq!(o.status.code(), Some(2), "{args:?}");
+            let e = text(&o.stderr);
+            assert!(
+                e.contains(want) && !e.contains("triangles"),
+                "{args:?}: {e}"
+            );
+        }
+    }
+    assert_eq!(
+        std::fs::read_to_string(tmp.path().join("mine/notes.txt")).unwrap(),
+        "mine"
+    );
+}

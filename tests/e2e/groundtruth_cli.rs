@@ -375,12 +375,13 @@ fn bad_inputs_name_the_file_and_the_rule_and_write_nothing() {
         "{}",
         text(&o.stderr)
     );
-    for bad in ["0", "-1", "268435457", "lots"] {
+    for bad in ["0", "-1", "4194305", "268435456", "lots"] {
         let o = groundtruth("cam.yaml", &["--max-pixels", bad]);
         assert_eq!(o.status.code(), Some(2), "{bad}");
         assert!(
             text(&o.stderr).contains(&format!("invalid value '{bad}' for '--max-pixels"))
-                && text(&o.stderr).contains("must be a whole number of pixels from 1 to 268435456"),
+                && text(&o.stderr)
+                    .contains("must be a whole number of pixels from 1 to 4194304 (2048 x 2048"),
             "{bad}: {}",
             text(&o.stderr)
         );
@@ -563,4 +564,290 @@ print("ok")
         "{}",
         text(&o.stderr)
     );
+}
+
+/// The raster memory is bounded before anything is allocated: an 8192 x 8192 or a
+/// 16384 x 16384 camera with `--max-pixels` at its largest value, run under a 2 GB
+/// address-space limit, exits 2 naming `--max-pixels` and the camera file's image size (the
+/// 8192 x 8192 camera aborted on allocation: the limit let 16384 x 16384 through), and leaves
+/// no output folder or temporary sibling behind. The largest `--max-pixels` is what the stated
+/// memory budget holds; the old largest value is refused.
+#[test]
+fn a_camera_past_the_memory_budget_is_refused_before_allocating_under_a_2_gb_limit() {
+    use fabkit::groundtruth_cmd::{render_memory, MAX_PIXELS_LIMIT, MEMORY_BUDGET_BYTES};
+    assert!(render_memory(MAX_PIXELS_LIMIT, 1) <= MEMORY_BUDGET_BYTES);
+    assert!(render_memory(MAX_PIXELS_LIMIT + 1, 1) > MEMORY_BUDGET_BYTES);
+    let d = tempfile::tempdir().unwrap();
+    std::fs::write(
+        d.path().join("extrinsics.json"),
+        r#"{"rvec": [0, 0, 0], "tvec_mm": [0, 0, 10]}"#,
+    )
+    .unwrap();
+    let max = MAX_PIXELS_LIMIT.to_string();
+    for side in [8192u32, 16384] {
+        let mut i = benchmark_intrinsics();
+        (i.image_width_px, i.image_height_px) = (side, side);
+        (i.cx_px, i.cy_px) = (side as f64 / 2.0 - 0.5, side as f64 / 2.0 - 0.5);
+        let cam = format!("cam{side}.yaml");
+        std::fs::write(
+            d.path().join(&cam),
+            write_camera(&i, CameraFileFormat::OpenCvYaml),
+        )
+        .unwrap();
+        let o = std::process::Command::new("bash")
+            .current_dir(d.path())
+            .arg("-c")
+            .arg("ulimit -v 2000000 && exec \"$@\"")
+            .arg("bash")
+            .arg(env!("CARGO_BIN_EXE_fabkit"))
+            .args([
+                "groundtruth",
+                "rtac0",
+                "--camera",
+                &cam,
+                "--extrinsics",
+                "extrinsics.json",
+                "--fixtures",
+                "fx",
+                "--out",
+                "gt",
+                "--max-pixels",
+                &max,
+            ])
+            .output()
+            .unwrap();
+        let e = text(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{side}: {e}");
+        let px = u64::from(side) * u64::from(side);
+        assert!(
+            e.contains(&format!(
+                "{cam}: the camera image is {side} x {side} = {px} pixels, over the ground-truth limit of {max} pixels (image_width x image_height against --max-pixels"
+            )) && e.contains("--max-pixels is at its largest value, what the render's memory budget of 2 GiB holds"),
+            "{side}: {e}"
+        );
+        assert!(
+            !e.contains("panicked") && !e.contains("memory allocation"),
+            "{e}"
+        );
+        let left: Vec<_> = std::fs::read_dir(d.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .filter(|n| n.contains("gt"))
+            .collect();
+        assert!(left.is_empty(), "{side}: {left:?}");
+    }
+    // the old largest value, 16384 x 16384, is past the budget
+    let o = run(
+        d.path(),
+        &[
+            "groundtruth",
+            "--camera",
+            "cam8192.yaml",
+            "--extrinsics",
+            "extrinsics.json",
+            "--fixtures",
+            "fx",
+            "--out",
+            "gt",
+            "--max-pixels",
+            "268435456",
+        ],
+        &[],
+    );
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        text(&o.stderr).contains("invalid value '268435456' for '--max-pixels")
+            && text(&o.stderr).contains(&format!(
+                "must be a whole number of pixels from 1 to {MAX_PIXELS_LIMIT} (2048 x 2048, what the render's memory budget of 2 GiB holds)"
+            )),
+        "{}",
+        text(&o.stderr)
+    );
+}
+
+/// A camera that sees (almost) none of the skin is refused before anything is written, naming
+/// the camera file's fields as the file names them; focal lengths and principal points far
+/// outside any camera are refused when the file is read (fx = 5e-324 px, fx = 1e300 px and
+/// cx = 1e300 px exited 0 with a dataset of 0 or 1 skin pixels).
+#[test]
+fn a_camera_that_sees_too_little_of_the_skin_is_refused_naming_its_fields() {
+    let d = tempfile::tempdir().unwrap();
+    setup(d.path());
+    let gt = |camera: &str| {
+        run(
+            d.path(),
+            &[
+                "groundtruth",
+                "rtac0",
+                "--camera",
+                camera,
+                "--extrinsics",
+                "extrinsics.json",
+                "--fixtures",
+                "fx",
+                "--out",
+                "gt",
+            ],
+            &[],
+        )
+    };
+    type Set = fn(&mut fabkit_calibration::Intrinsics);
+    let cases: [(Set, CameraFileFormat, &str); 4] = [
+        (
+            |i| i.fx_px = 5e-324,
+            CameraFileFormat::OpenCvYaml,
+            "fx_px = 5e-324: must be from 1 to 1e6 px",
+        ),
+        (
+            |i| i.fx_px = 1e300,
+            CameraFileFormat::Json,
+            "fx_px = 1e300: must be from 1 to 1e6 px",
+        ),
+        (
+            |i| i.cx_px = 1e300,
+            CameraFileFormat::RosYaml,
+            "cx_px = 1e300: the principal point must lie within the image",
+        ),
+        (
+            |i| i.cy_px = -1e300,
+            CameraFileFormat::OpenCvXml,
+            "cy_px = -1e300: the principal point must lie within the image",
+        ),
+    ];
+    for (k, (set, form, want)) in cases.into_iter().enumerate() {
+        let mut i = benchmark_intrinsics();
+        set(&mut i);
+        let name = format!("bad{k}.cam");
+        std::fs::write(d.path().join(&name), write_camera(&i, form)).unwrap();
+        let o = gt(&name);
+        let e = text(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{want}: {e}");
+        assert!(e.contains(&name) && e.contains(want), "{want}: {e}");
+        assert!(e.len() < 1000, "{e}");
+    }
+    // Within the bounds but seeing (almost) none of the skin: a 1 px focal length puts all but
+    // a few central pixels beyond the lens's field; the fields are named as each form names
+    // them.
+    let mut i = benchmark_intrinsics();
+    (i.fx_px, i.fy_px) = (1.0, 1.0);
+    for (name, form, fields) in [
+        (
+            "blind.yaml",
+            CameraFileFormat::OpenCvYaml,
+            "camera_matrix: fx = 1, fy = 1, cx = 319.5, cy = 239.5 px",
+        ),
+        (
+            "blind.json",
+            CameraFileFormat::Json,
+            "fx_px = 1, fy_px = 1, cx_px = 319.5, cy_px = 239.5 px",
+        ),
+    ] {
+        std::fs::write(d.path().join(name), write_camera(&i, form)).unwrap();
+        let o = gt(name);
+        let e = text(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{e}");
+        assert!(
+            e.contains(&format!(
+                "{name}: {fields}, image 640 x 480 px: the camera sees the skin in "
+            )) && e.contains(
+                " of its 307200 pixels, fewer than the 3072 (1% of the image) ground truth needs"
+            ) && !e.contains("rendering"),
+            "{e}"
+        );
+    }
+    assert!(!d.path().join("gt").exists());
+    // the legitimate camera sees far more than the bound (the manifest counts its pixels)
+    let o = gt("cam.yaml");
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let m: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.path().join("gt/manifest.json")).unwrap()).unwrap();
+    let seen = m["image"]["pixels_on_surface"].as_u64().unwrap();
+    assert!(seen * 100 >= 640 * 480, "{seen}");
+}
+
+/// The output folder is checked before anything is read or rendered: `--out /` and a folder
+/// of the user's own files are refused at once (they were refused only after rendering, for
+/// seconds), before the camera's size is even checked.
+#[test]
+fn groundtruth_refuses_an_unusable_out_folder_before_any_work() {
+    let d = tempfile::tempdir().unwrap();
+    std::fs::create_dir(d.path().join("mine")).unwrap();
+    std::fs::write(d.path().join("mine/notes.txt"), "mine").unwrap();
+    for (out, want) in [
+        ("/", "output directory /: has no final directory name"),
+        (
+            "mine",
+            "output directory mine is not a folder fabkit wrote: `notes.txt`",
+        ),
+    ] {
+        // no camera file, extrinsics or fixtures at all: the folder is refused first
+        let o = run(
+            d.path(),
+            &[
+                "groundtruth",
+                "--camera",
+                "missing.yaml",
+                "--extrinsics",
+                "missing.json",
+                "--fixtures",
+                "missing",
+                "--out",
+                out,
+            ],
+            &[],
+        );
+        assert_eq!(o.status.code(), Some(2), "{out}");
+        assert!(text(&o.stderr).contains(want), "{out}: {}", text(&o.stderr));
+    }
+    assert_eq!(
+        std::fs::read_to_string(d.path().join("mine/notes.txt")).unwrap(),
+        "mine"
+    );
+}
+
+/// The memory estimate bounds the render: a 1024 x 1024 camera (4 configurations, 2 frames at
+/// a time) renders under an address-space limit of the estimate (`ulimit -v`).
+#[test]
+fn a_render_fits_in_its_memory_estimate_under_an_address_space_limit() {
+    use fabkit::groundtruth_cmd::{frames_at_once, render_memory};
+    let d = tempfile::tempdir().unwrap();
+    setup(d.path());
+    let mut i = benchmark_intrinsics();
+    (i.image_width_px, i.image_height_px) = (1024, 1024);
+    (i.fx_px, i.fy_px, i.cx_px, i.cy_px) = (344.0, 344.0, 511.5, 511.5);
+    std::fs::write(
+        d.path().join("big.json"),
+        write_camera(&i, CameraFileFormat::Json),
+    )
+    .unwrap();
+    let px = 1024 * 1024;
+    let frames = frames_at_once(px, 2) as u64;
+    assert_eq!(frames, 2);
+    let limit_kb = render_memory(px, frames) / 1024;
+    let o = std::process::Command::new("bash")
+        .current_dir(d.path())
+        .env("RAYON_NUM_THREADS", "2")
+        .arg("-c")
+        .arg(format!("ulimit -v {limit_kb} && exec \"$@\""))
+        .arg("bash")
+        .arg(env!("CARGO_BIN_EXE_fabkit"))
+        .args([
+            "groundtruth",
+            "rtac0",
+            "--camera",
+            "big.json",
+            "--extrinsics",
+            "extrinsics.json",
+            "--fixtures",
+            "fx",
+            "--out",
+            "gt",
+            "--format",
+            "npy",
+            "--yes",
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(d.path().join("gt/manifest.json").exists());
 }

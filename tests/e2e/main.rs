@@ -15,6 +15,7 @@ mod docs;
 mod export_flat;
 mod export_markers;
 mod export_rtac0;
+mod extreme_values;
 mod fixtures_cli;
 mod groundtruth_cli;
 mod groundtruth_flat;

@@ -576,3 +576,35 @@ fn xml_errors_name_file_and_line() {
         "{e}"
     );
 }
+
+/// Every JSON file a user may have written (an editor's "UTF-8 with BOM"): extrinsics.json, a
+/// JSON camera file and the fixtures' protrusion index read as the same file without the byte
+/// order mark (extrinsics.json was refused with "expected value at line 1 column 1").
+#[test]
+fn json_inputs_with_a_byte_order_mark_read_as_without() {
+    use fabkit_calibration::groundtruth::inputs::{read_extrinsics, read_fixtures};
+    let d = tempfile::tempdir().unwrap();
+    let ext = r#"{"rvec": [0.02, -0.015, 0.4], "tvec_mm": [0.3, -0.2, 10.4]}"#;
+    std::fs::write(d.path().join("plain.json"), ext).unwrap();
+    std::fs::write(d.path().join("bom.json"), format!("\u{feff}{ext}")).unwrap();
+    let (plain, _) = read_extrinsics(&d.path().join("plain.json")).unwrap();
+    let (bom, _) = read_extrinsics(&d.path().join("bom.json")).unwrap();
+    assert_eq!(plain, bom);
+    for i in all() {
+        let j = write_camera(&i, CameraFileFormat::Json);
+        let cam = parse_camera(&format!("\u{feff}{j}"), "cam.json").unwrap();
+        assert_eq!(*cam.intrinsics(), i);
+        std::fs::write(d.path().join("cam.json"), format!("\u{feff}{j}")).unwrap();
+        let cam = fabkit_calibration::read_camera_file(&d.path().join("cam.json")).unwrap();
+        assert_eq!(*cam.intrinsics(), i);
+    }
+    // an empty protrusion index with a BOM reads (an error past the BOM would name line 1)
+    std::fs::create_dir_all(d.path().join("fx/protrusions")).unwrap();
+    std::fs::write(
+        d.path().join("fx/protrusions/index.json"),
+        "\u{feff}{\"patterns\": []}",
+    )
+    .unwrap();
+    let f = read_fixtures(&d.path().join("fx"), "rtac0").unwrap();
+    assert!(f.configurations.is_empty());
+}

@@ -153,3 +153,51 @@ proptest! {
         prop_assert!((b - p.normalize()).norm() < 1e-10, "angle {} b {:?} p {:?}", angle, b, p.normalize());
     }
 }
+
+/// Focal lengths and principal points far outside any camera are refused with the field, the
+/// value in scientific notation and the rule (fx = 5e-324 or 1e300 px and cx = 1e300 px were
+/// accepted, and ground truth rendered with 0 or 1 pixels on the skin).
+#[test]
+fn absurd_focal_lengths_and_principal_points_are_refused() {
+    let base = intr(Distortion::Fisheye([0.0; 4]));
+    let cases: [(fn(&mut Intrinsics), &str); 6] = [
+        (
+            |i| i.fx_px = 5e-324,
+            "fx_px = 5e-324: must be from 1 to 1e6 px",
+        ),
+        (
+            |i| i.fx_px = 1e300,
+            "fx_px = 1e300: must be from 1 to 1e6 px",
+        ),
+        (|i| i.fy_px = 0.5, "fy_px = 0.5: must be from 1 to 1e6 px"),
+        (
+            |i| i.cx_px = 1e300,
+            "cx_px = 1e300: the principal point must lie within the image",
+        ),
+        (
+            |i| i.cx_px = -641.0,
+            "cx_px = -641: the principal point must lie within the image",
+        ),
+        (
+            |i| i.cy_px = 961.0,
+            "cy_px = 961: the principal point must lie within the image",
+        ),
+    ];
+    for (set, want) in cases {
+        let mut i = base;
+        set(&mut i);
+        let e = CameraModel::new(i).unwrap_err().to_string();
+        assert!(e.starts_with(want), "{want}: {e}");
+    }
+    // the bounds themselves are accepted
+    for set in [
+        |i: &mut Intrinsics| i.fx_px = 1.0,
+        |i: &mut Intrinsics| i.fy_px = 1e6,
+        |i: &mut Intrinsics| i.cx_px = -640.0,
+        |i: &mut Intrinsics| i.cy_px = 960.0,
+    ] {
+        let mut i = base;
+        set(&mut i);
+        CameraModel::new(i).unwrap();
+    }
+}

@@ -195,3 +195,68 @@ fn tables_with_a_byte_order_mark_read_as_without() {
     let t = parse_point_table(&format!("\u{feff}{FIXTURES}"), "x.csv", PointsFrom::Tip).unwrap();
     assert_eq!(t.rows.len(), 2);
 }
+
+/// A point table or observation file with a NaN row and other bad rows lists every bad row in
+/// one error (the NaN row alone was listed; without it, the first bad row only), in line order.
+#[test]
+fn a_nan_row_and_every_other_bad_row_are_listed_together() {
+    let text =
+        "id,x_mm,y_mm,z_mm\n0,1,2,3\n1,NaN,2,3\n2,1,abc,3\n3,1,2\n,1,2,3\n0,4,5,6\n4,inf,2,-inf\n";
+    let e = parse_point_table(text, "p.csv", PointsFrom::Tip).unwrap_err();
+    assert!(matches!(e, TableError::Rows(_)), "{e:?}");
+    assert_eq!(
+        e.to_string(),
+        "p.csv:3: x_mm = NaN: must be finite\n\
+         p.csv:4: y_mm = abc: must be a number\n\
+         p.csv:5: 3 cells but the header has 4 columns\n\
+         p.csv:6: id = : must not be empty\n\
+         id 0 is given twice: p.csv:2 and p.csv:7\n\
+         p.csv:8: x_mm = inf: must be finite\n\
+         p.csv:8: z_mm = -inf: must be finite"
+    );
+    let e = parse_observations(&[
+        ("id,u_px,v_px\n1,nan,3\n2,x,4\n3,5\n", "a.csv"),
+        ("id,u_px,v_px\n4,1,NaN\n1,5,6\n", "b.csv"),
+    ])
+    .unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "a.csv:2: u_px = nan: must be finite\n\
+         a.csv:3: u_px = x: must be a number\n\
+         a.csv:4: 2 cells but the header has 3 columns\n\
+         b.csv:2: v_px = NaN: must be finite\n\
+         id 1 is given twice: a.csv:2 and b.csv:3"
+    );
+    // many bad rows: the first 20 listed, the rest counted
+    let many: String = (0..30).map(|i| format!("{i},NaN,1\n")).collect();
+    let e = parse_observations(&[(&format!("id,u_px,v_px\n{many}"), "m.csv")]).unwrap_err();
+    let shown = e.to_string();
+    assert_eq!(shown.lines().count(), 21, "{shown}");
+    assert!(shown.ends_with("\nand 10 more rows"), "{shown}");
+}
+
+/// Observations outside the camera's image are refused, every such row named with its file,
+/// line, id and values (a 1 x 1 px camera file took observations at u 183-465 px silently).
+/// The image's outer edges, -0.5 and width - 0.5, are inside.
+#[test]
+fn observations_outside_the_image_are_listed_row_by_row() {
+    use fabkit_calibration::tables::check_inside_image;
+    let o = parse_observations(&[(
+        "id,u_px,v_px\n0,-0.5,-0.5\n1,99.5,49.5\n2,183,20\n3,50,-0.6\n4,465,1e300\n",
+        "obs.csv",
+    )])
+    .unwrap();
+    let e = check_inside_image(&o, 100, 50, "cam.yaml").unwrap_err();
+    assert!(matches!(e, TableError::OutsideImage { .. }), "{e:?}");
+    assert_eq!(
+        e.to_string(),
+        "cam.yaml: the image is 100 x 50 px (u from -0.5 to 99.5 px, v from -0.5 to 49.5 px, \
+         pixel (0, 0) the centre of the top-left pixel), but these 3 observations are outside it:\n\
+         obs.csv:4: id 2: u_px = 183, v_px = 20\n\
+         obs.csv:5: id 3: u_px = 50, v_px = -0.6\n\
+         obs.csv:6: id 4: u_px = 465, v_px = 1e300"
+    );
+    let inside =
+        parse_observations(&[("id,u_px,v_px\n0,-0.5,-0.5\n1,99.5,49.5\n", "o.csv")]).unwrap();
+    check_inside_image(&inside, 100, 50, "cam.yaml").unwrap();
+}
