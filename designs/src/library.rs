@@ -58,7 +58,9 @@ impl LoadedDesign {
     /// # Errors
     /// As [`Design::with_preset_in`].
     pub fn apply_preset(&mut self, name: &str) -> Result<(), DesignError> {
-        self.design = self.design.with_preset_in(name, &self.yaml.0, &self.yaml.1)?;
+        self.design = self
+            .design
+            .with_preset_in(name, &self.yaml.0, &self.yaml.1)?;
         Ok(())
     }
 }

@@ -842,7 +842,9 @@ pub fn place(
                     // The parameter that drives the count: the ring pitch when there are more
                     // rings than markers on a ring, else the spacing along the rings.
                     let (field, value) = match pattern.polar_step_deg {
-                        Some(step) if f64::from(k) * f64::from(k) > total as f64 + n_f - n as f64 => {
+                        Some(step)
+                            if f64::from(k) * f64::from(k) > total as f64 + n_f - n as f64 =>
+                        {
                             ("polar_step_deg", step.to_string())
                         }
                         _ => ("spacing_mm", sp.to_string()),

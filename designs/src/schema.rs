@@ -1119,9 +1119,10 @@ impl Design {
             *slot = value.clone();
         }
         let mut d: Design = serde_json::from_value(v).map_err(|e| {
-            DesignError::Yaml(self.preset_value_errors(preset, source).unwrap_or_else(|| {
-                format!("presets.{preset}: {e}")
-            }))
+            DesignError::Yaml(
+                self.preset_value_errors(preset, source)
+                    .unwrap_or_else(|| format!("presets.{preset}: {e}")),
+            )
         })?;
         d.name = format!("{}_{preset}", self.name);
         Ok(d)
@@ -1358,7 +1359,9 @@ pub fn yaml_location(text: &str, path: &str) -> Option<(u64, u64)> {
 /// The plain scalar that starts at `line`, `column` (from 1) of `text`, as written: up to the
 /// end of the line or a comment; `None` for a quoted, flow or block value.
 fn written_scalar(text: &str, line: u64, column: u64) -> Option<String> {
-    let l = text.lines().nth(usize::try_from(line).ok()?.checked_sub(1)?)?;
+    let l = text
+        .lines()
+        .nth(usize::try_from(line).ok()?.checked_sub(1)?)?;
     let rest = l.get(usize::try_from(column).ok()?.checked_sub(1)?..)?;
     let scalar = rest.split(" #").next()?.trim_end();
     let plain = !scalar.is_empty()

@@ -1,6 +1,10 @@
 //! `fabkit groundtruth`: argument parsing, dispatch over fabkit-calibration (rendering) and
 //! fabkit-export (file encoders, atomic output folder), progress.
 
+use fabkit_calibration::groundtruth::budget::{
+    frames_at_once, min_skin_pixels, render_memory, FIXED_BYTES_PER_PIXEL, FRAME_BYTES_PER_PIXEL,
+    MAX_PIXELS_LIMIT, MEMORY_BUDGET_BYTES, MIN_SKIN_FRACTION,
+};
 use std::error::Error;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -97,45 +101,8 @@ fn parse_max_output_bytes(s: &str) -> Result<u64, String> {
     }
 }
 
-/// Memory the render may take, bytes: 2 GiB. Every per-pixel buffer of a run is estimated
-/// ([`render_memory`]) and a camera image whose render would need more is refused before
-/// anything is allocated; configurations are rendered as many at a time as fit in it.
-pub const MEMORY_BUDGET_BYTES: u64 = 2 << 30;
-
-/// Bytes per pixel that stay allocated while the configurations are rendered: the rays
-/// (sensor-frame directions and camera-frame bearings, 48), the reference hits (range, normal,
-/// contact, exit: 41) and the reference frame (range, z-depth, point, normal, contact: 65),
-/// rounded up; the rays' construction briefly holds them twice (+48), before any frame.
-pub const FIXED_BYTES_PER_PIXEL: u64 = 160;
-
-/// Bytes per pixel of one frame being rendered and encoded: its hits (41) and depth frame
-/// (65), the differences to the reference (16, twice), the float32 arrays, the 16-bit and
-/// preview PNGs, the normals, the PLY points and their encoded bytes (about 130 at the peak),
-/// and the PNG and deflate encoders' working copies, rounded up.
-pub const FRAME_BYTES_PER_PIXEL: u64 = 320;
-
-/// Bytes besides the per-pixel buffers: the program, thread stacks, the fixtures and the
-/// manifest.
-pub const BASE_MEMORY_BYTES: u64 = 128 << 20;
-
-/// Largest `--max-pixels`: the largest image whose render, one frame at a time, fits in
-/// [`MEMORY_BUDGET_BYTES`] (4194304 = 2048 x 2048; a 2 MP camera, 1920 x 1080, and a
-/// 2048 x 1536 one fit).
-pub const MAX_PIXELS_LIMIT: u64 = 2048 * 2048;
-
 /// Default bound of `--max-pixels`: its largest value.
 const DEFAULT_MAX_PIXELS: u64 = MAX_PIXELS_LIMIT;
-
-/// Memory a render of `pixels` pixels takes with `frames_at_once` frames rendered at a time,
-/// bytes (an upper bound; see [`FIXED_BYTES_PER_PIXEL`], [`FRAME_BYTES_PER_PIXEL`]).
-pub fn render_memory(pixels: u64, frames_at_once: u64) -> u64 {
-    pixels
-        .saturating_mul(
-            FIXED_BYTES_PER_PIXEL
-                .saturating_add(FRAME_BYTES_PER_PIXEL.saturating_mul(frames_at_once)),
-        )
-        .saturating_add(BASE_MEMORY_BYTES)
-}
 
 fn parse_max_pixels(s: &str) -> Result<u64, String> {
     match s.trim().parse::<u64>() {
@@ -147,10 +114,6 @@ fn parse_max_pixels(s: &str) -> Result<u64, String> {
         )),
     }
 }
-
-/// Smallest fraction of the image's pixels that must see the skin: a camera that sees less
-/// (focal length, principal point or pose far off) would give a dataset of empty maps.
-pub const MIN_SKIN_FRACTION: f64 = 0.01;
 
 /// 16-bit PNG encodings: depth in micrometres; differences offset by 32768 counts.
 const DEPTH_PNG: Png16Encoding = Png16Encoding {
@@ -468,17 +431,6 @@ fn free_bytes(out: &std::path::Path) -> Option<u64> {
     }
 }
 
-/// How many frames of `pixels` pixels to render at a time: at most `threads`, and as many as
-/// fit in [`MEMORY_BUDGET_BYTES`] besides the fixed buffers (at least 1: `--max-pixels`
-/// guarantees that one fits).
-pub fn frames_at_once(pixels: u64, threads: u64) -> usize {
-    let fit = (1..=threads.max(1))
-        .take_while(|&k| render_memory(pixels, k) <= MEMORY_BUDGET_BYTES)
-        .last()
-        .unwrap_or(1);
-    fit as usize
-}
-
 /// Checks that the camera sees the skin in at least [`MIN_SKIN_FRACTION`] of its pixels.
 /// `seen` pixels see it; `file` and `text` are the camera file's name and text (its form names
 /// the fields in the error), `pose` the extrinsics file.
@@ -496,7 +448,7 @@ pub fn check_skin_seen(
 ) -> Result<(), String> {
     let i = camera.intrinsics();
     let pixels = u64::from(i.image_width_px) * u64::from(i.image_height_px);
-    let needed = (MIN_SKIN_FRACTION * pixels as f64).ceil().max(1.0) as u64;
+    let needed = min_skin_pixels(pixels);
     if seen as u64 >= needed {
         return Ok(());
     }

@@ -256,10 +256,12 @@ class DepthRenderer:
         camera: Union[Camera, StrPath],
         T_cam_sensor: npt.ArrayLike,
         *,
-        max_pixels: int = 4096 * 4096,
+        max_pixels: int = 2048 * 2048,
     ) -> None:
         """T_cam_sensor (4, 4): sensor frame -> camera frame, mm; the camera centre must be
-        inside the sensor body. Raises GroundTruthError."""
+        inside the sensor body. max_pixels: 1 to 2048 * 2048 (the render's memory budget,
+        2 GiB), else ValueError. Raises GroundTruthError for a larger image or a camera that
+        sees the skin in under 1 % of its pixels."""
     @property
     def shape(self) -> Tuple[int, int]: ...
     @property

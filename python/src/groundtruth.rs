@@ -19,8 +19,13 @@ use crate::design::Design;
 use crate::errors::{err, GroundTruthError};
 use crate::kit::report_progress;
 
-/// Largest camera image by default, pixels: 4096 x 4096 (`fabkit groundtruth --max-pixels`).
-const DEFAULT_MAX_PIXELS: u64 = 4096 * 4096;
+use fabkit_calibration::groundtruth::budget::{
+    min_skin_pixels, MAX_PIXELS_LIMIT, MEMORY_BUDGET_BYTES, MIN_SKIN_FRACTION,
+};
+
+/// Largest camera image by default, pixels: the largest the render's memory budget holds,
+/// 2048 x 2048 (`fabkit groundtruth --max-pixels`).
+const DEFAULT_MAX_PIXELS: u64 = MAX_PIXELS_LIMIT;
 
 /// The protrusions of one semi-dome (or semi-plate) configuration of a fixtures folder: a
 /// pattern at orientation 0 deg (on the +x half) or 180 deg (on the -x half).
@@ -145,12 +150,25 @@ impl DepthRenderer {
         let pose = isometry_of(&m).map_err(|(field, value, rule)| {
             GroundTruthError::new_err(format!("{field} = {value}: {rule}"))
         })?;
+        if !(1..=MAX_PIXELS_LIMIT).contains(&max_pixels) {
+            return Err(PyValueError::new_err(format!(
+                "max_pixels = {max_pixels}: must be from 1 to {MAX_PIXELS_LIMIT} (2048 x 2048, what the render's memory budget of {} GiB holds)",
+                MEMORY_BUDGET_BYTES >> 30
+            )));
+        }
         let i = camera.model.intrinsics();
         let pixels = u64::from(i.image_width_px) * u64::from(i.image_height_px);
         if pixels > max_pixels {
             return Err(GroundTruthError::new_err(format!(
-                "{}: the camera image is {} x {} = {pixels} pixels, over the ground-truth limit of {max_pixels} pixels (every per-pixel array of a frame is sized by it; raise max_pixels)",
-                camera.source, i.image_width_px, i.image_height_px
+                "{}: the camera image is {} x {} = {pixels} pixels, over the ground-truth limit of {max_pixels} pixels (every per-pixel array of a frame is sized by it, refused before any is allocated; {})",
+                camera.source,
+                i.image_width_px,
+                i.image_height_px,
+                if max_pixels < MAX_PIXELS_LIMIT {
+                    "raise max_pixels"
+                } else {
+                    "max_pixels is at its largest, what the render's memory budget holds"
+                }
             )));
         }
         let design = &design.design;
@@ -158,6 +176,18 @@ impl DepthRenderer {
         crate::work(py, || {
             let scene = Scene::new(design, model, &pose, "T_cam_sensor")?;
             let hits = reference_hits(&scene.rays, &scene.surface);
+            let needed = min_skin_pixels(pixels);
+            if (hits.valid_count() as u64) < needed {
+                return Err(format!(
+                    "the camera sees the skin in {} of its {pixels} pixels, fewer than the {needed} ({}% of the image) ground truth needs (hint: check fx, fy, cx, cy = {}, {}, {}, {} px against the image size, the distortion model, and that T_cam_sensor points the camera at the skin)",
+                    hits.valid_count(),
+                    MIN_SKIN_FRACTION * 100.0,
+                    fabkit_calibration::shown_f64(i.fx_px),
+                    fabkit_calibration::shown_f64(i.fy_px),
+                    fabkit_calibration::shown_f64(i.cx_px),
+                    fabkit_calibration::shown_f64(i.cy_px),
+                ));
+            }
             let reference = DepthFrame::new(&scene.rays, &hits);
             Ok(DepthRenderer {
                 scene,

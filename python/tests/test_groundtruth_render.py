@@ -232,6 +232,9 @@ def test_max_pixels_is_the_cli_limit(scene, run_cli, monkeypatch):
     assert cli.startswith(stem) and py.startswith(stem), (cli, py)
     assert py.endswith("raise max_pixels)")
     assert fabkit.DepthRenderer(scene["design"], "cam.yaml", scene["T"], max_pixels=W * H).shape == (H, W)
+    # bounded by the render's memory budget, as --max-pixels
+    with pytest.raises(ValueError, match=r"max_pixels = 4194305: must be from 1 to 4194304"):
+        fabkit.DepthRenderer(scene["design"], "cam.yaml", scene["T"], max_pixels=2048 * 2048 + 1)
 
 
 def _progress_during(call):
@@ -280,3 +283,11 @@ def test_renders_release_the_gil(scene):
         inside = ((stamps > t0 + 0.1 * dur) & (stamps < t0 + 0.5 * dur)).sum()
         assert inside >= 10, (what, dur, inside)
     assert holder["r"].shape == (H * s, W * s)
+
+
+def test_a_camera_that_sees_no_skin_is_refused(scene):
+    # the camera turned about its own centre to look at the base: no pixel sees the skin
+    away = np.diag([1.0, -1.0, -1.0, 1.0]) @ scene["T"]
+    with pytest.raises(fabkit.GroundTruthError,
+                       match=r"the camera sees the skin in \d+ of its \d+ pixels, fewer than"):
+        fabkit.DepthRenderer(scene["design"], str(scene["dir"] / "cam.yaml"), away)

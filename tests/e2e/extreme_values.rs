@@ -15,7 +15,9 @@ fn run_limited(cwd: &Path, args: &[&str]) -> Output {
     std::process::Command::new("bash")
         .current_dir(cwd)
         .arg("-c")
-        .arg(format!("ulimit -v {ADDRESS_SPACE_KIB} && exec \"$0\" \"$@\""))
+        .arg(format!(
+            "ulimit -v {ADDRESS_SPACE_KIB} && exec \"$0\" \"$@\""
+        ))
         .arg(env!("CARGO_BIN_EXE_fabkit"))
         .args(args)
         .output()
@@ -38,11 +40,7 @@ fn shadowtac_with(dir: &Path, from: &str, to: &str) -> String {
 fn extreme_preset_values_are_refused_by_path() {
     let tmp = tempfile::tempdir().unwrap();
     let d = tmp.path();
-    shadowtac_with(
-        d,
-        "pattern.spacing_mm: 1.4",
-        "pattern.spacing_mm: 1.0e-300",
-    );
+    shadowtac_with(d, "pattern.spacing_mm: 1.4", "pattern.spacing_mm: 1.0e-300");
     let o = run_limited(d, &["validate", "shadowtac.yaml", "--preset", "paper_text"]);
     let err = text(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");

@@ -574,7 +574,9 @@ print("ok")
 /// memory budget holds; the old largest value is refused.
 #[test]
 fn a_camera_past_the_memory_budget_is_refused_before_allocating_under_a_2_gb_limit() {
-    use fabkit::groundtruth_cmd::{render_memory, MAX_PIXELS_LIMIT, MEMORY_BUDGET_BYTES};
+    use fabkit_calibration::groundtruth::budget::{
+        render_memory, MAX_PIXELS_LIMIT, MEMORY_BUDGET_BYTES,
+    };
     assert!(render_memory(MAX_PIXELS_LIMIT, 1) <= MEMORY_BUDGET_BYTES);
     assert!(render_memory(MAX_PIXELS_LIMIT + 1, 1) > MEMORY_BUDGET_BYTES);
     let d = tempfile::tempdir().unwrap();
@@ -809,7 +811,7 @@ fn groundtruth_refuses_an_unusable_out_folder_before_any_work() {
 /// a time) renders under an address-space limit of the estimate (`ulimit -v`).
 #[test]
 fn a_render_fits_in_its_memory_estimate_under_an_address_space_limit() {
-    use fabkit::groundtruth_cmd::{frames_at_once, render_memory};
+    use fabkit_calibration::groundtruth::budget::{frames_at_once, render_memory};
     let d = tempfile::tempdir().unwrap();
     setup(d.path());
     let mut i = benchmark_intrinsics();

@@ -14,6 +14,7 @@
 //! of the reference exit and the first entry into a protrusion ([`exact`] in closed form, or
 //! [`mesh`] for triangle meshes). Frames and units: `docs/conventions.md`.
 
+pub mod budget;
 pub mod exact;
 pub mod inputs;
 pub mod mesh;

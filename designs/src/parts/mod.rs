@@ -39,8 +39,7 @@ pub(crate) fn check_led_count(
     inner_diameter_mm: f64,
     errs: &mut Vec<ParamError>,
 ) {
-    let mid_circumference_mm =
-        std::f64::consts::PI * (outer_diameter_mm + inner_diameter_mm) / 2.0;
+    let mid_circumference_mm = std::f64::consts::PI * (outer_diameter_mm + inner_diameter_mm) / 2.0;
     let fit = (mid_circumference_mm / MIN_LED_PITCH_MM).floor().max(1.0);
     if led_count == 0 {
         errs.push(ParamError::new(path, 0, "must be 1 or more"));

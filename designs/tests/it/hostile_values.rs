@@ -324,7 +324,12 @@ fn counts_that_once_allocated_or_passed_are_refused_by_name() {
     d.housing.as_mut().unwrap().led_pcb.led_count = fit;
     assert!(errors(&d).is_empty(), "{}", listing(&errors(&d)));
     d.housing.as_mut().unwrap().led_pcb.led_count = fit + 1;
-    assert_refused(&d, "housing.led_pcb.led_count", &(fit + 1).to_string(), "fit");
+    assert_refused(
+        &d,
+        "housing.led_pcb.led_count",
+        &(fit + 1).to_string(),
+        "fit",
+    );
     let mut d = library::load("tactip_dualmodal").unwrap();
     d.shaft_body.as_mut().unwrap().led_ring.led_count = 1 << 31;
     assert_refused(
@@ -344,7 +349,11 @@ fn tiny_lengths_are_refused_by_name_before_the_kernel() {
             d.housing.as_mut().unwrap().camera.bay_height_mm = x
         }),
         ("housing.joint_screw.clearance_diameter_mm", |d, x| {
-            d.housing.as_mut().unwrap().joint_screw.clearance_diameter_mm = x
+            d.housing
+                .as_mut()
+                .unwrap()
+                .joint_screw
+                .clearance_diameter_mm = x
         }),
         ("core.wall_thickness_mm", |d, x| {
             d.core.as_mut().unwrap().wall_thickness_mm = x
@@ -354,11 +363,20 @@ fn tiny_lengths_are_refused_by_name_before_the_kernel() {
         }),
     ];
     for (path, set) in cases {
-        let name = if path.starts_with("casing") { "shadowtac" } else { "rtac0" };
+        let name = if path.starts_with("casing") {
+            "shadowtac"
+        } else {
+            "rtac0"
+        };
         for (x, shown) in [(1e-300, "1e-300"), (1e-12, "1e-12"), (5e-4, "0.0005")] {
             let mut d = library::load(name).unwrap();
             set(&mut d, x);
-            assert_refused(&d, path, shown, "must be 0 or a length of at least 0.001 mm");
+            assert_refused(
+                &d,
+                path,
+                shown,
+                "must be 0 or a length of at least 0.001 mm",
+            );
         }
     }
 }
