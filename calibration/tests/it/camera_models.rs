@@ -160,7 +160,8 @@ proptest! {
 #[test]
 fn absurd_focal_lengths_and_principal_points_are_refused() {
     let base = intr(Distortion::Fisheye([0.0; 4]));
-    let cases: [(fn(&mut Intrinsics), &str); 6] = [
+    type Mutate = fn(&mut Intrinsics);
+    let cases: [(Mutate, &str); 6] = [
         (
             |i| i.fx_px = 5e-324,
             "fx_px = 5e-324: must be from 1 to 1e6 px",

@@ -344,7 +344,8 @@ fn counts_that_once_allocated_or_passed_are_refused_by_name() {
 /// validation and failed in the kernel with a message naming a part but not the parameter.
 #[test]
 fn tiny_lengths_are_refused_by_name_before_the_kernel() {
-    let cases: [(&str, fn(&mut Design, f64)); 4] = [
+    type Set = fn(&mut Design, f64);
+    let cases: [(&str, Set); 4] = [
         ("housing.camera.bay_height_mm", |d, x| {
             d.housing.as_mut().unwrap().camera.bay_height_mm = x
         }),
