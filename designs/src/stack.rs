@@ -87,9 +87,14 @@ pub fn validate(
 ) -> Result<Stack, ParamErrors> {
     // Every number finite and within its unit's magnitude first: the rules below compare and
     // compute with them. Negative lengths are reported with the rules below.
-    let numbers = crate::values::check_values(design, DESIGN_SIGNED_MM);
-    if !numbers.unusable.is_empty() {
-        return Err(ParamErrors(numbers.unusable));
+    let mut numbers = crate::values::check_values(design, DESIGN_SIGNED_MM);
+    // A non-finite angle of a marker point list is reported by the placement with every other
+    // bad point of its list (the list's rule covers it); any other unusable value stops here.
+    let (in_points, other): (Vec<_>, Vec<_>) = std::mem::take(&mut numbers.unusable)
+        .into_iter()
+        .partition(|e| e.path.contains(".pattern.points["));
+    if !other.is_empty() {
+        return Err(ParamErrors(other.into_iter().chain(in_points).collect()));
     }
     let mut errs: Vec<ParamError> = Vec::new();
     let t = tol.mm();
@@ -637,7 +642,14 @@ pub fn validate(
             crate::molds::check_mold_fit(design, c, first.outer_offset_mm, &mut errs);
         }
     }
-    let errs = numbers.merge_negative(errs);
+    let mut errs = numbers.merge_negative(errs);
+    // a non-finite point's row, when the placement did not report it (its layer not placed)
+    for e in in_points {
+        let row = &e.path[..e.path.rfind('[').unwrap_or(e.path.len())];
+        if !errs.iter().any(|x| x.path == row || x.path == e.path) {
+            errs.push(e);
+        }
+    }
     if errs.is_empty() && stack_ok {
         Ok(Stack { core, layers })
     } else {

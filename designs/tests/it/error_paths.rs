@@ -108,6 +108,30 @@ fn every_bad_point_of_a_list_pattern_is_reported() {
         ],
         "{errs:?}"
     );
+    // a NaN row is listed with the others, not alone (it was the only one listed)
+    let mut with_nan = d.clone();
+    let pts = with_nan.layers[0].markers[0]
+        .pattern
+        .points
+        .as_mut()
+        .unwrap();
+    pts[2] = [f64::NAN, 90.0];
+    let errs = errors(&with_nan);
+    let rows: Vec<&str> = errs
+        .iter()
+        .filter_map(|e| e.path.strip_prefix("layers[0].markers[0].pattern."))
+        .collect();
+    assert_eq!(
+        rows,
+        [
+            "points[1]",
+            "points[2]",
+            "points[3]",
+            "points[4]",
+            "points[6]"
+        ],
+        "{errs:?}"
+    );
 }
 
 /// Scalars are taken as written: a number or a boolean where text is expected, a quoted number
