@@ -275,19 +275,22 @@ pub fn integer_paths<T: Serialize + ?Sized>(
     value: &T,
     skip: &[&str],
 ) -> Result<Vec<NumberPath>, String> {
-    paths_where(value, skip, |v| {
-        matches!(
-            v,
-            Value::U8(_)
-                | Value::U16(_)
-                | Value::U32(_)
-                | Value::U64(_)
-                | Value::I8(_)
-                | Value::I16(_)
-                | Value::I32(_)
-                | Value::I64(_)
-        )
-    })
+    paths_where(value, skip, is_integer)
+}
+
+/// Whether `v` is an integer of any width.
+fn is_integer(v: &Value) -> bool {
+    matches!(
+        v,
+        Value::U8(_)
+            | Value::U16(_)
+            | Value::U32(_)
+            | Value::U64(_)
+            | Value::I8(_)
+            | Value::I16(_)
+            | Value::I32(_)
+            | Value::I64(_)
+    )
 }
 
 /// The path of every leaf of `value` (as serialized) for which `leaf` holds, leaving out the
@@ -467,19 +470,11 @@ pub fn quoted_numbers<T: Serialize + ?Sized>(typed: &T, text: &str) -> Vec<(Stri
     }
     fn walk(t: &Value, u: &Value, path: &str, out: &mut Vec<(String, String)>) {
         match (unwrap(t), unwrap(u)) {
-            (
-                Value::F64(_)
-                | Value::F32(_)
-                | Value::U8(_)
-                | Value::U16(_)
-                | Value::U32(_)
-                | Value::U64(_)
-                | Value::I8(_)
-                | Value::I16(_)
-                | Value::I32(_)
-                | Value::I64(_),
-                Value::String(s),
-            ) => out.push((path.to_string(), s.clone())),
+            (n, Value::String(s))
+                if matches!(n, Value::F64(_) | Value::F32(_)) || is_integer(n) =>
+            {
+                out.push((path.to_string(), s.clone()))
+            }
             (Value::Seq(a), Value::Seq(b)) => {
                 for (i, (x, y)) in a.iter().zip(b).enumerate() {
                     walk(x, y, &format!("{path}[{i}]"), out);

@@ -22,6 +22,23 @@ pub fn run(cwd: &Path, args: &[&str], envs: &[(&str, &str)]) -> Output {
     c.output().expect("fabkit binary runs")
 }
 
+/// Runs fabkit with `args` in `cwd` under an address-space limit of `limit_kib` KiB
+/// (`ulimit -v`), with `envs`: an allocation past the limit fails as it would on a machine of
+/// that memory.
+pub fn run_limited(cwd: &Path, args: &[&str], envs: &[(&str, &str)], limit_kib: u64) -> Output {
+    let mut c = Command::new("bash");
+    c.current_dir(cwd)
+        .arg("-c")
+        .arg(format!("ulimit -v {limit_kib} && exec \"$@\""))
+        .arg("bash")
+        .arg(env!("CARGO_BIN_EXE_fabkit"))
+        .args(args);
+    for (k, v) in envs {
+        c.env(k, v);
+    }
+    c.output().expect("bash runs fabkit")
+}
+
 pub fn text(b: &[u8]) -> String {
     String::from_utf8_lossy(b).into_owned()
 }

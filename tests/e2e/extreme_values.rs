@@ -12,16 +12,7 @@ const ADDRESS_SPACE_KIB: u64 = 2 << 20;
 
 /// fabkit `args` in `cwd` under the address-space limit.
 fn run_limited(cwd: &Path, args: &[&str]) -> Output {
-    std::process::Command::new("bash")
-        .current_dir(cwd)
-        .arg("-c")
-        .arg(format!(
-            "ulimit -v {ADDRESS_SPACE_KIB} && exec \"$0\" \"$@\""
-        ))
-        .arg(env!("CARGO_BIN_EXE_fabkit"))
-        .args(args)
-        .output()
-        .unwrap()
+    crate::common::run_limited(cwd, args, &[], ADDRESS_SPACE_KIB)
 }
 
 /// ShadowTac's YAML with the first line holding `from` replaced by `to`.

@@ -84,6 +84,25 @@ pub(crate) fn groundtruth(dir: &Path, out: &str, threads: &str) -> std::process:
     )
 }
 
+/// `groundtruth rtac0 --camera CAMERA --extrinsics extrinsics.json --fixtures fx --out gt`, then
+/// `extra`: the run of the folder [`setup`] prepares.
+fn gt_args<'a>(camera: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
+    let mut a = vec![
+        "groundtruth",
+        "rtac0",
+        "--camera",
+        camera,
+        "--extrinsics",
+        "extrinsics.json",
+        "--fixtures",
+        "fx",
+        "--out",
+        "gt",
+    ];
+    a.extend(extra);
+    a
+}
+
 #[test]
 fn groundtruth_of_two_patterns_is_complete_consistent_and_deterministic() {
     let (d1, d2) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
@@ -347,22 +366,7 @@ fn bad_inputs_name_the_file_and_the_rule_and_write_nothing() {
 
     // Bounded work: the camera image against --max-pixels (checked before any per-pixel array),
     // bad --max-pixels values, a camera image side past 16384 px, a FIFO as the camera file.
-    let groundtruth = |camera: &str, extra: &[&str]| {
-        let mut a = vec![
-            "groundtruth",
-            "rtac0",
-            "--camera",
-            camera,
-            "--extrinsics",
-            "extrinsics.json",
-            "--fixtures",
-            "fx",
-            "--out",
-            "gt",
-        ];
-        a.extend(extra);
-        run(d.path(), &a, &[])
-    };
+    let groundtruth = |camera: &str, extra: &[&str]| run(d.path(), &gt_args(camera, extra), &[]);
     let i = benchmark_intrinsics();
     let (w, h) = (i.image_width_px, i.image_height_px);
     let o = groundtruth("cam.yaml", &["--max-pixels", "1000"]);
@@ -596,28 +600,12 @@ fn a_camera_past_the_memory_budget_is_refused_before_allocating_under_a_2_gb_lim
             write_camera(&i, CameraFileFormat::OpenCvYaml),
         )
         .unwrap();
-        let o = std::process::Command::new("bash")
-            .current_dir(d.path())
-            .arg("-c")
-            .arg("ulimit -v 2000000 && exec \"$@\"")
-            .arg("bash")
-            .arg(env!("CARGO_BIN_EXE_fabkit"))
-            .args([
-                "groundtruth",
-                "rtac0",
-                "--camera",
-                &cam,
-                "--extrinsics",
-                "extrinsics.json",
-                "--fixtures",
-                "fx",
-                "--out",
-                "gt",
-                "--max-pixels",
-                &max,
-            ])
-            .output()
-            .unwrap();
+        let o = run_limited(
+            d.path(),
+            &gt_args(&cam, &["--max-pixels", &max]),
+            &[],
+            2_000_000,
+        );
         let e = text(&o.stderr);
         assert_eq!(o.status.code(), Some(2), "{side}: {e}");
         let px = u64::from(side) * u64::from(side);
@@ -641,19 +629,7 @@ fn a_camera_past_the_memory_budget_is_refused_before_allocating_under_a_2_gb_lim
     // the old largest value, 16384 x 16384, is past the budget
     let o = run(
         d.path(),
-        &[
-            "groundtruth",
-            "--camera",
-            "cam8192.yaml",
-            "--extrinsics",
-            "extrinsics.json",
-            "--fixtures",
-            "fx",
-            "--out",
-            "gt",
-            "--max-pixels",
-            "268435456",
-        ],
+        &gt_args("cam8192.yaml", &["--max-pixels", "268435456"]),
         &[],
     );
     assert_eq!(o.status.code(), Some(2));
@@ -675,24 +651,7 @@ fn a_camera_past_the_memory_budget_is_refused_before_allocating_under_a_2_gb_lim
 fn a_camera_that_sees_too_little_of_the_skin_is_refused_naming_its_fields() {
     let d = tempfile::tempdir().unwrap();
     setup(d.path());
-    let gt = |camera: &str| {
-        run(
-            d.path(),
-            &[
-                "groundtruth",
-                "rtac0",
-                "--camera",
-                camera,
-                "--extrinsics",
-                "extrinsics.json",
-                "--fixtures",
-                "fx",
-                "--out",
-                "gt",
-            ],
-            &[],
-        )
-    };
+    let gt = |camera: &str| run(d.path(), &gt_args(camera, &[]), &[]);
     type Set = fn(&mut fabkit_calibration::Intrinsics);
     let cases: [(Set, CameraFileFormat, &str); 4] = [
         (
@@ -826,30 +785,12 @@ fn a_render_fits_in_its_memory_estimate_under_an_address_space_limit() {
     let frames = frames_at_once(px, 2) as u64;
     assert_eq!(frames, 2);
     let limit_kb = render_memory(px, frames) / 1024;
-    let o = std::process::Command::new("bash")
-        .current_dir(d.path())
-        .env("RAYON_NUM_THREADS", "2")
-        .arg("-c")
-        .arg(format!("ulimit -v {limit_kb} && exec \"$@\""))
-        .arg("bash")
-        .arg(env!("CARGO_BIN_EXE_fabkit"))
-        .args([
-            "groundtruth",
-            "rtac0",
-            "--camera",
-            "big.json",
-            "--extrinsics",
-            "extrinsics.json",
-            "--fixtures",
-            "fx",
-            "--out",
-            "gt",
-            "--format",
-            "npy",
-            "--yes",
-        ])
-        .output()
-        .unwrap();
+    let o = run_limited(
+        d.path(),
+        &gt_args("big.json", &["--format", "npy", "--yes"]),
+        &[("RAYON_NUM_THREADS", "2")],
+        limit_kb,
+    );
     assert!(o.status.success(), "{}", text(&o.stderr));
     assert!(d.path().join("gt/manifest.json").exists());
 }
