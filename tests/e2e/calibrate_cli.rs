@@ -98,6 +98,29 @@ pub(crate) fn pose_of(j: &serde_json::Value) -> Isometry3<f64> {
     )
 }
 
+/// `calibrate extrinsics --camera CAMERA --points pins.csv --observations obs.csv --out OUT`,
+/// then `extra`: the run of a folder of [`write_table`]'s pins and [`observe`]'s observations.
+pub(crate) fn extrinsics_args<'a>(
+    camera: &'a str,
+    out: &'a str,
+    extra: &[&'a str],
+) -> Vec<&'a str> {
+    let mut a = vec![
+        "calibrate",
+        "extrinsics",
+        "--camera",
+        camera,
+        "--points",
+        "pins.csv",
+        "--observations",
+        "obs.csv",
+        "--out",
+        out,
+    ];
+    a.extend(extra);
+    a
+}
+
 #[test]
 fn extrinsics_from_a_synthetic_capture_recover_the_pose_and_write_the_report() {
     let d = tempfile::tempdir().unwrap();
@@ -631,20 +654,7 @@ fn an_image_is_checked_from_its_header_and_inputs_are_regular_files() {
     for (camera, image, want) in cases {
         let o = run(
             dir,
-            &[
-                "calibrate",
-                "extrinsics",
-                "--camera",
-                camera,
-                "--points",
-                "pins.csv",
-                "--observations",
-                "obs.csv",
-                "--out",
-                "out",
-                "--image",
-                image,
-            ],
+            &extrinsics_args(camera, "out", &["--image", image]),
             &[],
         );
         assert_eq!(o.status.code(), Some(2), "{camera} {image}");
@@ -782,24 +792,7 @@ fn observations_outside_the_image_and_every_bad_row_are_listed() {
     write_table(&dir.join("pins.csv"));
     let obs = observe(false, 0..29);
     std::fs::write(dir.join("obs.csv"), &obs).unwrap();
-    let calibrate = |camera: &str| {
-        run(
-            dir,
-            &[
-                "calibrate",
-                "extrinsics",
-                "--camera",
-                camera,
-                "--points",
-                "pins.csv",
-                "--observations",
-                "obs.csv",
-                "--out",
-                "out",
-            ],
-            &[],
-        )
-    };
+    let calibrate = |camera: &str| run(dir, &extrinsics_args(camera, "out", &[]), &[]);
     let o = calibrate("one.yaml");
     let e = text(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{e}");

@@ -9,7 +9,7 @@
 
 use std::path::Path;
 
-use crate::calibrate_cli::{intrinsics, json, observe, write_table};
+use crate::calibrate_cli::{extrinsics_args, intrinsics, json, observe, write_table};
 use crate::common::{missing, oracle_python, repo_root, run, text};
 use fabkit_calibration::nalgebra::Vector3;
 use fabkit_calibration::synthetic::benchmark_intrinsics;
@@ -315,20 +315,7 @@ fn calibrate_extrinsics_reads_opencvs_fisheye_files() {
     write_table(&dir.join("pins.csv"));
     std::fs::write(dir.join("obs.csv"), observe(false, 0..29)).unwrap();
     let calibrate = |camera: &str, model: &[&str], out: &str| {
-        let mut args = vec![
-            "calibrate",
-            "extrinsics",
-            "--camera",
-            camera,
-            "--points",
-            "pins.csv",
-            "--observations",
-            "obs.csv",
-            "--out",
-            out,
-        ];
-        args.extend(model);
-        run(dir, &args, &[])
+        run(dir, &extrinsics_args(camera, out, model), &[])
     };
     let o = calibrate("cam.json", &[], "ours");
     assert!(o.status.success(), "{}", text(&o.stderr));
