@@ -26,17 +26,34 @@ pub fn run(cwd: &Path, args: &[&str], envs: &[(&str, &str)]) -> Output {
 /// (`ulimit -v`), with `envs`: an allocation past the limit fails as it would on a machine of
 /// that memory.
 pub fn run_limited(cwd: &Path, args: &[&str], envs: &[(&str, &str)], limit_kib: u64) -> Output {
+    run_program_limited(
+        Path::new(env!("CARGO_BIN_EXE_fabkit")),
+        cwd,
+        args,
+        envs,
+        limit_kib,
+    )
+}
+
+/// [`run_limited`] for any `program` (a test binary running one of its own tests).
+pub fn run_program_limited(
+    program: &Path,
+    cwd: &Path,
+    args: &[&str],
+    envs: &[(&str, &str)],
+    limit_kib: u64,
+) -> Output {
     let mut c = Command::new("bash");
     c.current_dir(cwd)
         .arg("-c")
         .arg(format!("ulimit -v {limit_kib} && exec \"$@\""))
         .arg("bash")
-        .arg(env!("CARGO_BIN_EXE_fabkit"))
+        .arg(program)
         .args(args);
     for (k, v) in envs {
         c.env(k, v);
     }
-    c.output().expect("bash runs fabkit")
+    c.output().expect("bash runs the program")
 }
 
 pub fn text(b: &[u8]) -> String {

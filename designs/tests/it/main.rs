@@ -4,7 +4,6 @@ mod assembly;
 mod common;
 mod error_paths;
 mod estimate;
-mod extreme_values;
 mod flat_skin;
 mod geometry;
 mod hostile_values;
