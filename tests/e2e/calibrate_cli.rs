@@ -686,22 +686,8 @@ fn camera_model_option_bad_value_mismatch_and_hint() {
     write_table(&dir.join("pins.csv"));
     std::fs::write(dir.join("obs.csv"), observe(false, 0..29)).unwrap();
     let calibrate = |camera: &str, model: Option<&str>, out: &str| {
-        let mut args = vec![
-            "calibrate",
-            "extrinsics",
-            "--camera",
-            camera,
-            "--points",
-            "pins.csv",
-            "--observations",
-            "obs.csv",
-            "--out",
-            out,
-        ];
-        if let Some(m) = model {
-            args.extend(["--camera-model", m]);
-        }
-        run(dir, &args, &[])
+        let extra = model.map_or(vec![], |m| vec!["--camera-model", m]);
+        run(dir, &extrinsics_args(camera, out, &extra), &[])
     };
     // clap refuses an unknown model with its usage error.
     let o = calibrate("cam.yaml", Some("kb8"), "out");

@@ -369,22 +369,7 @@ fn opencv_filestorage_reads_extrinsics_yaml_with_a_multi_line_command_line() {
     write_table(&dir.join("pins.csv"));
     std::fs::write(dir.join("obs.csv"), observe(false, 0..29)).unwrap();
     let out = "out\n  \"two\" \\ lines: # not a comment";
-    let o = run(
-        dir,
-        &[
-            "calibrate",
-            "extrinsics",
-            "--camera",
-            "cam.yaml",
-            "--points",
-            "pins.csv",
-            "--observations",
-            "obs.csv",
-            "--out",
-            out,
-        ],
-        &[],
-    );
+    let o = run(dir, &extrinsics_args("cam.yaml", out, &[]), &[]);
     assert!(o.status.success(), "{}", text(&o.stderr));
     // (cv::FileStorage refuses such a path itself: read a copy.)
     let yaml = dir.join("extrinsics.yaml");

@@ -87,9 +87,18 @@ pub(crate) fn groundtruth(dir: &Path, out: &str, threads: &str) -> std::process:
 /// `groundtruth rtac0 --camera CAMERA --extrinsics extrinsics.json --fixtures fx --out gt`, then
 /// `extra`: the run of the folder [`setup`] prepares.
 fn gt_args<'a>(camera: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
+    design_gt_args("rtac0", camera, extra)
+}
+
+/// [`gt_args`] of `design`.
+pub(crate) fn design_gt_args<'a>(
+    design: &'a str,
+    camera: &'a str,
+    extra: &[&'a str],
+) -> Vec<&'a str> {
     let mut a = vec![
         "groundtruth",
-        "rtac0",
+        design,
         "--camera",
         camera,
         "--extrinsics",
@@ -284,22 +293,7 @@ fn bad_inputs_name_the_file_and_the_rule_and_write_nothing() {
     let d = tempfile::tempdir().unwrap();
     setup(d.path());
     // Fixtures of another design.
-    let o = run(
-        d.path(),
-        &[
-            "groundtruth",
-            "uvdtact",
-            "--camera",
-            "cam.yaml",
-            "--extrinsics",
-            "extrinsics.json",
-            "--fixtures",
-            "fx",
-            "--out",
-            "gt",
-        ],
-        &[],
-    );
+    let o = run(d.path(), &design_gt_args("uvdtact", "cam.yaml", &[]), &[]);
     assert_eq!(o.status.code(), Some(2));
     let e = text(&o.stderr);
     assert!(

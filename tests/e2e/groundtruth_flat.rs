@@ -59,18 +59,7 @@ fn groundtruth_of_a_flat_skin_sees_the_face_and_each_protrusion_at_its_depth() {
     setup(d);
     let o = run(
         d,
-        &[
-            "groundtruth",
-            "soter_channels",
-            "--camera",
-            "cam.yaml",
-            "--extrinsics",
-            "extrinsics.json",
-            "--fixtures",
-            "fx",
-            "--out",
-            "gt",
-        ],
+        &crate::groundtruth_cli::design_gt_args("soter_channels", "cam.yaml", &[]),
         &[],
     );
     assert!(o.status.success(), "{}", text(&o.stderr));
