@@ -11,7 +11,7 @@
 //! floating-point field, 2^31, 2^32 + 1, 2^63 and 2^64 in every integer field. Each walk runs
 //! in a child process (this test binary, one ignored test) under the limit, each case within
 //! 20 s: a rule that allocates before it refuses aborts the child, and the parent names the
-//! case. The built parts are checked in memory (the kernel's solids, as export writes them).
+//! case. What builds is exported (STL, 3MF and the manifest) into a temporary folder.
 
 use crate::common::{repo_root, run_program_limited, text};
 use fabkit_designs::materials::MaterialsTable;
@@ -135,6 +135,37 @@ fn assert_names(e: &str, path: &str, origin: &str, case: &str) {
     );
 }
 
+/// Every part of `kit` is a closed, consistently oriented 2-manifold, and the kit exports as
+/// STL and 3MF with its manifest.
+#[track_caller]
+fn export(
+    kit: &fabkit_designs::kit::Kit,
+    printers: &fabkit_designs::schema::PrinterProfiles,
+    case: &str,
+) {
+    for part in &kit.parts {
+        part.solid
+            .mesh()
+            .check_closed_manifold()
+            .unwrap_or_else(|e| panic!("{case}: {}: {e}", part.name));
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    let opts = fabkit_export::ExportOptions::for_design(
+        fabkit_export::Formats {
+            stl: true,
+            threemf: true,
+            step: false,
+        },
+        vec!["extreme_values".into()],
+        case,
+        &"0".repeat(64),
+        0.05,
+        printers.clone(),
+    );
+    fabkit_export::write_kit(kit, &tmp.path().join("out"), &opts)
+        .unwrap_or_else(|e| panic!("{case}: builds but does not export: {e}"));
+}
+
 #[test]
 fn every_numeric_design_field_takes_extreme_values_under_a_memory_limit() {
     let names: Vec<String> = library::LIBRARY
@@ -209,12 +240,7 @@ fn walk_one_design() {
             Ok(()) => {
                 let kit = build_kit_bounded(&m, tol, 4_000_000)
                     .unwrap_or_else(|e| panic!("{case} validates but fails: {e}"));
-                for part in &kit.parts {
-                    part.solid
-                        .mesh()
-                        .check_closed_manifold()
-                        .unwrap_or_else(|e| panic!("{case}: {}: {e}", part.name));
-                }
+                export(&kit, &m.printers, &case);
                 built.push(format!("{p} = {x}"));
             }
         }
@@ -274,12 +300,7 @@ fn walk_one_fixture_set() {
                 Err(DesignError::WorkLimit(_)) => {
                     let set = build_fixtures(&d, &m, tol, 20_000_000, "test")
                         .unwrap_or_else(|e| panic!("{case} validates but fails: {e}"));
-                    for part in &set.kit.parts {
-                        part.solid
-                            .mesh()
-                            .check_closed_manifold()
-                            .unwrap_or_else(|e| panic!("{case}: {}: {e}", part.name));
-                    }
+                    export(&set.kit, &d.printers, &case);
                     built.push(format!("{p} = {x}"));
                 }
                 Err(e) => panic!("{case}: {e}"),
