@@ -2,8 +2,8 @@
 //! their names carry (`docs/conventions.md`: `_mm`, `_deg`), so that no field can be forgotten:
 //! a new field is checked by its name alone.
 //!
-//! The rules, for every floating-point value (integers are typed `u32` / `u64` by the schema
-//! and refused by the parser when out of range):
+//! The rules, for every number (integers are typed `u32` / `u64` by the schema and refused by
+//! the parser past their type's range):
 //!
 //! - every value is finite (YAML `.nan`, `.inf` and numbers past `f64` are refused);
 //! - a length (`_mm`, or an element or field of a `_mm` parameter such as
@@ -12,6 +12,7 @@
 //! - an angle (`_deg`) is from -[`MAX_ANGLE_DEG`] to [`MAX_ANGLE_DEG`], and 0 or at least
 //!   [`MIN_ANGLE_DEG`] in magnitude;
 //! - any other number (a ratio such as `waste_allowance`) is within +-[`MAX_PLAIN`];
+//! - an integer (a count) is within +-[`MAX_PLAIN`], except a `seed`;
 //! - text (names, descriptions, keys) holds no control characters but line breaks and tabs.
 //!
 //! Each parameter's own range (above 0, below a radius, within a body's polar range) is checked
@@ -144,6 +145,7 @@ fn walk(
             signed,
             errs,
         ),
+        n if is_integer(n) => check_integer(n, path, errs),
         Value::Option(Some(inner)) | Value::Newtype(inner) => {
             walk(inner, path, unit, signed, signed_mm, errs)
         }
@@ -169,6 +171,35 @@ fn walk(
             }
         }
         _ => {}
+    }
+}
+
+/// An integer (a count) is within +-[`MAX_PLAIN`], except a random generator's `seed`: a count
+/// that no part of the design reads would otherwise take any value (2^31 vents on a mold
+/// without vents); the counts that are read have their own, smaller bounds.
+fn check_integer(v: &Value, path: &str, errs: &mut ValueErrors) {
+    let n: i128 = match *v {
+        Value::U8(n) => n.into(),
+        Value::U16(n) => n.into(),
+        Value::U32(n) => n.into(),
+        Value::U64(n) => n.into(),
+        Value::I8(n) => n.into(),
+        Value::I16(n) => n.into(),
+        Value::I32(n) => n.into(),
+        Value::I64(n) => n.into(),
+        _ => return,
+    };
+    let seed = path
+        .rsplit(['.', '['])
+        .next()
+        .is_some_and(|k| k.ends_with("seed"));
+    if !seed && n.unsigned_abs() > MAX_PLAIN as u128 {
+        let path = if path.is_empty() { "(value)" } else { path };
+        errs.unusable.push(ParamError::new(
+            path,
+            n,
+            format!("must be a count from -{MAX_PLAIN} to {MAX_PLAIN}"),
+        ));
     }
 }
 

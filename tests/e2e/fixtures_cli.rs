@@ -280,7 +280,11 @@ fn bad_fixture_parameters_name_the_parameter_and_write_nothing() {
         // once aborted on a 32 GB allocation
         (
             "pin_dome:\n  rings:\n    - {polar_angle_deg: 20, count: 4000000000}\n",
-            "pin_dome.rings[0].count = 4000000000: must be at most 1000 holes on one ring",
+            "pin_dome.rings[0].count = 4000000000: must be a count from -1000000 to 1000000",
+        ),
+        (
+            "pin_dome:\n  rings:\n    - {polar_angle_deg: 20, count: 1000000}\n",
+            "pin_dome.rings[0].count = 1000000: must be at most 1000 holes on one ring",
         ),
         ("pin_dome:\n  pin:\n    length_mm: 2.0\n", "pin_dome.pin.length_mm"),
         ("semidomes:\n  patterns:\n    - name: edge\n      protrusions:\n        - {polar_angle_deg: 40, azimuth_deg: 88, indentation_depth_mm: 1, shape: {type: sphere, radius_mm: 2}}\n", "semidomes.patterns[0].protrusions[0].azimuth_deg"),
@@ -332,7 +336,13 @@ fn bad_fixture_parameters_name_the_parameter_and_write_nothing() {
     }
     // The semi-dome count is bounded before any pattern is generated (--semidomes 4294967295
     // once aborted; 1000 took 4 GB).
-    for n in ["101", "4294967295"] {
+    for (n, rule) in [
+        (
+            "101",
+            "with 0 listed patterns makes 101 semi-domes, more than the 100",
+        ),
+        ("4294967295", "must be a count from -1000000 to 1000000"),
+    ] {
         let o = run(
             tmp.path(),
             &["fixtures", "rtac0", "--semidomes", n, "--out", "never"],
@@ -341,9 +351,7 @@ fn bad_fixture_parameters_name_the_parameter_and_write_nothing() {
         assert_eq!(o.status.code(), Some(2), "{n}");
         let err = text(&o.stderr);
         assert!(
-            err.contains(&format!(
-                "semidomes.generate = {n}: with 0 listed patterns makes {n} semi-domes, more than the 100"
-            )),
+            err.contains(&format!("semidomes.generate = {n}: {rule}")),
             "{n}: {err}"
         );
         assert!(!tmp.path().join("never").exists());

@@ -272,12 +272,20 @@ fn a_vanishing_concentric_spacing_is_refused_before_placing() {
 
 /// Counts that once allocated before their rule: 2e8 clamp bolts (a position per bolt), a flat
 /// marker grid of 1e8 columns or 2^63 rows (rows x columns positions), 2^31 LEDs on a ring
-/// PCB (which reached the shopping list).
+/// PCB (which reached the shopping list). Past 1e6 a count is refused as a number; up to it,
+/// by its own rule, which computes before it allocates.
 #[test]
 fn counts_that_once_allocated_or_passed_are_refused_by_name() {
     let mut d = library::load("shadowtac").unwrap();
     d.mold.two_piece.bolt_count = 200_000_000;
-    assert_refused(&d, "mold.two_piece.bolt_count", "200000000", "bolts");
+    assert_refused(
+        &d,
+        "mold.two_piece.bolt_count",
+        "200000000",
+        "must be a count from -1000000 to 1000000",
+    );
+    d.mold.two_piece.bolt_count = 1_000_000;
+    assert_refused(&d, "mold.two_piece.bolt_count", "1000000", "bolts");
 
     let soter = library::load("soter_channels").unwrap();
     let i = soter
@@ -285,11 +293,31 @@ fn counts_that_once_allocated_or_passed_are_refused_by_name() {
         .iter()
         .position(|l| l.marker_grid.is_some())
         .unwrap();
-    for (rows, columns, path, value) in [
-        (1, 100_000_000, "columns", "100000000"),
-        (1 << 31, 10, "rows", "2147483648"),
-        (1 << 63, 10, "rows", "9223372036854775808"),
-        (1 << 63, 1 << 63, "rows", "9223372036854775808"),
+    for (rows, columns, path, value, rule) in [
+        (1, 100_000_000, "columns", "100000000", "must be a count"),
+        (1 << 31, 10, "rows", "2147483648", "must be a count"),
+        (
+            1 << 63,
+            10,
+            "rows",
+            "9223372036854775808",
+            "must be a count",
+        ),
+        (1000, 1000, "rows", "1000", "more than the 100000 markers"),
+        (
+            1,
+            1_000_000,
+            "columns",
+            "1000000",
+            "more than the 100000 markers",
+        ),
+        (
+            1_000_000,
+            1_000_000,
+            "rows",
+            "1000000",
+            "more than the 100000 markers",
+        ),
     ] {
         let mut d = soter.clone();
         let g = d.layers[i].marker_grid.as_mut().unwrap();
@@ -301,9 +329,8 @@ fn counts_that_once_allocated_or_passed_are_refused_by_name() {
             .unwrap_or_default();
         let path = format!("layers[{i}].marker_grid.{path}");
         assert!(
-            errs.iter().any(|e| e.path == path
-                && e.value == value
-                && e.rule.contains("more than the 100000 markers")),
+            errs.iter()
+                .any(|e| e.path == path && e.value == value && e.rule.contains(rule)),
             "{path}:{}",
             listing(&errs)
         );
@@ -315,6 +342,13 @@ fn counts_that_once_allocated_or_passed_are_refused_by_name() {
         &d,
         "housing.led_pcb.led_count",
         "2147483648",
+        "must be a count",
+    );
+    d.housing.as_mut().unwrap().led_pcb.led_count = 1_000_000;
+    assert_refused(
+        &d,
+        "housing.led_pcb.led_count",
+        "1000000",
         "LEDs fit around the ring",
     );
     // the published eight fit; one per millimetre of the mid-line is the most
@@ -331,11 +365,11 @@ fn counts_that_once_allocated_or_passed_are_refused_by_name() {
         "fit",
     );
     let mut d = library::load("tactip_dualmodal").unwrap();
-    d.shaft_body.as_mut().unwrap().led_ring.led_count = 1 << 31;
+    d.shaft_body.as_mut().unwrap().led_ring.led_count = 100_000;
     assert_refused(
         &d,
         "shaft_body.led_ring.led_count",
-        "2147483648",
+        "100000",
         "LEDs fit around the ring",
     );
 }

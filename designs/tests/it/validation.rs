@@ -918,7 +918,7 @@ fn round_tube_rules_name_their_parameters() {
 /// single mutations that combine with stack errors.)
 #[test]
 fn more_vents_than_fit_yield_one_error() {
-    for (count, value) in [(22, "22"), (10_000, "10000"), (u32::MAX, "4294967295")] {
+    for (count, value) in [(22, "22"), (10_000, "10000"), (1_000_000, "1000000")] {
         let mut d = baseline();
         d.mold.vent.count = count;
         assert_exactly(
@@ -930,6 +930,17 @@ fn more_vents_than_fit_yield_one_error() {
             }],
         );
     }
+    // past any count: refused as a number, before the rule
+    let mut d = baseline();
+    d.mold.vent.count = u32::MAX;
+    assert_exactly(
+        &errors(&d),
+        &[&Expect {
+            path: "mold.vent.count",
+            value: "4294967295",
+            rule: &["must be a count from -1000000 to 1000000"],
+        }],
+    );
     let mut d = baseline();
     d.mold.vent.count = 21;
     assert_exactly(&errors(&d), &[]);
