@@ -48,12 +48,7 @@ pub const MAX_BINARY_INPUT_BYTES: u64 = 1 << 30;
 /// `x` as a reader would write it: `{}` where that is short, scientific notation (`1e300`,
 /// `5e-324`) where `{}` would print hundreds of digits.
 pub fn shown_f64(x: f64) -> String {
-    let s = format!("{x}");
-    if s.len() > 24 {
-        format!("{x:e}")
-    } else {
-        s
-    }
+    fabkit_designs::error::compact_numbers(&x.to_string())
 }
 
 /// A regular file of at most [`MAX_TEXT_INPUT_BYTES`] as UTF-8 text.

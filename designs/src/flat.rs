@@ -611,7 +611,7 @@ pub fn validate(
         return Err(crate::ParamErrors(numbers.unusable));
     }
     let mut errs = Vec::new();
-    if !crate::stack::is_identifier(&design.name) {
+    if !crate::values::is_file_stem(&design.name) {
         errs.push(ParamError::new(
             "name",
             format!("{:?}", design.name),
@@ -655,7 +655,7 @@ pub fn validate(
     let mut names = std::collections::BTreeSet::new();
     for (i, l) in design.layers.iter().enumerate() {
         let p = |f: &str| format!("layers[{i}].{f}");
-        if !crate::stack::is_identifier(&l.name) || !names.insert(l.name.as_str()) {
+        if !crate::values::is_file_stem(&l.name) || !names.insert(l.name.as_str()) {
             errs.push(ParamError::new(
                 p("name"),
                 format!("{:?}", l.name),

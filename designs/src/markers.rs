@@ -835,16 +835,12 @@ pub fn place(
                 // counted in f64 and compared before the cast: a spacing of 1e-300 mm makes
                 // a ratio past usize::MAX
                 let n_f = (2.0 * PI * surface.radius_at(s) / sp).round().max(1.0);
-                let past_cap = total as f64 + n_f > cap;
-                let n = if past_cap { 0 } else { n_f as usize };
-                total += n;
-                if past_cap || total > MAX_MARKERS_PER_PATTERN {
+                let count_f = total as f64 + n_f;
+                if count_f > cap {
                     // The parameter that drives the count: the ring pitch when there are more
                     // rings than markers on a ring, else the spacing along the rings.
                     let (field, value) = match pattern.polar_step_deg {
-                        Some(step)
-                            if f64::from(k) * f64::from(k) > total as f64 + n_f - n as f64 =>
-                        {
+                        Some(step) if f64::from(k) * f64::from(k) > count_f => {
                             ("polar_step_deg", step.to_string())
                         }
                         _ => ("spacing_mm", sp.to_string()),
@@ -857,6 +853,8 @@ pub fn place(
                         ),
                     ));
                 }
+                let n = n_f as usize;
+                total += n;
                 push_ring(&mut raw, s, k, n);
                 k += 1;
             }

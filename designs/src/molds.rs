@@ -896,13 +896,14 @@ impl TwoPieceFrame {
         let m = &design.mold;
         let t = &m.two_piece;
         let zb = design.body.base_z_mm();
+        let layout = BoltLayout::new(design);
         let BoltLayout {
             boss,
             pocket,
             h,
             kx,
             ky,
-        } = BoltLayout::new(design);
+        } = layout;
         let (ax, ay) = (2.0 * h[0], 2.0 * h[1]);
         let outer = [pocket[0] + m.flange_width_mm, pocket[1] + m.flange_width_mm];
         let mut bolts = vec![[h[0], h[1]], [-h[0], h[1]], [-h[0], -h[1]], [h[0], -h[1]]];
@@ -927,7 +928,7 @@ impl TwoPieceFrame {
             bolts_xy_mm: bolts,
             cavity_block_bolt_hole_mm: t.bolt_holes_mm(m.clamp_bolt.clearance_diameter_mm).0,
             top_piece_bolt_hole_mm: t.bolt_holes_mm(m.clamp_bolt.clearance_diameter_mm).1,
-            bolt_pitch_mm: [ax / (kx + 1) as f64, ay / (ky + 1) as f64],
+            bolt_pitch_mm: layout.pitch_mm(),
         }
     }
 }

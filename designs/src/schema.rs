@@ -1147,15 +1147,10 @@ impl Design {
                 let (l, c) = preset_value_location(text, preset, path)?;
                 Some((format!("{origin}:{l}:{c}: "), written_scalar(text, l, c)))
             });
+            let (at, written) = located.unwrap_or_default();
             // the value as written where it is found (2^64 reads back as a float)
-            let (at, shown) = match located {
-                Some((at, Some(written))) => (at, written),
-                Some((at, None)) => (at, crate::error::compact_numbers(&value.to_string())),
-                None => (
-                    String::new(),
-                    crate::error::compact_numbers(&value.to_string()),
-                ),
-            };
+            let shown =
+                written.unwrap_or_else(|| crate::error::compact_numbers(&value.to_string()));
             lines.push(format!("{at}presets.{preset}: {path} = {shown}: {e}"));
         }
         (!lines.is_empty()).then(|| lines.join("\n"))

@@ -69,10 +69,6 @@ impl Stack {
     }
 }
 
-pub(crate) fn is_identifier(s: &str) -> bool {
-    crate::values::is_file_stem(s)
-}
-
 /// Lengths of a design that may be negative ([`crate::values::check_values`]): none.
 pub const DESIGN_SIGNED_MM: &[&str] = &[];
 
@@ -98,7 +94,7 @@ pub fn validate(
     }
     let mut errs: Vec<ParamError> = Vec::new();
     let t = tol.mm();
-    if !is_identifier(&design.name) {
+    if !crate::values::is_file_stem(&design.name) {
         errs.push(ParamError::new(
             "name",
             format!("{:?}", design.name),
@@ -301,7 +297,7 @@ pub fn validate(
     let mut names = std::collections::BTreeSet::new();
     let errors_before_layer_specs = errs.len();
     for (i, l) in design.layers.iter().enumerate() {
-        if !is_identifier(&l.name) {
+        if !crate::values::is_file_stem(&l.name) {
             errs.push(ParamError::new(
                 format!("layers[{i}].name"),
                 format!("{:?}", l.name),
