@@ -1,49 +1,216 @@
 //! Replacing an output directory without ever leaving a mixed state under its name.
 //!
 //! Everything is written into a fresh sibling `.<name>.tmp-<pid>-<n>` and synced; then a
-//! previous export is renamed to `.<name>.old-<pid>-<n>`, the new directory is renamed into
+//! previous output is renamed to `.<name>.old-<pid>-<n>`, the new directory is renamed into
 //! place and the old one deleted. Between the two renames the name is briefly absent (a POSIX
-//! rename cannot swap two directories), but it never holds a half-written export.
+//! rename cannot swap two directories), but it never holds a half-written output.
 //!
-//! Every folder written here carries a marker, [`OUTPUT_MARKER`]: the list of the folder's
-//! files with their sizes. A folder is replaced only when it is empty or when its marker lists
-//! every file in it (at its listed size): a folder a user made, or a fabkit output a user added
-//! to or edited, is refused whole and left untouched.
+//! Every folder written here carries a marker, [`OUTPUT_MARKER`]: the command that wrote it,
+//! its job, and the list of the folder's files with their sizes and SHA-256. A folder is
+//! replaced only when it is empty or when its marker lists every file in it, each still with
+//! the bytes fabkit wrote, and the marker names the same command ([`OutputClaim`]) and, unless
+//! forced, the same job. A folder a user made, a fabkit output a user added to or edited, and
+//! another command's output are refused whole and left untouched.
 
 use crate::ExportError;
+use sha2::{Digest, Sha256};
+use std::collections::BTreeMap;
 use std::ffi::OsString;
 use std::fs;
-use std::io::{ErrorKind, Write as _};
+use std::io::{ErrorKind, Read as _, Write as _};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::Mutex;
 
 /// Sibling names from one process never repeat.
 static SIBLING_COUNTER: AtomicU32 = AtomicU32::new(0);
 
-/// Name of the marker file in every output folder fabkit writes (JSON: `format` and `files`,
-/// each file's `/`-separated path and size in bytes, sorted by path; the marker itself is not
-/// listed). Its bytes depend only on the folder's files: same input, same bytes.
+/// Name of the marker file in every output folder fabkit writes (JSON: `format`, `command`,
+/// `job` and `files`, each file's `/`-separated path, size in bytes and SHA-256, sorted by
+/// path; the marker itself is not listed). Its bytes depend only on the folder's files and
+/// its claim: same input, same bytes.
 pub const OUTPUT_MARKER: &str = ".fabkit-output";
-const MARKER_FORMAT: &str = "fabkit-output/1";
+const MARKER_FORMAT: &str = "fabkit-output/2";
+/// The marker of earlier fabkit versions: paths and sizes only, which a user's folder can
+/// imitate; such a folder is not replaced.
+const MARKER_FORMAT_V1: &str = "fabkit-output/1";
+
+/// The fabkit command that writes an output folder, recorded in its marker: a command replaces
+/// only its own kind of output.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OutputCommand {
+    /// `fabkit export` (and `Kit.export` in Python).
+    Export,
+    /// `fabkit fixtures` (and a fixtures kit's `export` in Python).
+    Fixtures,
+    /// `fabkit groundtruth`.
+    Groundtruth,
+    /// `fabkit calibrate extrinsics`.
+    CalibrateExtrinsics,
+    /// One variant's folder of `fabkit sweep` (`variants/<id>/`).
+    SweepVariant,
+}
+
+impl OutputCommand {
+    /// The command as the user types it after `fabkit ` (`calibrate extrinsics`), as the
+    /// marker records it.
+    pub fn name(self) -> &'static str {
+        match self {
+            OutputCommand::Export => "export",
+            OutputCommand::Fixtures => "fixtures",
+            OutputCommand::Groundtruth => "groundtruth",
+            OutputCommand::CalibrateExtrinsics => "calibrate extrinsics",
+            OutputCommand::SweepVariant => "sweep",
+        }
+    }
+}
+
+/// Who writes an output folder: the command, the job (what distinguishes one output of the
+/// command from another, e.g. `kit 'rtac0' at chord tolerance 0.05 mm`) and whether an
+/// earlier output of another job of the same command may be replaced (`--force`). Another
+/// command's output is never replaced.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct OutputClaim {
+    pub command: OutputCommand,
+    /// A short human description, compared as a whole and quoted in refusals.
+    pub job: String,
+    pub force: bool,
+}
+
+impl OutputClaim {
+    /// The claim of a kit's folder (export, fixtures or a sweep variant): the job is the kit
+    /// (its name: the design, its preset and mold strategy) and the chord tolerance.
+    pub fn kit(
+        command: OutputCommand,
+        kit_name: &str,
+        chord_tolerance_mm: f64,
+        force: bool,
+    ) -> OutputClaim {
+        OutputClaim {
+            command,
+            job: format!("kit '{kit_name}' at chord tolerance {chord_tolerance_mm} mm"),
+            force,
+        }
+    }
+}
+
+impl OutputClaim {
+    /// The claim of an output computed from input files (ground truth, a calibration): the job
+    /// is `what` followed by a SHA-256 over the inputs' contents, in order, so that an output
+    /// of other inputs (other captures, another camera file) is another job. Only regular
+    /// files of at most [`MAX_HASHED_INPUT_BYTES`] are read; any other path (missing, a FIFO,
+    /// a folder, a larger file, one that cannot be read) counts by its path alone, and the
+    /// command's own reader reports it.
+    pub fn of_inputs(
+        command: OutputCommand,
+        what: &str,
+        inputs: &[&Path],
+        force: bool,
+    ) -> OutputClaim {
+        let mut h = Sha256::new();
+        for p in inputs {
+            let regular =
+                fs::metadata(p).is_ok_and(|m| m.is_file() && m.len() <= MAX_HASHED_INPUT_BYTES);
+            match regular.then(|| sha256_of_file(p).ok()).flatten() {
+                Some(file) => h.update(format!("file {file}\n")),
+                None => h.update(format!("path {}\n", p.display())),
+            }
+        }
+        let digest = hex(&h.finalize());
+        OutputClaim {
+            command,
+            job: format!("{what} (inputs sha256 {})", &digest[..16]),
+            force,
+        }
+    }
+}
+
+/// Largest input file [`OutputClaim::of_inputs`] reads, bytes (1 GiB).
+pub const MAX_HASHED_INPUT_BYTES: u64 = 1 << 30;
 
 /// One file of an output folder as the marker lists it.
-#[derive(Debug, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 struct MarkedFile {
     path: String,
     bytes: u64,
+    sha256: String,
 }
 
 #[derive(Debug, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 struct Marker {
     format: String,
+    command: String,
+    job: String,
     files: Vec<MarkedFile>,
+}
+
+/// Only the format of a marker, to tell an earlier fabkit's marker from a foreign file.
+#[derive(serde::Deserialize)]
+struct MarkerFormat {
+    format: String,
+}
+
+/// A file found on disk: relative `/`-separated path and size.
+#[derive(Debug)]
+struct FoundFile {
+    path: String,
+    bytes: u64,
+}
+
+/// SHA-256 of bytes, 64 lowercase hex digits.
+pub(crate) fn sha256_hex(bytes: &[u8]) -> String {
+    hex(&Sha256::digest(bytes))
+}
+
+fn hex(digest: &[u8]) -> String {
+    digest.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// SHA-256 of a file's content, streamed.
+fn sha256_of_file(path: &Path) -> Result<String, ExportError> {
+    let mut f = fs::File::open(path).map_err(ExportError::io("reading", path))?;
+    let mut h = Sha256::new();
+    let mut buf = vec![0u8; 1 << 20];
+    loop {
+        let n = f.read(&mut buf).map_err(ExportError::io("reading", path))?;
+        if n == 0 {
+            break;
+        }
+        h.update(&buf[..n]);
+    }
+    Ok(hex(&h.finalize()))
+}
+
+/// SHA-256 of the files written into a temporary output folder, by relative path, recorded
+/// as they are written (so that the marker does not read them back).
+#[derive(Debug, Default)]
+pub(crate) struct WrittenHashes(Mutex<BTreeMap<String, String>>);
+
+impl WrittenHashes {
+    pub(crate) fn record(&self, rel: &str, bytes: &[u8]) {
+        self.insert(rel, sha256_hex(bytes));
+    }
+
+    /// Records the SHA-256 `h` (64 hex digits) of the file `rel`, computed by the caller.
+    pub(crate) fn insert(&self, rel: &str, h: String) {
+        self.0
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .insert(rel.to_string(), h);
+    }
+
+    fn into_map(self) -> BTreeMap<String, String> {
+        self.0
+            .into_inner()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+    }
 }
 
 /// Every regular file under `dir` (relative `/`-separated path and size, sorted), or the first
 /// entry that is neither a regular file nor a folder (a symlink, a FIFO, ...) as `Err`.
-fn list_tree(dir: &Path) -> Result<Result<Vec<MarkedFile>, String>, ExportError> {
+fn list_tree(dir: &Path) -> Result<Result<Vec<FoundFile>, String>, ExportError> {
     let mut files = Vec::new();
     let mut stack = vec![(dir.to_path_buf(), String::new())];
     while let Some((d, prefix)) = stack.pop() {
@@ -55,7 +222,7 @@ fn list_tree(dir: &Path) -> Result<Result<Vec<MarkedFile>, String>, ExportError>
             if md.is_dir() {
                 stack.push((e.path(), format!("{rel}/")));
             } else if md.is_file() {
-                files.push(MarkedFile {
+                files.push(FoundFile {
                     path: rel,
                     bytes: md.len(),
                 });
@@ -68,8 +235,13 @@ fn list_tree(dir: &Path) -> Result<Result<Vec<MarkedFile>, String>, ExportError>
     Ok(Ok(files))
 }
 
-/// Writes the marker of the finished folder `dir` (every file in it, see [`OUTPUT_MARKER`]).
-fn write_marker(dir: &Path) -> Result<(), ExportError> {
+/// Writes the marker of the finished folder `dir` (every file in it, see [`OUTPUT_MARKER`]):
+/// the SHA-256 of a file is taken from `written` where recorded, read from disk otherwise.
+fn write_marker(
+    dir: &Path,
+    claim: &OutputClaim,
+    written: WrittenHashes,
+) -> Result<(), ExportError> {
     let files = match list_tree(dir)? {
         Ok(f) => f,
         Err(entry) => {
@@ -80,8 +252,25 @@ fn write_marker(dir: &Path) -> Result<(), ExportError> {
             })
         }
     };
+    let written = written.into_map();
+    let files = files
+        .into_iter()
+        .map(|f| {
+            let sha256 = match written.get(&f.path) {
+                Some(h) => h.clone(),
+                None => sha256_of_file(&crate::join_rel(dir, &f.path))?,
+            };
+            Ok(MarkedFile {
+                path: f.path,
+                bytes: f.bytes,
+                sha256,
+            })
+        })
+        .collect::<Result<Vec<_>, ExportError>>()?;
     let marker = Marker {
         format: MARKER_FORMAT.into(),
+        command: claim.command.name().into(),
+        job: claim.job.clone(),
         files,
     };
     let mut bytes = serde_json::to_vec_pretty(&marker).map_err(|e| ExportError::Encode {
@@ -101,26 +290,31 @@ pub(crate) struct Replaced {
     pub warnings: Vec<String>,
 }
 
-/// Fills a fresh temporary sibling of `out_dir` with `fill` and moves it into place.
+/// Fills a fresh temporary sibling of `out_dir` with `fill` and moves it into place. `fill`
+/// records the SHA-256 of what it writes in the [`WrittenHashes`] it is given (a file it does
+/// not record is read back for the marker).
 ///
 /// `out_dir` may be missing (its parents are created), an empty directory, or an earlier
-/// fabkit output that its [`OUTPUT_MARKER`] lists whole, which is replaced as a whole.
+/// fabkit output that `claim` may replace (see [`check_out_dir`]), which is replaced whole.
 ///
 /// # Errors
 /// [`ExportError::InvalidOutDir`], [`ExportError::NotADirectory`],
-/// [`ExportError::ForeignDirectory`], [`ExportError::Io`], or `fill`'s error. On every error
+/// [`ExportError::ForeignDirectory`], [`ExportError::OtherCommand`],
+/// [`ExportError::OtherJob`], [`ExportError::Io`], or `fill`'s error. On every error
 /// `out_dir` is as it was and the temporary directory is removed.
 pub(crate) fn replace_dir(
     out_dir: &Path,
-    fill: impl FnOnce(&Path) -> Result<(), ExportError>,
+    claim: &OutputClaim,
+    fill: impl FnOnce(&Path, &WrittenHashes) -> Result<(), ExportError>,
 ) -> Result<Replaced, ExportError> {
     let (parent, name) = split(out_dir)?;
     let created = create_parents(&parent)?;
     let result = (|| {
-        let existing = inspect_existing(out_dir)?;
+        let existing = inspect_existing(out_dir, claim)?;
         let tmp = create_unique_sibling(&parent, &name, "tmp")?;
-        if let Err(e) = fill(&tmp)
-            .and_then(|()| write_marker(&tmp))
+        let written = WrittenHashes::default();
+        if let Err(e) = fill(&tmp, &written)
+            .and_then(|()| write_marker(&tmp, claim, written))
             .and_then(|()| sync_dir(&tmp))
         {
             let _ = fs::remove_dir_all(&tmp);
@@ -231,8 +425,8 @@ fn move_into_place(
 /// An output folder written file by file (e.g. a dataset too large to hold in memory): files go
 /// into a fresh temporary sibling of the folder; [`StagedDir::commit`] moves it into place
 /// exactly as [`crate::write_kit`] does (a missing folder, an empty one, or an earlier fabkit
-/// output whose [`OUTPUT_MARKER`] lists every file in it is replaced; anything else, a symbolic
-/// link included, is refused before writing).
+/// output that the claim may replace, see [`check_out_dir`]; anything else, a symbolic link
+/// included, is refused before writing).
 /// Dropped without a commit, the temporary folder is removed and the output is untouched.
 #[derive(Debug)]
 pub struct StagedDir {
@@ -244,18 +438,21 @@ pub struct StagedDir {
     done: bool,
     /// The parent folders this output created, removed again if it is dropped uncommitted.
     created: Vec<PathBuf>,
+    claim: OutputClaim,
+    written: WrittenHashes,
 }
 
 impl StagedDir {
-    /// Checks `out_dir` and creates the temporary sibling.
+    /// Checks `out_dir` for `claim` (see [`check_out_dir`]) and creates the temporary sibling.
     ///
     /// # Errors
     /// [`ExportError::InvalidOutDir`], [`ExportError::NotADirectory`],
-    /// [`ExportError::ForeignDirectory`], [`ExportError::Io`].
-    pub fn new(out_dir: &Path) -> Result<StagedDir, ExportError> {
+    /// [`ExportError::ForeignDirectory`], [`ExportError::OtherCommand`],
+    /// [`ExportError::OtherJob`], [`ExportError::Io`].
+    pub fn new(out_dir: &Path, claim: OutputClaim) -> Result<StagedDir, ExportError> {
         let (parent, name) = split(out_dir)?;
         let created = create_parents(&parent)?;
-        let staged = inspect_existing(out_dir)
+        let staged = inspect_existing(out_dir, &claim)
             .and_then(|existing| Ok((existing, create_unique_sibling(&parent, &name, "tmp")?)));
         let (existing, tmp) = match staged {
             Ok(x) => x,
@@ -272,6 +469,8 @@ impl StagedDir {
             existing,
             done: false,
             created,
+            claim,
+            written: WrittenHashes::default(),
         })
     }
 
@@ -287,7 +486,9 @@ impl StagedDir {
         if let Some(dir) = path.parent() {
             fs::create_dir_all(dir).map_err(ExportError::io("creating", dir))?;
         }
-        write_file_synced(&path, bytes)
+        write_file_synced(&path, bytes)?;
+        self.written.record(rel, bytes);
+        Ok(())
     }
 
     /// Syncs every folder and moves the finished output into place; returns warnings (e.g. a
@@ -296,7 +497,7 @@ impl StagedDir {
     /// # Errors
     /// [`ExportError::Io`]; the output is then as it was.
     pub fn commit(mut self) -> Result<Vec<String>, ExportError> {
-        write_marker(&self.tmp)?;
+        write_marker(&self.tmp, &self.claim, std::mem::take(&mut self.written))?;
         let mut dirs = vec![self.tmp.clone()];
         let mut k = 0;
         while k < dirs.len() {
@@ -387,16 +588,20 @@ pub(crate) fn sync_dir(dir: &Path) -> Result<(), ExportError> {
     Ok(())
 }
 
-/// Checks `out_dir` as an output folder before any work is done, creating nothing: it must
-/// have a final name (not `/` or `..`), its nearest existing ancestor must be a folder, and it
-/// must be missing, an empty folder, or an earlier fabkit output (the rules [`StagedDir::new`]
-/// and [`crate::write_kit`] apply when they write it). A command runs this first, so that a
-/// folder it would refuse is refused before building or rendering for seconds.
+/// Checks `out_dir` as an output folder of `claim` before any work is done, creating nothing:
+/// it must have a final name (not `/` or `..`), its nearest existing ancestor must be a
+/// folder, and it must be missing, an empty folder, or an earlier fabkit output that `claim`
+/// may replace: every file in it listed in its [`OUTPUT_MARKER`] with the SHA-256 fabkit
+/// wrote, written by the same command, and (unless `claim.force`) for the same job. These are
+/// the rules [`StagedDir::new`] and [`crate::write_kit`] apply when they write it. A command
+/// runs this first, so that a folder it would refuse is refused before building or rendering
+/// for seconds. An earlier output's files are read in full to check them.
 ///
 /// # Errors
 /// [`ExportError::InvalidOutDir`], [`ExportError::NotADirectory`],
-/// [`ExportError::ForeignDirectory`], [`ExportError::Io`].
-pub fn check_out_dir(out_dir: &Path) -> Result<(), ExportError> {
+/// [`ExportError::ForeignDirectory`] (naming the first file that is not fabkit's as written),
+/// [`ExportError::OtherCommand`], [`ExportError::OtherJob`], [`ExportError::Io`].
+pub fn check_out_dir(out_dir: &Path, claim: &OutputClaim) -> Result<(), ExportError> {
     let (parent, _) = split(out_dir)?;
     if let Some(existing) = parent.ancestors().find(|a| fs::symlink_metadata(a).is_ok()) {
         if !existing.is_dir() {
@@ -405,7 +610,7 @@ pub fn check_out_dir(out_dir: &Path) -> Result<(), ExportError> {
             });
         }
     }
-    inspect_existing(out_dir).map(|_| ())
+    inspect_existing(out_dir, claim).map(|_| ())
 }
 
 /// (parent directory, final name) of `out_dir`; an empty parent means the current directory.
@@ -423,8 +628,8 @@ fn split(out_dir: &Path) -> Result<(PathBuf, OsString), ExportError> {
     Ok((parent, name.to_os_string()))
 }
 
-/// `Ok(true)` for a directory that may be replaced, `Ok(false)` when nothing is there.
-fn inspect_existing(out_dir: &Path) -> Result<bool, ExportError> {
+/// `Ok(true)` for a directory that `claim` may replace, `Ok(false)` when nothing is there.
+fn inspect_existing(out_dir: &Path, claim: &OutputClaim) -> Result<bool, ExportError> {
     let md = match fs::symlink_metadata(out_dir) {
         Ok(md) => md,
         Err(e) if e.kind() == ErrorKind::NotFound => return Ok(false),
@@ -450,30 +655,34 @@ fn inspect_existing(out_dir: &Path) -> Result<bool, ExportError> {
     if empty {
         return Ok(true);
     }
-    match foreign_entry(out_dir)? {
-        None => Ok(true),
-        Some((entry, why)) => Err(ExportError::ForeignDirectory {
-            path: out_dir.to_path_buf(),
-            entry,
-            why,
-        }),
-    }
+    check_earlier_output(out_dir, claim).map(|()| true)
 }
 
-/// `None` when the non-empty folder `dir` is an output fabkit wrote and nobody changed: its
-/// marker lists every file in it at its size (files the user deleted do not matter). Otherwise
-/// the first entry that shows it is not, and why.
-fn foreign_entry(dir: &Path) -> Result<Option<(String, String)>, ExportError> {
+/// `Ok(())` when the non-empty folder `dir` is an output that `claim` may replace: its marker
+/// (this fabkit's format) lists every file in it, each still at the size and SHA-256 fabkit
+/// wrote (files the user deleted do not matter), names `claim`'s command and, unless
+/// `claim.force`, its job. Otherwise the error names the first entry that shows it is not, or
+/// the other command or job. Names and sizes are checked before any file is read; every
+/// file's SHA-256 before the command and job, so that a forged marker is refused by the
+/// user's file it names.
+fn check_earlier_output(dir: &Path, claim: &OutputClaim) -> Result<(), ExportError> {
+    let foreign = |entry: String, why: String| ExportError::ForeignDirectory {
+        path: dir.to_path_buf(),
+        entry,
+        why,
+    };
     let files = match list_tree(dir)? {
         Ok(f) => f,
-        Err(entry) => return Ok(Some((entry, "is neither a file nor a folder".into()))),
+        Err(entry) => return Err(foreign(entry, "is neither a file nor a folder".into())),
     };
     let marker_path = dir.join(OUTPUT_MARKER);
-    let marker: Option<Marker> = fs::symlink_metadata(&marker_path)
+    let marker_bytes = fs::symlink_metadata(&marker_path)
         .ok()
         .filter(|m| m.is_file() && m.len() <= MAX_MARKER_BYTES)
-        .and_then(|_| fs::read(&marker_path).ok())
-        .and_then(|b| serde_json::from_slice(&b).ok())
+        .and_then(|_| fs::read(&marker_path).ok());
+    let marker: Option<Marker> = marker_bytes
+        .as_deref()
+        .and_then(|b| serde_json::from_slice(b).ok())
         .filter(|m: &Marker| m.format == MARKER_FORMAT);
     let Some(marker) = marker else {
         // The user's first file (not a look-alike manifest.json), for the message.
@@ -483,39 +692,73 @@ fn foreign_entry(dir: &Path) -> Result<Option<(String, String)>, ExportError> {
             .or(files.first())
             .map(|f| f.path.clone())
             .unwrap_or_default();
-        let why = if files.iter().any(|f| f.path == OUTPUT_MARKER) {
+        let earlier = marker_bytes
+            .as_deref()
+            .and_then(|b| serde_json::from_slice::<MarkerFormat>(b).ok())
+            .is_some_and(|m| m.format == MARKER_FORMAT_V1);
+        let why = if earlier {
+            format!(
+                "is there, and the folder's {OUTPUT_MARKER} is the marker of an earlier fabkit, \
+                 without checksums, which a folder of your own can imitate (delete the folder \
+                 yourself if it is an output you no longer need)"
+            )
+        } else if files.iter().any(|f| f.path == OUTPUT_MARKER) {
             format!("is there, and the folder's {OUTPUT_MARKER} is not a fabkit marker")
         } else {
             format!("is there, and the folder has no {OUTPUT_MARKER} marker (an output of an older fabkit has none: delete it yourself)")
         };
-        return Ok(Some((first, why)));
+        return Err(foreign(first, why));
     };
-    let listed: std::collections::BTreeMap<&str, u64> = marker
-        .files
-        .iter()
-        .map(|f| (f.path.as_str(), f.bytes))
-        .collect();
+    let listed: BTreeMap<&str, &MarkedFile> =
+        marker.files.iter().map(|f| (f.path.as_str(), f)).collect();
+    let mut to_hash = Vec::new();
     for f in files.iter().filter(|f| f.path != OUTPUT_MARKER) {
         match listed.get(f.path.as_str()) {
             None => {
-                return Ok(Some((
+                return Err(foreign(
                     f.path.clone(),
                     format!("is not one of the files fabkit wrote there (not in {OUTPUT_MARKER})"),
-                )))
+                ))
             }
-            Some(&n) if n != f.bytes => {
-                return Ok(Some((
+            Some(m) if m.bytes != f.bytes => {
+                return Err(foreign(
                     f.path.clone(),
                     format!(
-                        "was changed after fabkit wrote it ({} bytes, written {n})",
-                        f.bytes
+                        "was changed after fabkit wrote it ({} bytes, written {})",
+                        f.bytes, m.bytes
                     ),
-                )))
+                ))
             }
-            Some(_) => {}
+            Some(m) => to_hash.push(*m),
         }
     }
-    Ok(None)
+    for m in to_hash {
+        if sha256_of_file(&crate::join_rel(dir, &m.path))? != m.sha256 {
+            return Err(foreign(
+                m.path.clone(),
+                "was changed after fabkit wrote it (same size, other bytes: its SHA-256 is not \
+                 the one fabkit recorded)"
+                    .into(),
+            ));
+        }
+    }
+    if marker.command != claim.command.name() {
+        return Err(ExportError::OtherCommand {
+            path: dir.to_path_buf(),
+            command: marker.command,
+            job: marker.job,
+            this_command: claim.command.name(),
+        });
+    }
+    if marker.job != claim.job && !claim.force {
+        return Err(ExportError::OtherJob {
+            path: dir.to_path_buf(),
+            command: marker.command,
+            job: marker.job,
+            this_job: claim.job.clone(),
+        });
+    }
+    Ok(())
 }
 
 /// Largest marker file read back, bytes (a list of files, not a dataset).
@@ -602,6 +845,14 @@ fn create_unique_sibling(
 mod tests {
     use super::*;
 
+    fn claim() -> OutputClaim {
+        OutputClaim {
+            command: OutputCommand::Groundtruth,
+            job: "design 'rtac0'".into(),
+            force: false,
+        }
+    }
+
     fn siblings(parent: &Path) -> Vec<String> {
         let mut v: Vec<String> = fs::read_dir(parent)
             .unwrap()
@@ -615,7 +866,7 @@ mod tests {
     fn failing_fill_leaves_nothing_behind() {
         let root = tempfile::tempdir().unwrap();
         let out = root.path().join("kit");
-        let r = replace_dir(&out, |tmp| {
+        let r = replace_dir(&out, &claim(), |tmp, _| {
             write_file_synced(&tmp.join("half.stl"), b"x")?;
             Err(ExportError::ThreeMf {
                 reason: "injected".into(),
@@ -629,14 +880,14 @@ mod tests {
     fn failing_fill_keeps_the_previous_export() {
         let root = tempfile::tempdir().unwrap();
         let out = root.path().join("kit");
-        replace_dir(&out, |tmp| {
+        replace_dir(&out, &claim(), |tmp, _| {
             write_file_synced(
                 &tmp.join("manifest.json"),
                 b"{\"fabkit_version\": \"0.0.1\"}\n",
             )
         })
         .unwrap();
-        let r = replace_dir(&out, |_| {
+        let r = replace_dir(&out, &claim(), |_, _| {
             Err(ExportError::ThreeMf {
                 reason: "injected".into(),
             })
@@ -668,7 +919,10 @@ mod tests {
             fs::create_dir(d).unwrap();
             fs::write(d.join("half.stl"), b"x").unwrap();
         }
-        let r = replace_dir(&out, |tmp| write_file_synced(&tmp.join("a.stl"), b"a")).unwrap();
+        let r = replace_dir(&out, &claim(), |tmp, _| {
+            write_file_synced(&tmp.join("a.stl"), b"a")
+        })
+        .unwrap();
         let mut live = live;
         let _ = live.kill();
         let _ = live.wait();
@@ -702,7 +956,7 @@ mod tests {
         let out = root.path().join("kit");
         fs::create_dir(&out).unwrap();
         fs::write(out.join("manifest.json"), "{\"name\": \"web app\"}").unwrap();
-        let r = replace_dir(&out, |_| Ok(()));
+        let r = replace_dir(&out, &claim(), |_, _| Ok(()));
         assert!(
             matches!(r, Err(ExportError::ForeignDirectory { ref entry, .. }) if entry == "manifest.json")
         );
@@ -714,13 +968,13 @@ mod tests {
         let root = tempfile::tempdir().unwrap();
         let out = root.path().join("gt");
         {
-            let st = StagedDir::new(&out).unwrap();
+            let st = StagedDir::new(&out, claim()).unwrap();
             st.write("a/b.bin", b"x").unwrap();
             assert!(st.write("../c", b"y").is_err());
             // dropped without commit
         }
         assert!(siblings(root.path()).is_empty());
-        let st = StagedDir::new(&out).unwrap();
+        let st = StagedDir::new(&out, claim()).unwrap();
         st.write("a/b.bin", b"x").unwrap();
         st.write("manifest.json", b"{\"fabkit_version\": \"0\"}")
             .unwrap();
@@ -728,7 +982,7 @@ mod tests {
         assert_eq!(siblings(root.path()), vec!["gt"]);
         assert_eq!(fs::read(out.join("a/b.bin")).unwrap(), b"x");
         // A previous output is replaced; a foreign folder is refused.
-        let st = StagedDir::new(&out).unwrap();
+        let st = StagedDir::new(&out, claim()).unwrap();
         st.write("manifest.json", b"{\"fabkit_version\": \"1\"}")
             .unwrap();
         st.commit().unwrap();
@@ -737,7 +991,7 @@ mod tests {
         fs::create_dir(&foreign).unwrap();
         fs::write(foreign.join("notes.txt"), "keep").unwrap();
         assert!(matches!(
-            StagedDir::new(&foreign),
+            StagedDir::new(&foreign, claim()),
             Err(ExportError::ForeignDirectory { .. })
         ));
     }

@@ -87,6 +87,34 @@ pub enum ExportError {
         entry: String,
         why: String,
     },
+    /// The output directory holds another command's output (its marker names `command`):
+    /// a command replaces only its own kind of output, even with `--force`.
+    #[error(
+        "output directory {} holds the output of `fabkit {command}` ({job}), which `fabkit \
+         {this_command}` does not replace; refusing to replace it (hint: choose another \
+         directory, or delete it yourself if you no longer need it)",
+        path.display()
+    )]
+    OtherCommand {
+        path: PathBuf,
+        command: String,
+        job: String,
+        this_command: &'static str,
+    },
+    /// The output directory holds an output of the same command for another job (another
+    /// kit, tolerance or inputs): replaced only when forced.
+    #[error(
+        "output directory {} holds the output of `fabkit {command}` for {job}, made with other \
+         options or inputs than this one ({this_job}): refusing to replace it (hint: choose \
+         another directory, or give --force (Python: force=True) to replace it)",
+        path.display()
+    )]
+    OtherJob {
+        path: PathBuf,
+        command: String,
+        job: String,
+        this_job: String,
+    },
     /// A file-system operation failed; `action` says which (e.g. `writing`).
     #[error("{action} {}", path.display())]
     Io {

@@ -36,7 +36,7 @@ mod stl;
 mod three_mf;
 pub mod two_d;
 
-pub use atomic::{check_out_dir, StagedDir, OUTPUT_MARKER};
+pub use atomic::{check_out_dir, OutputClaim, OutputCommand, StagedDir, OUTPUT_MARKER};
 pub use check::check_printable_mesh;
 pub use error::ExportError;
 pub use manifest::{
@@ -49,7 +49,6 @@ pub use manifest::{
 use fabkit_designs::assembly::{ExactShape, MemberKind};
 use fabkit_designs::geometry::{Mesh, TopologyError};
 use fabkit_designs::kit::Kit;
-use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 
 /// Which mesh formats to write. `manifest.json` and `FABRICATION.md` are always written.
@@ -92,12 +91,19 @@ pub struct ExportOptions {
     /// The printers whose beds the plates are laid out in (the design's `printers`, with any
     /// `--printer` applied); a technology without a bed gets its shipped printer.
     pub printers: fabkit_designs::schema::PrinterProfiles,
+    /// The command whose output this is, recorded in the folder's marker: an earlier output
+    /// of another command is never replaced.
+    pub command: OutputCommand,
+    /// Replace an earlier output of the same command for another kit or chord tolerance
+    /// (`--force`).
+    pub force: bool,
 }
 
 impl ExportOptions {
     /// The options of an export of the design read from `design_source` (its path, or
     /// `embedded:<name>`) whose text hashes to `design_sha256`, built at `chord_tolerance_mm`,
-    /// by `command_line`, onto the beds of `printers`; this fabkit's version.
+    /// by `command_line`, onto the beds of `printers`; this fabkit's version; the output of
+    /// `fabkit export`, not forced.
     pub fn for_design(
         formats: Formats,
         command_line: Vec<String>,
@@ -114,47 +120,17 @@ impl ExportOptions {
             chord_tolerance_mm,
             fabkit_version: env!("CARGO_PKG_VERSION").to_string(),
             printers,
+            command: OutputCommand::Export,
+            force: false,
         }
     }
-}
 
-/// Refuses to replace an earlier export in `out` whose kit (`design.name` in its manifest: the
-/// design, its preset and mold strategy) or chord tolerance differ from this one's (`kit`,
-/// `chord_tolerance_mm`), unless `force`. A folder without a readable manifest is left to the
-/// writer's own rules. `out_name` and `force_name` name the output and the override where the
-/// caller takes them (`--out` and `--force` on the command line).
-///
-/// # Errors
-/// The message names the output, the earlier kit and tolerance, this one's and the remedy.
-pub fn check_replacing(
-    out: &Path,
-    kit: &str,
-    chord_tolerance_mm: f64,
-    force: bool,
-    out_name: &str,
-    force_name: &str,
-) -> Result<(), String> {
-    let Ok(text) = std::fs::read(out.join("manifest.json")) else {
-        return Ok(());
-    };
-    let Ok(m) = serde_json::from_slice::<serde_json::Value>(&text) else {
-        return Ok(());
-    };
-    let (Some(prev), Some(prev_tol)) = (
-        m["design"]["name"].as_str(),
-        m["chord_tolerance_mm"].as_f64(),
-    ) else {
-        return Ok(());
-    };
-    if force || (prev == kit && prev_tol == chord_tolerance_mm) {
-        return Ok(());
+    /// The claim on the output folder of `kit_name` (the kit's `design`) written with these
+    /// options: this command, the kit and chord tolerance as the job, and `force`. What
+    /// [`write_kit`] checks; a command checks it with [`check_out_dir`] before building.
+    pub fn claim(&self, kit_name: &str) -> OutputClaim {
+        OutputClaim::kit(self.command, kit_name, self.chord_tolerance_mm, self.force)
     }
-    Err(format!(
-        "{out_name} {}: holds the kit '{prev}' at chord tolerance {prev_tol} mm, made with other \
-         options than this export ('{kit}' at {chord_tolerance_mm} mm): refusing to replace it \
-         (hint: choose another {out_name}, or give {force_name} to replace it)",
-        out.display(),
-    ))
 }
 
 /// What [`write_kit`] wrote.
@@ -183,9 +159,10 @@ pub struct ExportSummary {
 /// every file holds and what every number in the manifest is computed from.
 ///
 /// `out_dir` may be missing (parent directories are created), an empty directory, or a
-/// previous fabkit export (a directory with a fabkit `manifest.json`), which is replaced as a
-/// whole, including any file added to it by hand. Nothing is written under `out_dir` until
-/// every file is complete and synced in a temporary sibling directory.
+/// previous output that [`ExportOptions::claim`] may replace (see [`check_out_dir`]: the
+/// same command, every file as fabkit wrote it, and unless `opts.force` the same kit and
+/// tolerance), which is replaced as a whole. Nothing is written under `out_dir` until every
+/// file is complete and synced in a temporary sibling directory.
 ///
 /// # Errors
 /// - names, options and meshes are checked before anything touches the disk:
@@ -195,7 +172,8 @@ pub struct ExportSummary {
 ///   [`ExportError::InvalidOption`], [`ExportError::NotManifold`],
 ///   [`ExportError::CoincidentVertices`], [`ExportError::TooManyTriangles`];
 /// - output path: [`ExportError::InvalidOutDir`], [`ExportError::NotADirectory`],
-///   [`ExportError::ForeignDirectory`] (a non-empty directory fabkit did not write);
+///   [`ExportError::ForeignDirectory`] (a non-empty directory fabkit did not write, or one
+///   changed since), [`ExportError::OtherCommand`], [`ExportError::OtherJob`];
 /// - [`ExportError::Io`], [`ExportError::ThreeMf`], [`ExportError::Json`].
 ///
 /// On every error `out_dir` is left exactly as it was and no temporary directory remains.
@@ -254,12 +232,21 @@ fn write_kit_meshes(
         check_printable_mesh(&part.name, mesh)?;
     }
     let rendered = render(kit, meshes, data_files, opts, step_progress)?;
-    let done = atomic::replace_dir(out_dir, |tmp| {
+    let claim = opts.claim(&kit.design);
+    let hashes: Vec<String> = {
+        use rayon::prelude::*;
+        rendered
+            .files
+            .par_iter()
+            .map(|(_, b)| sha256_hex(b))
+            .collect()
+    };
+    let done = atomic::replace_dir(out_dir, &claim, |tmp, written| {
         if opts.formats.stl {
             let parts_dir = tmp.join(PARTS_DIR);
             std::fs::create_dir(&parts_dir).map_err(ExportError::io("creating", &parts_dir))?;
         }
-        for (rel, bytes) in &rendered.files {
+        for ((rel, bytes), sha256) in rendered.files.iter().zip(hashes) {
             let path = join_rel(tmp, rel);
             if let Some(parent) = path.parent() {
                 if parent != tmp && !parent.exists() {
@@ -267,6 +254,7 @@ fn write_kit_meshes(
                 }
             }
             atomic::write_file_synced(&path, bytes)?;
+            written.insert(rel, sha256);
         }
         if opts.formats.stl {
             atomic::sync_dir(&tmp.join(PARTS_DIR))?;
@@ -1086,12 +1074,7 @@ fn join_rel(base: &Path, rel: &str) -> PathBuf {
     rel.split('/').fold(base.to_path_buf(), |p, c| p.join(c))
 }
 
-fn sha256_hex(bytes: &[u8]) -> String {
-    Sha256::digest(bytes)
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect()
-}
+use atomic::sha256_hex;
 
 #[cfg(test)]
 mod tests {
@@ -1133,6 +1116,8 @@ mod tests {
             chord_tolerance_mm: 0.01,
             fabkit_version: "0.1.0".into(),
             printers: Default::default(),
+            command: OutputCommand::Export,
+            force: false,
         }
     }
 

@@ -8,7 +8,7 @@ use fabkit_calibration::refine::RefineParameters;
 use fabkit_calibration::{
     calibrate_extrinsics, DistortionModelHint, ExtrinsicsJob, Observed, PointsFrom, RansacOptions,
 };
-use fabkit_export::StagedDir;
+use fabkit_export::{OutputClaim, OutputCommand, StagedDir};
 
 #[derive(clap::Subcommand, Debug)]
 pub enum CalibrateCommand {
@@ -83,10 +83,16 @@ pub struct ExtrinsicsArgs {
     #[arg(long, value_name = "PLAN.csv")]
     pub capture_plan: Option<PathBuf>,
     /// Output folder for extrinsics.json, extrinsics.yaml (overlay.png; from images
-    /// observations.csv and overlays/): missing, empty, or an
-    /// earlier fabkit output (replaced whole, never a folder of the user's own files).
+    /// observations.csv and overlays/): missing, empty, or an earlier calibration of the same
+    /// inputs as fabkit wrote it (replaced whole; never a folder of the user's own files or
+    /// another command's output).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
+    /// Replace an earlier calibration in --out computed from other inputs (other captures,
+    /// observations, camera file or point table); without it that result is kept and this run
+    /// refused. Another command's output (an export, fixtures, ground truth) is never replaced.
+    #[arg(long)]
+    pub force: bool,
     /// Capture image (PNG) for an overlay of observed and reprojected points.
     #[arg(long, value_name = "IMG.png")]
     pub image: Option<PathBuf>,
@@ -123,6 +129,29 @@ fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
         )
         .into());
     }
+    // The job of the output: its inputs (what it was computed from), not the solver's options.
+    let captures = a.images.len().max(a.observations.len());
+    let inputs: Vec<&std::path::Path> = [&a.camera, &a.points]
+        .into_iter()
+        .chain(&a.observations)
+        .chain(&a.images)
+        .chain(&a.reference)
+        .chain(&a.capture_plan)
+        .map(PathBuf::as_path)
+        .collect();
+    let claim = OutputClaim::of_inputs(
+        OutputCommand::CalibrateExtrinsics,
+        &format!(
+            "extrinsics from {captures} {}",
+            if a.images.is_empty() {
+                "observation files"
+            } else {
+                "captures"
+            }
+        ),
+        &inputs,
+        a.force,
+    );
     let job = ExtrinsicsJob {
         camera: a.camera,
         camera_model: a.camera_model.map(Into::into),
@@ -156,7 +185,7 @@ fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
     };
     // The output folder is checked (and its temporary sibling made) before the solve; nothing
     // appears under --out unless every file is written.
-    let staged = StagedDir::new(&a.out)?;
+    let staged = StagedDir::new(&a.out, claim)?;
     let out = calibrate_extrinsics(&job)?;
     for (name, bytes) in &out.files {
         staged.write(name, bytes)?;

@@ -94,6 +94,7 @@ struct ExportArgs {
     mold_strategy: Option<Strategy>,
     /// Replace an earlier export in --out made with other options (another design, preset,
     /// mold strategy or chord tolerance); without it that export is kept and this one refused.
+    /// Another command's output (fixtures, ground truth, calibration) is never replaced.
     #[arg(long)]
     force: bool,
     /// Also write the CSG tree of every part (fabkit-csg/1 JSON) to this file, for
@@ -187,22 +188,6 @@ pub fn main() -> i32 {
             2
         }
     }
-}
-
-/// Refuses to replace an earlier export in `out` whose kit (`design.name` in its manifest: the
-/// design, its preset and mold strategy) or chord tolerance differ from this one's, unless
-/// `force`. A folder without a readable manifest is left to the writer's own rules.
-///
-/// # Errors
-/// Naming `--out`, the earlier kit and tolerance, this one's and the remedy.
-pub(crate) fn check_replacing(
-    out: &Path,
-    kit: &str,
-    tol: ChordTolerance,
-    force: bool,
-) -> Result<(), Box<dyn Error>> {
-    fabkit_export::check_replacing(out, kit, tol.mm(), force, "--out", "--force")
-        .map_err(Into::into)
 }
 
 /// `v` with every number that is not an integer rounded to 1e-9 (float noise such as
@@ -491,9 +476,10 @@ fn export(args: ExportArgs) -> Result<(), Box<dyn Error>> {
         .out
         .clone()
         .unwrap_or_else(|| Path::new("out").join(&loaded.design.name));
+    let mut opts = export_options(&loaded, tol, &args.format);
+    opts.force = args.force;
     // The output folder is checked before anything is built.
-    fabkit_export::check_out_dir(&out)?;
-    check_replacing(&out, &loaded.design.name, tol, args.force)?;
+    fabkit_export::check_out_dir(&out, &opts.claim(&loaded.design.name))?;
     if let Some(csg) = &args.csg {
         check_csg_path(csg)?;
     }
@@ -507,7 +493,6 @@ fn export(args: ExportArgs) -> Result<(), Box<dyn Error>> {
     let kit = build_kit_bounded(&loaded.design, tol, args.max_triangles);
     spinner.finish_and_clear();
     let kit = kit?;
-    let opts = export_options(&loaded, tol, &args.format);
     // STEP export takes seconds a part: one plain line per part (a terminal, a log or a pipe)
     let step_progress = |i: usize, n: usize, part: &str| eprintln!("STEP {i}/{n}: {part}");
     let summary = write_kit_reporting(&kit, &[], &out, &opts, Some(&step_progress))?;

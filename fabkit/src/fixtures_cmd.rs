@@ -13,10 +13,15 @@ use std::path::{Path, PathBuf};
 pub struct FixturesArgs {
     /// A design YAML file or the name of a library design (default: rtac0).
     design: Option<String>,
-    /// Output directory (default: out/<design>_fixtures). Replaced as a whole if it holds a
-    /// previous export; refused if it holds anything else.
+    /// Output directory (default: out/<design>_fixtures). Replaced as a whole if it holds
+    /// earlier fixtures of the same design and chord tolerance, as fabkit wrote them; refused if
+    /// it holds anything else.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Replace earlier fixtures in --out of another design or chord tolerance. Another
+    /// command's output (an export, ground truth, a calibration) is never replaced.
+    #[arg(long)]
+    force: bool,
     /// Fixture parameters (YAML: pin_dome, semidomes, grid_plate, semiplates, indenters);
     /// defaults where absent.
     #[arg(long)]
@@ -75,9 +80,15 @@ pub fn run(args: FixturesArgs) -> Result<(), Box<dyn Error>> {
     let out = args
         .out
         .clone()
-        .unwrap_or_else(|| Path::new("out").join(format!("{}_fixtures", loaded.design.name)));
+        .unwrap_or_else(|| Path::new("out").join(fabkit_fixtures::kit_name(&loaded.design.name)));
+    let mut opts = export_options(&loaded, tol, &args.format);
+    opts.command = fabkit_export::OutputCommand::Fixtures;
+    opts.force = args.force;
     // The output folder is checked before anything is built, as `fabkit export` checks it.
-    fabkit_export::check_out_dir(&out)?;
+    fabkit_export::check_out_dir(
+        &out,
+        &opts.claim(&fabkit_fixtures::kit_name(&loaded.design.name)),
+    )?;
     let provenance =
         fabkit_fixtures::provenance(&loaded.design.name, &loaded.source, &loaded.sha256);
     if let Some(csg) = &args.csg {
@@ -129,7 +140,6 @@ pub fn run(args: FixturesArgs) -> Result<(), Box<dyn Error>> {
             out.display()
         ));
     }
-    let opts = export_options(&loaded, tol, &args.format);
     // STEP export takes seconds a part: each part as the CadQuery twin starts it
     let step_progress = |i: usize, n: usize, part: &str| {
         let what = format!("STEP {i}/{n}: {part}");

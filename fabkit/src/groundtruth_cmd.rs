@@ -6,7 +6,7 @@ use fabkit_calibration::groundtruth::budget::{
     MAX_PIXELS_LIMIT, MEMORY_BUDGET_BYTES, MIN_SKIN_FRACTION,
 };
 use std::error::Error;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use fabkit_calibration::groundtruth::inputs::{
@@ -21,7 +21,7 @@ use fabkit_export::raster::{
     normals_rgb, npy_f32, npz as npz_file, ply_points, png_gray16, png_gray8, png_rgb8,
     preview_rgb, PlyPoint, Png16Encoding,
 };
-use fabkit_export::StagedDir;
+use fabkit_export::{OutputClaim, OutputCommand, StagedDir};
 use rayon::prelude::*;
 use serde_json::{json, Value};
 
@@ -45,10 +45,16 @@ pub struct GroundTruthArgs {
     /// Output folder of `fabkit fixtures` (reads protrusions/index.json and the pattern files).
     #[arg(long, value_name = "FIXTURES_DIR")]
     fixtures: PathBuf,
-    /// Output folder. Replaced as a whole if it holds a previous fabkit output; refused if it
-    /// holds anything else.
+    /// Output folder. Replaced as a whole if it holds earlier ground truth of the same inputs
+    /// (design, camera, extrinsics, fixtures) as fabkit wrote it; refused if it holds anything
+    /// else.
     #[arg(long, value_name = "DIR")]
     out: PathBuf,
+    /// Replace earlier ground truth in --out computed from other inputs; without it that
+    /// output is kept and this run refused. Another command's output (an export, fixtures, a
+    /// calibration) is never replaced.
+    #[arg(long)]
+    force: bool,
     /// Apply one of the design's presets.
     #[arg(long)]
     preset: Option<String>,
@@ -480,11 +486,34 @@ pub fn check_skin_seen(
     ))
 }
 
+/// The claim on --out: ground truth of the design (by name, or its file's content), the
+/// camera file, the extrinsics and the fixtures folder (its marker lists the SHA-256 of every
+/// file in it; its protrusion index counts when there is no marker).
+fn claim(args: &GroundTruthArgs) -> OutputClaim {
+    let design = args
+        .design
+        .as_deref()
+        .unwrap_or(fabkit_designs::library::DEFAULT_DESIGN);
+    let design_file = Path::new(design);
+    let fixtures_marker = args.fixtures.join(fabkit_export::OUTPUT_MARKER);
+    let index = args.fixtures.join("protrusions").join("index.json");
+    let mut inputs: Vec<&Path> = vec![&args.camera, &args.extrinsics, &fixtures_marker, &index];
+    if design_file.is_file() {
+        inputs.push(design_file);
+    }
+    let what = match &args.preset {
+        Some(p) => format!("ground truth of design '{design}' preset '{p}'"),
+        None => format!("ground truth of design '{design}'"),
+    };
+    OutputClaim::of_inputs(OutputCommand::Groundtruth, &what, &inputs, args.force)
+}
+
 pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
     let t0 = std::time::Instant::now();
     // The output folder is checked before anything is read or rendered, as `fabkit export`
     // checks it.
-    fabkit_export::check_out_dir(&args.out)?;
+    let claim = claim(&args);
+    fabkit_export::check_out_dir(&args.out, &claim)?;
     let mut loaded = load_design(args.design.as_deref(), &args.data_files)?;
     if let Some(p) = &args.preset {
         loaded.apply_preset(p)?;
@@ -611,7 +640,7 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
         loaded.sha256
     );
 
-    let staged = StagedDir::new(&args.out)?;
+    let staged = StagedDir::new(&args.out, claim)?;
     let reference = DepthFrame::new(&rays, &ref_hits);
     let preview = finite_range(&reference.range_mm)
         .into_iter()

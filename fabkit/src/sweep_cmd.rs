@@ -5,7 +5,7 @@ use fabkit_designs::kit::Kit;
 use fabkit_designs::sweep::{
     self, Event, FilesJob, KitWriter, RunOptions, Shard, Status, SweepSpec,
 };
-use fabkit_export::{write_kit, ExportOptions, Formats};
+use fabkit_export::{write_kit, ExportOptions, Formats, OutputCommand};
 use std::error::Error;
 use std::io::IsTerminal as _;
 use std::path::PathBuf;
@@ -83,6 +83,9 @@ impl KitWriter for ExportWriter {
             fabkit_version: env!("CARGO_PKG_VERSION").to_string(),
             // the shipped printers: a sweep's variants are laid out for the default beds
             printers: Default::default(),
+            // variants/<id>/ of the sweep folder (which the sweep checks is its own)
+            command: OutputCommand::SweepVariant,
+            force: false,
         };
         write_kit(kit, &job.dir, &opts)
             .map(|_| ())

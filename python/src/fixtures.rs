@@ -177,6 +177,7 @@ pub fn build_fixtures(
         design: design.clone(),
         tol,
         files: files.clone(),
+        command: fabkit_export::OutputCommand::Fixtures,
     };
     Ok(Fixtures {
         kit: Py::new(py, kit)?,

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use fabkit_designs::{build_kit_bounded, ChordTolerance, Kit as KitData};
-use fabkit_export::{ExportOptions, Formats};
+use fabkit_export::{ExportOptions, Formats, OutputCommand};
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray2};
 use pyo3::exceptions::PyValueError;
@@ -75,6 +75,8 @@ pub struct Kit {
     pub(crate) tol: ChordTolerance,
     /// Data files written beside the meshes (fixtures: point tables, descriptions).
     pub(crate) files: Arc<Vec<(String, Vec<u8>)>>,
+    /// The command whose output `export` writes (an export or fixtures), as the CLI's.
+    pub(crate) command: OutputCommand,
 }
 
 /// One printable part of a kit, in print orientation (resting on z = 0), mm.
@@ -227,8 +229,10 @@ impl Kit {
     /// Writes the kit into the folder `out` as `fabkit export` (or `fabkit fixtures`) does:
     /// the same files, byte for byte, for the same design, options and `command_line` (which
     /// the manifest records; default: this process's arguments). `out` may be missing, empty or
-    /// an earlier export of the same kit and tolerance (replaced as a whole; another kit only
-    /// with `force`); anything else is refused and nothing is written. Returns the manifest
+    /// an earlier export (or fixtures) of the same kit and tolerance as fabkit wrote it
+    /// (replaced as a whole; another kit or tolerance only with `force`); anything else (a
+    /// folder of your own, an edited output, another command's output) is refused and nothing
+    /// is written. Returns the manifest
     /// as a dict. `progress(done, total, message)` is called as each STEP part starts.
     ///
     /// Raises ExportError with the CLI's message.
@@ -243,16 +247,7 @@ impl Kit {
         progress: Option<Py<PyAny>>,
     ) -> PyResult<Py<PyAny>> {
         let f = crate::kit::formats(&formats)?;
-        fabkit_export::check_replacing(
-            &out,
-            &self.kit.design,
-            self.tol.mm(),
-            force,
-            "out",
-            "force=True",
-        )
-        .map_err(ExportError::new_err)?;
-        let opts = ExportOptions::for_design(
+        let mut opts = ExportOptions::for_design(
             f,
             command_line.unwrap_or_else(|| std::env::args().collect()),
             &self.design.source,
@@ -260,6 +255,8 @@ impl Kit {
             self.tol.mm(),
             self.design.design.printers.clone(),
         );
+        opts.command = self.command;
+        opts.force = force;
         let step = |i: usize, n: usize, part: &str| {
             report_progress(&progress, i, n, &format!("STEP {i}/{n}: {part}"))
         };
@@ -316,6 +313,7 @@ pub fn build_kit(
         design: design.clone(),
         tol,
         files: Arc::new(Vec::new()),
+        command: OutputCommand::Export,
     })
 }
 

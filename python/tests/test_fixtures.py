@@ -162,3 +162,16 @@ def test_bad_fixture_params_message_matches_cli(tmp_path, run_cli):
         fabkit.build_fixtures(fabkit.Design.load("rtac0"), params=str(bad))
     assert str(e.value) == cli_message(p.stderr)
     assert not (tmp_path / "X").exists()
+
+
+def test_an_export_never_replaces_fixtures(pair):
+    """Kit.export into the folder of a fixtures kit is refused, even with force=True (a command
+    replaces only its own kind of output), naming the command, and the folder is unchanged."""
+    _, g, _, _ = pair
+    before = {p.relative_to(g): p.read_bytes() for p in sorted(g.rglob("*")) if p.is_file()}
+    kit = fabkit.build_kit(fabkit.Design.load("rtac0"))
+    for force in (False, True):
+        with pytest.raises(fabkit.ExportError, match="holds the output of `fabkit fixtures`"):
+            kit.export(g, force=force)
+    after = {p.relative_to(g): p.read_bytes() for p in sorted(g.rglob("*")) if p.is_file()}
+    assert after == before

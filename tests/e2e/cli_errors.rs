@@ -950,11 +950,11 @@ fn a_mold_strategy_export_never_silently_replaces_the_default_kit() {
     for (extra, words) in [
         (
             &["--mold-strategy", "direct", "--out", "out/rtac0"][..],
-            "--out out/rtac0: holds the kit 'rtac0' at chord tolerance 0.05 mm, made with other options than this export ('rtac0_mold_direct' at 0.05 mm): refusing to replace it (hint: choose another --out, or give --force to replace it)",
+            "output directory out/rtac0 holds the output of `fabkit export` for kit 'rtac0' at chord tolerance 0.05 mm, made with other options or inputs than this one (kit 'rtac0_mold_direct' at chord tolerance 0.05 mm): refusing to replace it (hint: choose another directory, or give --force (Python: force=True) to replace it)",
         ),
         (
             &["--chord-tolerance-mm", "0.06"][..],
-            "holds the kit 'rtac0' at chord tolerance 0.05 mm, made with other options than this export ('rtac0' at 0.06 mm)",
+            "for kit 'rtac0' at chord tolerance 0.05 mm, made with other options or inputs than this one (kit 'rtac0' at chord tolerance 0.06 mm)",
         ),
     ] {
         let o = export(extra);

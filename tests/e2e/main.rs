@@ -21,6 +21,7 @@ mod groundtruth_cli;
 mod groundtruth_flat;
 mod groundtruth_open3d;
 mod maker_path;
+mod output_ownership;
 mod plates;
 mod report_html;
 mod schema;

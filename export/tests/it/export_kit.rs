@@ -109,6 +109,8 @@ fn opts() -> ExportOptions {
         chord_tolerance_mm: 0.05,
         fabkit_version: "0.1.0".into(),
         printers: Default::default(),
+        command: fabkit_export::OutputCommand::Export,
+        force: false,
     }
 }
 
@@ -1015,7 +1017,8 @@ fn prusa_slicer_loads_a_group_as_one_object_with_named_volumes() {
     }
 }
 
-/// The marker lists every other file of the output with its size, sorted, and nothing else.
+/// The marker names the command and the job, and lists every other file of the output with
+/// its size and SHA-256 (computed here from the files on disk), sorted, and nothing else.
 #[test]
 fn marker_lists_every_file_of_the_output() {
     let root = tempfile::tempdir().unwrap();
@@ -1023,8 +1026,10 @@ fn marker_lists_every_file_of_the_output() {
     write_kit(&test_kit(), &out, &opts()).unwrap();
     let marker: serde_json::Value =
         serde_json::from_slice(&fs::read(out.join(OUTPUT_MARKER)).unwrap()).unwrap();
-    assert_eq!(marker["format"], "fabkit-output/1");
-    let listed: Vec<(PathBuf, u64)> = marker["files"]
+    assert_eq!(marker["format"], "fabkit-output/2");
+    assert_eq!(marker["command"], "export");
+    assert_eq!(marker["job"], "kit 'tiny' at chord tolerance 0.05 mm");
+    let listed: Vec<(PathBuf, u64, String)> = marker["files"]
         .as_array()
         .unwrap()
         .iter()
@@ -1032,19 +1037,127 @@ fn marker_lists_every_file_of_the_output() {
             (
                 PathBuf::from(f["path"].as_str().unwrap()),
                 f["bytes"].as_u64().unwrap(),
+                f["sha256"].as_str().unwrap().to_string(),
             )
         })
         .collect();
-    let on_disk: Vec<(PathBuf, u64)> = tree(&out)
+    let on_disk: Vec<(PathBuf, u64, String)> = tree(&out)
         .into_iter()
         .filter(|p| p != Path::new(OUTPUT_MARKER))
         .map(|p| {
-            let n = fs::metadata(out.join(&p)).unwrap().len();
-            (p, n)
+            let bytes = fs::read(out.join(&p)).unwrap();
+            (p, bytes.len() as u64, sha256_hex(&bytes))
         })
         .collect();
     assert!(on_disk.len() >= 3, "{on_disk:?}");
     assert_eq!(listed, on_disk);
+}
+
+/// A folder of the user's own files with a forged marker naming them at their sizes (in this
+/// fabkit's format with made-up checksums, or in the earlier format without any) is refused,
+/// naming the user's file, and nothing in it is touched.
+#[test]
+fn forged_marker_naming_the_users_files_is_refused() {
+    let root = tempfile::tempdir().unwrap();
+    let out = root.path().join("thesis");
+    fs::create_dir(&out).unwrap();
+    fs::write(out.join("thesis.tex"), b"\\section{Results}").unwrap();
+    let n = fs::metadata(out.join("thesis.tex")).unwrap().len();
+    let forged = [
+        serde_json::json!({"format": "fabkit-output/1",
+                           "files": [{"path": "thesis.tex", "bytes": n}]}),
+        serde_json::json!({"format": "fabkit-output/2", "command": "export",
+                           "job": "kit 'tiny' at chord tolerance 0.05 mm",
+                           "files": [{"path": "thesis.tex", "bytes": n,
+                                      "sha256": "0".repeat(64)}]}),
+    ];
+    for marker in forged {
+        fs::write(out.join(OUTPUT_MARKER), marker.to_string()).unwrap();
+        for force in [false, true] {
+            let o = ExportOptions { force, ..opts() };
+            let err = write_kit(&test_kit(), &out, &o).unwrap_err();
+            assert!(
+                matches!(err, ExportError::ForeignDirectory { ref entry, .. } if entry == "thesis.tex"),
+                "{marker}: {err}"
+            );
+            assert_eq!(
+                fs::read(out.join("thesis.tex")).unwrap(),
+                b"\\section{Results}"
+            );
+        }
+    }
+    assert_eq!(entries(&out), [OUTPUT_MARKER, "thesis.tex"]);
+}
+
+/// An output of another command is never replaced, even with force; one of the same command
+/// for another kit or tolerance only with force.
+#[test]
+fn another_commands_output_is_kept_and_another_job_only_with_force() {
+    use fabkit_export::{OutputClaim, OutputCommand, StagedDir};
+    let root = tempfile::tempdir().unwrap();
+    let calib = root.path().join("calib");
+    let claim = OutputClaim::of_inputs(
+        OutputCommand::CalibrateExtrinsics,
+        "extrinsics from 1 captures",
+        &[],
+        false,
+    );
+    let st = StagedDir::new(&calib, claim.clone()).unwrap();
+    st.write("extrinsics.json", b"{}\n").unwrap();
+    st.commit().unwrap();
+    for force in [false, true] {
+        let o = ExportOptions { force, ..opts() };
+        let err = write_kit(&test_kit(), &calib, &o).unwrap_err();
+        assert!(matches!(err, ExportError::OtherCommand { .. }), "{err}");
+        let text = err.to_string();
+        assert!(
+            text.contains("`fabkit calibrate extrinsics`") && text.contains("`fabkit export`"),
+            "{text}"
+        );
+        assert_eq!(fs::read(calib.join("extrinsics.json")).unwrap(), b"{}\n");
+    }
+    // and the other way round
+    let kit = root.path().join("kit");
+    write_kit(&test_kit(), &kit, &opts()).unwrap();
+    let err = StagedDir::new(
+        &kit,
+        OutputClaim {
+            force: true,
+            ..claim.clone()
+        },
+    )
+    .unwrap_err();
+    assert!(matches!(err, ExportError::OtherCommand { .. }), "{err}");
+    assert!(kit.join("manifest.json").is_file());
+    // the same command at another tolerance: only with force
+    let other = ExportOptions {
+        chord_tolerance_mm: 0.02,
+        ..opts()
+    };
+    let err = write_kit(&test_kit(), &kit, &other).unwrap_err();
+    assert!(
+        matches!(err, ExportError::OtherJob { ref job, ref this_job, .. }
+            if job == "kit 'tiny' at chord tolerance 0.05 mm"
+            && this_job == "kit 'tiny' at chord tolerance 0.02 mm"),
+        "{err}"
+    );
+    assert!(err.to_string().contains("--force"), "{err}");
+    let forced = ExportOptions {
+        force: true,
+        ..other
+    };
+    write_kit(&test_kit(), &kit, &forced).unwrap();
+    let marker: serde_json::Value =
+        serde_json::from_slice(&fs::read(kit.join(OUTPUT_MARKER)).unwrap()).unwrap();
+    assert_eq!(marker["job"], "kit 'tiny' at chord tolerance 0.02 mm");
+    // a calibration of the same inputs replaces its own output
+    let st = StagedDir::new(&calib, claim).unwrap();
+    st.write("extrinsics.json", b"{\"v\": 2}\n").unwrap();
+    st.commit().unwrap();
+    assert_eq!(
+        fs::read(calib.join("extrinsics.json")).unwrap(),
+        b"{\"v\": 2}\n"
+    );
 }
 
 /// A user's folder holding a look-alike fabkit manifest.json is not taken for an output:
@@ -1095,7 +1208,8 @@ fn previous_output_changed_by_the_user_is_refused_and_untouched() {
     fs::remove_file(out.join("parts/notes.txt")).unwrap();
     assert_eq!(tree(&out), before);
 
-    let mut md = fs::read(out.join("FABRICATION.md")).unwrap();
+    let original = fs::read(out.join("FABRICATION.md")).unwrap();
+    let mut md = original.clone();
     md.extend_from_slice(b"\nmy notes\n");
     fs::write(out.join("FABRICATION.md"), &md).unwrap();
     let err = write_kit(&test_kit(), &out, &opts()).unwrap_err();
@@ -1104,6 +1218,22 @@ fn previous_output_changed_by_the_user_is_refused_and_untouched() {
         "{err}"
     );
     assert_eq!(fs::read(out.join("FABRICATION.md")).unwrap(), md);
+
+    // an edit that keeps the size: the SHA-256 tells it
+    let mut same_size = original.clone();
+    let k = same_size
+        .iter()
+        .position(|b| b.is_ascii_lowercase())
+        .unwrap();
+    same_size[k] = same_size[k].to_ascii_uppercase();
+    fs::write(out.join("FABRICATION.md"), &same_size).unwrap();
+    let err = write_kit(&test_kit(), &out, &opts()).unwrap_err();
+    assert!(
+        matches!(err, ExportError::ForeignDirectory { ref entry, ref why, .. }
+            if entry == "FABRICATION.md" && why.contains("SHA-256")),
+        "{err}"
+    );
+    assert_eq!(fs::read(out.join("FABRICATION.md")).unwrap(), same_size);
 
     fs::remove_file(out.join("FABRICATION.md")).unwrap();
     write_kit(&test_kit(), &out, &opts()).unwrap();

@@ -47,6 +47,8 @@ fn export_as(
         chord_tolerance_mm: TOL_MM,
         fabkit_version: "test".into(),
         printers: Default::default(),
+        command: fabkit_export::OutputCommand::Export,
+        force: false,
     };
     write_kit(&kit, &out, &opts).unwrap();
     let exported = Exported {
