@@ -26,7 +26,7 @@ pub fn export_options(design: &str, bench: &str, tol: ChordTolerance) -> ExportO
         chord_tolerance_mm: tol.mm(),
         fabkit_version: env!("CARGO_PKG_VERSION").to_string(),
         printers: Default::default(),
-        command: fabkit_export::OutputCommand::Export,
+        command: fabkit::export::OutputCommand::Export,
         force: false,
     }
 }
