@@ -112,8 +112,19 @@ pub fn run(args: SweepArgs) -> Result<(), Box<dyn Error>> {
     let (Some(file), Some(out)) = (args.sweep, args.out) else {
         return Err("give a sweep file and --out DIR".into());
     };
-    let spec = SweepSpec::from_file_with(&file, &args.data_files.rules())?;
-    let plan = spec.plan()?;
+    let terminal = std::io::stderr().is_terminal();
+    let spec = {
+        // reading checks every value and builds a few probes (fabkit_designs::sweep::
+        // SweepSpec::refuse_ignored_parameters): a spinner on a terminal
+        let _reading = Spinner::new(terminal, format!("reading {}", file.display()));
+        SweepSpec::from_file_with(&file, &args.data_files.rules())?
+    };
+    let plan = {
+        let planning = Planning::new(terminal);
+        let plan = spec.plan_with_progress(&|done, total| planning.report(done, total))?;
+        planning.finish(plan.variants.len());
+        plan
+    };
     let opts = RunOptions {
         out_dir: out.clone(),
         jobs: args.jobs,
@@ -155,6 +166,105 @@ pub fn run(args: SweepArgs) -> Result<(), Box<dyn Error>> {
         .into());
     }
     Ok(())
+}
+
+/// A spinner with a message on a terminal while something without counts runs; nothing
+/// otherwise. Cleared when dropped.
+struct Spinner(Option<indicatif::ProgressBar>);
+
+impl Spinner {
+    fn new(terminal: bool, message: String) -> Self {
+        Self(terminal.then(|| {
+            let b = indicatif::ProgressBar::new_spinner();
+            b.set_style(
+                indicatif::ProgressStyle::with_template("{spinner} sweep: {msg} ({elapsed})")
+                    .unwrap_or_else(|_| indicatif::ProgressStyle::default_spinner()),
+            );
+            b.set_message(message);
+            b.enable_steady_tick(std::time::Duration::from_millis(200));
+            b
+        }))
+    }
+}
+
+impl Drop for Spinner {
+    fn drop(&mut self) {
+        if let Some(b) = &self.0 {
+            b.finish_and_clear();
+        }
+    }
+}
+
+/// Progress of planning (ids of millions of variants take seconds): on a terminal a bar that
+/// appears after half a second; otherwise a line every 5 s once planning has taken a second,
+/// and a last line with the time taken if any was printed. Quick plans print nothing.
+struct Planning {
+    terminal: bool,
+    t0: Instant,
+    /// The bar (terminal), and when the last plain line was printed.
+    state: Mutex<(Option<indicatif::ProgressBar>, Option<Instant>)>,
+}
+
+impl Planning {
+    /// Seconds between two plain lines.
+    const LINE_EVERY_S: f64 = 5.0;
+
+    fn new(terminal: bool) -> Self {
+        Self {
+            terminal,
+            t0: Instant::now(),
+            state: Mutex::new((None, None)),
+        }
+    }
+
+    /// `done` of `total` variants planned; called with counts that never decrease.
+    fn report(&self, done: usize, total: usize) {
+        let Ok(mut st) = self.state.lock() else {
+            return;
+        };
+        let s = self.t0.elapsed().as_secs_f64();
+        if self.terminal {
+            if st.0.is_none() && s >= 0.5 && done < total {
+                let b = indicatif::ProgressBar::new(total as u64);
+                b.set_style(
+                    indicatif::ProgressStyle::with_template(
+                        "{spinner} sweep: planning [{bar:30}] {pos}/{len} variants, ETA {eta}",
+                    )
+                    .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
+                    .progress_chars("=> "),
+                );
+                b.enable_steady_tick(std::time::Duration::from_millis(200));
+                st.0 = Some(b);
+            }
+            if let Some(b) = &st.0 {
+                b.set_position(done as u64);
+            }
+        } else if s >= 1.0
+            && done < total
+            && st
+                .1
+                .is_none_or(|t| t.elapsed().as_secs_f64() >= Self::LINE_EVERY_S)
+        {
+            eprintln!("sweep: planning: {done} of {total} variants ({s:.0} s)");
+            st.1 = Some(Instant::now());
+        }
+    }
+
+    /// Planning is over: clears the bar, or closes the plain lines with the time taken.
+    fn finish(&self, total: usize) {
+        let Ok(st) = self.state.lock() else {
+            return;
+        };
+        if let Some(b) = &st.0 {
+            b.finish_and_clear();
+        }
+        if st.1.is_some() {
+            eprintln!(
+                "sweep: planned {total} variants in {:.1} s",
+                self.t0.elapsed().as_secs_f64()
+            );
+        }
+    }
 }
 
 /// A progress bar with rate and ETA on a terminal; one plain line per variant otherwise.

@@ -4,7 +4,8 @@
 //! - an infeasible variant in the middle of a sweep is reported and the others are built;
 //! - a sweep killed mid-run completes only the missing variants when re-run;
 //! - variant folders hold the files of `fabkit export`, measured like the results table;
-//! - sweep file errors stop the run before anything is written.
+//! - sweep file errors stop the run before anything is written;
+//! - a sweep of too many variants is refused by its count (issue 70).
 //!
 //! The ShadowTac `paper_text` open mold at 0.05 mm chord tolerance keeps each variant near 0.3 s.
 
@@ -531,4 +532,40 @@ fn sweep_file_errors_stop_before_anything_is_written() {
     }
     let o = run(d, &["sweep", &s, "--out", "ours"], &[]);
     assert!(o.status.success(), "{}", text(&o.stderr));
+}
+
+/// A grid of 10^21 variants (seven parameters of 1000 values) is refused by its count, before
+/// any value is set into the design or any probe is built, and nothing is written.
+#[test]
+fn a_sweep_of_too_many_variants_is_refused_by_its_count() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let vary: String = [
+        "layers[0].markers[0].pattern.spacing_mm",
+        "layers[0].markers[0].feature.height_mm",
+        "layers[0].markers[0].feature.diameter_mm",
+        "body.base_diameter_mm",
+        "body.height_mm",
+        "backing.diameter_mm",
+        "backing.thickness_mm",
+    ]
+    .iter()
+    .map(|p| format!("  {p}: {{range: [1, 1000, 1]}}\n"))
+    .collect();
+    let s = write_sweep(
+        d,
+        "huge.yaml",
+        &format!("base: shadowtac\npreset: paper_text\nvary:\n{vary}"),
+    );
+    let o = run(d, &["sweep", &s, "--out", "out"], &[]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        text(&o.stderr).contains(
+            "huge.yaml: the sweep has 1000000000000000000000 variants (1000 x 1000 x 1000 x 1000 \
+             x 1000 x 1000 x 1000), more than the 10000000 allowed"
+        ),
+        "{}",
+        text(&o.stderr)
+    );
+    assert!(!d.join("out").exists());
 }

@@ -164,18 +164,30 @@ impl SweepSpec {
         let coarse = ChordTolerance::new(self.chord_tolerance.mm().max(PROBE_CHORD_TOLERANCE_MM))
             .unwrap_or(self.chord_tolerance);
         let at = |tol: ChordTolerance| -> Option<bool> {
-            let mut reference = None;
-            for v in probed {
-                let mut params = vec![(p.path.clone(), (*v).clone())];
+            let build = |v: &Value| -> Option<Fingerprint> {
+                let mut params = vec![(p.path.clone(), v.clone())];
                 if let Some((q, qv)) = ctx {
                     params.push((q.to_string(), qv.clone()));
                 }
                 let design = self.resolve(&params).ok()?;
-                let f = fingerprint(&design, materials, tol)?;
-                match &reference {
-                    None => reference = Some(f),
-                    Some(r) if *r != f => return Some(true),
-                    Some(_) => {}
+                fingerprint(&design, materials, tol)
+            };
+            // the first two at once (most parameters differ there), then one by one
+            let (reference, second) = match probed {
+                [a, b, ..] => rayon::join(|| build(a), || build(b)),
+                [a] => (build(a), None),
+                [] => return Some(false),
+            };
+            let reference = reference?;
+            if probed.len() < 2 {
+                return Some(false);
+            }
+            if second? != reference {
+                return Some(true);
+            }
+            for v in &probed[2..] {
+                if build(v)? != reference {
+                    return Some(true);
                 }
             }
             Some(false)

@@ -167,8 +167,12 @@ impl SweepSpec {
     /// Parses and checks a sweep file's text; `origin` names it in messages, `dir` is the folder
     /// a relative `base` path is read from.
     ///
-    /// Every value of every parameter is set into the base design and the design is checked
-    /// against the schema, so that a wrong type is found before anything runs. Whether a
+    /// The number of variants is counted first, from the numbers of values
+    /// ([`super::variant_count`]): a sweep of more than [`super::MAX_VARIANTS`] is refused
+    /// before any value is looked at. Then every value of every parameter is checked against
+    /// the schema in the base design, so that a wrong type is found before anything runs
+    /// (for a parameter that takes any number, a plain `f64`, the design is probed once with
+    /// extreme numbers and only its other values are set into it one by one). Whether a
     /// combination of values makes a feasible design is not checked here: an infeasible
     /// variant is a result. A parameter the design ignores is refused
     /// ([`SweepSpec::refuse_ignored_parameters`]: a few of its values are built).
@@ -275,7 +279,10 @@ impl SweepSpec {
                 at: origin.to_string(),
                 message: e,
             })?;
+        // First the paths and the number of values: a sweep of too many variants is refused
+        // before any value is looked at.
         let mut parameters: Vec<Parameter> = Vec::new();
+        let mut values_at: Vec<String> = Vec::new();
         for (key, spec) in &raw.vary.value.0 {
             let here = at(origin, key);
             // A short path (`markers.spacing_mm`) stands for the one full path it fits.
@@ -292,37 +299,39 @@ impl SweepSpec {
             }
             let values = values_of(&spec.value)
                 .map_err(|m| file_err(at(origin, spec), format!("vary.{path}: {m}")))?;
-            for (i, v) in values.iter().enumerate() {
-                if values[..i].contains(v) {
-                    return Err(file_err(
-                        at(origin, spec),
-                        format!("vary.{path}: the value {v} is listed twice"),
-                    ));
-                }
-                let variant = checked_value(&base.design, &base_json, &path, v, &at(origin, spec))?;
-                // A parameter the rest of the design ignores would give identical variants.
-                if i == 0 {
-                    if let Err(errs) = crate::stack::validate(&variant, &materials, chord_tolerance)
-                    {
-                        if let Some(e) = errs.0.iter().find(|e| {
-                            e.path == path && e.rule.starts_with(crate::markers::NO_EFFECT)
-                        }) {
-                            return Err(file_err(
-                                here.clone(),
-                                format!(
-                                    "vary.{path}: {} (every variant would be the same design)",
-                                    e.rule
-                                ),
-                            ));
-                        }
-                    }
-                }
-            }
             parameters.push(Parameter {
                 path,
                 values,
                 at: here,
             });
+            values_at.push(at(origin, spec));
+        }
+        super::plan::variant_count(
+            &parameters,
+            mode,
+            raw.count.as_ref().map(|c| c.value),
+            origin,
+        )?;
+        for (p, spec_at) in parameters.iter().zip(&values_at) {
+            check_values(p, spec_at, &base.design, &base_json, |variant| {
+                // A parameter the rest of the design ignores would give identical variants.
+                if let Err(errs) = crate::stack::validate(variant, &materials, chord_tolerance) {
+                    if let Some(e) = errs
+                        .0
+                        .iter()
+                        .find(|e| e.path == p.path && e.rule.starts_with(crate::markers::NO_EFFECT))
+                    {
+                        return Err(file_err(
+                            p.at.clone(),
+                            format!(
+                                "vary.{}: {} (every variant would be the same design)",
+                                p.path, e.rule
+                            ),
+                        ));
+                    }
+                }
+                Ok(())
+            })?;
         }
         if mode == Mode::Zip {
             let n = parameters[0].values.len();
@@ -356,6 +365,90 @@ impl SweepSpec {
         };
         spec.refuse_ignored_parameters(&materials)?;
         Ok(spec)
+    }
+}
+
+/// Checks the values of `p` (listed at `spec_at`) in order, as one loop would: the first value
+/// set into the base design (`base_json`, its JSON form) must fit the schema and pass
+/// `first_design`, then each further value must not repeat an earlier one and must fit the
+/// schema. The first problem in that order is the error. Linear: repeats are found by hashing,
+/// and the values are set into the base design in parallel.
+fn check_values(
+    p: &Parameter,
+    spec_at: &str,
+    design: &crate::schema::Design,
+    base_json: &Value,
+    first_design: impl FnOnce(&crate::schema::Design) -> Result<(), SweepError>,
+) -> Result<(), SweepError> {
+    use rayon::prelude::*;
+    let values = &p.values;
+    let mut seen: std::collections::HashSet<String> =
+        std::collections::HashSet::with_capacity(values.len());
+    let repeated = values.iter().position(|v| !seen.insert(equality_key(v)));
+    drop(seen);
+    let first = checked_value(design, base_json, &p.path, &values[0], spec_at)?;
+    first_design(&first)?;
+    let end = repeated.unwrap_or(values.len());
+    // a plain number parameter takes any number: only its other values are set into the design
+    let numbers = super::plan::takes_any_number(base_json, &p.path);
+    let bad = (1..end)
+        .into_par_iter()
+        .map_init(
+            || None,
+            |json: &mut Option<Value>, i| {
+                if numbers && values[i].is_number() {
+                    return None;
+                }
+                let json = json.get_or_insert_with(|| base_json.clone());
+                let fits = super::variants::design_with(json, &p.path, &values[i])
+                    .is_some_and(|d| d.is_ok());
+                (!fits).then_some(i)
+            },
+        )
+        .find_first(Option::is_some)
+        .flatten();
+    if let Some(i) = bad {
+        // the error exactly as the value alone gives it
+        checked_value(design, base_json, &p.path, &values[i], spec_at)?;
+    }
+    if let Some(i) = repeated {
+        return Err(SweepError::File {
+            at: spec_at.to_string(),
+            message: format!("vary.{}: the value {} is listed twice", p.path, values[i]),
+        });
+    }
+    Ok(())
+}
+
+/// A text equal for two values exactly when they are equal as JSON values (`==`): the
+/// canonical JSON, with a negative zero written as zero (`-0.0 == 0.0`).
+fn equality_key(v: &Value) -> String {
+    fn has_negative_zero(v: &Value) -> bool {
+        match v {
+            Value::Number(n) => n.as_f64().is_some_and(|f| f == 0.0 && f.is_sign_negative()),
+            Value::Array(a) => a.iter().any(has_negative_zero),
+            Value::Object(o) => o.values().any(has_negative_zero),
+            _ => false,
+        }
+    }
+    fn positive_zero(v: &Value) -> Value {
+        match v {
+            Value::Number(n) if n.as_f64().is_some_and(|f| f == 0.0 && f.is_sign_negative()) => {
+                Value::from(0.0)
+            }
+            Value::Array(a) => Value::Array(a.iter().map(positive_zero).collect()),
+            Value::Object(o) => Value::Object(
+                o.iter()
+                    .map(|(k, x)| (k.clone(), positive_zero(x)))
+                    .collect(),
+            ),
+            other => other.clone(),
+        }
+    }
+    if has_negative_zero(v) {
+        super::paths::canonical_json(&positive_zero(v))
+    } else {
+        super::paths::canonical_json(v)
     }
 }
 

@@ -42,7 +42,9 @@ pub use metrics::{
     Outcome, PartMetrics, Verdict, PROFILES,
 };
 pub use paths::{canonical_json, expand_short_path, nearest_paths, parameter_paths, path_exists};
-pub use plan::{variant_id, Plan, Shard, Variant, ID_HEX_DIGITS, MAX_VARIANTS};
+pub use plan::{
+    variant_count, variant_id, Plan, PlanProgress, Shard, Variant, ID_HEX_DIGITS, MAX_VARIANTS,
+};
 pub use results::{render_csv, render_jsonl, Status, VariantResult};
 pub use run::{
     record, run, write_atomic, Event, FilesJob, KitWriter, RunOptions, RunSummary, SweepRecord,

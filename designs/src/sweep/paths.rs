@@ -185,37 +185,180 @@ pub fn with_value(base: &Value, path: &str, value: &Value) -> Option<Value> {
 /// shortest round-trip form. Independent of map ordering features, so that hashes of it are
 /// stable.
 pub fn canonical_json(v: &Value) -> String {
-    let mut s = String::new();
+    let mut s = Vec::new();
     write_canonical(v, &mut s);
-    s
+    // serde_json writes valid UTF-8 and every other byte is ASCII punctuation
+    String::from_utf8(s).unwrap_or_default()
 }
 
-fn write_canonical(v: &Value, s: &mut String) {
+/// Writes the canonical text into a byte buffer: serde_json's escaping for keys and scalars,
+/// without a temporary string per node.
+fn write_canonical(v: &Value, s: &mut Vec<u8>) {
     match v {
         Value::Object(o) => {
             let mut keys: Vec<&String> = o.keys().collect();
             keys.sort();
-            s.push('{');
+            s.push(b'{');
             for (i, k) in keys.into_iter().enumerate() {
                 if i > 0 {
-                    s.push(',');
+                    s.push(b',');
                 }
-                s.push_str(&Value::String(k.clone()).to_string());
-                s.push(':');
+                // writing into a Vec cannot fail, nor can serializing a string
+                let _ = serde_json::to_writer(&mut *s, k);
+                s.push(b':');
                 write_canonical(&o[k], s);
             }
-            s.push('}');
+            s.push(b'}');
         }
         Value::Array(a) => {
-            s.push('[');
+            s.push(b'[');
             for (i, x) in a.iter().enumerate() {
                 if i > 0 {
-                    s.push(',');
+                    s.push(b',');
                 }
                 write_canonical(x, s);
             }
-            s.push(']');
+            s.push(b']');
         }
-        other => s.push_str(&other.to_string()),
+        other => {
+            let _ = serde_json::to_writer(&mut *s, other);
+        }
     }
+}
+
+/// The keys and list indices of a parameter path, as [`crate::schema::value_at`] reads them:
+/// `layers[0].markers` -> [layers, 0, markers].
+fn path_steps(path: &str) -> Option<Vec<&str>> {
+    let mut out = Vec::new();
+    for part in path.split('.') {
+        match part.find('[') {
+            None => out.push(part),
+            Some(i) => {
+                out.push(&part[..i]);
+                let mut rest = &part[i..];
+                while let Some(stripped) = rest.strip_prefix('[') {
+                    let j = stripped.find(']')?;
+                    out.push(&stripped[..j]);
+                    rest = &stripped[j + 1..];
+                }
+                if !rest.is_empty() {
+                    return None;
+                }
+            }
+        }
+    }
+    Some(out)
+}
+
+fn skip_ws(b: &[u8], mut i: usize) -> usize {
+    while i < b.len() && b[i].is_ascii_whitespace() {
+        i += 1;
+    }
+    i
+}
+
+/// The end of the JSON string that starts at `b[i]` (a `"`), after its closing quote.
+fn string_end(b: &[u8], mut i: usize) -> Option<usize> {
+    i += 1;
+    while i < b.len() {
+        match b[i] {
+            b'\\' => i += 2,
+            b'"' => return Some(i + 1),
+            _ => i += 1,
+        }
+    }
+    None
+}
+
+/// The end of the JSON value that starts at `b[i]`.
+fn value_end(b: &[u8], i: usize) -> Option<usize> {
+    match *b.get(i)? {
+        b'"' => string_end(b, i),
+        b'{' | b'[' => {
+            let mut depth = 0usize;
+            let mut j = i;
+            while j < b.len() {
+                match b[j] {
+                    b'"' => {
+                        j = string_end(b, j)?;
+                        continue;
+                    }
+                    b'{' | b'[' => depth += 1,
+                    b'}' | b']' => {
+                        depth -= 1;
+                        if depth == 0 {
+                            return Some(j + 1);
+                        }
+                    }
+                    _ => {}
+                }
+                j += 1;
+            }
+            None
+        }
+        _ => {
+            let mut j = i;
+            while j < b.len() && !matches!(b[j], b',' | b'}' | b']') && !b[j].is_ascii_whitespace()
+            {
+                j += 1;
+            }
+            (j > i).then_some(j)
+        }
+    }
+}
+
+/// The byte range of the value at parameter path `path` in the JSON text `text` (as serde_json
+/// writes it), found by scanning the text without building its tree; `None` when the path
+/// names nothing there.
+pub(crate) fn span_of(text: &str, path: &str) -> Option<(usize, usize)> {
+    let b = text.as_bytes();
+    let mut i = skip_ws(b, 0);
+    for step in path_steps(path)? {
+        match *b.get(i)? {
+            b'{' => {
+                i = skip_ws(b, i + 1);
+                loop {
+                    if b.get(i) != Some(&b'"') {
+                        return None;
+                    }
+                    let key_end = string_end(b, i)?;
+                    let raw = &text[i + 1..key_end - 1];
+                    let found = if raw.contains('\\') {
+                        serde_json::from_str::<String>(&text[i..key_end]).ok()? == step
+                    } else {
+                        raw == step
+                    };
+                    i = skip_ws(b, key_end);
+                    if b.get(i) != Some(&b':') {
+                        return None;
+                    }
+                    i = skip_ws(b, i + 1);
+                    if found {
+                        break;
+                    }
+                    i = skip_ws(b, value_end(b, i)?);
+                    if b.get(i) != Some(&b',') {
+                        return None;
+                    }
+                    i = skip_ws(b, i + 1);
+                }
+            }
+            b'[' => {
+                let k: usize = step.parse().ok()?;
+                i = skip_ws(b, i + 1);
+                if b.get(i) == Some(&b']') {
+                    return None;
+                }
+                for _ in 0..k {
+                    i = skip_ws(b, value_end(b, i)?);
+                    if b.get(i) != Some(&b',') {
+                        return None;
+                    }
+                    i = skip_ws(b, i + 1);
+                }
+            }
+            _ => return None,
+        }
+    }
+    Some((i, value_end(b, i)?))
 }

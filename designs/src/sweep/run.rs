@@ -430,9 +430,22 @@ pub fn run(
         .iter()
         .filter(|v| opts.shard.is_none_or(|s| s.contains(v.index)))
         .collect();
+    // One listing of variants/ rather than one open per variant: a sweep of millions of
+    // variants starts at once.
+    let results_on_disk: std::collections::HashSet<std::ffi::OsString> = std::fs::read_dir(&vdir)
+        .map_err(io(&vdir))?
+        .flatten()
+        .map(|e| e.file_name())
+        .collect();
     let mut done: Vec<Option<VariantResult>> = selected
-        .iter()
-        .map(|v| complete_result(&vdir, v, spec.files, &opts.fabkit_version))
+        .par_iter()
+        .map(|v| {
+            let name = std::ffi::OsString::from(format!("{}.json", v.id));
+            results_on_disk
+                .contains(&name)
+                .then(|| complete_result(&vdir, v, spec.files, &opts.fabkit_version))
+                .flatten()
+        })
         .collect();
     let reused = done.iter().filter(|d| d.is_some()).count();
     on_event(Event::Start {

@@ -12,7 +12,7 @@ use super::SweepError;
 use crate::geometry::ChordTolerance;
 use crate::kit::Kit;
 use crate::materials::MaterialsTable;
-use crate::schema::Design;
+use crate::schema::{value_at, Design};
 use serde_json::Value;
 
 /// The full parameter path of `design` that `given` names: itself, or the one path a short
@@ -117,6 +117,9 @@ pub fn plan_variants(
         message: e.to_string(),
     })?;
     let mut parameters: Vec<String> = Vec::new();
+    let mut listed: std::collections::HashSet<String> = Default::default();
+    // each given path is checked once, not once per variant that names it
+    let mut full_paths: std::collections::HashMap<&str, String> = Default::default();
     let mut variants = Vec::with_capacity(given.len());
     let mut seen: std::collections::HashMap<String, usize> = Default::default();
     for (index, values) in given.iter().enumerate() {
@@ -129,7 +132,14 @@ pub fn plan_variants(
         }
         let mut params: Vec<(String, Value)> = Vec::with_capacity(values.len());
         for (given_path, value) in values {
-            let path = checked_path(base, given_path, &at)?;
+            let path = match full_paths.get(given_path.as_str()) {
+                Some(p) => p.clone(),
+                None => {
+                    let p = checked_path(base, given_path, &at)?;
+                    full_paths.insert(given_path, p.clone());
+                    p
+                }
+            };
             if params.iter().any(|(p, _)| *p == path) {
                 return Err(file_err(
                     at,
@@ -140,7 +150,7 @@ pub fn plan_variants(
             checked_value(base, &base_json, &path, value, &at)?;
             params.push((path, value.clone()));
         }
-        let design = resolve_variant(base, &at, &params)?;
+        let design = resolve_in(&base_json, base, &at, &params)?;
         let id = variant_id(&design, tol.mm());
         if let Some(other) = seen.insert(id.clone(), index) {
             return Err(file_err(
@@ -151,7 +161,7 @@ pub fn plan_variants(
             ));
         }
         for (p, _) in &params {
-            if !parameters.contains(p) {
+            if listed.insert(p.clone()) {
                 parameters.push(p.clone());
             }
         }
@@ -173,14 +183,25 @@ pub fn resolve_variant(
     origin: &str,
     params: &[(String, Value)],
 ) -> Result<Design, SweepError> {
-    let mut v = serde_json::to_value(base).unwrap_or(Value::Null);
+    let v = serde_json::to_value(base).unwrap_or(Value::Null);
+    resolve_in(&v, base, origin, params)
+}
+
+/// [`resolve_variant`] with the base design's JSON form `base_json` computed once by the caller.
+pub(crate) fn resolve_in(
+    base_json: &Value,
+    base: &Design,
+    origin: &str,
+    params: &[(String, Value)],
+) -> Result<Design, SweepError> {
+    let mut v = base_json.clone();
     for (path, value) in params {
-        v = with_value(&v, path, value).ok_or_else(|| SweepError::UnknownPath {
+        *value_at(&mut v, path).ok_or_else(|| SweepError::UnknownPath {
             at: origin.to_string(),
             path: path.clone(),
             design: base.name.clone(),
             nearest: vec![],
-        })?;
+        })? = value.clone();
     }
     serde_json::from_value(v).map_err(|e| SweepError::WrongValue {
         at: origin.to_string(),
@@ -196,6 +217,61 @@ pub fn resolve_variant(
             .join(", "),
         message: e.to_string(),
     })
+}
+
+/// Whether every key and index of the parameter path `path` exists in `v` (nothing inserted).
+fn exists_at(v: &Value, path: &str) -> bool {
+    let mut cur = v;
+    for part in path.split('.') {
+        let (key, mut rest) = match part.find('[') {
+            Some(i) => (&part[..i], &part[i..]),
+            None => (part, ""),
+        };
+        fn step<'v>(cur: &'v Value, k: &str) -> Option<&'v Value> {
+            match cur {
+                Value::Object(o) => o.get(k),
+                Value::Array(a) => a.get(k.parse::<usize>().ok()?),
+                _ => None,
+            }
+        }
+        let Some(next) = step(cur, key) else {
+            return false;
+        };
+        cur = next;
+        while let Some(stripped) = rest.strip_prefix('[') {
+            let Some(j) = stripped.find(']') else {
+                return false;
+            };
+            let Some(next) = step(cur, &stripped[..j]) else {
+                return false;
+            };
+            cur = next;
+            rest = &stripped[j + 1..];
+        }
+    }
+    true
+}
+
+/// The design `base_json` (a design's JSON form) with `value` at `path`, deserialized without
+/// copying the whole form: the value is swapped in and `base_json` is restored afterwards.
+/// `None` when `path` names nothing in `base_json`.
+pub(crate) fn design_with(
+    base_json: &mut Value,
+    path: &str,
+    value: &Value,
+) -> Option<Result<Design, serde_json::Error>> {
+    use serde::Deserialize as _;
+    if !exists_at(base_json, path) {
+        // a key the form leaves out: set it on a copy, so that `base_json` keeps it absent
+        let v = with_value(base_json, path, value)?;
+        return Some(serde_json::from_value(v));
+    }
+    let old = std::mem::replace(value_at(base_json, path)?, value.clone());
+    let design = Design::deserialize(&*base_json);
+    if let Some(slot) = value_at(base_json, path) {
+        *slot = old;
+    }
+    Some(design)
 }
 
 /// Writes the files of an ok variant (its resolved design and kit); the error is the variant's.

@@ -23,6 +23,7 @@ mod shadowtac_casing;
 mod sweep;
 mod sweep_metrics;
 mod sweep_paths;
+mod sweep_plan;
 mod tactip_body;
 mod uvdtact_base;
 mod uvdtact_shell;
