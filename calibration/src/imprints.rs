@@ -8,6 +8,15 @@
 //! the lower threshold), with a score (peak over noise). Spots brighter than the reference (LED
 //! reflections) are never candidates.
 //!
+//! Real captures differ from their reference everywhere by a small global gain (LED flicker,
+//! auto exposure) and along every strong edge by a pixel or two (the saturated LED highlights
+//! at the chamber rim move): the reference is scaled by the capture's gain (the median ratio
+//! of capture to reference over the skin) and, before differencing, each reference pixel is
+//! replaced by the darkest reference pixel within [`DetectParams::edge_tolerance_px`] (a grey
+//! erosion), so that an edge that moved by up to that much does not read as a darkening. On
+//! smooth skin, where a pin's imprint is, the erosion lowers the difference by the
+//! reference's slope over that distance only.
+//!
 //! Images are grey levels as `f32`, row-major, (0, 0) the centre of the top-left pixel
 //! (docs/conventions.md).
 
@@ -41,6 +50,12 @@ pub struct DetectParams {
     pub grow_sigma: f64,
     /// Spots of fewer pixels (after growing) are noise.
     pub min_area_px: usize,
+    /// An edge of the reference that moved by up to this many px in the capture is not a
+    /// darkening (the reference is eroded by a square of this half-width); 0: none.
+    pub edge_tolerance_px: usize,
+    /// Scale the reference by the capture's global gain (the median ratio of capture to
+    /// reference over the mask) before differencing.
+    pub compensate_gain: bool,
 }
 
 impl Default for DetectParams {
@@ -50,6 +65,8 @@ impl Default for DetectParams {
             threshold_sigma: 8.0,
             grow_sigma: 2.0,
             min_area_px: 12,
+            edge_tolerance_px: 2,
+            compensate_gain: true,
         }
     }
 }
@@ -146,6 +163,128 @@ fn median(v: &mut [f32]) -> f32 {
     *v.select_nth_unstable_by(m, f32::total_cmp).1
 }
 
+/// The capture's gain and the erosion's offset are medians over every this many pixels (a
+/// prime, so that the samples do not line up in columns; about 14000 of 640 x 480).
+const LEVEL_STRIDE: usize = 23;
+
+/// Grey levels of the reference counted in the gain: above this (not the dark outside) ...
+const GAIN_MIN_GREY: f32 = 20.0;
+/// ... and below this (not saturated), on 8-bit images.
+const GAIN_MAX_GREY: f32 = 250.0;
+
+/// The capture's global gain against the reference: the median of capture / reference over
+/// the pixels `inside` (every [`LEVEL_STRIDE`]-th) whose reference grey is neither dark nor
+/// saturated; 1 when there are none. The imprints are a small part of the skin and do not
+/// move the median.
+fn capture_gain(reference: &GrayImage, capture: &GrayImage, inside: &dyn Fn(usize) -> bool) -> f32 {
+    let mut ratios: Vec<f32> = (0..reference.data.len())
+        .step_by(LEVEL_STRIDE)
+        .filter(|&i| inside(i))
+        .filter_map(|i| {
+            let r = reference.data[i];
+            (GAIN_MIN_GREY..GAIN_MAX_GREY)
+                .contains(&r)
+                .then(|| capture.data[i] / r)
+        })
+        .collect();
+    if ratios.is_empty() {
+        1.0
+    } else {
+        median(&mut ratios)
+    }
+}
+
+/// The median of `gain x (reference - eroded)` over the pixels `inside` (every
+/// [`LEVEL_STRIDE`]-th): how much the erosion lowers the difference on the skin.
+fn erosion_offset(
+    reference: &GrayImage,
+    eroded: &GrayImage,
+    gain: f32,
+    inside: &dyn Fn(usize) -> bool,
+) -> f64 {
+    let mut v: Vec<f32> = (0..reference.data.len())
+        .step_by(LEVEL_STRIDE)
+        .filter(|&i| inside(i))
+        .map(|i| gain * (reference.data[i] - eroded.data[i]))
+        .collect();
+    f64::from(median(&mut v))
+}
+
+/// `gain x reference - capture` at pixel `i`, smoothed by the separable kernel `k` (the
+/// Gaussian of [`gaussian_blur`], edges clamped), computed at that pixel alone.
+fn smoothed_at(reference: &GrayImage, capture: &GrayImage, gain: f32, k: &[f32], i: usize) -> f64 {
+    let (w, h) = (reference.width, reference.height);
+    let (u, v) = (i % w, i / w);
+    let r = k.len() / 2;
+    let mut sum = 0f32;
+    if u >= r && v >= r && u + r < w && v + r < h {
+        for (a, ka) in k.iter().enumerate() {
+            let start = (v + a - r) * w + u - r;
+            let rr = &reference.data[start..start + k.len()];
+            let cc = &capture.data[start..start + k.len()];
+            let row: f32 = k
+                .iter()
+                .zip(rr)
+                .zip(cc)
+                .map(|((kb, x), y)| kb * (gain * x - y))
+                .sum();
+            sum += ka * row;
+        }
+    } else {
+        for (a, ka) in k.iter().enumerate() {
+            let vv = (v + a).saturating_sub(r).min(h - 1);
+            for (b, kb) in k.iter().enumerate() {
+                let uu = (u + b).saturating_sub(r).min(w - 1);
+                let j = vv * w + uu;
+                sum += ka * kb * (gain * reference.data[j] - capture.data[j]);
+            }
+        }
+    }
+    f64::from(sum)
+}
+
+/// `out[j] = min(a[j], b[j], c[j])` for every `j`.
+fn min3_into(out: &mut [f32], a: &[f32], b: &[f32], c: &[f32]) {
+    for (((o, x), y), z) in out.iter_mut().zip(a).zip(b).zip(c) {
+        *o = x.min(*y).min(*z);
+    }
+}
+
+/// `img` with each pixel replaced by the smallest within `r` px along each axis (a grey
+/// erosion by a (2r + 1) x (2r + 1) square, as `r` erosions by a 3 x 3 one; separable; the
+/// window cut at the edges).
+pub fn erode(img: &GrayImage, r: usize) -> GrayImage {
+    let (w, h) = (img.width, img.height);
+    if w < 2 || h < 2 || r == 0 {
+        return img.clone();
+    }
+    let mut cur = img.data.clone();
+    let mut other = vec![0f32; w * h];
+    for _ in 0..r {
+        // along rows, cur -> other: each pixel and its left and right neighbours
+        for (out, src) in other.chunks_exact_mut(w).zip(cur.chunks_exact(w)) {
+            out[0] = src[0].min(src[1]);
+            min3_into(&mut out[1..w - 1], &src[..w - 2], &src[1..w - 1], &src[2..]);
+            out[w - 1] = src[w - 2].min(src[w - 1]);
+        }
+        // along columns, other -> cur: each row and the rows above and below
+        for v in 0..h {
+            let (up, down) = (v.saturating_sub(1), (v + 1).min(h - 1));
+            min3_into(
+                &mut cur[v * w..(v + 1) * w],
+                &other[up * w..(up + 1) * w],
+                &other[v * w..(v + 1) * w],
+                &other[down * w..(down + 1) * w],
+            );
+        }
+    }
+    GrayImage {
+        width: w,
+        height: h,
+        data: cur,
+    }
+}
+
 /// The imprints in `capture` against `reference` (same size; grey levels), within `mask` (true:
 /// a pixel that can be skin; `None`: every pixel), strongest first.
 ///
@@ -172,17 +311,24 @@ pub fn detect(
         }
     }
     let inside = |i: usize| mask.is_none_or(|m| m[i]);
-    let diff = GrayImage {
-        width: w,
-        height: h,
-        data: reference
-            .data
-            .iter()
-            .zip(&capture.data)
-            .map(|(r, c)| r - c)
-            .collect(),
+    let gain = if p.compensate_gain {
+        capture_gain(reference, capture, &inside)
+    } else {
+        1.0
     };
+    let eroded = erode(reference, p.edge_tolerance_px);
+    let lo_offset = erosion_offset(reference, &eroded, gain, &inside);
+    // the difference in the eroded reference's buffer
+    let mut diff = eroded;
+    for (r, c) in diff.data.iter_mut().zip(&capture.data) {
+        *r = gain * *r - c;
+    }
     let d = gaussian_blur(&diff, p.smooth_sigma_px);
+    let k = if p.smooth_sigma_px > 0.0 {
+        kernel(p.smooth_sigma_px)
+    } else {
+        vec![1.0]
+    };
     // noise: the median absolute deviation of the smoothed difference over the mask, on every
     // NOISE_STRIDE-th pixel (plenty for a median, in a fraction of the time)
     let mut vals: Vec<f32> = (0..w * h)
@@ -195,11 +341,35 @@ pub fn detect(
     let sigma = (1.4826 * median(&mut dev)).max(1e-6) as f64;
     let hi = med as f64 + p.threshold_sigma * sigma;
     let lo = med as f64 + p.grow_sigma * sigma;
+    // the same lower threshold on the difference with the reference itself: the erosion
+    // lowers the difference by about the same everywhere on smooth skin (the darkest of the
+    // reference's noise within the window), which would otherwise weigh every pixel of a spot
+    // alike and pull its centre to the middle of its area
+    let lo_plain = lo + lo_offset;
     let mut label = vec![0u32; w * h];
     let mut spots = Vec::new();
     let mut stack = Vec::new();
-    for start in 0..w * h {
-        if label[start] != 0 || !inside(start) || (d.data[start] as f64) <= hi {
+    // the seeds first, in one tight pass over the image; then each grows its spot
+    let hi32 = hi as f32;
+    let seeds: Vec<usize> = match mask {
+        Some(m) => d
+            .data
+            .iter()
+            .zip(m)
+            .enumerate()
+            .filter(|(_, (x, &m))| m && **x > hi32)
+            .map(|(i, _)| i)
+            .collect(),
+        None => d
+            .data
+            .iter()
+            .enumerate()
+            .filter(|(_, x)| **x > hi32)
+            .map(|(i, _)| i)
+            .collect(),
+    };
+    for start in seeds {
+        if label[start] != 0 || (d.data[start] as f64) <= hi {
             continue;
         }
         // grow by hysteresis over 8-neighbours above `lo`
@@ -209,7 +379,9 @@ pub fn detect(
         let (mut sw, mut su, mut sv, mut peak, mut area) = (0f64, 0f64, 0f64, 0f64, 0usize);
         while let Some(i) = stack.pop() {
             let (u, v) = (i % w, i / w);
-            let x = d.data[i] as f64 - lo;
+            // weighted by the difference with the reference itself (not eroded), smoothed
+            // the same way: the erosion decides which pixels a spot has, not its centre
+            let x = smoothed_at(reference, capture, gain, &k, i) - lo_plain;
             sw += x;
             su += x * u as f64;
             sv += x * v as f64;
@@ -518,6 +690,12 @@ pub mod synthetic {
         pub led_grey: f32,
         pub led_sigma_px: f64,
         pub led_flicker: f32,
+        /// How far each LED highlight moves between the reference and the capture, px (in a
+        /// random direction per highlight).
+        pub led_shift_px: f64,
+        /// The capture's global gain differs from the reference's by a random factor in
+        /// [1 - drift, 1 + drift] (auto exposure, LED supply).
+        pub gain_drift: f32,
     }
 
     impl Default for Shading {
@@ -533,6 +711,27 @@ pub mod synthetic {
                 led_grey: 90.0,
                 led_sigma_px: 3.0,
                 led_flicker: 0.3,
+                led_shift_px: 0.0,
+                gain_drift: 0.0,
+            }
+        }
+    }
+
+    impl Shading {
+        /// What a real R-Tac0 capture adds to [`Shading::default`]: a ring of 12 LED
+        /// highlights saturated at 255 (steep edges around flat tops, dark skin between them)
+        /// that each move by 1.5 px between the reference and the capture, and a global gain
+        /// that drifts by up to 5 %. It still lacks side-lit crescent imprints, specks off the
+        /// pins and JPEG compression.
+        pub fn real_rim() -> Self {
+            Self {
+                leds: 12,
+                led_grey: 300.0,
+                led_sigma_px: 8.0,
+                led_flicker: 0.1,
+                led_shift_px: 1.5,
+                gain_drift: 0.05,
+                ..Self::default()
             }
         }
     }
@@ -694,7 +893,29 @@ pub mod synthetic {
             .zip(&dent)
             .map(|(b, d)| b - s.grey_per_mm * d)
             .collect();
-        let capture = led_image(w, h, &blur(pressed), &leds, s, &mut rng);
+        // the highlights move, the gain drifts (no draws when neither does: the same images)
+        let moved: Vec<[f64; 2]> = if s.led_shift_px > 0.0 {
+            leds.iter()
+                .map(|c| {
+                    let a = std::f64::consts::TAU * unit(&mut rng);
+                    [
+                        c[0] + s.led_shift_px * a.cos(),
+                        c[1] + s.led_shift_px * a.sin(),
+                    ]
+                })
+                .collect()
+        } else {
+            leds.clone()
+        };
+        let gain = if s.gain_drift > 0.0 {
+            1.0 + s.gain_drift * (2.0 * unit(&mut rng) as f32 - 1.0)
+        } else {
+            1.0
+        };
+        let capture: Vec<f32> = led_image(w, h, &blur(pressed), &moved, s, &mut rng)
+            .into_iter()
+            .map(|g| gain * g)
+            .collect();
         let reference = noisy(reference, s.noise_sigma, &mut rng);
         let capture = noisy(capture, s.noise_sigma, &mut rng);
         Rendered {
