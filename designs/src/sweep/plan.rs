@@ -685,7 +685,13 @@ mod tests {
 
     #[test]
     fn the_canonical_json_is_unchanged() {
-        for name in ["shadowtac", "rtac0", "uvdtact", "tactip_dualmodal", "soter_channels"] {
+        for name in [
+            "shadowtac",
+            "rtac0",
+            "uvdtact",
+            "tactip_dualmodal",
+            "soter_channels",
+        ] {
             let d = crate::library::load(name).unwrap();
             let mut v = serde_json::to_value(&d).unwrap();
             v["name"] = Value::String("a \"quoted\" \\ name\n\u{1}é".into());
