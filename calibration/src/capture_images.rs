@@ -18,7 +18,8 @@ use nalgebra::{Isometry3, Point3, Vector2, Vector3};
 use rayon::prelude::*;
 
 use crate::imprints::{
-    assign_ids, detect, ids_from_file_name, reference_mask, CaptureSpots, DetectParams, GrayImage,
+    assign_ids, detect, ids_from_file_name, reference_mask, CaptureOutcome, CaptureSpots,
+    DetectParams, GrayImage,
 };
 use crate::overlay::{OverlayError, Rgb8};
 use crate::tables::{CapturePlan, Observations, PointTable};
@@ -155,8 +156,12 @@ pub struct ImageObservations {
     pub unobserved_ids: Vec<String>,
     /// `observations.csv`: capture, id, u_px, v_px, score, one row per detection.
     pub csv: String,
-    /// Each capture left out, with why and what was found.
-    pub rejected: Vec<String>,
+    /// A line per capture left out, or kept with a spot discarded or a pin missing (why, and
+    /// the pixels of the spots).
+    pub notes: Vec<String>,
+    /// Per capture, in input order: the spots found, kept (with ids), discarded (with why),
+    /// the pins missing, or why it is left out.
+    pub outcomes: Vec<CaptureOutcome>,
     captures: Vec<Capture>,
 }
 
@@ -319,7 +324,8 @@ pub fn observe_images(
         observations: Observations { rows },
         unobserved_ids,
         csv,
-        rejected: assignment.rejected,
+        notes: assignment.notes(),
+        outcomes: assignment.captures,
         captures,
     })
 }

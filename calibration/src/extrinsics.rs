@@ -16,7 +16,7 @@ use crate::pnp::{solve_pnp, PnpError, PnpOptions, RansacOptions};
 use crate::refine::{
     refine_intrinsics, solution_at, RefineError, RefineParameters, RefinementReport,
 };
-use crate::report::{ExtrinsicsReport, Provenance};
+use crate::report::{CaptureReport, ExtrinsicsReport, Provenance};
 use crate::tables::{
     check_inside_image, pair, read_capture_plan, read_captures, read_observations,
     read_point_table, PointsFrom, TableError,
@@ -100,8 +100,12 @@ pub struct ExtrinsicsOutput {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct FoundInImages {
     pub captures: usize,
-    /// Captures left out (a pin missing, an extra spot; reported in the warnings).
+    /// Captures left out (reported in the warnings with why).
     pub captures_left_out: usize,
+    /// Spots found but taken for no pin (a speck, an edge), in the captures kept.
+    pub spots_discarded: usize,
+    /// Planned pins without a spot in the captures kept.
+    pub pins_missing: usize,
     /// Rows of `observations.csv` (a pin in several captures once per capture).
     pub detections: usize,
 }
@@ -224,7 +228,8 @@ pub fn calibrate_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsOutput, Ext
         provenance,
     );
     if let Some(found) = &from_images {
-        report.warnings.extend(found.rejected.iter().cloned());
+        report.warnings.extend(found.notes.iter().cloned());
+        report.captures = found.outcomes.iter().map(CaptureReport::from).collect();
     }
     let refined_file = match &refinement {
         Some(r) => {
@@ -275,7 +280,9 @@ pub fn calibrate_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsOutput, Ext
     }
     let found = from_images.as_ref().map(|f| FoundInImages {
         captures: obs_paths.len(),
-        captures_left_out: f.rejected.len(),
+        captures_left_out: f.outcomes.iter().filter(|o| o.left_out.is_some()).count(),
+        spots_discarded: f.outcomes.iter().map(|o| o.discarded.len()).sum(),
+        pins_missing: f.outcomes.iter().map(|o| o.missing.len()).sum(),
         detections: f.csv.lines().filter(|l| !l.starts_with('#')).count() - 1,
     });
     Ok(ExtrinsicsOutput {

@@ -90,6 +90,81 @@ pub struct ExtrinsicsReport {
     /// The intrinsics refined with the pose (`--refine-intrinsics`); absent otherwise.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub intrinsics_refinement: Option<crate::refine::RefinementReport>,
+    /// From capture images: per capture, the spots found, kept with ids, discarded with why,
+    /// the pins missing, or why it is left out; absent for observation files.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub captures: Vec<CaptureReport>,
+}
+
+/// A spot of a capture image, px.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SpotReport {
+    /// The pin's id (kept spots only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub id: Option<String>,
+    pub u_px: f64,
+    pub v_px: f64,
+    /// The imprint's peak over the noise sigma.
+    pub score: f64,
+    /// Why it was discarded (discarded spots only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
+}
+
+/// A planned pin without a spot.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MissingPin {
+    pub id: String,
+    pub reason: String,
+}
+
+/// What the detector found in one capture image and what became of it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CaptureReport {
+    pub capture: String,
+    pub spots_found: usize,
+    pub kept: Vec<SpotReport>,
+    pub discarded: Vec<SpotReport>,
+    pub missing: Vec<MissingPin>,
+    /// Why the capture is left out (nothing kept); absent when it is used.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub left_out: Option<String>,
+}
+
+impl From<&crate::imprints::CaptureOutcome> for CaptureReport {
+    fn from(o: &crate::imprints::CaptureOutcome) -> Self {
+        let spot =
+            |id: Option<String>, s: &crate::imprints::Spot, reason: Option<String>| SpotReport {
+                id,
+                u_px: s.u_px,
+                v_px: s.v_px,
+                score: s.score,
+                reason,
+            };
+        CaptureReport {
+            capture: o.name.clone(),
+            spots_found: o.spots_found,
+            kept: o
+                .kept
+                .iter()
+                .map(|(id, s)| spot(Some(id.to_string()), s, None))
+                .collect(),
+            discarded: o
+                .discarded
+                .iter()
+                .map(|(s, why)| spot(None, s, Some(why.clone())))
+                .collect(),
+            missing: o
+                .missing
+                .iter()
+                .map(|(id, why)| MissingPin {
+                    id: id.to_string(),
+                    reason: why.clone(),
+                })
+                .collect(),
+            left_out: o.left_out.clone(),
+        }
+    }
 }
 
 /// [`crate::PoseUncertainty`] as reported.
@@ -195,6 +270,7 @@ impl ExtrinsicsReport {
             }),
             warnings,
             intrinsics_refinement: None,
+            captures: Vec::new(),
             description: "T_cam_sensor maps sensor-frame points (mm; docs/conventions.md) into the camera frame (mm; x right, y down, z forward). rvec/tvec_mm follow OpenCV's solvePnP convention: x_cam = R(rvec) x_sensor + tvec_mm. Pixels: (0, 0) is the centre of the top-left pixel.".into(),
             provenance,
             distortion_model: camera.intrinsics().distortion.name().into(),

@@ -197,10 +197,18 @@ fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
             f.detections,
             f.captures - f.captures_left_out,
             f.captures,
-            if f.captures_left_out > 0 {
-                "; the captures left out are named below"
+            if f.captures_left_out + f.spots_discarded + f.pins_missing > 0 {
+                let n = |k: usize, one: &str, many: &str| {
+                    format!("{k} {}", if k == 1 { one } else { many })
+                };
+                format!(
+                    "; {} left out, {} discarded, {} missing: named below",
+                    n(f.captures_left_out, "capture", "captures"),
+                    n(f.spots_discarded, "spot", "spots"),
+                    n(f.pins_missing, "pin", "pins")
+                )
             } else {
-                ""
+                String::new()
             }
         );
     }

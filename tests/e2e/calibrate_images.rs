@@ -314,7 +314,7 @@ fn pins_found_in_photos_get_the_plans_ids_and_give_the_pose() {
 }
 
 #[test]
-fn ids_from_file_names_and_captures_with_a_pin_missing_or_an_extra_spot_left_out() {
+fn ids_from_file_names_and_a_missing_pin_or_an_extra_spot_handled_per_spot() {
     let s = Scene::new();
     let mut names = Vec::new();
     let last = s.plan.len() - 1;
@@ -357,54 +357,72 @@ fn ids_from_file_names_and_captures_with_a_pin_missing_or_an_extra_spot_left_out
     let err = text(&o.stderr);
     assert!(o.status.success(), "{}{err}", text(&o.stdout));
     assert!(
-        text(&o.stdout).contains("imprints: 30 pins found in 6 of 8 captures"),
+        text(&o.stdout).contains(
+            "imprints: 39 pins found in 8 of 8 captures (observations.csv; overlays/); 0 captures left out, 1 spot discarded, 1 pin missing: named below"
+        ),
         "{}",
         text(&o.stdout)
     );
+    let popped = s.plan[last].last().unwrap();
+    let extra = &s.plan[0][2];
     assert!(
         err.contains(&format!(
-            "warning: {}: 4 spots for the 5 planned pins",
-            names[last]
-        )) && err.contains("(a pin missing): found at ("),
+            "warning: {}: 4 spots; kept pins {}; pin {popped} missing: no spot within",
+            names[last],
+            s.plan[last][..4]
+                .iter()
+                .map(|id| id.parse::<u32>().unwrap())
+                .collect::<std::collections::BTreeSet<_>>()
+                .iter()
+                .map(u32::to_string)
+                .collect::<Vec<_>>()
+                .join(", ")
+        )),
         "{err}"
     );
     assert!(
         err.contains(&format!(
-            "warning: {}: 6 spots for the 5 planned pins",
+            "warning: {}: 6 spots; kept pins ",
             names[last - 1]
-        )) && err.contains("(an extra spot): found at ("),
+        )) && err.contains("discarded: "),
         "{err}"
     );
     let found = observations(&s.path("out/observations.csv"));
-    assert_eq!(found.len(), 5 * (s.plan.len() - 2));
+    assert_eq!(found.len(), 5 * (s.plan.len() - 1) + 4);
     for (capture, id) in found.keys() {
         let k = names.iter().position(|n| n == capture).unwrap();
         assert!(s.plan[k].contains(id), "{capture} {id}");
+        assert!(k != last || id != popped, "the missing pin has no spot");
     }
-    // the pins of the two captures left out that no other capture holds
+    // the report lists per capture what was found, kept, discarded and missing
     let j = json(&s.path("out/extrinsics.json"));
-    let mut left: Vec<&String> = s.plan[last - 1..]
-        .iter()
-        .flatten()
-        .filter(|id| !s.plan[..last - 1].iter().flatten().any(|i| i == *id))
-        .collect();
-    left.sort_by_key(|id| id.parse::<u32>().unwrap());
-    let mut unobserved: Vec<String> = j["provenance"]["unobserved_ids"]
+    let caps = j["captures"].as_array().unwrap();
+    assert_eq!(caps.len(), s.plan.len());
+    let c = &caps[last - 1];
+    assert_eq!(c["spots_found"], 6);
+    assert_eq!(c["kept"].as_array().unwrap().len(), 5);
+    let d = &c["discarded"][0];
+    assert!(d["reason"].as_str().unwrap().len() > 10, "{d}");
+    // the discarded spot is the pin pressed but not named, not one of the capture's own pins
+    let t = s.render(std::slice::from_ref(extra), 0).2[0];
+    let (u, v) = (d["u_px"].as_f64().unwrap(), d["v_px"].as_f64().unwrap());
+    assert!((u - t[0]).hypot(v - t[1]) < 1.0, "{d} vs {t:?}");
+    let c = &caps[last];
+    assert_eq!(c["missing"][0]["id"].as_str().unwrap(), popped);
+    assert!(caps.iter().all(|c| c.get("left_out").is_none()));
+    // a pin that no other capture holds is the only one unobserved
+    let unobserved: Vec<&str> = j["provenance"]["unobserved_ids"]
         .as_array()
-        .unwrap()
-        .iter()
-        .map(|v| v.as_str().unwrap().to_string())
-        .collect();
-    unobserved.sort_by_key(|id| id.parse::<u32>().unwrap());
-    assert_eq!(unobserved.iter().collect::<Vec<_>>(), left);
-    assert!(
-        j["warnings"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .any(|w| w.as_str().unwrap().contains("(a pin missing)")),
-        "{}",
-        j["warnings"]
+        .map(|a| a.iter().map(|v| v.as_str().unwrap()).collect())
+        .unwrap_or_default();
+    let elsewhere = s.plan[..last].iter().flatten().any(|i| i == popped);
+    assert_eq!(
+        unobserved,
+        if elsewhere {
+            vec![]
+        } else {
+            vec![popped.as_str()]
+        }
     );
 }
 

@@ -1,0 +1,462 @@
+//! Ids for the spots of each capture (R-Tac0 Sec. IV-A: each capture holds a few pins of the
+//! dome, one per ring, listed by the capture plan or the file name). Extra spots (a speck, a
+//! highlight's edge) and missing ones (a pin that barely marks the skin) are handled per spot:
+//! a capture is kept with the spots that fit its pins at the pose solved from all captures,
+//! the others are reported by pixel with why, and a capture is left out only when it cannot be
+//! matched at all or when two spots fit one pin equally well.
+
+use std::collections::BTreeMap;
+
+use nalgebra::{Isometry3, Point3, Vector2, Vector3};
+
+use super::Spot;
+use crate::CameraModel;
+
+/// One capture's detected spots and the pins planned for it (the capture plan's row, or the
+/// ids its file name lists).
+#[derive(Debug, Clone, PartialEq)]
+pub struct CaptureSpots {
+    pub name: String,
+    pub planned_ids: Vec<u32>,
+    pub spots: Vec<Spot>,
+}
+
+/// A pin's pixel in a capture.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Observation {
+    pub capture: String,
+    pub id: u32,
+    pub u_px: f64,
+    pub v_px: f64,
+    pub score: f64,
+}
+
+/// What became of one capture's spots.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CaptureOutcome {
+    pub name: String,
+    /// Spots the detector found.
+    pub spots_found: usize,
+    /// The spots kept, each with its pin's id, in id order.
+    pub kept: Vec<(u32, Spot)>,
+    /// Spots not taken for a pin, each with why.
+    pub discarded: Vec<(Spot, String)>,
+    /// Planned pins without a spot, each with why.
+    pub missing: Vec<(u32, String)>,
+    /// Why the whole capture is left out (nothing is kept then).
+    pub left_out: Option<String>,
+}
+
+impl CaptureOutcome {
+    fn new(c: &CaptureSpots) -> Self {
+        Self {
+            name: c.name.clone(),
+            spots_found: c.spots.len(),
+            kept: Vec::new(),
+            discarded: Vec::new(),
+            missing: Vec::new(),
+            left_out: None,
+        }
+    }
+
+    /// One line for the report when the capture is left out, a spot was discarded or a pin
+    /// missed; `None` when every planned pin got a spot and every spot a pin.
+    pub fn summary(&self) -> Option<String> {
+        if let Some(why) = &self.left_out {
+            return Some(format!("{}: {why}; left out", self.name));
+        }
+        if self.discarded.is_empty() && self.missing.is_empty() {
+            return None;
+        }
+        let mut s = format!(
+            "{}: {} spots; kept pins {}",
+            self.name,
+            self.spots_found,
+            self.kept
+                .iter()
+                .map(|(id, _)| id.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+        for (id, why) in &self.missing {
+            s.push_str(&format!("; pin {id} missing: {why}"));
+        }
+        for (spot, why) in &self.discarded {
+            s.push_str(&format!(
+                "; spot at ({:.1}, {:.1}) discarded: {why}",
+                spot.u_px, spot.v_px
+            ));
+        }
+        Some(s)
+    }
+}
+
+/// The ids given to the spots of every capture.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Assignment {
+    /// Every kept spot, capture by capture (input order), ids in order.
+    pub observations: Vec<Observation>,
+    /// Per capture, in input order: spots kept, discarded and missing, or why it is left out.
+    pub captures: Vec<CaptureOutcome>,
+    /// The pose the final assignment was made with (`None` with fewer than 4 pins).
+    pub t_cam_sensor: Option<Isometry3<f64>>,
+}
+
+impl Assignment {
+    /// The captures left out, each with why and what was found.
+    pub fn left_out(&self) -> Vec<String> {
+        self.captures
+            .iter()
+            .filter(|c| c.left_out.is_some())
+            .filter_map(CaptureOutcome::summary)
+            .collect()
+    }
+
+    /// A line per capture that is left out or lost a spot or a pin ([`CaptureOutcome::summary`]).
+    pub fn notes(&self) -> Vec<String> {
+        self.captures
+            .iter()
+            .filter_map(CaptureOutcome::summary)
+            .collect()
+    }
+}
+
+/// Most pins of one capture.
+pub const MAX_PINS_PER_CAPTURE: usize = 8;
+
+/// Each pin considers at most this many spots, the nearest to its projection.
+const CANDIDATES_PER_PIN: usize = 4;
+
+/// Two spots fit one pin equally well when the farther one's squared distance to the pin's
+/// projection is within this factor of the nearer one's (plus 1 px^2).
+const AMBIGUOUS_RATIO: f64 = 2.0;
+
+/// Gives each capture's spots the ids of its planned pins (`points`: id to sensor-frame point,
+/// mm).
+///
+/// 1. A first pose: in each capture with at least as many spots as pins, its strongest spots,
+///    as many as it plans pins, ordered by their distance from the principal point, get the
+///    pins ordered by their polar angle about the sensor axis (spots from the centre outwards,
+///    pins from the pole outwards); the pose is solved from all of them with RANSAC, so that a
+///    capture whose strongest spots include a speck does not spoil it.
+/// 2. At that pose each capture's spots are matched to its pins' projections: each pin takes
+///    the spot that, over the capture, moves the spots least, within half the distance to the
+///    nearest other pin's projection of the capture (a tenth of the image's diagonal at most).
+///    A spot no pin takes is discarded, a pin no spot fits is missing; both are reported with
+///    why, and the capture's other pins are kept. The pose is solved again from what was kept,
+///    and the matching repeated until it does not change (three times at most).
+///
+/// A capture is left out, with why and what was found, when it plans a pin the table lacks,
+/// holds more than [`MAX_PINS_PER_CAPTURE`] pins, shows no spot, or has two spots that fit one
+/// pin equally well ([`AMBIGUOUS_RATIO`]). Without a first pose (fewer than 4 spots in all)
+/// only the captures with as many spots as pins are kept, by ring order.
+pub fn assign_ids(
+    camera: &CameraModel,
+    points: &BTreeMap<u32, Vector3<f64>>,
+    captures: &[CaptureSpots],
+) -> Assignment {
+    let mut outcomes: Vec<CaptureOutcome> = captures.iter().map(CaptureOutcome::new).collect();
+    for (c, o) in captures.iter().zip(&mut outcomes) {
+        o.left_out = if let Some(id) = c.planned_ids.iter().find(|id| !points.contains_key(id)) {
+            Some(format!("pin {id} is planned but not in the point table"))
+        } else if c.planned_ids.len() > MAX_PINS_PER_CAPTURE {
+            Some(format!(
+                "{} pins in one capture, more than the {MAX_PINS_PER_CAPTURE} told apart",
+                c.planned_ids.len()
+            ))
+        } else if c.spots.is_empty() {
+            Some(format!(
+                "no spot found for the {} planned pins {:?}",
+                c.planned_ids.len(),
+                c.planned_ids
+            ))
+        } else {
+            None
+        };
+    }
+    let usable: Vec<usize> = (0..captures.len())
+        .filter(|&k| outcomes[k].left_out.is_none())
+        .collect();
+    let first: Vec<(u32, Spot)> = usable
+        .iter()
+        .map(|&k| &captures[k])
+        .filter(|c| c.spots.len() >= c.planned_ids.len())
+        .flat_map(|c| by_ring(camera, points, c))
+        .collect();
+    let Some(mut pose) = solve(camera, points, &first) else {
+        for &k in &usable {
+            let (c, o) = (&captures[k], &mut outcomes[k]);
+            if c.spots.len() == c.planned_ids.len() {
+                o.kept = by_ring(camera, points, c);
+                o.kept.sort_by_key(|(id, _)| *id);
+            } else {
+                o.left_out = Some(format!(
+                    "{} spots for the {} planned pins {:?} ({}), and too few pins in all captures for a pose to choose by",
+                    c.spots.len(),
+                    c.planned_ids.len(),
+                    c.planned_ids,
+                    found_at(&c.spots)
+                ));
+            }
+        }
+        return finish(captures, outcomes, None);
+    };
+    let mut last: Option<Vec<Vec<(u32, Spot)>>> = None;
+    for _ in 0..3 {
+        for &k in &usable {
+            outcomes[k] = match_at(camera, points, &captures[k], &pose);
+        }
+        let kept: Vec<Vec<(u32, Spot)>> =
+            usable.iter().map(|&k| outcomes[k].kept.clone()).collect();
+        if last.as_ref() == Some(&kept) {
+            break;
+        }
+        let all: Vec<(u32, Spot)> = kept.iter().flatten().copied().collect();
+        match solve(camera, points, &all) {
+            Some(t) => pose = t,
+            None => break,
+        }
+        last = Some(kept);
+    }
+    finish(captures, outcomes, Some(pose))
+}
+
+fn finish(
+    captures: &[CaptureSpots],
+    outcomes: Vec<CaptureOutcome>,
+    pose: Option<Isometry3<f64>>,
+) -> Assignment {
+    let observations = captures
+        .iter()
+        .zip(&outcomes)
+        .flat_map(|(c, o)| {
+            o.kept.iter().map(|(id, s)| Observation {
+                capture: c.name.clone(),
+                id: *id,
+                u_px: s.u_px,
+                v_px: s.v_px,
+                score: s.score,
+            })
+        })
+        .collect();
+    Assignment {
+        observations,
+        captures: outcomes,
+        t_cam_sensor: pose,
+    }
+}
+
+/// "found at (u, v), ..." or "none found".
+fn found_at(spots: &[Spot]) -> String {
+    if spots.is_empty() {
+        return "none found".into();
+    }
+    format!(
+        "found at {}",
+        spots
+            .iter()
+            .map(|s| format!("({:.1}, {:.1})", s.u_px, s.v_px))
+            .collect::<Vec<_>>()
+            .join(", ")
+    )
+}
+
+/// The capture's strongest spots, as many as it plans pins, given the pins by ring: spots
+/// ordered by their distance from the principal point against pins by their polar angle.
+fn by_ring(
+    camera: &CameraModel,
+    points: &BTreeMap<u32, Vector3<f64>>,
+    c: &CaptureSpots,
+) -> Vec<(u32, Spot)> {
+    let i = camera.intrinsics();
+    let polar = |id: &u32| {
+        let p = points[id];
+        p.xy().norm().atan2(p.z)
+    };
+    let mut ids = c.planned_ids.clone();
+    ids.sort_by(|a, b| polar(a).total_cmp(&polar(b)));
+    let mut spots = c.spots.clone();
+    spots.sort_by(|a, b| b.score.total_cmp(&a.score));
+    spots.truncate(ids.len());
+    spots.sort_by(|a, b| {
+        (a.u_px - i.cx_px)
+            .hypot(a.v_px - i.cy_px)
+            .total_cmp(&(b.u_px - i.cx_px).hypot(b.v_px - i.cy_px))
+    });
+    ids.into_iter().zip(spots).collect()
+}
+
+/// The pose from `pairs` (RANSAC with the solver's defaults; without it if that fails).
+fn solve(
+    camera: &CameraModel,
+    points: &BTreeMap<u32, Vector3<f64>>,
+    pairs: &[(u32, Spot)],
+) -> Option<Isometry3<f64>> {
+    let (pts, px): (Vec<Vector3<f64>>, Vec<Vector2<f64>>) = pairs
+        .iter()
+        .map(|(id, s)| (points[id], Vector2::new(s.u_px, s.v_px)))
+        .unzip();
+    let with = crate::PnpOptions::default();
+    let without = crate::PnpOptions {
+        ransac: None,
+        ..with
+    };
+    crate::solve_pnp(camera, &pts, &px, &with)
+        .or_else(|_| crate::solve_pnp(camera, &pts, &px, &without))
+        .ok()
+        .map(|s| s.t_cam_sensor)
+}
+
+/// Matches the capture's spots to its pins' projections at `pose` ([`assign_ids`], step 2).
+fn match_at(
+    camera: &CameraModel,
+    points: &BTreeMap<u32, Vector3<f64>>,
+    c: &CaptureSpots,
+    pose: &Isometry3<f64>,
+) -> CaptureOutcome {
+    let mut o = CaptureOutcome::new(c);
+    let intr = camera.intrinsics();
+    let max_gate = 0.1 * f64::from(intr.image_width_px).hypot(f64::from(intr.image_height_px));
+    let proj: Vec<Option<Vector2<f64>>> = c
+        .planned_ids
+        .iter()
+        .map(|id| camera.project(&(pose * Point3::from(points[id])).coords))
+        .collect();
+    let gate: Vec<f64> = proj
+        .iter()
+        .enumerate()
+        .map(|(k, p)| {
+            let Some(p) = p else { return 0.0 };
+            proj.iter()
+                .enumerate()
+                .filter(|(j, _)| *j != k)
+                .filter_map(|(_, q)| q.map(|q| 0.5 * (q - p).norm()))
+                .fold(max_gate, f64::min)
+        })
+        .collect();
+    let dist = |k: usize, j: usize| {
+        proj[k].map_or(f64::INFINITY, |p| {
+            (p - Vector2::new(c.spots[j].u_px, c.spots[j].v_px)).norm()
+        })
+    };
+    // each pin's candidates: the nearest spots within its gate
+    let candidates: Vec<Vec<usize>> = (0..proj.len())
+        .map(|k| {
+            let mut js: Vec<usize> = (0..c.spots.len())
+                .filter(|&j| dist(k, j) < gate[k])
+                .collect();
+            js.sort_by(|&a, &b| dist(k, a).total_cmp(&dist(k, b)));
+            js.truncate(CANDIDATES_PER_PIN);
+            js
+        })
+        .collect();
+    // the choice of at most one spot per pin, each spot to one pin, that costs least: a taken
+    // spot its squared distance, a pin left without one its gate squared
+    let mut best: (f64, Vec<Option<usize>>) = (f64::INFINITY, Vec::new());
+    let mut choice = Vec::with_capacity(proj.len());
+    search(
+        &candidates,
+        &|k, j| match j {
+            Some(j) => dist(k, j).powi(2),
+            None => gate[k].powi(2),
+        },
+        &mut choice,
+        0.0,
+        &mut best,
+    );
+    let taken = best.1;
+    for (k, j) in taken.iter().enumerate() {
+        let Some(j) = *j else { continue };
+        let d1 = dist(k, j);
+        // another spot, taken by no pin, that fits this pin about as well
+        if let Some(&j2) = candidates[k]
+            .iter()
+            .find(|&&j2| j2 != j && !taken.contains(&Some(j2)))
+        {
+            let d2 = dist(k, j2);
+            if d2 * d2 <= AMBIGUOUS_RATIO * d1 * d1 + 1.0 {
+                let (a, b) = (c.spots[j], c.spots[j2]);
+                o.left_out = Some(format!(
+                    "pin {}: two spots fit it equally well, ({:.1}, {:.1}) at {d1:.1} px and ({:.1}, {:.1}) at {d2:.1} px from its projection",
+                    c.planned_ids[k], a.u_px, a.v_px, b.u_px, b.v_px
+                ));
+                return o;
+            }
+        }
+    }
+    for (k, j) in taken.iter().enumerate() {
+        let id = c.planned_ids[k];
+        match (j, proj[k]) {
+            (Some(j), _) => o.kept.push((id, c.spots[*j])),
+            (None, None) => o
+                .missing
+                .push((id, "it does not project into the image at the pose".into())),
+            (None, Some(p)) => o.missing.push((
+                id,
+                format!(
+                    "no spot within {:.0} px of its projection ({:.1}, {:.1})",
+                    gate[k], p.x, p.y
+                ),
+            )),
+        }
+    }
+    o.kept.sort_by_key(|(id, _)| *id);
+    for (j, s) in c.spots.iter().enumerate() {
+        if taken.contains(&Some(j)) {
+            continue;
+        }
+        // the nearest projection, and whether the spot lost a pin to a nearer one
+        let near = (0..proj.len())
+            .filter(|&k| proj[k].is_some())
+            .min_by(|&a, &b| dist(a, j).total_cmp(&dist(b, j)));
+        let why = match near {
+            None => "no planned pin projects into the image".to_string(),
+            Some(k) => {
+                let d = dist(k, j);
+                match taken[k] {
+                    Some(jk) if d < gate[k] => format!(
+                        "pin {} took a nearer spot ({:.1} px from its projection against {d:.1} px)",
+                        c.planned_ids[k],
+                        dist(k, jk)
+                    ),
+                    _ => format!(
+                        "{d:.1} px from the nearest planned pin's projection (pin {}), more than the {:.0} px a spot of it may be",
+                        c.planned_ids[k], gate[k]
+                    ),
+                }
+            }
+        };
+        o.discarded.push((*s, why));
+    }
+    o
+}
+
+/// Depth-first search over the pins' candidates for the cheapest choice (`cost(k, spot)`);
+/// `best` holds the cheapest so far.
+fn search(
+    candidates: &[Vec<usize>],
+    cost: &dyn Fn(usize, Option<usize>) -> f64,
+    choice: &mut Vec<Option<usize>>,
+    so_far: f64,
+    best: &mut (f64, Vec<Option<usize>>),
+) {
+    if so_far >= best.0 {
+        return;
+    }
+    let k = choice.len();
+    if k == candidates.len() {
+        *best = (so_far, choice.clone());
+        return;
+    }
+    for &j in &candidates[k] {
+        if choice.contains(&Some(j)) {
+            continue;
+        }
+        choice.push(Some(j));
+        search(candidates, cost, choice, so_far + cost(k, Some(j)), best);
+        choice.pop();
+    }
+    choice.push(None);
+    search(candidates, cost, choice, so_far + cost(k, None), best);
+    choice.pop();
+}
