@@ -220,13 +220,7 @@ pub fn calibrate_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsOutput, Ext
             Observed::Files(_) => None,
         },
     };
-    let mut report = ExtrinsicsReport::new(
-        &camera,
-        &pairs,
-        &sol,
-        job.ransac.map(|r| r.threshold_px),
-        provenance,
-    );
+    let mut report = ExtrinsicsReport::new(&camera, &pairs, &sol, provenance);
     if let Some(found) = &from_images {
         report.warnings.extend(found.notes.iter().cloned());
         report.captures = found.outcomes.iter().map(CaptureReport::from).collect();
@@ -235,7 +229,7 @@ pub fn calibrate_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsOutput, Ext
         Some(r) => {
             let text = crate::read_text(&job.camera).unwrap_or_default();
             let (name, format) = crate::refine::refined_camera_file(&text);
-            report.intrinsics_refinement = Some(RefinementReport::new(r, name));
+            report.set_refinement(RefinementReport::new(r, name));
             Some((
                 name.to_string(),
                 crate::write_camera(r.camera.intrinsics(), format).into_bytes(),

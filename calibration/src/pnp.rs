@@ -38,7 +38,7 @@ pub enum PnpError {
     NoSolution,
     #[error("point {index} is behind the camera or outside the lens's field at the solved pose")]
     BehindCamera { index: usize },
-    #[error("RANSAC found {inliers} inliers within {threshold_px} px: at least {needed} are needed (are the ids right?)")]
+    #[error("RANSAC found {inliers} inliers within {threshold_px:.2} px: at least {needed} are needed (are the ids right?)")]
     TooFewInliers {
         inliers: usize,
         needed: usize,
@@ -50,8 +50,10 @@ pub enum PnpError {
 /// (P3P, each refined on its consensus set when it is the best so far) follow until the adaptive count for `confidence` is reached.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RansacOptions {
-    /// A point is an inlier when its reprojection error is below this, px.
-    pub threshold_px: f64,
+    /// A point is an inlier when its reprojection error is below this, px; `None`: from the
+    /// data ([`robust_threshold_px`]), so that a lens the camera file describes only roughly
+    /// (errors of several px towards the edge of its field) still gives a consensus.
+    pub threshold_px: Option<f64>,
     /// Probability of drawing at least one outlier-free sample, in (0, 1).
     pub confidence: f64,
     /// Largest number of sampled hypotheses.
@@ -66,7 +68,7 @@ pub struct RansacOptions {
 impl Default for RansacOptions {
     fn default() -> Self {
         RansacOptions {
-            threshold_px: 3.0,
+            threshold_px: None,
             confidence: 0.999,
             max_hypotheses: 1000,
             seed: 0,
@@ -106,6 +108,98 @@ pub struct PnpSolution {
     pub rms_reprojection_error_px: f64,
     /// RANSAC hypotheses drawn (0 without RANSAC or when the all-points fit had no outlier).
     pub hypotheses: usize,
+    /// The RANSAC inlier threshold used, px: the option's, or the one from the data (`None`
+    /// without RANSAC).
+    pub ransac_threshold_px: Option<f64>,
+}
+
+/// The least inlier threshold taken from the data, px: on well-described lenses the consensus
+/// is that of a fixed 3 px (a good pin is never dropped for the noise of its centroid); the
+/// data only widen it.
+pub const MIN_ROBUST_THRESHOLD_PX: f64 = 3.0;
+
+/// The threshold from the data is this many robust standard deviations (per axis) of the
+/// reprojection error: 99.8 % of Gaussian errors fall within it in 2D.
+pub const ROBUST_THRESHOLD_SIGMAS: f64 = 3.5;
+
+/// ... and at most this fraction of the observed pixels' spread (the RMS distance from their
+/// mean): errors beyond it are no consensus (pins labelled at random), not a rough lens model.
+pub const MAX_ROBUST_THRESHOLD_OF_SPREAD: f64 = 0.1;
+
+/// The inlier threshold from the data, px: least median of squares (Rousseeuw 1984; Rousseeuw
+/// and Leroy 1987, Sec. 5.1) over the all-points pose `start` and minimal P3P samples (as many
+/// as give `confidence` of an outlier-free sample when half the points are outliers), the best
+/// refined on its better half; the median squared reprojection error at that pose gives the
+/// robust standard deviation per axis, sigma = sqrt(med / (2 ln 2)) (1 + 5 / (n - 6)) (2D
+/// Gaussian errors; the finite-sample factor of Rousseeuw and Leroy), and the threshold is
+/// [`ROBUST_THRESHOLD_SIGMAS`] sigma, at least [`MIN_ROBUST_THRESHOLD_PX`] and at most
+/// [`MAX_ROBUST_THRESHOLD_OF_SPREAD`] of the pixels' spread.
+#[allow(clippy::too_many_arguments)]
+fn robust_threshold_px(
+    camera: &CameraModel,
+    pts: &[Vector3<f64>],
+    px: &[Vector2<f64>],
+    bearings: &[Vector3<f64>],
+    start: (&Matrix3<f64>, &Vector3<f64>),
+    ro: &RansacOptions,
+    opts: &PnpOptions,
+) -> f64 {
+    let n = pts.len();
+    let half = n / 2;
+    let mut e2 = vec![0.0; n];
+    let median2 = |r: &Matrix3<f64>, t: &Vector3<f64>, e2: &mut Vec<f64>| {
+        for (k, (m, uv)) in pts.iter().zip(px).enumerate() {
+            e2[k] = camera
+                .project(&(r * m + t))
+                .map_or(f64::INFINITY, |p| (p - uv).norm_squared());
+        }
+        let mut sorted = e2.clone();
+        *sorted.select_nth_unstable_by(half, f64::total_cmp).1
+    };
+    let mut best = (median2(start.0, start.1, &mut e2), *start.0, *start.1);
+    let samples = ((1.0 - ro.confidence).ln() / (1.0 - 0.5f64.powi(3)).ln())
+        .ceil()
+        .clamp(1.0, ro.max_hypotheses.max(1) as f64) as usize;
+    let mut rng = ChaCha8Rng::seed_from_u64(ro.seed);
+    let mut sample = [0usize; 3];
+    let mut poses = Vec::with_capacity(4);
+    for _ in 0..samples {
+        draw(&mut rng, n, &mut sample);
+        p3p(
+            &sample.map(|i| pts[i]),
+            &sample.map(|i| bearings[i]),
+            &mut poses,
+        );
+        for (r, t) in &poses {
+            let m = median2(r, t, &mut e2);
+            if m < best.0 {
+                best = (m, *r, *t);
+            }
+        }
+    }
+    // the best pose refined on the half of the points it explains best
+    median2(&best.1, &best.2, &mut e2);
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by(|&a, &b| e2[a].total_cmp(&e2[b]));
+    order.truncate((half + 1).max(MIN_POINTS).min(n));
+    order.sort_unstable();
+    if let Some(mut f) = Fit::at(camera, pts, px, &order, best.1, best.2) {
+        f.refine(camera, pts, px, opts.max_iterations);
+        let m = median2(&f.r, &f.t, &mut e2);
+        if m < best.0 {
+            best.0 = m;
+        }
+    }
+    let finite = (1.0 + 5.0 / n.saturating_sub(6).max(1) as f64).min(2.0);
+    let sigma = (best.0 / (2.0 * std::f64::consts::LN_2)).sqrt() * finite;
+    let mean = px.iter().sum::<Vector2<f64>>() / n as f64;
+    let spread = (px.iter().map(|p| (p - mean).norm_squared()).sum::<f64>() / n as f64).sqrt();
+    let most = (MAX_ROBUST_THRESHOLD_OF_SPREAD * spread).max(MIN_ROBUST_THRESHOLD_PX);
+    if sigma.is_finite() {
+        (ROBUST_THRESHOLD_SIGMAS * sigma).clamp(MIN_ROBUST_THRESHOLD_PX, most)
+    } else {
+        MIN_ROBUST_THRESHOLD_PX
+    }
 }
 
 /// Solves T_cam_sensor from sensor-frame points `points_mm` (N, mm) and their observed pixels
@@ -167,10 +261,28 @@ pub fn solve_pnp(
     .ok_or(PnpError::NoSolution)?;
     let mut hypotheses = 0;
     let mut inliers = vec![true; n];
+    let mut threshold_used = None;
     match &opts.ransac {
         None => fit.refine(camera, points_mm, pixels_px, opts.max_iterations),
         Some(ro) => {
-            let thr2 = ro.threshold_px * ro.threshold_px;
+            let threshold_px = match ro.threshold_px {
+                Some(t) => t,
+                None => robust_threshold_px(
+                    camera,
+                    points_mm,
+                    pixels_px,
+                    &bearings,
+                    (&fit.r, &fit.t),
+                    ro,
+                    opts,
+                ),
+            };
+            threshold_used = Some(threshold_px);
+            let ro = &RansacOptions {
+                threshold_px: Some(threshold_px),
+                ..*ro
+            };
+            let thr2 = threshold_px * threshold_px;
             // The all-points SQPnP pose is the first hypothesis. When it explains every pair,
             // the refinement on all of them is the answer unless it pushes a pair out.
             let mut consensus = Consensus::new(n);
@@ -206,7 +318,7 @@ pub fn solve_pnp(
                 return Err(PnpError::TooFewInliers {
                     inliers: count,
                     needed,
-                    threshold_px: ro.threshold_px,
+                    threshold_px,
                 });
             }
         }
@@ -243,6 +355,7 @@ pub fn solve_pnp(
         residuals_px,
         rms_reprojection_error_px: (sum2 / m as f64).sqrt(),
         hypotheses,
+        ransac_threshold_px: threshold_used,
     })
 }
 
@@ -262,7 +375,8 @@ fn ransac(
     best: &mut Consensus,
 ) -> usize {
     let n = pts.len();
-    let thr2 = ro.threshold_px * ro.threshold_px;
+    let thr = ro.threshold_px.unwrap_or(MIN_ROBUST_THRESHOLD_PX);
+    let thr2 = thr * thr;
     // Local optimisation of the starting hypothesis.
     let local_opt = |fit: &mut Fit, c: &mut Consensus| {
         let idx = c.indices();

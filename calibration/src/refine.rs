@@ -573,5 +573,6 @@ pub fn solution_at(
         residuals_px,
         rms_reprojection_error_px: (sq / n.max(1) as f64).sqrt(),
         hypotheses: sol.hypotheses,
+        ransac_threshold_px: sol.ransac_threshold_px,
     }
 }

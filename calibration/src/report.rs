@@ -57,11 +57,130 @@ pub struct ResidualReport {
     pub inliers: usize,
     /// Ids rejected by RANSAC.
     pub outlier_ids: Vec<String>,
-    /// RANSAC inlier threshold, px (`null` without RANSAC).
+    /// RANSAC inlier threshold used, px: `--ransac-threshold-px`, or from the data (3.5 robust
+    /// standard deviations by least median of squares, at least 3 px, at most a tenth of the pixels' spread); `null` without RANSAC.
     pub ransac_threshold_px: Option<f64>,
     /// The camera's optical centre in the sensor frame, mm.
     pub camera_centre_in_sensor_mm: [f64; 3],
+    /// The reprojection errors by the points' polar angle about the sensor axis (a dome's
+    /// rings), inliers and outliers alike: errors that grow towards the edge of the lens's
+    /// field say that the camera file's model does not follow the lens there.
+    pub by_polar_angle: Vec<RingResidual>,
     pub points: Vec<PointResidual>,
+}
+
+/// The reprojection errors of the points in one band of polar angle.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RingResidual {
+    /// Smallest and largest polar angle of the band's points about the sensor z axis, deg.
+    pub polar_deg: [f64; 2],
+    pub points: usize,
+    pub inliers: usize,
+    /// RMS reprojection error of the band's points that project (outliers included), px.
+    pub rms_px: f64,
+}
+
+impl RingResidual {
+    /// `18 deg`, or `12-30 deg` for a band.
+    pub fn angles(&self) -> String {
+        let [lo, hi] = self.polar_deg;
+        if hi - lo < 0.5 {
+            format!("{lo:.0} deg")
+        } else {
+            format!("{lo:.0}-{hi:.0} deg")
+        }
+    }
+}
+
+/// Points whose polar angles are within this of their neighbours' share a ring, deg.
+const RING_GAP_DEG: f64 = 3.0;
+/// With fewer than 2 or more than this many rings the points are split in 5 bands of equal
+/// count instead.
+const MAX_RINGS: usize = 8;
+
+/// The polar angle of `p` about the sensor z axis, deg.
+fn polar_deg(p: &nalgebra::Vector3<f64>) -> f64 {
+    p.xy().norm().atan2(p.z).to_degrees()
+}
+
+/// The residuals by ring ([`ResidualReport::by_polar_angle`]): the points sorted by polar
+/// angle, a new ring at every gap of more than [`RING_GAP_DEG`]; 5 bands of equal count when
+/// that makes fewer than 2 or more than [`MAX_RINGS`] rings.
+fn ring_residuals(pairs: &Pairs, sol: &PnpSolution) -> Vec<RingResidual> {
+    let n = pairs.points_mm.len();
+    let mut order: Vec<usize> = (0..n).collect();
+    let polar: Vec<f64> = pairs.points_mm.iter().map(polar_deg).collect();
+    order.sort_by(|&a, &b| polar[a].total_cmp(&polar[b]));
+    let mut groups: Vec<Vec<usize>> = Vec::new();
+    for &i in &order {
+        match groups.last_mut() {
+            Some(g) if polar[i] - polar[*g.last().expect("never empty")] <= RING_GAP_DEG => {
+                g.push(i)
+            }
+            _ => groups.push(vec![i]),
+        }
+    }
+    if groups.len() < 2 || groups.len() > MAX_RINGS {
+        let bands = 5.min(n);
+        groups = (0..bands)
+            .map(|b| order[b * n / bands..(b + 1) * n / bands].to_vec())
+            .filter(|g| !g.is_empty())
+            .collect();
+    }
+    groups
+        .iter()
+        .map(|g| {
+            let errs: Vec<f64> = g
+                .iter()
+                .filter_map(|&i| sol.residuals_px[i].map(|r| r.norm_squared()))
+                .collect();
+            RingResidual {
+                polar_deg: [polar[g[0]], polar[*g.last().expect("never empty")]],
+                points: g.len(),
+                inliers: g.iter().filter(|&&i| sol.inliers[i]).count(),
+                rms_px: (errs.iter().sum::<f64>() / errs.len().max(1) as f64).sqrt(),
+            }
+        })
+        .collect()
+}
+
+/// The outermost ring's RMS is above this, px, ...
+const GROWING_MIN_PX: f64 = 2.0;
+/// ... and this many times the median of the inner half's rings: the residuals grow with the
+/// polar angle.
+const GROWING_RATIO: f64 = 3.0;
+
+/// The start of the warning of [`growing_residuals`].
+const GROWING: &str = "the reprojection errors grow with the polar angle";
+
+/// A warning when the residuals grow towards the edge of the field (at least 3 rings);
+/// `refined`: after `--refine-intrinsics`.
+fn growing_residuals(rings: &[RingResidual], refined: bool) -> Option<String> {
+    if rings.len() < 3 {
+        return None;
+    }
+    let outer = rings.last().expect("at least 3").rms_px;
+    let mut inner: Vec<f64> = rings[..rings.len().div_ceil(2)]
+        .iter()
+        .map(|r| r.rms_px)
+        .collect();
+    inner.sort_by(f64::total_cmp);
+    let median = inner[inner.len() / 2];
+    (outer > GROWING_MIN_PX && outer > GROWING_RATIO * median).then(|| {
+        format!(
+            "{GROWING} (RMS {}): {}",
+            rings
+                .iter()
+                .map(|r| format!("{:.1} px at {}", r.rms_px, r.angles()))
+                .collect::<Vec<_>>()
+                .join(", "),
+            if refined {
+                "the refined model still does not follow the lens towards the edge of its field, where the pins beyond the RANSAC threshold are left out (the pose rests on the others); a camera file calibrated over the whole field (e.g. the fisheye model for a wide-angle lens) would use them"
+            } else {
+                "the camera file's model does not follow the lens towards the edge of its field; try --refine-intrinsics (the intrinsics refined with the pose over the pins kept), or a camera file calibrated over the whole field (e.g. the fisheye model for a wide-angle lens)"
+            }
+        )
+    })
 }
 
 /// `extrinsics.json`: T_cam_sensor and the residual report.
@@ -187,7 +306,6 @@ impl ExtrinsicsReport {
         camera: &CameraModel,
         pairs: &Pairs,
         sol: &PnpSolution,
-        ransac_threshold_px: Option<f64>,
         provenance: Provenance,
     ) -> ExtrinsicsReport {
         let iso = &sol.t_cam_sensor;
@@ -229,6 +347,8 @@ impl ExtrinsicsReport {
             iso,
         );
         let mut warnings = Vec::new();
+        let by_polar_angle = ring_residuals(pairs, sol);
+        warnings.extend(growing_residuals(&by_polar_angle, false));
         let inlier_polar_deg = || {
             pairs
                 .points_mm
@@ -285,11 +405,21 @@ impl ExtrinsicsReport {
                 observations: pairs.ids.len(),
                 inliers: sol.inliers.iter().filter(|&&b| b).count(),
                 outlier_ids,
-                ransac_threshold_px,
+                ransac_threshold_px: sol.ransac_threshold_px,
                 camera_centre_in_sensor_mm: [centre.x, centre.y, centre.z],
+                by_polar_angle,
                 points,
             },
         }
+    }
+
+    /// Records the intrinsics refinement (`--refine-intrinsics`) and words the warning on
+    /// residuals that grow with the polar angle for it.
+    pub fn set_refinement(&mut self, r: crate::refine::RefinementReport) {
+        self.intrinsics_refinement = Some(r);
+        let refined = growing_residuals(&self.residuals.by_polar_angle, true);
+        self.warnings.retain(|w| !w.starts_with(GROWING));
+        self.warnings.extend(refined);
     }
 
     /// Pretty JSON, stable key order, newline-terminated.

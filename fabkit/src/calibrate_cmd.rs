@@ -96,9 +96,12 @@ pub struct ExtrinsicsArgs {
     /// Capture image (PNG) for an overlay of observed and reprojected points.
     #[arg(long, value_name = "IMG.png")]
     pub image: Option<PathBuf>,
-    /// RANSAC inlier threshold on the reprojection error, px.
-    #[arg(long, default_value_t = 3.0)]
-    pub ransac_threshold_px: f64,
+    /// RANSAC inlier threshold on the reprojection error, px. Default: from the data (3.5
+    /// robust standard deviations of the reprojection error by least median of squares, at
+    /// least 3 px, at most a tenth of the pixels' spread), so that a camera file that follows the lens only roughly towards the edge
+    /// of its field still gives a pose.
+    #[arg(long)]
+    pub ransac_threshold_px: Option<f64>,
     /// Use every observation (no outlier rejection).
     #[arg(long)]
     pub no_ransac: bool,
@@ -122,12 +125,10 @@ pub fn run(cmd: CalibrateCommand) -> Result<(), Box<dyn Error>> {
 }
 
 fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
-    if !(a.ransac_threshold_px.is_finite() && a.ransac_threshold_px > 0.0) {
-        return Err(format!(
-            "--ransac-threshold-px = {}: must be finite and > 0",
-            a.ransac_threshold_px
-        )
-        .into());
+    if let Some(t) = a.ransac_threshold_px {
+        if !(t.is_finite() && t > 0.0) {
+            return Err(format!("--ransac-threshold-px = {t}: must be finite and > 0").into());
+        }
     }
     // The job of the output: its inputs (what it was computed from), not the solver's options.
     let captures = a.images.len().max(a.observations.len());
@@ -223,8 +224,23 @@ fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
         r.residuals.worst_id
     );
     if !r.residuals.outlier_ids.is_empty() {
-        println!("outliers rejected: {}", r.residuals.outlier_ids.join(", "));
+        println!(
+            "outliers rejected: {}{}",
+            r.residuals.outlier_ids.join(", "),
+            r.residuals
+                .ransac_threshold_px
+                .map_or_else(String::new, |t| format!(" (beyond {t:.2} px)"))
+        );
     }
+    println!(
+        "RMS by polar angle: {}",
+        r.residuals
+            .by_polar_angle
+            .iter()
+            .map(|b| format!("{} {:.2} px ({} pins)", b.angles(), b.rms_px, b.points))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
     println!(
         "rvec = [{:.6}, {:.6}, {:.6}] rad, tvec_mm = [{:.4}, {:.4}, {:.4}], camera centre in sensor frame = [{:.4}, {:.4}, {:.4}] mm",
         r.rvec[0], r.rvec[1], r.rvec[2], r.tvec_mm[0], r.tvec_mm[1], r.tvec_mm[2], c[0], c[1], c[2]

@@ -220,7 +220,7 @@ def solve_extrinsics(
     *,
     ids: Optional[Sequence[str]] = None,
     ransac: bool = True,
-    threshold_px: float = 3.0,
+    threshold_px: float | None = None,
     seed: int = 0,
 ) -> Dict[str, Any]:
     """The camera pose from sensor-frame points (n, 3) mm and pixels (n, 2) px, as ``fabkit

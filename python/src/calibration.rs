@@ -232,7 +232,8 @@ pub(crate) fn rows<const N: usize>(a: &Bound<'_, PyAny>, name: &str) -> PyResult
 /// Solves the camera pose T_cam_sensor from sensor-frame points (n, 3) mm and their observed
 /// pixels (n, 2) px through `camera` (a Camera or a camera file path), as `fabkit calibrate
 /// extrinsics` does (SQPnP + Levenberg-Marquardt; with `ransac`, outliers rejected at
-/// `threshold_px`, reproducible by `seed`).
+/// `threshold_px`, or a threshold from the data when it is None: 3.5 robust standard deviations
+/// by least median of squares, at least 3 px, at most a tenth of the pixels' spread; reproducible by `seed`).
 ///
 /// Returns a dict: `T_cam_sensor` (4, 4) float64 (sensor frame -> camera frame, mm),
 /// `residuals_px` (n, 2) (reprojected minus observed, NaN where a point does not project),
@@ -241,7 +242,7 @@ pub(crate) fn rows<const N: usize>(a: &Bound<'_, PyAny>, name: &str) -> PyResult
 /// `ids` or the row numbers). Raises CalibrationError with the CLI's message (fewer than 4
 /// points, a non-finite value, a degenerate layout, too few inliers, ...).
 #[pyfunction]
-#[pyo3(signature = (points_mm, pixels_px, camera, *, ids=None, ransac=true, threshold_px=3.0, seed=0))]
+#[pyo3(signature = (points_mm, pixels_px, camera, *, ids=None, ransac=true, threshold_px=None, seed=0))]
 #[allow(clippy::too_many_arguments)]
 pub fn solve_extrinsics<'py>(
     py: Python<'py>,
@@ -250,9 +251,16 @@ pub fn solve_extrinsics<'py>(
     camera: &Bound<'py, PyAny>,
     ids: Option<Vec<String>>,
     ransac: bool,
-    threshold_px: f64,
+    threshold_px: Option<f64>,
     seed: u64,
 ) -> PyResult<Bound<'py, PyDict>> {
+    if let Some(t) = threshold_px {
+        if !(t.is_finite() && t > 0.0) {
+            return Err(PyValueError::new_err(format!(
+                "threshold_px = {t}: must be finite and > 0 (or None: from the data)"
+            )));
+        }
+    }
     let camera = Camera::of(camera)?;
     let points = rows::<3>(points_mm, "points_mm")?;
     let pixels = rows::<2>(pixels_px, "pixels_px")?;
@@ -303,13 +311,7 @@ pub fn solve_extrinsics<'py>(
         unobserved_ids: Vec::new(),
         reference_image: None,
     };
-    let report = ExtrinsicsReport::new(
-        model,
-        &pairs,
-        &sol,
-        ransac.map(|r| r.threshold_px),
-        provenance,
-    );
+    let report = ExtrinsicsReport::new(model, &pairs, &sol, provenance);
     let report: serde_json::Value = serde_json::from_str(&report.to_json())
         .map_err(|e| CalibrationError::new_err(e.to_string()))?;
     let h = sol.t_cam_sensor.to_homogeneous();

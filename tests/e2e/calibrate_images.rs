@@ -15,9 +15,13 @@ use crate::common::{run, text};
 use fabkit_calibration::groundtruth::surface::ReferenceSurface;
 use fabkit_calibration::imprints::synthetic::{render, Pin, Shading};
 use fabkit_calibration::imprints::GrayImage;
-use fabkit_calibration::nalgebra::{Isometry3, Vector2, Vector3};
+use fabkit_calibration::nalgebra::{
+    DMatrix, DVector, Isometry3, Translation3, UnitQuaternion, Vector2, Vector3,
+};
 use fabkit_calibration::tables::{read_capture_plan, read_point_table, PointsFrom};
-use fabkit_calibration::{solve_pnp, write_camera, CameraFileFormat, CameraModel, PnpOptions};
+use fabkit_calibration::{
+    solve_pnp, write_camera, CameraFileFormat, CameraModel, Distortion, Intrinsics, PnpOptions,
+};
 
 /// The tip radius of the fixtures' default pin, mm.
 const TIP_RADIUS_MM: f64 = 0.8;
@@ -73,7 +77,9 @@ fn save(img: &GrayImage, path: &Path, kind: Kind) {
 /// The fixtures' table and plan, and a renderer of captures of their pins.
 struct Scene {
     dir: tempfile::TempDir,
+    /// The camera the captures are rendered through, and its pose.
     camera: CameraModel,
+    pose: Isometry3<f64>,
     surface: ReferenceSurface,
     tips: BTreeMap<String, Vector3<f64>>,
     plan: Vec<Vec<String>>,
@@ -81,6 +87,11 @@ struct Scene {
 
 impl Scene {
     fn new() -> Scene {
+        Self::with(intrinsics(), truth())
+    }
+
+    /// The captures rendered through `camera` at `pose`; cam.yaml holds `camera`.
+    fn with(camera: Intrinsics, pose: Isometry3<f64>) -> Scene {
         let dir = tempfile::tempdir().unwrap();
         let o = run(
             dir.path(),
@@ -90,7 +101,7 @@ impl Scene {
         assert!(o.status.success(), "{}", text(&o.stderr));
         std::fs::write(
             dir.path().join("cam.yaml"),
-            write_camera(&intrinsics(), CameraFileFormat::OpenCvYaml),
+            write_camera(&camera, CameraFileFormat::OpenCvYaml),
         )
         .unwrap();
         let table = read_point_table(
@@ -102,7 +113,8 @@ impl Scene {
         let design = fabkit_designs::library::load("rtac0").unwrap();
         Scene {
             dir,
-            camera: CameraModel::new(intrinsics()).unwrap(),
+            camera: CameraModel::new(camera).unwrap(),
+            pose,
             surface: ReferenceSurface::of(&design.body).unwrap(),
             tips: table.rows.into_iter().map(|(id, p, _)| (id, p)).collect(),
             plan: plan.captures,
@@ -131,7 +143,14 @@ impl Scene {
             grey_per_mm: 60.0,
             ..Shading::default()
         };
-        let r = render(&self.camera, &truth(), &self.surface, &pins, &shading, seed);
+        let r = render(
+            &self.camera,
+            &self.pose,
+            &self.surface,
+            &pins,
+            &shading,
+            seed,
+        );
         let centres = r.centres_px.iter().map(|c| c.unwrap()).collect();
         (r.reference, r.capture, centres)
     }
@@ -666,4 +685,161 @@ fn refine_intrinsics_from_photos_writes_the_camera_file_in_the_form_read() {
         );
         assert!(!s.path("bad").exists(), "{refine}");
     }
+}
+
+/// A 160 deg lens close under the dome, as on the R-Tac0 (an equidistant fisheye, f = 172 px:
+/// 80 deg off the axis at 240 px; the camera 2 mm below the dome's centre, so that the outer
+/// ring is seen 67 deg off the axis), described by a 5-coefficient pinhole camera file
+/// (plumb_bob) fitted to the lens over the pins' field by least squares and then 20 px off at
+/// the outer ring: the default command (no --ransac-threshold-px, no --refine-intrinsics)
+/// gives a pose from the inner rings, and the report gives the RMS per ring and says that the
+/// errors grow with the polar angle, suggesting --refine-intrinsics.
+#[test]
+fn the_default_command_gives_a_pose_through_a_rough_pinhole_file_of_a_160_deg_lens() {
+    let lens = Intrinsics {
+        image_width_px: 640,
+        image_height_px: 480,
+        fx_px: 172.0,
+        fy_px: 172.0,
+        cx_px: 320.0,
+        cy_px: 240.0,
+        distortion: Distortion::Fisheye([0.0; 4]),
+    };
+    let pose = Isometry3::from_parts(
+        Translation3::new(0.2, -0.1, 2.0),
+        UnitQuaternion::from_scaled_axis(Vector3::new(0.015, -0.01, 0.3)),
+    );
+    let s = Scene::with(lens, pose);
+    // the pins' angles off the optical axis, and the outermost
+    let theta: Vec<f64> = s
+        .tips
+        .values()
+        .map(|p| {
+            let c = pose * fabkit_calibration::nalgebra::Point3::from(*p);
+            c.coords.xy().norm().atan2(c.z)
+        })
+        .collect();
+    let outer = theta.iter().copied().fold(0.0, f64::max);
+    assert!(outer.to_degrees() > 55.0, "{}", outer.to_degrees());
+    // plumb_bob: r_d = t (1 + k1 t^2 + k2 t^4 + k3 t^6), t = tan(theta), fitted to the
+    // equidistant r_d = theta over 0..outer
+    let samples: Vec<f64> = (1..=200).map(|i| outer * i as f64 / 200.0).collect();
+    let a = DMatrix::from_fn(samples.len(), 3, |i, j| {
+        let t = samples[i].tan();
+        t.powi(2 * j as i32 + 3)
+    });
+    let b = DVector::from_fn(samples.len(), |i, _| samples[i] - samples[i].tan());
+    let k = a.clone().svd(true, true).solve(&b, 1e-12).unwrap();
+    let to = outer.tan();
+    let fit_err_px =
+        172.0 * (to * (1.0 + k[0] * to.powi(2) + k[1] * to.powi(4) + k[2] * to.powi(6)) - outer);
+    // then 20 px off at the outer ring by k1, which moves the inner rings too (by t^3)
+    let k1 = k[0] + (20.0 - fit_err_px) / (172.0 * to.powi(3));
+    let file = Intrinsics {
+        distortion: Distortion::PlumbBob([k1, k[1], 0.0, 0.0, k[2]]),
+        ..lens
+    };
+    std::fs::write(
+        s.path("cam.yaml"),
+        write_camera(&file, CameraFileFormat::OpenCvYaml),
+    )
+    .unwrap();
+    let off = CameraModel::new(file).unwrap();
+    let true_cam = CameraModel::new(lens).unwrap();
+    let off_at = |p: &Vector3<f64>| {
+        let c = (pose * fabkit_calibration::nalgebra::Point3::from(*p)).coords;
+        (off.project(&c).unwrap() - true_cam.project(&c).unwrap()).norm()
+    };
+    let worst = s.tips.values().map(off_at).fold(0.0, f64::max);
+    assert!(
+        (worst - 20.0).abs() < 1.0,
+        "the file is {worst:.2} px off at the outer ring"
+    );
+    let mut names = Vec::new();
+    for (k, ids) in s.plan.iter().enumerate() {
+        let (reference, capture, _) = s.render(ids, 700 + k as u64);
+        if k == 0 {
+            save(&reference, &s.path("reference.png"), Kind::Gray8);
+        }
+        let name = format!("capture_{}.png", k + 1);
+        save(&capture, &s.path(&name), Kind::Gray8);
+        names.push(name);
+    }
+    let calibrate = |out: &str, extra: &[&str]| {
+        let mut args = vec![
+            "calibrate",
+            "extrinsics",
+            "--camera",
+            "cam.yaml",
+            "--points",
+            "fx/points/point_table.csv",
+            "--capture-plan",
+            "fx/points/capture_plan.csv",
+            "--reference",
+            "reference.png",
+            "--out",
+            out,
+        ];
+        args.extend_from_slice(extra);
+        args.push("--images");
+        args.extend(names.iter().map(String::as_str));
+        run(s.dir.path(), &args, &[])
+    };
+    let o = calibrate("out", &[]);
+    let (out, err) = (text(&o.stdout), text(&o.stderr));
+    assert!(o.status.success(), "{out}{err}");
+    assert!(out.contains("RMS by polar angle: 0 deg "), "{out}");
+    let j = json(&s.path("out/extrinsics.json"));
+    let rings = j["residuals"]["by_polar_angle"].as_array().unwrap();
+    assert_eq!(rings.len(), 5, "{rings:?}");
+    let rms: Vec<f64> = rings
+        .iter()
+        .map(|r| r["rms_px"].as_f64().unwrap())
+        .collect();
+    assert!(
+        rms[4] > 10.0 && rms[..3].iter().all(|&r| r < 2.0),
+        "{rms:?}"
+    );
+    let warning = j["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|w| w.as_str())
+        .find(|w| w.contains("grow with the polar angle"))
+        .unwrap_or_else(|| panic!("{}", j["warnings"]));
+    assert!(warning.contains("--refine-intrinsics"), "{warning}");
+    assert!(err.contains("grow with the polar angle"), "{err}");
+    let inliers = j["residuals"]["inliers"].as_u64().unwrap();
+    let threshold = j["residuals"]["ransac_threshold_px"].as_f64().unwrap();
+    let (rot, tr) = pose_errors_from(&pose_of(&j), &pose);
+    eprintln!("default: {inliers} inliers within {threshold:.2} px; pose off by {rot:.3} deg, {tr:.4} mm; rings {rms:?}");
+    assert!(inliers >= 19, "{inliers} inliers within {threshold} px");
+    // the wrong distortion trades against the camera's distance along its axis: 0.22 mm
+    assert!(rot < 0.5 && tr < 0.4, "pose off by {rot} deg and {tr} mm");
+    // refining the intrinsics over the pins kept, as the warning suggests, brings the pose
+    // back (0.02 mm); the outer ring stays out, and the report says why
+    let o = calibrate("refined", &["--refine-intrinsics"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let j = json(&s.path("refined/extrinsics.json"));
+    let (rot2, tr2) = pose_errors_from(&pose_of(&j), &pose);
+    eprintln!("refined: pose off by {rot2:.3} deg, {tr2:.4} mm");
+    assert!(rot2 < 0.2 && tr2 < 0.25 * tr, "{rot2} deg, {tr2} mm");
+    let warning = j["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|w| w.as_str())
+        .find(|w| w.contains("grow with the polar angle"))
+        .unwrap_or_else(|| panic!("{}", j["warnings"]));
+    assert!(
+        warning.contains("the refined model still does not follow"),
+        "{warning}"
+    );
+}
+
+fn pose_errors_from(pose: &Isometry3<f64>, truth: &Isometry3<f64>) -> (f64, f64) {
+    (
+        pose.rotation.angle_to(&truth.rotation).to_degrees(),
+        (pose.translation.vector - truth.translation.vector).norm(),
+    )
 }
