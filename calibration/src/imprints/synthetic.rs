@@ -1,0 +1,279 @@
+//! Synthetic captures for the tests and benchmarks: the skin rendered through a camera with the
+//! ground-truth caster ([`crate::groundtruth`]), each pin's imprint shaded as a darkening
+//! proportional to its indentation depth along the pixel's ray, blurred by a Gaussian
+//! point-spread function, with vignetting, bright LED reflections near the rim (a little
+//! brighter or dimmer in each image) and Gaussian noise.
+
+use super::{gaussian_blur, GrayImage};
+use crate::groundtruth::exact::ExactPrimitives;
+use crate::groundtruth::rays::PixelRays;
+use crate::groundtruth::surface::ReferenceSurface;
+use crate::groundtruth::{indented_hits, reference_hits};
+use crate::CameraModel;
+use fabkit_designs::primitives::Primitive;
+use nalgebra::Isometry3;
+use rand_chacha::rand_core::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// How the images are shaded.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Shading {
+    /// Grey of the skin at the image centre.
+    pub skin_grey: f32,
+    /// Grey outside the skin.
+    pub background_grey: f32,
+    /// Darkening per mm of indentation depth along the ray.
+    pub grey_per_mm: f32,
+    /// Sigma of the point-spread function, px.
+    pub psf_sigma_px: f64,
+    /// Sigma of the noise, grey levels.
+    pub noise_sigma: f64,
+    /// Fraction of the grey lost at the image's corners (quadratic in the radius).
+    pub vignetting: f32,
+    /// LED reflections: count, peak grey above the skin, sigma px, and how much each image's
+    /// peak varies (fraction).
+    pub leds: usize,
+    pub led_grey: f32,
+    pub led_sigma_px: f64,
+    pub led_flicker: f32,
+    /// How far each LED highlight moves between the reference and the capture, px (in a
+    /// random direction per highlight).
+    pub led_shift_px: f64,
+    /// The capture's global gain differs from the reference's by a random factor in
+    /// [1 - drift, 1 + drift] (auto exposure, LED supply).
+    pub gain_drift: f32,
+}
+
+impl Default for Shading {
+    fn default() -> Self {
+        Self {
+            skin_grey: 160.0,
+            background_grey: 12.0,
+            grey_per_mm: 120.0,
+            psf_sigma_px: 1.2,
+            noise_sigma: 2.0,
+            vignetting: 0.35,
+            leds: 6,
+            led_grey: 90.0,
+            led_sigma_px: 3.0,
+            led_flicker: 0.3,
+            led_shift_px: 0.0,
+            gain_drift: 0.0,
+        }
+    }
+}
+
+impl Shading {
+    /// What a real R-Tac0 capture adds to [`Shading::default`]: a ring of 12 LED
+    /// highlights saturated at 255 (steep edges around flat tops, dark skin between them)
+    /// that each move by 1.5 px between the reference and the capture, and a global gain
+    /// that drifts by up to 5 %. It still lacks side-lit crescent imprints, specks off the
+    /// pins and JPEG compression.
+    pub fn real_rim() -> Self {
+        Self {
+            leds: 12,
+            led_grey: 300.0,
+            led_sigma_px: 8.0,
+            led_flicker: 0.1,
+            led_shift_px: 1.5,
+            gain_drift: 0.05,
+            ..Self::default()
+        }
+    }
+}
+
+/// A pin of a capture: a sphere of `radius_mm` about `centre_mm` (sensor frame), pressing
+/// the skin.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Pin {
+    pub centre_mm: [f64; 3],
+    pub radius_mm: f64,
+}
+
+/// One pin per ring of an R-Tac0-like dome (polar 0, 18, 34, 50 and 64 deg, azimuths 0, 30,
+/// 150, 250 and 330 deg turned by `turn_deg`), each a ball of 1.5 mm radius pressed
+/// `depth_mm` into the R = 15 mm skin along its normal: the test and benchmark captures.
+pub fn ring_pins(turn_deg: f64, depth_mm: f64) -> Vec<Pin> {
+    [
+        (0.0, 0.0),
+        (18.0, 30.0),
+        (34.0, 150.0),
+        (50.0, 250.0),
+        (64.0, 330.0),
+    ]
+    .iter()
+    .map(|&(polar, az): &(f64, f64)| {
+        let (p, a) = (polar.to_radians(), (az + turn_deg).to_radians());
+        let c = 15.0 + 1.5 - depth_mm;
+        Pin {
+            centre_mm: [c * p.sin() * a.cos(), c * p.sin() * a.sin(), c * p.cos()],
+            radius_mm: 1.5,
+        }
+    })
+    .collect()
+}
+
+/// A rendered capture and its reference.
+#[derive(Debug, Clone)]
+pub struct Rendered {
+    pub reference: GrayImage,
+    pub capture: GrayImage,
+    /// Each pin's true centre, px: the centroid of its noise-free imprint (the darkening
+    /// before blur), in the order given; `None` for a pin the camera does not see press.
+    pub centres_px: Vec<Option<[f64; 2]>>,
+}
+
+/// Uniform in [0, 1).
+fn unit(rng: &mut ChaCha8Rng) -> f64 {
+    (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+}
+
+fn led_image(
+    w: usize,
+    h: usize,
+    base: &[f32],
+    leds: &[[f64; 2]],
+    s: &Shading,
+    rng: &mut ChaCha8Rng,
+) -> Vec<f32> {
+    let mut img = base.to_vec();
+    for c in leds {
+        let k = 1.0 + s.led_flicker * (2.0 * unit(rng) as f32 - 1.0);
+        let r = (4.0 * s.led_sigma_px).ceil() as i64;
+        for dv in -r..=r {
+            for du in -r..=r {
+                let (u, v) = (c[0].round() as i64 + du, c[1].round() as i64 + dv);
+                if u < 0 || v < 0 || u >= w as i64 || v >= h as i64 {
+                    continue;
+                }
+                let d2 = (u as f64 - c[0]).powi(2) + (v as f64 - c[1]).powi(2);
+                img[v as usize * w + u as usize] +=
+                    k * s.led_grey * (-d2 / (2.0 * s.led_sigma_px * s.led_sigma_px)).exp() as f32;
+            }
+        }
+    }
+    img
+}
+
+fn noisy(img: Vec<f32>, sigma: f64, rng: &mut ChaCha8Rng) -> Vec<f32> {
+    img.into_iter()
+        .map(|g| {
+            // Box-Muller
+            let (a, b): (f64, f64) = (unit(rng).max(1e-300), unit(rng));
+            let n = (-2.0 * a.ln()).sqrt() * (std::f64::consts::TAU * b).cos();
+            (g as f64 + sigma * n).clamp(0.0, 255.0) as f32
+        })
+        .collect()
+}
+
+/// Renders the reference and the capture of `pins` seen by `camera` at `t_cam_sensor`
+/// (seeded noise and flicker).
+pub fn render(
+    camera: &CameraModel,
+    t_cam_sensor: &Isometry3<f64>,
+    surface: &ReferenceSurface,
+    pins: &[Pin],
+    s: &Shading,
+    seed: u64,
+) -> Rendered {
+    let rays = PixelRays::new(camera, t_cam_sensor);
+    let (w, h) = (rays.width, rays.height);
+    let refh = reference_hits(&rays, surface);
+    let (cx, cy) = (0.5 * (w as f64 - 1.0), 0.5 * (h as f64 - 1.0));
+    let rmax = cx.hypot(cy);
+    let mut base = vec![s.background_grey; w * h];
+    let mut skin_r: f64 = 0.0;
+    for p in 0..w * h {
+        if refh.t_mm[p].is_finite() {
+            let r = ((p % w) as f64 - cx).hypot((p / w) as f64 - cy) / rmax;
+            base[p] = s.skin_grey * (1.0 - s.vignetting * (r * r) as f32);
+            skin_r = skin_r.max(r * rmax);
+        }
+    }
+    // LED reflections on a circle at 90 % of the skin's extent in the image
+    let leds: Vec<[f64; 2]> = (0..s.leds)
+        .map(|k| {
+            let a = std::f64::consts::TAU * (k as f64 + 0.5) / s.leds as f64;
+            let r = 0.9 * skin_r.min(cy);
+            [cx + r * a.cos(), cy + r * a.sin()]
+        })
+        .collect();
+    // each pin's imprint: the depth it pushes the skin in along each ray
+    let mut dent = vec![0f32; w * h];
+    let mut centres = Vec::with_capacity(pins.len());
+    for pin in pins {
+        let prim = ExactPrimitives::new(&[Primitive::Sphere {
+            centre_mm: pin.centre_mm,
+            radius_mm: pin.radius_mm,
+        }])
+        .expect("a sphere of positive radius");
+        let hits = indented_hits(&rays, &refh, &prim, surface.base_z_mm());
+        let (mut sw, mut su, mut sv) = (0f64, 0f64, 0f64);
+        for p in 0..w * h {
+            if hits.contact[p] && refh.t_mm[p].is_finite() {
+                let depth = refh.t_mm[p] - hits.t_mm[p];
+                dent[p] += depth as f32;
+                sw += depth;
+                su += depth * (p % w) as f64;
+                sv += depth * (p / w) as f64;
+            }
+        }
+        centres.push((sw > 0.0).then(|| [su / sw, sv / sw]));
+    }
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let blur = |img: Vec<f32>| {
+        gaussian_blur(
+            &GrayImage {
+                width: w,
+                height: h,
+                data: img,
+            },
+            s.psf_sigma_px,
+        )
+        .data
+    };
+    let reference = led_image(w, h, &blur(base.clone()), &leds, s, &mut rng);
+    let pressed: Vec<f32> = base
+        .iter()
+        .zip(&dent)
+        .map(|(b, d)| b - s.grey_per_mm * d)
+        .collect();
+    // the highlights move, the gain drifts (no draws when neither does: the same images)
+    let moved: Vec<[f64; 2]> = if s.led_shift_px > 0.0 {
+        leds.iter()
+            .map(|c| {
+                let a = std::f64::consts::TAU * unit(&mut rng);
+                [
+                    c[0] + s.led_shift_px * a.cos(),
+                    c[1] + s.led_shift_px * a.sin(),
+                ]
+            })
+            .collect()
+    } else {
+        leds.clone()
+    };
+    let gain = if s.gain_drift > 0.0 {
+        1.0 + s.gain_drift * (2.0 * unit(&mut rng) as f32 - 1.0)
+    } else {
+        1.0
+    };
+    let capture: Vec<f32> = led_image(w, h, &blur(pressed), &moved, s, &mut rng)
+        .into_iter()
+        .map(|g| gain * g)
+        .collect();
+    let reference = noisy(reference, s.noise_sigma, &mut rng);
+    let capture = noisy(capture, s.noise_sigma, &mut rng);
+    Rendered {
+        reference: GrayImage {
+            width: w,
+            height: h,
+            data: reference,
+        },
+        capture: GrayImage {
+            width: w,
+            height: h,
+            data: capture,
+        },
+        centres_px: centres,
+    }
+}
