@@ -131,9 +131,71 @@ const CANDIDATES_PER_PIN: usize = 4;
 /// projection is within this factor of the nearer one's (plus 1 px^2).
 const AMBIGUOUS_RATIO: f64 = 2.0;
 
+/// A pin's spot is at least this round ([`Spot::roundness`]): a scratch, a fibre or the edge
+/// of a highlight is a thin line.
+pub const MIN_ROUNDNESS: f64 = 0.5;
+
+/// A pin's spot covers at least this fraction of the pins' typical spot ([`spot_shape`]) ...
+pub const MIN_AREA_FRACTION: f64 = 0.15;
+/// ... and at most this multiple of it.
+pub const MAX_AREA_FACTOR: f64 = 5.0;
+
+/// The pins' typical spot area, px: over the captures, the median area of each capture's
+/// largest round spots, as many as it plans pins (most spots are pins; specks are small);
+/// `None` without a round spot.
+fn typical_area_px(captures: &[CaptureSpots]) -> Option<f64> {
+    let mut areas: Vec<usize> = captures
+        .iter()
+        .flat_map(|c| {
+            let mut a: Vec<usize> = c
+                .spots
+                .iter()
+                .filter(|s| s.roundness >= MIN_ROUNDNESS)
+                .map(|s| s.area_px)
+                .collect();
+            a.sort_unstable_by(|x, y| y.cmp(x));
+            a.truncate(c.planned_ids.len());
+            a
+        })
+        .collect();
+    if areas.is_empty() {
+        return None;
+    }
+    let m = areas.len() / 2;
+    Some(*areas.select_nth_unstable(m).1 as f64)
+}
+
+/// Why `spot` is not a pin's by its shape, `None` when it may be one: round
+/// ([`MIN_ROUNDNESS`]) and of an area within [[`MIN_AREA_FRACTION`], [`MAX_AREA_FACTOR`]]
+/// times the pins' typical spot (`typical_px`, from all captures: a barely pressed pin's spot
+/// is about a quarter of a fully pressed one's, a speck of dust a tenth or less).
+pub fn spot_shape(spot: &Spot, typical_px: f64) -> Option<String> {
+    let (lo, hi) = (MIN_AREA_FRACTION * typical_px, MAX_AREA_FACTOR * typical_px);
+    if spot.roundness < MIN_ROUNDNESS {
+        Some(format!(
+            "not round (minor over major axis {:.2}, a pin's spot at least {MIN_ROUNDNESS}): a scratch or an edge",
+            spot.roundness
+        ))
+    } else if (spot.area_px as f64) < lo {
+        Some(format!(
+            "{} px, smaller than a pin's spot may be ({lo:.0} px: {MIN_AREA_FRACTION} x the pins' typical {typical_px:.0} px): a speck",
+            spot.area_px
+        ))
+    } else if spot.area_px as f64 > hi {
+        Some(format!(
+            "{} px, larger than a pin's spot may be ({hi:.0} px: {MAX_AREA_FACTOR} x the pins' typical {typical_px:.0} px)",
+            spot.area_px
+        ))
+    } else {
+        None
+    }
+}
+
 /// Gives each capture's spots the ids of its planned pins (`points`: id to sensor-frame point,
 /// mm).
 ///
+/// 0. Spots not shaped as a pin's ([`spot_shape`]: thin, or much smaller or larger than the
+///    pins' typical spot) are discarded, with why.
 /// 1. A first pose: in each capture with at least as many spots as pins, its strongest spots,
 ///    as many as it plans pins, ordered by their distance from the principal point, get the
 ///    pins ordered by their polar angle about the sensor axis (spots from the centre outwards,
@@ -151,6 +213,54 @@ const AMBIGUOUS_RATIO: f64 = 2.0;
 /// pin equally well ([`AMBIGUOUS_RATIO`]). Without a first pose (fewer than 4 spots in all)
 /// only the captures with as many spots as pins are kept, by ring order.
 pub fn assign_ids(
+    camera: &CameraModel,
+    points: &BTreeMap<u32, Vector3<f64>>,
+    all: &[CaptureSpots],
+) -> Assignment {
+    // the spots shaped as a pin's go on; the others are discarded with why
+    let typical = typical_area_px(all);
+    let (captures, shape_discards): (Vec<CaptureSpots>, Vec<Vec<(Spot, String)>>) = all
+        .iter()
+        .map(|c| {
+            let (mut keep, mut out) = (Vec::new(), Vec::new());
+            for s in &c.spots {
+                // without a round spot anywhere only the roundness counts
+                match spot_shape(s, typical.unwrap_or(s.area_px as f64)) {
+                    Some(why) => out.push((*s, why)),
+                    None => keep.push(*s),
+                }
+            }
+            (
+                CaptureSpots {
+                    spots: keep,
+                    ..c.clone()
+                },
+                out,
+            )
+        })
+        .unzip();
+    let mut a = assign_shaped(camera, points, &captures);
+    for (k, (o, out)) in a.captures.iter_mut().zip(shape_discards).enumerate() {
+        o.spots_found = all[k].spots.len();
+        if o.left_out.is_none() {
+            o.discarded.extend(out);
+        } else if captures[k].spots.is_empty() && !out.is_empty() {
+            o.left_out = Some(format!(
+                "no spot shaped as a pin's for the {} planned pins {:?} ({})",
+                all[k].planned_ids.len(),
+                all[k].planned_ids,
+                out.iter()
+                    .map(|(s, why)| format!("({:.1}, {:.1}): {why}", s.u_px, s.v_px))
+                    .collect::<Vec<_>>()
+                    .join("; ")
+            ));
+        }
+    }
+    a
+}
+
+/// [`assign_ids`] after the spots' shapes were checked: steps 1 and 2.
+fn assign_shaped(
     camera: &CameraModel,
     points: &BTreeMap<u32, Vector3<f64>>,
     captures: &[CaptureSpots],
@@ -261,8 +371,9 @@ fn found_at(spots: &[Spot]) -> String {
     )
 }
 
-/// The capture's strongest spots, as many as it plans pins, given the pins by ring: spots
-/// ordered by their distance from the principal point against pins by their polar angle.
+/// The capture's strongest spots (peak times area), as many as it plans pins, given the pins
+/// by ring: spots ordered by their distance from the principal point against pins by their
+/// polar angle.
 fn by_ring(
     camera: &CameraModel,
     points: &BTreeMap<u32, Vector3<f64>>,
@@ -275,8 +386,11 @@ fn by_ring(
     };
     let mut ids = c.planned_ids.clone();
     ids.sort_by(|a, b| polar(a).total_cmp(&polar(b)));
+    // strongest: the most darkening in all (peak times area), so that a small dark speck
+    // does not beat a lightly pressed pin
+    let mass = |s: &Spot| s.score * s.area_px as f64;
     let mut spots = c.spots.clone();
-    spots.sort_by(|a, b| b.score.total_cmp(&a.score));
+    spots.sort_by(|a, b| mass(b).total_cmp(&mass(a)));
     spots.truncate(ids.len());
     spots.sort_by(|a, b| {
         (a.u_px - i.cx_px)

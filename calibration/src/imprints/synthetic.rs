@@ -2,7 +2,9 @@
 //! ground-truth caster ([`crate::groundtruth`]), each pin's imprint shaded as a darkening
 //! proportional to its indentation depth along the pixel's ray, blurred by a Gaussian
 //! point-spread function, with vignetting, bright LED reflections near the rim (a little
-//! brighter or dimmer in each image) and Gaussian noise.
+//! brighter or dimmer in each image) and Gaussian noise; [`Shading::real_capture`] adds what a
+//! real R-Tac0 capture shows besides (a saturated LED ring that moves, gain drift, side-lit
+//! crescent imprints, specks and a scratch off the pins, JPEG compression).
 
 use super::{gaussian_blur, GrayImage};
 use crate::groundtruth::exact::ExactPrimitives;
@@ -42,6 +44,24 @@ pub struct Shading {
     /// The capture's global gain differs from the reference's by a random factor in
     /// [1 - drift, 1 + drift] (auto exposure, LED supply).
     pub gain_drift: f32,
+    /// Side light: the imprint's darkening is `grey_per_mm x (d + side_light_px x l . grad d)`
+    /// with `d` the indentation depth (mm), `grad d` its gradient per pixel and `l` the
+    /// vector from the image centre to the pixel over the skin's radius in the image (0 at
+    /// the centre, 1 at the skin's edge): the LEDs at the rim light each imprint from
+    /// outside, so that its outer slope is darker and a thin crescent inside its inner edge
+    /// brighter than the skin. To first order the shading is the imprint moved by
+    /// `side_light_px x |l|` px towards the image centre; the true centres
+    /// ([`Rendered::centres_px`]) stay the centroids of the depth, so that move is error.
+    pub side_light_px: f64,
+    /// Specks on the skin that only the capture shows (dust, a fibre): this many dark dots of
+    /// 1 to 2 px radius, 40 to 80 grey levels deep, each at least 30 px from every pin's
+    /// imprint.
+    pub specks: usize,
+    /// And this many scratches: dark lines 1 px wide, 12 to 20 px long, 30 to 50 grey deep.
+    pub scratches: usize,
+    /// Both images are stored as 8-bit JPEG of this quality (1 to 100) and read back; `None`:
+    /// kept as the floating-point grey levels.
+    pub jpeg_quality: Option<u8>,
 }
 
 impl Default for Shading {
@@ -59,6 +79,10 @@ impl Default for Shading {
             led_flicker: 0.3,
             led_shift_px: 0.0,
             gain_drift: 0.0,
+            side_light_px: 0.0,
+            specks: 0,
+            scratches: 0,
+            jpeg_quality: None,
         }
     }
 }
@@ -67,8 +91,7 @@ impl Shading {
     /// What a real R-Tac0 capture adds to [`Shading::default`]: a ring of 12 LED
     /// highlights saturated at 255 (steep edges around flat tops, dark skin between them)
     /// that each move by 1.5 px between the reference and the capture, and a global gain
-    /// that drifts by up to 5 %. It still lacks side-lit crescent imprints, specks off the
-    /// pins and JPEG compression.
+    /// that drifts by up to 5 %.
     pub fn real_rim() -> Self {
         Self {
             leds: 12,
@@ -78,6 +101,22 @@ impl Shading {
             led_shift_px: 1.5,
             gain_drift: 0.05,
             ..Self::default()
+        }
+    }
+}
+
+impl Shading {
+    /// [`Shading::real_rim`] and the rest of what a real capture shows: imprints side-lit by
+    /// the rim's LEDs (moved up to 0.1 px towards the image centre, a faint bright crescent on
+    /// their inner edge), three specks and a scratch off the pins, JPEG at quality 90. It still
+    /// lacks the skin's texture, the sensor's rolling shutter and lens flare.
+    pub fn real_capture() -> Self {
+        Self {
+            side_light_px: 0.1,
+            specks: 3,
+            scratches: 1,
+            jpeg_quality: Some(90),
+            ..Self::real_rim()
         }
     }
 }
@@ -94,6 +133,12 @@ pub struct Pin {
 /// 150, 250 and 330 deg turned by `turn_deg`), each a ball of 1.5 mm radius pressed
 /// `depth_mm` into the R = 15 mm skin along its normal: the test and benchmark captures.
 pub fn ring_pins(turn_deg: f64, depth_mm: f64) -> Vec<Pin> {
+    ring_pins_pressed(turn_deg, [depth_mm; 5])
+}
+
+/// [`ring_pins`] with each ring's own depth, mm (from the pole outwards): a pin that barely
+/// marks the skin is one pressed a fraction of a millimetre.
+pub fn ring_pins_pressed(turn_deg: f64, depths_mm: [f64; 5]) -> Vec<Pin> {
     [
         (0.0, 0.0),
         (18.0, 30.0),
@@ -102,7 +147,8 @@ pub fn ring_pins(turn_deg: f64, depth_mm: f64) -> Vec<Pin> {
         (64.0, 330.0),
     ]
     .iter()
-    .map(|&(polar, az): &(f64, f64)| {
+    .zip(depths_mm)
+    .map(|(&(polar, az), depth_mm): (&(f64, f64), f64)| {
         let (p, a) = (polar.to_radians(), (az + turn_deg).to_radians());
         let c = 15.0 + 1.5 - depth_mm;
         Pin {
@@ -166,6 +212,25 @@ fn noisy(img: Vec<f32>, sigma: f64, rng: &mut ChaCha8Rng) -> Vec<f32> {
         .collect()
 }
 
+/// `img` (grey levels 0..255) stored as an 8-bit JPEG of `quality` and read back.
+fn jpeg(img: &[f32], w: usize, h: usize, quality: u8) -> Vec<f32> {
+    let bytes: Vec<u8> = img
+        .iter()
+        .map(|g| g.round().clamp(0.0, 255.0) as u8)
+        .collect();
+    let mut out = Vec::new();
+    image::codecs::jpeg::JpegEncoder::new_with_quality(&mut out, quality.clamp(1, 100))
+        .encode(&bytes, w as u32, h as u32, image::ExtendedColorType::L8)
+        .expect("a grey image of the camera's size encodes");
+    image::load_from_memory_with_format(&out, image::ImageFormat::Jpeg)
+        .expect("the JPEG just written decodes")
+        .into_luma8()
+        .into_raw()
+        .into_iter()
+        .map(f32::from)
+        .collect()
+}
+
 /// Renders the reference and the capture of `pins` seen by `camera` at `t_cam_sensor`
 /// (seeded noise and flicker).
 pub fn render(
@@ -220,6 +285,84 @@ pub fn render(
         }
         centres.push((sw > 0.0).then(|| [su / sw, sv / sw]));
     }
+    // the shading of the imprints, side-lit from the rim
+    let shade: Vec<f32> = if s.side_light_px > 0.0 && skin_r > 0.0 {
+        (0..w * h)
+            .map(|p| {
+                let (u, v) = (p % w, p / w);
+                let (l, r) = (u.saturating_sub(1), (u + 1).min(w - 1));
+                let (t, b) = (v.saturating_sub(1), (v + 1).min(h - 1));
+                let gu = f64::from(dent[v * w + r] - dent[v * w + l]) / (r - l) as f64;
+                let gv = f64::from(dent[b * w + u] - dent[t * w + u]) / (b - t) as f64;
+                let (lu, lv) = ((u as f64 - cx) / skin_r, (v as f64 - cy) / skin_r);
+                dent[p] + (s.side_light_px * (lu * gu + lv * gv)) as f32
+            })
+            .collect()
+    } else {
+        dent.clone()
+    };
+    // specks and scratches, from their own stream (the other draws stay as without them)
+    let mut marks = vec![0f32; w * h];
+    if s.specks + s.scratches > 0 {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x5bec_c5);
+        let clear = |u: f64, v: f64| {
+            let p = v.round() as usize * w + u.round() as usize;
+            refh.t_mm[p].is_finite()
+                && (u - cx).hypot(v - cy) < 0.8 * skin_r
+                && centres
+                    .iter()
+                    .flatten()
+                    .all(|c: &[f64; 2]| (c[0] - u).hypot(c[1] - v) >= 30.0)
+        };
+        let mut placed = 0;
+        for _ in 0..10_000 {
+            if placed == s.specks + s.scratches {
+                break;
+            }
+            let (u, v) = (
+                unit(&mut rng) * (w - 1) as f64,
+                unit(&mut rng) * (h - 1) as f64,
+            );
+            if !clear(u, v) {
+                continue;
+            }
+            if placed < s.specks {
+                let radius = 1.0 + unit(&mut rng);
+                let grey = (40.0 + 40.0 * unit(&mut rng)) as f32;
+                let r = radius.ceil() as i64 + 1;
+                for dv in -r..=r {
+                    for du in -r..=r {
+                        let (uu, vv) = (u.round() as i64 + du, v.round() as i64 + dv);
+                        if uu < 0 || vv < 0 || uu >= w as i64 || vv >= h as i64 {
+                            continue;
+                        }
+                        if (uu as f64 - u).hypot(vv as f64 - v) <= radius {
+                            marks[vv as usize * w + uu as usize] += grey;
+                        }
+                    }
+                }
+            } else {
+                let len = 12.0 + 8.0 * unit(&mut rng);
+                let a = std::f64::consts::TAU * unit(&mut rng);
+                let grey = (30.0 + 20.0 * unit(&mut rng)) as f32;
+                let steps = (2.0 * len).ceil() as usize;
+                let mut last = usize::MAX;
+                for i in 0..=steps {
+                    let t = len * (i as f64 / steps as f64 - 0.5);
+                    let (uu, vv) = (u + t * a.cos(), v + t * a.sin());
+                    if uu < 0.0 || vv < 0.0 || uu > (w - 1) as f64 || vv > (h - 1) as f64 {
+                        continue;
+                    }
+                    let p = vv.round() as usize * w + uu.round() as usize;
+                    if p != last {
+                        marks[p] += grey;
+                        last = p;
+                    }
+                }
+            }
+            placed += 1;
+        }
+    }
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let blur = |img: Vec<f32>| {
         gaussian_blur(
@@ -235,8 +378,9 @@ pub fn render(
     let reference = led_image(w, h, &blur(base.clone()), &leds, s, &mut rng);
     let pressed: Vec<f32> = base
         .iter()
-        .zip(&dent)
-        .map(|(b, d)| b - s.grey_per_mm * d)
+        .zip(&shade)
+        .zip(&marks)
+        .map(|((b, d), m)| b - s.grey_per_mm * d - m)
         .collect();
     // the highlights move, the gain drifts (no draws when neither does: the same images)
     let moved: Vec<[f64; 2]> = if s.led_shift_px > 0.0 {
@@ -263,6 +407,10 @@ pub fn render(
         .collect();
     let reference = noisy(reference, s.noise_sigma, &mut rng);
     let capture = noisy(capture, s.noise_sigma, &mut rng);
+    let (reference, capture) = match s.jpeg_quality {
+        Some(q) => (jpeg(&reference, w, h, q), jpeg(&capture, w, h, q)),
+        None => (reference, capture),
+    };
     Rendered {
         reference: GrayImage {
             width: w,
