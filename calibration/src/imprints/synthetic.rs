@@ -304,7 +304,7 @@ pub fn render(
     // specks and scratches, from their own stream (the other draws stay as without them)
     let mut marks = vec![0f32; w * h];
     if s.specks + s.scratches > 0 {
-        let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x5bec_c5);
+        let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x005b_ecc5);
         let clear = |u: f64, v: f64| {
             let p = v.round() as usize * w + u.round() as usize;
             refh.t_mm[p].is_finite()
