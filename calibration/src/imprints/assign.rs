@@ -173,8 +173,9 @@ pub fn spot_shape(spot: &Spot, typical_px: f64) -> Option<String> {
     let (lo, hi) = (MIN_AREA_FRACTION * typical_px, MAX_AREA_FACTOR * typical_px);
     if spot.roundness < MIN_ROUNDNESS {
         Some(format!(
-            "not round (minor over major axis {:.2}, a pin's spot at least {MIN_ROUNDNESS}): a scratch or an edge",
-            spot.roundness
+            "not round (minor over major axis {:.2}, a pin's spot at least {MIN_ROUNDNESS:.2}): a scratch or an edge",
+            // rounded down: 0.499 is not "0.50"
+            (spot.roundness * 100.0).floor() / 100.0
         ))
     } else if (spot.area_px as f64) < lo {
         Some(format!(
