@@ -125,52 +125,175 @@ fn kernel(sigma: f64) -> Vec<f32> {
     k.iter().map(|x| (x / s) as f32).collect()
 }
 
+/// `pad` (a row with `r` spare values at each end) padded with its edge values.
+#[inline(always)]
+fn pad_edges(pad: &mut [f32], r: usize) {
+    let n = pad.len();
+    let (first, last) = (pad[r], pad[n - r - 1]);
+    pad[..r].fill(first);
+    pad[n - r..].fill(last);
+}
+
+/// Pixels computed together by [`fold_rows`], in registers.
+const LANES: usize = 32;
+
+/// For every `u`, `out[u]` the fold by `f` of `src[start(0) + u]`, `src[start(1) + u]`, ..
+/// `src[start(n - 1) + u]` (`f(acc, j, x)`, from `init`, in that order): [`LANES`] outputs at
+/// a time, held in registers over all the `n` terms, then 8 at a time, then one by one.
+#[inline(always)]
+fn fold_rows(
+    out: &mut [f32],
+    src: &[f32],
+    n: usize,
+    start: impl Fn(usize) -> usize,
+    init: f32,
+    f: impl Fn(f32, usize, f32) -> f32,
+) {
+    let done = fold_lanes::<LANES>(out, 0, src, n, &start, init, &f);
+    let done = fold_lanes::<8>(out, done, src, n, &start, init, &f);
+    fold_lanes::<1>(out, done, src, n, &start, init, &f);
+}
+
+/// [`fold_rows`] from `out[from]` on, `L` outputs at a time: as far as whole chunks go (the
+/// end returned).
+#[inline(always)]
+fn fold_lanes<const L: usize>(
+    out: &mut [f32],
+    from: usize,
+    src: &[f32],
+    n: usize,
+    start: &impl Fn(usize) -> usize,
+    init: f32,
+    f: &impl Fn(f32, usize, f32) -> f32,
+) -> usize {
+    let end = from + (out.len() - from) / L * L;
+    for (c, o) in out[from..end].chunks_exact_mut(L).enumerate() {
+        let at = from + c * L;
+        let mut acc = [init; L];
+        for j in 0..n {
+            let s = start(j) + at;
+            for (a, x) in acc.iter_mut().zip(&src[s..s + L]) {
+                *a = f(*a, j, *x);
+            }
+        }
+        o.copy_from_slice(&acc);
+    }
+    end
+}
+
+/// `out[u] = 0 + k[0] x src[starts[0] + u] + k[1] x src[starts[1] + u] + ...` (in that order)
+/// for every `u`; `starts` as long as `k`.
+#[inline(always)]
+fn weighted_sum(out: &mut [f32], k: &[f32], src: &[f32], starts: &[usize]) {
+    fold_rows(
+        out,
+        src,
+        k.len(),
+        |j| starts[j],
+        0.0,
+        |a, j, x| a + k[j] * x,
+    );
+}
+
+/// The steps before and after the smoothing of [`blur_rows`].
+trait RowSteps {
+    /// Writes the input's row `t` into `line`.
+    fn fill(&mut self, t: usize, line: &mut [f32]);
+    /// Takes the output's row `v` (to change at will).
+    fn emit(&mut self, v: usize, row: &mut [f32]);
+}
+
+/// A `w` x `h` image smoothed by the separable kernel `k` (edges clamped), one row at a time:
+/// `steps.fill(t, line)` writes the input's row `t` into `line`, and `steps.emit(v, row)`
+/// takes the output's row `v`, in order. Only the last `k.len()` horizontally smoothed rows
+/// are kept (a ring), so that the steps before and after the smoothing run on rows in the
+/// cache rather than through full-size intermediate images. The taps are summed in the same
+/// order as a horizontal pass over the whole image followed by a vertical one. `w` and `h`
+/// are not 0.
+///
+/// On a CPU with AVX2 the same code (the steps too: their methods are inlined) runs compiled
+/// for it: twice the pixels per instruction, the same operations in the same order (no fused
+/// multiply-adds), so the same results.
+fn blur_rows(w: usize, h: usize, k: &[f32], steps: &mut impl RowSteps) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU supports the features the function is compiled for.
+        unsafe { blur_rows_avx2(w, h, k, steps) };
+        return;
+    }
+    blur_rows_any(w, h, k, steps);
+}
+
+/// [`blur_rows_any`] compiled for AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn blur_rows_avx2(w: usize, h: usize, k: &[f32], steps: &mut impl RowSteps) {
+    blur_rows_any(w, h, k, steps);
+}
+
+/// [`blur_rows`] for any CPU.
+#[inline(always)]
+fn blur_rows_any(w: usize, h: usize, k: &[f32], steps: &mut impl RowSteps) {
+    let n = k.len();
+    let r = n / 2;
+    // the input row padded with its edge values: the taps without bounds checks
+    let mut pad = vec![0f32; w + 2 * r];
+    let mut ring = vec![0f32; n * w];
+    let mut out = vec![0f32; w];
+    let shifts: Vec<usize> = (0..n).collect();
+    let mut rows = vec![0usize; n];
+    for t in 0..h + r {
+        if t < h {
+            steps.fill(t, &mut pad[r..r + w]);
+            pad_edges(&mut pad, r);
+            weighted_sum(&mut ring[(t % n) * w..(t % n + 1) * w], k, &pad, &shifts);
+        }
+        // the output row r rows up: a weighted sum of the rows within r of it (edge rows
+        // repeated), all still in the ring
+        if let Some(v) = t.checked_sub(r) {
+            for (j, s) in rows.iter_mut().enumerate() {
+                *s = (v + j).saturating_sub(r).min(h - 1) % n * w;
+            }
+            weighted_sum(&mut out, k, &ring, &rows);
+            steps.emit(v, &mut out);
+        }
+    }
+}
+
 /// `img` smoothed by a separable Gaussian of `sigma` px (edges clamped).
 pub fn gaussian_blur(img: &GrayImage, sigma: f64) -> GrayImage {
-    if !(sigma > 0.0) {
+    if !(sigma > 0.0) || img.data.is_empty() {
         return img.clone();
     }
-    let k = kernel(sigma);
-    let r = k.len() / 2;
     let (w, h) = (img.width, img.height);
-    // horizontally: one row at a time over a copy padded with its edge values, the taps
-    // without bounds checks
-    let pass = |line: &[f32], out: &mut [f32], pad: &mut Vec<f32>| {
-        let n = line.len();
-        pad.clear();
-        pad.extend(std::iter::repeat_n(line[0], r));
-        pad.extend_from_slice(line);
-        pad.extend(std::iter::repeat_n(line[n - 1], r));
-        out.fill(0.0);
-        for (j, kj) in k.iter().enumerate() {
-            for (o, p) in out.iter_mut().zip(&pad[j..j + n]) {
-                *o += kj * p;
-            }
-        }
+    let mut steps = Copied {
+        img,
+        out: Vec::with_capacity(w * h),
     };
-    let mut pad = Vec::with_capacity(w.max(h) + 2 * r);
-    let mut tmp = vec![0f32; w * h];
-    for v in 0..h {
-        pass(
-            &img.data[v * w..(v + 1) * w],
-            &mut tmp[v * w..(v + 1) * w],
-            &mut pad,
-        );
-    }
-    // vertically: each output row a weighted sum of whole rows (edge rows repeated)
-    let mut out = vec![0f32; w * h];
-    for (v, row) in out.chunks_exact_mut(w).enumerate() {
-        for (j, kj) in k.iter().enumerate() {
-            let src = (v + j).saturating_sub(r).min(h - 1);
-            for (o, t) in row.iter_mut().zip(&tmp[src * w..(src + 1) * w]) {
-                *o += kj * t;
-            }
-        }
-    }
+    blur_rows(w, h, &kernel(sigma), &mut steps);
     GrayImage {
         width: w,
         height: h,
-        data: out,
+        data: steps.out,
+    }
+}
+
+/// [`gaussian_blur`]'s steps: the image's rows in, the smoothed rows kept.
+struct Copied<'a> {
+    img: &'a GrayImage,
+    out: Vec<f32>,
+}
+
+impl RowSteps for Copied<'_> {
+    #[inline(always)]
+    fn fill(&mut self, t: usize, line: &mut [f32]) {
+        let w = self.img.width;
+        line.copy_from_slice(&self.img.data[t * w..(t + 1) * w]);
+    }
+
+    #[inline(always)]
+    fn emit(&mut self, _: usize, row: &mut [f32]) {
+        self.out.extend_from_slice(row);
     }
 }
 
@@ -196,13 +319,11 @@ const GAIN_MIN_GREY: f32 = 20.0;
 const GAIN_MAX_GREY: f32 = 250.0;
 
 /// The capture's global gain against the reference: the median of capture / reference over
-/// the pixels `inside` (every [`LEVEL_STRIDE`]-th) whose reference grey is neither dark nor
-/// saturated; 1 when there are none. The imprints are a small part of the skin and do not
+/// the pixels inside `mask` (every [`LEVEL_STRIDE`]-th) whose reference grey is neither dark
+/// nor saturated; 1 when there are none. The imprints are a small part of the skin and do not
 /// move the median.
-fn capture_gain(reference: &GrayImage, capture: &GrayImage, inside: &dyn Fn(usize) -> bool) -> f32 {
-    let mut ratios: Vec<f32> = (0..reference.data.len())
-        .step_by(LEVEL_STRIDE)
-        .filter(|&i| inside(i))
+fn capture_gain(reference: &GrayImage, capture: &GrayImage, mask: Option<&[bool]>) -> f32 {
+    let mut ratios: Vec<f32> = samples(0, reference.data.len(), LEVEL_STRIDE, mask)
         .filter_map(|i| {
             let r = reference.data[i];
             (GAIN_MIN_GREY..GAIN_MAX_GREY)
@@ -217,94 +338,220 @@ fn capture_gain(reference: &GrayImage, capture: &GrayImage, inside: &dyn Fn(usiz
     }
 }
 
-/// The median of `gain x (reference - eroded)` over the pixels `inside` (every
-/// [`LEVEL_STRIDE`]-th): how much the erosion lowers the difference on the skin.
-fn erosion_offset(
+/// The pixels on the grid of every `stride`-th pixel (of the whole image) among the `n` from
+/// pixel `base` on, inside `mask`: their offsets from `base`.
+fn samples(
+    base: usize,
+    n: usize,
+    stride: usize,
+    mask: Option<&[bool]>,
+) -> impl Iterator<Item = usize> + '_ {
+    (base.next_multiple_of(stride) - base..n)
+        .step_by(stride)
+        .filter(move |&u| mask.is_none_or(|m| m[base + u]))
+}
+
+/// `gain x reference - capture` smoothed by the separable kernel `k` (the Gaussian of
+/// [`gaussian_blur`], edges clamped, the taps summed in the same order) at each of `pixels`,
+/// computed over those pixels alone: along each of their rows from the first of them to the
+/// last, from the rows within the kernel's reach, smoothed horizontally over the columns that
+/// those runs need.
+fn smoothed_over(
     reference: &GrayImage,
-    eroded: &GrayImage,
+    capture: &GrayImage,
     gain: f32,
-    inside: &dyn Fn(usize) -> bool,
-) -> f64 {
-    let mut v: Vec<f32> = (0..reference.data.len())
-        .step_by(LEVEL_STRIDE)
-        .filter(|&i| inside(i))
-        .map(|i| gain * (reference.data[i] - eroded.data[i]))
-        .collect();
-    f64::from(median(&mut v))
-}
-
-/// `gain x reference - capture` at pixel `i`, smoothed by the separable kernel `k` (the
-/// Gaussian of [`gaussian_blur`], edges clamped), computed at that pixel alone.
-fn smoothed_at(reference: &GrayImage, capture: &GrayImage, gain: f32, k: &[f32], i: usize) -> f64 {
+    k: &[f32],
+    pixels: &[(usize, usize)],
+) -> Vec<f32> {
     let (w, h) = (reference.width, reference.height);
-    let (u, v) = (i % w, i / w);
-    let r = k.len() / 2;
-    let mut sum = 0f32;
-    if u >= r && v >= r && u + r < w && v + r < h {
-        for (a, ka) in k.iter().enumerate() {
-            let start = (v + a - r) * w + u - r;
-            let rr = &reference.data[start..start + k.len()];
-            let cc = &capture.data[start..start + k.len()];
-            let row: f32 = k
-                .iter()
-                .zip(rr)
-                .zip(cc)
-                .map(|((kb, x), y)| kb * (gain * x - y))
-                .sum();
-            sum += ka * row;
-        }
-    } else {
-        for (a, ka) in k.iter().enumerate() {
-            let vv = (v + a).saturating_sub(r).min(h - 1);
-            for (b, kb) in k.iter().enumerate() {
-                let uu = (u + b).saturating_sub(r).min(w - 1);
-                let j = vv * w + uu;
-                sum += ka * kb * (gain * reference.data[j] - capture.data[j]);
-            }
-        }
+    let n = k.len();
+    let r = n / 2;
+    let (v0, v1) = pixels
+        .iter()
+        .fold((usize::MAX, 0), |(a, b), &(_, v)| (a.min(v), b.max(v)));
+    if v0 > v1 {
+        return Vec::new();
     }
-    f64::from(sum)
+    // each row's run: the columns of its first and last pixel
+    let rows = v1 + 1 - v0;
+    let hull = |runs: &[(usize, usize)]| {
+        runs.iter()
+            .fold((usize::MAX, 0), |(a, b), e| (a.min(e.0), b.max(e.1)))
+    };
+    let mut run = vec![(usize::MAX, 0); rows];
+    for &(u, v) in pixels {
+        let e = &mut run[v - v0];
+        *e = (e.0.min(u), e.1.max(u));
+    }
+    let (u0, u1) = hull(&run);
+    let cols = u1 + 1 - u0;
+    // row q: the image's row v0 - r + q (clamped), smoothed along the row over the runs of
+    // the rows q - 2r ..= q, the ones whose vertical taps reach it
+    let mut hs = vec![0f32; (rows + 2 * r) * cols];
+    let mut line = Vec::with_capacity(cols + 2 * r);
+    let shifts: Vec<usize> = (0..n).collect();
+    for q in 0..rows + 2 * r {
+        let (a, b) = hull(&run[q.saturating_sub(2 * r)..(q + 1).min(rows)]);
+        if a > b {
+            continue;
+        }
+        let s = (v0 + q).saturating_sub(r).min(h - 1) * w;
+        line.clear();
+        line.extend((a..=b + 2 * r).map(|c| {
+            let j = s + c.saturating_sub(r).min(w - 1);
+            gain * reference.data[j] - capture.data[j]
+        }));
+        let out = &mut hs[q * cols + a - u0..q * cols + b + 1 - u0];
+        weighted_sum(out, k, &line, &shifts);
+    }
+    // then across the rows, along each run
+    let mut xs = vec![0f32; rows * cols];
+    let mut starts = vec![0; n];
+    for (j, &(a, b)) in run.iter().enumerate().filter(|(_, (a, b))| a <= b) {
+        for (t, st) in starts.iter_mut().enumerate() {
+            *st = (j + t) * cols + a - u0;
+        }
+        weighted_sum(
+            &mut xs[j * cols + a - u0..j * cols + b + 1 - u0],
+            k,
+            &hs,
+            &starts,
+        );
+    }
+    pixels
+        .iter()
+        .map(|&(u, v)| xs[(v - v0) * cols + u - u0])
+        .collect()
 }
 
-/// `out[j] = min(a[j], b[j], c[j])` for every `j`.
-fn min3_into(out: &mut [f32], a: &[f32], b: &[f32], c: &[f32]) {
-    for (((o, x), y), z) in out.iter_mut().zip(a).zip(b).zip(c) {
-        *o = x.min(*y).min(*z);
-    }
+/// `out[u]` the smallest of `src[u]`, `src[u + stride]`, .. `src[u + (n - 1) stride]` for
+/// every `u` (`f32::min` without its care for NaN, which does not vectorise as well).
+#[inline(always)]
+fn min_of_rows(out: &mut [f32], src: &[f32], n: usize, stride: usize) {
+    fold_rows(
+        out,
+        src,
+        n,
+        |j| j * stride,
+        f32::INFINITY,
+        |a, _, x| {
+            if a < x {
+                a
+            } else {
+                x
+            }
+        },
+    );
+}
+
+/// Row `t` of `img` eroded by a (2r + 1) x (2r + 1) square (the window cut at the edges) into
+/// `out`: the smallest of the rows within `r` of `t`, then the smallest of that within `r`
+/// along the row. `pad` is scratch of `width + 2 r` values.
+#[inline(always)]
+fn erode_row(img: &GrayImage, r: usize, t: usize, pad: &mut [f32], out: &mut [f32]) {
+    let (w, h) = (img.width, img.height);
+    let first = t.saturating_sub(r);
+    let rows = (t + r).min(h - 1) + 1 - first;
+    min_of_rows(&mut pad[r..r + w], &img.data[first * w..], rows, w);
+    // padded with its edge values, which are in every cut window anyway
+    pad_edges(pad, r);
+    min_of_rows(out, pad, 2 * r + 1, 1);
 }
 
 /// `img` with each pixel replaced by the smallest within `r` px along each axis (a grey
-/// erosion by a (2r + 1) x (2r + 1) square, as `r` erosions by a 3 x 3 one; separable; the
-/// window cut at the edges).
+/// erosion by a (2r + 1) x (2r + 1) square; separable; the window cut at the edges).
 pub fn erode(img: &GrayImage, r: usize) -> GrayImage {
     let (w, h) = (img.width, img.height);
     if w < 2 || h < 2 || r == 0 {
         return img.clone();
     }
-    let mut cur = img.data.clone();
-    let mut other = vec![0f32; w * h];
-    for _ in 0..r {
-        // along rows, cur -> other: each pixel and its left and right neighbours
-        for (out, src) in other.chunks_exact_mut(w).zip(cur.chunks_exact(w)) {
-            out[0] = src[0].min(src[1]);
-            min3_into(&mut out[1..w - 1], &src[..w - 2], &src[1..w - 1], &src[2..]);
-            out[w - 1] = src[w - 2].min(src[w - 1]);
-        }
-        // along columns, other -> cur: each row and the rows above and below
-        for v in 0..h {
-            let (up, down) = (v.saturating_sub(1), (v + 1).min(h - 1));
-            min3_into(
-                &mut cur[v * w..(v + 1) * w],
-                &other[up * w..(up + 1) * w],
-                &other[v * w..(v + 1) * w],
-                &other[down * w..(down + 1) * w],
-            );
-        }
+    let mut out = vec![0f32; w * h];
+    let mut pad = vec![0f32; w + 2 * r];
+    for (t, line) in out.chunks_exact_mut(w).enumerate() {
+        erode_row(img, r, t, &mut pad, line);
     }
     GrayImage {
         width: w,
         height: h,
-        data: cur,
+        data: out,
+    }
+}
+
+/// Seeds are looked for only in the runs of this many pixels of a row whose largest smoothed
+/// difference exceeds the upper threshold.
+const SEED_BLOCK: usize = 64;
+
+/// The largest of `x` (`-inf` when empty), in lanes that vectorise.
+#[inline(always)]
+fn max_of(x: &[f32]) -> f32 {
+    let mut lanes = [f32::NEG_INFINITY; 8];
+    let chunks = x.chunks_exact(8);
+    let rest = chunks.remainder();
+    for c in chunks {
+        for (l, y) in lanes.iter_mut().zip(c) {
+            *l = if *y > *l { *y } else { *l };
+        }
+    }
+    lanes
+        .iter()
+        .chain(rest)
+        .fold(f32::NEG_INFINITY, |a, &y| if y > a { y } else { a })
+}
+
+/// [`detect`]'s pass over the rows: each row of the reference eroded, the difference `gain x
+/// eroded - capture` smoothed (the Gaussian of [`gaussian_blur`]); from each smoothed row the
+/// samples of the noise, the pixels outside the mask set to -inf (never above a threshold),
+/// the largest value of each [`SEED_BLOCK`]; on the way, the samples of how much the erosion
+/// lowers the difference on the skin.
+struct Difference<'a> {
+    reference: &'a GrayImage,
+    capture: &'a GrayImage,
+    mask: Option<&'a [bool]>,
+    gain: f32,
+    /// The erosion's half-width, px.
+    erode_px: usize,
+    /// Scratch for [`erode_row`].
+    pad: Vec<f32>,
+    /// `gain x (reference - eroded)` on every [`LEVEL_STRIDE`]-th pixel inside the mask.
+    lowered: Vec<f32>,
+    /// The smoothed difference on every [`NOISE_STRIDE`]-th pixel inside the mask (plenty for
+    /// a median, in a fraction of the time).
+    noise: Vec<f32>,
+    /// The smoothed difference, -inf outside the mask.
+    d: Vec<f32>,
+    /// The largest of `d` over each [`SEED_BLOCK`] of each row.
+    block_max: Vec<f32>,
+}
+
+impl RowSteps for Difference<'_> {
+    #[inline(always)]
+    fn fill(&mut self, t: usize, line: &mut [f32]) {
+        let w = self.reference.width;
+        erode_row(self.reference, self.erode_px, t, &mut self.pad, line);
+        let base = t * w;
+        let plain = &self.reference.data[base..base + w];
+        let gain = self.gain;
+        let lowered =
+            samples(base, w, LEVEL_STRIDE, self.mask).map(|u| gain * (plain[u] - line[u]));
+        self.lowered.extend(lowered);
+        for (x, c) in line.iter_mut().zip(&self.capture.data[base..base + w]) {
+            *x = gain * *x - c;
+        }
+    }
+
+    #[inline(always)]
+    fn emit(&mut self, v: usize, row: &mut [f32]) {
+        let w = row.len();
+        let base = v * w;
+        let noise = samples(base, w, NOISE_STRIDE, self.mask).map(|u| row[u]);
+        self.noise.extend(noise);
+        if let Some(m) = self.mask {
+            for (x, &m) in row.iter_mut().zip(&m[base..base + w]) {
+                *x = if m { *x } else { f32::NEG_INFINITY };
+            }
+        }
+        self.block_max.extend(row.chunks(SEED_BLOCK).map(max_of));
+        self.d.extend_from_slice(row);
     }
 }
 
@@ -333,34 +580,49 @@ pub fn detect(
             return Err(DetectError::MaskSize(m.len(), w * h));
         }
     }
-    let inside = |i: usize| mask.is_none_or(|m| m[i]);
+    if w * h == 0 {
+        return Ok(Vec::new());
+    }
     let gain = if p.compensate_gain {
-        capture_gain(reference, capture, &inside)
+        capture_gain(reference, capture, mask)
     } else {
         1.0
     };
-    let eroded = erode(reference, p.edge_tolerance_px);
-    let lo_offset = erosion_offset(reference, &eroded, gain, &inside);
-    // the difference in the eroded reference's buffer
-    let mut diff = eroded;
-    for (r, c) in diff.data.iter_mut().zip(&capture.data) {
-        *r = gain * *r - c;
-    }
-    let d = gaussian_blur(&diff, p.smooth_sigma_px);
     let k = if p.smooth_sigma_px > 0.0 {
         kernel(p.smooth_sigma_px)
     } else {
         vec![1.0]
     };
-    // noise: the median absolute deviation of the smoothed difference over the mask, on every
-    // NOISE_STRIDE-th pixel (plenty for a median, in a fraction of the time)
-    let mut vals: Vec<f32> = (0..w * h)
-        .step_by(NOISE_STRIDE)
-        .filter(|&i| inside(i))
-        .map(|i| d.data[i])
-        .collect();
-    let med = median(&mut vals);
-    let mut dev: Vec<f32> = vals.iter().map(|x| (x - med).abs()).collect();
+    // as `erode` does, an image of one row or column is not eroded
+    let er = if w < 2 || h < 2 {
+        0
+    } else {
+        p.edge_tolerance_px
+    };
+    let mut pass = Difference {
+        reference,
+        capture,
+        mask,
+        gain,
+        erode_px: er,
+        pad: vec![0f32; w + 2 * er],
+        lowered: Vec::with_capacity(w * h / LEVEL_STRIDE + 1),
+        noise: Vec::with_capacity(w * h / NOISE_STRIDE + 1),
+        d: Vec::with_capacity(w * h),
+        block_max: Vec::with_capacity(h * w.div_ceil(SEED_BLOCK)),
+    };
+    blur_rows(w, h, &k, &mut pass);
+    let Difference {
+        mut lowered,
+        mut noise,
+        mut d,
+        block_max,
+        ..
+    } = pass;
+    let lo_offset = f64::from(median(&mut lowered));
+    // noise: the median absolute deviation of the smoothed difference over the mask
+    let med = median(&mut noise);
+    let mut dev: Vec<f32> = noise.iter().map(|x| (x - med).abs()).collect();
     let sigma = (1.4826 * median(&mut dev)).max(1e-6) as f64;
     let hi = med as f64 + p.threshold_sigma * sigma;
     let lo = med as f64 + p.grow_sigma * sigma;
@@ -369,76 +631,66 @@ pub fn detect(
     // reference's noise within the window), which would otherwise weigh every pixel of a spot
     // alike and pull its centre to the middle of its area
     let lo_plain = lo + lo_offset;
-    let mut label = vec![0u32; w * h];
     let mut spots = Vec::new();
-    let mut stack = Vec::new();
-    // the seeds first, in one tight pass over the image; then each grows its spot
+    let (mut stack, mut pixels) = (Vec::new(), Vec::new());
+    // the seeds in the order of the pixels, in the blocks whose largest value exceeds the upper
+    // threshold; each grows its spot. A pixel taken into a spot is set to -inf in `d`: no
+    // other spot takes it, and no later seed starts there.
     let hi32 = hi as f32;
-    let seeds: Vec<usize> = match mask {
-        Some(m) => d
-            .data
-            .iter()
-            .zip(m)
-            .enumerate()
-            .filter(|(_, (x, &m))| m && **x > hi32)
-            .map(|(i, _)| i)
-            .collect(),
-        None => d
-            .data
-            .iter()
-            .enumerate()
-            .filter(|(_, x)| **x > hi32)
-            .map(|(i, _)| i)
-            .collect(),
-    };
-    for start in seeds {
-        if label[start] != 0 || (d.data[start] as f64) <= hi {
-            continue;
-        }
-        // grow by hysteresis over 8-neighbours above `lo`
-        let id = spots.len() as u32 + 1;
-        label[start] = id;
-        stack.push(start);
-        let (mut sw, mut su, mut sv, mut peak, mut area) = (0f64, 0f64, 0f64, 0f64, 0usize);
-        // the spot's pixels' moments, unweighted (its shape)
-        let mut m = [0f64; 5];
-        while let Some(i) = stack.pop() {
-            let (u, v) = (i % w, i / w);
-            // weighted by the difference with the reference itself (not eroded), smoothed
-            // the same way: the erosion decides which pixels a spot has, not its centre
-            let x = smoothed_at(reference, capture, gain, &k, i) - lo_plain;
-            sw += x;
-            su += x * u as f64;
-            sv += x * v as f64;
-            peak = peak.max(d.data[i] as f64 - med as f64);
-            area += 1;
-            let (fu, fv) = (u as f64, v as f64);
-            m[0] += fu;
-            m[1] += fv;
-            m[2] += fu * fu;
-            m[3] += fv * fv;
-            m[4] += fu * fv;
-            for dv in -1i64..=1 {
-                for du in -1i64..=1 {
-                    let (uu, vv) = (u as i64 + du, v as i64 + dv);
-                    if uu < 0 || vv < 0 || uu >= w as i64 || vv >= h as i64 {
-                        continue;
-                    }
-                    let j = vv as usize * w + uu as usize;
-                    if label[j] == 0 && inside(j) && d.data[j] as f64 > lo {
-                        label[j] = id;
-                        stack.push(j);
+    let blocks = w.div_ceil(SEED_BLOCK);
+    for (b, _) in block_max.iter().enumerate().filter(|(_, &x)| x > hi32) {
+        let first = (b / blocks) * w + (b % blocks) * SEED_BLOCK;
+        let end = first + SEED_BLOCK.min(w - (b % blocks) * SEED_BLOCK);
+        for start in first..end {
+            if !(d[start] > hi32) || (d[start] as f64) <= hi {
+                continue;
+            }
+            // grow by hysteresis over 8-neighbours above `lo`; the peak over the pixels taken
+            let mut peak = (d[start] as f64 - med as f64).max(0.0);
+            d[start] = f32::NEG_INFINITY;
+            stack.push((start % w, start / w));
+            pixels.clear();
+            while let Some((u, v)) = stack.pop() {
+                pixels.push((u, v));
+                let (u0, u1) = (u.saturating_sub(1), (u + 1).min(w - 1));
+                for vv in v.saturating_sub(1)..=(v + 1).min(h - 1) {
+                    for uu in u0..=u1 {
+                        let j = vv * w + uu;
+                        if d[j] as f64 > lo {
+                            peak = peak.max(d[j] as f64 - med as f64);
+                            d[j] = f32::NEG_INFINITY;
+                            stack.push((uu, vv));
+                        }
                     }
                 }
             }
+            // weighted by the difference with the reference itself (not eroded), smoothed the
+            // same way: the erosion decides which pixels a spot has, not its centre
+            let plain = smoothed_over(reference, capture, gain, &k, &pixels);
+            let (mut sw, mut su, mut sv) = (0f64, 0f64, 0f64);
+            // the spot's pixels' moments, unweighted (its shape)
+            let mut m = [0f64; 5];
+            for (&(u, v), &x) in pixels.iter().zip(&plain) {
+                let (fu, fv) = (u as f64, v as f64);
+                let x = f64::from(x) - lo_plain;
+                sw += x;
+                su += x * fu;
+                sv += x * fv;
+                m[0] += fu;
+                m[1] += fv;
+                m[2] += fu * fu;
+                m[3] += fv * fv;
+                m[4] += fu * fv;
+            }
+            let area = pixels.len();
+            spots.push(Spot {
+                u_px: su / sw,
+                v_px: sv / sw,
+                score: peak / sigma,
+                area_px: area,
+                roundness: roundness(area as f64, m[0], m[1], m[2], m[3], m[4]),
+            });
         }
-        spots.push(Spot {
-            u_px: su / sw,
-            v_px: sv / sw,
-            score: peak / sigma,
-            area_px: area,
-            roundness: roundness(area as f64, m[0], m[1], m[2], m[3], m[4]),
-        });
     }
     let mut spots: Vec<Spot> = spots
         .into_iter()
