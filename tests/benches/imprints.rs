@@ -32,16 +32,17 @@ fn bench(c: &mut Criterion) {
         &pose,
         &surface,
         &pins,
-        &Shading::default(),
+        &Shading::real_capture(),
         1,
     );
     let mask = reference_mask(&r.reference, 255.0, 4);
     let p = DetectParams::default();
-    assert_eq!(
+    // the five pins, and the specks and the scratch of a real capture
+    assert!(
         detect(&r.reference, &r.capture, Some(&mask), &p)
             .unwrap()
-            .len(),
-        5
+            .len()
+            > 5
     );
     let mut g = c.benchmark_group("imprints_640x480");
     g.sample_size(50);
