@@ -718,15 +718,41 @@ pub fn ids_from_file_name(path: &std::path::Path) -> Option<Vec<u32>> {
         .collect()
 }
 
+/// Sectors (about the skin's centre) in which [`reference_mask`] looks for the ring of LED
+/// reflections at the rim ...
+const RING_SECTORS: usize = 12;
+/// ... which is a ring when this many of them hold a reflection.
+const RING_MIN_SECTORS: usize = 9;
+
 /// The pixels that can hold an imprint, from the reference image: skin (brighter than a
 /// quarter of the median grey) and not an LED reflection (at most halfway from the median to
-/// `white`), the reflections grown by `margin_px`.
+/// `white`), the reflections grown by `margin_px`. When the reflections ring the skin (as the
+/// LEDs at an R-Tac0's rim do: reflections in at least [`RING_MIN_SECTORS`] of
+/// [`RING_SECTORS`] sectors about the skin's centroid), only the disc inside the ring counts,
+/// less `margin_px`: the dark notches between the highlights and whatever lies beyond them
+/// are not skin a pin can press. The ring's inner radius is the median over the sectors of
+/// the nearest reflection in each, so that one stray reflection does not shrink the disc.
 pub fn reference_mask(reference: &GrayImage, white: f32, margin_px: usize) -> Vec<bool> {
     let (w, h) = (reference.width, reference.height);
     let mut all = reference.data.clone();
     let med = median(&mut all);
     let bright = 0.5 * (med + white);
     let mut mask: Vec<bool> = reference.data.iter().map(|&g| g > 0.25 * med).collect();
+    if let Some((c, radius)) = reflection_ring(reference, &mask, bright) {
+        let r2 = (radius - margin_px as f64).max(0.0).powi(2);
+        // each row keeps the columns within the disc
+        for (v, row) in mask.chunks_exact_mut(w).enumerate() {
+            let half = (r2 - (v as f64 - c[1]).powi(2)).max(0.0).sqrt();
+            let a = (c[0] - half).ceil().clamp(0.0, w as f64) as usize;
+            let b = ((c[0] + half).floor() + 1.0).clamp(a as f64, w as f64) as usize;
+            if half <= 0.0 {
+                row.fill(false);
+                continue;
+            }
+            row[..a].fill(false);
+            row[b..].fill(false);
+        }
+    }
     let m = margin_px as i64;
     for v in 0..h as i64 {
         for u in 0..w as i64 {
@@ -744,6 +770,47 @@ pub fn reference_mask(reference: &GrayImage, white: f32, margin_px: usize) -> Ve
         }
     }
     mask
+}
+
+/// The centre (the centroid of the `lit` pixels, px) and inner radius (px) of a ring of
+/// reflections (pixels above `bright`) about it; `None` when the reflections do not ring it
+/// ([`reference_mask`]).
+fn reflection_ring(reference: &GrayImage, lit: &[bool], bright: f32) -> Option<([f64; 2], f64)> {
+    let w = reference.width;
+    let (mut n, mut su, mut sv) = (0usize, 0usize, 0usize);
+    for (v, row) in lit.chunks_exact(w).enumerate() {
+        let (mut rn, mut ru) = (0usize, 0usize);
+        for (u, _) in row.iter().enumerate().filter(|(_, l)| **l) {
+            rn += 1;
+            ru += u;
+        }
+        n += rn;
+        su += ru;
+        sv += rn * v;
+    }
+    let (su, sv) = (su as f64, sv as f64);
+    if n == 0 {
+        return None;
+    }
+    let c = [su / n as f64, sv / n as f64];
+    let mut nearest = [f64::INFINITY; RING_SECTORS];
+    for (i, _) in reference
+        .data
+        .iter()
+        .enumerate()
+        .filter(|(_, g)| **g > bright)
+    {
+        let (du, dv) = ((i % w) as f64 - c[0], (i / w) as f64 - c[1]);
+        let turn = (dv.atan2(du) / std::f64::consts::TAU).rem_euclid(1.0);
+        let k = ((turn * RING_SECTORS as f64) as usize).min(RING_SECTORS - 1);
+        nearest[k] = nearest[k].min(du.hypot(dv));
+    }
+    let mut found: Vec<f64> = nearest.into_iter().filter(|d| d.is_finite()).collect();
+    if found.len() < RING_MIN_SECTORS {
+        return None;
+    }
+    let m = found.len() / 2;
+    Some((c, *found.select_nth_unstable_by(m, f64::total_cmp).1))
 }
 
 pub mod synthetic;

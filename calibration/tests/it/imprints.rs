@@ -440,3 +440,47 @@ fn on_captures_with_every_artifact_every_capture_is_used_and_every_id_right() {
         "detected: {rd:.4} deg, {td:.4} mm; true centroids: {rt:.4} deg, {tt:.4} mm (centroids {rms:.3} px RMS)"
     );
 }
+
+/// The reference's mask when LED highlights ring the skin (Shading::real_rim: 12 of them,
+/// saturated) is the disc inside the ring: no pixel of it as far from the image centre as the
+/// nearest highlight, the notches between the highlights and the skin beyond them out (without
+/// the ring the mask reaches 274 px from the centre, the highlights' inner edge 204 px); every
+/// pin's imprint (8 px about its centre) in.
+#[test]
+fn a_ring_of_led_highlights_bounds_the_mask_to_the_disc_inside_it() {
+    let design = fabkit_designs::library::load("rtac0").unwrap();
+    let surface = ReferenceSurface::of(&design.body).unwrap();
+    let cam = benchmark_camera();
+    let far = |r: &Rendered, mask: &[bool]| {
+        let w = r.reference.width;
+        let (cx, cy) = (
+            0.5 * (w as f64 - 1.0),
+            0.5 * (r.reference.height as f64 - 1.0),
+        );
+        let d = |i: usize| ((i % w) as f64 - cx).hypot((i / w) as f64 - cy);
+        let masked = (0..mask.len())
+            .filter(|&i| mask[i])
+            .map(d)
+            .fold(0.0, f64::max);
+        let lit = (0..mask.len())
+            .filter(|&i| r.reference.data[i] >= 250.0)
+            .map(d)
+            .fold(f64::INFINITY, f64::min);
+        for c in r.centres_px.iter().flatten() {
+            for dv in -8i64..=8 {
+                for du in -8i64..=8 {
+                    let (u, v) = (c[0].round() as i64 + du, c[1].round() as i64 + dv);
+                    assert!(mask[v as usize * w + u as usize], "({u}, {v}) by a pin");
+                }
+            }
+        }
+        (masked, lit)
+    };
+    let pins = capture_pins(30.0, 1.0);
+    let r = render(&cam, &pose(), &surface, &pins, &Shading::real_rim(), 7);
+    let (masked, lit) = far(&r, &reference_mask(&r.reference, 255.0, 4));
+    assert!(
+        masked < lit,
+        "masked to {masked:.1} px, a highlight at {lit:.1} px"
+    );
+}
