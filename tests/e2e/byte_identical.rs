@@ -1,0 +1,157 @@
+//! The check a refactor runs: every library design exported as is and with each of its
+//! presets (`fabkit export NAME [--preset P] --out kit`), and `fabkit fixtures NAME --out fx`
+//! for each design, every file written hashed (sha256) against the list committed in
+//! `tests/e2e/output_hashes.txt`. A change meant to keep every output byte-identical (a
+//! restructuring of the designs crate, a faster kernel) shows here as "no difference"; a
+//! change meant to alter outputs re-blesses the list and shows, in the list's diff, exactly
+//! which files changed.
+//!
+//! Ignored by default: it writes 21 outputs (about 40 s with the quick profile), and the
+//! hashes are of this platform's floating point (x86-64 Linux), not a property to hold CI to.
+//! Run it before and after a refactor:
+//!
+//! ```sh
+//! cargo test --profile quick -p fabkit --test e2e -- --ignored outputs_are_byte_identical
+//! FABKIT_BLESS=1 cargo test --profile quick -p fabkit --test e2e -- --ignored outputs_are_byte_identical
+//! ```
+//!
+//! The commands run as `fabkit` from the PATH in an empty folder with relative `--out`
+//! folders, so that the command lines the outputs record are the same in every checkout.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use sha2::{Digest, Sha256};
+
+use crate::common::{repo_root, text};
+
+/// The committed list, relative to the repository.
+const LIST: &str = "tests/e2e/output_hashes.txt";
+
+/// `fabkit ARGS` in `cwd`, the binary found on the PATH as `fabkit`; panics unless it succeeds.
+fn fabkit_on_path(cwd: &Path, args: &[&str]) {
+    let bin = PathBuf::from(env!("CARGO_BIN_EXE_fabkit"));
+    let path = std::env::join_paths(std::iter::once(bin.parent().unwrap().to_path_buf()).chain(
+        std::env::split_paths(&std::env::var_os("PATH").unwrap_or_default()),
+    ))
+    .unwrap();
+    let o = Command::new("fabkit")
+        .args(args)
+        .current_dir(cwd)
+        .env("PATH", path)
+        .output()
+        .expect("fabkit runs");
+    assert!(
+        o.status.success(),
+        "fabkit {}: {}{}",
+        args.join(" "),
+        text(&o.stdout),
+        text(&o.stderr)
+    );
+}
+
+/// The library's designs and their presets, as `fabkit designs` lists them.
+fn designs(cwd: &Path) -> Vec<(String, Vec<String>)> {
+    let o = crate::common::run(cwd, &["designs"], &[]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    text(&o.stdout)
+        .lines()
+        .map(|l| {
+            let name = l.split_whitespace().next().unwrap().to_string();
+            let presets = l
+                .split("presets: ")
+                .nth(1)
+                .map(|p| p.split(", ").map(|s| s.trim().to_string()).collect())
+                .unwrap_or_default();
+            (name, presets)
+        })
+        .collect()
+}
+
+/// Every file under `dir`, by its path relative to `root` ('/'-separated), with its sha256.
+fn hash_tree(root: &Path, dir: &Path, out: &mut BTreeMap<String, String>) {
+    let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    entries.sort();
+    for p in entries {
+        if p.is_dir() {
+            hash_tree(root, &p, out);
+        } else {
+            let rel = p.strip_prefix(root).unwrap();
+            let key = rel
+                .components()
+                .map(|c| c.as_os_str().to_string_lossy().into_owned())
+                .collect::<Vec<_>>()
+                .join("/");
+            let digest = Sha256::digest(std::fs::read(&p).unwrap());
+            let hex: String = digest.iter().map(|b| format!("{b:02x}")).collect();
+            out.insert(key, hex);
+        }
+    }
+}
+
+#[test]
+#[ignore = "a refactor's check: writes every library design's outputs (see the module docs)"]
+fn outputs_are_byte_identical_to_the_committed_hashes() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut hashes = BTreeMap::new();
+    for (name, presets) in designs(dir.path()) {
+        let mut jobs: Vec<(String, Vec<String>)> = vec![(
+            format!("export/{name}"),
+            vec!["export".into(), name.clone()],
+        )];
+        for p in &presets {
+            jobs.push((
+                format!("export/{name}_{p}"),
+                vec!["export".into(), name.clone(), "--preset".into(), p.clone()],
+            ));
+        }
+        jobs.push((
+            format!("fixtures/{name}"),
+            vec!["fixtures".into(), name.clone()],
+        ));
+        for (out, mut args) in jobs {
+            args.extend(["--out".into(), out.clone()]);
+            let args: Vec<&str> = args.iter().map(String::as_str).collect();
+            fabkit_on_path(dir.path(), &args);
+            hash_tree(dir.path(), &dir.path().join(&out), &mut hashes);
+        }
+    }
+    let listed: String = hashes.iter().map(|(f, h)| format!("{h}  {f}\n")).collect();
+    let path = repo_root().join(LIST);
+    if std::env::var("FABKIT_BLESS").is_ok_and(|v| v == "1") {
+        std::fs::write(&path, &listed).unwrap();
+    }
+    let committed = std::fs::read_to_string(&path).unwrap_or_default();
+    let parse = |t: &str| -> BTreeMap<String, String> {
+        t.lines()
+            .filter_map(|l| l.split_once("  "))
+            .map(|(h, f)| (f.to_string(), h.to_string()))
+            .collect()
+    };
+    let before = parse(&committed);
+    let mut differ = Vec::new();
+    for (f, h) in &hashes {
+        match before.get(f) {
+            None => differ.push(format!("new: {f}")),
+            Some(b) if b != h => differ.push(format!("changed: {f}")),
+            _ => {}
+        }
+    }
+    differ.extend(
+        before
+            .keys()
+            .filter(|f| !hashes.contains_key(*f))
+            .map(|f| format!("gone: {f}")),
+    );
+    assert!(
+        differ.is_empty(),
+        "{} of {} files differ from {LIST} (FABKIT_BLESS=1 rewrites it):\n{}",
+        differ.len(),
+        hashes.len(),
+        differ.join("\n")
+    );
+}
