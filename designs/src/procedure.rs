@@ -9,6 +9,7 @@
 
 use crate::kit::{CastReport, Part, ProcedureAction, ProcedureStep};
 use crate::materials::MaterialKind;
+use crate::parts::fasteners::bolt_name;
 use crate::schema::Design;
 
 /// The clamp bolts of one mold: `count` bolts of `name` (e.g. `M3 x 60`) through `grip_mm`.
@@ -24,28 +25,9 @@ pub struct ClampBolts {
     pub clearance_mm: f64,
 }
 
-/// ISO 4032 hexagon nut height, as a fraction of the nominal diameter.
-const NUT_HEIGHT_PER_D: f64 = 0.8;
-
 /// The cast name of the internal filling gel ([`crate::schema::FillingGel`]): poured during the
 /// assembly, not in a mold.
 pub const FILLING_GEL: &str = "filling_gel";
-/// Thread left beyond the nut, mm.
-const BOLT_PROTRUSION_MM: f64 = 1.0;
-
-/// The bolt for a through hole of `clearance_mm` clamping `grip_mm` with a nut: the shortest
-/// standard length ([`crate::build::SCREW_LENGTHS_MM`]) that passes the grip and the nut
-/// (0.8 d, ISO 4032) by [`BOLT_PROTRUSION_MM`]; `None` when no standard size or length fits.
-pub fn bolt_name(clearance_mm: f64, grip_mm: f64) -> Option<String> {
-    let d = crate::build::metric_from_clearance(clearance_mm)?;
-    let need = grip_mm + NUT_HEIGHT_PER_D * d + BOLT_PROTRUSION_MM;
-    let l = crate::build::SCREW_LENGTHS_MM
-        .iter()
-        .copied()
-        .find(|l| *l >= need - 1e-9)?;
-    Some(format!("M{d} x {l}"))
-}
-
 /// The clamp bolts of every bolted mold of the kit, from the parts' parameters: the direct
 /// strategy's halves (4 bolts across both halves, perpendicular to the parting plane) and the
 /// two-piece open mold (`two_piece.bolt_count` bolts through both pieces).
@@ -566,7 +548,7 @@ fn assembly_steps(
             || "the joint screws".to_string(),
             |n| format!("the 2 joint screws {n}"),
         );
-        let camera = crate::build::metric_from_pilot(h.camera.mount_pilot_diameter_mm)
+        let camera = crate::parts::fasteners::metric_from_pilot(h.camera.mount_pilot_diameter_mm)
             .map_or_else(String::new, |d| format!(" M{d}"));
         let tube = named("shell_tube");
         let collar = named("shell_collar");
@@ -661,7 +643,7 @@ fn assembly_steps(
             .first()
             .cloned()
             .unwrap_or_else(|| "the tip's fitting".into());
-        let screws = crate::build::metric_from_pilot(sb.camera.mount_pilot_diameter_mm)
+        let screws = crate::parts::fasteners::metric_from_pilot(sb.camera.mount_pilot_diameter_mm)
             .map_or_else(String::new, |d| format!(" M{d}"));
         let bayonet = &design.printers.fdm.bayonet;
         out.push(format!(

@@ -872,7 +872,7 @@ pub fn bought_items(c: &CasingParams) -> Vec<String> {
     if let Some(g) = &c.gripper_base {
         let under_head = g.thickness_mm - g.socket_depth_mm - s.head_depth_mm;
         let screw =
-            crate::build::screw_name(s.clearance_diameter_mm, under_head + s.pilot_depth_mm)
+            super::fasteners::screw_name(s.clearance_diameter_mm, under_head + s.pilot_depth_mm)
                 .unwrap_or_else(|| format!("{:.1} mm", s.clearance_diameter_mm));
         out.push(format!(
             "Casing to base: 4 self-tapping screws {screw} up through the base's counterbored holes into the casing's {:.1} mm pilots ({:.1} mm deep)",

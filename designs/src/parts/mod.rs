@@ -4,6 +4,7 @@
 pub mod bayonet;
 pub mod casing;
 pub mod core_shell;
+pub mod fasteners;
 pub mod fingertip_base;
 pub mod robot_mount;
 pub mod shaft_body;

@@ -1005,7 +1005,7 @@ pub fn members(
 /// lens window (cut), the microcontroller.
 pub fn bought_items(sb: &ShaftBodyParams) -> Vec<String> {
     let cam = &sb.camera;
-    let screw = crate::build::metric_from_pilot(cam.mount_pilot_diameter_mm)
+    let screw = super::fasteners::metric_from_pilot(cam.mount_pilot_diameter_mm)
         .map(|d| format!(" M{d}"))
         .unwrap_or_default();
     vec![

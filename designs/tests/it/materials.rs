@@ -179,7 +179,7 @@ fn the_black_coating_has_its_mix_and_amount() {
 /// tube: M2 x 6; the square halves: M2 x 10); a 1.6 mm pilot takes an M2 self-tapping screw.
 #[test]
 fn screws_are_named_by_standard_size_and_length() {
-    use fabkit_designs::build::{metric_from_clearance, metric_from_pilot, screw_name};
+    use fabkit_designs::parts::fasteners::{metric_from_clearance, metric_from_pilot, screw_name};
     assert_eq!(metric_from_clearance(2.2), Some(2.0));
     assert_eq!(metric_from_clearance(3.4), Some(3.0));
     assert_eq!(metric_from_clearance(3.5), Some(3.0));
@@ -270,7 +270,7 @@ fn treatments_carry_a_checked_amount_per_area() {
 /// radius + flange width)).
 #[test]
 fn clamp_bolts_are_named_by_standard_size_and_length() {
-    use fabkit_designs::procedure::bolt_name;
+    use fabkit_designs::parts::fasteners::bolt_name;
     assert_eq!(bolt_name(3.4, 53.0).as_deref(), Some("M3 x 60"));
     assert_eq!(bolt_name(3.4, 25.4).as_deref(), Some("M3 x 30"));
     assert_eq!(bolt_name(3.4, 26.6).as_deref(), Some("M3 x 30"));
