@@ -24,7 +24,7 @@
 //! The window must pass the camera's view of the whole skin: the ray from the lens's front to
 //! the skin's rim, refracted by the plate, must cross the casing's top face inside the window.
 
-use crate::assembly::{ExactShape, Member, MemberKind};
+use super::{ExactShape, Member, MemberKind};
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{cuboid, ChordTolerance, GeometryError, Solid};
 use crate::kit::{Part, PrintTechnology};

@@ -8,7 +8,7 @@
 //! on the half ellipsoid. Both continue straight down `below_base_mm` under the base plane to
 //! the open end.
 
-use crate::assembly::ExactShape;
+use super::ExactShape;
 use crate::error::{DesignError, GeometryContext as _};
 use crate::geometry::{revolve, ChordTolerance, Polyline2, Solid};
 use crate::profile::BodyProfile;

@@ -21,7 +21,7 @@
 //!   base's floor pass the camera's wire and the PCB's wires; the bolts come up through
 //!   counterbored holes in the base.
 
-use crate::assembly::{ExactShape, Member, MemberKind};
+use super::{ExactShape, Member, MemberKind};
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{ChordTolerance, GeometryError, Solid};
 use crate::kit::{Part, PrintTechnology};

@@ -6,8 +6,11 @@ pub mod casing;
 pub mod core_shell;
 pub mod fasteners;
 pub mod fingertip_base;
+mod member;
 pub mod robot_mount;
 pub mod shaft_body;
+
+pub use member::{ExactShape, Member, MemberKind};
 
 use crate::error::ParamError;
 use crate::geometry::{cylinder, ChordTolerance, GeometryError, Solid};

@@ -23,7 +23,7 @@
 //! surface it sees (through the lip, the LED ring and the shaft's bore, the pins' shadows
 //! ignored) is stated in the manifest ([`view_fraction`]).
 
-use crate::assembly::{ExactShape, Member, MemberKind};
+use super::{ExactShape, Member, MemberKind};
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::Polyline2;
 use crate::geometry::{cuboid, cylinder, revolve, ChordTolerance, GeometryError, Solid};

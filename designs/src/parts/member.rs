@@ -1,0 +1,81 @@
+//! What a part family contributes to the assembled sensor ([`crate::assembly`]): its members,
+//! each a solid in the sensor frame with where it comes from, the parameters that size it and
+//! what an exact B-rep of it is built from. The families build these; the assembly collects
+//! and fit-checks them.
+
+use crate::geometry::Solid;
+use serde::{Deserialize, Serialize};
+
+/// Where a member of the assembly comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MemberKind {
+    /// A printed part of the kit.
+    Printed,
+    /// A cast or sprayed layer of the skin.
+    Cast,
+    /// A bought part, modelled as a simple envelope.
+    Bought,
+}
+
+/// One part of the assembled sensor.
+#[derive(Debug, Clone)]
+pub struct Member {
+    /// The kit part's or layer's name; bought envelopes end in `_envelope`.
+    pub name: String,
+    pub kind: MemberKind,
+    pub description: String,
+    /// The solid in the sensor frame, mm.
+    pub solid: Solid,
+    /// The parameter paths that size or place this member: what a fit-check error suggests
+    /// changing.
+    pub fix: Vec<String>,
+    /// The member is a surface of revolution between two offsets of the body profile with
+    /// nothing on it (a cast layer without markers, the core), or the filling gel inside the
+    /// core's inner surface, or a printed skin, its marker tips and the gel filling it (the
+    /// gel is the skin's cavity less the very pin and tip solids the skin and tips are made
+    /// of): the stack's validation and their construction already nest such members without
+    /// overlap, so the fit check skips pairs of them.
+    pub nested_by_stack: bool,
+    /// What an exact B-rep of the member is built from (STEP export, `export/src/step.rs`),
+    /// in the sensor frame, mm; `None` for a printed member (its kit part's own parameters
+    /// describe it) and for a member that has no exact description (STEP export then sews its
+    /// mesh).
+    pub exact: Option<ExactShape>,
+}
+
+/// The exact shape of a non-printed assembly member, from which the CadQuery twin
+/// (`export/python/twins/step_export.py`) builds its B-rep. Sensor frame, mm; serialized with a
+/// `shape` tag (`layer`, `revolved`, `cylinder`, `ring`, `box`, `core_shell`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "shape", rename_all = "snake_case", deny_unknown_fields)]
+pub enum ExactShape {
+    /// A cast or sprayed layer: the same parameters as its printed or molded parts carry
+    /// (`layer`, `body`, `outer_offset_mm`, `inner_offset_mm`, `solid`, `markers`, see
+    /// [`crate::layers::layer_twin_params`]), built exactly by the twin.
+    Layer { params: serde_json::Value },
+    /// The solid of revolution about z of a closed (r, z) polygon, mm (r >= 0): exact for the
+    /// polygon (planes, cylinders, cones), which itself lies within half the chord tolerance
+    /// of the true profile.
+    Revolved { profile_rz_mm: Vec<[f64; 2]> },
+    /// A disc about the z axis from `z0_mm` to `z1_mm`.
+    Cylinder {
+        radius_mm: f64,
+        z0_mm: f64,
+        z1_mm: f64,
+    },
+    /// A flat ring about the z axis from `z0_mm` to `z1_mm`.
+    Ring {
+        outer_radius_mm: f64,
+        inner_radius_mm: f64,
+        z0_mm: f64,
+        z1_mm: f64,
+    },
+    /// An axis-aligned box.
+    Box { min_mm: [f64; 3], max_mm: [f64; 3] },
+    /// A core with a bore ([`crate::parts::core_shell::exact_shape`]): `body`,
+    /// `outer_offset_mm`, `wall_thickness_mm`, `below_base_mm`; the twin builds its outer
+    /// surface exactly and its inner surface by the rule of
+    /// [`crate::profile::BodyProfile::shell_inner_surface`].
+    CoreShell { params: serde_json::Value },
+}
