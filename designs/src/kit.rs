@@ -1,66 +1,7 @@
 //! The output of a design build: printable parts and the numbers needed to cast.
 
-use crate::geometry::Solid;
+pub use crate::parts::{Part, PrintTechnology};
 use serde::{Deserialize, Serialize};
-
-/// How a part is meant to be made.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum PrintTechnology {
-    /// Fused deposition modelling (filament).
-    #[serde(rename = "FDM")]
-    Fdm,
-    /// Stereolithography / masked SLA (resin).
-    #[serde(rename = "SLA")]
-    Sla,
-    /// Material jetting of several materials in one print (Stratasys PolyJet: Tango Black+,
-    /// Vero White; Pestell et al. Sec. III-A).
-    #[serde(rename = "PolyJet")]
-    Polyjet,
-}
-
-impl std::fmt::Display for PrintTechnology {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(match self {
-            Self::Fdm => "FDM",
-            Self::Sla => "SLA",
-            Self::Polyjet => "PolyJet",
-        })
-    }
-}
-
-/// One printable part of a kit.
-#[derive(Debug, Clone)]
-pub struct Part {
-    /// File stem and 3MF object name, unique in the kit, `[a-z0-9_]+`.
-    pub name: String,
-    /// What the part is for, e.g. `mold_half`, `core_holder`, `master_pattern`, `mold_box`,
-    /// `casting_jig`, `shell_half`.
-    pub role: String,
-    /// Human description, one line.
-    pub description: String,
-    /// Material key in the materials table (e.g. `pla_black`, `sla_standard_resin`).
-    pub material: String,
-    pub print_technology: PrintTechnology,
-    /// The solid in print orientation: resting on the build plate z = 0, mm.
-    pub solid: Solid,
-    /// The resolved parameters the part was built from (for the manifest and twins).
-    pub params: serde_json::Value,
-    /// Parts of one multi-material print share a group name: they are built in the same
-    /// coordinates and the 3MF places them with one translation, so they stay registered
-    /// (TacTip skin and pin-tip dots). `None` for a part printed on its own.
-    pub group: Option<String>,
-}
-
-impl Part {
-    /// The mesh that is written and measured: the solid's mesh with every coordinate rounded to
-    /// `f32` ([`crate::Mesh::rounded_to_f32`]). The export's files and manifest numbers
-    /// (volume, triangles, genus) and the sweep metrics are all computed from this form, so
-    /// that they agree with each other and with an independent reader of the STL or 3MF.
-    pub fn written_mesh(&self) -> crate::Mesh {
-        self.solid.mesh().rounded_to_f32()
-    }
-}
 
 /// Casting numbers for one pour.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -25,9 +25,9 @@
 //! the skin's rim, refracted by the plate, must cross the casing's top face inside the window.
 
 use super::{ExactShape, Member, MemberKind};
+use super::{Part, PrintTechnology};
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{cuboid, ChordTolerance, GeometryError, Solid};
-use crate::kit::{Part, PrintTechnology};
 use crate::molds::{place_posed, with_pose};
 use crate::parts::shaft_body::{half_nozzle, OVERLAP_MM};
 use crate::parts::z_cylinder;

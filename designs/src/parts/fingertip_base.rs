@@ -22,9 +22,9 @@
 //!   counterbored holes in the base.
 
 use super::{ExactShape, Member, MemberKind};
+use super::{Part, PrintTechnology};
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{ChordTolerance, GeometryError, Solid};
-use crate::kit::{Part, PrintTechnology};
 use crate::molds::{place_posed, with_pose};
 use crate::parts::shaft_body::OVERLAP_MM;
 use crate::parts::z_cylinder;

@@ -7,10 +7,12 @@ pub mod core_shell;
 pub mod fasteners;
 pub mod fingertip_base;
 mod member;
+mod part;
 pub mod robot_mount;
 pub mod shaft_body;
 
 pub use member::{ExactShape, Member, MemberKind};
+pub use part::{Part, PrintTechnology};
 
 use crate::error::ParamError;
 use crate::geometry::{cylinder, ChordTolerance, GeometryError, Solid};

@@ -13,9 +13,9 @@
 //! `bottom_z` ([`crate::parts::shaft_body::ShaftLevels`]), the cup from there up by
 //! `cup_height_mm`.
 
+use super::{Part, PrintTechnology};
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{cylinder, ChordTolerance, GeometryError, Solid};
-use crate::kit::{Part, PrintTechnology};
 use crate::molds::{place_posed, with_pose};
 use crate::parts::bayonet::{band, Bayonet};
 use crate::parts::shaft_body::{levels, BayonetLugs, ShaftBodyParams, CABLE_SLOT_MM, OVERLAP_MM};

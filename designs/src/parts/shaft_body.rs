@@ -24,10 +24,10 @@
 //! ignored) is stated in the manifest ([`view_fraction`]).
 
 use super::{ExactShape, Member, MemberKind};
+use super::{Part, PrintTechnology};
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::Polyline2;
 use crate::geometry::{cuboid, cylinder, revolve, ChordTolerance, GeometryError, Solid};
-use crate::kit::{Part, PrintTechnology};
 use crate::molds::{place_posed, with_pose};
 use crate::parts::bayonet::Bayonet;
 use crate::schema::{Design, FillingGel, LayerProcess};
