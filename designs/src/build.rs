@@ -6,7 +6,7 @@ use crate::geometry::ChordTolerance;
 use crate::kit::Kit;
 use crate::materials::{pour, MaterialsTable};
 use crate::molds::{build_mold, cast_plans};
-use crate::parts::fasteners::{metric_from_pilot, metric_name, screw_name};
+use crate::parts::fasteners::{metric_from_pilot, metric_name};
 use crate::schema::{Design, LayerProcess, MoldStrategy};
 use crate::stack::{validate, Stack};
 use rayon::prelude::*;
@@ -633,7 +633,7 @@ fn housing_items(h: &crate::schema::HousingParams) -> Vec<String> {
         ),
         format!(
             "2 joint screws{}{}: {:.1} mm clearance, {:.1} mm head, length about {:.0} mm (clamp {:.1} mm + pilot {:.1} mm)",
-            joint_screw_name(h)
+            crate::housing::joint_screw_name(h)
             .map(|n| format!(" {n}"))
             .unwrap_or_default(),
             match h.style {
@@ -670,15 +670,6 @@ fn build_casing_parts(
         }
         Ok(out)
     }
-}
-
-/// The joint screws of a housing by standard size and length (`M2 x 6`): the longest standard
-/// length within the clamp length plus the pilot depth, less 0.5 mm.
-pub fn joint_screw_name(h: &crate::schema::HousingParams) -> Option<String> {
-    screw_name(
-        h.joint_screw.clearance_diameter_mm,
-        h.joint_screw.clamp_length_mm + h.joint_screw.pilot_depth_mm - 0.5,
-    )
 }
 
 /// Volume of `layer` alone, mm^3: the solid under its outer surface down to the base plane,

@@ -1094,3 +1094,12 @@ pub fn filling_gel_volume_mm3(
             lv.diffuser_z_mm - lv.chamber_z_mm,
         )
 }
+
+/// The joint screws of a housing by standard size and length (`M2 x 6`): the longest standard
+/// length within the clamp length plus the pilot depth, less 0.5 mm.
+pub fn joint_screw_name(h: &HousingParams) -> Option<String> {
+    crate::parts::fasteners::screw_name(
+        h.joint_screw.clearance_diameter_mm,
+        h.joint_screw.clamp_length_mm + h.joint_screw.pilot_depth_mm - 0.5,
+    )
+}

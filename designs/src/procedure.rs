@@ -544,7 +544,7 @@ fn assembly_steps(
             .collect()
     };
     if let Some(h) = &design.housing {
-        let joint = crate::build::joint_screw_name(h).map_or_else(
+        let joint = crate::housing::joint_screw_name(h).map_or_else(
             || "the joint screws".to_string(),
             |n| format!("the 2 joint screws {n}"),
         );
