@@ -191,6 +191,59 @@ fn observations(path: &Path) -> BTreeMap<(String, String), [f64; 2]> {
         .collect()
 }
 
+/// The authors' file name of a capture of `ids`: `01_02_06_14_22.EXT`.
+fn file_name(ids: &[String], ext: &str) -> String {
+    ids.iter()
+        .map(|id| format!("{:02}", id.parse::<u32>().unwrap()))
+        .collect::<Vec<_>>()
+        .join("_")
+        + "."
+        + ext
+}
+
+/// `calibrate extrinsics --images NAMES --reference REFERENCE --out out` with the scene's
+/// camera and table, the ids from the file names.
+fn calibrate_by_file_names(s: &Scene, reference: &str, names: &[String]) -> std::process::Output {
+    let mut args = vec![
+        "calibrate",
+        "extrinsics",
+        "--camera",
+        "cam.yaml",
+        "--points",
+        "fx/points/point_table.csv",
+        "--reference",
+        reference,
+        "--out",
+        "out",
+        "--images",
+    ];
+    args.extend(names.iter().map(String::as_str));
+    run(s.dir.path(), &args, &[])
+}
+
+impl Scene {
+    /// The pose solved from the imprints' true centroids ((capture, id) -> px; a pin seen in
+    /// several captures averaged, as the command does).
+    fn pose_from_true_centres(
+        &self,
+        true_centres: &BTreeMap<(String, String), [f64; 2]>,
+    ) -> Isometry3<f64> {
+        let mut by_id: BTreeMap<&String, (Vector2<f64>, f64)> = BTreeMap::new();
+        for ((_, id), c) in true_centres {
+            let e = by_id.entry(id).or_insert((Vector2::zeros(), 0.0));
+            e.0 += Vector2::new(c[0], c[1]);
+            e.1 += 1.0;
+        }
+        let (pts, px): (Vec<Vector3<f64>>, Vec<Vector2<f64>>) = by_id
+            .iter()
+            .map(|(id, (sum, n))| (self.tips[*id], sum / *n))
+            .unzip();
+        solve_pnp(&self.camera, &pts, &px, &PnpOptions::default())
+            .unwrap()
+            .t_cam_sensor
+    }
+}
+
 #[test]
 fn pins_found_in_photos_get_the_plans_ids_and_give_the_pose() {
     let s = Scene::new();
@@ -285,18 +338,7 @@ fn pins_found_in_photos_get_the_plans_ids_and_give_the_pose() {
 
     // The pose as good as the pose from the true centroids (the pole pin's averaged over its
     // captures, as the command does), both against the true pose.
-    let mut by_id: BTreeMap<&String, (Vector2<f64>, f64)> = BTreeMap::new();
-    for ((_, id), c) in &true_centres {
-        let e = by_id.entry(id).or_insert((Vector2::zeros(), 0.0));
-        e.0 += Vector2::new(c[0], c[1]);
-        e.1 += 1.0;
-    }
-    let (pts, px): (Vec<Vector3<f64>>, Vec<Vector2<f64>>) = by_id
-        .iter()
-        .map(|(id, (sum, n))| (s.tips[*id], sum / *n))
-        .unzip();
-    let from_true = solve_pnp(&s.camera, &pts, &px, &PnpOptions::default()).unwrap();
-    let (rot_true, t_true) = pose_errors(&from_true.t_cam_sensor);
+    let (rot_true, t_true) = pose_errors(&s.pose_from_true_centres(&true_centres));
     let j = json(&s.path("out/extrinsics.json"));
     let (rot, t) = pose_errors(&pose_of(&j));
     assert!(
@@ -359,30 +401,11 @@ fn ids_from_file_names_and_a_missing_pin_or_an_extra_spot_handled_per_spot() {
         if k == 0 {
             save(&reference, &s.path("reference.png"), Kind::Gray8);
         }
-        let name = ids
-            .iter()
-            .map(|id| format!("{:02}", id.parse::<u32>().unwrap()))
-            .collect::<Vec<_>>()
-            .join("_")
-            + ".png";
+        let name = file_name(ids, "png");
         save(&capture, &s.path(&name), Kind::Gray8);
         names.push(name);
     }
-    let mut args = vec![
-        "calibrate",
-        "extrinsics",
-        "--camera",
-        "cam.yaml",
-        "--points",
-        "fx/points/point_table.csv",
-        "--reference",
-        "reference.png",
-        "--out",
-        "out",
-        "--images",
-    ];
-    args.extend(names.iter().map(String::as_str));
-    let o = run(s.dir.path(), &args, &[]);
+    let o = calibrate_by_file_names(&s, "reference.png", &names);
     let err = text(&o.stderr);
     assert!(o.status.success(), "{}{err}", text(&o.stdout));
     assert!(
@@ -476,33 +499,14 @@ fn the_default_command_on_photos_with_every_artifact_of_a_real_capture_uses_ever
         if k == 0 {
             save(&reference, &s.path("reference.jpg"), Kind::Jpeg);
         }
-        let name = ids
-            .iter()
-            .map(|id| format!("{:02}", id.parse::<u32>().unwrap()))
-            .collect::<Vec<_>>()
-            .join("_")
-            + ".jpg";
+        let name = file_name(ids, "jpg");
         save(&capture, &s.path(&name), Kind::Jpeg);
         for (id, c) in ids.iter().zip(centres) {
             true_centres.insert((name.clone(), id.clone()), c);
         }
         names.push(name);
     }
-    let mut args = vec![
-        "calibrate",
-        "extrinsics",
-        "--camera",
-        "cam.yaml",
-        "--points",
-        "fx/points/point_table.csv",
-        "--reference",
-        "reference.jpg",
-        "--out",
-        "out",
-        "--images",
-    ];
-    args.extend(names.iter().map(String::as_str));
-    let o = run(s.dir.path(), &args, &[]);
+    let o = calibrate_by_file_names(&s, "reference.jpg", &names);
     let (out, err) = (text(&o.stdout), text(&o.stderr));
     assert!(o.status.success(), "{out}{err}");
     assert!(
@@ -549,18 +553,7 @@ fn the_default_command_on_photos_with_every_artifact_of_a_real_capture_uses_ever
     let rms = (sq / true_centres.len() as f64).sqrt();
     assert!(rms < 0.2, "centroid error {rms:.4} px RMS");
     // the pose against the pose from the true centroids (the pole pin's averaged)
-    let mut by_id: BTreeMap<&String, (Vector2<f64>, f64)> = BTreeMap::new();
-    for ((_, id), c) in &true_centres {
-        let e = by_id.entry(id).or_insert((Vector2::zeros(), 0.0));
-        e.0 += Vector2::new(c[0], c[1]);
-        e.1 += 1.0;
-    }
-    let (pts, px): (Vec<Vector3<f64>>, Vec<Vector2<f64>>) = by_id
-        .iter()
-        .map(|(id, (sum, n))| (s.tips[*id], sum / *n))
-        .unzip();
-    let from_true = solve_pnp(&s.camera, &pts, &px, &PnpOptions::default()).unwrap();
-    let (rot_true, t_true) = pose_errors(&from_true.t_cam_sensor);
+    let (rot_true, t_true) = pose_errors(&s.pose_from_true_centres(&true_centres));
     let (rot, t) = pose_errors(&pose_of(&j));
     // (or 0.005 deg and 0.005 mm more, a micron at the pins, when the true centroids' pose
     // is as close as these)
