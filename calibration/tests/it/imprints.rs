@@ -218,32 +218,18 @@ fn ids_follow_the_plan_and_the_pose_is_as_good_as_from_true_centres() {
         );
     }
     // pose from the detected centres against the pose from the true centroids
-    let solve = |px: Vec<Vector2<f64>>, pts: Vec<Vector3<f64>>| {
-        fabkit_calibration::solve_pnp(&cam, &pts, &px, &Default::default())
-            .unwrap()
-            .t_cam_sensor
-    };
     let pts: Vec<Vector3<f64>> = a.observations.iter().map(|o| points[&o.id]).collect();
-    let detected = solve(
-        a.observations
-            .iter()
-            .map(|o| Vector2::new(o.u_px, o.v_px))
-            .collect(),
-        pts.clone(),
-    );
-    let from_truth = solve(
-        a.observations
-            .iter()
-            .map(|o| Vector2::new(truth[&o.id][0], truth[&o.id][1]))
-            .collect(),
-        pts,
-    );
-    let err = |t: &fabkit_calibration::nalgebra::Isometry3<f64>| {
-        let d = pose().inverse() * t;
-        (d.rotation.angle().to_degrees(), d.translation.vector.norm())
-    };
-    let (rd, td) = err(&detected);
-    let (rt, tt) = err(&from_truth);
+    let detected: Vec<Vector2<f64>> = a
+        .observations
+        .iter()
+        .map(|o| Vector2::new(o.u_px, o.v_px))
+        .collect();
+    let true_px: Vec<Vector2<f64>> = a
+        .observations
+        .iter()
+        .map(|o| Vector2::new(truth[&o.id][0], truth[&o.id][1]))
+        .collect();
+    let ((rd, td), (rt, tt)) = pose_errors(&cam, &pts, &detected, &true_px);
     assert!(
         rd <= 1.1 * rt + 1e-3 && td <= 1.1 * tt + 1e-4,
         "detected: {rd:.4} deg, {td:.4} mm; true centroids: {rt:.4} deg, {tt:.4} mm"
