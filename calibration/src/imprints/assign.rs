@@ -245,7 +245,13 @@ pub fn assign_ids(
         o.spots_found = all[k].spots.len();
         if o.left_out.is_none() {
             o.discarded.extend(out);
-        } else if captures[k].spots.is_empty() && !out.is_empty() {
+        } else if captures[k].spots.is_empty()
+            && !out.is_empty()
+            && all[k].planned_ids.iter().all(|id| points.contains_key(id))
+            && all[k].planned_ids.len() <= MAX_PINS_PER_CAPTURE
+        {
+            // left out for having no spot (not for its plan): say that the spots were not
+            // shaped as pins'
             o.left_out = Some(format!(
                 "no spot shaped as a pin's for the {} planned pins {:?} ({})",
                 all[k].planned_ids.len(),

@@ -470,3 +470,35 @@ fn a_ring_of_led_highlights_bounds_the_mask_to_the_disc_inside_it() {
         "masked to {masked:.1} px, a highlight at {lit:.1} px"
     );
 }
+
+/// A capture whose spots are all shaped unlike a pin's is left out for that, naming each;
+/// one that also plans a pin the table lacks is left out for the plan, the first reason.
+#[test]
+fn a_capture_without_a_pin_shaped_spot_is_left_out_saying_why() {
+    use fabkit_calibration::imprints::{assign_ids, CaptureSpots, Spot};
+    use fabkit_calibration::nalgebra::Vector3;
+    use std::collections::BTreeMap;
+    let scratch = Spot {
+        u_px: 300.0,
+        v_px: 200.0,
+        score: 40.0,
+        area_px: 90,
+        roundness: 0.3,
+    };
+    let points: BTreeMap<u32, Vector3<f64>> = [(1, Vector3::new(0.0, 0.0, 13.5))].into();
+    let capture = |ids: Vec<u32>| CaptureSpots {
+        name: "c.png".into(),
+        planned_ids: ids,
+        spots: vec![scratch],
+    };
+    let cam = benchmark_camera();
+    let a = assign_ids(&cam, &points, &[capture(vec![1])]);
+    let why = a.captures[0].left_out.as_deref().unwrap();
+    assert!(
+        why.starts_with("no spot shaped as a pin's") && why.contains("(300.0, 200.0): not round"),
+        "{why}"
+    );
+    let a = assign_ids(&cam, &points, &[capture(vec![1, 7])]);
+    let why = a.captures[0].left_out.as_deref().unwrap();
+    assert_eq!(why, "pin 7 is planned but not in the point table");
+}
