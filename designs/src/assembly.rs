@@ -16,7 +16,7 @@
 use crate::error::{DesignError, GeometryContext, ParamError, ParamErrors};
 use crate::geometry::{cuboid, cylinder, revolve, Affine, ChordTolerance, Solid};
 use crate::housing::ShellLevels;
-use crate::kit::Part;
+use crate::parts::Part;
 pub use crate::parts::{ExactShape, Member, MemberKind};
 use crate::schema::{Design, HousingStyle, LayerProcess};
 use crate::stack::Stack;

@@ -24,8 +24,8 @@
 
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{cuboid, cylinder, ChordTolerance, Solid};
-use crate::kit::{Part, PrintTechnology};
-use crate::molds::{place_posed, with_pose};
+use crate::parts::{Part, PrintTechnology};
+use crate::parts::placement::{place_posed, with_pose};
 use crate::schema::{Design, HousingParams, HousingStyle, RoundTube};
 use crate::stack::{ResolvedCore, Stack};
 use serde_json::json;
@@ -906,7 +906,7 @@ fn build_round_tube(
             "top face down",
         ),
         part(
-            place_posed(&base, &crate::molds::IDENTITY),
+            place_posed(&base, &crate::parts::placement::IDENTITY),
             "shell_base",
             "Sensor base: closes the tube and carries the camera board (4 pilots on its spigot); the camera cable leaves through its slot; 2 joint screws up through its flange into the tube",
             "flange down",

@@ -14,10 +14,12 @@
 
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{cuboid, revolve, sphere, Affine, ChordTolerance, Polyline2, Solid};
-use crate::kit::{Part, PrintTechnology};
+use crate::parts::{Part, PrintTechnology};
 use crate::schema::{Design, LayerProcess, MoldStrategy};
 use crate::stack::{ResolvedCore, Stack};
 use serde_json::json;
+
+pub use crate::parts::placement::{affine_then, place_on_bed, place_posed, with_pose, IDENTITY};
 
 /// Shoulder under the core's open end in the holder, mm.
 const SHOULDER_MM: f64 = 2.0;
@@ -31,71 +33,6 @@ pub(crate) const BOX_FLOOR_MM: f64 = 2.0;
 const BOX_WALL_MM: f64 = 2.0;
 /// How far the box rim stands above the Mold Star fill level, mm.
 pub(crate) const BOX_FREEBOARD_MM: f64 = 2.0;
-
-/// Places a solid for printing: minimum z on the plate (z = 0), bounding box centred on x = y = 0.
-pub fn place_on_bed(s: &Solid) -> Solid {
-    match s.bounding_box() {
-        Some(b) => s.translate([
-            -(b.min[0] + b.max[0]) / 2.0,
-            -(b.min[1] + b.max[1]) / 2.0,
-            -b.min[2],
-        ]),
-        None => s.clone(),
-    }
-}
-
-/// The identity pose (sensor frame = print frame before the bed placement).
-pub const IDENTITY: Affine = [
-    [1.0, 0.0, 0.0, 0.0],
-    [0.0, 1.0, 0.0, 0.0],
-    [0.0, 0.0, 1.0, 0.0],
-];
-
-/// `a` after `b`: the affine map p -> a(b(p)).
-pub fn affine_then(a: &Affine, b: &Affine) -> Affine {
-    let mut m = [[0.0; 4]; 3];
-    for (i, row) in m.iter_mut().enumerate() {
-        for (j, v) in row.iter_mut().enumerate() {
-            *v =
-                (0..3).map(|k| a[i][k] * b[k][j]).sum::<f64>() + if j == 3 { a[i][3] } else { 0.0 };
-        }
-    }
-    m
-}
-
-/// `s` turned by the rigid map `pose` into its print orientation, then placed as
-/// [`place_on_bed`] does; with the whole map `T_print_sensor` (3x4 row-major, sensor frame to
-/// print frame, mm). Parts record it in `params.T_print_sensor` so that an independent twin
-/// (export/python/twins) can rebuild them in the sensor frame and place them the same way.
-pub fn place_posed(s: &Solid, pose: &Affine) -> (Solid, Affine) {
-    let turned = if *pose == IDENTITY {
-        s.clone()
-    } else {
-        s.transform(pose)
-    };
-    let shift = match turned.bounding_box() {
-        Some(b) => [
-            -(b.min[0] + b.max[0]) / 2.0,
-            -(b.min[1] + b.max[1]) / 2.0,
-            -b.min[2],
-        ],
-        None => [0.0; 3],
-    };
-    let t = [
-        [1.0, 0.0, 0.0, shift[0]],
-        [0.0, 1.0, 0.0, shift[1]],
-        [0.0, 0.0, 1.0, shift[2]],
-    ];
-    (turned.translate(shift), affine_then(&t, pose))
-}
-
-/// `params` with `T_print_sensor` (see [`place_posed`]) added.
-pub fn with_pose(mut params: serde_json::Value, t: &Affine) -> serde_json::Value {
-    if let Some(o) = params.as_object_mut() {
-        o.insert("T_print_sensor".into(), json!(t));
-    }
-    params
-}
 
 /// One pour into a mold: which layer, the cavity surface, and the core under it.
 #[derive(Debug, Clone)]

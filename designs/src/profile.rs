@@ -9,7 +9,9 @@
 use crate::geometry::profile2d::{push_arc, push_curve};
 use crate::geometry::{ChordTolerance, Polyline2};
 use serde::{Deserialize, Serialize};
-use std::f64::consts::FRAC_PI_2;
+use crate::error::ParamError;
+use schemars::JsonSchema;
+use std::f64::consts::{FRAC_PI_2, PI};
 
 /// The outer surface of a sensor skin. In YAML: a mapping with `profile:` (the variant name in
 /// snake case) and that variant's fields.
@@ -440,14 +442,14 @@ impl BodyProfile {
     }
 
     /// The outline of a flat body; `None` for the other profiles.
-    pub fn flat_outline(&self) -> Option<crate::flat::FlatOutline> {
+    pub fn flat_outline(&self) -> Option<FlatOutline> {
         match *self {
             Self::Flat {
                 width_mm,
                 length_mm,
                 corner_radius_mm,
                 ..
-            } => Some(crate::flat::FlatOutline {
+            } => Some(FlatOutline {
                 width_mm,
                 length_mm,
                 corner_radius_mm,
@@ -807,4 +809,95 @@ fn point_segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
         0.0
     };
     (p[0] - a[0] - t * ux).hypot(p[1] - a[1] - t * uy)
+}
+
+/// The outline of a flat skin: a rectangle `width_mm` (x) by `length_mm` (y) with corners
+/// rounded to `corner_radius_mm`, centred on the z axis.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct FlatOutline {
+    /// Across x, mm, > 0.
+    pub width_mm: f64,
+    /// Along y (the channels' direction), mm, > 0.
+    pub length_mm: f64,
+    /// Corner radius, mm, in [0, half the shorter side).
+    #[serde(default)]
+    pub corner_radius_mm: f64,
+}
+
+impl FlatOutline {
+    /// Exact area, mm^2: w l - (4 - pi) r^2.
+    pub fn area_mm2(&self) -> f64 {
+        let r = self.corner_radius_mm;
+        self.width_mm * self.length_mm - (4.0 - PI) * r * r
+    }
+
+    /// The outline as a convex counter-clockwise polygon, its corner arcs inscribed within
+    /// `tol` (vertices on the arcs).
+    pub fn polygon(&self, tol: ChordTolerance) -> Vec<[f64; 2]> {
+        let (hw, hl, r) = (
+            self.width_mm / 2.0,
+            self.length_mm / 2.0,
+            self.corner_radius_mm,
+        );
+        if r <= 0.0 {
+            return vec![[-hw, -hl], [hw, -hl], [hw, hl], [-hw, hl]];
+        }
+        let per_quarter = tol.circle_segments(r).div_ceil(4).max(1);
+        let mut pts = Vec::with_capacity(4 * (per_quarter + 1));
+        // corner centres counter-clockwise from the (+x, -y) corner, each arc's start angle
+        for (k, (cx, cy)) in [
+            (hw - r, -hl + r),
+            (hw - r, hl - r),
+            (-hw + r, hl - r),
+            (-hw + r, -hl + r),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let a0 = -FRAC_PI_2 + k as f64 * FRAC_PI_2;
+            for i in 0..=per_quarter {
+                let a = a0 + FRAC_PI_2 * i as f64 / per_quarter as f64;
+                let p = [cx + r * a.cos(), cy + r * a.sin()];
+                if pts.last() != Some(&p) {
+                    pts.push(p);
+                }
+            }
+        }
+        pts
+    }
+
+    /// Distance from `(x, y)` inside the outline to its edge, mm (negative outside).
+    pub fn inset_mm(&self, [x, y]: [f64; 2]) -> f64 {
+        let (hw, hl, r) = (
+            self.width_mm / 2.0,
+            self.length_mm / 2.0,
+            self.corner_radius_mm,
+        );
+        let (dx, dy) = (x.abs() - (hw - r), y.abs() - (hl - r));
+        if dx > 0.0 && dy > 0.0 {
+            r - dx.hypot(dy)
+        } else {
+            (hw - x.abs()).min(hl - y.abs())
+        }
+    }
+
+    /// Every violation under `prefix` (`body.`).
+    pub fn errors(&self, prefix: &str) -> Vec<ParamError> {
+        let mut errs = Vec::new();
+        crate::parts::check_positive(
+            prefix,
+            &[("width_mm", self.width_mm), ("length_mm", self.length_mm)],
+            &mut errs,
+        );
+        let half = self.width_mm.min(self.length_mm) / 2.0;
+        if !(self.corner_radius_mm >= 0.0 && self.corner_radius_mm < half) && errs.is_empty() {
+            errs.push(ParamError::new(
+                format!("{prefix}corner_radius_mm"),
+                self.corner_radius_mm,
+                format!("must be 0 or more and below half the shorter side ({half} mm)"),
+            ));
+        }
+        errs
+    }
 }

@@ -237,9 +237,9 @@ pub enum Technology {
     Polyjet,
 }
 
-impl From<crate::kit::PrintTechnology> for Technology {
-    fn from(t: crate::kit::PrintTechnology) -> Self {
-        use crate::kit::PrintTechnology as P;
+impl From<crate::parts::PrintTechnology> for Technology {
+    fn from(t: crate::parts::PrintTechnology) -> Self {
+        use crate::parts::PrintTechnology as P;
         match t {
             P::Fdm => Self::Fdm,
             P::Sla => Self::Sla,
@@ -248,7 +248,7 @@ impl From<crate::kit::PrintTechnology> for Technology {
     }
 }
 
-impl From<Technology> for crate::kit::PrintTechnology {
+impl From<Technology> for crate::parts::PrintTechnology {
     fn from(t: Technology) -> Self {
         match t {
             Technology::Fdm => Self::Fdm,

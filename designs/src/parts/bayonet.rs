@@ -26,6 +26,30 @@ use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
+/// The bayonet's lugs (on the tip's skirt) and grooves (round the shaft's top); the lug
+/// count, ramp and clearance come from `printers.fdm.bayonet`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct BayonetLugs {
+    /// Lug width along the shaft's circumference, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    pub lug_width_mm: f64,
+    /// Lug height, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    pub lug_height_mm: f64,
+    /// How far a lug reaches into the shaft, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    pub lug_depth_mm: f64,
+    /// Turn from entry to locked, degrees, in (0, 90).
+    #[schemars(extend("exclusiveMinimum" = 0, "exclusiveMaximum" = 90))]
+    pub lock_angle_deg: f64,
+    /// Groove width along the circumference, mm; the lug's width plus the clearance on each
+    /// side when not given.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    pub groove_width_mm: Option<f64>,
+}
+
 /// A printer's bayonet settings (`printers.<technology>.bayonet`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields, default)]
@@ -87,7 +111,7 @@ impl Bayonet {
     /// The sizes of a joint from its lugs and the printer's profile (the groove's width
     /// defaults to the lug's plus the clearance on each side); the placement (radius, turn,
     /// levels) left at zero, for the caller to set.
-    pub fn sized(p: &BayonetProfile, b: &crate::parts::shaft_body::BayonetLugs) -> Self {
+    pub fn sized(p: &BayonetProfile, b: &BayonetLugs) -> Self {
         Self {
             spigot_radius_mm: 0.0,
             outward: false,

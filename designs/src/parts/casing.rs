@@ -28,7 +28,7 @@ use super::{ExactShape, Member, MemberKind};
 use super::{Part, PrintTechnology};
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{cuboid, ChordTolerance, GeometryError, Solid};
-use crate::molds::{place_posed, with_pose};
+use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::shaft_body::{half_nozzle, OVERLAP_MM};
 use crate::parts::z_cylinder;
 use crate::schema::Design;
@@ -679,7 +679,7 @@ pub fn build_casing(
         ))?);
     }
     let casing = g(block.difference(&g(Solid::union_all(&cuts))?))?;
-    let (placed, pose) = place_posed(&casing, &crate::molds::IDENTITY);
+    let (placed, pose) = place_posed(&casing, &crate::parts::placement::IDENTITY);
     Ok(Part {
         name: "casing".into(),
         role: "casing".into(),
@@ -758,7 +758,7 @@ pub fn build_base(
         ))?);
     }
     let base = g(plate.difference(&g(Solid::union_all(&cuts))?))?;
-    let (placed, pose) = place_posed(&base, &crate::molds::IDENTITY);
+    let (placed, pose) = place_posed(&base, &crate::parts::placement::IDENTITY);
     Ok(Part {
         name: "gripper_base".into(),
         role: "gripper_base".into(),

@@ -25,7 +25,7 @@ use super::{ExactShape, Member, MemberKind};
 use super::{Part, PrintTechnology};
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{ChordTolerance, GeometryError, Solid};
-use crate::molds::{place_posed, with_pose};
+use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::shaft_body::OVERLAP_MM;
 use crate::parts::z_cylinder;
 use crate::schema::Design;
@@ -522,7 +522,7 @@ pub fn build_parts(
     let b = &f.bolts;
     let bolts = bolt_xy(f, r.bolt_circle_mm);
     let part = |name: &str, material: &str, solid: Solid, description: String| {
-        let (placed, pose) = place_posed(&solid, &crate::molds::IDENTITY);
+        let (placed, pose) = place_posed(&solid, &crate::parts::placement::IDENTITY);
         Part {
             name: name.into(),
             role: name.into(),

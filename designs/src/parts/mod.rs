@@ -8,6 +8,7 @@ pub mod fasteners;
 pub mod fingertip_base;
 mod member;
 mod part;
+pub mod placement;
 pub mod robot_mount;
 pub mod shaft_body;
 

@@ -16,7 +16,7 @@
 use super::{Part, PrintTechnology};
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{cylinder, ChordTolerance, GeometryError, Solid};
-use crate::molds::{place_posed, with_pose};
+use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::bayonet::{band, Bayonet};
 use crate::parts::shaft_body::{levels, BayonetLugs, ShaftBodyParams, CABLE_SLOT_MM, OVERLAP_MM};
 use crate::schema::Design;
@@ -361,7 +361,7 @@ pub fn build_mount(
         pin_xy(m),
     ))?);
     let mount = g(g(plate.union(&cup))?.difference(&g(Solid::union_all(&cuts))?))?;
-    let (placed, pose) = place_posed(&mount, &crate::molds::IDENTITY);
+    let (placed, pose) = place_posed(&mount, &crate::parts::placement::IDENTITY);
     Ok(Part {
         name: "robot_mount".into(),
         role: "robot_mount".into(),

@@ -28,8 +28,9 @@ use super::{Part, PrintTechnology};
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::Polyline2;
 use crate::geometry::{cuboid, cylinder, revolve, ChordTolerance, GeometryError, Solid};
-use crate::molds::{place_posed, with_pose};
+use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::bayonet::Bayonet;
+pub use crate::parts::bayonet::BayonetLugs;
 use crate::schema::{Design, FillingGel, LayerProcess};
 use crate::stack::Stack;
 use schemars::JsonSchema;
@@ -85,30 +86,6 @@ pub struct TipFitting {
     /// Thickness of the lip, mm.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub lip_thickness_mm: f64,
-}
-
-/// The bayonet's lugs (on the tip's skirt) and grooves (round the shaft's top); the lug
-/// count, ramp and clearance come from `printers.fdm.bayonet`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct BayonetLugs {
-    /// Lug width along the shaft's circumference, mm.
-    #[schemars(extend("exclusiveMinimum" = 0))]
-    pub lug_width_mm: f64,
-    /// Lug height, mm.
-    #[schemars(extend("exclusiveMinimum" = 0))]
-    pub lug_height_mm: f64,
-    /// How far a lug reaches into the shaft, mm.
-    #[schemars(extend("exclusiveMinimum" = 0))]
-    pub lug_depth_mm: f64,
-    /// Turn from entry to locked, degrees, in (0, 90).
-    #[schemars(extend("exclusiveMinimum" = 0, "exclusiveMaximum" = 90))]
-    pub lock_angle_deg: f64,
-    /// Groove width along the circumference, mm; the lug's width plus the clearance on each
-    /// side when not given.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schemars(extend("exclusiveMinimum" = 0))]
-    pub groove_width_mm: Option<f64>,
 }
 
 /// The acrylic lens window (Sec. III-A: "an inserted acrylic lens"), laser-cut.
@@ -783,7 +760,7 @@ pub fn build_body(
         None => outer,
     };
     let body = g(outer.difference(&g(Solid::union_all(&cuts))?))?;
-    let (placed, pose) = place_posed(&body, &crate::molds::IDENTITY);
+    let (placed, pose) = place_posed(&body, &crate::parts::placement::IDENTITY);
     let fdm_tech = PrintTechnology::Fdm;
     Ok(Part {
         name: "shaft_body".into(),
