@@ -24,8 +24,8 @@
 
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{cuboid, cylinder, ChordTolerance, Solid};
-use crate::parts::{Part, PrintTechnology};
 use crate::parts::placement::{place_posed, with_pose};
+use crate::parts::{Part, PrintTechnology};
 use crate::schema::{Design, HousingParams, HousingStyle, RoundTube};
 use crate::stack::{ResolvedCore, Stack};
 use serde_json::json;

@@ -6,11 +6,11 @@
 //! skin; the origin is the centre of curvature of the tip (sphere centre, or ellipsoid centre);
 //! the skin ends on the base plane z = `base_z_mm()`.
 
+use crate::error::ParamError;
 use crate::geometry::profile2d::{push_arc, push_curve};
 use crate::geometry::{ChordTolerance, Polyline2};
-use serde::{Deserialize, Serialize};
-use crate::error::ParamError;
 use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
 use std::f64::consts::{FRAC_PI_2, PI};
 
 /// The outer surface of a sensor skin. In YAML: a mapping with `profile:` (the variant name in

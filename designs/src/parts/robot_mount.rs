@@ -16,8 +16,8 @@
 use super::{Part, PrintTechnology};
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{cylinder, ChordTolerance, GeometryError, Solid};
-use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::bayonet::{band, Bayonet};
+use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::shaft_body::{levels, BayonetLugs, ShaftBodyParams, CABLE_SLOT_MM, OVERLAP_MM};
 use crate::schema::Design;
 use schemars::JsonSchema;
