@@ -737,7 +737,7 @@ pub fn build_kit(
 ) -> Result<crate::Kit, crate::DesignError> {
     use crate::assembly::{Member, MemberKind};
     use crate::error::GeometryContext as _;
-    use crate::kit::{Part, ProcedureAction, ProcedureStep};
+    use crate::parts::{Part, ProcedureAction, ProcedureStep};
     use crate::DesignError;
     let layers = validate(design, materials).map_err(DesignError::Params)?;
     let Some(outline) = design.body.flat_outline() else {

@@ -33,6 +33,7 @@ pub mod schema;
 pub mod stack;
 pub mod sweep;
 pub mod values;
+pub mod yaml;
 
 pub use build::{build_kit, build_kit_bounded, validate_design};
 pub use error::{DesignError, ParamError, ParamErrors};

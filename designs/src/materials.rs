@@ -1,6 +1,5 @@
 //! The materials table (`designs/materials.yaml`) and the pour calculator.
 
-use crate::kit::{CastComponent, CastReport};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
@@ -87,8 +86,8 @@ impl MaterialsTable {
     /// The YAML error at `origin:line:column`, or the first rule broken, naming its path
     /// (`materials.<key>.mix.evaporates[0]`), value and rule.
     pub fn from_yaml(text: &str, origin: &str) -> Result<Self, String> {
-        let t: Self = crate::schema::yaml_from_str(text)
-            .map_err(|e| crate::schema::yaml_error(origin, &e))?;
+        let t: Self =
+            crate::yaml::yaml_from_str(text).map_err(|e| crate::yaml::yaml_error(origin, &e))?;
         t.check().map_err(|e| format!("{origin}: {e}"))?;
         Ok(t)
     }
@@ -200,16 +199,16 @@ pub fn pour(
 }
 
 /// The smallest weighable batch of a mix whose smallest component is below
-/// [`crate::kit::MIN_WEIGHABLE_G`] ([`crate::kit::MinBatch`]); `None` otherwise.
-fn min_batch(components: &[CastComponent], total_g: f64) -> Option<crate::kit::MinBatch> {
+/// [`MIN_WEIGHABLE_G`] ([`MinBatch`]); `None` otherwise.
+fn min_batch(components: &[CastComponent], total_g: f64) -> Option<MinBatch> {
     let smallest = components
         .iter()
         .map(|c| c.mass_g)
         .fold(f64::INFINITY, f64::min);
-    if !(smallest > 0.0 && smallest < crate::kit::MIN_WEIGHABLE_G) {
+    if !(smallest > 0.0 && smallest < MIN_WEIGHABLE_G) {
         return None;
     }
-    let k = crate::kit::MIN_WEIGHABLE_G / smallest;
+    let k = MIN_WEIGHABLE_G / smallest;
     let scaled: Vec<CastComponent> = components
         .iter()
         .map(|c| CastComponent {
@@ -219,7 +218,7 @@ fn min_batch(components: &[CastComponent], total_g: f64) -> Option<crate::kit::M
         })
         .collect();
     let total = total_g * k;
-    Some(crate::kit::MinBatch {
+    Some(MinBatch {
         components: scaled,
         total_mass_g: total,
         leftover_g: total - total_g,
@@ -229,7 +228,7 @@ fn min_batch(components: &[CastComponent], total_g: f64) -> Option<crate::kit::M
 /// The mix for a sprayed or brushed coat of `coat_volume_mm3` (the layer's own volume) of
 /// `material`: the components that stay in the coat make up its mass (volume x density), the
 /// evaporating ones ([`Mix::evaporates`]) are added in the mix ratio; no spray loss is
-/// included. With the smallest batch weighable by hand ([`crate::kit::MinBatch`]).
+/// included. With the smallest batch weighable by hand ([`MinBatch`]).
 ///
 /// # Errors
 /// When the material has no mix.
@@ -239,7 +238,7 @@ pub fn coat(
     material: &Material,
     thickness_mm: f64,
     coat_volume_mm3: f64,
-) -> Result<crate::kit::CoatReport, String> {
+) -> Result<CoatReport, String> {
     let mix = material
         .mix
         .as_ref()
@@ -256,7 +255,7 @@ pub fn coat(
     let total = coat_g * sum / staying;
     let components = split(mix, total, None);
 
-    Ok(crate::kit::CoatReport {
+    Ok(CoatReport {
         layer: layer.to_string(),
         material: material_key.to_string(),
         material_name: material.name.clone(),
@@ -298,4 +297,115 @@ fn ratio_text(mix: &Mix) -> String {
         MixBasis::Volume => "volume",
     };
     format!("{ratio} by {by}")
+}
+
+/// Casting numbers for one pour.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CastReport {
+    /// Order in which the pours are made, from 1.
+    pub step: u32,
+    /// What is cast: a layer name (`transparent_gel`) or `silicone_mold:<layer>` for a
+    /// Mold Star mold made from a master pattern.
+    pub cast: String,
+    /// Material key in the materials table.
+    pub material: String,
+    /// The material's product name (the table's `name`), for the fabrication sheet.
+    pub material_name: String,
+    /// Names of the parts that hold this pour.
+    pub mold_parts: Vec<String>,
+    /// Volume to fill, mL (= cm^3): the cavity with its reservoir and sprue (the pour).
+    pub cavity_volume_ml: f64,
+    /// Volume of the cast layer itself, mL: the solid between its inner and outer surfaces
+    /// down to the base plane, from the exact profile (marker features not counted); `None`
+    /// for a silicone mold.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub layer_volume_ml: Option<f64>,
+    /// Fraction added for losses in cups, sprue and vents (0.2 = 20 %).
+    pub waste_allowance: f64,
+    /// Mix ratio as written on the datasheet, e.g. `10:1 by weight`.
+    pub mix_ratio: String,
+    /// Mass of each component to weigh out, g, in datasheet order (Part A, Part B, ...).
+    pub components: Vec<CastComponent>,
+    /// Total mass to mix, g.
+    pub total_mass_g: f64,
+    /// Pot life, cure time and handling notes from the materials table.
+    pub notes: String,
+    /// The smallest batch that can be weighed by hand when a component of `components` is
+    /// below [`MIN_WEIGHABLE_G`]: every component scaled up until the smallest is that much;
+    /// `None` when the pour's own amounts can be weighed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_batch: Option<MinBatch>,
+    /// Coats sprayed into the mold before this pour (R-Tac0's black coating), in order.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub coats: Vec<CoatReport>,
+    /// Primer and release agent applied before this pour, in order (the core primed before
+    /// the first layer cast on it, the mold's surfaces released).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub treatments: Vec<TreatmentReport>,
+}
+
+/// A primer or release agent applied to a surface before a pour, with its amount.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TreatmentReport {
+    /// Material key in the materials table (kind `primer` or `release`), and its product name.
+    pub material: String,
+    pub material_name: String,
+    /// `primer` or `release`.
+    pub kind: MaterialKind,
+    /// What is treated, e.g. `the core's outer surface`, `the cavity of transparent_gel`.
+    pub surface: String,
+    /// Area treated, cm^2 (the exact profile's surface, features not counted).
+    pub area_cm2: f64,
+    /// Amount used, mL: `area_cm2` x the material's `applied_ml_per_cm2`.
+    pub amount_ml: f64,
+}
+
+/// A layer sprayed or brushed into a mold before a pour: its mix and amount.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CoatReport {
+    /// The sprayed layer's name.
+    pub layer: String,
+    /// Material key in the materials table, and its product name.
+    pub material: String,
+    pub material_name: String,
+    pub thickness_mm: f64,
+    /// Volume of the coat itself, mL (the layer's own volume from the exact profile).
+    pub coat_volume_ml: f64,
+    /// Mix ratio as on the datasheet or in the paper, e.g. `100:3:500 by weight`.
+    pub mix_ratio: String,
+    /// Components that evaporate (a thinner).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub evaporates: Vec<String>,
+    /// The mix that leaves the coat's mass once the thinner is gone, g, per component (no
+    /// spray loss included).
+    pub components: Vec<CastComponent>,
+    pub total_mass_g: f64,
+    /// The smallest batch weighable by hand, when a component is below [`MIN_WEIGHABLE_G`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_batch: Option<MinBatch>,
+}
+
+/// Least mass of one component that a kitchen scale weighs to about 10 % (0.1 g resolution), g.
+pub const MIN_WEIGHABLE_G: f64 = 1.0;
+
+/// A batch larger than the pour needs, so that every component can be weighed.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MinBatch {
+    /// Each component, in datasheet order; the smallest is [`MIN_WEIGHABLE_G`].
+    pub components: Vec<CastComponent>,
+    /// Total mass to mix, g.
+    pub total_mass_g: f64,
+    /// What is left over after the pour (waste allowance included), g.
+    pub leftover_g: f64,
+}
+
+/// One component of a mix.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CastComponent {
+    pub name: String,
+    pub mass_g: f64,
+    /// Volume to measure out, mL, for a mix by volume (Mold Star 30 is mixed 1A:1B by volume);
+    /// `None` for a mix by weight.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub volume_ml: Option<f64>,
 }

@@ -7,9 +7,10 @@
 //! clear silicone sealant); ShadowTac Sec. III (release sprayed, poured, degassed, cured 24 h,
 //! glued to the PMMA plate).
 
-use crate::kit::{CastReport, Part, ProcedureAction, ProcedureStep};
+use crate::materials::CastReport;
 use crate::materials::MaterialKind;
 use crate::parts::fasteners::bolt_name;
+use crate::parts::{Part, ProcedureAction, ProcedureStep};
 use crate::schema::Design;
 
 /// The clamp bolts of one mold: `count` bolts of `name` (e.g. `M3 x 60`) through `grip_mm`.

@@ -13,7 +13,7 @@ pub mod robot_mount;
 pub mod shaft_body;
 
 pub use member::{ExactShape, Member, MemberKind};
-pub use part::{Part, PrintTechnology};
+pub use part::{Part, PrintTechnology, ProcedureAction, ProcedureStep};
 
 use crate::error::ParamError;
 use crate::geometry::{cylinder, ChordTolerance, GeometryError, Solid};

@@ -62,3 +62,45 @@ impl Part {
         self.solid.mesh().rounded_to_f32()
     }
 }
+
+/// What a step of the procedure does; the steps of a kit come in a fixed order per pour.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ProcedureAction {
+    /// Print and check the parts.
+    Print,
+    /// Seat a master pattern in its mold box (or a negative mold level) for a Mold Star pour.
+    SeatMaster,
+    /// Pour Mold Star 30 around a master, up to the fill height.
+    FillMoldStar,
+    /// Take a cured silicone mold off its master or out of its negative.
+    DemoldSiliconeMold,
+    /// Wipe primer onto the core.
+    PrimeCore,
+    /// Mount the core on its holder or jig.
+    MountCore,
+    /// Move the core with the layers cast so far to the next layer's mold.
+    MoveCore,
+    /// Spray release agent into the mold.
+    SprayRelease,
+    /// Spray a coat into the mold before the pour.
+    SprayCoat,
+    /// Close the mold: halves or pieces together, clamp bolts in.
+    CloseMold,
+    /// Mix, degas and pour, mold pole-down, through the sprue.
+    Pour,
+    /// Cure and take the cast layer out of the mold.
+    Demold,
+    /// Brush a coat onto the demolded layer.
+    BrushCoat,
+    /// Assemble the sensor.
+    Assemble,
+}
+
+/// One step of the fabrication procedure.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ProcedureStep {
+    pub action: ProcedureAction,
+    /// The instruction, with the parts by name and the numbers it needs.
+    pub text: String,
+}

@@ -1,0 +1,256 @@
+//! The YAML reading rules of every fabkit input file, and where a value sits in its text
+//! (`file:line:column` for errors).
+
+use crate::error::DesignError;
+use serde::Deserialize;
+
+/// The YAML reading rules of every fabkit input file (designs, sweeps, fixture parameters): a
+/// scalar is taken as what it is written as, never converted. A number or a boolean where text
+/// is expected (`name: 25`, `description: true`) is refused (quote it); so are YAML 1.1
+/// booleans (`yes`, `on`) and tags fabkit does not know (`!!python/object/apply:...`).
+pub fn yaml_options() -> serde_saphyr::Options {
+    let mut o = serde_saphyr::Options::default();
+    o.no_schema = true;
+    o.strict_booleans = true;
+    o.reject_unsupported_tags = true;
+    o
+}
+
+/// Parses YAML `text` into `T` under [`yaml_options`].
+///
+/// # Errors
+/// The parser's error (with its location; see [`yaml_error`]).
+pub fn yaml_from_str<T: serde::de::DeserializeOwned>(text: &str) -> Result<T, serde_saphyr::Error> {
+    serde_saphyr::from_str_with_options(text, yaml_options())
+}
+
+/// Refuses a number written quoted in `text` (`radius_mm: "15.0"`), which the parser would
+/// convert ([`crate::values::quoted_numbers`]).
+///
+/// # Errors
+/// [`DesignError::Yaml`] naming every such value at its `origin:line:column`
+/// ([`yaml_location`]), with its parameter path and text.
+pub fn refuse_quoted_numbers<T: serde::Serialize + ?Sized>(
+    typed: &T,
+    text: &str,
+    origin: &str,
+) -> Result<(), DesignError> {
+    let quoted = crate::values::quoted_numbers(typed, text);
+    if quoted.is_empty() {
+        return Ok(());
+    }
+    Err(DesignError::Yaml(
+        quoted
+            .iter()
+            .map(|(path, s)| {
+                let at = yaml_location(text, path)
+                    .map(|(l, c)| format!(":{l}:{c}"))
+                    .unwrap_or_default();
+                format!("{origin}{at}: {path} = \"{s}\": a number must be written without quotes")
+            })
+            .collect::<Vec<_>>()
+            .join("\n"),
+    ))
+}
+
+/// Line and column (from 1) where the YAML node at parameter path `path` (`a.b[2].c`: `.`
+/// between keys, `[i]` for list items) starts in `text`; `None` when the text does not parse
+/// or has no such node.
+pub fn yaml_location(text: &str, path: &str) -> Option<(u64, u64)> {
+    let root: serde_saphyr::Spanned<Node> = serde_saphyr::from_str(text).ok()?;
+    let mut cur = &root;
+    for step in path_steps(path)? {
+        cur = match (&cur.value, step) {
+            (Node::Map(entries), Step::Key(k)) => &entries.iter().find(|(name, _)| *name == k)?.1,
+            (Node::Seq(items), Step::Index(i)) => items.get(i)?,
+            _ => return None,
+        };
+    }
+    Some((cur.referenced.line(), cur.referenced.column()))
+}
+
+/// The plain scalar that starts at `line`, `column` (from 1) of `text`, as written: up to the
+/// end of the line or a comment; `None` for a quoted, flow or block value.
+pub(crate) fn written_scalar(text: &str, line: u64, column: u64) -> Option<String> {
+    let l = text
+        .lines()
+        .nth(usize::try_from(line).ok()?.checked_sub(1)?)?;
+    let rest = l.get(usize::try_from(column).ok()?.checked_sub(1)?..)?;
+    let scalar = rest.split(" #").next()?.trim_end();
+    let plain = !scalar.is_empty()
+        && !scalar.starts_with(['"', '\'', '[', '{', '|', '>', '&', '*', '!'])
+        && !scalar.contains(": ");
+    plain.then(|| scalar.to_string())
+}
+
+/// Line and column (from 1) in `text` of the value that preset `preset` gives parameter `path`
+/// (a key of `presets.<preset>`, dots and brackets included).
+pub(crate) fn preset_value_location(text: &str, preset: &str, path: &str) -> Option<(u64, u64)> {
+    let root: serde_saphyr::Spanned<Node> = serde_saphyr::from_str(text).ok()?;
+    let mut cur = &root;
+    for key in ["presets", preset, path] {
+        let Node::Map(entries) = &cur.value else {
+            return None;
+        };
+        cur = &entries.iter().find(|(name, _)| name == key)?.1;
+    }
+    Some((cur.referenced.line(), cur.referenced.column()))
+}
+
+/// The parameter path (`core.wall_thickness_mm`, `layers[1].name`) of the scalar value that
+/// starts at `line`, `column` (from 1) of `text`; `None` when the text does not parse or no
+/// scalar value starts there (a key, a mapping, a list).
+pub fn yaml_scalar_path_at(text: &str, line: u64, column: u64) -> Option<String> {
+    fn find(n: &serde_saphyr::Spanned<Node>, at: (u64, u64), path: &mut String) -> bool {
+        match &n.value {
+            Node::Scalar => (n.referenced.line(), n.referenced.column()) == at,
+            Node::Map(entries) => entries.iter().any(|(k, v)| {
+                let len = path.len();
+                if !path.is_empty() {
+                    path.push('.');
+                }
+                path.push_str(k);
+                let hit = find(v, at, path);
+                if !hit {
+                    path.truncate(len);
+                }
+                hit
+            }),
+            Node::Seq(items) => items.iter().enumerate().any(|(i, v)| {
+                let len = path.len();
+                path.push_str(&format!("[{i}]"));
+                let hit = find(v, at, path);
+                if !hit {
+                    path.truncate(len);
+                }
+                hit
+            }),
+        }
+    }
+    let root: serde_saphyr::Spanned<Node> = serde_saphyr::from_str(text).ok()?;
+    let mut path = String::new();
+    (find(&root, (line, column), &mut path) && !path.is_empty()).then_some(path)
+}
+
+enum Step<'a> {
+    Key(&'a str),
+    Index(usize),
+}
+
+/// `a.b[2].c` as keys and indices; `None` for a malformed path.
+fn path_steps(path: &str) -> Option<Vec<Step<'_>>> {
+    let mut out = Vec::new();
+    for part in path.split('.') {
+        let (key, mut rest) = part.split_once('[').map_or((part, ""), |(k, r)| (k, r));
+        if key.is_empty() && out.is_empty() {
+            return None;
+        }
+        if !key.is_empty() {
+            out.push(Step::Key(key));
+        }
+        while !rest.is_empty() {
+            let (i, r) = rest.split_once(']')?;
+            out.push(Step::Index(i.parse().ok()?));
+            rest = r.strip_prefix('[').unwrap_or(r);
+            if !r.is_empty() && !r.starts_with('[') {
+                return None;
+            }
+        }
+    }
+    Some(out)
+}
+
+/// A YAML document with the location of every node: maps keep their keys in order.
+enum Node {
+    Map(Vec<(String, serde_saphyr::Spanned<Node>)>),
+    Seq(Vec<serde_saphyr::Spanned<Node>>),
+    Scalar,
+}
+
+impl<'de> Deserialize<'de> for Node {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        macro_rules! scalar {
+            ($($f:ident: $t:ty),*) => {
+                $(fn $f<E: serde::de::Error>(self, _: $t) -> Result<Node, E> { Ok(Node::Scalar) })*
+            };
+        }
+        impl<'de> serde::de::Visitor<'de> for V {
+            type Value = Node;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("any YAML node")
+            }
+            scalar!(visit_bool: bool, visit_i64: i64, visit_u64: u64, visit_i128: i128,
+                visit_u128: u128, visit_f64: f64, visit_str: &str, visit_bytes: &[u8]);
+            fn visit_unit<E: serde::de::Error>(self) -> Result<Node, E> {
+                Ok(Node::Scalar)
+            }
+            fn visit_none<E: serde::de::Error>(self) -> Result<Node, E> {
+                Ok(Node::Scalar)
+            }
+            fn visit_some<D: serde::Deserializer<'de>>(self, d: D) -> Result<Node, D::Error> {
+                Node::deserialize(d)
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut a: A) -> Result<Node, A::Error> {
+                let mut items = Vec::new();
+                while let Some(x) = a.next_element()? {
+                    items.push(x);
+                }
+                Ok(Node::Seq(items))
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(self, mut m: A) -> Result<Node, A::Error> {
+                let mut entries = Vec::new();
+                while let Some(k) = m.next_key::<serde_json::Value>()? {
+                    let key = match k {
+                        serde_json::Value::String(s) => s,
+                        other => other.to_string(),
+                    };
+                    entries.push((key, m.next_value()?));
+                }
+                Ok(Node::Map(entries))
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+/// [`yaml_error`] followed by ` (at <parameter path>)` when the error points at a scalar of
+/// `text` (the parsed YAML).
+pub fn yaml_error_in(origin: &str, text: &str, e: &serde_saphyr::Error) -> String {
+    let mut msg = yaml_error(origin, e);
+    let path = e
+        .location()
+        .and_then(|loc| yaml_scalar_path_at(text, loc.line(), loc.column()));
+    if let Some(path) = path {
+        msg.push_str(&format!(" (at {path})"));
+    }
+    msg
+}
+
+/// Formats a serde-saphyr error as `file:line:column: message`.
+pub fn yaml_error(origin: &str, e: &serde_saphyr::Error) -> String {
+    let msg = e.to_string();
+    let first = msg.lines().next().unwrap_or(&msg);
+    match e.location() {
+        Some(loc) => format!(
+            "{origin}:{}:{}: {}",
+            loc.line(),
+            loc.column(),
+            strip_location(first)
+        ),
+        None => format!("{origin}: {first}"),
+    }
+}
+
+/// Drops serde-saphyr's own `error: line N column M: ` prefix (we print file:line:col).
+fn strip_location(s: &str) -> &str {
+    let s = s.strip_prefix("error: ").unwrap_or(s);
+    if s.starts_with("line ") {
+        if let Some(i) = s.find(": ") {
+            if s[..i].contains("column") {
+                return &s[i + 2..];
+            }
+        }
+    }
+    s
+}
