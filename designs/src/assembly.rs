@@ -166,7 +166,7 @@ pub fn members(
     }
     let g = |name: &str, r: Result<Solid, crate::geometry::GeometryError>| r.part(name);
     if let (Some(c), Some(spec)) = (&stack.core, &design.core) {
-        let pl = crate::parts::core_shell::profile(design, c, spec, tol);
+        let pl = crate::parts::core_shell::profile(&design.context(), c, spec, tol);
         let solid = g(
             "core_envelope",
             revolve(&pl, tol).and_then(|m| Solid::from_mesh(&m)),

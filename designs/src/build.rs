@@ -121,11 +121,17 @@ pub fn build_kit_bounded(
                             design.shaft_body.as_ref().map(
                                 |sb| -> Result<Vec<crate::Part>, DesignError> {
                                     let mut out = vec![crate::parts::shaft_body::build_body(
-                                        design, sb, &stack, tol,
+                                        &design.context(),
+                                        sb,
+                                        &stack,
+                                        tol,
                                     )?];
                                     if let Some(m) = &sb.robot_mount {
                                         out.push(crate::parts::robot_mount::build_mount(
-                                            design, sb, m, tol,
+                                            &design.context(),
+                                            sb,
+                                            m,
+                                            tol,
                                         )?);
                                     }
                                     Ok(out)
@@ -138,7 +144,10 @@ pub fn build_kit_bounded(
                                 || {
                                     design.fingertip_base.as_ref().map(|f| {
                                         crate::parts::fingertip_base::build_parts(
-                                            design, f, &stack, tol,
+                                            &design.context(),
+                                            f,
+                                            &stack,
+                                            tol,
                                         )
                                     })
                                 },
@@ -207,14 +216,14 @@ pub fn build_kit_bounded(
 
     if let (Some(sb), Some(body)) = (&design.shaft_body, shaft_body) {
         parts.extend(body?);
-        let lv = crate::parts::shaft_body::levels(design, sb);
+        let lv = crate::parts::shaft_body::levels(&design.context(), sb);
         let r = design.body.rim_radius_mm(0.0);
         let w = sb.base.outer_diameter_mm.max(2.0 * r);
         summary["shaft_levels"] = json!(&lv);
         summary["envelope_mm"] = json!([w, w, lv.envelope_height_mm]);
         summary["camera_view"] = json!({
             "tip_inner_surface_fraction_seen":
-                crate::parts::shaft_body::view_fraction(design, sb, &stack, tol),
+                crate::parts::shaft_body::view_fraction(&design.context(), sb, &stack, tol),
             "lens_z_mm": lv.lens_z_mm,
             "view_angle_deg": sb.camera.view_angle_deg,
             "focal_length_mm": sb.camera.focal_length_mm,
@@ -228,7 +237,7 @@ pub fn build_kit_bounded(
 
     if let (Some(c), Some(parts_c)) = (&design.casing, casing) {
         parts.extend(parts_c?);
-        let lv = crate::parts::casing::levels(design, c);
+        let lv = crate::parts::casing::levels(&design.context(), c);
         let w = c
             .gripper_base
             .as_ref()
@@ -253,7 +262,7 @@ pub fn build_kit_bounded(
 
     if let (Some(f), Some(parts_f)) = (&design.fingertip_base, fingertip) {
         parts.extend(parts_f?);
-        let lv = crate::parts::fingertip_base::levels(design, f, &stack);
+        let lv = crate::parts::fingertip_base::levels(&design.context(), f, &stack);
         let w = f
             .outer_diameter_mm
             .max(2.0 * design.body.rim_radius_mm(0.0));
@@ -348,8 +357,16 @@ pub fn build_kit_bounded(
     let mut tip_gel = None;
     if let Some(sb) = &design.shaft_body {
         if let Some(f) = &sb.filling_gel {
-            let gel = crate::parts::shaft_body::filling_gel_solid(design, sb, &stack, tol)
+            let cavity = crate::layers::inner_cavity(design, &stack, 0, tol)
                 .part(crate::procedure::FILLING_GEL)?;
+            let gel = crate::parts::shaft_body::filling_gel_solid(
+                &design.context(),
+                sb,
+                &stack,
+                cavity,
+                tol,
+            )
+            .part(crate::procedure::FILLING_GEL)?;
             casts.push(filling_gel_cast(
                 &materials,
                 f,
@@ -374,7 +391,11 @@ pub fn build_kit_bounded(
     let mut assembly =
         crate::assembly::members(design, &stack, &parts, shell_levels.as_ref(), tol)?;
     if let Some(sb) = &design.shaft_body {
-        assembly.extend(crate::parts::shaft_body::members(design, sb, tol)?);
+        assembly.extend(crate::parts::shaft_body::members(
+            &design.context(),
+            sb,
+            tol,
+        )?);
         if let Some((solid, material)) = tip_gel {
             assembly.push(crate::assembly::Member {
                 name: crate::procedure::FILLING_GEL.into(),
@@ -391,11 +412,14 @@ pub fn build_kit_bounded(
         }
     }
     if let Some(c) = &design.casing {
-        assembly.extend(crate::parts::casing::members(design, c, tol)?);
+        assembly.extend(crate::parts::casing::members(&design.context(), c, tol)?);
     }
     if let Some(f) = &design.fingertip_base {
         assembly.extend(crate::parts::fingertip_base::members(
-            design, f, &stack, tol,
+            &design.context(),
+            f,
+            &stack,
+            tol,
         )?);
     }
     let found = crate::assembly::interferences(&assembly, tol)?;
@@ -411,9 +435,11 @@ pub fn build_kit_bounded(
     bought.extend(crate::procedure::clamp_bolt_items(&bolts));
     let procedure = crate::procedure::procedure(design, &parts, &casts, &bolts);
     let machined_parts = match (&stack.core, &design.core) {
-        (Some(c), Some(spec)) => crate::parts::core_shell::machined_part(design, c, spec, tol)?
-            .into_iter()
-            .collect(),
+        (Some(c), Some(spec)) => {
+            crate::parts::core_shell::machined_part(&design.context(), c, spec, tol)?
+                .into_iter()
+                .collect()
+        }
         _ => Vec::new(),
     };
     if let Some(m) = machined_parts
@@ -664,9 +690,18 @@ fn build_casing_parts(
     tol: ChordTolerance,
 ) -> impl Fn(&crate::parts::casing::CasingParams) -> Result<Vec<crate::Part>, DesignError> + '_ {
     move |c| {
-        let mut out = vec![crate::parts::casing::build_casing(design, c, tol)?];
+        let mut out = vec![crate::parts::casing::build_casing(
+            &design.context(),
+            c,
+            tol,
+        )?];
         if let Some(g) = &c.gripper_base {
-            out.push(crate::parts::casing::build_base(design, c, g, tol)?);
+            out.push(crate::parts::casing::build_base(
+                &design.context(),
+                c,
+                g,
+                tol,
+            )?);
         }
         Ok(out)
     }

@@ -92,7 +92,7 @@ pub fn estimate(design: &Design, stack: &Stack, tol: ChordTolerance) -> WorkEsti
     if let Some(sb) = &design.shaft_body {
         // the body's and the fitting's cylinders, seats and bayonet bands: about 30 and 27
         // circles of their outer radius
-        let r = crate::parts::shaft_body::radii(design, sb, stack);
+        let r = crate::parts::shaft_body::radii(&design.context(), sb, stack);
         surfaces += 30.0 * tol.circle_segments(r.base_outer_mm) as f64
             + 27.0 * tol.circle_segments(r.fitting_outer_mm) as f64;
     }

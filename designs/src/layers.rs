@@ -805,7 +805,7 @@ fn build_layer_parts(
             // a further volume of its object (Pestell et al. Sec. III-A).
             let fitting = match &design.shaft_body {
                 Some(sb) if i + 1 == stack.layers.len() => Some(g(
-                    crate::parts::shaft_body::tip_fitting_solid(design, sb, stack, tol),
+                    crate::parts::shaft_body::tip_fitting_solid(&design.context(), sb, stack, tol),
                 )?),
                 _ => None,
             };
@@ -868,7 +868,7 @@ fn build_layer_parts(
                     print_technology: tech,
                     solid: f.translate(shift),
                     params: with_pose(
-                        crate::parts::shaft_body::twin_params(design, sb, stack),
+                        crate::parts::shaft_body::twin_params(&design.context(), sb, stack),
                         &pose,
                     ),
                     group: group.clone(),

@@ -7,6 +7,15 @@
 // `!(x > 0.0)` is how the checks here reject NaN along with the out-of-range values.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+/// `impl Default` for a parameter struct from its fields' default values.
+macro_rules! defaults {
+    ($t:ident { $($f:ident : $v:expr),* $(,)? }) => {
+        impl Default for $t {
+            fn default() -> Self { Self { $($f: $v),* } }
+        }
+    };
+}
+
 pub mod assembly;
 pub mod build;
 pub mod cut;

@@ -12,6 +12,15 @@ pub use crate::yaml::{
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
+pub mod printers;
+pub mod shared;
+pub use printers::{
+    shipped_printers, Bed, PrinterFile, PrinterProfile, PrinterProfiles, Technology,
+};
+pub use shared::{
+    Backing, BrushedCoat, Core, CoreMachining, FillingGel, LayerProcess, MoldStrategy,
+};
+
 /// A sensor design: body profile, rigid core, layer stack, molds, housing, printers.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
@@ -64,113 +73,6 @@ pub struct Design {
         std::collections::BTreeMap<String, std::collections::BTreeMap<String, serde_json::Value>>,
 }
 
-/// A flat plate the skin is glued to.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct Backing {
-    /// Material key in the materials table (designs/materials.yaml), a bought or a printed
-    /// material (ShadowTac: `pmma`, Sec. IV-A).
-    pub material: String,
-    /// Diameter of the disc, mm, > 0; at least the skin's diameter on the base plane, since
-    /// the skin is glued onto it by its whole base.
-    ///
-    /// With a `casing`, the plate must also cover the casing's window with a 1 mm glue land
-    /// all round (`casing.window_diameter_mm`).
-    #[schemars(extend("exclusiveMinimum" = 0))]
-    pub diameter_mm: f64,
-    /// Thickness of the disc along the axis, from the base plane (its top face, under the
-    /// skin) down, mm, > 0.
-    ///
-    /// With a `casing`, the camera's view of the skin's rim is refracted through it (PMMA,
-    /// index 1.49) on its way to the casing's window.
-    #[schemars(extend("exclusiveMinimum" = 0))]
-    pub thickness_mm: f64,
-    /// What the plate is and how the skin is fixed to it, for the bought-items list and the
-    /// cut list (ShadowTac: "PMMA acrylic disc, glued with Smooth-On Sil-Poxy"); empty when
-    /// not given.
-    #[serde(default)]
-    pub description: String,
-}
-
-/// A coat brushed onto a cast layer after demolding (ShadowTac Sec. IV-A: the reflective layer
-/// of Smooth-On PsychoPaint with aluminium powder, Silc Pig white and a silicone solvent). Its
-/// amounts are the maker's: the sheet lists the components and the step.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct BrushedCoat {
-    /// What the coat does, for the sheet (e.g. "reflective layer").
-    pub purpose: String,
-    /// The products mixed into it, at least one.
-    pub components: Vec<String>,
-    /// Where the coat goes and how, for the sheet.
-    #[serde(default)]
-    pub notes: String,
-}
-
-/// The rigid transparent shell (R-Tac0: a glass test tube, Sec. III-B1). Its outer surface is
-/// the inner surface of the innermost layer; it is an offset of the body profile.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct Core {
-    /// What the core is, for the bought-items list (R-Tac0: "borosilicate glass test tube,
-    /// round bottom", Sec. III-B1); empty when not given.
-    #[serde(default)]
-    pub description: String,
-    /// Material key in the materials table (designs/materials.yaml), a bought or a printed
-    /// material (R-Tac0: `borosilicate_glass`; UVDtact: `pmma`).
-    pub material: String,
-    /// Wall thickness, mm, > 0.
-    #[schemars(extend("exclusiveMinimum" = 0))]
-    pub wall_thickness_mm: f64,
-    /// Length from the pole to the open end, mm; the part below the base plane is held by
-    /// the mold's core holder and seats in the housing.
-    pub length_mm: f64,
-    /// Outer diameter, mm (spherical profiles only). When given, it must equal the inner
-    /// diameter of the innermost layer; layers given by `outer_radius_mm` are measured from it.
-    #[serde(default)]
-    #[schemars(extend("exclusiveMinimum" = 0))]
-    pub outer_diameter_mm: Option<f64>,
-    /// Primer wiped onto the core's outer surface before the first layer is cast on it, so
-    /// that the layer bonds to it: a `primer` key of the materials table (R-Tac0: `pr_1200_rtv`,
-    /// Sec. III-B1); none when not given.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub primer: Option<String>,
-    /// A core made to order by a machine shop (UVDtact's acrylic shell, CNC machined and
-    /// vapour polished, Sec. III): `fabkit export` writes its dimensioned drawing, and with
-    /// `--format step` its STEP file, to order it. None for a bought core (a test tube).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub machining: Option<CoreMachining>,
-}
-
-/// How a core made to order is described to the shop ([`Core::machining`]). Its inner surface
-/// is [`crate::profile::BodyProfile::shell_inner_surface`] of the core's outer surface and
-/// wall.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct CoreMachining {
-    /// File stem of its drawing and STEP file, `[a-z0-9_]+`, unique among the kit's parts.
-    #[schemars(extend("pattern" = "^[a-z0-9_]+$", "maxLength" = 64))]
-    pub part_name: String,
-    /// Surface finish the shop is asked for, printed on the drawing.
-    pub finish: String,
-    /// General tolerance of the drawing's dimensions (+/-), mm, > 0.
-    #[schemars(extend("exclusiveMinimum" = 0))]
-    pub general_tolerance_mm: f64,
-}
-
-/// How a layer is made.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
-#[serde(rename_all = "snake_case")]
-pub enum LayerProcess {
-    /// Poured into a mold around the core and the layers under it.
-    Cast,
-    /// Sprayed or brushed onto the mold's cavity before the next layer inward is poured
-    /// (R-Tac0's black coating, Sec. III-B1); it gets no mold of its own.
-    Sprayed,
-    /// Printed directly (TacTip skin in Tango Black+, Pestell et al. Sec. III-A).
-    Printed,
-}
-
 /// One skin layer. Give exactly one of `thickness_mm` and `outer_radius_mm`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
@@ -209,66 +111,6 @@ pub struct Layer {
     /// A grid of markers on the layer's bottom face (flat skins only; Soter et al. Sec. II-A).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub marker_grid: Option<crate::flat::MarkerGrid>,
-}
-
-/// How a cast layer's mold is made.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
-#[serde(rename_all = "snake_case")]
-pub enum MoldStrategy {
-    /// A printed two-piece mold split on a parting plane through the axis.
-    Direct,
-    /// A printed master pattern and mold box for a Mold Star 30 silicone mold, plus a casting
-    /// jig (R-Tac0 Sec. III-B1, UVDtact Sec. III).
-    Master,
-    /// A one-piece printed mold open on the base plane, for a solid skin cast pole-down
-    /// (ShadowTac Sec. IV-A).
-    Open,
-    /// A solid skin cast pole-down in two printed pieces (the authors' ShadowTac mold,
-    /// authors' CAD, measured): the cavity block, and a top piece whose bore is the pour
-    /// reservoir that forms the skin's back, registered by a boss in a pocket and joined by
-    /// clamp bolts around the flange (`mold.two_piece`).
-    TwoPieceOpen,
-    /// Printed negatives for Mold Star 30 silicone molds of the outer and of the inner boundary
-    /// of the layer; the layer is cast between the two silicone molds (UVDtact Sec. III).
-    Boundary,
-}
-
-/// Print technologies, as used in the design file.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
-#[serde(rename_all = "lowercase")]
-pub enum Technology {
-    Fdm,
-    Sla,
-    Polyjet,
-}
-
-impl From<crate::parts::PrintTechnology> for Technology {
-    fn from(t: crate::parts::PrintTechnology) -> Self {
-        use crate::parts::PrintTechnology as P;
-        match t {
-            P::Fdm => Self::Fdm,
-            P::Sla => Self::Sla,
-            P::Polyjet => Self::Polyjet,
-        }
-    }
-}
-
-impl From<Technology> for crate::parts::PrintTechnology {
-    fn from(t: Technology) -> Self {
-        match t {
-            Technology::Fdm => Self::Fdm,
-            Technology::Sla => Self::Sla,
-            Technology::Polyjet => Self::Polyjet,
-        }
-    }
-}
-
-macro_rules! defaults {
-    ($t:ident { $($f:ident : $v:expr),* $(,)? }) => {
-        impl Default for $t {
-            fn default() -> Self { Self { $($f: $v),* } }
-        }
-    };
 }
 
 /// Mold parameters shared by every cast layer. Geometry: R-Tac0 Sec. III-B1 and Fig. 4.
@@ -569,183 +411,6 @@ defaults!(CoreHolderParams {
     min_wall_mm: 1.5,
 });
 
-/// Printer capabilities used to decide what can be printed.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct PrinterProfile {
-    /// Nozzle diameter (FDM) or pixel size (SLA), mm.
-    #[schemars(extend("exclusiveMinimum" = 0))]
-    pub xy_resolution_mm: f64,
-    /// Layer height the printer prints at, mm, > 0. Only that bound is checked: no rule or
-    /// part uses it.
-    #[schemars(extend("exclusiveMinimum" = 0))]
-    pub layer_height_mm: f64,
-    /// Thinnest wall that prints reliably, mm.
-    #[schemars(extend("exclusiveMinimum" = 0))]
-    pub min_wall_mm: f64,
-    /// Smallest hole that prints open, mm.
-    #[schemars(extend("exclusiveMinimum" = 0))]
-    pub min_hole_diameter_mm: f64,
-    /// Smallest positive feature (pin, key), mm.
-    #[schemars(extend("exclusiveMinimum" = 0))]
-    pub min_feature_mm: f64,
-    /// Lug count, ramp and clearance of a bayonet printed on this printer.
-    #[serde(default)]
-    pub bayonet: crate::parts::bayonet::BayonetProfile,
-    /// The printer's build volume, which the plates are laid out in; `None`: the technology's
-    /// shipped printer ([`shipped_printers`]).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub bed: Option<Bed>,
-}
-
-/// A printer's build volume: what one plate holds.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct Bed {
-    /// The printer's name, in messages and the manifest (`[a-z0-9_]+`).
-    #[schemars(extend("pattern" = "^[a-z0-9_]+$", "maxLength" = 64))]
-    pub name: String,
-    /// Build volume: x and y of the plate, z the height, mm.
-    #[schemars(extend("items" = {"type": "number", "exclusiveMinimum": 0}))]
-    pub size_mm: [f64; 3],
-    /// Border kept clear on every side of the plate, mm: an FDM slicer's skirt (PrusaSlicer
-    /// lays it 6 mm out, 6.4 mm with its line), an SLA support pad's rim.
-    pub margin_mm: f64,
-}
-
-/// A user's own printer (`--printer FILE.yaml`): its technology and bed.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct PrinterFile {
-    pub technology: Technology,
-    pub name: String,
-    pub size_mm: [f64; 3],
-    pub margin_mm: f64,
-}
-
-impl Bed {
-    /// The plate's usable x and y (the bed less its margin on both sides), mm.
-    pub fn usable_xy_mm(&self) -> [f64; 2] {
-        [
-            self.size_mm[0] - 2.0 * self.margin_mm,
-            self.size_mm[1] - 2.0 * self.margin_mm,
-        ]
-    }
-}
-
-/// The printers fabkit ships, each with its technology: a common FDM printer (Prusa MK4-class,
-/// 250 x 210 x 220 mm; PrusaSlicer's skirt needs the 10 mm margin), a common SLA printer
-/// (Formlabs Form 2-class, 145 x 145 x 175 mm) and a PolyJet printer (Stratasys J750-class
-/// tray, 490 x 390 x 200 mm). The first of each technology is its default.
-pub fn shipped_printers() -> Vec<(Technology, Bed)> {
-    let bed = |name: &str, size_mm: [f64; 3], margin_mm: f64| Bed {
-        name: name.into(),
-        size_mm,
-        margin_mm,
-    };
-    vec![
-        (
-            Technology::Fdm,
-            bed("prusa_mk4", [250.0, 210.0, 220.0], 10.0),
-        ),
-        (
-            Technology::Sla,
-            bed("formlabs_form2", [145.0, 145.0, 175.0], 5.0),
-        ),
-        (
-            Technology::Polyjet,
-            bed("stratasys_j750", [490.0, 390.0, 200.0], 10.0),
-        ),
-    ]
-}
-
-impl Technology {
-    /// The key of the technology in the design file (`fdm`, `sla`, `polyjet`).
-    pub fn key(self) -> &'static str {
-        match self {
-            Technology::Fdm => "fdm",
-            Technology::Sla => "sla",
-            Technology::Polyjet => "polyjet",
-        }
-    }
-}
-
-/// The FDM, SLA and PolyJet profiles.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields, default)]
-pub struct PrinterProfiles {
-    pub fdm: PrinterProfile,
-    pub sla: PrinterProfile,
-    pub polyjet: PrinterProfile,
-}
-defaults!(PrinterProfiles {
-    // 0.4 mm nozzle, 0.2 mm layers; two perimeters; holes below 1 mm close up.
-    fdm: PrinterProfile {
-        xy_resolution_mm: 0.4,
-        layer_height_mm: 0.2,
-        min_wall_mm: 0.8,
-        min_hole_diameter_mm: 1.0,
-        min_feature_mm: 0.8,
-        bayonet: crate::parts::bayonet::BayonetProfile::default(),
-        bed: None,
-    },
-    // Form 3 class: 25-50 um pixels and layers.
-    sla: PrinterProfile {
-        xy_resolution_mm: 0.05,
-        layer_height_mm: 0.05,
-        min_wall_mm: 0.4,
-        min_hole_diameter_mm: 0.4,
-        min_feature_mm: 0.3,
-        bayonet: crate::parts::bayonet::BayonetProfile {
-            clearance_mm: 0.1,
-            ..crate::parts::bayonet::BayonetProfile::default()
-        },
-        bed: None,
-    },
-    // Stratasys PolyJet (Connex): 42 um pixels, 16-30 um layers; Tango features below ~0.6 mm tear.
-    polyjet: PrinterProfile {
-        xy_resolution_mm: 0.042,
-        layer_height_mm: 0.03,
-        min_wall_mm: 0.6,
-        min_hole_diameter_mm: 0.5,
-        min_feature_mm: 0.5,
-        bayonet: crate::parts::bayonet::BayonetProfile {
-            clearance_mm: 0.1,
-            ..crate::parts::bayonet::BayonetProfile::default()
-        },
-        bed: None,
-    },
-});
-
-impl PrinterProfiles {
-    pub fn get(&self, t: Technology) -> &PrinterProfile {
-        match t {
-            Technology::Fdm => &self.fdm,
-            Technology::Sla => &self.sla,
-            Technology::Polyjet => &self.polyjet,
-        }
-    }
-
-    pub fn get_mut(&mut self, t: Technology) -> &mut PrinterProfile {
-        match t {
-            Technology::Fdm => &mut self.fdm,
-            Technology::Sla => &mut self.sla,
-            Technology::Polyjet => &mut self.polyjet,
-        }
-    }
-
-    /// The bed of technology `t`: the profile's, else the shipped printer's.
-    pub fn bed(&self, t: Technology) -> Bed {
-        self.get(t).bed.clone().unwrap_or_else(|| {
-            shipped_printers()
-                .into_iter()
-                .find(|(tech, _)| *tech == t)
-                .map(|(_, b)| b)
-                .expect("a shipped printer per technology")
-        })
-    }
-}
-
 /// Pour calculator settings.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields, default)]
@@ -890,17 +555,6 @@ pub struct LedPcb {
     /// LEDs on the ring, for the bought-items list and the assembly steps (R-Tac0 Sec.
     /// III-B2: eight LUXEON 2835 white LEDs); no part's shape depends on it.
     pub led_count: u32,
-}
-
-/// The internal filling gel (R-Tac0 Sec. III-B1): poured into the assembled shell with the
-/// sensor pole-down, before the camera goes on. It fills the core, the diffuser's opening and
-/// the light chamber up to the LED PCB's face, which is the flat window the camera looks
-/// through; it diffuses the LEDs' light and, cured, glues the core to the shell.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct FillingGel {
-    /// Material key in the materials table; a cast material (R-Tac0: `solaris`).
-    pub material: String,
 }
 
 /// The laser-cut diffuser (R-Tac0 Sec. III-B2): a ring whose inner edge carries the core's rim.
@@ -1050,6 +704,19 @@ fn unit_bounds(v: &mut serde_json::Value, unit: Unit) {
     if let Some(Value::Object(defs)) = m.get_mut("$defs") {
         for sub in defs.values_mut() {
             unit_bounds(sub, Unit::Plain);
+        }
+    }
+}
+
+impl Design {
+    /// What a family sees of this design beyond its own parameters
+    /// ([`crate::parts::Context`]).
+    pub fn context(&self) -> crate::parts::context::Context<'_> {
+        crate::parts::context::Context {
+            name: &self.name,
+            body: &self.body,
+            printers: &self.printers,
+            backing: self.backing.as_ref(),
         }
     }
 }

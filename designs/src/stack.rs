@@ -4,45 +4,8 @@
 use crate::error::{ParamError, ParamErrors};
 use crate::geometry::{revolve, ChordTolerance, Solid};
 use crate::materials::{MaterialKind, MaterialsTable};
+pub use crate::parts::context::{ResolvedCore, ResolvedLayer, Stack};
 use crate::schema::{Design, LayerProcess, MoldStrategy};
-use serde::Serialize;
-
-/// A layer with its surfaces resolved.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct ResolvedLayer {
-    pub index: usize,
-    pub name: String,
-    pub material: String,
-    pub process: LayerProcess,
-    /// Offset of the inner surface from the body surface, mm (negative inward).
-    pub inner_offset_mm: f64,
-    /// Offset of the outer surface, mm.
-    pub outer_offset_mm: f64,
-    pub thickness_mm: f64,
-    pub mold_strategy: MoldStrategy,
-    /// The layer fills the body down to the base plane (`inner_offset_mm` is -infinity).
-    pub solid: bool,
-}
-
-/// The rigid core with its surfaces resolved.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct ResolvedCore {
-    pub inner_offset_mm: f64,
-    pub outer_offset_mm: f64,
-    /// How far the core continues straight down below the base plane, mm.
-    pub below_base_mm: f64,
-    /// Outer radius for spherical profiles, mm.
-    pub outer_radius_mm: Option<f64>,
-    pub inner_radius_mm: Option<f64>,
-}
-
-/// A validated design with every surface placed.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Stack {
-    /// `None` for a design without core.
-    pub core: Option<ResolvedCore>,
-    pub layers: Vec<ResolvedLayer>,
-}
 
 impl Stack {
     /// The solid of layer `i` (between its inner and outer surfaces, closed on the base plane).
@@ -618,17 +581,17 @@ pub fn validate(
             core: core.clone(),
             layers: layers.clone(),
         };
-        crate::parts::shaft_body::check_params(design, sb, &st, &mut errs);
+        crate::parts::shaft_body::check_params(&design.context(), sb, &st, &mut errs);
     }
     if let (Some(c), true) = (&design.casing, stack_ok) {
-        crate::parts::casing::check_params(design, c, &mut errs);
+        crate::parts::casing::check_params(&design.context(), c, &mut errs);
     }
     if let (Some(f), true) = (&design.fingertip_base, stack_ok) {
         let st = Stack {
             core: core.clone(),
             layers: layers.clone(),
         };
-        crate::parts::fingertip_base::check_params(design, f, &st, &mut errs);
+        crate::parts::fingertip_base::check_params(&design.context(), f, &st, &mut errs);
     }
     if let (Some(c), true) = (sound_core, errs.is_empty()) {
         if let Some(first) = layers.iter().find(|l| {

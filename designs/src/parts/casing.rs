@@ -28,10 +28,10 @@ use super::{ExactShape, Member, MemberKind};
 use super::{Part, PrintTechnology};
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{cuboid, ChordTolerance, GeometryError, Solid};
+use crate::parts::context::Context;
 use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::shaft_body::{half_nozzle, OVERLAP_MM};
 use crate::parts::z_cylinder;
-use crate::schema::Design;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
@@ -229,9 +229,9 @@ pub struct CasingLevels {
 }
 
 /// The casing's levels (see [`CasingLevels`]); the plate's thickness from `backing` (0 without).
-pub fn levels(design: &Design, c: &CasingParams) -> CasingLevels {
-    let zb = design.body.base_z_mm();
-    let top = zb - design.backing.as_ref().map_or(0.0, |b| b.thickness_mm);
+pub fn levels(ctx: &Context<'_>, c: &CasingParams) -> CasingLevels {
+    let zb = ctx.body.base_z_mm();
+    let top = zb - ctx.backing.map_or(0.0, |b| b.thickness_mm);
     let bottom = top - c.height_mm;
     let ledge_bottom = bottom + c.bay_height_mm;
     let board_top = bottom + c.camera.board_height_mm;
@@ -252,7 +252,7 @@ pub fn levels(design: &Design, c: &CasingParams) -> CasingLevels {
         bottom_z_mm: bottom,
         base_top_z_mm: base.map(|b| b.0),
         base_bottom_z_mm: base.map(|b| b.1),
-        envelope_height_mm: design.body.pole_z_mm(0.0) - base.map_or(bottom, |b| b.1),
+        envelope_height_mm: ctx.body.pole_z_mm(0.0) - base.map_or(bottom, |b| b.1),
     }
 }
 
@@ -271,11 +271,10 @@ pub fn led_azimuths_deg(c: &CasingParams) -> Vec<f64> {
 
 /// Radii of an LED's slot, mm: (the chamber's wall, the slot's back face); and of its wire
 /// hole's centre, on the LED's azimuth, the FDM minimum wall inside the bay's side.
-fn slot_radii(design: &Design, c: &CasingParams) -> (f64, f64, f64) {
+fn slot_radii(ctx: &Context<'_>, c: &CasingParams) -> (f64, f64, f64) {
     let r = c.window_diameter_mm / 2.0;
     let back = r + c.leds.thickness_mm + c.fit_clearance_mm;
-    let wire =
-        bay_half_mm(c) - c.leds.wire_hole_diameter_mm / 2.0 - design.printers.fdm.min_wall_mm;
+    let wire = bay_half_mm(c) - c.leds.wire_hole_diameter_mm / 2.0 - ctx.printers.fdm.min_wall_mm;
     (r, back, wire)
 }
 
@@ -316,7 +315,7 @@ pub fn plate_crossing_radius_mm(r_mm: f64, h_mm: f64, t_mm: f64, n: f64) -> f64 
 /// Rules on the casing and its base, paths under `casing`: walls print, parts are held, the
 /// window passes the view. Overlaps between the casing and the parts it holds are the fit
 /// check's ([`crate::assembly`]).
-pub fn check_params(design: &Design, c: &CasingParams, errs: &mut Vec<ParamError>) {
+pub fn check_params(ctx: &Context<'_>, c: &CasingParams, errs: &mut Vec<ParamError>) {
     let before = errs.len();
     let path = |p: &str| format!("casing.{p}");
     let (cam, led, s) = (&c.camera, &c.leds, &c.screws);
@@ -377,9 +376,9 @@ pub fn check_params(design: &Design, c: &CasingParams, errs: &mut Vec<ParamError
             "must be 1 to 8",
         ));
     }
-    let fdm = &design.printers.fdm;
+    let fdm = &ctx.printers.fdm;
     half_nozzle(&path("fit_clearance_mm"), c.fit_clearance_mm, fdm, errs);
-    let Some(backing) = &design.backing else {
+    let Some(backing) = ctx.backing else {
         errs.push(ParamError::new(
             "casing",
             "given",
@@ -399,7 +398,7 @@ pub fn check_params(design: &Design, c: &CasingParams, errs: &mut Vec<ParamError
     };
     let half = c.outer_width_mm / 2.0;
     let bay = bay_half_mm(c);
-    let (r_ch, back, r_wire) = slot_radii(design, c);
+    let (r_ch, back, r_wire) = slot_radii(ctx, c);
     rule(
         c.wall_thickness_mm >= wall,
         "wall_thickness_mm",
@@ -505,10 +504,10 @@ pub fn check_params(design: &Design, c: &CasingParams, errs: &mut Vec<ParamError
     );
     // the camera must see the skin's rim through the window (a lens that reaches the plate is
     // the fit check's)
-    let lv = levels(design, c);
+    let lv = levels(ctx, c);
     let h = lv.top_z_mm - lv.lens_z_mm;
     if h > 0.0 {
-        let rim = design.body.rim_radius_mm(0.0);
+        let rim = ctx.body.rim_radius_mm(0.0);
         let cross = plate_crossing_radius_mm(rim, h, backing.thickness_mm, PMMA_REFRACTIVE_INDEX);
         rule(
             cross <= r_ch,
@@ -599,11 +598,11 @@ pub fn check_params(design: &Design, c: &CasingParams, errs: &mut Vec<ParamError
 }
 
 /// The casing's and base's parameters for their twins.
-pub fn twin_params(design: &Design, c: &CasingParams) -> serde_json::Value {
-    let (r_ch, back, r_wire) = slot_radii(design, c);
+pub fn twin_params(ctx: &Context<'_>, c: &CasingParams) -> serde_json::Value {
+    let (r_ch, back, r_wire) = slot_radii(ctx, c);
     json!({
         "casing": c,
-        "levels": levels(design, c),
+        "levels": levels(ctx, c),
         "bay_half_mm": bay_half_mm(c),
         "chamber_radius_mm": r_ch,
         "slot_back_radius_mm": back,
@@ -620,14 +619,14 @@ pub fn twin_params(design: &Design, c: &CasingParams) -> serde_json::Value {
 /// # Errors
 /// [`DesignError::Geometry`] naming the part if the kernel fails.
 pub fn build_casing(
-    design: &Design,
+    ctx: &Context<'_>,
     c: &CasingParams,
     tol: ChordTolerance,
 ) -> Result<Part, DesignError> {
     let g = |x: Result<Solid, GeometryError>| x.part("casing");
-    let lv = levels(design, c);
+    let lv = levels(ctx, c);
     let (half, bay, e) = (c.outer_width_mm / 2.0, bay_half_mm(c), OVERLAP_MM);
-    let (r_ch, back, r_wire) = slot_radii(design, c);
+    let (r_ch, back, r_wire) = slot_radii(ctx, c);
     let cl = c.fit_clearance_mm;
     let block = g(cuboid(
         [-half, -half, lv.bottom_z_mm],
@@ -690,7 +689,7 @@ pub fn build_casing(
         material: c.material.clone(),
         print_technology: PrintTechnology::Fdm,
         solid: placed,
-        params: with_pose(twin_params(design, c), &pose),
+        params: with_pose(twin_params(ctx, c), &pose),
         group: None,
     })
 }
@@ -700,13 +699,13 @@ pub fn build_casing(
 /// # Errors
 /// [`DesignError::Geometry`] naming the part if the kernel fails.
 pub fn build_base(
-    design: &Design,
+    ctx: &Context<'_>,
     c: &CasingParams,
     gb: &GripperBase,
     tol: ChordTolerance,
 ) -> Result<Part, DesignError> {
     let g = |x: Result<Solid, GeometryError>| x.part("gripper_base");
-    let lv = levels(design, c);
+    let lv = levels(ctx, c);
     let (top, bottom) = (
         lv.bottom_z_mm + gb.socket_depth_mm,
         lv.bottom_z_mm + gb.socket_depth_mm - gb.thickness_mm,
@@ -769,7 +768,7 @@ pub fn build_base(
         material: gb.material.clone(),
         print_technology: PrintTechnology::Fdm,
         solid: placed,
-        params: with_pose(twin_params(design, c), &pose),
+        params: with_pose(twin_params(ctx, c), &pose),
         group: None,
     })
 }
@@ -780,11 +779,11 @@ pub fn build_base(
 /// # Errors
 /// [`DesignError::Geometry`] naming the member if the kernel fails.
 pub fn members(
-    design: &Design,
+    ctx: &Context<'_>,
     c: &CasingParams,
     tol: ChordTolerance,
 ) -> Result<Vec<Member>, DesignError> {
-    let lv = levels(design, c);
+    let lv = levels(ctx, c);
     let member =
         |name: &str, description: String, solid: Solid, exact: Option<ExactShape>, fix: &[&str]| {
             Member {
@@ -825,7 +824,7 @@ pub fn members(
             &["camera.lens_height_mm", "camera.lens_diameter_mm"],
         ),
     ];
-    let (r_ch, _, _) = slot_radii(design, c);
+    let (r_ch, _, _) = slot_radii(ctx, c);
     let w = c.leds.width_mm / 2.0;
     for (k, a) in led_azimuths_deg(c).into_iter().enumerate() {
         let name = format!("led_{}_envelope", k + 1);

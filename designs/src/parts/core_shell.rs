@@ -11,16 +11,16 @@
 use super::ExactShape;
 use crate::error::{DesignError, GeometryContext as _};
 use crate::geometry::{revolve, ChordTolerance, Polyline2, Solid};
+use crate::parts::context::Context;
+use crate::parts::context::ResolvedCore;
 use crate::profile::BodyProfile;
-use crate::schema::{Core, CoreMachining, Design};
-use crate::stack::ResolvedCore;
+use crate::schema::shared::{Core, CoreMachining};
 
 /// The closed (r, z) profile of the core, sensor frame, mm: the shell between its outer and
 /// inner surfaces ([`BodyProfile::core_shell_profile`]), or, when the wall leaves no bore,
 /// the solid under its outer surface.
-pub fn profile(design: &Design, c: &ResolvedCore, spec: &Core, tol: ChordTolerance) -> Polyline2 {
-    design
-        .body
+pub fn profile(ctx: &Context<'_>, c: &ResolvedCore, spec: &Core, tol: ChordTolerance) -> Polyline2 {
+    ctx.body
         .core_shell_profile(
             c.outer_offset_mm,
             spec.wall_thickness_mm,
@@ -28,8 +28,7 @@ pub fn profile(design: &Design, c: &ResolvedCore, spec: &Core, tol: ChordToleran
             tol.half(),
         )
         .unwrap_or_else(|| {
-            design
-                .body
+            ctx.body
                 .solid_profile(c.outer_offset_mm, c.below_base_mm, tol.half())
         })
 }
@@ -37,13 +36,12 @@ pub fn profile(design: &Design, c: &ResolvedCore, spec: &Core, tol: ChordToleran
 /// The exact shape of a core with a bore, for the CadQuery twin: `{"shape": "core_shell",
 /// "params": {"body", "outer_offset_mm", "wall_thickness_mm", "below_base_mm"}}` (the twin
 /// derives the inner surface by the same rule); `None` without a bore.
-pub fn exact_shape(design: &Design, c: &ResolvedCore, spec: &Core) -> Option<ExactShape> {
-    design
-        .body
+pub fn exact_shape(ctx: &Context<'_>, c: &ResolvedCore, spec: &Core) -> Option<ExactShape> {
+    ctx.body
         .shell_inner_surface(c.outer_offset_mm, spec.wall_thickness_mm)?;
     Some(ExactShape::CoreShell {
         params: serde_json::json!({
-            "body": design.body,
+            "body": ctx.body,
             "outer_offset_mm": c.outer_offset_mm,
             "wall_thickness_mm": spec.wall_thickness_mm,
             "below_base_mm": c.below_base_mm,
@@ -136,7 +134,7 @@ impl Dimension {
 /// # Errors
 /// [`DesignError::Geometry`] when its solid cannot be built.
 pub fn machined_part(
-    design: &Design,
+    ctx: &Context<'_>,
     c: &ResolvedCore,
     spec: &Core,
     tol: ChordTolerance,
@@ -144,10 +142,10 @@ pub fn machined_part(
     let Some(m) = &spec.machining else {
         return Ok(None);
     };
-    let body = &design.body;
+    let body = &ctx.body;
     let w = spec.wall_thickness_mm;
     let (Some(exact), Some((inner, d_in)), Some(pl)) = (
-        exact_shape(design, c, spec),
+        exact_shape(ctx, c, spec),
         body.shell_inner_surface(c.outer_offset_mm, w),
         body.core_shell_profile(c.outer_offset_mm, w, c.below_base_mm, tol.half()),
     ) else {
@@ -159,7 +157,7 @@ pub fn machined_part(
     let (least_wall_mm, least_wall_polar_deg) =
         body.least_wall_mm(c.outer_offset_mm, w).unwrap_or((w, 0.0));
     let drawing = drawing(
-        design,
+        ctx,
         c,
         spec,
         m,
@@ -235,7 +233,7 @@ fn surface_words(body: &BodyProfile, d: f64) -> String {
 
 #[allow(clippy::too_many_arguments)]
 fn drawing(
-    design: &Design,
+    ctx: &Context<'_>,
     c: &ResolvedCore,
     spec: &Core,
     m: &CoreMachining,
@@ -245,7 +243,7 @@ fn drawing(
     least_wall_polar_deg: f64,
 ) -> Drawing {
     use DimensionAxis::{Horizontal, Vertical};
-    let body = &design.body;
+    let body = &ctx.body;
     let (ro, ri) = (
         body.rim_radius_mm(c.outer_offset_mm),
         inner.rim_radius_mm(d_in),
@@ -309,7 +307,7 @@ fn drawing(
         ));
     }
     Drawing {
-        title: format!("{} {}", design.name, m.part_name),
+        title: format!("{} {}", ctx.name, m.part_name),
         section_rz_mm: pl.points.clone(),
         dimensions,
         notes,

@@ -25,11 +25,11 @@ use super::{ExactShape, Member, MemberKind};
 use super::{Part, PrintTechnology};
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{ChordTolerance, GeometryError, Solid};
+use crate::parts::context::Context;
+use crate::parts::context::Stack;
 use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::shaft_body::OVERLAP_MM;
 use crate::parts::z_cylinder;
-use crate::schema::Design;
-use crate::stack::Stack;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
@@ -198,7 +198,7 @@ pub struct FingertipLevels {
 }
 
 /// The base's levels; the shell's end from the stack's core (the base plane without one).
-pub fn levels(design: &Design, f: &FingertipBase, stack: &Stack) -> FingertipLevels {
+pub fn levels(ctx: &Context<'_>, f: &FingertipBase, stack: &Stack) -> FingertipLevels {
     let end = -stack.core.as_ref().map_or(0.0, |c| c.below_base_mm);
     let floor = end - f.pocket_depth_mm;
     let pcb_top = floor + f.led_pcb.thickness_mm;
@@ -211,7 +211,7 @@ pub fn levels(design: &Design, f: &FingertipBase, stack: &Stack) -> FingertipLev
         pocket_floor_z_mm: floor,
         camera_back_z_mm: end - f.camera.length_mm,
         bottom_z_mm: bottom,
-        envelope_height_mm: design.body.pole_z_mm(0.0) - bottom,
+        envelope_height_mm: ctx.body.pole_z_mm(0.0) - bottom,
     }
 }
 
@@ -226,11 +226,11 @@ pub struct FingertipRadii {
 }
 
 /// The base's radii (see [`FingertipRadii`]).
-pub fn radii(design: &Design, f: &FingertipBase, stack: &Stack) -> FingertipRadii {
+pub fn radii(ctx: &Context<'_>, f: &FingertipBase, stack: &Stack) -> FingertipRadii {
     let shell = stack
         .core
         .as_ref()
-        .map_or(0.0, |c| design.body.rim_radius_mm(c.outer_offset_mm));
+        .map_or(0.0, |c| ctx.body.rim_radius_mm(c.outer_offset_mm));
     let bore = shell + f.fit_clearance_mm;
     let outside = f.outer_diameter_mm / 2.0;
     FingertipRadii {
@@ -267,7 +267,12 @@ fn pcb_wire_xy(f: &FingertipBase) -> [f64; 2] {
 
 /// Rules on the fingertip's base, paths under `fingertip_base`: walls print, parts are held.
 /// Overlaps between the printed parts and the bought ones are the fit check's.
-pub fn check_params(design: &Design, f: &FingertipBase, stack: &Stack, errs: &mut Vec<ParamError>) {
+pub fn check_params(
+    ctx: &Context<'_>,
+    f: &FingertipBase,
+    stack: &Stack,
+    errs: &mut Vec<ParamError>,
+) {
     let before = errs.len();
     let path = |p: &str| format!("fingertip_base.{p}");
     let (pcb, ring, cam, b) = (&f.led_pcb, &f.diffusion_ring, &f.camera, &f.bolts);
@@ -319,7 +324,7 @@ pub fn check_params(design: &Design, f: &FingertipBase, stack: &Stack, errs: &mu
             "must be 2 to 6",
         ));
     }
-    let sla = &design.printers.sla;
+    let sla = &ctx.printers.sla;
     if !(f.fit_clearance_mm >= sla.xy_resolution_mm && f.fit_clearance_mm.is_finite()) {
         errs.push(ParamError::new(
             path("fit_clearance_mm"),
@@ -347,7 +352,7 @@ pub fn check_params(design: &Design, f: &FingertipBase, stack: &Stack, errs: &mu
             errs.push(ParamError::new(path(p), v, text));
         }
     };
-    let r = radii(design, f, stack);
+    let r = radii(ctx, f, stack);
     let below = core.below_base_mm;
     rule(
         below >= b.pilot_depth_mm + wall,
@@ -481,11 +486,11 @@ pub fn check_params(design: &Design, f: &FingertipBase, stack: &Stack, errs: &mu
 }
 
 /// The parts' parameters for their twins.
-pub fn twin_params(design: &Design, f: &FingertipBase, stack: &Stack) -> serde_json::Value {
-    let r = radii(design, f, stack);
+pub fn twin_params(ctx: &Context<'_>, f: &FingertipBase, stack: &Stack) -> serde_json::Value {
+    let r = radii(ctx, f, stack);
     json!({
         "fingertip_base": f,
-        "levels": levels(design, f, stack),
+        "levels": levels(ctx, f, stack),
         "radii": r,
         "leds": leds(),
         "bolt_xy_mm": bolt_xy(f, r.bolt_circle_mm),
@@ -511,13 +516,13 @@ fn z_ring(ri: f64, ro: f64, z0: f64, z1: f64, tol: ChordTolerance) -> Result<Sol
 /// # Errors
 /// [`DesignError::Geometry`] naming the part if the kernel fails.
 pub fn build_parts(
-    design: &Design,
+    ctx: &Context<'_>,
     f: &FingertipBase,
     stack: &Stack,
     tol: ChordTolerance,
 ) -> Result<Vec<Part>, DesignError> {
-    let lv = levels(design, f, stack);
-    let r = radii(design, f, stack);
+    let lv = levels(ctx, f, stack);
+    let r = radii(ctx, f, stack);
     let e = OVERLAP_MM;
     let b = &f.bolts;
     let bolts = bolt_xy(f, r.bolt_circle_mm);
@@ -530,7 +535,7 @@ pub fn build_parts(
             material: material.into(),
             print_technology: PrintTechnology::Sla,
             solid: placed,
-            params: with_pose(twin_params(design, f, stack), &pose),
+            params: with_pose(twin_params(ctx, f, stack), &pose),
             group: None,
         }
     };
@@ -679,12 +684,12 @@ pub fn build_parts(
 /// # Errors
 /// [`DesignError::Geometry`] naming the member if the kernel fails.
 pub fn members(
-    design: &Design,
+    ctx: &Context<'_>,
     f: &FingertipBase,
     stack: &Stack,
     tol: ChordTolerance,
 ) -> Result<Vec<Member>, DesignError> {
-    let lv = levels(design, f, stack);
+    let lv = levels(ctx, f, stack);
     let member =
         |name: &str, description: String, (ri, ro, z0, z1): (f64, f64, f64, f64), fix: &[&str]| {
             let solid = if ri > 0.0 {

@@ -3,6 +3,7 @@
 
 pub mod bayonet;
 pub mod casing;
+pub mod context;
 pub mod core_shell;
 pub mod fasteners;
 pub mod fingertip_base;
@@ -12,6 +13,7 @@ pub mod placement;
 pub mod robot_mount;
 pub mod shaft_body;
 
+pub use context::{Context, ResolvedCore, ResolvedLayer, Stack};
 pub use member::{ExactShape, Member, MemberKind};
 pub use part::{Part, PrintTechnology, ProcedureAction, ProcedureStep};
 

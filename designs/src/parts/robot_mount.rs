@@ -17,9 +17,9 @@ use super::{Part, PrintTechnology};
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{cylinder, ChordTolerance, GeometryError, Solid};
 use crate::parts::bayonet::{band, Bayonet};
+use crate::parts::context::Context;
 use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::shaft_body::{levels, BayonetLugs, ShaftBodyParams, CABLE_SLOT_MM, OVERLAP_MM};
-use crate::schema::Design;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
@@ -82,30 +82,30 @@ pub const LUG_LIFT_MM: f64 = 1.0;
 pub const FIRST_LUG_DEG: f64 = -90.0;
 
 /// Radii of the cup, mm: (bore, outside).
-pub fn cup_radii(sb: &ShaftBodyParams, m: &RobotMount, design: &Design) -> (f64, f64) {
+pub fn cup_radii(sb: &ShaftBodyParams, m: &RobotMount, ctx: &Context<'_>) -> (f64, f64) {
     let bore = sb.base.outer_diameter_mm / 2.0 + sb.fit_clearance_mm;
-    let c = design.printers.fdm.bayonet.clearance_mm;
+    let c = ctx.printers.fdm.bayonet.clearance_mm;
     (bore, bore + m.bayonet.lug_depth_mm + c + m.cup_wall_mm)
 }
 
 /// The body-to-mount bayonet, locked.
-pub fn mount_bayonet(design: &Design, sb: &ShaftBodyParams, m: &RobotMount) -> Bayonet {
-    let zb = levels(design, sb).bottom_z_mm;
+pub fn mount_bayonet(ctx: &Context<'_>, sb: &ShaftBodyParams, m: &RobotMount) -> Bayonet {
+    let zb = levels(ctx, sb).bottom_z_mm;
     Bayonet {
-        spigot_radius_mm: cup_radii(sb, m, design).0,
+        spigot_radius_mm: cup_radii(sb, m, ctx).0,
         outward: true,
         clockwise: true,
         first_lug_deg: FIRST_LUG_DEG,
         lug_z_mm: zb + LUG_LIFT_MM + m.bayonet.lug_height_mm / 2.0,
         spigot_end_z_mm: zb + m.cup_height_mm,
-        ..Bayonet::sized(&design.printers.fdm.bayonet, &m.bayonet)
+        ..Bayonet::sized(&ctx.printers.fdm.bayonet, &m.bayonet)
     }
 }
 
 /// The cable window's azimuth range, radians: the base's slot on +y (locked) and where it
 /// comes from over the turn, with the fit clearance on each side.
-pub fn window_azimuths(sb: &ShaftBodyParams, m: &RobotMount, design: &Design) -> (f64, f64) {
-    let bore = cup_radii(sb, m, design).0;
+pub fn window_azimuths(sb: &ShaftBodyParams, m: &RobotMount, ctx: &Context<'_>) -> (f64, f64) {
+    let bore = cup_radii(sb, m, ctx).0;
     let w = (CABLE_SLOT_MM[0] / 2.0 + sb.fit_clearance_mm) / bore;
     let up = PI / 2.0;
     (up - w, up + m.bayonet.lock_angle_deg.to_radians() + w)
@@ -127,7 +127,7 @@ fn pin_xy(m: &RobotMount) -> [f64; 2] {
 
 /// Rules on the mount, paths under `shaft_body.robot_mount`.
 pub fn check_params(
-    design: &Design,
+    ctx: &Context<'_>,
     sb: &ShaftBodyParams,
     m: &RobotMount,
     errs: &mut Vec<ParamError>,
@@ -178,13 +178,13 @@ pub fn check_params(
     if errs.len() > before {
         return;
     }
-    let wall = design.printers.fdm.min_wall_mm;
+    let wall = ctx.printers.fdm.min_wall_mm;
     let mut rule = |ok: bool, p: &str, v: f64, text: String| {
         if !ok {
             errs.push(ParamError::new(path(p), v, text));
         }
     };
-    let (bore, outside) = cup_radii(sb, m, design);
+    let (bore, outside) = cup_radii(sb, m, ctx);
     rule(
         m.cup_wall_mm >= wall,
         "cup_wall_mm",
@@ -219,13 +219,13 @@ pub fn check_params(
             2.0 * outside
         ),
     );
-    let b = mount_bayonet(design, sb, m);
+    let b = mount_bayonet(ctx, sb, m);
     let tan = b.ramp_deg.to_radians().tan();
     let half = b.groove_width_mm / 2.0 / bore;
     let lock = b.lock_angle_deg.to_radians();
     let groove_top =
         b.lug_z_mm + bore * tan * (lock + half) + b.lug_height_mm / 2.0 + b.clearance_mm;
-    let zb = levels(design, sb).bottom_z_mm;
+    let zb = levels(ctx, sb).bottom_z_mm;
     rule(
         groove_top + wall <= zb + m.cup_height_mm,
         "cup_height_mm",
@@ -237,7 +237,7 @@ pub fn check_params(
     );
     // the grooves (each from its lug back over the turn), the walls between them and the
     // cable window must fit round the cup
-    let (w0, w1) = window_azimuths(sb, m, design);
+    let (w0, w1) = window_azimuths(sb, m, ctx);
     let mut spans: Vec<(f64, f64)> = b
         .lug_azimuths_deg()
         .iter()
@@ -270,10 +270,10 @@ pub fn check_params(
 }
 
 /// The mount's parameters for its twin, and the base's lugs for the body's twin.
-pub fn twin_params(design: &Design, sb: &ShaftBodyParams, m: &RobotMount) -> serde_json::Value {
-    let b = mount_bayonet(design, sb, m);
-    let (bore, outside) = cup_radii(sb, m, design);
-    let (w0, w1) = window_azimuths(sb, m, design);
+pub fn twin_params(ctx: &Context<'_>, sb: &ShaftBodyParams, m: &RobotMount) -> serde_json::Value {
+    let b = mount_bayonet(ctx, sb, m);
+    let (bore, outside) = cup_radii(sb, m, ctx);
+    let (w0, w1) = window_azimuths(sb, m, ctx);
     json!({
         "bayonet": b,
         "lug_azimuths_deg": b.lug_azimuths_deg(),
@@ -292,12 +292,12 @@ pub fn twin_params(design: &Design, sb: &ShaftBodyParams, m: &RobotMount) -> ser
 /// # Errors
 /// [`GeometryError`] if the kernel fails.
 pub fn base_lugs(
-    design: &Design,
+    ctx: &Context<'_>,
     sb: &ShaftBodyParams,
     m: &RobotMount,
     tol: ChordTolerance,
 ) -> Result<Solid, GeometryError> {
-    mount_bayonet(design, sb, m).lugs(sb.base.outer_diameter_mm / 2.0 - OVERLAP_MM, tol)
+    mount_bayonet(ctx, sb, m).lugs(sb.base.outer_diameter_mm / 2.0 - OVERLAP_MM, tol)
 }
 
 /// The mount, printed standing on its plate.
@@ -305,7 +305,7 @@ pub fn base_lugs(
 /// # Errors
 /// [`DesignError::Geometry`] naming the part if the kernel fails.
 pub fn build_mount(
-    design: &Design,
+    ctx: &Context<'_>,
     sb: &ShaftBodyParams,
     m: &RobotMount,
     tol: ChordTolerance,
@@ -314,10 +314,10 @@ pub fn build_mount(
     let cyl = |r: f64, z0: f64, z1: f64, [x, y]: [f64; 2]| {
         cylinder(z1 - z0, r, tol).map(|s| s.translate([x, y, z0]))
     };
-    let zb = levels(design, sb).bottom_z_mm;
+    let zb = levels(ctx, sb).bottom_z_mm;
     let z0 = zb - m.plate_thickness_mm;
-    let (bore, outside) = cup_radii(sb, m, design);
-    let (w0, w1) = window_azimuths(sb, m, design);
+    let (bore, outside) = cup_radii(sb, m, ctx);
+    let (w0, w1) = window_azimuths(sb, m, ctx);
     let e = OVERLAP_MM;
     let cup = g(
         cyl(outside, zb - e, zb + m.cup_height_mm, [0.0; 2]).and_then(|o| {
@@ -336,7 +336,7 @@ pub fn build_mount(
         0.0,
         tol,
     )))?;
-    let grooves = g(mount_bayonet(design, sb, m).grooves(tol))?;
+    let grooves = g(mount_bayonet(ctx, sb, m).grooves(tol))?;
     let cup = g(cup.difference(&g(window.union(&grooves))?))?;
     let plate = g(cyl(outside, z0, zb, [0.0; 2]))?;
     let mut cuts = Vec::new();
@@ -373,7 +373,7 @@ pub fn build_mount(
         print_technology: PrintTechnology::Fdm,
         solid: placed,
         params: with_pose(
-            json!({"mount": twin_params(design, sb, m), "levels": levels(design, sb)}),
+            json!({"mount": twin_params(ctx, sb, m), "levels": levels(ctx, sb)}),
             &pose,
         ),
         group: None,

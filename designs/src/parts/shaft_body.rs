@@ -30,9 +30,10 @@ use crate::geometry::Polyline2;
 use crate::geometry::{cuboid, cylinder, revolve, ChordTolerance, GeometryError, Solid};
 use crate::parts::bayonet::Bayonet;
 pub use crate::parts::bayonet::BayonetLugs;
+use crate::parts::context::Context;
+use crate::parts::context::Stack;
 use crate::parts::placement::{place_posed, with_pose};
-use crate::schema::{Design, FillingGel, LayerProcess};
-use crate::stack::Stack;
+use crate::schema::shared::{FillingGel, LayerProcess};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
@@ -224,7 +225,7 @@ pub struct ShaftLevels {
 }
 
 /// The skin's layer that carries the fitting: the outermost layer, printed.
-fn skin_layer(stack: &Stack) -> Option<&crate::stack::ResolvedLayer> {
+fn skin_layer(stack: &Stack) -> Option<&crate::parts::context::ResolvedLayer> {
     stack
         .layers
         .last()
@@ -232,8 +233,8 @@ fn skin_layer(stack: &Stack) -> Option<&crate::stack::ResolvedLayer> {
 }
 
 /// The shaft body's levels (see [`ShaftLevels`]).
-pub fn levels(design: &Design, sb: &ShaftBodyParams) -> ShaftLevels {
-    let zb = design.body.base_z_mm();
+pub fn levels(ctx: &Context<'_>, sb: &ShaftBodyParams) -> ShaftLevels {
+    let zb = ctx.body.base_z_mm();
     let lip = zb - sb.tip_fitting.lip_thickness_mm;
     let top = lip - sb.lens_window.thickness_mm;
     let base_top = top - sb.shaft_length_mm;
@@ -249,7 +250,7 @@ pub fn levels(design: &Design, sb: &ShaftBodyParams) -> ShaftLevels {
         ceiling_z_mm: ceiling,
         lens_z_mm: ceiling + sb.camera.lens_height_mm,
         bottom_z_mm: bottom,
-        envelope_height_mm: design.body.pole_z_mm(0.0) - bottom,
+        envelope_height_mm: ctx.body.pole_z_mm(0.0) - bottom,
     }
 }
 
@@ -276,16 +277,16 @@ pub struct ShaftRadii {
 }
 
 /// The radii of the fitting and the body.
-pub fn radii(design: &Design, sb: &ShaftBodyParams, stack: &Stack) -> ShaftRadii {
+pub fn radii(ctx: &Context<'_>, sb: &ShaftBodyParams, stack: &Stack) -> ShaftRadii {
     let c = sb.fit_clearance_mm;
     let outer = skin_layer(stack).map_or(0.0, |l| l.outer_offset_mm);
     let rw = sb.lens_window.diameter_mm / 2.0;
     let rs = sb.shaft_diameter_mm / 2.0;
     ShaftRadii {
-        fitting_outer_mm: design.body.rim_radius_mm(outer),
+        fitting_outer_mm: ctx.body.rim_radius_mm(outer),
         lip_inner_mm: rw - sb.tip_fitting.lip_width_mm,
         window_seat_mm: rw + c,
-        skirt_bore_mm: rs + design.printers.fdm.bayonet.clearance_mm,
+        skirt_bore_mm: rs + ctx.printers.fdm.bayonet.clearance_mm,
         shaft_outer_mm: rs,
         shaft_bore_mm: rs - sb.wall_thickness_mm,
         led_seat_mm: sb
@@ -299,8 +300,8 @@ pub fn radii(design: &Design, sb: &ShaftBodyParams, stack: &Stack) -> ShaftRadii
 }
 
 /// The tip-to-shaft bayonet, locked.
-pub fn tip_bayonet(design: &Design, sb: &ShaftBodyParams) -> Bayonet {
-    let lv = levels(design, sb);
+pub fn tip_bayonet(ctx: &Context<'_>, sb: &ShaftBodyParams) -> Bayonet {
+    let lv = levels(ctx, sb);
     Bayonet {
         spigot_radius_mm: sb.shaft_diameter_mm / 2.0,
         outward: false,
@@ -310,7 +311,7 @@ pub fn tip_bayonet(design: &Design, sb: &ShaftBodyParams) -> Bayonet {
         // lugs flush with the skirt's bottom
         lug_z_mm: lv.fitting_bottom_z_mm + sb.bayonet.lug_height_mm / 2.0,
         spigot_end_z_mm: lv.shaft_top_z_mm,
-        ..Bayonet::sized(&design.printers.fdm.bayonet, &sb.bayonet)
+        ..Bayonet::sized(&ctx.printers.fdm.bayonet, &sb.bayonet)
     }
 }
 
@@ -318,7 +319,7 @@ pub fn tip_bayonet(design: &Design, sb: &ShaftBodyParams) -> Bayonet {
 pub(crate) fn half_nozzle(
     path: &str,
     v: f64,
-    fdm: &crate::schema::PrinterProfile,
+    fdm: &crate::schema::printers::PrinterProfile,
     errs: &mut Vec<ParamError>,
 ) {
     if !(v >= fdm.xy_resolution_mm / 2.0 && v.is_finite()) {
@@ -335,7 +336,7 @@ pub(crate) fn half_nozzle(
 
 /// Rules on the shaft body: parts fit, walls print, the camera sees the tip.
 pub fn check_params(
-    design: &Design,
+    ctx: &Context<'_>,
     sb: &ShaftBodyParams,
     stack: &Stack,
     errs: &mut Vec<ParamError>,
@@ -395,7 +396,7 @@ pub fn check_params(
     if let Some(d) = sb.led_ring.seat_diameter_mm {
         pos("led_ring.seat_diameter_mm", d);
     }
-    let fdm = &design.printers.fdm;
+    let fdm = &ctx.printers.fdm;
     let bp = &fdm.bayonet;
     if !(2..=8).contains(&bp.lug_count) {
         errs.push(ParamError::new(
@@ -456,10 +457,10 @@ pub fn check_params(
     if errs.len() > before || skin_layer(stack).is_none() {
         return;
     }
-    let r = radii(design, sb, stack);
-    let lv = levels(design, sb);
-    let b = tip_bayonet(design, sb);
-    let poly = &design.printers.polyjet;
+    let r = radii(ctx, sb, stack);
+    let lv = levels(ctx, sb);
+    let b = tip_bayonet(ctx, sb);
+    let poly = &ctx.printers.polyjet;
     let mut rule = |ok: bool, path: &str, v: f64, text: String| {
         if !ok {
             errs.push(ParamError::new(format!("shaft_body.{path}"), v, text));
@@ -637,7 +638,7 @@ pub fn check_params(
         ),
     );
     if let Some(m) = &sb.robot_mount {
-        crate::parts::robot_mount::check_params(design, sb, m, errs);
+        crate::parts::robot_mount::check_params(ctx, sb, m, errs);
     }
 }
 
@@ -662,24 +663,24 @@ fn fitting_profile(r: &ShaftRadii, lv: &ShaftLevels) -> Polyline2 {
 /// # Errors
 /// [`GeometryError`] if the kernel fails.
 pub fn tip_fitting_solid(
-    design: &Design,
+    ctx: &Context<'_>,
     sb: &ShaftBodyParams,
     stack: &Stack,
     tol: ChordTolerance,
 ) -> Result<Solid, GeometryError> {
-    let r = radii(design, sb, stack);
-    let lv = levels(design, sb);
+    let r = radii(ctx, sb, stack);
+    let lv = levels(ctx, sb);
     let ring = Solid::from_mesh(&revolve(&fitting_profile(&r, &lv), tol)?)?;
-    let lugs = tip_bayonet(design, sb).lugs(r.skirt_bore_mm + OVERLAP_MM, tol)?;
+    let lugs = tip_bayonet(ctx, sb).lugs(r.skirt_bore_mm + OVERLAP_MM, tol)?;
     ring.union(&lugs)
 }
 
 /// The twin parameters of the fitting and the body: levels, radii, the bayonet, the pilots.
-pub fn twin_params(design: &Design, sb: &ShaftBodyParams, stack: &Stack) -> serde_json::Value {
-    let b = tip_bayonet(design, sb);
+pub fn twin_params(ctx: &Context<'_>, sb: &ShaftBodyParams, stack: &Stack) -> serde_json::Value {
+    let b = tip_bayonet(ctx, sb);
     json!({
-        "levels": levels(design, sb),
-        "radii": radii(design, sb, stack),
+        "levels": levels(ctx, sb),
+        "radii": radii(ctx, sb, stack),
         "bayonet": b,
         "lug_azimuths_deg": b.lug_azimuths_deg(),
         "mount_holes_xy_mm": mount_holes(sb),
@@ -689,7 +690,7 @@ pub fn twin_params(design: &Design, sb: &ShaftBodyParams, stack: &Stack) -> serd
         "mount": sb
             .robot_mount
             .as_ref()
-            .map(|m| crate::parts::robot_mount::twin_params(design, sb, m)),
+            .map(|m| crate::parts::robot_mount::twin_params(ctx, sb, m)),
     })
 }
 
@@ -703,13 +704,13 @@ fn mount_holes(sb: &ShaftBodyParams) -> Vec<[f64; 2]> {
 /// # Errors
 /// [`DesignError::Geometry`] naming the part if the kernel fails.
 pub fn build_body(
-    design: &Design,
+    ctx: &Context<'_>,
     sb: &ShaftBodyParams,
     stack: &Stack,
     tol: ChordTolerance,
 ) -> Result<Part, DesignError> {
-    let r = radii(design, sb, stack);
-    let lv = levels(design, sb);
+    let r = radii(ctx, sb, stack);
+    let lv = levels(ctx, sb);
     let g = |x: Result<Solid, GeometryError>| x.part("shaft_body");
     let cyl =
         |r: f64, z0: f64, z1: f64| cylinder(z1 - z0, r, tol).map(|s| s.translate([0.0, 0.0, z0]));
@@ -742,7 +743,7 @@ pub fn build_body(
             [-sw, 0.0, lv.bottom_z_mm - 1.0],
             [sw, r.base_outer_mm + 1.0, lv.bottom_z_mm + sh],
         ))?,
-        g(tip_bayonet(design, sb).grooves(tol))?,
+        g(tip_bayonet(ctx, sb).grooves(tol))?,
     ];
     for [x, y] in mount_holes(sb) {
         cuts.push(g(cyl(
@@ -754,9 +755,7 @@ pub fn build_body(
     }
     // the lugs that lock the base into the robot's mount
     let outer = match &sb.robot_mount {
-        Some(m) => g(outer.union(&g(crate::parts::robot_mount::base_lugs(
-            design, sb, m, tol,
-        ))?))?,
+        Some(m) => g(outer.union(&g(crate::parts::robot_mount::base_lugs(ctx, sb, m, tol))?))?,
         None => outer,
     };
     let body = g(outer.difference(&g(Solid::union_all(&cuts))?))?;
@@ -772,7 +771,7 @@ pub fn build_body(
         material: sb.material.clone(),
         print_technology: fdm_tech,
         solid: placed,
-        params: with_pose(twin_params(design, sb, stack), &pose),
+        params: with_pose(twin_params(ctx, sb, stack), &pose),
         group: None,
     })
 }
@@ -782,7 +781,7 @@ pub fn build_body(
 /// cone and its ray from the lens passes the lip's opening, the LED ring's bore and the
 /// shaft's bore (the pins' shadows and the gel's refraction ignored).
 pub fn view_fraction(
-    design: &Design,
+    ctx: &Context<'_>,
     sb: &ShaftBodyParams,
     stack: &Stack,
     tol: ChordTolerance,
@@ -790,13 +789,13 @@ pub fn view_fraction(
     let Some(skin) = skin_layer(stack) else {
         return 0.0;
     };
-    let r = radii(design, sb, stack);
-    let lv = levels(design, sb);
+    let r = radii(ctx, sb, stack);
+    let lv = levels(ctx, sb);
     let first = stack
         .layers
         .first()
         .map_or(skin.inner_offset_mm, |l| l.inner_offset_mm);
-    let curve = design.body.offset_polyline(first, 0.0, tol);
+    let curve = ctx.body.offset_polyline(first, 0.0, tol);
     let zl = lv.lens_z_mm;
     let tan_half = (sb.camera.view_angle_deg / 2.0).to_radians().tan();
     // apertures: (z of the top of the narrowing, radius)
@@ -841,21 +840,21 @@ pub fn view_fraction(
     }
 }
 
-/// The filling gel's solid, sensor frame: the innermost layer's inside above the base plane
-/// round the pins and their tips ([`crate::layers::inner_cavity`]), and the lip's opening down
-/// to the window.
+/// The filling gel's solid, sensor frame: `cavity`, the innermost layer's inside above the
+/// base plane round the pins and their tips (`layers::inner_cavity`), and the lip's opening
+/// down to the window.
 ///
 /// # Errors
 /// [`GeometryError`] if the kernel fails.
 pub fn filling_gel_solid(
-    design: &Design,
+    ctx: &Context<'_>,
     sb: &ShaftBodyParams,
     stack: &Stack,
+    cavity: Solid,
     tol: ChordTolerance,
 ) -> Result<Solid, GeometryError> {
-    let r = radii(design, sb, stack);
-    let lv = levels(design, sb);
-    let cavity = crate::layers::inner_cavity(design, stack, 0, tol)?;
+    let r = radii(ctx, sb, stack);
+    let lv = levels(ctx, sb);
     let lip = cylinder(lv.skin_base_z_mm - lv.lip_z_mm + 0.01, r.lip_inner_mm, tol)?.translate([
         0.0,
         0.0,
@@ -870,11 +869,11 @@ pub fn filling_gel_solid(
 /// # Errors
 /// [`DesignError::Geometry`] if the kernel fails.
 pub fn members(
-    design: &Design,
+    ctx: &Context<'_>,
     sb: &ShaftBodyParams,
     tol: ChordTolerance,
 ) -> Result<Vec<Member>, DesignError> {
-    let lv = levels(design, sb);
+    let lv = levels(ctx, sb);
     let disc = |name: &str, r: f64, z0: f64, z1: f64| -> Result<(Solid, ExactShape), DesignError> {
         let s = cylinder(z1 - z0, r, tol)
             .map(|s| s.translate([0.0, 0.0, z0]))

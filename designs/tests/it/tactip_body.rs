@@ -59,7 +59,7 @@ fn bayonet_bands_have_the_sectors_volume_ramped_or_flat() {
 fn locked_lugs_sit_clear_inside_their_grooves() {
     let d = tactip();
     let sb = d.shaft_body.as_ref().unwrap();
-    let b = tip_bayonet(&d, sb);
+    let b = tip_bayonet(&d.context(), sb);
     assert_eq!(b.lug_count, d.printers.fdm.bayonet.lug_count);
     assert_eq!(b.lug_count, 3);
     let r = b.spigot_radius_mm;
@@ -139,7 +139,7 @@ fn tactip_kit_has_the_body_and_an_assembly_without_interferences() {
     let materials = MaterialsTable::embedded().unwrap();
     let st = stack::validate(&d, &materials, tol()).unwrap();
     let narrow = fabkit_designs::parts::shaft_body::view_fraction(
-        &d,
+        &d.context(),
         d.shaft_body.as_ref().unwrap(),
         &st,
         tol(),
@@ -319,8 +319,8 @@ fn each_bayonet_unlocks_only_back_along_its_own_turn() {
     let d = tactip();
     let sb = d.shaft_body.as_ref().unwrap();
     let m = sb.robot_mount.as_ref().unwrap();
-    let tip = tip_bayonet(&d, sb);
-    let base = fabkit_designs::parts::robot_mount::mount_bayonet(&d, sb, m);
+    let tip = tip_bayonet(&d.context(), sb);
+    let base = fabkit_designs::parts::robot_mount::mount_bayonet(&d.context(), sb, m);
     assert!(!tip.clockwise && base.clockwise && base.outward && !tip.outward);
     let rot = |s: &Solid, deg: f64, dz: f64| {
         let (sn, cs) = deg.to_radians().sin_cos();
