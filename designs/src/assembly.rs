@@ -16,10 +16,10 @@
 use crate::error::{DesignError, GeometryContext, ParamError, ParamErrors};
 use crate::geometry::{cuboid, cylinder, revolve, Affine, ChordTolerance, Solid};
 use crate::housing::ShellLevels;
+use crate::parts::context::Stack;
 use crate::parts::Part;
 pub use crate::parts::{ExactShape, Member, MemberKind};
 use crate::schema::{Design, HousingStyle, LayerProcess};
-use crate::stack::Stack;
 
 /// Roles of kit parts that are part of the sensor (the rest are molds and tooling).
 pub const SENSOR_ROLES: [&str; 15] = [

@@ -10,8 +10,8 @@
 use crate::error::DesignError;
 use crate::geometry::ChordTolerance;
 use crate::layers::count_layer_markers;
+use crate::parts::context::Stack;
 use crate::schema::Design;
-use crate::stack::Stack;
 
 /// Default bound on the estimated triangles of one build: 4,000,000 (about 4 GB of peak memory;
 /// the library's kits have 40,000 to 170,000 at the default tolerance).

@@ -24,10 +24,10 @@
 
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{cuboid, cylinder, ChordTolerance, Solid};
+use crate::parts::context::{ResolvedCore, Stack};
 use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::{Part, PrintTechnology};
 use crate::schema::{Design, HousingParams, HousingStyle, RoundTube};
-use crate::stack::{ResolvedCore, Stack};
 use serde_json::json;
 
 /// z levels of the shell, sensor frame, mm (bottom to top).

@@ -13,8 +13,8 @@ use crate::assembly::{Interference, Member, MIN_OVERLAP_MM3};
 use crate::error::{DesignError, GeometryContext};
 use crate::geometry::{cylinder, ChordTolerance, Solid};
 use crate::housing::ShellLevels;
+use crate::parts::context::Stack;
 use crate::schema::{Design, HousingStyle};
-use crate::stack::Stack;
 
 /// The swept path of one member through one printed part, sensor frame, mm.
 #[derive(Debug, Clone)]

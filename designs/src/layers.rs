@@ -10,10 +10,10 @@
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{revolve, ChordTolerance, GeometryError, Polyline2, Solid};
 use crate::markers::{self, Marker, MarkerSpec, MarkerSurface, PatternStats, Polarity, Surface};
+use crate::parts::context::{ResolvedLayer, Stack};
 use crate::parts::placement::{place_posed, with_pose, IDENTITY};
 use crate::parts::{Part, PrintTechnology};
 use crate::schema::{Design, LayerProcess, MoldStrategy, Technology};
-use crate::stack::{ResolvedLayer, Stack};
 use crate::values::MAX_LENGTH_MM;
 use serde_json::json;
 

@@ -14,9 +14,9 @@
 
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{cuboid, revolve, sphere, Affine, ChordTolerance, Polyline2, Solid};
+use crate::parts::context::{ResolvedCore, Stack};
 use crate::parts::{Part, PrintTechnology};
 use crate::schema::{Design, LayerProcess, MoldStrategy};
-use crate::stack::{ResolvedCore, Stack};
 use serde_json::json;
 
 pub use crate::parts::placement::{affine_then, place_on_bed, place_posed, with_pose, IDENTITY};

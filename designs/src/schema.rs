@@ -21,6 +21,9 @@ pub use shared::{
     Backing, BrushedCoat, Core, CoreMachining, FillingGel, LayerProcess, MoldStrategy,
 };
 
+/// Lengths of a design that may be negative ([`crate::values::check_values`]): none.
+pub const DESIGN_SIGNED_MM: &[&str] = &[];
+
 /// A sensor design: body profile, rigid core, layer stack, molds, housing, printers.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
@@ -107,10 +110,10 @@ pub struct Layer {
     pub brushed_coat: Option<BrushedCoat>,
     /// Liquid channels in the layer (flat skins only; Soter et al. Sec. II-A).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub channels: Option<crate::flat::ChannelSet>,
+    pub channels: Option<crate::parts::channels::ChannelSet>,
     /// A grid of markers on the layer's bottom face (flat skins only; Soter et al. Sec. II-A).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub marker_grid: Option<crate::flat::MarkerGrid>,
+    pub marker_grid: Option<crate::parts::channels::MarkerGrid>,
 }
 
 /// Mold parameters shared by every cast layer. Geometry: R-Tac0 Sec. III-B1 and Fig. 4.

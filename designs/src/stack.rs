@@ -5,6 +5,9 @@ use crate::error::{ParamError, ParamErrors};
 use crate::geometry::{revolve, ChordTolerance, Solid};
 use crate::materials::{MaterialKind, MaterialsTable};
 pub use crate::parts::context::{ResolvedCore, ResolvedLayer, Stack};
+use crate::schema::printers::check_printers;
+pub use crate::schema::printers::{check_bed, MAX_BED_MM};
+pub use crate::schema::DESIGN_SIGNED_MM;
 use crate::schema::{Design, LayerProcess, MoldStrategy};
 
 impl Stack {
@@ -31,9 +34,6 @@ impl Stack {
         Solid::from_mesh(&revolve(&pl, tol)?)
     }
 }
-
-/// Lengths of a design that may be negative ([`crate::values::check_values`]): none.
-pub const DESIGN_SIGNED_MM: &[&str] = &[];
 
 /// Checks every rule of a design and resolves its stack. Reports every violation at once.
 ///
@@ -548,7 +548,7 @@ pub fn validate(
     }
 
     crate::molds::check_mold_params(design, &mut errs);
-    check_printers(design, &mut errs);
+    check_printers(&design.printers, &mut errs);
     if stack_ok {
         crate::layers::check_markers(design, &layers, &mut errs);
         let two_piece_rim = layers
@@ -706,78 +706,5 @@ fn resolve_core(
         below_base_mm: below_base.max(0.0),
         outer_radius_mm: sphere_r.map(|r| r + core_out),
         inner_radius_mm: sphere_r.map(|r| r + core_in),
-    }
-}
-
-pub(crate) fn check_printers(design: &Design, errs: &mut Vec<ParamError>) {
-    for (name, p) in [
-        ("fdm", &design.printers.fdm),
-        ("sla", &design.printers.sla),
-        ("polyjet", &design.printers.polyjet),
-    ] {
-        for (field, v) in [
-            ("xy_resolution_mm", p.xy_resolution_mm),
-            ("layer_height_mm", p.layer_height_mm),
-            ("min_wall_mm", p.min_wall_mm),
-            ("min_hole_diameter_mm", p.min_hole_diameter_mm),
-            ("min_feature_mm", p.min_feature_mm),
-        ] {
-            if !(v > 0.0 && v.is_finite()) {
-                errs.push(ParamError::new(
-                    format!("printers.{name}.{field}"),
-                    v,
-                    "must be above 0",
-                ));
-            }
-        }
-        if let Some(bed) = &p.bed {
-            check_bed(bed, &format!("printers.{name}.bed"), errs);
-        }
-    }
-}
-
-/// Largest bed side accepted, mm (a 10 m printer is a typo).
-pub const MAX_BED_MM: f64 = 10_000.0;
-
-/// The rules of a printer's bed, errors named under `path` (`printers.fdm.bed`, or a
-/// `--printer` file's own keys).
-pub fn check_bed(bed: &crate::schema::Bed, path: &str, errs: &mut Vec<ParamError>) {
-    let at = |k: &str| {
-        if path.is_empty() {
-            k.to_string()
-        } else {
-            format!("{path}.{k}")
-        }
-    };
-    if !crate::values::is_file_stem(&bed.name) {
-        errs.push(ParamError::new(
-            at("name"),
-            format!("'{}'", bed.name),
-            "must be a name of a-z, 0-9 and _, at most 64 characters (it names the plates in the manifest)",
-        ));
-    }
-    for (k, v) in bed.size_mm.iter().enumerate() {
-        if !(v.is_finite() && *v > 0.0 && *v <= MAX_BED_MM) {
-            errs.push(ParamError::new(
-                format!("{}[{k}]", at("size_mm")),
-                *v,
-                "must be above 0 and at most 10000 mm",
-            ));
-        }
-    }
-    let m = bed.margin_mm;
-    if !(m.is_finite() && m >= 0.0) {
-        errs.push(ParamError::new(at("margin_mm"), m, "must be 0 or more"));
-    } else if bed.size_mm[..2].iter().all(|v| v.is_finite() && *v > 0.0)
-        && 2.0 * m >= bed.size_mm[0].min(bed.size_mm[1])
-    {
-        errs.push(ParamError::new(
-            at("margin_mm"),
-            m,
-            format!(
-                "must leave room on the plate: twice the margin is below its smaller side ({} mm)",
-                bed.size_mm[0].min(bed.size_mm[1])
-            ),
-        ));
     }
 }

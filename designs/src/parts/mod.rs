@@ -3,6 +3,7 @@
 
 pub mod bayonet;
 pub mod casing;
+pub mod channels;
 pub mod context;
 pub mod core_shell;
 pub mod fasteners;

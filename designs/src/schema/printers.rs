@@ -1,6 +1,7 @@
 //! Printer profiles: what each print technology can print (walls, holes, features, the
 //! bayonet fit) and its bed; `printers` in a design.
 
+use crate::error::ParamError;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
@@ -208,5 +209,80 @@ impl PrinterProfiles {
                 .map(|(_, b)| b)
                 .expect("a shipped printer per technology")
         })
+    }
+}
+
+/// The rules of the printer profiles, errors named under `printers.<technology>.`: every
+/// capability above 0, and each bed's own rules ([`check_bed`]).
+pub(crate) fn check_printers(printers: &PrinterProfiles, errs: &mut Vec<ParamError>) {
+    for (name, p) in [
+        ("fdm", &printers.fdm),
+        ("sla", &printers.sla),
+        ("polyjet", &printers.polyjet),
+    ] {
+        for (field, v) in [
+            ("xy_resolution_mm", p.xy_resolution_mm),
+            ("layer_height_mm", p.layer_height_mm),
+            ("min_wall_mm", p.min_wall_mm),
+            ("min_hole_diameter_mm", p.min_hole_diameter_mm),
+            ("min_feature_mm", p.min_feature_mm),
+        ] {
+            if !(v > 0.0 && v.is_finite()) {
+                errs.push(ParamError::new(
+                    format!("printers.{name}.{field}"),
+                    v,
+                    "must be above 0",
+                ));
+            }
+        }
+        if let Some(bed) = &p.bed {
+            check_bed(bed, &format!("printers.{name}.bed"), errs);
+        }
+    }
+}
+
+/// Largest bed side accepted, mm (a 10 m printer is a typo).
+pub const MAX_BED_MM: f64 = 10_000.0;
+
+/// The rules of a printer's bed, errors named under `path` (`printers.fdm.bed`, or a
+/// `--printer` file's own keys).
+pub fn check_bed(bed: &Bed, path: &str, errs: &mut Vec<ParamError>) {
+    let at = |k: &str| {
+        if path.is_empty() {
+            k.to_string()
+        } else {
+            format!("{path}.{k}")
+        }
+    };
+    if !crate::values::is_file_stem(&bed.name) {
+        errs.push(ParamError::new(
+            at("name"),
+            format!("'{}'", bed.name),
+            "must be a name of a-z, 0-9 and _, at most 64 characters (it names the plates in the manifest)",
+        ));
+    }
+    for (k, v) in bed.size_mm.iter().enumerate() {
+        if !(v.is_finite() && *v > 0.0 && *v <= MAX_BED_MM) {
+            errs.push(ParamError::new(
+                format!("{}[{k}]", at("size_mm")),
+                *v,
+                "must be above 0 and at most 10000 mm",
+            ));
+        }
+    }
+    let m = bed.margin_mm;
+    if !(m.is_finite() && m >= 0.0) {
+        errs.push(ParamError::new(at("margin_mm"), m, "must be 0 or more"));
+    } else if bed.size_mm[..2].iter().all(|v| v.is_finite() && *v > 0.0)
+        && 2.0 * m >= bed.size_mm[0].min(bed.size_mm[1])
+    {
+        errs.push(ParamError::new(
+            at("margin_mm"),
+            m,
+            format!(
+                "must leave room on the plate: twice the margin is below its smaller side ({} mm)",
+                bed.size_mm[0].min(bed.size_mm[1])
+            ),
+        ));
     }
 }

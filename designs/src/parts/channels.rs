@@ -1,0 +1,364 @@
+//! The liquid channels and the marker grid of a flat skin's layer (Soter et al., Sec. II-A:
+//! 16 liquid-filled channels in the top layer, a 10 x 10 grid of markers on the bottom layer):
+//! their parameters (`layers[i].channels`, `layers[i].marker_grid`), rules and solids, in the
+//! flat-skin frame of [`crate::flat`] (docs/conventions.md, flat skins).
+
+use crate::error::ParamError;
+use crate::markers::{FeatureShape, Polarity};
+use crate::profile::FlatOutline;
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+use std::f64::consts::PI;
+
+/// What closes a channel's liquid circuit (Soter et al. Sec. II-A: "each channel is closed at
+/// both ends, this ensures that the liquid always returns back to its initial state"; and
+/// "the internal chambers are closed on one end", which is why they are filled in a tank).
+/// The channel in the skin is the same either way: closed at its far end, open at the near
+/// edge into its tube.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum ChannelEnds {
+    /// The tube's display end is sealed once filled: the liquid cannot leave the circuit.
+    #[default]
+    BothClosed,
+    /// The display end stays open to the air.
+    OneClosed,
+}
+
+/// The silicone tube glued into a channel's open end (Sil-Poxy, Soter et al. Sec. II-A).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ChannelTube {
+    /// Outer diameter, mm: at least the channel's width and height, so that it seals the
+    /// channel's mouth by stretching it.
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    pub outer_diameter_mm: f64,
+    /// Inner diameter, mm, below the outer.
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    pub inner_diameter_mm: f64,
+    /// From the skin to the display, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    pub length_mm: f64,
+    /// How far it is pushed into the channel, mm, below the channel's length.
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    pub insertion_mm: f64,
+}
+
+/// Straight channels of rectangular section in one layer, along y, side by side across x at
+/// `pitch_mm`, centred on the axis: grooves in the layer's bottom face, closed by the layer
+/// under it, open at the near edge for their tubes and closed `length_mm` from it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ChannelSet {
+    /// Number of channels, at least 1 (Soter et al. Sec. II-A: 16); their mouths together
+    /// must fit on the near edge's straight part less `min_wall_mm` at each corner.
+    #[schemars(extend("minimum" = 1))]
+    pub count: usize,
+    /// Across x, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    pub width_mm: f64,
+    /// Up z from the layer's bottom face, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    pub height_mm: f64,
+    /// Centre to centre, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    pub pitch_mm: f64,
+    /// From the near edge to the closed far end, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    pub length_mm: f64,
+    #[serde(default)]
+    pub ends: ChannelEnds,
+    /// Least silicone between two channels, over a channel (to the contact face), beyond its
+    /// far end and to the outline's side, mm.
+    #[serde(default = "default_min_wall")]
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    pub min_wall_mm: f64,
+    pub tube: ChannelTube,
+}
+
+fn default_min_wall() -> f64 {
+    0.5
+}
+
+impl ChannelSet {
+    /// x of each channel's centre line, mm.
+    pub fn centres_x_mm(&self) -> Vec<f64> {
+        let mid = (self.count as f64 - 1.0) / 2.0;
+        (0..self.count)
+            .map(|i| (i as f64 - mid) * self.pitch_mm)
+            .collect()
+    }
+
+    /// The void of one channel, mm^3: width x height x length.
+    pub fn channel_volume_mm3(&self) -> f64 {
+        self.width_mm * self.height_mm * self.length_mm
+    }
+
+    /// The liquid of one channel's circuit, mL: the channel less the tube's inserted end,
+    /// plus the tube's bore over its length.
+    pub fn liquid_per_channel_ml(&self) -> f64 {
+        let t = &self.tube;
+        let plug = PI * (t.outer_diameter_mm / 2.0).powi(2) * t.insertion_mm;
+        let bore = PI * (t.inner_diameter_mm / 2.0).powi(2) * t.length_mm;
+        ((self.channel_volume_mm3() - plug).max(0.0) + bore) / 1000.0
+    }
+
+    /// Every violation under `prefix` (`layers[1].channels.`), for channels in a layer
+    /// `layer_thickness_mm` thick inside `outline`.
+    pub fn errors(
+        &self,
+        prefix: &str,
+        layer_thickness_mm: f64,
+        outline: &FlatOutline,
+    ) -> Vec<ParamError> {
+        let mut errs = Vec::new();
+        let p = |f: &str| format!("{prefix}{f}");
+        if self.count == 0 {
+            errs.push(ParamError::new(p("count"), 0, "must be 1 or more"));
+        }
+        crate::parts::check_positive(
+            prefix,
+            &[
+                ("width_mm", self.width_mm),
+                ("height_mm", self.height_mm),
+                ("pitch_mm", self.pitch_mm),
+                ("length_mm", self.length_mm),
+                ("min_wall_mm", self.min_wall_mm),
+                ("tube.outer_diameter_mm", self.tube.outer_diameter_mm),
+                ("tube.inner_diameter_mm", self.tube.inner_diameter_mm),
+                ("tube.length_mm", self.tube.length_mm),
+                ("tube.insertion_mm", self.tube.insertion_mm),
+            ],
+            &mut errs,
+        );
+        if !errs.is_empty() {
+            return errs;
+        }
+        let w = self.min_wall_mm;
+        if self.count > 1 && self.width_mm + w > self.pitch_mm {
+            errs.push(ParamError::new(
+                p("width_mm"),
+                self.width_mm,
+                format!(
+                    "channels {} mm wide at a {} mm pitch leave less than min_wall_mm ({w} mm) between them: the width must be at most the pitch less the wall",
+                    self.width_mm, self.pitch_mm
+                ),
+            ));
+        }
+        if self.height_mm + w > layer_thickness_mm {
+            errs.push(ParamError::new(
+                p("height_mm"),
+                self.height_mm,
+                format!(
+                    "the channel breaks through the skin's face: its layer is {layer_thickness_mm} mm thick, so a channel may be at most {:.3} mm high under a min_wall_mm ({w} mm) roof",
+                    layer_thickness_mm - w
+                ),
+            ));
+        }
+        if self.length_mm + w > outline.length_mm {
+            errs.push(ParamError::new(
+                p("length_mm"),
+                self.length_mm,
+                format!(
+                    "the far end must stay min_wall_mm ({w} mm) inside the {} mm outline",
+                    outline.length_mm
+                ),
+            ));
+        }
+        // the mouths open on the near edge's straight part, min_wall_mm from its corners
+        let span = (self.count as f64 - 1.0) * self.pitch_mm / 2.0 + self.width_mm / 2.0;
+        let straight = outline.width_mm / 2.0 - outline.corner_radius_mm - w;
+        if span > straight {
+            errs.push(ParamError::new(
+                p("count"),
+                self.count,
+                format!(
+                    "{} channels at a {} mm pitch span {:.3} mm across: more than the near edge's straight part less min_wall_mm ({:.3} mm)",
+                    self.count,
+                    self.pitch_mm,
+                    2.0 * span,
+                    2.0 * straight
+                ),
+            ));
+        }
+        let t = &self.tube;
+        if t.inner_diameter_mm >= t.outer_diameter_mm {
+            errs.push(ParamError::new(
+                p("tube.inner_diameter_mm"),
+                t.inner_diameter_mm,
+                format!(
+                    "must be below the outer diameter ({} mm)",
+                    t.outer_diameter_mm
+                ),
+            ));
+        }
+        let mouth = self.width_mm.max(self.height_mm);
+        if t.outer_diameter_mm < mouth {
+            errs.push(ParamError::new(
+                p("tube.outer_diameter_mm"),
+                t.outer_diameter_mm,
+                format!("must be at least the channel's width and height ({mouth} mm), to seal its mouth"),
+            ));
+        }
+        if self.count > 1 && t.outer_diameter_mm >= self.pitch_mm {
+            errs.push(ParamError::new(
+                p("tube.outer_diameter_mm"),
+                t.outer_diameter_mm,
+                format!(
+                    "must be below the pitch ({} mm): neighbouring tubes side by side",
+                    self.pitch_mm
+                ),
+            ));
+        }
+        if t.insertion_mm >= self.length_mm {
+            errs.push(ParamError::new(
+                p("tube.insertion_mm"),
+                t.insertion_mm,
+                format!("must be below the channel's length ({} mm)", self.length_mm),
+            ));
+        }
+        errs
+    }
+}
+
+/// Markers on a grid, `rows` along y by `columns` along x at `pitch_mm`, centred on the axis,
+/// standing on a layer's bottom face towards the camera (Soter et al. Sec. II-A: a 10 x 10
+/// grid of 3D markers whose ends are painted white).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct MarkerGrid {
+    /// Number of rows, stacked along y, at least 1 (Soter et al. Sec. II-A: a 10 x 10 grid).
+    #[schemars(extend("minimum" = 1))]
+    pub rows: usize,
+    /// Number of columns, side by side along x, at least 1 (Soter et al. Sec. II-A: a 10 x 10
+    /// grid).
+    #[schemars(extend("minimum" = 1))]
+    pub columns: usize,
+    /// Centre-to-centre distance between neighbouring markers along x and along y, mm, > 0:
+    /// above the markers' diameter (with more than one row or column), and the outermost
+    /// markers must keep `edge_margin_mm` inside the outline.
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    pub pitch_mm: f64,
+    /// A cylinder ending in a hemisphere (`polarity: raised`: it stands out of the face).
+    pub feature: FeatureShape,
+    /// Least distance from a marker's side to the outline's edge, mm.
+    #[serde(default = "default_edge_margin")]
+    pub edge_margin_mm: f64,
+}
+
+fn default_edge_margin() -> f64 {
+    1.0
+}
+
+impl MarkerGrid {
+    /// (x, y) of each marker's axis, row by row from -y, mm.
+    pub fn positions_mm(&self) -> Vec<[f64; 2]> {
+        let (mr, mc) = (
+            (self.rows as f64 - 1.0) / 2.0,
+            (self.columns as f64 - 1.0) / 2.0,
+        );
+        (0..self.rows)
+            .flat_map(|r| {
+                (0..self.columns).map(move |c| {
+                    [
+                        (c as f64 - mc) * self.pitch_mm,
+                        (r as f64 - mr) * self.pitch_mm,
+                    ]
+                })
+            })
+            .collect()
+    }
+
+    /// Every violation under `prefix` (`layers[0].marker_grid.`).
+    pub fn errors(&self, prefix: &str, outline: &FlatOutline) -> Vec<ParamError> {
+        let mut errs = Vec::new();
+        let p = |f: &str| format!("{prefix}{f}");
+        for (f, n) in [("rows", self.rows), ("columns", self.columns)] {
+            if n == 0 {
+                errs.push(ParamError::new(p(f), 0, "must be 1 or more"));
+            }
+        }
+        // bounded before positions_mm allocates one position per marker
+        let max = crate::markers::MAX_MARKERS_PER_PATTERN;
+        if self.rows.checked_mul(self.columns).is_none_or(|n| n > max) {
+            let (f, n) = if self.rows >= self.columns {
+                ("rows", self.rows)
+            } else {
+                ("columns", self.columns)
+            };
+            errs.push(ParamError::new(
+                p(f),
+                n,
+                format!(
+                    "a {} x {} grid has more than the {max} markers one grid may have",
+                    self.rows, self.columns
+                ),
+            ));
+        }
+        crate::parts::check_positive(
+            prefix,
+            &[
+                ("pitch_mm", self.pitch_mm),
+                ("feature.diameter_mm", self.feature.diameter_mm),
+                ("feature.height_mm", self.feature.height_mm),
+            ],
+            &mut errs,
+        );
+        if !(self.edge_margin_mm >= 0.0 && self.edge_margin_mm.is_finite()) {
+            errs.push(ParamError::new(
+                p("edge_margin_mm"),
+                self.edge_margin_mm,
+                "must be 0 or more",
+            ));
+        }
+        if !errs.is_empty() {
+            return errs;
+        }
+        let r = self.feature.radius_mm();
+        if self.feature.height_mm < r {
+            errs.push(ParamError::new(
+                p("feature.height_mm"),
+                self.feature.height_mm,
+                format!("must be at least the radius ({r} mm): the marker ends in a hemisphere"),
+            ));
+        }
+        if self.feature.side() != Polarity::Raised {
+            errs.push(ParamError::new(
+                p("feature.polarity"),
+                "recessed",
+                "grid markers stand out of the face (raised)",
+            ));
+        }
+        if self.feature.diameter_mm >= self.pitch_mm && self.rows.max(self.columns) > 1 {
+            errs.push(ParamError::new(
+                p("feature.diameter_mm"),
+                self.feature.diameter_mm,
+                format!(
+                    "must be below the pitch ({} mm): markers would merge",
+                    self.pitch_mm
+                ),
+            ));
+        }
+        let worst = self
+            .positions_mm()
+            .into_iter()
+            .map(|q| outline.inset_mm(q))
+            .fold(f64::INFINITY, f64::min);
+        if worst - r < self.edge_margin_mm {
+            errs.push(ParamError::new(
+                p("pitch_mm"),
+                self.pitch_mm,
+                format!(
+                    "a {} x {} grid at this pitch does not fit the {} x {} mm outline: its outermost marker's side is {:.3} mm from the edge, edge_margin_mm is {}",
+                    self.rows,
+                    self.columns,
+                    outline.width_mm,
+                    outline.length_mm,
+                    worst - r,
+                    self.edge_margin_mm
+                ),
+            ));
+        }
+        errs
+    }
+}
