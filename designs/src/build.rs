@@ -7,6 +7,7 @@ use crate::kit::Kit;
 use crate::materials::{pour, MaterialsTable};
 use crate::molds::{build_mold, cast_plans};
 use crate::parts::fasteners::{metric_from_pilot, metric_name};
+use crate::parts::registry::FAMILIES;
 use crate::schema::{Design, LayerProcess, MoldStrategy};
 use crate::stack::{validate, Stack};
 use rayon::prelude::*;
@@ -116,49 +117,15 @@ pub fn build_kit_bounded(
                         .map(|h| crate::housing::build_shell(design, h, &stack, tol))
                 },
                 || {
-                    rayon::join(
-                        || {
-                            design.shaft_body.as_ref().map(
-                                |sb| -> Result<Vec<crate::Part>, DesignError> {
-                                    let mut out = vec![crate::parts::shaft_body::build_body(
-                                        &design.context(),
-                                        sb,
-                                        &stack,
-                                        tol,
-                                    )?];
-                                    if let Some(m) = &sb.robot_mount {
-                                        out.push(crate::parts::robot_mount::build_mount(
-                                            &design.context(),
-                                            sb,
-                                            m,
-                                            tol,
-                                        )?);
-                                    }
-                                    Ok(out)
-                                },
-                            )
-                        },
-                        || {
-                            rayon::join(
-                                || design.casing.as_ref().map(build_casing_parts(design, tol)),
-                                || {
-                                    design.fingertip_base.as_ref().map(|f| {
-                                        crate::parts::fingertip_base::build_parts(
-                                            &design.context(),
-                                            f,
-                                            &stack,
-                                            tol,
-                                        )
-                                    })
-                                },
-                            )
-                        },
-                    )
+                    FAMILIES
+                        .par_iter()
+                        .map(|f| f.build(design, &stack, tol))
+                        .collect::<Vec<_>>()
                 },
             )
         },
     );
-    let (shell, (shaft_body, (casing, fingertip))) = shell;
+    let (shell, sections) = shell;
     let mut layer_markers = Vec::new();
     for (&i, out) in other.iter().zip(others) {
         let out = out?;
@@ -214,61 +181,14 @@ pub fn build_kit_bounded(
         shell_levels = Some(levels);
     }
 
-    if let (Some(sb), Some(body)) = (&design.shaft_body, shaft_body) {
-        parts.extend(body?);
-        let lv = crate::parts::shaft_body::levels(&design.context(), sb);
-        let r = design.body.rim_radius_mm(0.0);
-        let w = sb.base.outer_diameter_mm.max(2.0 * r);
-        summary["shaft_levels"] = json!(&lv);
-        summary["envelope_mm"] = json!([w, w, lv.envelope_height_mm]);
-        summary["camera_view"] = json!({
-            "tip_inner_surface_fraction_seen":
-                crate::parts::shaft_body::view_fraction(&design.context(), sb, &stack, tol),
-            "lens_z_mm": lv.lens_z_mm,
-            "view_angle_deg": sb.camera.view_angle_deg,
-            "focal_length_mm": sb.camera.focal_length_mm,
-            "rule": "area fraction of the skin's inner surface above the base plane inside the lens's view cone whose ray passes the lip's opening, the LED ring's bore and the shaft's bore (the pins' shadows and the gel's refraction ignored)",
-        });
-        bought.extend(crate::parts::shaft_body::bought_items(sb));
-        if let Some(m) = &sb.robot_mount {
-            bought.extend(crate::parts::robot_mount::bought_items(m));
+    for (f, built) in FAMILIES.iter().zip(sections) {
+        let Some(built) = built else { continue };
+        let built = built?;
+        parts.extend(built.parts);
+        for (key, value) in built.summary {
+            summary[key] = value;
         }
-    }
-
-    if let (Some(c), Some(parts_c)) = (&design.casing, casing) {
-        parts.extend(parts_c?);
-        let lv = crate::parts::casing::levels(&design.context(), c);
-        let w = c
-            .gripper_base
-            .as_ref()
-            .map_or([c.outer_width_mm; 2], |g| [g.width_mm, g.length_mm]);
-        summary["casing_levels"] = json!(&lv);
-        if let Some(b) = &design.backing {
-            summary["camera_view"] = json!({
-                "rim_crossing_radius_mm": crate::parts::casing::plate_crossing_radius_mm(
-                    design.body.rim_radius_mm(0.0),
-                    lv.top_z_mm - lv.lens_z_mm,
-                    b.thickness_mm,
-                    crate::parts::casing::PMMA_REFRACTIVE_INDEX,
-                ),
-                "window_radius_mm": c.window_diameter_mm / 2.0,
-                "lens_z_mm": lv.lens_z_mm,
-                "rule": "the ray from the lens's front (on the axis) to the skin's rim, refracted by the backing plate, crosses the casing's top inside the window",
-            });
-        }
-        summary["envelope_mm"] = json!([w[0], w[1], lv.envelope_height_mm]);
-        bought.extend(crate::parts::casing::bought_items(c));
-    }
-
-    if let (Some(f), Some(parts_f)) = (&design.fingertip_base, fingertip) {
-        parts.extend(parts_f?);
-        let lv = crate::parts::fingertip_base::levels(&design.context(), f, &stack);
-        let w = f
-            .outer_diameter_mm
-            .max(2.0 * design.body.rim_radius_mm(0.0));
-        summary["fingertip_levels"] = json!(&lv);
-        summary["envelope_mm"] = json!([w, w, lv.envelope_height_mm]);
-        bought.extend(crate::parts::fingertip_base::bought_items(f));
+        bought.extend(f.bought_items(design));
     }
 
     let mut casts = Vec::new();
@@ -390,37 +310,22 @@ pub fn build_kit_bounded(
     // The assembled sensor and its fit check: no file is written when parts overlap.
     let mut assembly =
         crate::assembly::members(design, &stack, &parts, shell_levels.as_ref(), tol)?;
-    if let Some(sb) = &design.shaft_body {
-        assembly.extend(crate::parts::shaft_body::members(
-            &design.context(),
-            sb,
-            tol,
-        )?);
-        if let Some((solid, material)) = tip_gel {
-            assembly.push(crate::assembly::Member {
-                name: crate::procedure::FILLING_GEL.into(),
-                kind: crate::assembly::MemberKind::Cast,
-                description: format!(
-                    "Clear gel ({material}) between the skin and the lens window, round the pins"
-                ),
-                solid,
-                fix: vec!["shaft_body.tip_fitting.lip_width_mm".into()],
-                // the skin's cavity less its pins and tips: nested with them by construction
-                nested_by_stack: true,
-                exact: None,
-            });
-        }
+    for f in FAMILIES {
+        assembly.extend(f.members(design, &stack, tol)?);
     }
-    if let Some(c) = &design.casing {
-        assembly.extend(crate::parts::casing::members(&design.context(), c, tol)?);
-    }
-    if let Some(f) = &design.fingertip_base {
-        assembly.extend(crate::parts::fingertip_base::members(
-            &design.context(),
-            f,
-            &stack,
-            tol,
-        )?);
+    if let Some((solid, material)) = tip_gel {
+        assembly.push(crate::assembly::Member {
+            name: crate::procedure::FILLING_GEL.into(),
+            kind: crate::assembly::MemberKind::Cast,
+            description: format!(
+                "Clear gel ({material}) between the skin and the lens window, round the pins"
+            ),
+            solid,
+            fix: vec!["shaft_body.tip_fitting.lip_width_mm".into()],
+            // the skin's cavity less its pins and tips: nested with them by construction
+            nested_by_stack: true,
+            exact: None,
+        });
     }
     let found = crate::assembly::interferences(&assembly, tol)?;
     if let Some(e) = crate::assembly::fit_errors(design, &found) {
@@ -682,29 +587,6 @@ fn housing_items(h: &crate::schema::HousingParams) -> Vec<String> {
         );
     }
     v
-}
-
-/// The casing and, with one, its gripper base (ShadowTac Sec. IV-B).
-fn build_casing_parts(
-    design: &Design,
-    tol: ChordTolerance,
-) -> impl Fn(&crate::parts::casing::CasingParams) -> Result<Vec<crate::Part>, DesignError> + '_ {
-    move |c| {
-        let mut out = vec![crate::parts::casing::build_casing(
-            &design.context(),
-            c,
-            tol,
-        )?];
-        if let Some(g) = &c.gripper_base {
-            out.push(crate::parts::casing::build_base(
-                &design.context(),
-                c,
-                g,
-                tol,
-            )?);
-        }
-        Ok(out)
-    }
 }
 
 /// Volume of `layer` alone, mm^3: the solid under its outer surface down to the base plane,

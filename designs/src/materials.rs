@@ -409,3 +409,33 @@ pub struct CastComponent {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub volume_ml: Option<f64>,
 }
+
+impl CastReport {
+    /// How the mix of this pour is measured: `12.36 g of Dow SYLGARD 184 (10:1 by weight)`.
+    pub fn mix_text(&self) -> String {
+        let by_volume = self.components.iter().all(|x| x.volume_ml.is_some());
+        if by_volume {
+            let ml: f64 = self.components.iter().filter_map(|x| x.volume_ml).sum();
+            format!("{ml:.1} mL of {} ({})", self.material_name, self.mix_ratio)
+        } else {
+            format!(
+                "{:.2} g of {} ({})",
+                self.total_mass_g, self.material_name, self.mix_ratio
+            )
+        }
+    }
+}
+
+/// The cure time from a material's notes (`cure 4 h at 23 C`), or the notes' pointer.
+pub fn cure_text(notes: &str) -> String {
+    let lower = notes.to_lowercase();
+    lower
+        .find("cure")
+        .and_then(|i| {
+            let rest = &notes[i..];
+            let end = rest.find(['.', ';', '(']).unwrap_or(rest.len());
+            let t = rest[..end].trim();
+            (t.len() > "cure".len()).then(|| t.to_string())
+        })
+        .unwrap_or_else(|| "see the step's notes".into())
+}

@@ -7,9 +7,11 @@
 //! clear silicone sealant); ShadowTac Sec. III (release sprayed, poured, degassed, cured 24 h,
 //! glued to the PMMA plate).
 
-use crate::materials::CastReport;
 use crate::materials::MaterialKind;
+use crate::materials::{cure_text, CastReport};
+use crate::parts::family::AssemblyStep;
 use crate::parts::fasteners::bolt_name;
+use crate::parts::registry::FAMILIES;
 use crate::parts::{Part, ProcedureAction, ProcedureStep};
 use crate::schema::Design;
 
@@ -111,20 +113,6 @@ fn with_role<'a>(parts: &'a [Part], names: &[String], roles: &[&str]) -> Vec<&'a
 
 fn step(action: ProcedureAction, text: String) -> ProcedureStep {
     ProcedureStep { action, text }
-}
-
-/// How the mix of a pour is measured: `12.36 g of Dow SYLGARD 184 (10:1 by weight)`.
-fn mix_text(c: &CastReport) -> String {
-    let by_volume = c.components.iter().all(|x| x.volume_ml.is_some());
-    if by_volume {
-        let ml: f64 = c.components.iter().filter_map(|x| x.volume_ml).sum();
-        format!("{ml:.1} mL of {} ({})", c.material_name, c.mix_ratio)
-    } else {
-        format!(
-            "{:.2} g of {} ({})",
-            c.total_mass_g, c.material_name, c.mix_ratio
-        )
-    }
 }
 
 /// The procedure of a kit in order, from its parts (roles, names, parameters), its pours
@@ -232,7 +220,7 @@ pub fn procedure(
                 ),
             ));
         }
-        let mix = mix_text(c);
+        let mix = c.mix_text();
         if !halves.is_empty() {
             let (a, b) = (
                 &halves[0].name,
@@ -386,7 +374,7 @@ fn treatment_steps(out: &mut Vec<ProcedureStep>, c: &CastReport, kind: MaterialK
 fn mold_star_steps(out: &mut Vec<ProcedureStep>, design: &Design, parts: &[Part], c: &CastReport) {
     use ProcedureAction as A;
     let n = c.step;
-    let mix = mix_text(c);
+    let mix = c.mix_text();
     let master = with_role(parts, &c.mold_parts, &["master_pattern"]);
     let boxes = with_role(parts, &c.mold_parts, &["mold_box"]);
     let negative = with_role(parts, &c.mold_parts, &["negative_mold"]);
@@ -491,20 +479,6 @@ fn sprue_pour_text(n: u32, mix: &str, holder: Option<&Part>) -> String {
         "Step {n}: stand the mold pole-down, the holder's flange on top. Mix and degas {mix} and \
          pour it slowly through the sprue ({sprue}) until it shows in every vent."
     )
-}
-
-/// The cure time from a material's notes (`cure 4 h at 23 C`), or the notes' pointer.
-fn cure_text(notes: &str) -> String {
-    let lower = notes.to_lowercase();
-    lower
-        .find("cure")
-        .and_then(|i| {
-            let rest = &notes[i..];
-            let end = rest.find(['.', ';', '(']).unwrap_or(rest.len());
-            let t = rest[..end].trim();
-            (t.len() > "cure".len()).then(|| t.to_string())
-        })
-        .unwrap_or_else(|| "see the step's notes".into())
 }
 
 /// The assembly steps in order, each with its screws or glue: the contact module's own
@@ -635,114 +609,13 @@ fn assembly_steps(
             _ => {}
         }
     }
-    if let Some(sb) = &design.shaft_body {
-        let body = named("shaft_body")
-            .first()
-            .cloned()
-            .unwrap_or_else(|| "the body".into());
-        let fitting = named("tip_fitting")
-            .first()
-            .cloned()
-            .unwrap_or_else(|| "the tip's fitting".into());
-        let screws = crate::parts::fasteners::metric_from_pilot(sb.camera.mount_pilot_diameter_mm)
-            .map_or_else(String::new, |d| format!(" M{d}"));
-        let bayonet = &design.printers.fdm.bayonet;
-        out.push(format!(
-            "Press the LED ring PCB ({} LEDs, facing up) into its seat at the top of {body}, its \
-             wires down the bore, through the ceiling's hole beside the lens and out through the \
-             cable slot (Pestell et al. Sec. III-A).",
-            sb.led_ring.led_count
-        ));
-        out.push(format!(
-            "Screw the camera board into the pocket under {body}, up against the ceiling, with 4 \
-             self-tapping screws{screws} ({:.1} mm pilots), the lens up through the ceiling's \
-             hole and the cable out through the slot; focus the adjustable lens on the pins once \
-             the tip is on (Pestell et al. Sec. III-A2).",
-            sb.camera.mount_pilot_diameter_mm
-        ));
-        if let Some(c) = filling {
-            filled = Some((out.len(), tip_filling_step(c, &fitting)));
+    for f in FAMILIES {
+        for s in f.assembly_steps(design, parts, filling) {
+            match s {
+                AssemblyStep::Text(t) => out.push(t),
+                AssemblyStep::Step(s) => filled = Some((out.len(), s)),
+            }
         }
-        if let Some(m) = &sb.robot_mount {
-            out.push(format!(
-                "Bolt `robot_mount` to the tool flange of the {} with {} socket head cap \
-                 screws, its locating pin in the flange's pin hole; set the base of {body} into \
-                 its cup, the {n} lugs down the entry grooves and the camera's cable out through \
-                 the window, and turn {body} {:.0} deg clockwise (seen from the tip's pole) \
-                 until it stops (Pestell et al. Sec. III-A3: the body attaches to the robot's \
-                 mount by a bayonet).",
-                m.robot,
-                m.bolt_count,
-                m.bayonet.lock_angle_deg,
-                n = bayonet.lug_count
-            ));
-        }
-        out.push(format!(
-            "Twist the tip onto {body}: the {n} lugs of {fitting} down the {n} entry grooves, \
-             push it home, then turn it {:.0} deg counter-clockwise (seen from the tip's pole) \
-             until the lugs stop at the grooves' closed ends; the {:.0} deg ramp draws it down \
-             onto the shaft (Pestell et al. Sec. III-A: a bayonet mount for replacing tips).",
-            sb.bayonet.lock_angle_deg,
-            bayonet.ramp_deg,
-            n = bayonet.lug_count
-        ));
-    }
-    if let Some(c) = &design.casing {
-        let casing = named("casing")
-            .first()
-            .cloned()
-            .unwrap_or_else(|| "the casing".into());
-        let azimuths = crate::parts::casing::led_azimuths_deg(c)
-            .iter()
-            .map(|a| format!("{a:.0}"))
-            .collect::<Vec<_>>()
-            .join(", ");
-        out.push(format!(
-            "Cut {n} single-LED segments from the strip ({}) and push one into each slot in the light chamber's wall of {casing} (at {azimuths} deg from +x), LED facing the axis and its top end flush with the casing's top face, close under the plate; lead the wires down the slot, across the chamber's floor and through the ledge's hole into the camera bay (ShadowTac Sec. IV-B: red, green and blue at 120 deg, close to the acrylic plate).",
-            c.leds.description,
-            n = c.leds.count
-        ));
-        out.push(format!(
-            "Glue the backing plate, the skin up, onto the top face of {casing} with cyanoacrylate, centred over the window (ShadowTac Sec. IV-B)."
-        ));
-        out.push(format!(
-            "Set the camera board ({}) into the bay of {casing} from below, the lens up through the ledge's bore, the LEDs' wires beside it.",
-            c.camera.module
-        ));
-        if let Some(g) = &c.gripper_base {
-            out.push(format!(
-                "Set {casing} into the socket of `gripper_base`, the camera's cable out through the slot on +y, and fasten it with 4 screws up through the base's counterbored holes into the casing's pilots; bolt the base to the {} with 4 bolts (ShadowTac Sec. IV-B: a base to mount the sensor on a robotic gripper).",
-                g.gripper
-            ));
-        }
-    }
-    if let Some(f) = &design.fingertip_base {
-        out.push(format!(
-            "Glue the camera ({}) into `camera_holder` with instant adhesive, its front flush \
-             with the holder's top and its wire down the bore; glue the holder onto the floor of \
-             the pocket of `sensor_base`, over the centre hole, the wire down through the floor \
-             (UVDtact Sec. III-C).",
-            f.camera.module
-        ));
-        out.push(
-            "Lead the lighting PCB's wires down through the floor's wire hole and glue the PCB, \
-             LEDs up and the first white LED on +x, onto the pocket's floor round the camera \
-             holder; glue `diffusion_ring` on top, flush with the base's top, its holes over the \
-             UV LEDs (UVDtact Sec. III-C)."
-                .into(),
-        );
-        out.push(
-            "Glue the acrylic shell's foot, with the elastomer on it, into `shell_holder` with \
-             instant adhesive, the shell's end flush with the holder's bottom (UVDtact \
-             Sec. III-C)."
-                .into(),
-        );
-        out.push(format!(
-            "Set `shell_holder` on `sensor_base` and fasten them with {} bolts up through the \
-             base's counterbored holes; to replace the elastomer, undo them (UVDtact Sec. III-C: \
-             three M1.2 bolts).",
-            f.bolts.count
-        ));
     }
     if out.is_empty() && filled.is_none() {
         out.push(if parts.iter().any(|p| p.role == "printed_skin") {
@@ -764,25 +637,6 @@ fn assembly_steps(
     steps
 }
 
-/// The filling gel's pour into the printed tip, pole-down, closed by the lens window
-/// (Pestell et al. Sec. III-A).
-fn tip_filling_step(c: &CastReport, fitting: &str) -> ProcedureStep {
-    step(
-        ProcedureAction::Pour,
-        format!(
-            "Step {}: stand the tip pole-down, {fitting} up, mix and degas {} and pour it into \
-             the tip round the pins until it is level with the top of the lip's opening \
-             ({:.2} mL to fill); lay the lens window into its seat in {fitting} on the lip, \
-             sliding it on from one side so that no air is caught (Pestell et al. Sec. III-A). \
-             Let it cure ({}) before the tip goes on the body.",
-            c.step,
-            mix_text(c),
-            c.layer_volume_ml.unwrap_or(c.cavity_volume_ml),
-            cure_text(&c.notes)
-        ),
-    )
-}
-
 /// The filling gel's pour and cure, with the sensor pole-down and the camera not yet on
 /// (R-Tac0 Sec. III-B1).
 fn filling_step(c: &CastReport) -> ProcedureStep {
@@ -795,7 +649,7 @@ fn filling_step(c: &CastReport) -> ProcedureStep {
              opening and the light chamber and glues the core to the shell (R-Tac0 \
              Sec. III-B1). Let it cure ({}) before the camera goes on.",
             c.step,
-            mix_text(c),
+            c.mix_text(),
             c.layer_volume_ml.unwrap_or(c.cavity_volume_ml),
             cure_text(&c.notes)
         ),

@@ -5,6 +5,7 @@ use crate::error::{ParamError, ParamErrors};
 use crate::geometry::{revolve, ChordTolerance, Solid};
 use crate::materials::{MaterialKind, MaterialsTable};
 pub use crate::parts::context::{ResolvedCore, ResolvedLayer, Stack};
+use crate::parts::registry::FAMILIES;
 use crate::schema::printers::check_printers;
 pub use crate::schema::printers::{check_bed, MAX_BED_MM};
 pub use crate::schema::DESIGN_SIGNED_MM;
@@ -576,22 +577,14 @@ pub fn validate(
             )),
         }
     }
-    if let (Some(sb), true) = (&design.shaft_body, stack_ok) {
+    if stack_ok && FAMILIES.iter().any(|f| f.given(design)) {
         let st = Stack {
             core: core.clone(),
             layers: layers.clone(),
         };
-        crate::parts::shaft_body::check_params(&design.context(), sb, &st, &mut errs);
-    }
-    if let (Some(c), true) = (&design.casing, stack_ok) {
-        crate::parts::casing::check_params(&design.context(), c, &mut errs);
-    }
-    if let (Some(f), true) = (&design.fingertip_base, stack_ok) {
-        let st = Stack {
-            core: core.clone(),
-            layers: layers.clone(),
-        };
-        crate::parts::fingertip_base::check_params(&design.context(), f, &st, &mut errs);
+        for f in FAMILIES {
+            f.check(design, &st, &mut errs);
+        }
     }
     if let (Some(c), true) = (sound_core, errs.is_empty()) {
         if let Some(first) = layers.iter().find(|l| {

@@ -28,7 +28,10 @@ use super::{ExactShape, Member, MemberKind};
 use super::{Part, PrintTechnology};
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{cuboid, ChordTolerance, GeometryError, Solid};
+use crate::materials::CastReport;
 use crate::parts::context::Context;
+use crate::parts::context::Stack;
+use crate::parts::family::{named, AssemblyStep, Built, Family};
 use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::shaft_body::{half_nozzle, OVERLAP_MM};
 use crate::parts::z_cylinder;
@@ -887,4 +890,103 @@ pub fn bought_items(c: &CasingParams) -> Vec<String> {
         ));
     }
     out
+}
+
+/// The casing family (`casing`, with its `gripper_base`): the casing that holds the camera,
+/// the LEDs and the skin's backing plate (ShadowTac Sec. IV-B).
+pub struct CasingFamily;
+
+impl Family for CasingFamily {
+    type Params = CasingParams;
+    const PATH: &'static str = "casing";
+
+    fn check(c: &CasingParams, ctx: &Context<'_>, _stack: &Stack, errs: &mut Vec<ParamError>) {
+        check_params(ctx, c, errs);
+    }
+
+    fn build(
+        c: &CasingParams,
+        ctx: &Context<'_>,
+        _stack: &Stack,
+        tol: ChordTolerance,
+    ) -> Result<Built, DesignError> {
+        let mut parts = vec![build_casing(ctx, c, tol)?];
+        if let Some(g) = &c.gripper_base {
+            parts.push(build_base(ctx, c, g, tol)?);
+        }
+        let lv = levels(ctx, c);
+        let w = c
+            .gripper_base
+            .as_ref()
+            .map_or([c.outer_width_mm; 2], |g| [g.width_mm, g.length_mm]);
+        let mut summary = vec![("casing_levels", json!(&lv))];
+        if let Some(b) = ctx.backing {
+            summary.push((
+                "camera_view",
+                json!({
+                    "rim_crossing_radius_mm": plate_crossing_radius_mm(
+                        ctx.body.rim_radius_mm(0.0),
+                        lv.top_z_mm - lv.lens_z_mm,
+                        b.thickness_mm,
+                        PMMA_REFRACTIVE_INDEX,
+                    ),
+                    "window_radius_mm": c.window_diameter_mm / 2.0,
+                    "lens_z_mm": lv.lens_z_mm,
+                    "rule": "the ray from the lens's front (on the axis) to the skin's rim, refracted by the backing plate, crosses the casing's top inside the window",
+                }),
+            ));
+        }
+        summary.push(("envelope_mm", json!([w[0], w[1], lv.envelope_height_mm])));
+        Ok(Built { parts, summary })
+    }
+
+    fn members(
+        c: &CasingParams,
+        ctx: &Context<'_>,
+        _stack: &Stack,
+        tol: ChordTolerance,
+    ) -> Result<Vec<Member>, DesignError> {
+        members(ctx, c, tol)
+    }
+
+    fn bought_items(c: &CasingParams) -> Vec<String> {
+        bought_items(c)
+    }
+
+    fn assembly_steps(
+        c: &CasingParams,
+        _ctx: &Context<'_>,
+        parts: &[Part],
+        _filling: Option<&CastReport>,
+    ) -> Vec<AssemblyStep> {
+        let mut out = Vec::new();
+        let casing = named(parts, "casing")
+            .first()
+            .cloned()
+            .unwrap_or_else(|| "the casing".into());
+        let azimuths = led_azimuths_deg(c)
+            .iter()
+            .map(|a| format!("{a:.0}"))
+            .collect::<Vec<_>>()
+            .join(", ");
+        out.push(AssemblyStep::Text(format!(
+            "Cut {n} single-LED segments from the strip ({}) and push one into each slot in the light chamber's wall of {casing} (at {azimuths} deg from +x), LED facing the axis and its top end flush with the casing's top face, close under the plate; lead the wires down the slot, across the chamber's floor and through the ledge's hole into the camera bay (ShadowTac Sec. IV-B: red, green and blue at 120 deg, close to the acrylic plate).",
+            c.leds.description,
+            n = c.leds.count
+        )));
+        out.push(AssemblyStep::Text(format!(
+            "Glue the backing plate, the skin up, onto the top face of {casing} with cyanoacrylate, centred over the window (ShadowTac Sec. IV-B)."
+        )));
+        out.push(AssemblyStep::Text(format!(
+            "Set the camera board ({}) into the bay of {casing} from below, the lens up through the ledge's bore, the LEDs' wires beside it.",
+            c.camera.module
+        )));
+        if let Some(g) = &c.gripper_base {
+            out.push(AssemblyStep::Text(format!(
+                "Set {casing} into the socket of `gripper_base`, the camera's cable out through the slot on +y, and fasten it with 4 screws up through the base's counterbored holes into the casing's pilots; bolt the base to the {} with 4 bolts (ShadowTac Sec. IV-B: a base to mount the sensor on a robotic gripper).",
+                g.gripper
+            )));
+        }
+        out
+    }
 }

@@ -25,8 +25,10 @@ use super::{ExactShape, Member, MemberKind};
 use super::{Part, PrintTechnology};
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{ChordTolerance, GeometryError, Solid};
+use crate::materials::CastReport;
 use crate::parts::context::Context;
 use crate::parts::context::Stack;
+use crate::parts::family::{AssemblyStep, Built, Family};
 use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::shaft_body::OVERLAP_MM;
 use crate::parts::z_cylinder;
@@ -780,4 +782,84 @@ pub fn bought_items(f: &FingertipBase) -> Vec<String> {
         ),
         "Instant adhesive (cyanoacrylate): the camera, its holder, the PCB and the ring to the base; the shell to its holder (UVDtact Sec. III-C)".into(),
     ]
+}
+
+/// The fingertip-base family (`fingertip_base`): the sensor base, the shell holder, the
+/// camera holder and the diffusion ring round the lighting PCB (UVDtact Sec. III-C).
+pub struct FingertipBaseFamily;
+
+impl Family for FingertipBaseFamily {
+    type Params = FingertipBase;
+    const PATH: &'static str = "fingertip_base";
+
+    fn check(f: &FingertipBase, ctx: &Context<'_>, stack: &Stack, errs: &mut Vec<ParamError>) {
+        check_params(ctx, f, stack, errs);
+    }
+
+    fn build(
+        f: &FingertipBase,
+        ctx: &Context<'_>,
+        stack: &Stack,
+        tol: ChordTolerance,
+    ) -> Result<Built, DesignError> {
+        let parts = build_parts(ctx, f, stack, tol)?;
+        let lv = levels(ctx, f, stack);
+        let w = f.outer_diameter_mm.max(2.0 * ctx.body.rim_radius_mm(0.0));
+        Ok(Built {
+            parts,
+            summary: vec![
+                ("fingertip_levels", json!(&lv)),
+                ("envelope_mm", json!([w, w, lv.envelope_height_mm])),
+            ],
+        })
+    }
+
+    fn members(
+        f: &FingertipBase,
+        ctx: &Context<'_>,
+        stack: &Stack,
+        tol: ChordTolerance,
+    ) -> Result<Vec<Member>, DesignError> {
+        members(ctx, f, stack, tol)
+    }
+
+    fn bought_items(f: &FingertipBase) -> Vec<String> {
+        bought_items(f)
+    }
+
+    fn assembly_steps(
+        f: &FingertipBase,
+        _ctx: &Context<'_>,
+        _parts: &[Part],
+        _filling: Option<&CastReport>,
+    ) -> Vec<AssemblyStep> {
+        let mut out = Vec::new();
+        out.push(AssemblyStep::Text(format!(
+            "Glue the camera ({}) into `camera_holder` with instant adhesive, its front flush \
+             with the holder's top and its wire down the bore; glue the holder onto the floor of \
+             the pocket of `sensor_base`, over the centre hole, the wire down through the floor \
+             (UVDtact Sec. III-C).",
+            f.camera.module
+        )));
+        out.push(AssemblyStep::Text(
+            "Lead the lighting PCB's wires down through the floor's wire hole and glue the PCB, \
+             LEDs up and the first white LED on +x, onto the pocket's floor round the camera \
+             holder; glue `diffusion_ring` on top, flush with the base's top, its holes over the \
+             UV LEDs (UVDtact Sec. III-C)."
+                .into(),
+        ));
+        out.push(AssemblyStep::Text(
+            "Glue the acrylic shell's foot, with the elastomer on it, into `shell_holder` with \
+             instant adhesive, the shell's end flush with the holder's bottom (UVDtact \
+             Sec. III-C)."
+                .into(),
+        ));
+        out.push(AssemblyStep::Text(format!(
+            "Set `shell_holder` on `sensor_base` and fasten them with {} bolts up through the \
+             base's counterbored holes; to replace the elastomer, undo them (UVDtact Sec. III-C: \
+             three M1.2 bolts).",
+            f.bolts.count
+        )));
+        out
+    }
 }

@@ -6,11 +6,13 @@ pub mod casing;
 pub mod channels;
 pub mod context;
 pub mod core_shell;
+pub mod family;
 pub mod fasteners;
 pub mod fingertip_base;
 mod member;
 mod part;
 pub mod placement;
+pub mod registry;
 pub mod robot_mount;
 pub mod shaft_body;
 

@@ -28,11 +28,14 @@ use super::{Part, PrintTechnology};
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::Polyline2;
 use crate::geometry::{cuboid, cylinder, revolve, ChordTolerance, GeometryError, Solid};
+use crate::materials::CastReport;
 use crate::parts::bayonet::Bayonet;
 pub use crate::parts::bayonet::BayonetLugs;
 use crate::parts::context::Context;
 use crate::parts::context::Stack;
+use crate::parts::family::{named, AssemblyStep, Built, Family};
 use crate::parts::placement::{place_posed, with_pose};
+use crate::parts::{ProcedureAction, ProcedureStep};
 use crate::schema::shared::{FillingGel, LayerProcess};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -1009,4 +1012,143 @@ pub fn bought_items(sb: &ShaftBodyParams) -> Vec<String> {
         ),
         "Microcontroller: Arduino Nano (8-bit, 16 MHz) on the outside of the body, wired to the camera over SPI (Pestell et al. Sec. III-A2)".into(),
     ]
+}
+
+/// The shaft-body family (`shaft_body`, with its `robot_mount`): the body, the tip's fitting
+/// with the printed skin, the bayonet, the camera and the LED ring (Pestell et al. Sec. III-A).
+pub struct ShaftBodyFamily;
+
+impl Family for ShaftBodyFamily {
+    type Params = ShaftBodyParams;
+    const PATH: &'static str = "shaft_body";
+
+    fn check(sb: &ShaftBodyParams, ctx: &Context<'_>, stack: &Stack, errs: &mut Vec<ParamError>) {
+        check_params(ctx, sb, stack, errs);
+    }
+
+    fn build(
+        sb: &ShaftBodyParams,
+        ctx: &Context<'_>,
+        stack: &Stack,
+        tol: ChordTolerance,
+    ) -> Result<Built, DesignError> {
+        let mut parts = vec![build_body(ctx, sb, stack, tol)?];
+        if let Some(m) = &sb.robot_mount {
+            parts.push(crate::parts::robot_mount::build_mount(ctx, sb, m, tol)?);
+        }
+        let lv = levels(ctx, sb);
+        let r = ctx.body.rim_radius_mm(0.0);
+        let w = sb.base.outer_diameter_mm.max(2.0 * r);
+        let camera_view = json!({
+            "tip_inner_surface_fraction_seen": view_fraction(ctx, sb, stack, tol),
+            "lens_z_mm": lv.lens_z_mm,
+            "view_angle_deg": sb.camera.view_angle_deg,
+            "focal_length_mm": sb.camera.focal_length_mm,
+            "rule": "area fraction of the skin's inner surface above the base plane inside the lens's view cone whose ray passes the lip's opening, the LED ring's bore and the shaft's bore (the pins' shadows and the gel's refraction ignored)",
+        });
+        Ok(Built {
+            parts,
+            summary: vec![
+                ("shaft_levels", json!(&lv)),
+                ("envelope_mm", json!([w, w, lv.envelope_height_mm])),
+                ("camera_view", camera_view),
+            ],
+        })
+    }
+
+    fn members(
+        sb: &ShaftBodyParams,
+        ctx: &Context<'_>,
+        _stack: &Stack,
+        tol: ChordTolerance,
+    ) -> Result<Vec<Member>, DesignError> {
+        members(ctx, sb, tol)
+    }
+
+    fn bought_items(sb: &ShaftBodyParams) -> Vec<String> {
+        let mut v = bought_items(sb);
+        if let Some(m) = &sb.robot_mount {
+            v.extend(crate::parts::robot_mount::bought_items(m));
+        }
+        v
+    }
+
+    fn assembly_steps(
+        sb: &ShaftBodyParams,
+        ctx: &Context<'_>,
+        parts: &[Part],
+        filling: Option<&CastReport>,
+    ) -> Vec<AssemblyStep> {
+        let mut out = Vec::new();
+        let body = named(parts, "shaft_body")
+            .first()
+            .cloned()
+            .unwrap_or_else(|| "the body".into());
+        let fitting = named(parts, "tip_fitting")
+            .first()
+            .cloned()
+            .unwrap_or_else(|| "the tip's fitting".into());
+        let screws = crate::parts::fasteners::metric_from_pilot(sb.camera.mount_pilot_diameter_mm)
+            .map_or_else(String::new, |d| format!(" M{d}"));
+        let bayonet = &ctx.printers.fdm.bayonet;
+        out.push(AssemblyStep::Text(format!(
+            "Press the LED ring PCB ({} LEDs, facing up) into its seat at the top of {body}, its \
+             wires down the bore, through the ceiling's hole beside the lens and out through the \
+             cable slot (Pestell et al. Sec. III-A).",
+            sb.led_ring.led_count
+        )));
+        out.push(AssemblyStep::Text(format!(
+            "Screw the camera board into the pocket under {body}, up against the ceiling, with 4 \
+             self-tapping screws{screws} ({:.1} mm pilots), the lens up through the ceiling's \
+             hole and the cable out through the slot; focus the adjustable lens on the pins once \
+             the tip is on (Pestell et al. Sec. III-A2).",
+            sb.camera.mount_pilot_diameter_mm
+        )));
+        if let Some(c) = filling {
+            out.push(AssemblyStep::Step(tip_filling_step(c, &fitting)));
+        }
+        if let Some(m) = &sb.robot_mount {
+            out.push(AssemblyStep::Text(format!(
+                "Bolt `robot_mount` to the tool flange of the {} with {} socket head cap \
+                 screws, its locating pin in the flange's pin hole; set the base of {body} into \
+                 its cup, the {n} lugs down the entry grooves and the camera's cable out through \
+                 the window, and turn {body} {:.0} deg clockwise (seen from the tip's pole) \
+                 until it stops (Pestell et al. Sec. III-A3: the body attaches to the robot's \
+                 mount by a bayonet).",
+                m.robot,
+                m.bolt_count,
+                m.bayonet.lock_angle_deg,
+                n = bayonet.lug_count
+            )));
+        }
+        out.push(AssemblyStep::Text(format!(
+            "Twist the tip onto {body}: the {n} lugs of {fitting} down the {n} entry grooves, \
+             push it home, then turn it {:.0} deg counter-clockwise (seen from the tip's pole) \
+             until the lugs stop at the grooves' closed ends; the {:.0} deg ramp draws it down \
+             onto the shaft (Pestell et al. Sec. III-A: a bayonet mount for replacing tips).",
+            sb.bayonet.lock_angle_deg,
+            bayonet.ramp_deg,
+            n = bayonet.lug_count
+        )));
+        out
+    }
+}
+
+/// The filling gel's pour into the printed tip, pole-down, closed by the lens window
+/// (Pestell et al. Sec. III-A).
+pub fn tip_filling_step(c: &CastReport, fitting: &str) -> ProcedureStep {
+    ProcedureStep {
+        action: ProcedureAction::Pour,
+        text: format!(
+            "Step {}: stand the tip pole-down, {fitting} up, mix and degas {} and pour it into \
+             the tip round the pins until it is level with the top of the lip's opening \
+             ({:.2} mL to fill); lay the lens window into its seat in {fitting} on the lip, \
+             sliding it on from one side so that no air is caught (Pestell et al. Sec. III-A). \
+             Let it cure ({}) before the tip goes on the body.",
+            c.step,
+            c.mix_text(),
+            c.layer_volume_ml.unwrap_or(c.cavity_volume_ml),
+            crate::materials::cure_text(&c.notes)
+        ),
+    }
 }

@@ -1,0 +1,99 @@
+//! The one interface every section family implements ([`Family`]): a family owns the
+//! parameters under one key of a design (`casing`, `shaft_body` ...), their rules, its
+//! printable parts, its members of the assembled sensor, its bought items and its assembly
+//! steps. It sees the rest of the design only through a [`Context`] and the resolved
+//! [`Stack`]; [`crate::parts::registry`] lists the families, and the validation, the build, the
+//! assembly and the procedure loop over that list (docs/src/development.md, "Adding a part
+//! family").
+
+use crate::error::{DesignError, ParamError};
+use crate::geometry::ChordTolerance;
+use crate::materials::CastReport;
+use crate::parts::context::{Context, Stack};
+use crate::parts::member::Member;
+use crate::parts::part::{Part, ProcedureStep};
+
+/// What a family's build adds to the kit: its printable parts (print orientation, on the bed)
+/// and the entries it sets in the manifest's `summary` object, in order (a later family's
+/// entry replaces an earlier one of the same key, as `envelope_mm`).
+#[derive(Debug, Clone, Default)]
+pub struct Built {
+    pub parts: Vec<Part>,
+    pub summary: Vec<(&'static str, serde_json::Value)>,
+}
+
+/// One assembly step of a family, in order: a sentence of the `Assemble` step, or a pour
+/// that goes in between (the filling gel poured once the parts before it are together).
+#[derive(Debug, Clone, PartialEq)]
+pub enum AssemblyStep {
+    /// What to do, one sentence or a few; the procedure prefixes `Assemble: `.
+    Text(String),
+    /// A whole step of its own (a pour), placed after the sentences before it.
+    Step(ProcedureStep),
+}
+
+/// A section family: the parameters under [`Family::PATH`] and what they make. Every method
+/// takes the family's own parameters and the narrow context, never the whole design. A family
+/// is registered once, in [`crate::parts::registry::FAMILIES`].
+pub trait Family {
+    /// The family's parameter type (the value under [`Family::PATH`] in a design).
+    type Params: Sync;
+    /// The design key of the parameters (`casing`), the first step of every error path the
+    /// family reports.
+    const PATH: &'static str;
+
+    /// Appends every violated rule of `p` to `errs`, each with its parameter path under
+    /// `PATH.`, its value and the rule. Called once the layer stack is sound.
+    fn check(p: &Self::Params, ctx: &Context<'_>, stack: &Stack, errs: &mut Vec<ParamError>);
+
+    /// The family's printable parts and manifest summary entries.
+    ///
+    /// # Errors
+    /// [`DesignError::Geometry`] naming the failing part if the kernel fails.
+    fn build(
+        p: &Self::Params,
+        ctx: &Context<'_>,
+        stack: &Stack,
+        tol: ChordTolerance,
+    ) -> Result<Built, DesignError>;
+
+    /// Its bought and cut members of the assembled sensor, in the sensor frame (its printed
+    /// parts join the assembly from [`Family::build`] through their `T_print_sensor`).
+    ///
+    /// # Errors
+    /// [`DesignError::Geometry`] if the kernel fails.
+    fn members(
+        _p: &Self::Params,
+        _ctx: &Context<'_>,
+        _stack: &Stack,
+        _tol: ChordTolerance,
+    ) -> Result<Vec<Member>, DesignError> {
+        Ok(Vec::new())
+    }
+
+    /// Its lines of the bought-items list.
+    fn bought_items(_p: &Self::Params) -> Vec<String> {
+        Vec::new()
+    }
+
+    /// Its assembly steps, given the kit's parts (`parts`, to name them) and the filling gel's
+    /// pour if the kit has one.
+    fn assembly_steps(
+        _p: &Self::Params,
+        _ctx: &Context<'_>,
+        _parts: &[Part],
+        _filling: Option<&CastReport>,
+    ) -> Vec<AssemblyStep> {
+        Vec::new()
+    }
+}
+
+/// The names of the parts of role `role`, each in backticks, in kit order (for the steps'
+/// text).
+pub fn named(parts: &[Part], role: &str) -> Vec<String> {
+    parts
+        .iter()
+        .filter(|p| p.role == role)
+        .map(|p| format!("`{}`", p.name))
+        .collect()
+}

@@ -1,0 +1,130 @@
+//! The list of section families ([`FAMILIES`]): the validation ([`crate::stack::validate`]),
+//! the build ([`crate::build::build_kit_bounded`]), the assembly and the procedure loop over
+//! it and name no family. Adding a family is one module in `parts/`, its field in
+//! [`crate::schema::Design`] and one line here (docs/src/development.md, "Adding a part
+//! family").
+
+use std::marker::PhantomData;
+
+use crate::error::{DesignError, ParamError};
+use crate::geometry::ChordTolerance;
+use crate::materials::CastReport;
+use crate::parts::context::Stack;
+use crate::parts::family::{AssemblyStep, Built, Family};
+use crate::parts::member::Member;
+use crate::parts::part::Part;
+use crate::parts::{casing, fingertip_base, shaft_body};
+use crate::schema::Design;
+
+/// A registered family, as the loops see it: each method does nothing (or returns nothing)
+/// for a design without the family's parameters.
+pub trait Section: Sync {
+    /// The design key of the family's parameters.
+    fn path(&self) -> &'static str;
+    /// Whether the design gives the family's parameters.
+    fn given(&self, d: &Design) -> bool;
+    /// [`Family::check`].
+    fn check(&self, d: &Design, stack: &Stack, errs: &mut Vec<ParamError>);
+    /// [`Family::build`]; `None` without the family.
+    fn build(
+        &self,
+        d: &Design,
+        stack: &Stack,
+        tol: ChordTolerance,
+    ) -> Option<Result<Built, DesignError>>;
+    /// [`Family::members`].
+    ///
+    /// # Errors
+    /// As [`Family::members`].
+    fn members(
+        &self,
+        d: &Design,
+        stack: &Stack,
+        tol: ChordTolerance,
+    ) -> Result<Vec<Member>, DesignError>;
+    /// [`Family::bought_items`].
+    fn bought_items(&self, d: &Design) -> Vec<String>;
+    /// [`Family::assembly_steps`].
+    fn assembly_steps(
+        &self,
+        d: &Design,
+        parts: &[Part],
+        filling: Option<&CastReport>,
+    ) -> Vec<AssemblyStep>;
+}
+
+/// A family `F` with where its parameters sit in a design.
+pub struct Registered<F: Family> {
+    /// The family's parameters in a design, if given.
+    pub params: fn(&Design) -> Option<&F::Params>,
+    pub family: PhantomData<fn() -> F>,
+}
+
+impl<F: Family> Section for Registered<F> {
+    fn path(&self) -> &'static str {
+        F::PATH
+    }
+
+    fn given(&self, d: &Design) -> bool {
+        (self.params)(d).is_some()
+    }
+
+    fn check(&self, d: &Design, stack: &Stack, errs: &mut Vec<ParamError>) {
+        if let Some(p) = (self.params)(d) {
+            F::check(p, &d.context(), stack, errs);
+        }
+    }
+
+    fn build(
+        &self,
+        d: &Design,
+        stack: &Stack,
+        tol: ChordTolerance,
+    ) -> Option<Result<Built, DesignError>> {
+        (self.params)(d).map(|p| F::build(p, &d.context(), stack, tol))
+    }
+
+    fn members(
+        &self,
+        d: &Design,
+        stack: &Stack,
+        tol: ChordTolerance,
+    ) -> Result<Vec<Member>, DesignError> {
+        match (self.params)(d) {
+            Some(p) => F::members(p, &d.context(), stack, tol),
+            None => Ok(Vec::new()),
+        }
+    }
+
+    fn bought_items(&self, d: &Design) -> Vec<String> {
+        (self.params)(d).map_or_else(Vec::new, F::bought_items)
+    }
+
+    fn assembly_steps(
+        &self,
+        d: &Design,
+        parts: &[Part],
+        filling: Option<&CastReport>,
+    ) -> Vec<AssemblyStep> {
+        (self.params)(d).map_or_else(Vec::new, |p| {
+            F::assembly_steps(p, &d.context(), parts, filling)
+        })
+    }
+}
+
+/// The section families, in the order their parts, summary entries, members, bought items and
+/// assembly steps appear in a kit.
+pub static FAMILIES: &[&dyn Section] = &[
+    &Registered::<shaft_body::ShaftBodyFamily> {
+        params: |d| d.shaft_body.as_ref(),
+        family: PhantomData,
+    },
+    &Registered::<casing::CasingFamily> {
+        params: |d| d.casing.as_ref(),
+        family: PhantomData,
+    },
+    &Registered::<fingertip_base::FingertipBaseFamily> {
+        params: |d| d.fingertip_base.as_ref(),
+        family: PhantomData,
+    },
+];
