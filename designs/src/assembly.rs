@@ -17,53 +17,33 @@ use crate::error::{DesignError, GeometryContext, ParamError, ParamErrors};
 use crate::geometry::{cuboid, cylinder, revolve, Affine, ChordTolerance, Solid};
 use crate::housing::ShellLevels;
 use crate::parts::context::Stack;
+use crate::parts::registry::FAMILIES;
 use crate::parts::Part;
 pub use crate::parts::{ExactShape, Member, MemberKind};
 use crate::schema::{Design, HousingStyle, LayerProcess};
 
-/// Roles of kit parts that are part of the sensor (the rest are molds and tooling).
-pub const SENSOR_ROLES: [&str; 15] = [
+/// Roles of kit parts that are part of the sensor besides the section families' own
+/// ([`crate::parts::family::Family::SENSOR_PARTS`]); the rest are molds and tooling.
+pub const SENSOR_ROLES: [&str; 6] = [
     "shell_collar",
     "shell_tube",
     "shell_base",
     "shell_half",
     "printed_skin",
     "marker_tips",
-    "tip_fitting",
-    "shaft_body",
-    "robot_mount",
-    "casing",
-    "gripper_base",
-    "shell_holder",
-    "sensor_base",
-    "camera_holder",
-    "diffusion_ring",
 ];
+
+/// Whether a kit part of role `role` is part of the assembled sensor.
+fn in_sensor(role: &str) -> bool {
+    SENSOR_ROLES.contains(&role) || FAMILIES.iter().any(|f| f.sensor_part(role).is_some())
+}
 
 /// The parameter paths that size a printed member of `role`.
 fn printed_fix(role: &str) -> Vec<String> {
+    if let Some(fix) = FAMILIES.iter().find_map(|f| f.sensor_part(role)) {
+        return fix.iter().map(|f| (*f).to_string()).collect();
+    }
     match role {
-        "tip_fitting" => vec![
-            "shaft_body.bayonet.lug_width_mm".into(),
-            "shaft_body.tip_fitting".into(),
-        ],
-        "shaft_body" => vec![
-            "shaft_body.bayonet.groove_width_mm".into(),
-            "shaft_body".into(),
-        ],
-        "robot_mount" => vec![
-            "shaft_body.robot_mount.bayonet.groove_width_mm".into(),
-            "shaft_body.robot_mount".into(),
-        ],
-        "casing" => vec![
-            "casing.wall_thickness_mm".into(),
-            "casing.bay_height_mm".into(),
-            "casing.window_diameter_mm".into(),
-        ],
-        "gripper_base" => vec!["casing.gripper_base".into()],
-        "shell_holder" | "sensor_base" => vec!["fingertip_base.fit_clearance_mm".into()],
-        "camera_holder" => vec!["fingertip_base.camera_holder.outer_diameter_mm".into()],
-        "diffusion_ring" => vec!["fingertip_base.diffusion_ring.inner_diameter_mm".into()],
         "printed_skin" | "marker_tips" => vec!["layers".into()],
         _ => vec!["housing".into()],
     }
@@ -122,10 +102,7 @@ pub fn members(
     tol: ChordTolerance,
 ) -> Result<Vec<Member>, DesignError> {
     let mut out = Vec::new();
-    for p in parts
-        .iter()
-        .filter(|p| SENSOR_ROLES.contains(&p.role.as_str()))
-    {
+    for p in parts.iter().filter(|p| in_sensor(&p.role)) {
         if let Some(solid) = in_sensor_frame(p) {
             out.push(Member {
                 name: p.name.clone(),

@@ -11,6 +11,7 @@ use crate::error::DesignError;
 use crate::geometry::ChordTolerance;
 use crate::layers::count_layer_markers;
 use crate::parts::context::Stack;
+use crate::parts::registry::FAMILIES;
 use crate::schema::Design;
 
 /// Default bound on the estimated triangles of one build: 4,000,000 (about 4 GB of peak memory;
@@ -89,22 +90,8 @@ pub fn estimate(design: &Design, stack: &Stack, tol: ChordTolerance) -> WorkEsti
         surfaces += surface_triangles(design, c.outer_offset_mm, tol);
         surfaces += surface_triangles(design, c.inner_offset_mm, tol);
     }
-    if let Some(sb) = &design.shaft_body {
-        // the body's and the fitting's cylinders, seats and bayonet bands: about 30 and 27
-        // circles of their outer radius
-        let r = crate::parts::shaft_body::radii(&design.context(), sb, stack);
-        surfaces += 30.0 * tol.circle_segments(r.base_outer_mm) as f64
-            + 27.0 * tol.circle_segments(r.fitting_outer_mm) as f64;
-    }
-    if let Some(c) = &design.casing {
-        // the casing's and the gripper base's holes, bores and pockets: about 36 circles of
-        // the casing's half-width
-        surfaces += 36.0 * tol.circle_segments(c.outer_width_mm / 2.0) as f64;
-    }
-    if let Some(f) = &design.fingertip_base {
-        // the shell holder, sensor base, camera holder and diffusion ring: about 40 circles
-        // of the base's outer radius
-        surfaces += 40.0 * tol.circle_segments(f.outer_diameter_mm / 2.0) as f64;
+    for f in FAMILIES {
+        surfaces += f.estimated_triangles(design, stack, tol);
     }
     let (mut markers, mut feature_tris) = (0u64, 0.0);
     for l in &stack.layers {

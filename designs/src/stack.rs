@@ -224,31 +224,10 @@ pub fn validate(
             );
         }
     }
-    if let Some(c) = &design.casing {
-        check_material(
-            "casing.material".into(),
-            &c.material,
-            &[MaterialKind::Print],
-        );
-        if let Some(g) = &c.gripper_base {
-            check_material(
-                "casing.gripper_base.material".into(),
-                &g.material,
-                &[MaterialKind::Print],
-            );
+    for f in FAMILIES {
+        for (path, key, kinds) in f.materials(design) {
+            check_material(path, key, kinds);
         }
-    }
-    if let Some(f) = &design.fingertip_base {
-        check_material(
-            "fingertip_base.material".into(),
-            &f.material,
-            &[MaterialKind::Print],
-        );
-        check_material(
-            "fingertip_base.diffusion_ring.material".into(),
-            &f.diffusion_ring.material,
-            &[MaterialKind::Print],
-        );
     }
 
     if design.layers.is_empty() {

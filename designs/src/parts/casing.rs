@@ -29,6 +29,7 @@ use super::{Part, PrintTechnology};
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{cuboid, ChordTolerance, GeometryError, Solid};
 use crate::materials::CastReport;
+use crate::materials::MaterialKind;
 use crate::parts::context::Context;
 use crate::parts::context::Stack;
 use crate::parts::family::{named, AssemblyStep, Built, Family};
@@ -899,6 +900,44 @@ pub struct CasingFamily;
 impl Family for CasingFamily {
     type Params = CasingParams;
     const PATH: &'static str = "casing";
+    const SENSOR_PARTS: &'static [(&'static str, &'static [&'static str])] = &[
+        (
+            "casing",
+            &[
+                "casing.wall_thickness_mm",
+                "casing.bay_height_mm",
+                "casing.window_diameter_mm",
+            ],
+        ),
+        ("gripper_base", &["casing.gripper_base"]),
+    ];
+
+    fn materials(c: &CasingParams) -> Vec<(String, &str, &'static [MaterialKind])> {
+        let mut v = vec![(
+            "casing.material".to_string(),
+            c.material.as_str(),
+            &[MaterialKind::Print][..],
+        )];
+        if let Some(g) = &c.gripper_base {
+            v.push((
+                "casing.gripper_base.material".into(),
+                &g.material,
+                &[MaterialKind::Print],
+            ));
+        }
+        v
+    }
+
+    fn estimated_triangles(
+        c: &CasingParams,
+        _ctx: &Context<'_>,
+        _stack: &Stack,
+        tol: ChordTolerance,
+    ) -> f64 {
+        // the casing's and the gripper base's holes, bores and pockets: about 36 circles of
+        // the casing's half-width
+        36.0 * tol.circle_segments(c.outer_width_mm / 2.0) as f64
+    }
 
     fn check(c: &CasingParams, ctx: &Context<'_>, _stack: &Stack, errs: &mut Vec<ParamError>) {
         check_params(ctx, c, errs);

@@ -8,8 +8,9 @@
 
 use crate::error::{DesignError, ParamError};
 use crate::geometry::ChordTolerance;
-use crate::materials::CastReport;
+use crate::materials::{CastReport, MaterialKind};
 use crate::parts::context::{Context, Stack};
+use crate::parts::cut_part::CutPart;
 use crate::parts::member::Member;
 use crate::parts::part::{Part, ProcedureStep};
 
@@ -37,10 +38,19 @@ pub enum AssemblyStep {
 /// is registered once, in [`crate::parts::registry::FAMILIES`].
 pub trait Family {
     /// The family's parameter type (the value under [`Family::PATH`] in a design).
-    type Params: Sync;
+    type Params: Sync + 'static;
     /// The design key of the parameters (`casing`), the first step of every error path the
     /// family reports.
     const PATH: &'static str;
+    /// The roles of its printed parts that belong to the assembled sensor (the rest are molds
+    /// and tooling), each with the parameter paths that size it, which a fit error names.
+    const SENSOR_PARTS: &'static [(&'static str, &'static [&'static str])] = &[];
+
+    /// Its material keys to look up in the materials table, each with its parameter path and
+    /// the kinds of material it may be.
+    fn materials(_p: &Self::Params) -> Vec<(String, &str, &'static [MaterialKind])> {
+        Vec::new()
+    }
 
     /// Appends every violated rule of `p` to `errs`, each with its parameter path under
     /// `PATH.`, its value and the rule. Called once the layer stack is sound.
@@ -69,6 +79,27 @@ pub trait Family {
         _tol: ChordTolerance,
     ) -> Result<Vec<Member>, DesignError> {
         Ok(Vec::new())
+    }
+
+    /// About how many triangles its parts' surfaces make at `tol`, for the work bound checked
+    /// before a build ([`crate::estimate::estimate`]).
+    fn estimated_triangles(
+        _p: &Self::Params,
+        _ctx: &Context<'_>,
+        _stack: &Stack,
+        _tol: ChordTolerance,
+    ) -> f64 {
+        0.0
+    }
+
+    /// Its parts cut from sheet stock (laser-cut windows, plates), for DXF and SVG.
+    fn cut_parts(_p: &Self::Params) -> Vec<CutPart> {
+        Vec::new()
+    }
+
+    /// Its printed circuit boards' outlines, for PCB tools.
+    fn pcb_outlines(_p: &Self::Params) -> Vec<CutPart> {
+        Vec::new()
     }
 
     /// Its lines of the bought-items list.

@@ -26,8 +26,10 @@ use super::{Part, PrintTechnology};
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{ChordTolerance, GeometryError, Solid};
 use crate::materials::CastReport;
+use crate::materials::MaterialKind;
 use crate::parts::context::Context;
 use crate::parts::context::Stack;
+use crate::parts::cut_part::{CutPart, Operation, Outline};
 use crate::parts::family::{AssemblyStep, Built, Family};
 use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::shaft_body::OVERLAP_MM;
@@ -791,6 +793,77 @@ pub struct FingertipBaseFamily;
 impl Family for FingertipBaseFamily {
     type Params = FingertipBase;
     const PATH: &'static str = "fingertip_base";
+    const SENSOR_PARTS: &'static [(&'static str, &'static [&'static str])] = &[
+        ("shell_holder", &["fingertip_base.fit_clearance_mm"]),
+        ("sensor_base", &["fingertip_base.fit_clearance_mm"]),
+        (
+            "camera_holder",
+            &["fingertip_base.camera_holder.outer_diameter_mm"],
+        ),
+        (
+            "diffusion_ring",
+            &["fingertip_base.diffusion_ring.inner_diameter_mm"],
+        ),
+    ];
+
+    fn materials(f: &FingertipBase) -> Vec<(String, &str, &'static [MaterialKind])> {
+        vec![
+            (
+                "fingertip_base.material".into(),
+                &f.material,
+                &[MaterialKind::Print],
+            ),
+            (
+                "fingertip_base.diffusion_ring.material".into(),
+                &f.diffusion_ring.material,
+                &[MaterialKind::Print],
+            ),
+        ]
+    }
+
+    fn estimated_triangles(
+        f: &FingertipBase,
+        _ctx: &Context<'_>,
+        _stack: &Stack,
+        tol: ChordTolerance,
+    ) -> f64 {
+        // the shell holder, sensor base, camera holder and diffusion ring: about 40 circles
+        // of the base's outer radius
+        40.0 * tol.circle_segments(f.outer_diameter_mm / 2.0) as f64
+    }
+
+    fn pcb_outlines(f: &FingertipBase) -> Vec<CutPart> {
+        let circle = |[x, y]: [f64; 2], r: f64| Outline::Circle {
+            centre_mm: [x, y],
+            radius_mm: r,
+        };
+        let p = &f.led_pcb;
+        let mut outlines = vec![
+            (Operation::Cut, circle([0.0; 2], p.outer_diameter_mm / 2.0)),
+            (Operation::Cut, circle([0.0; 2], p.inner_diameter_mm / 2.0)),
+        ];
+        let r = p.led_circle_diameter_mm / 2.0;
+        for (a, _) in leds() {
+            let (s, c) = a.to_radians().sin_cos();
+            outlines.push((
+                Operation::Engrave,
+                circle([r * c, r * s], p.led_length_mm / 2.0),
+            ));
+        }
+        vec![CutPart {
+            name: "lighting_pcb".into(),
+            description: format!(
+                "Lighting PCB outline: {:.1} mm board with a {:.1} mm bore, {:.1} mm thick; 8 LED places on a {:.1} mm circle, white on +x then UV and white alternating every 45 deg (UVDtact Sec. III-C)",
+                p.outer_diameter_mm, p.inner_diameter_mm, p.thickness_mm, p.led_circle_diameter_mm
+            ),
+            material: "fr4".into(),
+            thickness_mm: p.thickness_mm,
+            outlines,
+            kerf_mm: 0.0,
+            quantity: 1,
+            nominal_rings_mm: None,
+        }]
+    }
 
     fn check(f: &FingertipBase, ctx: &Context<'_>, stack: &Stack, errs: &mut Vec<ParamError>) {
         check_params(ctx, f, stack, errs);

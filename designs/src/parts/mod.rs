@@ -6,6 +6,7 @@ pub mod casing;
 pub mod channels;
 pub mod context;
 pub mod core_shell;
+pub mod cut_part;
 pub mod family;
 pub mod fasteners;
 pub mod fingertip_base;

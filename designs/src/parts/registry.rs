@@ -8,8 +8,9 @@ use std::marker::PhantomData;
 
 use crate::error::{DesignError, ParamError};
 use crate::geometry::ChordTolerance;
-use crate::materials::CastReport;
+use crate::materials::{CastReport, MaterialKind};
 use crate::parts::context::Stack;
+use crate::parts::cut_part::CutPart;
 use crate::parts::family::{AssemblyStep, Built, Family};
 use crate::parts::member::Member;
 use crate::parts::part::Part;
@@ -23,6 +24,17 @@ pub trait Section: Sync {
     fn path(&self) -> &'static str;
     /// Whether the design gives the family's parameters.
     fn given(&self, d: &Design) -> bool;
+    /// The parameter paths that size its printed sensor part of role `role`
+    /// ([`Family::SENSOR_PARTS`]); `None` for a role it does not make.
+    fn sensor_part(&self, role: &str) -> Option<&'static [&'static str]>;
+    /// [`Family::materials`]; empty without the family.
+    fn materials<'d>(&self, d: &'d Design) -> Vec<(String, &'d str, &'static [MaterialKind])>;
+    /// [`Family::estimated_triangles`]; 0 without the family.
+    fn estimated_triangles(&self, d: &Design, stack: &Stack, tol: ChordTolerance) -> f64;
+    /// [`Family::cut_parts`].
+    fn cut_parts(&self, d: &Design) -> Vec<CutPart>;
+    /// [`Family::pcb_outlines`].
+    fn pcb_outlines(&self, d: &Design) -> Vec<CutPart>;
     /// [`Family::check`].
     fn check(&self, d: &Design, stack: &Stack, errs: &mut Vec<ParamError>);
     /// [`Family::build`]; `None` without the family.
@@ -67,6 +79,29 @@ impl<F: Family> Section for Registered<F> {
 
     fn given(&self, d: &Design) -> bool {
         (self.params)(d).is_some()
+    }
+
+    fn sensor_part(&self, role: &str) -> Option<&'static [&'static str]> {
+        F::SENSOR_PARTS
+            .iter()
+            .find(|(r, _)| *r == role)
+            .map(|(_, fix)| *fix)
+    }
+
+    fn materials<'d>(&self, d: &'d Design) -> Vec<(String, &'d str, &'static [MaterialKind])> {
+        (self.params)(d).map_or_else(Vec::new, F::materials)
+    }
+
+    fn estimated_triangles(&self, d: &Design, stack: &Stack, tol: ChordTolerance) -> f64 {
+        (self.params)(d).map_or(0.0, |p| F::estimated_triangles(p, &d.context(), stack, tol))
+    }
+
+    fn cut_parts(&self, d: &Design) -> Vec<CutPart> {
+        (self.params)(d).map_or_else(Vec::new, F::cut_parts)
+    }
+
+    fn pcb_outlines(&self, d: &Design) -> Vec<CutPart> {
+        (self.params)(d).map_or_else(Vec::new, F::pcb_outlines)
     }
 
     fn check(&self, d: &Design, stack: &Stack, errs: &mut Vec<ParamError>) {

@@ -33,6 +33,7 @@ use crate::parts::bayonet::Bayonet;
 pub use crate::parts::bayonet::BayonetLugs;
 use crate::parts::context::Context;
 use crate::parts::context::Stack;
+use crate::parts::cut_part::{CutPart, Operation, Outline};
 use crate::parts::family::{named, AssemblyStep, Built, Family};
 use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::{ProcedureAction, ProcedureStep};
@@ -1021,6 +1022,58 @@ pub struct ShaftBodyFamily;
 impl Family for ShaftBodyFamily {
     type Params = ShaftBodyParams;
     const PATH: &'static str = "shaft_body";
+    const SENSOR_PARTS: &'static [(&'static str, &'static [&'static str])] = &[
+        (
+            "tip_fitting",
+            &["shaft_body.bayonet.lug_width_mm", "shaft_body.tip_fitting"],
+        ),
+        (
+            "shaft_body",
+            &["shaft_body.bayonet.groove_width_mm", "shaft_body"],
+        ),
+        (
+            "robot_mount",
+            &[
+                "shaft_body.robot_mount.bayonet.groove_width_mm",
+                "shaft_body.robot_mount",
+            ],
+        ),
+    ];
+
+    fn estimated_triangles(
+        sb: &ShaftBodyParams,
+        ctx: &Context<'_>,
+        stack: &Stack,
+        tol: ChordTolerance,
+    ) -> f64 {
+        // the body's and the fitting's cylinders, seats and bayonet bands: about 30 and 27
+        // circles of their outer radius
+        let r = radii(ctx, sb, stack);
+        30.0 * tol.circle_segments(r.base_outer_mm) as f64
+            + 27.0 * tol.circle_segments(r.fitting_outer_mm) as f64
+    }
+
+    fn cut_parts(sb: &ShaftBodyParams) -> Vec<CutPart> {
+        let circle = |r: f64| Outline::Circle {
+            centre_mm: [0.0, 0.0],
+            radius_mm: r,
+        };
+        let w = &sb.lens_window;
+        vec![CutPart {
+            name: "lens_window".into(),
+            description: format!(
+                "Lens window: clear acrylic, {:.1} mm thick, diameter {:.1} mm (Pestell et al. \
+                 Sec. III-A: the acrylic lens the gel is filled against)",
+                w.thickness_mm, w.diameter_mm
+            ),
+            material: "pmma".into(),
+            thickness_mm: w.thickness_mm,
+            outlines: vec![(Operation::Cut, circle(w.diameter_mm / 2.0))],
+            kerf_mm: 0.0,
+            quantity: 1,
+            nominal_rings_mm: None,
+        }]
+    }
 
     fn check(sb: &ShaftBodyParams, ctx: &Context<'_>, stack: &Stack, errs: &mut Vec<ParamError>) {
         check_params(ctx, sb, stack, errs);
