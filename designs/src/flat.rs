@@ -14,6 +14,7 @@ use crate::geometry::{cuboid, prism, ChordTolerance, GeometryError, Solid};
 use crate::markers::feature_solid;
 use serde::Serialize;
 
+use crate::parts::registry::FAMILIES;
 pub use crate::profile::FlatOutline;
 
 pub use crate::parts::channels::{ChannelEnds, ChannelSet, ChannelTube, MarkerGrid};
@@ -184,10 +185,9 @@ pub fn validate(
         ("core", design.core.is_some()),
         ("backing", design.backing.is_some()),
         ("housing", design.housing.is_some()),
-        ("shaft_body", design.shaft_body.is_some()),
-        ("casing", design.casing.is_some()),
-        ("fingertip_base", design.fingertip_base.is_some()),
-    ];
+    ]
+    .into_iter()
+    .chain(FAMILIES.iter().map(|f| (f.path(), f.given(design))));
     for (path, given) in curved_only {
         if given {
             errs.push(ParamError::new(

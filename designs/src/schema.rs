@@ -65,6 +65,10 @@ pub struct Design {
     /// skin is cast onto a rigid shell (UVDtact Sec. III-C, Fig. 2); none when not given.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fingertip_base: Option<crate::parts::fingertip_base::FingertipBase>,
+    /// A printed spacer ring under the skin's base that raises the contact module by its
+    /// height; none when not given.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spacer: Option<crate::parts::spacer::SpacerParams>,
     #[serde(default)]
     pub printers: PrinterProfiles,
     #[serde(default)]

@@ -16,6 +16,7 @@ pub mod placement;
 pub mod registry;
 pub mod robot_mount;
 pub mod shaft_body;
+pub mod spacer;
 
 pub use context::{Context, ResolvedCore, ResolvedLayer, Stack};
 pub use member::{ExactShape, Member, MemberKind};

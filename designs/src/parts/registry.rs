@@ -14,7 +14,7 @@ use crate::parts::cut_part::CutPart;
 use crate::parts::family::{AssemblyStep, Built, Family};
 use crate::parts::member::Member;
 use crate::parts::part::Part;
-use crate::parts::{casing, fingertip_base, shaft_body};
+use crate::parts::{casing, fingertip_base, shaft_body, spacer};
 use crate::schema::Design;
 
 /// A registered family, as the loops see it: each method does nothing (or returns nothing)
@@ -160,6 +160,10 @@ pub static FAMILIES: &[&dyn Section] = &[
     },
     &Registered::<fingertip_base::FingertipBaseFamily> {
         params: |d| d.fingertip_base.as_ref(),
+        family: PhantomData,
+    },
+    &Registered::<spacer::SpacerFamily> {
+        params: |d| d.spacer.as_ref(),
         family: PhantomData,
     },
 ];

@@ -47,11 +47,17 @@ pub struct SpacerFamily;
 impl Family for SpacerFamily {
     type Params = SpacerParams;
     const PATH: &'static str = "spacer";
-    const SENSOR_PARTS: &'static [(&'static str, &'static [&'static str])] =
-        &[("spacer", &["spacer.inner_diameter_mm", "spacer.outer_diameter_mm"])];
+    const SENSOR_PARTS: &'static [(&'static str, &'static [&'static str])] = &[(
+        "spacer",
+        &["spacer.inner_diameter_mm", "spacer.outer_diameter_mm"],
+    )];
 
     fn materials(p: &SpacerParams) -> Vec<(String, &str, &'static [MaterialKind])> {
-        vec![("spacer.material".into(), &p.material, &[MaterialKind::Print])]
+        vec![(
+            "spacer.material".into(),
+            &p.material,
+            &[MaterialKind::Print],
+        )]
     }
 
     fn check(p: &SpacerParams, ctx: &Context<'_>, stack: &Stack, errs: &mut Vec<ParamError>) {
@@ -124,10 +130,7 @@ impl Family for SpacerFamily {
             material: p.material.clone(),
             print_technology: PrintTechnology::Fdm,
             solid: placed,
-            params: with_pose(
-                json!({"spacer": p, "base_z_mm": zb}),
-                &pose,
-            ),
+            params: with_pose(json!({"spacer": p, "base_z_mm": zb}), &pose),
             group: None,
         };
         let w = p.outer_diameter_mm;
@@ -166,6 +169,11 @@ fn ring_solid(
 ) -> Result<Solid, GeometryError> {
     let zb = ctx.body.base_z_mm();
     let z0 = zb - p.height_mm;
-    z_cylinder(p.outer_diameter_mm / 2.0, z0, zb, [0.0; 2], tol)?
-        .difference(&z_cylinder(p.inner_diameter_mm / 2.0, z0 - 1.0, zb + 1.0, [0.0; 2], tol)?)
+    z_cylinder(p.outer_diameter_mm / 2.0, z0, zb, [0.0; 2], tol)?.difference(&z_cylinder(
+        p.inner_diameter_mm / 2.0,
+        z0 - 1.0,
+        zb + 1.0,
+        [0.0; 2],
+        tol,
+    )?)
 }

@@ -20,6 +20,7 @@ mod profile;
 mod properties;
 mod shadowtac;
 mod shadowtac_casing;
+mod spacer_family;
 mod sweep;
 mod sweep_metrics;
 mod sweep_paths;
