@@ -47,6 +47,7 @@ const TWINS: &[(&str, &str)] = &[
     ),
     ("cq_casing.py", include_str!("../python/twins/cq_casing.py")),
     ("cq_flat.py", include_str!("../python/twins/cq_flat.py")),
+    ("cq_spacer.py", include_str!("../python/twins/cq_spacer.py")),
     (
         "cq_fixtures.py",
         include_str!("../python/twins/cq_fixtures.py"),

@@ -111,3 +111,16 @@ def fingertip_part(params: dict, role: str):
     ring = _ring(f["diffusion_ring"]["inner_diameter_mm"] / 2.0,
                  f["led_pcb"]["outer_diameter_mm"] / 2.0, lv["ring_bottom_z_mm"], end)
     return C.cut(ring, holes)
+
+
+def twin(part: dict):
+    """The twin of a casing or fingertip-base family part (sensor frame), or None when `part`
+    is not one."""
+    role, p = part["role"], part["params"]
+    if role == "casing":
+        return casing(p)
+    if role == "gripper_base":
+        return gripper_base(p)
+    if role in ("shell_holder", "sensor_base", "camera_holder", "diffusion_ring"):
+        return fingertip_part(p, role)
+    return None

@@ -275,3 +275,28 @@ def semiplate_half(params: dict):
     if g:
         s = C.fuse(s, [C.primitive(p) for p in g["primitives"]])
     return s
+
+
+def twin(part: dict):
+    """The twin of a calibration fixture (sensor frame; indenter frame for an indenter), or
+    None when `part` is not one."""
+    role, name, p = part["role"], part["name"], part["params"]
+    if role == "indenter":
+        return indenter(p)
+    if name == "grid_plate":
+        return grid_plate(p)
+    if name == "pin_dome":
+        return pin_dome(p)
+    if name == "pin_dome_ring":
+        return pin_dome_ring(p)
+    if role == "calibration pin":
+        return pin(p)
+    if name == "semiplate_holder":
+        return semiplate_holder(p)
+    if name.startswith("semiplate_"):
+        return semiplate_half(p)
+    if name == "semidome_holder":
+        return semidome_holder(p)
+    if name.startswith("semidome_"):
+        return semidome_half(p)
+    return None

@@ -67,3 +67,8 @@ def casting_tray(p: dict) -> cq.Solid:
         tray = C.cut(tray, [C.cylinder_z(r, z0 - floor - 1.0, z0 + t + 1.0, x, y)
                             for x, y in laser["registration_xy_mm"]])
     return tray
+
+
+def twin(part: dict):
+    """The twin of a flat skin's casting tray (sensor frame), or None when `part` is not one."""
+    return casting_tray(part["params"]) if part["role"] == "casting_tray" else None

@@ -103,3 +103,13 @@ def shell_base(params: dict):
     sx, sy = params["cable_slot_xy_mm"]
     cuts.append(C.box([-sx / 2.0, -sy / 2.0, bottom - 1.0], [sx / 2.0, sy / 2.0, top + 1.0]))
     return C.cut(base, cuts)
+
+
+def twin(part: dict):
+    """The twin of a shell part (sensor frame), or None when `part` is not one."""
+    role, name, p = part["role"], part["name"], part["params"]
+    if role == "shell_half":
+        return shell_half(p, name.rsplit("_", 1)[1])
+    builder = {"shell_tube": shell_tube, "shell_collar": shell_collar,
+               "shell_base": shell_base}.get(role)
+    return builder(p) if builder else None

@@ -174,3 +174,24 @@ def core_shell(params: dict):
     # the solid under the outer surface less the solid under the inner one (run 1 mm past the
     # open end): booleans, as the other twins, so that the same parameters give the same B-rep
     return C.cut(enclosed(body, d, below), [enclosed(inner, d_in, below + 1.0)])
+
+
+def twin(part: dict):
+    """The twin of a layer's part (sensor frame), or None when `part` is not one: the open
+    molds, the printed skin and its tips, the boundary strategy's master, box and negative."""
+    role, p = part["role"], part["params"]
+    if role == "master_pattern" and "master" not in p:
+        return boundary_master(p)
+    if role == "mold_box" and "master" not in p:
+        return boundary_box(p)
+    if role == "open_mold":
+        return open_mold(p)
+    if role == "open_mold_piece":
+        return open_mold_piece(p)
+    if role == "printed_skin":
+        return printed_skin(p, tips=False)
+    if role == "marker_tips":
+        return printed_skin(p, tips=True)
+    if role == "negative_mold":
+        return boundary_negative(p)
+    return None

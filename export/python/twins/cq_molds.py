@@ -101,3 +101,19 @@ def mold_half(params: dict, half: str):
     keys = [C.primitive({"type": "sphere", "centre_mm": [x, 0.0, z_mid],
                          "radius_mm": r_key + key["clearance_mm"]}) for x in (x_f, -x_f)]
     return C.cut(block, keys + bolts)
+
+
+def twin(part: dict):
+    """The twin of a mold part (sensor frame), or None when `part` is not one: the master
+    strategy's master pattern and mold box, the direct strategy's halves, the core holder and
+    casting jig."""
+    role, name, p = part["role"], part["name"], part["params"]
+    if role == "master_pattern" and "master" in p:
+        return master_pattern(p)
+    if role == "mold_box" and "master" in p:
+        return mold_box(p)
+    if role in ("core_holder", "casting_jig"):
+        return core_holder(p)
+    if role == "mold_half":
+        return mold_half(p, name.rsplit("_", 1)[1])
+    return None

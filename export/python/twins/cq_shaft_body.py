@@ -163,3 +163,10 @@ def robot_mount(params: dict):
     cuts.append(cyl(m["pin_hole_diameter_mm"] / 2.0, z0 - 1.0, z0 + m["pin_hole_depth_mm"],
                     px, py))
     return C.cut(mount, cuts)
+
+
+def twin(part: dict):
+    """The twin of a shaft-body family part (sensor frame), or None when `part` is not one."""
+    builder = {"tip_fitting": tip_fitting, "shaft_body": shaft_body,
+               "robot_mount": robot_mount}.get(part["role"])
+    return builder(part["params"]) if builder else None
