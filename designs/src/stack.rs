@@ -58,6 +58,50 @@ pub fn validate(
     }
     let mut errs: Vec<ParamError> = Vec::new();
     let t = tol.mm();
+    check_scope(design, &mut errs)?;
+    let body_ok = errs.iter().all(|e| !e.path.starts_with("body."));
+    let sphere_r = if body_ok {
+        design.body.sphere_radius_mm()
+    } else {
+        None
+    };
+
+    check_coats_and_backing(design, &mut errs);
+    check_materials(design, materials, &mut errs);
+
+    let layer_specs_ok = check_layer_specs(design, sphere_r, body_ok, &mut errs);
+    check_core_and_casting(design, sphere_r, body_ok, &mut errs);
+    check_mold_strategies(design, &mut errs);
+
+    // Resolve the stack from the inside out, in "radius" units for spheres (r = R + offset).
+    let (layers, core, stack_ok) = if body_ok && layer_specs_ok && !design.layers.is_empty() {
+        resolve_surfaces(design, sphere_r, t, &mut errs)
+    } else {
+        (Vec::new(), None, false)
+    };
+
+    check_with_stack(design, &layers, core.as_ref(), stack_ok, &mut errs);
+    let mut errs = numbers.merge_negative(errs);
+    // a non-finite point's row, when the placement did not report it (its layer not placed)
+    for e in in_points {
+        let row = &e.path[..e.path.rfind('[').unwrap_or(e.path.len())];
+        if !errs.iter().any(|x| x.path == row || x.path == e.path) {
+            errs.push(e);
+        }
+    }
+    if errs.is_empty() && stack_ok {
+        Ok(Stack { core, layers })
+    } else {
+        Err(ParamErrors(errs))
+    }
+}
+
+/// The design's name, whether its body is one this validation handles (flat skins have their
+/// own, [`crate::flat::validate`]), the body's own rules, and the flat-skin-only keys.
+///
+/// # Errors
+/// The one error of a flat body, alone.
+fn check_scope(design: &Design, errs: &mut Vec<ParamError>) -> Result<(), ParamErrors> {
     if !crate::values::is_file_stem(&design.name) {
         errs.push(ParamError::new(
             "name",
@@ -102,13 +146,11 @@ pub fn validate(
             }
         }
     }
-    let body_ok = errs.iter().all(|e| !e.path.starts_with("body."));
-    let sphere_r = if body_ok {
-        design.body.sphere_radius_mm()
-    } else {
-        None
-    };
+    Ok(())
+}
 
+/// The brushed coats' purpose and components, and the backing plate's size.
+fn check_coats_and_backing(design: &Design, errs: &mut Vec<ParamError>) {
     // Brushed coats name what they are and what goes into them.
     for (i, l) in design.layers.iter().enumerate() {
         if let Some(coat) = &l.brushed_coat {
@@ -149,7 +191,10 @@ pub fn validate(
             ));
         }
     }
+}
 
+/// Every material key of the design exists in `materials` and is of a kind its use allows.
+fn check_materials(design: &Design, materials: &MaterialsTable, errs: &mut Vec<ParamError>) {
     // Materials exist and fit their use.
     let mut check_material =
         |path: String, key: &str, kinds: &[MaterialKind]| match materials.get(key) {
@@ -229,7 +274,16 @@ pub fn validate(
             check_material(path, key, kinds);
         }
     }
+}
 
+/// The layers' names, solidity and thickness-or-radius; whether they all hold (the stack can
+/// then be resolved).
+fn check_layer_specs(
+    design: &Design,
+    sphere_r: Option<f64>,
+    body_ok: bool,
+    errs: &mut Vec<ParamError>,
+) -> bool {
     if design.layers.is_empty() {
         errs.push(ParamError::new(
             "layers",
@@ -299,7 +353,17 @@ pub fn validate(
             }
         }
     }
-    let layer_specs_ok = errs.len() == errors_before_layer_specs;
+    errs.len() == errors_before_layer_specs
+}
+
+/// The layers' processes (one cast or printed, the innermost not sprayed), the core's own
+/// fields and the pour's waste allowance.
+fn check_core_and_casting(
+    design: &Design,
+    sphere_r: Option<f64>,
+    body_ok: bool,
+    errs: &mut Vec<ParamError>,
+) {
     if !design.layers.is_empty()
         && design
             .layers
@@ -342,7 +406,7 @@ pub fn validate(
             ));
         }
         if let Some(m) = &c.machining {
-            check_machining(m, &mut errs);
+            check_machining(m, errs);
         }
     }
     if !(0.0..=1.0).contains(&design.casting.waste_allowance) {
@@ -352,7 +416,10 @@ pub fn validate(
             "must be in [0, 1]",
         ));
     }
-    // Mold strategies that need a rigid core (a holder grips it) or a solid layer.
+}
+
+/// Mold strategies that need a rigid core (a holder grips it) or a solid layer.
+fn check_mold_strategies(design: &Design, errs: &mut Vec<ParamError>) {
     for (i, l) in design.layers.iter().enumerate() {
         if l.process != LayerProcess::Cast {
             continue;
@@ -389,148 +456,165 @@ pub fn validate(
             ));
         }
     }
+}
 
-    // Resolve the stack from the inside out, in "radius" units for spheres (r = R + offset).
+/// The layers' and the core's surfaces, resolved from the inside out in "radius" units for
+/// spheres (r = R + offset), with the errors of a stack that does not close; whether it does.
+fn resolve_surfaces(
+    design: &Design,
+    sphere_r: Option<f64>,
+    t: f64,
+    errs: &mut Vec<ParamError>,
+) -> (Vec<ResolvedLayer>, Option<ResolvedCore>, bool) {
     let mut layers = Vec::new();
     let mut core = None;
     let mut stack_ok = false;
-    if body_ok && layer_specs_ok && !design.layers.is_empty() {
-        let solid_first = design.layers[0].solid;
-        let shells = if solid_first {
-            &design.layers[1..]
-        } else {
-            &design.layers[..]
-        };
-        let total_t: Option<f64> = shells.iter().map(|l| l.thickness_mm).sum();
-        let core_od = design.core.as_ref().and_then(|c| c.outer_diameter_mm);
-        // Offset of the innermost shell layer's inner surface.
-        let start = match (sphere_r, core_od) {
-            (_, Some(od)) if !(od > 0.0 && od.is_finite()) => {
-                errs.push(ParamError::new(
-                    "core.outer_diameter_mm",
-                    od,
-                    "must be above 0",
-                ));
-                None
-            }
-            (Some(r), Some(od)) => Some(od / 2.0 - r),
-            _ => total_t.map(|s| -s),
-        };
-        match start {
-            None if core_od.is_some() => {}
-            None => errs.push(ParamError::new(
-                if design.core.is_some() { "core.outer_diameter_mm" } else { "layers" },
-                "missing",
-                "layers given by outer_radius_mm are measured from the core: give core.outer_diameter_mm (or thickness_mm for every layer)",
-            )),
-            Some(start) => {
-                let r_body = sphere_r.unwrap_or(0.0);
-                let mut below = start;
-                let mut below_name = if design.core.is_some() { "the core".to_string() } else { "the inner surface".to_string() };
-                let errors_before_stack = errs.len();
-                if solid_first {
-                    let l = &design.layers[0];
-                    if !design.body.offset_is_valid(start) {
-                        errs.push(ParamError::new(
-                            "layers[1].thickness_mm",
-                            -start,
-                            "the layers above the solid layer leave no room for it",
-                        ));
-                    }
-                    layers.push(ResolvedLayer {
-                        index: 0,
-                        name: l.name.clone(),
-                        material: l.material.clone(),
-                        process: l.process,
-                        inner_offset_mm: f64::NEG_INFINITY,
-                        outer_offset_mm: start,
-                        thickness_mm: design.body.pole_z_mm(start) - design.body.base_z_mm(),
-                        mold_strategy: l.mold_strategy.unwrap_or(design.mold.strategy),
-                        solid: true,
-                    });
-                    below_name = format!("layer '{}'", l.name);
-                }
-                for (i, l) in design.layers.iter().enumerate().skip(usize::from(solid_first)) {
-                    let (out, path, value) = match (l.thickness_mm, l.outer_radius_mm) {
-                        (Some(th), _) => (below + th, format!("layers[{i}].thickness_mm"), th),
-                        (_, Some(ro)) => (ro - r_body, format!("layers[{i}].outer_radius_mm"), ro),
-                        _ => unreachable!("checked above"),
-                    };
-                    let th = out - below;
-                    if !(th >= t) {
-                        let rule = if i == 0 && l.outer_radius_mm.is_some() && th < 0.0 {
-                            format!(
-                                "the core (outer radius {:.3} mm) is larger than the cavity of layer '{}' (outer radius {:.3} mm)",
-                                r_body + below,
-                                l.name,
-                                r_body + out
-                            )
-                        } else if l.outer_radius_mm.is_some() && th < 0.0 {
-                            format!("must be above the outer radius of {below_name} under it ({:.3} mm)", r_body + below)
-                        } else {
-                            format!("leaves layer '{}' {:.4} mm thick, below the chord tolerance {} mm", l.name, th, t)
-                        };
-                        errs.push(ParamError::new(path, value, rule));
-                    }
-                    layers.push(ResolvedLayer {
-                        index: i,
-                        name: l.name.clone(),
-                        material: l.material.clone(),
-                        process: l.process,
-                        inner_offset_mm: below,
-                        outer_offset_mm: out,
-                        thickness_mm: th,
-                        mold_strategy: l.mold_strategy.unwrap_or(design.mold.strategy),
-                        solid: false,
-                    });
-                    below = out;
-                    below_name = format!("layer '{}'", l.name);
-                }
-                // A layer error already explains a stack that misses the body surface.
-                stack_ok = errs.len() == errors_before_stack;
-                if stack_ok && below.abs() > 1e-9 {
-                    stack_ok = false;
-                    let last = design.layers.len() - 1;
+    let solid_first = design.layers[0].solid;
+    let shells = if solid_first {
+        &design.layers[1..]
+    } else {
+        &design.layers[..]
+    };
+    let total_t: Option<f64> = shells.iter().map(|l| l.thickness_mm).sum();
+    let core_od = design.core.as_ref().and_then(|c| c.outer_diameter_mm);
+    // Offset of the innermost shell layer's inner surface.
+    let start = match (sphere_r, core_od) {
+        (_, Some(od)) if !(od > 0.0 && od.is_finite()) => {
+            errs.push(ParamError::new(
+                "core.outer_diameter_mm",
+                od,
+                "must be above 0",
+            ));
+            None
+        }
+        (Some(r), Some(od)) => Some(od / 2.0 - r),
+        _ => total_t.map(|s| -s),
+    };
+    match start {
+        None if core_od.is_some() => {}
+        None => errs.push(ParamError::new(
+            if design.core.is_some() { "core.outer_diameter_mm" } else { "layers" },
+            "missing",
+            "layers given by outer_radius_mm are measured from the core: give core.outer_diameter_mm (or thickness_mm for every layer)",
+        )),
+        Some(start) => {
+            let r_body = sphere_r.unwrap_or(0.0);
+            let mut below = start;
+            let mut below_name = if design.core.is_some() { "the core".to_string() } else { "the inner surface".to_string() };
+            let errors_before_stack = errs.len();
+            if solid_first {
+                let l = &design.layers[0];
+                if !design.body.offset_is_valid(start) {
                     errs.push(ParamError::new(
-                        if sphere_r.is_some() { "body.radius_mm" } else { "layers" },
-                        format!("{}", r_body),
-                        format!(
-                            "the outermost layer '{}' ends {:+.4} mm from the body surface; its outer surface must be the body surface{}",
-                            design.layers[last].name,
-                            below,
-                            if core_od.is_some() { " (check core.outer_diameter_mm and the layer radii)" } else { "" }
-                        ),
+                        "layers[1].thickness_mm",
+                        -start,
+                        "the layers above the solid layer leave no room for it",
                     ));
                 }
-                // Every shell surface must be a valid offset (no fold at high curvature).
-                if stack_ok {
-                    for l in &layers {
-                        if !l.solid && !design.body.offset_is_valid(l.inner_offset_mm) {
-                            stack_ok = false;
-                            errs.push(ParamError::new(
-                                format!("layers[{}]", l.index),
-                                &l.name,
-                                format!(
-                                    "its inner surface lies {:.3} mm inside the body surface, beyond what the {} allows (smallest radius of curvature {:.3} mm): the offset surface would fold",
-                                    -l.inner_offset_mm,
-                                    design.body.kind(),
-                                    design.body.min_curvature_radius_mm()
-                                ),
-                            ));
-                        }
+                layers.push(ResolvedLayer {
+                    index: 0,
+                    name: l.name.clone(),
+                    material: l.material.clone(),
+                    process: l.process,
+                    inner_offset_mm: f64::NEG_INFINITY,
+                    outer_offset_mm: start,
+                    thickness_mm: design.body.pole_z_mm(start) - design.body.base_z_mm(),
+                    mold_strategy: l.mold_strategy.unwrap_or(design.mold.strategy),
+                    solid: true,
+                });
+                below_name = format!("layer '{}'", l.name);
+            }
+            for (i, l) in design.layers.iter().enumerate().skip(usize::from(solid_first)) {
+                let (out, path, value) = match (l.thickness_mm, l.outer_radius_mm) {
+                    (Some(th), _) => (below + th, format!("layers[{i}].thickness_mm"), th),
+                    (_, Some(ro)) => (ro - r_body, format!("layers[{i}].outer_radius_mm"), ro),
+                    _ => unreachable!("checked above"),
+                };
+                let th = out - below;
+                if !(th >= t) {
+                    let rule = if i == 0 && l.outer_radius_mm.is_some() && th < 0.0 {
+                        format!(
+                            "the core (outer radius {:.3} mm) is larger than the cavity of layer '{}' (outer radius {:.3} mm)",
+                            r_body + below,
+                            l.name,
+                            r_body + out
+                        )
+                    } else if l.outer_radius_mm.is_some() && th < 0.0 {
+                        format!("must be above the outer radius of {below_name} under it ({:.3} mm)", r_body + below)
+                    } else {
+                        format!("leaves layer '{}' {:.4} mm thick, below the chord tolerance {} mm", l.name, th, t)
+                    };
+                    errs.push(ParamError::new(path, value, rule));
+                }
+                layers.push(ResolvedLayer {
+                    index: i,
+                    name: l.name.clone(),
+                    material: l.material.clone(),
+                    process: l.process,
+                    inner_offset_mm: below,
+                    outer_offset_mm: out,
+                    thickness_mm: th,
+                    mold_strategy: l.mold_strategy.unwrap_or(design.mold.strategy),
+                    solid: false,
+                });
+                below = out;
+                below_name = format!("layer '{}'", l.name);
+            }
+            // A layer error already explains a stack that misses the body surface.
+            stack_ok = errs.len() == errors_before_stack;
+            if stack_ok && below.abs() > 1e-9 {
+                stack_ok = false;
+                let last = design.layers.len() - 1;
+                errs.push(ParamError::new(
+                    if sphere_r.is_some() { "body.radius_mm" } else { "layers" },
+                    format!("{}", r_body),
+                    format!(
+                        "the outermost layer '{}' ends {:+.4} mm from the body surface; its outer surface must be the body surface{}",
+                        design.layers[last].name,
+                        below,
+                        if core_od.is_some() { " (check core.outer_diameter_mm and the layer radii)" } else { "" }
+                    ),
+                ));
+            }
+            // Every shell surface must be a valid offset (no fold at high curvature).
+            if stack_ok {
+                for l in &layers {
+                    if !l.solid && !design.body.offset_is_valid(l.inner_offset_mm) {
+                        stack_ok = false;
+                        errs.push(ParamError::new(
+                            format!("layers[{}]", l.index),
+                            &l.name,
+                            format!(
+                                "its inner surface lies {:.3} mm inside the body surface, beyond what the {} allows (smallest radius of curvature {:.3} mm): the offset surface would fold",
+                                -l.inner_offset_mm,
+                                design.body.kind(),
+                                design.body.min_curvature_radius_mm()
+                            ),
+                        ));
                     }
                 }
-                if let (Some(c), true) = (&design.core, stack_ok) {
-                    core = Some(resolve_core(design, c, start, sphere_r, &mut errs));
-                }
+            }
+            if let (Some(c), true) = (&design.core, stack_ok) {
+                core = Some(resolve_core(design, c, start, sphere_r, errs));
             }
         }
     }
+    (layers, core, stack_ok)
+}
 
-    crate::molds::check_mold_params(design, &mut errs);
-    check_printers(&design.printers, &mut errs);
+/// The checks that use the resolved stack: the molds', the printers', the markers', the
+/// housing's and every section family's rules, and the first held mold's fit on the core.
+fn check_with_stack(
+    design: &Design,
+    layers: &[ResolvedLayer],
+    core: Option<&ResolvedCore>,
+    stack_ok: bool,
+    errs: &mut Vec<ParamError>,
+) {
+    crate::molds::check_mold_params(design, errs);
+    check_printers(&design.printers, errs);
     if stack_ok {
-        crate::layers::check_markers(design, &layers, &mut errs);
+        crate::layers::check_markers(design, layers, errs);
         let two_piece_rim = layers
             .iter()
             .filter(|l| {
@@ -539,15 +623,15 @@ pub fn validate(
             .map(|l| design.body.rim_radius_mm(l.outer_offset_mm))
             .fold(None, |a: Option<f64>, r| Some(a.map_or(r, |a| a.max(r))));
         if let Some(rim) = two_piece_rim {
-            crate::molds::check_two_piece(design, rim, &mut errs);
+            crate::molds::check_two_piece(design, rim, errs);
         }
     }
     // Checks that use the core only make sense once the stack itself is sound.
-    let sound_core = core.as_ref().filter(|_| stack_ok);
+    let sound_core = core.filter(|_| stack_ok);
     if let Some(h) = &design.housing {
         match (sound_core, stack_ok) {
             (Some(_), _) | (None, false) => {
-                crate::housing::check_housing_params(design, h, sound_core, &mut errs)
+                crate::housing::check_housing_params(design, h, sound_core, errs)
             }
             (None, true) => errs.push(ParamError::new(
                 "housing",
@@ -558,11 +642,11 @@ pub fn validate(
     }
     if stack_ok && FAMILIES.iter().any(|f| f.given(design)) {
         let st = Stack {
-            core: core.clone(),
-            layers: layers.clone(),
+            core: core.cloned(),
+            layers: layers.to_vec(),
         };
         for f in FAMILIES {
-            f.check(design, &st, &mut errs);
+            f.check(design, &st, errs);
         }
     }
     if let (Some(c), true) = (sound_core, errs.is_empty()) {
@@ -570,21 +654,8 @@ pub fn validate(
             l.process == LayerProcess::Cast
                 && matches!(l.mold_strategy, MoldStrategy::Direct | MoldStrategy::Master)
         }) {
-            crate::molds::check_mold_fit(design, c, first.outer_offset_mm, &mut errs);
+            crate::molds::check_mold_fit(design, c, first.outer_offset_mm, errs);
         }
-    }
-    let mut errs = numbers.merge_negative(errs);
-    // a non-finite point's row, when the placement did not report it (its layer not placed)
-    for e in in_points {
-        let row = &e.path[..e.path.rfind('[').unwrap_or(e.path.len())];
-        if !errs.iter().any(|x| x.path == row || x.path == e.path) {
-            errs.push(e);
-        }
-    }
-    if errs.is_empty() && stack_ok {
-        Ok(Stack { core, layers })
-    } else {
-        Err(ParamErrors(errs))
     }
 }
 
