@@ -1,6 +1,8 @@
 //! From a validated design to a [`Kit`]: mold parts per cast layer, the shell, and the pour
 //! numbers.
 
+mod flat_kit;
+
 use crate::error::{DesignError, GeometryContext};
 use crate::geometry::ChordTolerance;
 use crate::kit::Kit;
@@ -60,7 +62,7 @@ pub fn build_kit_bounded(
 ) -> Result<Kit, DesignError> {
     let materials = MaterialsTable::embedded().map_err(DesignError::Yaml)?;
     if design.body.flat_outline().is_some() {
-        return crate::flat::build_kit(design, &materials, tol, max_triangles);
+        return flat_kit::build_flat_kit(design, &materials, tol, max_triangles);
     }
     let stack = validate(design, &materials, tol)?;
     if max_triangles < u64::MAX {

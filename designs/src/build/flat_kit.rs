@@ -1,0 +1,369 @@
+//! The kit of a flat skin (Soter et al. Sec. II-A): a casting tray per layer (printed, or
+//! stacked from laser-cut sheets), the pours, the channels' tubes and liquid, the procedure.
+//! Its layers' rules and solids are the flat family's ([`crate::flat`]).
+
+use crate::error::{DesignError, GeometryContext as _};
+use crate::flat::{
+    estimated_triangles, layer_solid, tray_solid, validate, ChannelEnds, ChannelSet, FlatLayer,
+    FlatOutline,
+};
+use crate::geometry::ChordTolerance;
+use crate::kit::Kit;
+use crate::materials::{CastReport, MaterialsTable};
+use crate::parts::cut_part::CutPart;
+use crate::parts::{Member, MemberKind, Part, PrintTechnology, ProcedureAction, ProcedureStep};
+use crate::schema::{Design, LaserCutParams};
+
+/// Validates a flat design ([`validate`]) and builds its kit at `tol`: one tray per layer
+/// (FDM or as `mold.fixture_print_technology` says; Soter et al. laser-cut theirs), the pours
+/// in order (the channel layers first, then the marker layer the channel layer is laid onto
+/// while it is tacky: Sec. II-A casts the top layer first), the tubes and liquid, the
+/// procedure, and the skin's layers as the assembly (for the section view).
+///
+/// # Errors
+/// [`crate::DesignError::Params`] with every violated rule; [`crate::DesignError::WorkLimit`]
+/// past `max_triangles`; [`crate::DesignError::Geometry`] on a kernel failure.
+pub(crate) fn build_flat_kit(
+    design: &Design,
+    materials: &MaterialsTable,
+    tol: ChordTolerance,
+    max_triangles: u64,
+) -> Result<Kit, DesignError> {
+    let layers = validate(design, materials).map_err(DesignError::Params)?;
+    let Some(outline) = design.body.flat_outline() else {
+        return Err(DesignError::Yaml("not a flat design".into()));
+    };
+    let est = estimated_triangles(&outline, &layers, design.mold.laser_cut.is_some(), tol);
+    if est > max_triangles as f64 {
+        return Err(DesignError::WorkLimit(format!(
+            "{}: the kit would have about {:.0} triangles at chord tolerance {} mm, more than the limit of {max_triangles} (about 1 KB of memory each; raise it with --max-triangles, up to {}, or coarsen --chord-tolerance-mm)",
+            design.name,
+            est,
+            tol.mm(),
+            crate::estimate::MAX_TRIANGLES_LIMIT
+        )));
+    }
+    let m = &design.mold;
+    let tech: PrintTechnology = m.fixture_print_technology.into();
+    let wall = m.wall_thickness_mm;
+    let mut parts = Vec::new();
+    let mut assembly = Vec::new();
+    let mut volumes = Vec::new();
+    let mut cut_parts = Vec::new();
+    let laser = design.mold.laser_cut.as_ref();
+    for (i, l) in layers.iter().enumerate() {
+        let (part, member, v, sheets) = layer_tray(&outline, l, i, laser, tech, wall, tol)?;
+        parts.push(part);
+        assembly.push(member);
+        volumes.push(v);
+        cut_parts.extend(sheets);
+    }
+    // pours: channel layers (outer) first, the innermost (marker) layer last
+    let order: Vec<usize> = (1..layers.len()).chain(std::iter::once(0)).collect();
+    let mut casts = Vec::new();
+    for (step, &i) in order.iter().enumerate() {
+        let l = &design.layers[i];
+        let mat = materials
+            .get(&l.material)
+            .ok_or_else(|| DesignError::Yaml(format!("unknown material {}", l.material)))?;
+        casts.push(
+            crate::materials::pour(
+                step as u32 + 1,
+                &l.name,
+                &l.material,
+                mat,
+                vec![parts[i].name.clone()],
+                volumes[i],
+                design.casting.waste_allowance,
+            )
+            .map_err(DesignError::Yaml)?,
+        );
+    }
+    let channel_sets: Vec<(&FlatLayer, &ChannelSet)> = layers
+        .iter()
+        .filter_map(|l| l.channels.as_ref().map(|c| (l, c)))
+        .collect();
+    let (bought, liquid_ml) = bought_items(&layers, &channel_sets, laser, &cut_parts);
+    let procedure = procedure(&parts, &casts, &layers, &channel_sets, laser);
+    let summary = serde_json::json!({
+        "flat": {
+            "outline": outline,
+            "area_mm2": outline.area_mm2(),
+            "layers": layers.iter().map(|l| serde_json::json!({"name": l.name, "z0_mm": l.z0_mm, "z1_mm": l.z1_mm})).collect::<Vec<_>>(),
+            "channels": channel_sets.iter().map(|(l, c)| serde_json::json!({
+                "layer": l.name, "count": c.count, "channel_volume_mm3": c.channel_volume_mm3(),
+                "liquid_per_channel_ml": c.liquid_per_channel_ml(), "ends": c.ends,
+                "centres_x_mm": c.centres_x_mm()})).collect::<Vec<_>>(),
+            "markers": layers.iter().filter_map(|l| l.marker_grid.as_ref()).map(|g| g.rows * g.columns).sum::<usize>(),
+            "liquid_ml": liquid_ml,
+        }
+    });
+    Ok(Kit {
+        design: design.name.clone(),
+        parts,
+        casts,
+        bought_items: bought,
+        procedure,
+        assembly,
+        cut_parts,
+        pcb_outlines: Vec::new(),
+        machined_parts: Vec::new(),
+        summary,
+    })
+}
+
+/// Layer `i`'s casting tray (printed, or the union of its laser-cut sheets) with the cast
+/// layer as its member of the assembly, the layer's exact volume (mm^3) and the tray's sheets
+/// as cut parts.
+///
+/// # Errors
+/// [`DesignError`] naming the tray or the layer if a sheet or the kernel fails.
+fn layer_tray(
+    outline: &FlatOutline,
+    l: &FlatLayer,
+    i: usize,
+    laser: Option<&LaserCutParams>,
+    tech: PrintTechnology,
+    wall: f64,
+    tol: ChordTolerance,
+) -> Result<(Part, Member, f64, Vec<CutPart>), DesignError> {
+    let mut cut_parts = Vec::new();
+    let name = format!("{}_tray", l.name);
+    // a laser-cut tray: its sheets, their union the printable tray; the layer's bottom face
+    // on the base sheet (and the marker sheet)
+    let (tray, floor, sheets) = match laser {
+        Some(lc) => {
+            let sheets = crate::lasercut::tray_sheets(&outline, l, i, wall, lc, tol)
+                .map_err(|e| DesignError::Params(crate::ParamErrors(e)))?;
+            for s in &sheets {
+                cut_parts.push(
+                    crate::lasercut::cut_part(
+                        s,
+                        &format!("{} tray, sheet {}: {}", l.name, s.name, s.role),
+                        tol,
+                    )
+                    .map_err(DesignError::Yaml)?,
+                );
+            }
+            let floor = sheets
+                .iter()
+                .filter(|s| s.role == "base" || s.role == "markers")
+                .map(|s| s.level_mm())
+                .sum::<f64>();
+            (
+                crate::lasercut::tray_union(&sheets).part(&name)?,
+                floor,
+                Some(sheets),
+            )
+        }
+        None => {
+            let floor = wall + l.marker_grid.as_ref().map_or(0.0, |g| g.feature.height_mm);
+            (
+                tray_solid(&outline, l, wall, floor, tol).part(&name)?,
+                floor,
+                None,
+            )
+        }
+    };
+    let skin = layer_solid(&outline, l, tol).part(&l.name)?;
+    let t = l.z1_mm - l.z0_mm;
+    // the cast layer's own volume, exact: the outline's prism, less the grooves, plus the
+    // markers beyond the face (flat-ended in a laser-cut tray: its holes go straight
+    // through their sheet)
+    let v = outline.area_mm2() * t
+        - l.channels
+            .as_ref()
+            .map_or(0.0, |c| c.count as f64 * c.channel_volume_mm3())
+        + l.marker_grid.as_ref().map_or(0.0, |g| {
+            let one = if laser.is_some() {
+                std::f64::consts::PI * (g.feature.diameter_mm / 2.0).powi(2) * g.feature.height_mm
+            } else {
+                g.feature.nominal_volume_mm3()
+            };
+            (g.rows * g.columns) as f64 * one
+        });
+    let what = match (&l.channels, &l.marker_grid) {
+        (Some(c), _) => format!(", {} ribs forming the channels' grooves", c.count),
+        (_, Some(g)) => format!(", {} x {} holes forming the markers", g.rows, g.columns),
+        _ => String::new(),
+    };
+    let made = match &sheets {
+        Some(s) => format!(
+            "; the union of its {} laser-cut sheets (cut/{}_*), or print it",
+            s.iter().map(|s| s.quantity).sum::<u32>(),
+            name
+        ),
+        None => String::new(),
+    };
+    let part = Part {
+        name: name.clone(),
+        role: "casting_tray".into(),
+        description: format!(
+            "Open tray of layer {} ({t:.2} mm deep{what}); pour to the brim and scrape level{made}",
+            l.name
+        ),
+        material: crate::molds::material_for(tech).into(),
+        print_technology: tech,
+        solid: tray,
+        params: serde_json::json!({
+            "layer": l.name, "layer_index": i, "outline": outline, "depth_mm": t,
+            "z0_mm": l.z0_mm, "wall_mm": wall, "floor_mm": floor,
+            "channels": l.channels, "marker_grid": l.marker_grid,
+            "laser_cut": sheets.as_ref().map(|sh| serde_json::json!({
+                "sheets": sh.iter().map(|s| serde_json::json!({"name": s.name, "role": s.role, "stock": s.stock,
+                    "quantity": s.quantity, "z0_mm": s.z0_mm, "level_mm": s.level_mm(), "area_mm2": s.region.area_mm2()})).collect::<Vec<_>>(),
+                "registration_xy_mm": crate::lasercut::registration_xy_mm(&outline, wall),
+                "registration_diameter_mm": laser.map(|lc| lc.registration.diameter_mm),
+                "markers": "flat-ended, straight through their sheet",
+            })),
+            // the layer's bottom face (sensor z0) on the tray's floor (print z = floor)
+            "T_print_sensor": [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, floor - l.z0_mm]],
+        }),
+        group: None,
+    };
+    let member = Member {
+        name: l.name.clone(),
+        kind: MemberKind::Cast,
+        description: format!("{} layer, {t:.2} mm", l.name),
+        solid: skin,
+        fix: vec![format!("layers[{i}]")],
+        nested_by_stack: true,
+        exact: None,
+    };
+    Ok((part, member, v, cut_parts))
+}
+
+/// The bought items of a flat kit: the channels' tubes, adhesive and liquid, the dowels and
+/// sheet stock of laser-cut trays, the markers' paint; with the liquid's volume, mL.
+fn bought_items(
+    layers: &[FlatLayer],
+    channel_sets: &[(&FlatLayer, &ChannelSet)],
+    laser: Option<&LaserCutParams>,
+    cut_parts: &[CutPart],
+) -> (Vec<String>, f64) {
+    let mut bought = Vec::new();
+    let mut liquid_ml = 0.0;
+    for (l, c) in channel_sets {
+        let t = &c.tube;
+        liquid_ml += c.count as f64 * c.liquid_per_channel_ml();
+        bought.push(format!(
+            "{} x silicone tube {:.1} mm OD, {:.1} mm ID, {:.0} mm long (one per channel of layer {}, from the skin to the display)",
+            c.count, t.outer_diameter_mm, t.inner_diameter_mm, t.length_mm, l.name
+        ));
+    }
+    if !channel_sets.is_empty() {
+        bought.push(
+            "Smooth-On Sil-Poxy silicone adhesive (glues the tubes into the channels' mouths)"
+                .into(),
+        );
+        bought.push(format!(
+            "Coloured liquid (water with food dye), {:.1} mL in the channels and tubes, and a tank deep enough to submerge the skin and tubes in it",
+            liquid_ml
+        ));
+    }
+    if let Some(lc) = laser {
+        bought.push(format!(
+            "{} x steel dowel pin {} mm diameter, as long as the thickest tray's stack (registration of each tray's sheets); {}",
+            4 * layers.len(),
+            lc.registration.diameter_mm,
+            {
+                let mut used: Vec<String> = Vec::new();
+                for c in cut_parts {
+                    let s = format!("{} mm {}", c.thickness_mm, c.material);
+                    if !used.contains(&s) {
+                        used.push(s);
+                    }
+                }
+                format!("sheet stock: {}", used.join(", "))
+            }
+        ));
+    }
+    if layers.iter().any(|l| l.marker_grid.is_some()) {
+        bought.push("White silicone paint (Silc Pig white in a little uncured Ecoflex) for the markers' ends".into());
+    }
+    (bought, liquid_ml)
+}
+
+/// The procedure of a flat kit: make the trays, pour and demold each layer in order (the last
+/// one closing the channels), fit and fill the channels' tubes.
+fn procedure(
+    parts: &[Part],
+    casts: &[CastReport],
+    layers: &[FlatLayer],
+    channel_sets: &[(&FlatLayer, &ChannelSet)],
+    laser: Option<&LaserCutParams>,
+) -> Vec<ProcedureStep> {
+    let step = |action, text: String| ProcedureStep { action, text };
+    let trays = parts
+        .iter()
+        .map(|p| p.name.as_str())
+        .collect::<Vec<_>>()
+        .join(", ");
+    let mut procedure = vec![match laser {
+        Some(lc) => step(
+            ProcedureAction::Print,
+            format!(
+                "Laser-cut the trays' sheets (cut/*.dxf or cut/*.svg: each sheet's paths already offset for its stock's kerf; the quantity of each is in its description), or print the trays ({trays}) instead. Stack each tray's sheets in order (base at the bottom) on four {} mm dowel pins through the registration holes, bond them (acrylic cement for acrylic, wood glue for plywood) and seal the cavity's inside edges with a thin bead of silicone; check that the tray is flat and its cavity clean.",
+                lc.registration.diameter_mm
+            ),
+        ),
+        None => step(
+            ProcedureAction::Print,
+            format!("Print the trays ({trays}); check that each is flat and its cavity clean."),
+        ),
+    }];
+    for c in casts {
+        let l = layers.iter().find(|l| l.name == c.cast);
+        let last = c.step as usize == casts.len() && casts.len() > 1;
+        procedure.push(step(
+            ProcedureAction::Pour,
+            format!(
+                "Pour {} ({:.2} mL, {:.2} g mixed) into {}: degas the mix in a vacuum chamber, pour to the brim and scrape level{}.",
+                c.cast,
+                c.cavity_volume_ml,
+                c.total_mass_g,
+                c.mold_parts.join(", "),
+                if last {
+                    "; when it has gelled until tacky (about half its pot life), lay the cured layers on it, grooves down, square to the tray's walls with the channels' mouths over the near wall, and weigh them down evenly: the tacky layer closes the grooves into channels"
+                } else {
+                    ""
+                }
+            ),
+        ));
+        let markers = l.and_then(|l| l.marker_grid.as_ref());
+        procedure.push(step(
+            ProcedureAction::Demold,
+            format!(
+                "Cure and take {} out of its tray{}.",
+                c.cast,
+                if markers.is_some() {
+                    "; paint the markers' ends white"
+                } else {
+                    ""
+                }
+            ),
+        ));
+    }
+    for (l, c) in channel_sets {
+        let t = &c.tube;
+        procedure.push(step(
+            ProcedureAction::Assemble,
+            format!(
+                "Push a tube {:.1} mm into each of the {} channels' mouths of {} at the near edge and glue it with Sil-Poxy; lead the tubes to the display.",
+                t.insertion_mm, c.count, l.name
+            ),
+        ));
+        procedure.push(step(
+            ProcedureAction::Assemble,
+            format!(
+                "Fill the channels: submerge the skin and the tubes in the tank of coloured liquid and squeeze each channel until no more air leaves it (a channel closed at its far end cannot be filled by a syringe; Soter et al. Sec. II-A): {:.3} mL per channel and its tube{}.",
+                c.liquid_per_channel_ml(),
+                match c.ends {
+                    ChannelEnds::BothClosed => "; close each tube's display end while still under the liquid, so that the liquid always returns to its place",
+                    ChannelEnds::OneClosed => "; the tubes' display ends stay open",
+                }
+            ),
+        ));
+    }
+    procedure
+}
