@@ -128,6 +128,119 @@ pub fn build_kit_bounded(
         },
     );
     let (shell, sections) = shell;
+    let layer_markers = gather_layer_outputs(
+        &other,
+        others,
+        &held,
+        molds,
+        &plans,
+        &stack,
+        (&mut parts, &mut silicone, &mut gel),
+    )?;
+    let mut bought = bought_items(design, &stack, &materials);
+    let mut summary = json!({
+        "body": design.body,
+        "base_z_mm": design.body.base_z_mm(),
+        "pole_z_mm": design.body.pole_z_mm(0.0),
+        "core": stack.core,
+        "layers": stack.layers,
+        "markers": layer_markers,
+    });
+    let mut shell_levels = None;
+    if let (Some(h), Some(shell)) = (&design.housing, shell) {
+        let (shell, levels) = shell?;
+        parts.extend(shell);
+        let r = design.body.rim_radius_mm(0.0);
+        let w = h.outer_width_mm.max(2.0 * r);
+        summary["shell_levels"] = json!(&levels);
+        summary["envelope_mm"] = json!([w, w, levels.envelope_height_mm]);
+        bought.extend(housing_items(h));
+        shell_levels = Some(levels);
+    }
+
+    for (f, built) in FAMILIES.iter().zip(sections) {
+        let Some(built) = built else { continue };
+        let built = built?;
+        parts.extend(built.parts);
+        for (key, value) in built.summary {
+            summary[key] = value;
+        }
+        bought.extend(f.bought_items(design));
+    }
+
+    let (mut casts, step) = layer_pours(design, &stack, &materials, silicone, gel)?;
+    let tip_gel = filling_gel_pours(
+        design,
+        &stack,
+        &materials,
+        &parts,
+        shell_levels.as_ref(),
+        (&mut casts, step),
+        tol,
+    )?;
+    check_unique_names(&parts)?;
+    // The assembled sensor and its fit check: no file is written when parts overlap.
+    let assembly = assembled(design, &stack, &parts, shell_levels.as_ref(), tip_gel, tol)?;
+    let bolts = crate::procedure::clamp_bolts(design, &parts);
+    bought.extend(crate::procedure::clamp_bolt_items(&bolts));
+    let procedure = crate::procedure::procedure(design, &parts, &casts, &bolts);
+    let machined_parts = machined_parts(design, &stack, &parts, tol)?;
+    Ok(Kit {
+        design: design.name.clone(),
+        parts,
+        casts,
+        bought_items: bought,
+        procedure,
+        assembly,
+        cut_parts: crate::cut::cut_parts(design),
+        pcb_outlines: crate::cut::pcb_outlines(design),
+        machined_parts,
+        summary,
+    })
+}
+
+/// Parts are named uniquely by construction; checked anyway, the manifest relies on it.
+///
+/// # Errors
+/// [`DesignError::Geometry`] on `kit` for a name used twice.
+fn check_unique_names(parts: &[crate::Part]) -> Result<(), DesignError> {
+    let mut names: Vec<&str> = parts.iter().map(|p| p.name.as_str()).collect();
+    names.sort_unstable();
+    if names.windows(2).any(|w| w[0] == w[1]) {
+        return Err(crate::geometry::GeometryError::InvalidPrimitive(
+            "duplicate part names".into(),
+        ))
+        .part("kit");
+    }
+    Ok(())
+}
+
+/// A silicone mold's pour: what, volume (mm^3), the parts that hold it.
+type SiliconePour = (String, f64, Vec<String>);
+/// A layer's pour: layer index, what, material key, volume (mm^3), the parts that hold it, the
+/// sprayed layers on its mold.
+type GelPour = (usize, String, String, f64, Vec<String>, Vec<usize>);
+
+/// The outputs of the layers built by `crate::layers` (`other`, by layer index) and of the
+/// held molds (`held`, by cast plan), in that order: their parts, silicone pours and gel pours
+/// appended to `into`; the layers' marker summaries.
+///
+/// # Errors
+/// The first build error among them.
+#[allow(clippy::type_complexity)]
+fn gather_layer_outputs(
+    other: &[usize],
+    others: Vec<Result<crate::layers::LayerOutput, DesignError>>,
+    held: &[crate::molds::CastPlan],
+    molds: Vec<Result<crate::molds::MoldOutput, DesignError>>,
+    plans: &[crate::molds::CastPlan],
+    stack: &Stack,
+    (parts, silicone, gel): (
+        &mut Vec<crate::Part>,
+        &mut Vec<SiliconePour>,
+        &mut Vec<GelPour>,
+    ),
+) -> Result<Vec<serde_json::Value>, DesignError> {
     let mut layer_markers = Vec::new();
     for (&i, out) in other.iter().zip(others) {
         let out = out?;
@@ -162,37 +275,21 @@ pub fn build_kit_bounded(
         ));
         parts.extend(out.parts);
     }
-    let mut bought = bought_items(design, &stack, &materials);
-    let mut summary = json!({
-        "body": design.body,
-        "base_z_mm": design.body.base_z_mm(),
-        "pole_z_mm": design.body.pole_z_mm(0.0),
-        "core": stack.core,
-        "layers": stack.layers,
-        "markers": layer_markers,
-    });
-    let mut shell_levels = None;
-    if let (Some(h), Some(shell)) = (&design.housing, shell) {
-        let (shell, levels) = shell?;
-        parts.extend(shell);
-        let r = design.body.rim_radius_mm(0.0);
-        let w = h.outer_width_mm.max(2.0 * r);
-        summary["shell_levels"] = json!(&levels);
-        summary["envelope_mm"] = json!([w, w, levels.envelope_height_mm]);
-        bought.extend(housing_items(h));
-        shell_levels = Some(levels);
-    }
+    Ok(layer_markers)
+}
 
-    for (f, built) in FAMILIES.iter().zip(sections) {
-        let Some(built) = built else { continue };
-        let built = built?;
-        parts.extend(built.parts);
-        for (key, value) in built.summary {
-            summary[key] = value;
-        }
-        bought.extend(f.bought_items(design));
-    }
-
+/// The pours of the silicone molds, then of the layers inner to outer, numbered from 1, with
+/// each layer's treatments and sprayed coats; the next step's number.
+///
+/// # Errors
+/// [`DesignError::Yaml`] for a material missing from `materials`.
+fn layer_pours(
+    design: &Design,
+    stack: &Stack,
+    materials: &MaterialsTable,
+    silicone: Vec<SiliconePour>,
+    mut gel: Vec<GelPour>,
+) -> Result<(Vec<crate::materials::CastReport>, u32), DesignError> {
     let mut casts = Vec::new();
     let waste = design.casting.waste_allowance;
     let mut step = 1;
@@ -229,8 +326,8 @@ pub fn build_kit_bounded(
         }
         r.treatments = treatments(
             design,
-            &stack,
-            &materials,
+            stack,
+            materials,
             &layer,
             &sprayed,
             &r.mold_parts,
@@ -261,15 +358,33 @@ pub fn build_kit_bounded(
         casts.push(r);
         step += 1;
     }
+    Ok((casts, step))
+}
+
+/// The filling gel's pour, step `step` of `casts`: the housing's, poured into the assembled
+/// shell, or the shaft body's, poured into the tip; the tip's gel solid with its material.
+///
+/// # Errors
+/// [`DesignError`] naming the filling gel if the kernel fails or its material is unknown.
+fn filling_gel_pours(
+    design: &Design,
+    stack: &Stack,
+    materials: &MaterialsTable,
+    parts: &[crate::Part],
+    shell_levels: Option<&crate::housing::ShellLevels>,
+    (casts, step): (&mut Vec<crate::materials::CastReport>, u32),
+    tol: ChordTolerance,
+) -> Result<Option<(crate::geometry::Solid, String)>, DesignError> {
+    let waste = design.casting.waste_allowance;
     // The filling gel, poured into the assembled shell (R-Tac0 Sec. III-B1).
-    if let (Some(h), Some(lv), Some(core)) = (&design.housing, &shell_levels, &stack.core) {
+    if let (Some(h), Some(lv), Some(core)) = (&design.housing, shell_levels, &stack.core) {
         if let Some(f) = &h.filling_gel {
             let v = crate::housing::filling_gel_volume_mm3(design, h, core, lv);
             casts.push(filling_gel_cast(
-                &materials,
+                materials,
                 f,
                 (step, waste),
-                holders(&parts, &["shell_collar", "shell_tube", "shell_half"]),
+                holders(parts, &["shell_collar", "shell_tube", "shell_half"]),
                 v,
                 "Poured into the assembled shell, pole-down, before the camera goes on: it fills the core, the diffuser's opening and the light chamber up to the LED PCB's face (R-Tac0 Sec. III-B1).",
             )?);
@@ -279,41 +394,48 @@ pub fn build_kit_bounded(
     let mut tip_gel = None;
     if let Some(sb) = &design.shaft_body {
         if let Some(f) = &sb.filling_gel {
-            let cavity = crate::layers::inner_cavity(design, &stack, 0, tol)
+            let cavity = crate::layers::inner_cavity(design, stack, 0, tol)
                 .part(crate::procedure::FILLING_GEL)?;
             let gel = crate::parts::shaft_body::filling_gel_solid(
                 &design.context(),
                 sb,
-                &stack,
+                stack,
                 cavity,
                 tol,
             )
             .part(crate::procedure::FILLING_GEL)?;
             casts.push(filling_gel_cast(
-                &materials,
+                materials,
                 f,
                 (step, waste),
-                holders(&parts, &["printed_skin", "tip_fitting"]),
+                holders(parts, &["printed_skin", "tip_fitting"]),
                 gel.volume(),
                 "Poured into the tip, pole-down, round the pins and up into the lip's opening; the lens window is then laid on (Pestell et al. Sec. III-A).",
             )?);
             tip_gel = Some((gel, f.material.clone()));
         }
     }
-    // Parts are named uniquely by construction; check anyway, the manifest relies on it.
-    let mut names: Vec<&str> = parts.iter().map(|p| p.name.as_str()).collect();
-    names.sort_unstable();
-    if names.windows(2).any(|w| w[0] == w[1]) {
-        return Err(crate::geometry::GeometryError::InvalidPrimitive(
-            "duplicate part names".into(),
-        ))
-        .part("kit");
-    }
-    // The assembled sensor and its fit check: no file is written when parts overlap.
-    let mut assembly =
-        crate::assembly::members(design, &stack, &parts, shell_levels.as_ref(), tol)?;
+    Ok(tip_gel)
+}
+
+/// The members of the assembled sensor (the parts in the sensor frame, the cast layers, every
+/// family's bought and cut members, the tip's gel), checked for interferences and for the
+/// paths each member goes in by.
+///
+/// # Errors
+/// [`DesignError`] naming the members that overlap or block each other's way in, or a kernel
+/// failure.
+fn assembled(
+    design: &Design,
+    stack: &Stack,
+    parts: &[crate::Part],
+    shell_levels: Option<&crate::housing::ShellLevels>,
+    tip_gel: Option<(crate::geometry::Solid, String)>,
+    tol: ChordTolerance,
+) -> Result<Vec<crate::parts::Member>, DesignError> {
+    let mut assembly = crate::assembly::members(design, stack, parts, shell_levels, tol)?;
     for f in FAMILIES {
-        assembly.extend(f.members(design, &stack, tol)?);
+        assembly.extend(f.members(design, stack, tol)?);
     }
     if let Some((solid, material)) = tip_gel {
         assembly.push(crate::assembly::Member {
@@ -333,14 +455,25 @@ pub fn build_kit_bounded(
     if let Some(e) = crate::assembly::fit_errors(design, &found) {
         return Err(e);
     }
-    let paths = crate::insertion::paths(design, &stack, shell_levels.as_ref(), tol)?;
+    let paths = crate::insertion::paths(design, stack, shell_levels, tol)?;
     let blocked = crate::insertion::blocked(&assembly, &paths, tol)?;
     if let Some(e) = crate::insertion::errors(design, &blocked) {
         return Err(e);
     }
-    let bolts = crate::procedure::clamp_bolts(design, &parts);
-    bought.extend(crate::procedure::clamp_bolt_items(&bolts));
-    let procedure = crate::procedure::procedure(design, &parts, &casts, &bolts);
+    Ok(assembly)
+}
+
+/// The core made to order, if the design gives its machining, checked against the kit's part
+/// names (it names the drawing and the STEP file).
+///
+/// # Errors
+/// [`DesignError::Params`] for a name another part has; a kernel failure.
+fn machined_parts(
+    design: &Design,
+    stack: &Stack,
+    parts: &[crate::Part],
+    tol: ChordTolerance,
+) -> Result<Vec<crate::parts::core_shell::MachinedPart>, DesignError> {
     let machined_parts = match (&stack.core, &design.core) {
         (Some(c), Some(spec)) => {
             crate::parts::core_shell::machined_part(&design.context(), c, spec, tol)?
@@ -361,18 +494,7 @@ pub fn build_kit_bounded(
             ),
         ])));
     }
-    Ok(Kit {
-        design: design.name.clone(),
-        parts,
-        casts,
-        bought_items: bought,
-        procedure,
-        assembly,
-        cut_parts: crate::cut::cut_parts(design),
-        pcb_outlines: crate::cut::pcb_outlines(design),
-        machined_parts,
-        summary,
-    })
+    Ok(machined_parts)
 }
 
 /// The primer and release agent applied before the pour of `layer` (with the `sprayed` layers

@@ -133,7 +133,7 @@ fn layer_tray(
     // on the base sheet (and the marker sheet)
     let (tray, floor, sheets) = match laser {
         Some(lc) => {
-            let sheets = crate::lasercut::tray_sheets(&outline, l, i, wall, lc, tol)
+            let sheets = crate::lasercut::tray_sheets(outline, l, i, wall, lc, tol)
                 .map_err(|e| DesignError::Params(crate::ParamErrors(e)))?;
             for s in &sheets {
                 cut_parts.push(
@@ -159,13 +159,13 @@ fn layer_tray(
         None => {
             let floor = wall + l.marker_grid.as_ref().map_or(0.0, |g| g.feature.height_mm);
             (
-                tray_solid(&outline, l, wall, floor, tol).part(&name)?,
+                tray_solid(outline, l, wall, floor, tol).part(&name)?,
                 floor,
                 None,
             )
         }
     };
-    let skin = layer_solid(&outline, l, tol).part(&l.name)?;
+    let skin = layer_solid(outline, l, tol).part(&l.name)?;
     let t = l.z1_mm - l.z0_mm;
     // the cast layer's own volume, exact: the outline's prism, less the grooves, plus the
     // markers beyond the face (flat-ended in a laser-cut tray: its holes go straight
@@ -212,7 +212,7 @@ fn layer_tray(
             "laser_cut": sheets.as_ref().map(|sh| serde_json::json!({
                 "sheets": sh.iter().map(|s| serde_json::json!({"name": s.name, "role": s.role, "stock": s.stock,
                     "quantity": s.quantity, "z0_mm": s.z0_mm, "level_mm": s.level_mm(), "area_mm2": s.region.area_mm2()})).collect::<Vec<_>>(),
-                "registration_xy_mm": crate::lasercut::registration_xy_mm(&outline, wall),
+                "registration_xy_mm": crate::lasercut::registration_xy_mm(outline, wall),
                 "registration_diameter_mm": laser.map(|lc| lc.registration.diameter_mm),
                 "markers": "flat-ended, straight through their sheet",
             })),
