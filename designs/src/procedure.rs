@@ -220,136 +220,178 @@ pub fn procedure(
                 ),
             ));
         }
-        let mix = c.mix_text();
-        if !halves.is_empty() {
-            let (a, b) = (
-                &halves[0].name,
-                halves.get(1).map_or("", |p| p.name.as_str()),
-            );
-            let h = holder
-                .first()
-                .map_or("the core holder", |p| p.name.as_str());
-            out.push(step(
-                A::CloseMold,
-                format!(
-                    "Step {n}: set the plinth of `{h}` into the recess of `{a}`, close `{b}` over \
-                     it on the registration keys{bolt_text}."
-                ),
-            ));
-            out.push(step(
-                A::Pour,
-                sprue_pour_text(n, &mix, holder.first().copied()),
-            ));
-        } else if let Some(h) = holder.first() {
-            // master strategy: the silicone mold, then the core pressed in on its jig
-            out.push(step(
-                A::Pour,
-                format!(
-                    "Step {n}: stand the silicone mold pole-down in its mold box, mix and degas \
-                     {mix} and pour it in, then press the core on `{}` in until its flange rests \
-                     on the mold: the surplus rises through the sprue ({}) and the vents.",
-                    h.name,
-                    sprue_text(h)
-                ),
-            ));
-        } else if boundary {
-            let inner = if boundary_cast {
-                "the layers cast so far, on the first inner silicone mold,"
-            } else {
-                "the inner silicone mold"
-            };
-            out.push(step(
-                A::Pour,
-                format!(
-                    "Step {n}: stand the outer silicone mold pole-down, mix and degas {mix}, pour \
-                     it in, then press {inner} in until the plinth seats in the outer mold's \
-                     recess."
-                ),
-            ));
-            boundary_cast = true;
-        } else if pieces.len() > 1 {
-            let top = pieces.iter().find(|p| p.params["piece"] == "reservoir_top");
-            let block = pieces.iter().find(|p| p.params["piece"] == "cavity_block");
-            if let (Some(t), Some(b)) = (top, block) {
-                out.push(step(
-                    A::CloseMold,
-                    format!(
-                        "Step {n}: set `{}` on `{}`, boss down into the pocket{bolt_text}.",
-                        t.name, b.name
-                    ),
-                ));
-            }
-            out.push(step(
-                A::Pour,
-                format!(
-                    "Step {n}: with the cavity down and the reservoir bore up, mix and degas {mix} \
-                     and pour it into the bore to its top face; degas the filled mold again."
-                ),
-            ));
-        } else if let Some(p) = pieces.first() {
-            out.push(step(
-                A::Pour,
-                format!(
-                    "Step {n}: stand `{}` level, open face up, mix and degas {mix} and pour it to \
-                     the brim.",
-                    p.name
-                ),
-            ));
-        }
-        let what = if core_mounted {
-            format!("the core with `{}`", c.cast)
-        } else {
-            format!("`{}`", c.cast)
-        };
-        let last_boundary = boundary
-            && !casts
-                .iter()
-                .any(|d| d.step > c.step && d.mold_parts.iter().any(|m| m.ends_with(":inner")));
-        let text = if boundary && !last_boundary {
-            format!(
-                "Step {n}: let it cure ({}) and remove the outer silicone mold; keep `{}` on the \
-                 inner silicone mold for the next pour.",
-                cure_text(&c.notes),
-                c.cast
-            )
-        } else if boundary {
-            format!(
-                "Step {n}: let it cure ({}) and take the skin out of the outer silicone mold and \
-                 off the inner one.",
-                cure_text(&c.notes)
-            )
-        } else {
-            format!(
-                "Step {n}: let it cure ({}), open the mold and take {what} out.",
-                cure_text(&c.notes)
-            )
-        };
-        out.push(step(A::Demold, text));
-        let coat = design
-            .layers
-            .iter()
-            .find(|l| l.name == c.cast)
-            .and_then(|l| l.brushed_coat.as_ref());
-        if let Some(coat) = coat {
-            out.push(step(
-                A::BrushCoat,
-                format!(
-                    "Step {n}: brush a thin {} onto `{}`: {}, mixed.{}",
-                    coat.purpose,
-                    c.cast,
-                    coat.components.join(", "),
-                    if coat.notes.is_empty() {
-                        String::new()
-                    } else {
-                        format!(" {}", coat.notes)
-                    }
-                ),
-            ));
-        }
+        close_and_pour(
+            &mut out,
+            c,
+            (&holder, &halves, &pieces),
+            &silicone,
+            &bolt_text,
+            &mut boundary_cast,
+        );
+        demold_steps(&mut out, design, casts, c, core_mounted);
     }
     let filling = casts.iter().find(|c| c.cast == FILLING_GEL);
     out.extend(assembly_steps(design, parts, core_mounted, filling));
     out
+}
+
+/// The steps of pour `c` that close its mold and pour it, by strategy: the direct strategy's
+/// halves round the core holder, the master strategy's silicone mold with the core pressed in,
+/// the boundary strategy's two silicone molds, a two-piece open mold, a one-piece open mold.
+fn close_and_pour(
+    out: &mut Vec<ProcedureStep>,
+    c: &CastReport,
+    (holder, halves, pieces): (&[&Part], &[&Part], &[&Part]),
+    silicone: &[&String],
+    bolt_text: &str,
+    boundary_cast: &mut bool,
+) {
+    use ProcedureAction as A;
+    let n = c.step;
+    let boundary = silicone.iter().any(|m| m.ends_with(":inner"));
+    let mix = c.mix_text();
+    if !halves.is_empty() {
+        let (a, b) = (
+            &halves[0].name,
+            halves.get(1).map_or("", |p| p.name.as_str()),
+        );
+        let h = holder
+            .first()
+            .map_or("the core holder", |p| p.name.as_str());
+        out.push(step(
+            A::CloseMold,
+            format!(
+                "Step {n}: set the plinth of `{h}` into the recess of `{a}`, close `{b}` over \
+                 it on the registration keys{bolt_text}."
+            ),
+        ));
+        out.push(step(
+            A::Pour,
+            sprue_pour_text(n, &mix, holder.first().copied()),
+        ));
+    } else if let Some(h) = holder.first() {
+        // master strategy: the silicone mold, then the core pressed in on its jig
+        out.push(step(
+            A::Pour,
+            format!(
+                "Step {n}: stand the silicone mold pole-down in its mold box, mix and degas \
+                 {mix} and pour it in, then press the core on `{}` in until its flange rests \
+                 on the mold: the surplus rises through the sprue ({}) and the vents.",
+                h.name,
+                sprue_text(h)
+            ),
+        ));
+    } else if boundary {
+        let inner = if *boundary_cast {
+            "the layers cast so far, on the first inner silicone mold,"
+        } else {
+            "the inner silicone mold"
+        };
+        out.push(step(
+            A::Pour,
+            format!(
+                "Step {n}: stand the outer silicone mold pole-down, mix and degas {mix}, pour \
+                 it in, then press {inner} in until the plinth seats in the outer mold's \
+                 recess."
+            ),
+        ));
+        *boundary_cast = true;
+    } else if pieces.len() > 1 {
+        let top = pieces.iter().find(|p| p.params["piece"] == "reservoir_top");
+        let block = pieces.iter().find(|p| p.params["piece"] == "cavity_block");
+        if let (Some(t), Some(b)) = (top, block) {
+            out.push(step(
+                A::CloseMold,
+                format!(
+                    "Step {n}: set `{}` on `{}`, boss down into the pocket{bolt_text}.",
+                    t.name, b.name
+                ),
+            ));
+        }
+        out.push(step(
+            A::Pour,
+            format!(
+                "Step {n}: with the cavity down and the reservoir bore up, mix and degas {mix} \
+                 and pour it into the bore to its top face; degas the filled mold again."
+            ),
+        ));
+    } else if let Some(p) = pieces.first() {
+        out.push(step(
+            A::Pour,
+            format!(
+                "Step {n}: stand `{}` level, open face up, mix and degas {mix} and pour it to \
+                 the brim.",
+                p.name
+            ),
+        ));
+    }
+}
+
+/// The steps of pour `c` after it is poured: cure and demold (keeping a boundary-cast layer on
+/// its inner silicone mold for the next pour), then its brushed coat, if any.
+fn demold_steps(
+    out: &mut Vec<ProcedureStep>,
+    design: &Design,
+    casts: &[CastReport],
+    c: &CastReport,
+    core_mounted: bool,
+) {
+    use ProcedureAction as A;
+    let n = c.step;
+    let boundary = c
+        .mold_parts
+        .iter()
+        .any(|m| m.starts_with("silicone_mold:") && m.ends_with(":inner"));
+    let what = if core_mounted {
+        format!("the core with `{}`", c.cast)
+    } else {
+        format!("`{}`", c.cast)
+    };
+    let last_boundary = boundary
+        && !casts
+            .iter()
+            .any(|d| d.step > c.step && d.mold_parts.iter().any(|m| m.ends_with(":inner")));
+    let text = if boundary && !last_boundary {
+        format!(
+            "Step {n}: let it cure ({}) and remove the outer silicone mold; keep `{}` on the \
+             inner silicone mold for the next pour.",
+            cure_text(&c.notes),
+            c.cast
+        )
+    } else if boundary {
+        format!(
+            "Step {n}: let it cure ({}) and take the skin out of the outer silicone mold and \
+             off the inner one.",
+            cure_text(&c.notes)
+        )
+    } else {
+        format!(
+            "Step {n}: let it cure ({}), open the mold and take {what} out.",
+            cure_text(&c.notes)
+        )
+    };
+    out.push(step(A::Demold, text));
+    let coat = design
+        .layers
+        .iter()
+        .find(|l| l.name == c.cast)
+        .and_then(|l| l.brushed_coat.as_ref());
+    if let Some(coat) = coat {
+        out.push(step(
+            A::BrushCoat,
+            format!(
+                "Step {n}: brush a thin {} onto `{}`: {}, mixed.{}",
+                coat.purpose,
+                c.cast,
+                coat.components.join(", "),
+                if coat.notes.is_empty() {
+                    String::new()
+                } else {
+                    format!(" {}", coat.notes)
+                }
+            ),
+        ));
+    }
 }
 
 /// The primer (`PrimeCore`, wiped) or release agent (`SprayRelease`, sprayed) steps of a pour.
@@ -511,13 +553,7 @@ fn assembly_steps(
                 .into(),
         );
     }
-    let named = |role: &str| -> Vec<String> {
-        parts
-            .iter()
-            .filter(|p| p.role == role)
-            .map(|p| format!("`{}`", p.name))
-            .collect()
-    };
+    let named = |role: &str| crate::parts::family::named(parts, role);
     if let Some(h) = &design.housing {
         let joint = crate::housing::joint_screw_name(h).map_or_else(
             || "the joint screws".to_string(),
