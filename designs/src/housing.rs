@@ -166,9 +166,30 @@ pub fn check_housing_params(
     core: Option<&ResolvedCore>,
     errs: &mut Vec<ParamError>,
 ) {
-    let fdm = &design.printers.fdm;
-    let half = h.outer_width_mm / 2.0;
-    let c = h.fit_clearance_mm;
+    if !check_housing_sizes(h, errs) {
+        return;
+    }
+    crate::parts::check_led_count(
+        "housing.led_pcb.led_count",
+        h.led_pcb.led_count,
+        h.led_pcb.outer_diameter_mm,
+        h.led_pcb.inner_diameter_mm,
+        errs,
+    );
+    check_housing_walls(design, h, errs);
+    check_housing_seats(design, h, errs);
+    match h.style {
+        HousingStyle::SquareSplit => check_square_split(design, h, errs),
+        HousingStyle::RoundTube => check_round_tube(design, h, core, errs),
+    }
+    if let Some(core) = core {
+        check_housing_core(design, h, core, errs);
+    }
+}
+
+/// Rules on the housing's sizes alone: each length and diameter must be above 0 (all are
+/// checked). Pushes its errors to `errs`; false when any failed, which ends the checks.
+fn check_housing_sizes(h: &HousingParams, errs: &mut Vec<ParamError>) -> bool {
     let errors_before = errs.len();
     let mut pos = |path: &str, v: f64| {
         if !(v > 0.0 && v.is_finite()) {
@@ -241,16 +262,17 @@ pub fn check_housing_params(
     ] {
         pos(p, v);
     }
-    if errs.len() > errors_before {
-        return;
-    }
-    crate::parts::check_led_count(
-        "housing.led_pcb.led_count",
-        h.led_pcb.led_count,
-        h.led_pcb.outer_diameter_mm,
-        h.led_pcb.inner_diameter_mm,
-        errs,
-    );
+    errs.len() == errors_before
+}
+
+/// Rules on the housing's walls and clearances: `housing.fit_clearance_mm` at least half the
+/// nozzle width, the minimum wall of printer profile `fdm` beside the camera bay and around the
+/// LED PCB and diffuser seats (or, for the round tube, the diffuser no wider than the shell),
+/// and the fixture dowel holes clear of the skin's footprint.
+fn check_housing_walls(design: &Design, h: &HousingParams, errs: &mut Vec<ParamError>) {
+    let fdm = &design.printers.fdm;
+    let half = h.outer_width_mm / 2.0;
+    let c = h.fit_clearance_mm;
     let wall = |errs: &mut Vec<ParamError>, path: &str, value: f64, room: f64, what: &str| {
         if room < fdm.min_wall_mm {
             errs.push(ParamError::new(
@@ -320,6 +342,14 @@ pub fn check_housing_params(
             ));
         }
     }
+}
+
+/// Rules on the seated parts against each other: a ledge under the diffuser and (square split)
+/// the LED PCB, the LED PCB's bore passing the lens barrel, inner diameters below outer ones,
+/// the camera's mounting holes on its board, and the printed pilot holes at least the minimum
+/// hole of printer profile `fdm`.
+fn check_housing_seats(design: &Design, h: &HousingParams, errs: &mut Vec<ParamError>) {
+    let fdm = &design.printers.fdm;
     let ledge =
         |errs: &mut Vec<ParamError>, path: &str, v: f64, inner: f64, outer: f64, what: &str| {
             if inner >= outer {
@@ -409,98 +439,114 @@ pub fn check_housing_params(
             ));
         }
     }
-    match h.style {
-        HousingStyle::SquareSplit => {
-            // Mount pilots stay in solid material beside the PCB seat and inside the outer wall.
-            let r_mount = h.camera.mount_hole_spacing_mm / 2.0 * std::f64::consts::SQRT_2;
-            if r_mount - h.camera.mount_pilot_diameter_mm / 2.0
-                < h.led_pcb.outer_diameter_mm / 2.0 + c + fdm.min_wall_mm
-            {
-                errs.push(ParamError::new(
-                    "housing.camera.mount_hole_spacing_mm",
-                    h.camera.mount_hole_spacing_mm,
-                    "puts the board's mounting holes under the LED PCB seat",
-                ));
-            }
-            // Joint screws run along x at y = +-screw_y beside the light chamber.
-            let (lo, hi) = screw_y_range(design, h);
-            if lo > hi {
-                errs.push(ParamError::new(
-                    "housing.joint_screw.head_diameter_mm",
-                    h.joint_screw.head_diameter_mm,
-                    format!(
-                        "the joint screws do not fit between the light chamber and the outer wall with {} mm walls (short by {:.2} mm)",
-                        fdm.min_wall_mm,
-                        lo - hi
-                    ),
-                ));
-            }
-            if h.joint_screw.clamp_length_mm + 1.0 > half {
-                errs.push(ParamError::new(
-                    "housing.joint_screw.clamp_length_mm",
-                    h.joint_screw.clamp_length_mm,
-                    "leaves no room for the screw head counterbore",
-                ));
-            }
-            if h.joint_screw.pilot_depth_mm > half - fdm.min_wall_mm {
-                errs.push(ParamError::new(
-                    "housing.joint_screw.pilot_depth_mm",
-                    h.joint_screw.pilot_depth_mm,
-                    "runs through the far wall of the shell",
-                ));
-            }
-            if h.diffuser.gap_above_pcb_mm
-                < h.joint_screw
-                    .head_diameter_mm
-                    .max(h.joint_screw.clearance_diameter_mm)
-                    + 2.0 * fdm.min_wall_mm
-            {
-                errs.push(ParamError::new(
-                    "housing.diffuser.gap_above_pcb_mm",
-                    h.diffuser.gap_above_pcb_mm,
-                    "leaves no height for the joint screws beside the light chamber",
-                ));
-            }
-        }
-        HousingStyle::RoundTube => check_round_tube(design, h, core, errs),
+}
+
+/// Rules on the split square shell (`housing.style: square_split`): the camera's mounting
+/// pilots beside the LED PCB seat, and the joint screws (along x beside the light chamber) with
+/// their counterbores and pilots inside the shell and under the diffuser.
+fn check_square_split(design: &Design, h: &HousingParams, errs: &mut Vec<ParamError>) {
+    let fdm = &design.printers.fdm;
+    let half = h.outer_width_mm / 2.0;
+    let c = h.fit_clearance_mm;
+    // Mount pilots stay in solid material beside the PCB seat and inside the outer wall.
+    let r_mount = h.camera.mount_hole_spacing_mm / 2.0 * std::f64::consts::SQRT_2;
+    if r_mount - h.camera.mount_pilot_diameter_mm / 2.0
+        < h.led_pcb.outer_diameter_mm / 2.0 + c + fdm.min_wall_mm
+    {
+        errs.push(ParamError::new(
+            "housing.camera.mount_hole_spacing_mm",
+            h.camera.mount_hole_spacing_mm,
+            "puts the board's mounting holes under the LED PCB seat",
+        ));
     }
-    if let Some(core) = core {
-        let r_core = design.body.rim_radius_mm(core.outer_offset_mm);
-        if r_core + c >= h.diffuser.outer_diameter_mm / 2.0 {
-            errs.push(ParamError::new(
-                "housing.diffuser.outer_diameter_mm",
-                h.diffuser.outer_diameter_mm,
-                format!("must exceed the core's outer diameter ({:.2} mm): the core's rim rests on the diffuser", 2.0 * r_core),
-            ));
-        }
-        if h.diffuser.inner_diameter_mm >= 2.0 * r_core {
-            errs.push(ParamError::new(
-                "housing.diffuser.inner_diameter_mm",
-                h.diffuser.inner_diameter_mm,
-                format!("must be below the core's outer diameter ({:.2} mm): the core's rim rests on the diffuser", 2.0 * r_core),
-            ));
-        }
-        if r_core + c + fdm.min_wall_mm > half {
-            errs.push(ParamError::new(
-                "housing.outer_width_mm",
-                h.outer_width_mm,
-                "does not fit around the core",
-            ));
-        }
-        if h.filling_gel.is_some() && !design.body.offset_is_valid(core.inner_offset_mm) {
-            errs.push(ParamError::new(
-                "housing.filling_gel",
-                "given",
-                "needs a hollow core: the core's inner surface (its wall inside the outer surface) folds or vanishes",
-            ));
-        }
-        if core.below_base_mm < 1.0 {
-            errs.push(ParamError::new(
-                "core.length_mm",
-                design.core.as_ref().map_or(0.0, |c| c.length_mm),
-                "the core must reach at least 1 mm below the base plane to seat in the housing",
-            ));
-        }
+    // Joint screws run along x at y = +-screw_y beside the light chamber.
+    let (lo, hi) = screw_y_range(design, h);
+    if lo > hi {
+        errs.push(ParamError::new(
+            "housing.joint_screw.head_diameter_mm",
+            h.joint_screw.head_diameter_mm,
+            format!(
+                "the joint screws do not fit between the light chamber and the outer wall with {} mm walls (short by {:.2} mm)",
+                fdm.min_wall_mm,
+                lo - hi
+            ),
+        ));
+    }
+    if h.joint_screw.clamp_length_mm + 1.0 > half {
+        errs.push(ParamError::new(
+            "housing.joint_screw.clamp_length_mm",
+            h.joint_screw.clamp_length_mm,
+            "leaves no room for the screw head counterbore",
+        ));
+    }
+    if h.joint_screw.pilot_depth_mm > half - fdm.min_wall_mm {
+        errs.push(ParamError::new(
+            "housing.joint_screw.pilot_depth_mm",
+            h.joint_screw.pilot_depth_mm,
+            "runs through the far wall of the shell",
+        ));
+    }
+    if h.diffuser.gap_above_pcb_mm
+        < h.joint_screw
+            .head_diameter_mm
+            .max(h.joint_screw.clearance_diameter_mm)
+            + 2.0 * fdm.min_wall_mm
+    {
+        errs.push(ParamError::new(
+            "housing.diffuser.gap_above_pcb_mm",
+            h.diffuser.gap_above_pcb_mm,
+            "leaves no height for the joint screws beside the light chamber",
+        ));
+    }
+}
+
+/// Rules on the housing around the resolved core: the core's rim resting on the diffuser, the
+/// shell fitting around the core, a hollow core for `housing.filling_gel`, and the core reaching
+/// at least 1 mm below the base plane.
+fn check_housing_core(
+    design: &Design,
+    h: &HousingParams,
+    core: &ResolvedCore,
+    errs: &mut Vec<ParamError>,
+) {
+    let fdm = &design.printers.fdm;
+    let half = h.outer_width_mm / 2.0;
+    let c = h.fit_clearance_mm;
+    let r_core = design.body.rim_radius_mm(core.outer_offset_mm);
+    if r_core + c >= h.diffuser.outer_diameter_mm / 2.0 {
+        errs.push(ParamError::new(
+            "housing.diffuser.outer_diameter_mm",
+            h.diffuser.outer_diameter_mm,
+            format!("must exceed the core's outer diameter ({:.2} mm): the core's rim rests on the diffuser", 2.0 * r_core),
+        ));
+    }
+    if h.diffuser.inner_diameter_mm >= 2.0 * r_core {
+        errs.push(ParamError::new(
+            "housing.diffuser.inner_diameter_mm",
+            h.diffuser.inner_diameter_mm,
+            format!("must be below the core's outer diameter ({:.2} mm): the core's rim rests on the diffuser", 2.0 * r_core),
+        ));
+    }
+    if r_core + c + fdm.min_wall_mm > half {
+        errs.push(ParamError::new(
+            "housing.outer_width_mm",
+            h.outer_width_mm,
+            "does not fit around the core",
+        ));
+    }
+    if h.filling_gel.is_some() && !design.body.offset_is_valid(core.inner_offset_mm) {
+        errs.push(ParamError::new(
+            "housing.filling_gel",
+            "given",
+            "needs a hollow core: the core's inner surface (its wall inside the outer surface) folds or vanishes",
+        ));
+    }
+    if core.below_base_mm < 1.0 {
+        errs.push(ParamError::new(
+            "core.length_mm",
+            design.core.as_ref().map_or(0.0, |c| c.length_mm),
+            "the core must reach at least 1 mm below the base plane to seat in the housing",
+        ));
     }
 }
 
@@ -535,6 +581,20 @@ fn check_round_tube(
     if errs.len() > before {
         return;
     }
+    check_round_tube_bay(design, h, t, errs);
+    check_round_tube_heights(design, h, t, core, errs);
+}
+
+/// Rules on the camera bay of the round tube `t` (`housing.round_tube`): the ledge under the
+/// LED PCB, the light chamber passing the LED PCB, the tube wall around the bay holding the
+/// joint screw pilots, the camera board in the bay, and its mounting holes on the base's
+/// spigot clear of the cable slot.
+fn check_round_tube_bay(
+    design: &Design,
+    h: &HousingParams,
+    t: &RoundTube,
+    errs: &mut Vec<ParamError>,
+) {
     let fdm = &design.printers.fdm;
     let c = h.fit_clearance_mm;
     let r_out = h.outer_width_mm / 2.0;
@@ -608,6 +668,22 @@ fn check_round_tube(
             ),
         ));
     }
+}
+
+/// Rules on the round tube `t` (`housing.round_tube`) and its base along the sensor axis: the
+/// joint screw heads inside the tube's diameter, the base's flange and the pilots' walls to the
+/// light chamber and the tube's top face, room in the base's spigot for the camera board's
+/// pilot holes, and (with a core) a camera bay between the spigot and the LED PCB.
+fn check_round_tube_heights(
+    design: &Design,
+    h: &HousingParams,
+    t: &RoundTube,
+    core: Option<&ResolvedCore>,
+    errs: &mut Vec<ParamError>,
+) {
+    let fdm = &design.printers.fdm;
+    let r_out = h.outer_width_mm / 2.0;
+    let js = &h.joint_screw;
     let r_js = round_screw_radius_mm(h, t);
     if r_js + js.head_diameter_mm / 2.0 > r_out {
         errs.push(ParamError::new(

@@ -13,7 +13,7 @@ use crate::markers::{self, Marker, MarkerSpec, MarkerSurface, PatternStats, Pola
 use crate::parts::context::{ResolvedLayer, Stack};
 use crate::parts::placement::{place_posed, with_pose, IDENTITY};
 use crate::parts::{Part, PrintTechnology};
-use crate::schema::{Design, LayerProcess, MoldStrategy, Technology};
+use crate::schema::{Design, LayerProcess, MoldStrategy, PrinterProfile, Technology};
 use crate::values::MAX_LENGTH_MM;
 use serde_json::json;
 
@@ -219,217 +219,13 @@ pub fn marker_errors(design: &Design, l: &ResolvedLayer, tech: Technology) -> Ve
     let profile = design.printers.get(tech);
     for (j, spec) in spec_layer.markers.iter().enumerate() {
         let path = format!("layers[{}].markers[{j}]", l.index);
-        let f = &spec.feature;
-        if !(f.diameter_mm > 0.0 && f.diameter_mm.is_finite()) {
-            errs.push(ParamError::new(
-                format!("{path}.feature.diameter_mm"),
-                f.diameter_mm,
-                "must be above 0",
-            ));
+        if !marker_shape_errors(design, l, &path, spec, &mut errs) {
             continue;
         }
-        if !(f.height_mm >= f.diameter_mm / 2.0 && f.height_mm.is_finite()) {
-            errs.push(ParamError::new(
-                format!("{path}.feature.height_mm"),
-                f.height_mm,
-                format!(
-                    "must be at least the radius {} mm (a cylinder ending in a hemisphere)",
-                    f.diameter_mm / 2.0
-                ),
-            ));
+        if !marker_size_errors(design, l, profile, &tech_name, &path, spec, &mut errs) {
             continue;
         }
-        if let (Some(_), Some(_)) | (None, None) = (f.polarity, f.on_skin) {
-            errs.push(ParamError::new(
-                format!("{path}.feature"),
-                match (f.polarity, f.on_skin) {
-                    (Some(p), Some(s)) => format!("polarity: {p:?}, on_skin: {s:?}").to_lowercase(),
-                    _ => "neither on_skin nor polarity".to_string(),
-                },
-                "give exactly one of on_skin (dimple | bump) and polarity (raised | recessed)",
-            ));
-            continue;
-        }
-        if l.solid && spec.surface == MarkerSurface::Inner {
-            errs.push(ParamError::new(
-                format!("{path}.surface"),
-                "inner",
-                "a solid layer has no inner surface",
-            ));
-            continue;
-        }
-        let molded = spec_layer.process == LayerProcess::Cast;
-        if molded
-            && spec.surface == MarkerSurface::Inner
-            && l.mold_strategy != MoldStrategy::Boundary
-        {
-            errs.push(ParamError::new(
-                    format!("{path}.surface"),
-                    "inner",
-                    format!(
-                        "features on the inner surface of a cast layer need the boundary strategy (its mold strategy is {:?})",
-                        l.mold_strategy
-                    ),
-                ));
-            continue;
-        }
-        // Features pointing inward must end before the body's centre of curvature: past it
-        // they cross each other and the axis (the offset surface at their ends folds).
-        let off = surface_offset(l, spec.surface);
-        if direction(spec) < 0.0 && !design.body.offset_is_valid(off - f.height_mm) {
-            errs.push(ParamError::new(
-                format!("{path}.feature.height_mm"),
-                f.height_mm,
-                format!(
-                    "must be below {:.3} mm: the features point inward from the {} surface (offset {off:.3} mm) and must end before the body's centre of curvature, its axis and its base plane",
-                    max_inward_reach(design, off),
-                    match spec.surface {
-                        MarkerSurface::Outer => "outer",
-                        MarkerSurface::Inner => "inner",
-                    }
-                ),
-            ));
-            continue;
-        }
-        if spec.tip_material.is_some()
-            && (spec_layer.process != LayerProcess::Printed || f.side() != Polarity::Raised)
-        {
-            errs.push(ParamError::new(
-                format!("{path}.tip_material"),
-                spec.tip_material.clone().unwrap_or_default(),
-                "separate tips need raised features on a printed layer",
-            ));
-        }
-        // Printability: in a mold, a raised feature is a hole and a recessed one a bump.
-        let (what, min) = match (molded, f.side()) {
-            (true, Polarity::Raised) | (false, Polarity::Recessed) => {
-                ("minimum hole", profile.min_hole_diameter_mm)
-            }
-            _ => ("minimum feature", profile.min_feature_mm),
-        };
-        if f.diameter_mm < min {
-            errs.push(ParamError::new(
-                format!("{path}.feature.diameter_mm"),
-                f.diameter_mm,
-                format!(
-                    "below the {what} {min} mm of printer profile '{tech_name}' that {} this layer",
-                    if molded {
-                        "prints the mold of"
-                    } else {
-                        "prints"
-                    }
-                ),
-            ));
-            continue;
-        }
-        // A feature cut into a shell layer must leave its minimum wall behind it.
-        let cut_in = f.side() == Polarity::Recessed;
-        if cut_in && !l.solid && f.height_mm > l.thickness_mm - profile.min_wall_mm {
-            errs.push(ParamError::new(
-                    format!("{path}.feature.height_mm"),
-                    f.height_mm,
-                    format!(
-                        "cuts {} mm into a {:.3} mm layer, leaving less than the minimum wall {} mm of printer profile '{tech_name}'",
-                        f.height_mm, l.thickness_mm, profile.min_wall_mm
-                    ),
-                ));
-            continue;
-        }
-        let field_errs = spec.pattern.field_errors();
-        if !field_errs.is_empty() {
-            for (field, value, rule) in field_errs {
-                errs.push(ParamError::new(
-                    format!("{path}.pattern.{field}"),
-                    value,
-                    rule,
-                ));
-            }
-            continue;
-        }
-        let surface = Surface::new(&design.body, surface_offset(l, spec.surface));
-        let margin = rim_margin(spec, profile.min_wall_mm);
-        let placed = match markers::place(&surface, &spec.pattern, margin) {
-            Ok(m) => m,
-            Err(first) => {
-                // a point list reports every point that cannot be placed
-                let all = if first.0.starts_with("points[") {
-                    markers::point_errors(&surface, &spec.pattern, margin)
-                } else {
-                    vec![first]
-                };
-                for (field, value, rule) in all {
-                    errs.push(ParamError::new(
-                        format!("{path}.pattern.{field}"),
-                        value,
-                        rule,
-                    ));
-                }
-                continue;
-            }
-        };
-        if placed.is_empty() {
-            errs.push(ParamError::new(
-                format!("{path}.pattern"),
-                "0 markers",
-                "places no marker",
-            ));
-            continue;
-        }
-        let st = markers::stats(&surface, &placed);
-        let gap = st.min_spacing_mm - f.diameter_mm;
-        if placed.len() > 1 && gap < profile.min_wall_mm {
-            let (a, b) = st.closest_pair.unwrap_or((0, 0));
-            errs.push(ParamError::new(
-                    format!("{path}.pattern"),
-                    markers::layout_name(spec.pattern.layout),
-                    format!(
-                        "markers {a} and {b} are {:.3} mm apart on the surface: features of {} mm {} (wall {:.3} mm, minimum {} mm of printer profile '{tech_name}')",
-                        st.min_spacing_mm,
-                        f.diameter_mm,
-                        if gap < 0.0 { "overlap" } else { "leave too thin a wall" },
-                        gap,
-                        profile.min_wall_mm
-                    ),
-                ));
-            continue;
-        }
-        // Features that converge (pointing into a concave side) must stay apart at their
-        // ends too: the hemisphere centres keep the same clearance as the bases.
-        let ends = feature_end_centres(&placed, f, direction(spec));
-        if ends.len() > 1 {
-            let nn = markers::nearest_neighbours(&ends);
-            if let Some((a, (b, d))) = nn.iter().enumerate().min_by(|x, y| {
-                x.1 .1
-                    .partial_cmp(&y.1 .1)
-                    .unwrap_or(std::cmp::Ordering::Equal)
-            }) {
-                if d - f.diameter_mm < profile.min_wall_mm {
-                    errs.push(ParamError::new(
-                            format!("{path}.feature.height_mm"),
-                            f.height_mm,
-                            format!(
-                                "features {a} and {b} converge: their ends are {d:.3} mm apart, closer than the diameter {} mm plus the minimum wall {} mm of printer profile '{tech_name}'",
-                                f.diameter_mm, profile.min_wall_mm
-                            ),
-                        ));
-                    continue;
-                }
-            }
-        }
-        // A recess into a solid layer must not cut through its flat base.
-        if l.solid && f.side() == Polarity::Recessed {
-            let worst = recess_clearance_to_base_mm(&placed, f, design.body.base_z_mm());
-            if worst < profile.min_wall_mm {
-                errs.push(ParamError::new(
-                        format!("{path}.feature.height_mm"),
-                        f.height_mm,
-                        format!(
-                            "recesses reach within {worst:.3} mm of the base plane, below the minimum wall {} mm of printer profile '{tech_name}'",
-                            profile.min_wall_mm
-                        ),
-                    ));
-            }
-        }
+        marker_layout_errors(design, l, profile, &tech_name, &path, spec, &mut errs);
     }
     // Recesses from both surfaces of a shell must leave the minimum wall between them.
     if !l.solid {
@@ -454,6 +250,267 @@ pub fn marker_errors(design: &Design, l: &ResolvedLayer, tech: Technology) -> Ve
         }
     }
     errs
+}
+
+/// The checks of marker set `spec` (at `path`) of layer `l` that do not depend on the printer:
+/// the feature's diameter and height, exactly one of `on_skin` and `polarity`, the surface
+/// (no inner surface on a solid layer; on a cast layer only with the `boundary` strategy), the
+/// reach of inward features, and `tip_material` only with raised features on a printed layer.
+/// Pushes its errors to `errs`; false when the checks that follow no longer apply.
+fn marker_shape_errors(
+    design: &Design,
+    l: &ResolvedLayer,
+    path: &str,
+    spec: &MarkerSpec,
+    errs: &mut Vec<ParamError>,
+) -> bool {
+    let spec_layer = &design.layers[l.index];
+    let f = &spec.feature;
+    if !(f.diameter_mm > 0.0 && f.diameter_mm.is_finite()) {
+        errs.push(ParamError::new(
+            format!("{path}.feature.diameter_mm"),
+            f.diameter_mm,
+            "must be above 0",
+        ));
+        return false;
+    }
+    if !(f.height_mm >= f.diameter_mm / 2.0 && f.height_mm.is_finite()) {
+        errs.push(ParamError::new(
+            format!("{path}.feature.height_mm"),
+            f.height_mm,
+            format!(
+                "must be at least the radius {} mm (a cylinder ending in a hemisphere)",
+                f.diameter_mm / 2.0
+            ),
+        ));
+        return false;
+    }
+    if let (Some(_), Some(_)) | (None, None) = (f.polarity, f.on_skin) {
+        errs.push(ParamError::new(
+            format!("{path}.feature"),
+            match (f.polarity, f.on_skin) {
+                (Some(p), Some(s)) => format!("polarity: {p:?}, on_skin: {s:?}").to_lowercase(),
+                _ => "neither on_skin nor polarity".to_string(),
+            },
+            "give exactly one of on_skin (dimple | bump) and polarity (raised | recessed)",
+        ));
+        return false;
+    }
+    if l.solid && spec.surface == MarkerSurface::Inner {
+        errs.push(ParamError::new(
+            format!("{path}.surface"),
+            "inner",
+            "a solid layer has no inner surface",
+        ));
+        return false;
+    }
+    let molded = spec_layer.process == LayerProcess::Cast;
+    if molded && spec.surface == MarkerSurface::Inner && l.mold_strategy != MoldStrategy::Boundary {
+        errs.push(ParamError::new(
+                format!("{path}.surface"),
+                "inner",
+                format!(
+                    "features on the inner surface of a cast layer need the boundary strategy (its mold strategy is {:?})",
+                    l.mold_strategy
+                ),
+            ));
+        return false;
+    }
+    // Features pointing inward must end before the body's centre of curvature: past it
+    // they cross each other and the axis (the offset surface at their ends folds).
+    let off = surface_offset(l, spec.surface);
+    if direction(spec) < 0.0 && !design.body.offset_is_valid(off - f.height_mm) {
+        errs.push(ParamError::new(
+            format!("{path}.feature.height_mm"),
+            f.height_mm,
+            format!(
+                "must be below {:.3} mm: the features point inward from the {} surface (offset {off:.3} mm) and must end before the body's centre of curvature, its axis and its base plane",
+                max_inward_reach(design, off),
+                match spec.surface {
+                    MarkerSurface::Outer => "outer",
+                    MarkerSurface::Inner => "inner",
+                }
+            ),
+        ));
+        return false;
+    }
+    if spec.tip_material.is_some()
+        && (spec_layer.process != LayerProcess::Printed || f.side() != Polarity::Raised)
+    {
+        errs.push(ParamError::new(
+            format!("{path}.tip_material"),
+            spec.tip_material.clone().unwrap_or_default(),
+            "separate tips need raised features on a printed layer",
+        ));
+    }
+    true
+}
+
+/// The printer checks of the feature size of marker set `spec` (at `path`) of layer `l`
+/// made with printer profile `profile` (named `tech_name`): the diameter at least its minimum
+/// feature (or, for a hole in the part or its mold, its minimum hole), a recess into a shell
+/// leaving its minimum wall, then the fields of the pattern. Pushes its errors to `errs`;
+/// false when the checks that follow no longer apply.
+fn marker_size_errors(
+    design: &Design,
+    l: &ResolvedLayer,
+    profile: &PrinterProfile,
+    tech_name: &str,
+    path: &str,
+    spec: &MarkerSpec,
+    errs: &mut Vec<ParamError>,
+) -> bool {
+    let f = &spec.feature;
+    let molded = design.layers[l.index].process == LayerProcess::Cast;
+    // Printability: in a mold, a raised feature is a hole and a recessed one a bump.
+    let (what, min) = match (molded, f.side()) {
+        (true, Polarity::Raised) | (false, Polarity::Recessed) => {
+            ("minimum hole", profile.min_hole_diameter_mm)
+        }
+        _ => ("minimum feature", profile.min_feature_mm),
+    };
+    if f.diameter_mm < min {
+        errs.push(ParamError::new(
+            format!("{path}.feature.diameter_mm"),
+            f.diameter_mm,
+            format!(
+                "below the {what} {min} mm of printer profile '{tech_name}' that {} this layer",
+                if molded {
+                    "prints the mold of"
+                } else {
+                    "prints"
+                }
+            ),
+        ));
+        return false;
+    }
+    // A feature cut into a shell layer must leave its minimum wall behind it.
+    let cut_in = f.side() == Polarity::Recessed;
+    if cut_in && !l.solid && f.height_mm > l.thickness_mm - profile.min_wall_mm {
+        errs.push(ParamError::new(
+                format!("{path}.feature.height_mm"),
+                f.height_mm,
+                format!(
+                    "cuts {} mm into a {:.3} mm layer, leaving less than the minimum wall {} mm of printer profile '{tech_name}'",
+                    f.height_mm, l.thickness_mm, profile.min_wall_mm
+                ),
+            ));
+        return false;
+    }
+    let field_errs = spec.pattern.field_errors();
+    if !field_errs.is_empty() {
+        for (field, value, rule) in field_errs {
+            errs.push(ParamError::new(
+                format!("{path}.pattern.{field}"),
+                value,
+                rule,
+            ));
+        }
+        return false;
+    }
+    true
+}
+
+/// The checks of the placement of marker set `spec` (at `path`) of layer `l` made with
+/// printer profile `profile` (named `tech_name`): the pattern places at least one marker
+/// (every point of a point list that cannot be placed is reported), neighbouring features
+/// leave its minimum wall between them at their bases and, when they converge, at their
+/// ends, and recesses into a solid layer leave its minimum wall above the base plane.
+/// Pushes its errors to `errs`.
+fn marker_layout_errors(
+    design: &Design,
+    l: &ResolvedLayer,
+    profile: &PrinterProfile,
+    tech_name: &str,
+    path: &str,
+    spec: &MarkerSpec,
+    errs: &mut Vec<ParamError>,
+) {
+    let f = &spec.feature;
+    let surface = Surface::new(&design.body, surface_offset(l, spec.surface));
+    let margin = rim_margin(spec, profile.min_wall_mm);
+    let placed = match markers::place(&surface, &spec.pattern, margin) {
+        Ok(m) => m,
+        Err(first) => {
+            // a point list reports every point that cannot be placed
+            let all = if first.0.starts_with("points[") {
+                markers::point_errors(&surface, &spec.pattern, margin)
+            } else {
+                vec![first]
+            };
+            for (field, value, rule) in all {
+                errs.push(ParamError::new(
+                    format!("{path}.pattern.{field}"),
+                    value,
+                    rule,
+                ));
+            }
+            return;
+        }
+    };
+    if placed.is_empty() {
+        errs.push(ParamError::new(
+            format!("{path}.pattern"),
+            "0 markers",
+            "places no marker",
+        ));
+        return;
+    }
+    let st = markers::stats(&surface, &placed);
+    let gap = st.min_spacing_mm - f.diameter_mm;
+    if placed.len() > 1 && gap < profile.min_wall_mm {
+        let (a, b) = st.closest_pair.unwrap_or((0, 0));
+        errs.push(ParamError::new(
+                format!("{path}.pattern"),
+                markers::layout_name(spec.pattern.layout),
+                format!(
+                    "markers {a} and {b} are {:.3} mm apart on the surface: features of {} mm {} (wall {:.3} mm, minimum {} mm of printer profile '{tech_name}')",
+                    st.min_spacing_mm,
+                    f.diameter_mm,
+                    if gap < 0.0 { "overlap" } else { "leave too thin a wall" },
+                    gap,
+                    profile.min_wall_mm
+                ),
+            ));
+        return;
+    }
+    // Features that converge (pointing into a concave side) must stay apart at their
+    // ends too: the hemisphere centres keep the same clearance as the bases.
+    let ends = feature_end_centres(&placed, f, direction(spec));
+    if ends.len() > 1 {
+        let nn = markers::nearest_neighbours(&ends);
+        if let Some((a, (b, d))) = nn.iter().enumerate().min_by(|x, y| {
+            x.1 .1
+                .partial_cmp(&y.1 .1)
+                .unwrap_or(std::cmp::Ordering::Equal)
+        }) {
+            if d - f.diameter_mm < profile.min_wall_mm {
+                errs.push(ParamError::new(
+                        format!("{path}.feature.height_mm"),
+                        f.height_mm,
+                        format!(
+                            "features {a} and {b} converge: their ends are {d:.3} mm apart, closer than the diameter {} mm plus the minimum wall {} mm of printer profile '{tech_name}'",
+                            f.diameter_mm, profile.min_wall_mm
+                        ),
+                    ));
+                return;
+            }
+        }
+    }
+    // A recess into a solid layer must not cut through its flat base.
+    if l.solid && f.side() == Polarity::Recessed {
+        let worst = recess_clearance_to_base_mm(&placed, f, design.body.base_z_mm());
+        if worst < profile.min_wall_mm {
+            errs.push(ParamError::new(
+                    format!("{path}.feature.height_mm"),
+                    f.height_mm,
+                    format!(
+                        "recesses reach within {worst:.3} mm of the base plane, below the minimum wall {} mm of printer profile '{tech_name}'",
+                        profile.min_wall_mm
+                    ),
+                ));
+        }
+    }
 }
 
 fn feature_solids(
@@ -787,375 +844,512 @@ fn build_layer_parts(
     let markers_json = marker_summary(l, &placed, tech_setting, design);
     let fixture_tech: PrintTechnology = design.mold.fixture_print_technology.into();
     let cavity_tech: PrintTechnology = design.mold.cavity_print_technology.into();
-    let m = &design.mold;
     let (outer, inner) = (
         on_surface(&placed, MarkerSurface::Outer),
         on_surface(&placed, MarkerSurface::Inner),
     );
     let base_params = twin_params(design, l, json!(markers_json));
-    let g = |r: Result<Solid, GeometryError>| r.part(&name);
+    let b = LayerBuild {
+        design,
+        stack,
+        i,
+        tol,
+        l,
+        name,
+        placed: &placed,
+        outer,
+        inner,
+        markers_json,
+        base_params,
+        fixture_tech,
+        cavity_tech,
+    };
     match (l.process, l.mold_strategy) {
-        (LayerProcess::Printed, _) => {
-            let skin = g(layer_solid(design, stack, i, tol))?;
-            let tech: PrintTechnology = spec_layer
-                .print_technology
-                .unwrap_or(Technology::Polyjet)
-                .into();
-            // The tip's fitting of a shaft body prints with the outermost (printed) layer, as
-            // a further volume of its object (Pestell et al. Sec. III-A).
-            let fitting = match &design.shaft_body {
-                Some(sb) if i + 1 == stack.layers.len() => Some(g(
-                    crate::parts::shaft_body::tip_fitting_solid(&design.context(), sb, stack, tol),
-                )?),
-                _ => None,
-            };
-            let group = (placed.iter().any(|p| p.spec.tip_material.is_some()) || fitting.is_some())
-                .then(|| name.clone());
-            // Skin, tips and fitting move together onto the plate (same translation).
-            let extent = match &fitting {
-                Some(f) => Solid::compose(&[skin.clone(), f.clone()]),
-                None => skin.clone(),
-            };
-            let shift = extent
-                .bounding_box()
-                .map(|b| {
-                    [
-                        -(b.min[0] + b.max[0]) / 2.0,
-                        -(b.min[1] + b.max[1]) / 2.0,
-                        -b.min[2],
-                    ]
-                })
-                .unwrap_or([0.0; 3]);
-            let pose = [
-                [1.0, 0.0, 0.0, shift[0]],
-                [0.0, 1.0, 0.0, shift[1]],
-                [0.0, 0.0, 1.0, shift[2]],
-            ];
-            let mut parts = vec![Part {
-                name: name.clone(),
-                role: "printed_skin".into(),
-                description: format!("Printed {name} layer with its marker features"),
-                material: l.material.clone(),
-                print_technology: tech,
-                solid: skin.translate(shift),
-                params: with_pose(base_params.clone(), &pose),
-                group: group.clone(),
-            }];
-            for p in placed.iter().filter(|p| p.spec.tip_material.is_some()) {
-                let tips = Solid::compose(&tip_solids(p, tol).part(&name)?);
-                parts.push(Part {
-                    name: format!("{name}_tips"),
-                    role: "marker_tips".into(),
-                    description: format!(
-                        "{} marker tips of {name}, printed in the second material with the skin",
-                        p.stats.count
-                    ),
-                    material: p.spec.tip_material.clone().unwrap_or_default(),
-                    print_technology: tech,
-                    solid: tips.translate(shift),
-                    params: with_pose(base_params.clone(), &pose),
-                    group: group.clone(),
-                });
-            }
-            if let (Some(f), Some(sb)) = (fitting, &design.shaft_body) {
-                parts.push(Part {
-                    name: "tip_fitting".into(),
-                    role: "tip_fitting".into(),
-                    description: format!(
-                        "The tip's rigid bayonet fitting, printed in the second material with {name} (Pestell et al. Sec. III-A)"
-                    ),
-                    material: sb.tip_fitting.material.clone(),
-                    print_technology: tech,
-                    solid: f.translate(shift),
-                    params: with_pose(
-                        crate::parts::shaft_body::twin_params(&design.context(), sb, stack),
-                        &pose,
-                    ),
-                    group: group.clone(),
-                });
-            }
-            Ok(LayerOutput {
-                parts,
-                pours: vec![],
-                markers: markers_json,
-            })
-        }
-        (_, MoldStrategy::Open) => {
-            // mold = (block - plain cavity) with the features cut or added: one boolean with
-            // the features, and the skin's volume falls out as block - mold.
-            let plain = g(body_solid(design, l.outer_offset_mm, 1.0, tol))?;
-            let rim = design.body.rim_radius_mm(l.outer_offset_mm);
-            let top = features_top_z_mm(design, l.outer_offset_mm, &outer);
-            let half = rim + m.wall_thickness_mm;
-            let zb = design.body.base_z_mm();
-            let block = g(crate::geometry::cuboid(
-                [-half, -half, zb],
-                [half, half, top + m.wall_thickness_mm],
-            ))?;
-            let mold = g(block
-                .difference(&plain)
-                .and_then(|b| apply_features_signed(b, &outer, tol, false, -1.0)))?;
-            let skin_volume = block.volume() - mold.volume();
-            let (mold_placed, mold_pose) =
-                place_posed(&mold, &crate::geometry::rotation_deg(180.0, 0.0, 0.0));
-            let part = Part {
-                name: format!("{name}_open_mold"),
-                role: "open_mold".into(),
-                description: format!(
-                    "One-piece mold for the solid {name} skin, open face up: pour to the brim"
-                ),
-                material: material_for(cavity_tech).into(),
-                print_technology: cavity_tech,
-                solid: mold_placed,
-                params: with_pose(
-                    json!({"base": base_params, "open_face": "the base plane, printed face up", "wall_thickness_mm": m.wall_thickness_mm,
-                    "block_mm": {"min": [-half, -half, zb], "max": [half, half, top + m.wall_thickness_mm]}}),
-                    &mold_pose,
-                ),
-                group: None,
-            };
-            let pour_parts = vec![part.name.clone()];
-            Ok(LayerOutput {
-                parts: vec![part],
-                pours: vec![(name.clone(), l.material.clone(), skin_volume, pour_parts)],
-                markers: markers_json,
-            })
-        }
-        (_, MoldStrategy::TwoPieceOpen) => {
-            // Cavity block: the outline from the parting face to the wall beyond the pole,
-            // less the cavity (continued 1 mm into the pocket), the pocket and the bolt holes,
-            // with the features: a dimple is a pin standing into the cavity.
-            let f = crate::molds::TwoPieceFrame::new(design);
-            let zb = f.base_z_mm;
-            let plain = g(body_solid(design, l.outer_offset_mm, 1.0, tol))?;
-            let cap = g(body_solid(design, l.outer_offset_mm, 0.0, tol))?;
-            let top = features_top_z_mm(design, l.outer_offset_mm, &outer);
-            let z_far = top + m.wall_thickness_mm;
-            let [ox, oy] = f.outer_half_mm;
-            let [px, py] = f.pocket_half_mm;
-            let [bx, by] = f.boss_half_mm;
-            let pocket = g(crate::geometry::cuboid(
-                [-px, -py, f.parting_z_mm - 1.0],
-                [px, py, zb],
-            ))?;
-            // The bolt holes of one piece: through both, each piece with its own diameter.
-            let bolt_holes = |diameter_mm: f64| -> Result<Solid, DesignError> {
-                let hole = g(crate::geometry::cylinder(
-                    z_far - f.top_z_mm + 2.0,
-                    diameter_mm / 2.0,
-                    tol,
-                ))?;
-                Ok(Solid::compose(
-                    &f.bolts_xy_mm
-                        .iter()
-                        .map(|b| hole.translate([b[0], b[1], f.top_z_mm - 1.0]))
-                        .collect::<Vec<_>>(),
-                ))
-            };
-            let bolts = bolt_holes(f.cavity_block_bolt_hole_mm)?;
-            let top_bolts = bolt_holes(f.top_piece_bolt_hole_mm)?;
-            let block = g(crate::geometry::cuboid(
-                [-ox, -oy, f.parting_z_mm],
-                [ox, oy, z_far],
-            ))?;
-            let bare = g(block
-                .difference(&plain)
-                .and_then(|b| b.difference(&pocket))
-                .and_then(|b| b.difference(&bolts)))?;
-            let bottom = g(apply_features_signed(
-                bare.clone(),
-                &outer,
-                tol,
-                false,
-                -1.0,
-            ))?;
-            // The skin: the cap less what the features added to the block, plus what they cut.
-            let skin_volume = cap.volume() - (bottom.volume() - bare.volume());
-            // Top piece: plate and boss, less the reservoir bore and the bolt holes.
-            let plate = g(crate::geometry::cuboid(
-                [-ox, -oy, f.top_z_mm],
-                [ox, oy, f.parting_z_mm],
-            ))?;
-            let boss = g(crate::geometry::cuboid(
-                [-bx, -by, f.parting_z_mm],
-                [bx, by, zb],
-            ))?;
-            let bore =
-                g(
-                    crate::geometry::cylinder(zb - f.top_z_mm + 2.0, f.reservoir_radius_mm, tol)
-                        .map(|c| c.translate([0.0, 0.0, f.top_z_mm - 1.0])),
-                )?;
-            let top_piece = g(plate
-                .union(&boss)
-                .and_then(|t| t.difference(&Solid::compose(&[bore, top_bolts]))))?;
-            let reservoir_mm3 =
-                std::f64::consts::PI * f.reservoir_radius_mm.powi(2) * (zb - f.top_z_mm);
-            let params = json!({
-                "base": base_params,
-                "two_piece": m.two_piece,
-                "frame": f,
-                "cavity_block_z_mm": [f.parting_z_mm, z_far],
-                "bolt_holes_z_mm": [f.top_z_mm - 1.0, z_far + 1.0],
-                "bolt_grip_mm": z_far - f.top_z_mm,
-                "registration_clearance_mm": m.registration_key.clearance_mm,
-                "reservoir_volume_mm3": reservoir_mm3,
-                "pull_direction": "along the sensor axis: the top piece off the cavity block, then the skin out of the cavity",
-            });
-            let (bottom_placed, bottom_pose) =
-                place_posed(&bottom, &crate::geometry::rotation_deg(180.0, 0.0, 0.0));
-            let (top_placed, top_pose) = place_posed(&top_piece, &IDENTITY);
-            let piece = |suffix: &str, which: &str, desc: String, solid, pose| {
-                let mut p = params.clone();
-                p["piece"] = json!(which);
-                Part {
-                    name: format!("{name}_{suffix}"),
-                    role: "open_mold_piece".into(),
-                    description: desc,
-                    material: material_for(cavity_tech).into(),
-                    print_technology: cavity_tech,
-                    solid,
-                    params: with_pose(p, &pose),
-                    group: None,
-                }
-            };
-            let n_bolts = f.bolts_xy_mm.len();
-            let parts = vec![
-                piece(
-                    "cavity_block",
-                    "cavity_block",
-                    format!(
-                        "Bottom piece of the two-piece mold for the solid {name} skin: the cavity, printed parting face up, with the pocket for the top piece's boss and {n_bolts} bolt holes"
-                    ),
-                    bottom_placed,
-                    bottom_pose,
-                ),
-                piece(
-                    "reservoir_top",
-                    "reservoir_top",
-                    format!(
-                        "Top piece of the two-piece mold for the {name} skin: its {} mm bore is the pour reservoir that forms the skin's back; boss down into the cavity block's pocket, {n_bolts} bolts",
-                        2.0 * f.reservoir_radius_mm
-                    ),
-                    top_placed,
-                    top_pose,
-                ),
-            ];
-            let pour_parts = parts.iter().map(|p| p.name.clone()).collect();
-            Ok(LayerOutput {
-                parts,
-                pours: vec![(name.clone(), l.material.clone(), skin_volume, pour_parts)],
-                markers: markers_json,
-            })
-        }
-        (_, MoldStrategy::Boundary) => {
-            let zb = design.body.base_z_mm();
-            let rim = design.body.rim_radius_mm(l.outer_offset_mm);
-            let r_p = rim + m.plinth.margin_mm;
-            let z_lo = zb - m.plinth.height_mm;
-            let fit = m.core_holder.fit_clearance_mm;
-            // Outer boundary: master (positive) with plinth and locating pin, and a drafted box.
-            let mut pl = design
-                .body
-                .offset_polyline(l.outer_offset_mm, 0.0, tol.half());
-            let pin_r = 3.0f64.min(r_p / 3.0);
-            for p in [
-                [r_p, zb],
-                [r_p, z_lo],
-                [pin_r, z_lo],
-                [pin_r, z_lo - 2.0],
-                [0.0, z_lo - 2.0],
-            ] {
-                pl.push(p);
-            }
-            let master_base = g(revolve(&pl, tol).and_then(|mesh| Solid::from_mesh(&mesh)))?;
-            let master = g(apply_features(master_base, &outer, tol, false))?;
-            let pole = master.bounding_box().map(|b| b.max[2]).unwrap_or(0.0);
-            let (mold_box, fill) =
-                crate::molds::drafted_box(design, r_p, z_lo, pole, tol).part(&name)?;
-            let silicone_outer = g(fill.difference(&master))?.volume();
-            // Inner boundary: a cup whose cavity casts the inner silicone core; the core's
-            // plinth fits the outer mold's plinth recess (with clearance), which centres it.
-            let inner_pl = {
-                let mut q = design
-                    .body
-                    .offset_polyline(l.inner_offset_mm, 0.0, tol.half());
-                for p in [[r_p - fit, zb], [r_p - fit, z_lo - 1.0], [0.0, z_lo - 1.0]] {
-                    q.push(p);
-                }
-                q
-            };
-            let core_pos = g(revolve(&inner_pl, tol)
-                .and_then(|mesh| Solid::from_mesh(&mesh))
-                .and_then(|s| apply_features(s, &inner, tol, false)))?;
-            let top =
-                core_pos.bounding_box().map(|b| b.max[2]).unwrap_or(0.0) + BOUNDARY_CUP_FLOOR_MM;
-            let cup_r = r_p + BOUNDARY_CUP_WALL_MM;
-            let cup = g(crate::geometry::cylinder(top - z_lo, cup_r, tol)
-                .map(|c| c.translate([0.0, 0.0, z_lo])))?;
-            let inner_negative = g(cup.difference(&core_pos))?;
-            let silicone_inner = g(core_pos.intersection(&cup))?.volume();
-            let gel = g(layer_solid(design, stack, i, tol))?.volume();
-            let boundary = json!({
-                "locating_pin": {"radius_mm": pin_r, "height_mm": 2.0},
-                "master_top_z_mm": pole,
-                "inner_plinth_bottom_z_mm": z_lo - 1.0,
-                "cup": {"radius_mm": cup_r, "bottom_z_mm": z_lo, "top_z_mm": top},
-                "box_floor_mm": 2.0, "box_wall_mm": 2.0, "box_freeboard_mm": 2.0,
-                "pin_socket_radius_mm": pin_r + fit,
-            });
-            let mk = |suffix: &str,
-                      role: &str,
-                      desc: String,
-                      tech: PrintTechnology,
-                      (solid, pose): (Solid, crate::geometry::Affine)| Part {
-                name: format!("{name}_{suffix}"),
-                role: role.into(),
-                description: desc,
-                material: material_for(tech).into(),
-                print_technology: tech,
-                solid,
-                params: with_pose(
-                    json!({"base": base_params, "plinth_radius_mm": r_p, "plinth_height_mm": m.plinth.height_mm, "fit_clearance_mm": fit, "draft_angle_deg": m.draft_angle_deg, "silicone_wall_mm": m.silicone_wall_mm, "boundary": boundary}),
-                    &pose,
-                ),
-                group: None,
-            };
-            let parts = vec![
-                mk("outer_master", "master_pattern", format!("Positive of the outer boundary of {name} with its features, to cast the outer Mold Star 30 mold"), cavity_tech, place_posed(&master, &IDENTITY)),
-                mk("outer_mold_box", "mold_box", format!("Drafted cup for the outer Mold Star 30 mold of {name}"), fixture_tech, place_posed(&mold_box, &IDENTITY)),
-                mk("inner_negative", "negative_mold", format!("Negative of the inner boundary of {name} with its features: pour Mold Star 30 in it for the inner silicone mold"), cavity_tech, place_posed(&inner_negative, &crate::geometry::rotation_deg(180.0, 0.0, 0.0))),
-            ];
-            let names: Vec<String> = parts.iter().map(|p| p.name.clone()).collect();
-            Ok(LayerOutput {
-                parts,
-                pours: vec![
-                    (
-                        format!("silicone_mold:{name}:outer"),
-                        "mold_star_30".into(),
-                        silicone_outer,
-                        vec![names[0].clone(), names[1].clone()],
-                    ),
-                    (
-                        format!("silicone_mold:{name}:inner"),
-                        "mold_star_30".into(),
-                        silicone_inner,
-                        vec![names[2].clone()],
-                    ),
-                    (
-                        name.clone(),
-                        l.material.clone(),
-                        gel,
-                        vec![
-                            format!("silicone_mold:{name}:outer"),
-                            format!("silicone_mold:{name}:inner"),
-                        ],
-                    ),
-                ],
-                markers: markers_json,
-            })
-        }
+        (LayerProcess::Printed, _) => build_printed_layer(b),
+        (_, MoldStrategy::Open) => build_open_mold_layer(b),
+        (_, MoldStrategy::TwoPieceOpen) => build_two_piece_open_layer(b),
+        (_, MoldStrategy::Boundary) => build_boundary_layer(b),
         _ => unreachable!("direct and master molds are built by molds::build_mold"),
     }
+}
+
+/// What every strategy of [`build_layer_parts`] builds from: layer `i` of `stack` (`l`), its
+/// name, its placed markers (all, on the outer surface, on the inner surface), its marker
+/// summary, the twin parameters its parts carry, and the print technologies of the mold's
+/// fixtures and cavities.
+struct LayerBuild<'a> {
+    design: &'a Design,
+    stack: &'a Stack,
+    i: usize,
+    tol: ChordTolerance,
+    l: &'a ResolvedLayer,
+    name: String,
+    placed: &'a [PlacedMarkers],
+    outer: Vec<&'a PlacedMarkers>,
+    inner: Vec<&'a PlacedMarkers>,
+    markers_json: Vec<serde_json::Value>,
+    base_params: serde_json::Value,
+    fixture_tech: PrintTechnology,
+    cavity_tech: PrintTechnology,
+}
+
+/// The parts of a printed layer: the skin with its features (stems only when the tips are
+/// separate), one `marker_tips` part per marker set with a `tip_material`, and for the
+/// outermost layer of a design with a `shaft_body` the tip's fitting; all moved onto the
+/// plate by the same translation, and grouped when there is more than the skin. No pours.
+fn build_printed_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
+    let LayerBuild {
+        design,
+        stack,
+        i,
+        tol,
+        l,
+        name,
+        placed,
+        markers_json,
+        base_params,
+        ..
+    } = b;
+    let spec_layer = &design.layers[i];
+    let g = |r: Result<Solid, GeometryError>| r.part(&name);
+    let skin = g(layer_solid(design, stack, i, tol))?;
+    let tech: PrintTechnology = spec_layer
+        .print_technology
+        .unwrap_or(Technology::Polyjet)
+        .into();
+    // The tip's fitting of a shaft body prints with the outermost (printed) layer, as
+    // a further volume of its object (Pestell et al. Sec. III-A).
+    let fitting = match &design.shaft_body {
+        Some(sb) if i + 1 == stack.layers.len() => Some(g(
+            crate::parts::shaft_body::tip_fitting_solid(&design.context(), sb, stack, tol),
+        )?),
+        _ => None,
+    };
+    let group = (placed.iter().any(|p| p.spec.tip_material.is_some()) || fitting.is_some())
+        .then(|| name.clone());
+    // Skin, tips and fitting move together onto the plate (same translation).
+    let extent = match &fitting {
+        Some(f) => Solid::compose(&[skin.clone(), f.clone()]),
+        None => skin.clone(),
+    };
+    let shift = extent
+        .bounding_box()
+        .map(|b| {
+            [
+                -(b.min[0] + b.max[0]) / 2.0,
+                -(b.min[1] + b.max[1]) / 2.0,
+                -b.min[2],
+            ]
+        })
+        .unwrap_or([0.0; 3]);
+    let pose = [
+        [1.0, 0.0, 0.0, shift[0]],
+        [0.0, 1.0, 0.0, shift[1]],
+        [0.0, 0.0, 1.0, shift[2]],
+    ];
+    let mut parts = vec![Part {
+        name: name.clone(),
+        role: "printed_skin".into(),
+        description: format!("Printed {name} layer with its marker features"),
+        material: l.material.clone(),
+        print_technology: tech,
+        solid: skin.translate(shift),
+        params: with_pose(base_params.clone(), &pose),
+        group: group.clone(),
+    }];
+    for p in placed.iter().filter(|p| p.spec.tip_material.is_some()) {
+        let tips = Solid::compose(&tip_solids(p, tol).part(&name)?);
+        parts.push(Part {
+            name: format!("{name}_tips"),
+            role: "marker_tips".into(),
+            description: format!(
+                "{} marker tips of {name}, printed in the second material with the skin",
+                p.stats.count
+            ),
+            material: p.spec.tip_material.clone().unwrap_or_default(),
+            print_technology: tech,
+            solid: tips.translate(shift),
+            params: with_pose(base_params.clone(), &pose),
+            group: group.clone(),
+        });
+    }
+    if let (Some(f), Some(sb)) = (fitting, &design.shaft_body) {
+        parts.push(Part {
+            name: "tip_fitting".into(),
+            role: "tip_fitting".into(),
+            description: format!(
+                "The tip's rigid bayonet fitting, printed in the second material with {name} (Pestell et al. Sec. III-A)"
+            ),
+            material: sb.tip_fitting.material.clone(),
+            print_technology: tech,
+            solid: f.translate(shift),
+            params: with_pose(
+                crate::parts::shaft_body::twin_params(&design.context(), sb, stack),
+                &pose,
+            ),
+            group: group.clone(),
+        });
+    }
+    Ok(LayerOutput {
+        parts,
+        pours: vec![],
+        markers: markers_json,
+    })
+}
+
+/// The one-piece open mold of a solid cast layer (`open` strategy): a block
+/// `mold.wall_thickness_mm` beyond the rim and the tallest outward feature, less the cavity
+/// (the outer surface with its features), printed open face up; one pour of the layer's
+/// material, its volume block - mold, mm^3.
+fn build_open_mold_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
+    let LayerBuild {
+        design,
+        tol,
+        l,
+        name,
+        outer,
+        markers_json,
+        base_params,
+        cavity_tech,
+        ..
+    } = b;
+    let m = &design.mold;
+    let g = |r: Result<Solid, GeometryError>| r.part(&name);
+    // mold = (block - plain cavity) with the features cut or added: one boolean with
+    // the features, and the skin's volume falls out as block - mold.
+    let plain = g(body_solid(design, l.outer_offset_mm, 1.0, tol))?;
+    let rim = design.body.rim_radius_mm(l.outer_offset_mm);
+    let top = features_top_z_mm(design, l.outer_offset_mm, &outer);
+    let half = rim + m.wall_thickness_mm;
+    let zb = design.body.base_z_mm();
+    let block = g(crate::geometry::cuboid(
+        [-half, -half, zb],
+        [half, half, top + m.wall_thickness_mm],
+    ))?;
+    let mold = g(block
+        .difference(&plain)
+        .and_then(|b| apply_features_signed(b, &outer, tol, false, -1.0)))?;
+    let skin_volume = block.volume() - mold.volume();
+    let (mold_placed, mold_pose) =
+        place_posed(&mold, &crate::geometry::rotation_deg(180.0, 0.0, 0.0));
+    let part = Part {
+        name: format!("{name}_open_mold"),
+        role: "open_mold".into(),
+        description: format!(
+            "One-piece mold for the solid {name} skin, open face up: pour to the brim"
+        ),
+        material: material_for(cavity_tech).into(),
+        print_technology: cavity_tech,
+        solid: mold_placed,
+        params: with_pose(
+            json!({"base": base_params, "open_face": "the base plane, printed face up", "wall_thickness_mm": m.wall_thickness_mm,
+            "block_mm": {"min": [-half, -half, zb], "max": [half, half, top + m.wall_thickness_mm]}}),
+            &mold_pose,
+        ),
+        group: None,
+    };
+    let pour_parts = vec![part.name.clone()];
+    Ok(LayerOutput {
+        parts: vec![part],
+        pours: vec![(name.clone(), l.material.clone(), skin_volume, pour_parts)],
+        markers: markers_json,
+    })
+}
+
+/// The two-piece open mold of a solid cast layer (`two_piece_open` strategy, frame
+/// [`crate::molds::TwoPieceFrame`]). Builds its solids: the cavity block (the outline from the
+/// parting face to `mold.wall_thickness_mm` beyond the tallest outward feature, less the
+/// cavity, the pocket and the bolt holes, with the features) and the top piece (plate and
+/// boss, less the reservoir bore and the bolt holes); [`two_piece_open_parts`] makes their
+/// parts.
+fn build_two_piece_open_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
+    let (design, tol, l) = (b.design, b.tol, b.l);
+    let m = &design.mold;
+    let g = |r: Result<Solid, GeometryError>| r.part(&b.name);
+    // Cavity block: the outline from the parting face to the wall beyond the pole,
+    // less the cavity (continued 1 mm into the pocket), the pocket and the bolt holes,
+    // with the features: a dimple is a pin standing into the cavity.
+    let f = crate::molds::TwoPieceFrame::new(design);
+    let zb = f.base_z_mm;
+    let plain = g(body_solid(design, l.outer_offset_mm, 1.0, tol))?;
+    let cap = g(body_solid(design, l.outer_offset_mm, 0.0, tol))?;
+    let top = features_top_z_mm(design, l.outer_offset_mm, &b.outer);
+    let z_far = top + m.wall_thickness_mm;
+    let [ox, oy] = f.outer_half_mm;
+    let [px, py] = f.pocket_half_mm;
+    let [bx, by] = f.boss_half_mm;
+    let pocket = g(crate::geometry::cuboid(
+        [-px, -py, f.parting_z_mm - 1.0],
+        [px, py, zb],
+    ))?;
+    // The bolt holes of one piece: through both, each piece with its own diameter.
+    let bolt_holes = |diameter_mm: f64| -> Result<Solid, DesignError> {
+        let hole = g(crate::geometry::cylinder(
+            z_far - f.top_z_mm + 2.0,
+            diameter_mm / 2.0,
+            tol,
+        ))?;
+        Ok(Solid::compose(
+            &f.bolts_xy_mm
+                .iter()
+                .map(|b| hole.translate([b[0], b[1], f.top_z_mm - 1.0]))
+                .collect::<Vec<_>>(),
+        ))
+    };
+    let bolts = bolt_holes(f.cavity_block_bolt_hole_mm)?;
+    let top_bolts = bolt_holes(f.top_piece_bolt_hole_mm)?;
+    let block = g(crate::geometry::cuboid(
+        [-ox, -oy, f.parting_z_mm],
+        [ox, oy, z_far],
+    ))?;
+    let bare = g(block
+        .difference(&plain)
+        .and_then(|b| b.difference(&pocket))
+        .and_then(|b| b.difference(&bolts)))?;
+    let bottom = g(apply_features_signed(
+        bare.clone(),
+        &b.outer,
+        tol,
+        false,
+        -1.0,
+    ))?;
+    // The skin: the cap less what the features added to the block, plus what they cut.
+    let skin_volume = cap.volume() - (bottom.volume() - bare.volume());
+    // Top piece: plate and boss, less the reservoir bore and the bolt holes.
+    let plate = g(crate::geometry::cuboid(
+        [-ox, -oy, f.top_z_mm],
+        [ox, oy, f.parting_z_mm],
+    ))?;
+    let boss = g(crate::geometry::cuboid(
+        [-bx, -by, f.parting_z_mm],
+        [bx, by, zb],
+    ))?;
+    let bore = g(
+        crate::geometry::cylinder(zb - f.top_z_mm + 2.0, f.reservoir_radius_mm, tol)
+            .map(|c| c.translate([0.0, 0.0, f.top_z_mm - 1.0])),
+    )?;
+    let top_piece = g(plate
+        .union(&boss)
+        .and_then(|t| t.difference(&Solid::compose(&[bore, top_bolts]))))?;
+    Ok(two_piece_open_parts(
+        b,
+        &f,
+        z_far,
+        bottom,
+        top_piece,
+        skin_volume,
+    ))
+}
+
+/// The two parts of a two-piece open mold of frame `f` from its solids (`bottom`, the cavity
+/// block, and `top_piece`, sensor frame), the cavity block reaching up to `z_far` mm: the
+/// cavity block printed parting face up and the reservoir top, with the frame, bolt grip and
+/// reservoir volume in their parameters; one pour of the layer's material, `skin_volume`
+/// mm^3, into both.
+fn two_piece_open_parts(
+    b: LayerBuild,
+    f: &crate::molds::TwoPieceFrame,
+    z_far: f64,
+    bottom: Solid,
+    top_piece: Solid,
+    skin_volume: f64,
+) -> LayerOutput {
+    let LayerBuild {
+        design,
+        l,
+        name,
+        markers_json,
+        base_params,
+        cavity_tech,
+        ..
+    } = b;
+    let m = &design.mold;
+    let zb = f.base_z_mm;
+    let reservoir_mm3 = std::f64::consts::PI * f.reservoir_radius_mm.powi(2) * (zb - f.top_z_mm);
+    let params = json!({
+        "base": base_params,
+        "two_piece": m.two_piece,
+        "frame": f,
+        "cavity_block_z_mm": [f.parting_z_mm, z_far],
+        "bolt_holes_z_mm": [f.top_z_mm - 1.0, z_far + 1.0],
+        "bolt_grip_mm": z_far - f.top_z_mm,
+        "registration_clearance_mm": m.registration_key.clearance_mm,
+        "reservoir_volume_mm3": reservoir_mm3,
+        "pull_direction": "along the sensor axis: the top piece off the cavity block, then the skin out of the cavity",
+    });
+    let (bottom_placed, bottom_pose) =
+        place_posed(&bottom, &crate::geometry::rotation_deg(180.0, 0.0, 0.0));
+    let (top_placed, top_pose) = place_posed(&top_piece, &IDENTITY);
+    let piece = |suffix: &str, which: &str, desc: String, solid, pose| {
+        let mut p = params.clone();
+        p["piece"] = json!(which);
+        Part {
+            name: format!("{name}_{suffix}"),
+            role: "open_mold_piece".into(),
+            description: desc,
+            material: material_for(cavity_tech).into(),
+            print_technology: cavity_tech,
+            solid,
+            params: with_pose(p, &pose),
+            group: None,
+        }
+    };
+    let n_bolts = f.bolts_xy_mm.len();
+    let parts = vec![
+        piece(
+            "cavity_block",
+            "cavity_block",
+            format!(
+                "Bottom piece of the two-piece mold for the solid {name} skin: the cavity, printed parting face up, with the pocket for the top piece's boss and {n_bolts} bolt holes"
+            ),
+            bottom_placed,
+            bottom_pose,
+        ),
+        piece(
+            "reservoir_top",
+            "reservoir_top",
+            format!(
+                "Top piece of the two-piece mold for the {name} skin: its {} mm bore is the pour reservoir that forms the skin's back; boss down into the cavity block's pocket, {n_bolts} bolts",
+                2.0 * f.reservoir_radius_mm
+            ),
+            top_placed,
+            top_pose,
+        ),
+    ];
+    let pour_parts = parts.iter().map(|p| p.name.clone()).collect();
+    LayerOutput {
+        parts,
+        pours: vec![(name.clone(), l.material.clone(), skin_volume, pour_parts)],
+        markers: markers_json,
+    }
+}
+
+/// The parts of a cast layer with the `boundary` strategy: the outer master (the outer
+/// boundary with its features, plinth and locating pin) with its drafted mold box, and the
+/// inner negative (a cup whose cavity casts the inner silicone core); three pours: the outer
+/// and inner Mold Star 30 molds, then the layer's gel between them, mm^3.
+fn build_boundary_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
+    let LayerBuild {
+        design,
+        stack,
+        i,
+        tol,
+        l,
+        name,
+        outer,
+        inner,
+        markers_json,
+        base_params,
+        fixture_tech,
+        cavity_tech,
+        ..
+    } = b;
+    let m = &design.mold;
+    let g = |r: Result<Solid, GeometryError>| r.part(&name);
+    let zb = design.body.base_z_mm();
+    let rim = design.body.rim_radius_mm(l.outer_offset_mm);
+    let r_p = rim + m.plinth.margin_mm;
+    let z_lo = zb - m.plinth.height_mm;
+    let fit = m.core_holder.fit_clearance_mm;
+    // Outer boundary: master (positive) with plinth and locating pin, and a drafted box.
+    let mut pl = design
+        .body
+        .offset_polyline(l.outer_offset_mm, 0.0, tol.half());
+    let pin_r = 3.0f64.min(r_p / 3.0);
+    for p in [
+        [r_p, zb],
+        [r_p, z_lo],
+        [pin_r, z_lo],
+        [pin_r, z_lo - 2.0],
+        [0.0, z_lo - 2.0],
+    ] {
+        pl.push(p);
+    }
+    let master_base = g(revolve(&pl, tol).and_then(|mesh| Solid::from_mesh(&mesh)))?;
+    let master = g(apply_features(master_base, &outer, tol, false))?;
+    let pole = master.bounding_box().map(|b| b.max[2]).unwrap_or(0.0);
+    let (mold_box, fill) = crate::molds::drafted_box(design, r_p, z_lo, pole, tol).part(&name)?;
+    let silicone_outer = g(fill.difference(&master))?.volume();
+    // Inner boundary: a cup whose cavity casts the inner silicone core; the core's
+    // plinth fits the outer mold's plinth recess (with clearance), which centres it.
+    let inner_pl = {
+        let mut q = design
+            .body
+            .offset_polyline(l.inner_offset_mm, 0.0, tol.half());
+        for p in [[r_p - fit, zb], [r_p - fit, z_lo - 1.0], [0.0, z_lo - 1.0]] {
+            q.push(p);
+        }
+        q
+    };
+    let core_pos = g(revolve(&inner_pl, tol)
+        .and_then(|mesh| Solid::from_mesh(&mesh))
+        .and_then(|s| apply_features(s, &inner, tol, false)))?;
+    let top = core_pos.bounding_box().map(|b| b.max[2]).unwrap_or(0.0) + BOUNDARY_CUP_FLOOR_MM;
+    let cup_r = r_p + BOUNDARY_CUP_WALL_MM;
+    let cup =
+        g(crate::geometry::cylinder(top - z_lo, cup_r, tol)
+            .map(|c| c.translate([0.0, 0.0, z_lo])))?;
+    let inner_negative = g(cup.difference(&core_pos))?;
+    let silicone_inner = g(core_pos.intersection(&cup))?.volume();
+    let gel = g(layer_solid(design, stack, i, tol))?.volume();
+    let boundary = json!({
+        "locating_pin": {"radius_mm": pin_r, "height_mm": 2.0},
+        "master_top_z_mm": pole,
+        "inner_plinth_bottom_z_mm": z_lo - 1.0,
+        "cup": {"radius_mm": cup_r, "bottom_z_mm": z_lo, "top_z_mm": top},
+        "box_floor_mm": 2.0, "box_wall_mm": 2.0, "box_freeboard_mm": 2.0,
+        "pin_socket_radius_mm": pin_r + fit,
+    });
+    let mk = |suffix: &str,
+              role: &str,
+              desc: String,
+              tech: PrintTechnology,
+              (solid, pose): (Solid, crate::geometry::Affine)| Part {
+        name: format!("{name}_{suffix}"),
+        role: role.into(),
+        description: desc,
+        material: material_for(tech).into(),
+        print_technology: tech,
+        solid,
+        params: with_pose(
+            json!({"base": base_params, "plinth_radius_mm": r_p, "plinth_height_mm": m.plinth.height_mm, "fit_clearance_mm": fit, "draft_angle_deg": m.draft_angle_deg, "silicone_wall_mm": m.silicone_wall_mm, "boundary": boundary}),
+            &pose,
+        ),
+        group: None,
+    };
+    let parts = vec![
+        mk("outer_master", "master_pattern", format!("Positive of the outer boundary of {name} with its features, to cast the outer Mold Star 30 mold"), cavity_tech, place_posed(&master, &IDENTITY)),
+        mk("outer_mold_box", "mold_box", format!("Drafted cup for the outer Mold Star 30 mold of {name}"), fixture_tech, place_posed(&mold_box, &IDENTITY)),
+        mk("inner_negative", "negative_mold", format!("Negative of the inner boundary of {name} with its features: pour Mold Star 30 in it for the inner silicone mold"), cavity_tech, place_posed(&inner_negative, &crate::geometry::rotation_deg(180.0, 0.0, 0.0))),
+    ];
+    let names: Vec<String> = parts.iter().map(|p| p.name.clone()).collect();
+    Ok(LayerOutput {
+        parts,
+        pours: vec![
+            (
+                format!("silicone_mold:{name}:outer"),
+                "mold_star_30".into(),
+                silicone_outer,
+                vec![names[0].clone(), names[1].clone()],
+            ),
+            (
+                format!("silicone_mold:{name}:inner"),
+                "mold_star_30".into(),
+                silicone_inner,
+                vec![names[2].clone()],
+            ),
+            (
+                name.clone(),
+                l.material.clone(),
+                gel,
+                vec![
+                    format!("silicone_mold:{name}:outer"),
+                    format!("silicone_mold:{name}:inner"),
+                ],
+            ),
+        ],
+        markers: markers_json,
+    })
 }
 
 const BOUNDARY_CUP_WALL_MM: f64 = 5.0;

@@ -134,10 +134,27 @@ impl MoldFrame {
 /// Rules on mold parameters alone (sizes, printability).
 pub fn check_mold_params(design: &Design, errs: &mut Vec<ParamError>) {
     let m = &design.mold;
-    let fix = design.printers.get(m.fixture_print_technology);
-    let cav = design.printers.get(m.cavity_print_technology);
-    let fixture = format!("{:?}", m.fixture_print_technology).to_lowercase();
-    let cavity = format!("{:?}", m.cavity_print_technology).to_lowercase();
+    if !check_mold_sizes(design, errs) {
+        return;
+    }
+    if m.plinth.reservoir_depth_mm >= m.plinth.height_mm {
+        errs.push(ParamError::new(
+            "mold.plinth.reservoir_depth_mm",
+            m.plinth.reservoir_depth_mm,
+            format!(
+                "must be below mold.plinth.height_mm ({}) so the spigot can centre the holder",
+                m.plinth.height_mm
+            ),
+        ));
+    }
+    check_mold_printability(design, errs);
+}
+
+/// Rules on the mold's sizes alone: lengths and diameters above 0 (all are checked),
+/// clearances 0 or more, at least one vent, and `mold.draft_angle_deg` in [0, 10). Pushes its
+/// errors to `errs`; false when a length or diameter is not above 0, which ends the checks.
+fn check_mold_sizes(design: &Design, errs: &mut Vec<ParamError>) -> bool {
+    let m = &design.mold;
     let mut pos = |path: &str, v: f64| {
         if !(v > 0.0 && v.is_finite()) {
             errs.push(ParamError::new(path, v, "must be above 0"));
@@ -206,19 +223,19 @@ pub fn check_mold_params(design: &Design, errs: &mut Vec<ParamError>) {
             "must be in [0, 10)",
         ));
     }
-    if !all_positive {
-        return;
-    }
-    if m.plinth.reservoir_depth_mm >= m.plinth.height_mm {
-        errs.push(ParamError::new(
-            "mold.plinth.reservoir_depth_mm",
-            m.plinth.reservoir_depth_mm,
-            format!(
-                "must be below mold.plinth.height_mm ({}) so the spigot can centre the holder",
-                m.plinth.height_mm
-            ),
-        ));
-    }
+    all_positive
+}
+
+/// Rules on printability: each hole, wall and feature of the mold at least the minimum of the
+/// printer profile of the part that carries it (the fixtures' for the sprue, vents and core
+/// holder, the cavities' for the keys, bolt holes and walls), and `mold.flange_width_mm` wide
+/// enough for the registration keys and clamp bolts with the minimum wall around them.
+fn check_mold_printability(design: &Design, errs: &mut Vec<ParamError>) {
+    let m = &design.mold;
+    let fix = design.printers.get(m.fixture_print_technology);
+    let cav = design.printers.get(m.cavity_print_technology);
+    let fixture = format!("{:?}", m.fixture_print_technology).to_lowercase();
+    let cavity = format!("{:?}", m.cavity_print_technology).to_lowercase();
     // Printability: every feature against the profile of the part that carries it.
     let below =
         |errs: &mut Vec<ParamError>, path: &str, v: f64, min: f64, what: &str, profile: &str| {
@@ -291,7 +308,6 @@ pub fn check_mold_params(design: &Design, errs: &mut Vec<ParamError>) {
         ));
     }
 }
-
 /// Rules that need the resolved core: does the holder fit between the core and the plinth.
 /// `first_cavity_offset_mm` is the cavity of the innermost cast, the tightest one.
 pub fn check_mold_fit(
@@ -522,9 +538,7 @@ fn build_mold_parts(
     let f = MoldFrame::new(design, core, plan.cavity_offset_mm);
     let m = &design.mold;
     let name = &layer.name;
-    let cavity_tech: PrintTechnology = m.cavity_print_technology.into();
     let fixture_tech: PrintTechnology = m.fixture_print_technology.into();
-    let cavity_material = material_for(cavity_tech);
     let fixture_material = material_for(fixture_tech);
 
     let cavity = Solid::from_mesh(
@@ -587,104 +601,173 @@ fn build_mold_parts(
         group: None,
     };
 
+    let c = CastMold {
+        name,
+        f,
+        common,
+        holder_name,
+        holder_part,
+        pour_volume,
+    };
     match plan.strategy {
         MoldStrategy::Open | MoldStrategy::TwoPieceOpen | MoldStrategy::Boundary => {
             unreachable!("built by crate::layers")
         }
-        MoldStrategy::Direct => {
-            let ((a, pose_a), (b, pose_b)) = direct_halves(design, &f, &cavity, tol).part(name)?;
-            let mut params = common.clone();
-            params["direct"] = json!({
-                "parting_plane": "y = 0 (through the sensor axis)",
-                "pull_direction": "+y for half a, -y for half b",
-                "half_width_mm": f.plinth_radius_mm + m.flange_width_mm,
-                "z_min_mm": f.open_face_z_mm,
-                "z_max_mm": f.cavity_pole_z_mm + m.wall_thickness_mm,
-                "registration_key": m.registration_key,
-                "clamp_bolt": m.clamp_bolt,
-                "feature_x_mm": f.plinth_radius_mm + m.flange_width_mm / 2.0,
-                "print_orientation": "parting face up",
-            });
-            let half = |s: Solid, pose: Affine, tag: &str, keys: &str| Part {
-                name: format!("{name}_mold_half_{tag}"),
-                role: "mold_half".into(),
-                description: format!(
-                    "Two-piece mold for the {name} layer, half {tag} ({keys} registration keys)"
-                ),
-                material: cavity_material.into(),
-                print_technology: cavity_tech,
-                solid: s,
-                params: with_pose(params.clone(), &pose),
-                group: None,
-            };
-            let parts = vec![
-                half(a, pose_a, "a", "male"),
-                half(b, pose_b, "b", "female"),
-                holder_part,
-            ];
-            let pour_parts = parts.iter().map(|p| p.name.clone()).collect();
-            Ok(MoldOutput {
-                parts,
-                pour_volume_mm3: pour_volume,
-                silicone_pour: None,
-                pour_parts,
-            })
-        }
-        MoldStrategy::Master => {
-            let master = Solid::from_mesh(
-                &revolve(
-                    &cavity_profile(design, &f, plan.cavity_offset_mm, true, tol),
-                    tol,
-                )
-                .part(name)?,
-            )
-            .part(name)?;
-            let (mold_box, fill) = master_box(design, &f, tol).part(name)?;
-            let silicone = fill.difference(&master).part(name)?.volume();
-            let mut params = common.clone();
-            params["master"] = json!({
-                "silicone_wall_mm": m.silicone_wall_mm,
-                "draft_angle_deg": m.draft_angle_deg,
-                "locating_pin": {"radius_mm": LOCATING_PIN_RADIUS_MM.min(f.plinth_radius_mm / 3.0), "height_mm": LOCATING_PIN_HEIGHT_MM},
-                "box_floor_mm": BOX_FLOOR_MM, "box_wall_mm": BOX_WALL_MM, "box_freeboard_mm": BOX_FREEBOARD_MM,
-                "pin_socket_radius_mm": LOCATING_PIN_RADIUS_MM.min(f.plinth_radius_mm / 3.0) + m.core_holder.fit_clearance_mm,
-                "fill_z_mm": f.cavity_pole_z_mm + m.silicone_wall_mm,
-            });
-            let (master_placed, master_pose) = place_posed(&master, &IDENTITY);
-            let (box_placed, box_pose) = place_posed(&mold_box, &IDENTITY);
-            let master_name = format!("{name}_master_pattern");
-            let box_name = format!("{name}_mold_box");
-            let parts = vec![
-                Part {
-                    name: master_name.clone(),
-                    role: "master_pattern".into(),
-                    description: format!("Positive of the {name} cavity with its plinth, to cast a Mold Star 30 mold"),
-                    material: cavity_material.into(),
-                    print_technology: cavity_tech,
-                    solid: master_placed,
-                    params: with_pose(params.clone(), &master_pose),
-                    group: None,
-                },
-                Part {
-                    name: box_name.clone(),
-                    role: "mold_box".into(),
-                    description: format!("Drafted cup that holds the {name} master pattern while Mold Star 30 cures"),
-                    material: fixture_material.into(),
-                    print_technology: fixture_tech,
-                    solid: box_placed,
-                    params: with_pose(params, &box_pose),
-                    group: None,
-                },
-                holder_part,
-            ];
-            Ok(MoldOutput {
-                parts,
-                pour_volume_mm3: pour_volume,
-                silicone_pour: Some((silicone, vec![master_name, box_name])),
-                pour_parts: vec![format!("silicone_mold:{name}"), holder_name],
-            })
-        }
+        MoldStrategy::Direct => direct_mold_parts(design, &cavity, tol, c),
+        MoldStrategy::Master => master_mold_parts(design, plan, tol, c),
     }
+}
+
+/// What both strategies of [`build_mold_parts`] build from: the cast layer's `name`, the
+/// mold frame `f`, the parameters `common` to the mold's parts, the core holder (or casting
+/// jig) part and its name, and the volume the gel pour fills, mm^3.
+struct CastMold<'a> {
+    name: &'a str,
+    f: MoldFrame,
+    common: serde_json::Value,
+    holder_name: String,
+    holder_part: Part,
+    pour_volume: f64,
+}
+
+/// The parts of a `direct` mold: the two mold halves split at the parting plane y = 0 around
+/// `cavity` (male and female registration keys) and the core holder; the gel pours into all
+/// three.
+fn direct_mold_parts(
+    design: &Design,
+    cavity: &Solid,
+    tol: ChordTolerance,
+    c: CastMold,
+) -> Result<MoldOutput, DesignError> {
+    let CastMold {
+        name,
+        f,
+        common,
+        holder_part,
+        pour_volume,
+        ..
+    } = c;
+    let m = &design.mold;
+    let cavity_tech: PrintTechnology = m.cavity_print_technology.into();
+    let cavity_material = material_for(cavity_tech);
+    let ((a, pose_a), (b, pose_b)) = direct_halves(design, &f, cavity, tol).part(name)?;
+    let mut params = common.clone();
+    params["direct"] = json!({
+        "parting_plane": "y = 0 (through the sensor axis)",
+        "pull_direction": "+y for half a, -y for half b",
+        "half_width_mm": f.plinth_radius_mm + m.flange_width_mm,
+        "z_min_mm": f.open_face_z_mm,
+        "z_max_mm": f.cavity_pole_z_mm + m.wall_thickness_mm,
+        "registration_key": m.registration_key,
+        "clamp_bolt": m.clamp_bolt,
+        "feature_x_mm": f.plinth_radius_mm + m.flange_width_mm / 2.0,
+        "print_orientation": "parting face up",
+    });
+    let half = |s: Solid, pose: Affine, tag: &str, keys: &str| Part {
+        name: format!("{name}_mold_half_{tag}"),
+        role: "mold_half".into(),
+        description: format!(
+            "Two-piece mold for the {name} layer, half {tag} ({keys} registration keys)"
+        ),
+        material: cavity_material.into(),
+        print_technology: cavity_tech,
+        solid: s,
+        params: with_pose(params.clone(), &pose),
+        group: None,
+    };
+    let parts = vec![
+        half(a, pose_a, "a", "male"),
+        half(b, pose_b, "b", "female"),
+        holder_part,
+    ];
+    let pour_parts = parts.iter().map(|p| p.name.clone()).collect();
+    Ok(MoldOutput {
+        parts,
+        pour_volume_mm3: pour_volume,
+        silicone_pour: None,
+        pour_parts,
+    })
+}
+
+/// The parts of a `master` mold: the master pattern (the cavity of the cast with its plinth
+/// and locating pin) and the drafted box that holds it while the Mold Star 30 mold cures, then
+/// the casting jig; the silicone pours into the master and box, the gel into the silicone
+/// mold and the jig.
+fn master_mold_parts(
+    design: &Design,
+    plan: &CastPlan,
+    tol: ChordTolerance,
+    c: CastMold,
+) -> Result<MoldOutput, DesignError> {
+    let CastMold {
+        name,
+        f,
+        common,
+        holder_name,
+        holder_part,
+        pour_volume,
+    } = c;
+    let m = &design.mold;
+    let cavity_tech: PrintTechnology = m.cavity_print_technology.into();
+    let fixture_tech: PrintTechnology = m.fixture_print_technology.into();
+    let cavity_material = material_for(cavity_tech);
+    let fixture_material = material_for(fixture_tech);
+    let master = Solid::from_mesh(
+        &revolve(
+            &cavity_profile(design, &f, plan.cavity_offset_mm, true, tol),
+            tol,
+        )
+        .part(name)?,
+    )
+    .part(name)?;
+    let (mold_box, fill) = master_box(design, &f, tol).part(name)?;
+    let silicone = fill.difference(&master).part(name)?.volume();
+    let mut params = common.clone();
+    params["master"] = json!({
+        "silicone_wall_mm": m.silicone_wall_mm,
+        "draft_angle_deg": m.draft_angle_deg,
+        "locating_pin": {"radius_mm": LOCATING_PIN_RADIUS_MM.min(f.plinth_radius_mm / 3.0), "height_mm": LOCATING_PIN_HEIGHT_MM},
+        "box_floor_mm": BOX_FLOOR_MM, "box_wall_mm": BOX_WALL_MM, "box_freeboard_mm": BOX_FREEBOARD_MM,
+        "pin_socket_radius_mm": LOCATING_PIN_RADIUS_MM.min(f.plinth_radius_mm / 3.0) + m.core_holder.fit_clearance_mm,
+        "fill_z_mm": f.cavity_pole_z_mm + m.silicone_wall_mm,
+    });
+    let (master_placed, master_pose) = place_posed(&master, &IDENTITY);
+    let (box_placed, box_pose) = place_posed(&mold_box, &IDENTITY);
+    let master_name = format!("{name}_master_pattern");
+    let box_name = format!("{name}_mold_box");
+    let parts = vec![
+        Part {
+            name: master_name.clone(),
+            role: "master_pattern".into(),
+            description: format!(
+                "Positive of the {name} cavity with its plinth, to cast a Mold Star 30 mold"
+            ),
+            material: cavity_material.into(),
+            print_technology: cavity_tech,
+            solid: master_placed,
+            params: with_pose(params.clone(), &master_pose),
+            group: None,
+        },
+        Part {
+            name: box_name.clone(),
+            role: "mold_box".into(),
+            description: format!(
+                "Drafted cup that holds the {name} master pattern while Mold Star 30 cures"
+            ),
+            material: fixture_material.into(),
+            print_technology: fixture_tech,
+            solid: box_placed,
+            params: with_pose(params, &box_pose),
+            group: None,
+        },
+        holder_part,
+    ];
+    Ok(MoldOutput {
+        parts,
+        pour_volume_mm3: pour_volume,
+        silicone_pour: Some((silicone, vec![master_name, box_name])),
+        pour_parts: vec![format!("silicone_mold:{name}"), holder_name],
+    })
 }
 
 pub(crate) fn material_for(t: PrintTechnology) -> &'static str {

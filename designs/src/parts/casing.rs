@@ -321,6 +321,29 @@ pub fn plate_crossing_radius_mm(r_mm: f64, h_mm: f64, t_mm: f64, n: f64) -> f64 
 /// check's ([`crate::assembly`]).
 pub fn check_params(ctx: &Context<'_>, c: &CasingParams, errs: &mut Vec<ParamError>) {
     let before = errs.len();
+    check_numbers(ctx, c, errs);
+    let Some(backing) = ctx.backing else {
+        errs.push(ParamError::new(
+            "casing",
+            "given",
+            "the casing carries the skin's backing plate over its window: give backing:",
+        ));
+        return;
+    };
+    if errs.len() > before {
+        return;
+    }
+    check_walls_and_fits(ctx, c, backing, errs);
+    check_view(ctx, c, backing, errs);
+    if let Some(g) = &c.gripper_base {
+        check_gripper_base(ctx, c, g, errs);
+    }
+}
+
+/// The casing's numbers that must be above 0 (the `gripper_base`'s among them when given),
+/// `leds.first_azimuth_deg` finite, `leds.count` 1 to 8, and `fit_clearance_mm` at least half
+/// the FDM nozzle; paths under `casing`.
+fn check_numbers(ctx: &Context<'_>, c: &CasingParams, errs: &mut Vec<ParamError>) {
     let path = |p: &str| format!("casing.{p}");
     let (cam, led, s) = (&c.camera, &c.leds, &c.screws);
     let mut numbers = vec![
@@ -382,17 +405,21 @@ pub fn check_params(ctx: &Context<'_>, c: &CasingParams, errs: &mut Vec<ParamErr
     }
     let fdm = &ctx.printers.fdm;
     half_nozzle(&path("fit_clearance_mm"), c.fit_clearance_mm, fdm, errs);
-    let Some(backing) = ctx.backing else {
-        errs.push(ParamError::new(
-            "casing",
-            "given",
-            "the casing carries the skin's backing plate over its window: give backing:",
-        ));
-        return;
-    };
-    if errs.len() > before {
-        return;
-    }
+}
+
+/// The casing's walls and what it holds, mm: the wall and the ledge at least the FDM minimum
+/// wall, the height for the bay, the ledge and the LEDs, the LEDs' slots round the window,
+/// the backing plate's glue land, the LEDs' wire holes, the lens's bore through the ledge and
+/// the casing screws' pilots and counterbores.
+fn check_walls_and_fits(
+    ctx: &Context<'_>,
+    c: &CasingParams,
+    backing: &crate::schema::shared::Backing,
+    errs: &mut Vec<ParamError>,
+) {
+    let path = |p: &str| format!("casing.{p}");
+    let (cam, led, s) = (&c.camera, &c.leds, &c.screws);
+    let fdm = &ctx.printers.fdm;
     let wall = fdm.min_wall_mm;
     let cl = c.fit_clearance_mm;
     let mut rule = |ok: bool, p: &str, v: f64, text: String| {
@@ -506,6 +533,24 @@ pub fn check_params(ctx: &Context<'_>, c: &CasingParams, errs: &mut Vec<ParamErr
             s.pilot_diameter_mm
         ),
     );
+}
+
+/// The camera's view through the window: the ray from the lens's front to the skin's rim,
+/// refracted by the backing plate (`backing.thickness_mm`), must cross the casing's top inside
+/// the window.
+fn check_view(
+    ctx: &Context<'_>,
+    c: &CasingParams,
+    backing: &crate::schema::shared::Backing,
+    errs: &mut Vec<ParamError>,
+) {
+    let path = |p: &str| format!("casing.{p}");
+    let mut rule = |ok: bool, p: &str, v: f64, text: String| {
+        if !ok {
+            errs.push(ParamError::new(path(p), v, text));
+        }
+    };
+    let (r_ch, _, _) = slot_radii(ctx, c);
     // the camera must see the skin's rim through the window (a lens that reaches the plate is
     // the fit check's)
     let lv = levels(ctx, c);
@@ -522,9 +567,28 @@ pub fn check_params(ctx: &Context<'_>, c: &CasingParams, errs: &mut Vec<ParamErr
             ),
         );
     }
-    let Some(g) = &c.gripper_base else {
-        return;
+}
+
+/// The gripper base under the casing, paths under `casing.gripper_base`, mm: the bolts'
+/// counterbores inside the base and outside the casing's socket, the socket shallower than the
+/// casing, the floor under the socket for the cable slot and the casing screws' counterbores,
+/// the bolts' heads, and the cable slot clear of the casing screws.
+fn check_gripper_base(
+    ctx: &Context<'_>,
+    c: &CasingParams,
+    g: &GripperBase,
+    errs: &mut Vec<ParamError>,
+) {
+    let path = |p: &str| format!("casing.{p}");
+    let s = &c.screws;
+    let wall = ctx.printers.fdm.min_wall_mm;
+    let cl = c.fit_clearance_mm;
+    let mut rule = |ok: bool, p: &str, v: f64, text: String| {
+        if !ok {
+            errs.push(ParamError::new(path(p), v, text));
+        }
     };
+    let half = c.outer_width_mm / 2.0;
     let gp = |p: &str| format!("gripper_base.{p}");
     let socket = half + cl;
     let [bx, by] = g.bolt_spacing_mm.map(|v| v / 2.0);

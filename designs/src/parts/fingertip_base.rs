@@ -278,6 +278,26 @@ pub fn check_params(
     errs: &mut Vec<ParamError>,
 ) {
     let before = errs.len();
+    check_numbers(ctx, f, errs);
+    let Some(core) = &stack.core else {
+        errs.push(ParamError::new(
+            "fingertip_base",
+            "given",
+            "the shell holder holds the core's foot: give core: with length_mm reaching below the base plane, or remove fingertip_base:",
+        ));
+        return;
+    };
+    if errs.len() > before {
+        return;
+    }
+    check_bolts(ctx, f, stack, core, errs);
+    check_lighting_and_camera(ctx, f, stack, errs);
+}
+
+/// The base's numbers that must be above 0, `camera.view_angle_deg` in (0, 180), `bolts.count`
+/// 2 to 6, and `fit_clearance_mm` at least the SLA printer's xy resolution; paths under
+/// `fingertip_base`.
+fn check_numbers(ctx: &Context<'_>, f: &FingertipBase, errs: &mut Vec<ParamError>) {
     let path = |p: &str| format!("fingertip_base.{p}");
     let (pcb, ring, cam, b) = (&f.led_pcb, &f.diffusion_ring, &f.camera, &f.bolts);
     crate::parts::check_positive(
@@ -339,18 +359,22 @@ pub fn check_params(
             ),
         ));
     }
-    let Some(core) = &stack.core else {
-        errs.push(ParamError::new(
-            "fingertip_base",
-            "given",
-            "the shell holder holds the core's foot: give core: with length_mm reaching below the base plane, or remove fingertip_base:",
-        ));
-        return;
-    };
-    if errs.len() > before {
-        return;
-    }
-    let wall = sla.min_wall_mm;
+}
+
+/// The bolts and the base's floor, mm: the pilots under the shell holder's top (the core's
+/// foot, `core.length_mm`), the bolts' circle between the holder's bore and the outside and
+/// clear of the PCB's pocket, the bolts' clearance holes and counterbores, and the floor at
+/// least the SLA minimum wall.
+fn check_bolts(
+    ctx: &Context<'_>,
+    f: &FingertipBase,
+    stack: &Stack,
+    core: &crate::parts::context::ResolvedCore,
+    errs: &mut Vec<ParamError>,
+) {
+    let path = |p: &str| format!("fingertip_base.{p}");
+    let (pcb, b) = (&f.led_pcb, &f.bolts);
+    let wall = ctx.printers.sla.min_wall_mm;
     let mut rule = |ok: bool, p: &str, v: f64, text: String| {
         if !ok {
             errs.push(ParamError::new(path(p), v, text));
@@ -415,6 +439,27 @@ pub fn check_params(
         f.floor_thickness_mm,
         format!("must be at least the SLA minimum wall ({wall:.2} mm)"),
     );
+}
+
+/// The lighting PCB, the diffusion ring and the camera, mm: the LEDs on the board, the PCB's
+/// wire hole between the camera holder and the pocket's side, the ring's holes over the UV
+/// LEDs and its thickness, the camera holder's wall round the camera's bore, the camera's
+/// length in the pocket and its wire hole under the holder's bore.
+fn check_lighting_and_camera(
+    ctx: &Context<'_>,
+    f: &FingertipBase,
+    stack: &Stack,
+    errs: &mut Vec<ParamError>,
+) {
+    let path = |p: &str| format!("fingertip_base.{p}");
+    let (pcb, ring, cam) = (&f.led_pcb, &f.diffusion_ring, &f.camera);
+    let wall = ctx.printers.sla.min_wall_mm;
+    let mut rule = |ok: bool, p: &str, v: f64, text: String| {
+        if !ok {
+            errs.push(ParamError::new(path(p), v, text));
+        }
+    };
+    let r = radii(ctx, f, stack);
     let (ri, ro) = (pcb.inner_diameter_mm / 2.0, pcb.outer_diameter_mm / 2.0);
     let rl = pcb.led_circle_diameter_mm / 2.0;
     rule(
@@ -527,7 +572,6 @@ pub fn build_parts(
 ) -> Result<Vec<Part>, DesignError> {
     let lv = levels(ctx, f, stack);
     let r = radii(ctx, f, stack);
-    let e = OVERLAP_MM;
     let b = &f.bolts;
     let bolts = bolt_xy(f, r.bolt_circle_mm);
     let part = |name: &str, material: &str, solid: Solid, description: String| {
@@ -544,74 +588,9 @@ pub fn build_parts(
         }
     };
     // the shell holder
-    let g = |x: Result<Solid, GeometryError>| x.part("shell_holder");
-    let mut cuts = Vec::new();
-    for &xy in &bolts {
-        cuts.push(g(z_cylinder(
-            b.pilot_diameter_mm / 2.0,
-            lv.shell_end_z_mm - 1.0,
-            lv.shell_end_z_mm + b.pilot_depth_mm,
-            xy,
-            tol,
-        ))?);
-    }
-    let holder = g(g(z_ring(
-        r.holder_bore_mm,
-        r.outside_mm,
-        lv.shell_end_z_mm,
-        0.0,
-        tol,
-    ))?
-    .difference(&g(Solid::union_all(&cuts))?))?;
+    let holder = build_shell_holder(f, &lv, &r, &bolts, tol)?;
     // the sensor base
-    let g = |x: Result<Solid, GeometryError>| x.part("sensor_base");
-    let mut cuts = vec![
-        g(z_cylinder(
-            r.pocket_mm,
-            lv.pocket_floor_z_mm,
-            lv.shell_end_z_mm + 1.0,
-            [0.0; 2],
-            tol,
-        ))?,
-        g(z_cylinder(
-            f.camera.wire_hole_diameter_mm / 2.0,
-            lv.bottom_z_mm - 1.0,
-            lv.pocket_floor_z_mm + e,
-            [0.0; 2],
-            tol,
-        ))?,
-        g(z_cylinder(
-            f.led_pcb.wire_hole_diameter_mm / 2.0,
-            lv.bottom_z_mm - 1.0,
-            lv.pocket_floor_z_mm + e,
-            pcb_wire_xy(f),
-            tol,
-        ))?,
-    ];
-    for &xy in &bolts {
-        cuts.push(g(z_cylinder(
-            b.clearance_diameter_mm / 2.0,
-            lv.bottom_z_mm - 1.0,
-            lv.shell_end_z_mm + 1.0,
-            xy,
-            tol,
-        ))?);
-        cuts.push(g(z_cylinder(
-            b.head_diameter_mm / 2.0,
-            lv.bottom_z_mm - 1.0,
-            lv.bottom_z_mm + b.head_depth_mm,
-            xy,
-            tol,
-        ))?);
-    }
-    let base = g(g(z_cylinder(
-        r.outside_mm,
-        lv.bottom_z_mm,
-        lv.shell_end_z_mm,
-        [0.0; 2],
-        tol,
-    ))?
-    .difference(&g(Solid::union_all(&cuts))?))?;
+    let base = build_sensor_base(f, &lv, &r, &bolts, tol)?;
     // the camera holder
     let camera_holder = z_ring(
         f.camera.diameter_mm / 2.0 + f.fit_clearance_mm,
@@ -622,29 +601,7 @@ pub fn build_parts(
     )
     .part("camera_holder")?;
     // the diffusion ring
-    let g = |x: Result<Solid, GeometryError>| x.part("diffusion_ring");
-    let rl = f.led_pcb.led_circle_diameter_mm / 2.0;
-    let mut holes = Vec::new();
-    for (a, uv) in leds() {
-        if uv {
-            let (s, c) = a.to_radians().sin_cos();
-            holes.push(g(z_cylinder(
-                f.diffusion_ring.uv_hole_diameter_mm / 2.0,
-                lv.ring_bottom_z_mm - 1.0,
-                lv.shell_end_z_mm + 1.0,
-                [rl * c, rl * s],
-                tol,
-            ))?);
-        }
-    }
-    let ring = g(g(z_ring(
-        f.diffusion_ring.inner_diameter_mm / 2.0,
-        f.led_pcb.outer_diameter_mm / 2.0,
-        lv.ring_bottom_z_mm,
-        lv.shell_end_z_mm,
-        tol,
-    ))?
-    .difference(&g(Solid::union_all(&holes))?))?;
+    let ring = build_diffusion_ring(f, &lv, tol)?;
     Ok(vec![
         part(
             "shell_holder",
@@ -680,6 +637,131 @@ pub fn build_parts(
             "Diffusion ring: white SLA ring over the LEDs, a hole over each UV LED (UVDtact Sec. III-C)".into(),
         ),
     ])
+}
+
+/// The shell holder: a ring from the holder's bore round the shell's foot to the outside, from
+/// the shell's end up to the base plane, with the bolts' pilots up into it.
+fn build_shell_holder(
+    f: &FingertipBase,
+    lv: &FingertipLevels,
+    r: &FingertipRadii,
+    bolts: &[[f64; 2]],
+    tol: ChordTolerance,
+) -> Result<Solid, DesignError> {
+    let b = &f.bolts;
+    let g = |x: Result<Solid, GeometryError>| x.part("shell_holder");
+    let mut cuts = Vec::new();
+    for &xy in bolts {
+        cuts.push(g(z_cylinder(
+            b.pilot_diameter_mm / 2.0,
+            lv.shell_end_z_mm - 1.0,
+            lv.shell_end_z_mm + b.pilot_depth_mm,
+            xy,
+            tol,
+        ))?);
+    }
+    g(g(z_ring(
+        r.holder_bore_mm,
+        r.outside_mm,
+        lv.shell_end_z_mm,
+        0.0,
+        tol,
+    ))?
+    .difference(&g(Solid::union_all(&cuts))?))
+}
+
+/// The sensor base: a disc from the bottom up to the shell's end, with the pocket for the
+/// lighting PCB and the diffusion ring, the camera's and the PCB's wire holes through the
+/// floor, and the bolts' clearance holes, counterbored from below.
+fn build_sensor_base(
+    f: &FingertipBase,
+    lv: &FingertipLevels,
+    r: &FingertipRadii,
+    bolts: &[[f64; 2]],
+    tol: ChordTolerance,
+) -> Result<Solid, DesignError> {
+    let e = OVERLAP_MM;
+    let b = &f.bolts;
+    let g = |x: Result<Solid, GeometryError>| x.part("sensor_base");
+    let mut cuts = vec![
+        g(z_cylinder(
+            r.pocket_mm,
+            lv.pocket_floor_z_mm,
+            lv.shell_end_z_mm + 1.0,
+            [0.0; 2],
+            tol,
+        ))?,
+        g(z_cylinder(
+            f.camera.wire_hole_diameter_mm / 2.0,
+            lv.bottom_z_mm - 1.0,
+            lv.pocket_floor_z_mm + e,
+            [0.0; 2],
+            tol,
+        ))?,
+        g(z_cylinder(
+            f.led_pcb.wire_hole_diameter_mm / 2.0,
+            lv.bottom_z_mm - 1.0,
+            lv.pocket_floor_z_mm + e,
+            pcb_wire_xy(f),
+            tol,
+        ))?,
+    ];
+    for &xy in bolts {
+        cuts.push(g(z_cylinder(
+            b.clearance_diameter_mm / 2.0,
+            lv.bottom_z_mm - 1.0,
+            lv.shell_end_z_mm + 1.0,
+            xy,
+            tol,
+        ))?);
+        cuts.push(g(z_cylinder(
+            b.head_diameter_mm / 2.0,
+            lv.bottom_z_mm - 1.0,
+            lv.bottom_z_mm + b.head_depth_mm,
+            xy,
+            tol,
+        ))?);
+    }
+    g(g(z_cylinder(
+        r.outside_mm,
+        lv.bottom_z_mm,
+        lv.shell_end_z_mm,
+        [0.0; 2],
+        tol,
+    ))?
+    .difference(&g(Solid::union_all(&cuts))?))
+}
+
+/// The diffusion ring: from the ring's bore to the PCB's edge, from the ring's bottom up to
+/// the shell's end, with a hole over each UV LED.
+fn build_diffusion_ring(
+    f: &FingertipBase,
+    lv: &FingertipLevels,
+    tol: ChordTolerance,
+) -> Result<Solid, DesignError> {
+    let g = |x: Result<Solid, GeometryError>| x.part("diffusion_ring");
+    let rl = f.led_pcb.led_circle_diameter_mm / 2.0;
+    let mut holes = Vec::new();
+    for (a, uv) in leds() {
+        if uv {
+            let (s, c) = a.to_radians().sin_cos();
+            holes.push(g(z_cylinder(
+                f.diffusion_ring.uv_hole_diameter_mm / 2.0,
+                lv.ring_bottom_z_mm - 1.0,
+                lv.shell_end_z_mm + 1.0,
+                [rl * c, rl * s],
+                tol,
+            ))?);
+        }
+    }
+    g(g(z_ring(
+        f.diffusion_ring.inner_diameter_mm / 2.0,
+        f.led_pcb.outer_diameter_mm / 2.0,
+        lv.ring_bottom_z_mm,
+        lv.shell_end_z_mm,
+        tol,
+    ))?
+    .difference(&g(Solid::union_all(&holes))?))
 }
 
 /// The bought parts the base holds, as assembly envelopes: the lighting PCB, its LEDs (one

@@ -346,6 +346,25 @@ pub fn check_params(
     errs: &mut Vec<ParamError>,
 ) {
     let before = errs.len();
+    check_numbers_positive(sb, errs);
+    check_printer_and_angles(ctx, sb, stack, errs);
+    if errs.len() > before || skin_layer(stack).is_none() {
+        return;
+    }
+    let r = radii(ctx, sb, stack);
+    let lv = levels(ctx, sb);
+    let b = tip_bayonet(ctx, sb);
+    check_fitting_and_shaft(ctx, sb, &r, &b, errs);
+    check_base(ctx, sb, &r, errs);
+    check_view(sb, &r, &lv, errs);
+    if let Some(m) = &sb.robot_mount {
+        crate::parts::robot_mount::check_params(ctx, sb, m, errs);
+    }
+}
+
+/// The shaft body's numbers that must be above 0 (paths under `shaft_body`), the optional
+/// `bayonet.groove_width_mm` and `led_ring.seat_diameter_mm` among them when given.
+fn check_numbers_positive(sb: &ShaftBodyParams, errs: &mut Vec<ParamError>) {
     let mut pos = |path: &str, v: f64| {
         if !(v > 0.0 && v.is_finite()) {
             errs.push(ParamError::new(
@@ -400,6 +419,19 @@ pub fn check_params(
     if let Some(d) = sb.led_ring.seat_diameter_mm {
         pos("led_ring.seat_diameter_mm", d);
     }
+}
+
+/// The FDM bayonet's settings (`printers.fdm.bayonet`: 2 to 8 lugs, the ramp below 15 deg, the
+/// clearance at least half the nozzle), the LED ring's LED count, `bayonet.lock_angle_deg` in
+/// (0, 90) and `camera.view_angle_deg` in (0, 180), `fit_clearance_mm` at least half the nozzle,
+/// and the skin's outermost layer printed (it carries the tip's fitting).
+fn check_printer_and_angles(
+    ctx: &Context<'_>,
+    sb: &ShaftBodyParams,
+    stack: &Stack,
+    errs: &mut Vec<ParamError>,
+) {
+    let cam = &sb.camera;
     let fdm = &ctx.printers.fdm;
     let bp = &fdm.bayonet;
     if !(2..=8).contains(&bp.lug_count) {
@@ -458,12 +490,20 @@ pub fn check_params(
             "shaft_body: the tip's fitting is printed with the skin, so the outermost layer must be printed",
         ));
     }
-    if errs.len() > before || skin_layer(stack).is_none() {
-        return;
-    }
-    let r = radii(ctx, sb, stack);
-    let lv = levels(ctx, sb);
-    let b = tip_bayonet(ctx, sb);
+}
+
+/// Fits of the tip's fitting and the shaft's top, mm: the bayonet's grooves round the shaft,
+/// the PolyJet walls of the skirt and the window's seat, the window on the shaft's top face,
+/// the lip, the skirt's length, the grooves' floor over the LED seat, the LED ring and the
+/// shaft's bore.
+fn check_fitting_and_shaft(
+    ctx: &Context<'_>,
+    sb: &ShaftBodyParams,
+    r: &ShaftRadii,
+    b: &Bayonet,
+    errs: &mut Vec<ParamError>,
+) {
+    let fdm = &ctx.printers.fdm;
     let poly = &ctx.printers.polyjet;
     let mut rule = |ok: bool, path: &str, v: f64, text: String| {
         if !ok {
@@ -568,6 +608,19 @@ pub fn check_params(
             2.0 * r.led_seat_mm
         ),
     );
+}
+
+/// The base under the shaft, mm: the camera board's pocket inside an FDM wall, the base at
+/// least the shaft's diameter, the board's mounting pilots between the lens's hole and the
+/// pocket's side and under the ceiling, and the cable slot in the camera's bay.
+fn check_base(ctx: &Context<'_>, sb: &ShaftBodyParams, r: &ShaftRadii, errs: &mut Vec<ParamError>) {
+    let cam = &sb.camera;
+    let fdm = &ctx.printers.fdm;
+    let mut rule = |ok: bool, path: &str, v: f64, text: String| {
+        if !ok {
+            errs.push(ParamError::new(format!("shaft_body.{path}"), v, text));
+        }
+    };
     let corner = r.board_pocket_half_mm * std::f64::consts::SQRT_2;
     rule(
         r.base_outer_mm - corner >= fdm.min_wall_mm,
@@ -621,6 +674,17 @@ pub fn check_params(
         cam.bay_height_mm,
         format!("must take the {:.1} mm cable slot", CABLE_SLOT_MM[1]),
     );
+}
+
+/// The camera's view: the lens's front at least 1 mm under the LED ring, and the view cone
+/// (`camera.view_angle_deg`) covering the lip's opening at the base plane.
+fn check_view(sb: &ShaftBodyParams, r: &ShaftRadii, lv: &ShaftLevels, errs: &mut Vec<ParamError>) {
+    let cam = &sb.camera;
+    let mut rule = |ok: bool, path: &str, v: f64, text: String| {
+        if !ok {
+            errs.push(ParamError::new(format!("shaft_body.{path}"), v, text));
+        }
+    };
     rule(
         lv.lens_z_mm < lv.led_pcb_z_mm - 1.0,
         "camera.lens_height_mm",
@@ -641,9 +705,6 @@ pub fn check_params(
             cam.view_angle_deg, r.lip_inner_mm
         ),
     );
-    if let Some(m) = &sb.robot_mount {
-        crate::parts::robot_mount::check_params(ctx, sb, m, errs);
-    }
 }
 
 /// The fitting's profile of revolution (r, z), closed, counter-clockwise.
