@@ -102,6 +102,16 @@ pub fn members(
     tol: ChordTolerance,
 ) -> Result<Vec<Member>, DesignError> {
     let mut out = Vec::new();
+    push_printed(&mut out, parts);
+    push_cast_layers(&mut out, design, stack, tol)?;
+    push_core_and_filling_gel(&mut out, design, stack, levels, tol)?;
+    push_bought_envelopes(&mut out, design, levels, tol)?;
+    Ok(out)
+}
+
+/// Pushes onto `out` the printed sensor parts among `parts`, in their order, each turned back
+/// into the sensor frame (parts that record no pose are left out).
+fn push_printed(out: &mut Vec<Member>, parts: &[Part]) {
     for p in parts.iter().filter(|p| in_sensor(&p.role)) {
         if let Some(solid) = in_sensor_frame(p) {
             out.push(Member {
@@ -117,6 +127,19 @@ pub fn members(
             });
         }
     }
+}
+
+/// Pushes onto `out` the cast layers of `stack` (every layer not printed), inner to outer; their
+/// solids are made in parallel.
+///
+/// # Errors
+/// [`DesignError::Geometry`] if the kernel fails.
+fn push_cast_layers(
+    out: &mut Vec<Member>,
+    design: &Design,
+    stack: &Stack,
+    tol: ChordTolerance,
+) -> Result<(), DesignError> {
     // The layers' solids in parallel (each single-threaded, collected in order: the same
     // members whatever the thread count).
     use rayon::prelude::*;
@@ -141,6 +164,21 @@ pub fn members(
             }),
         });
     }
+    Ok(())
+}
+
+/// Pushes onto `out` the bought core's envelope (when the design has a core), then the housing's
+/// internal filling gel (when it has one, with shell levels and a core).
+///
+/// # Errors
+/// [`DesignError::Geometry`] if the kernel fails.
+fn push_core_and_filling_gel(
+    out: &mut Vec<Member>,
+    design: &Design,
+    stack: &Stack,
+    levels: Option<&ShellLevels>,
+    tol: ChordTolerance,
+) -> Result<(), DesignError> {
     let g = |name: &str, r: Result<Solid, crate::geometry::GeometryError>| r.part(name);
     if let (Some(c), Some(spec)) = (&stack.core, &design.core) {
         let pl = crate::parts::core_shell::profile(&design.context(), c, spec, tol);
@@ -192,6 +230,20 @@ pub fn members(
             });
         }
     }
+    Ok(())
+}
+
+/// Pushes onto `out` the bought envelopes below the skin: the backing plate (when given), then,
+/// with a housing and its shell levels, the LED ring PCB, the camera board and the diffuser.
+///
+/// # Errors
+/// [`DesignError::Geometry`] if the kernel fails.
+fn push_bought_envelopes(
+    out: &mut Vec<Member>,
+    design: &Design,
+    levels: Option<&ShellLevels>,
+    tol: ChordTolerance,
+) -> Result<(), DesignError> {
     let zb = design.body.base_z_mm();
     type Exact = Result<(Solid, ExactShape), crate::geometry::GeometryError>;
     let disc = |r: f64, z0: f64, z1: f64| -> Exact {
@@ -285,7 +337,7 @@ pub fn members(
             ],
         ));
     }
-    Ok(out)
+    Ok(())
 }
 
 /// Two members that overlap.

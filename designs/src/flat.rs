@@ -163,8 +163,6 @@ pub fn validate(
     design: &crate::schema::Design,
     materials: &crate::materials::MaterialsTable,
 ) -> Result<Vec<FlatLayer>, crate::ParamErrors> {
-    use crate::materials::MaterialKind;
-    use crate::schema::LayerProcess;
     let numbers = crate::values::check_values(design, crate::schema::DESIGN_SIGNED_MM);
     if !numbers.unusable.is_empty() {
         return Err(crate::ParamErrors(numbers.unusable));
@@ -181,6 +179,31 @@ pub fn validate(
         errs.push(ParamError::new(path, value, rule));
     }
     let body_ok = errs.is_empty();
+    check_design_sections(design, &mut errs);
+    check_layer_fields(design, materials, &mut errs);
+    let Some(outline) = design.body.flat_outline() else {
+        return Err(crate::ParamErrors(numbers.merge_negative(errs)));
+    };
+    let layers = if errs.is_empty() {
+        flat_layers(design)
+    } else {
+        None
+    };
+    if let Some(layers) = &layers {
+        check_layer_stack(design, layers, &outline, body_ok, &mut errs);
+    }
+    check_laser_cut_trays(design, materials, layers.as_deref(), &outline, &mut errs);
+    let errs = numbers.merge_negative(errs);
+    match layers {
+        Some(l) if errs.is_empty() => Ok(l),
+        _ => Err(crate::ParamErrors(errs)),
+    }
+}
+
+/// The design-wide rules of a flat skin after its body: no curved skins' sections (`core`,
+/// `backing`, `housing`, the section families), at least one layer, the mold and printer
+/// parameters, and `casting.waste_allowance` in [0, 1]; pushed onto `errs` in that order.
+fn check_design_sections(design: &crate::schema::Design, errs: &mut Vec<ParamError>) {
     let curved_only = [
         ("core", design.core.is_some()),
         ("backing", design.backing.is_some()),
@@ -201,8 +224,8 @@ pub fn validate(
         errs.push(ParamError::new("layers", "[]", "give at least one layer"));
     }
     // the trays' walls and printers, the pours' waste (the curved skins' rules)
-    crate::molds::check_mold_params(design, &mut errs);
-    crate::schema::printers::check_printers(&design.printers, &mut errs);
+    crate::molds::check_mold_params(design, errs);
+    crate::schema::printers::check_printers(&design.printers, errs);
     if !(0.0..=1.0).contains(&design.casting.waste_allowance) {
         errs.push(ParamError::new(
             "casting.waste_allowance",
@@ -210,6 +233,18 @@ pub fn validate(
             "must be in [0, 1]",
         ));
     }
+}
+
+/// The rules of each layer's own fields (`layers[i].name`, `process`, `material`, `markers`,
+/// `outer_radius_mm`, `thickness_mm`, `channels`, `marker_grid`), layer by layer, pushed onto
+/// `errs`.
+fn check_layer_fields(
+    design: &crate::schema::Design,
+    materials: &crate::materials::MaterialsTable,
+    errs: &mut Vec<ParamError>,
+) {
+    use crate::materials::MaterialKind;
+    use crate::schema::LayerProcess;
     let mut names = std::collections::BTreeSet::new();
     for (i, l) in design.layers.iter().enumerate() {
         let p = |f: &str| format!("layers[{i}].{f}");
@@ -278,17 +313,19 @@ pub fn validate(
             ));
         }
     }
-    let Some(outline) = design.body.flat_outline() else {
-        return Err(crate::ParamErrors(numbers.merge_negative(errs)));
-    };
-    let layers = if errs.is_empty() {
-        flat_layers(design)
-    } else {
-        None
-    };
-    if let (Some(layers), crate::profile::BodyProfile::Flat { thickness_mm, .. }) =
-        (&layers, &design.body)
-    {
+}
+
+/// The rules of the stacked layers (valid fields): their thicknesses add up to
+/// `body.thickness_mm`, and, when the body is valid (`body_ok`), each layer's channels and
+/// marker grid fit `outline`; pushed onto `errs`.
+fn check_layer_stack(
+    design: &crate::schema::Design,
+    layers: &[FlatLayer],
+    outline: &FlatOutline,
+    body_ok: bool,
+    errs: &mut Vec<ParamError>,
+) {
+    if let crate::profile::BodyProfile::Flat { thickness_mm, .. } = &design.body {
         let top = layers.last().map_or(0.0, |l| l.z1_mm);
         if (top - thickness_mm).abs() > 1e-9 || layers.first().is_some_and(|l| l.z1_mm <= 0.0) {
             errs.push(ParamError::new(
@@ -307,33 +344,40 @@ pub fn validate(
                 errs.extend(c.errors(
                     &format!("layers[{i}].channels."),
                     l.z1_mm - l.z0_mm,
-                    &outline,
+                    outline,
                 ));
             }
             if let Some(g) = &l.marker_grid {
-                errs.extend(g.errors(&format!("layers[{i}].marker_grid."), &outline));
+                errs.extend(g.errors(&format!("layers[{i}].marker_grid."), outline));
             }
         }
     }
+}
+
+/// The rules of laser-cut trays (`mold.laser_cut`), checked only when the layers were stacked
+/// and nothing else is wrong: the stock and registration, then every tray's sheets; pushed
+/// onto `errs`.
+fn check_laser_cut_trays(
+    design: &crate::schema::Design,
+    materials: &crate::materials::MaterialsTable,
+    layers: Option<&[FlatLayer]>,
+    outline: &FlatOutline,
+    errs: &mut Vec<ParamError>,
+) {
     // laser-cut trays: the stock and registration, then every tray's sheets
-    if let (Some(lc), Some(layers), true) = (&design.mold.laser_cut, &layers, errs.is_empty()) {
+    if let (Some(lc), Some(layers), true) = (&design.mold.laser_cut, layers, errs.is_empty()) {
         let wall = design.mold.wall_thickness_mm;
         let lc_errs = crate::lasercut::check_params(lc, wall, materials);
         if lc_errs.is_empty() {
             let tol =
                 ChordTolerance::new(ChordTolerance::DEFAULT_MM).expect("the default is valid");
             for (i, l) in layers.iter().enumerate() {
-                if let Err(e) = crate::lasercut::tray_sheets(&outline, l, i, wall, lc, tol) {
+                if let Err(e) = crate::lasercut::tray_sheets(outline, l, i, wall, lc, tol) {
                     errs.extend(e);
                 }
             }
         }
         errs.extend(lc_errs);
-    }
-    let errs = numbers.merge_negative(errs);
-    match layers {
-        Some(l) if errs.is_empty() => Ok(l),
-        _ => Err(crate::ParamErrors(errs)),
     }
 }
 

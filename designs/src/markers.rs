@@ -717,244 +717,19 @@ pub fn place(
     if let Some(e) = pattern.field_errors().into_iter().next() {
         return Err(e);
     }
-    let err = |f: &str, v: String, rule: &str| Err((f.to_string(), v, rule.to_string()));
     let (s_min, s_max) = patterned_arc(surface, pattern, rim_margin_mm)?;
-    // The rule that bounds the patterned region, for messages.
-    let limit = || match pattern.max_polar_deg {
-        Some(p) => format!("max_polar_deg {p}"),
-        None => format!(
-            "the rim at {:.3} deg less a margin of {rim_margin_mm:.3} mm of arc",
-            surface.polar_deg_at(surface.total_arc_mm())
-        ),
-    };
     let polar_max = surface.polar_deg_at(s_max);
-    let positive = |f: &str, v: Option<f64>| -> Result<f64, PatternError> {
-        match v {
-            Some(x) if x > 0.0 && x.is_finite() => Ok(x),
-            Some(x) => Err((f.to_string(), x.to_string(), "must be above 0".into())),
-            None => Err((
-                f.to_string(),
-                "missing".into(),
-                format!("is required for layout {}", layout_name(pattern.layout)),
-            )),
-        }
-    };
-    // Counts are bounded before anything is placed.
-    let too_many = |field: &str, value: String, n: f64| -> PatternError {
-        (
-            field.to_string(),
-            value,
-            format!(
-                "places about {n:.0} markers, more than the {MAX_MARKERS_PER_PATTERN} one pattern may have"
-            ),
-        )
-    };
-    let cap = MAX_MARKERS_PER_PATTERN as f64;
-    // (s, azimuth radians, ring)
-    let mut raw: Vec<(f64, f64, u32)> = Vec::new();
     let centre = pattern.center_marker && s_min == 0.0;
-    let push_ring = |raw: &mut Vec<(f64, f64, u32)>, s: f64, k: u32, n: usize| {
-        let off = pattern.ring_offset_rad(k, n);
-        for j in 0..n {
-            raw.push((s, off + 2.0 * PI * j as f64 / n as f64, k));
-        }
-    };
-    match pattern.layout {
+    // (s, azimuth radians, ring)
+    let raw: Vec<(f64, f64, u32)> = match pattern.layout {
         Layout::Concentric6k => {
-            let rings = pattern.rings.ok_or_else(|| {
-                (
-                    "rings".to_string(),
-                    "missing".to_string(),
-                    "is required for concentric_6k".to_string(),
-                )
-            })?;
-            let n = 1.0 + 3.0 * f64::from(rings) * (f64::from(rings) + 1.0);
-            if n > cap {
-                return Err(too_many("rings", rings.to_string(), n));
-            }
-            if centre {
-                raw.push((0.0, 0.0, 0));
-            }
-            if let Some(step) = pattern.polar_step_deg {
-                let last = rings as f64 * step;
-                if last > polar_max + 1e-9 {
-                    return err(
-                        "polar_step_deg",
-                        step.to_string(),
-                        &format!(
-                            "puts ring {rings} at {rings} x {step} = {last:.4} deg, beyond the patterned region (up to {polar_max:.4} deg: {})",
-                            limit()
-                        ),
-                    );
-                }
-                for k in 1..=rings {
-                    let s = surface.s_at_polar_deg(k as f64 * step);
-                    push_ring(&mut raw, s, k, 6 * k as usize);
-                }
-            } else {
-                let pitch = positive("pitch_arc_mm", pattern.pitch_arc_mm)?;
-                for k in 1..=rings {
-                    let s = k as f64 * pitch;
-                    if s > s_max + 1e-9 {
-                        return err("rings", rings.to_string(), &format!("ring {k} at {s:.3} mm of arc lies beyond the patterned region ({s_max:.3} mm: {})", limit()));
-                    }
-                    push_ring(&mut raw, s, k, 6 * k as usize);
-                }
-            }
+            concentric_6k_raw(surface, pattern, rim_margin_mm, s_max, polar_max, centre)?
         }
-        Layout::Concentric => {
-            let sp = positive("spacing_mm", pattern.spacing_mm)?;
-            if centre {
-                raw.push((0.0, 0.0, 0));
-            }
-            // Ring k's arc length, or None beyond the region.
-            let ring_s = |k: u32| -> Option<f64> {
-                match pattern.polar_step_deg {
-                    Some(step) => {
-                        let p0 = pattern.min_polar_deg.filter(|_| s_min > 0.0);
-                        let polar = match p0 {
-                            Some(p0) => p0 + (k - 1) as f64 * step,
-                            None => k as f64 * step,
-                        };
-                        (polar <= polar_max + 1e-9).then(|| surface.s_at_polar_deg(polar))
-                    }
-                    None => {
-                        let s = if s_min > 0.0 {
-                            s_min + (k - 1) as f64 * sp
-                        } else {
-                            k as f64 * sp
-                        };
-                        (s <= s_max + 1e-9).then_some(s)
-                    }
-                }
-            };
-            // Each ring is counted before it is placed.
-            let mut total = usize::from(centre);
-            let mut k = 1;
-            while let Some(s) = ring_s(k) {
-                // counted in f64 and compared before the cast: a spacing of 1e-300 mm makes
-                // a ratio past usize::MAX
-                let n_f = (2.0 * PI * surface.radius_at(s) / sp).round().max(1.0);
-                let count_f = total as f64 + n_f;
-                if count_f > cap {
-                    // The parameter that drives the count: the ring pitch when there are more
-                    // rings than markers on a ring, else the spacing along the rings.
-                    let (field, value) = match pattern.polar_step_deg {
-                        Some(step) if f64::from(k) * f64::from(k) > count_f => {
-                            ("polar_step_deg", step.to_string())
-                        }
-                        _ => ("spacing_mm", sp.to_string()),
-                    };
-                    return Err((
-                        field.to_string(),
-                        value,
-                        format!(
-                            "places more than {MAX_MARKERS_PER_PATTERN} markers (by ring {k}), the most one pattern may have"
-                        ),
-                    ));
-                }
-                let n = n_f as usize;
-                total += n;
-                push_ring(&mut raw, s, k, n);
-                k += 1;
-            }
-            if let Some(RingAzimuthOffset::PerRingDeg(v)) = &pattern.ring_azimuth_offset {
-                if v.len() != (k - 1) as usize {
-                    return err(
-                        "ring_azimuth_offset.per_ring_deg",
-                        format!("{} entries", v.len()),
-                        &format!("needs one entry per ring (the pattern has {} rings)", k - 1),
-                    );
-                }
-            }
-        }
-        Layout::HexGrid => {
-            let a = positive("spacing_mm", pattern.spacing_mm)?;
-            // Lattice points in the disc of radius s_max (the loop visits its bounding square).
-            let n = PI * s_max * s_max / (a * a * 3f64.sqrt() / 2.0);
-            if n > cap {
-                return Err(too_many("spacing_mm", a.to_string(), n));
-            }
-            let m = (s_max / a).ceil() as i64 + 1;
-            // rows are (sqrt 3 / 2) a apart, and row j is shifted by j/2 pitches
-            let rows = (s_max / (a * 3f64.sqrt() / 2.0)).ceil() as i64 + 1;
-            for j in -rows..=rows {
-                let w = m + (j.abs() + 1) / 2;
-                for i in -w..=w {
-                    let x = a * (i as f64 + 0.5 * j as f64);
-                    let y = a * (3f64.sqrt() / 2.0) * j as f64;
-                    let s = (x * x + y * y).sqrt();
-                    if s >= s_min - 1e-12 && s <= s_max + 1e-12 {
-                        raw.push((s, y.atan2(x), 0));
-                    }
-                }
-            }
-            // deterministic order: by arc length, then azimuth
-            raw.sort_by(|p, q| {
-                (p.0, p.1)
-                    .partial_cmp(&(q.0, q.1))
-                    .unwrap_or(std::cmp::Ordering::Equal)
-            });
-        }
-        Layout::GoldenSpiral => {
-            // cumulative area table from s_min to s_max, inverted by interpolation
-            let k = 4096;
-            let ss: Vec<f64> = (0..=k)
-                .map(|i| s_min + (s_max - s_min) * i as f64 / k as f64)
-                .collect();
-            let rs: Vec<f64> = ss.iter().map(|&x| surface.radius_at(x)).collect();
-            let mut area = vec![0.0; k + 1];
-            for i in 1..=k {
-                area[i] = area[i - 1] + PI * (rs[i - 1] + rs[i]) * (ss[i] - ss[i - 1]);
-            }
-            let a_total = area[k];
-            let n = match (pattern.count, pattern.spacing_mm) {
-                (Some(c), _) if c as usize > MAX_MARKERS_PER_PATTERN => {
-                    return Err(too_many("count", c.to_string(), f64::from(c)))
-                }
-                (Some(c), _) if c > 0 => c as usize,
-                (Some(c), _) => return err("count", c.to_string(), "must be above 0"),
-                (None, sp) => {
-                    let sp = positive("spacing_mm", sp)?;
-                    let n = (a_total / (sp * sp * 3f64.sqrt() / 2.0)).round();
-                    if n > cap {
-                        return Err(too_many("spacing_mm", sp.to_string(), n));
-                    }
-                    (n as usize).max(1)
-                }
-            };
-            let golden = PI * (3.0 - 5f64.sqrt());
-            for i in 0..n {
-                let target = (i as f64 + 0.5) / n as f64 * a_total;
-                let j = area.partition_point(|&a| a < target).clamp(1, k);
-                let f = (target - area[j - 1]) / (area[j] - area[j - 1]).max(f64::MIN_POSITIVE);
-                let s = ss[j - 1] + f * (ss[j] - ss[j - 1]);
-                raw.push((s, (i as f64 * golden).rem_euclid(2.0 * PI), 0));
-            }
-        }
-        Layout::List => {
-            let pts = pattern.points.as_ref().ok_or_else(|| {
-                (
-                    "points".to_string(),
-                    "missing".to_string(),
-                    "is required for layout list (or csv_file)".to_string(),
-                )
-            })?;
-            if pts.len() > MAX_MARKERS_PER_PATTERN {
-                return Err(too_many(
-                    "points",
-                    format!("{} points", pts.len()),
-                    pts.len() as f64,
-                ));
-            }
-            if let Some(e) = bad_points(surface, pts, s_min, s_max).into_iter().next() {
-                return Err(e);
-            }
-            for p in pts {
-                raw.push((surface.s_at_polar_deg(p[0]), p[1].to_radians(), 0));
-            }
-        }
-    }
+        Layout::Concentric => concentric_raw(surface, pattern, s_min, s_max, polar_max, centre)?,
+        Layout::HexGrid => hex_grid_raw(pattern, s_min, s_max)?,
+        Layout::GoldenSpiral => golden_spiral_raw(surface, pattern, s_min, s_max)?,
+        Layout::List => list_raw(surface, pattern, s_min, s_max)?,
+    };
     Ok(raw
         .into_iter()
         .enumerate()
@@ -971,6 +746,333 @@ pub fn place(
             }
         })
         .collect())
+}
+
+/// A pattern error as an `Err`: (field below `pattern`, value, rule).
+fn pattern_err<T>(f: &str, v: String, rule: &str) -> Result<T, PatternError> {
+    Err((f.to_string(), v, rule.to_string()))
+}
+
+/// The rule that bounds the patterned region of `pattern` on `surface`, for messages:
+/// `max_polar_deg` when given, else the rim less `rim_margin_mm` mm of arc.
+fn region_limit(surface: &Surface, pattern: &Pattern, rim_margin_mm: f64) -> String {
+    // The rule that bounds the patterned region, for messages.
+    match pattern.max_polar_deg {
+        Some(p) => format!("max_polar_deg {p}"),
+        None => format!(
+            "the rim at {:.3} deg less a margin of {rim_margin_mm:.3} mm of arc",
+            surface.polar_deg_at(surface.total_arc_mm())
+        ),
+    }
+}
+
+/// The value `v` of field `f` of `pattern` when it is finite and above 0; the violation
+/// otherwise (a missing value is required by the pattern's layout).
+fn positive(pattern: &Pattern, f: &str, v: Option<f64>) -> Result<f64, PatternError> {
+    match v {
+        Some(x) if x > 0.0 && x.is_finite() => Ok(x),
+        Some(x) => Err((f.to_string(), x.to_string(), "must be above 0".into())),
+        None => Err((
+            f.to_string(),
+            "missing".into(),
+            format!("is required for layout {}", layout_name(pattern.layout)),
+        )),
+    }
+}
+
+/// The violation of a pattern whose `field` (of `value`) places about `n` markers, more than
+/// [`MAX_MARKERS_PER_PATTERN`].
+fn too_many(field: &str, value: String, n: f64) -> PatternError {
+    // Counts are bounded before anything is placed.
+    (
+        field.to_string(),
+        value,
+        format!(
+            "places about {n:.0} markers, more than the {MAX_MARKERS_PER_PATTERN} one pattern may have"
+        ),
+    )
+}
+
+/// Pushes onto `raw` ring `k` of `n` markers at arc length `s` mm, evenly spaced in azimuth
+/// from the ring's offset (`ring_azimuth_offset` of `pattern`).
+fn push_ring(pattern: &Pattern, raw: &mut Vec<(f64, f64, u32)>, s: f64, k: u32, n: usize) {
+    let off = pattern.ring_offset_rad(k, n);
+    for j in 0..n {
+        raw.push((s, off + 2.0 * PI * j as f64 / n as f64, k));
+    }
+}
+
+/// The markers of a `concentric_6k` pattern as (arc length mm, azimuth radians, ring): the
+/// centre marker when `centre`, then ring k of 6k markers at k pitches (`pitch_arc_mm` of arc
+/// or `polar_step_deg`), each ring within the patterned region (up to `s_max` mm of arc,
+/// `polar_max` deg).
+///
+/// # Errors
+/// The first violation, as [`place`] reports it.
+fn concentric_6k_raw(
+    surface: &Surface,
+    pattern: &Pattern,
+    rim_margin_mm: f64,
+    s_max: f64,
+    polar_max: f64,
+    centre: bool,
+) -> Result<Vec<(f64, f64, u32)>, PatternError> {
+    let cap = MAX_MARKERS_PER_PATTERN as f64;
+    let mut raw: Vec<(f64, f64, u32)> = Vec::new();
+    let rings = pattern.rings.ok_or_else(|| {
+        (
+            "rings".to_string(),
+            "missing".to_string(),
+            "is required for concentric_6k".to_string(),
+        )
+    })?;
+    let n = 1.0 + 3.0 * f64::from(rings) * (f64::from(rings) + 1.0);
+    if n > cap {
+        return Err(too_many("rings", rings.to_string(), n));
+    }
+    if centre {
+        raw.push((0.0, 0.0, 0));
+    }
+    if let Some(step) = pattern.polar_step_deg {
+        let last = rings as f64 * step;
+        if last > polar_max + 1e-9 {
+            return pattern_err(
+                "polar_step_deg",
+                step.to_string(),
+                &format!(
+                    "puts ring {rings} at {rings} x {step} = {last:.4} deg, beyond the patterned region (up to {polar_max:.4} deg: {})",
+                    region_limit(surface, pattern, rim_margin_mm)
+                ),
+            );
+        }
+        for k in 1..=rings {
+            let s = surface.s_at_polar_deg(k as f64 * step);
+            push_ring(pattern, &mut raw, s, k, 6 * k as usize);
+        }
+    } else {
+        let pitch = positive(pattern, "pitch_arc_mm", pattern.pitch_arc_mm)?;
+        for k in 1..=rings {
+            let s = k as f64 * pitch;
+            if s > s_max + 1e-9 {
+                return pattern_err("rings", rings.to_string(), &format!("ring {k} at {s:.3} mm of arc lies beyond the patterned region ({s_max:.3} mm: {})", region_limit(surface, pattern, rim_margin_mm)));
+            }
+            push_ring(pattern, &mut raw, s, k, 6 * k as usize);
+        }
+    }
+    Ok(raw)
+}
+
+/// The markers of a `concentric` pattern as (arc length mm, azimuth radians, ring): the
+/// centre marker when `centre`, then rings one `polar_step_deg` (or else one `spacing_mm` of
+/// arc) apart, the first at the inner limit (`min_polar_deg`, `s_min` mm of arc) when there is
+/// one and one step from the pole otherwise, up to `s_max` mm of arc (`polar_max` deg); each
+/// ring holds markers about `spacing_mm` apart.
+///
+/// # Errors
+/// The first violation, as [`place`] reports it.
+fn concentric_raw(
+    surface: &Surface,
+    pattern: &Pattern,
+    s_min: f64,
+    s_max: f64,
+    polar_max: f64,
+    centre: bool,
+) -> Result<Vec<(f64, f64, u32)>, PatternError> {
+    let cap = MAX_MARKERS_PER_PATTERN as f64;
+    let mut raw: Vec<(f64, f64, u32)> = Vec::new();
+    let sp = positive(pattern, "spacing_mm", pattern.spacing_mm)?;
+    if centre {
+        raw.push((0.0, 0.0, 0));
+    }
+    // Ring k's arc length, or None beyond the region.
+    let ring_s = |k: u32| -> Option<f64> {
+        match pattern.polar_step_deg {
+            Some(step) => {
+                let p0 = pattern.min_polar_deg.filter(|_| s_min > 0.0);
+                let polar = match p0 {
+                    Some(p0) => p0 + (k - 1) as f64 * step,
+                    None => k as f64 * step,
+                };
+                (polar <= polar_max + 1e-9).then(|| surface.s_at_polar_deg(polar))
+            }
+            None => {
+                let s = if s_min > 0.0 {
+                    s_min + (k - 1) as f64 * sp
+                } else {
+                    k as f64 * sp
+                };
+                (s <= s_max + 1e-9).then_some(s)
+            }
+        }
+    };
+    // Each ring is counted before it is placed.
+    let mut total = usize::from(centre);
+    let mut k = 1;
+    while let Some(s) = ring_s(k) {
+        // counted in f64 and compared before the cast: a spacing of 1e-300 mm makes
+        // a ratio past usize::MAX
+        let n_f = (2.0 * PI * surface.radius_at(s) / sp).round().max(1.0);
+        let count_f = total as f64 + n_f;
+        if count_f > cap {
+            // The parameter that drives the count: the ring pitch when there are more
+            // rings than markers on a ring, else the spacing along the rings.
+            let (field, value) = match pattern.polar_step_deg {
+                Some(step) if f64::from(k) * f64::from(k) > count_f => {
+                    ("polar_step_deg", step.to_string())
+                }
+                _ => ("spacing_mm", sp.to_string()),
+            };
+            return Err((
+                field.to_string(),
+                value,
+                format!(
+                    "places more than {MAX_MARKERS_PER_PATTERN} markers (by ring {k}), the most one pattern may have"
+                ),
+            ));
+        }
+        let n = n_f as usize;
+        total += n;
+        push_ring(pattern, &mut raw, s, k, n);
+        k += 1;
+    }
+    if let Some(RingAzimuthOffset::PerRingDeg(v)) = &pattern.ring_azimuth_offset {
+        if v.len() != (k - 1) as usize {
+            return pattern_err(
+                "ring_azimuth_offset.per_ring_deg",
+                format!("{} entries", v.len()),
+                &format!("needs one entry per ring (the pattern has {} rings)", k - 1),
+            );
+        }
+    }
+    Ok(raw)
+}
+
+/// The markers of a `hex_grid` pattern as (arc length mm, azimuth radians, 0): the points of a
+/// hexagonal lattice of pitch `spacing_mm`, laid out in arc length (mm) and azimuth about the
+/// pole, from `s_min` to `s_max` mm of arc; ordered by arc length, then azimuth.
+///
+/// # Errors
+/// The first violation, as [`place`] reports it.
+fn hex_grid_raw(
+    pattern: &Pattern,
+    s_min: f64,
+    s_max: f64,
+) -> Result<Vec<(f64, f64, u32)>, PatternError> {
+    let cap = MAX_MARKERS_PER_PATTERN as f64;
+    let mut raw: Vec<(f64, f64, u32)> = Vec::new();
+    let a = positive(pattern, "spacing_mm", pattern.spacing_mm)?;
+    // Lattice points in the disc of radius s_max (the loop visits its bounding square).
+    let n = PI * s_max * s_max / (a * a * 3f64.sqrt() / 2.0);
+    if n > cap {
+        return Err(too_many("spacing_mm", a.to_string(), n));
+    }
+    let m = (s_max / a).ceil() as i64 + 1;
+    // rows are (sqrt 3 / 2) a apart, and row j is shifted by j/2 pitches
+    let rows = (s_max / (a * 3f64.sqrt() / 2.0)).ceil() as i64 + 1;
+    for j in -rows..=rows {
+        let w = m + (j.abs() + 1) / 2;
+        for i in -w..=w {
+            let x = a * (i as f64 + 0.5 * j as f64);
+            let y = a * (3f64.sqrt() / 2.0) * j as f64;
+            let s = (x * x + y * y).sqrt();
+            if s >= s_min - 1e-12 && s <= s_max + 1e-12 {
+                raw.push((s, y.atan2(x), 0));
+            }
+        }
+    }
+    // deterministic order: by arc length, then azimuth
+    raw.sort_by(|p, q| {
+        (p.0, p.1)
+            .partial_cmp(&(q.0, q.1))
+            .unwrap_or(std::cmp::Ordering::Equal)
+    });
+    Ok(raw)
+}
+
+/// The markers of a `golden_spiral` pattern as (arc length mm, azimuth radians, 0): `count`
+/// markers (or as many as `spacing_mm` gives) at equal steps of surface area from `s_min` to
+/// `s_max` mm of arc, turned by the golden angle one to the next.
+///
+/// # Errors
+/// The first violation, as [`place`] reports it.
+fn golden_spiral_raw(
+    surface: &Surface,
+    pattern: &Pattern,
+    s_min: f64,
+    s_max: f64,
+) -> Result<Vec<(f64, f64, u32)>, PatternError> {
+    let cap = MAX_MARKERS_PER_PATTERN as f64;
+    let mut raw: Vec<(f64, f64, u32)> = Vec::new();
+    // cumulative area table from s_min to s_max, inverted by interpolation
+    let k = 4096;
+    let ss: Vec<f64> = (0..=k)
+        .map(|i| s_min + (s_max - s_min) * i as f64 / k as f64)
+        .collect();
+    let rs: Vec<f64> = ss.iter().map(|&x| surface.radius_at(x)).collect();
+    let mut area = vec![0.0; k + 1];
+    for i in 1..=k {
+        area[i] = area[i - 1] + PI * (rs[i - 1] + rs[i]) * (ss[i] - ss[i - 1]);
+    }
+    let a_total = area[k];
+    let n = match (pattern.count, pattern.spacing_mm) {
+        (Some(c), _) if c as usize > MAX_MARKERS_PER_PATTERN => {
+            return Err(too_many("count", c.to_string(), f64::from(c)))
+        }
+        (Some(c), _) if c > 0 => c as usize,
+        (Some(c), _) => return pattern_err("count", c.to_string(), "must be above 0"),
+        (None, sp) => {
+            let sp = positive(pattern, "spacing_mm", sp)?;
+            let n = (a_total / (sp * sp * 3f64.sqrt() / 2.0)).round();
+            if n > cap {
+                return Err(too_many("spacing_mm", sp.to_string(), n));
+            }
+            (n as usize).max(1)
+        }
+    };
+    let golden = PI * (3.0 - 5f64.sqrt());
+    for i in 0..n {
+        let target = (i as f64 + 0.5) / n as f64 * a_total;
+        let j = area.partition_point(|&a| a < target).clamp(1, k);
+        let f = (target - area[j - 1]) / (area[j] - area[j - 1]).max(f64::MIN_POSITIVE);
+        let s = ss[j - 1] + f * (ss[j] - ss[j - 1]);
+        raw.push((s, (i as f64 * golden).rem_euclid(2.0 * PI), 0));
+    }
+    Ok(raw)
+}
+
+/// The markers of a `list` pattern as (arc length mm, azimuth radians, 0), in list order, each
+/// point within `s_min` to `s_max` mm of arc.
+///
+/// # Errors
+/// The first violation, as [`place`] reports it.
+fn list_raw(
+    surface: &Surface,
+    pattern: &Pattern,
+    s_min: f64,
+    s_max: f64,
+) -> Result<Vec<(f64, f64, u32)>, PatternError> {
+    let mut raw: Vec<(f64, f64, u32)> = Vec::new();
+    let pts = pattern.points.as_ref().ok_or_else(|| {
+        (
+            "points".to_string(),
+            "missing".to_string(),
+            "is required for layout list (or csv_file)".to_string(),
+        )
+    })?;
+    if pts.len() > MAX_MARKERS_PER_PATTERN {
+        return Err(too_many(
+            "points",
+            format!("{} points", pts.len()),
+            pts.len() as f64,
+        ));
+    }
+    if let Some(e) = bad_points(surface, pts, s_min, s_max).into_iter().next() {
+        return Err(e);
+    }
+    for p in pts {
+        raw.push((surface.s_at_polar_deg(p[0]), p[1].to_radians(), 0));
+    }
+    Ok(raw)
 }
 
 /// For each point, (index, chord distance) of its nearest other point, by a bucket grid.
