@@ -219,51 +219,8 @@ impl SweepSpec {
             None => ChordTolerance::default(),
             Some(t) => ChordTolerance::new(t.value).map_err(|e| file_err(at(origin, t), e))?,
         };
-        let mode = raw.mode.as_ref().map(|m| m.value).unwrap_or(Mode::Grid);
-        match (&raw.count, &raw.seed, mode) {
-            (None, _, Mode::Random) => {
-                return Err(file_err(
-                    raw.mode.as_ref().map(|m| at(origin, m)).unwrap_or_default(),
-                    "mode random needs `count` (and takes `seed`, default 0)".into(),
-                ))
-            }
-            (Some(c), _, m) if m != Mode::Random => {
-                return Err(file_err(
-                    at(origin, c),
-                    "`count` only applies to mode random".into(),
-                ))
-            }
-            (_, Some(s), m) if m != Mode::Random => {
-                return Err(file_err(
-                    at(origin, s),
-                    "`seed` only applies to mode random".into(),
-                ))
-            }
-            (Some(c), _, _) if c.value == 0 => {
-                return Err(file_err(at(origin, c), "`count` must be above 0".into()))
-            }
-            _ => {}
-        }
-        let mut files = FileOutputs::default();
-        if let Some(o) = &raw.outputs {
-            if !o.value.contains(&Output::Metrics) {
-                return Err(file_err(
-                    at(origin, o),
-                    "outputs must include metrics (the results table is always written): [metrics] or [metrics, files]".into(),
-                ));
-            }
-            for x in &o.value {
-                match x {
-                    Output::Metrics => {}
-                    Output::Files => {
-                        files.stl = true;
-                        files.threemf = true;
-                    }
-                    Output::Stl => files.stl = true,
-                    Output::ThreeMf => files.threemf = true,
-                }
-            }
-        }
+        let mode = check_mode(&raw, origin)?;
+        let files = file_outputs(&raw, origin)?;
         if raw.vary.value.0.is_empty() {
             return Err(file_err(
                 at(origin, &raw.vary),
@@ -535,4 +492,69 @@ fn range(r: &Value) -> Result<Vec<Value>, String> {
                 .map(Value::from)
         })
         .collect()
+}
+
+/// The sweep's mode (default grid), with `count` and `seed` given only to, and `count` above
+/// 0 for, mode random.
+///
+/// # Errors
+/// [`SweepError::File`] at the key that breaks the rule.
+fn check_mode(raw: &RawSweep, origin: &str) -> Result<Mode, SweepError> {
+    let file_err = |s: String, message: String| SweepError::File { at: s, message };
+    let mode = raw.mode.as_ref().map(|m| m.value).unwrap_or(Mode::Grid);
+    match (&raw.count, &raw.seed, mode) {
+        (None, _, Mode::Random) => {
+            return Err(file_err(
+                raw.mode.as_ref().map(|m| at(origin, m)).unwrap_or_default(),
+                "mode random needs `count` (and takes `seed`, default 0)".into(),
+            ))
+        }
+        (Some(c), _, m) if m != Mode::Random => {
+            return Err(file_err(
+                at(origin, c),
+                "`count` only applies to mode random".into(),
+            ))
+        }
+        (_, Some(s), m) if m != Mode::Random => {
+            return Err(file_err(
+                at(origin, s),
+                "`seed` only applies to mode random".into(),
+            ))
+        }
+        (Some(c), _, _) if c.value == 0 => {
+            return Err(file_err(at(origin, c), "`count` must be above 0".into()))
+        }
+        _ => {}
+    }
+    Ok(mode)
+}
+
+/// Which files each variant writes besides its metrics row (`outputs`, which must include
+/// `metrics`).
+///
+/// # Errors
+/// [`SweepError::File`] at `outputs` when it leaves out `metrics`.
+fn file_outputs(raw: &RawSweep, origin: &str) -> Result<FileOutputs, SweepError> {
+    let file_err = |s: String, message: String| SweepError::File { at: s, message };
+    let mut files = FileOutputs::default();
+    if let Some(o) = &raw.outputs {
+        if !o.value.contains(&Output::Metrics) {
+            return Err(file_err(
+                at(origin, o),
+                "outputs must include metrics (the results table is always written): [metrics] or [metrics, files]".into(),
+            ));
+        }
+        for x in &o.value {
+            match x {
+                Output::Metrics => {}
+                Output::Files => {
+                    files.stl = true;
+                    files.threemf = true;
+                }
+                Output::Stl => files.stl = true,
+                Output::ThreeMf => files.threemf = true,
+            }
+        }
+    }
+    Ok(files)
 }

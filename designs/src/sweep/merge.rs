@@ -55,60 +55,10 @@ pub fn merge(
     for d in dirs {
         records.push((d.clone(), read_record(d)?));
     }
-    let (first_dir, first) = &records[0];
+    let first = &records[0].1;
     let n = first.shard.map(|s| s.count).unwrap_or(1);
-    for (d, r) in &records[1..] {
-        let what = if r.plan_sha256 != first.plan_sha256 || r.variant_count != first.variant_count {
-            Some("a different sweep (its variants differ)")
-        } else if r.parameters != first.parameters {
-            Some("a different sweep (its varied parameters differ)")
-        } else if r.fabkit_version != first.fabkit_version {
-            Some("another fabkit version")
-        } else {
-            None
-        };
-        if let Some(what) = what {
-            return Err(err(format!(
-                "{} holds {what} than {}",
-                d.display(),
-                first_dir.display()
-            )));
-        }
-        if r.shard.map(|s| s.count).unwrap_or(1) != n {
-            return Err(err(format!(
-                "{} is shard {} but {} is shard {}: shards of different splits",
-                d.display(),
-                shard_name(r),
-                first_dir.display(),
-                shard_name(first)
-            )));
-        }
-    }
-    // Every shard exactly once.
-    let mut by_shard: Vec<Option<&Path>> = vec![None; n];
-    for (d, r) in &records {
-        let i = r.shard.map(|s| s.index).unwrap_or(0);
-        if let Some(other) = by_shard[i] {
-            return Err(err(format!(
-                "shards overlap: {} and {} are both shard {i}/{n}",
-                other.display(),
-                d.display()
-            )));
-        }
-        by_shard[i] = Some(d);
-    }
-    let missing: Vec<String> = by_shard
-        .iter()
-        .enumerate()
-        .filter(|(_, d)| d.is_none())
-        .map(|(i, _)| format!("{i}/{n}"))
-        .collect();
-    if !missing.is_empty() {
-        return Err(err(format!(
-            "missing shard(s) {} of the {n}; run them with --shard and pass their folders",
-            missing.join(", ")
-        )));
-    }
+    check_same_sweep(&records)?;
+    let by_shard = check_shards(&records, n)?;
     // Rows: each in its shard, none twice, none missing.
     let total = first.variant_count;
     let mut rows: Vec<Option<VariantResult>> = vec![None; total];
@@ -189,6 +139,81 @@ pub fn merge(
         results_csv: csv,
         results_jsonl: jsonl,
     })
+}
+
+/// Every record after the first is of the same sweep (variants, varied parameters, fabkit
+/// version) and of the same split into shards as the first.
+///
+/// # Errors
+/// [`SweepError::Merge`] naming the folder that differs and how.
+fn check_same_sweep(records: &[(PathBuf, SweepRecord)]) -> Result<(), SweepError> {
+    let err = |m: String| SweepError::Merge(m);
+    let (first_dir, first) = &records[0];
+    let n = first.shard.map(|s| s.count).unwrap_or(1);
+    for (d, r) in &records[1..] {
+        let what = if r.plan_sha256 != first.plan_sha256 || r.variant_count != first.variant_count {
+            Some("a different sweep (its variants differ)")
+        } else if r.parameters != first.parameters {
+            Some("a different sweep (its varied parameters differ)")
+        } else if r.fabkit_version != first.fabkit_version {
+            Some("another fabkit version")
+        } else {
+            None
+        };
+        if let Some(what) = what {
+            return Err(err(format!(
+                "{} holds {what} than {}",
+                d.display(),
+                first_dir.display()
+            )));
+        }
+        if r.shard.map(|s| s.count).unwrap_or(1) != n {
+            return Err(err(format!(
+                "{} is shard {} but {} is shard {}: shards of different splits",
+                d.display(),
+                shard_name(r),
+                first_dir.display(),
+                shard_name(first)
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Every shard of the `n` exactly once among the records; the folder of each shard.
+///
+/// # Errors
+/// [`SweepError::Merge`] naming two folders of one shard, or the missing shards.
+fn check_shards(
+    records: &[(PathBuf, SweepRecord)],
+    n: usize,
+) -> Result<Vec<Option<&Path>>, SweepError> {
+    let err = |m: String| SweepError::Merge(m);
+    let mut by_shard: Vec<Option<&Path>> = vec![None; n];
+    for (d, r) in records {
+        let i = r.shard.map(|s| s.index).unwrap_or(0);
+        if let Some(other) = by_shard[i] {
+            return Err(err(format!(
+                "shards overlap: {} and {} are both shard {i}/{n}",
+                other.display(),
+                d.display()
+            )));
+        }
+        by_shard[i] = Some(d);
+    }
+    let missing: Vec<String> = by_shard
+        .iter()
+        .enumerate()
+        .filter(|(_, d)| d.is_none())
+        .map(|(i, _)| format!("{i}/{n}"))
+        .collect();
+    if !missing.is_empty() {
+        return Err(err(format!(
+            "missing shard(s) {} of the {n}; run them with --shard and pass their folders",
+            missing.join(", ")
+        )));
+    }
+    Ok(by_shard)
 }
 
 fn shard_name(r: &SweepRecord) -> String {
