@@ -14,13 +14,12 @@
 //! tolerance and its volume passes [`MIN_OVERLAP_MM3`].
 
 use crate::error::{DesignError, GeometryContext, ParamError, ParamErrors};
-use crate::geometry::{cuboid, cylinder, revolve, Affine, ChordTolerance, Solid};
-use crate::housing::ShellLevels;
+use crate::geometry::{cylinder, revolve, Affine, ChordTolerance, Solid};
 use crate::parts::context::Stack;
 use crate::parts::registry::FAMILIES;
 use crate::parts::Part;
 pub use crate::parts::{ExactShape, Member, MemberKind};
-use crate::schema::{Design, HousingStyle, LayerProcess};
+use crate::schema::{Design, LayerProcess};
 
 /// Roles of kit parts that are part of the sensor besides the section families' own
 /// ([`crate::parts::family::Family::SENSOR_PARTS`]); the rest are molds and tooling.
@@ -89,8 +88,9 @@ pub fn in_sensor_frame(part: &Part) -> Option<Solid> {
     Some(part.solid.transform(&rigid_inverse(&t)))
 }
 
-/// The members of the assembled sensor, in order: printed sensor parts, cast layers (inner to
-/// outer), then the bought envelopes.
+/// The members of the assembled sensor that no family gives, in order: printed sensor parts,
+/// cast layers (inner to outer), the bought core's and backing plate's envelopes. The
+/// families' members follow ([`crate::parts::family::Family::members`]).
 ///
 /// # Errors
 /// [`DesignError::Geometry`] if the kernel fails.
@@ -98,14 +98,13 @@ pub fn members(
     design: &Design,
     stack: &Stack,
     parts: &[Part],
-    levels: Option<&ShellLevels>,
     tol: ChordTolerance,
 ) -> Result<Vec<Member>, DesignError> {
     let mut out = Vec::new();
     push_printed(&mut out, parts);
     push_cast_layers(&mut out, design, stack, tol)?;
-    push_core_and_filling_gel(&mut out, design, stack, levels, tol)?;
-    push_bought_envelopes(&mut out, design, levels, tol)?;
+    push_core(&mut out, design, stack, tol)?;
+    push_backing(&mut out, design, tol)?;
     Ok(out)
 }
 
@@ -167,16 +166,14 @@ fn push_cast_layers(
     Ok(())
 }
 
-/// Pushes onto `out` the bought core's envelope (when the design has a core), then the housing's
-/// internal filling gel (when it has one, with shell levels and a core).
+/// Pushes onto `out` the bought core's envelope, when the design has a core.
 ///
 /// # Errors
 /// [`DesignError::Geometry`] if the kernel fails.
-fn push_core_and_filling_gel(
+fn push_core(
     out: &mut Vec<Member>,
     design: &Design,
     stack: &Stack,
-    levels: Option<&ShellLevels>,
     tol: ChordTolerance,
 ) -> Result<(), DesignError> {
     let g = |name: &str, r: Result<Solid, crate::geometry::GeometryError>| r.part(name);
@@ -202,141 +199,37 @@ fn push_core_and_filling_gel(
             )
         });
     }
-    if let (Some(h), Some(lv), Some(c)) = (&design.housing, levels, &stack.core) {
-        if let Some(f) = &h.filling_gel {
-            let pl = crate::housing::filling_gel_profile(design, h, c, lv, tol);
-            let solid = g(
-                crate::procedure::FILLING_GEL,
-                revolve(&pl, tol).and_then(|m| Solid::from_mesh(&m)),
-            )?;
-            out.push(Member {
-                name: crate::procedure::FILLING_GEL.into(),
-                kind: MemberKind::Cast,
-                description: format!(
-                    "Internal filling gel ({}): the core, the diffuser's opening and the light chamber",
-                    f.material
-                ),
-                solid,
-                fix: vec![
-                    "housing.light_chamber_diameter_mm".into(),
-                    "housing.diffuser.inner_diameter_mm".into(),
-                ],
-                // inside the core's inner surface above the core's end, and under it only
-                // where no layer is: nested with the layers and the core by construction
-                nested_by_stack: true,
-                exact: Some(ExactShape::Revolved {
-                    profile_rz_mm: pl.points.clone(),
-                }),
-            });
-        }
-    }
     Ok(())
 }
 
-/// Pushes onto `out` the bought envelopes below the skin: the backing plate (when given), then,
-/// with a housing and its shell levels, the LED ring PCB, the camera board and the diffuser.
+/// Pushes onto `out` the backing plate's envelope, when the design has one.
 ///
 /// # Errors
 /// [`DesignError::Geometry`] if the kernel fails.
-fn push_bought_envelopes(
+fn push_backing(
     out: &mut Vec<Member>,
     design: &Design,
-    levels: Option<&ShellLevels>,
     tol: ChordTolerance,
 ) -> Result<(), DesignError> {
+    let Some(b) = &design.backing else {
+        return Ok(());
+    };
     let zb = design.body.base_z_mm();
-    type Exact = Result<(Solid, ExactShape), crate::geometry::GeometryError>;
-    let disc = |r: f64, z0: f64, z1: f64| -> Exact {
-        let solid = cylinder(z1 - z0, r, tol)?.translate([0.0, 0.0, z0]);
-        let exact = ExactShape::Cylinder {
-            radius_mm: r,
-            z0_mm: z0,
-            z1_mm: z1,
-        };
-        Ok((solid, exact))
+    let (r, z0, z1) = (b.diameter_mm / 2.0, zb - b.thickness_mm, zb);
+    let solid = cylinder(z1 - z0, r, tol)
+        .map(|s| s.translate([0.0, 0.0, z0]))
+        .part("backing_envelope")?;
+    let exact = ExactShape::Cylinder {
+        radius_mm: r,
+        z0_mm: z0,
+        z1_mm: z1,
     };
-    let ring = |ro: f64, ri: f64, z0: f64, z1: f64| -> Exact {
-        // the inner cut passes both faces so that the difference is clean
-        let (outer, _) = disc(ro, z0, z1)?;
-        let (inner, _) = disc(ri, z0 - 1.0, z1 + 1.0)?;
-        let exact = ExactShape::Ring {
-            outer_radius_mm: ro,
-            inner_radius_mm: ri,
-            z0_mm: z0,
-            z1_mm: z1,
-        };
-        Ok((outer.difference(&inner)?, exact))
-    };
-    let block = |min_mm: [f64; 3], max_mm: [f64; 3]| -> Exact {
-        Ok((cuboid(min_mm, max_mm)?, ExactShape::Box { min_mm, max_mm }))
-    };
-    let g = |name: &str, r: Exact| r.part(name);
-    if let Some(b) = &design.backing {
-        out.push(bought(
-            "backing_envelope",
-            format!("Backing plate (bought): {}", b.description),
-            g(
-                "backing_envelope",
-                disc(b.diameter_mm / 2.0, zb - b.thickness_mm, zb),
-            )?,
-            &["backing.diameter_mm", "backing.thickness_mm"],
-        ));
-    }
-    if let (Some(h), Some(lv)) = (&design.housing, levels) {
-        let bw = h.camera.board_width_mm / 2.0;
-        let (z0, z1) = match (h.style, lv.base_top_z_mm) {
-            (HousingStyle::RoundTube, Some(top)) => (top, top + h.camera.bay_height_mm),
-            _ => (lv.bulkhead_z_mm - h.camera.bay_height_mm, lv.bulkhead_z_mm),
-        };
-        out.push(bought(
-            "led_pcb_envelope",
-            format!("LED ring PCB (bought), {} LEDs", h.led_pcb.led_count),
-            g(
-                "led_pcb_envelope",
-                ring(
-                    h.led_pcb.outer_diameter_mm / 2.0,
-                    h.led_pcb.inner_diameter_mm / 2.0,
-                    lv.pcb_z_mm,
-                    lv.pcb_z_mm + h.led_pcb.thickness_mm,
-                ),
-            )?,
-            &[
-                "housing.led_pcb.outer_diameter_mm",
-                "housing.led_pcb.thickness_mm",
-            ],
-        ));
-        // after the LED PCB: an overlap names the later member's parameters first, and the
-        // board's height is what a board that reaches the PCB needs changed
-        out.push(bought(
-            "camera_board_envelope",
-            format!(
-                "Camera board with its components (bought): {}",
-                h.camera.module
-            ),
-            g("camera_board_envelope", block([-bw, -bw, z0], [bw, bw, z1]))?,
-            &[
-                "housing.camera.bay_height_mm",
-                "housing.camera.board_width_mm",
-            ],
-        ));
-        out.push(bought(
-            "diffuser_envelope",
-            "Diffuser ring (laser-cut acrylic)".into(),
-            g(
-                "diffuser_envelope",
-                ring(
-                    h.diffuser.outer_diameter_mm / 2.0,
-                    h.diffuser.inner_diameter_mm / 2.0,
-                    lv.diffuser_z_mm,
-                    lv.diffuser_z_mm + h.diffuser.thickness_mm,
-                ),
-            )?,
-            &[
-                "housing.diffuser.outer_diameter_mm",
-                "housing.diffuser.thickness_mm",
-            ],
-        ));
-    }
+    out.push(bought(
+        "backing_envelope",
+        format!("Backing plate (bought): {}", b.description),
+        (solid, exact),
+        &["backing.diameter_mm", "backing.thickness_mm"],
+    ));
     Ok(())
 }
 

@@ -1,5 +1,5 @@
-//! From a validated design to a [`Kit`]: mold parts per cast layer, the shell, and the pour
-//! numbers.
+//! From a validated design to a [`Kit`]: mold parts per cast layer, every section family's
+//! parts (the registry, [`crate::parts::registry::FAMILIES`]), and the pour numbers.
 
 mod flat_kit;
 
@@ -8,7 +8,6 @@ use crate::geometry::ChordTolerance;
 use crate::kit::Kit;
 use crate::materials::{pour, MaterialsTable};
 use crate::molds::{build_mold, cast_plans};
-use crate::parts::fasteners::{metric_from_pilot, metric_name};
 use crate::parts::registry::FAMILIES;
 use crate::schema::{Design, LayerProcess, MoldStrategy};
 use crate::stack::{validate, Stack};
@@ -17,7 +16,8 @@ use serde_json::json;
 
 /// Validates `design` and builds every part of its kit at chord tolerance `tol`.
 ///
-/// Mold parts come first (per cast layer, inner to outer), then the shell. Casts are listed in
+/// Mold parts come first (per cast layer, inner to outer), then the families' parts in registry
+/// order. Casts are listed in
 /// the order they are poured: silicone molds (master strategy) first, then the layers from the
 /// inside out.
 ///
@@ -72,7 +72,7 @@ pub fn build_kit_bounded(
     let mut parts = Vec::new();
     let mut silicone = Vec::new();
     let mut gel = Vec::new();
-    // Casts and the shell are independent: build them in parallel. Each build is
+    // Casts and the families' parts are independent: build them in parallel. Each build is
     // single-threaded and the results are collected in order, so the output does not depend
     // on the thread count.
     // Layers built by crate::layers: printed layers and the open / boundary strategies.
@@ -94,7 +94,7 @@ pub fn build_kit_bounded(
         .filter(|p| matches!(p.strategy, MoldStrategy::Direct | MoldStrategy::Master))
         .cloned()
         .collect();
-    let ((molds, others), shell) = rayon::join(
+    let ((molds, others), sections) = rayon::join(
         || {
             rayon::join(
                 || {
@@ -111,23 +111,12 @@ pub fn build_kit_bounded(
             )
         },
         || {
-            rayon::join(
-                || {
-                    design
-                        .housing
-                        .as_ref()
-                        .map(|h| crate::housing::build_shell(design, h, &stack, tol))
-                },
-                || {
-                    FAMILIES
-                        .par_iter()
-                        .map(|f| f.build(design, &stack, tol))
-                        .collect::<Vec<_>>()
-                },
-            )
+            FAMILIES
+                .par_iter()
+                .map(|f| f.build(design, &stack, tol))
+                .collect::<Vec<_>>()
         },
     );
-    let (shell, sections) = shell;
     let layer_markers = gather_layer_outputs(
         &other,
         others,
@@ -146,18 +135,6 @@ pub fn build_kit_bounded(
         "layers": stack.layers,
         "markers": layer_markers,
     });
-    let mut shell_levels = None;
-    if let (Some(h), Some(shell)) = (&design.housing, shell) {
-        let (shell, levels) = shell?;
-        parts.extend(shell);
-        let r = design.body.rim_radius_mm(0.0);
-        let w = h.outer_width_mm.max(2.0 * r);
-        summary["shell_levels"] = json!(&levels);
-        summary["envelope_mm"] = json!([w, w, levels.envelope_height_mm]);
-        bought.extend(housing_items(h));
-        shell_levels = Some(levels);
-    }
-
     for (f, built) in FAMILIES.iter().zip(sections) {
         let Some(built) = built else { continue };
         let built = built?;
@@ -169,18 +146,10 @@ pub fn build_kit_bounded(
     }
 
     let (mut casts, step) = layer_pours(design, &stack, &materials, silicone, gel)?;
-    let tip_gel = filling_gel_pours(
-        design,
-        &stack,
-        &materials,
-        &parts,
-        shell_levels.as_ref(),
-        (&mut casts, step),
-        tol,
-    )?;
+    let poured = filling_gel_pours(design, &stack, &materials, &parts, (&mut casts, step), tol)?;
     check_unique_names(&parts)?;
     // The assembled sensor and its fit check: no file is written when parts overlap.
-    let assembly = assembled(design, &stack, &parts, shell_levels.as_ref(), tip_gel, tol)?;
+    let assembly = assembled(design, &stack, &parts, poured, tol)?;
     let bolts = crate::procedure::clamp_bolts(design, &parts);
     bought.extend(crate::procedure::clamp_bolt_items(&bolts));
     let procedure = crate::procedure::procedure(design, &parts, &casts, &bolts);
@@ -361,8 +330,9 @@ fn layer_pours(
     Ok((casts, step))
 }
 
-/// The filling gel's pour, step `step` of `casts`: the housing's, poured into the assembled
-/// shell, or the shaft body's, poured into the tip; the tip's gel solid with its material.
+/// The filling gels' pours, step `step` of `casts`: each family's
+/// ([`crate::parts::family::Family::filling_pour`]: the housing's, poured into the assembled
+/// shell, or the shaft body's, poured into the tip); the members they bring to the assembly.
 ///
 /// # Errors
 /// [`DesignError`] naming the filling gel if the kernel fails or its material is unknown.
@@ -371,55 +341,31 @@ fn filling_gel_pours(
     stack: &Stack,
     materials: &MaterialsTable,
     parts: &[crate::Part],
-    shell_levels: Option<&crate::housing::ShellLevels>,
     (casts, step): (&mut Vec<crate::materials::CastReport>, u32),
     tol: ChordTolerance,
-) -> Result<Option<(crate::geometry::Solid, String)>, DesignError> {
+) -> Result<Vec<crate::parts::Member>, DesignError> {
     let waste = design.casting.waste_allowance;
-    // The filling gel, poured into the assembled shell (R-Tac0 Sec. III-B1).
-    if let (Some(h), Some(lv), Some(core)) = (&design.housing, shell_levels, &stack.core) {
-        if let Some(f) = &h.filling_gel {
-            let v = crate::housing::filling_gel_volume_mm3(design, h, core, lv);
-            casts.push(filling_gel_cast(
-                materials,
-                f,
-                (step, waste),
-                holders(parts, &["shell_collar", "shell_tube", "shell_half"]),
-                v,
-                "Poured into the assembled shell, pole-down, before the camera goes on: it fills the core, the diffuser's opening and the light chamber up to the LED PCB's face (R-Tac0 Sec. III-B1).",
-            )?);
-        }
+    let cavity = |i: usize| crate::layers::inner_cavity(design, stack, i, tol);
+    let mut members = Vec::new();
+    for f in FAMILIES {
+        let Some(pour) = f.filling_pour(design, stack, &cavity, tol)? else {
+            continue;
+        };
+        casts.push(filling_gel_cast(
+            materials,
+            pour.gel,
+            (step, waste),
+            holders(parts, pour.holder_roles),
+            pour.volume_mm3,
+            pour.how,
+        )?);
+        members.extend(pour.member);
     }
-    // The clear gel between the skin and the lens window (Pestell et al. Sec. III-A).
-    let mut tip_gel = None;
-    if let Some(sb) = &design.shaft_body {
-        if let Some(f) = &sb.filling_gel {
-            let cavity = crate::layers::inner_cavity(design, stack, 0, tol)
-                .part(crate::procedure::FILLING_GEL)?;
-            let gel = crate::parts::shaft_body::filling_gel_solid(
-                &design.context(),
-                sb,
-                stack,
-                cavity,
-                tol,
-            )
-            .part(crate::procedure::FILLING_GEL)?;
-            casts.push(filling_gel_cast(
-                materials,
-                f,
-                (step, waste),
-                holders(parts, &["printed_skin", "tip_fitting"]),
-                gel.volume(),
-                "Poured into the tip, pole-down, round the pins and up into the lip's opening; the lens window is then laid on (Pestell et al. Sec. III-A).",
-            )?);
-            tip_gel = Some((gel, f.material.clone()));
-        }
-    }
-    Ok(tip_gel)
+    Ok(members)
 }
 
 /// The members of the assembled sensor (the parts in the sensor frame, the cast layers, every
-/// family's bought and cut members, the tip's gel), checked for interferences and for the
+/// family's bought and cut members, the poured gels' members), checked for interferences and for the
 /// paths each member goes in by.
 ///
 /// # Errors
@@ -429,33 +375,19 @@ fn assembled(
     design: &Design,
     stack: &Stack,
     parts: &[crate::Part],
-    shell_levels: Option<&crate::housing::ShellLevels>,
-    tip_gel: Option<(crate::geometry::Solid, String)>,
+    poured: Vec<crate::parts::Member>,
     tol: ChordTolerance,
 ) -> Result<Vec<crate::parts::Member>, DesignError> {
-    let mut assembly = crate::assembly::members(design, stack, parts, shell_levels, tol)?;
+    let mut assembly = crate::assembly::members(design, stack, parts, tol)?;
     for f in FAMILIES {
         assembly.extend(f.members(design, stack, tol)?);
     }
-    if let Some((solid, material)) = tip_gel {
-        assembly.push(crate::assembly::Member {
-            name: crate::procedure::FILLING_GEL.into(),
-            kind: crate::assembly::MemberKind::Cast,
-            description: format!(
-                "Clear gel ({material}) between the skin and the lens window, round the pins"
-            ),
-            solid,
-            fix: vec!["shaft_body.tip_fitting.lip_width_mm".into()],
-            // the skin's cavity less its pins and tips: nested with them by construction
-            nested_by_stack: true,
-            exact: None,
-        });
-    }
+    assembly.extend(poured);
     let found = crate::assembly::interferences(&assembly, tol)?;
     if let Some(e) = crate::assembly::fit_errors(design, &found) {
         return Err(e);
     }
-    let paths = crate::insertion::paths(design, stack, shell_levels, tol)?;
+    let paths = crate::insertion::paths(design, stack, tol)?;
     let blocked = crate::insertion::blocked(&assembly, &paths, tol)?;
     if let Some(e) = crate::insertion::errors(design, &blocked) {
         return Err(e);
@@ -662,53 +594,6 @@ fn bought_items(design: &Design, stack: &Stack, materials: &MaterialsTable) -> V
                 l.thickness_mm
             ));
         }
-    }
-    v
-}
-
-fn housing_items(h: &crate::schema::HousingParams) -> Vec<String> {
-    let mut v = vec![
-        format!(
-            "Camera: {} on a {:.1} mm square board, fixed with 4 self-tapping screws{} ({:.1} mm pilots, {:.1} mm square pattern)",
-            h.camera.module,
-            h.camera.board_width_mm,
-            metric_from_pilot(h.camera.mount_pilot_diameter_mm)
-                .map(|d| format!(" {}", metric_name(d)))
-                .unwrap_or_default(),
-            h.camera.mount_pilot_diameter_mm,
-            h.camera.mount_hole_spacing_mm
-        ),
-        format!(
-            "LED ring PCB: {} LEDs, outer diameter {:.1} mm, inner diameter {:.1} mm, {:.1} mm thick",
-            h.led_pcb.led_count, h.led_pcb.outer_diameter_mm, h.led_pcb.inner_diameter_mm, h.led_pcb.thickness_mm
-        ),
-        format!(
-            "Diffuser: laser-cut double-sided frosted acrylic (cut/diffuser.dxf), outer diameter {:.1} mm, inner diameter {:.1} mm, {:.1} mm thick, {:.1} mm above the PCB",
-            h.diffuser.outer_diameter_mm, h.diffuser.inner_diameter_mm, h.diffuser.thickness_mm, h.diffuser.gap_above_pcb_mm
-        ),
-        format!(
-            "2 joint screws{}{}: {:.1} mm clearance, {:.1} mm head, length about {:.0} mm (clamp {:.1} mm + pilot {:.1} mm)",
-            crate::housing::joint_screw_name(h)
-            .map(|n| format!(" {n}"))
-            .unwrap_or_default(),
-            match h.style {
-                crate::schema::HousingStyle::RoundTube =>
-                    " (pan head), up through the base's flange into the tube wall",
-                crate::schema::HousingStyle::SquareSplit => " across the two halves",
-            },
-            h.joint_screw.clearance_diameter_mm,
-            h.joint_screw.head_diameter_mm,
-            (h.joint_screw.clamp_length_mm + h.joint_screw.pilot_depth_mm - 0.5).floor(),
-            h.joint_screw.clamp_length_mm,
-            h.joint_screw.pilot_depth_mm
-        ),
-    ];
-    if h.style == crate::schema::HousingStyle::RoundTube {
-        v.push(
-            "Cyanoacrylate glue (gel): the diffuser disc onto the tube's top face, the collar \
-             onto the diffuser"
-                .into(),
-        );
     }
     v
 }

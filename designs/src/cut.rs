@@ -9,34 +9,14 @@ use crate::schema::Design;
 pub use crate::parts::cut_part::{ring_area_mm2, CutPart, Operation, Outline};
 use crate::parts::registry::FAMILIES;
 
-/// The laser-cut parts of a design: the housing's diffuser ring, the shaft body's lens window,
-/// the backing plate.
+/// The laser-cut parts of a design: every family's ([`crate::parts::family::Family::cut_parts`]:
+/// the housing's diffuser ring, the shaft body's lens window ...), then the backing plate.
 pub fn cut_parts(design: &Design) -> Vec<CutPart> {
     let circle = |r: f64| Outline::Circle {
         centre_mm: [0.0, 0.0],
         radius_mm: r,
     };
     let mut out = Vec::new();
-    if let Some(h) = &design.housing {
-        let d = &h.diffuser;
-        out.push(CutPart {
-            name: "diffuser".into(),
-            description: format!(
-                "Diffuser ring: double-sided frosted acrylic, {:.1} mm thick, outer diameter \
-                 {:.1} mm, inner diameter {:.1} mm (R-Tac0 Sec. III-B2)",
-                d.thickness_mm, d.outer_diameter_mm, d.inner_diameter_mm
-            ),
-            material: "pmma".into(),
-            thickness_mm: d.thickness_mm,
-            outlines: vec![
-                (Operation::Cut, circle(d.outer_diameter_mm / 2.0)),
-                (Operation::Cut, circle(d.inner_diameter_mm / 2.0)),
-            ],
-            kerf_mm: 0.0,
-            quantity: 1,
-            nominal_rings_mm: None,
-        });
-    }
     for f in FAMILIES {
         out.extend(f.cut_parts(design));
     }

@@ -11,76 +11,29 @@
 
 use crate::assembly::{Interference, Member, MIN_OVERLAP_MM3};
 use crate::error::{DesignError, GeometryContext};
-use crate::geometry::{cylinder, ChordTolerance, Solid};
-use crate::housing::ShellLevels;
+use crate::geometry::ChordTolerance;
 use crate::parts::context::Stack;
-use crate::schema::{Design, HousingStyle};
+use crate::parts::registry::FAMILIES;
+use crate::schema::Design;
 
-/// The swept path of one member through one printed part, sensor frame, mm.
-#[derive(Debug, Clone)]
-pub struct InsertionPath {
-    /// The member that moves (an assembly member's name).
-    pub member: String,
-    /// The printed part it passes (an assembly member's name).
-    pub through: String,
-    /// The member's outer cylinder from its seat up past the part's top.
-    pub solid: Solid,
-    /// The parameters that size the passage, for the error.
-    pub fix: Vec<String>,
-}
+pub use crate::parts::family::InsertionPath;
 
-/// The insertion paths of `design`'s assembly: the round shell's LED PCB through the tube and
-/// core through the collar (the square shell's halves close around their parts: no paths).
+/// The insertion paths of `design`'s assembly: every family's
+/// ([`crate::parts::family::Family::insertion_paths`]: the round shell's LED PCB through the
+/// tube and core through the collar; the square shell's halves close around their parts).
 ///
 /// # Errors
 /// [`DesignError::Geometry`] if the kernel fails.
 pub fn paths(
     design: &Design,
     stack: &Stack,
-    levels: Option<&ShellLevels>,
     tol: ChordTolerance,
 ) -> Result<Vec<InsertionPath>, DesignError> {
-    let (Some(h), Some(lv), Some(core)) = (&design.housing, levels, &stack.core) else {
-        return Ok(Vec::new());
-    };
-    if h.style != HousingStyle::RoundTube {
-        return Ok(Vec::new());
+    let mut out = Vec::new();
+    for f in FAMILIES {
+        out.extend(f.insertion_paths(design, stack, tol)?);
     }
-    let cyl = |name: &str, r: f64, z0: f64, z1: f64| {
-        cylinder(z1 - z0, r, tol)
-            .map(|s| s.translate([0.0, 0.0, z0]))
-            .part(name)
-    };
-    Ok(vec![
-        InsertionPath {
-            member: "led_pcb_envelope".into(),
-            through: "shell_tube".into(),
-            solid: cyl(
-                "led_pcb_envelope",
-                h.led_pcb.outer_diameter_mm / 2.0,
-                lv.pcb_z_mm,
-                lv.diffuser_z_mm + 1.0,
-            )?,
-            fix: vec![
-                "housing.light_chamber_diameter_mm".into(),
-                "housing.led_pcb.outer_diameter_mm".into(),
-            ],
-        },
-        InsertionPath {
-            member: "core_envelope".into(),
-            through: "shell_collar".into(),
-            solid: cyl(
-                "core_envelope",
-                design.body.rim_radius_mm(core.outer_offset_mm),
-                lv.seat_z_mm,
-                lv.top_z_mm + 1.0,
-            )?,
-            fix: vec![
-                "housing.fit_clearance_mm".into(),
-                "core.outer_diameter_mm".into(),
-            ],
-        },
-    ])
+    Ok(out)
 }
 
 /// The paths that overlap the part they pass (`member` as `a`, the part as `b`), with the

@@ -24,7 +24,6 @@ pub mod estimate;
 pub mod flat;
 pub mod geometry;
 pub mod glyphs;
-pub mod housing;
 pub mod input_files;
 pub mod insertion;
 pub mod kit;

@@ -28,9 +28,7 @@ pub struct ClampBolts {
     pub clearance_mm: f64,
 }
 
-/// The cast name of the internal filling gel ([`crate::schema::FillingGel`]): poured during the
-/// assembly, not in a mold.
-pub const FILLING_GEL: &str = "filling_gel";
+pub use crate::parts::family::FILLING_GEL;
 /// The clamp bolts of every bolted mold of the kit, from the parts' parameters: the direct
 /// strategy's halves (4 bolts across both halves, perpendicular to the parting plane) and the
 /// two-piece open mold (`two_piece.bolt_count` bolts through both pieces).
@@ -524,9 +522,9 @@ fn sprue_pour_text(n: u32, mix: &str, holder: Option<&Part>) -> String {
 }
 
 /// The assembly steps in order, each with its screws or glue: the contact module's own
-/// bonding (core into the skin, skin onto its backing), then the shell from the inside out:
-/// LED PCB, diffuser, contact module, camera, the shell joined (R-Tac0 Sec. III-B2..B4;
-/// UVDtact Sec. III; ShadowTac Sec. IV-A, IV-B).
+/// bonding (core into the skin, skin onto its backing; UVDtact Sec. III, ShadowTac Sec. IV-A),
+/// then every family's steps in registry order ([`crate::parts::family::Family::assembly_steps`]),
+/// the filling gel's pour where its family puts it.
 fn assembly_steps(
     design: &Design,
     parts: &[Part],
@@ -552,98 +550,6 @@ fn assembly_steps(
              Sec. IV-A)."
                 .into(),
         );
-    }
-    let named = |role: &str| crate::parts::family::named(parts, role);
-    if let Some(h) = &design.housing {
-        let joint = crate::housing::joint_screw_name(h).map_or_else(
-            || "the joint screws".to_string(),
-            |n| format!("the 2 joint screws {n}"),
-        );
-        let camera = crate::parts::fasteners::metric_from_pilot(h.camera.mount_pilot_diameter_mm)
-            .map_or_else(String::new, |d| format!(" M{d}"));
-        let tube = named("shell_tube");
-        let collar = named("shell_collar");
-        let base = named("shell_base");
-        let halves = named("shell_half");
-        match (tube.first(), collar.first(), halves.first()) {
-            (Some(t), Some(k), _) => {
-                out.push(format!(
-                    "Drop the LED ring PCB ({} LEDs, facing up) down the light chamber of {t} \
-                     onto the ledge above the camera bay (R-Tac0 Sec. III-B2: press-fitted), \
-                     its wires down through the bay.",
-                    h.led_pcb.led_count
-                ));
-                out.push(format!(
-                    "Glue the diffuser disc onto the top face of {t} with cyanoacrylate gel, \
-                     {:.1} mm above the PCB and centred on the chamber; then glue {k} onto the \
-                     diffuser, flush with the tube's outside.",
-                    h.diffuser.gap_above_pcb_mm
-                ));
-                out.push(format!(
-                    "Push the contact module (the core with its layers) into {k} until the \
-                     core's rim rests on the diffuser's inner edge."
-                ));
-                if let Some(c) = filling {
-                    filled = Some((out.len(), filling_step(c)));
-                }
-            }
-            (t, _, a) => {
-                let (into, module_seat) = match (t, a) {
-                    (Some(t), _) => (
-                        t.clone(),
-                        format!("the contact-module seat at the top of {t}"),
-                    ),
-                    (None, Some(a)) => (a.clone(), format!("the contact-module seat of {a}")),
-                    (None, None) => ("the shell".into(), "its seat".into()),
-                };
-                out.push(format!(
-                    "Press the LED ring PCB ({} LEDs, facing up) into its seat in {into} \
-                     (R-Tac0 Sec. III-B2: press-fitted), its wires down through the camera bay.",
-                    h.led_pcb.led_count
-                ));
-                out.push(format!(
-                    "Lay the diffuser ring into its seat, {:.1} mm above the PCB.",
-                    h.diffuser.gap_above_pcb_mm
-                ));
-                out.push(format!(
-                    "Push the contact module (the core with its layers) into {module_seat} \
-                     until its rim rests on the diffuser."
-                ));
-            }
-        }
-        let into = tube
-            .first()
-            .or(halves.first())
-            .cloned()
-            .unwrap_or_else(|| "the shell".into());
-        match (base.first(), halves.get(1)) {
-            (Some(b), _) => {
-                out.push(format!(
-                    "Screw the camera board onto the spigot of {b} with 4 self-tapping \
-                     screws{camera} ({:.1} mm pilots), its cable through the slot.",
-                    h.camera.mount_pilot_diameter_mm
-                ));
-                out.push(format!(
-                    "Set {b} under {into}, spigot into the bay, and join them with {joint} up \
-                     through the flange."
-                ));
-            }
-            (None, Some(b)) => {
-                // the bulkhead spans both halves: close them before the camera goes on
-                out.push(format!(
-                    "Close {b} onto {into} and join the halves with {joint} across them."
-                ));
-                if let Some(c) = filling {
-                    filled = Some((out.len(), filling_step(c)));
-                }
-                out.push(format!(
-                    "Screw the camera board up against the bulkhead with 4 self-tapping \
-                     screws{camera} ({:.1} mm pilots), lens through the lens hole.",
-                    h.camera.mount_pilot_diameter_mm
-                ));
-            }
-            _ => {}
-        }
     }
     for f in FAMILIES {
         for s in f.assembly_steps(design, parts, filling) {
@@ -671,23 +577,4 @@ fn assembly_steps(
         steps.insert(at, s);
     }
     steps
-}
-
-/// The filling gel's pour and cure, with the sensor pole-down and the camera not yet on
-/// (R-Tac0 Sec. III-B1).
-fn filling_step(c: &CastReport) -> ProcedureStep {
-    step(
-        ProcedureAction::Pour,
-        format!(
-            "Step {}: stand the shell pole-down (the contact module in its seat, the camera not \
-             yet on), mix and degas {} and pour it through the LED PCB's bore until it wets \
-             the PCB's underside all round ({:.2} mL to fill): it fills the core, the diffuser's \
-             opening and the light chamber and glues the core to the shell (R-Tac0 \
-             Sec. III-B1). Let it cure ({}) before the camera goes on.",
-            c.step,
-            c.mix_text(),
-            c.layer_volume_ml.unwrap_or(c.cavity_volume_ml),
-            cure_text(&c.notes)
-        ),
-    )
 }

@@ -14,6 +14,9 @@ use serde::{Deserialize, Serialize};
 
 pub mod printers;
 pub mod shared;
+pub use crate::parts::housing::{
+    CameraBay, Diffuser, HousingParams, HousingStyle, JointScrew, LedPcb, RoundTube,
+};
 pub use printers::{
     shipped_printers, Bed, PrinterFile, PrinterProfile, PrinterProfiles, Technology,
 };
@@ -435,192 +438,6 @@ defaults!(CastingParams {
     mold_release: Some("ease_release_200".into())
 });
 
-/// The two-piece sensor shell (R-Tac0 Sec. III-B4, Fig. 2): camera bay, LED ring seat,
-/// diffuser seat, contact-module seat. Two arrangements (`style`): a round tube closed by a
-/// separate base that carries the camera (the authors' CAD), or a square shell split into
-/// two halves on a plane through the axis.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct HousingParams {
-    /// Material key of the printed shell parts (printed FDM), a print material of the
-    /// materials table (R-Tac0: black PLA, `pla_black`, Sec. III-B4).
-    pub material: String,
-    /// The arrangement of the shell; `square_split` when not given.
-    #[serde(default)]
-    pub style: HousingStyle,
-    /// Side of the square shell (`square_split`) or outer diameter of the tube
-    /// (`round_tube`), mm (R-Tac0 envelope 30 x 30 x 43 mm, Sec. III-B).
-    #[schemars(extend("exclusiveMinimum" = 0))]
-    pub outer_width_mm: f64,
-    /// The tube and its base; required with `style: round_tube`, unused otherwise.
-    #[serde(default)]
-    pub round_tube: Option<RoundTube>,
-    /// The camera board and its bay under the LED PCB (R-Tac0 Sec. III-B3).
-    pub camera: CameraBay,
-    /// `square_split`: thickness along the axis of the bulkhead between the camera bay and the
-    /// LED PCB's seat, mm, > 0; the lens hole goes through it and the board's mounting pilots
-    /// go up into it. Unused with `round_tube` (the PCB rests on the bay's ledge), but still
-    /// checked above 0.
-    #[schemars(extend("exclusiveMinimum" = 0))]
-    pub bulkhead_thickness_mm: f64,
-    /// The LED ring PCB (bought; R-Tac0 Sec. III-B2), LEDs up, its top face
-    /// `diffuser.gap_above_pcb_mm` under the diffuser.
-    pub led_pcb: LedPcb,
-    pub diffuser: Diffuser,
-    /// Diameter of the light chamber between the LED PCB and the diffuser, mm (`round_tube`:
-    /// at least the LED PCB's seat, since the PCB goes in through it).
-    #[schemars(extend("exclusiveMinimum" = 0))]
-    pub light_chamber_diameter_mm: f64,
-    /// Radial clearance around seated parts, mm.
-    pub fit_clearance_mm: f64,
-    /// The internal filling gel, cast into the assembled shell; none when not given.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub filling_gel: Option<FillingGel>,
-    /// The two screws that join the shell: across the parting plane along x
-    /// (`square_split`), or up through the base's flange into the tube wall (`round_tube`)
-    /// (R-Tac0 Sec. III-B4: "small bolts").
-    pub joint_screw: JointScrew,
-}
-
-/// How the sensor shell is arranged.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, JsonSchema)]
-#[serde(rename_all = "snake_case")]
-pub enum HousingStyle {
-    /// A round tube (outer diameter `outer_width_mm`) holding the contact module, diffuser
-    /// and LED PCB, closed at the bottom by a separate base that carries the camera; the base
-    /// is screwed up into the tube wall (R-Tac0 authors' CAD, measured: a 30 mm tube 21.65 mm
-    /// tall; the paper, Sec. III-B3: "The camera module is secured to the sensor base").
-    RoundTube,
-    /// A square shell split on the plane x = 0 into two halves joined by two screws across it;
-    /// the camera bay is in the shell.
-    #[default]
-    SquareSplit,
-}
-
-/// The round shell (`housing.style: round_tube`), from the top down: a collar that takes the
-/// core's end below the base plane, the diffuser disc, the tube (light chamber, LED PCB, camera
-/// bay) and the base. Below the LED PCB the tube is bored out to `bay_diameter_mm`, and the PCB
-/// rests on the ledge this leaves; the light chamber above is wide enough for the PCB to go in
-/// from the tube's top. The base is a flange under the tube (as thick as
-/// `joint_screw.clamp_length_mm`) with a spigot that enters the bay; the camera board is
-/// screwed onto the spigot.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct RoundTube {
-    /// Height from the tube's bottom to the base plane (tube, diffuser and collar), mm, > 0.
-    pub height_mm: f64,
-    /// Bore of the camera bay under the LED PCB, mm; smaller than the LED PCB seat.
-    pub bay_diameter_mm: f64,
-    /// Height of the base's spigot inside the bay (the camera board rests on it), mm, > 0.
-    pub base_spigot_height_mm: f64,
-}
-
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct CameraBay {
-    /// Camera module name, for the fabrication sheet.
-    pub module: String,
-    /// Side of the square camera board, mm.
-    #[schemars(extend("exclusiveMinimum" = 0))]
-    pub board_width_mm: f64,
-    /// Height of the bay under the bulkhead (board + components), mm (`square_split`); with
-    /// `round_tube`, the least height the board with its components needs between the base
-    /// and the LED PCB.
-    #[schemars(extend("exclusiveMinimum" = 0))]
-    pub bay_height_mm: f64,
-    /// Hole in the bulkhead for the lens barrel, mm.
-    #[schemars(extend("exclusiveMinimum" = 0))]
-    pub lens_hole_diameter_mm: f64,
-    /// Square pattern of the board's mounting holes, centre to centre, mm.
-    #[schemars(extend("exclusiveMinimum" = 0))]
-    pub mount_hole_spacing_mm: f64,
-    /// Pilot hole for the self-tapping mounting screws, mm.
-    #[schemars(extend("exclusiveMinimum" = 0))]
-    pub mount_pilot_diameter_mm: f64,
-}
-
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct LedPcb {
-    /// Outer diameter of the ring PCB, mm, > 0; its seat is this plus `fit_clearance_mm` on
-    /// each side and must keep the FDM minimum wall inside the shell.
-    ///
-    /// `round_tube`: the light chamber must pass it (the PCB goes in from the tube's top) and
-    /// its seat must overhang the camera bay by at least one nozzle width, the ledge it rests
-    /// on. `square_split`: above the lens hole, and the board's mounting pilots must lie
-    /// outside its seat.
-    #[schemars(extend("exclusiveMinimum" = 0))]
-    pub outer_diameter_mm: f64,
-    /// Diameter of the PCB's bore, mm, > 0: below the outer diameter and at least
-    /// `camera.lens_hole_diameter_mm`, to pass the lens barrel.
-    #[schemars(extend("exclusiveMinimum" = 0))]
-    pub inner_diameter_mm: f64,
-    /// Thickness of the PCB along the axis, mm, > 0: the height of its seat under the light
-    /// chamber.
-    #[schemars(extend("exclusiveMinimum" = 0))]
-    pub thickness_mm: f64,
-    /// LEDs on the ring, for the bought-items list and the assembly steps (R-Tac0 Sec.
-    /// III-B2: eight LUXEON 2835 white LEDs); no part's shape depends on it.
-    pub led_count: u32,
-}
-
-/// The laser-cut diffuser (R-Tac0 Sec. III-B2): a ring whose inner edge carries the core's rim.
-/// `round_tube`: a disc between the tube's top face and the collar, at most the shell's
-/// diameter; `square_split`: a ring in a seat inside the shell.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct Diffuser {
-    /// Outer diameter of the diffuser, mm, > 0: above the core's outer diameter plus twice
-    /// `fit_clearance_mm` (the core's rim rests on it) and above `light_chamber_diameter_mm`.
-    ///
-    /// `round_tube`: at most `outer_width_mm` (R-Tac0 authors' CAD, measured: 30 mm, the
-    /// shell's full diameter). `square_split`: its seat (this plus `fit_clearance_mm` on each
-    /// side) must keep the FDM minimum wall inside the shell.
-    #[schemars(extend("exclusiveMinimum" = 0))]
-    pub outer_diameter_mm: f64,
-    /// Diameter of the diffuser's opening, mm, > 0: below its outer diameter and below the
-    /// core's outer diameter, since the core's rim rests on its edge (R-Tac0 authors' CAD,
-    /// measured: 19.6 mm under the 20 mm core). The filling gel, when given, fills it.
-    #[schemars(extend("exclusiveMinimum" = 0))]
-    pub inner_diameter_mm: f64,
-    /// Thickness of the diffuser along the axis (the frosted acrylic sheet it is laser-cut
-    /// from), mm, > 0 (R-Tac0 authors' CAD, measured: 2 mm).
-    #[schemars(extend("exclusiveMinimum" = 0))]
-    pub thickness_mm: f64,
-    /// Distance from the top of the LED PCB to the diffuser, mm (R-Tac0: 10 mm).
-    #[schemars(extend("exclusiveMinimum" = 0))]
-    pub gap_above_pcb_mm: f64,
-}
-
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct JointScrew {
-    /// Diameter of the screw's clearance hole, mm, > 0: through the +x half (`square_split`)
-    /// or the base's flange (`round_tube`). It names the screw's size in the bought-items
-    /// list (R-Tac0: 2.2 mm for M2).
-    #[schemars(extend("exclusiveMinimum" = 0))]
-    pub clearance_diameter_mm: f64,
-    /// Diameter of the pilot hole the screw is driven into, mm, at least the FDM printer's
-    /// `min_hole_diameter_mm`: in the -x half (`square_split`) or up into the tube wall round
-    /// the camera bay (`round_tube`, where the wall must hold it between two FDM minimum
-    /// walls).
-    #[schemars(extend("exclusiveMinimum" = 0))]
-    pub pilot_diameter_mm: f64,
-    /// Diameter of the screw's head, mm, > 0. `square_split`: its counterbore in the +x half,
-    /// which with the clearance hole must fit between the light chamber and the outer wall
-    /// with FDM minimum walls; `round_tube`: the heads under the base's flange must stay
-    /// inside the tube's outer diameter.
-    #[schemars(extend("exclusiveMinimum" = 0))]
-    pub head_diameter_mm: f64,
-    /// Material clamped under the head, mm (`round_tube`: the thickness of the base's flange
-    /// under the tube).
-    #[schemars(extend("exclusiveMinimum" = 0))]
-    pub clamp_length_mm: f64,
-    /// Depth of the pilot hole in the other half (`round_tube`: up into the tube wall), mm.
-    #[schemars(extend("exclusiveMinimum" = 0))]
-    pub pilot_depth_mm: f64,
-}
-
 /// `$id` of the design file's JSON Schema ([`design_json_schema`]).
 pub const DESIGN_SCHEMA_ID: &str = "urn:fabkit:design";
 
@@ -724,6 +541,7 @@ impl Design {
             body: &self.body,
             printers: &self.printers,
             backing: self.backing.as_ref(),
+            core: self.core.as_ref(),
         }
     }
 }

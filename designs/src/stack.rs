@@ -255,20 +255,6 @@ fn check_materials(design: &Design, materials: &MaterialsTable, errs: &mut Vec<P
             }
         }
     }
-    if let Some(h) = &design.housing {
-        check_material(
-            "housing.material".into(),
-            &h.material,
-            &[MaterialKind::Print],
-        );
-        if let Some(f) = &h.filling_gel {
-            check_material(
-                "housing.filling_gel.material".into(),
-                &f.material,
-                &[MaterialKind::Cast],
-            );
-        }
-    }
     for f in FAMILIES {
         for (path, key, kinds) in f.materials(design) {
             check_material(path, key, kinds);
@@ -603,7 +589,8 @@ fn resolve_surfaces(
 }
 
 /// The checks that use the resolved stack: the molds', the printers', the markers', the
-/// housing's and every section family's rules, and the first held mold's fit on the core.
+/// every section family's rules (those that need no stack when it is not sound), and the first
+/// held mold's fit on the core.
 fn check_with_stack(
     design: &Design,
     layers: &[ResolvedLayer],
@@ -628,26 +615,13 @@ fn check_with_stack(
     }
     // Checks that use the core only make sense once the stack itself is sound.
     let sound_core = core.filter(|_| stack_ok);
-    if let Some(h) = &design.housing {
-        match (sound_core, stack_ok) {
-            (Some(_), _) | (None, false) => {
-                crate::housing::check_housing_params(design, h, sound_core, errs)
-            }
-            (None, true) => errs.push(ParamError::new(
-                "housing",
-                "given",
-                "the housing seats a core: give core: or remove housing:",
-            )),
-        }
-    }
-    if stack_ok && FAMILIES.iter().any(|f| f.given(design)) {
-        let st = Stack {
-            core: core.cloned(),
-            layers: layers.to_vec(),
-        };
-        for f in FAMILIES {
-            f.check(design, &st, errs);
-        }
+    // the families' rules with the sound stack, or those that need none
+    let st = stack_ok.then(|| Stack {
+        core: core.cloned(),
+        layers: layers.to_vec(),
+    });
+    for f in FAMILIES {
+        f.check(design, st.as_ref(), errs);
     }
     if let (Some(c), true) = (sound_core, errs.is_empty()) {
         if let Some(first) = layers.iter().find(|l| {

@@ -5,7 +5,7 @@
 
 use crate::profile::BodyProfile;
 use crate::schema::printers::PrinterProfiles;
-use crate::schema::shared::{Backing, LayerProcess, MoldStrategy};
+use crate::schema::shared::{Backing, Core, LayerProcess, MoldStrategy};
 use serde::Serialize;
 
 /// The parts of a design every family may read: built from a design by
@@ -20,6 +20,8 @@ pub struct Context<'a> {
     pub printers: &'a PrinterProfiles,
     /// The backing plate the skin is glued to, if any.
     pub backing: Option<&'a Backing>,
+    /// The bought core as the design gives it (its resolved offsets are in [`Stack::core`]).
+    pub core: Option<&'a Core>,
 }
 
 /// A layer with its surfaces resolved.

@@ -7,12 +7,52 @@
 //! family").
 
 use crate::error::{DesignError, ParamError};
-use crate::geometry::ChordTolerance;
+use crate::geometry::{ChordTolerance, GeometryError, Solid};
 use crate::materials::{CastReport, MaterialKind};
 use crate::parts::context::{Context, Stack};
 use crate::parts::cut_part::CutPart;
 use crate::parts::member::Member;
 use crate::parts::part::{Part, ProcedureStep};
+use crate::schema::shared::FillingGel;
+
+/// The cast name of the internal filling gel ([`FillingGel`]): poured during the assembly, not
+/// in a mold.
+pub const FILLING_GEL: &str = "filling_gel";
+
+/// The inner cavity of layer `i` of the stack, as a solid (the space inside its inner surface
+/// down to the base plane, less its marker features): what a gel poured against the layer
+/// fills. The build passes it to [`Family::filling_pour`].
+pub type InnerCavity<'a> = &'a dyn Fn(usize) -> Result<Solid, GeometryError>;
+
+/// A gel poured into the assembled sensor (the filling gel, cast [`FILLING_GEL`]).
+#[derive(Debug, Clone)]
+pub struct FillingPour<'p> {
+    /// The gel and its material.
+    pub gel: &'p FillingGel,
+    /// The volume to fill, mm^3.
+    pub volume_mm3: f64,
+    /// The roles of the kit parts it is poured into.
+    pub holder_roles: &'static [&'static str],
+    /// How it is poured, a sentence before the material's own notes.
+    pub how: &'static str,
+    /// Its member of the assembly when the family's [`Family::members`] does not give it:
+    /// placed after every family's members.
+    pub member: Option<Member>,
+}
+
+/// The swept path of one member through one printed part on its way in along the sensor
+/// axis, sensor frame, mm ([`crate::insertion`]).
+#[derive(Debug, Clone)]
+pub struct InsertionPath {
+    /// The member that moves (an assembly member's name).
+    pub member: String,
+    /// The printed part it passes (an assembly member's name).
+    pub through: String,
+    /// The member's outer cylinder from its seat up past the part's top.
+    pub solid: Solid,
+    /// The parameters that size the passage, for the error.
+    pub fix: Vec<String>,
+}
 
 /// What a family's build adds to the kit: its printable parts (print orientation, on the bed)
 /// and the entries it sets in the manifest's `summary` object, in order (a later family's
@@ -56,6 +96,11 @@ pub trait Family {
     /// `PATH.`, its value and the rule. Called once the layer stack is sound.
     fn check(p: &Self::Params, ctx: &Context<'_>, stack: &Stack, errs: &mut Vec<ParamError>);
 
+    /// Appends the violated rules of `p` that need no resolved stack, when the layer stack is
+    /// not sound (its own sizes and walls, so that one run names them with the stack's
+    /// errors); nothing by default.
+    fn check_without_stack(_p: &Self::Params, _ctx: &Context<'_>, _errs: &mut Vec<ParamError>) {}
+
     /// The family's printable parts and manifest summary entries.
     ///
     /// # Errors
@@ -78,6 +123,35 @@ pub trait Family {
         _stack: &Stack,
         _tol: ChordTolerance,
     ) -> Result<Vec<Member>, DesignError> {
+        Ok(Vec::new())
+    }
+
+    /// The gel it pours into the assembled sensor, if any. `cavity` gives the inner cavity of
+    /// a layer of the stack.
+    ///
+    /// # Errors
+    /// [`DesignError::Geometry`] naming the filling gel if the kernel fails.
+    fn filling_pour<'p>(
+        _p: &'p Self::Params,
+        _ctx: &Context<'_>,
+        _stack: &Stack,
+        _cavity: InnerCavity<'_>,
+        _tol: ChordTolerance,
+    ) -> Result<Option<FillingPour<'p>>, DesignError> {
+        Ok(None)
+    }
+
+    /// The paths its members take into its printed parts along the sensor axis, checked
+    /// against the assembly's members ([`crate::insertion::blocked`]).
+    ///
+    /// # Errors
+    /// [`DesignError::Geometry`] if the kernel fails.
+    fn insertion_paths(
+        _p: &Self::Params,
+        _ctx: &Context<'_>,
+        _stack: &Stack,
+        _tol: ChordTolerance,
+    ) -> Result<Vec<InsertionPath>, DesignError> {
         Ok(Vec::new())
     }
 

@@ -10,6 +10,7 @@ pub mod cut_part;
 pub mod family;
 pub mod fasteners;
 pub mod fingertip_base;
+pub mod housing;
 mod member;
 mod part;
 pub mod placement;

@@ -11,10 +11,10 @@ use crate::geometry::ChordTolerance;
 use crate::materials::{CastReport, MaterialKind};
 use crate::parts::context::Stack;
 use crate::parts::cut_part::CutPart;
-use crate::parts::family::{AssemblyStep, Built, Family};
+use crate::parts::family::{AssemblyStep, Built, Family, FillingPour, InnerCavity, InsertionPath};
 use crate::parts::member::Member;
 use crate::parts::part::Part;
-use crate::parts::{casing, fingertip_base, shaft_body, spacer};
+use crate::parts::{casing, fingertip_base, housing, shaft_body, spacer};
 use crate::schema::Design;
 
 /// A registered family, as the loops see it: each method does nothing (or returns nothing)
@@ -35,8 +35,30 @@ pub trait Section: Sync {
     fn cut_parts(&self, d: &Design) -> Vec<CutPart>;
     /// [`Family::pcb_outlines`].
     fn pcb_outlines(&self, d: &Design) -> Vec<CutPart>;
-    /// [`Family::check`].
-    fn check(&self, d: &Design, stack: &Stack, errs: &mut Vec<ParamError>);
+    /// [`Family::check`] with the sound stack `stack`, or [`Family::check_without_stack`]
+    /// when the stack is not sound (`None`).
+    fn check(&self, d: &Design, stack: Option<&Stack>, errs: &mut Vec<ParamError>);
+    /// [`Family::filling_pour`]; `None` without the family.
+    ///
+    /// # Errors
+    /// As [`Family::filling_pour`].
+    fn filling_pour<'d>(
+        &self,
+        d: &'d Design,
+        stack: &Stack,
+        cavity: InnerCavity<'_>,
+        tol: ChordTolerance,
+    ) -> Result<Option<FillingPour<'d>>, DesignError>;
+    /// [`Family::insertion_paths`].
+    ///
+    /// # Errors
+    /// As [`Family::insertion_paths`].
+    fn insertion_paths(
+        &self,
+        d: &Design,
+        stack: &Stack,
+        tol: ChordTolerance,
+    ) -> Result<Vec<InsertionPath>, DesignError>;
     /// [`Family::build`]; `None` without the family.
     fn build(
         &self,
@@ -104,9 +126,36 @@ impl<F: Family> Section for Registered<F> {
         (self.params)(d).map_or_else(Vec::new, F::pcb_outlines)
     }
 
-    fn check(&self, d: &Design, stack: &Stack, errs: &mut Vec<ParamError>) {
-        if let Some(p) = (self.params)(d) {
-            F::check(p, &d.context(), stack, errs);
+    fn check(&self, d: &Design, stack: Option<&Stack>, errs: &mut Vec<ParamError>) {
+        match ((self.params)(d), stack) {
+            (Some(p), Some(stack)) => F::check(p, &d.context(), stack, errs),
+            (Some(p), None) => F::check_without_stack(p, &d.context(), errs),
+            (None, _) => {}
+        }
+    }
+
+    fn filling_pour<'d>(
+        &self,
+        d: &'d Design,
+        stack: &Stack,
+        cavity: InnerCavity<'_>,
+        tol: ChordTolerance,
+    ) -> Result<Option<FillingPour<'d>>, DesignError> {
+        match (self.params)(d) {
+            Some(p) => F::filling_pour(p, &d.context(), stack, cavity, tol),
+            None => Ok(None),
+        }
+    }
+
+    fn insertion_paths(
+        &self,
+        d: &Design,
+        stack: &Stack,
+        tol: ChordTolerance,
+    ) -> Result<Vec<InsertionPath>, DesignError> {
+        match (self.params)(d) {
+            Some(p) => F::insertion_paths(p, &d.context(), stack, tol),
+            None => Ok(Vec::new()),
         }
     }
 
@@ -150,6 +199,10 @@ impl<F: Family> Section for Registered<F> {
 /// The section families, in the order their parts, summary entries, members, bought items and
 /// assembly steps appear in a kit.
 pub static FAMILIES: &[&dyn Section] = &[
+    &Registered::<housing::HousingFamily> {
+        params: |d| d.housing.as_ref(),
+        family: PhantomData,
+    },
     &Registered::<shaft_body::ShaftBodyFamily> {
         params: |d| d.shaft_body.as_ref(),
         family: PhantomData,

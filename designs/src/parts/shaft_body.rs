@@ -34,7 +34,9 @@ pub use crate::parts::bayonet::BayonetLugs;
 use crate::parts::context::Context;
 use crate::parts::context::Stack;
 use crate::parts::cut_part::{CutPart, Operation, Outline};
-use crate::parts::family::{named, AssemblyStep, Built, Family};
+use crate::parts::family::{
+    named, AssemblyStep, Built, Family, FillingPour, InnerCavity, FILLING_GEL,
+};
 use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::{ProcedureAction, ProcedureStep};
 use crate::schema::shared::{FillingGel, LayerProcess};
@@ -1185,6 +1187,41 @@ impl Family for ShaftBodyFamily {
             v.extend(crate::parts::robot_mount::bought_items(m));
         }
         v
+    }
+
+    fn filling_pour<'p>(
+        sb: &'p ShaftBodyParams,
+        ctx: &Context<'_>,
+        stack: &Stack,
+        cavity: InnerCavity<'_>,
+        tol: ChordTolerance,
+    ) -> Result<Option<FillingPour<'p>>, DesignError> {
+        // The clear gel between the skin and the lens window (Pestell et al. Sec. III-A).
+        let Some(f) = &sb.filling_gel else {
+            return Ok(None);
+        };
+        let gel = cavity(0)
+            .and_then(|c| filling_gel_solid(ctx, sb, stack, c, tol))
+            .part(FILLING_GEL)?;
+        Ok(Some(FillingPour {
+            gel: f,
+            volume_mm3: gel.volume(),
+            holder_roles: &["printed_skin", "tip_fitting"],
+            how: "Poured into the tip, pole-down, round the pins and up into the lip's opening; the lens window is then laid on (Pestell et al. Sec. III-A).",
+            member: Some(Member {
+                name: FILLING_GEL.into(),
+                kind: MemberKind::Cast,
+                description: format!(
+                    "Clear gel ({}) between the skin and the lens window, round the pins",
+                    f.material
+                ),
+                solid: gel,
+                fix: vec!["shaft_body.tip_fitting.lip_width_mm".into()],
+                // the skin's cavity less its pins and tips: nested with them by construction
+                nested_by_stack: true,
+                exact: None,
+            }),
+        }))
     }
 
     fn assembly_steps(

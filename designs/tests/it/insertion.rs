@@ -19,9 +19,12 @@ fn the_pcb_and_the_core_go_in_from_the_top_and_a_ledge_blocks_the_pcb() {
     let d = library::load("rtac0").unwrap();
     let kit = build_kit(&d, tol()).unwrap();
     let s = stack::validate(&d, &MaterialsTable::embedded().unwrap(), tol()).unwrap();
-    let lv =
-        fabkit_designs::housing::levels(&d, d.housing.as_ref().unwrap(), s.core.as_ref().unwrap());
-    let p = paths(&d, &s, Some(&lv), tol()).unwrap();
+    let lv = fabkit_designs::parts::housing::levels(
+        &d.context(),
+        d.housing.as_ref().unwrap(),
+        s.core.as_ref().unwrap(),
+    );
+    let p = paths(&d, &s, tol()).unwrap();
     let names: Vec<(&str, &str)> = p
         .iter()
         .map(|p| (p.member.as_str(), p.through.as_str()))

@@ -22,13 +22,205 @@
 //!   up against a bulkhead with the lens hole); the shell splits on the plane x = 0 into two
 //!   halves joined by two screws across it.
 
+mod family;
+pub use family::HousingFamily;
+
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{cuboid, cylinder, ChordTolerance, Solid};
+use crate::parts::context::Context;
 use crate::parts::context::{ResolvedCore, Stack};
 use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::{Part, PrintTechnology};
-use crate::schema::{Design, HousingParams, HousingStyle, RoundTube};
+use crate::schema::FillingGel;
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
 use serde_json::json;
+
+/// The two-piece sensor shell (R-Tac0 Sec. III-B4, Fig. 2): camera bay, LED ring seat,
+/// diffuser seat, contact-module seat. Two arrangements (`style`): a round tube closed by a
+/// separate base that carries the camera (the authors' CAD), or a square shell split into
+/// two halves on a plane through the axis.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct HousingParams {
+    /// Material key of the printed shell parts (printed FDM), a print material of the
+    /// materials table (R-Tac0: black PLA, `pla_black`, Sec. III-B4).
+    pub material: String,
+    /// The arrangement of the shell; `square_split` when not given.
+    #[serde(default)]
+    pub style: HousingStyle,
+    /// Side of the square shell (`square_split`) or outer diameter of the tube
+    /// (`round_tube`), mm (R-Tac0 envelope 30 x 30 x 43 mm, Sec. III-B).
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    pub outer_width_mm: f64,
+    /// The tube and its base; required with `style: round_tube`, unused otherwise.
+    #[serde(default)]
+    pub round_tube: Option<RoundTube>,
+    /// The camera board and its bay under the LED PCB (R-Tac0 Sec. III-B3).
+    pub camera: CameraBay,
+    /// `square_split`: thickness along the axis of the bulkhead between the camera bay and the
+    /// LED PCB's seat, mm, > 0; the lens hole goes through it and the board's mounting pilots
+    /// go up into it. Unused with `round_tube` (the PCB rests on the bay's ledge), but still
+    /// checked above 0.
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    pub bulkhead_thickness_mm: f64,
+    /// The LED ring PCB (bought; R-Tac0 Sec. III-B2), LEDs up, its top face
+    /// `diffuser.gap_above_pcb_mm` under the diffuser.
+    pub led_pcb: LedPcb,
+    pub diffuser: Diffuser,
+    /// Diameter of the light chamber between the LED PCB and the diffuser, mm (`round_tube`:
+    /// at least the LED PCB's seat, since the PCB goes in through it).
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    pub light_chamber_diameter_mm: f64,
+    /// Radial clearance around seated parts, mm.
+    pub fit_clearance_mm: f64,
+    /// The internal filling gel, cast into the assembled shell; none when not given.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub filling_gel: Option<FillingGel>,
+    /// The two screws that join the shell: across the parting plane along x
+    /// (`square_split`), or up through the base's flange into the tube wall (`round_tube`)
+    /// (R-Tac0 Sec. III-B4: "small bolts").
+    pub joint_screw: JointScrew,
+}
+
+/// How the sensor shell is arranged.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum HousingStyle {
+    /// A round tube (outer diameter `outer_width_mm`) holding the contact module, diffuser
+    /// and LED PCB, closed at the bottom by a separate base that carries the camera; the base
+    /// is screwed up into the tube wall (R-Tac0 authors' CAD, measured: a 30 mm tube 21.65 mm
+    /// tall; the paper, Sec. III-B3: "The camera module is secured to the sensor base").
+    RoundTube,
+    /// A square shell split on the plane x = 0 into two halves joined by two screws across it;
+    /// the camera bay is in the shell.
+    #[default]
+    SquareSplit,
+}
+
+/// The round shell (`housing.style: round_tube`), from the top down: a collar that takes the
+/// core's end below the base plane, the diffuser disc, the tube (light chamber, LED PCB, camera
+/// bay) and the base. Below the LED PCB the tube is bored out to `bay_diameter_mm`, and the PCB
+/// rests on the ledge this leaves; the light chamber above is wide enough for the PCB to go in
+/// from the tube's top. The base is a flange under the tube (as thick as
+/// `joint_screw.clamp_length_mm`) with a spigot that enters the bay; the camera board is
+/// screwed onto the spigot.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct RoundTube {
+    /// Height from the tube's bottom to the base plane (tube, diffuser and collar), mm, > 0.
+    pub height_mm: f64,
+    /// Bore of the camera bay under the LED PCB, mm; smaller than the LED PCB seat.
+    pub bay_diameter_mm: f64,
+    /// Height of the base's spigot inside the bay (the camera board rests on it), mm, > 0.
+    pub base_spigot_height_mm: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct CameraBay {
+    /// Camera module name, for the fabrication sheet.
+    pub module: String,
+    /// Side of the square camera board, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    pub board_width_mm: f64,
+    /// Height of the bay under the bulkhead (board + components), mm (`square_split`); with
+    /// `round_tube`, the least height the board with its components needs between the base
+    /// and the LED PCB.
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    pub bay_height_mm: f64,
+    /// Hole in the bulkhead for the lens barrel, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    pub lens_hole_diameter_mm: f64,
+    /// Square pattern of the board's mounting holes, centre to centre, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    pub mount_hole_spacing_mm: f64,
+    /// Pilot hole for the self-tapping mounting screws, mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    pub mount_pilot_diameter_mm: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct LedPcb {
+    /// Outer diameter of the ring PCB, mm, > 0; its seat is this plus `fit_clearance_mm` on
+    /// each side and must keep the FDM minimum wall inside the shell.
+    ///
+    /// `round_tube`: the light chamber must pass it (the PCB goes in from the tube's top) and
+    /// its seat must overhang the camera bay by at least one nozzle width, the ledge it rests
+    /// on. `square_split`: above the lens hole, and the board's mounting pilots must lie
+    /// outside its seat.
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    pub outer_diameter_mm: f64,
+    /// Diameter of the PCB's bore, mm, > 0: below the outer diameter and at least
+    /// `camera.lens_hole_diameter_mm`, to pass the lens barrel.
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    pub inner_diameter_mm: f64,
+    /// Thickness of the PCB along the axis, mm, > 0: the height of its seat under the light
+    /// chamber.
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    pub thickness_mm: f64,
+    /// LEDs on the ring, for the bought-items list and the assembly steps (R-Tac0 Sec.
+    /// III-B2: eight LUXEON 2835 white LEDs); no part's shape depends on it.
+    pub led_count: u32,
+}
+
+/// The laser-cut diffuser (R-Tac0 Sec. III-B2): a ring whose inner edge carries the core's rim.
+/// `round_tube`: a disc between the tube's top face and the collar, at most the shell's
+/// diameter; `square_split`: a ring in a seat inside the shell.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Diffuser {
+    /// Outer diameter of the diffuser, mm, > 0: above the core's outer diameter plus twice
+    /// `fit_clearance_mm` (the core's rim rests on it) and above `light_chamber_diameter_mm`.
+    ///
+    /// `round_tube`: at most `outer_width_mm` (R-Tac0 authors' CAD, measured: 30 mm, the
+    /// shell's full diameter). `square_split`: its seat (this plus `fit_clearance_mm` on each
+    /// side) must keep the FDM minimum wall inside the shell.
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    pub outer_diameter_mm: f64,
+    /// Diameter of the diffuser's opening, mm, > 0: below its outer diameter and below the
+    /// core's outer diameter, since the core's rim rests on its edge (R-Tac0 authors' CAD,
+    /// measured: 19.6 mm under the 20 mm core). The filling gel, when given, fills it.
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    pub inner_diameter_mm: f64,
+    /// Thickness of the diffuser along the axis (the frosted acrylic sheet it is laser-cut
+    /// from), mm, > 0 (R-Tac0 authors' CAD, measured: 2 mm).
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    pub thickness_mm: f64,
+    /// Distance from the top of the LED PCB to the diffuser, mm (R-Tac0: 10 mm).
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    pub gap_above_pcb_mm: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct JointScrew {
+    /// Diameter of the screw's clearance hole, mm, > 0: through the +x half (`square_split`)
+    /// or the base's flange (`round_tube`). It names the screw's size in the bought-items
+    /// list (R-Tac0: 2.2 mm for M2).
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    pub clearance_diameter_mm: f64,
+    /// Diameter of the pilot hole the screw is driven into, mm, at least the FDM printer's
+    /// `min_hole_diameter_mm`: in the -x half (`square_split`) or up into the tube wall round
+    /// the camera bay (`round_tube`, where the wall must hold it between two FDM minimum
+    /// walls).
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    pub pilot_diameter_mm: f64,
+    /// Diameter of the screw's head, mm, > 0. `square_split`: its counterbore in the +x half,
+    /// which with the clearance hole must fit between the light chamber and the outer wall
+    /// with FDM minimum walls; `round_tube`: the heads under the base's flange must stay
+    /// inside the tube's outer diameter.
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    pub head_diameter_mm: f64,
+    /// Material clamped under the head, mm (`round_tube`: the thickness of the base's flange
+    /// under the tube).
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    pub clamp_length_mm: f64,
+    /// Depth of the pilot hole in the other half (`round_tube`: up into the tube wall), mm.
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    pub pilot_depth_mm: f64,
+}
 
 /// z levels of the shell, sensor frame, mm (bottom to top).
 #[derive(Debug, Clone, serde::Serialize)]
@@ -56,8 +248,8 @@ pub struct ShellLevels {
 
 /// The shell's z levels for `design` with its housing `h` and resolved core (sensor frame, mm):
 /// what fixtures that hold the sensor (the pin dome's holder ring) are sized from.
-pub fn levels(design: &Design, h: &HousingParams, core: &ResolvedCore) -> ShellLevels {
-    let top = design.body.base_z_mm();
+pub fn levels(ctx: &Context<'_>, h: &HousingParams, core: &ResolvedCore) -> ShellLevels {
+    let top = ctx.body.base_z_mm();
     let seat = top - core.below_base_mm;
     let diffuser = seat - h.diffuser.thickness_mm;
     let chamber = diffuser - h.diffuser.gap_above_pcb_mm;
@@ -87,7 +279,7 @@ pub fn levels(design: &Design, h: &HousingParams, core: &ResolvedCore) -> ShellL
         top_z_mm: top,
         tube_bottom_z_mm: tube_bottom,
         base_top_z_mm: base_top,
-        envelope_height_mm: design.body.pole_z_mm(0.0) - bottom,
+        envelope_height_mm: ctx.body.pole_z_mm(0.0) - bottom,
     }
 }
 
@@ -111,13 +303,13 @@ pub fn round_screw_radius_mm(h: &HousingParams, t: &RoundTube) -> f64 {
 
 /// y position of the joint screws (they run along x across the parting plane): centred
 /// between the clearance hole's wall to the light chamber and the head's wall to the outside.
-fn screw_y_mm(design: &Design, h: &HousingParams) -> f64 {
-    let (lo, hi) = screw_y_range(design, h);
+fn screw_y_mm(ctx: &Context<'_>, h: &HousingParams) -> f64 {
+    let (lo, hi) = screw_y_range(ctx, h);
     0.5 * (lo + hi)
 }
 
-fn screw_y_range(design: &Design, h: &HousingParams) -> (f64, f64) {
-    let m = design.printers.fdm.min_wall_mm;
+fn screw_y_range(ctx: &Context<'_>, h: &HousingParams) -> (f64, f64) {
+    let m = ctx.printers.fdm.min_wall_mm;
     (
         h.light_chamber_diameter_mm / 2.0 + h.joint_screw.clearance_diameter_mm / 2.0 + m,
         h.outer_width_mm / 2.0 - h.joint_screw.head_diameter_mm / 2.0 - m,
@@ -161,7 +353,7 @@ pub fn fixture_dowel_holes(h: &HousingParams) -> Option<FixtureDowelHoles> {
 
 /// Rules on the housing: parts fit inside each other and the walls print.
 pub fn check_housing_params(
-    design: &Design,
+    ctx: &Context<'_>,
     h: &HousingParams,
     core: Option<&ResolvedCore>,
     errs: &mut Vec<ParamError>,
@@ -176,14 +368,14 @@ pub fn check_housing_params(
         h.led_pcb.inner_diameter_mm,
         errs,
     );
-    check_housing_walls(design, h, errs);
-    check_housing_seats(design, h, errs);
+    check_housing_walls(ctx, h, errs);
+    check_housing_seats(ctx, h, errs);
     match h.style {
-        HousingStyle::SquareSplit => check_square_split(design, h, errs),
-        HousingStyle::RoundTube => check_round_tube(design, h, core, errs),
+        HousingStyle::SquareSplit => check_square_split(ctx, h, errs),
+        HousingStyle::RoundTube => check_round_tube(ctx, h, core, errs),
     }
     if let Some(core) = core {
-        check_housing_core(design, h, core, errs);
+        check_housing_core(ctx, h, core, errs);
     }
 }
 
@@ -269,8 +461,8 @@ fn check_housing_sizes(h: &HousingParams, errs: &mut Vec<ParamError>) -> bool {
 /// nozzle width, the minimum wall of printer profile `fdm` beside the camera bay and around the
 /// LED PCB and diffuser seats (or, for the round tube, the diffuser no wider than the shell),
 /// and the fixture dowel holes clear of the skin's footprint.
-fn check_housing_walls(design: &Design, h: &HousingParams, errs: &mut Vec<ParamError>) {
-    let fdm = &design.printers.fdm;
+fn check_housing_walls(ctx: &Context<'_>, h: &HousingParams, errs: &mut Vec<ParamError>) {
+    let fdm = &ctx.printers.fdm;
     let half = h.outer_width_mm / 2.0;
     let c = h.fit_clearance_mm;
     let wall = |errs: &mut Vec<ParamError>, path: &str, value: f64, room: f64, what: &str| {
@@ -331,7 +523,7 @@ fn check_housing_walls(design: &Design, h: &HousingParams, errs: &mut Vec<ParamE
     }
     if let Some(dowels) = fixture_dowel_holes(h) {
         let [dx, dy] = dowels.positions_xy_mm[0];
-        let skin_r = design.body.rim_radius_mm(0.0);
+        let skin_r = ctx.body.rim_radius_mm(0.0);
         if (dx * dx + dy * dy).sqrt() - dowels.diameter_mm / 2.0 < skin_r + c {
             errs.push(ParamError::new(
                 "housing.outer_width_mm",
@@ -348,8 +540,8 @@ fn check_housing_walls(design: &Design, h: &HousingParams, errs: &mut Vec<ParamE
 /// the LED PCB, the LED PCB's bore passing the lens barrel, inner diameters below outer ones,
 /// the camera's mounting holes on its board, and the printed pilot holes at least the minimum
 /// hole of printer profile `fdm`.
-fn check_housing_seats(design: &Design, h: &HousingParams, errs: &mut Vec<ParamError>) {
-    let fdm = &design.printers.fdm;
+fn check_housing_seats(ctx: &Context<'_>, h: &HousingParams, errs: &mut Vec<ParamError>) {
+    let fdm = &ctx.printers.fdm;
     let ledge =
         |errs: &mut Vec<ParamError>, path: &str, v: f64, inner: f64, outer: f64, what: &str| {
             if inner >= outer {
@@ -444,8 +636,8 @@ fn check_housing_seats(design: &Design, h: &HousingParams, errs: &mut Vec<ParamE
 /// Rules on the split square shell (`housing.style: square_split`): the camera's mounting
 /// pilots beside the LED PCB seat, and the joint screws (along x beside the light chamber) with
 /// their counterbores and pilots inside the shell and under the diffuser.
-fn check_square_split(design: &Design, h: &HousingParams, errs: &mut Vec<ParamError>) {
-    let fdm = &design.printers.fdm;
+fn check_square_split(ctx: &Context<'_>, h: &HousingParams, errs: &mut Vec<ParamError>) {
+    let fdm = &ctx.printers.fdm;
     let half = h.outer_width_mm / 2.0;
     let c = h.fit_clearance_mm;
     // Mount pilots stay in solid material beside the PCB seat and inside the outer wall.
@@ -460,7 +652,7 @@ fn check_square_split(design: &Design, h: &HousingParams, errs: &mut Vec<ParamEr
         ));
     }
     // Joint screws run along x at y = +-screw_y beside the light chamber.
-    let (lo, hi) = screw_y_range(design, h);
+    let (lo, hi) = screw_y_range(ctx, h);
     if lo > hi {
         errs.push(ParamError::new(
             "housing.joint_screw.head_diameter_mm",
@@ -504,15 +696,15 @@ fn check_square_split(design: &Design, h: &HousingParams, errs: &mut Vec<ParamEr
 /// shell fitting around the core, a hollow core for `housing.filling_gel`, and the core reaching
 /// at least 1 mm below the base plane.
 fn check_housing_core(
-    design: &Design,
+    ctx: &Context<'_>,
     h: &HousingParams,
     core: &ResolvedCore,
     errs: &mut Vec<ParamError>,
 ) {
-    let fdm = &design.printers.fdm;
+    let fdm = &ctx.printers.fdm;
     let half = h.outer_width_mm / 2.0;
     let c = h.fit_clearance_mm;
-    let r_core = design.body.rim_radius_mm(core.outer_offset_mm);
+    let r_core = ctx.body.rim_radius_mm(core.outer_offset_mm);
     if r_core + c >= h.diffuser.outer_diameter_mm / 2.0 {
         errs.push(ParamError::new(
             "housing.diffuser.outer_diameter_mm",
@@ -534,7 +726,7 @@ fn check_housing_core(
             "does not fit around the core",
         ));
     }
-    if h.filling_gel.is_some() && !design.body.offset_is_valid(core.inner_offset_mm) {
+    if h.filling_gel.is_some() && !ctx.body.offset_is_valid(core.inner_offset_mm) {
         errs.push(ParamError::new(
             "housing.filling_gel",
             "given",
@@ -544,7 +736,7 @@ fn check_housing_core(
     if core.below_base_mm < 1.0 {
         errs.push(ParamError::new(
             "core.length_mm",
-            design.core.as_ref().map_or(0.0, |c| c.length_mm),
+            ctx.core.map_or(0.0, |c| c.length_mm),
             "the core must reach at least 1 mm below the base plane to seat in the housing",
         ));
     }
@@ -552,7 +744,7 @@ fn check_housing_core(
 
 /// Rules on the round tube and its base (`housing.style: round_tube`).
 fn check_round_tube(
-    design: &Design,
+    ctx: &Context<'_>,
     h: &HousingParams,
     core: Option<&ResolvedCore>,
     errs: &mut Vec<ParamError>,
@@ -581,8 +773,8 @@ fn check_round_tube(
     if errs.len() > before {
         return;
     }
-    check_round_tube_bay(design, h, t, errs);
-    check_round_tube_heights(design, h, t, core, errs);
+    check_round_tube_bay(ctx, h, t, errs);
+    check_round_tube_heights(ctx, h, t, core, errs);
 }
 
 /// Rules on the camera bay of the round tube `t` (`housing.round_tube`): the ledge under the
@@ -590,12 +782,12 @@ fn check_round_tube(
 /// joint screw pilots, the camera board in the bay, and its mounting holes on the base's
 /// spigot clear of the cable slot.
 fn check_round_tube_bay(
-    design: &Design,
+    ctx: &Context<'_>,
     h: &HousingParams,
     t: &RoundTube,
     errs: &mut Vec<ParamError>,
 ) {
-    let fdm = &design.printers.fdm;
+    let fdm = &ctx.printers.fdm;
     let c = h.fit_clearance_mm;
     let r_out = h.outer_width_mm / 2.0;
     let r_bay = t.bay_diameter_mm / 2.0;
@@ -675,13 +867,13 @@ fn check_round_tube_bay(
 /// light chamber and the tube's top face, room in the base's spigot for the camera board's
 /// pilot holes, and (with a core) a camera bay between the spigot and the LED PCB.
 fn check_round_tube_heights(
-    design: &Design,
+    ctx: &Context<'_>,
     h: &HousingParams,
     t: &RoundTube,
     core: Option<&ResolvedCore>,
     errs: &mut Vec<ParamError>,
 ) {
-    let fdm = &design.printers.fdm;
+    let fdm = &ctx.printers.fdm;
     let r_out = h.outer_width_mm / 2.0;
     let js = &h.joint_screw;
     let r_js = round_screw_radius_mm(h, t);
@@ -769,16 +961,16 @@ fn check_round_tube_heights(
 /// [`DesignError::Params`] when the design has no core to seat, [`DesignError::Geometry`]
 /// if the kernel fails.
 pub fn build_shell(
-    design: &Design,
+    ctx: &Context<'_>,
     h: &HousingParams,
     stack: &Stack,
     tol: ChordTolerance,
 ) -> Result<(Vec<Part>, ShellLevels), DesignError> {
-    build_shell_parts(design, h, stack, tol).map_err(|e| e.from_params(&["housing".to_string()]))
+    build_shell_parts(ctx, h, stack, tol).map_err(|e| e.from_params(&["housing".to_string()]))
 }
 
 fn build_shell_parts(
-    design: &Design,
+    ctx: &Context<'_>,
     h: &HousingParams,
     stack: &Stack,
     tol: ChordTolerance,
@@ -790,9 +982,9 @@ fn build_shell_parts(
             "the housing seats a core",
         )]))
     })?;
-    let lv = levels(design, h, core);
+    let lv = levels(ctx, h, core);
     match (h.style, &h.round_tube) {
-        (HousingStyle::RoundTube, Some(t)) => build_round_tube(design, h, t, core, lv, tol),
+        (HousingStyle::RoundTube, Some(t)) => build_round_tube(ctx, h, t, core, lv, tol),
         (HousingStyle::RoundTube, None) => {
             Err(DesignError::Params(crate::error::ParamErrors(vec![
                 ParamError::new(
@@ -802,7 +994,7 @@ fn build_shell_parts(
                 ),
             ])))
         }
-        (HousingStyle::SquareSplit, _) => build_square_split(design, h, core, lv, tol),
+        (HousingStyle::SquareSplit, _) => build_square_split(ctx, h, core, lv, tol),
     }
 }
 
@@ -842,7 +1034,7 @@ fn upper_bores(
 
 /// The round tube and its base (see the module docs).
 fn build_round_tube(
-    design: &Design,
+    ctx: &Context<'_>,
     h: &HousingParams,
     t: &RoundTube,
     core: &ResolvedCore,
@@ -851,11 +1043,11 @@ fn build_round_tube(
 ) -> Result<(Vec<Part>, ShellLevels), DesignError> {
     let r_out = h.outer_width_mm / 2.0;
     let c = h.fit_clearance_mm;
-    let r_core = design.body.rim_radius_mm(core.outer_offset_mm);
+    let r_core = ctx.body.rim_radius_mm(core.outer_offset_mm);
     let r_bay = t.bay_diameter_mm / 2.0;
     let tube_bottom = lv.tube_bottom_z_mm.unwrap_or(lv.bottom_z_mm);
     let base_top = lv.base_top_z_mm.unwrap_or(tube_bottom);
-    let fdm = &design.printers.fdm;
+    let fdm = &ctx.printers.fdm;
     let cyl =
         |r: f64, z0: f64, z1: f64| cylinder(z1 - z0, r, tol).map(|s| s.translate([0.0, 0.0, z0]));
     let e = 0.01;
@@ -993,7 +1185,7 @@ fn build_round_tube(
 
 /// The two square halves (see the module docs).
 fn build_square_split(
-    design: &Design,
+    ctx: &Context<'_>,
     h: &HousingParams,
     core: &ResolvedCore,
     lv: ShellLevels,
@@ -1001,7 +1193,7 @@ fn build_square_split(
 ) -> Result<(Vec<Part>, ShellLevels), DesignError> {
     let w = h.outer_width_mm / 2.0;
     let c = h.fit_clearance_mm;
-    let r_core = design.body.rim_radius_mm(core.outer_offset_mm);
+    let r_core = ctx.body.rim_radius_mm(core.outer_offset_mm);
     let g = |r: Result<Solid, _>| r.part("shell");
     let shell = g(cuboid([-w, -w, lv.bottom_z_mm], [w, w, lv.top_z_mm]))?;
     let bw = h.camera.board_width_mm / 2.0 + c;
@@ -1035,7 +1227,7 @@ fn build_square_split(
     }
     // Joint screws along x: counterbore and clearance in the +x half, pilot in the -x half.
     let js = &h.joint_screw;
-    let y = screw_y_mm(design, h);
+    let y = screw_y_mm(ctx, h);
     let z = 0.5 * (lv.chamber_z_mm + lv.diffuser_z_mm);
     let along_x = |r: f64, x0: f64, x1: f64| {
         cylinder(x1 - x0, r, tol).map(|p| p.rotate_deg(0.0, 90.0, 0.0).translate([x0, 0.0, 0.0]))
@@ -1122,13 +1314,13 @@ fn build_square_split(
 /// LED PCB's face, closed on the axis. The core's inner surface is tessellated as the core's
 /// own (`tol` halved, as in the assembly), so the two share it.
 pub fn filling_gel_profile(
-    design: &Design,
+    ctx: &Context<'_>,
     h: &HousingParams,
     core: &ResolvedCore,
     lv: &ShellLevels,
     tol: ChordTolerance,
 ) -> crate::geometry::Polyline2 {
-    let mut pl = design
+    let mut pl = ctx
         .body
         .offset_polyline(core.inner_offset_mm, core.below_base_mm, tol.half());
     let (r_open, r_chamber) = (
@@ -1152,14 +1344,13 @@ pub fn filling_gel_profile(
 /// chamber. LEDs and wires inside the chamber are not subtracted (about 60 mm^3 for eight
 /// 2835 LEDs, covered by the pour's waste allowance).
 pub fn filling_gel_volume_mm3(
-    design: &Design,
+    ctx: &Context<'_>,
     h: &HousingParams,
     core: &ResolvedCore,
     lv: &ShellLevels,
 ) -> f64 {
     let disc = |d: f64, height: f64| std::f64::consts::PI * d * d / 4.0 * height;
-    design
-        .body
+    ctx.body
         .analytic_solid_volume_mm3(core.inner_offset_mm, core.below_base_mm)
         + disc(
             h.diffuser.inner_diameter_mm,
