@@ -147,7 +147,9 @@ fn push_cast_layers(
         .collect();
     let solids = cast
         .par_iter()
-        .map(|&i| crate::layers::layer_solid(design, stack, i, tol).part(&stack.layers[i].name))
+        .map(|&i| {
+            crate::parts::layers::layer_solid(design, stack, i, tol).part(&stack.layers[i].name)
+        })
         .collect::<Result<Vec<_>, _>>()?;
     for (&i, solid) in cast.iter().zip(solids) {
         let l = &stack.layers[i];
@@ -159,7 +161,7 @@ fn push_cast_layers(
             fix: vec![format!("layers[{i}]")],
             nested_by_stack: design.layers[i].markers.is_empty(),
             exact: Some(ExactShape::Layer {
-                params: crate::layers::layer_twin_params(design, stack, i, tol),
+                params: crate::parts::layers::layer_twin_params(design, stack, i, tol),
             }),
         });
     }

@@ -7,7 +7,7 @@ use crate::error::{DesignError, GeometryContext};
 use crate::geometry::ChordTolerance;
 use crate::kit::Kit;
 use crate::materials::{pour, MaterialsTable};
-use crate::molds::{build_mold, cast_plans};
+use crate::parts::molds::{build_mold, cast_plans};
 use crate::parts::registry::FAMILIES;
 use crate::schema::{Design, LayerProcess, MoldStrategy};
 use crate::stack::{validate, Stack};
@@ -30,7 +30,7 @@ pub fn build_kit(design: &Design, tol: ChordTolerance) -> Result<Kit, DesignErro
 
 /// Validates `design` as `fabkit validate` does and returns its resolved layer stack: for a
 /// curved skin the [`Stack`] ([`crate::stack::validate`]) as JSON, for a flat skin
-/// `{"flat_layers": [...]}` ([`crate::flat::validate`]); mm, inner to outer.
+/// `{"flat_layers": [...]}` ([`crate::parts::flat::validate`]); mm, inner to outer.
 ///
 /// # Errors
 /// [`DesignError::Params`] with every violated rule at once (parameter path, value, rule);
@@ -41,7 +41,7 @@ pub fn validate_design(
 ) -> Result<serde_json::Value, DesignError> {
     let materials = MaterialsTable::embedded().map_err(DesignError::Yaml)?;
     if design.body.flat_outline().is_some() {
-        let layers = crate::flat::validate(design, &materials)?;
+        let layers = crate::parts::flat::validate(design, &materials)?;
         Ok(json!({ "flat_layers": layers }))
     } else {
         let stack = validate(design, &materials, tol)?;
@@ -75,7 +75,7 @@ pub fn build_kit_bounded(
     // Casts and the families' parts are independent: build them in parallel. Each build is
     // single-threaded and the results are collected in order, so the output does not depend
     // on the thread count.
-    // Layers built by crate::layers: printed layers and the open / boundary strategies.
+    // Layers built by crate::parts::layers: printed layers and the open / boundary strategies.
     let other: Vec<usize> = stack
         .layers
         .iter()
@@ -105,7 +105,7 @@ pub fn build_kit_bounded(
                 || {
                     other
                         .par_iter()
-                        .map(|&i| crate::layers::build_layer(design, &stack, i, tol))
+                        .map(|&i| crate::parts::layers::build_layer(design, &stack, i, tol))
                         .collect::<Vec<_>>()
                 },
             )
@@ -190,7 +190,7 @@ type SiliconePour = (String, f64, Vec<String>);
 /// sprayed layers on its mold.
 type GelPour = (usize, String, String, f64, Vec<String>, Vec<usize>);
 
-/// The outputs of the layers built by `crate::layers` (`other`, by layer index) and of the
+/// The outputs of the layers built by `crate::parts::layers` (`other`, by layer index) and of the
 /// held molds (`held`, by cast plan), in that order: their parts, silicone pours and gel pours
 /// appended to `into`; the layers' marker summaries.
 ///
@@ -199,10 +199,10 @@ type GelPour = (usize, String, String, f64, Vec<String>, Vec<usize>);
 #[allow(clippy::type_complexity)]
 fn gather_layer_outputs(
     other: &[usize],
-    others: Vec<Result<crate::layers::LayerOutput, DesignError>>,
-    held: &[crate::molds::CastPlan],
-    molds: Vec<Result<crate::molds::MoldOutput, DesignError>>,
-    plans: &[crate::molds::CastPlan],
+    others: Vec<Result<crate::parts::layers::LayerOutput, DesignError>>,
+    held: &[crate::parts::molds::CastPlan],
+    molds: Vec<Result<crate::parts::molds::MoldOutput, DesignError>>,
+    plans: &[crate::parts::molds::CastPlan],
     stack: &Stack,
     (parts, silicone, gel): (
         &mut Vec<crate::Part>,
@@ -345,7 +345,7 @@ fn filling_gel_pours(
     tol: ChordTolerance,
 ) -> Result<Vec<crate::parts::Member>, DesignError> {
     let waste = design.casting.waste_allowance;
-    let cavity = |i: usize| crate::layers::inner_cavity(design, stack, i, tol);
+    let cavity = |i: usize| crate::parts::layers::inner_cavity(design, stack, i, tol);
     let mut members = Vec::new();
     for f in FAMILIES {
         let Some(pour) = f.filling_pour(design, stack, &cavity, tol)? else {

@@ -9,8 +9,8 @@
 
 use crate::error::DesignError;
 use crate::geometry::ChordTolerance;
-use crate::layers::count_layer_markers;
 use crate::parts::context::Stack;
+use crate::parts::layers::count_layer_markers;
 use crate::parts::registry::FAMILIES;
 use crate::schema::Design;
 

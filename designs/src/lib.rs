@@ -21,18 +21,14 @@ pub mod build;
 pub mod cut;
 pub mod error;
 pub mod estimate;
-pub mod flat;
 pub mod geometry;
 pub mod glyphs;
 pub mod input_files;
 pub mod insertion;
 pub mod kit;
-pub mod lasercut;
-pub mod layers;
 pub mod library;
 pub mod markers;
 pub mod materials;
-pub mod molds;
 pub mod parts;
 pub mod primitives;
 pub mod procedure;
@@ -42,6 +38,9 @@ pub mod stack;
 pub mod sweep;
 pub mod values;
 pub mod yaml;
+
+/// The layer stack's part families, at their older paths.
+pub use parts::{flat, lasercut, layers, molds};
 
 pub use build::{build_kit, build_kit_bounded, validate_design};
 pub use error::{DesignError, ParamError, ParamErrors};

@@ -432,7 +432,8 @@ fn mold_star_steps(out: &mut Vec<ProcedureStep>, design: &Design, parts: &[Part]
             .bounding_box()
             .map(|bb| bb.max[2] - bb.min[2])
             .unwrap_or(0.0);
-        let fill = height - crate::molds::BOX_FLOOR_MM - crate::molds::BOX_FREEBOARD_MM;
+        let fill =
+            height - crate::parts::molds::BOX_FLOOR_MM - crate::parts::molds::BOX_FREEBOARD_MM;
         out.push(step(
             A::FillMoldStar,
             format!(
@@ -440,7 +441,7 @@ fn mold_star_steps(out: &mut Vec<ProcedureStep>, design: &Design, parts: &[Part]
                  it, up to {fill:.1} mm above the box floor: {:.1} mm over the master's top, \
                  {:.1} mm below the rim.",
                 design.mold.silicone_wall_mm,
-                crate::molds::BOX_FREEBOARD_MM
+                crate::parts::molds::BOX_FREEBOARD_MM
             ),
         ));
         out.push(step(

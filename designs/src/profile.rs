@@ -38,7 +38,7 @@ pub enum BodyProfile {
     HalfEllipsoid { diameter_mm: f64, height_mm: f64 },
     /// A flat skin (Soter et al. Sec. II-A; GelSight, DIGIT): a rounded rectangle
     /// `width_mm` (x) by `length_mm` (y), corners rounded to `corner_radius_mm`, its contact
-    /// face `thickness_mm` above the base plane z = 0 ([`crate::flat`]). Offsets move the face
+    /// face `thickness_mm` above the base plane z = 0 ([`crate::parts::flat`]). Offsets move the face
     /// along z; the (r, z) forms below give its section through the x axis.
     Flat {
         width_mm: f64,

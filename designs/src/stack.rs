@@ -97,7 +97,7 @@ pub fn validate(
 }
 
 /// The design's name, whether its body is one this validation handles (flat skins have their
-/// own, [`crate::flat::validate`]), the body's own rules, and the flat-skin-only keys.
+/// own, [`crate::parts::flat::validate`]), the body's own rules, and the flat-skin-only keys.
 ///
 /// # Errors
 /// The one error of a flat body, alone.
@@ -598,10 +598,10 @@ fn check_with_stack(
     stack_ok: bool,
     errs: &mut Vec<ParamError>,
 ) {
-    crate::molds::check_mold_params(design, errs);
+    crate::parts::molds::check_mold_params(design, errs);
     check_printers(&design.printers, errs);
     if stack_ok {
-        crate::layers::check_markers(design, layers, errs);
+        crate::parts::layers::check_markers(design, layers, errs);
         let two_piece_rim = layers
             .iter()
             .filter(|l| {
@@ -610,7 +610,7 @@ fn check_with_stack(
             .map(|l| design.body.rim_radius_mm(l.outer_offset_mm))
             .fold(None, |a: Option<f64>, r| Some(a.map_or(r, |a| a.max(r))));
         if let Some(rim) = two_piece_rim {
-            crate::molds::check_two_piece(design, rim, errs);
+            crate::parts::molds::check_two_piece(design, rim, errs);
         }
     }
     // Checks that use the core only make sense once the stack itself is sound.
@@ -628,7 +628,7 @@ fn check_with_stack(
             l.process == LayerProcess::Cast
                 && matches!(l.mold_strategy, MoldStrategy::Direct | MoldStrategy::Master)
         }) {
-            crate::molds::check_mold_fit(design, c, first.outer_offset_mm, errs);
+            crate::parts::molds::check_mold_fit(design, c, first.outer_offset_mm, errs);
         }
     }
 }

@@ -1,16 +1,16 @@
 //! The kit of a flat skin (Soter et al. Sec. II-A): a casting tray per layer (printed, or
 //! stacked from laser-cut sheets), the pours, the channels' tubes and liquid, the procedure.
-//! Its layers' rules and solids are the flat family's ([`crate::flat`]).
+//! Its layers' rules and solids are the flat family's ([`crate::parts::flat`]).
 
 use crate::error::{DesignError, GeometryContext as _};
-use crate::flat::{
-    estimated_triangles, layer_solid, tray_solid, validate, ChannelEnds, ChannelSet, FlatLayer,
-    FlatOutline,
-};
 use crate::geometry::ChordTolerance;
 use crate::kit::Kit;
 use crate::materials::{CastReport, MaterialsTable};
 use crate::parts::cut_part::CutPart;
+use crate::parts::flat::{
+    estimated_triangles, layer_solid, tray_solid, validate, ChannelEnds, ChannelSet, FlatLayer,
+    FlatOutline,
+};
 use crate::parts::{Member, MemberKind, Part, PrintTechnology, ProcedureAction, ProcedureStep};
 use crate::schema::{Design, LaserCutParams};
 
@@ -133,11 +133,11 @@ fn layer_tray(
     // on the base sheet (and the marker sheet)
     let (tray, floor, sheets) = match laser {
         Some(lc) => {
-            let sheets = crate::lasercut::tray_sheets(outline, l, i, wall, lc, tol)
+            let sheets = crate::parts::lasercut::tray_sheets(outline, l, i, wall, lc, tol)
                 .map_err(|e| DesignError::Params(crate::ParamErrors(e)))?;
             for s in &sheets {
                 cut_parts.push(
-                    crate::lasercut::cut_part(
+                    crate::parts::lasercut::cut_part(
                         s,
                         &format!("{} tray, sheet {}: {}", l.name, s.name, s.role),
                         tol,
@@ -151,7 +151,7 @@ fn layer_tray(
                 .map(|s| s.level_mm())
                 .sum::<f64>();
             (
-                crate::lasercut::tray_union(&sheets).part(&name)?,
+                crate::parts::lasercut::tray_union(&sheets).part(&name)?,
                 floor,
                 Some(sheets),
             )
@@ -202,7 +202,7 @@ fn layer_tray(
             "Open tray of layer {} ({t:.2} mm deep{what}); pour to the brim and scrape level{made}",
             l.name
         ),
-        material: crate::molds::material_for(tech).into(),
+        material: crate::parts::molds::material_for(tech).into(),
         print_technology: tech,
         solid: tray,
         params: serde_json::json!({
@@ -212,7 +212,7 @@ fn layer_tray(
             "laser_cut": sheets.as_ref().map(|sh| serde_json::json!({
                 "sheets": sh.iter().map(|s| serde_json::json!({"name": s.name, "role": s.role, "stock": s.stock,
                     "quantity": s.quantity, "z0_mm": s.z0_mm, "level_mm": s.level_mm(), "area_mm2": s.region.area_mm2()})).collect::<Vec<_>>(),
-                "registration_xy_mm": crate::lasercut::registration_xy_mm(outline, wall),
+                "registration_xy_mm": crate::parts::lasercut::registration_xy_mm(outline, wall),
                 "registration_diameter_mm": laser.map(|lc| lc.registration.diameter_mm),
                 "markers": "flat-ended, straight through their sheet",
             })),

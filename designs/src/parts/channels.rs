@@ -1,7 +1,7 @@
 //! The liquid channels and the marker grid of a flat skin's layer (Soter et al., Sec. II-A:
 //! 16 liquid-filled channels in the top layer, a 10 x 10 grid of markers on the bottom layer):
 //! their parameters (`layers[i].channels`, `layers[i].marker_grid`), rules and solids, in the
-//! flat-skin frame of [`crate::flat`] (docs/conventions.md, flat skins).
+//! flat-skin frame of [`crate::parts::flat`] (docs/conventions.md, flat skins).
 
 use crate::error::ParamError;
 use crate::markers::{FeatureShape, Polarity};

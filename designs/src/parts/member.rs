@@ -52,7 +52,7 @@ pub struct Member {
 pub enum ExactShape {
     /// A cast or sprayed layer: the same parameters as its printed or molded parts carry
     /// (`layer`, `body`, `outer_offset_mm`, `inner_offset_mm`, `solid`, `markers`, see
-    /// [`crate::layers::layer_twin_params`]), built exactly by the twin.
+    /// [`crate::parts::layers::layer_twin_params`]), built exactly by the twin.
     Layer { params: serde_json::Value },
     /// The solid of revolution about z of a closed (r, z) polygon, mm (r >= 0): exact for the
     /// polygon (planes, cylinders, cones), which itself lies within half the chord tolerance

@@ -4,11 +4,11 @@
 
 use crate::build::build_kit;
 use crate::kit::{Kit, PrintTechnology};
-use crate::layers::{
-    feature_end_centres, place_layer_markers, recess_clearance_to_base_mm, PlacedMarkers,
-};
 use crate::markers::{nearest_neighbours, MarkerSurface, Polarity};
 use crate::materials::MaterialsTable;
+use crate::parts::layers::{
+    feature_end_centres, place_layer_markers, recess_clearance_to_base_mm, PlacedMarkers,
+};
 use crate::schema::{Design, LayerProcess, Technology};
 use crate::stack::{validate, ResolvedLayer, Stack};
 use crate::{ChordTolerance, DesignError};

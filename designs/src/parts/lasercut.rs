@@ -20,10 +20,77 @@
 
 use crate::cut::{ring_area_mm2, CutPart, Operation, Outline};
 use crate::error::ParamError;
-use crate::flat::{FlatLayer, FlatOutline};
 use crate::geometry::{extrude, ChordTolerance, GeometryError, Solid};
-use crate::schema::{LaserCutParams, SheetStock};
-use serde::Serialize;
+use crate::parts::flat::{FlatLayer, FlatOutline};
+
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+/// Laser-cut molds of a flat skin (Soter et al. Sec. II-A: the molds are laser-cut): the sheet
+/// stock and the registration holes that align a stack of sheets.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct LaserCutParams {
+    /// The sheet stock, in the order fabkit picks from: each level of a tray is made of the
+    /// first stock whose thickness, taken 1 to 8 times, equals the level's; the base sheet is
+    /// the first stock.
+    #[schemars(extend("minItems" = 1))]
+    pub stock: Vec<SheetStock>,
+    /// Dowel holes through every sheet of a stack, one in each corner of the tray's wall.
+    pub registration: SheetRegistration,
+}
+defaults!(LaserCutParams {
+    stock: vec![
+        SheetStock {
+            name: "acrylic_3mm".into(),
+            material: "pmma".into(),
+            thickness_mm: 3.0,
+            kerf_mm: 0.15,
+        },
+        SheetStock {
+            name: "acrylic_2mm".into(),
+            material: "pmma".into(),
+            thickness_mm: 2.0,
+            kerf_mm: 0.12,
+        },
+        SheetStock {
+            name: "acrylic_1_5mm".into(),
+            material: "pmma".into(),
+            thickness_mm: 1.5,
+            kerf_mm: 0.1,
+        },
+    ],
+    registration: SheetRegistration::default(),
+});
+
+/// One sheet material profile: what the sheet is and what the laser takes out of it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct SheetStock {
+    /// `[a-z0-9_]+`, for file names and the bill of materials.
+    #[schemars(extend("pattern" = "^[a-z0-9_]+$", "maxLength" = 64))]
+    pub name: String,
+    /// Material key in the materials table (designs/materials.yaml).
+    pub material: String,
+    /// Thickness of the sheet, mm, above 0 and at most 25 (a laser cutter's sheet). Every
+    /// level of a tray is 1 to 8 sheets of the first stock whose thickness makes it; the
+    /// tray's base sheet is one sheet of the first stock.
+    #[schemars(extend("exclusiveMinimum" = 0, "maximum" = 25))]
+    pub thickness_mm: f64,
+    /// Width of the laser's cut in this sheet, mm: every path is offset by half of it.
+    #[schemars(extend("minimum" = 0, "exclusiveMaximum" = 2))]
+    pub kerf_mm: f64,
+}
+
+/// Registration (dowel) holes through a stack of sheets.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct SheetRegistration {
+    /// Hole diameter, mm (a dowel pin of this diameter, a sliding fit after the kerf).
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    pub diameter_mm: f64,
+}
+defaults!(SheetRegistration { diameter_mm: 3.0 });
 
 /// Most sheets of one stock a level may take.
 pub const MAX_SHEETS_PER_LEVEL: u32 = 8;

@@ -1057,7 +1057,7 @@ fn build_open_mold_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
 }
 
 /// The two-piece open mold of a solid cast layer (`two_piece_open` strategy, frame
-/// [`crate::molds::TwoPieceFrame`]). Builds its solids: the cavity block (the outline from the
+/// [`crate::parts::molds::TwoPieceFrame`]). Builds its solids: the cavity block (the outline from the
 /// parting face to `mold.wall_thickness_mm` beyond the tallest outward feature, less the
 /// cavity, the pocket and the bolt holes, with the features) and the top piece (plate and
 /// boss, less the reservoir bore and the bolt holes); [`two_piece_open_parts`] makes their
@@ -1069,7 +1069,7 @@ fn build_two_piece_open_layer(b: LayerBuild) -> Result<LayerOutput, DesignError>
     // Cavity block: the outline from the parting face to the wall beyond the pole,
     // less the cavity (continued 1 mm into the pocket), the pocket and the bolt holes,
     // with the features: a dimple is a pin standing into the cavity.
-    let f = crate::molds::TwoPieceFrame::new(design);
+    let f = crate::parts::molds::TwoPieceFrame::new(design);
     let zb = f.base_z_mm;
     let plain = g(body_solid(design, l.outer_offset_mm, 1.0, tol))?;
     let cap = g(body_solid(design, l.outer_offset_mm, 0.0, tol))?;
@@ -1148,7 +1148,7 @@ fn build_two_piece_open_layer(b: LayerBuild) -> Result<LayerOutput, DesignError>
 /// mm^3, into both.
 fn two_piece_open_parts(
     b: LayerBuild,
-    f: &crate::molds::TwoPieceFrame,
+    f: &crate::parts::molds::TwoPieceFrame,
     z_far: f64,
     bottom: Solid,
     top_piece: Solid,
@@ -1268,7 +1268,8 @@ fn build_boundary_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
     let master_base = g(revolve(&pl, tol).and_then(|mesh| Solid::from_mesh(&mesh)))?;
     let master = g(apply_features(master_base, &outer, tol, false))?;
     let pole = master.bounding_box().map(|b| b.max[2]).unwrap_or(0.0);
-    let (mold_box, fill) = crate::molds::drafted_box(design, r_p, z_lo, pole, tol).part(&name)?;
+    let (mold_box, fill) =
+        crate::parts::molds::drafted_box(design, r_p, z_lo, pole, tol).part(&name)?;
     let silicone_outer = g(fill.difference(&master))?.volume();
     // Inner boundary: a cup whose cavity casts the inner silicone core; the core's
     // plinth fits the outer mold's plinth recess (with clearance), which centres it.

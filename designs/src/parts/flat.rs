@@ -224,7 +224,7 @@ fn check_design_sections(design: &crate::schema::Design, errs: &mut Vec<ParamErr
         errs.push(ParamError::new("layers", "[]", "give at least one layer"));
     }
     // the trays' walls and printers, the pours' waste (the curved skins' rules)
-    crate::molds::check_mold_params(design, errs);
+    crate::parts::molds::check_mold_params(design, errs);
     crate::schema::printers::check_printers(&design.printers, errs);
     if !(0.0..=1.0).contains(&design.casting.waste_allowance) {
         errs.push(ParamError::new(
@@ -367,12 +367,12 @@ fn check_laser_cut_trays(
     // laser-cut trays: the stock and registration, then every tray's sheets
     if let (Some(lc), Some(layers), true) = (&design.mold.laser_cut, layers, errs.is_empty()) {
         let wall = design.mold.wall_thickness_mm;
-        let lc_errs = crate::lasercut::check_params(lc, wall, materials);
+        let lc_errs = crate::parts::lasercut::check_params(lc, wall, materials);
         if lc_errs.is_empty() {
             let tol =
                 ChordTolerance::new(ChordTolerance::DEFAULT_MM).expect("the default is valid");
             for (i, l) in layers.iter().enumerate() {
-                if let Err(e) = crate::lasercut::tray_sheets(outline, l, i, wall, lc, tol) {
+                if let Err(e) = crate::parts::lasercut::tray_sheets(outline, l, i, wall, lc, tol) {
                     errs.extend(e);
                 }
             }
