@@ -31,34 +31,9 @@ use std::io::BufRead as _;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
-/// The twin package, embedded: (file name, text).
-const TWINS: &[(&str, &str)] = &[
-    ("__init__.py", include_str!("../python/twins/__init__.py")),
-    ("cq_common.py", include_str!("../python/twins/cq_common.py")),
-    ("cq_molds.py", include_str!("../python/twins/cq_molds.py")),
-    ("cq_layers.py", include_str!("../python/twins/cq_layers.py")),
-    (
-        "cq_housing.py",
-        include_str!("../python/twins/cq_housing.py"),
-    ),
-    (
-        "cq_shaft_body.py",
-        include_str!("../python/twins/cq_shaft_body.py"),
-    ),
-    ("cq_casing.py", include_str!("../python/twins/cq_casing.py")),
-    ("cq_flat.py", include_str!("../python/twins/cq_flat.py")),
-    ("cq_spacer.py", include_str!("../python/twins/cq_spacer.py")),
-    (
-        "cq_fixtures.py",
-        include_str!("../python/twins/cq_fixtures.py"),
-    ),
-    ("cq_twin.py", include_str!("../python/twins/cq_twin.py")),
-    ("families.py", include_str!("../python/twins/families.py")),
-    (
-        "step_export.py",
-        include_str!("../python/twins/step_export.py"),
-    ),
-];
+/// The twin package, embedded: (file name, text) of every `cq_*.py` family twin and the
+/// package's modules, listed by `build.rs`.
+const TWINS: &[(&str, &str)] = include!(concat!(env!("OUT_DIR"), "/twins.rs"));
 
 /// The environment variable that names the CadQuery Python explicitly.
 pub const PYTHON_VAR: &str = "FABKIT_CADQUERY_PYTHON";

@@ -123,7 +123,7 @@ def check_export(d: Path, tier: str, log, manifold3d: bool = True) -> list[dict]
 
 
 def _check_sheets(d: Path, man: dict, tol: float, tier: str, log, m3d) -> list[dict]:
-    """The laser-cut sheets of the trays (`cut/<sheet>.stl`; designs/src/lasercut.rs): each is
+    """The laser-cut sheets of the trays (`cut/<sheet>.stl`; designs/src/parts/lasercut.rs): each is
     its tray (the union of the sheets) between the planes of its faces, so the twins are the
     tray's twins cut there: manifold3d (the tray's replayed booleans, both tiers) and CadQuery
     (the tray's exact twin, full tier), with the parts' bounds."""

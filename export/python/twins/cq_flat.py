@@ -1,4 +1,4 @@
-"""CadQuery twins of flat skins' parts (designs/src/flat.rs): the open casting tray of a layer,
+"""CadQuery twins of flat skins' parts (designs/src/parts/flat.rs): the open casting tray of a layer,
 with the ribs that form its channels' grooves or the holes that form its markers.
 
 Built from the parameters alone, in the sensor frame (x across the outline's width, y along its
@@ -29,7 +29,7 @@ def casting_tray(p: dict) -> cq.Solid:
     o = p["outline"]
     z0, t = float(p["z0_mm"]), float(p["depth_mm"])
     wall, floor = float(p["wall_mm"]), float(p["floor_mm"])
-    # a laser-cut tray (designs/src/lasercut.rs): the union of its sheets is this tray with
+    # a laser-cut tray (designs/src/parts/lasercut.rs): the union of its sheets is this tray with
     # flat-ended marker holes and a registration hole through each corner of the wall
     laser = p.get("laser_cut")
     hw, hl = float(o["width_mm"]) / 2.0, float(o["length_mm"]) / 2.0
