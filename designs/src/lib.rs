@@ -29,6 +29,7 @@ pub mod kit;
 pub mod library;
 pub mod markers;
 pub mod materials;
+pub mod optics;
 pub mod parts;
 pub mod primitives;
 pub mod procedure;

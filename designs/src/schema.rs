@@ -29,8 +29,9 @@ pub use shared::{
     Backing, BrushedCoat, Core, CoreMachining, FillingGel, LayerProcess, MoldStrategy,
 };
 
-/// Lengths of a design that may be negative ([`crate::values::check_values`]): none.
-pub const DESIGN_SIGNED_MM: &[&str] = &[];
+/// Lengths of a design that may be negative ([`crate::values::check_values`]): the lights'
+/// positions in the sensor frame (`optics.lights[i].position_mm`).
+pub const DESIGN_SIGNED_MM: &[&str] = &["position_mm"];
 
 /// A sensor design: body profile, rigid core, layer stack, molds, housing, printers.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
@@ -77,6 +78,10 @@ pub struct Design {
     /// height; none when not given.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spacer: Option<crate::parts::spacer::SpacerParams>,
+    /// How the inside is lit and imaged, for rendering what the camera sees; the families'
+    /// lights and default reflectance and camera response when not given.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub optics: Option<crate::optics::OpticsParams>,
     #[serde(default)]
     pub printers: PrinterProfiles,
     #[serde(default)]

@@ -166,7 +166,12 @@ fn enum_values(node: &Value) -> Option<Vec<String>> {
         return Some(
             values
                 .iter()
-                .map(|v| format!("`{}`", v.as_str().unwrap_or("?")))
+                .map(|v| {
+                    format!(
+                        "`{}`",
+                        v.as_str().map_or_else(|| v.to_string(), String::from)
+                    )
+                })
                 .collect(),
         );
     }

@@ -30,6 +30,7 @@ use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{cuboid, ChordTolerance, GeometryError, Solid};
 use crate::materials::CastReport;
 use crate::materials::MaterialKind;
+use crate::optics::{ring_of_lights, Light};
 use crate::parts::context::Context;
 use crate::parts::context::Stack;
 use crate::parts::family::{named, AssemblyStep, Built, Family};
@@ -990,6 +991,27 @@ impl Family for CasingFamily {
             ));
         }
         v
+    }
+
+    fn lights(c: &CasingParams, ctx: &Context<'_>, _stack: &Stack) -> Vec<Light> {
+        // each LED at the chamber's wall, half-way down its segment, facing the axis;
+        // three LEDs are red, green and blue in azimuth order (ShadowTac Sec. IV-B: "red,
+        // green and blue LEDs ... at 120 deg"; which colour sits where is not given)
+        let lv = levels(ctx, c);
+        let rgb = c.leds.count == 3;
+        ring_of_lights(
+            c.leds.count,
+            c.window_diameter_mm / 2.0,
+            lv.top_z_mm - c.leds.length_mm / 2.0,
+            c.leds.first_azimuth_deg,
+            None,
+            |k| match (rgb, k) {
+                (true, 0) => [1.0, 0.0, 0.0],
+                (true, 1) => [0.0, 1.0, 0.0],
+                (true, _) => [0.0, 0.0, 1.0],
+                (false, _) => [1.0, 1.0, 1.0],
+            },
+        )
     }
 
     fn estimated_triangles(

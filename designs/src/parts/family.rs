@@ -9,6 +9,7 @@
 use crate::error::{DesignError, ParamError};
 use crate::geometry::{ChordTolerance, GeometryError, Solid};
 use crate::materials::{CastReport, MaterialKind};
+use crate::optics::Light;
 use crate::parts::context::{Context, Stack};
 use crate::parts::cut_part::CutPart;
 use crate::parts::member::Member;
@@ -153,6 +154,12 @@ pub trait Family {
         _tol: ChordTolerance,
     ) -> Result<Vec<InsertionPath>, DesignError> {
         Ok(Vec::new())
+    }
+
+    /// Its lights, sensor frame (the LEDs it carries), for rendering what the camera sees when
+    /// the design gives no `optics.lights` ([`crate::optics`]).
+    fn lights(_p: &Self::Params, _ctx: &Context<'_>, _stack: &Stack) -> Vec<Light> {
+        Vec::new()
     }
 
     /// About how many triangles its parts' surfaces make at `tol`, for the work bound checked

@@ -27,6 +27,7 @@ use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{ChordTolerance, GeometryError, Solid};
 use crate::materials::CastReport;
 use crate::materials::MaterialKind;
+use crate::optics::{Light, DEFAULT_LED_INTENSITY};
 use crate::parts::context::Context;
 use crate::parts::context::Stack;
 use crate::parts::cut_part::{CutPart, Operation, Outline};
@@ -245,6 +246,10 @@ pub fn radii(ctx: &Context<'_>, f: &FingertipBase, stack: &Stack) -> FingertipRa
         outside_mm: outside,
     }
 }
+
+/// What an RGB camera sees of a 365 nm UV LED: a faint violet (the LED's visible tail), relative
+/// RGB.
+pub const UV_LED_RGB: [f64; 3] = [0.1, 0.0, 0.3];
 
 /// The LEDs' azimuths, degrees, and whether each is a UV LED: white on +x, then alternating
 /// every 45 deg (UVDtact Sec. III-C).
@@ -901,6 +906,27 @@ impl Family for FingertipBaseFamily {
                 &[MaterialKind::Print],
             ),
         ]
+    }
+
+    fn lights(f: &FingertipBase, ctx: &Context<'_>, stack: &Stack) -> Vec<Light> {
+        // the LEDs' tops on their circle, facing the skin: white, and UV (365 nm) that the
+        // camera sees only by its faint violet tail (UVDtact Sec. III-C; the UV ink's
+        // fluorescence is not modelled)
+        let z = levels(ctx, f, stack).led_top_z_mm;
+        let r = f.led_pcb.led_circle_diameter_mm / 2.0;
+        leds()
+            .into_iter()
+            .map(|(az, uv)| {
+                let a = az.to_radians();
+                Light {
+                    position_mm: [r * a.cos(), r * a.sin(), z],
+                    direction: [0.0, 0.0, 1.0],
+                    cone_half_angle_deg: 90.0,
+                    colour_rgb: if uv { UV_LED_RGB } else { [1.0, 1.0, 1.0] },
+                    intensity: DEFAULT_LED_INTENSITY,
+                }
+            })
+            .collect()
     }
 
     fn estimated_triangles(

@@ -201,8 +201,9 @@ pub fn validate(
 }
 
 /// The design-wide rules of a flat skin after its body: no curved skins' sections (`core`,
-/// `backing`, `housing`, the section families), at least one layer, the mold and printer
-/// parameters, and `casting.waste_allowance` in [0, 1]; pushed onto `errs` in that order.
+/// `backing`, `housing`, the section families), at least one layer, the mold, printer and
+/// optics parameters, and `casting.waste_allowance` in [0, 1]; pushed onto `errs` in that
+/// order.
 fn check_design_sections(design: &crate::schema::Design, errs: &mut Vec<ParamError>) {
     let curved_only = [
         ("core", design.core.is_some()),
@@ -226,6 +227,9 @@ fn check_design_sections(design: &crate::schema::Design, errs: &mut Vec<ParamErr
     // the trays' walls and printers, the pours' waste (the curved skins' rules)
     crate::parts::molds::check_mold_params(design, errs);
     crate::schema::printers::check_printers(&design.printers, errs);
+    if let Some(o) = &design.optics {
+        crate::optics::check(o, errs);
+    }
     if !(0.0..=1.0).contains(&design.casting.waste_allowance) {
         errs.push(ParamError::new(
             "casting.waste_allowance",

@@ -9,6 +9,7 @@ use std::marker::PhantomData;
 use crate::error::{DesignError, ParamError};
 use crate::geometry::ChordTolerance;
 use crate::materials::{CastReport, MaterialKind};
+use crate::optics::Light;
 use crate::parts::context::Stack;
 use crate::parts::cut_part::CutPart;
 use crate::parts::family::{AssemblyStep, Built, Family, FillingPour, InnerCavity, InsertionPath};
@@ -38,6 +39,8 @@ pub trait Section: Sync {
     /// [`Family::check`] with the sound stack `stack`, or [`Family::check_without_stack`]
     /// when the stack is not sound (`None`).
     fn check(&self, d: &Design, stack: Option<&Stack>, errs: &mut Vec<ParamError>);
+    /// [`Family::lights`]; empty without the family.
+    fn lights(&self, d: &Design, stack: &Stack) -> Vec<Light>;
     /// [`Family::filling_pour`]; `None` without the family.
     ///
     /// # Errors
@@ -132,6 +135,10 @@ impl<F: Family> Section for Registered<F> {
             (Some(p), None) => F::check_without_stack(p, &d.context(), errs),
             (None, _) => {}
         }
+    }
+
+    fn lights(&self, d: &Design, stack: &Stack) -> Vec<Light> {
+        (self.params)(d).map_or_else(Vec::new, |p| F::lights(p, &d.context(), stack))
     }
 
     fn filling_pour<'d>(

@@ -29,6 +29,7 @@ use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::Polyline2;
 use crate::geometry::{cuboid, cylinder, revolve, ChordTolerance, GeometryError, Solid};
 use crate::materials::CastReport;
+use crate::optics::{ring_of_lights, Light};
 use crate::parts::bayonet::Bayonet;
 pub use crate::parts::bayonet::BayonetLugs;
 use crate::parts::context::Context;
@@ -1102,6 +1103,21 @@ impl Family for ShaftBodyFamily {
             ],
         ),
     ];
+
+    fn lights(sb: &ShaftBodyParams, ctx: &Context<'_>, _stack: &Stack) -> Vec<Light> {
+        // the LEDs' tops at the shaft's top face, under the window, at the ring's mid-width,
+        // facing the skin (Pestell et al. Sec. III-A: "a PCB ring of six LEDs"; white and the
+        // first on +x, not given)
+        let l = &sb.led_ring;
+        ring_of_lights(
+            l.led_count,
+            (l.outer_diameter_mm + l.inner_diameter_mm) / 4.0,
+            levels(ctx, sb).shaft_top_z_mm,
+            0.0,
+            Some([0.0, 0.0, 1.0]),
+            |_| [1.0, 1.0, 1.0],
+        )
+    }
 
     fn estimated_triangles(
         sb: &ShaftBodyParams,

@@ -14,6 +14,7 @@ mod marker_layout;
 mod markers;
 mod materials;
 mod mesh;
+mod optics;
 mod patterns;
 mod primitives;
 mod profile;

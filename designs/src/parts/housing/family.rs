@@ -10,6 +10,7 @@ use super::{
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{cuboid, cylinder, revolve, ChordTolerance, GeometryError, Solid};
 use crate::materials::{cure_text, CastReport, MaterialKind};
+use crate::optics::{ring_of_lights, Light};
 use crate::parts::context::{Context, Stack};
 use crate::parts::cut_part::{CutPart, Operation, Outline};
 use crate::parts::family::{
@@ -123,6 +124,23 @@ impl Family for HousingFamily {
         }
         out.extend(bought_envelopes(h, &lv, tol)?);
         Ok(out)
+    }
+
+    fn lights(h: &HousingParams, ctx: &Context<'_>, stack: &Stack) -> Vec<Light> {
+        // the LEDs on the ring PCB's top face, at its mid-width, facing the skin (R-Tac0
+        // Sec. III-B2: eight LUXEON 2835 white LEDs, evenly spaced; the first on +x)
+        let Some(lv) = shell_levels(ctx, h, stack) else {
+            return Vec::new();
+        };
+        let r = (h.led_pcb.outer_diameter_mm + h.led_pcb.inner_diameter_mm) / 4.0;
+        ring_of_lights(
+            h.led_pcb.led_count,
+            r,
+            lv.chamber_z_mm,
+            0.0,
+            Some([0.0, 0.0, 1.0]),
+            |_| [1.0, 1.0, 1.0],
+        )
     }
 
     fn filling_pour<'p>(

@@ -1,0 +1,189 @@
+//! The `optics` section (designs/src/optics.rs): the lights each library sensor gets from the
+//! part that carries its LEDs, a design's own lights in their place, and each rule refused by
+//! its path.
+
+use crate::common::{assert_each_rule_names_its_path, RuleCase};
+use fabkit_designs::materials::MaterialsTable;
+use fabkit_designs::optics::{resolve, Light, OpticsParams};
+use fabkit_designs::parts::Stack;
+use fabkit_designs::{library, stack, ChordTolerance, Design};
+
+fn resolved(d: &Design) -> fabkit_designs::optics::ResolvedOptics {
+    let s = stack::validate(
+        d,
+        &MaterialsTable::embedded().unwrap(),
+        ChordTolerance::new(0.01).unwrap(),
+    )
+    .unwrap();
+    resolve(d, &s).unwrap()
+}
+
+fn near(a: f64, b: f64) -> bool {
+    (a - b).abs() < 1e-9
+}
+
+/// R-Tac0: eight white LEDs on the ring PCB's top face, 15 mm under the skin's base plane
+/// (z = -6 - 1 (core below it) - 2 (diffuser) - 10 (gap) - ... = -21 mm), on the PCB's
+/// mid-width circle, (23 + 15) / 4 = 9.5 mm, 45 deg apart from +x, facing the skin.
+#[test]
+fn rtac0_is_lit_by_its_led_ring_under_the_diffuser() {
+    let o = resolved(&library::load("rtac0").unwrap());
+    assert_eq!(o.lights.len(), 8);
+    assert!(o.light_sources.iter().all(|s| s == "housing"));
+    for (k, l) in o.lights.iter().enumerate() {
+        let a = (45.0 * k as f64).to_radians();
+        let [x, y, z] = l.position_mm;
+        assert!(near(x, 9.5 * a.cos()) && near(y, 9.5 * a.sin()), "{l:?}");
+        assert!(near(z, -21.0), "{l:?}");
+        assert_eq!(l.direction, [0.0, 0.0, 1.0]);
+        assert_eq!(l.colour_rgb, [1.0, 1.0, 1.0]);
+    }
+}
+
+/// ShadowTac: red, green and blue LEDs at 90, 210 and 330 deg on the light chamber's wall
+/// (15.5 mm from the axis), half-way down their 7 mm segments from the casing's top under the
+/// 3 mm plate (the skin's base plane at z = 14.142: z = 11.142 - 3.5), each facing the axis.
+#[test]
+fn shadowtac_is_lit_by_three_coloured_leds_facing_the_axis() {
+    let o = resolved(&library::load("shadowtac").unwrap());
+    let colours: Vec<[f64; 3]> = o.lights.iter().map(|l| l.colour_rgb).collect();
+    assert_eq!(colours, [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]);
+    for (l, az) in o.lights.iter().zip([90.0f64, 210.0, 330.0]) {
+        let a = az.to_radians();
+        let [x, y, z] = l.position_mm;
+        assert!(near(x, 15.5 * a.cos()) && near(y, 15.5 * a.sin()), "{l:?}");
+        assert!((z - (11.142 - 3.5)).abs() < 1e-3, "{l:?}");
+        let d = l.direction;
+        assert!(near(d[0], -a.cos()) && near(d[1], -a.sin()) && d[2] == 0.0);
+    }
+}
+
+/// The TacTip's six LEDs sit under the window, the dual-modal fingertip's four white and four
+/// UV LEDs alternate from +x; a design's own `optics.lights` replace the families' lights.
+#[test]
+fn the_other_sensors_get_their_leds_and_given_lights_replace_them() {
+    let tactip = resolved(&library::load("tactip_dualmodal").unwrap());
+    assert_eq!(tactip.lights.len(), 6);
+    assert!(tactip.light_sources.iter().all(|s| s == "shaft_body"));
+    let uvd = resolved(&library::load("uvdtact").unwrap());
+    assert_eq!(uvd.lights.len(), 8);
+    let white: Vec<bool> = uvd
+        .lights
+        .iter()
+        .map(|l| l.colour_rgb == [1.0, 1.0, 1.0])
+        .collect();
+    assert_eq!(white, [true, false, true, false, true, false, true, false]);
+
+    let mut d = library::load("rtac0").unwrap();
+    let own = Light {
+        position_mm: [0.0, 0.0, -20.0],
+        direction: [0.0, 0.0, 2.0],
+        cone_half_angle_deg: 60.0,
+        colour_rgb: [1.0, 0.5, 0.0],
+        intensity: 50.0,
+    };
+    d.optics = Some(OpticsParams {
+        lights: Some(vec![own.clone()]),
+        ..OpticsParams::default()
+    });
+    let o = resolved(&d);
+    assert_eq!(o.lights, vec![own]);
+    assert_eq!(o.light_sources, ["optics.lights[0]"]);
+}
+
+/// A flat skin carries no lights: rendering it needs `optics.lights`, said by that path.
+#[test]
+fn a_design_without_lights_must_give_them() {
+    let d = library::load("soter_channels").unwrap();
+    let e = resolve(
+        &d,
+        &Stack {
+            core: None,
+            layers: Vec::new(),
+        },
+    )
+    .unwrap_err();
+    assert_eq!(e.len(), 1);
+    assert_eq!(e[0].path, "optics.lights");
+}
+
+fn rtac0_with_optics() -> Design {
+    let mut d = library::load("rtac0").unwrap();
+    d.optics = Some(OpticsParams {
+        lights: Some(vec![Light {
+            position_mm: [0.0, 0.0, -20.0],
+            direction: [0.0, 0.0, 1.0],
+            cone_half_angle_deg: 60.0,
+            colour_rgb: [1.0, 1.0, 1.0],
+            intensity: 50.0,
+        }]),
+        ..OpticsParams::default()
+    });
+    d
+}
+
+fn optics(d: &mut Design) -> &mut OpticsParams {
+    d.optics.as_mut().unwrap()
+}
+
+fn light(d: &mut Design) -> &mut Light {
+    &mut optics(d).lights.as_mut().unwrap()[0]
+}
+
+/// One bad value per rule, each refused by its path (with nothing built).
+#[test]
+fn each_optics_rule_names_its_path() {
+    let cases: &[RuleCase] = &[
+        ("optics.lights", |d| optics(d).lights = Some(Vec::new())),
+        ("optics.lights[0].direction", |d| {
+            light(d).direction = [0.0, 0.0, 0.0]
+        }),
+        ("optics.lights[0].cone_half_angle_deg", |d| {
+            light(d).cone_half_angle_deg = 95.0
+        }),
+        ("optics.lights[0].colour_rgb", |d| {
+            light(d).colour_rgb = [0.0, 0.0, 0.0]
+        }),
+        ("optics.lights[0].colour_rgb[1]", |d| {
+            light(d).colour_rgb = [1.0, 1.5, 1.0]
+        }),
+        ("optics.lights[0].intensity", |d| light(d).intensity = 0.0),
+        ("optics.surface.albedo_rgb[2]", |d| {
+            optics(d).surface.albedo_rgb = [0.5, 0.5, 1.2]
+        }),
+        ("optics.surface.specular", |d| {
+            optics(d).surface.specular = 1.5
+        }),
+        ("optics.surface.roughness", |d| {
+            optics(d).surface.roughness = 0.0
+        }),
+        ("optics.marker_albedo_rgb[0]", |d| {
+            optics(d).marker_albedo_rgb = [2.0, 0.9, 0.9]
+        }),
+        ("optics.camera.gain", |d| optics(d).camera.gain = 0.0),
+        ("optics.camera.vignetting", |d| {
+            optics(d).camera.vignetting = 1.0
+        }),
+        ("optics.camera.full_well_electrons", |d| {
+            optics(d).camera.full_well_electrons = 0.5
+        }),
+        ("optics.camera.bit_depth", |d| {
+            optics(d).camera.bit_depth = 12
+        }),
+    ];
+    assert_each_rule_names_its_path(rtac0_with_optics, cases);
+}
+
+/// The section in YAML: lights below the base plane (negative z) are accepted, an unknown key
+/// is refused at its line.
+#[test]
+fn the_section_reads_from_yaml_with_signed_positions() {
+    let text = library::yaml("rtac0").unwrap();
+    let with = |extra: &str| {
+        format!("{text}\noptics:\n  lights:\n    - position_mm: [0, 0, -20]\n      direction: [0, 0, 1]\n      cone_half_angle_deg: 60\n      colour_rgb: [1, 1, 1]\n      intensity: 50\n{extra}")
+    };
+    let d = Design::from_yaml(&with(""), "rtac0.yaml").unwrap();
+    assert_eq!(resolved(&d).lights[0].position_mm, [0.0, 0.0, -20.0]);
+    let e = Design::from_yaml(&with("      colour: red\n"), "rtac0.yaml").unwrap_err();
+    assert!(e.to_string().contains("colour"), "{e}");
+}
