@@ -20,6 +20,7 @@ pub mod inputs;
 pub mod mesh;
 pub mod raster;
 pub mod rays;
+pub mod shading;
 pub mod surface;
 pub mod synthetic;
 

@@ -7,4 +7,5 @@ mod groundtruth_closed_form;
 mod groundtruth_undistort;
 mod imprints;
 mod refine;
+mod shading;
 mod tables;

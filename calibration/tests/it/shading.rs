@@ -1,0 +1,189 @@
+//! Image formation (calibration/src/groundtruth/shading.rs) against closed forms: the flux a
+//! point light sends onto a flat Lambertian floor, a light's cone and shadows, and the camera's
+//! response (gain, vignetting, photon and read noise, seeded and thread-count independent).
+
+use fabkit_calibration::groundtruth::shading::{expose, irradiance, radiance};
+use fabkit_designs::optics::{CameraResponse, Light, Reflectance};
+use std::f64::consts::PI;
+
+fn down_light(h_mm: f64, cone_deg: f64) -> Light {
+    Light {
+        position_mm: [0.0, 0.0, h_mm],
+        direction: [0.0, 0.0, -1.0],
+        cone_half_angle_deg: cone_deg,
+        colour_rgb: [1.0, 0.5, 0.25],
+        intensity: 100.0,
+    }
+}
+
+/// A cosine-beam light `h` mm above a floor, facing it, sends `pi I R^2 / (h^2 + R^2)` onto
+/// the disc of radius `R` under it (the integral of `I h^2 / (h^2 + r^2)^2` over the disc);
+/// summed from the irradiance at 4000 radii it agrees within 0.5 %, per colour channel.
+#[test]
+fn a_flat_floor_receives_the_analytic_flux_of_a_point_light() {
+    let (h, big_r, n) = (10.0, 30.0, 4000);
+    let light = down_light(h, 90.0);
+    let mut flux = [0.0; 3];
+    for k in 0..n {
+        let r = (k as f64 + 0.5) * big_r / n as f64;
+        let e = irradiance(&light, [r, 0.0, 0.0], [0.0, 0.0, 1.0]);
+        for c in 0..3 {
+            flux[c] += e[c] * 2.0 * PI * r * big_r / n as f64;
+        }
+    }
+    let want = PI * light.intensity * big_r * big_r / (h * h + big_r * big_r);
+    for c in 0..3 {
+        let w = want * light.colour_rgb[c];
+        assert!((flux[c] - w).abs() <= 0.005 * w, "{c}: {} vs {w}", flux[c]);
+    }
+    // a Lambertian floor (no specular lobe) sends albedo E / pi towards any viewer
+    let matte = Reflectance {
+        albedo_rgb: [0.8, 0.8, 0.8],
+        specular: 0.0,
+        roughness: 1.0,
+    };
+    let p = [3.0, 4.0, 0.0];
+    let e = irradiance(&light, p, [0.0, 0.0, 1.0]);
+    for eye in [[0.0, 0.0, 1.0], [0.6, 0.0, 0.8]] {
+        let l = radiance(
+            p,
+            [0.0, 0.0, 1.0],
+            eye,
+            matte.albedo_rgb,
+            &matte,
+            &[light.clone()],
+            |_| true,
+        );
+        for c in 0..3 {
+            assert!((l[c] - 0.8 * e[c] / PI).abs() < 1e-12 * e[c].max(1.0));
+        }
+    }
+}
+
+/// Outside its 30 deg cone (beyond h tan 30 deg = 5.77 mm from under a light 10 mm up) a light
+/// gives nothing; a point facing away gets nothing; a light in shadow adds nothing, and two
+/// lights add up.
+#[test]
+fn cones_shadows_and_two_lights() {
+    let narrow = down_light(10.0, 30.0);
+    let up = [0.0, 0.0, 1.0];
+    assert!(irradiance(&narrow, [5.7, 0.0, 0.0], up)[0] > 0.0);
+    assert_eq!(irradiance(&narrow, [5.8, 0.0, 0.0], up), [0.0; 3]);
+    assert_eq!(
+        irradiance(&narrow, [0.0, 0.0, 0.0], [0.0, 0.0, -1.0]),
+        [0.0; 3]
+    );
+
+    let s = Reflectance::default();
+    let a = down_light(10.0, 90.0);
+    let b = Light {
+        position_mm: [8.0, 0.0, 6.0],
+        direction: [-1.0, 0.0, -1.0],
+        ..down_light(10.0, 90.0)
+    };
+    let p = [1.0, 2.0, 0.0];
+    let eye = [0.0, 0.0, 1.0];
+    let both = radiance(
+        p,
+        up,
+        eye,
+        s.albedo_rgb,
+        &s,
+        &[a.clone(), b.clone()],
+        |_| true,
+    );
+    let only_a = radiance(p, up, eye, s.albedo_rgb, &s, &[a.clone(), b.clone()], |i| {
+        i == 0
+    });
+    let only_b = radiance(p, up, eye, s.albedo_rgb, &s, &[b], |_| true);
+    let a_alone = radiance(p, up, eye, s.albedo_rgb, &s, &[a], |_| true);
+    for c in 0..3 {
+        assert!((only_a[c] - a_alone[c]).abs() < 1e-15);
+        assert!((both[c] - only_a[c] - only_b[c]).abs() < 1e-12);
+        assert!(only_b[c] > 0.0);
+    }
+}
+
+fn flat_field(w: usize, h: usize, value: f64) -> Vec<[f64; 3]> {
+    vec![[value; 3]; w * h]
+}
+
+/// A flat field at half scale, 16 bit: its mean is half of 65535 within 0.2 % and its spread
+/// is the photon and read noise, sqrt(5000 + 5^2) / 10000 of full scale, within 3 %; the same
+/// seed gives the same values with one thread or two, another seed other values.
+#[test]
+fn the_camera_adds_the_noise_of_its_electrons_the_same_for_a_seed() {
+    let (w, h) = (256, 256);
+    let cam = CameraResponse {
+        bit_depth: 16,
+        seed: 7,
+        ..CameraResponse::default()
+    };
+    let img = expose(&flat_field(w, h, 0.5), w, h, [127.5, 127.5], &cam);
+    let vals: Vec<f64> = img.iter().map(|p| f64::from(p[1])).collect();
+    let mean = vals.iter().sum::<f64>() / vals.len() as f64;
+    let sd = (vals.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / vals.len() as f64).sqrt();
+    let full = 65535.0;
+    assert!(
+        (mean - 0.5 * full).abs() < 0.002 * 0.5 * full,
+        "mean {mean}"
+    );
+    let want = (5000.0f64 + 25.0).sqrt() / 10000.0 * full;
+    assert!((sd - want).abs() < 0.03 * want, "sd {sd} vs {want}");
+
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    let two = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap();
+    let a = one.install(|| expose(&flat_field(w, h, 0.5), w, h, [127.5, 127.5], &cam));
+    let b = two.install(|| expose(&flat_field(w, h, 0.5), w, h, [127.5, 127.5], &cam));
+    assert_eq!(a, b);
+    assert_eq!(a, img);
+    let other = expose(
+        &flat_field(w, h, 0.5),
+        w,
+        h,
+        [127.5, 127.5],
+        &CameraResponse { seed: 8, ..cam },
+    );
+    assert_ne!(other, img);
+}
+
+/// Without noise, the corners record `1 - vignetting` of the centre; a pixel that sees nothing
+/// (NaN) records 0; 8 bits quantise to 255 levels and a bright pixel clips at full scale.
+#[test]
+fn vignetting_quantisation_and_clipping() {
+    let (w, h) = (101, 81);
+    let cam = CameraResponse {
+        gain: 2.0,
+        vignetting: 0.3,
+        full_well_electrons: 1e12,
+        read_noise_electrons: 0.0,
+        bit_depth: 16,
+        seed: 1,
+    };
+    let mut rad = flat_field(w, h, 0.2);
+    rad[1] = [f64::NAN; 3];
+    rad[w * h - 2] = [10.0; 3];
+    let img = expose(&rad, w, h, [50.0, 40.0], &cam);
+    let full: f64 = 65535.0;
+    assert_eq!(f64::from(img[40 * w + 50][0]), (0.4 * full).round());
+    assert_eq!(f64::from(img[0][0]), (0.7 * 0.4 * full).round());
+    assert_eq!(img[1], [0, 0, 0]);
+    assert_eq!(img[w * h - 2], [65535; 3]);
+    let eight = expose(
+        &rad,
+        w,
+        h,
+        [50.0, 40.0],
+        &CameraResponse {
+            bit_depth: 8,
+            ..cam
+        },
+    );
+    assert_eq!(eight[40 * w + 50][0], 102);
+}
