@@ -137,3 +137,49 @@ pub fn expose(
         })
         .collect()
 }
+
+/// The radiance every pixel of a frame receives (row-major, per channel; NaN where the ray
+/// sees no skin): the surface `hits` along `rays` (reference or indented) lit by `optics`'
+/// lights, the skin's albedo everywhere (markers are not drawn yet), a light shadowed where the
+/// segment from the point to it enters a protrusion of `protrusions`. The reference skin is
+/// convex: seen from inside it casts no shadow on itself. Pixels are shaded in parallel, each
+/// on its own: the result does not depend on the thread count.
+pub fn frame_radiance(
+    rays: &super::rays::PixelRays,
+    hits: &super::SurfaceHits,
+    optics: &fabkit_designs::optics::ResolvedOptics,
+    protrusions: Option<&super::exact::ExactPrimitives>,
+) -> Vec<[f64; 3]> {
+    let o = rays.origin_mm;
+    (0..rays.dirs.len())
+        .into_par_iter()
+        .map(|i| {
+            let (t, d) = (hits.t_mm[i], rays.dirs[i]);
+            if !t.is_finite() {
+                return [f64::NAN; 3];
+            }
+            let p = [o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2]];
+            // the normal on the camera's side: the elastomer's outward normal reversed
+            let n = hits.normal[i].map(|v| -v);
+            let lit = |k: usize| {
+                let Some(prims) = protrusions else {
+                    return true;
+                };
+                let to_light = sub(optics.lights[k].position_mm, p);
+                let dist = dot(to_light, to_light).sqrt();
+                let l = unit(to_light);
+                let start = [p[0] + 1e-6 * n[0], p[1] + 1e-6 * n[1], p[2] + 1e-6 * n[2]];
+                prims.first_crossing(start, l, dist).is_none()
+            };
+            radiance(
+                p,
+                n,
+                [-d[0], -d[1], -d[2]],
+                optics.surface.albedo_rgb,
+                &optics.surface,
+                &optics.lights,
+                lit,
+            )
+        })
+        .collect()
+}

@@ -187,3 +187,133 @@ fn vignetting_quantisation_and_clipping() {
     );
     assert_eq!(eight[40 * w + 50][0], 102);
 }
+
+use fabkit_calibration::groundtruth::exact::ExactPrimitives;
+use fabkit_calibration::groundtruth::rays::PixelRays;
+use fabkit_calibration::groundtruth::shading::frame_radiance;
+use fabkit_calibration::groundtruth::surface::ReferenceSurface;
+use fabkit_calibration::groundtruth::synthetic::{benchmark_pose, rtac0_body};
+use fabkit_calibration::groundtruth::{indented_hits, reference_hits};
+use fabkit_calibration::synthetic::benchmark_intrinsics;
+use fabkit_calibration::CameraModel;
+use fabkit_designs::optics::ResolvedOptics;
+use fabkit_designs::primitives::Primitive;
+
+fn optics_with(lights: Vec<Light>) -> ResolvedOptics {
+    ResolvedOptics {
+        light_sources: vec!["test".into(); lights.len()],
+        lights,
+        surface: Reflectance {
+            albedo_rgb: [0.7, 0.7, 0.7],
+            specular: 0.0,
+            roughness: 1.0,
+        },
+        marker_albedo_rgb: [0.9; 3],
+        camera: CameraResponse::default(),
+    }
+}
+
+/// R-Tac0's skin (a 15 mm hemisphere on a cylinder) seen by the 160 deg benchmark camera, a
+/// 4 mm sphere tip pressed 2 mm into it near the pole.
+fn pressed() -> (PixelRays, ExactPrimitives, [f64; 3], f64) {
+    let cam = CameraModel::new(benchmark_intrinsics()).unwrap();
+    let rays = PixelRays::new(&cam, &benchmark_pose());
+    let (c, r) = ([2.0, -1.0, 15.0], 4.0);
+    let prims = ExactPrimitives::new(&[Primitive::Sphere {
+        centre_mm: c,
+        radius_mm: r,
+    }])
+    .unwrap();
+    (rays, prims, c, r)
+}
+
+/// A distant light straight under the skin (1 km down, facing up; irradiance 1 where it
+/// faces the light): on the sphere tip's imprint every pixel's radiance is
+/// `albedo / pi x cos`, the cosine between the tip's own normal at the point (from its centre,
+/// not from the caster) and the light, within 0.1 %.
+#[test]
+fn a_sphere_tip_imprint_under_a_distant_light_has_the_analytic_shading() {
+    let (rays, prims, c, r) = pressed();
+    let surface = ReferenceSurface::of(&rtac0_body()).unwrap();
+    let reference = reference_hits(&rays, &surface);
+    let hits = indented_hits(&rays, &reference, &prims, surface.base_z_mm());
+    let far = 1e6;
+    let light = Light {
+        position_mm: [0.0, 0.0, -far],
+        direction: [0.0, 0.0, 1.0],
+        cone_half_angle_deg: 90.0,
+        colour_rgb: [1.0, 1.0, 1.0],
+        intensity: far * far,
+    };
+    let rad = frame_radiance(&rays, &hits, &optics_with(vec![light]), Some(&prims));
+    let mut checked = 0;
+    for i in 0..rays.dirs.len() {
+        if !hits.contact[i] {
+            continue;
+        }
+        let (t, d, o) = (hits.t_mm[i], rays.dirs[i], rays.origin_mm);
+        let p = [o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2]];
+        // the tip's outward normal, facing the camera; the light comes from -z
+        let cos = ((c[2] - p[2]) / r).max(0.0);
+        let want = 0.7 / PI * cos;
+        assert!(
+            (rad[i][0] - want).abs() <= 1e-3 * want.max(1e-3),
+            "pixel {i}: {} vs {want}",
+            rad[i][0]
+        );
+        checked += 1;
+    }
+    assert!(checked > 500, "{checked} imprint pixels");
+}
+
+/// A light beside the tip, inside the skin: the skin's pixels it leaves dark are exactly those
+/// whose segment to the light passes through the tip (a closed-form segment-sphere test),
+/// bar pixels whose segment grazes the tip within 1 um.
+#[test]
+fn the_tip_shadows_the_skin_where_its_sphere_blocks_the_light() {
+    let (rays, prims, c, r) = pressed();
+    let surface = ReferenceSurface::of(&rtac0_body()).unwrap();
+    let reference = reference_hits(&rays, &surface);
+    let hits = indented_hits(&rays, &reference, &prims, surface.base_z_mm());
+    let light = Light {
+        position_mm: [-9.0, 4.0, 6.0],
+        direction: [1.0, -0.4, 1.0],
+        cone_half_angle_deg: 90.0,
+        colour_rgb: [1.0, 1.0, 1.0],
+        intensity: 100.0,
+    };
+    let rad = frame_radiance(
+        &rays,
+        &hits,
+        &optics_with(vec![light.clone()]),
+        Some(&prims),
+    );
+    let unshadowed = frame_radiance(&rays, &hits, &optics_with(vec![light.clone()]), None);
+    let (mut shadowed, mut graze) = (0, 0);
+    for i in 0..rays.dirs.len() {
+        if !hits.t_mm[i].is_finite() || hits.contact[i] || !(unshadowed[i][0] > 0.0) {
+            continue;
+        }
+        let (t, d, o) = (hits.t_mm[i], rays.dirs[i], rays.origin_mm);
+        let p = [o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2]];
+        // the segment p -> light against the sphere |x - c| = r
+        let s: Vec<f64> = (0..3).map(|k| light.position_mm[k] - p[k]).collect();
+        let len = s.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let u: Vec<f64> = s.iter().map(|x| x / len).collect();
+        let m: Vec<f64> = (0..3).map(|k| p[k] - c[k]).collect();
+        let b = (0..3).map(|k| m[k] * u[k]).sum::<f64>();
+        let cc = m.iter().map(|x| x * x).sum::<f64>() - r * r;
+        let disc = b * b - cc;
+        let t_hit = -b - disc.max(0.0).sqrt();
+        let blocked = disc > 0.0 && t_hit > 0.0 && t_hit < len;
+        let near_graze = disc.abs() < 2.0 * r * 1e-3;
+        let dark = rad[i][0] == 0.0;
+        if dark != blocked {
+            assert!(near_graze, "pixel {i}: dark {dark}, blocked {blocked}");
+            graze += 1;
+        }
+        shadowed += usize::from(dark);
+    }
+    assert!(shadowed > 100, "{shadowed} shadowed pixels");
+    assert!(graze < 10, "{graze} grazing pixels");
+}
