@@ -113,11 +113,18 @@ pub fn expose(
         .flat_map_iter(|v| {
             let mut rng = ChaCha8Rng::seed_from_u64(camera.seed);
             rng.set_stream(v as u64);
+            let mut spare: Option<f64> = None;
             let mut gauss = move || {
-                // Box-Muller from two uniforms in (0, 1]
+                // Box-Muller from two uniforms in (0, 1]: two normal values, the second kept
+                if let Some(g) = spare.take() {
+                    return g;
+                }
                 let a = ((rng.next_u64() >> 11) as f64 + 1.0) / (1u64 << 53) as f64;
                 let b = (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
-                (-2.0 * a.ln()).sqrt() * (std::f64::consts::TAU * b).cos()
+                let (s, c) = (std::f64::consts::TAU * b).sin_cos();
+                let r = (-2.0 * a.ln()).sqrt();
+                spare = Some(r * s);
+                r * c
             };
             (0..width)
                 .map(|u| {
