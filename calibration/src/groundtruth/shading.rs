@@ -11,8 +11,9 @@
 //! reflected from one part of the skin onto another.
 
 use fabkit_designs::optics::{CameraResponse, Light, Reflectance};
-use rand_chacha::rand_core::{Rng, SeedableRng};
+use rand_chacha::rand_core::SeedableRng;
 use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
@@ -84,8 +85,8 @@ pub fn radiance(
 /// The image the camera records of `radiance` (row-major, `width` x `height`, per channel):
 /// times `gain` and the vignetting (`1 - vignetting x (r / r_corner)^2` about `principal_px`),
 /// as a fraction of full scale, with photon noise (the signal's electrons out of
-/// `full_well_electrons`, Gaussian with the Poisson variance) and read noise, clipped and
-/// quantised to `bit_depth` bits. NaN radiance (a pixel that sees nothing) records 0 plus
+/// `full_well_electrons`, Gaussian with the Poisson variance; `rand_distr`'s ziggurat) and read
+/// noise, clipped and quantised to `bit_depth` bits. NaN radiance (a pixel that sees nothing) records 0 plus
 /// noise. The noise of row `v` comes from its own stream of `seed`: the same seed gives the
 /// same values whatever the thread count.
 pub fn expose(
@@ -113,19 +114,7 @@ pub fn expose(
         .flat_map_iter(|v| {
             let mut rng = ChaCha8Rng::seed_from_u64(camera.seed);
             rng.set_stream(v as u64);
-            let mut spare: Option<f64> = None;
-            let mut gauss = move || {
-                // Box-Muller from two uniforms in (0, 1]: two normal values, the second kept
-                if let Some(g) = spare.take() {
-                    return g;
-                }
-                let a = ((rng.next_u64() >> 11) as f64 + 1.0) / (1u64 << 53) as f64;
-                let b = (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
-                let (s, c) = (std::f64::consts::TAU * b).sin_cos();
-                let r = (-2.0 * a.ln()).sqrt();
-                spare = Some(r * s);
-                r * c
-            };
+            let mut gauss = move || -> f64 { StandardNormal.sample(&mut rng) };
             (0..width)
                 .map(|u| {
                     let r2 =
