@@ -14,7 +14,7 @@
 //! tolerance and its volume passes [`MIN_OVERLAP_MM3`].
 
 use crate::error::{DesignError, GeometryContext, ParamError, ParamErrors};
-use crate::geometry::{cylinder, revolve, Affine, ChordTolerance, Solid};
+use crate::geometry::{revolve, Affine, ChordTolerance, Solid};
 use crate::parts::context::Stack;
 use crate::parts::registry::FAMILIES;
 use crate::parts::Part;
@@ -217,19 +217,12 @@ fn push_backing(
         return Ok(());
     };
     let zb = design.body.base_z_mm();
-    let (r, z0, z1) = (b.diameter_mm / 2.0, zb - b.thickness_mm, zb);
-    let solid = cylinder(z1 - z0, r, tol)
-        .map(|s| s.translate([0.0, 0.0, z0]))
+    let envelope = crate::parts::axial_cylinder(b.diameter_mm / 2.0, zb - b.thickness_mm, zb, tol)
         .part("backing_envelope")?;
-    let exact = ExactShape::Cylinder {
-        radius_mm: r,
-        z0_mm: z0,
-        z1_mm: z1,
-    };
     out.push(bought(
         "backing_envelope",
         format!("Backing plate (bought): {}", b.description),
-        (solid, exact),
+        envelope,
         &["backing.diameter_mm", "backing.thickness_mm"],
     ));
     Ok(())

@@ -21,7 +21,7 @@
 //!   base's floor pass the camera's wire and the PCB's wires; the bolts come up through
 //!   counterbored holes in the base.
 
-use super::{ExactShape, Member, MemberKind};
+use super::{axial_cylinder, axial_ring, Member, MemberKind};
 use super::{Part, PrintTechnology};
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{ChordTolerance, GeometryError, Solid};
@@ -783,26 +783,12 @@ pub fn members(
     let lv = levels(ctx, f, stack);
     let member =
         |name: &str, description: String, (ri, ro, z0, z1): (f64, f64, f64, f64), fix: &[&str]| {
-            let solid = if ri > 0.0 {
-                z_ring(ri, ro, z0, z1, tol)
+            let (solid, exact) = if ri > 0.0 {
+                axial_ring(ro, ri, z0, z1, tol)
             } else {
-                z_cylinder(ro, z0, z1, [0.0; 2], tol)
+                axial_cylinder(ro, z0, z1, tol)
             }
             .part(name)?;
-            let exact = if ri > 0.0 {
-                ExactShape::Ring {
-                    outer_radius_mm: ro,
-                    inner_radius_mm: ri,
-                    z0_mm: z0,
-                    z1_mm: z1,
-                }
-            } else {
-                ExactShape::Cylinder {
-                    radius_mm: ro,
-                    z0_mm: z0,
-                    z1_mm: z1,
-                }
-            };
             Ok::<_, DesignError>(Member {
                 name: name.into(),
                 kind: MemberKind::Bought,

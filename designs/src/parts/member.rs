@@ -3,7 +3,7 @@
 //! what an exact B-rep of it is built from. The families build these; the assembly collects
 //! and fit-checks them.
 
-use crate::geometry::Solid;
+use crate::geometry::{cylinder, ChordTolerance, GeometryError, Solid};
 use serde::{Deserialize, Serialize};
 
 /// Where a member of the assembly comes from.
@@ -78,4 +78,48 @@ pub enum ExactShape {
     /// surface exactly and its inner surface by the rule of
     /// [`crate::profile::BodyProfile::shell_inner_surface`].
     CoreShell { params: serde_json::Value },
+}
+
+/// A bought part's envelope about the sensor axis: the cylinder of radius `r_mm` from `z0_mm`
+/// up to `z1_mm` (sensor frame), tessellated at `tol`, with its exact shape.
+///
+/// # Errors
+/// [`GeometryError`] if the kernel fails.
+pub fn axial_cylinder(
+    r_mm: f64,
+    z0_mm: f64,
+    z1_mm: f64,
+    tol: ChordTolerance,
+) -> Result<(Solid, ExactShape), GeometryError> {
+    let solid = cylinder(z1_mm - z0_mm, r_mm, tol)?.translate([0.0, 0.0, z0_mm]);
+    let exact = ExactShape::Cylinder {
+        radius_mm: r_mm,
+        z0_mm,
+        z1_mm,
+    };
+    Ok((solid, exact))
+}
+
+/// [`axial_cylinder`] of radius `outer_mm` less its bore of radius `inner_mm` (a ring PCB, a
+/// diffuser ring), with its exact shape.
+///
+/// # Errors
+/// [`GeometryError`] if the kernel fails.
+pub fn axial_ring(
+    outer_mm: f64,
+    inner_mm: f64,
+    z0_mm: f64,
+    z1_mm: f64,
+    tol: ChordTolerance,
+) -> Result<(Solid, ExactShape), GeometryError> {
+    // the bore passes both faces so that the difference is clean
+    let (outer, _) = axial_cylinder(outer_mm, z0_mm, z1_mm, tol)?;
+    let (bore, _) = axial_cylinder(inner_mm, z0_mm - 1.0, z1_mm + 1.0, tol)?;
+    let exact = ExactShape::Ring {
+        outer_radius_mm: outer_mm,
+        inner_radius_mm: inner_mm,
+        z0_mm,
+        z1_mm,
+    };
+    Ok((outer.difference(&bore)?, exact))
 }

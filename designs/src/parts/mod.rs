@@ -24,7 +24,7 @@ pub mod shaft_body;
 pub mod spacer;
 
 pub use context::{Context, ResolvedCore, ResolvedLayer, Stack};
-pub use member::{ExactShape, Member, MemberKind};
+pub use member::{axial_cylinder, axial_ring, ExactShape, Member, MemberKind};
 pub use part::{Part, PrintTechnology, ProcedureAction, ProcedureStep};
 
 use crate::error::ParamError;

@@ -23,7 +23,7 @@
 //! surface it sees (through the lip, the LED ring and the shaft's bore, the pins' shadows
 //! ignored) is stated in the manifest ([`view_fraction`]).
 
-use super::{ExactShape, Member, MemberKind};
+use super::{axial_cylinder, ExactShape, Member, MemberKind};
 use super::{Part, PrintTechnology};
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::Polyline2;
@@ -943,17 +943,7 @@ pub fn members(
 ) -> Result<Vec<Member>, DesignError> {
     let lv = levels(ctx, sb);
     let disc = |name: &str, r: f64, z0: f64, z1: f64| -> Result<(Solid, ExactShape), DesignError> {
-        let s = cylinder(z1 - z0, r, tol)
-            .map(|s| s.translate([0.0, 0.0, z0]))
-            .part(name)?;
-        Ok((
-            s,
-            ExactShape::Cylinder {
-                radius_mm: r,
-                z0_mm: z0,
-                z1_mm: z1,
-            },
-        ))
+        Ok(axial_cylinder(r, z0, z1, tol).part(name)?)
     };
     let member = |name: &str,
                   description: String,

@@ -11,6 +11,7 @@ use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{cuboid, cylinder, revolve, ChordTolerance, GeometryError, Solid};
 use crate::materials::{cure_text, CastReport, MaterialKind};
 use crate::optics::{ring_of_lights, Light};
+use crate::parts::axial_ring;
 use crate::parts::context::{Context, Stack};
 use crate::parts::cut_part::{CutPart, Operation, Outline};
 use crate::parts::family::{
@@ -222,27 +223,7 @@ fn bought_envelopes(
     tol: ChordTolerance,
 ) -> Result<Vec<Member>, DesignError> {
     type Exact = Result<(Solid, ExactShape), GeometryError>;
-    let disc = |r: f64, z0: f64, z1: f64| -> Exact {
-        let solid = cylinder(z1 - z0, r, tol)?.translate([0.0, 0.0, z0]);
-        let exact = ExactShape::Cylinder {
-            radius_mm: r,
-            z0_mm: z0,
-            z1_mm: z1,
-        };
-        Ok((solid, exact))
-    };
-    let ring = |ro: f64, ri: f64, z0: f64, z1: f64| -> Exact {
-        // the inner cut passes both faces so that the difference is clean
-        let (outer, _) = disc(ro, z0, z1)?;
-        let (inner, _) = disc(ri, z0 - 1.0, z1 + 1.0)?;
-        let exact = ExactShape::Ring {
-            outer_radius_mm: ro,
-            inner_radius_mm: ri,
-            z0_mm: z0,
-            z1_mm: z1,
-        };
-        Ok((outer.difference(&inner)?, exact))
-    };
+    let ring = |ro: f64, ri: f64, z0: f64, z1: f64| axial_ring(ro, ri, z0, z1, tol);
     let block = |min_mm: [f64; 3], max_mm: [f64; 3]| -> Exact {
         Ok((cuboid(min_mm, max_mm)?, ExactShape::Box { min_mm, max_mm }))
     };
