@@ -106,9 +106,12 @@ impl Default for Reflectance {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields, default)]
 pub struct CameraResponse {
-    /// Pixel value, as a fraction of full scale, per unit of radiance, > 0. Default 1.
+    /// Pixel value, as a fraction of full scale, per unit of radiance, > 0. When not given,
+    /// the exposure is set once on the reference image (its 99th-percentile pixel at 0.8 of
+    /// full scale) and held for every frame of the set, as a camera in manual exposure.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schemars(extend("exclusiveMinimum" = 0))]
-    pub gain: f64,
+    pub gain: Option<f64>,
     /// Light lost at the image's corners, a fraction in [0, 1): the response falls as
     /// `1 - vignetting x (r / r_corner)^2` with the distance `r` from the principal point.
     /// Default 0.
@@ -130,7 +133,7 @@ pub struct CameraResponse {
 impl Default for CameraResponse {
     fn default() -> Self {
         Self {
-            gain: 1.0,
+            gain: None,
             vignetting: 0.0,
             full_well_electrons: 10_000.0,
             read_noise_electrons: 5.0,
@@ -183,12 +186,14 @@ pub fn check(o: &OpticsParams, errs: &mut Vec<ParamError>) {
     }
     check_rgb("optics.marker_albedo_rgb", o.marker_albedo_rgb, false, errs);
     let c = &o.camera;
-    if !(c.gain > 0.0) {
-        errs.push(ParamError::new(
-            "optics.camera.gain",
-            c.gain,
-            "must be above 0",
-        ));
+    if let Some(g) = c.gain {
+        if !(g > 0.0) {
+            errs.push(ParamError::new(
+                "optics.camera.gain",
+                g,
+                "must be above 0 (or leave it out for the exposure set on the reference image)",
+            ));
+        }
     }
     if !(0.0..1.0).contains(&c.vignetting) {
         errs.push(ParamError::new(
@@ -314,6 +319,31 @@ pub fn resolve(design: &Design, stack: &Stack) -> Result<ResolvedOptics, Vec<Par
         marker_albedo_rgb: o.marker_albedo_rgb,
         camera: o.camera,
     })
+}
+
+/// The optics of `design` for a render: the design validated as `fabkit validate` does (its
+/// stack for a curved skin; a flat skin has no stack and carries no family's lights), then
+/// [`resolve`]d.
+///
+/// # Errors
+/// [`DesignError::Params`] with every violated rule of the design and of its `optics` (paths
+/// under `optics.`); [`DesignError::Yaml`] if the embedded materials table does not load.
+pub fn of_design(
+    design: &Design,
+    tol: crate::geometry::ChordTolerance,
+) -> Result<ResolvedOptics, crate::error::DesignError> {
+    use crate::error::DesignError;
+    let materials = crate::materials::MaterialsTable::embedded().map_err(DesignError::Yaml)?;
+    let stack = if design.body.flat_outline().is_some() {
+        crate::parts::flat::validate(design, &materials)?;
+        Stack {
+            core: None,
+            layers: Vec::new(),
+        }
+    } else {
+        crate::stack::validate(design, &materials, tol)?
+    };
+    resolve(design, &stack).map_err(|e| DesignError::Params(crate::ParamErrors(e)))
 }
 
 /// `n` white lights of `intensity` evenly round a circle of radius `r_mm` at height `z_mm`

@@ -173,6 +173,35 @@ pub fn png_rgb8(
     )
 }
 
+/// A 16-bit RGB PNG; `rgb` holds `width * height` pixels (big-endian in the file, as PNG
+/// stores them).
+///
+/// # Errors
+/// [`ExportError::Encode`] if the encoder fails.
+///
+/// # Panics
+/// If `rgb.len() != width * height`.
+pub fn png_rgb16(
+    width: usize,
+    height: usize,
+    rgb: &[[u16; 3]],
+    text: &[(&str, &str)],
+) -> Result<Vec<u8>, ExportError> {
+    assert_eq!(rgb.len(), width * height);
+    let bytes: Vec<u8> = rgb
+        .iter()
+        .flat_map(|p| p.iter().flat_map(|c| c.to_be_bytes()))
+        .collect();
+    png_bytes(
+        width,
+        height,
+        png::ColorType::Rgb,
+        png::BitDepth::Sixteen,
+        &bytes,
+        text,
+    )
+}
+
 /// How a quantity is stored in a 16-bit PNG: `value = (count - offset_counts) * scale`,
 /// count 0 = no value.
 #[derive(Debug, Clone, Copy, PartialEq)]

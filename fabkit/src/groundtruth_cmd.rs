@@ -9,16 +9,19 @@ use std::error::Error;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
+use fabkit_calibration::groundtruth::exact::ExactPrimitives;
 use fabkit_calibration::groundtruth::inputs::{
     pairs_csv, read_extrinsics, read_fixtures, read_with_hash, sha256_hex, Configuration,
     PAIRS_NOTES,
 };
+use fabkit_calibration::groundtruth::rays::PixelRays;
+use fabkit_calibration::groundtruth::shading::Imaging;
 use fabkit_calibration::groundtruth::{
-    half_masks, indented_hits, reference_hits, DepthFrame, Scene,
+    half_masks, indented_hits, reference_hits, DepthFrame, Scene, SurfaceHits,
 };
 use fabkit_calibration::read_camera_file_as;
 use fabkit_export::raster::{
-    normals_rgb, npy_f32, npz as npz_file, ply_points, png_gray16, png_gray8, png_rgb8,
+    normals_rgb, npy_f32, npz as npz_file, ply_points, png_gray16, png_gray8, png_rgb16, png_rgb8,
     preview_rgb, PlyPoint, Png16Encoding,
 };
 use fabkit_export::{OutputClaim, OutputCommand, StagedDir};
@@ -78,6 +81,12 @@ pub struct GroundTruthArgs {
     /// output's file system).
     #[arg(long)]
     yes: bool,
+    /// Also render the tactile image the camera sees of every frame (`image.png` beside the
+    /// depth maps, RGB at the design's `optics.camera.bit_depth`): the design's lights, skin
+    /// reflectance and camera response (its `optics` section, or the lights of its housing),
+    /// shadows cast by the protrusions, seeded camera noise.
+    #[arg(long)]
+    images: bool,
     #[command(flatten)]
     data_files: DataFileArgs,
 }
@@ -336,6 +345,45 @@ fn frame_files(
     Ok(files)
 }
 
+/// What the rendered images leave out, in the manifest and the guide.
+const IMAGES_NOT_MODELLED: &str = "refraction through the clear layers between the camera and the reflective surface (rays are straight from the camera centre); light scattered inside the elastomer; light reflected from one part of the skin onto another; the skin's deformation around a protrusion (the indented surface is the skin minus the protrusion solids); markers and dimples (the skin has one albedo); lens blur, motion blur and rolling shutter";
+
+/// The rendered image of a frame (`--images`): `dir/image.png`, RGB at the optics' bit
+/// depth, on the depth maps' pixel grid; its noise is that of frame `frame` of the set.
+fn image_file(
+    dir: &str,
+    im: &Imaging,
+    rays: &PixelRays,
+    hits: &SurfaceHits,
+    protrusions: Option<&ExactPrimitives>,
+    frame: u64,
+) -> Result<(String, Vec<u8>, Value), Box<dyn Error>> {
+    let (w, h) = (rays.width, rays.height);
+    let img = im.image(rays, hits, protrusions, frame);
+    let bits = im.optics.camera.bit_depth;
+    let full = ((1u32 << bits) - 1) as u16;
+    let saturated = img.iter().filter(|p| p.contains(&full)).count();
+    let file = format!("{dir}/image.png");
+    let text = format!(
+        "fabkit rendered tactile image, frame {frame}: RGB, {bits} bit; the skin lit by the design's lights, exposure gain {}",
+        im.gain
+    );
+    let meta = [("Description", text.as_str())];
+    let bytes = if bits == 16 {
+        png_rgb16(w, h, &img, &meta)?
+    } else {
+        let rgb: Vec<u8> = img.iter().flat_map(|p| p.map(|c| c as u8)).collect();
+        png_rgb8(w, h, &rgb, &meta)?
+    };
+    Ok((
+        file.clone(),
+        bytes,
+        json!({"file": file, "quantity": "the tactile image the camera sees: the surface of this frame under the design's lights, with its shadows, the camera's gain, vignetting and noise (see images in the manifest)",
+               "dtype": if bits == 16 { "uint16" } else { "uint8" }, "shape": [h, w, 3], "channels": "RGB",
+               "bit_depth": bits, "noise_frame": frame, "saturated_pixels": saturated}),
+    ))
+}
+
 /// The surface points of a frame with their normals as binary PLY.
 fn ply_file(files: &mut Files, dir: &str, f: &DepthFrame, provenance: &str) {
     let w = f.width;
@@ -368,11 +416,23 @@ fn png_bound(raw: u64, rows: u64) -> u64 {
 /// Files and bytes of the output, (files, bytes): the files exactly, the bytes as an upper
 /// bound (float arrays and PLY at their exact sizes, PNG and NPZ at deflate's worst case, the
 /// manifest and pairs.csv generously), for a `w` x `h` camera, `n_cfg` configurations and
-/// `n_patterns` patterns.
-pub fn output_bound(w: u64, h: u64, n_cfg: u64, n_patterns: u64, format: DataFormat) -> (u64, u64) {
+/// `n_patterns` patterns, with an RGB image of `image_bits` bits per channel per frame
+/// (`--images`).
+pub fn output_bound(
+    w: u64,
+    h: u64,
+    n_cfg: u64,
+    n_patterns: u64,
+    format: DataFormat,
+    image_bits: Option<u32>,
+) -> (u64, u64) {
     let px = w * h;
     let frame = |delta: bool| -> (u64, u64) {
         let (mut files, mut bytes, mut arrays) = (0u64, 0u64, Vec::new());
+        if let Some(bits) = image_bits {
+            files += 1;
+            bytes += png_bound(3 * px * u64::from(bits.div_ceil(8)), h);
+        }
         let maps = if delta { 4 } else { 2 };
         for _ in 0..maps {
             arrays.push(4 * px + 128);
@@ -560,6 +620,16 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
     let scene = Scene::new(design, &camera, &t_cam_sensor, &pose_name)?;
     scene.check_outside(&fixtures.configurations, &pose_name)?;
     let Scene { surface, rays } = scene;
+    // The optics are checked before the output is bounded or anything is written.
+    let optics = if args.images {
+        Some(fabkit_designs::optics::of_design(
+            design,
+            fabkit_designs::ChordTolerance::new(fabkit_designs::ChordTolerance::DEFAULT_MM)?,
+        )?)
+    } else {
+        None
+    };
+    let image_bits = optics.as_ref().map(|o| o.camera.bit_depth);
     let c = rays.origin_mm;
     let (w, h) = (rays.width, rays.height);
     let n_cfg = fixtures.configurations.len();
@@ -570,6 +640,7 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
         n_cfg as u64,
         fixtures.patterns.len() as u64,
         args.format,
+        image_bits,
     );
     let format_name = |f: DataFormat| match f {
         DataFormat::Npy => "npy",
@@ -592,6 +663,7 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
                 n_cfg as u64,
                 fixtures.patterns.len() as u64,
                 f,
+                image_bits,
             );
             format!("--format {} (at most {})", format_name(f), shown_bytes(b))
         })
@@ -640,6 +712,10 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
         loaded.sha256
     );
 
+    let imaging = optics.map(|o| {
+        let i = camera.intrinsics();
+        Imaging::new(o, [i.cx_px, i.cy_px], &rays, &ref_hits)
+    });
     let staged = StagedDir::new(&args.out, claim)?;
     let reference = DepthFrame::new(&rays, &ref_hits);
     let preview = finite_range(&reference.range_mm)
@@ -667,7 +743,7 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
         }
         Ok(entries)
     };
-    let ref_entries = write(
+    let mut ref_entries = write(
         frame_files(
             "reference",
             &reference,
@@ -678,13 +754,19 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
         )?,
         &mut all,
     )?;
+    if let Some(im) = &imaging {
+        ref_entries.extend(write(
+            vec![image_file("reference", im, &rays, &ref_hits, None, 0)?],
+            &mut all,
+        )?);
+    }
     bar.set(1, frames);
 
     // Configurations in parallel, as many at a time as the memory budget holds; each writes
     // its own folder. Entries are kept in index order.
     let at_once = frames_at_once(w as u64 * h as u64, rayon::current_num_threads() as u64);
     let done = AtomicUsize::new(0);
-    let render = |cfg: &Configuration| -> Result<(Value, Written), String> {
+    let render = |(k, cfg): (usize, &Configuration)| -> Result<(Value, Written), String> {
         let hits = indented_hits(&rays, &ref_hits, &cfg.primitives, surface.base_z_mm());
         let frame = DepthFrame::new(&rays, &hits);
         let files = frame_files(
@@ -698,12 +780,30 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
         .map_err(|e| e.to_string())?;
         let mut entries = Vec::new();
         let mut list = Vec::new();
-        for (rel, bytes, mut e) in files {
-            staged.write(&rel, &bytes).map_err(|e| e.to_string())?;
-            let sha = sha256_hex(&bytes);
-            e["sha256"] = json!(sha);
-            list.push((rel, sha, bytes.len()));
-            entries.push(e);
+        let mut put = |files: Files| -> Result<(), String> {
+            for (rel, bytes, mut e) in files {
+                staged.write(&rel, &bytes).map_err(|e| e.to_string())?;
+                let sha = sha256_hex(&bytes);
+                e["sha256"] = json!(sha);
+                list.push((rel, sha, bytes.len()));
+                entries.push(e);
+            }
+            Ok(())
+        };
+        put(files)?;
+        // The image after the depth files are written: its buffers take the place of theirs
+        // in the frame's memory budget.
+        if let Some(im) = &imaging {
+            let f = image_file(
+                &cfg.name,
+                im,
+                &rays,
+                &hits,
+                Some(&cfg.primitives),
+                k as u64 + 1,
+            )
+            .map_err(|e| e.to_string())?;
+            put(vec![f])?;
         }
         let contact = (0..w * h)
             .filter(|&p| frame.contact[p] && reference.range_mm[p].is_finite())
@@ -724,10 +824,11 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
             list,
         ))
     };
-    let rendered: Vec<Result<(Value, Written), String>> = fixtures
-        .configurations
+    let indexed: Vec<(usize, &Configuration)> =
+        fixtures.configurations.iter().enumerate().collect();
+    let rendered: Vec<Result<(Value, Written), String>> = indexed
         .chunks(at_once)
-        .flat_map(|chunk| chunk.par_iter().map(&render).collect::<Vec<_>>())
+        .flat_map(|chunk| chunk.par_iter().copied().map(&render).collect::<Vec<_>>())
         .collect();
     let mut cfg_entries = Vec::new();
     for r in rendered {
@@ -759,7 +860,7 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
 
     let i = camera.intrinsics();
     let m = t_cam_sensor.to_homogeneous();
-    let manifest = json!({
+    let mut manifest = json!({
         "fabkit_version": env!("CARGO_PKG_VERSION"),
         "command_line": std::env::args().collect::<Vec<_>>(),
         "description": format!("Ground-truth depth of the sensor surface, reference (undeformed) and indented by each protrusion {} configuration (R-Tac0 Sec. IV-B, Fig. 6, Eq. (2)-(3)): complete depth = reference + delta. Exact per-pixel rays of the camera model; surfaces in closed form.", fixture_kind),
@@ -791,6 +892,23 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
         "masks_and_pairs": extra_entries,
         "files": all.iter().map(|(f, s, b)| json!({"file": f, "sha256": s, "bytes": b})).collect::<Vec<_>>(),
     });
+    if let Some(im) = &imaging {
+        manifest["images"] = json!({
+            "file": "image.png in reference/ and in each configuration's folder",
+            "model": "each light a point emitter with a cosine beam inside its cone, inverse-square fall-off and the incidence cosine; the surface Lambertian (albedo_rgb) plus a normalised Blinn-Phong lobe (specular, roughness); a light is shadowed where the segment to it enters a protrusion; then gain, vignetting 1 - v (r / r_corner)^2 about the principal point, photon noise (Gaussian with the Poisson variance of the signal's electrons) and read noise, clipped and quantised (calibration/src/groundtruth/shading.rs)",
+            "lights": im.optics.lights.iter().zip(&im.optics.light_sources).map(|(l, src)| {
+                let mut v = serde_json::to_value(l).unwrap_or(Value::Null);
+                v["source"] = json!(src);
+                v
+            }).collect::<Vec<_>>(),
+            "surface": im.optics.surface,
+            "camera": im.optics.camera,
+            "gain": im.gain,
+            "exposure": if im.auto_exposed { "set on the reference image (its 99th-percentile pixel at 0.8 of full scale; optics.camera.gain not given) and held for every frame" } else { "optics.camera.gain, every frame" },
+            "noise": "seeded (optics.camera.seed): each frame draws its own noise (noise_frame: 0 for the reference, i + 1 for configuration i); the same seed gives the same bytes",
+            "not_modelled": IMAGES_NOT_MODELLED,
+        });
+    }
     let mut text = serde_json::to_vec_pretty(&manifest)?;
     text.push(b'\n');
     staged.write("manifest.json", &text)?;

@@ -6,6 +6,8 @@
 //! - `radiance_two_lights_shadows`: every pixel's radiance, with a shadow ray per light
 //!   against the tip;
 //! - `expose_8bit`: the camera's response (gain, vignetting, seeded noise, 8 bit);
+//! - `frame_image_two_lights_shadows_8bit`: both, the whole image of a frame as `fabkit
+//!   groundtruth --images` makes it (the 20 ms target);
 //! - `indented_hits`: the surface along every ray (closed-form skin, exact tip), for scale.
 //!
 //! Not timed: the camera's rays (once per camera).
@@ -13,7 +15,7 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use fabkit_calibration::groundtruth::exact::ExactPrimitives;
 use fabkit_calibration::groundtruth::rays::PixelRays;
-use fabkit_calibration::groundtruth::shading::{expose, frame_radiance};
+use fabkit_calibration::groundtruth::shading::{expose, frame_radiance, Exposure, Imaging};
 use fabkit_calibration::groundtruth::surface::ReferenceSurface;
 use fabkit_calibration::groundtruth::synthetic::{benchmark_pose, rtac0_body};
 use fabkit_calibration::groundtruth::{indented_hits, reference_hits};
@@ -61,7 +63,25 @@ fn bench(c: &mut Criterion) {
         b.iter(|| pool.install(|| frame_radiance(&rays, &hits, &optics, Some(&prims))))
     });
     g.bench_function("expose_8bit", |b| {
-        b.iter(|| pool.install(|| expose(&rad, 640, 480, [320.0, 240.0], &optics.camera)))
+        b.iter(|| {
+            pool.install(|| {
+                expose(
+                    &rad,
+                    640,
+                    480,
+                    [320.0, 240.0],
+                    &optics.camera,
+                    Exposure {
+                        gain: 1.0,
+                        frame: 0,
+                    },
+                )
+            })
+        })
+    });
+    let imaging = Imaging::new(optics.clone(), [320.0, 240.0], &rays, &reference);
+    g.bench_function("frame_image_two_lights_shadows_8bit", |b| {
+        b.iter(|| pool.install(|| imaging.image(&rays, &hits, Some(&prims), 1)))
     });
     g.bench_function("indented_hits", |b| {
         b.iter(|| indented_hits(&rays, &reference, &prims, surface.base_z_mm()))

@@ -499,7 +499,7 @@ fn groundtruth_bounds_its_output_first_and_writes_npz_or_png_on_request() {
             "npz" => fabkit::groundtruth_cmd::DataFormat::Npz,
             _ => fabkit::groundtruth_cmd::DataFormat::Png,
         };
-        let (n_files, bound) = fabkit::groundtruth_cmd::output_bound(w, h, 4, 2, f);
+        let (n_files, bound) = fabkit::groundtruth_cmd::output_bound(w, h, 4, 2, f, None);
         assert_eq!(files.len() as u64 + 1, n_files, "{format}");
         assert!(
             bytes <= bound,

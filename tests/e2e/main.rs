@@ -20,6 +20,7 @@ mod extreme_values;
 mod fixtures_cli;
 mod groundtruth_cli;
 mod groundtruth_flat;
+mod groundtruth_images;
 mod groundtruth_open3d;
 mod maker_path;
 mod output_ownership;

@@ -11,9 +11,9 @@
 //! reflected from one part of the skin onto another.
 
 use fabkit_designs::optics::{CameraResponse, Light, Reflectance};
-use rand_chacha::rand_core::SeedableRng;
-use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
+use rand_pcg::rand_core::SeedableRng;
+use rand_pcg::Pcg64Mcg;
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
@@ -30,24 +30,94 @@ fn unit(a: [f64; 3]) -> [f64; 3] {
     [a[0] / n, a[1] / n, a[2] / n]
 }
 
+/// A light with what every pixel needs of it worked out once: its beam's unit axis, its cone's
+/// cosine and its coloured intensity.
+#[derive(Debug, Clone, Copy)]
+struct Prepared {
+    position_mm: [f64; 3],
+    axis: [f64; 3],
+    cos_cone: f64,
+    rgb: [f64; 3],
+}
+
+impl Prepared {
+    fn of(light: &Light) -> Prepared {
+        Prepared {
+            position_mm: light.position_mm,
+            axis: unit(light.direction),
+            cos_cone: light.cone_half_angle_deg.to_radians().cos() - 1e-12,
+            rgb: light.colour_rgb.map(|c| c * light.intensity),
+        }
+    }
+
+    /// The irradiance factor at `p_mm` with normal `n` and the unit vector to the light, or
+    /// `None` where the point is outside the cone or faces away.
+    #[inline]
+    fn incident(&self, p_mm: [f64; 3], n: [f64; 3]) -> Option<(f64, [f64; 3])> {
+        let to_light = sub(self.position_mm, p_mm);
+        let d2 = dot(to_light, to_light);
+        if !(d2 > 0.0) {
+            return None;
+        }
+        let inv = 1.0 / d2.sqrt();
+        let l = to_light.map(|x| x * inv);
+        let cos_incidence = dot(n, l);
+        let cos_axis = -dot(self.axis, l);
+        if cos_incidence <= 0.0 || cos_axis <= 0.0 || cos_axis < self.cos_cone {
+            return None;
+        }
+        Some((cos_axis * cos_incidence / d2, l))
+    }
+}
+
 /// The irradiance `light` gives the point `p_mm` whose surface normal (towards the light's
 /// side) is `n`, per colour channel, relative units (see [`Light::intensity`]); 0 when the
 /// point is outside the light's cone or faces away from it.
 pub fn irradiance(light: &Light, p_mm: [f64; 3], n: [f64; 3]) -> [f64; 3] {
-    let to_light = sub(light.position_mm, p_mm);
-    let d2 = dot(to_light, to_light);
-    if !(d2 > 0.0) {
-        return [0.0; 3];
+    let pl = Prepared::of(light);
+    match pl.incident(p_mm, n) {
+        Some((e, _)) => pl.rgb.map(|c| c * e),
+        None => [0.0; 3],
     }
-    let l = unit(to_light);
-    let cos_incidence = dot(n, l);
-    let cos_axis = -dot(unit(light.direction), l);
-    let cone = light.cone_half_angle_deg.to_radians().cos();
-    if cos_incidence <= 0.0 || cos_axis <= 0.0 || cos_axis < cone - 1e-12 {
-        return [0.0; 3];
+}
+
+/// The specular lobe's exponent and normalisation of `surface` (normalised Blinn-Phong).
+fn lobe_of(surface: &Reflectance) -> (f64, f64) {
+    let r = surface.roughness.clamp(1e-3, 1.0);
+    let shininess = (2.0 / (r * r) - 2.0).max(0.0);
+    (shininess, surface.specular * (shininess + 8.0) / (8.0 * PI))
+}
+
+#[inline]
+fn radiance_prepared(
+    p_mm: [f64; 3],
+    n: [f64; 3],
+    to_eye: [f64; 3],
+    albedo_rgb: [f64; 3],
+    (shininess, lobe_scale): (f64, f64),
+    lights: &[Prepared],
+    lit: impl Fn(usize, [f64; 3]) -> bool,
+) -> [f64; 3] {
+    let diffuse = albedo_rgb.map(|a| a / PI);
+    let mut out = [0.0; 3];
+    for (i, light) in lights.iter().enumerate() {
+        let Some((e, l)) = light.incident(p_mm, n) else {
+            continue;
+        };
+        if !lit(i, l) {
+            continue;
+        }
+        let lobe = if lobe_scale > 0.0 {
+            let h = unit([l[0] + to_eye[0], l[1] + to_eye[1], l[2] + to_eye[2]]);
+            lobe_scale * dot(n, h).max(0.0).powf(shininess)
+        } else {
+            0.0
+        };
+        for c in 0..3 {
+            out[c] += (diffuse[c] + lobe) * e * light.rgb[c];
+        }
     }
-    let e = light.intensity * cos_axis * cos_incidence / d2;
-    light.colour_rgb.map(|c| c * e)
+    out
 }
 
 /// The radiance the point `p_mm` (surface normal `n`, towards the camera's side) sends along
@@ -63,38 +133,77 @@ pub fn radiance(
     lights: &[Light],
     lit: impl Fn(usize) -> bool,
 ) -> [f64; 3] {
-    let r = surface.roughness.clamp(1e-3, 1.0);
-    let shininess = (2.0 / (r * r) - 2.0).max(0.0);
-    let mut out = [0.0; 3];
-    for (i, light) in lights.iter().enumerate() {
-        let e = irradiance(light, p_mm, n);
-        if e == [0.0; 3] || !lit(i) {
-            continue;
-        }
-        let l = unit(sub(light.position_mm, p_mm));
-        let h = unit([l[0] + to_eye[0], l[1] + to_eye[1], l[2] + to_eye[2]]);
-        let lobe =
-            surface.specular * (shininess + 8.0) / (8.0 * PI) * dot(n, h).max(0.0).powf(shininess);
-        for c in 0..3 {
-            out[c] += (albedo_rgb[c] / PI + lobe) * e[c];
-        }
+    let prepared: Vec<Prepared> = lights.iter().map(Prepared::of).collect();
+    radiance_prepared(
+        p_mm,
+        n,
+        to_eye,
+        albedo_rgb,
+        lobe_of(surface),
+        &prepared,
+        |i, _| lit(i),
+    )
+}
+
+/// What differs between the frames of one set: the gain they are all exposed with (a manual
+/// exposure, held) and the frame's index, whose noise is its own.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Exposure {
+    /// Pixel value, as a fraction of full scale, per unit of radiance, > 0.
+    pub gain: f64,
+    /// The frame's index in its set (0 for the reference): each frame draws its own noise.
+    pub frame: u64,
+}
+
+/// The fraction of full scale [`auto_gain`] puts the reference image's bright pixels at.
+pub const AUTO_EXPOSURE_LEVEL: f64 = 0.8;
+
+/// The gain that puts the 99th percentile of `radiance`'s brightest channel (pixels that see
+/// the skin, NaN elsewhere) at [`AUTO_EXPOSURE_LEVEL`] of full scale: the camera's exposure set
+/// once on the reference image, as on a real sensor whose exposure is then held. 1 when no
+/// pixel has light.
+pub fn auto_gain(radiance: &[[f64; 3]]) -> f64 {
+    let mut v: Vec<f64> = radiance
+        .iter()
+        .map(|p| p[0].max(p[1]).max(p[2]))
+        .filter(|x| x.is_finite() && *x > 0.0)
+        .collect();
+    if v.is_empty() {
+        return 1.0;
     }
-    out
+    let k = ((v.len() - 1) as f64 * 0.99).round() as usize;
+    let (_, p99, _) = v.select_nth_unstable_by(k, f64::total_cmp);
+    AUTO_EXPOSURE_LEVEL / *p99
+}
+
+/// SplitMix64's finaliser: a bijection of the 64-bit words that scatters nearby inputs.
+fn mix64(mut z: u64) -> u64 {
+    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// The seed of row `v` of frame `frame` of a camera seeded with `seed`.
+fn row_seed(seed: u64, frame: u64, v: u64) -> u64 {
+    mix64(mix64(mix64(seed) ^ frame) ^ v)
 }
 
 /// The image the camera records of `radiance` (row-major, `width` x `height`, per channel):
-/// times `gain` and the vignetting (`1 - vignetting x (r / r_corner)^2` about `principal_px`),
-/// as a fraction of full scale, with photon noise (the signal's electrons out of
-/// `full_well_electrons`, Gaussian with the Poisson variance; `rand_distr`'s ziggurat) and read
-/// noise, clipped and quantised to `bit_depth` bits. NaN radiance (a pixel that sees nothing) records 0 plus
-/// noise. The noise of row `v` comes from its own stream of `seed`: the same seed gives the
-/// same values whatever the thread count.
+/// times the exposure's gain and the vignetting (`1 - vignetting x (r / r_corner)^2` about
+/// `principal_px`), as a fraction of full scale, with photon noise (the signal's electrons out
+/// of `full_well_electrons`, Poisson as a Gaussian of the same variance) and read noise (one
+/// Gaussian of the summed variance, `rand_distr`'s ziggurat on a PCG-64 stream), clipped and quantised to
+/// `bit_depth` bits. NaN radiance (a pixel that sees nothing) records 0 plus noise. The noise
+/// of row `v` of frame `exposure.frame` comes from its own stream of `seed`: the same seed
+/// gives the same values whatever the thread count, and each frame of a set its own noise.
 pub fn expose(
     radiance: &[[f64; 3]],
     width: usize,
     height: usize,
     principal_px: [f64; 2],
     camera: &CameraResponse,
+    exposure: Exposure,
 ) -> Vec<[u16; 3]> {
     let full = f64::from((1u32 << camera.bit_depth.min(16)) - 1);
     let corners = [
@@ -109,29 +218,31 @@ pub fn expose(
         .fold(0.0f64, f64::max)
         .max(1e-12);
     let fw = camera.full_well_electrons;
-    (0..height)
-        .into_par_iter()
-        .flat_map_iter(|v| {
-            let mut rng = ChaCha8Rng::seed_from_u64(camera.seed);
-            rng.set_stream(v as u64);
-            let mut gauss = move || -> f64 { StandardNormal.sample(&mut rng) };
-            (0..width)
-                .map(|u| {
-                    let r2 =
-                        (u as f64 - principal_px[0]).powi(2) + (v as f64 - principal_px[1]).powi(2);
-                    let k = camera.gain * (1.0 - camera.vignetting * r2 / r_corner2);
-                    let l = radiance[v * width + u];
-                    l.map(|x| {
-                        let signal = if x.is_finite() { (k * x).max(0.0) } else { 0.0 };
-                        let electrons = signal.min(1.0) * fw;
-                        let sigma = (electrons + camera.read_noise_electrons.powi(2)).sqrt();
-                        let noisy = (electrons + sigma * gauss()) / fw;
-                        (noisy.clamp(0.0, 1.0) * full).round() as u16
-                    })
-                })
-                .collect::<Vec<_>>()
-        })
-        .collect()
+    let read2 = camera.read_noise_electrons.powi(2);
+    let to_counts = full / fw;
+    let mut out = vec![[0u16; 3]; width * height];
+    if width == 0 {
+        return out;
+    }
+    out.par_chunks_mut(width).enumerate().for_each(|(v, row)| {
+        let mut rng = Pcg64Mcg::seed_from_u64(row_seed(camera.seed, exposure.frame, v as u64));
+        let dv2 = (v as f64 - principal_px[1]).powi(2);
+        let line = &radiance[v * width..(v + 1) * width];
+        for (u, (px, l)) in row.iter_mut().zip(line).enumerate() {
+            let r2 = (u as f64 - principal_px[0]).powi(2) + dv2;
+            let k = exposure.gain * (1.0 - camera.vignetting * r2 / r_corner2);
+            for c in 0..3 {
+                let x = l[c];
+                let signal = if x.is_finite() { (k * x).max(0.0) } else { 0.0 };
+                let electrons = signal.min(1.0) * fw;
+                let sigma = (electrons + read2).sqrt();
+                let g: f64 = StandardNormal.sample(&mut rng);
+                // clamped to [0, full]: adding a half and truncating rounds to nearest
+                px[c] = (((electrons + sigma * g) * to_counts).clamp(0.0, full) + 0.5) as u16;
+            }
+        }
+    });
+    out
 }
 
 /// The radiance every pixel of a frame receives (row-major, per channel; NaN where the ray
@@ -147,6 +258,8 @@ pub fn frame_radiance(
     protrusions: Option<&super::exact::ExactPrimitives>,
 ) -> Vec<[f64; 3]> {
     let o = rays.origin_mm;
+    let lights: Vec<Prepared> = optics.lights.iter().map(Prepared::of).collect();
+    let lobe = lobe_of(&optics.surface);
     (0..rays.dirs.len())
         .into_par_iter()
         .map(|i| {
@@ -157,25 +270,85 @@ pub fn frame_radiance(
             let p = [o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2]];
             // the normal on the camera's side: the elastomer's outward normal reversed
             let n = hits.normal[i].map(|v| -v);
-            let lit = |k: usize| {
+            let lit = |k: usize, l: [f64; 3]| {
                 let Some(prims) = protrusions else {
                     return true;
                 };
-                let to_light = sub(optics.lights[k].position_mm, p);
+                let to_light = sub(lights[k].position_mm, p);
                 let dist = dot(to_light, to_light).sqrt();
-                let l = unit(to_light);
                 let start = [p[0] + 1e-6 * n[0], p[1] + 1e-6 * n[1], p[2] + 1e-6 * n[2]];
                 prims.first_crossing(start, l, dist).is_none()
             };
-            radiance(
+            radiance_prepared(
                 p,
                 n,
                 [-d[0], -d[1], -d[2]],
                 optics.surface.albedo_rgb,
-                &optics.surface,
-                &optics.lights,
+                lobe,
+                &lights,
                 lit,
             )
         })
         .collect()
+}
+
+/// How the frames of one ground-truth set are imaged: the optics, the principal point the
+/// vignetting is centred on, and the gain every frame is exposed with.
+#[derive(Debug, Clone)]
+pub struct Imaging {
+    pub optics: fabkit_designs::optics::ResolvedOptics,
+    /// The camera's principal point (cx, cy), px.
+    pub principal_px: [f64; 2],
+    /// The gain of every frame: `optics.camera.gain`, or [`auto_gain`] of the reference.
+    pub gain: f64,
+    /// The gain was set on the reference image ([`auto_gain`]), not given.
+    pub auto_exposed: bool,
+}
+
+impl Imaging {
+    /// The imaging of the frames seen along `rays`, whose reference surface is `reference`
+    /// (for the exposure when `optics` gives no gain).
+    pub fn new(
+        optics: fabkit_designs::optics::ResolvedOptics,
+        principal_px: [f64; 2],
+        rays: &super::rays::PixelRays,
+        reference: &super::SurfaceHits,
+    ) -> Imaging {
+        let (gain, auto_exposed) = match optics.camera.gain {
+            Some(g) => (g, false),
+            None => (
+                auto_gain(&frame_radiance(rays, reference, &optics, None)),
+                true,
+            ),
+        };
+        Imaging {
+            optics,
+            principal_px,
+            gain,
+            auto_exposed,
+        }
+    }
+
+    /// The image of frame `frame` (0: the reference) whose surface is `hits`, shadowed by
+    /// `protrusions`: row-major `width x height` RGB values of `optics.camera.bit_depth` bits.
+    pub fn image(
+        &self,
+        rays: &super::rays::PixelRays,
+        hits: &super::SurfaceHits,
+        protrusions: Option<&super::exact::ExactPrimitives>,
+        frame: u64,
+    ) -> Vec<[u16; 3]> {
+        let radiance = frame_radiance(rays, hits, &self.optics, protrusions);
+        expose(
+            &radiance,
+            rays.width,
+            rays.height,
+            self.principal_px,
+            &self.optics.camera,
+            Exposure {
+                gain: self.gain,
+                frame,
+            },
+        )
+    }
 }

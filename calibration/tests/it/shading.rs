@@ -2,7 +2,12 @@
 //! point light sends onto a flat Lambertian floor, a light's cone and shadows, and the camera's
 //! response (gain, vignetting, photon and read noise, seeded and thread-count independent).
 
-use fabkit_calibration::groundtruth::shading::{expose, irradiance, radiance};
+use fabkit_calibration::groundtruth::shading::{expose, irradiance, radiance, Exposure};
+
+const FRAME0: Exposure = Exposure {
+    gain: 1.0,
+    frame: 0,
+};
 use fabkit_designs::optics::{CameraResponse, Light, Reflectance};
 use std::f64::consts::PI;
 
@@ -119,7 +124,7 @@ fn the_camera_adds_the_noise_of_its_electrons_the_same_for_a_seed() {
         seed: 7,
         ..CameraResponse::default()
     };
-    let img = expose(&flat_field(w, h, 0.5), w, h, [127.5, 127.5], &cam);
+    let img = expose(&flat_field(w, h, 0.5), w, h, [127.5, 127.5], &cam, FRAME0);
     let vals: Vec<f64> = img.iter().map(|p| f64::from(p[1])).collect();
     let mean = vals.iter().sum::<f64>() / vals.len() as f64;
     let sd = (vals.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / vals.len() as f64).sqrt();
@@ -139,8 +144,8 @@ fn the_camera_adds_the_noise_of_its_electrons_the_same_for_a_seed() {
         .num_threads(2)
         .build()
         .unwrap();
-    let a = one.install(|| expose(&flat_field(w, h, 0.5), w, h, [127.5, 127.5], &cam));
-    let b = two.install(|| expose(&flat_field(w, h, 0.5), w, h, [127.5, 127.5], &cam));
+    let a = one.install(|| expose(&flat_field(w, h, 0.5), w, h, [127.5, 127.5], &cam, FRAME0));
+    let b = two.install(|| expose(&flat_field(w, h, 0.5), w, h, [127.5, 127.5], &cam, FRAME0));
     assert_eq!(a, b);
     assert_eq!(a, img);
     let other = expose(
@@ -149,8 +154,21 @@ fn the_camera_adds_the_noise_of_its_electrons_the_same_for_a_seed() {
         h,
         [127.5, 127.5],
         &CameraResponse { seed: 8, ..cam },
+        FRAME0,
     );
     assert_ne!(other, img);
+    let next = expose(
+        &flat_field(w, h, 0.5),
+        w,
+        h,
+        [127.5, 127.5],
+        &cam,
+        Exposure {
+            gain: 1.0,
+            frame: 1,
+        },
+    );
+    assert_ne!(next, img, "each frame of a set has its own noise");
 }
 
 /// Without noise, the corners record `1 - vignetting` of the centre; a pixel that sees nothing
@@ -159,7 +177,7 @@ fn the_camera_adds_the_noise_of_its_electrons_the_same_for_a_seed() {
 fn vignetting_quantisation_and_clipping() {
     let (w, h) = (101, 81);
     let cam = CameraResponse {
-        gain: 2.0,
+        gain: None,
         vignetting: 0.3,
         full_well_electrons: 1e12,
         read_noise_electrons: 0.0,
@@ -169,7 +187,11 @@ fn vignetting_quantisation_and_clipping() {
     let mut rad = flat_field(w, h, 0.2);
     rad[1] = [f64::NAN; 3];
     rad[w * h - 2] = [10.0; 3];
-    let img = expose(&rad, w, h, [50.0, 40.0], &cam);
+    let gain2 = Exposure {
+        gain: 2.0,
+        frame: 0,
+    };
+    let img = expose(&rad, w, h, [50.0, 40.0], &cam, gain2);
     let full: f64 = 65535.0;
     assert_eq!(f64::from(img[40 * w + 50][0]), (0.4 * full).round());
     assert_eq!(f64::from(img[0][0]), (0.7 * 0.4 * full).round());
@@ -184,6 +206,7 @@ fn vignetting_quantisation_and_clipping() {
             bit_depth: 8,
             ..cam
         },
+        gain2,
     );
     assert_eq!(eight[40 * w + 50][0], 102);
 }

@@ -160,7 +160,7 @@ fn each_optics_rule_names_its_path() {
         ("optics.marker_albedo_rgb[0]", |d| {
             optics(d).marker_albedo_rgb = [2.0, 0.9, 0.9]
         }),
-        ("optics.camera.gain", |d| optics(d).camera.gain = 0.0),
+        ("optics.camera.gain", |d| optics(d).camera.gain = Some(0.0)),
         ("optics.camera.vignetting", |d| {
             optics(d).camera.vignetting = 1.0
         }),
