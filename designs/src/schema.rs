@@ -169,7 +169,7 @@ pub const DESIGN_SCHEMA_TITLE: &str = "fabkit design";
 pub fn design_json_schema() -> serde_json::Value {
     let generator = schemars::generate::SchemaSettings::draft2020_12().into_generator();
     let mut v = generator.into_root_schema_for::<Design>().to_value();
-    unit_bounds(&mut v, Unit::Plain);
+    unit_bounds(&mut v, Unit::Plain, false);
     if let serde_json::Value::Object(m) = &mut v {
         m.insert("$id".into(), DESIGN_SCHEMA_ID.into());
         m.insert("title".into(), DESIGN_SCHEMA_TITLE.into());
@@ -189,7 +189,8 @@ pub fn design_json_schema_text() -> String {
 /// Adds the ranges of [`crate::values::check_values`] to every number of the schema `v`
 /// under `unit` (a key ending `_mm` or `_deg` sets the unit for everything under it, as there),
 /// leaving bounds already given alone, and the unit as description of a key that has none.
-fn unit_bounds(v: &mut serde_json::Value, unit: Unit) {
+/// `signed`: under a length of [`DESIGN_SIGNED_MM`], which may be negative.
+fn unit_bounds(v: &mut serde_json::Value, unit: Unit, signed: bool) {
     use crate::values::{MAX_ANGLE_DEG, MAX_LENGTH_MM, MAX_PLAIN};
     use serde_json::Value;
     let Value::Object(m) = v else { return };
@@ -200,6 +201,7 @@ fn unit_bounds(v: &mut serde_json::Value, unit: Unit) {
     };
     if is_number {
         let (lo, hi) = match unit {
+            Unit::Mm if signed => (-MAX_LENGTH_MM, MAX_LENGTH_MM),
             Unit::Mm => (0.0, MAX_LENGTH_MM),
             Unit::Deg => (-MAX_ANGLE_DEG, MAX_ANGLE_DEG),
             Unit::Plain => (-MAX_PLAIN, MAX_PLAIN),
@@ -222,24 +224,28 @@ fn unit_bounds(v: &mut serde_json::Value, unit: Unit) {
                 };
                 sm.entry("description").or_insert_with(|| said.into());
             }
-            unit_bounds(sub, own.unwrap_or(unit));
+            let signed = match own {
+                Some(_) => DESIGN_SIGNED_MM.contains(&key.as_str()),
+                None => signed,
+            };
+            unit_bounds(sub, own.unwrap_or(unit), signed);
         }
     }
     for key in ["items", "additionalProperties"] {
         if let Some(sub) = m.get_mut(key) {
-            unit_bounds(sub, unit);
+            unit_bounds(sub, unit, signed);
         }
     }
     for key in ["prefixItems", "anyOf", "oneOf", "allOf"] {
         if let Some(Value::Array(subs)) = m.get_mut(key) {
             for sub in subs {
-                unit_bounds(sub, unit);
+                unit_bounds(sub, unit, signed);
             }
         }
     }
     if let Some(Value::Object(defs)) = m.get_mut("$defs") {
         for sub in defs.values_mut() {
-            unit_bounds(sub, Unit::Plain);
+            unit_bounds(sub, Unit::Plain, false);
         }
     }
 }

@@ -5,6 +5,7 @@ mod camera_models;
 mod extrinsics_synthetic;
 mod groundtruth_closed_form;
 mod groundtruth_undistort;
+mod images_library;
 mod imprints;
 mod refine;
 mod shading;

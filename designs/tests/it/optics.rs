@@ -4,7 +4,7 @@
 
 use crate::common::{assert_each_rule_names_its_path, RuleCase};
 use fabkit_designs::materials::MaterialsTable;
-use fabkit_designs::optics::{resolve, Light, OpticsParams};
+use fabkit_designs::optics::{of_design, resolve, Light, OpticsParams};
 use fabkit_designs::parts::Stack;
 use fabkit_designs::{library, stack, ChordTolerance, Design};
 
@@ -91,10 +91,15 @@ fn the_other_sensors_get_their_leds_and_given_lights_replace_them() {
     assert_eq!(o.light_sources, ["optics.lights[0]"]);
 }
 
-/// A flat skin carries no lights: rendering it needs `optics.lights`, said by that path.
+/// A flat skin carries no lights: rendering it needs `optics.lights`, said by that path
+/// (the library's flat skin gives four; without them it is refused).
 #[test]
 fn a_design_without_lights_must_give_them() {
-    let d = library::load("soter_channels").unwrap();
+    let mut d = library::load("soter_channels").unwrap();
+    let given = of_design(&d, ChordTolerance::new(0.01).unwrap()).unwrap();
+    assert_eq!(given.lights.len(), 4);
+    assert_eq!(given.light_sources[3], "optics.lights[3]");
+    d.optics.as_mut().unwrap().lights = None;
     let e = resolve(
         &d,
         &Stack {

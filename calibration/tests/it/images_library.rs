@@ -1,0 +1,87 @@
+//! Every library design renders a reference and an indented image from its own optics (the
+//! lights of its housing, casing, shaft body or fingertip base, or its `optics.lights`): seen
+//! from a camera on its axis under the base plane, with a 3 mm sphere tip pressed 1 mm into the
+//! skin part-way to its rim.
+
+use fabkit_calibration::groundtruth::exact::ExactPrimitives;
+use fabkit_calibration::groundtruth::shading::Imaging;
+use fabkit_calibration::groundtruth::{indented_hits, reference_hits, Scene};
+use fabkit_calibration::synthetic::benchmark_intrinsics;
+use fabkit_calibration::CameraModel;
+use fabkit_designs::optics::of_design;
+use fabkit_designs::primitives::Primitive;
+use fabkit_designs::{library, ChordTolerance};
+use nalgebra::{Isometry3, Translation3, UnitQuaternion};
+
+#[test]
+fn every_library_design_renders_a_reference_and_an_indented_image() {
+    let cam = CameraModel::new(benchmark_intrinsics()).unwrap();
+    for (name, _) in library::LIBRARY {
+        let design = library::load(name).unwrap();
+        let optics = of_design(&design, ChordTolerance::new(0.01).unwrap())
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert!(!optics.lights.is_empty(), "{name}");
+        // on the axis, 8 mm under the base plane, looking along +z
+        let base = design.body.base_z_mm();
+        let pose = Isometry3::from_parts(
+            Translation3::new(0.0, 0.0, -(base - 8.0)),
+            UnitQuaternion::identity(),
+        );
+        let scene = Scene::new(&design, &cam, &pose, "pose").unwrap_or_else(|e| panic!("{e}"));
+        let reference = reference_hits(&scene.rays, &scene.surface);
+        let seen = reference.valid_count();
+        assert!(seen > 20_000, "{name}: {seen} pixels see the skin");
+        // the tip pressed 1 mm in along the skin's normal, 60 % of the way from the image
+        // centre to the rim along the middle row (off the pole, where side lights graze)
+        let row = 240 * 640;
+        let rim = (320..640)
+            .take_while(|&u| reference.t_mm[row + u].is_finite())
+            .last()
+            .unwrap();
+        let k = row + 320 + (rim - 320) * 6 / 10;
+        let (o, d, t) = (scene.rays.origin_mm, scene.rays.dirs[k], reference.t_mm[k]);
+        let n = reference.normal[k];
+        let tip = ExactPrimitives::new(&[Primitive::Sphere {
+            centre_mm: std::array::from_fn(|c| o[c] + t * d[c] + 2.0 * n[c]),
+            radius_mm: 3.0,
+        }])
+        .unwrap();
+        let pressed = indented_hits(&scene.rays, &reference, &tip, scene.surface.base_z_mm());
+        let imaging = Imaging::new(optics, [319.5, 239.5], &scene.rays, &reference);
+        let a = imaging.image(&scene.rays, &reference, None, 0);
+        let b = imaging.image(&scene.rays, &pressed, Some(&tip), 1);
+        // the skin is lit: most of the pixels that see it are above the dark level
+        let lit = (0..a.len())
+            .filter(|&i| reference.t_mm[i].is_finite() && a[i].iter().any(|&c| c > 10))
+            .count();
+        assert!(
+            lit as f64 > 0.5 * seen as f64,
+            "{name}: {lit} of {seen} skin pixels lit"
+        );
+        // the imprint shows where the tip pushes the skin in
+        let contact: Vec<usize> = (0..a.len())
+            .filter(|&i| pressed.contact[i] && reference.t_mm[i].is_finite())
+            .collect();
+        assert!(
+            contact.len() > 50,
+            "{name}: {} contact pixels",
+            contact.len()
+        );
+        // green channel: mean difference on the contact against away from it (the noise of two
+        // frames, and the tip's shadow)
+        let diff = |i: usize| f64::from(a[i][1].abs_diff(b[i][1]));
+        let on = contact.iter().map(|&i| diff(i)).sum::<f64>() / contact.len() as f64;
+        let away: Vec<usize> = (0..a.len())
+            .filter(|&i| !pressed.contact[i] && reference.t_mm[i].is_finite())
+            .collect();
+        let off = away.iter().map(|&i| diff(i)).sum::<f64>() / away.len() as f64;
+        eprintln!(
+            "{name}: lit {lit} of {seen}, contact {} px, mean change {on:.2} on it, {off:.2} away",
+            contact.len()
+        );
+        assert!(
+            on > 3.0 * off,
+            "{name}: the imprint changes the image by {on:.2} counts against {off:.2} away from it"
+        );
+    }
+}
