@@ -3,7 +3,7 @@
 //! `values::check_values` bounds it, deterministic text. Validating designs against it is the
 //! end-to-end tests' part (tests/e2e/schema.rs, with an independent validator).
 
-use fabkit_designs::schema::{design_json_schema, design_json_schema_text};
+use fabkit_designs::schema::{design_json_schema, design_json_schema_text, DESIGN_SIGNED_MM};
 use fabkit_designs::values::{MAX_ANGLE_DEG, MAX_LENGTH_MM};
 use serde_json::Value;
 
@@ -92,7 +92,8 @@ fn every_section_refuses_unknown_keys() {
     );
 }
 
-/// Every number under a `_mm` key is a length from 0 (or above 0) to 1000 mm, every number
+/// Every number under a `_mm` key is a length from 0 (or above 0; from -1000 for the signed
+/// lengths of `DESIGN_SIGNED_MM`) to 1000 mm, every number
 /// under a `_deg` key an angle within +-360 deg, as `values::check_values` refuses otherwise.
 #[test]
 fn every_length_and_angle_is_bounded_as_the_validator_bounds_it() {
@@ -109,7 +110,13 @@ fn every_length_and_angle_is_bounded_as_the_validator_bounds_it() {
         };
         if key.ends_with("_mm") {
             lengths += 1;
-            assert!(lo >= 0.0 && hi <= MAX_LENGTH_MM, "`{key}`: {m:?}");
+            // a length the validator lets be negative (a light's position) is signed
+            let floor = if DESIGN_SIGNED_MM.iter().any(|k| key.contains(k)) {
+                -MAX_LENGTH_MM
+            } else {
+                0.0
+            };
+            assert!(lo >= floor && hi <= MAX_LENGTH_MM, "`{key}`: {m:?}");
             assert!(
                 !own || m
                     .get("description")
