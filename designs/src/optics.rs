@@ -143,6 +143,22 @@ impl Default for CameraResponse {
     }
 }
 
+/// A marker's face the camera sees (a TacTip pin's white tip, a UV-ink marker, a painted 3D
+/// marker's end), drawn as `marker_albedo_rgb` on the skin's reference surface: the surface
+/// points within `radius_mm` of `centre_mm`. Recessed features (ShadowTac's dimples) are not
+/// spots: they show by their shape.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MarkerSpot {
+    /// The marker's centre moved along its normal onto the reference surface (offset 0),
+    /// sensor frame, mm.
+    pub centre_mm: [f64; 3],
+    /// Outward unit normal of the surface there: the direction the marker moves in when the
+    /// skin is pushed in.
+    pub normal: [f64; 3],
+    /// Radius of the feature, mm.
+    pub radius_mm: f64,
+}
+
 /// The optics a render uses: the design's `optics` (or its defaults) with its lights resolved.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ResolvedOptics {
@@ -153,6 +169,57 @@ pub struct ResolvedOptics {
     pub surface: Reflectance,
     pub marker_albedo_rgb: [f64; 3],
     pub camera: CameraResponse,
+    /// The markers drawn as albedo, from the layers' raised marker features.
+    pub markers: Vec<MarkerSpot>,
+    /// Where the markers came from: `layers[i].markers[k]` or `layers[i].marker_grid`, one
+    /// entry per pattern with its count.
+    pub marker_sources: Vec<(String, usize)>,
+}
+
+/// The raised marker features of `design` (placed on `stack`'s layers; a flat skin's marker
+/// grids) as spots on its reference surface.
+fn marker_spots(design: &Design, stack: &Stack) -> (Vec<MarkerSpot>, Vec<(String, usize)>) {
+    use crate::markers::Polarity;
+    let (mut spots, mut sources) = (Vec::new(), Vec::new());
+    if design.body.flat_outline().is_some() {
+        let top = design.body.pole_z_mm(0.0);
+        for (i, l) in design.layers.iter().enumerate() {
+            let Some(g) = &l.marker_grid else { continue };
+            if g.feature.side() != Polarity::Raised {
+                continue;
+            }
+            let at = g.positions_mm();
+            sources.push((format!("layers[{i}].marker_grid"), at.len()));
+            spots.extend(at.into_iter().map(|[x, y]| MarkerSpot {
+                centre_mm: [x, y, top],
+                normal: [0.0, 0.0, 1.0],
+                radius_mm: g.feature.radius_mm(),
+            }));
+        }
+        return (spots, sources);
+    }
+    for layer in &stack.layers {
+        let specs = &design.layers[layer.index].markers;
+        for (spec, offset, _, markers) in crate::parts::layers::placed_patterns(design, layer) {
+            if spec.feature.side() != Polarity::Raised {
+                continue;
+            }
+            let k = specs
+                .iter()
+                .position(|s| std::ptr::eq(s, spec))
+                .unwrap_or(0);
+            sources.push((
+                format!("layers[{}].markers[{k}]", layer.index),
+                markers.len(),
+            ));
+            spots.extend(markers.into_iter().map(|m| MarkerSpot {
+                centre_mm: std::array::from_fn(|c| m.position_mm[c] - offset * m.normal[c]),
+                normal: m.normal,
+                radius_mm: spec.feature.radius_mm(),
+            }));
+        }
+    }
+    (spots, sources)
 }
 
 /// Appends every violated rule of `o` to `errs`, each path under `optics.`.
@@ -312,12 +379,15 @@ pub fn resolve(design: &Design, stack: &Stack) -> Result<ResolvedOptics, Vec<Par
     if !errs.is_empty() {
         return Err(errs);
     }
+    let (markers, marker_sources) = marker_spots(design, stack);
     Ok(ResolvedOptics {
         lights,
         light_sources,
         surface: o.surface,
         marker_albedo_rgb: o.marker_albedo_rgb,
         camera: o.camera,
+        markers,
+        marker_sources,
     })
 }
 

@@ -346,7 +346,7 @@ fn frame_files(
 }
 
 /// What the rendered images leave out, in the manifest and the guide.
-const IMAGES_NOT_MODELLED: &str = "refraction through the clear layers between the camera and the reflective surface (rays are straight from the camera centre); light scattered inside the elastomer; light reflected from one part of the skin onto another; the skin's deformation around a protrusion (the indented surface is the skin minus the protrusion solids); markers and dimples (the skin has one albedo); lens blur, motion blur and rolling shutter";
+const IMAGES_NOT_MODELLED: &str = "refraction through the clear layers between the camera and the reflective surface (rays are straight from the camera centre); light scattered inside the elastomer; light reflected from one part of the skin onto another; the skin's deformation around a protrusion (the indented surface is the skin minus the protrusion solids); recessed marker features (ShadowTac's dimples) are not in the surface, so they neither shade nor cast shadows; the markers' own relief and their parallax (a marker is albedo on the reference surface at its normal's foot); fluorescence under UV LEDs (UV light is drawn as violet); lens blur, motion blur and rolling shutter";
 
 /// The rendered image of a frame (`--images`): `dir/image.png`, RGB at the optics' bit
 /// depth, on the depth maps' pixel grid; its noise is that of frame `frame` of the set.
@@ -902,6 +902,12 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
                 v
             }).collect::<Vec<_>>(),
             "surface": im.optics.surface,
+            "markers": {
+                "albedo_rgb": im.optics.marker_albedo_rgb,
+                "patterns": im.optics.marker_sources.iter().map(|(src, n)| json!({"source": src, "count": n})).collect::<Vec<_>>(),
+                "drawn_as": "albedo on the skin's reference surface: the points within the feature's radius of the marker's centre, moved along its normal onto the reference surface; raised features only (pins, painted ends, ink-filled protrusions)",
+                "motion": "normal displacement only: a marker a protrusion pushes in moves along its normal to the protrusion's surface, keeping its size; the skin's stretch along the surface is not modelled",
+            },
             "camera": im.optics.camera,
             "gain": im.gain,
             "exposure": if im.auto_exposed { "set on the reference image (its 99th-percentile pixel at 0.8 of full scale; optics.camera.gain not given) and held for every frame" } else { "optics.camera.gain, every frame" },

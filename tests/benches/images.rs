@@ -55,6 +55,8 @@ fn bench(c: &mut Criterion) {
             vignetting: 0.2,
             ..CameraResponse::default()
         },
+        markers: Vec::new(),
+        marker_sources: Vec::new(),
     };
     let rad = pool.install(|| frame_radiance(&rays, &hits, &optics, Some(&prims)));
     let mut g = c.benchmark_group("images_640x480_one_thread");

@@ -245,10 +245,93 @@ pub fn expose(
     out
 }
 
+/// How far inward (mm) a marker's centre is followed to the indented surface: past any
+/// indentation a protrusion makes.
+const MARKER_FOLLOW_MM: f64 = 50.0;
+
+/// The markers of one frame, moved with its surface: a spot whose centre a protrusion pushes
+/// in moves along its normal to where that line enters the protrusion (normal displacement
+/// only: the skin's stretch along the surface is not modelled), keeping its radius. Looked up
+/// by a hashed grid of cells at least a marker's diameter wide.
+#[derive(Debug, Clone)]
+pub struct MarkerMap {
+    cell_mm: f64,
+    cells: rustc_hash::FxHashMap<[i64; 3], Vec<u32>>,
+    centres: Vec<[f64; 3]>,
+    r2: Vec<f64>,
+}
+
+impl MarkerMap {
+    /// The spots of `spots` on the surface indented by `protrusions` (none: the reference).
+    pub fn new(
+        spots: &[fabkit_designs::optics::MarkerSpot],
+        protrusions: Option<&super::exact::ExactPrimitives>,
+    ) -> MarkerMap {
+        let r_max = spots.iter().map(|m| m.radius_mm).fold(0.0f64, f64::max);
+        let cell_mm = (2.0 * r_max).max(1e-3);
+        let centres: Vec<[f64; 3]> = spots
+            .iter()
+            .map(|m| {
+                let c = m.centre_mm;
+                let Some(prims) = protrusions.filter(|p| p.contains(c)) else {
+                    return c;
+                };
+                let n = m.normal;
+                let start: [f64; 3] = std::array::from_fn(|k| c[k] - MARKER_FOLLOW_MM * n[k]);
+                match prims.first_crossing(start, n, MARKER_FOLLOW_MM) {
+                    Some(hit) => std::array::from_fn(|k| start[k] + hit.t_mm * n[k]),
+                    None => c,
+                }
+            })
+            .collect();
+        let mut cells = rustc_hash::FxHashMap::<[i64; 3], Vec<u32>>::default();
+        for (i, (c, m)) in centres.iter().zip(spots).enumerate() {
+            let r = m.radius_mm;
+            let lo = c.map(|x| ((x - r) / cell_mm).floor() as i64);
+            let hi = c.map(|x| ((x + r) / cell_mm).floor() as i64);
+            for x in lo[0]..=hi[0] {
+                for y in lo[1]..=hi[1] {
+                    for z in lo[2]..=hi[2] {
+                        cells.entry([x, y, z]).or_default().push(i as u32);
+                    }
+                }
+            }
+        }
+        MarkerMap {
+            cell_mm,
+            cells,
+            r2: spots.iter().map(|m| m.radius_mm * m.radius_mm).collect(),
+            centres,
+        }
+    }
+
+    /// Whether the surface point `p_mm` lies on a marker.
+    #[inline]
+    pub fn covers(&self, p_mm: [f64; 3]) -> bool {
+        if self.centres.is_empty() {
+            return false;
+        }
+        let key = p_mm.map(|x| (x / self.cell_mm).floor() as i64);
+        self.cells.get(&key).is_some_and(|list| {
+            list.iter().any(|&i| {
+                let c = self.centres[i as usize];
+                let d = sub(p_mm, c);
+                dot(d, d) <= self.r2[i as usize]
+            })
+        })
+    }
+
+    /// The markers' centres on this frame's surface, sensor frame, mm.
+    pub fn centres_mm(&self) -> &[[f64; 3]] {
+        &self.centres
+    }
+}
+
 /// The radiance every pixel of a frame receives (row-major, per channel; NaN where the ray
 /// sees no skin): the surface `hits` along `rays` (reference or indented) lit by `optics`'
-/// lights, the skin's albedo everywhere (markers are not drawn yet), a light shadowed where the
-/// segment from the point to it enters a protrusion of `protrusions`. The reference skin is
+/// lights, with the markers' albedo on the points within a marker of its centre (moved with the
+/// surface, [`MarkerMap`]) and the skin's elsewhere, a light shadowed where the segment from
+/// the point to it enters a protrusion of `protrusions`. The reference skin is
 /// convex: seen from inside it casts no shadow on itself. Pixels are shaded in parallel, each
 /// on its own: the result does not depend on the thread count.
 pub fn frame_radiance(
@@ -260,6 +343,7 @@ pub fn frame_radiance(
     let o = rays.origin_mm;
     let lights: Vec<Prepared> = optics.lights.iter().map(Prepared::of).collect();
     let lobe = lobe_of(&optics.surface);
+    let markers = MarkerMap::new(&optics.markers, protrusions);
     (0..rays.dirs.len())
         .into_par_iter()
         .map(|i| {
@@ -283,7 +367,11 @@ pub fn frame_radiance(
                 p,
                 n,
                 [-d[0], -d[1], -d[2]],
-                optics.surface.albedo_rgb,
+                if markers.covers(p) {
+                    optics.marker_albedo_rgb
+                } else {
+                    optics.surface.albedo_rgb
+                },
                 lobe,
                 &lights,
                 lit,

@@ -233,6 +233,8 @@ fn optics_with(lights: Vec<Light>) -> ResolvedOptics {
         },
         marker_albedo_rgb: [0.9; 3],
         camera: CameraResponse::default(),
+        markers: Vec::new(),
+        marker_sources: Vec::new(),
     }
 }
 
@@ -339,4 +341,93 @@ fn the_tip_shadows_the_skin_where_its_sphere_blocks_the_light() {
     }
     assert!(shadowed > 100, "{shadowed} shadowed pixels");
     assert!(graze < 10, "{graze} grazing pixels");
+}
+
+/// Markers as albedo, moving with the skin: spots on R-Tac0's sphere (radius 15 mm about the
+/// origin) round the pressed tip. A spot the tip pushes in moves along its normal to where that
+/// line meets the tip's sphere (a quadratic solved here); the pixels drawn with the markers'
+/// albedo are exactly the surface points within a spot's radius of its moved centre, and there
+/// the radiance is that of the skin times 0.9 / 0.7 (the albedos).
+#[test]
+fn markers_move_along_their_normals_and_carry_their_albedo() {
+    use fabkit_calibration::groundtruth::shading::MarkerMap;
+    use fabkit_designs::optics::MarkerSpot;
+    let (rays, prims, c, r) = pressed();
+    let surface = ReferenceSurface::of(&rtac0_body()).unwrap();
+    let reference = reference_hits(&rays, &surface);
+    let hits = indented_hits(&rays, &reference, &prims, surface.base_z_mm());
+    let spots: Vec<MarkerSpot> = (0..12)
+        .flat_map(|k| {
+            [4.0f64, 9.0, 16.0].map(|polar| {
+                let (p, a) = (polar.to_radians(), (30.0 * f64::from(k)).to_radians());
+                let n = [p.sin() * a.cos(), p.sin() * a.sin(), p.cos()];
+                MarkerSpot {
+                    centre_mm: n.map(|x| 15.0 * x),
+                    normal: n,
+                    radius_mm: 0.6,
+                }
+            })
+        })
+        .collect();
+    let map = MarkerMap::new(&spots, Some(&prims));
+    let mut moved = 0;
+    for (s, got) in spots.iter().zip(map.centres_mm()) {
+        let (m, n) = (s.centre_mm, s.normal);
+        let inside = (0..3).map(|k| (m[k] - c[k]).powi(2)).sum::<f64>() < r * r;
+        let want = if inside {
+            // m - t n on the sphere |x - c| = r, the root on the camera's side (t > 0)
+            let d: Vec<f64> = (0..3).map(|k| m[k] - c[k]).collect();
+            let b = (0..3).map(|k| d[k] * n[k]).sum::<f64>();
+            let cc = d.iter().map(|x| x * x).sum::<f64>() - r * r;
+            let t = b + (b * b - cc).sqrt();
+            moved += 1;
+            std::array::from_fn(|k| m[k] - t * n[k])
+        } else {
+            m
+        };
+        for k in 0..3 {
+            assert!((got[k] - want[k]).abs() < 1e-9, "{got:?} vs {want:?}");
+        }
+    }
+    assert!(moved >= 10, "{moved} spots pushed in");
+
+    let light = Light {
+        position_mm: [0.0, 0.0, -1e6],
+        direction: [0.0, 0.0, 1.0],
+        cone_half_angle_deg: 90.0,
+        colour_rgb: [1.0, 1.0, 1.0],
+        intensity: 1e12,
+    };
+    let plain = optics_with(vec![light]);
+    let marked = ResolvedOptics {
+        markers: spots.clone(),
+        ..plain.clone()
+    };
+    let a = frame_radiance(&rays, &hits, &plain, Some(&prims));
+    let b = frame_radiance(&rays, &hits, &marked, Some(&prims));
+    let (mut on_marker, mut on_pushed) = (0, 0);
+    for i in 0..rays.dirs.len() {
+        let t = hits.t_mm[i];
+        if !t.is_finite() {
+            continue;
+        }
+        let (o, d) = (rays.origin_mm, rays.dirs[i]);
+        let p: [f64; 3] = std::array::from_fn(|k| o[k] + t * d[k]);
+        let within = map
+            .centres_mm()
+            .iter()
+            .any(|q| (0..3).map(|k| (p[k] - q[k]).powi(2)).sum::<f64>() <= 0.36);
+        if within {
+            on_marker += 1;
+            on_pushed += usize::from(hits.contact[i]);
+            assert!(
+                (b[i][0] - a[i][0] * 0.9 / 0.7).abs() <= 1e-12 * a[i][0].max(1.0),
+                "pixel {i}"
+            );
+        } else {
+            assert_eq!(a[i], b[i], "pixel {i} off the markers");
+        }
+    }
+    assert!(on_marker > 500, "{on_marker} marker pixels");
+    assert!(on_pushed > 50, "{on_pushed} marker pixels on the imprint");
 }

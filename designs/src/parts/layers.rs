@@ -82,7 +82,7 @@ fn rim_margin(spec: &MarkerSpec, min_wall: f64) -> f64 {
 
 /// Every pattern of `layer` that places (a pattern that does not is the validation's to
 /// report): the spec, its surface offset, the surface and the markers.
-fn placed_patterns<'a>(
+pub(crate) fn placed_patterns<'a>(
     design: &'a Design,
     layer: &ResolvedLayer,
 ) -> Vec<(&'a MarkerSpec, f64, Surface, Vec<markers::Marker>)> {

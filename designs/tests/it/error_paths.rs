@@ -223,7 +223,7 @@ fn each_quoted_number_is_refused_at_its_own_location() {
             "x.yaml:28:19: layers[0].thickness_mm = \"1.5\": a number must be written without quotes",
             "x.yaml:42:19: layers[1].thickness_mm = \"1.5\": a number must be written without quotes",
             "x.yaml:55:19: layers[2].thickness_mm = \"1.5\": a number must be written without quotes",
-            "x.yaml:62:24: mold.sprue.diameter_mm = \"3\": a number must be written without quotes",
+            "x.yaml:70:24: mold.sprue.diameter_mm = \"3\": a number must be written without quotes",
         ],
         "{e}"
     );
