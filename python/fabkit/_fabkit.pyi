@@ -278,6 +278,15 @@ class DepthRenderer:
     def masks(self) -> Tuple[npt.NDArray[np.bool_], npt.NDArray[np.bool_]]:
         """(left, right) half masks (H, W): rays meeting the reference surface at sensor-frame
         x < 0 / x >= 0."""
+    def image(
+        self, protrusions: Optional[ProtrusionSet] = None, *, frame: int = 0
+    ) -> np.ndarray:
+        """The tactile image the camera sees, (H, W, 3) RGB uint8 or uint16
+        (optics.camera.bit_depth), as `fabkit groundtruth --images` writes image.png: the
+        reference skin, or the skin indented by the protrusions with their shadows, under the
+        design's lights, markers moved with the skin, the camera's gain, vignetting and seeded
+        noise. frame: the frame's own noise (the CLI: reference 0, configuration i -> i + 1).
+        Raises GroundTruthError naming the path of a bad optics value."""
 
 def _library_build_seconds(
     design: Design, repeats: int, *, chord_tolerance_mm: float = 0.01

@@ -5,6 +5,7 @@
 use std::sync::Arc;
 
 use fabkit_calibration::groundtruth::inputs::{isometry_of, read_fixtures, Configuration};
+use fabkit_calibration::groundtruth::shading::Imaging;
 use fabkit_calibration::groundtruth::{
     half_masks, indented_hits, reference_hits, DepthFrame, Scene, SurfaceHits,
 };
@@ -90,6 +91,13 @@ pub struct DepthRenderer {
     scene: Scene,
     reference_hits: SurfaceHits,
     reference: DepthFrame,
+    /// The design, for its optics when an image is first asked for.
+    design: fabkit_designs::Design,
+    /// The camera's principal point (cx, cy), px: the vignetting's centre.
+    principal_px: [f64; 2],
+    /// The imaging of `image`, set up on its first call (the optics resolved, the exposure set
+    /// on the reference).
+    imaging: std::sync::OnceLock<Result<Imaging, String>>,
 }
 
 fn f32_map(v: &[f64], h: usize, w: usize) -> Array2<f32> {
@@ -193,6 +201,9 @@ impl DepthRenderer {
                 scene,
                 reference_hits: hits,
                 reference,
+                design: design.clone(),
+                principal_px: [i.cx_px, i.cy_px],
+                imaging: std::sync::OnceLock::new(),
             })
         })?
         .map_err(|e: String| GroundTruthError::new_err(e))
@@ -267,6 +278,81 @@ impl DepthRenderer {
             report_progress(&progress, k + 1, n, &p.cfg.name);
         }
         Ok(out)
+    }
+
+    /// The tactile image the camera sees, (H, W, 3) RGB, uint8 or uint16 by the design's
+    /// `optics.camera.bit_depth`, as `fabkit groundtruth --images` writes `image.png`: the
+    /// reference skin, or the skin indented by `protrusions` (a ProtrusionSet) with its shadows,
+    /// under the design's lights (its `optics` section, or the lights of its housing, casing,
+    /// shaft body or fingertip base), the markers moved with the skin, the camera's gain,
+    /// vignetting and seeded noise. `frame` picks the frame's own noise: the CLI gives the
+    /// reference 0 and configuration i of the fixtures folder i + 1. The exposure, when
+    /// `optics.camera.gain` is not given, is set once on the reference and held. Raises
+    /// GroundTruthError naming the parameter path of bad optics, or when the camera centre is
+    /// inside a protrusion.
+    #[pyo3(signature = (protrusions=None, *, frame=0))]
+    fn image<'py>(
+        &self,
+        py: Python<'py>,
+        protrusions: Option<&ProtrusionSet>,
+        frame: u64,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        if let Some(p) = protrusions {
+            self.scene
+                .check_outside(std::slice::from_ref(p.cfg.as_ref()), "T_cam_sensor")
+                .map_err(GroundTruthError::new_err)?;
+        }
+        let rays = &self.scene.rays;
+        let img = crate::work(py, || -> Result<Vec<[u16; 3]>, String> {
+            let imaging = self
+                .imaging
+                .get_or_init(|| {
+                    let tol = fabkit_designs::ChordTolerance::new(
+                        fabkit_designs::ChordTolerance::DEFAULT_MM,
+                    )
+                    .map_err(|e| e.to_string())?;
+                    let optics = fabkit_designs::optics::of_design(&self.design, tol)
+                        .map_err(|e| e.to_string())?;
+                    Ok(Imaging::new(
+                        optics,
+                        self.principal_px,
+                        rays,
+                        &self.reference_hits,
+                    ))
+                })
+                .as_ref()
+                .map_err(Clone::clone)?;
+            Ok(match protrusions {
+                None => imaging.image(rays, &self.reference_hits, None, frame),
+                Some(p) => {
+                    let hits = indented_hits(
+                        rays,
+                        &self.reference_hits,
+                        &p.cfg.primitives,
+                        self.scene.surface.base_z_mm(),
+                    );
+                    imaging.image(rays, &hits, Some(&p.cfg.primitives), frame)
+                }
+            })
+        })?
+        .map_err(GroundTruthError::new_err)?;
+        let (h, w) = (rays.height, rays.width);
+        let bits = match self.imaging.get() {
+            Some(Ok(im)) => im.optics.camera.bit_depth,
+            _ => 8,
+        };
+        let flat = img.into_iter().flatten();
+        Ok(if bits == 16 {
+            Array3::from_shape_vec((h, w, 3), flat.collect::<Vec<u16>>())
+                .expect("h x w x 3")
+                .into_pyarray(py)
+                .into_any()
+        } else {
+            Array3::from_shape_vec((h, w, 3), flat.map(|c| c as u8).collect::<Vec<u8>>())
+                .expect("h x w x 3")
+                .into_pyarray(py)
+                .into_any()
+        })
     }
 
     /// The half masks (left, right), (H, W) bool: pixels whose ray meets the reference

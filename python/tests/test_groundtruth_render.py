@@ -143,6 +143,40 @@ def test_indented_all_is_indented_in_order_with_progress(scene):
     assert r.indented_all([]) == []
 
 
+def test_images_equal_the_cli_pngs(scene, run_cli):
+    """DepthRenderer.image gives the pixels `fabkit groundtruth --images` writes: the
+    reference as frame 0, configuration i as frame i + 1, 8-bit RGB."""
+    d, r = scene["dir"], scene["renderer"]
+    run_cli(d, "groundtruth", "rtac0", "--camera", "cam.yaml", "--extrinsics",
+            "extrinsics.json", "--fixtures", "fx", "--out", "gt_img", "--format", "png",
+            "--images")
+    ref = r.image()
+    assert ref.dtype == np.uint8 and ref.shape == (H, W, 3)
+    np.testing.assert_array_equal(ref, _read_png(str(d / "gt_img/reference/image.png")))
+    for k, s in enumerate(scene["sets"]):
+        img = r.image(s, frame=k + 1)
+        np.testing.assert_array_equal(img, _read_png(str(d / "gt_img" / s.name / "image.png")),
+                                      err_msg=s.name)
+        # the imprint is where the contact mask is: the image changes most there
+        c = r.indented(s)["contact"]
+        diff = np.abs(img.astype(int) - ref.astype(int)).sum(axis=2)
+        assert diff[c].mean() > 4 * diff[~c & np.isfinite(r.reference()["range_mm"])].mean()
+    # another frame index draws other noise, the same one the same
+    assert not np.array_equal(r.image(frame=1), ref)
+    np.testing.assert_array_equal(r.image(frame=0), ref)
+
+
+def test_bad_optics_name_their_path(scene):
+    import pathlib
+    text = (pathlib.Path(__file__).parents[2] / "designs/library/rtac0.yaml").read_text()
+    path = scene["dir"] / "rough.yaml"
+    path.write_text(text + "\noptics:\n  surface:\n    roughness: 0\n")
+    design = fabkit.Design.load(str(path))
+    r = fabkit.DepthRenderer(design, str(scene["dir"] / "cam.yaml"), scene["T"])
+    with pytest.raises(fabkit.GroundTruthError, match=r"optics\.surface\.roughness"):
+        r.image()
+
+
 def test_masks_equal_the_cli_pngs(scene):
     left, right = scene["renderer"].masks()
     for m, name in ((left, "left_mask.png"), (right, "right_mask.png")):
