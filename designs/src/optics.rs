@@ -159,6 +159,21 @@ pub struct MarkerSpot {
     pub radius_mm: f64,
 }
 
+/// A dimple in the surface the camera sees (ShadowTac's, Sec. III-B, IV-A): a recessed
+/// feature of the skin's outer surface, a cylinder with a hemispherical end cut into the
+/// elastomer, which from inside stands towards the camera, shades and casts shadows.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Dimple {
+    /// Centre of the feature's base on the reference surface (offset 0), sensor frame, mm.
+    pub base_mm: [f64; 3],
+    /// Outward unit normal there: the feature reaches `height_mm` against it.
+    pub normal: [f64; 3],
+    /// Radius of the cylinder and of its hemispherical end, mm.
+    pub radius_mm: f64,
+    /// From the surface to the hemisphere's tip, mm (>= radius).
+    pub height_mm: f64,
+}
+
 /// The optics a render uses: the design's `optics` (or its defaults) with its lights resolved.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ResolvedOptics {
@@ -174,11 +189,23 @@ pub struct ResolvedOptics {
     /// Where the markers came from: `layers[i].markers[k]` or `layers[i].marker_grid`, one
     /// entry per pattern with its count.
     pub marker_sources: Vec<(String, usize)>,
+    /// The recessed features of the surface the camera sees, from the layers' marker
+    /// patterns on the outer skin surface.
+    pub dimples: Vec<Dimple>,
+    /// Where the dimples came from: `layers[i].markers[k]` with its count.
+    pub dimple_sources: Vec<(String, usize)>,
 }
 
+/// Spots and dimples on the reference surface, each with its sources.
+type Features = (
+    (Vec<MarkerSpot>, Vec<(String, usize)>),
+    (Vec<Dimple>, Vec<(String, usize)>),
+);
+
 /// The raised marker features of `design` (placed on `stack`'s layers; a flat skin's marker
-/// grids) as spots on its reference surface.
-fn marker_spots(design: &Design, stack: &Stack) -> (Vec<MarkerSpot>, Vec<(String, usize)>) {
+/// grids) as spots on its reference surface, and the recessed features of that surface (offset
+/// 0) as [`Dimple`]s.
+fn marker_features(design: &Design, stack: &Stack) -> Features {
     use crate::markers::Polarity;
     let (mut spots, mut sources) = (Vec::new(), Vec::new());
     if design.body.flat_outline().is_some() {
@@ -196,18 +223,31 @@ fn marker_spots(design: &Design, stack: &Stack) -> (Vec<MarkerSpot>, Vec<(String
                 radius_mm: g.feature.radius_mm(),
             }));
         }
-        return (spots, sources);
+        return ((spots, sources), (Vec::new(), Vec::new()));
     }
+    let (mut dimples, mut dimple_sources) = (Vec::new(), Vec::new());
     for layer in &stack.layers {
         let specs = &design.layers[layer.index].markers;
         for (spec, offset, _, markers) in crate::parts::layers::placed_patterns(design, layer) {
-            if spec.feature.side() != Polarity::Raised {
-                continue;
-            }
             let k = specs
                 .iter()
                 .position(|s| std::ptr::eq(s, spec))
                 .unwrap_or(0);
+            if spec.feature.side() != Polarity::Raised {
+                if offset.abs() < 1e-9 {
+                    dimple_sources.push((
+                        format!("layers[{}].markers[{k}]", layer.index),
+                        markers.len(),
+                    ));
+                    dimples.extend(markers.into_iter().map(|m| Dimple {
+                        base_mm: m.position_mm,
+                        normal: m.normal,
+                        radius_mm: spec.feature.radius_mm(),
+                        height_mm: spec.feature.height_mm,
+                    }));
+                }
+                continue;
+            }
             sources.push((
                 format!("layers[{}].markers[{k}]", layer.index),
                 markers.len(),
@@ -219,7 +259,7 @@ fn marker_spots(design: &Design, stack: &Stack) -> (Vec<MarkerSpot>, Vec<(String
             }));
         }
     }
-    (spots, sources)
+    ((spots, sources), (dimples, dimple_sources))
 }
 
 /// Appends every violated rule of `o` to `errs`, each path under `optics.`.
@@ -379,7 +419,7 @@ pub fn resolve(design: &Design, stack: &Stack) -> Result<ResolvedOptics, Vec<Par
     if !errs.is_empty() {
         return Err(errs);
     }
-    let (markers, marker_sources) = marker_spots(design, stack);
+    let ((markers, marker_sources), (dimples, dimple_sources)) = marker_features(design, stack);
     Ok(ResolvedOptics {
         lights,
         light_sources,
@@ -388,6 +428,8 @@ pub fn resolve(design: &Design, stack: &Stack) -> Result<ResolvedOptics, Vec<Par
         camera: o.camera,
         markers,
         marker_sources,
+        dimples,
+        dimple_sources,
     })
 }
 

@@ -346,7 +346,7 @@ fn frame_files(
 }
 
 /// What the rendered images leave out, in the manifest and the guide.
-const IMAGES_NOT_MODELLED: &str = "refraction through the clear layers between the camera and the reflective surface (rays are straight from the camera centre); light scattered inside the elastomer; light reflected from one part of the skin onto another; the skin's deformation around a protrusion (the indented surface is the skin minus the protrusion solids); recessed marker features (ShadowTac's dimples) are not in the surface, so they neither shade nor cast shadows; the markers' own relief and their parallax (a marker is albedo on the reference surface at its normal's foot); fluorescence under UV LEDs (UV light is drawn as violet); lens blur, motion blur and rolling shutter";
+const IMAGES_NOT_MODELLED: &str = "refraction through the clear layers between the camera and the reflective surface (rays are straight from the camera centre); light scattered inside the elastomer; light reflected from one part of the skin onto another; the skin's deformation around a protrusion (the indented surface is the skin minus the protrusion solids); the dimples in the depth maps (the images show them, the depth is of the skin without them); penumbrae (each LED is a point: shadows have hard edges); the markers' own relief and their parallax (a marker is albedo on the reference surface at its normal's foot); fluorescence under UV LEDs (UV light is drawn as violet); lens blur, motion blur and rolling shutter";
 
 /// The rendered image of a frame (`--images`): `dir/image.png`, RGB at the optics' bit
 /// depth, on the depth maps' pixel grid; its noise is that of frame `frame` of the set.
@@ -902,6 +902,10 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
                 v
             }).collect::<Vec<_>>(),
             "surface": im.optics.surface,
+            "dimples": {
+                "patterns": im.optics.dimple_sources.iter().map(|(src, n)| json!({"source": src, "count": n})).collect::<Vec<_>>(),
+                "drawn_as": "solids in the surface the camera sees: the recessed features of the outer skin surface, each a cylinder with a hemispherical end standing towards the camera, which shade and cast shadows (ShadowTac Sec. III-A); moved with the skin as the markers are",
+            },
             "markers": {
                 "albedo_rgb": im.optics.marker_albedo_rgb,
                 "patterns": im.optics.marker_sources.iter().map(|(src, n)| json!({"source": src, "count": n})).collect::<Vec<_>>(),

@@ -57,6 +57,8 @@ fn bench(c: &mut Criterion) {
         },
         markers: Vec::new(),
         marker_sources: Vec::new(),
+        dimples: Vec::new(),
+        dimple_sources: Vec::new(),
     };
     let rad = pool.install(|| frame_radiance(&rays, &hits, &optics, Some(&prims)));
     let mut g = c.benchmark_group("images_640x480_one_thread");

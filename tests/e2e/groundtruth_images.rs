@@ -82,7 +82,7 @@ fn every_frame_gets_its_image_the_same_bytes_with_any_thread_count() {
     assert!(lights.iter().all(|l| l["source"] == "housing"));
     assert!(im["gain"].as_f64().unwrap() > 0.0);
     assert!(im["exposure"].as_str().unwrap().contains("reference"));
-    for gap in ["refraction", "dimples", "deformation"] {
+    for gap in ["refraction", "penumbrae", "deformation"] {
         assert!(im["not_modelled"].as_str().unwrap().contains(gap), "{gap}");
     }
     let files = m["files"].as_array().unwrap();

@@ -245,9 +245,29 @@ impl ExactPrimitives {
     /// vector), or `None`.
     #[inline]
     pub fn first_crossing(&self, o: [f64; 3], d: [f64; 3], t_max_mm: f64) -> Option<Crossing> {
+        self.first_crossing_among(o, d, t_max_mm, 0..self.shapes.len())
+    }
+
+    /// The bounding sphere of primitive `k`: (centre, radius), mm.
+    pub fn bounding_sphere_of(&self, k: usize) -> ([f64; 3], f64) {
+        let (_, c, r) = &self.shapes[k];
+        (*c, *r)
+    }
+
+    /// [`Self::first_crossing`] of the primitives numbered `candidates` only (each index below
+    /// [`Self::len`]; a repeated index is tested again).
+    #[inline]
+    pub fn first_crossing_among(
+        &self,
+        o: [f64; 3],
+        d: [f64; 3],
+        t_max_mm: f64,
+        candidates: impl IntoIterator<Item = usize>,
+    ) -> Option<Crossing> {
         let mut best: Option<Crossing> = None;
         let mut tmax = t_max_mm;
-        for (k, (s, c, r)) in self.shapes.iter().enumerate() {
+        for k in candidates {
+            let (s, c, r) = &self.shapes[k];
             // Bounding sphere: skip when the ray misses it or reaches it beyond tmax.
             let oc = sub(o, *c);
             let b = dot(oc, d);

@@ -6,9 +6,11 @@
 //! beam's axis and is 0 outside its cone; the irradiance it gives a point `d` mm away is
 //! `intensity x cos(off-axis) x cos(incidence) / d^2` per colour channel, times its colour.
 //! The surface reflects it with a Lambertian albedo plus a normalised Blinn-Phong lobe (its
-//! exponent from the roughness). Not modelled: refraction through the clear layers between
-//! the camera and the reflective surface, light scattered inside the elastomer, and light
-//! reflected from one part of the skin onto another.
+//! exponent from the roughness). Markers are albedo on the surface ([`MarkerMap`]); dimples
+//! are solids in it that shade and cast shadows ([`DimpleField`]); both move with the surface
+//! along their normals. Not modelled: refraction through the clear layers between the camera
+//! and the reflective surface, light scattered inside the elastomer, light reflected from one
+//! part of the skin onto another, and penumbrae (each light is a point).
 
 use fabkit_designs::optics::{CameraResponse, Light, Reflectance};
 use rand_distr::{Distribution, StandardNormal};
@@ -249,6 +251,141 @@ pub fn expose(
 /// indentation a protrusion makes.
 const MARKER_FOLLOW_MM: f64 = 50.0;
 
+/// The point `c` of the reference surface (outward normal `n`) on the frame's surface: moved
+/// along its normal to where that line enters a protrusion of `protrusions` that holds it
+/// (normal displacement), else `c`.
+fn follow(
+    c: [f64; 3],
+    n: [f64; 3],
+    protrusions: Option<&super::exact::ExactPrimitives>,
+) -> [f64; 3] {
+    let Some(prims) = protrusions.filter(|p| p.contains(c)) else {
+        return c;
+    };
+    let start: [f64; 3] = std::array::from_fn(|k| c[k] - MARKER_FOLLOW_MM * n[k]);
+    match prims.first_crossing(start, n, MARKER_FOLLOW_MM) {
+        Some(hit) => std::array::from_fn(|k| start[k] + hit.t_mm * n[k]),
+        None => c,
+    }
+}
+
+/// The cosine below which a ray's window near the surface stops growing: a ray within 3 deg
+/// of the surface is searched for dimples over 1 / 0.05 = 20 times their reach.
+const GRAZING_COS: f64 = 0.05;
+
+/// The dimples of one frame as solids: each a capsule (its cylinder and hemispherical end, the
+/// cylinder continued out past the surface), its base moved with the surface as a marker is
+/// ([`MarkerMap`]), its axis along its reference normal. Looked up along a ray by the cells of
+/// a hashed grid the ray passes (sampled at half a cell; each capsule listed in every cell its
+/// bounding sphere, grown by a quarter cell, touches).
+#[derive(Debug, Clone)]
+pub struct DimpleField {
+    solids: super::exact::ExactPrimitives,
+    cell_mm: f64,
+    cells: rustc_hash::FxHashMap<[i64; 3], Vec<u32>>,
+    /// How far from the surface a dimple reaches, mm: height plus a diameter.
+    reach_mm: f64,
+}
+
+impl DimpleField {
+    /// The field of `dimples` on the surface indented by `protrusions` (none: the reference);
+    /// `None` without dimples.
+    pub fn new(
+        dimples: &[fabkit_designs::optics::Dimple],
+        protrusions: Option<&super::exact::ExactPrimitives>,
+    ) -> Option<DimpleField> {
+        use fabkit_designs::primitives::Primitive;
+        if dimples.is_empty() {
+            return None;
+        }
+        let prims: Vec<Primitive> = dimples
+            .iter()
+            .map(|m| {
+                let (n, r) = (m.normal, m.radius_mm);
+                let b = follow(m.base_mm, n, protrusions);
+                let deep = (m.height_mm - r).max(0.0);
+                Primitive::Capsule {
+                    p0_mm: std::array::from_fn(|k| b[k] + r * n[k]),
+                    p1_mm: std::array::from_fn(|k| b[k] - deep * n[k]),
+                    radius_mm: r,
+                }
+            })
+            .collect();
+        let solids = super::exact::ExactPrimitives::new(&prims).ok()?;
+        let r_max = dimples.iter().map(|m| m.radius_mm).fold(0.0f64, f64::max);
+        let h_max = dimples.iter().map(|m| m.height_mm).fold(0.0f64, f64::max);
+        let cell_mm = (2.0 * r_max).max(0.05);
+        let mut cells = rustc_hash::FxHashMap::<[i64; 3], Vec<u32>>::default();
+        for k in 0..solids.len() {
+            let (c, r) = solids.bounding_sphere_of(k);
+            let r = r + 0.25 * cell_mm;
+            let lo = c.map(|x| ((x - r) / cell_mm).floor() as i64);
+            let hi = c.map(|x| ((x + r) / cell_mm).floor() as i64);
+            for x in lo[0]..=hi[0] {
+                for y in lo[1]..=hi[1] {
+                    for z in lo[2]..=hi[2] {
+                        cells.entry([x, y, z]).or_default().push(k as u32);
+                    }
+                }
+            }
+        }
+        Some(DimpleField {
+            solids,
+            cell_mm,
+            cells,
+            reach_mm: h_max + 2.0 * r_max,
+        })
+    }
+
+    /// The first crossing of a dimple along `o + t d` (d unit) with `t0 <= t < t1`, the
+    /// normal pointing out of the capsule.
+    pub fn first_crossing(
+        &self,
+        o: [f64; 3],
+        d: [f64; 3],
+        t0: f64,
+        t1: f64,
+    ) -> Option<super::exact::Crossing> {
+        if !(t1 > t0) {
+            return None;
+        }
+        let step = 0.5 * self.cell_mm;
+        let n = ((t1 - t0) / step).ceil() as usize;
+        let mut found: Vec<u32> = Vec::new();
+        let mut last: Option<[i64; 3]> = None;
+        for j in 0..=n {
+            let t = (t0 + j as f64 * step).min(t1);
+            let key = std::array::from_fn(|k| ((o[k] + t * d[k]) / self.cell_mm).floor() as i64);
+            if last == Some(key) {
+                continue;
+            }
+            last = Some(key);
+            if let Some(list) = self.cells.get(&key) {
+                found.extend_from_slice(list);
+            }
+        }
+        if found.is_empty() {
+            return None;
+        }
+        found.sort_unstable();
+        found.dedup();
+        let start: [f64; 3] = std::array::from_fn(|k| o[k] + t0 * d[k]);
+        self.solids
+            .first_crossing_among(start, d, t1 - t0, found.iter().map(|&k| k as usize))
+            .map(|c| super::exact::Crossing {
+                t_mm: c.t_mm + t0,
+                ..c
+            })
+    }
+
+    /// The window of a ray near the surface whose normal is `n` (unit, either side): how far
+    /// before the surface (or from it, towards a light) a dimple can be met, mm.
+    #[inline]
+    fn window_mm(&self, d: [f64; 3], n: [f64; 3]) -> f64 {
+        self.reach_mm / dot(d, n).abs().max(GRAZING_COS)
+    }
+}
+
 /// The markers of one frame, moved with its surface: a spot whose centre a protrusion pushes
 /// in moves along its normal to where that line enters the protrusion (normal displacement
 /// only: the skin's stretch along the surface is not modelled), keeping its radius. Looked up
@@ -271,18 +408,7 @@ impl MarkerMap {
         let cell_mm = (2.0 * r_max).max(1e-3);
         let centres: Vec<[f64; 3]> = spots
             .iter()
-            .map(|m| {
-                let c = m.centre_mm;
-                let Some(prims) = protrusions.filter(|p| p.contains(c)) else {
-                    return c;
-                };
-                let n = m.normal;
-                let start: [f64; 3] = std::array::from_fn(|k| c[k] - MARKER_FOLLOW_MM * n[k]);
-                match prims.first_crossing(start, n, MARKER_FOLLOW_MM) {
-                    Some(hit) => std::array::from_fn(|k| start[k] + hit.t_mm * n[k]),
-                    None => c,
-                }
-            })
+            .map(|m| follow(m.centre_mm, m.normal, protrusions))
             .collect();
         let mut cells = rustc_hash::FxHashMap::<[i64; 3], Vec<u32>>::default();
         for (i, (c, m)) in centres.iter().zip(spots).enumerate() {
@@ -331,7 +457,9 @@ impl MarkerMap {
 /// sees no skin): the surface `hits` along `rays` (reference or indented) lit by `optics`'
 /// lights, with the markers' albedo on the points within a marker of its centre (moved with the
 /// surface, [`MarkerMap`]) and the skin's elsewhere, a light shadowed where the segment from
-/// the point to it enters a protrusion of `protrusions`. The reference skin is
+/// the point to it enters a protrusion of `protrusions` or a dimple. The dimples of `optics`
+/// ([`DimpleField`]) are part of the surface seen: a ray that meets one before the skin sees
+/// the dimple (the depth maps' `hits` do not hold them). The reference skin is
 /// convex: seen from inside it casts no shadow on itself. Pixels are shaded in parallel, each
 /// on its own: the result does not depend on the thread count.
 pub fn frame_radiance(
@@ -344,24 +472,40 @@ pub fn frame_radiance(
     let lights: Vec<Prepared> = optics.lights.iter().map(Prepared::of).collect();
     let lobe = lobe_of(&optics.surface);
     let markers = MarkerMap::new(&optics.markers, protrusions);
+    let dimples = DimpleField::new(&optics.dimples, protrusions);
     (0..rays.dirs.len())
         .into_par_iter()
         .map(|i| {
-            let (t, d) = (hits.t_mm[i], rays.dirs[i]);
-            if !t.is_finite() {
+            let (t_skin, d) = (hits.t_mm[i], rays.dirs[i]);
+            if !t_skin.is_finite() {
                 return [f64::NAN; 3];
             }
-            let p = [o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2]];
             // the normal on the camera's side: the elastomer's outward normal reversed
-            let n = hits.normal[i].map(|v| -v);
+            let n_skin = hits.normal[i].map(|v| -v);
+            // a dimple stands towards the camera: met first, it is the surface seen
+            let (t, n) = match dimples.as_ref().and_then(|f| {
+                let w = f.window_mm(d, n_skin);
+                f.first_crossing(o, d, (t_skin - w).max(0.0), t_skin)
+            }) {
+                Some(c) => (c.t_mm, c.normal),
+                None => (t_skin, n_skin),
+            };
+            let p = [o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2]];
             let lit = |k: usize, l: [f64; 3]| {
-                let Some(prims) = protrusions else {
-                    return true;
-                };
                 let to_light = sub(lights[k].position_mm, p);
                 let dist = dot(to_light, to_light).sqrt();
                 let start = [p[0] + 1e-6 * n[0], p[1] + 1e-6 * n[1], p[2] + 1e-6 * n[2]];
-                prims.first_crossing(start, l, dist).is_none()
+                if let Some(prims) = protrusions {
+                    if prims.first_crossing(start, l, dist).is_some() {
+                        return false;
+                    }
+                }
+                match &dimples {
+                    Some(f) => f
+                        .first_crossing(start, l, 0.0, dist.min(f.window_mm(l, n_skin)))
+                        .is_none(),
+                    None => true,
+                }
             };
             radiance_prepared(
                 p,

@@ -235,6 +235,8 @@ fn optics_with(lights: Vec<Light>) -> ResolvedOptics {
         camera: CameraResponse::default(),
         markers: Vec::new(),
         marker_sources: Vec::new(),
+        dimples: Vec::new(),
+        dimple_sources: Vec::new(),
     }
 }
 
@@ -430,4 +432,93 @@ fn markers_move_along_their_normals_and_carry_their_albedo() {
     }
     assert!(on_marker > 500, "{on_marker} marker pixels");
     assert!(on_pushed > 50, "{on_pushed} marker pixels on the imprint");
+}
+
+/// A dimple under a grazing light casts a shadow of the analytic length: a flat skin's face
+/// (z = 5 mm) seen from 10 mm below by a pinhole camera (f = 1000 px, 0.01 mm a pixel on the
+/// face), one ShadowTac dimple (0.45 mm wide, 0.5 mm high: a hemisphere of radius r on a
+/// cylinder, its centre a = 0.275 mm from the face) standing towards the camera, a distant
+/// light at 20 deg above the face from +x. Along the row through the dimple the face is dark
+/// from the dimple to x = x_b - (r + a cos(20 deg)) / sin(20 deg), where the line to the light
+/// grazes the hemisphere: the farthest dark pixel is within one pixel of it.
+#[test]
+fn a_dimple_under_a_grazing_light_casts_a_shadow_of_the_analytic_length() {
+    use fabkit_calibration::camera::{Distortion, Intrinsics};
+    use fabkit_designs::optics::Dimple;
+    use nalgebra::{Isometry3, Translation3, UnitQuaternion};
+    let (w, h, f) = (401u32, 41u32, 1000.0);
+    let cam = CameraModel::new(Intrinsics {
+        image_width_px: w,
+        image_height_px: h,
+        fx_px: f,
+        fy_px: f,
+        cx_px: 200.0,
+        cy_px: 20.0,
+        distortion: Distortion::PlumbBob([0.0; 5]),
+    })
+    .unwrap();
+    let pose = Isometry3::from_parts(Translation3::new(0.0, 0.0, 5.0), UnitQuaternion::identity());
+    let rays = PixelRays::new(&cam, &pose);
+    let surface = ReferenceSurface::Flat {
+        half_width_mm: 10.0,
+        half_length_mm: 10.0,
+        corner_radius_mm: 1.0,
+        top_z_mm: 5.0,
+    };
+    let hits = reference_hits(&rays, &surface);
+    let (xb, r, height) = (0.8, 0.225, 0.5);
+    let alpha = 20f64.to_radians();
+    let far = 1e6;
+    let to_light = [alpha.cos(), 0.0, -alpha.sin()];
+    let light = Light {
+        position_mm: [xb + far * to_light[0], 0.0, 5.0 + far * to_light[2]],
+        direction: to_light.map(|x| -x),
+        cone_half_angle_deg: 90.0,
+        colour_rgb: [1.0, 1.0, 1.0],
+        intensity: far * far,
+    };
+    let optics = ResolvedOptics {
+        dimples: vec![Dimple {
+            base_mm: [xb, 0.0, 5.0],
+            normal: [0.0, 0.0, 1.0],
+            radius_mm: r,
+            height_mm: height,
+        }],
+        ..optics_with(vec![light])
+    };
+    let rad = frame_radiance(&rays, &hits, &optics, None);
+    let a = height - r;
+    let tip = xb - (r + a * alpha.cos()) / alpha.sin();
+    let row = (h / 2) as usize * w as usize;
+    let (o, mut farthest, mut dark) = (rays.origin_mm, f64::INFINITY, 0);
+    for u in 0..w as usize {
+        let i = row + u;
+        let (t, d) = (hits.t_mm[i], rays.dirs[i]);
+        let x = o[0] + t * d[0];
+        // the face's pixels beside the dimple (not those that see it)
+        if (x - xb).abs() <= r + 0.02 {
+            continue;
+        }
+        if rad[i][0] == 0.0 {
+            dark += 1;
+            farthest = farthest.min(x);
+        } else {
+            assert!(rad[i][0] > 0.0, "pixel {u}");
+        }
+    }
+    let pixel_mm = 10.0 / f;
+    assert!(dark > 50, "{dark} dark pixels");
+    assert!(
+        farthest >= tip - 1e-9 && farthest - tip <= pixel_mm,
+        "the shadow ends at x = {farthest} mm, the analytic tip is {tip} mm"
+    );
+    // the dark pixels are those between the dimple and the tip
+    let lit_between = (0..w as usize)
+        .map(|u| row + u)
+        .filter(|&i| {
+            let x = o[0] + hits.t_mm[i] * rays.dirs[i][0];
+            x > tip + pixel_mm && x < xb - r - 0.02 && rad[i][0] > 0.0
+        })
+        .count();
+    assert_eq!(lit_between, 0);
 }

@@ -192,3 +192,33 @@ fn the_section_reads_from_yaml_with_signed_positions() {
     let e = Design::from_yaml(&with("      colour: red\n"), "rtac0.yaml").unwrap_err();
     assert!(e.to_string().contains("colour"), "{e}");
 }
+
+/// The features the renderer draws: ShadowTac's 469 dimples (recessed into the outer skin
+/// surface, the authors' CAD), the TacTip's pin tips and Soter's 100 painted markers (raised),
+/// UVDtact's 85 ink-filled protrusions (the raised twin of its slots, drawn once); each spot or
+/// dimple on the reference surface (offset 0) of its design.
+#[test]
+fn markers_and_dimples_come_from_the_layers_features() {
+    let tol = ChordTolerance::new(0.01).unwrap();
+    let of = |n: &str| of_design(&library::load(n).unwrap(), tol).unwrap();
+    let s = of("shadowtac");
+    assert_eq!(s.dimples.len(), 469);
+    assert_eq!(s.markers.len(), 0);
+    assert_eq!(s.dimple_sources, [("layers[0].markers[0]".to_string(), 469)]);
+    let d = &s.dimples[0];
+    assert!(near(d.radius_mm, 0.225) && near(d.height_mm, 0.5));
+    let u = of("uvdtact");
+    assert_eq!((u.markers.len(), u.dimples.len()), (85, 0));
+    let t = of("tactip_dualmodal");
+    assert!(t.markers.len() > 100, "{}", t.markers.len());
+    assert_eq!(of("soter_channels").markers.len(), 100);
+    // on the reference sphere of R = 13.5 mm (the TacTip's skin), at the pins' normals
+    for m in &t.markers {
+        let r = m.centre_mm.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let z = m.centre_mm[2];
+        if z > 0.0 {
+            assert!((r - 13.5).abs() < 1e-6, "{m:?}");
+        }
+        assert!(near(m.radius_mm, 0.5));
+    }
+}
