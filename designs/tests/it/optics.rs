@@ -204,7 +204,10 @@ fn markers_and_dimples_come_from_the_layers_features() {
     let s = of("shadowtac");
     assert_eq!(s.dimples.len(), 469);
     assert_eq!(s.markers.len(), 0);
-    assert_eq!(s.dimple_sources, [("layers[0].markers[0]".to_string(), 469)]);
+    assert_eq!(
+        s.dimple_sources,
+        [("layers[0].markers[0]".to_string(), 469)]
+    );
     let d = &s.dimples[0];
     assert!(near(d.radius_mm, 0.225) && near(d.height_mm, 0.5));
     let u = of("uvdtact");
