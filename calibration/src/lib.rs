@@ -17,6 +17,7 @@ pub mod groundtruth;
 pub mod imprints;
 pub mod overlay;
 pub mod p3p;
+pub mod photometric;
 pub mod pnp;
 pub mod refine;
 pub mod report;

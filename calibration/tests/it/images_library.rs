@@ -54,9 +54,12 @@ fn every_library_design_renders_a_reference_and_an_indented_image() {
         let lit = (0..a.len())
             .filter(|&i| reference.t_mm[i].is_finite() && a[i].iter().any(|&c| c > 3))
             .count();
+        let lit_pressed = (0..b.len())
+            .filter(|&i| reference.t_mm[i].is_finite() && b[i].iter().any(|&c| c > 3))
+            .count();
         assert!(
-            lit as f64 > 0.5 * seen as f64,
-            "{name}: {lit} of {seen} skin pixels lit"
+            lit as f64 > 0.5 * seen as f64 && lit_pressed as f64 > 0.5 * seen as f64,
+            "{name}: {lit} and {lit_pressed} of {seen} skin pixels lit"
         );
         // the imprint shows where the tip pushes the skin in, in the radiance before the
         // camera's noise: changed by more than 2 % on most contact pixels, unchanged on most

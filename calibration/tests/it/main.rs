@@ -7,6 +7,7 @@ mod groundtruth_closed_form;
 mod groundtruth_undistort;
 mod images_library;
 mod imprints;
+mod photometric;
 mod refine;
 mod shading;
 mod tables;

@@ -943,7 +943,7 @@ pub fn members(
 ) -> Result<Vec<Member>, DesignError> {
     let lv = levels(ctx, sb);
     let disc = |name: &str, r: f64, z0: f64, z1: f64| -> Result<(Solid, ExactShape), DesignError> {
-        Ok(axial_cylinder(r, z0, z1, tol).part(name)?)
+        axial_cylinder(r, z0, z1, tol).part(name)
     };
     let member = |name: &str,
                   description: String,

@@ -1,0 +1,364 @@
+//! A photometric model fitted from calibration captures: how the real camera's intensities
+//! respond to the skin's surface normal, so that images of any protrusion set can be rendered
+//! in a sensor's own appearance.
+//!
+//! Each capture pairs known geometry (the pins' imprints through the solved pose: every
+//! pixel's surface point and normal, [`crate::groundtruth::SurfaceHits`]) with the
+//! intensities the camera recorded. The model, per colour channel, is
+//!
+//! `I(x, n) = gain x R(x) x (1 + sum_k sum_m c_km P_m(x) f_k(n, x))`
+//!
+//! - `R(x)`: the unindented appearance, per pixel: the reference image, averaged with the
+//!   unpressed pixels of every capture (each divided by its gain) to lower its noise;
+//! - `f_k`: the surface's tilt from the reference normal in the reference surface's local
+//!   frame about the camera's optical axis (`a` along the tangent away from the axis, `r` round
+//!   it), its monomials up to degree 3 (`a, r, a^2, ar, r^2, a^3, a^2 r, a r^2, r^3`), and the
+//!   indentation depth along the ray (mm);
+//! - `P_m(x)`: powers of the pixel's normalised distance from the image centre up to
+//!   [`SPATIAL_DEGREE`]: the lights' directions and fall-off change slowly over the skin;
+//! - `gain`: each capture's global gain against the reference (exposure and LED drift), the
+//!   median ratio over its unpressed skin.
+//!
+//! Why this form: under Lambertian lights the radiance is a sum of clamped cosines
+//! `max(0, n . l_k)`, a smooth function of the normal that low-order polynomials in the tilt
+//! approximate closely (order 2 already holds most of a clamped cosine's energy, Ramamoorthi
+//! and Hanrahan 2001; order 3 brings the re-rendered imprints of the tests within 1.6 grey
+//! levels of the noise-free captures). Divided by the reference, the response is `1` at no
+//! tilt, and what remains varies slowly over the skin; moving the surface by the indentation
+//! changes the distances to the lights to first order in the depth. Fitting the ratio, not the
+//! intensity, leaves every pixel's own appearance (rim LEDs, vignetting, the skin's albedo)
+//! to the reference and only the response to tilt to the captures. A look-up table over
+//! binned normals (Taxim) needs a flat sensor and many more imprints per bin than a pin dome
+//! gives; a low-order spatial term is what a curved skin's few dozen imprints can fix.
+//!
+//! Limits: the spatial term depends on the distance from the image centre only, so the
+//! coefficients are those of lights in a ring about the optical axis (R-Tac0's, the TacTip's,
+//! UVDtact's); lights at a few azimuths (ShadowTac's three single-colour LEDs) need angular
+//! terms too. Shadows cast by a pin onto the skin beside its imprint are not in the model.
+
+use crate::groundtruth::rays::PixelRays;
+use crate::groundtruth::SurfaceHits;
+use nalgebra::{DMatrix, DVector};
+
+/// Degree of the spatial polynomial in the normalised distance from the image centre.
+pub const SPATIAL_DEGREE: usize = 3;
+
+/// Number of spatial terms: the powers 0 to [`SPATIAL_DEGREE`].
+pub const SPATIAL_TERMS: usize = SPATIAL_DEGREE + 1;
+
+/// Number of features of the surface: the tilt along and round the axis, the indentation
+/// depth, and the tilt's quadratic (3) and cubic (4) terms.
+pub const FEATURES: usize = 10;
+
+/// Least reference intensity (counts) of a pixel used to fit or to measure a gain: darker
+/// pixels carry mostly noise in a ratio.
+pub const MIN_REFERENCE_COUNTS: f64 = 8.0;
+
+/// A fitted photometric model of one camera at one pose.
+#[derive(Debug, Clone)]
+pub struct PhotometricModel {
+    pub width: usize,
+    pub height: usize,
+    /// The unindented appearance per pixel and channel, counts (NaN off the skin).
+    pub reference: Vec<[f64; 3]>,
+    /// Per channel, the coefficients `c_km` at `k * SPATIAL_TERMS + m`.
+    pub coefficients: [Vec<f64>; 3],
+    /// The camera's optical axis in the sensor frame (the local frame of the features).
+    pub axis: [f64; 3],
+    /// The gain of each fitted capture against the reference.
+    pub gains: Vec<f64>,
+    /// Root-mean-square residual of each fitted capture over its skin, counts (all channels).
+    pub residual_rms: Vec<f64>,
+}
+
+/// One capture to fit: its image (row-major, per channel, counts) and its surface.
+#[derive(Debug, Clone, Copy)]
+pub struct Capture<'a> {
+    pub image: &'a [[f64; 3]],
+    pub hits: &'a SurfaceHits,
+}
+
+/// The spatial basis at pixel `i`: the powers 0 to [`SPATIAL_DEGREE`] of its distance from the
+/// image centre over the half-diagonal.
+fn spatial(i: usize, width: usize, height: usize) -> [f64; SPATIAL_TERMS] {
+    let (hw, hh) = (0.5 * width as f64, 0.5 * height as f64);
+    let s = hw.hypot(hh).max(1.0);
+    let u = ((i % width) as f64 + 0.5 - hw) / s;
+    let v = ((i / width) as f64 + 0.5 - hh) / s;
+    let rho = u.hypot(v);
+    let mut out = [0.0; SPATIAL_TERMS];
+    for d in 0..=SPATIAL_DEGREE {
+        out[d] = rho.powi(d as i32);
+    }
+    out
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// The surface features of pixel `i` of a frame against the reference: the change of the
+/// camera-side normal in the reference surface's local frame about the optical axis `axis`
+/// (along the tangent away from the axis, along the tangent round it, along the normal) and
+/// the indentation depth along the ray (mm); `None` off the skin. In that frame a ring of
+/// lights about the axis gives coefficients that depend on the distance from the axis only.
+fn features(
+    i: usize,
+    hits: &SurfaceHits,
+    reference: &SurfaceHits,
+    axis: [f64; 3],
+) -> Option<[f64; FEATURES]> {
+    let (t, t0) = (hits.t_mm[i], reference.t_mm[i]);
+    if !t.is_finite() || !t0.is_finite() {
+        return None;
+    }
+    // normals out of the elastomer: the camera's side is their negative
+    let (n, n0) = (hits.normal[i], reference.normal[i]);
+    let dn = [n0[0] - n[0], n0[1] - n[1], n0[2] - n[2]];
+    let mut round = cross(axis, n0);
+    let len = dot(round, round).sqrt();
+    if len < 1e-9 {
+        round = cross([1.0, 0.0, 0.0], n0);
+        let l = dot(round, round).sqrt();
+        round = round.map(|x| x / l);
+    } else {
+        round = round.map(|x| x / len);
+    }
+    let away = cross(n0, round);
+    let (a, r) = (dot(dn, away), dot(dn, round));
+    Some([
+        a,
+        r,
+        t0 - t,
+        a * a,
+        r * r,
+        a * r,
+        a * a * a,
+        a * a * r,
+        a * r * r,
+        r * r * r,
+    ])
+}
+
+/// The camera's optical axis in the sensor frame: the direction of the ray nearest the image
+/// centre.
+fn optical_axis(rays: &PixelRays) -> [f64; 3] {
+    let i = (rays.height / 2) * rays.width + rays.width / 2;
+    let d = rays.dirs.get(i).copied().unwrap_or([0.0, 0.0, 1.0]);
+    if d.iter().all(|x| x.is_finite()) {
+        d
+    } else {
+        [0.0, 0.0, 1.0]
+    }
+}
+
+fn median(mut v: Vec<f64>) -> Option<f64> {
+    if v.is_empty() {
+        return None;
+    }
+    let k = v.len() / 2;
+    let (_, m, _) = v.select_nth_unstable_by(k, f64::total_cmp);
+    Some(*m)
+}
+
+/// The gain of `image` against `reference` over the unpressed skin: the median ratio of the
+/// green channel (or the first channel with light) where the reference is bright enough.
+fn gain_of(image: &[[f64; 3]], reference: &[[f64; 3]], pressed: impl Fn(usize) -> bool) -> f64 {
+    let ratios: Vec<f64> = (0..image.len())
+        .filter(|&i| !pressed(i))
+        .filter_map(|i| {
+            let (a, r) = (image[i], reference[i]);
+            let c = (0..3).max_by(|&x, &y| r[x].total_cmp(&r[y]))?;
+            (r[c] >= MIN_REFERENCE_COUNTS && a[c].is_finite()).then(|| a[c] / r[c])
+        })
+        .collect();
+    median(ratios).filter(|g| *g > 0.0).unwrap_or(1.0)
+}
+
+impl PhotometricModel {
+    /// Fits the model of the camera whose rays are `rays`, from its `reference_image` of the
+    /// unindented skin (whose surface is `reference`) and `captures`.
+    ///
+    /// # Errors
+    /// A message when the sizes disagree or when the captures hold fewer pressed pixels than
+    /// twice the unknowns (too few imprints to fit the response to tilt).
+    pub fn fit(
+        rays: &PixelRays,
+        reference: &SurfaceHits,
+        reference_image: &[[f64; 3]],
+        captures: &[Capture<'_>],
+    ) -> Result<PhotometricModel, String> {
+        let (w, h) = (rays.width, rays.height);
+        let n = w * h;
+        if reference_image.len() != n || reference.t_mm.len() != n {
+            return Err(format!(
+                "the reference image has {} pixels, the camera {w} x {h} = {n}",
+                reference_image.len()
+            ));
+        }
+        for (k, c) in captures.iter().enumerate() {
+            if c.image.len() != n || c.hits.t_mm.len() != n {
+                return Err(format!(
+                    "capture {k}: {} pixels, the camera {w} x {h} = {n}",
+                    c.image.len()
+                ));
+            }
+        }
+        let on_skin = |i: usize| reference.t_mm[i].is_finite();
+        let axis = optical_axis(rays);
+        // The unindented appearance: the reference averaged with every capture's unpressed
+        // pixels, each divided by its gain.
+        let gains: Vec<f64> = captures
+            .iter()
+            .map(|c| gain_of(c.image, reference_image, |i| c.hits.contact[i]))
+            .collect();
+        let mut appearance: Vec<[f64; 3]> = reference_image.to_vec();
+        for i in 0..n {
+            if !on_skin(i) {
+                appearance[i] = [f64::NAN; 3];
+                continue;
+            }
+            let mut sum = reference_image[i];
+            let mut count = 1.0;
+            for (c, g) in captures.iter().zip(&gains) {
+                if !c.hits.contact[i] {
+                    for ch in 0..3 {
+                        sum[ch] += c.image[i][ch] / g;
+                    }
+                    count += 1.0;
+                }
+            }
+            appearance[i] = sum.map(|s| s / count);
+        }
+        // The response to tilt, by least squares on the pressed pixels of every capture.
+        let unknowns = FEATURES * SPATIAL_TERMS;
+        let mut rows: Vec<(usize, usize)> = Vec::new();
+        for (k, c) in captures.iter().enumerate() {
+            for i in 0..n {
+                if c.hits.contact[i] && on_skin(i) {
+                    rows.push((k, i));
+                }
+            }
+        }
+        if rows.len() < 2 * unknowns {
+            return Err(format!(
+                "the captures press {} pixels of the skin, fewer than the {} the fit needs (twice its {unknowns} unknowns): give captures with more imprints",
+                rows.len(),
+                2 * unknowns
+            ));
+        }
+        let mut coefficients: [Vec<f64>; 3] = Default::default();
+        for (ch, coef) in coefficients.iter_mut().enumerate() {
+            let mut ata = DMatrix::<f64>::zeros(unknowns, unknowns);
+            let mut atb = DVector::<f64>::zeros(unknowns);
+            let mut row = vec![0.0; unknowns];
+            for &(k, i) in &rows {
+                let r = appearance[i][ch];
+                if !(r >= MIN_REFERENCE_COUNTS) {
+                    continue;
+                }
+                let Some(f) = features(i, captures[k].hits, reference, axis) else {
+                    continue;
+                };
+                let p = spatial(i, w, h);
+                for (a, fa) in f.iter().enumerate() {
+                    for (m, pm) in p.iter().enumerate() {
+                        row[a * SPATIAL_TERMS + m] = fa * pm;
+                    }
+                }
+                // the ratio's change, weighted by the reference so that each row counts in
+                // grey levels
+                let y = captures[k].image[i][ch] / (gains[k] * r) - 1.0;
+                let wgt = r * r;
+                for a in 0..unknowns {
+                    atb[a] += wgt * row[a] * y;
+                    for b in a..unknowns {
+                        ata[(a, b)] += wgt * row[a] * row[b];
+                    }
+                }
+            }
+            for a in 0..unknowns {
+                for b in 0..a {
+                    ata[(a, b)] = ata[(b, a)];
+                }
+            }
+            // a channel without light (all pixels below the floor) keeps zero coefficients
+            let x = ata
+                .clone()
+                .cholesky()
+                .map(|c| c.solve(&atb))
+                .or_else(|| ata.svd(true, true).solve(&atb, 1e-12).ok())
+                .unwrap_or_else(|| DVector::zeros(unknowns));
+            *coef = x.iter().copied().collect();
+        }
+        let mut model = PhotometricModel {
+            width: w,
+            height: h,
+            reference: appearance,
+            coefficients,
+            axis,
+            gains: gains.clone(),
+            residual_rms: Vec::new(),
+        };
+        model.residual_rms = captures
+            .iter()
+            .zip(&gains)
+            .map(|(c, g)| rms_over_skin(&model.render(reference, c.hits, *g), c.image))
+            .collect();
+        Ok(model)
+    }
+
+    /// The image (row-major, per channel, counts; NaN off the skin) of the surface `hits`
+    /// (the reference's, or indented: its contact pixels follow the model) at `gain`.
+    pub fn render(&self, reference: &SurfaceHits, hits: &SurfaceHits, gain: f64) -> Vec<[f64; 3]> {
+        (0..self.width * self.height)
+            .map(|i| {
+                let r = self.reference[i];
+                if !hits.contact[i] {
+                    return r.map(|x| gain * x);
+                }
+                let Some(f) = features(i, hits, reference, self.axis) else {
+                    return r.map(|x| gain * x);
+                };
+                let p = spatial(i, self.width, self.height);
+                std::array::from_fn(|ch| {
+                    let c = &self.coefficients[ch];
+                    let mut s = 0.0;
+                    for (a, fa) in f.iter().enumerate() {
+                        for (m, pm) in p.iter().enumerate() {
+                            s += c[a * SPATIAL_TERMS + m] * fa * pm;
+                        }
+                    }
+                    gain * r[ch] * (1.0 + s)
+                })
+            })
+            .collect()
+    }
+}
+
+/// Root-mean-square difference of `a` and `b` over the pixels where `a` is finite, all
+/// channels, counts.
+pub fn rms_over_skin(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
+    let (mut s, mut n) = (0.0, 0usize);
+    for (x, y) in a.iter().zip(b) {
+        for c in 0..3 {
+            if x[c].is_finite() && y[c].is_finite() {
+                s += (x[c] - y[c]).powi(2);
+                n += 1;
+            }
+        }
+    }
+    if n == 0 {
+        0.0
+    } else {
+        (s / n as f64).sqrt()
+    }
+}
