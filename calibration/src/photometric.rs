@@ -67,6 +67,8 @@ pub struct PhotometricModel {
     pub axis: [f64; 3],
     /// The gain of each fitted capture against the reference.
     pub gains: Vec<f64>,
+    /// The images' full scale, counts: rendered values are clipped to it.
+    pub full_scale: f64,
     /// Root-mean-square residual of each fitted capture over its skin, counts (all channels).
     pub residual_rms: Vec<f64>,
 }
@@ -185,7 +187,9 @@ fn gain_of(image: &[[f64; 3]], reference: &[[f64; 3]], pressed: impl Fn(usize) -
 
 impl PhotometricModel {
     /// Fits the model of the camera whose rays are `rays`, from its `reference_image` of the
-    /// unindented skin (whose surface is `reference`) and `captures`.
+    /// unindented skin (whose surface is `reference`) and `captures`, whose values are
+    /// counts of at most `full_scale` (255 for 8-bit images): saturated pixels are left out of
+    /// the fit.
     ///
     /// # Errors
     /// A message when the sizes disagree or when the captures hold fewer pressed pixels than
@@ -195,6 +199,7 @@ impl PhotometricModel {
         reference: &SurfaceHits,
         reference_image: &[[f64; 3]],
         captures: &[Capture<'_>],
+        full_scale: f64,
     ) -> Result<PhotometricModel, String> {
         let (w, h) = (rays.width, rays.height);
         let n = w * h;
@@ -214,30 +219,38 @@ impl PhotometricModel {
         }
         let on_skin = |i: usize| reference.t_mm[i].is_finite();
         let axis = optical_axis(rays);
-        // The unindented appearance: the reference averaged with every capture's unpressed
-        // pixels, each divided by its gain.
         let gains: Vec<f64> = captures
             .iter()
             .map(|c| gain_of(c.image, reference_image, |i| c.hits.contact[i]))
             .collect();
-        let mut appearance: Vec<[f64; 3]> = reference_image.to_vec();
-        for i in 0..n {
-            if !on_skin(i) {
-                appearance[i] = [f64::NAN; 3];
-                continue;
-            }
-            let mut sum = reference_image[i];
-            let mut count = 1.0;
-            for (c, g) in captures.iter().zip(&gains) {
-                if !c.hits.contact[i] {
-                    for ch in 0..3 {
-                        sum[ch] += c.image[i][ch] / g;
-                    }
-                    count += 1.0;
+        // The unindented appearance: per pixel and channel, the median of the reference and
+        // every capture's unpressed value divided by its gain (a highlight or a speck that only
+        // one image shows does not move it; with no capture unpressed there, the reference).
+        let appearance: Vec<[f64; 3]> = (0..n)
+            .map(|i| {
+                if !on_skin(i) {
+                    return [f64::NAN; 3];
                 }
-            }
-            appearance[i] = sum.map(|s| s / count);
-        }
+                std::array::from_fn(|ch| {
+                    let mut v: Vec<f64> = std::iter::once(reference_image[i][ch])
+                        .chain(
+                            captures
+                                .iter()
+                                .zip(&gains)
+                                .filter(|(c, _)| !c.hits.contact[i])
+                                .map(|(c, g)| c.image[i][ch] / g),
+                        )
+                        .collect();
+                    v.sort_unstable_by(f64::total_cmp);
+                    let m = v.len() / 2;
+                    if v.len() % 2 == 1 {
+                        v[m]
+                    } else {
+                        0.5 * (v[m - 1] + v[m])
+                    }
+                })
+            })
+            .collect();
         // The response to tilt, by least squares on the pressed pixels of every capture.
         let unknowns = FEATURES * SPATIAL_TERMS;
         let mut rows: Vec<(usize, usize)> = Vec::new();
@@ -262,7 +275,11 @@ impl PhotometricModel {
             let mut row = vec![0.0; unknowns];
             for &(k, i) in &rows {
                 let r = appearance[i][ch];
-                if !(r >= MIN_REFERENCE_COUNTS) {
+                let y_counts = captures[k].image[i][ch];
+                if !(r >= MIN_REFERENCE_COUNTS)
+                    || y_counts >= full_scale
+                    || r * gains[k] >= full_scale
+                {
                     continue;
                 }
                 let Some(f) = features(i, captures[k].hits, reference, axis) else {
@@ -276,7 +293,7 @@ impl PhotometricModel {
                 }
                 // the ratio's change, weighted by the reference so that each row counts in
                 // grey levels
-                let y = captures[k].image[i][ch] / (gains[k] * r) - 1.0;
+                let y = y_counts / (gains[k] * r) - 1.0;
                 let wgt = r * r;
                 for a in 0..unknowns {
                     atb[a] += wgt * row[a] * y;
@@ -306,6 +323,7 @@ impl PhotometricModel {
             coefficients,
             axis,
             gains: gains.clone(),
+            full_scale,
             residual_rms: Vec::new(),
         };
         model.residual_rms = captures
@@ -316,17 +334,25 @@ impl PhotometricModel {
         Ok(model)
     }
 
-    /// The image (row-major, per channel, counts; NaN off the skin) of the surface `hits`
-    /// (the reference's, or indented: its contact pixels follow the model) at `gain`.
+    /// The gain of `image` (a capture whose surface is `hits`) against the model's appearance:
+    /// the median ratio over its unpressed skin, for re-rendering it.
+    pub fn gain_of(&self, image: &[[f64; 3]], hits: &SurfaceHits) -> f64 {
+        gain_of(image, &self.reference, |i| hits.contact[i])
+    }
+
+    /// The image (row-major, per channel, counts clipped to the full scale; NaN off the skin)
+    /// of the surface `hits` (the reference's, or indented: its contact pixels follow the
+    /// model) at `gain`.
     pub fn render(&self, reference: &SurfaceHits, hits: &SurfaceHits, gain: f64) -> Vec<[f64; 3]> {
         (0..self.width * self.height)
             .map(|i| {
                 let r = self.reference[i];
+                let plain = || r.map(|x| (gain * x).clamp(0.0, self.full_scale));
                 if !hits.contact[i] {
-                    return r.map(|x| gain * x);
+                    return plain();
                 }
                 let Some(f) = features(i, hits, reference, self.axis) else {
-                    return r.map(|x| gain * x);
+                    return plain();
                 };
                 let p = spatial(i, self.width, self.height);
                 std::array::from_fn(|ch| {
@@ -337,7 +363,7 @@ impl PhotometricModel {
                             s += c[a * SPATIAL_TERMS + m] * fa * pm;
                         }
                     }
-                    gain * r[ch] * (1.0 + s)
+                    (gain * r[ch] * (1.0 + s)).clamp(0.0, self.full_scale)
                 })
             })
             .collect()

@@ -55,8 +55,16 @@ fn centroid(
     (sw > 0.0).then(|| [su / sw, sv / sw])
 }
 
-#[test]
-fn leave_one_out_re_renders_each_capture_within_3_grey_levels() {
+/// The scene and the captures: rays, reference surface, reference image and per capture its
+/// pins, surface and image.
+struct Captures {
+    rays: PixelRays,
+    reference: SurfaceHits,
+    reference_image: Vec<[f64; 3]>,
+    scenes: Vec<(Vec<Pin>, SurfaceHits, Vec<[f64; 3]>)>,
+}
+
+fn captures() -> Captures {
     let cam = CameraModel::new(benchmark_intrinsics()).unwrap();
     let rays = PixelRays::new(&cam, &benchmark_pose());
     let surface = ReferenceSurface::of(&rtac0_body()).unwrap();
@@ -103,38 +111,146 @@ fn leave_one_out_re_renders_each_capture_within_3_grey_levels() {
             (pins, hits, image)
         })
         .collect();
-    for k in 0..scenes.len() {
-        let others: Vec<Capture> = (0..scenes.len())
+    Captures {
+        rays,
+        reference,
+        reference_image,
+        scenes,
+    }
+}
+
+/// Each capture re-rendered from the model fitted on the others, at its own gain: the RMS
+/// over the skin pixels `counted` keeps, and the largest distance between a pin's imprint
+/// centroid in the capture and in its re-rendering, px.
+fn leave_one_out(c: &Captures, counted: impl Fn(usize) -> bool) -> (f64, f64) {
+    let (rays, reference) = (&c.rays, &c.reference);
+    let (mut worst_rms, mut worst_centroid) = (0.0f64, 0.0f64);
+    for k in 0..c.scenes.len() {
+        let others: Vec<Capture> = (0..c.scenes.len())
             .filter(|&j| j != k)
             .map(|j| Capture {
-                image: &scenes[j].2,
-                hits: &scenes[j].1,
+                image: &c.scenes[j].2,
+                hits: &c.scenes[j].1,
             })
             .collect();
-        let model = PhotometricModel::fit(&rays, &reference, &reference_image, &others).unwrap();
-        let (pins, hits, image) = &scenes[k];
-        let again: Vec<[f64; 3]> = model
-            .render(&reference, hits, 1.0)
-            .into_iter()
-            .map(|p| p.map(|x| x.clamp(0.0, 255.0)))
-            .collect();
-        let rms = rms_over_skin(&again, image);
+        let model =
+            PhotometricModel::fit(rays, reference, &c.reference_image, &others, 255.0).unwrap();
+        let (pins, hits, image) = &c.scenes[k];
+        let gain = model.gain_of(image, hits);
+        let again = model.render(reference, hits, gain);
+        let keep = |p: &[[f64; 3]]| -> Vec<[f64; 3]> {
+            p.iter()
+                .enumerate()
+                .map(|(i, x)| if counted(i) { *x } else { [f64::NAN; 3] })
+                .collect()
+        };
+        let rms = rms_over_skin(&keep(&again), &keep(image));
         eprintln!(
-            "capture {k}: re-rendered within {rms:.2} grey levels RMS; fit residuals {:?}",
+            "capture {k}: gain {gain:.4}, re-rendered within {rms:.2} grey levels RMS; fit residuals {:?}",
             model.residual_rms
         );
-        assert!(rms < 3.0, "capture {k}: {rms} grey levels RMS");
+        worst_rms = worst_rms.max(rms);
         for j in 0..pins.len() {
-            let base = |i: usize| model.reference[i][1];
+            let base = |i: usize| gain * model.reference[i][1];
             // the imprint's contrast above the camera's noise (sigma about 1.8 counts at half
             // scale), the same threshold for both
             let contrast = |x: f64| (x.abs() - NOISE_FLOOR).max(0.0);
-            let a = centroid(&rays, hits, pins, j, |i| contrast(image[i][1] - base(i)));
-            let b = centroid(&rays, hits, pins, j, |i| contrast(again[i][1] - base(i)));
+            let a = centroid(rays, hits, pins, j, |i| contrast(image[i][1] - base(i)));
+            let b = centroid(rays, hits, pins, j, |i| contrast(again[i][1] - base(i)));
             let (Some(a), Some(b)) = (a, b) else { continue };
-            let d = (a[0] - b[0]).hypot(a[1] - b[1]);
-            eprintln!("  pin {j}: centroid {a:?} vs {b:?}: {d:.3} px");
-            assert!(d < 0.2, "capture {k} pin {j}: centroids {d} px apart");
+            worst_centroid = worst_centroid.max((a[0] - b[0]).hypot(a[1] - b[1]));
         }
     }
+    (worst_rms, worst_centroid)
+}
+
+#[test]
+fn leave_one_out_re_renders_each_capture_within_3_grey_levels() {
+    let c = captures();
+    let (rms, centroid) = leave_one_out(&c, |_| true);
+    assert!(rms < 3.0, "{rms} grey levels RMS");
+    assert!(centroid < 0.2, "imprint centroids {centroid} px apart");
+}
+
+/// What a real capture adds (the artifacts of `imprints::synthetic::Shading::real_rim` and
+/// `real_capture`, put on the physically rendered images): a global gain that drifts by up to
+/// 5 % (0.96 to 1.05), 12 LED highlights on the skin's rim (peak 300 counts, sigma 8 px,
+/// clipped at 255, each image's a little brighter or dimmer) that each move by 1.5 px between
+/// images, and three dark specks per capture off the pins. The fit measures each capture's
+/// gain and takes the median of the images for the appearance; re-rendered, every capture is
+/// still within 3 grey levels RMS over the skin away from the highlights (24 px, 3 sigma; no
+/// model can say where a highlight moves) and its imprints within 0.2 px.
+#[test]
+fn leave_one_out_holds_with_gain_drift_moving_led_highlights_and_specks() {
+    let mut c = captures();
+    let (w, h) = (c.rays.width, c.rays.height);
+    let (cx, cy) = (0.5 * (w as f64 - 1.0), 0.5 * (h as f64 - 1.0));
+    let skin_r = (0..w * h)
+        .filter(|&i| c.reference.t_mm[i].is_finite())
+        .map(|i| ((i % w) as f64 - cx).hypot((i / w) as f64 - cy))
+        .fold(0.0f64, f64::max);
+    let ring: Vec<[f64; 2]> = (0..12)
+        .map(|k| {
+            let a = std::f64::consts::TAU * (k as f64 + 0.5) / 12.0;
+            let r = 0.9 * skin_r.min(cy);
+            [cx + r * a.cos(), cy + r * a.sin()]
+        })
+        .collect();
+    // each image's highlights: the ring moved 1.5 px per highlight, a flicker of +-10 %
+    let lit = |img: &mut Vec<[f64; 3]>, k: usize, gain: f64| {
+        for p in img.iter_mut() {
+            *p = p.map(|x| x * gain);
+        }
+        for (j, q) in ring.iter().enumerate() {
+            let a = 2.399963 * (7 * k + j) as f64;
+            let (u0, v0) = (q[0] + 1.5 * a.cos(), q[1] + 1.5 * a.sin());
+            let peak = 300.0 * (1.0 + 0.1 * (1.7 * (k + 3 * j) as f64).sin());
+            for i in 0..w * h {
+                let d2 = ((i % w) as f64 - u0).powi(2) + ((i / w) as f64 - v0).powi(2);
+                if d2 < 1600.0 {
+                    let add = peak * (-d2 / 128.0).exp();
+                    img[i] = img[i].map(|x| x + add);
+                }
+            }
+        }
+        for p in img.iter_mut() {
+            *p = p.map(|x| x.clamp(0.0, 255.0).round());
+        }
+    };
+    lit(&mut c.reference_image, 0, 1.0);
+    let gains = [0.96, 1.04, 0.98, 1.05, 0.97];
+    for (k, scene) in c.scenes.iter_mut().enumerate() {
+        lit(&mut scene.2, k + 1, gains[k]);
+        // three specks, 1.5 px, 60 counts dark, 30 px or more from any pressed pixel
+        let pressed: Vec<usize> = (0..w * h).filter(|&i| scene.1.contact[i]).collect();
+        let mut placed = 0;
+        for t in 0..200 {
+            if placed == 3 {
+                break;
+            }
+            let a = 2.399963 * (t + 11 * k) as f64;
+            let r = 0.6 * skin_r.min(cy) * ((t as f64 * 0.37).fract());
+            let (u, v) = (cx + r * a.cos(), cy + r * a.sin());
+            let far = pressed
+                .iter()
+                .all(|&i| ((i % w) as f64 - u).hypot((i / w) as f64 - v) >= 30.0);
+            if !far {
+                continue;
+            }
+            for i in 0..w * h {
+                if ((i % w) as f64 - u).hypot((i / w) as f64 - v) <= 1.5 {
+                    scene.2[i] = scene.2[i].map(|x| (x - 60.0).max(0.0));
+                }
+            }
+            placed += 1;
+        }
+        assert_eq!(placed, 3);
+    }
+    let away = |i: usize| {
+        let (u, v) = ((i % w) as f64, (i / w) as f64);
+        ring.iter().all(|q| (q[0] - u).hypot(q[1] - v) > 24.0 + 1.5)
+    };
+    let (rms, centroid) = leave_one_out(&c, away);
+    assert!(rms < 3.0, "{rms} grey levels RMS away from the highlights");
+    assert!(centroid < 0.2, "imprint centroids {centroid} px apart");
 }
