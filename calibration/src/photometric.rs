@@ -107,7 +107,7 @@ fn spatial(i: usize, width: usize, height: usize) -> [f64; SPATIAL_TERMS] {
         if d == 0 {
             continue;
         }
-        for j in 1..=ANGULAR_ORDER {
+        for j in (1..).take(ANGULAR_ORDER) {
             let (sn, cs) = (j as f64 * phi).sin_cos();
             out[k] = r * cs;
             out[k + 1] = r * sn;
