@@ -16,7 +16,9 @@ pub const FIXED_BYTES_PER_PIXEL: u64 = 160;
 /// Bytes per pixel of one frame being rendered and encoded: its hits (41) and depth frame
 /// (65), the differences to the reference (16, twice), the float32 arrays, the 16-bit and
 /// preview PNGs, the normals, the PLY points and their encoded bytes (about 130 at the peak),
-/// and the PNG and deflate encoders' working copies, rounded up.
+/// and the PNG and deflate encoders' working copies, rounded up. The image of `--images`
+/// (radiance 24, counts 6, its PNG) is made after the frame's depth files are written and
+/// dropped, within the same bytes.
 pub const FRAME_BYTES_PER_PIXEL: u64 = 320;
 
 /// Bytes besides the per-pixel buffers: the program, thread stacks, the fixtures and the
