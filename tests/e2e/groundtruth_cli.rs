@@ -761,7 +761,8 @@ fn groundtruth_refuses_an_unusable_out_folder_before_any_work() {
 }
 
 /// The memory estimate bounds the render: a 1024 x 1024 camera (4 configurations, 2 frames at
-/// a time) renders under an address-space limit of the estimate (`ulimit -v`).
+/// a time, with their images) renders under an address-space limit of the estimate
+/// (`ulimit -v`).
 #[test]
 fn a_render_fits_in_its_memory_estimate_under_an_address_space_limit() {
     use fabkit_calibration::groundtruth::budget::{frames_at_once, render_memory};
@@ -781,10 +782,11 @@ fn a_render_fits_in_its_memory_estimate_under_an_address_space_limit() {
     let limit_kb = render_memory(px, frames) / 1024;
     let o = run_limited(
         d.path(),
-        &gt_args("big.json", &["--format", "npy", "--yes"]),
+        &gt_args("big.json", &["--format", "npy", "--yes", "--images"]),
         &[("RAYON_NUM_THREADS", "2")],
         limit_kb,
     );
     assert!(o.status.success(), "{}", text(&o.stderr));
     assert!(d.path().join("gt/manifest.json").exists());
+    assert!(d.path().join("gt/p001_0/image.png").exists());
 }
