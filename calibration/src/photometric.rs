@@ -410,3 +410,41 @@ pub fn rms_over_skin(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
         (s / n as f64).sqrt()
     }
 }
+
+/// A calibration pin of the pin dome as solids for the ground-truth caster: its hemispherical
+/// tip of `tip_radius_mm` whose lowest point is `tip_mm`, the 45 deg cone to the shaft (when
+/// the shaft is wider), and the shaft of `shaft_radius_mm` up to `length_mm` from the tip,
+/// along `axis` (unit, from the tip towards the head; the point table's `axis`). The profile of
+/// `fixtures`' pin solid (pindome.rs `pin_solid_of`), the head left out (it never reaches the
+/// skin). The cone, whose apex is the tip, lies inside the hemisphere below the tip's centre.
+pub fn pin_primitives(
+    tip_mm: [f64; 3],
+    axis: [f64; 3],
+    tip_radius_mm: f64,
+    shaft_radius_mm: f64,
+    length_mm: f64,
+) -> Vec<fabkit_designs::primitives::Primitive> {
+    use fabkit_designs::primitives::Primitive;
+    let at = |h: f64| -> [f64; 3] { std::array::from_fn(|k| tip_mm[k] + h * axis[k]) };
+    let (rt, rs) = (tip_radius_mm, shaft_radius_mm.max(tip_radius_mm));
+    let mut out = vec![Primitive::Sphere {
+        centre_mm: at(rt),
+        radius_mm: rt,
+    }];
+    if rs > rt {
+        out.push(Primitive::Cone {
+            apex_mm: tip_mm,
+            base_mm: at(rs),
+            base_radius_mm: rs,
+        });
+    }
+    let from = if rs > rt { rs } else { rt };
+    if length_mm > from {
+        out.push(Primitive::Cylinder {
+            base_mm: at(from),
+            top_mm: at(length_mm),
+            radius_mm: rs,
+        });
+    }
+    out
+}

@@ -257,3 +257,46 @@ fn leave_one_out_holds_with_gain_drift_moving_led_highlights_and_specks() {
     assert!(rms < 3.0, "{rms} grey levels RMS away from the highlights");
     assert!(centroid < 0.2, "imprint centroids {centroid} px apart");
 }
+
+/// The pin's solids have the fixtures' pin profile: rays parallel to the axis from below meet
+/// it at the hemisphere's height `rt - sqrt(rt^2 - rho^2)` for `rho < rt`, on the 45 deg cone
+/// at `rho` for `rt <= rho < rs`, and miss it beyond the shaft.
+#[test]
+fn pin_solids_have_the_pin_profile() {
+    use fabkit_calibration::photometric::pin_primitives;
+    let a = {
+        let v = [0.3f64, -0.2, 0.93];
+        let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        v.map(|x| x / n)
+    };
+    let tip = [1.0, 2.0, 12.0];
+    let (rt, rs) = (0.5, 0.8);
+    let prims = ExactPrimitives::new(&pin_primitives(tip, a, rt, rs, 10.0)).unwrap();
+    // a unit vector perpendicular to the axis
+    let e = {
+        let c = [a[1], -a[0], 0.0];
+        let n = (c[0] * c[0] + c[1] * c[1]).sqrt();
+        c.map(|x| x / n)
+    };
+    for k in 0..=40 {
+        let rho = 0.9 * f64::from(k) / 40.0;
+        let start: [f64; 3] = std::array::from_fn(|i| tip[i] + rho * e[i] - 5.0 * a[i]);
+        let hit = prims.first_crossing(start, a, 20.0);
+        let want = if rho < rt {
+            Some(rt - (rt * rt - rho * rho).sqrt())
+        } else if rho < rs {
+            Some(rho)
+        } else {
+            None
+        };
+        match (hit, want) {
+            (Some(c), Some(h)) => assert!(
+                (c.t_mm - 5.0 - h).abs() < 1e-9,
+                "rho {rho}: {} vs {h}",
+                c.t_mm - 5.0
+            ),
+            (None, None) => {}
+            (c, h) => panic!("rho {rho}: {:?} vs {h:?}", c.map(|c| c.t_mm - 5.0)),
+        }
+    }
+}
