@@ -77,17 +77,14 @@ pub enum ImageError {
     Twice { file: String },
 }
 
-/// Reads `path` (PNG or JPEG, any depth, grey or colour) as grey levels 0..255, checking its
-/// size against the camera's (`expect_px`, from the camera file `camera`) before decoding.
-///
-/// # Errors
-/// [`ImageError`] naming `option` and the file.
-pub fn read_gray(
+/// Decodes `path` (PNG or JPEG), checking its size against the camera's (`expect_px`, from
+/// the camera file `camera`) before decoding.
+fn decode_checked(
     path: &Path,
     option: &'static str,
     expect_px: (u32, u32),
     camera: &str,
-) -> Result<GrayImage, ImageError> {
+) -> Result<image::DynamicImage, ImageError> {
     let file = path.display().to_string();
     let bytes = crate::read_binary(path).map_err(|source| ImageError::Io {
         option,
@@ -123,13 +120,57 @@ pub fn read_gray(
             camera_height: expect_px.1,
         });
     }
-    let img = reader()?.decode().map_err(|e| decode(e.to_string()))?;
+    reader()?.decode().map_err(|e| decode(e.to_string()))
+}
+
+/// Reads `path` (PNG or JPEG, any depth, grey or colour) as grey levels 0..255, checking its
+/// size against the camera's (`expect_px`, from the camera file `camera`) before decoding.
+///
+/// # Errors
+/// [`ImageError`] naming `option` and the file.
+pub fn read_gray(
+    path: &Path,
+    option: &'static str,
+    expect_px: (u32, u32),
+    camera: &str,
+) -> Result<GrayImage, ImageError> {
+    let img = decode_checked(path, option, expect_px, camera)?;
     // 16 bits per grey level: 8-bit images come back as g * 257, exactly g after the division
     let luma = img.into_luma16();
     Ok(GrayImage {
-        width: width as usize,
-        height: height as usize,
+        width: luma.width() as usize,
+        height: luma.height() as usize,
         data: luma.as_raw().iter().map(|&g| g as f32 / 257.0).collect(),
+    })
+}
+
+/// Reads `path` (PNG or JPEG, grey or colour) as RGB counts at its own bit depth, row-major,
+/// with its full scale (255 for 8-bit images, 65535 for 16-bit; a grey image gives three
+/// equal channels), checking its size against the camera's as [`read_gray`] does: the
+/// intensities the photometric model is fitted to.
+///
+/// # Errors
+/// [`ImageError`] naming `option` and the file.
+pub fn read_rgb(
+    path: &Path,
+    option: &'static str,
+    expect_px: (u32, u32),
+    camera: &str,
+) -> Result<(Vec<[f64; 3]>, f64), ImageError> {
+    let img = decode_checked(path, option, expect_px, camera)?;
+    let sixteen = matches!(
+        img.color(),
+        image::ColorType::L16
+            | image::ColorType::La16
+            | image::ColorType::Rgb16
+            | image::ColorType::Rgba16
+    );
+    Ok(if sixteen {
+        let rgb = img.into_rgb16();
+        (rgb.pixels().map(|p| p.0.map(f64::from)).collect(), 65535.0)
+    } else {
+        let rgb = img.into_rgb8();
+        (rgb.pixels().map(|p| p.0.map(f64::from)).collect(), 255.0)
     })
 }
 

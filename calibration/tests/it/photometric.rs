@@ -300,3 +300,37 @@ fn pin_solids_have_the_pin_profile() {
         }
     }
 }
+
+/// The captures are read at their own depth: an 8-bit RGB PNG gives its counts and full scale
+/// 255, a 16-bit one its counts and 65535, a grey one three equal channels; an image of
+/// another size than the camera's is refused naming the option and both sizes.
+#[test]
+fn captures_are_read_as_rgb_counts_at_their_depth() {
+    use fabkit_calibration::capture_images::read_rgb;
+    let d = tempfile::tempdir().unwrap();
+    let (w, h) = (5u32, 3u32);
+    let rgb8 = image::RgbImage::from_fn(w, h, |x, y| image::Rgb([x as u8 * 40, y as u8 * 90, 7]));
+    rgb8.save(d.path().join("a.png")).unwrap();
+    let rgb16: image::ImageBuffer<image::Rgb<u16>, Vec<u16>> =
+        image::ImageBuffer::from_fn(w, h, |x, y| {
+            image::Rgb([x as u16 * 9000, y as u16 * 20000, 65535])
+        });
+    rgb16.save(d.path().join("b.png")).unwrap();
+    let grey = image::GrayImage::from_fn(w, h, |x, _| image::Luma([x as u8 * 50]));
+    grey.save(d.path().join("c.png")).unwrap();
+    let (a, fa) = read_rgb(&d.path().join("a.png"), "--images", (w, h), "cam.yaml").unwrap();
+    assert_eq!(fa, 255.0);
+    assert_eq!(a[(2 * w + 4) as usize], [160.0, 180.0, 7.0]);
+    let (b, fb) = read_rgb(&d.path().join("b.png"), "--images", (w, h), "cam.yaml").unwrap();
+    assert_eq!(fb, 65535.0);
+    assert_eq!(b[(1 * w + 3) as usize], [27000.0, 20000.0, 65535.0]);
+    let (c, _) = read_rgb(&d.path().join("c.png"), "--reference", (w, h), "cam.yaml").unwrap();
+    assert_eq!(c[3], [150.0; 3]);
+    let e = read_rgb(&d.path().join("a.png"), "--images", (6, 3), "cam.yaml")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("--images = ") && e.contains("5 x 3 px") && e.contains("6 x 3 px"),
+        "{e}"
+    );
+}
