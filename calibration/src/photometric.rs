@@ -36,6 +36,7 @@
 //! UVDtact's); lights at a few azimuths (ShadowTac's three single-colour LEDs) need angular
 //! terms too. Shadows cast by a pin onto the skin beside its imprint are not in the model.
 
+use crate::groundtruth::inputs::InputError;
 use crate::groundtruth::rays::PixelRays;
 use crate::groundtruth::SurfaceHits;
 use nalgebra::{DMatrix, DVector};
@@ -447,4 +448,162 @@ pub fn pin_primitives(
         });
     }
     out
+}
+
+/// The pins of a pin dome as `fabkit fixtures` wrote them: each pin's id with its tip and
+/// axis (points/point_table.csv) and the pin's shape (the `pin` part of manifest.json).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Pins {
+    /// (id, tip mm, unit axis from the tip towards the head), sensor frame, in file order.
+    pub rows: Vec<(String, [f64; 3], [f64; 3])>,
+    pub tip_radius_mm: f64,
+    pub shaft_radius_mm: f64,
+    /// From the tip to the head's underside, mm.
+    pub length_mm: f64,
+}
+
+impl Pins {
+    /// The solids of the pins `ids` ([`pin_primitives`]).
+    ///
+    /// # Errors
+    /// The first id that is not in the table.
+    pub fn primitives(
+        &self,
+        ids: &[String],
+    ) -> Result<Vec<fabkit_designs::primitives::Primitive>, String> {
+        let mut out = Vec::new();
+        for id in ids {
+            let (_, tip, axis) = self
+                .rows
+                .iter()
+                .find(|r| &r.0 == id)
+                .ok_or_else(|| id.clone())?;
+            out.extend(pin_primitives(
+                *tip,
+                *axis,
+                self.tip_radius_mm,
+                self.shaft_radius_mm,
+                self.length_mm,
+            ));
+        }
+        Ok(out)
+    }
+}
+
+#[derive(serde::Deserialize)]
+struct FixturesManifest {
+    parts: Vec<ManifestPart>,
+}
+
+#[derive(serde::Deserialize)]
+struct ManifestPart {
+    name: String,
+    #[serde(default)]
+    params: serde_json::Value,
+}
+
+/// Reads the pins of the fixtures folder `dir`: points/point_table.csv (columns `id`,
+/// `tip_x_mm`, `tip_y_mm`, `tip_z_mm`, `axis_x`, `axis_y`, `axis_z`, any order, others
+/// ignored) and the `pin` part's `params.pin` (`tip_radius_mm`, `shaft_diameter_mm`) and
+/// `params.length_mm` in manifest.json.
+///
+/// # Errors
+/// [`InputError`] naming the file, the line or field, the value and the rule: a missing
+/// column, a number that does not parse or is not finite, an axis that is not a unit vector
+/// (to 1e-6), a repeated id, no pin part, a pin size that is missing or not above 0.
+pub fn read_pins(dir: &std::path::Path) -> Result<Pins, InputError> {
+    use crate::groundtruth::inputs::{json, read_with_hash};
+    let table = dir.join("points").join("point_table.csv");
+    let (bytes, _) = read_with_hash(&table)?;
+    let file = table.display().to_string();
+    let field = |field: String, value: String, rule: &str| InputError::Field {
+        file: file.clone(),
+        field,
+        value,
+        rule: rule.to_string(),
+    };
+    let text = String::from_utf8_lossy(&bytes);
+    let mut lines = text.lines().enumerate();
+    let header: Vec<&str> = lines
+        .next()
+        .map(|(_, l)| l.split(',').map(str::trim).collect())
+        .unwrap_or_default();
+    let col = |name: &str| {
+        header.iter().position(|h| *h == name).ok_or_else(|| {
+            field(
+                "header".into(),
+                header.join(","),
+                &format!("has no column {name}"),
+            )
+        })
+    };
+    let id_col = col("id")?;
+    let cols: Vec<usize> = [
+        "tip_x_mm", "tip_y_mm", "tip_z_mm", "axis_x", "axis_y", "axis_z",
+    ]
+    .iter()
+    .map(|c| col(c))
+    .collect::<Result<_, _>>()?;
+    let mut rows: Vec<(String, [f64; 3], [f64; 3])> = Vec::new();
+    for (k, line) in lines {
+        if line.trim().is_empty() {
+            continue;
+        }
+        let cells: Vec<&str> = line.split(',').map(str::trim).collect();
+        let at = |c: usize| cells.get(c).copied().unwrap_or("");
+        let id = at(id_col).to_string();
+        let mut v = [0.0; 6];
+        for (j, &c) in cols.iter().enumerate() {
+            v[j] = at(c)
+                .parse::<f64>()
+                .ok()
+                .filter(|x| x.is_finite())
+                .ok_or_else(|| {
+                    field(
+                        format!("line {} {}", k + 1, header[c]),
+                        format!("{:?}", at(c)),
+                        "must be a finite number",
+                    )
+                })?;
+        }
+        let axis = [v[3], v[4], v[5]];
+        if ((axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt() - 1.0).abs() > 1e-6 {
+            return Err(field(
+                format!("line {} axis", k + 1),
+                format!("{axis:?}"),
+                "must be a unit vector (to 1e-6)",
+            ));
+        }
+        if rows.iter().any(|r| r.0 == id) {
+            return Err(field(format!("line {} id", k + 1), id, "is given twice"));
+        }
+        rows.push((id, [v[0], v[1], v[2]], axis));
+    }
+    let manifest = dir.join("manifest.json");
+    let (bytes, _) = read_with_hash(&manifest)?;
+    let m: FixturesManifest = json(&bytes, &manifest)?;
+    let mfile = manifest.display().to_string();
+    let part = m.parts.iter().find(|p| p.name == "pin").ok_or_else(|| InputError::Field {
+        file: mfile.clone(),
+        field: "parts".into(),
+        value: "(no part named pin)".into(),
+        rule: "must list the pin dome's pin (hint: pass the output folder of `fabkit fixtures` with a pin dome)".into(),
+    })?;
+    let size = |path: &[&str]| -> Result<f64, InputError> {
+        let v = path.iter().fold(&part.params, |v, k| &v[*k]);
+        v.as_f64()
+            .filter(|x| *x > 0.0)
+            .ok_or_else(|| InputError::Field {
+                file: mfile.clone(),
+                field: format!("parts[pin].params.{}", path.join(".")),
+                value: v.to_string(),
+                rule: "must be a number above 0".into(),
+            })
+    };
+    Ok(Pins {
+        rows,
+        tip_radius_mm: size(&["pin", "tip_radius_mm"])?,
+        shaft_radius_mm: size(&["pin", "shaft_diameter_mm"])? / 2.0,
+        length_mm: size(&["length_mm"])?,
+    })
 }

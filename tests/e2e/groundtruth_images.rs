@@ -227,3 +227,37 @@ fn bad_optics_are_refused_by_path_and_nothing_is_written() {
         assert!(!d.path().join(&out).exists(), "{path}: {out} written");
     }
 }
+
+/// The pins of a real `fabkit fixtures` folder (R-Tac0's published pin dome) as the
+/// photometric fit reads them: 29 pins, each tip on the skin's sphere (R = 15 mm about the
+/// origin) pushed in by its indentation depth along its axis, which is radial; the pin's tip
+/// radius and shaft from the manifest.
+#[test]
+fn the_photometric_fit_reads_the_pins_of_a_fixtures_folder() {
+    let d = tempfile::tempdir().unwrap();
+    setup(d.path());
+    let pins = fabkit_calibration::photometric::read_pins(&d.path().join("fx")).unwrap();
+    assert_eq!(pins.rows.len(), 29);
+    let table = std::fs::read_to_string(d.path().join("fx/points/point_table.csv")).unwrap();
+    let depth: f64 = table
+        .lines()
+        .nth(1)
+        .unwrap()
+        .rsplit(',')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    for (id, tip, axis) in &pins.rows {
+        let r = tip.iter().map(|x| x * x).sum::<f64>().sqrt();
+        assert!((r - (15.0 - depth)).abs() < 1e-6, "pin {id}: |tip| = {r}");
+        for k in 0..3 {
+            assert!(
+                (axis[k] - tip[k] / r).abs() < 1e-6,
+                "pin {id}: axis {axis:?}"
+            );
+        }
+    }
+    assert!(pins.tip_radius_mm > 0.0 && pins.shaft_radius_mm >= pins.tip_radius_mm);
+    assert!(pins.length_mm > depth);
+}

@@ -64,7 +64,10 @@ pub fn sha256_hex(bytes: &[u8]) -> String {
 
 /// A JSON input file; a leading UTF-8 byte order mark (an editor's "UTF-8 with BOM") is
 /// skipped, as the CSV readers skip it.
-fn json<T: for<'de> Deserialize<'de>>(bytes: &[u8], file: &Path) -> Result<T, InputError> {
+pub(crate) fn json<T: for<'de> Deserialize<'de>>(
+    bytes: &[u8],
+    file: &Path,
+) -> Result<T, InputError> {
     let bytes = bytes.strip_prefix(b"\xef\xbb\xbf").unwrap_or(bytes);
     serde_json::from_slice(bytes).map_err(|e| InputError::Json {
         file: file.display().to_string(),

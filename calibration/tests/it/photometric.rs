@@ -334,3 +334,63 @@ fn captures_are_read_as_rgb_counts_at_their_depth() {
         "{e}"
     );
 }
+
+/// A fixtures folder's pins: the point table's tips and axes and the pin's shape from the
+/// manifest; a bad axis, a missing column and a manifest without a pin are refused naming the
+/// file and the field.
+#[test]
+fn pins_are_read_from_a_fixtures_folder() {
+    use fabkit_calibration::photometric::read_pins;
+    let d = tempfile::tempdir().unwrap();
+    std::fs::create_dir(d.path().join("points")).unwrap();
+    let header = "id,ring,tip_x_mm,tip_y_mm,tip_z_mm,contact_x_mm,contact_y_mm,contact_z_mm,axis_x,axis_y,axis_z,indentation_depth_mm";
+    let table = |rows: &str| {
+        std::fs::write(
+            d.path().join("points/point_table.csv"),
+            format!("{header}\n{rows}"),
+        )
+        .unwrap()
+    };
+    table("1,0,0,0,13.459,0,0,15,0,0,1,1.541\n2,1,4.13,0,12.81,4.6,0,14.28,0.306858322,0,0.951755205,1.541\n");
+    let manifest = |pin: &str| {
+        std::fs::write(
+            d.path().join("manifest.json"),
+            format!(r#"{{"parts": [{{"name": "pin_dome", "params": {{}}}}, {pin}]}}"#),
+        )
+        .unwrap()
+    };
+    manifest(
+        r#"{"name": "pin", "params": {"length_mm": 5.6, "pin": {"shaft_diameter_mm": 1.6, "tip_radius_mm": 0.8}}}"#,
+    );
+    let pins = read_pins(d.path()).unwrap();
+    assert_eq!(pins.rows.len(), 2);
+    assert_eq!(pins.rows[1].0, "2");
+    assert_eq!(pins.rows[0].1, [0.0, 0.0, 13.459]);
+    assert_eq!(
+        (pins.tip_radius_mm, pins.shaft_radius_mm, pins.length_mm),
+        (0.8, 0.8, 5.6)
+    );
+    assert_eq!(pins.primitives(&["2".into()]).unwrap().len(), 2);
+    assert_eq!(pins.primitives(&["7".into()]).unwrap_err(), "7");
+
+    table("1,0,0,0,13.459,0,0,15,0,0,2,1.541\n");
+    let e = read_pins(d.path()).unwrap_err().to_string();
+    assert!(
+        e.contains("point_table.csv: line 2 axis") && e.contains("unit vector"),
+        "{e}"
+    );
+    std::fs::write(
+        d.path().join("points/point_table.csv"),
+        "id,tip_x_mm\n1,0\n",
+    )
+    .unwrap();
+    let e = read_pins(d.path()).unwrap_err().to_string();
+    assert!(e.contains("has no column tip_y_mm"), "{e}");
+    table("1,0,0,0,13.459,0,0,15,0,0,1,1.541\n");
+    manifest(r#"{"name": "semidome_p001", "params": {}}"#);
+    let e = read_pins(d.path()).unwrap_err().to_string();
+    assert!(
+        e.contains("manifest.json: parts") && e.contains("pin"),
+        "{e}"
+    );
+}
