@@ -47,6 +47,8 @@ pub enum OutputCommand {
     Groundtruth,
     /// `fabkit calibrate extrinsics`.
     CalibrateExtrinsics,
+    /// `fabkit calibrate photometric`.
+    CalibratePhotometric,
     /// One variant's folder of `fabkit sweep` (`variants/<id>/`).
     SweepVariant,
 }
@@ -60,6 +62,7 @@ impl OutputCommand {
             OutputCommand::Fixtures => "fixtures",
             OutputCommand::Groundtruth => "groundtruth",
             OutputCommand::CalibrateExtrinsics => "calibrate extrinsics",
+            OutputCommand::CalibratePhotometric => "calibrate photometric",
             OutputCommand::SweepVariant => "sweep",
         }
     }

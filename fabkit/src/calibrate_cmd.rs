@@ -14,6 +14,9 @@ use fabkit_export::{OutputClaim, OutputCommand, StagedDir};
 pub enum CalibrateCommand {
     /// Solve the camera pose (T_cam_sensor) from pin-dome observations.
     Extrinsics(ExtrinsicsArgs),
+    /// Fit the sensor's photometric model (how its images respond to the skin's normal) from
+    /// pin captures whose pose is solved.
+    Photometric(crate::photometric_cmd::PhotometricArgs),
 }
 
 /// Which point of the fixtures point table the pins touch.
@@ -121,6 +124,7 @@ pub struct ExtrinsicsArgs {
 pub fn run(cmd: CalibrateCommand) -> Result<(), Box<dyn Error>> {
     match cmd {
         CalibrateCommand::Extrinsics(a) => extrinsics(a),
+        CalibrateCommand::Photometric(a) => crate::photometric_cmd::run(a),
     }
 }
 

@@ -22,6 +22,7 @@ pub mod calibrate_cmd;
 pub mod cli;
 pub mod fixtures_cmd;
 pub mod groundtruth_cmd;
+pub mod photometric_cmd;
 pub mod printers;
 mod progress;
 pub mod sweep_cmd;

@@ -10,6 +10,7 @@ mod byte_identical;
 mod calibrate_cli;
 mod calibrate_images;
 mod calibrate_opencv;
+mod calibrate_photometric;
 mod cli_errors;
 mod default_readers;
 mod docs;
