@@ -100,6 +100,77 @@ fn png_bytes(
     Ok(out)
 }
 
+/// Reads an NPY file of float32 (`<f4`, C order, format version 1.0 to 3.0) as its shape and
+/// values: the files [`npy_f32`] writes, and numpy's `np.save` of a `float32` array.
+///
+/// # Errors
+/// A message saying what is wrong: not NPY, another dtype, Fortran order, a shape that does
+/// not parse or does not match the data's length.
+pub fn read_npy_f32(bytes: &[u8]) -> Result<(Vec<usize>, Vec<f32>), String> {
+    if bytes.len() < 10 || &bytes[..6] != b"\x93NUMPY" {
+        return Err("not an NPY file (bad magic)".into());
+    }
+    let (header_len, start): (usize, usize) = match bytes[6] {
+        1 => (u16::from_le_bytes([bytes[8], bytes[9]]) as usize, 10),
+        2 | 3 if bytes.len() >= 12 => (
+            u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]) as usize,
+            12,
+        ),
+        v => return Err(format!("NPY format version {v} is not read")),
+    };
+    let end = start
+        .checked_add(header_len)
+        .filter(|e| *e <= bytes.len())
+        .ok_or("the NPY header runs past the file")?;
+    let header =
+        std::str::from_utf8(&bytes[start..end]).map_err(|_| "the NPY header is not text")?;
+    let field = |key: &str| -> Option<&str> {
+        let i = header.find(&format!("'{key}'"))? + key.len() + 2;
+        let rest = header[i..].trim_start().strip_prefix(':')?.trim_start();
+        Some(rest)
+    };
+    let descr = field("descr").ok_or("the NPY header has no descr")?;
+    if !descr.starts_with("'<f4'") {
+        return Err(format!(
+            "dtype {}: only little-endian float32 ('<f4') is read",
+            descr.split(',').next().unwrap_or("")
+        ));
+    }
+    if !field("fortran_order").is_some_and(|f| f.starts_with("False")) {
+        return Err("only C-order arrays (fortran_order False) are read".into());
+    }
+    let shape_txt = field("shape").ok_or("the NPY header has no shape")?;
+    let close = shape_txt.find(')').ok_or("the NPY shape does not parse")?;
+    let shape: Vec<usize> = shape_txt[1..close]
+        .split(',')
+        .map(str::trim)
+        .filter(|t| !t.is_empty())
+        .map(|t| {
+            t.parse::<usize>()
+                .map_err(|_| format!("the NPY shape {} does not parse", &shape_txt[..=close]))
+        })
+        .collect::<Result<_, _>>()?;
+    let n = shape
+        .iter()
+        .try_fold(1usize, |a, d| a.checked_mul(*d))
+        .ok_or("the NPY shape is too large")?;
+    let data = &bytes[end..];
+    if data.len() != 4 * n {
+        return Err(format!(
+            "the NPY data holds {} bytes, the shape {:?} needs {}",
+            data.len(),
+            shape,
+            4 * n
+        ));
+    }
+    Ok((
+        shape,
+        data.chunks_exact(4)
+            .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+            .collect(),
+    ))
+}
+
 /// A 16-bit greyscale PNG (`text`: tEXt chunks, e.g. the units and scale).
 ///
 /// # Errors
@@ -374,6 +445,31 @@ mod tests {
         let h = std::str::from_utf8(&b[10..10 + hlen]).unwrap();
         assert!(h.contains("'shape': (2, 3)") && h.ends_with('\n'));
         assert_eq!(&b[10 + hlen + 20..], &5.5f32.to_le_bytes());
+    }
+
+    #[test]
+    fn npy_files_read_back_and_bad_ones_are_refused() {
+        let data = [0.0, 1.5, f32::NAN, -3.25, 7.0, 8.0];
+        let (shape, back) = read_npy_f32(&npy_f32(&[1, 2, 3], &data)).unwrap();
+        assert_eq!(shape, [1, 2, 3]);
+        assert_eq!(back[1], 1.5);
+        assert!(back[2].is_nan());
+        assert_eq!(back[5], 8.0);
+        let (shape, _) = read_npy_f32(&npy_f32(&[6], &data)).unwrap();
+        assert_eq!(shape, [6]);
+        let mut short = npy_f32(&[2, 3], &data);
+        short.pop();
+        assert!(read_npy_f32(&short).unwrap_err().contains("needs 24"));
+        let f8 = npy_f32(&[2, 3], &data)
+            .iter()
+            .map(|&b| b)
+            .collect::<Vec<u8>>();
+        let text = String::from_utf8_lossy(&f8[10..74]).replace("<f4", "<f8");
+        let mut bad = f8[..10].to_vec();
+        bad.extend_from_slice(text.as_bytes());
+        bad.extend_from_slice(&f8[74..]);
+        assert!(read_npy_f32(&bad).unwrap_err().contains("float32"));
+        assert!(read_npy_f32(b"not an npy file").is_err());
     }
 
     #[test]

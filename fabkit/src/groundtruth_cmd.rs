@@ -19,6 +19,7 @@ use fabkit_calibration::groundtruth::shading::Imaging;
 use fabkit_calibration::groundtruth::{
     half_masks, indented_hits, reference_hits, DepthFrame, Scene, SurfaceHits,
 };
+use fabkit_calibration::photometric::PhotometricModel;
 use fabkit_calibration::read_camera_file_as;
 use fabkit_export::raster::{
     normals_rgb, npy_f32, npz as npz_file, ply_points, png_gray16, png_gray8, png_rgb16, png_rgb8,
@@ -87,6 +88,11 @@ pub struct GroundTruthArgs {
     /// shadows cast by the protrusions, seeded camera noise.
     #[arg(long)]
     images: bool,
+    /// With --images: render them in the sensor's own appearance, from the photometric model
+    /// `fabkit calibrate photometric` wrote to DIR (photometric.json, appearance.npy; same
+    /// camera size), instead of the design's optics. The model's mean image: no noise.
+    #[arg(long, value_name = "DIR", requires = "images")]
+    photometric: Option<PathBuf>,
     #[command(flatten)]
     data_files: DataFileArgs,
 }
@@ -348,26 +354,142 @@ fn frame_files(
 /// What the rendered images leave out, in the manifest and the guide.
 const IMAGES_NOT_MODELLED: &str = "refraction through the clear layers between the camera and the reflective surface (rays are straight from the camera centre); light scattered inside the elastomer; light reflected from one part of the skin onto another; the skin's deformation around a protrusion (the indented surface is the skin minus the protrusion solids); the dimples in the depth maps (the images show them, the depth is of the skin without them); penumbrae (each LED is a point: shadows have hard edges); the markers' own relief and their parallax (a marker is albedo on the reference surface at its normal's foot); fluorescence under UV LEDs (UV light is drawn as violet); lens blur, motion blur and rolling shutter";
 
-/// The rendered image of a frame (`--images`): `dir/image.png`, RGB at the optics' bit
-/// depth, on the depth maps' pixel grid; its noise is that of frame `frame` of the set.
+/// Where the images of `--images` come from.
+enum ImageSource {
+    /// The design's optics through the physical image model.
+    Physical(Imaging),
+    /// The sensor's photometric model (`--photometric DIR`), with the folder and the sha256
+    /// of its photometric.json.
+    Photometric(PhotometricModel, String, String),
+}
+
+impl ImageSource {
+    fn bits(&self) -> u32 {
+        match self {
+            ImageSource::Physical(im) => im.optics.camera.bit_depth,
+            ImageSource::Photometric(m, ..) => {
+                if m.full_scale > 255.0 {
+                    16
+                } else {
+                    8
+                }
+            }
+        }
+    }
+}
+
+/// The photometric model `fabkit calibrate photometric` wrote to `dir`, for a `w` x `h`
+/// camera, and the sha256 of its photometric.json.
+///
+/// # Errors
+/// Naming `--photometric`, the file and what does not fit: another basis than this fabkit's,
+/// coefficients of another length, an appearance of another size than the camera's.
+fn load_photometric(
+    dir: &Path,
+    w: usize,
+    h: usize,
+) -> Result<(PhotometricModel, String), Box<dyn Error>> {
+    use fabkit_calibration::photometric::{ANGULAR_ORDER, FEATURES, SPATIAL_DEGREE, SPATIAL_TERMS};
+    let jpath = dir.join("photometric.json");
+    let (bytes, sha) = read_with_hash(&jpath)?;
+    let bad = |what: String| -> Box<dyn Error> {
+        format!("--photometric {}: {what}", jpath.display()).into()
+    };
+    let v: Value = serde_json::from_slice(&bytes).map_err(|e| bad(format!("not JSON: {e}")))?;
+    let m = &v["model"];
+    let basis = [
+        ("feature_count", FEATURES),
+        ("spatial_degree", SPATIAL_DEGREE),
+        ("angular_order", ANGULAR_ORDER),
+        ("spatial_terms", SPATIAL_TERMS),
+    ];
+    for (key, want) in basis {
+        if m[key].as_u64() != Some(want as u64) {
+            return Err(bad(format!(
+                "model.{key} = {}: this fabkit's model has {want} (fit it again with this version)",
+                m[key]
+            )));
+        }
+    }
+    let coefficients: [Vec<f64>; 3] = serde_json::from_value(m["coefficients_rgb"].clone())
+        .ok()
+        .filter(|c: &[Vec<f64>; 3]| c.iter().all(|x| x.len() == FEATURES * SPATIAL_TERMS))
+        .ok_or_else(|| {
+            bad(format!(
+                "model.coefficients_rgb must be 3 lists of {} numbers",
+                FEATURES * SPATIAL_TERMS
+            ))
+        })?;
+    let axis: [f64; 3] = serde_json::from_value(m["optical_axis"].clone())
+        .map_err(|_| bad("model.optical_axis must be 3 numbers".into()))?;
+    let full_scale = m["full_scale_counts"]
+        .as_f64()
+        .filter(|f| *f == 255.0 || *f == 65535.0)
+        .ok_or_else(|| bad("model.full_scale_counts must be 255 or 65535".into()))?;
+    let apath = dir.join("appearance.npy");
+    let (abytes, _) = read_with_hash(&apath)?;
+    let (shape, data) = fabkit_export::raster::read_npy_f32(&abytes)
+        .map_err(|e| format!("--photometric {}: {e}", apath.display()))?;
+    if shape != [h, w, 3] {
+        return Err(format!(
+            "--photometric {}: shape {shape:?}, the camera's images need [{h}, {w}, 3] (the model was fitted to another camera)",
+            apath.display()
+        )
+        .into());
+    }
+    let reference = data
+        .chunks_exact(3)
+        .map(|c| [f64::from(c[0]), f64::from(c[1]), f64::from(c[2])])
+        .collect();
+    Ok((
+        PhotometricModel {
+            width: w,
+            height: h,
+            reference,
+            coefficients,
+            axis,
+            gains: Vec::new(),
+            full_scale,
+            residual_rms: Vec::new(),
+        },
+        sha,
+    ))
+}
+
+/// The rendered image of a frame (`--images`): `dir/image.png`, RGB at the source's bit
+/// depth, on the depth maps' pixel grid; from the design's optics its noise is that of frame
+/// `frame` of the set, from a photometric model it is the model's noise-free image.
+#[allow(clippy::too_many_arguments)]
 fn image_file(
     dir: &str,
-    im: &Imaging,
+    src: &ImageSource,
     rays: &PixelRays,
+    reference: &SurfaceHits,
     hits: &SurfaceHits,
     protrusions: Option<&ExactPrimitives>,
     frame: u64,
 ) -> Result<(String, Vec<u8>, Value), Box<dyn Error>> {
     let (w, h) = (rays.width, rays.height);
-    let img = im.image(rays, hits, protrusions, frame);
-    let bits = im.optics.camera.bit_depth;
+    let bits = src.bits();
     let full = ((1u32 << bits) - 1) as u16;
+    let (img, text) = match src {
+        ImageSource::Physical(im) => (
+            im.image(rays, hits, protrusions, frame),
+            format!(
+                "fabkit rendered tactile image, frame {frame}: RGB, {bits} bit; the skin lit by the design's lights, exposure gain {}",
+                im.gain
+            ),
+        ),
+        ImageSource::Photometric(m, folder, _) => (
+            m.render(reference, hits, 1.0)
+                .into_iter()
+                .map(|p| p.map(|x| if x.is_finite() { x.round().clamp(0.0, f64::from(full)) as u16 } else { 0 }))
+                .collect(),
+            format!("fabkit rendered tactile image: RGB, {bits} bit; the sensor's photometric model from {folder}"),
+        ),
+    };
     let saturated = img.iter().filter(|p| p.contains(&full)).count();
     let file = format!("{dir}/image.png");
-    let text = format!(
-        "fabkit rendered tactile image, frame {frame}: RGB, {bits} bit; the skin lit by the design's lights, exposure gain {}",
-        im.gain
-    );
     let meta = [("Description", text.as_str())];
     let bytes = if bits == 16 {
         png_rgb16(w, h, &img, &meta)?
@@ -620,8 +742,13 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
     let scene = Scene::new(design, &camera, &t_cam_sensor, &pose_name)?;
     scene.check_outside(&fixtures.configurations, &pose_name)?;
     let Scene { surface, rays } = scene;
-    // The optics are checked before the output is bounded or anything is written.
-    let optics = if args.images {
+    // The optics (or the photometric model) are checked before the output is bounded or
+    // anything is written.
+    let photometric = match &args.photometric {
+        Some(dir) => Some((load_photometric(dir, rays.width, rays.height)?, dir)),
+        None => None,
+    };
+    let optics = if args.images && photometric.is_none() {
         Some(fabkit_designs::optics::of_design(
             design,
             fabkit_designs::ChordTolerance::new(fabkit_designs::ChordTolerance::DEFAULT_MM)?,
@@ -629,7 +756,10 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
     } else {
         None
     };
-    let image_bits = optics.as_ref().map(|o| o.camera.bit_depth);
+    let image_bits = match &photometric {
+        Some(((m, _), _)) => Some(if m.full_scale > 255.0 { 16 } else { 8 }),
+        None => optics.as_ref().map(|o| o.camera.bit_depth),
+    };
     let c = rays.origin_mm;
     let (w, h) = (rays.width, rays.height);
     let n_cfg = fixtures.configurations.len();
@@ -712,10 +842,13 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
         loaded.sha256
     );
 
-    let imaging = optics.map(|o| {
-        let i = camera.intrinsics();
-        Imaging::new(o, [i.cx_px, i.cy_px], &rays, &ref_hits)
-    });
+    let imaging = match photometric {
+        Some(((m, sha), dir)) => Some(ImageSource::Photometric(m, dir.display().to_string(), sha)),
+        None => optics.map(|o| {
+            let i = camera.intrinsics();
+            ImageSource::Physical(Imaging::new(o, [i.cx_px, i.cy_px], &rays, &ref_hits))
+        }),
+    };
     let staged = StagedDir::new(&args.out, claim)?;
     let reference = DepthFrame::new(&rays, &ref_hits);
     let preview = finite_range(&reference.range_mm)
@@ -756,7 +889,15 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
     )?;
     if let Some(im) = &imaging {
         ref_entries.extend(write(
-            vec![image_file("reference", im, &rays, &ref_hits, None, 0)?],
+            vec![image_file(
+                "reference",
+                im,
+                &rays,
+                &ref_hits,
+                &ref_hits,
+                None,
+                0,
+            )?],
             &mut all,
         )?);
     }
@@ -798,6 +939,7 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
                 &cfg.name,
                 im,
                 &rays,
+                &ref_hits,
                 &hits,
                 Some(&cfg.primitives),
                 k as u64 + 1,
@@ -892,7 +1034,15 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
         "masks_and_pairs": extra_entries,
         "files": all.iter().map(|(f, s, b)| json!({"file": f, "sha256": s, "bytes": b})).collect::<Vec<_>>(),
     });
-    if let Some(im) = &imaging {
+    if let Some(ImageSource::Photometric(_, dir, sha)) = &imaging {
+        manifest["images"] = json!({
+            "file": "image.png in reference/ and in each configuration's folder",
+            "model": "the sensor's photometric model (fabkit calibrate photometric): per channel the appearance of every pixel times one plus its fitted response to the surface's tilt and indentation (calibration/src/photometric.rs); the model's mean image, no noise",
+            "photometric": {"dir": dir, "photometric_json_sha256": sha},
+            "not_modelled": "shadows cast beside an imprint onto the unpressed skin; lights at a few azimuths (the spatial term depends on the distance from the image centre only); refraction; the skin's deformation around a protrusion",
+        });
+    }
+    if let Some(ImageSource::Physical(im)) = &imaging {
         manifest["images"] = json!({
             "file": "image.png in reference/ and in each configuration's folder",
             "model": "each light a point emitter with a cosine beam inside its cone, inverse-square fall-off and the incidence cosine; the surface Lambertian (albedo_rgb) plus a normalised Blinn-Phong lobe (specular, roughness); a light is shadowed where the segment to it enters a protrusion; then gain, vignetting 1 - v (r / r_corner)^2 about the principal point, photon noise (Gaussian with the Poisson variance of the signal's electrons) and read noise, clipped and quantised (calibration/src/groundtruth/shading.rs)",

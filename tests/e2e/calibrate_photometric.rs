@@ -133,6 +133,94 @@ fn the_photometric_model_re_renders_each_capture_from_the_others() {
     let appearance = read_npy_f32(&d.path().join("ph/appearance.npy"));
     assert_eq!(appearance.len(), 640 * 480 * 3);
     assert_eq!(m["model"]["coefficients_rgb"].as_array().unwrap().len(), 3);
+
+    // The ground truth's images in the sensor's own appearance: the reference is the fitted
+    // appearance, a pressed frame differs from it where the protrusions press.
+    let gt = |out: &str, ph: &str| {
+        run(
+            d.path(),
+            &[
+                "groundtruth",
+                "rtac0",
+                "--camera",
+                "cam.yaml",
+                "--extrinsics",
+                "extrinsics.json",
+                "--fixtures",
+                "fx",
+                "--format",
+                "png",
+                "--images",
+                "--photometric",
+                ph,
+                "--out",
+                out,
+            ],
+            &[],
+        )
+    };
+    let o = gt("gt", "ph");
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let reference = image::open(d.path().join("gt/reference/image.png"))
+        .unwrap()
+        .into_rgb8();
+    for (i, p) in reference.pixels().enumerate() {
+        for c in 0..3 {
+            let a = appearance[3 * i + c];
+            let want = if a.is_finite() {
+                a.round().clamp(0.0, 255.0) as u8
+            } else {
+                0
+            };
+            assert_eq!(p[c], want, "pixel {i} channel {c}");
+        }
+    }
+    let pressed = image::open(d.path().join("gt/p001_0/image.png"))
+        .unwrap()
+        .into_rgb8();
+    let contact = image::open(d.path().join("gt/p001_0/contact_mask.png"))
+        .unwrap()
+        .into_luma8();
+    let (mut on, mut off) = (0, 0);
+    for (i, (p, q)) in pressed.pixels().zip(reference.pixels()).enumerate() {
+        let differs = p != q;
+        if contact.as_raw()[i] > 0 {
+            on += usize::from(differs);
+        } else {
+            off += usize::from(differs);
+        }
+    }
+    assert!(
+        on > 100 && off == 0,
+        "{on} contact pixels differ, {off} elsewhere"
+    );
+    let gm: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.path().join("gt/manifest.json")).unwrap()).unwrap();
+    assert!(gm["images"]["model"]
+        .as_str()
+        .unwrap()
+        .contains("photometric"));
+
+    // a model of another camera is refused naming the option, nothing written
+    std::fs::create_dir(d.path().join("ph2")).unwrap();
+    std::fs::copy(
+        d.path().join("ph/photometric.json"),
+        d.path().join("ph2/photometric.json"),
+    )
+    .unwrap();
+    std::fs::write(
+        d.path().join("ph2/appearance.npy"),
+        fabkit_export::raster::npy_f32(&[2, 2, 3], &[0.0; 12]),
+    )
+    .unwrap();
+    let o = gt("gt2", "ph2");
+    assert!(!o.status.success());
+    let e = text(&o.stderr);
+    assert!(
+        e.contains("--photometric") && e.contains("[480, 640, 3]"),
+        "{e}"
+    );
+    assert!(!d.path().join("gt2").exists());
 }
 
 #[test]
