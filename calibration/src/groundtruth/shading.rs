@@ -269,6 +269,48 @@ fn follow(
     }
 }
 
+/// Balls (centre, radius) hashed by the cells of a uniform grid they touch: what
+/// [`MarkerMap`] and [`DimpleField`] look their features up in.
+#[derive(Debug, Clone)]
+struct SphereGrid {
+    cell_mm: f64,
+    cells: rustc_hash::FxHashMap<[i64; 3], Vec<u32>>,
+}
+
+impl SphereGrid {
+    fn new(cell_mm: f64) -> SphereGrid {
+        SphereGrid {
+            cell_mm,
+            cells: rustc_hash::FxHashMap::default(),
+        }
+    }
+
+    /// Lists `k` in every cell that the ball about `c` of radius `r` (mm) touches.
+    fn insert(&mut self, k: u32, c: [f64; 3], r: f64) {
+        let lo = c.map(|x| ((x - r) / self.cell_mm).floor() as i64);
+        let hi = c.map(|x| ((x + r) / self.cell_mm).floor() as i64);
+        for x in lo[0]..=hi[0] {
+            for y in lo[1]..=hi[1] {
+                for z in lo[2]..=hi[2] {
+                    self.cells.entry([x, y, z]).or_default().push(k);
+                }
+            }
+        }
+    }
+
+    /// The cell holding `p_mm`.
+    #[inline]
+    fn key(&self, p_mm: [f64; 3]) -> [i64; 3] {
+        p_mm.map(|x| (x / self.cell_mm).floor() as i64)
+    }
+
+    /// The balls listed in the cell `key`.
+    #[inline]
+    fn at(&self, key: [i64; 3]) -> &[u32] {
+        self.cells.get(&key).map_or(&[], Vec::as_slice)
+    }
+}
+
 /// The cosine below which a ray's window near the surface stops growing: a ray within 3 deg
 /// of the surface is searched for dimples over 1 / 0.05 = 20 times their reach.
 const GRAZING_COS: f64 = 0.05;
@@ -281,8 +323,7 @@ const GRAZING_COS: f64 = 0.05;
 #[derive(Debug, Clone)]
 pub struct DimpleField {
     solids: super::exact::ExactPrimitives,
-    cell_mm: f64,
-    cells: rustc_hash::FxHashMap<[i64; 3], Vec<u32>>,
+    grid: SphereGrid,
     /// How far from the surface a dimple reaches, mm: height plus a diameter.
     reach_mm: f64,
 }
@@ -314,25 +355,14 @@ impl DimpleField {
         let solids = super::exact::ExactPrimitives::new(&prims).ok()?;
         let r_max = dimples.iter().map(|m| m.radius_mm).fold(0.0f64, f64::max);
         let h_max = dimples.iter().map(|m| m.height_mm).fold(0.0f64, f64::max);
-        let cell_mm = (2.0 * r_max).max(0.05);
-        let mut cells = rustc_hash::FxHashMap::<[i64; 3], Vec<u32>>::default();
+        let mut grid = SphereGrid::new((2.0 * r_max).max(0.05));
         for k in 0..solids.len() {
             let (c, r) = solids.bounding_sphere_of(k);
-            let r = r + 0.25 * cell_mm;
-            let lo = c.map(|x| ((x - r) / cell_mm).floor() as i64);
-            let hi = c.map(|x| ((x + r) / cell_mm).floor() as i64);
-            for x in lo[0]..=hi[0] {
-                for y in lo[1]..=hi[1] {
-                    for z in lo[2]..=hi[2] {
-                        cells.entry([x, y, z]).or_default().push(k as u32);
-                    }
-                }
-            }
+            grid.insert(k as u32, c, r + 0.25 * grid.cell_mm);
         }
         Some(DimpleField {
             solids,
-            cell_mm,
-            cells,
+            grid,
             reach_mm: h_max + 2.0 * r_max,
         })
     }
@@ -349,20 +379,18 @@ impl DimpleField {
         if !(t1 > t0) {
             return None;
         }
-        let step = 0.5 * self.cell_mm;
+        let step = 0.5 * self.grid.cell_mm;
         let n = ((t1 - t0) / step).ceil() as usize;
         let mut found: Vec<u32> = Vec::new();
         let mut last: Option<[i64; 3]> = None;
         for j in 0..=n {
             let t = (t0 + j as f64 * step).min(t1);
-            let key = std::array::from_fn(|k| ((o[k] + t * d[k]) / self.cell_mm).floor() as i64);
+            let key = self.grid.key(std::array::from_fn(|k| o[k] + t * d[k]));
             if last == Some(key) {
                 continue;
             }
             last = Some(key);
-            if let Some(list) = self.cells.get(&key) {
-                found.extend_from_slice(list);
-            }
+            found.extend_from_slice(self.grid.at(key));
         }
         if found.is_empty() {
             return None;
@@ -392,8 +420,7 @@ impl DimpleField {
 /// by a hashed grid of cells at least a marker's diameter wide.
 #[derive(Debug, Clone)]
 pub struct MarkerMap {
-    cell_mm: f64,
-    cells: rustc_hash::FxHashMap<[i64; 3], Vec<u32>>,
+    grid: SphereGrid,
     centres: Vec<[f64; 3]>,
     r2: Vec<f64>,
 }
@@ -405,27 +432,16 @@ impl MarkerMap {
         protrusions: Option<&super::exact::ExactPrimitives>,
     ) -> MarkerMap {
         let r_max = spots.iter().map(|m| m.radius_mm).fold(0.0f64, f64::max);
-        let cell_mm = (2.0 * r_max).max(1e-3);
+        let mut grid = SphereGrid::new((2.0 * r_max).max(1e-3));
         let centres: Vec<[f64; 3]> = spots
             .iter()
             .map(|m| follow(m.centre_mm, m.normal, protrusions))
             .collect();
-        let mut cells = rustc_hash::FxHashMap::<[i64; 3], Vec<u32>>::default();
         for (i, (c, m)) in centres.iter().zip(spots).enumerate() {
-            let r = m.radius_mm;
-            let lo = c.map(|x| ((x - r) / cell_mm).floor() as i64);
-            let hi = c.map(|x| ((x + r) / cell_mm).floor() as i64);
-            for x in lo[0]..=hi[0] {
-                for y in lo[1]..=hi[1] {
-                    for z in lo[2]..=hi[2] {
-                        cells.entry([x, y, z]).or_default().push(i as u32);
-                    }
-                }
-            }
+            grid.insert(i as u32, *c, m.radius_mm);
         }
         MarkerMap {
-            cell_mm,
-            cells,
+            grid,
             r2: spots.iter().map(|m| m.radius_mm * m.radius_mm).collect(),
             centres,
         }
@@ -437,13 +453,9 @@ impl MarkerMap {
         if self.centres.is_empty() {
             return false;
         }
-        let key = p_mm.map(|x| (x / self.cell_mm).floor() as i64);
-        self.cells.get(&key).is_some_and(|list| {
-            list.iter().any(|&i| {
-                let c = self.centres[i as usize];
-                let d = sub(p_mm, c);
-                dot(d, d) <= self.r2[i as usize]
-            })
+        self.grid.at(self.grid.key(p_mm)).iter().any(|&i| {
+            let d = sub(p_mm, self.centres[i as usize]);
+            dot(d, d) <= self.r2[i as usize]
         })
     }
 

@@ -15,7 +15,7 @@ use fabkit_calibration::imprints::synthetic::{ring_pins, Pin};
 use fabkit_calibration::photometric::{rms_over_skin, Capture, PhotometricModel};
 use fabkit_calibration::synthetic::benchmark_intrinsics;
 use fabkit_calibration::CameraModel;
-use fabkit_designs::optics::{ring_of_lights, CameraResponse, Light, Reflectance, ResolvedOptics};
+use fabkit_designs::optics::{ring_of_lights, Light, Reflectance, ResolvedOptics};
 use fabkit_designs::primitives::Primitive;
 
 /// Contrast below this many counts is the camera's noise, not the imprint.
@@ -76,20 +76,14 @@ fn captures(lights: Vec<Light>) -> Captures {
     let rays = PixelRays::new(&cam, &benchmark_pose());
     let surface = ReferenceSurface::of(&rtac0_body()).unwrap();
     let reference = reference_hits(&rays, &surface);
+    // a matte grey skin with the default glossy lobe and camera
     let optics = ResolvedOptics {
-        light_sources: vec!["test".into(); lights.len()],
-        lights,
         surface: Reflectance {
             albedo_rgb: [0.6, 0.6, 0.6],
             specular: 0.04,
             roughness: 0.5,
         },
-        marker_albedo_rgb: [0.9; 3],
-        camera: CameraResponse::default(),
-        markers: Vec::new(),
-        marker_sources: Vec::new(),
-        dimples: Vec::new(),
-        dimple_sources: Vec::new(),
+        ..crate::shading::optics_with(lights)
     };
     let imaging = Imaging::new(optics, [319.5, 239.5], &rays, &reference);
     let reference_image = counts(imaging.image(&rays, &reference, None, 0));

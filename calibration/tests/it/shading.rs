@@ -222,7 +222,7 @@ use fabkit_calibration::CameraModel;
 use fabkit_designs::optics::ResolvedOptics;
 use fabkit_designs::primitives::Primitive;
 
-fn optics_with(lights: Vec<Light>) -> ResolvedOptics {
+pub(crate) fn optics_with(lights: Vec<Light>) -> ResolvedOptics {
     ResolvedOptics {
         light_sources: vec!["test".into(); lights.len()],
         lights,
