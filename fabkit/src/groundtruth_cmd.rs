@@ -14,6 +14,7 @@ use fabkit_calibration::groundtruth::inputs::{
     pairs_csv, read_extrinsics, read_fixtures, read_with_hash, sha256_hex, Configuration,
     PAIRS_NOTES,
 };
+use fabkit_calibration::groundtruth::pins::read_pin_captures;
 use fabkit_calibration::groundtruth::rays::PixelRays;
 use fabkit_calibration::groundtruth::shading::Imaging;
 use fabkit_calibration::groundtruth::{
@@ -46,9 +47,17 @@ pub struct GroundTruthArgs {
     /// extrinsics.json of `fabkit calibrate extrinsics` (T_cam_sensor).
     #[arg(long, value_name = "extrinsics.json")]
     extrinsics: PathBuf,
-    /// Output folder of `fabkit fixtures` (reads protrusions/index.json and the pattern files).
+    /// Output folder of `fabkit fixtures` (reads protrusions/index.json and the pattern files;
+    /// with --pin-captures the pin dome's points/ and manifest.json).
     #[arg(long, value_name = "FIXTURES_DIR")]
     fixtures: PathBuf,
+    /// Render the pin dome's captures instead of the protrusion patterns: one frame per capture
+    /// of points/capture_plan.csv with its pins pressed in (tips and axes from
+    /// points/point_table.csv, the pin's tip, cone and shaft from manifest.json), each folder
+    /// named by its pins (`01_02_06_14_22`) as `fabkit calibrate images` and `calibrate
+    /// photometric` read a capture's file name. With --images: synthetic pin captures.
+    #[arg(long)]
+    pin_captures: bool,
     /// Output folder. Replaced as a whole if it holds earlier ground truth of the same inputs
     /// (design, camera, extrinsics, fixtures) as fabkit wrote it; refused if it holds anything
     /// else.
@@ -678,8 +687,18 @@ fn claim(args: &GroundTruthArgs) -> OutputClaim {
         .unwrap_or(fabkit_designs::library::DEFAULT_DESIGN);
     let design_file = Path::new(design);
     let fixtures_marker = args.fixtures.join(fabkit_export::OUTPUT_MARKER);
-    let index = args.fixtures.join("protrusions").join("index.json");
-    let mut inputs: Vec<&Path> = vec![&args.camera, &args.extrinsics, &fixtures_marker, &index];
+    let points = args.fixtures.join("points");
+    let fixture_files = if args.pin_captures {
+        vec![
+            points.join("point_table.csv"),
+            points.join("capture_plan.csv"),
+            args.fixtures.join("manifest.json"),
+        ]
+    } else {
+        vec![args.fixtures.join("protrusions").join("index.json")]
+    };
+    let mut inputs: Vec<&Path> = vec![&args.camera, &args.extrinsics, &fixtures_marker];
+    inputs.extend(fixture_files.iter().map(PathBuf::as_path));
     if design_file.is_file() {
         inputs.push(design_file);
     }
@@ -732,8 +751,14 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
     }
     let (camera_bytes, camera_sha) = read_with_hash(&args.camera)?;
     let (t_cam_sensor, extrinsics_sha) = read_extrinsics(&args.extrinsics)?;
-    let fixtures = read_fixtures(&args.fixtures, &design.name)?;
-    let (fixture_kind, surface_text) = if design.body.flat_outline().is_some() {
+    let fixtures = if args.pin_captures {
+        read_pin_captures(&args.fixtures, &design.name)?
+    } else {
+        read_fixtures(&args.fixtures, &design.name)?
+    };
+    let (fixture_kind, surface_text) = if args.pin_captures {
+        ("pin-dome", "outer skin surface (body profile at offset 0) from the pole to the base plane; indented: the skin minus the solids of the capture's pins (hemispherical tip, 45 deg cone, shaft)")
+    } else if design.body.flat_outline().is_some() {
         ("semi-plate", "the flat skin's contact face over its outline (its edges continued below the base plane bound the body); indented: the skin minus the protrusion solids")
     } else {
         ("semi-dome", "outer skin surface (body profile at offset 0) from the pole to the base plane; indented: the skin minus the protrusion solids")
@@ -954,17 +979,22 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
         let deepest = finite_range(&dr).map(|x| -x.0).unwrap_or(0.0).max(0.0);
         let k = done.fetch_add(1, Ordering::Relaxed) + 2;
         bar.set(k as u64, frames);
-        Ok((
-            json!({
-                "name": cfg.name, "dir": cfg.name, "pattern": cfg.pattern, "orientation_deg": cfg.orientation_deg,
-                "pattern_side": if cfg.orientation_deg == 0 { "+x (right_mask.png)" } else { "-x (left_mask.png)" },
-                "fixture_description": {"file": cfg.description_file, "sha256": cfg.description_sha256},
-                "primitives": cfg.geometry.primitives.len(),
-                "contact_pixels": contact, "max_range_decrease_mm": deepest,
-                "files": entries,
-            }),
-            list,
-        ))
+        let mut entry = json!({
+            "name": cfg.name, "dir": cfg.name, "pattern": cfg.pattern, "orientation_deg": cfg.orientation_deg,
+            "pattern_side": if cfg.orientation_deg == 0 { "+x (right_mask.png)" } else { "-x (left_mask.png)" },
+            "fixture_description": {"file": cfg.description_file, "sha256": cfg.description_sha256},
+            "primitives": cfg.geometry.primitives.len(),
+            "contact_pixels": contact, "max_range_decrease_mm": deepest,
+            "files": entries,
+        });
+        if !cfg.pins.is_empty() {
+            let e = entry.as_object_mut().expect("an object");
+            for k in ["pattern", "orientation_deg", "pattern_side"] {
+                e.remove(k);
+            }
+            e.insert("pins".into(), json!(cfg.pins));
+        }
+        Ok((entry, list))
     };
     let indexed: Vec<(usize, &Configuration)> =
         fixtures.configurations.iter().enumerate().collect();
@@ -990,13 +1020,14 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
         let count = m.iter().filter(|&&b| b).count();
         extra.push((name.into(), png_gray8(w, h, &px, &[])?, json!({"file": name, "quantity": format!("pixels whose ray meets the reference surface at sensor-frame {side}: 255, else 0"), "pixels": count})));
     }
-    let pairs = pairs_csv(&fixtures.patterns);
     let n_pairs = fixtures.patterns.len() * fixtures.patterns.len();
-    extra.push((
-        "pairs.csv".into(),
-        pairs.into_bytes(),
-        json!({"file": "pairs.csv", "pairs": n_pairs, "notes": PAIRS_NOTES}),
-    ));
+    if !args.pin_captures {
+        extra.push((
+            "pairs.csv".into(),
+            pairs_csv(&fixtures.patterns).into_bytes(),
+            json!({"file": "pairs.csv", "pairs": n_pairs, "notes": PAIRS_NOTES}),
+        ));
+    }
     let extra_entries = write(extra, &mut all)?;
     all.sort();
 
@@ -1005,7 +1036,11 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
     let mut manifest = json!({
         "fabkit_version": env!("CARGO_PKG_VERSION"),
         "command_line": std::env::args().collect::<Vec<_>>(),
-        "description": format!("Ground-truth depth of the sensor surface, reference (undeformed) and indented by each protrusion {} configuration (R-Tac0 Sec. IV-B, Fig. 6, Eq. (2)-(3)): complete depth = reference + delta. Exact per-pixel rays of the camera model; surfaces in closed form.", fixture_kind),
+        "description": if args.pin_captures {
+            "Ground-truth depth of the sensor surface, reference (undeformed) and indented by the pins of each capture of the pin dome (R-Tac0 Sec. IV-A, Fig. 5; the capture plan of points/capture_plan.csv): complete depth = reference + delta. Exact per-pixel rays of the camera model; surfaces in closed form.".to_string()
+        } else {
+            format!("Ground-truth depth of the sensor surface, reference (undeformed) and indented by each protrusion {} configuration (R-Tac0 Sec. IV-B, Fig. 6, Eq. (2)-(3)): complete depth = reference + delta. Exact per-pixel rays of the camera model; surfaces in closed form.", fixture_kind)
+        },
         "design": {"name": design.name, "source": loaded.source, "sha256": loaded.sha256},
         "camera": {"file": args.camera.display().to_string(), "sha256": camera_sha, "distortion_model": i.distortion.name(),
                    "fx_px": i.fx_px, "fy_px": i.fy_px, "cx_px": i.cx_px, "cy_px": i.cy_px, "distortion_coefficients": i.distortion.coefficients(),
@@ -1013,7 +1048,11 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
         "extrinsics": {"file": args.extrinsics.display().to_string(), "sha256": extrinsics_sha,
                        "T_cam_sensor": (0..4).map(|r| (0..4).map(|c| m[(r, c)]).collect::<Vec<_>>()).collect::<Vec<_>>(),
                        "camera_centre_in_sensor_mm": c},
-        "fixtures": {"dir": fixtures.dir.display().to_string(), "index_sha256": fixtures.index_sha256, "patterns": fixtures.patterns},
+        "fixtures": if args.pin_captures {
+            json!({"dir": fixtures.dir.display().to_string(), "capture_plan_sha256": fixtures.index_sha256, "pin_captures": fixtures.configurations.len()})
+        } else {
+            json!({"dir": fixtures.dir.display().to_string(), "index_sha256": fixtures.index_sha256, "patterns": fixtures.patterns})
+        },
         "conventions": {
             "pixels": "(u, v) = (column, row); (0, 0) is the centre of the top-left pixel; arrays are (H, W) row-major",
             "camera_frame": "x right, y down, z forward (docs/conventions.md)",
@@ -1075,12 +1114,17 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
     for w in staged.commit()? {
         eprintln!("warning: {w}");
     }
+    let what = if args.pin_captures {
+        format!("{n_cfg} pin captures")
+    } else {
+        format!(
+            "{n_cfg} configurations ({} patterns x 2 orientations), {n_pairs} stitched pairs",
+            fixtures.patterns.len()
+        )
+    };
     out!(
-        "{}: reference + {} configurations ({} patterns x 2 orientations), {} stitched pairs, {} of {} pixels on the surface -> {} ({} files, {:.2} s)",
+        "{}: reference + {what}, {} of {} pixels on the surface -> {} ({} files, {:.2} s)",
         design.name,
-        n_cfg,
-        fixtures.patterns.len(),
-        n_pairs,
         ref_hits.valid_count(),
         w * h,
         args.out.display(),

@@ -1,77 +1,156 @@
 //! `fabkit calibrate photometric` end to end: R-Tac0's published pin dome (`fabkit fixtures
-//! --pins-preset rtac0`), the captures of its first five capture-plan rows rendered by the
-//! physical image model (groundtruth::shading, R-Tac0's LED ring, the pins' shadows, camera
-//! noise) at the pose of extrinsics.json and written as 8-bit PNGs named by their pins; the
-//! command fits the model, re-renders each capture from the others within a count of the fit,
-//! and refuses a capture whose name lists no pins, or a pin the table does not have, with
-//! nothing written.
+//! --pins-preset rtac0`), the captures of its first five capture-plan rows rendered by
+//! `fabkit groundtruth --pin-captures --images` (the physical image model: R-Tac0's LED ring,
+//! the pins' shadows, camera noise) at the pose of extrinsics.json and copied as 8-bit PNGs
+//! named by their pins; the command fits the model, re-renders each capture from the others
+//! within a count of the fit, and refuses a capture whose name lists no pins, or a pin the
+//! table does not have, with nothing written. And the pin captures themselves: one frame per
+//! capture-plan row, named by its pins, each pin's tip where the point table puts it.
 
-use std::collections::BTreeMap;
 use std::path::Path;
 
 use crate::common::*;
 use crate::groundtruth_cli::setup;
-use fabkit_calibration::groundtruth::exact::ExactPrimitives;
 use fabkit_calibration::groundtruth::inputs::read_extrinsics;
-use fabkit_calibration::groundtruth::shading::Imaging;
-use fabkit_calibration::groundtruth::{indented_hits, reference_hits, Scene};
-use fabkit_calibration::photometric::read_pins;
+use fabkit_calibration::nalgebra::{Point3, Vector3};
 use fabkit_calibration::synthetic::benchmark_intrinsics;
 use fabkit_calibration::CameraModel;
 
-fn save(path: &Path, img: &[[u16; 3]], w: u32, h: u32) {
-    let raw: Vec<u8> = img.iter().flat_map(|p| p.map(|c| c as u8)).collect();
-    image::RgbImage::from_raw(w, h, raw)
-        .unwrap()
-        .save(path)
-        .unwrap();
+fn pin_captures(dir: &Path, out: &str, format: &str) -> std::process::Output {
+    run(
+        dir,
+        &[
+            "groundtruth",
+            "rtac0",
+            "--camera",
+            "cam.yaml",
+            "--extrinsics",
+            "extrinsics.json",
+            "--fixtures",
+            "fx",
+            "--pin-captures",
+            "--images",
+            "--format",
+            format,
+            "--out",
+            out,
+        ],
+        &[],
+    )
 }
 
-/// Writes ref.png and five captures; returns their file names.
+/// Writes ref.png and the first five pin captures; returns their file names.
 fn captures(dir: &Path) -> Vec<String> {
-    let design = fabkit_designs::library::load("rtac0").unwrap();
-    let cam = CameraModel::new(benchmark_intrinsics()).unwrap();
-    let (pose, _) = read_extrinsics(&dir.join("extrinsics.json")).unwrap();
-    let scene = Scene::new(&design, &cam, &pose, "pose").unwrap();
-    let reference = reference_hits(&scene.rays, &scene.surface);
-    let optics = fabkit_designs::optics::of_design(
-        &design,
-        fabkit_designs::ChordTolerance::new(0.01).unwrap(),
-    )
-    .unwrap();
-    let imaging = Imaging::new(optics, [319.5, 239.5], &scene.rays, &reference);
-    let (w, h) = (scene.rays.width as u32, scene.rays.height as u32);
-    save(
-        &dir.join("ref.png"),
-        &imaging.image(&scene.rays, &reference, None, 0),
-        w,
-        h,
-    );
-    let pins = read_pins(&dir.join("fx")).unwrap();
-    let plan = std::fs::read_to_string(dir.join("fx/points/capture_plan.csv")).unwrap();
-    let mut by_capture: BTreeMap<u32, Vec<String>> = BTreeMap::new();
-    for line in plan.lines().skip(1) {
-        let c: Vec<&str> = line.split(',').collect();
-        by_capture
-            .entry(c[0].parse().unwrap())
-            .or_default()
-            .push(c[1].to_string());
-    }
+    let o = pin_captures(dir, "caps", "png");
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    std::fs::copy(dir.join("caps/reference/image.png"), dir.join("ref.png")).unwrap();
+    let m: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("caps/manifest.json")).unwrap()).unwrap();
     let mut names = Vec::new();
-    for (k, ids) in by_capture.values().take(5).enumerate() {
-        let prims = ExactPrimitives::new(&pins.primitives(ids).unwrap()).unwrap();
-        let hits = indented_hits(&scene.rays, &reference, &prims, scene.surface.base_z_mm());
-        let img = imaging.image(&scene.rays, &hits, Some(&prims), k as u64 + 1);
-        let name = ids
-            .iter()
-            .map(|i| format!("{:02}", i.parse::<u32>().unwrap()))
-            .collect::<Vec<_>>()
-            .join("_")
-            + ".png";
-        save(&dir.join(&name), &img, w, h);
+    for c in m["configurations"].as_array().unwrap().iter().take(5) {
+        let folder = c["dir"].as_str().unwrap();
+        let name = format!("{folder}.png");
+        std::fs::copy(
+            dir.join("caps").join(folder).join("image.png"),
+            dir.join(&name),
+        )
+        .unwrap();
         names.push(name);
     }
     names
+}
+
+#[test]
+fn groundtruth_renders_one_frame_per_pin_capture_with_the_pins_at_their_tips() {
+    let d = tempfile::tempdir().unwrap();
+    setup(d.path());
+    let o = pin_captures(d.path(), "gt", "npy");
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(
+        text(&o.stdout).contains("reference + 8 pin captures"),
+        "{}",
+        text(&o.stdout)
+    );
+    let m: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.path().join("gt/manifest.json")).unwrap()).unwrap();
+    // the frames are the plan's rows, in order, each named by its pins
+    let plan = std::fs::read_to_string(d.path().join("fx/points/capture_plan.csv")).unwrap();
+    let mut rows: Vec<(String, Vec<String>)> = Vec::new();
+    for line in plan.lines().skip(1) {
+        let c: Vec<&str> = line.split(',').collect();
+        match rows.last_mut() {
+            Some((k, ids)) if k == c[0] => ids.push(c[1].to_string()),
+            _ => rows.push((c[0].to_string(), vec![c[1].to_string()])),
+        }
+    }
+    let cfgs = m["configurations"].as_array().unwrap();
+    assert_eq!(cfgs.len(), rows.len());
+    assert!(!d.path().join("gt/pairs.csv").exists());
+    // each pin's tip is where the camera sees the skin pressed in: the range at the pixel the
+    // tip projects to is the tip's distance from the camera centre (the pixel's ray passes
+    // within half a pixel of the tip; the hemisphere there is about square to the ray)
+    let cam = CameraModel::new(benchmark_intrinsics()).unwrap();
+    let (pose, _) = read_extrinsics(&d.path().join("extrinsics.json")).unwrap();
+    let table = std::fs::read_to_string(d.path().join("fx/points/point_table.csv")).unwrap();
+    let tip_of = |id: &str| -> [f64; 3] {
+        let row: Vec<f64> = table
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').collect::<Vec<_>>())
+            .find(|c| c[0] == id)
+            .unwrap()[2..5]
+            .iter()
+            .map(|x| x.parse().unwrap())
+            .collect();
+        [row[0], row[1], row[2]]
+    };
+    let centre = pose.inverse() * Point3::origin();
+    for (c, (_, ids)) in cfgs.iter().zip(&rows) {
+        let names: Vec<String> = ids
+            .iter()
+            .map(|i| format!("{:02}", i.parse::<u32>().unwrap()))
+            .collect();
+        assert_eq!(c["name"].as_str().unwrap(), names.join("_"));
+        assert_eq!(c["pins"], serde_json::json!(ids));
+        let dir = d.path().join("gt").join(c["dir"].as_str().unwrap());
+        let range = read_npy_f32(&dir.join("range_mm.npy"));
+        let delta = read_npy_f32(&dir.join("delta_range_mm.npy"));
+        assert!(dir.join("image.png").is_file());
+        let pole = &ids[0];
+        assert_eq!(pole, "1");
+        for id in ids {
+            let tip = tip_of(id);
+            let p = pose * Point3::new(tip[0], tip[1], tip[2]);
+            let uv = cam.project(&Vector3::new(p.x, p.y, p.z)).unwrap();
+            let px = uv.y.round() as usize * 640 + uv.x.round() as usize;
+            let want = (Point3::new(tip[0], tip[1], tip[2]) - centre).norm();
+            let tol = if id == pole { 0.005 } else { 0.05 };
+            assert!(
+                (f64::from(range[px]) - want).abs() < tol,
+                "capture {}, pin {id}: range {} mm at ({:.1}, {:.1}) px, tip at {want:.4} mm",
+                c["name"],
+                range[px],
+                uv.x,
+                uv.y
+            );
+            // pressed in by about the pin's indentation depth (1.54 mm along its axis)
+            assert!(delta[px] < -1.0, "pin {id}: delta {}", delta[px]);
+        }
+    }
+    // a plan naming a pin the table lacks is refused by file, line and rule, nothing written
+    std::fs::write(
+        d.path().join("fx/points/capture_plan.csv"),
+        format!("{plan}9,99,4\n"),
+    )
+    .unwrap();
+    let o = pin_captures(d.path(), "gt2", "png");
+    assert!(!o.status.success());
+    let e = text(&o.stderr);
+    assert!(
+        e.contains("capture_plan.csv") && e.contains("\"99\"") && e.contains("point_table.csv"),
+        "{e}"
+    );
+    assert!(!d.path().join("gt2").exists());
 }
 
 fn args<'a>(names: &'a [String], out: &'a str) -> Vec<&'a str> {

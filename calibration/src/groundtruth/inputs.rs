@@ -215,17 +215,21 @@ pub struct Configuration {
     /// The primitives (sensor frame, mm) as described.
     pub geometry: Geometry,
     pub primitives: ExactPrimitives,
+    /// A pin dome's capture ([`crate::groundtruth::pins::read_pin_captures`]): the ids of the
+    /// pins pressed in, in the capture plan's order; empty for a protrusion pattern.
+    pub pins: Vec<String>,
 }
 
 /// The protrusion descriptions of a fixtures folder.
 #[derive(Debug, Clone)]
 pub struct Fixtures {
     pub dir: PathBuf,
-    /// sha256 of `protrusions/index.json`.
+    /// sha256 of `protrusions/index.json` (of `points/capture_plan.csv` for a pin dome's
+    /// captures).
     pub index_sha256: String,
-    /// Pattern names in index order.
+    /// Pattern names in index order (none for a pin dome's captures).
     pub patterns: Vec<String>,
-    /// Two per pattern (0 and 180 deg), in index order.
+    /// Two per pattern (0 and 180 deg), in index order; or one per capture of a pin dome.
     pub configurations: Vec<Configuration>,
 }
 
@@ -327,6 +331,7 @@ pub fn read_fixtures(dir: &Path, design_name: &str) -> Result<Fixtures, InputErr
                 description_sha256: sha.clone(),
                 geometry: o.geometry.clone(),
                 primitives,
+                pins: Vec::new(),
             });
         }
         patterns.push(e.pattern.clone());

@@ -18,6 +18,7 @@ pub mod budget;
 pub mod exact;
 pub mod inputs;
 pub mod mesh;
+pub mod pins;
 pub mod raster;
 pub mod rays;
 pub mod shading;
@@ -94,6 +95,10 @@ impl Scene {
     ) -> Result<(), String> {
         let c = self.rays.origin_mm;
         match configurations.iter().find(|k| k.primitives.contains(c)) {
+            Some(cfg) if !cfg.pins.is_empty() => Err(format!(
+                "{pose_name}: the camera centre is inside a pin of capture {}",
+                cfg.name
+            )),
             Some(cfg) => Err(format!(
                 "{pose_name}: the camera centre is inside a protrusion of {} at {} deg",
                 cfg.pattern, cfg.orientation_deg
