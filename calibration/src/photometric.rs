@@ -6,39 +6,51 @@
 //! pixel's surface point and normal, [`crate::groundtruth::SurfaceHits`]) with the
 //! intensities the camera recorded. The model, per colour channel, is
 //!
-//! `I(x, n) = gain x R(x) x (1 + sum_k sum_m c_km P_m(x) f_k(n, x))`
+//! `I(x, n) = gain x R(x) x (1 + sum_k sum_m c_km P_m(x) f_k(n, x) - sum_j b_j S_j(x))`
 //!
 //! - `R(x)`: the unindented appearance, per pixel: the reference image, averaged with the
 //!   unpressed pixels of every capture (each divided by its gain) to lower its noise;
-//! - `f_k`: the surface's tilt from the reference normal in the reference surface's local
-//!   frame about the camera's optical axis (`a` along the tangent away from the axis, `r` round
-//!   it), its monomials up to degree 3 (`a, r, a^2, ar, r^2, a^3, a^2 r, a r^2, r^3`), and the
+//! - `f_k`: the change of the surface normal from the reference normal in the reference
+//!   surface's local frame about the camera's optical axis (`a` along the tangent away from
+//!   the axis, `r` round it, `c` along the reference normal: one minus the tilt's cosine), the
+//!   monomials of `a` and `r` up to degree 3 (`a^2, ar, r^2, a^3, a^2 r, a r^2, r^3`), and the
 //!   indentation depth along the ray (mm);
 //! - `P_m(x)`: powers of the pixel's normalised distance from the image centre up to
 //!   [`SPATIAL_DEGREE`]: the lights' directions and fall-off change slowly over the skin;
+//! - `S_j(x)`: the shadows ([`shadow_map`]): the share of candidate ring `j`'s light (rings of
+//!   effective lights about the optical axis, [`ShadowRings`]) that the protrusions block at
+//!   the pixel, beside an imprint or inside it; `b_j` the share of the pixel's light the ring
+//!   stands for;
 //! - `gain`: each capture's global gain against the reference (exposure and LED drift), the
 //!   median ratio over its unpressed skin.
 //!
 //! Why this form: under Lambertian lights the radiance is a sum of clamped cosines
-//! `max(0, n . l_k)`, a smooth function of the normal that low-order polynomials in the tilt
-//! approximate closely (order 2 already holds most of a clamped cosine's energy, Ramamoorthi
-//! and Hanrahan 2001; order 3 brings the re-rendered imprints of the tests within 1.6 grey
-//! levels of the noise-free captures). Divided by the reference, the response is `1` at no
-//! tilt, and what remains varies slowly over the skin; moving the surface by the indentation
-//! changes the distances to the lights to first order in the depth. Fitting the ratio, not the
-//! intensity, leaves every pixel's own appearance (rim LEDs, vignetting, the skin's albedo)
-//! to the reference and only the response to tilt to the captures. A look-up table over
-//! binned normals (Taxim) needs a flat sensor and many more imprints per bin than a pin dome
-//! gives; a low-order spatial term is what a curved skin's few dozen imprints can fix.
+//! `max(0, n . l_k)`, a smooth function of the normal. With `n = (1 - c) n0 - a e_a - r e_r`
+//! each cosine is linear in `a`, `r` and `c` until it clamps, and low-order polynomials in the
+//! tilt take the clamping and the lights' spread (order 2 already holds most of a clamped
+//! cosine's energy, Ramamoorthi and Hanrahan 2001; `c` keeps the walls of a deep imprint,
+//! tilted near 90 deg, from bending the polynomial). Divided by the reference, the response is
+//! `1` at no tilt, and what remains varies slowly over the skin; moving the surface by the
+//! indentation changes the distances to the lights to first order in the depth. Fitting the
+//! ratio, not the intensity, leaves every pixel's own appearance (rim LEDs, vignetting, the
+//! skin's albedo) to the reference and only the response to tilt to the captures. A look-up
+//! table over binned normals (Taxim) needs a flat sensor and many more imprints per bin than a
+//! pin dome gives; a low-order spatial term is what a curved skin's few dozen imprints can
+//! fix. A pin pressed deeper than its tip's radius shadows the skin beside its imprint from
+//! lights at grazing incidence; the lights are not known, so the shadow term spans candidate
+//! rings of them and the fit weighs each (with R-Tac0's LED ring the weight goes to the ring
+//! nearest it, about 0.9 of the light).
 //!
-//! Limits: the spatial term depends on the distance from the image centre only, so the
-//! coefficients are those of lights in a ring about the optical axis (R-Tac0's, the TacTip's,
-//! UVDtact's); lights at a few azimuths (ShadowTac's three single-colour LEDs) need angular
-//! terms too. Shadows cast by a pin onto the skin beside its imprint are not in the model.
+//! Limits: the spatial term and the candidate rings are round the optical axis, so the model
+//! is that of lights in a ring about it (R-Tac0's, the TacTip's, UVDtact's); lights at a few
+//! azimuths (ShadowTac's three single-colour LEDs) need angular terms too. Penumbrae are those
+//! of the sampled rings (24 lights each).
 
+use crate::groundtruth::exact::ExactPrimitives;
 use crate::groundtruth::rays::PixelRays;
 use crate::groundtruth::SurfaceHits;
 use nalgebra::{DMatrix, DVector};
+use rayon::prelude::*;
 
 pub use crate::groundtruth::pins::{pin_primitives, read_pins, Pins};
 
@@ -55,9 +67,33 @@ pub const ANGULAR_ORDER: usize = 0;
 /// Number of spatial terms ([`spatial`]).
 pub const SPATIAL_TERMS: usize = SPATIAL_DEGREE + 1 + 2 * ANGULAR_ORDER * SPATIAL_DEGREE;
 
-/// Number of features of the surface: the tilt along and round the axis, the indentation
-/// depth, and the tilt's quadratic (3) and cubic (4) terms.
-pub const FEATURES: usize = 10;
+/// Number of features of the surface: the normal's change along and round the axis and along
+/// the reference normal, the indentation depth, and the quadratic (3) and cubic (4) terms of
+/// the first two.
+pub const FEATURES: usize = 11;
+
+/// Number of candidate rings of effective lights the shadow term is fitted over:
+/// [`SHADOW_HEIGHTS`] x [`SHADOW_RADII`].
+pub const SHADOW_TERMS: usize = 9;
+
+/// Lights sampled on each candidate ring, evenly in azimuth.
+pub const SHADOW_AZIMUTHS: usize = 24;
+
+/// Heights of the candidate rings' centres along the optical axis from the camera centre, as
+/// fractions of the skin's median range (negative: behind the camera).
+pub const SHADOW_HEIGHTS: [f64; 3] = [-0.5, -0.2, 0.1];
+
+/// Radii of the candidate rings about the optical axis, as fractions of the skin's median
+/// range.
+pub const SHADOW_RADII: [f64; 3] = [0.2, 0.45, 0.7];
+
+/// How far from a protrusion's bounding sphere a surface point may lie and still be tested
+/// for its shadow, as a fraction of the skin's median range.
+pub const SHADOW_REACH: f64 = 0.25;
+
+/// Margin about a dent's contact points (the pixels sample its rim), as a fraction of the
+/// skin's median range.
+const DENT_MARGIN: f64 = 0.02;
 
 /// Least reference intensity (counts) of a pixel used to fit or to measure a gain: darker
 /// pixels carry mostly noise in a ratio.
@@ -74,6 +110,11 @@ pub struct PhotometricModel {
     pub coefficients: [Vec<f64>; 3],
     /// The camera's optical axis in the sensor frame (the local frame of the features).
     pub axis: [f64; 3],
+    /// The candidate light rings of the shadow term.
+    pub rings: ShadowRings,
+    /// Per channel, the weight of each candidate ring's shadow ([`ShadowMap`]): the fraction
+    /// of a pixel's light its ring stands for.
+    pub shadow_coefficients: [[f64; SHADOW_TERMS]; 3],
     /// The gain of each fitted capture against the reference.
     pub gains: Vec<f64>,
     /// The images' full scale, counts: rendered values are clipped to it.
@@ -82,11 +123,205 @@ pub struct PhotometricModel {
     pub residual_rms: Vec<f64>,
 }
 
-/// One capture to fit: its image (row-major, per channel, counts) and its surface.
+/// One capture to fit: its image (row-major, per channel, counts), its surface and the
+/// shadows its protrusions cast ([`shadow_map`]).
 #[derive(Debug, Clone, Copy)]
 pub struct Capture<'a> {
     pub image: &'a [[f64; 3]],
     pub hits: &'a SurfaceHits,
+    pub shadows: &'a ShadowMap,
+}
+
+/// The candidate lights of the shadow term: rings about the camera's optical axis, where a
+/// sensor's LEDs are not known (a ring of LEDs, or a few, round the camera or the skin's
+/// base), at [`SHADOW_HEIGHTS`] and [`SHADOW_RADII`] times the skin's median range `scale_mm`
+/// from the camera centre.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShadowRings {
+    /// The camera centre, sensor frame, mm.
+    pub centre_mm: [f64; 3],
+    /// The optical axis, sensor frame (unit).
+    pub axis: [f64; 3],
+    /// The median distance from the camera centre to the reference skin, mm.
+    pub scale_mm: f64,
+}
+
+impl ShadowRings {
+    /// The rings of the camera whose rays are `rays`, seeing the reference skin `reference`.
+    pub fn of(rays: &PixelRays, reference: &SurfaceHits) -> ShadowRings {
+        let ranges: Vec<f64> = reference
+            .t_mm
+            .iter()
+            .copied()
+            .filter(|t| t.is_finite())
+            .collect();
+        ShadowRings {
+            centre_mm: rays.origin_mm,
+            axis: optical_axis(rays),
+            scale_mm: median(ranges).unwrap_or(1.0),
+        }
+    }
+
+    /// The sampled lights of ring `m` (height major, radius minor), sensor frame, mm.
+    fn lights(&self, m: usize) -> [[f64; 3]; SHADOW_AZIMUTHS] {
+        let a = self.axis;
+        let helper = if a[0].abs() < 0.9 {
+            [1.0, 0.0, 0.0]
+        } else {
+            [0.0, 1.0, 0.0]
+        };
+        let e1 = cross(a, helper);
+        let l1 = dot(e1, e1).sqrt();
+        let e1 = e1.map(|x| x / l1);
+        let e2 = cross(a, e1);
+        let h = SHADOW_HEIGHTS[m / SHADOW_RADII.len()] * self.scale_mm;
+        let r = SHADOW_RADII[m % SHADOW_RADII.len()] * self.scale_mm;
+        std::array::from_fn(|j| {
+            let (sn, cs) = (std::f64::consts::TAU * j as f64 / SHADOW_AZIMUTHS as f64).sin_cos();
+            std::array::from_fn(|q| self.centre_mm[q] + h * a[q] + r * (cs * e1[q] + sn * e2[q]))
+        })
+    }
+}
+
+/// The shadows the protrusions of a frame cast on its surface from the candidate rings: for
+/// each pixel near a protrusion, per ring the share of the ring's light (each sampled light
+/// weighted by its incidence cosine over the squared distance) that the protrusions block.
+/// Pixels with no shadow are left out (sorted by pixel index).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ShadowMap {
+    pub rings: ShadowRings,
+    pub pixels: Vec<(u32, [f64; SHADOW_TERMS])>,
+}
+
+impl ShadowMap {
+    /// No shadow (the reference, or a frame without protrusions).
+    pub fn none(rings: ShadowRings) -> ShadowMap {
+        ShadowMap {
+            rings,
+            pixels: Vec::new(),
+        }
+    }
+
+    /// The shadow features of pixel `i`, if it is shadowed.
+    pub fn at(&self, i: usize) -> Option<&[f64; SHADOW_TERMS]> {
+        self.pixels
+            .binary_search_by_key(&(i as u32), |p| p.0)
+            .ok()
+            .map(|k| &self.pixels[k].1)
+    }
+}
+
+/// The [`ShadowMap`] of the surface `hits` (seen along `rays`) under `protrusions`. Pixels
+/// are computed in parallel; the map does not depend on the thread count.
+pub fn shadow_map(
+    rays: &PixelRays,
+    hits: &SurfaceHits,
+    protrusions: &ExactPrimitives,
+    rings: &ShadowRings,
+) -> ShadowMap {
+    let lights: Vec<[[f64; 3]; SHADOW_AZIMUTHS]> =
+        (0..SHADOW_TERMS).map(|m| rings.lights(m)).collect();
+    let reach = SHADOW_REACH * rings.scale_mm;
+    let o = rays.origin_mm;
+    let point = |i: usize| -> [f64; 3] {
+        let (t, d) = (hits.t_mm[i], rays.dirs[i]);
+        std::array::from_fn(|q| o[q] + t * d[q])
+    };
+    // Only what a protrusion pushes into the skin can shadow it from lights inside: each
+    // primitive's dent is bounded by the contact points in its bounding sphere; a primitive
+    // with none does not press the skin.
+    let contact: Vec<[f64; 3]> = (0..hits.t_mm.len())
+        .filter(|&i| hits.contact[i] && hits.t_mm[i].is_finite())
+        .map(point)
+        .collect();
+    let dents: Vec<(usize, [f64; 3], f64)> = (0..protrusions.len())
+        .filter_map(|k| {
+            let (c, r) = protrusions.bounding_sphere_of(k);
+            let inside: Vec<&[f64; 3]> = contact
+                .iter()
+                .filter(|q| {
+                    let v = [q[0] - c[0], q[1] - c[1], q[2] - c[2]];
+                    dot(v, v) <= r * r
+                })
+                .collect();
+            if inside.is_empty() {
+                return None;
+            }
+            let n = inside.len() as f64;
+            let m: [f64; 3] = std::array::from_fn(|q| inside.iter().map(|p| p[q]).sum::<f64>() / n);
+            let rad = inside
+                .iter()
+                .map(|p| {
+                    let v = [p[0] - m[0], p[1] - m[1], p[2] - m[2]];
+                    dot(v, v)
+                })
+                .fold(0.0, f64::max)
+                .sqrt();
+            Some((k, m, rad + DENT_MARGIN * rings.scale_mm))
+        })
+        .collect();
+    let pixels = (0..hits.t_mm.len())
+        .into_par_iter()
+        .filter_map(|i| {
+            if !hits.t_mm[i].is_finite() {
+                return None;
+            }
+            let p = point(i);
+            // the protrusions whose dents are near enough to shadow the point
+            let near: Vec<&(usize, [f64; 3], f64)> = dents
+                .iter()
+                .filter(|(_, c, r)| {
+                    let v = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
+                    dot(v, v).sqrt() <= r + reach
+                })
+                .collect();
+            if near.is_empty() {
+                return None;
+            }
+            // the camera's side of the surface: the elastomer's outward normal reversed
+            let n = hits.normal[i].map(|v| -v);
+            let start = [p[0] + 1e-6 * n[0], p[1] + 1e-6 * n[1], p[2] + 1e-6 * n[2]];
+            let mut f = [0.0; SHADOW_TERMS];
+            for (m, ring) in lights.iter().enumerate() {
+                let (mut blocked, mut all) = (0.0, 0.0);
+                for l in ring {
+                    let v = [l[0] - p[0], l[1] - p[1], l[2] - p[2]];
+                    let dist = dot(v, v).sqrt();
+                    let u = v.map(|x| x / dist);
+                    let w = dot(n, u).max(0.0) / (dist * dist);
+                    if w <= 0.0 {
+                        continue;
+                    }
+                    all += w;
+                    // only a dent the segment passes through can block it
+                    let crossed = near.iter().filter_map(|(k, c, r)| {
+                        let v = [c[0] - p[0], c[1] - p[1], c[2] - p[2]];
+                        let along = dot(v, u).clamp(0.0, dist);
+                        let w = [
+                            v[0] - along * u[0],
+                            v[1] - along * u[1],
+                            v[2] - along * u[2],
+                        ];
+                        (dot(w, w) <= r * r).then_some(*k)
+                    });
+                    if protrusions
+                        .first_crossing_among(start, u, dist, crossed)
+                        .is_some()
+                    {
+                        blocked += w;
+                    }
+                }
+                if all > 0.0 {
+                    f[m] = blocked / all;
+                }
+            }
+            f.iter().any(|x| *x > 0.0).then_some((i as u32, f))
+        })
+        .collect();
+    ShadowMap {
+        rings: *rings,
+        pixels,
+    }
 }
 
 /// The spatial basis at pixel `i`: with `rho` its distance from the image centre over the
@@ -163,6 +398,7 @@ fn features(
     Some([
         a,
         r,
+        dot(dn, n0),
         t0 - t,
         a * a,
         r * r,
@@ -243,6 +479,12 @@ impl PhotometricModel {
         }
         let on_skin = |i: usize| reference.t_mm[i].is_finite();
         let axis = optical_axis(rays);
+        let rings = ShadowRings::of(rays, reference);
+        if let Some(k) = captures.iter().position(|c| c.shadows.rings != rings) {
+            return Err(format!(
+                "capture {k}: its shadows are of other light rings than this camera's"
+            ));
+        }
         let gains: Vec<f64> = captures
             .iter()
             .map(|c| gain_of(c.image, reference_image, |i| c.hits.contact[i]))
@@ -275,29 +517,47 @@ impl PhotometricModel {
                 })
             })
             .collect();
-        // The response to tilt, by least squares on the pressed pixels of every capture.
-        let unknowns = FEATURES * SPATIAL_TERMS;
-        let mut rows: Vec<(usize, usize)> = Vec::new();
+        // The response to tilt and the shadows, by least squares on the pressed and the
+        // shadowed pixels of every capture.
+        let tilt_unknowns = FEATURES * SPATIAL_TERMS;
+        let unknowns = tilt_unknowns + SHADOW_TERMS;
+        let mut rows: Vec<(usize, usize, Option<&[f64; SHADOW_TERMS]>)> = Vec::new();
+        let mut pressed = 0;
         for (k, c) in captures.iter().enumerate() {
+            let mut shadowed = c.shadows.pixels.iter().peekable();
             for i in 0..n {
-                if c.hits.contact[i] && on_skin(i) {
-                    rows.push((k, i));
+                let mut sh = None;
+                while let Some((j, f)) = shadowed.peek() {
+                    if (*j as usize) < i {
+                        shadowed.next();
+                    } else {
+                        if *j as usize == i {
+                            sh = Some(f);
+                        }
+                        break;
+                    }
+                }
+                if on_skin(i) && (c.hits.contact[i] || sh.is_some()) {
+                    pressed += usize::from(c.hits.contact[i]);
+                    rows.push((k, i, sh));
                 }
             }
         }
-        if rows.len() < 2 * unknowns {
+        if pressed < 2 * unknowns {
             return Err(format!(
                 "the captures press {} pixels of the skin, fewer than the {} the fit needs (twice its {unknowns} unknowns): give captures with more imprints",
-                rows.len(),
+                pressed,
                 2 * unknowns
             ));
         }
         let mut coefficients: [Vec<f64>; 3] = Default::default();
+        let mut shadow_coefficients = [[0.0; SHADOW_TERMS]; 3];
         for (ch, coef) in coefficients.iter_mut().enumerate() {
             let mut ata = DMatrix::<f64>::zeros(unknowns, unknowns);
             let mut atb = DVector::<f64>::zeros(unknowns);
             let mut row = vec![0.0; unknowns];
-            for &(k, i) in &rows {
+            let mut nonzero: Vec<usize> = Vec::with_capacity(unknowns);
+            for &(k, i, sh) in &rows {
                 let r = appearance[i][ch];
                 let y_counts = captures[k].image[i][ch];
                 if !(r >= MIN_REFERENCE_COUNTS)
@@ -315,13 +575,19 @@ impl PhotometricModel {
                         row[a * SPATIAL_TERMS + m] = fa * pm;
                     }
                 }
+                for (m, x) in row[tilt_unknowns..].iter_mut().enumerate() {
+                    *x = -sh.map_or(0.0, |f| f[m]);
+                }
                 // the ratio's change, weighted by the reference so that each row counts in
                 // grey levels
                 let y = y_counts / (gains[k] * r) - 1.0;
                 let wgt = r * r;
-                for a in 0..unknowns {
+                // an unpressed pixel's row has only its shadow terms
+                nonzero.clear();
+                nonzero.extend((0..unknowns).filter(|&a| row[a] != 0.0));
+                for (j, &a) in nonzero.iter().enumerate() {
                     atb[a] += wgt * row[a] * y;
-                    for b in a..unknowns {
+                    for &b in &nonzero[j..] {
                         ata[(a, b)] += wgt * row[a] * row[b];
                     }
                 }
@@ -338,7 +604,8 @@ impl PhotometricModel {
                 .map(|c| c.solve(&atb))
                 .or_else(|| ata.svd(true, true).solve(&atb, 1e-12).ok())
                 .unwrap_or_else(|| DVector::zeros(unknowns));
-            *coef = x.iter().copied().collect();
+            *coef = x.iter().take(tilt_unknowns).copied().collect();
+            shadow_coefficients[ch] = std::array::from_fn(|m| x[tilt_unknowns + m]);
         }
         let mut model = PhotometricModel {
             width: w,
@@ -346,6 +613,8 @@ impl PhotometricModel {
             reference: appearance,
             coefficients,
             axis,
+            rings,
+            shadow_coefficients,
             gains: gains.clone(),
             full_scale,
             residual_rms: Vec::new(),
@@ -353,7 +622,7 @@ impl PhotometricModel {
         model.residual_rms = captures
             .iter()
             .zip(&gains)
-            .map(|(c, g)| rms_over_skin(&model.render(reference, c.hits, *g), c.image))
+            .map(|(c, g)| rms_over_skin(&model.render(reference, c.hits, c.shadows, *g), c.image))
             .collect();
         Ok(model)
     }
@@ -366,13 +635,22 @@ impl PhotometricModel {
 
     /// The image (row-major, per channel, counts clipped to the full scale; NaN off the skin)
     /// of the surface `hits` (the reference's, or indented: its contact pixels follow the
-    /// model) at `gain`.
-    pub fn render(&self, reference: &SurfaceHits, hits: &SurfaceHits, gain: f64) -> Vec<[f64; 3]> {
+    /// model) with the protrusions' `shadows` ([`shadow_map`] of the model's rings; those of
+    /// other rings are ignored) at `gain`.
+    pub fn render(
+        &self,
+        reference: &SurfaceHits,
+        hits: &SurfaceHits,
+        shadows: &ShadowMap,
+        gain: f64,
+    ) -> Vec<[f64; 3]> {
+        let same_rings = shadows.rings == self.rings;
         (0..self.width * self.height)
             .map(|i| {
                 let r = self.reference[i];
                 let plain = || r.map(|x| (gain * x).clamp(0.0, self.full_scale));
-                if !hits.contact[i] {
+                let sh = if same_rings { shadows.at(i) } else { None };
+                if !hits.contact[i] && sh.is_none() {
                     return plain();
                 }
                 let Some(f) = features(i, hits, reference, self.axis) else {
@@ -386,6 +664,13 @@ impl PhotometricModel {
                         for (m, pm) in p.iter().enumerate() {
                             s += c[a * SPATIAL_TERMS + m] * fa * pm;
                         }
+                    }
+                    if let Some(sh) = sh {
+                        s -= sh
+                            .iter()
+                            .zip(&self.shadow_coefficients[ch])
+                            .map(|(x, b)| x * b)
+                            .sum::<f64>();
                     }
                     (gain * r[ch] * (1.0 + s)).clamp(0.0, self.full_scale)
                 })

@@ -21,6 +21,7 @@ use fabkit_calibration::groundtruth::{
     half_masks, indented_hits, reference_hits, DepthFrame, Scene, SurfaceHits,
 };
 use fabkit_calibration::photometric::PhotometricModel;
+use fabkit_calibration::photometric::{shadow_map, ShadowMap};
 use fabkit_calibration::read_camera_file_as;
 use fabkit_export::raster::{
     normals_rgb, npy_f32, npz as npz_file, ply_points, png_gray16, png_gray8, png_rgb16, png_rgb8,
@@ -366,10 +367,10 @@ const IMAGES_NOT_MODELLED: &str = "refraction through the clear layers between t
 /// Where the images of `--images` come from.
 enum ImageSource {
     /// The design's optics through the physical image model.
-    Physical(Imaging),
+    Physical(Box<Imaging>),
     /// The sensor's photometric model (`--photometric DIR`), with the folder and the sha256
     /// of its photometric.json.
-    Photometric(PhotometricModel, String, String),
+    Photometric(Box<PhotometricModel>, String, String),
 }
 
 impl ImageSource {
@@ -398,7 +399,10 @@ fn load_photometric(
     w: usize,
     h: usize,
 ) -> Result<(PhotometricModel, String), Box<dyn Error>> {
-    use fabkit_calibration::photometric::{ANGULAR_ORDER, FEATURES, SPATIAL_DEGREE, SPATIAL_TERMS};
+    use fabkit_calibration::photometric::{
+        ShadowRings, ANGULAR_ORDER, FEATURES, SHADOW_AZIMUTHS, SHADOW_TERMS, SPATIAL_DEGREE,
+        SPATIAL_TERMS,
+    };
     let jpath = dir.join("photometric.json");
     let (bytes, sha) = read_with_hash(&jpath)?;
     let bad = |what: String| -> Box<dyn Error> {
@@ -411,6 +415,8 @@ fn load_photometric(
         ("spatial_degree", SPATIAL_DEGREE),
         ("angular_order", ANGULAR_ORDER),
         ("spatial_terms", SPATIAL_TERMS),
+        ("shadow_terms", SHADOW_TERMS),
+        ("shadow_azimuths", SHADOW_AZIMUTHS),
     ];
     for (key, want) in basis {
         if m[key].as_u64() != Some(want as u64) {
@@ -431,6 +437,29 @@ fn load_photometric(
         })?;
     let axis: [f64; 3] = serde_json::from_value(m["optical_axis"].clone())
         .map_err(|_| bad("model.optical_axis must be 3 numbers".into()))?;
+    let shadow_coefficients: [[f64; SHADOW_TERMS]; 3] =
+        serde_json::from_value(m["shadow"]["coefficients_rgb"].clone()).map_err(|_| {
+            bad(format!(
+                "model.shadow.coefficients_rgb must be 3 lists of {SHADOW_TERMS} numbers"
+            ))
+        })?;
+    let ring = &m["shadow"]["rings"];
+    let rings = match (
+        serde_json::from_value::<[f64; 3]>(ring["centre_mm"].clone()),
+        serde_json::from_value::<[f64; 3]>(ring["axis"].clone()),
+        ring["scale_mm"].as_f64().filter(|x| *x > 0.0),
+    ) {
+        (Ok(centre_mm), Ok(axis), Some(scale_mm)) => ShadowRings {
+            centre_mm,
+            axis,
+            scale_mm,
+        },
+        _ => {
+            return Err(bad(
+                "model.shadow.rings must hold centre_mm and axis (3 numbers each) and scale_mm (above 0)".into(),
+            ))
+        }
+    };
     let full_scale = m["full_scale_counts"]
         .as_f64()
         .filter(|f| *f == 255.0 || *f == 65535.0)
@@ -457,6 +486,8 @@ fn load_photometric(
             reference,
             coefficients,
             axis,
+            rings,
+            shadow_coefficients,
             gains: Vec::new(),
             full_scale,
             residual_rms: Vec::new(),
@@ -490,7 +521,15 @@ fn image_file(
             ),
         ),
         ImageSource::Photometric(m, folder, _) => (
-            m.render(reference, hits, 1.0)
+            m.render(
+                reference,
+                hits,
+                &match protrusions {
+                    Some(p) => shadow_map(rays, hits, p, &m.rings),
+                    None => ShadowMap::none(m.rings),
+                },
+                1.0,
+            )
                 .into_iter()
                 .map(|p| p.map(|x| if x.is_finite() { x.round().clamp(0.0, f64::from(full)) as u16 } else { 0 }))
                 .collect(),
@@ -868,10 +907,19 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
     );
 
     let imaging = match photometric {
-        Some(((m, sha), dir)) => Some(ImageSource::Photometric(m, dir.display().to_string(), sha)),
+        Some(((m, sha), dir)) => Some(ImageSource::Photometric(
+            Box::new(m),
+            dir.display().to_string(),
+            sha,
+        )),
         None => optics.map(|o| {
             let i = camera.intrinsics();
-            ImageSource::Physical(Imaging::new(o, [i.cx_px, i.cy_px], &rays, &ref_hits))
+            ImageSource::Physical(Box::new(Imaging::new(
+                o,
+                [i.cx_px, i.cy_px],
+                &rays,
+                &ref_hits,
+            )))
         }),
     };
     let staged = StagedDir::new(&args.out, claim)?;
@@ -1078,7 +1126,7 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
             "file": "image.png in reference/ and in each configuration's folder",
             "model": "the sensor's photometric model (fabkit calibrate photometric): per channel the appearance of every pixel times one plus its fitted response to the surface's tilt and indentation (calibration/src/photometric.rs); the model's mean image, no noise",
             "photometric": {"dir": dir, "photometric_json_sha256": sha},
-            "not_modelled": "shadows cast beside an imprint onto the unpressed skin; lights at a few azimuths (the spatial term depends on the distance from the image centre only); refraction; the skin's deformation around a protrusion",
+            "not_modelled": "lights at a few azimuths (the spatial term and the shadows' light rings are round the optical axis); refraction; the skin's deformation around a protrusion",
         });
     }
     if let Some(ImageSource::Physical(im)) = &imaging {

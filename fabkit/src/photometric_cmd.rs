@@ -11,8 +11,9 @@ use fabkit_calibration::groundtruth::inputs::{read_extrinsics, sha256_hex};
 use fabkit_calibration::groundtruth::{indented_hits, reference_hits, Scene, SurfaceHits};
 use fabkit_calibration::imprints::ids_from_file_name;
 use fabkit_calibration::photometric::{
-    read_pins, rms_over_skin, Capture, PhotometricModel, ANGULAR_ORDER, FEATURES, SPATIAL_DEGREE,
-    SPATIAL_TERMS,
+    read_pins, rms_over_skin, shadow_map, Capture, PhotometricModel, ShadowMap, ShadowRings,
+    ANGULAR_ORDER, FEATURES, SHADOW_AZIMUTHS, SHADOW_HEIGHTS, SHADOW_RADII, SHADOW_TERMS,
+    SPATIAL_DEGREE, SPATIAL_TERMS,
 };
 use fabkit_calibration::read_camera_file_as;
 use fabkit_export::raster::{npy_f32, png_rgb16, png_rgb8};
@@ -63,6 +64,7 @@ struct Posed {
     ids: Vec<String>,
     image: Vec<[f64; 3]>,
     hits: SurfaceHits,
+    shadows: ShadowMap,
 }
 
 pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
@@ -103,6 +105,7 @@ pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
     let pose_name = a.extrinsics.display().to_string();
     let Scene { surface, rays } = Scene::new(design, &camera, &t_cam_sensor, &pose_name)?;
     let reference = reference_hits(&rays, &surface);
+    let rings = ShadowRings::of(&rays, &reference);
     let (reference_image, full_scale) = read_rgb(&a.reference, "--reference", size, &camera_name)?;
     let mut posed = Vec::new();
     for file in &a.images {
@@ -136,11 +139,13 @@ pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
             return Err(format!("{pose_name}: the camera centre is inside a pin of {name}").into());
         }
         let hits = indented_hits(&rays, &reference, &prims, surface.base_z_mm());
+        let shadows = shadow_map(&rays, &hits, &prims, &rings);
         posed.push(Posed {
             file: file.clone(),
             ids,
             image,
             hits,
+            shadows,
         });
     }
     let all: Vec<Capture> = posed
@@ -148,6 +153,7 @@ pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
         .map(|p| Capture {
             image: &p.image,
             hits: &p.hits,
+            shadows: &p.shadows,
         })
         .collect();
     let model = PhotometricModel::fit(&rays, &reference, &reference_image, &all, full_scale)?;
@@ -161,7 +167,7 @@ pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
         let m = PhotometricModel::fit(&rays, &reference, &reference_image, &others, full_scale)
             .map_err(|e| format!("leaving out {}: {e}", posed[k].file.display()))?;
         let gain = m.gain_of(&posed[k].image, &posed[k].hits);
-        let again = m.render(&reference, &posed[k].hits, gain);
+        let again = m.render(&reference, &posed[k].hits, &posed[k].shadows, gain);
         loo.push((rms_over_skin(&again, &posed[k].image), again));
     }
 
@@ -209,16 +215,23 @@ pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
     let report = json!({
         "fabkit_version": env!("CARGO_PKG_VERSION"),
         "command_line": std::env::args().collect::<Vec<_>>(),
-        "description": "Photometric model of the sensor: per channel I(x, n) = gain x R(x) x (1 + sum_km c_km P_m(x) f_k(n, x)); R: appearance.npy (H, W, 3 float32 counts, NaN off the skin), the median of the reference and the captures' unpressed pixels over their gains; f_k: the tilt of the surface from the reference normal in the local frame about the optical axis (a away from it, r round it), its monomials to degree 3 and the indentation depth along the ray (mm); P_m: powers of the pixel's distance from the image centre over the half-diagonal (calibration/src/photometric.rs)",
+        "description": "Photometric model of the sensor: per channel I(x, n) = gain x R(x) x (1 + sum_km c_km P_m(x) f_k(n, x) - sum_j b_j S_j(x)); R: appearance.npy (H, W, 3 float32 counts, NaN off the skin), the median of the reference and the captures' unpressed pixels over their gains; f_k: the change of the surface normal from the reference normal in the local frame about the optical axis (a along the tangent away from the axis, r round it, c along the reference normal: 1 - cos of the tilt), the monomials of a and r to degree 3 and the indentation depth along the ray (mm); P_m: powers of the pixel's distance from the image centre over the half-diagonal; S_j: the share of candidate light ring j's light the protrusions block at the pixel (shadows, also beside the imprints), weighted by b_j (calibration/src/photometric.rs)",
         "design": {"name": design.name, "source": loaded.source, "sha256": loaded.sha256},
         "camera": {"file": camera_name, "image_width_px": w, "image_height_px": h},
         "extrinsics": {"file": pose_name, "sha256": extrinsics_sha},
         "fixtures": a.fixtures.display().to_string(),
         "model": {
-            "features": ["a", "r", "depth_mm", "a^2", "r^2", "a r", "a^3", "a^2 r", "a r^2", "r^3"],
+            "features": ["a", "r", "c", "depth_mm", "a^2", "r^2", "a r", "a^3", "a^2 r", "a r^2", "r^3"],
             "feature_count": FEATURES, "spatial_degree": SPATIAL_DEGREE, "angular_order": ANGULAR_ORDER,
             "spatial_terms": SPATIAL_TERMS, "optical_axis": model.axis, "full_scale_counts": full_scale,
             "coefficients_rgb": model.coefficients, "appearance": "appearance.npy",
+            "shadow_terms": SHADOW_TERMS, "shadow_azimuths": SHADOW_AZIMUTHS,
+            "shadow": {
+                "rings": {"centre_mm": model.rings.centre_mm, "axis": model.rings.axis, "scale_mm": model.rings.scale_mm,
+                          "heights": SHADOW_HEIGHTS, "radii": SHADOW_RADII,
+                          "notes": "candidate rings of effective lights about the optical axis, ring m at height heights[m / 3] x scale_mm along the axis from the camera centre (centre_mm) and radius radii[m % 3] x scale_mm, each sampled by shadow_azimuths lights; scale_mm is the skin's median range"},
+                "coefficients_rgb": model.shadow_coefficients,
+            },
         },
         "captures": captures,
         "files": files,

@@ -193,13 +193,14 @@ fn the_photometric_model_re_renders_each_capture_from_the_others() {
     assert_eq!(caps.len(), 5);
     for c in caps {
         // R-Tac0's pins (0.8 mm tips pressed 1.54 mm: the shaft enters the skin) shadow the
-        // skin beside their imprints from the LED ring, which the model does not hold: it fits
-        // within about 3.7 counts and re-renders within about 4.1 (without those shadows 2.0
-        // and 2.7); the leave-one-out stays within a count of the fit (no overfitting)
+        // skin beside their imprints from the LED ring; with the shadow term the model fits
+        // these five within about 2.2 counts and re-renders each from the other four within
+        // about 2.8 (without it 3.7 and 4.1); the leave-one-out stays within a count of the
+        // fit (no overfitting)
         let loo = c["leave_one_out_rms_counts"].as_f64().unwrap();
         let fit = c["fit_rms_counts"].as_f64().unwrap();
         assert!(
-            loo < 5.0 && loo < fit + 1.0,
+            loo < 3.0 && loo < fit + 1.0,
             "{}: {loo} grey levels RMS, fit {fit}",
             c["file"]
         );
@@ -260,18 +261,28 @@ fn the_photometric_model_re_renders_each_capture_from_the_others() {
     let contact = image::open(d.path().join("gt/p001_0/contact_mask.png"))
         .unwrap()
         .into_luma8();
-    let (mut on, mut off) = (0, 0);
+    // it differs on the contact and in the shadows beside it, nowhere else
+    let touched: Vec<(f64, f64)> = (0..640 * 480)
+        .filter(|&i| contact.as_raw()[i] > 0)
+        .map(|i| ((i % 640) as f64, (i / 640) as f64))
+        .collect();
+    let (mut on, mut beside, mut far) = (0, 0, 0);
     for (i, (p, q)) in pressed.pixels().zip(reference.pixels()).enumerate() {
-        let differs = p != q;
+        if p == q {
+            continue;
+        }
+        let (u, v) = ((i % 640) as f64, (i / 640) as f64);
         if contact.as_raw()[i] > 0 {
-            on += usize::from(differs);
+            on += 1;
+        } else if touched.iter().any(|t| (t.0 - u).hypot(t.1 - v) < 20.0) {
+            beside += 1;
         } else {
-            off += usize::from(differs);
+            far += 1;
         }
     }
     assert!(
-        on > 100 && off == 0,
-        "{on} contact pixels differ, {off} elsewhere"
+        on > 100 && beside > 0 && far == 0,
+        "{on} contact pixels differ, {beside} within 20 px of the contact, {far} farther"
     );
     let gm: serde_json::Value =
         serde_json::from_slice(&std::fs::read(d.path().join("gt/manifest.json")).unwrap()).unwrap();
