@@ -400,8 +400,8 @@ fn load_photometric(
     h: usize,
 ) -> Result<(PhotometricModel, String), Box<dyn Error>> {
     use fabkit_calibration::photometric::{
-        ShadowRings, ANGULAR_ORDER, FEATURES, SHADOW_AZIMUTHS, SHADOW_TERMS, SPATIAL_DEGREE,
-        SPATIAL_TERMS,
+        ShadowRings, ANGULAR_ORDER, COEFFICIENTS, FEATURES, LIGHT_TERMS, SHADOW_AZIMUTHS,
+        SHADOW_TERMS, SPATIAL_DEGREE, SPATIAL_TERMS,
     };
     let jpath = dir.join("photometric.json");
     let (bytes, sha) = read_with_hash(&jpath)?;
@@ -416,6 +416,7 @@ fn load_photometric(
         ("angular_order", ANGULAR_ORDER),
         ("spatial_terms", SPATIAL_TERMS),
         ("shadow_terms", SHADOW_TERMS),
+        ("light_terms", LIGHT_TERMS),
         ("shadow_azimuths", SHADOW_AZIMUTHS),
     ];
     for (key, want) in basis {
@@ -428,11 +429,10 @@ fn load_photometric(
     }
     let coefficients: [Vec<f64>; 3] = serde_json::from_value(m["coefficients_rgb"].clone())
         .ok()
-        .filter(|c: &[Vec<f64>; 3]| c.iter().all(|x| x.len() == FEATURES * SPATIAL_TERMS))
+        .filter(|c: &[Vec<f64>; 3]| c.iter().all(|x| x.len() == COEFFICIENTS))
         .ok_or_else(|| {
             bad(format!(
-                "model.coefficients_rgb must be 3 lists of {} numbers",
-                FEATURES * SPATIAL_TERMS
+                "model.coefficients_rgb must be 3 lists of {COEFFICIENTS} numbers"
             ))
         })?;
     let axis: [f64; 3] = serde_json::from_value(m["optical_axis"].clone())
@@ -522,6 +522,7 @@ fn image_file(
         ),
         ImageSource::Photometric(m, folder, _) => (
             m.render(
+                rays,
                 reference,
                 hits,
                 &match protrusions {

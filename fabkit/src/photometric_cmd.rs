@@ -12,8 +12,8 @@ use fabkit_calibration::groundtruth::{indented_hits, reference_hits, Scene, Surf
 use fabkit_calibration::imprints::ids_from_file_name;
 use fabkit_calibration::photometric::{
     read_pins, rms_over_skin, shadow_map, Capture, PhotometricModel, ShadowMap, ShadowRings,
-    ANGULAR_ORDER, FEATURES, SHADOW_AZIMUTHS, SHADOW_HEIGHTS, SHADOW_RADII, SHADOW_TERMS,
-    SPATIAL_DEGREE, SPATIAL_TERMS,
+    ANGULAR_ORDER, FEATURES, LIGHT_AZIMUTHS, LIGHT_HEIGHTS, LIGHT_RADIUS, LIGHT_TERMS,
+    SHADOW_AZIMUTHS, SHADOW_HEIGHTS, SHADOW_RADII, SHADOW_TERMS, SPATIAL_DEGREE, SPATIAL_TERMS,
 };
 use fabkit_calibration::read_camera_file_as;
 use fabkit_export::raster::{npy_f32, png_rgb16, png_rgb8};
@@ -167,7 +167,7 @@ pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
         let m = PhotometricModel::fit(&rays, &reference, &reference_image, &others, full_scale)
             .map_err(|e| format!("leaving out {}: {e}", posed[k].file.display()))?;
         let gain = m.gain_of(&posed[k].image, &posed[k].hits);
-        let again = m.render(&reference, &posed[k].hits, &posed[k].shadows, gain);
+        let again = m.render(&rays, &reference, &posed[k].hits, &posed[k].shadows, gain);
         loo.push((rms_over_skin(&again, &posed[k].image), again));
     }
 
@@ -215,7 +215,7 @@ pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
     let report = json!({
         "fabkit_version": env!("CARGO_PKG_VERSION"),
         "command_line": std::env::args().collect::<Vec<_>>(),
-        "description": "Photometric model of the sensor: per channel I(x, n) = gain x R(x) x (1 + sum_km c_km P_m(x) f_k(n, x) - sum_j b_j S_j(x)); R: appearance.npy (H, W, 3 float32 counts, NaN off the skin), the median of the reference and the captures' unpressed pixels over their gains; f_k: the change of the surface normal from the reference normal in the local frame about the optical axis (a along the tangent away from the axis, r round it, c along the reference normal: 1 - cos of the tilt), the monomials of a and r to degree 3 and the indentation depth along the ray (mm); P_m: powers of the pixel's distance from the image centre over the half-diagonal; S_j: the share of candidate light ring j's light the protrusions block at the pixel (shadows, also beside the imprints), weighted by b_j (calibration/src/photometric.rs)",
+        "description": "Photometric model of the sensor: per channel I(x, n) = gain x R(x) x (1 + sum_km c_km P_m(x) f_k(n, x) + sum_l w_l G_l(x, n) - sum_j b_j S_j(x)); R: appearance.npy (H, W, 3 float32 counts, NaN off the skin), the median of the reference and the captures' unpressed pixels over their gains; f_k: the change of the surface normal from the reference normal in the local frame about the optical axis (a along the tangent away from the axis, r round it, c along the reference normal: 1 - cos of the tilt), the monomials of a and r to degree 3 and the indentation depth along the ray (mm); P_m: powers of the pixel's distance from the image centre over the half-diagonal; G_l: the change of candidate point light l's Lambertian irradiance (incidence cosine over squared distance; 0 where the protrusions block it) from the reference surface to the pressed one, over the sum of all candidates' irradiance of the reference, weighted by w_l (the last light_terms numbers of each coefficients list); S_j: the share of candidate light ring j's light the protrusions block at the pixel (shadows, also beside the imprints), weighted by b_j (calibration/src/photometric.rs)",
         "design": {"name": design.name, "source": loaded.source, "sha256": loaded.sha256},
         "camera": {"file": camera_name, "image_width_px": w, "image_height_px": h},
         "extrinsics": {"file": pose_name, "sha256": extrinsics_sha},
@@ -225,7 +225,9 @@ pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
             "feature_count": FEATURES, "spatial_degree": SPATIAL_DEGREE, "angular_order": ANGULAR_ORDER,
             "spatial_terms": SPATIAL_TERMS, "optical_axis": model.axis, "full_scale_counts": full_scale,
             "coefficients_rgb": model.coefficients, "appearance": "appearance.npy",
-            "shadow_terms": SHADOW_TERMS, "shadow_azimuths": SHADOW_AZIMUTHS,
+            "light_terms": LIGHT_TERMS, "shadow_terms": SHADOW_TERMS, "shadow_azimuths": SHADOW_AZIMUTHS,
+            "lights": {"heights": LIGHT_HEIGHTS, "radius": LIGHT_RADIUS, "azimuths": LIGHT_AZIMUTHS,
+                       "notes": "candidate point lights l = h x azimuths + j at height heights[h] x scale_mm along the axis from the camera centre and radius radius x scale_mm, azimuth j x 360 / azimuths deg from the axis x e1 with e1 = axis x (x or y); scale_mm and centre_mm as in shadow.rings"},
             "shadow": {
                 "rings": {"centre_mm": model.rings.centre_mm, "axis": model.rings.axis, "scale_mm": model.rings.scale_mm,
                           "heights": SHADOW_HEIGHTS, "radii": SHADOW_RADII,
