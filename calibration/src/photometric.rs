@@ -761,6 +761,140 @@ impl PhotometricModel {
         Ok(model)
     }
 
+    /// The model's section of photometric.json (`fabkit calibrate photometric`): the basis
+    /// (feature names and counts, the candidate lights and rings), the optical axis, the full
+    /// scale and the coefficients per channel. The appearance goes to its own file
+    /// (appearance.npy, (H, W, 3) float32).
+    pub fn model_json(&self) -> serde_json::Value {
+        serde_json::json!({
+            "features": ["a", "r", "c", "depth_mm", "a^2", "r^2", "a r", "a^3", "a^2 r", "a r^2", "r^3"],
+            "feature_count": FEATURES, "spatial_degree": SPATIAL_DEGREE, "angular_order": ANGULAR_ORDER,
+            "spatial_terms": SPATIAL_TERMS, "optical_axis": self.axis, "full_scale_counts": self.full_scale,
+            "coefficients_rgb": self.coefficients, "appearance": "appearance.npy",
+            "light_terms": LIGHT_TERMS, "shadow_terms": SHADOW_TERMS, "shadow_azimuths": SHADOW_AZIMUTHS,
+            "lights": {"heights": LIGHT_HEIGHTS, "radius": LIGHT_RADIUS, "azimuths": LIGHT_AZIMUTHS,
+                       "notes": "candidate point lights l = h x azimuths + j at height heights[h] x scale_mm along the axis from the camera centre and radius radius x scale_mm, azimuth j x 360 / azimuths deg from the axis x e1 with e1 = axis x (x or y); scale_mm and centre_mm as in shadow.rings"},
+            "shadow": {
+                "rings": {"centre_mm": self.rings.centre_mm, "axis": self.rings.axis, "scale_mm": self.rings.scale_mm,
+                          "heights": SHADOW_HEIGHTS, "radii": SHADOW_RADII,
+                          "notes": "candidate rings of effective lights about the optical axis, ring m at height heights[m / 3] x scale_mm along the axis from the camera centre (centre_mm) and radius radii[m % 3] x scale_mm, each sampled by shadow_azimuths lights; scale_mm is the skin's median range"},
+                "coefficients_rgb": self.shadow_coefficients,
+            },
+        })
+    }
+
+    /// The model from its section of photometric.json ([`Self::model_json`]) and its
+    /// appearance (row-major, `width` x `height`, counts; NaN off the skin).
+    ///
+    /// # Errors
+    /// A message naming the key (`model.<key>`), the value and the rule: another basis than
+    /// this fabkit's (fit the model again), coefficients of another length, an axis, ring or
+    /// full scale that is not one, an appearance of another size.
+    pub fn from_json(
+        model: &serde_json::Value,
+        appearance: Vec<[f64; 3]>,
+        width: usize,
+        height: usize,
+    ) -> Result<PhotometricModel, String> {
+        use serde_json::from_value;
+        let m = model;
+        let basis = [
+            ("feature_count", FEATURES),
+            ("spatial_degree", SPATIAL_DEGREE),
+            ("angular_order", ANGULAR_ORDER),
+            ("spatial_terms", SPATIAL_TERMS),
+            ("shadow_terms", SHADOW_TERMS),
+            ("light_terms", LIGHT_TERMS),
+            ("shadow_azimuths", SHADOW_AZIMUTHS),
+        ];
+        for (key, want) in basis {
+            if m[key].as_u64() != Some(want as u64) {
+                return Err(format!(
+                    "model.{key} = {}: this fabkit's model has {want} (fit it again with this version)",
+                    m[key]
+                ));
+            }
+        }
+        let coefficients: [Vec<f64>; 3] = from_value(m["coefficients_rgb"].clone())
+            .ok()
+            .filter(|c: &[Vec<f64>; 3]| c.iter().all(|x| x.len() == COEFFICIENTS))
+            .ok_or_else(|| {
+                format!("model.coefficients_rgb must be 3 lists of {COEFFICIENTS} numbers")
+            })?;
+        let axis: [f64; 3] = from_value(m["optical_axis"].clone())
+            .map_err(|_| "model.optical_axis must be 3 numbers".to_string())?;
+        let shadow_coefficients: [[f64; SHADOW_TERMS]; 3] =
+            from_value(m["shadow"]["coefficients_rgb"].clone()).map_err(|_| {
+                format!("model.shadow.coefficients_rgb must be 3 lists of {SHADOW_TERMS} numbers")
+            })?;
+        let ring = &m["shadow"]["rings"];
+        let rings = match (
+            from_value::<[f64; 3]>(ring["centre_mm"].clone()),
+            from_value::<[f64; 3]>(ring["axis"].clone()),
+            ring["scale_mm"].as_f64().filter(|x| *x > 0.0),
+        ) {
+            (Ok(centre_mm), Ok(axis), Some(scale_mm)) => ShadowRings {
+                centre_mm,
+                axis,
+                scale_mm,
+            },
+            _ => {
+                return Err("model.shadow.rings must hold centre_mm and axis (3 numbers each) and scale_mm (above 0)".into())
+            }
+        };
+        let full_scale = m["full_scale_counts"]
+            .as_f64()
+            .filter(|f| *f == 255.0 || *f == 65535.0)
+            .ok_or_else(|| "model.full_scale_counts must be 255 or 65535".to_string())?;
+        if appearance.len() != width * height {
+            return Err(format!(
+                "the appearance has {} pixels, the camera {width} x {height}",
+                appearance.len()
+            ));
+        }
+        Ok(PhotometricModel {
+            width,
+            height,
+            reference: appearance,
+            coefficients,
+            axis,
+            rings,
+            shadow_coefficients,
+            gains: Vec::new(),
+            full_scale,
+            residual_rms: Vec::new(),
+        })
+    }
+
+    /// The model's image of the surface `hits` (seen along `rays`; `reference` the
+    /// unindented one) pressed by `protrusions` (their shadows computed here): [`Self::render`]
+    /// at gain 1, rounded to counts, 0 off the skin. The model's mean image: no noise.
+    pub fn image(
+        &self,
+        rays: &PixelRays,
+        reference: &SurfaceHits,
+        hits: &SurfaceHits,
+        protrusions: Option<&ExactPrimitives>,
+    ) -> Vec<[u16; 3]> {
+        let shadows = match protrusions {
+            Some(p) => shadow_map(rays, hits, p, &self.rings),
+            None => ShadowMap::none(self.rings),
+        };
+        let full = self.full_scale;
+        self.render(rays, reference, hits, &shadows, 1.0)
+            .into_iter()
+            .map(|p| {
+                p.map(|x| {
+                    if x.is_finite() {
+                        x.round().clamp(0.0, full) as u16
+                    } else {
+                        0
+                    }
+                })
+            })
+            .collect()
+    }
+
     /// The gain of `image` (a capture whose surface is `hits`) against the model's appearance:
     /// the median ratio over its unpressed skin, for re-rendering it.
     pub fn gain_of(&self, image: &[[f64; 3]], hits: &SurfaceHits) -> f64 {

@@ -21,7 +21,6 @@ use fabkit_calibration::groundtruth::{
     half_masks, indented_hits, reference_hits, DepthFrame, Scene, SurfaceHits,
 };
 use fabkit_calibration::photometric::PhotometricModel;
-use fabkit_calibration::photometric::{shadow_map, ShadowMap};
 use fabkit_calibration::read_camera_file_as;
 use fabkit_export::raster::{
     normals_rgb, npy_f32, npz as npz_file, ply_points, png_gray16, png_gray8, png_rgb16, png_rgb8,
@@ -399,71 +398,12 @@ fn load_photometric(
     w: usize,
     h: usize,
 ) -> Result<(PhotometricModel, String), Box<dyn Error>> {
-    use fabkit_calibration::photometric::{
-        ShadowRings, ANGULAR_ORDER, COEFFICIENTS, FEATURES, LIGHT_TERMS, SHADOW_AZIMUTHS,
-        SHADOW_TERMS, SPATIAL_DEGREE, SPATIAL_TERMS,
-    };
     let jpath = dir.join("photometric.json");
     let (bytes, sha) = read_with_hash(&jpath)?;
     let bad = |what: String| -> Box<dyn Error> {
         format!("--photometric {}: {what}", jpath.display()).into()
     };
     let v: Value = serde_json::from_slice(&bytes).map_err(|e| bad(format!("not JSON: {e}")))?;
-    let m = &v["model"];
-    let basis = [
-        ("feature_count", FEATURES),
-        ("spatial_degree", SPATIAL_DEGREE),
-        ("angular_order", ANGULAR_ORDER),
-        ("spatial_terms", SPATIAL_TERMS),
-        ("shadow_terms", SHADOW_TERMS),
-        ("light_terms", LIGHT_TERMS),
-        ("shadow_azimuths", SHADOW_AZIMUTHS),
-    ];
-    for (key, want) in basis {
-        if m[key].as_u64() != Some(want as u64) {
-            return Err(bad(format!(
-                "model.{key} = {}: this fabkit's model has {want} (fit it again with this version)",
-                m[key]
-            )));
-        }
-    }
-    let coefficients: [Vec<f64>; 3] = serde_json::from_value(m["coefficients_rgb"].clone())
-        .ok()
-        .filter(|c: &[Vec<f64>; 3]| c.iter().all(|x| x.len() == COEFFICIENTS))
-        .ok_or_else(|| {
-            bad(format!(
-                "model.coefficients_rgb must be 3 lists of {COEFFICIENTS} numbers"
-            ))
-        })?;
-    let axis: [f64; 3] = serde_json::from_value(m["optical_axis"].clone())
-        .map_err(|_| bad("model.optical_axis must be 3 numbers".into()))?;
-    let shadow_coefficients: [[f64; SHADOW_TERMS]; 3] =
-        serde_json::from_value(m["shadow"]["coefficients_rgb"].clone()).map_err(|_| {
-            bad(format!(
-                "model.shadow.coefficients_rgb must be 3 lists of {SHADOW_TERMS} numbers"
-            ))
-        })?;
-    let ring = &m["shadow"]["rings"];
-    let rings = match (
-        serde_json::from_value::<[f64; 3]>(ring["centre_mm"].clone()),
-        serde_json::from_value::<[f64; 3]>(ring["axis"].clone()),
-        ring["scale_mm"].as_f64().filter(|x| *x > 0.0),
-    ) {
-        (Ok(centre_mm), Ok(axis), Some(scale_mm)) => ShadowRings {
-            centre_mm,
-            axis,
-            scale_mm,
-        },
-        _ => {
-            return Err(bad(
-                "model.shadow.rings must hold centre_mm and axis (3 numbers each) and scale_mm (above 0)".into(),
-            ))
-        }
-    };
-    let full_scale = m["full_scale_counts"]
-        .as_f64()
-        .filter(|f| *f == 255.0 || *f == 65535.0)
-        .ok_or_else(|| bad("model.full_scale_counts must be 255 or 65535".into()))?;
     let apath = dir.join("appearance.npy");
     let (abytes, _) = read_with_hash(&apath)?;
     let (shape, data) = fabkit_export::raster::read_npy_f32(&abytes)
@@ -475,25 +415,12 @@ fn load_photometric(
         )
         .into());
     }
-    let reference = data
+    let appearance = data
         .chunks_exact(3)
         .map(|c| [f64::from(c[0]), f64::from(c[1]), f64::from(c[2])])
         .collect();
-    Ok((
-        PhotometricModel {
-            width: w,
-            height: h,
-            reference,
-            coefficients,
-            axis,
-            rings,
-            shadow_coefficients,
-            gains: Vec::new(),
-            full_scale,
-            residual_rms: Vec::new(),
-        },
-        sha,
-    ))
+    let model = PhotometricModel::from_json(&v["model"], appearance, w, h).map_err(bad)?;
+    Ok((model, sha))
 }
 
 /// The rendered image of a frame (`--images`): `dir/image.png`, RGB at the source's bit
@@ -521,19 +448,7 @@ fn image_file(
             ),
         ),
         ImageSource::Photometric(m, folder, _) => (
-            m.render(
-                rays,
-                reference,
-                hits,
-                &match protrusions {
-                    Some(p) => shadow_map(rays, hits, p, &m.rings),
-                    None => ShadowMap::none(m.rings),
-                },
-                1.0,
-            )
-                .into_iter()
-                .map(|p| p.map(|x| if x.is_finite() { x.round().clamp(0.0, f64::from(full)) as u16 } else { 0 }))
-                .collect(),
+            m.image(rays, reference, hits, protrusions),
             format!("fabkit rendered tactile image: RGB, {bits} bit; the sensor's photometric model from {folder}"),
         ),
     };

@@ -12,8 +12,6 @@ use fabkit_calibration::groundtruth::{indented_hits, reference_hits, Scene, Surf
 use fabkit_calibration::imprints::ids_from_file_name;
 use fabkit_calibration::photometric::{
     read_pins, rms_over_skin, shadow_map, Capture, PhotometricModel, ShadowMap, ShadowRings,
-    ANGULAR_ORDER, FEATURES, LIGHT_AZIMUTHS, LIGHT_HEIGHTS, LIGHT_RADIUS, LIGHT_TERMS,
-    SHADOW_AZIMUTHS, SHADOW_HEIGHTS, SHADOW_RADII, SHADOW_TERMS, SPATIAL_DEGREE, SPATIAL_TERMS,
 };
 use fabkit_calibration::read_camera_file_as;
 use fabkit_export::raster::{npy_f32, png_rgb16, png_rgb8};
@@ -220,21 +218,7 @@ pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
         "camera": {"file": camera_name, "image_width_px": w, "image_height_px": h},
         "extrinsics": {"file": pose_name, "sha256": extrinsics_sha},
         "fixtures": a.fixtures.display().to_string(),
-        "model": {
-            "features": ["a", "r", "c", "depth_mm", "a^2", "r^2", "a r", "a^3", "a^2 r", "a r^2", "r^3"],
-            "feature_count": FEATURES, "spatial_degree": SPATIAL_DEGREE, "angular_order": ANGULAR_ORDER,
-            "spatial_terms": SPATIAL_TERMS, "optical_axis": model.axis, "full_scale_counts": full_scale,
-            "coefficients_rgb": model.coefficients, "appearance": "appearance.npy",
-            "light_terms": LIGHT_TERMS, "shadow_terms": SHADOW_TERMS, "shadow_azimuths": SHADOW_AZIMUTHS,
-            "lights": {"heights": LIGHT_HEIGHTS, "radius": LIGHT_RADIUS, "azimuths": LIGHT_AZIMUTHS,
-                       "notes": "candidate point lights l = h x azimuths + j at height heights[h] x scale_mm along the axis from the camera centre and radius radius x scale_mm, azimuth j x 360 / azimuths deg from the axis x e1 with e1 = axis x (x or y); scale_mm and centre_mm as in shadow.rings"},
-            "shadow": {
-                "rings": {"centre_mm": model.rings.centre_mm, "axis": model.rings.axis, "scale_mm": model.rings.scale_mm,
-                          "heights": SHADOW_HEIGHTS, "radii": SHADOW_RADII,
-                          "notes": "candidate rings of effective lights about the optical axis, ring m at height heights[m / 3] x scale_mm along the axis from the camera centre (centre_mm) and radius radii[m % 3] x scale_mm, each sampled by shadow_azimuths lights; scale_mm is the skin's median range"},
-                "coefficients_rgb": model.shadow_coefficients,
-            },
-        },
+        "model": model.model_json(),
         "captures": captures,
         "files": files,
     });

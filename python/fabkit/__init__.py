@@ -35,6 +35,9 @@ from ._fabkit import (  # noqa: F401
     ProtrusionSet,
     DepthRenderer,
     read_protrusions,
+    read_pin_captures,
+    PhotometricModel,
+    read_photometric,
 )
 from .groundtruth import GroundTruth, StitchedPair  # noqa: F401
 from .sweep import SweepTables, sweep  # noqa: F401

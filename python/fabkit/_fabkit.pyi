@@ -230,20 +230,45 @@ def solve_extrinsics(
     (a non-finite entry: ``points_mm[i, j] = nan: must be finite``), ValueError (shapes)."""
 
 class ProtrusionSet:
-    """One semi-dome (semi-plate) configuration: a pattern at 0 deg (+x half) or 180 deg."""
+    """One semi-dome (semi-plate) configuration: a pattern at 0 deg (+x half) or 180 deg;
+    or one capture of a pin dome (read_pin_captures)."""
 
     @property
     def name(self) -> str:
-        """``<pattern>_<orientation_deg>``, the frame's folder in a ground-truth output."""
+        """``<pattern>_<orientation_deg>`` (a pin capture: its pins, ``01_02_06_14_22``), the
+        frame's folder in a ground-truth output."""
     @property
     def pattern(self) -> str: ...
     @property
     def orientation_deg(self) -> int: ...
+    @property
+    def pins(self) -> List[str]:
+        """A pin capture's pin ids in the capture plan's order; empty for a pattern."""
     def __len__(self) -> int: ...
 
 def read_protrusions(fixtures_dir: StrPath, design: Design) -> List[ProtrusionSet]:
     """The configurations of a ``fabkit fixtures`` folder (protrusions/index.json), two per
     pattern in index order. Raises GroundTruthError naming the file."""
+
+def read_pin_captures(fixtures_dir: StrPath, design: Design) -> List[ProtrusionSet]:
+    """The captures of a pin dome's ``fabkit fixtures`` folder (points/capture_plan.csv),
+    each its planned pins pressed in, named by its pins as ``fabkit groundtruth
+    --pin-captures`` names its folders. Raises GroundTruthError naming the file and line."""
+
+class PhotometricModel:
+    """A sensor's photometric model from ``fabkit calibrate photometric`` (read_photometric)."""
+
+    @property
+    def width(self) -> int: ...
+    @property
+    def height(self) -> int: ...
+    @property
+    def bit_depth(self) -> int:
+        """8 or 16, that of the captures it was fitted to."""
+
+def read_photometric(dir: StrPath) -> PhotometricModel:
+    """The model in the output folder of ``fabkit calibrate photometric`` (photometric.json,
+    appearance.npy). Raises GroundTruthError naming the file and what does not fit."""
 
 class DepthRenderer:
     """Ground-truth depth of a design's skin through a calibrated camera (R-Tac0 Sec. IV-B,
@@ -279,14 +304,21 @@ class DepthRenderer:
         """(left, right) half masks (H, W): rays meeting the reference surface at sensor-frame
         x < 0 / x >= 0."""
     def image(
-        self, protrusions: Optional[ProtrusionSet] = None, *, frame: int = 0
+        self,
+        protrusions: Optional[ProtrusionSet] = None,
+        *,
+        frame: int = 0,
+        photometric: Optional[PhotometricModel] = None,
     ) -> np.ndarray:
         """The tactile image the camera sees, (H, W, 3) RGB uint8 or uint16
         (optics.camera.bit_depth), as `fabkit groundtruth --images` writes image.png: the
         reference skin, or the skin indented by the protrusions with their shadows, under the
         design's lights, markers moved with the skin, the camera's gain, vignetting and seeded
         noise. frame: the frame's own noise (the CLI: reference 0, configuration i -> i + 1).
-        Raises GroundTruthError naming the path of a bad optics value."""
+        photometric: the sensor's own appearance from its fitted model instead (``fabkit
+        groundtruth --images --photometric``), noise-free, at the model's bit depth.
+        Raises GroundTruthError naming the path of a bad optics value, or for a model of
+        another camera size."""
 
 def _library_build_seconds(
     design: Design, repeats: int, *, chord_tolerance_mm: float = 0.01

@@ -29,7 +29,8 @@ use fabkit_calibration::groundtruth::budget::{
 const DEFAULT_MAX_PIXELS: u64 = MAX_PIXELS_LIMIT;
 
 /// The protrusions of one semi-dome (or semi-plate) configuration of a fixtures folder: a
-/// pattern at orientation 0 deg (on the +x half) or 180 deg (on the -x half).
+/// pattern at orientation 0 deg (on the +x half) or 180 deg (on the -x half); or the pins of
+/// one capture of a pin dome ([`read_pin_captures`]).
 #[pyclass(module = "fabkit", frozen)]
 pub struct ProtrusionSet {
     cfg: Arc<Configuration>,
@@ -49,6 +50,11 @@ impl ProtrusionSet {
     #[getter]
     fn orientation_deg(&self) -> u32 {
         self.cfg.orientation_deg
+    }
+    /// The ids of a pin capture's pins, in the capture plan's order; empty for a pattern.
+    #[getter]
+    fn pins(&self) -> Vec<String> {
+        self.cfg.pins.clone()
     }
     /// Number of primitives (spheres, cylinders, ridges) in the set.
     fn __len__(&self) -> usize {
@@ -80,6 +86,100 @@ pub fn read_protrusions(
         .collect())
 }
 
+/// The captures of the pin dome of a `fabkit fixtures` output folder built from `design`
+/// (points/capture_plan.csv, points/point_table.csv, the pin's shape in manifest.json): one
+/// set per capture, its planned pins pressed in, named by its pins (`01_02_06_14_22`) as
+/// `fabkit groundtruth --pin-captures` names its folders. Raises GroundTruthError naming the
+/// file, the line and the rule.
+#[pyfunction]
+pub fn read_pin_captures(
+    py: Python<'_>,
+    fixtures_dir: std::path::PathBuf,
+    design: &Design,
+) -> PyResult<Vec<ProtrusionSet>> {
+    let f = crate::work(py, || {
+        fabkit_calibration::groundtruth::pins::read_pin_captures(&fixtures_dir, &design.design.name)
+    })?
+    .map_err(|e| err::<GroundTruthError>(&e))?;
+    Ok(f.configurations
+        .into_iter()
+        .map(|c| ProtrusionSet { cfg: Arc::new(c) })
+        .collect())
+}
+
+/// A sensor's photometric model as `fabkit calibrate photometric` wrote it
+/// ([`read_photometric`]): images in the sensor's own appearance from `DepthRenderer.image(...,
+/// photometric=model)`.
+#[pyclass(module = "fabkit", frozen)]
+pub struct PhotometricModel {
+    model: Arc<fabkit_calibration::photometric::PhotometricModel>,
+    source: String,
+}
+
+#[pymethods]
+impl PhotometricModel {
+    /// The camera image's width, px.
+    #[getter]
+    fn width(&self) -> usize {
+        self.model.width
+    }
+    /// The camera image's height, px.
+    #[getter]
+    fn height(&self) -> usize {
+        self.model.height
+    }
+    /// 8 or 16: the bit depth of the captures it was fitted to, and of its images.
+    #[getter]
+    fn bit_depth(&self) -> u32 {
+        if self.model.full_scale > 255.0 {
+            16
+        } else {
+            8
+        }
+    }
+    fn __repr__(&self) -> String {
+        format!(
+            "PhotometricModel({:?}, {} x {} px)",
+            self.source, self.model.width, self.model.height
+        )
+    }
+}
+
+/// The photometric model in `dir`, the output folder of `fabkit calibrate photometric`
+/// (photometric.json and appearance.npy). Raises GroundTruthError naming the file and what
+/// does not fit: not JSON, another basis than this fabkit's, an appearance that is not
+/// (H, W, 3) float32.
+#[pyfunction]
+pub fn read_photometric(py: Python<'_>, dir: std::path::PathBuf) -> PyResult<PhotometricModel> {
+    let model = crate::work(py, || -> Result<_, String> {
+        let jpath = dir.join("photometric.json");
+        let bytes = std::fs::read(&jpath).map_err(|e| format!("{}: {e}", jpath.display()))?;
+        let v: serde_json::Value = serde_json::from_slice(&bytes)
+            .map_err(|e| format!("{}: not JSON: {e}", jpath.display()))?;
+        let apath = dir.join("appearance.npy");
+        let abytes = std::fs::read(&apath).map_err(|e| format!("{}: {e}", apath.display()))?;
+        let (shape, data) = fabkit_export::raster::read_npy_f32(&abytes)
+            .map_err(|e| format!("{}: {e}", apath.display()))?;
+        let [h, w, 3] = shape[..] else {
+            return Err(format!(
+                "{}: shape {shape:?}, not (H, W, 3)",
+                apath.display()
+            ));
+        };
+        let appearance = data
+            .chunks_exact(3)
+            .map(|c| [f64::from(c[0]), f64::from(c[1]), f64::from(c[2])])
+            .collect();
+        fabkit_calibration::photometric::PhotometricModel::from_json(&v["model"], appearance, w, h)
+            .map_err(|e| format!("{}: {e}", jpath.display()))
+    })?
+    .map_err(GroundTruthError::new_err)?;
+    Ok(PhotometricModel {
+        model: Arc::new(model),
+        source: dir.display().to_string(),
+    })
+}
+
 /// Renders ground-truth depth of a design's skin seen through a calibrated camera.
 ///
 /// `DepthRenderer(design, camera, T_cam_sensor)`: `camera` a Camera or a camera file path,
@@ -98,6 +198,28 @@ pub struct DepthRenderer {
     /// The imaging of `image`, set up on its first call (the optics resolved, the exposure set
     /// on the reference).
     imaging: std::sync::OnceLock<Result<Imaging, String>>,
+}
+
+/// An (H, W, 3) RGB image as a numpy array: uint16 at 16 bits, else uint8.
+fn rgb_array(
+    py: Python<'_>,
+    img: Vec<[u16; 3]>,
+    h: usize,
+    w: usize,
+    bits: u32,
+) -> Bound<'_, PyAny> {
+    let flat = img.into_iter().flatten();
+    if bits == 16 {
+        Array3::from_shape_vec((h, w, 3), flat.collect::<Vec<u16>>())
+            .expect("h x w x 3")
+            .into_pyarray(py)
+            .into_any()
+    } else {
+        Array3::from_shape_vec((h, w, 3), flat.map(|c| c as u8).collect::<Vec<u8>>())
+            .expect("h x w x 3")
+            .into_pyarray(py)
+            .into_any()
+    }
 }
 
 fn f32_map(v: &[f64], h: usize, w: usize) -> Array2<f32> {
@@ -289,13 +411,18 @@ impl DepthRenderer {
     /// reference 0 and configuration i of the fixtures folder i + 1. The exposure, when
     /// `optics.camera.gain` is not given, is set once on the reference and held. Raises
     /// GroundTruthError naming the parameter path of bad optics, or when the camera centre is
-    /// inside a protrusion.
-    #[pyo3(signature = (protrusions=None, *, frame=0))]
+    /// inside a protrusion. With `photometric` (a PhotometricModel, [`read_photometric`]) the
+    /// image is the sensor's own appearance from the fitted model instead, as `fabkit
+    /// groundtruth --images --photometric DIR` writes it: its mean image, no noise (`frame` is
+    /// not used), at the bit depth of the captures it was fitted to; a model of another camera
+    /// size raises GroundTruthError.
+    #[pyo3(signature = (protrusions=None, *, frame=0, photometric=None))]
     fn image<'py>(
         &self,
         py: Python<'py>,
         protrusions: Option<&ProtrusionSet>,
         frame: u64,
+        photometric: Option<&PhotometricModel>,
     ) -> PyResult<Bound<'py, PyAny>> {
         if let Some(p) = protrusions {
             self.scene
@@ -303,6 +430,29 @@ impl DepthRenderer {
                 .map_err(GroundTruthError::new_err)?;
         }
         let rays = &self.scene.rays;
+        if let Some(m) = photometric {
+            let m = &m.model;
+            if (m.width, m.height) != (rays.width, rays.height) {
+                return Err(GroundTruthError::new_err(format!(
+                    "photometric: the model is of a {} x {} px camera, this renderer's is {} x {} px (the model was fitted to another camera)",
+                    m.width, m.height, rays.width, rays.height
+                )));
+            }
+            let img = crate::work(py, || match protrusions {
+                None => m.image(rays, &self.reference_hits, &self.reference_hits, None),
+                Some(p) => {
+                    let hits = indented_hits(
+                        rays,
+                        &self.reference_hits,
+                        &p.cfg.primitives,
+                        self.scene.surface.base_z_mm(),
+                    );
+                    m.image(rays, &self.reference_hits, &hits, Some(&p.cfg.primitives))
+                }
+            })?;
+            let bits = if m.full_scale > 255.0 { 16 } else { 8 };
+            return Ok(rgb_array(py, img, rays.height, rays.width, bits));
+        }
         let img = crate::work(py, || -> Result<Vec<[u16; 3]>, String> {
             let imaging = self
                 .imaging
@@ -341,18 +491,7 @@ impl DepthRenderer {
             Some(Ok(im)) => im.optics.camera.bit_depth,
             _ => 8,
         };
-        let flat = img.into_iter().flatten();
-        Ok(if bits == 16 {
-            Array3::from_shape_vec((h, w, 3), flat.collect::<Vec<u16>>())
-                .expect("h x w x 3")
-                .into_pyarray(py)
-                .into_any()
-        } else {
-            Array3::from_shape_vec((h, w, 3), flat.map(|c| c as u8).collect::<Vec<u8>>())
-                .expect("h x w x 3")
-                .into_pyarray(py)
-                .into_any()
-        })
+        Ok(rgb_array(py, img, h, w, bits))
     }
 
     /// The half masks (left, right), (H, W) bool: pixels whose ray meets the reference
@@ -372,5 +511,8 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<ProtrusionSet>()?;
     m.add_class::<DepthRenderer>()?;
     m.add_function(wrap_pyfunction!(read_protrusions, m)?)?;
+    m.add_class::<PhotometricModel>()?;
+    m.add_function(wrap_pyfunction!(read_pin_captures, m)?)?;
+    m.add_function(wrap_pyfunction!(read_photometric, m)?)?;
     Ok(())
 }

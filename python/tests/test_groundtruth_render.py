@@ -166,6 +166,53 @@ def test_images_equal_the_cli_pngs(scene, run_cli):
     np.testing.assert_array_equal(r.image(frame=0), ref)
 
 
+def test_pin_captures_and_photometric_images_equal_the_cli(scene, run_cli):
+    """read_pin_captures gives the frames `fabkit groundtruth --pin-captures` writes (named by
+    their pins, the same images); a photometric model fitted on those captures by `fabkit
+    calibrate photometric` and read with read_photometric renders, through
+    DepthRenderer.image(..., photometric=model), the pixels `--images --photometric` writes."""
+    d, r, design = scene["dir"], scene["renderer"], scene["design"]
+    run_cli(d, "groundtruth", "rtac0", "--camera", "cam.yaml", "--extrinsics",
+            "extrinsics.json", "--fixtures", "fx", "--pin-captures", "--out", "gt_pins",
+            "--format", "png", "--images")
+    pins = fabkit.read_pin_captures(d / "fx", design)
+    plan = (d / "fx/points/capture_plan.csv").read_text().splitlines()[1:]
+    assert len(pins) == len({row.split(",")[0] for row in plan})
+    (d / "caps").mkdir()
+    names = []
+    for k, s in enumerate(pins):
+        assert s.pins and s.name == "_".join("%02d" % int(i) for i in s.pins)
+        img = r.image(s, frame=k + 1)
+        cli = _read_png(str(d / "gt_pins" / s.name / "image.png"))
+        np.testing.assert_array_equal(img, cli, err_msg=s.name)
+        (d / "caps" / (s.name + ".png")).write_bytes((d / "gt_pins" / s.name / "image.png").read_bytes())
+        names.append("caps/%s.png" % s.name)
+    (d / "caps/ref.png").write_bytes((d / "gt_pins/reference/image.png").read_bytes())
+    run_cli(d, "calibrate", "photometric", "rtac0", "--camera", "cam.yaml", "--extrinsics",
+            "extrinsics.json", "--fixtures", "fx", "--reference", "caps/ref.png", "--out", "ph",
+            "--images", *names)
+    model = fabkit.read_photometric(d / "ph")
+    assert (model.width, model.height, model.bit_depth) == (W, H, 8)
+    run_cli(d, "groundtruth", "rtac0", "--camera", "cam.yaml", "--extrinsics",
+            "extrinsics.json", "--fixtures", "fx", "--out", "gt_ph", "--format", "png",
+            "--images", "--photometric", "ph")
+    ref = r.image(photometric=model)
+    np.testing.assert_array_equal(ref, _read_png(str(d / "gt_ph/reference/image.png")))
+    for s in scene["sets"]:
+        img = r.image(s, photometric=model)
+        np.testing.assert_array_equal(img, _read_png(str(d / "gt_ph" / s.name / "image.png")),
+                                      err_msg=s.name)
+        assert not np.array_equal(img, ref)
+    # a model of another camera size is refused
+    other = fabkit.DepthRenderer(design, str(d / "cam.yaml"), scene["T"], max_pixels=W * H)
+    (d / "ph2").mkdir()
+    (d / "ph2/photometric.json").write_bytes((d / "ph/photometric.json").read_bytes())
+    np.save(d / "ph2/appearance.npy", np.zeros((4, 4, 3), np.float32))
+    small = fabkit.read_photometric(d / "ph2")
+    with pytest.raises(fabkit.GroundTruthError, match="4 x 4 px camera"):
+        other.image(photometric=small)
+
+
 def test_bad_optics_name_their_path(scene):
     import pathlib
     text = (pathlib.Path(__file__).parents[2] / "designs/library/rtac0.yaml").read_text()

@@ -46,6 +46,10 @@ def test_guide_example_runs(tmp_path, run_cli, monkeypatch):
         "out/rtac0_fixtures", scope["design"])}]
     assert len(frames) == 4
     assert all(float(l.split()[1]) < 0 and int(l.split()[2]) > 0 for l in frames)
+    # the pin dome's captures, named by their pins; the first rendered as a capture
+    captures = scope["captures"]
+    assert captures and all(c.name == "_".join("%02d" % int(i) for i in c.pins) for c in captures)
+    assert scope["capture_image"].shape == scope["image"].shape
     # the loop visited the 2 x 2 stitched pairs, each with a finite depth and a push somewhere
     assert len(scope["gt"]) == 4
     assert scope["pair"].index == 3

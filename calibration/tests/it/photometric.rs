@@ -448,3 +448,52 @@ fn side_leds_at_three_azimuths_re_render_within_5_and_7_grey_levels() {
     let (rms, _) = leave_one_out(&captures(lights, rtac0_pins), |_| true);
     assert!(rms < 7.0, "R-Tac0's pins: {rms} grey levels RMS");
 }
+
+/// photometric.json's model section round-trips: read back with the fitted appearance, the
+/// model renders every capture to the same values; a file of another basis or a short
+/// coefficient list is refused naming its key.
+#[test]
+fn the_model_json_reads_back_to_the_same_images() {
+    let c = captures(warm_ring(), rtac0_pins);
+    let all: Vec<Capture> = c
+        .scenes
+        .iter()
+        .map(|s| Capture {
+            image: &s.2,
+            hits: &s.1,
+            shadows: &s.3,
+        })
+        .collect();
+    let m = PhotometricModel::fit(&c.rays, &c.reference, &c.reference_image, &all, 255.0).unwrap();
+    // through text, as the file is written and read
+    let text = serde_json::to_string(&m.model_json()).unwrap();
+    let json: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let back = PhotometricModel::from_json(&json, m.reference.clone(), m.width, m.height).unwrap();
+    for s in &c.scenes {
+        let a = m.render(&c.rays, &c.reference, &s.1, &s.3, 1.0);
+        let b = back.render(&c.rays, &c.reference, &s.1, &s.3, 1.0);
+        for (x, y) in a.iter().zip(&b) {
+            for ch in 0..3 {
+                assert!(x[ch] == y[ch] || (x[ch].is_nan() && y[ch].is_nan()));
+            }
+        }
+    }
+    let mut other = json.clone();
+    other["light_terms"] = serde_json::json!(12);
+    let e =
+        PhotometricModel::from_json(&other, m.reference.clone(), m.width, m.height).unwrap_err();
+    assert!(
+        e.contains("model.light_terms = 12") && e.contains("fit it again"),
+        "{e}"
+    );
+    let mut short = json.clone();
+    short["coefficients_rgb"][1] = serde_json::json!([1.0, 2.0]);
+    let e =
+        PhotometricModel::from_json(&short, m.reference.clone(), m.width, m.height).unwrap_err();
+    assert!(
+        e.contains("model.coefficients_rgb must be 3 lists of"),
+        "{e}"
+    );
+    let e = PhotometricModel::from_json(&json, vec![[0.0; 3]; 4], m.width, m.height).unwrap_err();
+    assert!(e.contains("the appearance has 4 pixels"), "{e}");
+}
