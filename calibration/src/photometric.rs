@@ -200,6 +200,7 @@ impl ShadowRings {
         })
     }
 
+    /// Two unit vectors square to the axis and to each other: the rings' azimuth 0 and 90 deg.
     fn frame(&self) -> ([f64; 3], [f64; 3]) {
         let a = self.axis;
         let helper = if a[0].abs() < 0.9 {
@@ -216,15 +217,7 @@ impl ShadowRings {
     /// The sampled lights of ring `m` (height major, radius minor), sensor frame, mm.
     fn lights(&self, m: usize) -> [[f64; 3]; SHADOW_AZIMUTHS] {
         let a = self.axis;
-        let helper = if a[0].abs() < 0.9 {
-            [1.0, 0.0, 0.0]
-        } else {
-            [0.0, 1.0, 0.0]
-        };
-        let e1 = cross(a, helper);
-        let l1 = dot(e1, e1).sqrt();
-        let e1 = e1.map(|x| x / l1);
-        let e2 = cross(a, e1);
+        let (e1, e2) = self.frame();
         let h = SHADOW_HEIGHTS[m / SHADOW_RADII.len()] * self.scale_mm;
         let r = SHADOW_RADII[m % SHADOW_RADII.len()] * self.scale_mm;
         std::array::from_fn(|j| {

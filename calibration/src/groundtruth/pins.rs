@@ -108,45 +108,20 @@ struct ManifestPart {
 /// column, a number that does not parse or is not finite, an axis that is not a unit vector
 /// (to 1e-6), a repeated id, no pin part, a pin size that is missing or not above 0.
 pub fn read_pins(dir: &std::path::Path) -> Result<Pins, InputError> {
-    use crate::groundtruth::inputs::{json, read_with_hash};
-    let table = dir.join("points").join("point_table.csv");
-    let (bytes, _) = read_with_hash(&table)?;
-    let file = table.display().to_string();
-    let field = |field: String, value: String, rule: &str| InputError::Field {
-        file: file.clone(),
-        field,
-        value,
-        rule: rule.to_string(),
-    };
-    let text = String::from_utf8_lossy(&bytes);
-    let mut lines = text.lines().enumerate();
-    let header: Vec<&str> = lines
-        .next()
-        .map(|(_, l)| l.split(',').map(str::trim).collect())
-        .unwrap_or_default();
-    let col = |name: &str| {
-        header.iter().position(|h| *h == name).ok_or_else(|| {
-            field(
-                "header".into(),
-                header.join(","),
-                &format!("has no column {name}"),
-            )
-        })
-    };
-    let id_col = col("id")?;
+    let (table, _) = CsvTable::read(&dir.join("points").join("point_table.csv"))?;
+    let field = |f: String, value: String, rule: &str| table.error(f, value, rule);
+    let header = &table.header;
+    let id_col = table.col("id")?;
     let cols: Vec<usize> = [
         "tip_x_mm", "tip_y_mm", "tip_z_mm", "axis_x", "axis_y", "axis_z",
     ]
     .iter()
-    .map(|c| col(c))
+    .map(|c| table.col(c))
     .collect::<Result<_, _>>()?;
     let mut rows: Vec<(String, [f64; 3], [f64; 3])> = Vec::new();
-    for (k, line) in lines {
-        if line.trim().is_empty() {
-            continue;
-        }
-        let cells: Vec<&str> = line.split(',').map(str::trim).collect();
-        let at = |c: usize| cells.get(c).copied().unwrap_or("");
+    for (k, cells) in &table.rows {
+        let k = *k;
+        let at = |c: usize| cells.get(c).map_or("", String::as_str);
         let id = at(id_col).to_string();
         let mut v = [0.0; 6];
         for (j, &c) in cols.iter().enumerate() {
@@ -204,6 +179,53 @@ pub fn read_pins(dir: &std::path::Path) -> Result<Pins, InputError> {
     })
 }
 
+/// A CSV file of `fabkit fixtures`' points/ folder: its header and its rows, cells trimmed,
+/// blank lines left out, a leading byte-order mark ignored.
+struct CsvTable {
+    file: String,
+    header: Vec<String>,
+    /// (0-based line index, cells)
+    rows: Vec<(usize, Vec<String>)>,
+}
+
+impl CsvTable {
+    /// The table in `path` and the file's sha256.
+    fn read(path: &Path) -> Result<(CsvTable, String), InputError> {
+        let (bytes, sha) = read_with_hash(path)?;
+        let text = String::from_utf8_lossy(&bytes);
+        let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
+        let cells = |l: &str| l.split(',').map(|c| c.trim().to_string()).collect();
+        let mut lines = text.lines().enumerate();
+        let header = lines.next().map(|(_, l)| cells(l)).unwrap_or_default();
+        let rows = lines
+            .filter(|(_, l)| !l.trim().is_empty())
+            .map(|(k, l)| (k, cells(l)))
+            .collect();
+        let file = path.display().to_string();
+        Ok((CsvTable { file, header, rows }, sha))
+    }
+
+    /// The index of column `name`, or the error naming the header.
+    fn col(&self, name: &str) -> Result<usize, InputError> {
+        self.header.iter().position(|h| h == name).ok_or_else(|| {
+            self.error(
+                "header".into(),
+                self.header.join(","),
+                &format!("has no column {name}"),
+            )
+        })
+    }
+
+    fn error(&self, field: String, value: String, rule: &str) -> InputError {
+        InputError::Field {
+            file: self.file.clone(),
+            field,
+            value,
+            rule: rule.to_string(),
+        }
+    }
+}
+
 /// The name of a pin capture: its pins' ids in the given order joined by `_`, numeric ids
 /// with two digits (`01_02_06_14_22`), the file names `fabkit calibrate images` and
 /// `fabkit calibrate photometric` read a capture's pins from (the R-Tac0 authors' convention).
@@ -248,39 +270,14 @@ pub fn read_pin_captures(dir: &Path, design_name: &str) -> Result<Fixtures, Inpu
             }
         }
     }
-    let plan = dir.join("points").join("capture_plan.csv");
-    let (bytes, sha) = read_with_hash(&plan)?;
-    let file = plan.display().to_string();
-    let field = |field: String, value: String, rule: &str| InputError::Field {
-        file: file.clone(),
-        field,
-        value,
-        rule: rule.to_string(),
-    };
-    let text = String::from_utf8_lossy(&bytes);
-    let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
-    let mut lines = text.lines().enumerate();
-    let header: Vec<&str> = lines
-        .next()
-        .map(|(_, l)| l.split(',').map(str::trim).collect())
-        .unwrap_or_default();
-    let col = |name: &str| {
-        header.iter().position(|h| *h == name).ok_or_else(|| {
-            field(
-                "header".into(),
-                header.join(","),
-                &format!("has no column {name}"),
-            )
-        })
-    };
-    let (capture_col, id_col) = (col("capture")?, col("id")?);
+    let (table, sha) = CsvTable::read(&dir.join("points").join("capture_plan.csv"))?;
+    let file = table.file.clone();
+    let field = |f: String, value: String, rule: &str| table.error(f, value, rule);
+    let (capture_col, id_col) = (table.col("capture")?, table.col("id")?);
     let mut captures: Vec<(String, Vec<String>)> = Vec::new();
-    for (k, line) in lines {
-        if line.trim().is_empty() {
-            continue;
-        }
-        let cells: Vec<&str> = line.split(',').map(str::trim).collect();
-        let at = |c: usize| cells.get(c).copied().unwrap_or("").to_string();
+    for (k, cells) in &table.rows {
+        let k = *k;
+        let at = |c: usize| cells.get(c).cloned().unwrap_or_default();
         let (capture, id) = (at(capture_col), at(id_col));
         if capture.parse::<u32>().is_err() {
             return Err(field(

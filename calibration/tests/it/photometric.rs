@@ -70,8 +70,11 @@ struct Captures {
     rays: PixelRays,
     reference: SurfaceHits,
     reference_image: Vec<[f64; 3]>,
-    scenes: Vec<(Vec<Pin>, SurfaceHits, Vec<[f64; 3]>, ShadowMap)>,
+    scenes: Vec<PressedCapture>,
 }
+
+/// One capture: where its imprints are, its surface, its image (counts) and its shadows.
+type PressedCapture = (Vec<Pin>, SurfaceHits, Vec<[f64; 3]>, ShadowMap);
 
 /// The balls of [`ring_pins`] turned by `turn_deg`, pressed 1 mm: where each imprint is and
 /// its solids.
