@@ -52,8 +52,9 @@ impl From<CameraModelArg> for DistortionModelHint {
     }
 }
 
+/// The camera options of every command that reads a camera file.
 #[derive(clap::Args, Debug)]
-pub struct ExtrinsicsArgs {
+pub struct CameraArgs {
     /// Camera file: OpenCV FileStorage YAML or XML, ROS camera_info YAML or fabkit JSON.
     #[arg(long, value_name = "CAM")]
     pub camera: PathBuf,
@@ -61,6 +62,21 @@ pub struct ExtrinsicsArgs {
     /// cv2.fisheye.calibrate)
     #[arg(long, value_enum, value_name = "MODEL")]
     pub camera_model: Option<CameraModelArg>,
+}
+
+impl CameraArgs {
+    /// The camera of `--camera` (with `--camera-model` for a file that names none).
+    pub fn read(
+        &self,
+    ) -> Result<fabkit_calibration::CameraModel, fabkit_calibration::CameraFileError> {
+        fabkit_calibration::read_camera_file_as(&self.camera, self.camera_model.map(Into::into))
+    }
+}
+
+#[derive(clap::Args, Debug)]
+pub struct ExtrinsicsArgs {
+    #[command(flatten)]
+    pub cam: CameraArgs,
     /// Point table: the one `fabkit fixtures` writes, or a CSV with id,x_mm,y_mm,z_mm (sensor frame, mm).
     #[arg(long, value_name = "POINTS.csv")]
     pub points: PathBuf,
@@ -136,7 +152,7 @@ fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
     }
     // The job of the output: its inputs (what it was computed from), not the solver's options.
     let captures = a.images.len().max(a.observations.len());
-    let inputs: Vec<&std::path::Path> = [&a.camera, &a.points]
+    let inputs: Vec<&std::path::Path> = [&a.cam.camera, &a.points]
         .into_iter()
         .chain(&a.observations)
         .chain(&a.images)
@@ -158,8 +174,8 @@ fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
         a.force,
     );
     let job = ExtrinsicsJob {
-        camera: a.camera,
-        camera_model: a.camera_model.map(Into::into),
+        camera: a.cam.camera,
+        camera_model: a.cam.camera_model.map(Into::into),
         points: a.points,
         points_from: match a.points_from {
             PointsFromArg::Tip => PointsFrom::Tip,

@@ -21,7 +21,6 @@ use fabkit_calibration::groundtruth::{
     half_masks, indented_hits, reference_hits, DepthFrame, Scene, SurfaceHits,
 };
 use fabkit_calibration::photometric::PhotometricModel;
-use fabkit_calibration::read_camera_file_as;
 use fabkit_export::raster::{
     normals_rgb, npy_f32, npz as npz_file, ply_points, png_gray16, png_gray8, png_rgb16, png_rgb8,
     preview_rgb, PlyPoint, Png16Encoding,
@@ -37,13 +36,8 @@ pub struct GroundTruthArgs {
     /// A design YAML file or the name of a library design (default: rtac0); the fixtures must
     /// have been built from it.
     design: Option<String>,
-    /// Camera file (OpenCV FileStorage YAML or XML, ROS camera_info YAML or fabkit JSON).
-    #[arg(long, value_name = "CAM")]
-    camera: PathBuf,
-    /// Distortion model of a camera file that does not name one (e.g. the 4 coefficients of
-    /// cv2.fisheye.calibrate)
-    #[arg(long, value_enum, value_name = "MODEL")]
-    camera_model: Option<crate::calibrate_cmd::CameraModelArg>,
+    #[command(flatten)]
+    cam: crate::calibrate_cmd::CameraArgs,
     /// extrinsics.json of `fabkit calibrate extrinsics` (T_cam_sensor).
     #[arg(long, value_name = "extrinsics.json")]
     extrinsics: PathBuf,
@@ -652,7 +646,7 @@ fn claim(args: &GroundTruthArgs) -> OutputClaim {
     } else {
         vec![args.fixtures.join("protrusions").join("index.json")]
     };
-    let mut inputs: Vec<&Path> = vec![&args.camera, &args.extrinsics, &fixtures_marker];
+    let mut inputs: Vec<&Path> = vec![&args.cam.camera, &args.extrinsics, &fixtures_marker];
     inputs.extend(fixture_files.iter().map(PathBuf::as_path));
     if design_file.is_file() {
         inputs.push(design_file);
@@ -675,7 +669,7 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
         loaded.apply_preset(p)?;
     }
     let design = &loaded.design;
-    let camera = read_camera_file_as(&args.camera, args.camera_model.map(Into::into))?;
+    let camera = args.cam.read()?;
     let (cw, ch) = (
         camera.intrinsics().image_width_px,
         camera.intrinsics().image_height_px,
@@ -698,13 +692,13 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
              {} pixels (image_width x image_height against --max-pixels; the render would need \
              about {} of memory, every per-pixel array of a frame being sized by it; {remedy}; \
              hint: calibrate the camera at a lower resolution or crop its image)",
-            args.camera.display(),
+            args.cam.camera.display(),
             args.max_pixels,
             shown_bytes(render_memory(pixels, 1)),
         )
         .into());
     }
-    let (camera_bytes, camera_sha) = read_with_hash(&args.camera)?;
+    let (camera_bytes, camera_sha) = read_with_hash(&args.cam.camera)?;
     let (t_cam_sensor, extrinsics_sha) = read_extrinsics(&args.extrinsics)?;
     let fixtures = if args.pin_captures {
         read_pin_captures(&args.fixtures, &design.name)?
@@ -805,7 +799,7 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
     check_skin_seen(
         ref_hits.valid_count(),
         &camera,
-        &args.camera.display().to_string(),
+        &args.cam.camera.display().to_string(),
         &String::from_utf8_lossy(&camera_bytes),
         &pose_name,
     )?;
@@ -1006,7 +1000,7 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
             format!("Ground-truth depth of the sensor surface, reference (undeformed) and indented by each protrusion {} configuration (R-Tac0 Sec. IV-B, Fig. 6, Eq. (2)-(3)): complete depth = reference + delta. Exact per-pixel rays of the camera model; surfaces in closed form.", fixture_kind)
         },
         "design": {"name": design.name, "source": loaded.source, "sha256": loaded.sha256},
-        "camera": {"file": args.camera.display().to_string(), "sha256": camera_sha, "distortion_model": i.distortion.name(),
+        "camera": {"file": args.cam.camera.display().to_string(), "sha256": camera_sha, "distortion_model": i.distortion.name(),
                    "fx_px": i.fx_px, "fy_px": i.fy_px, "cx_px": i.cx_px, "cy_px": i.cy_px, "distortion_coefficients": i.distortion.coefficients(),
                    "image_width_px": w, "image_height_px": h},
         "extrinsics": {"file": args.extrinsics.display().to_string(), "sha256": extrinsics_sha,

@@ -13,7 +13,6 @@ use fabkit_calibration::imprints::ids_from_file_name;
 use fabkit_calibration::photometric::{
     read_pins, rms_over_skin, shadow_map, Capture, PhotometricModel, ShadowMap, ShadowRings,
 };
-use fabkit_calibration::read_camera_file_as;
 use fabkit_export::raster::{npy_f32, png_rgb16, png_rgb8};
 use fabkit_export::{OutputClaim, OutputCommand, StagedDir};
 use serde_json::{json, Value};
@@ -25,12 +24,8 @@ pub struct PhotometricArgs {
     /// A design YAML file or the name of a library design (default: rtac0): its skin is the
     /// surface the pins press.
     design: Option<String>,
-    /// Camera file (OpenCV FileStorage YAML or XML, ROS camera_info YAML or fabkit JSON).
-    #[arg(long, value_name = "CAM")]
-    camera: PathBuf,
-    /// Distortion model of a camera file that does not name one.
-    #[arg(long, value_enum, value_name = "MODEL")]
-    camera_model: Option<crate::calibrate_cmd::CameraModelArg>,
+    #[command(flatten)]
+    cam: crate::calibrate_cmd::CameraArgs,
     /// extrinsics.json of `fabkit calibrate extrinsics` (T_cam_sensor) for these captures.
     #[arg(long, value_name = "extrinsics.json")]
     extrinsics: PathBuf,
@@ -74,7 +69,7 @@ pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
     let point_table = a.fixtures.join("points").join("point_table.csv");
     let fixtures_manifest = a.fixtures.join("manifest.json");
     let mut inputs: Vec<&Path> = vec![
-        &a.camera,
+        &a.cam.camera,
         &a.extrinsics,
         &point_table,
         &fixtures_manifest,
@@ -94,10 +89,10 @@ pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
     fabkit_export::check_out_dir(&a.out, &claim)?;
     let loaded = load_design(a.design.as_deref(), &a.data_files)?;
     let design = &loaded.design;
-    let camera = read_camera_file_as(&a.camera, a.camera_model.map(Into::into))?;
+    let camera = a.cam.read()?;
     let i = camera.intrinsics();
     let size = (i.image_width_px, i.image_height_px);
-    let camera_name = a.camera.display().to_string();
+    let camera_name = a.cam.camera.display().to_string();
     let (t_cam_sensor, extrinsics_sha) = read_extrinsics(&a.extrinsics)?;
     let pins = read_pins(&a.fixtures)?;
     let pose_name = a.extrinsics.display().to_string();
