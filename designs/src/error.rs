@@ -2,6 +2,22 @@
 
 use crate::geometry::GeometryError;
 
+/// An error's message, then each cause the lines above do not already state on its own
+/// `  caused by: ` line (an I/O error that the message quotes is said once): the text the CLI
+/// prints after `error: ` and the Python exceptions carry.
+pub fn error_report(e: &(dyn std::error::Error + 'static)) -> String {
+    let mut out = e.to_string();
+    let mut src = e.source();
+    while let Some(s) = src {
+        let text = s.to_string();
+        if !out.contains(&text) {
+            out.push_str(&format!("\n  caused by: {text}"));
+        }
+        src = s.source();
+    }
+    out
+}
+
 /// One violated rule of a design parameter: `path = value: rule`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ParamError {

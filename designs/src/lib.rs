@@ -44,7 +44,7 @@ pub mod yaml;
 pub use parts::{flat, lasercut, layers, molds};
 
 pub use build::{build_kit, build_kit_bounded, validate_design};
-pub use error::{DesignError, ParamError, ParamErrors};
+pub use error::{error_report, DesignError, ParamError, ParamErrors};
 pub use geometry::{ChordTolerance, Mesh, Solid};
 pub use kit::{Kit, Part, PrintTechnology};
 pub use schema::Design;

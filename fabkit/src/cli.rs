@@ -209,18 +209,9 @@ fn rounded(v: &serde_json::Value) -> serde_json::Value {
 }
 
 /// `error: <e>` and each cause on its own `  caused by:` line, except a cause whose text the
-/// lines above already state (an I/O error that the message quotes is said once).
+/// lines above already state ([`fabkit_designs::error_report`]).
 pub fn error_report(e: &(dyn std::error::Error + 'static)) -> String {
-    let mut out = format!("error: {e}\n");
-    let mut src = e.source();
-    while let Some(s) = src {
-        let text = s.to_string();
-        if !out.contains(&text) {
-            out.push_str(&format!("  caused by: {text}\n"));
-        }
-        src = s.source();
-    }
-    out
+    format!("error: {}\n", fabkit_designs::error_report(e))
 }
 
 /// A design and where it came from.

@@ -74,19 +74,9 @@ impl ParamError {
     }
 }
 
-/// The CLI's error text without its `error: ` prefix: the message, then each cause the message
-/// does not already state on its own `  caused by:` line.
+/// The CLI's error text without its `error: ` prefix ([`fabkit_designs::error_report`]).
 pub fn report(e: &(dyn std::error::Error + 'static)) -> String {
-    let mut out = e.to_string();
-    let mut src = e.source();
-    while let Some(s) = src {
-        let text = s.to_string();
-        if !out.contains(&text) {
-            out.push_str(&format!("\n  caused by: {text}"));
-        }
-        src = s.source();
-    }
-    out
+    fabkit_designs::error_report(e)
 }
 
 /// A `DesignError` with its parameter errors (empty for other kinds) in `errors`.

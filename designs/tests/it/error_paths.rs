@@ -306,3 +306,32 @@ fn kernel_errors_name_the_parameters_of_the_failing_solid() {
         }
     }
 }
+
+/// The error text of the CLI and of Python: a cause the message already quotes is said once,
+/// another gets its own `caused by:` line.
+#[test]
+fn error_report_states_each_cause_once() {
+    #[derive(Debug)]
+    struct Wrap(&'static str, std::io::Error);
+    impl std::fmt::Display for Wrap {
+        fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+            f.write_str(self.0)
+        }
+    }
+    impl std::error::Error for Wrap {
+        fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+            Some(&self.1)
+        }
+    }
+    let gone = || std::io::Error::new(std::io::ErrorKind::NotFound, "no such file");
+    let quoted = Wrap("reading a.yaml: no such file", gone());
+    assert_eq!(
+        fabkit_designs::error_report(&quoted),
+        "reading a.yaml: no such file"
+    );
+    let plain = Wrap("reading a.yaml", gone());
+    assert_eq!(
+        fabkit_designs::error_report(&plain),
+        "reading a.yaml\n  caused by: no such file"
+    );
+}
