@@ -310,6 +310,14 @@ class GroundTruth:
                 f"{p}: configurations must be a list and reference an object "
                 "(the manifest of `fabkit groundtruth`)"
             )
+        fixtures = m.get("fixtures")
+        if isinstance(fixtures, dict) and "pin_captures" in fixtures:
+            raise ValueError(
+                f"{p}: the ground truth of a pin dome's captures (`fabkit groundtruth "
+                "--pin-captures`) has no stitched pairs; its frames are the folders its "
+                "configurations list (numpy.load each <capture>/range_mm.npy), or render them "
+                "with fabkit.read_pin_captures and DepthRenderer"
+            )
         return m
 
     def _frame_entry(self, entry: dict) -> dict:

@@ -175,6 +175,9 @@ def test_pin_captures_and_photometric_images_equal_the_cli(scene, run_cli):
     run_cli(d, "groundtruth", "rtac0", "--camera", "cam.yaml", "--extrinsics",
             "extrinsics.json", "--fixtures", "fx", "--pin-captures", "--out", "gt_pins",
             "--format", "png", "--images")
+    # the stitched-pair reader says what such a folder is instead
+    with pytest.raises(ValueError, match="pin dome's captures"):
+        fabkit.GroundTruth(d / "gt_pins")
     pins = fabkit.read_pin_captures(d / "fx", design)
     plan = (d / "fx/points/capture_plan.csv").read_text().splitlines()[1:]
     assert len(pins) == len({row.split(",")[0] for row in plan})
