@@ -2,8 +2,8 @@
 //! fabkit-export (file encoders, atomic output folder), progress.
 
 use fabkit_calibration::groundtruth::budget::{
-    frames_at_once, min_skin_pixels, render_memory, FIXED_BYTES_PER_PIXEL, FRAME_BYTES_PER_PIXEL,
-    MAX_PIXELS_LIMIT, MEMORY_BUDGET_BYTES, MIN_SKIN_FRACTION,
+    frames_at_once, min_skin_pixels, render_memory, DEFAULT_MAX_PIXELS, FIXED_BYTES_PER_PIXEL,
+    FRAME_BYTES_PER_PIXEL, MAX_PIXELS_LIMIT, MEMORY_BUDGET_BYTES, MIN_SKIN_FRACTION,
 };
 use std::error::Error;
 use std::path::{Path, PathBuf};
@@ -124,9 +124,6 @@ fn parse_max_output_bytes(s: &str) -> Result<u64, String> {
         )),
     }
 }
-
-/// Default bound of `--max-pixels`: its largest value.
-const DEFAULT_MAX_PIXELS: u64 = MAX_PIXELS_LIMIT;
 
 fn parse_max_pixels(s: &str) -> Result<u64, String> {
     match s.trim().parse::<u64>() {

@@ -21,12 +21,8 @@ use crate::errors::{err, GroundTruthError};
 use crate::kit::report_progress;
 
 use fabkit_calibration::groundtruth::budget::{
-    min_skin_pixels, MAX_PIXELS_LIMIT, MEMORY_BUDGET_BYTES, MIN_SKIN_FRACTION,
+    min_skin_pixels, DEFAULT_MAX_PIXELS, MAX_PIXELS_LIMIT, MEMORY_BUDGET_BYTES, MIN_SKIN_FRACTION,
 };
-
-/// Largest camera image by default, pixels: the largest the render's memory budget holds,
-/// 2048 x 2048 (`fabkit groundtruth --max-pixels`).
-const DEFAULT_MAX_PIXELS: u64 = MAX_PIXELS_LIMIT;
 
 /// The protrusions of one semi-dome (or semi-plate) configuration of a fixtures folder: a
 /// pattern at orientation 0 deg (on the +x half) or 180 deg (on the -x half); or the pins of

@@ -30,6 +30,10 @@ pub const BASE_MEMORY_BYTES: u64 = 128 << 20;
 /// 2048 x 1536 one fit).
 pub const MAX_PIXELS_LIMIT: u64 = 2048 * 2048;
 
+/// Default bound on the camera image, pixels (`--max-pixels`, `DepthRenderer(max_pixels=)`):
+/// the largest, [`MAX_PIXELS_LIMIT`].
+pub const DEFAULT_MAX_PIXELS: u64 = MAX_PIXELS_LIMIT;
+
 /// Memory a render of `pixels` pixels takes with `frames_at_once` frames rendered at a time,
 /// bytes (an upper bound; see [`FIXED_BYTES_PER_PIXEL`], [`FRAME_BYTES_PER_PIXEL`]).
 pub fn render_memory(pixels: u64, frames_at_once: u64) -> u64 {
