@@ -74,8 +74,19 @@ pub fn read_protrusions(
     fixtures_dir: std::path::PathBuf,
     design: &Design,
 ) -> PyResult<Vec<ProtrusionSet>> {
-    let f = crate::work(py, || read_fixtures(&fixtures_dir, &design.design.name))?
-        .map_err(|e| err::<GroundTruthError>(&e))?;
+    sets_of(py, || read_fixtures(&fixtures_dir, &design.design.name))
+}
+
+/// The configurations `read` gives (off the GIL) as protrusion sets; its error as
+/// GroundTruthError.
+fn sets_of(
+    py: Python<'_>,
+    read: impl FnOnce() -> Result<
+            fabkit_calibration::groundtruth::inputs::Fixtures,
+            fabkit_calibration::groundtruth::inputs::InputError,
+        > + Send,
+) -> PyResult<Vec<ProtrusionSet>> {
+    let f = crate::work(py, read)?.map_err(|e| err::<GroundTruthError>(&e))?;
     Ok(f.configurations
         .into_iter()
         .map(|c| ProtrusionSet { cfg: Arc::new(c) })
@@ -93,14 +104,9 @@ pub fn read_pin_captures(
     fixtures_dir: std::path::PathBuf,
     design: &Design,
 ) -> PyResult<Vec<ProtrusionSet>> {
-    let f = crate::work(py, || {
+    sets_of(py, || {
         fabkit_calibration::groundtruth::pins::read_pin_captures(&fixtures_dir, &design.design.name)
-    })?
-    .map_err(|e| err::<GroundTruthError>(&e))?;
-    Ok(f.configurations
-        .into_iter()
-        .map(|c| ProtrusionSet { cfg: Arc::new(c) })
-        .collect())
+    })
 }
 
 /// A sensor's photometric model as `fabkit calibrate photometric` wrote it
