@@ -1,5 +1,6 @@
-//! `fabkit groundtruth`: argument parsing, dispatch over fabkit-calibration (rendering) and
-//! fabkit-export (file encoders, atomic output folder), progress.
+//! `fabkit groundtruth`: argument parsing, dispatch over fabkit-calibration (rendering; the
+//! dataset's files and bounds in `groundtruth::dataset`) and fabkit-export (the atomic output
+//! folder), progress.
 
 use fabkit_calibration::groundtruth::budget::{
     frames_at_once, min_skin_pixels, render_memory, DEFAULT_MAX_PIXELS, FIXED_BYTES_PER_PIXEL,
@@ -9,22 +10,21 @@ use std::error::Error;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-use fabkit_calibration::groundtruth::exact::ExactPrimitives;
+use fabkit_calibration::groundtruth::dataset::{
+    self, finite_range, frame_files, image_file, output_bound, Files, ImageSource, DELTA_PNG,
+    DEPTH_PNG, IMAGES_NOT_MODELLED,
+};
 use fabkit_calibration::groundtruth::inputs::{
     pairs_csv, read_extrinsics, read_fixtures, read_with_hash, sha256_hex, Configuration,
     PAIRS_NOTES,
 };
 use fabkit_calibration::groundtruth::pins::read_pin_captures;
-use fabkit_calibration::groundtruth::rays::PixelRays;
 use fabkit_calibration::groundtruth::shading::Imaging;
 use fabkit_calibration::groundtruth::{
-    half_masks, indented_hits, reference_hits, DepthFrame, Scene, SurfaceHits,
+    half_masks, indented_hits, reference_hits, DepthFrame, Scene,
 };
 use fabkit_calibration::photometric::PhotometricModel;
-use fabkit_export::raster::{
-    normals_rgb, npy_f32, npz as npz_file, ply_points, png_gray16, png_gray8, png_rgb16, png_rgb8,
-    preview_rgb, PlyPoint, Png16Encoding,
-};
+use fabkit_export::raster::png_gray8;
 use fabkit_export::{OutputClaim, OutputCommand, StagedDir};
 use rayon::prelude::*;
 use serde_json::{json, Value};
@@ -111,6 +111,16 @@ pub enum DataFormat {
     Png,
 }
 
+impl From<DataFormat> for dataset::DataFormat {
+    fn from(f: DataFormat) -> Self {
+        match f {
+            DataFormat::Npy => dataset::DataFormat::Npy,
+            DataFormat::Npz => dataset::DataFormat::Npz,
+            DataFormat::Png => dataset::DataFormat::Png,
+        }
+    }
+}
+
 /// Default `--max-output-bytes`: 1 GB.
 const DEFAULT_MAX_OUTPUT_BYTES: u64 = 1_000_000_000;
 /// Largest `--max-output-bytes`: 1 PB.
@@ -136,247 +146,8 @@ fn parse_max_pixels(s: &str) -> Result<u64, String> {
     }
 }
 
-/// 16-bit PNG encodings: depth in micrometres; differences offset by 32768 counts.
-const DEPTH_PNG: Png16Encoding = Png16Encoding {
-    scale: 0.001,
-    offset_counts: 0,
-};
-const DELTA_PNG: Png16Encoding = Png16Encoding {
-    scale: 0.001,
-    offset_counts: 32768,
-};
-
-/// Files of one rendered frame: (relative path, bytes, manifest entry).
-type Files = Vec<(String, Vec<u8>, Value)>;
 /// Written files: (relative path, sha256, bytes).
 type Written = Vec<(String, String, usize)>;
-
-fn f32s(v: &[f64]) -> Vec<f32> {
-    v.iter().map(|x| *x as f32).collect()
-}
-
-fn finite_range(v: &[f64]) -> Option<(f64, f64)> {
-    let (lo, hi) = v
-        .iter()
-        .filter(|x| x.is_finite())
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
-            (a.min(*x), b.max(*x))
-        });
-    (lo <= hi).then_some((lo, hi))
-}
-
-/// The float32 maps of a frame bound for its `arrays.npz`: (name, NPY bytes, description).
-type NpzArrays = Vec<(String, Vec<u8>, Value)>;
-
-/// A float32 map as a `.npy` file (`npy`), an entry of the frame's `arrays.npz` (`npz`) or
-/// nothing (`png`).
-#[allow(clippy::too_many_arguments)]
-fn array_file(
-    files: &mut Files,
-    npz: &mut NpzArrays,
-    format: DataFormat,
-    dir: &str,
-    name: &str,
-    shape: &[usize],
-    data: &[f32],
-    meta: Value,
-) {
-    match format {
-        DataFormat::Npy => {
-            let file = format!("{dir}/{name}.npy");
-            let mut e = meta;
-            e["file"] = json!(file);
-            files.push((file, npy_f32(shape, data), e));
-        }
-        DataFormat::Npz => npz.push((name.to_string(), npy_f32(shape, data), meta)),
-        DataFormat::Png => {}
-    }
-}
-
-/// A scalar map as float32 mm ([`array_file`]), 16-bit PNG (um) and preview PNG.
-#[allow(clippy::too_many_arguments)]
-fn scalar_files(
-    files: &mut Files,
-    npz: &mut NpzArrays,
-    format: DataFormat,
-    dir: &str,
-    name: &str,
-    what: &str,
-    values: &[f64],
-    (w, h): (usize, usize),
-    enc: Png16Encoding,
-    preview: (f64, f64),
-) -> Result<(), Box<dyn Error>> {
-    let stem = name.trim_end_matches("_mm");
-    array_file(
-        files,
-        npz,
-        format,
-        dir,
-        name,
-        &[h, w],
-        &f32s(values),
-        json!({"quantity": what, "units": "mm", "dtype": "float32", "shape": [h, w], "missing": "NaN"}),
-    );
-    let (counts, clipped) = enc.encode(values);
-    let png = format!("{dir}/{stem}_um.png");
-    let text = format!(
-        "{what}; value_mm = (count - {}) * {}; count 0 = no value",
-        enc.offset_counts, enc.scale
-    );
-    files.push((
-        png.clone(),
-        png_gray16(w, h, &counts, &[("Description", &text)])?,
-        json!({"file": png, "quantity": what, "units": "um", "dtype": "uint16", "shape": [h, w],
-               "value_mm": format!("(count - {}) * {}", enc.offset_counts, enc.scale), "scale_mm_per_count": enc.scale,
-               "offset_counts": enc.offset_counts, "missing": 0, "clipped_pixels": clipped}),
-    ));
-    let pv = format!("{dir}/{stem}_preview.png");
-    let (w2, rgb) = fabkit_export::raster::with_colour_bar(
-        w,
-        h,
-        &preview_rgb(values, preview.0, preview.1),
-        preview.0,
-        preview.1,
-    );
-    files.push((
-        pv.clone(),
-        png_rgb8(w2, h, &rgb, &[])?,
-        json!({"file": pv, "quantity": format!("preview of {name}"), "colour_map": "turbo (d3, colorous)", "range_mm": [preview.0, preview.1], "missing": "black",
-               "colour_bar": {"columns_px": [w, w2], "top_mm": preview.1, "bottom_mm": preview.0}}),
-    ));
-    Ok(())
-}
-
-/// Every file of a rendered frame (and of its difference to the reference, for a
-/// configuration).
-fn frame_files(
-    dir: &str,
-    f: &DepthFrame,
-    reference: Option<&DepthFrame>,
-    preview: (f64, f64),
-    provenance: &str,
-    format: DataFormat,
-) -> Result<Files, Box<dyn Error>> {
-    let (w, h) = (f.width, f.height);
-    let mut files = Files::new();
-    let mut npz = NpzArrays::new();
-    scalar_files(
-        &mut files,
-        &mut npz,
-        format,
-        dir,
-        "range_mm",
-        "range: distance along the pixel's ray from the camera centre to the elastomer surface",
-        &f.range_mm,
-        (w, h),
-        DEPTH_PNG,
-        preview,
-    )?;
-    scalar_files(
-        &mut files,
-        &mut npz,
-        format,
-        dir,
-        "zdepth_mm",
-        "z-depth: z of the surface point in the camera frame",
-        &f.zdepth_mm,
-        (w, h),
-        DEPTH_PNG,
-        preview,
-    )?;
-    let normals: Vec<f32> = f
-        .normal_cam
-        .iter()
-        .flat_map(|n| n.map(|c| c as f32))
-        .collect();
-    array_file(
-        &mut files,
-        &mut npz,
-        format,
-        dir,
-        "normals",
-        &[h, w, 3],
-        &normals,
-        json!({"quantity": "unit normal of the elastomer surface, pointing out of the elastomer, camera frame", "units": "1", "dtype": "float32", "shape": [h, w, 3], "missing": "NaN"}),
-    );
-    let np = format!("{dir}/normals_preview.png");
-    files.push((np.clone(), png_rgb8(w, h, &normals_rgb(&f.normal_cam), &[])?, json!({"file": np, "quantity": "preview of the unit normals: rgb = (n + 1) / 2", "missing": "black"})));
-    if format == DataFormat::Npy {
-        ply_file(&mut files, dir, f, provenance);
-    }
-    if let Some(r) = reference {
-        let (dr, dz) = f.delta(r);
-        let lo = finite_range(&dr)
-            .map(|x| x.0)
-            .unwrap_or(0.0)
-            .min(finite_range(&dz).map(|x| x.0).unwrap_or(0.0));
-        let pr = (if lo < 0.0 { lo } else { -0.001 }, 0.0);
-        scalar_files(&mut files, &mut npz, format, dir, "delta_range_mm", "differential range: indented minus reference (negative where the skin is pushed towards the camera)", &dr, (w, h), DELTA_PNG, pr)?;
-        scalar_files(
-            &mut files,
-            &mut npz,
-            format,
-            dir,
-            "delta_zdepth_mm",
-            "differential z-depth: indented minus reference",
-            &dz,
-            (w, h),
-            DELTA_PNG,
-            pr,
-        )?;
-        let mask: Vec<u8> = f
-            .contact_mask(r)
-            .iter()
-            .map(|&c| if c { 255 } else { 0 })
-            .collect();
-        let cm = format!("{dir}/contact_mask.png");
-        files.push((cm.clone(), png_gray8(w, h, &mask, &[])?, json!({"file": cm, "quantity": "contact mask: 255 where a protrusion pushes the skin in (the surface seen is a protrusion), else 0", "dtype": "uint8", "shape": [h, w]})));
-    }
-    if format == DataFormat::Npz {
-        let file = format!("{dir}/arrays.npz");
-        let bytes = npz_file(
-            &npz.iter()
-                .map(|(n, b, _)| (n.as_str(), b.as_slice()))
-                .collect::<Vec<_>>(),
-        )?;
-        let arrays: serde_json::Map<String, Value> =
-            npz.into_iter().map(|(n, _, m)| (n, m)).collect();
-        files.push((
-            file.clone(),
-            bytes,
-            json!({"file": file, "quantity": "the float32 maps of this frame (numpy.load: a mapping from name to array)", "arrays": arrays}),
-        ));
-    }
-    Ok(files)
-}
-
-/// What the rendered images leave out, in the manifest and the guide.
-const IMAGES_NOT_MODELLED: &str = "refraction through the clear layers between the camera and the reflective surface (rays are straight from the camera centre); light scattered inside the elastomer; light reflected from one part of the skin onto another; the skin's deformation around a protrusion (the indented surface is the skin minus the protrusion solids); the dimples in the depth maps (the images show them, the depth is of the skin without them); penumbrae (each LED is a point: shadows have hard edges); the markers' own relief and their parallax (a marker is albedo on the reference surface at its normal's foot); fluorescence under UV LEDs (UV light is drawn as violet); lens blur, motion blur and rolling shutter";
-
-/// Where the images of `--images` come from.
-enum ImageSource {
-    /// The design's optics through the physical image model.
-    Physical(Box<Imaging>),
-    /// The sensor's photometric model (`--photometric DIR`), with the folder and the sha256
-    /// of its photometric.json.
-    Photometric(Box<PhotometricModel>, String, String),
-}
-
-impl ImageSource {
-    fn bits(&self) -> u32 {
-        match self {
-            ImageSource::Physical(im) => im.optics.camera.bit_depth,
-            ImageSource::Photometric(m, ..) => {
-                if m.full_scale > 255.0 {
-                    16
-                } else {
-                    8
-                }
-            }
-        }
-    }
-}
 
 /// The photometric model `fabkit calibrate photometric` wrote to `dir`, for a `w` x `h`
 /// camera, and the sha256 of its photometric.json.
@@ -412,137 +183,6 @@ fn load_photometric(
         .collect();
     let model = PhotometricModel::from_json(&v["model"], appearance, w, h).map_err(bad)?;
     Ok((model, sha))
-}
-
-/// The rendered image of a frame (`--images`): `dir/image.png`, RGB at the source's bit
-/// depth, on the depth maps' pixel grid; from the design's optics its noise is that of frame
-/// `frame` of the set, from a photometric model it is the model's noise-free image.
-#[allow(clippy::too_many_arguments)]
-fn image_file(
-    dir: &str,
-    src: &ImageSource,
-    rays: &PixelRays,
-    reference: &SurfaceHits,
-    hits: &SurfaceHits,
-    protrusions: Option<&ExactPrimitives>,
-    frame: u64,
-) -> Result<(String, Vec<u8>, Value), Box<dyn Error>> {
-    let (w, h) = (rays.width, rays.height);
-    let bits = src.bits();
-    let full = ((1u32 << bits) - 1) as u16;
-    let (img, text) = match src {
-        ImageSource::Physical(im) => (
-            im.image(rays, hits, protrusions, frame),
-            format!(
-                "fabkit rendered tactile image, frame {frame}: RGB, {bits} bit; the skin lit by the design's lights, exposure gain {}",
-                im.gain
-            ),
-        ),
-        ImageSource::Photometric(m, folder, _) => (
-            m.image(rays, reference, hits, protrusions),
-            format!("fabkit rendered tactile image: RGB, {bits} bit; the sensor's photometric model from {folder}"),
-        ),
-    };
-    let saturated = img.iter().filter(|p| p.contains(&full)).count();
-    let file = format!("{dir}/image.png");
-    let meta = [("Description", text.as_str())];
-    let bytes = if bits == 16 {
-        png_rgb16(w, h, &img, &meta)?
-    } else {
-        let rgb: Vec<u8> = img.iter().flat_map(|p| p.map(|c| c as u8)).collect();
-        png_rgb8(w, h, &rgb, &meta)?
-    };
-    Ok((
-        file.clone(),
-        bytes,
-        json!({"file": file, "quantity": "the tactile image the camera sees: the surface of this frame under the design's lights, with its shadows, the camera's gain, vignetting and noise (see images in the manifest)",
-               "dtype": if bits == 16 { "uint16" } else { "uint8" }, "shape": [h, w, 3], "channels": "RGB",
-               "bit_depth": bits, "noise_frame": frame, "saturated_pixels": saturated}),
-    ))
-}
-
-/// The surface points of a frame with their normals as binary PLY.
-fn ply_file(files: &mut Files, dir: &str, f: &DepthFrame, provenance: &str) {
-    let w = f.width;
-    let pts: Vec<PlyPoint> = (0..w * f.height)
-        .filter(|&p| f.range_mm[p].is_finite())
-        .map(|p| PlyPoint {
-            xyz: f.point_cam_mm[p].map(|c| c as f32),
-            normal: f.normal_cam[p].map(|c| c as f32),
-            u: (p % w) as u16,
-            v: (p / w) as u16,
-            contact: f.contact[p] as u8,
-        })
-        .collect();
-    let ply = format!("{dir}/points.ply");
-    let comments = vec![
-        "frame: camera (x right, y down, z forward; docs/conventions.md), mm".to_string(),
-        "properties: point, unit normal out of the elastomer, pixel (u column, v row), contact (1 on a protrusion)".to_string(),
-        provenance.to_string(),
-    ];
-    files.push((ply.clone(), ply_points(&pts, &comments), json!({"file": ply, "quantity": "surface points with normals, one per pixel that sees the surface", "frame": "camera", "units": "mm", "points": pts.len()})));
-}
-
-/// A bound on the size of a PNG of `raw` pixel bytes in `rows` rows: the filter byte of each
-/// row, deflate's stored-block worst case (5 bytes per 16 KiB) and the chunks around it.
-fn png_bound(raw: u64, rows: u64) -> u64 {
-    let filtered = raw + rows;
-    filtered + filtered / 16_384 * 5 + 1024
-}
-
-/// Files and bytes of the output, (files, bytes): the files exactly, the bytes as an upper
-/// bound (float arrays and PLY at their exact sizes, PNG and NPZ at deflate's worst case, the
-/// manifest and pairs.csv generously), for a `w` x `h` camera, `n_cfg` configurations and
-/// `n_patterns` patterns, with an RGB image of `image_bits` bits per channel per frame
-/// (`--images`).
-pub fn output_bound(
-    w: u64,
-    h: u64,
-    n_cfg: u64,
-    n_patterns: u64,
-    format: DataFormat,
-    image_bits: Option<u32>,
-) -> (u64, u64) {
-    let px = w * h;
-    let frame = |delta: bool| -> (u64, u64) {
-        let (mut files, mut bytes, mut arrays) = (0u64, 0u64, Vec::new());
-        if let Some(bits) = image_bits {
-            files += 1;
-            bytes += png_bound(3 * px * u64::from(bits.div_ceil(8)), h);
-        }
-        let maps = if delta { 4 } else { 2 };
-        for _ in 0..maps {
-            arrays.push(4 * px + 128);
-            files += 2;
-            bytes += png_bound(2 * px, h) + png_bound(3 * px, h);
-        }
-        arrays.push(12 * px + 128);
-        files += 1;
-        bytes += png_bound(3 * px, h);
-        if delta {
-            files += 1;
-            bytes += png_bound(px, h);
-        }
-        match format {
-            DataFormat::Npy => {
-                files += arrays.len() as u64 + 1;
-                bytes += arrays.iter().sum::<u64>() + 33 * px + 4096;
-            }
-            DataFormat::Npz => {
-                files += 1;
-                bytes += arrays.iter().map(|a| a + a / 16_384 * 5 + 256).sum::<u64>() + 1024;
-            }
-            DataFormat::Png => {}
-        }
-        (files, bytes)
-    };
-    let (rf, rb) = frame(false);
-    let (cf, cb) = frame(true);
-    // two half masks, pairs.csv and the manifest
-    let files = rf + n_cfg * cf + 4;
-    let pairs = 128 * (n_patterns * n_patterns + 1);
-    let bytes = rb + n_cfg * cb + 2 * png_bound(px, h) + pairs + 65_536 + 4096 * files;
-    (files, bytes)
 }
 
 /// `n` bytes for people: `1.2 GB`, `340 MB`, `12 kB`.
@@ -740,7 +380,7 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
         h as u64,
         n_cfg as u64,
         fixtures.patterns.len() as u64,
-        args.format,
+        args.format.into(),
         image_bits,
     );
     let format_name = |f: DataFormat| match f {
@@ -763,7 +403,7 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
                 h as u64,
                 n_cfg as u64,
                 fixtures.patterns.len() as u64,
-                f,
+                f.into(),
                 image_bits,
             );
             format!("--format {} (at most {})", format_name(f), shown_bytes(b))
@@ -863,7 +503,7 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
             None,
             preview,
             &provenance,
-            args.format,
+            args.format.into(),
         )?,
         &mut all,
     )?;
@@ -896,7 +536,7 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
             Some(&reference),
             preview,
             &provenance,
-            args.format,
+            args.format.into(),
         )
         .map_err(|e| e.to_string())?;
         let mut entries = Vec::new();

@@ -495,11 +495,12 @@ fn groundtruth_bounds_its_output_first_and_writes_npz_or_png_on_request() {
             m["image"]["height_px"].as_u64().unwrap(),
         );
         let f = match format {
-            "npy" => fabkit::groundtruth_cmd::DataFormat::Npy,
-            "npz" => fabkit::groundtruth_cmd::DataFormat::Npz,
-            _ => fabkit::groundtruth_cmd::DataFormat::Png,
+            "npy" => fabkit::calibration::groundtruth::dataset::DataFormat::Npy,
+            "npz" => fabkit::calibration::groundtruth::dataset::DataFormat::Npz,
+            _ => fabkit::calibration::groundtruth::dataset::DataFormat::Png,
         };
-        let (n_files, bound) = fabkit::groundtruth_cmd::output_bound(w, h, 4, 2, f, None);
+        let (n_files, bound) =
+            fabkit::calibration::groundtruth::dataset::output_bound(w, h, 4, 2, f, None);
         assert_eq!(files.len() as u64 + 1, n_files, "{format}");
         assert!(
             bytes <= bound,

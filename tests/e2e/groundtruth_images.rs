@@ -154,12 +154,12 @@ fn every_frame_gets_its_image_the_same_bytes_with_any_thread_count() {
         .map(|f| f["bytes"].as_u64().unwrap())
         .sum::<u64>()
         + std::fs::metadata(a.join("manifest.json")).unwrap().len();
-    let (n_files, bound) = fabkit::groundtruth_cmd::output_bound(
+    let (n_files, bound) = fabkit::calibration::groundtruth::dataset::output_bound(
         640,
         480,
         4,
         2,
-        fabkit::groundtruth_cmd::DataFormat::Png,
+        fabkit::calibration::groundtruth::dataset::DataFormat::Png,
         Some(8),
     );
     assert_eq!(files.len() as u64 + 1, n_files);

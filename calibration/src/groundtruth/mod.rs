@@ -15,6 +15,7 @@
 //! [`mesh`] for triangle meshes). Frames and units: `docs/conventions.md`.
 
 pub mod budget;
+pub mod dataset;
 pub mod exact;
 pub mod inputs;
 pub mod mesh;
