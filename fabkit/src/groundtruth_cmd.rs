@@ -3,30 +3,22 @@
 //! folder), progress.
 
 use fabkit_calibration::groundtruth::budget::{
-    frames_at_once, min_skin_pixels, render_memory, DEFAULT_MAX_PIXELS, FIXED_BYTES_PER_PIXEL,
+    min_skin_pixels, render_memory, DEFAULT_MAX_PIXELS, FIXED_BYTES_PER_PIXEL,
     FRAME_BYTES_PER_PIXEL, MAX_PIXELS_LIMIT, MEMORY_BUDGET_BYTES, MIN_SKIN_FRACTION,
 };
 use std::error::Error;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 use fabkit_calibration::groundtruth::dataset::{
-    self, finite_range, frame_files, image_file, output_bound, Files, ImageSource, DELTA_PNG,
-    DEPTH_PNG, IMAGES_NOT_MODELLED,
+    self, output_bound, render_frames, FrameInputs, ImageSource, DELTA_PNG, DEPTH_PNG,
+    IMAGES_NOT_MODELLED,
 };
-use fabkit_calibration::groundtruth::inputs::{
-    pairs_csv, read_extrinsics, read_fixtures, read_with_hash, sha256_hex, Configuration,
-    PAIRS_NOTES,
-};
+use fabkit_calibration::groundtruth::inputs::{read_extrinsics, read_fixtures, read_with_hash};
 use fabkit_calibration::groundtruth::pins::read_pin_captures;
 use fabkit_calibration::groundtruth::shading::Imaging;
-use fabkit_calibration::groundtruth::{
-    half_masks, indented_hits, reference_hits, DepthFrame, Scene,
-};
+use fabkit_calibration::groundtruth::{reference_hits, Scene};
 use fabkit_calibration::photometric::PhotometricModel;
-use fabkit_export::raster::png_gray8;
 use fabkit_export::{OutputClaim, OutputCommand, StagedDir};
-use rayon::prelude::*;
 use serde_json::{json, Value};
 
 use crate::cli::{load_design, DataFileArgs};
@@ -145,9 +137,6 @@ fn parse_max_pixels(s: &str) -> Result<u64, String> {
         )),
     }
 }
-
-/// Written files: (relative path, sha256, bytes).
-type Written = Vec<(String, String, usize)>;
 
 /// The photometric model `fabkit calibrate photometric` wrote to `dir`, for a `w` x `h`
 /// camera, and the sha256 of its photometric.json.
@@ -470,161 +459,28 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
         }),
     };
     let staged = StagedDir::new(&args.out, claim)?;
-    let reference = DepthFrame::new(&rays, &ref_hits);
-    let preview = finite_range(&reference.range_mm)
-        .into_iter()
-        .chain(finite_range(&reference.zdepth_mm))
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), (lo, hi)| {
-            (a.min(lo), b.max(hi))
-        });
-    let preview = if preview.0 <= preview.1 {
-        preview
-    } else {
-        (0.0, 1.0)
-    };
-    let mut all: Vec<(String, String, usize)> = Vec::new();
-    let write = |files: Files,
-                 all: &mut Vec<(String, String, usize)>|
-     -> Result<Vec<Value>, Box<dyn Error>> {
-        let mut entries = Vec::new();
-        for (rel, bytes, mut e) in files {
-            staged.write(&rel, &bytes)?;
-            let sha = sha256_hex(&bytes);
-            e["sha256"] = json!(sha);
-            all.push((rel, sha, bytes.len()));
-            entries.push(e);
-        }
-        Ok(entries)
-    };
-    let mut ref_entries = write(
-        frame_files(
-            "reference",
-            &reference,
-            None,
-            preview,
-            &provenance,
-            args.format.into(),
-        )?,
-        &mut all,
-    )?;
-    if let Some(im) = &imaging {
-        ref_entries.extend(write(
-            vec![image_file(
-                "reference",
-                im,
-                &rays,
-                &ref_hits,
-                &ref_hits,
-                None,
-                0,
-            )?],
-            &mut all,
-        )?);
-    }
-    bar.set(1, frames);
-
-    // Configurations in parallel, as many at a time as the memory budget holds; each writes
-    // its own folder. Entries are kept in index order.
-    let at_once = frames_at_once(w as u64 * h as u64, rayon::current_num_threads() as u64);
-    let done = AtomicUsize::new(0);
-    let render = |(k, cfg): (usize, &Configuration)| -> Result<(Value, Written), String> {
-        let hits = indented_hits(&rays, &ref_hits, &cfg.primitives, surface.base_z_mm());
-        let frame = DepthFrame::new(&rays, &hits);
-        let files = frame_files(
-            &cfg.name,
-            &frame,
-            Some(&reference),
-            preview,
-            &provenance,
-            args.format.into(),
-        )
-        .map_err(|e| e.to_string())?;
-        let mut entries = Vec::new();
-        let mut list = Vec::new();
-        let mut put = |files: Files| -> Result<(), String> {
-            for (rel, bytes, mut e) in files {
-                staged.write(&rel, &bytes).map_err(|e| e.to_string())?;
-                let sha = sha256_hex(&bytes);
-                e["sha256"] = json!(sha);
-                list.push((rel, sha, bytes.len()));
-                entries.push(e);
-            }
-            Ok(())
-        };
-        put(files)?;
-        // The image after the depth files are written: its buffers take the place of theirs
-        // in the frame's memory budget.
-        if let Some(im) = &imaging {
-            let f = image_file(
-                &cfg.name,
-                im,
-                &rays,
-                &ref_hits,
-                &hits,
-                Some(&cfg.primitives),
-                k as u64 + 1,
-            )
-            .map_err(|e| e.to_string())?;
-            put(vec![f])?;
-        }
-        let contact = (0..w * h)
-            .filter(|&p| frame.contact[p] && reference.range_mm[p].is_finite())
-            .count();
-        let (dr, _) = frame.delta(&reference);
-        let deepest = finite_range(&dr).map(|x| -x.0).unwrap_or(0.0).max(0.0);
-        let k = done.fetch_add(1, Ordering::Relaxed) + 2;
-        bar.set(k as u64, frames);
-        let mut entry = json!({
-            "name": cfg.name, "dir": cfg.name, "pattern": cfg.pattern, "orientation_deg": cfg.orientation_deg,
-            "pattern_side": if cfg.orientation_deg == 0 { "+x (right_mask.png)" } else { "-x (left_mask.png)" },
-            "fixture_description": {"file": cfg.description_file, "sha256": cfg.description_sha256},
-            "primitives": cfg.geometry.primitives.len(),
-            "contact_pixels": contact, "max_range_decrease_mm": deepest,
-            "files": entries,
-        });
-        if !cfg.pins.is_empty() {
-            let e = entry.as_object_mut().expect("an object");
-            for k in ["pattern", "orientation_deg", "pattern_side"] {
-                e.remove(k);
-            }
-            e.insert("pins".into(), json!(cfg.pins));
-        }
-        Ok((entry, list))
-    };
-    let indexed: Vec<(usize, &Configuration)> =
-        fixtures.configurations.iter().enumerate().collect();
-    let rendered: Vec<Result<(Value, Written), String>> = indexed
-        .chunks(at_once)
-        .flat_map(|chunk| chunk.par_iter().copied().map(&render).collect::<Vec<_>>())
-        .collect();
-    let mut cfg_entries = Vec::new();
-    for r in rendered {
-        let (e, list) = r?;
-        cfg_entries.push(e);
-        all.extend(list);
-    }
+    let rendered = render_frames(
+        &FrameInputs {
+            rays: &rays,
+            reference_hits: &ref_hits,
+            base_z_mm: surface.base_z_mm(),
+            fixtures: &fixtures,
+            format: args.format.into(),
+            imaging: imaging.as_ref(),
+            provenance: &provenance,
+        },
+        &|rel, bytes| staged.write(rel, bytes).map_err(Into::into),
+        &|k| bar.set(k, frames),
+    )
+    .map_err(|e| -> Box<dyn Error> { e })?;
     bar.finish();
-
-    let (left, right) = half_masks(&rays, &ref_hits);
-    let mut extra: Files = Vec::new();
-    for (name, m, side) in [
-        ("left_mask.png", &left, "x < 0 (the -x half)"),
-        ("right_mask.png", &right, "x >= 0 (the +x half)"),
-    ] {
-        let px: Vec<u8> = m.iter().map(|&b| if b { 255 } else { 0 }).collect();
-        let count = m.iter().filter(|&&b| b).count();
-        extra.push((name.into(), png_gray8(w, h, &px, &[])?, json!({"file": name, "quantity": format!("pixels whose ray meets the reference surface at sensor-frame {side}: 255, else 0"), "pixels": count})));
-    }
+    let (ref_entries, cfg_entries, extra_entries, all) = (
+        rendered.reference,
+        rendered.configurations,
+        rendered.masks_and_pairs,
+        rendered.files,
+    );
     let n_pairs = fixtures.patterns.len() * fixtures.patterns.len();
-    if !args.pin_captures {
-        extra.push((
-            "pairs.csv".into(),
-            pairs_csv(&fixtures.patterns).into_bytes(),
-            json!({"file": "pairs.csv", "pairs": n_pairs, "notes": PAIRS_NOTES}),
-        ));
-    }
-    let extra_entries = write(extra, &mut all)?;
-    all.sort();
 
     let i = camera.intrinsics();
     let m = t_cam_sensor.to_homogeneous();

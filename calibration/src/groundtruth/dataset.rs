@@ -11,9 +11,16 @@ use fabkit_export::raster::{
 use fabkit_export::ExportError;
 use serde_json::{json, Value};
 
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use rayon::prelude::*;
+
+use super::budget::frames_at_once;
 use super::exact::ExactPrimitives;
+use super::inputs::{pairs_csv, sha256_hex, Configuration, Fixtures, PAIRS_NOTES};
 use super::rays::PixelRays;
 use super::shading::Imaging;
+use super::{half_masks, indented_hits};
 use super::{DepthFrame, SurfaceHits};
 use crate::photometric::PhotometricModel;
 
@@ -399,4 +406,219 @@ pub fn output_bound(
     let pairs = 128 * (n_patterns * n_patterns + 1);
     let bytes = rb + n_cfg * cb + 2 * png_bound(px, h) + pairs + 65_536 + 4096 * files;
     (files, bytes)
+}
+
+/// Written files: (relative path, sha256, bytes).
+pub type Written = Vec<(String, String, usize)>;
+
+/// An error of the sink the dataset's files are written to (or of their encoding).
+pub type SinkError = Box<dyn std::error::Error + Send + Sync>;
+
+/// Where a dataset's files go: called with each file's relative `/`-separated path and bytes,
+/// from any thread.
+pub type Sink<'a> = dyn Fn(&str, &[u8]) -> Result<(), SinkError> + Sync + 'a;
+
+/// What a dataset's frames are rendered from: the camera's rays and the reference surface
+/// they see, the body's base plane, the configurations, the array format, the image source
+/// (`--images`) and the provenance line of the PLY files.
+#[derive(Clone, Copy)]
+pub struct FrameInputs<'a> {
+    pub rays: &'a PixelRays,
+    pub reference_hits: &'a SurfaceHits,
+    pub base_z_mm: f64,
+    pub fixtures: &'a Fixtures,
+    pub format: DataFormat,
+    pub imaging: Option<&'a ImageSource>,
+    pub provenance: &'a str,
+}
+
+/// The manifest entries of a rendered dataset and its files.
+#[derive(Debug)]
+pub struct Rendered {
+    /// The reference frame's files.
+    pub reference: Vec<Value>,
+    /// One entry per configuration, in the fixtures' order, with its files.
+    pub configurations: Vec<Value>,
+    /// The half masks and (for protrusion patterns) pairs.csv.
+    pub masks_and_pairs: Vec<Value>,
+    /// Every file written: (relative path, sha256, bytes), sorted by path.
+    pub files: Written,
+}
+
+/// Renders every frame of a dataset (the reference, then the configurations in parallel, as
+/// many at a time as the memory budget holds, [`super::budget::frames_at_once`]), hands each
+/// file to `write` (relative `/`-separated path, bytes) as it is made, and calls `progress`
+/// with the number of frames done. The half masks and, for protrusion patterns, pairs.csv
+/// come last. The files and entries do not depend on the thread count.
+///
+/// # Errors
+/// The first error of `write` or of an encoder.
+pub fn render_frames(
+    inputs: &FrameInputs<'_>,
+    write: &Sink<'_>,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<Rendered, SinkError> {
+    let FrameInputs {
+        rays,
+        reference_hits: ref_hits,
+        fixtures,
+        format,
+        imaging,
+        provenance,
+        ..
+    } = *inputs;
+    let (w, h) = (rays.width, rays.height);
+    let pin_captures = fixtures.configurations.iter().any(|c| !c.pins.is_empty());
+    let reference = DepthFrame::new(rays, ref_hits);
+    let preview = finite_range(&reference.range_mm)
+        .into_iter()
+        .chain(finite_range(&reference.zdepth_mm))
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), (lo, hi)| {
+            (a.min(lo), b.max(hi))
+        });
+    let preview = if preview.0 <= preview.1 {
+        preview
+    } else {
+        (0.0, 1.0)
+    };
+    let mut all: Vec<(String, String, usize)> = Vec::new();
+    let put =
+        |files: Files, all: &mut Vec<(String, String, usize)>| -> Result<Vec<Value>, SinkError> {
+            let mut entries = Vec::new();
+            for (rel, bytes, mut e) in files {
+                write(&rel, &bytes)?;
+                let sha = sha256_hex(&bytes);
+                e["sha256"] = json!(sha);
+                all.push((rel, sha, bytes.len()));
+                entries.push(e);
+            }
+            Ok(entries)
+        };
+    let mut ref_entries = put(
+        frame_files("reference", &reference, None, preview, provenance, format)?,
+        &mut all,
+    )?;
+    if let Some(im) = imaging {
+        ref_entries.extend(put(
+            vec![image_file(
+                "reference",
+                im,
+                rays,
+                ref_hits,
+                ref_hits,
+                None,
+                0,
+            )?],
+            &mut all,
+        )?);
+    }
+    progress(1);
+
+    // Configurations in parallel, as many at a time as the memory budget holds; each writes
+    // its own folder. Entries are kept in index order.
+    let at_once = frames_at_once(w as u64 * h as u64, rayon::current_num_threads() as u64);
+    let done = AtomicUsize::new(0);
+    let render = |(k, cfg): (usize, &Configuration)| -> Result<(Value, Written), String> {
+        let hits = indented_hits(rays, ref_hits, &cfg.primitives, inputs.base_z_mm);
+        let frame = DepthFrame::new(rays, &hits);
+        let files = frame_files(
+            &cfg.name,
+            &frame,
+            Some(&reference),
+            preview,
+            provenance,
+            format,
+        )
+        .map_err(|e| e.to_string())?;
+        let mut entries = Vec::new();
+        let mut list = Vec::new();
+        let mut put = |files: Files| -> Result<(), String> {
+            for (rel, bytes, mut e) in files {
+                write(&rel, &bytes).map_err(|e| e.to_string())?;
+                let sha = sha256_hex(&bytes);
+                e["sha256"] = json!(sha);
+                list.push((rel, sha, bytes.len()));
+                entries.push(e);
+            }
+            Ok(())
+        };
+        put(files)?;
+        // The image after the depth files are written: its buffers take the place of theirs
+        // in the frame's memory budget.
+        if let Some(im) = imaging {
+            let f = image_file(
+                &cfg.name,
+                im,
+                rays,
+                ref_hits,
+                &hits,
+                Some(&cfg.primitives),
+                k as u64 + 1,
+            )
+            .map_err(|e| e.to_string())?;
+            put(vec![f])?;
+        }
+        let contact = (0..w * h)
+            .filter(|&p| frame.contact[p] && reference.range_mm[p].is_finite())
+            .count();
+        let (dr, _) = frame.delta(&reference);
+        let deepest = finite_range(&dr).map(|x| -x.0).unwrap_or(0.0).max(0.0);
+        let k = done.fetch_add(1, Ordering::Relaxed) + 2;
+        progress(k as u64);
+        let mut entry = json!({
+            "name": cfg.name, "dir": cfg.name, "pattern": cfg.pattern, "orientation_deg": cfg.orientation_deg,
+            "pattern_side": if cfg.orientation_deg == 0 { "+x (right_mask.png)" } else { "-x (left_mask.png)" },
+            "fixture_description": {"file": cfg.description_file, "sha256": cfg.description_sha256},
+            "primitives": cfg.geometry.primitives.len(),
+            "contact_pixels": contact, "max_range_decrease_mm": deepest,
+            "files": entries,
+        });
+        if !cfg.pins.is_empty() {
+            let e = entry.as_object_mut().expect("an object");
+            for k in ["pattern", "orientation_deg", "pattern_side"] {
+                e.remove(k);
+            }
+            e.insert("pins".into(), json!(cfg.pins));
+        }
+        Ok((entry, list))
+    };
+    let indexed: Vec<(usize, &Configuration)> =
+        fixtures.configurations.iter().enumerate().collect();
+    let rendered: Vec<Result<(Value, Written), String>> = indexed
+        .chunks(at_once)
+        .flat_map(|chunk| chunk.par_iter().copied().map(&render).collect::<Vec<_>>())
+        .collect();
+    let mut cfg_entries = Vec::new();
+    for r in rendered {
+        let (e, list) = r?;
+        cfg_entries.push(e);
+        all.extend(list);
+    }
+
+    let (left, right) = half_masks(rays, ref_hits);
+    let mut extra: Files = Vec::new();
+    for (name, m, side) in [
+        ("left_mask.png", &left, "x < 0 (the -x half)"),
+        ("right_mask.png", &right, "x >= 0 (the +x half)"),
+    ] {
+        let px: Vec<u8> = m.iter().map(|&b| if b { 255 } else { 0 }).collect();
+        let count = m.iter().filter(|&&b| b).count();
+        extra.push((name.into(), png_gray8(w, h, &px, &[])?, json!({"file": name, "quantity": format!("pixels whose ray meets the reference surface at sensor-frame {side}: 255, else 0"), "pixels": count})));
+    }
+    let n_pairs = fixtures.patterns.len() * fixtures.patterns.len();
+    if !pin_captures {
+        extra.push((
+            "pairs.csv".into(),
+            pairs_csv(&fixtures.patterns).into_bytes(),
+            json!({"file": "pairs.csv", "pairs": n_pairs, "notes": PAIRS_NOTES}),
+        ));
+    }
+    let extra_entries = put(extra, &mut all)?;
+    all.sort();
+    Ok(Rendered {
+        reference: ref_entries,
+        configurations: cfg_entries,
+        masks_and_pairs: extra_entries,
+        files: all,
+    })
 }
