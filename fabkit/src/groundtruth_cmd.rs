@@ -10,8 +10,7 @@ use std::error::Error;
 use std::path::{Path, PathBuf};
 
 use fabkit_calibration::groundtruth::dataset::{
-    self, output_bound, render_frames, FrameInputs, ImageSource, DELTA_PNG, DEPTH_PNG,
-    IMAGES_NOT_MODELLED,
+    self, output_bound, render_frames, FrameInputs, ImageSource, ManifestInputs,
 };
 use fabkit_calibration::groundtruth::inputs::{read_extrinsics, read_fixtures, read_with_hash};
 use fabkit_calibration::groundtruth::pins::read_pin_captures;
@@ -19,7 +18,7 @@ use fabkit_calibration::groundtruth::shading::Imaging;
 use fabkit_calibration::groundtruth::{reference_hits, Scene};
 use fabkit_calibration::photometric::PhotometricModel;
 use fabkit_export::{OutputClaim, OutputCommand, StagedDir};
-use serde_json::{json, Value};
+use serde_json::Value;
 
 use crate::cli::{load_design, DataFileArgs};
 
@@ -331,13 +330,6 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
     } else {
         read_fixtures(&args.fixtures, &design.name)?
     };
-    let (fixture_kind, surface_text) = if args.pin_captures {
-        ("pin-dome", "outer skin surface (body profile at offset 0) from the pole to the base plane; indented: the skin minus the solids of the capture's pins (hemispherical tip, 45 deg cone, shaft)")
-    } else if design.body.flat_outline().is_some() {
-        ("semi-plate", "the flat skin's contact face over its outline (its edges continued below the base plane bound the body); indented: the skin minus the protrusion solids")
-    } else {
-        ("semi-dome", "outer skin surface (body profile at offset 0) from the pole to the base plane; indented: the skin minus the protrusion solids")
-    };
     let pose_name = args.extrinsics.display().to_string();
     let scene = Scene::new(design, &camera, &t_cam_sensor, &pose_name)?;
     scene.check_outside(&fixtures.configurations, &pose_name)?;
@@ -474,91 +466,29 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
     )
     .map_err(|e| -> Box<dyn Error> { e })?;
     bar.finish();
-    let (ref_entries, cfg_entries, extra_entries, all) = (
-        rendered.reference,
-        rendered.configurations,
-        rendered.masks_and_pairs,
-        rendered.files,
-    );
     let n_pairs = fixtures.patterns.len() * fixtures.patterns.len();
-
-    let i = camera.intrinsics();
-    let m = t_cam_sensor.to_homogeneous();
-    let mut manifest = json!({
-        "fabkit_version": env!("CARGO_PKG_VERSION"),
-        "command_line": std::env::args().collect::<Vec<_>>(),
-        "description": if args.pin_captures {
-            "Ground-truth depth of the sensor surface, reference (undeformed) and indented by the pins of each capture of the pin dome (R-Tac0 Sec. IV-A, Fig. 5; the capture plan of points/capture_plan.csv): complete depth = reference + delta. Exact per-pixel rays of the camera model; surfaces in closed form.".to_string()
-        } else {
-            format!("Ground-truth depth of the sensor surface, reference (undeformed) and indented by each protrusion {} configuration (R-Tac0 Sec. IV-B, Fig. 6, Eq. (2)-(3)): complete depth = reference + delta. Exact per-pixel rays of the camera model; surfaces in closed form.", fixture_kind)
+    let manifest = dataset::manifest(
+        &ManifestInputs {
+            fabkit_version: env!("CARGO_PKG_VERSION"),
+            command_line: &std::env::args().collect::<Vec<_>>(),
+            design_name: &design.name,
+            design_source: &loaded.source,
+            design_sha256: &loaded.sha256,
+            flat_skin: design.body.flat_outline().is_some(),
+            camera: &camera,
+            camera_file: &args.cam.camera.display().to_string(),
+            camera_sha256: &camera_sha,
+            extrinsics_file: &args.extrinsics.display().to_string(),
+            extrinsics_sha256: &extrinsics_sha,
+            t_cam_sensor: &t_cam_sensor,
+            camera_centre_mm: c,
+            fixtures: &fixtures,
+            pixels_on_surface: ref_hits.valid_count(),
+            imaging: imaging.as_ref(),
         },
-        "design": {"name": design.name, "source": loaded.source, "sha256": loaded.sha256},
-        "camera": {"file": args.cam.camera.display().to_string(), "sha256": camera_sha, "distortion_model": i.distortion.name(),
-                   "fx_px": i.fx_px, "fy_px": i.fy_px, "cx_px": i.cx_px, "cy_px": i.cy_px, "distortion_coefficients": i.distortion.coefficients(),
-                   "image_width_px": w, "image_height_px": h},
-        "extrinsics": {"file": args.extrinsics.display().to_string(), "sha256": extrinsics_sha,
-                       "T_cam_sensor": (0..4).map(|r| (0..4).map(|c| m[(r, c)]).collect::<Vec<_>>()).collect::<Vec<_>>(),
-                       "camera_centre_in_sensor_mm": c},
-        "fixtures": if args.pin_captures {
-            json!({"dir": fixtures.dir.display().to_string(), "capture_plan_sha256": fixtures.index_sha256, "pin_captures": fixtures.configurations.len()})
-        } else {
-            json!({"dir": fixtures.dir.display().to_string(), "index_sha256": fixtures.index_sha256, "patterns": fixtures.patterns})
-        },
-        "conventions": {
-            "pixels": "(u, v) = (column, row); (0, 0) is the centre of the top-left pixel; arrays are (H, W) row-major",
-            "camera_frame": "x right, y down, z forward (docs/conventions.md)",
-            "sensor_frame": "docs/conventions.md; split plane x = 0",
-            "range_mm": "distance along the pixel's ray from the camera centre to the surface, mm",
-            "zdepth_mm": "z of the surface point in the camera frame, mm (= range * bearing z)",
-            "delta": "indented minus reference, mm (negative where the skin is pushed towards the camera, 0 elsewhere)",
-            "surface": surface_text,
-            "missing": "a pixel whose ray misses the skin (or does not unproject) is NaN in float files, 0 in integer files, and in no mask",
-            "png16": {"depth": {"scale_mm_per_count": DEPTH_PNG.scale, "offset_counts": DEPTH_PNG.offset_counts},
-                      "delta": {"scale_mm_per_count": DELTA_PNG.scale, "offset_counts": DELTA_PNG.offset_counts},
-                      "value_mm": "(count - offset_counts) * scale_mm_per_count; count 0 = no value (also values that do not fit, counted as clipped_pixels)"},
-            "not_modelled": "refraction in the elastomer and the core; the skin's deformation around a protrusion (the indented surface is the skin minus the protrusion solids)",
-        },
-        "image": {"width_px": w, "height_px": h, "pixels_on_surface": ref_hits.valid_count()},
-        "reference": {"dir": "reference", "files": ref_entries},
-        "configurations": cfg_entries,
-        "masks_and_pairs": extra_entries,
-        "files": all.iter().map(|(f, s, b)| json!({"file": f, "sha256": s, "bytes": b})).collect::<Vec<_>>(),
-    });
-    if let Some(ImageSource::Photometric(_, dir, sha)) = &imaging {
-        manifest["images"] = json!({
-            "file": "image.png in reference/ and in each configuration's folder",
-            "model": "the sensor's photometric model (fabkit calibrate photometric): per channel the appearance of every pixel times one plus its fitted response to the surface's tilt and indentation (calibration/src/photometric.rs); the model's mean image, no noise",
-            "photometric": {"dir": dir, "photometric_json_sha256": sha},
-            "not_modelled": "lights at a few azimuths (the spatial term and the shadows' light rings are round the optical axis); refraction; the skin's deformation around a protrusion",
-        });
-    }
-    if let Some(ImageSource::Physical(im)) = &imaging {
-        manifest["images"] = json!({
-            "file": "image.png in reference/ and in each configuration's folder",
-            "model": "each light a point emitter with a cosine beam inside its cone, inverse-square fall-off and the incidence cosine; the surface Lambertian (albedo_rgb) plus a normalised Blinn-Phong lobe (specular, roughness); a light is shadowed where the segment to it enters a protrusion; then gain, vignetting 1 - v (r / r_corner)^2 about the principal point, photon noise (Gaussian with the Poisson variance of the signal's electrons) and read noise, clipped and quantised (calibration/src/groundtruth/shading.rs)",
-            "lights": im.optics.lights.iter().zip(&im.optics.light_sources).map(|(l, src)| {
-                let mut v = serde_json::to_value(l).unwrap_or(Value::Null);
-                v["source"] = json!(src);
-                v
-            }).collect::<Vec<_>>(),
-            "surface": im.optics.surface,
-            "dimples": {
-                "patterns": im.optics.dimple_sources.iter().map(|(src, n)| json!({"source": src, "count": n})).collect::<Vec<_>>(),
-                "drawn_as": "solids in the surface the camera sees: the recessed features of the outer skin surface, each a cylinder with a hemispherical end standing towards the camera, which shade and cast shadows (ShadowTac Sec. III-A); moved with the skin as the markers are",
-            },
-            "markers": {
-                "albedo_rgb": im.optics.marker_albedo_rgb,
-                "patterns": im.optics.marker_sources.iter().map(|(src, n)| json!({"source": src, "count": n})).collect::<Vec<_>>(),
-                "drawn_as": "albedo on the skin's reference surface: the points within the feature's radius of the marker's centre, moved along its normal onto the reference surface; raised features only (pins, painted ends, ink-filled protrusions)",
-                "motion": "normal displacement only: a marker a protrusion pushes in moves along its normal to the protrusion's surface, keeping its size; the skin's stretch along the surface is not modelled",
-            },
-            "camera": im.optics.camera,
-            "gain": im.gain,
-            "exposure": if im.auto_exposed { "set on the reference image (its 99th-percentile pixel at 0.8 of full scale; optics.camera.gain not given) and held for every frame" } else { "optics.camera.gain, every frame" },
-            "noise": "seeded (optics.camera.seed): each frame draws its own noise (noise_frame: 0 for the reference, i + 1 for configuration i); the same seed gives the same bytes",
-            "not_modelled": IMAGES_NOT_MODELLED,
-        });
-    }
+        &rendered,
+    );
+    let all = rendered.files;
     let mut text = serde_json::to_vec_pretty(&manifest)?;
     text.push(b'\n');
     staged.write("manifest.json", &text)?;
