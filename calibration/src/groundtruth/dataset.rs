@@ -35,11 +35,12 @@ pub enum DataFormat {
     Png,
 }
 
-/// 16-bit PNG encodings: depth in micrometres; differences offset by 32768 counts.
+/// 16-bit PNG encoding of depth and range: micrometres (`value_mm = count * 0.001`).
 pub const DEPTH_PNG: Png16Encoding = Png16Encoding {
     scale: 0.001,
     offset_counts: 0,
 };
+/// 16-bit PNG encoding of the differences: micrometres offset by 32768 counts.
 pub const DELTA_PNG: Png16Encoding = Png16Encoding {
     scale: 0.001,
     offset_counts: 32768,
@@ -147,7 +148,10 @@ fn scalar_files(
 }
 
 /// Every file of a rendered frame (and of its difference to the reference, for a
-/// configuration).
+/// configuration), in folder `dir`, maps previewed over `preview` (mm).
+///
+/// # Errors
+/// [`ExportError`] of a PNG or NPZ encoder.
 pub fn frame_files(
     dir: &str,
     f: &DepthFrame,
@@ -280,6 +284,9 @@ impl ImageSource {
 /// The rendered image of a frame (`--images`): `dir/image.png`, RGB at the source's bit
 /// depth, on the depth maps' pixel grid; from the design's optics its noise is that of frame
 /// `frame` of the set, from a photometric model it is the model's noise-free image.
+///
+/// # Errors
+/// [`ExportError`] of the PNG encoder.
 #[allow(clippy::too_many_arguments)]
 pub fn image_file(
     dir: &str,
