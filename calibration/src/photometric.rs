@@ -776,6 +776,37 @@ impl PhotometricModel {
         })
     }
 
+    /// The model `fabkit calibrate photometric` wrote to `dir` (photometric.json and the
+    /// (H, W, 3) float32 appearance.npy) and the sha256 of its photometric.json.
+    ///
+    /// # Errors
+    /// A message naming the file and what does not fit: unreadable, not JSON, an appearance
+    /// that is not (H, W, 3) float32, or what [`Self::from_json`] refuses.
+    pub fn read(dir: &std::path::Path) -> Result<(PhotometricModel, String), String> {
+        use crate::groundtruth::inputs::read_with_hash;
+        let jpath = dir.join("photometric.json");
+        let (bytes, sha) = read_with_hash(&jpath).map_err(|e| e.to_string())?;
+        let v: serde_json::Value = serde_json::from_slice(&bytes)
+            .map_err(|e| format!("{}: not JSON: {e}", jpath.display()))?;
+        let apath = dir.join("appearance.npy");
+        let (abytes, _) = read_with_hash(&apath).map_err(|e| e.to_string())?;
+        let (shape, data) = fabkit_export::raster::read_npy_f32(&abytes)
+            .map_err(|e| format!("{}: {e}", apath.display()))?;
+        let [h, w, 3] = shape[..] else {
+            return Err(format!(
+                "{}: shape {shape:?}, not (H, W, 3)",
+                apath.display()
+            ));
+        };
+        let appearance = data
+            .chunks_exact(3)
+            .map(|c| [f64::from(c[0]), f64::from(c[1]), f64::from(c[2])])
+            .collect();
+        let model = PhotometricModel::from_json(&v["model"], appearance, w, h)
+            .map_err(|e| format!("{}: {e}", jpath.display()))?;
+        Ok((model, sha))
+    }
+
     /// The model from its section of photometric.json ([`Self::model_json`]) and its
     /// appearance (row-major, `width` x `height`, counts; NaN off the skin).
     ///

@@ -128,6 +128,23 @@ impl OutputClaim {
     }
 }
 
+/// Free bytes for an unprivileged user on the file system that would hold `out` (its nearest
+/// existing ancestor); `None` where that cannot be told.
+pub fn free_bytes(out: &Path) -> Option<u64> {
+    let abs = std::path::absolute(out).ok()?;
+    let dir = abs.ancestors().find(|a| a.exists())?;
+    #[cfg(unix)]
+    {
+        let s = rustix::fs::statvfs(dir).ok()?;
+        Some(s.f_bavail.saturating_mul(s.f_frsize))
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = dir;
+        None
+    }
+}
+
 /// Largest input file [`OutputClaim::of_inputs`] reads, bytes (1 GiB).
 pub const MAX_HASHED_INPUT_BYTES: u64 = 1 << 30;
 

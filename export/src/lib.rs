@@ -36,7 +36,7 @@ mod stl;
 mod three_mf;
 pub mod two_d;
 
-pub use atomic::{check_out_dir, OutputClaim, OutputCommand, StagedDir, OUTPUT_MARKER};
+pub use atomic::{check_out_dir, free_bytes, OutputClaim, OutputCommand, StagedDir, OUTPUT_MARKER};
 pub use check::check_printable_mesh;
 pub use error::ExportError;
 pub use manifest::{

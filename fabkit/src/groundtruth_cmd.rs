@@ -10,15 +10,15 @@ use std::error::Error;
 use std::path::{Path, PathBuf};
 
 use fabkit_calibration::groundtruth::dataset::{
-    self, output_bound, render_frames, FrameInputs, ImageSource, ManifestInputs,
+    self, output_bound, FrameInputs, ImageSource, ManifestInputs, DEFAULT_MAX_OUTPUT_BYTES,
+    MAX_OUTPUT_BYTES_LIMIT,
 };
 use fabkit_calibration::groundtruth::inputs::{read_extrinsics, read_fixtures, read_with_hash};
 use fabkit_calibration::groundtruth::pins::read_pin_captures;
 use fabkit_calibration::groundtruth::shading::Imaging;
 use fabkit_calibration::groundtruth::{reference_hits, Scene};
 use fabkit_calibration::photometric::PhotometricModel;
-use fabkit_export::{OutputClaim, OutputCommand, StagedDir};
-use serde_json::Value;
+use fabkit_export::{OutputClaim, StagedDir};
 
 use crate::cli::{load_design, DataFileArgs};
 
@@ -112,11 +112,6 @@ impl From<DataFormat> for dataset::DataFormat {
     }
 }
 
-/// Default `--max-output-bytes`: 1 GB.
-const DEFAULT_MAX_OUTPUT_BYTES: u64 = 1_000_000_000;
-/// Largest `--max-output-bytes`: 1 PB.
-const MAX_OUTPUT_BYTES_LIMIT: u64 = 1_000_000_000_000_000;
-
 fn parse_max_output_bytes(s: &str) -> Result<u64, String> {
     match s.trim().parse::<u64>() {
         Ok(n) if (1..=MAX_OUTPUT_BYTES_LIMIT).contains(&n) => Ok(n),
@@ -148,28 +143,16 @@ fn load_photometric(
     w: usize,
     h: usize,
 ) -> Result<(PhotometricModel, String), Box<dyn Error>> {
-    let jpath = dir.join("photometric.json");
-    let (bytes, sha) = read_with_hash(&jpath)?;
-    let bad = |what: String| -> Box<dyn Error> {
-        format!("--photometric {}: {what}", jpath.display()).into()
-    };
-    let v: Value = serde_json::from_slice(&bytes).map_err(|e| bad(format!("not JSON: {e}")))?;
-    let apath = dir.join("appearance.npy");
-    let (abytes, _) = read_with_hash(&apath)?;
-    let (shape, data) = fabkit_export::raster::read_npy_f32(&abytes)
-        .map_err(|e| format!("--photometric {}: {e}", apath.display()))?;
-    if shape != [h, w, 3] {
+    let (model, sha) = PhotometricModel::read(dir).map_err(|e| format!("--photometric {e}"))?;
+    if (model.width, model.height) != (w, h) {
         return Err(format!(
-            "--photometric {}: shape {shape:?}, the camera's images need [{h}, {w}, 3] (the model was fitted to another camera)",
-            apath.display()
+            "--photometric {}: shape [{}, {}, 3], the camera's images need [{h}, {w}, 3] (the model was fitted to another camera)",
+            dir.join("appearance.npy").display(),
+            model.height,
+            model.width
         )
         .into());
     }
-    let appearance = data
-        .chunks_exact(3)
-        .map(|c| [f64::from(c[0]), f64::from(c[1]), f64::from(c[2])])
-        .collect();
-    let model = PhotometricModel::from_json(&v["model"], appearance, w, h).map_err(bad)?;
     Ok((model, sha))
 }
 
@@ -182,23 +165,6 @@ fn shown_bytes(n: u64) -> String {
         format!("{:.0} MB", x / 1e6)
     } else {
         format!("{:.0} kB", (x / 1e3).ceil())
-    }
-}
-
-/// Free bytes for an unprivileged user on the file system that would hold `out` (its nearest
-/// existing ancestor); `None` where that cannot be told.
-fn free_bytes(out: &std::path::Path) -> Option<u64> {
-    let abs = std::path::absolute(out).ok()?;
-    let dir = abs.ancestors().find(|a| a.exists())?;
-    #[cfg(unix)]
-    {
-        let s = rustix::fs::statvfs(dir).ok()?;
-        Some(s.f_bavail.saturating_mul(s.f_frsize))
-    }
-    #[cfg(not(unix))]
-    {
-        let _ = dir;
-        None
     }
 }
 
@@ -251,36 +217,22 @@ pub fn check_skin_seen(
     ))
 }
 
-/// The claim on --out: ground truth of the design (by name, or its file's content), the
-/// camera file, the extrinsics and the fixtures folder (its marker lists the SHA-256 of every
-/// file in it; its protrusion index counts when there is no marker).
+/// The claim on --out ([`dataset::claim`]).
 fn claim(args: &GroundTruthArgs) -> OutputClaim {
-    let design = args
-        .design
-        .as_deref()
-        .unwrap_or(fabkit_designs::library::DEFAULT_DESIGN);
-    let design_file = Path::new(design);
-    let fixtures_marker = args.fixtures.join(fabkit_export::OUTPUT_MARKER);
-    let points = args.fixtures.join("points");
-    let fixture_files = if args.pin_captures {
-        vec![
-            points.join("point_table.csv"),
-            points.join("capture_plan.csv"),
-            args.fixtures.join("manifest.json"),
-        ]
-    } else {
-        vec![args.fixtures.join("protrusions").join("index.json")]
-    };
-    let mut inputs: Vec<&Path> = vec![&args.cam.camera, &args.extrinsics, &fixtures_marker];
-    inputs.extend(fixture_files.iter().map(PathBuf::as_path));
-    if design_file.is_file() {
-        inputs.push(design_file);
-    }
-    let what = match &args.preset {
-        Some(p) => format!("ground truth of design '{design}' preset '{p}'"),
-        None => format!("ground truth of design '{design}'"),
-    };
-    OutputClaim::of_inputs(OutputCommand::Groundtruth, &what, &inputs, args.force)
+    dataset::claim(
+        &dataset::ClaimInputs {
+            design: args
+                .design
+                .as_deref()
+                .unwrap_or(fabkit_designs::library::DEFAULT_DESIGN),
+            preset: args.preset.as_deref(),
+            camera_file: &args.cam.camera,
+            extrinsics_file: &args.extrinsics,
+            fixtures_dir: &args.fixtures,
+            pin_captures: args.pin_captures,
+        },
+        args.force,
+    )
 }
 
 pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
@@ -401,7 +353,7 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
         )
         .into());
     }
-    if let Some(free) = free_bytes(&args.out) {
+    if let Some(free) = fabkit_export::free_bytes(&args.out) {
         if bound > free {
             return Err(format!(
                 "--out {}: the ground truth may take up to {} ({bound} bytes, {n_files} files), more than the {} ({free} bytes) free on its file system: refusing before rendering (hint: use {alternatives}, free space, or write elsewhere)",
@@ -427,12 +379,7 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
         &format!("rendering {frames} frames of {}", design.name),
         frames,
     );
-    let provenance = format!(
-        "fabkit {} groundtruth, design {} (sha256 {})",
-        env!("CARGO_PKG_VERSION"),
-        design.name,
-        loaded.sha256
-    );
+    let provenance = dataset::provenance(&design.name, &loaded.sha256);
 
     let imaging = match photometric {
         Some(((m, sha), dir)) => Some(ImageSource::Photometric(
@@ -451,7 +398,8 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
         }),
     };
     let staged = StagedDir::new(&args.out, claim)?;
-    let rendered = render_frames(
+    let all = dataset::write(
+        &staged,
         &FrameInputs {
             rays: &rays,
             reference_hits: &ref_hits,
@@ -461,13 +409,6 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
             imaging: imaging.as_ref(),
             provenance: &provenance,
         },
-        &|rel, bytes| staged.write(rel, bytes).map_err(Into::into),
-        &|k| bar.set(k, frames),
-    )
-    .map_err(|e| -> Box<dyn Error> { e })?;
-    bar.finish();
-    let n_pairs = fixtures.patterns.len() * fixtures.patterns.len();
-    let manifest = dataset::manifest(
         &ManifestInputs {
             fabkit_version: env!("CARGO_PKG_VERSION"),
             command_line: &std::env::args().collect::<Vec<_>>(),
@@ -477,21 +418,20 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
             flat_skin: design.body.flat_outline().is_some(),
             camera: &camera,
             camera_file: &args.cam.camera.display().to_string(),
-            camera_sha256: &camera_sha,
+            camera_sha256: Some(&camera_sha),
             extrinsics_file: &args.extrinsics.display().to_string(),
-            extrinsics_sha256: &extrinsics_sha,
+            extrinsics_sha256: Some(&extrinsics_sha),
             t_cam_sensor: &t_cam_sensor,
             camera_centre_mm: c,
             fixtures: &fixtures,
             pixels_on_surface: ref_hits.valid_count(),
             imaging: imaging.as_ref(),
         },
-        &rendered,
-    );
-    let all = rendered.files;
-    let mut text = serde_json::to_vec_pretty(&manifest)?;
-    text.push(b'\n');
-    staged.write("manifest.json", &text)?;
+        &|k| bar.set(k, frames),
+    )
+    .map_err(|e| -> Box<dyn Error> { e })?;
+    bar.finish();
+    let n_pairs = fixtures.patterns.len() * fixtures.patterns.len();
     for w in staged.commit()? {
         eprintln!("warning: {w}");
     }

@@ -38,6 +38,7 @@ from ._fabkit import (  # noqa: F401
     read_pin_captures,
     PhotometricModel,
     read_photometric,
+    GROUNDTRUTH_FILES,
 )
 from .groundtruth import GroundTruth, StitchedPair  # noqa: F401
 from .sweep import SweepTables, sweep  # noqa: F401

@@ -16,6 +16,11 @@ __version__: str
 DEFAULT_DESIGN: str
 #: The default chord tolerance of every build, mm (0.01).
 DEFAULT_CHORD_TOLERANCE_MM: float
+#: The names of a ground-truth dataset's files (manifest, pairs, left_mask, right_mask,
+#: reference_dir, maps, delta_maps, normals, npy_suffix, png16_suffix, preview_suffix,
+#: arrays_npz, points, contact_mask, image, pairs_header) and its 16-bit PNG encodings
+#: (png16_depth, png16_delta: scale_mm_per_count, offset_counts), as the writer uses them.
+GROUNDTRUTH_FILES: Dict[str, Any]
 
 StrPath = Union[str, PathLike]
 #: progress(done, total, message), called as long work advances (from any thread, GIL held).
@@ -279,12 +284,13 @@ class DepthRenderer:
         self,
         design: Design,
         camera: Union[Camera, StrPath],
-        T_cam_sensor: npt.ArrayLike,
+        T_cam_sensor: Union[npt.ArrayLike, StrPath],
         *,
         max_pixels: int = 2048 * 2048,
     ) -> None:
-        """T_cam_sensor (4, 4): sensor frame -> camera frame, mm; the camera centre must be
-        inside the sensor body. max_pixels: 1 to 2048 * 2048 (the render's memory budget,
+        """T_cam_sensor (4, 4): sensor frame -> camera frame, mm, or the path of the
+        extrinsics.json of ``fabkit calibrate extrinsics``; the camera centre must be inside
+        the sensor body. max_pixels: 1 to 2048 * 2048 (the render's memory budget,
         2 GiB), else ValueError. Raises GroundTruthError for a larger image or a camera that
         sees the skin in under 1 % of its pixels."""
     @property
@@ -319,6 +325,29 @@ class DepthRenderer:
         groundtruth --images --photometric``), noise-free, at the model's bit depth.
         Raises GroundTruthError naming the path of a bad optics value, or for a model of
         another camera size."""
+    def write(
+        self,
+        out: StrPath,
+        fixtures: StrPath,
+        *,
+        pin_captures: bool = False,
+        format: str = "npy",
+        images: bool = False,
+        photometric: Optional[PhotometricModel] = None,
+        force: bool = False,
+        max_output_bytes: int = 1_000_000_000,
+        yes: bool = False,
+        command_line: Optional[Sequence[str]] = None,
+        progress: Optional[Progress] = None,
+    ) -> List[str]:
+        """Writes the ground-truth dataset of a ``fabkit fixtures`` folder to ``out`` as
+        ``fabkit groundtruth`` does, byte for byte for the same inputs and ``command_line``
+        (default ``sys.argv``; recorded in manifest.json). format: npy, npz or png (ValueError
+        else); images: each frame's image.png, from ``photometric`` when given. ``out`` is
+        replaced only when it holds earlier ground truth of the same inputs (any, with force).
+        The output is bounded first: over max_output_bytes it is refused unless yes, and
+        beyond the free space. Returns the relative paths written, manifest.json last. Raises
+        GroundTruthError naming the file and the rule."""
 
 def _library_build_seconds(
     design: Design, repeats: int, *, chord_tolerance_mm: float = 0.01

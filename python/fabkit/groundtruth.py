@@ -45,14 +45,30 @@ from typing import Dict, List, NamedTuple, Optional, Tuple
 
 import numpy as np
 
+from ._fabkit import GROUNDTRUTH_FILES as _F
+
 __all__ = ["GroundTruth", "StitchedPair"]
 
 #: Header row of ``pairs.csv``.
-PAIRS_HEADER = ["pair", "right_pattern", "right_dir", "left_pattern", "left_dir"]
+PAIRS_HEADER = list(_F["pairs_header"])
 #: Keys every ``fabkit groundtruth`` manifest has.
 _MANIFEST_KEYS = ("reference", "configurations", "masks_and_pairs", "image", "camera", "extrinsics")
 #: Scalar maps of a configuration frame; the reference has only the first two.
-_SCALARS = ("range_mm", "zdepth_mm", "delta_range_mm", "delta_zdepth_mm")
+_SCALARS = tuple(_F["maps"]) + tuple(_F["delta_maps"])
+_MANIFEST = _F["manifest"]
+_PAIRS = _F["pairs"]
+_LEFT_MASK = _F["left_mask"]
+_RIGHT_MASK = _F["right_mask"]
+_NORMALS = _F["normals"]
+_NPY = _F["npy_suffix"]
+_NPZ = _F["arrays_npz"]
+_CONTACT = _F["contact_mask"]
+
+
+def _png16(map_name: str) -> str:
+    """``range_mm`` -> ``range_um.png``: a map's 16-bit PNG."""
+    stem = map_name[: -len("_mm")] if map_name.endswith("_mm") else map_name
+    return stem + _F["png16_suffix"]
 _PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
 
@@ -167,13 +183,13 @@ class GroundTruth:
             w = int(m["image"]["width_px"])
         except (KeyError, TypeError, ValueError):
             raise ValueError(
-                f"{self._path('manifest.json')}: image = {m.get('image')!r}: must hold "
+                f"{self._path(_MANIFEST)}: image = {m.get('image')!r}: must hold "
                 "width_px and height_px"
             ) from None
         self.shape: Tuple[int, int] = (h, w)
         if not isinstance(m["camera"], dict) or not isinstance(m["extrinsics"], dict):
             raise ValueError(
-                f"{self._path('manifest.json')}: camera and extrinsics must be JSON objects"
+                f"{self._path(_MANIFEST)}: camera and extrinsics must be JSON objects"
             )
         self.camera: dict = dict(m["camera"])
         try:
@@ -182,19 +198,19 @@ class GroundTruth:
             t = np.zeros(0)
         if t.shape != (4, 4):
             raise ValueError(
-                f"{self._path('manifest.json')}: extrinsics.T_cam_sensor: must be a 4 x 4 matrix"
+                f"{self._path(_MANIFEST)}: extrinsics.T_cam_sensor: must be a 4 x 4 matrix"
             )
         self.T_cam_sensor: np.ndarray = t
         self.patterns: List[str] = list((m.get("fixtures") or {}).get("patterns") or [])
 
         self._frames: Dict[str, dict] = {}  # frame dir -> {"files": {rel path: entry}}
-        ref_dir = m["reference"].get("dir", "reference")
+        ref_dir = m["reference"].get("dir", _F["reference_dir"])
         self._reference_dir = ref_dir
         self._frames[ref_dir] = self._frame_entry(m["reference"])
         for c in m["configurations"]:
             if "dir" not in c:
                 raise ValueError(
-                    f"{self._path('manifest.json')}: configurations: an entry has no 'dir'"
+                    f"{self._path(_MANIFEST)}: configurations: an entry has no 'dir'"
                 )
             self._frames[c["dir"]] = self._frame_entry(c)
         self.format: str = self._detect_format(ref_dir)
@@ -209,11 +225,11 @@ class GroundTruth:
                         f"(--format {self.format}); the folder is incomplete"
                     )
 
-        left = self._read_mask("left_mask.png")
-        right = self._read_mask("right_mask.png")
+        left = self._read_mask(_LEFT_MASK)
+        right = self._read_mask(_RIGHT_MASK)
         if (left & right).any():
             raise ValueError(
-                f"{self._path('left_mask.png')}: overlaps right_mask.png: the half masks must be disjoint"
+                f"{self._path(_LEFT_MASK)}: overlaps {_RIGHT_MASK}: the half masks must be disjoint"
             )
         left.flags.writeable = False
         right.flags.writeable = False
@@ -283,7 +299,7 @@ class GroundTruth:
         return os.path.join(self.folder, *rel.split("/"))
 
     def _read_manifest(self) -> dict:
-        p = self._path("manifest.json")
+        p = self._path(_MANIFEST)
         if not os.path.isfile(p):
             raise FileNotFoundError(
                 f"{p}: missing: not a `fabkit groundtruth` output folder "
@@ -329,32 +345,34 @@ class GroundTruth:
 
     def _detect_format(self, ref_dir: str) -> str:
         files = self._frames[ref_dir]["files"]
-        if f"{ref_dir}/arrays.npz" in files:
-            return "npz"
-        if f"{ref_dir}/range_mm.npy" in files:
-            return "npy"
-        if f"{ref_dir}/range_um.png" in files:
-            return "png"
+        candidates = (
+            ("npz", f"{ref_dir}/{_NPZ}"),
+            ("npy", f"{ref_dir}/{_SCALARS[0]}{_NPY}"),
+            ("png", f"{ref_dir}/{_png16(_SCALARS[0])}"),
+        )
+        for fmt, rel in candidates:
+            if rel in files:
+                return fmt
         raise ValueError(
-            f"{self._path('manifest.json')}: reference.files lists none of {ref_dir}/arrays.npz, "
-            f"{ref_dir}/range_mm.npy, {ref_dir}/range_um.png: cannot tell the --format"
+            f"{self._path(_MANIFEST)}: reference.files lists none of "
+            f"{', '.join(rel for _, rel in candidates)}: cannot tell the --format"
         )
 
     def _frame_files(self, d: str, reference: bool) -> List[str]:
         """Relative paths of the files read for frame ``d``."""
         names = _SCALARS[:2] if reference else _SCALARS
         if self.format == "npy":
-            files = [f"{d}/{n}.npy" for n in names] + [f"{d}/normals.npy"]
+            files = [f"{d}/{n}{_NPY}" for n in names + (_NORMALS,)]
         elif self.format == "npz":
-            files = [f"{d}/arrays.npz"]
+            files = [f"{d}/{_NPZ}"]
         else:
-            files = [f"{d}/{n[:-3]}_um.png" for n in names]
+            files = [f"{d}/{_png16(n)}" for n in names]
         if not reference:
-            files.append(f"{d}/contact_mask.png")
+            files.append(f"{d}/{_CONTACT}")
         return files
 
     def _read_pairs(self) -> List[Tuple[int, str, str, str, str]]:
-        p = self._path("pairs.csv")
+        p = self._path(_PAIRS)
         if not os.path.isfile(p):
             raise FileNotFoundError(f"{p}: missing: a `fabkit groundtruth` folder lists its stitched pairs there")
         with open(p, newline="", encoding="utf-8") as f:
@@ -404,18 +422,18 @@ class GroundTruth:
         names = _SCALARS[:2] if reference else _SCALARS
         out: Dict[str, np.ndarray] = {}
         if self.format == "npy":
-            for n in names + ("normals",):
-                p = self._path(f"{d}/{n}.npy")
-                shape = (h, w, 3) if n == "normals" else (h, w)
+            for n in names + (_NORMALS,):
+                p = self._path(f"{d}/{n}{_NPY}")
+                shape = (h, w, 3) if n == _NORMALS else (h, w)
                 out[n] = self._check(p, _np_load(p), shape)
         elif self.format == "npz":
-            p = self._path(f"{d}/arrays.npz")
+            p = self._path(f"{d}/{_NPZ}")
             try:
                 with np.load(p, allow_pickle=False) as z:
-                    for n in names + ("normals",):
+                    for n in names + (_NORMALS,):
                         if n not in z.files:
                             raise ValueError(f"{p}: no array {n!r} (holds {sorted(z.files)})")
-                        shape = (h, w, 3) if n == "normals" else (h, w)
+                        shape = (h, w, 3) if n == _NORMALS else (h, w)
                         out[n] = self._check(f"{p}[{n}]", z[n], shape)
             except FileNotFoundError:
                 raise FileNotFoundError(f"{p}: missing (frame {d!r})") from None
@@ -424,11 +442,12 @@ class GroundTruth:
         else:
             entries = self._frames[d]["files"]
             for n in names:
-                rel = f"{d}/{n[:-3]}_um.png"
+                rel = f"{d}/{_png16(n)}"
                 p = self._path(rel)
                 e = entries.get(rel, {})
-                scale = float(e.get("scale_mm_per_count", 0.001))
-                offset = int(e.get("offset_counts", 32768 if n.startswith("delta") else 0))
+                enc = _F["png16_delta"] if n in _F["delta_maps"] else _F["png16_depth"]
+                scale = float(e.get("scale_mm_per_count", enc["scale_mm_per_count"]))
+                offset = int(e.get("offset_counts", enc["offset_counts"]))
                 counts = _read_png(p)
                 if counts.dtype != np.uint16 or counts.shape != (h, w):
                     raise ValueError(
@@ -438,7 +457,7 @@ class GroundTruth:
                 v[counts == 0] = np.nan
                 out[n] = v
         if not reference:
-            p = self._path(f"{d}/contact_mask.png")
+            p = self._path(f"{d}/{_CONTACT}")
             c = _read_png(p)
             if c.dtype != np.uint8 or c.shape != (h, w):
                 raise ValueError(f"{p}: {c.dtype} {c.shape}: must be 8-bit greyscale of shape {(h, w)}")

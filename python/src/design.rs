@@ -28,6 +28,8 @@ pub struct Design {
     /// sha256 of the design's text (and marker files) as loaded; parameters set later are in
     /// the design's name only through presets.
     pub(crate) sha256: String,
+    /// The preset applied with `with_preset`, for a ground-truth dataset's claim.
+    pub(crate) preset: Option<String>,
 }
 
 impl Design {
@@ -36,6 +38,17 @@ impl Design {
             design,
             source,
             sha256,
+            preset: None,
+        }
+    }
+
+    /// The design as `fabkit` would be given it: a library design's name, a design file's
+    /// path, or the design's name when it came from text or a dict.
+    pub(crate) fn as_named(&self) -> String {
+        match self.source.strip_prefix("embedded:") {
+            Some(name) => name.to_string(),
+            None if std::path::Path::new(&self.source).is_file() => self.source.clone(),
+            None => self.design.name.clone(),
         }
     }
 }
@@ -358,7 +371,10 @@ impl Design {
             .design
             .with_preset(name)
             .map_err(|e| design_error(&e))?;
-        Ok(Design::of(d, self.source.clone(), self.sha256.clone()))
+        Ok(Design {
+            preset: Some(name.to_string()),
+            ..Design::of(d, self.source.clone(), self.sha256.clone())
+        })
     }
 
     /// Checks every rule of the design at once, as `fabkit validate`; returns the resolved layer

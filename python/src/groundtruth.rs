@@ -4,7 +4,12 @@
 
 use std::sync::Arc;
 
-use fabkit_calibration::groundtruth::inputs::{isometry_of, read_fixtures, Configuration};
+use fabkit_calibration::groundtruth::dataset::{
+    self, DataFormat, FrameInputs, ImageSource, ManifestInputs, DEFAULT_MAX_OUTPUT_BYTES,
+};
+use fabkit_calibration::groundtruth::inputs::{
+    isometry_of, read_extrinsics, read_fixtures, read_with_hash, Configuration,
+};
 use fabkit_calibration::groundtruth::shading::Imaging;
 use fabkit_calibration::groundtruth::{
     half_masks, indented_hits, reference_hits, DepthFrame, Scene, SurfaceHits,
@@ -116,6 +121,8 @@ pub fn read_pin_captures(
 pub struct PhotometricModel {
     model: Arc<fabkit_calibration::photometric::PhotometricModel>,
     source: String,
+    /// sha256 of its photometric.json, for a dataset's manifest.
+    sha256: String,
 }
 
 #[pymethods]
@@ -153,32 +160,14 @@ impl PhotometricModel {
 /// (H, W, 3) float32.
 #[pyfunction]
 pub fn read_photometric(py: Python<'_>, dir: std::path::PathBuf) -> PyResult<PhotometricModel> {
-    let model = crate::work(py, || -> Result<_, String> {
-        let jpath = dir.join("photometric.json");
-        let bytes = std::fs::read(&jpath).map_err(|e| format!("{}: {e}", jpath.display()))?;
-        let v: serde_json::Value = serde_json::from_slice(&bytes)
-            .map_err(|e| format!("{}: not JSON: {e}", jpath.display()))?;
-        let apath = dir.join("appearance.npy");
-        let abytes = std::fs::read(&apath).map_err(|e| format!("{}: {e}", apath.display()))?;
-        let (shape, data) = fabkit_export::raster::read_npy_f32(&abytes)
-            .map_err(|e| format!("{}: {e}", apath.display()))?;
-        let [h, w, 3] = shape[..] else {
-            return Err(format!(
-                "{}: shape {shape:?}, not (H, W, 3)",
-                apath.display()
-            ));
-        };
-        let appearance = data
-            .chunks_exact(3)
-            .map(|c| [f64::from(c[0]), f64::from(c[1]), f64::from(c[2])])
-            .collect();
-        fabkit_calibration::photometric::PhotometricModel::from_json(&v["model"], appearance, w, h)
-            .map_err(|e| format!("{}: {e}", jpath.display()))
+    let (model, sha256) = crate::work(py, || {
+        fabkit_calibration::photometric::PhotometricModel::read(&dir)
     })?
     .map_err(GroundTruthError::new_err)?;
     Ok(PhotometricModel {
         model: Arc::new(model),
         source: dir.display().to_string(),
+        sha256,
     })
 }
 
@@ -191,6 +180,19 @@ pub fn read_photometric(py: Python<'_>, dir: std::path::PathBuf) -> PyResult<Pho
 #[pyclass(module = "fabkit", frozen)]
 pub struct DepthRenderer {
     scene: Scene,
+    /// The camera, its file (or `<arrays>`) and that file's sha256, for `write`'s manifest.
+    camera: fabkit_calibration::CameraModel,
+    camera_file: String,
+    camera_sha256: Option<String>,
+    /// T_cam_sensor, its extrinsics.json (or `<array>`) and that file's sha256.
+    pose: nalgebra::Isometry3<f64>,
+    extrinsics_file: String,
+    extrinsics_sha256: Option<String>,
+    /// The design as loaded: as named, its source, sha256 and preset.
+    named: String,
+    source: String,
+    sha256: String,
+    preset: Option<String>,
     reference_hits: SurfaceHits,
     reference: DepthFrame,
     /// The design, for its optics when an image is first asked for.
@@ -256,6 +258,52 @@ fn frame_dict<'py>(py: Python<'py>, f: &DepthFrame) -> PyResult<Bound<'py, PyDic
     Ok(d)
 }
 
+impl DepthRenderer {
+    /// The imaging of the design's optics, set up on first use (the optics resolved, the
+    /// exposure set on the reference).
+    fn physical_imaging(&self) -> Result<&Imaging, String> {
+        self.imaging
+            .get_or_init(|| {
+                ImageSource::of_design(
+                    &self.design,
+                    self.principal_px,
+                    &self.scene.rays,
+                    &self.reference_hits,
+                )
+                .map_err(|e| e.to_string())
+            })
+            .as_ref()
+            .map_err(Clone::clone)
+    }
+}
+
+/// T_cam_sensor from a (4, 4) array (`<array>`, no file) or the path of an extrinsics.json of
+/// `fabkit calibrate extrinsics` (with its sha256).
+fn pose_of(
+    py: Python<'_>,
+    t: &Bound<'_, PyAny>,
+) -> PyResult<(nalgebra::Isometry3<f64>, String, Option<String>)> {
+    if let Ok(path) = t.extract::<std::path::PathBuf>() {
+        let (pose, sha) =
+            crate::work(py, || read_extrinsics(&path))?.map_err(|e| err::<GroundTruthError>(&e))?;
+        return Ok((pose, path.display().to_string(), Some(sha)));
+    }
+    let t = crate::calibration::float64_array(t, "T_cam_sensor")?;
+    if t.shape() != [4, 4] {
+        return Err(PyValueError::new_err(format!(
+            "T_cam_sensor: shape {} where (4, 4) is needed",
+            crate::calibration::shape_text(t.shape())
+        )));
+    }
+    let t = t.readonly();
+    let t = t.as_array();
+    let m: [[f64; 4]; 4] = std::array::from_fn(|r| std::array::from_fn(|c| t[[r, c]]));
+    let pose = isometry_of(&m).map_err(|(field, value, rule)| {
+        GroundTruthError::new_err(format!("{field} = {value}: {rule}"))
+    })?;
+    Ok((pose, "<array>".into(), None))
+}
+
 #[pymethods]
 impl DepthRenderer {
     #[new]
@@ -269,19 +317,7 @@ impl DepthRenderer {
         max_pixels: u64,
     ) -> PyResult<DepthRenderer> {
         let camera = Camera::of(camera)?;
-        let t = crate::calibration::float64_array(T_cam_sensor, "T_cam_sensor")?;
-        if t.shape() != [4, 4] {
-            return Err(PyValueError::new_err(format!(
-                "T_cam_sensor: shape {} where (4, 4) is needed",
-                crate::calibration::shape_text(t.shape())
-            )));
-        }
-        let t = t.readonly();
-        let t = t.as_array();
-        let m: [[f64; 4]; 4] = std::array::from_fn(|r| std::array::from_fn(|c| t[[r, c]]));
-        let pose = isometry_of(&m).map_err(|(field, value, rule)| {
-            GroundTruthError::new_err(format!("{field} = {value}: {rule}"))
-        })?;
+        let (pose, extrinsics_file, extrinsics_sha256) = pose_of(py, T_cam_sensor)?;
         if !(1..=MAX_PIXELS_LIMIT).contains(&max_pixels) {
             return Err(PyValueError::new_err(format!(
                 "max_pixels = {max_pixels}: must be from 1 to {MAX_PIXELS_LIMIT} (2048 x 2048, what the render's memory budget of {} GiB holds)",
@@ -303,6 +339,17 @@ impl DepthRenderer {
                 }
             )));
         }
+        let camera_sha256 = std::path::Path::new(&camera.source)
+            .is_file()
+            .then(|| read_with_hash(std::path::Path::new(&camera.source)).ok())
+            .flatten()
+            .map(|(_, sha)| sha);
+        let (named, source, sha256, preset) = (
+            design.as_named(),
+            design.source.clone(),
+            design.sha256.clone(),
+            design.preset.clone(),
+        );
         let design = &design.design;
         let model = &camera.model;
         crate::work(py, || {
@@ -323,6 +370,16 @@ impl DepthRenderer {
             let reference = DepthFrame::new(&scene.rays, &hits);
             Ok(DepthRenderer {
                 scene,
+                camera: *model,
+                camera_file: camera.source.clone(),
+                camera_sha256,
+                pose,
+                extrinsics_file,
+                extrinsics_sha256,
+                named,
+                source,
+                sha256,
+                preset,
                 reference_hits: hits,
                 reference,
                 design: design.clone(),
@@ -456,24 +513,7 @@ impl DepthRenderer {
             return Ok(rgb_array(py, img, rays.height, rays.width, bits));
         }
         let img = crate::work(py, || -> Result<Vec<[u16; 3]>, String> {
-            let imaging = self
-                .imaging
-                .get_or_init(|| {
-                    let tol = fabkit_designs::ChordTolerance::new(
-                        fabkit_designs::ChordTolerance::DEFAULT_MM,
-                    )
-                    .map_err(|e| e.to_string())?;
-                    let optics = fabkit_designs::optics::of_design(&self.design, tol)
-                        .map_err(|e| e.to_string())?;
-                    Ok(Imaging::new(
-                        optics,
-                        self.principal_px,
-                        rays,
-                        &self.reference_hits,
-                    ))
-                })
-                .as_ref()
-                .map_err(Clone::clone)?;
+            let imaging = self.physical_imaging()?;
             Ok(match protrusions {
                 None => imaging.image(rays, &self.reference_hits, None, frame),
                 Some(p) => {
@@ -496,6 +536,178 @@ impl DepthRenderer {
         Ok(rgb_array(py, img, h, w, bits))
     }
 
+    /// Writes the ground-truth dataset of the fixtures in `fixtures` (a `fabkit fixtures`
+    /// output folder built from this design) to the folder `out`, exactly as `fabkit
+    /// groundtruth` writes it: the same files, names, encodings and manifest.json, byte for
+    /// byte for the same inputs and command line (`command_line`, default `sys.argv`, is
+    /// recorded in the manifest). `pin_captures` renders the pin dome's captures instead of the
+    /// protrusion patterns; `format` is `npy`, `npz` or `png`; `images` adds each frame's
+    /// `image.png` from the design's optics, or from `photometric` (a PhotometricModel) when
+    /// given. `out` is replaced as a whole only when it holds earlier ground truth of the same
+    /// inputs (or of any inputs with `force`); anything else in it is refused. The output is
+    /// bounded before anything is rendered: over `max_output_bytes` (bytes, default 1 GB) it is
+    /// refused unless `yes`, and it is refused when larger than the free space. Files appear
+    /// only when all are written. `progress(done, total, message)` after each frame. Returns
+    /// the files written (relative paths, sorted; manifest.json last). Raises
+    /// GroundTruthError naming the file and the rule, ValueError for a bad argument.
+    #[pyo3(signature = (out, fixtures, *, pin_captures=false, format="npy", images=false,
+                        photometric=None, force=false, max_output_bytes=DEFAULT_MAX_OUTPUT_BYTES,
+                        yes=false, command_line=None, progress=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn write(
+        &self,
+        py: Python<'_>,
+        out: std::path::PathBuf,
+        fixtures: std::path::PathBuf,
+        pin_captures: bool,
+        format: &str,
+        images: bool,
+        photometric: Option<&PhotometricModel>,
+        force: bool,
+        max_output_bytes: u64,
+        yes: bool,
+        command_line: Option<Vec<String>>,
+        progress: Option<Py<PyAny>>,
+    ) -> PyResult<Vec<String>> {
+        let format = match format {
+            "npy" => DataFormat::Npy,
+            "npz" => DataFormat::Npz,
+            "png" => DataFormat::Png,
+            other => {
+                return Err(PyValueError::new_err(format!(
+                    "format = '{other}': must be 'npy', 'npz' or 'png'"
+                )))
+            }
+        };
+        if photometric.is_some() && !images {
+            return Err(PyValueError::new_err(
+                "photometric: given without images=True (the model renders each frame's image.png)",
+            ));
+        }
+        if !(1..=dataset::MAX_OUTPUT_BYTES_LIMIT).contains(&max_output_bytes) {
+            return Err(PyValueError::new_err(format!(
+                "max_output_bytes = {max_output_bytes}: must be from 1 to {} (10^15)",
+                dataset::MAX_OUTPUT_BYTES_LIMIT
+            )));
+        }
+        let command_line = match command_line {
+            Some(c) => c,
+            None => py.import("sys")?.getattr("argv")?.extract()?,
+        };
+        let claim = dataset::claim(
+            &dataset::ClaimInputs {
+                design: &self.named,
+                preset: self.preset.as_deref(),
+                camera_file: std::path::Path::new(&self.camera_file),
+                extrinsics_file: std::path::Path::new(&self.extrinsics_file),
+                fixtures_dir: &fixtures,
+                pin_captures,
+            },
+            force,
+        );
+        fabkit_export::check_out_dir(&out, &claim).map_err(|e| err::<GroundTruthError>(&e))?;
+        let name = self.design.name.clone();
+        let fixture_set = crate::work(py, || {
+            if pin_captures {
+                fabkit_calibration::groundtruth::pins::read_pin_captures(&fixtures, &name)
+            } else {
+                read_fixtures(&fixtures, &name)
+            }
+        })?
+        .map_err(|e| err::<GroundTruthError>(&e))?;
+        self.scene
+            .check_outside(&fixture_set.configurations, "T_cam_sensor")
+            .map_err(GroundTruthError::new_err)?;
+        let rays = &self.scene.rays;
+        if let Some(m) = photometric {
+            let m = &m.model;
+            if (m.width, m.height) != (rays.width, rays.height) {
+                return Err(GroundTruthError::new_err(format!(
+                    "photometric: the model is of a {} x {} px camera, this renderer's is {} x {} px (the model was fitted to another camera)",
+                    m.width, m.height, rays.width, rays.height
+                )));
+            }
+        }
+        let imaging = match photometric {
+            Some(m) => Some(ImageSource::Photometric(
+                Box::new((*m.model).clone()),
+                m.source.clone(),
+                m.sha256.clone(),
+            )),
+            None if images => Some(ImageSource::Physical(Box::new(
+                crate::work(py, || self.physical_imaging().cloned())?
+                    .map_err(GroundTruthError::new_err)?,
+            ))),
+            None => None,
+        };
+        let n_cfg = fixture_set.configurations.len();
+        let (n_files, bound) = dataset::output_bound(
+            rays.width as u64,
+            rays.height as u64,
+            n_cfg as u64,
+            fixture_set.patterns.len() as u64,
+            format,
+            imaging.as_ref().map(ImageSource::bits),
+        );
+        if bound > max_output_bytes && !yes {
+            return Err(GroundTruthError::new_err(format!(
+                "{}: the ground truth would take up to {bound} bytes ({n_files} files), over max_output_bytes = {max_output_bytes}: refused before rendering (give yes=True to write it, or format='npz' or 'png')",
+                out.display()
+            )));
+        }
+        if let Some(free) = fabkit_export::free_bytes(&out) {
+            if bound > free {
+                return Err(GroundTruthError::new_err(format!(
+                    "{}: the ground truth may take up to {bound} bytes ({n_files} files), more than the {free} bytes free on its file system: refused before rendering",
+                    out.display()
+                )));
+            }
+        }
+        let frames = n_cfg as u64 + 1;
+        let provenance = dataset::provenance(&name, &self.sha256);
+        let written = crate::work(py, || -> Result<Vec<String>, String> {
+            let staged = fabkit_export::StagedDir::new(&out, claim).map_err(|e| e.to_string())?;
+            let files = dataset::write(
+                &staged,
+                &FrameInputs {
+                    rays,
+                    reference_hits: &self.reference_hits,
+                    base_z_mm: self.scene.surface.base_z_mm(),
+                    fixtures: &fixture_set,
+                    format,
+                    imaging: imaging.as_ref(),
+                    provenance: &provenance,
+                },
+                &ManifestInputs {
+                    fabkit_version: env!("CARGO_PKG_VERSION"),
+                    command_line: &command_line,
+                    design_name: &name,
+                    design_source: &self.source,
+                    design_sha256: &self.sha256,
+                    flat_skin: self.design.body.flat_outline().is_some(),
+                    camera: &self.camera,
+                    camera_file: &self.camera_file,
+                    camera_sha256: self.camera_sha256.as_deref(),
+                    extrinsics_file: &self.extrinsics_file,
+                    extrinsics_sha256: self.extrinsics_sha256.as_deref(),
+                    t_cam_sensor: &self.pose,
+                    camera_centre_mm: rays.origin_mm,
+                    fixtures: &fixture_set,
+                    pixels_on_surface: self.reference_hits.valid_count(),
+                    imaging: imaging.as_ref(),
+                },
+                &|k| report_progress(&progress, k as usize, frames as usize, "groundtruth"),
+            )
+            .map_err(|e| e.to_string())?;
+            staged.commit().map_err(|e| e.to_string())?;
+            let mut names: Vec<String> = files.into_iter().map(|(f, ..)| f).collect();
+            names.push("manifest.json".into());
+            Ok(names)
+        })?
+        .map_err(GroundTruthError::new_err)?;
+        Ok(written)
+    }
+
     /// The half masks (left, right), (H, W) bool: pixels whose ray meets the reference
     /// surface at sensor-frame x < 0 (left) or x >= 0 (right), as left_mask.png and
     /// right_mask.png.
@@ -509,7 +721,42 @@ impl DepthRenderer {
     }
 }
 
+/// `fabkit.GROUNDTRUTH_FILES`: the names of a ground-truth dataset's files and the 16-bit
+/// PNG encodings, as the writer (`fabkit groundtruth`, `DepthRenderer.write`) uses them.
+fn groundtruth_files(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
+    use fabkit_calibration::groundtruth::dataset::{files, DELTA_PNG, DEPTH_PNG};
+    let d = PyDict::new(py);
+    for (k, v) in [
+        ("manifest", files::MANIFEST),
+        ("pairs", files::PAIRS),
+        ("left_mask", files::LEFT_MASK),
+        ("right_mask", files::RIGHT_MASK),
+        ("reference_dir", files::REFERENCE_DIR),
+        ("normals", files::NORMALS),
+        ("npy_suffix", files::NPY_SUFFIX),
+        ("png16_suffix", files::PNG16_SUFFIX),
+        ("preview_suffix", files::PREVIEW_SUFFIX),
+        ("arrays_npz", files::ARRAYS_NPZ),
+        ("points", files::POINTS),
+        ("contact_mask", files::CONTACT_MASK),
+        ("image", files::IMAGE),
+    ] {
+        d.set_item(k, v)?;
+    }
+    d.set_item("pairs_header", files::PAIRS_HEADER.to_vec())?;
+    d.set_item("maps", files::MAPS.to_vec())?;
+    d.set_item("delta_maps", files::DELTA_MAPS.to_vec())?;
+    for (k, e) in [("png16_depth", DEPTH_PNG), ("png16_delta", DELTA_PNG)] {
+        let enc = PyDict::new(py);
+        enc.set_item("scale_mm_per_count", e.scale)?;
+        enc.set_item("offset_counts", e.offset_counts)?;
+        d.set_item(k, enc)?;
+    }
+    Ok(d)
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("GROUNDTRUTH_FILES", groundtruth_files(m.py())?)?;
     m.add_class::<ProtrusionSet>()?;
     m.add_class::<DepthRenderer>()?;
     m.add_function(wrap_pyfunction!(read_protrusions, m)?)?;

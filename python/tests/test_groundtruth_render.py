@@ -375,3 +375,63 @@ def test_a_camera_that_sees_no_skin_is_refused(scene):
     with pytest.raises(fabkit.GroundTruthError,
                        match=r"the camera sees the skin in \d+ of its \d+ pixels, fewer than"):
         fabkit.DepthRenderer(scene["design"], str(scene["dir"] / "cam.yaml"), away)
+
+
+def _tree(folder):
+    """{relative path: bytes} of every file under folder."""
+    return {
+        p.relative_to(folder).as_posix(): p.read_bytes()
+        for p in sorted(folder.rglob("*"))
+        if p.is_file()
+    }
+
+
+@pytest.mark.parametrize(
+    "out,extra,kwargs",
+    [
+        ("gt", ("--format", "npy"), {"format": "npy"}),
+        ("gt_npz_img", ("--format", "npz", "--images"), {"format": "npz", "images": True}),
+    ],
+)
+def test_write_is_the_cli_dataset_byte_for_byte(scene, run_cli, fabkit_bin, monkeypatch,
+                                                out, extra, kwargs):
+    """DepthRenderer.write, given the CLI's inputs (the same relative paths from the same
+    folder) and its command line, writes the dataset `fabkit groundtruth` writes: every file,
+    the manifest and the output marker, byte for byte; GroundTruth reads both alike."""
+    d = scene["dir"]
+    args = ["groundtruth", "rtac0", "--camera", "cam.yaml", "--extrinsics",
+            "extrinsics.json", "--fixtures", "fx", "--out", out, *extra]
+    if out != "gt":
+        run_cli(d, *args)
+    monkeypatch.chdir(d)
+    r = fabkit.DepthRenderer(fabkit.Design.load("rtac0"), "cam.yaml", "extrinsics.json")
+    seen = []
+    written = r.write(out + "_py", "fx", command_line=[fabkit_bin, *args],
+                      progress=lambda done, total, msg: seen.append((done, total)), **kwargs)
+    cli, py = _tree(d / out), _tree(d / (out + "_py"))
+    assert sorted(py) == sorted(cli)
+    assert len(py) > 10 and written[-1] == fabkit.GROUNDTRUTH_FILES["manifest"]
+    assert set(written) <= set(py) and len(written) == len(py) - 1  # and the marker
+    for rel in cli:
+        assert py[rel] == cli[rel], rel
+    assert sorted(seen)[-1] == (len(scene["sets"]) + 1,) * 2
+    a, b = fabkit.GroundTruth(d / out), fabkit.GroundTruth(d / (out + "_py"))
+    assert len(a) == len(b) == 4
+    for pa, pb in zip(a, b):
+        np.testing.assert_array_equal(pa.delta_zdepth_mm, pb.delta_zdepth_mm)
+        np.testing.assert_array_equal(pa.contact, pb.contact)
+    # the same inputs again replace the earlier output; another's folder is refused
+    r.write(out + "_py", "fx", command_line=[fabkit_bin, *args], **kwargs)
+    assert _tree(d / (out + "_py")) == py
+    with pytest.raises(fabkit.FabkitError, match="fx"):
+        r.write("fx", "fx", **kwargs)
+
+
+def test_write_bounds_its_output_before_rendering(scene, monkeypatch):
+    monkeypatch.chdir(scene["dir"])
+    r = scene["renderer"]
+    with pytest.raises(fabkit.GroundTruthError, match="max_output_bytes = 1000: refused before rendering"):
+        r.write("gt_small", "fx", max_output_bytes=1000)
+    assert not (scene["dir"] / "gt_small").exists()
+    with pytest.raises(ValueError, match="format = 'tiff'"):
+        r.write("gt_small", "fx", format="tiff")

@@ -8,8 +8,9 @@ use fabkit_export::raster::{
     normals_rgb, npy_f32, npz as npz_file, ply_points, png_gray16, png_gray8, png_rgb16, png_rgb8,
     preview_rgb, with_colour_bar, PlyPoint, Png16Encoding,
 };
-use fabkit_export::ExportError;
+use fabkit_export::{ExportError, OutputClaim, OutputCommand, StagedDir};
 use serde_json::{json, Value};
+use std::path::{Path, PathBuf};
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -23,6 +24,53 @@ use super::shading::Imaging;
 use super::{half_masks, indented_hits};
 use super::{DepthFrame, SurfaceHits};
 use crate::photometric::PhotometricModel;
+
+/// The names of a dataset's files, defined once for the writer here and its readers (Python's
+/// `fabkit.GroundTruth` takes them from `fabkit.GROUNDTRUTH_FILES`).
+pub mod files {
+    /// The manifest, at the top of the dataset.
+    pub const MANIFEST: &str = "manifest.json";
+    /// The stitched pairs of protrusion patterns (not written for pin captures).
+    pub const PAIRS: &str = "pairs.csv";
+    /// pairs.csv's header row.
+    pub const PAIRS_HEADER: [&str; 5] = [
+        "pair",
+        "right_pattern",
+        "right_dir",
+        "left_pattern",
+        "left_dir",
+    ];
+    /// The half masks: pixels seeing the reference surface at sensor-frame x < 0 and x >= 0.
+    pub const LEFT_MASK: &str = "left_mask.png";
+    pub const RIGHT_MASK: &str = "right_mask.png";
+    /// The reference (undeformed) frame's folder.
+    pub const REFERENCE_DIR: &str = "reference";
+    /// The float32 maps of every frame, in mm.
+    pub const MAPS: [&str; 2] = ["range_mm", "zdepth_mm"];
+    /// The differences to the reference of an indented frame's maps, mm.
+    pub const DELTA_MAPS: [&str; 2] = ["delta_range_mm", "delta_zdepth_mm"];
+    /// The (H, W, 3) float32 unit normals of every frame.
+    pub const NORMALS: &str = "normals";
+    /// A map's float32 file (`npy`): `<map>.npy`.
+    pub const NPY_SUFFIX: &str = ".npy";
+    /// A map `<stem>_mm`'s 16-bit PNG: `<stem>_um.png`.
+    pub const PNG16_SUFFIX: &str = "_um.png";
+    /// A map `<stem>_mm`'s colour-mapped preview: `<stem>_preview.png`.
+    pub const PREVIEW_SUFFIX: &str = "_preview.png";
+    /// A frame's float32 maps in one file (`npz`).
+    pub const ARRAYS_NPZ: &str = "arrays.npz";
+    /// A frame's surface points (`npy`).
+    pub const POINTS: &str = "points.ply";
+    /// An indented frame's contact mask.
+    pub const CONTACT_MASK: &str = "contact_mask.png";
+    /// A frame's rendered image (`--images`).
+    pub const IMAGE: &str = "image.png";
+
+    /// The stem of a map's PNG files: `range_mm` -> `range`.
+    pub fn stem(map: &str) -> &str {
+        map.trim_end_matches("_mm")
+    }
+}
 
 /// How the ground-truth arrays are written (`--format`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -82,7 +130,7 @@ fn array_file(
 ) {
     match format {
         DataFormat::Npy => {
-            let file = format!("{dir}/{name}.npy");
+            let file = format!("{dir}/{name}{}", files::NPY_SUFFIX);
             let mut e = meta;
             e["file"] = json!(file);
             files.push((file, npy_f32(shape, data), e));
@@ -106,7 +154,7 @@ fn scalar_files(
     enc: Png16Encoding,
     preview: (f64, f64),
 ) -> Result<(), ExportError> {
-    let stem = name.trim_end_matches("_mm");
+    let stem = files::stem(name);
     array_file(
         files,
         npz,
@@ -118,7 +166,7 @@ fn scalar_files(
         json!({"quantity": what, "units": "mm", "dtype": "float32", "shape": [h, w], "missing": "NaN"}),
     );
     let (counts, clipped) = enc.encode(values);
-    let png = format!("{dir}/{stem}_um.png");
+    let png = format!("{dir}/{stem}{}", files::PNG16_SUFFIX);
     let text = format!(
         "{what}; value_mm = (count - {}) * {}; count 0 = no value",
         enc.offset_counts, enc.scale
@@ -130,7 +178,7 @@ fn scalar_files(
                "value_mm": format!("(count - {}) * {}", enc.offset_counts, enc.scale), "scale_mm_per_count": enc.scale,
                "offset_counts": enc.offset_counts, "missing": 0, "clipped_pixels": clipped}),
     ));
-    let pv = format!("{dir}/{stem}_preview.png");
+    let pv = format!("{dir}/{stem}{}", files::PREVIEW_SUFFIX);
     let (w2, rgb) = with_colour_bar(
         w,
         h,
@@ -168,7 +216,7 @@ pub fn frame_files(
         &mut npz,
         format,
         dir,
-        "range_mm",
+        files::MAPS[0],
         "range: distance along the pixel's ray from the camera centre to the elastomer surface",
         &f.range_mm,
         (w, h),
@@ -180,7 +228,7 @@ pub fn frame_files(
         &mut npz,
         format,
         dir,
-        "zdepth_mm",
+        files::MAPS[1],
         "z-depth: z of the surface point in the camera frame",
         &f.zdepth_mm,
         (w, h),
@@ -197,12 +245,12 @@ pub fn frame_files(
         &mut npz,
         format,
         dir,
-        "normals",
+        files::NORMALS,
         &[h, w, 3],
         &normals,
         json!({"quantity": "unit normal of the elastomer surface, pointing out of the elastomer, camera frame", "units": "1", "dtype": "float32", "shape": [h, w, 3], "missing": "NaN"}),
     );
-    let np = format!("{dir}/normals_preview.png");
+    let np = format!("{dir}/{}{}", files::NORMALS, files::PREVIEW_SUFFIX);
     files.push((np.clone(), png_rgb8(w, h, &normals_rgb(&f.normal_cam), &[])?, json!({"file": np, "quantity": "preview of the unit normals: rgb = (n + 1) / 2", "missing": "black"})));
     if format == DataFormat::Npy {
         ply_file(&mut files, dir, f, provenance);
@@ -214,13 +262,13 @@ pub fn frame_files(
             .unwrap_or(0.0)
             .min(finite_range(&dz).map(|x| x.0).unwrap_or(0.0));
         let pr = (if lo < 0.0 { lo } else { -0.001 }, 0.0);
-        scalar_files(&mut files, &mut npz, format, dir, "delta_range_mm", "differential range: indented minus reference (negative where the skin is pushed towards the camera)", &dr, (w, h), DELTA_PNG, pr)?;
+        scalar_files(&mut files, &mut npz, format, dir, files::DELTA_MAPS[0], "differential range: indented minus reference (negative where the skin is pushed towards the camera)", &dr, (w, h), DELTA_PNG, pr)?;
         scalar_files(
             &mut files,
             &mut npz,
             format,
             dir,
-            "delta_zdepth_mm",
+            files::DELTA_MAPS[1],
             "differential z-depth: indented minus reference",
             &dz,
             (w, h),
@@ -232,11 +280,11 @@ pub fn frame_files(
             .iter()
             .map(|&c| if c { 255 } else { 0 })
             .collect();
-        let cm = format!("{dir}/contact_mask.png");
+        let cm = format!("{dir}/{}", files::CONTACT_MASK);
         files.push((cm.clone(), png_gray8(w, h, &mask, &[])?, json!({"file": cm, "quantity": "contact mask: 255 where a protrusion pushes the skin in (the surface seen is a protrusion), else 0", "dtype": "uint8", "shape": [h, w]})));
     }
     if format == DataFormat::Npz {
-        let file = format!("{dir}/arrays.npz");
+        let file = format!("{dir}/{}", files::ARRAYS_NPZ);
         let bytes = npz_file(
             &npz.iter()
                 .map(|(n, b, _)| (n.as_str(), b.as_slice()))
@@ -266,6 +314,22 @@ pub enum ImageSource {
 }
 
 impl ImageSource {
+    /// The design's optics through the physical image model ([`Imaging::new`]: the exposure
+    /// set on the reference image, the vignetting centred on the principal point
+    /// `principal_px`).
+    ///
+    /// # Errors
+    /// The design's optics do not resolve (the error names the parameter path).
+    pub fn of_design(
+        design: &fabkit_designs::Design,
+        principal_px: [f64; 2],
+        rays: &PixelRays,
+        reference_hits: &SurfaceHits,
+    ) -> Result<Imaging, fabkit_designs::DesignError> {
+        let optics = fabkit_designs::optics::of_design(design, Default::default())?;
+        Ok(Imaging::new(optics, principal_px, rays, reference_hits))
+    }
+
     /// Bits per channel of the images: the design's camera's, or the model's captures'.
     pub fn bits(&self) -> u32 {
         match self {
@@ -314,7 +378,7 @@ pub fn image_file(
         ),
     };
     let saturated = img.iter().filter(|p| p.contains(&full)).count();
-    let file = format!("{dir}/image.png");
+    let file = format!("{dir}/{}", files::IMAGE);
     let meta = [("Description", text.as_str())];
     let bytes = if bits == 16 {
         png_rgb16(w, h, &img, &meta)?
@@ -344,7 +408,7 @@ fn ply_file(files: &mut Files, dir: &str, f: &DepthFrame, provenance: &str) {
             contact: f.contact[p] as u8,
         })
         .collect();
-    let ply = format!("{dir}/points.ply");
+    let ply = format!("{dir}/{}", files::POINTS);
     let comments = vec![
         "frame: camera (x right, y down, z forward; docs/conventions.md), mm".to_string(),
         "properties: point, unit normal out of the elastomer, pixel (u column, v row), contact (1 on a protrusion)".to_string(),
@@ -502,13 +566,20 @@ pub fn render_frames(
             Ok(entries)
         };
     let mut ref_entries = put(
-        frame_files("reference", &reference, None, preview, provenance, format)?,
+        frame_files(
+            files::REFERENCE_DIR,
+            &reference,
+            None,
+            preview,
+            provenance,
+            format,
+        )?,
         &mut all,
     )?;
     if let Some(im) = imaging {
         ref_entries.extend(put(
             vec![image_file(
-                "reference",
+                files::REFERENCE_DIR,
                 im,
                 rays,
                 ref_hits,
@@ -605,8 +676,8 @@ pub fn render_frames(
     let (left, right) = half_masks(rays, ref_hits);
     let mut extra: Files = Vec::new();
     for (name, m, side) in [
-        ("left_mask.png", &left, "x < 0 (the -x half)"),
-        ("right_mask.png", &right, "x >= 0 (the +x half)"),
+        (files::LEFT_MASK, &left, "x < 0 (the -x half)"),
+        (files::RIGHT_MASK, &right, "x >= 0 (the +x half)"),
     ] {
         let px: Vec<u8> = m.iter().map(|&b| if b { 255 } else { 0 }).collect();
         let count = m.iter().filter(|&&b| b).count();
@@ -615,9 +686,9 @@ pub fn render_frames(
     let n_pairs = fixtures.patterns.len() * fixtures.patterns.len();
     if !pin_captures {
         extra.push((
-            "pairs.csv".into(),
+            files::PAIRS.into(),
             pairs_csv(&fixtures.patterns).into_bytes(),
-            json!({"file": "pairs.csv", "pairs": n_pairs, "notes": PAIRS_NOTES}),
+            json!({"file": files::PAIRS, "pairs": n_pairs, "notes": PAIRS_NOTES}),
         ));
     }
     let extra_entries = put(extra, &mut all)?;
@@ -644,9 +715,11 @@ pub struct ManifestInputs<'a> {
     pub flat_skin: bool,
     pub camera: &'a crate::CameraModel,
     pub camera_file: &'a str,
-    pub camera_sha256: &'a str,
+    /// The camera file's sha256; `None` for a camera that is not from a file (null).
+    pub camera_sha256: Option<&'a str>,
     pub extrinsics_file: &'a str,
-    pub extrinsics_sha256: &'a str,
+    /// The extrinsics file's sha256; `None` for a pose that is not from a file (null).
+    pub extrinsics_sha256: Option<&'a str>,
     pub t_cam_sensor: &'a nalgebra::Isometry3<f64>,
     /// The camera centre in the sensor frame, mm.
     pub camera_centre_mm: [f64; 3],
@@ -716,7 +789,7 @@ pub fn manifest(inputs: &ManifestInputs<'_>, rendered: &Rendered) -> Value {
             "not_modelled": "refraction in the elastomer and the core; the skin's deformation around a protrusion (the indented surface is the skin minus the protrusion solids)",
         },
         "image": {"width_px": w, "height_px": h, "pixels_on_surface": inputs.pixels_on_surface},
-        "reference": {"dir": "reference", "files": ref_entries},
+        "reference": {"dir": files::REFERENCE_DIR, "files": ref_entries},
         "configurations": cfg_entries,
         "masks_and_pairs": extra_entries,
         "files": all.iter().map(|(f, s, b)| json!({"file": f, "sha256": s, "bytes": b})).collect::<Vec<_>>(),
@@ -757,4 +830,85 @@ pub fn manifest(inputs: &ManifestInputs<'_>, rendered: &Rendered) -> Value {
         });
     }
     manifest
+}
+
+/// Default bound on a dataset's bytes, refused above it unless asked for (`--max-output-bytes`,
+/// `max_output_bytes=`): 1 GB.
+pub const DEFAULT_MAX_OUTPUT_BYTES: u64 = 1_000_000_000;
+/// Largest bound on a dataset's bytes: 1 PB.
+pub const MAX_OUTPUT_BYTES_LIMIT: u64 = 1_000_000_000_000_000;
+
+/// The provenance line of the dataset's PLY files: fabkit's version, the design's name and
+/// the sha256 of its text.
+pub fn provenance(design_name: &str, design_sha256: &str) -> String {
+    format!(
+        "fabkit {} groundtruth, design {design_name} (sha256 {design_sha256})",
+        env!("CARGO_PKG_VERSION")
+    )
+}
+
+/// What a dataset is rendered from, for its claim on the output folder
+/// ([`claim`]).
+pub struct ClaimInputs<'a> {
+    /// The design as named: a library design's name or a design file's path.
+    pub design: &'a str,
+    pub preset: Option<&'a str>,
+    pub camera_file: &'a Path,
+    pub extrinsics_file: &'a Path,
+    pub fixtures_dir: &'a Path,
+    pub pin_captures: bool,
+}
+
+/// The dataset's claim on its output folder: ground truth of the design (by name, or its
+/// file's content), the camera file, the extrinsics and the fixtures folder (its marker lists
+/// the SHA-256 of every file in it; its protrusion index, or its point table, capture plan and
+/// manifest, count when there is no marker). `force` replaces earlier ground truth of other
+/// inputs.
+pub fn claim(inputs: &ClaimInputs<'_>, force: bool) -> OutputClaim {
+    let design_file = Path::new(inputs.design);
+    let fixtures_marker = inputs.fixtures_dir.join(fabkit_export::OUTPUT_MARKER);
+    let points = inputs.fixtures_dir.join("points");
+    let fixture_files = if inputs.pin_captures {
+        vec![
+            points.join("point_table.csv"),
+            points.join("capture_plan.csv"),
+            inputs.fixtures_dir.join("manifest.json"),
+        ]
+    } else {
+        vec![inputs.fixtures_dir.join("protrusions").join("index.json")]
+    };
+    let mut files: Vec<&Path> = vec![inputs.camera_file, inputs.extrinsics_file, &fixtures_marker];
+    files.extend(fixture_files.iter().map(PathBuf::as_path));
+    if design_file.is_file() {
+        files.push(design_file);
+    }
+    let what = match inputs.preset {
+        Some(p) => format!("ground truth of design '{}' preset '{p}'", inputs.design),
+        None => format!("ground truth of design '{}'", inputs.design),
+    };
+    OutputClaim::of_inputs(OutputCommand::Groundtruth, &what, &files, force)
+}
+
+/// Renders the dataset into `staged` ([`render_frames`], `progress` with the frames done) and
+/// writes its manifest.json ([`manifest`]) last; the caller commits the folder. Returns every
+/// file written but the manifest: (relative path, sha256, bytes), sorted by path.
+///
+/// # Errors
+/// The first error of an encoder or of writing a file.
+pub fn write(
+    staged: &StagedDir,
+    frames: &FrameInputs<'_>,
+    manifest_inputs: &ManifestInputs<'_>,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<Written, SinkError> {
+    let rendered = render_frames(
+        frames,
+        &|rel, bytes| staged.write(rel, bytes).map_err(Into::into),
+        progress,
+    )?;
+    let manifest = manifest(manifest_inputs, &rendered);
+    let mut text = serde_json::to_vec_pretty(&manifest)?;
+    text.push(b'\n');
+    staged.write(files::MANIFEST, &text)?;
+    Ok(rendered.files)
 }
