@@ -36,8 +36,8 @@ pub mod procedure;
 pub mod profile;
 pub mod schema;
 pub mod stack;
-pub mod sweep;
 pub mod values;
+pub mod variant;
 pub mod yaml;
 
 /// The layer stack's part families, at their older paths.

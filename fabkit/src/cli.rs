@@ -360,7 +360,7 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
             // one copy for every lookup: value_at adds a null for an unset optional key,
             // which only reads as unset
             let mut json = serde_json::to_value(&loaded.design)?;
-            for path in fabkit_designs::sweep::parameter_paths(&loaded.design) {
+            for path in fabkit_sweep::parameter_paths(&loaded.design) {
                 let value = fabkit_designs::schema::value_at(&mut json, &path)
                     .map(|x| rounded(x))
                     .unwrap_or(serde_json::Value::Null);

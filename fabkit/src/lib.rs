@@ -17,6 +17,7 @@ pub use fabkit_calibration as calibration;
 pub use fabkit_designs as designs;
 pub use fabkit_export as export;
 pub use fabkit_fixtures as fixtures;
+pub use fabkit_sweep as sweep;
 
 pub mod calibrate_cmd;
 pub mod cli;

@@ -1,11 +1,7 @@
 //! `fabkit sweep` and `fabkit sweep merge`: argument parsing, progress and dispatch over
-//! `fabkit_designs::sweep`; the export crate writes variant files.
+//! `fabkit_sweep` (which writes variant files with the export crate's writer).
 
-use fabkit_designs::kit::Kit;
-use fabkit_designs::sweep::{
-    self, Event, FilesJob, KitWriter, RunOptions, Shard, Status, SweepSpec,
-};
-use fabkit_export::{write_kit, ExportOptions, Formats, OutputCommand};
+use fabkit_sweep::{self as sweep, Event, ExportWriter, RunOptions, Shard, Status, SweepSpec};
 use std::error::Error;
 use std::io::IsTerminal as _;
 use std::path::PathBuf;
@@ -63,36 +59,6 @@ enum SweepCommand {
     },
 }
 
-/// Writes a variant's files with `fabkit export`'s writer.
-struct ExportWriter {
-    command_line: Vec<String>,
-}
-
-impl KitWriter for ExportWriter {
-    fn write(&self, kit: &Kit, job: &FilesJob<'_>) -> Result<(), String> {
-        let opts = ExportOptions {
-            formats: Formats {
-                stl: job.files.stl,
-                threemf: job.files.threemf,
-                step: false,
-            },
-            command_line: self.command_line.clone(),
-            design_source: job.design_source.clone(),
-            design_sha256: job.design_sha256.clone(),
-            chord_tolerance_mm: job.chord_tolerance_mm,
-            fabkit_version: env!("CARGO_PKG_VERSION").to_string(),
-            // the shipped printers: a sweep's variants are laid out for the default beds
-            printers: Default::default(),
-            // variants/<id>/ of the sweep folder (which the sweep checks is its own)
-            command: OutputCommand::SweepVariant,
-            force: false,
-        };
-        write_kit(kit, &job.dir, &opts)
-            .map(|_| ())
-            .map_err(|e| e.to_string())
-    }
-}
-
 pub fn run(args: SweepArgs) -> Result<(), Box<dyn Error>> {
     if let Some(SweepCommand::Merge {
         dirs,
@@ -114,7 +80,7 @@ pub fn run(args: SweepArgs) -> Result<(), Box<dyn Error>> {
     };
     let terminal = std::io::stderr().is_terminal();
     let spec = {
-        // reading checks every value and builds a few probes (fabkit_designs::sweep::
+        // reading checks every value and builds a few probes (fabkit_sweep::
         // SweepSpec::refuse_ignored_parameters): a spinner on a terminal
         let _reading = Spinner::new(terminal, format!("reading {}", file.display()));
         SweepSpec::from_file_with(&file, &args.data_files.rules())?

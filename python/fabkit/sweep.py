@@ -17,6 +17,7 @@ import csv
 import io
 import os
 import queue
+import sys
 from concurrent.futures import ProcessPoolExecutor
 from typing import Any, Callable, Dict, Iterable, List, Mapping, Optional
 
@@ -61,10 +62,11 @@ def _cell(text: str):
 
 
 def _evaluate(base_json: str, chord_tolerance_mm: float, max_triangles: int, index: int,
-              variant_id: str, params_json: str) -> str:
-    """One variant, in whatever process runs it: its results.jsonl line."""
+              variant_id: str, params_json: str, files: Optional[dict] = None) -> str:
+    """One variant, in whatever process runs it: its results.jsonl line (and its files, when
+    ``files`` holds outputs, out, source and command_line)."""
     return _fabkit._sweep_evaluate(base_json, chord_tolerance_mm, max_triangles, index,
-                                   variant_id, params_json)
+                                   variant_id, params_json, **(files or {}))
 
 
 def _check_start_method(executor) -> None:
@@ -92,6 +94,8 @@ def sweep(
     build_time: bool = True,
     progress: Optional[Progress] = None,
     table: str = "auto",
+    outputs: Iterable[str] = ("metrics",),
+    out=None,
 ):
     """Builds and measures every variant of ``design`` and returns the results table of
     ``fabkit sweep``.
@@ -117,6 +121,13 @@ def sweep(
     printable.<printer>, build_time_s, errors); ``"pandas"``; ``"tables"``: a SweepTables with
     the exact text of results.csv and results.jsonl.
 
+    ``outputs``: as a sweep file's: ``["metrics"]``, or ``["metrics", "files"]`` (``stl`` or
+    ``3mf`` for one format) to also write each ok variant's files of ``fabkit export`` into
+    ``out/<id>/`` (``out`` a folder path, created if missing; an earlier export of the same
+    variant there is replaced, anything else refused and the variant recorded as an error).
+    The files are written by whichever process builds the variant: with an executor on
+    other machines, ``out`` must be a shared folder.
+
     A variant that breaks the design's rules is a row with status ``infeasible`` and its
     violations; a failed build, status ``error``. Raises DesignError with the message of
     ``fabkit sweep`` for an unknown path or a value of the wrong type (``variants[3]:
@@ -125,6 +136,13 @@ def sweep(
     """
     if table not in ("auto", "records", "pandas", "tables"):
         raise ValueError(f"table: '{table}' is not one of auto, records, pandas, tables")
+    outputs = [outputs] if isinstance(outputs, str) else list(outputs)
+    out = None if out is None else os.fspath(out)
+    _fabkit._sweep_check_outputs(outputs, out)
+    files = None
+    if outputs != ["metrics"]:
+        files = {"outputs": outputs, "out": out, "source": design.source,
+                 "command_line": list(sys.argv)}
     _check_start_method(executor)
     parameters, planned = _fabkit._sweep_plan(design, variants, chord_tolerance_mm)
     base = _fabkit._sweep_base(design)
@@ -136,7 +154,7 @@ def sweep(
                 f"jobs = {n}: must be from 1 to {4 * (os.cpu_count() or 1)} "
                 f"(4 x the {os.cpu_count() or 1} CPUs of this machine)")
         results = _fabkit._sweep_run_threads(base, chord_tolerance_mm, max_triangles, planned,
-                                             n, progress)
+                                             n, progress, **(files or {}))
     else:
         # completion through add_done_callback, which concurrent.futures and dask.distributed
         # futures both have (their as_completed functions take only their own futures)
@@ -144,7 +162,7 @@ def sweep(
         futures = []
         for index, variant_id, params in planned:
             f = executor.submit(_evaluate, base, chord_tolerance_mm, max_triangles, index,
-                                variant_id, params)
+                                variant_id, params, files)
             f.add_done_callback(lambda _, i=index: finished.put(i))
             futures.append(f)
         for done in range(1, total + 1):

@@ -5,7 +5,8 @@ use std::collections::BTreeMap;
 
 use fabkit_designs::input_files::DataFileRules;
 use fabkit_designs::values::{value_at_path, with_value_at, NumberPath};
-use fabkit_designs::{library, sweep, ChordTolerance, Design as DesignData};
+use fabkit_designs::{library, ChordTolerance, Design as DesignData};
+use fabkit_sweep as sweep;
 use pyo3::exceptions::{PyKeyError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};

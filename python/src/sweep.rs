@@ -4,11 +4,11 @@
 //! Everything is fabkit-designs' sweep code ([`fabkit_designs::sweep`]).
 
 use fabkit_designs::materials::MaterialsTable;
-use fabkit_designs::sweep::{
-    evaluate_variant, plan_variants, render_csv, render_jsonl, resolve_variant, FileOutputs,
-    Variant, VariantResult,
-};
 use fabkit_designs::{ChordTolerance, Design as DesignData};
+use fabkit_sweep::{
+    evaluate_variant, plan_variants, render_csv, render_jsonl, resolve_variant, ExportWriter,
+    FileOutputs, FilesJob, KitWriter, Output, Variant, VariantResult,
+};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
@@ -113,13 +113,68 @@ fn variant_of(index: usize, id: String, params_json: &str) -> PyResult<Variant> 
     Ok(Variant { index, id, params })
 }
 
+/// Where a Python sweep writes its variants' files (`outputs` with files, stl or 3mf): the
+/// export of variant `<id>` into `<out>/<id>/`, its manifest naming the base design's source.
+struct FilesTarget {
+    out: std::path::PathBuf,
+    files: FileOutputs,
+    source: String,
+    writer: ExportWriter,
+}
+
+/// The files target of `outputs` (names as a sweep file's) into `out`; `None` for metrics
+/// only.
+fn files_target(
+    outputs: &[String],
+    out: Option<std::path::PathBuf>,
+    source: String,
+    command_line: Vec<String>,
+) -> PyResult<Option<FilesTarget>> {
+    let outputs = outputs
+        .iter()
+        .map(|o| Output::from_name(o))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| PyValueError::new_err(format!("outputs: {e}")))?;
+    if !outputs.contains(&Output::Metrics) {
+        return Err(PyValueError::new_err(
+            "outputs must include metrics (the results table is always returned): ['metrics'] or ['metrics', 'files']",
+        ));
+    }
+    let files = FileOutputs::of(&outputs);
+    if !files.any() {
+        return Ok(None);
+    }
+    let out = out.ok_or_else(|| {
+        PyValueError::new_err("out: a folder is needed for outputs with files, stl or 3mf")
+    })?;
+    Ok(Some(FilesTarget {
+        out,
+        files,
+        source,
+        writer: ExportWriter { command_line },
+    }))
+}
+
 fn evaluate(
     base: &DesignData,
     v: &Variant,
     materials: &MaterialsTable,
     tol: ChordTolerance,
     max_triangles: u64,
+    target: Option<&FilesTarget>,
 ) -> VariantResult {
+    let write = |design: &DesignData, kit: &fabkit_designs::kit::Kit| -> Result<(), String> {
+        let Some(t) = target else { return Ok(()) };
+        let job = FilesJob::new(
+            t.out.join(&v.id),
+            t.files,
+            v,
+            design,
+            format!("{} variant {} of fabkit.sweep", t.source, v.id),
+            tol.mm(),
+        );
+        t.writer.write(kit, &job)
+    };
     evaluate_variant(
         v,
         resolve_variant(base, "variants", &v.params).map_err(|e| e.to_string()),
@@ -127,8 +182,10 @@ fn evaluate(
         tol,
         max_triangles,
         env!("CARGO_PKG_VERSION"),
-        FileOutputs::default(),
-        None,
+        target.map(|t| t.files).unwrap_or_default(),
+        target
+            .is_some()
+            .then_some(&write as fabkit_sweep::WriteFiles<'_>),
     )
 }
 
@@ -142,8 +199,14 @@ fn base_of(base_json: &str) -> PyResult<DesignData> {
 
 /// Builds and measures one planned variant of the base design `base_json` (from
 /// `_sweep_base`), as `fabkit sweep` does; returns its result as JSON (a line of
-/// results.jsonl). Runs in whatever process an executor gives it; the GIL is released.
+/// results.jsonl). With `outputs` naming files (`files`, `stl`, `3mf`) it also writes the
+/// variant's export into `<out>/<id>/`, its manifest naming `source` and `command_line`.
+/// Runs in whatever process an executor gives it; the GIL is released.
 #[pyfunction]
+#[pyo3(signature = (base_json, chord_tolerance_mm, max_triangles, index, id, params_json,
+                    outputs=vec!["metrics".to_string()], out=None, source=String::new(),
+                    command_line=Vec::new()))]
+#[allow(clippy::too_many_arguments)]
 pub fn _sweep_evaluate(
     py: Python<'_>,
     base_json: &str,
@@ -152,19 +215,30 @@ pub fn _sweep_evaluate(
     index: usize,
     id: String,
     params_json: &str,
+    outputs: Vec<String>,
+    out: Option<std::path::PathBuf>,
+    source: String,
+    command_line: Vec<String>,
 ) -> PyResult<String> {
     let tol = crate::kit::tolerance(chord_tolerance_mm)?;
     let base = base_of(base_json)?;
     let v = variant_of(index, id, params_json)?;
     let materials = materials()?;
-    let r = crate::work(py, || evaluate(&base, &v, &materials, tol, max_triangles))?;
+    let target = files_target(&outputs, out, source, command_line)?;
+    let r = crate::work(py, || {
+        evaluate(&base, &v, &materials, tol, max_triangles, target.as_ref())
+    })?;
     serde_json::to_string(&r).map_err(|e| FabkitError::new_err(e.to_string()))
 }
 
-/// Every planned variant evaluated here on `jobs` threads (the GIL released), in any order;
-/// `progress(done, total, id)` as each finishes. Returns the results as JSON, in plan order.
+/// Every planned variant evaluated here on `jobs` threads (the GIL released), in any order,
+/// writing their files as `_sweep_evaluate` does; `progress(done, total, id)` as each
+/// finishes. Returns the results as JSON, in plan order.
 #[pyfunction]
-#[pyo3(signature = (base_json, chord_tolerance_mm, max_triangles, variants, jobs, progress=None))]
+#[pyo3(signature = (base_json, chord_tolerance_mm, max_triangles, variants, jobs, progress=None,
+                    outputs=vec!["metrics".to_string()], out=None, source=String::new(),
+                    command_line=Vec::new()))]
+#[allow(clippy::too_many_arguments)]
 pub fn _sweep_run_threads(
     py: Python<'_>,
     base_json: &str,
@@ -173,8 +247,13 @@ pub fn _sweep_run_threads(
     variants: Vec<PlannedVariant>,
     jobs: usize,
     progress: Option<Py<PyAny>>,
+    outputs: Vec<String>,
+    out: Option<std::path::PathBuf>,
+    source: String,
+    command_line: Vec<String>,
 ) -> PyResult<Vec<String>> {
     let tol = crate::kit::tolerance(chord_tolerance_mm)?;
+    let target = files_target(&outputs, out, source, command_line)?;
     let base = base_of(base_json)?;
     let vs: Vec<Variant> = variants
         .into_iter()
@@ -191,7 +270,7 @@ pub fn _sweep_run_threads(
         pool.install(|| {
             vs.par_iter()
                 .map(|v| {
-                    let r = evaluate(&base, v, &materials, tol, max_triangles);
+                    let r = evaluate(&base, v, &materials, tol, max_triangles, target.as_ref());
                     let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
                     report_progress(&progress, k, total, &v.id);
                     r
@@ -230,7 +309,16 @@ pub fn _sweep_tables(
     Ok((csv, jsonl))
 }
 
+/// Checks `outputs` (names as a sweep file's) and `out` before anything is planned or built:
+/// ValueError naming what is wrong.
+#[pyfunction]
+#[pyo3(signature = (outputs, out=None))]
+pub fn _sweep_check_outputs(outputs: Vec<String>, out: Option<std::path::PathBuf>) -> PyResult<()> {
+    files_target(&outputs, out, String::new(), Vec::new()).map(|_| ())
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(_sweep_check_outputs, m)?)?;
     m.add_function(wrap_pyfunction!(_sweep_plan, m)?)?;
     m.add_function(wrap_pyfunction!(_sweep_base, m)?)?;
     m.add_function(wrap_pyfunction!(_sweep_evaluate, m)?)?;

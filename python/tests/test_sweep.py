@@ -130,3 +130,45 @@ def test_a_forking_process_pool_is_refused_before_any_task():
             fabkit.sweep(fabkit.Design.load("rtac0"), [{"core.wall_thickness_mm": 1.1}],
                          executor=pool)
         assert not pool._processes  # no worker was started
+
+
+def test_files_are_the_cli_variant_exports(tmp_path, run_cli):
+    """outputs with files write each ok variant's export as `fabkit sweep` does
+    (variants/<id>/ there, out/<id>/ here): the same STL bytes, the same design hash, and the
+    same results table; a variant the rules refuse writes nothing."""
+    (tmp_path / "s.yaml").write_text(
+        "base: rtac0\nvary:\n  core.wall_thickness_mm: [1.1, -0.5]\noutputs: [metrics, stl]\n")
+    run_cli(tmp_path, "sweep", "s.yaml", "--out", "cli", "--no-build-time", "--jobs", "1")
+    cli_csv = (tmp_path / "cli" / "results.csv").read_text()
+    t = fabkit.sweep(fabkit.Design.load("rtac0"), [{"core.wall_thickness_mm": 1.1},
+                                                  {"core.wall_thickness_mm": -0.5}],
+                     build_time=False, table="tables", outputs=["metrics", "stl"],
+                     out=tmp_path / "py")
+    assert t.csv == cli_csv
+    rows = list(csv.DictReader(io.StringIO(cli_csv)))
+    ok = [r["id"] for r in rows if r["status"] == "ok"]
+    assert len(ok) == 1 and len(rows) == 2
+    assert sorted(p.name for p in (tmp_path / "py").iterdir()) == ok
+    cli_dir, py_dir = tmp_path / "cli" / "variants" / ok[0], tmp_path / "py" / ok[0]
+    stls = sorted(p.relative_to(cli_dir) for p in cli_dir.rglob("*.stl"))
+    assert stls and stls == sorted(p.relative_to(py_dir) for p in py_dir.rglob("*.stl"))
+    assert not list(py_dir.rglob("*.3mf"))
+    for rel in stls:
+        assert (py_dir / rel).read_bytes() == (cli_dir / rel).read_bytes(), rel
+    import json
+    m_cli = json.loads((cli_dir / "manifest.json").read_text())
+    m_py = json.loads((py_dir / "manifest.json").read_text())
+    assert m_py["design"]["sha256"] == m_cli["design"]["sha256"]
+    assert "of fabkit.sweep" in m_py["design"]["source"]
+
+
+def test_bad_outputs_are_refused_before_anything_is_built(tmp_path):
+    d = fabkit.Design.load("rtac0")
+    with pytest.raises(ValueError, match="needed for outputs"):
+        fabkit.sweep(d, [{"core.wall_thickness_mm": 1.1}], outputs=["metrics", "files"])
+    with pytest.raises(ValueError, match="'step' is not one of"):
+        fabkit.sweep(d, [{"core.wall_thickness_mm": 1.1}], outputs=["metrics", "step"],
+                     out=tmp_path)
+    with pytest.raises(ValueError, match="must include metrics"):
+        fabkit.sweep(d, [{"core.wall_thickness_mm": 1.1}], outputs=["files"], out=tmp_path)
+    assert not list(tmp_path.iterdir())

@@ -15,7 +15,7 @@ fn validate_lists_every_path_without_noise_and_show_gives_a_template() {
         assert!(o.status.success(), "{name}: {}", text(&o.stderr));
         let out = text(&o.stdout);
         let design = fabkit::designs::library::load(name).unwrap();
-        let paths = fabkit::designs::sweep::parameter_paths(&design);
+        let paths = fabkit::sweep::parameter_paths(&design);
         let has_markers = design.layers.iter().any(|l| !l.markers.is_empty());
         assert_eq!(
             paths.iter().any(|p| p.contains("markers[0].pattern.")),

@@ -22,10 +22,10 @@ mod properties;
 mod shadowtac;
 mod shadowtac_casing;
 mod spacer_family;
-mod sweep;
-mod sweep_metrics;
-mod sweep_paths;
-mod sweep_plan;
+
+mod variant_metrics;
+mod variant_paths;
+
 mod tactip_body;
 mod uvdtact_base;
 mod uvdtact_shell;

@@ -1,5 +1,5 @@
 use fabkit_designs::materials::MaterialsTable;
-use fabkit_designs::sweep::*;
+use fabkit_designs::variant::*;
 use fabkit_designs::ChordTolerance;
 
 #[test]

@@ -2,9 +2,9 @@
 //! shards.
 
 use super::file::{Mode, Parameter, SweepSpec};
-use super::paths::canonical_json;
 use super::SweepError;
-use crate::schema::Design;
+use fabkit_designs::schema::Design;
+use fabkit_designs::variant::canonical_json;
 use rand_chacha::rand_core::SeedableRng;
 use rayon::prelude::*;
 use serde_json::Value;
@@ -379,7 +379,7 @@ impl SweepSpec {
         let canonical = canonical_json(&serde_json::to_value(&base).ok()?);
         let mut spans: Vec<(usize, usize, usize)> = Vec::with_capacity(paths.len());
         for (k, p) in paths.iter().enumerate() {
-            let (a, b) = super::paths::span_of(&canonical, p)?;
+            let (a, b) = fabkit_designs::variant::span_of(&canonical, p)?;
             spans.push((a, b, k));
         }
         spans.sort_unstable();
@@ -395,7 +395,7 @@ impl SweepSpec {
         pieces.push(canonical.as_bytes()[at..].to_vec());
         let mut texts = Vec::with_capacity(paths.len());
         for p in &self.parameters {
-            let span = super::paths::span_of(&text, &p.path)?;
+            let span = fabkit_designs::variant::span_of(&text, &p.path)?;
             let numbers = takes_any_number(base_json, &p.path);
             let t: Option<Vec<Vec<u8>>> = p
                 .values
@@ -465,7 +465,7 @@ pub(crate) fn takes_any_number(base_json: &Value, path: &str) -> bool {
     let Ok(text) = serde_json::to_string(&base) else {
         return false;
     };
-    let Some(span) = super::paths::span_of(&text, path) else {
+    let Some(span) = fabkit_designs::variant::span_of(&text, path) else {
         return false;
     };
     let mut json = base_json.clone();
@@ -487,7 +487,7 @@ fn value_text(
 ) -> Option<Vec<u8>> {
     let design = super::variants::design_with(base_json, path, value)?.ok()?;
     let text = serde_json::to_string(&design).ok()?;
-    let (a, b) = super::paths::span_of(&text, path)?;
+    let (a, b) = fabkit_designs::variant::span_of(&text, path)?;
     if text[..a] != base_text[..base_span.0] || text[b..] != base_text[base_span.1..] {
         return None;
     }
@@ -496,7 +496,7 @@ fn value_text(
         // a list or an object: its canonical form from the design's tree (keys sorted;
         // numbers as serde_json writes them, not parsed back)
         let mut tree = serde_json::to_value(&design).ok()?;
-        let at = crate::schema::value_at(&mut tree, path)?;
+        let at = fabkit_designs::schema::value_at(&mut tree, path)?;
         return Some(canonical_json(at).into_bytes());
     }
     // a scalar: written by the same serializer as the canonical form
@@ -651,64 +651,5 @@ mod tests {
         assert!(!takes_any_number(&json, "name"));
         let body = spec("  body.base_diameter_mm: [34.0, 35.0]\n  body.height_mm: [7.5, 8.0]\n");
         assert!(body.splice(&json).is_none());
-    }
-
-    /// The canonical JSON that ids hash, written node by node through strings as it was first
-    /// written: the faster writer must give the same bytes.
-    fn canonical_by_strings(v: &Value) -> String {
-        match v {
-            Value::Object(o) => {
-                let mut keys: Vec<&String> = o.keys().collect();
-                keys.sort();
-                let items: Vec<String> = keys
-                    .into_iter()
-                    .map(|k| {
-                        format!(
-                            "{}:{}",
-                            Value::String(k.clone()),
-                            canonical_by_strings(&o[k])
-                        )
-                    })
-                    .collect();
-                format!("{{{}}}", items.join(","))
-            }
-            Value::Array(a) => format!(
-                "[{}]",
-                a.iter()
-                    .map(canonical_by_strings)
-                    .collect::<Vec<_>>()
-                    .join(",")
-            ),
-            other => other.to_string(),
-        }
-    }
-
-    #[test]
-    fn the_canonical_json_is_unchanged() {
-        for name in [
-            "shadowtac",
-            "rtac0",
-            "uvdtact",
-            "tactip_dualmodal",
-            "soter_channels",
-        ] {
-            let d = crate::library::load(name).unwrap();
-            let mut v = serde_json::to_value(&d).unwrap();
-            v["name"] = Value::String("a \"quoted\" \\ name\n\u{1}é".into());
-            v["extra"] = serde_json::json!({"z": [1, -2, 0.5, -0.0, 1e300, null, true], "a": {}});
-            assert_eq!(canonical_json(&v), canonical_by_strings(&v), "{name}");
-        }
-    }
-
-    #[test]
-    fn spans_are_found_in_compact_json() {
-        let text = r#"{"a":{"b":[1,{"c":"x]}"},[2,3]],"d":-1.5e3},"e\"":null}"#;
-        let at = |p: &str| super::super::paths::span_of(text, p).map(|(a, b)| &text[a..b]);
-        assert_eq!(at("a.b[1].c"), Some(r#""x]}""#));
-        assert_eq!(at("a.b[2]"), Some("[2,3]"));
-        assert_eq!(at("a.d"), Some("-1.5e3"));
-        assert_eq!(at("e\""), Some("null"));
-        assert_eq!(at("a.b[3]"), None);
-        assert_eq!(at("a.x"), None);
     }
 }

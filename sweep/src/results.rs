@@ -1,7 +1,7 @@
 //! One result per variant, and the results table (`results.csv`, `results.jsonl`).
 
 use super::file::FileOutputs;
-use super::metrics::{Metrics, Verdict};
+use fabkit_designs::variant::{Metrics, Verdict};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
@@ -42,7 +42,7 @@ pub struct VariantResult {
     pub errors: Vec<String>,
     /// `None` unless the status is ok.
     pub metrics: Option<Metrics>,
-    /// One verdict per printer profile ([`super::metrics::printability`]), for every status.
+    /// One verdict per printer profile ([`fabkit_designs::variant::printability`]), for every status.
     pub printability: Vec<Verdict>,
     /// Which files the variant folder `variants/<id>/` holds (none: metrics only).
     pub files: FileOutputs,
@@ -188,10 +188,10 @@ pub fn render_csv(parameters: &[String], rows: &[VariantResult]) -> Vec<u8> {
     w.into_inner().unwrap_or_default()
 }
 
-fn surface_name(m: &super::metrics::MarkerMetrics) -> String {
+fn surface_name(m: &fabkit_designs::variant::MarkerMetrics) -> String {
     match m.surface {
-        crate::markers::MarkerSurface::Outer => "outer".into(),
-        crate::markers::MarkerSurface::Inner => "inner".into(),
+        fabkit_designs::markers::MarkerSurface::Outer => "outer".into(),
+        fabkit_designs::markers::MarkerSurface::Inner => "inner".into(),
     }
 }
 

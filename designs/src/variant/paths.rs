@@ -1,6 +1,6 @@
-//! Parameter paths of a design (`layers[0].markers[0].pattern.spacing_mm`): which exist, the
-//! nearest ones to a path that does not, setting a value at a path, and the canonical JSON of a
-//! design that variant ids hash.
+//! Parameter paths of a design (`layers[0].markers[0].pattern.spacing_mm`): which exist, a
+//! short path expanded, setting a value at a path, and the canonical JSON of a design that
+//! variant ids hash.
 
 use crate::markers::{Layout, MarkerSpec, Pattern};
 use crate::schema::{value_at, Design};
@@ -116,7 +116,7 @@ pub fn path_exists(design: &Design, path: &str) -> bool {
 }
 
 /// The keys of a parameter path without its list indices: `layers[0].markers` -> [layers, markers].
-fn path_keys(p: &str) -> Vec<String> {
+pub fn path_keys(p: &str) -> Vec<String> {
     p.split(['.', '[', ']'])
         .filter(|k| !k.is_empty() && !k.chars().all(|c| c.is_ascii_digit()))
         .map(str::to_owned)
@@ -145,33 +145,6 @@ pub fn expand_short_path(design: &Design, path: &str) -> Option<String> {
     let mut found = parameter_paths(design).into_iter().filter(|p| fits(p));
     let first = found.next()?;
     found.next().is_none().then_some(first)
-}
-
-/// Up to `n` valid paths nearest to the unknown `path`, best first: paths ending in the same
-/// key come first (`markers.spacing_mm` finds `layers[0].markers[0].pattern.spacing_mm`), then
-/// by similarity of the last key, then of the keys they share and of the whole string.
-pub fn nearest_paths(design: &Design, path: &str, n: usize) -> Vec<String> {
-    let asked = path_keys(path);
-    let last = asked.last().cloned().unwrap_or_default();
-    let mut scored: Vec<(f64, String)> = parameter_paths(design)
-        .into_iter()
-        .map(|p| {
-            let k = path_keys(&p);
-            let l = k.last().cloned().unwrap_or_default();
-            let last_sim = strsim::normalized_damerau_levenshtein(&last, &l);
-            let shared =
-                asked.iter().filter(|a| k.contains(a)).count() as f64 / asked.len().max(1) as f64;
-            let whole = strsim::normalized_levenshtein(path, &p);
-            (2.0 * last_sim + shared + whole, p)
-        })
-        .collect();
-    scored.sort_by(|a, b| b.0.total_cmp(&a.0).then_with(|| a.1.cmp(&b.1)));
-    scored
-        .into_iter()
-        .filter(|(s, _)| *s >= 1.5)
-        .take(n)
-        .map(|(_, p)| p)
-        .collect()
 }
 
 /// `base` (a design's JSON form) with `value` at `path`; `None` when the path does not exist.
@@ -310,7 +283,7 @@ fn value_end(b: &[u8], i: usize) -> Option<usize> {
 /// The byte range of the value at parameter path `path` in the JSON text `text` (as serde_json
 /// writes it), found by scanning the text without building its tree; `None` when the path
 /// names nothing there.
-pub(crate) fn span_of(text: &str, path: &str) -> Option<(usize, usize)> {
+pub fn span_of(text: &str, path: &str) -> Option<(usize, usize)> {
     let b = text.as_bytes();
     let mut i = skip_ws(b, 0);
     for step in path_steps(path)? {

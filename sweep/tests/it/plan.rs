@@ -3,7 +3,7 @@
 //! are those of the resolved designs.
 
 use fabkit_designs::library;
-use fabkit_designs::sweep::*;
+use fabkit_sweep::*;
 use serde_json::Value;
 use std::path::Path;
 use std::sync::Mutex;

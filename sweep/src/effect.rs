@@ -2,10 +2,10 @@
 //! ignores would give identical variants, and the sweep refuses it before anything runs.
 
 use super::file::{Parameter, SweepSpec};
-use super::metrics::{evaluate, printability, Metrics, Outcome, Verdict};
 use super::SweepError;
-use crate::materials::MaterialsTable;
-use crate::ChordTolerance;
+use fabkit_designs::materials::MaterialsTable;
+use fabkit_designs::variant::{evaluate, printability, Metrics, Outcome, Verdict};
+use fabkit_designs::ChordTolerance;
 use serde_json::Value;
 use sha2::{Digest, Sha256};
 
@@ -35,7 +35,7 @@ struct Fingerprint {
 }
 
 fn fingerprint(
-    design: &crate::schema::Design,
+    design: &fabkit_designs::schema::Design,
     materials: &MaterialsTable,
     tol: ChordTolerance,
 ) -> Option<Fingerprint> {
@@ -204,8 +204,8 @@ impl SweepSpec {
 
 /// Why the design ignores `path`, for the common switches: a housing part of the other style,
 /// mold fields no cast layer's strategy uses, the technology of a layer that is not printed.
-fn why_ignored(design: &crate::schema::Design, path: &str) -> Option<String> {
-    use crate::schema::{HousingStyle, LayerProcess, MoldStrategy};
+fn why_ignored(design: &fabkit_designs::schema::Design, path: &str) -> Option<String> {
+    use fabkit_designs::schema::{HousingStyle, LayerProcess, MoldStrategy};
     let cast: Vec<MoldStrategy> = design
         .layers
         .iter()

@@ -3,10 +3,10 @@
 
 use super::variants::{checked_path, checked_value};
 use super::SweepError;
-use crate::input_files::{read_text_file, DataFileRules, MAX_DESIGN_FILE_BYTES};
-use crate::library::{load_source_with, LoadedDesign};
-use crate::schema::yaml_error;
-use crate::ChordTolerance;
+use fabkit_designs::input_files::{read_text_file, DataFileRules, MAX_DESIGN_FILE_BYTES};
+use fabkit_designs::library::{load_source_with, LoadedDesign};
+use fabkit_designs::schema::yaml_error;
+use fabkit_designs::ChordTolerance;
 use serde::de::{MapAccess, Visitor};
 use serde::{Deserialize, Deserializer, Serialize};
 use serde_json::Value;
@@ -62,6 +62,39 @@ pub struct FileOutputs {
 impl FileOutputs {
     pub fn any(self) -> bool {
         self.stl || self.threemf
+    }
+
+    /// The files `outputs` ask for: `files` both formats, `stl` or `3mf` one; `metrics` none.
+    pub fn of(outputs: &[Output]) -> FileOutputs {
+        let mut files = FileOutputs::default();
+        for x in outputs {
+            match x {
+                Output::Metrics => {}
+                Output::Files => {
+                    files.stl = true;
+                    files.threemf = true;
+                }
+                Output::Stl => files.stl = true,
+                Output::ThreeMf => files.threemf = true,
+            }
+        }
+        files
+    }
+}
+
+impl Output {
+    /// The output a sweep file names `name` (`metrics`, `files`, `stl`, `3mf`).
+    ///
+    /// # Errors
+    /// A message naming the value and the names allowed.
+    pub fn from_name(name: &str) -> Result<Output, String> {
+        match name {
+            "metrics" => Ok(Output::Metrics),
+            "files" => Ok(Output::Files),
+            "stl" => Ok(Output::Stl),
+            "3mf" => Ok(Output::ThreeMf),
+            other => Err(format!("'{other}' is not one of metrics, files, stl, 3mf")),
+        }
     }
 }
 
@@ -150,8 +183,8 @@ impl SweepSpec {
     }
 
     /// [`SweepSpec::from_file`] with the rules for the data files the base design reads (see
-    /// [`crate::input_files`]). The sweep file must be a regular file of at most
-    /// [`crate::input_files::MAX_DESIGN_FILE_BYTES`].
+    /// [`fabkit_designs::input_files`]). The sweep file must be a regular file of at most
+    /// [`fabkit_designs::input_files::MAX_DESIGN_FILE_BYTES`].
     ///
     /// # Errors
     /// As [`SweepSpec::from_file`].
@@ -197,10 +230,11 @@ impl SweepSpec {
         rules: &DataFileRules,
     ) -> Result<SweepSpec, SweepError> {
         use sha2::{Digest, Sha256};
-        let raw: RawSweep = crate::schema::yaml_from_str(text).map_err(|e| SweepError::File {
-            at: String::new(),
-            message: yaml_error(origin, &e),
-        })?;
+        let raw: RawSweep =
+            fabkit_designs::schema::yaml_from_str(text).map_err(|e| SweepError::File {
+                at: String::new(),
+                message: yaml_error(origin, &e),
+            })?;
         let file_err = |s: String, message: String| SweepError::File { at: s, message };
         let mut base =
             load_source_with(&raw.base.value, dir, rules).map_err(|e| SweepError::Design {
@@ -231,11 +265,12 @@ impl SweepSpec {
             at: origin.to_string(),
             message: e.to_string(),
         })?;
-        let materials =
-            crate::materials::MaterialsTable::embedded().map_err(|e| SweepError::File {
+        let materials = fabkit_designs::materials::MaterialsTable::embedded().map_err(|e| {
+            SweepError::File {
                 at: origin.to_string(),
                 message: e,
-            })?;
+            }
+        })?;
         // First the paths and the number of values: a sweep of too many variants is refused
         // before any value is looked at.
         let mut parameters: Vec<Parameter> = Vec::new();
@@ -272,12 +307,12 @@ impl SweepSpec {
         for (p, spec_at) in parameters.iter().zip(&values_at) {
             check_values(p, spec_at, &base.design, &base_json, |variant| {
                 // A parameter the rest of the design ignores would give identical variants.
-                if let Err(errs) = crate::stack::validate(variant, &materials, chord_tolerance) {
-                    if let Some(e) = errs
-                        .0
-                        .iter()
-                        .find(|e| e.path == p.path && e.rule.starts_with(crate::markers::NO_EFFECT))
-                    {
+                if let Err(errs) =
+                    fabkit_designs::stack::validate(variant, &materials, chord_tolerance)
+                {
+                    if let Some(e) = errs.0.iter().find(|e| {
+                        e.path == p.path && e.rule.starts_with(fabkit_designs::markers::NO_EFFECT)
+                    }) {
                         return Err(file_err(
                             p.at.clone(),
                             format!(
@@ -333,9 +368,9 @@ impl SweepSpec {
 fn check_values(
     p: &Parameter,
     spec_at: &str,
-    design: &crate::schema::Design,
+    design: &fabkit_designs::schema::Design,
     base_json: &Value,
-    first_design: impl FnOnce(&crate::schema::Design) -> Result<(), SweepError>,
+    first_design: impl FnOnce(&fabkit_designs::schema::Design) -> Result<(), SweepError>,
 ) -> Result<(), SweepError> {
     use rayon::prelude::*;
     let values = &p.values;
@@ -403,9 +438,9 @@ fn equality_key(v: &Value) -> String {
         }
     }
     if has_negative_zero(v) {
-        super::paths::canonical_json(&positive_zero(v))
+        fabkit_designs::variant::canonical_json(&positive_zero(v))
     } else {
-        super::paths::canonical_json(v)
+        fabkit_designs::variant::canonical_json(v)
     }
 }
 
@@ -544,17 +579,7 @@ fn file_outputs(raw: &RawSweep, origin: &str) -> Result<FileOutputs, SweepError>
                 "outputs must include metrics (the results table is always written): [metrics] or [metrics, files]".into(),
             ));
         }
-        for x in &o.value {
-            match x {
-                Output::Metrics => {}
-                Output::Files => {
-                    files.stl = true;
-                    files.threemf = true;
-                }
-                Output::Stl => files.stl = true,
-                Output::ThreeMf => files.threemf = true,
-            }
-        }
+        files = FileOutputs::of(&o.value);
     }
     Ok(files)
 }

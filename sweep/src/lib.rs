@@ -21,41 +21,44 @@
 //! - [`run`] builds them in parallel into a sweep folder, one atomically written result per
 //!   variant, resumable and shardable; [`merge`] joins the shards.
 //!
-//! The export crate depends on this one, so files are written through a [`KitWriter`] that
-//! the caller (the CLI) provides.
+//! A variant's files are written through a [`KitWriter`]: [`ExportWriter`] writes what
+//! `fabkit export` writes. What one variant needs (parameter paths, values, metrics) is
+//! `fabkit_designs::variant`, re-exported here.
 
 mod effect;
 mod file;
 mod merge;
-mod metrics;
-mod paths;
+mod nearest;
 mod plan;
 mod results;
 mod run;
 mod variants;
 
 pub use effect::{MAX_CONTEXT_VALUES, MAX_PROBED_VALUES, PROBE_CHORD_TOLERANCE_MM};
-pub use file::{values_of, FileOutputs, Mode, Output, Parameter, SweepSpec};
-pub use merge::{merge, MergeSummary};
-pub use metrics::{
+pub use fabkit_designs::variant::{
+    canonical_json, expand_short_path, parameter_paths, path_exists,
+};
+pub use fabkit_designs::variant::{
     evaluate, evaluate_bounded, min_wall, printability, CastMetrics, MarkerMetrics, Metrics,
     Outcome, PartMetrics, Verdict, PROFILES,
 };
-pub use paths::{canonical_json, expand_short_path, nearest_paths, parameter_paths, path_exists};
+pub use file::{values_of, FileOutputs, Mode, Output, Parameter, SweepSpec};
+pub use merge::{merge, MergeSummary};
+pub use nearest::nearest_paths;
 pub use plan::{
     variant_count, variant_id, Plan, PlanProgress, Shard, Variant, ID_HEX_DIGITS, MAX_VARIANTS,
 };
 pub use results::{render_csv, render_jsonl, Status, VariantResult};
 pub use run::{
-    record, run, write_atomic, Event, FilesJob, KitWriter, RunOptions, RunSummary, SweepRecord,
-    FORMAT,
+    record, run, write_atomic, Event, ExportWriter, FilesJob, KitWriter, RunOptions, RunSummary,
+    SweepRecord, FORMAT,
 };
 pub use variants::{
     checked_path, checked_value, evaluate_variant, plan_variants, resolve_variant, VariantList,
     WriteFiles,
 };
 
-use crate::error::DesignError;
+use fabkit_designs::DesignError;
 
 /// Why a sweep could not be read, run or merged. Problems of single variants are not errors:
 /// they are results ([`Status`]).

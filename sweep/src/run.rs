@@ -2,14 +2,14 @@
 //! written atomically, resume, shards.
 
 use super::file::{FileOutputs, Mode, SweepSpec};
-use super::paths::canonical_json;
 use super::plan::{hex, Plan, Shard, Variant};
 use super::results::{render_csv, render_jsonl, Status, VariantResult};
 use super::variants::{evaluate_variant, WriteFiles};
 use super::SweepError;
-use crate::kit::Kit;
-use crate::materials::MaterialsTable;
-use crate::schema::Design;
+use fabkit_designs::kit::Kit;
+use fabkit_designs::materials::MaterialsTable;
+use fabkit_designs::schema::Design;
+use fabkit_designs::variant::canonical_json;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
@@ -37,13 +37,12 @@ pub struct RunOptions {
     pub command_line: Vec<String>,
     /// fabkit version, recorded with every result; results of another version are recomputed.
     pub fabkit_version: String,
-    /// Bound on each variant's estimated triangles ([`crate::estimate::check_work`]); a variant
+    /// Bound on each variant's estimated triangles ([`fabkit_designs::estimate::check_work`]); a variant
     /// past it is recorded with status error, before its kit is built.
     pub max_triangles: u64,
 }
 
-/// Writes the files of `fabkit export` for one variant (the CLI passes the export crate's
-/// writer: designs cannot depend on it).
+/// Writes the files of one variant ([`ExportWriter`]: those of `fabkit export`).
 pub trait KitWriter: Sync {
     /// Writes `kit` into `job.dir` (replacing a previous export there) with the formats of
     /// `job.files`.
@@ -66,6 +65,62 @@ pub struct FilesJob<'a> {
     /// `<base source> variant <id> of sweep <sweep file>`.
     pub design_source: String,
     pub chord_tolerance_mm: f64,
+}
+
+impl<'a> FilesJob<'a> {
+    /// The job of variant `v` (its resolved `design`) into `dir`, its manifest naming
+    /// `design_source` and the sha256 of the design's canonical JSON.
+    pub fn new(
+        dir: PathBuf,
+        files: FileOutputs,
+        variant: &'a Variant,
+        design: &'a Design,
+        design_source: String,
+        chord_tolerance_mm: f64,
+    ) -> FilesJob<'a> {
+        let canon = canonical_json(&serde_json::to_value(design).unwrap_or_default());
+        FilesJob {
+            dir,
+            files,
+            variant,
+            design,
+            design_sha256: hex(&Sha256::digest(canon.as_bytes())),
+            design_source,
+            chord_tolerance_mm,
+        }
+    }
+}
+
+/// Writes a variant's files with `fabkit export`'s writer, into `variants/<id>/` of the sweep
+/// folder (which the sweep checks is its own), laid out for the shipped printers' beds.
+#[derive(Debug, Clone)]
+pub struct ExportWriter {
+    /// The command line recorded in each variant's manifest.json.
+    pub command_line: Vec<String>,
+}
+
+impl KitWriter for ExportWriter {
+    fn write(&self, kit: &Kit, job: &FilesJob<'_>) -> Result<(), String> {
+        use fabkit_export::{write_kit, ExportOptions, Formats, OutputCommand};
+        let opts = ExportOptions {
+            formats: Formats {
+                stl: job.files.stl,
+                threemf: job.files.threemf,
+                step: false,
+            },
+            command_line: self.command_line.clone(),
+            design_source: job.design_source.clone(),
+            design_sha256: job.design_sha256.clone(),
+            chord_tolerance_mm: job.chord_tolerance_mm,
+            fabkit_version: env!("CARGO_PKG_VERSION").to_string(),
+            printers: Default::default(),
+            command: OutputCommand::SweepVariant,
+            force: false,
+        };
+        write_kit(kit, &job.dir, &opts)
+            .map(|_| ())
+            .map_err(|e| e.to_string())
+    }
 }
 
 /// Progress of a run, reported from the worker threads.
@@ -156,7 +211,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), SweepError> {
 
 /// Whether `name` is a variant id (16 lowercase hex digits).
 fn is_variant_id(name: &str) -> bool {
-    name.len() == crate::sweep::plan::ID_HEX_DIGITS
+    name.len() == crate::plan::ID_HEX_DIGITS
         && name
             .bytes()
             .all(|b| b.is_ascii_digit() || (b'a'..=b'f').contains(&b))
@@ -304,19 +359,19 @@ pub(crate) fn read_record(dir: &Path) -> Result<SweepRecord, SweepError> {
         path: p.display().to_string(),
         message: format!("{field} = {value}: {rule}; not a record fabkit wrote"),
     };
-    if r.variant_count as u64 > crate::sweep::plan::MAX_VARIANTS {
+    if r.variant_count as u64 > crate::plan::MAX_VARIANTS {
         return Err(bad(
             "variant_count",
             r.variant_count.to_string(),
-            format!("must be at most {}", crate::sweep::plan::MAX_VARIANTS),
+            format!("must be at most {}", crate::plan::MAX_VARIANTS),
         ));
     }
     if let Some(s) = r.shard {
-        if s.count == 0 || s.index >= s.count || s.count as u64 > crate::sweep::plan::MAX_VARIANTS {
+        if s.count == 0 || s.index >= s.count || s.count as u64 > crate::plan::MAX_VARIANTS {
             return Err(bad(
                 "shard",
                 format!("{}/{}", s.index, s.count),
-                format!("needs 0 <= I < N <= {}", crate::sweep::plan::MAX_VARIANTS),
+                format!("needs 0 <= I < N <= {}", crate::plan::MAX_VARIANTS),
             ));
         }
     }
@@ -569,19 +624,17 @@ fn run_variant(
 ) -> VariantResult {
     let tol = spec.chord_tolerance;
     let write = |design: &Design, kit: &Kit| -> Result<(), String> {
-        let canon = canonical_json(&serde_json::to_value(design).unwrap_or_default());
-        let job = FilesJob {
-            dir: vdir.join(&v.id),
-            files: spec.files,
-            variant: v,
+        let job = FilesJob::new(
+            vdir.join(&v.id),
+            spec.files,
+            v,
             design,
-            design_sha256: hex(&Sha256::digest(canon.as_bytes())),
-            design_source: format!(
+            format!(
                 "{} variant {} of sweep {}",
                 spec.base.source, v.id, spec.origin
             ),
-            chord_tolerance_mm: tol.mm(),
-        };
+            tol.mm(),
+        );
         match writer {
             Some(w) => w.write(kit, &job),
             None => Ok(()),

@@ -4,15 +4,16 @@
 //! give the same results table as `fabkit sweep`.
 
 use super::file::FileOutputs;
-use super::metrics::{evaluate_bounded, printability, Outcome};
-use super::paths::{expand_short_path, nearest_paths, path_exists, with_value};
 use super::plan::{variant_id, Variant, MAX_VARIANTS};
 use super::results::{Status, VariantResult};
 use super::SweepError;
-use crate::geometry::ChordTolerance;
-use crate::kit::Kit;
-use crate::materials::MaterialsTable;
-use crate::schema::{value_at, Design};
+use crate::nearest::nearest_paths;
+use fabkit_designs::geometry::ChordTolerance;
+use fabkit_designs::kit::Kit;
+use fabkit_designs::materials::MaterialsTable;
+use fabkit_designs::schema::{value_at, Design};
+use fabkit_designs::variant::{evaluate_bounded, printability, Outcome};
+use fabkit_designs::variant::{expand_short_path, path_exists, with_value};
 use serde_json::Value;
 
 /// The full parameter path of `design` that `given` names: itself, or the one path a short

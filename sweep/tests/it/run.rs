@@ -2,7 +2,7 @@
 //! anything runs.
 
 use fabkit_designs::library;
-use fabkit_designs::sweep::*;
+use fabkit_sweep::*;
 use serde_json::Value;
 use std::path::Path;
 
