@@ -14,7 +14,7 @@
 //! tolerance and its volume passes [`MIN_OVERLAP_MM3`].
 
 use crate::error::{DesignError, GeometryContext, ParamError, ParamErrors};
-use crate::geometry::{revolve, Affine, ChordTolerance, Solid};
+use crate::geometry::{revolve, ChordTolerance, Solid};
 use crate::parts::context::Stack;
 use crate::parts::registry::FAMILIES;
 use crate::parts::Part;
@@ -69,23 +69,20 @@ fn bought(
     }
 }
 
-/// The inverse of a rigid map (rotation and translation, 3x4 row-major).
-fn rigid_inverse(t: &Affine) -> Affine {
-    let mut m = [[0.0; 4]; 3];
-    for i in 0..3 {
-        for j in 0..3 {
-            m[i][j] = t[j][i];
-        }
-        m[i][3] = -(0..3).map(|k| t[k][i] * t[k][3]).sum::<f64>();
-    }
-    m
-}
-
 /// A kit part in the sensor frame: its solid moved back by the inverse of
 /// `params.T_print_sensor`; `None` when the part records no pose.
 pub fn in_sensor_frame(part: &Part) -> Option<Solid> {
-    let t: Affine = serde_json::from_value(part.params.get("T_print_sensor")?.clone()).ok()?;
-    Some(part.solid.transform(&rigid_inverse(&t)))
+    let t = crate::geometry::transform::from_json(part.params.get("T_print_sensor")?)?;
+    // rigid: the inverse is (R^T, -R^T t)
+    let r = t.matrix().fixed_view::<3, 3>(0, 0).transpose();
+    let back = -(r * t.matrix().fixed_view::<3, 1>(0, 3));
+    Some(
+        part.solid
+            .transform(&crate::geometry::transform::with_translation(
+                &r,
+                back.into(),
+            )),
+    )
 }
 
 /// The members of the assembled sensor that no family gives, in order: printed sensor parts,

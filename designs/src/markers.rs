@@ -1219,30 +1219,17 @@ pub fn local_feature(
 
 /// The affine map taking the local +z axis at the origin to `dir` at `position`.
 pub fn frame_to(position: [f64; 3], dir: [f64; 3]) -> crate::geometry::Affine {
-    let z = dir;
+    use nalgebra::Vector3;
+    let z = Vector3::from(dir);
     // any vector not parallel to z
     let helper = if z[2].abs() < 0.9 {
-        [0.0, 0.0, 1.0]
+        Vector3::z()
     } else {
-        [1.0, 0.0, 0.0]
+        Vector3::x()
     };
-    let mut x = [
-        helper[1] * z[2] - helper[2] * z[1],
-        helper[2] * z[0] - helper[0] * z[2],
-        helper[0] * z[1] - helper[1] * z[0],
-    ];
-    let l = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
-    x = [x[0] / l, x[1] / l, x[2] / l];
-    let y = [
-        z[1] * x[2] - z[2] * x[1],
-        z[2] * x[0] - z[0] * x[2],
-        z[0] * x[1] - z[1] * x[0],
-    ];
-    [
-        [x[0], y[0], z[0], position[0]],
-        [x[1], y[1], z[1], position[1]],
-        [x[2], y[2], z[2], position[2]],
-    ]
+    let x = helper.cross(&z).normalize();
+    let y = z.cross(&x);
+    crate::geometry::transform::from_columns(x.into(), y.into(), dir, position)
 }
 
 /// Volume of the gap between the tangent plane and the surface over the feature's base disc,

@@ -218,11 +218,7 @@ impl Primitive {
                 let e = half_extents_mm;
                 let b = cuboid([-e[0], -e[1], -e[2]], [e[0], e[1], e[2]])?;
                 let a = axes;
-                let m: Affine = [
-                    [a[0][0], a[1][0], a[2][0], centre_mm[0]],
-                    [a[0][1], a[1][1], a[2][1], centre_mm[1]],
-                    [a[0][2], a[1][2], a[2][2], centre_mm[2]],
-                ];
+                let m = crate::geometry::transform::from_columns(a[0], a[1], a[2], *centre_mm);
                 Ok(b.transform(&m))
             }
             Primitive::Prism {
@@ -234,11 +230,7 @@ impl Primitive {
             } => {
                 let mesh = extrude(polygon_mm, *height_mm)?;
                 let z = cross(*x_axis, *y_axis);
-                let m: Affine = [
-                    [x_axis[0], y_axis[0], z[0], origin_mm[0]],
-                    [x_axis[1], y_axis[1], z[1], origin_mm[1]],
-                    [x_axis[2], y_axis[2], z[2], origin_mm[2]],
-                ];
+                let m = crate::geometry::transform::from_columns(*x_axis, *y_axis, z, *origin_mm);
                 Ok(Solid::from_mesh(&mesh)?.transform(&m))
             }
         }
@@ -344,19 +336,10 @@ impl Geometry {
     /// The same geometry moved by a rigid map `m` (rotation rows + translation column).
     pub fn transformed(&self, m: &Affine) -> Geometry {
         let p = |v: [f64; 3]| -> [f64; 3] {
-            [
-                m[0][0] * v[0] + m[0][1] * v[1] + m[0][2] * v[2] + m[0][3],
-                m[1][0] * v[0] + m[1][1] * v[1] + m[1][2] * v[2] + m[1][3],
-                m[2][0] * v[0] + m[2][1] * v[1] + m[2][2] * v[2] + m[2][3],
-            ]
+            m.transform_point(&nalgebra::Point3::from(v)).coords.into()
         };
-        let d = |v: [f64; 3]| -> [f64; 3] {
-            [
-                m[0][0] * v[0] + m[0][1] * v[1] + m[0][2] * v[2],
-                m[1][0] * v[0] + m[1][1] * v[1] + m[1][2] * v[2],
-                m[2][0] * v[0] + m[2][1] * v[1] + m[2][2] * v[2],
-            ]
-        };
+        let d =
+            |v: [f64; 3]| -> [f64; 3] { m.transform_vector(&nalgebra::Vector3::from(v)).into() };
         let primitives = self
             .primitives
             .iter()

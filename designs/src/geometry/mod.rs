@@ -7,10 +7,12 @@
 mod mesh;
 pub mod profile2d;
 mod solid;
+pub mod transform;
 
 pub use mesh::{triangle_cross, Aabb, Mesh, TopologyError};
 pub use profile2d::Polyline2;
-pub use solid::{csg_json, rotation_deg, Affine, CsgNode, GeometryError, Solid};
+pub use solid::{csg_json, rotation_deg, CsgNode, GeometryError, Solid};
+pub use transform::Affine;
 
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;

@@ -1,6 +1,7 @@
 //! [`Solid`]: our own handle on the boolean kernel (`manifold-rust`), so that the kernel can be
 //! swapped without touching the part code.
 
+use super::transform::{self, Affine};
 use super::{Aabb, Mesh, TopologyError};
 use manifold_rust::linalg::{Mat3x4, Vec3};
 use manifold_rust::manifold::Manifold;
@@ -30,9 +31,6 @@ pub struct Solid {
     m: Manifold,
     csg: Arc<CsgNode>,
 }
-
-/// A 3x4 row-major affine map: p' = R p + t.
-pub type Affine = [[f64; 4]; 3];
 
 /// How a solid was built.
 #[derive(Debug)]
@@ -68,30 +66,16 @@ fn sincos_deg(d: f64) -> (f64, f64) {
     }
 }
 
-fn mat3_mul(a: [[f64; 3]; 3], b: [[f64; 3]; 3]) -> [[f64; 3]; 3] {
-    let mut m = [[0.0; 3]; 3];
-    for i in 0..3 {
-        for j in 0..3 {
-            m[i][j] = (0..3).map(|k| a[i][k] * b[k][j]).sum();
-        }
-    }
-    m
-}
-
 /// The rotation about x, then y, then z (degrees), as an affine map.
 pub fn rotation_deg(x: f64, y: f64, z: f64) -> Affine {
+    use nalgebra::Matrix3;
     let (sx, cx) = sincos_deg(x);
     let (sy, cy) = sincos_deg(y);
     let (sz, cz) = sincos_deg(z);
-    let rx = [[1.0, 0.0, 0.0], [0.0, cx, -sx], [0.0, sx, cx]];
-    let ry = [[cy, 0.0, sy], [0.0, 1.0, 0.0], [-sy, 0.0, cy]];
-    let rz = [[cz, -sz, 0.0], [sz, cz, 0.0], [0.0, 0.0, 1.0]];
-    let m = mat3_mul(rz, mat3_mul(ry, rx));
-    [
-        [m[0][0], m[0][1], m[0][2], 0.0],
-        [m[1][0], m[1][1], m[1][2], 0.0],
-        [m[2][0], m[2][1], m[2][2], 0.0],
-    ]
+    let rx = Matrix3::new(1.0, 0.0, 0.0, 0.0, cx, -sx, 0.0, sx, cx);
+    let ry = Matrix3::new(cy, 0.0, sy, 0.0, 1.0, 0.0, -sy, 0.0, cy);
+    let rz = Matrix3::new(cz, -sz, 0.0, sz, cz, 0.0, 0.0, 0.0, 1.0);
+    transform::with_translation(&(rz * (ry * rx)), [0.0; 3])
 }
 
 impl std::fmt::Debug for Solid {
@@ -221,9 +205,10 @@ impl Solid {
         }
     }
 
-    /// This solid under the affine map `a` (p' = R p + t, row-major 3x4).
+    /// This solid under the affine map `a` (p' = R p + t).
     pub fn transform(&self, a: &Affine) -> Solid {
-        let col = |j: usize| Vec3::new(a[0][j], a[1][j], a[2][j]);
+        let m = a.matrix();
+        let col = |j: usize| Vec3::new(m[(0, j)], m[(1, j)], m[(2, j)]);
         let m = Mat3x4 {
             x: col(0),
             y: col(1),
@@ -238,11 +223,7 @@ impl Solid {
 
     /// Translated by `d` mm.
     pub fn translate(&self, d: [f64; 3]) -> Solid {
-        self.transform(&[
-            [1.0, 0.0, 0.0, d[0]],
-            [0.0, 1.0, 0.0, d[1]],
-            [0.0, 0.0, 1.0, d[2]],
-        ])
+        self.transform(&transform::translation(d))
     }
 
     /// Rotated about x, then y, then z, by the given angles in degrees (exact for multiples
@@ -253,13 +234,9 @@ impl Solid {
 
     /// Mirrored through the plane through the origin with unit normal `n`.
     pub fn mirror(&self, n: [f64; 3]) -> Solid {
-        let mut a = [[0.0; 4]; 3];
-        for i in 0..3 {
-            for j in 0..3 {
-                a[i][j] = if i == j { 1.0 } else { 0.0 } - 2.0 * n[i] * n[j];
-            }
-        }
-        self.transform(&a)
+        let n = nalgebra::Vector3::from(n);
+        let householder = nalgebra::Matrix3::identity() - (n * n.transpose()) * 2.0;
+        self.transform(&transform::with_translation(&householder, [0.0; 3]))
     }
 
     /// The two parts on either side of the plane `n . x = offset` (`n` need not be unit):
@@ -366,7 +343,7 @@ pub fn csg_json(parts: &[(&str, &Solid)]) -> serde_json::Value {
                 json!({"op": "intersection", "children": kids(&[a, b], ids, out)})
             }
             CsgNode::Transform(a, c) => {
-                json!({"op": "transform", "matrix": a, "children": kids(&[c], ids, out)})
+                json!({"op": "transform", "matrix": transform::rows(a), "children": kids(&[c], ids, out)})
             }
             CsgNode::SplitKeep {
                 normal,

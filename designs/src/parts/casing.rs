@@ -747,7 +747,7 @@ pub fn build_casing(
         ))?);
     }
     let casing = g(block.difference(&g(Solid::union_all(&cuts))?))?;
-    let (placed, pose) = place_posed(&casing, &crate::parts::placement::IDENTITY);
+    let (placed, pose) = place_posed(&casing, &crate::geometry::Affine::identity());
     Ok(Part {
         name: "casing".into(),
         role: "casing".into(),
@@ -826,7 +826,7 @@ pub fn build_base(
         ))?);
     }
     let base = g(plate.difference(&g(Solid::union_all(&cuts))?))?;
-    let (placed, pose) = place_posed(&base, &crate::parts::placement::IDENTITY);
+    let (placed, pose) = place_posed(&base, &crate::geometry::Affine::identity());
     Ok(Part {
         name: "gripper_base".into(),
         role: "gripper_base".into(),

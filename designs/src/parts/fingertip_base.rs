@@ -580,7 +580,7 @@ pub fn build_parts(
     let b = &f.bolts;
     let bolts = bolt_xy(f, r.bolt_circle_mm);
     let part = |name: &str, material: &str, solid: Solid, description: String| {
-        let (placed, pose) = place_posed(&solid, &crate::parts::placement::IDENTITY);
+        let (placed, pose) = place_posed(&solid, &crate::geometry::Affine::identity());
         Part {
             name: name.into(),
             role: name.into(),

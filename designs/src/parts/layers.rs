@@ -11,7 +11,7 @@ use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{revolve, ChordTolerance, GeometryError, Polyline2, Solid};
 use crate::markers::{self, Marker, MarkerSpec, MarkerSurface, PatternStats, Polarity, Surface};
 use crate::parts::context::{ResolvedLayer, Stack};
-use crate::parts::placement::{place_posed, with_pose, IDENTITY};
+use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::{Part, PrintTechnology};
 use crate::schema::{Design, LayerProcess, MoldStrategy, PrinterProfile, Technology};
 use crate::values::MAX_LENGTH_MM;
@@ -942,11 +942,7 @@ fn build_printed_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
             ]
         })
         .unwrap_or([0.0; 3]);
-    let pose = [
-        [1.0, 0.0, 0.0, shift[0]],
-        [0.0, 1.0, 0.0, shift[1]],
-        [0.0, 0.0, 1.0, shift[2]],
-    ];
+    let pose = crate::geometry::transform::translation(shift);
     let mut parts = vec![Part {
         name: name.clone(),
         role: "printed_skin".into(),
@@ -1179,7 +1175,7 @@ fn two_piece_open_parts(
     });
     let (bottom_placed, bottom_pose) =
         place_posed(&bottom, &crate::geometry::rotation_deg(180.0, 0.0, 0.0));
-    let (top_placed, top_pose) = place_posed(&top_piece, &IDENTITY);
+    let (top_placed, top_pose) = place_posed(&top_piece, &crate::geometry::Affine::identity());
     let piece = |suffix: &str, which: &str, desc: String, solid, pose| {
         let mut p = params.clone();
         p["piece"] = json!(which);
@@ -1319,8 +1315,8 @@ fn build_boundary_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
         group: None,
     };
     let parts = vec![
-        mk("outer_master", "master_pattern", format!("Positive of the outer boundary of {name} with its features, to cast the outer Mold Star 30 mold"), cavity_tech, place_posed(&master, &IDENTITY)),
-        mk("outer_mold_box", "mold_box", format!("Drafted cup for the outer Mold Star 30 mold of {name}"), fixture_tech, place_posed(&mold_box, &IDENTITY)),
+        mk("outer_master", "master_pattern", format!("Positive of the outer boundary of {name} with its features, to cast the outer Mold Star 30 mold"), cavity_tech, place_posed(&master, &crate::geometry::Affine::identity())),
+        mk("outer_mold_box", "mold_box", format!("Drafted cup for the outer Mold Star 30 mold of {name}"), fixture_tech, place_posed(&mold_box, &crate::geometry::Affine::identity())),
         mk("inner_negative", "negative_mold", format!("Negative of the inner boundary of {name} with its features: pour Mold Star 30 in it for the inner silicone mold"), cavity_tech, place_posed(&inner_negative, &crate::geometry::rotation_deg(180.0, 0.0, 0.0))),
     ];
     let names: Vec<String> = parts.iter().map(|p| p.name.clone()).collect();

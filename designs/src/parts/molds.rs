@@ -20,7 +20,7 @@ use crate::schema::{Design, LayerProcess, MoldStrategy};
 use serde_json::json;
 
 use crate::parts::lasercut::LaserCutParams;
-pub use crate::parts::placement::{affine_then, place_on_bed, place_posed, with_pose, IDENTITY};
+pub use crate::parts::placement::{place_on_bed, place_posed, with_pose};
 use crate::schema::Technology;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -823,7 +823,7 @@ fn build_mold_parts(
     } else {
         format!("{name}_casting_jig")
     };
-    let (holder_placed, holder_pose) = place_posed(&holder, &IDENTITY);
+    let (holder_placed, holder_pose) = place_posed(&holder, &crate::geometry::Affine::identity());
     let holder_part = Part {
         name: holder_name.clone(),
         role: if direct { "core_holder".into() } else { "casting_jig".into() },
@@ -968,8 +968,8 @@ fn master_mold_parts(
         "pin_socket_radius_mm": LOCATING_PIN_RADIUS_MM.min(f.plinth_radius_mm / 3.0) + m.core_holder.fit_clearance_mm,
         "fill_z_mm": f.cavity_pole_z_mm + m.silicone_wall_mm,
     });
-    let (master_placed, master_pose) = place_posed(&master, &IDENTITY);
-    let (box_placed, box_pose) = place_posed(&mold_box, &IDENTITY);
+    let (master_placed, master_pose) = place_posed(&master, &crate::geometry::Affine::identity());
+    let (box_placed, box_pose) = place_posed(&mold_box, &crate::geometry::Affine::identity());
     let master_name = format!("{name}_master_pattern");
     let box_name = format!("{name}_mold_box");
     let parts = vec![

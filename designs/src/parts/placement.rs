@@ -3,7 +3,6 @@
 //! (`docs/conventions.md`, `T_print_sensor`).
 
 use crate::geometry::{Affine, Solid};
-use serde_json::json;
 
 /// Places a solid for printing: minimum z on the plate (z = 0), bounding box centred on x = y = 0.
 pub fn place_on_bed(s: &Solid) -> Solid {
@@ -17,31 +16,12 @@ pub fn place_on_bed(s: &Solid) -> Solid {
     }
 }
 
-/// The identity pose (sensor frame = print frame before the bed placement).
-pub const IDENTITY: Affine = [
-    [1.0, 0.0, 0.0, 0.0],
-    [0.0, 1.0, 0.0, 0.0],
-    [0.0, 0.0, 1.0, 0.0],
-];
-
-/// `a` after `b`: the affine map p -> a(b(p)).
-pub fn affine_then(a: &Affine, b: &Affine) -> Affine {
-    let mut m = [[0.0; 4]; 3];
-    for (i, row) in m.iter_mut().enumerate() {
-        for (j, v) in row.iter_mut().enumerate() {
-            *v =
-                (0..3).map(|k| a[i][k] * b[k][j]).sum::<f64>() + if j == 3 { a[i][3] } else { 0.0 };
-        }
-    }
-    m
-}
-
 /// `s` turned by the rigid map `pose` into its print orientation, then placed as
-/// [`place_on_bed`] does; with the whole map `T_print_sensor` (3x4 row-major, sensor frame to
-/// print frame, mm). Parts record it in `params.T_print_sensor` so that an independent twin
+/// [`place_on_bed`] does; with the whole map `T_print_sensor` (sensor frame to print frame,
+/// mm). Parts record it in `params.T_print_sensor` so that an independent twin
 /// (export/python/twins) can rebuild them in the sensor frame and place them the same way.
 pub fn place_posed(s: &Solid, pose: &Affine) -> (Solid, Affine) {
-    let turned = if *pose == IDENTITY {
+    let turned = if *pose == Affine::identity() {
         s.clone()
     } else {
         s.transform(pose)
@@ -54,18 +34,19 @@ pub fn place_posed(s: &Solid, pose: &Affine) -> (Solid, Affine) {
         ],
         None => [0.0; 3],
     };
-    let t = [
-        [1.0, 0.0, 0.0, shift[0]],
-        [0.0, 1.0, 0.0, shift[1]],
-        [0.0, 0.0, 1.0, shift[2]],
-    ];
-    (turned.translate(shift), affine_then(&t, pose))
+    (
+        turned.translate(shift),
+        crate::geometry::transform::translation(shift) * pose,
+    )
 }
 
 /// `params` with `T_print_sensor` (see [`place_posed`]) added.
 pub fn with_pose(mut params: serde_json::Value, t: &Affine) -> serde_json::Value {
     if let Some(o) = params.as_object_mut() {
-        o.insert("T_print_sensor".into(), json!(t));
+        o.insert(
+            "T_print_sensor".into(),
+            crate::geometry::transform::to_json(t),
+        );
     }
     params
 }

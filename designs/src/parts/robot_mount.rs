@@ -361,7 +361,7 @@ pub fn build_mount(
         pin_xy(m),
     ))?);
     let mount = g(g(plate.union(&cup))?.difference(&g(Solid::union_all(&cuts))?))?;
-    let (placed, pose) = place_posed(&mount, &crate::parts::placement::IDENTITY);
+    let (placed, pose) = place_posed(&mount, &crate::geometry::Affine::identity());
     Ok(Part {
         name: "robot_mount".into(),
         role: "robot_mount".into(),

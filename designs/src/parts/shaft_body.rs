@@ -827,7 +827,7 @@ pub fn build_body(
         None => outer,
     };
     let body = g(outer.difference(&g(Solid::union_all(&cuts))?))?;
-    let (placed, pose) = place_posed(&body, &crate::parts::placement::IDENTITY);
+    let (placed, pose) = place_posed(&body, &crate::geometry::Affine::identity());
     let fdm_tech = PrintTechnology::Fdm;
     Ok(Part {
         name: "shaft_body".into(),

@@ -15,7 +15,7 @@ use crate::materials::{CastReport, MaterialKind};
 use crate::parts::context::{Context, Stack};
 use crate::parts::family::{named, AssemblyStep, Built, Family};
 use crate::parts::part::{Part, PrintTechnology};
-use crate::parts::placement::{place_posed, with_pose, IDENTITY};
+use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::{check_positive, z_cylinder};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -118,7 +118,7 @@ impl Family for SpacerFamily {
         tol: ChordTolerance,
     ) -> Result<Built, DesignError> {
         let ring = ring_solid(p, ctx, tol).part("spacer")?;
-        let (placed, pose) = place_posed(&ring, &IDENTITY);
+        let (placed, pose) = place_posed(&ring, &crate::geometry::Affine::identity());
         let zb = ctx.body.base_z_mm();
         let part = Part {
             name: "spacer".into(),

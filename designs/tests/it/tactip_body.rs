@@ -324,7 +324,10 @@ fn each_bayonet_unlocks_only_back_along_its_own_turn() {
     assert!(!tip.clockwise && base.clockwise && base.outward && !tip.outward);
     let rot = |s: &Solid, deg: f64, dz: f64| {
         let (sn, cs) = deg.to_radians().sin_cos();
-        s.transform(&[[cs, -sn, 0.0, 0.0], [sn, cs, 0.0, 0.0], [0.0, 0.0, 1.0, dz]])
+        s.transform(&fabkit_designs::geometry::transform::with_translation(
+            &nalgebra::Matrix3::new(cs, -sn, 0.0, sn, cs, 0.0, 0.0, 0.0, 1.0),
+            [0.0, 0.0, dz],
+        ))
     };
     for b in [&tip, &base] {
         let r = b.spigot_radius_mm;

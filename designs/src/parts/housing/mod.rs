@@ -1174,7 +1174,7 @@ fn build_round_tube(
             "top face down",
         ),
         part(
-            place_posed(&base, &crate::parts::placement::IDENTITY),
+            place_posed(&base, &crate::geometry::Affine::identity()),
             "shell_base",
             "Sensor base: closes the tube and carries the camera board (4 pilots on its spigot); the camera cable leaves through its slot; 2 joint screws up through its flange into the tube",
             "flange down",
