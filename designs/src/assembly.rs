@@ -52,7 +52,7 @@ fn printed_fix(role: &str) -> Vec<String> {
 pub const MIN_OVERLAP_MM3: f64 = 1e-3;
 
 /// A bought part's envelope as a member: never nested by the stack.
-fn bought(
+pub(crate) fn bought(
     name: &str,
     description: String,
     (solid, exact): (Solid, ExactShape),

@@ -367,19 +367,17 @@ fn render_with(
         };
         return Err(ExportError::Step { part, reason });
     }
+    let read = |name: &str| {
+        let f = out_dir.join(format!("{name}.step"));
+        std::fs::read(&f).map_err(ExportError::io("reading", &f))
+    };
     let parts = parts
         .iter()
-        .map(|p| {
-            let f = out_dir.join(format!("{}.step", p.name));
-            std::fs::read(&f).map_err(ExportError::io("reading", &f))
-        })
+        .map(|p| read(&p.name))
         .collect::<Result<_, _>>()?;
     let machined = machined
         .iter()
-        .map(|m| {
-            let f = out_dir.join(format!("{}.step", m.name));
-            std::fs::read(&f).map_err(ExportError::io("reading", &f))
-        })
+        .map(|m| read(&m.name))
         .collect::<Result<_, _>>()?;
     let assembly = match assembly {
         Some(_) => Some(

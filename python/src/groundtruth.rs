@@ -259,6 +259,18 @@ fn frame_dict<'py>(py: Python<'py>, f: &DepthFrame) -> PyResult<Bound<'py, PyDic
 }
 
 impl DepthRenderer {
+    /// Refuses a photometric model of another camera size than this renderer's.
+    fn check_camera_of(&self, m: &PhotometricModel) -> PyResult<()> {
+        let (m, rays) = (&m.model, &self.scene.rays);
+        if (m.width, m.height) != (rays.width, rays.height) {
+            return Err(GroundTruthError::new_err(format!(
+                "photometric: the model is of a {} x {} px camera, this renderer's is {} x {} px (the model was fitted to another camera)",
+                m.width, m.height, rays.width, rays.height
+            )));
+        }
+        Ok(())
+    }
+
     /// The imaging of the design's optics, set up on first use (the optics resolved, the
     /// exposure set on the reference).
     fn physical_imaging(&self) -> Result<&Imaging, String> {
@@ -490,13 +502,8 @@ impl DepthRenderer {
         }
         let rays = &self.scene.rays;
         if let Some(m) = photometric {
+            self.check_camera_of(m)?;
             let m = &m.model;
-            if (m.width, m.height) != (rays.width, rays.height) {
-                return Err(GroundTruthError::new_err(format!(
-                    "photometric: the model is of a {} x {} px camera, this renderer's is {} x {} px (the model was fitted to another camera)",
-                    m.width, m.height, rays.width, rays.height
-                )));
-            }
             let img = crate::work(py, || match protrusions {
                 None => m.image(rays, &self.reference_hits, &self.reference_hits, None),
                 Some(p) => {
@@ -620,13 +627,7 @@ impl DepthRenderer {
             .map_err(GroundTruthError::new_err)?;
         let rays = &self.scene.rays;
         if let Some(m) = photometric {
-            let m = &m.model;
-            if (m.width, m.height) != (rays.width, rays.height) {
-                return Err(GroundTruthError::new_err(format!(
-                    "photometric: the model is of a {} x {} px camera, this renderer's is {} x {} px (the model was fitted to another camera)",
-                    m.width, m.height, rays.width, rays.height
-                )));
-            }
+            self.check_camera_of(m)?;
         }
         let imaging = match photometric {
             Some(m) => Some(ImageSource::Photometric(

@@ -228,16 +228,12 @@ fn bought_envelopes(
         Ok((cuboid(min_mm, max_mm)?, ExactShape::Box { min_mm, max_mm }))
     };
     let bought = |name: &str, description: String, r: Exact, fix: &[&str]| {
-        let (solid, exact) = r.part(name)?;
-        Ok::<_, DesignError>(Member {
-            name: name.into(),
-            kind: MemberKind::Bought,
+        Ok::<_, DesignError>(crate::assembly::bought(
+            name,
             description,
-            solid,
-            fix: fix.iter().map(|f| (*f).to_string()).collect(),
-            nested_by_stack: false,
-            exact: Some(exact),
-        })
+            r.part(name)?,
+            fix,
+        ))
     };
     let bw = h.camera.board_width_mm / 2.0;
     let (z0, z1) = match (h.style, lv.base_top_z_mm) {
