@@ -11,6 +11,7 @@ use crate::parts::molds::{build_mold, cast_plans};
 use crate::parts::registry::FAMILIES;
 use crate::schema::{Design, LayerProcess, MoldStrategy};
 use crate::stack::{validate, Stack};
+use crate::timings;
 use rayon::prelude::*;
 use serde_json::json;
 
@@ -62,12 +63,16 @@ pub fn build_kit_bounded(
 ) -> Result<Kit, DesignError> {
     let materials = MaterialsTable::embedded().map_err(DesignError::Yaml)?;
     if design.body.flat_outline().is_some() {
+        let _t = timings::stage("build the flat kit (parts, trays, pours)");
         return flat_kit::build_flat_kit(design, &materials, tol, max_triangles);
     }
+    let t = timings::stage("check the design (layer stack, rules, work bound)");
     let stack = validate(design, &materials, tol)?;
     if max_triangles < u64::MAX {
         crate::estimate::check_work(design, &stack, tol, max_triangles)?;
     }
+    drop(t);
+    let t = timings::stage("build the parts (molds, layers, families; in parallel)");
     let plans = cast_plans(design, &stack);
     let mut parts = Vec::new();
     let mut silicone = Vec::new();
@@ -145,15 +150,22 @@ pub fn build_kit_bounded(
         bought.extend(f.bought_items(design));
     }
 
+    drop(t);
+    let t = timings::stage("pour volumes");
     let (mut casts, step) = layer_pours(design, &stack, &materials, silicone, gel)?;
     let poured = filling_gel_pours(design, &stack, &materials, &parts, (&mut casts, step), tol)?;
+    drop(t);
     check_unique_names(&parts)?;
     // The assembled sensor and its fit check: no file is written when parts overlap.
+    let t = timings::stage("assembly, fit and insertion checks");
     let assembly = assembled(design, &stack, &parts, poured, tol)?;
+    drop(t);
+    let t = timings::stage("procedure and machined parts");
     let bolts = crate::procedure::clamp_bolts(design, &parts);
     bought.extend(crate::procedure::clamp_bolt_items(&bolts));
     let procedure = crate::procedure::procedure(design, &parts, &casts, &bolts);
     let machined_parts = machined_parts(design, &stack, &parts, tol)?;
+    drop(t);
     Ok(Kit {
         design: design.name.clone(),
         parts,

@@ -36,6 +36,7 @@ pub mod procedure;
 pub mod profile;
 pub mod schema;
 pub mod stack;
+pub mod timings;
 pub mod values;
 pub mod variant;
 pub mod yaml;

@@ -212,7 +212,9 @@ pub fn write_kit_reporting(
     for (rel, _) in data_files {
         atomic::check_relative_path("data_files", rel)?;
     }
+    let t = fabkit_designs::timings::stage("written meshes");
     let meshes: Vec<Mesh> = kit.parts.iter().map(|p| p.written_mesh()).collect();
+    drop(t);
     write_kit_meshes(kit, &meshes, data_files, out_dir, opts, step_progress)
 }
 
@@ -228,11 +230,14 @@ fn write_kit_meshes(
 ) -> Result<ExportSummary, ExportError> {
     check::check_options(opts)?;
     check::check_names(kit)?;
+    let t = fabkit_designs::timings::stage("printable-mesh checks");
     for (part, mesh) in kit.parts.iter().zip(meshes) {
         check_printable_mesh(&part.name, mesh)?;
     }
+    drop(t);
     let rendered = render(kit, meshes, data_files, opts, step_progress)?;
     let claim = opts.claim(&kit.design);
+    let t = fabkit_designs::timings::stage("file hashes");
     let hashes: Vec<String> = {
         use rayon::prelude::*;
         rendered
@@ -241,6 +246,8 @@ fn write_kit_meshes(
             .map(|(_, b)| sha256_hex(b))
             .collect()
     };
+    drop(t);
+    let t = fabkit_designs::timings::stage("write, fsync and rename the folder");
     let done = atomic::replace_dir(out_dir, &claim, |tmp, written| {
         if opts.formats.stl {
             let parts_dir = tmp.join(PARTS_DIR);
@@ -261,6 +268,7 @@ fn write_kit_meshes(
         }
         Ok(())
     })?;
+    drop(t);
     Ok(ExportSummary {
         out_dir: out_dir.to_path_buf(),
         files: rendered
@@ -547,6 +555,7 @@ fn render(
     opts: &ExportOptions,
     step_progress: Option<step::StepProgress<'_>>,
 ) -> Result<Rendered, ExportError> {
+    let t = fabkit_designs::timings::stage("STL files and part entries");
     let mut files = Vec::new();
     let mut parts = Vec::with_capacity(kit.parts.len());
     // product names and densities of the printed materials
@@ -597,6 +606,8 @@ fn render(
             ],
         }
     };
+    drop(t);
+    let t = fabkit_designs::timings::stage("plates");
     // the plates first: a part larger than its bed stops the export before anything is made
     let plates = if opts.formats.threemf {
         let keyed: Vec<_> = kit
@@ -610,6 +621,8 @@ fn render(
     } else {
         Vec::new()
     };
+    drop(t);
+    let t = fabkit_designs::timings::stage("kit 3MF and its thumbnail");
     let kit_3mf = if opts.formats.threemf {
         let boxes: Vec<_> = parts.iter().map(|p| p.bbox_mm).collect();
         let translations = layout::pack_units(&boxes, &units, layout::ROW_WIDTH_MM, layout::GAP_MM);
@@ -670,6 +683,8 @@ fn render(
     } else {
         None
     };
+    drop(t);
+    let t = fabkit_designs::timings::stage("pictures (part previews, plates)");
     // pictures whenever a mesh format is written: every part's preview, every plate's picture
     // (also its 3MF's thumbnail)
     let pictures = opts.formats.stl || opts.formats.threemf;
@@ -822,6 +837,8 @@ fn render(
         files.push((rel, png));
     }
     files.extend(plate_picture_files);
+    drop(t);
+    let t = fabkit_designs::timings::stage("assembly meshes, 3MF and drawings");
     // The assembled sensor's meshes, made and checked once for the section view and the 3MF.
     let assembly_meshes: Vec<Mesh> = kit
         .assembly
@@ -868,6 +885,11 @@ fn render(
         });
         files.push((drawing, drawing_bytes));
     }
+    drop(t);
+    let t = opts
+        .formats
+        .step
+        .then(|| fabkit_designs::timings::stage("STEP (CadQuery twin)"));
     let assembly_step = if opts.formats.step {
         let (steps, assembly) = step_files(kit, &parts, &assembly_meshes, opts, step_progress)?;
         for (p, bytes) in parts.iter_mut().zip(steps.parts) {
@@ -893,6 +915,8 @@ fn render(
     } else {
         None
     };
+    drop(t);
+    let t = fabkit_designs::timings::stage("section view and the assembly's entry");
     let section_view = if kit.assembly.is_empty() {
         None
     } else {
@@ -980,6 +1004,8 @@ fn render(
         None
     };
 
+    drop(t);
+    let t = fabkit_designs::timings::stage("manifest, FABRICATION.md and .html");
     let manifest = Manifest {
         fabkit_version: opts.fabkit_version.clone(),
         design: ManifestDesign {
@@ -1033,6 +1059,7 @@ fn render(
     );
     files.push(("FABRICATION.md".to_owned(), sheet_md.into_bytes()));
     files.push(("FABRICATION.html".to_owned(), sheet_html.into_bytes()));
+    drop(t);
     Ok(Rendered { files, manifest })
 }
 

@@ -377,7 +377,7 @@ fn render_with(
         .collect::<Result<_, _>>()?;
     let machined = machined
         .iter()
-        .map(|m| read(&m.name))
+        .map(|m| read(m.name))
         .collect::<Result<_, _>>()?;
     let assembly = match assembly {
         Some(_) => Some(

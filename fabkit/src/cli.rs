@@ -4,6 +4,7 @@
 use clap::{Parser, Subcommand, ValueEnum};
 use fabkit_designs::input_files::DataFileRules;
 use fabkit_designs::schema::MoldStrategy;
+use fabkit_designs::timings;
 use fabkit_designs::{build_kit_bounded, library, ChordTolerance, DesignError};
 use fabkit_export::{write_kit_reporting, ExportOptions, Formats};
 use std::error::Error;
@@ -107,6 +108,12 @@ struct ExportArgs {
     #[arg(long, value_name = "N", default_value_t = fabkit_designs::estimate::DEFAULT_MAX_TRIANGLES,
           value_parser = fabkit_designs::estimate::parse_max_triangles, allow_negative_numbers = true)]
     max_triangles: u64,
+    /// Print where the time went to stderr after the export: the wall and CPU time of each
+    /// stage (reading, checks, parts, pours, assembly and fit check, meshes, pictures, plates,
+    /// 3MF, manifest and sheet, writing) and of the whole command; CPU / wall is the number of
+    /// cores a stage kept busy.
+    #[arg(long)]
+    timings: bool,
     #[command(flatten)]
     data_files: DataFileArgs,
 }
@@ -437,11 +444,17 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
 }
 
 fn export(args: ExportArgs) -> Result<(), Box<dyn Error>> {
+    let (wall0, cpu0) = (std::time::Instant::now(), timings::cpu_seconds());
+    if args.timings {
+        timings::enable();
+    }
     let tol = tolerance(args.chord_tolerance_mm)?;
+    let t = timings::stage("read the design");
     let mut loaded = load_design(args.design.as_deref(), &args.data_files)?;
     if let Some(p) = &args.preset {
         loaded.apply_preset(p)?;
     }
+    drop(t);
     crate::printers::apply(&args.printer, &mut loaded.design.printers)?;
     if let Some(s) = args.mold_strategy {
         let s = match s {
@@ -489,6 +502,7 @@ fn export(args: ExportArgs) -> Result<(), Box<dyn Error>> {
     let step_progress = |i: usize, n: usize, part: &str| eprintln!("STEP {i}/{n}: {part}");
     let summary = write_kit_reporting(&kit, &[], &out, &opts, Some(&step_progress))?;
     if let Some(csg) = &args.csg {
+        let _t = timings::stage("CSG tree");
         write_csg(&kit, csg)?;
     }
     for w in &summary.warnings {
@@ -537,6 +551,16 @@ fn export(args: ExportArgs) -> Result<(), Box<dyn Error>> {
             c.cast,
             c.cavity_volume_ml,
             comps.join(", ")
+        );
+    }
+    if args.timings {
+        eprint!(
+            "{}",
+            timings::table(
+                &timings::take(),
+                wall0.elapsed().as_secs_f64(),
+                timings::cpu_seconds() - cpu0
+            )
         );
     }
     Ok(())

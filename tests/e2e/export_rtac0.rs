@@ -574,3 +574,74 @@ print(json.dumps({
     assert_eq!(v["entities"], 2, "{v}");
     assert!((v["area"].as_f64().unwrap() - area).abs() < 1e-9, "{v}");
 }
+
+/// `--timings`: every stage of the export in the table, none longer than the whole command
+/// (they run one after another), together most of it; the parts' STL files are those of an
+/// export without it (the manifest and 3MF record the command line).
+#[test]
+fn timings_account_for_the_whole_command_and_change_no_file() {
+    let tmp = tempfile::tempdir().unwrap();
+    let plain = run(tmp.path(), &["export", "rtac0", "--out", "a"], &[]);
+    assert!(plain.status.success(), "{}", text(&plain.stderr));
+    let o = run(
+        tmp.path(),
+        &["export", "rtac0", "--out", "b", "--timings"],
+        &[],
+    );
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let err = text(&o.stderr);
+    let rows: BTreeMap<String, (f64, f64)> = err
+        .lines()
+        .skip_while(|l| !l.starts_with("stage "))
+        .skip(1)
+        .map(|l| {
+            let f: Vec<&str> = l.split_whitespace().collect();
+            let n = f.len();
+            let name = f[..n - 3].join(" ");
+            (name, (f[n - 3].parse().unwrap(), f[n - 2].parse().unwrap()))
+        })
+        .collect();
+    for stage in [
+        "read the design",
+        "build the parts (molds, layers, families; in parallel)",
+        "assembly, fit and insertion checks",
+        "pictures (part previews, plates)",
+        "kit 3MF and its thumbnail",
+        "section view and the assembly's entry",
+        "write, fsync and rename the folder",
+    ] {
+        assert!(rows.contains_key(stage), "{stage} missing from\n{err}");
+    }
+    assert!(
+        !rows.contains_key("STEP (CadQuery twin)"),
+        "no STEP asked for:\n{err}"
+    );
+    let (whole, _) = rows["whole command"];
+    let staged: f64 = rows
+        .iter()
+        .filter(|(k, _)| k.as_str() != "whole command")
+        .map(|(_, (w, _))| w)
+        .sum();
+    assert!(
+        staged <= whole * 1.001 + 1e-3,
+        "stages {staged} s > whole {whole} s:\n{err}"
+    );
+    assert!(
+        staged >= 0.7 * whole,
+        "stages {staged} s cover too little of {whole} s:\n{err}"
+    );
+    let stls: Vec<PathBuf> = files_of(&tmp.path().join("a"))
+        .into_iter()
+        .filter(|f| f.extension().is_some_and(|e| e == "stl"))
+        .collect();
+    assert!(stls.len() >= 9);
+    for f in stls {
+        let rel = f.strip_prefix(tmp.path().join("a")).unwrap();
+        assert_eq!(
+            std::fs::read(&f).unwrap(),
+            std::fs::read(tmp.path().join("b").join(rel)).unwrap(),
+            "{}",
+            rel.display()
+        );
+    }
+}
