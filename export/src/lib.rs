@@ -622,8 +622,15 @@ fn render(
         Vec::new()
     };
     drop(t);
-    let t = fabkit_designs::timings::stage("kit 3MF and its thumbnail");
-    let kit_3mf = if opts.formats.threemf {
+    // The kit 3MF (its thumbnail rendered), the pictures and the section view are independent:
+    // made in parallel, then filed in this order. Each is deterministic, so the bytes do not
+    // depend on the thread count.
+    let t = fabkit_designs::timings::stage("kit 3MF, pictures and section view (in parallel)");
+    type Kit3mf<'m> = Option<(Vec<three_mf::Object<'m>>, Vec<u8>)>;
+    let kit_3mf_bytes = || -> Result<Kit3mf<'_>, ExportError> {
+        if !opts.formats.threemf {
+            return Ok(None);
+        }
         let boxes: Vec<_> = parts.iter().map(|p| p.bbox_mm).collect();
         let translations = layout::pack_units(&boxes, &units, layout::ROW_WIDTH_MM, layout::GAP_MM);
         let objects: Vec<three_mf::Object<'_>> = units
@@ -651,55 +658,54 @@ fn render(
             kit.design
         ))?;
         let bytes = three_mf::encode(&objects, &metadata, Some(&thumbnail))?;
-        let rel = format!("{}.3mf", kit.design);
-        let sha = sha256_hex(&bytes);
-        files.push((rel.clone(), bytes));
-        Some(ManifestKit3mf {
-            file: rel,
-            sha256: sha,
-            objects: objects
-                .iter()
-                .zip(1u32..)
-                .map(|(o, id)| ManifestObject {
-                    id,
-                    name: o.name.clone(),
-                    group: o.group.map(str::to_owned),
-                    translation_mm: o.translation_mm,
-                    volumes: o
-                        .volumes
-                        .iter()
-                        .zip(o.triangle_ranges())
-                        .zip(1u32..)
-                        .map(|((v, (first, last)), extruder)| ManifestVolume {
-                            part: v.name.to_owned(),
-                            first_triangle: first,
-                            last_triangle: last,
-                            extruder,
-                        })
-                        .collect(),
-                })
-                .collect(),
-        })
-    } else {
-        None
+        Ok(Some((objects, bytes)))
     };
-    drop(t);
-    let t = fabkit_designs::timings::stage("pictures (part previews, plates)");
     // pictures whenever a mesh format is written: every part's preview, every plate's picture
     // (also its 3MF's thumbnail)
     let pictures = opts.formats.stl || opts.formats.threemf;
-    let part_pngs = if pictures {
+    let part_pictures = || -> Result<Vec<Vec<u8>>, ExportError> {
+        if !pictures {
+            return Ok(Vec::new());
+        }
         let named: Vec<(&str, &Mesh)> = kit
             .parts
             .iter()
             .zip(meshes)
             .map(|(p, m)| (p.name.as_str(), m))
             .collect();
-        preview::part_pngs(&named)?
-    } else {
-        Vec::new()
+        preview::part_pngs(&named)
     };
-    let plate_pngs: Vec<Vec<u8>> = {
+    // a plate's picture, also its 3MF's thumbnail, and the 3MF
+    let plate_metadata = |plate: &layout::Plate| {
+        [
+            (
+                "Title",
+                format!(
+                    "fabkit plate {} {} {} {}",
+                    kit.design, plate.technology, plate.material, plate.number
+                ),
+            ),
+            ("Application", format!("fabkit {}", opts.fabkit_version)),
+            (
+                "Description",
+                format!(
+                    "{} plate {} of design {} (sha256:{}) for the {} ({} x {} x {} mm, {} mm margin), parts in print orientation",
+                    plate.technology,
+                    plate.number,
+                    kit.design,
+                    opts.design_sha256,
+                    plate.bed.name,
+                    plate.bed.size_mm[0],
+                    plate.bed.size_mm[1],
+                    plate.bed.size_mm[2],
+                    plate.bed.margin_mm
+                ),
+            ),
+        ]
+    };
+    // (picture, 3MF) of each plate
+    type PlateFiles = Vec<(Vec<u8>, Vec<u8>)>;
+    let plate_pictures = || -> Result<PlateFiles, ExportError> {
         use rayon::prelude::*;
         plates
             .par_iter()
@@ -717,16 +723,108 @@ fn render(
                     size_xy_mm: [plate.bed.size_mm[0], plate.bed.size_mm[1]],
                     margin_mm: plate.bed.margin_mm,
                 };
-                preview::render_plate(&objects, Some(bed)).png(&format!(
+                let png = preview::render_plate(&objects, Some(bed)).png(&format!(
                     "fabkit {} plate {} of design {} ({}) on the {} bed, seen from above-front",
                     plate.technology, plate.number, kit.design, plate.material, plate.bed.name
-                ))
+                ))?;
+                let objects: Vec<three_mf::Object<'_>> = plate
+                    .items
+                    .iter()
+                    .map(|it| object(&units[it.unit], it.translation_mm, it.turned))
+                    .collect();
+                let bytes = three_mf::encode(&objects, &plate_metadata(plate), Some(&png))?;
+                Ok((png, bytes))
             })
-            .collect::<Result<_, _>>()?
+            .collect()
     };
+    // The assembled sensor's meshes, made once for the section view, the STEP and the 3MF
+    // (checked below), and the section view's picture.
+    type AssemblyFiles = (
+        Vec<Mesh>,
+        Option<(Vec<u8>, section::SectionView)>,
+        Option<Result<(ManifestAssembly, Vec<u8>), ExportError>>,
+    );
+    let assembly_section = || -> Result<AssemblyFiles, ExportError> {
+        let assembly_meshes: Vec<Mesh> = kit
+            .assembly
+            .iter()
+            .map(|m| m.solid.mesh().rounded_to_f32())
+            .collect();
+        if kit.assembly.is_empty() {
+            return Ok((assembly_meshes, None, None));
+        }
+        // its 3MF's error, if any, is reported where the 3MF is filed, after the meshes'
+        // checks
+        let three_mf = opts
+            .formats
+            .threemf
+            .then(|| assembly_3mf(kit, &assembly_meshes, opts));
+        let members: Vec<_> = kit
+            .assembly
+            .iter()
+            .zip(&assembly_meshes)
+            .map(|(m, mesh)| (m.name.as_str(), m.kind, mesh))
+            .collect();
+        let (rgb, view) = section::render(&members);
+        let bytes = raster::png_rgb8(
+            view.width_px,
+            view.height_px,
+            &rgb,
+            &[(
+                "Description",
+                "fabkit section view: the assembled sensor cut by the plane y = 0, x right, z up",
+            )],
+        )?;
+        Ok((assembly_meshes, Some((bytes, view)), three_mf))
+    };
+    let (kit_3mf_made, ((part_pngs, plate_pngs), assembly_made)) =
+        rayon::join(kit_3mf_bytes, || {
+            rayon::join(
+                || rayon::join(part_pictures, plate_pictures),
+                assembly_section,
+            )
+        });
+    drop(t);
+    let t = fabkit_designs::timings::stage("kit and plate 3MF files, pictures filed");
+    let kit_3mf = match kit_3mf_made? {
+        None => None,
+        Some((objects, bytes)) => {
+            let rel = format!("{}.3mf", kit.design);
+            let sha = sha256_hex(&bytes);
+            files.push((rel.clone(), bytes));
+            Some(ManifestKit3mf {
+                file: rel,
+                sha256: sha,
+                objects: objects
+                    .iter()
+                    .zip(1u32..)
+                    .map(|(o, id)| ManifestObject {
+                        id,
+                        name: o.name.clone(),
+                        group: o.group.map(str::to_owned),
+                        translation_mm: o.translation_mm,
+                        volumes: o
+                            .volumes
+                            .iter()
+                            .zip(o.triangle_ranges())
+                            .zip(1u32..)
+                            .map(|((v, (first, last)), extruder)| ManifestVolume {
+                                part: v.name.to_owned(),
+                                first_triangle: first,
+                                last_triangle: last,
+                                extruder,
+                            })
+                            .collect(),
+                    })
+                    .collect(),
+            })
+        }
+    };
+    let part_pngs = part_pngs?;
+    let plate_pngs: PlateFiles = plate_pngs?;
     let mut plate_picture_files = Vec::with_capacity(plates.len());
     let mut manifest_plates = Vec::with_capacity(plates.len());
-    for (plate, png) in plates.iter().zip(plate_pngs) {
+    for (plate, (png, bytes)) in plates.iter().zip(plate_pngs) {
         let objects: Vec<three_mf::Object<'_>> = plate
             .items
             .iter()
@@ -755,32 +853,6 @@ fn render(
             plate.number,
             w = count.to_string().len()
         );
-        let metadata = [
-            (
-                "Title",
-                format!(
-                    "fabkit plate {} {} {} {}",
-                    kit.design, plate.technology, plate.material, plate.number
-                ),
-            ),
-            ("Application", format!("fabkit {}", opts.fabkit_version)),
-            (
-                "Description",
-                format!(
-                    "{} plate {} of design {} (sha256:{}) for the {} ({} x {} x {} mm, {} mm margin), parts in print orientation",
-                    plate.technology,
-                    plate.number,
-                    kit.design,
-                    opts.design_sha256,
-                    plate.bed.name,
-                    plate.bed.size_mm[0],
-                    plate.bed.size_mm[1],
-                    plate.bed.size_mm[2],
-                    plate.bed.margin_mm
-                ),
-            ),
-        ];
-        let bytes = three_mf::encode(&objects, &metadata, Some(&png))?;
         let sha = sha256_hex(&bytes);
         let picture = format!(
             "{PREVIEWS_DIR}/plate_{}.png",
@@ -838,13 +910,8 @@ fn render(
     }
     files.extend(plate_picture_files);
     drop(t);
-    let t = fabkit_designs::timings::stage("assembly meshes, 3MF and drawings");
-    // The assembled sensor's meshes, made and checked once for the section view and the 3MF.
-    let assembly_meshes: Vec<Mesh> = kit
-        .assembly
-        .iter()
-        .map(|m| m.solid.mesh().rounded_to_f32())
-        .collect();
+    let (assembly_meshes, section_png, assembly_3mf_made) = assembly_made?;
+    let t = fabkit_designs::timings::stage("assembly checks, machined parts and drawings");
     for (m, mesh) in kit.assembly.iter().zip(&assembly_meshes) {
         check_printable_mesh(&m.name, mesh)?;
     }
@@ -916,30 +983,14 @@ fn render(
         None
     };
     drop(t);
-    let t = fabkit_designs::timings::stage("section view and the assembly's entry");
-    let section_view = if kit.assembly.is_empty() {
-        None
-    } else {
-        let members: Vec<_> = kit
-            .assembly
-            .iter()
-            .zip(&assembly_meshes)
-            .map(|(m, mesh)| (m.name.as_str(), m.kind, mesh))
-            .collect();
-        let (rgb, mut view) = section::render(&members);
-        let bytes = raster::png_rgb8(
-            view.width_px,
-            view.height_px,
-            &rgb,
-            &[(
-                "Description",
-                "fabkit section view: the assembled sensor cut by the plane y = 0, x right, z up",
-            )],
-        )?;
+    let t = fabkit_designs::timings::stage("cut parts, boards and the assembly 3MF");
+    let section_view = if let Some((bytes, mut view)) = section_png {
         view.file = SECTION_PNG.into();
         view.sha256 = sha256_hex(&bytes);
         files.push((SECTION_PNG.into(), bytes));
         Some(view)
+    } else {
+        None
     };
     let mut cut_parts = Vec::with_capacity(kit.cut_parts.len());
     for c in &kit.cut_parts {
@@ -996,12 +1047,13 @@ fn render(
         });
         files.push((dxf, dxf_bytes));
     }
-    let assembly_3mf = if opts.formats.threemf && !kit.assembly.is_empty() {
-        let (manifest_assembly, bytes) = assembly_3mf(kit, &assembly_meshes, opts)?;
-        files.push((manifest_assembly.file.clone(), bytes));
-        Some(manifest_assembly)
-    } else {
-        None
+    let assembly_3mf = match assembly_3mf_made {
+        Some(made) => {
+            let (manifest_assembly, bytes) = made?;
+            files.push((manifest_assembly.file.clone(), bytes));
+            Some(manifest_assembly)
+        }
+        None => None,
     };
 
     drop(t);

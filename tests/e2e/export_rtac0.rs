@@ -605,9 +605,9 @@ fn timings_account_for_the_whole_command_and_change_no_file() {
         "read the design",
         "build the parts (molds, layers, families; in parallel)",
         "assembly, fit and insertion checks",
-        "pictures (part previews, plates)",
-        "kit 3MF and its thumbnail",
-        "section view and the assembly's entry",
+        "kit 3MF, pictures and section view (in parallel)",
+        "kit and plate 3MF files, pictures filed",
+        "cut parts, boards and the assembly 3MF",
         "write, fsync and rename the folder",
     ] {
         assert!(rows.contains_key(stage), "{stage} missing from\n{err}");
