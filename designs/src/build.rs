@@ -157,9 +157,7 @@ pub fn build_kit_bounded(
     drop(t);
     check_unique_names(&parts)?;
     // The assembled sensor and its fit check: no file is written when parts overlap.
-    let t = timings::stage("assembly, fit and insertion checks");
     let assembly = assembled(design, &stack, &parts, poured, tol)?;
-    drop(t);
     let t = timings::stage("procedure and machined parts");
     let bolts = crate::procedure::clamp_bolts(design, &parts);
     bought.extend(crate::procedure::clamp_bolt_items(&bolts));
@@ -390,15 +388,20 @@ fn assembled(
     poured: Vec<crate::parts::Member>,
     tol: ChordTolerance,
 ) -> Result<Vec<crate::parts::Member>, DesignError> {
+    let t = timings::stage("assembly members");
     let mut assembly = crate::assembly::members(design, stack, parts, tol)?;
     for f in FAMILIES {
         assembly.extend(f.members(design, stack, tol)?);
     }
     assembly.extend(poured);
+    drop(t);
+    let t = timings::stage("fit check (interferences)");
     let found = crate::assembly::interferences(&assembly, tol)?;
     if let Some(e) = crate::assembly::fit_errors(design, &found) {
         return Err(e);
     }
+    drop(t);
+    let _t = timings::stage("insertion check");
     let paths = crate::insertion::paths(design, stack, tol)?;
     let blocked = crate::insertion::blocked(&assembly, &paths, tol)?;
     if let Some(e) = crate::insertion::errors(design, &blocked) {

@@ -604,7 +604,9 @@ fn timings_account_for_the_whole_command_and_change_no_file() {
     for stage in [
         "read the design",
         "build the parts (molds, layers, families; in parallel)",
-        "assembly, fit and insertion checks",
+        "assembly members",
+        "fit check (interferences)",
+        "insertion check",
         "kit 3MF, pictures and section view (in parallel)",
         "kit and plate 3MF files, pictures filed",
         "cut parts, boards and the assembly 3MF",
