@@ -703,9 +703,9 @@ fn render(
             ),
         ]
     };
-    // (picture, 3MF) of each plate
-    type PlateFiles = Vec<(Vec<u8>, Vec<u8>)>;
-    let plate_pictures = || -> Result<PlateFiles, ExportError> {
+    // (picture, 3MF, its objects) of each plate
+    type PlateFiles<'m> = Vec<(Vec<u8>, Vec<u8>, Vec<three_mf::Object<'m>>)>;
+    let plate_pictures = || -> Result<PlateFiles<'_>, ExportError> {
         use rayon::prelude::*;
         plates
             .par_iter()
@@ -733,7 +733,7 @@ fn render(
                     .map(|it| object(&units[it.unit], it.translation_mm, it.turned))
                     .collect();
                 let bytes = three_mf::encode(&objects, &plate_metadata(plate), Some(&png))?;
-                Ok((png, bytes))
+                Ok((png, bytes, objects))
             })
             .collect()
     };
@@ -821,15 +821,10 @@ fn render(
         }
     };
     let part_pngs = part_pngs?;
-    let plate_pngs: PlateFiles = plate_pngs?;
+    let plate_pngs = plate_pngs?;
     let mut plate_picture_files = Vec::with_capacity(plates.len());
     let mut manifest_plates = Vec::with_capacity(plates.len());
-    for (plate, (png, bytes)) in plates.iter().zip(plate_pngs) {
-        let objects: Vec<three_mf::Object<'_>> = plate
-            .items
-            .iter()
-            .map(|it| object(&units[it.unit], it.translation_mm, it.turned))
-            .collect();
+    for (plate, (png, bytes, objects)) in plates.iter().zip(plate_pngs) {
         let tech = plate.technology.to_string().to_lowercase();
         let material: String = plate
             .material

@@ -88,13 +88,9 @@ impl Output {
     /// # Errors
     /// A message naming the value and the names allowed.
     pub fn from_name(name: &str) -> Result<Output, String> {
-        match name {
-            "metrics" => Ok(Output::Metrics),
-            "files" => Ok(Output::Files),
-            "stl" => Ok(Output::Stl),
-            "3mf" => Ok(Output::ThreeMf),
-            other => Err(format!("'{other}' is not one of metrics, files, stl, 3mf")),
-        }
+        // the names a sweep file's `outputs` takes (the serde names)
+        Output::deserialize(serde_json::Value::from(name))
+            .map_err(|_| format!("'{name}' is not one of metrics, files, stl, 3mf"))
     }
 }
 

@@ -43,7 +43,7 @@ pub fn to_json(a: &Affine) -> serde_json::Value {
 /// The map of JSON rows (three rows of four numbers; the homogeneous matrix's last row is
 /// (0, 0, 0, 1)); `None` for anything else.
 pub fn from_json(v: &serde_json::Value) -> Option<Affine> {
-    let rows: Vec<[f64; 4]> = serde_json::from_value(v.clone()).ok()?;
+    let rows = <Vec<[f64; 4]> as serde::Deserialize>::deserialize(v).ok()?;
     if rows.len() != 3 {
         return None;
     }
