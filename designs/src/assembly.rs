@@ -14,11 +14,11 @@
 //! tolerance and its volume passes [`MIN_OVERLAP_MM3`].
 
 use crate::error::{DesignError, GeometryContext, ParamError, ParamErrors};
-use crate::geometry::{revolve, ChordTolerance, Solid};
+use crate::geometry::{revolve, ChordTolerance, GeometryError, Solid};
 use crate::parts::context::Stack;
 use crate::parts::registry::FAMILIES;
 use crate::parts::Part;
-pub use crate::parts::{ExactShape, Member, MemberKind};
+pub use crate::parts::{ExactShape, FeatureKey, Member, MemberFeatures, MemberKind};
 use crate::schema::{Design, LayerProcess};
 
 /// Roles of kit parts that are part of the sensor besides the section families' own
@@ -65,6 +65,7 @@ pub(crate) fn bought(
         solid,
         fix: fix.iter().map(|f| (*f).to_string()).collect(),
         nested_by_stack: false,
+        features: Default::default(),
         exact: Some(exact),
     }
 }
@@ -119,6 +120,7 @@ fn push_printed(out: &mut Vec<Member>, parts: &[Part]) {
                 // a printed skin and its tips are made from the same placed features, and a
                 // tip's filling gel is their cavity less those features
                 nested_by_stack: matches!(p.role.as_str(), "printed_skin" | "marker_tips"),
+                features: Default::default(),
                 exact: None,
             });
         }
@@ -145,10 +147,14 @@ fn push_cast_layers(
     let solids = cast
         .par_iter()
         .map(|&i| {
-            crate::parts::layers::layer_solid(design, stack, i, tol).part(&stack.layers[i].name)
+            let name = &stack.layers[i].name;
+            let solid = crate::parts::layers::layer_solid(design, stack, i, tol).part(name)?;
+            let features =
+                crate::parts::layers::layer_features(design, stack, i, tol).part(name)?;
+            Ok((solid, features))
         })
-        .collect::<Result<Vec<_>, _>>()?;
-    for (&i, solid) in cast.iter().zip(solids) {
+        .collect::<Result<Vec<_>, DesignError>>()?;
+    for (&i, (solid, features)) in cast.iter().zip(solids) {
         let l = &stack.layers[i];
         out.push(Member {
             name: l.name.clone(),
@@ -156,7 +162,8 @@ fn push_cast_layers(
             description: format!("{} layer, {:.2} mm", l.name, l.thickness_mm),
             solid,
             fix: vec![format!("layers[{i}]")],
-            nested_by_stack: design.layers[i].markers.is_empty(),
+            nested_by_stack: true,
+            features,
             exact: Some(ExactShape::Layer {
                 params: crate::parts::layers::layer_twin_params(design, stack, i, tol),
             }),
@@ -190,6 +197,7 @@ fn push_core(
         };
         out.push(Member {
             nested_by_stack: true,
+            features: Default::default(),
             ..bought(
                 "core_envelope",
                 format!("Core (bought): {}", spec.description),
@@ -239,9 +247,10 @@ pub struct Interference {
 }
 
 /// Every pair of members that overlaps by more than a tessellation can: thicker than
-/// `tol` and larger than [`MIN_OVERLAP_MM3`]. Pairs whose boxes do not meet, and pairs that
-/// the stack nests ([`Member::nested_by_stack`]), are skipped; the rest are intersected in
-/// parallel, the result in pair order.
+/// `tol` and larger than [`MIN_OVERLAP_MM3`]. Pairs whose boxes do not meet are skipped; a
+/// pair that the stack nests ([`Member::nested_by_stack`]) can overlap only inside the features
+/// that grow either ([`MemberFeatures`]), and is intersected only there (none: skipped); the
+/// rest are intersected whole. In parallel, the result in pair order.
 ///
 /// # Errors
 /// [`DesignError::Geometry`] if the kernel fails.
@@ -259,7 +268,9 @@ pub fn interferences(
             };
             let apart = (0..3).any(|k| a.max[k] <= b.min[k] || b.max[k] <= a.min[k]);
             let nested = members[i].nested_by_stack && members[j].nested_by_stack;
-            if !apart && !nested {
+            let grown =
+                !members[i].features.grow.is_empty() || !members[j].features.grow.is_empty();
+            if !apart && (!nested || grown) {
                 pairs.push((i, j));
             }
         }
@@ -268,10 +279,15 @@ pub fn interferences(
         .par_iter()
         .map(|&(i, j)| {
             let (ma, mb) = (&members[i], &members[j]);
-            let overlap = ma
-                .solid
-                .intersection(&mb.solid)
-                .part(&format!("fit check {} / {}", ma.name, mb.name))?;
+            let overlap = if ma.nested_by_stack && mb.nested_by_stack {
+                overlap_in_growth(ma, mb)
+            } else {
+                ma.solid.intersection(&mb.solid).map(Some)
+            }
+            .part(&format!("fit check {} / {}", ma.name, mb.name))?;
+            let Some(overlap) = overlap else {
+                return Ok(None);
+            };
             let v = overlap.volume();
             let thickness = 2.0 * v / overlap.surface_area().max(f64::MIN_POSITIVE);
             Ok(
@@ -287,6 +303,41 @@ pub fn interferences(
         })
         .collect::<Result<_, DesignError>>()?;
     Ok(found.into_iter().flatten().collect())
+}
+
+/// The overlap of two nested members: `a` ∩ `b` within the features that grow either (outside
+/// them the stack nests the two apart), but for a growing set the other member cuts into
+/// itself as the same features ([`MemberFeatures`]); the growth's piece of the other member is
+/// cut first (it is small, where the whole members' surfaces coincide over their shared
+/// offset). `None` when no growth meets the other member.
+fn overlap_in_growth(a: &Member, b: &Member) -> Result<Option<Solid>, GeometryError> {
+    let mut pieces = Vec::new();
+    for (own, other) in [(a, b), (b, a)] {
+        let grow = Solid::compose(
+            &own.features
+                .grow
+                .iter()
+                .filter(|(key, _)| !other.features.cut.contains(key))
+                .map(|(_, s)| s.clone())
+                .collect::<Vec<_>>(),
+        );
+        let meets = match (grow.bounding_box(), other.solid.bounding_box()) {
+            (Some(x), Some(y)) => (0..3).all(|k| x.min[k] < y.max[k] && y.min[k] < x.max[k]),
+            _ => false,
+        };
+        if !meets {
+            continue;
+        }
+        let piece = grow.intersection(&other.solid)?;
+        if !piece.is_empty() {
+            pieces.push(piece.intersection(&own.solid)?);
+        }
+    }
+    Ok(match pieces.len() {
+        0 => None,
+        1 => pieces.pop(),
+        _ => Some(pieces[0].union(&pieces[1])?),
+    })
 }
 
 /// [`interferences`] as parameter errors, one per overlapping pair: the path is the first

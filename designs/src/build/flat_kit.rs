@@ -228,6 +228,7 @@ fn layer_tray(
         solid: skin,
         fix: vec![format!("layers[{i}]")],
         nested_by_stack: true,
+        features: Default::default(),
         exact: None,
     };
     Ok((part, member, v, cut_parts))

@@ -862,6 +862,7 @@ pub fn members(
                 solid,
                 fix: fix.iter().map(|f| format!("casing.{f}")).collect(),
                 nested_by_stack: false,
+                features: Default::default(),
                 exact,
             }
         };

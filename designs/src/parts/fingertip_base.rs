@@ -796,6 +796,7 @@ pub fn members(
                 solid,
                 fix: fix.iter().map(|p| format!("fingertip_base.{p}")).collect(),
                 nested_by_stack: false,
+                features: Default::default(),
                 exact: Some(exact),
             })
         };

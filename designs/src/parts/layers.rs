@@ -11,6 +11,7 @@ use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{revolve, ChordTolerance, GeometryError, Polyline2, Solid};
 use crate::markers::{self, Marker, MarkerSpec, MarkerSurface, PatternStats, Polarity, Surface};
 use crate::parts::context::{ResolvedLayer, Stack};
+use crate::parts::member::{FeatureKey, MemberFeatures};
 use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::{Part, PrintTechnology};
 use crate::schema::{Design, LayerProcess, MoldStrategy, PrinterProfile, Technology};
@@ -700,6 +701,58 @@ pub fn layer_solid(
     }
     let inn = enclosed(design, l.inner_offset_mm, 1.0, &inner, tol, stems_only)?;
     o.difference(&inn)
+}
+
+/// The marker features of layer `i` for the fit check ([`MemberFeatures`]): the sets that grow
+/// it beyond the shell between its two offsets (outward on its outer surface, inward on its
+/// inner surface) with their solids as [`layer_solid`] places them, and the keys of the sets
+/// that cut into it.
+///
+/// # Errors
+/// Only on a kernel failure.
+pub fn layer_features(
+    design: &Design,
+    stack: &Stack,
+    i: usize,
+    tol: ChordTolerance,
+) -> Result<MemberFeatures, GeometryError> {
+    let l = &stack.layers[i];
+    let placed = place_layer_markers(design, l, tol);
+    let stems_only = placed.iter().any(|p| p.spec.tip_material.is_some());
+    let mut out = MemberFeatures::default();
+    for pm in &placed {
+        let outward = pm.direction > 0.0;
+        let grows = match pm.spec.surface {
+            MarkerSurface::Outer => outward,
+            MarkerSurface::Inner if l.solid => continue,
+            MarkerSurface::Inner => !outward,
+        };
+        let key = feature_key(pm, stems_only);
+        if grows {
+            out.grow
+                .push((key, Solid::compose(&feature_solids(pm, tol, stems_only)?)));
+        } else {
+            out.cut.push(key);
+        }
+    }
+    Ok(out)
+}
+
+/// The [`FeatureKey`] of a placed marker set: what [`feature_solids`] builds its solids from
+/// but the depth they reach behind the surface.
+fn feature_key(pm: &PlacedMarkers, stems_only: bool) -> FeatureKey {
+    let f = &pm.spec.feature;
+    let mut bits = vec![
+        f.diameter_mm.to_bits(),
+        f.height_mm.to_bits(),
+        pm.offset_mm.to_bits(),
+        pm.direction.to_bits(),
+        u64::from(stems_only),
+    ];
+    for m in &pm.markers {
+        bits.extend(m.position_mm.iter().chain(&m.normal).map(|c| c.to_bits()));
+    }
+    FeatureKey(bits)
 }
 
 /// The space inside layer `i` above the base plane, sensor frame, mm: the solid under its

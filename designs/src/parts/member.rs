@@ -35,14 +35,41 @@ pub struct Member {
     /// core's inner surface, or a printed skin, its marker tips and the gel filling it (the
     /// gel is the skin's cavity less the very pin and tip solids the skin and tips are made
     /// of): the stack's validation and their construction already nest such members without
-    /// overlap, so the fit check skips pairs of them.
+    /// overlap, so the fit check skips pairs of them. A cast layer with markers is nested too,
+    /// outside its features ([`Member::features`]).
     pub nested_by_stack: bool,
+    /// Of a nested member: the marker features that grow it beyond what the stack nests and
+    /// those that cut into it ([`MemberFeatures`]); empty for every member but a cast layer
+    /// with markers.
+    pub features: MemberFeatures,
     /// What an exact B-rep of the member is built from (STEP export, `export/src/step.rs`),
     /// in the sensor frame, mm; `None` for a printed member (its kit part's own parameters
     /// describe it) and for a member that has no exact description (STEP export then sews its
     /// mesh).
     pub exact: Option<ExactShape>,
 }
+
+/// The marker features of a nested member (a cast layer), for the fit check
+/// ([`crate::assembly::interferences`]): outside the features that grow it (outward ones on its
+/// outer surface, inward ones on its inner surface) the layer is the featureless shell between
+/// its two offsets, which the stack nests against its neighbours; so two nested members can
+/// overlap only inside the growth of either. A growing marker set of one layer that its
+/// neighbour cuts into itself as the very same features (the same shape, surface offset,
+/// direction and placements: a layer's protrusions in the slots of the layer under it) is
+/// nested by construction too, and not intersected.
+#[derive(Debug, Clone, Default)]
+pub struct MemberFeatures {
+    /// Each growing marker set: its key and its features' solids composed, sensor frame, mm.
+    pub grow: Vec<(FeatureKey, Solid)>,
+    /// The keys of the marker sets that cut into the member.
+    pub cut: Vec<FeatureKey>,
+}
+
+/// What makes two marker sets' features the same solids where they meet the surface: the
+/// feature's diameter and height, the surface's offset, the direction the features point, whether
+/// only stems are built, and every marker's position and normal (the bit patterns, mm).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FeatureKey(pub Vec<u64>);
 
 /// The exact shape of a non-printed assembly member, from which the CadQuery twin
 /// (`export/python/twins/step_export.py`) builds its B-rep. Sensor frame, mm; serialized with a

@@ -24,7 +24,9 @@ pub mod shaft_body;
 pub mod spacer;
 
 pub use context::{Context, ResolvedCore, ResolvedLayer, Stack};
-pub use member::{axial_cylinder, axial_ring, ExactShape, Member, MemberKind};
+pub use member::{
+    axial_cylinder, axial_ring, ExactShape, FeatureKey, Member, MemberFeatures, MemberKind,
+};
 pub use part::{Part, PrintTechnology, ProcedureAction, ProcedureStep};
 
 use crate::error::ParamError;

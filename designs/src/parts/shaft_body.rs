@@ -955,6 +955,7 @@ pub fn members(
         solid,
         fix: fix.iter().map(|f| format!("shaft_body.{f}")).collect(),
         nested_by_stack: false,
+        features: Default::default(),
         exact: Some(exact),
     };
     let l = &sb.led_ring;
@@ -1225,6 +1226,7 @@ impl Family for ShaftBodyFamily {
                 fix: vec!["shaft_body.tip_fitting.lip_width_mm".into()],
                 // the skin's cavity less its pins and tips: nested with them by construction
                 nested_by_stack: true,
+                features: Default::default(),
                 exact: None,
             }),
         }))

@@ -285,3 +285,58 @@ fn a_camera_board_too_tall_for_its_bay_is_a_named_fit_error() {
         "{e} (analytic {want})"
     );
 }
+
+/// UVDtact's two mixed layers interlock: the outer layer's 85 protrusions fill the inner
+/// layer's 85 slots (Sec. III). The fit check intersects nested layers only inside the features
+/// that grow them, and skips protrusions that the neighbour cuts as the very same slots: no
+/// interference. Protrusions 0.3 mm longer than the slots reach into the inner layer: one
+/// interference of the two layers, its volume the whole layers' intersection (to 0.1 %: the
+/// booleans meet in another order) and about 85 x pi x 0.5^2 x 0.3 mm^3 (the cylinders' extra
+/// length), its error naming both layers.
+#[test]
+fn interlocking_layers_are_checked_inside_their_features() {
+    use fabkit_designs::{library, materials::MaterialsTable, stack};
+    let materials = MaterialsTable::embedded().unwrap();
+    let layers = |d: &fabkit_designs::Design| -> Vec<Member> {
+        let st = stack::validate(d, &materials, tol()).unwrap();
+        fabkit_designs::assembly::members(d, &st, &[], tol())
+            .unwrap()
+            .into_iter()
+            .filter(|m| m.kind == MemberKind::Cast)
+            .collect()
+    };
+    let d = library::load("uvdtact").unwrap();
+    let fits = layers(&d);
+    assert_eq!(fits.len(), 3);
+    assert!(fits.iter().all(|m| m.nested_by_stack));
+    assert_eq!(interferences(&fits, tol()).unwrap(), vec![]);
+
+    let mut long = d.clone();
+    long.layers[1].markers[0].feature.height_mm = 1.3;
+    let members = layers(&long);
+    let found = interferences(&members, tol()).unwrap();
+    assert_eq!(found.len(), 1, "{found:?}");
+    assert_eq!(
+        (found[0].a.as_str(), found[0].b.as_str()),
+        ("inner_mixed", "outer_mixed")
+    );
+    let whole = member(&members, "inner_mixed")
+        .solid
+        .intersection(&member(&members, "outer_mixed").solid)
+        .unwrap()
+        .volume();
+    rel_close(
+        found[0].volume_mm3,
+        whole,
+        1e-3,
+        "overlap inside the features",
+    );
+    rel_close(
+        found[0].volume_mm3,
+        85.0 * PI * 0.25 * 0.3,
+        0.02,
+        "85 cylinders 0.3 mm long",
+    );
+    let e = fit_errors(&long, &found).unwrap().to_string();
+    assert!(e.contains("change layers[1] or layers[0]"), "{e}");
+}

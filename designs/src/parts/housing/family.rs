@@ -118,6 +118,7 @@ impl Family for HousingFamily {
                 // inside the core's inner surface above the core's end, and under it only
                 // where no layer is: nested with the layers and the core by construction
                 nested_by_stack: true,
+                features: Default::default(),
                 exact: Some(ExactShape::Revolved {
                     profile_rz_mm: pl.points.clone(),
                 }),
