@@ -98,17 +98,32 @@ pub fn members(
     parts: &[Part],
     tol: ChordTolerance,
 ) -> Result<Vec<Member>, DesignError> {
+    let mut out = printed_members(parts);
+    out.extend(unprinted_members(design, stack, tol)?);
+    Ok(out)
+}
+
+/// The members of [`members`] that do not come from the kit's parts: the cast layers, the
+/// core's and the backing's envelopes (what a kit builds alongside its parts).
+///
+/// # Errors
+/// [`DesignError::Geometry`] if the kernel fails.
+pub fn unprinted_members(
+    design: &Design,
+    stack: &Stack,
+    tol: ChordTolerance,
+) -> Result<Vec<Member>, DesignError> {
     let mut out = Vec::new();
-    push_printed(&mut out, parts);
     push_cast_layers(&mut out, design, stack, tol)?;
     push_core(&mut out, design, stack, tol)?;
     push_backing(&mut out, design, tol)?;
     Ok(out)
 }
 
-/// Pushes onto `out` the printed sensor parts among `parts`, in their order, each turned back
-/// into the sensor frame (parts that record no pose are left out).
-fn push_printed(out: &mut Vec<Member>, parts: &[Part]) {
+/// The printed sensor parts among `parts` as members, in their order, each turned back into
+/// the sensor frame (parts that record no pose are left out).
+pub fn printed_members(parts: &[Part]) -> Vec<Member> {
+    let mut out = Vec::new();
     for p in parts.iter().filter(|p| in_sensor(&p.role)) {
         if let Some(solid) = in_sensor_frame(p) {
             out.push(Member {
@@ -125,6 +140,7 @@ fn push_printed(out: &mut Vec<Member>, parts: &[Part]) {
             });
         }
     }
+    out
 }
 
 /// Pushes onto `out` the cast layers of `stack` (every layer not printed), inner to outer; their

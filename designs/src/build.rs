@@ -72,7 +72,7 @@ pub fn build_kit_bounded(
         crate::estimate::check_work(design, &stack, tol, max_triangles)?;
     }
     drop(t);
-    let t = timings::stage("build the parts (molds, layers, families; in parallel)");
+    let t = timings::stage("build the parts and the assembly's layers (in parallel)");
     let plans = cast_plans(design, &stack);
     let mut parts = Vec::new();
     let mut silicone = Vec::new();
@@ -99,27 +99,44 @@ pub fn build_kit_bounded(
         .filter(|p| matches!(p.strategy, MoldStrategy::Direct | MoldStrategy::Master))
         .cloned()
         .collect();
-    let ((molds, others), sections) = rayon::join(
+    // The assembly's members that come from no part (the cast layers, the core's and backing's
+    // envelopes, the families' bought and cut members) build alongside the parts.
+    let (((molds, others), sections), unprinted) = rayon::join(
         || {
             rayon::join(
                 || {
-                    held.par_iter()
-                        .map(|plan| build_mold(design, &stack, plan, tol))
-                        .collect::<Vec<_>>()
+                    rayon::join(
+                        || {
+                            held.par_iter()
+                                .map(|plan| build_mold(design, &stack, plan, tol))
+                                .collect::<Vec<_>>()
+                        },
+                        || {
+                            other
+                                .par_iter()
+                                .map(|&i| crate::parts::layers::build_layer(design, &stack, i, tol))
+                                .collect::<Vec<_>>()
+                        },
+                    )
                 },
                 || {
-                    other
+                    FAMILIES
                         .par_iter()
-                        .map(|&i| crate::parts::layers::build_layer(design, &stack, i, tol))
+                        .map(|f| f.build(design, &stack, tol))
                         .collect::<Vec<_>>()
                 },
             )
         },
         || {
-            FAMILIES
-                .par_iter()
-                .map(|f| f.build(design, &stack, tol))
-                .collect::<Vec<_>>()
+            rayon::join(
+                || crate::assembly::unprinted_members(design, &stack, tol),
+                || {
+                    FAMILIES
+                        .par_iter()
+                        .map(|f| f.members(design, &stack, tol))
+                        .collect::<Vec<_>>()
+                },
+            )
         },
     );
     let layer_markers = gather_layer_outputs(
@@ -157,7 +174,7 @@ pub fn build_kit_bounded(
     drop(t);
     check_unique_names(&parts)?;
     // The assembled sensor and its fit check: no file is written when parts overlap.
-    let assembly = assembled(design, &stack, &parts, poured, tol)?;
+    let assembly = assembled(design, &stack, &parts, unprinted, poured, tol)?;
     let t = timings::stage("procedure and machined parts");
     let bolts = crate::procedure::clamp_bolts(design, &parts);
     bought.extend(crate::procedure::clamp_bolt_items(&bolts));
@@ -193,6 +210,13 @@ fn check_unique_names(parts: &[crate::Part]) -> Result<(), DesignError> {
     }
     Ok(())
 }
+
+/// The assembly's members that come from no part, as the parts' build gives them: the cast
+/// layers with the core's and backing's envelopes, and each family's members.
+type UnprintedMembers = (
+    Result<Vec<crate::parts::Member>, DesignError>,
+    Vec<Result<Vec<crate::parts::Member>, DesignError>>,
+);
 
 /// A silicone mold's pour: what, volume (mm^3), the parts that hold it.
 type SiliconePour = (String, f64, Vec<String>);
@@ -374,9 +398,10 @@ fn filling_gel_pours(
     Ok(members)
 }
 
-/// The members of the assembled sensor (the parts in the sensor frame, the cast layers, every
-/// family's bought and cut members, the poured gels' members), checked for interferences and for the
-/// paths each member goes in by.
+/// The members of the assembled sensor (the parts in the sensor frame, then `unprinted`: the
+/// cast layers with the core's and backing's envelopes and every family's bought and cut members,
+/// then the poured gels' members), checked for interferences and for the paths each member goes
+/// in by.
 ///
 /// # Errors
 /// [`DesignError`] naming the members that overlap or block each other's way in, or a kernel
@@ -385,13 +410,16 @@ fn assembled(
     design: &Design,
     stack: &Stack,
     parts: &[crate::Part],
+    unprinted: UnprintedMembers,
     poured: Vec<crate::parts::Member>,
     tol: ChordTolerance,
 ) -> Result<Vec<crate::parts::Member>, DesignError> {
     let t = timings::stage("assembly members");
-    let mut assembly = crate::assembly::members(design, stack, parts, tol)?;
-    for f in FAMILIES {
-        assembly.extend(f.members(design, stack, tol)?);
+    let (own, families) = unprinted;
+    let mut assembly = crate::assembly::printed_members(parts);
+    assembly.extend(own?);
+    for members in families {
+        assembly.extend(members?);
     }
     assembly.extend(poured);
     drop(t);
