@@ -7,6 +7,7 @@ use crate::error::{DesignError, GeometryContext};
 use crate::geometry::ChordTolerance;
 use crate::kit::Kit;
 use crate::materials::{pour, MaterialsTable};
+use crate::parts::family::FillingPour;
 use crate::parts::molds::{build_mold, cast_plans};
 use crate::parts::registry::FAMILIES;
 use crate::schema::{Design, LayerProcess, MoldStrategy};
@@ -72,7 +73,7 @@ pub fn build_kit_bounded(
         crate::estimate::check_work(design, &stack, tol, max_triangles)?;
     }
     drop(t);
-    let t = timings::stage("build the parts and the assembly's layers (in parallel)");
+    let t = timings::stage("build the parts, the assembly's layers and the fillings (in parallel)");
     let plans = cast_plans(design, &stack);
     let mut parts = Vec::new();
     let mut silicone = Vec::new();
@@ -100,8 +101,9 @@ pub fn build_kit_bounded(
         .cloned()
         .collect();
     // The assembly's members that come from no part (the cast layers, the core's and backing's
-    // envelopes, the families' bought and cut members) build alongside the parts.
-    let (((molds, others), sections), unprinted) = rayon::join(
+    // envelopes, the families' bought and cut members) and the filling gels' pours build
+    // alongside the parts.
+    let (((molds, others), sections), (unprinted, fillings)) = rayon::join(
         || {
             rayon::join(
                 || {
@@ -128,15 +130,25 @@ pub fn build_kit_bounded(
             )
         },
         || {
-            rayon::join(
-                || crate::assembly::unprinted_members(design, &stack, tol),
-                || {
-                    FAMILIES
-                        .par_iter()
-                        .map(|f| f.members(design, &stack, tol))
-                        .collect::<Vec<_>>()
-                },
-            )
+            let members = || {
+                rayon::join(
+                    || crate::assembly::unprinted_members(design, &stack, tol),
+                    || {
+                        FAMILIES
+                            .par_iter()
+                            .map(|f| f.members(design, &stack, tol))
+                            .collect::<Vec<_>>()
+                    },
+                )
+            };
+            let fillings = || {
+                let cavity = |i: usize| crate::parts::layers::inner_cavity(design, &stack, i, tol);
+                FAMILIES
+                    .iter()
+                    .map(|f| f.filling_pour(design, &stack, &cavity, tol))
+                    .collect::<Vec<_>>()
+            };
+            rayon::join(members, fillings)
         },
     );
     let layer_markers = gather_layer_outputs(
@@ -170,7 +182,7 @@ pub fn build_kit_bounded(
     drop(t);
     let t = timings::stage("pour volumes");
     let (mut casts, step) = layer_pours(design, &stack, &materials, silicone, gel)?;
-    let poured = filling_gel_pours(design, &stack, &materials, &parts, (&mut casts, step), tol)?;
+    let poured = filling_gel_pours(design, &materials, &parts, fillings, (&mut casts, step))?;
     drop(t);
     check_unique_names(&parts)?;
     // The assembled sensor and its fit check: no file is written when parts overlap.
@@ -364,25 +376,24 @@ fn layer_pours(
     Ok((casts, step))
 }
 
-/// The filling gels' pours, step `step` of `casts`: each family's
-/// ([`crate::parts::family::Family::filling_pour`]: the housing's, poured into the assembled
-/// shell, or the shaft body's, poured into the tip); the members they bring to the assembly.
+/// The filling gels' pours, step `step` of `casts`: each family's `fillings` as the parts'
+/// build gave them ([`crate::parts::family::Family::filling_pour`]: the housing's, poured into
+/// the assembled shell, or the shaft body's, poured into the tip); the members they bring to
+/// the assembly.
 ///
 /// # Errors
-/// [`DesignError`] naming the filling gel if the kernel fails or its material is unknown.
+/// [`DesignError`] naming the filling gel if the kernel failed or its material is unknown.
 fn filling_gel_pours(
     design: &Design,
-    stack: &Stack,
     materials: &MaterialsTable,
     parts: &[crate::Part],
+    fillings: Vec<Result<Option<FillingPour<'_>>, DesignError>>,
     (casts, step): (&mut Vec<crate::materials::CastReport>, u32),
-    tol: ChordTolerance,
 ) -> Result<Vec<crate::parts::Member>, DesignError> {
     let waste = design.casting.waste_allowance;
-    let cavity = |i: usize| crate::parts::layers::inner_cavity(design, stack, i, tol);
     let mut members = Vec::new();
-    for f in FAMILIES {
-        let Some(pour) = f.filling_pour(design, stack, &cavity, tol)? else {
+    for pour in fillings {
+        let Some(pour) = pour? else {
             continue;
         };
         casts.push(filling_gel_cast(

@@ -603,7 +603,7 @@ fn timings_account_for_the_whole_command_and_change_no_file() {
         .collect();
     for stage in [
         "read the design",
-        "build the parts and the assembly's layers (in parallel)",
+        "build the parts, the assembly's layers and the fillings (in parallel)",
         "assembly members",
         "fit check (interferences)",
         "insertion check",
