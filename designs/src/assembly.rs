@@ -13,6 +13,7 @@
 //! that: its mean thickness (2 x volume / surface area, for a thin slab) passes the chord
 //! tolerance and its volume passes [`MIN_OVERLAP_MM3`].
 
+pub use crate::build::AssemblyScope;
 use crate::error::{DesignError, GeometryContext, ParamError, ParamErrors};
 use crate::geometry::{revolve, ChordTolerance, GeometryError, Solid};
 use crate::parts::context::Stack;
@@ -99,12 +100,14 @@ pub fn members(
     tol: ChordTolerance,
 ) -> Result<Vec<Member>, DesignError> {
     let mut out = printed_members(parts);
-    out.extend(unprinted_members(design, stack, tol)?);
+    out.extend(unprinted_members(design, stack, tol, AssemblyScope::Whole)?);
     Ok(out)
 }
 
 /// The members of [`members`] that do not come from the kit's parts: the cast layers, the
-/// core's and the backing's envelopes (what a kit builds alongside its parts).
+/// core's and the backing's envelopes (what a kit builds alongside its parts); with
+/// [`AssemblyScope::FitCheck`] the cast layers are stand-ins
+/// ([`MemberFeatures::stand_in_for_layer`]).
 ///
 /// # Errors
 /// [`DesignError::Geometry`] if the kernel fails.
@@ -112,9 +115,10 @@ pub fn unprinted_members(
     design: &Design,
     stack: &Stack,
     tol: ChordTolerance,
+    scope: AssemblyScope,
 ) -> Result<Vec<Member>, DesignError> {
     let mut out = Vec::new();
-    push_cast_layers(&mut out, design, stack, tol)?;
+    push_cast_layers(&mut out, design, stack, tol, scope)?;
     push_core(&mut out, design, stack, tol)?;
     push_backing(&mut out, design, tol)?;
     Ok(out)
@@ -153,6 +157,7 @@ fn push_cast_layers(
     design: &Design,
     stack: &Stack,
     tol: ChordTolerance,
+    scope: AssemblyScope,
 ) -> Result<(), DesignError> {
     // The layers' solids in parallel (each single-threaded, collected in order: the same
     // members whatever the thread count).
@@ -164,9 +169,16 @@ fn push_cast_layers(
         .par_iter()
         .map(|&i| {
             let name = &stack.layers[i].name;
-            let solid = crate::parts::layers::layer_solid(design, stack, i, tol).part(name)?;
-            let features =
+            let mut features =
                 crate::parts::layers::layer_features(design, stack, i, tol).part(name)?;
+            let solid = match scope {
+                AssemblyScope::Whole => crate::parts::layers::layer_solid(design, stack, i, tol),
+                AssemblyScope::FitCheck => {
+                    features.stand_in_for_layer = Some(i);
+                    crate::parts::layers::layer_stand_in(design, stack, i, &features, tol)
+                }
+            }
+            .part(name)?;
             Ok((solid, features))
         })
         .collect::<Result<Vec<_>, DesignError>>()?;
@@ -249,6 +261,29 @@ fn push_backing(
     Ok(())
 }
 
+/// The cast layers' exact solids for the members of `members` that stand in for them
+/// ([`MemberFeatures::stand_in_for_layer`]), in parallel; the other members as they are.
+///
+/// # Errors
+/// [`DesignError::Geometry`] if the kernel fails.
+pub fn with_exact_layers(
+    members: Vec<Member>,
+    design: &Design,
+    stack: &Stack,
+    tol: ChordTolerance,
+) -> Result<Vec<Member>, DesignError> {
+    use rayon::prelude::*;
+    members
+        .into_par_iter()
+        .map(|mut m| {
+            if let Some(i) = m.features.stand_in_for_layer.take() {
+                m.solid = crate::parts::layers::layer_solid(design, stack, i, tol).part(&m.name)?;
+            }
+            Ok(m)
+        })
+        .collect()
+}
+
 /// Two members that overlap.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Interference {
@@ -274,6 +309,15 @@ pub fn interferences(
     members: &[Member],
     tol: ChordTolerance,
 ) -> Result<Vec<Interference>, DesignError> {
+    overlaps(members, tol.mm())
+}
+
+/// [`interferences`] thicker than `thickness_mm` (0: every overlap larger than
+/// [`MIN_OVERLAP_MM3`], whatever its thickness).
+///
+/// # Errors
+/// [`DesignError::Geometry`] if the kernel fails.
+pub fn overlaps(members: &[Member], thickness_mm: f64) -> Result<Vec<Interference>, DesignError> {
     use rayon::prelude::*;
     let boxes: Vec<_> = members.iter().map(|m| m.solid.bounding_box()).collect();
     let mut pairs = Vec::new();
@@ -307,7 +351,7 @@ pub fn interferences(
             let v = overlap.volume();
             let thickness = 2.0 * v / overlap.surface_area().max(f64::MIN_POSITIVE);
             Ok(
-                (v > MIN_OVERLAP_MM3 && thickness > tol.mm()).then(|| Interference {
+                (v > MIN_OVERLAP_MM3 && thickness > thickness_mm).then(|| Interference {
                     a: ma.name.clone(),
                     b: mb.name.clone(),
                     volume_mm3: v,

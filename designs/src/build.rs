@@ -62,6 +62,34 @@ pub fn build_kit_bounded(
     tol: ChordTolerance,
     max_triangles: u64,
 ) -> Result<Kit, DesignError> {
+    build_kit_scoped(design, tol, max_triangles, AssemblyScope::Whole)
+}
+
+/// How much of the assembled sensor a build makes ([`build_kit_scoped`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AssemblyScope {
+    /// Every member's exact solid: what an export writes (the assembly 3MF, the section view,
+    /// STEP).
+    Whole,
+    /// What the fit check and the insertion check need, for a kit that is measured and not
+    /// written (a metrics-only sweep): a cast layer's member is first a stand-in that holds it
+    /// (its featureless shell with the features that grow it,
+    /// [`crate::parts::layers::layer_stand_in`]), replaced by the exact layer only when the
+    /// stand-in overlaps another member or an insertion path passes it; the same errors as
+    /// [`AssemblyScope::Whole`], and the kit's assembly leaves out the stand-ins.
+    FitCheck,
+}
+
+/// [`build_kit_bounded`] with the assembly made as `scope` says.
+///
+/// # Errors
+/// As [`build_kit_bounded`].
+pub fn build_kit_scoped(
+    design: &Design,
+    tol: ChordTolerance,
+    max_triangles: u64,
+    scope: AssemblyScope,
+) -> Result<Kit, DesignError> {
     let materials = MaterialsTable::embedded().map_err(DesignError::Yaml)?;
     if design.body.flat_outline().is_some() {
         let _t = timings::stage("build the flat kit (parts, trays, pours)");
@@ -132,7 +160,7 @@ pub fn build_kit_bounded(
         || {
             let members = || {
                 rayon::join(
-                    || crate::assembly::unprinted_members(design, &stack, tol),
+                    || crate::assembly::unprinted_members(design, &stack, tol, scope),
                     || {
                         FAMILIES
                             .par_iter()
@@ -187,6 +215,13 @@ pub fn build_kit_bounded(
     check_unique_names(&parts)?;
     // The assembled sensor and its fit check: no file is written when parts overlap.
     let assembly = assembled(design, &stack, &parts, unprinted, poured, tol)?;
+    let assembly = match scope {
+        AssemblyScope::Whole => assembly,
+        AssemblyScope::FitCheck => assembly
+            .into_iter()
+            .filter(|m| m.features.stand_in_for_layer.is_none())
+            .collect(),
+    };
     let t = timings::stage("procedure and machined parts");
     let bolts = crate::procedure::clamp_bolts(design, &parts);
     bought.extend(crate::procedure::clamp_bolt_items(&bolts));
@@ -435,13 +470,40 @@ fn assembled(
     assembly.extend(poured);
     drop(t);
     let t = timings::stage("fit check (interferences)");
-    let found = crate::assembly::interferences(&assembly, tol)?;
+    let stand_in = |assembly: &[crate::parts::Member], name: &str| {
+        assembly
+            .iter()
+            .any(|m| m.name == name && m.features.stand_in_for_layer.is_some())
+    };
+    // A stand-in holds its layer: the layer's overlap with another member is within the
+    // stand-in's, its volume at most the stand-in's (its mean thickness may be more), so any
+    // overlap of a stand-in over the volume threshold, however thin, asks for the exact layer.
+    let any_stand_in = assembly
+        .iter()
+        .any(|m| m.features.stand_in_for_layer.is_some());
+    let mut found = if any_stand_in {
+        crate::assembly::overlaps(&assembly, 0.0)?
+    } else {
+        crate::assembly::interferences(&assembly, tol)?
+    };
+    if found
+        .iter()
+        .any(|f| stand_in(&assembly, &f.a) || stand_in(&assembly, &f.b))
+    {
+        assembly = crate::assembly::with_exact_layers(assembly, design, stack, tol)?;
+        found = crate::assembly::interferences(&assembly, tol)?;
+    } else {
+        found.retain(|f| f.thickness_mm > tol.mm());
+    }
     if let Some(e) = crate::assembly::fit_errors(design, &found) {
         return Err(e);
     }
     drop(t);
     let _t = timings::stage("insertion check");
     let paths = crate::insertion::paths(design, stack, tol)?;
+    if paths.iter().any(|p| stand_in(&assembly, &p.through)) {
+        assembly = crate::assembly::with_exact_layers(assembly, design, stack, tol)?;
+    }
     let blocked = crate::insertion::blocked(&assembly, &paths, tol)?;
     if let Some(e) = crate::insertion::errors(design, &blocked) {
         return Err(e);

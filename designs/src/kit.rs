@@ -20,7 +20,8 @@ pub struct Kit {
     pub procedure: Vec<ProcedureStep>,
     /// The assembled sensor: every printed, cast and bought part in the sensor frame
     /// ([`crate::assembly::members`]), fit-checked; empty for a kit that is not a sensor
-    /// (fixtures).
+    /// (fixtures). A kit built with [`crate::build::AssemblyScope::FitCheck`] leaves out the
+    /// cast layers whose exact solids the fit check did not need.
     pub assembly: Vec<crate::parts::Member>,
     /// Parts cut from sheet stock, as outlines for DXF and SVG ([`crate::cut::cut_parts`]).
     pub cut_parts: Vec<crate::cut::CutPart>,

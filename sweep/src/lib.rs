@@ -39,8 +39,8 @@ pub use fabkit_designs::variant::{
     canonical_json, expand_short_path, parameter_paths, path_exists,
 };
 pub use fabkit_designs::variant::{
-    evaluate, evaluate_bounded, min_wall, printability, CastMetrics, MarkerMetrics, Metrics,
-    Outcome, PartMetrics, Verdict, PROFILES,
+    evaluate, evaluate_bounded, evaluate_scoped, min_wall, printability, CastMetrics,
+    MarkerMetrics, Metrics, Outcome, PartMetrics, Verdict, PROFILES,
 };
 pub use file::{values_of, FileOutputs, Mode, Output, Parameter, SweepSpec};
 pub use merge::{merge, MergeSummary};

@@ -8,11 +8,12 @@ use super::plan::{variant_id, Variant, MAX_VARIANTS};
 use super::results::{Status, VariantResult};
 use super::SweepError;
 use crate::nearest::nearest_paths;
+use fabkit_designs::build::AssemblyScope;
 use fabkit_designs::geometry::ChordTolerance;
 use fabkit_designs::kit::Kit;
 use fabkit_designs::materials::MaterialsTable;
 use fabkit_designs::schema::{value_at, Design};
-use fabkit_designs::variant::{evaluate_bounded, printability, Outcome};
+use fabkit_designs::variant::{evaluate_scoped, printability, Outcome};
 use fabkit_designs::variant::{expand_short_path, path_exists, with_value};
 use serde_json::Value;
 
@@ -316,7 +317,13 @@ pub fn evaluate_variant(
     };
     // A panic in the kernel must not end the sweep: record it as this variant's error.
     let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        let outcome = evaluate_bounded(&design, materials, tol, max_triangles);
+        // a variant only measured needs of its assembly what the fit check needs
+        let scope = if write.is_some() {
+            AssemblyScope::Whole
+        } else {
+            AssemblyScope::FitCheck
+        };
+        let outcome = evaluate_scoped(&design, materials, tol, max_triangles, scope);
         let verdicts = printability(&design, materials, tol);
         (outcome, verdicts)
     }));

@@ -738,6 +738,33 @@ pub fn layer_features(
     Ok(out)
 }
 
+/// A solid that holds layer `i` ([`layer_solid`]), for a fit check that needs the exact layer
+/// only where something overlaps it: the shell between the layer's two offsets (the same
+/// surfaces as the layer's) united with `features`' growing sets; the features that cut into
+/// the layer are left in. Sensor frame, mm.
+///
+/// # Errors
+/// Only on a kernel failure.
+pub fn layer_stand_in(
+    design: &Design,
+    stack: &Stack,
+    i: usize,
+    features: &MemberFeatures,
+    tol: ChordTolerance,
+) -> Result<Solid, GeometryError> {
+    let l = &stack.layers[i];
+    let mut shell = enclosed(design, l.outer_offset_mm, 0.0, &[], tol, false)?;
+    if !l.solid {
+        shell = shell.difference(&enclosed(design, l.inner_offset_mm, 1.0, &[], tol, false)?)?;
+    }
+    if features.grow.is_empty() {
+        return Ok(shell);
+    }
+    let mut all = vec![shell];
+    all.extend(features.grow.iter().map(|(_, s)| s.clone()));
+    Solid::union_all(&all)
+}
+
 /// The [`FeatureKey`] of a placed marker set: what [`feature_solids`] builds its solids from
 /// but the depth they reach behind the surface.
 fn feature_key(pm: &PlacedMarkers, stems_only: bool) -> FeatureKey {

@@ -63,6 +63,12 @@ pub struct MemberFeatures {
     pub grow: Vec<(FeatureKey, Solid)>,
     /// The keys of the marker sets that cut into the member.
     pub cut: Vec<FeatureKey>,
+    /// `Some(i)` when the member's solid stands in for cast layer `i` in a build that only
+    /// fit-checks the assembly ([`crate::build::AssemblyScope::FitCheck`]): the featureless shell
+    /// with the growing features, which holds the layer; the fit check builds the layer's exact
+    /// solid ([`crate::parts::layers::layer_solid`]) only when the stand-in overlaps another
+    /// member.
+    pub stand_in_for_layer: Option<usize>,
 }
 
 /// What makes two marker sets' features the same solids where they meet the surface: the

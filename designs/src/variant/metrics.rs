@@ -2,7 +2,7 @@
 //! masses, marker count and spacing, the thinnest wall, and a printability verdict per printer
 //! profile.
 
-use crate::build::build_kit;
+use crate::build::{build_kit_scoped, AssemblyScope};
 use crate::kit::{Kit, PrintTechnology};
 use crate::markers::{nearest_neighbours, MarkerSurface, Polarity};
 use crate::materials::MaterialsTable;
@@ -111,6 +111,19 @@ pub fn evaluate_bounded(
     tol: ChordTolerance,
     max_triangles: u64,
 ) -> Outcome {
+    evaluate_scoped(design, materials, tol, max_triangles, AssemblyScope::Whole)
+}
+
+/// [`evaluate_bounded`] with the kit's assembly made as `scope` says: the same outcome and
+/// metrics, and with [`AssemblyScope::FitCheck`] (a variant measured and not written) a kit
+/// whose assembly leaves out the cast layers the fit check did not need.
+pub fn evaluate_scoped(
+    design: &Design,
+    materials: &MaterialsTable,
+    tol: ChordTolerance,
+    max_triangles: u64,
+    scope: AssemblyScope,
+) -> Outcome {
     let stack = match validate(design, materials, tol) {
         Ok(s) => s,
         Err(e) => return Outcome::Infeasible(e.0.iter().map(ToString::to_string).collect()),
@@ -118,7 +131,7 @@ pub fn evaluate_bounded(
     if let Err(e) = crate::estimate::check_work(design, &stack, tol, max_triangles) {
         return Outcome::Error(e.to_string());
     }
-    let kit = match build_kit(design, tol) {
+    let kit = match build_kit_scoped(design, tol, u64::MAX, scope) {
         Ok(k) => k,
         Err(DesignError::Params(e)) => {
             return Outcome::Infeasible(e.0.iter().map(ToString::to_string).collect())

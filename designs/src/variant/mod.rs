@@ -7,8 +7,8 @@ mod metrics;
 mod paths;
 
 pub use metrics::{
-    evaluate, evaluate_bounded, min_wall, printability, CastMetrics, MarkerMetrics, Metrics,
-    Outcome, PartMetrics, Verdict, PROFILES,
+    evaluate, evaluate_bounded, evaluate_scoped, min_wall, printability, CastMetrics,
+    MarkerMetrics, Metrics, Outcome, PartMetrics, Verdict, PROFILES,
 };
 pub use paths::{
     canonical_json, expand_short_path, parameter_paths, path_exists, path_keys, span_of, with_value,

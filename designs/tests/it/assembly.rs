@@ -340,3 +340,45 @@ fn interlocking_layers_are_checked_inside_their_features() {
     let e = fit_errors(&long, &found).unwrap().to_string();
     assert!(e.contains("change layers[1] or layers[0]"), "{e}");
 }
+
+/// A kit built only to be measured ([`AssemblyScope::FitCheck`], a metrics-only sweep) stands
+/// cast layers in by their featureless shells with their growing features, and builds a layer
+/// exactly only where its stand-in overlaps: R-Tac0 gives the same parts (the same written
+/// meshes) and the whole assembly but its cast layers; UVDtact with protrusions longer than
+/// their slots gives the whole build's very error.
+#[test]
+fn a_fit_check_build_gives_the_whole_builds_parts_and_errors() {
+    use fabkit_designs::build::{build_kit_scoped, AssemblyScope};
+    let d = fabkit_designs::library::load("rtac0").unwrap();
+    let whole = rtac0();
+    let fit = build_kit_scoped(&d, tol(), u64::MAX, AssemblyScope::FitCheck).unwrap();
+    assert_eq!(fit.parts.len(), whole.parts.len());
+    for (a, b) in fit.parts.iter().zip(&whole.parts) {
+        assert_eq!(a.name, b.name);
+        assert!(a.written_mesh() == b.written_mesh(), "{}", a.name);
+    }
+    let names = |k: &[Member]| -> Vec<String> { k.iter().map(|m| m.name.clone()).collect() };
+    let not_layers: Vec<Member> = whole
+        .assembly
+        .iter()
+        .filter(|m| !d.layers.iter().any(|l| l.name == m.name))
+        .cloned()
+        .collect();
+    assert!(not_layers.len() < whole.assembly.len());
+    assert_eq!(names(&fit.assembly), names(&not_layers));
+
+    let mut long = fabkit_designs::library::load("uvdtact").unwrap();
+    long.layers[1].markers[0].feature.height_mm = 1.3;
+    let err = |scope| {
+        build_kit_scoped(&long, tol(), u64::MAX, scope)
+            .err()
+            .expect("the protrusions overlap the inner layer")
+            .to_string()
+    };
+    let e = err(AssemblyScope::FitCheck);
+    assert!(
+        e.contains("`inner_mixed` and `outer_mixed` overlap by"),
+        "{e}"
+    );
+    assert_eq!(e, err(AssemblyScope::Whole));
+}
