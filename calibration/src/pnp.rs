@@ -710,6 +710,15 @@ pub(crate) fn normal_equations(
     Some((jtj, jte, s))
 }
 
+/// The rotation matrix and translation of a pose, as [`cost`] and [`normal_equations`] take
+/// them.
+fn rotation_translation(pose: &Isometry3<f64>) -> (Matrix3<f64>, Vector3<f64>) {
+    (
+        *pose.rotation.to_rotation_matrix().matrix(),
+        pose.translation.vector,
+    )
+}
+
 /// Reprojection cost of a pose over all pairs, px^2 (for tests and reports).
 pub fn reprojection_cost(
     camera: &CameraModel,
@@ -718,15 +727,8 @@ pub fn reprojection_cost(
     t_cam_sensor: &Isometry3<f64>,
 ) -> Option<f64> {
     let idx: Vec<usize> = (0..points_mm.len()).collect();
-    let r = *t_cam_sensor.rotation.to_rotation_matrix().matrix();
-    cost(
-        camera,
-        points_mm,
-        pixels_px,
-        &idx,
-        &r,
-        &t_cam_sensor.translation.vector,
-    )
+    let (r, t) = rotation_translation(t_cam_sensor);
+    cost(camera, points_mm, pixels_px, &idx, &r, &t)
 }
 
 /// Normal equations at a pose (J^T J, J^T e, cost); used by the Jacobian test and the
@@ -738,16 +740,8 @@ pub fn reprojection_normal_equations(
     t_cam_sensor: &Isometry3<f64>,
 ) -> Option<(Matrix6<f64>, Vector6<f64>, f64)> {
     let idx: Vec<usize> = (0..points_mm.len()).collect();
-    let r = *t_cam_sensor.rotation.to_rotation_matrix().matrix();
-    normal_equations(
-        camera,
-        points_mm,
-        pixels_px,
-        &idx,
-        &r,
-        &t_cam_sensor.translation.vector,
-        &mut Vec::new(),
-    )
+    let (r, t) = rotation_translation(t_cam_sensor);
+    normal_equations(camera, points_mm, pixels_px, &idx, &r, &t, &mut Vec::new())
 }
 
 /// How well the pins' geometry fixes a pose: the first-order covariance of the pose from the
@@ -786,8 +780,7 @@ pub fn pose_uncertainty(
     let idx: Vec<usize> = (0..points_mm.len())
         .filter(|&i| inliers.get(i).copied().unwrap_or(false))
         .collect();
-    let r = *t_cam_sensor.rotation.to_rotation_matrix().matrix();
-    let t = t_cam_sensor.translation.vector;
+    let (r, t) = rotation_translation(t_cam_sensor);
     let mut residuals = Vec::with_capacity(idx.len());
     let (jtj, _, _) = normal_equations(camera, points_mm, pixels_px, &idx, &r, &t, &mut residuals)?;
     let cov = jtj.try_inverse()?;

@@ -335,7 +335,7 @@ pub fn refine_intrinsics(
         t: t_cam_sensor.translation.vector,
     };
     // hold what the captures do not constrain
-    loop {
+    let pb = loop {
         let pb = Problem {
             base,
             free: free.clone(),
@@ -345,7 +345,7 @@ pub fn refine_intrinsics(
         let j = pb.jacobian(&start).ok_or(RefineError::Unprojectable)?;
         let (cond, v) = scaled_condition(&j);
         if cond <= MAX_CONDITION {
-            break;
+            break pb;
         }
         let col_names: Vec<String> = free
             .iter()
@@ -412,12 +412,6 @@ pub fn refine_intrinsics(
             .filter(|k| !hold.contains(k))
             .map(|k| free[k])
             .collect();
-    }
-    let pb = Problem {
-        base,
-        free: free.clone(),
-        points: points_mm,
-        pixels: pixels_px,
     };
     let e0 = pb.residuals(&start).ok_or(RefineError::Unprojectable)?;
     let rms = |e: &DVector<f64>| (e.norm_squared() / points_mm.len() as f64).sqrt();
