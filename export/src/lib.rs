@@ -213,7 +213,10 @@ pub fn write_kit_reporting(
         atomic::check_relative_path("data_files", rel)?;
     }
     let t = fabkit_designs::timings::stage("written meshes");
-    let meshes: Vec<Mesh> = kit.parts.iter().map(|p| p.written_mesh()).collect();
+    let meshes: Vec<Mesh> = {
+        use rayon::prelude::*;
+        kit.parts.par_iter().map(|p| p.written_mesh()).collect()
+    };
     drop(t);
     write_kit_meshes(kit, &meshes, data_files, out_dir, opts, step_progress)
 }
@@ -231,9 +234,8 @@ fn write_kit_meshes(
     check::check_options(opts)?;
     check::check_names(kit)?;
     let t = fabkit_designs::timings::stage("printable-mesh checks");
-    for (part, mesh) in kit.parts.iter().zip(meshes) {
-        check_printable_mesh(&part.name, mesh)?;
-    }
+    let names: Vec<&str> = kit.parts.iter().map(|p| p.name.as_str()).collect();
+    check_printable_meshes(&names, meshes)?;
     drop(t);
     let rendered = render(kit, meshes, data_files, opts, step_progress)?;
     let claim = opts.claim(&kit.design);
@@ -560,12 +562,26 @@ fn render(
     let mut parts = Vec::with_capacity(kit.parts.len());
     // product names and densities of the printed materials
     let materials = fabkit_designs::materials::MaterialsTable::embedded().ok();
-    for (part, mesh) in kit.parts.iter().zip(meshes) {
-        let mut entry = part_entry(part, mesh, materials.as_ref())?;
-        let (file, sha256) = stl_file(kit, opts, PARTS_DIR, &part.name, mesh, &mut files)?;
+    // each part's entry and STL in parallel, filed in kit order (the first error in that order)
+    let made: Vec<Result<_, ExportError>> = {
+        use rayon::prelude::*;
+        kit.parts
+            .par_iter()
+            .zip(meshes)
+            .map(|(part, mesh)| {
+                let entry = part_entry(part, mesh, materials.as_ref())?;
+                let mut stl = Vec::new();
+                let named = stl_file(kit, opts, PARTS_DIR, &part.name, mesh, &mut stl)?;
+                Ok((entry, named, stl))
+            })
+            .collect()
+    };
+    for m in made {
+        let (mut entry, (file, sha256), stl) = m?;
         entry.file = file;
         entry.sha256 = sha256;
         parts.push(entry);
+        files.extend(stl);
     }
 
     let groups: Vec<_> = parts.iter().map(|p| p.group.as_deref()).collect();
@@ -653,11 +669,13 @@ fn render(
                 ),
             ),
         ];
-        let thumbnail = preview::render_plate(&placed_objects(&objects), None).png(&format!(
-            "fabkit kit {}: the kit 3MF's layout seen from above-front",
-            kit.design
-        ))?;
-        let bytes = three_mf::encode(&objects, &metadata, Some(&thumbnail))?;
+        let thumbnail = || {
+            preview::render_plate(&placed_objects(&objects), None).png(&format!(
+                "fabkit kit {}: the kit 3MF's layout seen from above-front",
+                kit.design
+            ))
+        };
+        let (bytes, _) = three_mf::encode_drawn(&objects, &metadata, Some(thumbnail))?;
         Ok(Some((objects, bytes)))
     };
     // pictures whenever a mesh format is written: every part's preview, every plate's picture
@@ -723,17 +741,20 @@ fn render(
                     size_xy_mm: [plate.bed.size_mm[0], plate.bed.size_mm[1]],
                     margin_mm: plate.bed.margin_mm,
                 };
-                let png = preview::render_plate(&objects, Some(bed)).png(&format!(
-                    "fabkit {} plate {} of design {} ({}) on the {} bed, seen from above-front",
-                    plate.technology, plate.number, kit.design, plate.material, plate.bed.name
-                ))?;
+                let png = || {
+                    preview::render_plate(&objects, Some(bed)).png(&format!(
+                        "fabkit {} plate {} of design {} ({}) on the {} bed, seen from above-front",
+                        plate.technology, plate.number, kit.design, plate.material, plate.bed.name
+                    ))
+                };
                 let objects: Vec<three_mf::Object<'_>> = plate
                     .items
                     .iter()
                     .map(|it| object(&units[it.unit], it.translation_mm, it.turned))
                     .collect();
-                let bytes = three_mf::encode(&objects, &plate_metadata(plate), Some(&png))?;
-                Ok((png, bytes, objects))
+                let (bytes, png) =
+                    three_mf::encode_drawn(&objects, &plate_metadata(plate), Some(png))?;
+                Ok((png.unwrap_or_default(), bytes, objects))
             })
             .collect()
     };
@@ -745,9 +766,10 @@ fn render(
         Option<Result<(ManifestAssembly, Vec<u8>), ExportError>>,
     );
     let assembly_section = || -> Result<AssemblyFiles, ExportError> {
+        use rayon::prelude::*;
         let assembly_meshes: Vec<Mesh> = kit
             .assembly
-            .iter()
+            .par_iter()
             .map(|m| m.solid.mesh().rounded_to_f32())
             .collect();
         if kit.assembly.is_empty() {
@@ -755,35 +777,37 @@ fn render(
         }
         // its 3MF's error, if any, is reported where the 3MF is filed, after the meshes'
         // checks
-        let three_mf = opts
-            .formats
-            .threemf
-            .then(|| assembly_3mf(kit, &assembly_meshes, opts));
-        let members: Vec<_> = kit
-            .assembly
-            .iter()
-            .zip(&assembly_meshes)
-            .map(|(m, mesh)| (m.name.as_str(), m.kind, mesh))
-            .collect();
-        let (rgb, view) = section::render(&members);
-        let bytes = raster::png_rgb8(
-            view.width_px,
-            view.height_px,
-            &rgb,
-            &[(
-                "Description",
-                "fabkit section view: the assembled sensor cut by the plane y = 0, x right, z up",
-            )],
-        )?;
-        Ok((assembly_meshes, Some((bytes, view)), three_mf))
-    };
-    let (kit_3mf_made, ((part_pngs, plate_pngs), assembly_made)) =
-        rayon::join(kit_3mf_bytes, || {
-            rayon::join(
-                || rayon::join(part_pictures, plate_pictures),
-                assembly_section,
+        let three_mf = || {
+            opts.formats
+                .threemf
+                .then(|| assembly_3mf(kit, &assembly_meshes, opts))
+        };
+        let section_view = || {
+            let members: Vec<_> = kit
+                .assembly
+                .iter()
+                .zip(&assembly_meshes)
+                .map(|(m, mesh)| (m.name.as_str(), m.kind, mesh))
+                .collect();
+            let (rgb, view) = section::render(&members);
+            raster::png_rgb8(
+                view.width_px,
+                view.height_px,
+                &rgb,
+                &[(
+                    "Description",
+                    "fabkit section view: the assembled sensor cut by the plane y = 0, x right, z up",
+                )],
             )
-        });
+            .map(|bytes| (bytes, view))
+        };
+        let (three_mf, section) = rayon::join(three_mf, section_view);
+        Ok((assembly_meshes, Some(section?), three_mf))
+    };
+    let ((assembly_made, kit_3mf_made), (plate_pngs, part_pngs)) = rayon::join(
+        || rayon::join(assembly_section, kit_3mf_bytes),
+        || rayon::join(plate_pictures, part_pictures),
+    );
     drop(t);
     let t = fabkit_designs::timings::stage("kit and plate 3MF files, pictures filed");
     let kit_3mf = match kit_3mf_made? {
@@ -907,9 +931,8 @@ fn render(
     drop(t);
     let (assembly_meshes, section_png, assembly_3mf_made) = assembly_made?;
     let t = fabkit_designs::timings::stage("assembly checks, machined parts and drawings");
-    for (m, mesh) in kit.assembly.iter().zip(&assembly_meshes) {
-        check_printable_mesh(&m.name, mesh)?;
-    }
+    let names: Vec<&str> = kit.assembly.iter().map(|m| m.name.as_str()).collect();
+    check_printable_meshes(&names, &assembly_meshes)?;
     let mut machined_parts = Vec::with_capacity(kit.machined_parts.len());
     for m in &kit.machined_parts {
         let mesh = m.solid.mesh().rounded_to_f32();
@@ -1112,6 +1135,21 @@ fn render(
 
 /// With STL on, `<dir>/<name>.stl` of `mesh` (provenance in its header) pushed onto `files`,
 /// and its relative path and sha256; `(None, None)` otherwise.
+/// [`check_printable_mesh`] of each `(name, mesh)` pair, in parallel; the first failure in
+/// their order.
+///
+/// # Errors
+/// As [`check_printable_mesh`].
+fn check_printable_meshes(names: &[&str], meshes: &[Mesh]) -> Result<(), ExportError> {
+    use rayon::prelude::*;
+    let checked: Vec<Result<(), ExportError>> = names
+        .par_iter()
+        .zip(meshes)
+        .map(|(name, mesh)| check_printable_mesh(name, mesh))
+        .collect();
+    checked.into_iter().collect()
+}
+
 fn stl_file(
     kit: &Kit,
     opts: &ExportOptions,

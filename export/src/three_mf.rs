@@ -303,14 +303,71 @@ pub(crate) fn encode(
     metadata: &[(&str, String)],
     thumbnail: Option<&[u8]>,
 ) -> Result<Vec<u8>, ExportError> {
+    match thumbnail {
+        None => encode_drawn(
+            objects,
+            metadata,
+            None::<fn() -> Result<Vec<u8>, ExportError>>,
+        )
+        .map(|(bytes, _)| bytes),
+        Some(png) => encode_drawn(objects, metadata, Some(|| Ok(png.to_vec()))).map(|(b, _)| b),
+    }
+}
+
+/// [`encode`] with the thumbnail drawn by `thumbnail` while the model is written and
+/// deflated (the thumbnail is the package's last entry): the same bytes as [`encode`] with
+/// the drawn PNG, and the PNG.
+///
+/// # Errors
+/// [`ExportError::ThreeMf`] as [`encode`]; the thumbnail's own error.
+pub(crate) fn encode_drawn<F>(
+    objects: &[Object<'_>],
+    metadata: &[(&str, String)],
+    thumbnail: Option<F>,
+) -> Result<(Vec<u8>, Option<Vec<u8>>), ExportError>
+where
+    F: FnOnce() -> Result<Vec<u8>, ExportError> + Send,
+{
+    let with_thumbnail = thumbnail.is_some();
+    let (zip, png) = rayon::join(
+        || model_entries(objects, metadata, with_thumbnail),
+        || thumbnail.map(|f| f()),
+    );
+    // the thumbnail's error first, as when it is drawn before the package
+    let png = png.transpose()?;
+    let (mut zip, opts) = zip?;
+    if let Some(png) = &png {
+        zip.start_file(THUMBNAIL_PATH, opts).map_err(zip_error)?;
+        zip.write_all(png).map_err(io_error)?;
+    }
+    Ok((zip.finish().map_err(zip_error)?.into_inner(), png))
+}
+
+fn zip_error(e: zip::result::ZipError) -> ExportError {
+    ExportError::ThreeMf {
+        reason: e.to_string(),
+    }
+}
+
+fn io_error(e: std::io::Error) -> ExportError {
+    ExportError::ThreeMf {
+        reason: e.to_string(),
+    }
+}
+
+/// A 3MF package being written, in memory.
+type Package = ZipWriter<Cursor<Vec<u8>>>;
+
+/// The package's entries up to the thumbnail: content types and relationships (naming the
+/// thumbnail when `with_thumbnail`), the model and PrusaSlicer's config; and the entries'
+/// options.
+fn model_entries(
+    objects: &[Object<'_>],
+    metadata: &[(&str, String)],
+    with_thumbnail: bool,
+) -> Result<(Package, SimpleFileOptions), ExportError> {
     let model = model_xml(objects, metadata);
     let config = prusa_config_xml(objects);
-    let zip_err = |e: zip::result::ZipError| ExportError::ThreeMf {
-        reason: e.to_string(),
-    };
-    let io_err = |e: std::io::Error| ExportError::ThreeMf {
-        reason: e.to_string(),
-    };
     let mut zip = ZipWriter::new(Cursor::new(Vec::new()));
     let opts = zip_entry_options(model.len());
     let content_types = if config.is_some() {
@@ -318,11 +375,12 @@ pub(crate) fn encode(
     } else {
         CONTENT_TYPES
     };
-    let content_types = match thumbnail {
-        Some(_) => content_types.replace("</Types>", &format!("{PNG_CONTENT_TYPE}</Types>")),
-        None => content_types.to_owned(),
+    let content_types = if with_thumbnail {
+        content_types.replace("</Types>", &format!("{PNG_CONTENT_TYPE}</Types>"))
+    } else {
+        content_types.to_owned()
     };
-    let rels = if thumbnail.is_some() {
+    let rels = if with_thumbnail {
         RELS_WITH_THUMBNAIL
     } else {
         RELS
@@ -335,14 +393,11 @@ pub(crate) fn encode(
     if let Some(c) = &config {
         entries.push((PRUSA_CONFIG_PATH, c.as_bytes()));
     }
-    if let Some(png) = thumbnail {
-        entries.push((THUMBNAIL_PATH, png));
-    }
     for (name, body) in entries {
-        zip.start_file(name, opts).map_err(zip_err)?;
-        zip.write_all(body).map_err(io_err)?;
+        zip.start_file(name, opts).map_err(zip_error)?;
+        zip.write_all(body).map_err(io_error)?;
     }
-    Ok(zip.finish().map_err(zip_err)?.into_inner())
+    Ok((zip, opts))
 }
 
 /// The coordinate rounded to f32, as the shortest decimal that reads back to that value as

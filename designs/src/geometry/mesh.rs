@@ -158,8 +158,12 @@ impl Mesh {
         if self.vertices.iter().flatten().any(|c| !c.is_finite()) {
             return Err(TopologyError::NonFinite);
         }
+        use rayon::prelude::*;
         let nv = self.vertices.len() as u32;
-        let mut directed: Vec<(u32, u32)> = Vec::with_capacity(self.triangles.len() * 3);
+        // each directed edge (a, b) as the number a << 32 | b, its twin (b, a) that number
+        // rotated by 32 bits: sorted, an edge is paired by a binary search
+        let edge = |a: u32, b: u32| (u64::from(a) << 32) | u64::from(b);
+        let mut directed: Vec<u64> = Vec::with_capacity(self.triangles.len() * 3);
         for (i, t) in self.triangles.iter().enumerate() {
             if t.iter().any(|&x| x >= nv) {
                 return Err(TopologyError::BadIndex(i));
@@ -167,17 +171,26 @@ impl Mesh {
             if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
                 return Err(TopologyError::RepeatedVertex(i));
             }
-            directed.extend([(t[0], t[1]), (t[1], t[2]), (t[2], t[0])]);
+            directed.extend([edge(t[0], t[1]), edge(t[1], t[2]), edge(t[2], t[0])]);
         }
-        directed.sort_unstable();
+        // large meshes (the whole kit's parts) on every core; the counts do not depend on it
+        const PARALLEL_EDGES: usize = 1 << 16;
+        let large = directed.len() >= PARALLEL_EDGES;
+        if large {
+            directed.par_sort_unstable();
+        } else {
+            directed.sort_unstable();
+        }
         let dup = directed.windows(2).filter(|w| w[0] == w[1]).count();
         if dup > 0 {
             return Err(TopologyError::InconsistentWinding(dup));
         }
-        let unpaired = directed
-            .iter()
-            .filter(|&&(a, b)| directed.binary_search(&(b, a)).is_err())
-            .count();
+        let twinless = |&e: &u64| directed.binary_search(&e.rotate_right(32)).is_err();
+        let unpaired = if large {
+            directed.par_iter().filter(|e| twinless(e)).count()
+        } else {
+            directed.iter().filter(|e| twinless(e)).count()
+        };
         if unpaired > 0 {
             return Err(TopologyError::OpenOrNonManifoldEdges(unpaired));
         }
