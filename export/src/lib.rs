@@ -255,14 +255,30 @@ fn write_kit_meshes(
             let parts_dir = tmp.join(PARTS_DIR);
             std::fs::create_dir(&parts_dir).map_err(ExportError::io("creating", &parts_dir))?;
         }
-        for ((rel, bytes), sha256) in rendered.files.iter().zip(hashes) {
-            let path = join_rel(tmp, rel);
+        // the folders first, then the files written and synced in parallel (their syncs
+        // overlap); the first error in file order
+        let paths: Vec<PathBuf> = rendered
+            .files
+            .iter()
+            .map(|(rel, _)| join_rel(tmp, rel))
+            .collect();
+        for path in &paths {
             if let Some(parent) = path.parent() {
                 if parent != tmp && !parent.exists() {
                     std::fs::create_dir_all(parent).map_err(ExportError::io("creating", parent))?;
                 }
             }
-            atomic::write_file_synced(&path, bytes)?;
+        }
+        let synced: Vec<Result<(), ExportError>> = {
+            use rayon::prelude::*;
+            paths
+                .par_iter()
+                .zip(&rendered.files)
+                .map(|(path, (_, bytes))| atomic::write_file_synced(path, bytes))
+                .collect()
+        };
+        for (((rel, _), sha256), r) in rendered.files.iter().zip(hashes).zip(synced) {
+            r?;
             written.insert(rel, sha256);
         }
         if opts.formats.stl {
