@@ -457,17 +457,14 @@ fn assembly_3mf(
             ],
         })
         .collect();
-    let metadata = [
-        ("Title", format!("fabkit assembly {}", kit.design)),
-        ("Application", format!("fabkit {}", opts.fabkit_version)),
-        (
-            "Description",
-            format!(
-                "the assembled sensor in the sensor frame (docs/conventions.md); bought parts are envelopes; design {} sha256:{}",
-                kit.design, opts.design_sha256
-            ),
+    let metadata = package_metadata(
+        format!("fabkit assembly {}", kit.design),
+        opts,
+        format!(
+            "the assembled sensor in the sensor frame (docs/conventions.md); bought parts are envelopes; design {} sha256:{}",
+            kit.design, opts.design_sha256
         ),
-    ];
+    );
     let bytes = three_mf::encode(&objects, &metadata, None)?;
     Ok((
         ManifestAssembly {
@@ -477,6 +474,19 @@ fn assembly_3mf(
         },
         bytes,
     ))
+}
+
+/// A 3MF package's metadata: its title, fabkit's version as the application, its description.
+fn package_metadata(
+    title: String,
+    opts: &ExportOptions,
+    description: String,
+) -> [(&'static str, String); 3] {
+    [
+        ("Title", title),
+        ("Application", format!("fabkit {}", opts.fabkit_version)),
+        ("Description", description),
+    ]
 }
 
 /// The product name of a material key (the key itself when the table lacks it).
@@ -670,21 +680,18 @@ fn render(
             .zip(&translations)
             .map(|(members, t)| object(members, *t, false))
             .collect();
-        let metadata = [
-            ("Title", format!("fabkit kit {}", kit.design)),
-            ("Application", format!("fabkit {}", opts.fabkit_version)),
-            (
-                "Description",
-                format!(
-                    "design {} from {}, sha256:{}, chord tolerance {} mm; command line: {}",
-                    kit.design,
-                    opts.design_source,
-                    opts.design_sha256,
-                    opts.chord_tolerance_mm,
-                    sheet::shell_words(&opts.command_line)
-                ),
+        let metadata = package_metadata(
+            format!("fabkit kit {}", kit.design),
+            opts,
+            format!(
+                "design {} from {}, sha256:{}, chord tolerance {} mm; command line: {}",
+                kit.design,
+                opts.design_source,
+                opts.design_sha256,
+                opts.chord_tolerance_mm,
+                sheet::shell_words(&opts.command_line)
             ),
-        ];
+        );
         let thumbnail = || {
             preview::render_plate(&placed_objects(&objects), None).png(&format!(
                 "fabkit kit {}: the kit 3MF's layout seen from above-front",
@@ -711,31 +718,25 @@ fn render(
     };
     // a plate's picture, also its 3MF's thumbnail, and the 3MF
     let plate_metadata = |plate: &layout::Plate| {
-        [
-            (
-                "Title",
-                format!(
-                    "fabkit plate {} {} {} {}",
-                    kit.design, plate.technology, plate.material, plate.number
-                ),
+        package_metadata(
+            format!(
+                "fabkit plate {} {} {} {}",
+                kit.design, plate.technology, plate.material, plate.number
             ),
-            ("Application", format!("fabkit {}", opts.fabkit_version)),
-            (
-                "Description",
-                format!(
-                    "{} plate {} of design {} (sha256:{}) for the {} ({} x {} x {} mm, {} mm margin), parts in print orientation",
-                    plate.technology,
-                    plate.number,
-                    kit.design,
-                    opts.design_sha256,
-                    plate.bed.name,
-                    plate.bed.size_mm[0],
-                    plate.bed.size_mm[1],
-                    plate.bed.size_mm[2],
-                    plate.bed.margin_mm
-                ),
+            opts,
+            format!(
+                "{} plate {} of design {} (sha256:{}) for the {} ({} x {} x {} mm, {} mm margin), parts in print orientation",
+                plate.technology,
+                plate.number,
+                kit.design,
+                opts.design_sha256,
+                plate.bed.name,
+                plate.bed.size_mm[0],
+                plate.bed.size_mm[1],
+                plate.bed.size_mm[2],
+                plate.bed.margin_mm
             ),
-        ]
+        )
     };
     // (picture, 3MF, its objects) of each plate
     type PlateFiles<'m> = Vec<(Vec<u8>, Vec<u8>, Vec<three_mf::Object<'m>>)>;

@@ -30,6 +30,12 @@ pub struct Variant {
     pub params: Vec<(String, Value)>,
 }
 
+impl Variant {
+    fn new(index: usize, id: String, params: Vec<(String, Value)>) -> Self {
+        Self { index, id, params }
+    }
+}
+
 /// Every variant of a sweep, in order.
 #[derive(Debug, Clone)]
 pub struct Plan {
@@ -268,14 +274,7 @@ impl SweepSpec {
                 super::variants::resolve_in(&base_json, &self.base.design, &self.origin, &params)?;
             let id = variant_id(&design, tol);
             let key = u64::from_str_radix(&id, 16).unwrap_or_default();
-            Ok((
-                key,
-                Variant {
-                    index: i,
-                    id,
-                    params,
-                },
-            ))
+            Ok((key, Variant::new(i, id, params)))
         };
         let splice = self.splice(&base_json).filter(|s| {
             // a sample of variants resolved in full must give the spliced ids
@@ -310,14 +309,7 @@ impl SweepSpec {
                                 let (key, id) = s.id_of(&c, tol, Some((&mut states, &prev)));
                                 let params = params_of(&c);
                                 prev = c;
-                                Ok((
-                                    key,
-                                    Variant {
-                                        index: i,
-                                        id,
-                                        params,
-                                    },
-                                ))
+                                Ok((key, Variant::new(i, id, params)))
                             })
                             .collect()
                     }
