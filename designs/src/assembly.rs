@@ -125,12 +125,15 @@ pub fn unprinted_members(
 }
 
 /// The printed sensor parts among `parts` as members, in their order, each turned back into
-/// the sensor frame (parts that record no pose are left out).
+/// the sensor frame (parts that record no pose are left out); in parallel.
 pub fn printed_members(parts: &[Part]) -> Vec<Member> {
-    let mut out = Vec::new();
-    for p in parts.iter().filter(|p| in_sensor(&p.role)) {
-        if let Some(solid) = in_sensor_frame(p) {
-            out.push(Member {
+    use rayon::prelude::*;
+    parts
+        .par_iter()
+        .filter(|p| in_sensor(&p.role))
+        .filter_map(|p| {
+            let solid = in_sensor_frame(p)?;
+            Some(Member {
                 name: p.name.clone(),
                 kind: MemberKind::Printed,
                 description: p.description.clone(),
@@ -141,10 +144,9 @@ pub fn printed_members(parts: &[Part]) -> Vec<Member> {
                 nested_by_stack: matches!(p.role.as_str(), "printed_skin" | "marker_tips"),
                 features: Default::default(),
                 exact: None,
-            });
-        }
-    }
-    out
+            })
+        })
+        .collect()
 }
 
 /// Pushes onto `out` the cast layers of `stack` (every layer not printed), inner to outer; their
