@@ -32,9 +32,11 @@ pub use part::{Part, PrintTechnology, ProcedureAction, ProcedureStep};
 use crate::error::ParamError;
 use crate::geometry::{cylinder, ChordTolerance, GeometryError, Solid};
 
-/// "must be above 0" for each `(path, value)` that is not a positive finite number, the path
-/// under `prefix` (`casing.` ...).
-pub(crate) fn check_positive(prefix: &str, values: &[(&str, f64)], errs: &mut Vec<ParamError>) {
+/// The rule on lengths and sizes: "must be above 0" for each `(path, value)` that is not a
+/// positive finite number, the path under `prefix` (`casing.`, `pin_dome.` ...); whether any
+/// broke it.
+pub fn check_positive(prefix: &str, values: &[(&str, f64)], errs: &mut Vec<ParamError>) -> bool {
+    let before = errs.len();
     for &(p, v) in values {
         if !(v > 0.0 && v.is_finite()) {
             errs.push(ParamError::new(
@@ -44,6 +46,7 @@ pub(crate) fn check_positive(prefix: &str, values: &[(&str, f64)], errs: &mut Ve
             ));
         }
     }
+    errs.len() > before
 }
 
 /// Smallest LED package fabkit counts around a ring, mm along the ring: the 0402 package

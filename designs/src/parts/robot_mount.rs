@@ -134,7 +134,7 @@ pub fn check_params(
 ) {
     let before = errs.len();
     let path = |p: &str| format!("shaft_body.robot_mount.{p}");
-    for (p, v) in [
+    let mut numbers = vec![
         ("plate_thickness_mm", m.plate_thickness_mm),
         ("cup_wall_mm", m.cup_wall_mm),
         ("cup_height_mm", m.cup_height_mm),
@@ -147,20 +147,11 @@ pub fn check_params(
         ("bayonet.lug_width_mm", m.bayonet.lug_width_mm),
         ("bayonet.lug_height_mm", m.bayonet.lug_height_mm),
         ("bayonet.lug_depth_mm", m.bayonet.lug_depth_mm),
-    ] {
-        if !(v > 0.0 && v.is_finite()) {
-            errs.push(ParamError::new(path(p), v, "must be above 0"));
-        }
-    }
+    ];
     if let Some(g) = m.bayonet.groove_width_mm {
-        if !(g > 0.0 && g.is_finite()) {
-            errs.push(ParamError::new(
-                path("bayonet.groove_width_mm"),
-                g,
-                "must be above 0",
-            ));
-        }
+        numbers.push(("bayonet.groove_width_mm", g));
     }
+    crate::parts::check_positive("shaft_body.robot_mount.", &numbers, errs);
     if !(2..=8).contains(&m.bolt_count) {
         errs.push(ParamError::new(
             path("bolt_count"),

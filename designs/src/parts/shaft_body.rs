@@ -368,17 +368,12 @@ pub fn check_params(
 /// The shaft body's numbers that must be above 0 (paths under `shaft_body`), the optional
 /// `bayonet.groove_width_mm` and `led_ring.seat_diameter_mm` among them when given.
 fn check_numbers_positive(sb: &ShaftBodyParams, errs: &mut Vec<ParamError>) {
-    let mut pos = |path: &str, v: f64| {
-        if !(v > 0.0 && v.is_finite()) {
-            errs.push(ParamError::new(
-                format!("shaft_body.{path}"),
-                v,
-                "must be above 0",
-            ));
-        }
-    };
     let cam = &sb.camera;
-    for (p, v) in [
+    let optional = [
+        ("bayonet.groove_width_mm", sb.bayonet.groove_width_mm),
+        ("led_ring.seat_diameter_mm", sb.led_ring.seat_diameter_mm),
+    ];
+    let mut numbers = vec![
         ("shaft_diameter_mm", sb.shaft_diameter_mm),
         ("shaft_length_mm", sb.shaft_length_mm),
         ("wall_thickness_mm", sb.wall_thickness_mm),
@@ -413,15 +408,9 @@ fn check_numbers_positive(sb: &ShaftBodyParams, errs: &mut Vec<ParamError>) {
         ("camera.mount_pilot_depth_mm", cam.mount_pilot_depth_mm),
         ("base.outer_diameter_mm", sb.base.outer_diameter_mm),
         ("base.ceiling_thickness_mm", sb.base.ceiling_thickness_mm),
-    ] {
-        pos(p, v);
-    }
-    if let Some(d) = sb.bayonet.groove_width_mm {
-        pos("bayonet.groove_width_mm", d);
-    }
-    if let Some(d) = sb.led_ring.seat_diameter_mm {
-        pos("led_ring.seat_diameter_mm", d);
-    }
+    ];
+    numbers.extend(optional.into_iter().filter_map(|(p, v)| Some((p, v?))));
+    crate::parts::check_positive("shaft_body.", &numbers, errs);
 }
 
 /// The FDM bayonet's settings (`printers.fdm.bayonet`: 2 to 8 lugs, the ramp below 15 deg, the

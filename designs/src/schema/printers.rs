@@ -220,21 +220,17 @@ pub(crate) fn check_printers(printers: &PrinterProfiles, errs: &mut Vec<ParamErr
         ("sla", &printers.sla),
         ("polyjet", &printers.polyjet),
     ] {
-        for (field, v) in [
-            ("xy_resolution_mm", p.xy_resolution_mm),
-            ("layer_height_mm", p.layer_height_mm),
-            ("min_wall_mm", p.min_wall_mm),
-            ("min_hole_diameter_mm", p.min_hole_diameter_mm),
-            ("min_feature_mm", p.min_feature_mm),
-        ] {
-            if !(v > 0.0 && v.is_finite()) {
-                errs.push(ParamError::new(
-                    format!("printers.{name}.{field}"),
-                    v,
-                    "must be above 0",
-                ));
-            }
-        }
+        crate::parts::check_positive(
+            &format!("printers.{name}."),
+            &[
+                ("xy_resolution_mm", p.xy_resolution_mm),
+                ("layer_height_mm", p.layer_height_mm),
+                ("min_wall_mm", p.min_wall_mm),
+                ("min_hole_diameter_mm", p.min_hole_diameter_mm),
+                ("min_feature_mm", p.min_feature_mm),
+            ],
+            errs,
+        );
         if let Some(bed) = &p.bed {
             check_bed(bed, &format!("printers.{name}.bed"), errs);
         }
