@@ -465,7 +465,7 @@ fn assembly_3mf(
             kit.design, opts.design_sha256
         ),
     );
-    let bytes = three_mf::encode(&objects, &metadata, None)?;
+    let bytes = three_mf::encode(&objects, &metadata)?;
     Ok((
         ManifestAssembly {
             file: ASSEMBLY_3MF.into(),

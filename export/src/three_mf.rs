@@ -290,36 +290,33 @@ pub(crate) fn prusa_config_xml(objects: &[Object<'_>]) -> Option<String> {
     Some(x)
 }
 
-/// The whole 3MF package as bytes: `[Content_Types].xml`, `_rels/.rels`, `3D/3dmodel.model`
-/// and, when an object holds a group, [`PRUSA_CONFIG_PATH`], and with `thumbnail` (PNG bytes)
-/// the package thumbnail [`THUMBNAIL_PATH`] (its root relationship in `_rels/.rels`, the `png`
-/// content type declared); deflated at level 6, every entry dated 1980-01-01 00:00:00 with host system Unix and mode
-/// 0644, so the bytes depend only on the input (and the deflate implementation).
+/// The whole 3MF package as bytes, without a thumbnail: [`encode_drawn`] with none.
 ///
 /// # Errors
 /// [`ExportError::ThreeMf`] if the zip writer fails (it writes to memory).
 pub(crate) fn encode(
     objects: &[Object<'_>],
     metadata: &[(&str, String)],
-    thumbnail: Option<&[u8]>,
 ) -> Result<Vec<u8>, ExportError> {
-    match thumbnail {
-        None => encode_drawn(
-            objects,
-            metadata,
-            None::<fn() -> Result<Vec<u8>, ExportError>>,
-        )
-        .map(|(bytes, _)| bytes),
-        Some(png) => encode_drawn(objects, metadata, Some(|| Ok(png.to_vec()))).map(|(b, _)| b),
-    }
+    encode_drawn(
+        objects,
+        metadata,
+        None::<fn() -> Result<Vec<u8>, ExportError>>,
+    )
+    .map(|(bytes, _)| bytes)
 }
 
-/// [`encode`] with the thumbnail drawn by `thumbnail` while the model is written and
-/// deflated (the thumbnail is the package's last entry): the same bytes as [`encode`] with
-/// the drawn PNG, and the PNG.
+/// The whole 3MF package as bytes: `[Content_Types].xml`, `_rels/.rels`, `3D/3dmodel.model`
+/// and, when an object holds a group, [`PRUSA_CONFIG_PATH`], and with `thumbnail` the package
+/// thumbnail [`THUMBNAIL_PATH`] (its root relationship in `_rels/.rels`, the `png` content
+/// type declared); deflated at level 6, every entry dated 1980-01-01 00:00:00 with host system
+/// Unix and mode 0644, so the bytes depend only on the input (and the deflate implementation).
+/// The thumbnail (PNG bytes) is drawn by `thumbnail` while the model is written and deflated
+/// (it is the package's last entry), and returned with the package.
 ///
 /// # Errors
-/// [`ExportError::ThreeMf`] as [`encode`]; the thumbnail's own error.
+/// [`ExportError::ThreeMf`] if the zip writer fails (it writes to memory); the thumbnail's own
+/// error first.
 pub(crate) fn encode_drawn<F>(
     objects: &[Object<'_>],
     metadata: &[(&str, String)],
