@@ -366,7 +366,7 @@ fn layer_pours(
             .layers
             .iter()
             .find(|l| l.name == layer)
-            .map(|l| layer_volume_mm3(&design.body, l) / 1000.0);
+            .map(|l| layer_volume_mm3(design, l) / 1000.0);
         if r.mold_parts.iter().any(|p| p.ends_with(":inner")) {
             // boundary strategy (UVDtact Sec. III)
             r.notes = format!(
@@ -391,7 +391,7 @@ fn layer_pours(
                     &sl.material,
                     cm,
                     sl.thickness_mm,
-                    layer_volume_mm3(&design.body, sl),
+                    layer_volume_mm3(design, sl),
                 ) {
                     r.coats.push(c);
                 }
@@ -715,15 +715,16 @@ fn bought_items(design: &Design, stack: &Stack, materials: &MaterialsTable) -> V
 }
 
 /// Volume of `layer` alone, mm^3: the solid under its outer surface down to the base plane,
-/// less the solid under its inner surface (nothing for a solid layer), from the exact profile
-/// ([`crate::profile::BodyProfile::analytic_solid_volume_mm3`]); marker features not counted.
-pub fn layer_volume_mm3(
-    body: &crate::profile::BodyProfile,
-    layer: &crate::stack::ResolvedLayer,
-) -> f64 {
+/// less the solid under its inner surface (for a solid layer, its recess if it has one), from
+/// the exact profile ([`crate::profile::BodyProfile::analytic_solid_volume_mm3`],
+/// [`crate::parts::recess::RecessOutline::volume_mm3`]); marker features not counted.
+pub fn layer_volume_mm3(design: &Design, layer: &crate::stack::ResolvedLayer) -> f64 {
+    let body = &design.body;
     let outer = body.analytic_solid_volume_mm3(layer.outer_offset_mm, 0.0);
     if layer.solid {
         outer
+            - crate::parts::recess::layer_recess(design, layer.index)
+                .map_or(0.0, |r| r.volume_mm3())
     } else {
         outer - body.analytic_solid_volume_mm3(layer.inner_offset_mm, 0.0)
     }

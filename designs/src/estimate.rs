@@ -72,6 +72,15 @@ pub fn estimate(design: &Design, stack: &Stack, tol: ChordTolerance) -> WorkEsti
         if !l.solid {
             surfaces += surface_triangles(design, l.inner_offset_mm, tol);
         }
+        if let Some(r) = crate::parts::recess::layer_recess(design, l.index) {
+            // the recess in the layer, in the mold's insert and in the mold's own layer
+            let profile = r.polyline(0.0, 0.0, tol.half()).points.len() as f64;
+            let around = tol
+                .half()
+                .circle_segments(design.body.rim_radius_mm(l.outer_offset_mm))
+                as f64;
+            surfaces += 3.0 * 2.0 * profile * around;
+        }
     }
     for l in &stack.layers {
         if l.process == crate::schema::LayerProcess::Cast

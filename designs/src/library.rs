@@ -17,6 +17,7 @@ pub const LIBRARY: &[(&str, &str)] = &[
         "soter_channels",
         include_str!("../library/soter_channels.yaml"),
     ),
+    ("digit_pinki", include_str!("../library/digit_pinki.yaml")),
 ];
 
 /// The default design of `fabkit export` without a design argument.

@@ -152,7 +152,11 @@ pub fn procedure(
         }
         let holder = with_role(parts, &c.mold_parts, &["core_holder", "casting_jig"]);
         let halves = with_role(parts, &c.mold_parts, &["mold_half"]);
-        let pieces = with_role(parts, &c.mold_parts, &["open_mold_piece", "open_mold"]);
+        let pieces = with_role(
+            parts,
+            &c.mold_parts,
+            &["open_mold_piece", "open_mold", "recess_insert"],
+        );
         let silicone: Vec<&String> = c
             .mold_parts
             .iter()
@@ -248,6 +252,8 @@ fn close_and_pour(
     let n = c.step;
     let boundary = silicone.iter().any(|m| m.ends_with(":inner"));
     let mix = c.mix_text();
+    let (inserts, pieces): (Vec<&Part>, Vec<&Part>) =
+        pieces.iter().partition(|p| p.role == "recess_insert");
     if !halves.is_empty() {
         let (a, b) = (
             &halves[0].name,
@@ -322,6 +328,16 @@ fn close_and_pour(
                 p.name
             ),
         ));
+        for insert in &inserts {
+            out.push(step(
+                A::CloseMold,
+                format!(
+                    "Step {n}: press `{}` into the gel dome first, centred on the cavity, until \
+                     its flat face lies in the open face of `{}`; wipe off the gel it pushes out.",
+                    insert.name, p.name
+                ),
+            ));
+        }
     }
 }
 

@@ -19,8 +19,8 @@ pub use crate::parts::housing::{
 };
 pub use crate::parts::lasercut::{LaserCutParams, SheetRegistration, SheetStock};
 pub use crate::parts::molds::{
-    ClampBolt, CoreHolderParams, MoldParams, Plinth, RegistrationBoss, RegistrationKey, Sprue,
-    TwoPieceOpenParams, Vent,
+    ClampBolt, CoreHolderParams, MoldParams, OpenBlock, Plinth, RegistrationBoss, RegistrationKey,
+    Sprue, TwoPieceOpenParams, Vent,
 };
 pub use printers::{
     shipped_printers, Bed, PrinterFile, PrinterProfile, PrinterProfiles, Technology,
@@ -116,6 +116,10 @@ pub struct Layer {
     /// a design without core). Give neither thickness_mm nor outer_radius_mm.
     #[serde(default)]
     pub solid: bool,
+    /// The seat of an optic under a solid layer, open on the base plane (DIGIT Pinki's gel);
+    /// none when not given.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub recess: Option<crate::parts::recess::Recess>,
     /// Marker features on this layer's surfaces.
     #[serde(default)]
     pub markers: Vec<crate::markers::MarkerSpec>,

@@ -24,9 +24,12 @@ impl Stack {
     ) -> Result<Solid, crate::geometry::GeometryError> {
         let l = &self.layers[i];
         let pl = if l.solid {
-            design
-                .body
-                .solid_profile(l.outer_offset_mm, 0.0, tol.half())
+            crate::parts::recess::solid_layer_profile(
+                &design.body,
+                l.outer_offset_mm,
+                crate::parts::recess::layer_recess(design, i).as_ref(),
+                tol.half(),
+            )
         } else {
             design
                 .body
@@ -72,6 +75,7 @@ pub fn validate(
     let layer_specs_ok = check_layer_specs(design, sphere_r, body_ok, &mut errs);
     check_core_and_casting(design, sphere_r, body_ok, &mut errs);
     check_mold_strategies(design, &mut errs);
+    crate::parts::recess::check_layer_recesses(design, body_ok, &mut errs);
 
     // Resolve the stack from the inside out, in "radius" units for spheres (r = R + offset).
     let (layers, core, stack_ok) = if body_ok && layer_specs_ok && !design.layers.is_empty() {
@@ -444,6 +448,46 @@ fn check_mold_strategies(design: &Design, errs: &mut Vec<ParamError>) {
     }
 }
 
+/// `mold.open_block` against the layers cast in an open mold: the largest cavity (its rim on
+/// the base plane, its height with the tallest raised outward feature) with the cavity
+/// printer's minimum wall around it.
+fn check_open_block(
+    design: &Design,
+    block: &crate::parts::molds::OpenBlock,
+    layers: &[ResolvedLayer],
+    errs: &mut Vec<ParamError>,
+) {
+    let b = &design.body;
+    let open: Vec<_> = layers
+        .iter()
+        .filter(|l| l.process == LayerProcess::Cast && l.mold_strategy == MoldStrategy::Open)
+        .collect();
+    let rim = open
+        .iter()
+        .map(|l| b.rim_radius_mm(l.outer_offset_mm))
+        .fold(0.0, f64::max);
+    let height = open
+        .iter()
+        .map(|l| {
+            let raised = design.layers[l.index]
+                .markers
+                .iter()
+                .filter(|m| {
+                    m.surface == crate::markers::MarkerSurface::Outer
+                        && m.feature.side() == crate::markers::Polarity::Raised
+                })
+                .map(|m| m.feature.height_mm)
+                .fold(0.0, f64::max);
+            b.pole_z_mm(l.outer_offset_mm) + raised - b.base_z_mm()
+        })
+        .fold(0.0, f64::max);
+    let min_wall = design
+        .printers
+        .get(design.mold.cavity_print_technology)
+        .min_wall_mm;
+    block.check(!open.is_empty(), rim, height, min_wall, errs);
+}
+
 /// The layers' and the core's surfaces, resolved from the inside out in "radius" units for
 /// spheres (r = R + offset), with the errors of a stack that does not close; whether it does.
 fn resolve_surfaces(
@@ -612,6 +656,20 @@ fn check_with_stack(
         if let Some(rim) = two_piece_rim {
             crate::parts::molds::check_two_piece(design, rim, errs);
         }
+        if let Some(block) = &design.mold.open_block {
+            check_open_block(design, block, layers, errs);
+        }
+    } else if design.mold.open_block.is_some() {
+        crate::parts::check_positive(
+            "mold.open_block.",
+            &design
+                .mold
+                .open_block
+                .iter()
+                .flat_map(|b| [("width_mm", b.width_mm), ("height_mm", b.height_mm)])
+                .collect::<Vec<_>>(),
+            errs,
+        );
     }
     // Checks that use the core only make sense once the stack itself is sound.
     let sound_core = core.filter(|_| stack_ok);

@@ -36,6 +36,8 @@ const CASES: &[(&str, &[&str])] = &[
     ("tactip_dualmodal", &["export", "tactip_dualmodal"]),
     // the flat skin's casting trays (Soter et al. Sec. II-A)
     ("soter_channels", &["export", "soter_channels"]),
+    // a solid gel with its optic's seat: the open mold's block and the seat's insert
+    ("digit_pinki", &["export", "digit_pinki"]),
     (
         "rtac0_fixtures",
         &[
@@ -53,6 +55,11 @@ const CASES: &[(&str, &[&str])] = &[
     (
         "tactip_dualmodal_fixtures",
         &["fixtures", "tactip_dualmodal"],
+    ),
+    // the pin dome and semi-domes of the small hemisphere-on-cylinder tip (R7.5)
+    (
+        "digit_pinki_fixtures",
+        &["fixtures", "digit_pinki", "--semidomes", "2"],
     ),
     // the flat skin's indenter grid plate and pin, semi-plate holder and halves
     (

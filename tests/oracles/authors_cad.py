@@ -7,8 +7,8 @@ Runs `fabkit export` / `fabkit fixtures` into WORKDIR and measures fabkit's expo
 meshes mapped back into the sensor frame through each part's `T_print_sensor`, the manifest, the
 point table) with numpy/trimesh, independently of fabkit's own code. Each row compares one
 quantity with the authors' CAD (their STL/STEP files, measured: the ShadowTac repository's mold
-STEP, the R-Tac0 files of the PP-Tac repository) or TacTipGenerator's default layout, within a
-stated tolerance. Rows marked `differs` are known, documented differences (they are printed, not
+STEP, the R-Tac0 files of the PP-Tac repository, the DIGIT Pinki gel and gel mold STEP files of
+facebookresearch/digit-design) or TacTipGenerator's default layout, within a stated tolerance. Rows marked `differs` are known, documented differences (they are printed, not
 asserted). With --markdown the table is printed in the form of docs/src/validation.md.
 
 Exit status: 0 when every asserted row holds, 1 otherwise (each failure printed), 2 on a usage or
@@ -298,13 +298,92 @@ def tactip(fabkit, work):
     row("TacTip", "TacTipGenerator default layout: pins", "217", float(mk["count"]), "{:.0f}", 0, 217)
 
 
+def pinki_surfaces(z_shift):
+    """The published DIGIT Pinki surfaces (`Pinki Gel.step`, `Pinki Gel Mold.step`, exact
+    B-rep faces, mm) as distance functions of (rho, z) in fabkit's sensor frame, whose z is the
+    CAD's plus `z_shift`."""
+    t = math.tan(math.radians(2.0))
+    c = math.cos(math.radians(2.0))
+    zs = -12.6400119738395 + z_shift   # the recess roof's sphere centre
+    zt = -7.13970690406748 + z_shift   # the fillet torus's centre plane
+    zr = -7.02109322044459 + z_shift   # the cone's reference circle R4.875
+    zb = -8.5 + z_shift                # the gel's base (the mold's open face)
+    return {
+        "tip sphere R7.5": lambda r, z: np.where(z >= -0.4 + z_shift - 1e-9,
+                                                 np.abs(np.hypot(r, z + 0.4 - z_shift) - 7.5), np.inf),
+        "cylinder R7.5": lambda r, z: np.where((z <= -0.4 + z_shift + 1e-9) & (z >= zb - 1e-9),
+                                               np.abs(r - 7.5), np.inf),
+        "base plane": lambda r, z: np.abs(z - zb),
+        "recess cone 2 deg": lambda r, z: np.abs((r - (4.87499999999981 + (zr - z) * t)) * c),
+        "recess fillet torus": lambda r, z: np.abs(np.hypot(r - 4.62898969502947, z - zt) - 0.25),
+        "recess roof R7.438943": lambda r, z: np.abs(np.hypot(r, z - zs) - 7.438943),
+        "block top": lambda r, z: np.abs(z - (8.5 + z_shift)),
+    }
+
+
+def off_surfaces(points, surfaces, names):
+    """The largest distance of `points` (N x 3, sensor frame) from the nearest of `names`."""
+    r, z = np.hypot(points[:, 0], points[:, 1]), points[:, 2]
+    return float(np.min([surfaces[n](r, z) for n in names], axis=0).max())
+
+
+def digit_pinki(fabkit, work):
+    run(fabkit, ["export", "digit_pinki", "--out", "out/digit_pinki", "--chord-tolerance-mm", "0.005"], work)
+    d = work / "out/digit_pinki"
+    m = manifest(d)
+    sf = pinki_surfaces(0.4)  # fabkit's frame: the tip sphere's centre at the origin
+    # the gel: the assembly's cast member (assembly.3mf, sensor frame)
+    import xml.etree.ElementTree as ET
+    import zipfile
+    ns = {"m": "http://schemas.microsoft.com/3dmanufacturing/core/2015/02"}
+    with zipfile.ZipFile(d / m["assembly_3mf"]["file"]) as z:
+        root = ET.fromstring(z.read("3D/3dmodel.model"))
+    obj = next(o for o in root.iterfind(".//m:object", ns) if o.get("name") == "gel")
+    gv = np.array([[float(v.get(k)) for k in "xyz"] for v in obj.iterfind(".//m:vertex", ns)])
+    gt = np.array([[int(t.get(k)) for k in ("v1", "v2", "v3")] for t in obj.iterfind(".//m:triangle", ns)])
+    gel = trimesh.Trimesh(gv, gt, process=False)
+    gel_faces = ["tip sphere R7.5", "cylinder R7.5", "base plane", "recess cone 2 deg",
+                 "recess fillet torus", "recess roof R7.438943"]
+    insert_faces = ["base plane", "recess cone 2 deg", "recess fillet torus", "recess roof R7.438943"]
+    block_faces = ["tip sphere R7.5", "cylinder R7.5", "base plane", "block top"]
+    for what, mesh, faces in [
+        ("gel", gel, gel_faces),
+        ("mold cavity block", None, block_faces),
+        ("mold insert", None, insert_faces),
+    ]:
+        if mesh is None:
+            p = part(m, "gel_open_mold" if what == "mold cavity block" else "gel_recess_insert")
+            v = sensor_vertices(d, p)
+            mesh = trimesh.Trimesh(v, np.asarray(print_mesh(d, p).faces), process=False)
+        # every vertex and every facet's centre (a facet's sag is largest near it)
+        pts = np.vstack([np.asarray(mesh.vertices, dtype=float), mesh.triangles_center])
+        if what == "mold cavity block":
+            # less the block's four sides: the 25.4 mm square
+            side = (np.abs(np.abs(pts[:, 0]) - 12.7) < 1e-4) | (np.abs(np.abs(pts[:, 1]) - 12.7) < 1e-4)
+            pts = pts[~side]
+        worst = off_surfaces(pts, sf, faces)
+        row("DIGIT Pinki", f"{what}: vertices and facet centres off the published faces",
+            "0 (exact faces)", worst * 1000, "{:.1f} um", 10.0, 0.0)
+    # volumes: the published gel 2132.3 mm3; the mold's two solids 8835.4 mm3 together
+    row("DIGIT Pinki", "gel volume", "2,132.3 mm3", float(gel.volume), "{:,.1f} mm3",
+        0.001 * 2132.3, 2132.3)
+    mold = part(m, "gel_open_mold")["volume_mm3"] + part(m, "gel_recess_insert")["volume_mm3"]
+    row("DIGIT Pinki", "mold volume (cavity block + insert)", "8,835.4 mm3", float(mold),
+        "{:,.1f} mm3", 0.001 * 8835.4, 8835.4)
+    bv = sensor_vertices(d, part(m, "gel_open_mold"))
+    ext = bv.max(axis=0) - bv.min(axis=0)
+    row("DIGIT Pinki", "mold block", "25.4 x 25.4 x 17.0 mm",
+        f"{ext[0]:.3f} x {ext[1]:.3f} x {ext[2]:.3f} mm", "{}")
+    ROWS[-1] = ROWS[-1][:4] + (bool(np.all(np.abs(ext - [25.4, 25.4, 17.0]) < 1e-4)),)
+
+
 def main():
     if len(sys.argv) < 3:
         sys.stderr.write(__doc__)
         sys.exit(2)
     fabkit, work = str(Path(sys.argv[1]).resolve()), Path(sys.argv[2])
     work.mkdir(parents=True, exist_ok=True)
-    for f in (shadowtac, rtac0, pin_dome, tactip):
+    for f in (shadowtac, rtac0, pin_dome, tactip, digit_pinki):
         f(fabkit, work)
     failed = [r for r in ROWS if r[4] is False]
     if "--markdown" in sys.argv:

@@ -279,6 +279,13 @@ fn check_layer_fields(
                 "unknown material",
             )),
         }
+        if l.recess.is_some() {
+            errs.push(ParamError::new(
+                p("recess"),
+                "given",
+                "applies to curved skins only: a flat skin has no optic's seat",
+            ));
+        }
         if !l.markers.is_empty() {
             errs.push(ParamError::new(
                 p("markers"),

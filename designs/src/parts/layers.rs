@@ -677,6 +677,33 @@ fn enclosed(
     apply_features(base, sets, tol, stems_only)
 }
 
+/// The solid that solid layer `l` fills, with the features `sets` of its outer surface: the
+/// solid under its outer surface down to the base plane, less its recess if it has one
+/// ([`crate::parts::recess`]).
+fn solid_enclosed(
+    design: &Design,
+    l: &ResolvedLayer,
+    sets: &[&PlacedMarkers],
+    tol: ChordTolerance,
+    stems_only: bool,
+) -> Result<Solid, GeometryError> {
+    let Some(r) = crate::parts::recess::layer_recess(design, l.index) else {
+        return enclosed(design, l.outer_offset_mm, 0.0, sets, tol, stems_only);
+    };
+    let pl = crate::parts::recess::solid_layer_profile(
+        &design.body,
+        l.outer_offset_mm,
+        Some(&r),
+        tol.half(),
+    );
+    apply_features(
+        Solid::from_mesh(&revolve(&pl, tol)?)?,
+        sets,
+        tol,
+        stems_only,
+    )
+}
+
 /// The solid of layer `i` with its features (for printed layers with separate tips, the
 /// stems only), closed on the base plane.
 ///
@@ -695,10 +722,10 @@ pub fn layer_solid(
         on_surface(&placed, MarkerSurface::Outer),
         on_surface(&placed, MarkerSurface::Inner),
     );
-    let o = enclosed(design, l.outer_offset_mm, 0.0, &outer, tol, stems_only)?;
     if l.solid {
-        return Ok(o);
+        return solid_enclosed(design, l, &outer, tol, stems_only);
     }
+    let o = enclosed(design, l.outer_offset_mm, 0.0, &outer, tol, stems_only)?;
     let inn = enclosed(design, l.inner_offset_mm, 1.0, &inner, tol, stems_only)?;
     o.difference(&inn)
 }
@@ -753,7 +780,11 @@ pub fn layer_stand_in(
     tol: ChordTolerance,
 ) -> Result<Solid, GeometryError> {
     let l = &stack.layers[i];
-    let mut shell = enclosed(design, l.outer_offset_mm, 0.0, &[], tol, false)?;
+    let mut shell = if l.solid {
+        solid_enclosed(design, l, &[], tol, false)?
+    } else {
+        enclosed(design, l.outer_offset_mm, 0.0, &[], tol, false)?
+    };
     if !l.solid {
         shell = shell.difference(&enclosed(design, l.inner_offset_mm, 1.0, &[], tol, false)?)?;
     }
@@ -903,11 +934,15 @@ fn twin_params(
     l: &ResolvedLayer,
     markers: serde_json::Value,
 ) -> serde_json::Value {
-    json!({
+    let mut v = json!({
         "layer": l.name, "body": design.body, "outer_offset_mm": l.outer_offset_mm,
         "inner_offset_mm": if l.solid { serde_json::Value::Null } else { json!(l.inner_offset_mm) },
         "solid": l.solid, "markers": markers,
-    })
+    });
+    if let Some(r) = crate::parts::recess::layer_recess(design, l.index) {
+        v["recess"] = json!(r);
+    }
+    v
 }
 
 fn build_layer_parts(
@@ -1096,16 +1131,25 @@ fn build_open_mold_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
     let plain = g(body_solid(design, l.outer_offset_mm, 1.0, tol))?;
     let rim = design.body.rim_radius_mm(l.outer_offset_mm);
     let top = features_top_z_mm(design, l.outer_offset_mm, &outer);
-    let half = rim + m.wall_thickness_mm;
     let zb = design.body.base_z_mm();
+    let (half, z_top) = match &m.open_block {
+        Some(ob) => (ob.width_mm / 2.0, zb + ob.height_mm),
+        None => (rim + m.wall_thickness_mm, top + m.wall_thickness_mm),
+    };
     let block = g(crate::geometry::cuboid(
         [-half, -half, zb],
-        [half, half, top + m.wall_thickness_mm],
+        [half, half, z_top],
     ))?;
     let mold = g(block
         .difference(&plain)
         .and_then(|b| apply_features_signed(b, &outer, tol, false, -1.0)))?;
-    let skin_volume = block.volume() - mold.volume();
+    // the optic's seat: an insert set in the open face forms it
+    let recess = crate::parts::recess::layer_recess(design, l.index);
+    let insert = recess
+        .as_ref()
+        .map(|r| g(r.solid(zb, 0.0, tol)))
+        .transpose()?;
+    let skin_volume = block.volume() - mold.volume() - insert.as_ref().map_or(0.0, Solid::volume);
     let (mold_placed, mold_pose) =
         place_posed(&mold, &crate::geometry::rotation_deg(180.0, 0.0, 0.0));
     let part = Part {
@@ -1119,14 +1163,34 @@ fn build_open_mold_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
         solid: mold_placed,
         params: with_pose(
             json!({"base": base_params, "open_face": "the base plane, printed face up", "wall_thickness_mm": m.wall_thickness_mm,
-            "block_mm": {"min": [-half, -half, zb], "max": [half, half, top + m.wall_thickness_mm]}}),
+            "block_mm": {"min": [-half, -half, zb], "max": [half, half, z_top]}}),
             &mold_pose,
         ),
         group: None,
     };
-    let pour_parts = vec![part.name.clone()];
+    let mut parts = vec![part];
+    if let (Some(r), Some(insert)) = (recess, insert) {
+        let (placed, pose) = place_posed(&insert, &crate::geometry::Affine::identity());
+        parts.push(Part {
+            name: format!("{name}_recess_insert"),
+            role: "recess_insert".into(),
+            description: format!(
+                "Forms the optic's seat under the {name} skin: once the open mold is poured to the brim, press it in dome first until its flat face lies in the mold's open face, centred on the cavity"
+            ),
+            material: material_for(cavity_tech).into(),
+            print_technology: cavity_tech,
+            solid: placed,
+            params: with_pose(
+                json!({"base": base_params, "base_z_mm": zb, "recess": r,
+                       "print_orientation": "flat face on the bed"}),
+                &pose,
+            ),
+            group: None,
+        });
+    }
+    let pour_parts = parts.iter().map(|p| p.name.clone()).collect();
     Ok(LayerOutput {
-        parts: vec![part],
+        parts,
         pours: vec![(name.clone(), l.material.clone(), skin_volume, pour_parts)],
         markers: markers_json,
     })

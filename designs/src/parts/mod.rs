@@ -18,6 +18,7 @@ mod member;
 pub mod molds;
 mod part;
 pub mod placement;
+pub mod recess;
 pub mod registry;
 pub mod robot_mount;
 pub mod shaft_body;

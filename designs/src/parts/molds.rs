@@ -60,6 +60,71 @@ pub struct MoldParams {
     /// sheet) whose union is also written as the printable tray ([`crate::lasercut`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub laser_cut: Option<LaserCutParams>,
+    /// The block of an `open` mold, square about the axis from the base plane up (the DIGIT
+    /// Pinki gel mold's 25.4 x 25.4 x 17 mm); when not given, `wall_thickness_mm` beyond the
+    /// cavity's rim and beyond its tallest outward feature.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub open_block: Option<OpenBlock>,
+}
+
+/// The outer size of an `open` mold's block (`mold.open_block`), mm.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct OpenBlock {
+    /// Width of the square block, mm, > 0: at least the cavity's diameter on the base plane
+    /// plus the cavity printer's `min_wall_mm` each side.
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    pub width_mm: f64,
+    /// Height of the block from the base plane (the open face), mm, > 0: at least the
+    /// cavity's height with its outward features plus the cavity printer's `min_wall_mm`.
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    pub height_mm: f64,
+}
+
+impl OpenBlock {
+    /// The rules of `mold.open_block`: given for an `open` mold only, sizes above 0, and a
+    /// wall of at least `min_wall_mm` around a cavity of `rim_radius_mm` on the base plane
+    /// that reaches `cavity_height_mm` over it.
+    pub fn check(
+        &self,
+        open: bool,
+        rim_radius_mm: f64,
+        cavity_height_mm: f64,
+        min_wall_mm: f64,
+        errs: &mut Vec<ParamError>,
+    ) {
+        if !open {
+            errs.push(ParamError::new(
+                "mold.open_block",
+                "given",
+                "applies to the open mold strategy only (no layer is cast in an open mold)",
+            ));
+            return;
+        }
+        if crate::parts::check_positive(
+            "mold.open_block.",
+            &[("width_mm", self.width_mm), ("height_mm", self.height_mm)],
+            errs,
+        ) {
+            return;
+        }
+        let least_width = 2.0 * (rim_radius_mm + min_wall_mm);
+        if self.width_mm < least_width {
+            errs.push(ParamError::new(
+                "mold.open_block.width_mm",
+                self.width_mm,
+                format!("must be at least the cavity's diameter plus the cavity printer's min_wall_mm each side ({least_width:.3} mm)"),
+            ));
+        }
+        let least_height = cavity_height_mm + min_wall_mm;
+        if self.height_mm < least_height {
+            errs.push(ParamError::new(
+                "mold.open_block.height_mm",
+                self.height_mm,
+                format!("must be at least the cavity's height with its outward features plus the cavity printer's min_wall_mm ({least_height:.3} mm)"),
+            ));
+        }
+    }
 }
 
 defaults!(MoldParams {
@@ -79,6 +144,7 @@ defaults!(MoldParams {
     cavity_print_technology: Technology::Sla,
     fixture_print_technology: Technology::Fdm,
     laser_cut: None,
+    open_block: None,
 });
 
 /// The disc-shaped recess at the open end of the cavity: it centres the core holder (its

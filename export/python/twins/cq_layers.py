@@ -1,5 +1,6 @@
 """CadQuery twins of the parts built from a layer and its marker features (ShadowTac
-Sec. III-IV, UVDtact Sec. III, Pestell et al. Sec. III-A): one-piece open molds (dimples),
+Sec. III-IV, UVDtact Sec. III, Pestell et al. Sec. III-A): one-piece open molds (dimples) and
+the insert that forms a solid layer's recess (DIGIT Pinki),
 printed skins with pins and their tips, and the boundary strategy's master, mold box and
 inner negative (slots and protrusions). From a part's manifest `params` alone: the body, the
 layer offsets, and per marker set the feature, direction and (polar, azimuth) placements."""
@@ -51,6 +52,37 @@ def enclosed(body: C.Body, d: float, below: float, extra=None):
     pts = [(body.rim_radius(d), zb)]
     pts += extra if extra is not None else [(body.rim_radius(d), zb - below), (0.0, zb - below)]
     return C.revolve(body.curve_edges(d), pts)
+
+
+def recess_solid(r: dict, zb: float, below: float):
+    """The recess under a solid layer (the optic's seat, DIGIT Pinki) from its resolved outline
+    `r` ((r, h) points, h up from the base plane `zb`): the roof's arc from the apex, the
+    fillet's arc, the wall's line to the mouth, continued `below` mm under the base plane and
+    closed there; exact arcs."""
+    import cadquery as cq
+    R, hs = r["cap_radius_mm"], r["cap_centre_h_mm"]
+    er, eh = r["roof_edge"]
+    a_edge = math.atan2(eh - hs, er)
+    mid = (math.pi / 2 + a_edge) / 2
+    edges = [cq.Edge.makeThreePointArc(C.vec(0.0, zb + r["depth_mm"]),
+                                       C.vec(R * math.cos(mid), zb + hs + R * math.sin(mid)),
+                                       C.vec(er, zb + eh))]
+    draft = math.radians(r["draft_angle_deg"])
+    rf = r["fillet_radius_mm"]
+    if rf > 0:
+        fr, fh = r["fillet_centre"]
+        wr, wh = r["wall_top"]
+        m = (a_edge + draft) / 2
+        edges.append(cq.Edge.makeThreePointArc(C.vec(er, zb + eh),
+                                               C.vec(fr + rf * math.cos(m), zb + fh + rf * math.sin(m)),
+                                               C.vec(wr, zb + wh)))
+    r0 = r["mouth_radius_mm"]
+    pts = [(r0, zb)]
+    if below > 0:
+        pts += [(r0 + below * math.tan(draft), zb - below), (0.0, zb - below)]
+    else:
+        pts += [(0.0, zb)]
+    return C.revolve(edges, pts)
 
 
 def marker_sets(base: dict, surface: str) -> list:
@@ -109,6 +141,8 @@ def printed_skin(params: dict, tips: bool):
     outer = with_features(enclosed(body, params["outer_offset_mm"], 0.0), body,
                           marker_sets(params, "outer"), 1.0, stems_only)
     if params["solid"]:
+        if params.get("recess"):
+            return C.cut(outer, [recess_solid(params["recess"], body.base_z(), 1.0)])
         return outer
     inner = with_features(enclosed(body, params["inner_offset_mm"], 1.0), body,
                           marker_sets(params, "inner"), 1.0, stems_only)
@@ -188,6 +222,8 @@ def twin(part: dict):
         return open_mold(p)
     if role == "open_mold_piece":
         return open_mold_piece(p)
+    if role == "recess_insert":
+        return recess_solid(p["recess"], p["base_z_mm"], 0.0)
     if role == "printed_skin":
         return printed_skin(p, tips=False)
     if role == "marker_tips":

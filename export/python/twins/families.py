@@ -15,6 +15,8 @@ def family(part: dict) -> str:
         return "dimple molds"
     if role == "open_mold_piece":
         return "two-piece dimple molds"
+    if role == "recess_insert":
+        return "recess inserts"
     if role == "printed_skin":
         return "layer shells"
     if role == "marker_tips":
