@@ -791,3 +791,80 @@ fn a_render_fits_in_its_memory_estimate_under_an_address_space_limit() {
     assert!(d.path().join("gt/manifest.json").exists());
     assert!(d.path().join("gt/p001_0/image.png").exists());
 }
+
+/// DIGIT Pinki's ground truth through a camera file of the user's (OpenCV YAML, plumb_bob, a
+/// camera looking up the axis from the seat's mouth on the base plane, as the fiber bundle's
+/// end sits): its semi-domes render, and the reference range along the optical axis is the
+/// distance to the gel's pole (the R7.5 tip 15.6 mm above the base plane).
+#[test]
+fn digit_pinki_ground_truth_through_the_users_camera_file() {
+    use fabkit_calibration::{Distortion, Intrinsics};
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let o = run(
+        dir,
+        &[
+            "fixtures",
+            "digit_pinki",
+            "--semidomes",
+            "2",
+            "--seed",
+            "5",
+            "--format",
+            "stl",
+            "--out",
+            "fx",
+        ],
+        &[],
+    );
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let k = Intrinsics {
+        image_width_px: 400,
+        image_height_px: 400,
+        fx_px: 300.0,
+        fy_px: 300.0,
+        cx_px: 200.0,
+        cy_px: 200.0,
+        distortion: Distortion::PlumbBob([-0.05, 0.01, 0.0, 0.0, 0.0]),
+    };
+    std::fs::write(
+        dir.join("cam.yaml"),
+        write_camera(&k, CameraFileFormat::OpenCvYaml),
+    )
+    .unwrap();
+    // the camera on the axis at the base plane (z = -8.1 mm), looking along +z
+    let m = [
+        [1.0, 0.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0, 0.0],
+        [0.0, 0.0, 1.0, 8.1],
+        [0.0, 0.0, 0.0, 1.0],
+    ];
+    let ext =
+        serde_json::json!({"rvec": [0.0, 0.0, 0.0], "tvec_mm": [0.0, 0.0, 8.1], "T_cam_sensor": m});
+    std::fs::write(
+        dir.join("extrinsics.json"),
+        serde_json::to_vec_pretty(&ext).unwrap(),
+    )
+    .unwrap();
+    let o = run(dir, &design_gt_args("digit_pinki", "cam.yaml", &[]), &[]);
+    assert!(o.status.success(), "{}{}", text(&o.stdout), text(&o.stderr));
+    assert!(
+        text(&o.stdout).contains("4 configurations (2 patterns x 2 orientations)"),
+        "{}",
+        text(&o.stdout)
+    );
+    let range = read_npy_f32(&dir.join("gt/reference/range_mm.npy"));
+    assert_eq!(range.len(), 400 * 400);
+    // the pixel whose centre is the principal point (200, 200) looks along the axis
+    let centre = f64::from(range[200 * 400 + 200]);
+    assert!(
+        (centre - 15.6).abs() < 0.01,
+        "range on the axis {centre} mm, the pole at 15.6 mm"
+    );
+    // every pixel sees the gel's outer surface: no range beyond the farthest point of it
+    let far = 7.5 + 8.1;
+    assert!(range
+        .iter()
+        .filter(|r| r.is_finite())
+        .all(|&r| f64::from(r) <= far + 0.01));
+}
