@@ -945,3 +945,97 @@ fn more_vents_than_fit_yield_one_error() {
     d.mold.vent.count = 21;
     assert_exactly(&errors(&d), &[]);
 }
+
+/// DIGIT Pinki's recess and open block: each broken rule is one error naming its path, value
+/// and rule, and the library design itself is valid.
+#[test]
+fn pinki_recess_and_open_block_rules_name_their_parameters() {
+    let pinki = || {
+        Design::from_yaml(
+            fabkit_designs::library::yaml("digit_pinki").unwrap(),
+            ORIGIN,
+        )
+        .unwrap()
+    };
+    assert_exactly(&errors(&pinki()), &[]);
+    let cases: Vec<(Box<dyn Fn(&mut Design)>, Expect)> = vec![
+        (
+            Box::new(|d| d.layers[0].recess.as_mut().unwrap().cap_radius_mm = 3.0),
+            Expect {
+                path: "layers[0].recess.cap_radius_mm",
+                value: "3",
+                rule: &["must exceed", "meets the wall above the base plane"],
+            },
+        ),
+        (
+            Box::new(|d| d.layers[0].recess.as_mut().unwrap().fillet_radius_mm = 3.5),
+            Expect {
+                path: "layers[0].recess.fillet_radius_mm",
+                value: "3.5",
+                rule: &["too large"],
+            },
+        ),
+        (
+            Box::new(|d| d.layers[0].recess.as_mut().unwrap().draft_angle_deg = 45.0),
+            Expect {
+                path: "layers[0].recess.draft_angle_deg",
+                value: "45",
+                rule: &["[0, 45)"],
+            },
+        ),
+        (
+            Box::new(|d| {
+                let r = d.layers[0].recess.as_mut().unwrap();
+                (r.depth_mm, r.cap_radius_mm) = (15.6, 9.0);
+            }),
+            Expect {
+                path: "layers[0].recess.depth_mm",
+                value: "15.6",
+                rule: &["below the skin's height"],
+            },
+        ),
+        (
+            Box::new(|d| d.mold.open_block.as_mut().unwrap().width_mm = 15.0),
+            Expect {
+                path: "mold.open_block.width_mm",
+                value: "15",
+                rule: &["min_wall_mm each side"],
+            },
+        ),
+        (
+            Box::new(|d| d.mold.open_block.as_mut().unwrap().height_mm = 15.6),
+            Expect {
+                path: "mold.open_block.height_mm",
+                value: "15.6",
+                rule: &["cavity's height"],
+            },
+        ),
+        (
+            Box::new(|d| {
+                d.mold.strategy = fabkit_designs::schema::MoldStrategy::TwoPieceOpen;
+                d.mold.open_block = None;
+            }),
+            Expect {
+                path: "layers[0].recess",
+                value: "given",
+                rule: &["open mold strategy"],
+            },
+        ),
+    ];
+    for (mutate, want) in cases {
+        let mut d = pinki();
+        mutate(&mut d);
+        assert_exactly(&errors(&d), &[&want]);
+    }
+    // a mutation in the YAML text is reported like one in Rust
+    let t = fabkit_designs::library::yaml("digit_pinki")
+        .unwrap()
+        .replacen("draft_angle_deg: 2.0", "draft_angle_deg: -1.0", 1);
+    let d = Design::from_yaml(&t, ORIGIN).unwrap();
+    let errs = errors(&d);
+    assert_eq!(errs.len(), 1, "{}", listing(&errs));
+    assert_eq!(
+        errs[0].to_string(),
+        "layers[0].recess.draft_angle_deg = -1: must be in [0, 45)"
+    );
+}
