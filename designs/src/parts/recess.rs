@@ -252,6 +252,52 @@ impl RecessOutline {
         wall + fillet + roof
     }
 
+    /// The least thickness of skin between the recess and the outer surface, the body's offset
+    /// surface at `outer_offset_mm`, mm, measured between their polylines at `tol` (so within
+    /// `tol` of the exact figure); 0 when a point of the recess lies outside that surface.
+    pub fn skin_mm(
+        &self,
+        body: &crate::profile::BodyProfile,
+        outer_offset_mm: f64,
+        tol: ChordTolerance,
+    ) -> f64 {
+        let zb = body.base_z_mm();
+        let outer = body.offset_polyline(outer_offset_mm, 0.0, tol).points;
+        let mut closed = outer.clone();
+        closed.push([0.0, zb]);
+        let inside = |p: [f64; 2]| {
+            // even-odd rule on the closed (r, z) profile
+            let mut c = false;
+            for w in 0..closed.len() {
+                let (a, b) = (closed[w], closed[(w + 1) % closed.len()]);
+                if (a[1] > p[1]) != (b[1] > p[1])
+                    && p[0] < a[0] + (p[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0])
+                {
+                    c = !c;
+                }
+            }
+            c
+        };
+        let mut least = f64::INFINITY;
+        for p in self.polyline(zb, 0.0, tol).points {
+            if p[1] > zb && !inside(p) {
+                return 0.0;
+            }
+            for w in outer.windows(2) {
+                let (a, b) = (w[0], w[1]);
+                let ab = [b[0] - a[0], b[1] - a[1]];
+                let len2 = ab[0] * ab[0] + ab[1] * ab[1];
+                let u = if len2 > 0.0 {
+                    (((p[0] - a[0]) * ab[0] + (p[1] - a[1]) * ab[1]) / len2).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                least = least.min((p[0] - a[0] - u * ab[0]).hypot(p[1] - a[1] - u * ab[1]));
+            }
+        }
+        least
+    }
+
     /// The distance from the point (r, h) (h up from the base plane) to the recess's surface
     /// above the base plane (wall, fillet and roof), mm.
     pub fn distance_mm(&self, p: [f64; 2]) -> f64 {
@@ -430,13 +476,17 @@ pub fn check_layer_recesses(design: &Design, body_ok: bool, errs: &mut Vec<Param
         }
         if body_ok {
             let b = &design.body;
-            check_recess(
-                &path,
-                r,
-                b.rim_radius_mm(0.0),
-                b.pole_z_mm(0.0) - b.base_z_mm(),
-                errs,
-            );
+            let before = errs.len();
+            let height = b.pole_z_mm(0.0) - b.base_z_mm();
+            check_recess(&path, r, b.rim_radius_mm(0.0), height, errs);
+            let outline = r.outline().ok().filter(|_| errs.len() == before);
+            if outline.is_some_and(|o| o.skin_mm(b, 0.0, ChordTolerance::default()) <= 0.0) {
+                errs.push(ParamError::new(
+                    &path,
+                    "given",
+                    "breaks through the skin's outer surface: the roof or the wall reaches it",
+                ));
+            }
         }
     }
 }

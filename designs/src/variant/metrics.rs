@@ -9,7 +9,7 @@ use crate::materials::MaterialsTable;
 use crate::parts::layers::{
     feature_end_centres, place_layer_markers, recess_clearance_to_base_mm, PlacedMarkers,
 };
-use crate::schema::{Design, LayerProcess, Technology};
+use crate::schema::{Design, LayerProcess, MoldStrategy, Technology};
 use crate::stack::{validate, ResolvedLayer, Stack};
 use crate::{ChordTolerance, DesignError};
 use serde::{Deserialize, Serialize};
@@ -202,7 +202,9 @@ pub fn evaluate_scoped(
 /// - behind a recessed feature: the layer thickness minus the feature height (shell layers),
 ///   or the distance from the recess to the base plane (solid layers);
 /// - a printed layer's thickness;
-/// - `mold.wall_thickness_mm` when a layer is cast in a printed mold.
+/// - a solid layer's skin between its recess and its outer surface;
+/// - `mold.wall_thickness_mm` when a layer is cast in a printed mold sized by it, or the walls
+///   of `mold.open_block` beside and beyond the cavity of an `open` mold.
 ///
 /// `None` when the design has none of these. The housing's walls are not included.
 pub fn min_wall(
@@ -262,7 +264,44 @@ pub fn min_wall(
             ));
         }
     }
-    if stack.layers.iter().any(|l| l.process == LayerProcess::Cast) {
+    let b = &design.body;
+    for l in &stack.layers {
+        if let Some(r) = crate::parts::recess::layer_recess(design, l.index) {
+            walls.push((
+                r.skin_mm(b, l.outer_offset_mm, ChordTolerance::default().half()),
+                format!(
+                    "layers[{}].recess: the skin between the seat and the outer surface",
+                    l.index
+                ),
+            ));
+        }
+    }
+    let cast = |l: &&ResolvedLayer| l.process == LayerProcess::Cast;
+    let open_block = design.mold.open_block.as_ref();
+    for l in stack.layers.iter().filter(cast) {
+        if let (Some(ob), MoldStrategy::Open) = (open_block, l.mold_strategy) {
+            let raised = design.layers[l.index]
+                .markers
+                .iter()
+                .filter(|m| {
+                    m.surface == crate::markers::MarkerSurface::Outer
+                        && m.feature.side() == Polarity::Raised
+                })
+                .map(|m| m.feature.height_mm)
+                .fold(0.0, f64::max);
+            walls.push((
+                ob.width_mm / 2.0 - b.rim_radius_mm(l.outer_offset_mm),
+                "mold.open_block.width_mm: open mold's wall beside the cavity".into(),
+            ));
+            walls.push((
+                b.base_z_mm() + ob.height_mm - b.pole_z_mm(l.outer_offset_mm) - raised,
+                "mold.open_block.height_mm: open mold's wall beyond the cavity".into(),
+            ));
+        }
+    }
+    let sized_by_wall =
+        |l: &&ResolvedLayer| !(open_block.is_some() && l.mold_strategy == MoldStrategy::Open);
+    if stack.layers.iter().filter(cast).any(|l| sized_by_wall(&l)) {
         walls.push((
             design.mold.wall_thickness_mm,
             "mold.wall_thickness_mm: mold wall around the cavity".into(),

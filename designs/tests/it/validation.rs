@@ -995,6 +995,18 @@ fn pinki_recess_and_open_block_rules_name_their_parameters() {
             },
         ),
         (
+            // a nearly flat roof 15.5 mm up pokes out of the R7.5 tip
+            Box::new(|d| {
+                let r = d.layers[0].recess.as_mut().unwrap();
+                (r.depth_mm, r.cap_radius_mm) = (15.5, 20.0);
+            }),
+            Expect {
+                path: "layers[0].recess",
+                value: "given",
+                rule: &["breaks through the skin's outer surface"],
+            },
+        ),
+        (
             Box::new(|d| d.mold.open_block.as_mut().unwrap().width_mm = 15.0),
             Expect {
                 path: "mold.open_block.width_mm",
@@ -1038,4 +1050,31 @@ fn pinki_recess_and_open_block_rules_name_their_parameters() {
         errs[0].to_string(),
         "layers[0].recess.draft_angle_deg = -1: must be in [0, 45)"
     );
+}
+
+/// The least wall of DIGIT Pinki is its open block's 1.4 mm beyond the pole (17.0 mm block,
+/// 15.6 mm gel), not `mold.wall_thickness_mm`; a seat 14 mm across at its mouth (no fillet)
+/// leaves 0.5 mm of skin beside the mouth, inside the R7.5 cylinder: the least.
+#[test]
+fn pinki_min_wall_is_the_open_blocks_or_the_skin_over_its_seat() {
+    use fabkit_designs::variant::{evaluate, Outcome};
+    let materials = MaterialsTable::embedded().unwrap();
+    let tol = ChordTolerance::default();
+    let least = |d: &Design| match evaluate(d, &materials, tol) {
+        Outcome::Ok { metrics, .. } => (metrics.min_wall_mm.unwrap(), metrics.min_wall_at.unwrap()),
+        _ => panic!("digit_pinki does not build"),
+    };
+    let mut d = Design::from_yaml(
+        fabkit_designs::library::yaml("digit_pinki").unwrap(),
+        ORIGIN,
+    )
+    .unwrap();
+    let (w, at) = least(&d);
+    assert!((w - 1.4).abs() < 1e-9, "{w} at {at}");
+    assert!(at.starts_with("mold.open_block.height_mm"), "{at}");
+    let r = d.layers[0].recess.as_mut().unwrap();
+    (r.base_diameter_mm, r.cap_radius_mm, r.fillet_radius_mm) = (14.0, 9.5, 0.0);
+    let (w, at) = least(&d);
+    assert!((w - 0.5).abs() < 1e-9, "{w} at {at}");
+    assert!(at.starts_with("layers[0].recess: the skin between"), "{at}");
 }
