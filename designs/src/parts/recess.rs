@@ -9,7 +9,7 @@
 //! the z axis; its heights `h` are measured up from the base plane (`z = base_z + h`).
 
 use crate::error::ParamError;
-use crate::geometry::profile2d::push_arc;
+use crate::geometry::profile2d::{point_segment_distance, push_arc};
 use crate::geometry::{revolve, ChordTolerance, GeometryError, Polyline2, Solid};
 use crate::schema::{Design, LayerProcess, MoldStrategy};
 use schemars::JsonSchema;
@@ -261,38 +261,22 @@ impl RecessOutline {
         outer_offset_mm: f64,
         tol: ChordTolerance,
     ) -> f64 {
+        use geo::Contains;
         let zb = body.base_z_mm();
         let outer = body.offset_polyline(outer_offset_mm, 0.0, tol).points;
-        let mut closed = outer.clone();
-        closed.push([0.0, zb]);
-        let inside = |p: [f64; 2]| {
-            // even-odd rule on the closed (r, z) profile
-            let mut c = false;
-            for w in 0..closed.len() {
-                let (a, b) = (closed[w], closed[(w + 1) % closed.len()]);
-                if (a[1] > p[1]) != (b[1] > p[1])
-                    && p[0] < a[0] + (p[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0])
-                {
-                    c = !c;
-                }
-            }
-            c
-        };
+        let mut ring: Vec<geo::Coord> = outer
+            .iter()
+            .map(|p| geo::coord! {x: p[0], y: p[1]})
+            .collect();
+        ring.push(geo::coord! {x: 0.0, y: zb});
+        let section = geo::Polygon::new(geo::LineString::new(ring), vec![]);
         let mut least = f64::INFINITY;
         for p in self.polyline(zb, 0.0, tol).points {
-            if p[1] > zb && !inside(p) {
+            if p[1] > zb && p[0] > 0.0 && !section.contains(&geo::point! {x: p[0], y: p[1]}) {
                 return 0.0;
             }
             for w in outer.windows(2) {
-                let (a, b) = (w[0], w[1]);
-                let ab = [b[0] - a[0], b[1] - a[1]];
-                let len2 = ab[0] * ab[0] + ab[1] * ab[1];
-                let u = if len2 > 0.0 {
-                    (((p[0] - a[0]) * ab[0] + (p[1] - a[1]) * ab[1]) / len2).clamp(0.0, 1.0)
-                } else {
-                    0.0
-                };
-                least = least.min((p[0] - a[0] - u * ab[0]).hypot(p[1] - a[1] - u * ab[1]));
+                least = least.min(point_segment_distance(p, w[0], w[1]));
             }
         }
         least
@@ -303,13 +287,7 @@ impl RecessOutline {
     pub fn distance_mm(&self, p: [f64; 2]) -> f64 {
         let t = self.draft_angle_deg.to_radians();
         // the wall: the segment from the mouth to the wall's top
-        let a = [self.mouth_radius_mm, 0.0];
-        let b = self.wall_top;
-        let ab = [b[0] - a[0], b[1] - a[1]];
-        let u = (((p[0] - a[0]) * ab[0] + (p[1] - a[1]) * ab[1])
-            / (ab[0] * ab[0] + ab[1] * ab[1]).max(1e-300))
-        .clamp(0.0, 1.0);
-        let wall = (p[0] - a[0] - u * ab[0]).hypot(p[1] - a[1] - u * ab[1]);
+        let wall = point_segment_distance(p, [self.mouth_radius_mm, 0.0], self.wall_top);
         let arc = |centre: [f64; 2], radius: f64, a0: f64, a1: f64| {
             let ang = (p[1] - centre[1]).atan2(p[0] - centre[0]);
             let (lo, hi) = (a0.min(a1), a0.max(a1));
