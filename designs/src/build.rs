@@ -564,9 +564,9 @@ fn treatments(
     let Some(l) = stack.layers.iter().find(|l| l.name == layer) else {
         return Vec::new();
     };
-    let report = |key: &str, surface: String, offset_mm: f64| {
+    let report = |key: &str, surface: String, area_mm2: f64| {
         let m = materials.get(key)?;
-        let area_cm2 = design.body.surface_area_mm2(offset_mm) / 100.0;
+        let area_cm2 = area_mm2 / 100.0;
         Some(crate::kit::TreatmentReport {
             material: key.to_string(),
             material_name: m.name.clone(),
@@ -586,7 +586,7 @@ fn treatments(
             out.extend(report(
                 p,
                 "the core's outer surface".into(),
-                l.inner_offset_mm,
+                design.body.surface_area_mm2(l.inner_offset_mm),
             ));
         }
     }
@@ -598,15 +598,22 @@ fn treatments(
         out.extend(report(
             rel,
             format!("the cavity of the {layer} mold"),
-            cavity,
+            design.body.surface_area_mm2(cavity),
         ));
+        if let Some(r) = crate::parts::recess::layer_recess(design, l.index) {
+            out.extend(report(
+                rel,
+                format!("the insert that forms the seat under {layer}"),
+                r.surface_area_mm2(),
+            ));
+        }
         if mold_parts.iter().any(|p| p.ends_with(":inner")) && !l.solid && !*inner_released {
             // later layers are cast onto the layers before them, which they must bond to
             *inner_released = true;
             out.extend(report(
                 rel,
                 format!("the inner silicone mold of {layer}"),
-                l.inner_offset_mm,
+                design.body.surface_area_mm2(l.inner_offset_mm),
             ));
         }
     }

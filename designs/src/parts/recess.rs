@@ -252,6 +252,26 @@ impl RecessOutline {
         wall + fillet + roof
     }
 
+    /// The area of the recess's surface above the base plane (wall, fillet and roof), mm^2,
+    /// from its exact outline: the wall a cone frustum, the roof a spherical zone, the fillet
+    /// the surface its arc sweeps (Pappus).
+    pub fn surface_area_mm2(&self) -> f64 {
+        use std::f64::consts::PI;
+        let (r0, [r1, h1]) = (self.mouth_radius_mm, self.wall_top);
+        let wall = PI * (r0 + r1) * (r0 - r1).hypot(h1);
+        let fillet = if self.fillet_radius_mm > 0.0 {
+            let (rc, rf) = (self.fillet_centre[0], self.fillet_radius_mm);
+            let a0 = self.draft_angle_deg.to_radians();
+            let a1 = (self.roof_edge[1] - self.fillet_centre[1])
+                .atan2(self.roof_edge[0] - self.fillet_centre[0]);
+            2.0 * PI * rf * (rc * (a1 - a0) + rf * (a1.sin() - a0.sin()))
+        } else {
+            0.0
+        };
+        let roof = 2.0 * PI * self.cap_radius_mm * (self.depth_mm - self.roof_edge[1]);
+        wall + fillet + roof
+    }
+
     /// The least thickness of skin between the recess and the outer surface, the body's offset
     /// surface at `outer_offset_mm`, mm, measured between their polylines at `tol` (so within
     /// `tol` of the exact figure); 0 when a point of the recess lies outside that surface.
@@ -529,6 +549,33 @@ mod tests {
             let p = [v[0].hypot(v[1]), v[2] + 8.5];
             assert!(o.distance_mm(p) < 1e-9, "{p:?}: {}", o.distance_mm(p));
         }
+    }
+
+    #[test]
+    fn the_surface_area_is_the_meshs() {
+        let o = pinki().outline().unwrap();
+        let tol = ChordTolerance::new(0.001).unwrap();
+        let mesh = o.solid(-8.5, 0.0, tol).unwrap().mesh().clone();
+        // the mesh's area less its flat base (the mouth's disc)
+        let mut area = 0.0;
+        for t in &mesh.triangles {
+            let [a, b, c] = t.map(|i| mesh.vertices[i as usize]);
+            if [a, b, c].iter().all(|v| v[2] == -8.5) {
+                continue;
+            }
+            let (u, v) = (
+                [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
+                [c[0] - a[0], c[1] - a[1], c[2] - a[2]],
+            );
+            let n = [
+                u[1] * v[2] - u[2] * v[1],
+                u[2] * v[0] - u[0] * v[2],
+                u[0] * v[1] - u[1] * v[0],
+            ];
+            area += 0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        }
+        let exact = o.surface_area_mm2();
+        assert!((area - exact).abs() / exact < 1e-3, "{area} {exact}");
     }
 
     #[test]
