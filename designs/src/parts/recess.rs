@@ -67,8 +67,9 @@ pub struct RecessOutline {
 }
 
 impl Recess {
-    /// The recess's outline, or the rule it breaks (for [`check_recess`]): `None` when a size
-    /// is not usable at all.
+    /// The recess's outline, or the field and the rule its sizes break together (for
+    /// [`check_recess`], which checks each size on its own first: above 0, the draft in
+    /// [0, 45) degrees).
     pub fn outline(&self) -> Result<RecessOutline, (&'static str, String)> {
         let r0 = self.base_diameter_mm / 2.0;
         let (d, cap, rf) = (self.depth_mm, self.cap_radius_mm, self.fillet_radius_mm);
