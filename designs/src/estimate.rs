@@ -73,7 +73,8 @@ pub fn estimate(design: &Design, stack: &Stack, tol: ChordTolerance) -> WorkEsti
             surfaces += surface_triangles(design, l.inner_offset_mm, tol);
         }
         if let Some(r) = crate::parts::recess::layer_recess(design, l.index) {
-            // the recess in the layer, in the mold's insert and in the mold's own layer
+            // the recess's surface three times: in the layer's part, its assembly member and
+            // the mold's insert
             let profile = r.polyline(0.0, 0.0, tol.half()).points.len() as f64;
             let around = tol
                 .half()

@@ -457,30 +457,13 @@ fn check_open_block(
     layers: &[ResolvedLayer],
     errs: &mut Vec<ParamError>,
 ) {
-    let b = &design.body;
     let open: Vec<_> = layers
         .iter()
         .filter(|l| l.process == LayerProcess::Cast && l.mold_strategy == MoldStrategy::Open)
+        .map(|l| crate::parts::molds::open_cavity_mm(design, l))
         .collect();
-    let rim = open
-        .iter()
-        .map(|l| b.rim_radius_mm(l.outer_offset_mm))
-        .fold(0.0, f64::max);
-    let height = open
-        .iter()
-        .map(|l| {
-            let raised = design.layers[l.index]
-                .markers
-                .iter()
-                .filter(|m| {
-                    m.surface == crate::markers::MarkerSurface::Outer
-                        && m.feature.side() == crate::markers::Polarity::Raised
-                })
-                .map(|m| m.feature.height_mm)
-                .fold(0.0, f64::max);
-            b.pole_z_mm(l.outer_offset_mm) + raised - b.base_z_mm()
-        })
-        .fold(0.0, f64::max);
+    let rim = open.iter().map(|c| c.0).fold(0.0, f64::max);
+    let height = open.iter().map(|c| c.1).fold(0.0, f64::max);
     let min_wall = design
         .printers
         .get(design.mold.cavity_print_technology)
@@ -659,15 +642,10 @@ fn check_with_stack(
         if let Some(block) = &design.mold.open_block {
             check_open_block(design, block, layers, errs);
         }
-    } else if design.mold.open_block.is_some() {
+    } else if let Some(b) = &design.mold.open_block {
         crate::parts::check_positive(
             "mold.open_block.",
-            &design
-                .mold
-                .open_block
-                .iter()
-                .flat_map(|b| [("width_mm", b.width_mm), ("height_mm", b.height_mm)])
-                .collect::<Vec<_>>(),
+            &[("width_mm", b.width_mm), ("height_mm", b.height_mm)],
             errs,
         );
     }

@@ -780,14 +780,18 @@ pub fn layer_stand_in(
     tol: ChordTolerance,
 ) -> Result<Solid, GeometryError> {
     let l = &stack.layers[i];
-    let mut shell = if l.solid {
+    let shell = if l.solid {
         solid_enclosed(design, l, &[], tol, false)?
     } else {
-        enclosed(design, l.outer_offset_mm, 0.0, &[], tol, false)?
+        enclosed(design, l.outer_offset_mm, 0.0, &[], tol, false)?.difference(&enclosed(
+            design,
+            l.inner_offset_mm,
+            1.0,
+            &[],
+            tol,
+            false,
+        )?)?
     };
-    if !l.solid {
-        shell = shell.difference(&enclosed(design, l.inner_offset_mm, 1.0, &[], tol, false)?)?;
-    }
     if features.grow.is_empty() {
         return Ok(shell);
     }

@@ -81,6 +81,26 @@ pub struct OpenBlock {
     pub height_mm: f64,
 }
 
+/// The cavity of layer `l` in an open mold, from the layer's parameters alone: its radius on
+/// the base plane and its height over it with the tallest raised feature of its outer surface,
+/// mm (what `mold.open_block` must hold, and its walls are measured from).
+pub fn open_cavity_mm(design: &Design, l: &crate::parts::context::ResolvedLayer) -> (f64, f64) {
+    let b = &design.body;
+    let raised = design.layers[l.index]
+        .markers
+        .iter()
+        .filter(|m| {
+            m.surface == crate::markers::MarkerSurface::Outer
+                && m.feature.side() == crate::markers::Polarity::Raised
+        })
+        .map(|m| m.feature.height_mm)
+        .fold(0.0, f64::max);
+    (
+        b.rim_radius_mm(l.outer_offset_mm),
+        b.pole_z_mm(l.outer_offset_mm) + raised - b.base_z_mm(),
+    )
+}
+
 impl OpenBlock {
     /// The rules of `mold.open_block`: given for an `open` mold only, sizes above 0, and a
     /// wall of at least `min_wall_mm` around a cavity of `rim_radius_mm` on the base plane

@@ -280,21 +280,13 @@ pub fn min_wall(
     let open_block = design.mold.open_block.as_ref();
     for l in stack.layers.iter().filter(cast) {
         if let (Some(ob), MoldStrategy::Open) = (open_block, l.mold_strategy) {
-            let raised = design.layers[l.index]
-                .markers
-                .iter()
-                .filter(|m| {
-                    m.surface == crate::markers::MarkerSurface::Outer
-                        && m.feature.side() == Polarity::Raised
-                })
-                .map(|m| m.feature.height_mm)
-                .fold(0.0, f64::max);
+            let (rim, height) = crate::parts::molds::open_cavity_mm(design, l);
             walls.push((
-                ob.width_mm / 2.0 - b.rim_radius_mm(l.outer_offset_mm),
+                ob.width_mm / 2.0 - rim,
                 "mold.open_block.width_mm: open mold's wall beside the cavity".into(),
             ));
             walls.push((
-                b.base_z_mm() + ob.height_mm - b.pole_z_mm(l.outer_offset_mm) - raised,
+                ob.height_mm - height,
                 "mold.open_block.height_mm: open mold's wall beyond the cavity".into(),
             ));
         }
