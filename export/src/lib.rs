@@ -47,7 +47,7 @@ pub use manifest::{
 };
 
 use fabkit_designs::assembly::{ExactShape, MemberKind};
-use fabkit_designs::geometry::{Mesh, TopologyError};
+use fabkit_designs::geometry::{Aabb, Mesh, TopologyError};
 use fabkit_designs::kit::Kit;
 use std::path::{Path, PathBuf};
 
@@ -323,12 +323,7 @@ fn step_files(
             kind: MemberKind::Bought,
             volume_mm3: mesh.signed_volume(),
             surface_area_mm2: mesh.surface_area(),
-            bbox_mm: mesh
-                .bounding_box()
-                .ok_or_else(|| ExportError::NotManifold {
-                    part: m.name.clone(),
-                    source: TopologyError::Empty,
-                })?,
+            bbox_mm: bbox_of(&m.name, mesh)?,
             shells: mesh.shell_count(),
             source: step::StepSource::Exact(&m.exact),
         });
@@ -365,12 +360,7 @@ fn step_files(
             ),
             (None, None) => (step::StepSource::Mesh(mesh), StepGeometry::SewnMesh),
         };
-        let bbox_mm = mesh
-            .bounding_box()
-            .ok_or_else(|| ExportError::NotManifold {
-                part: m.name.clone(),
-                source: TopologyError::Empty,
-            })?;
+        let bbox_mm = bbox_of(&m.name, mesh)?;
         let (volume_mm3, surface_area_mm2) = (mesh.signed_volume(), mesh.surface_area());
         let shells = mesh.shell_count();
         members.push(step::StepMember {
@@ -427,12 +417,7 @@ fn assembly_3mf(
             kind: m.kind,
             description: m.description.clone(),
             volume_mm3: mesh.signed_volume(),
-            bbox_mm: mesh
-                .bounding_box()
-                .ok_or_else(|| ExportError::NotManifold {
-                    part: m.name.clone(),
-                    source: TopologyError::Empty,
-                })?,
+            bbox_mm: bbox_of(&m.name, mesh)?,
         });
     }
     let objects: Vec<three_mf::Object<'_>> = kit
@@ -530,6 +515,17 @@ struct Rendered {
     manifest: Manifest,
 }
 
+/// The bounding box of `mesh`, the mesh of part or member `name`, mm.
+///
+/// # Errors
+/// [`ExportError::NotManifold`] for a mesh without vertices.
+fn bbox_of(name: &str, mesh: &Mesh) -> Result<Aabb, ExportError> {
+    mesh.bounding_box().ok_or_else(|| ExportError::NotManifold {
+        part: name.to_string(),
+        source: TopologyError::Empty,
+    })
+}
+
 /// The manifest's numbers of `part` whose written mesh ([`fabkit_designs::Part::written_mesh`])
 /// is `mesh`: volume (mm³), mass (g, from the density in `materials`; 0 when absent), surface
 /// area (mm²), bounding box (mm, print orientation), vertex and triangle counts, genus, and the
@@ -543,12 +539,7 @@ pub fn part_entry(
     mesh: &Mesh,
     materials: Option<&fabkit_designs::materials::MaterialsTable>,
 ) -> Result<ManifestPart, ExportError> {
-    let bbox = mesh
-        .bounding_box()
-        .ok_or_else(|| ExportError::NotManifold {
-            part: part.name.clone(),
-            source: TopologyError::Empty,
-        })?;
+    let bbox = bbox_of(&part.name, mesh)?;
     Ok(ManifestPart {
         name: part.name.clone(),
         file: None,
@@ -954,12 +945,7 @@ fn render(
     for m in &kit.machined_parts {
         let mesh = m.solid.mesh().rounded_to_f32();
         check_printable_mesh(&m.name, &mesh)?;
-        let bbox = mesh
-            .bounding_box()
-            .ok_or_else(|| ExportError::NotManifold {
-                part: m.name.clone(),
-                source: TopologyError::Empty,
-            })?;
+        let bbox = bbox_of(&m.name, &mesh)?;
         let drawing = format!("{MACHINED_DIR}/{}.svg", m.name);
         let drawing_bytes = two_d::drawing_svg(&m.drawing).into_bytes();
         let (file, sha256) = stl_file(kit, opts, MACHINED_DIR, &m.name, &mesh, &mut files)?;
