@@ -218,7 +218,8 @@ pub enum StepGeometry {
     RevolvedProfile,
     /// An exact cylinder, ring or box (a bought part's envelope).
     ExactEnvelope,
-    /// The member's mesh, its triangles sewn by OCCT into a closed shell (faceted).
+    /// The member's mesh, one planar OCCT face per triangle, joined at the mesh's shared edges
+    /// into closed shells (faceted).
     SewnMesh,
 }
 

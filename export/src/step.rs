@@ -187,7 +187,8 @@ pub enum StepSource<'a> {
     Part(&'a str),
     /// An exact shape in the sensor frame.
     Exact(&'a ExactShape),
-    /// A mesh in the sensor frame (a closed 2-manifold), sewn into a solid by OCCT.
+    /// A mesh in the sensor frame (a closed 2-manifold): one planar face per triangle, joined at
+    /// the shared edges into a solid.
     Mesh(&'a Mesh),
 }
 
