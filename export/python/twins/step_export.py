@@ -171,9 +171,9 @@ def sewn_mesh(mesh: dict):
         return i
 
     for a, b, c in triangles:
-        ra, rb, rc = root(a), root(b), root(c)
-        parent[rb] = ra
-        parent[root(rc)] = ra
+        ra = root(a)
+        parent[root(b)] = ra
+        parent[root(c)] = ra
     builder = BRep_Builder()
     shells = {}
     for a, b, c in triangles:
