@@ -331,7 +331,11 @@ fn settle(key: Option<[u8; 32]>, passed: bool) {
 /// [`printcheck_all`] with extra printcheck flags (e.g. `--no-fdm` for resin and PolyJet parts).
 pub fn printcheck_all_with(files: &[PathBuf], flags: &'static [&'static str]) {
     let Some(pc) = printcheck() else {
-        return missing("printcheck (prusa-slicer + admesh)");
+        return missing(&format!(
+            "printcheck (prusa-slicer on PATH, and $FABKIT_PRINTCHECK or {}: the shared/ folder \
+             cloned beside the repository)",
+            repo_root().join("../shared/tools/printcheck").display()
+        ));
     };
     let jobs: Vec<Job> = files
         .iter()
