@@ -169,10 +169,7 @@ pub fn pour(
     cavity_volume_mm3: f64,
     waste_allowance: f64,
 ) -> Result<CastReport, String> {
-    let mix = material
-        .mix
-        .as_ref()
-        .ok_or_else(|| format!("material '{material_key}' has no mix ratio: it cannot be cast"))?;
+    let mix = mix_of(material_key, material).map_err(|e| format!("{e}: it cannot be cast"))?;
     let volume_ml = cavity_volume_mm3 / 1000.0;
     let total = volume_ml * material.density_g_per_cm3 * (1.0 + waste_allowance);
     let by_volume = matches!(mix.by, MixBasis::Volume);
@@ -239,10 +236,7 @@ pub fn coat(
     thickness_mm: f64,
     coat_volume_mm3: f64,
 ) -> Result<CoatReport, String> {
-    let mix = material
-        .mix
-        .as_ref()
-        .ok_or_else(|| format!("material '{material_key}' has no mix ratio"))?;
+    let mix = mix_of(material_key, material)?;
     let coat_g = coat_volume_mm3 / 1000.0 * material.density_g_per_cm3;
     let sum: f64 = mix.ratio.iter().sum();
     let staying: f64 = mix
@@ -267,6 +261,14 @@ pub fn coat(
         components,
         total_mass_g: total,
     })
+}
+
+/// The mix of `material` (key `material_key`), or the error that it has none.
+fn mix_of<'m>(material_key: &str, material: &'m Material) -> Result<&'m Mix, String> {
+    material
+        .mix
+        .as_ref()
+        .ok_or_else(|| format!("material '{material_key}' has no mix ratio"))
 }
 
 /// `total_g` (and `total_ml`, for a mix by volume) split over the components of `mix` in its

@@ -368,6 +368,20 @@ fn paths_where<T: Serialize + ?Sized>(
     Ok(out)
 }
 
+/// The value at `path` in a serialized value, through options and newtypes; `None` when the
+/// path leads nowhere.
+fn at_path_mut<'a>(v: &'a mut Value, path: &[Step]) -> Option<&'a mut Value> {
+    let Some((first, rest)) = path.split_first() else {
+        return Some(v);
+    };
+    match (first, v) {
+        (_, Value::Option(Some(x))) | (_, Value::Newtype(x)) => at_path_mut(x, path),
+        (Step::Key(k), Value::Map(m)) => at_path_mut(m.get_mut(&Value::String(k.clone()))?, rest),
+        (Step::Index(i), Value::Seq(items)) => at_path_mut(items.get_mut(*i)?, rest),
+        _ => None,
+    }
+}
+
 /// `value` with the number at `path` (from [`number_paths`]) set to `x`, any `f64` (NaN
 /// included), read back through the type's own deserializer.
 ///
@@ -378,19 +392,8 @@ pub fn with_number<T: Serialize + serde::de::DeserializeOwned>(
     path: &NumberPath,
     x: f64,
 ) -> Result<T, String> {
-    fn leaf<'a>(v: &'a mut Value, path: &[Step]) -> Option<&'a mut Value> {
-        let Some((first, rest)) = path.split_first() else {
-            return Some(v);
-        };
-        match (first, v) {
-            (_, Value::Option(Some(x))) | (_, Value::Newtype(x)) => leaf(x, path),
-            (Step::Key(k), Value::Map(m)) => leaf(m.get_mut(&Value::String(k.clone()))?, rest),
-            (Step::Index(i), Value::Seq(items)) => leaf(items.get_mut(*i)?, rest),
-            _ => None,
-        }
-    }
     let mut v = serde_value::to_value(value).map_err(|e| e.to_string())?;
-    *leaf(&mut v, &path.0).ok_or_else(|| format!("no number at {path}"))? = Value::F64(x);
+    *at_path_mut(&mut v, &path.0).ok_or_else(|| format!("no number at {path}"))? = Value::F64(x);
     T::deserialize(v).map_err(|e| e.to_string())
 }
 
@@ -432,19 +435,8 @@ impl NumberPath {
 /// The value at `path` in `value`'s serialized form (NaN kept); `None` when the path leads
 /// nowhere. An optional field that is unset reads as `Value::Option(None)`.
 pub fn value_at_path<T: Serialize>(value: &T, path: &NumberPath) -> Option<Value> {
-    fn find<'a>(v: &'a Value, path: &[Step]) -> Option<&'a Value> {
-        let Some((first, rest)) = path.split_first() else {
-            return Some(v);
-        };
-        match (first, v) {
-            (_, Value::Option(Some(x))) | (_, Value::Newtype(x)) => find(x, path),
-            (Step::Key(k), Value::Map(m)) => find(m.get(&Value::String(k.clone()))?, rest),
-            (Step::Index(i), Value::Seq(items)) => find(items.get(*i)?, rest),
-            _ => None,
-        }
-    }
-    let v = serde_value::to_value(value).ok()?;
-    find(&v, &path.0).cloned()
+    let mut v = serde_value::to_value(value).ok()?;
+    at_path_mut(&mut v, &path.0).cloned()
 }
 
 /// `value` with the value at `path` replaced by `new` (any value: NaN kept, a list, a whole

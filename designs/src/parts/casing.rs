@@ -33,7 +33,7 @@ use crate::materials::MaterialKind;
 use crate::optics::{ring_of_lights, Light};
 use crate::parts::context::Context;
 use crate::parts::context::Stack;
-use crate::parts::family::{named, AssemblyStep, Built, Family};
+use crate::parts::family::{named, AssemblyStep, Built, Family, FamilyInput};
 use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::shaft_body::{half_nozzle, OVERLAP_MM};
 use crate::parts::z_cylinder;
@@ -1015,27 +1015,18 @@ impl Family for CasingFamily {
         )
     }
 
-    fn estimated_triangles(
-        c: &CasingParams,
-        _ctx: &Context<'_>,
-        _stack: &Stack,
-        tol: ChordTolerance,
-    ) -> f64 {
+    fn estimated_triangles(c: &CasingParams, input: FamilyInput<'_>) -> f64 {
         // the casing's and the gripper base's holes, bores and pockets: about 36 circles of
         // the casing's half-width
-        36.0 * tol.circle_segments(c.outer_width_mm / 2.0) as f64
+        36.0 * input.tol.circle_segments(c.outer_width_mm / 2.0) as f64
     }
 
     fn check(c: &CasingParams, ctx: &Context<'_>, _stack: &Stack, errs: &mut Vec<ParamError>) {
         check_params(ctx, c, errs);
     }
 
-    fn build(
-        c: &CasingParams,
-        ctx: &Context<'_>,
-        _stack: &Stack,
-        tol: ChordTolerance,
-    ) -> Result<Built, DesignError> {
+    fn build(c: &CasingParams, input: FamilyInput<'_>) -> Result<Built, DesignError> {
+        let FamilyInput { ctx, tol, .. } = input;
         let mut parts = vec![build_casing(ctx, c, tol)?];
         if let Some(g) = &c.gripper_base {
             parts.push(build_base(ctx, c, g, tol)?);
@@ -1066,13 +1057,8 @@ impl Family for CasingFamily {
         Ok(Built { parts, summary })
     }
 
-    fn members(
-        c: &CasingParams,
-        ctx: &Context<'_>,
-        _stack: &Stack,
-        tol: ChordTolerance,
-    ) -> Result<Vec<Member>, DesignError> {
-        members(ctx, c, tol)
+    fn members(c: &CasingParams, input: FamilyInput<'_>) -> Result<Vec<Member>, DesignError> {
+        members(input.ctx, c, input.tol)
     }
 
     fn bought_items(c: &CasingParams) -> Vec<String> {

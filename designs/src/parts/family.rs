@@ -74,6 +74,16 @@ pub enum AssemblyStep {
     Step(ProcedureStep),
 }
 
+/// What a family's build, members, paths and estimate see besides the family's own
+/// parameters: the design's [`Context`], the resolved [`Stack`] and the chord tolerance the
+/// solids are tessellated to.
+#[derive(Debug, Clone, Copy)]
+pub struct FamilyInput<'a> {
+    pub ctx: &'a Context<'a>,
+    pub stack: &'a Stack,
+    pub tol: ChordTolerance,
+}
+
 /// A section family: the parameters under [`Family::PATH`] and what they make. Every method
 /// takes the family's own parameters and the narrow context, never the whole design. A family
 /// is registered once, in [`crate::parts::registry::FAMILIES`].
@@ -106,24 +116,14 @@ pub trait Family {
     ///
     /// # Errors
     /// [`DesignError::Geometry`] naming the failing part if the kernel fails.
-    fn build(
-        p: &Self::Params,
-        ctx: &Context<'_>,
-        stack: &Stack,
-        tol: ChordTolerance,
-    ) -> Result<Built, DesignError>;
+    fn build(p: &Self::Params, input: FamilyInput<'_>) -> Result<Built, DesignError>;
 
     /// Its bought and cut members of the assembled sensor, in the sensor frame (its printed
     /// parts join the assembly from [`Family::build`] through their `T_print_sensor`).
     ///
     /// # Errors
     /// [`DesignError::Geometry`] if the kernel fails.
-    fn members(
-        _p: &Self::Params,
-        _ctx: &Context<'_>,
-        _stack: &Stack,
-        _tol: ChordTolerance,
-    ) -> Result<Vec<Member>, DesignError> {
+    fn members(_p: &Self::Params, _input: FamilyInput<'_>) -> Result<Vec<Member>, DesignError> {
         Ok(Vec::new())
     }
 
@@ -134,10 +134,8 @@ pub trait Family {
     /// [`DesignError::Geometry`] naming the filling gel if the kernel fails.
     fn filling_pour<'p>(
         _p: &'p Self::Params,
-        _ctx: &Context<'_>,
-        _stack: &Stack,
+        _input: FamilyInput<'_>,
         _cavity: InnerCavity<'_>,
-        _tol: ChordTolerance,
     ) -> Result<Option<FillingPour<'p>>, DesignError> {
         Ok(None)
     }
@@ -149,9 +147,7 @@ pub trait Family {
     /// [`DesignError::Geometry`] if the kernel fails.
     fn insertion_paths(
         _p: &Self::Params,
-        _ctx: &Context<'_>,
-        _stack: &Stack,
-        _tol: ChordTolerance,
+        _input: FamilyInput<'_>,
     ) -> Result<Vec<InsertionPath>, DesignError> {
         Ok(Vec::new())
     }
@@ -164,12 +160,7 @@ pub trait Family {
 
     /// About how many triangles its parts' surfaces make at `tol`, for the work bound checked
     /// before a build ([`crate::estimate::estimate`]).
-    fn estimated_triangles(
-        _p: &Self::Params,
-        _ctx: &Context<'_>,
-        _stack: &Stack,
-        _tol: ChordTolerance,
-    ) -> f64 {
+    fn estimated_triangles(_p: &Self::Params, _input: FamilyInput<'_>) -> f64 {
         0.0
     }
 

@@ -31,7 +31,7 @@ use crate::optics::{Light, DEFAULT_LED_INTENSITY};
 use crate::parts::context::Context;
 use crate::parts::context::Stack;
 use crate::parts::cut_part::{CutPart, Operation, Outline};
-use crate::parts::family::{AssemblyStep, Built, Family};
+use crate::parts::family::{AssemblyStep, Built, Family, FamilyInput};
 use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::shaft_body::OVERLAP_MM;
 use crate::parts::z_cylinder;
@@ -916,15 +916,10 @@ impl Family for FingertipBaseFamily {
             .collect()
     }
 
-    fn estimated_triangles(
-        f: &FingertipBase,
-        _ctx: &Context<'_>,
-        _stack: &Stack,
-        tol: ChordTolerance,
-    ) -> f64 {
+    fn estimated_triangles(f: &FingertipBase, input: FamilyInput<'_>) -> f64 {
         // the shell holder, sensor base, camera holder and diffusion ring: about 40 circles
         // of the base's outer radius
-        40.0 * tol.circle_segments(f.outer_diameter_mm / 2.0) as f64
+        40.0 * input.tol.circle_segments(f.outer_diameter_mm / 2.0) as f64
     }
 
     fn pcb_outlines(f: &FingertipBase) -> Vec<CutPart> {
@@ -964,12 +959,8 @@ impl Family for FingertipBaseFamily {
         check_params(ctx, f, stack, errs);
     }
 
-    fn build(
-        f: &FingertipBase,
-        ctx: &Context<'_>,
-        stack: &Stack,
-        tol: ChordTolerance,
-    ) -> Result<Built, DesignError> {
+    fn build(f: &FingertipBase, input: FamilyInput<'_>) -> Result<Built, DesignError> {
+        let FamilyInput { ctx, stack, tol } = input;
         let parts = build_parts(ctx, f, stack, tol)?;
         let lv = levels(ctx, f, stack);
         let w = f.outer_diameter_mm.max(2.0 * ctx.body.rim_radius_mm(0.0));
@@ -982,13 +973,8 @@ impl Family for FingertipBaseFamily {
         })
     }
 
-    fn members(
-        f: &FingertipBase,
-        ctx: &Context<'_>,
-        stack: &Stack,
-        tol: ChordTolerance,
-    ) -> Result<Vec<Member>, DesignError> {
-        members(ctx, f, stack, tol)
+    fn members(f: &FingertipBase, input: FamilyInput<'_>) -> Result<Vec<Member>, DesignError> {
+        members(input.ctx, f, input.stack, input.tol)
     }
 
     fn bought_items(f: &FingertipBase) -> Vec<String> {

@@ -1017,18 +1017,7 @@ struct LayerBuild<'a> {
 /// outermost layer of a design with a `shaft_body` the tip's fitting; all moved onto the
 /// plate by the same translation, and grouped when there is more than the skin. No pours.
 fn build_printed_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
-    let LayerBuild {
-        design,
-        stack,
-        i,
-        tol,
-        l,
-        name,
-        placed,
-        markers_json,
-        base_params,
-        ..
-    } = b;
+    let (design, stack, i, tol, l, name) = (b.design, b.stack, b.i, b.tol, b.l, &b.name);
     let spec_layer = &design.layers[i];
     let g = |r: Result<Solid, GeometryError>| r.part(&name);
     let skin = g(layer_solid(design, stack, i, tol))?;
@@ -1044,7 +1033,7 @@ fn build_printed_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
         )?),
         _ => None,
     };
-    let group = (placed.iter().any(|p| p.spec.tip_material.is_some()) || fitting.is_some())
+    let group = (b.placed.iter().any(|p| p.spec.tip_material.is_some()) || fitting.is_some())
         .then(|| name.clone());
     // Skin, tips and fitting move together onto the plate (same translation).
     let extent = match &fitting {
@@ -1069,10 +1058,10 @@ fn build_printed_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
         material: l.material.clone(),
         print_technology: tech,
         solid: skin.translate(shift),
-        params: with_pose(base_params.clone(), &pose),
+        params: with_pose(b.base_params.clone(), &pose),
         group: group.clone(),
     }];
-    for p in placed.iter().filter(|p| p.spec.tip_material.is_some()) {
+    for p in b.placed.iter().filter(|p| p.spec.tip_material.is_some()) {
         let tips = Solid::compose(&tip_solids(p, tol).part(&name)?);
         parts.push(Part {
             name: format!("{name}_tips"),
@@ -1084,7 +1073,7 @@ fn build_printed_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
             material: p.spec.tip_material.clone().unwrap_or_default(),
             print_technology: tech,
             solid: tips.translate(shift),
-            params: with_pose(base_params.clone(), &pose),
+            params: with_pose(b.base_params.clone(), &pose),
             group: group.clone(),
         });
     }
@@ -1108,7 +1097,7 @@ fn build_printed_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
     Ok(LayerOutput {
         parts,
         pours: vec![],
-        markers: markers_json,
+        markers: b.markers_json,
     })
 }
 
@@ -1117,24 +1106,15 @@ fn build_printed_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
 /// (the outer surface with its features), printed open face up; one pour of the layer's
 /// material, its volume block - mold, mm^3.
 fn build_open_mold_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
-    let LayerBuild {
-        design,
-        tol,
-        l,
-        name,
-        outer,
-        markers_json,
-        base_params,
-        cavity_tech,
-        ..
-    } = b;
+    let (design, tol, l, name, outer) = (b.design, b.tol, b.l, &b.name, &b.outer);
+    let (base_params, cavity_tech) = (&b.base_params, b.cavity_tech);
     let m = &design.mold;
     let g = |r: Result<Solid, GeometryError>| r.part(&name);
     // mold = (block - plain cavity) with the features cut or added: one boolean with
     // the features, and the skin's volume falls out as block - mold.
     let plain = g(body_solid(design, l.outer_offset_mm, 1.0, tol))?;
     let rim = design.body.rim_radius_mm(l.outer_offset_mm);
-    let top = features_top_z_mm(design, l.outer_offset_mm, &outer);
+    let top = features_top_z_mm(design, l.outer_offset_mm, outer);
     let zb = design.body.base_z_mm();
     let (half, z_top) = match &m.open_block {
         Some(ob) => (ob.width_mm / 2.0, zb + ob.height_mm),
@@ -1146,7 +1126,7 @@ fn build_open_mold_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
     ))?;
     let mold = g(block
         .difference(&plain)
-        .and_then(|b| apply_features_signed(b, &outer, tol, false, -1.0)))?;
+        .and_then(|b| apply_features_signed(b, outer, tol, false, -1.0)))?;
     // the optic's seat: an insert set in the open face forms it
     let recess = crate::parts::recess::layer_recess(design, l.index);
     let insert = recess
@@ -1196,7 +1176,7 @@ fn build_open_mold_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
     Ok(LayerOutput {
         parts,
         pours: vec![(name.clone(), l.material.clone(), skin_volume, pour_parts)],
-        markers: markers_json,
+        markers: b.markers_json,
     })
 }
 
@@ -1298,20 +1278,12 @@ fn two_piece_open_parts(
     top_piece: Solid,
     skin_volume: f64,
 ) -> LayerOutput {
-    let LayerBuild {
-        design,
-        l,
-        name,
-        markers_json,
-        base_params,
-        cavity_tech,
-        ..
-    } = b;
+    let (design, l, name, cavity_tech) = (b.design, b.l, &b.name, b.cavity_tech);
     let m = &design.mold;
     let zb = f.base_z_mm;
     let reservoir_mm3 = std::f64::consts::PI * f.reservoir_radius_mm.powi(2) * (zb - f.top_z_mm);
     let params = json!({
-        "base": base_params,
+        "base": b.base_params,
         "two_piece": m.two_piece,
         "frame": f,
         "cavity_block_z_mm": [f.parting_z_mm, z_far],
@@ -1364,7 +1336,7 @@ fn two_piece_open_parts(
     LayerOutput {
         parts,
         pours: vec![(name.clone(), l.material.clone(), skin_volume, pour_parts)],
-        markers: markers_json,
+        markers: b.markers_json,
     }
 }
 
@@ -1373,21 +1345,8 @@ fn two_piece_open_parts(
 /// inner negative (a cup whose cavity casts the inner silicone core); three pours: the outer
 /// and inner Mold Star 30 molds, then the layer's gel between them, mm^3.
 fn build_boundary_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
-    let LayerBuild {
-        design,
-        stack,
-        i,
-        tol,
-        l,
-        name,
-        outer,
-        inner,
-        markers_json,
-        base_params,
-        fixture_tech,
-        cavity_tech,
-        ..
-    } = b;
+    let (design, stack, i, tol, l, name) = (b.design, b.stack, b.i, b.tol, b.l, &b.name);
+    let (fixture_tech, cavity_tech) = (b.fixture_tech, b.cavity_tech);
     let m = &design.mold;
     let g = |r: Result<Solid, GeometryError>| r.part(&name);
     let zb = design.body.base_z_mm();
@@ -1410,7 +1369,7 @@ fn build_boundary_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
         pl.push(p);
     }
     let master_base = g(revolve(&pl, tol).and_then(|mesh| Solid::from_mesh(&mesh)))?;
-    let master = g(apply_features(master_base, &outer, tol, false))?;
+    let master = g(apply_features(master_base, &b.outer, tol, false))?;
     let pole = master.bounding_box().map(|b| b.max[2]).unwrap_or(0.0);
     let (mold_box, fill) =
         crate::parts::molds::drafted_box(design, r_p, z_lo, pole, tol).part(&name)?;
@@ -1428,7 +1387,7 @@ fn build_boundary_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
     };
     let core_pos = g(revolve(&inner_pl, tol)
         .and_then(|mesh| Solid::from_mesh(&mesh))
-        .and_then(|s| apply_features(s, &inner, tol, false)))?;
+        .and_then(|s| apply_features(s, &b.inner, tol, false)))?;
     let top = core_pos.bounding_box().map(|b| b.max[2]).unwrap_or(0.0) + BOUNDARY_CUP_FLOOR_MM;
     let cup_r = r_p + BOUNDARY_CUP_WALL_MM;
     let cup =
@@ -1457,7 +1416,7 @@ fn build_boundary_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
         print_technology: tech,
         solid,
         params: with_pose(
-            json!({"base": base_params, "plinth_radius_mm": r_p, "plinth_height_mm": m.plinth.height_mm, "fit_clearance_mm": fit, "draft_angle_deg": m.draft_angle_deg, "silicone_wall_mm": m.silicone_wall_mm, "boundary": boundary}),
+            json!({"base": b.base_params, "plinth_radius_mm": r_p, "plinth_height_mm": m.plinth.height_mm, "fit_clearance_mm": fit, "draft_angle_deg": m.draft_angle_deg, "silicone_wall_mm": m.silicone_wall_mm, "boundary": boundary}),
             &pose,
         ),
         group: None,
@@ -1493,7 +1452,7 @@ fn build_boundary_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
                 ],
             ),
         ],
-        markers: markers_json,
+        markers: b.markers_json,
     })
 }
 

@@ -962,19 +962,12 @@ fn direct_mold_parts(
     tol: ChordTolerance,
     c: CastMold,
 ) -> Result<MoldOutput, DesignError> {
-    let CastMold {
-        name,
-        f,
-        common,
-        holder_part,
-        pour_volume,
-        ..
-    } = c;
+    let (name, f) = (c.name, &c.f);
     let m = &design.mold;
     let cavity_tech: PrintTechnology = m.cavity_print_technology.into();
     let cavity_material = material_for(cavity_tech);
-    let ((a, pose_a), (b, pose_b)) = direct_halves(design, &f, cavity, tol).part(name)?;
-    let mut params = common.clone();
+    let ((a, pose_a), (b, pose_b)) = direct_halves(design, f, cavity, tol).part(name)?;
+    let mut params = c.common.clone();
     params["direct"] = json!({
         "parting_plane": "y = 0 (through the sensor axis)",
         "pull_direction": "+y for half a, -y for half b",
@@ -1001,12 +994,12 @@ fn direct_mold_parts(
     let parts = vec![
         half(a, pose_a, "a", "male"),
         half(b, pose_b, "b", "female"),
-        holder_part,
+        c.holder_part,
     ];
     let pour_parts = parts.iter().map(|p| p.name.clone()).collect();
     Ok(MoldOutput {
         parts,
-        pour_volume_mm3: pour_volume,
+        pour_volume_mm3: c.pour_volume,
         silicone_pour: None,
         pour_parts,
     })
@@ -1022,14 +1015,7 @@ fn master_mold_parts(
     tol: ChordTolerance,
     c: CastMold,
 ) -> Result<MoldOutput, DesignError> {
-    let CastMold {
-        name,
-        f,
-        common,
-        holder_name,
-        holder_part,
-        pour_volume,
-    } = c;
+    let (name, f) = (c.name, &c.f);
     let m = &design.mold;
     let cavity_tech: PrintTechnology = m.cavity_print_technology.into();
     let fixture_tech: PrintTechnology = m.fixture_print_technology.into();
@@ -1037,15 +1023,15 @@ fn master_mold_parts(
     let fixture_material = material_for(fixture_tech);
     let master = Solid::from_mesh(
         &revolve(
-            &cavity_profile(design, &f, plan.cavity_offset_mm, true, tol),
+            &cavity_profile(design, f, plan.cavity_offset_mm, true, tol),
             tol,
         )
         .part(name)?,
     )
     .part(name)?;
-    let (mold_box, fill) = master_box(design, &f, tol).part(name)?;
+    let (mold_box, fill) = master_box(design, f, tol).part(name)?;
     let silicone = fill.difference(&master).part(name)?.volume();
-    let mut params = common.clone();
+    let mut params = c.common.clone();
     params["master"] = json!({
         "silicone_wall_mm": m.silicone_wall_mm,
         "draft_angle_deg": m.draft_angle_deg,
@@ -1083,13 +1069,13 @@ fn master_mold_parts(
             params: with_pose(params, &box_pose),
             group: None,
         },
-        holder_part,
+        c.holder_part,
     ];
     Ok(MoldOutput {
         parts,
-        pour_volume_mm3: pour_volume,
+        pour_volume_mm3: c.pour_volume,
         silicone_pour: Some((silicone, vec![master_name, box_name])),
-        pour_parts: vec![format!("silicone_mold:{name}"), holder_name],
+        pour_parts: vec![format!("silicone_mold:{name}"), c.holder_name],
     })
 }
 

@@ -10,9 +10,11 @@ use crate::error::{DesignError, ParamError};
 use crate::geometry::ChordTolerance;
 use crate::materials::{CastReport, MaterialKind};
 use crate::optics::Light;
-use crate::parts::context::Stack;
+use crate::parts::context::{Context, Stack};
 use crate::parts::cut_part::CutPart;
-use crate::parts::family::{AssemblyStep, Built, Family, FillingPour, InnerCavity, InsertionPath};
+use crate::parts::family::{
+    AssemblyStep, Built, Family, FamilyInput, FillingPour, InnerCavity, InsertionPath,
+};
 use crate::parts::member::Member;
 use crate::parts::part::Part;
 use crate::parts::{casing, fingertip_base, housing, shaft_body, spacer};
@@ -90,11 +92,26 @@ pub trait Section: Sync {
     ) -> Vec<AssemblyStep>;
 }
 
+/// The input of a family's build-time methods.
+fn input<'a>(ctx: &'a Context<'a>, stack: &'a Stack, tol: ChordTolerance) -> FamilyInput<'a> {
+    FamilyInput { ctx, stack, tol }
+}
+
 /// A family `F` with where its parameters sit in a design.
 pub struct Registered<F: Family> {
     /// The family's parameters in a design, if given.
     pub params: fn(&Design) -> Option<&F::Params>,
     pub family: PhantomData<fn() -> F>,
+}
+
+impl<F: Family> Registered<F> {
+    /// The family `F` with its parameters at `params`.
+    pub const fn at(params: fn(&Design) -> Option<&F::Params>) -> Self {
+        Registered {
+            params,
+            family: PhantomData,
+        }
+    }
 }
 
 impl<F: Family> Section for Registered<F> {
@@ -118,7 +135,9 @@ impl<F: Family> Section for Registered<F> {
     }
 
     fn estimated_triangles(&self, d: &Design, stack: &Stack, tol: ChordTolerance) -> f64 {
-        (self.params)(d).map_or(0.0, |p| F::estimated_triangles(p, &d.context(), stack, tol))
+        (self.params)(d).map_or(0.0, |p| {
+            F::estimated_triangles(p, input(&d.context(), stack, tol))
+        })
     }
 
     fn cut_parts(&self, d: &Design) -> Vec<CutPart> {
@@ -149,7 +168,7 @@ impl<F: Family> Section for Registered<F> {
         tol: ChordTolerance,
     ) -> Result<Option<FillingPour<'d>>, DesignError> {
         match (self.params)(d) {
-            Some(p) => F::filling_pour(p, &d.context(), stack, cavity, tol),
+            Some(p) => F::filling_pour(p, input(&d.context(), stack, tol), cavity),
             None => Ok(None),
         }
     }
@@ -161,7 +180,7 @@ impl<F: Family> Section for Registered<F> {
         tol: ChordTolerance,
     ) -> Result<Vec<InsertionPath>, DesignError> {
         match (self.params)(d) {
-            Some(p) => F::insertion_paths(p, &d.context(), stack, tol),
+            Some(p) => F::insertion_paths(p, input(&d.context(), stack, tol)),
             None => Ok(Vec::new()),
         }
     }
@@ -172,7 +191,7 @@ impl<F: Family> Section for Registered<F> {
         stack: &Stack,
         tol: ChordTolerance,
     ) -> Option<Result<Built, DesignError>> {
-        (self.params)(d).map(|p| F::build(p, &d.context(), stack, tol))
+        (self.params)(d).map(|p| F::build(p, input(&d.context(), stack, tol)))
     }
 
     fn members(
@@ -182,7 +201,7 @@ impl<F: Family> Section for Registered<F> {
         tol: ChordTolerance,
     ) -> Result<Vec<Member>, DesignError> {
         match (self.params)(d) {
-            Some(p) => F::members(p, &d.context(), stack, tol),
+            Some(p) => F::members(p, input(&d.context(), stack, tol)),
             None => Ok(Vec::new()),
         }
     }
@@ -206,24 +225,9 @@ impl<F: Family> Section for Registered<F> {
 /// The section families, in the order their parts, summary entries, members, bought items and
 /// assembly steps appear in a kit.
 pub static FAMILIES: &[&dyn Section] = &[
-    &Registered::<housing::HousingFamily> {
-        params: |d| d.housing.as_ref(),
-        family: PhantomData,
-    },
-    &Registered::<shaft_body::ShaftBodyFamily> {
-        params: |d| d.shaft_body.as_ref(),
-        family: PhantomData,
-    },
-    &Registered::<casing::CasingFamily> {
-        params: |d| d.casing.as_ref(),
-        family: PhantomData,
-    },
-    &Registered::<fingertip_base::FingertipBaseFamily> {
-        params: |d| d.fingertip_base.as_ref(),
-        family: PhantomData,
-    },
-    &Registered::<spacer::SpacerFamily> {
-        params: |d| d.spacer.as_ref(),
-        family: PhantomData,
-    },
+    &Registered::<housing::HousingFamily>::at(|d| d.housing.as_ref()),
+    &Registered::<shaft_body::ShaftBodyFamily>::at(|d| d.shaft_body.as_ref()),
+    &Registered::<casing::CasingFamily>::at(|d| d.casing.as_ref()),
+    &Registered::<fingertip_base::FingertipBaseFamily>::at(|d| d.fingertip_base.as_ref()),
+    &Registered::<spacer::SpacerFamily>::at(|d| d.spacer.as_ref()),
 ];

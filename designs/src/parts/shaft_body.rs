@@ -36,7 +36,7 @@ use crate::parts::context::Context;
 use crate::parts::context::Stack;
 use crate::parts::cut_part::{CutPart, Operation, Outline};
 use crate::parts::family::{
-    named, AssemblyStep, Built, Family, FillingPour, InnerCavity, FILLING_GEL,
+    named, AssemblyStep, Built, Family, FamilyInput, FillingPour, InnerCavity, FILLING_GEL,
 };
 use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::{ProcedureAction, ProcedureStep};
@@ -1099,12 +1099,8 @@ impl Family for ShaftBodyFamily {
         )
     }
 
-    fn estimated_triangles(
-        sb: &ShaftBodyParams,
-        ctx: &Context<'_>,
-        stack: &Stack,
-        tol: ChordTolerance,
-    ) -> f64 {
+    fn estimated_triangles(sb: &ShaftBodyParams, input: FamilyInput<'_>) -> f64 {
+        let FamilyInput { ctx, stack, tol } = input;
         // the body's and the fitting's cylinders, seats and bayonet bands: about 30 and 27
         // circles of their outer radius
         let r = radii(ctx, sb, stack);
@@ -1138,12 +1134,8 @@ impl Family for ShaftBodyFamily {
         check_params(ctx, sb, stack, errs);
     }
 
-    fn build(
-        sb: &ShaftBodyParams,
-        ctx: &Context<'_>,
-        stack: &Stack,
-        tol: ChordTolerance,
-    ) -> Result<Built, DesignError> {
+    fn build(sb: &ShaftBodyParams, input: FamilyInput<'_>) -> Result<Built, DesignError> {
+        let FamilyInput { ctx, stack, tol } = input;
         let mut parts = vec![build_body(ctx, sb, stack, tol)?];
         if let Some(m) = &sb.robot_mount {
             parts.push(crate::parts::robot_mount::build_mount(ctx, sb, m, tol)?);
@@ -1168,13 +1160,8 @@ impl Family for ShaftBodyFamily {
         })
     }
 
-    fn members(
-        sb: &ShaftBodyParams,
-        ctx: &Context<'_>,
-        _stack: &Stack,
-        tol: ChordTolerance,
-    ) -> Result<Vec<Member>, DesignError> {
-        members(ctx, sb, tol)
+    fn members(sb: &ShaftBodyParams, input: FamilyInput<'_>) -> Result<Vec<Member>, DesignError> {
+        members(input.ctx, sb, input.tol)
     }
 
     fn bought_items(sb: &ShaftBodyParams) -> Vec<String> {
@@ -1187,11 +1174,10 @@ impl Family for ShaftBodyFamily {
 
     fn filling_pour<'p>(
         sb: &'p ShaftBodyParams,
-        ctx: &Context<'_>,
-        stack: &Stack,
+        input: FamilyInput<'_>,
         cavity: InnerCavity<'_>,
-        tol: ChordTolerance,
     ) -> Result<Option<FillingPour<'p>>, DesignError> {
+        let FamilyInput { ctx, stack, tol } = input;
         // The clear gel between the skin and the lens window (Pestell et al. Sec. III-A).
         let Some(f) = &sb.filling_gel else {
             return Ok(None);

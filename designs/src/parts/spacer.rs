@@ -13,7 +13,7 @@ use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{ChordTolerance, GeometryError, Solid};
 use crate::materials::{CastReport, MaterialKind};
 use crate::parts::context::{Context, Stack};
-use crate::parts::family::{named, AssemblyStep, Built, Family};
+use crate::parts::family::{named, AssemblyStep, Built, Family, FamilyInput};
 use crate::parts::part::{Part, PrintTechnology};
 use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::{check_positive, z_cylinder};
@@ -111,12 +111,8 @@ impl Family for SpacerFamily {
         }
     }
 
-    fn build(
-        p: &SpacerParams,
-        ctx: &Context<'_>,
-        _stack: &Stack,
-        tol: ChordTolerance,
-    ) -> Result<Built, DesignError> {
+    fn build(p: &SpacerParams, input: FamilyInput<'_>) -> Result<Built, DesignError> {
+        let FamilyInput { ctx, tol, .. } = input;
         let ring = ring_solid(p, ctx, tol).part("spacer")?;
         let (placed, pose) = place_posed(&ring, &crate::geometry::Affine::identity());
         let zb = ctx.body.base_z_mm();

@@ -15,7 +15,8 @@ use crate::parts::axial_ring;
 use crate::parts::context::{Context, Stack};
 use crate::parts::cut_part::{CutPart, Operation, Outline};
 use crate::parts::family::{
-    named, AssemblyStep, Built, Family, FillingPour, InnerCavity, InsertionPath, FILLING_GEL,
+    named, AssemblyStep, Built, Family, FamilyInput, FillingPour, InnerCavity, InsertionPath,
+    FILLING_GEL,
 };
 use crate::parts::fasteners::{metric_from_pilot, metric_name};
 use crate::parts::{ExactShape, Member, MemberKind, Part, ProcedureAction, ProcedureStep};
@@ -71,12 +72,8 @@ impl Family for HousingFamily {
         check_housing_params(ctx, h, None, errs);
     }
 
-    fn build(
-        h: &HousingParams,
-        ctx: &Context<'_>,
-        stack: &Stack,
-        tol: ChordTolerance,
-    ) -> Result<Built, DesignError> {
+    fn build(h: &HousingParams, input: FamilyInput<'_>) -> Result<Built, DesignError> {
+        let FamilyInput { ctx, stack, tol } = input;
         let (parts, levels) = build_shell(ctx, h, stack, tol)?;
         let w = h.outer_width_mm.max(2.0 * ctx.body.rim_radius_mm(0.0));
         Ok(Built {
@@ -88,12 +85,8 @@ impl Family for HousingFamily {
         })
     }
 
-    fn members(
-        h: &HousingParams,
-        ctx: &Context<'_>,
-        stack: &Stack,
-        tol: ChordTolerance,
-    ) -> Result<Vec<Member>, DesignError> {
+    fn members(h: &HousingParams, input: FamilyInput<'_>) -> Result<Vec<Member>, DesignError> {
+        let FamilyInput { ctx, stack, tol } = input;
         let Some(lv) = shell_levels(ctx, h, stack) else {
             return Ok(Vec::new());
         };
@@ -147,11 +140,10 @@ impl Family for HousingFamily {
 
     fn filling_pour<'p>(
         h: &'p HousingParams,
-        ctx: &Context<'_>,
-        stack: &Stack,
+        input: FamilyInput<'_>,
         _cavity: InnerCavity<'_>,
-        _tol: ChordTolerance,
     ) -> Result<Option<FillingPour<'p>>, DesignError> {
+        let FamilyInput { ctx, stack, .. } = input;
         let (Some(gel), Some(core)) = (&h.filling_gel, &stack.core) else {
             return Ok(None);
         };
@@ -167,11 +159,9 @@ impl Family for HousingFamily {
 
     fn insertion_paths(
         h: &HousingParams,
-        ctx: &Context<'_>,
-        stack: &Stack,
-        tol: ChordTolerance,
+        input: FamilyInput<'_>,
     ) -> Result<Vec<InsertionPath>, DesignError> {
-        insertion_paths(h, ctx, stack, tol)
+        insertion_paths(h, input.ctx, input.stack, input.tol)
     }
 
     fn cut_parts(h: &HousingParams) -> Vec<CutPart> {
@@ -224,7 +214,6 @@ fn bought_envelopes(
     tol: ChordTolerance,
 ) -> Result<Vec<Member>, DesignError> {
     type Exact = Result<(Solid, ExactShape), GeometryError>;
-    let ring = |ro: f64, ri: f64, z0: f64, z1: f64| axial_ring(ro, ri, z0, z1, tol);
     let block = |min_mm: [f64; 3], max_mm: [f64; 3]| -> Exact {
         Ok((cuboid(min_mm, max_mm)?, ExactShape::Box { min_mm, max_mm }))
     };
@@ -236,25 +225,28 @@ fn bought_envelopes(
             fix,
         ))
     };
+    // a board's envelope: diameters [outer, inner] and [bottom z, thickness], mm; sized by
+    // `housing.<key>`'s outer diameter and thickness
+    let annulus = |name: &str, description: String, key: &str, d: [f64; 2], z: [f64; 2]| {
+        let fix = [
+            format!("housing.{key}.outer_diameter_mm"),
+            format!("housing.{key}.thickness_mm"),
+        ];
+        let r = axial_ring(d[0] / 2.0, d[1] / 2.0, z[0], z[0] + z[1], tol);
+        bought(name, description, r, &[fix[0].as_str(), fix[1].as_str()])
+    };
     let bw = h.camera.board_width_mm / 2.0;
     let (z0, z1) = match (h.style, lv.base_top_z_mm) {
         (HousingStyle::RoundTube, Some(top)) => (top, top + h.camera.bay_height_mm),
         _ => (lv.bulkhead_z_mm - h.camera.bay_height_mm, lv.bulkhead_z_mm),
     };
     Ok(vec![
-        bought(
+        annulus(
             "led_pcb_envelope",
             format!("LED ring PCB (bought), {} LEDs", h.led_pcb.led_count),
-            ring(
-                h.led_pcb.outer_diameter_mm / 2.0,
-                h.led_pcb.inner_diameter_mm / 2.0,
-                lv.pcb_z_mm,
-                lv.pcb_z_mm + h.led_pcb.thickness_mm,
-            ),
-            &[
-                "housing.led_pcb.outer_diameter_mm",
-                "housing.led_pcb.thickness_mm",
-            ],
+            "led_pcb",
+            [h.led_pcb.outer_diameter_mm, h.led_pcb.inner_diameter_mm],
+            [lv.pcb_z_mm, h.led_pcb.thickness_mm],
         )?,
         // after the LED PCB: an overlap names the later member's parameters first, and the
         // board's height is what a board that reaches the PCB needs changed
@@ -270,19 +262,12 @@ fn bought_envelopes(
                 "housing.camera.board_width_mm",
             ],
         )?,
-        bought(
+        annulus(
             "diffuser_envelope",
             "Diffuser ring (laser-cut acrylic)".into(),
-            ring(
-                h.diffuser.outer_diameter_mm / 2.0,
-                h.diffuser.inner_diameter_mm / 2.0,
-                lv.diffuser_z_mm,
-                lv.diffuser_z_mm + h.diffuser.thickness_mm,
-            ),
-            &[
-                "housing.diffuser.outer_diameter_mm",
-                "housing.diffuser.thickness_mm",
-            ],
+            "diffuser",
+            [h.diffuser.outer_diameter_mm, h.diffuser.inner_diameter_mm],
+            [lv.diffuser_z_mm, h.diffuser.thickness_mm],
         )?,
     ])
 }
