@@ -9,7 +9,7 @@ use crate::kit::Kit;
 use crate::materials::{pour, MaterialsTable};
 use crate::parts::family::FillingPour;
 use crate::parts::molds::{build_mold, cast_plans};
-use crate::parts::registry::FAMILIES;
+use crate::parts::registry::{SectionInput, FAMILIES};
 use crate::schema::{Design, LayerProcess, MoldStrategy};
 use crate::stack::{validate, Stack};
 use crate::timings;
@@ -128,6 +128,11 @@ pub fn build_kit_scoped(
         .filter(|p| matches!(p.strategy, MoldStrategy::Direct | MoldStrategy::Master))
         .cloned()
         .collect();
+    let at = SectionInput {
+        design,
+        stack: &stack,
+        tol,
+    };
     // The assembly's members that come from no part (the cast layers, the core's and backing's
     // envelopes, the families' bought and cut members) and the filling gels' pours build
     // alongside the parts.
@@ -149,12 +154,7 @@ pub fn build_kit_scoped(
                         },
                     )
                 },
-                || {
-                    FAMILIES
-                        .par_iter()
-                        .map(|f| f.build(design, &stack, tol))
-                        .collect::<Vec<_>>()
-                },
+                || FAMILIES.par_iter().map(|f| f.build(at)).collect::<Vec<_>>(),
             )
         },
         || {
@@ -164,7 +164,7 @@ pub fn build_kit_scoped(
                     || {
                         FAMILIES
                             .par_iter()
-                            .map(|f| f.members(design, &stack, tol))
+                            .map(|f| f.members(at))
                             .collect::<Vec<_>>()
                     },
                 )
@@ -173,7 +173,7 @@ pub fn build_kit_scoped(
                 let cavity = |i: usize| crate::parts::layers::inner_cavity(design, &stack, i, tol);
                 FAMILIES
                     .iter()
-                    .map(|f| f.filling_pour(design, &stack, &cavity, tol))
+                    .map(|f| f.filling_pour(at, &cavity))
                     .collect::<Vec<_>>()
             };
             rayon::join(members, fillings)

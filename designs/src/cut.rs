@@ -12,10 +12,6 @@ use crate::parts::registry::FAMILIES;
 /// The laser-cut parts of a design: every family's ([`crate::parts::family::Family::cut_parts`]:
 /// the housing's diffuser ring, the shaft body's lens window ...), then the backing plate.
 pub fn cut_parts(design: &Design) -> Vec<CutPart> {
-    let circle = |r: f64| Outline::Circle {
-        centre_mm: [0.0, 0.0],
-        radius_mm: r,
-    };
     let mut out = Vec::new();
     for f in FAMILIES {
         out.extend(f.cut_parts(design));
@@ -29,7 +25,7 @@ pub fn cut_parts(design: &Design) -> Vec<CutPart> {
             ),
             material: b.material.clone(),
             thickness_mm: b.thickness_mm,
-            outlines: vec![(Operation::Cut, circle(b.diameter_mm / 2.0))],
+            outlines: vec![(Operation::Cut, Outline::centred_circle(b.diameter_mm / 2.0))],
             kerf_mm: 0.0,
             quantity: 1,
             nominal_rings_mm: None,

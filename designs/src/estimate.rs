@@ -11,7 +11,7 @@ use crate::error::DesignError;
 use crate::geometry::ChordTolerance;
 use crate::parts::context::Stack;
 use crate::parts::layers::count_layer_markers;
-use crate::parts::registry::FAMILIES;
+use crate::parts::registry::{SectionInput, FAMILIES};
 use crate::schema::Design;
 
 /// Default bound on the estimated triangles of one build: 4,000,000 (about 4 GB of peak memory;
@@ -101,7 +101,7 @@ pub fn estimate(design: &Design, stack: &Stack, tol: ChordTolerance) -> WorkEsti
         surfaces += surface_triangles(design, c.inner_offset_mm, tol);
     }
     for f in FAMILIES {
-        surfaces += f.estimated_triangles(design, stack, tol);
+        surfaces += f.estimated_triangles(SectionInput { design, stack, tol });
     }
     let (mut markers, mut feature_tris) = (0u64, 0.0);
     for l in &stack.layers {

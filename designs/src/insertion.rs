@@ -13,7 +13,7 @@ use crate::assembly::{Interference, Member, MIN_OVERLAP_MM3};
 use crate::error::{DesignError, GeometryContext};
 use crate::geometry::ChordTolerance;
 use crate::parts::context::Stack;
-use crate::parts::registry::FAMILIES;
+use crate::parts::registry::{SectionInput, FAMILIES};
 use crate::schema::Design;
 
 pub use crate::parts::family::InsertionPath;
@@ -31,7 +31,7 @@ pub fn paths(
 ) -> Result<Vec<InsertionPath>, DesignError> {
     let mut out = Vec::new();
     for f in FAMILIES {
-        out.extend(f.insertion_paths(design, stack, tol)?);
+        out.extend(f.insertion_paths(SectionInput { design, stack, tol })?);
     }
     Ok(out)
 }

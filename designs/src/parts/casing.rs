@@ -28,12 +28,11 @@ use super::{ExactShape, Member, MemberKind};
 use super::{Part, PrintTechnology};
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{cuboid, ChordTolerance, GeometryError, Solid};
-use crate::materials::CastReport;
 use crate::materials::MaterialKind;
 use crate::optics::{ring_of_lights, Light};
 use crate::parts::context::Context;
 use crate::parts::context::Stack;
-use crate::parts::family::{named, AssemblyStep, Built, Family, FamilyInput};
+use crate::parts::family::{named, AssemblyInput, AssemblyStep, Built, Family, FamilyInput};
 use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::shaft_body::{half_nozzle, OVERLAP_MM};
 use crate::parts::z_cylinder;
@@ -1065,12 +1064,8 @@ impl Family for CasingFamily {
         bought_items(c)
     }
 
-    fn assembly_steps(
-        c: &CasingParams,
-        _ctx: &Context<'_>,
-        parts: &[Part],
-        _filling: Option<&CastReport>,
-    ) -> Vec<AssemblyStep> {
+    fn assembly_steps(c: &CasingParams, input: AssemblyInput<'_>) -> Vec<AssemblyStep> {
+        let AssemblyInput { parts, .. } = input;
         let mut out = Vec::new();
         let casing = named(parts, "casing")
             .first()

@@ -25,6 +25,14 @@ pub enum Outline {
 }
 
 impl Outline {
+    /// A circle of radius `radius_mm` on the sensor axis (centre (0, 0)), mm.
+    pub fn centred_circle(radius_mm: f64) -> Outline {
+        Outline::Circle {
+            centre_mm: [0.0, 0.0],
+            radius_mm,
+        }
+    }
+
     /// Enclosed area, mm^2 (unsigned).
     pub fn area_mm2(&self) -> f64 {
         match self {

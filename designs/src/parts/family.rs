@@ -64,6 +64,17 @@ pub struct Built {
     pub summary: Vec<(&'static str, serde_json::Value)>,
 }
 
+/// The manifest's `envelope_mm` summary entry of a family whose parts stand round the axis:
+/// `[w, w, height_mm]`, `w` the larger of its outer width and the skin's rim diameter, mm.
+pub fn envelope(
+    ctx: &Context<'_>,
+    outer_width_mm: f64,
+    height_mm: f64,
+) -> (&'static str, serde_json::Value) {
+    let w = outer_width_mm.max(2.0 * ctx.body.rim_radius_mm(0.0));
+    ("envelope_mm", serde_json::json!([w, w, height_mm]))
+}
+
 /// One assembly step of a family, in order: a sentence of the `Assemble` step, or a pour
 /// that goes in between (the filling gel poured once the parts before it are together).
 #[derive(Debug, Clone, PartialEq)]
@@ -82,6 +93,15 @@ pub struct FamilyInput<'a> {
     pub ctx: &'a Context<'a>,
     pub stack: &'a Stack,
     pub tol: ChordTolerance,
+}
+
+/// What a family's assembly steps see besides the family's own parameters: the design's
+/// [`Context`], the kit's parts (to name them) and the filling gel's pour if the kit has one.
+#[derive(Debug, Clone, Copy)]
+pub struct AssemblyInput<'a> {
+    pub ctx: &'a Context<'a>,
+    pub parts: &'a [Part],
+    pub filling: Option<&'a CastReport>,
 }
 
 /// A section family: the parameters under [`Family::PATH`] and what they make. Every method
@@ -179,14 +199,9 @@ pub trait Family {
         Vec::new()
     }
 
-    /// Its assembly steps, given the kit's parts (`parts`, to name them) and the filling gel's
-    /// pour if the kit has one.
-    fn assembly_steps(
-        _p: &Self::Params,
-        _ctx: &Context<'_>,
-        _parts: &[Part],
-        _filling: Option<&CastReport>,
-    ) -> Vec<AssemblyStep> {
+    /// Its assembly steps, given the kit's parts (to name them) and the filling gel's pour if
+    /// the kit has one ([`AssemblyInput`]).
+    fn assembly_steps(_p: &Self::Params, _input: AssemblyInput<'_>) -> Vec<AssemblyStep> {
         Vec::new()
     }
 }

@@ -25,13 +25,12 @@ use super::{axial_cylinder, axial_ring, Member, MemberKind};
 use super::{Part, PrintTechnology};
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{ChordTolerance, GeometryError, Solid};
-use crate::materials::CastReport;
 use crate::materials::MaterialKind;
 use crate::optics::{Light, DEFAULT_LED_INTENSITY};
 use crate::parts::context::Context;
 use crate::parts::context::Stack;
 use crate::parts::cut_part::{CutPart, Operation, Outline};
-use crate::parts::family::{AssemblyStep, Built, Family, FamilyInput};
+use crate::parts::family::{envelope, AssemblyInput, AssemblyStep, Built, Family, FamilyInput};
 use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::shaft_body::OVERLAP_MM;
 use crate::parts::z_cylinder;
@@ -569,12 +568,8 @@ fn z_ring(ri: f64, ro: f64, z0: f64, z1: f64, tol: ChordTolerance) -> Result<Sol
 ///
 /// # Errors
 /// [`DesignError::Geometry`] naming the part if the kernel fails.
-pub fn build_parts(
-    ctx: &Context<'_>,
-    f: &FingertipBase,
-    stack: &Stack,
-    tol: ChordTolerance,
-) -> Result<Vec<Part>, DesignError> {
+pub fn build_parts(f: &FingertipBase, input: FamilyInput<'_>) -> Result<Vec<Part>, DesignError> {
+    let FamilyInput { ctx, stack, tol } = input;
     let lv = levels(ctx, f, stack);
     let r = radii(ctx, f, stack);
     let b = &f.bolts;
@@ -774,12 +769,8 @@ fn build_diffusion_ring(
 ///
 /// # Errors
 /// [`DesignError::Geometry`] naming the member if the kernel fails.
-pub fn members(
-    ctx: &Context<'_>,
-    f: &FingertipBase,
-    stack: &Stack,
-    tol: ChordTolerance,
-) -> Result<Vec<Member>, DesignError> {
+pub fn members(f: &FingertipBase, input: FamilyInput<'_>) -> Result<Vec<Member>, DesignError> {
+    let FamilyInput { ctx, stack, tol } = input;
     let lv = levels(ctx, f, stack);
     let member =
         |name: &str, description: String, (ri, ro, z0, z1): (f64, f64, f64, f64), fix: &[&str]| {
@@ -960,33 +951,27 @@ impl Family for FingertipBaseFamily {
     }
 
     fn build(f: &FingertipBase, input: FamilyInput<'_>) -> Result<Built, DesignError> {
-        let FamilyInput { ctx, stack, tol } = input;
-        let parts = build_parts(ctx, f, stack, tol)?;
+        let FamilyInput { ctx, stack, .. } = input;
+        let parts = build_parts(f, input)?;
         let lv = levels(ctx, f, stack);
-        let w = f.outer_diameter_mm.max(2.0 * ctx.body.rim_radius_mm(0.0));
         Ok(Built {
             parts,
             summary: vec![
                 ("fingertip_levels", json!(&lv)),
-                ("envelope_mm", json!([w, w, lv.envelope_height_mm])),
+                envelope(ctx, f.outer_diameter_mm, lv.envelope_height_mm),
             ],
         })
     }
 
     fn members(f: &FingertipBase, input: FamilyInput<'_>) -> Result<Vec<Member>, DesignError> {
-        members(input.ctx, f, input.stack, input.tol)
+        members(f, input)
     }
 
     fn bought_items(f: &FingertipBase) -> Vec<String> {
         bought_items(f)
     }
 
-    fn assembly_steps(
-        f: &FingertipBase,
-        _ctx: &Context<'_>,
-        _parts: &[Part],
-        _filling: Option<&CastReport>,
-    ) -> Vec<AssemblyStep> {
+    fn assembly_steps(f: &FingertipBase, _input: AssemblyInput<'_>) -> Vec<AssemblyStep> {
         let mut out = Vec::new();
         out.push(AssemblyStep::Text(format!(
             "Glue the camera ({}) into `camera_holder` with instant adhesive, its front flush \

@@ -11,6 +11,7 @@ use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{revolve, ChordTolerance, GeometryError, Polyline2, Solid};
 use crate::markers::{self, Marker, MarkerSpec, MarkerSurface, PatternStats, Polarity, Surface};
 use crate::parts::context::{ResolvedLayer, Stack};
+use crate::parts::family::FamilyInput;
 use crate::parts::member::{FeatureKey, MemberFeatures};
 use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::{Part, PrintTechnology};
@@ -1019,7 +1020,7 @@ struct LayerBuild<'a> {
 fn build_printed_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
     let (design, stack, i, tol, l, name) = (b.design, b.stack, b.i, b.tol, b.l, &b.name);
     let spec_layer = &design.layers[i];
-    let g = |r: Result<Solid, GeometryError>| r.part(&name);
+    let g = |r: Result<Solid, GeometryError>| r.part(name);
     let skin = g(layer_solid(design, stack, i, tol))?;
     let tech: PrintTechnology = spec_layer
         .print_technology
@@ -1028,9 +1029,16 @@ fn build_printed_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
     // The tip's fitting of a shaft body prints with the outermost (printed) layer, as
     // a further volume of its object (Pestell et al. Sec. III-A).
     let fitting = match &design.shaft_body {
-        Some(sb) if i + 1 == stack.layers.len() => Some(g(
-            crate::parts::shaft_body::tip_fitting_solid(&design.context(), sb, stack, tol),
-        )?),
+        Some(sb) if i + 1 == stack.layers.len() => {
+            Some(g(crate::parts::shaft_body::tip_fitting_solid(
+                sb,
+                FamilyInput {
+                    ctx: &design.context(),
+                    stack,
+                    tol,
+                },
+            ))?)
+        }
         _ => None,
     };
     let group = (b.placed.iter().any(|p| p.spec.tip_material.is_some()) || fitting.is_some())
@@ -1062,7 +1070,7 @@ fn build_printed_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
         group: group.clone(),
     }];
     for p in b.placed.iter().filter(|p| p.spec.tip_material.is_some()) {
-        let tips = Solid::compose(&tip_solids(p, tol).part(&name)?);
+        let tips = Solid::compose(&tip_solids(p, tol).part(name)?);
         parts.push(Part {
             name: format!("{name}_tips"),
             role: "marker_tips".into(),
@@ -1109,7 +1117,7 @@ fn build_open_mold_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
     let (design, tol, l, name, outer) = (b.design, b.tol, b.l, &b.name, &b.outer);
     let (base_params, cavity_tech) = (&b.base_params, b.cavity_tech);
     let m = &design.mold;
-    let g = |r: Result<Solid, GeometryError>| r.part(&name);
+    let g = |r: Result<Solid, GeometryError>| r.part(name);
     // mold = (block - plain cavity) with the features cut or added: one boolean with
     // the features, and the skin's volume falls out as block - mold.
     let plain = g(body_solid(design, l.outer_offset_mm, 1.0, tol))?;
@@ -1348,7 +1356,7 @@ fn build_boundary_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
     let (design, stack, i, tol, l, name) = (b.design, b.stack, b.i, b.tol, b.l, &b.name);
     let (fixture_tech, cavity_tech) = (b.fixture_tech, b.cavity_tech);
     let m = &design.mold;
-    let g = |r: Result<Solid, GeometryError>| r.part(&name);
+    let g = |r: Result<Solid, GeometryError>| r.part(name);
     let zb = design.body.base_z_mm();
     let rim = design.body.rim_radius_mm(l.outer_offset_mm);
     let r_p = rim + m.plinth.margin_mm;
@@ -1372,7 +1380,7 @@ fn build_boundary_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
     let master = g(apply_features(master_base, &b.outer, tol, false))?;
     let pole = master.bounding_box().map(|b| b.max[2]).unwrap_or(0.0);
     let (mold_box, fill) =
-        crate::parts::molds::drafted_box(design, r_p, z_lo, pole, tol).part(&name)?;
+        crate::parts::molds::drafted_box(design, r_p, z_lo, pole, tol).part(name)?;
     let silicone_outer = g(fill.difference(&master))?.volume();
     // Inner boundary: a cup whose cavity casts the inner silicone core; the core's
     // plinth fits the outer mold's plinth recess (with clearance), which centres it.

@@ -10,10 +10,11 @@ use crate::error::{DesignError, ParamError};
 use crate::geometry::ChordTolerance;
 use crate::materials::{CastReport, MaterialKind};
 use crate::optics::Light;
-use crate::parts::context::{Context, Stack};
+use crate::parts::context::Stack;
 use crate::parts::cut_part::CutPart;
 use crate::parts::family::{
-    AssemblyStep, Built, Family, FamilyInput, FillingPour, InnerCavity, InsertionPath,
+    AssemblyInput, AssemblyStep, Built, Family, FamilyInput, FillingPour, InnerCavity,
+    InsertionPath,
 };
 use crate::parts::member::Member;
 use crate::parts::part::Part;
@@ -33,7 +34,7 @@ pub trait Section: Sync {
     /// [`Family::materials`]; empty without the family.
     fn materials<'d>(&self, d: &'d Design) -> Vec<(String, &'d str, &'static [MaterialKind])>;
     /// [`Family::estimated_triangles`]; 0 without the family.
-    fn estimated_triangles(&self, d: &Design, stack: &Stack, tol: ChordTolerance) -> f64;
+    fn estimated_triangles(&self, at: SectionInput<'_>) -> f64;
     /// [`Family::cut_parts`].
     fn cut_parts(&self, d: &Design) -> Vec<CutPart>;
     /// [`Family::pcb_outlines`].
@@ -49,38 +50,21 @@ pub trait Section: Sync {
     /// As [`Family::filling_pour`].
     fn filling_pour<'d>(
         &self,
-        d: &'d Design,
-        stack: &Stack,
+        at: SectionInput<'d>,
         cavity: InnerCavity<'_>,
-        tol: ChordTolerance,
     ) -> Result<Option<FillingPour<'d>>, DesignError>;
     /// [`Family::insertion_paths`].
     ///
     /// # Errors
     /// As [`Family::insertion_paths`].
-    fn insertion_paths(
-        &self,
-        d: &Design,
-        stack: &Stack,
-        tol: ChordTolerance,
-    ) -> Result<Vec<InsertionPath>, DesignError>;
+    fn insertion_paths(&self, at: SectionInput<'_>) -> Result<Vec<InsertionPath>, DesignError>;
     /// [`Family::build`]; `None` without the family.
-    fn build(
-        &self,
-        d: &Design,
-        stack: &Stack,
-        tol: ChordTolerance,
-    ) -> Option<Result<Built, DesignError>>;
+    fn build(&self, at: SectionInput<'_>) -> Option<Result<Built, DesignError>>;
     /// [`Family::members`].
     ///
     /// # Errors
     /// As [`Family::members`].
-    fn members(
-        &self,
-        d: &Design,
-        stack: &Stack,
-        tol: ChordTolerance,
-    ) -> Result<Vec<Member>, DesignError>;
+    fn members(&self, at: SectionInput<'_>) -> Result<Vec<Member>, DesignError>;
     /// [`Family::bought_items`].
     fn bought_items(&self, d: &Design) -> Vec<String>;
     /// [`Family::assembly_steps`].
@@ -92,9 +76,13 @@ pub trait Section: Sync {
     ) -> Vec<AssemblyStep>;
 }
 
-/// The input of a family's build-time methods.
-fn input<'a>(ctx: &'a Context<'a>, stack: &'a Stack, tol: ChordTolerance) -> FamilyInput<'a> {
-    FamilyInput { ctx, stack, tol }
+/// What the loops give a registered family's build-time methods: the design, its resolved
+/// stack and the chord tolerance.
+#[derive(Debug, Clone, Copy)]
+pub struct SectionInput<'d> {
+    pub design: &'d Design,
+    pub stack: &'d Stack,
+    pub tol: ChordTolerance,
 }
 
 /// A family `F` with where its parameters sit in a design.
@@ -111,6 +99,23 @@ impl<F: Family> Registered<F> {
             params,
             family: PhantomData,
         }
+    }
+
+    /// `f` of the family's parameters in `at.design` and its [`FamilyInput`]; `None` without
+    /// the family.
+    fn with<'d, T>(
+        &self,
+        at: SectionInput<'d>,
+        f: impl FnOnce(&'d F::Params, FamilyInput<'_>) -> T,
+    ) -> Option<T> {
+        let p = (self.params)(at.design)?;
+        let ctx = at.design.context();
+        let input = FamilyInput {
+            ctx: &ctx,
+            stack: at.stack,
+            tol: at.tol,
+        };
+        Some(f(p, input))
     }
 }
 
@@ -134,10 +139,8 @@ impl<F: Family> Section for Registered<F> {
         (self.params)(d).map_or_else(Vec::new, F::materials)
     }
 
-    fn estimated_triangles(&self, d: &Design, stack: &Stack, tol: ChordTolerance) -> f64 {
-        (self.params)(d).map_or(0.0, |p| {
-            F::estimated_triangles(p, input(&d.context(), stack, tol))
-        })
+    fn estimated_triangles(&self, at: SectionInput<'_>) -> f64 {
+        self.with(at, F::estimated_triangles).unwrap_or(0.0)
     }
 
     fn cut_parts(&self, d: &Design) -> Vec<CutPart> {
@@ -162,48 +165,24 @@ impl<F: Family> Section for Registered<F> {
 
     fn filling_pour<'d>(
         &self,
-        d: &'d Design,
-        stack: &Stack,
+        at: SectionInput<'d>,
         cavity: InnerCavity<'_>,
-        tol: ChordTolerance,
     ) -> Result<Option<FillingPour<'d>>, DesignError> {
-        match (self.params)(d) {
-            Some(p) => F::filling_pour(p, input(&d.context(), stack, tol), cavity),
-            None => Ok(None),
-        }
+        self.with(at, |p, input| F::filling_pour(p, input, cavity))
+            .unwrap_or(Ok(None))
     }
 
-    fn insertion_paths(
-        &self,
-        d: &Design,
-        stack: &Stack,
-        tol: ChordTolerance,
-    ) -> Result<Vec<InsertionPath>, DesignError> {
-        match (self.params)(d) {
-            Some(p) => F::insertion_paths(p, input(&d.context(), stack, tol)),
-            None => Ok(Vec::new()),
-        }
+    fn insertion_paths(&self, at: SectionInput<'_>) -> Result<Vec<InsertionPath>, DesignError> {
+        self.with(at, F::insertion_paths)
+            .unwrap_or_else(|| Ok(Vec::new()))
     }
 
-    fn build(
-        &self,
-        d: &Design,
-        stack: &Stack,
-        tol: ChordTolerance,
-    ) -> Option<Result<Built, DesignError>> {
-        (self.params)(d).map(|p| F::build(p, input(&d.context(), stack, tol)))
+    fn build(&self, at: SectionInput<'_>) -> Option<Result<Built, DesignError>> {
+        self.with(at, F::build)
     }
 
-    fn members(
-        &self,
-        d: &Design,
-        stack: &Stack,
-        tol: ChordTolerance,
-    ) -> Result<Vec<Member>, DesignError> {
-        match (self.params)(d) {
-            Some(p) => F::members(p, input(&d.context(), stack, tol)),
-            None => Ok(Vec::new()),
-        }
+    fn members(&self, at: SectionInput<'_>) -> Result<Vec<Member>, DesignError> {
+        self.with(at, F::members).unwrap_or_else(|| Ok(Vec::new()))
     }
 
     fn bought_items(&self, d: &Design) -> Vec<String> {
@@ -217,7 +196,15 @@ impl<F: Family> Section for Registered<F> {
         filling: Option<&CastReport>,
     ) -> Vec<AssemblyStep> {
         (self.params)(d).map_or_else(Vec::new, |p| {
-            F::assembly_steps(p, &d.context(), parts, filling)
+            let ctx = d.context();
+            F::assembly_steps(
+                p,
+                AssemblyInput {
+                    ctx: &ctx,
+                    parts,
+                    filling,
+                },
+            )
         })
     }
 }

@@ -35,8 +35,10 @@ pub use crate::parts::bayonet::BayonetLugs;
 use crate::parts::context::Context;
 use crate::parts::context::Stack;
 use crate::parts::cut_part::{CutPart, Operation, Outline};
+use crate::parts::family::envelope;
 use crate::parts::family::{
-    named, AssemblyStep, Built, Family, FamilyInput, FillingPour, InnerCavity, FILLING_GEL,
+    named, AssemblyInput, AssemblyStep, Built, Family, FamilyInput, FillingPour, InnerCavity,
+    FILLING_GEL,
 };
 use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::{ProcedureAction, ProcedureStep};
@@ -720,11 +722,10 @@ fn fitting_profile(r: &ShaftRadii, lv: &ShaftLevels) -> Polyline2 {
 /// # Errors
 /// [`GeometryError`] if the kernel fails.
 pub fn tip_fitting_solid(
-    ctx: &Context<'_>,
     sb: &ShaftBodyParams,
-    stack: &Stack,
-    tol: ChordTolerance,
+    input: FamilyInput<'_>,
 ) -> Result<Solid, GeometryError> {
+    let FamilyInput { ctx, stack, tol } = input;
     let r = radii(ctx, sb, stack);
     let lv = levels(ctx, sb);
     let ring = Solid::from_mesh(&revolve(&fitting_profile(&r, &lv), tol)?)?;
@@ -760,12 +761,8 @@ fn mount_holes(sb: &ShaftBodyParams) -> Vec<[f64; 2]> {
 ///
 /// # Errors
 /// [`DesignError::Geometry`] naming the part if the kernel fails.
-pub fn build_body(
-    ctx: &Context<'_>,
-    sb: &ShaftBodyParams,
-    stack: &Stack,
-    tol: ChordTolerance,
-) -> Result<Part, DesignError> {
+pub fn build_body(sb: &ShaftBodyParams, input: FamilyInput<'_>) -> Result<Part, DesignError> {
+    let FamilyInput { ctx, stack, tol } = input;
     let r = radii(ctx, sb, stack);
     let lv = levels(ctx, sb);
     let g = |x: Result<Solid, GeometryError>| x.part("shaft_body");
@@ -837,12 +834,8 @@ pub fn build_body(
 /// inner surface above the base plane, a point counting when it lies inside the lens's view
 /// cone and its ray from the lens passes the lip's opening, the LED ring's bore and the
 /// shaft's bore (the pins' shadows and the gel's refraction ignored).
-pub fn view_fraction(
-    ctx: &Context<'_>,
-    sb: &ShaftBodyParams,
-    stack: &Stack,
-    tol: ChordTolerance,
-) -> f64 {
+pub fn view_fraction(sb: &ShaftBodyParams, input: FamilyInput<'_>) -> f64 {
+    let FamilyInput { ctx, stack, tol } = input;
     let Some(skin) = skin_layer(stack) else {
         return 0.0;
     };
@@ -904,12 +897,11 @@ pub fn view_fraction(
 /// # Errors
 /// [`GeometryError`] if the kernel fails.
 pub fn filling_gel_solid(
-    ctx: &Context<'_>,
     sb: &ShaftBodyParams,
-    stack: &Stack,
+    input: FamilyInput<'_>,
     cavity: Solid,
-    tol: ChordTolerance,
 ) -> Result<Solid, GeometryError> {
+    let FamilyInput { ctx, stack, tol } = input;
     let r = radii(ctx, sb, stack);
     let lv = levels(ctx, sb);
     let lip = cylinder(lv.skin_base_z_mm - lv.lip_z_mm + 0.01, r.lip_inner_mm, tol)?.translate([
@@ -1109,10 +1101,6 @@ impl Family for ShaftBodyFamily {
     }
 
     fn cut_parts(sb: &ShaftBodyParams) -> Vec<CutPart> {
-        let circle = |r: f64| Outline::Circle {
-            centre_mm: [0.0, 0.0],
-            radius_mm: r,
-        };
         let w = &sb.lens_window;
         vec![CutPart {
             name: "lens_window".into(),
@@ -1123,7 +1111,7 @@ impl Family for ShaftBodyFamily {
             ),
             material: "pmma".into(),
             thickness_mm: w.thickness_mm,
-            outlines: vec![(Operation::Cut, circle(w.diameter_mm / 2.0))],
+            outlines: vec![(Operation::Cut, Outline::centred_circle(w.diameter_mm / 2.0))],
             kerf_mm: 0.0,
             quantity: 1,
             nominal_rings_mm: None,
@@ -1135,16 +1123,14 @@ impl Family for ShaftBodyFamily {
     }
 
     fn build(sb: &ShaftBodyParams, input: FamilyInput<'_>) -> Result<Built, DesignError> {
-        let FamilyInput { ctx, stack, tol } = input;
-        let mut parts = vec![build_body(ctx, sb, stack, tol)?];
+        let FamilyInput { ctx, tol, .. } = input;
+        let mut parts = vec![build_body(sb, input)?];
         if let Some(m) = &sb.robot_mount {
             parts.push(crate::parts::robot_mount::build_mount(ctx, sb, m, tol)?);
         }
         let lv = levels(ctx, sb);
-        let r = ctx.body.rim_radius_mm(0.0);
-        let w = sb.base.outer_diameter_mm.max(2.0 * r);
         let camera_view = json!({
-            "tip_inner_surface_fraction_seen": view_fraction(ctx, sb, stack, tol),
+            "tip_inner_surface_fraction_seen": view_fraction(sb, input),
             "lens_z_mm": lv.lens_z_mm,
             "view_angle_deg": sb.camera.view_angle_deg,
             "focal_length_mm": sb.camera.focal_length_mm,
@@ -1154,7 +1140,7 @@ impl Family for ShaftBodyFamily {
             parts,
             summary: vec![
                 ("shaft_levels", json!(&lv)),
-                ("envelope_mm", json!([w, w, lv.envelope_height_mm])),
+                envelope(ctx, sb.base.outer_diameter_mm, lv.envelope_height_mm),
                 ("camera_view", camera_view),
             ],
         })
@@ -1177,13 +1163,12 @@ impl Family for ShaftBodyFamily {
         input: FamilyInput<'_>,
         cavity: InnerCavity<'_>,
     ) -> Result<Option<FillingPour<'p>>, DesignError> {
-        let FamilyInput { ctx, stack, tol } = input;
         // The clear gel between the skin and the lens window (Pestell et al. Sec. III-A).
         let Some(f) = &sb.filling_gel else {
             return Ok(None);
         };
         let gel = cavity(0)
-            .and_then(|c| filling_gel_solid(ctx, sb, stack, c, tol))
+            .and_then(|c| filling_gel_solid(sb, input, c))
             .part(FILLING_GEL)?;
         Ok(Some(FillingPour {
             gel: f,
@@ -1207,12 +1192,12 @@ impl Family for ShaftBodyFamily {
         }))
     }
 
-    fn assembly_steps(
-        sb: &ShaftBodyParams,
-        ctx: &Context<'_>,
-        parts: &[Part],
-        filling: Option<&CastReport>,
-    ) -> Vec<AssemblyStep> {
+    fn assembly_steps(sb: &ShaftBodyParams, input: AssemblyInput<'_>) -> Vec<AssemblyStep> {
+        let AssemblyInput {
+            ctx,
+            parts,
+            filling,
+        } = input;
         let mut out = Vec::new();
         let body = named(parts, "shaft_body")
             .first()

@@ -11,9 +11,9 @@
 
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{ChordTolerance, GeometryError, Solid};
-use crate::materials::{CastReport, MaterialKind};
+use crate::materials::MaterialKind;
 use crate::parts::context::{Context, Stack};
-use crate::parts::family::{named, AssemblyStep, Built, Family, FamilyInput};
+use crate::parts::family::{named, AssemblyInput, AssemblyStep, Built, Family, FamilyInput};
 use crate::parts::part::{Part, PrintTechnology};
 use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::{check_positive, z_cylinder};
@@ -141,12 +141,8 @@ impl Family for SpacerFamily {
         vec!["Cyanoacrylate glue (gel): the skin's rim onto the spacer's top face".into()]
     }
 
-    fn assembly_steps(
-        _p: &SpacerParams,
-        _ctx: &Context<'_>,
-        parts: &[Part],
-        _filling: Option<&CastReport>,
-    ) -> Vec<AssemblyStep> {
+    fn assembly_steps(_p: &SpacerParams, input: AssemblyInput<'_>) -> Vec<AssemblyStep> {
+        let AssemblyInput { parts, .. } = input;
         let spacer = named(parts, "spacer")
             .first()
             .cloned()

@@ -7,6 +7,7 @@ use crate::common::{assert_each_rule_names_its_path, assert_one_interference, Ru
 use fabkit_designs::assembly::{interferences, MemberKind};
 use fabkit_designs::materials::MaterialsTable;
 use fabkit_designs::parts::bayonet::band;
+use fabkit_designs::parts::family::FamilyInput;
 use fabkit_designs::parts::shaft_body::tip_bayonet;
 use fabkit_designs::{build_kit, library, stack, ChordTolerance, Design, Kit, Solid};
 use std::f64::consts::PI;
@@ -139,10 +140,12 @@ fn tactip_kit_has_the_body_and_an_assembly_without_interferences() {
     let materials = MaterialsTable::embedded().unwrap();
     let st = stack::validate(&d, &materials, tol()).unwrap();
     let narrow = fabkit_designs::parts::shaft_body::view_fraction(
-        &d.context(),
         d.shaft_body.as_ref().unwrap(),
-        &st,
-        tol(),
+        FamilyInput {
+            ctx: &d.context(),
+            stack: &st,
+            tol: tol(),
+        },
     );
     assert!(narrow < f, "{narrow} vs {f}");
 }

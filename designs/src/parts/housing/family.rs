@@ -14,9 +14,10 @@ use crate::optics::{ring_of_lights, Light};
 use crate::parts::axial_ring;
 use crate::parts::context::{Context, Stack};
 use crate::parts::cut_part::{CutPart, Operation, Outline};
+use crate::parts::family::envelope;
 use crate::parts::family::{
-    named, AssemblyStep, Built, Family, FamilyInput, FillingPour, InnerCavity, InsertionPath,
-    FILLING_GEL,
+    named, AssemblyInput, AssemblyStep, Built, Family, FamilyInput, FillingPour, InnerCavity,
+    InsertionPath, FILLING_GEL,
 };
 use crate::parts::fasteners::{metric_from_pilot, metric_name};
 use crate::parts::{ExactShape, Member, MemberKind, Part, ProcedureAction, ProcedureStep};
@@ -73,14 +74,12 @@ impl Family for HousingFamily {
     }
 
     fn build(h: &HousingParams, input: FamilyInput<'_>) -> Result<Built, DesignError> {
-        let FamilyInput { ctx, stack, tol } = input;
-        let (parts, levels) = build_shell(ctx, h, stack, tol)?;
-        let w = h.outer_width_mm.max(2.0 * ctx.body.rim_radius_mm(0.0));
+        let (parts, levels) = build_shell(h, input)?;
         Ok(Built {
             parts,
             summary: vec![
                 ("shell_levels", json!(&levels)),
-                ("envelope_mm", json!([w, w, levels.envelope_height_mm])),
+                envelope(input.ctx, h.outer_width_mm, levels.envelope_height_mm),
             ],
         })
     }
@@ -161,14 +160,10 @@ impl Family for HousingFamily {
         h: &HousingParams,
         input: FamilyInput<'_>,
     ) -> Result<Vec<InsertionPath>, DesignError> {
-        insertion_paths(h, input.ctx, input.stack, input.tol)
+        insertion_paths(h, input)
     }
 
     fn cut_parts(h: &HousingParams) -> Vec<CutPart> {
-        let circle = |r: f64| Outline::Circle {
-            centre_mm: [0.0, 0.0],
-            radius_mm: r,
-        };
         let d = &h.diffuser;
         vec![CutPart {
             name: "diffuser".into(),
@@ -180,8 +175,14 @@ impl Family for HousingFamily {
             material: "pmma".into(),
             thickness_mm: d.thickness_mm,
             outlines: vec![
-                (Operation::Cut, circle(d.outer_diameter_mm / 2.0)),
-                (Operation::Cut, circle(d.inner_diameter_mm / 2.0)),
+                (
+                    Operation::Cut,
+                    Outline::centred_circle(d.outer_diameter_mm / 2.0),
+                ),
+                (
+                    Operation::Cut,
+                    Outline::centred_circle(d.inner_diameter_mm / 2.0),
+                ),
             ],
             kerf_mm: 0.0,
             quantity: 1,
@@ -193,12 +194,8 @@ impl Family for HousingFamily {
         bought_items(h)
     }
 
-    fn assembly_steps(
-        h: &HousingParams,
-        _ctx: &Context<'_>,
-        parts: &[Part],
-        filling: Option<&CastReport>,
-    ) -> Vec<AssemblyStep> {
+    fn assembly_steps(h: &HousingParams, input: AssemblyInput<'_>) -> Vec<AssemblyStep> {
+        let AssemblyInput { parts, filling, .. } = input;
         assembly_steps(h, parts, filling)
     }
 }
@@ -279,10 +276,9 @@ fn bought_envelopes(
 /// [`DesignError::Geometry`] if the kernel fails.
 fn insertion_paths(
     h: &HousingParams,
-    ctx: &Context<'_>,
-    stack: &Stack,
-    tol: ChordTolerance,
+    input: FamilyInput<'_>,
 ) -> Result<Vec<InsertionPath>, DesignError> {
+    let FamilyInput { ctx, stack, tol } = input;
     let Some(core) = &stack.core else {
         return Ok(Vec::new());
     };

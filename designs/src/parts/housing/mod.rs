@@ -28,7 +28,8 @@ pub use family::HousingFamily;
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{cuboid, cylinder, ChordTolerance, Solid};
 use crate::parts::context::Context;
-use crate::parts::context::{ResolvedCore, Stack};
+use crate::parts::context::ResolvedCore;
+use crate::parts::family::FamilyInput;
 use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::{Part, PrintTechnology};
 use crate::schema::FillingGel;
@@ -961,20 +962,17 @@ fn check_round_tube_heights(
 /// [`DesignError::Params`] when the design has no core to seat, [`DesignError::Geometry`]
 /// if the kernel fails.
 pub fn build_shell(
-    ctx: &Context<'_>,
     h: &HousingParams,
-    stack: &Stack,
-    tol: ChordTolerance,
+    input: FamilyInput<'_>,
 ) -> Result<(Vec<Part>, ShellLevels), DesignError> {
-    build_shell_parts(ctx, h, stack, tol).map_err(|e| e.from_params(&["housing".to_string()]))
+    build_shell_parts(h, input).map_err(|e| e.from_params(&["housing".to_string()]))
 }
 
 fn build_shell_parts(
-    ctx: &Context<'_>,
     h: &HousingParams,
-    stack: &Stack,
-    tol: ChordTolerance,
+    input: FamilyInput<'_>,
 ) -> Result<(Vec<Part>, ShellLevels), DesignError> {
+    let FamilyInput { ctx, stack, tol } = input;
     let core = stack.core.as_ref().ok_or_else(|| {
         DesignError::Params(crate::error::ParamErrors(vec![ParamError::new(
             "housing",
