@@ -126,6 +126,16 @@ pub const ROBUST_THRESHOLD_SIGMAS: f64 = 3.5;
 /// mean): errors beyond it are no consensus (pins labelled at random), not a rough lens model.
 pub const MAX_ROBUST_THRESHOLD_OF_SPREAD: f64 = 0.1;
 
+/// The point-pixel pairs a solve draws its samples from: the camera, the points (sensor
+/// frame, mm), their pixels (px) and the pixels' unit bearing vectors.
+#[derive(Clone, Copy)]
+struct Pairs<'a> {
+    camera: &'a CameraModel,
+    pts: &'a [Vector3<f64>],
+    px: &'a [Vector2<f64>],
+    bearings: &'a [Vector3<f64>],
+}
+
 /// The inlier threshold from the data, px: least median of squares (Rousseeuw 1984; Rousseeuw
 /// and Leroy 1987, Sec. 5.1) over the all-points pose `start` and minimal P3P samples (as many
 /// as give `confidence` of an outlier-free sample when half the points are outliers), the best
@@ -134,16 +144,18 @@ pub const MAX_ROBUST_THRESHOLD_OF_SPREAD: f64 = 0.1;
 /// Gaussian errors; the finite-sample factor of Rousseeuw and Leroy), and the threshold is
 /// [`ROBUST_THRESHOLD_SIGMAS`] sigma, at least [`MIN_ROBUST_THRESHOLD_PX`] and at most
 /// [`MAX_ROBUST_THRESHOLD_OF_SPREAD`] of the pixels' spread.
-#[allow(clippy::too_many_arguments)]
 fn robust_threshold_px(
-    camera: &CameraModel,
-    pts: &[Vector3<f64>],
-    px: &[Vector2<f64>],
-    bearings: &[Vector3<f64>],
+    pairs: &Pairs<'_>,
     start: (&Matrix3<f64>, &Vector3<f64>),
     ro: &RansacOptions,
     opts: &PnpOptions,
 ) -> f64 {
+    let Pairs {
+        camera,
+        pts,
+        px,
+        bearings,
+    } = *pairs;
     let n = pts.len();
     let half = n / 2;
     let mut e2 = vec![0.0; n];
@@ -262,20 +274,18 @@ pub fn solve_pnp(
     let mut hypotheses = 0;
     let mut inliers = vec![true; n];
     let mut threshold_used = None;
+    let pairs = Pairs {
+        camera,
+        pts: points_mm,
+        px: pixels_px,
+        bearings: &bearings,
+    };
     match &opts.ransac {
         None => fit.refine(camera, points_mm, pixels_px, opts.max_iterations),
         Some(ro) => {
             let threshold_px = match ro.threshold_px {
                 Some(t) => t,
-                None => robust_threshold_px(
-                    camera,
-                    points_mm,
-                    pixels_px,
-                    &bearings,
-                    (&fit.r, &fit.t),
-                    ro,
-                    opts,
-                ),
+                None => robust_threshold_px(&pairs, (&fit.r, &fit.t), ro, opts),
             };
             threshold_used = Some(threshold_px);
             let ro = &RansacOptions {
@@ -300,16 +310,7 @@ pub fn solve_pnp(
                 consensus.set_from_fit(&fit, thr2);
             }
             if consensus.count() < n {
-                hypotheses = ransac(
-                    camera,
-                    points_mm,
-                    pixels_px,
-                    &bearings,
-                    ro,
-                    opts,
-                    &mut fit,
-                    &mut consensus,
-                );
+                hypotheses = ransac(&pairs, ro, opts, &mut fit, &mut consensus);
             }
             inliers = consensus.inliers;
             let count = inliers.iter().filter(|&&b| b).count();
@@ -363,17 +364,19 @@ pub fn solve_pnp(
 /// Levenberg-Marquardt refinement of every new best hypothesis on its consensus set, then a final
 /// refinement repeated while the consensus set changes. `fit` and `consensus` hold the best so
 /// far on entry and the result on return. Returns the number of hypotheses drawn.
-#[allow(clippy::too_many_arguments)]
 fn ransac(
-    camera: &CameraModel,
-    pts: &[Vector3<f64>],
-    px: &[Vector2<f64>],
-    bearings: &[Vector3<f64>],
+    pairs: &Pairs<'_>,
     ro: &RansacOptions,
     opts: &PnpOptions,
     fit: &mut Fit,
     best: &mut Consensus,
 ) -> usize {
+    let Pairs {
+        camera,
+        pts,
+        px,
+        bearings,
+    } = *pairs;
     let n = pts.len();
     let thr = ro.threshold_px.unwrap_or(MIN_ROBUST_THRESHOLD_PX);
     let thr2 = thr * thr;
