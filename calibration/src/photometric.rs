@@ -57,6 +57,7 @@
 use crate::groundtruth::exact::ExactPrimitives;
 use crate::groundtruth::rays::PixelRays;
 use crate::groundtruth::SurfaceHits;
+use fabkit_designs::primitives::{cross, dot};
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
@@ -423,18 +424,6 @@ fn spatial(i: usize, width: usize, height: usize) -> [f64; SPATIAL_TERMS] {
         }
     }
     out
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 /// The surface features of pixel `i` of a frame against the reference: the change of the

@@ -82,22 +82,27 @@ pub struct Geometry {
 }
 
 /// a - b.
+#[inline]
 pub fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 /// a + b.
+#[inline]
 pub fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
 }
 /// a s.
+#[inline]
 pub fn scale(a: [f64; 3], s: f64) -> [f64; 3] {
     [a[0] * s, a[1] * s, a[2] * s]
 }
 /// a . b.
+#[inline]
 pub fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 /// a x b.
+#[inline]
 pub fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [
         a[1] * b[2] - a[2] * b[1],
@@ -106,10 +111,12 @@ pub fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     ]
 }
 /// |a|.
+#[inline]
 pub fn norm(a: [f64; 3]) -> f64 {
     dot(a, a).sqrt()
 }
 /// a / |a|.
+#[inline]
 pub fn unit(a: [f64; 3]) -> [f64; 3] {
     scale(a, 1.0 / norm(a))
 }

@@ -7,7 +7,7 @@
 //! capsules, boxes with orthonormal axes, prisms over a simple counter-clockwise polygon) are
 //! those of the JSON form written by `fabkit fixtures`.
 
-use fabkit_designs::primitives::{cross, dot, norm, scale, sub, Primitive};
+use fabkit_designs::primitives::{add, cross, dot, norm, scale, sub, Primitive};
 
 /// Why a primitive cannot be intersected.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -71,10 +71,6 @@ pub struct Crossing {
     pub t_mm: f64,
     pub normal: [f64; 3],
     pub primitive: usize,
-}
-
-fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
 }
 
 fn check_unit(v: [f64; 3]) -> bool {

@@ -25,6 +25,7 @@
 use fabkit_designs::geometry::Mesh;
 
 use super::rays::PixelRays;
+use fabkit_designs::primitives::{cross, dot, scale, sub};
 
 /// No triangle hit.
 pub const NO_HIT: u32 = u32::MAX;
@@ -1152,26 +1153,6 @@ fn build(
     me
 }
 
-#[inline(always)]
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-#[inline(always)]
-fn scale(a: [f64; 3], s: f64) -> [f64; 3] {
-    [a[0] * s, a[1] * s, a[2] * s]
-}
-#[inline(always)]
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-#[inline(always)]
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
 fn normalize(a: [f64; 3]) -> [f64; 3] {
     let l = dot(a, a).sqrt();
     [a[0] / l, a[1] / l, a[2] / l]

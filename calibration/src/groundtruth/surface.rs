@@ -8,6 +8,7 @@
 //! leaves it exactly once; the ray hits the surface if it leaves above the base plane and
 //! misses (it sees the housing) if it leaves below.
 
+use fabkit_designs::primitives::dot;
 use fabkit_designs::profile::BodyProfile;
 
 /// The outer skin surface of one body profile, in closed form (sensor frame, mm).
@@ -38,10 +39,6 @@ pub struct Exit {
     pub t_mm: f64,
     pub normal: [f64; 3],
     pub on_skin: bool,
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 /// Far root of `a t^2 + 2 b t + c = 0` (a > 0), or None without real roots.
