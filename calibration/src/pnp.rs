@@ -150,12 +150,7 @@ fn robust_threshold_px(
     ro: &RansacOptions,
     opts: &PnpOptions,
 ) -> f64 {
-    let Pairs {
-        camera,
-        pts,
-        px,
-        bearings,
-    } = *pairs;
+    let (camera, pts, px, bearings) = (pairs.camera, pairs.pts, pairs.px, pairs.bearings);
     let n = pts.len();
     let half = n / 2;
     let mut e2 = vec![0.0; n];
@@ -371,12 +366,7 @@ fn ransac(
     fit: &mut Fit,
     best: &mut Consensus,
 ) -> usize {
-    let Pairs {
-        camera,
-        pts,
-        px,
-        bearings,
-    } = *pairs;
+    let (camera, pts, px, bearings) = (pairs.camera, pairs.pts, pairs.px, pairs.bearings);
     let n = pts.len();
     let thr = ro.threshold_px.unwrap_or(MIN_ROBUST_THRESHOLD_PX);
     let thr2 = thr * thr;
