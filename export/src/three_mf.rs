@@ -94,27 +94,32 @@ const PNG_CONTENT_TYPE: &str = r#"<Default Extension="png" ContentType="image/pn
 /// Where the package thumbnail goes (PrusaSlicer reads and writes it there).
 pub(crate) const THUMBNAIL_PATH: &str = "Metadata/thumbnail.png";
 
+/// The package relationships (`_rels/.rels`) with the relationships given after the 3D model's:
+/// a `concat!` of literals, so that both forms below are `&'static str` constants.
+macro_rules! package_rels {
+    ($($extra:literal),*) => {
+        concat!(
+            r#"<?xml version="1.0" encoding="UTF-8"?>"#,
+            "\n",
+            r#"<Relationships xmlns="http://schemas.openxmlformats.org/package/2006/relationships">"#,
+            r#"<Relationship Target="/3D/3dmodel.model" Id="rel0" Type="http://schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel"/>"#,
+            $($extra,)*
+            "</Relationships>\n"
+        )
+    };
+}
+
 /// [`RELS`] plus the package thumbnail: the OPC relationship of the 3MF core specification
 /// (Sec. 6.1, "Package Thumbnail"), from the package root to [`THUMBNAIL_PATH`].
-const RELS_WITH_THUMBNAIL: &str = concat!(
-    r#"<?xml version="1.0" encoding="UTF-8"?>"#,
-    "\n",
-    r#"<Relationships xmlns="http://schemas.openxmlformats.org/package/2006/relationships">"#,
-    r#"<Relationship Target="/3D/3dmodel.model" Id="rel0" Type="http://schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel"/>"#,
-    r#"<Relationship Target="/Metadata/thumbnail.png" Id="rel1" Type="http://schemas.openxmlformats.org/package/2006/relationships/metadata/thumbnail"/>"#,
-    "</Relationships>\n"
+const RELS_WITH_THUMBNAIL: &str = package_rels!(
+    r#"<Relationship Target="/Metadata/thumbnail.png" Id="rel1" Type="http://schemas.openxmlformats.org/package/2006/relationships/metadata/thumbnail"/>"#
 );
 
 /// Where PrusaSlicer reads the volumes of its objects.
 pub(crate) const PRUSA_CONFIG_PATH: &str = "Metadata/Slic3r_PE_model.config";
 
-const RELS: &str = concat!(
-    r#"<?xml version="1.0" encoding="UTF-8"?>"#,
-    "\n",
-    r#"<Relationships xmlns="http://schemas.openxmlformats.org/package/2006/relationships">"#,
-    r#"<Relationship Target="/3D/3dmodel.model" Id="rel0" Type="http://schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel"/>"#,
-    "</Relationships>\n"
-);
+/// The package relationships: the 3D model's only.
+const RELS: &str = package_rels!();
 
 /// One part inside an object: a range of the object's triangles.
 pub(crate) struct Volume<'a> {
