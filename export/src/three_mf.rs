@@ -67,26 +67,30 @@ use std::io::{Cursor, Write as _};
 use zip::write::SimpleFileOptions;
 use zip::{CompressionMethod, DateTime, System, ZipWriter};
 
-const CONTENT_TYPES: &str = concat!(
-    r#"<?xml version="1.0" encoding="UTF-8"?>"#,
-    "\n",
-    r#"<Types xmlns="http://schemas.openxmlformats.org/package/2006/content-types">"#,
-    r#"<Default Extension="rels" ContentType="application/vnd.openxmlformats-package.relationships+xml"/>"#,
-    r#"<Default Extension="model" ContentType="application/vnd.ms-package.3dmanufacturing-3dmodel+xml"/>"#,
-    "</Types>\n"
-);
+/// The package's content types (`[Content_Types].xml`) with the types given after the
+/// relationships' and the 3D model's: a `concat!` of literals, so that both forms below are
+/// `&'static str` constants.
+macro_rules! content_types {
+    ($($extra:literal),*) => {
+        concat!(
+            r#"<?xml version="1.0" encoding="UTF-8"?>"#,
+            "\n",
+            r#"<Types xmlns="http://schemas.openxmlformats.org/package/2006/content-types">"#,
+            r#"<Default Extension="rels" ContentType="application/vnd.openxmlformats-package.relationships+xml"/>"#,
+            r#"<Default Extension="model" ContentType="application/vnd.ms-package.3dmanufacturing-3dmodel+xml"/>"#,
+            $($extra,)*
+            "</Types>\n"
+        )
+    };
+}
+
+/// The content types of the relationships and the 3D model.
+const CONTENT_TYPES: &str = content_types!();
 
 /// [`CONTENT_TYPES`] plus the type of the PrusaSlicer config part (OPC wants a content type
 /// for every part; PrusaSlicer itself declares none for it).
-const CONTENT_TYPES_WITH_CONFIG: &str = concat!(
-    r#"<?xml version="1.0" encoding="UTF-8"?>"#,
-    "\n",
-    r#"<Types xmlns="http://schemas.openxmlformats.org/package/2006/content-types">"#,
-    r#"<Default Extension="rels" ContentType="application/vnd.openxmlformats-package.relationships+xml"/>"#,
-    r#"<Default Extension="model" ContentType="application/vnd.ms-package.3dmanufacturing-3dmodel+xml"/>"#,
-    r#"<Default Extension="config" ContentType="application/xml"/>"#,
-    "</Types>\n"
-);
+const CONTENT_TYPES_WITH_CONFIG: &str =
+    content_types!(r#"<Default Extension="config" ContentType="application/xml"/>"#);
 
 /// The content type line of the package thumbnail (OPC wants one for every part).
 const PNG_CONTENT_TYPE: &str = r#"<Default Extension="png" ContentType="image/png"/>"#;
