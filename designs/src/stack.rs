@@ -643,11 +643,7 @@ fn check_with_stack(
             check_open_block(design, block, layers, errs);
         }
     } else if let Some(b) = &design.mold.open_block {
-        crate::parts::check_positive(
-            "mold.open_block.",
-            &[("width_mm", b.width_mm), ("height_mm", b.height_mm)],
-            errs,
-        );
+        crate::parts::check_above_zero("mold.open_block.", b, &[], errs);
     }
     // Checks that use the core only make sense once the stack itself is sound.
     let sound_core = core.filter(|_| stack_ok);

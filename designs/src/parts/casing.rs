@@ -345,50 +345,8 @@ pub fn check_params(ctx: &Context<'_>, c: &CasingParams, errs: &mut Vec<ParamErr
 /// the FDM nozzle; paths under `casing`.
 fn check_numbers(ctx: &Context<'_>, c: &CasingParams, errs: &mut Vec<ParamError>) {
     let path = |p: &str| format!("casing.{p}");
-    let (cam, led, s) = (&c.camera, &c.leds, &c.screws);
-    let mut numbers = vec![
-        ("outer_width_mm", c.outer_width_mm),
-        ("height_mm", c.height_mm),
-        ("wall_thickness_mm", c.wall_thickness_mm),
-        ("window_diameter_mm", c.window_diameter_mm),
-        ("bay_height_mm", c.bay_height_mm),
-        ("ledge_thickness_mm", c.ledge_thickness_mm),
-        ("camera.board_width_mm", cam.board_width_mm),
-        ("camera.board_height_mm", cam.board_height_mm),
-        ("camera.lens_diameter_mm", cam.lens_diameter_mm),
-        ("camera.lens_height_mm", cam.lens_height_mm),
-        ("leds.width_mm", led.width_mm),
-        ("leds.length_mm", led.length_mm),
-        ("leds.thickness_mm", led.thickness_mm),
-        ("leds.wire_hole_diameter_mm", led.wire_hole_diameter_mm),
-        ("screws.pilot_diameter_mm", s.pilot_diameter_mm),
-        ("screws.pilot_depth_mm", s.pilot_depth_mm),
-        ("screws.clearance_diameter_mm", s.clearance_diameter_mm),
-        ("screws.head_diameter_mm", s.head_diameter_mm),
-        ("screws.head_depth_mm", s.head_depth_mm),
-    ];
-    if let Some(g) = &c.gripper_base {
-        numbers.extend([
-            ("gripper_base.width_mm", g.width_mm),
-            ("gripper_base.length_mm", g.length_mm),
-            ("gripper_base.thickness_mm", g.thickness_mm),
-            ("gripper_base.socket_depth_mm", g.socket_depth_mm),
-            ("gripper_base.cable_slot_width_mm", g.cable_slot_width_mm),
-            ("gripper_base.cable_slot_depth_mm", g.cable_slot_depth_mm),
-            ("gripper_base.bolt_spacing_mm[0]", g.bolt_spacing_mm[0]),
-            ("gripper_base.bolt_spacing_mm[1]", g.bolt_spacing_mm[1]),
-            (
-                "gripper_base.bolt_clearance_diameter_mm",
-                g.bolt_clearance_diameter_mm,
-            ),
-            (
-                "gripper_base.bolt_head_diameter_mm",
-                g.bolt_head_diameter_mm,
-            ),
-            ("gripper_base.bolt_head_depth_mm", g.bolt_head_depth_mm),
-        ]);
-    }
-    crate::parts::check_positive("casing.", &numbers, errs);
+    let led = &c.leds;
+    crate::parts::check_above_zero("casing.", c, &[], errs);
     if !led.first_azimuth_deg.is_finite() {
         errs.push(ParamError::new(
             path("leds.first_azimuth_deg"),

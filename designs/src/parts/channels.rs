@@ -116,21 +116,7 @@ impl ChannelSet {
         if self.count == 0 {
             errs.push(ParamError::new(p("count"), 0, "must be 1 or more"));
         }
-        crate::parts::check_positive(
-            prefix,
-            &[
-                ("width_mm", self.width_mm),
-                ("height_mm", self.height_mm),
-                ("pitch_mm", self.pitch_mm),
-                ("length_mm", self.length_mm),
-                ("min_wall_mm", self.min_wall_mm),
-                ("tube.outer_diameter_mm", self.tube.outer_diameter_mm),
-                ("tube.inner_diameter_mm", self.tube.inner_diameter_mm),
-                ("tube.length_mm", self.tube.length_mm),
-                ("tube.insertion_mm", self.tube.insertion_mm),
-            ],
-            &mut errs,
-        );
+        crate::parts::check_above_zero(prefix, self, &[], &mut errs);
         if !errs.is_empty() {
             return errs;
         }
@@ -295,15 +281,7 @@ impl MarkerGrid {
                 ),
             ));
         }
-        crate::parts::check_positive(
-            prefix,
-            &[
-                ("pitch_mm", self.pitch_mm),
-                ("feature.diameter_mm", self.feature.diameter_mm),
-                ("feature.height_mm", self.feature.height_mm),
-            ],
-            &mut errs,
-        );
+        crate::parts::check_above_zero(prefix, self, &[], &mut errs);
         if !(self.edge_margin_mm >= 0.0 && self.edge_margin_mm.is_finite()) {
             errs.push(ParamError::new(
                 p("edge_margin_mm"),

@@ -303,41 +303,8 @@ pub fn check_params(
 /// `fingertip_base`.
 fn check_numbers(ctx: &Context<'_>, f: &FingertipBase, errs: &mut Vec<ParamError>) {
     let path = |p: &str| format!("fingertip_base.{p}");
-    let (pcb, ring, cam, b) = (&f.led_pcb, &f.diffusion_ring, &f.camera, &f.bolts);
-    crate::parts::check_positive(
-        "fingertip_base.",
-        &[
-            ("outer_diameter_mm", f.outer_diameter_mm),
-            ("pocket_depth_mm", f.pocket_depth_mm),
-            ("floor_thickness_mm", f.floor_thickness_mm),
-            ("led_pcb.outer_diameter_mm", pcb.outer_diameter_mm),
-            ("led_pcb.inner_diameter_mm", pcb.inner_diameter_mm),
-            ("led_pcb.thickness_mm", pcb.thickness_mm),
-            ("led_pcb.led_circle_diameter_mm", pcb.led_circle_diameter_mm),
-            ("led_pcb.led_length_mm", pcb.led_length_mm),
-            ("led_pcb.led_height_mm", pcb.led_height_mm),
-            ("led_pcb.wire_hole_diameter_mm", pcb.wire_hole_diameter_mm),
-            ("diffusion_ring.inner_diameter_mm", ring.inner_diameter_mm),
-            ("diffusion_ring.thickness_mm", ring.thickness_mm),
-            (
-                "diffusion_ring.uv_hole_diameter_mm",
-                ring.uv_hole_diameter_mm,
-            ),
-            ("camera.diameter_mm", cam.diameter_mm),
-            ("camera.length_mm", cam.length_mm),
-            ("camera.wire_hole_diameter_mm", cam.wire_hole_diameter_mm),
-            (
-                "camera_holder.outer_diameter_mm",
-                f.camera_holder.outer_diameter_mm,
-            ),
-            ("bolts.pilot_diameter_mm", b.pilot_diameter_mm),
-            ("bolts.pilot_depth_mm", b.pilot_depth_mm),
-            ("bolts.clearance_diameter_mm", b.clearance_diameter_mm),
-            ("bolts.head_diameter_mm", b.head_diameter_mm),
-            ("bolts.head_depth_mm", b.head_depth_mm),
-        ],
-        errs,
-    );
+    let (cam, b) = (&f.camera, &f.bolts);
+    crate::parts::check_above_zero("fingertip_base.", f, &[], errs);
     if !(cam.view_angle_deg > 0.0 && cam.view_angle_deg < 180.0) {
         errs.push(ParamError::new(
             path("camera.view_angle_deg"),

@@ -50,6 +50,144 @@ pub fn check_positive(prefix: &str, values: &[(&str, f64)], errs: &mut Vec<Param
     errs.len() > before
 }
 
+/// The rule "must be above 0" for every number of `value` whose JSON Schema bound is only
+/// `exclusiveMinimum: 0`, so that the published schema (`fabkit schema`) and the validation
+/// cannot disagree: a new field marked `#[schemars(extend("exclusiveMinimum" = 0))]` is checked
+/// by that mark alone. A number with a range of its own (`camera.view_angle_deg` in (0, 180)) is
+/// left to its own rule and message; so are the top-level keys in `skip` (a nested family that
+/// checks itself). Optional fields are checked when given, arrays element by element
+/// (`bolt_spacing_mm[1]`).
+///
+/// Paths are under `prefix` (`casing.`), in the schema's (alphabetical) order. Returns whether
+/// any number broke the rule.
+pub fn check_above_zero<T: schemars::JsonSchema + serde::Serialize>(
+    prefix: &str,
+    value: &T,
+    skip: &[&str],
+    errs: &mut Vec<ParamError>,
+) -> bool {
+    let schema = schemars::generate::SchemaSettings::draft2020_12()
+        .into_generator()
+        .into_root_schema_for::<T>()
+        .to_value();
+    let before = errs.len();
+    match serde_value::to_value(value) {
+        Ok(v) => AboveZero {
+            root: &schema,
+            skip,
+            errs,
+        }
+        .walk(&schema, &v, prefix, true),
+        // Serialize of a schema type does not fail; say so rather than pass silently.
+        Err(e) => errs.push(ParamError::new(
+            prefix,
+            "?",
+            format!("cannot be read as numbers: {e}"),
+        )),
+    }
+    errs.len() > before
+}
+
+/// The walk of [`check_above_zero`]: a schema and a serialized value side by side.
+struct AboveZero<'a> {
+    root: &'a serde_json::Value,
+    skip: &'a [&'a str],
+    errs: &'a mut Vec<ParamError>,
+}
+
+impl AboveZero<'_> {
+    fn walk(&mut self, s: &serde_json::Value, v: &serde_value::Value, path: &str, top: bool) {
+        use serde_value::Value as V;
+        let s = resolve(self.root, s);
+        let v = match v {
+            V::Option(None) | V::Unit => return,
+            V::Option(Some(inner)) | V::Newtype(inner) => return self.walk(s, inner, path, top),
+            v => v,
+        };
+        let only_above_zero = s.get("exclusiveMinimum").and_then(|b| b.as_f64()) == Some(0.0)
+            && ["minimum", "maximum", "exclusiveMaximum"]
+                .iter()
+                .all(|k| s.get(k).is_none());
+        if only_above_zero {
+            if let Some(x) = number(v) {
+                if !(x > 0.0 && x.is_finite()) {
+                    self.errs.push(ParamError::new(path, x, "must be above 0"));
+                }
+            }
+        }
+        let join = |k: &str| {
+            if top {
+                format!("{path}{k}")
+            } else {
+                format!("{path}.{k}")
+            }
+        };
+        match v {
+            V::Map(m) => {
+                let Some(props) = s.get("properties").and_then(|p| p.as_object()) else {
+                    return;
+                };
+                for (k, sub) in props {
+                    if top && self.skip.contains(&k.as_str()) {
+                        continue;
+                    }
+                    if let Some(x) = m.get(&V::String(k.clone())) {
+                        self.walk(sub, x, &join(k), false);
+                    }
+                }
+            }
+            V::Seq(items) => {
+                if let Some(sub) = s.get("items").filter(|i| i.is_object()) {
+                    for (i, x) in items.iter().enumerate() {
+                        self.walk(sub, x, &format!("{path}[{i}]"), false);
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+}
+
+/// The schema `s` stands for: behind a `$ref` into `root`'s `$defs`, the non-null branch of an
+/// `Option`'s `anyOf`, or a single `allOf`.
+fn resolve<'s>(root: &'s serde_json::Value, s: &'s serde_json::Value) -> &'s serde_json::Value {
+    if let Some(r) = s.get("$ref").and_then(|r| r.as_str()) {
+        let def = r
+            .strip_prefix("#/$defs/")
+            .and_then(|name| root.get("$defs")?.get(name));
+        return def.map_or(s, |d| resolve(root, d));
+    }
+    for key in ["anyOf", "oneOf", "allOf"] {
+        if let Some(branches) = s.get(key).and_then(|b| b.as_array()) {
+            let mut real = branches
+                .iter()
+                .filter(|b| b.get("type").and_then(|t| t.as_str()) != Some("null"));
+            if let (Some(only), None) = (real.next(), real.next()) {
+                return resolve(root, only);
+            }
+        }
+    }
+    s
+}
+
+/// A number of a serialized value, as f64.
+fn number(v: &serde_value::Value) -> Option<f64> {
+    use serde_value::Value as V;
+    Some(match *v {
+        V::F64(x) => x,
+        V::F32(x) => f64::from(x),
+        V::I8(x) => f64::from(x),
+        V::I16(x) => f64::from(x),
+        V::I32(x) => f64::from(x),
+        V::I64(x) => x as f64,
+        V::U8(x) => f64::from(x),
+        V::U16(x) => f64::from(x),
+        V::U32(x) => f64::from(x),
+        V::U64(x) => x as f64,
+        _ => return None,
+    })
+}
+
 /// Smallest LED package fabkit counts around a ring, mm along the ring: the 0402 package
 /// (1.0 x 0.5 mm), the smallest in common use.
 pub const MIN_LED_PITCH_MM: f64 = 1.0;

@@ -121,11 +121,7 @@ impl OpenBlock {
             ));
             return;
         }
-        if crate::parts::check_positive(
-            "mold.open_block.",
-            &[("width_mm", self.width_mm), ("height_mm", self.height_mm)],
-            errs,
-        ) {
+        if crate::parts::check_above_zero("mold.open_block.", self, &[], errs) {
             return;
         }
         let least_width = 2.0 * (rim_radius_mm + min_wall_mm);

@@ -379,15 +379,7 @@ pub fn check_recess(
     errs: &mut Vec<ParamError>,
 ) {
     let prefix = format!("{path}.");
-    let mut bad = crate::parts::check_positive(
-        &prefix,
-        &[
-            ("base_diameter_mm", r.base_diameter_mm),
-            ("depth_mm", r.depth_mm),
-            ("cap_radius_mm", r.cap_radius_mm),
-        ],
-        errs,
-    );
+    let mut bad = crate::parts::check_above_zero(&prefix, r, &[], errs);
     if !(r.fillet_radius_mm >= 0.0 && r.fillet_radius_mm.is_finite()) {
         errs.push(ParamError::new(
             format!("{prefix}fillet_radius_mm"),

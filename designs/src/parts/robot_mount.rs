@@ -134,24 +134,7 @@ pub fn check_params(
 ) {
     let before = errs.len();
     let path = |p: &str| format!("shaft_body.robot_mount.{p}");
-    let mut numbers = vec![
-        ("plate_thickness_mm", m.plate_thickness_mm),
-        ("cup_wall_mm", m.cup_wall_mm),
-        ("cup_height_mm", m.cup_height_mm),
-        ("bolt_circle_diameter_mm", m.bolt_circle_diameter_mm),
-        ("bolt_clearance_diameter_mm", m.bolt_clearance_diameter_mm),
-        ("bolt_head_diameter_mm", m.bolt_head_diameter_mm),
-        ("bolt_head_depth_mm", m.bolt_head_depth_mm),
-        ("pin_hole_diameter_mm", m.pin_hole_diameter_mm),
-        ("pin_hole_depth_mm", m.pin_hole_depth_mm),
-        ("bayonet.lug_width_mm", m.bayonet.lug_width_mm),
-        ("bayonet.lug_height_mm", m.bayonet.lug_height_mm),
-        ("bayonet.lug_depth_mm", m.bayonet.lug_depth_mm),
-    ];
-    if let Some(g) = m.bayonet.groove_width_mm {
-        numbers.push(("bayonet.groove_width_mm", g));
-    }
-    crate::parts::check_positive("shaft_body.robot_mount.", &numbers, errs);
+    crate::parts::check_above_zero("shaft_body.robot_mount.", m, &[], errs);
     if !(2..=8).contains(&m.bolt_count) {
         errs.push(ParamError::new(
             path("bolt_count"),

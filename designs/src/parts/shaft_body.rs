@@ -351,7 +351,8 @@ pub fn check_params(
     errs: &mut Vec<ParamError>,
 ) {
     let before = errs.len();
-    check_numbers_positive(sb, errs);
+    // The mount checks its own numbers (robot_mount::check_params).
+    crate::parts::check_above_zero("shaft_body.", sb, &["robot_mount"], errs);
     check_printer_and_angles(ctx, sb, stack, errs);
     if errs.len() > before || skin_layer(stack).is_none() {
         return;
@@ -365,54 +366,6 @@ pub fn check_params(
     if let Some(m) = &sb.robot_mount {
         crate::parts::robot_mount::check_params(ctx, sb, m, errs);
     }
-}
-
-/// The shaft body's numbers that must be above 0 (paths under `shaft_body`), the optional
-/// `bayonet.groove_width_mm` and `led_ring.seat_diameter_mm` among them when given.
-fn check_numbers_positive(sb: &ShaftBodyParams, errs: &mut Vec<ParamError>) {
-    let cam = &sb.camera;
-    let optional = [
-        ("bayonet.groove_width_mm", sb.bayonet.groove_width_mm),
-        ("led_ring.seat_diameter_mm", sb.led_ring.seat_diameter_mm),
-    ];
-    let mut numbers = vec![
-        ("shaft_diameter_mm", sb.shaft_diameter_mm),
-        ("shaft_length_mm", sb.shaft_length_mm),
-        ("wall_thickness_mm", sb.wall_thickness_mm),
-        (
-            "tip_fitting.skirt_length_mm",
-            sb.tip_fitting.skirt_length_mm,
-        ),
-        ("tip_fitting.lip_width_mm", sb.tip_fitting.lip_width_mm),
-        (
-            "tip_fitting.lip_thickness_mm",
-            sb.tip_fitting.lip_thickness_mm,
-        ),
-        ("bayonet.lug_width_mm", sb.bayonet.lug_width_mm),
-        ("bayonet.lug_height_mm", sb.bayonet.lug_height_mm),
-        ("bayonet.lug_depth_mm", sb.bayonet.lug_depth_mm),
-        ("lens_window.diameter_mm", sb.lens_window.diameter_mm),
-        ("lens_window.thickness_mm", sb.lens_window.thickness_mm),
-        ("led_ring.outer_diameter_mm", sb.led_ring.outer_diameter_mm),
-        ("led_ring.inner_diameter_mm", sb.led_ring.inner_diameter_mm),
-        ("led_ring.thickness_mm", sb.led_ring.thickness_mm),
-        ("led_ring.led_height_mm", sb.led_ring.led_height_mm),
-        ("camera.board_width_mm", cam.board_width_mm),
-        ("camera.bay_height_mm", cam.bay_height_mm),
-        ("camera.lens_diameter_mm", cam.lens_diameter_mm),
-        ("camera.lens_height_mm", cam.lens_height_mm),
-        ("camera.focal_length_mm", cam.focal_length_mm),
-        ("camera.mount_hole_spacing_mm", cam.mount_hole_spacing_mm),
-        (
-            "camera.mount_pilot_diameter_mm",
-            cam.mount_pilot_diameter_mm,
-        ),
-        ("camera.mount_pilot_depth_mm", cam.mount_pilot_depth_mm),
-        ("base.outer_diameter_mm", sb.base.outer_diameter_mm),
-        ("base.ceiling_thickness_mm", sb.base.ceiling_thickness_mm),
-    ];
-    numbers.extend(optional.into_iter().filter_map(|(p, v)| Some((p, v?))));
-    crate::parts::check_positive("shaft_body.", &numbers, errs);
 }
 
 /// The FDM bayonet's settings (`printers.fdm.bayonet`: 2 to 8 lugs, the ramp below 15 deg, the

@@ -16,7 +16,7 @@ use crate::parts::context::{Context, Stack};
 use crate::parts::family::{named, AssemblyInput, AssemblyStep, Built, Family, FamilyInput};
 use crate::parts::part::{Part, PrintTechnology};
 use crate::parts::placement::{place_posed, with_pose};
-use crate::parts::{check_positive, z_cylinder};
+use crate::parts::{check_above_zero, z_cylinder};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
@@ -61,17 +61,7 @@ impl Family for SpacerFamily {
     }
 
     fn check(p: &SpacerParams, ctx: &Context<'_>, stack: &Stack, errs: &mut Vec<ParamError>) {
-        let before = errs.len();
-        check_positive(
-            "spacer.",
-            &[
-                ("outer_diameter_mm", p.outer_diameter_mm),
-                ("inner_diameter_mm", p.inner_diameter_mm),
-                ("height_mm", p.height_mm),
-            ],
-            errs,
-        );
-        if errs.len() > before {
+        if check_above_zero("spacer.", p, &[], errs) {
             return;
         }
         let rim_mm = 2.0 * ctx.body.rim_radius_mm(0.0);

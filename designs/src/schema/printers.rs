@@ -220,17 +220,8 @@ pub(crate) fn check_printers(printers: &PrinterProfiles, errs: &mut Vec<ParamErr
         ("sla", &printers.sla),
         ("polyjet", &printers.polyjet),
     ] {
-        crate::parts::check_positive(
-            &format!("printers.{name}."),
-            &[
-                ("xy_resolution_mm", p.xy_resolution_mm),
-                ("layer_height_mm", p.layer_height_mm),
-                ("min_wall_mm", p.min_wall_mm),
-                ("min_hole_diameter_mm", p.min_hole_diameter_mm),
-                ("min_feature_mm", p.min_feature_mm),
-            ],
-            errs,
-        );
+        // The bed has its own rules (check_bed).
+        crate::parts::check_above_zero(&format!("printers.{name}."), p, &["bed"], errs);
         if let Some(bed) = &p.bed {
             check_bed(bed, &format!("printers.{name}.bed"), errs);
         }

@@ -137,3 +137,81 @@ fn every_length_and_angle_is_bounded_as_the_validator_bounds_it() {
         "{lengths} lengths, {angles} angles"
     );
 }
+
+/// The subschemas `steps` lead to from `s` (several where `oneOf` branches share a key), behind
+/// `$ref`s into `root`'s `$defs`.
+fn schemas_at<'a>(
+    root: &'a Value,
+    s: &'a Value,
+    steps: &[fabkit_designs::values::Step],
+) -> Vec<&'a serde_json::Map<String, Value>> {
+    use fabkit_designs::values::Step;
+    let Value::Object(m) = s else {
+        return Vec::new();
+    };
+    if let Some(r) = m.get("$ref").and_then(Value::as_str) {
+        let name = r.trim_start_matches("#/$defs/");
+        return schemas_at(root, &root["$defs"][name], steps);
+    }
+    let mut out = Vec::new();
+    for k in ["anyOf", "oneOf", "allOf"] {
+        if let Some(Value::Array(subs)) = m.get(k) {
+            for sub in subs {
+                out.extend(schemas_at(root, sub, steps));
+            }
+        }
+    }
+    match steps.split_first() {
+        None => out.push(m),
+        Some((Step::Key(k), rest)) => {
+            if let Some(sub) = m.get("properties").and_then(|p| p.get(k.as_str())) {
+                out.extend(schemas_at(root, sub, rest));
+            } else if let Some(sub) = m.get("additionalProperties") {
+                out.extend(schemas_at(root, sub, rest));
+            }
+        }
+        Some((Step::Index(_), rest)) => {
+            if let Some(sub) = m.get("items") {
+                out.extend(schemas_at(root, sub, rest));
+            }
+        }
+    }
+    out
+}
+
+/// The schema and the validator agree on "above 0": every number of every library design whose
+/// schema bound is only `exclusiveMinimum: 0` (no range of its own), set to 0, is refused by
+/// `validate` under its own path. The families read that bound back from the schema
+/// (`parts::check_above_zero`), so a field marked in the schema cannot go unchecked.
+#[test]
+fn every_number_the_schema_marks_above_0_is_refused_at_0_under_its_path() {
+    use fabkit_designs::values::{number_paths, with_number};
+    let schema = design_json_schema();
+    let mut checked = 0;
+    for (name, _) in fabkit_designs::library::LIBRARY {
+        let design = fabkit_designs::library::load(name).unwrap();
+        for path in number_paths(&design, &["presets"]).unwrap() {
+            let at = schemas_at(&schema, &schema, &path.0);
+            let above_zero_only = !at.is_empty()
+                && at.iter().all(|m| {
+                    num(m, "exclusiveMinimum") == Some(0.0) && !m.contains_key("exclusiveMaximum")
+                });
+            if !above_zero_only {
+                continue;
+            }
+            let zero = with_number(&design, &path, 0.0).unwrap();
+            let named = path.to_string();
+            let errs = match fabkit_designs::validate_design(&zero, Default::default()) {
+                Ok(_) => Vec::new(),
+                Err(fabkit_designs::DesignError::Params(e)) => e.0,
+                Err(e) => panic!("{name}: {named} = 0: {e}"),
+            };
+            assert!(
+                errs.iter().any(|e| e.path == named),
+                "{name}: {named} = 0 is not refused under its path: {errs:?}"
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked > 100, "{checked} numbers checked");
+}
