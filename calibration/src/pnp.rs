@@ -646,22 +646,6 @@ fn draw(rng: &mut ChaCha8Rng, n: usize, out: &mut [usize]) {
     }
 }
 
-/// Sum of squared reprojection errors over `idx`, or `None` if a point does not project.
-fn cost(
-    camera: &CameraModel,
-    pts: &[Vector3<f64>],
-    px: &[Vector2<f64>],
-    idx: &[usize],
-    r: &Matrix3<f64>,
-    t: &Vector3<f64>,
-) -> Option<f64> {
-    let mut s = 0.0;
-    for &i in idx {
-        s += (camera.project(&(r * pts[i] + t))? - px[i]).norm_squared();
-    }
-    Some(s)
-}
-
 /// Normal equations of the reprojection error at (r, t): J^T J and J^T e over `idx`, with the
 /// rotation perturbed on the left (R <- exp(w) R) and parameters (w, t); `residuals` gets the
 /// reprojected minus observed pixel per entry of `idx`.
@@ -703,8 +687,7 @@ pub(crate) fn normal_equations(
     Some((jtj, jte, s))
 }
 
-/// The rotation matrix and translation of a pose, as [`cost`] and [`normal_equations`] take
-/// them.
+/// The rotation matrix and translation of a pose, as [`normal_equations`] takes them.
 fn rotation_translation(pose: &Isometry3<f64>) -> (Matrix3<f64>, Vector3<f64>) {
     (
         *pose.rotation.to_rotation_matrix().matrix(),
@@ -712,16 +695,18 @@ fn rotation_translation(pose: &Isometry3<f64>) -> (Matrix3<f64>, Vector3<f64>) {
     )
 }
 
-/// Reprojection cost of a pose over all pairs, px^2 (for tests and reports).
+/// Reprojection cost of a pose over all pairs, px^2 (for tests and reports): the sum of the
+/// squared reprojection errors, or `None` if a point does not project.
 pub fn reprojection_cost(
     camera: &CameraModel,
     points_mm: &[Vector3<f64>],
     pixels_px: &[Vector2<f64>],
     t_cam_sensor: &Isometry3<f64>,
 ) -> Option<f64> {
-    let idx: Vec<usize> = (0..points_mm.len()).collect();
     let (r, t) = rotation_translation(t_cam_sensor);
-    cost(camera, points_mm, pixels_px, &idx, &r, &t)
+    points_mm.iter().zip(pixels_px).try_fold(0.0, |s, (p, x)| {
+        Some(s + (camera.project(&(r * p + t))? - x).norm_squared())
+    })
 }
 
 /// Normal equations at a pose (J^T J, J^T e, cost); used by the Jacobian test and the

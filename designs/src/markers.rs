@@ -718,17 +718,21 @@ pub fn place(
         return Err(e);
     }
     let (s_min, s_max) = patterned_arc(surface, pattern, rim_margin_mm)?;
-    let polar_max = surface.polar_deg_at(s_max);
-    let centre = pattern.center_marker && s_min == 0.0;
-    // (s, azimuth radians, ring)
-    let raw: Vec<(f64, f64, u32)> = match pattern.layout {
-        Layout::Concentric6k => {
-            concentric_6k_raw(surface, pattern, rim_margin_mm, s_max, polar_max, centre)?
-        }
-        Layout::Concentric => concentric_raw(surface, pattern, s_min, s_max, polar_max, centre)?,
-        Layout::HexGrid => hex_grid_raw(pattern, s_min, s_max)?,
-        Layout::GoldenSpiral => golden_spiral_raw(surface, pattern, s_min, s_max)?,
-        Layout::List => list_raw(surface, pattern, s_min, s_max)?,
+    let region = Region {
+        surface,
+        pattern,
+        rim_margin_mm,
+        s_min,
+        s_max,
+        polar_max: surface.polar_deg_at(s_max),
+        centre: pattern.center_marker && s_min == 0.0,
+    };
+    let raw = match pattern.layout {
+        Layout::Concentric6k => concentric_6k_raw(&region)?,
+        Layout::Concentric => concentric_raw(&region)?,
+        Layout::HexGrid => hex_grid_raw(&region)?,
+        Layout::GoldenSpiral => golden_spiral_raw(&region)?,
+        Layout::List => list_raw(&region)?,
     };
     Ok(raw
         .into_iter()
@@ -747,6 +751,29 @@ pub fn place(
         })
         .collect())
 }
+
+/// What every layout places its markers in: the pattern on its surface, and the patterned
+/// region between `s_min` and `s_max` mm of arc from the pole (`polar_max` deg at its outer
+/// edge); `centre`: a marker goes on the pole.
+struct Region<'a> {
+    surface: &'a Surface,
+    pattern: &'a Pattern,
+    rim_margin_mm: f64,
+    s_min: f64,
+    s_max: f64,
+    polar_max: f64,
+    centre: bool,
+}
+
+impl Region<'_> {
+    /// The rule that bounds the region, for messages ([`region_limit`]).
+    fn limit(&self) -> String {
+        region_limit(self.surface, self.pattern, self.rim_margin_mm)
+    }
+}
+
+/// A marker before it is placed: (arc length mm, azimuth radians, ring).
+type RawMarker = (f64, f64, u32);
 
 /// A pattern error as an `Err`: (field below `pattern`, value, rule).
 fn pattern_err<T>(f: &str, v: String, rule: &str) -> Result<T, PatternError> {
@@ -795,7 +822,7 @@ fn too_many(field: &str, value: String, n: f64) -> PatternError {
 
 /// Pushes onto `raw` ring `k` of `n` markers at arc length `s` mm, evenly spaced in azimuth
 /// from the ring's offset (`ring_azimuth_offset` of `pattern`).
-fn push_ring(pattern: &Pattern, raw: &mut Vec<(f64, f64, u32)>, s: f64, k: u32, n: usize) {
+fn push_ring(pattern: &Pattern, raw: &mut Vec<RawMarker>, s: f64, k: u32, n: usize) {
     let off = pattern.ring_offset_rad(k, n);
     for j in 0..n {
         raw.push((s, off + 2.0 * PI * j as f64 / n as f64, k));
@@ -809,16 +836,17 @@ fn push_ring(pattern: &Pattern, raw: &mut Vec<(f64, f64, u32)>, s: f64, k: u32, 
 ///
 /// # Errors
 /// The first violation, as [`place`] reports it.
-fn concentric_6k_raw(
-    surface: &Surface,
-    pattern: &Pattern,
-    rim_margin_mm: f64,
-    s_max: f64,
-    polar_max: f64,
-    centre: bool,
-) -> Result<Vec<(f64, f64, u32)>, PatternError> {
+fn concentric_6k_raw(r: &Region<'_>) -> Result<Vec<RawMarker>, PatternError> {
+    let Region {
+        surface,
+        pattern,
+        s_max,
+        polar_max,
+        centre,
+        ..
+    } = *r;
     let cap = MAX_MARKERS_PER_PATTERN as f64;
-    let mut raw: Vec<(f64, f64, u32)> = Vec::new();
+    let mut raw = Vec::new();
     let rings = pattern.rings.ok_or_else(|| {
         (
             "rings".to_string(),
@@ -841,7 +869,7 @@ fn concentric_6k_raw(
                 step.to_string(),
                 &format!(
                     "puts ring {rings} at {rings} x {step} = {last:.4} deg, beyond the patterned region (up to {polar_max:.4} deg: {})",
-                    region_limit(surface, pattern, rim_margin_mm)
+                    r.limit()
                 ),
             );
         }
@@ -854,7 +882,7 @@ fn concentric_6k_raw(
         for k in 1..=rings {
             let s = k as f64 * pitch;
             if s > s_max + 1e-9 {
-                return pattern_err("rings", rings.to_string(), &format!("ring {k} at {s:.3} mm of arc lies beyond the patterned region ({s_max:.3} mm: {})", region_limit(surface, pattern, rim_margin_mm)));
+                return pattern_err("rings", rings.to_string(), &format!("ring {k} at {s:.3} mm of arc lies beyond the patterned region ({s_max:.3} mm: {})", r.limit()));
             }
             push_ring(pattern, &mut raw, s, k, 6 * k as usize);
         }
@@ -870,16 +898,18 @@ fn concentric_6k_raw(
 ///
 /// # Errors
 /// The first violation, as [`place`] reports it.
-fn concentric_raw(
-    surface: &Surface,
-    pattern: &Pattern,
-    s_min: f64,
-    s_max: f64,
-    polar_max: f64,
-    centre: bool,
-) -> Result<Vec<(f64, f64, u32)>, PatternError> {
+fn concentric_raw(r: &Region<'_>) -> Result<Vec<RawMarker>, PatternError> {
+    let Region {
+        surface,
+        pattern,
+        s_min,
+        s_max,
+        polar_max,
+        centre,
+        ..
+    } = *r;
     let cap = MAX_MARKERS_PER_PATTERN as f64;
-    let mut raw: Vec<(f64, f64, u32)> = Vec::new();
+    let mut raw = Vec::new();
     let sp = positive(pattern, "spacing_mm", pattern.spacing_mm)?;
     if centre {
         raw.push((0.0, 0.0, 0));
@@ -953,13 +983,15 @@ fn concentric_raw(
 ///
 /// # Errors
 /// The first violation, as [`place`] reports it.
-fn hex_grid_raw(
-    pattern: &Pattern,
-    s_min: f64,
-    s_max: f64,
-) -> Result<Vec<(f64, f64, u32)>, PatternError> {
+fn hex_grid_raw(r: &Region<'_>) -> Result<Vec<RawMarker>, PatternError> {
+    let Region {
+        pattern,
+        s_min,
+        s_max,
+        ..
+    } = *r;
     let cap = MAX_MARKERS_PER_PATTERN as f64;
-    let mut raw: Vec<(f64, f64, u32)> = Vec::new();
+    let mut raw = Vec::new();
     let a = positive(pattern, "spacing_mm", pattern.spacing_mm)?;
     // Lattice points in the disc of radius s_max (the loop visits its bounding square).
     let n = PI * s_max * s_max / (a * a * 3f64.sqrt() / 2.0);
@@ -995,14 +1027,16 @@ fn hex_grid_raw(
 ///
 /// # Errors
 /// The first violation, as [`place`] reports it.
-fn golden_spiral_raw(
-    surface: &Surface,
-    pattern: &Pattern,
-    s_min: f64,
-    s_max: f64,
-) -> Result<Vec<(f64, f64, u32)>, PatternError> {
+fn golden_spiral_raw(r: &Region<'_>) -> Result<Vec<RawMarker>, PatternError> {
+    let Region {
+        surface,
+        pattern,
+        s_min,
+        s_max,
+        ..
+    } = *r;
     let cap = MAX_MARKERS_PER_PATTERN as f64;
-    let mut raw: Vec<(f64, f64, u32)> = Vec::new();
+    let mut raw = Vec::new();
     // cumulative area table from s_min to s_max, inverted by interpolation
     let k = 4096;
     let ss: Vec<f64> = (0..=k)
@@ -1045,13 +1079,15 @@ fn golden_spiral_raw(
 ///
 /// # Errors
 /// The first violation, as [`place`] reports it.
-fn list_raw(
-    surface: &Surface,
-    pattern: &Pattern,
-    s_min: f64,
-    s_max: f64,
-) -> Result<Vec<(f64, f64, u32)>, PatternError> {
-    let mut raw: Vec<(f64, f64, u32)> = Vec::new();
+fn list_raw(r: &Region<'_>) -> Result<Vec<RawMarker>, PatternError> {
+    let Region {
+        surface,
+        pattern,
+        s_min,
+        s_max,
+        ..
+    } = *r;
+    let mut raw = Vec::new();
     let pts = pattern.points.as_ref().ok_or_else(|| {
         (
             "points".to_string(),
