@@ -98,12 +98,12 @@ struct AboveZero<'a> {
 impl AboveZero<'_> {
     fn walk(&mut self, s: &serde_json::Value, v: &serde_value::Value, path: &str, top: bool) {
         use serde_value::Value as V;
-        let s = resolve(self.root, s);
         let v = match v {
             V::Option(None) | V::Unit => return,
             V::Option(Some(inner)) | V::Newtype(inner) => return self.walk(s, inner, path, top),
             v => v,
         };
+        let s = resolve(self.root, s, v);
         let only_above_zero = s.get("exclusiveMinimum").and_then(|b| b.as_f64()) == Some(0.0)
             && ["minimum", "maximum", "exclusiveMaximum"]
                 .iter()
@@ -148,22 +148,42 @@ impl AboveZero<'_> {
     }
 }
 
-/// The schema `s` stands for: behind a `$ref` into `root`'s `$defs`, the non-null branch of an
-/// `Option`'s `anyOf`, or a single `allOf`.
-fn resolve<'s>(root: &'s serde_json::Value, s: &'s serde_json::Value) -> &'s serde_json::Value {
+/// The schema `s` stands for where it describes `v`: behind a `$ref` into `root`'s `$defs`,
+/// the non-null branch of an `Option`'s `anyOf`, or, of several branches (an enum's variants),
+/// the first whose properties hold every key of the mapping `v`.
+fn resolve<'s>(
+    root: &'s serde_json::Value,
+    s: &'s serde_json::Value,
+    v: &serde_value::Value,
+) -> &'s serde_json::Value {
     if let Some(r) = s.get("$ref").and_then(|r| r.as_str()) {
         let def = r
             .strip_prefix("#/$defs/")
             .and_then(|name| root.get("$defs")?.get(name));
-        return def.map_or(s, |d| resolve(root, d));
+        return def.map_or(s, |d| resolve(root, d, v));
     }
     for key in ["anyOf", "oneOf", "allOf"] {
-        if let Some(branches) = s.get(key).and_then(|b| b.as_array()) {
-            let mut real = branches
-                .iter()
-                .filter(|b| b.get("type").and_then(|t| t.as_str()) != Some("null"));
-            if let (Some(only), None) = (real.next(), real.next()) {
-                return resolve(root, only);
+        let Some(branches) = s.get(key).and_then(|b| b.as_array()) else {
+            continue;
+        };
+        let real: Vec<_> = branches
+            .iter()
+            .filter(|b| b.get("type").and_then(|t| t.as_str()) != Some("null"))
+            .map(|b| resolve(root, b, v))
+            .collect();
+        let fits = |b: &&serde_json::Value| match (v, b.get("properties")) {
+            (serde_value::Value::Map(m), Some(props)) => m.keys().all(|k| match k {
+                serde_value::Value::String(k) => props.get(k).is_some(),
+                _ => false,
+            }),
+            _ => false,
+        };
+        match real.as_slice() {
+            [only] => return only,
+            [..] => {
+                if let Some(b) = real.iter().copied().find(fits) {
+                    return b;
+                }
             }
         }
     }

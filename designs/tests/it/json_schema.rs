@@ -215,3 +215,87 @@ fn every_number_the_schema_marks_above_0_is_refused_at_0_under_its_path() {
     }
     assert!(checked > 100, "{checked} numbers checked");
 }
+
+#[derive(serde::Serialize, schemars::JsonSchema)]
+#[serde(rename_all = "snake_case")]
+enum ProbeShape {
+    Disc {
+        #[schemars(extend("exclusiveMinimum" = 0))]
+        diameter_mm: f64,
+    },
+    Square {
+        #[schemars(extend("exclusiveMinimum" = 0))]
+        side_mm: f64,
+    },
+}
+
+#[derive(serde::Serialize, schemars::JsonSchema)]
+struct ProbeInner {
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    a_mm: f64,
+    /// No bound: never this rule's.
+    b_mm: f64,
+}
+
+#[derive(serde::Serialize, schemars::JsonSchema)]
+struct Probe {
+    shape: ProbeShape,
+    #[schemars(extend("exclusiveMinimum" = 0, "exclusiveMaximum" = 180))]
+    view_angle_deg: f64,
+    #[schemars(extend("items" = {"type": "number", "exclusiveMinimum": 0}))]
+    spacing_mm: [f64; 2],
+    nested: Option<ProbeInner>,
+    absent: Option<ProbeInner>,
+    skipped: ProbeInner,
+}
+
+/// `check_above_zero` follows the schema into enum variants, optional fields and array items,
+/// leaves a number with a range of its own (an angle in (0, 180)) and the skipped keys to their
+/// own rules, and names each path under the prefix in the schema's order.
+#[test]
+fn above_zero_follows_the_schema_into_variants_options_and_items() {
+    let p = Probe {
+        shape: ProbeShape::Square { side_mm: 0.0 },
+        view_angle_deg: 0.0,
+        spacing_mm: [1.0, -1.0],
+        nested: Some(ProbeInner {
+            a_mm: -2.0,
+            b_mm: -2.0,
+        }),
+        absent: None,
+        skipped: ProbeInner {
+            a_mm: 0.0,
+            b_mm: 0.0,
+        },
+    };
+    let mut errs = Vec::new();
+    assert!(fabkit_designs::parts::check_above_zero(
+        "probe.",
+        &p,
+        &["skipped"],
+        &mut errs
+    ));
+    let named: Vec<String> = errs.iter().map(|e| e.to_string()).collect();
+    assert_eq!(
+        named,
+        [
+            "probe.nested.a_mm = -2: must be above 0",
+            "probe.shape.square.side_mm = 0: must be above 0",
+            "probe.spacing_mm[1] = -1: must be above 0",
+        ]
+    );
+    let fine = Probe {
+        shape: ProbeShape::Disc { diameter_mm: 3.0 },
+        spacing_mm: [1.0, 1.0],
+        nested: None,
+        ..p
+    };
+    let mut errs = Vec::new();
+    assert!(!fabkit_designs::parts::check_above_zero(
+        "probe.",
+        &fine,
+        &["skipped"],
+        &mut errs
+    ));
+    assert!(errs.is_empty(), "{errs:?}");
+}
