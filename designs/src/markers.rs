@@ -837,14 +837,8 @@ fn push_ring(pattern: &Pattern, raw: &mut Vec<RawMarker>, s: f64, k: u32, n: usi
 /// # Errors
 /// The first violation, as [`place`] reports it.
 fn concentric_6k_raw(r: &Region<'_>) -> Result<Vec<RawMarker>, PatternError> {
-    let Region {
-        surface,
-        pattern,
-        s_max,
-        polar_max,
-        centre,
-        ..
-    } = *r;
+    let (surface, pattern, s_max, polar_max, centre) =
+        (r.surface, r.pattern, r.s_max, r.polar_max, r.centre);
     let cap = MAX_MARKERS_PER_PATTERN as f64;
     let mut raw = Vec::new();
     let rings = pattern.rings.ok_or_else(|| {
@@ -899,15 +893,8 @@ fn concentric_6k_raw(r: &Region<'_>) -> Result<Vec<RawMarker>, PatternError> {
 /// # Errors
 /// The first violation, as [`place`] reports it.
 fn concentric_raw(r: &Region<'_>) -> Result<Vec<RawMarker>, PatternError> {
-    let Region {
-        surface,
-        pattern,
-        s_min,
-        s_max,
-        polar_max,
-        centre,
-        ..
-    } = *r;
+    let (surface, pattern, s_min, s_max) = (r.surface, r.pattern, r.s_min, r.s_max);
+    let (polar_max, centre) = (r.polar_max, r.centre);
     let cap = MAX_MARKERS_PER_PATTERN as f64;
     let mut raw = Vec::new();
     let sp = positive(pattern, "spacing_mm", pattern.spacing_mm)?;
@@ -984,12 +971,7 @@ fn concentric_raw(r: &Region<'_>) -> Result<Vec<RawMarker>, PatternError> {
 /// # Errors
 /// The first violation, as [`place`] reports it.
 fn hex_grid_raw(r: &Region<'_>) -> Result<Vec<RawMarker>, PatternError> {
-    let Region {
-        pattern,
-        s_min,
-        s_max,
-        ..
-    } = *r;
+    let (pattern, s_min, s_max) = (r.pattern, r.s_min, r.s_max);
     let cap = MAX_MARKERS_PER_PATTERN as f64;
     let mut raw = Vec::new();
     let a = positive(pattern, "spacing_mm", pattern.spacing_mm)?;
@@ -1028,13 +1010,7 @@ fn hex_grid_raw(r: &Region<'_>) -> Result<Vec<RawMarker>, PatternError> {
 /// # Errors
 /// The first violation, as [`place`] reports it.
 fn golden_spiral_raw(r: &Region<'_>) -> Result<Vec<RawMarker>, PatternError> {
-    let Region {
-        surface,
-        pattern,
-        s_min,
-        s_max,
-        ..
-    } = *r;
+    let (surface, pattern, s_min, s_max) = (r.surface, r.pattern, r.s_min, r.s_max);
     let cap = MAX_MARKERS_PER_PATTERN as f64;
     let mut raw = Vec::new();
     // cumulative area table from s_min to s_max, inverted by interpolation
@@ -1080,13 +1056,7 @@ fn golden_spiral_raw(r: &Region<'_>) -> Result<Vec<RawMarker>, PatternError> {
 /// # Errors
 /// The first violation, as [`place`] reports it.
 fn list_raw(r: &Region<'_>) -> Result<Vec<RawMarker>, PatternError> {
-    let Region {
-        surface,
-        pattern,
-        s_min,
-        s_max,
-        ..
-    } = *r;
+    let (surface, pattern, s_min, s_max) = (r.surface, r.pattern, r.s_min, r.s_max);
     let mut raw = Vec::new();
     let pts = pattern.points.as_ref().ok_or_else(|| {
         (

@@ -34,8 +34,9 @@ use crate::error::ParamError;
 use crate::geometry::{cylinder, ChordTolerance, GeometryError, Solid};
 
 /// The rule on lengths and sizes: "must be above 0" for each `(path, value)` that is not a
-/// positive finite number, the path under `prefix` (`casing.`, `pin_dome.` ...); whether any
-/// broke it.
+/// positive finite number, the path under `prefix` (`pin_dome.`, `body.` ...); whether any
+/// broke it. For parameters without a JSON Schema (the fixtures) or with a hand-written one
+/// (the body profile); a design section with a derived schema uses [`check_above_zero`].
 pub fn check_positive(prefix: &str, values: &[(&str, f64)], errs: &mut Vec<ParamError>) -> bool {
     let before = errs.len();
     for &(p, v) in values {
