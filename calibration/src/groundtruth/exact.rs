@@ -18,32 +18,28 @@ pub struct PrimitiveError {
     pub rule: String,
 }
 
+/// A shape about a segment: from `a` along the unit axis `w` for length `h` (mm), radius `r`
+/// (mm).
+#[derive(Debug, Clone, Copy)]
+struct Axial {
+    a: [f64; 3],
+    w: [f64; 3],
+    h: f64,
+    r: f64,
+}
+
 #[derive(Debug, Clone)]
 enum Shape {
     Sphere {
         c: [f64; 3],
         r: f64,
     },
-    /// Flat-capped cylinder from `a` along unit `w` for length `h`.
-    Cylinder {
-        a: [f64; 3],
-        w: [f64; 3],
-        h: f64,
-        r: f64,
-    },
-    /// Solid cone: apex, unit axis `w` from the apex to the base, height, base radius.
-    Cone {
-        apex: [f64; 3],
-        w: [f64; 3],
-        h: f64,
-        r: f64,
-    },
-    Capsule {
-        a: [f64; 3],
-        w: [f64; 3],
-        h: f64,
-        r: f64,
-    },
+    /// Flat-capped cylinder of radius `r` round the segment.
+    Cylinder(Axial),
+    /// Solid cone: its apex at `a`, its base disc of radius `r` at the segment's end.
+    Cone(Axial),
+    /// The points within `r` of the segment.
+    Capsule(Axial),
     /// Box: centre, orthonormal axes (rows), half extents.
     Box {
         c: [f64; 3],
@@ -129,9 +125,9 @@ impl ExactPrimitives {
                     }
                     let (a, w, r) = (*base_mm, scale(axis, 1.0 / h), *radius_mm);
                     if kind == "cylinder" {
-                        Shape::Cylinder { a, w, h, r }
+                        Shape::Cylinder(Axial { a, w, h, r })
                     } else {
-                        Shape::Capsule { a, w, h, r }
+                        Shape::Capsule(Axial { a, w, h, r })
                     }
                 }
                 Primitive::Cone {
@@ -149,12 +145,12 @@ impl ExactPrimitives {
                     {
                         return Err(err("cone", format!("height {h} mm, base_radius_mm = {base_radius_mm}: needs distinct finite apex and base and a radius above 0")));
                     }
-                    Shape::Cone {
-                        apex: *apex_mm,
+                    Shape::Cone(Axial {
+                        a: *apex_mm,
                         w: scale(axis, 1.0 / h),
                         h,
                         r: *base_radius_mm,
-                    }
+                    })
                 }
                 Primitive::Box {
                     centre_mm,
@@ -289,8 +285,8 @@ fn bounding_sphere(s: &Shape) -> ([f64; 3], f64) {
     let slack = 1.0 + 1e-9;
     match s {
         Shape::Sphere { c, r } => (*c, r * slack + 1e-9),
-        Shape::Cylinder { a, w, h, r } | Shape::Capsule { a, w, h, r } => {
-            let cap = if matches!(s, Shape::Capsule { .. }) {
+        Shape::Cylinder(Axial { a, w, h, r }) | Shape::Capsule(Axial { a, w, h, r }) => {
+            let cap = if matches!(s, Shape::Capsule(_)) {
                 *r
             } else {
                 0.0
@@ -300,7 +296,7 @@ fn bounding_sphere(s: &Shape) -> ([f64; 3], f64) {
                 ((h / 2.0 + cap).hypot(*r) + cap) * slack + 1e-9,
             )
         }
-        Shape::Cone { apex, w, h, r } => (
+        Shape::Cone(Axial { a: apex, w, h, r }) => (
             add(*apex, scale(*w, h / 2.0)),
             (h / 2.0).hypot(*r) * slack + 1e-9,
         ),
@@ -429,17 +425,17 @@ fn crossing(s: &Shape, o: [f64; 3], d: [f64; 3], tmax: f64) -> Option<(f64, [f64
     let mut best = Best::new(tmax);
     match s {
         Shape::Sphere { c, r } => sphere_hits(*c, *r, o, d, &mut best),
-        Shape::Capsule { a, w, h, r } => {
+        Shape::Capsule(Axial { a, w, h, r }) => {
             tube_hits(*a, *w, *h, *r, o, d, &mut best);
             sphere_hits(*a, *r, o, d, &mut best);
             sphere_hits(add(*a, scale(*w, *h)), *r, o, d, &mut best);
         }
-        Shape::Cylinder { a, w, h, r } => {
+        Shape::Cylinder(Axial { a, w, h, r }) => {
             tube_hits(*a, *w, *h, *r, o, d, &mut best);
             disc_hit(*a, scale(*w, -1.0), *r, o, d, &mut best);
             disc_hit(add(*a, scale(*w, *h)), *w, *r, o, d, &mut best);
         }
-        Shape::Cone { apex, w, h, r } => {
+        Shape::Cone(Axial { a: apex, w, h, r }) => {
             // Lateral surface: |q - (q.w) w|^2 = k^2 (q.w)^2 with q = p - apex, k = r / h,
             // on the nappe 0 <= q.w <= h.
             let k2 = (r / h) * (r / h);
@@ -564,15 +560,15 @@ fn inside(s: &Shape, p: [f64; 3]) -> bool {
     };
     match s {
         Shape::Sphere { c, r } => norm(sub(p, *c)) <= *r,
-        Shape::Cylinder { a, w, h, r } => {
+        Shape::Cylinder(Axial { a, w, h, r }) => {
             let (s, rho, h) = seg(*a, *w, *h);
             (0.0..=h).contains(&s) && rho <= *r
         }
-        Shape::Capsule { a, w, h, r } => {
+        Shape::Capsule(Axial { a, w, h, r }) => {
             let s = dot(sub(p, *a), *w).clamp(0.0, *h);
             norm(sub(p, add(*a, scale(*w, s)))) <= *r
         }
-        Shape::Cone { apex, w, h, r } => {
+        Shape::Cone(Axial { a: apex, w, h, r }) => {
             let (s, rho, h) = seg(*apex, *w, *h);
             (0.0..=h).contains(&s) && rho <= r * s / h
         }
