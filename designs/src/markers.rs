@@ -766,9 +766,17 @@ struct Region<'a> {
 }
 
 impl Region<'_> {
-    /// The rule that bounds the region, for messages ([`region_limit`]).
+    /// The rule that bounds the region, for messages: `max_polar_deg` when given, else the rim
+    /// less `rim_margin_mm` mm of arc.
     fn limit(&self) -> String {
-        region_limit(self.surface, self.pattern, self.rim_margin_mm)
+        match self.pattern.max_polar_deg {
+            Some(p) => format!("max_polar_deg {p}"),
+            None => format!(
+                "the rim at {:.3} deg less a margin of {:.3} mm of arc",
+                self.surface.polar_deg_at(self.surface.total_arc_mm()),
+                self.rim_margin_mm
+            ),
+        }
     }
 }
 
@@ -778,19 +786,6 @@ type RawMarker = (f64, f64, u32);
 /// A pattern error as an `Err`: (field below `pattern`, value, rule).
 fn pattern_err<T>(f: &str, v: String, rule: &str) -> Result<T, PatternError> {
     Err((f.to_string(), v, rule.to_string()))
-}
-
-/// The rule that bounds the patterned region of `pattern` on `surface`, for messages:
-/// `max_polar_deg` when given, else the rim less `rim_margin_mm` mm of arc.
-fn region_limit(surface: &Surface, pattern: &Pattern, rim_margin_mm: f64) -> String {
-    // The rule that bounds the patterned region, for messages.
-    match pattern.max_polar_deg {
-        Some(p) => format!("max_polar_deg {p}"),
-        None => format!(
-            "the rim at {:.3} deg less a margin of {rim_margin_mm:.3} mm of arc",
-            surface.polar_deg_at(surface.total_arc_mm())
-        ),
-    }
 }
 
 /// The value `v` of field `f` of `pattern` when it is finite and above 0; the violation

@@ -179,13 +179,11 @@ fn resolve<'s>(
             }),
             _ => false,
         };
-        match real.as_slice() {
-            [only] => return only,
-            [..] => {
-                if let Some(b) = real.iter().copied().find(fits) {
-                    return b;
-                }
-            }
+        if let [only] = real.as_slice() {
+            return only;
+        }
+        if let Some(b) = real.iter().copied().find(fits) {
+            return b;
         }
     }
     s
