@@ -77,15 +77,8 @@ struct ExportArgs {
     /// previous export; refused if it holds anything else.
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Output formats, comma separated: stl, 3mf, step (exact B-rep through the CadQuery twin;
-    /// needs scripts/setup-cadquery or FABKIT_CADQUERY_PYTHON).
-    #[arg(long, value_delimiter = ',', default_value = "stl,3mf")]
-    format: Vec<Format>,
     #[command(flatten)]
-    printer: crate::printers::PrinterArgs,
-    /// Largest distance between the exported meshes and the exact solids, mm (seams included).
-    #[arg(long, default_value_t = ChordTolerance::DEFAULT_MM)]
-    chord_tolerance_mm: f64,
+    mesh: MeshOutputArgs,
     /// Apply one of the design's presets (see `fabkit designs`); the kit is named
     /// <design>_<preset>.
     #[arg(long)]
@@ -99,15 +92,6 @@ struct ExportArgs {
     /// Another command's output (fixtures, ground truth, calibration) is never replaced.
     #[arg(long)]
     force: bool,
-    /// Also write the CSG tree of every part (fabkit-csg/1 JSON) to this file, for
-    /// tests/oracles/replay_csg.py.
-    #[arg(long)]
-    csg: Option<PathBuf>,
-    /// Refuse a kit estimated (before building) at more triangles than this (about 1 KB of
-    /// memory each; 1 to 100000000).
-    #[arg(long, value_name = "N", default_value_t = fabkit_designs::estimate::DEFAULT_MAX_TRIANGLES,
-          value_parser = fabkit_designs::estimate::parse_max_triangles, allow_negative_numbers = true)]
-    max_triangles: u64,
     /// Print where the time went to stderr after the export: the wall and CPU time of each
     /// stage (reading, checks, parts, pours, assembly and fit check, meshes, pictures, plates,
     /// 3MF, manifest and sheet, writing) and of the whole command; CPU / wall is the number of
@@ -116,6 +100,72 @@ struct ExportArgs {
     timings: bool,
     #[command(flatten)]
     data_files: DataFileArgs,
+}
+
+/// The mesh output options of `fabkit export` and `fabkit fixtures`: what is written, for which
+/// printers, how finely, and the bound on the work.
+#[derive(clap::Args, Debug)]
+pub(crate) struct MeshOutputArgs {
+    /// Output formats, comma separated: stl, 3mf, step (exact B-rep through the CadQuery twin;
+    /// needs scripts/setup-cadquery or FABKIT_CADQUERY_PYTHON).
+    #[arg(long, value_delimiter = ',', default_value = "stl,3mf")]
+    pub format: Vec<Format>,
+    #[command(flatten)]
+    pub printer: crate::printers::PrinterArgs,
+    /// Largest distance between the exported meshes and the exact solids, mm (seams included).
+    #[arg(long, default_value_t = ChordTolerance::DEFAULT_MM)]
+    pub chord_tolerance_mm: f64,
+    /// Also write the CSG tree of every part (fabkit-csg/1 JSON) to this file, for the
+    /// manifold3d replays (tests/oracles/replay_csg.py, export/python/twins).
+    #[arg(long)]
+    pub csg: Option<PathBuf>,
+    /// Refuse an output estimated (before building) at more triangles than this (about 1 KB of
+    /// memory each; 1 to 100000000).
+    #[arg(long, value_name = "N", default_value_t = fabkit_designs::estimate::DEFAULT_MAX_TRIANGLES,
+          value_parser = fabkit_designs::estimate::parse_max_triangles, allow_negative_numbers = true)]
+    pub max_triangles: u64,
+}
+
+impl MeshOutputArgs {
+    /// The chord tolerance, checked (`--chord-tolerance-mm` names the error).
+    pub fn tolerance(&self) -> Result<ChordTolerance, Box<dyn Error>> {
+        tolerance(self.chord_tolerance_mm)
+    }
+
+    /// Reads the design (`design`, or the default library design), applies `preset` and then
+    /// the printer overrides.
+    pub fn load(
+        &self,
+        design: Option<&str>,
+        preset: Option<&str>,
+        data: &DataFileArgs,
+    ) -> Result<Loaded, Box<dyn Error>> {
+        let t = timings::stage("read the design");
+        let mut loaded = load_design(design, data)?;
+        if let Some(p) = preset {
+            loaded.apply_preset(p)?;
+        }
+        drop(t);
+        crate::printers::apply(&self.printer, &mut loaded.design.printers)?;
+        Ok(loaded)
+    }
+
+    /// The export options of this run: formats, provenance (command line, design, version).
+    pub fn options(&self, loaded: &Loaded, tol: ChordTolerance) -> ExportOptions {
+        export_options(loaded, tol, &self.format)
+    }
+
+    /// Refuses a `--csg` path that may not be written, before anything is built.
+    pub fn check_csg(&self) -> Result<(), Box<dyn Error>> {
+        self.csg.as_deref().map_or(Ok(()), check_csg_path)
+    }
+
+    /// Writes the CSG tree of `kit` to `--csg`, if given.
+    pub fn write_csg(&self, kit: &fabkit_designs::Kit) -> Result<(), Box<dyn Error>> {
+        self.csg
+            .as_deref()
+            .map_or(Ok(()), |path| write_csg(kit, path))
+    }
 }
 
 /// Which data files (a pattern's `csv_file`) a design file may read.
@@ -319,6 +369,19 @@ pub(crate) fn spinner(message: String) -> indicatif::ProgressBar {
     s
 }
 
+/// Prints the written parts, a line each: name, print technology, volume and file.
+pub(crate) fn print_parts(parts: &[fabkit_export::ManifestPart]) {
+    for p in parts {
+        out!(
+            "  {:34} {:4} {:>10.1} mm3  {}",
+            p.name,
+            p.print_technology.to_string(),
+            p.volume_mm3,
+            p.file.as_deref().unwrap_or("(3MF only)")
+        );
+    }
+}
+
 pub(crate) fn tolerance(mm: f64) -> Result<ChordTolerance, Box<dyn Error>> {
     ChordTolerance::new(mm).map_err(|e| format!("--chord-tolerance-mm: {e}").into())
 }
@@ -448,14 +511,12 @@ fn export(args: ExportArgs) -> Result<(), Box<dyn Error>> {
     if args.timings {
         timings::enable();
     }
-    let tol = tolerance(args.chord_tolerance_mm)?;
-    let t = timings::stage("read the design");
-    let mut loaded = load_design(args.design.as_deref(), &args.data_files)?;
-    if let Some(p) = &args.preset {
-        loaded.apply_preset(p)?;
-    }
-    drop(t);
-    crate::printers::apply(&args.printer, &mut loaded.design.printers)?;
+    let tol = args.mesh.tolerance()?;
+    let mut loaded = args.mesh.load(
+        args.design.as_deref(),
+        args.preset.as_deref(),
+        &args.data_files,
+    )?;
     if let Some(s) = args.mold_strategy {
         let s = match s {
             Strategy::Direct => MoldStrategy::Direct,
@@ -481,13 +542,11 @@ fn export(args: ExportArgs) -> Result<(), Box<dyn Error>> {
         .out
         .clone()
         .unwrap_or_else(|| Path::new("out").join(&loaded.design.name));
-    let mut opts = export_options(&loaded, tol, &args.format);
+    let mut opts = args.mesh.options(&loaded, tol);
     opts.force = args.force;
     // The output folder is checked before anything is built.
     fabkit_export::check_out_dir(&out, &opts.claim(&loaded.design.name))?;
-    if let Some(csg) = &args.csg {
-        check_csg_path(csg)?;
-    }
+    args.mesh.check_csg()?;
     let spinner = spinner(format!(
         "building {} at {} mm chord tolerance",
         loaded.design.name,
@@ -495,15 +554,15 @@ fn export(args: ExportArgs) -> Result<(), Box<dyn Error>> {
     ));
     let t0 = std::time::Instant::now();
     // The work is estimated and bounded before anything is built.
-    let kit = build_kit_bounded(&loaded.design, tol, args.max_triangles);
+    let kit = build_kit_bounded(&loaded.design, tol, args.mesh.max_triangles);
     spinner.finish_and_clear();
     let kit = kit?;
     // STEP export takes seconds a part: one plain line per part (a terminal, a log or a pipe)
     let step_progress = |i: usize, n: usize, part: &str| eprintln!("STEP {i}/{n}: {part}");
     let summary = write_kit_reporting(&kit, &[], &out, &opts, Some(&step_progress))?;
-    if let Some(csg) = &args.csg {
+    if args.mesh.csg.is_some() {
         let _t = timings::stage("CSG tree");
-        write_csg(&kit, csg)?;
+        args.mesh.write_csg(&kit)?;
     }
     for w in &summary.warnings {
         eprintln!("warning: {w}");
@@ -517,15 +576,7 @@ fn export(args: ExportArgs) -> Result<(), Box<dyn Error>> {
         summary.files.len(),
         t0.elapsed().as_secs_f64()
     );
-    for p in &summary.manifest.parts {
-        out!(
-            "  {:34} {:4} {:>10.1} mm3  {}",
-            p.name,
-            p.print_technology.to_string(),
-            p.volume_mm3,
-            p.file.as_deref().unwrap_or("(3MF only)")
-        );
-    }
+    print_parts(&summary.manifest.parts);
     if let Some(markers) = kit.summary.get("markers").and_then(|m| m.as_array()) {
         for m in markers {
             out!(

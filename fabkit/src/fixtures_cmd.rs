@@ -1,8 +1,7 @@
 //! `fabkit fixtures`: argument parsing and dispatch over fabkit-fixtures.
 
-use crate::cli::{export_options, load_design, tolerance, DataFileArgs, Format};
+use crate::cli::{DataFileArgs, MeshOutputArgs};
 use crate::progress::Progress;
-use fabkit_designs::ChordTolerance;
 use fabkit_export::write_kit_reporting;
 use fabkit_fixtures::params::{from_yaml, resolve};
 use fabkit_fixtures::FixtureProgress;
@@ -39,34 +38,19 @@ pub struct FixturesArgs {
     /// Apply one of the design's presets.
     #[arg(long)]
     preset: Option<String>,
-    /// Mesh formats, comma separated.
-    #[arg(long, value_delimiter = ',', default_value = "stl,3mf")]
-    format: Vec<Format>,
     #[command(flatten)]
-    printer: crate::printers::PrinterArgs,
-    /// Largest distance between the exported meshes and the exact solids, mm (seams included).
-    #[arg(long, default_value_t = ChordTolerance::DEFAULT_MM)]
-    chord_tolerance_mm: f64,
-    /// Also write the CSG tree of every part (fabkit-csg/1 JSON) to this file, for the
-    /// manifold3d twin (export/python/twins).
-    #[arg(long)]
-    csg: Option<PathBuf>,
-    /// Refuse fixtures estimated (before building) at more triangles than this (about 1 KB of
-    /// memory each; 1 to 100000000).
-    #[arg(long, value_name = "N", default_value_t = fabkit_designs::estimate::DEFAULT_MAX_TRIANGLES,
-          value_parser = fabkit_designs::estimate::parse_max_triangles, allow_negative_numbers = true)]
-    max_triangles: u64,
+    mesh: MeshOutputArgs,
     #[command(flatten)]
     data_files: DataFileArgs,
 }
 
 pub fn run(args: FixturesArgs) -> Result<(), Box<dyn Error>> {
-    let tol = tolerance(args.chord_tolerance_mm)?;
-    let mut loaded = load_design(args.design.as_deref(), &args.data_files)?;
-    if let Some(p) = &args.preset {
-        loaded.apply_preset(p)?;
-    }
-    crate::printers::apply(&args.printer, &mut loaded.design.printers)?;
+    let tol = args.mesh.tolerance()?;
+    let loaded = args.mesh.load(
+        args.design.as_deref(),
+        args.preset.as_deref(),
+        &args.data_files,
+    )?;
     let base = match &args.params {
         Some(path) => {
             // A regular file of bounded size, as a design file.
@@ -81,7 +65,7 @@ pub fn run(args: FixturesArgs) -> Result<(), Box<dyn Error>> {
         .out
         .clone()
         .unwrap_or_else(|| Path::new("out").join(fabkit_fixtures::kit_name(&loaded.design.name)));
-    let mut opts = export_options(&loaded, tol, &args.format);
+    let mut opts = args.mesh.options(&loaded, tol);
     opts.command = fabkit_export::OutputCommand::Fixtures;
     opts.force = args.force;
     // The output folder is checked before anything is built, as `fabkit export` checks it.
@@ -91,16 +75,14 @@ pub fn run(args: FixturesArgs) -> Result<(), Box<dyn Error>> {
     )?;
     let provenance =
         fabkit_fixtures::provenance(&loaded.design.name, &loaded.source, &loaded.sha256);
-    if let Some(csg) = &args.csg {
-        crate::cli::check_csg_path(csg)?;
-    }
+    args.mesh.check_csg()?;
     let t0 = std::time::Instant::now();
     let progress: std::sync::OnceLock<Progress> = std::sync::OnceLock::new();
     let set = fabkit_fixtures::build_fixtures_reporting(
         &loaded.design,
         &params,
         tol,
-        args.max_triangles,
+        args.mesh.max_triangles,
         &provenance,
         &|p| match p {
             FixtureProgress::Started { parts, triangles } => {
@@ -153,9 +135,7 @@ pub fn run(args: FixturesArgs) -> Result<(), Box<dyn Error>> {
         p.finish();
     }
     let summary = summary?;
-    if let Some(csg) = &args.csg {
-        crate::cli::write_csg(&set.kit, csg)?;
-    }
+    args.mesh.write_csg(&set.kit)?;
     for w in &summary.warnings {
         eprintln!("warning: {w}");
     }
@@ -225,14 +205,6 @@ pub fn run(args: FixturesArgs) -> Result<(), Box<dyn Error>> {
             ),
         }
     }
-    for p in &summary.manifest.parts {
-        out!(
-            "  {:34} {:4} {:>10.1} mm3  {}",
-            p.name,
-            p.print_technology.to_string(),
-            p.volume_mm3,
-            p.file.as_deref().unwrap_or("(3MF only)")
-        );
-    }
+    crate::cli::print_parts(&summary.manifest.parts);
     Ok(())
 }
