@@ -58,6 +58,14 @@ fn sha256_hex(text: &str) -> String {
     fabkit_calibration::groundtruth::inputs::sha256_hex(text.as_bytes())
 }
 
+/// A dict key as text; any other key is a TypeError: `refusal` and the key's repr.
+pub(crate) fn text_key(k: &Bound<'_, PyAny>, refusal: &str) -> PyResult<String> {
+    k.extract().map_err(|_| {
+        let shown = k.repr().map(|r| r.to_string()).unwrap_or_default();
+        PyTypeError::new_err(format!("{refusal} {shown}"))
+    })
+}
+
 /// A Python value (dict, list, tuple, str, bool, int, float, None) as a serialized value; NaN
 /// and infinities kept (the design's rules refuse them by path).
 pub(crate) fn value_of(obj: &Bound<'_, PyAny>, at: &str) -> PyResult<Value> {
@@ -96,12 +104,8 @@ fn value_at_depth(obj: &Bound<'_, PyAny>, at: &str, depth: usize) -> PyResult<Va
     if let Ok(d) = obj.cast::<PyDict>() {
         let mut m = BTreeMap::new();
         for (k, v) in d.iter() {
-            let key: String = k.extract().map_err(|_| {
-                PyTypeError::new_err(format!(
-                    "{at}: a key must be text, found {}",
-                    k.repr().map(|r| r.to_string()).unwrap_or_default()
-                ))
-            })?;
+            let shown = if at.is_empty() { "(value)" } else { at };
+            let key = text_key(&k, &format!("{shown}: a key must be text, found"))?;
             let here = if at.is_empty() {
                 key.clone()
             } else {

@@ -73,12 +73,8 @@ pub fn _sweep_plan(
         })?;
         let mut params = Vec::new();
         for (k, v) in d.iter() {
-            let path: String = k.extract().map_err(|_| {
-                PyTypeError::new_err(format!(
-                    "{at}: a parameter path is text, not {}",
-                    k.repr().map(|r| r.to_string()).unwrap_or_default()
-                ))
-            })?;
+            let path =
+                crate::design::text_key(&k, &format!("{at}: a parameter path is text, not"))?;
             let value = json_of(&v, &format!("{at}: vary.{path}"))?;
             params.push((path, value));
         }
