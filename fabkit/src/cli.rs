@@ -152,7 +152,19 @@ impl MeshOutputArgs {
 
     /// The export options of this run: formats, provenance (command line, design, version).
     pub fn options(&self, loaded: &Loaded, tol: ChordTolerance) -> ExportOptions {
-        export_options(loaded, tol, &self.format)
+        let format = &self.format;
+        ExportOptions::for_design(
+            Formats {
+                stl: format.contains(&Format::Stl),
+                threemf: format.contains(&Format::ThreeMf),
+                step: format.contains(&Format::Step),
+            },
+            std::env::args().collect(),
+            &loaded.source,
+            &loaded.sha256,
+            tol.mm(),
+            loaded.design.printers.clone(),
+        )
     }
 
     /// Refuses a `--csg` path that may not be written, before anything is built.
@@ -277,26 +289,6 @@ pub(crate) type Loaded = library::LoadedDesign;
 pub(crate) fn load_design(arg: Option<&str>, data: &DataFileArgs) -> Result<Loaded, DesignError> {
     let arg = arg.unwrap_or(library::DEFAULT_DESIGN);
     library::load_source_with(arg, Path::new(""), &data.rules())
-}
-
-/// The export options of this run: formats, provenance (command line, design, version).
-pub(crate) fn export_options(
-    loaded: &Loaded,
-    tol: ChordTolerance,
-    format: &[Format],
-) -> ExportOptions {
-    ExportOptions::for_design(
-        Formats {
-            stl: format.contains(&Format::Stl),
-            threemf: format.contains(&Format::ThreeMf),
-            step: format.contains(&Format::Step),
-        },
-        std::env::args().collect(),
-        &loaded.source,
-        &loaded.sha256,
-        tol.mm(),
-        loaded.design.printers.clone(),
-    )
 }
 
 /// The first bytes of every CSG file fabkit writes (`serde_json` orders the keys).

@@ -58,11 +58,11 @@ fn sha256_hex(text: &str) -> String {
     fabkit_calibration::groundtruth::inputs::sha256_hex(text.as_bytes())
 }
 
-/// A dict key as text; any other key is a TypeError: `refusal` and the key's repr.
-pub(crate) fn text_key(k: &Bound<'_, PyAny>, refusal: &str) -> PyResult<String> {
+/// A dict key as text; any other key is a TypeError `{at}: {refusal} {repr of the key}`.
+pub(crate) fn text_key(k: &Bound<'_, PyAny>, at: &str, refusal: &str) -> PyResult<String> {
     k.extract().map_err(|_| {
         let shown = k.repr().map(|r| r.to_string()).unwrap_or_default();
-        PyTypeError::new_err(format!("{refusal} {shown}"))
+        PyTypeError::new_err(format!("{at}: {refusal} {shown}"))
     })
 }
 
@@ -103,9 +103,9 @@ fn value_at_depth(obj: &Bound<'_, PyAny>, at: &str, depth: usize) -> PyResult<Va
     }
     if let Ok(d) = obj.cast::<PyDict>() {
         let mut m = BTreeMap::new();
+        let shown = if at.is_empty() { "(value)" } else { at };
         for (k, v) in d.iter() {
-            let shown = if at.is_empty() { "(value)" } else { at };
-            let key = text_key(&k, &format!("{shown}: a key must be text, found"))?;
+            let key = text_key(&k, shown, "a key must be text, found")?;
             let here = if at.is_empty() {
                 key.clone()
             } else {

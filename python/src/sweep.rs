@@ -73,8 +73,7 @@ pub fn _sweep_plan(
         })?;
         let mut params = Vec::new();
         for (k, v) in d.iter() {
-            let path =
-                crate::design::text_key(&k, &format!("{at}: a parameter path is text, not"))?;
+            let path = crate::design::text_key(&k, &at, "a parameter path is text, not")?;
             let value = json_of(&v, &format!("{at}: vary.{path}"))?;
             params.push((path, value));
         }
