@@ -1209,8 +1209,32 @@ pub fn local_feature(
     embed_mm: f64,
     tol: ChordTolerance,
 ) -> Result<Solid, GeometryError> {
-    let r = shape.radius_mm();
-    let hc = shape.height_mm - r;
+    local_feature_dilated(shape, 0.0, embed_mm, tol)
+}
+
+/// The feature of `shape` grown by `dilation_mm` all round (its Minkowski sum with a ball,
+/// the rounding of its rim left out), seen from the offset surface `dilation_mm` beyond the
+/// one that carries it: what a coat of that thickness, sprayed into the mold so that it
+/// follows the cavity, needs from the cavity so that the layer under it gets `shape`. Its own
+/// frame: axis +z along the feature, the point on the offset surface at the origin. The
+/// radius becomes r + t and the hemisphere's centre moves t closer to the new surface; the
+/// height from the new surface stays `height_mm` (the coat offsets both the surface and the
+/// feature's end). For a recessed feature give `dilation_mm` < 0: the former shrinks by the
+/// coat (r - t), its centre moves t deeper. 0 gives [`local_feature`]. Sources: the coat as
+/// a conformal film of uniform thickness (the model of a sprayed coat, Sec. III-B1 of the
+/// R-Tac0 paper: sprayed into the mold, it takes the cavity's shape).
+///
+/// # Errors
+/// Only on a kernel failure.
+pub fn local_feature_dilated(
+    shape: &FeatureShape,
+    dilation_mm: f64,
+    embed_mm: f64,
+    tol: ChordTolerance,
+) -> Result<Solid, GeometryError> {
+    let r = shape.radius_mm() + dilation_mm;
+    let hc = shape.height_mm - shape.radius_mm() - dilation_mm;
+    let embed_mm = embed_mm.max(-hc + tol.mm());
     let mut pl = Polyline2::default();
     pl.push([0.0, -embed_mm]);
     pl.push([r, -embed_mm]);

@@ -31,6 +31,41 @@ pub struct PlacedMarkers {
     pub direction: f64,
     /// Depth behind the surface the feature solids reach, mm.
     pub embed_mm: f64,
+    /// How far the carrying surface lies beyond the surface the features were designed on,
+    /// mm: 0 for a layer's own features; for the features a sprayed coat (or the cavity it is
+    /// sprayed into) takes from the cast layer under it, the coats' thickness between, and the
+    /// features are that much larger all round ([`markers::local_feature_dilated`]).
+    pub dilation_mm: f64,
+}
+
+impl PlacedMarkers {
+    /// The same features seen from the offset surface `t_mm` beyond this one, grown by
+    /// `t_mm` all round: what a conformal coat of thickness `t_mm` over this surface carries
+    /// on its outer face, and what the mold cavity that forms the coat must carry
+    /// ([`markers::local_feature_dilated`]). Positions move `t_mm` along their normals.
+    pub fn conformal(&self, t_mm: f64) -> PlacedMarkers {
+        let mut out = self.clone();
+        for m in &mut out.markers {
+            for k in 0..3 {
+                m.position_mm[k] += t_mm * m.normal[k];
+            }
+        }
+        out.offset_mm += t_mm;
+        out.dilation_mm += t_mm;
+        // The embedding covers the gap between the tangent plane and the surface over the
+        // base disc (second order in the radius, markers::embed_depth_mm): scaled with the
+        // radius it grows to, and reaching back to the surface the features were designed on.
+        let r = self.spec.feature.radius_mm();
+        let grown = (self.radius_mm() + t_mm * self.direction.max(0.0)) / r;
+        out.embed_mm = self.embed_mm * grown.powi(2).max(1.0) + t_mm;
+        out
+    }
+
+    /// The features' radius on this surface, mm: the designed radius grown (raised) or shrunk
+    /// (recessed) by [`Self::dilation_mm`].
+    pub fn radius_mm(&self) -> f64 {
+        self.spec.feature.radius_mm() + self.direction * self.dilation_mm
+    }
 }
 
 fn surface_offset(l: &ResolvedLayer, s: MarkerSurface) -> f64 {
@@ -139,8 +174,99 @@ pub fn place_layer_markers(
                 offset_mm: offset,
                 direction: direction(spec),
                 embed_mm: markers::embed_depth_mm(&spec.feature, max_k, tol),
+                dilation_mm: 0.0,
             }
         })
+        .collect()
+}
+
+/// Whether layer `i` is formed against the layers under it: a sprayed coat (sprayed into the
+/// mold of the layer under it) or a layer cast in a `direct` or `master` mold onto the core and
+/// the layers already on it. Its inner surface is then the outer surface of layer `i - 1` as
+/// the stack formed it ([`formed_outer_features`]).
+fn formed_on_stack(stack: &Stack, i: usize) -> bool {
+    i > 0 && formed_on_stack_layer(&stack.layers[i])
+}
+
+/// [`formed_on_stack`] for a layer that has one under it.
+fn formed_on_stack_layer(l: &ResolvedLayer) -> bool {
+    l.process == LayerProcess::Sprayed
+        || (l.process == LayerProcess::Cast
+            && matches!(l.mold_strategy, MoldStrategy::Direct | MoldStrategy::Master))
+}
+
+/// The features on the outer surface of layer `i` as the stack forms them: its own, and for
+/// a sprayed coat those of the layer under it, grown by the coat's thickness
+/// ([`PlacedMarkers::conformal`]: the coat takes the shape of the cavity it is sprayed into).
+pub fn formed_outer_features(
+    design: &Design,
+    stack: &Stack,
+    i: usize,
+    tol: ChordTolerance,
+) -> Vec<PlacedMarkers> {
+    let l = &stack.layers[i];
+    let mut own: Vec<PlacedMarkers> = place_layer_markers(design, l, tol)
+        .into_iter()
+        .filter(|p| p.spec.surface == MarkerSurface::Outer)
+        .collect();
+    if l.process == LayerProcess::Sprayed && i > 0 {
+        let under = &stack.layers[i - 1];
+        own.extend(
+            formed_outer_features(design, stack, i - 1, tol)
+                .iter()
+                .map(|p| p.conformal(l.outer_offset_mm - under.outer_offset_mm)),
+        );
+    }
+    own
+}
+
+/// The features layer `i` takes from the layers under it when it is formed against them
+/// (`formed_on_stack`): on its inner surface, the outer features of layer `i - 1` as the stack
+/// formed them; on the outer surface of a sprayed coat, the same grown by its thickness.
+/// (outer sets, inner sets); both empty for a layer formed by molds of its own.
+pub fn taken_features(
+    design: &Design,
+    stack: &Stack,
+    i: usize,
+    tol: ChordTolerance,
+) -> (Vec<PlacedMarkers>, Vec<PlacedMarkers>) {
+    if !formed_on_stack(stack, i) {
+        return (Vec::new(), Vec::new());
+    }
+    let (l, under) = (&stack.layers[i], &stack.layers[i - 1]);
+    let below = formed_outer_features(design, stack, i - 1, tol);
+    let at = |offset_mm: f64| -> Vec<PlacedMarkers> {
+        below
+            .iter()
+            .map(|p| p.conformal(offset_mm - under.outer_offset_mm))
+            .collect()
+    };
+    let outer = if l.process == LayerProcess::Sprayed {
+        at(l.outer_offset_mm)
+    } else {
+        Vec::new()
+    };
+    (outer, at(l.inner_offset_mm))
+}
+
+/// The features the cavity of cast layer `i`'s mold carries when the cavity is the offset
+/// surface `cavity_offset_mm` (the outermost coat sprayed into it, plus the mold's clearance):
+/// the layer's outer-surface features grown by the distance between
+/// ([`PlacedMarkers::conformal`]), so that the coats sprayed into the cavity and the layer
+/// poured behind them take the designed features. Sensor frame, mm.
+/// (A sprayed coat's own markers are refused: [`check_markers`].)
+pub fn cavity_features(
+    design: &Design,
+    stack: &Stack,
+    i: usize,
+    cavity_offset_mm: f64,
+    tol: ChordTolerance,
+) -> Vec<PlacedMarkers> {
+    let l = &stack.layers[i];
+    let placed = place_layer_markers(design, l, tol);
+    on_surface(&placed, MarkerSurface::Outer)
+        .into_iter()
+        .map(|p| p.conformal(cavity_offset_mm - l.outer_offset_mm))
         .collect()
 }
 
@@ -190,7 +316,103 @@ pub fn recess_clearance_to_base_mm(
 pub fn check_markers(design: &Design, layers: &[ResolvedLayer], errs: &mut Vec<ParamError>) {
     for l in layers {
         let tech = feature_technology(design, &design.layers[l.index]);
-        errs.extend(marker_errors(design, l, tech));
+        let own = marker_errors(design, l, tech);
+        let clean = own.is_empty();
+        errs.extend(own);
+        if clean {
+            coat_former_errors(design, layers, l, errs);
+        }
+    }
+}
+
+/// How far the cavity of the mold that casts layer `l` lies beyond the layer's outer surface,
+/// mm: the coats sprayed into it before the pour ([`crate::parts::molds::cast_plans`]) plus
+/// the mold's clearance; 0 for a layer not cast in a `direct` or `master` mold (the other
+/// strategies form the layer's outer surface itself).
+pub fn cavity_gap_mm(design: &Design, layers: &[ResolvedLayer], l: &ResolvedLayer) -> f64 {
+    if l.process != LayerProcess::Cast
+        || !matches!(l.mold_strategy, MoldStrategy::Direct | MoldStrategy::Master)
+    {
+        return 0.0;
+    }
+    let outer = layers[l.index + 1..]
+        .iter()
+        .take_while(|s| s.process == LayerProcess::Sprayed)
+        .last()
+        .map_or(l.outer_offset_mm, |s| s.outer_offset_mm);
+    outer + design.mold.cavity_clearance_mm - l.outer_offset_mm
+}
+
+/// A dimple on the outer surface of a cast layer under sprayed coats is formed by a pin in the
+/// mold's cavity that the coats cover: the pin is the dimple shrunk by the coats' thickness
+/// all round ([`PlacedMarkers::conformal`]), and it must be a feature the cavity's printer
+/// makes. A dimple of up to twice the coats' thickness is filled by the coat.
+fn coat_former_errors(
+    design: &Design,
+    layers: &[ResolvedLayer],
+    l: &ResolvedLayer,
+    errs: &mut Vec<ParamError>,
+) {
+    // Bumps on a layer that the next layer is cast onto stand into that layer: they must
+    // leave its printer's minimum wall of it over them (else they show through its surface).
+    if let Some(next) = layers
+        .get(l.index + 1)
+        .filter(|n| n.process == LayerProcess::Cast && formed_on_stack_layer(n))
+    {
+        let min_wall = design
+            .printers
+            .get(design.mold.cavity_print_technology)
+            .min_wall_mm;
+        for (j, spec) in design.layers[l.index].markers.iter().enumerate() {
+            let f = &spec.feature;
+            if spec.surface == MarkerSurface::Outer
+                && f.side() == Polarity::Raised
+                && f.height_mm > next.thickness_mm - min_wall
+            {
+                errs.push(ParamError::new(
+                    format!("layers[{}].markers[{j}].feature.height_mm", l.index),
+                    f.height_mm,
+                    format!(
+                        "the bumps stand into layer '{}' cast over them ({:.3} mm thick) and would leave less than the minimum wall {min_wall} mm of it; give at most {:.3} mm, or put them on the outer surface of '{}'",
+                        next.name,
+                        next.thickness_mm,
+                        next.thickness_mm - min_wall,
+                        next.name
+                    ),
+                ));
+            }
+        }
+    }
+    let t = cavity_gap_mm(design, layers, l);
+    if t <= 0.0 {
+        return;
+    }
+    let tech = design.mold.cavity_print_technology;
+    let min = design.printers.get(tech).min_feature_mm;
+    let coats: Vec<&str> = layers[l.index + 1..]
+        .iter()
+        .take_while(|s| s.process == LayerProcess::Sprayed)
+        .map(|s| s.name.as_str())
+        .collect();
+    for (j, spec) in design.layers[l.index].markers.iter().enumerate() {
+        if spec.surface != MarkerSurface::Outer || spec.feature.side() != Polarity::Recessed {
+            continue;
+        }
+        let former = spec.feature.diameter_mm - 2.0 * t;
+        if former < min {
+            errs.push(ParamError::new(
+                format!("layers[{}].markers[{j}].feature.diameter_mm", l.index),
+                spec.feature.diameter_mm,
+                format!(
+                    "the {t:.3} mm sprayed into the mold over layer '{}' ({}{}) covers the pin that forms each dimple: the pin is {former:.3} mm across, below the minimum feature {min} mm of printer profile '{}' that prints the mold (a coat fills a dimple of up to twice its thickness); give at least {:.3} mm, or put the markers on a surface no coat covers",
+                    l.name,
+                    coats.join(", "),
+                    if design.mold.cavity_clearance_mm > 0.0 { " and the cavity clearance" } else { "" },
+                    format!("{tech:?}").to_lowercase(),
+                    min + 2.0 * t
+                ),
+            ));
+        }
     }
 }
 
@@ -298,6 +520,23 @@ fn marker_shape_errors(
         ));
         return false;
     }
+    if spec_layer.process == LayerProcess::Sprayed {
+        let under = (0..l.index)
+            .rev()
+            .find(|&k| design.layers[k].process != LayerProcess::Sprayed);
+        errs.push(ParamError::new(
+            path.to_string(),
+            format!("{} markers on sprayed layer '{}'", markers::layout_name(spec.pattern.layout), l.name),
+            match under {
+                Some(k) => format!(
+                    "a sprayed coat follows the surface it is sprayed onto and forms no features of its own; put them on layers[{k}].markers with surface: outer (layer '{}' under the coat): its mold carries them through the coat",
+                    design.layers[k].name
+                ),
+                None => "a sprayed coat follows the surface it is sprayed onto and forms no features of its own".to_string(),
+            },
+        ));
+        return false;
+    }
     if l.solid && spec.surface == MarkerSurface::Inner {
         errs.push(ParamError::new(
             format!("{path}.surface"),
@@ -312,8 +551,15 @@ fn marker_shape_errors(
                 format!("{path}.surface"),
                 "inner",
                 format!(
-                    "features on the inner surface of a cast layer need the boundary strategy (its mold strategy is {:?})",
-                    l.mold_strategy
+                    "features on the inner surface of a cast layer need the boundary strategy (its mold strategy is {:?}): {}",
+                    l.mold_strategy,
+                    match l.index.checked_sub(1) {
+                        Some(k) => format!(
+                            "the layer is cast onto layer '{}', whose mold forms this surface; put them on layers[{k}].markers with surface: outer and the opposite polarity",
+                            design.layers[k].name
+                        ),
+                        None => "the core forms this surface and no mold touches it; put them on the outer surface".to_string(),
+                    }
                 ),
             ));
         return false;
@@ -527,7 +773,12 @@ fn feature_solids(
         shape.height_mm -= shape.radius_mm();
         stem_solid(&shape, [0.0; 3], [0.0, 0.0, 1.0], pm.embed_mm, tol)?
     } else {
-        markers::local_feature(&pm.spec.feature, pm.embed_mm, tol)?
+        markers::local_feature_dilated(
+            &pm.spec.feature,
+            pm.direction * pm.dilation_mm,
+            pm.embed_mm,
+            tol,
+        )?
     };
     Ok(pm
         .markers
@@ -621,7 +872,7 @@ fn features_top_z_mm(design: &Design, offset_mm: f64, sets: &[&PlacedMarkers]) -
 }
 
 /// Adds the outward features and removes the inward ones: one compose and one boolean each.
-fn apply_features(
+pub(crate) fn apply_features(
     base: Solid,
     sets: &[&PlacedMarkers],
     tol: ChordTolerance,
@@ -719,10 +970,13 @@ pub fn layer_solid(
     let l = &stack.layers[i];
     let placed = place_layer_markers(design, l, tol);
     let stems_only = placed.iter().any(|p| p.spec.tip_material.is_some());
-    let (outer, inner) = (
+    let (coat_outer, coat_inner) = taken_features(design, stack, i, tol);
+    let (mut outer, mut inner) = (
         on_surface(&placed, MarkerSurface::Outer),
         on_surface(&placed, MarkerSurface::Inner),
     );
+    outer.extend(&coat_outer);
+    inner.extend(&coat_inner);
     if l.solid {
         return solid_enclosed(design, l, &outer, tol, stems_only);
     }
@@ -747,10 +1001,16 @@ pub fn layer_features(
     let l = &stack.layers[i];
     let placed = place_layer_markers(design, l, tol);
     let stems_only = placed.iter().any(|p| p.spec.tip_material.is_some());
+    let (coat_outer, coat_inner) = taken_features(design, stack, i, tol);
     let mut out = MemberFeatures::default();
-    for pm in &placed {
+    let sets = placed
+        .iter()
+        .map(|pm| (pm, pm.spec.surface))
+        .chain(coat_outer.iter().map(|pm| (pm, MarkerSurface::Outer)))
+        .chain(coat_inner.iter().map(|pm| (pm, MarkerSurface::Inner)));
+    for (pm, surface) in sets {
         let outward = pm.direction > 0.0;
-        let grows = match pm.spec.surface {
+        let grows = match surface {
             MarkerSurface::Outer => outward,
             MarkerSurface::Inner if l.solid => continue,
             MarkerSurface::Inner => !outward,
@@ -812,6 +1072,9 @@ fn feature_key(pm: &PlacedMarkers, stems_only: bool) -> FeatureKey {
         pm.direction.to_bits(),
         u64::from(stems_only),
     ];
+    if pm.dilation_mm != 0.0 {
+        bits.push(pm.dilation_mm.to_bits());
+    }
     for m in &pm.markers {
         bits.extend(m.position_mm.iter().chain(&m.normal).map(|c| c.to_bits()));
     }

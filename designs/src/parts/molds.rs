@@ -860,14 +860,27 @@ fn build_mold_parts(
     let fixture_tech: PrintTechnology = m.fixture_print_technology.into();
     let fixture_material = material_for(fixture_tech);
 
-    let cavity = Solid::from_mesh(
-        &revolve(
-            &cavity_profile(design, &f, plan.cavity_offset_mm, false, tol),
-            tol,
+    // The cavity carries the layer's outer features, grown by the coats sprayed into it.
+    let features = crate::parts::layers::cavity_features(
+        design,
+        stack,
+        plan.layer,
+        plan.cavity_offset_mm,
+        tol,
+    );
+    let features: Vec<_> = features.iter().collect();
+    let with_features =
+        |s: Solid| crate::parts::layers::apply_features(s, &features, tol, false).part(name);
+    let cavity = with_features(
+        Solid::from_mesh(
+            &revolve(
+                &cavity_profile(design, &f, plan.cavity_offset_mm, false, tol),
+                tol,
+            )
+            .part(name)?,
         )
         .part(name)?,
-    )
-    .part(name)?;
+    )?;
     let holder = core_holder(design, &f, tol)?;
     // The pour fills the cavity, minus what is inside it (core and inner layers), minus the holder.
     // What the pour lands on: the layers under it down to the base plane, and below it the
@@ -882,10 +895,18 @@ fn build_mold_parts(
     let void = cavity
         .difference(&holder.union(&inner).part(name)?)
         .part(name)?;
+    // a coat over features follows them (crate::parts::layers::taken_features)
     let sprayed_volume: f64 = plan
         .sprayed
         .iter()
-        .map(|&i| stack.layer_solid(design, i, tol).map(|s| s.volume()))
+        .map(|&i| {
+            if features.is_empty() {
+                stack.layer_solid(design, i, tol)
+            } else {
+                crate::parts::layers::layer_solid(design, stack, i, tol)
+            }
+            .map(|s| s.volume())
+        })
         .sum::<Result<f64, _>>()
         .part(name)?;
     let pour_volume = void.volume() - sprayed_volume;
@@ -933,7 +954,7 @@ fn build_mold_parts(
             unreachable!("built by crate::parts::layers")
         }
         MoldStrategy::Direct => direct_mold_parts(design, &cavity, tol, c),
-        MoldStrategy::Master => master_mold_parts(design, plan, tol, c),
+        MoldStrategy::Master => master_mold_parts(design, plan, tol, c, &with_features),
     }
 }
 
@@ -1010,6 +1031,7 @@ fn master_mold_parts(
     plan: &CastPlan,
     tol: ChordTolerance,
     c: CastMold,
+    with_features: &dyn Fn(Solid) -> Result<Solid, DesignError>,
 ) -> Result<MoldOutput, DesignError> {
     let (name, f) = (c.name, &c.f);
     let m = &design.mold;
@@ -1017,14 +1039,16 @@ fn master_mold_parts(
     let fixture_tech: PrintTechnology = m.fixture_print_technology.into();
     let cavity_material = material_for(cavity_tech);
     let fixture_material = material_for(fixture_tech);
-    let master = Solid::from_mesh(
-        &revolve(
-            &cavity_profile(design, f, plan.cavity_offset_mm, true, tol),
-            tol,
+    let master = with_features(
+        Solid::from_mesh(
+            &revolve(
+                &cavity_profile(design, f, plan.cavity_offset_mm, true, tol),
+                tol,
+            )
+            .part(name)?,
         )
         .part(name)?,
-    )
-    .part(name)?;
+    )?;
     let (mold_box, fill) = master_box(design, f, tol).part(name)?;
     let silicone = fill.difference(&master).part(name)?.volume();
     let mut params = c.common.clone();

@@ -1,6 +1,7 @@
 //! The designs crate's integration tests, one binary (one link) with a module per area.
 
 mod assembly;
+mod cast_markers;
 mod common;
 mod error_paths;
 mod estimate;

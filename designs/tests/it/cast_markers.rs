@@ -1,0 +1,285 @@
+//! Markers on a surface that a sprayed coat or a later layer covers reach the molds that form
+//! that surface (the tutorial's design: 127 dimples on R-Tac0's translucent gel, under the
+//! sprayed black coat), and the refusals of features no mold can form.
+
+use crate::common::validation_errors;
+use fabkit_designs::geometry::{ChordTolerance, Solid};
+use fabkit_designs::markers::{FeatureShape, MarkerSpec, Polarity};
+use fabkit_designs::schema::MoldStrategy;
+use fabkit_designs::{build_kit, library, Design};
+use serde_json::json;
+
+/// The tutorial's step 3: 0.6 mm dimples, 0.4 mm deep, `concentric_6k`, 6 rings 6 deg apart,
+/// on the outer face of R-Tac0's translucent gel (127 markers).
+fn tutorial_markers() -> MarkerSpec {
+    serde_json::from_value(json!({
+        "surface": "outer",
+        "feature": {"diameter_mm": 0.6, "height_mm": 0.4, "on_skin": "dimple"},
+        "pattern": {"layout": "concentric_6k", "rings": 6, "polar_step_deg": 6.0},
+    }))
+    .unwrap()
+}
+
+fn tutorial(strategy: MoldStrategy) -> Design {
+    let mut d = library::load("rtac0").unwrap();
+    d.mold.strategy = strategy;
+    d.layers[1].markers.push(tutorial_markers());
+    d
+}
+
+fn stock(strategy: MoldStrategy) -> Design {
+    let mut d = library::load("rtac0").unwrap();
+    d.mold.strategy = strategy;
+    d
+}
+
+const TOL: f64 = 0.01;
+
+fn tol() -> ChordTolerance {
+    ChordTolerance::new(TOL).unwrap()
+}
+
+fn part<'a>(kit: &'a fabkit_designs::Kit, name: &str) -> &'a Solid {
+    &kit.parts
+        .iter()
+        .find(|p| p.name == name)
+        .unwrap_or_else(|| panic!("no part {name}"))
+        .solid
+}
+
+fn member<'a>(kit: &'a fabkit_designs::Kit, name: &str) -> &'a Solid {
+    &kit.assembly
+        .iter()
+        .find(|m| m.name == name)
+        .unwrap_or_else(|| panic!("no member {name}"))
+        .solid
+}
+
+/// The pieces of at least `min_mm3` where two versions of a part differ (the symmetric
+/// difference's shells; the kernel's slivers along re-cut facets fall below it), and the
+/// volume of all of it, mm^3.
+fn difference(a: &Solid, b: &Solid) -> (usize, f64) {
+    let d = a
+        .difference(b)
+        .unwrap()
+        .union(&b.difference(a).unwrap())
+        .unwrap();
+    let pieces = shell_volumes(&d.mesh())
+        .into_iter()
+        .filter(|&v| v > MIN_PIECE_MM3)
+        .count();
+    (pieces, d.volume())
+}
+
+/// Well below half of the smallest former (a 0.4 mm pin, 0.4 mm tall: 0.042 mm^3), well
+/// above the slivers (below 1e-4 mm^3).
+const MIN_PIECE_MM3: f64 = 0.005;
+
+/// The volume of each edge-connected shell of `m`, mm^3.
+fn shell_volumes(m: &fabkit_designs::geometry::Mesh) -> Vec<f64> {
+    let n = m.vertices.len();
+    let mut parent: Vec<usize> = (0..n).collect();
+    fn find(p: &mut [usize], mut x: usize) -> usize {
+        while p[x] != x {
+            p[x] = p[p[x]];
+            x = p[x];
+        }
+        x
+    }
+    for t in &m.triangles {
+        for &o in &t[1..] {
+            let (ra, ro) = (
+                find(&mut parent, t[0] as usize),
+                find(&mut parent, o as usize),
+            );
+            if ra != ro {
+                parent[ra] = ro;
+            }
+        }
+    }
+    let mut by_root = std::collections::BTreeMap::<usize, f64>::new();
+    for t in &m.triangles {
+        let [a, b, c] = t.map(|i| m.vertices[i as usize]);
+        let v = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+            + a[2] * (b[0] * c[1] - b[1] * c[0]);
+        *by_root.entry(find(&mut parent, t[0] as usize)).or_default() += v / 6.0;
+    }
+    by_root.into_values().collect()
+}
+
+/// One dimple's volume below the curved surface it is cut into, mm^3: the nominal volume less
+/// the gap between the tangent plane and the sphere over its base disc (second order,
+/// `markers::tangent_gap_volume_mm3`).
+fn dimple_volume_mm3(f: &FeatureShape, sphere_radius_mm: f64) -> f64 {
+    let k = 1.0 / sphere_radius_mm;
+    f.nominal_volume_mm3() - fabkit_designs::markers::tangent_gap_volume_mm3(f, k, k)
+}
+
+#[test]
+fn tutorial_dimples_under_the_coat_reach_the_master_pattern() {
+    let (with, without) = (
+        build_kit(&tutorial(MoldStrategy::Master), tol()).unwrap(),
+        build_kit(&stock(MoldStrategy::Master), tol()).unwrap(),
+    );
+    let name = "translucent_gel_master_pattern";
+    let (pieces, _) = difference(part(&with, name), part(&without, name));
+    assert_eq!(pieces, 127, "{name}: one dimple former per marker");
+    // every other part is the stock kit's
+    for p in &without.parts {
+        if p.name != name {
+            let (n, v) = difference(&p.solid, part(&with, &p.name));
+            assert!(n == 0 || v < 1e-6, "{}: {n} pieces, {v} mm3", p.name);
+        }
+    }
+    check_cast_layer_volume(&with, &without);
+}
+
+#[test]
+fn tutorial_dimples_under_the_coat_reach_the_direct_mold_halves() {
+    let (with, without) = (
+        build_kit(&tutorial(MoldStrategy::Direct), tol()).unwrap(),
+        build_kit(&stock(MoldStrategy::Direct), tol()).unwrap(),
+    );
+    // the formers standing in the cavity: the centre one and those on the parting plane
+    // y = 0 (azimuths 0 and 180 deg of every ring) are split between the halves
+    let (a, _) = difference(
+        part(&with, "translucent_gel_mold_half_a"),
+        part(&without, "translucent_gel_mold_half_a"),
+    );
+    let (b, _) = difference(
+        part(&with, "translucent_gel_mold_half_b"),
+        part(&without, "translucent_gel_mold_half_b"),
+    );
+    let split = 1 + 2 * 6;
+    assert_eq!(a + b, 127 + split, "half a {a}, half b {b}");
+    check_cast_layer_volume(&with, &without);
+}
+
+/// The chord-tolerance bound on the volume of the 127 dimples' meshes, mm^3: every facet
+/// within `TOL` of its true surface, over the dimple's wall and end (2 pi r (h - r) + 2 pi r^2).
+fn chord_bound_mm3(f: &FeatureShape) -> f64 {
+    let r = f.radius_mm();
+    let area =
+        2.0 * std::f64::consts::PI * r * (f.height_mm - r) + 2.0 * std::f64::consts::PI * r * r;
+    127.0 * area * TOL
+}
+
+/// The translucent layer of the assembly and the pour that casts it lose the dimples' volume
+/// (within 1 % and the chord tolerance's bound), and the coat over the layer follows them:
+/// its volume stays that of the plain film.
+fn check_cast_layer_volume(with: &fabkit_designs::Kit, without: &fabkit_designs::Kit) {
+    let f = tutorial_markers().feature;
+    assert_eq!(f.side(), Polarity::Recessed);
+    let expected = 127.0 * dimple_volume_mm3(&f, 14.9);
+    let bound = 0.01 * expected + chord_bound_mm3(&f);
+    let lost =
+        member(without, "translucent_gel").volume() - member(with, "translucent_gel").volume();
+    assert!(
+        (lost - expected).abs() < bound,
+        "the layer lost {lost:.4} mm3, the dimples hold {expected:.4} mm3 (bound {bound:.4})"
+    );
+    // The coat lines each dimple: it gains the dimple less the pin that formed it (0.1 mm
+    // smaller all round, on the R15.0 cavity).
+    let mut pin = f.clone();
+    pin.diameter_mm -= 2.0 * 0.1;
+    let lining = expected - 127.0 * dimple_volume_mm3(&pin, 15.0);
+    let coat = member(with, "black_coating").volume() - member(without, "black_coating").volume();
+    assert!(
+        (coat - lining).abs() < bound,
+        "the coat grew by {coat:.4} mm3, the lining of the dimples is {lining:.4} mm3"
+    );
+    // the pour of the translucent gel into the mold drops by the dimples too
+    let pour = |k: &fabkit_designs::Kit| {
+        k.casts
+            .iter()
+            .find(|c| c.cast == "translucent_gel")
+            .map(|c| c.cavity_volume_ml * 1000.0)
+            .unwrap()
+    };
+    let dropped = pour(without) - pour(with);
+    assert!(
+        (dropped - expected).abs() < bound,
+        "the pour dropped by {dropped:.4} mm3, the dimples hold {expected:.4} mm3 (bound {bound:.4})"
+    );
+}
+
+/// At a fine tolerance (0.001 mm: the 0.6 mm dimples as 40-gons) the layer loses the dimples'
+/// volume within 1 %.
+#[test]
+fn tutorial_layer_loses_the_dimples_volume_within_one_percent() {
+    let fine = ChordTolerance::new(0.001).unwrap();
+    let materials = fabkit_designs::materials::MaterialsTable::embedded().unwrap();
+    let volume = |d: &Design| {
+        let stack = fabkit_designs::stack::validate(d, &materials, fine).unwrap();
+        fabkit_designs::layers::layer_solid(d, &stack, 1, fine)
+            .unwrap()
+            .volume()
+    };
+    let f = tutorial_markers().feature;
+    let expected = 127.0 * dimple_volume_mm3(&f, 14.9);
+    let lost = volume(&stock(MoldStrategy::Master)) - volume(&tutorial(MoldStrategy::Master));
+    assert!(
+        (lost - expected).abs() < 0.01 * expected,
+        "the layer lost {lost:.4} mm3, the dimples hold {expected:.4} mm3"
+    );
+}
+
+#[test]
+fn markers_on_a_sprayed_coat_are_refused_with_the_surface_that_works() {
+    let mut d = stock(MoldStrategy::Master);
+    d.layers[2].markers.push(tutorial_markers());
+    let errs = validation_errors(&d);
+    assert_eq!(errs.len(), 1, "{errs:?}");
+    assert_eq!(errs[0].path, "layers[2].markers[0]");
+    assert!(
+        errs[0].rule.contains("layers[1].markers"),
+        "{}",
+        errs[0].rule
+    );
+}
+
+#[test]
+fn a_dimple_the_coat_fills_is_refused() {
+    let mut d = tutorial(MoldStrategy::Master);
+    d.layers[1].outer_radius_mm = Some(14.7); // a 0.3 mm coat: the pin is 0.0 mm across
+    let errs = validation_errors(&d);
+    assert!(
+        errs.iter()
+            .any(|e| e.path == "layers[1].markers[0].feature.diameter_mm"
+                && e.rule.contains("sprayed into the mold")),
+        "{errs:?}"
+    );
+}
+
+#[test]
+fn inner_features_of_a_layer_cast_onto_another_are_refused_with_the_surface_that_works() {
+    let mut d = stock(MoldStrategy::Master);
+    let mut m = tutorial_markers();
+    m.surface = fabkit_designs::markers::MarkerSurface::Inner;
+    d.layers[1].markers.push(m);
+    let errs = validation_errors(&d);
+    assert_eq!(errs.len(), 1, "{errs:?}");
+    assert_eq!(errs[0].path, "layers[1].markers[0].surface");
+    assert!(
+        errs[0]
+            .rule
+            .contains("layers[0].markers with surface: outer"),
+        "{}",
+        errs[0].rule
+    );
+}
+
+#[test]
+fn bumps_under_a_layer_cast_over_them_must_leave_its_wall() {
+    let mut d = stock(MoldStrategy::Master);
+    let mut m = tutorial_markers();
+    m.feature = FeatureShape::new(0.6, 1.3, Polarity::Raised);
+    d.layers[0].markers.push(m);
+    let errs = validation_errors(&d);
+    assert!(
+        errs.iter()
+            .any(|e| e.path == "layers[0].markers[0].feature.height_mm"
+                && e.rule.contains("translucent_gel")),
+        "{errs:?}"
+    );
+}
