@@ -18,6 +18,7 @@ macro_rules! defaults {
 
 pub mod assembly;
 pub mod build;
+pub mod cast_check;
 pub mod cut;
 pub mod error;
 pub mod estimate;

@@ -283,3 +283,105 @@ fn bumps_under_a_layer_cast_over_them_must_leave_its_wall() {
         "{errs:?}"
     );
 }
+
+/// Every cast layer of `d` is the layer its molds cast: the check's figures when it fails.
+fn assert_cast_equals_assembly(d: &Design, tol: ChordTolerance) {
+    let kit = build_kit(d, tol).unwrap_or_else(|e| panic!("{}: {e}", d.name));
+    let checks = fabkit_designs::cast_check::check_casts(d, &kit, tol).unwrap();
+    assert!(!checks.is_empty(), "{}: no cast layer checked", d.name);
+    for c in &checks {
+        assert!(
+            c.holds(),
+            "{} layer {} ({:?}, formed by {:?}): cast {:.3} mm3, assembly {:.3} mm3, symmetric difference {:.4} mm3 (bound {:.4}), features cast {} / assembly {} / designed {}",
+            d.name,
+            c.layer,
+            c.strategy,
+            c.formed_by,
+            c.cast_volume_mm3,
+            c.assembly_volume_mm3,
+            c.symmetric_difference_mm3,
+            c.bound_mm3,
+            c.cast_features,
+            c.assembly_features,
+            c.designed_features
+        );
+    }
+}
+
+#[test]
+fn every_cast_layer_of_the_library_is_what_its_molds_cast() {
+    for d in crate::common::library_designs_and_presets() {
+        if d.body.flat_outline().is_some() {
+            continue; // cast in trays: the flat kit's own checks (flat_skin.rs)
+        }
+        if d.layers
+            .iter()
+            .all(|l| l.process != fabkit_designs::schema::LayerProcess::Cast)
+        {
+            continue;
+        }
+        assert_cast_equals_assembly(&d, ChordTolerance::new(0.02).unwrap());
+    }
+}
+
+#[test]
+fn the_tutorials_cast_layers_are_what_its_molds_cast() {
+    for s in [MoldStrategy::Master, MoldStrategy::Direct] {
+        assert_cast_equals_assembly(&tutorial(s), ChordTolerance::new(0.02).unwrap());
+    }
+}
+
+/// Markers on every layer position that validate accepts: dimples and bumps on the outer
+/// surface of the first layer (the second is cast over them), dimples on the second under the
+/// coat.
+#[test]
+fn markers_on_every_layer_position_reach_the_cast() {
+    for s in [MoldStrategy::Master, MoldStrategy::Direct] {
+        let mut d = tutorial(s);
+        let mut bumps = tutorial_markers();
+        bumps.feature = FeatureShape::new(0.8, 0.6, Polarity::Raised);
+        bumps.pattern = serde_json::from_value(
+            json!({"layout": "concentric_6k", "rings": 3, "polar_step_deg": 10.0}),
+        )
+        .unwrap();
+        d.layers[0].markers.push(bumps);
+        assert!(
+            validation_errors(&d).is_empty(),
+            "{:?}",
+            validation_errors(&d)
+        );
+        assert_cast_equals_assembly(&d, ChordTolerance::new(0.02).unwrap());
+    }
+}
+
+/// Regression: the tutorial's dimples were in the assembly but in no mold. The check finds a
+/// master pattern without them: the translucent layer's cast lacks all 127.
+#[test]
+fn the_cast_check_catches_a_mold_without_the_markers() {
+    let tol = ChordTolerance::new(0.02).unwrap();
+    let d = tutorial(MoldStrategy::Master);
+    let mut kit = build_kit(&d, tol).unwrap();
+    let stock_kit = build_kit(&stock(MoldStrategy::Master), tol).unwrap();
+    let name = "translucent_gel_master_pattern";
+    let plain = stock_kit
+        .parts
+        .iter()
+        .find(|p| p.name == name)
+        .unwrap()
+        .clone();
+    *kit.parts.iter_mut().find(|p| p.name == name).unwrap() = plain;
+    let checks = fabkit_designs::cast_check::check_casts(&d, &kit, tol).unwrap();
+    let c = checks
+        .iter()
+        .find(|c| c.layer == "translucent_gel")
+        .unwrap();
+    assert!(!c.holds());
+    assert_eq!(
+        (c.cast_features, c.assembly_features, c.designed_features),
+        (0, 127, 127)
+    );
+    assert!(checks
+        .iter()
+        .filter(|c| c.layer != "translucent_gel")
+        .all(|c| c.holds()));
+}

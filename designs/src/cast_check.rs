@@ -1,0 +1,386 @@
+//! The layers as the molds cast them, checked against the layers the assembly shows: what is
+//! designed is what gets cast.
+//!
+//! For each cast layer of a built kit, [`cast_layer`] rebuilds, from the kit's printed mold
+//! parts alone (taken back from their print poses into the sensor frame with their
+//! `T_print_sensor`), the solid the closed mold leaves for the pour above the base plane:
+//!
+//! * `master` and the outer boundary of `boundary`: the master pattern is the cavity's positive
+//!   (the Mold Star mold is cast around it), so the pour fills the pattern's shape;
+//! * `boundary`: less the inner silicone core, the positive of the inner negative's cup;
+//! * `direct`, `open`, `two_piece_open`: the space the closed pieces (halves and core holder,
+//!   open mold and seat insert, cavity block and reservoir top) leave;
+//!
+//! each within an envelope just beyond the cavity (its offset surface plus the tallest
+//! feature, closed on the base plane) that keeps the bolt holes, keys and the outside out;
+//! and for the layers cast onto the stack (`direct`, `master`), less what is already in the
+//! mold: the core's envelope, the layers cast before and the coats sprayed into it, as the
+//! assembly shows them.
+//!
+//! [`check_casts`] compares that solid with the layer's member of the assembly: the volume of
+//! their symmetric difference, bounded by twice the chord tolerance times the layer's surface
+//! area (each mesh lies within the chord tolerance of the true surfaces), and the number of
+//! features each carries (the pieces where it differs from the layer's featureless shell).
+//! Printed layers and sprayed coats are formed by no mold of their own (a coat follows the
+//! cavity it is sprayed into, [`crate::parts::layers::taken_features`]); flat skins are cast in
+//! trays ([`crate::build`]'s flat kit) and are not covered here.
+
+use crate::error::{DesignError, GeometryContext};
+use crate::geometry::{cuboid, ChordTolerance, Solid};
+use crate::kit::Kit;
+use crate::markers::MarkerSurface;
+use crate::parts::layers;
+use crate::schema::{Design, LayerProcess, MoldStrategy};
+use crate::stack::Stack;
+
+/// One cast layer, as the molds cast it and as the assembly shows it.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct CastCheck {
+    pub layer: String,
+    pub strategy: MoldStrategy,
+    /// The printed parts whose closed cavity (or positive) forms the layer.
+    pub formed_by: Vec<String>,
+    /// Volume of the solid the molds cast, above the base plane, mm^3.
+    pub cast_volume_mm3: f64,
+    /// Volume of the layer's member in the assembly, mm^3.
+    pub assembly_volume_mm3: f64,
+    /// Volume of the symmetric difference of the two, mm^3.
+    pub symmetric_difference_mm3: f64,
+    /// The bound on it: 2 x chord tolerance x the layer's surface area in the assembly, mm^3.
+    pub bound_mm3: f64,
+    /// The designed features the cast layer carries (its own and those it takes from the layer
+    /// it is cast onto), each found by a probe inside it (a cube halfway along its axis that
+    /// the layer must hold whole, or leave empty, where the featureless shell does the other).
+    pub cast_features: usize,
+    /// The same count on the assembly's layer.
+    pub assembly_features: usize,
+    /// The features the design places on the layer's surfaces (the layer's patterns and those
+    /// it takes from the layer under it).
+    pub designed_features: usize,
+}
+
+impl CastCheck {
+    /// The cast layer is the assembly's: the difference within its bound, every designed
+    /// feature on both.
+    pub fn holds(&self) -> bool {
+        self.symmetric_difference_mm3 <= self.bound_mm3
+            && self.cast_features == self.designed_features
+            && self.assembly_features == self.designed_features
+    }
+}
+
+/// Checks every cast layer of `kit`, the kit built from `design` at `tol` with its whole
+/// assembly ([`crate::build_kit`]), inner to outer.
+///
+/// # Errors
+/// [`DesignError::Params`] if the design does not validate; [`DesignError::Geometry`] if the
+/// kernel fails or a mold part or assembly member the check needs is missing (naming it).
+pub fn check_casts(
+    design: &Design,
+    kit: &Kit,
+    tol: ChordTolerance,
+) -> Result<Vec<CastCheck>, DesignError> {
+    let materials = crate::materials::MaterialsTable::embedded().map_err(DesignError::Yaml)?;
+    let stack = crate::stack::validate(design, &materials, tol)?;
+    stack
+        .layers
+        .iter()
+        .filter(|l| l.process == LayerProcess::Cast)
+        .map(|l| check_layer(design, &stack, kit, l.index, tol))
+        .collect()
+}
+
+fn missing(what: String) -> DesignError {
+    DesignError::Geometry {
+        part: what.clone(),
+        params: Vec::new(),
+        source: crate::geometry::GeometryError::InvalidPrimitive(format!(
+            "the cast check needs {what}, which the kit does not hold"
+        )),
+    }
+}
+
+fn check_layer(
+    design: &Design,
+    stack: &Stack,
+    kit: &Kit,
+    i: usize,
+    tol: ChordTolerance,
+) -> Result<CastCheck, DesignError> {
+    let l = &stack.layers[i];
+    let name = &l.name;
+    let (cast, formed_by) = cast_layer(design, stack, kit, i, tol)?;
+    let shown = &kit
+        .assembly
+        .iter()
+        .find(|m| &m.name == name)
+        .ok_or_else(|| missing(format!("the assembly's member {name}")))?
+        .solid;
+    let g = |r: Result<Solid, crate::geometry::GeometryError>| r.part(name);
+    let sym = g(cast.difference(shown))?.volume() + g(shown.difference(&cast))?.volume();
+    let placed = layers::place_layer_markers(design, l, tol);
+    let (_, taken) = layers::taken_features(design, stack, i, tol);
+    let sets: Vec<(&layers::PlacedMarkers, MarkerSurface)> = placed
+        .iter()
+        .map(|p| (p, p.spec.surface))
+        .chain(taken.iter().map(|p| (p, MarkerSurface::Inner)))
+        .collect();
+    let designed = sets.iter().map(|(p, _)| p.markers.len()).sum();
+    let probes = Probes::new(&sets).part(name)?;
+    let cast_features = probes.present(&cast).part(name)?;
+    let assembly_features = probes.present(shown).part(name)?;
+    Ok(CastCheck {
+        layer: name.clone(),
+        strategy: l.mold_strategy,
+        formed_by,
+        cast_volume_mm3: cast.volume(),
+        assembly_volume_mm3: shown.volume(),
+        symmetric_difference_mm3: sym,
+        bound_mm3: 2.0 * tol.mm() * shown.surface_area(),
+        cast_features,
+        assembly_features,
+        designed_features: designed,
+    })
+}
+
+/// The solid the molds of cast layer `i` of `kit` cast above the base plane, sensor frame, mm
+/// (see the module's description), and the names of the parts that form it.
+///
+/// # Errors
+/// [`DesignError::Geometry`] if the kernel fails or a part the layer's strategy makes is
+/// missing from the kit.
+pub fn cast_layer(
+    design: &Design,
+    stack: &Stack,
+    kit: &Kit,
+    i: usize,
+    tol: ChordTolerance,
+) -> Result<(Solid, Vec<String>), DesignError> {
+    let l = &stack.layers[i];
+    let name = &l.name;
+    let g = |r: Result<Solid, crate::geometry::GeometryError>| r.part(name);
+    let part = |suffix: &str| {
+        kit.parts
+            .iter()
+            .find(|p| p.name == format!("{name}_{suffix}"))
+    };
+    let need = |suffix: &str| part(suffix).ok_or_else(|| missing(format!("{name}_{suffix}")));
+    let in_sensor = |p: &crate::Part| -> Result<Solid, DesignError> {
+        let t = crate::geometry::transform::from_json(&p.params["T_print_sensor"])
+            .ok_or_else(|| missing(format!("the print pose of {}", p.name)))?;
+        Ok(p.solid.transform(&t.inverse()))
+    };
+    // The envelope: the cavity's offset surface, beyond the tallest feature, closed on the
+    // base plane.
+    let cavity_offset = l.outer_offset_mm + layers::cavity_gap_mm(design, &stack.layers, l);
+    let reach = layers::place_layer_markers(design, l, tol)
+        .iter()
+        .map(|p| p.spec.feature.height_mm)
+        .fold(0.0, f64::max);
+    let envelope = g(crate::geometry::revolve(
+        &design
+            .body
+            .solid_profile(cavity_offset + reach + 0.1, 0.0, tol.half()),
+        tol,
+    )
+    .and_then(|m| Solid::from_mesh(&m)))?;
+    // the space the closed pieces leave, within the envelope
+    let negative = |pieces: &[&crate::Part]| -> Result<Solid, DesignError> {
+        let solids = pieces
+            .iter()
+            .map(|p| in_sensor(p))
+            .collect::<Result<Vec<_>, _>>()?;
+        let b = envelope
+            .bounding_box()
+            .ok_or_else(|| missing(format!("the envelope of {name}")))?;
+        let bx = g(cuboid(
+            [b.min[0] - 1.0, b.min[1] - 1.0, b.min[2]],
+            [b.max[0] + 1.0, b.max[1] + 1.0, b.max[2] + 1.0],
+        ))?;
+        g(bx.difference(&g(Solid::union_all(&solids))?)
+            .and_then(|s| s.intersection(&envelope)))
+    };
+    let (cast, pieces): (Solid, Vec<&crate::Part>) = match l.mold_strategy {
+        MoldStrategy::Master => {
+            let master = need("master_pattern")?;
+            (g(in_sensor(master)?.intersection(&envelope))?, vec![master])
+        }
+        MoldStrategy::Boundary => {
+            let (outer, inner) = (need("outer_master")?, need("inner_negative")?);
+            let cup = &inner.params["boundary"]["cup"];
+            let num = |k: &str| {
+                cup[k]
+                    .as_f64()
+                    .ok_or_else(|| missing(format!("the cup of {}", inner.name)))
+            };
+            let (r, z0, z1) = (num("radius_mm")?, num("bottom_z_mm")?, num("top_z_mm")?);
+            let cup =
+                g(crate::geometry::cylinder(z1 - z0, r, tol).map(|c| c.translate([0.0, 0.0, z0])))?;
+            // the inner silicone core: what Mold Star fills in the negative's cup
+            let core = g(cup.difference(&in_sensor(inner)?))?;
+            (
+                g(in_sensor(outer)?
+                    .intersection(&envelope)
+                    .and_then(|s| s.difference(&core)))?,
+                vec![outer, inner],
+            )
+        }
+        MoldStrategy::Direct => {
+            let p = vec![
+                need("mold_half_a")?,
+                need("mold_half_b")?,
+                need("core_holder")?,
+            ];
+            (negative(&p)?, p)
+        }
+        MoldStrategy::Open => {
+            let mut p = vec![need("open_mold")?];
+            p.extend(part("recess_insert"));
+            (negative(&p)?, p)
+        }
+        MoldStrategy::TwoPieceOpen => {
+            let p = vec![need("cavity_block")?, need("reservoir_top")?];
+            (negative(&p)?, p)
+        }
+    };
+    let formed_by = pieces.iter().map(|p| p.name.clone()).collect();
+    if !matches!(l.mold_strategy, MoldStrategy::Direct | MoldStrategy::Master) {
+        return Ok((cast, formed_by));
+    }
+    // Cast onto the stack: the core and the layers in the mold before the pour (those under
+    // it and the coats sprayed into the cavity), as the assembly shows them.
+    let coats = stack.layers[i + 1..]
+        .iter()
+        .take_while(|s| s.process == LayerProcess::Sprayed)
+        .map(|s| s.name.as_str());
+    let before: Vec<&str> = std::iter::once("core_envelope")
+        .chain(stack.layers[..i].iter().map(|s| s.name.as_str()))
+        .chain(coats)
+        .collect();
+    let mut in_mold = Vec::new();
+    // the core's bore: closed by its round end and by the holder's pin, the pour never fills it
+    if let Some(core) = &stack.core {
+        in_mold.push(g(crate::geometry::revolve(
+            &design
+                .body
+                .solid_profile(core.inner_offset_mm, 0.0, tol.half()),
+            tol,
+        )
+        .and_then(|m| Solid::from_mesh(&m)))?);
+    }
+    for b in before {
+        let m = kit
+            .assembly
+            .iter()
+            .find(|m| m.name == b)
+            .ok_or_else(|| missing(format!("the assembly's member {b}")))?;
+        in_mold.push(m.solid.clone());
+    }
+    Ok((
+        g(cast.difference(&g(Solid::union_all(&in_mold))?))?,
+        formed_by,
+    ))
+}
+
+/// A small cube inside each feature of a layer, halfway along its axis, split by where the
+/// layer has it: inside the layer (a feature that adds to it: raised on its outer surface, or
+/// on its inner surface a feature that points inward, into the space under it), or outside (one
+/// cut from it). The featureless shell has each the other way round, so a probe tells whether
+/// the feature is there.
+struct Probes {
+    inside: Vec<Solid>,
+    outside: Vec<Solid>,
+    /// The volume of one probe of each list, mm^3.
+    inside_mm3: Vec<f64>,
+    outside_mm3: Vec<f64>,
+}
+
+impl Probes {
+    fn new(
+        sets: &[(&layers::PlacedMarkers, MarkerSurface)],
+    ) -> Result<Self, crate::geometry::GeometryError> {
+        let mut p = Probes {
+            inside: Vec::new(),
+            outside: Vec::new(),
+            inside_mm3: Vec::new(),
+            outside_mm3: Vec::new(),
+        };
+        for (pm, surface) in sets {
+            let h = pm.spec.feature.height_mm;
+            let a = 0.25 * pm.radius_mm().min(h);
+            let adds = match surface {
+                MarkerSurface::Outer => pm.direction > 0.0,
+                MarkerSurface::Inner => pm.direction < 0.0,
+            };
+            for m in &pm.markers {
+                let c: [f64; 3] = std::array::from_fn(|k| {
+                    m.position_mm[k] + pm.direction * m.normal[k] * h / 2.0
+                });
+                let cube = cuboid(
+                    [c[0] - a, c[1] - a, c[2] - a],
+                    [c[0] + a, c[1] + a, c[2] + a],
+                )?;
+                let (list, vols) = if adds {
+                    (&mut p.inside, &mut p.inside_mm3)
+                } else {
+                    (&mut p.outside, &mut p.outside_mm3)
+                };
+                list.push(cube);
+                vols.push(8.0 * a * a * a);
+            }
+        }
+        Ok(p)
+    }
+
+    /// How many of the features `s` has: the inside probes it holds whole, and the outside
+    /// probes it leaves empty.
+    fn present(&self, s: &Solid) -> Result<usize, crate::geometry::GeometryError> {
+        let held =
+            |probes: &[Solid], vols: &[f64]| -> Result<usize, crate::geometry::GeometryError> {
+                if probes.is_empty() {
+                    return Ok(0);
+                }
+                let smallest = vols.iter().copied().fold(f64::INFINITY, f64::min);
+                let inter = s.intersection(&Solid::compose(probes))?;
+                Ok(shell_volumes(&inter.mesh())
+                    .into_iter()
+                    .filter(|&v| v > 0.5 * smallest)
+                    .count())
+            };
+        let inside = held(&self.inside, &self.inside_mm3)?;
+        let outside = held(&self.outside, &self.outside_mm3)?;
+        Ok(inside + self.outside.len() - outside.min(self.outside.len()))
+    }
+}
+
+/// The volume of each edge-connected shell of `m`, mm^3 (divergence theorem per shell).
+pub fn shell_volumes(m: &crate::Mesh) -> Vec<f64> {
+    let n = m.vertices.len();
+    let mut parent: Vec<usize> = (0..n).collect();
+    fn find(p: &mut [usize], mut x: usize) -> usize {
+        while p[x] != x {
+            p[x] = p[p[x]];
+            x = p[x];
+        }
+        x
+    }
+    for t in &m.triangles {
+        for &o in &t[1..] {
+            let (ra, ro) = (
+                find(&mut parent, t[0] as usize),
+                find(&mut parent, o as usize),
+            );
+            if ra != ro {
+                parent[ra] = ro;
+            }
+        }
+    }
+    let mut by_root = std::collections::BTreeMap::<usize, f64>::new();
+    for t in &m.triangles {
+        let [a, b, c] = t.map(|i| m.vertices[i as usize]);
+        let v = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+            + a[2] * (b[0] * c[1] - b[1] * c[0]);
+        *by_root.entry(find(&mut parent, t[0] as usize)).or_default() += v / 6.0;
+    }
+    by_root.into_values().collect()
+}
