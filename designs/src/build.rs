@@ -323,7 +323,26 @@ fn gather_layer_outputs(
             out.pour_parts,
             plan.sprayed.clone(),
         ));
+        layer_markers.extend(out.markers);
         parts.extend(out.parts);
+    }
+    // inner to outer, whatever built each layer
+    let at = |m: &serde_json::Value| {
+        stack
+            .layers
+            .iter()
+            .position(|l| m["layer"].as_str() == Some(l.name.as_str()))
+    };
+    layer_markers.sort_by_key(at);
+    // a pattern that no part carries would be cast without its features
+    if let Some(m) = layer_markers
+        .iter()
+        .find(|m| m["formed_by"].as_array().is_none_or(|a| a.is_empty()))
+    {
+        return Err(DesignError::Yaml(format!(
+            "the markers on {} ({}) are carried by no part of the kit",
+            m["layer"], m["surface"]
+        )));
     }
     Ok(layer_markers)
 }

@@ -31,6 +31,7 @@ pub mod preview;
 pub mod raster;
 pub mod section;
 mod sheet;
+pub use sheet::{marker_feature_words, marker_formers};
 pub mod step;
 mod stl;
 mod three_mf;

@@ -145,6 +145,7 @@ Each part in print orientation, from above-front-right and from below-back-left.
     print_settings(&mut s, m);
 
     layer_stack(&mut s, m);
+    markers(&mut s, m);
     section_view(&mut s, m);
 
     s.push_str("## Cast order\n\n");
@@ -630,6 +631,77 @@ fn layer_stack(s: &mut String, m: &Manifest) {
         );
     }
     s.push('\n');
+}
+
+/// The marker patterns, layer by layer, with the parts that carry their features, from
+/// `summary.markers` (nothing when the kit has none): a maker checks them on the printed mold
+/// before casting.
+fn markers(s: &mut String, m: &Manifest) {
+    let Some(sets) = m.summary["markers"].as_array().filter(|l| !l.is_empty()) else {
+        return;
+    };
+    s.push_str(
+        "## Markers
+
+",
+    );
+    s.push_str(
+        "The features of each marker pattern and the printed parts that form them: check that \
+         each of these parts shows them before you cast. Under a sprayed coat the formers are \
+         smaller (dimples) or larger (bumps) by the coat's thickness all round: the coat, \
+         sprayed into the mold, follows them.\n\n",
+    );
+    s.push_str("| Layer | Surface | Markers | Feature | Formed by |\n");
+    s.push_str("|-------|---------|--------:|---------|-----------|\n");
+    for k in sets {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {} |",
+            code(k["layer"].as_str().unwrap_or("?")),
+            text(k["surface"].as_str().unwrap_or("?")),
+            k["count"],
+            text(&marker_feature_words(k)),
+            text(&marker_formers(k))
+        );
+    }
+    s.push('\n');
+}
+
+/// A marker set's feature in a maker's words: "0.6 mm dimples, 0.4 mm deep".
+pub fn marker_feature_words(k: &serde_json::Value) -> String {
+    let f = &k["feature"];
+    let d = f["diameter_mm"].as_f64().unwrap_or(f64::NAN);
+    let h = f["height_mm"].as_f64().unwrap_or(f64::NAN);
+    let recessed = matches!(f["on_skin"].as_str(), Some("dimple"))
+        || matches!(f["polarity"].as_str(), Some("recessed"));
+    if recessed {
+        format!("{d} mm dimples, {h} mm deep")
+    } else {
+        format!("{d} mm bumps, {h} mm tall")
+    }
+}
+
+/// The parts that carry a marker set's features and the formers' size:
+/// "translucent_gel_master_pattern: 127 dimple formers, 0.400 mm (under 0.100 mm of coat)".
+pub fn marker_formers(k: &serde_json::Value) -> String {
+    let parts: Vec<&str> = k["formed_by"]
+        .as_array()
+        .map(|a| a.iter().filter_map(|x| x.as_str()).collect())
+        .unwrap_or_default();
+    let recessed = marker_feature_words(k).contains("dimples");
+    let coat = k["coat_mm"].as_f64().unwrap_or(0.0);
+    format!(
+        "{}: {} {} formers, {:.3} mm{}",
+        parts.join(", "),
+        k["count"],
+        if recessed { "dimple" } else { "bump" },
+        k["former_diameter_mm"].as_f64().unwrap_or(f64::NAN),
+        if coat > 0.0 {
+            format!(" (under {coat:.3} mm of coat)")
+        } else {
+            String::new()
+        }
+    )
 }
 
 /// One note per multi-material group, in order of first appearance; nothing without groups.

@@ -572,13 +572,15 @@ fn export(args: ExportArgs) -> Result<(), Box<dyn Error>> {
     if let Some(markers) = kit.summary.get("markers").and_then(|m| m.as_array()) {
         for m in markers {
             out!(
-                "  markers on {} ({}): {} features, nearest-neighbour spacing on the surface min {:.3} mm, median {:.3} mm; printable with {}",
+                "  markers on {} ({}): {} features ({}), nearest-neighbour spacing on the surface min {:.3} mm, median {:.3} mm; printable with {}; formed by {}",
                 m["layer"].as_str().unwrap_or("?"),
                 m["surface"].as_str().unwrap_or("?"),
                 m["count"],
+                fabkit_export::marker_feature_words(m),
                 m["min_spacing_mm"].as_f64().unwrap_or(0.0),
                 m["median_spacing_mm"].as_f64().unwrap_or(0.0),
-                m["printable_with"].as_array().map(|a| a.iter().filter_map(|x| x.as_str()).collect::<Vec<_>>().join(", ")).unwrap_or_default()
+                m["printable_with"].as_array().map(|a| a.iter().filter_map(|x| x.as_str()).collect::<Vec<_>>().join(", ")).unwrap_or_default(),
+                fabkit_export::marker_formers(m)
             );
         }
     }

@@ -495,3 +495,64 @@ fn tactip_kits() {
     let tips = dir.join(part(&m, "skin_tips")["file"].as_str().unwrap());
     printcheck_all_with(&[tips], &["--no-fdm"]);
 }
+
+/// The tutorial's design (R-Tac0 with 127 dimples on the translucent gel, under the sprayed
+/// coat), exported with its `master` molds and with `--mold-strategy direct`: the parts that
+/// form the dimples are named in the manifest and the command's summary, the oracle reads every
+/// output back, and every part and the kit 3MF pass `printcheck --strict`.
+#[test]
+fn tutorial_markers_under_the_coat_kits() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let o = run(dir, &["show", "rtac0", "--out", "my_sensor.yaml"], &[]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let yaml = std::fs::read_to_string(dir.join("my_sensor.yaml")).unwrap().replace(
+        "  - name: translucent_gel\n",
+        "  - name: translucent_gel\n    markers:\n      - surface: outer\n        feature: {diameter_mm: 0.6, height_mm: 0.4, on_skin: dimple}\n        pattern: {layout: concentric_6k, rings: 6, polar_step_deg: 6.0}\n",
+    );
+    std::fs::write(dir.join("my_sensor.yaml"), yaml).unwrap();
+    let mut files = Vec::new();
+    for (strategy, carriers) in [
+        ("master", vec!["translucent_gel_master_pattern"]),
+        (
+            "direct",
+            vec!["translucent_gel_mold_half_a", "translucent_gel_mold_half_b"],
+        ),
+    ] {
+        let out = dir.join("out").join(strategy);
+        let o = run(
+            dir,
+            &[
+                "export",
+                "my_sensor.yaml",
+                "--mold-strategy",
+                strategy,
+                "--out",
+                out.to_str().unwrap(),
+            ],
+            &[],
+        );
+        assert!(o.status.success(), "{}", text(&o.stderr));
+        let stdout = text(&o.stdout);
+        assert!(
+            stdout.contains(&format!(
+                "formed by {}: 127 dimple formers, 0.400 mm (under 0.100 mm of coat)",
+                carriers.join(", ")
+            )),
+            "{stdout}"
+        );
+        let m: Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("manifest.json")).unwrap())
+                .unwrap();
+        let sets = markers_summary(&m);
+        assert_eq!(sets.len(), 1);
+        assert_eq!(sets[0]["count"], 127);
+        assert_eq!(sets[0]["formed_by"], serde_json::json!(carriers));
+        for c in &carriers {
+            part(&m, c);
+        }
+        oracle_check(&out);
+        files.extend(printable_files(&out, &m));
+    }
+    printcheck_all(&files);
+}

@@ -119,6 +119,21 @@ fn the_tutorial_runs_as_written() {
         assert!(valid, "{out}");
     }
     assert!(manifest.to_string().contains("my_sensor"));
+    // Steps 3 and 5: the dimples under the coat are formed by the translucent layer's master
+    // pattern, 0.4 mm formers (0.6 mm less the 0.1 mm coat all round), and the sheet says so.
+    let markers = manifest["summary"]["markers"].as_array().unwrap();
+    assert_eq!(markers.len(), 1, "{markers:?}");
+    assert_eq!(markers[0]["count"], 127);
+    assert_eq!(
+        markers[0]["formed_by"],
+        serde_json::json!(["translucent_gel_master_pattern"])
+    );
+    assert!((markers[0]["former_diameter_mm"].as_f64().unwrap() - 0.4).abs() < 1e-9);
+    let sheet = std::fs::read_to_string(dir.join("out/my_sensor/FABRICATION.md")).unwrap();
+    assert!(
+        sheet.contains("translucent_gel_master_pattern: 127 dimple formers, 0.400 mm"),
+        "{sheet}"
+    );
     // Step 8: the pose of the lab inputs is recovered.
     let e = json(&dir.join("calib/extrinsics.json"));
     let m: Vec<f64> = e["T_cam_sensor"]

@@ -85,7 +85,7 @@ fn direction(spec: &MarkerSpec) -> f64 {
 }
 
 /// The print technology that makes the surface carrying a layer's features.
-fn feature_technology(design: &Design, layer: &crate::schema::Layer) -> Technology {
+pub(crate) fn feature_technology(design: &Design, layer: &crate::schema::Layer) -> Technology {
     match layer.process {
         LayerProcess::Printed => layer.print_technology.unwrap_or(Technology::Polyjet),
         _ => design.mold.cavity_print_technology,
@@ -1109,7 +1109,7 @@ pub struct LayerOutput {
     pub markers: Vec<serde_json::Value>,
 }
 
-fn marker_summary(
+pub(crate) fn marker_summary(
     l: &ResolvedLayer,
     placed: &[PlacedMarkers],
     tech: Technology,
@@ -1154,6 +1154,27 @@ fn marker_summary(
             })
         })
         .collect()
+}
+
+/// Adds to each entry of a layer's marker summary the parts that carry its features
+/// (`formed_by`: `outer` for the features of the outer surface, `inner` for the inner one) and
+/// the diameter of the features on them (`former_diameter_mm`: the feature grown, raised, or
+/// shrunk, recessed, by `gap_mm`, the coats sprayed into the mold before the pour and the
+/// mold's clearance, [`PlacedMarkers::conformal`]), with `gap_mm` as `coat_mm`.
+pub fn set_forming(
+    entries: &mut [serde_json::Value],
+    outer: &[String],
+    inner: &[String],
+    gap_mm: f64,
+) {
+    for e in entries {
+        let on_outer = e["surface"] == json!(MarkerSurface::Outer);
+        let d = e["feature"]["diameter_mm"].as_f64().unwrap_or(0.0);
+        let sign = e["direction"].as_f64().unwrap_or(1.0);
+        e["formed_by"] = json!(if on_outer { outer } else { inner });
+        e["former_diameter_mm"] = json!(((d + 2.0 * sign * gap_mm) * 1e9).round() / 1e9);
+        e["coat_mm"] = json!((gap_mm * 1e9).round() / 1e9);
+    }
 }
 
 /// The parameter paths a layer's parts are built from: the layer, and the mold for a cast one.
@@ -1365,10 +1386,17 @@ fn build_printed_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
             group: group.clone(),
         });
     }
+    let mut markers = b.markers_json;
+    let carriers: Vec<String> = parts
+        .iter()
+        .filter(|p| p.role != "tip_fitting")
+        .map(|p| p.name.clone())
+        .collect();
+    set_forming(&mut markers, &carriers, &carriers, 0.0);
     Ok(LayerOutput {
         parts,
         pours: vec![],
-        markers: b.markers_json,
+        markers,
     })
 }
 
@@ -1444,10 +1472,12 @@ fn build_open_mold_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
         });
     }
     let pour_parts = parts.iter().map(|p| p.name.clone()).collect();
+    let mut markers = b.markers_json;
+    set_forming(&mut markers, &[format!("{name}_open_mold")], &[], 0.0);
     Ok(LayerOutput {
         parts,
         pours: vec![(name.clone(), l.material.clone(), skin_volume, pour_parts)],
-        markers: b.markers_json,
+        markers,
     })
 }
 
@@ -1604,10 +1634,12 @@ fn two_piece_open_parts(
         ),
     ];
     let pour_parts = parts.iter().map(|p| p.name.clone()).collect();
+    let mut markers = b.markers_json;
+    set_forming(&mut markers, &[format!("{name}_cavity_block")], &[], 0.0);
     LayerOutput {
         parts,
         pours: vec![(name.clone(), l.material.clone(), skin_volume, pour_parts)],
-        markers: b.markers_json,
+        markers,
     }
 }
 
@@ -1698,6 +1730,8 @@ fn build_boundary_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
         mk("inner_negative", "negative_mold", format!("Negative of the inner boundary of {name} with its features: pour Mold Star 30 in it for the inner silicone mold"), cavity_tech, place_posed(&inner_negative, &crate::geometry::rotation_deg(180.0, 0.0, 0.0))),
     ];
     let names: Vec<String> = parts.iter().map(|p| p.name.clone()).collect();
+    let mut markers = b.markers_json;
+    set_forming(&mut markers, &names[..1], &names[2..3], 0.0);
     Ok(LayerOutput {
         parts,
         pours: vec![
@@ -1723,7 +1757,7 @@ fn build_boundary_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
                 ],
             ),
         ],
-        markers: b.markers_json,
+        markers,
     })
 }
 

@@ -819,6 +819,9 @@ pub struct MoldOutput {
     pub silicone_pour: Option<(f64, Vec<String>)>,
     /// Names of the parts that hold the gel pour.
     pub pour_parts: Vec<String>,
+    /// The layer's marker summary with the parts that form the features
+    /// ([`crate::parts::layers::set_forming`]).
+    pub markers: Vec<serde_json::Value>,
 }
 
 /// Builds the mold parts of one cast.
@@ -949,13 +952,33 @@ fn build_mold_parts(
         holder_part,
         pour_volume,
     };
-    match plan.strategy {
+    let mut out = match plan.strategy {
         MoldStrategy::Open | MoldStrategy::TwoPieceOpen | MoldStrategy::Boundary => {
             unreachable!("built by crate::parts::layers")
         }
         MoldStrategy::Direct => direct_mold_parts(design, &cavity, tol, c),
         MoldStrategy::Master => master_mold_parts(design, plan, tol, c, &with_features),
-    }
+    }?;
+    let placed = crate::parts::layers::place_layer_markers(design, layer, tol);
+    out.markers = crate::parts::layers::marker_summary(
+        layer,
+        &placed,
+        crate::parts::layers::feature_technology(design, &design.layers[plan.layer]),
+        design,
+    );
+    let carriers: Vec<String> = out
+        .parts
+        .iter()
+        .filter(|p| matches!(p.role.as_str(), "mold_half" | "master_pattern"))
+        .map(|p| p.name.clone())
+        .collect();
+    crate::parts::layers::set_forming(
+        &mut out.markers,
+        &carriers,
+        &[],
+        plan.cavity_offset_mm - layer.outer_offset_mm,
+    );
+    Ok(out)
 }
 
 /// What both strategies of [`build_mold_parts`] build from: the cast layer's `name`, the
@@ -1019,6 +1042,7 @@ fn direct_mold_parts(
         pour_volume_mm3: c.pour_volume,
         silicone_pour: None,
         pour_parts,
+        markers: Vec::new(),
     })
 }
 
@@ -1096,6 +1120,7 @@ fn master_mold_parts(
         pour_volume_mm3: c.pour_volume,
         silicone_pour: Some((silicone, vec![master_name, box_name])),
         pour_parts: vec![format!("silicone_mold:{name}"), c.holder_name],
+        markers: Vec::new(),
     })
 }
 
