@@ -22,8 +22,8 @@
 //! area (each mesh lies within the chord tolerance of the true surfaces), and the number of
 //! features each carries (the pieces where it differs from the layer's featureless shell).
 //! Printed layers and sprayed coats are formed by no mold of their own (a coat follows the
-//! cavity it is sprayed into, [`crate::parts::layers::taken_features`]); flat skins are cast in
-//! trays ([`crate::build`]'s flat kit) and are not covered here.
+//! cavity it is sprayed into, [`crate::parts::layers::taken_features`]). A flat skin's layers
+//! are each cast alone in a tray: the space the tray leaves up to its brim.
 
 use crate::error::{DesignError, GeometryContext};
 use crate::geometry::{cuboid, ChordTolerance, Solid};
@@ -37,7 +37,9 @@ use crate::stack::Stack;
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct CastCheck {
     pub layer: String,
-    pub strategy: MoldStrategy,
+    /// How the layer is cast: its mold strategy (`master`, `direct`, `boundary`, `open`,
+    /// `two_piece_open`), or `tray` / `laser_cut_tray` for a flat skin's layer.
+    pub strategy: String,
     /// The printed parts whose closed cavity (or positive) forms the layer.
     pub formed_by: Vec<String>,
     /// Volume of the solid the molds cast, above the base plane, mm^3.
@@ -48,6 +50,11 @@ pub struct CastCheck {
     pub symmetric_difference_mm3: f64,
     /// The bound on it: 2 x chord tolerance x the layer's surface area in the assembly, mm^3.
     pub bound_mm3: f64,
+    /// The pieces of the symmetric difference thicker than twice the chord tolerance (mean
+    /// thickness 2 x volume / area): where both meshes are within the chord tolerance of the
+    /// same surface they differ by slivers at most that thick, so each such piece is a shape
+    /// the molds cast and the assembly does not show, or the other way round.
+    pub thick_pieces: usize,
     /// The designed features the cast layer carries (its own and those it takes from the layer
     /// it is cast onto), each found by a probe inside it (a cube halfway along its axis that
     /// the layer must hold whole, or leave empty, where the featureless shell does the other).
@@ -64,6 +71,7 @@ impl CastCheck {
     /// feature on both.
     pub fn holds(&self) -> bool {
         self.symmetric_difference_mm3 <= self.bound_mm3
+            && self.thick_pieces == 0
             && self.cast_features == self.designed_features
             && self.assembly_features == self.designed_features
     }
@@ -81,6 +89,15 @@ pub fn check_casts(
     tol: ChordTolerance,
 ) -> Result<Vec<CastCheck>, DesignError> {
     let materials = crate::materials::MaterialsTable::embedded().map_err(DesignError::Yaml)?;
+    if let Some(outline) = design.body.flat_outline() {
+        let layers =
+            crate::parts::flat::validate(design, &materials).map_err(DesignError::Params)?;
+        let laser_cut = design.mold.laser_cut.is_some();
+        return layers
+            .iter()
+            .map(|l| check_flat_layer(&outline, l, laser_cut, kit, tol))
+            .collect();
+    }
     let stack = crate::stack::validate(design, &materials, tol)?;
     stack
         .layers
@@ -116,8 +133,7 @@ fn check_layer(
         .find(|m| &m.name == name)
         .ok_or_else(|| missing(format!("the assembly's member {name}")))?
         .solid;
-    let g = |r: Result<Solid, crate::geometry::GeometryError>| r.part(name);
-    let sym = g(cast.difference(shown))?.volume() + g(shown.difference(&cast))?.volume();
+    let (sym, thick_pieces) = compare(&cast, shown, tol).part(name)?;
     let placed = layers::place_layer_markers(design, l, tol);
     let (_, taken) = layers::taken_features(design, stack, i, tol);
     let sets: Vec<(&layers::PlacedMarkers, MarkerSurface)> = placed
@@ -131,15 +147,85 @@ fn check_layer(
     let assembly_features = probes.present(shown).part(name)?;
     Ok(CastCheck {
         layer: name.clone(),
-        strategy: l.mold_strategy,
+        strategy: serde_json::to_value(l.mold_strategy)
+            .ok()
+            .and_then(|v| v.as_str().map(str::to_string))
+            .unwrap_or_default(),
         formed_by,
         cast_volume_mm3: cast.volume(),
         assembly_volume_mm3: shown.volume(),
         symmetric_difference_mm3: sym,
         bound_mm3: 2.0 * tol.mm() * shown.surface_area(),
+        thick_pieces,
         cast_features,
         assembly_features,
         designed_features: designed,
+    })
+}
+
+/// One layer of a flat skin: the space its tray (taken back to the sensor frame) leaves within
+/// the outline's prism from below its markers' ends up to the brim (the layer's top face),
+/// against the assembly's layer; the markers found by a probe halfway down each.
+fn check_flat_layer(
+    outline: &crate::parts::flat::FlatOutline,
+    l: &crate::parts::flat::FlatLayer,
+    laser_cut: bool,
+    kit: &Kit,
+    tol: ChordTolerance,
+) -> Result<CastCheck, DesignError> {
+    let name = &l.name;
+    let g = |r: Result<Solid, crate::geometry::GeometryError>| r.part(name);
+    let tray_name = format!("{name}_tray");
+    let tray = kit
+        .parts
+        .iter()
+        .find(|p| p.name == tray_name)
+        .ok_or_else(|| missing(tray_name.clone()))?;
+    let t = crate::geometry::transform::from_json(&tray.params["T_print_sensor"])
+        .ok_or_else(|| missing(format!("the print pose of {tray_name}")))?;
+    let reach = l.marker_grid.as_ref().map_or(0.0, |m| m.feature.height_mm);
+    let envelope = g(crate::geometry::prism(
+        &outline.polygon(tol),
+        l.z0_mm - reach - 0.1,
+        l.z1_mm,
+    ))?;
+    let cast = g(envelope.difference(&tray.solid.transform(&t.inverse())))?;
+    let shown = &kit
+        .assembly
+        .iter()
+        .find(|m| &m.name == name)
+        .ok_or_else(|| missing(format!("the assembly's member {name}")))?
+        .solid;
+    let (sym, thick_pieces) = compare(&cast, shown, tol).part(name)?;
+    let mut probes = Probes {
+        inside: Vec::new(),
+        outside: Vec::new(),
+        inside_mm3: Vec::new(),
+        outside_mm3: Vec::new(),
+    };
+    if let Some(m) = &l.marker_grid {
+        let (h, r) = (m.feature.height_mm, m.feature.diameter_mm / 2.0);
+        let a = 0.25 * r.min(h);
+        for [x, y] in m.positions_mm() {
+            let z = l.z0_mm - h / 2.0;
+            probes
+                .inside
+                .push(g(cuboid([x - a, y - a, z - a], [x + a, y + a, z + a]))?);
+            probes.inside_mm3.push(8.0 * a * a * a);
+        }
+    }
+    Ok(CastCheck {
+        layer: name.clone(),
+        strategy: if laser_cut { "laser_cut_tray" } else { "tray" }.into(),
+        formed_by: vec![tray_name],
+        cast_volume_mm3: cast.volume(),
+        assembly_volume_mm3: shown.volume(),
+        symmetric_difference_mm3: sym,
+        bound_mm3: 2.0 * tol.mm() * shown.surface_area(),
+        thick_pieces,
+        cast_features: probes.present(&cast).part(name)?,
+        assembly_features: probes.present(shown).part(name)?,
+        designed_features: l.marker_grid.as_ref().map_or(0, |m| m.positions_mm().len()),
     })
 }
 
@@ -353,8 +439,28 @@ impl Probes {
     }
 }
 
+/// The volume of the symmetric difference of `a` and `b`, mm^3, and the number of its pieces
+/// (edge-connected shells) thicker than twice the chord tolerance ([`CastCheck::thick_pieces`]).
+fn compare(
+    a: &Solid,
+    b: &Solid,
+    tol: ChordTolerance,
+) -> Result<(f64, usize), crate::geometry::GeometryError> {
+    let d = a.difference(b)?.union(&b.difference(a)?)?;
+    let thick = shells(&d.mesh())
+        .into_iter()
+        .filter(|&(v, area)| 2.0 * v > 2.0 * tol.mm() * area + 1e-9)
+        .count();
+    Ok((d.volume(), thick))
+}
+
 /// The volume of each edge-connected shell of `m`, mm^3 (divergence theorem per shell).
 pub fn shell_volumes(m: &crate::Mesh) -> Vec<f64> {
+    shells(m).into_iter().map(|(v, _)| v).collect()
+}
+
+/// The volume (mm^3) and surface area (mm^2) of each edge-connected shell of `m`.
+fn shells(m: &crate::Mesh) -> Vec<(f64, f64)> {
     let n = m.vertices.len();
     let mut parent: Vec<usize> = (0..n).collect();
     fn find(p: &mut [usize], mut x: usize) -> usize {
@@ -375,12 +481,16 @@ pub fn shell_volumes(m: &crate::Mesh) -> Vec<f64> {
             }
         }
     }
-    let mut by_root = std::collections::BTreeMap::<usize, f64>::new();
+    let mut by_root = std::collections::BTreeMap::<usize, (f64, f64)>::new();
     for t in &m.triangles {
         let [a, b, c] = t.map(|i| m.vertices[i as usize]);
         let v = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
             + a[2] * (b[0] * c[1] - b[1] * c[0]);
-        *by_root.entry(find(&mut parent, t[0] as usize)).or_default() += v / 6.0;
+        let n = crate::geometry::triangle_cross(a, b, c);
+        let area = 0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        let e = by_root.entry(find(&mut parent, t[0] as usize)).or_default();
+        e.0 += v / 6.0;
+        e.1 += area;
     }
     by_root.into_values().collect()
 }

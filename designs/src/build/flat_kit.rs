@@ -8,8 +8,8 @@ use crate::kit::Kit;
 use crate::materials::{CastReport, MaterialsTable};
 use crate::parts::cut_part::CutPart;
 use crate::parts::flat::{
-    estimated_triangles, layer_solid, tray_solid, validate, ChannelEnds, ChannelSet, FlatLayer,
-    FlatOutline,
+    estimated_triangles, layer_solid_as_cast, tray_solid, validate, ChannelEnds, ChannelSet,
+    FlatLayer, FlatOutline,
 };
 use crate::parts::{Member, MemberKind, Part, PrintTechnology, ProcedureAction, ProcedureStep};
 use crate::schema::{Design, LaserCutParams};
@@ -165,7 +165,7 @@ fn layer_tray(
             )
         }
     };
-    let skin = layer_solid(outline, l, tol).part(&l.name)?;
+    let skin = layer_solid_as_cast(outline, l, laser.is_some(), tol).part(&l.name)?;
     let t = l.z1_mm - l.z0_mm;
     // the cast layer's own volume, exact: the outline's prism, less the grooves, plus the
     // markers beyond the face (flat-ended in a laser-cut tray: its holes go straight

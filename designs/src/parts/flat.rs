@@ -40,6 +40,22 @@ pub fn layer_solid(
     layer: &FlatLayer,
     tol: ChordTolerance,
 ) -> Result<Solid, GeometryError> {
+    layer_solid_as_cast(outline, layer, false, tol)
+}
+
+/// [`layer_solid`] as the layer's tray casts it: in a laser-cut tray (`laser_cut`) the markers
+/// are flat-ended, the straight holes through the marker sheet
+/// ([`crate::parts::lasercut::tray_sheets`]) with the same polygon, instead of ending in a
+/// hemisphere as a printed tray's holes do.
+///
+/// # Errors
+/// [`GeometryError`] on a kernel failure.
+pub fn layer_solid_as_cast(
+    outline: &FlatOutline,
+    layer: &FlatLayer,
+    laser_cut: bool,
+    tol: ChordTolerance,
+) -> Result<Solid, GeometryError> {
     let mut s = prism(&outline.polygon(tol), layer.z0_mm, layer.z1_mm)?;
     if let Some(ch) = &layer.channels {
         let y_near = -outline.length_mm / 2.0;
@@ -65,13 +81,22 @@ pub fn layer_solid(
             .positions_mm()
             .into_iter()
             .map(|[x, y]| {
-                feature_solid(
-                    &g.feature,
-                    [x, y, layer.z0_mm],
-                    [0.0, 0.0, -1.0],
-                    embed,
-                    tol,
-                )
+                if laser_cut {
+                    let r = g.feature.diameter_mm / 2.0;
+                    prism(
+                        &crate::parts::lasercut::circle([x, y], r, tol),
+                        layer.z0_mm - g.feature.height_mm,
+                        layer.z0_mm + embed,
+                    )
+                } else {
+                    feature_solid(
+                        &g.feature,
+                        [x, y, layer.z0_mm],
+                        [0.0, 0.0, -1.0],
+                        embed,
+                        tol,
+                    )
+                }
             })
             .collect::<Result<Vec<_>, _>>()?;
         s = s.union(&Solid::compose(&markers))?;
@@ -414,8 +439,9 @@ pub fn estimated_triangles(
             let mk = l.marker_grid.as_ref().map_or(0.0, |g| {
                 let n = tol.circle_segments(g.feature.radius_mm()) as f64;
                 let revolved = 4.0 * n * (n / 4.0 + 3.0);
-                let hole = if laser_cut { 4.0 * n } else { revolved };
-                (g.rows * g.columns) as f64 * (revolved + hole)
+                // a laser-cut tray's straight holes cast flat-ended markers (layer_solid_as_cast)
+                let one = if laser_cut { 4.0 * n } else { revolved };
+                (g.rows * g.columns) as f64 * 2.0 * one
             });
             3.0 * prism_tris + ch + mk
         })

@@ -176,7 +176,7 @@ impl Sheet {
 
 /// A circle of radius `r` about `c` as a polygon of `tol`'s segment count, vertices on the
 /// circle (the first at angle 0), counter-clockwise.
-fn circle(c: [f64; 2], r: f64, tol: ChordTolerance) -> Vec<[f64; 2]> {
+pub(crate) fn circle(c: [f64; 2], r: f64, tol: ChordTolerance) -> Vec<[f64; 2]> {
     let n = tol.circle_segments(r).max(8);
     (0..n)
         .map(|i| {

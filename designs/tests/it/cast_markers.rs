@@ -292,7 +292,7 @@ fn assert_cast_equals_assembly(d: &Design, tol: ChordTolerance) {
     for c in &checks {
         assert!(
             c.holds(),
-            "{} layer {} ({:?}, formed by {:?}): cast {:.3} mm3, assembly {:.3} mm3, symmetric difference {:.4} mm3 (bound {:.4}), features cast {} / assembly {} / designed {}",
+            "{} layer {} ({}, formed by {:?}): cast {:.3} mm3, assembly {:.3} mm3, symmetric difference {:.4} mm3 (bound {:.4}), {} pieces thicker than 2 x the chord tolerance, features cast {} / assembly {} / designed {}",
             d.name,
             c.layer,
             c.strategy,
@@ -301,6 +301,7 @@ fn assert_cast_equals_assembly(d: &Design, tol: ChordTolerance) {
             c.assembly_volume_mm3,
             c.symmetric_difference_mm3,
             c.bound_mm3,
+            c.thick_pieces,
             c.cast_features,
             c.assembly_features,
             c.designed_features
@@ -311,9 +312,6 @@ fn assert_cast_equals_assembly(d: &Design, tol: ChordTolerance) {
 #[test]
 fn every_cast_layer_of_the_library_is_what_its_molds_cast() {
     for d in crate::common::library_designs_and_presets() {
-        if d.body.flat_outline().is_some() {
-            continue; // cast in trays: the flat kit's own checks (flat_skin.rs)
-        }
         if d.layers
             .iter()
             .all(|l| l.process != fabkit_designs::schema::LayerProcess::Cast)
@@ -384,4 +382,28 @@ fn the_cast_check_catches_a_mold_without_the_markers() {
         .iter()
         .filter(|c| c.layer != "translucent_gel")
         .all(|c| c.holds()));
+}
+
+/// Regression: the Soter skin's laser-cut tray casts flat-ended markers (straight holes through
+/// the marker sheet) while the assembly showed them ending in hemispheres. The check finds the
+/// 100 ends that differ (each a piece far thicker than the chord tolerance).
+#[test]
+fn the_cast_check_catches_markers_shaped_otherwise_than_the_tray_casts_them() {
+    let tol = ChordTolerance::new(0.02).unwrap();
+    let d = library::load("soter_channels").unwrap();
+    let mut kit = build_kit(&d, tol).unwrap();
+    let ok = fabkit_designs::cast_check::check_casts(&d, &kit, tol).unwrap();
+    assert!(ok.iter().all(|c| c.holds()), "{ok:?}");
+    let layers = fabkit_designs::flat::flat_layers(&d).unwrap();
+    let outline = d.body.flat_outline().unwrap();
+    let member = kit
+        .assembly
+        .iter_mut()
+        .find(|m| m.name == "marker_layer")
+        .unwrap();
+    member.solid = fabkit_designs::flat::layer_solid(&outline, &layers[0], tol).unwrap();
+    let checks = fabkit_designs::cast_check::check_casts(&d, &kit, tol).unwrap();
+    let c = checks.iter().find(|c| c.layer == "marker_layer").unwrap();
+    assert!(!c.holds());
+    assert_eq!(c.thick_pieces, 100, "{c:?}");
 }
