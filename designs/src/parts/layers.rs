@@ -1215,7 +1215,38 @@ pub fn layer_twin_params(
     let l = &stack.layers[i];
     let placed = place_layer_markers(design, l, tol);
     let tech = feature_technology(design, &design.layers[i]);
-    twin_params(design, l, json!(marker_summary(l, &placed, tech, design)))
+    let mut sets = marker_summary(l, &placed, tech, design);
+    let (outer, inner) = taken_features(design, stack, i, tol);
+    sets.extend(
+        outer
+            .iter()
+            .map(|p| twin_marker_set(p, MarkerSurface::Outer)),
+    );
+    sets.extend(
+        inner
+            .iter()
+            .map(|p| twin_marker_set(p, MarkerSurface::Inner)),
+    );
+    twin_params(design, l, json!(sets))
+}
+
+/// A placed marker set as the CadQuery twins build it (`export/python/twins/cq_layers.py`):
+/// its feature, the surface it sits on and that surface's offset, its direction, how much the
+/// features are grown ([`PlacedMarkers::dilation_mm`]) and each marker's (polar, azimuth)
+/// angle seen from the sensor-frame origin, degrees.
+pub fn twin_marker_set(p: &PlacedMarkers, surface: MarkerSurface) -> serde_json::Value {
+    json!({
+        "surface": surface,
+        "feature": p.spec.feature,
+        "tip_material": p.spec.tip_material,
+        "surface_offset_mm": p.offset_mm,
+        "direction": p.direction,
+        "dilation_mm": p.dilation_mm,
+        "placements_deg": p.markers.iter().map(|m| {
+            let [x, y, z] = m.position_mm;
+            [x.hypot(y).atan2(z).to_degrees(), m.azimuth_deg]
+        }).collect::<Vec<_>>(),
+    })
 }
 
 fn twin_params(

@@ -14,6 +14,7 @@
 
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{cuboid, revolve, sphere, Affine, ChordTolerance, Polyline2, Solid};
+use crate::markers::MarkerSurface;
 use crate::parts::context::{ResolvedCore, Stack};
 use crate::parts::{Part, PrintTechnology};
 use crate::schema::{Design, LayerProcess, MoldStrategy};
@@ -914,7 +915,7 @@ fn build_mold_parts(
         .part(name)?;
     let pour_volume = void.volume() - sprayed_volume;
 
-    let common = json!({
+    let mut common = json!({
         "layer": name,
         "strategy": plan.strategy,
         "cavity_offset_mm": plan.cavity_offset_mm,
@@ -923,6 +924,13 @@ fn build_mold_parts(
         "frame": f,
         "plinth": m.plinth,
     });
+    if !features.is_empty() {
+        // the features the cavity carries, for the twins (export/python/twins/cq_molds.py)
+        common["markers"] = json!(features
+            .iter()
+            .map(|p| crate::parts::layers::twin_marker_set(p, MarkerSurface::Outer))
+            .collect::<Vec<_>>());
+    }
     let direct = plan.strategy == MoldStrategy::Direct;
     let holder_name = if direct {
         format!("{name}_core_holder")

@@ -234,11 +234,16 @@ def place_along(shape, origin, direction):
     return shape.moved(cq.Location(cq.Plane(origin=cq.Vector(*origin), xDir=x, normal=n)))
 
 
-def feature(diameter_mm: float, height_mm: float, embed_mm: float) -> cq.Solid:
+def feature(diameter_mm: float, height_mm: float, embed_mm: float,
+            dilation_mm: float = 0.0) -> cq.Solid:
     """A marker feature in its own frame: a cylinder from `embed_mm` behind the surface
-    (z = -embed) ending in a hemisphere whose top is at z = height (axis +z)."""
-    r = diameter_mm / 2.0
-    hc = height_mm - r
+    (z = -embed) ending in a hemisphere whose top is at z = height (axis +z). With
+    `dilation_mm`, the feature grown by it all round and seen from the surface that far beyond
+    (designs/src/markers.rs, local_feature_dilated): radius r + t, the hemisphere's centre t
+    closer to the surface, the same height; negative for a recessed feature."""
+    r = diameter_mm / 2.0 + dilation_mm
+    hc = height_mm - diameter_mm / 2.0 - dilation_mm
+    embed_mm = max(embed_mm, -hc + 0.01)
     arc = cq.Edge.makeThreePointArc(vec(r, hc), vec(r * math.cos(math.pi / 4),
                                                     hc + r * math.sin(math.pi / 4)), vec(0.0, height_mm))
     return revolve([cq.Edge.makeLine(vec(0.0, -embed_mm), vec(r, -embed_mm)),

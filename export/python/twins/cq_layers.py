@@ -32,7 +32,12 @@ def placements(body: C.Body, ms: dict):
 
 def feature_solids(body: C.Body, ms: dict, stems_only: bool):
     f = ms["feature"]
-    local = (C.stem if stems_only else C.feature)(f["diameter_mm"], f["height_mm"], EMBED_MM)
+    t = ms.get("dilation_mm", 0.0)
+    if stems_only:
+        local = C.stem(f["diameter_mm"], f["height_mm"], EMBED_MM)
+    else:
+        # features grown by a coat (a mold's cavity, a coat's faces) reach back as far
+        local = C.feature(f["diameter_mm"], f["height_mm"], EMBED_MM + t, ms["direction"] * t)
     return [C.place_along(local, o, u) for o, u in placements(body, ms)]
 
 

@@ -22,7 +22,12 @@ def cavity(params: dict, with_pin: bool):
                 (0.0, z - pin["height_mm"])]
     else:
         pts.append((0.0, f["open_face_z_mm"]))
-    return C.revolve(body.curve_edges(d), [(body.rim_radius(d), body.base_z())] + pts)
+    cav = C.revolve(body.curve_edges(d), [(body.rim_radius(d), body.base_z())] + pts)
+    if params.get("markers"):
+        # the layer's features, grown by the coats sprayed into the cavity
+        from .cq_layers import with_features
+        cav = with_features(cav, body, params["markers"], 1.0)
+    return cav
 
 
 def master_pattern(params: dict):
