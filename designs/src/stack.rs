@@ -431,6 +431,25 @@ fn check_mold_strategies(design: &Design, errs: &mut Vec<ParamError>) {
                 ),
             ));
         }
+        // A coat is sprayed into the cavity before the pour: only the direct and master molds
+        // have their cavity the coat's thickness beyond the layer.
+        if !needs_core
+            && design
+                .layers
+                .get(i + 1)
+                .is_some_and(|n| n.process == LayerProcess::Sprayed)
+        {
+            errs.push(ParamError::new(
+                format!("layers[{}].process", i + 1),
+                "sprayed",
+                format!(
+                    "a coat is sprayed into the mold of the layer under it, but the {} strategy of layer '{}' forms that layer's outer surface itself and leaves no room for the coat; cast '{}' with mold_strategy: direct or master (their cavity lies the coat's thickness beyond it), or cast the coat as a layer of its own",
+                    format!("{strategy:?}").to_lowercase(),
+                    l.name,
+                    l.name
+                ),
+            ));
+        }
         if matches!(strategy, MoldStrategy::Open | MoldStrategy::TwoPieceOpen) && !l.solid {
             errs.push(ParamError::new(
                 path,

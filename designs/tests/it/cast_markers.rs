@@ -407,3 +407,42 @@ fn the_cast_check_catches_markers_shaped_otherwise_than_the_tray_casts_them() {
     assert!(!c.holds());
     assert_eq!(c.thick_pieces, 100, "{c:?}");
 }
+
+#[test]
+fn inner_features_against_the_core_are_refused_naming_the_core() {
+    let mut d = stock(MoldStrategy::Master);
+    let mut m = tutorial_markers();
+    m.surface = fabkit_designs::markers::MarkerSurface::Inner;
+    d.layers[0].markers.push(m);
+    let errs = validation_errors(&d);
+    assert_eq!(errs.len(), 1, "{errs:?}");
+    assert_eq!(errs[0].path, "layers[0].markers[0].surface");
+    assert!(
+        errs[0].rule.contains("the core forms this surface"),
+        "{}",
+        errs[0].rule
+    );
+}
+
+/// A coat over a layer whose mold forms the layer's outer surface itself (boundary, open,
+/// two-piece open) would be sprayed inside the layer: refused, naming the strategies that work.
+#[test]
+fn a_coat_over_a_layer_without_room_for_it_is_refused() {
+    let mut d = library::load("uvdtact").unwrap();
+    let mut coat = d.layers[0].clone();
+    coat.name = "coat".into();
+    coat.process = fabkit_designs::schema::LayerProcess::Sprayed;
+    coat.material = "ptg_501_black".into();
+    coat.markers.clear();
+    coat.thickness_mm = Some(0.1);
+    d.layers[2].thickness_mm = Some(0.3);
+    d.layers.push(coat);
+    let errs = validation_errors(&d);
+    assert_eq!(errs.len(), 1, "{errs:?}");
+    assert_eq!(errs[0].path, "layers[3].process");
+    assert!(
+        errs[0].rule.contains("direct or master"),
+        "{}",
+        errs[0].rule
+    );
+}
