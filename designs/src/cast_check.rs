@@ -107,6 +107,15 @@ pub fn check_casts(
         .collect()
 }
 
+/// The solid of the assembly's member `name`.
+fn member<'a>(kit: &'a Kit, name: &str) -> Result<&'a Solid, DesignError> {
+    kit.assembly
+        .iter()
+        .find(|m| m.name == name)
+        .map(|m| &m.solid)
+        .ok_or_else(|| missing(format!("the assembly's member {name}")))
+}
+
 fn missing(what: String) -> DesignError {
     DesignError::Geometry {
         part: what.clone(),
@@ -127,12 +136,7 @@ fn check_layer(
     let l = &stack.layers[i];
     let name = &l.name;
     let (cast, formed_by) = cast_layer(design, stack, kit, i, tol)?;
-    let shown = &kit
-        .assembly
-        .iter()
-        .find(|m| &m.name == name)
-        .ok_or_else(|| missing(format!("the assembly's member {name}")))?
-        .solid;
+    let shown = member(kit, name)?;
     let (sym, thick_pieces) = compare(&cast, shown, tol).part(name)?;
     let placed = layers::place_layer_markers(design, l, tol);
     let (_, taken) = layers::taken_features(design, stack, i, tol);
@@ -190,12 +194,7 @@ fn check_flat_layer(
         l.z1_mm,
     ))?;
     let cast = g(envelope.difference(&tray.solid.transform(&t.inverse())))?;
-    let shown = &kit
-        .assembly
-        .iter()
-        .find(|m| &m.name == name)
-        .ok_or_else(|| missing(format!("the assembly's member {name}")))?
-        .solid;
+    let shown = member(kit, name)?;
     let (sym, thick_pieces) = compare(&cast, shown, tol).part(name)?;
     let mut probes = Probes {
         inside: Vec::new(),
@@ -355,12 +354,7 @@ pub fn cast_layer(
         .and_then(|m| Solid::from_mesh(&m)))?);
     }
     for b in before {
-        let m = kit
-            .assembly
-            .iter()
-            .find(|m| m.name == b)
-            .ok_or_else(|| missing(format!("the assembly's member {b}")))?;
-        in_mold.push(m.solid.clone());
+        in_mold.push(member(kit, b)?.clone());
     }
     Ok((
         g(cast.difference(&g(Solid::union_all(&in_mold))?))?,
@@ -447,7 +441,9 @@ fn compare(
     tol: ChordTolerance,
 ) -> Result<(f64, usize), crate::geometry::GeometryError> {
     let d = a.difference(b)?.union(&b.difference(a)?)?;
-    let thick = shells(&d.mesh())
+    let thick = d
+        .mesh()
+        .shell_volumes_and_areas()
         .into_iter()
         .filter(|&(v, area)| 2.0 * v > 2.0 * tol.mm() * area + 1e-9)
         .count();
@@ -456,41 +452,8 @@ fn compare(
 
 /// The volume of each edge-connected shell of `m`, mm^3 (divergence theorem per shell).
 pub fn shell_volumes(m: &crate::Mesh) -> Vec<f64> {
-    shells(m).into_iter().map(|(v, _)| v).collect()
-}
-
-/// The volume (mm^3) and surface area (mm^2) of each edge-connected shell of `m`.
-fn shells(m: &crate::Mesh) -> Vec<(f64, f64)> {
-    let n = m.vertices.len();
-    let mut parent: Vec<usize> = (0..n).collect();
-    fn find(p: &mut [usize], mut x: usize) -> usize {
-        while p[x] != x {
-            p[x] = p[p[x]];
-            x = p[x];
-        }
-        x
-    }
-    for t in &m.triangles {
-        for &o in &t[1..] {
-            let (ra, ro) = (
-                find(&mut parent, t[0] as usize),
-                find(&mut parent, o as usize),
-            );
-            if ra != ro {
-                parent[ra] = ro;
-            }
-        }
-    }
-    let mut by_root = std::collections::BTreeMap::<usize, (f64, f64)>::new();
-    for t in &m.triangles {
-        let [a, b, c] = t.map(|i| m.vertices[i as usize]);
-        let v = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
-            + a[2] * (b[0] * c[1] - b[1] * c[0]);
-        let n = crate::geometry::triangle_cross(a, b, c);
-        let area = 0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-        let e = by_root.entry(find(&mut parent, t[0] as usize)).or_default();
-        e.0 += v / 6.0;
-        e.1 += area;
-    }
-    by_root.into_values().collect()
+    m.shell_volumes_and_areas()
+        .into_iter()
+        .map(|(v, _)| v)
+        .collect()
 }

@@ -119,6 +119,38 @@ impl Mesh {
 
     /// Number of edge-connected shells.
     pub fn shell_count(&self) -> usize {
+        let roots = self.vertex_roots();
+        let mut used = vec![false; self.vertices.len()];
+        for t in &self.triangles {
+            for &v in t {
+                used[v as usize] = true;
+            }
+        }
+        (0..roots.len())
+            .filter(|&i| used[i] && roots[i] == i)
+            .count()
+    }
+
+    /// The volume (mm^3, divergence theorem) and surface area (mm^2) of each edge-connected
+    /// shell, in the order of their lowest root vertex.
+    pub fn shell_volumes_and_areas(&self) -> Vec<(f64, f64)> {
+        let roots = self.vertex_roots();
+        let mut by_root = std::collections::BTreeMap::<usize, (f64, f64)>::new();
+        for t in &self.triangles {
+            let [a, b, c] = t.map(|i| self.vertices[i as usize]);
+            let v = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+                + a[2] * (b[0] * c[1] - b[1] * c[0]);
+            let n = triangle_cross(a, b, c);
+            let e = by_root.entry(roots[t[0] as usize]).or_default();
+            e.0 += v / 6.0;
+            e.1 += 0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        }
+        by_root.into_values().collect()
+    }
+
+    /// Each vertex's shell, as the root vertex of its union-find tree over the triangles'
+    /// edges.
+    fn vertex_roots(&self) -> Vec<usize> {
         let n = self.vertices.len();
         let mut parent: Vec<usize> = (0..n).collect();
         fn find(p: &mut [usize], mut x: usize) -> usize {
@@ -128,22 +160,16 @@ impl Mesh {
             }
             x
         }
-        let mut used = vec![false; n];
         for t in &self.triangles {
             let a = t[0] as usize;
-            used[a] = true;
             for &o in &t[1..] {
-                let o = o as usize;
-                used[o] = true;
-                let (ra, ro) = (find(&mut parent, a), find(&mut parent, o));
+                let (ra, ro) = (find(&mut parent, a), find(&mut parent, o as usize));
                 if ra != ro {
                     parent[ra] = ro;
                 }
             }
         }
-        (0..n)
-            .filter(|&i| used[i] && find(&mut parent, i) == i)
-            .count()
+        (0..n).map(|i| find(&mut parent, i)).collect()
     }
 
     /// Checks that the mesh is a closed, consistently oriented 2-manifold with positive volume:

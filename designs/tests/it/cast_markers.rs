@@ -64,7 +64,7 @@ fn difference(a: &Solid, b: &Solid) -> (usize, f64) {
         .unwrap()
         .union(&b.difference(a).unwrap())
         .unwrap();
-    let pieces = shell_volumes(&d.mesh())
+    let pieces = fabkit_designs::cast_check::shell_volumes(&d.mesh())
         .into_iter()
         .filter(|&v| v > MIN_PIECE_MM3)
         .count();
@@ -74,38 +74,6 @@ fn difference(a: &Solid, b: &Solid) -> (usize, f64) {
 /// Well below half of the smallest former (a 0.4 mm pin, 0.4 mm tall: 0.042 mm^3), well
 /// above the slivers (below 1e-4 mm^3).
 const MIN_PIECE_MM3: f64 = 0.005;
-
-/// The volume of each edge-connected shell of `m`, mm^3.
-fn shell_volumes(m: &fabkit_designs::geometry::Mesh) -> Vec<f64> {
-    let n = m.vertices.len();
-    let mut parent: Vec<usize> = (0..n).collect();
-    fn find(p: &mut [usize], mut x: usize) -> usize {
-        while p[x] != x {
-            p[x] = p[p[x]];
-            x = p[x];
-        }
-        x
-    }
-    for t in &m.triangles {
-        for &o in &t[1..] {
-            let (ra, ro) = (
-                find(&mut parent, t[0] as usize),
-                find(&mut parent, o as usize),
-            );
-            if ra != ro {
-                parent[ra] = ro;
-            }
-        }
-    }
-    let mut by_root = std::collections::BTreeMap::<usize, f64>::new();
-    for t in &m.triangles {
-        let [a, b, c] = t.map(|i| m.vertices[i as usize]);
-        let v = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
-            + a[2] * (b[0] * c[1] - b[1] * c[0]);
-        *by_root.entry(find(&mut parent, t[0] as usize)).or_default() += v / 6.0;
-    }
-    by_root.into_values().collect()
-}
 
 /// One dimple's volume below the curved surface it is cut into, mm^3: the nominal volume less
 /// the gap between the tangent plane and the sphere over its base disc (second order,
@@ -224,18 +192,19 @@ fn tutorial_layer_loses_the_dimples_volume_within_one_percent() {
     );
 }
 
+/// `d` fails validation with one error, at `path`, whose rule says `says`.
+fn assert_one_refusal(d: &Design, path: &str, says: &str) {
+    let errs = validation_errors(d);
+    assert_eq!(errs.len(), 1, "{errs:?}");
+    assert_eq!(errs[0].path, path);
+    assert!(errs[0].rule.contains(says), "{}", errs[0].rule);
+}
+
 #[test]
 fn markers_on_a_sprayed_coat_are_refused_with_the_surface_that_works() {
     let mut d = stock(MoldStrategy::Master);
     d.layers[2].markers.push(tutorial_markers());
-    let errs = validation_errors(&d);
-    assert_eq!(errs.len(), 1, "{errs:?}");
-    assert_eq!(errs[0].path, "layers[2].markers[0]");
-    assert!(
-        errs[0].rule.contains("layers[1].markers"),
-        "{}",
-        errs[0].rule
-    );
+    assert_one_refusal(&d, "layers[2].markers[0]", "layers[1].markers");
 }
 
 #[test]
@@ -414,13 +383,10 @@ fn inner_features_against_the_core_are_refused_naming_the_core() {
     let mut m = tutorial_markers();
     m.surface = fabkit_designs::markers::MarkerSurface::Inner;
     d.layers[0].markers.push(m);
-    let errs = validation_errors(&d);
-    assert_eq!(errs.len(), 1, "{errs:?}");
-    assert_eq!(errs[0].path, "layers[0].markers[0].surface");
-    assert!(
-        errs[0].rule.contains("the core forms this surface"),
-        "{}",
-        errs[0].rule
+    assert_one_refusal(
+        &d,
+        "layers[0].markers[0].surface",
+        "the core forms this surface",
     );
 }
 
@@ -437,12 +403,5 @@ fn a_coat_over_a_layer_without_room_for_it_is_refused() {
     coat.thickness_mm = Some(0.1);
     d.layers[2].thickness_mm = Some(0.3);
     d.layers.push(coat);
-    let errs = validation_errors(&d);
-    assert_eq!(errs.len(), 1, "{errs:?}");
-    assert_eq!(errs[0].path, "layers[3].process");
-    assert!(
-        errs[0].rule.contains("direct or master"),
-        "{}",
-        errs[0].rule
-    );
+    assert_one_refusal(&d, "layers[3].process", "direct or master");
 }
