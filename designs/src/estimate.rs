@@ -4,13 +4,14 @@
 //!
 //! The estimate counts the facets the tessellation will make (the same segment counts as
 //! [`crate::geometry::revolve`] and the feature primitives) for every layer surface and every
-//! marker feature, each counted once: on the library designs and presets that is 0.9 to 2.2
-//! times the built kits (measured; a test keeps it within 0.8 to 2.5).
+//! marker feature, each counted once (and once more for each mold cavity, coat or layer cast
+//! onto it that the features of a layer under a direct or master mold's coats or cast layers
+//! also shape): on the library designs and presets that is 0.9 to 2.2 times the built kits
+//! (measured; a test keeps it within 0.8 to 2.5).
 
 use crate::error::DesignError;
 use crate::geometry::ChordTolerance;
 use crate::parts::context::Stack;
-use crate::parts::layers::count_layer_markers;
 use crate::parts::registry::{SectionInput, FAMILIES};
 use crate::schema::Design;
 
@@ -105,9 +106,18 @@ pub fn estimate(design: &Design, stack: &Stack, tol: ChordTolerance) -> WorkEsti
     }
     let (mut markers, mut feature_tris) = (0u64, 0.0);
     for l in &stack.layers {
-        for (n, radius_mm) in count_layer_markers(design, l) {
+        // outer features also in a direct or master mold's cavity, the coats over the layer
+        // and the layer cast onto it (crate::parts::layers::taken_features)
+        let copies = 1.0 + crate::parts::layers::outer_feature_copies(stack, l.index) as f64;
+        for (spec, _, _, placed) in crate::parts::layers::placed_patterns(design, l) {
+            let n = placed.len();
             markers += n as u64;
-            feature_tris += n as f64 * feature_triangles(radius_mm, tol);
+            let k = if spec.surface == crate::markers::MarkerSurface::Outer {
+                copies
+            } else {
+                1.0
+            };
+            feature_tris += k * n as f64 * feature_triangles(spec.feature.radius_mm(), tol);
         }
     }
     let marker_triangles = feature_tris;

@@ -142,15 +142,6 @@ pub(crate) fn placed_patterns<'a>(
         .collect()
 }
 
-/// The marker count and feature radius (mm) of every pattern of `layer` that places, without
-/// the spacing statistics of [`place_layer_markers`]: the work estimate's input.
-pub fn count_layer_markers(design: &Design, layer: &ResolvedLayer) -> Vec<(usize, f64)> {
-    placed_patterns(design, layer)
-        .into_iter()
-        .map(|(spec, _, _, m)| (m.len(), spec.feature.radius_mm()))
-        .collect()
-}
-
 /// Places every marker pattern of layer `i`.
 pub fn place_layer_markers(
     design: &Design,
@@ -247,6 +238,26 @@ pub fn taken_features(
         Vec::new()
     };
     (outer, at(l.inner_offset_mm))
+}
+
+/// How many meshes besides layer `i` itself carry its outer features: the cavity of its
+/// `direct` or `master` mold, each face of the coats sprayed over it, and the layer cast onto
+/// it (or onto those coats) in a `direct` or `master` mold (`formed_on_stack`).
+pub fn outer_feature_copies(stack: &Stack, i: usize) -> usize {
+    let l = &stack.layers[i];
+    let mut copies = usize::from(
+        l.process == LayerProcess::Cast
+            && matches!(l.mold_strategy, MoldStrategy::Direct | MoldStrategy::Master),
+    );
+    for above in &stack.layers[i + 1..] {
+        if above.process == LayerProcess::Sprayed {
+            copies += 2;
+        } else {
+            copies += usize::from(formed_on_stack_layer(above));
+            break;
+        }
+    }
+    copies
 }
 
 /// The features the cavity of cast layer `i`'s mold carries when the cavity is the offset

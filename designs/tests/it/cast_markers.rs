@@ -405,3 +405,39 @@ fn a_coat_over_a_layer_without_room_for_it_is_refused() {
     d.layers.push(coat);
     assert_one_refusal(&d, "layers[3].process", "direct or master");
 }
+
+/// The work estimate counts the tutorial's dimples where the kit builds them (the layer and the
+/// coat's two faces in the assembly, the mold's cavity): within 0.8 to 2.5 times the
+/// triangles of the built kit's parts and assembly (most copies of the dimples are in the
+/// assembly: counting the parts alone, as estimate.rs does for the library designs, would
+/// leave them out), and its marker count is the kit's.
+#[test]
+fn the_work_estimate_counts_the_markers_under_the_coat() {
+    let materials = fabkit_designs::materials::MaterialsTable::embedded().unwrap();
+    for s in [MoldStrategy::Master, MoldStrategy::Direct] {
+        let d = tutorial(s);
+        for mm in [0.01, 0.05] {
+            let tol = ChordTolerance::new(mm).unwrap();
+            let kit = build_kit(&d, tol).unwrap();
+            let built: usize = kit
+                .parts
+                .iter()
+                .map(|p| p.solid.triangle_count())
+                .sum::<usize>()
+                + kit
+                    .assembly
+                    .iter()
+                    .map(|m| m.solid.triangle_count())
+                    .sum::<usize>();
+            let st = fabkit_designs::stack::validate(&d, &materials, tol).unwrap();
+            let e = fabkit_designs::estimate::estimate(&d, &st, tol);
+            let ratio = e.triangles as f64 / built as f64;
+            assert!(
+                (0.8..=2.5).contains(&ratio),
+                "{s:?} at {mm} mm: estimate {} vs {built} ({ratio:.2})",
+                e.triangles
+            );
+            assert_eq!(e.markers, 127);
+        }
+    }
+}
