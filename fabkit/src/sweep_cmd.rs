@@ -39,6 +39,11 @@ pub struct SweepArgs {
     #[arg(long, value_name = "N", default_value_t = fabkit_designs::estimate::DEFAULT_MAX_TRIANGLES,
           value_parser = fabkit_designs::estimate::parse_max_triangles, allow_negative_numbers = true)]
     max_triangles: u64,
+    /// Replace an --out folder that holds another sweep's output (another sweep file, plan or
+    /// shard) whole; without it such a folder is refused. A folder of your own is never
+    /// replaced.
+    #[arg(long)]
+    force: bool,
     #[command(flatten)]
     data_files: crate::cli::DataFileArgs,
 }
@@ -56,6 +61,10 @@ enum SweepCommand {
         /// As for `fabkit sweep`: leave build_time_s empty.
         #[arg(long)]
         no_build_time: bool,
+        /// Replace an --out folder that holds another sweep's output whole; without it such a
+        /// folder is refused.
+        #[arg(long)]
+        force: bool,
     },
 }
 
@@ -64,9 +73,16 @@ pub fn run(args: SweepArgs) -> Result<(), Box<dyn Error>> {
         dirs,
         out,
         no_build_time,
+        force,
     }) = args.command
     {
-        let m = sweep::merge(&dirs, &out, !no_build_time, std::env::args().collect())?;
+        let m = sweep::merge(
+            &dirs,
+            &out,
+            !no_build_time,
+            std::env::args().collect(),
+            force,
+        )?;
         out!(
             "merged {} shards, {} variants -> {}",
             m.shards,
@@ -99,6 +115,7 @@ pub fn run(args: SweepArgs) -> Result<(), Box<dyn Error>> {
         command_line: std::env::args().collect(),
         fabkit_version: env!("CARGO_PKG_VERSION").to_string(),
         max_triangles: args.max_triangles,
+        force: args.force,
     };
     let writer = ExportWriter {
         command_line: opts.command_line.clone(),

@@ -104,6 +104,17 @@ pub enum SweepError {
         entry: String,
         why: String,
     },
+    /// The output folder holds another sweep's output.
+    #[error(
+        "sweep folder {path} holds the output of another sweep, {theirs}; this is {ours}: \
+         refusing to mix them (hint: choose a new folder, or give --force to replace that \
+         folder whole)"
+    )]
+    OtherSweep {
+        path: String,
+        theirs: String,
+        ours: String,
+    },
     /// More worker threads than the machine can use (or none).
     #[error(
         "jobs = {jobs}: must be from 1 to {max} (4 x the {cpus} CPUs of this machine; each job \

@@ -2,8 +2,8 @@
 
 use super::results::{render_csv, render_jsonl, VariantResult};
 use super::run::{
-    claim_dir, json_pretty, read_record, write_atomic, SweepRecord, RESULTS_CSV, RESULTS_JSONL,
-    SWEEP_JSON,
+    claim_sweep_dir, json_pretty, read_record, write_atomic, SweepRecord, RESULTS_CSV,
+    RESULTS_JSONL, SWEEP_JSON,
 };
 use super::SweepError;
 use sha2::{Digest, Sha256};
@@ -32,12 +32,15 @@ pub struct MergeSummary {
 ///
 /// # Errors
 /// [`SweepError::Merge`] naming the folders and shards at fault, [`SweepError::Io`],
-/// [`SweepError::ForeignDirectory`] for an `out` that holds something else.
+/// [`SweepError::ForeignDirectory`] for an `out` that holds something else,
+/// [`SweepError::OtherSweep`] for one that holds another sweep's output (unless `force`, which
+/// replaces it whole).
 pub fn merge(
     dirs: &[PathBuf],
     out: &Path,
     build_time: bool,
     command_line: Vec<String>,
+    force: bool,
 ) -> Result<MergeSummary, SweepError> {
     let err = |m: String| SweepError::Merge(m);
     if dirs.is_empty() {
@@ -119,7 +122,6 @@ pub fn merge(
             r.build_time_s = None;
         }
     }
-    claim_dir(out)?;
     let mut rec = first.clone();
     rec.shard = None;
     rec.build_time = build_time;
@@ -128,6 +130,7 @@ pub fn merge(
         .map(|(d, _)| d.display().to_string())
         .collect();
     rec.command_line = command_line;
+    claim_sweep_dir(out, &rec, force)?;
     let csv = out.join(RESULTS_CSV);
     let jsonl = out.join(RESULTS_JSONL);
     write_atomic(&out.join(SWEEP_JSON), &json_pretty(&rec))?;

@@ -40,6 +40,9 @@ pub struct RunOptions {
     /// Bound on each variant's estimated triangles ([`fabkit_designs::estimate::check_work`]); a variant
     /// past it is recorded with status error, before its kit is built.
     pub max_triangles: u64,
+    /// Replace a folder that holds another sweep's output (another sweep file or plan, or
+    /// another shard) whole, instead of refusing it ([`claim_sweep_dir`]).
+    pub force: bool,
 }
 
 /// Writes the files of one variant ([`ExportWriter`]: those of `fabkit export`).
@@ -337,6 +340,78 @@ pub(crate) fn claim_dir(dir: &Path) -> Result<(), SweepError> {
     std::fs::create_dir_all(dir).map_err(io)
 }
 
+/// A sweep's output in words, for the refusal of a folder that holds another one: its sweep
+/// file, the first 12 hex digits of its sha256, and its shard or merge.
+fn sweep_words(r: &SweepRecord) -> String {
+    let what = match (&r.shard, r.merged_from.is_empty()) {
+        (Some(s), _) => format!("shard {s}"),
+        (None, false) => format!("merged from {} shards", r.merged_from.len()),
+        (None, true) => "all variants".to_string(),
+    };
+    format!(
+        "{} (sweep file sha256 {}..., {} variants, {what})",
+        r.sweep_file,
+        &r.sweep_sha256[..r.sweep_sha256.len().min(12)],
+        r.variant_count
+    )
+}
+
+/// [`claim_dir`], and a folder that holds another sweep's output is refused, naming both: a
+/// sweep folder holds one sweep, so that its tables list exactly the variants beside them.
+/// The same sweep (sweep file and plan) is another sweep's unless it is the same shard, or
+/// for a merge (`ours` merged from shards) the whole sweep. With `force` the other sweep's
+/// folder is emptied first (it holds only a fabkit sweep's files, [`claim_dir`] checked), so
+/// that nothing of it is mixed with this one.
+///
+/// # Errors
+/// [`SweepError::ForeignDirectory`], [`SweepError::OtherSweep`], [`SweepError::Io`].
+pub(crate) fn claim_sweep_dir(
+    dir: &Path,
+    ours: &SweepRecord,
+    force: bool,
+) -> Result<(), SweepError> {
+    claim_dir(dir)?;
+    if !dir.join(SWEEP_JSON).exists() {
+        return Ok(());
+    }
+    // claim_dir refused a folder whose sweep.json is not a record fabkit wrote
+    let theirs = read_record(dir)?;
+    let same_sweep =
+        theirs.sweep_sha256 == ours.sweep_sha256 && theirs.plan_sha256 == ours.plan_sha256;
+    let same_part = if ours.merged_from.is_empty() {
+        theirs.shard == ours.shard && theirs.merged_from.is_empty()
+    } else {
+        theirs.shard.is_none()
+    };
+    if same_sweep && same_part {
+        return Ok(());
+    }
+    if !force {
+        return Err(SweepError::OtherSweep {
+            path: dir.display().to_string(),
+            theirs: sweep_words(&theirs),
+            ours: sweep_words(ours),
+        });
+    }
+    let io = |p: &Path| {
+        let p = p.display().to_string();
+        move |e: std::io::Error| SweepError::Io {
+            path: p.clone(),
+            message: e.to_string(),
+        }
+    };
+    for e in std::fs::read_dir(dir).map_err(io(dir))? {
+        let p = e.map_err(io(dir))?.path();
+        let md = std::fs::symlink_metadata(&p).map_err(io(&p))?;
+        if md.is_dir() {
+            std::fs::remove_dir_all(&p).map_err(io(&p))?;
+        } else {
+            std::fs::remove_file(&p).map_err(io(&p))?;
+        }
+    }
+    Ok(())
+}
+
 pub(crate) fn read_record(dir: &Path) -> Result<SweepRecord, SweepError> {
     let p = dir.join(SWEEP_JSON);
     let text = std::fs::read_to_string(&p).map_err(|e| SweepError::Io {
@@ -458,7 +533,8 @@ pub fn run(
         }
     }
     let dir = &opts.out_dir;
-    claim_dir(dir)?;
+    let rec = record(spec, plan, opts);
+    claim_sweep_dir(dir, &rec, opts.force)?;
     let vdir = dir.join(VARIANTS);
     let io = |p: &Path| {
         let p = p.display().to_string();
@@ -475,10 +551,7 @@ pub fn run(
             std::fs::remove_file(&p).map_err(io(&p))?;
         }
     }
-    write_atomic(
-        &dir.join(SWEEP_JSON),
-        &json_pretty(&record(spec, plan, opts)),
-    )?;
+    write_atomic(&dir.join(SWEEP_JSON), &json_pretty(&rec))?;
 
     let selected: Vec<&Variant> = plan
         .variants

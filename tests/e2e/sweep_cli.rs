@@ -569,3 +569,101 @@ fn a_sweep_of_too_many_variants_is_refused_by_its_count() {
     );
     assert!(!d.join("out").exists());
 }
+
+/// Every file below `dir` with its bytes, for "left untouched" checks.
+fn snapshot(dir: &Path) -> std::collections::BTreeMap<std::path::PathBuf, Vec<u8>> {
+    let mut out = std::collections::BTreeMap::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(p) = stack.pop() {
+        for e in std::fs::read_dir(&p).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else {
+                out.insert(p.clone(), std::fs::read(&p).unwrap());
+            }
+        }
+    }
+    out
+}
+
+/// Issue 95, data loss: a sweep, a shard or a merge written into another sweep's folder (or
+/// into another shard's) replaced its tables and left its variants beside the new table. Now
+/// refused, naming both sweeps, and the folder is left as it was; with --force the folder is
+/// replaced whole (none of the other sweep's variants stay); the same shard still resumes.
+#[test]
+fn another_sweeps_folder_is_refused_and_replaced_only_whole_with_force() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let a = write_sweep(d, "a.yaml", SWEEP);
+    let b = write_sweep(
+        d,
+        "b.yaml",
+        &SWEEP
+            .replace("[0.45, 0.25, 0.5]", "[0.45]")
+            .replace("2.0, 0.2", "1.8, 0.2"),
+    );
+    for (i, out) in [(0, "a0"), (1, "a1")] {
+        let shard = format!("{i}/2");
+        ok(&run(
+            d,
+            &["sweep", &a, "--out", out, "--shard", &shard],
+            &[],
+        ));
+    }
+    ok(&run(d, &["sweep", &b, "--out", "B"], &[]));
+    let (b_before, a0_before) = (snapshot(&d.join("B")), snapshot(&d.join("a0")));
+    assert!(b_before
+        .keys()
+        .any(|p| p.to_string_lossy().contains("variants")));
+    let refused = |args: &[&str], folder: &str, before: &std::collections::BTreeMap<_, _>| {
+        let o = run(d, args, &[]);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", text(&o.stdout));
+        let e = text(&o.stderr);
+        assert!(
+            e.contains("holds the output of another sweep"),
+            "{args:?}: {e}"
+        );
+        assert!(e.contains("--force"), "{e}");
+        assert_eq!(
+            &snapshot(&d.join(folder)),
+            before,
+            "{args:?} changed {folder}"
+        );
+        e
+    };
+    // a merge and a whole run into sweep B's folder, a shard into another shard's folder
+    let e = refused(
+        &["sweep", "merge", "a0", "a1", "--out", "B"],
+        "B",
+        &b_before,
+    );
+    assert!(e.contains("b.yaml") && e.contains("a.yaml"), "{e}");
+    refused(&["sweep", &a, "--out", "B"], "B", &b_before);
+    refused(
+        &["sweep", &a, "--out", "a0", "--shard", "1/2"],
+        "a0",
+        &a0_before,
+    );
+    // the same shard resumes in its own folder
+    ok(&run(
+        d,
+        &["sweep", &a, "--out", "a0", "--shard", "0/2"],
+        &[],
+    ));
+    // --force replaces B whole: A's merged table, none of B's variants
+    ok(&run(
+        d,
+        &["sweep", "merge", "a0", "a1", "--out", "B", "--force"],
+        &[],
+    ));
+    let after = snapshot(&d.join("B"));
+    assert!(
+        after
+            .keys()
+            .all(|p| !p.to_string_lossy().contains("variants")),
+        "{:?}",
+        after.keys().collect::<Vec<_>>()
+    );
+    assert_eq!(jsonl(&d.join("B/results.jsonl")).len(), 9);
+}
