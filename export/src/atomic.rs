@@ -78,6 +78,9 @@ pub struct OutputClaim {
     /// A short human description, compared as a whole and quoted in refusals.
     pub job: String,
     pub force: bool,
+    /// The input files the output is computed from: none may lie inside the output directory,
+    /// which is replaced whole ([`ExportError::InputInsideOutput`]).
+    pub inputs: Vec<PathBuf>,
 }
 
 impl OutputClaim {
@@ -93,6 +96,7 @@ impl OutputClaim {
             command,
             job: format!("kit '{kit_name}' at chord tolerance {chord_tolerance_mm} mm"),
             force,
+            inputs: Vec::new(),
         }
     }
 }
@@ -124,6 +128,7 @@ impl OutputClaim {
             command,
             job: format!("{what} (inputs sha256 {})", &digest[..16]),
             force,
+            inputs: inputs.iter().map(|p| p.to_path_buf()).collect(),
         }
     }
 }
@@ -778,6 +783,18 @@ fn check_earlier_output(dir: &Path, claim: &OutputClaim) -> Result<(), ExportErr
             this_job: claim.job.clone(),
         });
     }
+    // The folder is one this command would replace: an input inside it would be deleted with
+    // it, --force or not.
+    if let Ok(canonical) = fs::canonicalize(dir) {
+        for input in &claim.inputs {
+            if fs::canonicalize(input).is_ok_and(|p| p.starts_with(&canonical)) {
+                return Err(ExportError::InputInsideOutput {
+                    path: dir.to_path_buf(),
+                    input: input.clone(),
+                });
+            }
+        }
+    }
     Ok(())
 }
 
@@ -870,6 +887,7 @@ mod tests {
             command: OutputCommand::Groundtruth,
             job: "design 'rtac0'".into(),
             force: false,
+            inputs: Vec::new(),
         }
     }
 

@@ -115,6 +115,15 @@ pub enum ExportError {
         job: String,
         this_job: String,
     },
+    /// An input of the command lies inside the output directory it would replace.
+    #[error(
+        "{} is an input of this command and lies inside its output directory {}, which the \
+         command replaces (with --force too): refusing before anything is written (hint: move \
+         the input out of it, or choose another output directory)",
+        input.display(),
+        path.display()
+    )]
+    InputInsideOutput { path: PathBuf, input: PathBuf },
     /// A file-system operation failed; `action` says which (e.g. `writing`).
     #[error("{action} {}", path.display())]
     Io {

@@ -214,6 +214,27 @@ fn the_photometric_model_re_renders_each_capture_from_the_others() {
     assert_eq!(appearance.len(), 640 * 480 * 3);
     assert_eq!(m["model"]["coefficients_rgb"].as_array().unwrap().len(), 3);
 
+    // Issue 95, data loss: captures inside the folder a fit replaces (here its own re-rendered
+    // captures) were deleted with it under --force. Refused before anything is written.
+    let inside: Vec<String> = caps
+        .iter()
+        .map(|c| format!("ph/{}", c["rerendered"].as_str().unwrap()))
+        .collect();
+    let before = std::fs::read(d.path().join(&inside[0])).unwrap();
+    let mut again = args(&inside, "ph");
+    again.push("--force");
+    let o = run(d.path(), &again, &[]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o.stdout));
+    let e = text(&o.stderr);
+    assert!(
+        e.contains(&format!(
+            "{} is an input of this command and lies inside its output directory ph",
+            inside[0]
+        )),
+        "{e}"
+    );
+    assert_eq!(std::fs::read(d.path().join(&inside[0])).unwrap(), before);
+
     // The ground truth's images in the sensor's own appearance: the reference is the fitted
     // appearance, a pressed frame differs from it where the protrusions press.
     let gt = |out: &str, ph: &str| {
