@@ -859,10 +859,25 @@ impl PhotometricModel {
             .as_f64()
             .filter(|f| *f == 255.0 || *f == 65535.0)
             .ok_or_else(|| "model.full_scale_counts must be 255 or 65535".to_string())?;
+        check_model_values(&coefficients, axis, &shadow_coefficients, &rings)?;
         if appearance.len() != width * height {
             return Err(format!(
                 "the appearance has {} pixels, the camera {width} x {height}",
                 appearance.len()
+            ));
+        }
+        if let Some((k, c, v)) = appearance.iter().enumerate().find_map(|(k, p)| {
+            (0..3)
+                .find(|&c| {
+                    !(p[c].is_nan() || (0.0..=APPEARANCE_HEADROOM * full_scale).contains(&p[c]))
+                })
+                .map(|c| (k, c, p[c]))
+        }) {
+            return Err(format!(
+                "appearance.npy: pixel ({}, {}) channel {c} = {v}: must be NaN (off the skin) or a count from 0 to {} ({APPEARANCE_HEADROOM} x the full scale {full_scale}: the captures over their gains)",
+                k % width.max(1),
+                k / width.max(1),
+                APPEARANCE_HEADROOM * full_scale
             ));
         }
         Ok(PhotometricModel {
@@ -992,4 +1007,74 @@ pub fn rms_over_skin(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
     } else {
         (s / n as f64).sqrt()
     }
+}
+
+/// How far above the full scale an appearance value may lie: the appearance is the captures'
+/// counts over their gains, and a gain below 1 lifts a saturated pixel past the full scale.
+pub const APPEARANCE_HEADROOM: f64 = 16.0;
+
+/// Largest coefficient a model may hold: a coefficient is the relative change of a pixel's
+/// intensity per unit of its feature (or the share of its light a ring or a light stands
+/// for), so past it every pressed pixel saturates; fits give values of order 1.
+pub const MAX_COEFFICIENT: f64 = 1000.0;
+
+/// Shortest and longest median range from the camera to the skin a model may hold, mm.
+pub const SCALE_RANGE_MM: (f64, f64) = (0.1, 1000.0);
+
+/// The numbers of a model read back ([`PhotometricModel::from_json`]): coefficients finite and
+/// within [`MAX_COEFFICIENT`], the axes unit vectors, the rings' centre finite and within
+/// 1000 mm, their scale within [`SCALE_RANGE_MM`]. Names the first value that is not.
+fn check_model_values(
+    coefficients: &[Vec<f64>; 3],
+    axis: [f64; 3],
+    shadow_coefficients: &[[f64; SHADOW_TERMS]; 3],
+    rings: &ShadowRings,
+) -> Result<(), String> {
+    let lists = coefficients
+        .iter()
+        .enumerate()
+        .flat_map(|(c, l)| {
+            l.iter()
+                .enumerate()
+                .map(move |(k, x)| (format!("coefficients_rgb[{c}][{k}]"), *x))
+        })
+        .chain(shadow_coefficients.iter().enumerate().flat_map(|(c, l)| {
+            l.iter()
+                .enumerate()
+                .map(move |(k, x)| (format!("shadow.coefficients_rgb[{c}][{k}]"), *x))
+        }));
+    for (key, x) in lists {
+        if !(x.is_finite() && x.abs() <= MAX_COEFFICIENT) {
+            return Err(format!(
+                "model.{key} = {x}: must be a finite number within +-{MAX_COEFFICIENT} (a relative change of the intensity; past it every pressed pixel saturates): not a model fabkit fits"
+            ));
+        }
+    }
+    for (key, a) in [("optical_axis", axis), ("shadow.rings.axis", rings.axis)] {
+        let n = a.iter().map(|x| x * x).sum::<f64>().sqrt();
+        if !(a.iter().all(|x| x.is_finite()) && (n - 1.0).abs() <= 1e-6) {
+            return Err(format!(
+                "model.{key} = {a:?}: must be a unit vector (length {n})"
+            ));
+        }
+    }
+    let max = fabkit_designs::values::MAX_LENGTH_MM;
+    if let Some(x) = rings
+        .centre_mm
+        .iter()
+        .find(|x| !(x.is_finite() && x.abs() <= max))
+    {
+        return Err(format!(
+            "model.shadow.rings.centre_mm = {:?}: each coordinate must be finite and within +-{max} mm ({x})",
+            rings.centre_mm
+        ));
+    }
+    let (lo, hi) = SCALE_RANGE_MM;
+    if !(lo..=hi).contains(&rings.scale_mm) {
+        return Err(format!(
+            "model.shadow.rings.scale_mm = {}: must be from {lo} to {hi} mm (the skin's median range from the camera)",
+            rings.scale_mm
+        ));
+    }
+    Ok(())
 }

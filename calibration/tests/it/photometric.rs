@@ -500,3 +500,101 @@ fn the_model_json_reads_back_to_the_same_images() {
     let e = PhotometricModel::from_json(&json, vec![[0.0; 3]; 4], m.width, m.height).unwrap_err();
     assert!(e.contains("the appearance has 4 pixels"), "{e}");
 }
+
+/// Issue 95: a model's values were not checked when read (an axis of [0, 0, 0] panicked in the
+/// render, coefficients of 1e308 or a scale of 1e-300 gave saturated images). Every numeric
+/// field set to 0, -1, 1e-300, 1e300 and null (JSON's NaN), one at a time, and the appearance
+/// to inf, -1e30 and NaN: each is refused naming the file's field, or the model renders a
+/// finite image wherever the skin is.
+#[test]
+fn every_model_value_is_checked_when_read() {
+    let c = captures(warm_ring(), rtac0_pins);
+    let all: Vec<Capture> = c
+        .scenes
+        .iter()
+        .map(|s| Capture {
+            image: &s.2,
+            hits: &s.1,
+            shadows: &s.3,
+        })
+        .collect();
+    let m = PhotometricModel::fit(&c.rays, &c.reference, &c.reference_image, &all, 255.0).unwrap();
+    let json: serde_json::Value =
+        serde_json::from_str(&serde_json::to_string(&m.model_json()).unwrap()).unwrap();
+    let mut fields: Vec<(Vec<String>, String)> = Vec::new();
+    let key = |path: &[&str]| path.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+    for ch in 0..3 {
+        for k in [0, 5, fabkit_calibration::photometric::COEFFICIENTS - 1] {
+            fields.push((
+                key(&["coefficients_rgb", &ch.to_string(), &k.to_string()]),
+                "coefficients_rgb".into(),
+            ));
+        }
+        fields.push((
+            key(&["shadow", "coefficients_rgb", &ch.to_string(), "0"]),
+            "shadow.coefficients_rgb".into(),
+        ));
+    }
+    for q in 0..3 {
+        fields.push((
+            key(&["optical_axis", &q.to_string()]),
+            "optical_axis".into(),
+        ));
+        fields.push((
+            key(&["shadow", "rings", "axis", &q.to_string()]),
+            "shadow.rings".into(),
+        ));
+        fields.push((
+            key(&["shadow", "rings", "centre_mm", &q.to_string()]),
+            "shadow.rings".into(),
+        ));
+    }
+    fields.push((key(&["shadow", "rings", "scale_mm"]), "shadow.rings".into()));
+    fields.push((key(&["full_scale_counts"]), "full_scale_counts".into()));
+    let values = [
+        serde_json::json!(0.0),
+        serde_json::json!(-1.0),
+        serde_json::json!(1e-300),
+        serde_json::json!(1e300),
+        serde_json::Value::Null,
+    ];
+    let s = &c.scenes[0];
+    for (path, name) in &fields {
+        for v in &values {
+            let mut bad = json.clone();
+            let mut at = &mut bad;
+            for p in path {
+                at = match p.parse::<usize>() {
+                    Ok(i) => &mut at[i],
+                    Err(_) => &mut at[p.as_str()],
+                };
+            }
+            *at = v.clone();
+            match PhotometricModel::from_json(&bad, m.reference.clone(), m.width, m.height) {
+                Err(e) => assert!(e.contains(&format!("model.{name}")), "{path:?} = {v}: {e}"),
+                Ok(back) => {
+                    let img = back.render(&c.rays, &c.reference, &s.1, &s.3, 1.0);
+                    for (p, r) in img.iter().zip(&m.reference) {
+                        for ch in 0..3 {
+                            assert!(
+                                r[ch].is_nan() || p[ch].is_finite(),
+                                "{path:?} = {v}: accepted, and renders {}",
+                                p[ch]
+                            );
+                        }
+                    }
+                }
+            }
+        }
+    }
+    for x in [f64::INFINITY, -1e30, f64::NEG_INFINITY] {
+        let mut appearance = m.reference.clone();
+        let k = appearance.iter().position(|p| p[0].is_finite()).unwrap();
+        appearance[k][1] = x;
+        let e = PhotometricModel::from_json(&json, appearance, m.width, m.height).unwrap_err();
+        assert!(
+            e.contains("appearance.npy: pixel") && e.contains("channel 1"),
+            "{e}"
+        );
+    }
+}
