@@ -75,6 +75,9 @@ pub enum ImageError {
     },
     #[error("--images = {file}: given twice")]
     Twice { file: String },
+    /// A capture that lists a pin more than once.
+    #[error("--images = {file}: pin {id} listed {times} times; a capture presses each pin once")]
+    RepeatedPin { file: String, id: u32, times: usize },
 }
 
 /// Decodes `path` (PNG or JPEG), checking its size against the camera's (`expect_px`, from
@@ -276,6 +279,15 @@ pub fn observe_images(
             })
             .collect::<Result<_, _>>()?,
     };
+    for (p, ids) in input.captures.iter().zip(&planned) {
+        if let Some((id, times)) = crate::imprints::repeated_pin(ids) {
+            return Err(ImageError::RepeatedPin {
+                file: p.display().to_string(),
+                id,
+                times,
+            });
+        }
+    }
     let reference = read_gray(&input.reference, "--reference", size, camera_file)?;
     let mask = reference_mask(&reference, 255.0, REFLECTION_MARGIN_PX);
     let params = DetectParams::default();

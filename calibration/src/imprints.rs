@@ -718,6 +718,14 @@ pub fn ids_from_file_name(path: &std::path::Path) -> Option<Vec<u32>> {
         .collect()
 }
 
+/// The first pin a capture lists more than once, with how often: a capture presses each pin
+/// once (`01_01_01_01_01.png` lists pin 1 five times). `None` when every pin is listed once.
+pub fn repeated_pin(ids: &[u32]) -> Option<(u32, usize)> {
+    ids.iter()
+        .find(|id| ids.iter().filter(|x| x == id).count() > 1)
+        .map(|&id| (id, ids.iter().filter(|&&x| x == id).count()))
+}
+
 /// Sectors (about the skin's centre) in which [`reference_mask`] looks for the ring of LED
 /// reflections at the rim ...
 const RING_SECTORS: usize = 12;

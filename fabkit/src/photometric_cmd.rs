@@ -101,13 +101,43 @@ pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
     let rings = ShadowRings::of(&rays, &reference);
     let (reference_image, full_scale) = read_rgb(&a.reference, "--reference", size, &camera_name)?;
     let mut posed = Vec::new();
+    // each capture once: no file twice, no two files of the same pins, no pin twice in one
+    let mut seen: Vec<(&Path, Vec<u32>)> = Vec::new();
     for file in &a.images {
         let name = file.display().to_string();
-        let ids: Vec<String> = ids_from_file_name(file)
+        let ids = ids_from_file_name(file)
             .filter(|ids| !ids.is_empty())
             .ok_or_else(|| {
                 format!("--images = {name}: the file name must list the capture's pins in ring order, e.g. 01_02_06_14_22.png")
-            })?
+            })?;
+        if let Some((id, times)) = fabkit_calibration::imprints::repeated_pin(&ids) {
+            return Err(format!(
+                "--images = {name}: pin {id} listed {times} times; a capture presses each pin once"
+            )
+            .into());
+        }
+        let mut sorted = ids.clone();
+        sorted.sort_unstable();
+        let same = |p: &Path| {
+            p == file.as_path()
+                || matches!(
+                    (std::fs::canonicalize(p), std::fs::canonicalize(file)),
+                    (Ok(a), Ok(b)) if a == b
+                )
+        };
+        if let Some((first, _)) = seen.iter().find(|(p, s)| same(p) || *s == sorted) {
+            return Err(format!(
+                "--images = {name}: given twice (as {}, the same pins); give each capture once",
+                first.display()
+            )
+            .into());
+        }
+        seen.push((file.as_path(), sorted));
+    }
+    for file in &a.images {
+        let name = file.display().to_string();
+        let ids: Vec<String> = ids_from_file_name(file)
+            .unwrap_or_default()
             .iter()
             .map(u32::to_string)
             .collect();

@@ -579,6 +579,7 @@ fn bad_images_and_reference_exit_2_naming_the_option_and_write_nothing() {
     std::fs::copy(s.path("01_05_09_17_25.png"), s.path("small.png")).unwrap();
     std::fs::write(s.path("01_04_08_16_24.png"), "not an image\n").unwrap();
     std::fs::write(s.path("obs.csv"), "id,u_px,v_px\n").unwrap();
+    save(&blank, &s.path("01_01_01_01_01.png"), Kind::Gray8);
     let base = [
         "calibrate",
         "extrinsics",
@@ -634,6 +635,11 @@ fn bad_images_and_reference_exit_2_naming_the_option_and_write_nothing() {
                 "01_02_06_14_22.png",
             ],
             "--images = 01_02_06_14_22.png: given twice",
+        ),
+        // issue 95: a name that lists a pin five times was accepted with five warnings
+        (
+            &["--reference", "ref.png", "--images", "01_01_01_01_01.png"],
+            "--images = 01_01_01_01_01.png: pin 1 listed 5 times",
         ),
         (&["--reference", "ref.png"], "--images"),
         (&["--images", "01_02_06_14_22.png"], "--reference"),

@@ -360,4 +360,40 @@ fn a_capture_without_pins_in_its_name_is_refused_and_nothing_is_written() {
         text(&o.stderr)
     );
     assert!(!d.path().join("ph").exists());
+    // Issue 95: a pin listed twice, the same capture twice, two files of the same pins: the
+    // fit ran to its end, then failed on a file that existed. Refused up front.
+    let names = captures(d.path());
+    let first = names[0].clone();
+    std::fs::copy(d.path().join(&first), d.path().join("01_01_01_01_01.png")).unwrap();
+    std::fs::create_dir(d.path().join("sub")).unwrap();
+    std::fs::copy(d.path().join(&first), d.path().join("sub").join(&first)).unwrap();
+    for (extra, message) in [
+        (
+            vec!["01_01_01_01_01.png".to_string()],
+            "--images = 01_01_01_01_01.png: pin 1 listed 5 times".to_string(),
+        ),
+        (
+            vec![first.clone()],
+            format!("--images = {first}: given twice"),
+        ),
+        (
+            vec![format!("./{first}")],
+            format!("--images = ./{first}: given twice"),
+        ),
+        (
+            vec![format!("sub/{first}")],
+            format!("--images = sub/{first}: given twice (as {first}, the same pins)"),
+        ),
+    ] {
+        let mut images = names.clone();
+        images.extend(extra);
+        let o = run(d.path(), &args(&images, "ph"), &[]);
+        assert_eq!(o.status.code(), Some(2), "{images:?}");
+        assert!(
+            text(&o.stderr).contains(&message),
+            "{message}: {}",
+            text(&o.stderr)
+        );
+        assert!(!d.path().join("ph").exists());
+    }
 }
