@@ -301,25 +301,35 @@ impl SweepSpec {
             origin,
         )?;
         for (p, spec_at) in parameters.iter().zip(&values_at) {
-            check_values(p, spec_at, &base.design, &base_json, |variant| {
-                // A parameter the rest of the design ignores would give identical variants.
-                if let Err(errs) =
-                    fabkit_designs::stack::validate(variant, &materials, chord_tolerance)
-                {
-                    if let Some(e) = errs.0.iter().find(|e| {
-                        e.path == p.path && e.rule.starts_with(fabkit_designs::markers::NO_EFFECT)
-                    }) {
-                        return Err(file_err(
-                            p.at.clone(),
-                            format!(
-                                "vary.{}: {} (every variant would be the same design)",
-                                p.path, e.rule
-                            ),
-                        ));
+            // in a zip a value may repeat in one list: only a repeated row is one variant twice
+            let refuse_repeats = mode != Mode::Zip;
+            check_values(
+                p,
+                spec_at,
+                &base.design,
+                &base_json,
+                refuse_repeats,
+                |variant| {
+                    // A parameter the rest of the design ignores would give identical variants.
+                    if let Err(errs) =
+                        fabkit_designs::stack::validate(variant, &materials, chord_tolerance)
+                    {
+                        if let Some(e) = errs.0.iter().find(|e| {
+                            e.path == p.path
+                                && e.rule.starts_with(fabkit_designs::markers::NO_EFFECT)
+                        }) {
+                            return Err(file_err(
+                                p.at.clone(),
+                                format!(
+                                    "vary.{}: {} (every variant would be the same design)",
+                                    p.path, e.rule
+                                ),
+                            ));
+                        }
                     }
-                }
-                Ok(())
-            })?;
+                    Ok(())
+                },
+            )?;
         }
         if mode == Mode::Zip {
             let n = parameters[0].values.len();
@@ -333,6 +343,30 @@ impl SweepSpec {
                         parameters[0].path
                     ),
                 ));
+            }
+            // a row repeated is the same variant twice
+            let mut rows: std::collections::HashMap<String, usize> =
+                std::collections::HashMap::with_capacity(n);
+            for i in 0..n {
+                let key = parameters
+                    .iter()
+                    .map(|p| equality_key(&p.values[i]))
+                    .collect::<Vec<_>>()
+                    .join("\u{1f}");
+                if let Some(&j) = rows.get(&key) {
+                    return Err(file_err(
+                        parameters[0].at.clone(),
+                        format!(
+                            "mode zip: rows {j} and {i} of the lists are the same variant ({}); give each row once",
+                            parameters
+                                .iter()
+                                .map(|p| format!("{} = {}", p.path, p.values[i]))
+                                .collect::<Vec<_>>()
+                                .join(", ")
+                        ),
+                    ));
+                }
+                rows.insert(key, i);
             }
         }
         let sha256 = Sha256::digest(text.as_bytes())
@@ -366,13 +400,17 @@ fn check_values(
     spec_at: &str,
     design: &fabkit_designs::schema::Design,
     base_json: &Value,
+    refuse_repeats: bool,
     first_design: impl FnOnce(&fabkit_designs::schema::Design) -> Result<(), SweepError>,
 ) -> Result<(), SweepError> {
     use rayon::prelude::*;
     let values = &p.values;
     let mut seen: std::collections::HashSet<String> =
         std::collections::HashSet::with_capacity(values.len());
-    let repeated = values.iter().position(|v| !seen.insert(equality_key(v)));
+    let repeated = values
+        .iter()
+        .position(|v| !seen.insert(equality_key(v)))
+        .filter(|_| refuse_repeats);
     drop(seen);
     let first = checked_value(design, base_json, &p.path, &values[0], spec_at)?;
     first_design(&first)?;

@@ -126,6 +126,35 @@ mode: zip
     assert_eq!(plan.variants[0].id, grid.variants[4].id);
 }
 
+/// Issue 95: in a zip a value may repeat in one list while the rows differ (it was refused as
+/// "the value 3.0 is listed twice"); only a repeated row, the same variant twice, is refused.
+#[test]
+fn a_zip_refuses_repeated_rows_only() {
+    let plan = spec(
+        "base: shadowtac
+preset: paper_text
+vary:
+  layers[0].markers[0].pattern.spacing_mm: [1.4, 1.4, 1.6]
+  layers[0].markers[0].feature.height_mm: [0.3, 0.4, 0.4]
+mode: zip
+",
+    )
+    .plan()
+    .unwrap();
+    assert_eq!(plan.variants.len(), 3);
+    let e = err("base: shadowtac
+preset: paper_text
+vary:
+  layers[0].markers[0].pattern.spacing_mm: [1.4, 1.6, 1.4]
+  layers[0].markers[0].feature.height_mm: [0.3, 0.4, 0.3]
+mode: zip
+");
+    assert!(
+        e.contains("mode zip: rows 0 and 2 of the lists are the same variant"),
+        "{e}"
+    );
+}
+
 #[test]
 fn random_draws_distinct_grid_points_reproducibly() {
     let random = |seed: u64, count: u64| {
