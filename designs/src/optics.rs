@@ -262,6 +262,10 @@ fn marker_features(design: &Design, stack: &Stack) -> Features {
     ((spots, sources), (dimples, dimple_sources))
 }
 
+/// Most lights a design may give (`optics.lights`): the render's work grows with lights x
+/// pixels x frames, and this bounds it before anything is rendered.
+pub const MAX_LIGHTS: usize = 64;
+
 /// Appends every violated rule of `o` to `errs`, each path under `optics.`.
 pub fn check(o: &OpticsParams, errs: &mut Vec<ParamError>) {
     if let Some(lights) = &o.lights {
@@ -271,6 +275,16 @@ pub fn check(o: &OpticsParams, errs: &mut Vec<ParamError>) {
                 "[]",
                 "give at least one light, or leave the key out for the families' lights",
             ));
+        }
+        if lights.len() > MAX_LIGHTS {
+            errs.push(ParamError::new(
+                "optics.lights",
+                format!("{} lights", lights.len()),
+                format!(
+                    "give at most {MAX_LIGHTS}: each light adds a shading and a shadow pass over every pixel of every rendered frame (a sensor's ring of LEDs is 3 to 16)"
+                ),
+            ));
+            return;
         }
         for (i, l) in lights.iter().enumerate() {
             check_light(&format!("optics.lights[{i}]"), l, errs);

@@ -140,6 +140,11 @@ fn light(d: &mut Design) -> &mut Light {
 fn each_optics_rule_names_its_path() {
     let cases: &[RuleCase] = &[
         ("optics.lights", |d| optics(d).lights = Some(Vec::new())),
+        // issue 95: 20,000 lights passed and would take hours to render
+        ("optics.lights", |d| {
+            let one = light(d).clone();
+            optics(d).lights = Some(vec![one; fabkit_designs::optics::MAX_LIGHTS + 1])
+        }),
         ("optics.lights[0].direction", |d| {
             light(d).direction = [0.0, 0.0, 0.0]
         }),
