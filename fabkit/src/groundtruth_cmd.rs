@@ -142,8 +142,28 @@ fn load_photometric(
     dir: &Path,
     w: usize,
     h: usize,
+    fitted_for: [(&str, &str, &Path); 3],
 ) -> Result<(PhotometricModel, String), Box<dyn Error>> {
     let (model, sha) = PhotometricModel::read(dir).map_err(|e| format!("--photometric {e}"))?;
+    // A model is of one sensor, camera and pose: those it was fitted with, by their files'
+    // sha256 as photometric.json records them.
+    let jpath = dir.join("photometric.json");
+    let record: serde_json::Value = serde_json::from_slice(&std::fs::read(&jpath)?)?;
+    for (key, sha, file) in fitted_for {
+        let theirs = record[key]["sha256"].as_str();
+        if theirs.is_some_and(|t| t != sha) {
+            return Err(format!(
+                "--photometric {}: the model was fitted with another {key} ({} {}, sha256 {}...), not {} (sha256 {}...): a photometric model belongs to one sensor, camera and pose; fit one for these with fabkit calibrate photometric",
+                jpath.display(),
+                key,
+                record[key]["name"].as_str().or(record[key]["file"].as_str()).unwrap_or("?"),
+                &theirs.unwrap_or_default()[..12.min(theirs.unwrap_or_default().len())],
+                file.display(),
+                &sha[..12.min(sha.len())]
+            )
+            .into());
+        }
+    }
     if (model.width, model.height) != (w, h) {
         return Err(format!(
             "--photometric {}: shape [{}, {}, 3], the camera's images need [{h}, {w}, 3] (the model was fitted to another camera)",
@@ -289,7 +309,27 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
     // The optics (or the photometric model) are checked before the output is bounded or
     // anything is written.
     let photometric = match &args.photometric {
-        Some(dir) => Some((load_photometric(dir, rays.width, rays.height)?, dir)),
+        Some(dir) => Some((
+            load_photometric(
+                dir,
+                rays.width,
+                rays.height,
+                [
+                    (
+                        "design",
+                        loaded.sha256.as_str(),
+                        Path::new(
+                            args.design
+                                .as_deref()
+                                .unwrap_or(fabkit_designs::library::DEFAULT_DESIGN),
+                        ),
+                    ),
+                    ("camera", camera_sha.as_str(), &args.cam.camera),
+                    ("extrinsics", extrinsics_sha.as_str(), &args.extrinsics),
+                ],
+            )?,
+            dir,
+        )),
         None => None,
     };
     let optics = if args.images && photometric.is_none() {

@@ -93,6 +93,7 @@ pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
     let i = camera.intrinsics();
     let size = (i.image_width_px, i.image_height_px);
     let camera_name = a.cam.camera.display().to_string();
+    let (_, camera_sha) = fabkit_calibration::groundtruth::inputs::read_with_hash(&a.cam.camera)?;
     let (t_cam_sensor, extrinsics_sha) = read_extrinsics(&a.extrinsics)?;
     let pins = read_pins(&a.fixtures)?;
     let pose_name = a.extrinsics.display().to_string();
@@ -240,7 +241,7 @@ pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
         "command_line": std::env::args().collect::<Vec<_>>(),
         "description": "Photometric model of the sensor: per channel I(x, n) = gain x R(x) x (1 + sum_km c_km P_m(x) f_k(n, x) + sum_l w_l G_l(x, n) - sum_j b_j S_j(x)); R: appearance.npy (H, W, 3 float32 counts, NaN off the skin), the median of the reference and the captures' unpressed pixels over their gains; f_k: the change of the surface normal from the reference normal in the local frame about the optical axis (a along the tangent away from the axis, r round it, c along the reference normal: 1 - cos of the tilt), the monomials of a and r to degree 3 and the indentation depth along the ray (mm); P_m: powers of the pixel's distance from the image centre over the half-diagonal; G_l: the change of candidate point light l's Lambertian irradiance (incidence cosine over squared distance; 0 where the protrusions block it) from the reference surface to the pressed one, over the sum of all candidates' irradiance of the reference, weighted by w_l (the last light_terms numbers of each coefficients list); S_j: the share of candidate light ring j's light the protrusions block at the pixel (shadows, also beside the imprints), weighted by b_j (calibration/src/photometric.rs)",
         "design": {"name": design.name, "source": loaded.source, "sha256": loaded.sha256},
-        "camera": {"file": camera_name, "image_width_px": w, "image_height_px": h},
+        "camera": {"file": camera_name, "sha256": camera_sha, "image_width_px": w, "image_height_px": h},
         "extrinsics": {"file": pose_name, "sha256": extrinsics_sha},
         "fixtures": a.fixtures.display().to_string(),
         "model": model.model_json(),

@@ -312,6 +312,48 @@ fn the_photometric_model_re_renders_each_capture_from_the_others() {
         .unwrap()
         .contains("photometric"));
 
+    // Issue 95: a model used with another pose (or design, or camera) gave images with no
+    // word; refused naming the file it was fitted with
+    let mut pose: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.path().join("extrinsics.json")).unwrap()).unwrap();
+    let t = pose["T_cam_sensor"][0][3].as_f64().unwrap();
+    pose["T_cam_sensor"][0][3] = serde_json::json!(t + 0.5);
+    let x = pose["tvec_mm"][0].as_f64().unwrap();
+    pose["tvec_mm"][0] = serde_json::json!(x + 0.5);
+    std::fs::write(
+        d.path().join("moved.json"),
+        serde_json::to_vec(&pose).unwrap(),
+    )
+    .unwrap();
+    let o = run(
+        d.path(),
+        &[
+            "groundtruth",
+            "rtac0",
+            "--camera",
+            "cam.yaml",
+            "--extrinsics",
+            "moved.json",
+            "--fixtures",
+            "fx",
+            "--format",
+            "png",
+            "--images",
+            "--photometric",
+            "ph",
+            "--out",
+            "gt3",
+        ],
+        &[],
+    );
+    assert_eq!(o.status.code(), Some(2));
+    let e = text(&o.stderr);
+    assert!(
+        e.contains("the model was fitted with another extrinsics") && e.contains("moved.json"),
+        "{e}"
+    );
+    assert!(!d.path().join("gt3").exists());
+
     // a model of another camera is refused naming the option, nothing written
     std::fs::create_dir(d.path().join("ph2")).unwrap();
     std::fs::copy(
