@@ -96,6 +96,8 @@ pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
     let (_, camera_sha) = fabkit_calibration::groundtruth::inputs::read_with_hash(&a.cam.camera)?;
     let (t_cam_sensor, extrinsics_sha) = read_extrinsics(&a.extrinsics)?;
     let pins = read_pins(&a.fixtures)?;
+    // the pin dome of this design, as groundtruth --pin-captures checks it
+    fabkit_calibration::groundtruth::pins::check_made_for(&a.fixtures, &design.name)?;
     let pose_name = a.extrinsics.display().to_string();
     let Scene { surface, rays } = Scene::new(design, &camera, &t_cam_sensor, &pose_name)?;
     let reference = reference_hits(&rays, &surface);

@@ -438,4 +438,24 @@ fn a_capture_without_pins_in_its_name_is_refused_and_nothing_is_written() {
         );
         assert!(!d.path().join("ph").exists());
     }
+    // Issue 95: R-Tac0's pin dome with another design was fitted anyway; refused as
+    // groundtruth refuses it
+    let o = run(d.path(), &["show", "rtac0", "--out", "other.yaml"], &[]);
+    assert!(o.status.success());
+    let yaml = std::fs::read_to_string(d.path().join("other.yaml")).unwrap();
+    std::fs::write(
+        d.path().join("other.yaml"),
+        yaml.replace("name: rtac0", "name: other"),
+    )
+    .unwrap();
+    let mut other = args(&names, "ph");
+    other[2] = "other.yaml";
+    let o = run(d.path(), &other, &[]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        text(&o.stderr).contains("the pin dome was made for another design than 'other'"),
+        "{}",
+        text(&o.stderr)
+    );
+    assert!(!d.path().join("ph").exists());
 }

@@ -254,6 +254,16 @@ pub fn capture_name(ids: &[String]) -> String {
 /// whose solids the caster refuses.
 pub fn read_pin_captures(dir: &Path, design_name: &str) -> Result<Fixtures, InputError> {
     let pins = read_pins(dir)?;
+    check_made_for(dir, design_name)?;
+    read_plan(dir, pins)
+}
+
+/// Refuses a pin dome made for another design than `design_name`: its point table's
+/// provenance (`points/point_table.json`) names the design it was built from.
+///
+/// # Errors
+/// [`InputError::Field`] naming the file, its provenance and the design.
+pub fn check_made_for(dir: &Path, design_name: &str) -> Result<(), InputError> {
     let table_json = dir.join("points").join("point_table.json");
     if let Ok((bytes, _)) = read_with_hash(&table_json) {
         let t: serde_json::Value = json(&bytes, &table_json)?;
@@ -270,6 +280,11 @@ pub fn read_pin_captures(dir: &Path, design_name: &str) -> Result<Fixtures, Inpu
             }
         }
     }
+    Ok(())
+}
+
+/// The pin captures of `points/capture_plan.csv` with the pins `pins` of the point table.
+fn read_plan(dir: &Path, pins: Pins) -> Result<Fixtures, InputError> {
     let (table, sha) = CsvTable::read(&dir.join("points").join("capture_plan.csv"))?;
     let file = table.file.clone();
     let field = |f: String, value: String, rule: &str| table.error(f, value, rule);
