@@ -80,6 +80,17 @@ pub enum ImageError {
     RepeatedPin { file: String, id: u32, times: usize },
 }
 
+/// Whether a JPEG's bytes hold an end-of-image marker (FF D9) after its first start-of-scan
+/// (FF DA): a file cut short has none, and the decoder fills what is missing in grey. Inside
+/// the scan data an FF byte is followed by 00 (or a restart marker), so FF D9 there is the
+/// end (ITU-T T.81, B.1.1.2 and F.1.2.3).
+fn jpeg_is_complete(bytes: &[u8]) -> bool {
+    let Some(sos) = bytes.windows(2).position(|w| w == [0xFF, 0xDA]) else {
+        return false;
+    };
+    bytes[sos..].windows(2).any(|w| w == [0xFF, 0xD9])
+}
+
 /// Decodes `path` (PNG or JPEG), checking its size against the camera's (`expect_px`, from
 /// the camera file `camera`) before decoding.
 fn decode_checked(
@@ -105,6 +116,11 @@ fn decode_checked(
             .map_err(|e| decode(e.to_string()))
     };
     match reader()?.format() {
+        Some(image::ImageFormat::Jpeg) if !jpeg_is_complete(&bytes) => {
+            return Err(decode(
+                "the JPEG is incomplete (no end-of-image marker after its scan data: the file was cut short)".into(),
+            ))
+        }
         Some(image::ImageFormat::Png | image::ImageFormat::Jpeg) => {}
         Some(f) => return Err(decode(format!("{f:?} images are not read"))),
         None => return Err(decode("the content is neither PNG nor JPEG".into())),

@@ -580,6 +580,10 @@ fn bad_images_and_reference_exit_2_naming_the_option_and_write_nothing() {
     std::fs::write(s.path("01_04_08_16_24.png"), "not an image\n").unwrap();
     std::fs::write(s.path("obs.csv"), "id,u_px,v_px\n").unwrap();
     save(&blank, &s.path("01_01_01_01_01.png"), Kind::Gray8);
+    // issue 95: a JPEG cut to half its bytes was accepted (the decoder fills the rest)
+    save(&blank, &s.path("01_06_10_18_26.jpg"), Kind::Jpeg);
+    let jpeg = std::fs::read(s.path("01_06_10_18_26.jpg")).unwrap();
+    std::fs::write(s.path("01_06_10_18_26.jpg"), &jpeg[..jpeg.len() / 2]).unwrap();
     let base = [
         "calibrate",
         "extrinsics",
@@ -635,6 +639,10 @@ fn bad_images_and_reference_exit_2_naming_the_option_and_write_nothing() {
                 "01_02_06_14_22.png",
             ],
             "--images = 01_02_06_14_22.png: given twice",
+        ),
+        (
+            &["--reference", "ref.png", "--images", "01_06_10_18_26.jpg"],
+            "--images = 01_06_10_18_26.jpg: not a readable PNG or JPEG image: the JPEG is incomplete",
         ),
         // issue 95: a name that lists a pin five times was accepted with five warnings
         (
