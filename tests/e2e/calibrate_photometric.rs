@@ -151,6 +151,49 @@ fn groundtruth_renders_one_frame_per_pin_capture_with_the_pins_at_their_tips() {
         "{e}"
     );
     assert!(!d.path().join("gt2").exists());
+    std::fs::write(d.path().join("fx/points/capture_plan.csv"), &plan).unwrap();
+    // Issue 95: fixture files read back with a pin tip radius of 1e-300 mm, a shaft of 1e300 mm
+    // or a tip at x = 1e300 mm were accepted; the design's bounds apply, by file and field
+    let manifest = std::fs::read_to_string(d.path().join("fx/manifest.json")).unwrap();
+    let table = std::fs::read_to_string(d.path().join("fx/points/point_table.csv")).unwrap();
+    let mut m: serde_json::Value = serde_json::from_str(&manifest).unwrap();
+    let pin = m["parts"]
+        .as_array_mut()
+        .unwrap()
+        .iter_mut()
+        .find(|p| p["name"] == "pin")
+        .unwrap();
+    pin["params"]["pin"]["tip_radius_mm"] = serde_json::json!(1e-300);
+    std::fs::write(d.path().join("fx/manifest.json"), m.to_string()).unwrap();
+    let o = pin_captures(d.path(), "gt2", "png");
+    let e = text(&o.stderr);
+    assert!(
+        !o.status.success()
+            && e.contains("parts[pin].params.pin.tip_radius_mm")
+            && e.contains("must be a length from 0.001"),
+        "{e}"
+    );
+    std::fs::write(d.path().join("fx/manifest.json"), &manifest).unwrap();
+    let mut lines: Vec<String> = table.lines().map(str::to_string).collect();
+    let x = lines[0]
+        .split(',')
+        .position(|c| c.trim() == "tip_x_mm")
+        .unwrap();
+    let mut cells: Vec<String> = lines[1].split(',').map(str::to_string).collect();
+    cells[x] = "1e300".into();
+    lines[1] = cells.join(",");
+    std::fs::write(
+        d.path().join("fx/points/point_table.csv"),
+        lines.join("\n") + "\n",
+    )
+    .unwrap();
+    let o = pin_captures(d.path(), "gt2", "png");
+    let e = text(&o.stderr);
+    assert!(
+        !o.status.success() && e.contains("tip_x_mm") && e.contains("must be within +-1000 mm"),
+        "{e}"
+    );
+    assert!(!d.path().join("gt2").exists());
 }
 
 fn args<'a>(names: &'a [String], out: &'a str) -> Vec<&'a str> {

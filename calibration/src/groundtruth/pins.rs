@@ -137,6 +137,15 @@ pub fn read_pins(dir: &std::path::Path) -> Result<Pins, InputError> {
                     )
                 })?;
         }
+        // the design's bounds on a length (fabkit_designs::values), as the fixtures were built
+        let max = fabkit_designs::values::MAX_LENGTH_MM;
+        if let Some(j) = (0..3).find(|&j| v[j].abs() > max) {
+            return Err(field(
+                format!("line {} {}", k + 1, header[cols[j]]),
+                format!("{:e}", v[j]),
+                &format!("must be within +-{max} mm (a pin tip of the sensor's pin dome)"),
+            ));
+        }
         let axis = [v[3], v[4], v[5]];
         if ((axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt() - 1.0).abs() > 1e-6 {
             return Err(field(
@@ -162,13 +171,17 @@ pub fn read_pins(dir: &std::path::Path) -> Result<Pins, InputError> {
     })?;
     let size = |path: &[&str]| -> Result<f64, InputError> {
         let v = path.iter().fold(&part.params, |v, k| &v[*k]);
+        let (lo, hi) = (
+            fabkit_designs::values::MIN_LENGTH_MM,
+            fabkit_designs::values::MAX_LENGTH_MM,
+        );
         v.as_f64()
-            .filter(|x| *x > 0.0)
+            .filter(|x| (lo..=hi).contains(x))
             .ok_or_else(|| InputError::Field {
                 file: mfile.clone(),
                 field: format!("parts[pin].params.{}", path.join(".")),
                 value: v.to_string(),
-                rule: "must be a number above 0".into(),
+                rule: format!("must be a length from {lo} to {hi} mm (the design's bounds)"),
             })
     };
     Ok(Pins {
