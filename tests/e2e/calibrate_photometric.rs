@@ -151,6 +151,43 @@ fn groundtruth_renders_one_frame_per_pin_capture_with_the_pins_at_their_tips() {
         "{e}"
     );
     assert!(!d.path().join("gt2").exists());
+    // Issue 95: a plan with two captures of the same pins ran, then failed on a folder that
+    // existed; refused up front by file and capture
+    let header: Vec<&str> = plan.lines().next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| h.trim() == name).unwrap();
+    let (cap, first) = (
+        col("capture"),
+        plan.lines()
+            .nth(1)
+            .unwrap()
+            .split(',')
+            .nth(col("capture"))
+            .unwrap()
+            .to_string(),
+    );
+    let again: String = plan
+        .lines()
+        .skip(1)
+        .filter(|l| l.split(',').nth(cap) == Some(first.as_str()))
+        .map(|l| {
+            let mut c: Vec<&str> = l.split(',').collect();
+            c[cap] = "99";
+            c.join(",") + "\n"
+        })
+        .collect();
+    std::fs::write(
+        d.path().join("fx/points/capture_plan.csv"),
+        format!("{plan}{again}"),
+    )
+    .unwrap();
+    let o = pin_captures(d.path(), "gt2", "png");
+    let e = text(&o.stderr);
+    assert!(
+        !o.status.success()
+            && e.contains("capture 99")
+            && e.contains(&format!("presses the same pins as capture {first}")),
+        "{e}"
+    );
     std::fs::write(d.path().join("fx/points/capture_plan.csv"), &plan).unwrap();
     // Issue 95: fixture files read back with a pin tip radius of 1e-300 mm, a shaft of 1e300 mm
     // or a tip at x = 1e300 mm were accepted; the design's bounds apply, by file and field

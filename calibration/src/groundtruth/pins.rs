@@ -351,6 +351,22 @@ fn read_plan(dir: &Path, pins: Pins) -> Result<Fixtures, InputError> {
             "must plan at least one capture",
         ));
     }
+    // two captures of the same pins would write one folder twice (its name is its pins)
+    for (k, (capture, ids)) in captures.iter().enumerate() {
+        let mut sorted = ids.clone();
+        sorted.sort();
+        if let Some((first, _)) = captures[..k].iter().find(|(_, other)| {
+            let mut o = other.clone();
+            o.sort();
+            o == sorted
+        }) {
+            return Err(field(
+                format!("capture {capture}"),
+                capture_name(ids),
+                &format!("presses the same pins as capture {first}: plan each capture once"),
+            ));
+        }
+    }
     let mut configurations = Vec::new();
     for (capture, ids) in captures {
         let primitives = pins
