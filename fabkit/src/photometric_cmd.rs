@@ -92,6 +92,19 @@ pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
     let camera = a.cam.read()?;
     let i = camera.intrinsics();
     let size = (i.image_width_px, i.image_height_px);
+    // every per-pixel array of the fit is sized by the camera: bounded before any is allocated,
+    // as groundtruth bounds its render (issue 95: 16384 x 16384 aborted at 3.9 GB)
+    let limit = fabkit_calibration::groundtruth::budget::MAX_PIXELS_LIMIT;
+    let pixels = u64::from(size.0) * u64::from(size.1);
+    if pixels > limit {
+        return Err(format!(
+            "{}: the camera image is {} x {} = {pixels} pixels, over the limit of {limit} pixels (2048 x 2048) that the fit's per-pixel arrays hold in its memory budget (hint: calibrate the camera at a lower resolution or crop its image)",
+            a.cam.camera.display(),
+            size.0,
+            size.1
+        )
+        .into());
+    }
     let camera_name = a.cam.camera.display().to_string();
     let (_, camera_sha) = fabkit_calibration::groundtruth::inputs::read_with_hash(&a.cam.camera)?;
     let (t_cam_sensor, extrinsics_sha) = read_extrinsics(&a.extrinsics)?;

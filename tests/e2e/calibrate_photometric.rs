@@ -539,3 +539,36 @@ fn a_capture_without_pins_in_its_name_is_refused_and_nothing_is_written() {
     );
     assert!(!d.path().join("ph").exists());
 }
+
+/// Issue 95: a 16384 x 16384 camera (allowed by the camera rule) made `calibrate photometric`
+/// allocate its per-pixel arrays before anything else: exit 134 at 3.9 GB. Under a 2 GB
+/// address-space limit it now exits 2 naming the camera file and the pixel limit, before
+/// reading a capture, and writes nothing.
+#[test]
+fn a_camera_past_the_pixel_limit_is_refused_before_allocating_under_a_2_gb_limit() {
+    use fabkit_calibration::{write_camera, CameraFileFormat};
+    let d = tempfile::tempdir().unwrap();
+    let mut i = benchmark_intrinsics();
+    let side = 16384u32;
+    (i.image_width_px, i.image_height_px) = (side, side);
+    (i.cx_px, i.cy_px) = (side as f64 / 2.0 - 0.5, side as f64 / 2.0 - 0.5);
+    std::fs::write(
+        d.path().join("cam.yaml"),
+        write_camera(&i, CameraFileFormat::OpenCvYaml),
+    )
+    .unwrap();
+    std::fs::write(
+        d.path().join("extrinsics.json"),
+        r#"{"rvec": [0, 0, 0], "tvec_mm": [0, 0, 10]}"#,
+    )
+    .unwrap();
+    let names = vec!["01_02.png".to_string(), "01_03.png".to_string()];
+    let o = run_limited(d.path(), &args(&names, "ph"), &[], 2_000_000);
+    let e = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(
+        e.contains("cam.yaml: the camera image is 16384 x 16384 = 268435456 pixels, over the limit of 4194304 pixels"),
+        "{e}"
+    );
+    assert!(!d.path().join("ph").exists());
+}
