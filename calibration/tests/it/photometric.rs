@@ -452,11 +452,8 @@ fn side_leds_at_three_azimuths_re_render_within_5_and_7_grey_levels() {
     assert!(rms < 7.0, "R-Tac0's pins: {rms} grey levels RMS");
 }
 
-/// photometric.json's model section round-trips: read back with the fitted appearance, the
-/// model renders every capture to the same values; a file of another basis or a short
-/// coefficient list is refused naming its key.
-#[test]
-fn the_model_json_reads_back_to_the_same_images() {
+/// R-Tac0's captures under a warm LED ring and the model fitted to them.
+fn warm_ring_model() -> (Captures, PhotometricModel) {
     let c = captures(warm_ring(), rtac0_pins);
     let all: Vec<Capture> = c
         .scenes
@@ -468,6 +465,15 @@ fn the_model_json_reads_back_to_the_same_images() {
         })
         .collect();
     let m = PhotometricModel::fit(&c.rays, &c.reference, &c.reference_image, &all, 255.0).unwrap();
+    (c, m)
+}
+
+/// photometric.json's model section round-trips: read back with the fitted appearance, the
+/// model renders every capture to the same values; a file of another basis or a short
+/// coefficient list is refused naming its key.
+#[test]
+fn the_model_json_reads_back_to_the_same_images() {
+    let (c, m) = warm_ring_model();
     // through text, as the file is written and read
     let text = serde_json::to_string(&m.model_json()).unwrap();
     let json: serde_json::Value = serde_json::from_str(&text).unwrap();
@@ -508,17 +514,7 @@ fn the_model_json_reads_back_to_the_same_images() {
 /// finite image wherever the skin is.
 #[test]
 fn every_model_value_is_checked_when_read() {
-    let c = captures(warm_ring(), rtac0_pins);
-    let all: Vec<Capture> = c
-        .scenes
-        .iter()
-        .map(|s| Capture {
-            image: &s.2,
-            hits: &s.1,
-            shadows: &s.3,
-        })
-        .collect();
-    let m = PhotometricModel::fit(&c.rays, &c.reference, &c.reference_image, &all, 255.0).unwrap();
+    let (c, m) = warm_ring_model();
     let json: serde_json::Value =
         serde_json::from_str(&serde_json::to_string(&m.model_json()).unwrap()).unwrap();
     let mut fields: Vec<(Vec<String>, String)> = Vec::new();
