@@ -502,3 +502,24 @@ pub fn write_design(path: &Path, text: &str, verdict: SchemaVerdict) {
         .unwrap_or_else(|e| e.into_inner())
         .insert(key, accepts);
 }
+
+/// Every file under `dir` (relative path, bytes), or an empty map for a missing folder.
+pub fn snapshot(dir: &std::path::Path) -> std::collections::BTreeMap<String, Vec<u8>> {
+    let mut files = std::collections::BTreeMap::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        let Ok(entries) = std::fs::read_dir(&d) else {
+            continue;
+        };
+        for e in entries {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else {
+                let rel = p.strip_prefix(dir).unwrap().display().to_string();
+                files.insert(rel, std::fs::read(&p).unwrap());
+            }
+        }
+    }
+    files
+}

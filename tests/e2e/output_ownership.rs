@@ -3,34 +3,12 @@
 //! exported file. Nothing is deleted or overwritten without --force, another command's output
 //! never, and each refusal names the file or the other command.
 
-use std::collections::BTreeMap;
 use std::path::Path;
 
 use crate::calibrate_cli::{intrinsics, observe, write_table};
-use crate::common::{run, text};
+use crate::common::{run, snapshot, text};
 use crate::groundtruth_cli::setup;
 use fabkit_calibration::{write_camera, CameraFileFormat};
-
-/// Every file under `dir` (relative path, bytes), or an empty map for a missing folder.
-fn snapshot(dir: &Path) -> BTreeMap<String, Vec<u8>> {
-    let mut files = BTreeMap::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        let Ok(entries) = std::fs::read_dir(&d) else {
-            continue;
-        };
-        for e in entries {
-            let p = e.unwrap().path();
-            if p.is_dir() {
-                stack.push(p);
-            } else {
-                let rel = p.strip_prefix(dir).unwrap().display().to_string();
-                files.insert(rel, std::fs::read(&p).unwrap());
-            }
-        }
-    }
-    files
-}
 
 /// The command lines of the four commands that write an output folder, writing into `out`
 /// (the inputs are those [`prepare`] writes), with `extra` appended; and the name each

@@ -9,7 +9,7 @@
 //!
 //! The ShadowTac `paper_text` open mold at 0.05 mm chord tolerance keeps each variant near 0.3 s.
 
-use crate::common::{fabkit, run, text};
+use crate::common::{fabkit, run, snapshot, text};
 use serde_json::Value;
 use std::collections::BTreeSet;
 use std::path::Path;
@@ -570,23 +570,6 @@ fn a_sweep_of_too_many_variants_is_refused_by_its_count() {
     assert!(!d.join("out").exists());
 }
 
-/// Every file below `dir` with its bytes, for "left untouched" checks.
-fn snapshot(dir: &Path) -> std::collections::BTreeMap<std::path::PathBuf, Vec<u8>> {
-    let mut out = std::collections::BTreeMap::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(p) = stack.pop() {
-        for e in std::fs::read_dir(&p).unwrap() {
-            let p = e.unwrap().path();
-            if p.is_dir() {
-                stack.push(p);
-            } else {
-                out.insert(p.clone(), std::fs::read(&p).unwrap());
-            }
-        }
-    }
-    out
-}
-
 /// Issue 95, data loss: a sweep, a shard or a merge written into another sweep's folder (or
 /// into another shard's) replaced its tables and left its variants beside the new table. Now
 /// refused, naming both sweeps, and the folder is left as it was; with --force the folder is
@@ -613,25 +596,24 @@ fn another_sweeps_folder_is_refused_and_replaced_only_whole_with_force() {
     }
     ok(&run(d, &["sweep", &b, "--out", "B"], &[]));
     let (b_before, a0_before) = (snapshot(&d.join("B")), snapshot(&d.join("a0")));
-    assert!(b_before
-        .keys()
-        .any(|p| p.to_string_lossy().contains("variants")));
-    let refused = |args: &[&str], folder: &str, before: &std::collections::BTreeMap<_, _>| {
-        let o = run(d, args, &[]);
-        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", text(&o.stdout));
-        let e = text(&o.stderr);
-        assert!(
-            e.contains("holds the output of another sweep"),
-            "{args:?}: {e}"
-        );
-        assert!(e.contains("--force"), "{e}");
-        assert_eq!(
-            &snapshot(&d.join(folder)),
-            before,
-            "{args:?} changed {folder}"
-        );
-        e
-    };
+    assert!(b_before.keys().any(|p| p.contains("variants")));
+    let refused =
+        |args: &[&str], folder: &str, before: &std::collections::BTreeMap<String, Vec<u8>>| {
+            let o = run(d, args, &[]);
+            assert_eq!(o.status.code(), Some(2), "{args:?}: {}", text(&o.stdout));
+            let e = text(&o.stderr);
+            assert!(
+                e.contains("holds the output of another sweep"),
+                "{args:?}: {e}"
+            );
+            assert!(e.contains("--force"), "{e}");
+            assert_eq!(
+                &snapshot(&d.join(folder)),
+                before,
+                "{args:?} changed {folder}"
+            );
+            e
+        };
     // a merge and a whole run into sweep B's folder, a shard into another shard's folder
     let e = refused(
         &["sweep", "merge", "a0", "a1", "--out", "B"],
@@ -659,9 +641,7 @@ fn another_sweeps_folder_is_refused_and_replaced_only_whole_with_force() {
     ));
     let after = snapshot(&d.join("B"));
     assert!(
-        after
-            .keys()
-            .all(|p| !p.to_string_lossy().contains("variants")),
+        after.keys().all(|p| !p.contains("variants")),
         "{:?}",
         after.keys().collect::<Vec<_>>()
     );
