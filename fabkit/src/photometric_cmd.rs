@@ -119,6 +119,7 @@ pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
     let mut posed = Vec::new();
     // each capture once: no file twice, no two files of the same pins, no pin twice in one
     let mut seen: Vec<(&Path, Vec<u32>)> = Vec::new();
+    let mut listed: Vec<Vec<u32>> = Vec::new();
     for file in &a.images {
         let name = file.display().to_string();
         let ids = ids_from_file_name(file)
@@ -149,14 +150,11 @@ pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
             .into());
         }
         seen.push((file.as_path(), sorted));
+        listed.push(ids);
     }
-    for file in &a.images {
+    for (file, ids) in a.images.iter().zip(&listed) {
         let name = file.display().to_string();
-        let ids: Vec<String> = ids_from_file_name(file)
-            .unwrap_or_default()
-            .iter()
-            .map(u32::to_string)
-            .collect();
+        let ids: Vec<String> = ids.iter().map(u32::to_string).collect();
         let prims = pins.primitives(&ids).map_err(|id| {
             format!(
                 "--images = {name}: pin {id} is not in {}",
