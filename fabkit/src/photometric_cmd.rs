@@ -11,7 +11,8 @@ use fabkit_calibration::groundtruth::inputs::{read_extrinsics, sha256_hex};
 use fabkit_calibration::groundtruth::{indented_hits, reference_hits, Scene, SurfaceHits};
 use fabkit_calibration::imprints::ids_from_file_name;
 use fabkit_calibration::photometric::{
-    read_pins, rms_over_skin, shadow_map, Capture, PhotometricModel, ShadowMap, ShadowRings,
+    capture_fault, image_fault, read_pins, rms_over_skin, shadow_map, Capture, PhotometricModel,
+    ShadowMap, ShadowRings,
 };
 use fabkit_export::raster::{npy_f32, png_rgb16, png_rgb8};
 use fabkit_export::{OutputClaim, OutputCommand, StagedDir};
@@ -193,6 +194,17 @@ pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
             shadows: &p.shadows,
         })
         .collect();
+    // a frame the camera saw no imprint in (a copy of the reference, an unpressed, dark or
+    // white frame) fits nothing: refused by file before the fit (issue 95: it "fitted within
+    // 0.00 counts" to an all-zero model)
+    if let Some(f) = image_fault(&reference, &reference_image, full_scale) {
+        return Err(format!("--reference = {}: {f}", a.reference.display()).into());
+    }
+    for (p, c) in posed.iter().zip(&all) {
+        if let Some(f) = capture_fault(&reference, &reference_image, c, full_scale) {
+            return Err(format!("--images = {}: {f}", p.file.display()).into());
+        }
+    }
     let model = PhotometricModel::fit(&rays, &reference, &reference_image, &all, full_scale)?;
     // Each capture from the model fitted on the others.
     let mut loo = Vec::new();

@@ -572,3 +572,63 @@ fn a_camera_past_the_pixel_limit_is_refused_before_allocating_under_a_2_gb_limit
     );
     assert!(!d.path().join("ph").exists());
 }
+
+/// Issue 95: captures that are copies of the reference, all black or all white "fitted within
+/// 0.00 counts RMS" to an all-zero model with exit 0. Each is refused by file with what it
+/// lacks, before the fit, with nothing written; a black reference is refused as dark; the
+/// real captures beside them fit.
+#[test]
+fn a_capture_that_shows_no_imprint_is_refused_by_file() {
+    let d = tempfile::tempdir().unwrap();
+    setup(d.path());
+    let names = captures(d.path());
+    let reference = image::open(d.path().join("ref.png")).unwrap().to_rgb8();
+    let (w, h) = reference.dimensions();
+    let flat = |v: u8| image::RgbImage::from_pixel(w, h, image::Rgb([v, v, v]));
+    // the reference pressed nowhere (its exact copy), and the same with one count of noise
+    // (an unpressed frame): no imprint at the pins
+    let mut noisy = reference.clone();
+    for (k, p) in noisy.pixels_mut().enumerate() {
+        let step = [0u8, 1, 0, 2][k % 4];
+        p.0 = p.0.map(|x| x.saturating_add(step).saturating_sub(1));
+    }
+    for (image, message) in [
+        (reference.clone(), "no imprint at its pins"),
+        (noisy, "no imprint at its pins"),
+        (flat(0), "dark"),
+        (flat(255), "saturated"),
+    ] {
+        let mut images = names.clone();
+        image.save(d.path().join(&images[2])).unwrap();
+        images.truncate(3);
+        let o = run(d.path(), &args(&images, "ph"), &[]);
+        let e = text(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{message}: {e}");
+        assert!(
+            e.contains(&format!("--images = {}: {message}", images[2])),
+            "{message}: {e}"
+        );
+        assert!(!d.path().join("ph").exists());
+    }
+    // every capture a copy of the reference: no fit from no imprint
+    let mut images = Vec::new();
+    for n in &names[..2] {
+        reference.save(d.path().join(n)).unwrap();
+        images.push(n.clone());
+    }
+    let o = run(d.path(), &args(&images, "ph"), &[]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o.stderr).contains("no imprint at its pins"));
+    assert!(!d.path().join("ph").exists());
+    // a black reference
+    let names = captures(d.path());
+    flat(0).save(d.path().join("ref.png")).unwrap();
+    let o = run(d.path(), &args(&names, "ph"), &[]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        text(&o.stderr).contains("--reference = ref.png: dark"),
+        "{}",
+        text(&o.stderr)
+    );
+    assert!(!d.path().join("ph").exists());
+}

@@ -13,7 +13,8 @@ use fabkit_calibration::groundtruth::synthetic::{benchmark_pose, rtac0_body};
 use fabkit_calibration::groundtruth::{indented_hits, reference_hits, SurfaceHits};
 use fabkit_calibration::imprints::synthetic::{ring_pins, Pin};
 use fabkit_calibration::photometric::{
-    pin_primitives, rms_over_skin, shadow_map, Capture, PhotometricModel, ShadowMap, ShadowRings,
+    capture_fault, pin_primitives, rms_over_skin, shadow_map, Capture, ImageFault,
+    PhotometricModel, ShadowMap, ShadowRings,
 };
 use fabkit_calibration::synthetic::benchmark_intrinsics;
 use fabkit_calibration::CameraModel;
@@ -593,4 +594,69 @@ fn every_model_value_is_checked_when_read() {
             "{e}"
         );
     }
+}
+
+/// Issue 95: a capture the camera saw no imprint in fitted "within 0.00 counts" to an
+/// all-zero model. The rendered captures show theirs far above the noise; the reference's
+/// copy, the reference with the camera's noise, a dark and a white frame at the same pins do
+/// not, and the fit refuses them naming the capture.
+#[test]
+fn captures_show_their_imprints_and_frames_without_them_are_refused() {
+    let c = captures(warm_ring(), balls);
+    let fault = |image: &[[f64; 3]], k: usize| {
+        let (_, hits, _, shadows) = &c.scenes[k];
+        let capture = Capture {
+            image,
+            hits,
+            shadows,
+        };
+        capture_fault(&c.reference, &c.reference_image, &capture, 255.0)
+    };
+    for (k, s) in c.scenes.iter().enumerate() {
+        assert_eq!(fault(&s.2, k), None, "capture {k}");
+    }
+    // the margin: the same imprint at a tenth of its contrast still shows
+    let faint: Vec<[f64; 3]> = c.scenes[0]
+        .2
+        .iter()
+        .zip(&c.reference_image)
+        .map(|(y, r)| std::array::from_fn(|ch| r[ch] + 0.1 * (y[ch] - r[ch])))
+        .collect();
+    assert_eq!(fault(&faint, 0), None);
+    let noisy: Vec<[f64; 3]> = c
+        .reference_image
+        .iter()
+        .enumerate()
+        .map(|(i, r)| r.map(|x| x + [-1.5, 0.5, 1.0, -0.5][(i * 7) % 4]))
+        .collect();
+    for (image, what) in [(c.reference_image.clone(), "copy"), (noisy, "noisy copy")] {
+        assert!(
+            matches!(fault(&image, 1), Some(ImageFault::NoImprint { .. })),
+            "{what}: {:?}",
+            fault(&image, 1)
+        );
+    }
+    let flat = |v: f64| vec![[v; 3]; c.reference_image.len()];
+    assert!(matches!(
+        fault(&flat(0.0), 1),
+        Some(ImageFault::Dark { .. })
+    ));
+    assert!(matches!(
+        fault(&flat(255.0), 1),
+        Some(ImageFault::Saturated { .. })
+    ));
+    // the fit names the capture
+    let captures: Vec<Capture> = c
+        .scenes
+        .iter()
+        .enumerate()
+        .map(|(k, s)| Capture {
+            image: if k == 2 { &c.reference_image } else { &s.2 },
+            hits: &s.1,
+            shadows: &s.3,
+        })
+        .collect();
+    let e = PhotometricModel::fit(&c.rays, &c.reference, &c.reference_image, &captures, 255.0)
+        .unwrap_err();
+    assert!(e.starts_with("capture 2: no imprint at its pins"), "{e}");
 }
