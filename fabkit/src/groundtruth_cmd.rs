@@ -304,6 +304,15 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
     };
     let pose_name = args.extrinsics.display().to_string();
     let scene = Scene::new(design, &camera, &t_cam_sensor, &pose_name)?;
+    if args.pin_captures {
+        // the pin dome of this design's skin, whatever its name
+        let pins = fabkit_calibration::groundtruth::pins::read_pins(&args.fixtures)?;
+        fabkit_calibration::groundtruth::pins::check_on_skin(
+            &args.fixtures,
+            &pins,
+            &scene.surface,
+        )?;
+    }
     scene.check_outside(&fixtures.configurations, &pose_name)?;
     let Scene { surface, rays } = scene;
     // The optics (or the photometric model) are checked before the output is bounded or

@@ -114,6 +114,8 @@ pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
     fabkit_calibration::groundtruth::pins::check_made_for(&a.fixtures, &design.name)?;
     let pose_name = a.extrinsics.display().to_string();
     let Scene { surface, rays } = Scene::new(design, &camera, &t_cam_sensor, &pose_name)?;
+    // and of its skin, whatever the design's name (issue 95: R-Tac0's dome fitted to R15.3)
+    fabkit_calibration::groundtruth::pins::check_on_skin(&a.fixtures, &pins, &surface)?;
     let reference = reference_hits(&rays, &surface);
     let rings = ShadowRings::of(&rays, &reference);
     let (reference_image, full_scale) = read_rgb(&a.reference, "--reference", size, &camera_name)?;

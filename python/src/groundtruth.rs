@@ -622,6 +622,12 @@ impl DepthRenderer {
             }
         })?
         .map_err(|e| err::<GroundTruthError>(&e))?;
+        if pin_captures {
+            use fabkit_calibration::groundtruth::pins::{check_on_skin, read_pins};
+            read_pins(&fixtures)
+                .and_then(|pins| check_on_skin(&fixtures, &pins, &self.scene.surface))
+                .map_err(|e| err::<GroundTruthError>(&e))?;
+        }
         self.scene
             .check_outside(&fixture_set.configurations, "T_cam_sensor")
             .map_err(GroundTruthError::new_err)?;

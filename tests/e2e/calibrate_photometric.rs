@@ -632,3 +632,104 @@ fn a_capture_that_shows_no_imprint_is_refused_by_file() {
     );
     assert!(!d.path().join("ph").exists());
 }
+
+/// Issue 95: R-Tac0's pin dome with a design of the same name whose skin is R15.3 (not 15.0)
+/// was fitted by `calibrate photometric`: the fixtures were matched by name only. Both
+/// commands that press the dome's pins now check its geometry: each pin's recorded contact
+/// point must be where its axis meets this design's skin. Refused naming the point table's
+/// line and the distance, with nothing written; the R15.0 design still passes.
+#[test]
+fn a_pin_dome_of_another_skin_under_the_same_name_is_refused() {
+    let d = tempfile::tempdir().unwrap();
+    setup(d.path());
+    let names = captures(d.path());
+    let o = run(d.path(), &["show", "rtac0", "--out", "r153.yaml"], &[]);
+    assert!(o.status.success());
+    let yaml = std::fs::read_to_string(d.path().join("r153.yaml")).unwrap();
+    let yaml = yaml
+        .replacen("  radius_mm: 15.0", "  radius_mm: 15.3", 1)
+        .replacen("outer_radius_mm: 15.0", "outer_radius_mm: 15.3", 1);
+    assert!(yaml.contains("name: rtac0"));
+    std::fs::write(d.path().join("r153.yaml"), yaml).unwrap();
+    let mut photometric = args(&names, "ph");
+    photometric[2] = "r153.yaml";
+    let groundtruth = [
+        "groundtruth",
+        "r153.yaml",
+        "--camera",
+        "cam.yaml",
+        "--extrinsics",
+        "extrinsics.json",
+        "--fixtures",
+        "fx",
+        "--pin-captures",
+        "--out",
+        "gt",
+    ];
+    for (argv, out) in [(&photometric[..], "ph"), (&groundtruth[..], "gt")] {
+        let o = run(d.path(), argv, &[]);
+        let e = text(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{argv:?}: {e}");
+        assert!(
+            e.contains("point_table.csv")
+                && e.contains("line 2 contact_mm")
+                && e.contains("lies 0.3000 mm from where pin 1's axis meets the design's skin")
+                && e.contains("built for another skin"),
+            "{e}"
+        );
+        assert!(!d.path().join(out).exists());
+    }
+    let o = run(
+        d.path(),
+        &groundtruth.map(|a| if a == "r153.yaml" { "rtac0" } else { a }),
+        &[],
+    );
+    assert!(o.status.success(), "{}", text(&o.stderr));
+}
+
+/// The geometry check above holds for every library pin dome against its own design: each
+/// pin's contact point lies on the design's closed-form skin within a micron (the dome is
+/// built from that surface), so the check refuses no dome built from its design.
+#[test]
+fn every_library_pin_dome_lies_on_its_designs_skin() {
+    use fabkit_calibration::groundtruth::pins::{check_on_skin, read_pins};
+    use fabkit_calibration::groundtruth::surface::ReferenceSurface;
+    let d = tempfile::tempdir().unwrap();
+    for name in ["rtac0", "uvdtact", "shadowtac", "digit_pinki"] {
+        let o = run(
+            d.path(),
+            &["fixtures", name, "--format", "stl", "--out", name],
+            &[],
+        );
+        assert!(o.status.success(), "{name}: {}", text(&o.stderr));
+        let design = fabkit_designs::library::load(name).unwrap();
+        let surface = ReferenceSurface::of(&design.body).unwrap();
+        let dir = d.path().join(name);
+        let pins = read_pins(&dir).unwrap();
+        assert!(pins.rows.len() >= 5, "{name}: {} pins", pins.rows.len());
+        check_on_skin(&dir, &pins, &surface).unwrap_or_else(|e| panic!("{name}: {e}"));
+        // and a skin 0.01 mm larger is another skin
+        let larger = match surface {
+            ReferenceSurface::Cap {
+                radius_mm,
+                base_z_mm,
+            } => ReferenceSurface::Cap {
+                radius_mm: radius_mm + 0.01,
+                base_z_mm,
+            },
+            ReferenceSurface::HemisphereOnCylinder {
+                radius_mm,
+                base_z_mm,
+            } => ReferenceSurface::HemisphereOnCylinder {
+                radius_mm: radius_mm + 0.01,
+                base_z_mm,
+            },
+            ReferenceSurface::HalfEllipsoid { a_mm, c_mm } => ReferenceSurface::HalfEllipsoid {
+                a_mm: a_mm + 0.01,
+                c_mm: c_mm + 0.01,
+            },
+            ReferenceSurface::Flat { .. } => panic!("{name}: a pin dome on a flat skin"),
+        };
+        assert!(check_on_skin(&dir, &pins, &larger).is_err(), "{name}");
+    }
+}

@@ -6,6 +6,7 @@ use std::path::Path;
 
 use crate::groundtruth::exact::ExactPrimitives;
 use crate::groundtruth::inputs::{json, read_with_hash, Configuration, Fixtures, InputError};
+use crate::groundtruth::surface::ReferenceSurface;
 use fabkit_designs::primitives::Geometry;
 
 /// A calibration pin of the pin dome as solids for the ground-truth caster: its hemispherical
@@ -291,6 +292,80 @@ pub fn check_made_for(dir: &Path, design_name: &str) -> Result<(), InputError> {
                     rule: format!("the pin dome was made for another design than '{design_name}' (hint: pass the design the fixtures were built from)"),
                 });
             }
+        }
+    }
+    Ok(())
+}
+
+/// How far (mm) a pin's recorded contact point may lie from the design's skin: the point
+/// table is written to 1e-9 mm from the same closed-form surface, so anything above a micron
+/// is another geometry.
+pub const CONTACT_TOLERANCE_MM: f64 = 1e-3;
+
+/// Refuses a pin dome built for another skin than `surface` (the design's reference surface,
+/// sensor frame, mm), whatever its name: each pin of points/point_table.csv whose row gives
+/// its contact point (`contact_x_mm`, `contact_y_mm`, `contact_z_mm`: where the hole axis
+/// meets the undeformed surface) must have its tip inside the skin and that point on it,
+/// within [`CONTACT_TOLERANCE_MM`] of where its axis leaves `surface`. A table without the
+/// contact columns is not checked (read_pins does not need them).
+///
+/// # Errors
+/// [`InputError::Field`] naming the file, the pin's line and the distance from the skin.
+pub fn check_on_skin(
+    dir: &Path,
+    pins: &Pins,
+    surface: &ReferenceSurface,
+) -> Result<(), InputError> {
+    let (table, _) = CsvTable::read(&dir.join("points").join("point_table.csv"))?;
+    let cols: Vec<usize> = ["contact_x_mm", "contact_y_mm", "contact_z_mm"]
+        .iter()
+        .filter_map(|c| table.header.iter().position(|h| h == c))
+        .collect();
+    let Ok(id_col) = table.col("id") else {
+        return Ok(());
+    };
+    if cols.len() != 3 {
+        return Ok(());
+    }
+    let hint = "the pin dome was built for another skin than this design's (hint: pass the design the fixtures were built from, or build the fixtures again from this one)";
+    for (k, cells) in &table.rows {
+        let at = |c: usize| cells.get(c).map_or("", String::as_str);
+        let Some((_, tip, axis)) = pins.rows.iter().find(|r| r.0 == at(id_col)) else {
+            continue;
+        };
+        let contact: Vec<f64> = cols.iter().filter_map(|&c| at(c).parse().ok()).collect();
+        let field = format!("line {} contact_mm", k + 1);
+        let value = format!("{contact:?}");
+        if contact.len() != 3 || contact.iter().any(|x: &f64| !x.is_finite()) {
+            return Err(table.error(field, value, "must be three finite numbers"));
+        }
+        if !surface.contains(*tip, 0.0) {
+            return Err(table.error(
+                field,
+                value,
+                &format!(
+                    "pin {}'s tip {tip:?} lies outside the design's skin: {hint}",
+                    at(id_col)
+                ),
+            ));
+        }
+        let Some(exit) = surface.exit(*tip, *axis) else {
+            continue;
+        };
+        let on = std::array::from_fn::<f64, 3, _>(|j| tip[j] + exit.t_mm * axis[j]);
+        let off = (0..3)
+            .map(|j| (on[j] - contact[j]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        if !(off <= CONTACT_TOLERANCE_MM) {
+            return Err(table.error(
+                field,
+                value,
+                &format!(
+                    "lies {off:.4} mm from where pin {}'s axis meets the design's skin ({:.4}, {:.4}, {:.4}), more than {CONTACT_TOLERANCE_MM} mm: {hint}",
+                    at(id_col), on[0], on[1], on[2]
+                ),
+            ));
         }
     }
     Ok(())
