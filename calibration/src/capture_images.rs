@@ -139,8 +139,25 @@ fn decode_checked(
             camera_height: expect_px.1,
         });
     }
-    reader()?.decode().map_err(|e| decode(e.to_string()))
+    reader()?.decode().map_err(|e| match e {
+        // the decoder's memory limit, in words (issue 95: "Memory limit exceeded")
+        image::ImageError::Limits(_) => {
+            let bytes = reader()
+                .ok()
+                .and_then(|r| r.into_decoder().ok())
+                .map(|d| image::ImageDecoder::total_bytes(&d));
+            decode(format!(
+                "{width} x {height} pixels{} decode to more than the {} MiB an image may take in memory (hint: calibrate the camera at a lower resolution or crop its images)",
+                bytes.map_or(String::new(), |b| format!(" ({} MiB decoded)", b.div_ceil(1 << 20))),
+                IMAGE_MEMORY_LIMIT_BYTES >> 20
+            ))
+        }
+        e => decode(e.to_string()),
+    })
 }
+
+/// The image decoder's memory limit (the `image` crate's default allocation limit), bytes.
+pub const IMAGE_MEMORY_LIMIT_BYTES: u64 = 512 << 20;
 
 /// Reads `path` (PNG or JPEG, any depth, grey or colour) as grey levels 0..255, checking its
 /// size against the camera's (`expect_px`, from the camera file `camera`) before decoding.

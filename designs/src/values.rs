@@ -479,7 +479,9 @@ pub fn with_value_at<T: Serialize + serde::de::DeserializeOwned>(
 /// Empty when `text` does not parse as YAML (the schema parse reports that).
 pub fn quoted_numbers<T: Serialize + ?Sized>(typed: &T, text: &str) -> Vec<(String, String)> {
     // The untyped reading keeps quoted scalars as strings.
-    let Ok(untyped) = serde_saphyr::from_str::<Value>(text) else {
+    let Ok(untyped) =
+        serde_saphyr::from_str_with_options::<Value>(text, crate::yaml::budget_options())
+    else {
         return Vec::new();
     };
     let Ok(typed) = serde_value::to_value(typed) else {

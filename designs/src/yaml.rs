@@ -9,10 +9,40 @@ use serde::Deserialize;
 /// is expected (`name: 25`, `description: true`) is refused (quote it); so are YAML 1.1
 /// booleans (`yes`, `on`) and tags fabkit does not know (`!!python/object/apply:...`).
 pub fn yaml_options() -> serde_saphyr::Options {
-    let mut o = serde_saphyr::Options::default();
+    let mut o = budget_options();
     o.no_schema = true;
     o.strict_booleans = true;
     o.reject_unsupported_tags = true;
+    o
+}
+
+/// Marker patterns of [`crate::markers::MAX_MARKERS_PER_PATTERN`] listed points each that one
+/// input file may hold within [`MAX_YAML_NODES`].
+pub const MAX_LISTED_PATTERNS: usize = 4;
+
+/// Most YAML values (nodes: lists, mappings and scalars) one input file may hold: what the
+/// design limits allow, [`MAX_LISTED_PATTERNS`] marker lists of
+/// [`crate::markers::MAX_MARKERS_PER_PATTERN`] points (a list of two numbers, three nodes,
+/// each) and 100,000 nodes for the rest of the design. Bounds the parser's memory before any
+/// value is typed.
+pub const MAX_YAML_NODES: usize =
+    MAX_LISTED_PATTERNS * 3 * crate::markers::MAX_MARKERS_PER_PATTERN + 100_000;
+
+/// The parser's budget for every fabkit input file: [`MAX_YAML_NODES`] nodes, twice as many
+/// parser events (a list or mapping is two), the library's defaults otherwise (64 levels of
+/// nesting, 64 MiB of scalars, 50,000 aliases).
+pub fn yaml_budget() -> serde_saphyr::Budget {
+    let mut b = serde_saphyr::Budget::default();
+    b.max_nodes = MAX_YAML_NODES;
+    b.max_events = 2 * MAX_YAML_NODES;
+    b
+}
+
+/// The parser's default reading rules under [`yaml_budget`]: for the untyped passes that find
+/// where a value sits ([`yaml_location`]) and which numbers were quoted.
+pub fn budget_options() -> serde_saphyr::Options {
+    let mut o = serde_saphyr::Options::default();
+    o.budget = Some(yaml_budget());
     o
 }
 
@@ -57,7 +87,8 @@ pub fn refuse_quoted_numbers<T: serde::Serialize + ?Sized>(
 /// between keys, `[i]` for list items) starts in `text`; `None` when the text does not parse
 /// or has no such node.
 pub fn yaml_location(text: &str, path: &str) -> Option<(u64, u64)> {
-    let root: serde_saphyr::Spanned<Node> = serde_saphyr::from_str(text).ok()?;
+    let root: serde_saphyr::Spanned<Node> =
+        serde_saphyr::from_str_with_options(text, budget_options()).ok()?;
     let mut cur = &root;
     for step in path_steps(path)? {
         cur = match (&cur.value, step) {
@@ -86,7 +117,8 @@ pub(crate) fn written_scalar(text: &str, line: u64, column: u64) -> Option<Strin
 /// Line and column (from 1) in `text` of the value that preset `preset` gives parameter `path`
 /// (a key of `presets.<preset>`, dots and brackets included).
 pub(crate) fn preset_value_location(text: &str, preset: &str, path: &str) -> Option<(u64, u64)> {
-    let root: serde_saphyr::Spanned<Node> = serde_saphyr::from_str(text).ok()?;
+    let root: serde_saphyr::Spanned<Node> =
+        serde_saphyr::from_str_with_options(text, budget_options()).ok()?;
     let mut cur = &root;
     for key in ["presets", preset, path] {
         let Node::Map(entries) = &cur.value else {
@@ -127,7 +159,8 @@ pub fn yaml_scalar_path_at(text: &str, line: u64, column: u64) -> Option<String>
             }),
         }
     }
-    let root: serde_saphyr::Spanned<Node> = serde_saphyr::from_str(text).ok()?;
+    let root: serde_saphyr::Spanned<Node> =
+        serde_saphyr::from_str_with_options(text, budget_options()).ok()?;
     let mut path = String::new();
     (find(&root, (line, column), &mut path) && !path.is_empty()).then_some(path)
 }
@@ -229,7 +262,7 @@ pub fn yaml_error_in(origin: &str, text: &str, e: &serde_saphyr::Error) -> Strin
 
 /// Formats a serde-saphyr error as `file:line:column: message`.
 pub fn yaml_error(origin: &str, e: &serde_saphyr::Error) -> String {
-    let msg = e.to_string();
+    let msg = plain_message(e).unwrap_or_else(|| e.to_string());
     let first = msg.lines().next().unwrap_or(&msg);
     match e.location() {
         Some(loc) => format!(
@@ -240,6 +273,42 @@ pub fn yaml_error(origin: &str, e: &serde_saphyr::Error) -> String {
         ),
         None => format!("{origin}: {first}"),
     }
+}
+
+/// The rule and the limit in words for the parser's errors that name its internals (a budget
+/// breached, its non-finite float policy); `None` for the others, whose text is the parser's.
+fn plain_message(e: &serde_saphyr::Error) -> Option<String> {
+    use serde_saphyr::budget::BudgetBreach;
+    let budget = yaml_budget();
+    Some(match e.without_snippet() {
+        serde_saphyr::Error::NonFiniteFloat { value, .. } => format!(
+            "`{value}` is not a finite number: every number in a fabkit input must be finite"
+        ),
+        serde_saphyr::Error::Budget { breach, .. } => match breach {
+            BudgetBreach::Nodes { .. } | BudgetBreach::Events { .. } => format!(
+                "the file holds more than {} YAML values (lists, mappings and numbers), the most an input file may hold: enough for {MAX_LISTED_PATTERNS} marker lists of {} points (hint: give a long point list as a csv_file)",
+                budget.max_nodes,
+                crate::markers::MAX_MARKERS_PER_PATTERN
+            ),
+            BudgetBreach::Depth { .. } => format!(
+                "lists and mappings are nested more than {} levels deep, the most an input file may have",
+                budget.max_depth
+            ),
+            BudgetBreach::Aliases { .. } | BudgetBreach::Anchors { .. } => format!(
+                "more than {} YAML anchors or aliases (&name, *name), the most an input file may have",
+                budget.max_aliases.min(budget.max_anchors)
+            ),
+            BudgetBreach::Documents { .. } => {
+                "more than one YAML document (---): an input file is one document".to_string()
+            }
+            BudgetBreach::ScalarBytes { .. } => format!(
+                "its values hold more than {} bytes of text, the most an input file may",
+                budget.max_total_scalar_bytes
+            ),
+            other => format!("the file is beyond the YAML reader's limits ({other:?})"),
+        },
+        _ => return None,
+    })
 }
 
 /// Drops serde-saphyr's own `error: line N column M: ` prefix (we print file:line:col).

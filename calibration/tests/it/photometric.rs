@@ -660,3 +660,58 @@ fn captures_show_their_imprints_and_frames_without_them_are_refused() {
         .unwrap_err();
     assert!(e.starts_with("capture 2: no imprint at its pins"), "{e}");
 }
+
+/// Issue 95: a 16384 x 16384 16-bit RGB capture (a camera of that size passes the camera
+/// rule) was refused as "not a readable PNG or JPEG image: Memory limit exceeded". The PNG's
+/// header alone (its pixels are never decoded) now gives the size, the memory it would take
+/// and the limit, in words.
+#[test]
+fn a_capture_past_the_decoders_memory_limit_is_refused_in_words() {
+    use fabkit_calibration::capture_images::read_rgb;
+    fn crc32(bytes: &[u8]) -> u32 {
+        let mut c = !0u32;
+        for &b in bytes {
+            c ^= u32::from(b);
+            for _ in 0..8 {
+                c = if c & 1 == 1 {
+                    0xEDB8_8320 ^ (c >> 1)
+                } else {
+                    c >> 1
+                };
+            }
+        }
+        !c
+    }
+    let chunk = |kind: &[u8], data: &[u8]| -> Vec<u8> {
+        let mut v = (data.len() as u32).to_be_bytes().to_vec();
+        let body = [kind, data].concat();
+        v.extend(&body);
+        v.extend(crc32(&body).to_be_bytes());
+        v
+    };
+    let side = 16384u32;
+    let mut ihdr = side.to_be_bytes().to_vec();
+    ihdr.extend(side.to_be_bytes());
+    ihdr.extend([16, 2, 0, 0, 0]); // 16-bit, RGB, deflate, adaptive filter, no interlace
+    let png = [
+        b"\x89PNG\r\n\x1a\n".to_vec(),
+        chunk(b"IHDR", &ihdr),
+        chunk(b"IDAT", &[0x78, 0x9c, 0x03, 0x00, 0x00, 0x00, 0x00, 0x01]),
+        chunk(b"IEND", &[]),
+    ]
+    .concat();
+    let d = tempfile::tempdir().unwrap();
+    let file = d.path().join("big.png");
+    std::fs::write(&file, png).unwrap();
+    let e = read_rgb(&file, "--images", (side, side), "cam.yaml")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("--images = ")
+            && e.contains(
+                "16384 x 16384 pixels (1536 MiB decoded) decode to more than the 512 MiB"
+            )
+            && !e.contains("Memory limit exceeded"),
+        "{e}"
+    );
+}

@@ -482,3 +482,48 @@ fn preset_values_are_reported_like_direct_ones() {
         "{e}"
     );
 }
+
+/// Issue 95: a design with 90,000 listed marker points (under the 100,000 one pattern may
+/// have) was refused by the parser as "budget breached: Nodes { nodes: 250001 }". The YAML
+/// node budget follows the design limits: 90,000 points parse; past the budget the error
+/// says the limit and the hint in words.
+#[test]
+fn the_yaml_budget_follows_the_design_limits_and_speaks_in_words() {
+    use fabkit_designs::yaml::MAX_YAML_NODES;
+    let base = fabkit_designs::library::yaml("shadowtac").unwrap();
+    let layout = "layout: concentric_6k";
+    assert!(base.contains(layout));
+    let listed = |n: usize| {
+        let pts: Vec<String> = (0..n)
+            .map(|i| {
+                format!(
+                    "[{:.3}, {:.2}]",
+                    5.0 + (i % 400) as f64 * 0.1,
+                    (i / 400) as f64
+                )
+            })
+            .collect();
+        base.replacen(
+            layout,
+            &format!("layout: list\n          points: [{}]", pts.join(", ")),
+            1,
+        )
+        .replacen("rings: 12 ", "", 1)
+        .replacen("polar_step_deg: 3.9474 ", "", 1)
+    };
+    let d = Design::from_yaml(&listed(90_000), "big.yaml").unwrap();
+    let points = d.layers[0].markers[0].pattern.points.as_ref().unwrap();
+    assert_eq!(points.len(), 90_000);
+    // past the budget: a point is three nodes
+    let e = Design::from_yaml(&listed(MAX_YAML_NODES / 3 + 1), "huge.yaml")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("huge.yaml:")
+            && e.contains(&format!("more than {MAX_YAML_NODES} YAML values"))
+            && e.contains("csv_file")
+            && !e.contains("budget breached"),
+        "{}",
+        &e[..e.len().min(400)]
+    );
+}

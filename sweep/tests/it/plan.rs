@@ -227,3 +227,23 @@ fn repeats_in_long_lists_are_found() {
         "{e}"
     );
 }
+
+/// Issue 95: a non-finite number in a sweep file was refused as "non-finite float `.nan`
+/// rejected by the configured policy". Each spelling of one is refused at its file:line:col
+/// with the rule in words.
+#[test]
+fn a_non_finite_value_is_refused_in_words_at_its_place() {
+    for bad in [".nan", ".inf", "-.inf", "1e999"] {
+        let e = parse(&sweep(&format!("  {SPACING}: [1.4, {bad}]\n"), ""))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("sweep.yaml:4:")
+                && e.contains(&format!(
+                    "`{bad}` is not a finite number: every number in a fabkit input must be finite"
+                ))
+                && !e.contains("policy"),
+            "{bad}: {e}"
+        );
+    }
+}
