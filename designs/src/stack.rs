@@ -57,6 +57,13 @@ pub fn validate(
         .into_iter()
         .partition(|e| e.path.contains(".pattern.points["));
     if !other.is_empty() {
+        // a count past any count, said by its field's own rule
+        let other = crate::values::with_field_count_rules(design, other, |d| {
+            validate(d, materials, tol)
+                .err()
+                .map(|e| e.0)
+                .unwrap_or_default()
+        });
         return Err(ParamErrors(other.into_iter().chain(in_points).collect()));
     }
     let mut errs: Vec<ParamError> = Vec::new();

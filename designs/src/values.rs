@@ -195,12 +195,65 @@ fn check_integer(v: &Value, path: &str, errs: &mut ValueErrors) {
         .is_some_and(|k| k.ends_with("seed"));
     if !seed && n.unsigned_abs() > MAX_PLAIN as u128 {
         let path = if path.is_empty() { "(value)" } else { path };
+        let signed = matches!(
+            v,
+            Value::I8(_) | Value::I16(_) | Value::I32(_) | Value::I64(_)
+        );
+        let least = if signed { -MAX_PLAIN } else { 0.0 };
         errs.unusable.push(ParamError::new(
             path,
             n,
-            format!("must be a count from -{MAX_PLAIN} to {MAX_PLAIN}"),
+            format!("{PAST_ANY_COUNT} from {least} to {MAX_PLAIN}"),
         ));
     }
+}
+
+/// The start of the rule [`check_values`] gives a count past +-[`MAX_PLAIN`] (before the
+/// field's own rule is known: [`with_field_count_rules`]).
+pub const PAST_ANY_COUNT: &str = "must be a count";
+
+/// `errs` (from [`check_values`] of `value`) with each count past [`MAX_PLAIN`] said by its
+/// field's own rule: `rules` (the checks of `value`'s type, every error) is run on `value` with
+/// those counts set to [`MAX_PLAIN`], where its work is bounded, and the rule it gives at each
+/// such path replaces the generic range, marked as checked at [`MAX_PLAIN`]. A count whose
+/// field has no rule of its own there keeps the generic range.
+pub fn with_field_count_rules<T: Serialize + serde::de::DeserializeOwned>(
+    value: &T,
+    errs: Vec<ParamError>,
+    rules: impl FnOnce(&T) -> Vec<ParamError>,
+) -> Vec<ParamError> {
+    let counts: Vec<usize> = (0..errs.len())
+        .filter(|&k| {
+            errs[k].rule.starts_with(PAST_ANY_COUNT) && errs[k].value.parse::<u64>().is_ok()
+        })
+        .collect();
+    if counts.is_empty() {
+        return errs;
+    }
+    let mut clamped = None;
+    for &k in &counts {
+        let Some(path) = NumberPath::parse(&errs[k].path) else {
+            continue;
+        };
+        match with_integer(clamped.as_ref().unwrap_or(value), &path, MAX_PLAIN as u64) {
+            Ok(c) => clamped = Some(c),
+            Err(_) => continue,
+        }
+    }
+    let Some(clamped) = clamped else {
+        return errs;
+    };
+    let found = rules(&clamped);
+    let mut errs = errs;
+    for k in counts {
+        if let Some(e) = found.iter().find(|e| e.path == errs[k].path) {
+            errs[k].rule = format!(
+                "{} (checked at {MAX_PLAIN}, the most any count may be)",
+                e.rule
+            );
+        }
+    }
+    errs
 }
 
 /// Text holds no control characters other than line breaks and tabs: an escape sequence in a
@@ -394,6 +447,22 @@ pub fn with_number<T: Serialize + serde::de::DeserializeOwned>(
 ) -> Result<T, String> {
     let mut v = serde_value::to_value(value).map_err(|e| e.to_string())?;
     *at_path_mut(&mut v, &path.0).ok_or_else(|| format!("no number at {path}"))? = Value::F64(x);
+    T::deserialize(v).map_err(|e| e.to_string())
+}
+
+/// `value` with the integer at `path` (from [`integer_paths`]) set to `n`, read back through
+/// the type's own deserializer.
+///
+/// # Errors
+/// A path that does not lead to a value, or the deserializer's message (`n` past the field's
+/// type).
+pub fn with_integer<T: Serialize + serde::de::DeserializeOwned>(
+    value: &T,
+    path: &NumberPath,
+    n: u64,
+) -> Result<T, String> {
+    let mut v = serde_value::to_value(value).map_err(|e| e.to_string())?;
+    *at_path_mut(&mut v, &path.0).ok_or_else(|| format!("no integer at {path}"))? = Value::U64(n);
     T::deserialize(v).map_err(|e| e.to_string())
 }
 

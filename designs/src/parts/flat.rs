@@ -190,7 +190,17 @@ pub fn validate(
 ) -> Result<Vec<FlatLayer>, crate::ParamErrors> {
     let numbers = crate::values::check_values(design, crate::schema::DESIGN_SIGNED_MM);
     if !numbers.unusable.is_empty() {
-        return Err(crate::ParamErrors(numbers.unusable));
+        // a count past any count, said by its field's own rule
+        return Err(crate::ParamErrors(crate::values::with_field_count_rules(
+            design,
+            numbers.unusable,
+            |d| {
+                validate(d, materials)
+                    .err()
+                    .map(|e| e.0)
+                    .unwrap_or_default()
+            },
+        )));
     }
     let mut errs = Vec::new();
     if !crate::values::is_file_stem(&design.name) {

@@ -294,7 +294,7 @@ fn counts_that_once_allocated_or_passed_are_refused_by_name() {
         &d,
         "mold.two_piece.bolt_count",
         "200000000",
-        "must be a count from -1000000 to 1000000",
+        "bolts 0.000 mm apart on the flange",
     );
     d.mold.two_piece.bolt_count = 1_000_000;
     assert_refused(&d, "mold.two_piece.bolt_count", "1000000", "bolts");
@@ -306,14 +306,26 @@ fn counts_that_once_allocated_or_passed_are_refused_by_name() {
         .position(|l| l.marker_grid.is_some())
         .unwrap();
     for (rows, columns, path, value, rule) in [
-        (1, 100_000_000, "columns", "100000000", "must be a count"),
-        (1 << 31, 10, "rows", "2147483648", "must be a count"),
+        (
+            1,
+            100_000_000,
+            "columns",
+            "100000000",
+            "more than the 100000 markers",
+        ),
+        (
+            1 << 31,
+            10,
+            "rows",
+            "2147483648",
+            "more than the 100000 markers",
+        ),
         (
             1 << 63,
             10,
             "rows",
             "9223372036854775808",
-            "must be a count",
+            "more than the 100000 markers",
         ),
         (1000, 1000, "rows", "1000", "more than the 100000 markers"),
         (
@@ -354,7 +366,7 @@ fn counts_that_once_allocated_or_passed_are_refused_by_name() {
         &d,
         "housing.led_pcb.led_count",
         "2147483648",
-        "must be a count",
+        "at most 59 LEDs fit around the ring",
     );
     d.housing.as_mut().unwrap().led_pcb.led_count = 1_000_000;
     assert_refused(
@@ -525,5 +537,79 @@ fn the_yaml_budget_follows_the_design_limits_and_speaks_in_words() {
             && !e.contains("budget breached"),
         "{}",
         &e[..e.len().min(400)]
+    );
+}
+
+/// Issue 95: every count past 1,000,000 was refused as "must be a count from -1000000 to
+/// 1000000", whatever the field's own range. Each count is now said by its field's rule (run
+/// at 1,000,000, where its work is bounded), or, for a count this design does not read, the
+/// range of any unsigned count.
+#[test]
+fn a_count_past_any_count_is_said_by_its_fields_own_rule() {
+    use fabkit_designs::values::{with_integer, NumberPath};
+    let checked = "(checked at 1000000, the most any count may be)";
+    for (name, path, words) in [
+        (
+            "rtac0",
+            "mold.vent.count",
+            "at most 21 vents fit beside the sprue",
+        ),
+        (
+            "rtac0",
+            "housing.led_pcb.led_count",
+            "at most 59 LEDs fit around the ring",
+        ),
+        ("shadowtac", "casing.leds.count", "must be 1 to 8"),
+        ("uvdtact", "fingertip_base.bolts.count", "must be 2 to 6"),
+        ("uvdtact", "optics.camera.bit_depth", "must be 8 or 16"),
+        (
+            "tactip_dualmodal",
+            "shaft_body.robot_mount.bolt_count",
+            "must be 2 to 8",
+        ),
+        (
+            "tactip_dualmodal",
+            "printers.fdm.bayonet.lug_count",
+            "must be 2 to 8",
+        ),
+        (
+            "rtac0",
+            "mold.two_piece.bolt_count",
+            "must be a count from 0 to 1000000",
+        ),
+    ] {
+        let d = library::load(name).unwrap();
+        let d = with_integer(&d, &NumberPath::parse(path).unwrap(), u64::from(u32::MAX)).unwrap();
+        let errs = errors(&d);
+        let e = errs
+            .iter()
+            .find(|e| e.path == path)
+            .unwrap_or_else(|| panic!("{name} {path}:{}", listing(&errs)));
+        assert_eq!(e.value, "4294967295");
+        assert!(e.rule.starts_with(words), "{name}: {e}");
+        assert_eq!(
+            e.rule.ends_with(checked),
+            !words.starts_with("must be a count"),
+            "{e}"
+        );
+        assert!(!e.rule.contains("-1000000"), "{e}");
+    }
+    // a flat skin's own rules
+    let soter = library::load("soter_channels").unwrap();
+    let materials = MaterialsTable::embedded().unwrap();
+    let d = with_integer(
+        &soter,
+        &NumberPath::parse("layers[1].channels.count").unwrap(),
+        u64::from(u32::MAX),
+    )
+    .unwrap();
+    let errs = fabkit_designs::flat::validate(&d, &materials)
+        .unwrap_err()
+        .0;
+    assert!(
+        errs.iter()
+            .any(|e| e.path == "layers[1].channels.count" && e.rule.ends_with(checked)),
+        "{}",
+        listing(&errs)
     );
 }

@@ -938,7 +938,10 @@ fn more_vents_than_fit_yield_one_error() {
         &[&Expect {
             path: "mold.vent.count",
             value: "4294967295",
-            rule: &["must be a count from -1000000 to 1000000"],
+            rule: &[
+                "vents fit beside the sprue",
+                "(checked at 1000000, the most any count may be)",
+            ],
         }],
     );
     let mut d = baseline();
