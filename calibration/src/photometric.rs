@@ -1140,6 +1140,64 @@ impl PhotometricModel {
     }
 }
 
+/// The inputs a model was fitted with, as `fabkit calibrate photometric` records them in
+/// photometric.json: per input (`design`, `camera`, `extrinsics`), its name or file and its
+/// sha256. A model belongs to one sensor, camera and pose.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct FittedWith {
+    /// (input, name or file, sha256), in the record's order.
+    pub inputs: Vec<(String, String, String)>,
+    /// The record, for messages.
+    pub file: String,
+}
+
+impl FittedWith {
+    /// The inputs recorded in `dir`/photometric.json (none for a record without them).
+    ///
+    /// # Errors
+    /// The file unreadable or not JSON, naming it.
+    pub fn read(dir: &std::path::Path) -> Result<FittedWith, String> {
+        let path = dir.join("photometric.json");
+        let file = path.display().to_string();
+        let bytes = std::fs::read(&path).map_err(|e| format!("{file}: {e}"))?;
+        let v: serde_json::Value =
+            serde_json::from_slice(&bytes).map_err(|e| format!("{file}: not JSON: {e}"))?;
+        let inputs = ["design", "camera", "extrinsics"]
+            .iter()
+            .filter_map(|&key| {
+                let sha = v[key]["sha256"].as_str()?;
+                let name = v[key]["name"]
+                    .as_str()
+                    .or(v[key]["file"].as_str())
+                    .unwrap_or("?");
+                Some((key.to_string(), name.to_string(), sha.to_string()))
+            })
+            .collect();
+        Ok(FittedWith { inputs, file })
+    }
+
+    /// Refuses `input` (`design`, `camera` or `extrinsics`) with sha256 `sha`, named `ours`
+    /// (a file or a design), when the model was fitted with another.
+    ///
+    /// # Errors
+    /// Naming the record, the input, both names and both hashes (first 12 digits).
+    pub fn check(&self, input: &str, sha: &str, ours: &str) -> Result<(), String> {
+        let Some((_, name, theirs)) = self.inputs.iter().find(|(k, _, _)| k == input) else {
+            return Ok(());
+        };
+        if theirs == sha {
+            return Ok(());
+        }
+        let short = |s: &str| s.chars().take(12).collect::<String>();
+        Err(format!(
+            "{}: the model was fitted with another {input} ({name}, sha256 {}...), not {ours} (sha256 {}...): a photometric model belongs to one sensor, camera and pose; fit one for these with fabkit calibrate photometric",
+            self.file,
+            short(theirs),
+            short(sha)
+        ))
+    }
+}
+
 /// Root-mean-square difference of `a` and `b` over the pixels where `a` is finite, all
 /// channels, counts.
 pub fn rms_over_skin(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {

@@ -147,22 +147,12 @@ fn load_photometric(
     let (model, sha) = PhotometricModel::read(dir).map_err(|e| format!("--photometric {e}"))?;
     // A model is of one sensor, camera and pose: those it was fitted with, by their files'
     // sha256 as photometric.json records them.
-    let jpath = dir.join("photometric.json");
-    let record: serde_json::Value = serde_json::from_slice(&std::fs::read(&jpath)?)?;
+    let fitted = fabkit_calibration::photometric::FittedWith::read(dir)
+        .map_err(|e| format!("--photometric {e}"))?;
     for (key, sha, file) in fitted_for {
-        let theirs = record[key]["sha256"].as_str();
-        if theirs.is_some_and(|t| t != sha) {
-            return Err(format!(
-                "--photometric {}: the model was fitted with another {key} ({} {}, sha256 {}...), not {} (sha256 {}...): a photometric model belongs to one sensor, camera and pose; fit one for these with fabkit calibrate photometric",
-                jpath.display(),
-                key,
-                record[key]["name"].as_str().or(record[key]["file"].as_str()).unwrap_or("?"),
-                &theirs.unwrap_or_default()[..12.min(theirs.unwrap_or_default().len())],
-                file.display(),
-                &sha[..12.min(sha.len())]
-            )
-            .into());
-        }
+        fitted
+            .check(key, sha, &file.display().to_string())
+            .map_err(|e| format!("--photometric {e}"))?;
     }
     if (model.width, model.height) != (w, h) {
         return Err(format!(

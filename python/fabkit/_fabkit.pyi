@@ -273,7 +273,11 @@ class PhotometricModel:
 
 def read_photometric(dir: StrPath) -> PhotometricModel:
     """The model in the output folder of ``fabkit calibrate photometric`` (photometric.json,
-    appearance.npy). Raises GroundTruthError naming the file and what does not fit."""
+    appearance.npy). Raises GroundTruthError naming the file and what does not fit.
+    ``DepthRenderer.image(..., photometric=model)`` refuses it (GroundTruthError) for another
+    design, camera file or extrinsics file than it was fitted with (by sha256, as
+    ``fabkit groundtruth --photometric``), and warns (UserWarning) where the renderer's camera
+    or pose was given as values, which cannot be checked."""
 
 class DepthRenderer:
     """Ground-truth depth of a design's skin through a calibrated camera (R-Tac0 Sec. IV-B,

@@ -123,6 +123,8 @@ pub struct PhotometricModel {
     source: String,
     /// sha256 of its photometric.json, for a dataset's manifest.
     sha256: String,
+    /// The design, camera and extrinsics it was fitted with (photometric.json's record).
+    fitted_with: fabkit_calibration::photometric::FittedWith,
 }
 
 #[pymethods]
@@ -158,16 +160,21 @@ impl PhotometricModel {
 /// (photometric.json and appearance.npy). Raises GroundTruthError naming the file and what
 /// does not fit: not JSON, another basis than this fabkit's, an appearance that is not
 /// (H, W, 3) float32.
+/// `DepthRenderer.image(..., photometric=model)` refuses it for another design, camera file
+/// or extrinsics file than it was fitted with (photometric.json's record).
 #[pyfunction]
 pub fn read_photometric(py: Python<'_>, dir: std::path::PathBuf) -> PyResult<PhotometricModel> {
-    let (model, sha256) = crate::work(py, || {
-        fabkit_calibration::photometric::PhotometricModel::read(&dir)
+    let (model, sha256, fitted_with) = crate::work(py, || {
+        let (m, sha) = fabkit_calibration::photometric::PhotometricModel::read(&dir)?;
+        let fitted = fabkit_calibration::photometric::FittedWith::read(&dir)?;
+        Ok::<_, String>((m, sha, fitted))
     })?
     .map_err(GroundTruthError::new_err)?;
     Ok(PhotometricModel {
         model: Arc::new(model),
         source: dir.display().to_string(),
         sha256,
+        fitted_with,
     })
 }
 
@@ -259,9 +266,40 @@ fn frame_dict<'py>(py: Python<'py>, f: &DepthFrame) -> PyResult<Bound<'py, PyDic
 }
 
 impl DepthRenderer {
-    /// Refuses a photometric model of another camera size than this renderer's.
-    fn check_camera_of(&self, m: &PhotometricModel) -> PyResult<()> {
-        let (m, rays) = (&m.model, &self.scene.rays);
+    /// Refuses a photometric model fitted with another design, camera file or extrinsics file
+    /// than this renderer's (by sha256, as `fabkit groundtruth --photometric` does), or of
+    /// another camera size; warns (UserWarning) where the renderer's camera or pose was given
+    /// as values, whose match with the model's files cannot be checked.
+    fn check_camera_of(&self, py: Python<'_>, model: &PhotometricModel) -> PyResult<()> {
+        let fitted = &model.fitted_with;
+        fitted
+            .check("design", &self.sha256, &format!("design {}", self.named))
+            .map_err(GroundTruthError::new_err)?;
+        for (key, sha, file) in [
+            ("camera", &self.camera_sha256, &self.camera_file),
+            ("extrinsics", &self.extrinsics_sha256, &self.extrinsics_file),
+        ] {
+            match sha {
+                Some(sha) => fitted
+                    .check(key, sha, file)
+                    .map_err(GroundTruthError::new_err)?,
+                None if fitted.inputs.iter().any(|(k, _, _)| k == key) => {
+                    let msg = std::ffi::CString::new(format!(
+                        "photometric {}: this renderer's {key} was given as values ({file}), so fabkit cannot check that the model was fitted with it; pass the {key} file to check",
+                        model.source
+                    ))
+                    .unwrap_or_default();
+                    pyo3::PyErr::warn(
+                        py,
+                        &py.get_type::<pyo3::exceptions::PyUserWarning>(),
+                        &msg,
+                        1,
+                    )?;
+                }
+                None => {}
+            }
+        }
+        let (m, rays) = (&model.model, &self.scene.rays);
         if (m.width, m.height) != (rays.width, rays.height) {
             return Err(GroundTruthError::new_err(format!(
                 "photometric: the model is of a {} x {} px camera, this renderer's is {} x {} px (the model was fitted to another camera)",
@@ -502,7 +540,7 @@ impl DepthRenderer {
         }
         let rays = &self.scene.rays;
         if let Some(m) = photometric {
-            self.check_camera_of(m)?;
+            self.check_camera_of(py, m)?;
             let m = &m.model;
             let img = crate::work(py, || match protrusions {
                 None => m.image(rays, &self.reference_hits, &self.reference_hits, None),
@@ -633,7 +671,7 @@ impl DepthRenderer {
             .map_err(GroundTruthError::new_err)?;
         let rays = &self.scene.rays;
         if let Some(m) = photometric {
-            self.check_camera_of(m)?;
+            self.check_camera_of(py, m)?;
         }
         let imaging = match photometric {
             Some(m) => Some(ImageSource::Photometric(

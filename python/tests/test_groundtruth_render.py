@@ -8,6 +8,7 @@ files exactly.
 """
 
 import json
+import warnings
 import threading
 import time
 
@@ -206,6 +207,27 @@ def test_pin_captures_and_photometric_images_equal_the_cli(scene, run_cli):
         np.testing.assert_array_equal(img, _read_png(str(d / "gt_ph" / s.name / "image.png")),
                                       err_msg=s.name)
         assert not np.array_equal(img, ref)
+    # Issue 95: the model's design, camera and pose are checked as `groundtruth --photometric`
+    # checks them (by their files' sha256); a pose given as values cannot be, and says so
+    with pytest.warns(UserWarning, match="extrinsics was given as values"):
+        r.image(photometric=model)
+    by_file = fabkit.DepthRenderer(design, str(d / "cam.yaml"), str(d / "extrinsics.json"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        np.testing.assert_array_equal(by_file.image(photometric=model), ref)
+    moved = json.loads((d / "extrinsics.json").read_text())
+    moved["T_cam_sensor"][0][3] += 0.5
+    (d / "moved.json").write_text(json.dumps(moved))
+    elsewhere = fabkit.DepthRenderer(design, str(d / "cam.yaml"), str(d / "moved.json"))
+    with pytest.raises(fabkit.GroundTruthError, match="fitted with another extrinsics"):
+        elsewhere.image(photometric=model)
+    import pathlib
+    text = (pathlib.Path(__file__).parents[2] / "designs/library/rtac0.yaml").read_text()
+    (d / "edited.yaml").write_text(text + "\n# edited\n")
+    edited = fabkit.DepthRenderer(fabkit.Design.load(str(d / "edited.yaml")),
+                                  str(d / "cam.yaml"), str(d / "extrinsics.json"))
+    with pytest.raises(fabkit.GroundTruthError, match="fitted with another design"):
+        edited.image(photometric=model)
     # a model of another camera size is refused
     other = fabkit.DepthRenderer(design, str(d / "cam.yaml"), scene["T"], max_pixels=W * H)
     (d / "ph2").mkdir()
