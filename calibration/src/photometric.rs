@@ -925,7 +925,8 @@ impl PhotometricModel {
         use crate::groundtruth::inputs::read_with_hash;
         let jpath = dir.join("photometric.json");
         let (bytes, sha) = read_with_hash(&jpath).map_err(|e| e.to_string())?;
-        let v: serde_json::Value = serde_json::from_slice(&bytes)
+        let text = quote_non_finite(&String::from_utf8_lossy(&bytes));
+        let v: serde_json::Value = serde_json::from_str(&text)
             .map_err(|e| format!("{}: not JSON: {e}", jpath.display()))?;
         let apath = dir.join("appearance.npy");
         let (abytes, _) = read_with_hash(&apath).map_err(|e| e.to_string())?;
@@ -975,6 +976,41 @@ impl PhotometricModel {
                 return Err(format!(
                     "model.{key} = {}: this fabkit's model has {want} (fit it again with this version)",
                     m[key]
+                ));
+            }
+        }
+        // the candidate lights and rings the basis is made of
+        let lights_basis = [
+            (
+                "lights.heights",
+                &m["lights"]["heights"],
+                serde_json::json!(LIGHT_HEIGHTS),
+            ),
+            (
+                "lights.radius",
+                &m["lights"]["radius"],
+                serde_json::json!(LIGHT_RADIUS),
+            ),
+            (
+                "lights.azimuths",
+                &m["lights"]["azimuths"],
+                serde_json::json!(LIGHT_AZIMUTHS),
+            ),
+            (
+                "shadow.rings.heights",
+                &m["shadow"]["rings"]["heights"],
+                serde_json::json!(SHADOW_HEIGHTS),
+            ),
+            (
+                "shadow.rings.radii",
+                &m["shadow"]["rings"]["radii"],
+                serde_json::json!(SHADOW_RADII),
+            ),
+        ];
+        for (key, have, want) in lights_basis {
+            if *have != want {
+                return Err(format!(
+                    "model.{key} = {have}: this fabkit's model has {want} (fit it again with this version)"
                 ));
             }
         }
@@ -1138,6 +1174,65 @@ impl PhotometricModel {
             })
             .collect()
     }
+}
+
+/// JSON `text` with the numbers JSON cannot hold quoted as strings: the `NaN`, `Infinity` and
+/// `-Infinity` that Python's `json` module writes, and numbers past the f64 range (`1e999`).
+/// The model's reader then names the field that holds one (a number is expected there)
+/// instead of failing on the syntax.
+pub fn quote_non_finite(text: &str) -> String {
+    let b = text.as_bytes();
+    let mut out = String::with_capacity(text.len());
+    let (mut i, mut start) = (0, 0);
+    let mut in_string = false;
+    while i < b.len() {
+        let c = b[i];
+        if in_string {
+            match c {
+                b'\\' => i += 1,
+                b'"' => in_string = false,
+                _ => {}
+            }
+            i += 1;
+            continue;
+        }
+        let word = ["-Infinity", "Infinity", "NaN"]
+            .into_iter()
+            .find(|w| b[i..].starts_with(w.as_bytes()));
+        let token = if let Some(w) = word {
+            Some(w.len())
+        } else if c == b'-' || c.is_ascii_digit() {
+            let n = b[i..]
+                .iter()
+                .take_while(|x| x.is_ascii_digit() || matches!(x, b'-' | b'+' | b'.' | b'e' | b'E'))
+                .count();
+            // the token's bytes are ASCII: a char boundary on both sides
+            let finite = text[i..i + n].parse::<f64>().is_ok_and(f64::is_finite);
+            if finite {
+                i += n;
+                continue;
+            }
+            Some(n)
+        } else {
+            None
+        };
+        match token {
+            Some(n) => {
+                out.push_str(&text[start..i]);
+                out.push('"');
+                out.push_str(&text[i..i + n]);
+                out.push('"');
+                i += n;
+                start = i;
+            }
+            None => {
+                in_string = c == b'"';
+                i += 1;
+            }
+        }
+    }
+    out.push_str(&text[start..]);
+    out
 }
 
 /// The inputs a model was fitted with, as `fabkit calibrate photometric` records them in

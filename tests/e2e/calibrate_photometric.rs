@@ -733,3 +733,162 @@ fn every_library_pin_dome_lies_on_its_designs_skin() {
         assert!(check_on_skin(&dir, &pins, &larger).is_err(), "{name}");
     }
 }
+
+/// Issue 95, done when: `calibrate photometric` fits a model under a 2 GB address-space limit,
+/// and `groundtruth --images --photometric` reads it with every numeric field of its model
+/// (the first and last number of each list) set to 0, -1, 1e-300, 1e300, NaN and infinity (as
+/// Python's json writes them), one at a time, and with a skin pixel of its appearance.npy set
+/// to each: each run exits 2 naming the file and the field, or renders its frames; none
+/// panics, aborts or exits otherwise, and no refused run leaves its output folder.
+#[test]
+fn every_model_value_is_refused_by_name_or_renders_under_a_2_gb_limit() {
+    const LIMIT_KIB: u64 = 2 << 20;
+    let d = tempfile::tempdir().unwrap();
+    setup(d.path());
+    let names = captures(d.path());
+    let o = run_limited(d.path(), &args(&names, "ph"), &[], LIMIT_KIB);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let record: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.path().join("ph/photometric.json")).unwrap())
+            .unwrap();
+    // every numeric leaf of the model, lists by their first and last number
+    fn leaves(v: &serde_json::Value, path: Vec<String>, out: &mut Vec<Vec<String>>) {
+        match v {
+            serde_json::Value::Number(_) => out.push(path),
+            serde_json::Value::Object(m) => {
+                for (k, x) in m {
+                    let mut p = path.clone();
+                    p.push(k.clone());
+                    leaves(x, p, out);
+                }
+            }
+            serde_json::Value::Array(a) => {
+                let mut ends = vec![0];
+                if a.len() > 1 {
+                    ends.push(a.len() - 1);
+                }
+                for i in ends {
+                    let mut p = path.clone();
+                    p.push(i.to_string());
+                    leaves(&a[i], p, out);
+                }
+            }
+            _ => {}
+        }
+    }
+    let mut fields = Vec::new();
+    leaves(&record["model"], vec!["model".into()], &mut fields);
+    assert!(fields.len() >= 30, "{}", fields.len());
+    let appearance = std::fs::read(d.path().join("ph/appearance.npy")).unwrap();
+    let values = ["0", "-1", "1e-300", "1e300", "NaN", "Infinity"];
+    // one semi-dome pattern: the reference and two frames per run
+    let o = run(
+        d.path(),
+        &[
+            "fixtures",
+            "rtac0",
+            "--semidomes",
+            "1",
+            "--seed",
+            "3",
+            "--format",
+            "stl",
+            "--out",
+            "fx1",
+        ],
+        &[],
+    );
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let mut outcomes = (0, 0);
+    let mut check = |dir: &str, field: &str, what: &str| {
+        let o = run_limited(
+            d.path(),
+            &[
+                "groundtruth",
+                "rtac0",
+                "--camera",
+                "cam.yaml",
+                "--extrinsics",
+                "extrinsics.json",
+                "--fixtures",
+                "fx1",
+                "--format",
+                "png",
+                "--images",
+                "--photometric",
+                dir,
+                "--out",
+                "gt",
+            ],
+            &[],
+            LIMIT_KIB,
+        );
+        let e = text(&o.stderr);
+        match o.status.code() {
+            Some(0) => {
+                assert!(d.path().join("gt/reference/image.png").is_file(), "{what}");
+                std::fs::remove_dir_all(d.path().join("gt")).unwrap();
+                outcomes.0 += 1;
+            }
+            Some(2) => {
+                assert!(e.contains(field), "{what}: {e}");
+                assert!(!d.path().join("gt").exists(), "{what}");
+                outcomes.1 += 1;
+            }
+            c => panic!("{what}: exit {c:?}: {e}"),
+        }
+    };
+    for path in &fields {
+        // the message names the model's key (and the file)
+        let key: Vec<&str> = path
+            .iter()
+            .map(String::as_str)
+            .filter(|k| k.parse::<usize>().is_err())
+            .take(2)
+            .collect();
+        for v in values {
+            let mut bad = record.clone();
+            let mut at = &mut bad;
+            for p in path {
+                at = match p.parse::<usize>() {
+                    Ok(i) => &mut at[i],
+                    Err(_) => &mut at[p.as_str()],
+                };
+            }
+            *at = serde_json::json!("__VALUE__");
+            let body = serde_json::to_string_pretty(&bad)
+                .unwrap()
+                .replace("\"__VALUE__\"", v);
+            let dir = d.path().join("bad");
+            let _ = std::fs::remove_dir_all(&dir);
+            std::fs::create_dir(&dir).unwrap();
+            std::fs::write(dir.join("photometric.json"), body).unwrap();
+            std::fs::write(dir.join("appearance.npy"), &appearance).unwrap();
+            check(
+                "bad",
+                &format!("photometric.json: {}", key.join(".")),
+                &format!("{path:?} = {v}"),
+            );
+        }
+    }
+    // a pixel of the skin in appearance.npy
+    let (shape, mut data) = fabkit_export::raster::read_npy_f32(&appearance).unwrap();
+    let k = data.iter().position(|x| x.is_finite()).unwrap();
+    for v in [0.0f32, -1.0, 1e-30, f32::MAX, f32::NAN, f32::INFINITY] {
+        data[k + 1] = v;
+        let dir = d.path().join("bad");
+        std::fs::write(
+            dir.join("photometric.json"),
+            serde_json::to_vec(&record).unwrap(),
+        )
+        .unwrap();
+        std::fs::write(
+            dir.join("appearance.npy"),
+            fabkit_export::raster::npy_f32(&shape, &data),
+        )
+        .unwrap();
+        check("bad", "appearance.npy: pixel", &format!("appearance = {v}"));
+    }
+    eprintln!("{} rendered, {} refused by name", outcomes.0, outcomes.1);
+    assert!(outcomes.1 > outcomes.0, "{outcomes:?}");
+}

@@ -715,3 +715,21 @@ fn a_capture_past_the_decoders_memory_limit_is_refused_in_words() {
         "{e}"
     );
 }
+
+/// The numbers JSON cannot hold, as Python's json writes them, are quoted so that the model's
+/// reader names their field; text inside strings and finite numbers are left as they are.
+#[test]
+fn non_finite_numbers_are_quoted_outside_strings_only() {
+    use fabkit_calibration::photometric::quote_non_finite;
+    let text = r#"{"a": NaN, "b": [-Infinity, 1e999, -2.5e-3, Infinity], "NaN \"Infinity\"": "1e999", "é": 1}"#;
+    let v: serde_json::Value = serde_json::from_str(&quote_non_finite(text)).unwrap();
+    assert_eq!(v["a"], "NaN");
+    assert_eq!(
+        v["b"],
+        serde_json::json!(["-Infinity", "1e999", -2.5e-3, "Infinity"])
+    );
+    assert_eq!(v["NaN \"Infinity\""], "1e999");
+    assert_eq!(v["é"], 1);
+    let plain = r#"{"x": [1, 2.5, -3e5]}"#;
+    assert_eq!(quote_non_finite(plain), plain);
+}
