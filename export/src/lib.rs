@@ -24,6 +24,7 @@
 mod atomic;
 mod check;
 mod error;
+pub mod hold;
 mod html;
 mod layout;
 mod manifest;
@@ -282,6 +283,8 @@ fn write_kit_meshes(
             r?;
             written.insert(rel, sha256);
         }
+        // every file in the temporary sibling, none under the final name yet
+        hold::hold_point("export-written");
         if opts.formats.stl {
             atomic::sync_dir(&tmp.join(PARTS_DIR))?;
         }

@@ -593,6 +593,7 @@ pub fn run(
             .map(|&(k, v)| {
                 let r = run_variant(spec, v, &vdir, &materials, opts, writer);
                 write_atomic(&vdir.join(format!("{}.json", v.id)), &json_pretty(&r))?;
+                fabkit_export::hold::hold_point("sweep-variant-written");
                 on_event(Event::Done(&r));
                 Ok((k, r))
             })

@@ -824,13 +824,13 @@ fn marker_list_from_csv_is_placed_and_hashed() {
 fn a_run_after_a_sigkill_mid_write_removes_the_stale_sibling_and_says_so() {
     let tmp = tempfile::tempdir().unwrap();
     std::fs::create_dir(tmp.path().join("out")).unwrap();
-    let mut child = crate::common::fabkit()
-        .current_dir(tmp.path())
-        .args(["export", "uvdtact", "--out", "out/u"])
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
+    // held once every file is in the temporary sibling, before the rename
+    let mut child = crate::common::spawn_held(
+        tmp.path(),
+        &["export", "uvdtact", "--out", "out/u"],
+        "export-written",
+        1,
+    );
     let prefix = format!(".u.tmp-{}-", child.id());
     let sibling = || {
         std::fs::read_dir(tmp.path().join("out"))
@@ -838,20 +838,9 @@ fn a_run_after_a_sigkill_mid_write_removes_the_stale_sibling_and_says_so() {
             .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
             .find(|n| n.starts_with(&prefix))
     };
-    // the temporary sibling exists once the parts are being written
-    let t0 = std::time::Instant::now();
-    while sibling().is_none() && child.try_wait().unwrap().is_none() {
-        assert!(
-            t0.elapsed().as_secs() < 120,
-            "no temporary sibling appeared"
-        );
-        std::thread::sleep(std::time::Duration::from_millis(5));
-    }
     child.kill().unwrap(); // SIGKILL: no chance to clean up
     child.wait().unwrap();
-    let Some(stale) = sibling() else {
-        panic!("the export finished before it could be killed");
-    };
+    let stale = sibling().expect("the temporary sibling of the held export");
     assert!(!tmp.path().join("out/u").exists());
 
     let o = run(tmp.path(), &["export", "rtac0", "--out", "out/u"], &[]);

@@ -523,3 +523,31 @@ pub fn snapshot(dir: &std::path::Path) -> std::collections::BTreeMap<String, Vec
     }
     files
 }
+
+/// Spawns fabkit with `args` in `cwd`, held at the `n`-th arrival at the hold point `point`
+/// (`fabkit_export::hold`): returns the child once it holds there (it sleeps until killed).
+/// No time limit: the child either reaches the point or exits, which panics naming the point.
+pub fn spawn_held(cwd: &Path, args: &[&str], point: &str, n: usize) -> std::process::Child {
+    let held = cwd.join(format!(".held-{point}-{n}"));
+    let _ = std::fs::remove_file(&held);
+    let mut child = fabkit()
+        .current_dir(cwd)
+        .args(args)
+        .env("FABKIT_TEST_HOLD", format!("{point}:{n}"))
+        .env("FABKIT_TEST_HOLD_FILE", &held)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .expect("fabkit starts");
+    while !held.exists() {
+        if let Some(status) = child.try_wait().unwrap() {
+            panic!(
+                "fabkit {} exited ({status}) before holding at {point}:{n}",
+                args.join(" ")
+            );
+        }
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    std::fs::remove_file(&held).unwrap();
+    child
+}

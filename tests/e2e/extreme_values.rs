@@ -9,9 +9,12 @@
 //! and on the flat skin of Soter et al. with its grid plate, and R-Tac0's published pin dome),
 //! written into a fixture parameter file: 1e-300, 5e-324, 1e-12, 1e12 and 1e300 in every
 //! floating-point field, 2^31, 2^32 + 1, 2^63 and 2^64 in every integer field. Each walk runs
-//! in a child process (this test binary, one ignored test) under the limit, each case within
-//! 20 s: a rule that allocates before it refuses aborts the child, and the parent names the
-//! case. What builds is exported (STL, 3MF and the manifest) into a temporary folder.
+//! in a child process (this test binary, one ignored test) under the limit: a rule that
+//! allocates before it refuses aborts the child, and the parent names the case. The work of a
+//! case is bounded by triangles, not by time (a design builds under a limit of 4,000,000, a
+//! fixture set is first asked to stop at one triangle and built only when that is its refusal),
+//! so a fast or a slow machine gives the same result. What builds is exported (STL, 3MF and
+//! the manifest) into a temporary folder.
 
 use crate::common::{repo_root, run_program_limited, text};
 use fabkit_designs::materials::MaterialsTable;
@@ -22,7 +25,6 @@ use fabkit_fixtures::build_fixtures;
 use fabkit_fixtures::params::{apply_pin_preset, from_yaml, FixtureParams};
 use std::path::Path;
 use std::process::Output;
-use std::time::{Duration, Instant};
 
 /// Floating-point values of the walks.
 const FLOATS: [&str; 5] = ["1e-300", "5e-324", "1e-12", "1e12", "1e300"];
@@ -33,8 +35,6 @@ const INTEGERS: [&str; 4] = [
     "9223372036854775808",
     "18446744073709551616",
 ];
-/// Longest one case may take.
-const CASE_LIMIT: Duration = Duration::from_secs(20);
 /// The child's variable: which walk to run.
 const WALK_ENV: &str = "FABKIT_EXTREME_VALUES_WALK";
 /// A string no design holds, replaced by the literal value in the YAML text.
@@ -198,7 +198,6 @@ fn walk_one_design() {
         let p = path.to_string();
         let case = format!("{name}: {p} = {x}");
         println!("case: {case}");
-        let t0 = Instant::now();
         let direct = Design::from_yaml(&yaml_with(&d, path, x, None), &origin);
         // through a preset: the same design, or an error naming the path in the preset
         let text = yaml_with(&d, path, x, Some("extreme"));
@@ -250,7 +249,6 @@ fn walk_one_design() {
                 built.push(format!("{p} = {x}"));
             }
         }
-        assert!(t0.elapsed() < CASE_LIMIT, "{case} took {:?}", t0.elapsed());
     }
     println!(
         "walked: {name}: {} cases, {refused} refused by name, {} built: {}",
@@ -288,7 +286,6 @@ fn walk_one_fixture_set() {
         let p = path.to_string();
         let case = format!("{design}, {which}: {p} = {x}");
         println!("case: {case}");
-        let t0 = Instant::now();
         match from_yaml(&yaml_with(&params, path, x, None), origin) {
             Err(e) => {
                 assert_names(&e.to_string(), &p, origin, &case);
@@ -313,7 +310,6 @@ fn walk_one_fixture_set() {
                 Ok(_) => panic!("{case}: built past a limit of one triangle"),
             },
         }
-        assert!(t0.elapsed() < CASE_LIMIT, "{case} took {:?}", t0.elapsed());
     }
     println!(
         "walked: {design}, {which}: {} cases, {refused} refused by name, {} built: {}",
