@@ -76,3 +76,33 @@ distortion_coefficients:
   cols: 4
   data: [{', '.join(map(str, KB))}]
 """
+
+
+def ran_during(call):
+    """(call's result, whether this thread ran Python while call() ran in another thread),
+    decided without a clock. With the interpreter's switch interval set to an hour, a thread
+    that holds the GIL keeps it until it blocks or releases it, as a Rust call does around its
+    work (`allow_threads`): this thread, woken as the call starts, then runs before the call
+    returns only if the call released the GIL. A fast or slow machine gives the same answer."""
+    import sys
+    import threading
+
+    started, finished = threading.Event(), threading.Event()
+    box = {}
+
+    def worker():
+        started.set()
+        box["out"] = call()
+        finished.set()
+
+    old = sys.getswitchinterval()
+    sys.setswitchinterval(3600.0)
+    try:
+        th = threading.Thread(target=worker)
+        th.start()
+        started.wait()
+        during = not finished.is_set()
+        th.join()
+    finally:
+        sys.setswitchinterval(old)
+    return box.get("out"), during
