@@ -276,22 +276,111 @@ fn the_photometric_model_re_renders_each_capture_from_the_others() {
         // skin beside their imprints from the LED ring; with the shadow term the model fits
         // these five within about 2.2 counts and re-renders each from the other four within
         // about 2.8 (without it 3.7 and 4.1); the leave-one-out stays within a count of the
-        // fit (no overfitting)
+        // fit (no overfitting: about 0.55 apart); the re-renderings are judged from the files
+        // below
         let loo = c["leave_one_out_rms_counts"].as_f64().unwrap();
         let fit = c["fit_rms_counts"].as_f64().unwrap();
         assert!(
-            loo < 3.0 && loo < fit + 1.0,
+            loo < fit + 1.0,
             "{}: {loo} grey levels RMS, fit {fit}",
             c["file"]
         );
         assert_eq!(c["pins"].as_array().unwrap().len(), 5);
-        let img = image::open(d.path().join("ph").join(c["rerendered"].as_str().unwrap()))
-            .unwrap()
-            .into_rgb8();
-        assert_eq!(img.dimensions(), (640, 480));
     }
     let appearance = read_npy_f32(&d.path().join("ph/appearance.npy"));
     assert_eq!(appearance.len(), 640 * 480 * 3);
+    // Issue 96: the figures above are the command's own; the test computes them again from
+    // the files: each capture against its re-rendering from the other four, over the skin
+    // (where the appearance is not NaN), all channels, in counts
+    let reference_png = image::open(d.path().join("ref.png")).unwrap().into_rgb8();
+    for c in caps {
+        let capture = image::open(d.path().join(c["file"].as_str().unwrap()))
+            .unwrap()
+            .into_rgb8();
+        // the camera's noise in the capture (the re-rendering has none): from its difference
+        // with the reference, a frame of independent noise, over the skin (1.4826 x the median
+        // absolute difference over sqrt 2; the few pressed pixels do not move a median)
+        let mut diff: Vec<f64> = capture
+            .pixels()
+            .zip(reference_png.pixels())
+            .enumerate()
+            .filter(|(k, _)| !appearance[3 * k].is_nan())
+            .flat_map(|(_, (a, b))| {
+                (0..3).map(move |ch| (f64::from(a[ch]) - f64::from(b[ch])).abs())
+            })
+            .collect();
+        diff.sort_by(f64::total_cmp);
+        let noise = 1.4826 * diff[diff.len() / 2] / 2f64.sqrt();
+        let again = image::open(d.path().join("ph").join(c["rerendered"].as_str().unwrap()))
+            .unwrap()
+            .into_rgb8();
+        assert_eq!(again.dimensions(), (640, 480));
+        let (mut sq, mut n) = (0.0, 0usize);
+        for (k, (a, b)) in capture.pixels().zip(again.pixels()).enumerate() {
+            if appearance[3 * k].is_nan() {
+                continue;
+            }
+            for ch in 0..3 {
+                sq += (f64::from(a[ch]) - f64::from(b[ch])).powi(2);
+                n += 1;
+            }
+        }
+        let rms = (sq / n as f64).sqrt();
+        let reported = c["leave_one_out_rms_counts"].as_f64().unwrap();
+        // what the model misses, the noise taken out in quadrature: within an error budget of
+        // 2.5 counts (1 % of full scale)
+        let model = (rms * rms - noise * noise).max(0.0).sqrt();
+        eprintln!(
+            "{}: {rms:.3} counts RMS from the files ({reported:.3} reported), noise {noise:.3}, model {model:.3}",
+            c["file"]
+        );
+        assert!(
+            model < 2.5,
+            "{}: {rms} counts RMS, noise {noise}",
+            c["file"]
+        );
+        // the report's figure is of the unrounded re-rendering: within the rounding's
+        // 1 / sqrt(12) count of the file's
+        assert!(
+            (rms - reported).abs() < 0.3,
+            "{}: {rms} from the files, {reported} reported",
+            c["file"]
+        );
+    }
+    // A parameter the test chose, recovered: the third capture at 0.9 of its exposure (its
+    // counts scaled and rounded, as a camera's gain drift would) is fitted with a gain 0.9 of
+    // the first fit's, within the rounding's effect on a median ratio of counts near 100
+    std::fs::create_dir(d.path().join("dim")).unwrap();
+    let dimmed = image::open(d.path().join(&names[2])).unwrap().into_rgb8();
+    let dimmed = image::RgbImage::from_fn(640, 480, |x, y| {
+        image::Rgb(
+            dimmed
+                .get_pixel(x, y)
+                .0
+                .map(|v| (f64::from(v) * 0.9).round() as u8),
+        )
+    });
+    dimmed.save(d.path().join("dim").join(&names[2])).unwrap();
+    let mut with_dimmed = names.clone();
+    with_dimmed[2] = format!("dim/{}", names[2]);
+    let o = run(d.path(), &args(&with_dimmed, "phd"), &[]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let md: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.path().join("phd/photometric.json")).unwrap())
+            .unwrap();
+    let gain = |m: &serde_json::Value, k: usize| m["captures"][k]["gain"].as_f64().unwrap();
+    let ratio = gain(&md, 2) / gain(&m, 2);
+    eprintln!("gain ratio {ratio:.5}");
+    assert!(
+        (ratio - 0.9).abs() < 0.005,
+        "gain ratio {ratio}, chosen 0.9"
+    );
+    for k in [0, 1, 3, 4] {
+        assert!(
+            (gain(&md, k) / gain(&m, k) - 1.0).abs() < 0.005,
+            "capture {k}"
+        );
+    }
     assert_eq!(m["model"]["coefficients_rgb"].as_array().unwrap().len(), 3);
 
     // Issue 95, data loss: captures inside the folder a fit replaces (here its own re-rendered
