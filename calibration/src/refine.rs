@@ -115,6 +115,11 @@ pub struct Refinement {
     pub rms_before_px: f64,
     pub rms_after_px: f64,
     pub iterations: usize,
+    /// Standard deviations of the refined pose from the same covariance (the intrinsics'
+    /// uncertainty included): the rotation about the camera's x, y and z axes (the left
+    /// increment of T_cam_sensor), degrees, and the translation along them, mm; `None` when the
+    /// covariance is singular.
+    pub pose_std: Option<([f64; 3], [f64; 3])>,
 }
 
 /// The intrinsic parameter vector of a camera: fx, fy, cx, cy, distortion coefficients.
@@ -472,6 +477,14 @@ pub fn refine_intrinsics(
             }
         })
         .collect();
+    let m = free.len();
+    let pose_std = cov.as_ref().map(|c| {
+        let sd = |k: usize| c[(k, k)].max(0.0).sqrt();
+        (
+            std::array::from_fn(|i| sd(m + i).to_degrees()),
+            std::array::from_fn(|i| sd(m + 3 + i)),
+        )
+    });
     let camera =
         CameraModel::new(with_vector(&base, &s.intr)).map_err(|_| RefineError::Unprojectable)?;
     Ok(Refinement {
@@ -485,6 +498,7 @@ pub fn refine_intrinsics(
         rms_before_px,
         rms_after_px: rms(&e),
         iterations,
+        pose_std,
     })
 }
 
