@@ -222,6 +222,46 @@ fn calibrate_by_file_names(s: &Scene, reference: &str, names: &[String]) -> std:
 }
 
 impl Scene {
+    /// How far from the true pose the camera's noise may move a pose solved from these
+    /// observations ((capture, id) -> px, a pin seen in several captures averaged) when each
+    /// centre is off by `sigma_px` RMS: 6 standard deviations of the Cramer-Rao bound at the
+    /// true pose (pnp::pose_uncertainty, Hartley & Zisserman Ch. 5), rotation (deg) and
+    /// translation (mm), the root of the traces of their blocks. An error past it is not noise.
+    fn noise_allowance(
+        &self,
+        centres: &BTreeMap<(String, String), [f64; 2]>,
+        sigma_px: f64,
+    ) -> (f64, f64) {
+        let mut by_id: BTreeMap<&String, (Vector2<f64>, f64)> = BTreeMap::new();
+        for ((_, id), c) in centres {
+            let e = by_id.entry(id).or_insert((Vector2::zeros(), 0.0));
+            e.0 += Vector2::new(c[0], c[1]);
+            e.1 += 1.0;
+        }
+        let (pts, px): (Vec<Vector3<f64>>, Vec<Vector2<f64>>) = by_id
+            .iter()
+            .map(|(id, (sum, n))| (self.tips[*id], sum / *n))
+            .unzip();
+        let u = fabkit_calibration::pnp::pose_uncertainty(
+            &self.camera,
+            &pts,
+            &px,
+            &vec![true; pts.len()],
+            &truth(),
+        )
+        .unwrap();
+        let block = |k: usize| {
+            (0..3)
+                .map(|i| u.covariance_per_px2[k + i][k + i])
+                .sum::<f64>()
+                .sqrt()
+        };
+        (
+            6.0 * sigma_px * block(0).to_degrees(),
+            6.0 * sigma_px * block(3),
+        )
+    }
+
     /// The pose solved from the imprints' true centroids ((capture, id) -> px; a pin seen in
     /// several captures averaged, as the command does).
     fn pose_from_true_centres(
@@ -336,14 +376,18 @@ fn pins_found_in_photos_get_the_plans_ids_and_give_the_pose() {
         "centroid error {rms:.4} px RMS, worst {worst:.4} px"
     );
 
-    // The pose as good as the pose from the true centroids (the pole pin's averaged over its
-    // captures, as the command does), both against the true pose.
+    // The pose against the true pose (issue 96: not against another run of the solver). An
+    // imprint's centroid is not the image of the pin's tip: that offset, the same for every
+    // capture, moves the pose from the true centroids by (rot_true, t_true) from the truth;
+    // the detection's noise (the centres' RMS error above) may move it by its Cramer-Rao
+    // allowance more, no further.
     let (rot_true, t_true) = pose_errors(&s.pose_from_true_centres(&true_centres));
+    let (rot_noise, t_noise) = s.noise_allowance(&true_centres, rms);
     let j = json(&s.path("out/extrinsics.json"));
     let (rot, t) = pose_errors(&pose_of(&j));
     assert!(
-        rot <= 1.1 * rot_true && t <= 1.1 * t_true,
-        "from the images: {rot:.4} deg, {t:.4} mm; from the true centroids: {rot_true:.4} deg, {t_true:.4} mm"
+        rot <= rot_true + rot_noise && t <= t_true + t_noise,
+        "from the images: {rot:.4} deg, {t:.4} mm from the truth; the centroids' offset {rot_true:.4} deg, {t_true:.4} mm, the noise's allowance {rot_noise:.4} deg, {t_noise:.4} mm"
     );
     assert_eq!(j["residuals"]["observations"], 29);
     assert_eq!(j["provenance"]["reference_image"], "reference.png");
@@ -552,15 +596,14 @@ fn the_default_command_on_photos_with_every_artifact_of_a_real_capture_uses_ever
         .sum();
     let rms = (sq / true_centres.len() as f64).sqrt();
     assert!(rms < 0.2, "centroid error {rms:.4} px RMS");
-    // the pose against the pose from the true centroids (the pole pin's averaged)
+    // the pose against the true pose: the centroids' own offset from the tips' images, and
+    // the detection noise's Cramer-Rao allowance (issue 96)
     let (rot_true, t_true) = pose_errors(&s.pose_from_true_centres(&true_centres));
+    let (rot_noise, t_noise) = s.noise_allowance(&true_centres, rms);
     let (rot, t) = pose_errors(&pose_of(&j));
-    // (or 0.005 deg and 0.005 mm more, a micron at the pins, when the true centroids' pose
-    // is as close as these)
     assert!(
-        rot <= (1.2 * rot_true).max(rot_true + 0.005)
-            && t <= (1.2 * t_true).max(t_true + 0.005),
-        "from the images: {rot:.4} deg, {t:.4} mm; from the true centroids: {rot_true:.4} deg, {t_true:.4} mm"
+        rot <= rot_true + rot_noise && t <= t_true + t_noise,
+        "from the images: {rot:.4} deg, {t:.4} mm from the truth; the centroids' offset {rot_true:.4} deg, {t_true:.4} mm, the noise's allowance {rot_noise:.4} deg, {t_noise:.4} mm"
     );
 }
 

@@ -230,9 +230,17 @@ fn ids_follow_the_plan_and_the_pose_is_as_good_as_from_true_centres() {
         .map(|o| Vector2::new(truth[&o.id][0], truth[&o.id][1]))
         .collect();
     let ((rd, td), (rt, tt)) = pose_errors(&cam, &pts, &detected, &true_px);
+    let sigma = (detected
+        .iter()
+        .zip(&true_px)
+        .map(|(a, b)| (a - b).norm_squared())
+        .sum::<f64>()
+        / detected.len() as f64)
+        .sqrt();
+    let (rn, tn) = noise_allowance(&cam, &pts, &true_px, sigma);
     assert!(
-        rd <= 1.1 * rt + 1e-3 && td <= 1.1 * tt + 1e-4,
-        "detected: {rd:.4} deg, {td:.4} mm; true centroids: {rt:.4} deg, {tt:.4} mm"
+        rd <= rt + rn && td <= tt + tn,
+        "detected: {rd:.4} deg, {td:.4} mm from the truth; the true centroids' {rt:.4} deg, {tt:.4} mm, the noise's allowance {rn:.4} deg, {tn:.4} mm"
     );
 }
 
@@ -306,13 +314,41 @@ fn pose_errors(
     (err(detected), err(truth))
 }
 
+/// How far the detection's noise (`sigma_px` RMS per centre) may move a pose from `pts` seen
+/// at `px` from the true pose: 6 standard deviations of the Cramer-Rao bound there
+/// (pnp::pose_uncertainty, Hartley & Zisserman Ch. 5), rotation (deg) and translation (mm).
+/// The pose from the detected centres lies within the pose from the true centroids' own
+/// offset from the truth (a centroid is not the image of the tip) plus this (issue 96: the
+/// truth is the reference, not another run of the solver).
+fn noise_allowance(
+    cam: &fabkit_calibration::CameraModel,
+    pts: &[fabkit_calibration::nalgebra::Vector3<f64>],
+    px: &[fabkit_calibration::nalgebra::Vector2<f64>],
+    sigma_px: f64,
+) -> (f64, f64) {
+    let u =
+        fabkit_calibration::pnp::pose_uncertainty(cam, pts, px, &vec![true; pts.len()], &pose())
+            .unwrap();
+    let block = |k: usize| {
+        (0..3)
+            .map(|i| u.covariance_per_px2[k + i][k + i])
+            .sum::<f64>()
+            .sqrt()
+    };
+    (
+        6.0 * sigma_px * block(0).to_degrees(),
+        6.0 * sigma_px * block(3),
+    )
+}
+
 /// Every artifact of a real capture at once (Shading::real_capture: a saturated LED ring that
 /// moves 1.5 px, gain drift, side-lit crescent imprints, three specks and a scratch off the
 /// pins, JPEG at quality 90), and in three of the eight captures one pin that barely marks
 /// the skin (pressed 0.25 mm, its spot a quarter of the others' and a fifth as dark): every
 /// capture is used, every planned pin found with its own id, each speck and scratch
 /// discarded for its shape, the centres within 0.2 px RMS of the true centroids, and the pose
-/// from them within 1.2 x of the pose from the true centroids.
+/// from them within the true centroids' offset from the truth plus the noise's Cramer-Rao
+/// allowance.
 #[test]
 fn on_captures_with_every_artifact_every_capture_is_used_and_every_id_right() {
     use fabkit_calibration::imprints::synthetic::ring_pins_pressed;
@@ -421,9 +457,10 @@ fn on_captures_with_every_artifact_every_capture_is_used_and_every_id_right() {
     let rms = (sq / a.observations.len() as f64).sqrt();
     assert!(rms < 0.2, "centroid error {rms:.3} px RMS");
     let ((rd, td), (rt, tt)) = pose_errors(&cam, &pts, &detected, &true_px);
+    let (rn, tn) = noise_allowance(&cam, &pts, &true_px, rms);
     assert!(
-        rd <= 1.2 * rt + 1e-3 && td <= 1.2 * tt + 1e-3,
-        "detected: {rd:.4} deg, {td:.4} mm; true centroids: {rt:.4} deg, {tt:.4} mm (centroids {rms:.3} px RMS)"
+        rd <= rt + rn && td <= tt + tn,
+        "detected: {rd:.4} deg, {td:.4} mm from the truth; the true centroids' {rt:.4} deg, {tt:.4} mm, the noise's allowance {rn:.4} deg, {tn:.4} mm (centroids {rms:.3} px RMS)"
     );
 }
 
