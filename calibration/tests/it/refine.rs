@@ -27,18 +27,19 @@ fn truth_vector(i: &Intrinsics) -> Vec<f64> {
 }
 
 /// Largest |error / standard deviation| of a refined parameter or the pose's translation:
-/// about 90 are checked (10 seeds, 4 to 8 refined intrinsics and 3 translations each); for all
-/// of them to lie within it but with a probability of 1e-6 (Bonferroni over 110), each must
-/// with 1 - 9e-9: 2 (1 - Phi(5.75)) = 8.9e-9. A bound of 3 was exceeded somewhere about one
-/// run in five.
-const Z_MAX: f64 = 5.75;
+/// about 270 are checked (30 seeds, 4 to 8 refined intrinsics and 3 translations each); for
+/// all of them to lie within it but with a probability of 1e-6 (Bonferroni over 330), each
+/// must with 1 - 3e-9: 2 (1 - Phi(6.0)) = 2.0e-9. A bound of 3 was exceeded somewhere about
+/// one run in five with ten seeds.
+const Z_MAX: f64 = 6.0;
 
 #[test]
 fn refined_intrinsics_recover_the_truth_within_their_standard_deviations() {
     let truth = truth_vector(&benchmark_intrinsics());
     let cam = camera_file();
     let (mut z2, mut nz) = (0.0, 0);
-    for seed in 1..=10 {
+    // three seed sets of ten (issue 96: a bound that holds on one set only is tuned to it)
+    for seed in 1..=30 {
         let t = benchmark_trial(seed, 0.2, 0);
         let sol = solve_pnp(&cam, &t.points(), &t.pixels(), &PnpOptions::default()).unwrap();
         let r = refine_intrinsics(
