@@ -76,18 +76,18 @@ fn rtac0_members_are_in_the_sensor_frame_with_their_volumes() {
     let shell = |ri: f64, ro: f64, below: f64| {
         2.0 / 3.0 * PI * (ro.powi(3) - ri.powi(3)) + PI * (ro * ro - ri * ri) * (6.0 + below)
     };
-    for (name, v) in [
-        ("transparent_gel", shell(10.0, 13.5, 0.0)),
-        ("translucent_gel", shell(13.5, 14.9, 0.0)),
-        ("black_coating", shell(14.9, 15.0, 0.0)),
-        ("core_envelope", shell(9.0, 10.0, 3.0)),
+    for (name, v, ri) in [
+        ("transparent_gel", shell(10.0, 13.5, 0.0), 10.0),
+        ("translucent_gel", shell(13.5, 14.9, 0.0), 13.5),
+        ("black_coating", shell(14.9, 15.0, 0.0), 14.9),
+        ("core_envelope", shell(9.0, 10.0, 3.0), 9.0),
     ] {
-        // the inscribed tessellation at 0.01 mm loses at most about 2 x 0.01 / wall of a shell
-        let wall = match name {
-            "black_coating" => 0.1,
-            _ => 1.0,
-        };
-        rel_close(member(a, name).solid.volume(), v, 2.0 * 0.01 / wall, name);
+        // Both surfaces of a shell are inscribed at the chord tolerance d = 0.01 mm: each loses
+        // about d x its area, so the shell changes by about d (A_outer - A_inner), some
+        // 2 d / r_inner of its volume for the hemisphere and less for the cylinder; allowed
+        // twice that again (the triangles' sagittas spread about d): 4 d / r_inner, 0.27 % for
+        // the coat (issue 96 asked 1 %; measured 0.04 to 0.07 % for the four)
+        rel_close(member(a, name).solid.volume(), v, 4.0 * 0.01 / ri, name);
     }
     // the camera board: 15 mm square, 3 mm of board and components, on the base's spigot
     let board = member(a, "camera_board_envelope").solid.volume();
