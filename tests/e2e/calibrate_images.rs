@@ -222,6 +222,24 @@ fn calibrate_by_file_names(s: &Scene, reference: &str, names: &[String]) -> std:
 }
 
 impl Scene {
+    /// Each pin's tip and its observed centre ((capture, id) -> px), a pin seen in several
+    /// captures averaged, as the command does; by id.
+    fn tips_and_mean_centres(
+        &self,
+        centres: &BTreeMap<(String, String), [f64; 2]>,
+    ) -> (Vec<Vector3<f64>>, Vec<Vector2<f64>>) {
+        let mut by_id: BTreeMap<&String, (Vector2<f64>, f64)> = BTreeMap::new();
+        for ((_, id), c) in centres {
+            let e = by_id.entry(id).or_insert((Vector2::zeros(), 0.0));
+            e.0 += Vector2::new(c[0], c[1]);
+            e.1 += 1.0;
+        }
+        by_id
+            .iter()
+            .map(|(id, (sum, n))| (self.tips[*id], sum / *n))
+            .unzip()
+    }
+
     /// How far from the true pose the camera's noise may move a pose solved from these
     /// observations ((capture, id) -> px, a pin seen in several captures averaged) when each
     /// centre is off by `sigma_px` RMS: 6 standard deviations of the Cramer-Rao bound at the
@@ -232,16 +250,7 @@ impl Scene {
         centres: &BTreeMap<(String, String), [f64; 2]>,
         sigma_px: f64,
     ) -> (f64, f64) {
-        let mut by_id: BTreeMap<&String, (Vector2<f64>, f64)> = BTreeMap::new();
-        for ((_, id), c) in centres {
-            let e = by_id.entry(id).or_insert((Vector2::zeros(), 0.0));
-            e.0 += Vector2::new(c[0], c[1]);
-            e.1 += 1.0;
-        }
-        let (pts, px): (Vec<Vector3<f64>>, Vec<Vector2<f64>>) = by_id
-            .iter()
-            .map(|(id, (sum, n))| (self.tips[*id], sum / *n))
-            .unzip();
+        let (pts, px) = self.tips_and_mean_centres(centres);
         let u = fabkit_calibration::pnp::pose_uncertainty(
             &self.camera,
             &pts,
@@ -250,16 +259,8 @@ impl Scene {
             &truth(),
         )
         .unwrap();
-        let block = |k: usize| {
-            (0..3)
-                .map(|i| u.covariance_per_px2[k + i][k + i])
-                .sum::<f64>()
-                .sqrt()
-        };
-        (
-            6.0 * sigma_px * block(0).to_degrees(),
-            6.0 * sigma_px * block(3),
-        )
+        let (rot_deg, t_mm) = u.rms_errors(sigma_px);
+        (6.0 * rot_deg, 6.0 * t_mm)
     }
 
     /// The pose solved from the imprints' true centroids ((capture, id) -> px; a pin seen in
@@ -268,16 +269,7 @@ impl Scene {
         &self,
         true_centres: &BTreeMap<(String, String), [f64; 2]>,
     ) -> Isometry3<f64> {
-        let mut by_id: BTreeMap<&String, (Vector2<f64>, f64)> = BTreeMap::new();
-        for ((_, id), c) in true_centres {
-            let e = by_id.entry(id).or_insert((Vector2::zeros(), 0.0));
-            e.0 += Vector2::new(c[0], c[1]);
-            e.1 += 1.0;
-        }
-        let (pts, px): (Vec<Vector3<f64>>, Vec<Vector2<f64>>) = by_id
-            .iter()
-            .map(|(id, (sum, n))| (self.tips[*id], sum / *n))
-            .unzip();
+        let (pts, px) = self.tips_and_mean_centres(true_centres);
         solve_pnp(&self.camera, &pts, &px, &PnpOptions::default())
             .unwrap()
             .t_cam_sensor

@@ -690,36 +690,38 @@ fn a_capture_that_shows_no_imprint_is_refused_by_file() {
         let mut images = names.clone();
         image.save(d.path().join(&images[2])).unwrap();
         images.truncate(3);
-        let o = run(d.path(), &args(&images, "ph"), &[]);
-        let e = text(&o.stderr);
-        assert_eq!(o.status.code(), Some(2), "{message}: {e}");
-        assert!(
-            e.contains(&format!("--images = {}: {message}", images[2])),
-            "{message}: {e}"
-        );
-        assert!(!d.path().join("ph").exists());
+        let says = format!("--images = {}: {message}", images[2]);
+        refused(d.path(), &args(&images, "ph"), &says, "ph");
     }
     // every capture a copy of the reference: no fit from no imprint
-    let mut images = Vec::new();
     for n in &names[..2] {
         reference.save(d.path().join(n)).unwrap();
-        images.push(n.clone());
     }
-    let o = run(d.path(), &args(&images, "ph"), &[]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(text(&o.stderr).contains("no imprint at its pins"));
-    assert!(!d.path().join("ph").exists());
+    refused(
+        d.path(),
+        &args(&names[..2], "ph"),
+        "no imprint at its pins",
+        "ph",
+    );
     // a black reference
     let names = captures(d.path());
     flat(0).save(d.path().join("ref.png")).unwrap();
-    let o = run(d.path(), &args(&names, "ph"), &[]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(
-        text(&o.stderr).contains("--reference = ref.png: dark"),
-        "{}",
-        text(&o.stderr)
+    refused(
+        d.path(),
+        &args(&names, "ph"),
+        "--reference = ref.png: dark",
+        "ph",
     );
-    assert!(!d.path().join("ph").exists());
+}
+
+/// `fabkit ARGV` in `dir` exits 2 saying `says`, and `out` is not there.
+#[track_caller]
+fn refused(dir: &Path, argv: &[&str], says: &str, out: &str) {
+    let o = run(dir, argv, &[]);
+    let e = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{says}: {e}");
+    assert!(e.contains(says), "{says}: {e}");
+    assert!(!dir.join(out).exists(), "{says}: {out} written");
 }
 
 /// Issue 95: R-Tac0's pin dome with a design of the same name whose skin is R15.3 (not 15.0)

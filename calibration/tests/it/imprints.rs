@@ -329,16 +329,8 @@ fn noise_allowance(
     let u =
         fabkit_calibration::pnp::pose_uncertainty(cam, pts, px, &vec![true; pts.len()], &pose())
             .unwrap();
-    let block = |k: usize| {
-        (0..3)
-            .map(|i| u.covariance_per_px2[k + i][k + i])
-            .sum::<f64>()
-            .sqrt()
-    };
-    (
-        6.0 * sigma_px * block(0).to_degrees(),
-        6.0 * sigma_px * block(3),
-    )
+    let (rot_deg, t_mm) = u.rms_errors(sigma_px);
+    (6.0 * rot_deg, 6.0 * t_mm)
 }
 
 /// Every artifact of a real capture at once (Shading::real_capture: a saturated LED ring that
