@@ -283,7 +283,8 @@ fn pins_found_in_photos_get_the_plans_ids_and_give_the_pose() {
     let mut names = Vec::new();
     let mut true_centres: BTreeMap<(String, String), [f64; 2]> = BTreeMap::new();
     for (k, ids) in s.plan.iter().enumerate() {
-        let (reference, capture, centres) = s.render(ids, 100 + k as u64);
+        let seed = 1000 * crate::common::seed_set() + 100 + k as u64;
+        let (reference, capture, centres) = s.render(ids, seed);
         if k == 0 {
             save(&reference, &s.path("reference.png"), Kind::Gray16);
         }

@@ -41,7 +41,8 @@ fn detect_each(turns: &[f64], shading: &Shading, seed: u64) -> (f64, Vec<(Render
     let mut renders = Vec::new();
     for (k, &turn) in turns.iter().enumerate() {
         let pins = capture_pins(turn, 1.0);
-        let r = render(&cam, &pose(), &surface, &pins, shading, seed + k as u64);
+        let seed = 1000 * crate::common::seed_set() + seed + k as u64;
+        let r = render(&cam, &pose(), &surface, &pins, shading, seed);
         let mask = reference_mask(&r.reference, 255.0, 4);
         let spots = detect(
             &r.reference,
@@ -149,7 +150,7 @@ fn ids_follow_the_plan_and_the_pose_is_as_good_as_from_true_centres() {
             &surface,
             &pins,
             &Shading::default(),
-            10 + k as u64,
+            1000 * crate::common::seed_set() + 10 + k as u64,
         );
         {
             for (id, c) in ids.iter().zip(&r.centres_px) {

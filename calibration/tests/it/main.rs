@@ -2,6 +2,7 @@
 
 mod camera_files;
 mod camera_models;
+mod common;
 mod extrinsics_synthetic;
 mod groundtruth_closed_form;
 mod groundtruth_undistort;

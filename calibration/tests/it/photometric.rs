@@ -125,7 +125,8 @@ fn captures(lights: Vec<Light>, pressed: fn(f64) -> (Vec<Pin>, Vec<Primitive>)) 
         ..crate::shading::optics_with(lights)
     };
     let imaging = Imaging::new(optics, [319.5, 239.5], &rays, &reference);
-    let reference_image = counts(imaging.image(&rays, &reference, None, 0));
+    let reference_image =
+        counts(imaging.image(&rays, &reference, None, 1000 * crate::common::seed_set()));
     let turns = [0.0, 40.0, 80.0, 120.0, 160.0];
     let rings = ShadowRings::of(&rays, &reference);
     let scenes = turns
@@ -135,7 +136,8 @@ fn captures(lights: Vec<Light>, pressed: fn(f64) -> (Vec<Pin>, Vec<Primitive>)) 
             let (pins, solids) = pressed(turn);
             let prims = ExactPrimitives::new(&solids).unwrap();
             let hits = indented_hits(&rays, &reference, &prims, surface.base_z_mm());
-            let image = counts(imaging.image(&rays, &hits, Some(&prims), k as u64 + 1));
+            let seed = 1000 * crate::common::seed_set() + k as u64 + 1;
+            let image = counts(imaging.image(&rays, &hits, Some(&prims), seed));
             let shadows = shadow_map(&rays, &hits, &prims, &rings);
             (pins, hits, image, shadows)
         })

@@ -70,7 +70,8 @@ fn runner(cases: u32) -> TestRunner {
         max_global_rejects: 10 * cases,
         ..Config::default()
     };
-    TestRunner::new_with_rng(config, TestRng::from_seed(RngAlgorithm::ChaCha, &[11; 32]))
+    let seed = [11 + crate::common::seed_set() as u8; 32];
+    TestRunner::new_with_rng(config, TestRng::from_seed(RngAlgorithm::ChaCha, &seed))
 }
 
 fn materials() -> MaterialsTable {
