@@ -20,7 +20,10 @@
 //!
 //! `step_files_are_byte_identical_to_the_committed_hashes` does the same with `--format step`
 //! for the STEP files, against `tests/e2e/output_hashes_step.txt` (CadQuery's OCCT writes the
-//! same bytes every run: no time stamp in the header, single-threaded booleans):
+//! same bytes every run for most files: no time stamp in the header, single-threaded booleans;
+//! not for a compound of many holes or tips, the pin dome's and the TacTip's skin tips'). It
+//! takes 15 minutes, so it is ignored; the suite checks the default design's STEP files
+//! (`the_default_designs_step_files_are_byte_identical_to_the_committed_hashes`):
 //!
 //! ```sh
 //! cargo test --profile quick -p fabkit --test e2e -- --ignored step_files_are_byte_identical
@@ -186,6 +189,44 @@ fn outputs_are_byte_identical_to_the_committed_hashes() {
         return;
     }
     assert_listed(&library_outputs(&[], |_| true), LIST);
+}
+
+/// In the suite (so in CI, where `FABKIT_CADQUERY_PYTHON` is set): the STEP files of the
+/// default design's export against their lines of the committed STEP list. The whole list
+/// takes 15 minutes and is run by hand; R-Tac0's export takes about 10 s, and OCCT writes its
+/// files the same every run (four runs measured). The pin dome's `pin_dome.step` (fixtures) is
+/// not held to it: OCCT writes its compound of many holes differently from run to run (one run
+/// in three measured), as it does the TacTip's `skin_tips`.
+#[test]
+fn the_default_designs_step_files_are_byte_identical_to_the_committed_hashes() {
+    if crate::common::cadquery_python().is_none() {
+        eprintln!("SKIPPED: STEP hashes (set FABKIT_CADQUERY_PYTHON; .ci/run does)");
+        return;
+    }
+    if !on_listed_platform(STEP_LIST) {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let out = "export/rtac0";
+    fabkit_on_path(
+        dir.path(),
+        &["export", "rtac0", "--format", "step", "--out", out],
+    );
+    let mut hashes = BTreeMap::new();
+    hash_tree(dir.path(), &dir.path().join(out), &mut hashes);
+    hashes.retain(|f, _| f.ends_with(".step"));
+    let committed = std::fs::read_to_string(repo_root().join(STEP_LIST)).unwrap();
+    let listed: BTreeMap<String, String> = committed
+        .lines()
+        .filter_map(|l| l.split_once("  "))
+        .filter(|(_, f)| f.starts_with(&format!("{out}/")))
+        .map(|(h, f)| (f.to_string(), h.to_string()))
+        .collect();
+    assert!(listed.len() >= 10, "{} files of {out} listed", listed.len());
+    assert_eq!(
+        hashes, listed,
+        "the STEP files of {out} differ from {STEP_LIST} (bless the list with the ignored full test)"
+    );
 }
 
 /// This build's platform, as the lists record it: `<arch>-<os>` (`x86_64-linux`).
