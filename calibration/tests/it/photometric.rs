@@ -443,7 +443,9 @@ fn pins_are_read_from_a_fixtures_folder() {
 /// re-renders from the others within about 4.7 grey levels with the balls (9.2 without the
 /// point lights) and 6.4 with R-Tac0's pins, whose hard single-LED shadows the candidates
 /// place only roughly. Bounds with a little room, so that a change that loses this ground
-/// shows.
+/// shows: measured 4.665 to 4.669 and 6.419 to 6.424 on seed sets 0, 1 and 2 (the camera noise
+/// moves them by 0.1 %: what remains is the model's error, not noise), so 5 and 7 (7 % and 9 %
+/// above) are a regression guard, not a statistical bound.
 #[test]
 fn side_leds_at_three_azimuths_re_render_within_5_and_7_grey_levels() {
     let lights = ring_of_lights(3, 12.0, 2.0, 90.0, None, |k| {
