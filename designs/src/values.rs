@@ -445,8 +445,18 @@ pub fn with_number<T: Serialize + serde::de::DeserializeOwned>(
     path: &NumberPath,
     x: f64,
 ) -> Result<T, String> {
+    with_value(value, path, Value::F64(x))
+}
+
+/// `value` with the serialized value at `path` replaced by `x`, read back through the type's
+/// own deserializer ([`with_number`], [`with_integer`]).
+fn with_value<T: Serialize + serde::de::DeserializeOwned>(
+    value: &T,
+    path: &NumberPath,
+    x: Value,
+) -> Result<T, String> {
     let mut v = serde_value::to_value(value).map_err(|e| e.to_string())?;
-    *at_path_mut(&mut v, &path.0).ok_or_else(|| format!("no number at {path}"))? = Value::F64(x);
+    *at_path_mut(&mut v, &path.0).ok_or_else(|| format!("no value at {path}"))? = x;
     T::deserialize(v).map_err(|e| e.to_string())
 }
 
@@ -461,9 +471,7 @@ pub fn with_integer<T: Serialize + serde::de::DeserializeOwned>(
     path: &NumberPath,
     n: u64,
 ) -> Result<T, String> {
-    let mut v = serde_value::to_value(value).map_err(|e| e.to_string())?;
-    *at_path_mut(&mut v, &path.0).ok_or_else(|| format!("no integer at {path}"))? = Value::U64(n);
-    T::deserialize(v).map_err(|e| e.to_string())
+    with_value(value, path, Value::U64(n))
 }
 
 impl NumberPath {

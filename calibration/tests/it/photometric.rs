@@ -304,15 +304,7 @@ fn leave_one_out_holds_with_gain_drift_moving_led_highlights_and_specks() {
     // the gains the test chose, recovered by the fit on all five (issue 96): a median ratio of
     // counts rounded to integers near 100 to 200 is quantised by up to 0.5 / 100; measured
     // within 0.0007 on seed sets 0 to 2
-    let all: Vec<Capture> = c
-        .scenes
-        .iter()
-        .map(|s| Capture {
-            image: &s.2,
-            hits: &s.1,
-            shadows: &s.3,
-        })
-        .collect();
+    let all = all_captures(&c);
     let model =
         PhotometricModel::fit(&c.rays, &c.reference, &c.reference_image, &all, 255.0).unwrap();
     for (k, g) in gains.iter().enumerate() {
@@ -482,18 +474,22 @@ fn side_leds_at_three_azimuths_re_render_within_5_and_7_grey_levels() {
     assert!(rms < 7.0, "R-Tac0's pins: {rms} grey levels RMS");
 }
 
-/// R-Tac0's captures under a warm LED ring and the model fitted to them.
-fn warm_ring_model() -> (Captures, PhotometricModel) {
-    let c = captures(warm_ring(), rtac0_pins);
-    let all: Vec<Capture> = c
-        .scenes
+/// Every capture of `c`, to fit.
+fn all_captures(c: &Captures) -> Vec<Capture<'_>> {
+    c.scenes
         .iter()
         .map(|s| Capture {
             image: &s.2,
             hits: &s.1,
             shadows: &s.3,
         })
-        .collect();
+        .collect()
+}
+
+/// R-Tac0's captures under a warm LED ring and the model fitted to them.
+fn warm_ring_model() -> (Captures, PhotometricModel) {
+    let c = captures(warm_ring(), rtac0_pins);
+    let all = all_captures(&c);
     let m = PhotometricModel::fit(&c.rays, &c.reference, &c.reference_image, &all, 255.0).unwrap();
     (c, m)
 }
