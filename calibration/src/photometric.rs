@@ -916,12 +916,13 @@ impl PhotometricModel {
     }
 
     /// The model `fabkit calibrate photometric` wrote to `dir` (photometric.json and the
-    /// (H, W, 3) float32 appearance.npy) and the sha256 of its photometric.json.
+    /// (H, W, 3) float32 appearance.npy), the sha256 of its photometric.json, and the inputs
+    /// it records it was fitted with ([`FittedWith`]).
     ///
     /// # Errors
     /// A message naming the file and what does not fit: unreadable, not JSON, an appearance
     /// that is not (H, W, 3) float32, or what [`Self::from_json`] refuses.
-    pub fn read(dir: &std::path::Path) -> Result<(PhotometricModel, String), String> {
+    pub fn read(dir: &std::path::Path) -> Result<(PhotometricModel, String, FittedWith), String> {
         use crate::groundtruth::inputs::read_with_hash;
         let jpath = dir.join("photometric.json");
         let (bytes, sha) = read_with_hash(&jpath).map_err(|e| e.to_string())?;
@@ -944,7 +945,8 @@ impl PhotometricModel {
             .collect();
         let model = PhotometricModel::from_json(&v["model"], appearance, w, h)
             .map_err(|e| format!("{}: {e}", jpath.display()))?;
-        Ok((model, sha))
+        let fitted = FittedWith::of_record(&v, jpath.display().to_string());
+        Ok((model, sha, fitted))
     }
 
     /// The model from its section of photometric.json ([`Self::model_json`]) and its
@@ -1247,16 +1249,9 @@ pub struct FittedWith {
 }
 
 impl FittedWith {
-    /// The inputs recorded in `dir`/photometric.json (none for a record without them).
-    ///
-    /// # Errors
-    /// The file unreadable or not JSON, naming it.
-    pub fn read(dir: &std::path::Path) -> Result<FittedWith, String> {
-        let path = dir.join("photometric.json");
-        let file = path.display().to_string();
-        let bytes = std::fs::read(&path).map_err(|e| format!("{file}: {e}"))?;
-        let v: serde_json::Value =
-            serde_json::from_slice(&bytes).map_err(|e| format!("{file}: not JSON: {e}"))?;
+    /// The inputs recorded in photometric.json's record `v` (none for a record without
+    /// them), `file` naming it in messages.
+    pub fn of_record(v: &serde_json::Value, file: String) -> FittedWith {
         let inputs = ["design", "camera", "extrinsics"]
             .iter()
             .filter_map(|&key| {
@@ -1268,7 +1263,7 @@ impl FittedWith {
                 Some((key.to_string(), name.to_string(), sha.to_string()))
             })
             .collect();
-        Ok(FittedWith { inputs, file })
+        FittedWith { inputs, file }
     }
 
     /// Refuses `input` (`design`, `camera` or `extrinsics`) with sha256 `sha`, named `ours`

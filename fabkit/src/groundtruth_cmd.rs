@@ -144,11 +144,10 @@ fn load_photometric(
     h: usize,
     fitted_for: [(&str, &str, &Path); 3],
 ) -> Result<(PhotometricModel, String), Box<dyn Error>> {
-    let (model, sha) = PhotometricModel::read(dir).map_err(|e| format!("--photometric {e}"))?;
+    let (model, sha, fitted) =
+        PhotometricModel::read(dir).map_err(|e| format!("--photometric {e}"))?;
     // A model is of one sensor, camera and pose: those it was fitted with, by their files'
     // sha256 as photometric.json records them.
-    let fitted = fabkit_calibration::photometric::FittedWith::read(dir)
-        .map_err(|e| format!("--photometric {e}"))?;
     for (key, sha, file) in fitted_for {
         fitted
             .check(key, sha, &file.display().to_string())

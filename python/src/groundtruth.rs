@@ -165,9 +165,7 @@ impl PhotometricModel {
 #[pyfunction]
 pub fn read_photometric(py: Python<'_>, dir: std::path::PathBuf) -> PyResult<PhotometricModel> {
     let (model, sha256, fitted_with) = crate::work(py, || {
-        let (m, sha) = fabkit_calibration::photometric::PhotometricModel::read(&dir)?;
-        let fitted = fabkit_calibration::photometric::FittedWith::read(&dir)?;
-        Ok::<_, String>((m, sha, fitted))
+        fabkit_calibration::photometric::PhotometricModel::read(&dir)
     })?
     .map_err(GroundTruthError::new_err)?;
     Ok(PhotometricModel {
