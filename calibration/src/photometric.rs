@@ -215,8 +215,9 @@ impl ShadowRings {
         (e1, cross(a, e1))
     }
 
-    /// The sampled lights of ring `m` (height major, radius minor), sensor frame, mm.
-    fn lights(&self, m: usize) -> [[f64; 3]; SHADOW_AZIMUTHS] {
+    /// The sampled lights of ring `m` (height major, radius minor), sensor frame, mm: a ring
+    /// at [`SHADOW_HEIGHTS`]`[m / 3]` and [`SHADOW_RADII`]`[m % 3]` times `scale_mm`.
+    pub fn lights(&self, m: usize) -> [[f64; 3]; SHADOW_AZIMUTHS] {
         let a = self.axis;
         let (e1, e2) = self.frame();
         let h = SHADOW_HEIGHTS[m / SHADOW_RADII.len()] * self.scale_mm;
