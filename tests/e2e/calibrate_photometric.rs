@@ -125,6 +125,8 @@ fn groundtruth_renders_one_frame_per_pin_capture_with_the_pins_at_their_tips() {
             let px = uv.y.round() as usize * 640 + uv.x.round() as usize;
             let want = (Point3::new(tip[0], tip[1], tip[2]) - centre).norm();
             let tol = if id == pole { 0.005 } else { 0.05 };
+            // measured up to 0.00024 mm at the pole and 0.023 mm elsewhere (the nearest pixel
+            // centre is up to 0.7 px from the tip, on a slope away from the pole)
             assert!(
                 (f64::from(range[px]) - want).abs() < tol,
                 "capture {}, pin {id}: range {} mm at ({:.1}, {:.1}) px, tip at {want:.4} mm",

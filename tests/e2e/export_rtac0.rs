@@ -632,6 +632,9 @@ fn timings_account_for_the_whole_command_and_change_no_file() {
         staged <= whole * 1.001 + 1e-3,
         "stages {staged} s > whole {whole} s:\n{err}"
     );
+    // a ratio of one run's own times, not a limit on them: a slow or loaded machine stretches
+    // the stages and the whole alike (measured 0.987 of the wall time, 0.995 of the CPU time;
+    // what the stages leave out is the process's start and the table's printing)
     assert!(
         staged >= 0.7 * whole,
         "stages {staged} s cover too little of {whole} s:\n{err}"

@@ -106,6 +106,7 @@ fn groundtruth_of_a_flat_skin_sees_the_face_and_each_protrusion_at_its_depth() {
         }
     }
     assert!((zref[240 * w + 320] as f64 - face).abs() < 1e-4);
+    // measured 134,476 valid, 115,788 on the face
     assert!(
         valid > 100_000 && on_face * 2 > valid,
         "{on_face} of {valid} pixels on the face"
@@ -154,6 +155,7 @@ fn groundtruth_of_a_flat_skin_sees_the_face_and_each_protrusion_at_its_depth() {
                 }
             }
         }
+        // measured 251 to 578
         assert!(pushed > 20, "{name}: {pushed} pixels pushed");
         assert!(
             most <= deepest + 1e-4 && most > deepest - 0.2,

@@ -116,10 +116,12 @@ fn fabrication_html_renders_its_pictures_in_chromium() {
         let coloured = coloured_pixels(&shot);
         if has_section {
             // the section view alone is tens of thousands of coloured pixels
+            // measured 639,251
             assert!(coloured > 20_000, "{out}: {coloured} coloured pixels");
         }
         let img = image::open(&shot).unwrap().into_rgb8();
         let non_white = img.pixels().filter(|p| p.0 != [255, 255, 255]).count();
+        // measured 2.0 and 4.2 million
         assert!(non_white > 50_000, "{out}: {non_white} non-white pixels");
     }
 }

@@ -146,6 +146,7 @@ fn the_tutorial_runs_as_written() {
     for (i, v) in m.iter().enumerate() {
         let want = t[(i / 4, i % 4)];
         let bound = if i % 4 == 3 { 0.05 } else { 0.002 };
+        // measured up to 0.0031 mm and 0.00033
         assert!(
             (v - want).abs() < bound,
             "T_cam_sensor[{}][{}] = {v}, want {want}",

@@ -102,6 +102,8 @@ fn pinhole_render_plus_undistort_differs_from_the_exact_render_on_the_rtac0_came
         e50 * 1e3,
         emax * 1e3
     );
+    // measured: 42 % lost, 0.26 mm at the edges, 1.9e-4 mm on smooth skin (each bound a
+    // floor that shows the effect exists, a quarter to half of the measured value)
     assert!(
         lost_pct > 10.0,
         "a 160 deg fisheye holds rays a same-size pinhole image cannot"

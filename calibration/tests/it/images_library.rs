@@ -30,6 +30,7 @@ fn every_library_design_renders_a_reference_and_an_indented_image() {
         let scene = Scene::new(&design, &cam, &pose, "pose").unwrap_or_else(|e| panic!("{e}"));
         let reference = reference_hits(&scene.rays, &scene.surface);
         let seen = reference.valid_count();
+        // measured 80,692 to 242,988 pixels over the library's designs
         assert!(seen > 20_000, "{name}: {seen} pixels see the skin");
         // the tip pressed 1 mm in along the skin's normal, 60 % of the way from the image
         // centre to the rim along the middle row (off the pole, where side lights graze)
@@ -57,6 +58,7 @@ fn every_library_design_renders_a_reference_and_an_indented_image() {
         let lit_pressed = (0..b.len())
             .filter(|&i| reference.t_mm[i].is_finite() && b[i].iter().any(|&c| c > 3))
             .count();
+        // measured 0.65 to 1 of the seen pixels
         assert!(
             lit as f64 > 0.5 * seen as f64 && lit_pressed as f64 > 0.5 * seen as f64,
             "{name}: {lit} and {lit_pressed} of {seen} skin pixels lit"

@@ -53,6 +53,7 @@ fn detect_each(turns: &[f64], shading: &Shading, seed: u64) -> (f64, Vec<(Render
         .unwrap();
         let truth: Vec<[f64; 2]> = r.centres_px.iter().map(|c| c.unwrap()).collect();
         // a pressed ball tip's imprint is round, even foreshortened at the outer ring
+        // measured 0.83 to 0.91 on seed sets 0 to 2
         assert!(
             spots.iter().all(|s| s.roundness > 0.75),
             "capture {k}: {spots:?}"
@@ -99,7 +100,8 @@ fn imprints_are_found_alone_and_centred_within_a_tenth_of_a_pixel() {
 /// Ids and pose from the detections: six captures of one pin per ring (ids 1 for the pole pin,
 /// then 10 k + ring), their ids given in any order: every spot gets its pin's id; the pose
 /// solved from the detected centres is as good as the one solved from the true centroids
-/// (within 1.1 x, both against the true pose, the pins' tips as the points); a capture with a
+/// (both against the true pose, the pins' tips as the points: within the true centroids' error
+/// plus 6 sd of the Cramer-Rao spread at the detections' measured noise); a capture with a
 /// pin missing and one with an extra press the plan does not list are kept: the missing pin
 /// and the extra spot are reported by id and pixel, the other pins get their ids.
 #[test]
@@ -197,6 +199,7 @@ fn ids_follow_the_plan_and_the_pose_is_as_good_as_from_true_centres() {
     assert_eq!(extra.discarded.len(), 1, "{extra:?}");
     let (spot, why) = &extra.discarded[0];
     let t = r_extra_centre(&cam, &surface, depth);
+    // measured 0.005 to 0.04 px on seed sets 0 to 2
     assert!(
         (spot.u_px - t[0]).hypot(spot.v_px - t[1]) < 0.5,
         "the discarded spot is the extra press: {spot:?} vs {t:?}"
@@ -212,6 +215,7 @@ fn ids_follow_the_plan_and_the_pose_is_as_good_as_from_true_centres() {
         // the pole pin is pressed in every capture: its true centre is the same
         let t = truth[&o.id];
         let e = (o.u_px - t[0]).hypot(o.v_px - t[1]);
+        // measured up to 0.062 px on seed sets 0 to 2
         assert!(
             e < 0.5,
             "{} pin {}: {e} px from its own imprint",
@@ -422,6 +426,7 @@ fn on_captures_with_every_artifact_every_capture_is_used_and_every_id_right() {
                 .filter(|((c, _), _)| *c == o.name)
                 .map(|(_, t)| (s.u_px - t[0]).hypot(s.v_px - t[1]))
                 .fold(f64::INFINITY, f64::min);
+            // measured 32 px or more on seed sets 0 to 2
             assert!(
                 nearest > 10.0,
                 "{}: ({:.1}, {:.1}) is a pin's: {why}",
@@ -432,12 +437,14 @@ fn on_captures_with_every_artifact_every_capture_is_used_and_every_id_right() {
             by_shape += usize::from(why.contains("a speck") || why.contains("a scratch"));
         }
     }
+    // measured 27 on seed sets 0 to 2
     assert!(by_shape >= 16, "{by_shape} spots discarded for their shape");
     let (mut sq, mut pts, mut detected, mut true_px) = (0.0, vec![], vec![], vec![]);
     for o in &a.observations {
         let t = truth[&(o.capture.clone(), o.id)];
         // its own imprint: nearer than any other pin's of the capture
         let e = (o.u_px - t[0]).hypot(o.v_px - t[1]);
+        // measured up to 0.096 px on seed sets 0 to 2
         assert!(
             e < 1.0,
             "{} pin {}: {e:.2} px from its imprint",

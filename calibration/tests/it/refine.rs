@@ -50,8 +50,12 @@ fn refined_intrinsics_recover_the_truth_within_their_standard_deviations() {
             &RefineParameters::Constrained,
         )
         .unwrap();
+        // the residual RMS is the noise's: 30 x RMS^2 / sigma^2 is chi-square with 60 - p
+        // degrees of freedom (p = 6 pose + 4 to 8 intrinsics), below 125 (Wilson-Hilferty, 50
+        // dof) but with a probability of 3e-8 per seed, 1e-6 over the 30: RMS under
+        // sqrt(125 x 0.2^2 / 30) = 0.41 px. Measured 0.20 to 0.30 px.
         assert!(
-            r.rms_after_px < r.rms_before_px && r.rms_after_px < 0.3,
+            r.rms_after_px < r.rms_before_px && r.rms_after_px < 0.41,
             "seed {seed}: rms {} -> {} px",
             r.rms_before_px,
             r.rms_after_px
@@ -103,6 +107,7 @@ fn refined_intrinsics_recover_the_truth_within_their_standard_deviations() {
     }
     // the standard deviations are the spread of the errors (not 10 x too small or too large)
     let z_rms = (z2 / nz as f64).sqrt();
+    // measured 0.986 over about 270; an RMS of n unit normals varies by 1 / sqrt(2n) = 4 %
     assert!(
         (0.4..1.7).contains(&z_rms),
         "errors over standard deviations: RMS {z_rms:.2} over {nz}"
