@@ -108,6 +108,7 @@ def test_masks_partition_the_surface_pixels(gt, folders):
     assert int(right.sum()) == m["masks_and_pairs"][1]["pixels"]
     ref = _npy(folders["npy"], "reference", "range_mm")
     assert np.array_equal(left | right, np.isfinite(ref))
+    # measured 6,852 and 6,740
     assert left.sum() > 1000 and right.sum() > 1000
 
 
