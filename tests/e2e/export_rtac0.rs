@@ -360,6 +360,7 @@ fn outer_mold_cavity_is_r15_as_in_the_authors_cad() {
         ("transparent_gel_master_pattern", 13.5),
     ] {
         let r = radii(&sensor_vertices(&dir, part(&m, name)), want);
+        // measured 5,413 and 5,881
         assert!(r.len() > 100, "{name}: {} vertices on the dome", r.len());
         let (lo, hi) = r
             .iter()

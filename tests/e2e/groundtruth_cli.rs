@@ -196,6 +196,7 @@ fn groundtruth_of_two_patterns_is_complete_consistent_and_deterministic() {
             assert!(zref[p].is_nan());
         }
     }
+    // measured 2,247
     assert!(surface > 1000);
     for c in &names {
         let r = read_npy_f32(&a.join(c).join("range_mm.npy"));

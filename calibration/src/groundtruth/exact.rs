@@ -661,6 +661,7 @@ mod tests {
                     assert!(!ex.contains(add(add(o, scale(d, c.t_mm)), scale(c.normal, 1e-7))));
                 }
             }
+            // measured 71 to 400 hits
             assert!(hits > 50, "primitive {k}: {hits} hits");
         }
     }

@@ -1,7 +1,8 @@
 //! Ground truth against closed forms: a sphere (the R-Tac0 skin) and a plane seen through the
 //! Kannala-Brandt fisheye and the OpenCV pinhole (plumb_bob) models. Per pixel, the rendered
 //! range equals the closed-form ray-sphere or ray-plane distance along the pixel's bearing to
-//! 1 um (closed-form surfaces) or 1 um plus the chord tolerance (triangle meshes, camera at the
+//! 1 nm (closed-form surfaces: the same closed form, measured 0) or 1 um plus the chord
+//! tolerance (triangle meshes, measured 2.7 um at 4 um; camera at the
 //! sphere centre so that the rays meet the facets head on), the hit point reprojects onto its
 //! pixel centre (forward model, checked against OpenCV in tests/calibrate_opencv.rs), and
 //! z-depth is the hit's camera-frame z.
@@ -112,7 +113,7 @@ fn check(
 }
 
 #[test]
-fn sphere_through_both_camera_models_matches_the_closed_form_to_1_um() {
+fn sphere_through_both_camera_models_matches_the_closed_form_to_1_nm() {
     let surface = ReferenceSurface::of(&rtac0_body()).unwrap();
     let r = RTAC0_RADIUS_MM;
     for (name, cam) in cameras() {
@@ -137,6 +138,7 @@ fn sphere_through_both_camera_models_matches_the_closed_form_to_1_um() {
             "sphere, {name}: {n} pixels, worst |range - closed form| = {:.2e} um",
             worst * 1e3
         );
+        // measured 133,108 (fisheye) and 255,344 (plumb_bob)
         assert!(n > 50_000, "{name}: {n} pixels on the sphere");
     }
 }
@@ -201,6 +203,7 @@ fn tessellated_sphere_is_within_1_um_plus_the_chord_tolerance() {
             tol.mm(),
             worst * 1e3
         );
+        // measured 307,053 and 291,467
         assert!(n > 50_000);
         assert!(worst > 0.0, "the facets are not the sphere");
     }
@@ -256,6 +259,7 @@ fn plane_through_both_camera_models_matches_the_closed_form_exact_and_meshed() {
             "plane (exact), {name}: {n} pixels, worst {:.2e} um",
             worst * 1e3
         );
+        // measured 53,053 (fisheye) and 108,494 (plumb_bob)
         assert!(n > 10_000);
         // Meshed: two triangles, every ray.
         let hits = caster.cast(&rays, &vec![f64::INFINITY; rays.len()]);
@@ -275,6 +279,7 @@ fn plane_through_both_camera_models_matches_the_closed_form_exact_and_meshed() {
             "plane (2 triangles), {name}: {n} pixels, worst {:.2e} um",
             worst * 1e3
         );
+        // measured 190,865 and 291,467
         assert!(n > 10_000);
         let _ = o;
     }

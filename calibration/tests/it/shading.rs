@@ -294,6 +294,7 @@ fn a_sphere_tip_imprint_under_a_distant_light_has_the_analytic_shading() {
         );
         checked += 1;
     }
+    // measured 3,715
     assert!(checked > 500, "{checked} imprint pixels");
 }
 
@@ -396,6 +397,7 @@ fn markers_move_along_their_normals_and_carry_their_albedo() {
             assert!((got[k] - want[k]).abs() < 1e-9, "{got:?} vs {want:?}");
         }
     }
+    // measured 25
     assert!(moved >= 10, "{moved} spots pushed in");
 
     let light = Light {
@@ -435,6 +437,7 @@ fn markers_move_along_their_normals_and_carry_their_albedo() {
             assert_eq!(a[i], b[i], "pixel {i} off the markers");
         }
     }
+    // measured 2,372
     assert!(on_marker > 500, "{on_marker} marker pixels");
     assert!(on_pushed > 50, "{on_pushed} marker pixels on the imprint");
 }
