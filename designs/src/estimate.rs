@@ -6,8 +6,8 @@
 //! [`crate::geometry::revolve`] and the feature primitives) for every layer surface and every
 //! marker feature, each counted once (and once more for each mold cavity, coat or layer cast
 //! onto it that the features of a layer under a direct or master mold's coats or cast layers
-//! also shape): on the library designs and presets that is 0.9 to 2.2 times the built kits
-//! (measured; a test keeps it within 0.8 to 2.5).
+//! also shape): on the library designs and presets that is 0.87 to 2.28 times the built kits
+//! (measured; a test keeps it within 0.75 to 2.6).
 
 use crate::error::DesignError;
 use crate::geometry::ChordTolerance;

@@ -188,6 +188,7 @@ fn groundtruth_of_two_patterns_is_complete_consistent_and_deterministic() {
                 .unproject(&Vector2::new((p % w) as f64, (p / w) as f64))
                 .unwrap()
                 .z;
+            // float32 arrays: ulp 9.5e-7 mm at 8 to 16 mm, 1e-5 is 10 ulp
             assert!(
                 (zref[p] as f64 - rref[p] as f64 * bz).abs() < 1e-5,
                 "zdepth = range * bearing z at {p}"

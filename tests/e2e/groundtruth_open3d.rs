@@ -97,5 +97,6 @@ fn frame_cast_agrees_with_open3d_raycasting_scene_to_1_um_with_no_hit_mask_misma
         "hit-mask mismatches (u, v, fabkit, open3d): {:?}",
         &mismatch[..mismatch.len().min(10)]
     );
+    // measured 1.4e-5 mm (Open3D casts in float32: ulp 1.9e-6 mm at 16 mm)
     assert!(worst <= 1e-3, "worst difference {worst} mm");
 }

@@ -124,22 +124,28 @@ fn tutorial_dimples_under_the_coat_reach_the_direct_mold_halves() {
 }
 
 /// The chord-tolerance bound on the volume of the 127 dimples' meshes, mm^3: every facet
-/// within `TOL` of its true surface, over the dimple's wall and end (2 pi r (h - r) + 2 pi r^2).
+/// within `TOL` of its true surface, over the dimple's wall and end (2 pi r (h - r) + 2 pi r^2)
+/// and its opening (pi r^2: the layer's facets over it, which lie up to `TOL` inside the
+/// sphere the dimple's volume is counted from): 127 x 1.037 mm^2 x 0.01 mm = 1.32 mm^3.
 fn chord_bound_mm3(f: &FeatureShape) -> f64 {
     let r = f.radius_mm();
-    let area =
-        2.0 * std::f64::consts::PI * r * (f.height_mm - r) + 2.0 * std::f64::consts::PI * r * r;
+    let area = 2.0 * std::f64::consts::PI * r * (f.height_mm - r)
+        + 2.0 * std::f64::consts::PI * r * r
+        + std::f64::consts::PI * r * r;
     127.0 * area * TOL
 }
 
 /// The translucent layer of the assembly and the pour that casts it lose the dimples' volume
-/// (within 1 % and the chord tolerance's bound), and the coat over the layer follows them:
-/// its volume stays that of the plain film.
+/// (within the chord tolerance's bound), and the coat over the layer follows them: its volume
+/// stays that of the plain film.
 fn check_cast_layer_volume(with: &fabkit_designs::Kit, without: &fabkit_designs::Kit) {
     let f = tutorial_markers().feature;
     assert_eq!(f.side(), Polarity::Recessed);
     let expected = 127.0 * dimple_volume_mm3(&f, 14.9);
-    let bound = 0.01 * expected + chord_bound_mm3(&f);
+    // measured: the layer lost 0.338, the pour 0.336 mm^3 less than the 10.72 mm^3 of the
+    // dimples, the coat gained 0.158 less than the lining (both strategies): a quarter of the
+    // bound (the facets lie on average well inside the tolerance); no dimples would be 10.7 off
+    let bound = chord_bound_mm3(&f);
     let lost =
         member(without, "translucent_gel").volume() - member(with, "translucent_gel").volume();
     assert!(
@@ -186,6 +192,8 @@ fn tutorial_layer_loses_the_dimples_volume_within_one_percent() {
     let f = tutorial_markers().feature;
     let expected = 127.0 * dimple_volume_mm3(&f, 14.9);
     let lost = volume(&stock(MoldStrategy::Master)) - volume(&tutorial(MoldStrategy::Master));
+    // measured -0.38 % (0.040 mm^3), a third of the chord bound at 0.001 mm (127 x 1.037 mm^2
+    // x 0.001 mm = 1.2 %) as at 0.01 mm (0.338 of 1.32 mm^3): 1 % is 2.6 times the measured
     assert!(
         (lost - expected).abs() < 0.01 * expected,
         "the layer lost {lost:.4} mm3, the dimples hold {expected:.4} mm3"
@@ -432,6 +440,7 @@ fn the_work_estimate_counts_the_markers_under_the_coat() {
             let st = fabkit_designs::stack::validate(&d, &materials, tol).unwrap();
             let e = fabkit_designs::estimate::estimate(&d, &st, tol);
             let ratio = e.triangles as f64 / built as f64;
+            // measured 0.94 to 1.06 (both strategies, both tolerances)
             assert!(
                 (0.8..=2.5).contains(&ratio),
                 "{s:?} at {mm} mm: estimate {} vs {built} ({ratio:.2})",

@@ -5,8 +5,12 @@ use fabkit_designs::materials::MaterialsTable;
 use fabkit_designs::{build_kit, library, stack, ChordTolerance, DesignError};
 
 /// Every library design and preset, at two tolerances: the estimate, made from the parameters
-/// before anything is built, is within 0.8 to 2.5 times the triangles of the built kit, and its
+/// before anything is built, is within 0.75 to 2.6 times the triangles of the built kit, and its
 /// marker count is the kit's.
+///
+/// Measured 0.87 (uvdtact_no_markers at 0.05 mm) to 2.28 (digit_pinki at 0.05 mm); the bounds
+/// are 14 % beyond them (0.8 and 2.5 were 8 % and 10 %). An estimate that left out the markers
+/// (36 to 91 % of it where there are any) would fall to 0.6 or less.
 #[test]
 fn estimate_is_within_a_small_factor_of_every_library_kit() {
     let materials = MaterialsTable::embedded().unwrap();
@@ -34,7 +38,7 @@ fn estimate_is_within_a_small_factor_of_every_library_kit() {
                         .sum::<usize>();
                 let ratio = e / actual as f64;
                 assert!(
-                    (0.8..=2.5).contains(&ratio),
+                    (0.75..=2.6).contains(&ratio),
                     "{} at {mm} mm: estimate {e} vs {actual} triangles ({ratio:.2})",
                     d.name
                 );
@@ -45,7 +49,7 @@ fn estimate_is_within_a_small_factor_of_every_library_kit() {
             let e = estimate(&d, &st, tol);
             let ratio = e.triangles as f64 / actual as f64;
             assert!(
-                (0.8..=2.5).contains(&ratio),
+                (0.75..=2.6).contains(&ratio),
                 "{} at {mm} mm: estimate {} vs {actual} triangles ({ratio:.2})",
                 d.name,
                 e.triangles
@@ -72,6 +76,9 @@ fn check_work_refuses_past_the_limit_and_names_the_remedy() {
     let st = stack::validate(&d, &materials, coarse).unwrap();
     let e_coarse = estimate(&d, &st, coarse).triangles as f64;
     let e_fine = estimate(&d, &st, fine).triangles as f64;
+    // measured 7.29: a revolved surface's facets go as 1 / tolerance (segments along and around
+    // as 1 / sqrt(tolerance)); counts rounded up to multiples of 4 (at least 8) and flat faces
+    // keep the coarse count relatively larger
     assert!(
         (6.0..11.0).contains(&(e_fine / e_coarse)),
         "{e_fine} / {e_coarse}"

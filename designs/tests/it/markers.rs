@@ -593,6 +593,9 @@ fn check_pattern_case(c: &PatternCase) -> Result<(), TestCaseError> {
     let margin = f.diameter_mm + pj.min_wall_mm;
     let surface = Surface::new(&c.body, c.offset_mm());
     let mer = Meridian::new(&c.body, c.offset_mm());
+    // spheres exact; on ellipses `Surface` sums 4096 chords, short of the arc by
+    // (ds^2 / 24) x integral of curvature^2 ds, some 2.5e-7 mm (the model's 200 000 chords
+    // 4e-4 of that): measured up to 2.8e-7 over the 96 cases of seed sets 0, 1 and 2
     prop_assert!(
         (surface.total_arc_mm() - mer.total()).abs() < 1e-6,
         "arc length {} vs {}",

@@ -18,7 +18,9 @@ fn ellipse_offset_is_at_constant_distance() {
                 let s = p.offset_point(0.0, k as f64 / 20000.0);
                 best = best.min(((q[0] - s[0]).powi(2) + (q[1] - s[1]).powi(2)).sqrt());
             }
-            assert!((best - d.abs()).abs() < 2e-3, "d={d} t={t} dist={best}");
+            // q's foot t = i / 50 is itself a sample (k = 400 i), so the search finds it: measured
+            // 1.8e-15 mm at most; an offset off the normal would find a nearer sample
+            assert!((best - d.abs()).abs() < 1e-9, "d={d} t={t} dist={best}");
         }
     }
 }

@@ -331,6 +331,7 @@ fn the_surface_oracle_is_sharp() {
         let s = [(a + d) * th.cos(), (c + d) * th.sin()];
         scaled_off = scaled_off.max(piece_distance(s, &piece));
     }
+    // measured 0.406 mm (an offset ellipse is no ellipse); a blunt oracle would give about 0
     assert!(scaled_off > 0.1, "{scaled_off}");
     // and the arc: a cap's offset arc ends on the base plane
     let arc = Piece::Arc {

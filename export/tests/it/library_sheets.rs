@@ -255,7 +255,11 @@ fn rtac0_sheet_states_volumes_coats_treatments_and_the_procedure() {
     let tr = arr(first, "treatments");
     assert_eq!(tr.len(), 2, "{first}");
     assert_eq!(tr[0]["material"], "pr_1200_rtv");
-    // (the area comes from a 1 µm polyline: within 1e-4 relative)
+    // The area comes from a 1 µm polyline: each chord's band is short of its sphere zone by
+    // s / r (s its sagitta), so the hemisphere's 2 pi r^2 by 2 pi r x 1 µm at most: 6.3e-4,
+    // 8.5e-4 and 9.4e-4 cm^2 for r = 10, 13.5 and 15 (the cylinder is exact); measured 4.3e-4,
+    // 6.0e-4 and 6.6e-4 cm^2 short. The primer amount follows (x 0.002 mL/cm^2: 1.3e-6 mL at
+    // most, measured 8.6e-7).
     close(
         tr[0]["area_cm2"].as_f64().unwrap(),
         area(10.0),
@@ -761,8 +765,16 @@ fn rtac0_section_view_shows_each_member_with_its_section_area() {
         ("diffuser_envelope", 2.0 * (15.0 - 9.8) * 2.0),
     ] {
         let l = arr(v, "legend").iter().find(|l| l["name"] == name).unwrap();
+        // measured -0.076 % (gel) and -0.042 % (core), the rectangles exact: the profiles are
+        // drawn at half the 0.05 mm tolerance, and a quarter arc's chords (sagitta s) take
+        // (pi / 3) r s, net (2 pi / 3)(r_o - r_i) s for the two quarter annuli: 0.11 % of either
+        // at s = 0.025 mm
         close(l["area_mm2"].as_f64().unwrap(), area, 0.002 * area, name);
         let pixels = count(l["colour"].as_str().unwrap()) / (px * px);
+        // measured -0.092 % (gel) and -0.053 % (core), the rectangles exact: each row counts the
+        // columns whose centres lie inside, up to half a pixel (0.025 mm at 20 px/mm) off at
+        // each crossing; off by as much all down a vertical edge, the core's four (9 mm, 180
+        // rows each) would take 0.9 mm^2, 1.9 %
         close(pixels, area, 0.03 * area, name);
     }
     assert!(e
