@@ -7,8 +7,6 @@
 use nalgebra::{
     Isometry3, Matrix3, Matrix6, Rotation3, Translation3, UnitQuaternion, Vector2, Vector3, Vector6,
 };
-use rand_chacha::rand_core::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
 
 use crate::camera::{CameraError, CameraModel};
 use crate::p3p::p3p;
@@ -47,7 +45,10 @@ pub enum PnpError {
 }
 
 /// RANSAC settings. The first hypothesis is the all-points solution; minimal samples of 3 points
-/// (P3P, each refined on its consensus set when it is the best so far) follow until the adaptive count for `confidence` is reached.
+/// (P3P, each refined on its consensus set when it is the best so far) follow until the adaptive
+/// count for `confidence` is reached. The samples are a fixed schedule ([`Triples`]) over the
+/// pairs in a canonical order: the same pairs in any order give the same pose, bit for bit, and
+/// no seed enters it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RansacOptions {
     /// A point is an inlier when its reprojection error is below this, px; `None`: from the
@@ -58,8 +59,6 @@ pub struct RansacOptions {
     pub confidence: f64,
     /// Largest number of sampled hypotheses.
     pub max_hypotheses: usize,
-    /// Seed of the sampler (same seed and input, same result).
-    pub seed: u64,
     /// Smallest fraction of the points that must be inliers, in (0, 1]; below it the consensus
     /// is a coincidence (e.g. observations labelled at random) and solving fails.
     pub min_inlier_fraction: f64,
@@ -71,7 +70,6 @@ impl Default for RansacOptions {
             threshold_px: None,
             confidence: 0.999,
             max_hypotheses: 1000,
-            seed: 0,
             min_inlier_fraction: 0.5,
         }
     }
@@ -118,9 +116,18 @@ pub struct PnpSolution {
 /// data only widen it.
 pub const MIN_ROBUST_THRESHOLD_PX: f64 = 3.0;
 
-/// The threshold from the data is this many robust standard deviations (per axis) of the
-/// reprojection error: 99.8 % of Gaussian errors fall within it in 2D.
-pub const ROBUST_THRESHOLD_SIGMAS: f64 = 3.5;
+/// The chance, per solve, that the noise alone puts any good pair outside the threshold from
+/// the data.
+pub const ROBUST_THRESHOLD_RISK: f64 = 0.002;
+
+/// How many robust standard deviations (per axis) of the reprojection error the threshold from
+/// the data is for `n` pairs: a 2D Gaussian error's length exceeds `k sigma` with probability
+/// `exp(-k^2 / 2)` (Rayleigh), so that none of `n` good pairs does but with probability
+/// [`ROBUST_THRESHOLD_RISK`] (Bonferroni), `k = sqrt(2 ln(n / risk))`: 3.5 for one pair, 4.4
+/// for 30, 4.7 for 150. A fixed 3.5 sigma rejected some good pair of 30 in 6 % of solves.
+pub fn threshold_sigmas(n: usize) -> f64 {
+    (2.0 * (n.max(1) as f64 / ROBUST_THRESHOLD_RISK).ln()).sqrt()
+}
 
 /// ... and at most this fraction of the observed pixels' spread (the RMS distance from their
 /// mean): errors beyond it are no consensus (pins labelled at random), not a rough lens model.
@@ -142,7 +149,7 @@ struct Pairs<'a> {
 /// refined on its better half; the median squared reprojection error at that pose gives the
 /// robust standard deviation per axis, sigma = sqrt(med / (2 ln 2)) (1 + 5 / (n - 6)) (2D
 /// Gaussian errors; the finite-sample factor of Rousseeuw and Leroy), and the threshold is
-/// [`ROBUST_THRESHOLD_SIGMAS`] sigma, at least [`MIN_ROBUST_THRESHOLD_PX`] and at most
+/// [`threshold_sigmas`] sigma, at least [`MIN_ROBUST_THRESHOLD_PX`] and at most
 /// [`MAX_ROBUST_THRESHOLD_OF_SPREAD`] of the pixels' spread.
 fn robust_threshold_px(
     pairs: &Pairs<'_>,
@@ -167,11 +174,10 @@ fn robust_threshold_px(
     let samples = ((1.0 - ro.confidence).ln() / (1.0 - 0.5f64.powi(3)).ln())
         .ceil()
         .clamp(1.0, ro.max_hypotheses.max(1) as f64) as usize;
-    let mut rng = ChaCha8Rng::seed_from_u64(ro.seed);
-    let mut sample = [0usize; 3];
+    let mut triples = Triples::new(n);
     let mut poses = Vec::with_capacity(4);
     for _ in 0..samples {
-        draw(&mut rng, n, &mut sample);
+        let sample = triples.next_triple();
         p3p(
             &sample.map(|i| pts[i]),
             &sample.map(|i| bearings[i]),
@@ -199,14 +205,21 @@ fn robust_threshold_px(
     }
     let finite = (1.0 + 5.0 / n.saturating_sub(6).max(1) as f64).min(2.0);
     let sigma = (best.0 / (2.0 * std::f64::consts::LN_2)).sqrt() * finite;
-    let mean = px.iter().sum::<Vector2<f64>>() / n as f64;
-    let spread = (px.iter().map(|p| (p - mean).norm_squared()).sum::<f64>() / n as f64).sqrt();
-    let most = (MAX_ROBUST_THRESHOLD_OF_SPREAD * spread).max(MIN_ROBUST_THRESHOLD_PX);
+    let most = most_threshold_px(px);
     if sigma.is_finite() {
-        (ROBUST_THRESHOLD_SIGMAS * sigma).clamp(MIN_ROBUST_THRESHOLD_PX, most)
+        (threshold_sigmas(n) * sigma).clamp(MIN_ROBUST_THRESHOLD_PX, most)
     } else {
         MIN_ROBUST_THRESHOLD_PX
     }
+}
+
+/// The largest inlier threshold the data may give, px: [`MAX_ROBUST_THRESHOLD_OF_SPREAD`] of the
+/// pixels' spread (the RMS distance from their mean), at least [`MIN_ROBUST_THRESHOLD_PX`].
+fn most_threshold_px(px: &[Vector2<f64>]) -> f64 {
+    let n = px.len().max(1) as f64;
+    let mean = px.iter().sum::<Vector2<f64>>() / n;
+    let spread = (px.iter().map(|p| (p - mean).norm_squared()).sum::<f64>() / n).sqrt();
+    (MAX_ROBUST_THRESHOLD_OF_SPREAD * spread).max(MIN_ROBUST_THRESHOLD_PX)
 }
 
 /// Solves T_cam_sensor from sensor-frame points `points_mm` (N, mm) and their observed pixels
@@ -254,9 +267,55 @@ pub fn solve_pnp(
                 .map_err(|source| PnpError::Unprojectable { index, source })?,
         );
     }
-    check_layout(points_mm, &bearings)?;
+    // The pairs in a canonical order (by point, then pixel): every sum and every sample below
+    // follows it, so the same pairs in any input order give the same pose, bit for bit.
+    let mut order: Vec<usize> = (0..n).collect();
+    let key = |i: usize| {
+        let (m, uv) = (points_mm[i], pixels_px[i]);
+        [m.x, m.y, m.z, uv.x, uv.y]
+    };
+    order.sort_by(|&a, &b| {
+        let (ka, kb) = (key(a), key(b));
+        ka.iter()
+            .zip(&kb)
+            .map(|(x, y)| x.total_cmp(y))
+            .find(|o| o.is_ne())
+            .unwrap_or(std::cmp::Ordering::Equal)
+    });
+    let points: Vec<Vector3<f64>> = order.iter().map(|&i| points_mm[i]).collect();
+    let pixels: Vec<Vector2<f64>> = order.iter().map(|&i| pixels_px[i]).collect();
+    let bearings: Vec<Vector3<f64>> = order.iter().map(|&i| bearings[i]).collect();
+    let s = solve_in_order(camera, &points, &pixels, &bearings, opts).map_err(|e| match e {
+        PnpError::BehindCamera { index } => PnpError::BehindCamera {
+            index: order[index],
+        },
+        e => e,
+    })?;
+    let mut inliers = vec![false; n];
+    let mut residuals_px = vec![None; n];
+    for (k, &i) in order.iter().enumerate() {
+        inliers[i] = s.inliers[k];
+        residuals_px[i] = s.residuals_px[k];
+    }
+    Ok(PnpSolution {
+        inliers,
+        residuals_px,
+        ..s
+    })
+}
+
+/// [`solve_pnp`] on validated pairs in the canonical order, with their bearings.
+fn solve_in_order(
+    camera: &CameraModel,
+    points_mm: &[Vector3<f64>],
+    pixels_px: &[Vector2<f64>],
+    bearings: &[Vector3<f64>],
+    opts: &PnpOptions,
+) -> Result<PnpSolution, PnpError> {
+    let n = points_mm.len();
+    check_layout(points_mm, bearings)?;
     let all: Vec<usize> = (0..n).collect();
-    let start = sqpnp(points_mm, &bearings).ok_or(PnpError::NoSolution)?;
+    let start = sqpnp(points_mm, bearings).ok_or(PnpError::NoSolution)?;
     let mut fit = Fit::at(
         camera,
         points_mm,
@@ -273,7 +332,7 @@ pub fn solve_pnp(
         camera,
         pts: points_mm,
         px: pixels_px,
-        bearings: &bearings,
+        bearings,
     };
     match &opts.ransac {
         None => fit.refine(camera, points_mm, pixels_px, opts.max_iterations),
@@ -282,7 +341,6 @@ pub fn solve_pnp(
                 Some(t) => t,
                 None => robust_threshold_px(&pairs, (&fit.r, &fit.t), ro, opts),
             };
-            threshold_used = Some(threshold_px);
             let ro = &RansacOptions {
                 threshold_px: Some(threshold_px),
                 ..*ro
@@ -307,6 +365,31 @@ pub fn solve_pnp(
             if consensus.count() < n {
                 hypotheses = ransac(&pairs, ro, opts, &mut fit, &mut consensus);
             }
+            // The final fit on the consensus ([`fit_on`]), scored again and fitted again until
+            // the set stops changing.
+            let t2 = threshold_px * threshold_px;
+            for _ in 0..6 {
+                let idx = consensus.indices();
+                if idx.len() < MIN_POINTS {
+                    break;
+                }
+                if let Some(f) = fit_on(&pairs, &idx, &fit, opts) {
+                    fit = f;
+                }
+                consensus.score(
+                    camera,
+                    points_mm,
+                    pixels_px,
+                    &fit.r,
+                    &fit.t,
+                    t2,
+                    f64::INFINITY,
+                );
+                if consensus.indices() == idx {
+                    break;
+                }
+            }
+            threshold_used = Some(threshold_px);
             inliers = consensus.inliers;
             let count = inliers.iter().filter(|&&b| b).count();
             let needed = MIN_POINTS.max((ro.min_inlier_fraction * n as f64).ceil() as usize);
@@ -398,14 +481,13 @@ fn ransac(
         }
     };
     let mut needed = adaptive(best).min(ro.max_hypotheses);
-    let mut rng = ChaCha8Rng::seed_from_u64(ro.seed);
-    let mut sample = [0usize; 3];
+    let mut triples = Triples::new(n);
     let mut poses = Vec::with_capacity(4);
     let mut trial = Consensus::new(n);
     let mut hypotheses = 0;
     while hypotheses < needed {
         hypotheses += 1;
-        draw(&mut rng, n, &mut sample);
+        let sample = triples.next_triple();
         let sp = sample.map(|i| pts[i]);
         let sb = sample.map(|i| bearings[i]);
         p3p(&sp, &sb, &mut poses);
@@ -425,19 +507,41 @@ fn ransac(
             needed = adaptive(best).min(ro.max_hypotheses);
         }
     }
-    // Final fit on the consensus set, repeated while the set changes.
-    for _ in 0..3 {
+    // Final fit on the consensus set ([`fit_on`]), repeated while the set changes.
+    for _ in 0..4 {
         let idx = best.indices();
         if idx.len() < MIN_POINTS || fit.idx == idx {
             break;
         }
-        if let Some(mut f) = Fit::at(camera, pts, px, &idx, fit.r, fit.t) {
-            f.refine(camera, pts, px, opts.max_iterations);
+        if let Some(f) = fit_on(pairs, &idx, fit, opts) {
             *fit = f;
         }
         best.score(camera, pts, px, &fit.r, &fit.t, thr2, f64::INFINITY);
     }
     hypotheses
+}
+
+/// The fit on the pairs `idx`: refined from `from` and from SQPnP's globally optimal start on
+/// them, the lower cost kept, so that the pose is the optimum of the set, not of where a
+/// hypothesis left the refinement (a flat valley of the reprojection error can hold one start
+/// short of it). `None` when neither start projects every pair.
+fn fit_on(pairs: &Pairs<'_>, idx: &[usize], from: &Fit, opts: &PnpOptions) -> Option<Fit> {
+    let (camera, pts, px, bearings) = (pairs.camera, pairs.pts, pairs.px, pairs.bearings);
+    let mut best: Option<Fit> = None;
+    let mut consider = |r: Matrix3<f64>, t: Vector3<f64>| {
+        if let Some(mut f) = Fit::at(camera, pts, px, idx, r, t) {
+            f.refine(camera, pts, px, opts.max_iterations);
+            if best.as_ref().is_none_or(|b| f.cost < b.cost) {
+                best = Some(f);
+            }
+        }
+    };
+    consider(from.r, from.t);
+    let (sp, sb): (Vec<_>, Vec<_>) = idx.iter().map(|&i| (pts[i], bearings[i])).unzip();
+    if let Some(g) = sqpnp(&sp, &sb) {
+        consider(g.rotation, g.translation_mm);
+    }
+    best
 }
 
 /// MSAC consensus of a pose: which pairs reproject within the threshold and the truncated score.
@@ -633,14 +737,41 @@ fn check_layout(points: &[Vector3<f64>], bearings: &[Vector3<f64>]) -> Result<()
     Ok(())
 }
 
-/// Draws distinct indices in 0..n.
-fn draw(rng: &mut ChaCha8Rng, n: usize, out: &mut [usize]) {
-    for k in 0..out.len() {
+/// The minimal samples of a solve: triples of distinct indices in `0..n` from the R3
+/// low-discrepancy sequence (Roberts 2018, "The unreasonable effectiveness of quasirandom
+/// sequences"): point `k` is `frac(0.5 + k (1/g, 1/g^2, 1/g^3))` in the unit cube, `g` the
+/// positive root of `x^4 = x + 1`, scaled to indices; points with a repeated index are
+/// skipped. A fixed schedule, not a random one: the triples depend on `n` only, and they
+/// spread over all triples as evenly as the sequence spreads over the cube, from the first.
+pub struct Triples {
+    n: usize,
+    k: u64,
+}
+
+impl Triples {
+    const G: f64 = 1.220_744_084_605_759_5;
+
+    /// The schedule for `n >= 3` indices.
+    pub fn new(n: usize) -> Triples {
+        Triples { n, k: 0 }
+    }
+
+    /// The next triple of distinct indices.
+    pub fn next_triple(&mut self) -> [usize; 3] {
+        let a = [
+            1.0 / Self::G,
+            1.0 / (Self::G * Self::G),
+            1.0 / Self::G.powi(3),
+        ];
+        let n = self.n.max(3);
         loop {
-            let i = (rng.next_u64() % n as u64) as usize;
-            if !out[..k].contains(&i) {
-                out[k] = i;
-                break;
+            self.k += 1;
+            let s = a.map(|a| {
+                let x = (0.5 + self.k as f64 * a).fract();
+                ((x * n as f64) as usize).min(n - 1)
+            });
+            if s[0] != s[1] && s[0] != s[2] && s[1] != s[2] {
+                return s;
             }
         }
     }

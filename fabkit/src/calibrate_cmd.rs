@@ -115,10 +115,11 @@ pub struct ExtrinsicsArgs {
     /// Capture image (PNG) for an overlay of observed and reprojected points.
     #[arg(long, value_name = "IMG.png")]
     pub image: Option<PathBuf>,
-    /// RANSAC inlier threshold on the reprojection error, px. Default: from the data (3.5
-    /// robust standard deviations of the reprojection error by least median of squares, at
-    /// least 3 px, at most a tenth of the pixels' spread), so that a camera file that follows the lens only roughly towards the edge
-    /// of its field still gives a pose.
+    /// RANSAC inlier threshold on the reprojection error, px. Default: from the data
+    /// (sqrt(2 ln(n / 0.002)) robust standard deviations of the reprojection error by least
+    /// median of squares, 4.4 for 30 pins, at least 3 px, at most a tenth of the pixels'
+    /// spread), so that a camera file that follows the lens only roughly towards the edge of
+    /// its field still gives a pose.
     #[arg(long)]
     pub ransac_threshold_px: Option<f64>,
     /// Use every observation (no outlier rejection).
@@ -132,9 +133,11 @@ pub struct ExtrinsicsArgs {
     /// refused if the captures do not constrain it.
     #[arg(long, value_name = "PARAMS", num_args = 0..=1, default_missing_value = "")]
     pub refine_intrinsics: Option<String>,
-    /// Seed of the RANSAC sampler.
-    #[arg(long, default_value_t = 0)]
-    pub seed: u64,
+    /// Ignored: RANSAC draws its samples on a fixed schedule, so the pose depends on the data
+    /// only (the same captures in any order, the same pose). Accepted so that command lines
+    /// that give it still run.
+    #[arg(long, value_name = "SEED")]
+    pub seed: Option<u64>,
 }
 
 pub fn run(cmd: CalibrateCommand) -> Result<(), Box<dyn Error>> {
@@ -145,6 +148,11 @@ pub fn run(cmd: CalibrateCommand) -> Result<(), Box<dyn Error>> {
 }
 
 fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
+    if let Some(seed) = a.seed {
+        eprintln!(
+            "note: --seed {seed} has no effect: RANSAC samples on a fixed schedule, so the pose depends on the data only"
+        );
+    }
     if let Some(t) = a.ransac_threshold_px {
         if !(t.is_finite() && t > 0.0) {
             return Err(format!("--ransac-threshold-px = {t}: must be finite and > 0").into());
@@ -199,7 +207,6 @@ fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
         },
         ransac: (!a.no_ransac).then_some(RansacOptions {
             threshold_px: a.ransac_threshold_px,
-            seed: a.seed,
             ..Default::default()
         }),
         command_line: std::env::args().collect::<Vec<_>>().join(" "),

@@ -232,8 +232,11 @@ pub(crate) fn rows<const N: usize>(a: &Bound<'_, PyAny>, name: &str) -> PyResult
 /// Solves the camera pose T_cam_sensor from sensor-frame points (n, 3) mm and their observed
 /// pixels (n, 2) px through `camera` (a Camera or a camera file path), as `fabkit calibrate
 /// extrinsics` does (SQPnP + Levenberg-Marquardt; with `ransac`, outliers rejected at
-/// `threshold_px`, or a threshold from the data when it is None: 3.5 robust standard deviations
-/// by least median of squares, at least 3 px, at most a tenth of the pixels' spread; reproducible by `seed`).
+/// `threshold_px`, or a threshold from the data when it is None: sqrt(2 ln(n / 0.002))
+/// robust standard deviations by least median of squares (4.4 for 30 pins), at least 3 px, at most a tenth of the pixels' spread). The RANSAC
+/// samples are a fixed schedule over the pairs in a canonical order: the same pairs in any order
+/// give the same pose; `seed` is accepted for older scripts and has no effect (a
+/// DeprecationWarning).
 ///
 /// Returns a dict: `T_cam_sensor` (4, 4) float64 (sensor frame -> camera frame, mm),
 /// `residuals_px` (n, 2) (reprojected minus observed, NaN where a point does not project),
@@ -242,7 +245,7 @@ pub(crate) fn rows<const N: usize>(a: &Bound<'_, PyAny>, name: &str) -> PyResult
 /// `ids` or the row numbers). Raises CalibrationError with the CLI's message (fewer than 4
 /// points, a non-finite value, a degenerate layout, too few inliers, ...).
 #[pyfunction]
-#[pyo3(signature = (points_mm, pixels_px, camera, *, ids=None, ransac=true, threshold_px=None, seed=0))]
+#[pyo3(signature = (points_mm, pixels_px, camera, *, ids=None, ransac=true, threshold_px=None, seed=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn solve_extrinsics<'py>(
     py: Python<'py>,
@@ -252,7 +255,7 @@ pub fn solve_extrinsics<'py>(
     ids: Option<Vec<String>>,
     ransac: bool,
     threshold_px: Option<f64>,
-    seed: u64,
+    seed: Option<u64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     if let Some(t) = threshold_px {
         if !(t.is_finite() && t > 0.0) {
@@ -286,9 +289,16 @@ pub fn solve_extrinsics<'py>(
         points_mm: points.iter().map(|p| Vector3::from(*p)).collect(),
         pixels_px: pixels.iter().map(|p| Vector2::from(*p)).collect(),
     };
+    if seed.is_some() {
+        pyo3::PyErr::warn(
+            py,
+            &py.get_type::<pyo3::exceptions::PyDeprecationWarning>(),
+            c"seed has no effect: RANSAC samples on a fixed schedule, so the pose depends on the data only",
+            1,
+        )?;
+    }
     let ransac = ransac.then(|| RansacOptions {
         threshold_px,
-        seed,
         ..RansacOptions::default()
     });
     let opts = PnpOptions {

@@ -190,7 +190,15 @@ def test_gross_outliers_are_flagged_exactly_and_the_pose_kept(camera):
     offsets = np.array([[12.0, -9.0], [-8.0, 15.0], [25.0, 4.0], [-6.0, -7.0]])
     pixels[bad] += offsets
     ids = [f"pin{i}" for i in range(len(points))]
-    r = fabkit.solve_extrinsics(points, pixels, camera, ids=ids, threshold_px=2.0, seed=7)
+    r = fabkit.solve_extrinsics(points, pixels, camera, ids=ids, threshold_px=2.0)
+    # the pairs in another order: the same pose, bit for bit, the flags following their pairs;
+    # a seed changes nothing (and says so)
+    perm = np.random.default_rng(0).permutation(len(points))
+    with pytest.warns(DeprecationWarning, match="seed has no effect"):
+        rp = fabkit.solve_extrinsics(points[perm], pixels[perm], camera,
+                                     ids=[ids[i] for i in perm], threshold_px=2.0, seed=7)
+    np.testing.assert_array_equal(rp["T_cam_sensor"], r["T_cam_sensor"])
+    np.testing.assert_array_equal(rp["outliers"], r["outliers"][perm])
     expected = np.zeros(len(points), bool)
     expected[bad] = True
     np.testing.assert_array_equal(r["outliers"], expected)

@@ -347,6 +347,7 @@ print(json.dumps({"width": root.get("width"), "height": root.get("height"), "lin
         .zip(v["lines"].as_array().unwrap())
     {
         let (want, got) = (d["value_mm"].as_f64().unwrap(), line.as_f64().unwrap());
+        // measured 0 (the drawing writes the value's own digits)
         assert!((want - got).abs() < 2e-3, "{d}: drawn {got} mm");
     }
     let vol = shell["volume_mm3"].as_f64().unwrap();

@@ -459,6 +459,7 @@ fn round_shell_and_camera_base_match_the_authors_cad() {
                 f(&h["joint_screw"]["pilot_depth_mm"]),
             );
     let v = f(&tube["volume_mm3"]);
+    // measured -0.032 % (the 30 mm bore's and the screws' polygons at the chord tolerance)
     assert!(
         (v - analytic).abs() < 0.003 * analytic,
         "tube volume {v} mm3, analytic {analytic} mm3"
@@ -466,6 +467,7 @@ fn round_shell_and_camera_base_match_the_authors_cad() {
     let (seat, top) = (f(&lv["seat_z_mm"]), f(&lv["top_z_mm"]));
     let collar_analytic = disc(15.0, seat, top) - disc(f(&p["core_seat_radius_mm"]), seat, top);
     let vc = f(&collar["volume_mm3"]);
+    // measured -0.040 %
     assert!(
         (vc - collar_analytic).abs() < 0.003 * collar_analytic,
         "collar volume {vc} mm3, analytic {collar_analytic} mm3"

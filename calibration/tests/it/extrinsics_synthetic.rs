@@ -162,13 +162,67 @@ fn ransac_rejects_swapped_pins_and_keeps_the_cramer_rao_bound_of_the_rest() {
     assert!(rn > 3.0 * r0, "no-RANSAC rotation RMS {rn}");
 }
 
+/// The same pairs in any order give the same pose, bit for bit, and the same inliers (each
+/// flag following its pair): with three swapped pins that RANSAC must reject and the
+/// threshold from the data (issue 97: on real captures the pose moved 0.83 deg with the order
+/// of the captures and 1.96 deg with the sampler's seed, which is gone).
 #[test]
-fn same_input_same_pose() {
+fn the_pose_does_not_depend_on_the_order_of_the_pairs() {
     let cam = benchmark_camera();
-    let t = benchmark_trial(3, 0.5, 3);
-    let a = solve_pnp(&cam, &t.points(), &t.pixels(), &PnpOptions::default()).unwrap();
-    let b = solve_pnp(&cam, &t.points(), &t.pixels(), &PnpOptions::default()).unwrap();
-    assert_eq!(a, b);
+    for seed in 0..5 {
+        let seed = 1000 * crate::common::seed_set() + seed;
+        let t = benchmark_trial(seed, 0.5, 3);
+        let (pts, px) = (t.points(), t.pixels());
+        let a = solve_pnp(&cam, &pts, &px, &PnpOptions::default()).unwrap();
+        assert_eq!(
+            a.inliers.iter().filter(|&&b| !b).count(),
+            3,
+            "seed {seed}: {:?}",
+            a.inliers
+        );
+        let n = pts.len();
+        let orders: Vec<Vec<usize>> = [1usize, 7, 13, 29]
+            .iter()
+            .map(|&step| (0..n).map(|i| (i * step + 5) % n).collect())
+            .chain(std::iter::once((0..n).rev().collect()))
+            .collect();
+        for order in orders {
+            let p: Vec<_> = order.iter().map(|&i| pts[i]).collect();
+            let q: Vec<_> = order.iter().map(|&i| px[i]).collect();
+            let b = solve_pnp(&cam, &p, &q, &PnpOptions::default()).unwrap();
+            assert_eq!(
+                b.t_cam_sensor, a.t_cam_sensor,
+                "seed {seed}, order {order:?}"
+            );
+            for (k, &i) in order.iter().enumerate() {
+                assert_eq!(b.inliers[k], a.inliers[i]);
+                assert_eq!(b.residuals_px[k], a.residuals_px[i]);
+            }
+            assert_eq!(b.ransac_threshold_px, a.ransac_threshold_px);
+        }
+    }
+}
+
+/// RANSAC's samples: a fixed schedule of triples of distinct indices that reaches every
+/// triple of a few points soon (each of the C(n, 3) within 40 x C(n, 3) draws for n up to 12).
+#[test]
+fn the_sample_schedule_reaches_every_triple() {
+    use fabkit_calibration::pnp::Triples;
+    for n in 3..=12usize {
+        let all = n * (n - 1) * (n - 2) / 6;
+        let mut seen = std::collections::BTreeSet::new();
+        let mut t = Triples::new(n);
+        for _ in 0..40 * all {
+            let mut s = t.next_triple();
+            assert!(s.iter().all(|&i| i < n) && s[0] != s[1] && s[1] != s[2] && s[0] != s[2]);
+            s.sort_unstable();
+            seen.insert(s);
+        }
+        assert_eq!(seen.len(), all, "n = {n}");
+        // the same n, the same schedule
+        let (mut a, mut b) = (Triples::new(n), Triples::new(n));
+        assert!((0..100).all(|_| a.next_triple() == b.next_triple()));
+    }
 }
 
 fn project_all(pose: &Isometry3<f64>, pts: &[Vector3<f64>]) -> Vec<Vector2<f64>> {
@@ -438,8 +492,9 @@ fn the_threshold_from_the_data_follows_a_rough_camera_file() {
         assert!(rotation_error_deg(&s.t_cam_sensor, &t.t_cam_sensor()) < 2.0);
     }
     eprintln!("fixed 3 px failed {fixed_failed} of 20; thresholds {thresholds:?}");
+    // measured 11 of 20: a fixed 3 px drops good pins of a rough file's edge in about half
     assert!(
-        fixed_failed >= 10,
+        fixed_failed >= 8,
         "fixed 3 px failed only {fixed_failed} of 20"
     );
     assert!(thresholds.iter().all(|&t| t > 3.0));

@@ -39,6 +39,7 @@ fn a_flat_floor_receives_the_analytic_flux_of_a_point_light() {
     let want = PI * light.intensity * big_r * big_r / (h * h + big_r * big_r);
     for c in 0..3 {
         let w = want * light.colour_rgb[c];
+        // measured 5.3e-8 relative: the midpoint rule's error at 4000 radii, of order (R / n)^2 / h^2
         assert!((flux[c] - w).abs() <= 0.005 * w, "{c}: {} vs {w}", flux[c]);
     }
     // a Lambertian floor (no specular lobe) sends albedo E / pi towards any viewer
