@@ -499,3 +499,56 @@ fn the_threshold_from_the_data_follows_a_rough_camera_file() {
     );
     assert!(thresholds.iter().all(|&t| t > 3.0));
 }
+
+/// The final refinement reaches the optimum of the pins it keeps (issue 97: on real captures
+/// it stopped 1.96 deg short with one seed): through a camera file whose k1 is 0.08 off (the
+/// camera's distance trades against the lens along a flat valley of the reprojection error)
+/// with three pins swapped, the returned pose is a stationary point of the reprojection error
+/// over its inliers (the Gauss-Newton step from it would gain at most 1e-6 of the cost: the
+/// refinement stops at a relative change of 1e-8), and a second solve on those inliers alone
+/// (SQPnP and Levenberg-Marquardt, no RANSAC) finds no lower cost. Measured on seed sets 0 to
+/// 2: gains of at most 5e-11 of the cost; second solves equal to 1e-12.
+#[test]
+fn the_final_pose_is_the_optimum_of_its_inliers() {
+    use fabkit_calibration::pnp::{reprojection_cost, reprojection_normal_equations};
+    use fabkit_calibration::{CameraModel, Distortion};
+    let truth = fabkit_calibration::synthetic::benchmark_intrinsics();
+    let Distortion::Fisheye(k) = truth.distortion else {
+        panic!("the benchmark lens is a fisheye")
+    };
+    let rough = CameraModel::new(fabkit_calibration::Intrinsics {
+        distortion: Distortion::Fisheye([k[0] + 0.08, k[1], k[2], k[3]]),
+        ..truth
+    })
+    .unwrap();
+    let (mut worst_gain, mut worst_second) = (0.0f64, f64::INFINITY);
+    for seed in 0..20 {
+        let seed = 1000 * crate::common::seed_set() + seed;
+        let t = benchmark_trial(seed, 0.5, 3);
+        let (pts, px) = (t.points(), t.pixels());
+        let s = solve_pnp(&rough, &pts, &px, &PnpOptions::default()).unwrap();
+        let keep: Vec<usize> = (0..pts.len()).filter(|&i| s.inliers[i]).collect();
+        let (p, q): (Vec<_>, Vec<_>) = keep.iter().map(|&i| (pts[i], px[i])).unzip();
+        let (jtj, jte, cost) =
+            reprojection_normal_equations(&rough, &p, &q, &s.t_cam_sensor).unwrap();
+        let d = jtj.cholesky().unwrap().solve(&(-jte));
+        let gain = -(d.dot(&jte)) - 0.5 * (d.transpose() * jtj * d)[0];
+        worst_gain = worst_gain.max(gain / cost);
+        assert!(
+            gain <= 1e-6 * cost,
+            "seed {seed}: a step would gain {gain} of {cost} px^2"
+        );
+        let plain = PnpOptions {
+            ransac: None,
+            ..Default::default()
+        };
+        let second = solve_pnp(&rough, &p, &q, &plain).unwrap();
+        let c2 = reprojection_cost(&rough, &p, &q, &second.t_cam_sensor).unwrap();
+        worst_second = worst_second.min(c2 / cost - 1.0);
+        assert!(
+            c2 >= cost * (1.0 - 1e-9),
+            "seed {seed}: a second solve reaches {c2} < {cost}"
+        );
+    }
+    eprintln!("worst predicted gain {worst_gain:.2e} of the cost; second solves at least {worst_second:.2e} above");
+}
