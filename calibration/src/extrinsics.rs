@@ -13,6 +13,7 @@ use crate::camera_file::{read_camera_file_as, CameraFileError, DistortionModelHi
 use crate::capture_images::{observe_images, CaptureImages, ImageError};
 use crate::overlay::{read_png_rgb8_sized, render_overlay, OverlayError};
 use crate::pnp::{solve_pnp, PnpError, PnpOptions, RansacOptions};
+use nalgebra::{Vector2, Vector3};
 use crate::refine::{
     refine_intrinsics, solution_at, RefineError, RefineParameters, RefinementReport,
 };
@@ -180,20 +181,45 @@ pub fn calibrate_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsOutput, Ext
     let (camera, sol, refinement) = match &job.refine_intrinsics {
         None => (camera, sol, None),
         Some(which) => {
-            let (pts, px): (Vec<_>, Vec<_>) = pairs
-                .points_mm
-                .iter()
-                .zip(&pairs.pixels_px)
-                .zip(&sol.inliers)
-                .filter(|(_, &inlier)| inlier)
-                .map(|((p, q), _)| (*p, *q))
-                .unzip();
-            let r = refine_intrinsics(&camera, &pts, &px, &sol.t_cam_sensor, which)?;
+            // Refined over the inliers, then the pose solved again through the refined camera:
+            // pairs the camera file's model put out may come back in; refined again (from the
+            // file's values) over the larger set, while it grows (at most 4 rounds).
+            let inliers_of = |s: &crate::PnpSolution| -> (Vec<Vector3<f64>>, Vec<Vector2<f64>>) {
+                pairs
+                    .points_mm
+                    .iter()
+                    .zip(&pairs.pixels_px)
+                    .zip(&s.inliers)
+                    .filter(|(_, &inlier)| inlier)
+                    .map(|((p, q), _)| (*p, *q))
+                    .unzip()
+            };
+            let count = |s: &crate::PnpSolution| s.inliers.iter().filter(|&&b| b).count();
+            let (pts, px) = inliers_of(&sol);
+            let mut r = refine_intrinsics(&camera, &pts, &px, &sol.t_cam_sensor, which)?;
+            let mut kept = sol;
+            for _ in 1..4 {
+                let Ok(again) = solve_pnp(&r.camera, &pairs.points_mm, &pairs.pixels_px, &opts)
+                else {
+                    break;
+                };
+                if count(&again) <= count(&kept) {
+                    break;
+                }
+                let (pts, px) = inliers_of(&again);
+                match refine_intrinsics(&camera, &pts, &px, &again.t_cam_sensor, which) {
+                    Ok(r2) => {
+                        r = r2;
+                        kept = again;
+                    }
+                    Err(_) => break,
+                }
+            }
             let sol = solution_at(
                 &r.camera,
                 &pairs.points_mm,
                 &pairs.pixels_px,
-                &sol,
+                &kept,
                 r.t_cam_sensor,
             );
             (r.camera, sol, Some(r))

@@ -827,3 +827,72 @@ fn observations_outside_the_image_and_every_bad_row_are_listed() {
     );
     assert!(!dir.join("out").exists());
 }
+
+/// `--refine-intrinsics` refines over every pin the refined camera explains, not only those the
+/// camera file's model kept (issue 97): through a file whose fisheye k1 is 0.2 off (errors
+/// growing to several px towards the outer rings) and a fixed 3 px threshold, the solve keeps
+/// 19 of the 29 pins; refined over them, the camera is solved again and the others come back
+/// in, and the result is the refinement over all 29 (that of `--no-ransac`, to 1e-6).
+#[test]
+fn refined_intrinsics_bring_back_the_pins_the_camera_files_model_put_out() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let mut rough = intrinsics();
+    let Distortion::Fisheye(k) = rough.distortion else {
+        unreachable!()
+    };
+    rough.distortion = Distortion::Fisheye([k[0] + 0.2, k[1], k[2], k[3]]);
+    std::fs::write(
+        dir.join("cam.yaml"),
+        write_camera(&rough, CameraFileFormat::OpenCvYaml),
+    )
+    .unwrap();
+    write_table(&dir.join("pins.csv"));
+    std::fs::write(dir.join("obs.csv"), observe(false, 0..29)).unwrap();
+    let fixed = ["--ransac-threshold-px", "3"];
+    let o = run(dir, &extrinsics_args("cam.yaml", "plain", &fixed), &[]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let plain = json(&dir.join("plain/extrinsics.json"));
+    let kept = plain["residuals"]["inliers"].as_u64().unwrap();
+    // measured 19
+    assert!(kept < 29, "{kept} inliers");
+    let mut refine = fixed.to_vec();
+    refine.push("--refine-intrinsics");
+    let o = run(dir, &extrinsics_args("cam.yaml", "refined", &refine), &[]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let j = json(&dir.join("refined/extrinsics.json"));
+    let pose = pose_of(&j);
+    assert_eq!(j["residuals"]["inliers"], 29, "{}", j["residuals"]);
+    // the same refinement as over all 29 pins from the start (--no-ransac)
+    let o = run(
+        dir,
+        &extrinsics_args("cam.yaml", "all", &["--no-ransac", "--refine-intrinsics"]),
+        &[],
+    );
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let all = json(&dir.join("all/extrinsics.json"));
+    let params = |j: &serde_json::Value| -> Vec<(String, f64)> {
+        j["intrinsics_refinement"]["parameters"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|p| {
+                (
+                    p["name"].as_str().unwrap().to_string(),
+                    p["value"].as_f64().unwrap(),
+                )
+            })
+            .collect()
+    };
+    for ((n, a), (_, b)) in params(&j).iter().zip(&params(&all)) {
+        assert!((a - b).abs() <= 1e-6 * (1.0 + b.abs()), "{n}: {a} vs {b}");
+    }
+    let (r2, t2) = (
+        pose.rotation.angle_to(&pose_of(&all).rotation).to_degrees(),
+        (pose.translation.vector - pose_of(&all).translation.vector).norm(),
+    );
+    assert!(
+        r2 < 1e-6 && t2 < 1e-6,
+        "{r2} deg, {t2} mm from the refinement over all"
+    );
+}
