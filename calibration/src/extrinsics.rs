@@ -13,7 +13,6 @@ use crate::camera_file::{read_camera_file_as, CameraFileError, DistortionModelHi
 use crate::capture_images::{observe_images, CaptureImages, ImageError};
 use crate::overlay::{read_png_rgb8_sized, render_overlay, OverlayError};
 use crate::pnp::{solve_pnp, PnpError, PnpOptions, RansacOptions};
-use nalgebra::{Vector2, Vector3};
 use crate::refine::{
     refine_intrinsics, solution_at, RefineError, RefineParameters, RefinementReport,
 };
@@ -22,6 +21,7 @@ use crate::tables::{
     check_inside_image, pair, read_capture_plan, read_captures, read_observations,
     read_point_table, PointsFrom, TableError,
 };
+use nalgebra::{Vector2, Vector3};
 
 /// Inputs of one extrinsics calibration.
 #[derive(Debug, Clone)]

@@ -171,14 +171,27 @@ impl Problem<'_> {
     /// Residuals (reprojected minus observed, u then v per point), or `None` when a point
     /// does not project or the intrinsics are not a camera.
     fn residuals(&self, s: &State) -> Option<DVector<f64>> {
-        let cam = CameraModel::new(with_vector(&self.base, &s.intr)).ok()?;
+        let each = self.point_residuals(s)?;
         let mut e = DVector::zeros(2 * self.points.len());
-        for (k, (p, px)) in self.points.iter().zip(self.pixels).enumerate() {
-            let uv = cam.project(&(s.r * p + s.t))?;
-            e[2 * k] = uv.x - px.x;
-            e[2 * k + 1] = uv.y - px.y;
+        for (k, r) in each.iter().enumerate() {
+            let r = (*r)?;
+            e[2 * k] = r.x;
+            e[2 * k + 1] = r.y;
         }
         Some(e)
+    }
+
+    /// Each point's residual, `None` for a point that does not project; `None` in all when
+    /// the intrinsics are not a camera.
+    fn point_residuals(&self, s: &State) -> Option<Vec<Option<Vector2<f64>>>> {
+        let cam = CameraModel::new(with_vector(&self.base, &s.intr)).ok()?;
+        Some(
+            self.points
+                .iter()
+                .zip(self.pixels)
+                .map(|(p, px)| cam.project(&(s.r * p + s.t)).map(|uv| uv - px))
+                .collect(),
+        )
     }
 
     /// `s` moved by `d` (free intrinsics, then the rotation increment on the left, then t).
@@ -193,11 +206,18 @@ impl Problem<'_> {
         n
     }
 
-    /// Central-difference Jacobian of the residuals.
+    /// Central-difference Jacobian of the residuals; for a point that a parameter's step one
+    /// way puts outside the model's field (a pin at the edge of a pinhole model's monotonic
+    /// radius, where a little more distortion folds the image back), the one-sided difference
+    /// of the other way. `None` when a point does not project at `s` or at both steps.
     fn jacobian(&self, s: &State) -> Option<DMatrix<f64>> {
         let p = self.n_params();
         let mut j = DMatrix::zeros(2 * self.points.len(), p);
         let m = self.free.len();
+        let at: Vec<Vector2<f64>> = self
+            .point_residuals(s)?
+            .into_iter()
+            .collect::<Option<_>>()?;
         for c in 0..p {
             let h = if c < m {
                 1e-6 * (s.intr[self.free[c]].abs() + 1e-2)
@@ -208,10 +228,19 @@ impl Problem<'_> {
             };
             let mut d = vec![0.0; p];
             d[c] = h;
-            let plus = self.residuals(&self.step(s, &d))?;
+            let plus = self.point_residuals(&self.step(s, &d))?;
             d[c] = -h;
-            let minus = self.residuals(&self.step(s, &d))?;
-            j.set_column(c, &((plus - minus) / (2.0 * h)));
+            let minus = self.point_residuals(&self.step(s, &d))?;
+            for (k, (a, b)) in plus.iter().zip(&minus).enumerate() {
+                let dk = match (a, b) {
+                    (Some(a), Some(b)) => (a - b) / (2.0 * h),
+                    (Some(a), None) => (a - at[k]) / h,
+                    (None, Some(b)) => (at[k] - b) / h,
+                    (None, None) => return None,
+                };
+                j[(2 * k, c)] = dk.x;
+                j[(2 * k + 1, c)] = dk.y;
+            }
         }
         Some(j)
     }

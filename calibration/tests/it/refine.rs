@@ -213,3 +213,57 @@ fn near_the_axis_the_focal_length_is_held_and_the_report_says_why() {
         .unwrap_err();
     assert!(matches!(e, RefineError::TooFewObservations { .. }), "{e}");
 }
+
+/// A pin at the edge of the camera model's field (issue 97: `--no-ransac --refine-intrinsics`
+/// failed with "a point does not project at the camera file's intrinsics" where k1 and k2
+/// alone worked): the camera file's plumb_bob k1 = -0.05 folds the image back beyond a radius
+/// of 1 / sqrt(0.15), and the outermost of 25 pins lies 1e-7 inside it, so that the Jacobian's
+/// step of k1 one way (6e-8) puts it outside. The refinement takes the other side's difference
+/// there and recovers the camera the pixels were made with (k1 = -0.048, cx 2 px away).
+#[test]
+fn a_pin_at_the_edge_of_the_files_field_is_refined_one_sided() {
+    let lens = |cx_px: f64, k1: f64| Intrinsics {
+        image_width_px: 640,
+        image_height_px: 480,
+        fx_px: 300.0,
+        fy_px: 300.0,
+        cx_px,
+        cy_px: 240.0,
+        distortion: Distortion::PlumbBob([k1, 0.0, 0.0, 0.0, 0.0]),
+    };
+    let truth = CameraModel::new(lens(320.0, -0.048)).unwrap();
+    let file = CameraModel::new(lens(322.0, -0.05)).unwrap();
+    let r_edge = 1.0 / (0.15f64).sqrt() * (1.0 - 1e-7);
+    // pins on a 10 mm sphere about the camera, out to the edge, five per ring
+    let mut pts = Vec::new();
+    for (ring, frac) in [0.0, 0.3, 0.55, 0.8, 1.0].iter().enumerate() {
+        let theta = (r_edge * frac).atan();
+        for k in 0..5 {
+            let a = 2.0 * std::f64::consts::PI * (k as f64 + 0.37 * ring as f64) / 5.0;
+            pts.push(
+                10.0 * Vector3::new(theta.sin() * a.cos(), theta.sin() * a.sin(), theta.cos()),
+            );
+        }
+    }
+    let pose = Isometry3::identity();
+    let px: Vec<Vector2<f64>> = pts.iter().map(|p| truth.project(p).unwrap()).collect();
+    // the precondition: at the file's values a little more distortion puts the outermost
+    // pins outside the field
+    assert!(file.project(&pts[24]).is_some());
+    let folded = CameraModel::new(lens(322.0, -0.05 - 6e-8)).unwrap();
+    assert!(folded.project(&pts[24]).is_none());
+    let only = RefineParameters::Only(vec!["cx".into(), "k1".into()]);
+    let r = refine_intrinsics(&file, &pts, &px, &pose, &only).unwrap();
+    let got = r.camera.intrinsics();
+    let Distortion::PlumbBob(k) = got.distortion else {
+        unreachable!()
+    };
+    // noise-free pixels: the truth to the refinement's convergence (measured 1e-13 px and
+    // 7e-18)
+    assert!(
+        (got.cx_px - 320.0).abs() < 1e-6 && (k[0] + 0.048).abs() < 1e-9,
+        "cx {} k1 {}",
+        got.cx_px,
+        k[0]
+    );
+}
