@@ -367,7 +367,6 @@ fn solve_in_order(
             }
             // The final fit on the consensus ([`fit_on`]), scored again and fitted again until
             // the set stops changing.
-            let t2 = threshold_px * threshold_px;
             for _ in 0..6 {
                 let idx = consensus.indices();
                 if idx.len() < MIN_POINTS {
@@ -382,7 +381,7 @@ fn solve_in_order(
                     pixels_px,
                     &fit.r,
                     &fit.t,
-                    t2,
+                    thr2,
                     f64::INFINITY,
                 );
                 if consensus.indices() == idx {
