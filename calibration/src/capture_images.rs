@@ -225,7 +225,8 @@ pub const OBSERVATIONS_NOTES: &str = "fabkit pin-imprint observations: pixel of 
 /// The captures' observations.
 #[derive(Debug, Clone)]
 pub struct ImageObservations {
-    /// One row per pin id (a pin seen in several captures, the pole pin, averaged), first-seen
+    /// One row per pin id (a pin seen in several captures, the pole pin, combined by
+    /// [`crate::tables::combine_observations`]), first-seen
     /// order; ids spelled as in the point table.
     pub observations: Observations,
     /// Planned pins with no observation (in a capture left out, or not in the table), plan
@@ -357,7 +358,7 @@ pub fn observe_images(
     let assignment = assign_ids(camera, &points, &spots);
     let mut csv = String::from("capture,id,u_px,v_px,score\n");
     // id -> (sum of pixels, count, captures), first-seen order
-    let mut merged: Vec<(String, Vector2<f64>, usize, Vec<String>)> = Vec::new();
+    let mut merged: Vec<(String, Vec<Vector2<f64>>, Vec<String>)> = Vec::new();
     for o in &assignment.observations {
         csv.push_str(&format!(
             "{},{},{:.4},{:.4},{:.2}\n",
@@ -383,18 +384,17 @@ pub fn observe_images(
         let uv = Vector2::new(o.u_px, o.v_px);
         match merged.iter_mut().find(|m| m.0 == id) {
             Some(m) => {
-                m.1 += uv;
-                m.2 += 1;
-                m.3.push(o.capture.clone());
+                m.1.push(uv);
+                m.2.push(o.capture.clone());
             }
-            None => merged.push((id, uv, 1, vec![o.capture.clone()])),
+            None => merged.push((id, vec![uv], vec![o.capture.clone()])),
         }
     }
     let rows: Vec<(String, Vector2<f64>, String)> = merged
         .into_iter()
-        .map(|(id, sum, n, caps)| {
+        .map(|(id, px, caps)| {
             let origin = format!("detected in {}", caps.join(" + "));
-            (id, sum / n as f64, origin)
+            (id, crate::tables::combine_observations(&px), origin)
         })
         .collect();
     let mut unobserved_ids: Vec<String> = Vec::new();

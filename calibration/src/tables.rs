@@ -544,10 +544,57 @@ pub fn parse_capture_plan(text: &str, file: &str) -> Result<CapturePlan, TableEr
     })
 }
 
+/// Least robust noise of a pin's centroid, px, per axis, when its observations are combined
+/// ([`combine_observations`]): observations that agree closer than this are all kept.
+pub const MIN_CENTROID_NOISE_PX: f64 = 0.02;
+
+/// One pin's observations from several captures combined into one pixel, px. The camera does
+/// not move between captures, so they differ by the centroids' noise, unless one is bad (a spot
+/// merged with a neighbour's, or grown into the imprint's halo). Two or fewer: their mean. More:
+/// about the coordinate-wise median `m`, the robust noise per axis `sigma` = median |p - m| /
+/// sqrt(2 ln 2) (the median length of a 2D Gaussian error), at least
+/// [`MIN_CENTROID_NOISE_PX`]; the mean of the observations within
+/// [`crate::pnp::threshold_sigmas`]`(n)` sigma of `m` (none of n good ones left out but with
+/// probability 0.002). The result does not depend on the observations' order but for the
+/// rounding of a sum.
+pub fn combine_observations(px: &[Vector2<f64>]) -> Vector2<f64> {
+    let n = px.len();
+    let mean = |v: &[Vector2<f64>]| v.iter().sum::<Vector2<f64>>() / v.len().max(1) as f64;
+    if n <= 2 {
+        return mean(px);
+    }
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        let h = v.len() / 2;
+        if v.len() % 2 == 1 {
+            v[h]
+        } else {
+            0.5 * (v[h - 1] + v[h])
+        }
+    };
+    let m = Vector2::new(
+        median(px.iter().map(|p| p.x).collect()),
+        median(px.iter().map(|p| p.y).collect()),
+    );
+    let sigma = (median(px.iter().map(|p| (p - m).norm()).collect())
+        / (2.0 * std::f64::consts::LN_2).sqrt())
+    .max(MIN_CENTROID_NOISE_PX);
+    let reach = crate::pnp::threshold_sigmas(n) * sigma;
+    let mut kept: Vec<Vector2<f64>> = px
+        .iter()
+        .copied()
+        .filter(|p| (p - m).norm() <= reach)
+        .collect();
+    // a consistent order for the sum
+    kept.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+    mean(&kept)
+}
+
 /// Reads observation files given one per capture, in capture order, and checks them against
 /// the plan: every id of file k must be a pin of capture k. A pin that stays in for several
 /// captures (the pole pin of a fixtures plan) may be observed in each of them; the camera does
-/// not move between captures, so its observations are averaged into one (origins joined by ` + `).
+/// not move between captures, so its observations are combined into one
+/// ([`combine_observations`]; origins joined by ` + `).
 /// Pins of the plan that were not observed are allowed (a pin the detector missed); they are
 /// returned, in plan order, with the merged observations (first-seen order).
 ///
@@ -577,8 +624,8 @@ pub fn parse_captures(
             files: texts.len(),
         });
     }
-    // id -> (sum of pixels, count, origins), in first-seen order.
-    let mut merged: Vec<(String, Vector2<f64>, usize, Vec<Origin>)> = Vec::new();
+    // id -> (pixels, origins), in first-seen order.
+    let mut merged: Vec<(String, Vec<Vector2<f64>>, Vec<Origin>)> = Vec::new();
     for (k, pair) in texts.iter().enumerate() {
         let obs = parse_observations(std::slice::from_ref(pair))?;
         for (id, uv, origin) in obs.rows {
@@ -597,11 +644,10 @@ pub fn parse_captures(
             }
             match merged.iter_mut().find(|m| m.0 == id) {
                 Some(m) => {
-                    m.1 += uv;
-                    m.2 += 1;
-                    m.3.push(origin);
+                    m.1.push(uv);
+                    m.2.push(origin);
                 }
-                None => merged.push((id, uv, 1, vec![origin])),
+                None => merged.push((id, vec![uv], vec![origin])),
             }
         }
     }
@@ -618,7 +664,7 @@ pub fn parse_captures(
         });
     let rows = merged
         .into_iter()
-        .map(|(id, sum, n, origins)| (id, sum / n as f64, origins.join(" + ")))
+        .map(|(id, px, origins)| (id, combine_observations(&px), origins.join(" + ")))
         .collect();
     Ok((Observations { rows }, unobserved))
 }
