@@ -53,6 +53,21 @@ pub fn shown_f64(x: f64) -> String {
 }
 
 /// A regular file of at most [`MAX_TEXT_INPUT_BYTES`] as UTF-8 text.
+/// The median of `v` (sorted in place): the middle value, or the mean of the middle two; NaN
+/// when `v` is empty.
+pub(crate) fn median_sorting(v: &mut [f64]) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    v.sort_unstable_by(f64::total_cmp);
+    let m = v.len() / 2;
+    if v.len() % 2 == 1 {
+        v[m]
+    } else {
+        0.5 * (v[m - 1] + v[m])
+    }
+}
+
 pub(crate) fn read_text(path: &std::path::Path) -> std::io::Result<String> {
     fabkit_designs::input_files::read_text_file(path, MAX_TEXT_INPUT_BYTES)
 }

@@ -757,13 +757,7 @@ impl PhotometricModel {
                                 .map(|(c, g)| c.image[i][ch] / g),
                         )
                         .collect();
-                    v.sort_unstable_by(f64::total_cmp);
-                    let m = v.len() / 2;
-                    if v.len() % 2 == 1 {
-                        v[m]
-                    } else {
-                        0.5 * (v[m - 1] + v[m])
-                    }
+                    crate::median_sorting(&mut v)
                 })
             })
             .collect();

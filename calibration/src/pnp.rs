@@ -348,16 +348,19 @@ fn solve_in_order(
             let thr2 = threshold_px * threshold_px;
             // The all-points SQPnP pose is the first hypothesis. When it explains every pair,
             // the refinement on all of them is the answer unless it pushes a pair out.
+            let rescore = |c: &mut Consensus, fit: &Fit| {
+                c.score(
+                    camera,
+                    points_mm,
+                    pixels_px,
+                    &fit.r,
+                    &fit.t,
+                    thr2,
+                    f64::INFINITY,
+                );
+            };
             let mut consensus = Consensus::new(n);
-            consensus.score(
-                camera,
-                points_mm,
-                pixels_px,
-                &fit.r,
-                &fit.t,
-                thr2,
-                f64::INFINITY,
-            );
+            rescore(&mut consensus, &fit);
             if consensus.count() == n {
                 fit.refine(camera, points_mm, pixels_px, opts.max_iterations);
                 consensus.set_from_fit(&fit, thr2);
@@ -375,15 +378,7 @@ fn solve_in_order(
                 if let Some(f) = fit_on(&pairs, &idx, &fit, opts) {
                     fit = f;
                 }
-                consensus.score(
-                    camera,
-                    points_mm,
-                    pixels_px,
-                    &fit.r,
-                    &fit.t,
-                    thr2,
-                    f64::INFINITY,
-                );
+                rescore(&mut consensus, &fit);
                 if consensus.indices() == idx {
                     break;
                 }

@@ -563,15 +563,7 @@ pub fn combine_observations(px: &[Vector2<f64>]) -> Vector2<f64> {
     if n <= 2 {
         return mean(px);
     }
-    let median = |mut v: Vec<f64>| {
-        v.sort_by(f64::total_cmp);
-        let h = v.len() / 2;
-        if v.len() % 2 == 1 {
-            v[h]
-        } else {
-            0.5 * (v[h - 1] + v[h])
-        }
-    };
+    let median = |mut v: Vec<f64>| crate::median_sorting(&mut v);
     let m = Vector2::new(
         median(px.iter().map(|p| p.x).collect()),
         median(px.iter().map(|p| p.y).collect()),
