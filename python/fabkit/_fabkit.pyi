@@ -226,13 +226,15 @@ def solve_extrinsics(
     ids: Optional[Sequence[str]] = None,
     ransac: bool = True,
     threshold_px: float | None = None,
-    seed: int = 0,
+    seed: Optional[int] = None,
 ) -> Dict[str, Any]:
     """The camera pose from sensor-frame points (n, 3) mm and pixels (n, 2) px, as ``fabkit
     calibrate extrinsics``. Returns T_cam_sensor (4, 4) (sensor -> camera, mm), residuals_px
     (n, 2) (NaN where a point does not project), inliers and outliers (n,) bool,
-    rms_reprojection_error_px and report (extrinsics.json's content). Raises CalibrationError
-    (a non-finite entry: ``points_mm[i, j] = nan: must be finite``), ValueError (shapes)."""
+    rms_reprojection_error_px and report (extrinsics.json's content). The same pairs in any
+    order give the same pose; ``seed`` has no effect (a DeprecationWarning). Raises
+    CalibrationError (a non-finite entry: ``points_mm[i, j] = nan: must be finite``),
+    ValueError (shapes)."""
 
 class ProtrusionSet:
     """One semi-dome (semi-plate) configuration: a pattern at 0 deg (+x half) or 180 deg;
