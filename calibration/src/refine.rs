@@ -209,15 +209,24 @@ impl Problem<'_> {
     /// Central-difference Jacobian of the residuals; for a point that a parameter's step one
     /// way puts outside the model's field (a pin at the edge of a pinhole model's monotonic
     /// radius, where a little more distortion folds the image back), the one-sided difference
-    /// of the other way. `None` when a point does not project at `s` or at both steps.
+    /// of the other way. `None` when a point does not project at both steps (or, where one
+    /// side is needed, at `s`).
     fn jacobian(&self, s: &State) -> Option<DMatrix<f64>> {
         let p = self.n_params();
         let mut j = DMatrix::zeros(2 * self.points.len(), p);
         let m = self.free.len();
-        let at: Vec<Vector2<f64>> = self
-            .point_residuals(s)?
-            .into_iter()
-            .collect::<Option<_>>()?;
+        // the residuals at `s`, needed only for a one-sided difference
+        let mut at: Option<Vec<Vector2<f64>>> = None;
+        let mut at_s = |k: usize| -> Option<Vector2<f64>> {
+            if at.is_none() {
+                at = Some(
+                    self.point_residuals(s)?
+                        .into_iter()
+                        .collect::<Option<_>>()?,
+                );
+            }
+            at.as_ref().map(|v| v[k])
+        };
         for c in 0..p {
             let h = if c < m {
                 1e-6 * (s.intr[self.free[c]].abs() + 1e-2)
@@ -234,8 +243,8 @@ impl Problem<'_> {
             for (k, (a, b)) in plus.iter().zip(&minus).enumerate() {
                 let dk = match (a, b) {
                     (Some(a), Some(b)) => (a - b) / (2.0 * h),
-                    (Some(a), None) => (a - at[k]) / h,
-                    (None, Some(b)) => (at[k] - b) / h,
+                    (Some(a), None) => (a - at_s(k)?) / h,
+                    (None, Some(b)) => (at_s(k)? - b) / h,
                     (None, None) => return None,
                 };
                 j[(2 * k, c)] = dk.x;
