@@ -20,6 +20,7 @@ pub mod p3p;
 pub mod photometric;
 pub mod pnp;
 pub mod refine;
+pub mod refraction;
 pub mod report;
 pub mod sqpnp;
 pub mod synthetic;

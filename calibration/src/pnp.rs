@@ -10,6 +10,7 @@ use nalgebra::{
 
 use crate::camera::{CameraError, CameraModel};
 use crate::p3p::p3p;
+use crate::refraction::Imaging;
 use crate::sqpnp::sqpnp;
 
 /// Smallest number of point-pixel pairs the solver accepts.
@@ -137,7 +138,7 @@ pub const MAX_ROBUST_THRESHOLD_OF_SPREAD: f64 = 0.1;
 /// frame, mm), their pixels (px) and the pixels' unit bearing vectors.
 #[derive(Clone, Copy)]
 struct Pairs<'a> {
-    camera: &'a CameraModel,
+    camera: Imaging<'a>,
     pts: &'a [Vector3<f64>],
     px: &'a [Vector2<f64>],
     bearings: &'a [Vector3<f64>],
@@ -157,14 +158,14 @@ fn robust_threshold_px(
     ro: &RansacOptions,
     opts: &PnpOptions,
 ) -> f64 {
-    let (camera, pts, px, bearings) = (pairs.camera, pairs.pts, pairs.px, pairs.bearings);
+    let (camera, pts, px, bearings) = (&pairs.camera, pairs.pts, pairs.px, pairs.bearings);
     let n = pts.len();
     let half = n / 2;
     let mut e2 = vec![0.0; n];
     let median2 = |r: &Matrix3<f64>, t: &Vector3<f64>, e2: &mut Vec<f64>| {
         for (k, (m, uv)) in pts.iter().zip(px).enumerate() {
             e2[k] = camera
-                .project(&(r * m + t))
+                .project(r, t, m)
                 .map_or(f64::INFINITY, |p| (p - uv).norm_squared());
         }
         let mut sorted = e2.clone();
@@ -234,6 +235,21 @@ pub fn solve_pnp(
     pixels_px: &[Vector2<f64>],
     opts: &PnpOptions,
 ) -> Result<PnpSolution, PnpError> {
+    solve_pnp_through(&Imaging::straight(camera), points_mm, pixels_px, opts)
+}
+
+/// [`solve_pnp`] through an optical path: the residuals, the consensus and every refinement
+/// project through `imaging`'s layers ([`crate::refraction`]); the minimal samples and the
+/// closed-form starts take the pixels' straight bearings, which the refinement then corrects.
+///
+/// # Errors
+/// As [`solve_pnp`].
+pub fn solve_pnp_through(
+    camera: &Imaging<'_>,
+    points_mm: &[Vector3<f64>],
+    pixels_px: &[Vector2<f64>],
+    opts: &PnpOptions,
+) -> Result<PnpSolution, PnpError> {
     let n = points_mm.len();
     if pixels_px.len() != n {
         return Err(PnpError::LengthMismatch {
@@ -263,6 +279,7 @@ pub fn solve_pnp(
         }
         bearings.push(
             camera
+                .camera
                 .unproject(uv)
                 .map_err(|source| PnpError::Unprojectable { index, source })?,
         );
@@ -306,7 +323,7 @@ pub fn solve_pnp(
 
 /// [`solve_pnp`] on validated pairs in the canonical order, with their bearings.
 fn solve_in_order(
-    camera: &CameraModel,
+    camera: &Imaging<'_>,
     points_mm: &[Vector3<f64>],
     pixels_px: &[Vector2<f64>],
     bearings: &[Vector3<f64>],
@@ -329,7 +346,7 @@ fn solve_in_order(
     let mut inliers = vec![true; n];
     let mut threshold_used = None;
     let pairs = Pairs {
-        camera,
+        camera: *camera,
         pts: points_mm,
         px: pixels_px,
         bearings,
@@ -405,7 +422,7 @@ fn solve_in_order(
     for i in 0..n {
         if residuals_px[i].is_none() {
             residuals_px[i] = camera
-                .project(&(fit.r * points_mm[i] + fit.t))
+                .project(&fit.r, &fit.t, &points_mm[i])
                 .map(|uv| uv - pixels_px[i]);
         }
         if inliers[i] {
@@ -443,7 +460,7 @@ fn ransac(
     fit: &mut Fit,
     best: &mut Consensus,
 ) -> usize {
-    let (camera, pts, px, bearings) = (pairs.camera, pairs.pts, pairs.px, pairs.bearings);
+    let (camera, pts, px, bearings) = (&pairs.camera, pairs.pts, pairs.px, pairs.bearings);
     let n = pts.len();
     let thr = ro.threshold_px.unwrap_or(MIN_ROBUST_THRESHOLD_PX);
     let thr2 = thr * thr;
@@ -520,7 +537,7 @@ fn ransac(
 /// hypothesis left the refinement (a flat valley of the reprojection error can hold one start
 /// short of it). `None` when neither start projects every pair.
 fn fit_on(pairs: &Pairs<'_>, idx: &[usize], from: &Fit, opts: &PnpOptions) -> Option<Fit> {
-    let (camera, pts, px, bearings) = (pairs.camera, pairs.pts, pairs.px, pairs.bearings);
+    let (camera, pts, px, bearings) = (&pairs.camera, pairs.pts, pairs.px, pairs.bearings);
     let mut best: Option<Fit> = None;
     let mut consider = |r: Matrix3<f64>, t: Vector3<f64>| {
         if let Some(mut f) = Fit::at(camera, pts, px, idx, r, t) {
@@ -569,7 +586,7 @@ impl Consensus {
     #[allow(clippy::too_many_arguments)]
     fn score(
         &mut self,
-        camera: &CameraModel,
+        camera: &Imaging<'_>,
         pts: &[Vector3<f64>],
         px: &[Vector2<f64>],
         r: &Matrix3<f64>,
@@ -580,7 +597,7 @@ impl Consensus {
         let mut s = 0.0;
         for (k, (m, uv)) in pts.iter().zip(px).enumerate() {
             let e2 = camera
-                .project(&(r * m + t))
+                .project(r, t, m)
                 .map_or(f64::INFINITY, |p| (p - uv).norm_squared());
             self.inliers[k] = e2 < thr2;
             s += e2.min(thr2);
@@ -622,7 +639,7 @@ struct Fit {
 impl Fit {
     /// `None` if a point of `idx` does not project at (r, t).
     fn at(
-        camera: &CameraModel,
+        camera: &Imaging<'_>,
         pts: &[Vector3<f64>],
         px: &[Vector2<f64>],
         idx: &[usize],
@@ -645,7 +662,7 @@ impl Fit {
     /// Levenberg-Marquardt on the reprojection error over `idx`, from the current pose.
     fn refine(
         &mut self,
-        camera: &CameraModel,
+        camera: &Imaging<'_>,
         pts: &[Vector3<f64>],
         px: &[Vector2<f64>],
         max_iterations: usize,
@@ -775,7 +792,7 @@ impl Triples {
 /// rotation perturbed on the left (R <- exp(w) R) and parameters (w, t); `residuals` gets the
 /// reprojected minus observed pixel per entry of `idx`.
 pub(crate) fn normal_equations(
-    camera: &CameraModel,
+    camera: &Imaging<'_>,
     pts: &[Vector3<f64>],
     px: &[Vector2<f64>],
     idx: &[usize],
@@ -788,26 +805,12 @@ pub(crate) fn normal_equations(
     let mut jte = Vector6::zeros();
     let mut s = 0.0;
     for &i in idx {
-        let q = r * pts[i];
-        let (uv, j) = camera.project_with_jacobian(&(q + t))?;
+        let (uv, j) = camera.project_with_jacobian(r, t, &pts[i])?;
         let e = uv - px[i];
         residuals.push(e);
         s += e.norm_squared();
-        // d(pc)/dw = -[q]x, d(pc)/dt = I.
-        let jw = j * (-q.cross_matrix());
-        let row = |k: usize| {
-            Vector6::new(
-                jw[(k, 0)],
-                jw[(k, 1)],
-                jw[(k, 2)],
-                j[(k, 0)],
-                j[(k, 1)],
-                j[(k, 2)],
-            )
-        };
-        let (a, b) = (row(0), row(1));
-        jtj += a * a.transpose() + b * b.transpose();
-        jte += a * e.x + b * e.y;
+        jtj += j.transpose() * j;
+        jte += j.transpose() * e;
     }
     Some((jtj, jte, s))
 }
@@ -829,8 +832,9 @@ pub fn reprojection_cost(
     t_cam_sensor: &Isometry3<f64>,
 ) -> Option<f64> {
     let (r, t) = rotation_translation(t_cam_sensor);
+    let camera = Imaging::straight(camera);
     points_mm.iter().zip(pixels_px).try_fold(0.0, |s, (p, x)| {
-        Some(s + (camera.project(&(r * p + t))? - x).norm_squared())
+        Some(s + (camera.project(&r, &t, p)? - x).norm_squared())
     })
 }
 
@@ -844,7 +848,15 @@ pub fn reprojection_normal_equations(
 ) -> Option<(Matrix6<f64>, Vector6<f64>, f64)> {
     let idx: Vec<usize> = (0..points_mm.len()).collect();
     let (r, t) = rotation_translation(t_cam_sensor);
-    normal_equations(camera, points_mm, pixels_px, &idx, &r, &t, &mut Vec::new())
+    normal_equations(
+        &Imaging::straight(camera),
+        points_mm,
+        pixels_px,
+        &idx,
+        &r,
+        &t,
+        &mut Vec::new(),
+    )
 }
 
 /// How well the pins' geometry fixes a pose: the first-order covariance of the pose from the
@@ -886,6 +898,23 @@ pub const WEAK_POSE_MM_PER_PX: f64 = 1.0;
 /// the pose is not determined (J^T J singular) or a point does not project.
 pub fn pose_uncertainty(
     camera: &CameraModel,
+    points_mm: &[Vector3<f64>],
+    pixels_px: &[Vector2<f64>],
+    inliers: &[bool],
+    t_cam_sensor: &Isometry3<f64>,
+) -> Option<PoseUncertainty> {
+    pose_uncertainty_through(
+        &Imaging::straight(camera),
+        points_mm,
+        pixels_px,
+        inliers,
+        t_cam_sensor,
+    )
+}
+
+/// [`pose_uncertainty`] through an optical path.
+pub fn pose_uncertainty_through(
+    camera: &Imaging<'_>,
     points_mm: &[Vector3<f64>],
     pixels_px: &[Vector2<f64>],
     inliers: &[bool],

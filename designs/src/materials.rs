@@ -59,9 +59,29 @@ pub struct Material {
     /// where it is required), in (0, 0.1].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub applied_ml_per_cm2: Option<f64>,
+    /// Refractive index for visible light, where the camera looks through the material
+    /// (clear gels, glass, acrylic); `None` for opaque materials.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub refractive_index: Option<RefractiveIndex>,
     /// Where the numbers come from (datasheet, paper and section).
     pub source: String,
 }
+
+/// Refractive index of a clear material at the sodium D line (589 nm), with its source.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RefractiveIndex {
+    /// n_D, dimensionless, in [1, 3): 1.41 for the clear silicones, 1.47 for borosilicate
+    /// glass, 1.49 for PMMA.
+    pub n: f64,
+    /// Where the value comes from (datasheet, paper); a value no maker publishes starts with
+    /// `ASSUMPTION:` and says what it is taken from.
+    pub source: String,
+}
+
+/// Largest refractive index the table accepts (exclusive): beyond any clear material a
+/// tactile sensor is made of (diamond is 2.42).
+pub const MAX_REFRACTIVE_INDEX: f64 = 3.0;
 
 /// The whole table, keyed by material key.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -99,6 +119,19 @@ impl MaterialsTable {
             }
             if m.source.trim().is_empty() {
                 return Err(format!("materials.{k}.source must name a source"));
+            }
+            if let Some(r) = &m.refractive_index {
+                if !(r.n >= 1.0 && r.n < MAX_REFRACTIVE_INDEX) {
+                    return Err(format!(
+                        "materials.{k}.refractive_index.n = {}: must be from 1 to below 3 (n_D of a clear material)",
+                        r.n
+                    ));
+                }
+                if r.source.trim().is_empty() {
+                    return Err(format!(
+                        "materials.{k}.refractive_index.source must name a source (or start with ASSUMPTION:)"
+                    ));
+                }
             }
             let treatment = matches!(m.kind, MaterialKind::Primer | MaterialKind::Release);
             match m.applied_ml_per_cm2 {

@@ -10,5 +10,6 @@ mod images_library;
 mod imprints;
 mod photometric;
 mod refine;
+mod refraction;
 mod shading;
 mod tables;

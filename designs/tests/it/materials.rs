@@ -290,3 +290,42 @@ fn clamp_bolts_are_named_by_standard_size_and_length() {
         kit.bought_items
     );
 }
+
+/// Every clear material the camera looks through in a library sensor has a refractive index
+/// with a source; values no maker publishes say ASSUMPTION. A bad index or a missing source is
+/// an error naming its path, value and rule.
+#[test]
+fn clear_materials_carry_a_sourced_refractive_index() {
+    let t = MaterialsTable::embedded().unwrap();
+    // the clear silicones, the R-Tac0 core's glass and ShadowTac's plate
+    for (k, n) in [
+        ("sylgard_184", 1.41),
+        ("solaris", 1.41),
+        ("ecoflex_00_30", 1.41),
+        ("borosilicate_glass", 1.473),
+        ("pmma", 1.491),
+    ] {
+        let r = t.get(k).unwrap().refractive_index.as_ref().unwrap();
+        assert_eq!(r.n, n, "{k}");
+        assert!(!r.source.trim().is_empty(), "{k}");
+    }
+    assert!(t
+        .get("solaris")
+        .unwrap()
+        .refractive_index
+        .as_ref()
+        .unwrap()
+        .source
+        .starts_with("ASSUMPTION:"));
+    assert!(t.get("pla_black").unwrap().refractive_index.is_none());
+    let base = "materials:\n  gel:\n    name: g\n    kind: bought\n    density_g_per_cm3: 1.0\n    source: s\n";
+    let with = |r: &str| format!("{base}    refractive_index: {r}\n");
+    assert!(MaterialsTable::from_yaml(&with("{n: 1.41, source: x}"), "m.yaml").is_ok());
+    let e = MaterialsTable::from_yaml(&with("{n: 0.9, source: x}"), "m.yaml").unwrap_err();
+    assert!(
+        e.contains("materials.gel.refractive_index.n = 0.9") && e.contains("from 1 to below 3"),
+        "{e}"
+    );
+    let e = MaterialsTable::from_yaml(&with("{n: 1.4, source: ' '}"), "m.yaml").unwrap_err();
+    assert!(e.contains("materials.gel.refractive_index.source"), "{e}");
+}

@@ -1,0 +1,308 @@
+//! The optical path between the lens and the skin: clear media bounded by flat interfaces
+//! normal to the sensor's z axis (a filling gel's free surface, a clear plate, flat cast
+//! layers), each ray bent at every interface by Snell's law, and the projection of a
+//! sensor-frame point through them ([`Imaging`]). Sensor frame, mm (docs/conventions.md).
+//!
+//! Snell's law at a plane, n1 sin(theta1) = n2 sin(theta2) with the ray staying in the plane of
+//! incidence (Hecht, *Optics*, 5th ed., Sec. 4.4), makes `s = n sin(theta)` (theta from the
+//! interfaces' common normal) the same in every medium, and the ray's lateral run through a
+//! medium of thickness `t` and index `n` is `t s / sqrt(n^2 - s^2)`. The ray from the camera's
+//! centre `C` to a point `P` is therefore the one whose `s` solves
+//!
+//! ```text
+//! sum_i t_i s / sqrt(n_i^2 - s^2) = |(P - C)_xy|,
+//! ```
+//!
+//! a sum increasing in `s` from 0 on [0, min n_i): one root, found by safeguarded Newton steps.
+//! Paraxially, a point at depth `d` below one interface seen straight along its normal appears
+//! at depth `d / n` (Hecht Sec. 5.2.3, the apparent depth), as the tests check.
+//!
+//! Assumed: the interfaces are planes normal to the sensor's z axis and the media are
+//! homogeneous and isotropic; the camera file describes the lens in the medium the camera's
+//! centre sits in (air for every library sensor: it was calibrated there). Not modelled yet:
+//! curved interfaces (a glass core's faces, the skin's layers on a dome), whose bending is
+//! small where the layers' indices are close (1.41 silicones against 1.47 glass).
+
+use crate::camera::CameraModel;
+use nalgebra::{Matrix2x6, Matrix3, Rotation3, Vector2, Vector3};
+
+/// Largest refractive index a medium may have (exclusive), as the materials table.
+pub const MAX_INDEX: f64 = 3.0;
+
+/// A bad optical path: what is wrong, with the value and the rule.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{field} = {value}: {rule}")]
+pub struct LayersError {
+    pub field: String,
+    pub value: String,
+    pub rule: &'static str,
+}
+
+/// Clear media bounded by planes `z = z_k` of the sensor frame: the medium below the first
+/// plane, between consecutive planes, and above the last, each with its refractive index.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FlatLayers {
+    planes_z_mm: Vec<f64>,
+    indices: Vec<f64>,
+}
+
+impl FlatLayers {
+    /// `planes_z_mm` (K, mm, strictly increasing, finite) and `indices` (K + 1, each in
+    /// [1, 3)): the medium below `planes_z_mm[0]`, then each medium above a plane.
+    ///
+    /// # Errors
+    /// [`LayersError`] naming the entry, its value and the rule.
+    pub fn new(planes_z_mm: Vec<f64>, indices: Vec<f64>) -> Result<FlatLayers, LayersError> {
+        if indices.len() != planes_z_mm.len() + 1 {
+            return Err(LayersError {
+                field: "indices".into(),
+                value: format!("{} entries", indices.len()),
+                rule: "one index per medium: one more than the planes",
+            });
+        }
+        for (k, z) in planes_z_mm.iter().enumerate() {
+            if !z.is_finite() || (k > 0 && !(*z > planes_z_mm[k - 1])) {
+                return Err(LayersError {
+                    field: format!("planes_z_mm[{k}]"),
+                    value: crate::shown_f64(*z),
+                    rule: "must be finite and above the plane before it",
+                });
+            }
+        }
+        for (k, n) in indices.iter().enumerate() {
+            if !(*n >= 1.0 && *n < MAX_INDEX) {
+                return Err(LayersError {
+                    field: format!("indices[{k}]"),
+                    value: crate::shown_f64(*n),
+                    rule: "a refractive index must be from 1 to below 3",
+                });
+            }
+        }
+        Ok(FlatLayers {
+            planes_z_mm,
+            indices,
+        })
+    }
+
+    /// One plane at `z_mm` between a medium of index `below` and one of index `above`.
+    ///
+    /// # Errors
+    /// As [`FlatLayers::new`].
+    pub fn single(z_mm: f64, below: f64, above: f64) -> Result<FlatLayers, LayersError> {
+        FlatLayers::new(vec![z_mm], vec![below, above])
+    }
+
+    /// The planes' heights, sensor frame z, mm, increasing.
+    pub fn planes_z_mm(&self) -> &[f64] {
+        &self.planes_z_mm
+    }
+
+    /// The media's refractive indices, from below the first plane to above the last.
+    pub fn indices(&self) -> &[f64] {
+        &self.indices
+    }
+
+    /// The index of the medium at height `z_mm` (a point on a plane counts as below it).
+    pub fn index_at(&self, z_mm: f64) -> f64 {
+        self.indices[self.planes_z_mm.iter().filter(|&&p| p < z_mm).count()]
+    }
+
+    /// The thickness along z (mm) and index of each medium the segment from height `z0` to
+    /// height `z1` passes through, in either direction.
+    fn runs(&self, z0: f64, z1: f64) -> impl Iterator<Item = (f64, f64)> + '_ {
+        let (lo, hi) = if z0 <= z1 { (z0, z1) } else { (z1, z0) };
+        let k = self.planes_z_mm.len();
+        (0..=k).filter_map(move |i| {
+            let bottom = if i == 0 {
+                lo
+            } else {
+                self.planes_z_mm[i - 1].max(lo)
+            };
+            let top = if i == k {
+                hi
+            } else {
+                self.planes_z_mm[i].min(hi)
+            };
+            (top > bottom).then_some((top - bottom, self.indices[i]))
+        })
+    }
+
+    /// The unit direction (sensor frame) in which the ray that reaches `to` leaves `from`, in
+    /// the medium at `from`: the root of the lateral-run equation of the module docs. `None`
+    /// when the points coincide or are not finite.
+    pub fn direction_to(&self, from: &Vector3<f64>, to: &Vector3<f64>) -> Option<Vector3<f64>> {
+        let h = to - from;
+        let run = h.xy().norm();
+        if !(h.norm() > 0.0) || !h.iter().all(|v| v.is_finite()) {
+            return None;
+        }
+        let runs: Vec<(f64, f64)> = self.runs(from.z, to.z).collect();
+        let n_from = self.index_at(from.z);
+        if runs.is_empty() || run == 0.0 || runs.iter().all(|&(_, n)| n == n_from) {
+            return Some(h / h.norm());
+        }
+        let n_min = runs.iter().map(|&(_, n)| n).fold(f64::INFINITY, f64::min);
+        let f = |s: f64| {
+            runs.iter().fold((-run, 0.0), |(v, d), &(t, n)| {
+                let c2 = n * n - s * s;
+                (v + t * s / c2.sqrt(), d + t * n * n / (c2 * c2.sqrt()))
+            })
+        };
+        // Newton from the straight ray's invariant, kept inside a shrinking bracket [lo, hi].
+        let (mut lo, mut hi) = (0.0, n_min);
+        let mut s = (n_from * run / h.norm()).min(0.5 * n_min);
+        for _ in 0..200 {
+            let (v, d) = f(s);
+            if v == 0.0 {
+                break;
+            }
+            if v < 0.0 {
+                lo = s;
+            } else {
+                hi = s;
+            }
+            let newton = s - v / d;
+            let next = if newton > lo && newton < hi {
+                newton
+            } else {
+                0.5 * (lo + hi)
+            };
+            if (next - s).abs() <= 4.0 * f64::EPSILON * n_min {
+                s = next;
+                break;
+            }
+            s = next;
+        }
+        let sin = (s / n_from).min(1.0);
+        let along = h.xy() / run;
+        Some(Vector3::new(
+            sin * along.x,
+            sin * along.y,
+            (1.0 - sin * sin).sqrt().copysign(h.z),
+        ))
+    }
+
+    /// Traces the ray leaving `from` along `direction` (any length above 0, in the medium at
+    /// `from`) to the height `z_mm`, bending it at every plane between: the point where it
+    /// reaches that height and its unit direction there. `None` when the ray runs parallel to
+    /// the planes or away from `z_mm`, or is totally internally reflected on the way.
+    pub fn trace_to_z(
+        &self,
+        from: &Vector3<f64>,
+        direction: &Vector3<f64>,
+        z_mm: f64,
+    ) -> Option<(Vector3<f64>, Vector3<f64>)> {
+        let d = direction.try_normalize(0.0)?;
+        if !(d.z != 0.0 && (z_mm - from.z) * d.z >= 0.0) {
+            return None;
+        }
+        let s = self.index_at(from.z) * d.xy().norm();
+        let along = if d.xy().norm() > 0.0 {
+            d.xy() / d.xy().norm()
+        } else {
+            Vector2::zeros()
+        };
+        let runs: Vec<(f64, f64)> = self.runs(from.z, z_mm).collect();
+        let mut lateral = 0.0;
+        for &(t, n) in &runs {
+            if !(s < n) {
+                return None;
+            }
+            lateral += t * s / (n * n - s * s).sqrt();
+        }
+        // the medium the ray is in when it reaches z_mm: the last one on its way
+        let last = if d.z > 0.0 { runs.last() } else { runs.first() };
+        let n_end = last.map_or(self.index_at(from.z), |&(_, n)| n);
+        let sin = s / n_end;
+        if !(sin < 1.0) {
+            return None;
+        }
+        let end = Vector3::new(from.x + lateral * along.x, from.y + lateral * along.y, z_mm);
+        let dir = Vector3::new(
+            sin * along.x,
+            sin * along.y,
+            (1.0 - sin * sin).sqrt().copysign(d.z),
+        );
+        Some((end, dir))
+    }
+}
+
+/// A camera and the optical path in front of it: what projects a sensor-frame point at a
+/// pose. `layers: None` is the straight-ray pinhole or fisheye projection of the camera file
+/// alone.
+#[derive(Debug, Clone, Copy)]
+pub struct Imaging<'a> {
+    pub camera: &'a CameraModel,
+    pub layers: Option<&'a FlatLayers>,
+}
+
+impl<'a> Imaging<'a> {
+    /// The camera file's model with straight rays.
+    pub fn straight(camera: &'a CameraModel) -> Imaging<'a> {
+        Imaging {
+            camera,
+            layers: None,
+        }
+    }
+
+    /// The pixel (px) of the sensor-frame point `p` (mm) seen by the camera at the pose
+    /// T_cam_sensor = (`r`, `t`) through the layers: the lens projects the direction in which
+    /// the ray that reaches `p` leaves the camera's centre. `None` where the camera model's
+    /// field ends.
+    #[inline]
+    pub fn project(
+        &self,
+        r: &Matrix3<f64>,
+        t: &Vector3<f64>,
+        p: &Vector3<f64>,
+    ) -> Option<Vector2<f64>> {
+        match self.layers {
+            None => self.camera.project(&(r * p + t)),
+            Some(l) => {
+                let centre = -(r.transpose() * t);
+                let d = l.direction_to(&centre, p)?;
+                self.camera.project(&(r * d))
+            }
+        }
+    }
+
+    /// [`project`](Self::project) and its 2 x 6 Jacobian with respect to the pose, the
+    /// rotation perturbed on the left (R <- exp(w) R, w in rad) then t (mm): analytic for
+    /// straight rays, central differences through the layers (steps 1e-6 rad and 1e-6 mm,
+    /// truncation error of order 1e-12 of the derivative against a root solved to rounding).
+    pub fn project_with_jacobian(
+        &self,
+        r: &Matrix3<f64>,
+        t: &Vector3<f64>,
+        p: &Vector3<f64>,
+    ) -> Option<(Vector2<f64>, Matrix2x6<f64>)> {
+        let Some(_) = self.layers else {
+            let q = r * p;
+            let (uv, j) = self.camera.project_with_jacobian(&(q + t))?;
+            // d(pc)/dw = -[q]x, d(pc)/dt = I.
+            let jw = j * (-q.cross_matrix());
+            let mut out = Matrix2x6::zeros();
+            out.fixed_view_mut::<2, 3>(0, 0).copy_from(&jw);
+            out.fixed_view_mut::<2, 3>(0, 3).copy_from(&j);
+            return Some((uv, out));
+        };
+        let uv = self.project(r, t, p)?;
+        let h = 1e-6;
+        let mut out = Matrix2x6::zeros();
+        for k in 0..6 {
+            let mut e = Vector3::zeros();
+            e[k % 3] = h;
+            let (plus, minus) = if k < 3 {
+                let (rp, rm) = (
+                    Rotation3::new(e).matrix() * r,
+                    Rotation3::new(-e).matrix() * r,
+                );
+                (self.project(&rp, t, p)?, self.project(&rm, t, p)?)
+            } else {
+                (self.project(r, &(t + e), p)?, self.project(r, &(t - e), p)?)
+            };
+            out.set_column(k, &((plus - minus) / (2.0 * h)));
+        }
+        Some((uv, out))
+    }
+}
