@@ -26,7 +26,7 @@ pub use printers::{
     shipped_printers, Bed, PrinterFile, PrinterProfile, PrinterProfiles, Technology,
 };
 pub use shared::{
-    Backing, BrushedCoat, Core, CoreMachining, FillingGel, LayerProcess, MoldStrategy,
+    Backing, BrushedCoat, Core, CoreMachining, FillingGel, GelFill, LayerProcess, MoldStrategy,
 };
 
 /// Lengths of a design that may be negative ([`crate::values::check_values`]): the lights'

@@ -351,6 +351,13 @@ pub fn check_params(
     errs: &mut Vec<ParamError>,
 ) {
     let before = errs.len();
+    if let Some(fills) = sb.filling_gel.as_ref().and_then(|f| f.fills) {
+        errs.push(ParamError::new(
+            "shaft_body.filling_gel.fills",
+            format!("{fills:?}").to_lowercase(),
+            "the shaft body's gel always fills down to its lens window: remove fills",
+        ));
+    }
     // The mount checks its own numbers (robot_mount::check_params).
     crate::parts::check_above_zero("shaft_body.", sb, &["robot_mount"], errs);
     check_printer_and_angles(ctx, sb, stack, errs);

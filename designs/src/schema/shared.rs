@@ -134,12 +134,29 @@ pub enum MoldStrategy {
 }
 
 /// The internal filling gel (R-Tac0 Sec. III-B1): poured into the assembled shell with the
-/// sensor pole-down, before the camera goes on. It fills the core, the diffuser's opening and
-/// the light chamber up to the LED PCB's face, which is the flat window the camera looks
-/// through; it diffuses the LEDs' light and, cured, glues the core to the shell.
+/// sensor pole-down, before the camera goes on; it diffuses the LEDs' light and, cured, glues
+/// the core to the shell. Its flat free surface is the interface through which the camera
+/// looks into it (`calibration::refraction`): where it lies is set by `fills`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct FillingGel {
     /// Material key in the materials table; a cast material (R-Tac0: `solaris`).
     pub material: String,
+    /// How far the gel is poured (housing only; the shaft body's gel always reaches its lens
+    /// window): `chamber` (the default) fills the core, the diffuser's opening and the light
+    /// chamber up to the LED PCB's face, which is then its free surface; `core` fills the core
+    /// to its open end, whose plane is then the free surface and the diffuser and chamber stay
+    /// air.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fills: Option<GelFill>,
+}
+
+/// How far a housing's filling gel is poured ([`FillingGel::fills`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum GelFill {
+    /// The core only, to its open end.
+    Core,
+    /// The core, the diffuser's opening and the light chamber, to the LED PCB's face.
+    Chamber,
 }

@@ -104,21 +104,46 @@ fn rtac0_members_are_in_the_sensor_frame_with_their_volumes() {
         2.0 * 0.01 / 4.8,
         "collar",
     );
-    // the filling gel (R-Tac0 Sec. III-B1): the core's inside (radius 9 mm, hemisphere on
-    // 6 + 3 mm of cylinder), the diffuser's opening (9.8 mm, 2 mm) and the light chamber
-    // (11.7 mm, 10 mm down to the LED PCB)
+    // the filling gel (R-Tac0 Sec. III-B1, `fills: core`): the core's inside (radius 9 mm,
+    // hemisphere on 6 + 3 mm of cylinder) down to the tube's mouth at z = -9 mm
+    let gel = member(a, "filling_gel");
     rel_close(
-        member(a, "filling_gel").solid.volume(),
-        shell(0.0, 9.0, 3.0) + ring(9.8, 0.0, 2.0) + ring(11.7, 0.0, 10.0),
+        gel.solid.volume(),
+        shell(0.0, 9.0, 3.0),
         2.0 * 0.01 / 9.0,
         "filling gel",
     );
+    assert!((gel.solid.bounding_box().unwrap().min[2] - -9.0).abs() < 1e-9);
     rel_close(
         member(a, "diffuser_envelope").solid.volume(),
         ring(15.0, 9.8, 2.0),
         2.0 * 0.01 / 5.2,
         "diffuser",
     );
+}
+
+/// `fills: chamber` pours the gel on through the diffuser's opening (9.8 mm, 2 mm) and the
+/// light chamber (11.7 mm, 10 mm down to the LED PCB's face at z = -21 mm).
+#[test]
+fn a_gel_that_fills_the_chamber_reaches_the_led_pcb() {
+    let text = fabkit_designs::library::LIBRARY
+        .iter()
+        .find(|(n, _)| *n == "rtac0")
+        .unwrap()
+        .1
+        .replace("fills: core ", "fills: chamber ");
+    let design = fabkit_designs::Design::from_yaml(&text, "rtac0.yaml").unwrap();
+    let kit = build_kit(&design, ChordTolerance::new(0.05).unwrap()).unwrap();
+    let gel = member(&kit.assembly, "filling_gel");
+    let shell = |r: f64, below: f64| 2.0 / 3.0 * PI * r.powi(3) + PI * r * r * (6.0 + below);
+    let disc = |r: f64, h: f64| PI * r * r * h;
+    rel_close(
+        gel.solid.volume(),
+        shell(9.0, 3.0) + disc(9.8, 2.0) + disc(11.7, 10.0),
+        2.0 * 0.05 / 9.0,
+        "filling gel",
+    );
+    assert!((gel.solid.bounding_box().unwrap().min[2] - -21.0).abs() < 1e-9);
 }
 
 /// Parts that are designed to touch (the skin's base on the shell's top face, the tube's rim

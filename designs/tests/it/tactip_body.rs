@@ -282,6 +282,9 @@ fn each_rule_of_the_body_names_its_parameter() {
         ("shaft_body.robot_mount.cup_wall_mm", |d| {
             mount(d).cup_wall_mm = 0.5
         }),
+        ("shaft_body.filling_gel.fills", |d| {
+            sb(d).filling_gel.as_mut().unwrap().fills = Some(fabkit_designs::schema::GelFill::Core)
+        }),
         // the grooves over a 80 deg turn run into the cable window
         ("shaft_body.robot_mount.bayonet.lock_angle_deg", |d| {
             mount(d).bayonet.lock_angle_deg = 80.0

@@ -4,7 +4,7 @@
 //! round tube and its assembly steps (R-Tac0 Sec. III-B1..B4).
 
 use super::{
-    build_shell, check_housing_params, filling_gel_profile, filling_gel_volume_mm3,
+    build_shell, check_housing_params, filling_gel_profile, filling_gel_volume_mm3, gel_fill,
     joint_screw_name, levels, HousingParams, HousingStyle, ShellLevels,
 };
 use crate::error::{DesignError, GeometryContext, ParamError};
@@ -21,6 +21,7 @@ use crate::parts::family::{
 };
 use crate::parts::fasteners::{metric_from_pilot, metric_name};
 use crate::parts::{ExactShape, Member, MemberKind, Part, ProcedureAction, ProcedureStep};
+use crate::schema::GelFill;
 use serde_json::json;
 
 /// The housing (`housing` in a design): the sensor shell in one of its two styles.
@@ -98,15 +99,23 @@ impl Family for HousingFamily {
             out.push(Member {
                 name: FILLING_GEL.into(),
                 kind: MemberKind::Cast,
-                description: format!(
-                    "Internal filling gel ({}): the core, the diffuser's opening and the light chamber",
-                    f.material
-                ),
+                description: match gel_fill(h) {
+                    Some(GelFill::Core) => {
+                        format!("Internal filling gel ({}): the core to its open end", f.material)
+                    }
+                    _ => format!(
+                        "Internal filling gel ({}): the core, the diffuser's opening and the light chamber",
+                        f.material
+                    ),
+                },
                 solid,
-                fix: vec![
-                    "housing.light_chamber_diameter_mm".into(),
-                    "housing.diffuser.inner_diameter_mm".into(),
-                ],
+                fix: match gel_fill(h) {
+                    Some(GelFill::Core) => vec!["core.length_mm".into()],
+                    _ => vec![
+                        "housing.light_chamber_diameter_mm".into(),
+                        "housing.diffuser.inner_diameter_mm".into(),
+                    ],
+                },
                 // inside the core's inner surface above the core's end, and under it only
                 // where no layer is: nested with the layers and the core by construction
                 nested_by_stack: true,
@@ -151,7 +160,10 @@ impl Family for HousingFamily {
             gel,
             volume_mm3: filling_gel_volume_mm3(ctx, h, core, &lv),
             holder_roles: &["shell_collar", "shell_tube", "shell_half"],
-            how: "Poured into the assembled shell, pole-down, before the camera goes on: it fills the core, the diffuser's opening and the light chamber up to the LED PCB's face (R-Tac0 Sec. III-B1).",
+            how: match gel_fill(h) {
+                Some(GelFill::Core) => "Poured into the assembled shell, pole-down, before the camera goes on: it fills the core up to its open end, flush with the diffuser's top face, and leaves the diffuser's opening and the light chamber air; its flat free surface is the window the camera looks through (R-Tac0 Sec. III-B1).",
+                _ => "Poured into the assembled shell, pole-down, before the camera goes on: it fills the core, the diffuser's opening and the light chamber up to the LED PCB's face (R-Tac0 Sec. III-B1).",
+            },
             member: None,
         }))
     }

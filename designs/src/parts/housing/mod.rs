@@ -32,7 +32,7 @@ use crate::parts::context::ResolvedCore;
 use crate::parts::family::FamilyInput;
 use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::{Part, PrintTechnology};
-use crate::schema::FillingGel;
+use crate::schema::{FillingGel, GelFill};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
@@ -1306,11 +1306,27 @@ fn build_square_split(
     Ok((parts, lv))
 }
 
+/// How far the housing's filling gel reaches ([`FillingGel::fills`]; `chamber` when not given).
+pub fn gel_fill(h: &HousingParams) -> Option<GelFill> {
+    h.filling_gel
+        .as_ref()
+        .map(|f| f.fills.unwrap_or(GelFill::Chamber))
+}
+
+/// The height of the filling gel's flat free surface, sensor frame z, mm: the core's open end
+/// (`fills: core`) or the LED PCB's face (`chamber`); `None` without a filling gel.
+pub fn gel_free_surface_z_mm(h: &HousingParams, lv: &ShellLevels) -> Option<f64> {
+    gel_fill(h).map(|f| match f {
+        GelFill::Core => lv.seat_z_mm,
+        GelFill::Chamber => lv.chamber_z_mm,
+    })
+}
+
 /// The internal filling gel's region (R-Tac0 Sec. III-B1; [`crate::schema::FillingGel`]) as a
 /// closed profile in the (r, z) half-plane of the sensor frame, mm: the inside of the core
-/// down to its open end, the diffuser's opening under it, then the light chamber down to the
-/// LED PCB's face, closed on the axis. The core's inner surface is tessellated as the core's
-/// own (`tol` halved, as in the assembly), so the two share it.
+/// down to its open end, then (`fills: chamber`) the diffuser's opening under it and the light
+/// chamber down to the LED PCB's face, closed on the axis. The core's inner surface is
+/// tessellated as the core's own (`tol` halved, as in the assembly), so the two share it.
 pub fn filling_gel_profile(
     ctx: &Context<'_>,
     h: &HousingParams,
@@ -1321,6 +1337,10 @@ pub fn filling_gel_profile(
     let mut pl = ctx
         .body
         .offset_polyline(core.inner_offset_mm, core.below_base_mm, tol.half());
+    if gel_fill(h) == Some(GelFill::Core) {
+        pl.push([0.0, lv.seat_z_mm]);
+        return pl;
+    }
     let (r_open, r_chamber) = (
         h.diffuser.inner_diameter_mm / 2.0,
         h.light_chamber_diameter_mm / 2.0,
@@ -1338,9 +1358,9 @@ pub fn filling_gel_profile(
 }
 
 /// The filling gel's volume from the exact surfaces, mm^3: the solid inside the core's inner
-/// surface down to its open end, plus the cylinders of the diffuser's opening and of the light
-/// chamber. LEDs and wires inside the chamber are not subtracted (about 60 mm^3 for eight
-/// 2835 LEDs, covered by the pour's waste allowance).
+/// surface down to its open end, plus (`fills: chamber`) the cylinders of the diffuser's
+/// opening and of the light chamber. LEDs and wires inside the chamber are not subtracted
+/// (about 60 mm^3 for eight 2835 LEDs, covered by the pour's waste allowance).
 pub fn filling_gel_volume_mm3(
     ctx: &Context<'_>,
     h: &HousingParams,
@@ -1348,8 +1368,13 @@ pub fn filling_gel_volume_mm3(
     lv: &ShellLevels,
 ) -> f64 {
     let disc = |d: f64, height: f64| std::f64::consts::PI * d * d / 4.0 * height;
-    ctx.body
-        .analytic_solid_volume_mm3(core.inner_offset_mm, core.below_base_mm)
+    let core_part = ctx
+        .body
+        .analytic_solid_volume_mm3(core.inner_offset_mm, core.below_base_mm);
+    if gel_fill(h) == Some(GelFill::Core) {
+        return core_part;
+    }
+    core_part
         + disc(
             h.diffuser.inner_diameter_mm,
             lv.seat_z_mm - lv.diffuser_z_mm,
