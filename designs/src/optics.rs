@@ -500,3 +500,131 @@ pub fn ring_of_lights(
 /// The intensity of a family's LED, relative units (see [`Light::intensity`]): 100, so that a
 /// white patch 10 mm in front of one LED receives 1.
 pub const DEFAULT_LED_INTENSITY: f64 = 100.0;
+
+/// One flat interface between the camera and the skin: a plane normal to the sensor's z axis
+/// where the medium changes (a filling gel's free surface, a window's or a plate's face).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FlatInterface {
+    /// Height of the plane, sensor frame z, mm.
+    pub z_mm: f64,
+    /// The medium above the plane (towards the skin): a material key of the materials table,
+    /// or [`AIR`].
+    pub above: String,
+    /// What the plane is, naming the parameters it comes from
+    /// (`housing.filling_gel: the gel's free surface at the core's open end`).
+    pub what: String,
+}
+
+/// The medium key of air (n = 1.000 at the sodium D line; 1.0003 in fact, a 0.03 % bend
+/// ignored), the medium a camera file's lens was calibrated in.
+pub const AIR: &str = "air";
+
+/// One plane of a design's [`OpticalPath`], resolved against the materials table.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PathPlane {
+    /// Height of the plane, sensor frame z, mm.
+    pub z_mm: f64,
+    /// What the plane is, naming its parameters.
+    pub what: String,
+    /// The medium above it: a material key or `air`.
+    pub above: String,
+    /// The refractive index above it (n_D).
+    pub index_above: f64,
+    /// Where that index comes from (the materials table's source; `ASSUMPTION: ...` where no
+    /// maker publishes one).
+    pub index_source: String,
+}
+
+/// The flat optical path of a design from the camera up: air under the lowest plane (where the
+/// camera sits), then each plane with the medium above it, increasing in z. Curved interfaces
+/// (a glass core's faces, cast layers on a dome) are not in it: their bending is small where
+/// the indices on both sides are close (1.41 silicones, 1.47 glass) and is not modelled.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct OpticalPath {
+    pub planes: Vec<PathPlane>,
+}
+
+/// The design's flat optical path ([`OpticalPath`]): its families' flat interfaces
+/// ([`crate::parts::family::Family::flat_interfaces`]) and the backing plate's faces (air
+/// under it; above it the skin's innermost layer when that is solid, else air), sorted by
+/// height, each
+/// medium's index from `materials`.
+///
+/// # Errors
+/// The parameter path of a medium whose material is not in the table or has no
+/// `refractive_index`, and of two planes at the same height.
+pub fn optical_path(
+    design: &Design,
+    stack: &Stack,
+    materials: &crate::materials::MaterialsTable,
+) -> Result<OpticalPath, ParamError> {
+    let mut planes: Vec<FlatInterface> = Vec::new();
+    for f in FAMILIES {
+        planes.extend(f.flat_interfaces(design, stack));
+    }
+    if let Some(b) = &design.backing {
+        let top = design.body.base_z_mm();
+        planes.push(FlatInterface {
+            z_mm: top - b.thickness_mm,
+            above: b.material.clone(),
+            what: "backing: the plate's bottom face".into(),
+        });
+        // a solid innermost layer fills the skin down to the plate; else the skin's inside is air
+        let (above, what) = match design.layers.first().filter(|l| l.solid) {
+            Some(l) => (
+                l.material.clone(),
+                "backing: the plate's top face, under the solid skin (layers[0])",
+            ),
+            None => (
+                AIR.to_string(),
+                "backing: the plate's top face, under the skin's inside (air)",
+            ),
+        };
+        planes.push(FlatInterface {
+            z_mm: top,
+            above,
+            what: what.into(),
+        });
+    }
+    planes.sort_by(|a, b| a.z_mm.total_cmp(&b.z_mm));
+    for w in planes.windows(2) {
+        if !(w[1].z_mm > w[0].z_mm) {
+            return Err(ParamError::new(
+                w[1].what.split(':').next().unwrap_or("optics"),
+                w[1].z_mm,
+                format!(
+                    "two flat interfaces at the same height ({} and {})",
+                    w[0].what, w[1].what
+                ),
+            ));
+        }
+    }
+    let planes = planes
+        .into_iter()
+        .map(|p| {
+            let (n, source) = if p.above == AIR {
+                (1.0, "air, n = 1.000 (1.0003 at 589 nm, taken as 1)".to_string())
+            } else {
+                let r = materials
+                    .get(&p.above)
+                    .and_then(|m| m.refractive_index.as_ref())
+                    .ok_or_else(|| {
+                        ParamError::new(
+                            p.what.split(':').next().unwrap_or("optics"),
+                            &p.above,
+                            "the camera looks through this material: it needs a refractive_index in the materials table",
+                        )
+                    })?;
+                (r.n, r.source.clone())
+            };
+            Ok(PathPlane {
+                z_mm: p.z_mm,
+                what: p.what,
+                above: p.above,
+                index_above: n,
+                index_source: source,
+            })
+        })
+        .collect::<Result<Vec<_>, ParamError>>()?;
+    Ok(OpticalPath { planes })
+}

@@ -9,7 +9,7 @@
 use crate::error::{DesignError, ParamError};
 use crate::geometry::{ChordTolerance, GeometryError, Solid};
 use crate::materials::{CastReport, MaterialKind};
-use crate::optics::Light;
+use crate::optics::{FlatInterface, Light};
 use crate::parts::context::{Context, Stack};
 use crate::parts::cut_part::CutPart;
 use crate::parts::member::Member;
@@ -175,6 +175,18 @@ pub trait Family {
     /// Its lights, sensor frame (the LEDs it carries), for rendering what the camera sees when
     /// the design gives no `optics.lights` ([`crate::optics`]).
     fn lights(_p: &Self::Params, _ctx: &Context<'_>, _stack: &Stack) -> Vec<Light> {
+        Vec::new()
+    }
+
+    /// Its flat interfaces between the camera and the skin, normal to the sensor's z axis,
+    /// sensor frame ([`crate::optics::FlatInterface`]): a filling gel's free surface, a window's
+    /// or a plate's faces, each with the material above it; the optical path the camera's rays
+    /// bend along ([`crate::optics::optical_path`]).
+    fn flat_interfaces(
+        _p: &Self::Params,
+        _ctx: &Context<'_>,
+        _stack: &Stack,
+    ) -> Vec<FlatInterface> {
         Vec::new()
     }
 

@@ -9,7 +9,7 @@ use std::marker::PhantomData;
 use crate::error::{DesignError, ParamError};
 use crate::geometry::ChordTolerance;
 use crate::materials::{CastReport, MaterialKind};
-use crate::optics::Light;
+use crate::optics::{FlatInterface, Light};
 use crate::parts::context::Stack;
 use crate::parts::cut_part::CutPart;
 use crate::parts::family::{
@@ -44,6 +44,8 @@ pub trait Section: Sync {
     fn check(&self, d: &Design, stack: Option<&Stack>, errs: &mut Vec<ParamError>);
     /// [`Family::lights`]; empty without the family.
     fn lights(&self, d: &Design, stack: &Stack) -> Vec<Light>;
+    /// [`Family::flat_interfaces`]; empty without the family.
+    fn flat_interfaces(&self, d: &Design, stack: &Stack) -> Vec<FlatInterface>;
     /// [`Family::filling_pour`]; `None` without the family.
     ///
     /// # Errors
@@ -161,6 +163,10 @@ impl<F: Family> Section for Registered<F> {
 
     fn lights(&self, d: &Design, stack: &Stack) -> Vec<Light> {
         (self.params)(d).map_or_else(Vec::new, |p| F::lights(p, &d.context(), stack))
+    }
+
+    fn flat_interfaces(&self, d: &Design, stack: &Stack) -> Vec<FlatInterface> {
+        (self.params)(d).map_or_else(Vec::new, |p| F::flat_interfaces(p, &d.context(), stack))
     }
 
     fn filling_pour<'d>(

@@ -29,7 +29,7 @@ use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::Polyline2;
 use crate::geometry::{cuboid, cylinder, revolve, ChordTolerance, GeometryError, Solid};
 use crate::materials::CastReport;
-use crate::optics::{ring_of_lights, Light};
+use crate::optics::{ring_of_lights, FlatInterface, Light};
 use crate::parts::bayonet::Bayonet;
 pub use crate::parts::bayonet::BayonetLugs;
 use crate::parts::context::Context;
@@ -1035,6 +1035,33 @@ impl Family for ShaftBodyFamily {
             ],
         ),
     ];
+
+    fn flat_interfaces(
+        sb: &ShaftBodyParams,
+        ctx: &Context<'_>,
+        _stack: &Stack,
+    ) -> Vec<FlatInterface> {
+        // the acrylic lens window's faces (Pestell et al. Sec. III-A: "an inserted acrylic
+        // lens"), the filling gel over it when there is one, else the air of the tip's inside
+        let lv = levels(ctx, sb);
+        let (above, what) = match &sb.filling_gel {
+            Some(g) => (g.material.clone(), "under the filling gel"),
+            None => (crate::optics::AIR.to_string(), "under the tip's air"),
+        };
+        vec![
+            FlatInterface {
+                z_mm: lv.shaft_top_z_mm,
+                // the window is acrylic (Sec. III-A): the materials table's `pmma`
+                above: "pmma".into(),
+                what: "shaft_body.lens_window: the acrylic window's bottom face".into(),
+            },
+            FlatInterface {
+                z_mm: lv.lip_z_mm,
+                above,
+                what: format!("shaft_body.lens_window: the window's top face, {what}"),
+            },
+        ]
+    }
 
     fn lights(sb: &ShaftBodyParams, ctx: &Context<'_>, _stack: &Stack) -> Vec<Light> {
         // the LEDs' tops at the shaft's top face, under the window, at the ring's mid-width,

@@ -232,3 +232,68 @@ fn markers_and_dimples_come_from_the_layers_features() {
         assert!(near(m.radius_mm, 0.5));
     }
 }
+
+fn path_of(d: &Design) -> Result<fabkit_designs::optics::OpticalPath, fabkit_designs::ParamError> {
+    let m = MaterialsTable::embedded().unwrap();
+    let s = stack::validate(d, &m, ChordTolerance::new(0.01).unwrap()).unwrap();
+    fabkit_designs::optics::optical_path(d, &s, &m)
+}
+
+/// Each library sensor's flat optical path from the camera up (calibration::refraction):
+/// R-Tac0's gel surface at the tube's mouth (z = -6 - 3 = -9 mm, Solaris 1.41, assumed); the
+/// TacTip's 2 mm acrylic window (PMMA 1.491) under its RTV27905 gel; ShadowTac's 3 mm PMMA
+/// plate under its solid Solaris skin, whose base plane is 22.5 - 8.358 = 14.142 mm above the
+/// sphere's centre. `fills: chamber` moves R-Tac0's surface to the LED PCB's face (-21 mm).
+#[test]
+fn each_sensor_gives_its_flat_optical_path() {
+    let planes = |name: &str| {
+        path_of(&library::load(name).unwrap())
+            .unwrap()
+            .planes
+            .into_iter()
+            .map(|p| (p.z_mm, p.above, p.index_above))
+            .collect::<Vec<_>>()
+    };
+    let r = planes("rtac0");
+    assert_eq!(r.len(), 1);
+    assert!(
+        near(r[0].0, -9.0) && r[0].1 == "solaris" && r[0].2 == 1.41,
+        "{r:?}"
+    );
+    let t = planes("tactip_dualmodal");
+    assert_eq!(t.len(), 2, "{t:?}");
+    assert!(near(t[1].0 - t[0].0, 2.0), "{t:?}");
+    assert_eq!((t[0].1.as_str(), t[0].2), ("pmma", 1.491));
+    assert_eq!((t[1].1.as_str(), t[1].2), ("rtv27905", 1.41));
+    let s = planes("shadowtac");
+    let base = 22.5 - (22.5f64.powi(2) - 17.5f64.powi(2)).sqrt();
+    assert_eq!(s.len(), 2, "{s:?}");
+    assert!(
+        (s[1].0 - (22.5 - base)).abs() < 1e-3 && near(s[1].0 - s[0].0, 3.0),
+        "{s:?}"
+    );
+    assert_eq!(
+        (s[0].1.as_str(), s[1].1.as_str()),
+        ("pmma", "solaris_thinner_40")
+    );
+    let yaml = library::LIBRARY
+        .iter()
+        .find(|(n, _)| *n == "rtac0")
+        .unwrap()
+        .1;
+    let chamber =
+        Design::from_yaml(&yaml.replace("fills: core ", "fills: chamber "), "r.yaml").unwrap();
+    let p = path_of(&chamber).unwrap();
+    assert!(near(p.planes[0].z_mm, -21.0), "{p:?}");
+    // a gel without a refractive index in the table is an error naming the gel's path
+    let moldstar = Design::from_yaml(
+        &yaml.replace("material: solaris\n", "material: mold_star_30\n"),
+        "r.yaml",
+    )
+    .unwrap();
+    let e = path_of(&moldstar).unwrap_err().to_string();
+    assert!(
+        e.starts_with("housing.filling_gel = mold_star_30") && e.contains("refractive_index"),
+        "{e}"
+    );
+}

@@ -335,16 +335,11 @@ fn rtac0_sheet_states_volumes_coats_treatments_and_the_procedure() {
             A::Assemble,
         ]
     );
-    // the filling gel (R-Tac0 Sec. III-B1), poured into the assembled shell: the core's inside
-    // (radius 9 mm: hemisphere on 6 + 3 mm of cylinder), the diffuser's opening (radius 9.8 mm,
-    // 2 mm) and the light chamber (radius 11.7 mm, 10 mm); Solaris 1.02 g/cm3, 1:1 by weight,
-    // 20 % waste
+    // the filling gel (R-Tac0 Sec. III-B1, `fills: core`), poured into the assembled shell:
+    // the core's inside (radius 9 mm: hemisphere on 6 + 3 mm of cylinder) up to its open end;
+    // Solaris 1.02 g/cm3, 1:1 by weight, 20 % waste
     let gel = cast(&e, "filling_gel");
-    let v_ml = (2.0 / 3.0 * PI * 9.0f64.powi(3)
-        + PI * 81.0 * 9.0
-        + PI * 9.8 * 9.8 * 2.0
-        + PI * 11.7 * 11.7 * 10.0)
-        / 1000.0;
+    let v_ml = (2.0 / 3.0 * PI * 9.0f64.powi(3) + PI * 81.0 * 9.0) / 1000.0;
     close(
         gel["cavity_volume_ml"].as_f64().unwrap(),
         v_ml,

@@ -10,7 +10,7 @@ use super::{
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{cuboid, cylinder, revolve, ChordTolerance, GeometryError, Solid};
 use crate::materials::{cure_text, CastReport, MaterialKind};
-use crate::optics::{ring_of_lights, Light};
+use crate::optics::{ring_of_lights, FlatInterface, Light};
 use crate::parts::axial_ring;
 use crate::parts::context::{Context, Stack};
 use crate::parts::cut_part::{CutPart, Operation, Outline};
@@ -144,6 +144,25 @@ impl Family for HousingFamily {
             Some([0.0, 0.0, 1.0]),
             |_| [1.0, 1.0, 1.0],
         )
+    }
+
+    fn flat_interfaces(h: &HousingParams, ctx: &Context<'_>, stack: &Stack) -> Vec<FlatInterface> {
+        // the gel's flat free surface: the camera's rays enter the gel there (issue 97)
+        let (Some(gel), Some(lv)) = (&h.filling_gel, shell_levels(ctx, h, stack)) else {
+            return Vec::new();
+        };
+        let Some(z_mm) = super::gel_free_surface_z_mm(h, &lv) else {
+            return Vec::new();
+        };
+        let at = match gel_fill(h) {
+            Some(GelFill::Core) => "at the core's open end",
+            _ => "at the LED PCB's face",
+        };
+        vec![FlatInterface {
+            z_mm,
+            above: gel.material.clone(),
+            what: format!("housing.filling_gel: the gel's free surface {at}"),
+        }]
     }
 
     fn filling_pour<'p>(
