@@ -14,7 +14,7 @@ use std::collections::BTreeMap;
 use std::io::Cursor;
 use std::path::{Path, PathBuf};
 
-use nalgebra::{Isometry3, Point3, Vector2, Vector3};
+use nalgebra::{Isometry3, Vector2, Vector3};
 use rayon::prelude::*;
 
 use crate::imprints::{
@@ -426,7 +426,7 @@ impl ImageObservations {
     /// [`OverlayError::Encode`].
     pub fn overlays(
         &self,
-        camera: &CameraModel,
+        camera: &crate::refraction::Imaging<'_>,
         table: &PointTable,
         t_cam_sensor: &Isometry3<f64>,
     ) -> Result<Vec<(String, Vec<u8>)>, OverlayError> {
@@ -436,6 +436,8 @@ impl ImageObservations {
         const MAGENTA: [u8; 3] = [255, 0, 255];
         let mut names: Vec<String> = Vec::new();
         let mut out = Vec::new();
+        let r = *t_cam_sensor.rotation.to_rotation_matrix().matrix();
+        let t = t_cam_sensor.translation.vector;
         for c in &self.captures {
             let stem = Path::new(&c.spots.name)
                 .file_stem()
@@ -465,7 +467,7 @@ impl ImageObservations {
                 else {
                     continue;
                 };
-                if let Some(q) = camera.project(&(t_cam_sensor * Point3::from(*p)).coords) {
+                if let Some(q) = camera.project(&r, &t, p) {
                     img.line(q.x - 3.0, q.y, q.x + 3.0, q.y, RED);
                     img.line(q.x, q.y - 3.0, q.x, q.y + 3.0, RED);
                 }

@@ -12,10 +12,11 @@ use std::path::{Path, PathBuf};
 use crate::camera_file::{read_camera_file_as, CameraFileError, DistortionModelHint};
 use crate::capture_images::{observe_images, CaptureImages, ImageError};
 use crate::overlay::{read_png_rgb8_sized, render_overlay, OverlayError};
-use crate::pnp::{solve_pnp, PnpError, PnpOptions, RansacOptions};
+use crate::pnp::{solve_pnp_through, PnpError, PnpOptions, RansacOptions};
 use crate::refine::{
-    refine_intrinsics, solution_at, RefineError, RefineParameters, RefinementReport,
+    refine_intrinsics_through, solution_at, RefineError, RefineParameters, RefinementReport,
 };
+use crate::refraction::{FlatLayers, Imaging};
 use crate::report::{CaptureReport, ExtrinsicsReport, Provenance};
 use crate::tables::{
     check_inside_image, pair, read_capture_plan, read_captures, read_observations,
@@ -47,6 +48,10 @@ pub struct ExtrinsicsJob {
     /// pose solve, and write the refined camera file in the form read; `None`: the camera
     /// file's intrinsics are used as they are.
     pub refine_intrinsics: Option<RefineParameters>,
+    /// The flat optical path between the lens and the pins (a design's
+    /// `fabkit_designs::optics::optical_path`): rays bend at each plane ([`crate::refraction`]);
+    /// `None`: straight rays from the lens.
+    pub optical_path: Option<fabkit_designs::optics::OpticalPath>,
     /// Recorded in the report's provenance.
     pub command_line: String,
 }
@@ -81,6 +86,8 @@ pub enum ExtrinsicsError {
     Refine(#[from] RefineError),
     #[error("cannot serialise the report as YAML: {0}")]
     Yaml(String),
+    #[error("the design's optical path: {0}")]
+    OpticalPath(String),
 }
 
 /// The result of one extrinsics calibration: the report and the files of its output folder.
@@ -157,7 +164,19 @@ pub fn calibrate_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsOutput, Ext
         ransac: job.ransac,
         ..Default::default()
     };
-    let sol = solve_pnp(&camera, &pairs.points_mm, &pairs.pixels_px, &opts).map_err(|source| {
+    let layers = job
+        .optical_path
+        .as_ref()
+        .map(FlatLayers::from_optical_path)
+        .transpose()
+        .map_err(|e| ExtrinsicsError::OpticalPath(e.to_string()))?;
+    let sol = solve_pnp_through(
+        &Imaging::new(&camera, layers.as_ref()),
+        &pairs.points_mm,
+        &pairs.pixels_px,
+        &opts,
+    )
+    .map_err(|source| {
         let at = |index: usize| {
             let (id, _, origin) = &obs.rows[index];
             format!("id {id} ({origin})")
@@ -196,18 +215,23 @@ pub fn calibrate_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsOutput, Ext
             };
             let count = |s: &crate::PnpSolution| s.inliers.iter().filter(|&&b| b).count();
             let (pts, px) = inliers_of(&sol);
-            let mut r = refine_intrinsics(&camera, &pts, &px, &sol.t_cam_sensor, which)?;
+            let l = layers.as_ref();
+            let mut r = refine_intrinsics_through(&camera, l, &pts, &px, &sol.t_cam_sensor, which)?;
             let mut kept = sol;
             for _ in 1..4 {
-                let Ok(again) = solve_pnp(&r.camera, &pairs.points_mm, &pairs.pixels_px, &opts)
-                else {
+                let Ok(again) = solve_pnp_through(
+                    &Imaging::new(&r.camera, layers.as_ref()),
+                    &pairs.points_mm,
+                    &pairs.pixels_px,
+                    &opts,
+                ) else {
                     break;
                 };
                 if count(&again) <= count(&kept) {
                     break;
                 }
                 let (pts, px) = inliers_of(&again);
-                match refine_intrinsics(&camera, &pts, &px, &again.t_cam_sensor, which) {
+                match refine_intrinsics_through(&camera, l, &pts, &px, &again.t_cam_sensor, which) {
                     Ok(r2) => {
                         r = r2;
                         kept = again;
@@ -216,7 +240,7 @@ pub fn calibrate_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsOutput, Ext
                 }
             }
             let sol = solution_at(
-                &r.camera,
+                &Imaging::new(&r.camera, layers.as_ref()),
                 &pairs.points_mm,
                 &pairs.pixels_px,
                 &kept,
@@ -246,7 +270,13 @@ pub fn calibrate_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsOutput, Ext
             Observed::Files(_) => None,
         },
     };
-    let mut report = ExtrinsicsReport::new(&camera, &pairs, &sol, provenance);
+    let mut report = ExtrinsicsReport::new(
+        &Imaging::new(&camera, layers.as_ref()),
+        &pairs,
+        &sol,
+        provenance,
+    );
+    report.optical_path = job.optical_path.clone();
     if let Some(found) = &from_images {
         report.warnings.extend(found.notes.iter().cloned());
         report.captures = found.outcomes.iter().map(CaptureReport::from).collect();
@@ -296,7 +326,11 @@ pub fn calibrate_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsOutput, Ext
             "observations.json".into(),
             format!("{sidecar:#}\n").into_bytes(),
         ));
-        files.extend(found.overlays(&camera, &table, &sol.t_cam_sensor)?);
+        files.extend(found.overlays(
+            &Imaging::new(&camera, layers.as_ref()),
+            &table,
+            &sol.t_cam_sensor,
+        )?);
     }
     let found = from_images.as_ref().map(|f| FoundInImages {
         captures: obs_paths.len(),

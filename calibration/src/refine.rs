@@ -20,6 +20,7 @@ use nalgebra::{
 
 use crate::camera::{CameraModel, Distortion, Intrinsics};
 use crate::pnp::PnpSolution;
+use crate::refraction::{FlatLayers, Imaging};
 
 /// Largest condition number of the column-scaled Jacobian (pose and free intrinsics) that is
 /// refined; a parameter beyond it is not constrained by the captures.
@@ -153,6 +154,8 @@ struct Problem<'a> {
     free: Vec<usize>,
     points: &'a [Vector3<f64>],
     pixels: &'a [Vector2<f64>],
+    /// The optical path in front of the lens ([`crate::refraction`]); `None`: straight rays.
+    layers: Option<&'a FlatLayers>,
 }
 
 /// A state: the full intrinsic vector and the pose (R, t).
@@ -185,11 +188,16 @@ impl Problem<'_> {
     /// the intrinsics are not a camera.
     fn point_residuals(&self, s: &State) -> Option<Vec<Option<Vector2<f64>>>> {
         let cam = CameraModel::new(with_vector(&self.base, &s.intr)).ok()?;
+        let imaging = Imaging {
+            camera: &cam,
+            layers: self.layers,
+        };
+        let r = *s.r.matrix();
         Some(
             self.points
                 .iter()
                 .zip(self.pixels)
-                .map(|(p, px)| cam.project(&(s.r * p + s.t)).map(|uv| uv - px))
+                .map(|(p, px)| imaging.project(&r, &s.t, p).map(|uv| uv - px))
                 .collect(),
         )
     }
@@ -329,6 +337,22 @@ pub fn refine_intrinsics(
     t_cam_sensor: &Isometry3<f64>,
     which: &RefineParameters,
 ) -> Result<Refinement, RefineError> {
+    refine_intrinsics_through(camera, None, points_mm, pixels_px, t_cam_sensor, which)
+}
+
+/// [`refine_intrinsics`] with the rays bent by `layers` between the lens and the points
+/// ([`crate::refraction`]): the lens model is refined, the optical path held.
+///
+/// # Errors
+/// As [`refine_intrinsics`].
+pub fn refine_intrinsics_through(
+    camera: &CameraModel,
+    layers: Option<&FlatLayers>,
+    points_mm: &[Vector3<f64>],
+    pixels_px: &[Vector2<f64>],
+    t_cam_sensor: &Isometry3<f64>,
+    which: &RefineParameters,
+) -> Result<Refinement, RefineError> {
     let base = *camera.intrinsics();
     let names = parameter_names(&base.distortion);
     let model = base.distortion.name();
@@ -384,6 +408,7 @@ pub fn refine_intrinsics(
             free: free.clone(),
             points: points_mm,
             pixels: pixels_px,
+            layers,
         };
         let j = pb.jacobian(&start).ok_or(RefineError::Unprojectable)?;
         let (cond, v) = scaled_condition(&j);
@@ -591,20 +616,18 @@ pub fn refined_camera_file(text: &str) -> (&'static str, crate::CameraFileFormat
 /// The pose solution `sol` re-evaluated at `camera` and `t_cam_sensor` (same inliers): the
 /// residuals of every pair and the inliers' RMS.
 pub fn solution_at(
-    camera: &CameraModel,
+    camera: &Imaging<'_>,
     points_mm: &[Vector3<f64>],
     pixels_px: &[Vector2<f64>],
     sol: &PnpSolution,
     t_cam_sensor: Isometry3<f64>,
 ) -> PnpSolution {
+    let r = *t_cam_sensor.rotation.to_rotation_matrix().matrix();
+    let t = t_cam_sensor.translation.vector;
     let residuals_px: Vec<Option<Vector2<f64>>> = points_mm
         .iter()
         .zip(pixels_px)
-        .map(|(p, px)| {
-            camera
-                .project(&(t_cam_sensor * nalgebra::Point3::from(*p)).coords)
-                .map(|uv| uv - px)
-        })
+        .map(|(p, px)| camera.project(&r, &t, p).map(|uv| uv - px))
         .collect();
     let (mut sq, mut n) = (0.0, 0usize);
     for (r, &inl) in residuals_px.iter().zip(&sol.inliers) {

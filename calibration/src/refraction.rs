@@ -92,6 +92,19 @@ impl FlatLayers {
         FlatLayers::new(vec![z_mm], vec![below, above])
     }
 
+    /// The layers of a design's flat optical path (`fabkit_designs::optics::optical_path`):
+    /// air (n = 1) under its lowest plane, where the camera sits, then each plane's medium.
+    ///
+    /// # Errors
+    /// As [`FlatLayers::new`].
+    pub fn from_optical_path(
+        path: &fabkit_designs::optics::OpticalPath,
+    ) -> Result<FlatLayers, LayersError> {
+        let mut indices = vec![1.0];
+        indices.extend(path.planes.iter().map(|p| p.index_above));
+        FlatLayers::new(path.planes.iter().map(|p| p.z_mm).collect(), indices)
+    }
+
     /// The planes' heights, sensor frame z, mm, increasing.
     pub fn planes_z_mm(&self) -> &[f64] {
         &self.planes_z_mm
@@ -237,6 +250,11 @@ pub struct Imaging<'a> {
 }
 
 impl<'a> Imaging<'a> {
+    /// `camera` behind `layers` (`None`: straight rays).
+    pub fn new(camera: &'a CameraModel, layers: Option<&'a FlatLayers>) -> Imaging<'a> {
+        Imaging { camera, layers }
+    }
+
     /// The camera file's model with straight rays.
     pub fn straight(camera: &'a CameraModel) -> Imaging<'a> {
         Imaging {

@@ -3,8 +3,8 @@
 use nalgebra::Point3;
 use serde::Serialize;
 
-use crate::camera::CameraModel;
 use crate::pnp::PnpSolution;
+use crate::refraction::Imaging;
 use crate::tables::Pairs;
 
 /// Where the inputs came from.
@@ -191,6 +191,11 @@ pub struct ExtrinsicsReport {
     pub provenance: Provenance,
     /// `fisheye`, `plumb_bob` or `rational_polynomial`.
     pub distortion_model: String,
+    /// The flat optical path the rays were bent along (`--design`: the filling gel's surface,
+    /// a window's or a plate's faces, each with its refractive index and source); absent:
+    /// straight rays from the lens.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub optical_path: Option<fabkit_designs::optics::OpticalPath>,
     /// Rotation of T_cam_sensor as an OpenCV rotation vector (axis times angle), radians.
     pub rvec: [f64; 3],
     /// Translation of T_cam_sensor (the sensor origin in the camera frame), mm.
@@ -303,7 +308,7 @@ pub struct PoseUncertaintyReport {
 impl ExtrinsicsReport {
     /// Builds the report of a solution over its pairs.
     pub fn new(
-        camera: &CameraModel,
+        camera: &Imaging<'_>,
         pairs: &Pairs,
         sol: &PnpSolution,
         provenance: Provenance,
@@ -339,7 +344,7 @@ impl ExtrinsicsReport {
                 inlier: sol.inliers[k],
             });
         }
-        let uncertainty = crate::pose_uncertainty(
+        let uncertainty = crate::pnp::pose_uncertainty_through(
             camera,
             &pairs.points_mm,
             &pairs.pixels_px,
@@ -393,7 +398,8 @@ impl ExtrinsicsReport {
             captures: Vec::new(),
             description: "T_cam_sensor maps sensor-frame points (mm; docs/conventions.md) into the camera frame (mm; x right, y down, z forward). rvec/tvec_mm follow OpenCV's solvePnP convention: x_cam = R(rvec) x_sensor + tvec_mm. Pixels: (0, 0) is the centre of the top-left pixel.".into(),
             provenance,
-            distortion_model: camera.intrinsics().distortion.name().into(),
+            distortion_model: camera.camera.intrinsics().distortion.name().into(),
+            optical_path: None,
             rvec: [rvec.x, rvec.y, rvec.z],
             tvec_mm: [iso.translation.x, iso.translation.y, iso.translation.z],
             t_cam_sensor: std::array::from_fn(|i| std::array::from_fn(|j| h[(i, j)])),

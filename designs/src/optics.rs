@@ -472,6 +472,30 @@ pub fn of_design(
     resolve(design, &stack).map_err(|e| DesignError::Params(crate::ParamErrors(e)))
 }
 
+/// The flat optical path ([`optical_path`]) of `design`, its stack resolved at `tol` and the
+/// indices from the embedded materials table.
+///
+/// # Errors
+/// The design's validation errors, and [`optical_path`]'s.
+pub fn optical_path_of_design(
+    design: &Design,
+    tol: crate::geometry::ChordTolerance,
+) -> Result<OpticalPath, crate::error::DesignError> {
+    use crate::error::DesignError;
+    let materials = crate::materials::MaterialsTable::embedded().map_err(DesignError::Yaml)?;
+    let stack = if design.body.flat_outline().is_some() {
+        crate::parts::flat::validate(design, &materials)?;
+        Stack {
+            core: None,
+            layers: Vec::new(),
+        }
+    } else {
+        crate::stack::validate(design, &materials, tol)?
+    };
+    optical_path(design, &stack, &materials)
+        .map_err(|e| DesignError::Params(crate::ParamErrors(vec![e])))
+}
+
 /// `n` white lights of `intensity` evenly round a circle of radius `r_mm` at height `z_mm`
 /// (the first on +x), each pointing along `direction` (`None`: towards the axis), cone 90 deg.
 pub fn ring_of_lights(

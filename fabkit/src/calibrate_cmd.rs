@@ -138,6 +138,17 @@ pub struct ExtrinsicsArgs {
     /// that give it still run.
     #[arg(long, value_name = "SEED")]
     pub seed: Option<u64>,
+    /// The sensor's design (a YAML file or a library name): the rays from the lens bend by
+    /// Snell's law at its flat interfaces (the filling gel's free surface, a window's or a
+    /// plate's faces), with the refractive indices of the materials table; the report lists
+    /// them (`optical_path`). Without it the rays are straight from the lens.
+    #[arg(long, value_name = "DESIGN")]
+    pub design: Option<String>,
+    /// Apply one of the design's presets (with --design).
+    #[arg(long, value_name = "NAME", requires = "design")]
+    pub preset: Option<String>,
+    #[command(flatten)]
+    pub(crate) data_files: crate::cli::DataFileArgs,
 }
 
 pub fn run(cmd: CalibrateCommand) -> Result<(), Box<dyn Error>> {
@@ -181,7 +192,21 @@ fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
         &inputs,
         a.force,
     );
+    let optical_path = match &a.design {
+        None => None,
+        Some(d) => {
+            let mut loaded = crate::cli::load_design(Some(d), &a.data_files)?;
+            if let Some(p) = &a.preset {
+                loaded.apply_preset(p)?;
+            }
+            Some(fabkit_designs::optics::optical_path_of_design(
+                &loaded.design,
+                fabkit_designs::ChordTolerance::new(fabkit_designs::ChordTolerance::DEFAULT_MM)?,
+            )?)
+        }
+    };
     let job = ExtrinsicsJob {
+        optical_path,
         camera: a.cam.camera,
         camera_model: a.cam.camera_model.map(Into::into),
         points: a.points,

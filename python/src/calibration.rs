@@ -321,7 +321,12 @@ pub fn solve_extrinsics<'py>(
         unobserved_ids: Vec::new(),
         reference_image: None,
     };
-    let report = ExtrinsicsReport::new(model, &pairs, &sol, provenance);
+    let report = ExtrinsicsReport::new(
+        &fabkit_calibration::refraction::Imaging::straight(model),
+        &pairs,
+        &sol,
+        provenance,
+    );
     let report: serde_json::Value = serde_json::from_str(&report.to_json())
         .map_err(|e| CalibrationError::new_err(e.to_string()))?;
     let h = sol.t_cam_sensor.to_homogeneous();

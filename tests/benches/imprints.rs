@@ -146,6 +146,7 @@ fn bench_calibration(c: &mut Criterion) {
         image: None,
         ransac: Some(Default::default()),
         refine_intrinsics: None,
+        optical_path: None,
         command_line: "bench".into(),
     };
     let out = calibrate_extrinsics(&job).unwrap();

@@ -896,3 +896,85 @@ fn refined_intrinsics_bring_back_the_pins_the_camera_files_model_put_out() {
         "{r2} deg, {t2} mm from the refinement over all"
     );
 }
+
+/// `--design rtac0`: the rays bend at the filling gel's free surface (z = -9 mm, the tube's
+/// mouth, Solaris n = 1.41 assumed), and the pose of a capture made through it comes back with
+/// every pin; the report lists the plane, its index and the index's source. The same capture
+/// solved with straight rays puts the camera millimetres too close to the dome (issue 97:
+/// 5.66 against 7.02 mm) and leaves the outer ring's residuals high.
+#[test]
+fn the_design_bends_the_rays_at_the_gel_surface() {
+    use fabkit_calibration::refraction::{FlatLayers, Imaging};
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let cam = CameraModel::new(intrinsics()).unwrap();
+    std::fs::write(
+        dir.join("cam.yaml"),
+        write_camera(&intrinsics(), CameraFileFormat::OpenCvYaml),
+    )
+    .unwrap();
+    write_table(&dir.join("pins.csv"));
+    // the camera 11.4 mm under the base plane (z = -17.4 mm), looking up the axis
+    let rot = UnitQuaternion::from_scaled_axis(Vector3::new(0.02, -0.015, 0.4));
+    let centre = Vector3::new(0.3, -0.2, -17.4);
+    let truth = Isometry3::from_parts(Translation3::from(-(rot * centre)), rot);
+    let gel = FlatLayers::single(-9.0, 1.0, 1.41).unwrap();
+    let through = Imaging::new(&cam, Some(&gel));
+    let (r, t) = (
+        *truth.rotation.to_rotation_matrix().matrix(),
+        truth.translation.vector,
+    );
+    let mut obs = String::from("id,u_px,v_px\n");
+    for (id, tip, _) in pins() {
+        let uv = through.project(&r, &t, &tip).unwrap();
+        let n = if id % 2 == 0 { 0.3 } else { -0.3 };
+        obs.push_str(&format!("{id},{},{}\n", uv.x + n, uv.y - 0.5 * n));
+    }
+    std::fs::write(dir.join("obs.csv"), obs).unwrap();
+    let o = run(
+        dir,
+        &extrinsics_args("cam.yaml", "bent", &["--design", "rtac0"]),
+        &[],
+    );
+    assert!(o.status.success(), "{}{}", text(&o.stdout), text(&o.stderr));
+    let j = json(&dir.join("bent/extrinsics.json"));
+    let pose = pose_of(&j);
+    let rot_err = pose.rotation.angle_to(&truth.rotation).to_degrees();
+    let t_err = (pose.translation.vector - truth.translation.vector).norm();
+    eprintln!("through the gel: {rot_err:.4} deg, {t_err:.4} mm");
+    // measured 0.018 deg and 0.0007 mm: the +-0.3 px pattern, as without refraction above
+    assert!(
+        rot_err < 0.1 && t_err < 0.03,
+        "rotation {rot_err} deg, translation {t_err} mm"
+    );
+    assert_eq!(j["residuals"]["inliers"], 29);
+    let rms = j["rms_reprojection_error_px"].as_f64().unwrap();
+    assert!((0.2..0.4).contains(&rms), "rms {rms}");
+    let plane = &j["optical_path"]["planes"][0];
+    assert_eq!(plane["z_mm"], -9.0);
+    assert_eq!(plane["above"], "solaris");
+    assert_eq!(plane["index_above"], 1.41);
+    assert!(
+        plane["index_source"]
+            .as_str()
+            .unwrap()
+            .starts_with("ASSUMPTION"),
+        "{plane}"
+    );
+
+    let o = run(dir, &extrinsics_args("cam.yaml", "straight", &[]), &[]);
+    assert!(o.status.success(), "{}{}", text(&o.stdout), text(&o.stderr));
+    let j = json(&dir.join("straight/extrinsics.json"));
+    assert!(j.get("optical_path").is_none());
+    let c = &j["residuals"]["camera_centre_in_sensor_mm"];
+    let closer = c[2].as_f64().unwrap() - centre.z;
+    let outer = j["residuals"]["by_polar_angle"]
+        .as_array()
+        .unwrap()
+        .last()
+        .unwrap()["rms_px"]
+        .as_f64()
+        .unwrap();
+    eprintln!("straight rays: camera {closer:.2} mm closer, outer ring {outer:.2} px");
+    assert!(closer > 3.0 && outer > 1.0, "{closer} mm, {outer} px");
+}

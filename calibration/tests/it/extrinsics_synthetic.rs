@@ -415,7 +415,15 @@ fn four_pins_near_the_pole_report_their_covariance_and_warn() {
             unobserved_ids: Vec::new(),
             reference_image: None,
         };
-        (s.clone(), ExtrinsicsReport::new(&cam, &pairs, &s, prov))
+        (
+            s.clone(),
+            ExtrinsicsReport::new(
+                &fabkit_calibration::refraction::Imaging::straight(&cam),
+                &pairs,
+                &s,
+                prov,
+            ),
+        )
     };
     let weak = scene(3, 4, 18.0, 0.15);
     let (s, r) = report(&weak);
