@@ -16,8 +16,8 @@ use crate::pnp::{solve_pnp_through, PnpError, PnpOptions, RansacOptions};
 use crate::refine::{
     refine_intrinsics_through, solution_at, RefineError, RefineParameters, RefinementReport,
 };
-use crate::refraction::{FlatLayers, Imaging};
-use crate::report::{CaptureReport, ExtrinsicsReport, Provenance};
+use crate::refraction::{refine_plane, FlatLayers, Imaging, PlanePrior};
+use crate::report::{CaptureReport, ExtrinsicsReport, PlaneFitReport, Provenance};
 use crate::tables::{
     check_inside_image, pair, read_capture_plan, read_captures, read_observations,
     read_point_table, PointsFrom, TableError,
@@ -48,6 +48,11 @@ pub struct ExtrinsicsJob {
     /// pose solve, and write the refined camera file in the form read; `None`: the camera
     /// file's intrinsics are used as they are.
     pub refine_intrinsics: Option<RefineParameters>,
+    /// Refine the filling gel's free surface of `optical_path` (its height and the gel's
+    /// index, under the priors [`crate::refraction::GEL_SURFACE_HEIGHT_SD_MM`] and
+    /// [`crate::refraction::SILICONE_INDEX_SD`]) with the pose over the inliers, before any
+    /// intrinsics refinement, which then sees the refined surface.
+    pub refine_optical_path: bool,
     /// The flat optical path between the lens and the pins (a design's
     /// `fabkit_designs::optics::optical_path`): rays bend at each plane ([`crate::refraction`]);
     /// `None`: straight rays from the lens.
@@ -197,6 +202,65 @@ pub fn calibrate_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsOutput, Ext
         };
         ExtrinsicsError::Pnp { context, source }
     })?;
+    let mut layers = layers;
+    let (sol, path_fit) = if job.refine_optical_path {
+        let (path, l) = match (&job.optical_path, &layers) {
+            (Some(p), Some(l)) => (p, l),
+            _ => {
+                return Err(ExtrinsicsError::OpticalPath(
+                    "--refine-optical-path needs the design's optical path (--design)".into(),
+                ))
+            }
+        };
+        let Some(plane) = path
+            .planes
+            .iter()
+            .position(|p| p.what.starts_with("housing.filling_gel"))
+        else {
+            return Err(ExtrinsicsError::OpticalPath(format!(
+                "--refine-optical-path refines a filling gel's free surface; the design's planes are: {}",
+                if path.planes.is_empty() {
+                    "none".to_string()
+                } else {
+                    path.planes
+                        .iter()
+                        .map(|p| p.what.as_str())
+                        .collect::<Vec<_>>()
+                        .join("; ")
+                }
+            )));
+        };
+        let prior = PlanePrior {
+            plane,
+            height_sd_mm: crate::refraction::GEL_SURFACE_HEIGHT_SD_MM,
+            index_sd: crate::refraction::SILICONE_INDEX_SD,
+        };
+        let (pts, px): (Vec<Vector3<f64>>, Vec<Vector2<f64>>) = pairs
+            .points_mm
+            .iter()
+            .zip(&pairs.pixels_px)
+            .zip(&sol.inliers)
+            .filter(|(_, &inlier)| inlier)
+            .map(|((p, q), _)| (*p, *q))
+            .unzip();
+        let fit = refine_plane(&camera, l, prior, &pts, &px, &sol.t_cam_sensor).ok_or_else(|| {
+            ExtrinsicsError::OpticalPath(
+                "--refine-optical-path: the gel's surface and the pose are not determined by these pins (a point does not project, or the normal matrix is singular)".into(),
+            )
+        })?;
+        let refined = solution_at(
+            &Imaging::new(&camera, Some(&fit.layers)),
+            &pairs.points_mm,
+            &pairs.pixels_px,
+            &sol,
+            fit.t_cam_sensor,
+        );
+        layers = Some(fit.layers.clone());
+        let report = PlaneFitReport::new(&fit, &path.planes[plane].what);
+        (refined, Some(report))
+    } else {
+        (sol, None)
+    };
     let (camera, sol, refinement) = match &job.refine_intrinsics {
         None => (camera, sol, None),
         Some(which) => {
@@ -277,6 +341,7 @@ pub fn calibrate_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsOutput, Ext
         provenance,
     );
     report.optical_path = job.optical_path.clone();
+    report.optical_path_fit = path_fit;
     if let Some(found) = &from_images {
         report.warnings.extend(found.notes.iter().cloned());
         report.captures = found.outcomes.iter().map(CaptureReport::from).collect();

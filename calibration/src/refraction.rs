@@ -324,3 +324,190 @@ impl<'a> Imaging<'a> {
         Some((uv, out))
     }
 }
+
+/// The prior on one plane of an optical path for [`refine_plane`]: the design's height and the
+/// materials table's index are the means; these are their standard deviations.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlanePrior {
+    /// Which plane (index into [`FlatLayers::planes_z_mm`]).
+    pub plane: usize,
+    /// Standard deviation of the plane's height about the given one, mm, > 0.
+    pub height_sd_mm: f64,
+    /// Standard deviation of the index of the medium above the plane about the given one, > 0.
+    pub index_sd: f64,
+}
+
+/// How far a poured gel's free surface may sit from where the design puts it, one standard
+/// deviation, mm. ASSUMPTION: a hand pour levelled by eye at a tube's mouth, a meniscus of a
+/// few tenths of a millimetre.
+pub const GEL_SURFACE_HEIGHT_SD_MM: f64 = 0.5;
+/// How far a clear silicone's index may be from the materials table's, one standard
+/// deviation. ASSUMPTION: clear platinum-cure silicones span about 1.40 to 1.43 at 589 nm.
+pub const SILICONE_INDEX_SD: f64 = 0.01;
+
+/// A plane of the optical path refined with the pose ([`refine_plane`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlaneFit {
+    pub t_cam_sensor: nalgebra::Isometry3<f64>,
+    /// The layers with the refined height and index.
+    pub layers: FlatLayers,
+    pub prior: PlanePrior,
+    /// The prior's means: the given height (mm) and index.
+    pub prior_height_mm: f64,
+    pub prior_index: f64,
+    /// The refined height, mm, and its standard deviation (data and prior together).
+    pub height_mm: f64,
+    pub height_sd_mm: f64,
+    /// The refined index above the plane and its standard deviation.
+    pub index: f64,
+    pub index_sd: f64,
+    /// Pixel noise per coordinate estimated from the residuals, px.
+    pub sigma_px: f64,
+    /// RMS reprojection error over the pairs, px.
+    pub rms_px: f64,
+}
+
+/// Refines the pose together with the height of one plane of `layers` and the index above it,
+/// from sensor-frame points (N, mm) and their pixels (N, px), starting at `start`: maximum a
+/// posteriori under Gaussian pixel noise and the Gaussian `prior` (Levenberg-Marquardt on the
+/// reprojection errors over the noise and the prior's two terms; the noise from the residuals,
+/// sqrt(sum e^2 / (2N - 6)), fitted again once at it). The standard deviations are the square
+/// roots of the diagonal of the inverse normal matrix at the solution (Hartley & Zisserman,
+/// Multiple View Geometry, 2nd ed., Sec. 5.2): below the prior's where the captures say more
+/// than it. `None` when a point does not project at the start or the normal matrix is singular.
+pub fn refine_plane(
+    camera: &CameraModel,
+    layers: &FlatLayers,
+    prior: PlanePrior,
+    points_mm: &[Vector3<f64>],
+    pixels_px: &[Vector2<f64>],
+    start: &nalgebra::Isometry3<f64>,
+) -> Option<PlaneFit> {
+    use nalgebra::{DMatrix, DVector, UnitQuaternion};
+    let k = prior.plane;
+    let (z0, n0) = (*layers.planes_z_mm.get(k)?, *layers.indices.get(k + 1)?);
+    let n = points_mm.len();
+    // state: rotation, translation, height, index
+    #[derive(Clone)]
+    struct S {
+        r: Matrix3<f64>,
+        t: Vector3<f64>,
+        z: f64,
+        idx: f64,
+    }
+    let with = |s: &S| {
+        let mut l = layers.clone();
+        l.planes_z_mm[k] = s.z;
+        l.indices[k + 1] = s.idx;
+        FlatLayers::new(l.planes_z_mm, l.indices).ok()
+    };
+    let residuals = |s: &S, sigma: f64| -> Option<DVector<f64>> {
+        let l = with(s)?;
+        let im = Imaging::new(camera, Some(&l));
+        let mut e = DVector::zeros(2 * n + 2);
+        for (i, (p, q)) in points_mm.iter().zip(pixels_px).enumerate() {
+            let d = im.project(&s.r, &s.t, p)? - q;
+            e[2 * i] = d.x / sigma;
+            e[2 * i + 1] = d.y / sigma;
+        }
+        e[2 * n] = (s.z - z0) / prior.height_sd_mm;
+        e[2 * n + 1] = (s.idx - n0) / prior.index_sd;
+        Some(e)
+    };
+    let step = |s: &S, d: &[f64]| S {
+        r: Rotation3::new(Vector3::new(d[0], d[1], d[2])).matrix() * s.r,
+        t: s.t + Vector3::new(d[3], d[4], d[5]),
+        z: s.z + d[6],
+        idx: s.idx + d[7],
+    };
+    let jacobian = |s: &S, sigma: f64| -> Option<DMatrix<f64>> {
+        let mut j = DMatrix::zeros(2 * n + 2, 8);
+        for c in 0..8 {
+            let h = match c {
+                0..=2 => 1e-7,
+                7 => 1e-7,
+                _ => 1e-6,
+            };
+            let mut d = [0.0; 8];
+            d[c] = h;
+            let plus = residuals(&step(s, &d), sigma)?;
+            d[c] = -h;
+            let minus = residuals(&step(s, &d), sigma)?;
+            j.set_column(c, &((plus - minus) / (2.0 * h)));
+        }
+        Some(j)
+    };
+    let mut s = S {
+        r: *start.rotation.to_rotation_matrix().matrix(),
+        t: start.translation.vector,
+        z: z0,
+        idx: n0,
+    };
+    let pixel_cost = |s: &S| -> Option<f64> {
+        let e = residuals(s, 1.0)?;
+        Some(e.rows(0, 2 * n).norm_squared())
+    };
+    let dof = (2 * n).saturating_sub(6).max(1) as f64;
+    let mut sigma = (pixel_cost(&s)? / dof).sqrt().max(1e-3);
+    for _pass in 0..2 {
+        let mut lambda = 1e-4;
+        let mut e = residuals(&s, sigma)?;
+        for _ in 0..100 {
+            let j = jacobian(&s, sigma)?;
+            let jtj = j.transpose() * &j;
+            let g = j.transpose() * &e;
+            let mut a = jtj.clone();
+            for c in 0..8 {
+                a[(c, c)] += lambda * jtj[(c, c)].max(1e-12);
+            }
+            let Some(ch) = a.cholesky() else {
+                lambda *= 10.0;
+                continue;
+            };
+            let d = ch.solve(&(-&g));
+            let s1 = step(&s, d.as_slice());
+            match residuals(&s1, sigma) {
+                Some(e1) if e1.norm_squared() <= e.norm_squared() => {
+                    let done =
+                        e.norm_squared() - e1.norm_squared() <= 1e-12 * e.norm_squared().max(1e-30);
+                    (s, e) = (s1, e1);
+                    lambda = (lambda * 0.1).max(1e-12);
+                    if done {
+                        break;
+                    }
+                }
+                _ => {
+                    lambda *= 10.0;
+                    if lambda > 1e10 {
+                        break;
+                    }
+                }
+            }
+        }
+        sigma = (pixel_cost(&s)? / dof).sqrt().max(1e-3);
+    }
+    let j = jacobian(&s, sigma)?;
+    let cov = (j.transpose() * &j).try_inverse()?;
+    let (var_z, var_n) = (cov[(6, 6)], cov[(7, 7)]);
+    if !(var_z >= 0.0 && var_n >= 0.0) {
+        return None;
+    }
+    let rot = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(s.r));
+    let layers = with(&s)?;
+    Some(PlaneFit {
+        t_cam_sensor: nalgebra::Isometry3::from_parts(
+            nalgebra::Translation3::from(s.t),
+            UnitQuaternion::new_normalize(rot.into_inner()),
+        ),
+        layers,
+        prior,
+        prior_height_mm: z0,
+        prior_index: n0,
+        height_mm: s.z,
+        height_sd_mm: var_z.sqrt(),
+        index: s.idx,
+        index_sd: var_n.sqrt(),
+        sigma_px: sigma,
+        rms_px: (pixel_cost(&s)? / n as f64).sqrt(),
+    })
+}

@@ -196,6 +196,9 @@ pub struct ExtrinsicsReport {
     /// straight rays from the lens.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub optical_path: Option<fabkit_designs::optics::OpticalPath>,
+    /// The filling gel's surface refined with the pose (`--refine-optical-path`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub optical_path_fit: Option<PlaneFitReport>,
     /// Rotation of T_cam_sensor as an OpenCV rotation vector (axis times angle), radians.
     pub rvec: [f64; 3],
     /// Translation of T_cam_sensor (the sensor origin in the camera frame), mm.
@@ -305,6 +308,46 @@ pub struct PoseUncertaintyReport {
     pub covariance_per_px2: [[f64; 6]; 6],
 }
 
+/// A plane of the optical path refined with the pose ([`crate::refraction::refine_plane`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PlaneFitReport {
+    pub description: String,
+    /// Which plane (`housing.filling_gel: the gel's free surface at ...`).
+    pub plane: String,
+    /// The design's height, mm, and the prior's standard deviation about it.
+    pub prior_height_mm: f64,
+    pub prior_height_sd_mm: f64,
+    /// The refined height, mm, and its standard deviation.
+    pub height_mm: f64,
+    pub height_sd_mm: f64,
+    /// The materials table's index above it, and the prior's standard deviation.
+    pub prior_index: f64,
+    pub prior_index_sd: f64,
+    /// The refined index and its standard deviation.
+    pub index: f64,
+    pub index_sd: f64,
+    /// Pixel noise per coordinate the fit estimated from its residuals, px.
+    pub sigma_px: f64,
+}
+
+impl PlaneFitReport {
+    pub fn new(f: &crate::refraction::PlaneFit, plane: &str) -> PlaneFitReport {
+        PlaneFitReport {
+            description: "The plane's height and the index above it refined with the pose, maximum a posteriori under Gaussian pixel noise (estimated from the residuals) and the Gaussian priors given; standard deviations from the inverse normal matrix at the solution, below the prior's where the pins say more than it. The pose and residuals of this report are at the refined plane.".into(),
+            plane: plane.to_string(),
+            prior_height_mm: f.prior_height_mm,
+            prior_height_sd_mm: f.prior.height_sd_mm,
+            height_mm: f.height_mm,
+            height_sd_mm: f.height_sd_mm,
+            prior_index: f.prior_index,
+            prior_index_sd: f.prior.index_sd,
+            index: f.index,
+            index_sd: f.index_sd,
+            sigma_px: f.sigma_px,
+        }
+    }
+}
+
 impl ExtrinsicsReport {
     /// Builds the report of a solution over its pairs.
     pub fn new(
@@ -400,6 +443,7 @@ impl ExtrinsicsReport {
             provenance,
             distortion_model: camera.camera.intrinsics().distortion.name().into(),
             optical_path: None,
+            optical_path_fit: None,
             rvec: [rvec.x, rvec.y, rvec.z],
             tvec_mm: [iso.translation.x, iso.translation.y, iso.translation.z],
             t_cam_sensor: std::array::from_fn(|i| std::array::from_fn(|j| h[(i, j)])),

@@ -144,6 +144,11 @@ pub struct ExtrinsicsArgs {
     /// them (`optical_path`). Without it the rays are straight from the lens.
     #[arg(long, value_name = "DESIGN")]
     pub design: Option<String>,
+    /// Refine the height of the design's filling gel surface and the gel's index with the
+    /// pose, under priors of 0.5 mm and 0.01 about the design's and the materials table's
+    /// values; the report gives both with their standard deviations (`optical_path_fit`).
+    #[arg(long, requires = "design")]
+    pub refine_optical_path: bool,
     /// Apply one of the design's presets (with --design).
     #[arg(long, value_name = "NAME", requires = "design")]
     pub preset: Option<String>,
@@ -207,6 +212,7 @@ fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
     };
     let job = ExtrinsicsJob {
         optical_path,
+        refine_optical_path: a.refine_optical_path,
         camera: a.cam.camera,
         camera_model: a.cam.camera_model.map(Into::into),
         points: a.points,

@@ -147,6 +147,7 @@ fn bench_calibration(c: &mut Criterion) {
         ransac: Some(Default::default()),
         refine_intrinsics: None,
         optical_path: None,
+        refine_optical_path: false,
         command_line: "bench".into(),
     };
     let out = calibrate_extrinsics(&job).unwrap();

@@ -978,3 +978,68 @@ fn the_design_bends_the_rays_at_the_gel_surface() {
     eprintln!("straight rays: camera {closer:.2} mm closer, outer ring {outer:.2} px");
     assert!(closer > 3.0 && outer > 1.0, "{closer} mm, {outer} px");
 }
+
+/// `--refine-optical-path`: a capture made through a gel surface 0.4 mm above the design's
+/// (z = -8.6 mm) with index 1.42: the report's `optical_path_fit` gives the height and index
+/// back within 3 of their standard deviations, and the pose at them. Without `--design` the
+/// option is refused by name.
+#[test]
+fn the_gel_surface_is_refined_with_the_pose() {
+    use fabkit_calibration::refraction::{FlatLayers, Imaging};
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let cam = CameraModel::new(intrinsics()).unwrap();
+    std::fs::write(
+        dir.join("cam.yaml"),
+        write_camera(&intrinsics(), CameraFileFormat::OpenCvYaml),
+    )
+    .unwrap();
+    write_table(&dir.join("pins.csv"));
+    let rot = UnitQuaternion::from_scaled_axis(Vector3::new(0.02, -0.015, 0.4));
+    let centre = Vector3::new(0.3, -0.2, -17.4);
+    let truth = Isometry3::from_parts(Translation3::from(-(rot * centre)), rot);
+    let gel = FlatLayers::single(-8.6, 1.0, 1.42).unwrap();
+    let through = Imaging::new(&cam, Some(&gel));
+    let (r, t) = (
+        *truth.rotation.to_rotation_matrix().matrix(),
+        truth.translation.vector,
+    );
+    let mut obs = String::from("id,u_px,v_px\n");
+    for (id, tip, _) in pins() {
+        let uv = through.project(&r, &t, &tip).unwrap();
+        let n = if id % 2 == 0 { 0.3 } else { -0.3 };
+        obs.push_str(&format!("{id},{},{}\n", uv.x + n, uv.y - 0.5 * n));
+    }
+    std::fs::write(dir.join("obs.csv"), obs).unwrap();
+    let args = extrinsics_args(
+        "cam.yaml",
+        "out",
+        &["--design", "rtac0", "--refine-optical-path"],
+    );
+    let o = run(dir, &args, &[]);
+    assert!(o.status.success(), "{}{}", text(&o.stdout), text(&o.stderr));
+    let j = json(&dir.join("out/extrinsics.json"));
+    let f = &j["optical_path_fit"];
+    let g = |k: &str| f[k].as_f64().unwrap();
+    eprintln!("{f:#}");
+    assert_eq!(g("prior_height_mm"), -9.0);
+    // measured: -8.608 +- 0.359 mm, 1.4172 +- 0.0079, the pose 0.018 deg off
+    assert!(
+        (g("height_mm") - -8.6).abs() < 3.0 * g("height_sd_mm"),
+        "{f}"
+    );
+    assert!((g("index") - 1.42).abs() < 3.0 * g("index_sd"), "{f}");
+    assert!(g("height_sd_mm") < 0.5, "{f}");
+    let pose = pose_of(&j);
+    let rot_err = pose.rotation.angle_to(&truth.rotation).to_degrees();
+    eprintln!("pose {rot_err:.4} deg");
+    assert!(rot_err < 0.2, "{rot_err}");
+
+    let o = run(
+        dir,
+        &extrinsics_args("cam.yaml", "out2", &["--refine-optical-path"]),
+        &[],
+    );
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o.stderr).contains("--design"), "{}", text(&o.stderr));
+}
