@@ -240,6 +240,48 @@ impl FlatLayers {
     }
 }
 
+impl FlatLayers {
+    /// Traces the ray leaving `from` along `direction` (in the medium at `from`) across every
+    /// plane it meets: where it crosses the last one and its unit direction in the medium
+    /// beyond it. No plane on its way: `from` and the direction. `None` when the ray runs
+    /// parallel to the planes or is totally internally reflected.
+    pub fn trace_beyond(
+        &self,
+        from: &Vector3<f64>,
+        direction: &Vector3<f64>,
+    ) -> Option<(Vector3<f64>, Vector3<f64>)> {
+        let d = direction.try_normalize(0.0)?;
+        let last = if d.z > 0.0 {
+            self.planes_z_mm.iter().rev().find(|&&z| z > from.z)
+        } else {
+            self.planes_z_mm.iter().find(|&&z| z < from.z)
+        };
+        let Some(&z) = last else {
+            return Some((*from, d));
+        };
+        let (at, _) = self.trace_to_z(from, &d, z)?;
+        let s = self.index_at(from.z) * d.xy().norm();
+        let beyond = if d.z > 0.0 {
+            self.index_at(z + 1.0)
+        } else {
+            self.index_at(z)
+        };
+        let sin = s / beyond;
+        if !(sin < 1.0) {
+            return None;
+        }
+        let along = d.xy().try_normalize(0.0).unwrap_or_else(Vector2::zeros);
+        Some((
+            at,
+            Vector3::new(
+                sin * along.x,
+                sin * along.y,
+                (1.0 - sin * sin).sqrt().copysign(d.z),
+            ),
+        ))
+    }
+}
+
 /// A camera and the optical path in front of it: what projects a sensor-frame point at a
 /// pose. `layers: None` is the straight-ray pinhole or fisheye projection of the camera file
 /// alone.

@@ -292,7 +292,23 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
         read_fixtures(&args.fixtures, &design.name)?
     };
     let pose_name = args.extrinsics.display().to_string();
-    let scene = Scene::new(design, &camera, &t_cam_sensor, &pose_name)?;
+    // the rays bend where the pose was solved through an optical path (`calibrate extrinsics
+    // --design`): the depth maps register with the captures that calibration saw
+    let optical_path =
+        fabkit_calibration::groundtruth::inputs::read_optical_path(&args.extrinsics)?;
+    if optical_path.is_some() && args.images {
+        return Err(format!(
+            "--images with --extrinsics {pose_name}: the pose was solved through the design's optical path (its optical_path), and the tactile images are not yet rendered through it (the depth maps are); render the depth maps without --images, or the images from a pose solved without --design"
+        )
+        .into());
+    }
+    let scene = Scene::through(
+        design,
+        &camera,
+        &t_cam_sensor,
+        &pose_name,
+        optical_path.as_ref().map(|(l, _)| l),
+    )?;
     if args.pin_captures {
         // the pin dome of this design's skin, whatever its name
         let pins = fabkit_calibration::groundtruth::pins::read_pins(&args.fixtures)?;
@@ -463,6 +479,7 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
             camera_centre_mm: c,
             fixtures: &fixtures,
             pixels_on_surface: ref_hits.valid_count(),
+            optical_path: optical_path.as_ref().map(|(_, v)| v),
             imaging: imaging.as_ref(),
         },
         &|k| bar.set(k, frames),

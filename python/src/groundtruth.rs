@@ -737,6 +737,7 @@ impl DepthRenderer {
                     camera_centre_mm: rays.origin_mm,
                     fixtures: &fixture_set,
                     pixels_on_surface: self.reference_hits.valid_count(),
+                    optical_path: None,
                     imaging: imaging.as_ref(),
                 },
                 &|k| report_progress(&progress, k as usize, frames as usize, "groundtruth"),

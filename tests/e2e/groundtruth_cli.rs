@@ -873,3 +873,88 @@ fn digit_pinki_ground_truth_through_the_users_camera_file() {
         .filter(|r| r.is_finite())
         .all(|&r| f64::from(r) <= far + 0.01));
 }
+
+/// A pose solved through the design's optical path (an extrinsics file with `optical_path`, as
+/// `calibrate extrinsics --design rtac0` writes it): the depth maps are rendered with the rays
+/// bent at the gel's surface (z = -9 mm, n = 1.41), as the library renders them
+/// (`Scene::through`, whose maps project back onto their pixels: calibration's refraction
+/// tests), the manifest says so, and they differ from the straight rays' towards the rim;
+/// `--images` with such a pose is refused by name.
+#[test]
+fn a_pose_solved_through_the_gel_gives_depth_maps_through_it() {
+    use fabkit_calibration::groundtruth::{reference_hits, DepthFrame, Scene};
+    use fabkit_calibration::refraction::FlatLayers;
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    setup(dir);
+    let mut ext: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("extrinsics.json")).unwrap()).unwrap();
+    ext["optical_path"] = serde_json::json!({"planes": [{"z_mm": -9.0, "what": "housing.filling_gel: the gel's free surface at the core's open end", "above": "solaris", "index_above": 1.41, "index_source": "ASSUMPTION"}]});
+    std::fs::write(
+        dir.join("bent.json"),
+        serde_json::to_vec_pretty(&ext).unwrap(),
+    )
+    .unwrap();
+    let args = |ext: &'static str, out: &'static str, extra: &[&'static str]| {
+        let mut a = vec![
+            "groundtruth",
+            "rtac0",
+            "--camera",
+            "cam.yaml",
+            "--extrinsics",
+            ext,
+            "--fixtures",
+            "fx",
+            "--out",
+            out,
+        ];
+        a.extend(extra);
+        a
+    };
+    let o = run(dir, &args("bent.json", "bent", &[]), &[]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let o = run(dir, &args("extrinsics.json", "straight", &[]), &[]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let manifest: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("bent/manifest.json")).unwrap()).unwrap();
+    assert_eq!(manifest["optical_path"]["planes"][0]["z_mm"], -9.0);
+    assert!(manifest["conventions"]["not_modelled"]
+        .as_str()
+        .unwrap()
+        .starts_with("refraction at curved interfaces"));
+    // the library's render of the same scene, to float32
+    let design = fabkit_designs::library::load("rtac0").unwrap();
+    let cam = CameraModel::new(benchmark_intrinsics()).unwrap();
+    let (pose, _) =
+        fabkit_calibration::groundtruth::inputs::read_extrinsics(&dir.join("extrinsics.json"))
+            .unwrap();
+    let gel = FlatLayers::single(-9.0, 1.0, 1.41).unwrap();
+    let scene = Scene::through(&design, &cam, &pose, "pose", Some(&gel)).unwrap();
+    let frame = DepthFrame::new(&scene.rays, &reference_hits(&scene.rays, &scene.surface));
+    let bent = read_npy_f32(&dir.join("bent/reference/zdepth_mm.npy"));
+    let straight = read_npy_f32(&dir.join("straight/reference/zdepth_mm.npy"));
+    let (mut n, mut most) = (0, 0.0f32);
+    for p in 0..bent.len() {
+        let z = frame.zdepth_mm[p];
+        if z.is_finite() {
+            assert_eq!(bent[p], z as f32, "pixel {p}");
+            n += 1;
+            if straight[p].is_finite() {
+                most = most.max((bent[p] - straight[p]).abs());
+            }
+        } else {
+            assert!(bent[p].is_nan());
+        }
+    }
+    eprintln!("{n} pixels; bent and straight depth differ by up to {most:.2} mm");
+    // measured: 255,480 pixels; up to 8.27 mm apart (the rim, seen through the gel's surface)
+    assert!(n > 1000 && most > 0.5, "{n} {most}");
+    let o = run(dir, &args("bent.json", "img", &["--images"]), &[]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o.stderr));
+    assert!(
+        text(&o.stderr).contains("--images with --extrinsics bent.json"),
+        "{}",
+        text(&o.stderr)
+    );
+    assert!(!dir.join("img").exists());
+}

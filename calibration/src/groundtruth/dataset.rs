@@ -727,6 +727,9 @@ pub struct ManifestInputs<'a> {
     /// Pixels whose ray meets the reference skin.
     pub pixels_on_surface: usize,
     pub imaging: Option<&'a ImageSource>,
+    /// The optical path the rays were bent along ([`super::inputs::read_optical_path`]'s
+    /// summary); `None`: straight rays.
+    pub optical_path: Option<&'a Value>,
 }
 
 /// The dataset's manifest.json ([`render_frames`] made `rendered`): what it is, its inputs,
@@ -794,6 +797,13 @@ pub fn manifest(inputs: &ManifestInputs<'_>, rendered: &Rendered) -> Value {
         "masks_and_pairs": extra_entries,
         "files": all.iter().map(|(f, s, b)| json!({"file": f, "sha256": s, "bytes": b})).collect::<Vec<_>>(),
     });
+    if let Some(path) = inputs.optical_path {
+        manifest["optical_path"] = path.clone();
+        let c = &mut manifest["conventions"];
+        c["range_mm"] = json!("distance from the camera centre to the surface point, mm (the pixel's ray is bent by Snell's law at each plane of optical_path, so the hit is not on the straight bearing)");
+        c["zdepth_mm"] = json!("z of the surface point in the camera frame, mm");
+        c["not_modelled"] = json!("refraction at curved interfaces (a glass core's faces, the cast layers on a dome; optical_path holds the flat ones); the skin's deformation around a protrusion (the indented surface is the skin minus the protrusion solids)");
+    }
     if let Some(ImageSource::Photometric(_, dir, sha)) = imaging {
         manifest["images"] = json!({
             "file": "image.png in reference/ and in each configuration's folder",

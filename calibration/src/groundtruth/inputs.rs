@@ -145,6 +145,64 @@ pub fn read_extrinsics(path: &Path) -> Result<(Isometry3<f64>, String), InputErr
     }
 }
 
+/// The optical path an extrinsics file was solved through (`optical_path` of `fabkit calibrate
+/// extrinsics --design`, its gel surface as `optical_path_fit` refined it): the layers, air
+/// under the lowest plane, and the planes as used (z_mm, index_above, what) for a manifest.
+/// `None` when the file has none (straight rays).
+///
+/// # Errors
+/// [`InputError`] naming the file and the field of a plane that is not a number or of layers
+/// that are not valid ([`crate::refraction::FlatLayers::new`]).
+pub fn read_optical_path(
+    path: &Path,
+) -> Result<Option<(crate::refraction::FlatLayers, serde_json::Value)>, InputError> {
+    let (bytes, _) = read_with_hash(path)?;
+    let v: serde_json::Value = json(&bytes, path)?;
+    let Some(planes) = v.get("optical_path").and_then(|p| p.get("planes")) else {
+        return Ok(None);
+    };
+    let file = path.display().to_string();
+    let bad = |field: String, value: String, rule: &str| InputError::Field {
+        file: file.clone(),
+        field,
+        value,
+        rule: rule.into(),
+    };
+    let fit = v.get("optical_path_fit");
+    let mut used = Vec::new();
+    for (k, p) in planes.as_array().into_iter().flatten().enumerate() {
+        let num = |key: &str| {
+            p.get(key)
+                .and_then(serde_json::Value::as_f64)
+                .ok_or_else(|| {
+                    bad(
+                        format!("optical_path.planes[{k}].{key}"),
+                        p.get(key).map_or("missing".into(), |x| x.to_string()),
+                        "must be a number",
+                    )
+                })
+        };
+        let what = p.get("what").and_then(|w| w.as_str()).unwrap_or("");
+        let (mut z, mut n) = (num("z_mm")?, num("index_above")?);
+        if let Some(f) = fit.filter(|f| f.get("plane").and_then(|w| w.as_str()) == Some(what)) {
+            let g = |key: &str| f.get(key).and_then(serde_json::Value::as_f64);
+            if let (Some(fz), Some(fn_)) = (g("height_mm"), g("index")) {
+                (z, n) = (fz, fn_);
+            }
+        }
+        used.push((z, n, what.to_string()));
+    }
+    let mut indices = vec![1.0];
+    indices.extend(used.iter().map(|u| u.1));
+    let layers = crate::refraction::FlatLayers::new(used.iter().map(|u| u.0).collect(), indices)
+        .map_err(|e| bad(format!("optical_path.{}", e.field), e.value, e.rule))?;
+    let summary = serde_json::json!({
+        "from": file,
+        "planes": used.iter().map(|(z, n, what)| serde_json::json!({"z_mm": z, "index_above": n, "what": what})).collect::<Vec<_>>(),
+    });
+    Ok(Some((layers, summary)))
+}
+
 /// The rigid transform of a 4 x 4 matrix `m` (rows), such as `T_cam_sensor`.
 ///
 /// # Errors

@@ -54,13 +54,32 @@ impl Scene {
         t_cam_sensor: &nalgebra::Isometry3<f64>,
         pose_name: &str,
     ) -> Result<Scene, String> {
+        Scene::through(design, camera, t_cam_sensor, pose_name, None)
+    }
+
+    /// [`Scene::new`] with the rays bent at the flat interfaces of `layers`
+    /// ([`PixelRays::through`]); `None`: straight rays.
+    ///
+    /// # Errors
+    /// As [`Scene::new`], and when the camera centre is not under every plane of `layers`.
+    pub fn through(
+        design: &fabkit_designs::Design,
+        camera: &crate::CameraModel,
+        t_cam_sensor: &nalgebra::Isometry3<f64>,
+        pose_name: &str,
+        layers: Option<&crate::refraction::FlatLayers>,
+    ) -> Result<Scene, String> {
         let surface = ReferenceSurface::of(&design.body).ok_or_else(|| {
             format!(
                 "body.profile = {}: no reference surface for this profile",
                 design.body.kind()
             )
         })?;
-        let rays = PixelRays::new(camera, t_cam_sensor);
+        let rays = match layers {
+            None => PixelRays::new(camera, t_cam_sensor),
+            Some(l) => PixelRays::through(camera, t_cam_sensor, l)
+                .map_err(|e| format!("{pose_name}: {e}"))?,
+        };
         let c = rays.origin_mm;
         if !surface.contains(c, 0.0) {
             let body = match design.body.flat_outline() {
@@ -112,7 +131,8 @@ impl Scene {
 /// The surface seen along every ray of a frame, sensor frame.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SurfaceHits {
-    /// Distance along the ray (range), mm; NaN where the ray misses the skin.
+    /// Distance along the ray from its start (the camera centre; for bent rays their start in
+    /// the last medium, [`PixelRays::origin`]), mm; NaN where the ray misses the skin.
     pub t_mm: Vec<f64>,
     /// Unit normal of the elastomer surface at the hit, pointing out of the elastomer (away
     /// from the sensor's inside), sensor frame; NaN where the ray misses.
@@ -140,6 +160,18 @@ pub fn reference_hits(rays: &PixelRays, surface: &ReferenceSurface) -> SurfaceHi
         contact: vec![false; n],
         t_exit_mm: vec![f64::NAN; n],
     };
+    if rays.origins.is_some() {
+        for p in 0..n {
+            if let Some(e) = surface.exit(rays.origin(p), rays.dirs[p]) {
+                h.t_exit_mm[p] = e.t_mm;
+                if e.on_skin {
+                    h.t_mm[p] = e.t_mm;
+                    h.normal[p] = e.normal;
+                }
+            }
+        }
+        return h;
+    }
     surface.exit_all(
         rays.origin_mm,
         &rays.dirs,
@@ -158,8 +190,8 @@ pub fn indented_hits(
     base_z_mm: f64,
 ) -> SurfaceHits {
     let mut h = reference.clone();
-    let o = rays.origin_mm;
     for (p, d) in rays.dirs.iter().enumerate() {
+        let o = rays.origin(p);
         let tmax = reference.t_exit_mm[p];
         if !(tmax > 0.0) {
             continue;
@@ -231,7 +263,9 @@ pub fn mesh_hits(
 pub struct DepthFrame {
     pub width: usize,
     pub height: usize,
-    /// Distance along the ray from the camera centre, mm; NaN where the ray misses.
+    /// Distance from the camera centre to the surface along the ray, mm (for rays bent by an
+    /// optical path, [`PixelRays::through`], the straight distance from the camera centre to
+    /// the hit); NaN where the ray misses.
     pub range_mm: Vec<f64>,
     /// z of the hit in the camera frame, mm; NaN where the ray misses.
     pub zdepth_mm: Vec<f64>,
@@ -261,9 +295,19 @@ impl DepthFrame {
             if !t.is_finite() {
                 continue;
             }
-            let b = rays.bearings[p];
-            f.zdepth_mm[p] = t * b[2];
-            f.point_cam_mm[p] = [t * b[0], t * b[1], t * b[2]];
+            if rays.origins.is_some() {
+                // bent rays: the hit from the ray's start in the last medium, in the camera
+                // frame; the range is its distance from the camera centre
+                let (o, d) = (rays.origin(p), rays.dirs[p]);
+                let q = rays.to_camera([o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2]]);
+                f.range_mm[p] = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]).sqrt();
+                f.zdepth_mm[p] = q[2];
+                f.point_cam_mm[p] = q;
+            } else {
+                let b = rays.bearings[p];
+                f.zdepth_mm[p] = t * b[2];
+                f.point_cam_mm[p] = [t * b[0], t * b[1], t * b[2]];
+            }
             f.normal_cam[p] = rays.dir_to_camera(hits.normal[p]);
         }
         f
@@ -296,13 +340,12 @@ impl DepthFrame {
 /// half, where orientation 0 puts the pattern), at x < 0 in the left mask; a miss is in
 /// neither.
 pub fn half_masks(rays: &PixelRays, reference: &SurfaceHits) -> (Vec<bool>, Vec<bool>) {
-    let o = rays.origin_mm;
     let mut left = vec![false; rays.len()];
     let mut right = vec![false; rays.len()];
     for p in 0..rays.len() {
         let t = reference.t_mm[p];
         if t.is_finite() {
-            let x = o[0] + t * rays.dirs[p][0];
+            let x = rays.origin(p)[0] + t * rays.dirs[p][0];
             if x >= 0.0 {
                 right[p] = true;
             } else {
