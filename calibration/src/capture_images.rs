@@ -18,12 +18,11 @@ use nalgebra::{Isometry3, Vector2, Vector3};
 use rayon::prelude::*;
 
 use crate::imprints::{
-    assign_ids, detect, ids_from_file_name, reference_mask, CaptureOutcome, CaptureSpots,
+    assign_ids_through, detect, ids_from_file_name, reference_mask, CaptureOutcome, CaptureSpots,
     DetectParams, GrayImage,
 };
 use crate::overlay::{OverlayError, Rgb8};
 use crate::tables::{CapturePlan, Observations, PointTable};
-use crate::CameraModel;
 
 /// Capture images and the reference image they are compared with.
 #[derive(Debug, Clone)]
@@ -260,12 +259,13 @@ fn csv_cell(s: &str) -> String {
 /// given twice, a file name that lists no ids (without a plan), a plan id that is not a
 /// number, a plan with another number of captures.
 pub fn observe_images(
-    camera: &CameraModel,
+    imaging: &crate::refraction::Imaging<'_>,
     camera_file: &str,
     table: &PointTable,
     plan: Option<&CapturePlan>,
     input: &CaptureImages,
 ) -> Result<ImageObservations, ImageError> {
+    let camera = imaging.camera;
     let intr = camera.intrinsics();
     let size = (intr.image_width_px, intr.image_height_px);
     for (k, p) in input.captures.iter().enumerate() {
@@ -355,7 +355,7 @@ pub fn observe_images(
     let points: BTreeMap<u32, Vector3<f64>> =
         by_number.iter().map(|(n, (_, p))| (*n, *p)).collect();
     let spots: Vec<CaptureSpots> = captures.iter().map(|c| c.spots.clone()).collect();
-    let assignment = assign_ids(camera, &points, &spots);
+    let assignment = assign_ids_through(imaging, &points, &spots);
     let mut csv = String::from("capture,id,u_px,v_px,score\n");
     // id -> (sum of pixels, count, captures), first-seen order
     let mut merged: Vec<(String, Vec<Vector2<f64>>, Vec<String>)> = Vec::new();

@@ -135,6 +135,13 @@ pub struct FoundInImages {
 /// a plan of another length).
 pub fn calibrate_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsOutput, ExtrinsicsError> {
     let camera = read_camera_file_as(&job.camera, job.camera_model)?;
+    let layers = job
+        .optical_path
+        .as_ref()
+        .map(FlatLayers::from_optical_path)
+        .transpose()
+        .map_err(|e| ExtrinsicsError::OpticalPath(e.to_string()))?;
+
     let table = read_point_table(&job.points, job.points_from)?;
     let plan = job
         .capture_plan
@@ -145,7 +152,13 @@ pub fn calibrate_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsOutput, Ext
         Observed::Files(f) => (f.iter().map(PathBuf::as_path).collect(), None),
         Observed::Images(i) => {
             let camera_file = job.camera.display().to_string();
-            let found = observe_images(&camera, &camera_file, &table, plan.as_ref(), i)?;
+            let found = observe_images(
+                &Imaging::new(&camera, layers.as_ref()),
+                &camera_file,
+                &table,
+                plan.as_ref(),
+                i,
+            )?;
             (
                 i.captures.iter().map(PathBuf::as_path).collect(),
                 Some(found),
@@ -169,12 +182,6 @@ pub fn calibrate_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsOutput, Ext
         ransac: job.ransac,
         ..Default::default()
     };
-    let layers = job
-        .optical_path
-        .as_ref()
-        .map(FlatLayers::from_optical_path)
-        .transpose()
-        .map_err(|e| ExtrinsicsError::OpticalPath(e.to_string()))?;
     let sol = solve_pnp_through(
         &Imaging::new(&camera, layers.as_ref()),
         &pairs.points_mm,

@@ -701,7 +701,8 @@ pub fn detect(
 }
 
 pub use assign::{
-    assign_ids, Assignment, CaptureOutcome, CaptureSpots, Observation, MAX_PINS_PER_CAPTURE,
+    assign_ids, assign_ids_through, Assignment, CaptureOutcome, CaptureSpots, Observation,
+    MAX_PINS_PER_CAPTURE,
 };
 
 /// The ids a capture's file name lists in ring order (the R-Tac0 authors' convention:

@@ -140,6 +140,9 @@ pub const MAX_ROBUST_THRESHOLD_OF_SPREAD: f64 = 0.1;
 struct Pairs<'a> {
     camera: Imaging<'a>,
     pts: &'a [Vector3<f64>],
+    /// The points where the straight-ray solvers (P3P, SQPnP) take them: as they are, or
+    /// where they appear through the layers ([`Imaging::apparent_points`]).
+    apparent: &'a [Vector3<f64>],
     px: &'a [Vector2<f64>],
     bearings: &'a [Vector3<f64>],
 }
@@ -180,14 +183,15 @@ fn robust_threshold_px(
     for _ in 0..samples {
         let sample = triples.next_triple();
         p3p(
-            &sample.map(|i| pts[i]),
+            &sample.map(|i| pairs.apparent[i]),
             &sample.map(|i| bearings[i]),
             &mut poses,
         );
         for (r, t) in &poses {
-            let m = median2(r, t, &mut e2);
+            let t = camera.admissible_start(r, t);
+            let m = median2(r, &t, &mut e2);
             if m < best.0 {
-                best = (m, *r, *t);
+                best = (m, *r, t);
             }
         }
     }
@@ -332,14 +336,15 @@ fn solve_in_order(
     let n = points_mm.len();
     check_layout(points_mm, bearings)?;
     let all: Vec<usize> = (0..n).collect();
-    let start = sqpnp(points_mm, bearings).ok_or(PnpError::NoSolution)?;
+    let apparent = camera.apparent_points(points_mm);
+    let start = sqpnp(&apparent, bearings).ok_or(PnpError::NoSolution)?;
     let mut fit = Fit::at(
         camera,
         points_mm,
         pixels_px,
         &all,
         start.rotation,
-        start.translation_mm,
+        camera.admissible_start(&start.rotation, &start.translation_mm),
     )
     .ok_or(PnpError::NoSolution)?;
     let mut hypotheses = 0;
@@ -348,6 +353,7 @@ fn solve_in_order(
     let pairs = Pairs {
         camera: *camera,
         pts: points_mm,
+        apparent: &apparent,
         px: pixels_px,
         bearings,
     };
@@ -499,10 +505,11 @@ fn ransac(
     while hypotheses < needed {
         hypotheses += 1;
         let sample = triples.next_triple();
-        let sp = sample.map(|i| pts[i]);
+        let sp = sample.map(|i| pairs.apparent[i]);
         let sb = sample.map(|i| bearings[i]);
         p3p(&sp, &sb, &mut poses);
         for (hr, ht) in &poses {
+            let ht = &camera.admissible_start(hr, ht);
             if !trial.score(camera, pts, px, hr, ht, thr2, best.score) {
                 continue;
             }
@@ -548,9 +555,15 @@ fn fit_on(pairs: &Pairs<'_>, idx: &[usize], from: &Fit, opts: &PnpOptions) -> Op
         }
     };
     consider(from.r, from.t);
-    let (sp, sb): (Vec<_>, Vec<_>) = idx.iter().map(|&i| (pts[i], bearings[i])).unzip();
+    let (sp, sb): (Vec<_>, Vec<_>) = idx
+        .iter()
+        .map(|&i| (pairs.apparent[i], bearings[i]))
+        .unzip();
     if let Some(g) = sqpnp(&sp, &sb) {
-        consider(g.rotation, g.translation_mm);
+        consider(
+            g.rotation,
+            camera.admissible_start(&g.rotation, &g.translation_mm),
+        );
     }
     best
 }

@@ -241,6 +241,25 @@ impl FlatLayers {
 }
 
 impl FlatLayers {
+    /// Where a point appears to a camera in the medium under the lowest plane looking along
+    /// the planes' normal: each medium's run above that plane scaled by the camera's medium's
+    /// index over its own (the paraxial apparent depth, Hecht Sec. 5.2.3: `d / n` under one
+    /// interface). Exact only on the axis; what the straight-ray closed-form and minimal
+    /// solvers of PnP take, so that their poses start the refinement through the layers near
+    /// the camera's true height rather than too close by the missing bend. Points under the
+    /// lowest plane are returned as they are.
+    pub fn apparent(&self, p: &Vector3<f64>) -> Vector3<f64> {
+        let Some(&z0) = self.planes_z_mm.first() else {
+            return *p;
+        };
+        if !(p.z > z0) {
+            return *p;
+        }
+        let n0 = self.indices[0];
+        let z = z0 + self.runs(z0, p.z).map(|(t, n)| t * n0 / n).sum::<f64>();
+        Vector3::new(p.x, p.y, z)
+    }
+
     /// Traces the ray leaving `from` along `direction` (in the medium at `from`) across every
     /// plane it meets: where it crosses the last one and its unit direction in the medium
     /// beyond it. No plane on its way: `from` and the direction. `None` when the ray runs
@@ -282,6 +301,10 @@ impl FlatLayers {
     }
 }
 
+/// How far under the lowest plane [`Imaging::admissible_start`] puts a camera that a start
+/// had beyond it, mm.
+pub const START_BELOW_PLANE_MM: f64 = 1.0;
+
 /// A camera and the optical path in front of it: what projects a sensor-frame point at a
 /// pose. `layers: None` is the straight-ray pinhole or fisheye projection of the camera file
 /// alone.
@@ -292,6 +315,14 @@ pub struct Imaging<'a> {
 }
 
 impl<'a> Imaging<'a> {
+    /// [`FlatLayers::apparent`] of each point, or the points as they are for straight rays.
+    pub fn apparent_points(&self, points: &[Vector3<f64>]) -> Vec<Vector3<f64>> {
+        match self.layers {
+            None => points.to_vec(),
+            Some(l) => points.iter().map(|p| l.apparent(p)).collect(),
+        }
+    }
+
     /// `camera` behind `layers` (`None`: straight rays).
     pub fn new(camera: &'a CameraModel, layers: Option<&'a FlatLayers>) -> Imaging<'a> {
         Imaging { camera, layers }
@@ -320,10 +351,30 @@ impl<'a> Imaging<'a> {
             None => self.camera.project(&(r * p + t)),
             Some(l) => {
                 let centre = -(r.transpose() * t);
+                // the model puts the camera in the air under the layers
+                if l.planes_z_mm.first().is_some_and(|&z| !(centre.z < z)) {
+                    return None;
+                }
                 let d = l.direction_to(&centre, p)?;
                 self.camera.project(&(r * d))
             }
         }
+    }
+
+    /// A pose to start a refinement through the layers from: `t` as given when the camera
+    /// centre is under the lowest plane, else the centre moved along the sensor's z to
+    /// [`START_BELOW_PLANE_MM`] under it (a straight-ray solution puts the camera too close to
+    /// what it sees through a denser medium, often beyond the plane, where no ray bends).
+    pub fn admissible_start(&self, r: &Matrix3<f64>, t: &Vector3<f64>) -> Vector3<f64> {
+        let Some(&z0) = self.layers.and_then(|l| l.planes_z_mm.first()) else {
+            return *t;
+        };
+        let mut centre = -(r.transpose() * t);
+        if centre.z < z0 - START_BELOW_PLANE_MM {
+            return *t;
+        }
+        centre.z = z0 - START_BELOW_PLANE_MM;
+        -(r * centre)
     }
 
     /// [`project`](Self::project) and its 2 x 6 Jacobian with respect to the pose, the

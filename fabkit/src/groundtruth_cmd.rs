@@ -296,12 +296,6 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
     // --design`): the depth maps register with the captures that calibration saw
     let optical_path =
         fabkit_calibration::groundtruth::inputs::read_optical_path(&args.extrinsics)?;
-    if optical_path.is_some() && args.images {
-        return Err(format!(
-            "--images with --extrinsics {pose_name}: the pose was solved through the design's optical path (its optical_path), and the tactile images are not yet rendered through it (the depth maps are); render the depth maps without --images, or the images from a pose solved without --design"
-        )
-        .into());
-    }
     let scene = Scene::through(
         design,
         &camera,

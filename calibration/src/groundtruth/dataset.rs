@@ -838,9 +838,21 @@ pub fn manifest(inputs: &ManifestInputs<'_>, rendered: &Rendered) -> Value {
             "noise": "seeded (optics.camera.seed): each frame draws its own noise (noise_frame: 0 for the reference, i + 1 for configuration i); the same seed gives the same bytes",
             "not_modelled": IMAGES_NOT_MODELLED,
         });
+        if inputs.optical_path.is_some() {
+            manifest["images"]["not_modelled"] = json!(IMAGES_NOT_MODELLED.replacen(
+                IMAGES_REFRACTION,
+                IMAGES_REFRACTION_THROUGH_PATH,
+                1
+            ));
+        }
     }
     manifest
 }
+
+/// The first clause of [`IMAGES_NOT_MODELLED`], for straight rays.
+const IMAGES_REFRACTION: &str = "refraction through the clear layers between the camera and the reflective surface (rays are straight from the camera centre)";
+/// ... and in its place when the camera's rays are bent at the optical path's planes.
+const IMAGES_REFRACTION_THROUGH_PATH: &str = "refraction at curved interfaces (the camera's rays bend at the flat planes of optical_path only), and of the light: the LEDs' rays to the skin are straight, without Fresnel losses at the planes";
 
 /// Default bound on a dataset's bytes, refused above it unless asked for (`--max-output-bytes`,
 /// `max_output_bytes=`): 1 GB.

@@ -473,7 +473,6 @@ pub fn frame_radiance(
     optics: &fabkit_designs::optics::ResolvedOptics,
     protrusions: Option<&super::exact::ExactPrimitives>,
 ) -> Vec<[f64; 3]> {
-    let o = rays.origin_mm;
     let lights: Vec<Prepared> = optics.lights.iter().map(Prepared::of).collect();
     let lobe = lobe_of(&optics.surface);
     let markers = MarkerMap::new(&optics.markers, protrusions);
@@ -481,7 +480,8 @@ pub fn frame_radiance(
     (0..rays.dirs.len())
         .into_par_iter()
         .map(|i| {
-            let (t_skin, d) = (hits.t_mm[i], rays.dirs[i]);
+            // a ray bent by an optical path starts in the last medium (`PixelRays::through`)
+            let (t_skin, d, o) = (hits.t_mm[i], rays.dirs[i], rays.origin(i));
             if !t_skin.is_finite() {
                 return [f64::NAN; 3];
             }

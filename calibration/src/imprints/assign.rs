@@ -7,9 +7,10 @@
 
 use std::collections::BTreeMap;
 
-use nalgebra::{Isometry3, Point3, Vector2, Vector3};
+use nalgebra::{Isometry3, Vector2, Vector3};
 
 use super::Spot;
+use crate::refraction::Imaging;
 use crate::CameraModel;
 
 /// One capture's detected spots and the pins planned for it (the capture plan's row, or the
@@ -218,6 +219,16 @@ pub fn assign_ids(
     points: &BTreeMap<u32, Vector3<f64>>,
     all: &[CaptureSpots],
 ) -> Assignment {
+    assign_ids_through(&Imaging::straight(camera), points, all)
+}
+
+/// [`assign_ids`] through an optical path: the pose solved and the pins projected through
+/// `camera`'s layers ([`crate::refraction`]).
+pub fn assign_ids_through(
+    camera: &Imaging<'_>,
+    points: &BTreeMap<u32, Vector3<f64>>,
+    all: &[CaptureSpots],
+) -> Assignment {
     // the spots shaped as a pin's go on; the others are discarded with why
     let typical = typical_area_px(all);
     let (captures, shape_discards): (Vec<CaptureSpots>, Vec<Vec<(Spot, String)>>) = all
@@ -268,7 +279,7 @@ pub fn assign_ids(
 
 /// [`assign_ids`] after the spots' shapes were checked: steps 1 and 2.
 fn assign_shaped(
-    camera: &CameraModel,
+    camera: &Imaging<'_>,
     points: &BTreeMap<u32, Vector3<f64>>,
     captures: &[CaptureSpots],
 ) -> Assignment {
@@ -382,11 +393,11 @@ fn found_at(spots: &[Spot]) -> String {
 /// by ring: spots ordered by their distance from the principal point against pins by their
 /// polar angle.
 fn by_ring(
-    camera: &CameraModel,
+    camera: &Imaging<'_>,
     points: &BTreeMap<u32, Vector3<f64>>,
     c: &CaptureSpots,
 ) -> Vec<(u32, Spot)> {
-    let i = camera.intrinsics();
+    let i = camera.camera.intrinsics();
     let polar = |id: &u32| {
         let p = points[id];
         p.xy().norm().atan2(p.z)
@@ -409,7 +420,7 @@ fn by_ring(
 
 /// The pose from `pairs` (RANSAC with the solver's defaults; without it if that fails).
 fn solve(
-    camera: &CameraModel,
+    camera: &Imaging<'_>,
     points: &BTreeMap<u32, Vector3<f64>>,
     pairs: &[(u32, Spot)],
 ) -> Option<Isometry3<f64>> {
@@ -422,26 +433,32 @@ fn solve(
         ransac: None,
         ..with
     };
-    crate::solve_pnp(camera, &pts, &px, &with)
-        .or_else(|_| crate::solve_pnp(camera, &pts, &px, &without))
+    crate::pnp::solve_pnp_through(camera, &pts, &px, &with)
+        .or_else(|_| crate::pnp::solve_pnp_through(camera, &pts, &px, &without))
         .ok()
         .map(|s| s.t_cam_sensor)
 }
 
 /// Matches the capture's spots to its pins' projections at `pose` ([`assign_ids`], step 2).
 fn match_at(
-    camera: &CameraModel,
+    camera: &Imaging<'_>,
     points: &BTreeMap<u32, Vector3<f64>>,
     c: &CaptureSpots,
     pose: &Isometry3<f64>,
 ) -> CaptureOutcome {
     let mut o = CaptureOutcome::new(c);
-    let intr = camera.intrinsics();
+    let intr = camera.camera.intrinsics();
     let max_gate = 0.1 * f64::from(intr.image_width_px).hypot(f64::from(intr.image_height_px));
     let proj: Vec<Option<Vector2<f64>>> = c
         .planned_ids
         .iter()
-        .map(|id| camera.project(&(pose * Point3::from(points[id])).coords))
+        .map(|id| {
+            camera.project(
+                pose.rotation.to_rotation_matrix().matrix(),
+                &pose.translation.vector,
+                &points[id],
+            )
+        })
         .collect();
     let gate: Vec<f64> = proj
         .iter()

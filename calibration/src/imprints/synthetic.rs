@@ -241,7 +241,29 @@ pub fn render(
     s: &Shading,
     seed: u64,
 ) -> Rendered {
-    let rays = PixelRays::new(camera, t_cam_sensor);
+    render_through(camera, t_cam_sensor, None, surface, pins, s, seed)
+}
+
+/// [`render`] with the camera's rays bent at the flat interfaces of `layers`
+/// ([`PixelRays::through`]): a pin dome seen through a filling gel's surface. The imprints'
+/// true centroids are those of the bent rays.
+///
+/// # Panics
+/// When the camera centre is not under every plane of `layers` (a test scene's error).
+pub fn render_through(
+    camera: &CameraModel,
+    t_cam_sensor: &Isometry3<f64>,
+    layers: Option<&crate::refraction::FlatLayers>,
+    surface: &ReferenceSurface,
+    pins: &[Pin],
+    s: &Shading,
+    seed: u64,
+) -> Rendered {
+    let rays = match layers {
+        None => PixelRays::new(camera, t_cam_sensor),
+        Some(l) => PixelRays::through(camera, t_cam_sensor, l)
+            .expect("the scene's camera is under the layers"),
+    };
     let (w, h) = (rays.width, rays.height);
     let refh = reference_hits(&rays, surface);
     let (cx, cy) = (0.5 * (w as f64 - 1.0), 0.5 * (h as f64 - 1.0));

@@ -87,6 +87,14 @@ fn a_point_under_the_surface_appears_at_its_apparent_depth() {
             "x = {x}: slope {slope}, apparent {apparent}"
         );
     }
+    // what the straight-ray solvers of PnP take: the point at its apparent depth
+    assert!(
+        (l.apparent(&Vector3::new(1.0, 2.0, d)) - Vector3::new(1.0, 2.0, d / n)).norm() < 1e-15
+    );
+    assert_eq!(
+        l.apparent(&Vector3::new(1.0, 2.0, -3.0)),
+        Vector3::new(1.0, 2.0, -3.0)
+    );
     // a ray along the normal is not bent; equal indices do not bend any ray
     let up = l.direction_to(&c, &Vector3::new(0.0, 0.0, d)).unwrap();
     assert_eq!(up, Vector3::new(0.0, 0.0, 1.0));
