@@ -744,7 +744,7 @@ const RING_MIN_SECTORS: usize = 9;
 pub fn reference_mask(reference: &GrayImage, white: f32, margin_px: usize) -> Vec<bool> {
     let (w, h) = (reference.width, reference.height);
     let mut all = reference.data.clone();
-    let med = median(&mut all);
+    let med = skin_level(&mut all);
     let bright = 0.5 * (med + white);
     let mut mask: Vec<bool> = reference.data.iter().map(|&g| g > 0.25 * med).collect();
     if let Some((c, radius)) = reflection_ring(reference, &mask, bright) {
@@ -779,6 +779,46 @@ pub fn reference_mask(reference: &GrayImage, white: f32, margin_px: usize) -> Ve
         }
     }
     mask
+}
+
+/// The skin's grey level in a reference image, for [`reference_mask`]: the median grey, or,
+/// when the skin covers under half of the frame (a camera far under a small dome: the median is
+/// the dark outside, under half the level of the pixels brighter than Otsu's threshold between
+/// the two, Otsu 1979), the median of those brighter pixels. `v` is reordered.
+fn skin_level(v: &mut [f32]) -> f32 {
+    let med = median(v);
+    // Otsu's threshold over 256 bins of 0..=255 grey
+    let mut hist = [0u64; 256];
+    for &g in v.iter() {
+        hist[g.clamp(0.0, 255.0) as usize] += 1;
+    }
+    let total = v.len() as f64;
+    let sum_all: f64 = hist
+        .iter()
+        .enumerate()
+        .map(|(i, &c)| i as f64 * c as f64)
+        .sum();
+    let (mut w0, mut sum0, mut best, mut split) = (0.0, 0.0, -1.0, 0usize);
+    for (i, &c) in hist.iter().enumerate() {
+        w0 += c as f64;
+        sum0 += i as f64 * c as f64;
+        let w1 = total - w0;
+        if w0 == 0.0 || w1 == 0.0 {
+            continue;
+        }
+        let (m0, m1) = (sum0 / w0, (sum_all - sum0) / w1);
+        let between = w0 * w1 * (m0 - m1).powi(2);
+        if between > best {
+            (best, split) = (between, i);
+        }
+    }
+    let mut bright: Vec<f32> = v.iter().copied().filter(|&g| g > split as f32).collect();
+    let upper = median(&mut bright);
+    if med < 0.5 * upper {
+        upper
+    } else {
+        med
+    }
 }
 
 /// The centre (the centroid of the `lit` pixels, px) and inner radius (px) of a ring of

@@ -1067,18 +1067,18 @@ fn pose_errors_from(pose: &Isometry3<f64>, truth: &Isometry3<f64>) -> (f64, f64)
 }
 
 /// The pin dome's eight captures seen through R-Tac0's filling gel (its flat free surface at
-/// the tube's mouth, z = -9 mm, n = 1.41), the camera 5 mm under it: with `--design rtac0`
-/// every pin is found with its id and kept, and the pose is as good as the pose solved through
-/// the gel from the imprints' true centroids; with straight rays the camera comes out
-/// millimetres off at a low RMS (issue 97's drifting camera). (At 8.4 mm under it, where the
-/// authors' camera is, the detector finds no imprint in these renders: an open detector
-/// question.)
+/// the tube's mouth, z = -9 mm, n = 1.41), the camera 8.4 mm under it as issue 97 measured
+/// the authors' (the skin then covers under half of the frame: the reference mask takes the
+/// skin's level above Otsu's threshold): with `--design rtac0` every pin is found with its id
+/// and kept, and the pose is as good as the pose solved through the gel from the imprints'
+/// true centroids; with straight rays the camera comes out millimetres off at a low RMS
+/// (issue 97's drifting camera).
 #[test]
 fn captures_through_the_gel_give_the_pose_with_the_design() {
     use fabkit_calibration::pnp::{pose_uncertainty_through, solve_pnp_through};
     use fabkit_calibration::refraction::{FlatLayers, Imaging};
     let rot = UnitQuaternion::from_scaled_axis(Vector3::new(0.02, -0.015, 0.4));
-    let centre = Vector3::new(0.3, -0.2, -14.0);
+    let centre = Vector3::new(0.3, -0.2, -17.4);
     let pose = Isometry3::from_parts(Translation3::from(-(rot * centre)), rot);
     let mut s = Scene::with(intrinsics(), pose);
     s.layers = Some(FlatLayers::single(-9.0, 1.0, 1.41).unwrap());
@@ -1160,9 +1160,9 @@ fn captures_through_the_gel_give_the_pose_with_the_design() {
         6.0 * rot_noise,
         6.0 * t_noise
     );
-    // measured: centroids 0.028 px RMS; 0.013 deg and 0.485 mm from the truth, the true
-    // centroids' pose 0.015 deg and 0.488 mm (the imprint's centroid is not the tip's image),
-    // the allowance 0.075 deg and 0.008 mm
+    // measured on seed sets 0 to 2: centroids 0.028 to 0.031 px RMS; 0.028 to 0.036 deg and
+    // 0.660 mm from the truth, the true centroids' pose 0.033 deg and 0.664 mm (the imprint's
+    // centroid is not the tip's image), the allowance 0.10 to 0.11 deg and 0.011 to 0.012 mm
     assert!(
         rot <= rot_true + 6.0 * rot_noise && t <= t_true + 6.0 * t_noise,
         "{rot} deg, {t} mm"
@@ -1178,6 +1178,6 @@ fn captures_through_the_gel_give_the_pose_with_the_design() {
         "straight rays: camera {closer:.2} mm closer, RMS {} px",
         j["rms_reprojection_error_px"]
     );
-    // measured 6.46 mm closer at an RMS of 1.9 px
+    // measured 6.12 mm closer at an RMS of 2.2 px
     assert!(closer > 3.0, "{closer}");
 }
