@@ -459,6 +459,20 @@ pub fn of_design(
     tol: crate::geometry::ChordTolerance,
 ) -> Result<ResolvedOptics, crate::error::DesignError> {
     use crate::error::DesignError;
+    let (stack, _) = validated_stack(design, tol)?;
+    resolve(design, &stack).map_err(|e| DesignError::Params(crate::ParamErrors(e)))
+}
+
+/// The design's stack resolved at `tol` (none for a flat skin, whose parameters are checked),
+/// and the embedded materials table it was checked against.
+///
+/// # Errors
+/// The design's validation errors.
+fn validated_stack(
+    design: &Design,
+    tol: crate::geometry::ChordTolerance,
+) -> Result<(Stack, crate::materials::MaterialsTable), crate::error::DesignError> {
+    use crate::error::DesignError;
     let materials = crate::materials::MaterialsTable::embedded().map_err(DesignError::Yaml)?;
     let stack = if design.body.flat_outline().is_some() {
         crate::parts::flat::validate(design, &materials)?;
@@ -469,7 +483,7 @@ pub fn of_design(
     } else {
         crate::stack::validate(design, &materials, tol)?
     };
-    resolve(design, &stack).map_err(|e| DesignError::Params(crate::ParamErrors(e)))
+    Ok((stack, materials))
 }
 
 /// The flat optical path ([`optical_path`]) of `design`, its stack resolved at `tol` and the
@@ -482,16 +496,7 @@ pub fn optical_path_of_design(
     tol: crate::geometry::ChordTolerance,
 ) -> Result<OpticalPath, crate::error::DesignError> {
     use crate::error::DesignError;
-    let materials = crate::materials::MaterialsTable::embedded().map_err(DesignError::Yaml)?;
-    let stack = if design.body.flat_outline().is_some() {
-        crate::parts::flat::validate(design, &materials)?;
-        Stack {
-            core: None,
-            layers: Vec::new(),
-        }
-    } else {
-        crate::stack::validate(design, &materials, tol)?
-    };
+    let (stack, materials) = validated_stack(design, tol)?;
     optical_path(design, &stack, &materials)
         .map_err(|e| DesignError::Params(crate::ParamErrors(vec![e])))
 }

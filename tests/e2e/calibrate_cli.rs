@@ -897,16 +897,12 @@ fn refined_intrinsics_bring_back_the_pins_the_camera_files_model_put_out() {
     );
 }
 
-/// `--design rtac0`: the rays bend at the filling gel's free surface (z = -9 mm, the tube's
-/// mouth, Solaris n = 1.41 assumed), and the pose of a capture made through it comes back with
-/// every pin; the report lists the plane, its index and the index's source. The same capture
-/// solved with straight rays puts the camera millimetres too close to the dome (issue 97:
-/// 5.66 against 7.02 mm) and leaves the outer ring's residuals high.
-#[test]
-fn the_design_bends_the_rays_at_the_gel_surface() {
+/// A folder with the e2e camera file, the fixtures table and the observations of its tips seen
+/// through a flat gel surface at `surface_z_mm` of index `n` (the +-0.3 px pattern), the camera
+/// 11.4 mm under the base plane (z = -17.4 mm, as issue 97 measured R-Tac0's): the true pose
+/// and camera centre.
+fn observed_through_gel(dir: &Path, surface_z_mm: f64, n: f64) -> (Isometry3<f64>, Vector3<f64>) {
     use fabkit_calibration::refraction::{FlatLayers, Imaging};
-    let d = tempfile::tempdir().unwrap();
-    let dir = d.path();
     let cam = CameraModel::new(intrinsics()).unwrap();
     std::fs::write(
         dir.join("cam.yaml"),
@@ -914,11 +910,10 @@ fn the_design_bends_the_rays_at_the_gel_surface() {
     )
     .unwrap();
     write_table(&dir.join("pins.csv"));
-    // the camera 11.4 mm under the base plane (z = -17.4 mm), looking up the axis
     let rot = UnitQuaternion::from_scaled_axis(Vector3::new(0.02, -0.015, 0.4));
     let centre = Vector3::new(0.3, -0.2, -17.4);
     let truth = Isometry3::from_parts(Translation3::from(-(rot * centre)), rot);
-    let gel = FlatLayers::single(-9.0, 1.0, 1.41).unwrap();
+    let gel = FlatLayers::single(surface_z_mm, 1.0, n).unwrap();
     let through = Imaging::new(&cam, Some(&gel));
     let (r, t) = (
         *truth.rotation.to_rotation_matrix().matrix(),
@@ -927,10 +922,23 @@ fn the_design_bends_the_rays_at_the_gel_surface() {
     let mut obs = String::from("id,u_px,v_px\n");
     for (id, tip, _) in pins() {
         let uv = through.project(&r, &t, &tip).unwrap();
-        let n = if id % 2 == 0 { 0.3 } else { -0.3 };
-        obs.push_str(&format!("{id},{},{}\n", uv.x + n, uv.y - 0.5 * n));
+        let e = if id % 2 == 0 { 0.3 } else { -0.3 };
+        obs.push_str(&format!("{id},{},{}\n", uv.x + e, uv.y - 0.5 * e));
     }
     std::fs::write(dir.join("obs.csv"), obs).unwrap();
+    (truth, centre)
+}
+
+/// `--design rtac0`: the rays bend at the filling gel's free surface (z = -9 mm, the tube's
+/// mouth, Solaris n = 1.41 assumed), and the pose of a capture made through it comes back with
+/// every pin; the report lists the plane, its index and the index's source. The same capture
+/// solved with straight rays puts the camera millimetres too close to the dome (issue 97:
+/// 5.66 against 7.02 mm) and leaves the outer ring's residuals high.
+#[test]
+fn the_design_bends_the_rays_at_the_gel_surface() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let (truth, centre) = observed_through_gel(dir, -9.0, 1.41);
     let o = run(
         dir,
         &extrinsics_args("cam.yaml", "bent", &["--design", "rtac0"]),
@@ -985,32 +993,9 @@ fn the_design_bends_the_rays_at_the_gel_surface() {
 /// option is refused by name.
 #[test]
 fn the_gel_surface_is_refined_with_the_pose() {
-    use fabkit_calibration::refraction::{FlatLayers, Imaging};
     let d = tempfile::tempdir().unwrap();
     let dir = d.path();
-    let cam = CameraModel::new(intrinsics()).unwrap();
-    std::fs::write(
-        dir.join("cam.yaml"),
-        write_camera(&intrinsics(), CameraFileFormat::OpenCvYaml),
-    )
-    .unwrap();
-    write_table(&dir.join("pins.csv"));
-    let rot = UnitQuaternion::from_scaled_axis(Vector3::new(0.02, -0.015, 0.4));
-    let centre = Vector3::new(0.3, -0.2, -17.4);
-    let truth = Isometry3::from_parts(Translation3::from(-(rot * centre)), rot);
-    let gel = FlatLayers::single(-8.6, 1.0, 1.42).unwrap();
-    let through = Imaging::new(&cam, Some(&gel));
-    let (r, t) = (
-        *truth.rotation.to_rotation_matrix().matrix(),
-        truth.translation.vector,
-    );
-    let mut obs = String::from("id,u_px,v_px\n");
-    for (id, tip, _) in pins() {
-        let uv = through.project(&r, &t, &tip).unwrap();
-        let n = if id % 2 == 0 { 0.3 } else { -0.3 };
-        obs.push_str(&format!("{id},{},{}\n", uv.x + n, uv.y - 0.5 * n));
-    }
-    std::fs::write(dir.join("obs.csv"), obs).unwrap();
+    let (truth, _) = observed_through_gel(dir, -8.6, 1.42);
     let args = extrinsics_args(
         "cam.yaml",
         "out",
