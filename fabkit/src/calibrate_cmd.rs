@@ -197,6 +197,11 @@ fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
         &inputs,
         a.force,
     );
+    if a.design.is_none() {
+        if let Some(hint) = design_hint(&a.points, &a.data_files) {
+            eprintln!("note: {hint}");
+        }
+    }
     let optical_path = match &a.design {
         None => None,
         Some(d) => {
@@ -331,4 +336,33 @@ fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
         eprintln!("warning: {w}");
     }
     Ok(())
+}
+
+/// A hint when the point table is of a design whose camera looks through flat interfaces and
+/// `--design` is not given: the table's sidecar (`point_table.json`, as `fabkit fixtures`
+/// writes it) names the design in its provenance (`fabkit V, design NAME (SOURCE, sha256 H)`).
+/// `None` when there is no sidecar, the design cannot be loaded, or it has no flat interface.
+fn design_hint(points: &std::path::Path, data: &crate::cli::DataFileArgs) -> Option<String> {
+    let side = points.with_extension("json");
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(side).ok()?).ok()?;
+    let prov = v.get("provenance")?.as_str()?;
+    let (name, inside) = prov.split_once(", design ")?.1.split_once(" (")?;
+    let source = inside.split(", sha256").next()?;
+    let arg = source.strip_prefix("embedded:").unwrap_or(source);
+    let loaded = crate::cli::load_design(Some(arg), data).ok()?;
+    let tol =
+        fabkit_designs::ChordTolerance::new(fabkit_designs::ChordTolerance::DEFAULT_MM).ok()?;
+    let path = fabkit_designs::optics::optical_path_of_design(&loaded.design, tol).ok()?;
+    if path.planes.is_empty() {
+        return None;
+    }
+    let planes: Vec<&str> = path
+        .planes
+        .iter()
+        .map(|p| p.what.split_once(": ").map_or(p.what.as_str(), |(_, w)| w))
+        .collect();
+    Some(format!(
+        "the point table is of design {name}, whose camera looks through {}: give --design {arg} for the rays to bend there (straight rays put the camera too close to what it sees through a gel; the guide's Calibration, the optical path)",
+        planes.join("; ")
+    ))
 }

@@ -1168,9 +1168,16 @@ fn captures_through_the_gel_give_the_pose_with_the_design() {
         "{rot} deg, {t} mm"
     );
 
-    // straight rays: the camera pulled towards the dome
+    assert!(!text(&o.stderr).contains("note: the point table is of design"));
+    // straight rays: the camera pulled towards the dome, and a note says which design's
+    // interfaces the point table's camera looks through
     let o = calibrate("straight", &[]);
     assert!(o.status.success(), "{}{}", text(&o.stdout), text(&o.stderr));
+    assert!(
+        text(&o.stderr).contains("note: the point table is of design rtac0, whose camera looks through the gel's free surface at the core's open end: give --design rtac0"),
+        "{}",
+        text(&o.stderr)
+    );
     let j = json(&s.path("straight/extrinsics.json"));
     let c = &j["residuals"]["camera_centre_in_sensor_mm"];
     let closer = c[2].as_f64().unwrap() - centre.z;
