@@ -209,6 +209,17 @@ pub fn calibrate_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsOutput, Ext
         };
         ExtrinsicsError::Pnp { context, source }
     })?;
+    // the pairs a solution keeps, for the refinements over its inliers
+    let inliers_of = |s: &crate::PnpSolution| -> (Vec<Vector3<f64>>, Vec<Vector2<f64>>) {
+        pairs
+            .points_mm
+            .iter()
+            .zip(&pairs.pixels_px)
+            .zip(&s.inliers)
+            .filter(|(_, &inlier)| inlier)
+            .map(|((p, q), _)| (*p, *q))
+            .unzip()
+    };
     let mut layers = layers;
     let (sol, path_fit) = if job.refine_optical_path {
         let (path, l) = match (&job.optical_path, &layers) {
@@ -242,14 +253,7 @@ pub fn calibrate_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsOutput, Ext
             height_sd_mm: crate::refraction::GEL_SURFACE_HEIGHT_SD_MM,
             index_sd: crate::refraction::SILICONE_INDEX_SD,
         };
-        let (pts, px): (Vec<Vector3<f64>>, Vec<Vector2<f64>>) = pairs
-            .points_mm
-            .iter()
-            .zip(&pairs.pixels_px)
-            .zip(&sol.inliers)
-            .filter(|(_, &inlier)| inlier)
-            .map(|((p, q), _)| (*p, *q))
-            .unzip();
+        let (pts, px) = inliers_of(&sol);
         let fit = refine_plane(&camera, l, prior, &pts, &px, &sol.t_cam_sensor).ok_or_else(|| {
             ExtrinsicsError::OpticalPath(
                 "--refine-optical-path: the gel's surface and the pose are not determined by these pins (a point does not project, or the normal matrix is singular)".into(),
@@ -274,16 +278,6 @@ pub fn calibrate_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsOutput, Ext
             // Refined over the inliers, then the pose solved again through the refined camera:
             // pairs the camera file's model put out may come back in; refined again (from the
             // file's values) over the larger set, while it grows (at most 4 rounds).
-            let inliers_of = |s: &crate::PnpSolution| -> (Vec<Vector3<f64>>, Vec<Vector2<f64>>) {
-                pairs
-                    .points_mm
-                    .iter()
-                    .zip(&pairs.pixels_px)
-                    .zip(&s.inliers)
-                    .filter(|(_, &inlier)| inlier)
-                    .map(|((p, q), _)| (*p, *q))
-                    .unzip()
-            };
             let count = |s: &crate::PnpSolution| s.inliers.iter().filter(|&&b| b).count();
             let (pts, px) = inliers_of(&sol);
             let l = layers.as_ref();
