@@ -57,6 +57,9 @@ pub struct ExtrinsicsJob {
     /// `fabkit_designs::optics::optical_path`): rays bend at each plane ([`crate::refraction`]);
     /// `None`: straight rays from the lens.
     pub optical_path: Option<fabkit_designs::optics::OpticalPath>,
+    /// Where `optical_path` comes from, in words (`--design rtac0`, or the point table's
+    /// design); recorded in the report.
+    pub optical_path_from: Option<String>,
     /// Recorded in the report's provenance.
     pub command_line: String,
 }
@@ -342,6 +345,7 @@ pub fn calibrate_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsOutput, Ext
         provenance,
     );
     report.optical_path = job.optical_path.clone();
+    report.optical_path_from = job.optical_path.as_ref().and(job.optical_path_from.clone());
     report.optical_path_fit = path_fit;
     if let Some(found) = &from_images {
         report.warnings.extend(found.notes.iter().cloned());

@@ -191,11 +191,15 @@ pub struct ExtrinsicsReport {
     pub provenance: Provenance,
     /// `fisheye`, `plumb_bob` or `rational_polynomial`.
     pub distortion_model: String,
-    /// The flat optical path the rays were bent along (`--design`: the filling gel's surface,
-    /// a window's or a plate's faces, each with its refractive index and source); absent:
-    /// straight rays from the lens.
+    /// The flat optical path the rays were bent along (the point table's design or `--design`:
+    /// the filling gel's surface, a window's or a plate's faces, each with its refractive index
+    /// and source); absent: straight rays from the lens.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub optical_path: Option<fabkit_designs::optics::OpticalPath>,
+    /// Where `optical_path` comes from: `--design NAME [--preset P]`, or `design NAME, the
+    /// point table's (point_table.json)` when the point table's sidecar names it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub optical_path_from: Option<String>,
     /// The filling gel's surface refined with the pose (`--refine-optical-path`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub optical_path_fit: Option<PlaneFitReport>,
@@ -443,6 +447,7 @@ impl ExtrinsicsReport {
             provenance,
             distortion_model: camera.camera.intrinsics().distortion.name().into(),
             optical_path: None,
+            optical_path_from: None,
             optical_path_fit: None,
             rvec: [rvec.x, rvec.y, rvec.z],
             tvec_mm: [iso.translation.x, iso.translation.y, iso.translation.z],

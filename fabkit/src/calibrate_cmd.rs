@@ -141,13 +141,21 @@ pub struct ExtrinsicsArgs {
     /// The sensor's design (a YAML file or a library name): the rays from the lens bend by
     /// Snell's law at its flat interfaces (the filling gel's free surface, a window's or a
     /// plate's faces), with the refractive indices of the materials table; the report lists
-    /// them (`optical_path`). Without it the rays are straight from the lens.
+    /// them (`optical_path`).
+    /// Without it, the design the point table was made for (its sidecar point_table.json,
+    /// as `fabkit fixtures` writes it) gives the optical path, when that design reads as it
+    /// did then (the same sha256) and none of its presets moves an interface.
     #[arg(long, value_name = "DESIGN")]
     pub design: Option<String>,
+    /// Straight rays from the lens: no optical path, not even the point table's design's (a
+    /// camera that looks at the skin through air only).
+    #[arg(long, conflicts_with_all = ["design", "refine_optical_path"])]
+    pub straight_rays: bool,
     /// Refine the height of the design's filling gel surface and the gel's index with the
     /// pose, under priors of 0.5 mm and 0.01 about the design's and the materials table's
     /// values; the report gives both with their standard deviations (`optical_path_fit`).
-    #[arg(long, requires = "design")]
+    /// With --design or the point table's design.
+    #[arg(long)]
     pub refine_optical_path: bool,
     /// Apply one of the design's presets (with --design).
     #[arg(long, value_name = "NAME", requires = "design")]
@@ -197,26 +205,47 @@ fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
         &inputs,
         a.force,
     );
-    if a.design.is_none() {
-        if let Some(hint) = design_hint(&a.points, &a.data_files) {
-            eprintln!("note: {hint}");
-        }
-    }
-    let optical_path = match &a.design {
-        None => None,
-        Some(d) => {
+    let (optical_path, optical_path_from) = match (&a.design, a.straight_rays) {
+        (_, true) => (None, None),
+        (Some(d), false) => {
             let mut loaded = crate::cli::load_design(Some(d), &a.data_files)?;
             if let Some(p) = &a.preset {
                 loaded.apply_preset(p)?;
             }
-            Some(fabkit_designs::optics::optical_path_of_design(
+            let path = fabkit_designs::optics::optical_path_of_design(
                 &loaded.design,
                 fabkit_designs::ChordTolerance::new(fabkit_designs::ChordTolerance::DEFAULT_MM)?,
-            )?)
+            )?;
+            let from = match &a.preset {
+                Some(p) => format!("--design {d} --preset {p}"),
+                None => format!("--design {d}"),
+            };
+            (Some(path), Some(from))
         }
+        (None, false) => match table_design(&a.points, &a.data_files) {
+            TableDesign::Unknown => (None, None),
+            TableDesign::Unusable(why) => {
+                eprintln!("note: {why}; the rays are straight from the lens");
+                (None, None)
+            }
+            TableDesign::Path { path, from } => {
+                eprintln!(
+                    "note: the rays bend at the interfaces of {from}: {} (--straight-rays for straight rays)",
+                    plane_names(&path).join("; ")
+                );
+                (Some(path), Some(from))
+            }
+        },
     };
+    if a.refine_optical_path && optical_path.is_none() {
+        return Err(
+            "--refine-optical-path: there is no optical path to refine (give --design; the point table names no design whose camera looks through an interface)"
+                .into(),
+        );
+    }
     let job = ExtrinsicsJob {
         optical_path,
+        optical_path_from,
         refine_optical_path: a.refine_optical_path,
         camera: a.cam.camera,
         camera_model: a.cam.camera_model.map(Into::into),
@@ -338,31 +367,89 @@ fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
     Ok(())
 }
 
-/// A hint when the point table is of a design whose camera looks through flat interfaces and
-/// `--design` is not given: the table's sidecar (`point_table.json`, as `fabkit fixtures`
-/// writes it) names the design in its provenance (`fabkit V, design NAME (SOURCE, sha256 H)`).
-/// `None` when there is no sidecar, the design cannot be loaded, or it has no flat interface.
-fn design_hint(points: &std::path::Path, data: &crate::cli::DataFileArgs) -> Option<String> {
-    let side = points.with_extension("json");
-    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(side).ok()?).ok()?;
-    let prov = v.get("provenance")?.as_str()?;
-    let (name, inside) = prov.split_once(", design ")?.1.split_once(" (")?;
-    let source = inside.split(", sha256").next()?;
-    let arg = source.strip_prefix("embedded:").unwrap_or(source);
-    let loaded = crate::cli::load_design(Some(arg), data).ok()?;
-    let tol =
-        fabkit_designs::ChordTolerance::new(fabkit_designs::ChordTolerance::DEFAULT_MM).ok()?;
-    let path = fabkit_designs::optics::optical_path_of_design(&loaded.design, tol).ok()?;
-    if path.planes.is_empty() {
-        return None;
-    }
-    let planes: Vec<&str> = path
-        .planes
+/// The design a point table was made for, as its sidecar (`point_table.json`, as `fabkit
+/// fixtures` writes it) names it in its provenance (`fabkit V, design NAME (SOURCE, sha256 H)`).
+enum TableDesign {
+    /// No sidecar, no provenance, or a design with no flat interface: straight rays.
+    Unknown,
+    /// A design whose optical path cannot be taken for the table's: why, in words.
+    Unusable(String),
+    /// The design's optical path, and where it comes from in words.
+    Path {
+        path: fabkit_designs::optics::OpticalPath,
+        from: String,
+    },
+}
+
+/// The names of the planes of `path` without their parameter paths.
+fn plane_names(path: &fabkit_designs::optics::OpticalPath) -> Vec<&str> {
+    path.planes
         .iter()
         .map(|p| p.what.split_once(": ").map_or(p.what.as_str(), |(_, w)| w))
-        .collect();
-    Some(format!(
-        "the point table is of design {name}, whose camera looks through {}: give --design {arg} for the rays to bend there (straight rays put the camera too close to what it sees through a gel; the guide's Calibration, the optical path)",
-        planes.join("; ")
-    ))
+        .collect()
+}
+
+/// [`TableDesign`] of the point table `points`. The design is used only when it reads as it
+/// did when the table was written (the same sha256) and its presets, which the provenance does
+/// not record, leave its optical path as it is.
+fn table_design(points: &std::path::Path, data: &crate::cli::DataFileArgs) -> TableDesign {
+    let side = points.with_extension("json");
+    let Some(prov) = std::fs::read(&side)
+        .ok()
+        .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
+        .and_then(|v| v.get("provenance")?.as_str().map(str::to_string))
+    else {
+        return TableDesign::Unknown;
+    };
+    let Some((name, source, sha)) = (|| {
+        let (name, inside) = prov.split_once(", design ")?.1.split_once(" (")?;
+        let (source, rest) = inside.split_once(", sha256 ")?;
+        Some((name, source, rest.trim_end_matches(')')))
+    })() else {
+        return TableDesign::Unknown;
+    };
+    let arg = source.strip_prefix("embedded:").unwrap_or(source);
+    let Ok(tol) = fabkit_designs::ChordTolerance::new(fabkit_designs::ChordTolerance::DEFAULT_MM)
+    else {
+        return TableDesign::Unknown;
+    };
+    let loaded = match crate::cli::load_design(Some(arg), data) {
+        Ok(l) => l,
+        Err(e) => {
+            return TableDesign::Unusable(format!(
+                "the point table is of design {name} ({}), which does not load ({e}): give --design for its optical path",
+                side.display()
+            ))
+        }
+    };
+    let Ok(path) = fabkit_designs::optics::optical_path_of_design(&loaded.design, tol) else {
+        return TableDesign::Unknown;
+    };
+    if path.planes.is_empty() {
+        return TableDesign::Unknown;
+    }
+    let planes = plane_names(&path).join("; ");
+    if loaded.sha256 != sha {
+        return TableDesign::Unusable(format!(
+            "the point table is of design {name}, whose camera looks through {planes}, but {arg} no longer reads as it did when the table was written (sha256 {sha} in {}): give --design {arg} for its optical path",
+            side.display()
+        ));
+    }
+    for preset in loaded.design.presets.keys() {
+        let mut variant = loaded.clone();
+        let moved = match variant.apply_preset(preset) {
+            Ok(()) => fabkit_designs::optics::optical_path_of_design(&variant.design, tol)
+                .map_or(true, |p| p != path),
+            Err(_) => true,
+        };
+        if moved {
+            return TableDesign::Unusable(format!(
+                "the point table is of design {name}, whose camera looks through {planes}, and its preset {preset} moves them (the table does not say which preset it was made with): give --design {arg} [--preset {preset}] for its optical path"
+            ));
+        }
+    }
+    TableDesign::Path {
+        path,
+        from: format!("design {name}, the point table's ({})", side.display()),
+    }
 }

@@ -147,6 +147,7 @@ fn bench_calibration(c: &mut Criterion) {
         ransac: Some(Default::default()),
         refine_intrinsics: None,
         optical_path: None,
+        optical_path_from: None,
         refine_optical_path: false,
         command_line: "bench".into(),
     };

@@ -6,8 +6,9 @@
 //! tutorial writes has its markers, the calibration recovers the pose, the ground truth and
 //! the sweep are complete.
 
-use crate::calibrate_cli::{intrinsics, truth, write_plan_observations};
+use crate::calibrate_cli::{intrinsics, write_plan_observations};
 use crate::common::{design_schema_path, repo_root, schema_check, text};
+use fabkit_calibration::nalgebra::Isometry3;
 use fabkit_calibration::tables::{read_capture_plan, read_point_table, PointsFrom};
 use fabkit_calibration::{write_camera, CameraFileFormat};
 use std::path::Path;
@@ -41,9 +42,9 @@ fn steps(markdown: &str) -> Vec<Step> {
 }
 
 /// The camera file and one observation file per capture of the plan (`capture_<k>.csv`,
-/// `id,u_px,v_px`): the pins' tips projected at the known pose, with +-0.3 px of alternating
-/// noise.
-fn write_lab_inputs(dir: &Path) {
+/// `id,u_px,v_px`): the pins' tips seen at a known pose through the tutorial design's filling
+/// gel, with +-0.3 px of alternating noise. Returns the pose.
+fn write_lab_inputs(dir: &Path) -> Isometry3<f64> {
     let points = dir.join("out/my_sensor_fixtures/points");
     assert!(
         points.is_dir(),
@@ -56,7 +57,8 @@ fn write_lab_inputs(dir: &Path) {
     .unwrap();
     let table = read_point_table(&points.join("point_table.csv"), PointsFrom::Tip).unwrap();
     let plan = read_capture_plan(&points.join("capture_plan.csv")).unwrap();
-    write_plan_observations(dir, &table, &plan);
+    let design = dir.join("my_sensor.yaml");
+    write_plan_observations(dir, &table, &plan, design.to_str().unwrap()).1
 }
 
 fn json(path: &Path) -> serde_json::Value {
@@ -84,9 +86,10 @@ fn the_tutorial_runs_as_written() {
     );
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
+    let mut truth = None;
     for step in &steps {
         match step {
-            Step::LabInputs => write_lab_inputs(dir),
+            Step::LabInputs => truth = Some(write_lab_inputs(dir)),
             Step::Shell(script) => {
                 let o = std::process::Command::new("bash")
                     .args(["-euo", "pipefail", "-c", script])
@@ -142,7 +145,15 @@ fn the_tutorial_runs_as_written() {
         .iter()
         .flat_map(|row| row.as_array().unwrap().iter().map(|v| v.as_f64().unwrap()))
         .collect();
-    let t = truth().to_homogeneous();
+    // the tutorial's design (R-Tac0's) has a filling gel: the rays bend at its surface
+    assert!(
+        e["optical_path_from"]
+            .as_str()
+            .is_some_and(|s| s.starts_with("design my_sensor, the point table's")),
+        "{}",
+        e["optical_path_from"]
+    );
+    let t = truth.unwrap().to_homogeneous();
     for (i, v) in m.iter().enumerate() {
         let want = t[(i / 4, i % 4)];
         let bound = if i % 4 == 3 { 0.05 } else { 0.002 };
