@@ -257,6 +257,10 @@ pub struct CaptureReport {
     pub kept: Vec<SpotReport>,
     pub discarded: Vec<SpotReport>,
     pub missing: Vec<MissingPin>,
+    /// Spots cut in two because two of the capture's pins project onto their halves (two
+    /// imprints that touch): the whole spot, its `id` the two pins' ids (`"14+22"`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub split: Vec<SpotReport>,
     /// Why the capture is left out (nothing kept); absent when it is used.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub left_out: Option<String>,
@@ -292,6 +296,11 @@ impl From<&crate::imprints::CaptureOutcome> for CaptureReport {
                     id: id.to_string(),
                     reason: why.clone(),
                 })
+                .collect(),
+            split: o
+                .split
+                .iter()
+                .map(|(s, [a, b])| spot(Some(format!("{a}+{b}")), s, None))
                 .collect(),
             left_out: o.left_out.clone(),
         }

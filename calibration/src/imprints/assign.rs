@@ -44,6 +44,9 @@ pub struct CaptureOutcome {
     pub discarded: Vec<(Spot, String)>,
     /// Planned pins without a spot, each with why.
     pub missing: Vec<(u32, String)>,
+    /// Spots cut in two ([`Spot::halves`]) because two of the capture's pins project onto
+    /// their halves (two imprints that touch): the spot and the two pins' ids.
+    pub split: Vec<(Spot, [u32; 2])>,
     /// Why the whole capture is left out (nothing is kept then).
     pub left_out: Option<String>,
 }
@@ -56,6 +59,7 @@ impl CaptureOutcome {
             kept: Vec::new(),
             discarded: Vec::new(),
             missing: Vec::new(),
+            split: Vec::new(),
             left_out: None,
         }
     }
@@ -66,7 +70,7 @@ impl CaptureOutcome {
         if let Some(why) = &self.left_out {
             return Some(format!("{}: {why}; left out", self.name));
         }
-        if self.discarded.is_empty() && self.missing.is_empty() {
+        if self.discarded.is_empty() && self.missing.is_empty() && self.split.is_empty() {
             return None;
         }
         let mut s = format!(
@@ -79,6 +83,12 @@ impl CaptureOutcome {
                 .collect::<Vec<_>>()
                 .join(", ")
         );
+        for (spot, [a, b]) in &self.split {
+            s.push_str(&format!(
+                "; spot at ({:.1}, {:.1}) split in two for pins {a} and {b} (two imprints that touch)",
+                spot.u_px, spot.v_px
+            ));
+        }
         for (id, why) in &self.missing {
             s.push_str(&format!("; pin {id} missing: {why}"));
         }
@@ -136,14 +146,36 @@ const AMBIGUOUS_RATIO: f64 = 2.0;
 /// of a highlight is a thin line.
 pub const MIN_ROUNDNESS: f64 = 0.5;
 
+/// A spot less round than [`MIN_ROUNDNESS`] may still be a pin's when it is as wide as one
+/// (its minor axis's standard deviation at least this fraction of a disc of the pins' typical
+/// area's, r / 2; a scratch or a highlight's edge is a line of 1 to 3 px) and either clipped
+/// by the mask ([`Spot::clipped`]: a half disc's minor sd is 0.53 of the disc's) ...
+pub const MIN_WIDTH_FRACTION: f64 = 0.4;
+/// ... and no longer than a pin's spot (its major sd at most this multiple of the disc's; a
+/// disc cut by a straight edge keeps at most the disc's r / 2, but the pins' spots differ in
+/// size from ring to ring and the outer ring's are ellipses, long across the radius: an
+/// outer imprint cut by a notch measured 1.6) ...
+pub const CLIPPED_MAX_LENGTH_FACTOR: f64 = 2.0;
+/// ... or two imprints joined into one spot (their halos or their edges touch: a spot whose
+/// halves, [`Spot::halves`], each hold at least this fraction of the pins' typical core; a
+/// scratch cut in two leaves two thin lines of a few pixels).
+pub const PAIR_MIN_HALF_FRACTION: f64 = 0.5;
+
+/// A spot of at most this roundness is cut in two when two of the capture's pins project onto
+/// its halves, each nearer its half than the whole spot's centre (two touching equal discs:
+/// 0.45; overlapping by 40 % of their radius: 0.64; a single imprint measured 0.83 or more).
+pub const SPLIT_MAX_ROUNDNESS: f64 = 0.75;
+
 /// A pin's spot covers at least this fraction of the pins' typical spot ([`spot_shape`]) ...
 pub const MIN_AREA_FRACTION: f64 = 0.15;
 /// ... and at most this multiple of it.
 pub const MAX_AREA_FACTOR: f64 = 5.0;
 
-/// The pins' typical spot area, px: over the captures, the median area of each capture's
-/// largest round spots, as many as it plans pins (most spots are pins; specks are small);
-/// `None` without a round spot.
+/// The pins' typical spot area, px: over the captures, the median core ([`Spot::core_px`],
+/// the imprint without the halo a spot grows into) of each capture's largest round spots, as
+/// many as half the pins it plans, rounded up (specks are small, and two joined imprints are
+/// not round: a capture of five pins may show three round ones beside three specks); `None`
+/// without a round spot.
 fn typical_area_px(captures: &[CaptureSpots]) -> Option<f64> {
     let mut areas: Vec<usize> = captures
         .iter()
@@ -152,10 +184,10 @@ fn typical_area_px(captures: &[CaptureSpots]) -> Option<f64> {
                 .spots
                 .iter()
                 .filter(|s| s.roundness >= MIN_ROUNDNESS)
-                .map(|s| s.area_px)
+                .map(|s| s.core_px)
                 .collect();
             a.sort_unstable_by(|x, y| y.cmp(x));
-            a.truncate(c.planned_ids.len());
+            a.truncate(c.planned_ids.len().div_ceil(2));
             a
         })
         .collect();
@@ -167,26 +199,39 @@ fn typical_area_px(captures: &[CaptureSpots]) -> Option<f64> {
 }
 
 /// Why `spot` is not a pin's by its shape, `None` when it may be one: round
-/// ([`MIN_ROUNDNESS`]) and of an area within [[`MIN_AREA_FRACTION`], [`MAX_AREA_FACTOR`]]
-/// times the pins' typical spot (`typical_px`, from all captures: a barely pressed pin's spot
+/// ([`MIN_ROUNDNESS`]) and of a core ([`Spot::core_px`]) within [[`MIN_AREA_FRACTION`],
+/// [`MAX_AREA_FACTOR`]] times the pins' typical one (`typical_px`, from all captures: a barely pressed pin's spot
 /// is about a quarter of a fully pressed one's, a speck of dust a tenth or less).
+///
+/// A spot less round than that is kept when it is as wide as a pin's spot
+/// ([`MIN_WIDTH_FRACTION`]) and either clipped by the mask and no longer than a pin's
+/// ([`CLIPPED_MAX_LENGTH_FACTOR`]: what shows of an imprint at a dark LED notch) or cut in two
+/// halves that each hold a good part of a pin's core ([`PAIR_MIN_HALF_FRACTION`]: two imprints
+/// joined).
 pub fn spot_shape(spot: &Spot, typical_px: f64) -> Option<String> {
     let (lo, hi) = (MIN_AREA_FRACTION * typical_px, MAX_AREA_FACTOR * typical_px);
-    if spot.roundness < MIN_ROUNDNESS {
+    let disc_sd = 0.5 * (typical_px / std::f64::consts::PI).sqrt();
+    let wide = spot.roundness * spot.major_sd_px >= MIN_WIDTH_FRACTION * disc_sd;
+    let clipped_pin = spot.clipped && spot.major_sd_px <= CLIPPED_MAX_LENGTH_FACTOR * disc_sd;
+    let pair = spot.halves.is_some_and(|hs| {
+        hs.iter()
+            .all(|h| h.area_px as f64 >= PAIR_MIN_HALF_FRACTION * typical_px)
+    });
+    if spot.roundness < MIN_ROUNDNESS && !(wide && (clipped_pin || pair)) {
         Some(format!(
             "not round (minor over major axis {:.2}, a pin's spot at least {MIN_ROUNDNESS:.2}): a scratch or an edge",
             // rounded down: 0.499 is not "0.50"
             (spot.roundness * 100.0).floor() / 100.0
         ))
-    } else if (spot.area_px as f64) < lo {
+    } else if (spot.core_px as f64) < lo {
         Some(format!(
-            "{} px, smaller than a pin's spot may be ({lo:.0} px: {MIN_AREA_FRACTION} x the pins' typical {typical_px:.0} px): a speck",
-            spot.area_px
+            "a core of {} px, smaller than a pin's spot's may be ({lo:.0} px: {MIN_AREA_FRACTION} x the pins' typical {typical_px:.0} px): a speck",
+            spot.core_px
         ))
-    } else if spot.area_px as f64 > hi {
+    } else if spot.core_px as f64 > hi {
         Some(format!(
-            "{} px, larger than a pin's spot may be ({hi:.0} px: {MAX_AREA_FACTOR} x the pins' typical {typical_px:.0} px)",
-            spot.area_px
+            "a core of {} px, larger than a pin's spot's may be ({hi:.0} px: {MAX_AREA_FACTOR} x the pins' typical {typical_px:.0} px)",
+            spot.core_px
         ))
     } else {
         None
@@ -237,7 +282,7 @@ pub fn assign_ids_through(
             let (mut keep, mut out) = (Vec::new(), Vec::new());
             for s in &c.spots {
                 // without a round spot anywhere only the roundness counts
-                match spot_shape(s, typical.unwrap_or(s.area_px as f64)) {
+                match spot_shape(s, typical.unwrap_or(s.core_px as f64)) {
                     Some(why) => out.push((*s, why)),
                     None => keep.push(*s),
                 }
@@ -251,7 +296,29 @@ pub fn assign_ids_through(
             )
         })
         .unzip();
+    // a capture that shows fewer spots than it plans pins: its largest joined spots cut in two
+    let (captures, cut): (Vec<CaptureSpots>, Vec<Vec<Spot>>) = captures
+        .into_iter()
+        .map(|mut c| {
+            let cut = typical.map_or_else(Vec::new, |t| split_by_plan(&mut c, t));
+            (c, cut)
+        })
+        .unzip();
     let mut a = assign_shaped(camera, points, &captures);
+    for (o, cut) in a.captures.iter_mut().zip(cut) {
+        for whole in cut {
+            let Some(hs) = whole.halves else { continue };
+            let id_of = |h: &super::Half| {
+                o.kept
+                    .iter()
+                    .find(|(_, k)| k.u_px == h.u_px && k.v_px == h.v_px)
+                    .map(|(id, _)| *id)
+            };
+            if let (Some(x), Some(y)) = (id_of(&hs[0]), id_of(&hs[1])) {
+                o.split.push((whole, [x.min(y), x.max(y)]));
+            }
+        }
+    }
     for (k, (o, out)) in a.captures.iter_mut().zip(shape_discards).enumerate() {
         o.spots_found = all[k].spots.len();
         if o.left_out.is_none() {
@@ -460,6 +527,12 @@ fn match_at(
             )
         })
         .collect();
+    let (split_spots, splits) = split_touching(c, &proj);
+    o.split = splits;
+    let c = &CaptureSpots {
+        spots: split_spots,
+        ..c.clone()
+    };
     let gate: Vec<f64> = proj
         .iter()
         .enumerate()
@@ -567,6 +640,98 @@ fn match_at(
         o.discarded.push((*s, why));
     }
     o
+}
+
+/// A spot is cut in two by the capture plan ([`split_by_plan`]) when its core holds at least
+/// this multiple of the pins' typical one (two joined imprints: about 2).
+pub const SPLIT_MIN_CORE_FACTOR: f64 = 1.5;
+
+/// Cuts in two ([`Spot::halves`]) the spots of a capture that shows fewer spots than it plans
+/// pins, the largest core first, while it does and a spot has halves and a core of at least
+/// [`SPLIT_MIN_CORE_FACTOR`] times the pins' typical one (`typical_px`): two imprints that
+/// touch or whose halos join make one spot. Returns the spots cut; each half becomes a spot
+/// of its own ([`half_spot`]).
+fn split_by_plan(c: &mut CaptureSpots, typical_px: f64) -> Vec<Spot> {
+    let mut cut = Vec::new();
+    while c.spots.len() < c.planned_ids.len() {
+        let Some(j) = c
+            .spots
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| {
+                s.halves.is_some() && s.core_px as f64 >= SPLIT_MIN_CORE_FACTOR * typical_px
+            })
+            .max_by(|a, b| a.1.core_px.cmp(&b.1.core_px).then(b.0.cmp(&a.0)))
+            .map(|(j, _)| j)
+        else {
+            break;
+        };
+        let whole = c.spots.remove(j);
+        if let Some(hs) = whole.halves {
+            c.spots.extend(hs.iter().map(|h| half_spot(&whole, h)));
+        }
+        cut.push(whole);
+    }
+    cut
+}
+
+/// A half of `whole` ([`Spot::halves`]) as a spot of its own: its centre and core, the whole's
+/// score, round, its own halves its parts ([`super::Half::parts`]).
+fn half_spot(whole: &Spot, h: &super::Half) -> Spot {
+    Spot {
+        u_px: h.u_px,
+        v_px: h.v_px,
+        area_px: h.area_px,
+        core_px: h.area_px,
+        roundness: 1.0,
+        major_sd_px: 0.5 * (h.area_px as f64 / std::f64::consts::PI).sqrt(),
+        halves: h.parts.map(|ps| {
+            ps.map(|q| super::Half {
+                u_px: q.u_px,
+                v_px: q.v_px,
+                area_px: q.area_px,
+                parts: None,
+            })
+        }),
+        ..*whole
+    }
+}
+
+/// The capture's spots with each spot that two of its pins share cut in two: a spot of at
+/// most [`SPLIT_MAX_ROUNDNESS`] with halves ([`Spot::halves`]) whose halves are nearest two
+/// different pins' projections (`proj`, in plan order), each pin nearer its half than the
+/// whole spot's centre. Each half becomes a spot of its own (the whole's score, its own
+/// centre and pixel count, round). Returns the spots and the spots split with their pins' ids.
+fn split_touching(
+    c: &CaptureSpots,
+    proj: &[Option<Vector2<f64>>],
+) -> (Vec<Spot>, Vec<(Spot, [u32; 2])>) {
+    let nearest = |u: f64, v: f64| {
+        proj.iter()
+            .enumerate()
+            .filter_map(|(k, p)| p.map(|p| (k, (p - Vector2::new(u, v)).norm())))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+    };
+    let (mut spots, mut splits) = (Vec::with_capacity(c.spots.len() + 1), Vec::new());
+    for s in &c.spots {
+        let halves = s.halves.filter(|_| s.roundness <= SPLIT_MAX_ROUNDNESS);
+        let pins = halves.and_then(|[a, b]| {
+            let (ka, da) = nearest(a.u_px, a.v_px)?;
+            let (kb, db) = nearest(b.u_px, b.v_px)?;
+            let whole = |k: usize| {
+                proj[k].map_or(f64::INFINITY, |p| (p - Vector2::new(s.u_px, s.v_px)).norm())
+            };
+            (ka != kb && da < whole(ka) && db < whole(kb)).then_some([ka, kb])
+        });
+        match (halves, pins) {
+            (Some(hs), Some([ka, kb])) => {
+                spots.extend(hs.iter().map(|h| half_spot(s, h)));
+                splits.push((*s, [c.planned_ids[ka], c.planned_ids[kb]]));
+            }
+            _ => spots.push(*s),
+        }
+    }
+    (spots, splits)
 }
 
 /// Depth-first search over the pins' candidates for the cheapest choice (`cost(k, spot)`);

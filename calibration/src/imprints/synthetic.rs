@@ -62,6 +62,24 @@ pub struct Shading {
     /// Both images are stored as 8-bit JPEG of this quality (1 to 100) and read back; `None`:
     /// kept as the floating-point grey levels.
     pub jpeg_quality: Option<u8>,
+    /// The skin around each imprint is pulled in too: outside the contact the depth follows
+    /// the surface displacement of a Hertz contact, `halo x d (h(s) - h(4))` with `h(s) = (1 /
+    /// pi) [(2 - s^2) asin(1 / s) + sqrt(s^2 - 1)]` at `s` contact radii from the imprint's
+    /// deepest point on the skin (`d` its deepest depth; Johnson, *Contact Mechanics*,
+    /// Sec. 3.4, Eq. 3.42: half the depth at the contact's edge, falling as 1 / s), lowered to
+    /// end at 4 radii; 0: the imprint ends at the contact (ASSUMPTION: the rigid sphere's contact radius stands for the Hertz
+    /// one; issue 101 models the skin). A faint skirt the detector's spots grow into, and
+    /// that joins two imprints near each other.
+    pub halo: f64,
+    /// Dark LED notches at the skin's rim, in both images: this many slots at the
+    /// background's grey, `notch_width_px` wide, from the skin's edge in the image inwards by
+    /// `notch_depth_px`, along the azimuths `notch_phase_deg + k 360 / notches` (about the
+    /// image centre, from +u towards +v). The reference mask leaves them out, clipping an
+    /// imprint beside one.
+    pub notches: usize,
+    pub notch_phase_deg: f64,
+    pub notch_width_px: f64,
+    pub notch_depth_px: f64,
 }
 
 impl Default for Shading {
@@ -83,6 +101,11 @@ impl Default for Shading {
             specks: 0,
             scratches: 0,
             jpeg_quality: None,
+            halo: 0.0,
+            notches: 0,
+            notch_phase_deg: 0.0,
+            notch_width_px: 0.0,
+            notch_depth_px: 0.0,
         }
     }
 }
@@ -159,13 +182,29 @@ pub fn ring_pins_pressed(turn_deg: f64, depths_mm: [f64; 5]) -> Vec<Pin> {
     .collect()
 }
 
+/// The fraction of an imprint's deepest depth above which its core lies
+/// ([`Rendered::centres_px`]), as the detector's default `DetectParams::core_fraction`.
+pub const CORE_FRACTION: f64 = 0.5;
+
+/// Where [`Shading::halo`] ends, in contact radii.
+const HALO_RADII: f64 = 4.0;
+
+/// Hertz's surface displacement outside the contact over the indentation depth at `s > 1`
+/// contact radii from its centre (Johnson, *Contact Mechanics*, Eq. 3.42b): 1/2 at `s = 1`.
+fn hertz(s: f64) -> f64 {
+    ((2.0 - s * s) * (1.0 / s).asin() + (s * s - 1.0).sqrt()) / std::f64::consts::PI
+}
+
 /// A rendered capture and its reference.
 #[derive(Debug, Clone)]
 pub struct Rendered {
     pub reference: GrayImage,
     pub capture: GrayImage,
-    /// Each pin's true centre, px: the centroid of its noise-free imprint (the darkening
-    /// before blur), in the order given; `None` for a pin the camera does not see press.
+    /// Each pin's true centre, px: the centroid of its noise-free imprint's core as the lens
+    /// images it (its depth along the rays blurred by the PSF, above [`CORE_FRACTION`] of its
+    /// deepest: the part nearest the tip, as the detector takes it,
+    /// `DetectParams::core_fraction`), in the order given; `None` for a pin the camera does
+    /// not see press.
     pub centres_px: Vec<Option<[f64; 2]>>,
 }
 
@@ -285,9 +324,40 @@ pub fn render_through(
             [cx + r * a.cos(), cy + r * a.sin()]
         })
         .collect();
+    // dark notches at the rim: the skin's edge in the image along each notch's azimuth
+    if s.notches > 0 && s.notch_width_px > 0.0 && s.notch_depth_px > 0.0 {
+        for k in 0..s.notches {
+            let a = (s.notch_phase_deg + 360.0 * k as f64 / s.notches as f64).to_radians();
+            let (du, dv) = (a.cos(), a.sin());
+            // the last skin pixel along the azimuth
+            let mut edge: f64 = 0.0;
+            let mut r = 0.0;
+            while r < rmax {
+                let (u, v) = ((cx + r * du).round(), (cy + r * dv).round());
+                if u < 0.0 || v < 0.0 || u > (w - 1) as f64 || v > (h - 1) as f64 {
+                    break;
+                }
+                if refh.t_mm[v as usize * w + u as usize].is_finite() {
+                    edge = r;
+                }
+                r += 0.5;
+            }
+            for (p, b) in base.iter_mut().enumerate() {
+                let (x, y) = ((p % w) as f64 - cx, (p / w) as f64 - cy);
+                let (along, across) = (x * du + y * dv, -x * dv + y * du);
+                if along >= edge - s.notch_depth_px && across.abs() <= 0.5 * s.notch_width_px {
+                    *b = s.background_grey;
+                }
+            }
+        }
+    }
     // each pin's imprint: the depth it pushes the skin in along each ray
     let mut dent = vec![0f32; w * h];
     let mut centres = Vec::with_capacity(pins.len());
+    let hit_point = |p: usize| {
+        let (o, d, t) = (rays.origin(p), rays.dirs[p], refh.t_mm[p]);
+        nalgebra::Vector3::new(o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2])
+    };
     for pin in pins {
         let prim = ExactPrimitives::new(&[Primitive::Sphere {
             centre_mm: pin.centre_mm,
@@ -295,17 +365,61 @@ pub fn render_through(
         }])
         .expect("a sphere of positive radius");
         let hits = indented_hits(&rays, &refh, &prim, surface.base_z_mm());
-        let (mut sw, mut su, mut sv) = (0f64, 0f64, 0f64);
+        let depth = |p: usize| {
+            (hits.contact[p] && refh.t_mm[p].is_finite()).then(|| refh.t_mm[p] - hits.t_mm[p])
+        };
+        let mut own = vec![0f32; w * h];
+        let mut deepest_at: Option<(usize, f64)> = None;
         for p in 0..w * h {
-            if hits.contact[p] && refh.t_mm[p].is_finite() {
-                let depth = refh.t_mm[p] - hits.t_mm[p];
-                dent[p] += depth as f32;
-                sw += depth;
-                su += depth * (p % w) as f64;
-                sv += depth * (p / w) as f64;
+            if let Some(d) = depth(p) {
+                own[p] = d as f32;
+                if deepest_at.is_none_or(|(_, e)| d > e) {
+                    deepest_at = Some((p, d));
+                }
             }
         }
-        centres.push((sw > 0.0).then(|| [su / sw, sv / sw]));
+        // the halo: Hertz's surface displacement outside the contact (Johnson Eq. 3.42)
+        if let (true, Some((q, d))) = (s.halo > 0.0, deepest_at) {
+            let c = hit_point(q);
+            let a = (0..w * h)
+                .filter(|&p| own[p] > 0.0)
+                .map(|p| (hit_point(p) - c).norm())
+                .fold(0.0, f64::max);
+            if a > 0.0 {
+                for p in 0..w * h {
+                    if own[p] > 0.0 || !refh.t_mm[p].is_finite() {
+                        continue;
+                    }
+                    let r = (hit_point(p) - c).norm() / a;
+                    if r > 1.0 && r < HALO_RADII {
+                        own[p] = (s.halo * d * (hertz(r) - hertz(HALO_RADII))) as f32;
+                    }
+                }
+            }
+        }
+        for (x, o) in dent.iter_mut().zip(&own) {
+            *x += o;
+        }
+        // the core of the imprint as the lens images it (blurred by the PSF, noise-free):
+        // its depth above CORE_FRACTION of its deepest
+        let seen = gaussian_blur(
+            &GrayImage {
+                width: w,
+                height: h,
+                data: own,
+            },
+            s.psf_sigma_px,
+        )
+        .data;
+        let deepest = seen.iter().fold(0f32, |a, &b| a.max(b)) as f64;
+        let (mut sw, mut su, mut sv) = (0f64, 0f64, 0f64);
+        for (p, &d) in seen.iter().enumerate() {
+            let x = (f64::from(d) - CORE_FRACTION * deepest).max(0.0);
+            sw += x;
+            su += x * (p % w) as f64;
+            sv += x * (p / w) as f64;
+        }
+        centres.push((deepest > 0.0 && sw > 0.0).then(|| [su / sw, sv / sw]));
     }
     // the shading of the imprints, side-lit from the rim
     let shade: Vec<f32> = if s.side_light_px > 0.0 && skin_r > 0.0 {

@@ -524,6 +524,11 @@ fn a_capture_without_a_pin_shaped_spot_is_left_out_saying_why() {
         score: 40.0,
         area_px: 90,
         roundness: 0.3,
+        // a line of 90 px, 3 px wide: 30 px long, sd 30 / sqrt(12)
+        major_sd_px: 8.7,
+        core_px: 90,
+        clipped: false,
+        halves: None,
     };
     let points: BTreeMap<u32, Vector3<f64>> = [(1, Vector3::new(0.0, 0.0, 13.5))].into();
     let capture = |ids: Vec<u32>| CaptureSpots {
