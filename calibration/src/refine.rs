@@ -11,8 +11,16 @@
 //! Jacobian's columns are scaled to unit length and its condition number taken; while it is
 //! above [`MAX_CONDITION`], the parameter that weighs most in the least-determined direction
 //! (the right singular vector of the smallest singular value) is held at the camera file's
-//! value, and the report says which and with what it trades. Parameters named by the user are
-//! never held: a list that the captures do not constrain is refused.
+//! value, and the report says which and with what it trades. After the fit, the distortion
+//! coefficients beyond k1 and k2 (the lens's main distortion, always refined when the
+//! condition number allows) are taken from the highest order down: one whose move from the camera file's
+//! value lowers the squared reprojection error by less than ln N sigma^2 (N the observations;
+//! dropping one parameter raises it by t^2 sigma^2, t its move over its standard deviation) is
+//! not worth its place by the Bayesian information criterion (Schwarz 1978) and is held, and
+//! the fit repeated; the first that is worth it ends the pruning. A coefficient independent of
+//! the others (within [`MAX_CONDITION`]) may still be so weakly seen that its value is the
+//! fit's guess (issue 97: k3 = -1.02 +- 3.9 from 29 pins of a 160 deg lens). Parameters named
+//! by the user are never held: a list that the captures do not constrain is refused.
 
 use nalgebra::{
     DMatrix, DVector, Isometry3, Rotation3, Translation3, UnitQuaternion, Vector2, Vector3,
@@ -307,6 +315,11 @@ fn distortion_order(name: &str) -> u32 {
     }
 }
 
+/// The lowest [`distortion_order`] the information criterion may hold (p1, p2, k3 and beyond;
+/// k1 and k2 carry a lens's main distortion and are refined whenever the condition number
+/// allows).
+const MIN_PRUNED_ORDER: u32 = 3;
+
 /// The names of the columns that weigh in `v` (|component| at least a third of the largest),
 /// but `except`, largest first.
 fn trading(v: &DVector<f64>, names: &[String], except: &[usize]) -> String {
@@ -481,51 +494,52 @@ pub fn refine_intrinsics_through(
             .map(|k| free[k])
             .collect();
     };
+    let mut pb = pb;
+    let initial = intrinsic_vector(&base);
     let e0 = pb.residuals(&start).ok_or(RefineError::Unprojectable)?;
     let rms = |e: &DVector<f64>| (e.norm_squared() / points_mm.len() as f64).sqrt();
     let rms_before_px = rms(&e0);
-    // Levenberg-Marquardt, Marquardt's scaling by the diagonal
-    let (mut s, mut e, mut lambda) = (start.clone(), e0, 1e-3);
-    let mut iterations = 0;
-    for _ in 0..100 {
-        iterations += 1;
-        let Some(j) = pb.jacobian(&s) else { break };
-        let a = j.transpose() * &j;
-        let g = j.transpose() * &e;
-        let cost = e.norm_squared();
-        let mut improved = false;
-        while lambda < 1e12 {
-            let mut m = a.clone();
-            for k in 0..m.nrows() {
-                m[(k, k)] += lambda * a[(k, k)].max(1e-12);
+    // fit; then, from the highest order down, hold the distortion coefficient the fit does not
+    // need (the Bayesian information criterion) and fit again
+    let (s, e, iterations, j, cov) = loop {
+        let (s, e, iterations) = levenberg_marquardt(&pb, &start, e0.clone());
+        let j = pb.jacobian(&s).ok_or(RefineError::Unprojectable)?;
+        let dof = (n_obs - pb.n_params()) as f64;
+        let sigma2 = e.norm_squared() / dof;
+        let cov = (j.transpose() * &j).try_inverse().map(|c| c * sigma2);
+        // the highest-order free distortion coefficient, and whether the fit needs it
+        let last = pb
+            .free
+            .iter()
+            .enumerate()
+            .filter(|(_, &k)| k >= 4 && distortion_order(names[k]) >= MIN_PRUNED_ORDER)
+            .max_by_key(|(_, &k)| (distortion_order(names[k]), k))
+            .map(|(col, &k)| (col, k));
+        let undetermined = match (which, &cov, last) {
+            (RefineParameters::Constrained, Some(c), Some((col, k))) => {
+                let var = c[(col, col)].max(0.0);
+                // dropping it raises the squared error by about t^2 sigma^2
+                let t2 = (s.intr[k] - initial[k]).powi(2) / var.max(1e-300);
+                (t2 < (n_obs as f64).ln()).then_some((col, k, var.sqrt(), t2))
             }
-            let Some(d) = m.cholesky().map(|c| c.solve(&(-&g))) else {
-                lambda *= 10.0;
-                continue;
-            };
-            let cand = pb.step(&s, d.as_slice());
-            match pb.residuals(&cand) {
-                Some(ec) if ec.norm_squared() < cost => {
-                    let gain = cost - ec.norm_squared();
-                    s = cand;
-                    e = ec;
-                    lambda = (lambda / 10.0).max(1e-12);
-                    improved = gain > 1e-14 * cost.max(1e-300);
-                    break;
-                }
-                _ => lambda *= 10.0,
-            }
-        }
-        if !improved {
-            break;
-        }
-    }
-    let j = pb.jacobian(&s).ok_or(RefineError::Unprojectable)?;
-    let (condition_number, _) = scaled_condition(&j);
-    let dof = (n_obs - pb.n_params()) as f64;
-    let sigma2 = e.norm_squared() / dof;
-    let cov = (j.transpose() * &j).try_inverse().map(|c| c * sigma2);
-    let initial = intrinsic_vector(&base);
+            _ => None,
+        };
+        let Some((col, k, sd, t2)) = undetermined else {
+            break (s, e, iterations, j, cov);
+        };
+        held.push((
+            k,
+            format!(
+                "the captures do not determine {}: refined, it moves {:.4} +- {sd:.4} from the camera file's value, which lowers the squared reprojection error by {t2:.2} sigma^2, less than ln {n_obs} = {:.2} for a parameter (the Bayesian information criterion)",
+                names[k],
+                s.intr[k] - initial[k],
+                (n_obs as f64).ln()
+            ),
+        ));
+        pb.free.remove(col);
+        free = pb.free.clone();
+    };
+    let condition_number = scaled_condition(&j).0;
     let parameters = names
         .iter()
         .enumerate()
@@ -565,6 +579,52 @@ pub fn refine_intrinsics_through(
     })
 }
 
+/// Levenberg-Marquardt from `start` (residuals `e0`), Marquardt's scaling by the diagonal: the
+/// state, its residuals and the iterations taken (at most 100; until a step gains less than
+/// 1e-14 of the cost).
+fn levenberg_marquardt(
+    pb: &Problem<'_>,
+    start: &State,
+    e0: DVector<f64>,
+) -> (State, DVector<f64>, usize) {
+    let (mut s, mut e, mut lambda) = (start.clone(), e0, 1e-3);
+    let mut iterations = 0;
+    for _ in 0..100 {
+        iterations += 1;
+        let Some(j) = pb.jacobian(&s) else { break };
+        let a = j.transpose() * &j;
+        let g = j.transpose() * &e;
+        let cost = e.norm_squared();
+        let mut improved = false;
+        while lambda < 1e12 {
+            let mut m = a.clone();
+            for k in 0..m.nrows() {
+                m[(k, k)] += lambda * a[(k, k)].max(1e-12);
+            }
+            let Some(d) = m.cholesky().map(|c| c.solve(&(-&g))) else {
+                lambda *= 10.0;
+                continue;
+            };
+            let cand = pb.step(&s, d.as_slice());
+            match pb.residuals(&cand) {
+                Some(ec) if ec.norm_squared() < cost => {
+                    let gain = cost - ec.norm_squared();
+                    s = cand;
+                    e = ec;
+                    lambda = (lambda / 10.0).max(1e-12);
+                    improved = gain > 1e-14 * cost.max(1e-300);
+                    break;
+                }
+                _ => lambda *= 10.0,
+            }
+        }
+        if !improved {
+            break;
+        }
+    }
+    (s, e, iterations)
+}
+
 /// The refinement as `extrinsics.json` reports it.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct RefinementReport {
@@ -586,7 +646,7 @@ pub struct RefinementReport {
 impl RefinementReport {
     pub fn new(r: &Refinement, camera_file: &str) -> RefinementReport {
         RefinementReport {
-            description: format!("Intrinsics refined jointly with the pose by Levenberg-Marquardt on the reprojection error; standard deviations from the covariance sigma^2 (J^T J)^-1 at the solution, sigma^2 the residual variance. A parameter the captures do not constrain (the column-scaled Jacobian's condition number above {MAX_CONDITION:.0e} with it free) is held at the camera file's value, and says why."),
+            description: format!("Intrinsics refined jointly with the pose by Levenberg-Marquardt on the reprojection error; standard deviations from the covariance sigma^2 (J^T J)^-1 at the solution, sigma^2 the residual variance. A parameter the captures do not constrain (the column-scaled Jacobian's condition number above {MAX_CONDITION:.0e} with it free), or a distortion coefficient beyond k1 and k2 they do not determine (from the highest order down, one whose move lowers the squared reprojection error by less than ln N sigma^2, N the observations: the Bayesian information criterion), is held at the camera file's value, and says why."),
             camera_file: camera_file.into(),
             parameters: r.parameters.clone(),
             condition_number: r.condition_number,

@@ -27,7 +27,7 @@ fn truth_vector(i: &Intrinsics) -> Vec<f64> {
 }
 
 /// Largest |error / standard deviation| of a refined parameter or the pose's translation:
-/// about 270 are checked (30 seeds, 4 to 8 refined intrinsics and 3 translations each); for
+/// about 215 are checked (30 seeds, 4 to 8 refined intrinsics and 3 translations each); for
 /// all of them to lie within it but with a probability of 1e-6 (Bonferroni over 330), each
 /// must with 1 - 3e-9: 2 (1 - Phi(6.0)) = 2.0e-9. A bound of 3 was exceeded somewhere about
 /// one run in five with ten seeds.
@@ -38,6 +38,7 @@ fn refined_intrinsics_recover_the_truth_within_their_standard_deviations() {
     let truth = truth_vector(&benchmark_intrinsics());
     let cam = camera_file();
     let (mut z2, mut nz) = (0.0, 0);
+    let mut by_criterion = 0;
     // three seed sets of ten (issue 96: a bound that holds on one set only is tuned to it)
     for seed in 1..=30 {
         let t = benchmark_trial(seed, 0.2, 0);
@@ -68,6 +69,14 @@ fn refined_intrinsics_recover_the_truth_within_their_standard_deviations() {
             .collect();
         for n in ["cx", "cy", "k1", "k2"] {
             assert!(refined.contains(&n), "seed {seed}: {n} not refined");
+        }
+        // k3 and k4 are the camera file's (the truth's): a fit that frees them gains too
+        // little to pay for them (the Bayesian information criterion), or they trade
+        // against the others beyond the condition number
+        for p in &r.parameters[6..] {
+            if let Some(why) = &p.held {
+                by_criterion += usize::from(why.contains("the Bayesian information criterion"));
+            }
         }
         for (p, tv) in r.parameters.iter().zip(&truth) {
             match (&p.held, p.std) {
@@ -105,9 +114,13 @@ fn refined_intrinsics_recover_the_truth_within_their_standard_deviations() {
             nz += 1;
         }
     }
+    // k3 held by the information criterion where the condition number did not hold it:
+    // measured in 26 of the 30 seeds
+    eprintln!("k3 or k4 held by the information criterion in {by_criterion} of 30 seeds");
+    assert!(by_criterion >= 15, "{by_criterion}");
     // the standard deviations are the spread of the errors (not 10 x too small or too large)
     let z_rms = (z2 / nz as f64).sqrt();
-    // measured 0.986 over about 270; an RMS of n unit normals varies by 1 / sqrt(2n) = 4 %
+    // measured 1.024 over 214; an RMS of n unit normals varies by 1 / sqrt(2n) = 5 %
     assert!(
         (0.4..1.7).contains(&z_rms),
         "errors over standard deviations: RMS {z_rms:.2} over {nz}"
