@@ -14,7 +14,7 @@ use crate::capture_images::{observe_images, CaptureImages, ImageError};
 use crate::overlay::{read_png_rgb8_sized, render_overlay, OverlayError};
 use crate::pnp::{solve_pnp_through, PnpError, PnpOptions, RansacOptions};
 use crate::refine::{
-    refine_intrinsics_through, solution_at, RefineError, RefineParameters, RefinementReport,
+    refine_intrinsics_keeping, solution_at, RefineError, RefineParameters, RefinementReport,
 };
 use crate::refraction::{refine_plane, FlatLayers, Imaging, PlanePrior};
 use crate::report::{CaptureReport, ExtrinsicsReport, PlaneFitReport, Provenance};
@@ -284,7 +284,10 @@ pub fn calibrate_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsOutput, Ext
             let count = |s: &crate::PnpSolution| s.inliers.iter().filter(|&&b| b).count();
             let (pts, px) = inliers_of(&sol);
             let l = layers.as_ref();
-            let mut r = refine_intrinsics_through(&camera, l, &pts, &px, &sol.t_cam_sensor, which)?;
+            // every pin that projects at the camera file's intrinsics keeps projecting
+            let all = &pairs.points_mm;
+            let mut r =
+                refine_intrinsics_keeping(&camera, l, &pts, &px, &sol.t_cam_sensor, which, all)?;
             let mut kept = sol;
             for _ in 1..4 {
                 let Ok(again) = solve_pnp_through(
@@ -299,7 +302,15 @@ pub fn calibrate_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsOutput, Ext
                     break;
                 }
                 let (pts, px) = inliers_of(&again);
-                match refine_intrinsics_through(&camera, l, &pts, &px, &again.t_cam_sensor, which) {
+                match refine_intrinsics_keeping(
+                    &camera,
+                    l,
+                    &pts,
+                    &px,
+                    &again.t_cam_sensor,
+                    which,
+                    all,
+                ) {
                     Ok(r2) => {
                         r = r2;
                         kept = again;

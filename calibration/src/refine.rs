@@ -164,6 +164,9 @@ struct Problem<'a> {
     pixels: &'a [Vector2<f64>],
     /// The optical path in front of the lens ([`crate::refraction`]); `None`: straight rays.
     layers: Option<&'a FlatLayers>,
+    /// Points that must keep projecting (the pins the fit leaves out but that project at the
+    /// start: a refined model must not fold the image back before them).
+    keep: &'a [Vector3<f64>],
 }
 
 /// A state: the full intrinsic vector and the pose (R, t).
@@ -208,6 +211,24 @@ impl Problem<'_> {
                 .map(|(p, px)| imaging.project(&r, &s.t, p).map(|uv| uv - px))
                 .collect(),
         )
+    }
+
+    /// Whether every point of `keep` projects at `s`.
+    fn keeps(&self, s: &State) -> bool {
+        if self.keep.is_empty() {
+            return true;
+        }
+        let Ok(cam) = CameraModel::new(with_vector(&self.base, &s.intr)) else {
+            return false;
+        };
+        let imaging = Imaging {
+            camera: &cam,
+            layers: self.layers,
+        };
+        let r = *s.r.matrix();
+        self.keep
+            .iter()
+            .all(|p| imaging.project(&r, &s.t, p).is_some())
     }
 
     /// `s` moved by `d` (free intrinsics, then the rotation increment on the left, then t).
@@ -366,6 +387,46 @@ pub fn refine_intrinsics_through(
     t_cam_sensor: &Isometry3<f64>,
     which: &RefineParameters,
 ) -> Result<Refinement, RefineError> {
+    refine_intrinsics_keeping(
+        camera,
+        layers,
+        points_mm,
+        pixels_px,
+        t_cam_sensor,
+        which,
+        &[],
+    )
+}
+
+/// [`refine_intrinsics_through`] that never leaves a point of `keep` (sensor frame, mm)
+/// unprojected: the pins the fit does not use (RANSAC's outliers) that project at the camera
+/// file's intrinsics and the starting pose still project at the refined ones (a step that would
+/// fold the image back before one of them is refused), so that their residuals can be
+/// reported and the pose solved again may take them in (issue 97: refined over the inner
+/// rings, the outer ring no longer projected at all).
+///
+/// # Errors
+/// As [`refine_intrinsics`].
+pub fn refine_intrinsics_keeping(
+    camera: &CameraModel,
+    layers: Option<&FlatLayers>,
+    points_mm: &[Vector3<f64>],
+    pixels_px: &[Vector2<f64>],
+    t_cam_sensor: &Isometry3<f64>,
+    which: &RefineParameters,
+    keep: &[Vector3<f64>],
+) -> Result<Refinement, RefineError> {
+    let imaging = Imaging { camera, layers };
+    let (r0, t0) = (
+        *t_cam_sensor.rotation.to_rotation_matrix().matrix(),
+        t_cam_sensor.translation.vector,
+    );
+    let keep: Vec<Vector3<f64>> = keep
+        .iter()
+        .filter(|p| imaging.project(&r0, &t0, p).is_some())
+        .copied()
+        .collect();
+    let keep = keep.as_slice();
     let base = *camera.intrinsics();
     let names = parameter_names(&base.distortion);
     let model = base.distortion.name();
@@ -422,6 +483,7 @@ pub fn refine_intrinsics_through(
             points: points_mm,
             pixels: pixels_px,
             layers,
+            keep,
         };
         let j = pb.jacobian(&start).ok_or(RefineError::Unprojectable)?;
         let (cond, v) = scaled_condition(&j);
@@ -607,7 +669,7 @@ fn levenberg_marquardt(
             };
             let cand = pb.step(&s, d.as_slice());
             match pb.residuals(&cand) {
-                Some(ec) if ec.norm_squared() < cost => {
+                Some(ec) if ec.norm_squared() < cost && pb.keeps(&cand) => {
                     let gain = cost - ec.norm_squared();
                     s = cand;
                     e = ec;

@@ -76,7 +76,10 @@ pub struct RingResidual {
     pub polar_deg: [f64; 2],
     pub points: usize,
     pub inliers: usize,
-    /// RMS reprojection error of the band's points that project (outliers included), px.
+    /// The band's points that project at the solved pose and intrinsics.
+    pub projected: usize,
+    /// RMS reprojection error of the band's points that project (outliers included), px; 0
+    /// when none does (`projected` = 0).
     pub rms_px: f64,
 }
 
@@ -138,6 +141,7 @@ fn ring_residuals(pairs: &Pairs, sol: &PnpSolution) -> Vec<RingResidual> {
                 polar_deg: [polar[g[0]], polar[*g.last().expect("never empty")]],
                 points: g.len(),
                 inliers: g.iter().filter(|&&i| sol.inliers[i]).count(),
+                projected: errs.len(),
                 rms_px: (errs.iter().sum::<f64>() / errs.len().max(1) as f64).sqrt(),
             }
         })
@@ -159,7 +163,19 @@ fn growing_residuals(rings: &[RingResidual], refined: bool) -> Option<String> {
     if rings.len() < 3 {
         return None;
     }
-    let outer = rings.last().expect("at least 3").rms_px;
+    let last = rings.last().expect("at least 3");
+    if last.projected == 0 {
+        return Some(format!(
+            "{GROWING}: the outermost ring ({}) does not project at all at the solved pose{}",
+            last.angles(),
+            if refined {
+                " and the refined intrinsics"
+            } else {
+                ""
+            }
+        ));
+    }
+    let outer = last.rms_px;
     let mut inner: Vec<f64> = rings[..rings.len().div_ceil(2)]
         .iter()
         .map(|r| r.rms_px)

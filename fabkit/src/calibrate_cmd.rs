@@ -329,7 +329,10 @@ fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
         r.residuals
             .by_polar_angle
             .iter()
-            .map(|b| format!("{} {:.2} px ({} pins)", b.angles(), b.rms_px, b.points))
+            .map(|b| match b.projected {
+                0 => format!("{} none projects ({} pins)", b.angles(), b.points),
+                _ => format!("{} {:.2} px ({} pins)", b.angles(), b.rms_px, b.points),
+            })
             .collect::<Vec<_>>()
             .join(", ")
     );
