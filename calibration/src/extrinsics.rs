@@ -224,7 +224,41 @@ pub fn calibrate_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsOutput, Ext
             .unzip()
     };
     let mut layers = layers;
-    let (sol, path_fit) = if job.refine_optical_path {
+    // the design's filling gel surface, and its prior, when the optical path has one
+    let gel = job.optical_path.as_ref().and_then(|path| {
+        let plane = path
+            .planes
+            .iter()
+            .position(|p| p.what.starts_with("housing.filling_gel"))?;
+        Some((
+            PlanePrior {
+                plane,
+                height_sd_mm: crate::refraction::GEL_SURFACE_HEIGHT_SD_MM,
+                index_sd: crate::refraction::SILICONE_INDEX_SD,
+            },
+            path.planes[plane].what.clone(),
+        ))
+    });
+    // pins left out: the models that might explain them compared first (crate::models)
+    let mut compared = match (job.refine_optical_path, sol.ransac_threshold_px) {
+        (false, Some(threshold)) if sol.inliers.iter().any(|&b| !b) => crate::models::compare(
+            &camera,
+            layers.as_ref(),
+            gel.as_ref().map(|g| g.0),
+            &pairs.points_mm,
+            &pairs.pixels_px,
+            &sol.t_cam_sensor,
+            threshold,
+        ),
+        _ => None,
+    };
+    let (sol, path_fit) = if let Some((fit, every)) = compared.as_mut().and_then(|c| c.taken.take())
+    {
+        let what = gel.as_ref().map_or("", |g| g.1.as_str());
+        let report = PlaneFitReport::new(&fit, what);
+        layers = Some(fit.layers);
+        (every, Some(report))
+    } else if job.refine_optical_path {
         let (path, l) = match (&job.optical_path, &layers) {
             (Some(p), Some(l)) => (p, l),
             _ => {
@@ -358,6 +392,10 @@ pub fn calibrate_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsOutput, Ext
     report.optical_path = job.optical_path.clone();
     report.optical_path_from = job.optical_path.as_ref().and(job.optical_path_from.clone());
     report.optical_path_fit = path_fit;
+    if let Some(c) = compared {
+        report.warnings.extend(c.warning);
+        report.model_comparison = Some(c.report);
+    }
     if let Some(found) = &from_images {
         report.warnings.extend(found.notes.iter().cloned());
         report.captures = found.outcomes.iter().map(CaptureReport::from).collect();

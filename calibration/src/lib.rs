@@ -15,6 +15,7 @@ pub mod capture_images;
 pub mod extrinsics;
 pub mod groundtruth;
 pub mod imprints;
+pub mod models;
 pub mod overlay;
 pub mod p3p;
 pub mod photometric;

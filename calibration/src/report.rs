@@ -216,6 +216,10 @@ pub struct ExtrinsicsReport {
     /// point table's (point_table.json)` when the point table's sidecar names it.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub optical_path_from: Option<String>,
+    /// RANSAC left pins out: the models fitted to every pin and compared before they were
+    /// rejected ([`crate::models`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub model_comparison: Option<crate::models::ModelComparison>,
     /// The filling gel's surface refined with the pose (`--refine-optical-path`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub optical_path_fit: Option<PlaneFitReport>,
@@ -473,6 +477,7 @@ impl ExtrinsicsReport {
             distortion_model: camera.camera.intrinsics().distortion.name().into(),
             optical_path: None,
             optical_path_from: None,
+            model_comparison: None,
             optical_path_fit: None,
             rvec: [rvec.x, rvec.y, rvec.z],
             tvec_mm: [iso.translation.x, iso.translation.y, iso.translation.z],

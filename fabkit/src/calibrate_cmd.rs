@@ -324,6 +324,24 @@ fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
                 .map_or_else(String::new, |t| format!(" (beyond {t:.2} px)"))
         );
     }
+    if let Some(c) = &r.model_comparison {
+        println!(
+            "models compared before rejecting: {}; {}",
+            c.models
+                .iter()
+                .map(|m| format!(
+                    "{} BIC {:.1} (RMS {:.2} px, worst {:.2} px)",
+                    m.model, m.bic, m.rms_px, m.worst_px
+                ))
+                .collect::<Vec<_>>()
+                .join(", "),
+            if c.chosen == "RANSAC" {
+                "the rejection stands".to_string()
+            } else {
+                format!("{}: every pin kept", c.chosen)
+            }
+        );
+    }
     println!(
         "RMS by polar angle: {}",
         r.residuals

@@ -53,7 +53,7 @@ fn detect_each(turns: &[f64], shading: &Shading, seed: u64) -> (f64, Vec<(Render
         .unwrap();
         let truth: Vec<[f64; 2]> = r.centres_px.iter().map(|c| c.unwrap()).collect();
         // a pressed ball tip's imprint is round, even foreshortened at the outer ring
-        // measured 0.83 to 0.91 on seed sets 0 to 2
+        // measured 0.80 to 1.00 on seed sets 0 to 2
         assert!(
             spots.iter().all(|s| s.roundness > 0.75),
             "capture {k}: {spots:?}"
@@ -93,7 +93,7 @@ fn imprints_are_found_alone_and_centred_within_a_tenth_of_a_pixel() {
         extra > 0,
         "the LED reflections should differ between the images"
     );
-    // measured 0.028 to 0.034 px on seed sets 0 to 2
+    // measured 0.047 to 0.051 px on seed sets 0 to 2
     assert!(rms < 0.1, "centroid error {rms:.4} px RMS");
 }
 
@@ -199,7 +199,7 @@ fn ids_follow_the_plan_and_the_pose_is_as_good_as_from_true_centres() {
     assert_eq!(extra.discarded.len(), 1, "{extra:?}");
     let (spot, why) = &extra.discarded[0];
     let t = r_extra_centre(&cam, &surface, depth);
-    // measured 0.005 to 0.04 px on seed sets 0 to 2
+    // measured 0.022 to 0.047 px on seed sets 0 to 2
     assert!(
         (spot.u_px - t[0]).hypot(spot.v_px - t[1]) < 0.5,
         "the discarded spot is the extra press: {spot:?} vs {t:?}"
@@ -215,7 +215,7 @@ fn ids_follow_the_plan_and_the_pose_is_as_good_as_from_true_centres() {
         // the pole pin is pressed in every capture: its true centre is the same
         let t = truth[&o.id];
         let e = (o.u_px - t[0]).hypot(o.v_px - t[1]);
-        // measured up to 0.062 px on seed sets 0 to 2
+        // measured up to 0.109 px on seed sets 0 to 2
         assert!(
             e < 0.5,
             "{} pin {}: {e} px from its own imprint",
@@ -299,7 +299,7 @@ fn a_moving_saturated_rim_and_gain_drift_make_no_extra_spots() {
         raw_extra > 0,
         "the raw difference should show the moved rim as spots"
     );
-    // measured 0.030 to 0.032 px on seed sets 0 to 2
+    // measured 0.049 to 0.057 px on seed sets 0 to 2
     assert!(rms < 0.2, "centroid error {rms:.4} px RMS");
 }
 
@@ -426,7 +426,7 @@ fn on_captures_with_every_artifact_every_capture_is_used_and_every_id_right() {
                 .filter(|((c, _), _)| *c == o.name)
                 .map(|(_, t)| (s.u_px - t[0]).hypot(s.v_px - t[1]))
                 .fold(f64::INFINITY, f64::min);
-            // measured 32 px or more on seed sets 0 to 2
+            // measured 31.6 px or more on seed sets 0 to 2
             assert!(
                 nearest > 10.0,
                 "{}: ({:.1}, {:.1}) is a pin's: {why}",
@@ -437,14 +437,14 @@ fn on_captures_with_every_artifact_every_capture_is_used_and_every_id_right() {
             by_shape += usize::from(why.contains("a speck") || why.contains("a scratch"));
         }
     }
-    // measured 27 on seed sets 0 to 2
+    // measured 28 on seed sets 0 to 2
     assert!(by_shape >= 16, "{by_shape} spots discarded for their shape");
     let (mut sq, mut pts, mut detected, mut true_px) = (0.0, vec![], vec![], vec![]);
     for o in &a.observations {
         let t = truth[&(o.capture.clone(), o.id)];
         // its own imprint: nearer than any other pin's of the capture
         let e = (o.u_px - t[0]).hypot(o.v_px - t[1]);
-        // measured up to 0.096 px on seed sets 0 to 2
+        // measured up to 0.083 px on seed sets 0 to 2
         assert!(
             e < 1.0,
             "{} pin {}: {e:.2} px from its imprint",
@@ -457,7 +457,7 @@ fn on_captures_with_every_artifact_every_capture_is_used_and_every_id_right() {
         true_px.push(Vector2::new(t[0], t[1]));
     }
     let rms = (sq / a.observations.len() as f64).sqrt();
-    // measured 0.056 px
+    // measured 0.040 px on seed sets 0 to 2
     assert!(rms < 0.2, "centroid error {rms:.3} px RMS");
     let ((rd, td), (rt, tt)) = pose_errors(&cam, &pts, &detected, &true_px);
     let (rn, tn) = noise_allowance(&cam, &pts, &true_px, rms);
