@@ -225,32 +225,19 @@ pub fn calibrate_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsOutput, Ext
     };
     let mut layers = layers;
     // the design's filling gel surface, and its prior, when the optical path has one
-    let gel = job.optical_path.as_ref().and_then(|path| {
-        let plane = path
-            .planes
-            .iter()
-            .position(|p| p.what.starts_with("housing.filling_gel"))?;
-        Some((
-            PlanePrior {
-                plane,
-                height_sd_mm: crate::refraction::GEL_SURFACE_HEIGHT_SD_MM,
-                index_sd: crate::refraction::SILICONE_INDEX_SD,
-            },
-            path.planes[plane].what.clone(),
-        ))
-    });
+    let gel = job.optical_path.as_ref().and_then(crate::models::gel_prior);
     // pins left out: the models that might explain them compared first (crate::models)
-    let mut compared = match (job.refine_optical_path, sol.ransac_threshold_px) {
-        (false, Some(threshold)) if sol.inliers.iter().any(|&b| !b) => crate::models::compare(
+    let mut compared = if job.refine_optical_path {
+        None
+    } else {
+        crate::models::compare_if_rejected(
             &camera,
             layers.as_ref(),
-            gel.as_ref().map(|g| g.0),
+            job.optical_path.as_ref(),
             &pairs.points_mm,
             &pairs.pixels_px,
-            &sol.t_cam_sensor,
-            threshold,
-        ),
-        _ => None,
+            &sol,
+        )
     };
     let (sol, path_fit) = if let Some((fit, every)) = compared.as_mut().and_then(|c| c.taken.take())
     {

@@ -187,6 +187,51 @@ pub fn compare(
     })
 }
 
+/// The prior of the filling gel's free surface of `path` ([`crate::refraction::refine_plane`]:
+/// [`crate::refraction::GEL_SURFACE_HEIGHT_SD_MM`] and [`crate::refraction::SILICONE_INDEX_SD`]
+/// about the design's height and the materials table's index) and what the plane is; `None`
+/// when the path has no such surface.
+pub fn gel_prior(path: &fabkit_designs::optics::OpticalPath) -> Option<(PlanePrior, String)> {
+    let plane = path
+        .planes
+        .iter()
+        .position(|p| p.what.starts_with("housing.filling_gel"))?;
+    Some((
+        PlanePrior {
+            plane,
+            height_sd_mm: crate::refraction::GEL_SURFACE_HEIGHT_SD_MM,
+            index_sd: crate::refraction::SILICONE_INDEX_SD,
+        },
+        path.planes[plane].what.clone(),
+    ))
+}
+
+/// [`compare`] when `sol` left pins out at a RANSAC threshold (else `None`), with the gel
+/// surface of `path` when it has one.
+pub fn compare_if_rejected(
+    camera: &CameraModel,
+    layers: Option<&FlatLayers>,
+    path: Option<&fabkit_designs::optics::OpticalPath>,
+    points_mm: &[Vector3<f64>],
+    pixels_px: &[Vector2<f64>],
+    sol: &PnpSolution,
+) -> Option<Compared> {
+    let threshold = sol.ransac_threshold_px?;
+    if sol.inliers.iter().all(|&b| b) {
+        return None;
+    }
+    let gel = path.and_then(gel_prior).map(|g| g.0);
+    compare(
+        camera,
+        layers,
+        gel,
+        points_mm,
+        pixels_px,
+        &sol.t_cam_sensor,
+        threshold,
+    )
+}
+
 /// `model BIC b (RMS r px)` for each model.
 fn bic_list(models: &[ModelScore]) -> String {
     models

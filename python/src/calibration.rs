@@ -5,7 +5,7 @@ use fabkit_calibration::nalgebra::{Vector2, Vector3};
 use fabkit_calibration::report::Provenance;
 use fabkit_calibration::tables::Pairs;
 use fabkit_calibration::{
-    read_camera_file_as, solve_pnp, CameraModel, Distortion, DistortionModelHint, ExtrinsicsReport,
+    read_camera_file_as, CameraModel, Distortion, DistortionModelHint, ExtrinsicsReport,
     Intrinsics, PnpOptions, RansacOptions,
 };
 use numpy::ndarray::{Array1, Array2};
@@ -242,10 +242,13 @@ pub(crate) fn rows<const N: usize>(a: &Bound<'_, PyAny>, name: &str) -> PyResult
 /// `residuals_px` (n, 2) (reprojected minus observed, NaN where a point does not project),
 /// `inliers` and `outliers` (n,) bool, `rms_reprojection_error_px`, and `report`: the dict
 /// `extrinsics.json` holds (rvec, tvec, pose uncertainty, per-point residuals by id; ids are
-/// `ids` or the row numbers). Raises CalibrationError with the CLI's message (fewer than 4
+/// `ids` or the row numbers). With `design` (a `Design`), the rays bend by Snell's law at the
+/// design's flat interfaces (its filling gel's free surface, a window's or a plate's faces;
+/// indices from the materials table), as `calibrate extrinsics --design` does, and the report
+/// lists them (`optical_path`). Raises CalibrationError with the CLI's message (fewer than 4
 /// points, a non-finite value, a degenerate layout, too few inliers, ...).
 #[pyfunction]
-#[pyo3(signature = (points_mm, pixels_px, camera, *, ids=None, ransac=true, threshold_px=None, seed=None))]
+#[pyo3(signature = (points_mm, pixels_px, camera, *, ids=None, ransac=true, threshold_px=None, seed=None, design=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn solve_extrinsics<'py>(
     py: Python<'py>,
@@ -256,6 +259,7 @@ pub fn solve_extrinsics<'py>(
     ransac: bool,
     threshold_px: Option<f64>,
     seed: Option<u64>,
+    design: Option<PyRef<'py, crate::design::Design>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     if let Some(t) = threshold_px {
         if !(t.is_finite() && t > 0.0) {
@@ -306,8 +310,31 @@ pub fn solve_extrinsics<'py>(
         ..PnpOptions::default()
     };
     let model = &camera.model;
+    let optical_path = match &design {
+        None => None,
+        Some(d) => {
+            let tol =
+                fabkit_designs::ChordTolerance::new(fabkit_designs::ChordTolerance::DEFAULT_MM)
+                    .map_err(|e| CalibrationError::new_err(e.to_string()))?;
+            Some(
+                fabkit_designs::optics::optical_path_of_design(&d.design, tol)
+                    .map_err(|e| CalibrationError::new_err(format!("design: {e}")))?,
+            )
+        }
+    };
+    let layers = optical_path
+        .as_ref()
+        .map(fabkit_calibration::refraction::FlatLayers::from_optical_path)
+        .transpose()
+        .map_err(|e| CalibrationError::new_err(format!("design: {e}")))?;
+    let imaging = fabkit_calibration::refraction::Imaging::new(model, layers.as_ref());
     let sol = crate::work(py, || {
-        solve_pnp(model, &pairs.points_mm, &pairs.pixels_px, &opts)
+        fabkit_calibration::pnp::solve_pnp_through(
+            &imaging,
+            &pairs.points_mm,
+            &pairs.pixels_px,
+            &opts,
+        )
     })?
     .map_err(|e| err::<CalibrationError>(&e))?;
     let provenance = Provenance {
@@ -321,12 +348,39 @@ pub fn solve_extrinsics<'py>(
         unobserved_ids: Vec::new(),
         reference_image: None,
     };
-    let report = ExtrinsicsReport::new(
-        &fabkit_calibration::refraction::Imaging::straight(model),
-        &pairs,
-        &sol,
-        provenance,
-    );
+    // pins left out: the models that might explain them compared first, as the CLI does
+    let mut compared = crate::work(py, || {
+        fabkit_calibration::models::compare_if_rejected(
+            model,
+            layers.as_ref(),
+            optical_path.as_ref(),
+            &pairs.points_mm,
+            &pairs.pixels_px,
+            &sol,
+        )
+    })?;
+    let (sol, layers, path_fit) = match compared.as_mut().and_then(|c| c.taken.take()) {
+        Some((fit, every)) => {
+            let what = optical_path
+                .as_ref()
+                .and_then(fabkit_calibration::models::gel_prior)
+                .map_or(String::new(), |g| g.1);
+            let report = fabkit_calibration::report::PlaneFitReport::new(&fit, &what);
+            (every, Some(fit.layers), Some(report))
+        }
+        None => (sol, layers, None),
+    };
+    let imaging = fabkit_calibration::refraction::Imaging::new(model, layers.as_ref());
+    let mut report = ExtrinsicsReport::new(&imaging, &pairs, &sol, provenance);
+    if let (Some(path), Some(d)) = (optical_path, &design) {
+        report.optical_path = Some(path);
+        report.optical_path_from = Some(format!("design {} ({})", d.design.name, d.source));
+    }
+    report.optical_path_fit = path_fit;
+    if let Some(c) = compared {
+        report.warnings.extend(c.warning);
+        report.model_comparison = Some(c.report);
+    }
     let report: serde_json::Value = serde_json::from_str(&report.to_json())
         .map_err(|e| CalibrationError::new_err(e.to_string()))?;
     let h = sol.t_cam_sensor.to_homogeneous();

@@ -293,3 +293,31 @@ def test_a_missing_camera_file_is_the_cli_message(tmp_path, run_cli, camera):
     with pytest.raises(fabkit.CalibrationError) as e:
         fabkit.solve_extrinsics(points, pixels, "/nonexistent.yaml")
     assert str(e.value) == expected
+
+
+def test_solve_extrinsics_through_a_designs_gel_equals_the_cli(tmp_path, run_cli, camera):
+    """With ``design``, the rays bend at the design's filling gel surface as ``calibrate
+    extrinsics --design`` bends them: the same pose, to the bit, and the report lists the
+    optical path; without it, the same pixels put the camera elsewhere (straight rays)."""
+    design = fabkit.Design.load("rtac0")
+    # the CLI's pose through R-Tac0's gel from pixels made by straight projection at a pose
+    # 17.4 mm under the dome's centre, under the gel's surface (z = -9 mm)
+    t = pose(tvec=[-0.4, 0.3, 17.4])
+    points = pins()
+    pixels = observe(camera, t=t)
+    write_inputs(tmp_path, points, pixels)
+    run_cli(tmp_path, "calibrate", "extrinsics", "--camera", "cam.yaml", "--points", "pts.csv",
+            "--observations", "obs.csv", "--design", "rtac0", "--out", "out")
+    j = json.loads((tmp_path / "out" / "extrinsics.json").read_text())
+    ids = [str(i) for i in range(len(points))]
+    r = fabkit.solve_extrinsics(points, pixels, fabkit.Camera.from_file(tmp_path / "cam.yaml"),
+                                ids=ids, design=design)
+    np.testing.assert_array_equal(r["T_cam_sensor"], np.array(j["T_cam_sensor"]))
+    assert r["report"]["optical_path"] == j["optical_path"]
+    assert [p["z_mm"] for p in j["optical_path"]["planes"]] == [-9.0]
+    assert r["report"]["optical_path_from"] == "design rtac0 (embedded:rtac0)"
+    straight = fabkit.solve_extrinsics(points, pixels, camera, ids=ids)
+    assert "optical_path" not in straight["report"]
+    # straight pixels read through the gel: the camera comes out at another distance
+    # (measured 5.7 mm; through the gel the straight pixels leave 0.53 px RMS)
+    assert max_pose_error_mm(r["T_cam_sensor"], straight["T_cam_sensor"], points) > 0.5
