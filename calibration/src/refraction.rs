@@ -149,14 +149,15 @@ impl FlatLayers {
         if !(h.norm() > 0.0) || !h.iter().all(|v| v.is_finite()) {
             return None;
         }
-        let runs: Vec<(f64, f64)> = self.runs(from.z, to.z).collect();
+        // the media's runs, walked afresh at each use (no allocation per projection)
+        let runs = || self.runs(from.z, to.z);
         let n_from = self.index_at(from.z);
-        if runs.is_empty() || run == 0.0 || runs.iter().all(|&(_, n)| n == n_from) {
+        if runs().next().is_none() || run == 0.0 || runs().all(|(_, n)| n == n_from) {
             return Some(h / h.norm());
         }
-        let n_min = runs.iter().map(|&(_, n)| n).fold(f64::INFINITY, f64::min);
+        let n_min = runs().map(|(_, n)| n).fold(f64::INFINITY, f64::min);
         let f = |s: f64| {
-            runs.iter().fold((-run, 0.0), |(v, d), &(t, n)| {
+            runs().fold((-run, 0.0), |(v, d), (t, n)| {
                 let c2 = n * n - s * s;
                 (v + t * s / c2.sqrt(), d + t * n * n / (c2 * c2.sqrt()))
             })

@@ -113,7 +113,16 @@ pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
     // the pin dome of this design, as groundtruth --pin-captures checks it
     fabkit_calibration::groundtruth::pins::check_made_for(&a.fixtures, &design.name)?;
     let pose_name = a.extrinsics.display().to_string();
-    let Scene { surface, rays } = Scene::new(design, &camera, &t_cam_sensor, &pose_name)?;
+    // the rays bend where the pose was solved through an optical path, as groundtruth bends
+    // them: the model's shading registers with the captures
+    let optical_path = fabkit_calibration::groundtruth::inputs::read_optical_path(&a.extrinsics)?;
+    let Scene { surface, rays } = Scene::through(
+        design,
+        &camera,
+        &t_cam_sensor,
+        &pose_name,
+        optical_path.as_ref().map(|(l, _)| l),
+    )?;
     // and of its skin, whatever the design's name (issue 95: R-Tac0's dome fitted to R15.3)
     fabkit_calibration::groundtruth::pins::check_on_skin(&a.fixtures, &pins, &surface)?;
     let reference = reference_hits(&rays, &surface);

@@ -207,6 +207,9 @@ pub struct DepthRenderer {
     /// The imaging of `image`, set up on its first call (the optics resolved, the exposure set
     /// on the reference).
     imaging: std::sync::OnceLock<Result<Imaging, String>>,
+    /// The optical path the extrinsics.json's pose was solved through, as the manifest lists
+    /// it; `None`: straight rays.
+    optical_path: Option<serde_json::Value>,
 }
 
 /// An (H, W, 3) RGB image as a numpy array: uint16 at 16 bits, else uint8.
@@ -325,16 +328,32 @@ impl DepthRenderer {
     }
 }
 
+/// The optical path an extrinsics.json holds (its layers, and the planes as the manifest lists
+/// them), when the pose was solved through one.
+type OpticalPathOf = Option<(
+    fabkit_calibration::refraction::FlatLayers,
+    serde_json::Value,
+)>;
+
 /// T_cam_sensor from a (4, 4) array (`<array>`, no file) or the path of an extrinsics.json of
-/// `fabkit calibrate extrinsics` (with its sha256).
+/// `fabkit calibrate extrinsics` (with its sha256 and the optical path it was solved through).
 fn pose_of(
     py: Python<'_>,
     t: &Bound<'_, PyAny>,
-) -> PyResult<(nalgebra::Isometry3<f64>, String, Option<String>)> {
+) -> PyResult<(
+    nalgebra::Isometry3<f64>,
+    String,
+    Option<String>,
+    OpticalPathOf,
+)> {
     if let Ok(path) = t.extract::<std::path::PathBuf>() {
         let (pose, sha) =
             crate::work(py, || read_extrinsics(&path))?.map_err(|e| err::<GroundTruthError>(&e))?;
-        return Ok((pose, path.display().to_string(), Some(sha)));
+        let optical = crate::work(py, || {
+            fabkit_calibration::groundtruth::inputs::read_optical_path(&path)
+        })?
+        .map_err(|e| err::<GroundTruthError>(&e))?;
+        return Ok((pose, path.display().to_string(), Some(sha), optical));
     }
     let t = crate::calibration::float64_array(t, "T_cam_sensor")?;
     if t.shape() != [4, 4] {
@@ -349,7 +368,7 @@ fn pose_of(
     let pose = isometry_of(&m).map_err(|(field, value, rule)| {
         GroundTruthError::new_err(format!("{field} = {value}: {rule}"))
     })?;
-    Ok((pose, "<array>".into(), None))
+    Ok((pose, "<array>".into(), None, None))
 }
 
 #[pymethods]
@@ -365,7 +384,7 @@ impl DepthRenderer {
         max_pixels: u64,
     ) -> PyResult<DepthRenderer> {
         let camera = Camera::of(camera)?;
-        let (pose, extrinsics_file, extrinsics_sha256) = pose_of(py, T_cam_sensor)?;
+        let (pose, extrinsics_file, extrinsics_sha256, optical) = pose_of(py, T_cam_sensor)?;
         if !(1..=MAX_PIXELS_LIMIT).contains(&max_pixels) {
             return Err(PyValueError::new_err(format!(
                 "max_pixels = {max_pixels}: must be from 1 to {MAX_PIXELS_LIMIT} (2048 x 2048, what the render's memory budget of {} GiB holds)",
@@ -401,7 +420,15 @@ impl DepthRenderer {
         let design = &design.design;
         let model = &camera.model;
         crate::work(py, || {
-            let scene = Scene::new(design, model, &pose, "T_cam_sensor")?;
+            // the rays bend where the pose was solved through an optical path, as `fabkit
+            // groundtruth` bends them
+            let scene = Scene::through(
+                design,
+                model,
+                &pose,
+                "T_cam_sensor",
+                optical.as_ref().map(|(l, _)| l),
+            )?;
             let hits = reference_hits(&scene.rays, &scene.surface);
             let needed = min_skin_pixels(pixels);
             if (hits.valid_count() as u64) < needed {
@@ -433,6 +460,7 @@ impl DepthRenderer {
                 design: design.clone(),
                 principal_px: [i.cx_px, i.cy_px],
                 imaging: std::sync::OnceLock::new(),
+                optical_path: optical.map(|(_, v)| v),
             })
         })?
         .map_err(|e: String| GroundTruthError::new_err(e))
@@ -737,7 +765,7 @@ impl DepthRenderer {
                     camera_centre_mm: rays.origin_mm,
                     fixtures: &fixture_set,
                     pixels_on_surface: self.reference_hits.valid_count(),
-                    optical_path: None,
+                    optical_path: self.optical_path.as_ref(),
                     imaging: imaging.as_ref(),
                 },
                 &|k| report_progress(&progress, k as usize, frames as usize, "groundtruth"),
