@@ -547,3 +547,30 @@ fn a_capture_without_a_pin_shaped_spot_is_left_out_saying_why() {
     let why = a.captures[0].left_out.as_deref().unwrap();
     assert_eq!(why, "pin 7 is planned but not in the point table");
 }
+
+/// A real imprint (tests/data/9dtact_sensor1: a 4 mm ball pressed into a 9DTact's gel, its
+/// unloaded reference beside it): the detector finds one spot, centred within 0.5 px of an
+/// independent estimate of the imprint's core, the difference (reference minus capture, grey,
+/// 5 x 5 box-smoothed) weighted above half its peak: (341.55, 255.72) px, computed with numpy
+/// (the same estimate above 30 % and 70 % of the peak: 341.4 to 341.6, 255.4 to 255.9).
+/// Measured (341.7, 255.9) px, 0.24 px away.
+#[test]
+fn a_real_ball_imprint_is_found_once_at_its_core() {
+    use fabkit_calibration::imprints::GrayImage;
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../tests/data/9dtact_sensor1/depth_calibration");
+    let load = |name: &str| {
+        let i = image::open(dir.join(name)).unwrap().into_luma8();
+        GrayImage {
+            width: i.width() as usize,
+            height: i.height() as usize,
+            data: i.into_raw().into_iter().map(f32::from).collect(),
+        }
+    };
+    let (reference, capture) = (load("ref.png"), load("sample.png"));
+    let mask = reference_mask(&reference, 255.0, 4);
+    let spots = detect(&reference, &capture, Some(&mask), &DetectParams::default()).unwrap();
+    assert_eq!(spots.len(), 1, "{spots:?}");
+    let e = (spots[0].u_px - 341.55).hypot(spots[0].v_px - 255.72);
+    assert!(e < 0.5, "{:?}: {e:.2} px off", spots[0]);
+}
