@@ -18,7 +18,7 @@
 //! the user's call), a warning says so and suggests `--refine-intrinsics`; otherwise RANSAC's
 //! rejection stands, and the report says the models were compared.
 
-use nalgebra::{Isometry3, Vector2, Vector3};
+use nalgebra::{Vector2, Vector3};
 use serde::Serialize;
 
 use crate::pnp::{solve_pnp_through, PnpOptions, PnpSolution};
@@ -92,7 +92,8 @@ fn score(model: &str, p: usize, sol: &PnpSolution, threshold: f64) -> Option<Mod
 
 /// Compares the models of the module docs over every pair (`points_mm`, `pixels_px`), RANSAC
 /// having left some out at `threshold_px`. `layers` is the optical path as given, `gel` the
-/// prior of its filling gel's surface when it has one. `None` when even the model as given
+/// prior of its filling gel's surface when it has one. Each model starts from the pose of the
+/// model as given over every pin. `None` when even the model as given
 /// cannot be fitted to every pin (a pin that does not project).
 pub fn compare(
     camera: &CameraModel,
@@ -100,7 +101,6 @@ pub fn compare(
     gel: Option<PlanePrior>,
     points_mm: &[Vector3<f64>],
     pixels_px: &[Vector2<f64>],
-    start: &Isometry3<f64>,
     threshold_px: f64,
 ) -> Option<Compared> {
     let given = Imaging::new(camera, layers);
@@ -112,18 +112,7 @@ pub fn compare(
     let mut models = vec![score("as given", 6, &all, threshold_px)?];
     let mut plane: Option<(PlaneFit, PnpSolution)> = None;
     if let (Some(l), Some(prior)) = (layers, gel) {
-        let from = if all
-            .t_cam_sensor
-            .translation
-            .vector
-            .iter()
-            .all(|v| v.is_finite())
-        {
-            all.t_cam_sensor
-        } else {
-            *start
-        };
-        if let Some(fit) = refine_plane(camera, l, prior, points_mm, pixels_px, &from) {
+        if let Some(fit) = refine_plane(camera, l, prior, points_mm, pixels_px, &all.t_cam_sensor) {
             let sol = solution_at(
                 &Imaging::new(camera, Some(&fit.layers)),
                 points_mm,
@@ -221,15 +210,7 @@ pub fn compare_if_rejected(
         return None;
     }
     let gel = path.and_then(gel_prior).map(|g| g.0);
-    compare(
-        camera,
-        layers,
-        gel,
-        points_mm,
-        pixels_px,
-        &sol.t_cam_sensor,
-        threshold,
-    )
+    compare(camera, layers, gel, points_mm, pixels_px, threshold)
 }
 
 /// `model BIC b (RMS r px)` for each model.

@@ -418,23 +418,7 @@ fn the_model_that_explains_every_pin_is_chosen_before_pins_are_rejected() {
         height_sd_mm: 3.0,
         index_sd: SILICONE_INDEX_SD,
     };
-    let s = solve_pnp_through(
-        &Imaging::new(&cam, Some(&design)),
-        &pts,
-        &px,
-        &PnpOptions::default(),
-    )
-    .unwrap();
-    let c = compare(
-        &cam,
-        Some(&design),
-        Some(prior),
-        &pts,
-        &px,
-        &s.t_cam_sensor,
-        0.5,
-    )
-    .unwrap();
+    let c = compare(&cam, Some(&design), Some(prior), &pts, &px, 0.5).unwrap();
     let m = |name: &str| c.report.models.iter().find(|m| m.model == name).unwrap();
     assert!(!m("as given").explains_every_pin);
     assert!(m("gel surface refined").explains_every_pin);
