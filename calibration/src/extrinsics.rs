@@ -16,7 +16,7 @@ use crate::pnp::{solve_pnp_through, PnpError, PnpOptions, RansacOptions};
 use crate::refine::{
     refine_intrinsics_keeping, solution_at, RefineError, RefineParameters, RefinementReport,
 };
-use crate::refraction::{refine_plane, FlatLayers, Imaging, PlanePrior};
+use crate::refraction::{refine_plane, Imaging, OpticalLayers, PlanePrior};
 use crate::report::{CaptureReport, ExtrinsicsReport, PlaneFitReport, Provenance};
 use crate::tables::{
     check_inside_image, pair, read_capture_plan, read_captures, read_observations,
@@ -141,7 +141,7 @@ pub fn calibrate_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsOutput, Ext
     let layers = job
         .optical_path
         .as_ref()
-        .map(FlatLayers::from_optical_path)
+        .map(OpticalLayers::from_optical_path)
         .transpose()
         .map_err(|e| ExtrinsicsError::OpticalPath(e.to_string()))?;
 

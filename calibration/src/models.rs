@@ -23,7 +23,7 @@ use serde::Serialize;
 
 use crate::pnp::{solve_pnp_through, PnpOptions, PnpSolution};
 use crate::refine::{refine_intrinsics_keeping, solution_at, RefineParameters};
-use crate::refraction::{refine_plane, FlatLayers, Imaging, PlaneFit, PlanePrior};
+use crate::refraction::{refine_plane, Imaging, OpticalLayers, PlaneFit, PlanePrior};
 use crate::CameraModel;
 
 /// One model fitted to every pin.
@@ -97,7 +97,7 @@ fn score(model: &str, p: usize, sol: &PnpSolution, threshold: f64) -> Option<Mod
 /// cannot be fitted to every pin (a pin that does not project).
 pub fn compare(
     camera: &CameraModel,
-    layers: Option<&FlatLayers>,
+    layers: Option<&OpticalLayers>,
     gel: Option<PlanePrior>,
     points_mm: &[Vector3<f64>],
     pixels_px: &[Vector2<f64>],
@@ -199,7 +199,7 @@ pub fn gel_prior(path: &fabkit_designs::optics::OpticalPath) -> Option<(PlanePri
 /// surface of `path` when it has one.
 pub fn compare_if_rejected(
     camera: &CameraModel,
-    layers: Option<&FlatLayers>,
+    layers: Option<&OpticalLayers>,
     path: Option<&fabkit_designs::optics::OpticalPath>,
     points_mm: &[Vector3<f64>],
     pixels_px: &[Vector2<f64>],

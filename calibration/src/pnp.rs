@@ -347,6 +347,23 @@ fn solve_in_order(
         camera.admissible_start(&start.rotation, &start.translation_mm),
     )
     .ok_or(PnpError::NoSolution)?;
+    // Through an optical path the apparent points are exact on the axis only: far off it (a
+    // glass core's faces) the closed-form start misses the outer pins by pixels. The start
+    // refined through the path on every pair replaces it when that lowers the median
+    // reprojection error, so that the threshold and the first consensus are taken where the
+    // path's model holds.
+    if camera.layers.is_some() {
+        let median = |f: &Fit| {
+            let mut e: Vec<f64> = f.residuals.iter().map(|r| r.norm()).collect();
+            e.sort_by(f64::total_cmp);
+            e[e.len() / 2]
+        };
+        let mut refined = fit.clone();
+        refined.refine(camera, points_mm, pixels_px, opts.max_iterations);
+        if median(&refined) < median(&fit) {
+            fit = refined;
+        }
+    }
     let mut hypotheses = 0;
     let mut inliers = vec![true; n];
     let mut threshold_used = None;

@@ -28,7 +28,7 @@ use nalgebra::{
 
 use crate::camera::{CameraModel, Distortion, Intrinsics};
 use crate::pnp::PnpSolution;
-use crate::refraction::{FlatLayers, Imaging};
+use crate::refraction::{Imaging, OpticalLayers};
 
 /// Largest condition number of the column-scaled Jacobian (pose and free intrinsics) that is
 /// refined; a parameter beyond it is not constrained by the captures.
@@ -163,7 +163,7 @@ struct Problem<'a> {
     points: &'a [Vector3<f64>],
     pixels: &'a [Vector2<f64>],
     /// The optical path in front of the lens ([`crate::refraction`]); `None`: straight rays.
-    layers: Option<&'a FlatLayers>,
+    layers: Option<&'a OpticalLayers>,
     /// Points that must keep projecting (the pins the fit leaves out but that project at the
     /// start: a refined model must not fold the image back before them).
     keep: &'a [Vector3<f64>],
@@ -381,7 +381,7 @@ pub fn refine_intrinsics(
 /// As [`refine_intrinsics`].
 pub fn refine_intrinsics_through(
     camera: &CameraModel,
-    layers: Option<&FlatLayers>,
+    layers: Option<&OpticalLayers>,
     points_mm: &[Vector3<f64>],
     pixels_px: &[Vector2<f64>],
     t_cam_sensor: &Isometry3<f64>,
@@ -409,7 +409,7 @@ pub fn refine_intrinsics_through(
 /// As [`refine_intrinsics`].
 pub fn refine_intrinsics_keeping(
     camera: &CameraModel,
-    layers: Option<&FlatLayers>,
+    layers: Option<&OpticalLayers>,
     points_mm: &[Vector3<f64>],
     pixels_px: &[Vector2<f64>],
     t_cam_sensor: &Isometry3<f64>,

@@ -564,20 +564,143 @@ pub struct PathPlane {
     pub index_source: String,
 }
 
-/// The flat optical path of a design from the camera up: air under the lowest plane (where the
-/// camera sits), then each plane with the medium above it, increasing in z. Curved interfaces
-/// (a glass core's faces, cast layers on a dome) are not in it: their bending is small where
-/// the indices on both sides are close (1.41 silicones, 1.47 glass) and is not modelled.
+/// One curved interface of a design's [`OpticalPath`]: a face of the core or of a cast layer
+/// on a spherical body, coaxial with the sensor's z axis: the sphere of `radius_mm` centred on
+/// the axis at `centre_z_mm`, above `join_z_mm`, and below it the cylinder of the sphere's
+/// section there down to `bottom_z_mm` (a test tube's hemisphere on its cylinder: join at the
+/// centre). Resolved against the materials table.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PathShell {
+    pub radius_mm: f64,
+    pub centre_z_mm: f64,
+    pub join_z_mm: f64,
+    pub bottom_z_mm: f64,
+    /// Where the medium outside begins, mm: the core's open end for its inner face, the base
+    /// plane for the faces of the layers cast above it (below it is the housing's seat).
+    pub outside_bottom_z_mm: f64,
+    /// What the face is, naming its parameters (`core: the inner face`).
+    pub what: String,
+    /// The medium outside it: a material key.
+    pub outside: String,
+    /// The refractive index outside it (n_D).
+    pub index_outside: f64,
+    /// Where that index comes from (the materials table's source).
+    pub index_source: String,
+}
+
+/// The optical path of a design from the camera up: air under the lowest plane (where the
+/// camera sits), then each plane with the medium above it, increasing in z; then, inside the
+/// medium above the last plane, the curved faces of a spherical core and of the clear layers
+/// cast on it, innermost first, up to the first layer the camera cannot see through (no
+/// refractive index: the coat it images). Not in it: the faces of a half-ellipsoidal core
+/// (UVDtact's acrylic shell), which are not spheres.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct OpticalPath {
     pub planes: Vec<PathPlane>,
+    /// The curved faces (empty without a spherical core); left out of JSON when empty.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub shells: Vec<PathShell>,
 }
 
-/// The design's flat optical path ([`OpticalPath`]): its families' flat interfaces
+/// The index and its source of the medium `key` (a material key or [`AIR`]); `None` for a
+/// material without a refractive index (an opaque one) or not in the table.
+fn index_of(key: &str, materials: &crate::materials::MaterialsTable) -> Option<(f64, String)> {
+    if key == AIR {
+        return Some((
+            1.0,
+            "air, n = 1.000 (1.0003 at 589 nm, taken as 1)".to_string(),
+        ));
+    }
+    materials
+        .get(key)
+        .and_then(|m| m.refractive_index.as_ref())
+        .map(|r| (r.n, r.source.clone()))
+}
+
+/// The curved faces of the design's optical path ([`OpticalPath::shells`]): the core's inner
+/// and outer faces and the outer face of each cast layer on it, while the medium outside is
+/// clear (has a refractive index), for a body whose offsets are spheres (a hemisphere on a
+/// cylinder, a spherical cap); none without a core or when the core is not clear. The core
+/// reaches `below_base_mm` under the base plane; the layers end at it.
+pub fn curved_interfaces(
+    design: &Design,
+    stack: &Stack,
+    materials: &crate::materials::MaterialsTable,
+) -> Vec<PathShell> {
+    let (Some(core), Some(core_params), Some(r_body)) =
+        (&stack.core, &design.core, design.body.sphere_radius_mm())
+    else {
+        return Vec::new();
+    };
+    let base = design.body.base_z_mm();
+    let join = base.max(0.0);
+    let shell = |offset: f64, bottom: f64, outside_bottom: f64, outside: &str, what: String| {
+        index_of(outside, materials).map(|(n, source)| PathShell {
+            radius_mm: r_body + offset,
+            centre_z_mm: 0.0,
+            join_z_mm: join,
+            bottom_z_mm: bottom,
+            outside_bottom_z_mm: outside_bottom,
+            what,
+            outside: outside.to_string(),
+            index_outside: n,
+            index_source: source,
+        })
+    };
+    let core_bottom = base - core.below_base_mm;
+    let mut out = Vec::new();
+    let Some(inner) = shell(
+        core.inner_offset_mm,
+        core_bottom,
+        core_bottom,
+        &core_params.material,
+        "core: the core's inner face".into(),
+    ) else {
+        return out;
+    };
+    out.push(inner);
+    // outside the core: the first layer when it is cast on the core, else air
+    let first = stack
+        .layers
+        .first()
+        .filter(|l| (l.inner_offset_mm - core.outer_offset_mm).abs() < 1e-9);
+    let outside = first.map_or(AIR, |l| l.material.as_str());
+    match shell(
+        core.outer_offset_mm,
+        core_bottom,
+        base,
+        outside,
+        "core: the core's outer face".into(),
+    ) {
+        Some(s) => out.push(s),
+        None => return out,
+    }
+    if first.is_none() {
+        return out;
+    }
+    for (k, w) in stack.layers.windows(2).enumerate() {
+        if (w[1].inner_offset_mm - w[0].outer_offset_mm).abs() > 1e-9 {
+            break;
+        }
+        match shell(
+            w[0].outer_offset_mm,
+            base,
+            base,
+            &w[1].material,
+            format!("layers[{k}]: the outer face of {}", w[0].name),
+        ) {
+            Some(s) => out.push(s),
+            None => break,
+        }
+    }
+    out
+}
+
+/// The design's optical path ([`OpticalPath`]): its families' flat interfaces
 /// ([`crate::parts::family::Family::flat_interfaces`]) and the backing plate's faces (air
 /// under it; above it the skin's innermost layer when that is solid, else air), sorted by
-/// height, each
-/// medium's index from `materials`.
+/// height, each medium's index from `materials`; then the curved faces of a spherical core
+/// and its clear layers ([`curved_interfaces`]).
 ///
 /// # Errors
 /// The parameter path of a medium whose material is not in the table or has no
@@ -631,21 +754,13 @@ pub fn optical_path(
     let planes = planes
         .into_iter()
         .map(|p| {
-            let (n, source) = if p.above == AIR {
-                (1.0, "air, n = 1.000 (1.0003 at 589 nm, taken as 1)".to_string())
-            } else {
-                let r = materials
-                    .get(&p.above)
-                    .and_then(|m| m.refractive_index.as_ref())
-                    .ok_or_else(|| {
-                        ParamError::new(
-                            p.what.split(':').next().unwrap_or("optics"),
-                            &p.above,
-                            "the camera looks through this material: it needs a refractive_index in the materials table",
-                        )
-                    })?;
-                (r.n, r.source.clone())
-            };
+            let (n, source) = index_of(&p.above, materials).ok_or_else(|| {
+                ParamError::new(
+                    p.what.split(':').next().unwrap_or("optics"),
+                    &p.above,
+                    "the camera looks through this material: it needs a refractive_index in the materials table",
+                )
+            })?;
             Ok(PathPlane {
                 z_mm: p.z_mm,
                 what: p.what,
@@ -655,5 +770,8 @@ pub fn optical_path(
             })
         })
         .collect::<Result<Vec<_>, ParamError>>()?;
-    Ok(OpticalPath { planes })
+    Ok(OpticalPath {
+        planes,
+        shells: curved_interfaces(design, stack, materials),
+    })
 }

@@ -404,9 +404,12 @@ enum TableDesign {
 
 /// The names of the planes of `path` without their parameter paths.
 fn plane_names(path: &fabkit_designs::optics::OpticalPath) -> Vec<&str> {
-    path.planes
+    let what = path
+        .planes
         .iter()
-        .map(|p| p.what.split_once(": ").map_or(p.what.as_str(), |(_, w)| w))
+        .map(|p| p.what.as_str())
+        .chain(path.shells.iter().map(|s| s.what.as_str()));
+    what.map(|w| w.split_once(": ").map_or(w, |(_, w)| w))
         .collect()
 }
 
@@ -446,7 +449,7 @@ fn table_design(points: &std::path::Path, data: &crate::cli::DataFileArgs) -> Ta
     let Ok(path) = fabkit_designs::optics::optical_path_of_design(&loaded.design, tol) else {
         return TableDesign::Unknown;
     };
-    if path.planes.is_empty() {
+    if path.planes.is_empty() && path.shells.is_empty() {
         return TableDesign::Unknown;
     }
     let planes = plane_names(&path).join("; ");

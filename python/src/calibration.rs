@@ -324,7 +324,7 @@ pub fn solve_extrinsics<'py>(
     };
     let layers = optical_path
         .as_ref()
-        .map(fabkit_calibration::refraction::FlatLayers::from_optical_path)
+        .map(fabkit_calibration::refraction::OpticalLayers::from_optical_path)
         .transpose()
         .map_err(|e| CalibrationError::new_err(format!("design: {e}")))?;
     let imaging = fabkit_calibration::refraction::Imaging::new(model, layers.as_ref());

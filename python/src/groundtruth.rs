@@ -331,7 +331,7 @@ impl DepthRenderer {
 /// The optical path an extrinsics.json holds (its layers, and the planes as the manifest lists
 /// them), when the pose was solved through one.
 type OpticalPathOf = Option<(
-    fabkit_calibration::refraction::FlatLayers,
+    fabkit_calibration::refraction::OpticalLayers,
     serde_json::Value,
 )>;
 

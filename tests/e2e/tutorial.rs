@@ -6,9 +6,9 @@
 //! tutorial writes has its markers, the calibration recovers the pose, the ground truth and
 //! the sweep are complete.
 
-use crate::calibrate_cli::{intrinsics, write_plan_observations};
+use crate::calibrate_cli::{intrinsics, write_plan_observations_at};
 use crate::common::{design_schema_path, repo_root, schema_check, text};
-use fabkit_calibration::nalgebra::Isometry3;
+use fabkit_calibration::nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use fabkit_calibration::tables::{read_capture_plan, read_point_table, PointsFrom};
 use fabkit_calibration::{write_camera, CameraFileFormat};
 use std::path::Path;
@@ -43,7 +43,11 @@ fn steps(markdown: &str) -> Vec<Step> {
 
 /// The camera file and one observation file per capture of the plan (`capture_<k>.csv`,
 /// `id,u_px,v_px`): the pins' tips seen at a known pose through the tutorial design's filling
-/// gel, with +-0.3 px of alternating noise. Returns the pose.
+/// gel and glass tube, with +-0.3 px of alternating noise. Returns the pose. The camera is 6 mm
+/// under the gel's free surface (z = -15 mm), from where the default dome's outer ring (polar
+/// 84.8 deg) is in view through the tube's mouth; from R-Tac0's measured 8.4 mm
+/// ([`crate::calibrate_cli::truth_under_gel`]) the view ends at about 83 deg and that ring is
+/// hidden (docs/src/guide/fixtures.md).
 fn write_lab_inputs(dir: &Path) -> Isometry3<f64> {
     let points = dir.join("out/my_sensor_fixtures/points");
     assert!(
@@ -58,7 +62,10 @@ fn write_lab_inputs(dir: &Path) -> Isometry3<f64> {
     let table = read_point_table(&points.join("point_table.csv"), PointsFrom::Tip).unwrap();
     let plan = read_capture_plan(&points.join("capture_plan.csv")).unwrap();
     let design = dir.join("my_sensor.yaml");
-    write_plan_observations(dir, &table, &plan, design.to_str().unwrap()).1
+    let rot = UnitQuaternion::from_scaled_axis(Vector3::new(0.02, -0.015, 0.4));
+    let centre = Vector3::new(0.3, -0.2, -15.0);
+    let pose = Isometry3::from_parts(Translation3::from(-(rot * centre)), rot);
+    write_plan_observations_at(dir, &table, &plan, design.to_str().unwrap(), pose).1
 }
 
 fn json(path: &Path) -> serde_json::Value {
@@ -154,10 +161,22 @@ fn the_tutorial_runs_as_written() {
         e["optical_path_from"]
     );
     let t = truth.unwrap().to_homogeneous();
+    let most = |col3: bool| {
+        m.iter()
+            .enumerate()
+            .filter(|(i, _)| (i % 4 == 3) == col3)
+            .map(|(i, v)| (v - t[(i / 4, i % 4)]).abs())
+            .fold(0.0, f64::max)
+    };
+    eprintln!(
+        "T_cam_sensor off by up to {:.5} (rotation) and {:.4} mm",
+        most(false),
+        most(true)
+    );
     for (i, v) in m.iter().enumerate() {
         let want = t[(i / 4, i % 4)];
         let bound = if i % 4 == 3 { 0.05 } else { 0.002 };
-        // measured up to 0.0031 mm and 0.00033
+        // measured up to 0.0010 mm and 0.00039 (camera 6 mm under the gel surface)
         assert!(
             (v - want).abs() < bound,
             "T_cam_sensor[{}][{}] = {v}, want {want}",

@@ -800,9 +800,9 @@ pub fn manifest(inputs: &ManifestInputs<'_>, rendered: &Rendered) -> Value {
     if let Some(path) = inputs.optical_path {
         manifest["optical_path"] = path.clone();
         let c = &mut manifest["conventions"];
-        c["range_mm"] = json!("distance from the camera centre to the surface point, mm (the pixel's ray is bent by Snell's law at each plane of optical_path, so the hit is not on the straight bearing)");
+        c["range_mm"] = json!("distance from the camera centre to the surface point, mm (the pixel's ray is bent by Snell's law at each plane and curved face of optical_path, so the hit is not on the straight bearing)");
         c["zdepth_mm"] = json!("z of the surface point in the camera frame, mm");
-        c["not_modelled"] = json!("refraction at curved interfaces (a glass core's faces, the cast layers on a dome; optical_path holds the flat ones); the skin's deformation around a protrusion (the indented surface is the skin minus the protrusion solids)");
+        c["not_modelled"] = json!("refraction at faces that are not planes or spheres on cylinders (a half-ellipsoidal core); the clear layers' faces moving under a protrusion (they bend the rays where the design puts them); the skin's deformation around a protrusion (the indented surface is the skin minus the protrusion solids)");
     }
     if let Some(ImageSource::Photometric(_, dir, sha)) = imaging {
         manifest["images"] = json!({
@@ -852,7 +852,7 @@ pub fn manifest(inputs: &ManifestInputs<'_>, rendered: &Rendered) -> Value {
 /// The first clause of [`IMAGES_NOT_MODELLED`], for straight rays.
 const IMAGES_REFRACTION: &str = "refraction through the clear layers between the camera and the reflective surface (rays are straight from the camera centre)";
 /// ... and in its place when the camera's rays are bent at the optical path's planes.
-const IMAGES_REFRACTION_THROUGH_PATH: &str = "refraction at curved interfaces (the camera's rays bend at the flat planes of optical_path only), and of the light: the LEDs' rays to the skin are straight, without Fresnel losses at the planes";
+const IMAGES_REFRACTION_THROUGH_PATH: &str = "refraction of the light (the camera's rays bend at the planes and curved faces of optical_path; the LEDs' rays to the skin are straight, without Fresnel losses at them)";
 
 /// Default bound on a dataset's bytes, refused above it unless asked for (`--max-output-bytes`,
 /// `max_output_bytes=`): 1 GB.

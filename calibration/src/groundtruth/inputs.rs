@@ -147,15 +147,16 @@ pub fn read_extrinsics(path: &Path) -> Result<(Isometry3<f64>, String), InputErr
 
 /// The optical path an extrinsics file was solved through (`optical_path` of `fabkit calibrate
 /// extrinsics --design`, its gel surface as `optical_path_fit` refined it): the layers, air
-/// under the lowest plane, and the planes as used (z_mm, index_above, what) for a manifest.
+/// under the lowest plane, then its curved faces (`optical_path.shells`), and the planes and
+/// faces as used (z_mm, index_above, what; the shells' fields) for a manifest.
 /// `None` when the file has none (straight rays).
 ///
 /// # Errors
 /// [`InputError`] naming the file and the field of a plane that is not a number or of layers
-/// that are not valid ([`crate::refraction::FlatLayers::new`]).
+/// that are not valid ([`crate::refraction::OpticalLayers::new`]).
 pub fn read_optical_path(
     path: &Path,
-) -> Result<Option<(crate::refraction::FlatLayers, serde_json::Value)>, InputError> {
+) -> Result<Option<(crate::refraction::OpticalLayers, serde_json::Value)>, InputError> {
     let (bytes, _) = read_with_hash(path)?;
     let v: serde_json::Value = json(&bytes, path)?;
     let Some(planes) = v.get("optical_path").and_then(|p| p.get("planes")) else {
@@ -192,14 +193,65 @@ pub fn read_optical_path(
         }
         used.push((z, n, what.to_string()));
     }
+    let shells_json = v
+        .get("optical_path")
+        .and_then(|p| p.get("shells"))
+        .and_then(serde_json::Value::as_array)
+        .cloned()
+        .unwrap_or_default();
+    let mut shells = Vec::new();
+    for (k, s) in shells_json.iter().enumerate() {
+        let num = |key: &str| {
+            s.get(key)
+                .and_then(serde_json::Value::as_f64)
+                .ok_or_else(|| {
+                    bad(
+                        format!("optical_path.shells[{k}].{key}"),
+                        s.get(key).map_or("missing".into(), |x| x.to_string()),
+                        "must be a number",
+                    )
+                })
+        };
+        shells.push(crate::refraction::Shell {
+            radius_mm: num("radius_mm")?,
+            centre_z_mm: num("centre_z_mm")?,
+            join_z_mm: num("join_z_mm")?,
+            bottom_z_mm: num("bottom_z_mm")?,
+            index_outside: num("index_outside")?,
+            outside_bottom_z_mm: num("outside_bottom_z_mm")?,
+        });
+    }
     let mut indices = vec![1.0];
     indices.extend(used.iter().map(|u| u.1));
-    let layers = crate::refraction::FlatLayers::new(used.iter().map(|u| u.0).collect(), indices)
+    let layers = crate::refraction::OpticalLayers::new(used.iter().map(|u| u.0).collect(), indices)
+        .and_then(|l| l.with_shells(shells))
         .map_err(|e| bad(format!("optical_path.{}", e.field), e.value, e.rule))?;
-    let summary = serde_json::json!({
+    let mut summary = serde_json::json!({
         "from": file,
         "planes": used.iter().map(|(z, n, what)| serde_json::json!({"z_mm": z, "index_above": n, "what": what})).collect::<Vec<_>>(),
     });
+    if !shells_json.is_empty() {
+        summary["shells"] = shells_json
+            .iter()
+            .map(|s| {
+                let mut o = serde_json::Map::new();
+                for key in [
+                    "radius_mm",
+                    "centre_z_mm",
+                    "join_z_mm",
+                    "bottom_z_mm",
+                    "outside_bottom_z_mm",
+                    "index_outside",
+                    "what",
+                ] {
+                    if let Some(x) = s.get(key) {
+                        o.insert(key.into(), x.clone());
+                    }
+                }
+                serde_json::Value::Object(o)
+            })
+            .collect();
+    }
     Ok(Some((layers, summary)))
 }
 

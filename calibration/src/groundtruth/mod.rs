@@ -67,7 +67,7 @@ impl Scene {
         camera: &crate::CameraModel,
         t_cam_sensor: &nalgebra::Isometry3<f64>,
         pose_name: &str,
-        layers: Option<&crate::refraction::FlatLayers>,
+        layers: Option<&crate::refraction::OpticalLayers>,
     ) -> Result<Scene, String> {
         let surface = ReferenceSurface::of(&design.body).ok_or_else(|| {
             format!(

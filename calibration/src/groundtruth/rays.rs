@@ -88,7 +88,7 @@ impl PixelRays {
     pub fn through(
         camera: &CameraModel,
         t_cam_sensor: &Isometry3<f64>,
-        layers: &crate::refraction::FlatLayers,
+        layers: &crate::refraction::OpticalLayers,
     ) -> Result<PixelRays, String> {
         let mut rays = PixelRays::new(camera, t_cam_sensor);
         if layers.planes_z_mm().is_empty() {

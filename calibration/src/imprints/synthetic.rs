@@ -292,7 +292,7 @@ pub fn render(
 pub fn render_through(
     camera: &CameraModel,
     t_cam_sensor: &Isometry3<f64>,
-    layers: Option<&crate::refraction::FlatLayers>,
+    layers: Option<&crate::refraction::OpticalLayers>,
     surface: &ReferenceSurface,
     pins: &[Pin],
     s: &Shading,
@@ -316,11 +316,14 @@ pub fn render_through(
             skin_r = skin_r.max(r * rmax);
         }
     }
-    // LED reflections on a circle at 90 % of the skin's extent in the image
+    // LED reflections on a circle at 90 % of the skin's extent in the image; where a core's
+    // open end bounds the view (the layers have shells), on that edge: the lit diffuser ring
+    // beside the tube's mouth mirrored in the gel's free surface
+    let at_edge = layers.is_some_and(|l| !l.shells().is_empty());
     let leds: Vec<[f64; 2]> = (0..s.leds)
         .map(|k| {
             let a = std::f64::consts::TAU * (k as f64 + 0.5) / s.leds as f64;
-            let r = 0.9 * skin_r.min(cy);
+            let r = if at_edge { 1.0 } else { 0.9 } * skin_r.min(cy);
             [cx + r * a.cos(), cy + r * a.sin()]
         })
         .collect();

@@ -12,4 +12,5 @@ mod photometric;
 mod refine;
 mod refraction;
 mod shading;
+mod shells;
 mod tables;

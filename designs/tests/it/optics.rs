@@ -297,3 +297,62 @@ fn each_sensor_gives_its_flat_optical_path() {
         "{e}"
     );
 }
+
+/// R-Tac0's curved faces from the camera's side (rtac0.yaml): the tube's inner face R9 (glass,
+/// 1.473) and outer face R10 (Sylgard, 1.41) down to its open end at -6 - 3 = -9 mm, the
+/// Sylgard's outer face R13.5 (Ecoflex, 1.41, assumed) down to the base plane at -6 mm, all
+/// a hemisphere on the axis at z = 0 on a cylinder; the Ecoflex's outer face is not one (the
+/// black coat outside it has no index: it is what the camera images). No other library sensor
+/// has a spherical core; a core without an index (opaque) gives none.
+#[test]
+fn a_spherical_core_gives_its_curved_faces_up_to_the_imaged_coat() {
+    let d = library::load("rtac0").unwrap();
+    let shells = path_of(&d).unwrap().shells;
+    let got: Vec<_> = shells
+        .iter()
+        .map(|s| {
+            (
+                s.radius_mm,
+                s.bottom_z_mm,
+                s.outside.as_str(),
+                s.index_outside,
+            )
+        })
+        .collect();
+    let want = [
+        (9.0, -9.0, "borosilicate_glass", 1.473),
+        (10.0, -9.0, "sylgard_184", 1.41),
+        (13.5, -6.0, "ecoflex_00_30", 1.41),
+    ];
+    assert_eq!(got.len(), want.len(), "{got:?}");
+    for (g, w) in got.iter().zip(want) {
+        assert!(
+            near(g.0, w.0) && near(g.1, w.1) && g.2 == w.2 && g.3 == w.3,
+            "{g:?}"
+        );
+    }
+    assert!(shells
+        .iter()
+        .all(|s| s.centre_z_mm == 0.0 && s.join_z_mm == 0.0));
+    assert!(shells[0].what.starts_with("core"), "{}", shells[0].what);
+    for name in ["tactip_dualmodal", "shadowtac", "digit_pinki", "uvdtact"] {
+        assert!(
+            path_of(&library::load(name).unwrap())
+                .unwrap()
+                .shells
+                .is_empty(),
+            "{name}"
+        );
+    }
+    let yaml = library::LIBRARY
+        .iter()
+        .find(|(n, _)| *n == "rtac0")
+        .unwrap()
+        .1;
+    let opaque = Design::from_yaml(
+        &yaml.replace("material: borosilicate_glass", "material: pla_black"),
+        "r.yaml",
+    )
+    .unwrap();
+    assert!(path_of(&opaque).unwrap().shells.is_empty());
+}

@@ -17,14 +17,22 @@
 //! Paraxially, a point at depth `d` below one interface seen straight along its normal appears
 //! at depth `d / n` (Hecht Sec. 5.2.3, the apparent depth), as the tests check.
 //!
-//! Assumed: the interfaces are planes normal to the sensor's z axis and the media are
-//! homogeneous and isotropic; the camera file describes the lens in the medium the camera's
-//! centre sits in (air for every library sensor: it was calibrated there). Not modelled yet:
-//! curved interfaces (a glass core's faces, the skin's layers on a dome), whose bending is
-//! small where the layers' indices are close (1.41 silicones against 1.47 glass).
+//! Above the planes the ray may cross curved interfaces of revolution about the z axis, a
+//! glass core's faces and the cast layers on it ([`shells`]): there the ray leaves each shell
+//! once and bends by Snell's law in vector form, and the ray to a point is found by
+//! Gauss-Newton on its direction from the camera, started from the ray through the planes
+//! alone (see [`OpticalLayers::direction_to`]).
+//!
+//! Assumed: the flat interfaces are planes normal to the sensor's z axis, the curved ones
+//! spheres on cylinders coaxial with it, and the media homogeneous and isotropic; the camera
+//! file describes the lens in the medium the camera's centre sits in (air for every library
+//! sensor: it was calibrated there).
+
+pub mod shells;
 
 use crate::camera::CameraModel;
 use nalgebra::{Matrix2x6, Matrix3, Rotation3, Vector2, Vector3};
+pub use shells::Shell;
 
 /// Largest refractive index a medium may have (exclusive), as the materials table.
 pub const MAX_INDEX: f64 = 3.0;
@@ -39,20 +47,23 @@ pub struct LayersError {
 }
 
 /// Clear media bounded by planes `z = z_k` of the sensor frame: the medium below the first
-/// plane, between consecutive planes, and above the last, each with its refractive index.
+/// plane, between consecutive planes, and above the last, each with its refractive index;
+/// then, in the medium above the last plane, nested curved interfaces ([`Shell`]) each with
+/// the index outside it.
 #[derive(Debug, Clone, PartialEq)]
-pub struct FlatLayers {
+pub struct OpticalLayers {
     planes_z_mm: Vec<f64>,
     indices: Vec<f64>,
+    shells: Vec<Shell>,
 }
 
-impl FlatLayers {
+impl OpticalLayers {
     /// `planes_z_mm` (K, mm, strictly increasing, finite) and `indices` (K + 1, each in
     /// [1, 3)): the medium below `planes_z_mm[0]`, then each medium above a plane.
     ///
     /// # Errors
     /// [`LayersError`] naming the entry, its value and the rule.
-    pub fn new(planes_z_mm: Vec<f64>, indices: Vec<f64>) -> Result<FlatLayers, LayersError> {
+    pub fn new(planes_z_mm: Vec<f64>, indices: Vec<f64>) -> Result<OpticalLayers, LayersError> {
         if indices.len() != planes_z_mm.len() + 1 {
             return Err(LayersError {
                 field: "indices".into(),
@@ -78,31 +89,205 @@ impl FlatLayers {
                 });
             }
         }
-        Ok(FlatLayers {
+        Ok(OpticalLayers {
             planes_z_mm,
             indices,
+            shells: Vec::new(),
         })
+    }
+
+    /// These layers with nested curved interfaces above the last plane, innermost first: the
+    /// medium inside the first is the one above the last plane (the filling gel), outside
+    /// each its `index_outside`. A shell whose outside index is its inside one bends nothing
+    /// and is left out (two clear silicones of the same index: the ray's last stretch then
+    /// starts at the last shell that bends it).
+    ///
+    /// # Errors
+    /// [`LayersError`] naming `shells[k]` and its field: not finite, a radius not above 0, a
+    /// join below the centre or beyond the sphere, a bottom above the join, an index outside
+    /// [1, 3), a shell not about the same centre as the first or not larger than the one
+    /// inside it.
+    pub fn with_shells(mut self, shells: Vec<Shell>) -> Result<OpticalLayers, LayersError> {
+        let bad = |k: usize, f: &str, v: f64, rule: &'static str| LayersError {
+            field: format!("shells[{k}].{f}"),
+            value: crate::shown_f64(v),
+            rule,
+        };
+        for (k, s) in shells.iter().enumerate() {
+            for (f, v) in [
+                ("radius_mm", s.radius_mm),
+                ("centre_z_mm", s.centre_z_mm),
+                ("join_z_mm", s.join_z_mm),
+                ("bottom_z_mm", s.bottom_z_mm),
+                ("outside_bottom_z_mm", s.outside_bottom_z_mm),
+            ] {
+                if !v.is_finite() {
+                    return Err(bad(k, f, v, "must be finite"));
+                }
+            }
+            if !(s.radius_mm > 0.0) {
+                return Err(bad(k, "radius_mm", s.radius_mm, "must be above 0"));
+            }
+            if !(s.join_z_mm >= s.centre_z_mm && s.join_z_mm < s.centre_z_mm + s.radius_mm) {
+                return Err(bad(
+                    k,
+                    "join_z_mm",
+                    s.join_z_mm,
+                    "must be at or above the centre and below the sphere's top",
+                ));
+            }
+            if !(s.bottom_z_mm <= s.join_z_mm) {
+                return Err(bad(
+                    k,
+                    "bottom_z_mm",
+                    s.bottom_z_mm,
+                    "must be at or below the join",
+                ));
+            }
+            if !(s.index_outside >= 1.0 && s.index_outside < MAX_INDEX) {
+                return Err(bad(
+                    k,
+                    "index_outside",
+                    s.index_outside,
+                    "a refractive index must be from 1 to below 3",
+                ));
+            }
+            if k > 0 {
+                let inner = &shells[k - 1];
+                if s.centre_z_mm != shells[0].centre_z_mm {
+                    return Err(bad(
+                        k,
+                        "centre_z_mm",
+                        s.centre_z_mm,
+                        "nested shells share the first one's centre",
+                    ));
+                }
+                if !(s.radius_mm > inner.radius_mm)
+                    || !(s.cylinder_radius_mm() > inner.cylinder_radius_mm())
+                {
+                    return Err(bad(
+                        k,
+                        "radius_mm",
+                        s.radius_mm,
+                        "must be larger than the shell inside it (sphere and cylinder)",
+                    ));
+                }
+            }
+        }
+        let mut kept: Vec<Shell> = Vec::new();
+        for s in shells {
+            let inside = kept
+                .last()
+                .map_or(*self.indices.last().unwrap_or(&1.0), |k| k.index_outside);
+            // the first is kept: the index inside it (the gel's) may be refined
+            if kept.is_empty() || s.index_outside != inside {
+                kept.push(s);
+            }
+        }
+        self.shells = kept;
+        Ok(self)
+    }
+
+    /// The curved interfaces that bend rays, innermost first ([`OpticalLayers::with_shells`]).
+    pub fn shells(&self) -> &[Shell] {
+        &self.shells
+    }
+
+    /// How many shells, from the innermost, a ray crosses to reach `p`: up to the first that
+    /// holds `p`.
+    pub fn shells_before(&self, p: &Vector3<f64>) -> usize {
+        self.shells
+            .iter()
+            .position(|s| s.contains(p))
+            .unwrap_or(self.shells.len())
+    }
+
+    /// Traces the ray at `o` along `d` (in the medium above the last plane, at or above it)
+    /// out of the first `count` shells: where it leaves the last of them and its unit
+    /// direction beyond. A ray below the first shell's open bottom enters it there. `None`
+    /// when the ray does not enter the first shell through its open end (it meets the core's
+    /// rim or what holds it), leaves a shell through its open end or below where the medium
+    /// outside it begins ([`Shell::outside_bottom_z_mm`]), or is totally internally
+    /// reflected.
+    pub fn trace_shells(
+        &self,
+        o: &Vector3<f64>,
+        d: &Vector3<f64>,
+        count: usize,
+    ) -> Option<(Vector3<f64>, Vector3<f64>)> {
+        let mut d = d.try_normalize(0.0)?;
+        let mut o = *o;
+        let Some(first) = self.shells.first().filter(|_| count > 0) else {
+            return Some((o, d));
+        };
+        if !(o.z > first.bottom_z_mm) {
+            if !(d.z > 0.0) {
+                return None;
+            }
+            o += (first.bottom_z_mm - o.z) / d.z * d;
+            o.z = first.bottom_z_mm;
+            let rho = first.cylinder_radius_mm();
+            if !(o.xy().norm_squared() < rho * rho) {
+                return None;
+            }
+        } else if !first.contains(&o) {
+            return None;
+        }
+        let mut n_in = *self.indices.last().unwrap_or(&1.0);
+        for s in self.shells.iter().take(count) {
+            let (p, normal) = s.exit(&o, &d)?;
+            // below where the medium outside begins: what holds the shell
+            if !(p.z >= s.outside_bottom_z_mm) {
+                return None;
+            }
+            d = shells::refract(&d, &normal, n_in, s.index_outside)?;
+            o = p;
+            n_in = s.index_outside;
+        }
+        Some((o, d))
+    }
+
+    /// The index of the medium `p` is in, past the planes: the one outside the last shell
+    /// before it ([`OpticalLayers::shells_before`]), else [`OpticalLayers::index_at`].
+    pub fn index_of_point(&self, p: &Vector3<f64>) -> f64 {
+        match self.shells_before(p) {
+            0 => self.index_at(p.z),
+            j => self.shells[j - 1].index_outside,
+        }
     }
 
     /// One plane at `z_mm` between a medium of index `below` and one of index `above`.
     ///
     /// # Errors
-    /// As [`FlatLayers::new`].
-    pub fn single(z_mm: f64, below: f64, above: f64) -> Result<FlatLayers, LayersError> {
-        FlatLayers::new(vec![z_mm], vec![below, above])
+    /// As [`OpticalLayers::new`].
+    pub fn single(z_mm: f64, below: f64, above: f64) -> Result<OpticalLayers, LayersError> {
+        OpticalLayers::new(vec![z_mm], vec![below, above])
     }
 
-    /// The layers of a design's flat optical path (`fabkit_designs::optics::optical_path`):
-    /// air (n = 1) under its lowest plane, where the camera sits, then each plane's medium.
+    /// The layers of a design's optical path (`fabkit_designs::optics::optical_path`): air
+    /// (n = 1) under its lowest plane, where the camera sits, then each plane's medium, then
+    /// its curved faces ([`OpticalLayers::with_shells`]).
     ///
     /// # Errors
-    /// As [`FlatLayers::new`].
+    /// As [`OpticalLayers::new`] and [`OpticalLayers::with_shells`].
     pub fn from_optical_path(
         path: &fabkit_designs::optics::OpticalPath,
-    ) -> Result<FlatLayers, LayersError> {
+    ) -> Result<OpticalLayers, LayersError> {
         let mut indices = vec![1.0];
         indices.extend(path.planes.iter().map(|p| p.index_above));
-        FlatLayers::new(path.planes.iter().map(|p| p.z_mm).collect(), indices)
+        OpticalLayers::new(path.planes.iter().map(|p| p.z_mm).collect(), indices)?.with_shells(
+            path.shells
+                .iter()
+                .map(|s| Shell {
+                    radius_mm: s.radius_mm,
+                    centre_z_mm: s.centre_z_mm,
+                    join_z_mm: s.join_z_mm,
+                    bottom_z_mm: s.bottom_z_mm,
+                    index_outside: s.index_outside,
+                    outside_bottom_z_mm: s.outside_bottom_z_mm,
+                })
+                .collect(),
+        )
     }
 
     /// The planes' heights, sensor frame z, mm, increasing.
@@ -141,9 +326,92 @@ impl FlatLayers {
     }
 
     /// The unit direction (sensor frame) in which the ray that reaches `to` leaves `from`, in
-    /// the medium at `from`: the root of the lateral-run equation of the module docs. `None`
-    /// when the points coincide or are not finite.
+    /// the medium at `from`. Through the planes alone: the root of the lateral-run equation
+    /// of the module docs. Through shells as well (`to` beyond the first): Gauss-Newton on
+    /// the direction's two angles about that root, the ray's miss of `to` measured across
+    /// the line of sight from the last exit to `to`, with forward-difference derivatives
+    /// (steps 1e-7 rad), step halving while the miss does not fall, until it stops falling
+    /// below 1e-12 mm. `None` when the points coincide or are not finite, or through shells
+    /// when no ray reaches `to` (blocked by a shell's open end or totally reflected) or the
+    /// miss stays above 1e-9 mm.
     pub fn direction_to(&self, from: &Vector3<f64>, to: &Vector3<f64>) -> Option<Vector3<f64>> {
+        let d0 = self.direction_through_planes(from, to)?;
+        let count = self.shells_before(to);
+        if count == 0 {
+            return Some(d0);
+        }
+        let end = |d: &Vector3<f64>| -> Option<(Vector3<f64>, Vector3<f64>)> {
+            let (o, e) = self.trace_beyond_planes(from, d)?;
+            self.trace_shells(&o, &e, count)
+        };
+        // from the ray through the planes, or the straight one where that is blocked
+        let (d0, (o0, _)) = match end(&d0) {
+            Some(e) => (d0, e),
+            None => {
+                let straight = (to - from).try_normalize(0.0)?;
+                (straight, end(&straight)?)
+            }
+        };
+        let w = (to - o0).try_normalize(0.0)?;
+        let f1 = w
+            .cross(&Vector3::z())
+            .try_normalize(1e-9)
+            .unwrap_or_else(|| w.cross(&Vector3::x()).normalize());
+        let f2 = w.cross(&f1);
+        let miss = |d: &Vector3<f64>| -> Option<nalgebra::Vector2<f64>> {
+            let (o, u) = end(d)?;
+            let uw = u.dot(&w);
+            if !(uw > 0.0) {
+                return None;
+            }
+            let x = o + ((to - o).dot(&w) / uw) * u - to;
+            Some(nalgebra::Vector2::new(x.dot(&f1), x.dot(&f2)))
+        };
+        let along = |d: &Vector3<f64>, a: f64, b: f64| -> Vector3<f64> {
+            let e1 = d
+                .cross(&Vector3::z())
+                .try_normalize(1e-9)
+                .unwrap_or_else(|| d.cross(&Vector3::x()).normalize());
+            let e2 = d.cross(&e1);
+            (d + a * e1 + b * e2).normalize()
+        };
+        let mut d = d0;
+        let mut r = miss(&d)?;
+        let h = 1e-7;
+        for _ in 0..60 {
+            if r.norm() <= 1e-12 {
+                break;
+            }
+            let j = nalgebra::Matrix2::from_columns(&[
+                (miss(&along(&d, h, 0.0))? - r) / h,
+                (miss(&along(&d, 0.0, h))? - r) / h,
+            ]);
+            let step = j.try_inverse()? * (-r);
+            let mut scale = 1.0;
+            let mut better = None;
+            for _ in 0..30 {
+                let dn = along(&d, scale * step.x, scale * step.y);
+                if let Some(rn) = miss(&dn) {
+                    if rn.norm() < r.norm() {
+                        better = Some((dn, rn));
+                        break;
+                    }
+                }
+                scale *= 0.5;
+            }
+            let Some((dn, rn)) = better else { break };
+            (d, r) = (dn, rn);
+        }
+        (r.norm() <= 1e-9).then_some(d)
+    }
+
+    /// [`direction_to`](Self::direction_to) through the planes alone (every medium above the
+    /// last plane taken as the one just above it).
+    fn direction_through_planes(
+        &self,
+        from: &Vector3<f64>,
+        to: &Vector3<f64>,
+    ) -> Option<Vector3<f64>> {
         let h = to - from;
         let run = h.xy().norm();
         if !(h.norm() > 0.0) || !h.iter().all(|v| v.is_finite()) {
@@ -241,7 +509,7 @@ impl FlatLayers {
     }
 }
 
-impl FlatLayers {
+impl OpticalLayers {
     /// Where a point appears to a camera in the medium under the lowest plane looking along
     /// the planes' normal: each medium's run above that plane scaled by the camera's medium's
     /// index over its own (the paraxial apparent depth, Hecht Sec. 5.2.3: `d / n` under one
@@ -261,11 +529,26 @@ impl FlatLayers {
         Vector3::new(p.x, p.y, z)
     }
 
-    /// Traces the ray leaving `from` along `direction` (in the medium at `from`) across every
-    /// plane it meets: where it crosses the last one and its unit direction in the medium
-    /// beyond it. No plane on its way: `from` and the direction. `None` when the ray runs
-    /// parallel to the planes or is totally internally reflected.
+    /// Traces the ray leaving `from` along `direction` (in the medium at `from`, under the
+    /// planes or inside the first shell) across every plane it meets and, going up, out of
+    /// every shell ([`OpticalLayers::trace_shells`]): where it leaves the last interface and
+    /// its unit direction in the medium beyond. No interface on its way: `from` and the
+    /// direction. `None` when the ray runs parallel to the planes, is totally internally
+    /// reflected, or is blocked at a shell's open end.
     pub fn trace_beyond(
+        &self,
+        from: &Vector3<f64>,
+        direction: &Vector3<f64>,
+    ) -> Option<(Vector3<f64>, Vector3<f64>)> {
+        let (o, d) = self.trace_beyond_planes(from, direction)?;
+        if self.shells.is_empty() || !(d.z > 0.0) {
+            return Some((o, d));
+        }
+        self.trace_shells(&o, &d, self.shells.len())
+    }
+
+    /// [`trace_beyond`](Self::trace_beyond) across the planes only.
+    pub fn trace_beyond_planes(
         &self,
         from: &Vector3<f64>,
         direction: &Vector3<f64>,
@@ -312,11 +595,11 @@ pub const START_BELOW_PLANE_MM: f64 = 1.0;
 #[derive(Debug, Clone, Copy)]
 pub struct Imaging<'a> {
     pub camera: &'a CameraModel,
-    pub layers: Option<&'a FlatLayers>,
+    pub layers: Option<&'a OpticalLayers>,
 }
 
 impl<'a> Imaging<'a> {
-    /// [`FlatLayers::apparent`] of each point, or the points as they are for straight rays.
+    /// [`OpticalLayers::apparent`] of each point, or the points as they are for straight rays.
     pub fn apparent_points(&self, points: &[Vector3<f64>]) -> Vec<Vector3<f64>> {
         match self.layers {
             None => points.to_vec(),
@@ -325,7 +608,7 @@ impl<'a> Imaging<'a> {
     }
 
     /// `camera` behind `layers` (`None`: straight rays).
-    pub fn new(camera: &'a CameraModel, layers: Option<&'a FlatLayers>) -> Imaging<'a> {
+    pub fn new(camera: &'a CameraModel, layers: Option<&'a OpticalLayers>) -> Imaging<'a> {
         Imaging { camera, layers }
     }
 
@@ -423,7 +706,7 @@ impl<'a> Imaging<'a> {
 /// materials table's index are the means; these are their standard deviations.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PlanePrior {
-    /// Which plane (index into [`FlatLayers::planes_z_mm`]).
+    /// Which plane (index into [`OpticalLayers::planes_z_mm`]).
     pub plane: usize,
     /// Standard deviation of the plane's height about the given one, mm, > 0.
     pub height_sd_mm: f64,
@@ -444,7 +727,7 @@ pub const SILICONE_INDEX_SD: f64 = 0.01;
 pub struct PlaneFit {
     pub t_cam_sensor: nalgebra::Isometry3<f64>,
     /// The layers with the refined height and index.
-    pub layers: FlatLayers,
+    pub layers: OpticalLayers,
     pub prior: PlanePrior,
     /// The prior's means: the given height (mm) and index.
     pub prior_height_mm: f64,
@@ -471,7 +754,7 @@ pub struct PlaneFit {
 /// than it. `None` when a point does not project at the start or the normal matrix is singular.
 pub fn refine_plane(
     camera: &CameraModel,
-    layers: &FlatLayers,
+    layers: &OpticalLayers,
     prior: PlanePrior,
     points_mm: &[Vector3<f64>],
     pixels_px: &[Vector2<f64>],
@@ -493,7 +776,10 @@ pub fn refine_plane(
         let mut l = layers.clone();
         l.planes_z_mm[k] = s.z;
         l.indices[k + 1] = s.idx;
-        FlatLayers::new(l.planes_z_mm, l.indices).ok()
+        OpticalLayers::new(l.planes_z_mm, l.indices)
+            .ok()?
+            .with_shells(layers.shells.clone())
+            .ok()
     };
     let residuals = |s: &S, sigma: f64| -> Option<DVector<f64>> {
         let l = with(s)?;
