@@ -53,8 +53,9 @@ pub struct ExtrinsicsJob {
     /// [`crate::refraction::SILICONE_INDEX_SD`]) with the pose over the inliers, before any
     /// intrinsics refinement, which then sees the refined surface.
     pub refine_optical_path: bool,
-    /// The flat optical path between the lens and the pins (a design's
-    /// `fabkit_designs::optics::optical_path`): rays bend at each plane ([`crate::refraction`]);
+    /// The optical path between the lens and the pins (a design's
+    /// `fabkit_designs::optics::optical_path`): rays bend at each plane and curved face
+    /// ([`crate::refraction`]);
     /// `None`: straight rays from the lens.
     pub optical_path: Option<fabkit_designs::optics::OpticalPath>,
     /// Where `optical_path` comes from, in words (`--design rtac0`, or the point table's

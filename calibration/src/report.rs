@@ -207,9 +207,9 @@ pub struct ExtrinsicsReport {
     pub provenance: Provenance,
     /// `fisheye`, `plumb_bob` or `rational_polynomial`.
     pub distortion_model: String,
-    /// The flat optical path the rays were bent along (the point table's design or `--design`:
-    /// the filling gel's surface, a window's or a plate's faces, each with its refractive index
-    /// and source); absent: straight rays from the lens.
+    /// The optical path the rays were bent along (the point table's design or `--design`: the
+    /// filling gel's surface, a window's or a plate's faces, a spherical core's faces, each
+    /// with its refractive index and source); absent: straight rays from the lens.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub optical_path: Option<fabkit_designs::optics::OpticalPath>,
     /// Where `optical_path` comes from: `--design NAME [--preset P]`, or `design NAME, the

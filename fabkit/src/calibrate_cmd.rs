@@ -139,9 +139,9 @@ pub struct ExtrinsicsArgs {
     #[arg(long, value_name = "SEED")]
     pub seed: Option<u64>,
     /// The sensor's design (a YAML file or a library name): the rays from the lens bend by
-    /// Snell's law at its flat interfaces (the filling gel's free surface, a window's or a
-    /// plate's faces), with the refractive indices of the materials table; the report lists
-    /// them (`optical_path`).
+    /// Snell's law at its interfaces (the filling gel's free surface, a window's or a plate's
+    /// faces, a spherical core's faces), with the refractive indices of the materials table;
+    /// the report lists them (`optical_path`).
     /// Without it, the design the point table was made for (its sidecar point_table.json,
     /// as `fabkit fixtures` writes it) gives the optical path, when that design reads as it
     /// did then (the same sha256) and none of its presets moves an interface.
@@ -391,7 +391,7 @@ fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
 /// The design a point table was made for, as its sidecar (`point_table.json`, as `fabkit
 /// fixtures` writes it) names it in its provenance (`fabkit V, design NAME (SOURCE, sha256 H)`).
 enum TableDesign {
-    /// No sidecar, no provenance, or a design with no flat interface: straight rays.
+    /// No sidecar, no provenance, or a design with no interface: straight rays.
     Unknown,
     /// A design whose optical path cannot be taken for the table's: why, in words.
     Unusable(String),
@@ -402,7 +402,7 @@ enum TableDesign {
     },
 }
 
-/// The names of the planes of `path` without their parameter paths.
+/// The names of the planes and curved faces of `path` without their parameter paths.
 fn plane_names(path: &fabkit_designs::optics::OpticalPath) -> Vec<&str> {
     let what = path
         .planes

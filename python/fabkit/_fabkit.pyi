@@ -233,9 +233,9 @@ def solve_extrinsics(
     calibrate extrinsics``. Returns T_cam_sensor (4, 4) (sensor -> camera, mm), residuals_px
     (n, 2) (NaN where a point does not project), inliers and outliers (n,) bool,
     rms_reprojection_error_px and report (extrinsics.json's content). With ``design`` the rays
-    bend by Snell's law at its flat interfaces (the filling gel's free surface, ...), as
-    ``calibrate extrinsics --design``; the report lists them (``optical_path``). The same pairs
-    in any order give the same pose; ``seed`` has no effect (a DeprecationWarning). Raises
+    bend by Snell's law at its interfaces (the filling gel's free surface, the core's faces,
+    ...), as ``calibrate extrinsics --design``; the report lists them (``optical_path``). The
+    same pairs in any order give the same pose; ``seed`` has no effect (a DeprecationWarning). Raises
     CalibrationError (a non-finite entry: ``points_mm[i, j] = nan: must be finite``),
     ValueError (shapes)."""
 

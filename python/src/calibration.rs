@@ -243,9 +243,9 @@ pub(crate) fn rows<const N: usize>(a: &Bound<'_, PyAny>, name: &str) -> PyResult
 /// `inliers` and `outliers` (n,) bool, `rms_reprojection_error_px`, and `report`: the dict
 /// `extrinsics.json` holds (rvec, tvec, pose uncertainty, per-point residuals by id; ids are
 /// `ids` or the row numbers). With `design` (a `Design`), the rays bend by Snell's law at the
-/// design's flat interfaces (its filling gel's free surface, a window's or a plate's faces;
-/// indices from the materials table), as `calibrate extrinsics --design` does, and the report
-/// lists them (`optical_path`). Raises CalibrationError with the CLI's message (fewer than 4
+/// design's interfaces (its filling gel's free surface, a window's or a plate's faces, a
+/// spherical core's faces; indices from the materials table), as `calibrate extrinsics
+/// --design` does, and the report lists them (`optical_path`). Raises CalibrationError with the CLI's message (fewer than 4
 /// points, a non-finite value, a degenerate layout, too few inliers, ...).
 #[pyfunction]
 #[pyo3(signature = (points_mm, pixels_px, camera, *, ids=None, ransac=true, threshold_px=None, seed=None, design=None))]

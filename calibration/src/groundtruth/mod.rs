@@ -57,7 +57,7 @@ impl Scene {
         Scene::through(design, camera, t_cam_sensor, pose_name, None)
     }
 
-    /// [`Scene::new`] with the rays bent at the flat interfaces of `layers`
+    /// [`Scene::new`] with the rays bent at the interfaces of `layers`
     /// ([`PixelRays::through`]); `None`: straight rays.
     ///
     /// # Errors

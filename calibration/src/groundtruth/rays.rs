@@ -74,10 +74,11 @@ impl PixelRays {
         }
     }
 
-    /// The rays of [`PixelRays::new`] bent at the flat interfaces of `layers` by Snell's law
-    /// ([`crate::refraction`]): each ray is traced from the camera centre to the last plane
-    /// and continues from there in the last medium, where the skin is; `origins` holds those
-    /// starts. A ray that runs away from the planes or is totally internally reflected has NaN
+    /// The rays of [`PixelRays::new`] bent at the interfaces of `layers` by Snell's law
+    /// ([`crate::refraction`]): each ray is traced from the camera centre across the planes
+    /// and out of the curved faces, and continues from the last in the last medium, where the
+    /// skin is; `origins` holds those starts. A ray that runs away from the planes, is
+    /// totally internally reflected, or is blocked at a core's open end or seat has NaN
     /// direction and never hits anything. The depth maps of these rays
     /// ([`super::DepthFrame::new`]) give the hit's camera-frame z and its distance from the
     /// camera centre. The mesh casts and the image rasteriser take straight rays only.

@@ -283,7 +283,7 @@ pub fn render(
     render_through(camera, t_cam_sensor, None, surface, pins, s, seed)
 }
 
-/// [`render`] with the camera's rays bent at the flat interfaces of `layers`
+/// [`render`] with the camera's rays bent at the interfaces of `layers`
 /// ([`PixelRays::through`]): a pin dome seen through a filling gel's surface. The imprints'
 /// true centroids are those of the bent rays.
 ///

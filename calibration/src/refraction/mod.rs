@@ -1,6 +1,7 @@
 //! The optical path between the lens and the skin: clear media bounded by flat interfaces
 //! normal to the sensor's z axis (a filling gel's free surface, a clear plate, flat cast
-//! layers), each ray bent at every interface by Snell's law, and the projection of a
+//! layers) and then by the curved faces of a core ([`shells`]), each ray bent at every
+//! interface by Snell's law, and the projection of a
 //! sensor-frame point through them ([`Imaging`]). Sensor frame, mm (docs/conventions.md).
 //!
 //! Snell's law at a plane, n1 sin(theta1) = n2 sin(theta2) with the ray staying in the plane of
