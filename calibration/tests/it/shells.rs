@@ -257,3 +257,72 @@ fn bad_shells_are_named_errors() {
     });
     assert_eq!(base().with_shells(s).unwrap().shells().len(), 2);
 }
+
+/// A spherical cap on a narrower cylinder (the join 4 mm above the sphere's centre, as the
+/// offsets of a cap-shaped body are): the rays found still reach their points, the normal
+/// creases at the join by asin(4 / 9) (the cylinder's is horizontal, the sphere's leans up),
+/// and a point inside the first shell is seen through the planes alone.
+#[test]
+fn a_cap_on_a_narrower_cylinder_reaches_its_points_and_creases_at_the_join() {
+    let cap = |r: f64, n: f64| Shell {
+        radius_mm: r,
+        centre_z_mm: -2.0,
+        join_z_mm: 2.0,
+        bottom_z_mm: -6.0,
+        index_outside: n,
+        outside_bottom_z_mm: -6.0,
+    };
+    let l = OpticalLayers::single(-6.0, 1.0, 1.41)
+        .unwrap()
+        .with_shells(vec![cap(9.0, 1.49), cap(11.0, 1.41)])
+        .unwrap();
+    assert!((l.shells()[0].cylinder_radius_mm() - 65f64.sqrt()).abs() < 1e-12);
+    let c = Vector3::new(0.2, 0.1, -14.0);
+    let mut reached = 0;
+    for k in 0..24 {
+        let a = 0.3 * k as f64;
+        let p = Vector3::new(11.5 * a.cos(), 11.5 * a.sin(), -1.0 + 0.5 * k as f64);
+        let Some(d) = l.direction_to(&c, &p) else {
+            continue;
+        };
+        reached += 1;
+        let (o, e) = l.trace_beyond(&c, &d).unwrap();
+        let miss = (p - o) - (p - o).dot(&e) * e;
+        assert!(miss.norm() < 1e-11, "{p:?}: {:e}", miss.norm());
+    }
+    // measured 20 of 24: no ray reaches the other four past the mouth (r < 8.06 mm at
+    // z = -6) and the seat
+    assert!(reached >= 16, "{reached}");
+    // the normal at the join from the cylinder's side and from the sphere's side
+    let s = l.shells()[0];
+    let rho = s.cylinder_radius_mm();
+    let inside = Vector3::new(0.0, 0.0, 1.9);
+    let (q1, n1) = s
+        .exit(
+            &inside,
+            &(Vector3::new(rho, 0.0, 1.9999) - inside).normalize(),
+        )
+        .unwrap();
+    let (q2, n2) = s
+        .exit(
+            &inside,
+            &(Vector3::new(rho, 0.0, 2.0001) - inside).normalize(),
+        )
+        .unwrap();
+    assert!(q1.z <= 2.0 && q2.z >= 2.0);
+    // the sphere's normal at the join leans up by asin(4 / 9): not continuous with the
+    // cylinder's horizontal one (a cap on a cylinder has a crease there)
+    let lean = n2.z.asin().to_degrees();
+    assert!(
+        n1.z.abs() < 1e-12 && (lean - (4f64 / 9.0).asin().to_degrees()).abs() < 0.01,
+        "{lean}"
+    );
+    // inside the first shell: the planes alone
+    let gel_point = Vector3::new(1.0, 2.0, 0.0);
+    assert_eq!(l.shells_before(&gel_point), 0);
+    let flat = OpticalLayers::single(-6.0, 1.0, 1.41).unwrap();
+    assert_eq!(
+        l.direction_to(&c, &gel_point),
+        flat.direction_to(&c, &gel_point)
+    );
+}
