@@ -1434,3 +1434,98 @@ fn every_artifact_through_the_gel_keeps_every_pin_with_its_id() {
         assert!(r < 1e-9 && t < 1e-9, "{extra:?}: {r} deg, {t} mm apart");
     }
 }
+
+/// Issue 97's done-when on subsets, synthetic: 30 captures through R-Tac0's gel and tube with
+/// every artifact of [`every_artifact_through_the_gel_keeps_every_pin_with_its_id`] but the
+/// re-seating (the plan's eight captures cycled, each with its own noise, specks, gain and
+/// LED ring); the default command on eight subsets of 20 of them (a fixed schedule) gives
+/// poses within 0.05 deg of the one from all 30. Re-seating the dome by up to 0.1 mm per
+/// capture moves it by about 0.3 deg: per-capture seating is another issue's.
+#[test]
+fn subsets_of_20_captures_give_the_pose_of_all_30_within_005_deg() {
+    let s = Scene::with(intrinsics(), crate::calibrate_cli::truth_under_gel());
+    let through = s.imaging();
+    let (r, t) = (
+        *s.pose.rotation.to_rotation_matrix().matrix(),
+        s.pose.translation.vector,
+    );
+    let p22 = through.project(&r, &t, &s.tips["22"]).unwrap();
+    let (a22, r22) = (
+        (p22.y - 239.5).atan2(p22.x - 319.5),
+        (p22.y - 239.5).hypot(p22.x - 319.5),
+    );
+    let (reference, _, _) = s.render_with(&["22".to_string()], 1, &Shading::default());
+    let edge = (0..400)
+        .map(|k| 0.5 * k as f64)
+        .filter(|rr| {
+            let (u, v) = (319.5 + rr * a22.cos(), 239.5 + rr * a22.sin());
+            (0.0..640.0).contains(&u)
+                && (0.0..480.0).contains(&v)
+                && reference.data[v.round() as usize * 640 + u.round() as usize] > 60.0
+        })
+        .fold(0.0, f64::max);
+    // the notches of every_artifact_through_the_gel_keeps_every_pin_with_its_id
+    let shading = Shading {
+        grey_per_mm: 60.0,
+        jpeg_quality: None,
+        halo: 0.065,
+        notches: 4,
+        notch_phase_deg: (a22 + 6.0 / r22).to_degrees(),
+        notch_width_px: 8.0,
+        notch_depth_px: edge - r22,
+        ..Shading::real_capture()
+    };
+    let mut names = Vec::new();
+    for k in 0..30 {
+        let ids = &s.plan[k % s.plan.len()];
+        let seed = 1000 * crate::common::seed_set() + 300 + k as u64;
+        let (reference, capture, _) = s.render_seated(ids, seed, &shading, &Vector3::zeros());
+        if k == 0 {
+            save(&reference, &s.path("reference.jpg"), Kind::Jpeg);
+        }
+        let name = format!("capture_{k:02}.jpg");
+        save(&capture, &s.path(&name), Kind::Jpeg);
+        names.push(name);
+    }
+    let solve = |idx: &[usize], out: &str| -> Isometry3<f64> {
+        let mut plan = String::from("capture,id,ring\n");
+        for (j, &k) in idx.iter().enumerate() {
+            for id in &s.plan[k % s.plan.len()] {
+                plan.push_str(&format!("{},{id},0\n", j + 1));
+            }
+        }
+        let plan_file = format!("{out}_plan.csv");
+        std::fs::write(s.path(&plan_file), plan).unwrap();
+        let mut args = vec![
+            "calibrate",
+            "extrinsics",
+            "--camera",
+            "cam.yaml",
+            "--points",
+            "fx/points/point_table.csv",
+            "--capture-plan",
+            &plan_file,
+            "--reference",
+            "reference.jpg",
+            "--out",
+            out,
+            "--images",
+        ];
+        args.extend(idx.iter().map(|&k| names[k].as_str()));
+        let o = run(s.dir.path(), &args, &[]);
+        assert!(o.status.success(), "{out}: {}", text(&o.stderr));
+        pose_of(&json(&s.path(&format!("{out}/extrinsics.json"))))
+    };
+    let all = solve(&(0..30).collect::<Vec<_>>(), "all");
+    let mut worst = 0.0f64;
+    for k in 0..8 {
+        // leaves out ten captures spread over the thirty, a different ten each time
+        let idx: Vec<usize> = (0..30).filter(|i| (i * 7 + k * 3) % 30 >= 10).collect();
+        assert_eq!(idx.len(), 20);
+        let p = solve(&idx, &format!("subset_{k}"));
+        worst = worst.max(p.rotation.angle_to(&all.rotation).to_degrees());
+    }
+    eprintln!("subsets of 20: up to {worst:.4} deg from the pose of all 30");
+    // measured on seed sets 0 to 2: 0.027, 0.044 and 0.019 deg (the issue's goal: 0.05 deg)
+    assert!(worst < 0.05, "{worst} deg");
+}
