@@ -433,15 +433,21 @@ def test_write_bounds_its_output_before_rendering(scene, monkeypatch):
 
 
 def test_an_extrinsics_file_with_an_optical_path_bends_the_rays_as_the_cli(scene, run_cli):
-    """An extrinsics.json solved through R-Tac0's gel (its ``optical_path``, as ``calibrate
-    extrinsics --design`` writes it): ``fabkit groundtruth`` bends the rays at the gel's
-    surface, and so does DepthRenderer given that file: the same arrays, the manifest lists the
-    same planes; the same matrix given as an array renders straight rays."""
+    """An extrinsics.json solved through R-Tac0's gel and glass tube (its ``optical_path``, as
+    ``calibrate extrinsics --design`` writes it): ``fabkit groundtruth`` bends the rays at the
+    gel's surface and the tube's faces, and so does DepthRenderer given that file: the same
+    arrays, the manifest lists the same planes and faces; the same matrix given as an array
+    renders straight rays."""
     d = scene["dir"]
     t = pose(tvec=(0.3, -0.2, 17.4))  # 17.4 mm under the dome's centre, under the gel (-9 mm)
+    tube = [{"radius_mm": r, "centre_z_mm": 0.0, "join_z_mm": 0.0, "bottom_z_mm": -9.0,
+             "outside_bottom_z_mm": b, "index_outside": n, "what": w}
+            for r, b, n, w in [(9.0, -9.0, 1.473, "core: the core's inner face"),
+                               (10.0, -6.0, 1.41, "core: the core's outer face")]]
     e = {"T_cam_sensor": t.tolist(),
          "optical_path": {"planes": [{"z_mm": -9.0, "index_above": 1.41,
-                                      "what": "housing.filling_gel: the gel's free surface"}]}}
+                                      "what": "housing.filling_gel: the gel's free surface"}],
+                          "shells": tube}}
     (d / "through.json").write_text(json.dumps(e))
     run_cli(d, "groundtruth", "rtac0", "--camera", "cam.yaml", "--extrinsics", "through.json",
             "--fixtures", "fx", "--out", "gt_through", "--format", "npy")
@@ -451,8 +457,10 @@ def test_an_extrinsics_file_with_an_optical_path_bends_the_rays_as_the_cli(scene
         f = np.load(d / "gt_through" / "reference" / f"{name}.npy")
         np.testing.assert_array_equal(a, f, err_msg=name)
     bent.write(d / "py_through", d / "fx", format="npy")
-    planes = lambda p: json.loads((p / "manifest.json").read_text())["optical_path"]["planes"]
-    assert planes(d / "py_through") == planes(d / "gt_through")
+    path = lambda p: json.loads((p / "manifest.json").read_text())["optical_path"]
+    assert path(d / "py_through")["planes"] == path(d / "gt_through")["planes"]
+    assert path(d / "py_through")["shells"] == path(d / "gt_through")["shells"]
+    assert [s["radius_mm"] for s in path(d / "gt_through")["shells"]] == [9.0, 10.0]
     straight = fabkit.DepthRenderer(design, str(d / "cam.yaml"), t)
     r_bent, r_straight = bent.reference()["range_mm"], straight.reference()["range_mm"]
     both = np.isfinite(r_bent) & np.isfinite(r_straight)

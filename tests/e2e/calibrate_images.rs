@@ -1266,18 +1266,10 @@ fn captures_through_the_gel_give_the_pose_with_the_design() {
     assert!(closer > 3.0, "{closer}");
 }
 
-/// Issue 97's synthetic done-when: the eight captures seen through R-Tac0's gel with every
-/// artifact of the real ones: `Shading::real_capture` (saturated moving LED ring, gain drift,
-/// side light, specks, a scratch, JPEG), a faint Hertz halo around each imprint that joins
-/// neighbouring imprints of a capture into one spot (ring 3 and 4 share an azimuth, as on the
-/// real dome; 0.065 of Hertz's skirt: four to five captures join two or three imprints), dark LED
-/// notches at the rim that clip four of the outer imprints, and the dome re-seated by up to
-/// 0.1 mm per capture. The default command keeps every capture's five pins with the right ids
-/// and the pose is within 1.2 times the true centroids' error from the truth; `--seed` 0 to 11
-/// and the captures in reverse order give the same pose.
-#[test]
-fn every_artifact_through_the_gel_keeps_every_pin_with_its_id() {
-    let s = Scene::new();
+/// The shading of [`every_artifact_through_the_gel_keeps_every_pin_with_its_id`] for the scene
+/// `s`: `Shading::real_capture`, the Hertz halo and four dark notches beside the outer pins 22,
+/// 24, 26 and 28.
+fn every_artifact(s: &Scene) -> Shading {
     // the outer pins' azimuths and radii in the image (about its centre) at the true pose
     let through = s.imaging();
     let (r, t) = (
@@ -1309,7 +1301,7 @@ fn every_artifact_through_the_gel_keeps_every_pin_with_its_id() {
     // four slots 8 px wide, their middles 6 px beside pins 22, 24, 26 and 28, reaching as far
     // in as their centres (seen through the tube, the outer ring sits near the mouth's edge,
     // where a slot reaching past a pin's centre hides most of its imprint)
-    let shading = Shading {
+    Shading {
         grey_per_mm: 60.0,
         jpeg_quality: None, // the files are JPEG
         halo: 0.065,
@@ -1318,7 +1310,22 @@ fn every_artifact_through_the_gel_keeps_every_pin_with_its_id() {
         notch_width_px: 8.0,
         notch_depth_px: edge - r22,
         ..Shading::real_capture()
-    };
+    }
+}
+
+/// Issue 97's synthetic done-when: the eight captures seen through R-Tac0's gel with every
+/// artifact of the real ones: `Shading::real_capture` (saturated moving LED ring, gain drift,
+/// side light, specks, a scratch, JPEG), a faint Hertz halo around each imprint that joins
+/// neighbouring imprints of a capture into one spot (ring 3 and 4 share an azimuth, as on the
+/// real dome; 0.065 of Hertz's skirt: four to five captures join two or three imprints), dark LED
+/// notches at the rim that clip four of the outer imprints, and the dome re-seated by up to
+/// 0.1 mm per capture. The default command keeps every capture's five pins with the right ids
+/// and the pose is within 1.2 times the true centroids' error from the truth; `--seed` 0 to 11
+/// and the captures in reverse order give the same pose.
+#[test]
+fn every_artifact_through_the_gel_keeps_every_pin_with_its_id() {
+    let s = Scene::new();
+    let shading = every_artifact(&s);
     let mut names = Vec::new();
     let mut true_centres: BTreeMap<(String, String), [f64; 2]> = BTreeMap::new();
     for (k, ids) in s.plan.iter().enumerate() {
@@ -1443,38 +1450,8 @@ fn every_artifact_through_the_gel_keeps_every_pin_with_its_id() {
 /// capture moves it by about 0.3 deg: per-capture seating is another issue's.
 #[test]
 fn subsets_of_20_captures_give_the_pose_of_all_30_within_005_deg() {
-    let s = Scene::with(intrinsics(), crate::calibrate_cli::truth_under_gel());
-    let through = s.imaging();
-    let (r, t) = (
-        *s.pose.rotation.to_rotation_matrix().matrix(),
-        s.pose.translation.vector,
-    );
-    let p22 = through.project(&r, &t, &s.tips["22"]).unwrap();
-    let (a22, r22) = (
-        (p22.y - 239.5).atan2(p22.x - 319.5),
-        (p22.y - 239.5).hypot(p22.x - 319.5),
-    );
-    let (reference, _, _) = s.render_with(&["22".to_string()], 1, &Shading::default());
-    let edge = (0..400)
-        .map(|k| 0.5 * k as f64)
-        .filter(|rr| {
-            let (u, v) = (319.5 + rr * a22.cos(), 239.5 + rr * a22.sin());
-            (0.0..640.0).contains(&u)
-                && (0.0..480.0).contains(&v)
-                && reference.data[v.round() as usize * 640 + u.round() as usize] > 60.0
-        })
-        .fold(0.0, f64::max);
-    // the notches of every_artifact_through_the_gel_keeps_every_pin_with_its_id
-    let shading = Shading {
-        grey_per_mm: 60.0,
-        jpeg_quality: None,
-        halo: 0.065,
-        notches: 4,
-        notch_phase_deg: (a22 + 6.0 / r22).to_degrees(),
-        notch_width_px: 8.0,
-        notch_depth_px: edge - r22,
-        ..Shading::real_capture()
-    };
+    let s = Scene::new();
+    let shading = every_artifact(&s);
     let mut names = Vec::new();
     for k in 0..30 {
         let ids = &s.plan[k % s.plan.len()];
