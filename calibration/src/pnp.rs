@@ -33,7 +33,7 @@ pub enum PnpError {
     },
     #[error("degenerate layout: {reason}")]
     Degenerate { reason: String },
-    #[error("no pose puts the points in front of the camera")]
+    #[error("no pose puts the points in front of the camera (and, through an optical path, where its rays reach them)")]
     NoSolution,
     #[error("point {index} is behind the camera or outside the lens's field at the solved pose")]
     BehindCamera { index: usize },
@@ -338,15 +338,18 @@ fn solve_in_order(
     let all: Vec<usize> = (0..n).collect();
     let apparent = camera.apparent_points(points_mm);
     let start = sqpnp(&apparent, bearings).ok_or(PnpError::NoSolution)?;
-    let mut fit = Fit::at(
-        camera,
-        points_mm,
-        pixels_px,
-        &all,
-        start.rotation,
-        camera.admissible_start(&start.rotation, &start.translation_mm),
-    )
-    .ok_or(PnpError::NoSolution)?;
+    // A start from which a point is seen through no ray (a core's open end hides it from a
+    // camera too far below) is moved towards the lowest plane, where the view widens.
+    let start_t = camera.admissible_start(&start.rotation, &start.translation_mm);
+    let mut fit = Fit::at(camera, points_mm, pixels_px, &all, start.rotation, start_t);
+    for frac in [0.25, 0.5, 0.75, 1.0] {
+        if fit.is_some() {
+            break;
+        }
+        let t = camera.start_nearer_plane(&start.rotation, &start_t, frac);
+        fit = Fit::at(camera, points_mm, pixels_px, &all, start.rotation, t);
+    }
+    let mut fit = fit.ok_or(PnpError::NoSolution)?;
     // Through an optical path the apparent points are exact on the axis only: far off it (a
     // glass core's faces) the closed-form start misses the outer pins by pixels. The start
     // refined through the path on every pair replaces it when that lowers the median

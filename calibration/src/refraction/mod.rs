@@ -662,6 +662,28 @@ impl<'a> Imaging<'a> {
         -(r * centre)
     }
 
+    /// The pose `(r, t)` with the camera centre moved along the sensor's z the fraction `frac`
+    /// (in [0, 1]) of the way up to [`START_BELOW_PLANE_MM`] under the lowest plane: a start
+    /// from which the view through a core's open end is wider. `t` as given without planes or
+    /// when the centre is already that high.
+    pub fn start_nearer_plane(
+        &self,
+        r: &Matrix3<f64>,
+        t: &Vector3<f64>,
+        frac: f64,
+    ) -> Vector3<f64> {
+        let Some(&z0) = self.layers.and_then(|l| l.planes_z_mm.first()) else {
+            return *t;
+        };
+        let mut centre = -(r.transpose() * t);
+        let top = z0 - START_BELOW_PLANE_MM;
+        if !(centre.z < top) {
+            return *t;
+        }
+        centre.z += frac.clamp(0.0, 1.0) * (top - centre.z);
+        -(r * centre)
+    }
+
     /// [`project`](Self::project) and its 2 x 6 Jacobian with respect to the pose, the
     /// rotation perturbed on the left (R <- exp(w) R, w in rad) then t (mm): analytic for
     /// straight rays, central differences through the layers (steps 1e-6 rad and 1e-6 mm,
