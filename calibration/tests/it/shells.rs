@@ -358,9 +358,9 @@ fn a_start_that_hides_pins_behind_the_mouth_is_moved_up() {
     )
     .unwrap();
     let centre = sol.t_cam_sensor.inverse().translation.vector;
-    // measured: the camera 23.4 mm under the dome's centre, 5.9 mm farther than the straight
-    // rays' 17.5, the outer pins hidden or outliers
-    assert!(centre.z < -9.0 - 1.0 && centre.z < -19.0, "{centre:?}");
+    // measured: the camera 23.0 mm under the dome's centre, 5.6 mm farther than the straight
+    // rays' pose, 25 of 29 pins inliers (without the moved start: NoSolution)
+    assert!(centre.z < -19.0, "{centre:?}");
     eprintln!(
         "camera centre {centre:?}, {} inliers",
         sol.inliers.iter().filter(|&&i| i).count()
