@@ -14,10 +14,12 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use fabkit_calibration::groundtruth::surface::ReferenceSurface;
-use fabkit_calibration::imprints::synthetic::{render, ring_pins, Shading};
+use fabkit_calibration::imprints::synthetic::{render, render_through, ring_pins, Shading};
 use fabkit_calibration::imprints::{detect, reference_mask, DetectParams};
 use fabkit_calibration::nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
+use fabkit_calibration::refraction::OpticalLayers;
 use fabkit_calibration::synthetic::benchmark_camera;
+use fabkit_calibration::{calibrate_extrinsics, ExtrinsicsJob};
 
 fn bench(c: &mut Criterion) {
     let design = fabkit::designs::library::load("rtac0").unwrap();
@@ -58,8 +60,13 @@ fn bench(c: &mut Criterion) {
     g.finish();
 }
 
-/// The R-Tac0 fixtures' point table and plan, the camera file and the nine images in `dir`.
-fn calibration_inputs(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
+/// The R-Tac0 fixtures' point table and plan, the camera file and the nine images in `dir`:
+/// with `path`, seen through it (R-Tac0's gel and glass tube) from 17.4 mm under the dome's
+/// centre, else with straight rays from 10.4 mm under it.
+fn calibration_inputs(
+    dir: &std::path::Path,
+    path: Option<&fabkit::designs::optics::OpticalPath>,
+) -> Vec<std::path::PathBuf> {
     use fabkit::calibration::overlay::encode_gray8;
     use fabkit::calibration::tables::{read_capture_plan, read_point_table, PointsFrom};
     use fabkit::calibration::{write_camera, CameraFileFormat};
@@ -86,10 +93,15 @@ fn calibration_inputs(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
     let table = read_point_table(&dir.join("points/point_table.csv"), PointsFrom::Tip).unwrap();
     let plan = read_capture_plan(&dir.join("points/capture_plan.csv")).unwrap();
     let surface = ReferenceSurface::of(&design.body).unwrap();
-    let pose = Isometry3::from_parts(
-        Translation3::new(0.3, -0.2, 10.4),
-        UnitQuaternion::from_scaled_axis(Vector3::new(0.02, -0.015, 0.4)),
-    );
+    let rot = UnitQuaternion::from_scaled_axis(Vector3::new(0.02, -0.015, 0.4));
+    let pose = match path {
+        None => Isometry3::from_parts(Translation3::new(0.3, -0.2, 10.4), rot),
+        Some(_) => Isometry3::from_parts(
+            Translation3::from(-(rot * Vector3::new(0.3, -0.2, -17.4))),
+            rot,
+        ),
+    };
+    let layers = path.map(|p| OpticalLayers::from_optical_path(p).unwrap());
     let shading = Shading {
         grey_per_mm: 60.0,
         ..Shading::default()
@@ -116,7 +128,15 @@ fn calibration_inputs(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
                 }
             })
             .collect();
-        let r = render(&cam, &pose, &surface, &pins, &shading, k as u64);
+        let r = render_through(
+            &cam,
+            &pose,
+            layers.as_ref(),
+            &surface,
+            &pins,
+            &shading,
+            k as u64,
+        );
         if k == 0 {
             png(&r.reference, &dir.join("reference.png"));
         }
@@ -128,11 +148,31 @@ fn calibration_inputs(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
 }
 
 fn bench_calibration(c: &mut Criterion) {
+    let mut g = c.benchmark_group("calibration_from_images");
+    g.sample_size(20);
+    let tol =
+        fabkit::designs::ChordTolerance::new(fabkit::designs::ChordTolerance::DEFAULT_MM).unwrap();
+    let design = fabkit::designs::library::load("rtac0").unwrap();
+    let path = fabkit::designs::optics::optical_path_of_design(&design, tol).unwrap();
+    for (name, path) in [
+        ("rtac0_29_pins_8_captures", None),
+        ("rtac0_29_pins_8_captures_through_the_tube", Some(&path)),
+    ] {
+        let d = tempfile::tempdir().unwrap();
+        let job = calibration_job(d.path(), path);
+        g.bench_function(name, |b| b.iter(|| calibrate_extrinsics(&job).unwrap()));
+    }
+    g.finish();
+}
+
+/// The job of [`bench_calibration`] on [`calibration_inputs`] in `dir`, checked once.
+fn calibration_job(
+    dir: &std::path::Path,
+    path: Option<&fabkit::designs::optics::OpticalPath>,
+) -> ExtrinsicsJob {
     use fabkit_calibration::capture_images::CaptureImages;
-    use fabkit_calibration::{calibrate_extrinsics, ExtrinsicsJob, Observed, PointsFrom};
-    let d = tempfile::tempdir().unwrap();
-    let dir = d.path();
-    let captures = calibration_inputs(dir);
+    use fabkit_calibration::{Observed, PointsFrom};
+    let captures = calibration_inputs(dir, path);
     let job = ExtrinsicsJob {
         camera: dir.join("cam.yaml"),
         camera_model: None,
@@ -146,20 +186,15 @@ fn bench_calibration(c: &mut Criterion) {
         image: None,
         ransac: Some(Default::default()),
         refine_intrinsics: None,
-        optical_path: None,
-        optical_path_from: None,
+        optical_path: path.cloned(),
+        optical_path_from: path.map(|_| "design rtac0".into()),
         refine_optical_path: false,
         command_line: "bench".into(),
     };
     let out = calibrate_extrinsics(&job).unwrap();
     assert_eq!(out.report.residuals.observations, 29);
     assert!(out.report.warnings.is_empty(), "{:?}", out.report.warnings);
-    let mut g = c.benchmark_group("calibration_from_images");
-    g.sample_size(20);
-    g.bench_function("rtac0_29_pins_8_captures", |b| {
-        b.iter(|| calibrate_extrinsics(&job).unwrap())
-    });
-    g.finish();
+    job
 }
 
 criterion_group!(benches, bench, bench_calibration);
