@@ -169,20 +169,23 @@ pub fn read_optical_path(
         value,
         rule: rule.into(),
     };
+    // the number at `key` of the entry `at` (`planes[k]`, `shells[k]`) of optical_path
+    let number = |entry: &serde_json::Value, at: &str, key: &str| {
+        entry
+            .get(key)
+            .and_then(serde_json::Value::as_f64)
+            .ok_or_else(|| {
+                bad(
+                    format!("optical_path.{at}.{key}"),
+                    entry.get(key).map_or("missing".into(), |x| x.to_string()),
+                    "must be a number",
+                )
+            })
+    };
     let fit = v.get("optical_path_fit");
     let mut used = Vec::new();
     for (k, p) in planes.as_array().into_iter().flatten().enumerate() {
-        let num = |key: &str| {
-            p.get(key)
-                .and_then(serde_json::Value::as_f64)
-                .ok_or_else(|| {
-                    bad(
-                        format!("optical_path.planes[{k}].{key}"),
-                        p.get(key).map_or("missing".into(), |x| x.to_string()),
-                        "must be a number",
-                    )
-                })
-        };
+        let num = |key: &str| number(p, &format!("planes[{k}]"), key);
         let what = p.get("what").and_then(|w| w.as_str()).unwrap_or("");
         let (mut z, mut n) = (num("z_mm")?, num("index_above")?);
         if let Some(f) = fit.filter(|f| f.get("plane").and_then(|w| w.as_str()) == Some(what)) {
@@ -201,17 +204,7 @@ pub fn read_optical_path(
         .unwrap_or_default();
     let mut shells = Vec::new();
     for (k, s) in shells_json.iter().enumerate() {
-        let num = |key: &str| {
-            s.get(key)
-                .and_then(serde_json::Value::as_f64)
-                .ok_or_else(|| {
-                    bad(
-                        format!("optical_path.shells[{k}].{key}"),
-                        s.get(key).map_or("missing".into(), |x| x.to_string()),
-                        "must be a number",
-                    )
-                })
-        };
+        let num = |key: &str| number(s, &format!("shells[{k}]"), key);
         shells.push(crate::refraction::Shell {
             radius_mm: num("radius_mm")?,
             centre_z_mm: num("centre_z_mm")?,

@@ -248,15 +248,6 @@ impl OpticalLayers {
         Some((o, d))
     }
 
-    /// The index of the medium `p` is in, past the planes: the one outside the last shell
-    /// before it ([`OpticalLayers::shells_before`]), else [`OpticalLayers::index_at`].
-    pub fn index_of_point(&self, p: &Vector3<f64>) -> f64 {
-        match self.shells_before(p) {
-            0 => self.index_at(p.z),
-            j => self.shells[j - 1].index_outside,
-        }
-    }
-
     /// One plane at `z_mm` between a medium of index `below` and one of index `above`.
     ///
     /// # Errors
@@ -354,11 +345,7 @@ impl OpticalLayers {
             }
         };
         let w = (to - o0).try_normalize(0.0)?;
-        let f1 = w
-            .cross(&Vector3::z())
-            .try_normalize(1e-9)
-            .unwrap_or_else(|| w.cross(&Vector3::x()).normalize());
-        let f2 = w.cross(&f1);
+        let (f1, f2) = across(&w);
         let miss = |d: &Vector3<f64>| -> Option<nalgebra::Vector2<f64>> {
             let (o, u) = end(d)?;
             let uw = u.dot(&w);
@@ -369,11 +356,7 @@ impl OpticalLayers {
             Some(nalgebra::Vector2::new(x.dot(&f1), x.dot(&f2)))
         };
         let along = |d: &Vector3<f64>, a: f64, b: f64| -> Vector3<f64> {
-            let e1 = d
-                .cross(&Vector3::z())
-                .try_normalize(1e-9)
-                .unwrap_or_else(|| d.cross(&Vector3::x()).normalize());
-            let e2 = d.cross(&e1);
+            let (e1, e2) = across(d);
             (d + a * e1 + b * e2).normalize()
         };
         let mut d = d0;
@@ -584,6 +567,15 @@ impl OpticalLayers {
             ),
         ))
     }
+}
+
+/// Two unit vectors across the unit vector `v`, each perpendicular to it and to the other.
+fn across(v: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+    let e1 = v
+        .cross(&Vector3::z())
+        .try_normalize(1e-9)
+        .unwrap_or_else(|| v.cross(&Vector3::x()).normalize());
+    (e1, v.cross(&e1))
 }
 
 /// How far under the lowest plane [`Imaging::admissible_start`] puts a camera that a start

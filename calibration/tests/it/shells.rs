@@ -366,3 +366,47 @@ fn a_start_that_hides_pins_behind_the_mouth_is_moved_up() {
         sol.inliers.iter().filter(|&&i| i).count()
     );
 }
+
+/// An extrinsics file's tube faces are read back as written (`optical_path.shells`, the form
+/// `calibrate extrinsics --design` writes), and a face with a field that is not a number, or
+/// faces that do not nest, are refused naming the field.
+#[test]
+fn an_extrinsics_files_faces_are_read_back_or_refused_by_field() {
+    use fabkit_calibration::groundtruth::inputs::read_optical_path;
+    let d = tempfile::tempdir().unwrap();
+    let write = |shells: serde_json::Value| {
+        let p = d.path().join("extrinsics.json");
+        let j = serde_json::json!({"optical_path": {
+            "planes": [{"z_mm": -9.0, "index_above": 1.41, "what": "gel"}],
+            "shells": shells,
+        }});
+        std::fs::write(&p, serde_json::to_vec(&j).unwrap()).unwrap();
+        p
+    };
+    let face = |r: f64, b: f64, n: f64| {
+        serde_json::json!({"radius_mm": r, "centre_z_mm": 0.0, "join_z_mm": 0.0,
+            "bottom_z_mm": -9.0, "outside_bottom_z_mm": b, "index_outside": n, "what": "face"})
+    };
+    let p = write(serde_json::json!([
+        face(9.0, -9.0, 1.473),
+        face(10.0, -6.0, 1.41)
+    ]));
+    let (layers, summary) = read_optical_path(&p).unwrap().unwrap();
+    assert_eq!(layers, rtac0_path());
+    assert_eq!(summary["shells"][1]["outside_bottom_z_mm"], -6.0);
+    let mut bad = face(9.0, -9.0, 1.473);
+    bad["radius_mm"] = serde_json::json!("nine");
+    let e = read_optical_path(&write(serde_json::json!([bad])))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("optical_path.shells[0].radius_mm") && e.contains("must be a number"),
+        "{e}"
+    );
+    let p = write(serde_json::json!([
+        face(10.0, -9.0, 1.473),
+        face(9.0, -6.0, 1.41)
+    ]));
+    let e = read_optical_path(&p).unwrap_err().to_string();
+    assert!(e.contains("optical_path.shells[1].radius_mm"), "{e}");
+}
