@@ -578,7 +578,7 @@ pub struct PathShell {
     /// Where the medium outside begins, mm: the core's open end for its inner face, the base
     /// plane for the faces of the layers cast above it (below it is the housing's seat).
     pub outside_bottom_z_mm: f64,
-    /// What the face is, naming its parameters (`core: the inner face`).
+    /// What the face is, naming its parameters (`core: the core's inner face`).
     pub what: String,
     /// The medium outside it: a material key.
     pub outside: String,
