@@ -544,6 +544,47 @@ pub struct FlatInterface {
     pub what: String,
 }
 
+/// The camera's lens as a section family places it ([`crate::parts::family::Family::lens`]):
+/// on the sensor's axis, looking along +z.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Lens {
+    /// Height of the lens's front, sensor frame z, mm: taken as the camera's centre of
+    /// projection (the entrance pupil of a short wide-angle lens lies close behind its front
+    /// element; R-Tac0's, measured from its authors' pose, 8.4 mm under the filling gel's free
+    /// surface, issue 97).
+    pub front_z_mm: f64,
+    /// The lens's full view angle, degrees, in (0, 180), when the design gives it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub view_angle_deg: Option<f64>,
+    /// Where it comes from, naming its parameters (`housing.camera.lens_height_mm`).
+    pub what: String,
+}
+
+/// The lens of the first section family of `design` that places one ([`Lens`]).
+pub fn lens(design: &Design, stack: &Stack) -> Option<Lens> {
+    FAMILIES.iter().find_map(|f| f.lens(design, stack))
+}
+
+/// What the camera of `design` sees through: its [`Lens`] and the [`OpticalPath`] in front of
+/// it, the stack resolved at `tol` and the indices from the embedded materials table. `None`
+/// when no section family places a lens.
+///
+/// # Errors
+/// The design's validation errors, and [`optical_path`]'s.
+pub fn camera_view_of_design(
+    design: &Design,
+    tol: crate::geometry::ChordTolerance,
+) -> Result<Option<(Lens, OpticalPath)>, crate::error::DesignError> {
+    use crate::error::DesignError;
+    let (stack, materials) = validated_stack(design, tol)?;
+    let Some(lens) = lens(design, &stack) else {
+        return Ok(None);
+    };
+    let path = optical_path(design, &stack, &materials)
+        .map_err(|e| DesignError::Params(crate::ParamErrors(vec![e])))?;
+    Ok(Some((lens, path)))
+}
+
 /// The medium key of air (n = 1.000 at the sodium D line; 1.0003 in fact, a 0.03 % bend
 /// ignored), the medium a camera file's lens was calibrated in.
 pub const AIR: &str = "air";

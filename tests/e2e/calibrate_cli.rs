@@ -499,11 +499,12 @@ fn the_point_tables_design_gives_the_optical_path_only_when_it_is_the_tables() {
     let d = tempfile::tempdir().unwrap();
     let dir = d.path();
     // a user's design: R-Tac0's with a preset that fills the light chamber instead of the core
+    // (the lens's front under the gel's surface at the LED PCB's face)
     let yaml =
         std::fs::read_to_string(crate::common::repo_root().join("designs/library/rtac0.yaml"))
             .unwrap()
             .replace("name: rtac0", "name: mine")
-            + "  chamber:\n    housing.filling_gel.fills: chamber\n";
+            + "  chamber:\n    housing.filling_gel.fills: chamber\n    housing.camera.lens_height_mm: 4.0\n";
     std::fs::write(dir.join("mine.yaml"), &yaml).unwrap();
     for (design, out) in [("rtac0", "fx"), ("mine.yaml", "fm")] {
         let o = run(

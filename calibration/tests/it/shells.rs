@@ -234,6 +234,65 @@ fn the_ray_through_the_tube_agrees_with_a_meridional_trace() {
     assert_eq!(cam.intrinsics().fx_px, 215.0);
 }
 
+/// How far round R-Tac0's skin (R15) the camera at z = -17.4 sees, by an independent
+/// meridional trace: the steeper the launch, the farther round the skin the ray ends, until it
+/// leaves the glass's outer face (R10) at the base plane, z = -6, below which the housing's
+/// seat holds the core and nothing passes. The launch that leaves there, found by bisection,
+/// ends at 80.601 deg from the pole (measured); `direction_to` reaches the skin 0.05 deg short
+/// of it and not 0.05 deg beyond. The pin dome's default rings keep their imprints inside this
+/// (fabkit-fixtures, `default_rings_stay_in_the_camera_view`).
+#[test]
+fn the_view_through_the_tube_ends_where_the_glass_meets_the_housing() {
+    // (the x and z where the ray launched at theta from the axis leaves the face of radius
+    // r_out, and the polar angle at which it then reaches the R15 skin)
+    let trace = |theta: f64| -> (f64, f64) {
+        let (mut x, mut z) = (8.4 * theta.tan(), -9.0);
+        let mut phi = (theta.sin() / 1.41).asin();
+        let mut n1 = 1.41;
+        let mut glass_exit_z = f64::NAN;
+        for (r, n2) in [(9.0, 1.473), (10.0, 1.41), (15.0, 1.41)] {
+            let (s, c) = (phi.sin(), phi.cos());
+            let b = x * s + z * c;
+            let disc = b * b - (x * x + z * z - r * r);
+            let t = -b + disc.max(0.0).sqrt();
+            let (nx, nz, normal) = if disc >= 0.0 && z + t * c > 0.0 {
+                (x + t * s, z + t * c, (x + t * s).atan2(z + t * c))
+            } else {
+                // the face's cylinder below its hemisphere
+                let t = (r - x) / s;
+                (r, z + t * c, std::f64::consts::FRAC_PI_2)
+            };
+            if r == 10.0 {
+                glass_exit_z = nz;
+            }
+            let inc = phi - normal;
+            phi = normal + (n1 / n2 * inc.sin()).asin();
+            (x, z, n1) = (nx, nz, n2);
+        }
+        (glass_exit_z, x.atan2(z).to_degrees())
+    };
+    let (mut lo, mut hi) = (0.5f64, 0.8f64);
+    assert!(trace(lo).0 > -6.0 && trace(hi).0 < -6.0);
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if trace(mid).0 > -6.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let reach_deg = trace(lo).1;
+    assert!((reach_deg - 80.601).abs() < 1e-3, "{reach_deg}");
+    let path = rtac0_path();
+    let c = Vector3::new(0.0, 0.0, -17.4);
+    let on_skin = |deg: f64| {
+        let p = deg.to_radians();
+        Vector3::new(15.0 * p.sin(), 0.0, 15.0 * p.cos())
+    };
+    assert!(path.direction_to(&c, &on_skin(reach_deg - 0.05)).is_some());
+    assert!(path.direction_to(&c, &on_skin(reach_deg + 0.05)).is_none());
+}
+
 #[test]
 fn bad_shells_are_named_errors() {
     let base = || OpticalLayers::single(-9.0, 1.0, 1.41).unwrap();

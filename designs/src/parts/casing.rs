@@ -29,7 +29,7 @@ use super::{Part, PrintTechnology};
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{cuboid, ChordTolerance, GeometryError, Solid};
 use crate::materials::MaterialKind;
-use crate::optics::{ring_of_lights, Light};
+use crate::optics::{ring_of_lights, Lens, Light};
 use crate::parts::context::Context;
 use crate::parts::context::Stack;
 use crate::parts::family::{named, AssemblyInput, AssemblyStep, Built, Family, FamilyInput};
@@ -949,6 +949,14 @@ impl Family for CasingFamily {
             ));
         }
         v
+    }
+
+    fn lens(c: &CasingParams, ctx: &Context<'_>, _stack: &Stack) -> Option<Lens> {
+        Some(Lens {
+            front_z_mm: levels(ctx, c).lens_z_mm,
+            view_angle_deg: None,
+            what: "casing.camera.lens_height_mm: the lens's front over the board's top".into(),
+        })
     }
 
     fn lights(c: &CasingParams, ctx: &Context<'_>, _stack: &Stack) -> Vec<Light> {

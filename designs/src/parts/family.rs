@@ -9,7 +9,7 @@
 use crate::error::{DesignError, ParamError};
 use crate::geometry::{ChordTolerance, GeometryError, Solid};
 use crate::materials::{CastReport, MaterialKind};
-use crate::optics::{FlatInterface, Light};
+use crate::optics::{FlatInterface, Lens, Light};
 use crate::parts::context::{Context, Stack};
 use crate::parts::cut_part::CutPart;
 use crate::parts::member::Member;
@@ -188,6 +188,13 @@ pub trait Family {
         _stack: &Stack,
     ) -> Vec<FlatInterface> {
         Vec::new()
+    }
+
+    /// The camera's lens it carries, sensor frame ([`crate::optics::Lens`]): where the
+    /// camera looks from and how wide, which the calibration fixtures keep their points in
+    /// view of; `None` when it carries no camera or its design does not say where the lens is.
+    fn lens(_p: &Self::Params, _ctx: &Context<'_>, _stack: &Stack) -> Option<Lens> {
+        None
     }
 
     /// About how many triangles its parts' surfaces make at `tol`, for the work bound checked

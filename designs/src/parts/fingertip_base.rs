@@ -26,7 +26,7 @@ use super::{Part, PrintTechnology};
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{ChordTolerance, GeometryError, Solid};
 use crate::materials::MaterialKind;
-use crate::optics::{Light, DEFAULT_LED_INTENSITY};
+use crate::optics::{Lens, Light, DEFAULT_LED_INTENSITY};
 use crate::parts::context::Context;
 use crate::parts::context::Stack;
 use crate::parts::cut_part::{CutPart, Operation, Outline};
@@ -851,6 +851,14 @@ impl Family for FingertipBaseFamily {
                 &[MaterialKind::Print],
             ),
         ]
+    }
+
+    fn lens(f: &FingertipBase, ctx: &Context<'_>, stack: &Stack) -> Option<Lens> {
+        Some(Lens {
+            front_z_mm: levels(ctx, f, stack).shell_end_z_mm,
+            view_angle_deg: Some(f.camera.view_angle_deg),
+            what: "fingertip_base.camera.length_mm: the camera's front flush with the diffusion ring's top".into(),
+        })
     }
 
     fn lights(f: &FingertipBase, ctx: &Context<'_>, stack: &Stack) -> Vec<Light> {

@@ -9,7 +9,7 @@ use std::marker::PhantomData;
 use crate::error::{DesignError, ParamError};
 use crate::geometry::ChordTolerance;
 use crate::materials::{CastReport, MaterialKind};
-use crate::optics::{FlatInterface, Light};
+use crate::optics::{FlatInterface, Lens, Light};
 use crate::parts::context::Stack;
 use crate::parts::cut_part::CutPart;
 use crate::parts::family::{
@@ -46,6 +46,8 @@ pub trait Section: Sync {
     fn lights(&self, d: &Design, stack: &Stack) -> Vec<Light>;
     /// [`Family::flat_interfaces`]; empty without the family.
     fn flat_interfaces(&self, d: &Design, stack: &Stack) -> Vec<FlatInterface>;
+    /// [`Family::lens`]; `None` without the family.
+    fn lens(&self, d: &Design, stack: &Stack) -> Option<Lens>;
     /// [`Family::filling_pour`]; `None` without the family.
     ///
     /// # Errors
@@ -167,6 +169,10 @@ impl<F: Family> Section for Registered<F> {
 
     fn flat_interfaces(&self, d: &Design, stack: &Stack) -> Vec<FlatInterface> {
         (self.params)(d).map_or_else(Vec::new, |p| F::flat_interfaces(p, &d.context(), stack))
+    }
+
+    fn lens(&self, d: &Design, stack: &Stack) -> Option<Lens> {
+        (self.params)(d).and_then(|p| F::lens(p, &d.context(), stack))
     }
 
     fn filling_pour<'d>(

@@ -29,7 +29,7 @@ use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::Polyline2;
 use crate::geometry::{cuboid, cylinder, revolve, ChordTolerance, GeometryError, Solid};
 use crate::materials::CastReport;
-use crate::optics::{ring_of_lights, FlatInterface, Light};
+use crate::optics::{ring_of_lights, FlatInterface, Lens, Light};
 use crate::parts::bayonet::Bayonet;
 pub use crate::parts::bayonet::BayonetLugs;
 use crate::parts::context::Context;
@@ -1061,6 +1061,14 @@ impl Family for ShaftBodyFamily {
                 what: format!("shaft_body.lens_window: the window's top face, {what}"),
             },
         ]
+    }
+
+    fn lens(sb: &ShaftBodyParams, ctx: &Context<'_>, _stack: &Stack) -> Option<Lens> {
+        Some(Lens {
+            front_z_mm: levels(ctx, sb).lens_z_mm,
+            view_angle_deg: Some(sb.camera.view_angle_deg),
+            what: "shaft_body.camera.lens_height_mm: the lens's front over the board's top".into(),
+        })
     }
 
     fn lights(sb: &ShaftBodyParams, ctx: &Context<'_>, _stack: &Stack) -> Vec<Light> {

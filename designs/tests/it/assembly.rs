@@ -131,7 +131,10 @@ fn a_gel_that_fills_the_chamber_reaches_the_led_pcb() {
         .find(|(n, _)| *n == "rtac0")
         .unwrap()
         .1
-        .replace("fills: core ", "fills: chamber ");
+        .replace("fills: core ", "fills: chamber ")
+        // the lens's front under the gel's surface at the PCB's face (z = -21): 4 mm over the
+        // spigot's top (z = -25.65)
+        .replace("lens_height_mm: 8.25 ", "lens_height_mm: 4.0 ");
     let design = fabkit_designs::Design::from_yaml(&text, "rtac0.yaml").unwrap();
     let kit = build_kit(&design, ChordTolerance::new(0.05).unwrap()).unwrap();
     let gel = member(&kit.assembly, "filling_gel");

@@ -233,6 +233,14 @@ fn markers_and_dimples_come_from_the_layers_features() {
     }
 }
 
+/// R-Tac0 with its gel filling the light chamber down to the LED PCB's face (z = -21) and the
+/// lens's front under it, 4 mm over the spigot's top (z = -25.65).
+fn chamber_fill(rtac0_yaml: &str) -> String {
+    rtac0_yaml
+        .replace("fills: core ", "fills: chamber ")
+        .replace("lens_height_mm: 8.25 ", "lens_height_mm: 4.0 ")
+}
+
 fn path_of(d: &Design) -> Result<fabkit_designs::optics::OpticalPath, fabkit_designs::ParamError> {
     let m = MaterialsTable::embedded().unwrap();
     let s = stack::validate(d, &m, ChordTolerance::new(0.01).unwrap()).unwrap();
@@ -281,8 +289,7 @@ fn each_sensor_gives_its_flat_optical_path() {
         .find(|(n, _)| *n == "rtac0")
         .unwrap()
         .1;
-    let chamber =
-        Design::from_yaml(&yaml.replace("fills: core ", "fills: chamber "), "r.yaml").unwrap();
+    let chamber = Design::from_yaml(&chamber_fill(yaml), "r.yaml").unwrap();
     let p = path_of(&chamber).unwrap();
     assert!(near(p.planes[0].z_mm, -21.0), "{p:?}");
     // a gel without a refractive index in the table is an error naming the gel's path

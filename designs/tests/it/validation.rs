@@ -219,6 +219,15 @@ fn single_mutations() -> Vec<Mutation> {
             },
         ),
         (
+            "lens view angle of 180 deg",
+            |d| housing(d).camera.view_angle_deg = Some(180.0),
+            Expect {
+                path: "housing.camera.view_angle_deg",
+                value: "180",
+                rule: &["must be in (0, 180)"],
+            },
+        ),
+        (
             "diffuser wider than the shell",
             |d| housing(d).diffuser.outer_diameter_mm = 30.5,
             Expect {
@@ -1080,4 +1089,36 @@ fn pinki_min_wall_is_the_open_blocks_or_the_skin_over_its_seat() {
     let (w, at) = least(&d);
     assert!((w - 0.5).abs() < 1e-9, "{w} at {at}");
     assert!(at.starts_with("layers[0].recess: the skin between"), "{at}");
+}
+
+/// The lens's front must sit in the air under the gel's free surface (z = -9, the core's open
+/// end, which the resolved core places): 17 mm over the spigot's top (z = -25.65) is above it;
+/// 16.6 mm, 0.05 mm under it, passes. A lens under a broken stack is checked once the stack is
+/// sound.
+#[test]
+fn lens_above_the_gel_surface_is_named() {
+    let mut d = baseline();
+    housing(&mut d).camera.lens_height_mm = Some(17.0);
+    assert_exactly(
+        &errors(&d),
+        &[&Expect {
+            path: "housing.camera.lens_height_mm",
+            value: "17",
+            rule: &[
+                "lens's front at z = -8.65 mm",
+                "not below the filling gel's free surface (z = -9.00 mm)",
+            ],
+        }],
+    );
+    housing(&mut d).camera.lens_height_mm = Some(16.6);
+    assert_exactly(&errors(&d), &[]);
+    housing(&mut d).camera.lens_height_mm = Some(-1.0);
+    assert_exactly(
+        &errors(&d),
+        &[&Expect {
+            path: "housing.camera.lens_height_mm",
+            value: "-1",
+            rule: &["must be above 0"],
+        }],
+    );
 }

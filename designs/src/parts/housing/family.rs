@@ -10,7 +10,7 @@ use super::{
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{cuboid, cylinder, revolve, ChordTolerance, GeometryError, Solid};
 use crate::materials::{cure_text, CastReport, MaterialKind};
-use crate::optics::{ring_of_lights, FlatInterface, Light};
+use crate::optics::{ring_of_lights, FlatInterface, Lens, Light};
 use crate::parts::axial_ring;
 use crate::parts::context::{Context, Stack};
 use crate::parts::cut_part::{CutPart, Operation, Outline};
@@ -144,6 +144,15 @@ impl Family for HousingFamily {
             Some([0.0, 0.0, 1.0]),
             |_| [1.0, 1.0, 1.0],
         )
+    }
+
+    fn lens(h: &HousingParams, ctx: &Context<'_>, stack: &Stack) -> Option<Lens> {
+        let lv = shell_levels(ctx, h, stack)?;
+        Some(Lens {
+            front_z_mm: super::lens_front_z_mm(h, &lv)?,
+            view_angle_deg: h.camera.view_angle_deg,
+            what: "housing.camera.lens_height_mm: the lens's front over the board's mount".into(),
+        })
     }
 
     fn flat_interfaces(h: &HousingParams, ctx: &Context<'_>, stack: &Stack) -> Vec<FlatInterface> {

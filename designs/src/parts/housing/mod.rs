@@ -139,6 +139,19 @@ pub struct CameraBay {
     /// Pilot hole for the self-tapping mounting screws, mm.
     #[schemars(extend("exclusiveMinimum" = 0))]
     pub mount_pilot_diameter_mm: f64,
+    /// Height of the lens's front, taken as the camera's centre of projection, over the face
+    /// the board is mounted by, mm, > 0: the base spigot's top (`round_tube`, the board's
+    /// underside) or the bulkhead's underside (`square_split`, the board's top face). The
+    /// front must sit in air under the optical path: below the filling gel's free surface,
+    /// or the diffuser without a gel. Optional: without it the design places no lens, and
+    /// the pin dome's default rings are not kept inside the camera's view.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    pub lens_height_mm: Option<f64>,
+    /// Full view angle of the lens, degrees, in (0, 180); optional.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schemars(extend("exclusiveMinimum" = 0, "exclusiveMaximum" = 180))]
+    pub view_angle_deg: Option<f64>,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
@@ -284,6 +297,14 @@ pub fn levels(ctx: &Context<'_>, h: &HousingParams, core: &ResolvedCore) -> Shel
     }
 }
 
+/// Height of the lens's front (sensor frame z, mm) with the shell's levels `lv`:
+/// `camera.lens_height_mm` over the face the board is mounted by (the base spigot's top of a
+/// round tube, the bulkhead's underside of a square shell); `None` when it is not given.
+pub fn lens_front_z_mm(h: &HousingParams, lv: &ShellLevels) -> Option<f64> {
+    let mount = lv.base_top_z_mm.unwrap_or(lv.bulkhead_z_mm);
+    h.camera.lens_height_mm.map(|l| mount + l)
+}
+
 /// The tube parameters when the housing is a round tube (and they are given).
 fn round_tube(h: &HousingParams) -> Option<&RoundTube> {
     match h.style {
@@ -369,6 +390,15 @@ pub fn check_housing_params(
         h.led_pcb.inner_diameter_mm,
         errs,
     );
+    if let Some(v) = h.camera.view_angle_deg {
+        if !(v > 0.0 && v < 180.0) {
+            errs.push(ParamError::new(
+                "housing.camera.view_angle_deg",
+                v,
+                "must be in (0, 180)",
+            ));
+        }
+    }
     check_housing_walls(ctx, h, errs);
     check_housing_seats(ctx, h, errs);
     match h.style {
@@ -734,12 +764,51 @@ fn check_housing_core(
             "needs a hollow core: the core's inner surface (its wall inside the outer surface) folds or vanishes",
         ));
     }
+    check_lens(ctx, h, core, errs);
     if core.below_base_mm < 1.0 {
         errs.push(ParamError::new(
             "core.length_mm",
             ctx.core.map_or(0.0, |c| c.length_mm),
             "the core must reach at least 1 mm below the base plane to seat in the housing",
         ));
+    }
+}
+
+/// Rules on the lens when it is placed, with the resolved core (which places the gel's free
+/// surface): `camera.lens_height_mm` above 0 with the lens's front in air under the optical
+/// path (below the filling gel's free surface, or the diffuser without a gel).
+fn check_lens(
+    ctx: &Context<'_>,
+    h: &HousingParams,
+    core: &ResolvedCore,
+    errs: &mut Vec<ParamError>,
+) {
+    let Some(l) = h.camera.lens_height_mm else {
+        return;
+    };
+    if !(l > 0.0 && l.is_finite()) {
+        errs.push(ParamError::new(
+            "housing.camera.lens_height_mm",
+            l,
+            "must be above 0",
+        ));
+        return;
+    }
+    let lv = levels(ctx, h, core);
+    let (limit, what) = match gel_free_surface_z_mm(h, &lv) {
+        Some(z) => (z, "the filling gel's free surface"),
+        None => (lv.diffuser_z_mm, "the diffuser's underside"),
+    };
+    if let Some(front) = lens_front_z_mm(h, &lv) {
+        if front >= limit {
+            errs.push(ParamError::new(
+                "housing.camera.lens_height_mm",
+                l,
+                format!(
+                    "puts the lens's front at z = {front:.2} mm, not below {what} (z = {limit:.2} mm): the camera looks from the air under it"
+                ),
+            ));
+        }
     }
 }
 
