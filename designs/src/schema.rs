@@ -12,6 +12,7 @@ pub use crate::yaml::{
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
+pub mod optics;
 pub mod printers;
 pub mod shared;
 pub use crate::parts::housing::{
@@ -81,7 +82,7 @@ pub struct Design {
     /// How the inside is lit and imaged, for rendering what the camera sees; the families'
     /// lights and default reflectance and camera response when not given.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub optics: Option<crate::optics::OpticsParams>,
+    pub optics: Option<optics::OpticsParams>,
     #[serde(default)]
     pub printers: PrinterProfiles,
     #[serde(default)]

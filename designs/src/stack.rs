@@ -682,7 +682,7 @@ fn check_with_stack(
         f.check(design, st.as_ref(), errs);
     }
     if let Some(o) = &design.optics {
-        crate::optics::check(o, errs);
+        crate::schema::optics::check(o, errs);
     }
     if let (Some(c), true) = (sound_core, errs.is_empty()) {
         if let Some(first) = layers.iter().find(|l| {

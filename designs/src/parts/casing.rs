@@ -29,7 +29,7 @@ use super::{Part, PrintTechnology};
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{cuboid, ChordTolerance, GeometryError, Solid};
 use crate::materials::MaterialKind;
-use crate::optics::{ring_of_lights, Lens, Light};
+use crate::optics::elements::{ring_of_lights, Lens, Light};
 use crate::parts::context::Context;
 use crate::parts::context::Stack;
 use crate::parts::family::{named, AssemblyInput, AssemblyStep, Built, Family, FamilyInput};

@@ -9,7 +9,7 @@
 use crate::error::{DesignError, ParamError};
 use crate::geometry::{ChordTolerance, GeometryError, Solid};
 use crate::materials::{CastReport, MaterialKind};
-use crate::optics::{FlatInterface, Lens, Light};
+use crate::optics::elements::{FlatInterface, Lens, Light};
 use crate::parts::context::{Context, Stack};
 use crate::parts::cut_part::CutPart;
 use crate::parts::member::Member;

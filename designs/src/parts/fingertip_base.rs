@@ -26,7 +26,7 @@ use super::{Part, PrintTechnology};
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{ChordTolerance, GeometryError, Solid};
 use crate::materials::MaterialKind;
-use crate::optics::{Lens, Light, DEFAULT_LED_INTENSITY};
+use crate::optics::elements::{Lens, Light, DEFAULT_LED_INTENSITY};
 use crate::parts::context::Context;
 use crate::parts::context::Stack;
 use crate::parts::cut_part::{CutPart, Operation, Outline};

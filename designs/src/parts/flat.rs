@@ -263,7 +263,7 @@ fn check_design_sections(design: &crate::schema::Design, errs: &mut Vec<ParamErr
     crate::parts::molds::check_mold_params(design, errs);
     crate::schema::printers::check_printers(&design.printers, errs);
     if let Some(o) = &design.optics {
-        crate::optics::check(o, errs);
+        crate::schema::optics::check(o, errs);
     }
     if !(0.0..=1.0).contains(&design.casting.waste_allowance) {
         errs.push(ParamError::new(

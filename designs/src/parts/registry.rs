@@ -9,7 +9,7 @@ use std::marker::PhantomData;
 use crate::error::{DesignError, ParamError};
 use crate::geometry::ChordTolerance;
 use crate::materials::{CastReport, MaterialKind};
-use crate::optics::{FlatInterface, Lens, Light};
+use crate::optics::elements::{FlatInterface, Lens, Light};
 use crate::parts::context::Stack;
 use crate::parts::cut_part::CutPart;
 use crate::parts::family::{

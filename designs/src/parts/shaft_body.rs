@@ -29,7 +29,7 @@ use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::Polyline2;
 use crate::geometry::{cuboid, cylinder, revolve, ChordTolerance, GeometryError, Solid};
 use crate::materials::CastReport;
-use crate::optics::{ring_of_lights, FlatInterface, Lens, Light};
+use crate::optics::elements::{ring_of_lights, FlatInterface, Lens, Light};
 use crate::parts::bayonet::Bayonet;
 pub use crate::parts::bayonet::BayonetLugs;
 use crate::parts::context::Context;
@@ -1046,7 +1046,10 @@ impl Family for ShaftBodyFamily {
         let lv = levels(ctx, sb);
         let (above, what) = match &sb.filling_gel {
             Some(g) => (g.material.clone(), "under the filling gel"),
-            None => (crate::optics::AIR.to_string(), "under the tip's air"),
+            None => (
+                crate::optics::elements::AIR.to_string(),
+                "under the tip's air",
+            ),
         };
         vec![
             FlatInterface {

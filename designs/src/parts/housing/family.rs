@@ -10,7 +10,7 @@ use super::{
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{cuboid, cylinder, revolve, ChordTolerance, GeometryError, Solid};
 use crate::materials::{cure_text, CastReport, MaterialKind};
-use crate::optics::{ring_of_lights, FlatInterface, Lens, Light};
+use crate::optics::elements::{ring_of_lights, FlatInterface, Lens, Light};
 use crate::parts::axial_ring;
 use crate::parts::context::{Context, Stack};
 use crate::parts::cut_part::{CutPart, Operation, Outline};
@@ -21,7 +21,7 @@ use crate::parts::family::{
 };
 use crate::parts::fasteners::{metric_from_pilot, metric_name};
 use crate::parts::{ExactShape, Member, MemberKind, Part, ProcedureAction, ProcedureStep};
-use crate::schema::GelFill;
+use crate::schema::shared::GelFill;
 use serde_json::json;
 
 /// The housing (`housing` in a design): the sensor shell in one of its two styles.

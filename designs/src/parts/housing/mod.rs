@@ -32,7 +32,7 @@ use crate::parts::context::ResolvedCore;
 use crate::parts::family::FamilyInput;
 use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::{Part, PrintTechnology};
-use crate::schema::{FillingGel, GelFill};
+use crate::schema::shared::{FillingGel, GelFill};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
