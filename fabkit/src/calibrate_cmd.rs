@@ -6,9 +6,11 @@ use std::path::PathBuf;
 use fabkit_calibration::capture_images::CaptureImages;
 use fabkit_calibration::refine::RefineParameters;
 use fabkit_calibration::{
-    calibrate_extrinsics, DistortionModelHint, ExtrinsicsJob, Observed, PointsFrom, RansacOptions,
+    calibrate_extrinsics, ExtrinsicsJob, Observed, PointsFrom, RansacOptions,
 };
 use fabkit_export::{OutputClaim, OutputCommand, StagedDir};
+
+use crate::args::CameraArgs;
 
 #[derive(clap::Subcommand, Debug)]
 pub enum CalibrateCommand {
@@ -26,51 +28,6 @@ pub enum PointsFromArg {
     Tip,
     /// The contact columns (contact_x_mm, ...).
     Contact,
-}
-
-/// `--camera-model`: the distortion model names of ROS and OpenCV.
-#[derive(clap::ValueEnum, Clone, Copy, Debug)]
-pub enum CameraModelArg {
-    /// Kannala-Brandt, k1..k4 (cv2.fisheye).
-    #[value(name = "fisheye")]
-    Fisheye,
-    /// k1, k2, p1, p2[, k3] (cv2.calibrateCamera).
-    #[value(name = "plumb_bob")]
-    PlumbBob,
-    /// k1, k2, p1, p2, k3..k6 (cv2.calibrateCamera with CALIB_RATIONAL_MODEL).
-    #[value(name = "rational_polynomial")]
-    RationalPolynomial,
-}
-
-impl From<CameraModelArg> for DistortionModelHint {
-    fn from(a: CameraModelArg) -> DistortionModelHint {
-        match a {
-            CameraModelArg::Fisheye => DistortionModelHint::Fisheye,
-            CameraModelArg::PlumbBob => DistortionModelHint::PlumbBob,
-            CameraModelArg::RationalPolynomial => DistortionModelHint::RationalPolynomial,
-        }
-    }
-}
-
-/// The camera options of every command that reads a camera file.
-#[derive(clap::Args, Debug)]
-pub struct CameraArgs {
-    /// Camera file: OpenCV FileStorage YAML or XML, ROS camera_info YAML or fabkit JSON.
-    #[arg(long, value_name = "CAM")]
-    pub camera: PathBuf,
-    /// Distortion model of a camera file that does not name one (e.g. the 4 coefficients of
-    /// cv2.fisheye.calibrate)
-    #[arg(long, value_enum, value_name = "MODEL")]
-    pub camera_model: Option<CameraModelArg>,
-}
-
-impl CameraArgs {
-    /// The camera of `--camera` (with `--camera-model` for a file that names none).
-    pub fn read(
-        &self,
-    ) -> Result<fabkit_calibration::CameraModel, fabkit_calibration::CameraFileError> {
-        fabkit_calibration::read_camera_file_as(&self.camera, self.camera_model.map(Into::into))
-    }
 }
 
 #[derive(clap::Args, Debug)]
@@ -161,7 +118,7 @@ pub struct ExtrinsicsArgs {
     #[arg(long, value_name = "NAME", requires = "design")]
     pub preset: Option<String>,
     #[command(flatten)]
-    pub(crate) data_files: crate::cli::DataFileArgs,
+    pub(crate) data_files: crate::args::DataFileArgs,
 }
 
 pub fn run(cmd: CalibrateCommand) -> Result<(), Box<dyn Error>> {
@@ -208,7 +165,7 @@ fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
     let (optical_path, optical_path_from) = match (&a.design, a.straight_rays) {
         (_, true) => (None, None),
         (Some(d), false) => {
-            let mut loaded = crate::cli::load_design(Some(d), &a.data_files)?;
+            let mut loaded = crate::args::load_design(Some(d), &a.data_files)?;
             if let Some(p) = &a.preset {
                 loaded.apply_preset(p)?;
             }
@@ -416,7 +373,7 @@ fn plane_names(path: &fabkit_designs::optics::OpticalPath) -> Vec<&str> {
 /// [`TableDesign`] of the point table `points`. The design is used only when it reads as it
 /// did when the table was written (the same sha256) and its presets, which the provenance does
 /// not record, leave its optical path as it is.
-fn table_design(points: &std::path::Path, data: &crate::cli::DataFileArgs) -> TableDesign {
+fn table_design(points: &std::path::Path, data: &crate::args::DataFileArgs) -> TableDesign {
     let side = points.with_extension("json");
     let Some(prov) = std::fs::read(&side)
         .ok()
@@ -437,7 +394,7 @@ fn table_design(points: &std::path::Path, data: &crate::cli::DataFileArgs) -> Ta
     else {
         return TableDesign::Unknown;
     };
-    let loaded = match crate::cli::load_design(Some(arg), data) {
+    let loaded = match crate::args::load_design(Some(arg), data) {
         Ok(l) => l,
         Err(e) => {
             return TableDesign::Unusable(format!(

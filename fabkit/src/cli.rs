@@ -1,12 +1,12 @@
 //! The `fabkit` command line: argument parsing, dispatch, progress and error printing.
 //! No geometry here.
 
+use crate::args::{load_design, print_parts, tolerance, DataFileArgs, MeshOutputArgs};
 use clap::{Parser, Subcommand, ValueEnum};
-use fabkit_designs::input_files::DataFileRules;
 use fabkit_designs::schema::MoldStrategy;
 use fabkit_designs::timings;
-use fabkit_designs::{build_kit_bounded, library, ChordTolerance, DesignError};
-use fabkit_export::{write_kit_reporting, ExportOptions, Formats};
+use fabkit_designs::{build_kit_bounded, library, ChordTolerance};
+use fabkit_export::write_kit_reporting;
 use std::error::Error;
 
 use std::path::{Path, PathBuf};
@@ -102,123 +102,6 @@ struct ExportArgs {
     data_files: DataFileArgs,
 }
 
-/// The mesh output options of `fabkit export` and `fabkit fixtures`: what is written, for which
-/// printers, how finely, and the bound on the work.
-#[derive(clap::Args, Debug)]
-pub(crate) struct MeshOutputArgs {
-    /// Output formats, comma separated: stl, 3mf, step (exact B-rep through the CadQuery twin;
-    /// needs scripts/setup-cadquery or FABKIT_CADQUERY_PYTHON).
-    #[arg(long, value_delimiter = ',', default_value = "stl,3mf")]
-    pub format: Vec<Format>,
-    #[command(flatten)]
-    pub printer: crate::printers::PrinterArgs,
-    /// Largest distance between the exported meshes and the exact solids, mm (seams included).
-    #[arg(long, default_value_t = ChordTolerance::DEFAULT_MM)]
-    pub chord_tolerance_mm: f64,
-    /// Also write the CSG tree of every part (fabkit-csg/1 JSON) to this file, for the
-    /// manifold3d replays (tests/oracles/replay_csg.py, export/python/twins).
-    #[arg(long)]
-    pub csg: Option<PathBuf>,
-    /// Refuse an output estimated (before building) at more triangles than this (about 1 KB of
-    /// memory each; 1 to 100000000).
-    #[arg(long, value_name = "N", default_value_t = fabkit_designs::estimate::DEFAULT_MAX_TRIANGLES,
-          value_parser = fabkit_designs::estimate::parse_max_triangles, allow_negative_numbers = true)]
-    pub max_triangles: u64,
-}
-
-impl MeshOutputArgs {
-    /// The chord tolerance, checked (`--chord-tolerance-mm` names the error).
-    pub fn tolerance(&self) -> Result<ChordTolerance, Box<dyn Error>> {
-        tolerance(self.chord_tolerance_mm)
-    }
-
-    /// Reads the design (`design`, or the default library design), applies `preset` and then
-    /// the printer overrides.
-    pub fn load(
-        &self,
-        design: Option<&str>,
-        preset: Option<&str>,
-        data: &DataFileArgs,
-    ) -> Result<Loaded, Box<dyn Error>> {
-        let t = timings::stage("read the design");
-        let mut loaded = load_design(design, data)?;
-        if let Some(p) = preset {
-            loaded.apply_preset(p)?;
-        }
-        drop(t);
-        crate::printers::apply(&self.printer, &mut loaded.design.printers)?;
-        Ok(loaded)
-    }
-
-    /// The export options of this run: formats, provenance (command line, design, version).
-    pub fn options(&self, loaded: &Loaded, tol: ChordTolerance) -> ExportOptions {
-        let format = &self.format;
-        ExportOptions::for_design(
-            Formats {
-                stl: format.contains(&Format::Stl),
-                threemf: format.contains(&Format::ThreeMf),
-                step: format.contains(&Format::Step),
-            },
-            std::env::args().collect(),
-            &loaded.source,
-            &loaded.sha256,
-            tol.mm(),
-            loaded.design.printers.clone(),
-        )
-    }
-
-    /// Refuses a `--csg` path that may not be written, before anything is built.
-    pub fn check_csg(&self) -> Result<(), Box<dyn Error>> {
-        self.csg.as_deref().map_or(Ok(()), check_csg_path)
-    }
-
-    /// Writes the CSG tree of `kit` to `--csg`, if given.
-    pub fn write_csg(&self, kit: &fabkit_designs::Kit) -> Result<(), Box<dyn Error>> {
-        self.csg
-            .as_deref()
-            .map_or(Ok(()), |path| write_csg(kit, path))
-    }
-}
-
-/// Which data files (a pattern's `csv_file`) a design file may read.
-#[derive(clap::Args, Debug, Clone, Default)]
-pub(crate) struct DataFileArgs {
-    /// Also read data files (a marker pattern's csv_file) from this folder and its subfolders;
-    /// by default only the design file's own folder is read. May be given more than once.
-    #[arg(long, value_name = "DIR", value_parser = parse_allow_data_dir)]
-    pub allow_data_dir: Vec<PathBuf>,
-    /// Largest data file, bytes (1 to 67108864).
-    #[arg(long, value_name = "BYTES", default_value_t = fabkit_designs::input_files::DEFAULT_MAX_DATA_FILE_BYTES, value_parser = parse_max_data_file_bytes,
-        allow_negative_numbers = true)]
-    pub max_data_file_bytes: u64,
-}
-
-impl DataFileArgs {
-    pub(crate) fn rules(&self) -> DataFileRules {
-        DataFileRules {
-            allowed_dirs: self.allow_data_dir.clone(),
-            max_bytes: self.max_data_file_bytes,
-        }
-    }
-}
-
-fn parse_allow_data_dir(s: &str) -> Result<PathBuf, String> {
-    DataFileRules::allow_dir(Path::new(s))
-}
-
-fn parse_max_data_file_bytes(s: &str) -> Result<u64, String> {
-    DataFileRules::parse_max_bytes(s)
-}
-
-#[derive(ValueEnum, Clone, Copy, Debug, PartialEq)]
-pub(crate) enum Format {
-    Stl,
-    #[value(name = "3mf")]
-    ThreeMf,
-    /// STEP through the CadQuery twin (export/python/twins).
-    Step,
-}
-
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq)]
 enum Strategy {
     Direct,
@@ -283,99 +166,12 @@ pub fn error_report(e: &(dyn std::error::Error + 'static)) -> String {
     format!("error: {}\n", fabkit_designs::error_report(e))
 }
 
-/// A design and where it came from.
-pub(crate) type Loaded = library::LoadedDesign;
-
-pub(crate) fn load_design(arg: Option<&str>, data: &DataFileArgs) -> Result<Loaded, DesignError> {
-    let arg = arg.unwrap_or(library::DEFAULT_DESIGN);
-    library::load_source_with(arg, Path::new(""), &data.rules())
-}
-
-/// The first bytes of every CSG file fabkit writes (`serde_json` orders the keys).
-const CSG_HEADER: &[u8] = b"{\"format\":\"fabkit-csg/1\"";
-
-/// Checks that `--csg PATH` may be written: missing, or a regular file that is an earlier
-/// fabkit CSG file. A user's own file (a design, anything else) and a symbolic link are refused.
-pub(crate) fn check_csg_path(path: &Path) -> Result<(), Box<dyn Error>> {
-    use std::io::Read as _;
-    let refuse = |why: &str| -> Box<dyn Error> {
-        format!(
-            "--csg {}: {why}; refusing to overwrite it (hint: name a new file)",
-            path.display()
-        )
-        .into()
-    };
-    let md = match std::fs::symlink_metadata(path) {
-        Ok(md) => md,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
-        Err(e) => return Err(format!("--csg {}: {e}", path.display()).into()),
-    };
-    if md.file_type().is_symlink() {
-        return Err(refuse("is a symbolic link"));
-    }
-    if !md.is_file() {
-        return Err(refuse("exists and is not a regular file"));
-    }
-    let mut head = Vec::new();
-    std::fs::File::open(path)
-        .and_then(|f| f.take(CSG_HEADER.len() as u64).read_to_end(&mut head))
-        .map_err(|e| format!("--csg {}: {e}", path.display()))?;
-    if head != CSG_HEADER {
-        return Err(refuse("exists and is not a CSG file fabkit wrote"));
-    }
-    Ok(())
-}
-
-/// Writes the CSG tree of every part of `kit` (fabkit-csg/1 JSON) to `path` (checked by
-/// [`check_csg_path`]) through a temporary sibling and a rename.
-pub(crate) fn write_csg(kit: &fabkit_designs::Kit, path: &Path) -> Result<(), Box<dyn Error>> {
-    check_csg_path(path)?;
-    let parts: Vec<(&str, &fabkit_designs::Solid)> = kit
-        .parts
-        .iter()
-        .map(|p| (p.name.as_str(), &p.solid))
-        .collect();
-    let json = serde_json::to_vec(&fabkit_designs::geometry::csg_json(&parts))?;
-    debug_assert!(json.starts_with(CSG_HEADER));
-    let name = path
-        .file_name()
-        .ok_or_else(|| format!("--csg {}: names no file", path.display()))?;
-    let tmp = path.with_file_name(format!(
-        ".{}.tmp-{}",
-        name.to_string_lossy(),
-        std::process::id()
-    ));
-    let r = std::fs::write(&tmp, &json).and_then(|()| std::fs::rename(&tmp, path));
-    if let Err(e) = r {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(format!("writing {}: {e}", path.display()).into());
-    }
-    Ok(())
-}
-
 /// A ticking spinner on stderr for a build step (hidden when stderr is not a terminal).
 pub(crate) fn spinner(message: String) -> indicatif::ProgressBar {
     let s = indicatif::ProgressBar::new_spinner();
     s.set_message(message);
     s.enable_steady_tick(std::time::Duration::from_millis(120));
     s
-}
-
-/// Prints the written parts, a line each: name, print technology, volume and file.
-pub(crate) fn print_parts(parts: &[fabkit_export::ManifestPart]) {
-    for p in parts {
-        out!(
-            "  {:34} {:4} {:>10.1} mm3  {}",
-            p.name,
-            p.print_technology.to_string(),
-            p.volume_mm3,
-            p.file.as_deref().unwrap_or("(3MF only)")
-        );
-    }
-}
-
-pub(crate) fn tolerance(mm: f64) -> Result<ChordTolerance, Box<dyn Error>> {
-    ChordTolerance::new(mm).map_err(|e| format!("--chord-tolerance-mm: {e}").into())
 }
 
 fn run(cli: Cli) -> Result<(), Box<dyn Error>> {

@@ -1,6 +1,6 @@
 //! `fabkit fixtures`: argument parsing and dispatch over fabkit-fixtures.
 
-use crate::cli::{DataFileArgs, MeshOutputArgs};
+use crate::args::{DataFileArgs, MeshOutputArgs};
 use crate::progress::Progress;
 use fabkit_export::write_kit_reporting;
 use fabkit_fixtures::params::{from_yaml, resolve};
@@ -205,6 +205,6 @@ pub fn run(args: FixturesArgs) -> Result<(), Box<dyn Error>> {
             ),
         }
     }
-    crate::cli::print_parts(&summary.manifest.parts);
+    crate::args::print_parts(&summary.manifest.parts);
     Ok(())
 }

@@ -20,7 +20,7 @@ use fabkit_calibration::groundtruth::{reference_hits, Scene};
 use fabkit_calibration::photometric::PhotometricModel;
 use fabkit_export::{OutputClaim, StagedDir};
 
-use crate::cli::{load_design, DataFileArgs};
+use crate::args::{load_design, DataFileArgs};
 
 #[derive(clap::Args, Debug)]
 pub struct GroundTruthArgs {
@@ -28,7 +28,7 @@ pub struct GroundTruthArgs {
     /// have been built from it.
     design: Option<String>,
     #[command(flatten)]
-    cam: crate::calibrate_cmd::CameraArgs,
+    cam: crate::args::CameraArgs,
     /// extrinsics.json of `fabkit calibrate extrinsics` (T_cam_sensor).
     #[arg(long, value_name = "extrinsics.json")]
     extrinsics: PathBuf,

@@ -19,6 +19,7 @@ pub use fabkit_export as export;
 pub use fabkit_fixtures as fixtures;
 pub use fabkit_sweep as sweep;
 
+pub mod args;
 pub mod calibrate_cmd;
 pub mod cli;
 pub mod fixtures_cmd;

@@ -18,7 +18,7 @@ use fabkit_export::raster::{npy_f32, png_rgb16, png_rgb8};
 use fabkit_export::{OutputClaim, OutputCommand, StagedDir};
 use serde_json::{json, Value};
 
-use crate::cli::{load_design, DataFileArgs};
+use crate::args::{load_design, DataFileArgs};
 
 #[derive(clap::Args, Debug)]
 pub struct PhotometricArgs {
@@ -26,7 +26,7 @@ pub struct PhotometricArgs {
     /// surface the pins press.
     design: Option<String>,
     #[command(flatten)]
-    cam: crate::calibrate_cmd::CameraArgs,
+    cam: crate::args::CameraArgs,
     /// extrinsics.json of `fabkit calibrate extrinsics` (T_cam_sensor) for these captures.
     #[arg(long, value_name = "extrinsics.json")]
     extrinsics: PathBuf,

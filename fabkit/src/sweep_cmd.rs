@@ -45,7 +45,7 @@ pub struct SweepArgs {
     #[arg(long)]
     force: bool,
     #[command(flatten)]
-    data_files: crate::cli::DataFileArgs,
+    data_files: crate::args::DataFileArgs,
 }
 
 #[derive(clap::Subcommand, Debug)]
