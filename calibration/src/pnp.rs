@@ -856,21 +856,6 @@ fn rotation_translation(pose: &Isometry3<f64>) -> (Matrix3<f64>, Vector3<f64>) {
     )
 }
 
-/// Reprojection cost of a pose over all pairs, px^2 (for tests and reports): the sum of the
-/// squared reprojection errors, or `None` if a point does not project.
-pub fn reprojection_cost(
-    camera: &CameraModel,
-    points_mm: &[Vector3<f64>],
-    pixels_px: &[Vector2<f64>],
-    t_cam_sensor: &Isometry3<f64>,
-) -> Option<f64> {
-    let (r, t) = rotation_translation(t_cam_sensor);
-    let camera = Imaging::straight(camera);
-    points_mm.iter().zip(pixels_px).try_fold(0.0, |s, (p, x)| {
-        Some(s + (camera.project(&r, &t, p)? - x).norm_squared())
-    })
-}
-
 /// Normal equations at a pose (J^T J, J^T e, cost); used by the Jacobian test and the
 /// Cramer-Rao bound of the benchmark. Parameters: left rotation increment w (rad), then t (mm).
 pub fn reprojection_normal_equations(

@@ -15,6 +15,7 @@
 
 use crate::ExportError;
 use fabkit_designs::geometry::Mesh;
+use fabkit_designs::primitives::{add, cross, dot, scale, sub, unit};
 use rayon::prelude::*;
 
 /// Width and height of one view of a part preview, px; the preview is two views side by side.
@@ -160,9 +161,9 @@ impl Camera {
     ) -> Self {
         let (az, el) = (dir.azimuth_deg.to_radians(), dir.elevation_deg.to_radians());
         let toward = [el.cos() * az.sin(), -el.cos() * az.cos(), el.sin()];
-        let right = normalized(cross([0.0, 0.0, 1.0], toward));
+        let right = unit(cross([0.0, 0.0, 1.0], toward));
         let up = cross(toward, right);
-        let light = normalized(add(
+        let light = unit(add(
             add(scale(right, -0.4), scale(up, 0.35)),
             scale(toward, 0.85),
         ));
@@ -460,34 +461,6 @@ fn draw_plate(objects: &[PlacedObject<'_>], bed: Option<BedOutline>) -> (Canvas,
     }
     canvas.silhouettes();
     (canvas, cam)
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-
-fn scale(a: [f64; 3], s: f64) -> [f64; 3] {
-    a.map(|v| v * s)
-}
-
-fn normalized(a: [f64; 3]) -> [f64; 3] {
-    scale(a, 1.0 / dot(a, a).sqrt())
 }
 
 /// Twice the signed area of the picture-plane triangle (a, b, c) (x and y only).

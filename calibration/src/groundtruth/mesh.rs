@@ -267,11 +267,6 @@ impl MeshCaster {
         self.index.len()
     }
 
-    /// Number of 4-wide hierarchy nodes.
-    pub fn node_count(&self) -> usize {
-        self.nodes.len()
-    }
-
     /// Casts every ray of `rays` whose `t_max_mm` is above 0 and finds its nearest hit with
     /// `0 < t < t_max`. Single-threaded; the result depends only on the inputs.
     ///

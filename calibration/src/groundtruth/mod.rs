@@ -27,7 +27,6 @@ pub mod surface;
 pub mod synthetic;
 
 use exact::ExactPrimitives;
-use mesh::{MeshCaster, NO_HIT};
 use rays::PixelRays;
 use surface::ReferenceSurface;
 
@@ -202,56 +201,6 @@ pub fn indented_hits(
                 h.t_mm[p] = c.t_mm;
                 h.normal[p] = c.normal.map(|v| -v);
                 h.contact[p] = true;
-            }
-        }
-    }
-    h
-}
-
-/// The surface seen along every ray against triangle meshes: `skin` is the closed sensor body
-/// (outward winding), `protrusions` (optional) the protrusion solids (outward winding). A hit
-/// on `skin` below `base_z_mm` is a miss; a protrusion hit is a contact (normal reversed).
-pub fn mesh_hits(
-    rays: &PixelRays,
-    skin: &MeshCaster,
-    protrusions: Option<&MeshCaster>,
-    base_z_mm: f64,
-) -> SurfaceHits {
-    let n = rays.len();
-    let s = skin.cast(rays, &vec![f64::INFINITY; n]);
-    let mut h = SurfaceHits {
-        t_mm: vec![f64::NAN; n],
-        normal: vec![[f64::NAN; 3]; n],
-        contact: vec![false; n],
-        t_exit_mm: vec![f64::NAN; n],
-    };
-    let o = rays.origin_mm;
-    for p in 0..n {
-        if s.triangle[p] == NO_HIT {
-            continue;
-        }
-        h.t_exit_mm[p] = s.t_mm[p];
-        let z = o[2] + s.t_mm[p] * rays.dirs[p][2];
-        if z >= base_z_mm - 1e-9 {
-            h.t_mm[p] = s.t_mm[p];
-            h.normal[p] = s.normal[p];
-        }
-    }
-    if let Some(pc) = protrusions {
-        let limit: Vec<f64> = h
-            .t_exit_mm
-            .iter()
-            .map(|t| if t.is_finite() { *t } else { 0.0 })
-            .collect();
-        let q = pc.cast(rays, &limit);
-        for p in 0..n {
-            if q.triangle[p] != NO_HIT {
-                let z = o[2] + q.t_mm[p] * rays.dirs[p][2];
-                if z >= base_z_mm {
-                    h.t_mm[p] = q.t_mm[p];
-                    h.normal[p] = q.normal[p].map(|v| -v);
-                    h.contact[p] = true;
-                }
             }
         }
     }

@@ -239,12 +239,4 @@ impl Mesh {
             triangles: self.triangles.clone(),
         }
     }
-
-    /// Applies `f` to every vertex.
-    pub fn map_vertices(&self, f: impl Fn([f64; 3]) -> [f64; 3]) -> Mesh {
-        Mesh {
-            vertices: self.vertices.iter().map(|&v| f(v)).collect(),
-            triangles: self.triangles.clone(),
-        }
-    }
 }

@@ -232,13 +232,6 @@ impl Solid {
         self.transform(&rotation_deg(x, y, z))
     }
 
-    /// Mirrored through the plane through the origin with unit normal `n`.
-    pub fn mirror(&self, n: [f64; 3]) -> Solid {
-        let n = nalgebra::Vector3::from(n);
-        let householder = nalgebra::Matrix3::identity() - (n * n.transpose()) * 2.0;
-        self.transform(&transform::with_translation(&householder, [0.0; 3]))
-    }
-
     /// The two parts on either side of the plane `n . x = offset` (`n` need not be unit):
     /// (the side `n` points to, the other side).
     pub fn split_by_plane(&self, n: [f64; 3], offset: f64) -> (Solid, Solid) {
