@@ -13,6 +13,32 @@ pub(crate) fn render(m: &Manifest) -> String {
          Lengths in mm, volumes in mm³ unless stated.\n\n",
     );
 
+    provenance(&mut s, m);
+
+    print_list(&mut s, m);
+    groups(&mut s, m);
+    print_settings(&mut s, m);
+
+    layer_stack(&mut s, m);
+    markers(&mut s, m);
+    section_view(&mut s, m);
+
+    cast_order(&mut s, m);
+
+    shopping_list(&mut s, m);
+    laser_cut(&mut s, m);
+    pcb_outlines(&mut s, m);
+    machined_parts(&mut s, m);
+    procedure(&mut s, m);
+
+    bought_items(&mut s, m);
+    checking_the_prints(&mut s, m);
+    s
+}
+
+/// `## Provenance`: the fabkit version, the design and its sha256, the chord tolerance, the
+/// command line, the frame and the kit 3MF.
+fn provenance(s: &mut String, m: &Manifest) {
     s.push_str("## Provenance\n\n");
     let _ = writeln!(s, "- fabkit version: {}", code(&m.fabkit_version));
     let _ = writeln!(
@@ -39,7 +65,11 @@ pub(crate) fn render(m: &Manifest) -> String {
         );
     }
     s.push_str("- file hashes and exact part numbers: `manifest.json`\n\n");
+}
 
+/// `## Print list`: every part with its file, technology, group, material, volume and size,
+/// what it is, the plates and the part previews.
+fn print_list(s: &mut String, m: &Manifest) {
     s.push_str("## Print list\n\n");
     s.push_str(
         "| # | Part | File | Technology | Group | Material | Volume (mm³) | \
@@ -141,13 +171,11 @@ Each part in print orientation, from above-front-right and from below-back-left.
             );
         }
     }
-    groups(&mut s, m);
-    print_settings(&mut s, m);
+}
 
-    layer_stack(&mut s, m);
-    markers(&mut s, m);
-    section_view(&mut s, m);
-
+/// `## Cast order`: each pour with its material, volumes, what to weigh or measure out, its
+/// coats and the smallest batch weighable by hand.
+fn cast_order(s: &mut String, m: &Manifest) {
     s.push_str("## Cast order\n\n");
     if m.casts.is_empty() {
         s.push_str("No pours in this kit.\n\n");
@@ -256,13 +284,10 @@ Each part in print orientation, from above-front-right and from below-back-left.
         }
         s.push('\n');
     }
+}
 
-    shopping_list(&mut s, m);
-    laser_cut(&mut s, m);
-    pcb_outlines(&mut s, m);
-    machined_parts(&mut s, m);
-    procedure(&mut s, m);
-
+/// `## Bought items`.
+fn bought_items(s: &mut String, m: &Manifest) {
     s.push_str("## Bought items\n\n");
     if m.bought_items.is_empty() {
         s.push_str("None.\n");
@@ -271,7 +296,11 @@ Each part in print orientation, from above-front-right and from below-back-left.
         let _ = writeln!(s, "- {}", text(b));
     }
     s.push('\n');
+}
 
+/// `## Checking the prints`: the files' hashes, the slicer's manifold check and volume, the
+/// sizes, and the fit checks of this kit.
+fn checking_the_prints(s: &mut String, m: &Manifest) {
     s.push_str("## Checking the prints\n\n");
     s.push_str(
         "1. Files: `sha256sum` of each file must equal its `sha256` in `manifest.json` \
@@ -289,7 +318,6 @@ Each part in print orientation, from above-front-right and from below-back-left.
     for check in fit_checks(m) {
         let _ = writeln!(s, "   - {check}");
     }
-    s
 }
 
 /// The consumables to buy, per product, with the amounts this kit uses: each cast material's
