@@ -10,6 +10,16 @@ use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
+/// One layer of a flat skin: from `z0_mm` up to `z1_mm`, with its channels and marker grid.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FlatLayer {
+    pub name: String,
+    pub z0_mm: f64,
+    pub z1_mm: f64,
+    pub channels: Option<ChannelSet>,
+    pub marker_grid: Option<MarkerGrid>,
+}
+
 /// What closes a channel's liquid circuit (Soter et al. Sec. II-A: "each channel is closed at
 /// both ends, this ensures that the liquid always returns back to its initial state"; and
 /// "the internal chambers are closed on one end", which is why they are filled in a tank).

@@ -12,22 +12,11 @@
 use crate::error::ParamError;
 use crate::geometry::{cuboid, prism, ChordTolerance, GeometryError, Solid};
 use crate::markers::feature_solid;
-use serde::Serialize;
 
 use crate::parts::registry::FAMILIES;
 pub use crate::profile::FlatOutline;
 
-pub use crate::parts::channels::{ChannelEnds, ChannelSet, ChannelTube, MarkerGrid};
-
-/// One layer of a flat skin: from `z0_mm` up to `z1_mm`, with its channels and marker grid.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct FlatLayer {
-    pub name: String,
-    pub z0_mm: f64,
-    pub z1_mm: f64,
-    pub channels: Option<ChannelSet>,
-    pub marker_grid: Option<MarkerGrid>,
-}
+pub use crate::parts::channels::{ChannelEnds, ChannelSet, ChannelTube, FlatLayer, MarkerGrid};
 
 /// The solid of one layer (validated parameters): the outline's prism from `z0_mm` to `z1_mm`,
 /// less its channels' grooves (open on the bottom face and at the near edge), with its

@@ -18,10 +18,11 @@
 //! Frame: the tray frame, x and y of the flat skin's frame (docs/conventions.md), z = 0 on the
 //! base sheet's underside, z up through the stack.
 
-use crate::cut::{ring_area_mm2, CutPart, Operation, Outline};
 use crate::error::ParamError;
 use crate::geometry::{extrude, ChordTolerance, GeometryError, Solid};
-use crate::parts::flat::{FlatLayer, FlatOutline};
+use crate::parts::channels::FlatLayer;
+use crate::parts::cut_part::{ring_area_mm2, CutPart, Operation, Outline};
+use crate::profile::FlatOutline;
 
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
