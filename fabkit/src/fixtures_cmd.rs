@@ -139,13 +139,27 @@ pub fn run(args: FixturesArgs) -> Result<(), Box<dyn Error>> {
     for w in &summary.warnings {
         eprintln!("warning: {w}");
     }
+    print_summary(&set, &params, &loaded.design, &out, t0.elapsed());
+    crate::args::print_parts(&summary.manifest.parts);
+    Ok(())
+}
+
+/// Prints what was written: the counts and time, then each fixture's figures and notes, and
+/// where the indenters come from.
+fn print_summary(
+    set: &fabkit_fixtures::FixtureSet,
+    params: &fabkit_fixtures::params::FixtureParams,
+    design: &fabkit_designs::Design,
+    out: &Path,
+    elapsed: std::time::Duration,
+) {
     out!(
         "{}: {} parts, {} data files -> {} ({:.2} s)",
         set.kit.design,
         set.kit.parts.len(),
         set.files.len(),
         out.display(),
-        t0.elapsed().as_secs_f64()
+        elapsed.as_secs_f64()
     );
     if let Some(d) = &set.pin_dome {
         out!(
@@ -185,11 +199,11 @@ pub fn run(args: FixturesArgs) -> Result<(), Box<dyn Error>> {
     }
     if params.indenters.is_none() {
         let names: Vec<String> = params
-            .indenters_for(&loaded.design)
+            .indenters_for(design)
             .iter()
             .map(|p| p.name.clone())
             .collect();
-        let paper = fabkit_fixtures::indenters::paper_of(&loaded.design).and_then(|d| {
+        let paper = fabkit_fixtures::indenters::paper_of(design).and_then(|d| {
             fabkit_fixtures::indenters::PAPER_INDENTERS
                 .iter()
                 .find(|p| p.0 == d)
@@ -205,6 +219,4 @@ pub fn run(args: FixturesArgs) -> Result<(), Box<dyn Error>> {
             ),
         }
     }
-    crate::args::print_parts(&summary.manifest.parts);
-    Ok(())
 }
