@@ -1,7 +1,12 @@
 //! The housing's rules: its sizes, walls and seats, the square shell's and the round tube's,
 //! the core's seat and the lens (`housing.*` paths), each reporting every violation.
 
-use super::*;
+use super::{
+    fixture_dowel_holes, gel_free_surface_z_mm, lens_front_z_mm, levels, round_screw_radius_mm,
+    screw_y_range, HousingParams, HousingStyle, RoundTube, CABLE_SLOT_XY_MM,
+};
+use crate::error::ParamError;
+use crate::parts::context::{Context, ResolvedCore};
 
 /// Rules on the housing: parts fit inside each other and the walls print.
 pub fn check_housing_params(
