@@ -181,17 +181,10 @@ pub fn svg_text(part: &CutPart) -> String {
     doc.to_string()
 }
 
-/// The SVG of a dimensioned drawing ([`fabkit_designs::parts::core_shell::Drawing`]): the
-/// section through the axis hatched, the axis as a chain line, each dimension with its
-/// extension lines, arrowed dimension line and value, then the title and notes. Paper units
-/// are mm (`width`/`height` in mm), the drawing at a scale of 1, 2, 4, 5 or 10 to 1 (the
-/// largest that keeps it under 170 mm high), given in the title line.
-pub fn drawing_svg(d: &fabkit_designs::parts::core_shell::Drawing) -> String {
+/// The extents of drawing `d` in the model, dimensions included: [x0, x1, z0, z1], mm (the
+/// section mirrored about the axis).
+fn drawing_extents(d: &fabkit_designs::parts::core_shell::Drawing) -> [f64; 4] {
     use fabkit_designs::parts::core_shell::DimensionAxis;
-    use svg::node::element::{
-        Definitions, Group, Line, Marker, Path, Pattern, Polygon, Text, Title,
-    };
-    // model extents, dimensions included
     let (mut x0, mut x1, mut z0, mut z1) = (0.0f64, 0.0f64, f64::INFINITY, f64::NEG_INFINITY);
     for &[r, z] in &d.section_rz_mm {
         x1 = x1.max(r);
@@ -211,35 +204,12 @@ pub fn drawing_svg(d: &fabkit_designs::parts::core_shell::Drawing) -> String {
             }
         }
     }
-    let height = (z1 - z0).max(1e-3);
-    let k = [10.0, 5.0, 4.0, 2.0, 1.0]
-        .into_iter()
-        .find(|k| k * height <= 170.0)
-        .unwrap_or(1.0);
-    let font = 3.0;
-    let margin = 12.0;
-    let (px, pz) = (|x: f64| k * x, |z: f64| -k * z);
-    let left = px(x0) - margin;
-    let top = pz(z1) - margin;
-    // the title line and the notes, wrapped at 95 characters (under 0.6 em each in a
-    // sans-serif font)
-    let heading = format!("{}: section through the axis, scale {k}:1, mm", d.title);
-    let lines: Vec<String> = std::iter::once(&heading)
-        .chain(&d.notes)
-        .flat_map(|n| wrap(n, 95))
-        .collect();
-    let notes_h = (lines.len() as f64 + 2.0) * font * 1.5;
-    let longest = lines.iter().map(|n| n.chars().count()).max().unwrap_or(0);
-    let width = (px(x1) - px(x0) + 2.0 * margin).max(longest as f64 * 0.6 * font + 8.0);
-    let paper_h = pz(z0) - pz(z1) + 2.0 * margin + notes_h;
-    let fmt = |v: f64| format!("{v:.3}");
-    let points = |sign: f64| {
-        d.section_rz_mm
-            .iter()
-            .map(|&[r, z]| format!("{},{}", fmt(px(sign * r)), fmt(pz(z))))
-            .collect::<Vec<_>>()
-            .join(" ")
-    };
+    [x0, x1, z0, z1]
+}
+
+/// The drawing's definitions: the section's 45 deg hatch and the dimension lines' arrow.
+fn drawing_definitions() -> svg::node::element::Definitions {
+    use svg::node::element::{Definitions, Line, Marker, Path, Pattern};
     let hatch = Pattern::new()
         .set("id", "hatch")
         .set("patternUnits", "userSpaceOnUse")
@@ -269,31 +239,20 @@ pub fn drawing_svg(d: &fabkit_designs::parts::core_shell::Drawing) -> String {
                 .set("d", "M 0 2 L 10 5 L 0 8 z")
                 .set("fill", "#000000"),
         );
-    let mut doc = svg::Document::new()
-        .set("width", format!("{}mm", fmt(width)))
-        .set("height", format!("{}mm", fmt(paper_h)))
-        .set("viewBox", (fmt(left), fmt(top), fmt(width), fmt(paper_h)))
-        .add(Title::new(d.title.clone()))
-        .add(Definitions::new().add(hatch).add(arrow));
-    let mut section = Group::new()
-        .set("id", "section")
-        .set("fill", "url(#hatch)")
-        .set("stroke", "#000000")
-        .set("stroke-width", 0.35);
-    for sign in [1.0, -1.0] {
-        section = section.add(Polygon::new().set("points", points(sign)));
-    }
-    doc = doc.add(section).add(
-        Line::new()
-            .set("id", "axis")
-            .set("x1", 0)
-            .set("y1", fmt(pz(z1) - 3.0))
-            .set("x2", 0)
-            .set("y2", fmt(pz(z0) + 3.0))
-            .set("stroke", "#000000")
-            .set("stroke-width", 0.18)
-            .set("stroke-dasharray", "6 1.5 1 1.5"),
-    );
+    Definitions::new().add(hatch).add(arrow)
+}
+
+/// The dimensions of drawing `d` at scale `k` (paper mm per model mm), text `font` mm high:
+/// each with its extension lines, arrowed dimension line and value.
+fn dimensions_group(
+    d: &fabkit_designs::parts::core_shell::Drawing,
+    k: f64,
+    font: f64,
+) -> svg::node::element::Group {
+    use fabkit_designs::parts::core_shell::DimensionAxis;
+    use svg::node::element::{Group, Line, Text};
+    let fmt = |v: f64| format!("{v:.3}");
+    let (px, pz) = (|x: f64| k * x, |z: f64| -k * z);
     let mut dims = Group::new()
         .set("id", "dimensions")
         .set("stroke", "#000000")
@@ -353,7 +312,72 @@ pub fn drawing_svg(d: &fabkit_designs::parts::core_shell::Drawing) -> String {
         }
         dims = dims.add(text);
     }
-    doc = doc.add(dims);
+    dims
+}
+
+/// The SVG of a dimensioned drawing ([`fabkit_designs::parts::core_shell::Drawing`]): the
+/// section through the axis hatched, the axis as a chain line, each dimension with its
+/// extension lines, arrowed dimension line and value, then the title and notes. Paper units
+/// are mm (`width`/`height` in mm), the drawing at a scale of 1, 2, 4, 5 or 10 to 1 (the
+/// largest that keeps it under 170 mm high), given in the title line.
+pub fn drawing_svg(d: &fabkit_designs::parts::core_shell::Drawing) -> String {
+    use svg::node::element::{Group, Line, Polygon, Text, Title};
+    let [x0, x1, z0, z1] = drawing_extents(d);
+    let height = (z1 - z0).max(1e-3);
+    let k = [10.0, 5.0, 4.0, 2.0, 1.0]
+        .into_iter()
+        .find(|k| k * height <= 170.0)
+        .unwrap_or(1.0);
+    let font = 3.0;
+    let margin = 12.0;
+    let (px, pz) = (|x: f64| k * x, |z: f64| -k * z);
+    let left = px(x0) - margin;
+    let top = pz(z1) - margin;
+    // the title line and the notes, wrapped at 95 characters (under 0.6 em each in a
+    // sans-serif font)
+    let heading = format!("{}: section through the axis, scale {k}:1, mm", d.title);
+    let lines: Vec<String> = std::iter::once(&heading)
+        .chain(&d.notes)
+        .flat_map(|n| wrap(n, 95))
+        .collect();
+    let notes_h = (lines.len() as f64 + 2.0) * font * 1.5;
+    let longest = lines.iter().map(|n| n.chars().count()).max().unwrap_or(0);
+    let width = (px(x1) - px(x0) + 2.0 * margin).max(longest as f64 * 0.6 * font + 8.0);
+    let paper_h = pz(z0) - pz(z1) + 2.0 * margin + notes_h;
+    let fmt = |v: f64| format!("{v:.3}");
+    let points = |sign: f64| {
+        d.section_rz_mm
+            .iter()
+            .map(|&[r, z]| format!("{},{}", fmt(px(sign * r)), fmt(pz(z))))
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    let mut doc = svg::Document::new()
+        .set("width", format!("{}mm", fmt(width)))
+        .set("height", format!("{}mm", fmt(paper_h)))
+        .set("viewBox", (fmt(left), fmt(top), fmt(width), fmt(paper_h)))
+        .add(Title::new(d.title.clone()))
+        .add(drawing_definitions());
+    let mut section = Group::new()
+        .set("id", "section")
+        .set("fill", "url(#hatch)")
+        .set("stroke", "#000000")
+        .set("stroke-width", 0.35);
+    for sign in [1.0, -1.0] {
+        section = section.add(Polygon::new().set("points", points(sign)));
+    }
+    doc = doc.add(section).add(
+        Line::new()
+            .set("id", "axis")
+            .set("x1", 0)
+            .set("y1", fmt(pz(z1) - 3.0))
+            .set("x2", 0)
+            .set("y2", fmt(pz(z0) + 3.0))
+            .set("stroke", "#000000")
+            .set("stroke-width", 0.18)
+            .set("stroke-dasharray", "6 1.5 1 1.5"),
+    );
+    doc = doc.add(dimensions_group(d, k, font));
     let mut notes = Group::new()
         .set("id", "notes")
         .set("font-family", "sans-serif")
