@@ -8,7 +8,7 @@ use crate::geometry::ChordTolerance;
 use crate::kit::Kit;
 use crate::materials::{pour, MaterialsTable};
 use crate::parts::family::FillingPour;
-use crate::parts::molds::{build_mold, cast_plans};
+use crate::parts::molds::{build_mold, cast_plans, CastPlan};
 use crate::parts::registry::{SectionInput, FAMILIES};
 use crate::schema::{Design, LayerProcess, MoldStrategy};
 use crate::stack::{validate, Stack};
@@ -80,6 +80,31 @@ pub enum AssemblyScope {
     FitCheck,
 }
 
+/// Which layers of `stack` are built how: those `crate::parts::layers` builds (printed layers,
+/// and cast ones in the open, two-piece open and boundary strategies), by index, and the pours
+/// of `plans` whose molds hold the core (direct and master).
+fn layer_builds(stack: &Stack, plans: &[CastPlan]) -> (Vec<usize>, Vec<CastPlan>) {
+    let other: Vec<usize> = stack
+        .layers
+        .iter()
+        .filter(|l| {
+            l.process == LayerProcess::Printed
+                || (l.process == LayerProcess::Cast
+                    && matches!(
+                        l.mold_strategy,
+                        MoldStrategy::Open | MoldStrategy::TwoPieceOpen | MoldStrategy::Boundary
+                    ))
+        })
+        .map(|l| l.index)
+        .collect();
+    let held: Vec<_> = plans
+        .iter()
+        .filter(|p| matches!(p.strategy, MoldStrategy::Direct | MoldStrategy::Master))
+        .cloned()
+        .collect();
+    (other, held)
+}
+
 /// [`build_kit_bounded`] with the assembly made as `scope` says.
 ///
 /// # Errors
@@ -109,25 +134,7 @@ pub fn build_kit_scoped(
     // Casts and the families' parts are independent: build them in parallel. Each build is
     // single-threaded and the results are collected in order, so the output does not depend
     // on the thread count.
-    // Layers built by crate::parts::layers: printed layers and the open / boundary strategies.
-    let other: Vec<usize> = stack
-        .layers
-        .iter()
-        .filter(|l| {
-            l.process == LayerProcess::Printed
-                || (l.process == LayerProcess::Cast
-                    && matches!(
-                        l.mold_strategy,
-                        MoldStrategy::Open | MoldStrategy::TwoPieceOpen | MoldStrategy::Boundary
-                    ))
-        })
-        .map(|l| l.index)
-        .collect();
-    let held: Vec<_> = plans
-        .iter()
-        .filter(|p| matches!(p.strategy, MoldStrategy::Direct | MoldStrategy::Master))
-        .cloned()
-        .collect();
+    let (other, held) = layer_builds(&stack, &plans);
     let at = SectionInput {
         design,
         stack: &stack,
