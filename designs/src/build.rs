@@ -626,7 +626,7 @@ fn treatments(
             format!("the cavity of the {layer} mold"),
             design.body.surface_area_mm2(cavity),
         ));
-        if let Some(r) = crate::parts::recess::layer_recess(design, l.index) {
+        if let Some(r) = crate::parts::layer_registry::seat_of(design, l.index) {
             out.extend(report(
                 rel,
                 format!("the insert that forms the seat under {layer}"),
@@ -750,13 +750,13 @@ fn bought_items(design: &Design, stack: &Stack, materials: &MaterialsTable) -> V
 /// Volume of `layer` alone, mm^3: the solid under its outer surface down to the base plane,
 /// less the solid under its inner surface (for a solid layer, its recess if it has one), from
 /// the exact profile ([`crate::profile::BodyProfile::analytic_solid_volume_mm3`],
-/// [`crate::parts::recess::RecessOutline::volume_mm3`]); marker features not counted.
+/// [`crate::parts::seat::Seat::volume_mm3`]); marker features not counted.
 pub fn layer_volume_mm3(design: &Design, layer: &crate::stack::ResolvedLayer) -> f64 {
     let body = &design.body;
     let outer = body.analytic_solid_volume_mm3(layer.outer_offset_mm, 0.0);
     if layer.solid {
         outer
-            - crate::parts::recess::layer_recess(design, layer.index)
+            - crate::parts::layer_registry::seat_of(design, layer.index)
                 .map_or(0.0, |r| r.volume_mm3())
     } else {
         outer - body.analytic_solid_volume_mm3(layer.inner_offset_mm, 0.0)

@@ -320,7 +320,9 @@ pub fn cast_layer(
         }
         MoldStrategy::Open => {
             let mut p = vec![need("open_mold")?];
-            p.extend(part("recess_insert"));
+            for role in crate::parts::layer_registry::insert_roles() {
+                p.extend(part(role));
+            }
             (negative(&p)?, p)
         }
         MoldStrategy::TwoPieceOpen => {

@@ -73,7 +73,7 @@ pub fn estimate(design: &Design, stack: &Stack, tol: ChordTolerance) -> WorkEsti
         if !l.solid {
             surfaces += surface_triangles(design, l.inner_offset_mm, tol);
         }
-        if let Some(r) = crate::parts::recess::layer_recess(design, l.index) {
+        if let Some(r) = crate::parts::layer_registry::seat_of(design, l.index) {
             // the recess's surface three times: in the layer's part, its assembly member and
             // the mold's insert
             let profile = r.polyline(0.0, 0.0, tol.half()).points.len() as f64;

@@ -11,6 +11,7 @@ use crate::materials::MaterialKind;
 use crate::materials::{cure_text, CastReport};
 use crate::parts::family::AssemblyStep;
 use crate::parts::fasteners::bolt_name;
+use crate::parts::layer_registry::insert_roles;
 use crate::parts::registry::FAMILIES;
 use crate::parts::{Part, ProcedureAction, ProcedureStep};
 use crate::schema::Design;
@@ -152,11 +153,9 @@ pub fn procedure(
         }
         let holder = with_role(parts, &c.mold_parts, &["core_holder", "casting_jig"]);
         let halves = with_role(parts, &c.mold_parts, &["mold_half"]);
-        let pieces = with_role(
-            parts,
-            &c.mold_parts,
-            &["open_mold_piece", "open_mold", "recess_insert"],
-        );
+        let mut piece_roles = vec!["open_mold_piece", "open_mold"];
+        piece_roles.extend(insert_roles());
+        let pieces = with_role(parts, &c.mold_parts, &piece_roles);
         let silicone: Vec<&String> = c
             .mold_parts
             .iter()
@@ -252,8 +251,9 @@ fn close_and_pour(
     let n = c.step;
     let boundary = silicone.iter().any(|m| m.ends_with(":inner"));
     let mix = c.mix_text();
-    let (inserts, pieces): (Vec<&Part>, Vec<&Part>) =
-        pieces.iter().partition(|p| p.role == "recess_insert");
+    let (inserts, pieces): (Vec<&Part>, Vec<&Part>) = pieces
+        .iter()
+        .partition(|p| insert_roles().contains(&p.role.as_str()));
     if !halves.is_empty() {
         let (a, b) = (
             &halves[0].name,

@@ -12,6 +12,7 @@ pub use crate::yaml::{
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
+pub mod mold;
 pub mod optics;
 pub mod printers;
 pub mod shared;
@@ -19,7 +20,7 @@ pub use crate::parts::housing::{
     CameraBay, Diffuser, HousingParams, HousingStyle, JointScrew, LedPcb, RoundTube,
 };
 pub use crate::parts::lasercut::{LaserCutParams, SheetRegistration, SheetStock};
-pub use crate::parts::molds::{
+pub use mold::{
     ClampBolt, CoreHolderParams, MoldParams, OpenBlock, Plinth, RegistrationBoss, RegistrationKey,
     Sprue, TwoPieceOpenParams, Vent,
 };

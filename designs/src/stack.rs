@@ -5,6 +5,8 @@ use crate::error::{ParamError, ParamErrors};
 use crate::geometry::{revolve, ChordTolerance, Solid};
 use crate::materials::{MaterialKind, MaterialsTable};
 pub use crate::parts::context::{ResolvedCore, ResolvedLayer, Stack};
+use crate::parts::layer_feature::solid_layer_profile;
+use crate::parts::layer_registry::{check_layer_features, seat_of};
 use crate::parts::registry::FAMILIES;
 use crate::schema::printers::check_printers;
 pub use crate::schema::printers::{check_bed, MAX_BED_MM};
@@ -24,10 +26,10 @@ impl Stack {
     ) -> Result<Solid, crate::geometry::GeometryError> {
         let l = &self.layers[i];
         let pl = if l.solid {
-            crate::parts::recess::solid_layer_profile(
+            solid_layer_profile(
                 &design.body,
                 l.outer_offset_mm,
-                crate::parts::recess::layer_recess(design, i).as_ref(),
+                seat_of(design, i).as_ref(),
                 tol.half(),
             )
         } else {
@@ -82,7 +84,7 @@ pub fn validate(
     let layer_specs_ok = check_layer_specs(design, sphere_r, body_ok, &mut errs);
     check_core_and_casting(design, sphere_r, body_ok, &mut errs);
     check_mold_strategies(design, &mut errs);
-    crate::parts::recess::check_layer_recesses(design, body_ok, &mut errs);
+    check_layer_features(design, body_ok, &mut errs);
 
     // Resolve the stack from the inside out, in "radius" units for spheres (r = R + offset).
     let (layers, core, stack_ok) = if body_ok && layer_specs_ok && !design.layers.is_empty() {

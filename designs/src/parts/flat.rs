@@ -303,12 +303,8 @@ fn check_layer_fields(
                 "unknown material",
             )),
         }
-        if l.recess.is_some() {
-            errs.push(ParamError::new(
-                p("recess"),
-                "given",
-                "applies to curved skins only: a flat skin has no optic's seat",
-            ));
+        for (key, rule) in crate::parts::layer_registry::flat_refusals(l) {
+            errs.push(ParamError::new(p(key), "given", rule));
         }
         if !l.markers.is_empty() {
             errs.push(ParamError::new(

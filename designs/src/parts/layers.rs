@@ -12,6 +12,8 @@ use crate::geometry::{revolve, ChordTolerance, GeometryError, Polyline2, Solid};
 use crate::markers::{self, Marker, MarkerSpec, MarkerSurface, PatternStats, Polarity, Surface};
 use crate::parts::context::{ResolvedLayer, Stack};
 use crate::parts::family::FamilyInput;
+use crate::parts::layer_feature::{solid_layer_profile, InsertInput};
+use crate::parts::layer_registry::{open_mold_inserts, seat_of};
 use crate::parts::member::{FeatureKey, MemberFeatures};
 use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::{Part, PrintTechnology};
@@ -941,8 +943,8 @@ fn enclosed(
 }
 
 /// The solid that solid layer `l` fills, with the features `sets` of its outer surface: the
-/// solid under its outer surface down to the base plane, less its recess if it has one
-/// ([`crate::parts::recess`]).
+/// solid under its outer surface down to the base plane, less the seat a layer feature cuts
+/// into it ([`crate::parts::layer_registry::seat_of`]).
 fn solid_enclosed(
     design: &Design,
     l: &ResolvedLayer,
@@ -950,15 +952,10 @@ fn solid_enclosed(
     tol: ChordTolerance,
     stems_only: bool,
 ) -> Result<Solid, GeometryError> {
-    let Some(r) = crate::parts::recess::layer_recess(design, l.index) else {
+    let Some(r) = seat_of(design, l.index) else {
         return enclosed(design, l.outer_offset_mm, 0.0, sets, tol, stems_only);
     };
-    let pl = crate::parts::recess::solid_layer_profile(
-        &design.body,
-        l.outer_offset_mm,
-        Some(&r),
-        tol.half(),
-    );
+    let pl = solid_layer_profile(&design.body, l.outer_offset_mm, Some(&r), tol.half());
     apply_features(
         Solid::from_mesh(&revolve(&pl, tol)?)?,
         sets,
@@ -1270,9 +1267,7 @@ fn twin_params(
         "inner_offset_mm": if l.solid { serde_json::Value::Null } else { json!(l.inner_offset_mm) },
         "solid": l.solid, "markers": markers,
     });
-    if let Some(r) = crate::parts::recess::layer_recess(design, l.index) {
-        v["recess"] = json!(r);
-    }
+    crate::parts::layer_registry::twin_params(design, l.index, &mut v);
     v
 }
 
@@ -1468,13 +1463,22 @@ fn build_open_mold_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
     let mold = g(block
         .difference(&plain)
         .and_then(|b| apply_features_signed(b, outer, tol, false, -1.0)))?;
-    // the optic's seat: an insert set in the open face forms it
-    let recess = crate::parts::recess::layer_recess(design, l.index);
-    let insert = recess
-        .as_ref()
-        .map(|r| g(r.solid(zb, 0.0, tol)))
-        .transpose()?;
-    let skin_volume = block.volume() - mold.volume() - insert.as_ref().map_or(0.0, Solid::volume);
+    // the features' inserts set in the open face (the optic's seat)
+    let inserts = open_mold_inserts(
+        design,
+        l.index,
+        InsertInput {
+            layer_name: name,
+            base_z_mm: zb,
+            base_params,
+            technology: cavity_tech,
+            material: material_for(cavity_tech),
+            tol,
+        },
+    )
+    .part(name)?;
+    let inserts_volume: f64 = inserts.iter().map(|i| i.volume_mm3).sum();
+    let skin_volume = block.volume() - mold.volume() - inserts_volume;
     let (mold_placed, mold_pose) =
         place_posed(&mold, &crate::geometry::rotation_deg(180.0, 0.0, 0.0));
     let part = Part {
@@ -1494,25 +1498,7 @@ fn build_open_mold_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
         group: None,
     };
     let mut parts = vec![part];
-    if let (Some(r), Some(insert)) = (recess, insert) {
-        let (placed, pose) = place_posed(&insert, &crate::geometry::Affine::identity());
-        parts.push(Part {
-            name: format!("{name}_recess_insert"),
-            role: "recess_insert".into(),
-            description: format!(
-                "Forms the optic's seat under the {name} skin: once the open mold is poured to the brim, press it in dome first until its flat face lies in the mold's open face, centred on the cavity"
-            ),
-            material: material_for(cavity_tech).into(),
-            print_technology: cavity_tech,
-            solid: placed,
-            params: with_pose(
-                json!({"base": base_params, "base_z_mm": zb, "recess": r,
-                       "print_orientation": "flat face on the bed"}),
-                &pose,
-            ),
-            group: None,
-        });
-    }
+    parts.extend(inserts.into_iter().map(|i| i.part));
     let pour_parts = parts.iter().map(|p| p.name.clone()).collect();
     let mut markers = b.markers_json;
     set_forming(&mut markers, &[format!("{name}_open_mold")], &[], 0.0);

@@ -13,6 +13,8 @@ pub mod fingertip_base;
 pub mod flat;
 pub mod housing;
 pub mod lasercut;
+pub mod layer_feature;
+pub mod layer_registry;
 pub mod layers;
 mod member;
 pub mod molds;
@@ -21,6 +23,7 @@ pub mod placement;
 pub mod recess;
 pub mod registry;
 pub mod robot_mount;
+pub mod seat;
 pub mod shaft_body;
 pub mod spacer;
 

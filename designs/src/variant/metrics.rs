@@ -266,11 +266,11 @@ pub fn min_wall(
     }
     let b = &design.body;
     for l in &stack.layers {
-        if let Some(r) = crate::parts::recess::layer_recess(design, l.index) {
+        if let Some((key, r)) = crate::parts::layer_registry::layer_seat(design, l.index) {
             walls.push((
                 r.skin_mm(b, l.outer_offset_mm, ChordTolerance::default().half()),
                 format!(
-                    "layers[{}].recess: the skin between the seat and the outer surface",
+                    "layers[{}].{key}: the skin between the seat and the outer surface",
                     l.index
                 ),
             ));

@@ -20,6 +20,7 @@ mod patterns;
 mod primitives;
 mod profile;
 mod properties;
+mod recess;
 mod shadowtac;
 mod shadowtac_casing;
 mod spacer_family;

@@ -1,0 +1,187 @@
+//! The list of layer features ([`LAYER_FEATURES`]) and the loops over it: the validation
+//! ([`check_layer_features`], [`flat_refusals`]), the solid a layer fills and its volume
+//! ([`seat_of`]), the open mold's inserts ([`open_mold_inserts`], [`insert_roles`]) and the
+//! layer's twin ([`twin_params`]). Adding a feature is one module in `parts/`, its field in
+//! [`crate::schema::Layer`] and one line here (docs/src/development.md, "Adding a layer
+//! feature").
+
+use std::marker::PhantomData;
+
+use crate::error::ParamError;
+use crate::geometry::GeometryError;
+use crate::parts::layer_feature::{InsertInput, LayerFeature, LayerInput, MoldInsert, Seat};
+use crate::parts::recess;
+use crate::schema::{Design, Layer};
+
+/// A registered layer feature, as the loops see it: each method does nothing (or returns
+/// nothing) for a layer without the feature.
+pub trait Feature: Sync {
+    /// [`LayerFeature::KEY`].
+    fn key(&self) -> &'static str;
+    /// Whether the layer gives the feature.
+    fn given(&self, l: &Layer) -> bool;
+    /// [`LayerFeature::FLAT_RULE`].
+    fn flat_rule(&self) -> Option<&'static str>;
+    /// [`LayerFeature::INSERT_ROLE`].
+    fn insert_role(&self) -> Option<&'static str>;
+    /// [`LayerFeature::check`].
+    fn check(&self, input: LayerInput<'_>, errs: &mut Vec<ParamError>);
+    /// [`LayerFeature::seat`].
+    fn seat(&self, l: &Layer) -> Option<Seat>;
+    /// [`LayerFeature::twin_params`].
+    fn twin_params(&self, l: &Layer) -> Option<serde_json::Value>;
+    /// [`LayerFeature::open_mold_inserts`].
+    ///
+    /// # Errors
+    /// As [`LayerFeature::open_mold_inserts`].
+    fn open_mold_inserts(
+        &self,
+        l: &Layer,
+        input: InsertInput<'_>,
+    ) -> Result<Vec<MoldInsert>, GeometryError>;
+}
+
+/// A feature `F` with where its parameters sit in a layer.
+pub struct RegisteredFeature<F: LayerFeature> {
+    /// The feature's parameters in a layer, if given.
+    pub params: fn(&Layer) -> Option<&F::Params>,
+    pub feature: PhantomData<fn() -> F>,
+}
+
+impl<F: LayerFeature> RegisteredFeature<F> {
+    /// The feature `F` with its parameters at `params`.
+    pub const fn at(params: fn(&Layer) -> Option<&F::Params>) -> Self {
+        RegisteredFeature {
+            params,
+            feature: PhantomData,
+        }
+    }
+}
+
+impl<F: LayerFeature> Feature for RegisteredFeature<F> {
+    fn key(&self) -> &'static str {
+        F::KEY
+    }
+
+    fn given(&self, l: &Layer) -> bool {
+        (self.params)(l).is_some()
+    }
+
+    fn flat_rule(&self) -> Option<&'static str> {
+        F::FLAT_RULE
+    }
+
+    fn insert_role(&self) -> Option<&'static str> {
+        F::INSERT_ROLE
+    }
+
+    fn check(&self, input: LayerInput<'_>, errs: &mut Vec<ParamError>) {
+        if let Some(p) = (self.params)(input.layer) {
+            F::check(p, input, errs);
+        }
+    }
+
+    fn seat(&self, l: &Layer) -> Option<Seat> {
+        (self.params)(l).and_then(F::seat)
+    }
+
+    fn twin_params(&self, l: &Layer) -> Option<serde_json::Value> {
+        (self.params)(l).and_then(F::twin_params)
+    }
+
+    fn open_mold_inserts(
+        &self,
+        l: &Layer,
+        input: InsertInput<'_>,
+    ) -> Result<Vec<MoldInsert>, GeometryError> {
+        (self.params)(l).map_or_else(|| Ok(Vec::new()), |p| F::open_mold_inserts(p, input))
+    }
+}
+
+/// Every layer feature, in the order their rules are reported and their twin keys written.
+pub static LAYER_FEATURES: &[&dyn Feature] =
+    &[&RegisteredFeature::<recess::RecessFeature>::at(|l| {
+        l.recess.as_ref()
+    })];
+
+/// The rules of every feature of every layer of `design` (`body_ok`: the body's own rules
+/// hold), layer by layer.
+pub fn check_layer_features(design: &Design, body_ok: bool, errs: &mut Vec<ParamError>) {
+    let ctx = design.context();
+    for (index, layer) in design.layers.iter().enumerate() {
+        let input = LayerInput {
+            ctx: &ctx,
+            index,
+            layer,
+            strategy: layer.mold_strategy.unwrap_or(design.mold.strategy),
+            body_ok,
+        };
+        for f in LAYER_FEATURES {
+            f.check(input, errs);
+        }
+    }
+}
+
+/// The features layer `l` of a flat skin gives that flat skins do not take: each key with
+/// the rule it breaks.
+pub fn flat_refusals(l: &Layer) -> Vec<(&'static str, &'static str)> {
+    LAYER_FEATURES
+        .iter()
+        .filter(|f| f.given(l))
+        .filter_map(|f| Some((f.key(), f.flat_rule()?)))
+        .collect()
+}
+
+/// The seat cut into layer `index` of `design` from below, with the key of the feature that
+/// cuts it; `None` when no feature does (or its rules do not hold).
+pub fn layer_seat(design: &Design, index: usize) -> Option<(&'static str, Seat)> {
+    let l = design.layers.get(index)?;
+    LAYER_FEATURES
+        .iter()
+        .find_map(|f| Some((f.key(), f.seat(l)?)))
+}
+
+/// The seat of layer `index` of `design` ([`layer_seat`]) without its key.
+pub fn seat_of(design: &Design, index: usize) -> Option<Seat> {
+    layer_seat(design, index).map(|(_, s)| s)
+}
+
+/// The roles of the parts the features set into molds.
+pub fn insert_roles() -> Vec<&'static str> {
+    LAYER_FEATURES
+        .iter()
+        .filter_map(|f| f.insert_role())
+        .collect()
+}
+
+/// Adds the twin parameters of layer `index`'s features to its twin's parameters `v`, each
+/// under its key.
+pub fn twin_params(design: &Design, index: usize, v: &mut serde_json::Value) {
+    let Some(l) = design.layers.get(index) else {
+        return;
+    };
+    for f in LAYER_FEATURES {
+        if let Some(p) = f.twin_params(l) {
+            v[f.key()] = p;
+        }
+    }
+}
+
+/// The inserts of layer `index`'s features in its one-piece open mold.
+///
+/// # Errors
+/// Only on a kernel failure.
+pub fn open_mold_inserts(
+    design: &Design,
+    index: usize,
+    input: InsertInput<'_>,
+) -> Result<Vec<MoldInsert>, GeometryError> {
+    let Some(l) = design.layers.get(index) else {
+        return Ok(Vec::new());
+    };
+    let mut out = Vec::new();
+    for f in LAYER_FEATURES {
+        out.extend(f.open_mold_inserts(l, input)?);
+    }
+    Ok(out)
+}
