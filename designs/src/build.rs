@@ -156,7 +156,7 @@ pub fn build_kit_scoped(
                         || {
                             other
                                 .par_iter()
-                                .map(|&i| crate::parts::layers::build_layer(design, &stack, i, tol))
+                                .map(|&i| crate::parts::molds::build_layer(design, &stack, i, tol))
                                 .collect::<Vec<_>>()
                         },
                     )

@@ -109,7 +109,7 @@ pub fn estimate(design: &Design, stack: &Stack, tol: ChordTolerance) -> WorkEsti
         // outer features also in a direct or master mold's cavity, the coats over the layer
         // and the layer cast onto it (crate::parts::layers::taken_features)
         let copies = 1.0 + crate::parts::layers::outer_feature_copies(stack, l.index) as f64;
-        for (spec, _, _, placed) in crate::parts::layers::placed_patterns(design, l) {
+        for (spec, _, _, placed) in crate::parts::layer_markers::placed_patterns(design, l) {
             let n = placed.len();
             markers += n as u64;
             let k = if spec.surface == crate::markers::MarkerSurface::Outer {

@@ -108,7 +108,9 @@ fn marker_features(design: &Design, stack: &Stack) -> Features {
     let (mut dimples, mut dimple_sources) = (Vec::new(), Vec::new());
     for layer in &stack.layers {
         let specs = &design.layers[layer.index].markers;
-        for (spec, offset, _, markers) in crate::parts::layers::placed_patterns(design, layer) {
+        for (spec, offset, _, markers) in
+            crate::parts::layer_markers::placed_patterns(design, layer)
+        {
             let k = specs
                 .iter()
                 .position(|s| std::ptr::eq(s, spec))

@@ -274,7 +274,7 @@ fn kernel_errors_name_the_parameters_of_the_failing_solid() {
     let mut d = library::load("tactip_dualmodal").unwrap();
     let st = stack::validate(&d, &materials, tol).unwrap();
     d.layers[0].markers[0].feature.diameter_mm = 0.0;
-    match layers::build_layer(&d, &st, 0, tol) {
+    match fabkit_designs::molds::build_layer(&d, &st, 0, tol) {
         Err(e @ DesignError::Geometry { .. }) => {
             let DesignError::Geometry { params, .. } = &e else {
                 unreachable!()

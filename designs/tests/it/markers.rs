@@ -1304,7 +1304,7 @@ fn tactip_skin_and_tips_make_whole_pins() {
     let tol = ChordTolerance::default();
     let d = library::load("tactip_dualmodal").unwrap();
     let stack = validate(&d, &materials(), tol).unwrap_or_else(|e| panic!("{e}"));
-    let out = layers::build_layer(&d, &stack, 0, tol).unwrap();
+    let out = fabkit_designs::molds::build_layer(&d, &stack, 0, tol).unwrap();
     let names: Vec<&str> = out.parts.iter().map(|p| p.name.as_str()).collect();
     // the outermost layer also prints the bayonet fitting, in the same 3MF object
     assert_eq!(names, ["skin", "skin_tips", "tip_fitting"]);

@@ -539,7 +539,7 @@ fn printable_with_follows_the_validation_rules() {
         fabkit_designs::layers::printable_with(&d, &stack.layers[0], 0),
         [Technology::Sla]
     );
-    let out = fabkit_designs::layers::build_layer(&d, &stack, 0, tol).unwrap();
+    let out = fabkit_designs::molds::build_layer(&d, &stack, 0, tol).unwrap();
     assert_eq!(out.markers[0]["printable_with"], serde_json::json!(["SLA"]));
     assert_eq!(out.markers[0]["needs_sla_or_finer"], true);
 

@@ -26,8 +26,7 @@ fn the_outline_meets_the_published_torus_and_circles() {
     );
     // the cone's top circle R4.878837 at z = -7.130982; the roof's edge R4.789966 at z = -6.948430
     assert!(
-        (o.wall_top[0] - 4.878837).abs() < 2e-5
-            && (o.wall_top[1] - (8.5 - 7.130982)).abs() < 2e-5
+        (o.wall_top[0] - 4.878837).abs() < 2e-5 && (o.wall_top[1] - (8.5 - 7.130982)).abs() < 2e-5
     );
     assert!(
         (o.roof_edge[0] - 4.789966).abs() < 2e-5

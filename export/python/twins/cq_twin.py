@@ -8,10 +8,19 @@ from . import (cq_casing, cq_fixtures, cq_flat, cq_housing, cq_layers, cq_molds,
                cq_spacer)
 from .families import family  # noqa: F401 (re-exported)
 
-# The twin modules, one per part family: each has `twin(part)`, the part's exact solid in its
-# own frame, or None for a part of another family. Adding a family adds its module here.
-TWINS = (cq_molds, cq_layers, cq_housing, cq_shaft_body, cq_casing, cq_flat, cq_spacer,
-         cq_fixtures)
+# The twin modules, one line per family as in the Rust registries (designs/src/parts/
+# registry.rs, layer_registry.rs): each has `twin(part)`, the part's exact solid in its own
+# frame, or None for a part of another family. Adding a family adds its line here.
+TWINS = (
+    cq_molds,       # parts::molds: master patterns, mold boxes, mold halves, core holders
+    cq_layers,      # parts::layers and the layer features: skins, tips, open molds, inserts
+    cq_housing,     # parts::housing
+    cq_shaft_body,  # parts::shaft_body and robot_mount
+    cq_casing,      # parts::casing and fingertip_base
+    cq_flat,        # parts::flat and lasercut: casting trays
+    cq_spacer,      # parts::spacer
+    cq_fixtures,    # fixtures: pin domes, pins, semi-domes, plates, indenters
+)
 
 
 def build(part: dict):

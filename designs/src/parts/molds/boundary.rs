@@ -1,0 +1,132 @@
+//! The `boundary` strategy: outer and inner master patterns in cups, to cast the two silicone
+//! molds the layer is poured between (UVDtact Sec. III).
+
+use super::frame::material_for;
+use crate::error::{DesignError, GeometryContext};
+use crate::geometry::{revolve, GeometryError, Solid};
+use crate::parts::layers::{apply_features, layer_solid, set_forming, LayerBuild, LayerOutput};
+use crate::parts::placement::{place_posed, with_pose};
+use crate::parts::{Part, PrintTechnology};
+use serde_json::json;
+
+/// The parts of a cast layer with the `boundary` strategy: the outer master (the outer
+/// boundary with its features, plinth and locating pin) with its drafted mold box, and the
+/// inner negative (a cup whose cavity casts the inner silicone core); three pours: the outer
+/// and inner Mold Star 30 molds, then the layer's gel between them, mm^3.
+pub(crate) fn build_boundary_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
+    let (design, stack, i, tol, l, name) = (b.design, b.stack, b.i, b.tol, b.l, &b.name);
+    let (fixture_tech, cavity_tech) = (b.fixture_tech, b.cavity_tech);
+    let m = &design.mold;
+    let g = |r: Result<Solid, GeometryError>| r.part(name);
+    let zb = design.body.base_z_mm();
+    let rim = design.body.rim_radius_mm(l.outer_offset_mm);
+    let r_p = rim + m.plinth.margin_mm;
+    let z_lo = zb - m.plinth.height_mm;
+    let fit = m.core_holder.fit_clearance_mm;
+    // Outer boundary: master (positive) with plinth and locating pin, and a drafted box.
+    let mut pl = design
+        .body
+        .offset_polyline(l.outer_offset_mm, 0.0, tol.half());
+    let pin_r = 3.0f64.min(r_p / 3.0);
+    for p in [
+        [r_p, zb],
+        [r_p, z_lo],
+        [pin_r, z_lo],
+        [pin_r, z_lo - 2.0],
+        [0.0, z_lo - 2.0],
+    ] {
+        pl.push(p);
+    }
+    let master_base = g(revolve(&pl, tol).and_then(|mesh| Solid::from_mesh(&mesh)))?;
+    let master = g(apply_features(master_base, &b.outer, tol, false))?;
+    let pole = master.bounding_box().map(|b| b.max[2]).unwrap_or(0.0);
+    let (mold_box, fill) =
+        crate::parts::molds::drafted_box(design, r_p, z_lo, pole, tol).part(name)?;
+    let silicone_outer = g(fill.difference(&master))?.volume();
+    // Inner boundary: a cup whose cavity casts the inner silicone core; the core's
+    // plinth fits the outer mold's plinth recess (with clearance), which centres it.
+    let inner_pl = {
+        let mut q = design
+            .body
+            .offset_polyline(l.inner_offset_mm, 0.0, tol.half());
+        for p in [[r_p - fit, zb], [r_p - fit, z_lo - 1.0], [0.0, z_lo - 1.0]] {
+            q.push(p);
+        }
+        q
+    };
+    let core_pos = g(revolve(&inner_pl, tol)
+        .and_then(|mesh| Solid::from_mesh(&mesh))
+        .and_then(|s| apply_features(s, &b.inner, tol, false)))?;
+    let top = core_pos.bounding_box().map(|b| b.max[2]).unwrap_or(0.0) + BOUNDARY_CUP_FLOOR_MM;
+    let cup_r = r_p + BOUNDARY_CUP_WALL_MM;
+    let cup =
+        g(crate::geometry::cylinder(top - z_lo, cup_r, tol)
+            .map(|c| c.translate([0.0, 0.0, z_lo])))?;
+    let inner_negative = g(cup.difference(&core_pos))?;
+    let silicone_inner = g(core_pos.intersection(&cup))?.volume();
+    let gel = g(layer_solid(design, stack, i, tol))?.volume();
+    let boundary = json!({
+        "locating_pin": {"radius_mm": pin_r, "height_mm": 2.0},
+        "master_top_z_mm": pole,
+        "inner_plinth_bottom_z_mm": z_lo - 1.0,
+        "cup": {"radius_mm": cup_r, "bottom_z_mm": z_lo, "top_z_mm": top},
+        "box_floor_mm": 2.0, "box_wall_mm": 2.0, "box_freeboard_mm": 2.0,
+        "pin_socket_radius_mm": pin_r + fit,
+    });
+    let mk = |suffix: &str,
+              role: &str,
+              desc: String,
+              tech: PrintTechnology,
+              (solid, pose): (Solid, crate::geometry::Affine)| Part {
+        name: format!("{name}_{suffix}"),
+        role: role.into(),
+        description: desc,
+        material: material_for(tech).into(),
+        print_technology: tech,
+        solid,
+        params: with_pose(
+            json!({"base": b.base_params, "plinth_radius_mm": r_p, "plinth_height_mm": m.plinth.height_mm, "fit_clearance_mm": fit, "draft_angle_deg": m.draft_angle_deg, "silicone_wall_mm": m.silicone_wall_mm, "boundary": boundary}),
+            &pose,
+        ),
+        group: None,
+    };
+    let parts = vec![
+        mk("outer_master", "master_pattern", format!("Positive of the outer boundary of {name} with its features, to cast the outer Mold Star 30 mold"), cavity_tech, place_posed(&master, &crate::geometry::Affine::identity())),
+        mk("outer_mold_box", "mold_box", format!("Drafted cup for the outer Mold Star 30 mold of {name}"), fixture_tech, place_posed(&mold_box, &crate::geometry::Affine::identity())),
+        mk("inner_negative", "negative_mold", format!("Negative of the inner boundary of {name} with its features: pour Mold Star 30 in it for the inner silicone mold"), cavity_tech, place_posed(&inner_negative, &crate::geometry::rotation_deg(180.0, 0.0, 0.0))),
+    ];
+    let names: Vec<String> = parts.iter().map(|p| p.name.clone()).collect();
+    let mut markers = b.markers_json;
+    set_forming(&mut markers, &names[..1], &names[2..3], 0.0);
+    Ok(LayerOutput {
+        parts,
+        pours: vec![
+            (
+                format!("silicone_mold:{name}:outer"),
+                "mold_star_30".into(),
+                silicone_outer,
+                vec![names[0].clone(), names[1].clone()],
+            ),
+            (
+                format!("silicone_mold:{name}:inner"),
+                "mold_star_30".into(),
+                silicone_inner,
+                vec![names[2].clone()],
+            ),
+            (
+                name.clone(),
+                l.material.clone(),
+                gel,
+                vec![
+                    format!("silicone_mold:{name}:outer"),
+                    format!("silicone_mold:{name}:inner"),
+                ],
+            ),
+        ],
+        markers,
+    })
+}
+
+const BOUNDARY_CUP_WALL_MM: f64 = 5.0;
+
+const BOUNDARY_CUP_FLOOR_MM: f64 = 5.0;

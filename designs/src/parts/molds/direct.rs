@@ -1,0 +1,114 @@
+//! The `direct` strategy: the printed block split on the parting plane y = 0, with registration
+//! keys, clamp bolt holes and the core holder (R-Tac0 Sec. III-B1, Fig. 4).
+
+use super::frame::{material_for, CastMold, MoldFrame, MoldOutput};
+use crate::error::{DesignError, GeometryContext};
+use crate::geometry::{cuboid, sphere, Affine, ChordTolerance, Solid};
+use crate::parts::placement::{place_posed, with_pose};
+use crate::parts::{Part, PrintTechnology};
+use crate::schema::Design;
+use serde_json::json;
+
+/// The parts of a `direct` mold: the two mold halves split at the parting plane y = 0 around
+/// `cavity` (male and female registration keys) and the core holder; the gel pours into all
+/// three.
+pub(crate) fn direct_mold_parts(
+    design: &Design,
+    cavity: &Solid,
+    tol: ChordTolerance,
+    c: CastMold,
+) -> Result<MoldOutput, DesignError> {
+    let (name, f) = (c.name, &c.f);
+    let m = &design.mold;
+    let cavity_tech: PrintTechnology = m.cavity_print_technology.into();
+    let cavity_material = material_for(cavity_tech);
+    let ((a, pose_a), (b, pose_b)) = direct_halves(design, f, cavity, tol).part(name)?;
+    let mut params = c.common.clone();
+    params["direct"] = json!({
+        "parting_plane": "y = 0 (through the sensor axis)",
+        "pull_direction": "+y for half a, -y for half b",
+        "half_width_mm": f.plinth_radius_mm + m.flange_width_mm,
+        "z_min_mm": f.open_face_z_mm,
+        "z_max_mm": f.cavity_pole_z_mm + m.wall_thickness_mm,
+        "registration_key": m.registration_key,
+        "clamp_bolt": m.clamp_bolt,
+        "feature_x_mm": f.plinth_radius_mm + m.flange_width_mm / 2.0,
+        "print_orientation": "parting face up",
+    });
+    let half = |s: Solid, pose: Affine, tag: &str, keys: &str| Part {
+        name: format!("{name}_mold_half_{tag}"),
+        role: "mold_half".into(),
+        description: format!(
+            "Two-piece mold for the {name} layer, half {tag} ({keys} registration keys)"
+        ),
+        material: cavity_material.into(),
+        print_technology: cavity_tech,
+        solid: s,
+        params: with_pose(params.clone(), &pose),
+        group: None,
+    };
+    let parts = vec![
+        half(a, pose_a, "a", "male"),
+        half(b, pose_b, "b", "female"),
+        c.holder_part,
+    ];
+    let pour_parts = parts.iter().map(|p| p.name.clone()).collect();
+    Ok(MoldOutput {
+        parts,
+        pour_volume_mm3: c.pour_volume,
+        silicone_pour: None,
+        pour_parts,
+        markers: Vec::new(),
+    })
+}
+
+/// The two halves of a direct mold, each in print orientation (parting face up).
+pub(crate) fn direct_halves(
+    design: &Design,
+    f: &MoldFrame,
+    cavity: &Solid,
+    tol: ChordTolerance,
+) -> Result<(Posed, Posed), crate::geometry::GeometryError> {
+    let m = &design.mold;
+    let b = f.plinth_radius_mm + m.flange_width_mm;
+    let z_lo = f.open_face_z_mm;
+    let z_hi = f.cavity_pole_z_mm + m.wall_thickness_mm;
+    let block = cuboid([-b, -b, z_lo], [b, b, z_hi])?.difference(cavity)?;
+    let (pos, neg) = block.split_by_plane([0.0, 1.0, 0.0], 0.0);
+    let x_f = f.plinth_radius_mm + m.flange_width_mm / 2.0;
+    let e = m.flange_width_mm / 2.0;
+    let z_mid = 0.5 * (z_lo + z_hi);
+    let r_key = m.registration_key.diameter_mm / 2.0;
+    let key_at = |r: f64| -> Result<Vec<Solid>, crate::geometry::GeometryError> {
+        let s = sphere(r, tol)?;
+        Ok(vec![
+            s.translate([x_f, 0.0, z_mid]),
+            s.translate([-x_f, 0.0, z_mid]),
+        ])
+    };
+    let bolt =
+        crate::geometry::cylinder(2.0 * b + 2.0, m.clamp_bolt.clearance_diameter_mm / 2.0, tol)?
+            .rotate_deg(-90.0, 0.0, 0.0);
+    let mut bolts = Vec::new();
+    for x in [x_f, -x_f] {
+        for z in [z_lo + e, z_hi - e] {
+            bolts.push(bolt.translate([x, -b - 1.0, z]));
+        }
+    }
+    let bolts = Solid::compose(&bolts);
+    let a = pos
+        .union(&Solid::compose(&key_at(r_key)?))?
+        .difference(&bolts)?;
+    let bh = neg
+        .difference(&Solid::compose(&key_at(
+            r_key + m.registration_key.clearance_mm,
+        )?))?
+        .difference(&bolts)?;
+    Ok((
+        place_posed(&a, &crate::geometry::rotation_deg(-90.0, 0.0, 0.0)),
+        place_posed(&bh, &crate::geometry::rotation_deg(90.0, 0.0, 0.0)),
+    ))
+}
+
+/// A solid in print orientation with its `T_print_sensor`.
+pub(crate) type Posed = (Solid, Affine);

@@ -1,0 +1,240 @@
+//! Molds for cast layers, one module per strategy (R-Tac0 Sec. III-B1, Fig. 4; UVDtact
+//! Sec. III; DIGIT Pinki; Sferrazza et al.):
+//!
+//! - [`direct`]: a printed block split on the parting plane y = 0 (through the axis), with
+//!   hemispherical registration keys, clamp bolt holes and a core holder that closes the open
+//!   end, keeps the core concentric and carries the sprue and vents.
+//! - [`master`]: a printed master pattern of the cavity and a drafted mold box, to cast a
+//!   Mold Star 30 silicone mold, plus the same core holder as casting jig.
+//! - [`open`]: a one-piece block open on the base plane, poured to the brim (with the inserts
+//!   of the layer's features, [`crate::parts::layer_registry::open_mold_inserts`]).
+//! - [`two_piece_open`]: a cavity block and a reservoir top bolted together.
+//! - [`boundary`]: outer and inner master patterns for two silicone molds.
+//!
+//! `direct` and `master` share the cavity ([`frame`]): the offset surface of the layer's
+//! outermost sprayed coat (or of the layer itself) plus `cavity_clearance_mm`, opening on the
+//! base plane into a disc-shaped plinth recess. The core holder's spigot plugs into that
+//! recess (centring it) and leaves a reservoir ring between the spigot and the base plane.
+//! Casting is done pole-down, so the reservoir is the high point of the cavity: the sprue and
+//! the vents open into it. The strategies' parameters are [`crate::schema::mold`]; their rules
+//! are [`checks`]; the laser-cut trays of flat skins are [`crate::parts::lasercut`].
+
+pub mod boundary;
+pub mod checks;
+pub mod direct;
+pub mod frame;
+pub mod master;
+pub mod open;
+pub mod two_piece_open;
+
+use crate::error::{DesignError, GeometryContext, ParamError};
+use crate::geometry::ChordTolerance;
+use crate::geometry::{revolve, Solid};
+use crate::markers::MarkerSurface;
+use crate::parts::context::Stack;
+use crate::parts::layers::{self, LayerOutput};
+use crate::parts::{Part, PrintTechnology};
+use crate::schema::{Design, LayerProcess, MoldStrategy};
+use direct::direct_mold_parts;
+use frame::{cavity_profile, core_holder, holder_params, CastMold};
+use master::master_mold_parts;
+use serde_json::json;
+
+pub use crate::parts::placement::{place_on_bed, place_posed, with_pose};
+pub use crate::schema::mold::{
+    ClampBolt, CoreHolderParams, MoldParams, OpenBlock, Plinth, RegistrationBoss, RegistrationKey,
+    Sprue, TwoPieceOpenParams, Vent,
+};
+pub use checks::{check_mold_fit, check_mold_params};
+pub use frame::{cast_plans, open_cavity_mm, CastPlan, MoldFrame, MoldOutput};
+pub(crate) use frame::{material_for, BOX_FLOOR_MM, BOX_FREEBOARD_MM};
+pub use master::drafted_box;
+pub use two_piece_open::{check_two_piece, TwoPieceFrame};
+
+/// Builds the mold parts of one cast.
+///
+/// # Errors
+/// [`DesignError::Geometry`] if the kernel fails.
+pub fn build_mold(
+    design: &Design,
+    stack: &Stack,
+    plan: &CastPlan,
+    tol: ChordTolerance,
+) -> Result<MoldOutput, DesignError> {
+    build_mold_parts(design, stack, plan, tol).map_err(|e| {
+        e.from_params(&[
+            format!("layers[{}]", plan.layer),
+            "mold".into(),
+            "core".into(),
+        ])
+    })
+}
+
+fn build_mold_parts(
+    design: &Design,
+    stack: &Stack,
+    plan: &CastPlan,
+    tol: ChordTolerance,
+) -> Result<MoldOutput, DesignError> {
+    let layer = &stack.layers[plan.layer];
+    let core = stack.core.as_ref().ok_or_else(|| {
+        DesignError::Params(crate::error::ParamErrors(vec![ParamError::new(
+            "core",
+            "missing",
+            "direct and master molds hold a core",
+        )]))
+    })?;
+    let f = MoldFrame::new(design, core, plan.cavity_offset_mm);
+    let m = &design.mold;
+    let name = &layer.name;
+    let fixture_tech: PrintTechnology = m.fixture_print_technology.into();
+    let fixture_material = material_for(fixture_tech);
+
+    // The cavity carries the layer's outer features, grown by the coats sprayed into it.
+    let features = crate::parts::layers::cavity_features(
+        design,
+        stack,
+        plan.layer,
+        plan.cavity_offset_mm,
+        tol,
+    );
+    let features: Vec<_> = features.iter().collect();
+    let with_features =
+        |s: Solid| crate::parts::layers::apply_features(s, &features, tol, false).part(name);
+    let cavity = with_features(
+        Solid::from_mesh(
+            &revolve(
+                &cavity_profile(design, &f, plan.cavity_offset_mm, false, tol),
+                tol,
+            )
+            .part(name)?,
+        )
+        .part(name)?,
+    )?;
+    let holder = core_holder(design, &f, tol)?;
+    // The pour fills the cavity, minus what is inside it (core and inner layers), minus the holder.
+    // What the pour lands on: the layers under it down to the base plane, and below it the
+    // core alone (its bore is closed by the holder's pin, so it counts as solid).
+    let mut inner_pl = design
+        .body
+        .offset_polyline(plan.core_offset_mm, 0.0, tol.half());
+    inner_pl.push([f.core_outer_radius_mm, f.base_z_mm]);
+    inner_pl.push([f.core_outer_radius_mm, f.core_end_z_mm]);
+    inner_pl.push([0.0, f.core_end_z_mm]);
+    let inner = Solid::from_mesh(&revolve(&inner_pl, tol).part(name)?).part(name)?;
+    let void = cavity
+        .difference(&holder.union(&inner).part(name)?)
+        .part(name)?;
+    // a coat over features follows them (crate::parts::layers::taken_features)
+    let sprayed_volume: f64 = plan
+        .sprayed
+        .iter()
+        .map(|&i| {
+            if features.is_empty() {
+                stack.layer_solid(design, i, tol)
+            } else {
+                crate::parts::layers::layer_solid(design, stack, i, tol)
+            }
+            .map(|s| s.volume())
+        })
+        .sum::<Result<f64, _>>()
+        .part(name)?;
+    let pour_volume = void.volume() - sprayed_volume;
+
+    let mut common = json!({
+        "layer": name,
+        "strategy": plan.strategy,
+        "cavity_offset_mm": plan.cavity_offset_mm,
+        "core_offset_mm": plan.core_offset_mm,
+        "body": design.body,
+        "frame": f,
+        "plinth": m.plinth,
+    });
+    if !features.is_empty() {
+        // the features the cavity carries, for the twins (export/python/twins/cq_molds.py)
+        common["markers"] = json!(features
+            .iter()
+            .map(|p| crate::parts::layers::twin_marker_set(p, MarkerSurface::Outer))
+            .collect::<Vec<_>>());
+    }
+    let direct = plan.strategy == MoldStrategy::Direct;
+    let holder_name = if direct {
+        format!("{name}_core_holder")
+    } else {
+        format!("{name}_casting_jig")
+    };
+    let (holder_placed, holder_pose) = place_posed(&holder, &crate::geometry::Affine::identity());
+    let holder_part = Part {
+        name: holder_name.clone(),
+        role: if direct { "core_holder".into() } else { "casting_jig".into() },
+        description: format!(
+            "Closes the {name} mold, centres the core on its bore and carries the sprue and {} vents",
+            m.vent.count
+        ),
+        material: fixture_material.into(),
+        print_technology: fixture_tech,
+        solid: holder_placed,
+        params: with_pose(holder_params(design, &f), &holder_pose),
+        group: None,
+    };
+
+    let c = CastMold {
+        name,
+        f,
+        common,
+        holder_name,
+        holder_part,
+        pour_volume,
+    };
+    let mut out = match plan.strategy {
+        MoldStrategy::Open | MoldStrategy::TwoPieceOpen | MoldStrategy::Boundary => {
+            unreachable!("built by crate::parts::layers")
+        }
+        MoldStrategy::Direct => direct_mold_parts(design, &cavity, tol, c),
+        MoldStrategy::Master => master_mold_parts(design, plan, tol, c, &with_features),
+    }?;
+    let placed = crate::parts::layers::place_layer_markers(design, layer, tol);
+    out.markers = crate::parts::layers::marker_summary(
+        layer,
+        &placed,
+        crate::parts::layer_markers::feature_technology(design, &design.layers[plan.layer]),
+        design,
+    );
+    let carriers: Vec<String> = out
+        .parts
+        .iter()
+        .filter(|p| matches!(p.role.as_str(), "mold_half" | "master_pattern"))
+        .map(|p| p.name.clone())
+        .collect();
+    crate::parts::layers::set_forming(
+        &mut out.markers,
+        &carriers,
+        &[],
+        plan.cavity_offset_mm - layer.outer_offset_mm,
+    );
+    Ok(out)
+}
+
+/// Builds the parts of a cast layer with the `open` or `boundary` strategy, or of a printed
+/// layer.
+///
+/// # Errors
+/// [`DesignError::Geometry`] if the kernel fails, naming the parameters (`layers[i]`, and
+/// `mold` for a cast layer).
+pub fn build_layer(
+    design: &Design,
+    stack: &Stack,
+    i: usize,
+    tol: ChordTolerance,
+) -> Result<LayerOutput, DesignError> {
+    layers::with_layer_build(design, stack, i, tol, |b| {
+        match (b.l.process, b.l.mold_strategy) {
+            (LayerProcess::Printed, _) => layers::build_printed_layer(b),
+            (_, MoldStrategy::Open) => open::build_open_mold_layer(b),
+            (_, MoldStrategy::TwoPieceOpen) => two_piece_open::build_two_piece_open_layer(b),
+            (_, MoldStrategy::Boundary) => boundary::build_boundary_layer(b),
+            _ => unreachable!("direct and master molds are built by molds::build_mold"),
+        }
+    })
+    .map_err(|e| e.from_params(&layers::layer_params(design, i)))
+}

@@ -1,0 +1,86 @@
+//! The `open` strategy: a one-piece block open on the base plane, printed open face up and poured
+//! to the brim, with the inserts of the layer's features (DIGIT Pinki).
+
+use super::frame::material_for;
+use crate::error::{DesignError, GeometryContext};
+use crate::geometry::{GeometryError, Solid};
+use crate::parts::layer_feature::InsertInput;
+use crate::parts::layer_registry::open_mold_inserts;
+use crate::parts::layers::{
+    apply_features_signed, body_solid, features_top_z_mm, set_forming, LayerBuild, LayerOutput,
+};
+use crate::parts::placement::{place_posed, with_pose};
+use crate::parts::Part;
+use serde_json::json;
+
+/// The one-piece open mold of a solid cast layer (`open` strategy): a block
+/// `mold.wall_thickness_mm` beyond the rim and the tallest outward feature, less the cavity
+/// (the outer surface with its features), printed open face up; one pour of the layer's
+/// material, its volume block - mold, mm^3.
+pub(crate) fn build_open_mold_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
+    let (design, tol, l, name, outer) = (b.design, b.tol, b.l, &b.name, &b.outer);
+    let (base_params, cavity_tech) = (&b.base_params, b.cavity_tech);
+    let m = &design.mold;
+    let g = |r: Result<Solid, GeometryError>| r.part(name);
+    // mold = (block - plain cavity) with the features cut or added: one boolean with
+    // the features, and the skin's volume falls out as block - mold.
+    let plain = g(body_solid(design, l.outer_offset_mm, 1.0, tol))?;
+    let rim = design.body.rim_radius_mm(l.outer_offset_mm);
+    let top = features_top_z_mm(design, l.outer_offset_mm, outer);
+    let zb = design.body.base_z_mm();
+    let (half, z_top) = match &m.open_block {
+        Some(ob) => (ob.width_mm / 2.0, zb + ob.height_mm),
+        None => (rim + m.wall_thickness_mm, top + m.wall_thickness_mm),
+    };
+    let block = g(crate::geometry::cuboid(
+        [-half, -half, zb],
+        [half, half, z_top],
+    ))?;
+    let mold = g(block
+        .difference(&plain)
+        .and_then(|b| apply_features_signed(b, outer, tol, false, -1.0)))?;
+    // the features' inserts set in the open face (the optic's seat)
+    let inserts = open_mold_inserts(
+        design,
+        l.index,
+        InsertInput {
+            layer_name: name,
+            base_z_mm: zb,
+            base_params,
+            technology: cavity_tech,
+            material: material_for(cavity_tech),
+            tol,
+        },
+    )
+    .part(name)?;
+    let inserts_volume: f64 = inserts.iter().map(|i| i.volume_mm3).sum();
+    let skin_volume = block.volume() - mold.volume() - inserts_volume;
+    let (mold_placed, mold_pose) =
+        place_posed(&mold, &crate::geometry::rotation_deg(180.0, 0.0, 0.0));
+    let part = Part {
+        name: format!("{name}_open_mold"),
+        role: "open_mold".into(),
+        description: format!(
+            "One-piece mold for the solid {name} skin, open face up: pour to the brim"
+        ),
+        material: material_for(cavity_tech).into(),
+        print_technology: cavity_tech,
+        solid: mold_placed,
+        params: with_pose(
+            json!({"base": base_params, "open_face": "the base plane, printed face up", "wall_thickness_mm": m.wall_thickness_mm,
+            "block_mm": {"min": [-half, -half, zb], "max": [half, half, z_top]}}),
+            &mold_pose,
+        ),
+        group: None,
+    };
+    let mut parts = vec![part];
+    parts.extend(inserts.into_iter().map(|i| i.part));
+    let pour_parts = parts.iter().map(|p| p.name.clone()).collect();
+    let mut markers = b.markers_json;
+    set_forming(&mut markers, &[format!("{name}_open_mold")], &[], 0.0);
+    Ok(LayerOutput {
+        parts,
+        pours: vec![(name.clone(), l.material.clone(), skin_volume, pour_parts)],
+        markers,
+    })
+}
