@@ -458,20 +458,22 @@ pub fn refine_intrinsics_keeping(
     pb.refinement(fit, &initial, &held, rms_before_px)
 }
 
+/// The parameters held at the camera file's value: (index into [`parameter_names`], why).
+type Held = Vec<(usize, String)>;
+
 /// The parameters to refine (indices into [`parameter_names`] of `distortion`'s model,
 /// ascending) and those held from the start with why: every parameter for
 /// [`RefineParameters::Constrained`], else exactly the listed ones.
 ///
 /// # Errors
 /// [`RefineError::UnknownParameter`], [`RefineError::Twice`].
-#[allow(clippy::type_complexity)]
 fn chosen_parameters(
     distortion: &Distortion,
     which: &RefineParameters,
-) -> Result<(Vec<usize>, Vec<(usize, String)>), RefineError> {
+) -> Result<(Vec<usize>, Held), RefineError> {
     let names = parameter_names(distortion);
     let model = distortion.name();
-    let mut held: Vec<(usize, String)> = Vec::new();
+    let mut held: Held = Vec::new();
     let free: Vec<usize> = match which {
         RefineParameters::Constrained => (0..names.len()).collect(),
         RefineParameters::Only(list) => {
@@ -534,7 +536,7 @@ impl Problem<'_> {
         &mut self,
         start: &State,
         which: &RefineParameters,
-        held: &mut Vec<(usize, String)>,
+        held: &mut Held,
     ) -> Result<(), RefineError> {
         let names = parameter_names(&self.base.distortion);
         loop {
@@ -625,7 +627,7 @@ impl Problem<'_> {
         e0: DVector<f64>,
         which: &RefineParameters,
         initial: &[f64],
-        held: &mut Vec<(usize, String)>,
+        held: &mut Held,
     ) -> Result<Fit, RefineError> {
         let names = parameter_names(&self.base.distortion);
         let n_obs = 2 * self.points.len();
