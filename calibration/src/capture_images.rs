@@ -19,7 +19,7 @@ use rayon::prelude::*;
 
 use crate::imprints::{
     assign_ids_through, detect, ids_from_file_name, reference_mask, CaptureOutcome, CaptureSpots,
-    DetectParams, GrayImage,
+    DetectParams, GrayImage, Observation,
 };
 use crate::overlay::{OverlayError, Rgb8};
 use crate::tables::{CapturePlan, Observations, PointTable};
@@ -275,7 +275,59 @@ pub fn observe_images(
             });
         }
     }
-    let planned: Vec<Vec<u32>> = match plan {
+    let planned = planned_ids(plan, input)?;
+    for (p, ids) in input.captures.iter().zip(&planned) {
+        if let Some((id, times)) = crate::imprints::repeated_pin(ids) {
+            return Err(ImageError::RepeatedPin {
+                file: p.display().to_string(),
+                id,
+                times,
+            });
+        }
+    }
+    let reference = read_gray(&input.reference, "--reference", size, camera_file)?;
+    let mut captures = detect_captures(&reference, input, &planned, size, camera_file)?;
+    // the table's ids by number
+    let by_number: BTreeMap<u32, (&String, Vector3<f64>)> = table
+        .rows
+        .iter()
+        .filter_map(|(id, p, _)| id.parse::<u32>().ok().map(|n| (n, (id, *p))))
+        .collect();
+    let points: BTreeMap<u32, Vector3<f64>> =
+        by_number.iter().map(|(n, (_, p))| (*n, *p)).collect();
+    let spots: Vec<CaptureSpots> = captures.iter().map(|c| c.spots.clone()).collect();
+    let assignment = assign_ids_through(imaging, &points, &spots);
+    let (csv, rows) = merge_observations(&assignment.observations, &mut captures, &by_number);
+    let mut unobserved_ids: Vec<String> = Vec::new();
+    for n in planned.iter().flatten() {
+        let id = by_number
+            .get(n)
+            .map_or_else(|| n.to_string(), |(id, _)| (*id).clone());
+        if !rows.iter().any(|r| r.0 == id) && !unobserved_ids.contains(&id) {
+            unobserved_ids.push(id);
+        }
+    }
+    Ok(ImageObservations {
+        observations: Observations { rows },
+        unobserved_ids,
+        csv,
+        notes: assignment.notes(),
+        outcomes: assignment.captures,
+        captures,
+    })
+}
+
+/// The pin ids of each capture of `input`: its row of `plan` (ids parsed as pin numbers), or
+/// without a plan the ids its file name lists ([`ids_from_file_name`]).
+///
+/// # Errors
+/// [`ImageError::Count`] for a plan of another number of captures, [`ImageError::Ids`] for a
+/// plan id that is not a number or a file name that lists no ids.
+fn planned_ids(
+    plan: Option<&CapturePlan>,
+    input: &CaptureImages,
+) -> Result<Vec<Vec<u32>>, ImageError> {
+    Ok(match plan {
         Some(plan) => {
             if plan.captures.len() != input.captures.len() {
                 return Err(ImageError::Count {
@@ -312,18 +364,23 @@ pub fn observe_images(
                 })
             })
             .collect::<Result<_, _>>()?,
-    };
-    for (p, ids) in input.captures.iter().zip(&planned) {
-        if let Some((id, times)) = crate::imprints::repeated_pin(ids) {
-            return Err(ImageError::RepeatedPin {
-                file: p.display().to_string(),
-                id,
-                times,
-            });
-        }
-    }
-    let reference = read_gray(&input.reference, "--reference", size, camera_file)?;
-    let mask = reference_mask(&reference, 255.0, REFLECTION_MARGIN_PX);
+    })
+}
+
+/// Each capture of `input` read (of the camera's `size`, px) and its spots detected against
+/// `reference` inside the reference's mask, with its `planned` ids; read and detected in
+/// parallel.
+///
+/// # Errors
+/// The first [`ImageError`] in capture order.
+fn detect_captures(
+    reference: &GrayImage,
+    input: &CaptureImages,
+    planned: &[Vec<u32>],
+    size: (u32, u32),
+    camera_file: &str,
+) -> Result<Vec<Capture>, ImageError> {
+    let mask = reference_mask(reference, 255.0, REFLECTION_MARGIN_PX);
     let params = DetectParams::default();
     // read and detect in parallel; the first error in capture order is reported
     let captures: Vec<Result<Capture, ImageError>> = input
@@ -332,7 +389,7 @@ pub fn observe_images(
         .zip(planned.par_iter())
         .map(|(p, ids)| {
             let image = read_gray(p, "--images", size, camera_file)?;
-            let spots = detect(&reference, &image, Some(&mask), &params)
+            let spots = detect(reference, &image, Some(&mask), &params)
                 .expect("sizes checked against the camera's");
             Ok(Capture {
                 image,
@@ -345,21 +402,23 @@ pub fn observe_images(
             })
         })
         .collect();
-    let mut captures: Vec<Capture> = captures.into_iter().collect::<Result<_, _>>()?;
-    // the table's ids by number
-    let by_number: BTreeMap<u32, (&String, Vector3<f64>)> = table
-        .rows
-        .iter()
-        .filter_map(|(id, p, _)| id.parse::<u32>().ok().map(|n| (n, (id, *p))))
-        .collect();
-    let points: BTreeMap<u32, Vector3<f64>> =
-        by_number.iter().map(|(n, (_, p))| (*n, *p)).collect();
-    let spots: Vec<CaptureSpots> = captures.iter().map(|c| c.spots.clone()).collect();
-    let assignment = assign_ids_through(imaging, &points, &spots);
+    captures.into_iter().collect()
+}
+
+/// The assigned `observations` as `observations.csv` (one row per detection) and as
+/// observation rows (id spelled as in the table's `by_number`, pixel, origin), one per pin in
+/// first-seen order, a pin seen in several captures combined
+/// ([`crate::tables::combine_observations`]); each capture's assigned spots noted in its
+/// `ids`.
+fn merge_observations(
+    observations: &[Observation],
+    captures: &mut [Capture],
+    by_number: &BTreeMap<u32, (&String, Vector3<f64>)>,
+) -> (String, Vec<(String, Vector2<f64>, String)>) {
     let mut csv = String::from("capture,id,u_px,v_px,score\n");
     // id -> (sum of pixels, count, captures), first-seen order
     let mut merged: Vec<(String, Vec<Vector2<f64>>, Vec<String>)> = Vec::new();
-    for o in &assignment.observations {
+    for o in observations {
         csv.push_str(&format!(
             "{},{},{:.4},{:.4},{:.2}\n",
             csv_cell(&o.capture),
@@ -390,30 +449,14 @@ pub fn observe_images(
             None => merged.push((id, vec![uv], vec![o.capture.clone()])),
         }
     }
-    let rows: Vec<(String, Vector2<f64>, String)> = merged
+    let rows = merged
         .into_iter()
         .map(|(id, px, caps)| {
             let origin = format!("detected in {}", caps.join(" + "));
             (id, crate::tables::combine_observations(&px), origin)
         })
         .collect();
-    let mut unobserved_ids: Vec<String> = Vec::new();
-    for n in planned.iter().flatten() {
-        let id = by_number
-            .get(n)
-            .map_or_else(|| n.to_string(), |(id, _)| (*id).clone());
-        if !rows.iter().any(|r| r.0 == id) && !unobserved_ids.contains(&id) {
-            unobserved_ids.push(id);
-        }
-    }
-    Ok(ImageObservations {
-        observations: Observations { rows },
-        unobserved_ids,
-        csv,
-        notes: assignment.notes(),
-        outcomes: assignment.captures,
-        captures,
-    })
+    (csv, rows)
 }
 
 impl ImageObservations {

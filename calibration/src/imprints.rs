@@ -21,6 +21,9 @@
 //! (docs/conventions.md).
 
 mod assign;
+mod mask;
+
+pub use mask::reference_mask;
 
 /// A grey image: `data[v * width + u]`, grey levels (any scale; 8-bit images 0..255).
 #[derive(Debug, Clone, PartialEq)]
@@ -816,158 +819,43 @@ pub fn detect(
     let Difference {
         mut lowered,
         mut noise,
-        mut d,
+        d,
         block_max,
         ..
     } = pass;
-    let lo_offset = f64::from(median(&mut lowered));
-    // noise: the median absolute deviation of the smoothed difference over the mask
-    let med = median(&mut noise);
-    let mut dev: Vec<f32> = noise.iter().map(|x| (x - med).abs()).collect();
-    let sigma = (1.4826 * median(&mut dev)).max(1e-6) as f64;
-    let hi = med as f64 + p.threshold_sigma * sigma;
-    let lo = med as f64 + p.grow_sigma * sigma;
-    // the same lower threshold on the difference with the reference itself: the erosion
-    // lowers the difference by about the same everywhere on smooth skin (the darkest of the
-    // reference's noise within the window), which would otherwise weigh every pixel of a spot
-    // alike and pull its centre to the middle of its area
-    let lo_plain = lo + lo_offset;
+    let levels = Levels::of(&mut lowered, &mut noise, p);
+    let measure = Measure {
+        reference,
+        capture,
+        mask,
+        gain,
+        kernel: &k,
+        levels: &levels,
+        p,
+    };
+    let mut grow = Growth {
+        d,
+        w,
+        h,
+        stack: Vec::new(),
+        pixels: Vec::new(),
+    };
     let mut spots = Vec::new();
-    let (mut stack, mut pixels) = (Vec::new(), Vec::new());
     // the seeds in the order of the pixels, in the blocks whose largest value exceeds the upper
     // threshold; each grows its spot. A pixel taken into a spot is set to -inf in `d`: no
     // other spot takes it, and no later seed starts there.
-    let hi32 = hi as f32;
+    let (hi, hi32) = (levels.hi, levels.hi as f32);
     let blocks = w.div_ceil(SEED_BLOCK);
     for (b, _) in block_max.iter().enumerate().filter(|(_, &x)| x > hi32) {
         let first = (b / blocks) * w + (b % blocks) * SEED_BLOCK;
         let end = first + SEED_BLOCK.min(w - (b % blocks) * SEED_BLOCK);
         for start in first..end {
+            let d = &grow.d;
             if !(d[start] > hi32) || (d[start] as f64) <= hi {
                 continue;
             }
-            // grow by hysteresis over 8-neighbours above `lo`; the peak over the pixels taken
-            let mut peak = (d[start] as f64 - med as f64).max(0.0);
-            d[start] = f32::NEG_INFINITY;
-            stack.push((start % w, start / w));
-            pixels.clear();
-            while let Some((u, v)) = stack.pop() {
-                pixels.push((u, v));
-                let (u0, u1) = (u.saturating_sub(1), (u + 1).min(w - 1));
-                for vv in v.saturating_sub(1)..=(v + 1).min(h - 1) {
-                    for uu in u0..=u1 {
-                        let j = vv * w + uu;
-                        if d[j] as f64 > lo {
-                            peak = peak.max(d[j] as f64 - med as f64);
-                            d[j] = f32::NEG_INFINITY;
-                            stack.push((uu, vv));
-                        }
-                    }
-                }
-            }
-            // weighted by the difference with the reference itself (not eroded), smoothed the
-            // same way: the erosion decides which pixels a spot has, not its centre; the
-            // weights are the darkening above the core's level (`core_fraction` of the way
-            // from the growing threshold to the spot's peak)
-            let plain = smoothed_over(reference, capture, gain, &k, &pixels);
-            let top = plain
-                .iter()
-                .fold(f64::NEG_INFINITY, |a, &x| a.max(f64::from(x)));
-            let level = lo_plain + p.core_fraction * (top - lo_plain).max(0.0);
-            let wts: Vec<f64> = plain
-                .iter()
-                .map(|&x| (f64::from(x) - level).max(0.0))
-                .collect();
-            let (mut sw, mut su, mut sv) = (0f64, 0f64, 0f64);
-            // the core's pixels' moments, unweighted (its shape: a halo the spot grew into
-            // is not the imprint's)
-            let mut m = [0f64; 5];
-            let mut core = Vec::with_capacity(pixels.len());
-            let (mut clipped, mut core_clipped) = (false, false);
-            for (&(u, v), &x) in pixels.iter().zip(&wts) {
-                let (fu, fv) = (u as f64, v as f64);
-                sw += x;
-                su += x * fu;
-                sv += x * fv;
-                if x > 0.0 {
-                    core.push((u, v));
-                    m[0] += fu;
-                    m[1] += fv;
-                    m[2] += fu * fu;
-                    m[3] += fv * fv;
-                    m[4] += fu * fv;
-                }
-                let edge = u == 0
-                    || v == 0
-                    || u + 1 == w
-                    || v + 1 == h
-                    || mask.is_some_and(|m| {
-                        !(m[v * w + u - 1]
-                            && m[v * w + u + 1]
-                            && m[v * w + u - w]
-                            && m[v * w + u + w])
-                    });
-                clipped |= edge;
-                core_clipped |= edge && x > 0.0;
-            }
-            let area = pixels.len();
-            let n = core.len() as f64;
-            let (roundness, major_sd) = if core.is_empty() {
-                (1.0, 0.0)
-            } else {
-                let (r, major, _, _) = shape(n, m[0], m[1], m[2], m[3], m[4]);
-                (r, major)
-            };
-            let core_wts: Vec<f64> = wts.iter().copied().filter(|&x| x > 0.0).collect();
-            let halves =
-                split_core(&core, &core_wts, 2 * p.min_area_px.max(1)).map(|(hs, sides)| {
-                    // each half cut in two again (three or four imprints joined)
-                    let mut out = hs;
-                    for (k, h) in out.iter_mut().enumerate() {
-                        let (px, ws): (Vec<(usize, usize)>, Vec<f64>) = core
-                            .iter()
-                            .zip(&core_wts)
-                            .zip(&sides)
-                            .filter(|(_, &sd)| usize::from(sd) == k)
-                            .map(|((&q, &x), _)| (q, x))
-                            .unzip();
-                        h.parts = split_core(&px, &ws, 2 * p.min_area_px.max(1)).map(|(ps, _)| {
-                            ps.map(|q| Part {
-                                u_px: q.u_px,
-                                v_px: q.v_px,
-                                area_px: q.area_px,
-                            })
-                        });
-                    }
-                    out
-                });
-            // a spot whose core has no weight (its peak at the growing threshold): its pixels'
-            // centroid
-            let (su, sv, sw) = if sw > 0.0 {
-                (su, sv, sw)
-            } else {
-                let (a, b) = pixels
-                    .iter()
-                    .fold((0.0, 0.0), |(a, b), &(u, v)| (a + u as f64, b + v as f64));
-                (a, b, area as f64)
-            };
-            // a core cut by the mask's edge: the centre of the disc whose visible part it is
-            let (du, dv) = if core_clipped && !core.is_empty() {
-                clipped_disc_shift(&core, 2.0 * major_sd, w, h, mask)
-            } else {
-                (0.0, 0.0)
-            };
-            spots.push(Spot {
-                u_px: su / sw + du,
-                v_px: sv / sw + dv,
-                score: peak / sigma,
-                area_px: area,
-                roundness,
-                major_sd_px: major_sd,
-                core_px: core.len(),
-                clipped,
-                halves,
-            });
+            let peak = grow.spot_from(start, levels.lo, levels.med);
+            spots.push(measure.spot(&grow.pixels, peak));
         }
     }
     let mut spots: Vec<Spot> = spots
@@ -976,6 +864,255 @@ pub fn detect(
         .collect();
     spots.sort_by(|a, b| b.score.total_cmp(&a.score));
     Ok(spots)
+}
+
+/// [`detect`]'s levels of the smoothed difference: its median and noise sigma over the mask,
+/// the thresholds a spot starts above and grows above, and the growing threshold on the
+/// difference with the reference itself (not eroded).
+struct Levels {
+    /// Median of the smoothed difference over the mask.
+    med: f32,
+    /// Noise: 1.4826 times the median absolute deviation of the smoothed difference.
+    sigma: f64,
+    /// A spot starts above this.
+    hi: f64,
+    /// ... and grows over its neighbours above this.
+    lo: f64,
+    /// `lo` on the difference with the reference itself (the erosion's median lowering added).
+    lo_plain: f64,
+}
+
+impl Levels {
+    /// The levels from [`Difference`]'s samples of the erosion's lowering (`lowered`) and of
+    /// the smoothed difference (`noise`), both sorted in place, and the thresholds of `p`.
+    fn of(lowered: &mut [f32], noise: &mut [f32], p: &DetectParams) -> Levels {
+        let lo_offset = f64::from(median(lowered));
+        // noise: the median absolute deviation of the smoothed difference over the mask
+        let med = median(noise);
+        let mut dev: Vec<f32> = noise.iter().map(|x| (x - med).abs()).collect();
+        let sigma = (1.4826 * median(&mut dev)).max(1e-6) as f64;
+        let hi = med as f64 + p.threshold_sigma * sigma;
+        let lo = med as f64 + p.grow_sigma * sigma;
+        // the same lower threshold on the difference with the reference itself: the erosion
+        // lowers the difference by about the same everywhere on smooth skin (the darkest of
+        // the reference's noise within the window), which would otherwise weigh every pixel of
+        // a spot alike and pull its centre to the middle of its area
+        let lo_plain = lo + lo_offset;
+        Levels {
+            med,
+            sigma,
+            hi,
+            lo,
+            lo_plain,
+        }
+    }
+}
+
+/// The growing of spots over the smoothed difference `d` (`w` x `h`, -inf outside the mask and
+/// where a spot took a pixel), with its scratch.
+struct Growth {
+    d: Vec<f32>,
+    w: usize,
+    h: usize,
+    stack: Vec<(usize, usize)>,
+    /// The pixels (u, v) of the spot grown last.
+    pixels: Vec<(usize, usize)>,
+}
+
+impl Growth {
+    /// Grows the spot seeded at pixel `start` by hysteresis over 8-neighbours above `lo` into
+    /// `pixels`, taking each pixel out of `d`; returns the peak over the pixels taken (above
+    /// the median `med`, at least 0).
+    fn spot_from(&mut self, start: usize, lo: f64, med: f32) -> f64 {
+        let (w, h) = (self.w, self.h);
+        let (d, stack, pixels) = (&mut self.d, &mut self.stack, &mut self.pixels);
+        // grow by hysteresis over 8-neighbours above `lo`; the peak over the pixels taken
+        let mut peak = (d[start] as f64 - med as f64).max(0.0);
+        d[start] = f32::NEG_INFINITY;
+        stack.push((start % w, start / w));
+        pixels.clear();
+        while let Some((u, v)) = stack.pop() {
+            pixels.push((u, v));
+            let (u0, u1) = (u.saturating_sub(1), (u + 1).min(w - 1));
+            for vv in v.saturating_sub(1)..=(v + 1).min(h - 1) {
+                for uu in u0..=u1 {
+                    let j = vv * w + uu;
+                    if d[j] as f64 > lo {
+                        peak = peak.max(d[j] as f64 - med as f64);
+                        d[j] = f32::NEG_INFINITY;
+                        stack.push((uu, vv));
+                    }
+                }
+            }
+        }
+        peak
+    }
+}
+
+/// [`detect`]'s measure of a grown spot: its centre, shape and halves from the difference with
+/// the reference itself.
+struct Measure<'a> {
+    reference: &'a GrayImage,
+    capture: &'a GrayImage,
+    mask: Option<&'a [bool]>,
+    gain: f32,
+    /// The smoothing Gaussian's kernel.
+    kernel: &'a [f32],
+    levels: &'a Levels,
+    p: &'a DetectParams,
+}
+
+/// A spot's sums over its pixels: the weighted centroid's, the core's (the pixels of positive
+/// weight) unweighted moments, and whether the spot and its core touch an edge.
+struct Moments {
+    /// Sum of the weights, and of the weights times u and v.
+    sw: f64,
+    su: f64,
+    sv: f64,
+    /// The core's sums of u, v, u^2, v^2 and u v.
+    m: [f64; 5],
+    /// The core's pixels (u, v).
+    core: Vec<(usize, usize)>,
+    clipped: bool,
+    core_clipped: bool,
+}
+
+impl Measure<'_> {
+    /// The [`Spot`] of `pixels` (grown from a seed, `peak` its largest smoothed difference
+    /// above the median).
+    fn spot(&self, pixels: &[(usize, usize)], peak: f64) -> Spot {
+        let (w, h) = (self.reference.width, self.reference.height);
+        let (p, lo_plain) = (self.p, self.levels.lo_plain);
+        // weighted by the difference with the reference itself (not eroded), smoothed the
+        // same way: the erosion decides which pixels a spot has, not its centre; the
+        // weights are the darkening above the core's level (`core_fraction` of the way
+        // from the growing threshold to the spot's peak)
+        let plain = smoothed_over(self.reference, self.capture, self.gain, self.kernel, pixels);
+        let top = plain
+            .iter()
+            .fold(f64::NEG_INFINITY, |a, &x| a.max(f64::from(x)));
+        let level = lo_plain + p.core_fraction * (top - lo_plain).max(0.0);
+        let wts: Vec<f64> = plain
+            .iter()
+            .map(|&x| (f64::from(x) - level).max(0.0))
+            .collect();
+        let Moments {
+            sw,
+            su,
+            sv,
+            m,
+            core,
+            clipped,
+            core_clipped,
+        } = self.moments(pixels, &wts);
+        let area = pixels.len();
+        let n = core.len() as f64;
+        let (roundness, major_sd) = if core.is_empty() {
+            (1.0, 0.0)
+        } else {
+            let (r, major, _, _) = shape(n, m[0], m[1], m[2], m[3], m[4]);
+            (r, major)
+        };
+        let core_wts: Vec<f64> = wts.iter().copied().filter(|&x| x > 0.0).collect();
+        let halves = halves_of(&core, &core_wts, 2 * p.min_area_px.max(1));
+        // a spot whose core has no weight (its peak at the growing threshold): its pixels'
+        // centroid
+        let (su, sv, sw) = if sw > 0.0 {
+            (su, sv, sw)
+        } else {
+            let (a, b) = pixels
+                .iter()
+                .fold((0.0, 0.0), |(a, b), &(u, v)| (a + u as f64, b + v as f64));
+            (a, b, area as f64)
+        };
+        // a core cut by the mask's edge: the centre of the disc whose visible part it is
+        let (du, dv) = if core_clipped && !core.is_empty() {
+            clipped_disc_shift(&core, 2.0 * major_sd, w, h, self.mask)
+        } else {
+            (0.0, 0.0)
+        };
+        Spot {
+            u_px: su / sw + du,
+            v_px: sv / sw + dv,
+            score: peak / self.levels.sigma,
+            area_px: area,
+            roundness,
+            major_sd_px: major_sd,
+            core_px: core.len(),
+            clipped,
+            halves,
+        }
+    }
+
+    /// The [`Moments`] of `pixels` weighted by `wts`; a pixel on the image's border or beside
+    /// one outside the mask is on an edge.
+    fn moments(&self, pixels: &[(usize, usize)], wts: &[f64]) -> Moments {
+        let (w, h, mask) = (self.reference.width, self.reference.height, self.mask);
+        let (mut sw, mut su, mut sv) = (0f64, 0f64, 0f64);
+        // the core's pixels' moments, unweighted (its shape: a halo the spot grew into
+        // is not the imprint's)
+        let mut m = [0f64; 5];
+        let mut core = Vec::with_capacity(pixels.len());
+        let (mut clipped, mut core_clipped) = (false, false);
+        for (&(u, v), &x) in pixels.iter().zip(wts) {
+            let (fu, fv) = (u as f64, v as f64);
+            sw += x;
+            su += x * fu;
+            sv += x * fv;
+            if x > 0.0 {
+                core.push((u, v));
+                m[0] += fu;
+                m[1] += fv;
+                m[2] += fu * fu;
+                m[3] += fv * fv;
+                m[4] += fu * fv;
+            }
+            let edge = u == 0
+                || v == 0
+                || u + 1 == w
+                || v + 1 == h
+                || mask.is_some_and(|m| {
+                    !(m[v * w + u - 1] && m[v * w + u + 1] && m[v * w + u - w] && m[v * w + u + w])
+                });
+            clipped |= edge;
+            core_clipped |= edge && x > 0.0;
+        }
+        Moments {
+            sw,
+            su,
+            sv,
+            m,
+            core,
+            clipped,
+            core_clipped,
+        }
+    }
+}
+
+/// A spot's core (`core` pixels, weights `core_wts`) cut in two ([`split_core`]) and each half
+/// cut in two again (three or four imprints joined); `None` for fewer than `min_px` pixels.
+fn halves_of(core: &[(usize, usize)], core_wts: &[f64], min_px: usize) -> Option<[Half; 2]> {
+    split_core(core, core_wts, min_px).map(|(hs, sides)| {
+        // each half cut in two again (three or four imprints joined)
+        let mut out = hs;
+        for (k, h) in out.iter_mut().enumerate() {
+            let (px, ws): (Vec<(usize, usize)>, Vec<f64>) = core
+                .iter()
+                .zip(core_wts)
+                .zip(&sides)
+                .filter(|(_, &sd)| usize::from(sd) == k)
+                .map(|((&q, &x), _)| (q, x))
+                .unzip();
+            h.parts = split_core(&px, &ws, min_px).map(|(ps, _)| {
+                ps.map(|q| Part {
+                    u_px: q.u_px,
+                    v_px: q.v_px,
+                    area_px: q.area_px,
+                })
+            });
+        }
+        out
+    })
 }
 
 pub use assign::{
@@ -1003,141 +1140,6 @@ pub fn repeated_pin(ids: &[u32]) -> Option<(u32, usize)> {
     ids.iter()
         .find(|id| ids.iter().filter(|x| x == id).count() > 1)
         .map(|&id| (id, ids.iter().filter(|&&x| x == id).count()))
-}
-
-/// Sectors (about the skin's centre) in which [`reference_mask`] looks for the ring of LED
-/// reflections at the rim ...
-const RING_SECTORS: usize = 12;
-/// ... which is a ring when this many of them hold a reflection.
-const RING_MIN_SECTORS: usize = 9;
-
-/// The pixels that can hold an imprint, from the reference image: skin (brighter than a
-/// quarter of the median grey) and not an LED reflection (at most halfway from the median to
-/// `white`), the reflections grown by `margin_px`. When the reflections ring the skin (as the
-/// LEDs at an R-Tac0's rim do: reflections in at least [`RING_MIN_SECTORS`] of
-/// [`RING_SECTORS`] sectors about the skin's centroid), only the disc inside the ring counts,
-/// less `margin_px`: the dark notches between the highlights and whatever lies beyond them
-/// are not skin a pin can press. The ring's inner radius is the median over the sectors of
-/// the nearest reflection in each, so that one stray reflection does not shrink the disc.
-pub fn reference_mask(reference: &GrayImage, white: f32, margin_px: usize) -> Vec<bool> {
-    let (w, h) = (reference.width, reference.height);
-    let mut all = reference.data.clone();
-    let med = skin_level(&mut all);
-    let bright = 0.5 * (med + white);
-    let mut mask: Vec<bool> = reference.data.iter().map(|&g| g > 0.25 * med).collect();
-    if let Some((c, radius)) = reflection_ring(reference, &mask, bright) {
-        let r2 = (radius - margin_px as f64).max(0.0).powi(2);
-        // each row keeps the columns within the disc
-        for (v, row) in mask.chunks_exact_mut(w).enumerate() {
-            let half = (r2 - (v as f64 - c[1]).powi(2)).max(0.0).sqrt();
-            let a = (c[0] - half).ceil().clamp(0.0, w as f64) as usize;
-            let b = ((c[0] + half).floor() + 1.0).clamp(a as f64, w as f64) as usize;
-            if half <= 0.0 {
-                row.fill(false);
-                continue;
-            }
-            row[..a].fill(false);
-            row[b..].fill(false);
-        }
-    }
-    let m = margin_px as i64;
-    for v in 0..h as i64 {
-        for u in 0..w as i64 {
-            if reference.data[v as usize * w + u as usize] <= bright {
-                continue;
-            }
-            for dv in -m..=m {
-                for du in -m..=m {
-                    let (uu, vv) = (u + du, v + dv);
-                    if uu >= 0 && vv >= 0 && uu < w as i64 && vv < h as i64 {
-                        mask[vv as usize * w + uu as usize] = false;
-                    }
-                }
-            }
-        }
-    }
-    mask
-}
-
-/// The skin's grey level in a reference image, for [`reference_mask`]: the median grey, or,
-/// when the skin covers under half of the frame (a camera far under a small dome: the median is
-/// the dark outside, under half the level of the pixels brighter than Otsu's threshold between
-/// the two, Otsu 1979), the median of those brighter pixels. `v` is reordered.
-fn skin_level(v: &mut [f32]) -> f32 {
-    let med = median(v);
-    // Otsu's threshold over 256 bins of 0..=255 grey
-    let mut hist = [0u64; 256];
-    for &g in v.iter() {
-        hist[g.clamp(0.0, 255.0) as usize] += 1;
-    }
-    let total = v.len() as f64;
-    let sum_all: f64 = hist
-        .iter()
-        .enumerate()
-        .map(|(i, &c)| i as f64 * c as f64)
-        .sum();
-    let (mut w0, mut sum0, mut best, mut split) = (0.0, 0.0, -1.0, 0usize);
-    for (i, &c) in hist.iter().enumerate() {
-        w0 += c as f64;
-        sum0 += i as f64 * c as f64;
-        let w1 = total - w0;
-        if w0 == 0.0 || w1 == 0.0 {
-            continue;
-        }
-        let (m0, m1) = (sum0 / w0, (sum_all - sum0) / w1);
-        let between = w0 * w1 * (m0 - m1).powi(2);
-        if between > best {
-            (best, split) = (between, i);
-        }
-    }
-    let mut bright: Vec<f32> = v.iter().copied().filter(|&g| g > split as f32).collect();
-    let upper = median(&mut bright);
-    if med < 0.5 * upper {
-        upper
-    } else {
-        med
-    }
-}
-
-/// The centre (the centroid of the `lit` pixels, px) and inner radius (px) of a ring of
-/// reflections (pixels above `bright`) about it; `None` when the reflections do not ring it
-/// ([`reference_mask`]).
-fn reflection_ring(reference: &GrayImage, lit: &[bool], bright: f32) -> Option<([f64; 2], f64)> {
-    let w = reference.width;
-    let (mut n, mut su, mut sv) = (0usize, 0usize, 0usize);
-    for (v, row) in lit.chunks_exact(w).enumerate() {
-        let (mut rn, mut ru) = (0usize, 0usize);
-        for (u, _) in row.iter().enumerate().filter(|(_, l)| **l) {
-            rn += 1;
-            ru += u;
-        }
-        n += rn;
-        su += ru;
-        sv += rn * v;
-    }
-    let (su, sv) = (su as f64, sv as f64);
-    if n == 0 {
-        return None;
-    }
-    let c = [su / n as f64, sv / n as f64];
-    let mut nearest = [f64::INFINITY; RING_SECTORS];
-    for (i, _) in reference
-        .data
-        .iter()
-        .enumerate()
-        .filter(|(_, g)| **g > bright)
-    {
-        let (du, dv) = ((i % w) as f64 - c[0], (i / w) as f64 - c[1]);
-        let turn = (dv.atan2(du) / std::f64::consts::TAU).rem_euclid(1.0);
-        let k = ((turn * RING_SECTORS as f64) as usize).min(RING_SECTORS - 1);
-        nearest[k] = nearest[k].min(du.hypot(dv));
-    }
-    let mut found: Vec<f64> = nearest.into_iter().filter(|d| d.is_finite()).collect();
-    if found.len() < RING_MIN_SECTORS {
-        return None;
-    }
-    let m = found.len() / 2;
-    Some((c, *found.select_nth_unstable_by(m, f64::total_cmp).1))
 }
 
 pub mod synthetic;

@@ -428,10 +428,53 @@ pub fn refine_intrinsics_keeping(
         .collect();
     let keep = keep.as_slice();
     let base = *camera.intrinsics();
-    let names = parameter_names(&base.distortion);
-    let model = base.distortion.name();
-    let mut held: Vec<(usize, String)> = Vec::new();
-    let mut free: Vec<usize> = match which {
+    let (free, mut held) = chosen_parameters(&base.distortion, which)?;
+    let n_obs = 2 * points_mm.len();
+    if n_obs <= free.len() + 6 {
+        return Err(RefineError::TooFewObservations {
+            observations: points_mm.len(),
+            parameters: free.len() + 6,
+            intrinsics: free.len(),
+        });
+    }
+    let start = State {
+        intr: intrinsic_vector(&base),
+        r: t_cam_sensor.rotation.to_rotation_matrix(),
+        t: t_cam_sensor.translation.vector,
+    };
+    let mut pb = Problem {
+        base,
+        free,
+        points: points_mm,
+        pixels: pixels_px,
+        layers,
+        keep,
+    };
+    pb.hold_unconstrained(&start, which, &mut held)?;
+    let initial = intrinsic_vector(&base);
+    let e0 = pb.residuals(&start).ok_or(RefineError::Unprojectable)?;
+    let rms_before_px = pb.rms(&e0);
+    let fit = pb.fit_pruning(&start, e0, which, &initial, &mut held)?;
+    pb.refinement(fit, &initial, &held, rms_before_px)
+}
+
+/// The parameters held at the camera file's value: (index into [`parameter_names`], why).
+type Held = Vec<(usize, String)>;
+
+/// The parameters to refine (indices into [`parameter_names`] of `distortion`'s model,
+/// ascending) and those held from the start with why: every parameter for
+/// [`RefineParameters::Constrained`], else exactly the listed ones.
+///
+/// # Errors
+/// [`RefineError::UnknownParameter`], [`RefineError::Twice`].
+fn chosen_parameters(
+    distortion: &Distortion,
+    which: &RefineParameters,
+) -> Result<(Vec<usize>, Held), RefineError> {
+    let names = parameter_names(distortion);
+    let model = distortion.name();
+    let mut held: Held = Vec::new();
+    let free: Vec<usize> = match which {
         RefineParameters::Constrained => (0..names.len()).collect(),
         RefineParameters::Only(list) => {
             let value = list.join(",");
@@ -462,183 +505,238 @@ pub fn refine_intrinsics_keeping(
             v
         }
     };
-    let n_obs = 2 * points_mm.len();
-    if n_obs <= free.len() + 6 {
-        return Err(RefineError::TooFewObservations {
-            observations: points_mm.len(),
-            parameters: free.len() + 6,
-            intrinsics: free.len(),
-        });
+    Ok((free, held))
+}
+
+/// A fit's outcome: the state, its residuals, the iterations taken, the Jacobian there and the
+/// covariance of the free parameters and the pose (`None` when singular).
+struct Fit {
+    s: State,
+    e: DVector<f64>,
+    iterations: usize,
+    j: DMatrix<f64>,
+    cov: Option<DMatrix<f64>>,
+}
+
+impl Problem<'_> {
+    /// RMS reprojection error of the residuals `e` over the points, px.
+    fn rms(&self, e: &DVector<f64>) -> f64 {
+        (e.norm_squared() / self.points.len() as f64).sqrt()
     }
-    let start = State {
-        intr: intrinsic_vector(&base),
-        r: t_cam_sensor.rotation.to_rotation_matrix(),
-        t: t_cam_sensor.translation.vector,
-    };
-    // hold what the captures do not constrain
-    let pb = loop {
-        let pb = Problem {
-            base,
-            free: free.clone(),
-            points: points_mm,
-            pixels: pixels_px,
-            layers,
-            keep,
-        };
-        let j = pb.jacobian(&start).ok_or(RefineError::Unprojectable)?;
-        let (cond, v) = scaled_condition(&j);
-        if cond <= MAX_CONDITION {
-            break pb;
+
+    /// Holds what the captures do not constrain: while the column-scaled Jacobian at `start`
+    /// has a condition number above [`MAX_CONDITION`], the intrinsics weighing most in the
+    /// least-determined direction leave `free` for `held`, with why.
+    ///
+    /// # Errors
+    /// [`RefineError::Unprojectable`] at `start`; [`RefineError::Unconstrained`] for a listed
+    /// parameter ([`RefineParameters::Only`]); [`RefineError::NothingConstrained`] when
+    /// nothing would be left free.
+    fn hold_unconstrained(
+        &mut self,
+        start: &State,
+        which: &RefineParameters,
+        held: &mut Held,
+    ) -> Result<(), RefineError> {
+        let names = parameter_names(&self.base.distortion);
+        loop {
+            let j = self.jacobian(start).ok_or(RefineError::Unprojectable)?;
+            let (cond, v) = scaled_condition(&j);
+            if cond <= MAX_CONDITION {
+                return Ok(());
+            }
+            let free = &self.free;
+            let col_names: Vec<String> = free
+                .iter()
+                .map(|&k| names[k].to_string())
+                .chain(POSE_NAMES.iter().map(|s| s.to_string()))
+                .collect();
+            // the intrinsic that weighs most in the least-determined direction
+            let Some(c) = (0..free.len()).max_by(|&a, &b| v[a].abs().total_cmp(&v[b].abs())) else {
+                return Err(RefineError::NothingConstrained {
+                    first: String::new(),
+                    condition: cond,
+                });
+            };
+            if let RefineParameters::Only(list) = which {
+                let with = trading(&v, &col_names, &[c]);
+                return Err(RefineError::Unconstrained {
+                    value: list.join(","),
+                    name: names[free[c]].into(),
+                    with,
+                    condition: cond,
+                    limit: MAX_CONDITION,
+                });
+            }
+            // what to hold, of the intrinsics weighing in that direction (at least a third of
+            // the largest): the focal length as a whole (fx and fy trade together against the
+            // camera's distance), else the highest-order distortion coefficient, else the
+            // principal point's coordinate that weighs most
+            let weighing: Vec<usize> = (0..free.len())
+                .filter(|&k| v[k].abs() >= v[c].abs() / 3.0)
+                .collect();
+            let is_focal = |k: &usize| matches!(names[free[*k]], "fx" | "fy");
+            let hold: Vec<usize> = if weighing.iter().any(is_focal) {
+                (0..free.len()).filter(is_focal).collect()
+            } else if let Some(k) = weighing
+                .iter()
+                .filter(|&&k| free[k] >= 4)
+                .max_by_key(|&&k| distortion_order(names[free[k]]))
+            {
+                vec![*k]
+            } else {
+                vec![c]
+            };
+            if hold.len() >= free.len() {
+                return Err(RefineError::NothingConstrained {
+                    first: names[free[c]].into(),
+                    condition: cond,
+                });
+            }
+            let what = if hold.len() == 2 {
+                "the focal length (fx and fy together)".to_string()
+            } else {
+                names[free[hold[0]]].to_string()
+            };
+            let with = trading(&v, &col_names, &hold);
+            for &k in &hold {
+                held.push((
+                    free[k],
+                    format!(
+                        "the captures do not constrain {what}; it trades against {with} (condition number {cond:.1e} with it free, above {MAX_CONDITION:.0e})"
+                    ),
+                ));
+            }
+            self.free = (0..free.len())
+                .filter(|k| !hold.contains(k))
+                .map(|k| free[k])
+                .collect();
         }
-        let col_names: Vec<String> = free
-            .iter()
-            .map(|&k| names[k].to_string())
-            .chain(POSE_NAMES.iter().map(|s| s.to_string()))
-            .collect();
-        // the intrinsic that weighs most in the least-determined direction
-        let Some(c) = (0..free.len()).max_by(|&a, &b| v[a].abs().total_cmp(&v[b].abs())) else {
-            return Err(RefineError::NothingConstrained {
-                first: String::new(),
-                condition: cond,
-            });
-        };
-        if let RefineParameters::Only(list) = which {
-            let with = trading(&v, &col_names, &[c]);
-            return Err(RefineError::Unconstrained {
-                value: list.join(","),
-                name: names[free[c]].into(),
-                with,
-                condition: cond,
-                limit: MAX_CONDITION,
-            });
-        }
-        // what to hold, of the intrinsics weighing in that direction (at least a third of the
-        // largest): the focal length as a whole (fx and fy trade together against the camera's
-        // distance), else the highest-order distortion coefficient, else the principal point's
-        // coordinate that weighs most
-        let weighing: Vec<usize> = (0..free.len())
-            .filter(|&k| v[k].abs() >= v[c].abs() / 3.0)
-            .collect();
-        let is_focal = |k: &usize| matches!(names[free[*k]], "fx" | "fy");
-        let hold: Vec<usize> = if weighing.iter().any(is_focal) {
-            (0..free.len()).filter(is_focal).collect()
-        } else if let Some(k) = weighing
-            .iter()
-            .filter(|&&k| free[k] >= 4)
-            .max_by_key(|&&k| distortion_order(names[free[k]]))
-        {
-            vec![*k]
-        } else {
-            vec![c]
-        };
-        if hold.len() >= free.len() {
-            return Err(RefineError::NothingConstrained {
-                first: names[free[c]].into(),
-                condition: cond,
-            });
-        }
-        let what = if hold.len() == 2 {
-            "the focal length (fx and fy together)".to_string()
-        } else {
-            names[free[hold[0]]].to_string()
-        };
-        let with = trading(&v, &col_names, &hold);
-        for &k in &hold {
+    }
+
+    /// Fits from `start` (residuals `e0`); then, from the highest order down, holds the
+    /// distortion coefficient the fit does not need (the Bayesian information criterion:
+    /// its move from `initial` lowers the squared error by less than ln N sigma^2), notes it
+    /// in `held` and fits again, until the last free one is worth its place.
+    ///
+    /// # Errors
+    /// [`RefineError::Unprojectable`] at a fitted state.
+    fn fit_pruning(
+        &mut self,
+        start: &State,
+        e0: DVector<f64>,
+        which: &RefineParameters,
+        initial: &[f64],
+        held: &mut Held,
+    ) -> Result<Fit, RefineError> {
+        let names = parameter_names(&self.base.distortion);
+        let n_obs = 2 * self.points.len();
+        loop {
+            let (s, e, iterations) = levenberg_marquardt(self, start, e0.clone());
+            let j = self.jacobian(&s).ok_or(RefineError::Unprojectable)?;
+            let dof = (n_obs - self.n_params()) as f64;
+            let sigma2 = e.norm_squared() / dof;
+            let cov = (j.transpose() * &j).try_inverse().map(|c| c * sigma2);
+            // the highest-order free distortion coefficient, and whether the fit needs it
+            let last = self
+                .free
+                .iter()
+                .enumerate()
+                .filter(|(_, &k)| k >= 4 && distortion_order(names[k]) >= MIN_PRUNED_ORDER)
+                .max_by_key(|(_, &k)| (distortion_order(names[k]), k))
+                .map(|(col, &k)| (col, k));
+            let undetermined = match (which, &cov, last) {
+                (RefineParameters::Constrained, Some(c), Some((col, k))) => {
+                    let var = c[(col, col)].max(0.0);
+                    // dropping it raises the squared error by about t^2 sigma^2
+                    let t2 = (s.intr[k] - initial[k]).powi(2) / var.max(1e-300);
+                    (t2 < (n_obs as f64).ln()).then_some((col, k, var.sqrt(), t2))
+                }
+                _ => None,
+            };
+            let Some((col, k, sd, t2)) = undetermined else {
+                return Ok(Fit {
+                    s,
+                    e,
+                    iterations,
+                    j,
+                    cov,
+                });
+            };
             held.push((
-                free[k],
+                k,
                 format!(
-                    "the captures do not constrain {what}; it trades against {with} (condition number {cond:.1e} with it free, above {MAX_CONDITION:.0e})"
+                    "the captures do not determine {}: refined, it moves {:.4} +- {sd:.4} from the camera file's value, which lowers the squared reprojection error by {t2:.2} sigma^2, less than ln {n_obs} = {:.2} for a parameter (the Bayesian information criterion)",
+                    names[k],
+                    s.intr[k] - initial[k],
+                    (n_obs as f64).ln()
                 ),
             ));
+            self.free.remove(col);
         }
-        free = (0..free.len())
-            .filter(|k| !hold.contains(k))
-            .map(|k| free[k])
-            .collect();
-    };
-    let mut pb = pb;
-    let initial = intrinsic_vector(&base);
-    let e0 = pb.residuals(&start).ok_or(RefineError::Unprojectable)?;
-    let rms = |e: &DVector<f64>| (e.norm_squared() / points_mm.len() as f64).sqrt();
-    let rms_before_px = rms(&e0);
-    // fit; then, from the highest order down, hold the distortion coefficient the fit does not
-    // need (the Bayesian information criterion) and fit again
-    let (s, e, iterations, j, cov) = loop {
-        let (s, e, iterations) = levenberg_marquardt(&pb, &start, e0.clone());
-        let j = pb.jacobian(&s).ok_or(RefineError::Unprojectable)?;
-        let dof = (n_obs - pb.n_params()) as f64;
-        let sigma2 = e.norm_squared() / dof;
-        let cov = (j.transpose() * &j).try_inverse().map(|c| c * sigma2);
-        // the highest-order free distortion coefficient, and whether the fit needs it
-        let last = pb
-            .free
+    }
+
+    /// The [`Refinement`] of `fit`: each parameter's value, standard deviation or why it was
+    /// `held`, the pose and its standard deviations, the condition number at the solution and
+    /// the RMS before (`rms_before_px`) and after.
+    ///
+    /// # Errors
+    /// [`RefineError::Unprojectable`] when the refined intrinsics are not a camera.
+    fn refinement(
+        &self,
+        fit: Fit,
+        initial: &[f64],
+        held: &[(usize, String)],
+        rms_before_px: f64,
+    ) -> Result<Refinement, RefineError> {
+        let Fit {
+            s,
+            e,
+            iterations,
+            j,
+            cov,
+        } = fit;
+        let (base, free) = (&self.base, &self.free);
+        let names = parameter_names(&base.distortion);
+        let condition_number = scaled_condition(&j).0;
+        let parameters = names
             .iter()
             .enumerate()
-            .filter(|(_, &k)| k >= 4 && distortion_order(names[k]) >= MIN_PRUNED_ORDER)
-            .max_by_key(|(_, &k)| (distortion_order(names[k]), k))
-            .map(|(col, &k)| (col, k));
-        let undetermined = match (which, &cov, last) {
-            (RefineParameters::Constrained, Some(c), Some((col, k))) => {
-                let var = c[(col, col)].max(0.0);
-                // dropping it raises the squared error by about t^2 sigma^2
-                let t2 = (s.intr[k] - initial[k]).powi(2) / var.max(1e-300);
-                (t2 < (n_obs as f64).ln()).then_some((col, k, var.sqrt(), t2))
-            }
-            _ => None,
-        };
-        let Some((col, k, sd, t2)) = undetermined else {
-            break (s, e, iterations, j, cov);
-        };
-        held.push((
-            k,
-            format!(
-                "the captures do not determine {}: refined, it moves {:.4} +- {sd:.4} from the camera file's value, which lowers the squared reprojection error by {t2:.2} sigma^2, less than ln {n_obs} = {:.2} for a parameter (the Bayesian information criterion)",
-                names[k],
-                s.intr[k] - initial[k],
-                (n_obs as f64).ln()
+            .map(|(k, n)| {
+                let col = free.iter().position(|&f| f == k);
+                RefinedParameter {
+                    name: (*n).into(),
+                    initial: initial[k],
+                    value: s.intr[k],
+                    std: col.and_then(|c| cov.as_ref().map(|m| m[(c, c)].max(0.0).sqrt())),
+                    held: held.iter().find(|(h, _)| *h == k).map(|(_, r)| r.clone()),
+                }
+            })
+            .collect();
+        let m = free.len();
+        let pose_std = cov.as_ref().map(|c| {
+            let sd = |k: usize| c[(k, k)].max(0.0).sqrt();
+            (
+                std::array::from_fn(|i| sd(m + i).to_degrees()),
+                std::array::from_fn(|i| sd(m + 3 + i)),
+            )
+        });
+        let camera =
+            CameraModel::new(with_vector(base, &s.intr)).map_err(|_| RefineError::Unprojectable)?;
+        Ok(Refinement {
+            camera,
+            t_cam_sensor: Isometry3::from_parts(
+                Translation3::from(s.t),
+                UnitQuaternion::from_rotation_matrix(&s.r),
             ),
-        ));
-        pb.free.remove(col);
-        free = pb.free.clone();
-    };
-    let condition_number = scaled_condition(&j).0;
-    let parameters = names
-        .iter()
-        .enumerate()
-        .map(|(k, n)| {
-            let col = free.iter().position(|&f| f == k);
-            RefinedParameter {
-                name: (*n).into(),
-                initial: initial[k],
-                value: s.intr[k],
-                std: col.and_then(|c| cov.as_ref().map(|m| m[(c, c)].max(0.0).sqrt())),
-                held: held.iter().find(|(h, _)| *h == k).map(|(_, r)| r.clone()),
-            }
+            parameters,
+            condition_number,
+            rms_before_px,
+            rms_after_px: self.rms(&e),
+            iterations,
+            pose_std,
         })
-        .collect();
-    let m = free.len();
-    let pose_std = cov.as_ref().map(|c| {
-        let sd = |k: usize| c[(k, k)].max(0.0).sqrt();
-        (
-            std::array::from_fn(|i| sd(m + i).to_degrees()),
-            std::array::from_fn(|i| sd(m + 3 + i)),
-        )
-    });
-    let camera =
-        CameraModel::new(with_vector(&base, &s.intr)).map_err(|_| RefineError::Unprojectable)?;
-    Ok(Refinement {
-        camera,
-        t_cam_sensor: Isometry3::from_parts(
-            Translation3::from(s.t),
-            UnitQuaternion::from_rotation_matrix(&s.r),
-        ),
-        parameters,
-        condition_number,
-        rms_before_px,
-        rms_after_px: rms(&e),
-        iterations,
-        pose_std,
-    })
+    }
 }
 
 /// Levenberg-Marquardt from `start` (residuals `e0`), Marquardt's scaling by the diagonal: the

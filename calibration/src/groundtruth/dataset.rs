@@ -541,31 +541,10 @@ pub fn render_frames(
     let (w, h) = (rays.width, rays.height);
     let pin_captures = fixtures.configurations.iter().any(|c| !c.pins.is_empty());
     let reference = DepthFrame::new(rays, ref_hits);
-    let preview = finite_range(&reference.range_mm)
-        .into_iter()
-        .chain(finite_range(&reference.zdepth_mm))
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), (lo, hi)| {
-            (a.min(lo), b.max(hi))
-        });
-    let preview = if preview.0 <= preview.1 {
-        preview
-    } else {
-        (0.0, 1.0)
-    };
+    let preview = preview_range(&reference);
     let mut all: Vec<(String, String, usize)> = Vec::new();
-    let put =
-        |files: Files, all: &mut Vec<(String, String, usize)>| -> Result<Vec<Value>, SinkError> {
-            let mut entries = Vec::new();
-            for (rel, bytes, mut e) in files {
-                write(&rel, &bytes)?;
-                let sha = sha256_hex(&bytes);
-                e["sha256"] = json!(sha);
-                all.push((rel, sha, bytes.len()));
-                entries.push(e);
-            }
-            Ok(entries)
-        };
-    let mut ref_entries = put(
+    let mut ref_entries = put_files(
+        write,
         frame_files(
             files::REFERENCE_DIR,
             &reference,
@@ -577,7 +556,8 @@ pub fn render_frames(
         &mut all,
     )?;
     if let Some(im) = imaging {
-        ref_entries.extend(put(
+        ref_entries.extend(put_files(
+            write,
             vec![image_file(
                 files::REFERENCE_DIR,
                 im,
@@ -595,15 +575,117 @@ pub fn render_frames(
     // Configurations in parallel, as many at a time as the memory budget holds; each writes
     // its own folder. Entries are kept in index order.
     let at_once = frames_at_once(w as u64 * h as u64, rayon::current_num_threads() as u64);
-    let done = AtomicUsize::new(0);
-    let render = |(k, cfg): (usize, &Configuration)| -> Result<(Value, Written), String> {
-        let hits = indented_hits(rays, ref_hits, &cfg.primitives, inputs.base_z_mm);
+    let frames = ConfigurationFrames {
+        inputs,
+        write,
+        progress,
+        reference: &reference,
+        preview,
+        done: AtomicUsize::new(0),
+    };
+    let indexed: Vec<(usize, &Configuration)> =
+        fixtures.configurations.iter().enumerate().collect();
+    let rendered: Vec<Result<(Value, Written), String>> = indexed
+        .chunks(at_once)
+        .flat_map(|chunk| {
+            chunk
+                .par_iter()
+                .copied()
+                .map(|(k, cfg)| frames.render(k, cfg))
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    let mut cfg_entries = Vec::new();
+    for r in rendered {
+        let (e, list) = r?;
+        cfg_entries.push(e);
+        all.extend(list);
+    }
+
+    let extra = masks_and_pairs(rays, ref_hits, fixtures, pin_captures)?;
+    let extra_entries = put_files(write, extra, &mut all)?;
+    all.sort();
+    Ok(Rendered {
+        reference: ref_entries,
+        configurations: cfg_entries,
+        masks_and_pairs: extra_entries,
+        files: all,
+    })
+}
+
+/// The range of the previews' colour map, mm: the least and greatest finite value of the
+/// reference frame's range and z-depth maps ((0, 1) when it has none).
+fn preview_range(reference: &DepthFrame) -> (f64, f64) {
+    let preview = finite_range(&reference.range_mm)
+        .into_iter()
+        .chain(finite_range(&reference.zdepth_mm))
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), (lo, hi)| {
+            (a.min(lo), b.max(hi))
+        });
+    if preview.0 <= preview.1 {
+        preview
+    } else {
+        (0.0, 1.0)
+    }
+}
+
+/// Hands each of `files` to `write` and adds it to `all` (path, sha256, bytes); returns their
+/// manifest entries with their sha256.
+///
+/// # Errors
+/// The first error of `write`.
+fn put_files(
+    write: &Sink<'_>,
+    files: Files,
+    all: &mut Vec<(String, String, usize)>,
+) -> Result<Vec<Value>, SinkError> {
+    let mut entries = Vec::new();
+    for (rel, bytes, mut e) in files {
+        write(&rel, &bytes)?;
+        let sha = sha256_hex(&bytes);
+        e["sha256"] = json!(sha);
+        all.push((rel, sha, bytes.len()));
+        entries.push(e);
+    }
+    Ok(entries)
+}
+
+/// What every configuration's frame is rendered with ([`render_frames`]): the inputs, the
+/// sink, the progress callback, the reference frame, the previews' range, and the count of
+/// frames done.
+struct ConfigurationFrames<'a> {
+    inputs: &'a FrameInputs<'a>,
+    write: &'a Sink<'a>,
+    progress: &'a (dyn Fn(u64) + Sync),
+    reference: &'a DepthFrame,
+    preview: (f64, f64),
+    done: AtomicUsize,
+}
+
+impl ConfigurationFrames<'_> {
+    /// Renders configuration `cfg` (index `k`): its depth files, then its image, each handed
+    /// to the sink; returns its manifest entry and its files, and reports the frames done.
+    ///
+    /// # Errors
+    /// The first error of the sink or of an encoder, as text.
+    fn render(&self, k: usize, cfg: &Configuration) -> Result<(Value, Written), String> {
+        let FrameInputs {
+            rays,
+            reference_hits: ref_hits,
+            format,
+            imaging,
+            provenance,
+            ..
+        } = *self.inputs;
+        let (w, h) = (rays.width, rays.height);
+        let (reference, write) = (self.reference, self.write);
+        let hits = indented_hits(rays, ref_hits, &cfg.primitives, self.inputs.base_z_mm);
         let frame = DepthFrame::new(rays, &hits);
         let files = frame_files(
             &cfg.name,
             &frame,
-            Some(&reference),
-            preview,
+            Some(reference),
+            self.preview,
             provenance,
             format,
         )
@@ -639,40 +721,52 @@ pub fn render_frames(
         let contact = (0..w * h)
             .filter(|&p| frame.contact[p] && reference.range_mm[p].is_finite())
             .count();
-        let (dr, _) = frame.delta(&reference);
+        let (dr, _) = frame.delta(reference);
         let deepest = finite_range(&dr).map(|x| -x.0).unwrap_or(0.0).max(0.0);
-        let k = done.fetch_add(1, Ordering::Relaxed) + 2;
-        progress(k as u64);
-        let mut entry = json!({
-            "name": cfg.name, "dir": cfg.name, "pattern": cfg.pattern, "orientation_deg": cfg.orientation_deg,
-            "pattern_side": if cfg.orientation_deg == 0 { "+x (right_mask.png)" } else { "-x (left_mask.png)" },
-            "fixture_description": {"file": cfg.description_file, "sha256": cfg.description_sha256},
-            "primitives": cfg.geometry.primitives.len(),
-            "contact_pixels": contact, "max_range_decrease_mm": deepest,
-            "files": entries,
-        });
-        if !cfg.pins.is_empty() {
-            let e = entry.as_object_mut().expect("an object");
-            for k in ["pattern", "orientation_deg", "pattern_side"] {
-                e.remove(k);
-            }
-            e.insert("pins".into(), json!(cfg.pins));
-        }
-        Ok((entry, list))
-    };
-    let indexed: Vec<(usize, &Configuration)> =
-        fixtures.configurations.iter().enumerate().collect();
-    let rendered: Vec<Result<(Value, Written), String>> = indexed
-        .chunks(at_once)
-        .flat_map(|chunk| chunk.par_iter().copied().map(&render).collect::<Vec<_>>())
-        .collect();
-    let mut cfg_entries = Vec::new();
-    for r in rendered {
-        let (e, list) = r?;
-        cfg_entries.push(e);
-        all.extend(list);
+        let k = self.done.fetch_add(1, Ordering::Relaxed) + 2;
+        (self.progress)(k as u64);
+        Ok((configuration_entry(cfg, contact, deepest, entries), list))
     }
+}
 
+/// The manifest entry of configuration `cfg`: its name, pattern or pins, fixture description,
+/// `contact` pixels, `deepest` range decrease (mm) and its files' `entries`.
+fn configuration_entry(
+    cfg: &Configuration,
+    contact: usize,
+    deepest: f64,
+    entries: Vec<Value>,
+) -> Value {
+    let mut entry = json!({
+        "name": cfg.name, "dir": cfg.name, "pattern": cfg.pattern, "orientation_deg": cfg.orientation_deg,
+        "pattern_side": if cfg.orientation_deg == 0 { "+x (right_mask.png)" } else { "-x (left_mask.png)" },
+        "fixture_description": {"file": cfg.description_file, "sha256": cfg.description_sha256},
+        "primitives": cfg.geometry.primitives.len(),
+        "contact_pixels": contact, "max_range_decrease_mm": deepest,
+        "files": entries,
+    });
+    if !cfg.pins.is_empty() {
+        let e = entry.as_object_mut().expect("an object");
+        for k in ["pattern", "orientation_deg", "pattern_side"] {
+            e.remove(k);
+        }
+        e.insert("pins".into(), json!(cfg.pins));
+    }
+    entry
+}
+
+/// The half masks (`left_mask.png`, `right_mask.png`) and, unless the frames are pin captures,
+/// pairs.csv, with their manifest entries.
+///
+/// # Errors
+/// An encoder's.
+fn masks_and_pairs(
+    rays: &PixelRays,
+    ref_hits: &SurfaceHits,
+    fixtures: &Fixtures,
+    pin_captures: bool,
+) -> Result<Files, SinkError> {
+    let (w, h) = (rays.width, rays.height);
     let (left, right) = half_masks(rays, ref_hits);
     let mut extra: Files = Vec::new();
     for (name, m, side) in [
@@ -691,14 +785,7 @@ pub fn render_frames(
             json!({"file": files::PAIRS, "pairs": n_pairs, "notes": PAIRS_NOTES}),
         ));
     }
-    let extra_entries = put(extra, &mut all)?;
-    all.sort();
-    Ok(Rendered {
-        reference: ref_entries,
-        configurations: cfg_entries,
-        masks_and_pairs: extra_entries,
-        files: all,
-    })
+    Ok(extra)
 }
 
 /// What a dataset's manifest.json says besides its files: the version and command line that

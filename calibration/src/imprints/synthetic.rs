@@ -10,7 +10,7 @@ use super::{gaussian_blur, GrayImage};
 use crate::groundtruth::exact::ExactPrimitives;
 use crate::groundtruth::rays::PixelRays;
 use crate::groundtruth::surface::ReferenceSurface;
-use crate::groundtruth::{indented_hits, reference_hits};
+use crate::groundtruth::{indented_hits, reference_hits, SurfaceHits};
 use crate::CameraModel;
 use fabkit_designs::primitives::Primitive;
 use nalgebra::Isometry3;
@@ -306,68 +306,149 @@ pub fn render_through(
     let (w, h) = (rays.width, rays.height);
     let refh = reference_hits(&rays, surface);
     let (cx, cy) = (0.5 * (w as f64 - 1.0), 0.5 * (h as f64 - 1.0));
-    let rmax = cx.hypot(cy);
-    let mut base = vec![s.background_grey; w * h];
-    let mut skin_r: f64 = 0.0;
-    for p in 0..w * h {
-        if refh.t_mm[p].is_finite() {
-            let r = ((p % w) as f64 - cx).hypot((p / w) as f64 - cy) / rmax;
-            base[p] = s.skin_grey * (1.0 - s.vignetting * (r * r) as f32);
-            skin_r = skin_r.max(r * rmax);
-        }
-    }
+    let mut scene = Scene {
+        rays: &rays,
+        refh: &refh,
+        s,
+        w,
+        h,
+        cx,
+        cy,
+        rmax: cx.hypot(cy),
+        skin_r: 0.0,
+    };
+    let mut base = scene.skin_base();
     // LED reflections on a circle at 90 % of the skin's extent in the image; where a core's
     // open end bounds the view (the layers have shells), on that edge: the lit diffuser ring
     // beside the tube's mouth mirrored in the gel's free surface
     let at_edge = layers.is_some_and(|l| !l.shells().is_empty());
-    let leds: Vec<[f64; 2]> = (0..s.leds)
-        .map(|k| {
-            let a = std::f64::consts::TAU * (k as f64 + 0.5) / s.leds as f64;
-            let r = if at_edge { 1.0 } else { 0.9 } * skin_r.min(cy);
-            [cx + r * a.cos(), cy + r * a.sin()]
-        })
-        .collect();
+    let leds = scene.led_centres(at_edge);
     // dark notches at the rim: the skin's edge in the image along each notch's azimuth
     if s.notches > 0 && s.notch_width_px > 0.0 && s.notch_depth_px > 0.0 {
         for k in 0..s.notches {
-            let a = (s.notch_phase_deg + 360.0 * k as f64 / s.notches as f64).to_radians();
-            let (du, dv) = (a.cos(), a.sin());
-            // the last skin pixel along the azimuth
-            let mut edge: f64 = 0.0;
-            let mut r = 0.0;
-            while r < rmax {
-                let (u, v) = ((cx + r * du).round(), (cy + r * dv).round());
-                if u < 0.0 || v < 0.0 || u > (w - 1) as f64 || v > (h - 1) as f64 {
-                    break;
-                }
-                if refh.t_mm[v as usize * w + u as usize].is_finite() {
-                    edge = r;
-                }
-                r += 0.5;
-            }
-            for (p, b) in base.iter_mut().enumerate() {
-                let (x, y) = ((p % w) as f64 - cx, (p / w) as f64 - cy);
-                let (along, across) = (x * du + y * dv, -x * dv + y * du);
-                if along >= edge - s.notch_depth_px && across.abs() <= 0.5 * s.notch_width_px {
-                    *b = s.background_grey;
-                }
-            }
+            scene.cut_notch(k, &mut base);
         }
     }
     // each pin's imprint: the depth it pushes the skin in along each ray
     let mut dent = vec![0f32; w * h];
     let mut centres = Vec::with_capacity(pins.len());
-    let hit_point = |p: usize| {
-        let (o, d, t) = (rays.origin(p), rays.dirs[p], refh.t_mm[p]);
-        nalgebra::Vector3::new(o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2])
-    };
     for pin in pins {
+        let own = scene.pin_depth(pin, surface);
+        for (x, o) in dent.iter_mut().zip(&own) {
+            *x += o;
+        }
+        centres.push(scene.imprint_centre(own));
+    }
+    let shade = scene.side_lit(&dent);
+    let marks = scene.marks(seed, &centres);
+    let (reference, capture) = scene.photographs(&base, &shade, &marks, &leds, seed);
+    Rendered {
+        reference: GrayImage {
+            width: w,
+            height: h,
+            data: reference,
+        },
+        capture: GrayImage {
+            width: w,
+            height: h,
+            data: capture,
+        },
+        centres_px: centres,
+    }
+}
+
+/// [`render_through`]'s scene: the camera's rays, the reference skin they meet, the shading,
+/// the image's size (`w` x `h` px), its centre (`cx`, `cy`) and half-diagonal `rmax`, px, and
+/// the skin's radius in the image about the centre (`skin_r`, px; set by [`Self::skin_base`]).
+struct Scene<'a> {
+    rays: &'a PixelRays,
+    refh: &'a SurfaceHits,
+    s: &'a Shading,
+    w: usize,
+    h: usize,
+    cx: f64,
+    cy: f64,
+    rmax: f64,
+    skin_r: f64,
+}
+
+impl Scene<'_> {
+    /// The unpressed image before the PSF: the skin's grey with vignetting, the background's
+    /// elsewhere; sets `skin_r`.
+    fn skin_base(&mut self) -> Vec<f32> {
+        let (w, h, s) = (self.w, self.h, self.s);
+        let (cx, cy, rmax) = (self.cx, self.cy, self.rmax);
+        let mut base = vec![s.background_grey; w * h];
+        let mut skin_r: f64 = 0.0;
+        for p in 0..w * h {
+            if self.refh.t_mm[p].is_finite() {
+                let r = ((p % w) as f64 - cx).hypot((p / w) as f64 - cy) / rmax;
+                base[p] = s.skin_grey * (1.0 - s.vignetting * (r * r) as f32);
+                skin_r = skin_r.max(r * rmax);
+            }
+        }
+        self.skin_r = skin_r;
+        base
+    }
+
+    /// The LED reflections' centres, px: evenly on a circle at 90 % of the skin's radius in
+    /// the image (`at_edge`: at 100 %), at most the image's half-height.
+    fn led_centres(&self, at_edge: bool) -> Vec<[f64; 2]> {
+        let (s, cx, cy, skin_r) = (self.s, self.cx, self.cy, self.skin_r);
+        (0..s.leds)
+            .map(|k| {
+                let a = std::f64::consts::TAU * (k as f64 + 0.5) / s.leds as f64;
+                let r = if at_edge { 1.0 } else { 0.9 } * skin_r.min(cy);
+                [cx + r * a.cos(), cy + r * a.sin()]
+            })
+            .collect()
+    }
+
+    /// Notch `k` ([`Shading::notches`]) cut into `base` at the background's grey: from the
+    /// skin's last pixel along its azimuth inwards.
+    fn cut_notch(&self, k: usize, base: &mut [f32]) {
+        let (w, h, s) = (self.w, self.h, self.s);
+        let (cx, cy, rmax) = (self.cx, self.cy, self.rmax);
+        let a = (s.notch_phase_deg + 360.0 * k as f64 / s.notches as f64).to_radians();
+        let (du, dv) = (a.cos(), a.sin());
+        // the last skin pixel along the azimuth
+        let mut edge: f64 = 0.0;
+        let mut r = 0.0;
+        while r < rmax {
+            let (u, v) = ((cx + r * du).round(), (cy + r * dv).round());
+            if u < 0.0 || v < 0.0 || u > (w - 1) as f64 || v > (h - 1) as f64 {
+                break;
+            }
+            if self.refh.t_mm[v as usize * w + u as usize].is_finite() {
+                edge = r;
+            }
+            r += 0.5;
+        }
+        for (p, b) in base.iter_mut().enumerate() {
+            let (x, y) = ((p % w) as f64 - cx, (p / w) as f64 - cy);
+            let (along, across) = (x * du + y * dv, -x * dv + y * du);
+            if along >= edge - s.notch_depth_px && across.abs() <= 0.5 * s.notch_width_px {
+                *b = s.background_grey;
+            }
+        }
+    }
+
+    /// The point where pixel `p`'s ray meets the reference skin, sensor frame, mm.
+    fn hit_point(&self, p: usize) -> nalgebra::Vector3<f64> {
+        let (o, d, t) = (self.rays.origin(p), self.rays.dirs[p], self.refh.t_mm[p]);
+        nalgebra::Vector3::new(o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2])
+    }
+
+    /// The depth `pin` pushes the skin in along each pixel's ray, mm (0 where it does not),
+    /// with its halo ([`Shading::halo`]) outside the contact.
+    fn pin_depth(&self, pin: &Pin, surface: &ReferenceSurface) -> Vec<f32> {
+        let (w, h, s, refh) = (self.w, self.h, self.s, self.refh);
         let prim = ExactPrimitives::new(&[Primitive::Sphere {
             centre_mm: pin.centre_mm,
             radius_mm: pin.radius_mm,
         }])
         .expect("a sphere of positive radius");
-        let hits = indented_hits(&rays, &refh, &prim, surface.base_z_mm());
+        let hits = indented_hits(self.rays, refh, &prim, surface.base_z_mm());
         let depth = |p: usize| {
             (hits.contact[p] && refh.t_mm[p].is_finite()).then(|| refh.t_mm[p] - hits.t_mm[p])
         };
@@ -383,35 +464,38 @@ pub fn render_through(
         }
         // the halo: Hertz's surface displacement outside the contact (Johnson Eq. 3.42)
         if let (true, Some((q, d))) = (s.halo > 0.0, deepest_at) {
-            let c = hit_point(q);
+            let c = self.hit_point(q);
             let a = (0..w * h)
                 .filter(|&p| own[p] > 0.0)
-                .map(|p| (hit_point(p) - c).norm())
+                .map(|p| (self.hit_point(p) - c).norm())
                 .fold(0.0, f64::max);
             if a > 0.0 {
                 for p in 0..w * h {
                     if own[p] > 0.0 || !refh.t_mm[p].is_finite() {
                         continue;
                     }
-                    let r = (hit_point(p) - c).norm() / a;
+                    let r = (self.hit_point(p) - c).norm() / a;
                     if r > 1.0 && r < HALO_RADII {
                         own[p] = (s.halo * d * (hertz(r) - hertz(HALO_RADII))) as f32;
                     }
                 }
             }
         }
-        for (x, o) in dent.iter_mut().zip(&own) {
-            *x += o;
-        }
-        // the core of the imprint as the lens images it (blurred by the PSF, noise-free):
-        // its depth above CORE_FRACTION of its deepest
+        own
+    }
+
+    /// The true centre of the imprint of depth `own` ([`Rendered::centres_px`]): the centroid
+    /// of its core as the lens images it (blurred by the PSF, noise-free), its depth above
+    /// [`CORE_FRACTION`] of its deepest; `None` for no imprint.
+    fn imprint_centre(&self, own: Vec<f32>) -> Option<[f64; 2]> {
+        let w = self.w;
         let seen = gaussian_blur(
             &GrayImage {
                 width: w,
-                height: h,
+                height: self.h,
                 data: own,
             },
-            s.psf_sigma_px,
+            self.s.psf_sigma_px,
         )
         .data;
         let deepest = seen.iter().fold(0f32, |a, &b| a.max(b)) as f64;
@@ -422,27 +506,41 @@ pub fn render_through(
             su += x * (p % w) as f64;
             sv += x * (p / w) as f64;
         }
-        centres.push((deepest > 0.0 && sw > 0.0).then(|| [su / sw, sv / sw]));
+        (deepest > 0.0 && sw > 0.0).then(|| [su / sw, sv / sw])
     }
-    // the shading of the imprints, side-lit from the rim
-    let shade: Vec<f32> = if s.side_light_px > 0.0 && skin_r > 0.0 {
-        (0..w * h)
-            .map(|p| {
-                let (u, v) = (p % w, p / w);
-                let (l, r) = (u.saturating_sub(1), (u + 1).min(w - 1));
-                let (t, b) = (v.saturating_sub(1), (v + 1).min(h - 1));
-                let gu = f64::from(dent[v * w + r] - dent[v * w + l]) / (r - l) as f64;
-                let gv = f64::from(dent[b * w + u] - dent[t * w + u]) / (b - t) as f64;
-                let (lu, lv) = ((u as f64 - cx) / skin_r, (v as f64 - cy) / skin_r);
-                dent[p] + (s.side_light_px * (lu * gu + lv * gv)) as f32
-            })
-            .collect()
-    } else {
-        dent.clone()
-    };
-    // specks and scratches, from their own stream (the other draws stay as without them)
-    let mut marks = vec![0f32; w * h];
-    if s.specks + s.scratches > 0 {
+
+    /// The shading of the imprints' depth `dent`, side-lit from the rim
+    /// ([`Shading::side_light_px`]); `dent` itself without side light.
+    fn side_lit(&self, dent: &[f32]) -> Vec<f32> {
+        let (w, h, s, skin_r) = (self.w, self.h, self.s, self.skin_r);
+        let (cx, cy) = (self.cx, self.cy);
+        if s.side_light_px > 0.0 && skin_r > 0.0 {
+            (0..w * h)
+                .map(|p| {
+                    let (u, v) = (p % w, p / w);
+                    let (l, r) = (u.saturating_sub(1), (u + 1).min(w - 1));
+                    let (t, b) = (v.saturating_sub(1), (v + 1).min(h - 1));
+                    let gu = f64::from(dent[v * w + r] - dent[v * w + l]) / (r - l) as f64;
+                    let gv = f64::from(dent[b * w + u] - dent[t * w + u]) / (b - t) as f64;
+                    let (lu, lv) = ((u as f64 - cx) / skin_r, (v as f64 - cy) / skin_r);
+                    dent[p] + (s.side_light_px * (lu * gu + lv * gv)) as f32
+                })
+                .collect()
+        } else {
+            dent.to_vec()
+        }
+    }
+
+    /// The darkening of the specks and scratches ([`Shading::specks`], [`Shading::scratches`])
+    /// on the skin, away from the imprints' `centres`, from their own random stream (the other
+    /// draws stay as without them).
+    fn marks(&self, seed: u64, centres: &[Option<[f64; 2]>]) -> Vec<f32> {
+        let (w, h, s, refh) = (self.w, self.h, self.s, self.refh);
+        let (cx, cy, skin_r) = (self.cx, self.cy, self.skin_r);
+        let mut marks = vec![0f32; w * h];
+        if s.specks + s.scratches == 0 {
+            return marks;
+        }
         let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x005b_ecc5);
         let clear = |u: f64, v: f64| {
             let p = v.round() as usize * w + u.round() as usize;
@@ -466,101 +564,118 @@ pub fn render_through(
                 continue;
             }
             if placed < s.specks {
-                let radius = 1.0 + unit(&mut rng);
-                let grey = (40.0 + 40.0 * unit(&mut rng)) as f32;
-                let r = radius.ceil() as i64 + 1;
-                for dv in -r..=r {
-                    for du in -r..=r {
-                        let (uu, vv) = (u.round() as i64 + du, v.round() as i64 + dv);
-                        if uu < 0 || vv < 0 || uu >= w as i64 || vv >= h as i64 {
-                            continue;
-                        }
-                        if (uu as f64 - u).hypot(vv as f64 - v) <= radius {
-                            marks[vv as usize * w + uu as usize] += grey;
-                        }
-                    }
-                }
+                self.speck(&mut marks, u, v, &mut rng);
             } else {
-                let len = 12.0 + 8.0 * unit(&mut rng);
-                let a = std::f64::consts::TAU * unit(&mut rng);
-                let grey = (30.0 + 20.0 * unit(&mut rng)) as f32;
-                let steps = (2.0 * len).ceil() as usize;
-                let mut last = usize::MAX;
-                for i in 0..=steps {
-                    let t = len * (i as f64 / steps as f64 - 0.5);
-                    let (uu, vv) = (u + t * a.cos(), v + t * a.sin());
-                    if uu < 0.0 || vv < 0.0 || uu > (w - 1) as f64 || vv > (h - 1) as f64 {
-                        continue;
-                    }
-                    let p = vv.round() as usize * w + uu.round() as usize;
-                    if p != last {
-                        marks[p] += grey;
-                        last = p;
-                    }
-                }
+                self.scratch(&mut marks, u, v, &mut rng);
             }
             placed += 1;
         }
+        marks
     }
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let blur = |img: Vec<f32>| {
-        gaussian_blur(
-            &GrayImage {
-                width: w,
-                height: h,
-                data: img,
-            },
-            s.psf_sigma_px,
-        )
-        .data
-    };
-    let reference = led_image(w, h, &blur(base.clone()), &leds, s, &mut rng);
-    let pressed: Vec<f32> = base
-        .iter()
-        .zip(&shade)
-        .zip(&marks)
-        .map(|((b, d), m)| b - s.grey_per_mm * d - m)
-        .collect();
-    // the highlights move, the gain drifts (no draws when neither does: the same images)
-    let moved: Vec<[f64; 2]> = if s.led_shift_px > 0.0 {
-        leds.iter()
-            .map(|c| {
-                let a = std::f64::consts::TAU * unit(&mut rng);
-                [
-                    c[0] + s.led_shift_px * a.cos(),
-                    c[1] + s.led_shift_px * a.sin(),
-                ]
-            })
-            .collect()
-    } else {
-        leds.clone()
-    };
-    let gain = if s.gain_drift > 0.0 {
-        1.0 + s.gain_drift * (2.0 * unit(&mut rng) as f32 - 1.0)
-    } else {
-        1.0
-    };
-    let capture: Vec<f32> = led_image(w, h, &blur(pressed), &moved, s, &mut rng)
-        .into_iter()
-        .map(|g| gain * g)
-        .collect();
-    let reference = noisy(reference, s.noise_sigma, &mut rng);
-    let capture = noisy(capture, s.noise_sigma, &mut rng);
-    let (reference, capture) = match s.jpeg_quality {
-        Some(q) => (jpeg(&reference, w, h, q), jpeg(&capture, w, h, q)),
-        None => (reference, capture),
-    };
-    Rendered {
-        reference: GrayImage {
-            width: w,
-            height: h,
-            data: reference,
-        },
-        capture: GrayImage {
-            width: w,
-            height: h,
-            data: capture,
-        },
-        centres_px: centres,
+
+    /// A speck at (`u`, `v`) px added to `marks`: a dot of 1 to 2 px radius, 40 to 80 grey
+    /// levels deep (drawn from `rng`).
+    fn speck(&self, marks: &mut [f32], u: f64, v: f64, rng: &mut ChaCha8Rng) {
+        let (w, h) = (self.w, self.h);
+        let radius = 1.0 + unit(rng);
+        let grey = (40.0 + 40.0 * unit(rng)) as f32;
+        let r = radius.ceil() as i64 + 1;
+        for dv in -r..=r {
+            for du in -r..=r {
+                let (uu, vv) = (u.round() as i64 + du, v.round() as i64 + dv);
+                if uu < 0 || vv < 0 || uu >= w as i64 || vv >= h as i64 {
+                    continue;
+                }
+                if (uu as f64 - u).hypot(vv as f64 - v) <= radius {
+                    marks[vv as usize * w + uu as usize] += grey;
+                }
+            }
+        }
+    }
+
+    /// A scratch about (`u`, `v`) px added to `marks`: a line 1 px wide, 12 to 20 px long, 30
+    /// to 50 grey levels deep, in a random direction (drawn from `rng`).
+    fn scratch(&self, marks: &mut [f32], u: f64, v: f64, rng: &mut ChaCha8Rng) {
+        let (w, h) = (self.w, self.h);
+        let len = 12.0 + 8.0 * unit(rng);
+        let a = std::f64::consts::TAU * unit(rng);
+        let grey = (30.0 + 20.0 * unit(rng)) as f32;
+        let steps = (2.0 * len).ceil() as usize;
+        let mut last = usize::MAX;
+        for i in 0..=steps {
+            let t = len * (i as f64 / steps as f64 - 0.5);
+            let (uu, vv) = (u + t * a.cos(), v + t * a.sin());
+            if uu < 0.0 || vv < 0.0 || uu > (w - 1) as f64 || vv > (h - 1) as f64 {
+                continue;
+            }
+            let p = vv.round() as usize * w + uu.round() as usize;
+            if p != last {
+                marks[p] += grey;
+                last = p;
+            }
+        }
+    }
+
+    /// The reference and the capture as the camera records them: `base` (minus the imprints'
+    /// `shade` and the `marks` for the capture) blurred by the PSF, the LED reflections at
+    /// `leds` (moved in the capture), the capture's gain drift, noise and JPEG, drawn from the
+    /// stream of `seed`.
+    fn photographs(
+        &self,
+        base: &[f32],
+        shade: &[f32],
+        marks: &[f32],
+        leds: &[[f64; 2]],
+        seed: u64,
+    ) -> (Vec<f32>, Vec<f32>) {
+        let (w, h, s) = (self.w, self.h, self.s);
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let blur = |img: Vec<f32>| {
+            gaussian_blur(
+                &GrayImage {
+                    width: w,
+                    height: h,
+                    data: img,
+                },
+                s.psf_sigma_px,
+            )
+            .data
+        };
+        let reference = led_image(w, h, &blur(base.to_vec()), leds, s, &mut rng);
+        let pressed: Vec<f32> = base
+            .iter()
+            .zip(shade)
+            .zip(marks)
+            .map(|((b, d), m)| b - s.grey_per_mm * d - m)
+            .collect();
+        // the highlights move, the gain drifts (no draws when neither does: the same images)
+        let moved: Vec<[f64; 2]> = if s.led_shift_px > 0.0 {
+            leds.iter()
+                .map(|c| {
+                    let a = std::f64::consts::TAU * unit(&mut rng);
+                    [
+                        c[0] + s.led_shift_px * a.cos(),
+                        c[1] + s.led_shift_px * a.sin(),
+                    ]
+                })
+                .collect()
+        } else {
+            leds.to_vec()
+        };
+        let gain = if s.gain_drift > 0.0 {
+            1.0 + s.gain_drift * (2.0 * unit(&mut rng) as f32 - 1.0)
+        } else {
+            1.0
+        };
+        let capture: Vec<f32> = led_image(w, h, &blur(pressed), &moved, s, &mut rng)
+            .into_iter()
+            .map(|g| gain * g)
+            .collect();
+        let reference = noisy(reference, s.noise_sigma, &mut rng);
+        let capture = noisy(capture, s.noise_sigma, &mut rng);
+        match s.jpeg_quality {
+            Some(q) => (jpeg(&reference, w, h, q), jpeg(&capture, w, h, q)),
+            None => (reference, capture),
+        }
     }
 }

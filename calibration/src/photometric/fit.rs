@@ -1,0 +1,300 @@
+//! Fitting the model ([`PhotometricModel::fit`]) from the reference image and the captures.
+
+use super::faults::{capture_fault, image_fault};
+use super::model::{Capture, PhotometricModel};
+use super::render::rms_over_skin;
+use super::shadows::{ShadowPixel, ShadowRings};
+use super::terms::{
+    features, gain_of, light_features, optical_axis, spatial, COEFFICIENTS, FEATURES, LIGHT_TERMS,
+    MIN_REFERENCE_COUNTS, SHADOW_TERMS, SPATIAL_TERMS,
+};
+use crate::groundtruth::rays::PixelRays;
+use crate::groundtruth::SurfaceHits;
+use nalgebra::{DMatrix, DVector};
+
+impl PhotometricModel {
+    /// Fits the model of the camera whose rays are `rays`, from its `reference_image` of the
+    /// unindented skin (whose surface is `reference`) and `captures`, whose values are
+    /// counts of at most `full_scale` (255 for 8-bit images): saturated pixels are left out of
+    /// the fit.
+    ///
+    /// # Errors
+    /// A message when the sizes disagree, when the reference is dark or saturated or a
+    /// capture shows no imprint ([`capture_fault`]), or when the captures hold fewer pressed
+    /// pixels than twice the unknowns (too few imprints to fit the response to tilt).
+    pub fn fit(
+        rays: &PixelRays,
+        reference: &SurfaceHits,
+        reference_image: &[[f64; 3]],
+        captures: &[Capture<'_>],
+        full_scale: f64,
+    ) -> Result<PhotometricModel, String> {
+        let (w, h) = (rays.width, rays.height);
+        let n = w * h;
+        check_inputs(rays, reference, reference_image, captures, full_scale)?;
+        let axis = optical_axis(rays);
+        let rings = ShadowRings::of(rays, reference);
+        if let Some(k) = captures.iter().position(|c| c.shadows.rings != rings) {
+            return Err(format!(
+                "capture {k}: its shadows are of other light rings than this camera's"
+            ));
+        }
+        let gains: Vec<f64> = captures
+            .iter()
+            .map(|c| gain_of(c.image, reference_image, |i| c.hits.contact[i]))
+            .collect();
+        let appearance = appearance(reference, reference_image, captures, &gains);
+        // The response to tilt and the shadows, by least squares on the pressed and the
+        // shadowed pixels of every capture.
+        let unknowns = COEFFICIENTS + SHADOW_TERMS;
+        let (rows, pressed) = fit_rows(reference, captures, n);
+        if pressed < 2 * unknowns {
+            return Err(format!(
+                "the captures press {} pixels of the skin, fewer than the {} the fit needs (twice its {unknowns} unknowns): give captures with more imprints",
+                pressed,
+                2 * unknowns
+            ));
+        }
+        let design = Design {
+            rays,
+            reference,
+            captures,
+            appearance: &appearance,
+            gains: &gains,
+            axis,
+            lights: rings.point_lights(),
+            full_scale,
+        };
+        let mut coefficients: [Vec<f64>; 3] = Default::default();
+        let mut shadow_coefficients = [[0.0; SHADOW_TERMS]; 3];
+        for (ch, coef) in coefficients.iter_mut().enumerate() {
+            let x = design.solve(ch, &rows);
+            *coef = x.iter().take(COEFFICIENTS).copied().collect();
+            shadow_coefficients[ch] = std::array::from_fn(|m| x[COEFFICIENTS + m]);
+        }
+        let mut model = PhotometricModel {
+            width: w,
+            height: h,
+            reference: appearance,
+            coefficients,
+            axis,
+            rings,
+            shadow_coefficients,
+            gains: gains.clone(),
+            full_scale,
+            residual_rms: Vec::new(),
+        };
+        model.residual_rms = captures
+            .iter()
+            .zip(&gains)
+            .map(|(c, g)| {
+                rms_over_skin(
+                    &model.render(rays, reference, c.hits, c.shadows, *g),
+                    c.image,
+                )
+            })
+            .collect();
+        Ok(model)
+    }
+}
+
+/// [`PhotometricModel::fit`]'s checks of its inputs: the reference image, the reference
+/// surface and every capture of the camera's size, the reference lit and not overexposed
+/// ([`image_fault`]), every capture showing its imprints ([`capture_fault`]).
+///
+/// # Errors
+/// A message naming the image and what is wrong with it.
+fn check_inputs(
+    rays: &PixelRays,
+    reference: &SurfaceHits,
+    reference_image: &[[f64; 3]],
+    captures: &[Capture<'_>],
+    full_scale: f64,
+) -> Result<(), String> {
+    let (w, h) = (rays.width, rays.height);
+    let n = w * h;
+    if reference_image.len() != n || reference.t_mm.len() != n {
+        return Err(format!(
+            "the reference image has {} pixels, the camera {w} x {h} = {n}",
+            reference_image.len()
+        ));
+    }
+    for (k, c) in captures.iter().enumerate() {
+        if c.image.len() != n || c.hits.t_mm.len() != n {
+            return Err(format!(
+                "capture {k}: {} pixels, the camera {w} x {h} = {n}",
+                c.image.len()
+            ));
+        }
+    }
+    if let Some(f) = image_fault(reference, reference_image, full_scale) {
+        return Err(format!("the reference image is {f}"));
+    }
+    for (k, c) in captures.iter().enumerate() {
+        if let Some(f) = capture_fault(reference, reference_image, c, full_scale) {
+            return Err(format!("capture {k}: {f}"));
+        }
+    }
+    Ok(())
+}
+
+/// The unindented appearance: per pixel and channel, the median of the reference and every
+/// capture's unpressed value divided by its gain (a highlight or a speck that only one image
+/// shows does not move it; with no capture unpressed there, the reference); NaN off the skin.
+fn appearance(
+    reference: &SurfaceHits,
+    reference_image: &[[f64; 3]],
+    captures: &[Capture<'_>],
+    gains: &[f64],
+) -> Vec<[f64; 3]> {
+    (0..reference_image.len())
+        .map(|i| {
+            if !reference.t_mm[i].is_finite() {
+                return [f64::NAN; 3];
+            }
+            std::array::from_fn(|ch| {
+                let mut v: Vec<f64> = std::iter::once(reference_image[i][ch])
+                    .chain(
+                        captures
+                            .iter()
+                            .zip(gains)
+                            .filter(|(c, _)| !c.hits.contact[i])
+                            .map(|(c, g)| c.image[i][ch] / g),
+                    )
+                    .collect();
+                crate::median_sorting(&mut v)
+            })
+        })
+        .collect()
+}
+
+/// A row of the fit: (capture, pixel, its shadow if shadowed).
+type FitRow<'a> = (usize, usize, Option<&'a ShadowPixel>);
+
+/// The rows of the fit: every capture's pressed or shadowed pixels on the skin (of `n`),
+/// capture major, and how many of them are pressed.
+fn fit_rows<'a>(
+    reference: &SurfaceHits,
+    captures: &[Capture<'a>],
+    n: usize,
+) -> (Vec<FitRow<'a>>, usize) {
+    let on_skin = |i: usize| reference.t_mm[i].is_finite();
+    let mut rows: Vec<FitRow<'a>> = Vec::new();
+    let mut pressed = 0;
+    for (k, c) in captures.iter().enumerate() {
+        let mut shadowed = c.shadows.pixels.iter().peekable();
+        for i in 0..n {
+            let mut sh = None;
+            while let Some(sp) = shadowed.peek() {
+                let j = sp.pixel as usize;
+                if j < i {
+                    shadowed.next();
+                } else {
+                    if j == i {
+                        sh = Some(*sp);
+                    }
+                    break;
+                }
+            }
+            if on_skin(i) && (c.hits.contact[i] || sh.is_some()) {
+                pressed += usize::from(c.hits.contact[i]);
+                rows.push((k, i, sh));
+            }
+        }
+    }
+    (rows, pressed)
+}
+
+/// The least-squares problem of the fit, one channel at a time: the camera's rays, the
+/// reference surface, the captures with their gains, the appearance, the optical axis, the
+/// candidate point lights and the full scale.
+struct Design<'a> {
+    rays: &'a PixelRays,
+    reference: &'a SurfaceHits,
+    captures: &'a [Capture<'a>],
+    appearance: &'a [[f64; 3]],
+    gains: &'a [f64],
+    axis: [f64; 3],
+    lights: [[f64; 3]; LIGHT_TERMS],
+    full_scale: f64,
+}
+
+impl Design<'_> {
+    /// Channel `ch`'s coefficients over `rows` ([`COEFFICIENTS`] of the response, then
+    /// [`SHADOW_TERMS`] of the shadows): the normal equations solved by Cholesky, else by SVD;
+    /// zero for a channel without light (all pixels below the floor).
+    fn solve(&self, ch: usize, rows: &[FitRow<'_>]) -> DVector<f64> {
+        let unknowns = COEFFICIENTS + SHADOW_TERMS;
+        let (ata, atb) = self.normal_equations(ch, rows);
+        // a channel without light (all pixels below the floor) keeps zero coefficients
+        ata.clone()
+            .cholesky()
+            .map(|c| c.solve(&atb))
+            .or_else(|| ata.svd(true, true).solve(&atb, 1e-12).ok())
+            .unwrap_or_else(|| DVector::zeros(unknowns))
+    }
+
+    /// The normal equations `A^T W A x = A^T W y` of channel `ch` over `rows`: each usable
+    /// row (lit, not saturated) the ratio's change `y` against the features times the spatial
+    /// terms, the light features and the shadows, weighted by the reference squared so that
+    /// each row counts in grey levels.
+    fn normal_equations(&self, ch: usize, rows: &[FitRow<'_>]) -> (DMatrix<f64>, DVector<f64>) {
+        let (w, h) = (self.rays.width, self.rays.height);
+        let (captures, gains, full_scale) = (self.captures, self.gains, self.full_scale);
+        let tilt_unknowns = COEFFICIENTS;
+        let unknowns = tilt_unknowns + SHADOW_TERMS;
+        let mut ata = DMatrix::<f64>::zeros(unknowns, unknowns);
+        let mut atb = DVector::<f64>::zeros(unknowns);
+        let mut row = vec![0.0; unknowns];
+        let mut nonzero: Vec<usize> = Vec::with_capacity(unknowns);
+        for &(k, i, sh) in rows {
+            let r = self.appearance[i][ch];
+            let y_counts = captures[k].image[i][ch];
+            if !(r >= MIN_REFERENCE_COUNTS) || y_counts >= full_scale || r * gains[k] >= full_scale
+            {
+                continue;
+            }
+            let Some(f) = features(i, captures[k].hits, self.reference, self.axis) else {
+                continue;
+            };
+            let p = spatial(i, w, h);
+            for (a, fa) in f.iter().enumerate() {
+                for (m, pm) in p.iter().enumerate() {
+                    row[a * SPATIAL_TERMS + m] = fa * pm;
+                }
+            }
+            let lf = light_features(
+                i,
+                self.rays,
+                captures[k].hits,
+                self.reference,
+                &self.lights,
+                sh.map_or(0, |f| f.blocked),
+            )
+            .unwrap_or([0.0; LIGHT_TERMS]);
+            row[FEATURES * SPATIAL_TERMS..tilt_unknowns].copy_from_slice(&lf);
+            for (m, x) in row[tilt_unknowns..].iter_mut().enumerate() {
+                *x = -sh.map_or(0.0, |f| f.rings[m]);
+            }
+            // the ratio's change, weighted by the reference so that each row counts in
+            // grey levels
+            let y = y_counts / (gains[k] * r) - 1.0;
+            let wgt = r * r;
+            // an unpressed pixel's row has only its shadow terms
+            nonzero.clear();
+            nonzero.extend((0..unknowns).filter(|&a| row[a] != 0.0));
+            for (j, &a) in nonzero.iter().enumerate() {
+                atb[a] += wgt * row[a] * y;
+                for &b in &nonzero[j..] {
+                    ata[(a, b)] += wgt * row[a] * row[b];
+                }
+            }
+        }
+        for a in 0..unknowns {
+            for b in 0..a {
+                ata[(a, b)] = ata[(b, a)];
+            }
+        }
+        (ata, atb)
+    }
+}

@@ -1,0 +1,253 @@
+//! The shadow term's candidate lights ([`ShadowRings`]) and the shadows the protrusions cast
+//! from them ([`shadow_map`]).
+
+use super::terms::{
+    median, optical_axis, DENT_MARGIN, LIGHT_AZIMUTHS, LIGHT_HEIGHTS, LIGHT_RADIUS, LIGHT_TERMS,
+    SHADOW_AZIMUTHS, SHADOW_HEIGHTS, SHADOW_RADII, SHADOW_REACH, SHADOW_TERMS,
+};
+use crate::groundtruth::exact::ExactPrimitives;
+use crate::groundtruth::rays::PixelRays;
+use crate::groundtruth::SurfaceHits;
+use fabkit_designs::primitives::{cross, dot};
+use rayon::prelude::*;
+
+/// The candidate lights of the shadow term: rings about the camera's optical axis, where a
+/// sensor's LEDs are not known (a ring of LEDs, or a few, round the camera or the skin's
+/// base), at [`SHADOW_HEIGHTS`] and [`SHADOW_RADII`] times the skin's median range `scale_mm`
+/// from the camera centre.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShadowRings {
+    /// The camera centre, sensor frame, mm.
+    pub centre_mm: [f64; 3],
+    /// The optical axis, sensor frame (unit).
+    pub axis: [f64; 3],
+    /// The median distance from the camera centre to the reference skin, mm.
+    pub scale_mm: f64,
+}
+
+impl ShadowRings {
+    /// The rings of the camera whose rays are `rays`, seeing the reference skin `reference`.
+    pub fn of(rays: &PixelRays, reference: &SurfaceHits) -> ShadowRings {
+        let ranges: Vec<f64> = reference
+            .t_mm
+            .iter()
+            .copied()
+            .filter(|t| t.is_finite())
+            .collect();
+        ShadowRings {
+            centre_mm: rays.origin_mm,
+            axis: optical_axis(rays),
+            scale_mm: median(ranges).unwrap_or(1.0),
+        }
+    }
+
+    /// The candidate point lights of the light term, sensor frame, mm.
+    pub(super) fn point_lights(&self) -> [[f64; 3]; LIGHT_TERMS] {
+        let (e1, e2) = self.frame();
+        std::array::from_fn(|k| {
+            let h = LIGHT_HEIGHTS[k / LIGHT_AZIMUTHS] * self.scale_mm;
+            let r = LIGHT_RADIUS * self.scale_mm;
+            let (sn, cs) = (std::f64::consts::TAU * (k % LIGHT_AZIMUTHS) as f64
+                / LIGHT_AZIMUTHS as f64)
+                .sin_cos();
+            std::array::from_fn(|q| {
+                self.centre_mm[q] + h * self.axis[q] + r * (cs * e1[q] + sn * e2[q])
+            })
+        })
+    }
+
+    /// Two unit vectors square to the axis and to each other: the rings' azimuth 0 and 90 deg.
+    fn frame(&self) -> ([f64; 3], [f64; 3]) {
+        let a = self.axis;
+        let helper = if a[0].abs() < 0.9 {
+            [1.0, 0.0, 0.0]
+        } else {
+            [0.0, 1.0, 0.0]
+        };
+        let e1 = cross(a, helper);
+        let l1 = dot(e1, e1).sqrt();
+        let e1 = e1.map(|x| x / l1);
+        (e1, cross(a, e1))
+    }
+
+    /// The sampled lights of ring `m` (height major, radius minor), sensor frame, mm: a ring
+    /// at [`SHADOW_HEIGHTS`]`[m / 3]` and [`SHADOW_RADII`]`[m % 3]` times `scale_mm`.
+    pub fn lights(&self, m: usize) -> [[f64; 3]; SHADOW_AZIMUTHS] {
+        let a = self.axis;
+        let (e1, e2) = self.frame();
+        let h = SHADOW_HEIGHTS[m / SHADOW_RADII.len()] * self.scale_mm;
+        let r = SHADOW_RADII[m % SHADOW_RADII.len()] * self.scale_mm;
+        std::array::from_fn(|j| {
+            let (sn, cs) = (std::f64::consts::TAU * j as f64 / SHADOW_AZIMUTHS as f64).sin_cos();
+            std::array::from_fn(|q| self.centre_mm[q] + h * a[q] + r * (cs * e1[q] + sn * e2[q]))
+        })
+    }
+}
+
+/// The shadows the protrusions of a frame cast on its surface from the candidate rings: for
+/// each pixel near a protrusion, per ring the share of the ring's light (each sampled light
+/// weighted by its incidence cosine over the squared distance) that the protrusions block.
+/// Pixels with no shadow are left out (sorted by pixel index).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ShadowMap {
+    pub rings: ShadowRings,
+    pub pixels: Vec<ShadowPixel>,
+}
+
+/// One shadowed pixel of a [`ShadowMap`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShadowPixel {
+    /// Row-major pixel index.
+    pub pixel: u32,
+    /// Per candidate ring, the share of its light the protrusions block.
+    pub rings: [f64; SHADOW_TERMS],
+    /// Bit `k`: candidate point light `k` of the light term is blocked.
+    pub blocked: u64,
+}
+
+impl ShadowMap {
+    /// No shadow (the reference, or a frame without protrusions).
+    pub fn none(rings: ShadowRings) -> ShadowMap {
+        ShadowMap {
+            rings,
+            pixels: Vec::new(),
+        }
+    }
+
+    /// The shadow features of pixel `i`, if it is shadowed.
+    pub fn at(&self, i: usize) -> Option<&ShadowPixel> {
+        self.pixels
+            .binary_search_by_key(&(i as u32), |p| p.pixel)
+            .ok()
+            .map(|k| &self.pixels[k])
+    }
+}
+
+/// The [`ShadowMap`] of the surface `hits` (seen along `rays`) under `protrusions`. Pixels
+/// are computed in parallel; the map does not depend on the thread count.
+pub fn shadow_map(
+    rays: &PixelRays,
+    hits: &SurfaceHits,
+    protrusions: &ExactPrimitives,
+    rings: &ShadowRings,
+) -> ShadowMap {
+    let lights: Vec<[[f64; 3]; SHADOW_AZIMUTHS]> =
+        (0..SHADOW_TERMS).map(|m| rings.lights(m)).collect();
+    let points = rings.point_lights();
+    let reach = SHADOW_REACH * rings.scale_mm;
+    let o = rays.origin_mm;
+    let point = |i: usize| -> [f64; 3] {
+        let (t, d) = (hits.t_mm[i], rays.dirs[i]);
+        std::array::from_fn(|q| o[q] + t * d[q])
+    };
+    // Only what a protrusion pushes into the skin can shadow it from lights inside: each
+    // primitive's dent is bounded by the contact points in its bounding sphere; a primitive
+    // with none does not press the skin.
+    let contact: Vec<[f64; 3]> = (0..hits.t_mm.len())
+        .filter(|&i| hits.contact[i] && hits.t_mm[i].is_finite())
+        .map(point)
+        .collect();
+    let dents: Vec<(usize, [f64; 3], f64)> = (0..protrusions.len())
+        .filter_map(|k| {
+            let (c, r) = protrusions.bounding_sphere_of(k);
+            let inside: Vec<&[f64; 3]> = contact
+                .iter()
+                .filter(|q| {
+                    let v = [q[0] - c[0], q[1] - c[1], q[2] - c[2]];
+                    dot(v, v) <= r * r
+                })
+                .collect();
+            if inside.is_empty() {
+                return None;
+            }
+            let n = inside.len() as f64;
+            let m: [f64; 3] = std::array::from_fn(|q| inside.iter().map(|p| p[q]).sum::<f64>() / n);
+            let rad = inside
+                .iter()
+                .map(|p| {
+                    let v = [p[0] - m[0], p[1] - m[1], p[2] - m[2]];
+                    dot(v, v)
+                })
+                .fold(0.0, f64::max)
+                .sqrt();
+            Some((k, m, rad + DENT_MARGIN * rings.scale_mm))
+        })
+        .collect();
+    let pixels = (0..hits.t_mm.len())
+        .into_par_iter()
+        .filter_map(|i| {
+            if !hits.t_mm[i].is_finite() {
+                return None;
+            }
+            let p = point(i);
+            // the protrusions whose dents are near enough to shadow the point
+            let near: Vec<&(usize, [f64; 3], f64)> = dents
+                .iter()
+                .filter(|(_, c, r)| {
+                    let v = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
+                    dot(v, v).sqrt() <= r + reach
+                })
+                .collect();
+            if near.is_empty() {
+                return None;
+            }
+            // the camera's side of the surface: the elastomer's outward normal reversed
+            let n = hits.normal[i].map(|v| -v);
+            let start = [p[0] + 1e-6 * n[0], p[1] + 1e-6 * n[1], p[2] + 1e-6 * n[2]];
+            // whether the segment to the light at `l` is blocked, and its weight
+            let to = |l: &[f64; 3]| -> (bool, f64) {
+                let v = [l[0] - p[0], l[1] - p[1], l[2] - p[2]];
+                let dist = dot(v, v).sqrt();
+                let u = v.map(|x| x / dist);
+                let w = dot(n, u).max(0.0) / (dist * dist);
+                if w <= 0.0 {
+                    return (false, 0.0);
+                }
+                // only a dent the segment passes through can block it
+                let crossed = near.iter().filter_map(|(k, c, r)| {
+                    let v = [c[0] - p[0], c[1] - p[1], c[2] - p[2]];
+                    let along = dot(v, u).clamp(0.0, dist);
+                    let w = [
+                        v[0] - along * u[0],
+                        v[1] - along * u[1],
+                        v[2] - along * u[2],
+                    ];
+                    (dot(w, w) <= r * r).then_some(*k)
+                });
+                let hit = protrusions
+                    .first_crossing_among(start, u, dist, crossed)
+                    .is_some();
+                (hit, w)
+            };
+            let mut f = [0.0; SHADOW_TERMS];
+            for (m, ring) in lights.iter().enumerate() {
+                let (mut blocked, mut all) = (0.0, 0.0);
+                for l in ring {
+                    let (hit, w) = to(l);
+                    all += w;
+                    if hit {
+                        blocked += w;
+                    }
+                }
+                if all > 0.0 {
+                    f[m] = blocked / all;
+                }
+            }
+            let mut mask = 0u64;
+            for (k, l) in points.iter().enumerate() {
+                if to(l).0 {
+                    mask |= 1 << k;
+                }
+            }
+            (f.iter().any(|x| *x > 0.0) || mask != 0).then_some(ShadowPixel {
+                pixel: i as u32,
+                rings: f,
+                blocked: mask,
+            })
+        })
+        .collect();
+    ShadowMap {
+        rings: *rings,
+        pixels,
+    }
+}
