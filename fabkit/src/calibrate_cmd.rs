@@ -6,7 +6,8 @@ use std::path::PathBuf;
 use fabkit_calibration::capture_images::CaptureImages;
 use fabkit_calibration::refine::RefineParameters;
 use fabkit_calibration::{
-    calibrate_extrinsics, ExtrinsicsJob, Observed, PointsFrom, RansacOptions,
+    calibrate_extrinsics, ExtrinsicsJob, ExtrinsicsReport, FoundInImages, Observed, PointsFrom,
+    RansacOptions,
 };
 use fabkit_export::{OutputClaim, OutputCommand, StagedDir};
 
@@ -129,6 +130,40 @@ pub fn run(cmd: CalibrateCommand) -> Result<(), Box<dyn Error>> {
 }
 
 fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
+    check_options(&a)?;
+    let claim = claim(&a);
+    let (optical_path, optical_path_from) = optical_path(&a)?;
+    if a.refine_optical_path && optical_path.is_none() {
+        return Err(
+            "--refine-optical-path: there is no optical path to refine (give --design; the point table names no design whose camera looks through an interface)"
+                .into(),
+        );
+    }
+    let out_dir = a.out.clone();
+    let job = job(a, optical_path, optical_path_from);
+    // The output folder is checked (and its temporary sibling made) before the solve; nothing
+    // appears under --out unless every file is written.
+    let staged = StagedDir::new(&out_dir, claim)?;
+    let out = calibrate_extrinsics(&job)?;
+    for (name, bytes) in &out.files {
+        staged.write(name, bytes)?;
+    }
+    let warnings = staged.commit()?;
+    if let Some(f) = out.found {
+        print_found(&f);
+    }
+    let r = out.report;
+    print_report(&r);
+    println!("wrote {}", out_dir.display());
+    for w in r.warnings.iter().chain(&warnings) {
+        eprintln!("warning: {w}");
+    }
+    Ok(())
+}
+
+/// Notes an ignored --seed and refuses a --ransac-threshold-px that is not a finite positive
+/// number.
+fn check_options(a: &ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
     if let Some(seed) = a.seed {
         eprintln!(
             "note: --seed {seed} has no effect: RANSAC samples on a fixed schedule, so the pose depends on the data only"
@@ -139,7 +174,12 @@ fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
             return Err(format!("--ransac-threshold-px = {t}: must be finite and > 0").into());
         }
     }
-    // The job of the output: its inputs (what it was computed from), not the solver's options.
+    Ok(())
+}
+
+/// The claim on --out: the job of the output is its inputs (what it was computed from), not
+/// the solver's options.
+fn claim(a: &ExtrinsicsArgs) -> OutputClaim {
     let captures = a.images.len().max(a.observations.len());
     let inputs: Vec<&std::path::Path> = [&a.cam.camera, &a.points]
         .into_iter()
@@ -149,7 +189,7 @@ fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
         .chain(&a.capture_plan)
         .map(PathBuf::as_path)
         .collect();
-    let claim = OutputClaim::of_inputs(
+    OutputClaim::of_inputs(
         OutputCommand::CalibrateExtrinsics,
         &format!(
             "extrinsics from {captures} {}",
@@ -161,8 +201,15 @@ fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
         ),
         &inputs,
         a.force,
-    );
-    let (optical_path, optical_path_from) = match (&a.design, a.straight_rays) {
+    )
+}
+
+/// The optical path the rays bend through and where it comes from in words: none with
+/// --straight-rays, that of --design (and --preset), or that of the point table's design.
+fn optical_path(
+    a: &ExtrinsicsArgs,
+) -> Result<(Option<fabkit_designs::optics::OpticalPath>, Option<String>), Box<dyn Error>> {
+    Ok(match (&a.design, a.straight_rays) {
         (_, true) => (None, None),
         (Some(d), false) => {
             let mut loaded = crate::args::load_design(Some(d), &a.data_files)?;
@@ -193,14 +240,16 @@ fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
                 (Some(path), Some(from))
             }
         },
-    };
-    if a.refine_optical_path && optical_path.is_none() {
-        return Err(
-            "--refine-optical-path: there is no optical path to refine (give --design; the point table names no design whose camera looks through an interface)"
-                .into(),
-        );
-    }
-    let job = ExtrinsicsJob {
+    })
+}
+
+/// The calibration job of the arguments `a` through `optical_path`.
+fn job(
+    a: ExtrinsicsArgs,
+    optical_path: Option<fabkit_designs::optics::OpticalPath>,
+    optical_path_from: Option<String>,
+) -> ExtrinsicsJob {
+    ExtrinsicsJob {
         optical_path,
         optical_path_from,
         refine_optical_path: a.refine_optical_path,
@@ -232,37 +281,35 @@ fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
             ..Default::default()
         }),
         command_line: std::env::args().collect::<Vec<_>>().join(" "),
-    };
-    // The output folder is checked (and its temporary sibling made) before the solve; nothing
-    // appears under --out unless every file is written.
-    let staged = StagedDir::new(&a.out, claim)?;
-    let out = calibrate_extrinsics(&job)?;
-    for (name, bytes) in &out.files {
-        staged.write(name, bytes)?;
     }
-    let warnings = staged.commit()?;
-    if let Some(f) = out.found {
-        println!(
-            "imprints: {} pins found in {} of {} captures (observations.csv; overlays/){}",
-            f.detections,
-            f.captures - f.captures_left_out,
-            f.captures,
-            if f.captures_left_out + f.spots_discarded + f.pins_missing > 0 {
-                let n = |k: usize, one: &str, many: &str| {
-                    format!("{k} {}", if k == 1 { one } else { many })
-                };
-                format!(
-                    "; {} left out, {} discarded, {} missing: named below",
-                    n(f.captures_left_out, "capture", "captures"),
-                    n(f.spots_discarded, "spot", "spots"),
-                    n(f.pins_missing, "pin", "pins")
-                )
-            } else {
-                String::new()
-            }
-        );
-    }
-    let r = out.report;
+}
+
+/// Prints the pins found in the capture images and what was left out.
+fn print_found(f: &FoundInImages) {
+    println!(
+        "imprints: {} pins found in {} of {} captures (observations.csv; overlays/){}",
+        f.detections,
+        f.captures - f.captures_left_out,
+        f.captures,
+        if f.captures_left_out + f.spots_discarded + f.pins_missing > 0 {
+            let n = |k: usize, one: &str, many: &str| {
+                format!("{k} {}", if k == 1 { one } else { many })
+            };
+            format!(
+                "; {} left out, {} discarded, {} missing: named below",
+                n(f.captures_left_out, "capture", "captures"),
+                n(f.spots_discarded, "spot", "spots"),
+                n(f.pins_missing, "pin", "pins")
+            )
+        } else {
+            String::new()
+        }
+    );
+}
+
+/// Prints the solved pose: the reprojection errors, outliers and models compared, the pose,
+/// refined intrinsics and the pose's uncertainty.
+fn print_report(r: &ExtrinsicsReport) {
     let c = r.residuals.camera_centre_in_sensor_mm;
     println!(
         "extrinsics: {} of {} points, RMS reprojection error {:.3} px, worst {:.3} px (id {})",
@@ -338,11 +385,6 @@ fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
             "pose standard deviation per px of pixel noise: rotation [{rx:.3}, {ry:.3}, {rz:.3}] deg, translation [{tx:.4}, {ty:.4}, {tz:.4}] mm"
         );
     }
-    println!("wrote {}", a.out.display());
-    for w in r.warnings.iter().chain(&warnings) {
-        eprintln!("warning: {w}");
-    }
-    Ok(())
 }
 
 /// The design a point table was made for, as its sidecar (`point_table.json`, as `fabkit

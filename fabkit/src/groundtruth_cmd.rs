@@ -13,11 +13,16 @@ use fabkit_calibration::groundtruth::dataset::{
     self, output_bound, FrameInputs, ImageSource, ManifestInputs, DEFAULT_MAX_OUTPUT_BYTES,
     MAX_OUTPUT_BYTES_LIMIT,
 };
-use fabkit_calibration::groundtruth::inputs::{read_extrinsics, read_fixtures, read_with_hash};
+use fabkit_calibration::groundtruth::inputs::{
+    read_extrinsics, read_fixtures, read_with_hash, Fixtures,
+};
 use fabkit_calibration::groundtruth::pins::read_pin_captures;
+use fabkit_calibration::groundtruth::rays::PixelRays;
 use fabkit_calibration::groundtruth::shading::Imaging;
-use fabkit_calibration::groundtruth::{reference_hits, Scene};
+use fabkit_calibration::groundtruth::surface::ReferenceSurface;
+use fabkit_calibration::groundtruth::{reference_hits, Scene, SurfaceHits};
 use fabkit_calibration::photometric::PhotometricModel;
+use fabkit_calibration::refraction::OpticalLayers;
 use fabkit_export::{OutputClaim, StagedDir};
 
 use crate::args::{load_design, DataFileArgs};
@@ -255,7 +260,76 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
         loaded.apply_preset(p)?;
     }
     let design = &loaded.design;
-    let camera = args.cam.read()?;
+    let inputs = Inputs::read(&args, design)?;
+    // The optics (or the photometric model) are checked before the output is bounded or
+    // anything is written.
+    let looks = Looks::read(&args, &loaded, &inputs)?;
+    // The output is bounded before anything is rendered or written.
+    check_output_bound(&args, &inputs, looks.image_bits())?;
+    // A camera that sees (almost) none of the skin is refused before anything is written.
+    let ref_hits = reference_hits(&inputs.rays, &inputs.surface);
+    check_skin_seen(
+        ref_hits.valid_count(),
+        &inputs.camera,
+        &args.cam.camera.display().to_string(),
+        &String::from_utf8_lossy(&inputs.camera_bytes),
+        &inputs.pose_name,
+    )?;
+    let n_cfg = inputs.fixtures.configurations.len();
+    let frames = n_cfg as u64 + 1;
+    let bar = crate::progress::Progress::new(
+        "groundtruth",
+        &format!("rendering {frames} frames of {}", design.name),
+        frames,
+    );
+    let imaging = looks.image_source(&inputs, &ref_hits);
+    let staged = StagedDir::new(&args.out, claim)?;
+    let all = write_dataset(
+        &staged,
+        &args,
+        &loaded,
+        &inputs,
+        &ref_hits,
+        imaging.as_ref(),
+        &|k| bar.set(k, frames),
+    )?;
+    bar.finish();
+    for w in staged.commit()? {
+        eprintln!("warning: {w}");
+    }
+    out!(
+        "{}: reference + {}, {} of {} pixels on the surface -> {} ({} files, {:.2} s)",
+        design.name,
+        rendered_what(&args, &inputs.fixtures),
+        ref_hits.valid_count(),
+        inputs.rays.width * inputs.rays.height,
+        args.out.display(),
+        all.len() + 1,
+        t0.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
+/// What was rendered besides the reference, in words: the pin captures, or the
+/// configurations and stitched pairs of the protrusion patterns.
+fn rendered_what(args: &GroundTruthArgs, fixtures: &Fixtures) -> String {
+    let n_cfg = fixtures.configurations.len();
+    let n_pairs = fixtures.patterns.len() * fixtures.patterns.len();
+    if args.pin_captures {
+        format!("{n_cfg} pin captures")
+    } else {
+        format!(
+            "{n_cfg} configurations ({} patterns x 2 orientations), {n_pairs} stitched pairs",
+            fixtures.patterns.len()
+        )
+    }
+}
+
+/// Refuses a camera image over --max-pixels, before any per-pixel buffer is allocated.
+fn check_pixels(
+    args: &GroundTruthArgs,
+    camera: &fabkit_calibration::CameraModel,
+) -> Result<(), Box<dyn Error>> {
     let (cw, ch) = (
         camera.intrinsics().image_width_px,
         camera.intrinsics().image_height_px,
@@ -284,91 +358,195 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
         )
         .into());
     }
-    let (camera_bytes, camera_sha) = read_with_hash(&args.cam.camera)?;
-    let (t_cam_sensor, extrinsics_sha) = read_extrinsics(&args.extrinsics)?;
-    let fixtures = if args.pin_captures {
-        read_pin_captures(&args.fixtures, &design.name)?
-    } else {
-        read_fixtures(&args.fixtures, &design.name)?
-    };
-    let pose_name = args.extrinsics.display().to_string();
-    // the rays bend where the pose was solved through an optical path (`calibrate extrinsics
-    // --design`): the depth maps register with the captures that calibration saw
-    let optical_path =
-        fabkit_calibration::groundtruth::inputs::read_optical_path(&args.extrinsics)?;
-    let scene = Scene::through(
-        design,
-        &camera,
-        &t_cam_sensor,
-        &pose_name,
-        optical_path.as_ref().map(|(l, _)| l),
-    )?;
-    if args.pin_captures {
-        // the pin dome of this design's skin, whatever its name
-        let pins = fabkit_calibration::groundtruth::pins::read_pins(&args.fixtures)?;
-        fabkit_calibration::groundtruth::pins::check_on_skin(
-            &args.fixtures,
-            &pins,
-            &scene.surface,
-        )?;
-    }
-    scene.check_outside(&fixtures.configurations, &pose_name)?;
-    let Scene { surface, rays } = scene;
-    // The optics (or the photometric model) are checked before the output is bounded or
-    // anything is written.
-    let photometric = match &args.photometric {
-        Some(dir) => Some((
-            load_photometric(
-                dir,
-                rays.width,
-                rays.height,
-                [
-                    (
-                        "design",
-                        loaded.sha256.as_str(),
-                        Path::new(
-                            args.design
-                                .as_deref()
-                                .unwrap_or(fabkit_designs::library::DEFAULT_DESIGN),
-                        ),
-                    ),
-                    ("camera", camera_sha.as_str(), &args.cam.camera),
-                    ("extrinsics", extrinsics_sha.as_str(), &args.extrinsics),
-                ],
-            )?,
-            dir,
-        )),
-        None => None,
-    };
-    let optics = if args.images && photometric.is_none() {
-        Some(fabkit_designs::optics::of_design(
+    Ok(())
+}
+
+/// The render's inputs besides the design, read and checked: the camera and pose files, the
+/// fixtures, and the camera's rays onto the reference skin.
+struct Inputs {
+    camera: fabkit_calibration::CameraModel,
+    camera_bytes: Vec<u8>,
+    camera_sha: String,
+    t_cam_sensor: fabkit_calibration::nalgebra::Isometry3<f64>,
+    extrinsics_sha: String,
+    fixtures: Fixtures,
+    pose_name: String,
+    optical_path: Option<(OpticalLayers, serde_json::Value)>,
+    surface: ReferenceSurface,
+    rays: PixelRays,
+}
+
+impl Inputs {
+    /// Reads the camera, pose and fixtures of `args` for `design` and sets the scene, in the
+    /// order their errors are reported; the fixtures must lie outside the camera.
+    fn read(
+        args: &GroundTruthArgs,
+        design: &fabkit_designs::schema::Design,
+    ) -> Result<Inputs, Box<dyn Error>> {
+        let camera = args.cam.read()?;
+        check_pixels(args, &camera)?;
+        let (camera_bytes, camera_sha) = read_with_hash(&args.cam.camera)?;
+        let (t_cam_sensor, extrinsics_sha) = read_extrinsics(&args.extrinsics)?;
+        let fixtures = if args.pin_captures {
+            read_pin_captures(&args.fixtures, &design.name)?
+        } else {
+            read_fixtures(&args.fixtures, &design.name)?
+        };
+        let pose_name = args.extrinsics.display().to_string();
+        // the rays bend where the pose was solved through an optical path (`calibrate
+        // extrinsics --design`): the depth maps register with the captures that calibration
+        // saw
+        let optical_path =
+            fabkit_calibration::groundtruth::inputs::read_optical_path(&args.extrinsics)?;
+        let scene = Scene::through(
             design,
-            fabkit_designs::ChordTolerance::new(fabkit_designs::ChordTolerance::DEFAULT_MM)?,
-        )?)
-    } else {
-        None
-    };
-    let image_bits = match &photometric {
-        Some(((m, _), _)) => Some(if m.full_scale > 255.0 { 16 } else { 8 }),
-        None => optics.as_ref().map(|o| o.camera.bit_depth),
-    };
-    let c = rays.origin_mm;
-    let (w, h) = (rays.width, rays.height);
-    let n_cfg = fixtures.configurations.len();
-    // The output is bounded before anything is rendered or written.
-    let (n_files, bound) = output_bound(
-        w as u64,
-        h as u64,
-        n_cfg as u64,
-        fixtures.patterns.len() as u64,
-        args.format.into(),
-        image_bits,
-    );
-    let format_name = |f: DataFormat| match f {
+            &camera,
+            &t_cam_sensor,
+            &pose_name,
+            optical_path.as_ref().map(|(l, _)| l),
+        )?;
+        if args.pin_captures {
+            // the pin dome of this design's skin, whatever its name
+            let pins = fabkit_calibration::groundtruth::pins::read_pins(&args.fixtures)?;
+            fabkit_calibration::groundtruth::pins::check_on_skin(
+                &args.fixtures,
+                &pins,
+                &scene.surface,
+            )?;
+        }
+        scene.check_outside(&fixtures.configurations, &pose_name)?;
+        let Scene { surface, rays } = scene;
+        Ok(Inputs {
+            camera,
+            camera_bytes,
+            camera_sha,
+            t_cam_sensor,
+            extrinsics_sha,
+            fixtures,
+            pose_name,
+            optical_path,
+            surface,
+            rays,
+        })
+    }
+}
+
+/// What the frames' images are rendered from, if any: the photometric model of
+/// --photometric (with its sha256 and folder), or the design's optics with --images alone.
+struct Looks<'a> {
+    photometric: Option<((PhotometricModel, String), &'a Path)>,
+    optics: Option<fabkit_designs::optics::ResolvedOptics>,
+}
+
+impl<'a> Looks<'a> {
+    /// Reads --photometric (checked against the design, camera and pose files it must have
+    /// been fitted with) or, with --images alone, the design's optics.
+    fn read(
+        args: &'a GroundTruthArgs,
+        loaded: &crate::args::Loaded,
+        inputs: &Inputs,
+    ) -> Result<Looks<'a>, Box<dyn Error>> {
+        let photometric = match &args.photometric {
+            Some(dir) => Some((
+                load_photometric(
+                    dir,
+                    inputs.rays.width,
+                    inputs.rays.height,
+                    [
+                        (
+                            "design",
+                            loaded.sha256.as_str(),
+                            Path::new(
+                                args.design
+                                    .as_deref()
+                                    .unwrap_or(fabkit_designs::library::DEFAULT_DESIGN),
+                            ),
+                        ),
+                        ("camera", inputs.camera_sha.as_str(), &args.cam.camera),
+                        (
+                            "extrinsics",
+                            inputs.extrinsics_sha.as_str(),
+                            &args.extrinsics,
+                        ),
+                    ],
+                )?,
+                dir.as_path(),
+            )),
+            None => None,
+        };
+        let optics = if args.images && photometric.is_none() {
+            Some(fabkit_designs::optics::of_design(
+                &loaded.design,
+                fabkit_designs::ChordTolerance::new(fabkit_designs::ChordTolerance::DEFAULT_MM)?,
+            )?)
+        } else {
+            None
+        };
+        Ok(Looks {
+            photometric,
+            optics,
+        })
+    }
+
+    /// The bit depth of the frames' images (None: no images).
+    fn image_bits(&self) -> Option<u32> {
+        match &self.photometric {
+            Some(((m, _), _)) => Some(if m.full_scale > 255.0 { 16 } else { 8 }),
+            None => self.optics.as_ref().map(|o| o.camera.bit_depth),
+        }
+    }
+
+    /// The source of the frames' images, the physical one shading from the reference skin
+    /// `ref_hits`.
+    fn image_source(self, inputs: &Inputs, ref_hits: &SurfaceHits) -> Option<ImageSource> {
+        match self.photometric {
+            Some(((m, sha), dir)) => Some(ImageSource::Photometric(
+                Box::new(m),
+                dir.display().to_string(),
+                sha,
+            )),
+            None => self.optics.map(|o| {
+                let i = inputs.camera.intrinsics();
+                ImageSource::Physical(Box::new(Imaging::new(
+                    o,
+                    [i.cx_px, i.cy_px],
+                    &inputs.rays,
+                    ref_hits,
+                )))
+            }),
+        }
+    }
+}
+
+/// The `--format` names.
+fn format_name(f: DataFormat) -> &'static str {
+    match f {
         DataFormat::Npy => "npy",
         DataFormat::Npz => "npz",
         DataFormat::Png => "png",
+    }
+}
+
+/// Prints the bound on the output and refuses it, before rendering, over --max-output-bytes
+/// (without --yes) or the free space of the output's file system.
+fn check_output_bound(
+    args: &GroundTruthArgs,
+    inputs: &Inputs,
+    image_bits: Option<u32>,
+) -> Result<(), Box<dyn Error>> {
+    let (w, h) = (inputs.rays.width, inputs.rays.height);
+    let n_cfg = inputs.fixtures.configurations.len();
+    let bound_of = |f: DataFormat| {
+        output_bound(
+            w as u64,
+            h as u64,
+            n_cfg as u64,
+            inputs.fixtures.patterns.len() as u64,
+            f.into(),
+            image_bits,
+        )
     };
+    let (n_files, bound) = bound_of(args.format);
     eprintln!(
         "groundtruth: reference + {n_cfg} configurations of {w} x {h} pixels -> {} files, at most {} (--format {})",
         n_files,
@@ -379,14 +557,7 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
         .into_iter()
         .filter(|f| *f != args.format)
         .map(|f| {
-            let (_, b) = output_bound(
-                w as u64,
-                h as u64,
-                n_cfg as u64,
-                fixtures.patterns.len() as u64,
-                f.into(),
-                image_bits,
-            );
+            let (_, b) = bound_of(f);
             format!("--format {} (at most {})", format_name(f), shown_bytes(b))
         })
         .collect::<Vec<_>>()
@@ -412,49 +583,31 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
             .into());
         }
     }
-    // A camera that sees (almost) none of the skin is refused before anything is written.
-    let ref_hits = reference_hits(&rays, &surface);
-    check_skin_seen(
-        ref_hits.valid_count(),
-        &camera,
-        &args.cam.camera.display().to_string(),
-        &String::from_utf8_lossy(&camera_bytes),
-        &pose_name,
-    )?;
-    let frames = n_cfg as u64 + 1;
-    let bar = crate::progress::Progress::new(
-        "groundtruth",
-        &format!("rendering {frames} frames of {}", design.name),
-        frames,
-    );
-    let provenance = dataset::provenance(&design.name, &loaded.sha256);
+    Ok(())
+}
 
-    let imaging = match photometric {
-        Some(((m, sha), dir)) => Some(ImageSource::Photometric(
-            Box::new(m),
-            dir.display().to_string(),
-            sha,
-        )),
-        None => optics.map(|o| {
-            let i = camera.intrinsics();
-            ImageSource::Physical(Box::new(Imaging::new(
-                o,
-                [i.cx_px, i.cy_px],
-                &rays,
-                &ref_hits,
-            )))
-        }),
-    };
-    let staged = StagedDir::new(&args.out, claim)?;
-    let all = dataset::write(
-        &staged,
+/// Renders every frame into `staged` and writes its manifest.json; `progress(k)` after each
+/// frame. Returns the files written.
+fn write_dataset(
+    staged: &StagedDir,
+    args: &GroundTruthArgs,
+    loaded: &crate::args::Loaded,
+    inputs: &Inputs,
+    ref_hits: &SurfaceHits,
+    imaging: Option<&ImageSource>,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<dataset::Written, Box<dyn Error>> {
+    let design = &loaded.design;
+    let provenance = dataset::provenance(&design.name, &loaded.sha256);
+    dataset::write(
+        staged,
         &FrameInputs {
-            rays: &rays,
-            reference_hits: &ref_hits,
-            base_z_mm: surface.base_z_mm(),
-            fixtures: &fixtures,
+            rays: &inputs.rays,
+            reference_hits: ref_hits,
+            base_z_mm: inputs.surface.base_z_mm(),
+            fixtures: &inputs.fixtures,
             format: args.format.into(),
-            imaging: imaging.as_ref(),
+            imaging,
             provenance: &provenance,
         },
         &ManifestInputs {
@@ -464,42 +617,19 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
             design_source: &loaded.source,
             design_sha256: &loaded.sha256,
             flat_skin: design.body.flat_outline().is_some(),
-            camera: &camera,
+            camera: &inputs.camera,
             camera_file: &args.cam.camera.display().to_string(),
-            camera_sha256: Some(&camera_sha),
+            camera_sha256: Some(&inputs.camera_sha),
             extrinsics_file: &args.extrinsics.display().to_string(),
-            extrinsics_sha256: Some(&extrinsics_sha),
-            t_cam_sensor: &t_cam_sensor,
-            camera_centre_mm: c,
-            fixtures: &fixtures,
+            extrinsics_sha256: Some(&inputs.extrinsics_sha),
+            t_cam_sensor: &inputs.t_cam_sensor,
+            camera_centre_mm: inputs.rays.origin_mm,
+            fixtures: &inputs.fixtures,
             pixels_on_surface: ref_hits.valid_count(),
-            optical_path: optical_path.as_ref().map(|(_, v)| v),
-            imaging: imaging.as_ref(),
+            optical_path: inputs.optical_path.as_ref().map(|(_, v)| v),
+            imaging,
         },
-        &|k| bar.set(k, frames),
+        progress,
     )
-    .map_err(|e| -> Box<dyn Error> { e })?;
-    bar.finish();
-    let n_pairs = fixtures.patterns.len() * fixtures.patterns.len();
-    for w in staged.commit()? {
-        eprintln!("warning: {w}");
-    }
-    let what = if args.pin_captures {
-        format!("{n_cfg} pin captures")
-    } else {
-        format!(
-            "{n_cfg} configurations ({} patterns x 2 orientations), {n_pairs} stitched pairs",
-            fixtures.patterns.len()
-        )
-    };
-    out!(
-        "{}: reference + {what}, {} of {} pixels on the surface -> {} ({} files, {:.2} s)",
-        design.name,
-        ref_hits.valid_count(),
-        w * h,
-        args.out.display(),
-        all.len() + 1,
-        t0.elapsed().as_secs_f64()
-    );
-    Ok(())
+    .map_err(|e| -> Box<dyn Error> { e })
 }

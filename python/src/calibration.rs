@@ -2,12 +2,14 @@
 //! `fabkit calibrate extrinsics`, from numpy arrays.
 
 use fabkit_calibration::nalgebra::{Vector2, Vector3};
+use fabkit_calibration::refraction::OpticalLayers;
 use fabkit_calibration::report::Provenance;
 use fabkit_calibration::tables::Pairs;
 use fabkit_calibration::{
     read_camera_file_as, CameraModel, Distortion, DistortionModelHint, ExtrinsicsReport,
-    Intrinsics, PnpOptions, RansacOptions,
+    Intrinsics, PnpOptions, PnpSolution, RansacOptions,
 };
+use fabkit_designs::optics::OpticalPath;
 use numpy::ndarray::{Array1, Array2};
 use numpy::{IntoPyArray, PyArray2, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
@@ -269,6 +271,46 @@ pub fn solve_extrinsics<'py>(
         }
     }
     let camera = Camera::of(camera)?;
+    let pairs = pairs_of(points_mm, pixels_px, ids)?;
+    if seed.is_some() {
+        pyo3::PyErr::warn(
+            py,
+            &py.get_type::<pyo3::exceptions::PyDeprecationWarning>(),
+            c"seed has no effect: RANSAC samples on a fixed schedule, so the pose depends on the data only",
+            1,
+        )?;
+    }
+    let ransac = ransac.then(|| RansacOptions {
+        threshold_px,
+        ..RansacOptions::default()
+    });
+    let opts = PnpOptions {
+        ransac,
+        ..PnpOptions::default()
+    };
+    let design = design.as_deref();
+    let (optical_path, layers) = optical_path_of(design)?;
+    let imaging = fabkit_calibration::refraction::Imaging::new(&camera.model, layers.as_ref());
+    let sol = crate::work(py, || {
+        fabkit_calibration::pnp::solve_pnp_through(
+            &imaging,
+            &pairs.points_mm,
+            &pairs.pixels_px,
+            &opts,
+        )
+    })?
+    .map_err(|e| err::<CalibrationError>(&e))?;
+    let (sol, report) = compare_and_report(py, &camera, layers, optical_path, design, &pairs, sol)?;
+    result_dict(py, &sol, &report, pairs.ids.len())
+}
+
+/// The pairs of `points_mm` (n, 3) and `pixels_px` (n, 2) by row, named by `ids` or their row
+/// numbers.
+fn pairs_of(
+    points_mm: &Bound<'_, PyAny>,
+    pixels_px: &Bound<'_, PyAny>,
+    ids: Option<Vec<String>>,
+) -> PyResult<Pairs> {
     let points = rows::<3>(points_mm, "points_mm")?;
     let pixels = rows::<2>(pixels_px, "pixels_px")?;
     let n = points.len();
@@ -288,29 +330,18 @@ pub fn solve_extrinsics<'py>(
         Some(ids) => ids,
         None => (0..n).map(|i| i.to_string()).collect(),
     };
-    let pairs = Pairs {
+    Ok(Pairs {
         ids,
         points_mm: points.iter().map(|p| Vector3::from(*p)).collect(),
         pixels_px: pixels.iter().map(|p| Vector2::from(*p)).collect(),
-    };
-    if seed.is_some() {
-        pyo3::PyErr::warn(
-            py,
-            &py.get_type::<pyo3::exceptions::PyDeprecationWarning>(),
-            c"seed has no effect: RANSAC samples on a fixed schedule, so the pose depends on the data only",
-            1,
-        )?;
-    }
-    let ransac = ransac.then(|| RansacOptions {
-        threshold_px,
-        ..RansacOptions::default()
-    });
-    let opts = PnpOptions {
-        ransac,
-        ..PnpOptions::default()
-    };
-    let model = &camera.model;
-    let optical_path = match &design {
+    })
+}
+
+/// The optical path of `design` (none without one) and its layers, that the rays bend at.
+fn optical_path_of(
+    design: Option<&crate::design::Design>,
+) -> PyResult<(Option<OpticalPath>, Option<OpticalLayers>)> {
+    let optical_path = match design {
         None => None,
         Some(d) => {
             let tol =
@@ -324,19 +355,25 @@ pub fn solve_extrinsics<'py>(
     };
     let layers = optical_path
         .as_ref()
-        .map(fabkit_calibration::refraction::OpticalLayers::from_optical_path)
+        .map(OpticalLayers::from_optical_path)
         .transpose()
         .map_err(|e| CalibrationError::new_err(format!("design: {e}")))?;
-    let imaging = fabkit_calibration::refraction::Imaging::new(model, layers.as_ref());
-    let sol = crate::work(py, || {
-        fabkit_calibration::pnp::solve_pnp_through(
-            &imaging,
-            &pairs.points_mm,
-            &pairs.pixels_px,
-            &opts,
-        )
-    })?
-    .map_err(|e| err::<CalibrationError>(&e))?;
+    Ok((optical_path, layers))
+}
+
+/// Compares the models that might explain the pins `sol` left out, as the CLI does (taking
+/// the gel surface's fit when it explains every pin), and reports the solution taken as
+/// `extrinsics.json` does.
+fn compare_and_report(
+    py: Python<'_>,
+    camera: &Camera,
+    layers: Option<OpticalLayers>,
+    optical_path: Option<OpticalPath>,
+    design: Option<&crate::design::Design>,
+    pairs: &Pairs,
+    sol: PnpSolution,
+) -> PyResult<(PnpSolution, serde_json::Value)> {
+    let model = &camera.model;
     let provenance = Provenance {
         fabkit_version: env!("CARGO_PKG_VERSION").into(),
         command_line: "fabkit.solve_extrinsics".into(),
@@ -371,8 +408,8 @@ pub fn solve_extrinsics<'py>(
         None => (sol, layers, None),
     };
     let imaging = fabkit_calibration::refraction::Imaging::new(model, layers.as_ref());
-    let mut report = ExtrinsicsReport::new(&imaging, &pairs, &sol, provenance);
-    if let (Some(path), Some(d)) = (optical_path, &design) {
+    let mut report = ExtrinsicsReport::new(&imaging, pairs, &sol, provenance);
+    if let (Some(path), Some(d)) = (optical_path, design) {
         report.optical_path = Some(path);
         report.optical_path_from = Some(format!("design {} ({})", d.design.name, d.source));
     }
@@ -383,6 +420,16 @@ pub fn solve_extrinsics<'py>(
     }
     let report: serde_json::Value = serde_json::from_str(&report.to_json())
         .map_err(|e| CalibrationError::new_err(e.to_string()))?;
+    Ok((sol, report))
+}
+
+/// The dict `solve_extrinsics` returns for the solution `sol` of `n` pairs and its `report`.
+fn result_dict<'py>(
+    py: Python<'py>,
+    sol: &PnpSolution,
+    report: &serde_json::Value,
+    n: usize,
+) -> PyResult<Bound<'py, PyDict>> {
     let h = sol.t_cam_sensor.to_homogeneous();
     let t = Array2::from_shape_fn((4, 4), |(r, c)| h[(r, c)]);
     let res: Vec<f64> = sol
@@ -407,7 +454,7 @@ pub fn solve_extrinsics<'py>(
         Array1::from_iter(sol.inliers.iter().map(|x| !x)).into_pyarray(py),
     )?;
     out.set_item("rms_reprojection_error_px", sol.rms_reprojection_error_px)?;
-    out.set_item("report", crate::to_py(py, &report)?)?;
+    out.set_item("report", crate::to_py(py, report)?)?;
     Ok(out)
 }
 

@@ -8,7 +8,7 @@ use fabkit_calibration::groundtruth::dataset::{
     self, DataFormat, FrameInputs, ImageSource, ManifestInputs, DEFAULT_MAX_OUTPUT_BYTES,
 };
 use fabkit_calibration::groundtruth::inputs::{
-    isometry_of, read_extrinsics, read_fixtures, read_with_hash, Configuration,
+    isometry_of, read_extrinsics, read_fixtures, read_with_hash, Configuration, Fixtures,
 };
 use fabkit_calibration::groundtruth::shading::Imaging;
 use fabkit_calibration::groundtruth::{
@@ -326,6 +326,192 @@ impl DepthRenderer {
             .as_ref()
             .map_err(Clone::clone)
     }
+
+    /// The fixtures of `fixtures` for this design (the pin dome's captures with
+    /// `pin_captures`, checked on this skin), each outside the camera.
+    fn read_fixture_set(
+        &self,
+        py: Python<'_>,
+        fixtures: &std::path::Path,
+        pin_captures: bool,
+    ) -> PyResult<Fixtures> {
+        let name = self.design.name.clone();
+        let fixture_set = crate::work(py, || {
+            if pin_captures {
+                fabkit_calibration::groundtruth::pins::read_pin_captures(fixtures, &name)
+            } else {
+                read_fixtures(fixtures, &name)
+            }
+        })?
+        .map_err(|e| err::<GroundTruthError>(&e))?;
+        if pin_captures {
+            use fabkit_calibration::groundtruth::pins::{check_on_skin, read_pins};
+            read_pins(fixtures)
+                .and_then(|pins| check_on_skin(fixtures, &pins, &self.scene.surface))
+                .map_err(|e| err::<GroundTruthError>(&e))?;
+        }
+        self.scene
+            .check_outside(&fixture_set.configurations, "T_cam_sensor")
+            .map_err(GroundTruthError::new_err)?;
+        Ok(fixture_set)
+    }
+
+    /// What `write` renders each frame's image.png from: `photometric` (checked against this
+    /// renderer), the design's optics with `images` alone, or nothing.
+    fn image_source(
+        &self,
+        py: Python<'_>,
+        photometric: Option<&PhotometricModel>,
+        images: bool,
+    ) -> PyResult<Option<ImageSource>> {
+        if let Some(m) = photometric {
+            self.check_camera_of(py, m)?;
+        }
+        Ok(match photometric {
+            Some(m) => Some(ImageSource::Photometric(
+                Box::new((*m.model).clone()),
+                m.source.clone(),
+                m.sha256.clone(),
+            )),
+            None if images => Some(ImageSource::Physical(Box::new(
+                crate::work(py, || self.physical_imaging().cloned())?
+                    .map_err(GroundTruthError::new_err)?,
+            ))),
+            None => None,
+        })
+    }
+
+    /// Renders every frame of `fixture_set` into `out` (claimed by `claim`) with its
+    /// manifest.json, as `fabkit groundtruth` does; `progress` after each frame. Returns the
+    /// files written, manifest.json last.
+    #[allow(clippy::too_many_arguments)]
+    fn write_dataset(
+        &self,
+        py: Python<'_>,
+        out: &std::path::Path,
+        claim: fabkit_export::OutputClaim,
+        fixture_set: &Fixtures,
+        format: DataFormat,
+        imaging: Option<&ImageSource>,
+        command_line: &[String],
+        progress: &Option<Py<PyAny>>,
+    ) -> PyResult<Vec<String>> {
+        let rays = &self.scene.rays;
+        let name = &self.design.name;
+        let frames = fixture_set.configurations.len() as u64 + 1;
+        let provenance = dataset::provenance(name, &self.sha256);
+        let written = crate::work(py, || -> Result<Vec<String>, String> {
+            let staged = fabkit_export::StagedDir::new(out, claim).map_err(|e| e.to_string())?;
+            let files = dataset::write(
+                &staged,
+                &FrameInputs {
+                    rays,
+                    reference_hits: &self.reference_hits,
+                    base_z_mm: self.scene.surface.base_z_mm(),
+                    fixtures: fixture_set,
+                    format,
+                    imaging,
+                    provenance: &provenance,
+                },
+                &ManifestInputs {
+                    fabkit_version: env!("CARGO_PKG_VERSION"),
+                    command_line,
+                    design_name: name,
+                    design_source: &self.source,
+                    design_sha256: &self.sha256,
+                    flat_skin: self.design.body.flat_outline().is_some(),
+                    camera: &self.camera,
+                    camera_file: &self.camera_file,
+                    camera_sha256: self.camera_sha256.as_deref(),
+                    extrinsics_file: &self.extrinsics_file,
+                    extrinsics_sha256: self.extrinsics_sha256.as_deref(),
+                    t_cam_sensor: &self.pose,
+                    camera_centre_mm: rays.origin_mm,
+                    fixtures: fixture_set,
+                    pixels_on_surface: self.reference_hits.valid_count(),
+                    optical_path: self.optical_path.as_ref(),
+                    imaging,
+                },
+                &|k| report_progress(progress, k as usize, frames as usize, "groundtruth"),
+            )
+            .map_err(|e| e.to_string())?;
+            staged.commit().map_err(|e| e.to_string())?;
+            let mut names: Vec<String> = files.into_iter().map(|(f, ..)| f).collect();
+            names.push("manifest.json".into());
+            Ok(names)
+        })?
+        .map_err(GroundTruthError::new_err)?;
+        Ok(written)
+    }
+}
+
+/// `write`'s `format`, checked with the options that go with it: `photometric` only with
+/// `images`, `max_output_bytes` within its range.
+fn checked_write_options(
+    format: &str,
+    images: bool,
+    photometric: Option<&PhotometricModel>,
+    max_output_bytes: u64,
+) -> PyResult<DataFormat> {
+    let format = match format {
+        "npy" => DataFormat::Npy,
+        "npz" => DataFormat::Npz,
+        "png" => DataFormat::Png,
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "format = '{other}': must be 'npy', 'npz' or 'png'"
+            )))
+        }
+    };
+    if photometric.is_some() && !images {
+        return Err(PyValueError::new_err(
+            "photometric: given without images=True (the model renders each frame's image.png)",
+        ));
+    }
+    if !(1..=dataset::MAX_OUTPUT_BYTES_LIMIT).contains(&max_output_bytes) {
+        return Err(PyValueError::new_err(format!(
+            "max_output_bytes = {max_output_bytes}: must be from 1 to {} (10^15)",
+            dataset::MAX_OUTPUT_BYTES_LIMIT
+        )));
+    }
+    Ok(format)
+}
+
+/// Refuses, before rendering, a dataset bounded over `max_output_bytes` (without `yes`) or
+/// over the free space of `out`'s file system.
+fn check_output_bound(
+    out: &std::path::Path,
+    rays: &fabkit_calibration::groundtruth::rays::PixelRays,
+    fixture_set: &Fixtures,
+    format: DataFormat,
+    imaging: Option<&ImageSource>,
+    max_output_bytes: u64,
+    yes: bool,
+) -> PyResult<()> {
+    let n_cfg = fixture_set.configurations.len();
+    let (n_files, bound) = dataset::output_bound(
+        rays.width as u64,
+        rays.height as u64,
+        n_cfg as u64,
+        fixture_set.patterns.len() as u64,
+        format,
+        imaging.map(ImageSource::bits),
+    );
+    if bound > max_output_bytes && !yes {
+        return Err(GroundTruthError::new_err(format!(
+            "{}: the ground truth would take up to {bound} bytes ({n_files} files), over max_output_bytes = {max_output_bytes}: refused before rendering (give yes=True to write it, or format='npz' or 'png')",
+            out.display()
+        )));
+    }
+    if let Some(free) = fabkit_export::free_bytes(out) {
+        if bound > free {
+            return Err(GroundTruthError::new_err(format!(
+                "{}: the ground truth may take up to {bound} bytes ({n_files} files), more than the {free} bytes free on its file system: refused before rendering",
+                out.display()
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// The optical path an extrinsics.json holds (its layers, and the planes as the manifest lists
@@ -640,27 +826,7 @@ impl DepthRenderer {
         command_line: Option<Vec<String>>,
         progress: Option<Py<PyAny>>,
     ) -> PyResult<Vec<String>> {
-        let format = match format {
-            "npy" => DataFormat::Npy,
-            "npz" => DataFormat::Npz,
-            "png" => DataFormat::Png,
-            other => {
-                return Err(PyValueError::new_err(format!(
-                    "format = '{other}': must be 'npy', 'npz' or 'png'"
-                )))
-            }
-        };
-        if photometric.is_some() && !images {
-            return Err(PyValueError::new_err(
-                "photometric: given without images=True (the model renders each frame's image.png)",
-            ));
-        }
-        if !(1..=dataset::MAX_OUTPUT_BYTES_LIMIT).contains(&max_output_bytes) {
-            return Err(PyValueError::new_err(format!(
-                "max_output_bytes = {max_output_bytes}: must be from 1 to {} (10^15)",
-                dataset::MAX_OUTPUT_BYTES_LIMIT
-            )));
-        }
+        let format = checked_write_options(format, images, photometric, max_output_bytes)?;
         let command_line = match command_line {
             Some(c) => c,
             None => py.import("sys")?.getattr("argv")?.extract()?,
@@ -677,107 +843,27 @@ impl DepthRenderer {
             force,
         );
         fabkit_export::check_out_dir(&out, &claim).map_err(|e| err::<GroundTruthError>(&e))?;
-        let name = self.design.name.clone();
-        let fixture_set = crate::work(py, || {
-            if pin_captures {
-                fabkit_calibration::groundtruth::pins::read_pin_captures(&fixtures, &name)
-            } else {
-                read_fixtures(&fixtures, &name)
-            }
-        })?
-        .map_err(|e| err::<GroundTruthError>(&e))?;
-        if pin_captures {
-            use fabkit_calibration::groundtruth::pins::{check_on_skin, read_pins};
-            read_pins(&fixtures)
-                .and_then(|pins| check_on_skin(&fixtures, &pins, &self.scene.surface))
-                .map_err(|e| err::<GroundTruthError>(&e))?;
-        }
-        self.scene
-            .check_outside(&fixture_set.configurations, "T_cam_sensor")
-            .map_err(GroundTruthError::new_err)?;
-        let rays = &self.scene.rays;
-        if let Some(m) = photometric {
-            self.check_camera_of(py, m)?;
-        }
-        let imaging = match photometric {
-            Some(m) => Some(ImageSource::Photometric(
-                Box::new((*m.model).clone()),
-                m.source.clone(),
-                m.sha256.clone(),
-            )),
-            None if images => Some(ImageSource::Physical(Box::new(
-                crate::work(py, || self.physical_imaging().cloned())?
-                    .map_err(GroundTruthError::new_err)?,
-            ))),
-            None => None,
-        };
-        let n_cfg = fixture_set.configurations.len();
-        let (n_files, bound) = dataset::output_bound(
-            rays.width as u64,
-            rays.height as u64,
-            n_cfg as u64,
-            fixture_set.patterns.len() as u64,
+        let fixture_set = self.read_fixture_set(py, &fixtures, pin_captures)?;
+        let imaging = self.image_source(py, photometric, images)?;
+        check_output_bound(
+            &out,
+            &self.scene.rays,
+            &fixture_set,
             format,
-            imaging.as_ref().map(ImageSource::bits),
-        );
-        if bound > max_output_bytes && !yes {
-            return Err(GroundTruthError::new_err(format!(
-                "{}: the ground truth would take up to {bound} bytes ({n_files} files), over max_output_bytes = {max_output_bytes}: refused before rendering (give yes=True to write it, or format='npz' or 'png')",
-                out.display()
-            )));
-        }
-        if let Some(free) = fabkit_export::free_bytes(&out) {
-            if bound > free {
-                return Err(GroundTruthError::new_err(format!(
-                    "{}: the ground truth may take up to {bound} bytes ({n_files} files), more than the {free} bytes free on its file system: refused before rendering",
-                    out.display()
-                )));
-            }
-        }
-        let frames = n_cfg as u64 + 1;
-        let provenance = dataset::provenance(&name, &self.sha256);
-        let written = crate::work(py, || -> Result<Vec<String>, String> {
-            let staged = fabkit_export::StagedDir::new(&out, claim).map_err(|e| e.to_string())?;
-            let files = dataset::write(
-                &staged,
-                &FrameInputs {
-                    rays,
-                    reference_hits: &self.reference_hits,
-                    base_z_mm: self.scene.surface.base_z_mm(),
-                    fixtures: &fixture_set,
-                    format,
-                    imaging: imaging.as_ref(),
-                    provenance: &provenance,
-                },
-                &ManifestInputs {
-                    fabkit_version: env!("CARGO_PKG_VERSION"),
-                    command_line: &command_line,
-                    design_name: &name,
-                    design_source: &self.source,
-                    design_sha256: &self.sha256,
-                    flat_skin: self.design.body.flat_outline().is_some(),
-                    camera: &self.camera,
-                    camera_file: &self.camera_file,
-                    camera_sha256: self.camera_sha256.as_deref(),
-                    extrinsics_file: &self.extrinsics_file,
-                    extrinsics_sha256: self.extrinsics_sha256.as_deref(),
-                    t_cam_sensor: &self.pose,
-                    camera_centre_mm: rays.origin_mm,
-                    fixtures: &fixture_set,
-                    pixels_on_surface: self.reference_hits.valid_count(),
-                    optical_path: self.optical_path.as_ref(),
-                    imaging: imaging.as_ref(),
-                },
-                &|k| report_progress(&progress, k as usize, frames as usize, "groundtruth"),
-            )
-            .map_err(|e| e.to_string())?;
-            staged.commit().map_err(|e| e.to_string())?;
-            let mut names: Vec<String> = files.into_iter().map(|(f, ..)| f).collect();
-            names.push("manifest.json".into());
-            Ok(names)
-        })?
-        .map_err(GroundTruthError::new_err)?;
-        Ok(written)
+            imaging.as_ref(),
+            max_output_bytes,
+            yes,
+        )?;
+        self.write_dataset(
+            py,
+            &out,
+            claim,
+            &fixture_set,
+            format,
+            imaging.as_ref(),
+            &command_line,
+            &progress,
+        )
     }
 
     /// The half masks (left, right), (H, W) bool: pixels whose ray meets the reference

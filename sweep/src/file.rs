@@ -231,20 +231,8 @@ impl SweepSpec {
                 at: String::new(),
                 message: yaml_error(origin, &e),
             })?;
-        let file_err = |s: String, message: String| SweepError::File { at: s, message };
-        let mut base =
-            load_source_with(&raw.base.value, dir, rules).map_err(|e| SweepError::Design {
-                at: at(origin, &raw.base),
-                error: e,
-            })?;
+        let base = read_base(&raw, origin, dir, rules)?;
         let preset = raw.preset.as_ref().map(|p| p.value.clone());
-        if let Some(p) = &raw.preset {
-            base.apply_preset(&p.value)
-                .map_err(|e| SweepError::Design {
-                    at: at(origin, p),
-                    error: e,
-                })?;
-        }
         let chord_tolerance = match &raw.chord_tolerance_mm {
             None => ChordTolerance::default(),
             Some(t) => ChordTolerance::new(t.value).map_err(|e| file_err(at(origin, t), e))?,
@@ -269,105 +257,24 @@ impl SweepSpec {
         })?;
         // First the paths and the number of values: a sweep of too many variants is refused
         // before any value is looked at.
-        let mut parameters: Vec<Parameter> = Vec::new();
-        let mut values_at: Vec<String> = Vec::new();
-        for (key, spec) in &raw.vary.value.0 {
-            let here = at(origin, key);
-            // A short path (`markers.spacing_mm`) stands for the one full path it fits.
-            let path = checked_path(&base.design, &key.value, &here)?;
-            if let Some(other) = parameters.iter().find(|p: &&Parameter| p.path == path) {
-                return Err(file_err(
-                    here,
-                    format!(
-                        "vary: '{}' names {path}, which is varied already (at {}): give each parameter once",
-                        key.value.trim(),
-                        other.at
-                    ),
-                ));
-            }
-            let values = values_of(&spec.value)
-                .map_err(|m| file_err(at(origin, spec), format!("vary.{path}: {m}")))?;
-            parameters.push(Parameter {
-                path,
-                values,
-                at: here,
-            });
-            values_at.push(at(origin, spec));
-        }
+        let (parameters, values_at) = listed_parameters(&raw, &base.design, origin)?;
         super::plan::variant_count(
             &parameters,
             mode,
             raw.count.as_ref().map(|c| c.value),
             origin,
         )?;
-        for (p, spec_at) in parameters.iter().zip(&values_at) {
-            // in a zip a value may repeat in one list: only a repeated row is one variant twice
-            let refuse_repeats = mode != Mode::Zip;
-            check_values(
-                p,
-                spec_at,
-                &base.design,
-                &base_json,
-                refuse_repeats,
-                |variant| {
-                    // A parameter the rest of the design ignores would give identical variants.
-                    if let Err(errs) =
-                        fabkit_designs::stack::validate(variant, &materials, chord_tolerance)
-                    {
-                        if let Some(e) = errs.0.iter().find(|e| {
-                            e.path == p.path
-                                && e.rule.starts_with(fabkit_designs::markers::NO_EFFECT)
-                        }) {
-                            return Err(file_err(
-                                p.at.clone(),
-                                format!(
-                                    "vary.{}: {} (every variant would be the same design)",
-                                    p.path, e.rule
-                                ),
-                            ));
-                        }
-                    }
-                    Ok(())
-                },
-            )?;
-        }
+        check_every_value(
+            &parameters,
+            &values_at,
+            mode,
+            &base.design,
+            &base_json,
+            &materials,
+            chord_tolerance,
+        )?;
         if mode == Mode::Zip {
-            let n = parameters[0].values.len();
-            if let Some(p) = parameters.iter().find(|p| p.values.len() != n) {
-                return Err(file_err(
-                    p.at.clone(),
-                    format!(
-                        "mode zip takes the lists in step, but vary.{} has {} values and vary.{} has {n}",
-                        p.path,
-                        p.values.len(),
-                        parameters[0].path
-                    ),
-                ));
-            }
-            // a row repeated is the same variant twice
-            let mut rows: std::collections::HashMap<String, usize> =
-                std::collections::HashMap::with_capacity(n);
-            for i in 0..n {
-                let key = parameters
-                    .iter()
-                    .map(|p| equality_key(&p.values[i]))
-                    .collect::<Vec<_>>()
-                    .join("\u{1f}");
-                if let Some(&j) = rows.get(&key) {
-                    return Err(file_err(
-                        parameters[0].at.clone(),
-                        format!(
-                            "mode zip: rows {j} and {i} of the lists are the same variant ({}); give each row once",
-                            parameters
-                                .iter()
-                                .map(|p| format!("{} = {}", p.path, p.values[i]))
-                                .collect::<Vec<_>>()
-                                .join(", ")
-                        ),
-                    ));
-                }
-                rows.insert(key, i);
-            }
+            check_zip_rows(&parameters)?;
         }
         let sha256 = Sha256::digest(text.as_bytes())
             .iter()
@@ -388,6 +295,146 @@ impl SweepSpec {
         spec.refuse_ignored_parameters(&materials)?;
         Ok(spec)
     }
+}
+
+/// A [`SweepError::File`] at `at`.
+fn file_err(at: String, message: String) -> SweepError {
+    SweepError::File { at, message }
+}
+
+/// Reads the sweep's base design (relative to `dir`) and applies its preset, if any.
+fn read_base(
+    raw: &RawSweep,
+    origin: &str,
+    dir: &Path,
+    rules: &DataFileRules,
+) -> Result<LoadedDesign, SweepError> {
+    let mut base =
+        load_source_with(&raw.base.value, dir, rules).map_err(|e| SweepError::Design {
+            at: at(origin, &raw.base),
+            error: e,
+        })?;
+    if let Some(p) = &raw.preset {
+        base.apply_preset(&p.value)
+            .map_err(|e| SweepError::Design {
+                at: at(origin, p),
+                error: e,
+            })?;
+    }
+    Ok(base)
+}
+
+/// The varied parameters in file order, each path checked against `design` and given once,
+/// with their values; and where each one's values are listed.
+fn listed_parameters(
+    raw: &RawSweep,
+    design: &fabkit_designs::schema::Design,
+    origin: &str,
+) -> Result<(Vec<Parameter>, Vec<String>), SweepError> {
+    let mut parameters: Vec<Parameter> = Vec::new();
+    let mut values_at: Vec<String> = Vec::new();
+    for (key, spec) in &raw.vary.value.0 {
+        let here = at(origin, key);
+        // A short path (`markers.spacing_mm`) stands for the one full path it fits.
+        let path = checked_path(design, &key.value, &here)?;
+        if let Some(other) = parameters.iter().find(|p: &&Parameter| p.path == path) {
+            return Err(file_err(
+                here,
+                format!(
+                    "vary: '{}' names {path}, which is varied already (at {}): give each parameter once",
+                    key.value.trim(),
+                    other.at
+                ),
+            ));
+        }
+        let values = values_of(&spec.value)
+            .map_err(|m| file_err(at(origin, spec), format!("vary.{path}: {m}")))?;
+        parameters.push(Parameter {
+            path,
+            values,
+            at: here,
+        });
+        values_at.push(at(origin, spec));
+    }
+    Ok((parameters, values_at))
+}
+
+/// Checks every value of every parameter against the schema in the base design
+/// ([`check_values`]), and that the design does not ignore the parameter.
+fn check_every_value(
+    parameters: &[Parameter],
+    values_at: &[String],
+    mode: Mode,
+    design: &fabkit_designs::schema::Design,
+    base_json: &Value,
+    materials: &fabkit_designs::materials::MaterialsTable,
+    chord_tolerance: ChordTolerance,
+) -> Result<(), SweepError> {
+    for (p, spec_at) in parameters.iter().zip(values_at) {
+        // in a zip a value may repeat in one list: only a repeated row is one variant twice
+        let refuse_repeats = mode != Mode::Zip;
+        check_values(p, spec_at, design, base_json, refuse_repeats, |variant| {
+            // A parameter the rest of the design ignores would give identical variants.
+            if let Err(errs) = fabkit_designs::stack::validate(variant, materials, chord_tolerance)
+            {
+                if let Some(e) = errs.0.iter().find(|e| {
+                    e.path == p.path && e.rule.starts_with(fabkit_designs::markers::NO_EFFECT)
+                }) {
+                    return Err(file_err(
+                        p.at.clone(),
+                        format!(
+                            "vary.{}: {} (every variant would be the same design)",
+                            p.path, e.rule
+                        ),
+                    ));
+                }
+            }
+            Ok(())
+        })?;
+    }
+    Ok(())
+}
+
+/// Checks the lists of a zip sweep: of one length, and no row repeated (the same variant
+/// twice).
+fn check_zip_rows(parameters: &[Parameter]) -> Result<(), SweepError> {
+    let n = parameters[0].values.len();
+    if let Some(p) = parameters.iter().find(|p| p.values.len() != n) {
+        return Err(file_err(
+            p.at.clone(),
+            format!(
+                "mode zip takes the lists in step, but vary.{} has {} values and vary.{} has {n}",
+                p.path,
+                p.values.len(),
+                parameters[0].path
+            ),
+        ));
+    }
+    // a row repeated is the same variant twice
+    let mut rows: std::collections::HashMap<String, usize> =
+        std::collections::HashMap::with_capacity(n);
+    for i in 0..n {
+        let key = parameters
+            .iter()
+            .map(|p| equality_key(&p.values[i]))
+            .collect::<Vec<_>>()
+            .join("\u{1f}");
+        if let Some(&j) = rows.get(&key) {
+            return Err(file_err(
+                parameters[0].at.clone(),
+                format!(
+                    "mode zip: rows {j} and {i} of the lists are the same variant ({}); give each row once",
+                    parameters
+                        .iter()
+                        .map(|p| format!("{} = {}", p.path, p.values[i]))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            ));
+        }
+        rows.insert(key, i);
+    }
+    Ok(())
 }
 
 /// Checks the values of `p` (listed at `spec_at`) in order, as one loop would: the first value
