@@ -16,7 +16,7 @@
 //! The criterion bench `tests/benches/markers.rs` builds the same designs (same rule).
 use fabkit_designs::markers::{Layout, Surface};
 use fabkit_designs::materials::MaterialsTable;
-use fabkit_designs::{geometry, layers, library, stack, ChordTolerance, Design};
+use fabkit_designs::{geometry, library, stack, ChordTolerance, Design};
 use serde_json::json;
 use std::time::Instant;
 

@@ -268,13 +268,13 @@ fn control_characters_in_text_are_refused_by_path() {
 /// (no cavity block left).
 #[test]
 fn kernel_errors_name_the_parameters_of_the_failing_solid() {
-    use fabkit_designs::{layers, molds, DesignError};
+    use fabkit_designs::{molds, DesignError};
     let tol = ChordTolerance::default();
     let materials = MaterialsTable::embedded().unwrap();
     let mut d = library::load("tactip_dualmodal").unwrap();
     let st = stack::validate(&d, &materials, tol).unwrap();
     d.layers[0].markers[0].feature.diameter_mm = 0.0;
-    match fabkit_designs::molds::build_layer(&d, &st, 0, tol) {
+    match molds::build_layer(&d, &st, 0, tol) {
         Err(e @ DesignError::Geometry { .. }) => {
             let DesignError::Geometry { params, .. } = &e else {
                 unreachable!()
