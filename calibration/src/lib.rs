@@ -54,7 +54,6 @@ pub fn shown_f64(x: f64) -> String {
     fabkit_designs::error::compact_numbers(&x.to_string())
 }
 
-/// A regular file of at most [`MAX_TEXT_INPUT_BYTES`] as UTF-8 text.
 /// The median of `v` (sorted in place): the middle value, or the mean of the middle two; NaN
 /// when `v` is empty.
 pub(crate) fn median_sorting(v: &mut [f64]) -> f64 {
@@ -70,6 +69,7 @@ pub(crate) fn median_sorting(v: &mut [f64]) -> f64 {
     }
 }
 
+/// A regular file of at most [`MAX_TEXT_INPUT_BYTES`] as UTF-8 text.
 pub(crate) fn read_text(path: &std::path::Path) -> std::io::Result<String> {
     fabkit_designs::input_files::read_text_file(path, MAX_TEXT_INPUT_BYTES)
 }

@@ -10,7 +10,7 @@ use crate::materials::{pour, MaterialsTable};
 use crate::parts::family::FillingPour;
 use crate::parts::molds::{build_mold, cast_plans, CastPlan};
 use crate::parts::registry::{SectionInput, FAMILIES};
-use crate::schema::{Design, LayerProcess, MoldStrategy};
+use crate::schema::{Design, LayerProcess};
 use crate::stack::{validate, Stack};
 use crate::timings;
 use rayon::prelude::*;
@@ -89,17 +89,13 @@ fn layer_builds(stack: &Stack, plans: &[CastPlan]) -> (Vec<usize>, Vec<CastPlan>
         .iter()
         .filter(|l| {
             l.process == LayerProcess::Printed
-                || (l.process == LayerProcess::Cast
-                    && matches!(
-                        l.mold_strategy,
-                        MoldStrategy::Open | MoldStrategy::TwoPieceOpen | MoldStrategy::Boundary
-                    ))
+                || (l.process == LayerProcess::Cast && !l.mold_strategy.holds_core())
         })
         .map(|l| l.index)
         .collect();
     let held: Vec<_> = plans
         .iter()
-        .filter(|p| matches!(p.strategy, MoldStrategy::Direct | MoldStrategy::Master))
+        .filter(|p| p.strategy.holds_core())
         .cloned()
         .collect();
     (other, held)

@@ -331,7 +331,7 @@ pub fn cast_layer(
         }
     };
     let formed_by = pieces.iter().map(|p| p.name.clone()).collect();
-    if !matches!(l.mold_strategy, MoldStrategy::Direct | MoldStrategy::Master) {
+    if !l.mold_strategy.holds_core() {
         return Ok((cast, formed_by));
     }
     // Cast onto the stack: the core and the layers in the mold before the pour (those under

@@ -429,7 +429,7 @@ fn check_mold_strategies(design: &Design, errs: &mut Vec<ParamError>) {
         } else {
             "mold.strategy".to_string()
         };
-        let needs_core = matches!(strategy, MoldStrategy::Direct | MoldStrategy::Master);
+        let needs_core = strategy.holds_core();
         if needs_core && (design.core.is_none() || l.solid) {
             errs.push(ParamError::new(
                 path.clone(),
@@ -687,10 +687,10 @@ fn check_with_stack(
         crate::schema::optics::check(o, errs);
     }
     if let (Some(c), true) = (sound_core, errs.is_empty()) {
-        if let Some(first) = layers.iter().find(|l| {
-            l.process == LayerProcess::Cast
-                && matches!(l.mold_strategy, MoldStrategy::Direct | MoldStrategy::Master)
-        }) {
+        if let Some(first) = layers
+            .iter()
+            .find(|l| l.process == LayerProcess::Cast && l.mold_strategy.holds_core())
+        {
             crate::parts::molds::check_mold_fit(design, c, first.outer_offset_mm, errs);
         }
     }
@@ -736,10 +736,7 @@ fn resolve_core(
     let below_base = c.length_mm - (pole_z - design.body.base_z_mm());
     let held = design.layers.iter().any(|l| {
         l.process == LayerProcess::Cast
-            && matches!(
-                l.mold_strategy.unwrap_or(design.mold.strategy),
-                MoldStrategy::Direct | MoldStrategy::Master
-            )
+            && l.mold_strategy.unwrap_or(design.mold.strategy).holds_core()
     });
     if !(c.length_mm > 0.0) || below_base < 0.0 {
         errs.push(ParamError::new(

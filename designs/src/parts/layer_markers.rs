@@ -6,7 +6,7 @@
 use crate::geometry::ChordTolerance;
 use crate::markers::{self, Marker, MarkerSpec, MarkerSurface, PatternStats, Polarity, Surface};
 use crate::parts::context::{ResolvedLayer, Stack};
-use crate::schema::{Design, LayerProcess, MoldStrategy, Technology};
+use crate::schema::{Design, LayerProcess, Technology};
 use crate::values::MAX_LENGTH_MM;
 
 /// Markers placed on one surface of a layer.
@@ -172,8 +172,7 @@ pub(crate) fn formed_on_stack(stack: &Stack, i: usize) -> bool {
 /// [`formed_on_stack`] for a layer that has one under it.
 pub(crate) fn formed_on_stack_layer(l: &ResolvedLayer) -> bool {
     l.process == LayerProcess::Sprayed
-        || (l.process == LayerProcess::Cast
-            && matches!(l.mold_strategy, MoldStrategy::Direct | MoldStrategy::Master))
+        || (l.process == LayerProcess::Cast && l.mold_strategy.holds_core())
 }
 
 /// The features on the outer surface of layer `i` as the stack forms them: its own, and for
@@ -235,10 +234,7 @@ pub fn taken_features(
 /// it (or onto those coats) in a `direct` or `master` mold (`formed_on_stack`).
 pub fn outer_feature_copies(stack: &Stack, i: usize) -> usize {
     let l = &stack.layers[i];
-    let mut copies = usize::from(
-        l.process == LayerProcess::Cast
-            && matches!(l.mold_strategy, MoldStrategy::Direct | MoldStrategy::Master),
-    );
+    let mut copies = usize::from(l.process == LayerProcess::Cast && l.mold_strategy.holds_core());
     for above in &stack.layers[i + 1..] {
         if above.process == LayerProcess::Sprayed {
             copies += 2;

@@ -31,9 +31,7 @@ pub fn check_markers(design: &Design, layers: &[ResolvedLayer], errs: &mut Vec<P
 /// the mold's clearance; 0 for a layer not cast in a `direct` or `master` mold (the other
 /// strategies form the layer's outer surface itself).
 pub fn cavity_gap_mm(design: &Design, layers: &[ResolvedLayer], l: &ResolvedLayer) -> f64 {
-    if l.process != LayerProcess::Cast
-        || !matches!(l.mold_strategy, MoldStrategy::Direct | MoldStrategy::Master)
-    {
+    if l.process != LayerProcess::Cast || !l.mold_strategy.holds_core() {
         return 0.0;
     }
     let outer = layers[l.index + 1..]

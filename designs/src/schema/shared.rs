@@ -133,6 +133,16 @@ pub enum MoldStrategy {
     Boundary,
 }
 
+impl MoldStrategy {
+    /// Whether the mold holds a bought core that the layer is cast onto (`direct`, `master`:
+    /// the core holder or casting jig closes the mold and carries the sprue and vents), so
+    /// the layer's inner surface is the core's and the build plans its pour
+    /// ([`crate::parts::molds::cast_plans`]).
+    pub fn holds_core(self) -> bool {
+        matches!(self, MoldStrategy::Direct | MoldStrategy::Master)
+    }
+}
+
 /// The internal filling gel (R-Tac0 Sec. III-B1): poured into the assembled shell with the
 /// sensor pole-down, before the camera goes on; it diffuses the LEDs' light and, cured, glues
 /// the core to the shell. Its flat free surface is the interface through which the camera
