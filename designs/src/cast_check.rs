@@ -30,7 +30,9 @@ use crate::geometry::{cuboid, ChordTolerance, Solid};
 use crate::kit::Kit;
 use crate::markers::MarkerSurface;
 use crate::parts::layers;
-use crate::schema::{Design, LayerProcess, MoldStrategy};
+use crate::parts::molds::strategy::CastPieces;
+use crate::parts::molds::strategy_of;
+use crate::schema::{Design, LayerProcess};
 use crate::stack::Stack;
 
 /// One cast layer, as the molds cast it and as the assembly shows it.
@@ -244,17 +246,6 @@ pub fn cast_layer(
     let l = &stack.layers[i];
     let name = &l.name;
     let g = |r: Result<Solid, crate::geometry::GeometryError>| r.part(name);
-    let part = |suffix: &str| {
-        kit.parts
-            .iter()
-            .find(|p| p.name == format!("{name}_{suffix}"))
-    };
-    let need = |suffix: &str| part(suffix).ok_or_else(|| missing(format!("{name}_{suffix}")));
-    let in_sensor = |p: &crate::Part| -> Result<Solid, DesignError> {
-        let t = crate::geometry::transform::from_json(&p.params["T_print_sensor"])
-            .ok_or_else(|| missing(format!("the print pose of {}", p.name)))?;
-        Ok(p.solid.transform(&t.inverse()))
-    };
     // The envelope: the cavity's offset surface, beyond the tallest feature, closed on the
     // base plane.
     let cavity_offset = l.outer_offset_mm + layers::cavity_gap_mm(design, &stack.layers, l);
@@ -269,67 +260,13 @@ pub fn cast_layer(
         tol,
     )
     .and_then(|m| Solid::from_mesh(&m)))?;
-    // the space the closed pieces leave, within the envelope
-    let negative = |pieces: &[&crate::Part]| -> Result<Solid, DesignError> {
-        let solids = pieces
-            .iter()
-            .map(|p| in_sensor(p))
-            .collect::<Result<Vec<_>, _>>()?;
-        let b = envelope
-            .bounding_box()
-            .ok_or_else(|| missing(format!("the envelope of {name}")))?;
-        let bx = g(cuboid(
-            [b.min[0] - 1.0, b.min[1] - 1.0, b.min[2]],
-            [b.max[0] + 1.0, b.max[1] + 1.0, b.max[2] + 1.0],
-        ))?;
-        g(bx.difference(&g(Solid::union_all(&solids))?)
-            .and_then(|s| s.intersection(&envelope)))
+    let kit_pieces = KitPieces {
+        name,
+        kit,
+        envelope,
+        tol,
     };
-    let (cast, pieces): (Solid, Vec<&crate::Part>) = match l.mold_strategy {
-        MoldStrategy::Master => {
-            let master = need("master_pattern")?;
-            (g(in_sensor(master)?.intersection(&envelope))?, vec![master])
-        }
-        MoldStrategy::Boundary => {
-            let (outer, inner) = (need("outer_master")?, need("inner_negative")?);
-            let cup = &inner.params["boundary"]["cup"];
-            let num = |k: &str| {
-                cup[k]
-                    .as_f64()
-                    .ok_or_else(|| missing(format!("the cup of {}", inner.name)))
-            };
-            let (r, z0, z1) = (num("radius_mm")?, num("bottom_z_mm")?, num("top_z_mm")?);
-            let cup =
-                g(crate::geometry::cylinder(z1 - z0, r, tol).map(|c| c.translate([0.0, 0.0, z0])))?;
-            // the inner silicone core: what Mold Star fills in the negative's cup
-            let core = g(cup.difference(&in_sensor(inner)?))?;
-            (
-                g(in_sensor(outer)?
-                    .intersection(&envelope)
-                    .and_then(|s| s.difference(&core)))?,
-                vec![outer, inner],
-            )
-        }
-        MoldStrategy::Direct => {
-            let p = vec![
-                need("mold_half_a")?,
-                need("mold_half_b")?,
-                need("core_holder")?,
-            ];
-            (negative(&p)?, p)
-        }
-        MoldStrategy::Open => {
-            let mut p = vec![need("open_mold")?];
-            for role in crate::parts::layer_registry::insert_roles() {
-                p.extend(part(role));
-            }
-            (negative(&p)?, p)
-        }
-        MoldStrategy::TwoPieceOpen => {
-            let p = vec![need("cavity_block")?, need("reservoir_top")?];
-            (negative(&p)?, p)
-        }
-    };
+    let (cast, pieces) = strategy_of(l.mold_strategy).cast(&kit_pieces)?;
     let formed_by = pieces.iter().map(|p| p.name.clone()).collect();
     if !l.mold_strategy.holds_core() {
         return Ok((cast, formed_by));
@@ -362,6 +299,76 @@ pub fn cast_layer(
         g(cast.difference(&g(Solid::union_all(&in_mold))?))?,
         formed_by,
     ))
+}
+
+/// The kit's parts of one cast layer as a strategy's cast check sees them
+/// ([`CastPieces`]).
+struct KitPieces<'k> {
+    name: &'k str,
+    kit: &'k Kit,
+    envelope: Solid,
+    tol: ChordTolerance,
+}
+
+impl<'k> CastPieces<'k> for KitPieces<'k> {
+    fn part(&self, suffix: &str) -> Option<&'k crate::Part> {
+        let name = self.name;
+        self.kit
+            .parts
+            .iter()
+            .find(|p| p.name == format!("{name}_{suffix}"))
+    }
+
+    fn need(&self, suffix: &str) -> Result<&'k crate::Part, DesignError> {
+        let name = self.name;
+        self.part(suffix)
+            .ok_or_else(|| missing(format!("{name}_{suffix}")))
+    }
+
+    fn in_sensor(&self, p: &crate::Part) -> Result<Solid, DesignError> {
+        let t = crate::geometry::transform::from_json(&p.params["T_print_sensor"])
+            .ok_or_else(|| missing(format!("the print pose of {}", p.name)))?;
+        Ok(p.solid.transform(&t.inverse()))
+    }
+
+    /// The space the closed pieces leave, within the envelope.
+    fn negative(&self, pieces: &[&crate::Part]) -> Result<Solid, DesignError> {
+        let solids = pieces
+            .iter()
+            .map(|p| self.in_sensor(p))
+            .collect::<Result<Vec<_>, _>>()?;
+        let b = self
+            .envelope
+            .bounding_box()
+            .ok_or_else(|| missing(format!("the envelope of {}", self.name)))?;
+        let bx = self.named(cuboid(
+            [b.min[0] - 1.0, b.min[1] - 1.0, b.min[2]],
+            [b.max[0] + 1.0, b.max[1] + 1.0, b.max[2] + 1.0],
+        ))?;
+        self.named(
+            bx.difference(&self.named(Solid::union_all(&solids))?)
+                .and_then(|s| s.intersection(&self.envelope)),
+        )
+    }
+
+    fn envelope(&self) -> &Solid {
+        &self.envelope
+    }
+
+    fn missing(&self, what: String) -> DesignError {
+        missing(what)
+    }
+
+    fn tol(&self) -> ChordTolerance {
+        self.tol
+    }
+
+    fn named(
+        &self,
+        r: Result<Solid, crate::geometry::GeometryError>,
+    ) -> Result<Solid, DesignError> {
+        r.part(self.name)
+    }
 }
 
 /// A small cube inside each feature of a layer, halfway along its axis, split by where the

@@ -85,16 +85,12 @@ pub fn estimate(design: &Design, stack: &Stack, tol: ChordTolerance) -> WorkEsti
         }
     }
     for l in &stack.layers {
-        if l.process == crate::schema::LayerProcess::Cast
-            && l.mold_strategy == crate::schema::MoldStrategy::Boundary
-        {
-            // the drafted Mold Star box round the outer master: about 14 circles of the
-            // layer's rim
-            surfaces += 14.0
-                * tol
-                    .half()
-                    .circle_segments(design.body.rim_radius_mm(l.outer_offset_mm))
-                    as f64;
+        if l.process == crate::schema::LayerProcess::Cast {
+            surfaces += crate::parts::molds::strategy_of(l.mold_strategy).estimated_triangles(
+                &design.body,
+                l,
+                tol,
+            );
         }
     }
     if let Some(c) = &stack.core {

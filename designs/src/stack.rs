@@ -459,14 +459,13 @@ fn check_mold_strategies(design: &Design, errs: &mut Vec<ParamError>) {
                 ),
             ));
         }
-        if matches!(strategy, MoldStrategy::Open | MoldStrategy::TwoPieceOpen) && !l.solid {
+        if crate::parts::molds::strategy_of(strategy).solid_only() && !l.solid {
             errs.push(ParamError::new(
                 path,
-                if strategy == MoldStrategy::Open {
-                    "open"
-                } else {
-                    "two_piece_open"
-                },
+                serde_json::to_value(strategy)
+                    .ok()
+                    .and_then(|v| v.as_str().map(str::to_owned))
+                    .unwrap_or_default(),
                 format!(
                     "an open mold casts a solid skin; layer '{}' is not solid (use boundary)",
                     l.name

@@ -557,7 +557,7 @@ pub(crate) fn with_layer_build<'d, T>(
 /// name, its placed markers (all, on the outer surface, on the inner surface), its marker
 /// summary, the twin parameters its parts carry, and the print technologies of the mold's
 /// fixtures and cavities.
-pub(crate) struct LayerBuild<'a> {
+pub struct LayerBuild<'a> {
     pub(crate) design: &'a Design,
     pub(crate) stack: &'a Stack,
     pub(crate) i: usize,

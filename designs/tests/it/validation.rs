@@ -1122,3 +1122,30 @@ fn lens_above_the_gel_surface_is_named() {
         }],
     );
 }
+
+/// Every mold strategy the schema publishes (`MoldStrategy`'s values) has exactly one line in
+/// `molds::STRATEGIES`, which the build and the cast check look a layer's strategy up in: a
+/// strategy added to the schema but not listed would panic there.
+#[test]
+fn every_strategy_is_listed() {
+    use fabkit_designs::molds::{strategy_of, STRATEGIES};
+    let schema = fabkit_designs::schema::design_json_schema();
+    let names: Vec<String> = schema["$defs"]["MoldStrategy"]["oneOf"]
+        .as_array()
+        .expect("MoldStrategy is a oneOf of constants")
+        .iter()
+        .map(|v| v["const"].as_str().expect("a constant").to_owned())
+        .collect();
+    assert_eq!(names.len(), 5, "{names:?}");
+    assert_eq!(STRATEGIES.len(), names.len());
+    for n in &names {
+        let kind: fabkit_designs::schema::MoldStrategy =
+            serde_json::from_value(serde_json::json!(n)).unwrap();
+        assert_eq!(strategy_of(kind).kind(), kind, "{n}");
+        assert_eq!(
+            STRATEGIES.iter().filter(|s| s.kind() == kind).count(),
+            1,
+            "{n}"
+        );
+    }
+}

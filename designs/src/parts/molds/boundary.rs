@@ -2,11 +2,13 @@
 //! molds the layer is poured between (UVDtact Sec. III).
 
 use super::frame::material_for;
+use super::strategy::{CastPieces, Strategy};
 use crate::error::{DesignError, GeometryContext};
 use crate::geometry::{revolve, GeometryError, Solid};
 use crate::parts::layers::{apply_features, layer_solid, set_forming, LayerBuild, LayerOutput};
 use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::{Part, PrintTechnology};
+use crate::schema::MoldStrategy as Kind;
 use serde_json::json;
 
 /// The parts of a cast layer with the `boundary` strategy: the outer master (the outer
@@ -130,3 +132,54 @@ pub(crate) fn build_boundary_layer(b: LayerBuild) -> Result<LayerOutput, DesignE
 const BOUNDARY_CUP_WALL_MM: f64 = 5.0;
 
 const BOUNDARY_CUP_FLOOR_MM: f64 = 5.0;
+
+/// The `boundary` strategy ([`super::STRATEGIES`]).
+pub struct Boundary;
+
+impl Strategy for Boundary {
+    fn kind(&self) -> Kind {
+        Kind::Boundary
+    }
+
+    /// The drafted Mold Star box round the outer master: about 14 circles of the layer's rim.
+    fn estimated_triangles(
+        &self,
+        body: &crate::profile::BodyProfile,
+        l: &crate::parts::context::ResolvedLayer,
+        tol: crate::geometry::ChordTolerance,
+    ) -> f64 {
+        14.0 * tol
+            .half()
+            .circle_segments(body.rim_radius_mm(l.outer_offset_mm)) as f64
+    }
+
+    fn build_layer(&self, b: LayerBuild<'_>) -> Option<Result<LayerOutput, DesignError>> {
+        Some(build_boundary_layer(b))
+    }
+
+    /// The outer master within the envelope, less the inner silicone core (what Mold Star
+    /// fills in the inner negative's cup).
+    fn cast<'k>(&self, c: &dyn CastPieces<'k>) -> Result<(Solid, Vec<&'k Part>), DesignError> {
+        let (outer, inner) = (c.need("outer_master")?, c.need("inner_negative")?);
+        let cup = &inner.params["boundary"]["cup"];
+        let num = |k: &str| {
+            cup[k]
+                .as_f64()
+                .ok_or_else(|| c.missing(format!("the cup of {}", inner.name)))
+        };
+        let (r, z0, z1) = (num("radius_mm")?, num("bottom_z_mm")?, num("top_z_mm")?);
+        let cup = c.named(
+            crate::geometry::cylinder(z1 - z0, r, c.tol()).map(|s| s.translate([0.0, 0.0, z0])),
+        )?;
+        // the inner silicone core: what Mold Star fills in the negative's cup
+        let core = c.named(cup.difference(&c.in_sensor(inner)?))?;
+        Ok((
+            c.named(
+                c.in_sensor(outer)?
+                    .intersection(c.envelope())
+                    .and_then(|s| s.difference(&core)),
+            )?,
+            vec![outer, inner],
+        ))
+    }
+}

@@ -2,11 +2,13 @@
 //! keys, clamp bolt holes and the core holder (R-Tac0 Sec. III-B1, Fig. 4).
 
 use super::frame::{material_for, CastMold, MoldFrame, MoldOutput};
+use super::strategy::{CastPieces, CoreMoldInput, Strategy};
 use crate::error::{DesignError, GeometryContext};
 use crate::geometry::{cuboid, sphere, Affine, ChordTolerance, Solid};
 use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::{Part, PrintTechnology};
 use crate::schema::Design;
+use crate::schema::MoldStrategy as Kind;
 use serde_json::json;
 
 /// The parts of a `direct` mold: the two mold halves split at the parting plane y = 0 around
@@ -112,3 +114,30 @@ pub(crate) fn direct_halves(
 
 /// A solid in print orientation with its `T_print_sensor`.
 pub(crate) type Posed = (Solid, Affine);
+
+/// The `direct` strategy ([`super::STRATEGIES`]).
+pub struct Direct;
+
+impl Strategy for Direct {
+    fn kind(&self) -> Kind {
+        Kind::Direct
+    }
+
+    fn core_mold(
+        &self,
+        input: CoreMoldInput<'_>,
+        c: CastMold,
+    ) -> Option<Result<MoldOutput, DesignError>> {
+        Some(direct_mold_parts(input.design, input.cavity, input.tol, c))
+    }
+
+    /// The space the closed halves and the core holder leave.
+    fn cast<'k>(&self, c: &dyn CastPieces<'k>) -> Result<(Solid, Vec<&'k Part>), DesignError> {
+        let p = vec![
+            c.need("mold_half_a")?,
+            c.need("mold_half_b")?,
+            c.need("core_holder")?,
+        ];
+        Ok((c.negative(&p)?, p))
+    }
+}

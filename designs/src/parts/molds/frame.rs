@@ -259,7 +259,7 @@ pub struct MoldOutput {
 /// What both strategies of [`build_mold_parts`] build from: the cast layer's `name`, the
 /// mold frame `f`, the parameters `common` to the mold's parts, the core holder (or casting
 /// jig) part and its name, and the volume the gel pour fills, mm^3.
-pub(crate) struct CastMold<'a> {
+pub struct CastMold<'a> {
     pub(crate) name: &'a str,
     pub(crate) f: MoldFrame,
     pub(crate) common: serde_json::Value,

@@ -5,11 +5,13 @@ use super::frame::{
     cavity_profile, material_for, CastMold, CastPlan, MoldFrame, MoldOutput, BOX_FLOOR_MM,
     BOX_FREEBOARD_MM, BOX_WALL_MM, LOCATING_PIN_HEIGHT_MM, LOCATING_PIN_RADIUS_MM,
 };
+use super::strategy::{CastPieces, CoreMoldInput, Strategy};
 use crate::error::{DesignError, GeometryContext};
 use crate::geometry::{revolve, ChordTolerance, Solid};
 use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::{Part, PrintTechnology};
 use crate::schema::Design;
+use crate::schema::MoldStrategy as Kind;
 use serde_json::json;
 
 /// The parts of a `master` mold: the master pattern (the cavity of the cast with its plinth
@@ -141,4 +143,36 @@ pub fn drafted_box(
     let cup = outer.difference(&inner.union(&socket)?)?;
     let fill = crate::geometry::cone(z_fill - z0, r0, r_at(z_fill), tol)?.translate([0.0, 0.0, z0]);
     Ok((cup, fill))
+}
+
+/// The `master` strategy ([`super::STRATEGIES`]).
+pub struct Master;
+
+impl Strategy for Master {
+    fn kind(&self) -> Kind {
+        Kind::Master
+    }
+
+    fn core_mold(
+        &self,
+        input: CoreMoldInput<'_>,
+        c: CastMold,
+    ) -> Option<Result<MoldOutput, DesignError>> {
+        Some(master_mold_parts(
+            input.design,
+            input.plan,
+            input.tol,
+            c,
+            input.with_features,
+        ))
+    }
+
+    /// The master pattern within the envelope (the silicone mold cast on it is its negative).
+    fn cast<'k>(&self, c: &dyn CastPieces<'k>) -> Result<(Solid, Vec<&'k Part>), DesignError> {
+        let master = c.need("master_pattern")?;
+        Ok((
+            c.named(c.in_sensor(master)?.intersection(c.envelope()))?,
+            vec![master],
+        ))
+    }
 }

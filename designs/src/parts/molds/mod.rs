@@ -25,6 +25,7 @@ pub mod direct;
 pub mod frame;
 pub mod master;
 pub mod open;
+pub mod strategy;
 pub mod two_piece_open;
 
 use crate::error::{DesignError, GeometryContext, ParamError};
@@ -35,10 +36,9 @@ use crate::parts::context::Stack;
 use crate::parts::layers::{self, LayerOutput};
 use crate::parts::{Part, PrintTechnology};
 use crate::schema::{Design, LayerProcess, MoldStrategy};
-use direct::direct_mold_parts;
 use frame::{cavity_profile, core_holder, holder_params, CastMold};
-use master::master_mold_parts;
 use serde_json::json;
+use strategy::{CoreMoldInput, Strategy};
 
 pub use crate::parts::placement::{place_on_bed, place_posed, with_pose};
 pub use crate::schema::mold::{
@@ -186,13 +186,16 @@ fn build_mold_parts(
         holder_part,
         pour_volume,
     };
-    let mut out = match plan.strategy {
-        MoldStrategy::Open | MoldStrategy::TwoPieceOpen | MoldStrategy::Boundary => {
-            unreachable!("built by crate::parts::layers")
-        }
-        MoldStrategy::Direct => direct_mold_parts(design, &cavity, tol, c),
-        MoldStrategy::Master => master_mold_parts(design, plan, tol, c, &with_features),
-    }?;
+    let input = CoreMoldInput {
+        design,
+        plan,
+        cavity: &cavity,
+        with_features: &with_features,
+        tol,
+    };
+    let mut out = strategy_of(plan.strategy)
+        .core_mold(input, c)
+        .expect("cast_plans plans the pours of core-holding strategies only")?;
     let placed = crate::parts::layers::place_layer_markers(design, layer, tol);
     out.markers = crate::parts::layers::marker_summary(
         layer,
@@ -215,8 +218,8 @@ fn build_mold_parts(
     Ok(out)
 }
 
-/// Builds the parts of a cast layer with the `open` or `boundary` strategy, or of a printed
-/// layer.
+/// Builds the parts of a cast layer whose strategy casts without a core
+/// ([`Strategy::build_layer`]: `open`, `two_piece_open`, `boundary`), or of a printed layer.
 ///
 /// # Errors
 /// [`DesignError::Geometry`] if the kernel fails, naming the parameters (`layers[i]`, and
@@ -228,13 +231,34 @@ pub fn build_layer(
     tol: ChordTolerance,
 ) -> Result<LayerOutput, DesignError> {
     layers::with_layer_build(design, stack, i, tol, |b| {
-        match (b.l.process, b.l.mold_strategy) {
-            (LayerProcess::Printed, _) => layers::build_printed_layer(b),
-            (_, MoldStrategy::Open) => open::build_open_mold_layer(b),
-            (_, MoldStrategy::TwoPieceOpen) => two_piece_open::build_two_piece_open_layer(b),
-            (_, MoldStrategy::Boundary) => boundary::build_boundary_layer(b),
-            _ => unreachable!("direct and master molds are built by molds::build_mold"),
+        if b.l.process == LayerProcess::Printed {
+            return layers::build_printed_layer(b);
         }
+        strategy_of(b.l.mold_strategy)
+            .build_layer(b)
+            .expect("direct and master molds are built by molds::build_mold")
     })
     .map_err(|e| e.from_params(&layers::layer_params(design, i)))
+}
+
+/// Every mold strategy, one line each: the build and the cast check find a layer's strategy
+/// here ([`strategy_of`]).
+pub static STRATEGIES: &[&dyn Strategy] = &[
+    &direct::Direct,
+    &master::Master,
+    &open::Open,
+    &two_piece_open::TwoPieceOpen,
+    &boundary::Boundary,
+];
+
+/// The strategy of kind `kind` in [`STRATEGIES`].
+///
+/// # Panics
+/// When `kind` has no line in [`STRATEGIES`] (a strategy added to the schema but not listed;
+/// `every_strategy_is_listed` in designs/tests/it/validation.rs checks that none is).
+pub fn strategy_of(kind: MoldStrategy) -> &'static dyn Strategy {
+    *STRATEGIES
+        .iter()
+        .find(|s| s.kind() == kind)
+        .expect("every mold strategy is listed in STRATEGIES")
 }

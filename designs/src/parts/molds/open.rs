@@ -2,6 +2,7 @@
 //! to the brim, with the inserts of the layer's features (DIGIT Pinki).
 
 use super::frame::material_for;
+use super::strategy::{CastPieces, Strategy};
 use crate::error::{DesignError, GeometryContext};
 use crate::geometry::{GeometryError, Solid};
 use crate::parts::layer_feature::InsertInput;
@@ -11,6 +12,7 @@ use crate::parts::layers::{
 };
 use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::Part;
+use crate::schema::MoldStrategy as Kind;
 use serde_json::json;
 
 /// The one-piece open mold of a solid cast layer (`open` strategy): a block
@@ -83,4 +85,30 @@ pub(crate) fn build_open_mold_layer(b: LayerBuild) -> Result<LayerOutput, Design
         pours: vec![(name.clone(), l.material.clone(), skin_volume, pour_parts)],
         markers,
     })
+}
+
+/// The `open` strategy ([`super::STRATEGIES`]).
+pub struct Open;
+
+impl Strategy for Open {
+    fn kind(&self) -> Kind {
+        Kind::Open
+    }
+
+    fn solid_only(&self) -> bool {
+        true
+    }
+
+    fn build_layer(&self, b: LayerBuild<'_>) -> Option<Result<LayerOutput, DesignError>> {
+        Some(build_open_mold_layer(b))
+    }
+
+    /// The space the open mold and the inserts of the layer's features leave.
+    fn cast<'k>(&self, c: &dyn CastPieces<'k>) -> Result<(Solid, Vec<&'k Part>), DesignError> {
+        let mut p = vec![c.need("open_mold")?];
+        for role in crate::parts::layer_registry::insert_roles() {
+            p.extend(c.part(role));
+        }
+        Ok((c.negative(&p)?, p))
+    }
 }

@@ -2,6 +2,7 @@
 //! registration bosses (its frame [`TwoPieceFrame`] and its rules).
 
 use super::frame::material_for;
+use super::strategy::{CastPieces, Strategy};
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{GeometryError, Solid};
 use crate::parts::layers::{
@@ -10,6 +11,7 @@ use crate::parts::layers::{
 use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::Part;
 use crate::schema::Design;
+use crate::schema::MoldStrategy as Kind;
 use serde_json::json;
 
 /// Where the parts of a `two_piece_open` mold lie, in the sensor frame, mm (see
@@ -441,5 +443,28 @@ pub(crate) fn two_piece_open_parts(
         parts,
         pours: vec![(name.clone(), l.material.clone(), skin_volume, pour_parts)],
         markers,
+    }
+}
+
+/// The `two_piece_open` strategy ([`super::STRATEGIES`]).
+pub struct TwoPieceOpen;
+
+impl Strategy for TwoPieceOpen {
+    fn kind(&self) -> Kind {
+        Kind::TwoPieceOpen
+    }
+
+    fn solid_only(&self) -> bool {
+        true
+    }
+
+    fn build_layer(&self, b: LayerBuild<'_>) -> Option<Result<LayerOutput, DesignError>> {
+        Some(build_two_piece_open_layer(b))
+    }
+
+    /// The space the closed cavity block and reservoir top leave.
+    fn cast<'k>(&self, c: &dyn CastPieces<'k>) -> Result<(Solid, Vec<&'k Part>), DesignError> {
+        let p = vec![c.need("cavity_block")?, c.need("reservoir_top")?];
+        Ok((c.negative(&p)?, p))
     }
 }
