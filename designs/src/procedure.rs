@@ -251,9 +251,10 @@ fn close_and_pour(
     let n = c.step;
     let boundary = silicone.iter().any(|m| m.ends_with(":inner"));
     let mix = c.mix_text();
+    let insert_roles = insert_roles();
     let (inserts, pieces): (Vec<&Part>, Vec<&Part>) = pieces
         .iter()
-        .partition(|p| insert_roles().contains(&p.role.as_str()));
+        .partition(|p| insert_roles.contains(&p.role.as_str()));
     if !halves.is_empty() {
         let (a, b) = (
             &halves[0].name,
