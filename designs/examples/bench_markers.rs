@@ -5,7 +5,7 @@
 //! Usage: `cargo run --release -p fabkit-designs --example bench_markers -- CASE [RUNS] [CSG]`
 //! - CASE: `published_469` (the authors' layout: concentric_6k, 12 rings 3.9474 deg apart) or a feature
 //!   count N (the scaling variant of [`scaled_design`]: N features on a golden spiral).
-//! - RUNS (default 3): timed runs; each is `stack::validate` + `molds::build_layer`, the mold
+//! - RUNS (default 3): timed runs; each is `stack::validate` + `build::build_layer`, the mold
 //!   only (nothing written). The YAML is parsed once, before the clock starts.
 //! - CSG: writes the mold part's CSG tree (fabkit-csg/1) from the last run to this file, for
 //!   `tests/oracles/replay_csg.py`.
@@ -89,7 +89,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let t0 = Instant::now();
         let st = stack::validate(&design, &materials, tol)?;
         let t1 = Instant::now();
-        let out = fabkit_designs::molds::build_layer(&design, &st, 0, tol)?;
+        let out = fabkit_designs::build::build_layer(&design, &st, 0, tol)?;
         let t2 = Instant::now();
         validate_s.push((t1 - t0).as_secs_f64());
         build_s.push((t2 - t1).as_secs_f64());

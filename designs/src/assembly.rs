@@ -172,12 +172,21 @@ fn push_cast_layers(
         .map(|&i| {
             let name = &stack.layers[i].name;
             let mut features =
-                crate::parts::layers::layer_features(design, stack, i, tol).part(name)?;
+                crate::parts::layers::layer_features(&design.stack_input(), stack, i, tol)
+                    .part(name)?;
             let solid = match scope {
-                AssemblyScope::Whole => crate::parts::layers::layer_solid(design, stack, i, tol),
+                AssemblyScope::Whole => {
+                    crate::parts::layers::layer_solid(&design.stack_input(), stack, i, tol)
+                }
                 AssemblyScope::FitCheck => {
                     features.stand_in_for_layer = Some(i);
-                    crate::parts::layers::layer_stand_in(design, stack, i, &features, tol)
+                    crate::parts::layers::layer_stand_in(
+                        &design.stack_input(),
+                        stack,
+                        i,
+                        &features,
+                        tol,
+                    )
                 }
             }
             .part(name)?;
@@ -195,7 +204,12 @@ fn push_cast_layers(
             nested_by_stack: true,
             features,
             exact: Some(ExactShape::Layer {
-                params: crate::parts::layers::layer_twin_params(design, stack, i, tol),
+                params: crate::parts::layers::layer_twin_params(
+                    &design.stack_input(),
+                    stack,
+                    i,
+                    tol,
+                ),
             }),
         });
     }
@@ -279,7 +293,8 @@ pub fn with_exact_layers(
         .into_par_iter()
         .map(|mut m| {
             if let Some(i) = m.features.stand_in_for_layer.take() {
-                m.solid = crate::parts::layers::layer_solid(design, stack, i, tol).part(&m.name)?;
+                m.solid = crate::parts::layers::layer_solid(&design.stack_input(), stack, i, tol)
+                    .part(&m.name)?;
             }
             Ok(m)
         })

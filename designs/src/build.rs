@@ -30,9 +30,25 @@ pub fn build_kit(design: &Design, tol: ChordTolerance) -> Result<Kit, DesignErro
     build_kit_bounded(design, tol, u64::MAX)
 }
 
+/// Builds layer `i` of `design` (its resolved `stack`) when it is printed or cast without a
+/// core ([`crate::parts::molds::build_layer`]), with the families' parts printed with the
+/// outermost layer ([`crate::parts::registry::printed_with_skin`]).
+///
+/// # Errors
+/// As [`crate::parts::molds::build_layer`].
+pub fn build_layer(
+    design: &Design,
+    stack: &Stack,
+    i: usize,
+    tol: ChordTolerance,
+) -> Result<crate::parts::layers::LayerOutput, DesignError> {
+    let with_skin = || crate::parts::registry::printed_with_skin(design, stack, tol);
+    crate::parts::molds::build_layer(&design.stack_input(), stack, i, tol, &with_skin)
+}
+
 /// Validates `design` as `fabkit validate` does and returns its resolved layer stack: for a
 /// curved skin the [`Stack`] ([`crate::stack::validate`]) as JSON, for a flat skin
-/// `{"flat_layers": [...]}` ([`crate::parts::flat::validate`]); mm, inner to outer.
+/// `{"flat_layers": [...]}` ([`crate::stack::flat::validate`]); mm, inner to outer.
 ///
 /// # Errors
 /// [`DesignError::Params`] with every violated rule at once (parameter path, value, rule);
@@ -43,7 +59,7 @@ pub fn validate_design(
 ) -> Result<serde_json::Value, DesignError> {
     let materials = MaterialsTable::embedded().map_err(DesignError::Yaml)?;
     if design.body.flat_outline().is_some() {
-        let layers = crate::parts::flat::validate(design, &materials)?;
+        let layers = crate::stack::flat::validate(design, &materials)?;
         Ok(json!({ "flat_layers": layers }))
     } else {
         let stack = validate(design, &materials, tol)?;
@@ -123,7 +139,7 @@ pub fn build_kit_scoped(
     }
     drop(t);
     let t = timings::stage("build the parts, the assembly's layers and the fillings (in parallel)");
-    let plans = cast_plans(design, &stack);
+    let plans = cast_plans(&design.stack_input(), &stack);
     let mut parts = Vec::new();
     let mut silicone = Vec::new();
     let mut gel = Vec::new();
@@ -146,13 +162,13 @@ pub fn build_kit_scoped(
                     rayon::join(
                         || {
                             held.par_iter()
-                                .map(|plan| build_mold(design, &stack, plan, tol))
+                                .map(|plan| build_mold(&design.stack_input(), &stack, plan, tol))
                                 .collect::<Vec<_>>()
                         },
                         || {
                             other
                                 .par_iter()
-                                .map(|&i| crate::parts::molds::build_layer(design, &stack, i, tol))
+                                .map(|&i| build_layer(design, &stack, i, tol))
                                 .collect::<Vec<_>>()
                         },
                     )
@@ -173,7 +189,9 @@ pub fn build_kit_scoped(
                 )
             };
             let fillings = || {
-                let cavity = |i: usize| crate::parts::layers::inner_cavity(design, &stack, i, tol);
+                let cavity = |i: usize| {
+                    crate::parts::layers::inner_cavity(&design.stack_input(), &stack, i, tol)
+                };
                 FAMILIES
                     .iter()
                     .map(|f| f.filling_pour(at, &cavity))
@@ -622,7 +640,7 @@ fn treatments(
             format!("the cavity of the {layer} mold"),
             design.body.surface_area_mm2(cavity),
         ));
-        if let Some(r) = crate::parts::layer_registry::seat_of(design, l.index) {
+        if let Some(r) = crate::parts::layer_registry::seat_of(&design.stack_input(), l.index) {
             out.extend(report(
                 rel,
                 format!("the insert that forms the seat under {layer}"),
@@ -752,7 +770,7 @@ pub fn layer_volume_mm3(design: &Design, layer: &crate::stack::ResolvedLayer) ->
     let outer = body.analytic_solid_volume_mm3(layer.outer_offset_mm, 0.0);
     if layer.solid {
         outer
-            - crate::parts::layer_registry::seat_of(design, layer.index)
+            - crate::parts::layer_registry::seat_of(&design.stack_input(), layer.index)
                 .map_or(0.0, |r| r.volume_mm3())
     } else {
         outer - body.analytic_solid_volume_mm3(layer.inner_offset_mm, 0.0)

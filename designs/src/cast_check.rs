@@ -93,7 +93,7 @@ pub fn check_casts(
     let materials = crate::materials::MaterialsTable::embedded().map_err(DesignError::Yaml)?;
     if let Some(outline) = design.body.flat_outline() {
         let layers =
-            crate::parts::flat::validate(design, &materials).map_err(DesignError::Params)?;
+            crate::stack::flat::validate(design, &materials).map_err(DesignError::Params)?;
         let laser_cut = design.mold.laser_cut.is_some();
         return layers
             .iter()
@@ -140,8 +140,8 @@ fn check_layer(
     let (cast, formed_by) = cast_layer(design, stack, kit, i, tol)?;
     let shown = member(kit, name)?;
     let (sym, thick_pieces) = compare(&cast, shown, tol).part(name)?;
-    let placed = layers::place_layer_markers(design, l, tol);
-    let (_, taken) = layers::taken_features(design, stack, i, tol);
+    let placed = layers::place_layer_markers(&design.stack_input(), l, tol);
+    let (_, taken) = layers::taken_features(&design.stack_input(), stack, i, tol);
     let sets: Vec<(&layers::PlacedMarkers, MarkerSurface)> = placed
         .iter()
         .map(|p| (p, p.spec.surface))
@@ -248,8 +248,9 @@ pub fn cast_layer(
     let g = |r: Result<Solid, crate::geometry::GeometryError>| r.part(name);
     // The envelope: the cavity's offset surface, beyond the tallest feature, closed on the
     // base plane.
-    let cavity_offset = l.outer_offset_mm + layers::cavity_gap_mm(design, &stack.layers, l);
-    let reach = layers::place_layer_markers(design, l, tol)
+    let cavity_offset =
+        l.outer_offset_mm + layers::cavity_gap_mm(&design.stack_input(), &stack.layers, l);
+    let reach = layers::place_layer_markers(&design.stack_input(), l, tol)
         .iter()
         .map(|p| p.spec.feature.height_mm)
         .fold(0.0, f64::max);

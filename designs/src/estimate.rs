@@ -73,7 +73,7 @@ pub fn estimate(design: &Design, stack: &Stack, tol: ChordTolerance) -> WorkEsti
         if !l.solid {
             surfaces += surface_triangles(design, l.inner_offset_mm, tol);
         }
-        if let Some(r) = crate::parts::layer_registry::seat_of(design, l.index) {
+        if let Some(r) = crate::parts::layer_registry::seat_of(&design.stack_input(), l.index) {
             // the recess's surface three times: in the layer's part, its assembly member and
             // the mold's insert
             let profile = r.polyline(0.0, 0.0, tol.half()).points.len() as f64;
@@ -105,7 +105,9 @@ pub fn estimate(design: &Design, stack: &Stack, tol: ChordTolerance) -> WorkEsti
         // outer features also in a direct or master mold's cavity, the coats over the layer
         // and the layer cast onto it (crate::parts::layers::taken_features)
         let copies = 1.0 + crate::parts::layers::outer_feature_copies(stack, l.index) as f64;
-        for (spec, _, _, placed) in crate::parts::layer_markers::placed_patterns(design, l) {
+        for (spec, _, _, placed) in
+            crate::parts::layer_markers::placed_patterns(&design.stack_input(), l)
+        {
             let n = placed.len();
             markers += n as u64;
             let k = if spec.surface == crate::markers::MarkerSurface::Outer {

@@ -109,7 +109,7 @@ fn marker_features(design: &Design, stack: &Stack) -> Features {
     for layer in &stack.layers {
         let specs = &design.layers[layer.index].markers;
         for (spec, offset, _, markers) in
-            crate::parts::layer_markers::placed_patterns(design, layer)
+            crate::parts::layer_markers::placed_patterns(&design.stack_input(), layer)
         {
             let k = specs
                 .iter()
@@ -225,7 +225,7 @@ fn validated_stack(
     use crate::error::DesignError;
     let materials = crate::materials::MaterialsTable::embedded().map_err(DesignError::Yaml)?;
     let stack = if design.body.flat_outline().is_some() {
-        crate::parts::flat::validate(design, &materials)?;
+        crate::stack::flat::validate(design, &materials)?;
         Stack {
             core: None,
             layers: Vec::new(),

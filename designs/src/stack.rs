@@ -1,6 +1,8 @@
 //! The layer stack: each layer's inner and outer surfaces as signed offsets from the body
 //! surface (negative = inward), and the validation of a design.
 
+pub mod flat;
+
 use crate::error::{ParamError, ParamErrors};
 use crate::geometry::{revolve, ChordTolerance, Solid};
 use crate::materials::{MaterialKind, MaterialsTable};
@@ -8,6 +10,7 @@ pub use crate::parts::context::{ResolvedCore, ResolvedLayer, Stack};
 use crate::parts::layer_feature::solid_layer_profile;
 use crate::parts::layer_registry::{check_layer_features, seat_of};
 use crate::parts::registry::FAMILIES;
+use crate::parts::stack_input::StackInput;
 use crate::schema::printers::check_printers;
 pub use crate::schema::printers::{check_bed, MAX_BED_MM};
 pub use crate::schema::DESIGN_SIGNED_MM;
@@ -20,20 +23,20 @@ impl Stack {
     /// Only on a kernel failure.
     pub fn layer_solid(
         &self,
-        design: &Design,
+        si: &StackInput<'_>,
         i: usize,
         tol: ChordTolerance,
     ) -> Result<Solid, crate::geometry::GeometryError> {
         let l = &self.layers[i];
         let pl = if l.solid {
             solid_layer_profile(
-                &design.body,
+                si.ctx.body,
                 l.outer_offset_mm,
-                seat_of(design, i).as_ref(),
+                seat_of(si, i).as_ref(),
                 tol.half(),
             )
         } else {
-            design
+            si.ctx
                 .body
                 .shell_profile(l.inner_offset_mm, l.outer_offset_mm, 0.0, tol.half())
         };
@@ -84,7 +87,7 @@ pub fn validate(
     let layer_specs_ok = check_layer_specs(design, sphere_r, body_ok, &mut errs);
     check_core_and_casting(design, sphere_r, body_ok, &mut errs);
     check_mold_strategies(design, &mut errs);
-    check_layer_features(design, body_ok, &mut errs);
+    check_layer_features(&design.stack_input(), body_ok, &mut errs);
 
     // Resolve the stack from the inside out, in "radius" units for spheres (r = R + offset).
     let (layers, core, stack_ok) = if body_ok && layer_specs_ok && !design.layers.is_empty() {
@@ -110,7 +113,7 @@ pub fn validate(
 }
 
 /// The design's name, whether its body is one this validation handles (flat skins have their
-/// own, [`crate::parts::flat::validate`]), the body's own rules, and the flat-skin-only keys.
+/// own, [`crate::stack::flat::validate`]), the body's own rules, and the flat-skin-only keys.
 ///
 /// # Errors
 /// The one error of a flat body, alone.
@@ -487,7 +490,7 @@ fn check_open_block(
     let open: Vec<_> = layers
         .iter()
         .filter(|l| l.process == LayerProcess::Cast && l.mold_strategy == MoldStrategy::Open)
-        .map(|l| crate::parts::molds::open_cavity_mm(design, l))
+        .map(|l| crate::parts::molds::open_cavity_mm(&design.stack_input(), l))
         .collect();
     let rim = open.iter().map(|c| c.0).fold(0.0, f64::max);
     let height = open.iter().map(|c| c.1).fold(0.0, f64::max);
@@ -652,10 +655,10 @@ fn check_with_stack(
     stack_ok: bool,
     errs: &mut Vec<ParamError>,
 ) {
-    crate::parts::molds::check_mold_params(design, errs);
+    crate::parts::molds::check_mold_params(&design.stack_input(), errs);
     check_printers(&design.printers, errs);
     if stack_ok {
-        crate::parts::layers::check_markers(design, layers, errs);
+        crate::parts::layers::check_markers(&design.stack_input(), layers, errs);
         let two_piece_rim = layers
             .iter()
             .filter(|l| {
@@ -664,7 +667,7 @@ fn check_with_stack(
             .map(|l| design.body.rim_radius_mm(l.outer_offset_mm))
             .fold(None, |a: Option<f64>, r| Some(a.map_or(r, |a| a.max(r))));
         if let Some(rim) = two_piece_rim {
-            crate::parts::molds::check_two_piece(design, rim, errs);
+            crate::parts::molds::check_two_piece(&design.stack_input(), rim, errs);
         }
         if let Some(block) = &design.mold.open_block {
             check_open_block(design, block, layers, errs);
@@ -690,7 +693,12 @@ fn check_with_stack(
             .iter()
             .find(|l| l.process == LayerProcess::Cast && l.mold_strategy.holds_core())
         {
-            crate::parts::molds::check_mold_fit(design, c, first.outer_offset_mm, errs);
+            crate::parts::molds::check_mold_fit(
+                &design.stack_input(),
+                c,
+                first.outer_offset_mm,
+                errs,
+            );
         }
     }
 }

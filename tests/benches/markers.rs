@@ -3,7 +3,7 @@
 //! hemisphere; pins standing into the cavity for the skin's dimples) join the mold with one
 //! `Solid::compose` of the features and one boolean.
 //!
-//! Every iteration is `stack::validate` + `fabkit_designs::molds::build_layer(.., 0, ..)`: the mold alone, every
+//! Every iteration is `stack::validate` + `fabkit_designs::build::build_layer(.., 0, ..)`: the mold alone, every
 //! boolean evaluated (the kernel evaluates each boolean when the solid is made), nothing written.
 //! The YAML is parsed, and the design mutated, once outside the timed loop.
 //!
@@ -87,7 +87,7 @@ fn build_mold(
     tol: ChordTolerance,
 ) -> layers::LayerOutput {
     let st = stack::validate(design, materials, tol).expect("the benchmark design validates");
-    fabkit_designs::molds::build_layer(design, &st, 0, tol).expect("the benchmark mold builds")
+    fabkit_designs::build::build_layer(design, &st, 0, tol).expect("the benchmark mold builds")
 }
 
 /// Features placed on layer 0 (validated first; panics with every violation otherwise).

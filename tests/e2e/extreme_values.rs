@@ -20,7 +20,7 @@ use crate::common::{repo_root, run_program_limited, text};
 use fabkit_designs::materials::MaterialsTable;
 use fabkit_designs::schema::Design;
 use fabkit_designs::values::{integer_paths, number_paths, NumberPath, Step};
-use fabkit_designs::{build_kit_bounded, flat, library, stack, ChordTolerance, DesignError};
+use fabkit_designs::{build_kit_bounded, library, stack, ChordTolerance, DesignError};
 use fabkit_fixtures::build_fixtures;
 use fabkit_fixtures::params::{apply_pin_preset, from_yaml, FixtureParams};
 use std::path::Path;
@@ -224,7 +224,7 @@ fn walk_one_design() {
             ),
         };
         let valid = if m.body.flat_outline().is_some() {
-            flat::validate(&m, &materials).map(|_| ())
+            stack::flat::validate(&m, &materials).map(|_| ())
         } else {
             stack::validate(&m, &materials, tol).map(|_| ())
         };

@@ -8,11 +8,12 @@ use crate::kit::Kit;
 use crate::materials::{CastReport, MaterialsTable};
 use crate::parts::cut_part::CutPart;
 use crate::parts::flat::{
-    estimated_triangles, layer_solid_as_cast, tray_solid, validate, ChannelEnds, ChannelSet,
-    FlatLayer, FlatOutline,
+    estimated_triangles, layer_solid_as_cast, tray_solid, ChannelEnds, ChannelSet, FlatLayer,
+    FlatOutline,
 };
 use crate::parts::{Member, MemberKind, Part, PrintTechnology, ProcedureAction, ProcedureStep};
 use crate::schema::{Design, LaserCutParams};
+use crate::stack::flat::validate;
 
 /// Validates a flat design ([`validate`]) and builds its kit at `tol`: one tray per layer
 /// (FDM or as `mold.fixture_print_technology` says; Soter et al. laser-cut theirs), the pours

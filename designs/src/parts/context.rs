@@ -1,7 +1,8 @@
 //! What a family sees of a design beyond its own parameters: the design's name, body
 //! profile, printer profiles and backing plate ([`Context`]), and the resolved layer stack
 //! ([`Stack`]: every surface placed). Families take these, never the whole design, so that a
-//! family depends on no other family's parameters.
+//! family depends on no other family's parameters. The layer stack's modules (layers, their
+//! markers and features, the molds) take [`crate::parts::stack_input::StackInput`].
 
 use crate::profile::BodyProfile;
 use crate::schema::printers::PrinterProfiles;

@@ -138,6 +138,21 @@ pub trait Family {
     /// [`DesignError::Geometry`] naming the failing part if the kernel fails.
     fn build(p: &Self::Params, input: FamilyInput<'_>) -> Result<Built, DesignError>;
 
+    /// The parts it prints with the outermost layer when that layer is printed, as further
+    /// volumes of the layer's object (the TacTip's rigid tip fitting printed with its skin,
+    /// Pestell et al. Sec. III-A): each solid in the sensor frame and its `params` without a
+    /// pose; the layer's build gives them its print technology, its group and its plate
+    /// pose. None by default.
+    ///
+    /// # Errors
+    /// [`DesignError::Geometry`] naming the outermost layer if the kernel fails.
+    fn printed_with_skin(
+        _p: &Self::Params,
+        _input: FamilyInput<'_>,
+    ) -> Result<Vec<Part>, DesignError> {
+        Ok(Vec::new())
+    }
+
     /// Its bought and cut members of the assembled sensor, in the sensor frame (its printed
     /// parts join the assembly from [`Family::build`] through their `T_print_sensor`).
     ///

@@ -6,7 +6,8 @@
 use crate::geometry::ChordTolerance;
 use crate::markers::{self, Marker, MarkerSpec, MarkerSurface, PatternStats, Polarity, Surface};
 use crate::parts::context::{ResolvedLayer, Stack};
-use crate::schema::{Design, LayerProcess, Technology};
+use crate::parts::stack_input::StackInput;
+use crate::schema::{LayerProcess, Technology};
 use crate::values::MAX_LENGTH_MM;
 
 /// Markers placed on one surface of a layer.
@@ -75,18 +76,18 @@ pub(crate) fn direction(spec: &MarkerSpec) -> f64 {
 }
 
 /// The print technology that makes the surface carrying a layer's features.
-pub(crate) fn feature_technology(design: &Design, layer: &crate::schema::Layer) -> Technology {
+pub(crate) fn feature_technology(si: &StackInput<'_>, layer: &crate::schema::Layer) -> Technology {
     match layer.process {
         LayerProcess::Printed => layer.print_technology.unwrap_or(Technology::Polyjet),
-        _ => design.mold.cavity_print_technology,
+        _ => si.mold.cavity_print_technology,
     }
 }
 
 /// How far inward from the offset surface at `off` a feature may reach before the offset
 /// surface at its end stops being valid ([`crate::profile::BodyProfile::offset_is_valid`]), mm
 /// (bisection; 0 when the surface itself is not valid).
-pub(crate) fn max_inward_reach(design: &Design, off: f64) -> f64 {
-    let body = &design.body;
+pub(crate) fn max_inward_reach(si: &StackInput<'_>, off: f64) -> f64 {
+    let body = &si.ctx.body;
     if !body.offset_is_valid(off) {
         return 0.0;
     }
@@ -110,17 +111,17 @@ pub(crate) fn rim_margin(spec: &MarkerSpec, min_wall: f64) -> f64 {
 /// Every pattern of `layer` that places (a pattern that does not is the validation's to
 /// report): the spec, its surface offset, the surface and the markers.
 pub(crate) fn placed_patterns<'a>(
-    design: &'a Design,
+    si: &'a StackInput<'a>,
     layer: &ResolvedLayer,
 ) -> Vec<(&'a MarkerSpec, f64, Surface, Vec<markers::Marker>)> {
-    let spec_layer = &design.layers[layer.index];
-    let profile = design.printers.get(feature_technology(design, spec_layer));
+    let spec_layer = &si.layers[layer.index];
+    let profile = si.ctx.printers.get(feature_technology(si, spec_layer));
     spec_layer
         .markers
         .iter()
         .filter_map(|spec| {
             let offset = surface_offset(layer, spec.surface);
-            let surface = Surface::new(&design.body, offset);
+            let surface = Surface::new(&si.ctx.body, offset);
             let markers = markers::place(
                 &surface,
                 &spec.pattern,
@@ -134,11 +135,11 @@ pub(crate) fn placed_patterns<'a>(
 
 /// Places every marker pattern of layer `i`.
 pub fn place_layer_markers(
-    design: &Design,
+    si: &StackInput<'_>,
     layer: &ResolvedLayer,
     tol: ChordTolerance,
 ) -> Vec<PlacedMarkers> {
-    placed_patterns(design, layer)
+    placed_patterns(si, layer)
         .into_iter()
         .map(|(spec, offset, surface, markers)| {
             let stats = markers::stats(&surface, &markers);
@@ -179,20 +180,20 @@ pub(crate) fn formed_on_stack_layer(l: &ResolvedLayer) -> bool {
 /// a sprayed coat those of the layer under it, grown by the coat's thickness
 /// ([`PlacedMarkers::conformal`]: the coat takes the shape of the cavity it is sprayed into).
 pub fn formed_outer_features(
-    design: &Design,
+    si: &StackInput<'_>,
     stack: &Stack,
     i: usize,
     tol: ChordTolerance,
 ) -> Vec<PlacedMarkers> {
     let l = &stack.layers[i];
-    let mut own: Vec<PlacedMarkers> = place_layer_markers(design, l, tol)
+    let mut own: Vec<PlacedMarkers> = place_layer_markers(si, l, tol)
         .into_iter()
         .filter(|p| p.spec.surface == MarkerSurface::Outer)
         .collect();
     if l.process == LayerProcess::Sprayed && i > 0 {
         let under = &stack.layers[i - 1];
         own.extend(
-            formed_outer_features(design, stack, i - 1, tol)
+            formed_outer_features(si, stack, i - 1, tol)
                 .iter()
                 .map(|p| p.conformal(l.outer_offset_mm - under.outer_offset_mm)),
         );
@@ -205,7 +206,7 @@ pub fn formed_outer_features(
 /// formed them; on the outer surface of a sprayed coat, the same grown by its thickness.
 /// (outer sets, inner sets); both empty for a layer formed by molds of its own.
 pub fn taken_features(
-    design: &Design,
+    si: &StackInput<'_>,
     stack: &Stack,
     i: usize,
     tol: ChordTolerance,
@@ -214,7 +215,7 @@ pub fn taken_features(
         return (Vec::new(), Vec::new());
     }
     let (l, under) = (&stack.layers[i], &stack.layers[i - 1]);
-    let below = formed_outer_features(design, stack, i - 1, tol);
+    let below = formed_outer_features(si, stack, i - 1, tol);
     let at = |offset_mm: f64| -> Vec<PlacedMarkers> {
         below
             .iter()
@@ -253,14 +254,14 @@ pub fn outer_feature_copies(stack: &Stack, i: usize) -> usize {
 /// poured behind them take the designed features. Sensor frame, mm.
 /// (A sprayed coat's own markers are refused: [`check_markers`].)
 pub fn cavity_features(
-    design: &Design,
+    si: &StackInput<'_>,
     stack: &Stack,
     i: usize,
     cavity_offset_mm: f64,
     tol: ChordTolerance,
 ) -> Vec<PlacedMarkers> {
     let l = &stack.layers[i];
-    let placed = place_layer_markers(design, l, tol);
+    let placed = place_layer_markers(si, l, tol);
     on_surface(&placed, MarkerSurface::Outer)
         .into_iter()
         .map(|p| p.conformal(cavity_offset_mm - l.outer_offset_mm))

@@ -11,7 +11,8 @@ use crate::error::ParamError;
 use crate::geometry::GeometryError;
 use crate::parts::layer_feature::{InsertInput, LayerFeature, LayerInput, MoldInsert, Seat};
 use crate::parts::recess;
-use crate::schema::{Design, Layer};
+use crate::parts::stack_input::StackInput;
+use crate::schema::Layer;
 
 /// A registered layer feature, as the loops see it: each method does nothing (or returns
 /// nothing) for a layer without the feature.
@@ -106,14 +107,14 @@ pub static LAYER_FEATURES: &[&dyn Feature] =
 
 /// The rules of every feature of every layer of `design` (`body_ok`: the body's own rules
 /// hold), layer by layer.
-pub fn check_layer_features(design: &Design, body_ok: bool, errs: &mut Vec<ParamError>) {
-    let ctx = design.context();
-    for (index, layer) in design.layers.iter().enumerate() {
+pub fn check_layer_features(si: &StackInput<'_>, body_ok: bool, errs: &mut Vec<ParamError>) {
+    let ctx = si.ctx;
+    for (index, layer) in si.layers.iter().enumerate() {
         let input = LayerInput {
             ctx: &ctx,
             index,
             layer,
-            strategy: layer.mold_strategy.unwrap_or(design.mold.strategy),
+            strategy: layer.mold_strategy.unwrap_or(si.mold.strategy),
             body_ok,
         };
         for f in LAYER_FEATURES {
@@ -134,16 +135,16 @@ pub fn flat_refusals(l: &Layer) -> Vec<(&'static str, &'static str)> {
 
 /// The seat cut into layer `index` of `design` from below, with the key of the feature that
 /// cuts it; `None` when no feature does (or its rules do not hold).
-pub fn layer_seat(design: &Design, index: usize) -> Option<(&'static str, Seat)> {
-    let l = design.layers.get(index)?;
+pub fn layer_seat(si: &StackInput<'_>, index: usize) -> Option<(&'static str, Seat)> {
+    let l = si.layers.get(index)?;
     LAYER_FEATURES
         .iter()
         .find_map(|f| Some((f.key(), f.seat(l)?)))
 }
 
 /// The seat of layer `index` of `design` ([`layer_seat`]) without its key.
-pub fn seat_of(design: &Design, index: usize) -> Option<Seat> {
-    layer_seat(design, index).map(|(_, s)| s)
+pub fn seat_of(si: &StackInput<'_>, index: usize) -> Option<Seat> {
+    layer_seat(si, index).map(|(_, s)| s)
 }
 
 /// The roles of the parts the features set into molds.
@@ -156,8 +157,8 @@ pub fn insert_roles() -> Vec<&'static str> {
 
 /// Adds the twin parameters of layer `index`'s features to its twin's parameters `v`, each
 /// under its key.
-pub fn twin_params(design: &Design, index: usize, v: &mut serde_json::Value) {
-    let Some(l) = design.layers.get(index) else {
+pub fn twin_params(si: &StackInput<'_>, index: usize, v: &mut serde_json::Value) {
+    let Some(l) = si.layers.get(index) else {
         return;
     };
     for f in LAYER_FEATURES {
@@ -172,11 +173,11 @@ pub fn twin_params(design: &Design, index: usize, v: &mut serde_json::Value) {
 /// # Errors
 /// Only on a kernel failure.
 pub fn open_mold_inserts(
-    design: &Design,
+    si: &StackInput<'_>,
     index: usize,
     input: InsertInput<'_>,
 ) -> Result<Vec<MoldInsert>, GeometryError> {
-    let Some(l) = design.layers.get(index) else {
+    let Some(l) = si.layers.get(index) else {
         return Ok(Vec::new());
     };
     let mut out = Vec::new();

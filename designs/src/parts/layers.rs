@@ -13,13 +13,13 @@ use crate::error::{DesignError, GeometryContext};
 use crate::geometry::{revolve, ChordTolerance, GeometryError, Polyline2, Solid};
 use crate::markers::{self, MarkerSurface};
 use crate::parts::context::{ResolvedLayer, Stack};
-use crate::parts::family::FamilyInput;
 use crate::parts::layer_feature::solid_layer_profile;
 use crate::parts::layer_registry::seat_of;
 use crate::parts::member::{FeatureKey, MemberFeatures};
 use crate::parts::placement::with_pose;
+use crate::parts::stack_input::StackInput;
 use crate::parts::{Part, PrintTechnology};
-use crate::schema::{Design, LayerProcess, Technology};
+use crate::schema::{LayerProcess, Technology};
 use serde_json::json;
 
 pub use crate::parts::layer_markers::{
@@ -118,13 +118,13 @@ fn tip_solids(pm: &PlacedMarkers, tol: ChordTolerance) -> Result<Vec<Solid>, Geo
 /// The solid bounded by the body's surface at `offset_mm`, continued `extend_mm` below the
 /// base plane (see [`crate::profile::BodyProfile::solid_profile`]), revolved at `tol`.
 pub(crate) fn body_solid(
-    design: &Design,
+    si: &StackInput<'_>,
     offset_mm: f64,
     extend_mm: f64,
     tol: ChordTolerance,
 ) -> Result<Solid, GeometryError> {
     revolve(
-        &design.body.solid_profile(offset_mm, extend_mm, tol.half()),
+        &si.ctx.body.solid_profile(offset_mm, extend_mm, tol.half()),
         tol,
     )
     .and_then(|mesh| Solid::from_mesh(&mesh))
@@ -132,8 +132,12 @@ pub(crate) fn body_solid(
 
 /// The highest z of the surface at `offset_mm` with its outward features: the pole plus the
 /// tallest outward feature, mm (sensor frame).
-pub(crate) fn features_top_z_mm(design: &Design, offset_mm: f64, sets: &[&PlacedMarkers]) -> f64 {
-    design.body.pole_z_mm(offset_mm)
+pub(crate) fn features_top_z_mm(
+    si: &StackInput<'_>,
+    offset_mm: f64,
+    sets: &[&PlacedMarkers],
+) -> f64 {
+    si.ctx.body.pole_z_mm(offset_mm)
         + sets
             .iter()
             .filter(|p| p.direction > 0.0)
@@ -183,7 +187,7 @@ pub(crate) fn apply_features_signed(
 /// The solid enclosed by a boundary surface (offset `offset_mm`), continued `below_base_mm`
 /// under the base plane, with the features carried by that surface.
 fn enclosed(
-    design: &Design,
+    si: &StackInput<'_>,
     offset_mm: f64,
     below_base_mm: f64,
     sets: &[&PlacedMarkers],
@@ -191,7 +195,7 @@ fn enclosed(
     stems_only: bool,
 ) -> Result<Solid, GeometryError> {
     let base = Solid::from_mesh(&revolve(
-        &design
+        &si.ctx
             .body
             .solid_profile(offset_mm, below_base_mm, tol.half()),
         tol,
@@ -203,16 +207,16 @@ fn enclosed(
 /// solid under its outer surface down to the base plane, less the seat a layer feature cuts
 /// into it ([`crate::parts::layer_registry::seat_of`]).
 fn solid_enclosed(
-    design: &Design,
+    si: &StackInput<'_>,
     l: &ResolvedLayer,
     sets: &[&PlacedMarkers],
     tol: ChordTolerance,
     stems_only: bool,
 ) -> Result<Solid, GeometryError> {
-    let Some(r) = seat_of(design, l.index) else {
-        return enclosed(design, l.outer_offset_mm, 0.0, sets, tol, stems_only);
+    let Some(r) = seat_of(si, l.index) else {
+        return enclosed(si, l.outer_offset_mm, 0.0, sets, tol, stems_only);
     };
-    let pl = solid_layer_profile(&design.body, l.outer_offset_mm, Some(&r), tol.half());
+    let pl = solid_layer_profile(&si.ctx.body, l.outer_offset_mm, Some(&r), tol.half());
     apply_features(
         Solid::from_mesh(&revolve(&pl, tol)?)?,
         sets,
@@ -227,15 +231,15 @@ fn solid_enclosed(
 /// # Errors
 /// Only on a kernel failure.
 pub fn layer_solid(
-    design: &Design,
+    si: &StackInput<'_>,
     stack: &Stack,
     i: usize,
     tol: ChordTolerance,
 ) -> Result<Solid, GeometryError> {
     let l = &stack.layers[i];
-    let placed = place_layer_markers(design, l, tol);
+    let placed = place_layer_markers(si, l, tol);
     let stems_only = placed.iter().any(|p| p.spec.tip_material.is_some());
-    let (coat_outer, coat_inner) = taken_features(design, stack, i, tol);
+    let (coat_outer, coat_inner) = taken_features(si, stack, i, tol);
     let (mut outer, mut inner) = (
         on_surface(&placed, MarkerSurface::Outer),
         on_surface(&placed, MarkerSurface::Inner),
@@ -243,10 +247,10 @@ pub fn layer_solid(
     outer.extend(&coat_outer);
     inner.extend(&coat_inner);
     if l.solid {
-        return solid_enclosed(design, l, &outer, tol, stems_only);
+        return solid_enclosed(si, l, &outer, tol, stems_only);
     }
-    let o = enclosed(design, l.outer_offset_mm, 0.0, &outer, tol, stems_only)?;
-    let inn = enclosed(design, l.inner_offset_mm, 1.0, &inner, tol, stems_only)?;
+    let o = enclosed(si, l.outer_offset_mm, 0.0, &outer, tol, stems_only)?;
+    let inn = enclosed(si, l.inner_offset_mm, 1.0, &inner, tol, stems_only)?;
     o.difference(&inn)
 }
 
@@ -258,15 +262,15 @@ pub fn layer_solid(
 /// # Errors
 /// Only on a kernel failure.
 pub fn layer_features(
-    design: &Design,
+    si: &StackInput<'_>,
     stack: &Stack,
     i: usize,
     tol: ChordTolerance,
 ) -> Result<MemberFeatures, GeometryError> {
     let l = &stack.layers[i];
-    let placed = place_layer_markers(design, l, tol);
+    let placed = place_layer_markers(si, l, tol);
     let stems_only = placed.iter().any(|p| p.spec.tip_material.is_some());
-    let (coat_outer, coat_inner) = taken_features(design, stack, i, tol);
+    let (coat_outer, coat_inner) = taken_features(si, stack, i, tol);
     let mut out = MemberFeatures::default();
     let sets = placed
         .iter()
@@ -299,7 +303,7 @@ pub fn layer_features(
 /// # Errors
 /// Only on a kernel failure.
 pub fn layer_stand_in(
-    design: &Design,
+    si: &StackInput<'_>,
     stack: &Stack,
     i: usize,
     features: &MemberFeatures,
@@ -307,10 +311,10 @@ pub fn layer_stand_in(
 ) -> Result<Solid, GeometryError> {
     let l = &stack.layers[i];
     let shell = if l.solid {
-        solid_enclosed(design, l, &[], tol, false)?
+        solid_enclosed(si, l, &[], tol, false)?
     } else {
-        enclosed(design, l.outer_offset_mm, 0.0, &[], tol, false)?.difference(&enclosed(
-            design,
+        enclosed(si, l.outer_offset_mm, 0.0, &[], tol, false)?.difference(&enclosed(
+            si,
             l.inner_offset_mm,
             1.0,
             &[],
@@ -354,16 +358,16 @@ fn feature_key(pm: &PlacedMarkers, stems_only: bool) -> FeatureKey {
 /// # Errors
 /// [`GeometryError`] if the kernel fails.
 pub fn inner_cavity(
-    design: &Design,
+    si: &StackInput<'_>,
     stack: &Stack,
     i: usize,
     tol: ChordTolerance,
 ) -> Result<Solid, GeometryError> {
     let l = &stack.layers[i];
-    let placed = place_layer_markers(design, l, tol);
+    let placed = place_layer_markers(si, l, tol);
     let inner = on_surface(&placed, MarkerSurface::Inner);
     // whole features (stems and tips as one solid each): no seam where a tip meets its stem
-    enclosed(design, l.inner_offset_mm, 0.0, &inner, tol, false)
+    enclosed(si, l.inner_offset_mm, 0.0, &inner, tol, false)
 }
 
 /// Parts and pour numbers of one cast or printed layer built here.
@@ -378,18 +382,18 @@ pub(crate) fn marker_summary(
     l: &ResolvedLayer,
     placed: &[PlacedMarkers],
     tech: Technology,
-    design: &Design,
+    si: &StackInput<'_>,
 ) -> Vec<serde_json::Value> {
     placed
         .iter()
         .map(|p| {
             // The technologies whose printer profile passes the same marker rules that
             // validate the design (feature or hole size, walls, rim margin).
-            let printable: Vec<&str> = design.layers[l.index]
+            let printable: Vec<&str> = si.layers[l.index]
                 .markers
                 .iter()
                 .position(|s| *s == p.spec)
-                .map(|j| printable_with(design, l, j))
+                .map(|j| printable_with(si, l, j))
                 .unwrap_or_default()
                 .into_iter()
                 .map(|t| match t {
@@ -443,9 +447,9 @@ pub fn set_forming(
 }
 
 /// The parameter paths a layer's parts are built from: the layer, and the mold for a cast one.
-pub(crate) fn layer_params(design: &Design, i: usize) -> Vec<String> {
+pub(crate) fn layer_params(si: &StackInput<'_>, i: usize) -> Vec<String> {
     let mut p = vec![format!("layers[{i}]")];
-    if design.layers[i].process == LayerProcess::Cast {
+    if si.layers[i].process == LayerProcess::Cast {
         p.push("mold".into());
     }
     p
@@ -457,16 +461,16 @@ pub(crate) fn layer_params(design: &Design, i: usize) -> Vec<String> {
 /// set with its feature, surface, direction and placements, degrees). Sensor frame, mm.
 /// `i` must index `stack.layers` (panics otherwise, as [`layer_solid`]).
 pub fn layer_twin_params(
-    design: &Design,
+    si: &StackInput<'_>,
     stack: &Stack,
     i: usize,
     tol: ChordTolerance,
 ) -> serde_json::Value {
     let l = &stack.layers[i];
-    let placed = place_layer_markers(design, l, tol);
-    let tech = feature_technology(design, &design.layers[i]);
-    let mut sets = marker_summary(l, &placed, tech, design);
-    let (outer, inner) = taken_features(design, stack, i, tol);
+    let placed = place_layer_markers(si, l, tol);
+    let tech = feature_technology(si, &si.layers[i]);
+    let mut sets = marker_summary(l, &placed, tech, si);
+    let (outer, inner) = taken_features(si, stack, i, tol);
     sets.extend(
         outer
             .iter()
@@ -477,7 +481,7 @@ pub fn layer_twin_params(
             .iter()
             .map(|p| twin_marker_set(p, MarkerSurface::Inner)),
     );
-    twin_params(design, l, json!(sets))
+    twin_params(si, l, json!(sets))
 }
 
 /// A placed marker set as the CadQuery twins build it (`export/python/twins/cq_layers.py`):
@@ -500,43 +504,44 @@ pub fn twin_marker_set(p: &PlacedMarkers, surface: MarkerSurface) -> serde_json:
 }
 
 fn twin_params(
-    design: &Design,
+    si: &StackInput<'_>,
     l: &ResolvedLayer,
     markers: serde_json::Value,
 ) -> serde_json::Value {
     let mut v = json!({
-        "layer": l.name, "body": design.body, "outer_offset_mm": l.outer_offset_mm,
+        "layer": l.name, "body": si.ctx.body, "outer_offset_mm": l.outer_offset_mm,
         "inner_offset_mm": if l.solid { serde_json::Value::Null } else { json!(l.inner_offset_mm) },
         "solid": l.solid, "markers": markers,
     });
-    crate::parts::layer_registry::twin_params(design, l.index, &mut v);
+    crate::parts::layer_registry::twin_params(si, l.index, &mut v);
     v
 }
 
 /// `build` of what every strategy builds layer `i` of `stack` from ([`LayerBuild`]): its
 /// placed markers, their summary, its twin parameters and the mold's print technologies.
 pub(crate) fn with_layer_build<'d, T>(
-    design: &'d Design,
+    si: &'d StackInput<'d>,
     stack: &'d Stack,
     i: usize,
     tol: ChordTolerance,
+    with_skin: WithSkin<'d>,
     build: impl FnOnce(LayerBuild<'_>) -> T,
 ) -> T {
     let l = &stack.layers[i];
     let name = l.name.clone();
-    let placed = place_layer_markers(design, l, tol);
-    let spec_layer = &design.layers[i];
-    let tech_setting = feature_technology(design, spec_layer);
-    let markers_json = marker_summary(l, &placed, tech_setting, design);
-    let fixture_tech: PrintTechnology = design.mold.fixture_print_technology.into();
-    let cavity_tech: PrintTechnology = design.mold.cavity_print_technology.into();
+    let placed = place_layer_markers(si, l, tol);
+    let spec_layer = &si.layers[i];
+    let tech_setting = feature_technology(si, spec_layer);
+    let markers_json = marker_summary(l, &placed, tech_setting, si);
+    let fixture_tech: PrintTechnology = si.mold.fixture_print_technology.into();
+    let cavity_tech: PrintTechnology = si.mold.cavity_print_technology.into();
     let (outer, inner) = (
         on_surface(&placed, MarkerSurface::Outer),
         on_surface(&placed, MarkerSurface::Inner),
     );
-    let base_params = twin_params(design, l, json!(markers_json));
+    let base_params = twin_params(si, l, json!(markers_json));
     let b = LayerBuild {
-        design,
+        si,
         stack,
         i,
         tol,
@@ -549,16 +554,22 @@ pub(crate) fn with_layer_build<'d, T>(
         base_params,
         fixture_tech,
         cavity_tech,
+        with_skin,
     };
     build(b)
 }
 
-/// What a printed layer and every strategy of [`crate::parts::molds::build_layer`] build from: layer `i` of `stack` (`l`), its
-/// name, its placed markers (all, on the outer surface, on the inner surface), its marker
-/// summary, the twin parameters its parts carry, and the print technologies of the mold's
-/// fixtures and cavities.
+/// The parts the families print with the outermost layer when it is printed
+/// ([`crate::parts::registry::printed_with_skin`]), asked only when that layer is built.
+pub type WithSkin<'a> = &'a (dyn Fn() -> Result<Vec<Part>, DesignError> + Sync);
+
+/// What a printed layer and every strategy of [`crate::parts::molds::build_layer`] build
+/// from: layer `i` of `stack` (`l`), its name, its placed markers (all, on the outer surface,
+/// on the inner surface), its marker summary, the twin parameters its parts carry, the print
+/// technologies of the mold's fixtures and cavities, and the families' parts printed with the
+/// outermost layer.
 pub struct LayerBuild<'a> {
-    pub(crate) design: &'a Design,
+    pub(crate) si: &'a StackInput<'a>,
     pub(crate) stack: &'a Stack,
     pub(crate) i: usize,
     pub(crate) tol: ChordTolerance,
@@ -571,42 +582,39 @@ pub struct LayerBuild<'a> {
     pub(crate) base_params: serde_json::Value,
     pub(crate) fixture_tech: PrintTechnology,
     pub(crate) cavity_tech: PrintTechnology,
+    pub(crate) with_skin: WithSkin<'a>,
 }
 
 /// The parts of a printed layer: the skin with its features (stems only when the tips are
 /// separate), one `marker_tips` part per marker set with a `tip_material`, and for the
-/// outermost layer of a design with a `shaft_body` the tip's fitting; all moved onto the
-/// plate by the same translation, and grouped when there is more than the skin. No pours.
+/// outermost layer the families' parts printed with it (a shaft body's tip fitting,
+/// [`LayerBuild::with_skin`]); all moved onto the plate by the same translation, and grouped
+/// when there is more than the skin. No pours.
 pub(crate) fn build_printed_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
-    let (design, stack, i, tol, l, name) = (b.design, b.stack, b.i, b.tol, b.l, &b.name);
-    let spec_layer = &design.layers[i];
+    let (si, stack, i, tol, l, name) = (b.si, b.stack, b.i, b.tol, b.l, &b.name);
+    let spec_layer = &si.layers[i];
     let g = |r: Result<Solid, GeometryError>| r.part(name);
-    let skin = g(layer_solid(design, stack, i, tol))?;
+    let skin = g(layer_solid(si, stack, i, tol))?;
     let tech: PrintTechnology = spec_layer
         .print_technology
         .unwrap_or(Technology::Polyjet)
         .into();
-    // The tip's fitting of a shaft body prints with the outermost (printed) layer, as
-    // a further volume of its object (Pestell et al. Sec. III-A).
-    let fitting = match &design.shaft_body {
-        Some(sb) if i + 1 == stack.layers.len() => {
-            Some(g(crate::parts::shaft_body::tip_fitting_solid(
-                sb,
-                FamilyInput {
-                    ctx: &design.context(),
-                    stack,
-                    tol,
-                },
-            ))?)
-        }
-        _ => None,
+    // The families' parts printed with the outermost layer, as further volumes of its
+    // object (the shaft body's tip fitting).
+    let with_skin = if i + 1 == stack.layers.len() {
+        (b.with_skin)()?
+    } else {
+        Vec::new()
     };
-    let group = (b.placed.iter().any(|p| p.spec.tip_material.is_some()) || fitting.is_some())
+    let group = (b.placed.iter().any(|p| p.spec.tip_material.is_some()) || !with_skin.is_empty())
         .then(|| name.clone());
-    // Skin, tips and fitting move together onto the plate (same translation).
-    let extent = match &fitting {
-        Some(f) => Solid::compose(&[skin.clone(), f.clone()]),
-        None => skin.clone(),
+    // Skin, tips and the families' parts move together onto the plate (same translation).
+    let extent = if with_skin.is_empty() {
+        skin.clone()
+    } else {
+        let mut all = vec![skin.clone()];
+        all.extend(with_skin.iter().map(|p| p.solid.clone()));
+        Solid::compose(&all)
     };
     let shift = extent
         .bounding_box()
@@ -645,29 +653,17 @@ pub(crate) fn build_printed_layer(b: LayerBuild) -> Result<LayerOutput, DesignEr
             group: group.clone(),
         });
     }
-    if let (Some(f), Some(sb)) = (fitting, &design.shaft_body) {
+    let carriers: Vec<String> = parts.iter().map(|p| p.name.clone()).collect();
+    for p in with_skin {
         parts.push(Part {
-            name: "tip_fitting".into(),
-            role: "tip_fitting".into(),
-            description: format!(
-                "The tip's rigid bayonet fitting, printed in the second material with {name} (Pestell et al. Sec. III-A)"
-            ),
-            material: sb.tip_fitting.material.clone(),
             print_technology: tech,
-            solid: f.translate(shift),
-            params: with_pose(
-                crate::parts::shaft_body::twin_params(&design.context(), sb, stack),
-                &pose,
-            ),
+            solid: p.solid.translate(shift),
+            params: with_pose(p.params, &pose),
             group: group.clone(),
+            ..p
         });
     }
     let mut markers = b.markers_json;
-    let carriers: Vec<String> = parts
-        .iter()
-        .filter(|p| p.role != "tip_fitting")
-        .map(|p| p.name.clone())
-        .collect();
     set_forming(&mut markers, &carriers, &carriers, 0.0);
     Ok(LayerOutput {
         parts,

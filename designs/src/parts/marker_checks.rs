@@ -9,19 +9,20 @@ use crate::parts::layer_markers::{
     direction, feature_end_centres, feature_technology, formed_on_stack_layer, max_inward_reach,
     recess_clearance_to_base_mm, rim_margin, surface_offset,
 };
-use crate::schema::{Design, LayerProcess, MoldStrategy, PrinterProfile, Technology};
+use crate::parts::stack_input::StackInput;
+use crate::schema::{LayerProcess, MoldStrategy, PrinterProfile, Technology};
 
 /// Rules on marker patterns: they place, do not overlap, leave the printer's minimum wall,
 /// and their features print on the technology that makes them (the mold's cavity printer for
 /// a cast layer, the layer's own for a printed one).
-pub fn check_markers(design: &Design, layers: &[ResolvedLayer], errs: &mut Vec<ParamError>) {
+pub fn check_markers(si: &StackInput<'_>, layers: &[ResolvedLayer], errs: &mut Vec<ParamError>) {
     for l in layers {
-        let tech = feature_technology(design, &design.layers[l.index]);
-        let own = marker_errors(design, l, tech);
+        let tech = feature_technology(si, &si.layers[l.index]);
+        let own = marker_errors(si, l, tech);
         let clean = own.is_empty();
         errs.extend(own);
         if clean {
-            coat_former_errors(design, layers, l, errs);
+            coat_former_errors(si, layers, l, errs);
         }
     }
 }
@@ -30,7 +31,7 @@ pub fn check_markers(design: &Design, layers: &[ResolvedLayer], errs: &mut Vec<P
 /// mm: the coats sprayed into it before the pour ([`crate::parts::molds::cast_plans`]) plus
 /// the mold's clearance; 0 for a layer not cast in a `direct` or `master` mold (the other
 /// strategies form the layer's outer surface itself).
-pub fn cavity_gap_mm(design: &Design, layers: &[ResolvedLayer], l: &ResolvedLayer) -> f64 {
+pub fn cavity_gap_mm(si: &StackInput<'_>, layers: &[ResolvedLayer], l: &ResolvedLayer) -> f64 {
     if l.process != LayerProcess::Cast || !l.mold_strategy.holds_core() {
         return 0.0;
     }
@@ -39,7 +40,7 @@ pub fn cavity_gap_mm(design: &Design, layers: &[ResolvedLayer], l: &ResolvedLaye
         .take_while(|s| s.process == LayerProcess::Sprayed)
         .last()
         .map_or(l.outer_offset_mm, |s| s.outer_offset_mm);
-    outer + design.mold.cavity_clearance_mm - l.outer_offset_mm
+    outer + si.mold.cavity_clearance_mm - l.outer_offset_mm
 }
 
 /// A dimple on the outer surface of a cast layer under sprayed coats is formed by a pin in the
@@ -47,7 +48,7 @@ pub fn cavity_gap_mm(design: &Design, layers: &[ResolvedLayer], l: &ResolvedLaye
 /// all round ([`PlacedMarkers::conformal`]), and it must be a feature the cavity's printer
 /// makes. A dimple of up to twice the coats' thickness is filled by the coat.
 fn coat_former_errors(
-    design: &Design,
+    si: &StackInput<'_>,
     layers: &[ResolvedLayer],
     l: &ResolvedLayer,
     errs: &mut Vec<ParamError>,
@@ -58,11 +59,12 @@ fn coat_former_errors(
         .get(l.index + 1)
         .filter(|n| n.process == LayerProcess::Cast && formed_on_stack_layer(n))
     {
-        let min_wall = design
+        let min_wall = si
+            .ctx
             .printers
-            .get(design.mold.cavity_print_technology)
+            .get(si.mold.cavity_print_technology)
             .min_wall_mm;
-        for (j, spec) in design.layers[l.index].markers.iter().enumerate() {
+        for (j, spec) in si.layers[l.index].markers.iter().enumerate() {
             let f = &spec.feature;
             if spec.surface == MarkerSurface::Outer
                 && f.side() == Polarity::Raised
@@ -82,18 +84,18 @@ fn coat_former_errors(
             }
         }
     }
-    let t = cavity_gap_mm(design, layers, l);
+    let t = cavity_gap_mm(si, layers, l);
     if t <= 0.0 {
         return;
     }
-    let tech = design.mold.cavity_print_technology;
-    let min = design.printers.get(tech).min_feature_mm;
+    let tech = si.mold.cavity_print_technology;
+    let min = si.ctx.printers.get(tech).min_feature_mm;
     let coats: Vec<&str> = layers[l.index + 1..]
         .iter()
         .take_while(|s| s.process == LayerProcess::Sprayed)
         .map(|s| s.name.as_str())
         .collect();
-    for (j, spec) in design.layers[l.index].markers.iter().enumerate() {
+    for (j, spec) in si.layers[l.index].markers.iter().enumerate() {
         if spec.surface != MarkerSurface::Outer || spec.feature.side() != Polarity::Recessed {
             continue;
         }
@@ -106,7 +108,7 @@ fn coat_former_errors(
                     "the {t:.3} mm sprayed into the mold over layer '{}' ({}{}) covers the pin that forms each dimple: the pin is {former:.3} mm across, below the minimum feature {min} mm of printer profile '{}' that prints the mold (a coat fills a dimple of up to twice its thickness); give at least {:.3} mm, or put the markers on a surface no coat covers",
                     l.name,
                     coats.join(", "),
-                    if design.mold.cavity_clearance_mm > 0.0 { " and the cavity clearance" } else { "" },
+                    if si.mold.cavity_clearance_mm > 0.0 { " and the cavity clearance" } else { "" },
                     format!("{tech:?}").to_lowercase(),
                     min + 2.0 * t
                 ),
@@ -118,13 +120,13 @@ fn coat_former_errors(
 /// The technologies that could make the features of marker pattern `j` of layer `l`: those
 /// for which [`marker_errors`], the rules that validate the design, report nothing on that
 /// pattern (nor on the layer's markers as a whole).
-pub fn printable_with(design: &Design, l: &ResolvedLayer, j: usize) -> Vec<Technology> {
+pub fn printable_with(si: &StackInput<'_>, l: &ResolvedLayer, j: usize) -> Vec<Technology> {
     let own = format!("layers[{}].markers[{j}]", l.index);
     let shared = format!("layers[{}].markers", l.index);
     [Technology::Fdm, Technology::Sla, Technology::Polyjet]
         .into_iter()
         .filter(|&t| {
-            marker_errors(design, l, t).iter().all(|e| {
+            marker_errors(si, l, t).iter().all(|e| {
                 !(e.path == own || e.path.starts_with(&format!("{own}.")) || e.path == shared)
             })
         })
@@ -135,20 +137,20 @@ pub fn printable_with(design: &Design, l: &ResolvedLayer, j: usize) -> Vec<Techn
 /// technology `tech` (its profile's minimum wall, hole and feature, and the rim margin that
 /// follows from them). [`check_markers`] applies it with the layer's own technology,
 /// [`printable_with`] with each.
-pub fn marker_errors(design: &Design, l: &ResolvedLayer, tech: Technology) -> Vec<ParamError> {
+pub fn marker_errors(si: &StackInput<'_>, l: &ResolvedLayer, tech: Technology) -> Vec<ParamError> {
     let mut errs = Vec::new();
-    let spec_layer = &design.layers[l.index];
+    let spec_layer = &si.layers[l.index];
     let tech_name = format!("{tech:?}").to_lowercase();
-    let profile = design.printers.get(tech);
+    let profile = si.ctx.printers.get(tech);
     for (j, spec) in spec_layer.markers.iter().enumerate() {
         let path = format!("layers[{}].markers[{j}]", l.index);
-        if !marker_shape_errors(design, l, &path, spec, &mut errs) {
+        if !marker_shape_errors(si, l, &path, spec, &mut errs) {
             continue;
         }
-        if !marker_size_errors(design, l, profile, &tech_name, &path, spec, &mut errs) {
+        if !marker_size_errors(si, l, profile, &tech_name, &path, spec, &mut errs) {
             continue;
         }
-        marker_layout_errors(design, l, profile, &tech_name, &path, spec, &mut errs);
+        marker_layout_errors(si, l, profile, &tech_name, &path, spec, &mut errs);
     }
     // Recesses from both surfaces of a shell must leave the minimum wall between them.
     if !l.solid {
@@ -181,13 +183,13 @@ pub fn marker_errors(design: &Design, l: &ResolvedLayer, tech: Technology) -> Ve
 /// reach of inward features, and `tip_material` only with raised features on a printed layer.
 /// Pushes its errors to `errs`; false when the checks that follow no longer apply.
 fn marker_shape_errors(
-    design: &Design,
+    si: &StackInput<'_>,
     l: &ResolvedLayer,
     path: &str,
     spec: &MarkerSpec,
     errs: &mut Vec<ParamError>,
 ) -> bool {
-    let spec_layer = &design.layers[l.index];
+    let spec_layer = &si.layers[l.index];
     let f = &spec.feature;
     if !(f.diameter_mm > 0.0 && f.diameter_mm.is_finite()) {
         errs.push(ParamError::new(
@@ -222,14 +224,14 @@ fn marker_shape_errors(
     if spec_layer.process == LayerProcess::Sprayed {
         let under = (0..l.index)
             .rev()
-            .find(|&k| design.layers[k].process != LayerProcess::Sprayed);
+            .find(|&k| si.layers[k].process != LayerProcess::Sprayed);
         errs.push(ParamError::new(
             path.to_string(),
             format!("{} markers on sprayed layer '{}'", markers::layout_name(spec.pattern.layout), l.name),
             match under {
                 Some(k) => format!(
                     "a sprayed coat follows the surface it is sprayed onto and forms no features of its own; put them on layers[{k}].markers with surface: outer (layer '{}' under the coat): its mold carries them through the coat",
-                    design.layers[k].name
+                    si.layers[k].name
                 ),
                 None => "a sprayed coat follows the surface it is sprayed onto and forms no features of its own".to_string(),
             },
@@ -255,7 +257,7 @@ fn marker_shape_errors(
                     match l.index.checked_sub(1) {
                         Some(k) => format!(
                             "the layer is cast onto layer '{}', whose mold forms this surface; put them on layers[{k}].markers with surface: outer and the opposite polarity",
-                            design.layers[k].name
+                            si.layers[k].name
                         ),
                         None => "the core forms this surface and no mold touches it; put them on the outer surface".to_string(),
                     }
@@ -266,13 +268,13 @@ fn marker_shape_errors(
     // Features pointing inward must end before the body's centre of curvature: past it
     // they cross each other and the axis (the offset surface at their ends folds).
     let off = surface_offset(l, spec.surface);
-    if direction(spec) < 0.0 && !design.body.offset_is_valid(off - f.height_mm) {
+    if direction(spec) < 0.0 && !si.ctx.body.offset_is_valid(off - f.height_mm) {
         errs.push(ParamError::new(
             format!("{path}.feature.height_mm"),
             f.height_mm,
             format!(
                 "must be below {:.3} mm: the features point inward from the {} surface (offset {off:.3} mm) and must end before the body's centre of curvature, its axis and its base plane",
-                max_inward_reach(design, off),
+                max_inward_reach(si, off),
                 match spec.surface {
                     MarkerSurface::Outer => "outer",
                     MarkerSurface::Inner => "inner",
@@ -299,7 +301,7 @@ fn marker_shape_errors(
 /// leaving its minimum wall, then the fields of the pattern. Pushes its errors to `errs`;
 /// false when the checks that follow no longer apply.
 fn marker_size_errors(
-    design: &Design,
+    si: &StackInput<'_>,
     l: &ResolvedLayer,
     profile: &PrinterProfile,
     tech_name: &str,
@@ -308,7 +310,7 @@ fn marker_size_errors(
     errs: &mut Vec<ParamError>,
 ) -> bool {
     let f = &spec.feature;
-    let molded = design.layers[l.index].process == LayerProcess::Cast;
+    let molded = si.layers[l.index].process == LayerProcess::Cast;
     // Printability: in a mold, a raised feature is a hole and a recessed one a bump.
     let (what, min) = match (molded, f.side()) {
         (true, Polarity::Raised) | (false, Polarity::Recessed) => {
@@ -365,7 +367,7 @@ fn marker_size_errors(
 /// ends, and recesses into a solid layer leave its minimum wall above the base plane.
 /// Pushes its errors to `errs`.
 fn marker_layout_errors(
-    design: &Design,
+    si: &StackInput<'_>,
     l: &ResolvedLayer,
     profile: &PrinterProfile,
     tech_name: &str,
@@ -374,7 +376,7 @@ fn marker_layout_errors(
     errs: &mut Vec<ParamError>,
 ) {
     let f = &spec.feature;
-    let surface = Surface::new(&design.body, surface_offset(l, spec.surface));
+    let surface = Surface::new(&si.ctx.body, surface_offset(l, spec.surface));
     let margin = rim_margin(spec, profile.min_wall_mm);
     let placed = match markers::place(&surface, &spec.pattern, margin) {
         Ok(m) => m,
@@ -446,7 +448,7 @@ fn marker_layout_errors(
     }
     // A recess into a solid layer must not cut through its flat base.
     if l.solid && f.side() == Polarity::Recessed {
-        let worst = recess_clearance_to_base_mm(&placed, f, design.body.base_z_mm());
+        let worst = recess_clearance_to_base_mm(&placed, f, si.ctx.body.base_z_mm());
         if worst < profile.min_wall_mm {
             errs.push(ParamError::new(
                     format!("{path}.feature.height_mm"),

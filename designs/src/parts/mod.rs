@@ -28,6 +28,7 @@ pub mod robot_mount;
 pub mod seat;
 pub mod shaft_body;
 pub mod spacer;
+pub mod stack_input;
 
 pub use context::{Context, ResolvedCore, ResolvedLayer, Stack};
 pub use member::{

@@ -69,6 +69,11 @@ pub trait Section: Sync {
     /// # Errors
     /// As [`Family::members`].
     fn members(&self, at: SectionInput<'_>) -> Result<Vec<Member>, DesignError>;
+    /// [`Family::printed_with_skin`]; none without the family.
+    ///
+    /// # Errors
+    /// As [`Family::printed_with_skin`].
+    fn printed_with_skin(&self, at: SectionInput<'_>) -> Result<Vec<Part>, DesignError>;
     /// [`Family::bought_items`].
     fn bought_items(&self, d: &Design) -> Vec<String>;
     /// [`Family::assembly_steps`].
@@ -197,6 +202,11 @@ impl<F: Family> Section for Registered<F> {
         self.with(at, F::members).unwrap_or_else(|| Ok(Vec::new()))
     }
 
+    fn printed_with_skin(&self, at: SectionInput<'_>) -> Result<Vec<Part>, DesignError> {
+        self.with(at, F::printed_with_skin)
+            .unwrap_or_else(|| Ok(Vec::new()))
+    }
+
     fn bought_items(&self, d: &Design) -> Vec<String> {
         (self.params)(d).map_or_else(Vec::new, F::bought_items)
     }
@@ -230,3 +240,21 @@ pub static FAMILIES: &[&dyn Section] = &[
     &Registered::<fingertip_base::FingertipBaseFamily>::at(|d| d.fingertip_base.as_ref()),
     &Registered::<spacer::SpacerFamily>::at(|d| d.spacer.as_ref()),
 ];
+
+/// The parts every family prints with the outermost layer of `design` when it is printed
+/// ([`Family::printed_with_skin`]), family by family.
+///
+/// # Errors
+/// As [`Family::printed_with_skin`].
+pub fn printed_with_skin(
+    design: &Design,
+    stack: &Stack,
+    tol: ChordTolerance,
+) -> Result<Vec<Part>, DesignError> {
+    let at = SectionInput { design, stack, tol };
+    let mut out = Vec::new();
+    for f in FAMILIES {
+        out.extend(f.printed_with_skin(at)?);
+    }
+    Ok(out)
+}

@@ -164,7 +164,7 @@ pub fn evaluate_scoped(
     let mut markers = Vec::new();
     let mut placed_all = Vec::new();
     for l in &stack.layers {
-        let placed = place_layer_markers(design, l, tol);
+        let placed = place_layer_markers(&design.stack_input(), l, tol);
         for p in &placed {
             markers.push(MarkerMetrics {
                 layer: l.name.clone(),
@@ -266,7 +266,9 @@ pub fn min_wall(
     }
     let b = &design.body;
     for l in &stack.layers {
-        if let Some((key, r)) = crate::parts::layer_registry::layer_seat(design, l.index) {
+        if let Some((key, r)) =
+            crate::parts::layer_registry::layer_seat(&design.stack_input(), l.index)
+        {
             walls.push((
                 r.skin_mm(b, l.outer_offset_mm, ChordTolerance::default().half()),
                 format!(
@@ -280,7 +282,7 @@ pub fn min_wall(
     let open_block = design.mold.open_block.as_ref();
     for l in stack.layers.iter().filter(cast) {
         if let (Some(ob), MoldStrategy::Open) = (open_block, l.mold_strategy) {
-            let (rim, height) = crate::parts::molds::open_cavity_mm(design, l);
+            let (rim, height) = crate::parts::molds::open_cavity_mm(&design.stack_input(), l);
             walls.push((
                 ob.width_mm / 2.0 - rim,
                 "mold.open_block.width_mm: open mold's wall beside the cavity".into(),

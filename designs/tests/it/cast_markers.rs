@@ -185,7 +185,7 @@ fn tutorial_layer_loses_the_dimples_volume_within_one_percent() {
     let materials = fabkit_designs::materials::MaterialsTable::embedded().unwrap();
     let volume = |d: &Design| {
         let stack = fabkit_designs::stack::validate(d, &materials, fine).unwrap();
-        fabkit_designs::layers::layer_solid(d, &stack, 1, fine)
+        fabkit_designs::layers::layer_solid(&d.stack_input(), &stack, 1, fine)
             .unwrap()
             .volume()
     };
@@ -371,7 +371,7 @@ fn the_cast_check_catches_markers_shaped_otherwise_than_the_tray_casts_them() {
     let mut kit = build_kit(&d, tol).unwrap();
     let ok = fabkit_designs::cast_check::check_casts(&d, &kit, tol).unwrap();
     assert!(ok.iter().all(|c| c.holds()), "{ok:?}");
-    let layers = fabkit_designs::flat::flat_layers(&d).unwrap();
+    let layers = fabkit_designs::stack::flat::flat_layers(&d).unwrap();
     let outline = d.body.flat_outline().unwrap();
     let member = kit
         .assembly

@@ -268,13 +268,13 @@ fn control_characters_in_text_are_refused_by_path() {
 /// (no cavity block left).
 #[test]
 fn kernel_errors_name_the_parameters_of_the_failing_solid() {
-    use fabkit_designs::{molds, DesignError};
+    use fabkit_designs::{build, molds, DesignError};
     let tol = ChordTolerance::default();
     let materials = MaterialsTable::embedded().unwrap();
     let mut d = library::load("tactip_dualmodal").unwrap();
     let st = stack::validate(&d, &materials, tol).unwrap();
     d.layers[0].markers[0].feature.diameter_mm = 0.0;
-    match molds::build_layer(&d, &st, 0, tol) {
+    match build::build_layer(&d, &st, 0, tol) {
         Err(e @ DesignError::Geometry { .. }) => {
             let DesignError::Geometry { params, .. } = &e else {
                 unreachable!()
@@ -290,10 +290,10 @@ fn kernel_errors_name_the_parameters_of_the_failing_solid() {
     let mut d = library::load("rtac0").unwrap();
     let st = stack::validate(&d, &materials, tol).unwrap();
     d.mold.draft_angle_deg = 90.0;
-    let plans = molds::cast_plans(&d, &st);
+    let plans = molds::cast_plans(&d.stack_input(), &st);
     let errs: Vec<DesignError> = plans
         .iter()
-        .filter_map(|p| molds::build_mold(&d, &st, p, tol).err())
+        .filter_map(|p| molds::build_mold(&d.stack_input(), &st, p, tol).err())
         .collect();
     assert!(!errs.is_empty());
     for e in errs {

@@ -23,7 +23,7 @@ fn estimate_is_within_a_small_factor_of_every_library_kit() {
             if let Some(outline) = d.body.flat_outline() {
                 // a flat skin's trays and layers: their own estimate (prisms, ribs, markers
                 // and their holes)
-                let layers = fabkit_designs::flat::validate(&d, &materials).unwrap();
+                let layers = fabkit_designs::stack::flat::validate(&d, &materials).unwrap();
                 let e = fabkit_designs::flat::estimated_triangles(
                     &outline,
                     &layers,

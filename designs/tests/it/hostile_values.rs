@@ -35,7 +35,7 @@ fn every_numeric_field_of_every_library_design_refuses_hostile_values_by_name() 
             for x in HOSTILE {
                 let m = with_number(&d, path, x).unwrap();
                 let valid = if m.body.flat_outline().is_some() {
-                    fabkit_designs::flat::validate(&m, &materials).map(|_| ())
+                    fabkit_designs::stack::flat::validate(&m, &materials).map(|_| ())
                 } else {
                     stack::validate(&m, &materials, tol).map(|_| ())
                 };
@@ -347,7 +347,7 @@ fn counts_that_once_allocated_or_passed_are_refused_by_name() {
         let g = d.layers[i].marker_grid.as_mut().unwrap();
         g.rows = rows;
         g.columns = columns;
-        let errs = fabkit_designs::flat::validate(&d, &MaterialsTable::embedded().unwrap())
+        let errs = fabkit_designs::stack::flat::validate(&d, &MaterialsTable::embedded().unwrap())
             .err()
             .map(|e| e.0)
             .unwrap_or_default();
@@ -603,7 +603,7 @@ fn a_count_past_any_count_is_said_by_its_fields_own_rule() {
         u64::from(u32::MAX),
     )
     .unwrap();
-    let errs = fabkit_designs::flat::validate(&d, &materials)
+    let errs = fabkit_designs::stack::flat::validate(&d, &materials)
         .unwrap_err()
         .0;
     assert!(

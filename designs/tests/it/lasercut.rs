@@ -28,7 +28,7 @@ const RECT_MM2: f64 = 92.0 * 92.0;
 fn soter_trays_are_stacks_of_sheets_of_the_right_stock_and_area() {
     let d = soter();
     let k = fabkit_designs::build_kit(&d, tol()).unwrap();
-    let layers = fabkit_designs::flat::flat_layers(&d).unwrap();
+    let layers = fabkit_designs::stack::flat::flat_layers(&d).unwrap();
     let outline = d.body.flat_outline().unwrap();
     let lc = d.mold.laser_cut.as_ref().unwrap();
     let reg = 4.0 * PI * 1.5 * 1.5;
@@ -117,7 +117,7 @@ fn soter_trays_are_stacks_of_sheets_of_the_right_stock_and_area() {
 fn each_tray_is_the_union_of_its_sheets_and_holds_its_pour() {
     let d = soter();
     let k = fabkit_designs::build_kit(&d, tol()).unwrap();
-    let layers = fabkit_designs::flat::flat_layers(&d).unwrap();
+    let layers = fabkit_designs::stack::flat::flat_layers(&d).unwrap();
     let outline = d.body.flat_outline().unwrap();
     let lc = d.mold.laser_cut.as_ref().unwrap();
     for (li, l) in layers.iter().enumerate() {
@@ -157,7 +157,7 @@ fn each_tray_is_the_union_of_its_sheets_and_holds_its_pour() {
 #[test]
 fn a_path_offset_by_half_the_kerf_cuts_the_nominal_sheet() {
     let d = soter();
-    let layers = fabkit_designs::flat::flat_layers(&d).unwrap();
+    let layers = fabkit_designs::stack::flat::flat_layers(&d).unwrap();
     let outline = d.body.flat_outline().unwrap();
     let mut lc = d.mold.laser_cut.clone().unwrap();
     for kerf in [0.1, 0.3] {

@@ -824,7 +824,7 @@ fn predict(design: &Design, stack: &Stack, i: usize, tol: ChordTolerance) -> Pre
         p.body_bound_mm3 += mer_in.area_to(mer_in.total()) * tol.mm();
         p.scale_mm3 += v_in;
     }
-    for pm in layers::place_layer_markers(design, l, tol) {
+    for pm in layers::place_layer_markers(&design.stack_input(), l, tol) {
         let f = &pm.spec.feature;
         let r = f.radius_mm();
         let surface = Surface::new(body, pm.offset_mm);
@@ -865,7 +865,7 @@ fn check_layer(
     tol: ChordTolerance,
 ) -> Result<Solid, TestCaseError> {
     let what = format!("{} layer {i}", design.name);
-    let solid = layers::layer_solid(design, stack, i, tol)
+    let solid = layers::layer_solid(&design.stack_input(), stack, i, tol)
         .map_err(|e| TestCaseError::fail(format!("{what}: {e}")))?;
     let mesh = solid.mesh();
     mesh.check_closed_manifold()
@@ -893,7 +893,7 @@ fn check_layer(
     );
     let mut bare = design.clone();
     bare.layers[stack.layers[i].index].markers.clear();
-    let v_bare = layers::layer_solid(&bare, stack, i, tol)
+    let v_bare = layers::layer_solid(&bare.stack_input(), stack, i, tol)
         .map_err(|e| TestCaseError::fail(format!("{what} without features: {e}")))?
         .volume();
     let dv = v - v_bare;
@@ -1040,7 +1040,7 @@ fn check_layer_case(c: &LayerCase) -> Result<(), TestCaseError> {
         Ok(s) => s,
         Err(_) => return Err(TestCaseError::reject("validation rejects the layer")),
     };
-    let pms = layers::place_layer_markers(&design, &stack.layers[0], tol);
+    let pms = layers::place_layer_markers(&design.stack_input(), &stack.layers[0], tol);
     if let Some(why) = unchecked_geometry_problem(&design, &pms) {
         return Err(TestCaseError::reject(why));
     }
@@ -1129,7 +1129,7 @@ fn feature_volume_signs_on_both_surfaces_of_a_shell() {
             tip_material: None,
         }];
         let stack = validate(&d, &materials(), tol).unwrap_or_else(|e| panic!("{what}: {e}"));
-        let pms = layers::place_layer_markers(&d, &stack.layers[0], tol);
+        let pms = layers::place_layer_markers(&d.stack_input(), &stack.layers[0], tol);
         assert_eq!(pms[0].markers.len(), 1, "{what}");
         assert_eq!(pms[0].direction, delta, "{what}: direction");
 
@@ -1148,7 +1148,10 @@ fn feature_volume_signs_on_both_surfaces_of_a_shell() {
         let solid = check_layer(&d, &stack, 0, tol).unwrap();
         let mut bare = d.clone();
         bare.layers[0].markers.clear();
-        let dv = solid.volume() - layers::layer_solid(&bare, &stack, 0, tol).unwrap().volume();
+        let dv = solid.volume()
+            - layers::layer_solid(&bare.stack_input(), &stack, 0, tol)
+                .unwrap()
+                .volume();
         let expected = sigma * (f.nominal_volume_mm3() + delta * gap);
         let bound = feature_area_mm2(&f) * tol.mm() + 1e-9 * solid.volume();
         assert!(
@@ -1196,8 +1199,8 @@ fn uvdtact_slots_and_protrusions_fit_without_overlap_or_gap() {
                 stack.layers
             );
         }
-        let slots = layers::place_layer_markers(&d, l0, tol);
-        let bumps = layers::place_layer_markers(&d, l1, tol);
+        let slots = layers::place_layer_markers(&d.stack_input(), l0, tol);
+        let bumps = layers::place_layer_markers(&d.stack_input(), l1, tol);
         assert_eq!(
             (slots[0].markers.len(), bumps[0].markers.len()),
             (n, n),
@@ -1259,7 +1262,7 @@ fn shadowtac_published_preset_places_469_markers_on_13_rings() {
         .with_preset("published_469")
         .unwrap();
     let stack = validate(&d, &materials(), tol).unwrap_or_else(|e| panic!("{e}"));
-    let pms = layers::place_layer_markers(&d, &stack.layers[0], tol);
+    let pms = layers::place_layer_markers(&d.stack_input(), &stack.layers[0], tol);
     assert_eq!(pms.len(), 1);
     let m = &pms[0].markers;
     assert_eq!(m.len(), 469);
@@ -1304,7 +1307,7 @@ fn tactip_skin_and_tips_make_whole_pins() {
     let tol = ChordTolerance::default();
     let d = library::load("tactip_dualmodal").unwrap();
     let stack = validate(&d, &materials(), tol).unwrap_or_else(|e| panic!("{e}"));
-    let out = fabkit_designs::molds::build_layer(&d, &stack, 0, tol).unwrap();
+    let out = fabkit_designs::build::build_layer(&d, &stack, 0, tol).unwrap();
     let names: Vec<&str> = out.parts.iter().map(|p| p.name.as_str()).collect();
     // the outermost layer also prints the bayonet fitting, in the same 3MF object
     assert_eq!(names, ["skin", "skin_tips", "tip_fitting"]);
@@ -1312,7 +1315,7 @@ fn tactip_skin_and_tips_make_whole_pins() {
     let (skin, tips) = (&out.parts[0].solid, &out.parts[1].solid);
     assert_eq!(out.parts[0].group.as_deref(), Some("skin"));
     assert_eq!(out.parts[0].group, out.parts[1].group);
-    let n = layers::place_layer_markers(&d, &stack.layers[0], tol)[0]
+    let n = layers::place_layer_markers(&d.stack_input(), &stack.layers[0], tol)[0]
         .markers
         .len();
     assert_eq!(tips.shell_count(), n);
@@ -1489,9 +1492,9 @@ fn inward_features_that_meet_are_rejected_or_united() {
         }
         Ok(s) => s,
     };
-    let solid = layers::layer_solid(&d, &stack, 0, tol).unwrap();
+    let solid = layers::layer_solid(&d.stack_input(), &stack, 0, tol).unwrap();
     // the reference: the same feature solids united first
-    let pm = &layers::place_layer_markers(&d, &stack.layers[0], tol)[0];
+    let pm = &layers::place_layer_markers(&d.stack_input(), &stack.layers[0], tol)[0];
     let features: Vec<Solid> = pm
         .markers
         .iter()
@@ -1503,7 +1506,7 @@ fn inward_features_that_meet_are_rejected_or_united() {
     let pins = Solid::union_all(&features).unwrap();
     let mut bare = d.clone();
     bare.layers[0].markers.clear();
-    let shell = layers::layer_solid(&bare, &stack, 0, tol).unwrap();
+    let shell = layers::layer_solid(&bare.stack_input(), &stack, 0, tol).unwrap();
     // (the pins point inward from the inner surface and stay inside the outer one)
     let reference = shell.union(&pins).unwrap();
     let bound = pm.markers.len() as f64 * feature_area_mm2(&pm.spec.feature) * tol.mm();
@@ -1537,7 +1540,7 @@ fn recesses_from_both_surfaces_leave_a_wall() {
             "{e}"
         ),
         Ok(stack) => {
-            let s = layers::layer_solid(&d, &stack, 0, tol).unwrap();
+            let s = layers::layer_solid(&d.stack_input(), &stack, 0, tol).unwrap();
             assert_eq!(s.genus(), 0, "recesses cut through the shell");
         }
     }

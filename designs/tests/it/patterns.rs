@@ -364,7 +364,7 @@ fn tactipgenerator_preset_places_the_generators_217_pins() {
         .unwrap_or_else(|e| panic!("{e}"));
     let materials = MaterialsTable::embedded().unwrap();
     let stack = validate(&d, &materials, tol).unwrap_or_else(|e| panic!("{e}"));
-    let pms = fabkit_designs::layers::place_layer_markers(&d, &stack.layers[0], tol);
+    let pms = fabkit_designs::layers::place_layer_markers(&d.stack_input(), &stack.layers[0], tol);
     let got: Vec<[f64; 3]> = pms[0].markers.iter().map(|m| m.position_mm).collect();
     let want = tactipgenerator_points(8, gen_theta(), 12.5);
     assert_eq!(got.len(), 217);
@@ -536,10 +536,10 @@ fn printable_with_follows_the_validation_rules() {
     let materials = MaterialsTable::embedded().unwrap();
     let stack = validate(&d, &materials, tol).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(
-        fabkit_designs::layers::printable_with(&d, &stack.layers[0], 0),
+        fabkit_designs::layers::printable_with(&d.stack_input(), &stack.layers[0], 0),
         [Technology::Sla]
     );
-    let out = fabkit_designs::molds::build_layer(&d, &stack, 0, tol).unwrap();
+    let out = fabkit_designs::build::build_layer(&d, &stack, 0, tol).unwrap();
     assert_eq!(out.markers[0]["printable_with"], serde_json::json!(["SLA"]));
     assert_eq!(out.markers[0]["needs_sla_or_finer"], true);
 
@@ -574,7 +574,7 @@ fn printable_with_and_validation_agree_on_every_library_design() {
         let stack = validate(&d, &materials, tol).unwrap();
         for l in &stack.layers {
             for j in 0..d.layers[l.index].markers.len() {
-                let listed = fabkit_designs::layers::printable_with(&d, l, j);
+                let listed = fabkit_designs::layers::printable_with(&d.stack_input(), l, j);
                 let own = format!("layers[{}].markers[{j}]", l.index);
                 let shared = format!("layers[{}].markers", l.index);
                 for tech in [Technology::Fdm, Technology::Sla, Technology::Polyjet] {

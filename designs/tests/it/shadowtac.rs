@@ -115,7 +115,8 @@ fn dimples_sit_at_the_authors_positions() {
     let d = shadowtac();
     let tol = ChordTolerance::default();
     let stack = validate(&d, &materials(), tol).unwrap_or_else(|e| panic!("{e}"));
-    let placed = fabkit_designs::layers::place_layer_markers(&d, &stack.layers[0], tol);
+    let placed =
+        fabkit_designs::layers::place_layer_markers(&d.stack_input(), &stack.layers[0], tol);
     assert_eq!(placed.len(), 1);
     let m = &placed[0].markers;
     let want = authors_positions();
@@ -148,7 +149,7 @@ fn cast_skin_has_469_recesses_half_a_millimetre_deep() {
     let d = shadowtac();
     let tol = ChordTolerance::new(0.005).unwrap();
     let stack = validate(&d, &materials(), tol).unwrap_or_else(|e| panic!("{e}"));
-    let skin = fabkit_designs::layers::layer_solid(&d, &stack, 0, tol).unwrap();
+    let skin = fabkit_designs::layers::layer_solid(&d.stack_input(), &stack, 0, tol).unwrap();
     assert_eq!(skin.genus(), 0);
     let mesh = skin.mesh();
     let f = &d.layers[0].markers[0].feature;
@@ -191,7 +192,7 @@ fn cast_skin_has_469_recesses_half_a_millimetre_deep() {
     let mut plain = d.clone();
     plain.layers[0].markers.clear();
     let plain_stack = validate(&plain, &materials(), tol).unwrap();
-    let v_plain = fabkit_designs::layers::layer_solid(&plain, &plain_stack, 0, tol)
+    let v_plain = fabkit_designs::layers::layer_solid(&plain.stack_input(), &plain_stack, 0, tol)
         .unwrap()
         .volume();
     let gap = PI * r.powi(4) * (2.0 / rho) / 8.0;
@@ -268,7 +269,7 @@ fn two_piece_mold_pieces_match_the_authors() {
     );
     // the pour is the cast skin
     let stack = validate(&d, &materials(), tol).unwrap();
-    let skin = fabkit_designs::layers::layer_solid(&d, &stack, 0, tol)
+    let skin = fabkit_designs::layers::layer_solid(&d.stack_input(), &stack, 0, tol)
         .unwrap()
         .volume();
     let pour = kit.casts[0].cavity_volume_ml * 1000.0;
@@ -287,7 +288,7 @@ fn open_mold_stays_available() {
     let roles: Vec<&str> = kit.parts.iter().map(|p| p.role.as_str()).collect();
     assert_eq!(roles, ["open_mold", "casing", "gripper_base"]);
     let stack = validate(&d, &materials(), tol).unwrap();
-    let skin = fabkit_designs::layers::layer_solid(&d, &stack, 0, tol)
+    let skin = fabkit_designs::layers::layer_solid(&d.stack_input(), &stack, 0, tol)
         .unwrap()
         .volume();
     let pour = kit.casts[0].cavity_volume_ml * 1000.0;

@@ -110,7 +110,7 @@ fn the_example_familys_rules_name_their_paths() {
 fn the_example_family_is_refused_on_a_flat_skin() {
     let mut d = library::load("soter_channels").unwrap();
     d.spacer = on_spacer().spacer;
-    let e = fabkit_designs::flat::validate(
+    let e = fabkit_designs::stack::flat::validate(
         &d,
         &fabkit_designs::materials::MaterialsTable::embedded().unwrap(),
     )

@@ -16,17 +16,18 @@ use serde_json::json;
 /// inner negative (a cup whose cavity casts the inner silicone core); three pours: the outer
 /// and inner Mold Star 30 molds, then the layer's gel between them, mm^3.
 pub(crate) fn build_boundary_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
-    let (design, stack, i, tol, l, name) = (b.design, b.stack, b.i, b.tol, b.l, &b.name);
+    let (si, stack, i, tol, l, name) = (b.si, b.stack, b.i, b.tol, b.l, &b.name);
     let (fixture_tech, cavity_tech) = (b.fixture_tech, b.cavity_tech);
-    let m = &design.mold;
+    let m = &si.mold;
     let g = |r: Result<Solid, GeometryError>| r.part(name);
-    let zb = design.body.base_z_mm();
-    let rim = design.body.rim_radius_mm(l.outer_offset_mm);
+    let zb = si.ctx.body.base_z_mm();
+    let rim = si.ctx.body.rim_radius_mm(l.outer_offset_mm);
     let r_p = rim + m.plinth.margin_mm;
     let z_lo = zb - m.plinth.height_mm;
     let fit = m.core_holder.fit_clearance_mm;
     // Outer boundary: master (positive) with plinth and locating pin, and a drafted box.
-    let mut pl = design
+    let mut pl = si
+        .ctx
         .body
         .offset_polyline(l.outer_offset_mm, 0.0, tol.half());
     let pin_r = 3.0f64.min(r_p / 3.0);
@@ -42,13 +43,13 @@ pub(crate) fn build_boundary_layer(b: LayerBuild) -> Result<LayerOutput, DesignE
     let master_base = g(revolve(&pl, tol).and_then(|mesh| Solid::from_mesh(&mesh)))?;
     let master = g(apply_features(master_base, &b.outer, tol, false))?;
     let pole = master.bounding_box().map(|b| b.max[2]).unwrap_or(0.0);
-    let (mold_box, fill) =
-        crate::parts::molds::drafted_box(design, r_p, z_lo, pole, tol).part(name)?;
+    let (mold_box, fill) = crate::parts::molds::drafted_box(si, r_p, z_lo, pole, tol).part(name)?;
     let silicone_outer = g(fill.difference(&master))?.volume();
     // Inner boundary: a cup whose cavity casts the inner silicone core; the core's
     // plinth fits the outer mold's plinth recess (with clearance), which centres it.
     let inner_pl = {
-        let mut q = design
+        let mut q = si
+            .ctx
             .body
             .offset_polyline(l.inner_offset_mm, 0.0, tol.half());
         for p in [[r_p - fit, zb], [r_p - fit, z_lo - 1.0], [0.0, z_lo - 1.0]] {
@@ -66,7 +67,7 @@ pub(crate) fn build_boundary_layer(b: LayerBuild) -> Result<LayerOutput, DesignE
             .map(|c| c.translate([0.0, 0.0, z_lo])))?;
     let inner_negative = g(cup.difference(&core_pos))?;
     let silicone_inner = g(core_pos.intersection(&cup))?.volume();
-    let gel = g(layer_solid(design, stack, i, tol))?.volume();
+    let gel = g(layer_solid(si, stack, i, tol))?.volume();
     let boundary = json!({
         "locating_pin": {"radius_mm": pin_r, "height_mm": 2.0},
         "master_top_z_mm": pole,

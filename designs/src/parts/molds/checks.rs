@@ -4,12 +4,12 @@
 use super::frame::MoldFrame;
 use crate::error::ParamError;
 use crate::parts::context::ResolvedCore;
-use crate::schema::Design;
+use crate::parts::stack_input::StackInput;
 
 /// Rules on mold parameters alone (sizes, printability).
-pub fn check_mold_params(design: &Design, errs: &mut Vec<ParamError>) {
-    let m = &design.mold;
-    if !check_mold_sizes(design, errs) {
+pub fn check_mold_params(si: &StackInput<'_>, errs: &mut Vec<ParamError>) {
+    let m = &si.mold;
+    if !check_mold_sizes(si, errs) {
         return;
     }
     if m.plinth.reservoir_depth_mm >= m.plinth.height_mm {
@@ -22,14 +22,14 @@ pub fn check_mold_params(design: &Design, errs: &mut Vec<ParamError>) {
             ),
         ));
     }
-    check_mold_printability(design, errs);
+    check_mold_printability(si, errs);
 }
 
 /// Rules on the mold's sizes alone: lengths and diameters above 0 (all are checked),
 /// clearances 0 or more, at least one vent, and `mold.draft_angle_deg` in [0, 10). Pushes its
 /// errors to `errs`; false when a length or diameter is not above 0, which ends the checks.
-fn check_mold_sizes(design: &Design, errs: &mut Vec<ParamError>) -> bool {
-    let m = &design.mold;
+fn check_mold_sizes(si: &StackInput<'_>, errs: &mut Vec<ParamError>) -> bool {
+    let m = &si.mold;
     let mut pos = |path: &str, v: f64| {
         if !(v > 0.0 && v.is_finite()) {
             errs.push(ParamError::new(path, v, "must be above 0"));
@@ -105,10 +105,10 @@ fn check_mold_sizes(design: &Design, errs: &mut Vec<ParamError>) -> bool {
 /// printer profile of the part that carries it (the fixtures' for the sprue, vents and core
 /// holder, the cavities' for the keys, bolt holes and walls), and `mold.flange_width_mm` wide
 /// enough for the registration keys and clamp bolts with the minimum wall around them.
-fn check_mold_printability(design: &Design, errs: &mut Vec<ParamError>) {
-    let m = &design.mold;
-    let fix = design.printers.get(m.fixture_print_technology);
-    let cav = design.printers.get(m.cavity_print_technology);
+fn check_mold_printability(si: &StackInput<'_>, errs: &mut Vec<ParamError>) {
+    let m = &si.mold;
+    let fix = si.ctx.printers.get(m.fixture_print_technology);
+    let cav = si.ctx.printers.get(m.cavity_print_technology);
     let fixture = format!("{:?}", m.fixture_print_technology).to_lowercase();
     let cavity = format!("{:?}", m.cavity_print_technology).to_lowercase();
     // Printability: every feature against the profile of the part that carries it.
@@ -187,14 +187,14 @@ fn check_mold_printability(design: &Design, errs: &mut Vec<ParamError>) {
 /// Rules that need the resolved core: does the holder fit between the core and the plinth.
 /// `first_cavity_offset_mm` is the cavity of the innermost cast, the tightest one.
 pub fn check_mold_fit(
-    design: &Design,
+    si: &StackInput<'_>,
     core: &ResolvedCore,
     first_cavity_offset_mm: f64,
     errs: &mut Vec<ParamError>,
 ) {
-    let m = &design.mold;
+    let m = &si.mold;
     let ch = &m.core_holder;
-    let f = MoldFrame::new(design, core, first_cavity_offset_mm + m.cavity_clearance_mm);
+    let f = MoldFrame::new(si, core, first_cavity_offset_mm + m.cavity_clearance_mm);
     let room = f.plinth_radius_mm
         - f.core_outer_radius_mm
         - 2.0 * ch.fit_clearance_mm
@@ -244,7 +244,7 @@ pub fn check_mold_fit(
     if f.core_end_z_mm > f.spigot_top_z_mm - 1.0 {
         errs.push(ParamError::new(
             "core.length_mm",
-            design.core.as_ref().map_or(0.0, |c| c.length_mm),
+            si.ctx.core.as_ref().map_or(0.0, |c| c.length_mm),
             format!(
                 "the core must reach at least {:.3} mm below the base plane so the holder can seat it (1 mm below the spigot top)",
                 f.base_z_mm - (f.spigot_top_z_mm - 1.0)
@@ -252,7 +252,7 @@ pub fn check_mold_fit(
         ));
     }
     if f.core_inner_radius_mm - ch.fit_clearance_mm
-        < design
+        < si.ctx
             .printers
             .get(m.fixture_print_technology)
             .min_feature_mm
@@ -260,11 +260,11 @@ pub fn check_mold_fit(
     {
         errs.push(ParamError::new(
             "core.wall_thickness_mm",
-            design.core.as_ref().map_or(0.0, |c| c.wall_thickness_mm),
+            si.ctx.core.as_ref().map_or(0.0, |c| c.wall_thickness_mm),
             "leaves no room for the holder's centring pin inside the core",
         ));
     }
-    if f.pin_top_z_mm(design) - f.core_end_z_mm < 1.0 {
+    if f.pin_top_z_mm(si) - f.core_end_z_mm < 1.0 {
         errs.push(ParamError::new(
             "mold.core_holder.pin_length_mm",
             ch.pin_length_mm,

@@ -6,8 +6,8 @@ use super::strategy::{CastPieces, CoreMoldInput, Strategy};
 use crate::error::{DesignError, GeometryContext};
 use crate::geometry::{cuboid, sphere, Affine, ChordTolerance, Solid};
 use crate::parts::placement::{place_posed, with_pose};
+use crate::parts::stack_input::StackInput;
 use crate::parts::{Part, PrintTechnology};
-use crate::schema::Design;
 use crate::schema::MoldStrategy as Kind;
 use serde_json::json;
 
@@ -15,16 +15,16 @@ use serde_json::json;
 /// `cavity` (male and female registration keys) and the core holder; the gel pours into all
 /// three.
 pub(crate) fn direct_mold_parts(
-    design: &Design,
+    si: &StackInput<'_>,
     cavity: &Solid,
     tol: ChordTolerance,
     c: CastMold,
 ) -> Result<MoldOutput, DesignError> {
     let (name, f) = (c.name, &c.f);
-    let m = &design.mold;
+    let m = &si.mold;
     let cavity_tech: PrintTechnology = m.cavity_print_technology.into();
     let cavity_material = material_for(cavity_tech);
-    let ((a, pose_a), (b, pose_b)) = direct_halves(design, f, cavity, tol).part(name)?;
+    let ((a, pose_a), (b, pose_b)) = direct_halves(si, f, cavity, tol).part(name)?;
     let mut params = c.common.clone();
     params["direct"] = json!({
         "parting_plane": "y = 0 (through the sensor axis)",
@@ -66,12 +66,12 @@ pub(crate) fn direct_mold_parts(
 
 /// The two halves of a direct mold, each in print orientation (parting face up).
 pub(crate) fn direct_halves(
-    design: &Design,
+    si: &StackInput<'_>,
     f: &MoldFrame,
     cavity: &Solid,
     tol: ChordTolerance,
 ) -> Result<(Posed, Posed), crate::geometry::GeometryError> {
-    let m = &design.mold;
+    let m = &si.mold;
     let b = f.plinth_radius_mm + m.flange_width_mm;
     let z_lo = f.open_face_z_mm;
     let z_hi = f.cavity_pole_z_mm + m.wall_thickness_mm;
@@ -128,7 +128,7 @@ impl Strategy for Direct {
         input: CoreMoldInput<'_>,
         c: CastMold,
     ) -> Option<Result<MoldOutput, DesignError>> {
-        Some(direct_mold_parts(input.design, input.cavity, input.tol, c))
+        Some(direct_mold_parts(input.si, input.cavity, input.tol, c))
     }
 
     /// The space the closed halves and the core holder leave.

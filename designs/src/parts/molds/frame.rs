@@ -4,16 +4,17 @@
 use crate::error::{DesignError, GeometryContext};
 use crate::geometry::{revolve, ChordTolerance, Polyline2, Solid};
 use crate::parts::context::{ResolvedCore, Stack};
+use crate::parts::stack_input::StackInput;
 use crate::parts::{Part, PrintTechnology};
-use crate::schema::{Design, LayerProcess, MoldStrategy};
+use crate::schema::{LayerProcess, MoldStrategy};
 use serde_json::json;
 
 /// The cavity of layer `l` in an open mold, from the layer's parameters alone: its radius on
 /// the base plane and its height over it with the tallest raised feature of its outer surface,
 /// mm (what `mold.open_block` must hold, and its walls are measured from).
-pub fn open_cavity_mm(design: &Design, l: &crate::parts::context::ResolvedLayer) -> (f64, f64) {
-    let b = &design.body;
-    let raised = design.layers[l.index]
+pub fn open_cavity_mm(si: &StackInput<'_>, l: &crate::parts::context::ResolvedLayer) -> (f64, f64) {
+    let b = &si.ctx.body;
+    let raised = si.layers[l.index]
         .markers
         .iter()
         .filter(|m| {
@@ -62,7 +63,7 @@ pub struct CastPlan {
 }
 
 /// The pours of a design in casting order (inner layers first).
-pub fn cast_plans(design: &Design, stack: &Stack) -> Vec<CastPlan> {
+pub fn cast_plans(si: &StackInput<'_>, stack: &Stack) -> Vec<CastPlan> {
     let mut plans = Vec::new();
     for (i, l) in stack.layers.iter().enumerate() {
         if l.process != LayerProcess::Cast {
@@ -81,7 +82,7 @@ pub fn cast_plans(design: &Design, stack: &Stack) -> Vec<CastPlan> {
         plans.push(CastPlan {
             layer: i,
             sprayed,
-            cavity_offset_mm: outer + design.mold.cavity_clearance_mm,
+            cavity_offset_mm: outer + si.mold.cavity_clearance_mm,
             core_offset_mm: l.inner_offset_mm,
             strategy: l.mold_strategy,
         });
@@ -105,9 +106,9 @@ pub struct MoldFrame {
 }
 
 impl MoldFrame {
-    pub fn new(design: &Design, core: &ResolvedCore, cavity_offset_mm: f64) -> Self {
-        let b = &design.body;
-        let m = &design.mold;
+    pub fn new(si: &StackInput<'_>, core: &ResolvedCore, cavity_offset_mm: f64) -> Self {
+        let b = &si.ctx.body;
+        let m = &si.mold;
         let base_z = b.base_z_mm();
         let rim = b.rim_radius_mm(cavity_offset_mm);
         Self {
@@ -124,20 +125,20 @@ impl MoldFrame {
     }
 
     /// Top of the centring pin: it must stay where the core's bore is still straight.
-    pub(crate) fn pin_top_z_mm(&self, design: &Design) -> f64 {
-        let straight_top = match design.body {
+    pub(crate) fn pin_top_z_mm(&self, si: &StackInput<'_>) -> f64 {
+        let straight_top = match si.ctx.body {
             crate::profile::BodyProfile::HemisphereOnCylinder {
                 cylinder_length_mm, ..
             } => self.base_z_mm + cylinder_length_mm,
             _ => self.base_z_mm,
         };
-        (self.core_end_z_mm + design.mold.core_holder.pin_length_mm).min(straight_top - 0.5)
+        (self.core_end_z_mm + si.mold.core_holder.pin_length_mm).min(straight_top - 0.5)
     }
 
     /// Radial position of the sprue axis: centred in the room between the core groove and
     /// the spigot edge.
-    fn sprue_radius_mm(&self, design: &Design) -> f64 {
-        let ch = &design.mold.core_holder;
+    fn sprue_radius_mm(&self, si: &StackInput<'_>) -> f64 {
+        let ch = &si.mold.core_holder;
         let lo = self.core_outer_radius_mm + ch.fit_clearance_mm + ch.min_wall_mm;
         let hi = self.plinth_radius_mm - ch.fit_clearance_mm - ch.min_wall_mm;
         0.5 * (lo + hi)
@@ -147,13 +148,13 @@ impl MoldFrame {
 /// The cavity solid with its plinth recess, and optionally the master pattern's locating pin,
 /// as one revolve.
 pub(crate) fn cavity_profile(
-    design: &Design,
+    si: &StackInput<'_>,
     f: &MoldFrame,
     offset: f64,
     with_pin: bool,
     tol: ChordTolerance,
 ) -> Polyline2 {
-    let mut pl = design.body.offset_polyline(offset, 0.0, tol.half());
+    let mut pl = si.ctx.body.offset_polyline(offset, 0.0, tol.half());
     pl.push([f.plinth_radius_mm, f.base_z_mm]);
     pl.push([f.plinth_radius_mm, f.open_face_z_mm]);
     if with_pin {
@@ -169,11 +170,11 @@ pub(crate) fn cavity_profile(
 
 /// The core holder / casting jig in the sensor frame (assembled position).
 pub(crate) fn core_holder(
-    design: &Design,
+    si: &StackInput<'_>,
     f: &MoldFrame,
     tol: ChordTolerance,
 ) -> Result<Solid, DesignError> {
-    let m = &design.mold;
+    let m = &si.mold;
     let ch = &m.core_holder;
     let fit = ch.fit_clearance_mm;
     let r_f = f.plinth_radius_mm + FLANGE_MARGIN_MM;
@@ -194,8 +195,8 @@ pub(crate) fn core_holder(
         [f.core_outer_radius_mm + fit, f.spigot_top_z_mm],
         [f.core_outer_radius_mm + fit, f.core_end_z_mm],
         [f.core_inner_radius_mm - fit, f.core_end_z_mm],
-        [f.core_inner_radius_mm - fit, f.pin_top_z_mm(design)],
-        [0.0, f.pin_top_z_mm(design)],
+        [f.core_inner_radius_mm - fit, f.pin_top_z_mm(si)],
+        [0.0, f.pin_top_z_mm(si)],
     ] {
         pl.push(p);
     }
@@ -205,7 +206,7 @@ pub(crate) fn core_holder(
     let h = f.spigot_top_z_mm + 1.0 - z0;
     let mut holes = vec![crate::geometry::cylinder(h, m.sprue.diameter_mm / 2.0, tol)
         .part("sprue")?
-        .translate([f.sprue_radius_mm(design), 0.0, z0])];
+        .translate([f.sprue_radius_mm(si), 0.0, z0])];
     let r_v = f.plinth_radius_mm - fit - ch.min_wall_mm - m.vent.diameter_mm / 2.0;
     for k in 1..=m.vent.count {
         let a = 2.0 * std::f64::consts::PI * k as f64 / (m.vent.count + 1) as f64;
@@ -218,8 +219,8 @@ pub(crate) fn core_holder(
     body.difference(&Solid::compose(&holes)).part("core holder")
 }
 
-pub(crate) fn holder_params(design: &Design, f: &MoldFrame) -> serde_json::Value {
-    let m = &design.mold;
+pub(crate) fn holder_params(si: &StackInput<'_>, f: &MoldFrame) -> serde_json::Value {
+    let m = &si.mold;
     let ch = &m.core_holder;
     let fit = ch.fit_clearance_mm;
     let z_f0 = f.open_face_z_mm - ch.flange_thickness_mm;
@@ -235,8 +236,8 @@ pub(crate) fn holder_params(design: &Design, f: &MoldFrame) -> serde_json::Value
         "fit_clearance_mm": m.core_holder.fit_clearance_mm,
         "flange_thickness_mm": m.core_holder.flange_thickness_mm,
         "flange_radius_mm": f.plinth_radius_mm + FLANGE_MARGIN_MM,
-        "pin_top_z_mm": f.pin_top_z_mm(design),
-        "sprue": {"diameter_mm": m.sprue.diameter_mm, "radius_mm": f.sprue_radius_mm(design), "azimuth_deg": 0.0},
+        "pin_top_z_mm": f.pin_top_z_mm(si),
+        "sprue": {"diameter_mm": m.sprue.diameter_mm, "radius_mm": f.sprue_radius_mm(si), "azimuth_deg": 0.0},
         "vent": {"diameter_mm": m.vent.diameter_mm, "count": m.vent.count},
         "print_orientation": "sensor frame, translated so the flange (or boss) rests on z = 0",
     })

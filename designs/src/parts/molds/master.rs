@@ -9,8 +9,8 @@ use super::strategy::{CastPieces, CoreMoldInput, Strategy};
 use crate::error::{DesignError, GeometryContext};
 use crate::geometry::{revolve, ChordTolerance, Solid};
 use crate::parts::placement::{place_posed, with_pose};
+use crate::parts::stack_input::StackInput;
 use crate::parts::{Part, PrintTechnology};
-use crate::schema::Design;
 use crate::schema::MoldStrategy as Kind;
 use serde_json::json;
 
@@ -19,14 +19,14 @@ use serde_json::json;
 /// the casting jig; the silicone pours into the master and box, the gel into the silicone
 /// mold and the jig.
 pub(crate) fn master_mold_parts(
-    design: &Design,
+    si: &StackInput<'_>,
     plan: &CastPlan,
     tol: ChordTolerance,
     c: CastMold,
     with_features: &dyn Fn(Solid) -> Result<Solid, DesignError>,
 ) -> Result<MoldOutput, DesignError> {
     let (name, f) = (c.name, &c.f);
-    let m = &design.mold;
+    let m = &si.mold;
     let cavity_tech: PrintTechnology = m.cavity_print_technology.into();
     let fixture_tech: PrintTechnology = m.fixture_print_technology.into();
     let cavity_material = material_for(cavity_tech);
@@ -34,14 +34,14 @@ pub(crate) fn master_mold_parts(
     let master = with_features(
         Solid::from_mesh(
             &revolve(
-                &cavity_profile(design, f, plan.cavity_offset_mm, true, tol),
+                &cavity_profile(si, f, plan.cavity_offset_mm, true, tol),
                 tol,
             )
             .part(name)?,
         )
         .part(name)?,
     )?;
-    let (mold_box, fill) = master_box(design, f, tol).part(name)?;
+    let (mold_box, fill) = master_box(si, f, tol).part(name)?;
     let silicone = fill.difference(&master).part(name)?.volume();
     let mut params = c.common.clone();
     params["master"] = json!({
@@ -94,12 +94,12 @@ pub(crate) fn master_mold_parts(
 
 /// The mold box (sensor frame) and the solid the Mold Star fills up to its fill level.
 pub(crate) fn master_box(
-    design: &Design,
+    si: &StackInput<'_>,
     f: &MoldFrame,
     tol: ChordTolerance,
 ) -> Result<(Solid, Solid), crate::geometry::GeometryError> {
     drafted_box(
-        design,
+        si,
         f.plinth_radius_mm,
         f.open_face_z_mm,
         f.cavity_pole_z_mm,
@@ -114,13 +114,13 @@ pub(crate) fn master_box(
 /// # Errors
 /// Only on a kernel failure.
 pub fn drafted_box(
-    design: &Design,
+    si: &StackInput<'_>,
     plinth_radius_mm: f64,
     z0: f64,
     pole_z: f64,
     tol: ChordTolerance,
 ) -> Result<(Solid, Solid), crate::geometry::GeometryError> {
-    let m = &design.mold;
+    let m = &si.mold;
     let z_fill = pole_z + m.silicone_wall_mm;
     let z_top = z_fill + BOX_FREEBOARD_MM;
     let r0 = plinth_radius_mm + m.silicone_wall_mm;
@@ -159,7 +159,7 @@ impl Strategy for Master {
         c: CastMold,
     ) -> Option<Result<MoldOutput, DesignError>> {
         Some(master_mold_parts(
-            input.design,
+            input.si,
             input.plan,
             input.tol,
             c,

@@ -34,8 +34,9 @@ use crate::geometry::{revolve, Solid};
 use crate::markers::MarkerSurface;
 use crate::parts::context::Stack;
 use crate::parts::layers::{self, LayerOutput};
+use crate::parts::stack_input::StackInput;
 use crate::parts::{Part, PrintTechnology};
-use crate::schema::{Design, LayerProcess, MoldStrategy};
+use crate::schema::{LayerProcess, MoldStrategy};
 use frame::{cavity_profile, core_holder, holder_params, CastMold};
 use serde_json::json;
 use strategy::{CoreMoldInput, Strategy};
@@ -56,12 +57,12 @@ pub use two_piece_open::{check_two_piece, TwoPieceFrame};
 /// # Errors
 /// [`DesignError::Geometry`] if the kernel fails.
 pub fn build_mold(
-    design: &Design,
+    si: &StackInput<'_>,
     stack: &Stack,
     plan: &CastPlan,
     tol: ChordTolerance,
 ) -> Result<MoldOutput, DesignError> {
-    build_mold_parts(design, stack, plan, tol).map_err(|e| {
+    build_mold_parts(si, stack, plan, tol).map_err(|e| {
         e.from_params(&[
             format!("layers[{}]", plan.layer),
             "mold".into(),
@@ -71,7 +72,7 @@ pub fn build_mold(
 }
 
 fn build_mold_parts(
-    design: &Design,
+    si: &StackInput<'_>,
     stack: &Stack,
     plan: &CastPlan,
     tol: ChordTolerance,
@@ -84,38 +85,34 @@ fn build_mold_parts(
             "direct and master molds hold a core",
         )]))
     })?;
-    let f = MoldFrame::new(design, core, plan.cavity_offset_mm);
-    let m = &design.mold;
+    let f = MoldFrame::new(si, core, plan.cavity_offset_mm);
+    let m = &si.mold;
     let name = &layer.name;
     let fixture_tech: PrintTechnology = m.fixture_print_technology.into();
     let fixture_material = material_for(fixture_tech);
 
     // The cavity carries the layer's outer features, grown by the coats sprayed into it.
-    let features = crate::parts::layers::cavity_features(
-        design,
-        stack,
-        plan.layer,
-        plan.cavity_offset_mm,
-        tol,
-    );
+    let features =
+        crate::parts::layers::cavity_features(si, stack, plan.layer, plan.cavity_offset_mm, tol);
     let features: Vec<_> = features.iter().collect();
     let with_features =
         |s: Solid| crate::parts::layers::apply_features(s, &features, tol, false).part(name);
     let cavity = with_features(
         Solid::from_mesh(
             &revolve(
-                &cavity_profile(design, &f, plan.cavity_offset_mm, false, tol),
+                &cavity_profile(si, &f, plan.cavity_offset_mm, false, tol),
                 tol,
             )
             .part(name)?,
         )
         .part(name)?,
     )?;
-    let holder = core_holder(design, &f, tol)?;
+    let holder = core_holder(si, &f, tol)?;
     // The pour fills the cavity, minus what is inside it (core and inner layers), minus the holder.
     // What the pour lands on: the layers under it down to the base plane, and below it the
     // core alone (its bore is closed by the holder's pin, so it counts as solid).
-    let mut inner_pl = design
+    let mut inner_pl = si
+        .ctx
         .body
         .offset_polyline(plan.core_offset_mm, 0.0, tol.half());
     inner_pl.push([f.core_outer_radius_mm, f.base_z_mm]);
@@ -131,9 +128,9 @@ fn build_mold_parts(
         .iter()
         .map(|&i| {
             if features.is_empty() {
-                stack.layer_solid(design, i, tol)
+                stack.layer_solid(si, i, tol)
             } else {
-                crate::parts::layers::layer_solid(design, stack, i, tol)
+                crate::parts::layers::layer_solid(si, stack, i, tol)
             }
             .map(|s| s.volume())
         })
@@ -146,7 +143,7 @@ fn build_mold_parts(
         "strategy": plan.strategy,
         "cavity_offset_mm": plan.cavity_offset_mm,
         "core_offset_mm": plan.core_offset_mm,
-        "body": design.body,
+        "body": si.ctx.body,
         "frame": f,
         "plinth": m.plinth,
     });
@@ -174,7 +171,7 @@ fn build_mold_parts(
         material: fixture_material.into(),
         print_technology: fixture_tech,
         solid: holder_placed,
-        params: with_pose(holder_params(design, &f), &holder_pose),
+        params: with_pose(holder_params(si, &f), &holder_pose),
         group: None,
     };
 
@@ -187,7 +184,7 @@ fn build_mold_parts(
         pour_volume,
     };
     let input = CoreMoldInput {
-        design,
+        si,
         plan,
         cavity: &cavity,
         with_features: &with_features,
@@ -196,12 +193,12 @@ fn build_mold_parts(
     let mut out = strategy_of(plan.strategy)
         .core_mold(input, c)
         .expect("cast_plans plans the pours of core-holding strategies only")?;
-    let placed = crate::parts::layers::place_layer_markers(design, layer, tol);
+    let placed = crate::parts::layers::place_layer_markers(si, layer, tol);
     out.markers = crate::parts::layers::marker_summary(
         layer,
         &placed,
-        crate::parts::layer_markers::feature_technology(design, &design.layers[plan.layer]),
-        design,
+        crate::parts::layer_markers::feature_technology(si, &si.layers[plan.layer]),
+        si,
     );
     let carriers: Vec<String> = out
         .parts
@@ -219,18 +216,21 @@ fn build_mold_parts(
 }
 
 /// Builds the parts of a cast layer whose strategy casts without a core
-/// ([`Strategy::build_layer`]: `open`, `two_piece_open`, `boundary`), or of a printed layer.
+/// ([`Strategy::build_layer`]: `open`, `two_piece_open`, `boundary`), or of a printed layer
+/// (with the families' parts printed with it when it is the outermost, `with_skin`;
+/// [`crate::build::build_layer`] gives them).
 ///
 /// # Errors
 /// [`DesignError::Geometry`] if the kernel fails, naming the parameters (`layers[i]`, and
 /// `mold` for a cast layer).
 pub fn build_layer(
-    design: &Design,
+    si: &StackInput<'_>,
     stack: &Stack,
     i: usize,
     tol: ChordTolerance,
+    with_skin: layers::WithSkin<'_>,
 ) -> Result<LayerOutput, DesignError> {
-    layers::with_layer_build(design, stack, i, tol, |b| {
+    layers::with_layer_build(si, stack, i, tol, with_skin, |b| {
         if b.l.process == LayerProcess::Printed {
             return layers::build_printed_layer(b);
         }
@@ -238,7 +238,7 @@ pub fn build_layer(
             .build_layer(b)
             .expect("direct and master molds are built by molds::build_mold")
     })
-    .map_err(|e| e.from_params(&layers::layer_params(design, i)))
+    .map_err(|e| e.from_params(&layers::layer_params(si, i)))
 }
 
 /// Every mold strategy, one line each: the build and the cast check find a layer's strategy

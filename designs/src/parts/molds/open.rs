@@ -20,16 +20,16 @@ use serde_json::json;
 /// (the outer surface with its features), printed open face up; one pour of the layer's
 /// material, its volume block - mold, mm^3.
 pub(crate) fn build_open_mold_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
-    let (design, tol, l, name, outer) = (b.design, b.tol, b.l, &b.name, &b.outer);
+    let (si, tol, l, name, outer) = (b.si, b.tol, b.l, &b.name, &b.outer);
     let (base_params, cavity_tech) = (&b.base_params, b.cavity_tech);
-    let m = &design.mold;
+    let m = &si.mold;
     let g = |r: Result<Solid, GeometryError>| r.part(name);
     // mold = (block - plain cavity) with the features cut or added: one boolean with
     // the features, and the skin's volume falls out as block - mold.
-    let plain = g(body_solid(design, l.outer_offset_mm, 1.0, tol))?;
-    let rim = design.body.rim_radius_mm(l.outer_offset_mm);
-    let top = features_top_z_mm(design, l.outer_offset_mm, outer);
-    let zb = design.body.base_z_mm();
+    let plain = g(body_solid(si, l.outer_offset_mm, 1.0, tol))?;
+    let rim = si.ctx.body.rim_radius_mm(l.outer_offset_mm);
+    let top = features_top_z_mm(si, l.outer_offset_mm, outer);
+    let zb = si.ctx.body.base_z_mm();
     let (half, z_top) = match &m.open_block {
         Some(ob) => (ob.width_mm / 2.0, zb + ob.height_mm),
         None => (rim + m.wall_thickness_mm, top + m.wall_thickness_mm),
@@ -43,7 +43,7 @@ pub(crate) fn build_open_mold_layer(b: LayerBuild) -> Result<LayerOutput, Design
         .and_then(|b| apply_features_signed(b, outer, tol, false, -1.0)))?;
     // the features' inserts set in the open face (the optic's seat)
     let inserts = open_mold_inserts(
-        design,
+        si,
         l.index,
         InsertInput {
             layer_name: name,

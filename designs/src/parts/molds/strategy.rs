@@ -9,8 +9,9 @@ use crate::geometry::{ChordTolerance, Solid};
 use crate::parts::context::ResolvedLayer;
 use crate::parts::layers::{LayerBuild, LayerOutput};
 use crate::parts::part::Part;
+use crate::parts::stack_input::StackInput;
 use crate::profile::BodyProfile;
-use crate::schema::{Design, MoldStrategy};
+use crate::schema::MoldStrategy;
 
 use super::frame::{CastMold, CastPlan, MoldOutput};
 
@@ -18,7 +19,7 @@ use super::frame::{CastMold, CastPlan, MoldOutput};
 /// the pour's plan, the cavity solid with its features, and the function that adds the
 /// cavity's features to a solid.
 pub struct CoreMoldInput<'a> {
-    pub design: &'a Design,
+    pub si: &'a StackInput<'a>,
     pub plan: &'a CastPlan,
     pub cavity: &'a Solid,
     pub with_features: &'a dyn Fn(Solid) -> Result<Solid, DesignError>,

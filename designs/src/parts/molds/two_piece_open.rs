@@ -9,8 +9,8 @@ use crate::parts::layers::{
     apply_features_signed, body_solid, features_top_z_mm, set_forming, LayerBuild, LayerOutput,
 };
 use crate::parts::placement::{place_posed, with_pose};
+use crate::parts::stack_input::StackInput;
 use crate::parts::Part;
-use crate::schema::Design;
 use crate::schema::MoldStrategy as Kind;
 use serde_json::json;
 
@@ -44,11 +44,11 @@ impl TwoPieceFrame {
     /// The frame of a design's `two_piece_open` mold whose cavity opens on the base plane.
     /// Needs an even `bolt_count` of at least 4 (validation checks it; fewer bolts give the
     /// four corners only).
-    pub fn new(design: &Design) -> Self {
-        let m = &design.mold;
+    pub fn new(si: &StackInput<'_>) -> Self {
+        let m = &si.mold;
         let t = &m.two_piece;
-        let zb = design.body.base_z_mm();
-        let layout = BoltLayout::new(design);
+        let zb = si.ctx.body.base_z_mm();
+        let layout = BoltLayout::new(si);
         let BoltLayout {
             boss,
             pocket,
@@ -99,8 +99,8 @@ struct BoltLayout {
 }
 
 impl BoltLayout {
-    fn new(design: &Design) -> Self {
-        let m = &design.mold;
+    fn new(si: &StackInput<'_>) -> Self {
+        let m = &si.mold;
         let t = &m.two_piece;
         let c = m.registration_key.clearance_mm;
         let boss = [t.boss.width_mm / 2.0, t.boss.length_mm / 2.0];
@@ -133,10 +133,10 @@ impl BoltLayout {
 /// Rules of the `two_piece_open` strategy, for a cavity of rim radius `rim_radius_mm` (the
 /// widest cast layer's): sizes, the reservoir bore between the cavity rim and the boss, the
 /// bolts on the flange, the plate above the boss, the pocket fit.
-pub fn check_two_piece(design: &Design, rim_radius_mm: f64, errs: &mut Vec<ParamError>) {
-    let m = &design.mold;
+pub fn check_two_piece(si: &StackInput<'_>, rim_radius_mm: f64, errs: &mut Vec<ParamError>) {
+    let m = &si.mold;
     let t = &m.two_piece;
-    let cav = design.printers.get(m.cavity_print_technology);
+    let cav = si.ctx.printers.get(m.cavity_print_technology);
     let cavity = format!("{:?}", m.cavity_print_technology).to_lowercase();
     let mut ok = true;
     for (p, v) in [
@@ -269,7 +269,7 @@ pub fn check_two_piece(design: &Design, rim_radius_mm: f64, errs: &mut Vec<Param
             ),
         ));
     }
-    let [px, py] = BoltLayout::new(design).pitch_mm();
+    let [px, py] = BoltLayout::new(si).pitch_mm();
     let pitch = px.min(py);
     let need = hole + cav.min_wall_mm;
     if pitch < need {
@@ -291,17 +291,17 @@ pub fn check_two_piece(design: &Design, rim_radius_mm: f64, errs: &mut Vec<Param
 /// boss, less the reservoir bore and the bolt holes); [`two_piece_open_parts`] makes their
 /// parts.
 pub(crate) fn build_two_piece_open_layer(b: LayerBuild) -> Result<LayerOutput, DesignError> {
-    let (design, tol, l) = (b.design, b.tol, b.l);
-    let m = &design.mold;
+    let (si, tol, l) = (b.si, b.tol, b.l);
+    let m = &si.mold;
     let g = |r: Result<Solid, GeometryError>| r.part(&b.name);
     // Cavity block: the outline from the parting face to the wall beyond the pole,
     // less the cavity (continued 1 mm into the pocket), the pocket and the bolt holes,
     // with the features: a dimple is a pin standing into the cavity.
-    let f = crate::parts::molds::TwoPieceFrame::new(design);
+    let f = crate::parts::molds::TwoPieceFrame::new(si);
     let zb = f.base_z_mm;
-    let plain = g(body_solid(design, l.outer_offset_mm, 1.0, tol))?;
-    let cap = g(body_solid(design, l.outer_offset_mm, 0.0, tol))?;
-    let top = features_top_z_mm(design, l.outer_offset_mm, &b.outer);
+    let plain = g(body_solid(si, l.outer_offset_mm, 1.0, tol))?;
+    let cap = g(body_solid(si, l.outer_offset_mm, 0.0, tol))?;
+    let top = features_top_z_mm(si, l.outer_offset_mm, &b.outer);
     let z_far = top + m.wall_thickness_mm;
     let [ox, oy] = f.outer_half_mm;
     let [px, py] = f.pocket_half_mm;
@@ -382,8 +382,8 @@ pub(crate) fn two_piece_open_parts(
     top_piece: Solid,
     skin_volume: f64,
 ) -> LayerOutput {
-    let (design, l, name, cavity_tech) = (b.design, b.l, &b.name, b.cavity_tech);
-    let m = &design.mold;
+    let (si, l, name, cavity_tech) = (b.si, b.l, &b.name, b.cavity_tech);
+    let m = &si.mold;
     let zb = f.base_z_mm;
     let reservoir_mm3 = std::f64::consts::PI * f.reservoir_radius_mm.powi(2) * (zb - f.top_z_mm);
     let params = json!({

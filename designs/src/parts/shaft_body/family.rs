@@ -3,10 +3,10 @@
 //! members and bought items, the filling gel's pour and the assembly steps.
 
 use super::checks::check_params;
-use super::dimensions::{levels, radii};
+use super::dimensions::{levels, radii, twin_params};
 use super::members::{bought_items, members};
 use super::params::ShaftBodyParams;
-use super::solids::{build_body, filling_gel_solid};
+use super::solids::{build_body, filling_gel_solid, tip_fitting_solid};
 use super::view::view_fraction;
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::materials::CastReport;
@@ -18,7 +18,7 @@ use crate::parts::family::{
     named, AssemblyInput, AssemblyStep, Built, Family, FamilyInput, FillingPour, InnerCavity,
     FILLING_GEL,
 };
-use crate::parts::{Member, MemberKind, ProcedureAction, ProcedureStep};
+use crate::parts::{Member, MemberKind, Part, PrintTechnology, ProcedureAction, ProcedureStep};
 use serde_json::json;
 
 /// The shaft-body family (`shaft_body`, with its `robot_mount`): the body, the tip's fitting
@@ -152,6 +152,28 @@ impl Family for ShaftBodyFamily {
                 ("camera_view", camera_view),
             ],
         })
+    }
+
+    fn printed_with_skin(
+        sb: &ShaftBodyParams,
+        input: FamilyInput<'_>,
+    ) -> Result<Vec<Part>, DesignError> {
+        // The tip's fitting prints with the outermost (printed) layer, as a further volume of
+        // its object (Pestell et al. Sec. III-A).
+        let name = input.stack.layers.last().map_or("", |l| l.name.as_str());
+        Ok(vec![Part {
+            name: "tip_fitting".into(),
+            role: "tip_fitting".into(),
+            description: format!(
+                "The tip's rigid bayonet fitting, printed in the second material with {name} (Pestell et al. Sec. III-A)"
+            ),
+            material: sb.tip_fitting.material.clone(),
+            // the layer's build prints it with the layer's own technology
+            print_technology: PrintTechnology::Polyjet,
+            solid: tip_fitting_solid(sb, input).part(name)?,
+            params: twin_params(input.ctx, sb, input.stack),
+            group: None,
+        }])
     }
 
     fn members(sb: &ShaftBodyParams, input: FamilyInput<'_>) -> Result<Vec<Member>, DesignError> {
