@@ -96,7 +96,7 @@ fn features_placed(design: &Design, materials: &MaterialsTable, tol: ChordTolera
         Ok(st) => st,
         Err(e) => panic!("the benchmark design does not validate: {e}"),
     };
-    layers::place_layer_markers(design, &st.layers[0], tol)
+    layers::place_layer_markers(&design.stack_input(), &st.layers[0], tol)
         .iter()
         .map(|p| p.markers.len())
         .sum()
