@@ -14,7 +14,7 @@ use crate::parts::stack_input::StackInput;
 use crate::schema::printers::check_printers;
 pub use crate::schema::printers::{check_bed, MAX_BED_MM};
 pub use crate::schema::DESIGN_SIGNED_MM;
-use crate::schema::{Design, LayerProcess, MoldStrategy};
+use crate::schema::{Design, LayerProcess};
 
 impl Stack {
     /// The solid of layer `i` (between its inner and outer surfaces, closed on the base plane).
@@ -478,29 +478,6 @@ fn check_mold_strategies(design: &Design, errs: &mut Vec<ParamError>) {
     }
 }
 
-/// `mold.open_block` against the layers cast in an open mold: the largest cavity (its rim on
-/// the base plane, its height with the tallest raised outward feature) with the cavity
-/// printer's minimum wall around it.
-fn check_open_block(
-    design: &Design,
-    block: &crate::parts::molds::OpenBlock,
-    layers: &[ResolvedLayer],
-    errs: &mut Vec<ParamError>,
-) {
-    let open: Vec<_> = layers
-        .iter()
-        .filter(|l| l.process == LayerProcess::Cast && l.mold_strategy == MoldStrategy::Open)
-        .map(|l| crate::parts::molds::open_cavity_mm(&design.stack_input(), l))
-        .collect();
-    let rim = open.iter().map(|c| c.0).fold(0.0, f64::max);
-    let height = open.iter().map(|c| c.1).fold(0.0, f64::max);
-    let min_wall = design
-        .printers
-        .get(design.mold.cavity_print_technology)
-        .min_wall_mm;
-    block.check(!open.is_empty(), rim, height, min_wall, errs);
-}
-
 /// The layers' and the core's surfaces, resolved from the inside out in "radius" units for
 /// spheres (r = R + offset), with the errors of a stack that does not close; whether it does.
 fn resolve_surfaces(
@@ -659,21 +636,14 @@ fn check_with_stack(
     check_printers(&design.printers, errs);
     if stack_ok {
         crate::parts::layers::check_markers(&design.stack_input(), layers, errs);
-        let two_piece_rim = layers
+    }
+    // each strategy's own mold parameters against the layers cast in it
+    for s in crate::parts::molds::STRATEGIES {
+        let cast: Vec<&ResolvedLayer> = layers
             .iter()
-            .filter(|l| {
-                l.process == LayerProcess::Cast && l.mold_strategy == MoldStrategy::TwoPieceOpen
-            })
-            .map(|l| design.body.rim_radius_mm(l.outer_offset_mm))
-            .fold(None, |a: Option<f64>, r| Some(a.map_or(r, |a| a.max(r))));
-        if let Some(rim) = two_piece_rim {
-            crate::parts::molds::check_two_piece(&design.stack_input(), rim, errs);
-        }
-        if let Some(block) = &design.mold.open_block {
-            check_open_block(design, block, layers, errs);
-        }
-    } else if let Some(b) = &design.mold.open_block {
-        crate::parts::check_above_zero("mold.open_block.", b, &[], errs);
+            .filter(|l| l.process == LayerProcess::Cast && l.mold_strategy == s.kind())
+            .collect();
+        s.check_layers(&design.stack_input(), stack_ok.then_some(&cast[..]), errs);
     }
     // Checks that use the core only make sense once the stack itself is sound.
     let sound_core = core.filter(|_| stack_ok);

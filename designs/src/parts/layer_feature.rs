@@ -8,11 +8,12 @@
 
 use crate::error::ParamError;
 use crate::geometry::{ChordTolerance, GeometryError, Polyline2};
+use crate::markers::MarkerSpec;
 use crate::parts::context::Context;
 use crate::parts::part::{Part, PrintTechnology};
 pub use crate::parts::seat::Seat;
 use crate::profile::BodyProfile;
-use crate::schema::{Layer, MoldStrategy};
+use crate::schema::shared::{LayerProcess, MoldStrategy};
 
 /// What a feature's rules see besides its own parameters.
 #[derive(Debug, Clone, Copy)]
@@ -21,8 +22,14 @@ pub struct LayerInput<'a> {
     pub ctx: &'a Context<'a>,
     /// The layer's index in `layers`.
     pub index: usize,
-    /// The layer as the design gives it.
-    pub layer: &'a Layer,
+    /// The layer's part name (`layers[i].name`).
+    pub name: &'a str,
+    /// Whether it fills the body down to the base plane (`layers[i].solid`).
+    pub solid: bool,
+    /// How it is made (`layers[i].process`).
+    pub process: LayerProcess,
+    /// The marker patterns it carries (`layers[i].markers`).
+    pub markers: &'a [MarkerSpec],
     /// The layer's mold strategy: its own `mold_strategy`, else the design's `mold.strategy`.
     pub strategy: MoldStrategy,
     /// Whether the body's own rules hold (its sizes may be measured).

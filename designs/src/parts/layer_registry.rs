@@ -25,8 +25,8 @@ pub trait Feature: Sync {
     fn flat_rule(&self) -> Option<&'static str>;
     /// [`LayerFeature::INSERT_ROLE`].
     fn insert_role(&self) -> Option<&'static str>;
-    /// [`LayerFeature::check`].
-    fn check(&self, input: LayerInput<'_>, errs: &mut Vec<ParamError>);
+    /// [`LayerFeature::check`] of layer `l`'s parameters.
+    fn check(&self, l: &Layer, input: LayerInput<'_>, errs: &mut Vec<ParamError>);
     /// [`LayerFeature::seat`].
     fn seat(&self, l: &Layer) -> Option<Seat>;
     /// [`LayerFeature::twin_params`].
@@ -76,8 +76,8 @@ impl<F: LayerFeature> Feature for RegisteredFeature<F> {
         F::INSERT_ROLE
     }
 
-    fn check(&self, input: LayerInput<'_>, errs: &mut Vec<ParamError>) {
-        if let Some(p) = (self.params)(input.layer) {
+    fn check(&self, l: &Layer, input: LayerInput<'_>, errs: &mut Vec<ParamError>) {
+        if let Some(p) = (self.params)(l) {
             F::check(p, input, errs);
         }
     }
@@ -113,12 +113,15 @@ pub fn check_layer_features(si: &StackInput<'_>, body_ok: bool, errs: &mut Vec<P
         let input = LayerInput {
             ctx: &ctx,
             index,
-            layer,
+            name: &layer.name,
+            solid: layer.solid,
+            process: layer.process,
+            markers: &layer.markers,
             strategy: layer.mold_strategy.unwrap_or(si.mold.strategy),
             body_ok,
         };
         for f in LAYER_FEATURES {
-            f.check(input, errs);
+            f.check(layer, input, errs);
         }
     }
 }

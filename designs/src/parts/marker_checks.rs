@@ -10,7 +10,7 @@ use crate::parts::layer_markers::{
     recess_clearance_to_base_mm, rim_margin, surface_offset,
 };
 use crate::parts::stack_input::StackInput;
-use crate::schema::{LayerProcess, MoldStrategy, PrinterProfile, Technology};
+use crate::schema::{LayerProcess, PrinterProfile, Technology};
 
 /// Rules on marker patterns: they place, do not overlap, leave the printer's minimum wall,
 /// and their features print on the technology that makes them (the mold's cavity printer for
@@ -247,7 +247,7 @@ fn marker_shape_errors(
         return false;
     }
     let molded = spec_layer.process == LayerProcess::Cast;
-    if molded && spec.surface == MarkerSurface::Inner && l.mold_strategy != MoldStrategy::Boundary {
+    if molded && spec.surface == MarkerSurface::Inner && !l.mold_strategy.forms_inner_surface() {
         errs.push(ParamError::new(
                 format!("{path}.surface"),
                 "inner",

@@ -15,7 +15,7 @@ use crate::parts::layer_feature::{InsertInput, LayerFeature, LayerInput, MoldIns
 use crate::parts::part::Part;
 use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::seat::Seat;
-use crate::schema::{LayerProcess, MoldStrategy};
+use crate::schema::shared::LayerProcess;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
@@ -222,7 +222,7 @@ impl LayerFeature for RecessFeature {
     const INSERT_ROLE: Option<&'static str> = Some("recess_insert");
 
     fn check(r: &Recess, input: LayerInput<'_>, errs: &mut Vec<ParamError>) {
-        let l = input.layer;
+        let l = input;
         let path = input.path(Self::KEY);
         if !l.solid {
             errs.push(ParamError::new(
@@ -236,7 +236,7 @@ impl LayerFeature for RecessFeature {
             return;
         }
         let strategy = input.strategy;
-        if l.process == LayerProcess::Cast && strategy != MoldStrategy::Open {
+        if l.process == LayerProcess::Cast && !strategy.sets_inserts() {
             errs.push(ParamError::new(
                 &path,
                 "given",

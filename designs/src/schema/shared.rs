@@ -141,6 +141,18 @@ impl MoldStrategy {
     pub fn holds_core(self) -> bool {
         matches!(self, MoldStrategy::Direct | MoldStrategy::Master)
     }
+
+    /// Whether its mold is open on the base plane and sets the inserts of the layer's
+    /// features there (`open`: [`crate::parts::layer_feature::LayerFeature::open_mold_inserts`]).
+    pub fn sets_inserts(self) -> bool {
+        matches!(self, MoldStrategy::Open)
+    }
+
+    /// Whether its molds form the layer's inner surface too (`boundary`: an inner master
+    /// pattern), so that features may stand on it.
+    pub fn forms_inner_surface(self) -> bool {
+        matches!(self, MoldStrategy::Boundary)
+    }
 }
 
 /// The internal filling gel (R-Tac0 Sec. III-B1): poured into the assembled shell with the

@@ -9,7 +9,7 @@ use crate::materials::MaterialsTable;
 use crate::parts::layers::{
     feature_end_centres, place_layer_markers, recess_clearance_to_base_mm, PlacedMarkers,
 };
-use crate::schema::{Design, LayerProcess, MoldStrategy, Technology};
+use crate::schema::{Design, LayerProcess, Technology};
 use crate::stack::{validate, ResolvedLayer, Stack};
 use crate::{ChordTolerance, DesignError};
 use serde::{Deserialize, Serialize};
@@ -278,24 +278,24 @@ pub fn min_wall(
             ));
         }
     }
-    let cast = |l: &&ResolvedLayer| l.process == LayerProcess::Cast;
-    let open_block = design.mold.open_block.as_ref();
-    for l in stack.layers.iter().filter(cast) {
-        if let (Some(ob), MoldStrategy::Open) = (open_block, l.mold_strategy) {
-            let (rim, height) = crate::parts::molds::open_cavity_mm(&design.stack_input(), l);
-            walls.push((
-                ob.width_mm / 2.0 - rim,
-                "mold.open_block.width_mm: open mold's wall beside the cavity".into(),
-            ));
-            walls.push((
-                ob.height_mm - height,
-                "mold.open_block.height_mm: open mold's wall beyond the cavity".into(),
-            ));
+    // each strategy's walls around the layers cast in it, or the mold's wall_thickness_mm
+    let si = design.stack_input();
+    let mut sized_by_wall = false;
+    for s in crate::parts::molds::STRATEGIES {
+        let cast: Vec<&ResolvedLayer> = stack
+            .layers
+            .iter()
+            .filter(|l| l.process == LayerProcess::Cast && l.mold_strategy == s.kind())
+            .collect();
+        if cast.is_empty() {
+            continue;
+        }
+        match s.walls(&si, &cast) {
+            Some(w) => walls.extend(w),
+            None => sized_by_wall = true,
         }
     }
-    let sized_by_wall =
-        |l: &&ResolvedLayer| !(open_block.is_some() && l.mold_strategy == MoldStrategy::Open);
-    if stack.layers.iter().filter(cast).any(|l| sized_by_wall(&l)) {
+    if sized_by_wall {
         walls.push((
             design.mold.wall_thickness_mm,
             "mold.wall_thickness_mm: mold wall around the cavity".into(),

@@ -242,12 +242,12 @@ pub fn build_layer(
 }
 
 /// Every mold strategy, one line each: the build and the cast check find a layer's strategy
-/// here ([`strategy_of`]).
+/// here ([`strategy_of`]); the validation and the thinnest-wall metric ask each in this order.
 pub static STRATEGIES: &[&dyn Strategy] = &[
     &direct::Direct,
     &master::Master,
-    &open::Open,
     &two_piece_open::TwoPieceOpen,
+    &open::Open,
     &boundary::Boundary,
 ];
 

@@ -2,15 +2,18 @@
 //! to the brim, with the inserts of the layer's features (DIGIT Pinki).
 
 use super::frame::material_for;
+use super::frame::open_cavity_mm;
 use super::strategy::{CastPieces, Strategy};
-use crate::error::{DesignError, GeometryContext};
+use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{GeometryError, Solid};
+use crate::parts::context::ResolvedLayer;
 use crate::parts::layer_feature::InsertInput;
 use crate::parts::layer_registry::open_mold_inserts;
 use crate::parts::layers::{
     apply_features_signed, body_solid, features_top_z_mm, set_forming, LayerBuild, LayerOutput,
 };
 use crate::parts::placement::{place_posed, with_pose};
+use crate::parts::stack_input::StackInput;
 use crate::parts::Part;
 use crate::schema::MoldStrategy as Kind;
 use serde_json::json;
@@ -97,6 +100,51 @@ impl Strategy for Open {
 
     fn solid_only(&self) -> bool {
         true
+    }
+
+    /// `mold.open_block` against the layers cast in an open mold: the largest cavity (its rim
+    /// on the base plane, its height with the tallest raised outward feature) with the cavity
+    /// printer's minimum wall around it; its sizes alone when the stack is not sound.
+    fn check_layers(
+        &self,
+        si: &StackInput<'_>,
+        cast: Option<&[&ResolvedLayer]>,
+        errs: &mut Vec<ParamError>,
+    ) {
+        let Some(block) = &si.mold.open_block else {
+            return;
+        };
+        let Some(cast) = cast else {
+            crate::parts::check_above_zero("mold.open_block.", block, &[], errs);
+            return;
+        };
+        let open: Vec<_> = cast.iter().map(|l| open_cavity_mm(si, l)).collect();
+        let rim = open.iter().map(|c| c.0).fold(0.0, f64::max);
+        let height = open.iter().map(|c| c.1).fold(0.0, f64::max);
+        let min_wall = si
+            .ctx
+            .printers
+            .get(si.mold.cavity_print_technology)
+            .min_wall_mm;
+        block.check(!open.is_empty(), rim, height, min_wall, errs);
+    }
+
+    /// With `mold.open_block`, the block's walls beside and beyond each cavity.
+    fn walls(&self, si: &StackInput<'_>, cast: &[&ResolvedLayer]) -> Option<Vec<(f64, String)>> {
+        let ob = si.mold.open_block.as_ref()?;
+        let mut walls = Vec::new();
+        for l in cast {
+            let (rim, height) = open_cavity_mm(si, l);
+            walls.push((
+                ob.width_mm / 2.0 - rim,
+                "mold.open_block.width_mm: open mold's wall beside the cavity".into(),
+            ));
+            walls.push((
+                ob.height_mm - height,
+                "mold.open_block.height_mm: open mold's wall beyond the cavity".into(),
+            ));
+        }
+        Some(walls)
     }
 
     fn build_layer(&self, b: LayerBuild<'_>) -> Option<Result<LayerOutput, DesignError>> {

@@ -4,7 +4,7 @@
 //! ([`crate::cast_check`]) loop over [`super::STRATEGIES`] and name no strategy
 //! (docs/src/development.md, "Adding a mold strategy").
 
-use crate::error::DesignError;
+use crate::error::{DesignError, ParamError};
 use crate::geometry::{ChordTolerance, Solid};
 use crate::parts::context::ResolvedLayer;
 use crate::parts::layers::{LayerBuild, LayerOutput};
@@ -71,6 +71,26 @@ pub trait Strategy: Sync {
     /// surface); validation refuses it for a layer that is not solid.
     fn solid_only(&self) -> bool {
         false
+    }
+
+    /// Appends the rules of its own mold parameters (`mold.open_block`, `mold.two_piece_open`)
+    /// against `cast`: the sound stack's cast layers whose strategy it is (possibly none), or
+    /// `None` when the stack is not sound (then only the rules that need no layer). Nothing by
+    /// default.
+    fn check_layers(
+        &self,
+        _si: &StackInput<'_>,
+        _cast: Option<&[&ResolvedLayer]>,
+        _errs: &mut Vec<ParamError>,
+    ) {
+    }
+
+    /// The walls of its molds around the layers `cast` in it (not empty), each thickness in mm
+    /// with what it is, for the thinnest-wall metric
+    /// ([`crate::variant::metrics`]); `None` when `mold.wall_thickness_mm` sizes them (the
+    /// default).
+    fn walls(&self, _si: &StackInput<'_>, _cast: &[&ResolvedLayer]) -> Option<Vec<(f64, String)>> {
+        None
     }
 
     /// Its share of the triangle estimate of a layer `l` cast in it beyond the layer's own

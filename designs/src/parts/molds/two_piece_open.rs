@@ -5,6 +5,7 @@ use super::frame::material_for;
 use super::strategy::{CastPieces, Strategy};
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{GeometryError, Solid};
+use crate::parts::context::ResolvedLayer;
 use crate::parts::layers::{
     apply_features_signed, body_solid, features_top_z_mm, set_forming, LayerBuild, LayerOutput,
 };
@@ -452,6 +453,23 @@ pub struct TwoPieceOpen;
 impl Strategy for TwoPieceOpen {
     fn kind(&self) -> Kind {
         Kind::TwoPieceOpen
+    }
+
+    /// [`check_two_piece`] for the widest layer cast in it.
+    fn check_layers(
+        &self,
+        si: &StackInput<'_>,
+        cast: Option<&[&ResolvedLayer]>,
+        errs: &mut Vec<ParamError>,
+    ) {
+        let rim = cast
+            .unwrap_or_default()
+            .iter()
+            .map(|l| si.ctx.body.rim_radius_mm(l.outer_offset_mm))
+            .fold(None, |a: Option<f64>, r| Some(a.map_or(r, |a| a.max(r))));
+        if let Some(rim) = rim {
+            check_two_piece(si, rim, errs);
+        }
     }
 
     fn solid_only(&self) -> bool {
