@@ -8,7 +8,7 @@ use crate::geometry::ChordTolerance;
 use crate::kit::Kit;
 use crate::materials::{pour, MaterialsTable};
 use crate::parts::family::FillingPour;
-use crate::parts::molds::{build_mold, cast_plans, CastPlan};
+use crate::parts::molds::{build_mold, cast_plans, strategy_of, CastPlan};
 use crate::parts::registry::{SectionInput, FAMILIES};
 use crate::schema::{Design, LayerProcess};
 use crate::stack::{validate, Stack};
@@ -407,12 +407,10 @@ fn layer_pours(
             .iter()
             .find(|l| l.name == layer)
             .map(|l| layer_volume_mm3(design, l) / 1000.0);
-        if r.mold_parts.iter().any(|p| p.ends_with(":inner")) {
-            // boundary strategy (UVDtact Sec. III)
-            r.notes = format!(
-                "Pour into the outer silicone mold, then press the inner silicone mold in: its plinth centres it in the outer mold's recess. For a layer after the first, the layers already cast, still on their inner silicone mold, can take the inner mold's place (UVDtact Sec. III). {}",
-                r.notes
-            );
+        // the note the layer's mold strategy starts a pour with (boundary: UVDtact Sec. III)
+        let poured = stack.layers.iter().find(|l| l.name == layer);
+        if let Some(note) = poured.and_then(|l| strategy_of(l.mold_strategy).pour_note()) {
+            r.notes = format!("{note} {}", r.notes);
         }
         r.treatments = treatments(
             design,

@@ -12,6 +12,8 @@ use crate::materials::{cure_text, CastReport};
 use crate::parts::family::AssemblyStep;
 use crate::parts::fasteners::bolt_name;
 use crate::parts::layer_registry::insert_roles;
+use crate::parts::molds::strategy::PourInput;
+use crate::parts::molds::{strategy_of, STRATEGIES};
 use crate::parts::registry::FAMILIES;
 use crate::parts::{Part, ProcedureAction, ProcedureStep};
 use crate::schema::Design;
@@ -30,50 +32,29 @@ pub struct ClampBolts {
 }
 
 pub use crate::parts::family::FILLING_GEL;
-/// The clamp bolts of every bolted mold of the kit, from the parts' parameters: the direct
-/// strategy's halves (4 bolts across both halves, perpendicular to the parting plane) and the
-/// two-piece open mold (`two_piece.bolt_count` bolts through both pieces).
+/// The clamp bolts of every bolted mold of the kit, from the parts' parameters, as each mold
+/// strategy names them ([`crate::parts::molds::strategy::Strategy::clamp_bolts`]: the direct
+/// strategy's halves, 4 bolts across both halves, perpendicular to the parting plane; the
+/// two-piece open mold, `two_piece.bolt_count` bolts through both pieces).
 pub fn clamp_bolts(design: &Design, parts: &[Part]) -> Vec<ClampBolts> {
+    let si = design.stack_input();
     let mut out = Vec::new();
     for p in parts {
+        let Some(b) = STRATEGIES.iter().find_map(|s| s.clamp_bolts(&si, p)) else {
+            continue;
+        };
         let layer = p.params["layer"]
             .as_str()
             .or_else(|| p.params["base"]["layer"].as_str())
             .unwrap_or(&p.name)
             .to_string();
-        if p.role == "mold_half" && p.name.ends_with("_a") {
-            let Some(half_width) = p.params["direct"]["half_width_mm"].as_f64() else {
-                continue;
-            };
-            let c = design.mold.clamp_bolt.clearance_diameter_mm;
-            let grip = 2.0 * half_width;
-            out.push(ClampBolts {
-                layer,
-                count: 4,
-                name: bolt_name(c, grip),
-                grip_mm: grip,
-                clearance_mm: c,
-            });
-        } else if p.role == "open_mold_piece" && p.params["piece"] == "cavity_block" {
-            let (Some(grip), Some(n)) = (
-                p.params["bolt_grip_mm"].as_f64(),
-                p.params["frame"]["bolts_xy_mm"].as_array().map(Vec::len),
-            ) else {
-                continue;
-            };
-            let (a, b) = design
-                .mold
-                .two_piece
-                .bolt_holes_mm(design.mold.clamp_bolt.clearance_diameter_mm);
-            let c = a.min(b);
-            out.push(ClampBolts {
-                layer,
-                count: n,
-                name: bolt_name(c, grip),
-                grip_mm: grip,
-                clearance_mm: c,
-            });
-        }
+        out.push(ClampBolts {
+            layer,
+            count: b.count,
+            name: bolt_name(b.clearance_mm, b.grip_mm),
+            grip_mm: b.grip_mm,
+            clearance_mm: b.clearance_mm,
+        });
     }
     out
 }
@@ -221,125 +202,34 @@ pub fn procedure(
                 ),
             ));
         }
-        close_and_pour(
-            &mut out,
-            c,
-            (&holder, &halves, &pieces),
-            &silicone,
-            &bolt_text,
-            &mut boundary_cast,
-        );
+        // the layer's mold strategy closes its mold and pours it
+        let insert_roles = insert_roles();
+        let (inserts, pieces): (Vec<&Part>, Vec<&Part>) = pieces
+            .iter()
+            .partition(|p| insert_roles.contains(&p.role.as_str()));
+        let strategy = design
+            .layers
+            .iter()
+            .find(|l| l.name == c.cast)
+            .map(|l| l.mold_strategy.unwrap_or(design.mold.strategy));
+        if let Some(s) = strategy {
+            out.extend(strategy_of(s).pour_steps(PourInput {
+                step: n,
+                mix: &c.mix_text(),
+                holder: holder.first().copied(),
+                halves: &halves,
+                pieces: &pieces,
+                inserts: &inserts,
+                bolt_text: &bolt_text,
+                after_boundary: boundary_cast,
+            }));
+        }
+        boundary_cast |= boundary;
         demold_steps(&mut out, design, casts, c, core_mounted);
     }
     let filling = casts.iter().find(|c| c.cast == FILLING_GEL);
     out.extend(assembly_steps(design, parts, core_mounted, filling));
     out
-}
-
-/// The steps of pour `c` that close its mold and pour it, by strategy: the direct strategy's
-/// halves round the core holder, the master strategy's silicone mold with the core pressed in,
-/// the boundary strategy's two silicone molds, a two-piece open mold, a one-piece open mold.
-fn close_and_pour(
-    out: &mut Vec<ProcedureStep>,
-    c: &CastReport,
-    (holder, halves, pieces): (&[&Part], &[&Part], &[&Part]),
-    silicone: &[&String],
-    bolt_text: &str,
-    boundary_cast: &mut bool,
-) {
-    use ProcedureAction as A;
-    let n = c.step;
-    let boundary = silicone.iter().any(|m| m.ends_with(":inner"));
-    let mix = c.mix_text();
-    let insert_roles = insert_roles();
-    let (inserts, pieces): (Vec<&Part>, Vec<&Part>) = pieces
-        .iter()
-        .partition(|p| insert_roles.contains(&p.role.as_str()));
-    if !halves.is_empty() {
-        let (a, b) = (
-            &halves[0].name,
-            halves.get(1).map_or("", |p| p.name.as_str()),
-        );
-        let h = holder
-            .first()
-            .map_or("the core holder", |p| p.name.as_str());
-        out.push(step(
-            A::CloseMold,
-            format!(
-                "Step {n}: set the plinth of `{h}` into the recess of `{a}`, close `{b}` over \
-                 it on the registration keys{bolt_text}."
-            ),
-        ));
-        out.push(step(
-            A::Pour,
-            sprue_pour_text(n, &mix, holder.first().copied()),
-        ));
-    } else if let Some(h) = holder.first() {
-        // master strategy: the silicone mold, then the core pressed in on its jig
-        out.push(step(
-            A::Pour,
-            format!(
-                "Step {n}: stand the silicone mold pole-down in its mold box, mix and degas \
-                 {mix} and pour it in, then press the core on `{}` in until its flange rests \
-                 on the mold: the surplus rises through the sprue ({}) and the vents.",
-                h.name,
-                sprue_text(h)
-            ),
-        ));
-    } else if boundary {
-        let inner = if *boundary_cast {
-            "the layers cast so far, on the first inner silicone mold,"
-        } else {
-            "the inner silicone mold"
-        };
-        out.push(step(
-            A::Pour,
-            format!(
-                "Step {n}: stand the outer silicone mold pole-down, mix and degas {mix}, pour \
-                 it in, then press {inner} in until the plinth seats in the outer mold's \
-                 recess."
-            ),
-        ));
-        *boundary_cast = true;
-    } else if pieces.len() > 1 {
-        let top = pieces.iter().find(|p| p.params["piece"] == "reservoir_top");
-        let block = pieces.iter().find(|p| p.params["piece"] == "cavity_block");
-        if let (Some(t), Some(b)) = (top, block) {
-            out.push(step(
-                A::CloseMold,
-                format!(
-                    "Step {n}: set `{}` on `{}`, boss down into the pocket{bolt_text}.",
-                    t.name, b.name
-                ),
-            ));
-        }
-        out.push(step(
-            A::Pour,
-            format!(
-                "Step {n}: with the cavity down and the reservoir bore up, mix and degas {mix} \
-                 and pour it into the bore to its top face; degas the filled mold again."
-            ),
-        ));
-    } else if let Some(p) = pieces.first() {
-        out.push(step(
-            A::Pour,
-            format!(
-                "Step {n}: stand `{}` level, open face up, mix and degas {mix} and pour it to \
-                 the brim.",
-                p.name
-            ),
-        ));
-        for insert in &inserts {
-            out.push(step(
-                A::CloseMold,
-                format!(
-                    "Step {n}: press `{}` into the gel dome first, centred on the cavity, until \
-                     its flat face lies in the open face of `{}`; wipe off the gel it pushes out.",
-                    insert.name, p.name
-                ),
-            ));
-        }
-    }
 }
 
 /// The steps of pour `c` after it is poured: cure and demold (keeping a boundary-cast layer on
@@ -505,38 +395,6 @@ fn mold_of(cast: &str) -> String {
         Some((layer, side)) => format!("{side} mold of {layer}"),
         None => format!("mold of {rest}"),
     }
-}
-
-/// `the 3.0 mm hole 12.5 mm from the axis, nearest it; the 3 vents are the 2.0 mm holes at
-/// 17.0 mm`, from the holder's parameters.
-fn sprue_text(holder: &Part) -> String {
-    let p = &holder.params;
-    let (Some(d), Some(r)) = (
-        p["sprue"]["diameter_mm"].as_f64(),
-        p["sprue"]["radius_mm"].as_f64(),
-    ) else {
-        return "the sprue".into();
-    };
-    let rv = p["vent_radius_mm"].as_f64().unwrap_or(f64::NAN);
-    let dv = p["vent"]["diameter_mm"].as_f64().unwrap_or(f64::NAN);
-    let nv = p["vent"]["count"].as_u64().unwrap_or(0);
-    let nearest = if r < rv {
-        ", the one nearest the axis"
-    } else {
-        ""
-    };
-    format!(
-        "the {d:.1} mm hole {r:.1} mm from the axis{nearest}; the {nv} vents are the {dv:.1} mm \
-         holes {rv:.1} mm from it"
-    )
-}
-
-fn sprue_pour_text(n: u32, mix: &str, holder: Option<&Part>) -> String {
-    let sprue = holder.map_or_else(|| "the sprue".to_string(), sprue_text);
-    format!(
-        "Step {n}: stand the mold pole-down, the holder's flange on top. Mix and degas {mix} and \
-         pour it slowly through the sprue ({sprue}) until it shows in every vent."
-    )
 }
 
 /// The assembly steps in order, each with its screws or glue: the contact module's own

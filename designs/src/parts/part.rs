@@ -104,3 +104,10 @@ pub struct ProcedureStep {
     /// The instruction, with the parts by name and the numbers it needs.
     pub text: String,
 }
+
+impl ProcedureStep {
+    /// The step `action` with its instruction `text`.
+    pub fn new(action: ProcedureAction, text: String) -> Self {
+        ProcedureStep { action, text }
+    }
+}

@@ -2,11 +2,14 @@
 //! molds the layer is poured between (UVDtact Sec. III).
 
 use super::frame::material_for;
+use super::strategy::PourInput;
 use super::strategy::{CastPieces, Strategy};
 use crate::error::{DesignError, GeometryContext};
 use crate::geometry::{revolve, GeometryError, Solid};
 use crate::parts::layers::{apply_features, layer_solid, set_forming, LayerBuild, LayerOutput};
+use crate::parts::part::ProcedureStep;
 use crate::parts::placement::{place_posed, with_pose};
+use crate::parts::ProcedureAction;
 use crate::parts::{Part, PrintTechnology};
 use crate::schema::MoldStrategy as Kind;
 use serde_json::json;
@@ -140,6 +143,29 @@ pub struct Boundary;
 impl Strategy for Boundary {
     fn kind(&self) -> Kind {
         Kind::Boundary
+    }
+
+    /// The outer silicone mold poured, the inner one (or the layers cast so far on it) pressed
+    /// in (UVDtact Sec. III).
+    fn pour_steps(&self, p: PourInput<'_>) -> Vec<ProcedureStep> {
+        let (n, mix) = (p.step, p.mix);
+        let inner = if p.after_boundary {
+            "the layers cast so far, on the first inner silicone mold,"
+        } else {
+            "the inner silicone mold"
+        };
+        vec![ProcedureStep::new(
+            ProcedureAction::Pour,
+            format!(
+                "Step {n}: stand the outer silicone mold pole-down, mix and degas {mix}, pour \
+                 it in, then press {inner} in until the plinth seats in the outer mold's \
+                 recess."
+            ),
+        )]
+    }
+
+    fn pour_note(&self) -> Option<&'static str> {
+        Some("Pour into the outer silicone mold, then press the inner silicone mold in: its plinth centres it in the outer mold's recess. For a layer after the first, the layers already cast, still on their inner silicone mold, can take the inner mold's place (UVDtact Sec. III).")
     }
 
     /// The drafted Mold Star box round the outer master: about 14 circles of the layer's rim.

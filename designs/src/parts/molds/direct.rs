@@ -1,12 +1,16 @@
 //! The `direct` strategy: the printed block split on the parting plane y = 0, with registration
 //! keys, clamp bolt holes and the core holder (R-Tac0 Sec. III-B1, Fig. 4).
 
+use super::frame::sprue_pour_text;
 use super::frame::{material_for, CastMold, MoldFrame, MoldOutput};
 use super::strategy::{CastPieces, CoreMoldInput, Strategy};
+use super::strategy::{MoldBolts, PourInput};
 use crate::error::{DesignError, GeometryContext};
 use crate::geometry::{cuboid, sphere, Affine, ChordTolerance, Solid};
+use crate::parts::part::ProcedureStep;
 use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::stack_input::StackInput;
+use crate::parts::ProcedureAction;
 use crate::parts::{Part, PrintTechnology};
 use crate::schema::MoldStrategy as Kind;
 use serde_json::json;
@@ -121,6 +125,38 @@ pub struct Direct;
 impl Strategy for Direct {
     fn kind(&self) -> Kind {
         Kind::Direct
+    }
+
+    /// The halves closed round the core holder, then the pour through its sprue.
+    fn pour_steps(&self, p: PourInput<'_>) -> Vec<ProcedureStep> {
+        let n = p.step;
+        let name = |i: usize| p.halves.get(i).map_or("", |h| h.name.as_str());
+        let (a, b) = (name(0), name(1));
+        let h = p.holder.map_or("the core holder", |h| h.name.as_str());
+        vec![
+            ProcedureStep::new(
+                ProcedureAction::CloseMold,
+                format!(
+                    "Step {n}: set the plinth of `{h}` into the recess of `{a}`, close `{b}` over \
+                     it on the registration keys{}.",
+                    p.bolt_text
+                ),
+            ),
+            ProcedureStep::new(ProcedureAction::Pour, sprue_pour_text(n, p.mix, p.holder)),
+        ]
+    }
+
+    /// Four bolts across both halves (perpendicular to the parting plane), named on half `_a`.
+    fn clamp_bolts(&self, si: &StackInput<'_>, p: &Part) -> Option<MoldBolts> {
+        if p.role != "mold_half" || !p.name.ends_with("_a") {
+            return None;
+        }
+        let half_width = p.params["direct"]["half_width_mm"].as_f64()?;
+        Some(MoldBolts {
+            count: 4,
+            grip_mm: 2.0 * half_width,
+            clearance_mm: si.mold.clamp_bolt.clearance_diameter_mm,
+        })
     }
 
     fn core_mold(

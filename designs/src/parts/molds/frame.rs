@@ -276,3 +276,36 @@ pub(crate) fn material_for(t: PrintTechnology) -> &'static str {
         PrintTechnology::Polyjet => "tango_black_plus",
     }
 }
+
+/// `the 3.0 mm hole 12.5 mm from the axis, nearest it; the 3 vents are the 2.0 mm holes at
+/// 17.0 mm`, from the holder's parameters.
+pub(crate) fn sprue_text(holder: &Part) -> String {
+    let p = &holder.params;
+    let (Some(d), Some(r)) = (
+        p["sprue"]["diameter_mm"].as_f64(),
+        p["sprue"]["radius_mm"].as_f64(),
+    ) else {
+        return "the sprue".into();
+    };
+    let rv = p["vent_radius_mm"].as_f64().unwrap_or(f64::NAN);
+    let dv = p["vent"]["diameter_mm"].as_f64().unwrap_or(f64::NAN);
+    let nv = p["vent"]["count"].as_u64().unwrap_or(0);
+    let nearest = if r < rv {
+        ", the one nearest the axis"
+    } else {
+        ""
+    };
+    format!(
+        "the {d:.1} mm hole {r:.1} mm from the axis{nearest}; the {nv} vents are the {dv:.1} mm \
+         holes {rv:.1} mm from it"
+    )
+}
+
+/// The pour through the core holder's sprue, step `n`, of `mix`.
+pub(crate) fn sprue_pour_text(n: u32, mix: &str, holder: Option<&Part>) -> String {
+    let sprue = holder.map_or_else(|| "the sprue".to_string(), sprue_text);
+    format!(
+        "Step {n}: stand the mold pole-down, the holder's flange on top. Mix and degas {mix} and \
+         pour it slowly through the sprue ({sprue}) until it shows in every vent."
+    )
+}

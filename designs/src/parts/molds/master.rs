@@ -1,15 +1,19 @@
 //! The `master` strategy: a printed master pattern of the cavity and a drafted mold box for a Mold
 //! Star 30 silicone mold, with the core holder as casting jig (R-Tac0 Sec. III-B1).
 
+use super::frame::sprue_text;
 use super::frame::{
     cavity_profile, material_for, CastMold, CastPlan, MoldFrame, MoldOutput, BOX_FLOOR_MM,
     BOX_FREEBOARD_MM, BOX_WALL_MM, LOCATING_PIN_HEIGHT_MM, LOCATING_PIN_RADIUS_MM,
 };
+use super::strategy::PourInput;
 use super::strategy::{CastPieces, CoreMoldInput, Strategy};
 use crate::error::{DesignError, GeometryContext};
 use crate::geometry::{revolve, ChordTolerance, Solid};
+use crate::parts::part::ProcedureStep;
 use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::stack_input::StackInput;
+use crate::parts::ProcedureAction;
 use crate::parts::{Part, PrintTechnology};
 use crate::schema::MoldStrategy as Kind;
 use serde_json::json;
@@ -151,6 +155,24 @@ pub struct Master;
 impl Strategy for Master {
     fn kind(&self) -> Kind {
         Kind::Master
+    }
+
+    /// The silicone mold in its box, then the core pressed in on its jig.
+    fn pour_steps(&self, p: PourInput<'_>) -> Vec<ProcedureStep> {
+        let (n, mix) = (p.step, p.mix);
+        let Some(h) = p.holder else {
+            return Vec::new();
+        };
+        vec![ProcedureStep::new(
+            ProcedureAction::Pour,
+            format!(
+                "Step {n}: stand the silicone mold pole-down in its mold box, mix and degas \
+                 {mix} and pour it in, then press the core on `{}` in until its flange rests \
+                 on the mold: the surplus rises through the sprue ({}) and the vents.",
+                h.name,
+                sprue_text(h)
+            ),
+        )]
     }
 
     fn core_mold(

@@ -3,6 +3,7 @@
 
 use super::frame::material_for;
 use super::frame::open_cavity_mm;
+use super::strategy::PourInput;
 use super::strategy::{CastPieces, Strategy};
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{GeometryError, Solid};
@@ -12,9 +13,11 @@ use crate::parts::layer_registry::open_mold_inserts;
 use crate::parts::layers::{
     apply_features_signed, body_solid, features_top_z_mm, set_forming, LayerBuild, LayerOutput,
 };
+use crate::parts::part::ProcedureStep;
 use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::stack_input::StackInput;
 use crate::parts::Part;
+use crate::parts::ProcedureAction;
 use crate::schema::MoldStrategy as Kind;
 use serde_json::json;
 
@@ -96,6 +99,33 @@ pub struct Open;
 impl Strategy for Open {
     fn kind(&self) -> Kind {
         Kind::Open
+    }
+
+    /// The block poured to the brim, then the features' inserts pressed in.
+    fn pour_steps(&self, p: PourInput<'_>) -> Vec<ProcedureStep> {
+        let (n, mix) = (p.step, p.mix);
+        let Some(block) = p.pieces.first() else {
+            return Vec::new();
+        };
+        let mut out = vec![ProcedureStep::new(
+            ProcedureAction::Pour,
+            format!(
+                "Step {n}: stand `{}` level, open face up, mix and degas {mix} and pour it to \
+                 the brim.",
+                block.name
+            ),
+        )];
+        for insert in p.inserts {
+            out.push(ProcedureStep::new(
+                ProcedureAction::CloseMold,
+                format!(
+                    "Step {n}: press `{}` into the gel dome first, centred on the cavity, until \
+                     its flat face lies in the open face of `{}`; wipe off the gel it pushes out.",
+                    insert.name, block.name
+                ),
+            ));
+        }
+        out
     }
 
     fn solid_only(&self) -> bool {

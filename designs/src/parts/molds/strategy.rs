@@ -8,7 +8,7 @@ use crate::error::{DesignError, ParamError};
 use crate::geometry::{ChordTolerance, Solid};
 use crate::parts::context::ResolvedLayer;
 use crate::parts::layers::{LayerBuild, LayerOutput};
-use crate::parts::part::Part;
+use crate::parts::part::{Part, ProcedureStep};
 use crate::parts::stack_input::StackInput;
 use crate::profile::BodyProfile;
 use crate::schema::MoldStrategy;
@@ -24,6 +24,41 @@ pub struct CoreMoldInput<'a> {
     pub cavity: &'a Solid,
     pub with_features: &'a dyn Fn(Solid) -> Result<Solid, DesignError>,
     pub tol: ChordTolerance,
+}
+
+/// What a strategy's pour steps are written from ([`Strategy::pour_steps`]): the pour's step
+/// number and mix, its mold's parts by role, the clamp bolts' words and whether a boundary pour
+/// came before.
+#[derive(Debug, Clone, Copy)]
+pub struct PourInput<'a> {
+    /// The pour's step number ([`crate::materials::CastReport::step`]).
+    pub step: u32,
+    /// The mix, with its amounts ([`crate::materials::CastReport::mix_text`]).
+    pub mix: &'a str,
+    /// The mold's core holder or casting jig, if it has one.
+    pub holder: Option<&'a Part>,
+    /// The mold's halves (`mold_half`).
+    pub halves: &'a [&'a Part],
+    /// The open mold's pieces (`open_mold_piece`, `open_mold`), without the inserts.
+    pub pieces: &'a [&'a Part],
+    /// The layer features' inserts set into the mold
+    /// ([`crate::parts::layer_registry::insert_roles`]).
+    pub inserts: &'a [&'a Part],
+    /// ` and tighten the 4 clamp bolts (M3 x 60, with nuts)`, or empty for a mold without.
+    pub bolt_text: &'a str,
+    /// Whether a boundary pour came before: its layers, still on the first inner silicone
+    /// mold, take the inner mold's place (UVDtact Sec. III).
+    pub after_boundary: bool,
+}
+
+/// The clamp bolts one part of a mold carries ([`Strategy::clamp_bolts`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MoldBolts {
+    pub count: usize,
+    /// The thickness they clamp, mm.
+    pub grip_mm: f64,
+    /// The clearance hole's diameter, mm.
+    pub clearance_mm: f64,
 }
 
 /// What the cast check asks a strategy for: the kit's parts of the layer by the suffix of
@@ -90,6 +125,21 @@ pub trait Strategy: Sync {
     /// ([`crate::variant::metrics`]); `None` when `mold.wall_thickness_mm` sizes them (the
     /// default).
     fn walls(&self, _si: &StackInput<'_>, _cast: &[&ResolvedLayer]) -> Option<Vec<(f64, String)>> {
+        None
+    }
+
+    /// The steps that close its mold and pour a layer in it, in the words of the fabrication
+    /// sheet ([`crate::procedure::procedure`]: `CloseMold`, `Pour`).
+    fn pour_steps(&self, p: PourInput<'_>) -> Vec<ProcedureStep>;
+
+    /// The clamp bolts its mold part `p` carries (one part per bolted mold names them, from
+    /// its parameters); `None` for every other part, and by default.
+    fn clamp_bolts(&self, _si: &StackInput<'_>, _p: &Part) -> Option<MoldBolts> {
+        None
+    }
+
+    /// A sentence the notes of a pour in its mold start with; `None` by default.
+    fn pour_note(&self) -> Option<&'static str> {
         None
     }
 

@@ -3,15 +3,18 @@
 
 use super::frame::material_for;
 use super::strategy::{CastPieces, Strategy};
+use super::strategy::{MoldBolts, PourInput};
 use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::{GeometryError, Solid};
 use crate::parts::context::ResolvedLayer;
 use crate::parts::layers::{
     apply_features_signed, body_solid, features_top_z_mm, set_forming, LayerBuild, LayerOutput,
 };
+use crate::parts::part::ProcedureStep;
 use crate::parts::placement::{place_posed, with_pose};
 use crate::parts::stack_input::StackInput;
 use crate::parts::Part;
+use crate::parts::ProcedureAction;
 use crate::schema::MoldStrategy as Kind;
 use serde_json::json;
 
@@ -453,6 +456,55 @@ pub struct TwoPieceOpen;
 impl Strategy for TwoPieceOpen {
     fn kind(&self) -> Kind {
         Kind::TwoPieceOpen
+    }
+
+    /// The reservoir top bolted onto the cavity block, then the pour into its bore.
+    fn pour_steps(&self, p: PourInput<'_>) -> Vec<ProcedureStep> {
+        let (n, mix) = (p.step, p.mix);
+        let mut out = Vec::new();
+        let top = p
+            .pieces
+            .iter()
+            .find(|q| q.params["piece"] == "reservoir_top");
+        let block = p
+            .pieces
+            .iter()
+            .find(|q| q.params["piece"] == "cavity_block");
+        if let (Some(t), Some(b)) = (top, block) {
+            out.push(ProcedureStep::new(
+                ProcedureAction::CloseMold,
+                format!(
+                    "Step {n}: set `{}` on `{}`, boss down into the pocket{}.",
+                    t.name, b.name, p.bolt_text
+                ),
+            ));
+        }
+        out.push(ProcedureStep::new(
+            ProcedureAction::Pour,
+            format!(
+                "Step {n}: with the cavity down and the reservoir bore up, mix and degas {mix} \
+                 and pour it into the bore to its top face; degas the filled mold again."
+            ),
+        ));
+        out
+    }
+
+    /// `mold.two_piece.bolt_count` bolts through both pieces, named on the cavity block.
+    fn clamp_bolts(&self, si: &StackInput<'_>, p: &Part) -> Option<MoldBolts> {
+        if p.role != "open_mold_piece" || p.params["piece"] != "cavity_block" {
+            return None;
+        }
+        let grip = p.params["bolt_grip_mm"].as_f64()?;
+        let n = p.params["frame"]["bolts_xy_mm"].as_array().map(Vec::len)?;
+        let (a, b) = si
+            .mold
+            .two_piece
+            .bolt_holes_mm(si.mold.clamp_bolt.clearance_diameter_mm);
+        Some(MoldBolts {
+            count: n,
+            grip_mm: grip,
+            clearance_mm: a.min(b),
+        })
     }
 
     /// [`check_two_piece`] for the widest layer cast in it.
