@@ -136,7 +136,7 @@ pub struct Layer {
     pub channels: Option<crate::parts::channels::ChannelSet>,
     /// A grid of markers on the layer's bottom face (flat skins only; Soter et al. Sec. II-A).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub marker_grid: Option<crate::parts::channels::MarkerGrid>,
+    pub marker_grid: Option<crate::parts::marker_grid::MarkerGrid>,
 }
 
 /// Pour calculator settings.

@@ -146,20 +146,15 @@ fn check_scope(design: &Design, errs: &mut Vec<ParamError>) -> Result<(), ParamE
         ));
     }
     for (i, l) in design.layers.iter().enumerate() {
-        for (field, given) in [
-            ("channels", l.channels.is_some()),
-            ("marker_grid", l.marker_grid.is_some()),
-        ] {
-            if given {
-                errs.push(ParamError::new(
-                    format!("layers[{i}].{field}"),
-                    "given",
-                    format!(
-                        "applies to flat skins only (body.profile: flat); this body is {}",
-                        design.body.kind()
-                    ),
-                ));
-            }
+        for field in crate::parts::layer_registry::flat_only_given(l) {
+            errs.push(ParamError::new(
+                format!("layers[{i}].{field}"),
+                "given",
+                format!(
+                    "applies to flat skins only (body.profile: flat); this body is {}",
+                    design.body.kind()
+                ),
+            ));
         }
     }
     Ok(())

@@ -1,10 +1,12 @@
-//! The liquid channels and the marker grid of a flat skin's layer (Soter et al., Sec. II-A:
-//! 16 liquid-filled channels in the top layer, a 10 x 10 grid of markers on the bottom layer):
-//! their parameters (`layers[i].channels`, `layers[i].marker_grid`), rules and solids, in the
-//! flat-skin frame of [`crate::parts::flat`] (docs/conventions.md, flat skins).
+//! A flat skin's layer ([`FlatLayer`]) and the liquid channels in it (Soter et al., Sec. II-A:
+//! 16 liquid-filled channels in the top layer): their parameters (`layers[i].channels`), rules
+//! and sizes, in the flat-skin frame of [`crate::parts::flat`] (docs/conventions.md, flat
+//! skins), and their place among the layer features ([`ChannelsFeature`]). The marker grid on
+//! the bottom layer is [`crate::parts::marker_grid`].
 
 use crate::error::ParamError;
-use crate::markers::{FeatureShape, Polarity};
+use crate::parts::layer_feature::{FlatInput, LayerFeature, LayerInput};
+pub use crate::parts::marker_grid::MarkerGrid;
 use crate::profile::FlatOutline;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -217,136 +219,25 @@ impl ChannelSet {
     }
 }
 
-/// Markers on a grid, `rows` along y by `columns` along x at `pitch_mm`, centred on the axis,
-/// standing on a layer's bottom face towards the camera (Soter et al. Sec. II-A: a 10 x 10
-/// grid of 3D markers whose ends are painted white).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct MarkerGrid {
-    /// Number of rows, stacked along y, at least 1 (Soter et al. Sec. II-A: a 10 x 10 grid).
-    #[schemars(extend("minimum" = 1))]
-    pub rows: usize,
-    /// Number of columns, side by side along x, at least 1 (Soter et al. Sec. II-A: a 10 x 10
-    /// grid).
-    #[schemars(extend("minimum" = 1))]
-    pub columns: usize,
-    /// Centre-to-centre distance between neighbouring markers along x and along y, mm, > 0:
-    /// above the markers' diameter (with more than one row or column), and the outermost
-    /// markers must keep `edge_margin_mm` inside the outline.
-    #[schemars(extend("exclusiveMinimum" = 0))]
-    pub pitch_mm: f64,
-    /// A cylinder ending in a hemisphere (`polarity: raised`: it stands out of the face).
-    pub feature: FeatureShape,
-    /// Least distance from a marker's side to the outline's edge, mm.
-    #[serde(default = "default_edge_margin")]
-    pub edge_margin_mm: f64,
-}
+/// The channels as a layer feature: flat skins only, in a layer with one under it to close
+/// their grooves, each groove within the layer and the outline.
+pub struct ChannelsFeature;
 
-fn default_edge_margin() -> f64 {
-    1.0
-}
+impl LayerFeature for ChannelsFeature {
+    type Params = ChannelSet;
+    const KEY: &'static str = "channels";
+    const FLAT_ONLY: bool = true;
 
-impl MarkerGrid {
-    /// (x, y) of each marker's axis, row by row from -y, mm.
-    pub fn positions_mm(&self) -> Vec<[f64; 2]> {
-        let (mr, mc) = (
-            (self.rows as f64 - 1.0) / 2.0,
-            (self.columns as f64 - 1.0) / 2.0,
-        );
-        (0..self.rows)
-            .flat_map(|r| {
-                (0..self.columns).map(move |c| {
-                    [
-                        (c as f64 - mc) * self.pitch_mm,
-                        (r as f64 - mr) * self.pitch_mm,
-                    ]
-                })
-            })
-            .collect()
+    /// Curved skins refuse them ([`LayerFeature::FLAT_ONLY`]): no rules of their own there.
+    fn check(_c: &ChannelSet, _input: LayerInput<'_>, _errs: &mut Vec<ParamError>) {}
+
+    fn flat_place_rule(index: usize) -> Option<&'static str> {
+        (index == 0).then_some(
+            "the innermost layer cannot hold channels: their grooves are closed by the layer under them",
+        )
     }
 
-    /// Every violation under `prefix` (`layers[0].marker_grid.`).
-    pub fn errors(&self, prefix: &str, outline: &FlatOutline) -> Vec<ParamError> {
-        let mut errs = Vec::new();
-        let p = |f: &str| format!("{prefix}{f}");
-        for (f, n) in [("rows", self.rows), ("columns", self.columns)] {
-            if n == 0 {
-                errs.push(ParamError::new(p(f), 0, "must be 1 or more"));
-            }
-        }
-        // bounded before positions_mm allocates one position per marker
-        let max = crate::markers::MAX_MARKERS_PER_PATTERN;
-        if self.rows.checked_mul(self.columns).is_none_or(|n| n > max) {
-            let (f, n) = if self.rows >= self.columns {
-                ("rows", self.rows)
-            } else {
-                ("columns", self.columns)
-            };
-            errs.push(ParamError::new(
-                p(f),
-                n,
-                format!(
-                    "a {} x {} grid has more than the {max} markers one grid may have",
-                    self.rows, self.columns
-                ),
-            ));
-        }
-        crate::parts::check_above_zero(prefix, self, &[], &mut errs);
-        if !(self.edge_margin_mm >= 0.0 && self.edge_margin_mm.is_finite()) {
-            errs.push(ParamError::new(
-                p("edge_margin_mm"),
-                self.edge_margin_mm,
-                "must be 0 or more",
-            ));
-        }
-        if !errs.is_empty() {
-            return errs;
-        }
-        let r = self.feature.radius_mm();
-        if self.feature.height_mm < r {
-            errs.push(ParamError::new(
-                p("feature.height_mm"),
-                self.feature.height_mm,
-                format!("must be at least the radius ({r} mm): the marker ends in a hemisphere"),
-            ));
-        }
-        if self.feature.side() != Polarity::Raised {
-            errs.push(ParamError::new(
-                p("feature.polarity"),
-                "recessed",
-                "grid markers stand out of the face (raised)",
-            ));
-        }
-        if self.feature.diameter_mm >= self.pitch_mm && self.rows.max(self.columns) > 1 {
-            errs.push(ParamError::new(
-                p("feature.diameter_mm"),
-                self.feature.diameter_mm,
-                format!(
-                    "must be below the pitch ({} mm): markers would merge",
-                    self.pitch_mm
-                ),
-            ));
-        }
-        let worst = self
-            .positions_mm()
-            .into_iter()
-            .map(|q| outline.inset_mm(q))
-            .fold(f64::INFINITY, f64::min);
-        if worst - r < self.edge_margin_mm {
-            errs.push(ParamError::new(
-                p("pitch_mm"),
-                self.pitch_mm,
-                format!(
-                    "a {} x {} grid at this pitch does not fit the {} x {} mm outline: its outermost marker's side is {:.3} mm from the edge, edge_margin_mm is {}",
-                    self.rows,
-                    self.columns,
-                    outline.width_mm,
-                    outline.length_mm,
-                    worst - r,
-                    self.edge_margin_mm
-                ),
-            ));
-        }
-        errs
+    fn check_flat(c: &ChannelSet, input: FlatInput<'_>, errs: &mut Vec<ParamError>) {
+        errs.extend(c.errors(&input.prefix(Self::KEY), input.thickness_mm, input.outline));
     }
 }

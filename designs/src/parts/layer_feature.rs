@@ -12,7 +12,7 @@ use crate::markers::MarkerSpec;
 use crate::parts::context::Context;
 use crate::parts::part::{Part, PrintTechnology};
 pub use crate::parts::seat::Seat;
-use crate::profile::BodyProfile;
+use crate::profile::{BodyProfile, FlatOutline};
 use crate::schema::shared::{LayerProcess, MoldStrategy};
 
 /// What a feature's rules see besides its own parameters.
@@ -56,6 +56,25 @@ pub struct InsertInput<'a> {
     pub tol: ChordTolerance,
 }
 
+/// What a flat skin's feature rules see ([`LayerFeature::check_flat`]): the layer's index,
+/// its thickness once the layers are stacked, and the skin's outline.
+#[derive(Debug, Clone, Copy)]
+pub struct FlatInput<'a> {
+    /// The layer's index in `layers` (0: the innermost, on the base plane).
+    pub index: usize,
+    /// The layer's thickness, mm.
+    pub thickness_mm: f64,
+    /// The skin's outline.
+    pub outline: &'a FlatOutline,
+}
+
+impl FlatInput<'_> {
+    /// The prefix of every error path of feature `key` of this layer (`layers[1].channels.`).
+    pub fn prefix(&self, key: &str) -> String {
+        format!("layers[{}].{key}.", self.index)
+    }
+}
+
 /// A part set into a mold to form a feature, with the volume it takes from the cavity, mm^3.
 #[derive(Debug, Clone)]
 pub struct MoldInsert {
@@ -74,6 +93,9 @@ pub trait LayerFeature {
     /// The rule a flat skin's layer breaks by giving the feature; `None` when flat skins take
     /// it.
     const FLAT_RULE: Option<&'static str> = None;
+    /// Whether only flat skins take it (`channels`, `marker_grid`): a curved skin's validation
+    /// refuses it by its path.
+    const FLAT_ONLY: bool = false;
     /// The role of the parts it sets into a mold ([`LayerFeature::open_mold_inserts`]), which
     /// the cast check counts as mold and the procedure places; `None` when it has none.
     const INSERT_ROLE: Option<&'static str> = None;
@@ -81,6 +103,16 @@ pub trait LayerFeature {
     /// Appends every violated rule of `p` to `errs`, each with its path under
     /// `layers[i].KEY`, its value and the rule.
     fn check(p: &Self::Params, input: LayerInput<'_>, errs: &mut Vec<ParamError>);
+
+    /// The rule layer `index` of a flat skin breaks by holding the feature there (channels
+    /// need a layer under them, the marker grid stands on the innermost); `None` by default.
+    fn flat_place_rule(_index: usize) -> Option<&'static str> {
+        None
+    }
+
+    /// Appends every violated rule of `p` in a flat skin's stacked layer (`input`), each with
+    /// its path under `layers[i].KEY.`; nothing by default.
+    fn check_flat(_p: &Self::Params, _input: FlatInput<'_>, _errs: &mut Vec<ParamError>) {}
 
     /// The seat it cuts into its solid layer from below; `None` by default, and when its
     /// rules do not hold (validation reports them).

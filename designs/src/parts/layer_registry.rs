@@ -1,5 +1,6 @@
 //! The list of layer features ([`LAYER_FEATURES`]) and the loops over it: the validation
-//! ([`check_layer_features`], [`flat_refusals`]), the solid a layer fills and its volume
+//! ([`check_layer_features`], [`flat_refusals`], [`flat_only_given`], [`flat_misplaced`],
+//! [`check_flat_features`]), the solid a layer fills and its volume
 //! ([`seat_of`]), the open mold's inserts ([`open_mold_inserts`], [`insert_roles`]) and the
 //! layer's twin ([`twin_params`]). Adding a feature is one module in `parts/`, its field in
 //! [`crate::schema::Layer`] and one line here (docs/src/development.md, "Adding a layer
@@ -9,9 +10,11 @@ use std::marker::PhantomData;
 
 use crate::error::ParamError;
 use crate::geometry::GeometryError;
-use crate::parts::layer_feature::{InsertInput, LayerFeature, LayerInput, MoldInsert, Seat};
-use crate::parts::recess;
+use crate::parts::layer_feature::{
+    FlatInput, InsertInput, LayerFeature, LayerInput, MoldInsert, Seat,
+};
 use crate::parts::stack_input::StackInput;
+use crate::parts::{channels, marker_grid, recess};
 use crate::schema::Layer;
 
 /// A registered layer feature, as the loops see it: each method does nothing (or returns
@@ -23,6 +26,12 @@ pub trait Feature: Sync {
     fn given(&self, l: &Layer) -> bool;
     /// [`LayerFeature::FLAT_RULE`].
     fn flat_rule(&self) -> Option<&'static str>;
+    /// [`LayerFeature::FLAT_ONLY`].
+    fn flat_only(&self) -> bool;
+    /// [`LayerFeature::flat_place_rule`].
+    fn flat_place_rule(&self, index: usize) -> Option<&'static str>;
+    /// [`LayerFeature::check_flat`] of layer `l`'s parameters.
+    fn check_flat(&self, l: &Layer, input: FlatInput<'_>, errs: &mut Vec<ParamError>);
     /// [`LayerFeature::INSERT_ROLE`].
     fn insert_role(&self) -> Option<&'static str>;
     /// [`LayerFeature::check`] of layer `l`'s parameters.
@@ -72,6 +81,20 @@ impl<F: LayerFeature> Feature for RegisteredFeature<F> {
         F::FLAT_RULE
     }
 
+    fn flat_only(&self) -> bool {
+        F::FLAT_ONLY
+    }
+
+    fn flat_place_rule(&self, index: usize) -> Option<&'static str> {
+        F::flat_place_rule(index)
+    }
+
+    fn check_flat(&self, l: &Layer, input: FlatInput<'_>, errs: &mut Vec<ParamError>) {
+        if let Some(p) = (self.params)(l) {
+            F::check_flat(p, input, errs);
+        }
+    }
+
     fn insert_role(&self) -> Option<&'static str> {
         F::INSERT_ROLE
     }
@@ -100,10 +123,11 @@ impl<F: LayerFeature> Feature for RegisteredFeature<F> {
 }
 
 /// Every layer feature, in the order their rules are reported and their twin keys written.
-pub static LAYER_FEATURES: &[&dyn Feature] =
-    &[&RegisteredFeature::<recess::RecessFeature>::at(|l| {
-        l.recess.as_ref()
-    })];
+pub static LAYER_FEATURES: &[&dyn Feature] = &[
+    &RegisteredFeature::<recess::RecessFeature>::at(|l| l.recess.as_ref()),
+    &RegisteredFeature::<channels::ChannelsFeature>::at(|l| l.channels.as_ref()),
+    &RegisteredFeature::<marker_grid::MarkerGridFeature>::at(|l| l.marker_grid.as_ref()),
+];
 
 /// The rules of every feature of every layer of `design` (`body_ok`: the body's own rules
 /// hold), layer by layer.
@@ -134,6 +158,32 @@ pub fn flat_refusals(l: &Layer) -> Vec<(&'static str, &'static str)> {
         .filter(|f| f.given(l))
         .filter_map(|f| Some((f.key(), f.flat_rule()?)))
         .collect()
+}
+
+/// The keys of the features layer `l` of a curved skin gives that only flat skins take.
+pub fn flat_only_given(l: &Layer) -> Vec<&'static str> {
+    LAYER_FEATURES
+        .iter()
+        .filter(|f| f.flat_only() && f.given(l))
+        .map(|f| f.key())
+        .collect()
+}
+
+/// The features layer `l` (index `index`) of a flat skin holds where the stack does not take
+/// them: each key with the rule it breaks.
+pub fn flat_misplaced(l: &Layer, index: usize) -> Vec<(&'static str, &'static str)> {
+    LAYER_FEATURES
+        .iter()
+        .filter(|f| f.given(l))
+        .filter_map(|f| Some((f.key(), f.flat_place_rule(index)?)))
+        .collect()
+}
+
+/// The rules of every feature of a flat skin's stacked layer `l` ([`LayerFeature::check_flat`]).
+pub fn check_flat_features(l: &Layer, input: FlatInput<'_>, errs: &mut Vec<ParamError>) {
+    for f in LAYER_FEATURES {
+        f.check_flat(l, input, errs);
+    }
 }
 
 /// The seat cut into layer `index` of `design` from below, with the key of the feature that

@@ -18,6 +18,7 @@ pub mod layer_markers;
 pub mod layer_registry;
 pub mod layers;
 pub mod marker_checks;
+pub mod marker_grid;
 mod member;
 pub mod molds;
 mod part;

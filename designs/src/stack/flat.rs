@@ -7,6 +7,7 @@
 use crate::error::ParamError;
 use crate::geometry::ChordTolerance;
 use crate::parts::channels::FlatLayer;
+use crate::parts::layer_feature::FlatInput;
 use crate::parts::registry::FAMILIES;
 use crate::profile::FlatOutline;
 use crate::schema::Design;
@@ -195,19 +196,8 @@ fn check_layer_fields(
                 "give a thickness above 0 (or solid: true on the innermost layer, which fills down to the base plane)",
             )),
         }
-        if i == 0 && l.channels.is_some() {
-            errs.push(ParamError::new(
-                p("channels"),
-                "given",
-                "the innermost layer cannot hold channels: their grooves are closed by the layer under them",
-            ));
-        }
-        if i != 0 && l.marker_grid.is_some() {
-            errs.push(ParamError::new(
-                p("marker_grid"),
-                "given",
-                "markers stand on the innermost layer's bottom face (towards the camera)",
-            ));
+        for (key, rule) in crate::parts::layer_registry::flat_misplaced(l, i) {
+            errs.push(ParamError::new(p(key), "given", rule));
         }
     }
 }
@@ -237,16 +227,12 @@ fn check_layer_stack(
             if !body_ok {
                 break;
             }
-            if let Some(c) = &l.channels {
-                errs.extend(c.errors(
-                    &format!("layers[{i}].channels."),
-                    l.z1_mm - l.z0_mm,
-                    outline,
-                ));
-            }
-            if let Some(g) = &l.marker_grid {
-                errs.extend(g.errors(&format!("layers[{i}].marker_grid."), outline));
-            }
+            let input = FlatInput {
+                index: i,
+                thickness_mm: l.z1_mm - l.z0_mm,
+                outline,
+            };
+            crate::parts::layer_registry::check_flat_features(&design.layers[i], input, errs);
         }
     }
 }
