@@ -264,15 +264,44 @@ pub fn yaml_error_in(origin: &str, text: &str, e: &serde_saphyr::Error) -> Strin
 pub fn yaml_error(origin: &str, e: &serde_saphyr::Error) -> String {
     let msg = plain_message(e).unwrap_or_else(|| e.to_string());
     let first = msg.lines().next().unwrap_or(&msg);
+    let hint = nearest_name_hint(first).unwrap_or_default();
     match e.location() {
         Some(loc) => format!(
-            "{origin}:{}:{}: {}",
+            "{origin}:{}:{}: {}{hint}",
             loc.line(),
             loc.column(),
             strip_location(first)
         ),
-        None => format!("{origin}: {first}"),
+        None => format!("{origin}: {first}{hint}"),
     }
+}
+
+/// `; did you mean `strategy`?` for the parser's "unknown field `strategi`, expected one of
+/// strategy, ..." (or "unknown variant"), when one of the names it lists is within a third of
+/// the mistyped name's length in edits (optimal string alignment distance: insertions,
+/// deletions, substitutions and swaps of neighbours; at least 1 and at most 3), the nearest and
+/// first in the listed order; `None` otherwise.
+fn nearest_name_hint(msg: &str) -> Option<String> {
+    let rest = msg
+        .split_once("unknown field `")
+        .or_else(|| msg.split_once("unknown variant `"))?
+        .1;
+    let (typed, rest) = rest.split_once('`')?;
+    let names = rest.split_once("expected one of ").map_or_else(
+        || {
+            rest.split_once("expected ")
+                .map(|(_, n)| n.split(" or ").collect::<Vec<_>>())
+        },
+        |(_, n)| Some(n.split(", ").collect()),
+    )?;
+    let limit = (typed.chars().count() / 3).clamp(1, 3);
+    let (d, best) = names
+        .iter()
+        .map(|n| n.trim().trim_matches('`'))
+        .filter(|n| !n.is_empty())
+        .map(|n| (strsim::osa_distance(typed, n), n))
+        .min_by_key(|(d, _)| *d)?;
+    (d <= limit).then(|| format!("; did you mean `{best}`?"))
 }
 
 /// The rule and the limit in words for the parser's errors that name its internals (a budget

@@ -609,6 +609,30 @@ fn yaml_error(text: &str) -> (usize, usize, String) {
     }
 }
 
+/// A mistyped key or value names the nearest valid one ("did you mean"), and only when one is
+/// near (within a third of its length in edits).
+#[test]
+fn a_mistyped_key_or_value_names_the_nearest_valid_one() {
+    let t = with_line(37, "  strategy: master", &["  strategi: master"]);
+    let (line, col, msg) = yaml_error(&t);
+    assert_eq!((line, col), (37, 3), "{msg}");
+    assert!(
+        msg.contains("unknown field `strategi`") && msg.contains("; did you mean `strategy`?"),
+        "{msg}"
+    );
+    // a value of an enumeration
+    let t = with_line(37, "  strategy: master", &["  strategy: mastr"]);
+    let (_, _, msg) = yaml_error(&t);
+    assert!(msg.contains("did you mean `master`?"), "{msg}");
+    // nothing near: no guess
+    let t = with_line(37, "  strategy: master", &["  colour: red"]);
+    let (_, _, msg) = yaml_error(&t);
+    assert!(
+        msg.contains("unknown field `colour`") && !msg.contains("did you mean"),
+        "{msg}"
+    );
+}
+
 #[test]
 fn unknown_key_points_at_its_line() {
     // line 16 is `  description: ...` under `core:`; the new key takes its place

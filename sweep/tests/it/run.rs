@@ -300,7 +300,7 @@ fn malformed_sweeps_are_refused_before_anything_runs() {
         ),
         (
             "base: shadowtac\nvray:\n  mold.wall_thickness_mm: [3]\n",
-            "sweep.yaml:2:1: unknown field `vray`",
+            "sweep.yaml:2:1: unknown field `vray`, expected one of base, preset, chord_tolerance_mm, vary, mode, seed, count, outputs; did you mean `vary`?",
         ),
         (
             "base: shadowtac\nvary:\n  layers[0].markers[0].pattern.csv_file: [a.csv]\n",
