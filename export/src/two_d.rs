@@ -22,11 +22,14 @@ fn layer(op: Operation) -> &'static str {
 pub fn dxf_bytes(part: &CutPart) -> Result<Vec<u8>, ExportError> {
     use chrono::TimeZone;
     use dxf::entities::{Circle, Entity, EntityType};
-    use dxf::enums::{AcadVersion, Units};
+    use dxf::enums::{AcadVersion, DrawingUnits, Units};
     use dxf::tables::Layer;
     let mut d = dxf::Drawing::new();
     d.header.version = AcadVersion::R2000;
+    // $INSUNITS 4 (millimetres) and $MEASUREMENT 1 (metric) agree: a CAD or laser program
+    // that reads either scales the same
     d.header.default_drawing_units = Units::Millimeters;
+    d.header.drawing_units = DrawingUnits::Metric;
     let epoch = chrono::Utc.with_ymd_and_hms(2000, 1, 1, 0, 0, 0).unwrap();
     d.header.creation_date = epoch.with_timezone(&chrono::Local);
     d.header.update_date = epoch.with_timezone(&chrono::Local);

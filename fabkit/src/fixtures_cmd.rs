@@ -163,11 +163,11 @@ fn print_summary(
     );
     if let Some(d) = &set.pin_dome {
         out!(
-            "  pin dome: {} holes in {} captures; pins {:.3} mm (head to tip), seat {:?}, indentation {:.3} mm",
+            "  pin dome: {} holes in {} captures; pins {:.3} mm (head to tip), seated with {}, indentation {:.3} mm",
             d.table.len(),
             d.capture_plan.len(),
             d.pin_length_mm,
-            d.seat,
+            d.seat.words(),
             d.table.first().map(|r| r.indentation_depth_mm).unwrap_or(0.0)
         );
         for n in &d.notes {

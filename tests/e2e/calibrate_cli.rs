@@ -393,6 +393,12 @@ fn rtac0_fixture_table_and_capture_plan_end_to_end() {
         &[],
     );
     assert!(o.status.success(), "{}", text(&o.stderr));
+    // the summary says in words how the pins sit (not a Rust name)
+    let said = text(&o.stdout);
+    assert!(
+        said.contains("seated with the head on ") && !said.contains("CounterboreFloor"),
+        "{said}"
+    );
     std::fs::write(
         dir.join("cam.yaml"),
         write_camera(&intrinsics(), CameraFileFormat::OpenCvYaml),

@@ -146,7 +146,8 @@ for c in m["cut_parts"]:
     out.append({"name": c["name"], "dxf_area": region([shoelace(p) for p in polys]),
                 "svg_area": region([shoelace(r) for r in rings]), "stl_volume": vol,
                 "errors": len(a.errors), "fixes": len(a.fixes), "closed": closed,
-                "version": doc.dxfversion, "units": doc.units, "rings": len(polys)})
+                "version": doc.dxfversion, "units": doc.units, "measurement": doc.header.get("$MEASUREMENT"),
+                "rings": len(polys)})
 print(json.dumps(out))
 "#;
     let o = std::process::Command::new(py)
@@ -160,7 +161,8 @@ print(json.dumps(out))
 }
 
 /// The laser-cut trays' sheets (Soter et al. Sec. II-A: laser-cut molds): each sheet's DXF
-/// passes ezdxf's audit with nothing to fix (R2000 or later, mm, closed polylines on `cut`);
+/// passes ezdxf's audit with nothing to fix (R2000 or later, mm and metric, closed polylines on
+/// `cut`);
 /// its DXF area equals its SVG area and the manifest's; its STL is one sheet, whose section
 /// (volume / thickness) is the nominal sheet's area; the paths enclose more than the sheet (the
 /// kerf taken outside it). With every kerf 0, the DXF and SVG areas equal the STL's section
@@ -210,7 +212,8 @@ fn soter_laser_cut_sheets_read_back() {
         for (c, r) in cut.iter().zip(&read) {
             let name = c["name"].as_str().unwrap();
             assert!(r["version"].as_str().unwrap() >= "AC1015", "{r}");
-            assert_eq!(r["units"], 4, "{r}"); // millimetres
+            assert_eq!(r["units"], 4, "{r}"); // $INSUNITS: millimetres
+            assert_eq!(r["measurement"], 1, "{r}"); // $MEASUREMENT: metric, agreeing
             assert_eq!(
                 (r["errors"].as_u64(), r["fixes"].as_u64()),
                 (Some(0), Some(0)),
