@@ -24,8 +24,8 @@ pub enum Polarity {
 
 /// Which side of the skin a feature is on, in a maker's words: a `dimple` is cut into the
 /// skin (its mold carries a pin standing out of the cavity wall into the cavity), a `bump`
-/// stands out of the skin (its mold carries a recess). The same as [`Polarity::Recessed`] and
-/// [`Polarity::Raised`] of the surface that carries the feature.
+/// stands out of the skin (its mold carries a recess). The same as `polarity: recessed` and
+/// `polarity: raised` of the surface that carries the feature.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum OnSkin {
@@ -215,7 +215,7 @@ pub enum RingAzimuthOffset {
     ),
 }
 
-/// The turn of the odd rings of an alternating [`RingAzimuthOffset`].
+/// The turn of the odd rings of an alternating ring azimuth offset (`RingAzimuthOffset`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum AlternateOffset {

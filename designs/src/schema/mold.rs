@@ -39,7 +39,7 @@ pub struct MoldParams {
     /// Technology of holders, jigs and boxes.
     pub fixture_print_technology: Technology,
     /// Flat skins: make each casting tray as a stack of laser-cut sheets (DXF and SVG per
-    /// sheet) whose union is also written as the printable tray ([`crate::lasercut`]).
+    /// sheet) whose union is also written as the printable tray.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub laser_cut: Option<LaserCutParams>,
     /// The block of an `open` mold, square about the axis from the base plane up (the DIGIT

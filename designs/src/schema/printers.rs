@@ -58,8 +58,8 @@ pub struct PrinterProfile {
     /// Lug count, ramp and clearance of a bayonet printed on this printer.
     #[serde(default)]
     pub bayonet: crate::parts::bayonet::BayonetProfile,
-    /// The printer's build volume, which the plates are laid out in; `None`: the technology's
-    /// shipped printer ([`shipped_printers`]).
+    /// The printer's build volume, which the plates are laid out in; not given: the bed of the
+    /// printer the technology ships with.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub bed: Option<Bed>,
 }

@@ -82,9 +82,8 @@ pub struct Core {
     pub machining: Option<CoreMachining>,
 }
 
-/// How a core made to order is described to the shop ([`Core::machining`]). Its inner surface
-/// is [`crate::profile::BodyProfile::shell_inner_surface`] of the core's outer surface and
-/// wall.
+/// How a core made to order is described to the shop (`core.machining`). Its inner surface
+/// is the core's outer surface offset inward by its wall.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct CoreMachining {
@@ -173,7 +172,7 @@ pub struct FillingGel {
     pub fills: Option<GelFill>,
 }
 
-/// How far a housing's filling gel is poured ([`FillingGel::fills`]).
+/// How far a housing's filling gel is poured (`filling_gel.fills`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum GelFill {

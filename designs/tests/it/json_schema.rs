@@ -64,6 +64,33 @@ fn the_schema_is_draft_2020_12_with_its_id_and_deterministic() {
     assert_eq!(serde_json::from_str::<Value>(&text).unwrap(), v);
 }
 
+/// The descriptions are plain text for a design's author: no rustdoc link brackets
+/// (`` [`Name`] ``) and no Rust paths (`crate::`), which an editor would show as they are.
+#[test]
+fn the_schema_descriptions_are_plain_text() {
+    let text = design_json_schema_text();
+    let v = design_json_schema();
+    let mut descriptions = Vec::new();
+    fn walk(v: &Value, out: &mut Vec<String>) {
+        match v {
+            Value::Object(m) => {
+                if let Some(Value::String(d)) = m.get("description") {
+                    out.push(d.clone());
+                }
+                m.values().for_each(|x| walk(x, out));
+            }
+            Value::Array(a) => a.iter().for_each(|x| walk(x, out)),
+            _ => {}
+        }
+    }
+    walk(&v, &mut descriptions);
+    assert!(descriptions.len() > 100, "{} descriptions", descriptions.len());
+    for d in &descriptions {
+        assert!(!d.contains("[`") && !d.contains("crate::"), "{d}");
+    }
+    assert!(!text.contains("crate::"));
+}
+
 /// Every section of a design refuses unknown keys (`deny_unknown_fields` on every design type),
 /// except the presets' maps of parameter paths, which take any path.
 #[test]
