@@ -268,6 +268,15 @@ pub fn observe_images(
     let camera = imaging.camera;
     let intr = camera.intrinsics();
     let size = (intr.image_width_px, intr.image_height_px);
+    if let Some(dir) = input.captures.iter().find(|p| p.is_dir()) {
+        return Err(ImageError::Ids {
+            file: dir.display().to_string(),
+            rule: format!(
+                "is a folder, not an image: give the capture images themselves (as {}/*.png, which the shell expands in name order)",
+                dir.display().to_string().trim_end_matches('/')
+            ),
+        });
+    }
     for (k, p) in input.captures.iter().enumerate() {
         if input.captures[..k].contains(p) {
             return Err(ImageError::Twice {

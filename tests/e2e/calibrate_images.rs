@@ -694,6 +694,7 @@ fn bad_images_and_reference_exit_2_naming_the_option_and_write_nothing() {
     std::fs::copy(s.path("01_05_09_17_25.png"), s.path("small.png")).unwrap();
     std::fs::write(s.path("01_04_08_16_24.png"), "not an image\n").unwrap();
     std::fs::write(s.path("obs.csv"), "id,u_px,v_px\n").unwrap();
+    std::fs::create_dir(s.path("caps")).unwrap();
     save(&blank, &s.path("01_01_01_01_01.png"), Kind::Gray8);
     // issue 95: a JPEG cut to half its bytes was accepted (the decoder fills the rest)
     save(&blank, &s.path("01_06_10_18_26.jpg"), Kind::Jpeg);
@@ -733,6 +734,11 @@ fn bad_images_and_reference_exit_2_naming_the_option_and_write_nothing() {
         (
             &["--reference", "ref.png", "--images", "capture.png"],
             "--images = capture.png: the file name does not list the capture's pin ids",
+        ),
+        // issue 102: a folder of captures was told its name lists no pin ids
+        (
+            &["--reference", "ref.png", "--images", "caps"],
+            "--images = caps: is a folder, not an image: give the capture images themselves (as caps/*.png",
         ),
         (
             &[

@@ -84,7 +84,11 @@ fn the_schema_descriptions_are_plain_text() {
         }
     }
     walk(&v, &mut descriptions);
-    assert!(descriptions.len() > 100, "{} descriptions", descriptions.len());
+    assert!(
+        descriptions.len() > 100,
+        "{} descriptions",
+        descriptions.len()
+    );
     for d in &descriptions {
         assert!(!d.contains("[`") && !d.contains("crate::"), "{d}");
     }
