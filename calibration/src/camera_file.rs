@@ -3,8 +3,9 @@
 //! Reading detects the form; errors name the file, line and field.
 //!
 //! Keys (OpenCV and ROS share them): `image_width`, `image_height`, `camera_matrix` (3 x 3,
-//! `[fx 0 cx; 0 fy cy; 0 0 1]`, px), `distortion_model` (`fisheye` or `equidistant`, `plumb_bob`,
-//! `rational_polynomial`) and `distortion_coefficients` (OpenCV order). A file without
+//! `[fx 0 cx; 0 fy cy; 0 0 1]`, px; also read as `K` or `cameraMatrix`), `distortion_model`
+//! (`fisheye` or `equidistant`, `plumb_bob`, `rational_polynomial`) and
+//! `distortion_coefficients` (OpenCV order; also read as `D`, `distCoeffs` or `dist_coeffs`). A file without
 //! `distortion_model` is read as `plumb_bob` for 5 coefficients and `rational_polynomial` for 8
 //! (what `cv2.calibrateCamera` writes), or for 12 or 14 (`CALIB_THIN_PRISM_MODEL`,
 //! `CALIB_RATIONAL_MODEL` in OpenCV 5) whose thin-prism and tilt coefficients s1..s4, tauX, tauY
@@ -136,11 +137,43 @@ struct YamlMatrix {
 struct YamlCamera {
     image_width: Option<u32>,
     image_height: Option<u32>,
+    /// Also read as `K` or `cameraMatrix` ([`SPELLINGS`]).
+    #[serde(alias = "K", alias = "cameraMatrix")]
     camera_matrix: Option<YamlMatrix>,
     distortion_model: Option<String>,
     /// OpenCV's camera_calibration sample: 1 for `cv::fisheye`, 0 otherwise.
     fisheye_model: Option<i64>,
+    /// Also read as `D`, `distCoeffs` or `dist_coeffs` ([`SPELLINGS`]).
+    #[serde(alias = "D", alias = "distCoeffs", alias = "dist_coeffs")]
     distortion_coefficients: Option<YamlMatrix>,
+}
+
+/// The other spellings of the matrices' keys that calibration scripts write with
+/// `cv2.FileStorage` (`fs.write("K", K)`; `cameraMatrix` and `distCoeffs` as OpenCV's own
+/// functions name them), read as the OpenCV and ROS keys.
+const SPELLINGS: &[(&str, &[&str])] = &[
+    ("camera_matrix", &["camera_matrix", "K", "cameraMatrix"]),
+    (
+        "distortion_coefficients",
+        &["distortion_coefficients", "D", "distCoeffs", "dist_coeffs"],
+    ),
+];
+
+/// The spellings of `key` a file may use ([`SPELLINGS`]; the key alone for the others).
+fn spellings(key: &str) -> Vec<&str> {
+    SPELLINGS
+        .iter()
+        .find(|(k, _)| *k == key)
+        .map_or_else(|| vec![key], |(_, all)| all.to_vec())
+}
+
+/// The 1-based line of `key` in `text` under any of its spellings; 0 when absent.
+fn line_of_any(text: &str, key: &str) -> usize {
+    spellings(key)
+        .into_iter()
+        .map(|k| line_of(text, k))
+        .find(|&l| l > 0)
+        .unwrap_or(0)
 }
 
 /// Reads and validates a camera file (form detected from the content).
@@ -200,7 +233,7 @@ pub fn parse_camera_as(
     CameraModel::new(intr).map_err(|e| match e {
         crate::camera::CameraError::Invalid { field, value, rule } => CameraFileError::Field {
             file: file.to_string(),
-            line: line_of(text, key_of_field(field)),
+            line: line_of_any(text, key_of_field(field)),
             field: field.to_string(),
             value,
             rule: rule.to_string(),
@@ -447,7 +480,7 @@ fn parse_yaml(
             message: first,
         }
     })?;
-    camera_of(y, file, hint, &|key| line_of(text, key))
+    camera_of(y, file, hint, &|key| line_of_any(text, key))
 }
 
 /// Intrinsics from the keys of an OpenCV or ROS file; `line(key)` is the key's 1-based line.
@@ -475,9 +508,12 @@ fn camera_of(
     let h = y
         .image_height
         .ok_or_else(|| missing("image_height", "image height in px"))?;
-    let k = y
-        .camera_matrix
-        .ok_or_else(|| missing("camera_matrix", "3 x 3 [fx 0 cx; 0 fy cy; 0 0 1], px"))?;
+    let k = y.camera_matrix.ok_or_else(|| {
+        missing(
+            "camera_matrix",
+            "3 x 3 [fx 0 cx; 0 fy cy; 0 0 1], px; also read as K or cameraMatrix",
+        )
+    })?;
     let check = |name: &str, m: &YamlMatrix| -> Result<(), CameraFileError> {
         if m.rows * m.cols != m.data.len() {
             return Err(field(
@@ -521,7 +557,7 @@ fn camera_of(
     let d = y.distortion_coefficients.ok_or_else(|| {
         missing(
             "distortion_coefficients",
-            "OpenCV order, e.g. k1, k2, k3, k4 for fisheye",
+            "OpenCV order, e.g. k1, k2, k3, k4 for fisheye; also read as D, distCoeffs or dist_coeffs",
         )
     })?;
     check("distortion_coefficients", &d)?;
@@ -673,7 +709,12 @@ fn parse_xml(
         }
         seen.push((&el.name, el.line));
     }
-    let get = |name: &str| root.children.iter().find(|el| el.name == name);
+    let get = |name: &str| {
+        let names = spellings(name);
+        root.children
+            .iter()
+            .find(|el| names.contains(&el.name.as_str()))
+    };
     // OpenCV writes strings with spaces in double quotes inside the element.
     let string = |el: &XmlElement| {
         let t = el.text.trim();

@@ -95,6 +95,52 @@ fn opencv_calibrate_output_without_model_name_reads_as_plumb_bob() {
     );
 }
 
+/// Calibration scripts' spellings of the matrices (`fs.write("K", K)`, `cameraMatrix` and
+/// `distCoeffs` as OpenCV's functions name them) read as the OpenCV keys, in YAML and XML; an
+/// error in one names its line; a file with neither spelling names them all.
+#[test]
+fn common_spellings_of_the_matrices_read_as_the_opencv_keys() {
+    let want = parse_camera(OPENCV_CALIBRATE_OUTPUT, "cal.yaml").unwrap();
+    for (k, d) in [
+        ("K", "D"),
+        ("cameraMatrix", "distCoeffs"),
+        ("K", "dist_coeffs"),
+    ] {
+        let yaml = OPENCV_CALIBRATE_OUTPUT
+            .replace("camera_matrix:", &format!("{k}:"))
+            .replace("distortion_coefficients:", &format!("{d}:"));
+        assert_eq!(
+            parse_camera(&yaml, "k.yaml").unwrap().intrinsics(),
+            want.intrinsics(),
+            "{k} {d}"
+        );
+        let xml = OPENCV_XML
+            .replace("camera_matrix", k)
+            .replace("distortion_coefficients", d);
+        assert_eq!(
+            parse_camera(&xml, "k.xml").unwrap().intrinsics(),
+            want.intrinsics(),
+            "{k} {d}"
+        );
+    }
+    // an error under another spelling names its line
+    let bad = OPENCV_CALIBRATE_OUTPUT
+        .replace("camera_matrix:", "K:")
+        .replace("rows: 3", "rows: 2");
+    let e = parse_camera(&bad, "k.yaml").unwrap_err().to_string();
+    let line = bad.lines().position(|l| l.starts_with("K:")).unwrap() + 1;
+    assert!(
+        e.starts_with(&format!("k.yaml:{line}: camera_matrix")),
+        "{e}"
+    );
+    let none = OPENCV_CALIBRATE_OUTPUT.replace("camera_matrix:", "intrinsics:");
+    let e = parse_camera(&none, "n.yaml").unwrap_err().to_string();
+    assert!(
+        e.contains("camera_matrix: missing") && e.contains("K or cameraMatrix"),
+        "{e}"
+    );
+}
+
 #[test]
 fn ros_equidistant_reads_as_fisheye() {
     let text = "image_width: 640\nimage_height: 480\ncamera_name: cam\ncamera_matrix:\n  rows: 3\n  cols: 3\n  data: [215, 0, 320, 0, 215, 240, 0, 0, 1]\ndistortion_model: equidistant\ndistortion_coefficients:\n  rows: 1\n  cols: 4\n  data: [0.1, 0.01, 0.001, 0.0001]\n";
