@@ -129,7 +129,7 @@ pub static LAYER_FEATURES: &[&dyn Feature] = &[
     &RegisteredFeature::<marker_grid::MarkerGridFeature>::at(|l| l.marker_grid.as_ref()),
 ];
 
-/// The rules of every feature of every layer of `design` (`body_ok`: the body's own rules
+/// The rules of every feature of every layer `si` gives (`body_ok`: the body's own rules
 /// hold), layer by layer.
 pub fn check_layer_features(si: &StackInput<'_>, body_ok: bool, errs: &mut Vec<ParamError>) {
     let ctx = si.ctx;
@@ -186,8 +186,8 @@ pub fn check_flat_features(l: &Layer, input: FlatInput<'_>, errs: &mut Vec<Param
     }
 }
 
-/// The seat cut into layer `index` of `design` from below, with the key of the feature that
-/// cuts it; `None` when no feature does (or its rules do not hold).
+/// The seat cut into layer `index` of `si` from below, with the key of the feature that cuts
+/// it; `None` when no feature does (or its rules do not hold).
 pub fn layer_seat(si: &StackInput<'_>, index: usize) -> Option<(&'static str, Seat)> {
     let l = si.layers.get(index)?;
     LAYER_FEATURES
@@ -195,7 +195,7 @@ pub fn layer_seat(si: &StackInput<'_>, index: usize) -> Option<(&'static str, Se
         .find_map(|f| Some((f.key(), f.seat(l)?)))
 }
 
-/// The seat of layer `index` of `design` ([`layer_seat`]) without its key.
+/// The seat of layer `index` of `si` ([`layer_seat`]) without its key.
 pub fn seat_of(si: &StackInput<'_>, index: usize) -> Option<Seat> {
     layer_seat(si, index).map(|(_, s)| s)
 }
