@@ -159,19 +159,6 @@ const SPELLINGS: &[(&str, &[&str])] = &[
     ),
 ];
 
-/// The other spellings of the matrices' keys camera-file text `text` uses ([`SPELLINGS`]):
-/// each as written with the key it is read as (`("K", "camera_matrix")`), in [`SPELLINGS`]'
-/// order; empty for a file that uses the OpenCV and ROS keys.
-pub fn spellings_used(text: &str) -> Vec<(&'static str, &'static str)> {
-    SPELLINGS
-        .iter()
-        .filter_map(|(key, all)| {
-            let used = all.iter().skip(1).find(|s| line_of(text, s) > 0)?;
-            Some((*used, *key))
-        })
-        .collect()
-}
-
 /// The spellings of `key` a file may use ([`SPELLINGS`]; the key alone for the others).
 fn spellings(key: &str) -> Vec<&str> {
     SPELLINGS

@@ -252,36 +252,10 @@ pub struct CameraArgs {
 }
 
 impl CameraArgs {
-    /// The camera of `--camera` (with `--camera-model` for a file that names none), with
-    /// [`CameraArgs::note_spellings`].
+    /// The camera of `--camera` (with `--camera-model` for a file that names none).
     pub fn read(
         &self,
     ) -> Result<fabkit_calibration::CameraModel, fabkit_calibration::CameraFileError> {
-        let model = fabkit_calibration::read_camera_file_as(
-            &self.camera,
-            self.camera_model.map(Into::into),
-        )?;
-        self.note_spellings();
-        Ok(model)
-    }
-
-    /// For a camera file that spells the matrices as calibration scripts do (`K`, `D`), a
-    /// note on stderr saying which keys were read as which; nothing for the others.
-    pub fn note_spellings(&self) {
-        let Ok(text) = std::fs::read_to_string(&self.camera) else {
-            return;
-        };
-        let used = fabkit_calibration::camera_file::spellings_used(&text);
-        if !used.is_empty() {
-            let read: Vec<String> = used
-                .iter()
-                .map(|(written, key)| format!("{written} as {key}"))
-                .collect();
-            eprintln!(
-                "note: --camera = {}: read {}",
-                self.camera.display(),
-                read.join(", ")
-            );
-        }
+        fabkit_calibration::read_camera_file_as(&self.camera, self.camera_model.map(Into::into))
     }
 }

@@ -249,7 +249,6 @@ fn job(
     optical_path: Option<fabkit_designs::optics::OpticalPath>,
     optical_path_from: Option<String>,
 ) -> ExtrinsicsJob {
-    a.cam.note_spellings();
     ExtrinsicsJob {
         optical_path,
         optical_path_from,
