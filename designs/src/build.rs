@@ -246,7 +246,7 @@ pub fn build_kit_scoped(
     let t = timings::stage("procedure and machined parts");
     let bolts = crate::procedure::clamp_bolts(design, &parts);
     bought.extend(crate::procedure::clamp_bolt_items(&bolts));
-    let procedure = crate::procedure::procedure(design, &parts, &casts, &bolts);
+    let procedure = crate::procedure::procedure(design, &parts, &stack.layers, &casts, &bolts);
     let machined_parts = machined_parts(design, &stack, &parts, tol)?;
     drop(t);
     Ok(Kit {

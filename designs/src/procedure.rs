@@ -9,10 +9,11 @@
 
 use crate::materials::MaterialKind;
 use crate::materials::{cure_text, CastReport};
+use crate::parts::context::ResolvedLayer;
 use crate::parts::family::AssemblyStep;
 use crate::parts::fasteners::bolt_name;
 use crate::parts::layer_registry::insert_roles;
-use crate::parts::molds::strategy::PourInput;
+use crate::parts::molds::strategy::{DemoldInput, PourInput};
 use crate::parts::molds::{strategy_of, STRATEGIES};
 use crate::parts::registry::FAMILIES;
 use crate::parts::{Part, ProcedureAction, ProcedureStep};
@@ -101,6 +102,7 @@ fn step(action: ProcedureAction, text: String) -> ProcedureStep {
 pub fn procedure(
     design: &Design,
     parts: &[Part],
+    layers: &[ResolvedLayer],
     casts: &[CastReport],
     bolts: &[ClampBolts],
 ) -> Vec<ProcedureStep> {
@@ -121,7 +123,7 @@ pub fn procedure(
         ));
     }
     let mut core_mounted = false;
-    let mut boundary_cast = false;
+    let mut on_inner_mold = false;
     for c in casts {
         let n = c.step;
         if c.cast.starts_with("silicone_mold:") {
@@ -137,12 +139,6 @@ pub fn procedure(
         let mut piece_roles = vec!["open_mold_piece", "open_mold"];
         piece_roles.extend(insert_roles());
         let pieces = with_role(parts, &c.mold_parts, &piece_roles);
-        let silicone: Vec<&String> = c
-            .mold_parts
-            .iter()
-            .filter(|m| m.starts_with("silicone_mold:"))
-            .collect();
-        let boundary = silicone.iter().any(|m| m.ends_with(":inner"));
         let bolt = bolts.iter().find(|b| b.layer == c.cast);
         let bolt_text = bolt.map_or_else(String::new, |b| {
             format!(
@@ -178,18 +174,24 @@ pub fn procedure(
             }
             core_mounted = true;
         }
-        if boundary && boundary_cast {
-            out.push(step(
-                A::MoveCore,
-                format!(
-                    "Step {n}: the layers cast so far, still on the first inner silicone mold, \
-                     take the place of `{}` (UVDtact Sec. III).",
-                    silicone
-                        .iter()
-                        .find(|m| m.ends_with(":inner"))
-                        .map_or("the inner silicone mold", |s| s.as_str())
-                ),
-            ));
+        // the layer's mold strategy: its own, else the design's (resolved in the stack)
+        let strategy = layers
+            .iter()
+            .find(|l| l.name == c.cast)
+            .map(|l| strategy_of(l.mold_strategy));
+        let input = PourInput {
+            step: n,
+            mix: &c.mix_text(),
+            holder: holder.first().copied(),
+            halves: &halves,
+            pieces: &pieces,
+            inserts: &[],
+            bolt_text: &bolt_text,
+            mold_parts: &c.mold_parts,
+            on_inner_mold,
+        };
+        if let Some(s) = strategy {
+            out.extend(s.seat_steps(input));
         }
         treatment_steps(&mut out, c, MaterialKind::Release);
         for k in &c.coats {
@@ -207,74 +209,60 @@ pub fn procedure(
         let (inserts, pieces): (Vec<&Part>, Vec<&Part>) = pieces
             .iter()
             .partition(|p| insert_roles.contains(&p.role.as_str()));
-        let strategy = design
-            .layers
-            .iter()
-            .find(|l| l.name == c.cast)
-            .map(|l| l.mold_strategy.unwrap_or(design.mold.strategy));
         if let Some(s) = strategy {
-            out.extend(strategy_of(s).pour_steps(PourInput {
-                step: n,
-                mix: &c.mix_text(),
-                holder: holder.first().copied(),
-                halves: &halves,
+            out.extend(s.pour_steps(PourInput {
                 pieces: &pieces,
                 inserts: &inserts,
-                bolt_text: &bolt_text,
-                after_boundary: boundary_cast,
+                ..input
             }));
         }
-        boundary_cast |= boundary;
-        demold_steps(&mut out, design, casts, c, core_mounted);
+        on_inner_mold |= strategy.is_some_and(|s| s.keeps_inner_mold());
+        demold_steps(&mut out, design, layers, casts, c, core_mounted);
     }
     let filling = casts.iter().find(|c| c.cast == FILLING_GEL);
     out.extend(assembly_steps(design, parts, core_mounted, filling));
     out
 }
 
-/// The steps of pour `c` after it is poured: cure and demold (keeping a boundary-cast layer on
-/// its inner silicone mold for the next pour), then its brushed coat, if any.
+/// The steps of pour `c` after it is poured: cure and demold in the words of its layer's mold
+/// strategy ([`crate::parts::molds::strategy::Strategy::demold_text`]: a boundary-cast layer
+/// stays on its inner silicone mold for the next pour), then its brushed coat, if any.
 fn demold_steps(
     out: &mut Vec<ProcedureStep>,
     design: &Design,
+    layers: &[ResolvedLayer],
     casts: &[CastReport],
     c: &CastReport,
     core_mounted: bool,
 ) {
     use ProcedureAction as A;
     let n = c.step;
-    let boundary = c
-        .mold_parts
-        .iter()
-        .any(|m| m.starts_with("silicone_mold:") && m.ends_with(":inner"));
+    let strategy_of_cast = |name: &str| {
+        layers
+            .iter()
+            .find(|l| l.name == name)
+            .map(|l| l.mold_strategy)
+    };
+    let kind = strategy_of_cast(&c.cast);
+    let cure = cure_text(&c.notes);
+    let custom = kind.and_then(|k| {
+        strategy_of(k).demold_text(DemoldInput {
+            step: n,
+            cure: &cure,
+            layer: &c.cast,
+            poured_again: casts
+                .iter()
+                .any(|d| d.step > c.step && strategy_of_cast(&d.cast) == Some(k)),
+        })
+    });
     let what = if core_mounted {
         format!("the core with `{}`", c.cast)
     } else {
         format!("`{}`", c.cast)
     };
-    let last_boundary = boundary
-        && !casts
-            .iter()
-            .any(|d| d.step > c.step && d.mold_parts.iter().any(|m| m.ends_with(":inner")));
-    let text = if boundary && !last_boundary {
-        format!(
-            "Step {n}: let it cure ({}) and remove the outer silicone mold; keep `{}` on the \
-             inner silicone mold for the next pour.",
-            cure_text(&c.notes),
-            c.cast
-        )
-    } else if boundary {
-        format!(
-            "Step {n}: let it cure ({}) and take the skin out of the outer silicone mold and \
-             off the inner one.",
-            cure_text(&c.notes)
-        )
-    } else {
-        format!(
-            "Step {n}: let it cure ({}), open the mold and take {what} out.",
-            cure_text(&c.notes)
-        )
-    };
+    let text = custom.unwrap_or_else(|| {
+        format!("Step {n}: let it cure ({cure}), open the mold and take {what} out.")
+    });
     out.push(step(A::Demold, text));
     let coat = design
         .layers

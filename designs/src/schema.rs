@@ -256,6 +256,14 @@ fn unit_bounds(v: &mut serde_json::Value, unit: Unit, signed: bool) {
     }
 }
 
+impl Layer {
+    /// The layer's mold strategy: its own `mold_strategy`, else the design's `mold.strategy`
+    /// (`default`): the one place that rule is written. A printed layer is cast in none.
+    pub fn strategy_or(&self, default: MoldStrategy) -> MoldStrategy {
+        self.mold_strategy.unwrap_or(default)
+    }
+}
+
 impl Design {
     /// What a family sees of this design beyond its own parameters
     /// ([`crate::parts::Context`]).

@@ -421,7 +421,7 @@ fn check_mold_strategies(design: &Design, errs: &mut Vec<ParamError>) {
         if l.process != LayerProcess::Cast {
             continue;
         }
-        let strategy = l.mold_strategy.unwrap_or(design.mold.strategy);
+        let strategy = l.strategy_or(design.mold.strategy);
         let path = if l.mold_strategy.is_some() {
             format!("layers[{i}].mold_strategy")
         } else {
@@ -534,7 +534,7 @@ fn resolve_surfaces(
                     inner_offset_mm: f64::NEG_INFINITY,
                     outer_offset_mm: start,
                     thickness_mm: design.body.pole_z_mm(start) - design.body.base_z_mm(),
-                    mold_strategy: l.mold_strategy.unwrap_or(design.mold.strategy),
+                    mold_strategy: l.strategy_or(design.mold.strategy),
                     solid: true,
                 });
                 below_name = format!("layer '{}'", l.name);
@@ -569,7 +569,7 @@ fn resolve_surfaces(
                     inner_offset_mm: below,
                     outer_offset_mm: out,
                     thickness_mm: th,
-                    mold_strategy: l.mold_strategy.unwrap_or(design.mold.strategy),
+                    mold_strategy: l.strategy_or(design.mold.strategy),
                     solid: false,
                 });
                 below = out;
@@ -634,10 +634,7 @@ fn check_with_stack(
     }
     // each strategy's own mold parameters against the layers cast in it
     for s in crate::parts::molds::STRATEGIES {
-        let cast: Vec<&ResolvedLayer> = layers
-            .iter()
-            .filter(|l| l.process == LayerProcess::Cast && l.mold_strategy == s.kind())
-            .collect();
+        let cast = crate::parts::molds::cast_in(layers, s.kind());
         s.check_layers(&design.stack_input(), stack_ok.then_some(&cast[..]), errs);
     }
     // Checks that use the core only make sense once the stack itself is sound.
@@ -707,8 +704,7 @@ fn resolve_core(
     let pole_z = design.body.pole_z_mm(core_out);
     let below_base = c.length_mm - (pole_z - design.body.base_z_mm());
     let held = design.layers.iter().any(|l| {
-        l.process == LayerProcess::Cast
-            && l.mold_strategy.unwrap_or(design.mold.strategy).holds_core()
+        l.process == LayerProcess::Cast && l.strategy_or(design.mold.strategy).holds_core()
     });
     if !(c.length_mm > 0.0) || below_base < 0.0 {
         errs.push(ParamError::new(

@@ -13,6 +13,7 @@ use crate::optics::elements::{FlatInterface, Lens, Light};
 use crate::parts::context::{Context, Stack};
 use crate::parts::cut_part::CutPart;
 use crate::parts::member::Member;
+use crate::parts::part::SkinVolume;
 use crate::parts::part::{Part, ProcedureStep};
 use crate::schema::shared::FillingGel;
 
@@ -149,7 +150,7 @@ pub trait Family {
     fn printed_with_skin(
         _p: &Self::Params,
         _input: FamilyInput<'_>,
-    ) -> Result<Vec<Part>, DesignError> {
+    ) -> Result<Vec<SkinVolume>, DesignError> {
         Ok(Vec::new())
     }
 

@@ -141,7 +141,7 @@ pub fn check_layer_features(si: &StackInput<'_>, body_ok: bool, errs: &mut Vec<P
             solid: layer.solid,
             process: layer.process,
             markers: &layer.markers,
-            strategy: layer.mold_strategy.unwrap_or(si.mold.strategy),
+            strategy: layer.strategy_or(si.mold.strategy),
             body_ok,
         };
         for f in LAYER_FEATURES {

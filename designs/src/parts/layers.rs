@@ -16,6 +16,7 @@ use crate::parts::context::{ResolvedLayer, Stack};
 use crate::parts::layer_feature::solid_layer_profile;
 use crate::parts::layer_registry::seat_of;
 use crate::parts::member::{FeatureKey, MemberFeatures};
+use crate::parts::part::SkinVolume;
 use crate::parts::placement::with_pose;
 use crate::parts::stack_input::StackInput;
 use crate::parts::{Part, PrintTechnology};
@@ -561,7 +562,7 @@ pub(crate) fn with_layer_build<'d, T>(
 
 /// The parts the families print with the outermost layer when it is printed
 /// ([`crate::parts::registry::printed_with_skin`]), asked only when that layer is built.
-pub type WithSkin<'a> = &'a (dyn Fn() -> Result<Vec<Part>, DesignError> + Sync);
+pub type WithSkin<'a> = &'a (dyn Fn() -> Result<Vec<SkinVolume>, DesignError> + Sync);
 
 /// What a printed layer and every strategy of [`crate::parts::molds::build_layer`] build
 /// from: layer `i` of `stack` (`l`), its name, its placed markers (all, on the outer surface,
@@ -656,11 +657,14 @@ pub(crate) fn build_printed_layer(b: LayerBuild) -> Result<LayerOutput, DesignEr
     let carriers: Vec<String> = parts.iter().map(|p| p.name.clone()).collect();
     for p in with_skin {
         parts.push(Part {
+            name: p.name,
+            role: p.role,
+            description: p.description,
+            material: p.material,
             print_technology: tech,
             solid: p.solid.translate(shift),
             params: with_pose(p.params, &pose),
             group: group.clone(),
-            ..p
         });
     }
     let mut markers = b.markers_json;

@@ -133,6 +133,19 @@ pub fn printable_with(si: &StackInput<'_>, l: &ResolvedLayer, j: usize) -> Vec<T
         .collect()
 }
 
+/// What the printer checks of one marker set see: the stack, its layer `l`, the printer
+/// profile that makes its features (named `tech_name`), the set's path
+/// (`layers[i].markers[j]`) and the set itself.
+#[derive(Clone, Copy)]
+struct MarkerCheck<'a> {
+    si: &'a StackInput<'a>,
+    l: &'a ResolvedLayer,
+    profile: &'a PrinterProfile,
+    tech_name: &'a str,
+    path: &'a str,
+    spec: &'a MarkerSpec,
+}
+
 /// Every violation of the marker rules of layer `l` when its features are made by printer
 /// technology `tech` (its profile's minimum wall, hole and feature, and the rim margin that
 /// follows from them). [`check_markers`] applies it with the layer's own technology,
@@ -147,10 +160,18 @@ pub fn marker_errors(si: &StackInput<'_>, l: &ResolvedLayer, tech: Technology) -
         if !marker_shape_errors(si, l, &path, spec, &mut errs) {
             continue;
         }
-        if !marker_size_errors(si, l, profile, &tech_name, &path, spec, &mut errs) {
+        let check = MarkerCheck {
+            si,
+            l,
+            profile,
+            tech_name: &tech_name,
+            path: &path,
+            spec,
+        };
+        if !marker_size_errors(&check, &mut errs) {
             continue;
         }
-        marker_layout_errors(si, l, profile, &tech_name, &path, spec, &mut errs);
+        marker_layout_errors(&check, &mut errs);
     }
     // Recesses from both surfaces of a shell must leave the minimum wall between them.
     if !l.solid {
@@ -300,15 +321,15 @@ fn marker_shape_errors(
 /// feature (or, for a hole in the part or its mold, its minimum hole), a recess into a shell
 /// leaving its minimum wall, then the fields of the pattern. Pushes its errors to `errs`;
 /// false when the checks that follow no longer apply.
-fn marker_size_errors(
-    si: &StackInput<'_>,
-    l: &ResolvedLayer,
-    profile: &PrinterProfile,
-    tech_name: &str,
-    path: &str,
-    spec: &MarkerSpec,
-    errs: &mut Vec<ParamError>,
-) -> bool {
+fn marker_size_errors(c: &MarkerCheck<'_>, errs: &mut Vec<ParamError>) -> bool {
+    let MarkerCheck {
+        si,
+        l,
+        profile,
+        tech_name,
+        path,
+        spec,
+    } = *c;
     let f = &spec.feature;
     let molded = si.layers[l.index].process == LayerProcess::Cast;
     // Printability: in a mold, a raised feature is a hole and a recessed one a bump.
@@ -366,15 +387,15 @@ fn marker_size_errors(
 /// leave its minimum wall between them at their bases and, when they converge, at their
 /// ends, and recesses into a solid layer leave its minimum wall above the base plane.
 /// Pushes its errors to `errs`.
-fn marker_layout_errors(
-    si: &StackInput<'_>,
-    l: &ResolvedLayer,
-    profile: &PrinterProfile,
-    tech_name: &str,
-    path: &str,
-    spec: &MarkerSpec,
-    errs: &mut Vec<ParamError>,
-) {
+fn marker_layout_errors(c: &MarkerCheck<'_>, errs: &mut Vec<ParamError>) {
+    let MarkerCheck {
+        si,
+        l,
+        profile,
+        tech_name,
+        path,
+        spec,
+    } = *c;
     let f = &spec.feature;
     let surface = Surface::new(&si.ctx.body, surface_offset(l, spec.surface));
     let margin = rim_margin(spec, profile.min_wall_mm);

@@ -53,6 +53,25 @@ pub struct Part {
     pub group: Option<String>,
 }
 
+/// A part printed as a further volume of the outermost layer's object
+/// ([`crate::parts::family::Family::printed_with_skin`]): the layer's build gives it the
+/// layer's print technology, group and plate pose, so it has none of its own.
+#[derive(Debug, Clone)]
+pub struct SkinVolume {
+    /// As [`Part::name`].
+    pub name: String,
+    /// As [`Part::role`].
+    pub role: String,
+    /// As [`Part::description`].
+    pub description: String,
+    /// As [`Part::material`].
+    pub material: String,
+    /// The solid in the sensor frame, mm.
+    pub solid: Solid,
+    /// Its parameters without a pose.
+    pub params: serde_json::Value,
+}
+
 impl Part {
     /// The mesh that is written and measured: the solid's mesh with every coordinate rounded to
     /// `f32` ([`crate::Mesh::rounded_to_f32`]). The export's files and manifest numbers

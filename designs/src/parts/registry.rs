@@ -4,6 +4,7 @@
 //! [`crate::schema::Design`] and one line here (docs/src/development.md, "Adding a part
 //! family").
 
+use crate::parts::part::SkinVolume;
 use std::marker::PhantomData;
 
 use crate::error::{DesignError, ParamError};
@@ -73,7 +74,7 @@ pub trait Section: Sync {
     ///
     /// # Errors
     /// As [`Family::printed_with_skin`].
-    fn printed_with_skin(&self, at: SectionInput<'_>) -> Result<Vec<Part>, DesignError>;
+    fn printed_with_skin(&self, at: SectionInput<'_>) -> Result<Vec<SkinVolume>, DesignError>;
     /// [`Family::bought_items`].
     fn bought_items(&self, d: &Design) -> Vec<String>;
     /// [`Family::assembly_steps`].
@@ -202,7 +203,7 @@ impl<F: Family> Section for Registered<F> {
         self.with(at, F::members).unwrap_or_else(|| Ok(Vec::new()))
     }
 
-    fn printed_with_skin(&self, at: SectionInput<'_>) -> Result<Vec<Part>, DesignError> {
+    fn printed_with_skin(&self, at: SectionInput<'_>) -> Result<Vec<SkinVolume>, DesignError> {
         self.with(at, F::printed_with_skin)
             .unwrap_or_else(|| Ok(Vec::new()))
     }
@@ -250,7 +251,7 @@ pub fn printed_with_skin(
     design: &Design,
     stack: &Stack,
     tol: ChordTolerance,
-) -> Result<Vec<Part>, DesignError> {
+) -> Result<Vec<SkinVolume>, DesignError> {
     let at = SectionInput { design, stack, tol };
     let mut out = Vec::new();
     for f in FAMILIES {

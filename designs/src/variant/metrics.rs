@@ -282,11 +282,7 @@ pub fn min_wall(
     let si = design.stack_input();
     let mut sized_by_wall = false;
     for s in crate::parts::molds::STRATEGIES {
-        let cast: Vec<&ResolvedLayer> = stack
-            .layers
-            .iter()
-            .filter(|l| l.process == LayerProcess::Cast && l.mold_strategy == s.kind())
-            .collect();
+        let cast = crate::parts::molds::cast_in(&stack.layers, s.kind());
         if cast.is_empty() {
             continue;
         }

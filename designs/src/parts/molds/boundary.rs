@@ -2,8 +2,8 @@
 //! molds the layer is poured between (UVDtact Sec. III).
 
 use super::frame::material_for;
-use super::strategy::PourInput;
 use super::strategy::{CastPieces, Strategy};
+use super::strategy::{DemoldInput, PourInput};
 use crate::error::{DesignError, GeometryContext};
 use crate::geometry::{revolve, GeometryError, Solid};
 use crate::parts::layers::{apply_features, layer_solid, set_forming, LayerBuild, LayerOutput};
@@ -149,7 +149,7 @@ impl Strategy for Boundary {
     /// in (UVDtact Sec. III).
     fn pour_steps(&self, p: PourInput<'_>) -> Vec<ProcedureStep> {
         let (n, mix) = (p.step, p.mix);
-        let inner = if p.after_boundary {
+        let inner = if p.on_inner_mold {
             "the layers cast so far, on the first inner silicone mold,"
         } else {
             "the inner silicone mold"
@@ -162,6 +162,48 @@ impl Strategy for Boundary {
                  recess."
             ),
         )]
+    }
+
+    fn keeps_inner_mold(&self) -> bool {
+        true
+    }
+
+    /// The layers cast so far, still on the first inner silicone mold, take the place of this
+    /// pour's inner silicone mold (UVDtact Sec. III).
+    fn seat_steps(&self, p: PourInput<'_>) -> Vec<ProcedureStep> {
+        if !p.on_inner_mold {
+            return Vec::new();
+        }
+        vec![ProcedureStep::new(
+            ProcedureAction::MoveCore,
+            format!(
+                "Step {}: the layers cast so far, still on the first inner silicone mold, \
+                 take the place of `{}` (UVDtact Sec. III).",
+                p.step,
+                p.mold_parts
+                    .iter()
+                    .find(|m| m.ends_with(":inner"))
+                    .map_or("the inner silicone mold", |s| s.as_str())
+            ),
+        )]
+    }
+
+    /// The outer silicone mold comes off; the layer stays on the inner one while another pour
+    /// follows.
+    fn demold_text(&self, d: DemoldInput<'_>) -> Option<String> {
+        let (n, cure) = (d.step, d.cure);
+        Some(if d.poured_again {
+            format!(
+                "Step {n}: let it cure ({cure}) and remove the outer silicone mold; keep `{}` on \
+                 the inner silicone mold for the next pour.",
+                d.layer
+            )
+        } else {
+            format!(
+                "Step {n}: let it cure ({cure}) and take the skin out of the outer silicone mold \
+                 and off the inner one."
+            )
+        })
     }
 
     fn pour_note(&self) -> Option<&'static str> {

@@ -32,7 +32,7 @@ use crate::error::{DesignError, GeometryContext, ParamError};
 use crate::geometry::ChordTolerance;
 use crate::geometry::{revolve, Solid};
 use crate::markers::MarkerSurface;
-use crate::parts::context::Stack;
+use crate::parts::context::{ResolvedLayer, Stack};
 use crate::parts::layers::{self, LayerOutput};
 use crate::parts::stack_input::StackInput;
 use crate::parts::{Part, PrintTechnology};
@@ -261,4 +261,13 @@ pub fn strategy_of(kind: MoldStrategy) -> &'static dyn Strategy {
         .iter()
         .find(|s| s.kind() == kind)
         .expect("every mold strategy is listed in STRATEGIES")
+}
+
+/// The cast layers of `layers` whose (resolved) mold strategy is `kind`, inner to outer;
+/// printed layers are cast in none.
+pub fn cast_in(layers: &[ResolvedLayer], kind: MoldStrategy) -> Vec<&ResolvedLayer> {
+    layers
+        .iter()
+        .filter(|l| l.process == LayerProcess::Cast && l.mold_strategy == kind)
+        .collect()
 }

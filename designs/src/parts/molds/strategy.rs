@@ -26,9 +26,9 @@ pub struct CoreMoldInput<'a> {
     pub tol: ChordTolerance,
 }
 
-/// What a strategy's pour steps are written from ([`Strategy::pour_steps`]): the pour's step
-/// number and mix, its mold's parts by role, the clamp bolts' words and whether a boundary pour
-/// came before.
+/// What a strategy's pour steps are written from ([`Strategy::pour_steps`],
+/// [`Strategy::seat_steps`]): the pour's step number and mix, its mold's parts by role and by
+/// name, the clamp bolts' words and whether an earlier pour's layers stay on an inner mold.
 #[derive(Debug, Clone, Copy)]
 pub struct PourInput<'a> {
     /// The pour's step number ([`crate::materials::CastReport::step`]).
@@ -46,9 +46,25 @@ pub struct PourInput<'a> {
     pub inserts: &'a [&'a Part],
     /// ` and tighten the 4 clamp bolts (M3 x 60, with nuts)`, or empty for a mold without.
     pub bolt_text: &'a str,
-    /// Whether a boundary pour came before: its layers, still on the first inner silicone
-    /// mold, take the inner mold's place (UVDtact Sec. III).
-    pub after_boundary: bool,
+    /// The names of every part that holds the pour
+    /// ([`crate::materials::CastReport::mold_parts`]), silicone molds included.
+    pub mold_parts: &'a [String],
+    /// Whether an earlier pour's layers stay on their inner mold
+    /// ([`Strategy::keeps_inner_mold`]): they take the inner mold's place (UVDtact Sec. III).
+    pub on_inner_mold: bool,
+}
+
+/// What the demold step of a pour is written from ([`Strategy::demold_text`]).
+#[derive(Debug, Clone, Copy)]
+pub struct DemoldInput<'a> {
+    /// The pour's step number.
+    pub step: u32,
+    /// The cure, in the words of the materials table ([`crate::materials::cure_text`]).
+    pub cure: &'a str,
+    /// The layer poured (`layers[i].name`).
+    pub layer: &'a str,
+    /// Whether a later pour in the same strategy follows (the layer then stays on its mold).
+    pub poured_again: bool,
 }
 
 /// The clamp bolts one part of a mold carries ([`Strategy::clamp_bolts`]).
@@ -135,6 +151,25 @@ pub trait Strategy: Sync {
     /// The clamp bolts its mold part `p` carries (one part per bolted mold names them, from
     /// its parameters); `None` for every other part, and by default.
     fn clamp_bolts(&self, _si: &StackInput<'_>, _p: &Part) -> Option<MoldBolts> {
+        None
+    }
+
+    /// Whether a layer cast in it stays on the mold's inner part for the next pour in it, the
+    /// layers so far then taking that part's place (boundary: on the inner silicone mold,
+    /// UVDtact Sec. III); false by default.
+    fn keeps_inner_mold(&self) -> bool {
+        false
+    }
+
+    /// The steps before the release agent of a pour in it, in the words of the fabrication
+    /// sheet (`MoveCore`); none by default.
+    fn seat_steps(&self, _p: PourInput<'_>) -> Vec<ProcedureStep> {
+        Vec::new()
+    }
+
+    /// The words of a pour's demold step (`Demold`) in it; `None` for the default ("open the
+    /// mold and take it out").
+    fn demold_text(&self, _d: DemoldInput<'_>) -> Option<String> {
         None
     }
 

@@ -18,7 +18,8 @@ use crate::parts::family::{
     named, AssemblyInput, AssemblyStep, Built, Family, FamilyInput, FillingPour, InnerCavity,
     FILLING_GEL,
 };
-use crate::parts::{Member, MemberKind, Part, PrintTechnology, ProcedureAction, ProcedureStep};
+use crate::parts::part::SkinVolume;
+use crate::parts::{Member, MemberKind, ProcedureAction, ProcedureStep};
 use serde_json::json;
 
 /// The shaft-body family (`shaft_body`, with its `robot_mount`): the body, the tip's fitting
@@ -157,22 +158,19 @@ impl Family for ShaftBodyFamily {
     fn printed_with_skin(
         sb: &ShaftBodyParams,
         input: FamilyInput<'_>,
-    ) -> Result<Vec<Part>, DesignError> {
+    ) -> Result<Vec<SkinVolume>, DesignError> {
         // The tip's fitting prints with the outermost (printed) layer, as a further volume of
         // its object (Pestell et al. Sec. III-A).
         let name = input.stack.layers.last().map_or("", |l| l.name.as_str());
-        Ok(vec![Part {
+        Ok(vec![SkinVolume {
             name: "tip_fitting".into(),
             role: "tip_fitting".into(),
             description: format!(
                 "The tip's rigid bayonet fitting, printed in the second material with {name} (Pestell et al. Sec. III-A)"
             ),
             material: sb.tip_fitting.material.clone(),
-            // the layer's build prints it with the layer's own technology
-            print_technology: PrintTechnology::Polyjet,
             solid: tip_fitting_solid(sb, input).part(name)?,
             params: twin_params(input.ctx, sb, input.stack),
-            group: None,
         }])
     }
 
