@@ -456,7 +456,7 @@ pub const PAIRS_NOTES: &str = "stitched pairs: depth = right_dir/* on right_mask
 /// The header row comes first; what the columns mean ([`PAIRS_NOTES`]) is in the manifest's
 /// `pairs.csv` entry.
 pub fn pairs_csv(patterns: &[String]) -> String {
-    let mut s = super::dataset::files::PAIRS_HEADER.join(",") + "\n";
+    let mut s = super::files::PAIRS_HEADER.join(",") + "\n";
     let mut k = 0;
     for r in patterns {
         for l in patterns {

@@ -3,7 +3,7 @@
 
 use super::model::Capture;
 use super::terms::{gain_of, median, MIN_REFERENCE_COUNTS};
-use crate::groundtruth::SurfaceHits;
+use crate::groundtruth::hits::SurfaceHits;
 
 /// Why an image cannot serve the fit ([`image_fault`], [`capture_fault`]).
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -8,8 +8,8 @@ use super::terms::{
     features, gain_of, light_features, optical_axis, spatial, COEFFICIENTS, FEATURES, LIGHT_TERMS,
     MIN_REFERENCE_COUNTS, SHADOW_TERMS, SPATIAL_TERMS,
 };
+use crate::groundtruth::hits::SurfaceHits;
 use crate::groundtruth::rays::PixelRays;
-use crate::groundtruth::SurfaceHits;
 use nalgebra::{DMatrix, DVector};
 
 impl PhotometricModel {

@@ -2,7 +2,7 @@
 
 use super::shadows::{ShadowMap, ShadowRings};
 use super::terms::SHADOW_TERMS;
-use crate::groundtruth::SurfaceHits;
+use crate::groundtruth::hits::SurfaceHits;
 
 /// A fitted photometric model of one camera at one pose.
 #[derive(Debug, Clone)]

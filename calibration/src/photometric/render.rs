@@ -7,8 +7,8 @@ use super::terms::{
     features, gain_of, light_features, spatial, FEATURES, LIGHT_TERMS, SPATIAL_TERMS,
 };
 use crate::groundtruth::exact::ExactPrimitives;
+use crate::groundtruth::hits::SurfaceHits;
 use crate::groundtruth::rays::PixelRays;
-use crate::groundtruth::SurfaceHits;
 
 impl PhotometricModel {
     /// The model's image of the surface `hits` (seen along `rays`; `reference` the

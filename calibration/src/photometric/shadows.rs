@@ -6,8 +6,8 @@ use super::terms::{
     SHADOW_AZIMUTHS, SHADOW_HEIGHTS, SHADOW_RADII, SHADOW_REACH, SHADOW_TERMS,
 };
 use crate::groundtruth::exact::ExactPrimitives;
+use crate::groundtruth::hits::SurfaceHits;
 use crate::groundtruth::rays::PixelRays;
-use crate::groundtruth::SurfaceHits;
 use fabkit_designs::primitives::{cross, dot};
 use rayon::prelude::*;
 

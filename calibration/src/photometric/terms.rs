@@ -2,8 +2,8 @@
 //! values at a pixel (the spatial basis, the surface features and the candidate point lights'
 //! features); and the optical axis, the medians and the gains they are measured with.
 
+use crate::groundtruth::hits::SurfaceHits;
 use crate::groundtruth::rays::PixelRays;
-use crate::groundtruth::SurfaceHits;
 use fabkit_designs::primitives::{cross, dot};
 
 /// Degree of the spatial polynomial in the normalised distance from the image centre.

@@ -383,7 +383,7 @@ fn captures_are_read_as_rgb_counts_at_their_depth() {
     assert_eq!(a[(2 * w + 4) as usize], [160.0, 180.0, 7.0]);
     let (b, fb) = read_rgb(&d.path().join("b.png"), "--images", (w, h), "cam.yaml").unwrap();
     assert_eq!(fb, 65535.0);
-    assert_eq!(b[(1 * w + 3) as usize], [27000.0, 20000.0, 65535.0]);
+    assert_eq!(b[(w + 3) as usize], [27000.0, 20000.0, 65535.0]);
     let (c, _) = read_rgb(&d.path().join("c.png"), "--reference", (w, h), "cam.yaml").unwrap();
     assert_eq!(c[3], [150.0; 3]);
     let e = read_rgb(&d.path().join("a.png"), "--images", (6, 3), "cam.yaml")

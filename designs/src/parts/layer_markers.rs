@@ -121,7 +121,7 @@ pub(crate) fn placed_patterns<'a>(
         .iter()
         .filter_map(|spec| {
             let offset = surface_offset(layer, spec.surface);
-            let surface = Surface::new(&si.ctx.body, offset);
+            let surface = Surface::new(si.ctx.body, offset);
             let markers = markers::place(
                 &surface,
                 &spec.pattern,

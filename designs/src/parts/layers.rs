@@ -217,7 +217,7 @@ fn solid_enclosed(
     let Some(r) = seat_of(si, l.index) else {
         return enclosed(si, l.outer_offset_mm, 0.0, sets, tol, stems_only);
     };
-    let pl = solid_layer_profile(&si.ctx.body, l.outer_offset_mm, Some(&r), tol.half());
+    let pl = solid_layer_profile(si.ctx.body, l.outer_offset_mm, Some(&r), tol.half());
     apply_features(
         Solid::from_mesh(&revolve(&pl, tol)?)?,
         sets,

@@ -397,7 +397,7 @@ fn marker_layout_errors(c: &MarkerCheck<'_>, errs: &mut Vec<ParamError>) {
         spec,
     } = *c;
     let f = &spec.feature;
-    let surface = Surface::new(&si.ctx.body, surface_offset(l, spec.surface));
+    let surface = Surface::new(si.ctx.body, surface_offset(l, spec.surface));
     let margin = rim_margin(spec, profile.min_wall_mm);
     let placed = match markers::place(&surface, &spec.pattern, margin) {
         Ok(m) => m,

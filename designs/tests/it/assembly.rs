@@ -413,8 +413,7 @@ fn a_fit_check_build_gives_the_whole_builds_parts_and_errors() {
     long.layers[1].markers[0].feature.height_mm = 1.3;
     let err = |scope| {
         build_kit_scoped(&long, tol(), u64::MAX, scope)
-            .err()
-            .expect("the protrusions overlap the inner layer")
+            .expect_err("the protrusions overlap the inner layer")
             .to_string()
     };
     let e = err(AssemblyScope::FitCheck);
