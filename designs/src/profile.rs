@@ -832,6 +832,16 @@ impl FlatOutline {
         self.width_mm * self.length_mm - (4.0 - PI) * r * r
     }
 
+    /// The signed distance from (x, y) `p` to the outline, mm: negative inside, 0 on it,
+    /// positive outside (exact for the rounded rectangle).
+    pub fn signed_distance_mm(&self, p: [f64; 2]) -> f64 {
+        let r = self.corner_radius_mm;
+        let qx = p[0].abs() - (self.width_mm / 2.0 - r);
+        let qy = p[1].abs() - (self.length_mm / 2.0 - r);
+        let outside = qx.max(0.0).hypot(qy.max(0.0));
+        outside + qx.max(qy).min(0.0) - r
+    }
+
     /// The outline as a convex counter-clockwise polygon, its corner arcs inscribed within
     /// `tol` (vertices on the arcs).
     pub fn polygon(&self, tol: ChordTolerance) -> Vec<[f64; 2]> {

@@ -32,8 +32,9 @@ pub use shared::{
 };
 
 /// Lengths of a design that may be negative ([`crate::values::check_values`]): the lights'
-/// positions in the sensor frame (`optics.lights[i].position_mm`).
-pub const DESIGN_SIGNED_MM: &[&str] = &["position_mm"];
+/// positions in the sensor frame (`optics.lights[i].position_mm`) and the centres of a
+/// laser-cut plate's holes (`mold.laser_cut.plate.holes.xy_mm`).
+pub const DESIGN_SIGNED_MM: &[&str] = &["position_mm", "xy_mm"];
 
 /// A sensor design: body profile, rigid core, layer stack, molds, housing, printers.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]

@@ -85,7 +85,7 @@ pub(crate) fn build_flat_kit(
         .filter_map(|l| l.channels.as_ref().map(|c| (l, c)))
         .collect();
     let (bought, liquid_ml) = bought_items(&layers, &channel_sets, laser, &cut_parts);
-    let procedure = procedure(&parts, &casts, &layers, &channel_sets, laser);
+    let procedure = procedure(&parts, &casts, &layers, &channel_sets, laser, &outline);
     let summary = serde_json::json!({
         "flat": {
             "outline": outline,
@@ -141,6 +141,7 @@ fn layer_tray(
                     crate::parts::lasercut::cut_part(
                         s,
                         &format!("{} tray, sheet {}: {}", l.name, s.name, s.role),
+                        lc.plate.as_ref(),
                         tol,
                     )
                     .map_err(DesignError::Yaml)?,
@@ -196,7 +197,7 @@ fn layer_tray(
         ),
         None => String::new(),
     };
-    let part = Part {
+    let mut part = Part {
         name: name.clone(),
         role: "casting_tray".into(),
         description: format!(
@@ -222,6 +223,13 @@ fn layer_tray(
         }),
         group: None,
     };
+    // a plate's outline and holes (mold.laser_cut.plate) for the tray's twin
+    if let (Some(plate), Some(lc)) = (
+        laser.and_then(|lc| lc.plate.as_ref()),
+        part.params.get_mut("laser_cut"),
+    ) {
+        lc["plate"] = serde_json::json!(plate);
+    }
     let member = Member {
         name: l.name.clone(),
         kind: MemberKind::Cast,
@@ -264,10 +272,20 @@ fn bought_items(
         ));
     }
     if let Some(lc) = laser {
+        let pins = match &lc.plate {
+            None => format!(
+                "{} x steel dowel pin {} mm diameter",
+                4 * layers.len(),
+                lc.registration.diameter_mm
+            ),
+            Some(p) => format!(
+                "{} x bolt (with nut) or dowel pin for the plates' {} mm holes",
+                p.holes.xy_mm.len() * layers.len(),
+                p.holes.diameter_mm
+            ),
+        };
         bought.push(format!(
-            "{} x steel dowel pin {} mm diameter, as long as the thickest tray's stack (registration of each tray's sheets); {}",
-            4 * layers.len(),
-            lc.registration.diameter_mm,
+            "{pins}, as long as the thickest tray's stack (registration of each tray's sheets); {}",
             {
                 let mut used: Vec<String> = Vec::new();
                 for c in cut_parts {
@@ -286,6 +304,19 @@ fn bought_items(
     (bought, liquid_ml)
 }
 
+/// Whether a base hole of the plate (`mold.laser_cut.plate.base_holes`) opens into the cavity
+/// (the skin's `outline`), where the pour would run into it.
+fn base_holes_under_pocket(lc: &LaserCutParams, outline: &FlatOutline) -> bool {
+    lc.plate
+        .as_ref()
+        .and_then(|p| p.base_holes.as_ref())
+        .is_some_and(|b| {
+            b.xy_mm
+                .iter()
+                .any(|&c| outline.signed_distance_mm(c) < b.diameter_mm / 2.0)
+        })
+}
+
 /// The procedure of a flat kit: make the trays, pour and demold each layer in order (the last
 /// one closing the channels), fit and fill the channels' tubes.
 fn procedure(
@@ -294,6 +325,7 @@ fn procedure(
     layers: &[FlatLayer],
     channel_sets: &[(&FlatLayer, &ChannelSet)],
     laser: Option<&LaserCutParams>,
+    outline: &FlatOutline,
 ) -> Vec<ProcedureStep> {
     let step = |action, text: String| ProcedureStep { action, text };
     let trays = parts
@@ -305,8 +337,23 @@ fn procedure(
         Some(lc) => step(
             ProcedureAction::Print,
             format!(
-                "Laser-cut the trays' sheets (cut/*.dxf or cut/*.svg: each sheet's paths already offset for its stock's kerf; the quantity of each is in its description), or print the trays ({trays}) instead. Stack each tray's sheets in order (base at the bottom) on four {} mm dowel pins through the registration holes, bond them (acrylic cement for acrylic, wood glue for plywood) and seal the cavity's inside edges with a thin bead of silicone; check that the tray is flat and its cavity clean.",
-                lc.registration.diameter_mm
+                "Laser-cut the trays' sheets (cut/*.dxf or cut/*.svg: each sheet's paths already offset for its stock's kerf; the quantity of each is in its description), or print the trays ({trays}) instead. Stack each tray's sheets in order (base at the bottom) on {}, bond them (acrylic cement for acrylic, wood glue for plywood) and seal the cavity's inside edges with a thin bead of silicone{}; check that the tray is flat and its cavity clean.",
+                match &lc.plate {
+                    None => format!(
+                        "four {} mm dowel pins through the registration holes",
+                        lc.registration.diameter_mm
+                    ),
+                    Some(p) => format!(
+                        "bolts or dowel pins through the {} {} mm holes of the plates",
+                        p.holes.xy_mm.len(),
+                        p.holes.diameter_mm
+                    ),
+                },
+                if base_holes_under_pocket(lc, outline) {
+                    "; tape the base sheet's holes under the cavity shut from below, so that no silicone runs into them"
+                } else {
+                    ""
+                }
             ),
         ),
         None => step(

@@ -37,8 +37,15 @@ pub struct LaserCutParams {
     /// the first stock.
     #[schemars(extend("minItems" = 1))]
     pub stock: Vec<SheetStock>,
-    /// Dowel holes through every sheet of a stack, one in each corner of the tray's wall.
+    /// Dowel holes through every sheet of a stack, one in each corner of the tray's wall
+    /// (when no `plate` is given).
     pub registration: SheetRegistration,
+    /// The sheets' own outline and holes, as a published mold gives them (9DTact's 60 x 50 mm
+    /// plates with R12 corners, eight 3.1 mm bolt holes, and the sensor's M2 pattern in the
+    /// base sheet); without it every sheet is the pocket grown by `mold.wall_thickness_mm`,
+    /// square-cornered, with a `registration` hole in each corner.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub plate: Option<SheetPlate>,
 }
 defaults!(LaserCutParams {
     stock: vec![
@@ -62,6 +69,7 @@ defaults!(LaserCutParams {
         },
     ],
     registration: SheetRegistration::default(),
+    plate: None,
 });
 
 /// One sheet material profile: what the sheet is and what the laser takes out of it.
@@ -92,6 +100,151 @@ pub struct SheetRegistration {
     pub diameter_mm: f64,
 }
 defaults!(SheetRegistration { diameter_mm: 3.0 });
+
+/// The outline and holes every sheet of a tray shares, centred on the skin: a rounded
+/// rectangle with holes through every sheet (bolts or dowels that clamp and register the
+/// stack) and, in the base sheet only, further holes (the sensor's own screw pattern).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct SheetPlate {
+    /// The plate's size across x and along y, mm: each above the pocket's by at least 2 mm.
+    pub size_mm: [f64; 2],
+    /// The plate's corner radius, mm, 0 (square) up to half its shorter side.
+    #[serde(default)]
+    #[schemars(extend("minimum" = 0))]
+    pub corner_radius_mm: f64,
+    /// Holes through every sheet (bolts or dowel pins through the whole stack).
+    pub holes: HolePattern,
+    /// Holes through the base sheet only (the sensor's screw pattern), which may lie under the
+    /// pocket (the procedure tapes those shut before the pours); none by default.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub base_holes: Option<HolePattern>,
+}
+
+/// Round holes of one diameter at given centres.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct HolePattern {
+    /// The hole's diameter, mm, above 0 (a sliding fit after the kerf).
+    #[schemars(extend("exclusiveMinimum" = 0))]
+    pub diameter_mm: f64,
+    /// The holes' centres (x, y), mm, in the skin's frame (the pocket centred on the origin):
+    /// each hole inside the plate and clear of the other holes by 1 mm, and a hole through
+    /// every sheet clear of the pocket by 1 mm.
+    #[schemars(extend("minItems" = 1))]
+    pub xy_mm: Vec<[f64; 2]>,
+}
+
+/// The least material left between a plate's hole and the plate's edge, the pocket or
+/// another hole, mm.
+pub const MIN_LIGAMENT_MM: f64 = 1.0;
+
+impl SheetPlate {
+    /// The plate's outline as a rounded rectangle.
+    pub fn outline(&self) -> FlatOutline {
+        FlatOutline {
+            width_mm: self.size_mm[0],
+            length_mm: self.size_mm[1],
+            corner_radius_mm: self.corner_radius_mm,
+        }
+    }
+
+    /// Every rule of the plate against the pocket `pocket` (the skin's outline), by path
+    /// under `mold.laser_cut.plate`, pushed onto `errs`.
+    pub fn check(&self, pocket: &FlatOutline, errs: &mut Vec<ParamError>) {
+        let p = "mold.laser_cut.plate";
+        let [w, l] = self.size_mm;
+        let fits = [(w, pocket.width_mm, 0), (l, pocket.length_mm, 1)];
+        let mut size_ok = true;
+        for (size, inner, k) in fits {
+            if !(size.is_finite() && size >= inner + 2.0 * MIN_LIGAMENT_MM) {
+                size_ok = false;
+                errs.push(ParamError::new(
+                    format!("{p}.size_mm[{k}]"),
+                    size,
+                    format!(
+                        "must exceed the pocket's {inner} mm by at least {} mm (1 mm of sheet either side)",
+                        2.0 * MIN_LIGAMENT_MM
+                    ),
+                ));
+            }
+        }
+        let r = self.corner_radius_mm;
+        if !(r >= 0.0 && r <= w.min(l) / 2.0) {
+            errs.push(ParamError::new(
+                format!("{p}.corner_radius_mm"),
+                r,
+                format!(
+                    "must be 0 or more and at most half the plate's shorter side ({} mm)",
+                    w.min(l) / 2.0
+                ),
+            ));
+            size_ok = false;
+        }
+        let mut all: Vec<(String, [f64; 2], f64)> = Vec::new();
+        for (key, pattern) in [
+            ("holes", Some(&self.holes)),
+            ("base_holes", self.base_holes.as_ref()),
+        ] {
+            let Some(h) = pattern else { continue };
+            let d = h.diameter_mm;
+            if !(d > 0.0 && d.is_finite()) {
+                errs.push(ParamError::new(
+                    format!("{p}.{key}.diameter_mm"),
+                    d,
+                    "must be above 0",
+                ));
+                continue;
+            }
+            if h.xy_mm.is_empty() {
+                errs.push(ParamError::new(
+                    format!("{p}.{key}.xy_mm"),
+                    "[]",
+                    "must list at least one hole",
+                ));
+            }
+            for (i, c) in h.xy_mm.iter().enumerate() {
+                all.push((format!("{p}.{key}.xy_mm[{i}]"), *c, d / 2.0));
+            }
+        }
+        if !size_ok {
+            return;
+        }
+        let plate = self.outline();
+        for (k, (path, c, r)) in all.iter().enumerate() {
+            let value = format!("[{}, {}]", c[0], c[1]);
+            let edge = -plate.signed_distance_mm(*c);
+            if !(edge >= r + MIN_LIGAMENT_MM) {
+                errs.push(ParamError::new(
+                    path.as_str(),
+                    &value,
+                    format!("a hole of radius {r} mm there leaves less than {MIN_LIGAMENT_MM} mm to the plate's edge"),
+                ));
+                continue;
+            }
+            // a base hole may lie under the pocket (the base sheet has none): taped shut for
+            // the pours
+            let to_pocket = pocket.signed_distance_mm(*c);
+            if !path.contains(".base_holes.") && !(to_pocket >= r + MIN_LIGAMENT_MM) {
+                errs.push(ParamError::new(
+                    path.as_str(),
+                    &value,
+                    format!("a hole of radius {r} mm there leaves less than {MIN_LIGAMENT_MM} mm to the pocket (the skin's outline, {} x {} mm)", pocket.width_mm, pocket.length_mm),
+                ));
+                continue;
+            }
+            if let Some((other, _, _)) = all[..k].iter().find(|(_, o, ro)| {
+                ((o[0] - c[0]).powi(2) + (o[1] - c[1]).powi(2)).sqrt() < r + ro + MIN_LIGAMENT_MM
+            }) {
+                errs.push(ParamError::new(
+                    path.as_str(),
+                    &value,
+                    format!("leaves less than {MIN_LIGAMENT_MM} mm to the hole at {other}"),
+                ));
+            }
+        }
+    }
+}
 
 /// Most sheets of one stock a level may take.
 pub const MAX_SHEETS_PER_LEVEL: u32 = 8;
@@ -201,6 +354,41 @@ pub fn registration_xy_mm(outline: &FlatOutline, wall_mm: f64) -> [[f64; 2]; 4] 
     [[-x, -y], [x, -y], [x, y], [-x, y]]
 }
 
+/// Every sheet's outer boundary (counter-clockwise), the holes through every sheet and the
+/// holes through the base sheet only (clockwise), from `mold.laser_cut.plate`, else the
+/// pocket grown by `wall_mm` with a registration hole in each corner.
+#[allow(clippy::type_complexity)]
+fn sheet_outline(
+    outline: &FlatOutline,
+    wall_mm: f64,
+    lc: &LaserCutParams,
+    tol: ChordTolerance,
+) -> (Vec<[f64; 2]>, Vec<Vec<[f64; 2]>>, Vec<Vec<[f64; 2]>>) {
+    let holes = |h: &HolePattern| -> Vec<Vec<[f64; 2]>> {
+        h.xy_mm
+            .iter()
+            .map(|&c| reversed(circle(c, h.diameter_mm / 2.0, tol)))
+            .collect()
+    };
+    if let Some(plate) = &lc.plate {
+        return (
+            plate.outline().polygon(tol),
+            holes(&plate.holes),
+            plate.base_holes.as_ref().map(holes).unwrap_or_default(),
+        );
+    }
+    let (hw, hl) = (
+        outline.width_mm / 2.0 + wall_mm,
+        outline.length_mm / 2.0 + wall_mm,
+    );
+    let rect = vec![[-hw, -hl], [hw, -hl], [hw, hl], [-hw, hl]];
+    let reg = holes(&HolePattern {
+        diameter_mm: lc.registration.diameter_mm,
+        xy_mm: registration_xy_mm(outline, wall_mm).to_vec(),
+    });
+    (rect, reg, Vec::new())
+}
+
 /// The stock a level of `thickness_mm` is made of: the first whose thickness, 1 to
 /// [`MAX_SHEETS_PER_LEVEL`] times, equals it (to 1 um); (index, count).
 fn stock_for(stock: &[SheetStock], thickness_mm: f64) -> Option<(usize, u32)> {
@@ -214,9 +402,11 @@ fn stock_for(stock: &[SheetStock], thickness_mm: f64) -> Option<(usize, u32)> {
 }
 
 /// Every rule on `mold.laser_cut` alone, by path: stock names, materials, thicknesses and
-/// kerfs, and the registration holes against the tray's wall.
+/// kerfs, and the plate against the pocket (the skin's outline `pocket`), or else the
+/// registration holes against the tray's wall.
 pub fn check_params(
     lc: &LaserCutParams,
+    pocket: &FlatOutline,
     wall_mm: f64,
     materials: &crate::materials::MaterialsTable,
 ) -> Vec<ParamError> {
@@ -262,7 +452,9 @@ pub fn check_params(
         }
     }
     let d = lc.registration.diameter_mm;
-    if !(d > 0.0 && d <= wall_mm - 2.0) {
+    if let Some(plate) = &lc.plate {
+        plate.check(pocket, &mut errs);
+    } else if !(d > 0.0 && d <= wall_mm - 2.0) {
         errs.push(ParamError::new(
             "mold.laser_cut.registration.diameter_mm",
             d,
@@ -294,16 +486,7 @@ pub fn tray_sheets(
     lc: &LaserCutParams,
     tol: ChordTolerance,
 ) -> Result<Vec<Sheet>, Vec<ParamError>> {
-    let (hw, hl) = (
-        outline.width_mm / 2.0 + wall_mm,
-        outline.length_mm / 2.0 + wall_mm,
-    );
-    let rect = vec![[-hw, -hl], [hw, -hl], [hw, hl], [-hw, hl]];
-    let r_reg = lc.registration.diameter_mm / 2.0;
-    let reg: Vec<Vec<[f64; 2]>> = registration_xy_mm(outline, wall_mm)
-        .into_iter()
-        .map(|c| reversed(circle(c, r_reg, tol)))
-        .collect();
+    let (rect, reg, base_holes) = sheet_outline(outline, wall_mm, lc, tol);
     let cavity = reversed(outline.polygon(tol));
     let depth = layer.z1_mm - layer.z0_mm;
     let name = &layer.name;
@@ -312,7 +495,7 @@ pub fn tray_sheets(
         "base",
         lc.stock.first().map_or(0.0, |s| s.thickness_mm),
         "mold.laser_cut.stock[0].thickness_mm".into(),
-        Vec::new(),
+        base_holes,
     ));
     let mut wall_depth = depth;
     if let Some(g) = &layer.marker_grid {
@@ -363,6 +546,8 @@ pub fn tray_sheets(
     let mut z = 0.0;
     for (k, (role, t, path, holes)) in levels.into_iter().enumerate() {
         let Some((si, n)) = stock_for(&lc.stock, t) else {
+            // a level is a difference of thicknesses: say it to the micrometre
+            let t = (t * 1e6).round() / 1e6;
             errs.push(ParamError::new(
                 path,
                 t,
@@ -477,7 +662,34 @@ pub fn tray_union(sheets: &[Sheet]) -> Result<Solid, GeometryError> {
 ///
 /// # Errors
 /// The sheet's name when its path cannot be offset (checked by [`tray_sheets`] before).
-pub fn cut_part(sheet: &Sheet, what: &str, tol: ChordTolerance) -> Result<CutPart, String> {
+pub fn cut_part(
+    sheet: &Sheet,
+    what: &str,
+    plate: Option<&SheetPlate>,
+    tol: ChordTolerance,
+) -> Result<CutPart, String> {
+    let holes_words = match plate {
+        None => "a registration hole in each corner".to_string(),
+        Some(p) => {
+            let base = p
+                .base_holes
+                .as_ref()
+                .filter(|_| sheet.role == "base")
+                .map(|b| {
+                    format!(
+                        " and {} {} mm holes of the sensor's screws",
+                        b.xy_mm.len(),
+                        b.diameter_mm
+                    )
+                })
+                .unwrap_or_default();
+            format!(
+                "the {} {} mm holes through the stack{base}",
+                p.holes.xy_mm.len(),
+                p.holes.diameter_mm
+            )
+        }
+    };
     let path = cut_path(&sheet.region, sheet.stock.kerf_mm, tol)
         .ok_or_else(|| format!("{}: the kerf closes a cut-out", sheet.name))?;
     let polygon = |r: &Vec<[f64; 2]>| {
@@ -491,7 +703,7 @@ pub fn cut_part(sheet: &Sheet, what: &str, tol: ChordTolerance) -> Result<CutPar
     Ok(CutPart {
         name: sheet.name.clone(),
         description: format!(
-            "{what}: {} sheet{} of {} ({} mm), {:.2} to {:.2} mm of the stack; paths offset {:.3} mm for a {:.2} mm kerf; a registration hole in each corner",
+            "{what}: {} sheet{} of {} ({} mm), {:.2} to {:.2} mm of the stack; paths offset {:.3} mm for a {:.2} mm kerf; {}",
             sheet.quantity,
             if sheet.quantity == 1 { "" } else { "s" },
             sheet.stock.name,
@@ -500,6 +712,7 @@ pub fn cut_part(sheet: &Sheet, what: &str, tol: ChordTolerance) -> Result<CutPar
             sheet.z0_mm + sheet.level_mm(),
             sheet.stock.kerf_mm / 2.0,
             sheet.stock.kerf_mm,
+            holes_words,
         ),
         material: sheet.stock.material.clone(),
         thickness_mm: sheet.stock.thickness_mm,

@@ -250,7 +250,7 @@ fn check_laser_cut_trays(
     // laser-cut trays: the stock and registration, then every tray's sheets
     if let (Some(lc), Some(layers), true) = (&design.mold.laser_cut, layers, errs.is_empty()) {
         let wall = design.mold.wall_thickness_mm;
-        let lc_errs = crate::parts::lasercut::check_params(lc, wall, materials);
+        let lc_errs = crate::parts::lasercut::check_params(lc, outline, wall, materials);
         if lc_errs.is_empty() {
             let tol =
                 ChordTolerance::new(ChordTolerance::DEFAULT_MM).expect("the default is valid");

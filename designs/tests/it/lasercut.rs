@@ -239,3 +239,220 @@ fn bad_laser_cut_values_are_refused_by_path() {
         other => panic!("{:?}", other.map(|k| k.parts.len())),
     }
 }
+
+/// The published sheets' geometry (9DTact, `9DTact_Design/fabrication/*.DXF`): every line,
+/// arc and circle of the file's entities.
+enum Drawn {
+    Line([f64; 2], [f64; 2]),
+    /// Centre, radius, start and end angle (degrees, counter-clockwise).
+    Arc([f64; 2], f64, f64, f64),
+}
+
+fn published(file: &str) -> Vec<Drawn> {
+    use dxf::entities::EntityType;
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../tests/data/9dtact_published_cad")
+        .join(file);
+    let drawing = dxf::Drawing::load_file(&path).unwrap();
+    drawing
+        .entities()
+        .filter_map(|e| match &e.specific {
+            EntityType::Line(l) => Some(Drawn::Line([l.p1.x, l.p1.y], [l.p2.x, l.p2.y])),
+            EntityType::Arc(a) => Some(Drawn::Arc(
+                [a.center.x, a.center.y],
+                a.radius,
+                a.start_angle,
+                a.end_angle,
+            )),
+            EntityType::Circle(c) => {
+                Some(Drawn::Arc([c.center.x, c.center.y], c.radius, 0.0, 360.0))
+            }
+            _ => None,
+        })
+        .collect()
+}
+
+fn segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    let len2 = dx * dx + dy * dy;
+    let t = if len2 > 0.0 {
+        (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (p[0] - a[0] - t * dx).hypot(p[1] - a[1] - t * dy)
+}
+
+impl Drawn {
+    fn distance(&self, p: [f64; 2]) -> f64 {
+        match *self {
+            Drawn::Line(a, b) => segment_distance(p, a, b),
+            Drawn::Arc(c, r, a0, a1) => {
+                let at = (p[1] - c[1])
+                    .atan2(p[0] - c[0])
+                    .to_degrees()
+                    .rem_euclid(360.0);
+                let span = (a1 - a0).rem_euclid(360.0);
+                let span = if span == 0.0 { 360.0 } else { span };
+                if (at - a0).rem_euclid(360.0) <= span {
+                    ((p[0] - c[0]).hypot(p[1] - c[1]) - r).abs()
+                } else {
+                    let end = |a: f64| {
+                        [
+                            c[0] + r * a.to_radians().cos(),
+                            c[1] + r * a.to_radians().sin(),
+                        ]
+                    };
+                    let (e0, e1) = (end(a0), end(a1));
+                    (p[0] - e0[0])
+                        .hypot(p[1] - e0[1])
+                        .min((p[0] - e1[0]).hypot(p[1] - e1[1]))
+                }
+            }
+        }
+    }
+
+    /// Points along it at most `step` mm apart.
+    fn samples(&self, step: f64) -> Vec<[f64; 2]> {
+        match *self {
+            Drawn::Line(a, b) => {
+                let n = ((a[0] - b[0]).hypot(a[1] - b[1]) / step).ceil().max(1.0) as usize;
+                (0..=n)
+                    .map(|i| {
+                        let t = i as f64 / n as f64;
+                        [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]
+                    })
+                    .collect()
+            }
+            Drawn::Arc(c, r, a0, a1) => {
+                let span = (a1 - a0).rem_euclid(360.0);
+                let span = if span == 0.0 { 360.0 } else { span };
+                let n = (span.to_radians() * r / step).ceil().max(1.0) as usize;
+                (0..=n)
+                    .map(|i| {
+                        let a = (a0 + span * i as f64 / n as f64).to_radians();
+                        [c[0] + r * a.cos(), c[1] + r * a.sin()]
+                    })
+                    .collect()
+            }
+        }
+    }
+}
+
+/// The two-sided distance between a sheet's rings and the published drawing, mm: every
+/// vertex and edge midpoint of the rings to the drawing, and every point along the drawing
+/// (0.01 mm apart) to the rings.
+fn hausdorff_to_published(rings: &[Vec<[f64; 2]>], drawn: &[Drawn]) -> f64 {
+    let to_drawn = |p: [f64; 2]| {
+        drawn
+            .iter()
+            .map(|d| d.distance(p))
+            .fold(f64::INFINITY, f64::min)
+    };
+    let mut worst: f64 = 0.0;
+    for r in rings {
+        for (i, &a) in r.iter().enumerate() {
+            let b = r[(i + 1) % r.len()];
+            worst = worst
+                .max(to_drawn(a))
+                .max(to_drawn([(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0]));
+        }
+    }
+    for d in drawn {
+        for p in d.samples(0.01) {
+            let near = rings
+                .iter()
+                .flat_map(|r| {
+                    (0..r.len()).map(move |i| segment_distance(p, r[i], r[(i + 1) % r.len()]))
+                })
+                .fold(f64::INFINITY, f64::min);
+            worst = worst.max(near);
+        }
+    }
+    worst
+}
+
+/// 9DTact's translucent gel in its published mold (`mold.laser_cut.plate`: 60 x 50 mm plates
+/// with R12 corners, eight 3.1 mm holes, the base's four 2.1 mm holes on the sensor's M2
+/// pattern; a 2.5 mm sheet round the 29.5 x 22.5 mm R1 pocket): the base sheet and the wall
+/// sheet are the published mold_base and mold_1 within 0.01 mm (arcs within a 0.001 mm chord
+/// tolerance), ring for ring, and the procedure tapes the base holes under the pocket shut.
+#[test]
+fn a_plate_as_published_gives_the_published_sheets() {
+    let d = Design::from_yaml(
+        include_str!("data/ninedtact_plate.yaml"),
+        "ninedtact_plate.yaml",
+    )
+    .unwrap();
+    let fine = ChordTolerance::new(0.001).unwrap();
+    let k = fabkit_designs::build_kit(&d, fine).unwrap();
+    let sheet = |name: &str| {
+        k.cut_parts
+            .iter()
+            .find(|c| c.name == name)
+            .unwrap_or_else(|| panic!("no sheet {name}"))
+    };
+    for (name, file, rings) in [
+        (
+            "translucent_gel_tray_1_base",
+            "mold_base_thickness_3.0mm.DXF",
+            13,
+        ),
+        (
+            "translucent_gel_tray_2_wall",
+            "mold_1_thickness_2.5mm.DXF",
+            10,
+        ),
+    ] {
+        let c = sheet(name);
+        let nominal = c.nominal_rings_mm.as_ref().unwrap();
+        assert_eq!(nominal.len(), rings, "{name}: outer boundary and holes");
+        let h = hausdorff_to_published(nominal, &published(file));
+        assert!(h < 0.01, "{name} is {h} mm from {file}");
+    }
+    assert_eq!(sheet("translucent_gel_tray_1_base").thickness_mm, 3.0);
+    assert_eq!(sheet("translucent_gel_tray_2_wall").thickness_mm, 2.5);
+    let make = &k.procedure[0].text;
+    assert!(
+        make.contains("the 8 3.1 mm holes") && make.contains("tape the base sheet's holes"),
+        "{make}"
+    );
+}
+
+/// A plate's rules by path: a plate no larger than the pocket, a corner radius past half its
+/// side, a hole through every sheet in the pocket, one past the plate's edge, two holes that
+/// overlap; a base hole may lie under the pocket.
+#[test]
+fn a_plates_bad_values_are_refused_by_path() {
+    let base = Design::from_yaml(
+        include_str!("data/ninedtact_plate.yaml"),
+        "ninedtact_plate.yaml",
+    )
+    .unwrap();
+    let cases: [(&str, fn(&mut fabkit_designs::lasercut::SheetPlate)); 5] = [
+        ("mold.laser_cut.plate.size_mm[0]", |p| p.size_mm[0] = 30.0),
+        ("mold.laser_cut.plate.corner_radius_mm", |p| {
+            p.corner_radius_mm = 26.0
+        }),
+        ("mold.laser_cut.plate.holes.xy_mm[0]", |p| {
+            p.holes.xy_mm[0] = [0.0, 5.0]
+        }),
+        ("mold.laser_cut.plate.holes.xy_mm[1]", |p| {
+            p.holes.xy_mm[1] = [-29.5, 0.0]
+        }),
+        ("mold.laser_cut.plate.holes.xy_mm[7]", |p| {
+            p.holes.xy_mm[7] = [27.0, -6.0]
+        }),
+    ];
+    for (path, edit) in cases {
+        let mut d = base.clone();
+        edit(d.mold.laser_cut.as_mut().unwrap().plate.as_mut().unwrap());
+        match fabkit_designs::build_kit(&d, tol()) {
+            Err(DesignError::Params(e)) => {
+                let paths: Vec<&str> = e.0.iter().map(|x| x.path.as_str()).collect();
+                assert!(paths.contains(&path), "{path}: {e}");
+            }
+            other => panic!("{path}: {:?}", other.map(|k| k.design)),
+        }
+    }
+}

@@ -25,7 +25,7 @@ def casting_tray(p: dict) -> cq.Solid:
     """The tray of one layer: a block `wall_mm` round the outline and `floor_mm` under the
     layer's bottom face (z0_mm), its cavity the outline `depth_mm` deep; ribs of the channels
     from inside the near wall to the closed far end, or holes of the markers below the floor;
-    for a laser-cut tray also its registration holes."""
+    for a laser-cut tray also its registration holes, or its plate's outline and holes."""
     o = p["outline"]
     z0, t = float(p["z0_mm"]), float(p["depth_mm"])
     wall, floor = float(p["wall_mm"]), float(p["floor_mm"])
@@ -33,8 +33,16 @@ def casting_tray(p: dict) -> cq.Solid:
     # flat-ended marker holes and a registration hole through each corner of the wall
     laser = p.get("laser_cut")
     hw, hl = float(o["width_mm"]) / 2.0, float(o["length_mm"]) / 2.0
-    tray = C.cut(C.box([-hw - wall, -hl - wall, z0 - floor], [hw + wall, hl + wall, z0 + t]),
-                 [outline_prism(o, z0, z0 + t + 1.0)])
+    plate = laser.get("plate") if laser else None
+    if plate:
+        # the published plate (mold.laser_cut.plate): its own rounded outline
+        size = plate["size_mm"]
+        block = outline_prism({"width_mm": size[0], "length_mm": size[1],
+                               "corner_radius_mm": plate.get("corner_radius_mm", 0.0)},
+                              z0 - floor, z0 + t)
+    else:
+        block = C.box([-hw - wall, -hl - wall, z0 - floor], [hw + wall, hl + wall, z0 + t])
+    tray = C.cut(block, [outline_prism(o, z0, z0 + t + 1.0)])
     ch = p.get("channels")
     if ch:
         n, pitch = int(ch["count"]), float(ch["pitch_mm"])
@@ -61,7 +69,18 @@ def casting_tray(p: dict) -> cq.Solid:
                     holes.append(C.place_along(C.feature(d, h, 1.0), (x, y, z0),
                                                (0.0, 0.0, -1.0)))
         tray = C.cut(tray, holes)
-    if laser:
+    if plate:
+        # the plate's holes through the whole stack, and its base holes through the base sheet
+        h = plate["holes"]
+        tray = C.cut(tray, [C.cylinder_z(float(h["diameter_mm"]) / 2.0, z0 - floor - 1.0,
+                                         z0 + t + 1.0, x, y) for x, y in h["xy_mm"]])
+        b = plate.get("base_holes")
+        if b:
+            base = next(s for s in laser["sheets"] if s["role"] == "base")
+            top = z0 - floor + float(base["level_mm"])
+            tray = C.cut(tray, [C.cylinder_z(float(b["diameter_mm"]) / 2.0, z0 - floor - 1.0,
+                                             top, x, y) for x, y in b["xy_mm"]])
+    elif laser:
         # the registration holes through the whole stack
         r = float(laser["registration_diameter_mm"]) / 2.0
         tray = C.cut(tray, [C.cylinder_z(r, z0 - floor - 1.0, z0 + t + 1.0, x, y)
