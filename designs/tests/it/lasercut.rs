@@ -456,3 +456,29 @@ fn a_plates_bad_values_are_refused_by_path() {
         }
     }
 }
+
+/// A level left over by a difference of thicknesses that no stock makes is said to the
+/// micrometre: a 3.1 mm channel layer less 2.4 mm channels is a 0.7 mm wall level
+/// (0.7000000000000002 in floating point).
+#[test]
+fn a_level_no_stock_makes_is_said_to_the_micrometre() {
+    let mut d = soter();
+    if let fabkit_designs::profile::BodyProfile::Flat { thickness_mm, .. } = &mut d.body {
+        *thickness_mm = 5.1;
+    }
+    let l = &mut d.layers[1];
+    l.thickness_mm = Some(3.1);
+    let ch = l.channels.as_mut().unwrap();
+    ch.height_mm = 2.4;
+    ch.tube.outer_diameter_mm = 2.5;
+    assert_ne!(3.1 - 2.4, 0.7);
+    match fabkit_designs::build_kit(&d, tol()) {
+        Err(DesignError::Params(e)) => {
+            let wall = e.0.iter().find(|x| x.path == "layers[1].thickness_mm");
+            let wall = wall.unwrap_or_else(|| panic!("{e}"));
+            assert_eq!(wall.value, "0.7", "{e}");
+            assert!(wall.rule.contains("makes 0.7 mm"), "{e}");
+        }
+        other => panic!("{:?}", other.map(|k| k.parts.len())),
+    }
+}
