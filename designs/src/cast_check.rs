@@ -91,13 +91,22 @@ pub fn check_casts(
     tol: ChordTolerance,
 ) -> Result<Vec<CastCheck>, DesignError> {
     let materials = crate::materials::MaterialsTable::embedded().map_err(DesignError::Yaml)?;
-    if let Some(outline) = design.body.flat_outline() {
+    if design.body.flat_outline().is_some() {
         let layers =
             crate::stack::flat::validate(design, &materials).map_err(DesignError::Params)?;
         let laser_cut = design.mold.laser_cut.is_some();
+        // the base sheet's holes under the pocket are taped shut on its top face before the
+        // pours (the procedure's first step)
+        let taped = design
+            .mold
+            .laser_cut
+            .as_ref()
+            .and_then(|lc| lc.plate.as_ref())
+            .and_then(|p| p.base_holes.as_ref());
         return layers
             .iter()
-            .map(|l| check_flat_layer(&outline, l, laser_cut, kit, tol))
+            .enumerate()
+            .map(|(i, l)| check_flat_layer(&layers[..i], l, (laser_cut, taped), kit, tol))
             .collect();
     }
     let stack = crate::stack::validate(design, &materials, tol)?;
@@ -170,12 +179,15 @@ fn check_layer(
 }
 
 /// One layer of a flat skin: the space its tray (taken back to the sensor frame) leaves within
-/// the outline's prism from below its markers' ends up to the brim (the layer's top face),
-/// against the assembly's layer; the markers found by a probe halfway down each.
+/// its outline's prism from below its markers' ends up to the brim (the layer's top face),
+/// less the cured layers under it (`under`) when it wraps them, against the assembly's layer;
+/// the markers found by a probe halfway down each. `trays`: whether the trays are laser-cut,
+/// and the base sheet's holes, taped shut on its top face for the pours.
 fn check_flat_layer(
-    outline: &crate::parts::flat::FlatOutline,
+    under: &[crate::parts::flat::FlatLayer],
     l: &crate::parts::flat::FlatLayer,
-    laser_cut: bool,
+    trays: (bool, Option<&crate::parts::lasercut::HolePattern>),
+
     kit: &Kit,
     tol: ChordTolerance,
 ) -> Result<CastCheck, DesignError> {
@@ -191,11 +203,38 @@ fn check_flat_layer(
         .ok_or_else(|| missing(format!("the print pose of {tray_name}")))?;
     let reach = l.marker_grid.as_ref().map_or(0.0, |m| m.feature.height_mm);
     let envelope = g(crate::geometry::prism(
-        &outline.polygon(tol),
-        l.z0_mm - reach - 0.1,
+        &l.outline.polygon(tol),
+        l.bottom_mm() - reach - 0.1,
         l.z1_mm,
     ))?;
-    let cast = g(envelope.difference(&tray.solid.transform(&t.inverse())))?;
+    let mut cast = g(envelope.difference(&tray.solid.transform(&t.inverse())))?;
+    let (laser_cut, taped) = trays;
+    if let Some(h) = taped {
+        // the tape over the base holes: the floor closed where they open
+        let floor = l.bottom_mm();
+        let tape = h
+            .xy_mm
+            .iter()
+            .map(|&c| {
+                let r = h.diameter_mm / 2.0 + 0.1;
+                crate::geometry::prism(
+                    &crate::parts::lasercut::circle(c, r, tol),
+                    floor - reach - 1.0,
+                    floor,
+                )
+            })
+            .collect::<Result<Vec<_>, _>>()
+            .part(name)?;
+        cast = g(cast.difference(&Solid::compose(&tape)))?;
+    }
+    let mut formed_by = vec![tray_name];
+    if l.wraps.is_some() {
+        // cast over the cured layers under it, which form its inner faces
+        for u in under {
+            cast = g(cast.difference(member(kit, &u.name)?))?;
+            formed_by.push(u.name.clone());
+        }
+    }
     let shown = member(kit, name)?;
     let (sym, thick_pieces) = compare(&cast, shown, tol).part(name)?;
     let mut probes = Probes {
@@ -218,7 +257,7 @@ fn check_flat_layer(
     Ok(CastCheck {
         layer: name.clone(),
         strategy: if laser_cut { "laser_cut_tray" } else { "tray" }.into(),
-        formed_by: vec![tray_name],
+        formed_by,
         cast_volume_mm3: cast.volume(),
         assembly_volume_mm3: shown.volume(),
         symmetric_difference_mm3: sym,

@@ -13,7 +13,7 @@ use crate::parts::context::ResolvedLayer;
 use crate::parts::family::AssemblyStep;
 use crate::parts::fasteners::bolt_name;
 use crate::parts::layer_registry::insert_roles;
-use crate::parts::molds::strategy::{DemoldInput, PourInput};
+use crate::parts::molds::strategy::{DemoldInput, PourInput, Strategy};
 use crate::parts::molds::{strategy_of, STRATEGIES};
 use crate::parts::registry::FAMILIES;
 use crate::parts::{Part, ProcedureAction, ProcedureStep};
@@ -179,13 +179,18 @@ pub fn procedure(
             .iter()
             .find(|l| l.name == c.cast)
             .map(|l| strategy_of(l.mold_strategy));
+        // the pieces the layer's features set into the mold apart from the mold's own
+        let insert_roles = insert_roles();
+        let (inserts, pieces): (Vec<&Part>, Vec<&Part>) = pieces
+            .iter()
+            .partition(|p| insert_roles.contains(&p.role.as_str()));
         let input = PourInput {
             step: n,
             mix: &c.mix_text(),
             holder: holder.first().copied(),
             halves: &halves,
             pieces: &pieces,
-            inserts: &[],
+            inserts: &inserts,
             bolt_text: &bolt_text,
             mold_parts: &c.mold_parts,
             on_inner_mold,
@@ -205,19 +210,11 @@ pub fn procedure(
             ));
         }
         // the layer's mold strategy closes its mold and pours it
-        let insert_roles = insert_roles();
-        let (inserts, pieces): (Vec<&Part>, Vec<&Part>) = pieces
-            .iter()
-            .partition(|p| insert_roles.contains(&p.role.as_str()));
         if let Some(s) = strategy {
-            out.extend(s.pour_steps(PourInput {
-                pieces: &pieces,
-                inserts: &inserts,
-                ..input
-            }));
+            out.extend(s.pour_steps(input));
         }
         on_inner_mold |= strategy.is_some_and(|s| s.keeps_inner_mold());
-        demold_steps(&mut out, design, layers, casts, c, core_mounted);
+        demold_steps(&mut out, design, (layers, casts), c, strategy, core_mounted);
     }
     let filling = casts.iter().find(|c| c.cast == FILLING_GEL);
     out.extend(assembly_steps(design, parts, core_mounted, filling));
@@ -230,29 +227,29 @@ pub fn procedure(
 fn demold_steps(
     out: &mut Vec<ProcedureStep>,
     design: &Design,
-    layers: &[ResolvedLayer],
-    casts: &[CastReport],
+    (layers, casts): (&[ResolvedLayer], &[CastReport]),
     c: &CastReport,
+    strategy: Option<&dyn Strategy>,
     core_mounted: bool,
 ) {
     use ProcedureAction as A;
     let n = c.step;
-    let strategy_of_cast = |name: &str| {
+    let kind_of = |name: &str| {
         layers
             .iter()
             .find(|l| l.name == name)
             .map(|l| l.mold_strategy)
     };
-    let kind = strategy_of_cast(&c.cast);
+    let kind = kind_of(&c.cast);
     let cure = cure_text(&c.notes);
-    let custom = kind.and_then(|k| {
-        strategy_of(k).demold_text(DemoldInput {
+    let custom = strategy.and_then(|s| {
+        s.demold_text(DemoldInput {
             step: n,
             cure: &cure,
             layer: &c.cast,
             poured_again: casts
                 .iter()
-                .any(|d| d.step > c.step && strategy_of_cast(&d.cast) == Some(k)),
+                .any(|d| d.step > c.step && kind.is_some() && kind_of(&d.cast) == kind),
         })
     });
     let what = if core_mounted {

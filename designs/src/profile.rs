@@ -877,6 +877,16 @@ impl FlatOutline {
         pts
     }
 
+    /// The outline offset outwards by `by_mm` (its exact offset: each side `by_mm` further out,
+    /// the corner radius `by_mm` larger).
+    pub fn grown(&self, by_mm: f64) -> Self {
+        Self {
+            width_mm: self.width_mm + 2.0 * by_mm,
+            length_mm: self.length_mm + 2.0 * by_mm,
+            corner_radius_mm: self.corner_radius_mm + by_mm,
+        }
+    }
+
     /// Distance from `(x, y)` inside the outline to its edge, mm (negative outside).
     pub fn inset_mm(&self, [x, y]: [f64; 2]) -> f64 {
         let (hw, hl, r) = (

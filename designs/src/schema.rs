@@ -138,6 +138,14 @@ pub struct Layer {
     /// A grid of markers on the layer's bottom face (flat skins only; Soter et al. Sec. II-A).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub marker_grid: Option<crate::parts::marker_grid::MarkerGrid>,
+    /// The layer wraps the layers under it (flat skins only; 9DTact's black gel over its
+    /// translucent gel): it covers their top and their sides down to the base plane, its
+    /// outline theirs grown by this much, mm, above 0. It is cast over them once they have
+    /// cured, in a pocket of its own outline as deep as the stack to its top. Every layer from
+    /// the second up wraps when one does; not on the innermost layer, nor with channels or a
+    /// marker grid.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wrap_mm: Option<f64>,
 }
 
 /// Pour calculator settings.

@@ -146,7 +146,11 @@ fn check_scope(design: &Design, errs: &mut Vec<ParamError>) -> Result<(), ParamE
         ));
     }
     for (i, l) in design.layers.iter().enumerate() {
-        for field in crate::parts::layer_registry::flat_only_given(l) {
+        let wrap = l.wrap_mm.map(|_| "wrap_mm");
+        for field in crate::parts::layer_registry::flat_only_given(l)
+            .into_iter()
+            .chain(wrap)
+        {
             errs.push(ParamError::new(
                 format!("layers[{i}].{field}"),
                 "given",

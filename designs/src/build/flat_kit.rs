@@ -34,7 +34,7 @@ pub(crate) fn build_flat_kit(
     let Some(outline) = design.body.flat_outline() else {
         return Err(DesignError::Yaml("not a flat design".into()));
     };
-    let est = estimated_triangles(&outline, &layers, design.mold.laser_cut.is_some(), tol);
+    let est = estimated_triangles(&layers, design.mold.laser_cut.is_some(), tol);
     if est > max_triangles as f64 {
         return Err(DesignError::WorkLimit(format!(
             "{}: the kit would have about {:.0} triangles at chord tolerance {} mm, more than the limit of {max_triangles} (about 1 KB of memory each; raise it with --max-triangles, up to {}, or coarsen --chord-tolerance-mm)",
@@ -52,15 +52,35 @@ pub(crate) fn build_flat_kit(
     let mut volumes = Vec::new();
     let mut cut_parts = Vec::new();
     let laser = design.mold.laser_cut.as_ref();
+    // the sheets of every tray round the largest pocket, the outermost layer's
+    let outer = layers.last().map_or(&outline, |l| &l.outline);
+    let wrapped = layers.iter().any(|l| l.wraps.is_some());
     for (i, l) in layers.iter().enumerate() {
-        let (part, member, v, sheets) = layer_tray(&outline, l, i, laser, tech, wall, tol)?;
+        let tray = TrayInput {
+            outer,
+            shared_base: wrapped.then(|| layers[0].name.as_str()),
+            laser,
+            tech,
+            wall,
+        };
+        let (part, member, v, sheets) = layer_tray(l, i, &tray, tol)?;
         parts.push(part);
         assembly.push(member);
         volumes.push(v);
-        cut_parts.extend(sheets);
+        // a wrapped stack's trays share the innermost tray's base sheet: cut once
+        for c in sheets {
+            if !cut_parts.iter().any(|k: &CutPart| k.name == c.name) {
+                cut_parts.push(c);
+            }
+        }
     }
-    // pours: channel layers (outer) first, the innermost (marker) layer last
-    let order: Vec<usize> = (1..layers.len()).chain(std::iter::once(0)).collect();
+    // pours: a wrapped stack inner first, each layer over the cured ones; else the channel
+    // layers (outer) first, the innermost (marker) layer last
+    let order: Vec<usize> = if wrapped {
+        (0..layers.len()).collect()
+    } else {
+        (1..layers.len()).chain(std::iter::once(0)).collect()
+    };
     let mut casts = Vec::new();
     for (step, &i) in order.iter().enumerate() {
         let l = &design.layers[i];
@@ -85,12 +105,18 @@ pub(crate) fn build_flat_kit(
         .filter_map(|l| l.channels.as_ref().map(|c| (l, c)))
         .collect();
     let (bought, liquid_ml) = bought_items(&layers, &channel_sets, laser, &cut_parts);
-    let procedure = procedure(&parts, &casts, &layers, &channel_sets, laser, &outline);
+    let procedure = procedure(&parts, &casts, &layers, &channel_sets, laser, outer);
     let summary = serde_json::json!({
         "flat": {
             "outline": outline,
             "area_mm2": outline.area_mm2(),
-            "layers": layers.iter().map(|l| serde_json::json!({"name": l.name, "z0_mm": l.z0_mm, "z1_mm": l.z1_mm})).collect::<Vec<_>>(),
+            "layers": layers.iter().map(|l| {
+                let mut j = serde_json::json!({"name": l.name, "z0_mm": l.z0_mm, "z1_mm": l.z1_mm});
+                if let Some(w) = &l.wraps {
+                    j["wraps"] = serde_json::json!(w);
+                }
+                j
+            }).collect::<Vec<_>>(),
             "channels": channel_sets.iter().map(|(l, c)| serde_json::json!({
                 "layer": l.name, "count": c.count, "channel_volume_mm3": c.channel_volume_mm3(),
                 "liquid_per_channel_ml": c.liquid_per_channel_ml(), "ends": c.ends,
@@ -113,6 +139,17 @@ pub(crate) fn build_flat_kit(
     })
 }
 
+/// What every tray of a flat kit shares: the outermost layer's outline (the laser-cut sheets
+/// are cut round it), the innermost layer's name when the trays share its base sheet (a
+/// wrapped stack), `mold.laser_cut`, the trays' print technology and wall, mm.
+struct TrayInput<'a> {
+    outer: &'a FlatOutline,
+    shared_base: Option<&'a str>,
+    laser: Option<&'a LaserCutParams>,
+    tech: PrintTechnology,
+    wall: f64,
+}
+
 /// Layer `i`'s casting tray (printed, or the union of its laser-cut sheets) with the cast
 /// layer as its member of the assembly, the layer's exact volume (mm^3) and the tray's sheets
 /// as cut parts.
@@ -120,31 +157,38 @@ pub(crate) fn build_flat_kit(
 /// # Errors
 /// [`DesignError`] naming the tray or the layer if a sheet or the kernel fails.
 fn layer_tray(
-    outline: &FlatOutline,
     l: &FlatLayer,
     i: usize,
-    laser: Option<&LaserCutParams>,
-    tech: PrintTechnology,
-    wall: f64,
+    input: &TrayInput<'_>,
     tol: ChordTolerance,
 ) -> Result<(Part, Member, f64, Vec<CutPart>), DesignError> {
+    let TrayInput {
+        outer,
+        shared_base,
+        laser,
+        tech,
+        wall,
+    } = *input;
     let mut cut_parts = Vec::new();
     let name = format!("{}_tray", l.name);
     // a laser-cut tray: its sheets, their union the printable tray; the layer's bottom face
     // on the base sheet (and the marker sheet)
     let (tray, floor, sheets) = match laser {
         Some(lc) => {
-            let sheets = crate::parts::lasercut::tray_sheets(outline, l, i, wall, lc, tol)
+            let mut sheets = crate::parts::lasercut::tray_sheets(outer, l, i, wall, lc, tol)
                 .map_err(|e| DesignError::Params(crate::ParamErrors(e)))?;
-            for s in &sheets {
+            for s in &mut sheets {
+                let what = match shared_base {
+                    Some(first) if s.role == "base" => {
+                        // one base sheet under every tray: the layers stay on it between pours
+                        s.name = format!("{first}_tray_1_base");
+                        format!("every tray's base (the cured layers stay on it for the next pour), sheet {}", s.name)
+                    }
+                    _ => format!("{} tray, sheet {}: {}", l.name, s.name, s.role),
+                };
                 cut_parts.push(
-                    crate::parts::lasercut::cut_part(
-                        s,
-                        &format!("{} tray, sheet {}: {}", l.name, s.name, s.role),
-                        lc.plate.as_ref(),
-                        tol,
-                    )
-                    .map_err(DesignError::Yaml)?,
+                    crate::parts::lasercut::cut_part(s, &what, lc.plate.as_ref(), tol)
+                        .map_err(DesignError::Yaml)?,
                 );
             }
             let floor = sheets
@@ -161,39 +205,39 @@ fn layer_tray(
         None => {
             let floor = wall + l.marker_grid.as_ref().map_or(0.0, |g| g.feature.height_mm);
             (
-                tray_solid(outline, l, wall, floor, tol).part(&name)?,
+                tray_solid(l, wall, floor, tol).part(&name)?,
                 floor,
                 None,
             )
         }
     };
-    let skin = layer_solid_as_cast(outline, l, laser.is_some(), tol).part(&l.name)?;
+    let skin = layer_solid_as_cast(l, laser.is_some(), tol).part(&l.name)?;
     let t = l.z1_mm - l.z0_mm;
-    // the cast layer's own volume, exact: the outline's prism, less the grooves, plus the
-    // markers beyond the face (flat-ended in a laser-cut tray: its holes go straight
-    // through their sheet)
-    let v = outline.area_mm2() * t
-        - l.channels
-            .as_ref()
-            .map_or(0.0, |c| c.count as f64 * c.channel_volume_mm3())
-        + l.marker_grid.as_ref().map_or(0.0, |g| {
-            let one = if laser.is_some() {
-                std::f64::consts::PI * (g.feature.diameter_mm / 2.0).powi(2) * g.feature.height_mm
-            } else {
-                g.feature.nominal_volume_mm3()
-            };
-            (g.rows * g.columns) as f64 * one
-        });
+    let depth = l.pocket_depth_mm();
+    // the cast layer's own volume, exact (flat-ended markers in a laser-cut tray: its holes
+    // go straight through their sheet)
+    let v = l.volume_mm3(laser.is_some());
     let what = match (&l.channels, &l.marker_grid) {
         (Some(c), _) => format!(", {} ribs forming the channels' grooves", c.count),
         (_, Some(g)) => format!(", {} x {} holes forming the markers", g.rows, g.columns),
         _ => String::new(),
     };
-    let made = match &sheets {
-        Some(s) => format!(
+    let made = match (&sheets, shared_base.filter(|_| l.wraps.is_some())) {
+        (Some(s), Some(first)) => format!(
+            "; the union of its {} laser-cut sheets (cut/{first}_tray_1_base, every tray's base, and cut/{name}_*), or print it",
+            s.iter().map(|s| s.quantity).sum::<u32>(),
+        ),
+        (Some(s), None) => format!(
             "; the union of its {} laser-cut sheets (cut/{}_*), or print it",
             s.iter().map(|s| s.quantity).sum::<u32>(),
             name
+        ),
+        (None, _) => String::new(),
+    };
+    let over = match &l.wraps {
+        Some(w) => format!(
+            ", round the cured layers under it: {:.2} mm over their top, {:.2} mm at their sides",
+            t, w.side_mm
         ),
         None => String::new(),
     };
@@ -201,25 +245,25 @@ fn layer_tray(
         name: name.clone(),
         role: "casting_tray".into(),
         description: format!(
-            "Open tray of layer {} ({t:.2} mm deep{what}); pour to the brim and scrape level{made}",
+            "Open tray of layer {} ({depth:.2} mm deep{what}{over}); pour to the brim and scrape level{made}",
             l.name
         ),
         material: crate::parts::molds::material_for(tech).into(),
         print_technology: tech,
         solid: tray,
         params: serde_json::json!({
-            "layer": l.name, "layer_index": i, "outline": outline, "depth_mm": t,
-            "z0_mm": l.z0_mm, "wall_mm": wall, "floor_mm": floor,
+            "layer": l.name, "layer_index": i, "outline": l.outline, "depth_mm": depth,
+            "z0_mm": l.bottom_mm(), "wall_mm": wall, "floor_mm": floor,
             "channels": l.channels, "marker_grid": l.marker_grid,
             "laser_cut": sheets.as_ref().map(|sh| serde_json::json!({
                 "sheets": sh.iter().map(|s| serde_json::json!({"name": s.name, "role": s.role, "stock": s.stock,
                     "quantity": s.quantity, "z0_mm": s.z0_mm, "level_mm": s.level_mm(), "area_mm2": s.region.area_mm2()})).collect::<Vec<_>>(),
-                "registration_xy_mm": crate::parts::lasercut::registration_xy_mm(outline, wall),
+                "registration_xy_mm": crate::parts::lasercut::registration_xy_mm(outer, wall),
                 "registration_diameter_mm": laser.map(|lc| lc.registration.diameter_mm),
                 "markers": "flat-ended, straight through their sheet",
             })),
-            // the layer's bottom face (sensor z0) on the tray's floor (print z = floor)
-            "T_print_sensor": [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, floor - l.z0_mm]],
+            // the layer's lowest face on the tray's floor (print z = floor)
+            "T_print_sensor": [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, floor - l.bottom_mm()]],
         }),
         group: None,
     };
@@ -229,6 +273,10 @@ fn layer_tray(
         part.params.get_mut("laser_cut"),
     ) {
         lc["plate"] = serde_json::json!(plate);
+    }
+    // the sheets of a wrapped stack's inner trays are cut round the outermost pocket
+    if let (true, Some(lc)) = (outer != &l.outline, part.params.get_mut("laser_cut")) {
+        lc["sheets_round"] = serde_json::json!(outer);
     }
     let member = Member {
         name: l.name.clone(),
@@ -253,6 +301,7 @@ fn bought_items(
 ) -> (Vec<String>, f64) {
     let mut bought = Vec::new();
     let mut liquid_ml = 0.0;
+    let wrapped = layers.iter().any(|l| l.wraps.is_some());
     for (l, c) in channel_sets {
         let t = &c.tube;
         liquid_ml += c.count as f64 * c.liquid_per_channel_ml();
@@ -280,7 +329,8 @@ fn bought_items(
             ),
             Some(p) => format!(
                 "{} x bolt (with nut) or dowel pin for the plates' {} mm holes",
-                p.holes.xy_mm.len() * layers.len(),
+                // a wrapped stack's trays are stacked on one base sheet, one at a time
+                p.holes.xy_mm.len() * if wrapped { 1 } else { layers.len() },
                 p.holes.diameter_mm
             ),
         };
@@ -328,6 +378,7 @@ fn procedure(
     outline: &FlatOutline,
 ) -> Vec<ProcedureStep> {
     let step = |action, text: String| ProcedureStep { action, text };
+    let wrapped = layers.iter().any(|l| l.wraps.is_some());
     let trays = parts
         .iter()
         .map(|p| p.name.as_str())
@@ -337,7 +388,7 @@ fn procedure(
         Some(lc) => step(
             ProcedureAction::Print,
             format!(
-                "Laser-cut the trays' sheets (cut/*.dxf or cut/*.svg: each sheet's paths already offset for its stock's kerf; the quantity of each is in its description), or print the trays ({trays}) instead. Stack each tray's sheets in order (base at the bottom) on {}, bond them (acrylic cement for acrylic, wood glue for plywood) and seal the cavity's inside edges with a thin bead of silicone{}; check that the tray is flat and its cavity clean.",
+                "Laser-cut the trays' sheets (cut/*.dxf or cut/*.svg: each sheet's paths already offset for its stock's kerf; the quantity of each is in its description), or print the trays ({trays}) instead. Stack each tray's sheets in order (base at the bottom) on {}, {} and seal the cavity's inside edges with a thin bead of silicone{}; check that the tray is flat and its cavity clean.",
                 match &lc.plate {
                     None => format!(
                         "four {} mm dowel pins through the registration holes",
@@ -349,8 +400,13 @@ fn procedure(
                         p.holes.diameter_mm
                     ),
                 },
+                if wrapped {
+                    "clamp them without bonding (the layers are cast one over another on the one base sheet: each tray's wall sheets come off it for the next)"
+                } else {
+                    "bond them (acrylic cement for acrylic, wood glue for plywood)"
+                },
                 if base_holes_under_pocket(lc, outline) {
-                    "; tape the base sheet's holes under the cavity shut from below, so that no silicone runs into them"
+                    "; tape the base sheet's holes under the cavity shut on its top face, so that no silicone runs into them and the cast face stays flat"
                 } else {
                     ""
                 }
@@ -361,6 +417,10 @@ fn procedure(
             format!("Print the trays ({trays}); check that each is flat and its cavity clean."),
         ),
     }];
+    if wrapped {
+        procedure.extend(wrapped_pours(casts, layers, laser.is_some()));
+        return procedure;
+    }
     for c in casts {
         let l = layers.iter().find(|l| l.name == c.cast);
         let last = c.step as usize == casts.len() && casts.len() > 1;
@@ -415,4 +475,60 @@ fn procedure(
         ));
     }
     procedure
+}
+
+/// The pours of a wrapped stack, inner first (9DTact's process: the translucent gel in the
+/// 2.5 mm sheet's pocket, then the black gel in the 2.8 mm sheet's pocket over it): each layer
+/// on the base sheet (`laser_cut`) or in its tray's floor, the next tray put round the cured
+/// layers, the last taken out with the skin.
+fn wrapped_pours(casts: &[CastReport], layers: &[FlatLayer], laser_cut: bool) -> Vec<ProcedureStep> {
+    let mut steps = Vec::new();
+    for (k, c) in casts.iter().enumerate() {
+        let Some(l) = layers.iter().find(|l| l.name == c.cast) else {
+            continue;
+        };
+        let tray = c.mold_parts.join(", ");
+        let into = match &l.wraps {
+            None => format!("into {tray}"),
+            Some(w) if laser_cut => format!(
+                "into {tray}: stack its wall sheets on the base sheet round the cured layers (bolts or pins through the plates' holes; the pocket {:.2} mm clear of them all round), then pour over them",
+                w.side_mm
+            ),
+            Some(w) => format!(
+                "into {tray}: set the cured layers on its floor, centred ({:.2} mm clear of its walls all round), then pour over them",
+                w.side_mm
+            ),
+        };
+        steps.push(ProcedureStep {
+            action: ProcedureAction::Pour,
+            text: format!(
+                "Pour {} ({:.2} mL, {:.2} g mixed) {into}: degas the mix in a vacuum chamber, pour to the brim and scrape level.",
+                c.cast, c.cavity_volume_ml, c.total_mass_g
+            ),
+        });
+        let next = casts.get(k + 1).map(|n| n.cast.as_str());
+        steps.push(ProcedureStep {
+            action: ProcedureAction::Demold,
+            text: match next {
+                Some(n) if laser_cut => format!(
+                    "Cure {}; lift its tray's wall sheets off and leave it on the base sheet for {n}.",
+                    c.cast
+                ),
+                Some(n) => format!(
+                    "Cure {} and take it out of its tray for {n}.",
+                    c.cast
+                ),
+                None => format!(
+                    "Cure {} and take the skin (every layer, bonded) out of its tray{}.",
+                    c.cast,
+                    if layers.iter().any(|l| l.marker_grid.is_some()) {
+                        "; paint the markers' ends white"
+                    } else {
+                        ""
+                    }
+                ),
+            },
+        });
+    }
+    steps
 }

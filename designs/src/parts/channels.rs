@@ -12,14 +12,75 @@ use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
-/// One layer of a flat skin: from `z0_mm` up to `z1_mm`, with its channels and marker grid.
+/// One layer of a flat skin: its outline's prism from `z0_mm` up to `z1_mm` (and, when it
+/// wraps the layers under it, down their sides to the base plane), with its channels and
+/// marker grid.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FlatLayer {
     pub name: String,
     pub z0_mm: f64,
     pub z1_mm: f64,
+    /// The layer's own outline: the body's, grown by the wraps of this layer and those under it.
+    #[serde(skip)]
+    pub outline: FlatOutline,
+    /// What the layer wraps (`layers[i].wrap_mm`); none for a layer that lies on the top of the
+    /// one under it only.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub wraps: Option<Wrap>,
     pub channels: Option<ChannelSet>,
     pub marker_grid: Option<MarkerGrid>,
+}
+
+/// How a flat layer wraps the layers under it: over their top and down their sides to the
+/// base plane, `side_mm` thick at the sides.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Wrap {
+    /// The thickness at the sides, mm (`layers[i].wrap_mm`).
+    pub side_mm: f64,
+    /// The outline of the layers it wraps, mm.
+    pub under: FlatOutline,
+    /// Its own outline: `under` grown by `side_mm`.
+    pub outline: FlatOutline,
+}
+
+impl FlatLayer {
+    /// z of the layer's lowest face, mm: the base plane for a wrapping layer, else `z0_mm`.
+    pub fn bottom_mm(&self) -> f64 {
+        if self.wraps.is_some() {
+            0.0
+        } else {
+            self.z0_mm
+        }
+    }
+
+    /// The depth of the pocket the layer is cast in, mm: from its lowest face to its top.
+    pub fn pocket_depth_mm(&self) -> f64 {
+        self.z1_mm - self.bottom_mm()
+    }
+
+    /// The layer's volume, mm^3, exact for its outline: its prism, less the layers it wraps,
+    /// less its channels' grooves, plus its markers beyond the face (`flat_ended`: straight
+    /// holes through a laser-cut sheet, else the marker's own feature).
+    pub fn volume_mm3(&self, flat_ended: bool) -> f64 {
+        let prism = self.outline.area_mm2() * self.pocket_depth_mm()
+            - self
+                .wraps
+                .as_ref()
+                .map_or(0.0, |w| w.under.area_mm2() * self.z0_mm);
+        let grooves = self
+            .channels
+            .as_ref()
+            .map_or(0.0, |c| c.count as f64 * c.channel_volume_mm3());
+        let markers = self.marker_grid.as_ref().map_or(0.0, |g| {
+            let one = if flat_ended {
+                PI * (g.feature.diameter_mm / 2.0).powi(2) * g.feature.height_mm
+            } else {
+                g.feature.nominal_volume_mm3()
+            };
+            (g.rows * g.columns) as f64 * one
+        });
+        prism - grooves + markers
+    }
 }
 
 /// What closes a channel's liquid circuit (Soter et al. Sec. II-A: "each channel is closed at

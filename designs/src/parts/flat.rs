@@ -14,20 +14,19 @@ use crate::markers::feature_solid;
 
 pub use crate::profile::FlatOutline;
 
-pub use crate::parts::channels::{ChannelEnds, ChannelSet, ChannelTube, FlatLayer, MarkerGrid};
+pub use crate::parts::channels::{
+    ChannelEnds, ChannelSet, ChannelTube, FlatLayer, MarkerGrid, Wrap,
+};
 
-/// The solid of one layer (validated parameters): the outline's prism from `z0_mm` to `z1_mm`,
-/// less its channels' grooves (open on the bottom face and at the near edge), with its
-/// markers standing below the bottom face (rooted `embed` into it so that they fuse).
+/// The solid of one layer (validated parameters): its outline's prism from `z0_mm` to
+/// `z1_mm` (from the base plane, less the layers under it, when it wraps them), less its
+/// channels' grooves (open on the bottom face and at the near edge), with its markers standing
+/// below the bottom face (rooted `embed` into it so that they fuse).
 ///
 /// # Errors
 /// [`GeometryError`] on a kernel failure.
-pub fn layer_solid(
-    outline: &FlatOutline,
-    layer: &FlatLayer,
-    tol: ChordTolerance,
-) -> Result<Solid, GeometryError> {
-    layer_solid_as_cast(outline, layer, false, tol)
+pub fn layer_solid(layer: &FlatLayer, tol: ChordTolerance) -> Result<Solid, GeometryError> {
+    layer_solid_as_cast(layer, false, tol)
 }
 
 /// [`layer_solid`] as the layer's tray casts it: in a laser-cut tray (`laser_cut`) the markers
@@ -38,12 +37,16 @@ pub fn layer_solid(
 /// # Errors
 /// [`GeometryError`] on a kernel failure.
 pub fn layer_solid_as_cast(
-    outline: &FlatOutline,
     layer: &FlatLayer,
     laser_cut: bool,
     tol: ChordTolerance,
 ) -> Result<Solid, GeometryError> {
-    let mut s = prism(&outline.polygon(tol), layer.z0_mm, layer.z1_mm)?;
+    let outline = &layer.outline;
+    let mut s = prism(&outline.polygon(tol), layer.bottom_mm(), layer.z1_mm)?;
+    if let Some(w) = &layer.wraps {
+        // the layers it wraps: their outline's prism from below the base plane to their top
+        s = s.difference(&prism(&w.under.polygon(tol), -1.0, layer.z0_mm)?)?;
+    }
     if let Some(ch) = &layer.channels {
         let y_near = -outline.length_mm / 2.0;
         let grooves = ch
@@ -92,23 +95,24 @@ pub fn layer_solid_as_cast(
 }
 
 /// The tray a flat layer is cast in (print orientation: floor on the plate, z up): a box
-/// `wall` mm round the outline and `floor` mm under the layer, its cavity the outline's prism
-/// as deep as the layer (poured to the brim and scraped level, the poured face the layer's
-/// top). For a channel layer, ribs on the floor form the grooves and run into the near wall,
+/// `wall` mm round the layer's outline and `floor` mm under the layer, its cavity the
+/// outline's prism as deep as the layer's pocket (a wrapping layer's from the base plane, the
+/// cured layers it wraps set on the floor; poured to the brim and scraped level, the poured
+/// face the layer's top). For a channel layer, ribs on the floor form the grooves and run into the near wall,
 /// so that the channels open at the near edge; for a marker layer, holes in the floor form the
 /// markers.
 ///
 /// # Errors
 /// [`GeometryError`] on a kernel failure.
 pub fn tray_solid(
-    outline: &FlatOutline,
     layer: &FlatLayer,
     wall_mm: f64,
     floor_mm: f64,
     tol: ChordTolerance,
 ) -> Result<Solid, GeometryError> {
+    let outline = &layer.outline;
     let (hw, hl) = (outline.width_mm / 2.0, outline.length_mm / 2.0);
-    let depth = layer.z1_mm - layer.z0_mm;
+    let depth = layer.pocket_depth_mm();
     let block = cuboid(
         [-hw - wall_mm, -hl - wall_mm, 0.0],
         [hw + wall_mm, hl + wall_mm, floor_mm + depth],
@@ -148,16 +152,13 @@ pub fn tray_solid(
 /// `circle_segments` by a quarter as many profile points (and its seam with the face) in its
 /// layer, and in its tray's hole
 /// another (printed trays) or a straight hole of 4 triangles a segment (`laser_cut` trays).
-pub fn estimated_triangles(
-    outline: &FlatOutline,
-    layers: &[FlatLayer],
-    laser_cut: bool,
-    tol: ChordTolerance,
-) -> f64 {
-    let prism_tris = 4.0 * outline.polygon(tol).len() as f64;
+pub fn estimated_triangles(layers: &[FlatLayer], laser_cut: bool, tol: ChordTolerance) -> f64 {
     layers
         .iter()
         .map(|l| {
+            // a wrapping layer: its prism and, inside it, the prism it wraps
+            let wrapped = if l.wraps.is_some() { 2.0 } else { 1.0 };
+            let prism_tris = wrapped * 4.0 * l.outline.polygon(tol).len() as f64;
             let ch = l
                 .channels
                 .as_ref()

@@ -181,10 +181,11 @@ impl SheetPlate {
             ));
             size_ok = false;
         }
-        let mut all: Vec<(String, [f64; 2], f64)> = Vec::new();
-        for (key, pattern) in [
-            ("holes", Some(&self.holes)),
-            ("base_holes", self.base_holes.as_ref()),
+        // each hole's path, centre, radius and whether it goes through every sheet
+        let mut all: Vec<(String, [f64; 2], f64, bool)> = Vec::new();
+        for (key, pattern, through) in [
+            ("holes", Some(&self.holes), true),
+            ("base_holes", self.base_holes.as_ref(), false),
         ] {
             let Some(h) = pattern else { continue };
             let d = h.diameter_mm;
@@ -204,14 +205,14 @@ impl SheetPlate {
                 ));
             }
             for (i, c) in h.xy_mm.iter().enumerate() {
-                all.push((format!("{p}.{key}.xy_mm[{i}]"), *c, d / 2.0));
+                all.push((format!("{p}.{key}.xy_mm[{i}]"), *c, d / 2.0, through));
             }
         }
         if !size_ok {
             return;
         }
         let plate = self.outline();
-        for (k, (path, c, r)) in all.iter().enumerate() {
+        for (k, (path, c, r, through)) in all.iter().enumerate() {
             let value = format!("[{}, {}]", c[0], c[1]);
             let edge = -plate.signed_distance_mm(*c);
             if !(edge >= r + MIN_LIGAMENT_MM) {
@@ -225,7 +226,7 @@ impl SheetPlate {
             // a base hole may lie under the pocket (the base sheet has none): taped shut for
             // the pours
             let to_pocket = pocket.signed_distance_mm(*c);
-            if !path.contains(".base_holes.") && !(to_pocket >= r + MIN_LIGAMENT_MM) {
+            if *through && !(to_pocket >= r + MIN_LIGAMENT_MM) {
                 errs.push(ParamError::new(
                     path.as_str(),
                     &value,
@@ -233,7 +234,7 @@ impl SheetPlate {
                 ));
                 continue;
             }
-            if let Some((other, _, _)) = all[..k].iter().find(|(_, o, ro)| {
+            if let Some((other, ..)) = all[..k].iter().find(|(_, o, ro, _)| {
                 ((o[0] - c[0]).powi(2) + (o[1] - c[1]).powi(2)).sqrt() < r + ro + MIN_LIGAMENT_MM
             }) {
                 errs.push(ParamError::new(
@@ -471,8 +472,10 @@ pub fn check_params(
 /// parameter that sets the thickness, and its holes besides the registration holes.
 type Level = (&'static str, f64, String, Vec<Vec<[f64; 2]>>);
 
-/// The sheets of the tray of `layer` (index `li`) of a flat skin of `outline`, bottom to top,
-/// with checked `mold.laser_cut` parameters ([`check_params`]).
+/// The sheets of the tray of `layer` (index `li`) of a flat skin whose largest pocket (its
+/// outermost layer's outline) is `outline`, bottom to top, with checked `mold.laser_cut`
+/// parameters ([`check_params`]): the sheets' outer boundary round `outline`, the cavity the
+/// layer's own outline as deep as its pocket ([`FlatLayer::pocket_depth_mm`]).
 ///
 /// # Errors
 /// The violated rules, by path: a level no stock makes (the channels' or markers' height, the
@@ -487,8 +490,9 @@ pub fn tray_sheets(
     tol: ChordTolerance,
 ) -> Result<Vec<Sheet>, Vec<ParamError>> {
     let (rect, reg, base_holes) = sheet_outline(outline, wall_mm, lc, tol);
+    let outline = &layer.outline;
     let cavity = reversed(outline.polygon(tol));
-    let depth = layer.z1_mm - layer.z0_mm;
+    let depth = layer.pocket_depth_mm();
     let name = &layer.name;
     let mut levels: Vec<Level> = Vec::new();
     levels.push((

@@ -18,6 +18,7 @@ pub fn flat_layers(design: &Design) -> Option<Vec<FlatLayer>> {
     let crate::profile::BodyProfile::Flat { thickness_mm, .. } = design.body else {
         return None;
     };
+    let mut outline = design.body.flat_outline()?;
     let given: f64 = design.layers.iter().filter_map(|l| l.thickness_mm).sum();
     let mut z = 0.0;
     let mut out = Vec::with_capacity(design.layers.len());
@@ -27,10 +28,21 @@ pub fn flat_layers(design: &Design) -> Option<Vec<FlatLayer>> {
             (None, true) => thickness_mm - given,
             (None, false) => return None,
         };
+        let wraps = l.wrap_mm.filter(|_| i > 0).map(|side_mm| {
+            let under = outline.clone();
+            outline = under.grown(side_mm);
+            crate::parts::channels::Wrap {
+                side_mm,
+                under,
+                outline: outline.clone(),
+            }
+        });
         out.push(FlatLayer {
             name: l.name.clone(),
             z0_mm: z,
             z1_mm: z + t,
+            outline: outline.clone(),
+            wraps,
             channels: l.channels.clone(),
             marker_grid: l.marker_grid.clone(),
         });
@@ -81,7 +93,7 @@ pub fn validate(
         None
     };
     if let Some(layers) = &layers {
-        check_layer_stack(design, layers, &outline, body_ok, &mut errs);
+        check_layer_stack(design, layers, body_ok, &mut errs);
     }
     check_laser_cut_trays(design, materials, layers.as_deref(), &outline, &mut errs);
     let errs = numbers.merge_negative(errs);
@@ -200,15 +212,62 @@ fn check_layer_fields(
             errs.push(ParamError::new(p(key), "given", rule));
         }
     }
+    check_wraps(design, errs);
+}
+
+/// The rules of wrapping layers (`layers[i].wrap_mm`): above 0, not on the innermost layer,
+/// on every layer from the second up when on one (each is cast over the cured layers under
+/// it, inner first), and no channels or marker grid on a wrapping layer nor channels in a
+/// wrapped stack (channel layers are cast outer first and laid on, Soter et al. Sec. II-A);
+/// pushed onto `errs`.
+fn check_wraps(design: &Design, errs: &mut Vec<ParamError>) {
+    let wrapped = design.layers.iter().any(|l| l.wrap_mm.is_some());
+    if !wrapped {
+        return;
+    }
+    for (i, l) in design.layers.iter().enumerate() {
+        let p = |f: &str| format!("layers[{i}].{f}");
+        match l.wrap_mm {
+            Some(_) if i == 0 => errs.push(ParamError::new(
+                p("wrap_mm"),
+                l.wrap_mm.unwrap_or_default(),
+                "the innermost layer has no layer under it to wrap",
+            )),
+            Some(w) if !(w > 0.0 && w.is_finite()) => errs.push(ParamError::new(
+                p("wrap_mm"),
+                w,
+                "must be above 0 (the layer's thickness at the sides of the layers it wraps)",
+            )),
+            None if i > 0 => errs.push(ParamError::new(
+                p("wrap_mm"),
+                "none",
+                "give it: when a layer wraps the layers under it, every layer from the second up does (each is cast over the cured layers under it, inner first)",
+            )),
+            _ => {}
+        }
+        if l.channels.is_some() {
+            errs.push(ParamError::new(
+                p("channels"),
+                "given",
+                "a stack of wrapping layers (layers[*].wrap_mm) takes no channels: channel layers are cast outer first and laid onto the tacky layer under them (Soter et al. Sec. II-A), wrapping layers inner first over the cured ones",
+            ));
+        }
+        if l.marker_grid.is_some() && i > 0 {
+            errs.push(ParamError::new(
+                p("marker_grid"),
+                "given",
+                "a wrapping layer takes no marker grid: its bottom face is the cured layers under it",
+            ));
+        }
+    }
 }
 
 /// The rules of the stacked layers (valid fields): their thicknesses add up to
 /// `body.thickness_mm`, and, when the body is valid (`body_ok`), each layer's channels and
-/// marker grid fit `outline`; pushed onto `errs`.
+/// marker grid fit its outline; pushed onto `errs`.
 fn check_layer_stack(
     design: &Design,
     layers: &[FlatLayer],
-    outline: &FlatOutline,
     body_ok: bool,
     errs: &mut Vec<ParamError>,
 ) {
@@ -230,7 +289,7 @@ fn check_layer_stack(
             let input = FlatInput {
                 index: i,
                 thickness_mm: l.z1_mm - l.z0_mm,
-                outline,
+                outline: &l.outline,
             };
             crate::parts::layer_registry::check_flat_features(&design.layers[i], input, errs);
         }
@@ -250,12 +309,14 @@ fn check_laser_cut_trays(
     // laser-cut trays: the stock and registration, then every tray's sheets
     if let (Some(lc), Some(layers), true) = (&design.mold.laser_cut, layers, errs.is_empty()) {
         let wall = design.mold.wall_thickness_mm;
-        let lc_errs = crate::parts::lasercut::check_params(lc, outline, wall, materials);
+        // the plate and the sheets round the largest pocket, the outermost layer's
+        let outer = layers.last().map_or(outline, |l| &l.outline);
+        let lc_errs = crate::parts::lasercut::check_params(lc, outer, wall, materials);
         if lc_errs.is_empty() {
             let tol =
                 ChordTolerance::new(ChordTolerance::DEFAULT_MM).expect("the default is valid");
             for (i, l) in layers.iter().enumerate() {
-                if let Err(e) = crate::parts::lasercut::tray_sheets(outline, l, i, wall, lc, tol) {
+                if let Err(e) = crate::parts::lasercut::tray_sheets(outer, l, i, wall, lc, tol) {
                     errs.extend(e);
                 }
             }

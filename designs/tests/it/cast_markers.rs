@@ -372,13 +372,12 @@ fn the_cast_check_catches_markers_shaped_otherwise_than_the_tray_casts_them() {
     let ok = fabkit_designs::cast_check::check_casts(&d, &kit, tol).unwrap();
     assert!(ok.iter().all(|c| c.holds()), "{ok:?}");
     let layers = fabkit_designs::stack::flat::flat_layers(&d).unwrap();
-    let outline = d.body.flat_outline().unwrap();
     let member = kit
         .assembly
         .iter_mut()
         .find(|m| m.name == "marker_layer")
         .unwrap();
-    member.solid = fabkit_designs::flat::layer_solid(&outline, &layers[0], tol).unwrap();
+    member.solid = fabkit_designs::flat::layer_solid(&layers[0], tol).unwrap();
     let checks = fabkit_designs::cast_check::check_casts(&d, &kit, tol).unwrap();
     let c = checks.iter().find(|c| c.layer == "marker_layer").unwrap();
     assert!(!c.holds());

@@ -56,6 +56,8 @@ fn layers() -> (FlatLayer, FlatLayer) {
             name: "markers".into(),
             z0_mm: 0.0,
             z1_mm: 2.0,
+            outline: outline(),
+            wraps: None,
             channels: None,
             marker_grid: Some(grid()),
         },
@@ -63,6 +65,8 @@ fn layers() -> (FlatLayer, FlatLayer) {
             name: "channels".into(),
             z0_mm: 2.0,
             z1_mm: 5.0,
+            outline: outline(),
+            wraps: None,
             channels: Some(channels()),
             marker_grid: None,
         },
@@ -107,7 +111,7 @@ fn outline_polygon_is_the_rounded_rectangle() {
 #[test]
 fn channel_layer_is_the_prism_less_its_grooves() {
     let (_, top) = layers();
-    let s = layer_solid(&outline(), &top, tol()).unwrap();
+    let s = layer_solid(&top, tol()).unwrap();
     let want = polygon_area(&outline().polygon(tol())) * 3.0 - 16.0 * 1.5 * 1.5 * 70.0;
     assert!(
         (s.volume() - want).abs() < 1e-6 * want,
@@ -126,8 +130,8 @@ fn channel_layer_is_the_prism_less_its_grooves() {
 #[test]
 fn bonded_skin_holds_the_channels_as_tunnels() {
     let (bottom, top) = layers();
-    let a = layer_solid(&outline(), &bottom, tol()).unwrap();
-    let b = layer_solid(&outline(), &top, tol()).unwrap();
+    let a = layer_solid(&bottom, tol()).unwrap();
+    let b = layer_solid(&top, tol()).unwrap();
     let skin = a.union(&b).unwrap();
     assert_eq!((skin.shell_count(), skin.genus()), (1, 0));
     let area = polygon_area(&outline().polygon(tol()));

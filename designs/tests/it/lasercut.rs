@@ -403,6 +403,7 @@ fn a_plate_as_published_gives_the_published_sheets() {
             "mold_1_thickness_2.5mm.DXF",
             10,
         ),
+        ("black_gel_tray_2_wall", "mold_2_thickness_2.8mm.DXF", 10),
     ] {
         let c = sheet(name);
         let nominal = c.nominal_rings_mm.as_ref().unwrap();
@@ -412,11 +413,64 @@ fn a_plate_as_published_gives_the_published_sheets() {
     }
     assert_eq!(sheet("translucent_gel_tray_1_base").thickness_mm, 3.0);
     assert_eq!(sheet("translucent_gel_tray_2_wall").thickness_mm, 2.5);
+    assert_eq!(sheet("black_gel_tray_2_wall").thickness_mm, 2.8);
+    // one base sheet under both trays: the three published sheets and no more
+    assert_eq!(k.cut_parts.len(), 3, "{:?}", names(&k));
     let make = &k.procedure[0].text;
     assert!(
         make.contains("the 8 3.1 mm holes") && make.contains("tape the base sheet's holes"),
         "{make}"
     );
+}
+
+/// The names of a kit's cut parts.
+fn names(k: &fabkit_designs::Kit) -> Vec<&str> {
+    k.cut_parts.iter().map(|c| c.name.as_str()).collect()
+}
+
+/// 9DTact's gels as published: the translucent gel cast in mold_1's 2.5 mm pocket, then the
+/// black gel poured over it in mold_2's 2.8 mm pocket, 0.8 mm round its sides
+/// (`layers[1].wrap_mm`). The gels' volumes are the published molds': translucent
+/// 662.89 mm2 x 2.5 mm = 1657.2 mm3, black 746.73 mm2 x 2.8 mm - 1657.2 = 433.6 mm3 (the
+/// pockets' areas from the DXFs), within 1 % as poured and as the assembly's solids; each layer
+/// is what its molds cast (the black gel's inner faces formed by the cured translucent gel),
+/// poured inner first.
+#[test]
+fn a_wrapped_gel_is_cast_over_the_cured_one_as_published() {
+    let d = Design::from_yaml(
+        include_str!("data/ninedtact_plate.yaml"),
+        "ninedtact_plate.yaml",
+    )
+    .unwrap();
+    let k = fabkit_designs::build_kit(&d, tol()).unwrap();
+    for (step, (layer, published)) in [("translucent_gel", 1657.2), ("black_gel", 433.6)]
+        .into_iter()
+        .enumerate()
+    {
+        let c = &k.casts[step];
+        assert_eq!(c.cast, layer, "pour {} is {}", step + 1, c.cast);
+        let poured = c.layer_volume_ml.unwrap_or(c.cavity_volume_ml) * 1000.0;
+        assert!(
+            (poured / published - 1.0).abs() < 0.01,
+            "{layer}: poured {poured} mm3, published {published}"
+        );
+        let shown = k.assembly.iter().find(|m| m.name == layer).unwrap().solid.volume();
+        assert!(
+            (shown / published - 1.0).abs() < 0.01,
+            "{layer}: the assembly's {shown} mm3, published {published}"
+        );
+    }
+    let checks = fabkit_designs::cast_check::check_casts(&d, &k, tol()).unwrap();
+    for c in &checks {
+        assert!(c.holds(), "{c:?}");
+    }
+    assert_eq!(checks[1].formed_by, ["black_gel_tray", "translucent_gel"]);
+    let pour = k
+        .procedure
+        .iter()
+        .find(|s| s.text.starts_with("Pour black_gel"))
+        .unwrap();
+    assert!(pour.text.contains("round the cured layers"), "{}", pour.text);
 }
 
 /// A plate's rules by path: a plate no larger than the pocket, a corner radius past half its
@@ -481,4 +535,52 @@ fn a_level_no_stock_makes_is_said_to_the_micrometre() {
         }
         other => panic!("{:?}", other.map(|k| k.parts.len())),
     }
+}
+
+/// The paths a design's errors name, or a panic naming `what` when it builds.
+fn refused_paths(d: &Design, what: &str) -> Vec<String> {
+    match fabkit_designs::build_kit(d, tol()) {
+        Err(DesignError::Params(e)) => e.0.iter().map(|x| x.path.clone()).collect(),
+        other => panic!("{what}: {:?}", other.map(|k| k.design)),
+    }
+}
+
+/// Wrapping layers' rules by path: not on the innermost layer, above 0, on every layer from
+/// the second up once on one, no channels in a wrapped stack, no marker grid on a wrapping
+/// layer, and not on a curved skin.
+#[test]
+fn a_wraps_bad_values_are_refused_by_path() {
+    let base = Design::from_yaml(
+        include_str!("data/ninedtact_plate.yaml"),
+        "ninedtact_plate.yaml",
+    )
+    .unwrap();
+    let mut d = base.clone();
+    d.layers[0].wrap_mm = Some(0.5);
+    assert!(refused_paths(&d, "a wrapped innermost layer").contains(&"layers[0].wrap_mm".into()));
+    for bad in [0.0, -0.5, f64::INFINITY] {
+        let mut d = base.clone();
+        d.layers[1].wrap_mm = Some(bad);
+        let paths = refused_paths(&d, "a wrap not above 0");
+        assert!(paths.contains(&"layers[1].wrap_mm".into()), "{bad}: {paths:?}");
+    }
+    // a third layer that does not wrap
+    let mut d = base.clone();
+    let mut third = d.layers[1].clone();
+    third.name = "coat".into();
+    third.wrap_mm = None;
+    d.layers.push(third);
+    if let fabkit_designs::profile::BodyProfile::Flat { thickness_mm, .. } = &mut d.body {
+        *thickness_mm = 3.1;
+    }
+    assert!(refused_paths(&d, "a third layer unwrapped").contains(&"layers[2].wrap_mm".into()));
+    // Soter's channel layer made to wrap its marker layer
+    let mut d = soter();
+    d.layers[1].wrap_mm = Some(1.0);
+    let paths = refused_paths(&d, "a wrapping channel layer");
+    assert!(paths.contains(&"layers[1].channels".into()), "{paths:?}");
+    let mut d = library::load("rtac0").unwrap();
+    d.layers[1].wrap_mm = Some(1.0);
+    let paths = refused_paths(&d, "a curved skin's wrap");
+    assert!(paths.contains(&"layers[1].wrap_mm".into()), "{paths:?}");
 }

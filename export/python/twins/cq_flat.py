@@ -33,6 +33,9 @@ def casting_tray(p: dict) -> cq.Solid:
     # flat-ended marker holes and a registration hole through each corner of the wall
     laser = p.get("laser_cut")
     hw, hl = float(o["width_mm"]) / 2.0, float(o["length_mm"]) / 2.0
+    # a wrapped stack's inner trays: the sheets are cut round the outermost pocket
+    so = laser.get("sheets_round") if laser else None
+    bw, bl = (float(so["width_mm"]) / 2.0, float(so["length_mm"]) / 2.0) if so else (hw, hl)
     plate = laser.get("plate") if laser else None
     if plate:
         # the published plate (mold.laser_cut.plate): its own rounded outline
@@ -41,7 +44,7 @@ def casting_tray(p: dict) -> cq.Solid:
                                "corner_radius_mm": plate.get("corner_radius_mm", 0.0)},
                               z0 - floor, z0 + t)
     else:
-        block = C.box([-hw - wall, -hl - wall, z0 - floor], [hw + wall, hl + wall, z0 + t])
+        block = C.box([-bw - wall, -bl - wall, z0 - floor], [bw + wall, bl + wall, z0 + t])
     tray = C.cut(block, [outline_prism(o, z0, z0 + t + 1.0)])
     ch = p.get("channels")
     if ch:
