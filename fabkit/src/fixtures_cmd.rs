@@ -21,7 +21,7 @@ pub struct FixturesArgs {
     /// command's output (an export, ground truth, a calibration) is never replaced.
     #[arg(long)]
     force: bool,
-    /// Fixture parameters (YAML: pin_dome, semidomes, grid_plate, semiplates, indenters);
+    /// Fixture parameters (YAML: pin_dome, semidomes, grid_plate, semiplates, board, indenters);
     /// defaults where absent.
     #[arg(long)]
     params: Option<PathBuf>,
@@ -195,6 +195,17 @@ fn print_summary(
         out!(
             "  semi-plates: {n} patterns + the empty half -> {} stitched pairs",
             n * n
+        );
+    } else if let Some(why) = set.kit.summary["semiplates"]["skipped"].as_str() {
+        out!("  semi-plates: none: {why}");
+    }
+    if let Some(b) = &set.board {
+        out!(
+            "  calibration board: {} bumps, {:.3} mm into the skin with its floor on the contact face; pocket {:.3} x {:.3} mm; point table points/board_table.csv",
+            b.table.len(),
+            b.table.first().map(|r| r.indentation_depth_mm).unwrap_or(0.0),
+            b.pocket.width_mm,
+            b.pocket.length_mm
         );
     }
     if params.indenters.is_none() {

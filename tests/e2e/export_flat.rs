@@ -471,7 +471,10 @@ fn ninedtact_sheets_are_the_published_ones() {
     // (2.8 / 0.05 rounds down in floating point) and reports its volume 1.79 % short
     printcheck_all_with(&stls, &["--no-sla"]);
     let pairs = [
-        ("translucent_gel_tray_1_base", "mold_base_thickness_3.0mm.DXF"),
+        (
+            "translucent_gel_tray_1_base",
+            "mold_base_thickness_3.0mm.DXF",
+        ),
         ("translucent_gel_tray_2_wall", "mold_1_thickness_2.5mm.DXF"),
         ("black_gel_tray_2_wall", "mold_2_thickness_2.8mm.DXF"),
     ];

@@ -66,6 +66,32 @@ const CASES: &[(&str, &[&str])] = &[
         "soter_channels_fixtures",
         &["fixtures", "soter_channels", "--semidomes", "3"],
     ),
+    // a wrapped gel stack in its published laser-cut plates (9DTact), and its calibration board
+    (
+        "ninedtact_plate",
+        &[
+            "export",
+            concat!(
+                env!("CARGO_MANIFEST_DIR"),
+                "/../designs/tests/it/data/ninedtact_plate.yaml"
+            ),
+        ],
+    ),
+    (
+        "ninedtact_board",
+        &[
+            "fixtures",
+            concat!(
+                env!("CARGO_MANIFEST_DIR"),
+                "/../designs/tests/it/data/ninedtact_plate.yaml"
+            ),
+            "--params",
+            concat!(
+                env!("CARGO_MANIFEST_DIR"),
+                "/../fixtures/tests/it/data/ninedtact_board.yaml"
+            ),
+        ],
+    ),
 ];
 
 /// Every case exported under `dir` with its CSG tree beside it (`<case>.csg.json`), two

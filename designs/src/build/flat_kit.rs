@@ -204,11 +204,7 @@ fn layer_tray(
         }
         None => {
             let floor = wall + l.marker_grid.as_ref().map_or(0.0, |g| g.feature.height_mm);
-            (
-                tray_solid(l, wall, floor, tol).part(&name)?,
-                floor,
-                None,
-            )
+            (tray_solid(l, wall, floor, tol).part(&name)?, floor, None)
         }
     };
     let skin = layer_solid_as_cast(l, laser.is_some(), tol).part(&l.name)?;
@@ -481,7 +477,11 @@ fn procedure(
 /// 2.5 mm sheet's pocket, then the black gel in the 2.8 mm sheet's pocket over it): each layer
 /// on the base sheet (`laser_cut`) or in its tray's floor, the next tray put round the cured
 /// layers, the last taken out with the skin.
-fn wrapped_pours(casts: &[CastReport], layers: &[FlatLayer], laser_cut: bool) -> Vec<ProcedureStep> {
+fn wrapped_pours(
+    casts: &[CastReport],
+    layers: &[FlatLayer],
+    laser_cut: bool,
+) -> Vec<ProcedureStep> {
     let mut steps = Vec::new();
     for (k, c) in casts.iter().enumerate() {
         let Some(l) = layers.iter().find(|l| l.name == c.cast) else {

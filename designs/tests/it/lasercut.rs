@@ -454,7 +454,13 @@ fn a_wrapped_gel_is_cast_over_the_cured_one_as_published() {
             (poured / published - 1.0).abs() < 0.01,
             "{layer}: poured {poured} mm3, published {published}"
         );
-        let shown = k.assembly.iter().find(|m| m.name == layer).unwrap().solid.volume();
+        let shown = k
+            .assembly
+            .iter()
+            .find(|m| m.name == layer)
+            .unwrap()
+            .solid
+            .volume();
         assert!(
             (shown / published - 1.0).abs() < 0.01,
             "{layer}: the assembly's {shown} mm3, published {published}"
@@ -470,7 +476,30 @@ fn a_wrapped_gel_is_cast_over_the_cured_one_as_published() {
         .iter()
         .find(|s| s.text.starts_with("Pour black_gel"))
         .unwrap();
-    assert!(pour.text.contains("round the cured layers"), "{}", pour.text);
+    assert!(
+        pour.text.contains("round the cured layers"),
+        "{}",
+        pour.text
+    );
+    // in printed trays: the same gels, each what its tray and the cured layers cast, the black
+    // gel's tray as deep as the stack, the cured gel set on its floor
+    let mut printed = d.clone();
+    printed.mold.laser_cut = None;
+    let k = fabkit_designs::build_kit(&printed, tol()).unwrap();
+    assert!(k.cut_parts.is_empty());
+    for (c, published) in k.casts.iter().zip([1657.2, 433.6]) {
+        let mm3 = c.cavity_volume_ml * 1000.0;
+        assert!((mm3 / published - 1.0).abs() < 0.01, "{}: {mm3}", c.cast);
+    }
+    for c in fabkit_designs::cast_check::check_casts(&printed, &k, tol()).unwrap() {
+        assert!(c.holds(), "{c:?}");
+    }
+    let tray = k.parts.iter().find(|p| p.name == "black_gel_tray").unwrap();
+    assert!((tray.params["depth_mm"].as_f64().unwrap() - 2.8).abs() < 1e-9);
+    assert!(k
+        .procedure
+        .iter()
+        .any(|s| s.text.contains("set the cured layers on its floor")));
 }
 
 /// A plate's rules by path: a plate no larger than the pocket, a corner radius past half its
@@ -562,7 +591,10 @@ fn a_wraps_bad_values_are_refused_by_path() {
         let mut d = base.clone();
         d.layers[1].wrap_mm = Some(bad);
         let paths = refused_paths(&d, "a wrap not above 0");
-        assert!(paths.contains(&"layers[1].wrap_mm".into()), "{bad}: {paths:?}");
+        assert!(
+            paths.contains(&"layers[1].wrap_mm".into()),
+            "{bad}: {paths:?}"
+        );
     }
     // a third layer that does not wrap
     let mut d = base.clone();

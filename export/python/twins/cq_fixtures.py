@@ -232,6 +232,25 @@ def grid_plate(params: dict):
                  [cq_flat.outline_prism(grown(c), -1.0, under)] + bores)
 
 
+def calibration_board(params: dict):
+    """The calibration board of a flat sensor (fixtures/src/board.rs), sensor frame, pressed
+    on: the pocket grown by the wall from the pocket's rim up to the floor's outer face, less
+    the pocket below the contact face, with a bump (a cylinder and a hemispherical cap) per
+    grid point down from the floor."""
+    from . import cq_flat
+    b, pocket = params["board"], params["pocket"]
+    face, top = float(params["face_z_mm"]), float(params["top_z_mm"])
+    rim = face - float(b["pocket_depth_mm"])
+    r, h = float(b["bump_radius_mm"]), float(b["bump_height_mm"])
+    cup = C.cut(cq_flat.outline_prism(_grown(pocket, float(b["wall_mm"])), rim, top),
+                [cq_flat.outline_prism(pocket, rim - 1.0, face)])
+    bumps = []
+    for x, y in params["bumps_xy_mm"]:
+        bumps.append(C.cylinder_z(r, face - (h - r), face + 0.01, x, y))
+        bumps.append(cq.Solid.makeSphere(r, cq.Vector(x, y, face - (h - r)), angleDegrees1=-90, angleDegrees2=90))
+    return C.fuse(cup, bumps)
+
+
 def _grown(o: dict, d: float) -> dict:
     """The outline `o` grown by `d` all round (corner radius grown too)."""
     return {"width_mm": o["width_mm"] + 2 * d, "length_mm": o["length_mm"] + 2 * d,
@@ -285,6 +304,8 @@ def twin(part: dict):
         return indenter(p)
     if name == "grid_plate":
         return grid_plate(p)
+    if name == "calibration_board":
+        return calibration_board(p)
     if name == "pin_dome":
         return pin_dome(p)
     if name == "pin_dome_ring":
