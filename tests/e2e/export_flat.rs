@@ -150,14 +150,20 @@ for c in m["cut_parts"]:
                 "rings": len(polys)})
 print(json.dumps(out))
 "#;
+    Some(python_json(&py, script, &[dir.as_os_str()]))
+}
+
+/// Runs the Python `script` with `args` and parses the JSON list it prints; a failure fails the
+/// test with its stderr.
+fn python_json(py: &std::path::Path, script: &str, args: &[&std::ffi::OsStr]) -> Vec<Value> {
     let o = std::process::Command::new(py)
         .arg("-c")
         .arg(script)
-        .arg(dir)
+        .args(args)
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", text(&o.stderr));
-    Some(serde_json::from_slice(&o.stdout).unwrap())
+    serde_json::from_slice(&o.stdout).unwrap()
 }
 
 /// The laser-cut trays' sheets (Soter et al. Sec. II-A: laser-cut molds): each sheet's DXF
@@ -400,16 +406,13 @@ for name, ref in json.loads(sys.argv[3]):
                 "polylines": len(mine.modelspace().query("LWPOLYLINE"))})
 print(json.dumps(out))
 "#;
-    let o = std::process::Command::new(py)
-        .arg("-c")
-        .arg(script)
-        .arg(dir)
-        .arg(repo_root().join("tests/data/9dtact_published_cad"))
-        .arg(serde_json::to_string(pairs).unwrap())
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", text(&o.stderr));
-    Some(serde_json::from_slice(&o.stdout).unwrap())
+    let published = repo_root().join("tests/data/9dtact_published_cad");
+    let pairs = serde_json::to_string(pairs).unwrap();
+    Some(python_json(
+        &py,
+        script,
+        &[dir.as_os_str(), published.as_os_str(), pairs.as_ref()],
+    ))
 }
 
 /// 9DTact's gel stack in its published laser-cut molds (the test design
