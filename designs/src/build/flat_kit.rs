@@ -384,7 +384,14 @@ fn procedure(
         Some(lc) => step(
             ProcedureAction::Print,
             format!(
-                "Laser-cut the trays' sheets (cut/*.dxf or cut/*.svg: each sheet's paths already offset for its stock's kerf; the quantity of each is in its description), or print the trays ({trays}) instead. Stack each tray's sheets in order (base at the bottom) on {}, {} and seal the cavity's inside edges with a thin bead of silicone{}; check that the tray is flat and its cavity clean.",
+                "Laser-cut the trays' sheets (cut/*.dxf or cut/*.svg: each sheet's paths already offset for its stock's kerf; the quantity of each is in its description), or print the trays ({trays}) instead. {} on {}, {} and seal the cavity's inside edges with a thin bead of silicone{}; check that the tray is flat and its cavity clean.",
+                match parts.first().filter(|_| wrapped) {
+                    Some(first) => format!(
+                        "Stack the base sheet and the wall sheets of {} (the first pour's tray)",
+                        first.name
+                    ),
+                    None => "Stack each tray's sheets in order (base at the bottom)".to_string(),
+                },
                 match &lc.plate {
                     None => format!(
                         "four {} mm dowel pins through the registration holes",
