@@ -34,7 +34,7 @@ pub use shared::{
 /// Lengths of a design that may be negative ([`crate::values::check_values`]): the lights'
 /// positions in the sensor frame (`optics.lights[i].position_mm`) and the centres of a
 /// laser-cut plate's holes (`mold.laser_cut.plate.holes.xy_mm`).
-pub const DESIGN_SIGNED_MM: &[&str] = &["position_mm", "xy_mm"];
+pub const DESIGN_SIGNED_MM: &[&str] = &["position_mm", "xy_mm", "y_mm", "ramp_y_mm"];
 
 /// A sensor design: body profile, rigid core, layer stack, molds, housing, printers.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
@@ -81,6 +81,10 @@ pub struct Design {
     /// height; none when not given.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spacer: Option<crate::parts::spacer::SpacerParams>,
+    /// The shell, base, isolation ring and window of a flat sensor (9DTact, Lin et al. RA-L
+    /// 2024); none when not given.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub flat_housing: Option<crate::parts::flat_housing::FlatHousingParams>,
     /// How the inside is lit and imaged, for rendering what the camera sees; the families'
     /// lights and default reflectance and camera response when not given.
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -145,6 +145,18 @@ fn check_scope(design: &Design, errs: &mut Vec<ParamError>) -> Result<(), ParamE
             ),
         ));
     }
+    for f in crate::parts::flat_family::FLAT_FAMILIES {
+        if f.given(design) {
+            errs.push(ParamError::new(
+                f.path(),
+                "given",
+                format!(
+                    "applies to flat skins only (body.profile: flat); this body is {}",
+                    design.body.kind()
+                ),
+            ));
+        }
+    }
     for (i, l) in design.layers.iter().enumerate() {
         let wrap = l.wrap_mm.map(|_| "wrap_mm");
         for field in crate::parts::layer_registry::flat_only_given(l)

@@ -491,3 +491,89 @@ fn ninedtact_sheets_are_the_published_ones() {
         assert!(h < 0.01, "{r}");
     }
 }
+
+/// 9DTact's housing (designs/tests/it/data/ninedtact_housing.yaml: the published numbers, read
+/// off the STEP files): `fabkit export` writes the shell, the base and the isolation ring, each
+/// within 0.02 mm of the published STEP (two-sided, sampled every 0.1 mm, measured by OCCT and
+/// libigl in tests/oracles/published_step.py; the issue asks 0.05 mm of the outer form, and the
+/// whole part holds) and of its volume within 0.1 %; each STL passes `printcheck --strict`. The
+/// window is cut to the chamber less its clearance, as thick as the chamber above the collar.
+#[test]
+fn ninedtact_housing_is_the_published_shell_base_and_ring() {
+    let tmp = tempfile::tempdir().unwrap();
+    let design = repo_root().join("designs/tests/it/data/ninedtact_housing.yaml");
+    let o = run(
+        tmp.path(),
+        &["export", design.to_str().unwrap(), "--out", "out"],
+        &[],
+    );
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let dir = tmp.path().join("out");
+    let m: Value =
+        serde_json::from_slice(&std::fs::read(dir.join("manifest.json")).unwrap()).unwrap();
+    let window = m["cut_parts"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["name"] == "window")
+        .expect("the window's drawing");
+    assert!((window["thickness_mm"].as_f64().unwrap() - 10.4).abs() < 1e-9);
+    // sensor frame -> each file's frame: the shell's y runs down from the skin's face, the
+    // base's up from its bottom face (22.5 mm below the skin's face), the ring's up from the
+    // plate's underside (13.2 mm below it)
+    let parts = [
+        (
+            "flat_shell",
+            "sensor_shell.STEP",
+            "[[1,0,0,0],[0,0,-1,0],[0,1,0,0]]",
+        ),
+        (
+            "flat_base",
+            "sensor_base.STEP",
+            "[[-1,0,0,0],[0,0,1,22.5],[0,1,0,0]]",
+        ),
+        (
+            "isolation_ring",
+            "isolation_ring.STEP",
+            "[[1,0,0,0],[0,0,1,13.2],[0,-1,0,0]]",
+        ),
+    ];
+    let stls: Vec<std::path::PathBuf> = parts
+        .iter()
+        .map(|(name, _, _)| dir.join(format!("parts/{name}.stl")))
+        .collect();
+    printcheck_all(&stls);
+    let Some(py) = cadquery_python() else {
+        eprintln!("SKIPPED: 9DTact's housing against its STEP files (set FABKIT_CADQUERY_PYTHON; .ci/run does)");
+        return;
+    };
+    for (name, step, t_step) in parts {
+        let p = m["parts"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|p| p["name"] == name)
+            .unwrap();
+        let o = std::process::Command::new(&py)
+            .arg(repo_root().join("tests/oracles/published_step.py"))
+            .arg(
+                repo_root()
+                    .join("tests/data/9dtact_published_cad")
+                    .join(step),
+            )
+            .arg(dir.join(format!("parts/{name}.stl")))
+            .arg(p["params"]["T_print_sensor"].to_string())
+            .arg(t_step)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{name}: {}", text(&o.stderr));
+        let r: Value = serde_json::from_slice(&o.stdout).unwrap();
+        let h = r["hausdorff_mm"].as_f64().unwrap();
+        assert!(h < 0.02, "{name} against {step}: {r}");
+        let (ours, theirs) = (
+            r["our_volume_mm3"].as_f64().unwrap(),
+            r["published_volume_mm3"].as_f64().unwrap(),
+        );
+        assert!((ours / theirs - 1.0).abs() < 1e-3, "{name}: {r}");
+    }
+}

@@ -66,14 +66,15 @@ const CASES: &[(&str, &[&str])] = &[
         "soter_channels_fixtures",
         &["fixtures", "soter_channels", "--semidomes", "3"],
     ),
-    // a wrapped gel stack in its published laser-cut plates (9DTact), and its calibration board
+    // a wrapped gel stack in its published laser-cut plates with its shell, base and isolation
+    // ring (9DTact), and its calibration board
     (
-        "ninedtact_plate",
+        "ninedtact_housing",
         &[
             "export",
             concat!(
                 env!("CARGO_MANIFEST_DIR"),
-                "/../designs/tests/it/data/ninedtact_plate.yaml"
+                "/../designs/tests/it/data/ninedtact_housing.yaml"
             ),
         ],
     ),

@@ -11,6 +11,7 @@ use crate::parts::flat::{
     estimated_triangles, layer_solid_as_cast, tray_solid, ChannelEnds, ChannelSet, FlatLayer,
     FlatOutline,
 };
+use crate::parts::flat_family::{FlatBuilt, FlatFamilyInput, FLAT_FAMILIES};
 use crate::parts::{Member, MemberKind, Part, PrintTechnology, ProcedureAction, ProcedureStep};
 use crate::schema::{Design, LaserCutParams};
 use crate::stack::flat::validate;
@@ -34,7 +35,11 @@ pub(crate) fn build_flat_kit(
     let Some(outline) = design.body.flat_outline() else {
         return Err(DesignError::Yaml("not a flat design".into()));
     };
-    let est = estimated_triangles(&layers, design.mold.laser_cut.is_some(), tol);
+    let est = estimated_triangles(&layers, design.mold.laser_cut.is_some(), tol)
+        + FLAT_FAMILIES
+            .iter()
+            .map(|f| f.estimated_triangles(design, tol))
+            .sum::<f64>();
     if est > max_triangles as f64 {
         return Err(DesignError::WorkLimit(format!(
             "{}: the kit would have about {:.0} triangles at chord tolerance {} mm, more than the limit of {max_triangles} (about 1 KB of memory each; raise it with --max-triangles, up to {}, or coarsen --chord-tolerance-mm)",
@@ -104,8 +109,29 @@ pub(crate) fn build_flat_kit(
         .iter()
         .filter_map(|l| l.channels.as_ref().map(|c| (l, c)))
         .collect();
-    let (bought, liquid_ml) = bought_items(&layers, &channel_sets, laser, &cut_parts);
-    let procedure = procedure(&parts, &casts, &layers, &channel_sets, laser, outer);
+    let (mut bought, liquid_ml) = bought_items(&layers, &channel_sets, laser, &cut_parts);
+    let mut procedure = procedure(&parts, &casts, &layers, &channel_sets, laser, outer);
+    let housed = families(design, &layers, tol)?;
+    if !housed.parts.is_empty() || !housed.cut_parts.is_empty() {
+        procedure.push(housing_print_step(&housed));
+    }
+    parts.extend(housed.parts);
+    cut_parts.extend(housed.cut_parts);
+    for f in FLAT_FAMILIES {
+        bought.extend(f.bought_items(design));
+        procedure.extend(
+            f.assembly_steps(design, &parts)
+                .into_iter()
+                .map(|t| ProcedureStep::new(ProcedureAction::Assemble, format!("Assemble: {t}"))),
+        );
+    }
+    if !housed.members.is_empty() {
+        assembly.extend(housed.members);
+        let found = crate::assembly::interferences(&assembly, tol)?;
+        if let Some(e) = crate::assembly::fit_errors(design, &found) {
+            return Err(e);
+        }
+    }
     let summary = serde_json::json!({
         "flat": {
             "outline": outline,
@@ -137,6 +163,54 @@ pub(crate) fn build_flat_kit(
         machined_parts: Vec::new(),
         summary,
     })
+}
+
+/// Every flat part family's parts, members and cut parts ([`FLAT_FAMILIES`]), in order.
+///
+/// # Errors
+/// As [`crate::parts::flat_family::FlatFamily::build`].
+fn families(
+    design: &Design,
+    layers: &[FlatLayer],
+    tol: ChordTolerance,
+) -> Result<FlatBuilt, DesignError> {
+    let mut out = FlatBuilt::default();
+    for f in FLAT_FAMILIES {
+        if let Some(built) = f.build(design, FlatFamilyInput { layers, tol }) {
+            let built = built?;
+            out.parts.extend(built.parts);
+            out.members.extend(built.members);
+            out.cut_parts.extend(built.cut_parts);
+        }
+    }
+    Ok(out)
+}
+
+/// The step that prints the families' parts and cuts their cut parts, after the pours.
+fn housing_print_step(housed: &FlatBuilt) -> ProcedureStep {
+    let printed = housed
+        .parts
+        .iter()
+        .map(|p| format!("{} ({:?}, {})", p.name, p.print_technology, p.material))
+        .collect::<Vec<_>>()
+        .join(", ");
+    let cut = housed
+        .cut_parts
+        .iter()
+        .map(|c| {
+            format!(
+                "{} (cut/{}.dxf, {} {:.2} mm)",
+                c.name, c.name, c.material, c.thickness_mm
+            )
+        })
+        .collect::<Vec<_>>()
+        .join(", ");
+    let text = match (printed.is_empty(), cut.is_empty()) {
+        (false, false) => format!("Print the housing's parts: {printed}; cut {cut}."),
+        (false, true) => format!("Print the housing's parts: {printed}."),
+        _ => format!("Cut {cut}."),
+    };
+    ProcedureStep::new(ProcedureAction::Print, text)
 }
 
 /// What every tray of a flat kit shares: the outermost layer's outline (the laser-cut sheets

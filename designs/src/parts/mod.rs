@@ -11,6 +11,8 @@ pub mod family;
 pub mod fasteners;
 pub mod fingertip_base;
 pub mod flat;
+pub mod flat_family;
+pub mod flat_housing;
 pub mod housing;
 pub mod lasercut;
 pub mod layer_feature;

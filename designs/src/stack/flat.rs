@@ -7,6 +7,7 @@
 use crate::error::ParamError;
 use crate::geometry::ChordTolerance;
 use crate::parts::channels::FlatLayer;
+use crate::parts::flat_family::FLAT_FAMILIES;
 use crate::parts::layer_feature::FlatInput;
 use crate::parts::registry::FAMILIES;
 use crate::profile::FlatOutline;
@@ -96,10 +97,35 @@ pub fn validate(
         check_layer_stack(design, layers, body_ok, &mut errs);
     }
     check_laser_cut_trays(design, materials, layers.as_deref(), &outline, &mut errs);
+    check_flat_families(design, materials, layers.as_deref(), &mut errs);
     let errs = numbers.merge_negative(errs);
     match layers {
         Some(l) if errs.is_empty() => Ok(l),
         _ => Err(crate::ParamErrors(errs)),
+    }
+}
+
+/// Every flat part family's rules ([`FLAT_FAMILIES`]): its materials, then its own rules (with
+/// the skin's layers when they are sound).
+fn check_flat_families(
+    design: &Design,
+    materials: &crate::materials::MaterialsTable,
+    layers: Option<&[FlatLayer]>,
+    errs: &mut Vec<ParamError>,
+) {
+    for f in FLAT_FAMILIES {
+        for (path, key, kinds) in f.materials(design) {
+            match materials.get(key) {
+                None => errs.push(ParamError::new(path, key, "unknown material")),
+                Some(m) if !kinds.contains(&m.kind) => errs.push(ParamError::new(
+                    path,
+                    key,
+                    format!("is a {:?} material, expected one of {:?}", m.kind, kinds),
+                )),
+                Some(_) => {}
+            }
+        }
+        f.check(design, layers, errs);
     }
 }
 

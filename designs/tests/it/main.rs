@@ -5,6 +5,7 @@ mod cast_markers;
 mod common;
 mod error_paths;
 mod estimate;
+mod flat_housing;
 mod flat_skin;
 mod geometry;
 mod hostile_values;

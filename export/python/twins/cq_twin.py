@@ -4,8 +4,8 @@ each asked in turn for the part's solid, then the recorded print placement."""
 from __future__ import annotations
 
 from . import cq_common as C
-from . import (cq_casing, cq_fixtures, cq_flat, cq_housing, cq_layers, cq_molds, cq_shaft_body,
-               cq_spacer)
+from . import (cq_casing, cq_fixtures, cq_flat, cq_flat_housing, cq_housing, cq_layers, cq_molds,
+               cq_shaft_body, cq_spacer)
 from .families import family  # noqa: F401 (re-exported)
 
 # The twin modules, one line per family as in the Rust registries (designs/src/parts/
@@ -18,6 +18,7 @@ TWINS = (
     cq_shaft_body,  # parts::shaft_body and robot_mount
     cq_casing,      # parts::casing and fingertip_base
     cq_flat,        # parts::flat and lasercut: casting trays
+    cq_flat_housing,  # parts::flat_housing: a flat sensor's shell, base, isolation ring
     cq_spacer,      # parts::spacer
     cq_fixtures,    # fixtures: pin domes, pins, semi-domes, plates, indenters
 )

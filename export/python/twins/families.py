@@ -28,6 +28,8 @@ def family(part: dict) -> str:
     if role in ("casing", "gripper_base", "shell_holder", "sensor_base", "camera_holder",
                 "diffusion_ring"):
         return "casings and bases"
+    if role in ("flat_shell", "flat_base", "isolation_ring"):
+        return "flat housings"
     if role == "casting_tray":
         return "casting trays (flat skins)"
     if role == "indenter":
