@@ -18,6 +18,7 @@ pub const LIBRARY: &[(&str, &str)] = &[
         include_str!("../library/soter_channels.yaml"),
     ),
     ("digit_pinki", include_str!("../library/digit_pinki.yaml")),
+    ("ninedtact", include_str!("../library/ninedtact.yaml")),
 ];
 
 /// The default design of `fabkit export` without a design argument.

@@ -36,10 +36,7 @@ pub(crate) fn build_flat_kit(
         return Err(DesignError::Yaml("not a flat design".into()));
     };
     let est = estimated_triangles(&layers, design.mold.laser_cut.is_some(), tol)
-        + FLAT_FAMILIES
-            .iter()
-            .map(|f| f.estimated_triangles(design, tol))
-            .sum::<f64>();
+        + crate::parts::flat_family::estimated_triangles(design, tol);
     if est > max_triangles as f64 {
         return Err(DesignError::WorkLimit(format!(
             "{}: the kit would have about {:.0} triangles at chord tolerance {} mm, more than the limit of {max_triangles} (about 1 KB of memory each; raise it with --max-triangles, up to {}, or coarsen --chord-tolerance-mm)",

@@ -152,3 +152,11 @@ impl<F: FlatFamily> FlatSection for FlatRegistered<F> {
 pub static FLAT_FAMILIES: &[&dyn FlatSection] = &[&FlatRegistered::<
     crate::parts::flat_housing::FlatHousingFamily,
 >::at(|d| d.flat_housing.as_ref())];
+
+/// Every flat family's estimated triangles for `design` at `tol` (0 without any).
+pub fn estimated_triangles(design: &Design, tol: ChordTolerance) -> f64 {
+    FLAT_FAMILIES
+        .iter()
+        .map(|f| f.estimated_triangles(design, tol))
+        .sum()
+}

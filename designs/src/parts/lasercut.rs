@@ -455,6 +455,14 @@ pub fn check_params(
     let d = lc.registration.diameter_mm;
     if let Some(plate) = &lc.plate {
         plate.check(pocket, &mut errs);
+        // unused under a plate's own holes, but a number the schema bounds is always held to it
+        if !(d > 0.0 && d.is_finite()) {
+            errs.push(ParamError::new(
+                "mold.laser_cut.registration.diameter_mm",
+                d,
+                "must be above 0",
+            ));
+        }
     } else if !(d > 0.0 && d <= wall_mm - 2.0) {
         errs.push(ParamError::new(
             "mold.laser_cut.registration.diameter_mm",

@@ -198,11 +198,25 @@ pub fn check(o: &OpticsParams, errs: &mut Vec<ParamError>) {
 fn check_light(path: &str, l: &Light, errs: &mut Vec<ParamError>) {
     let len = l.direction.iter().map(|x| x * x).sum::<f64>().sqrt();
     if !(len > 1e-9) {
-        errs.push(ParamError::new(
-            format!("{path}.direction"),
-            format!("{:?}", l.direction),
-            "must be a vector longer than 0",
-        ));
+        // all zero: the vector; else its longest component, the one too short to aim it
+        let longest = (0..3)
+            .filter(|&k| l.direction[k] != 0.0)
+            .max_by(|&a, &b| l.direction[a].abs().total_cmp(&l.direction[b].abs()));
+        errs.push(match longest {
+            None => ParamError::new(
+                format!("{path}.direction"),
+                format!("{:?}", l.direction),
+                "must be a vector longer than 0",
+            ),
+            Some(k) => ParamError::new(
+                format!("{path}.direction[{k}]"),
+                l.direction[k],
+                format!(
+                    "is the longest component of {:?}, which must be a vector longer than 1e-9 to give a direction",
+                    l.direction
+                ),
+            ),
+        });
     }
     let a = l.cone_half_angle_deg;
     if !(a > 0.0 && a <= 90.0) {

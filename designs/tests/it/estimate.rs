@@ -22,13 +22,13 @@ fn estimate_is_within_a_small_factor_of_every_library_kit() {
             let actual: usize = kit.parts.iter().map(|p| p.solid.triangle_count()).sum();
             if d.body.flat_outline().is_some() {
                 // a flat skin's trays and layers: their own estimate (prisms, ribs, markers
-                // and their holes)
+                // and their holes), and its part families'
                 let layers = fabkit_designs::stack::flat::validate(&d, &materials).unwrap();
                 let e = fabkit_designs::flat::estimated_triangles(
                     &layers,
                     d.mold.laser_cut.is_some(),
                     tol,
-                );
+                ) + fabkit_designs::parts::flat_family::estimated_triangles(&d, tol);
                 let actual = actual
                     + kit
                         .assembly

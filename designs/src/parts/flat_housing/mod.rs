@@ -404,8 +404,14 @@ impl FlatFamily for FlatHousingFamily {
         if let Some(r) = &p.isolation_ring {
             circles += 4.0 * seg(r.bore_diameter_mm / 2.0);
         }
-        // about 8 triangles per segment of each circle (caps, sides, the booleans' splits)
-        8.0 * circles + 2_000.0
+        if s.ceiling_fillet_mm > 0.0 {
+            // the fillet's section (a quarter circle) revolved about each boss
+            let section = seg(s.ceiling_fillet_mm) / 4.0 + 4.0;
+            circles += screws * seg(s.boss_radius_mm + s.ceiling_fillet_mm) * section / 4.0;
+        }
+        // about 8 triangles per segment of each circle (caps, sides, the booleans' splits),
+        // twice: the printed parts and their members of the assembly
+        2.0 * (8.0 * circles + 2_000.0)
     }
 
     fn build(p: &FlatHousingParams, input: FlatFamilyInput<'_>) -> Result<FlatBuilt, DesignError> {
