@@ -6,10 +6,10 @@ Usage: published_step.py PUBLISHED.STEP PART.stl T_PRINT_SENSOR T_STEP_SENSOR
 
 T_PRINT_SENSOR is the part's `params.T_print_sensor` from the manifest, T_STEP_SENSOR the map from
 the sensor frame into the published file's frame; both JSON, 3 x 4 rows. The STL is mapped back
-into the sensor frame and on into the STEP's frame; the STEP is tessellated by OCCT to 0.001 mm.
-Both meshes are subdivided to edges of at most 0.1 mm, and each one's vertices measured to the
+into the sensor frame and on into the STEP's frame; the STEP is tessellated by OCCT to 0.002 mm.
+Both meshes are subdivided to edges of at most 0.25 mm, and each one's vertices measured to the
 other's surface (libigl's exact point-to-triangle distance): the two one-sided distances and their maximum
-(the Hausdorff distance, sampled every 0.1 mm), the worst point of each, and both volumes.
+(the Hausdorff distance, sampled every 0.25 mm), the worst point of each, and both volumes.
 
 Prints one JSON object; exit status 0, or 2 when a file cannot be read.
 """
@@ -31,12 +31,12 @@ def step_mesh(path):
     import cadquery as cq
 
     shape = cq.importers.importStep(path).val()
-    verts, tris = shape.tessellate(0.001, 0.05)
+    verts, tris = shape.tessellate(0.002, 0.1)
     v = np.array([[p.x, p.y, p.z] for p in verts])
     return trimesh.Trimesh(v, np.array(tris), process=True), shape.Volume()
 
 
-def dense(mesh, edge_mm=0.1):
+def dense(mesh, edge_mm=0.25):
     v, _ = trimesh.remesh.subdivide_to_size(mesh.vertices, mesh.faces, max_edge=edge_mm)
     return v
 
