@@ -658,7 +658,10 @@ fn cut_part_files(
                             what: format!("{CUT_DIR}/{}.stl", c.name),
                             reason: e.to_string(),
                         })?;
-                    stl_file(kit, opts, CUT_DIR, &c.name, &solid.mesh(), files)?
+                    // as every exported solid: rounded to f32 once, then checked as written
+                    let mesh = solid.mesh().rounded_to_f32();
+                    check_printable_mesh(&c.name, &mesh)?;
+                    stl_file(kit, opts, CUT_DIR, &c.name, &mesh, files)?
                 }
                 None => (None, None),
             };

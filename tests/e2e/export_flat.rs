@@ -420,7 +420,7 @@ print(json.dumps(out))
 /// kerf 0): `fabkit export ninedtact` writes the three published sheets (and the housing's
 /// window), each DXF within 0.01 mm of the published one as ezdxf reads
 /// both (outline, pocket and holes; at a 0.001 mm chord tolerance), each sheet's STL passes
-/// `printcheck --strict` (FDM), and the pours are the published molds' gel volumes within 1 %
+/// `printcheck --strict`, and the pours are the published molds' gel volumes within 1 %
 /// (translucent 1657.2 mm3, black 433.6 mm3).
 #[test]
 fn ninedtact_sheets_are_the_published_ones() {
@@ -470,10 +470,9 @@ fn ninedtact_sheets_are_the_published_ones() {
         .filter(|c| c["name"] != "window")
         .map(|c| dir.join(c["stl"].as_str().unwrap()))
         .collect();
-    // --strict, as every printcheck here; the sheets are laser-cut, so their STLs are sliced
-    // for FDM only: PrusaSlicer's SLA slicer cuts the 2.8 mm sheet into 55 layers of 0.05 mm
-    // (2.8 / 0.05 rounds down in floating point) and reports its volume 1.79 % short
-    printcheck_all_with(&stls, &["--no-sla"]);
+    // FDM and SLA: the 2.8 mm sheet is sliced into 56 layers of 0.05 mm, its top stored as
+    // the f32 not below 2.8 (Mesh::rounded_to_f32)
+    printcheck_all(&stls);
     let pairs = [
         (
             "translucent_gel_tray_1_base",

@@ -67,32 +67,9 @@ const CASES: &[(&str, &[&str])] = &[
         &["fixtures", "soter_channels", "--semidomes", "3"],
     ),
     // a wrapped gel stack in its published laser-cut plates with its shell, base and isolation
-    // ring (9DTact), and its calibration board
-    (
-        "ninedtact_housing",
-        &[
-            "export",
-            concat!(
-                env!("CARGO_MANIFEST_DIR"),
-                "/../designs/tests/it/data/ninedtact_housing.yaml"
-            ),
-        ],
-    ),
-    (
-        "ninedtact_board",
-        &[
-            "fixtures",
-            concat!(
-                env!("CARGO_MANIFEST_DIR"),
-                "/../designs/tests/it/data/ninedtact_plate.yaml"
-            ),
-            "--params",
-            concat!(
-                env!("CARGO_MANIFEST_DIR"),
-                "/../fixtures/tests/it/data/ninedtact_board.yaml"
-            ),
-        ],
-    ),
+    // ring (9DTact), and its calibration board fitted over the shell by default
+    ("ninedtact", &["export", "ninedtact"]),
+    ("ninedtact_fixtures", &["fixtures", "ninedtact"]),
 ];
 
 /// Every case exported under `dir` with its CSG tree beside it (`<case>.csg.json`), two

@@ -229,14 +229,34 @@ impl Mesh {
 
     /// The same mesh with every coordinate rounded to `f32`, as STL and most 3MF readers store it.
     /// Statistics written beside a file are computed on this form so that they match the file.
+    ///
+    /// x and y round to the nearest `f32`; z, the build direction of a part in print orientation,
+    /// rounds up to the nearest `f32` not below it (at most one unit in the last place: 2.4e-7 mm
+    /// at 2-4 mm, 7.6e-6 mm at 64-128 mm). A slicer sizes its layer stack from the top of the mesh
+    /// and drops what lies past the last whole layer: PrusaSlicer truncates the top z to whole
+    /// nanometres and adds a layer while `first + k * layer <= top` (`SLAPrint::Steps::slice_model`),
+    /// so a 2.8 mm part stored as the nearest `f32`, 2.79999995 mm, is sliced into 55 layers of
+    /// 0.05 mm, 2.75 mm tall. Rounded up, a part resting on z = 0 whose height is a whole number of
+    /// layers keeps every layer.
     pub fn rounded_to_f32(&self) -> Mesh {
         Mesh {
             vertices: self
                 .vertices
                 .iter()
-                .map(|v| v.map(|c| c as f32 as f64))
+                .map(|&[x, y, z]| [x as f32 as f64, y as f32 as f64, f32_not_below(z)])
                 .collect(),
             triangles: self.triangles.clone(),
         }
+    }
+}
+
+/// The nearest `f32` not below `z`, as f64 (`z` itself when it is an `f32`; NaN stays NaN, a
+/// value past `f32::MAX` becomes infinite as `as f32` makes it).
+fn f32_not_below(z: f64) -> f64 {
+    let f = z as f32;
+    if (f as f64) < z {
+        f.next_up() as f64
+    } else {
+        f as f64
     }
 }

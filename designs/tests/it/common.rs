@@ -34,6 +34,15 @@ pub fn build_error(d: &Design) -> fabkit_designs::ParamErrors {
     }
 }
 
+/// The paths of the rules `d` breaks, as `build_kit` at 0.01 mm reports them; panics, naming
+/// `what`, when it builds or fails otherwise.
+pub fn refused_paths(d: &Design, what: &str) -> Vec<String> {
+    match fabkit_designs::build_kit(d, ChordTolerance::new(0.01).unwrap()) {
+        Err(fabkit_designs::DesignError::Params(e)) => e.0.iter().map(|x| x.path.clone()).collect(),
+        other => panic!("{what}: {:?}", other.map(|k| k.design)),
+    }
+}
+
 /// The overlap's volume in a fit-check error's rule ("overlap by V mm³").
 pub fn overlap(rule: &str) -> f64 {
     rule.split("overlap by ")

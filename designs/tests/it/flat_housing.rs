@@ -1,10 +1,11 @@
 //! The housing of a flat sensor (`flat_housing`; parts/flat_housing.rs) on 9DTact's published
-//! numbers (data/ninedtact_housing.yaml): its parts are closed solids of the published volumes,
+//! numbers (the library design `ninedtact`): its parts are closed solids of the published volumes,
 //! they fit together and round the skin in the sensor frame as the published sensor's do, and
 //! every rule is refused by its path.
 
+use crate::common::refused_paths;
 use fabkit_designs::schema::value_at;
-use fabkit_designs::{library, ChordTolerance, Design, DesignError};
+use fabkit_designs::{library, ChordTolerance, Design};
 use serde_json::{json, Value};
 use std::f64::consts::PI;
 
@@ -13,11 +14,7 @@ fn tol() -> ChordTolerance {
 }
 
 fn ninedtact() -> Design {
-    Design::from_yaml(
-        include_str!("data/ninedtact_housing.yaml"),
-        "ninedtact_housing.yaml",
-    )
-    .unwrap()
+    library::load("ninedtact").unwrap()
 }
 
 /// `d` with the value at each `(path, value)` replaced.
@@ -27,14 +24,6 @@ fn with(d: &Design, changes: &[(&str, Value)]) -> Design {
         *value_at(&mut v, path).unwrap_or_else(|| panic!("no {path}")) = value.clone();
     }
     serde_json::from_value(v).unwrap()
-}
-
-/// The paths of the rules `d` breaks (panics if it builds or fails otherwise).
-fn refused(d: &Design, what: &str) -> Vec<String> {
-    match fabkit_designs::build_kit(d, tol()) {
-        Err(DesignError::Params(e)) => e.0.iter().map(|x| x.path.clone()).collect(),
-        other => panic!("{what}: {:?}", other.map(|k| k.design)),
-    }
 }
 
 /// The three printed parts are closed solids of the published parts' volumes (the STEP files'
@@ -101,7 +90,7 @@ fn a_base_that_does_not_fit_the_shell_is_refused() {
             json!([[12.0, 8.5], [-8.5, 7.75], [-8.5, -7.75], [8.5, -7.75]]),
         )],
     );
-    let paths = refused(&d, "a boss into the shell's");
+    let paths = refused_paths(&d, "a boss into the shell's");
     assert!(
         paths
             .iter()
@@ -320,7 +309,7 @@ fn flat_housing_rules_are_refused_by_path() {
     ];
     for (path, value, want) in cases {
         let d = with(&base, &[(path, value.clone())]);
-        let paths = refused(&d, &format!("{path} = {value}"));
+        let paths = refused_paths(&d, &format!("{path} = {value}"));
         assert!(
             paths.iter().any(|p| p == want),
             "{path} = {value}: refused at {paths:?}, not {want}"
@@ -329,5 +318,5 @@ fn flat_housing_rules_are_refused_by_path() {
     // a curved skin refuses the flat housing
     let mut d = library::load("rtac0").unwrap();
     d.flat_housing = base.flat_housing.clone();
-    assert!(refused(&d, "a curved skin's flat housing").contains(&"flat_housing".into()));
+    assert!(refused_paths(&d, "a curved skin's flat housing").contains(&"flat_housing".into()));
 }

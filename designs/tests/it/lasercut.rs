@@ -3,6 +3,7 @@
 //! its cavity equal to the pour; kerf compensation (a path offset by half the kerf, cut with
 //! that kerf, leaves the nominal sheet); bad values by path.
 
+use crate::common::refused_paths;
 use fabkit_designs::cut::Operation;
 use fabkit_designs::lasercut::{cut_path, cut_result, tray_sheets, tray_union};
 use fabkit_designs::{library, ChordTolerance, Design, DesignError};
@@ -563,14 +564,6 @@ fn a_level_no_stock_makes_is_said_to_the_micrometre() {
             assert!(wall.rule.contains("makes 0.7 mm"), "{e}");
         }
         other => panic!("{:?}", other.map(|k| k.parts.len())),
-    }
-}
-
-/// The paths a design's errors name, or a panic naming `what` when it builds.
-fn refused_paths(d: &Design, what: &str) -> Vec<String> {
-    match fabkit_designs::build_kit(d, tol()) {
-        Err(DesignError::Params(e)) => e.0.iter().map(|x| x.path.clone()).collect(),
-        other => panic!("{what}: {:?}", other.map(|k| k.design)),
     }
 }
 

@@ -8,22 +8,40 @@ use crate::parts::channels::FlatLayer;
 use crate::parts::check_above_zero;
 use crate::profile::FlatOutline;
 
+/// The rules under one path prefix: [`Rules::check`] pushes the error at `prefix + path` when
+/// its rule fails.
+struct Rules<'a> {
+    prefix: &'static str,
+    errs: &'a mut Vec<ParamError>,
+}
+
+impl Rules<'_> {
+    fn check(&mut self, path: &str, value: f64, ok: bool, text: String) {
+        if !ok {
+            self.errs.push(ParamError::new(
+                format!("{}{path}", self.prefix),
+                value,
+                text,
+            ));
+        }
+    }
+}
+
 /// The rules that need no skin: sizes, and what fits in what.
 pub(super) fn check_sizes(p: &FlatHousingParams, errs: &mut Vec<ParamError>) {
     if check_above_zero("flat_housing.", p, &[], errs) {
         return;
     }
-    let mut rule = |path: &str, value: f64, ok: bool, text: String| {
-        if !ok {
-            errs.push(ParamError::new(format!("flat_housing.{path}"), value, text));
-        }
+    let mut rule = Rules {
+        prefix: "flat_housing.",
+        errs,
     };
     let s = &p.shell;
     let o = &s.outline;
     let short = o.width_mm.min(o.length_mm);
     let mut outline_errs = o.errors("flat_housing.shell.outline.");
     let outline_ok = outline_errs.is_empty();
-    rule(
+    rule.check(
         "shell.wall_mm",
         s.wall_mm,
         2.0 * s.wall_mm < short,
@@ -34,7 +52,7 @@ pub(super) fn check_sizes(p: &FlatHousingParams, errs: &mut Vec<ParamError>) {
     );
     let c = p.chamber();
     let c_short = c.width_mm.min(c.length_mm);
-    rule(
+    rule.check(
         "shell.chamber_corner_radius_mm",
         s.chamber_corner_radius_mm,
         (0.0..c_short / 2.0).contains(&s.chamber_corner_radius_mm) || c_short <= 0.0,
@@ -43,13 +61,13 @@ pub(super) fn check_sizes(p: &FlatHousingParams, errs: &mut Vec<ParamError>) {
             c_short / 2.0
         ),
     );
-    rule(
+    rule.check(
         "shell.chamber_depth_mm",
         s.chamber_depth_mm,
         s.chamber_depth_mm + s.plate_mm < s.height_mm,
         format!("must leave room for the camera pocket: the chamber and the plate ({} mm) below the height ({} mm)", s.chamber_depth_mm + s.plate_mm, s.height_mm),
     );
-    rule(
+    rule.check(
         "shell.collar.inner_mm",
         s.collar.inner_mm,
         s.collar.inner_mm > s.aperture_mm,
@@ -59,13 +77,13 @@ pub(super) fn check_sizes(p: &FlatHousingParams, errs: &mut Vec<ParamError>) {
         ),
     );
     let collar_out = s.collar.inner_mm + 2.0 * s.collar.width_mm;
-    rule(
+    rule.check(
         "shell.collar.width_mm",
         s.collar.width_mm,
         collar_out <= c_short,
         format!("must keep the collar ({collar_out} mm across) within the chamber's shorter side ({c_short} mm)"),
     );
-    rule(
+    rule.check(
         "shell.collar.height_mm",
         s.collar.height_mm,
         s.collar.height_mm < s.chamber_depth_mm,
@@ -81,20 +99,20 @@ pub(super) fn check_sizes(p: &FlatHousingParams, errs: &mut Vec<ParamError>) {
     } else {
         depth
     };
-    rule(
+    rule.check(
         "shell.ceiling_fillet_mm",
         f,
         f >= 0.0 && f < depth && f <= f_max,
         format!("must be 0 or more, below the camera pocket's depth ({depth:.3} mm) and at most the chamber's corner radius ({} mm)", s.chamber_corner_radius_mm),
     );
     let sc = &p.screws;
-    rule(
+    rule.check(
         "screws.insert_depth_mm",
         sc.insert_depth_mm,
         sc.insert_depth_mm <= depth,
         format!("must be at most the camera pocket's depth ({depth:.3} mm): the boss stops at the plate"),
     );
-    rule(
+    rule.check(
         "screws.insert_diameter_mm",
         sc.insert_diameter_mm,
         sc.insert_diameter_mm < 2.0 * s.boss_radius_mm,
@@ -103,7 +121,7 @@ pub(super) fn check_sizes(p: &FlatHousingParams, errs: &mut Vec<ParamError>) {
             2.0 * s.boss_radius_mm
         ),
     );
-    rule(
+    rule.check(
         "screws.counterbore_diameter_mm",
         sc.counterbore_diameter_mm,
         sc.counterbore_diameter_mm > sc.clearance_diameter_mm,
@@ -112,7 +130,7 @@ pub(super) fn check_sizes(p: &FlatHousingParams, errs: &mut Vec<ParamError>) {
             sc.clearance_diameter_mm
         ),
     );
-    rule(
+    rule.check(
         "screws.counterbore_depth_mm",
         sc.counterbore_depth_mm,
         sc.counterbore_depth_mm < p.base.thickness_mm,
@@ -184,30 +202,25 @@ fn holes_within(
 /// The cable slot's rules: within the wall's width and the pocket's depth, its corners
 /// leaving every edge.
 fn check_slot(slot: &CableSlot, chamber: &FlatOutline, depth: f64, errs: &mut Vec<ParamError>) {
-    let mut rule = |path: &str, value: f64, ok: bool, text: String| {
-        if !ok {
-            errs.push(ParamError::new(
-                format!("flat_housing.shell.cable_slot.{path}"),
-                value,
-                text,
-            ));
-        }
+    let mut rule = Rules {
+        prefix: "flat_housing.shell.cable_slot.",
+        errs,
     };
     let free = chamber.width_mm - 2.0 * chamber.corner_radius_mm;
-    rule(
+    rule.check(
         "width_mm",
         slot.width_mm,
         slot.width_mm < free,
         format!("must lie in the straight of the +y wall: below {free} mm"),
     );
-    rule(
+    rule.check(
         "above_bottom_mm",
         slot.above_bottom_mm,
         slot.above_bottom_mm >= 0.0 && slot.above_bottom_mm + slot.height_mm <= depth,
         format!("must be 0 or more, the slot's top ({} mm above the bottom) at most the camera pocket's depth ({depth:.3} mm)", slot.above_bottom_mm + slot.height_mm),
     );
     let c = slot.chamfer_mm;
-    rule(
+    rule.check(
         "chamfer_mm",
         c,
         c >= 0.0 && c < slot.height_mm && 2.0 * c < slot.width_mm,
@@ -223,7 +236,7 @@ fn check_slot(slot: &CableSlot, chamber: &FlatOutline, depth: f64, errs: &mut Ve
     } else {
         0.5 * slot.height_mm.min(slot.width_mm)
     };
-    rule(
+    rule.check(
         "corner_radius_mm",
         slot.corner_radius_mm,
         slot.corner_radius_mm >= 0.0 && slot.corner_radius_mm <= r_max,
@@ -237,29 +250,24 @@ fn check_slot(slot: &CableSlot, chamber: &FlatOutline, depth: f64, errs: &mut Ve
 fn check_base(p: &FlatHousingParams, errs: &mut Vec<ParamError>) {
     let t = p.base.thickness_mm;
     let o = &p.shell.outline;
-    let mut rule = |path: &str, value: f64, ok: bool, text: String| {
-        if !ok {
-            errs.push(ParamError::new(
-                format!("flat_housing.base.{path}"),
-                value,
-                text,
-            ));
-        }
+    let mut rule = Rules {
+        prefix: "flat_housing.base.",
+        errs,
     };
     if let Some(b) = &p.base.camera_bosses {
-        rule(
+        rule.check(
             "camera_bosses.hole_diameter_mm",
             b.hole_diameter_mm,
             b.hole_diameter_mm < b.diameter_mm,
             format!("must be below the boss's diameter ({} mm)", b.diameter_mm),
         );
-        rule(
+        rule.check(
             "camera_bosses.hole_floor_mm",
             b.hole_floor_mm,
             b.hole_floor_mm < t,
             format!("must be below the base's thickness ({t} mm)"),
         );
-        rule(
+        rule.check(
             "camera_bosses.through_diameter_mm",
             b.through_diameter_mm,
             b.through_diameter_mm <= b.hole_diameter_mm,
@@ -270,14 +278,14 @@ fn check_base(p: &FlatHousingParams, errs: &mut Vec<ParamError>) {
         );
     }
     if let Some(q) = &p.base.posts {
-        rule(
+        rule.check(
             "posts.pin_diameter_mm",
             q.pin_diameter_mm,
             q.pin_diameter_mm < q.diameter_mm,
             format!("must be below the post's diameter ({} mm)", q.diameter_mm),
         );
         let f_max = (q.pin_diameter_mm / 2.0).min(q.pin_height_mm);
-        rule(
+        rule.check(
             "posts.pin_fillet_mm",
             q.pin_fillet_mm,
             q.pin_fillet_mm >= 0.0 && q.pin_fillet_mm < f_max,
@@ -285,13 +293,13 @@ fn check_base(p: &FlatHousingParams, errs: &mut Vec<ParamError>) {
         );
     }
     if let Some(k) = &p.base.camera_pocket {
-        rule(
+        rule.check(
             "camera_pocket.depth_mm",
             k.depth_mm,
             k.depth_mm < t,
             format!("must be below the base's thickness ({t} mm)"),
         );
-        rule(
+        rule.check(
             "camera_pocket.width_mm",
             k.width_mm,
             k.width_mm < o.width_mm - 2.0 * o.corner_radius_mm,
@@ -301,7 +309,7 @@ fn check_base(p: &FlatHousingParams, errs: &mut Vec<ParamError>) {
             ),
         );
         let edge = o.length_mm / 2.0;
-        rule(
+        rule.check(
             "camera_pocket.y_mm[1]",
             k.y_mm[1],
             k.y_mm[1] > k.y_mm[0] && k.y_mm[0] > -edge && k.y_mm[1] < edge,
@@ -319,23 +327,18 @@ fn check_base(p: &FlatHousingParams, errs: &mut Vec<ParamError>) {
 /// The cable channel's rules: its width within the pocket's, its ramp between the pocket's far
 /// end and the edge, with room for a straight between the two arcs.
 fn check_channel(k: &CameraPocket, ch: &CableChannel, edge: f64, errs: &mut Vec<ParamError>) {
-    let mut rule = |path: &str, value: f64, ok: bool, text: String| {
-        if !ok {
-            errs.push(ParamError::new(
-                format!("flat_housing.base.camera_pocket.channel.{path}"),
-                value,
-                text,
-            ));
-        }
+    let mut rule = Rules {
+        prefix: "flat_housing.base.camera_pocket.channel.",
+        errs,
     };
-    rule(
+    rule.check(
         "width_mm",
         ch.width_mm,
         ch.width_mm <= k.width_mm,
         format!("must be at most the pocket's width ({} mm)", k.width_mm),
     );
     let r_max = (k.width_mm - ch.width_mm) / 2.0;
-    rule(
+    rule.check(
         "corner_radius_mm",
         ch.corner_radius_mm,
         ch.corner_radius_mm >= 0.0 && ch.corner_radius_mm <= r_max,
@@ -343,14 +346,14 @@ fn check_channel(k: &CameraPocket, ch: &CableChannel, edge: f64, errs: &mut Vec<
             "must be 0 or more and at most half the pocket's width less the channel's ({r_max} mm)"
         ),
     );
-    rule(
+    rule.check(
         "exit_depth_mm",
         ch.exit_depth_mm,
         ch.exit_depth_mm < k.depth_mm,
         format!("must be below the pocket's depth ({} mm)", k.depth_mm),
     );
     let [y0, y1] = ch.ramp_y_mm;
-    rule(
+    rule.check(
         "ramp_y_mm[0]",
         y0,
         y0 >= k.y_mm[1] + ch.corner_radius_mm && y1 > y0 && y1 < edge,
@@ -358,7 +361,7 @@ fn check_channel(k: &CameraPocket, ch: &CableChannel, edge: f64, errs: &mut Vec<
     );
     let [r1, r2] = ch.ramp_radii_mm;
     for (i, r) in [r1, r2].into_iter().enumerate() {
-        rule(
+        rule.check(
             &format!("ramp_radii_mm[{i}]"),
             r,
             r > 0.0 && r.is_finite(),
@@ -369,7 +372,7 @@ fn check_channel(k: &CameraPocket, ch: &CableChannel, edge: f64, errs: &mut Vec<
     let (dy, dz) = (y1 - y0, rise - r1 - r2);
     let d = dy.hypot(dz);
     let rising = d > r1 + r2 && dz.atan2(dy) + ((r1 + r2) / d).asin() < std::f64::consts::FRAC_PI_2;
-    rule(
+    rule.check(
         "ramp_radii_mm[0]",
         r1,
         !(r1 > 0.0 && r2 > 0.0) || rising,
@@ -381,29 +384,24 @@ fn check_channel(k: &CameraPocket, ch: &CableChannel, edge: f64, errs: &mut Vec<
 fn check_ring(p: &FlatHousingParams, r: &IsolationRing, errs: &mut Vec<ParamError>) {
     let a = p.shell.aperture_mm;
     let h = p.shell.plate_mm + p.shell.collar.height_mm;
-    let mut rule = |path: &str, value: f64, ok: bool, text: String| {
-        if !ok {
-            errs.push(ParamError::new(
-                format!("flat_housing.isolation_ring.{path}"),
-                value,
-                text,
-            ));
-        }
+    let mut rule = Rules {
+        prefix: "flat_housing.isolation_ring.",
+        errs,
     };
-    rule(
+    rule.check(
         "outer_mm",
         r.outer_mm,
         r.outer_mm <= a,
         format!("must fit the aperture: at most {a} mm"),
     );
-    rule(
+    rule.check(
         "bore_diameter_mm",
         r.bore_diameter_mm,
         r.bore_diameter_mm < r.outer_mm,
         format!("must be below the outer side ({} mm)", r.outer_mm),
     );
     let c_max = ((r.outer_mm - r.bore_diameter_mm) / 2.0).min(h);
-    rule(
+    rule.check(
         "countersink_mm",
         r.countersink_mm,
         r.countersink_mm >= 0.0 && r.countersink_mm <= c_max && r.countersink_mm < h,
