@@ -9,6 +9,7 @@
 // Negated comparisons (`!(x > 0.0)`) are deliberate: they also reject NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)]
 
+pub mod board;
 pub mod camera;
 pub mod camera_file;
 pub mod capture_images;

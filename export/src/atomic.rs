@@ -49,6 +49,8 @@ pub enum OutputCommand {
     CalibrateExtrinsics,
     /// `fabkit calibrate photometric`.
     CalibratePhotometric,
+    /// `fabkit calibrate board`.
+    CalibrateBoard,
     /// One variant's folder of `fabkit sweep` (`variants/<id>/`).
     SweepVariant,
 }
@@ -63,6 +65,7 @@ impl OutputCommand {
             OutputCommand::Groundtruth => "groundtruth",
             OutputCommand::CalibrateExtrinsics => "calibrate extrinsics",
             OutputCommand::CalibratePhotometric => "calibrate photometric",
+            OutputCommand::CalibrateBoard => "calibrate board",
             OutputCommand::SweepVariant => "sweep",
         }
     }

@@ -20,6 +20,50 @@ pub enum CalibrateCommand {
     /// Fit the sensor's photometric model (how its images respond to the skin's normal) from
     /// pin captures whose pose is solved.
     Photometric(crate::photometric_cmd::PhotometricArgs),
+    /// Calibrate a flat sensor's camera from one press of its calibration board: the bumps'
+    /// imprints found against the reference, each given its grid id, the camera model (the
+    /// distortion, its centre and the plane's pose; the focal length held, as one plane seen
+    /// square on shows it only over the plane's distance) and the map from pixels to the
+    /// skin's plane.
+    Board(BoardArgs),
+}
+
+#[derive(clap::Args, Debug)]
+pub struct BoardArgs {
+    /// The board's point table: points/board_table.csv of `fabkit fixtures`, or a CSV with
+    /// id,x_mm,y_mm,z_mm (sensor frame, mm) on one plane of constant z, filling a grid of one
+    /// pitch along x and y
+    #[arg(long, value_name = "BOARD_TABLE.csv")]
+    pub points: PathBuf,
+    /// Which columns of a fixtures point table give the plane: the skin's face where the
+    /// board's floor meets it (contact), or the bumps' tips (tip)
+    #[arg(long, value_enum, default_value = "contact")]
+    pub points_from: PointsFromArg,
+    /// Reference image of the skin with no contact (PNG or JPEG)
+    #[arg(long, value_name = "REF.png")]
+    pub reference: PathBuf,
+    /// The board pressed in: same camera, lighting and size as --reference
+    #[arg(long, value_name = "PRESS.png")]
+    pub image: PathBuf,
+    /// The plane's distance from the lens's centre of projection, in air (each solid layer's
+    /// thickness over its refractive index), mm: the focal length is held at this times the
+    /// scale the press shows. Default: from the design's flat housing (--design, or the design
+    /// the point table was made for), the lens taken at the shell plate's underside
+    #[arg(long, value_name = "MM")]
+    pub plane_distance_mm: Option<f64>,
+    /// The sensor's design (a YAML file or a library name), for --plane-distance-mm
+    #[arg(long, value_name = "DESIGN")]
+    pub design: Option<String>,
+    /// Output folder for extrinsics.json, extrinsics.yaml, camera.yaml (OpenCV), camera_info.yaml
+    /// (ROS), camera.json, observations.csv, pixel_to_plane_mm.npy and overlay.png: missing,
+    /// empty, or an earlier calibration of the same inputs as fabkit wrote it
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Replace an earlier board calibration in --out computed from other inputs
+    #[arg(long)]
+    pub force: bool,
+    #[command(flatten)]
+    pub(crate) data_files: crate::args::DataFileArgs,
 }
 
 /// Which point of the fixtures point table the pins touch.
@@ -126,7 +170,95 @@ pub fn run(cmd: CalibrateCommand) -> Result<(), Box<dyn Error>> {
     match cmd {
         CalibrateCommand::Extrinsics(a) => extrinsics(a),
         CalibrateCommand::Photometric(a) => crate::photometric_cmd::run(a),
+        CalibrateCommand::Board(a) => board(a),
     }
+}
+
+fn board(a: BoardArgs) -> Result<(), Box<dyn Error>> {
+    use fabkit_calibration::board::{calibrate_board, plane_distance_of_design, BoardJob};
+    let (plane_distance_mm, plane_distance_from) = match (a.plane_distance_mm, &a.design) {
+        (Some(d), _) => (d, "--plane-distance-mm".to_string()),
+        (None, given) => {
+            let arg = match given {
+                Some(d) => d.clone(),
+                None => provenance_design(&a.points).map(|(_, arg, _)| arg).ok_or_else(|| {
+                    format!(
+                        "--plane-distance-mm: not given, and no design to take it from: give it, or --design (the point table {} names none)",
+                        a.points.display()
+                    )
+                })?,
+            };
+            let loaded = crate::args::load_design(Some(&arg), &a.data_files)?;
+            let materials = fabkit_designs::materials::MaterialsTable::embedded()?;
+            plane_distance_of_design(&loaded.design, &materials).ok_or_else(|| {
+                format!(
+                    "--plane-distance-mm: not given, and the design {arg} has no flat_housing to take it from: give it"
+                )
+            })?
+        }
+    };
+    let claim = OutputClaim::of_inputs(
+        OutputCommand::CalibrateBoard,
+        "a board press",
+        &[a.points.as_path(), a.reference.as_path(), a.image.as_path()],
+        a.force,
+    );
+    let job = BoardJob {
+        points: a.points,
+        points_from: match a.points_from {
+            PointsFromArg::Tip => PointsFrom::Tip,
+            PointsFromArg::Contact => PointsFrom::Contact,
+        },
+        reference: a.reference,
+        image: a.image,
+        plane_distance_mm,
+        plane_distance_from,
+        command_line: std::env::args().collect::<Vec<_>>().join(" "),
+    };
+    let staged = StagedDir::new(&a.out, claim)?;
+    let out = calibrate_board(&job)?;
+    for (name, bytes) in &out.files {
+        staged.write(name, bytes)?;
+    }
+    let warnings = staged.commit()?;
+    let r = &out.report;
+    println!(
+        "board: {} of {} bumps found ({} spots; {} missing, {} taken for no bump)",
+        r.found,
+        r.grid.rows * r.grid.columns,
+        r.spots,
+        r.missing_ids.len(),
+        r.extra_spots.len()
+    );
+    for n in &r.notes {
+        println!("note: {n}");
+    }
+    println!(
+        "camera: RMS reprojection error {:.3} px, worst {:.3} px (id {}); plane {:.3} mm away ({})",
+        r.rms_reprojection_error_px,
+        r.worst_px,
+        r.worst_id,
+        r.plane_distance_mm,
+        r.plane_distance_from
+    );
+    for p in &r.parameters {
+        match (&p.held, p.std) {
+            (None, Some(sd)) => println!("  {} = {:.6} +- {:.6}", p.name, p.value, sd),
+            (Some(why), _) => println!("  {} = {:.6} held: {why}", p.name, p.value),
+            (None, None) => println!("  {} = {:.6}", p.name, p.value),
+        }
+    }
+    if let (Some(s), Some(n)) = (r.mm_per_px_at_centre, r.mm_per_px_neighbours) {
+        println!(
+            "scale at the centre bump {} ({:.1}, {:.1}) px: {s:.5} mm per px ({n:.5} from its four neighbours' distances)",
+            r.centre_bump_id, r.centre_bump_px[0], r.centre_bump_px[1]
+        );
+    }
+    println!("wrote {}", a.out.display());
+    for w in &warnings {
+        eprintln!("warning: {w}");
+    }
+    Ok(())
 }
 
 fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
@@ -412,26 +544,34 @@ fn plane_names(path: &fabkit_designs::optics::OpticalPath) -> Vec<&str> {
         .collect()
 }
 
+/// The design a point table's sidecar (`<table>.json`, as `fabkit fixtures` writes it) names in
+/// its provenance (`fabkit V, design NAME (SOURCE, sha256 H)`): its name, the `--design`
+/// argument that loads it (the library name for an embedded one) and its sha256.
+fn provenance_design(points: &std::path::Path) -> Option<(String, String, String)> {
+    let side = points.with_extension("json");
+    let prov = std::fs::read(&side)
+        .ok()
+        .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
+        .and_then(|v| v.get("provenance")?.as_str().map(str::to_string))?;
+    let (name, inside) = prov.split_once(", design ")?.1.split_once(" (")?;
+    let (source, rest) = inside.split_once(", sha256 ")?;
+    let arg = source.strip_prefix("embedded:").unwrap_or(source);
+    Some((
+        name.to_string(),
+        arg.to_string(),
+        rest.trim_end_matches(')').to_string(),
+    ))
+}
+
 /// [`TableDesign`] of the point table `points`. The design is used only when it reads as it
 /// did when the table was written (the same sha256) and its presets, which the provenance does
 /// not record, leave its optical path as it is.
 fn table_design(points: &std::path::Path, data: &crate::args::DataFileArgs) -> TableDesign {
     let side = points.with_extension("json");
-    let Some(prov) = std::fs::read(&side)
-        .ok()
-        .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
-        .and_then(|v| v.get("provenance")?.as_str().map(str::to_string))
-    else {
+    let Some((name, arg, sha)) = provenance_design(points) else {
         return TableDesign::Unknown;
     };
-    let Some((name, source, sha)) = (|| {
-        let (name, inside) = prov.split_once(", design ")?.1.split_once(" (")?;
-        let (source, rest) = inside.split_once(", sha256 ")?;
-        Some((name, source, rest.trim_end_matches(')')))
-    })() else {
-        return TableDesign::Unknown;
-    };
-    let arg = source.strip_prefix("embedded:").unwrap_or(source);
+    let (name, arg, sha) = (name.as_str(), arg.as_str(), sha.as_str());
     let Ok(tol) = fabkit_designs::ChordTolerance::new(fabkit_designs::ChordTolerance::DEFAULT_MM)
     else {
         return TableDesign::Unknown;

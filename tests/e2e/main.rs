@@ -7,6 +7,7 @@ mod common;
 mod assembly_step;
 mod authors_cad;
 mod byte_identical;
+mod calibrate_board;
 mod calibrate_cli;
 mod calibrate_images;
 mod calibrate_opencv;

@@ -1,5 +1,6 @@
 //! The calibration crate's integration tests, one binary (one link) with a module per area.
 
+mod board;
 mod camera_files;
 mod camera_models;
 mod common;

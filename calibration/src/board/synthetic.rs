@@ -1,0 +1,1 @@
+//! Synthetic board presses for the tests.

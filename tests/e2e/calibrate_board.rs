@@ -1,0 +1,193 @@
+//! `fabkit calibrate board` on the real 9DTact board press (tests/data/9dtact_sensor1): the
+//! board's point table from `fabkit fixtures ninedtact`, the camera solved with default options,
+//! its files read back by OpenCV and numpy (tests/oracles/board_check.py); bad input refused
+//! by option with nothing written.
+
+use crate::common::{missing, oracle_python, repo_root, run, text};
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+
+fn press(name: &str) -> PathBuf {
+    repo_root()
+        .join("tests/data/9dtact_sensor1/camera_calibration")
+        .join(name)
+}
+
+/// `fabkit fixtures ninedtact` in `dir`: the board's point table (with the sidecar that names
+/// the design).
+fn board_table(dir: &Path) -> PathBuf {
+    let o = run(dir, &["fixtures", "ninedtact", "--out", "fx"], &[]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    dir.join("fx/points/board_table.csv")
+}
+
+/// Default options on the real press: 63 of 63 bumps; the RMS reprojection error at most
+/// 1.3 px (1.16 measured; the centres scatter about 0.85 px about any smooth lens model, see
+/// calibration/tests/it/board.rs); the authors' scale (the pitch over the centre bump's mean
+/// distance to its four neighbours) within 1.5 % of their 0.05102 mm per px; the plane's
+/// distance from the design's housing (11.548 mm: 2.8 mm of air, the 10.4 mm window over
+/// n = 1.491, the 2.5 mm translucent gel over 1.41, up to the opaque black gel). OpenCV's
+/// projectPoints with the written camera.yaml and the pose puts every bump where fabkit's
+/// report does (1e-6 px), and the pixel-to-plane map numpy reads is 480 x 640 x 2 float32,
+/// finite, and takes the bumps' pixels to their points within their scatter (0.1 mm RMS).
+#[test]
+fn the_real_board_press_calibrates_the_9dtact_camera() {
+    let tmp = tempfile::tempdir().unwrap();
+    let table = board_table(tmp.path());
+    let o = run(
+        tmp.path(),
+        &[
+            "calibrate",
+            "board",
+            "--points",
+            table.to_str().unwrap(),
+            "--reference",
+            press("ref.png").to_str().unwrap(),
+            "--image",
+            press("sample.png").to_str().unwrap(),
+            "--out",
+            "cal",
+        ],
+        &[],
+    );
+    let out = text(&o.stdout);
+    assert!(o.status.success(), "{out}\n{}", text(&o.stderr));
+    assert!(out.contains("63 of 63 bumps found"), "{out}");
+    let dir = tmp.path().join("cal");
+    let r: Value =
+        serde_json::from_slice(&std::fs::read(dir.join("extrinsics.json")).unwrap()).unwrap();
+    assert_eq!(r["found"], 63);
+    assert_eq!(r["missing_ids"].as_array().unwrap().len(), 0);
+    let rms = r["rms_reprojection_error_px"].as_f64().unwrap();
+    assert!(rms < 1.3, "RMS {rms} px");
+    let scale = r["mm_per_px_neighbours"].as_f64().unwrap();
+    assert!(
+        (scale / 0.0510150969 - 1.0).abs() < 0.015,
+        "{scale} mm per px"
+    );
+    let d = r["plane_distance_mm"].as_f64().unwrap();
+    let want = 2.8 + 10.4 / 1.491 + 2.5 / 1.41;
+    assert!((d - want).abs() < 1e-9, "{d} against {want}");
+    assert!(r["plane_distance_from"]
+        .as_str()
+        .unwrap()
+        .contains("black_gel"));
+    for f in [
+        "camera.yaml",
+        "camera_info.yaml",
+        "camera.json",
+        "extrinsics.yaml",
+        "observations.csv",
+        "overlay.png",
+    ] {
+        assert!(dir.join(f).is_file(), "{f}");
+    }
+    let Some(py) = oracle_python() else {
+        return missing("the oracle python (opencv-python-headless, numpy)");
+    };
+    let o = std::process::Command::new(py)
+        .arg(repo_root().join("tests/oracles/board_check.py"))
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let c: Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(c["projection_max_diff_px"].as_f64().unwrap() < 1e-6, "{c}");
+    assert_eq!(c["map_shape"], serde_json::json!([480, 640, 2]), "{c}");
+    assert_eq!(c["map_dtype"], "float32");
+    assert_eq!(c["map_finite"], true);
+    assert!(c["map_at_bumps_rms_mm"].as_f64().unwrap() < 0.1, "{c}");
+}
+
+/// Bad input is refused naming the option and the file, and nothing is written under --out: a
+/// press of another size than its reference, a table whose points are not a grid, a press
+/// with no imprint (the reference itself), a plane distance that is not positive, and no
+/// plane distance with no design to take it from.
+#[test]
+fn bad_board_presses_are_refused_by_option_with_nothing_written() {
+    let tmp = tempfile::tempdir().unwrap();
+    let table = board_table(tmp.path());
+    let small = tmp.path().join("small.png");
+    image::open(press("sample.png"))
+        .unwrap()
+        .crop_imm(0, 0, 320, 240)
+        .save(&small)
+        .unwrap();
+    let not_grid = tmp.path().join("not_grid.csv");
+    std::fs::write(
+        &not_grid,
+        "id,x_mm,y_mm,z_mm\n1,0,0,2.8\n2,2.5,0,2.8\n3,0,2.5,2.8\n4,3,2.5,2.8\n",
+    )
+    .unwrap();
+    let plain = tmp.path().join("plain.csv");
+    let t = std::fs::read_to_string(&table).unwrap();
+    let mut rows = String::from("id,x_mm,y_mm,z_mm\n");
+    for l in t.lines().skip(1) {
+        let c: Vec<&str> = l.split(',').collect();
+        rows += &format!("{},{},{},{}\n", c[0], c[5], c[6], c[7]);
+    }
+    std::fs::write(&plain, rows).unwrap();
+    let (tab, pl, sm, ng) = (
+        table.to_str().unwrap(),
+        plain.to_str().unwrap(),
+        small.to_str().unwrap(),
+        not_grid.to_str().unwrap(),
+    );
+    let (r, s) = (press("ref.png"), press("sample.png"));
+    let (r, s) = (r.to_str().unwrap(), s.to_str().unwrap());
+    let cases: [(&[&str], &str); 5] = [
+        (
+            &["--points", tab, "--reference", r, "--image", sm],
+            "--image",
+        ),
+        (
+            &[
+                "--points",
+                ng,
+                "--reference",
+                r,
+                "--image",
+                s,
+                "--plane-distance-mm",
+                "12",
+            ],
+            "--points",
+        ),
+        (
+            &["--points", tab, "--reference", r, "--image", r],
+            "--image",
+        ),
+        (
+            &[
+                "--points",
+                tab,
+                "--reference",
+                r,
+                "--image",
+                s,
+                "--plane-distance-mm=-1",
+            ],
+            "--plane-distance-mm",
+        ),
+        (
+            &["--points", pl, "--reference", r, "--image", s],
+            "--plane-distance-mm",
+        ),
+    ];
+    for (k, (args, option)) in cases.iter().enumerate() {
+        let out = format!("out{k}");
+        let mut a = vec!["calibrate", "board", "--out", &out];
+        a.extend_from_slice(args);
+        let o = run(tmp.path(), &a, &[]);
+        let err = text(&o.stderr);
+        assert!(!o.status.success(), "case {k} ran");
+        assert!(err.contains(option), "case {k}: {err}");
+        assert!(!tmp.path().join(&out).exists(), "case {k} wrote {out}");
+        let leftovers: Vec<_> = std::fs::read_dir(tmp.path())
+            .unwrap()
+            .filter_map(|e| e.ok())
+            .filter(|e| e.file_name().to_string_lossy().contains(&out))
+            .collect();
+        assert!(leftovers.is_empty(), "case {k}: {leftovers:?}");
+    }
+}
