@@ -21,6 +21,7 @@ pub mod overlay;
 pub mod p3p;
 pub mod photometric;
 pub mod pnp;
+pub mod press;
 pub mod refine;
 pub mod refraction;
 pub mod report;

@@ -10,6 +10,7 @@ mod groundtruth_undistort;
 mod images_library;
 mod imprints;
 mod photometric;
+mod press;
 mod refine;
 mod refraction;
 mod shading;
