@@ -613,6 +613,7 @@ pub struct BoardReport {
     /// T_cam_sensor: rotation vector, rad, translation, mm, and the 4 x 4 matrix (row-major).
     pub rvec: [f64; 3],
     pub tvec_mm: [f64; 3],
+    #[serde(rename = "T_cam_sensor")]
     pub t_cam_sensor: [[f64; 4]; 4],
     /// Standard deviations of the pose: rotation about the camera's x, y, z, deg; translation
     /// along them, mm.
