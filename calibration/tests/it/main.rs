@@ -1,6 +1,7 @@
 //! The calibration crate's integration tests, one binary (one link) with a module per area.
 
 mod board;
+mod board_synthetic;
 mod camera_files;
 mod camera_models;
 mod common;
