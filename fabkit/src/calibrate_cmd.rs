@@ -20,11 +20,11 @@ pub enum CalibrateCommand {
     /// Fit the sensor's photometric model (how its images respond to the skin's normal) from
     /// pin captures whose pose is solved.
     Photometric(crate::photometric_cmd::PhotometricArgs),
-    /// Calibrate a flat sensor's camera from one press of its calibration board: the bumps'
-    /// imprints found against the reference, each given its grid id, the camera model (the
-    /// distortion, its centre and the plane's pose; the focal length held, as one plane seen
-    /// square on shows it only over the plane's distance) and the map from pixels to the
-    /// skin's plane.
+    /// Calibrate a flat sensor's camera from one press of its calibration board (or a grid
+    /// plate pressed over several captures): the bumps' imprints found against the reference,
+    /// each given its grid id, the camera model (the distortion, its centre and the plane's
+    /// pose; the focal length held, as one plane seen square on shows it only over the
+    /// plane's distance) and the map from pixels to the skin's plane.
     Board(BoardArgs),
 }
 
@@ -42,9 +42,17 @@ pub struct BoardArgs {
     /// Reference image of the skin with no contact (PNG or JPEG)
     #[arg(long, value_name = "REF.png")]
     pub reference: PathBuf,
-    /// The board pressed in: same camera, lighting and size as --reference
-    #[arg(long, value_name = "PRESS.png")]
-    pub image: PathBuf,
+    /// The board pressed in, in one capture or over several (each pressing some of its bumps or
+    /// pins, like a grid plate's): same camera, lighting and size as --reference. The
+    /// imprints of all captures form one lattice; a bump seen in several is solved at the
+    /// mean of its pixels
+    #[arg(long, visible_alias = "images", value_name = "PRESS.png", num_args = 1.., required = true)]
+    pub image: Vec<PathBuf>,
+    /// Which ids each capture presses (points/capture_plan.csv of `fabkit fixtures`), one
+    /// --image per capture in the plan's order: a spot at a place its capture does not press
+    /// is left out, and a planned id without a spot is reported missing
+    #[arg(long, value_name = "PLAN.csv")]
+    pub capture_plan: Option<PathBuf>,
     /// The plane's distance from the lens's centre of projection, in air (each solid layer's
     /// thickness over its refractive index), mm: the focal length is held at this times the
     /// scale the press shows. Default: from the design's flat housing (--design, or the design
@@ -197,10 +205,15 @@ fn board(a: BoardArgs) -> Result<(), Box<dyn Error>> {
             })?
         }
     };
+    let inputs: Vec<&std::path::Path> = [a.points.as_path(), a.reference.as_path()]
+        .into_iter()
+        .chain(a.image.iter().map(PathBuf::as_path))
+        .chain(a.capture_plan.as_deref())
+        .collect();
     let claim = OutputClaim::of_inputs(
         OutputCommand::CalibrateBoard,
         "a board press",
-        &[a.points.as_path(), a.reference.as_path(), a.image.as_path()],
+        &inputs,
         a.force,
     );
     let job = BoardJob {
@@ -210,7 +223,8 @@ fn board(a: BoardArgs) -> Result<(), Box<dyn Error>> {
             PointsFromArg::Contact => PointsFrom::Contact,
         },
         reference: a.reference,
-        image: a.image,
+        images: a.image,
+        capture_plan: a.capture_plan,
         plane_distance_mm,
         plane_distance_from,
         command_line: std::env::args().collect::<Vec<_>>().join(" "),
@@ -232,6 +246,25 @@ fn board(a: BoardArgs) -> Result<(), Box<dyn Error>> {
     );
     for n in &r.notes {
         println!("note: {n}");
+    }
+    if r.captures.len() > 1 {
+        for c in &r.captures {
+            let missing = if c.missing_planned_ids.is_empty() {
+                String::new()
+            } else {
+                format!(
+                    "; planned but not found: {}",
+                    c.missing_planned_ids.join(" ")
+                )
+            };
+            println!(
+                "  capture {} ({}): {} bumps found, {} spot(s) left out{missing}",
+                c.capture,
+                c.image,
+                c.found.len(),
+                c.extra.len()
+            );
+        }
     }
     println!(
         "camera: RMS reprojection error {:.3} px, worst {:.3} px (id {}); plane {:.3} mm away ({})",

@@ -31,8 +31,8 @@ enum Command {
     /// Camera calibration: extrinsics from pin-dome observations.
     #[command(subcommand)]
     Calibrate(crate::calibrate_cmd::CalibrateCommand),
-    /// Ground-truth depth maps of the protrusion semi-domes (or the pin dome's captures) through
-    /// the calibrated camera.
+    /// Ground-truth depth maps of the protrusion semi-domes (or the pin dome's captures, or a
+    /// real press of a sphere fitted in its capture) through the calibrated camera.
     Groundtruth(crate::groundtruth_cmd::GroundTruthArgs),
     /// Build and measure many variants of a design over a parameter grid (results table).
     Sweep(crate::sweep_cmd::SweepArgs),

@@ -17,6 +17,7 @@ use fabkit_calibration::groundtruth::inputs::{
     read_extrinsics, read_fixtures, read_with_hash, Fixtures,
 };
 use fabkit_calibration::groundtruth::pins::read_pin_captures;
+use fabkit_calibration::groundtruth::press::{self, Press, PressInputError, PressJob};
 use fabkit_calibration::groundtruth::rays::PixelRays;
 use fabkit_calibration::groundtruth::shading::Imaging;
 use fabkit_calibration::groundtruth::surface::ReferenceSurface;
@@ -38,19 +39,40 @@ pub struct GroundTruthArgs {
     #[arg(long, value_name = "extrinsics.json")]
     extrinsics: PathBuf,
     /// Output folder of `fabkit fixtures` (reads protrusions/index.json and the pattern files;
-    /// with --pin-captures the pin dome's points/ and manifest.json).
-    #[arg(long, value_name = "FIXTURES_DIR")]
-    fixtures: PathBuf,
+    /// with --pin-captures the pin dome's points/ and manifest.json). Not with --press-image.
+    #[arg(
+        long,
+        value_name = "FIXTURES_DIR",
+        required_unless_present = "press_image",
+        conflicts_with = "press_image"
+    )]
+    fixtures: Option<PathBuf>,
     /// Render the pin dome's captures instead of the protrusion patterns: one frame per capture
     /// of points/capture_plan.csv with its pins pressed in (tips and axes from
     /// points/point_table.csv, the pin's tip, cone and shaft from manifest.json), each folder
     /// named by its pins (`01_02_06_14_22`) as `fabkit calibrate images` and `calibrate
     /// photometric` read a capture's file name. With --images: synthetic pin captures.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "press_image")]
     pin_captures: bool,
+    /// Render a real press instead of fixtures: a capture of a sphere (--sphere-radius-mm)
+    /// pressed into the design's flat skin, taken by the calibrated camera (PNG or JPEG of its
+    /// size). The sphere's centre over the contact face and its depth are fitted against
+    /// --press-reference and printed with their standard deviations; one frame, `press/`, is
+    /// rendered with the sphere placed there, beside a copy of the capture (`capture.png`),
+    /// and the fit is written to press.json.
+    #[arg(long, value_name = "IMAGE", requires_all = ["press_reference", "sphere_radius_mm"])]
+    press_image: Option<PathBuf>,
+    /// With --press-image: the same camera's capture of the unpressed skin, under the same
+    /// lighting (copied to `reference/capture.png`).
+    #[arg(long, value_name = "IMAGE", requires = "press_image")]
+    press_reference: Option<PathBuf>,
+    /// With --press-image: the pressed sphere's radius, mm (above 0, at most 1000).
+    #[arg(long, value_name = "MM", requires = "press_image", value_parser = parse_radius_mm,
+          allow_negative_numbers = true)]
+    sphere_radius_mm: Option<f64>,
     /// Output folder. Replaced as a whole if it holds earlier ground truth of the same inputs
-    /// (design, camera, extrinsics, fixtures) as fabkit wrote it; refused if it holds anything
-    /// else.
+    /// (design, camera, extrinsics, fixtures; or the press's captures and sphere radius) as
+    /// fabkit wrote it; refused if it holds anything else.
     #[arg(long, value_name = "DIR")]
     out: PathBuf,
     /// Replace earlier ground truth in --out computed from other inputs; without it that
@@ -122,6 +144,16 @@ fn parse_max_output_bytes(s: &str) -> Result<u64, String> {
         Ok(n) if (1..=MAX_OUTPUT_BYTES_LIMIT).contains(&n) => Ok(n),
         _ => Err(format!(
             "must be a whole number of bytes from 1 to {MAX_OUTPUT_BYTES_LIMIT} (10^15)"
+        )),
+    }
+}
+
+fn parse_radius_mm(s: &str) -> Result<f64, String> {
+    let max = fabkit_designs::values::MAX_LENGTH_MM;
+    match s.trim().parse::<f64>() {
+        Ok(r) if r > 0.0 && r <= max => Ok(r),
+        _ => Err(format!(
+            "must be a finite length above 0 mm, at most {max} mm (the sphere's radius)"
         )),
     }
 }
@@ -231,29 +263,63 @@ pub fn check_skin_seen(
     ))
 }
 
-/// The claim on --out ([`dataset::claim`]).
-fn claim(args: &GroundTruthArgs) -> OutputClaim {
-    dataset::claim(
+/// The press of --press-image: (capture, reference, sphere radius mm); `None` without it.
+fn press_of(args: &GroundTruthArgs) -> Option<(&Path, &Path, f64)> {
+    match (
+        &args.press_image,
+        &args.press_reference,
+        args.sphere_radius_mm,
+    ) {
+        (Some(image), Some(reference), Some(r)) => Some((image, reference, r)),
+        _ => None,
+    }
+}
+
+/// --fixtures, which every mode but --press-image needs.
+fn fixtures_dir(args: &GroundTruthArgs) -> Result<&Path, String> {
+    args.fixtures.as_deref().ok_or_else(|| {
+        "--fixtures: required (the output folder of `fabkit fixtures`), unless --press-image, --press-reference and --sphere-radius-mm give a real press".to_string()
+    })
+}
+
+/// The claim on --out ([`dataset::claim`], or [`press::claim`] with --press-image).
+fn claim(args: &GroundTruthArgs) -> Result<OutputClaim, String> {
+    let design = args
+        .design
+        .as_deref()
+        .unwrap_or(fabkit_designs::library::DEFAULT_DESIGN);
+    if let Some((capture, reference, radius_mm)) = press_of(args) {
+        return Ok(press::claim(
+            &press::PressClaimInputs {
+                design,
+                preset: args.preset.as_deref(),
+                camera_file: &args.cam.camera,
+                extrinsics_file: &args.extrinsics,
+                capture,
+                reference,
+                radius_mm,
+            },
+            args.force,
+        ));
+    }
+    Ok(dataset::claim(
         &dataset::ClaimInputs {
-            design: args
-                .design
-                .as_deref()
-                .unwrap_or(fabkit_designs::library::DEFAULT_DESIGN),
+            design,
             preset: args.preset.as_deref(),
             camera_file: &args.cam.camera,
             extrinsics_file: &args.extrinsics,
-            fixtures_dir: &args.fixtures,
+            fixtures_dir: fixtures_dir(args)?,
             pin_captures: args.pin_captures,
         },
         args.force,
-    )
+    ))
 }
 
 pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
     let t0 = std::time::Instant::now();
     // The output folder is checked before anything is read or rendered, as `fabkit export`
     // checks it.
-    let claim = claim(&args);
+    let claim = claim(&args)?;
     fabkit_export::check_out_dir(&args.out, &claim)?;
     let mut loaded = load_design(args.design.as_deref(), &args.data_files)?;
     if let Some(p) = &args.preset {
@@ -297,6 +363,9 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
     for w in staged.commit()? {
         eprintln!("warning: {w}");
     }
+    if let Some(p) = &inputs.press {
+        print_press(p);
+    }
     out!(
         "{}: reference + {}, {} of {} pixels on the surface -> {} ({} files, {:.2} s)",
         design.name,
@@ -310,12 +379,38 @@ pub fn run(args: GroundTruthArgs) -> Result<(), Box<dyn Error>> {
     Ok(())
 }
 
-/// What was rendered besides the reference, in words: the pin captures, or the
+/// Prints the fitted press: the sphere's centre over the contact face and its depth with
+/// their standard deviations, the depth's spread over the core, the gain.
+fn print_press(p: &Press) {
+    let f = &p.fit;
+    out!(
+        "press: a {} mm sphere at ({:.3} +- {:.3}, {:.3} +- {:.3}) mm over the contact face z = {} mm, {:.3} +- {:.3} mm deep ({:.3} mm spread over the fitted core; gain {:.1} grey levels per mm, {} core pixels, residual RMS {:.2} grey levels)",
+        fabkit_calibration::shown_f64(p.radius_mm),
+        f.centre_mm[0],
+        f.centre_std_mm[0],
+        f.centre_mm[1],
+        f.centre_std_mm[1],
+        fabkit_calibration::shown_f64(p.plane_z_mm),
+        f.depth_mm,
+        f.depth_std_mm,
+        f.depth_spread_mm,
+        f.gain_grey_per_mm,
+        f.core_pixels,
+        f.residual_rms_grey
+    );
+}
+
+/// What was rendered besides the reference, in words: the press, the pin captures, or the
 /// configurations and stitched pairs of the protrusion patterns.
 fn rendered_what(args: &GroundTruthArgs, fixtures: &Fixtures) -> String {
     let n_cfg = fixtures.configurations.len();
     let n_pairs = fixtures.patterns.len() * fixtures.patterns.len();
-    if args.pin_captures {
+    if let Some((_, _, r)) = press_of(args) {
+        format!(
+            "the press of a {} mm sphere",
+            fabkit_calibration::shown_f64(r)
+        )
+    } else if args.pin_captures {
         format!("{n_cfg} pin captures")
     } else {
         format!(
@@ -362,7 +457,8 @@ fn check_pixels(
 }
 
 /// The render's inputs besides the design, read and checked: the camera and pose files, the
-/// fixtures, and the camera's rays onto the reference skin.
+/// fixtures (or the fitted press as one configuration), and the camera's rays onto the
+/// reference skin.
 struct Inputs {
     camera: fabkit_calibration::CameraModel,
     camera_bytes: Vec<u8>,
@@ -374,6 +470,8 @@ struct Inputs {
     optical_path: Option<(OpticalLayers, serde_json::Value)>,
     surface: ReferenceSurface,
     rays: PixelRays,
+    /// The press fitted with --press-image.
+    press: Option<Press>,
 }
 
 impl Inputs {
@@ -387,17 +485,41 @@ impl Inputs {
         check_pixels(args, &camera)?;
         let (camera_bytes, camera_sha) = read_with_hash(&args.cam.camera)?;
         let (t_cam_sensor, extrinsics_sha) = read_extrinsics(&args.extrinsics)?;
-        let fixtures = if args.pin_captures {
-            read_pin_captures(&args.fixtures, &design.name)?
-        } else {
-            read_fixtures(&args.fixtures, &design.name)?
-        };
         let pose_name = args.extrinsics.display().to_string();
         // the rays bend where the pose was solved through an optical path (`calibrate
         // extrinsics --design`): the depth maps register with the captures that calibration
         // saw
         let optical_path =
             fabkit_calibration::groundtruth::inputs::read_optical_path(&args.extrinsics)?;
+        let (fixtures, press) = match press_of(args) {
+            Some((capture, reference, radius_mm)) => {
+                // the press is fitted along straight rays
+                if optical_path.is_some() {
+                    return Err(PressInputError::OpticalPath {
+                        option: "--extrinsics",
+                        file: pose_name,
+                    }
+                    .into());
+                }
+                let press = press::fit_press(&PressJob {
+                    design,
+                    camera: &camera,
+                    camera_file: &args.cam.camera.display().to_string(),
+                    t_cam_sensor: &t_cam_sensor,
+                    capture,
+                    capture_option: "--press-image",
+                    reference,
+                    reference_option: "--press-reference",
+                    radius_mm,
+                    radius_option: "--sphere-radius-mm",
+                })?;
+                (press.fixtures()?, Some(press))
+            }
+            None if args.pin_captures => {
+                (read_pin_captures(fixtures_dir(args)?, &design.name)?, None)
+            }
+            None => (read_fixtures(fixtures_dir(args)?, &design.name)?, None),
+        };
         let scene = Scene::through(
             design,
             &camera,
@@ -407,12 +529,9 @@ impl Inputs {
         )?;
         if args.pin_captures {
             // the pin dome of this design's skin, whatever its name
-            let pins = fabkit_calibration::groundtruth::pins::read_pins(&args.fixtures)?;
-            fabkit_calibration::groundtruth::pins::check_on_skin(
-                &args.fixtures,
-                &pins,
-                &scene.surface,
-            )?;
+            let dir = fixtures_dir(args)?;
+            let pins = fabkit_calibration::groundtruth::pins::read_pins(dir)?;
+            fabkit_calibration::groundtruth::pins::check_on_skin(dir, &pins, &scene.surface)?;
         }
         scene.check_outside(&fixtures.configurations, &pose_name)?;
         let Scene { surface, rays } = scene;
@@ -427,6 +546,7 @@ impl Inputs {
             optical_path,
             surface,
             rays,
+            press,
         })
     }
 }
@@ -536,19 +656,24 @@ fn check_output_bound(
 ) -> Result<(), Box<dyn Error>> {
     let (w, h) = (inputs.rays.width, inputs.rays.height);
     let n_cfg = inputs.fixtures.configurations.len();
-    let bound_of = |f: DataFormat| {
-        output_bound(
+    let bound_of = |f: DataFormat| match &inputs.press {
+        Some(p) => press::output_bound(w as u64, h as u64, f.into(), image_bits, p),
+        None => output_bound(
             w as u64,
             h as u64,
             n_cfg as u64,
             inputs.fixtures.patterns.len() as u64,
             f.into(),
             image_bits,
-        )
+        ),
     };
     let (n_files, bound) = bound_of(args.format);
+    let frames = match inputs.press {
+        Some(_) => "the press".to_string(),
+        None => format!("{n_cfg} configurations"),
+    };
     eprintln!(
-        "groundtruth: reference + {n_cfg} configurations of {w} x {h} pixels -> {} files, at most {} (--format {})",
+        "groundtruth: reference + {frames} of {w} x {h} pixels -> {} files, at most {} (--format {})",
         n_files,
         shown_bytes(bound),
         format_name(args.format)
@@ -599,37 +724,38 @@ fn write_dataset(
 ) -> Result<dataset::Written, Box<dyn Error>> {
     let design = &loaded.design;
     let provenance = dataset::provenance(&design.name, &loaded.sha256);
-    dataset::write(
-        staged,
-        &FrameInputs {
-            rays: &inputs.rays,
-            reference_hits: ref_hits,
-            base_z_mm: inputs.surface.base_z_mm(),
-            fixtures: &inputs.fixtures,
-            format: args.format.into(),
-            imaging,
-            provenance: &provenance,
-        },
-        &ManifestInputs {
-            fabkit_version: env!("CARGO_PKG_VERSION"),
-            command_line: &std::env::args().collect::<Vec<_>>(),
-            design_name: &design.name,
-            design_source: &loaded.source,
-            design_sha256: &loaded.sha256,
-            flat_skin: design.body.flat_outline().is_some(),
-            camera: &inputs.camera,
-            camera_file: &args.cam.camera.display().to_string(),
-            camera_sha256: Some(&inputs.camera_sha),
-            extrinsics_file: &args.extrinsics.display().to_string(),
-            extrinsics_sha256: Some(&inputs.extrinsics_sha),
-            t_cam_sensor: &inputs.t_cam_sensor,
-            camera_centre_mm: inputs.rays.origin_mm,
-            fixtures: &inputs.fixtures,
-            pixels_on_surface: ref_hits.valid_count(),
-            optical_path: inputs.optical_path.as_ref().map(|(_, v)| v),
-            imaging,
-        },
-        progress,
-    )
+    let frames = FrameInputs {
+        rays: &inputs.rays,
+        reference_hits: ref_hits,
+        base_z_mm: inputs.surface.base_z_mm(),
+        fixtures: &inputs.fixtures,
+        format: args.format.into(),
+        imaging,
+        provenance: &provenance,
+    };
+    let command_line = std::env::args().collect::<Vec<_>>();
+    let manifest = ManifestInputs {
+        fabkit_version: env!("CARGO_PKG_VERSION"),
+        command_line: &command_line,
+        design_name: &design.name,
+        design_source: &loaded.source,
+        design_sha256: &loaded.sha256,
+        flat_skin: design.body.flat_outline().is_some(),
+        camera: &inputs.camera,
+        camera_file: &args.cam.camera.display().to_string(),
+        camera_sha256: Some(&inputs.camera_sha),
+        extrinsics_file: &args.extrinsics.display().to_string(),
+        extrinsics_sha256: Some(&inputs.extrinsics_sha),
+        t_cam_sensor: &inputs.t_cam_sensor,
+        camera_centre_mm: inputs.rays.origin_mm,
+        fixtures: &inputs.fixtures,
+        pixels_on_surface: ref_hits.valid_count(),
+        optical_path: inputs.optical_path.as_ref().map(|(_, v)| v),
+        imaging,
+    };
+    match &inputs.press {
+        Some(p) => press::write(staged, &frames, &manifest, p, progress),
+        None => dataset::write(staged, &frames, &manifest, progress),
+    }
     .map_err(|e| -> Box<dyn Error> { e })
 }

@@ -191,3 +191,181 @@ fn bad_board_presses_are_refused_by_option_with_nothing_written() {
         assert!(leftovers.is_empty(), "case {k}: {leftovers:?}");
     }
 }
+
+/// A grid plate pressed a few pins at a time (Soter et al.'s, `fabkit fixtures
+/// soter_channels`: 49 pins at 10 mm, its capture plan of 13 captures), rendered as a camera
+/// 55 mm away would see it (calibration/src/board/synthetic.rs; f = 290 px with a plumb_bob
+/// distortion, as calibration/tests/it/board_synthetic.rs's plate), one PNG per capture:
+/// `calibrate board --image` with the 13 captures and `--capture-plan` finds all 49 pins, each
+/// in its capture, and writes observations.csv (one row per pin, `id,u_px,v_px`) with the
+/// report naming every capture; the scale at the centre pin within 1 % of the truth. A plan
+/// of another length than the images is refused by `--capture-plan` with nothing written.
+#[test]
+fn a_grid_plate_pressed_over_several_captures_calibrates_with_its_plan() {
+    use fabkit_calibration::board::synthetic::{render_board, BoardPress, BoardShading};
+    use fabkit_calibration::board::{board_grid, mm_per_px_at, BoardCamera};
+    use fabkit_calibration::nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector2};
+    use fabkit_calibration::tables::{read_capture_plan, read_point_table, PointsFrom};
+    use fabkit_calibration::{CameraModel, Distortion, Intrinsics};
+
+    let tmp = tempfile::tempdir().unwrap();
+    let o = run(
+        tmp.path(),
+        &["fixtures", "soter_channels", "--out", "fx"],
+        &[],
+    );
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let points = tmp.path().join("fx/points/point_table.csv");
+    let plan_file = tmp.path().join("fx/points/capture_plan.csv");
+    let table = read_point_table(&points, PointsFrom::Contact).unwrap();
+    let grid = board_grid(&table).unwrap();
+    let plan = read_capture_plan(&plan_file).unwrap();
+    assert_eq!((grid.points.len(), plan.captures.len()), (49, 13));
+    let camera = CameraModel::new(Intrinsics {
+        image_width_px: 640,
+        image_height_px: 480,
+        fx_px: 290.0,
+        fy_px: 290.0,
+        cx_px: 319.5,
+        cy_px: 239.5,
+        distortion: Distortion::PlumbBob([0.9, -1.0, 0.0, 0.0, 0.5]),
+    })
+    .unwrap();
+    let distance_mm = 55.0;
+    let rot = UnitQuaternion::from_euler_angles(-0.01, 0.02, 0.01);
+    let pose = Isometry3::from_parts(
+        Translation3::new(0.5, -0.4, grid.plane_z_mm - distance_mm),
+        rot,
+    )
+    .inverse();
+    let all: Vec<String> = grid.points.iter().map(|g| g.id.clone()).collect();
+    let renders: Vec<_> = std::thread::scope(|s| {
+        let jobs: Vec<_> = plan
+            .captures
+            .iter()
+            .enumerate()
+            .map(|(k, ids)| {
+                let (camera, grid, all) = (&camera, &grid, &all);
+                s.spawn(move || {
+                    let press = BoardPress {
+                        bump_radius_mm: 3.0,
+                        depth_mm: 1.0,
+                        unpressed: all.iter().filter(|i| !ids.contains(i)).cloned().collect(),
+                        specks: Vec::new(),
+                    };
+                    let shading = BoardShading {
+                        darkening_per_mm: 0.15,
+                        seed: 200 + k as u64,
+                        ..BoardShading::default()
+                    };
+                    render_board(camera, &pose, grid, &press, &shading)
+                })
+            })
+            .collect();
+        jobs.into_iter().map(|j| j.join().unwrap()).collect()
+    });
+    let save = |name: &str, rgb: &[u8]| {
+        let p = tmp.path().join(name);
+        image::RgbImage::from_raw(640, 480, rgb.to_vec())
+            .unwrap()
+            .save(&p)
+            .unwrap();
+        p.to_str().unwrap().to_string()
+    };
+    let reference = save("ref.png", &renders[0].reference_rgb);
+    let images: Vec<String> = renders
+        .iter()
+        .enumerate()
+        .map(|(k, r)| save(&format!("capture_{:02}.png", k + 1), &r.capture_rgb))
+        .collect();
+    let distance = distance_mm.to_string();
+    let args = |out: &'static str, plan: &str, images: &[String]| -> Vec<String> {
+        let mut a: Vec<String> = [
+            "calibrate",
+            "board",
+            "--points",
+            points.to_str().unwrap(),
+            "--reference",
+            &reference,
+            "--capture-plan",
+            plan,
+            "--plane-distance-mm",
+            &distance,
+            "--out",
+            out,
+            "--image",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        a.extend_from_slice(images);
+        a
+    };
+    let a = args("cal", plan_file.to_str().unwrap(), &images);
+    let o = run(
+        tmp.path(),
+        &a.iter().map(String::as_str).collect::<Vec<_>>(),
+        &[],
+    );
+    let out = text(&o.stdout);
+    assert!(o.status.success(), "{out}\n{}", text(&o.stderr));
+    assert!(out.contains("49 of 49 bumps found"), "{out}");
+    let dir = tmp.path().join("cal");
+    let r: Value =
+        serde_json::from_slice(&std::fs::read(dir.join("extrinsics.json")).unwrap()).unwrap();
+    assert_eq!(r["found"], 49);
+    assert_eq!(r["capture_images"].as_array().unwrap().len(), 13);
+    let captures = r["captures"].as_array().unwrap();
+    for (k, c) in captures.iter().enumerate() {
+        let ids: Vec<&str> = c["found"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|b| b["id"].as_str().unwrap())
+            .collect();
+        let mut planned: Vec<&str> = plan.captures[k].iter().map(String::as_str).collect();
+        planned.sort_by_key(|i| i.parse::<u32>().unwrap());
+        assert_eq!(ids, planned, "capture {}", k + 1);
+        assert_eq!(c["missing_planned_ids"].as_array().unwrap().len(), 0);
+    }
+    let csv = std::fs::read_to_string(dir.join("observations.csv")).unwrap();
+    assert!(
+        csv.starts_with("id,u_px,v_px\n") && csv.lines().count() == 50,
+        "{csv}"
+    );
+    assert!(dir.join("overlay.png").is_file());
+    let rms = r["rms_reprojection_error_px"].as_f64().unwrap();
+    assert!(rms < 0.25, "RMS {rms} px");
+    let centre = &r["centre_bump_px"];
+    let at = Vector2::new(centre[0].as_f64().unwrap(), centre[1].as_f64().unwrap());
+    let truth = BoardCamera {
+        camera,
+        t_cam_sensor: pose,
+        parameters: Vec::new(),
+        condition_number: 0.0,
+        residuals_px: Vec::new(),
+        rms_px: 0.0,
+        pose_std: None,
+    };
+    let true_scale = mm_per_px_at(&truth, grid.plane_z_mm, at).unwrap();
+    let scale = r["mm_per_px_at_centre"].as_f64().unwrap();
+    assert!(
+        (scale / true_scale - 1.0).abs() < 0.01,
+        "{scale} mm per px, true {true_scale}"
+    );
+
+    // a plan of 13 captures with 12 images
+    let a = args("short", plan_file.to_str().unwrap(), &images[..12]);
+    let o = run(
+        tmp.path(),
+        &a.iter().map(String::as_str).collect::<Vec<_>>(),
+        &[],
+    );
+    let err = text(&o.stderr);
+    assert!(!o.status.success(), "ran with 12 images");
+    assert!(
+        err.contains("--capture-plan") && err.contains("13 captures but 12"),
+        "{err}"
+    );
+    assert!(!tmp.path().join("short").exists());
+}

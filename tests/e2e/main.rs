@@ -24,6 +24,7 @@ mod groundtruth_cli;
 mod groundtruth_flat;
 mod groundtruth_images;
 mod groundtruth_open3d;
+mod groundtruth_press;
 mod maker_path;
 mod output_ownership;
 mod plates;

@@ -3,6 +3,9 @@
 //! it and writes its point table): the bumps' imprints are found against the reference image,
 //! each is given its grid id by walking the lattice they form, and the camera model that maps
 //! the gel plane to pixels is solved from them, with the map from pixels back to the plane.
+//! A grid plate pressed a few pins at a time (Soter et al.'s, with its capture plan) is the
+//! same flow over several captures: the imprints of all of them form the lattice
+//! ([`find_bumps_in_captures`]).
 //!
 //! What one planar view determines (Zhang, "A flexible new technique for camera calibration",
 //! IEEE TPAMI 22(11), 2000, Sec. 2-3: a plane gives two constraints on the intrinsics per
@@ -40,6 +43,8 @@ pub enum BoardError {
     Press { file: String, rule: String },
     #[error("--reference {file}: {rule}")]
     Reference { file: String, rule: String },
+    #[error("--capture-plan {file}: {rule}")]
+    Plan { file: String, rule: String },
     #[error("--plane-distance-mm = {value}: {rule}")]
     PlaneDistance { value: String, rule: String },
     #[error("the camera model: {0}")]
@@ -612,9 +617,13 @@ pub struct BoardJob {
     pub points: std::path::PathBuf,
     /// Which of its points lie on the plane the press calibrates (`contact`: the skin's face).
     pub points_from: crate::tables::PointsFrom,
-    /// The skin with no contact, and the board pressed in: same camera, lighting and size.
+    /// The skin with no contact, and the board pressed in (one capture or several, each
+    /// pressing some of the bumps): same camera, lighting and size.
     pub reference: std::path::PathBuf,
-    pub image: std::path::PathBuf,
+    pub images: Vec<std::path::PathBuf>,
+    /// Which ids each capture presses (`points/capture_plan.csv` of `fabkit fixtures`), the
+    /// captures in `images`' order; none: every spot on the lattice counts.
+    pub capture_plan: Option<std::path::PathBuf>,
     /// The plane's distance from the lens's centre of projection in air, mm, and where it
     /// comes from in words.
     pub plane_distance_mm: f64,
@@ -629,7 +638,8 @@ pub struct BoardReport {
     pub command_line: String,
     pub points_file: String,
     pub reference_image: String,
-    pub capture_image: String,
+    pub capture_images: Vec<String>,
+    pub capture_plan: Option<String>,
     pub image_size_px: [u32; 2],
     pub grid: GridSummary,
     /// Spots the detector found.
@@ -638,6 +648,8 @@ pub struct BoardReport {
     pub missing_ids: Vec<String>,
     pub extra_spots: Vec<ExtraSpot>,
     pub notes: Vec<String>,
+    /// What each capture showed, in the order given.
+    pub captures: Vec<CaptureFind>,
     /// Per found bump, grid order.
     pub bumps: Vec<BumpResidual>,
     /// RMS of the reprojection errors' lengths, px, and the largest with its id.
@@ -684,7 +696,9 @@ pub struct BumpResidual {
     pub row: u32,
     pub column: u32,
     pub point_mm: [f64; 3],
+    /// The mean of its pixels over the captures that show it (`observations` of them).
     pub observed_px: [f64; 2],
+    pub observations: usize,
     pub reprojected_px: [f64; 2],
     pub reprojection_error_px: f64,
 }
@@ -696,7 +710,8 @@ pub struct BoardOutput {
     /// (file name, bytes): `extrinsics.json` and `extrinsics.yaml` (this report, the pose
     /// among it, as `calibrate extrinsics` writes them), `camera.yaml` (OpenCV),
     /// `camera_info.yaml` (ROS), `camera.json`, `observations.csv`, `pixel_to_plane_mm.npy`
-    /// (float32, H x W x 2: x and y on the plane, mm; NaN off it), `overlay.png`.
+    /// (float32, H x W x 2: x and y on the plane, mm; NaN off it), `overlay.png` (on the
+    /// darkest of the captures at each pixel, so that every capture's imprints show).
     pub files: Vec<(String, Vec<u8>)>,
 }
 
@@ -710,11 +725,13 @@ fn image_size(path: &std::path::Path) -> Result<(u32, u32), String> {
         .map_err(|e| format!("not a readable PNG or JPEG image: {e}"))
 }
 
-/// Runs the calibration of `job`; reads only its input files and writes nothing.
+/// Runs the calibration of `job` (one capture or several, [`find_bumps_in_captures`]); reads
+/// only its input files and writes nothing.
 ///
 /// # Errors
 /// [`BoardError`]: an unreadable or invalid point table (not one plane, not a grid), an
-/// unreadable image or one of another size than the reference, too few imprints on one
+/// unreadable capture plan, one of another length than the images or with an id the table
+/// lacks, an unreadable image or one of another size than the reference, too few imprints on one
 /// lattice or a lattice larger than the board, a plane distance that is not finite and
 /// positive, a failed solve.
 pub fn calibrate_board(job: &BoardJob) -> Result<BoardOutput, BoardError> {
@@ -732,26 +749,33 @@ pub fn calibrate_board(job: &BoardJob) -> Result<BoardOutput, BoardError> {
         }
     })?;
     let grid = board_grid(&table)?;
-    let (ref_file, cap_file) = (
-        job.reference.display().to_string(),
-        job.image.display().to_string(),
-    );
+    let plan = read_plan(job, &grid)?;
+    let ref_file = job.reference.display().to_string();
     let size = image_size(&job.reference).map_err(|rule| BoardError::Reference {
         file: ref_file.clone(),
         rule,
     })?;
-    let cap_size = image_size(&job.image).map_err(|rule| BoardError::Press {
-        file: cap_file.clone(),
-        rule,
-    })?;
-    if cap_size != size {
+    if job.images.is_empty() {
         return Err(BoardError::Press {
-            file: cap_file,
-            rule: format!(
-                "the image is {} x {} px but the reference {ref_file} is {} x {} px; a press and its reference are taken by one camera",
-                cap_size.0, cap_size.1, size.0, size.1
-            ),
+            file: String::new(),
+            rule: "no capture given: at least one".into(),
         });
+    }
+    for image in &job.images {
+        let cap_file = image.display().to_string();
+        let cap_size = image_size(image).map_err(|rule| BoardError::Press {
+            file: cap_file.clone(),
+            rule,
+        })?;
+        if cap_size != size {
+            return Err(BoardError::Press {
+                file: cap_file,
+                rule: format!(
+                    "the image is {} x {} px but the reference {ref_file} is {} x {} px; a press and its reference are taken by one camera",
+                    cap_size.0, cap_size.1, size.0, size.1
+                ),
+            });
+        }
     }
     let read = |path: &std::path::Path, option| {
         crate::capture_images::read_gray(path, option, size, "(the reference's size)")
@@ -760,19 +784,64 @@ pub fn calibrate_board(job: &BoardJob) -> Result<BoardOutput, BoardError> {
         file: ref_file.clone(),
         rule: e.to_string(),
     })?;
-    let capture = read(&job.image, "--image").map_err(|e| BoardError::Press {
-        file: cap_file.clone(),
-        rule: e.to_string(),
-    })?;
-    let (spots, find) = find_bumps(&reference, &capture, &grid, &cap_file)?;
-    let bc = solve_board_camera(&grid, &find, size, job.plane_distance_mm)?;
-    let report = board_report(job, &grid, spots.len(), &find, &bc, size);
-    let files = board_files(&report, &bc, &grid, &job.image)?;
+    let captures = job
+        .images
+        .iter()
+        .map(|image| {
+            let file = image.display().to_string();
+            read(image, "--image")
+                .map(|g| (file.clone(), g))
+                .map_err(|e| BoardError::Press {
+                    file,
+                    rule: e.to_string(),
+                })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let found = find_bumps_in_captures(&reference, &captures, &grid, plan.as_deref())?;
+    let bc = solve_board_camera(&grid, &found.find, size, job.plane_distance_mm)?;
+    let report = board_report(job, &grid, &found, &bc, size);
+    let files = board_files(&report, &bc, &grid, &job.images)?;
     Ok(BoardOutput { report, files })
 }
 
+/// The job's capture plan, checked against its images and grid: one capture per image, every
+/// id the board's.
+fn read_plan(job: &BoardJob, grid: &BoardGrid) -> Result<Option<Vec<Vec<String>>>, BoardError> {
+    let Some(path) = &job.capture_plan else {
+        return Ok(None);
+    };
+    let file = path.display().to_string();
+    let bad = |rule: String| BoardError::Plan {
+        file: file.clone(),
+        rule,
+    };
+    let plan = crate::tables::read_capture_plan(path).map_err(|e| bad(e.to_string()))?;
+    if plan.captures.len() != job.images.len() {
+        return Err(bad(format!(
+            "{} captures but {} --image given: one image per capture, in the plan's order",
+            plan.captures.len(),
+            job.images.len()
+        )));
+    }
+    for (k, ids) in plan.captures.iter().enumerate() {
+        if let Some(id) = ids
+            .iter()
+            .find(|id| !grid.points.iter().any(|g| &g.id == *id))
+        {
+            return Err(bad(format!(
+                "capture {} presses id {id}, which the point table {} does not hold",
+                k + 1,
+                job.points.display()
+            )));
+        }
+    }
+    Ok(Some(plan.captures))
+}
+
 /// The spots of a board press (`capture` against `reference`, grey levels) and the grid they
-/// walk ([`assign_grid`]); `file` names the capture in errors.
+/// walk ([`assign_grid`]); `file` names the capture in errors. A spot under a fifth of the
+/// spots' upper quartile area is left out (`extra`: noise or dust, not an imprint). This is
+/// [`find_bumps_in_captures`] of one capture without a plan.
 ///
 /// # Errors
 /// [`BoardError::Press`]: no imprint at all, the sizes differ, or [`assign_grid`]'s.
@@ -782,6 +851,34 @@ pub fn find_bumps(
     grid: &BoardGrid,
     file: &str,
 ) -> Result<(Vec<Spot>, GridFind), BoardError> {
+    let spots = detect_board_spots(reference, capture, file)?;
+    let found = group_and_walk(
+        vec![(file.to_string(), spots.clone())],
+        image_centre_px(capture),
+        grid,
+        None,
+    )?;
+    Ok((spots, found.find))
+}
+
+/// The image's centre, px.
+fn image_centre_px(img: &GrayImage) -> (f64, f64) {
+    (
+        (img.width as f64 - 1.0) / 2.0,
+        (img.height as f64 - 1.0) / 2.0,
+    )
+}
+
+/// The imprints of one board press (`capture` against `reference`), with
+/// [`board_detect_params`]; `file` names the capture in errors.
+///
+/// # Errors
+/// [`BoardError::Press`]: the sizes differ, or no imprint at all.
+pub fn detect_board_spots(
+    reference: &GrayImage,
+    capture: &GrayImage,
+    file: &str,
+) -> Result<Vec<Spot>, BoardError> {
     let bad = |rule: String| BoardError::Press {
         file: file.to_string(),
         rule,
@@ -793,28 +890,297 @@ pub fn find_bumps(
             "no imprint differs from the reference: is the board pressed in, and the reference the same sensor's?".into(),
         ));
     }
-    let pts: Vec<(f64, f64)> = spots.iter().map(|s| (s.u_px, s.v_px)).collect();
-    let centre = (
-        (capture.width as f64 - 1.0) / 2.0,
-        (capture.height as f64 - 1.0) / 2.0,
-    );
-    let find = assign_grid(&pts, grid, centre, file)?;
-    Ok((spots, find))
+    Ok(spots)
+}
+
+/// What one capture of a board calibration showed.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CaptureFind {
+    /// 1, 2, ... in the order the captures were given (the plan's, with a plan).
+    pub capture: usize,
+    pub image: String,
+    /// Spots the detector found in it.
+    pub spots: usize,
+    /// Its spots at the grid places the walk gave them (and, with a plan, that it plans),
+    /// grid order, px.
+    pub found: Vec<FoundBump>,
+    /// Ids its plan presses with no spot in it (empty without a plan).
+    pub missing_planned_ids: Vec<String>,
+    /// Its spots left out of the solve, and why.
+    pub extra: Vec<ExtraSpot>,
+}
+
+/// What [`find_bumps_in_captures`] made of several captures.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CapturesFind {
+    /// One pixel per found id (the mean of its observations over the captures), the ids no
+    /// capture shows, every capture's spots left out, the walk's notes and its spacing at the
+    /// start.
+    pub find: GridFind,
+    /// Per found id (as `find.found`), how many captures' spots the pixel averages.
+    pub observations: Vec<usize>,
+    pub captures: Vec<CaptureFind>,
+    /// Spots found in all captures.
+    pub spots: usize,
+}
+
+/// The bumps of a board pressed over several captures, each against one `reference`
+/// (captures: (file, image), in order): each capture's imprints are found
+/// ([`detect_board_spots`]); spots of different captures closer than the smaller one's
+/// radius (the radius of a disc of its area) are one bump pressed in both (single linkage, so
+/// the grouping does not depend on the captures' order); the groups' centres form the lattice
+/// [`assign_grid`] walks once, and each capture's spots take their group's id. With `plan`
+/// (one list of ids per capture, in the captures' order, as [`crate::tables::CapturePlan`]),
+/// a spot at a place its capture does not plan is left out (in its capture's `extra`, with
+/// why) and a planned id without a spot is `missing_planned_ids`. A bump seen in several
+/// captures is solved at the mean of its pixels (taken in order of u then v, so the same
+/// captures in any order give the same pixels). With one capture and no plan the result is
+/// [`find_bumps`]'.
+///
+/// # Errors
+/// [`BoardError::Press`]: a capture with no imprint, [`assign_grid`]'s on the union (named
+/// by every capture's file), or fewer than 4 bumps left after the plan.
+pub fn find_bumps_in_captures(
+    reference: &GrayImage,
+    captures: &[(String, GrayImage)],
+    grid: &BoardGrid,
+    plan: Option<&[Vec<String>]>,
+) -> Result<CapturesFind, BoardError> {
+    let Some((_, first)) = captures.first() else {
+        return Err(BoardError::Press {
+            file: String::new(),
+            rule: "no capture given: at least one".into(),
+        });
+    };
+    let spots = captures
+        .iter()
+        .map(|(file, img)| Ok((file.clone(), detect_board_spots(reference, img, file)?)))
+        .collect::<Result<Vec<_>, BoardError>>()?;
+    group_and_walk(spots, image_centre_px(first), grid, plan)
+}
+
+/// A spot under this fraction of the spots' upper quartile area is no imprint.
+const SMALL_SPOT_FRACTION: f64 = 0.2;
+
+/// [`find_bumps_in_captures`] from each capture's spots.
+fn group_and_walk(
+    spots: Vec<(String, Vec<Spot>)>,
+    centre_px: (f64, f64),
+    grid: &BoardGrid,
+    plan: Option<&[Vec<String>]>,
+) -> Result<CapturesFind, BoardError> {
+    let files: Vec<&str> = spots.iter().map(|(f, _)| f.as_str()).collect();
+    let union_file = files.join(", ");
+    let per_capture_spots: Vec<usize> = spots.iter().map(|(_, s)| s.len()).collect();
+    // noise and dust: spots far smaller than the imprints (sparse captures leave a few)
+    let mut areas: Vec<usize> = spots
+        .iter()
+        .flat_map(|(_, s)| s.iter().map(|s| s.area_px))
+        .collect();
+    areas.sort_unstable();
+    let upper_quartile = areas.get(areas.len() * 3 / 4).copied().unwrap_or(0);
+    let small_below = SMALL_SPOT_FRACTION * upper_quartile as f64;
+    let mut small: Vec<Vec<ExtraSpot>> = vec![Vec::new(); spots.len()];
+    // every other spot: (capture, u, v, radius)
+    let mut all: Vec<(usize, f64, f64, f64)> = Vec::new();
+    for (k, (_, list)) in spots.iter().enumerate() {
+        for s in list {
+            if (s.area_px as f64) < small_below {
+                small[k].push(ExtraSpot {
+                    u_px: s.u_px,
+                    v_px: s.v_px,
+                    why: format!(
+                        "{} px, under a fifth of the spots' upper quartile area ({upper_quartile} px): noise or dust, not an imprint",
+                        s.area_px
+                    ),
+                });
+                continue;
+            }
+            let r = (s.area_px as f64 / std::f64::consts::PI).sqrt();
+            all.push((k, s.u_px, s.v_px, r));
+        }
+    }
+    // single-linkage groups of spots of different captures
+    let mut parent: Vec<usize> = (0..all.len()).collect();
+    fn root(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    for a in 0..all.len() {
+        for b in a + 1..all.len() {
+            let (sa, sb) = (all[a], all[b]);
+            if sa.0 != sb.0 && (sa.1 - sb.1).hypot(sa.2 - sb.2) < sa.3.min(sb.3) {
+                let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
+                parent[ra.max(rb)] = ra.min(rb);
+            }
+        }
+    }
+    let group_of: Vec<usize> = (0..all.len()).map(|i| root(&mut parent, i)).collect();
+    let mut roots: Vec<usize> = group_of.clone();
+    roots.sort_unstable();
+    roots.dedup();
+    let centres: Vec<(f64, f64)> = roots
+        .iter()
+        .map(|&g| {
+            let members: Vec<(f64, f64)> = (0..all.len())
+                .filter(|&i| group_of[i] == g)
+                .map(|i| (all[i].1, all[i].2))
+                .collect();
+            mean_in_order(members)
+        })
+        .collect();
+    let walked = assign_grid(&centres, grid, centre_px, &union_file)?;
+    // the place of each group: the found bump whose pixel is its centre (copied exactly)
+    let id_of_group = |g: usize| -> Option<&FoundBump> {
+        let c = centres[roots.binary_search(&g).ok()?];
+        walked.found.iter().find(|b| b.u_px == c.0 && b.v_px == c.1)
+    };
+    let several = files.len() > 1;
+    // per grid place (row, column): its id and its pixels over the captures
+    type Seen = (String, Vec<(f64, f64)>);
+    let mut per_id: std::collections::BTreeMap<(u32, u32), Seen> = Default::default();
+    let mut capture_finds = Vec::new();
+    for (k, file) in files.iter().enumerate() {
+        let planned = plan.and_then(|p| p.get(k));
+        let mut found = Vec::new();
+        let mut extra = std::mem::take(&mut small[k]);
+        for (i, s) in all.iter().enumerate().filter(|(_, s)| s.0 == k) {
+            match id_of_group(group_of[i]) {
+                Some(b) if planned.is_none_or(|p| p.contains(&b.id)) => {
+                    found.push(FoundBump {
+                        u_px: s.1,
+                        v_px: s.2,
+                        ..b.clone()
+                    });
+                    per_id
+                        .entry((b.row, b.column))
+                        .or_insert_with(|| (b.id.clone(), Vec::new()))
+                        .1
+                        .push((s.1, s.2));
+                }
+                Some(b) => extra.push(ExtraSpot {
+                    u_px: s.1,
+                    v_px: s.2,
+                    why: format!(
+                        "at the place of bump {}, which capture {} does not press (--capture-plan)",
+                        b.id,
+                        k + 1
+                    ),
+                }),
+                None => extra.push(ExtraSpot {
+                    u_px: s.1,
+                    v_px: s.2,
+                    why: if several {
+                        "not on the lattice the imprints of all captures form".into()
+                    } else {
+                        "not on the lattice the other imprints form".into()
+                    },
+                }),
+            }
+        }
+        found.sort_by_key(|f| (f.row, f.column));
+        extra.sort_by(|a, b| a.v_px.total_cmp(&b.v_px).then(a.u_px.total_cmp(&b.u_px)));
+        let missing_planned_ids = planned.map_or_else(Vec::new, |p| {
+            p.iter()
+                .filter(|id| !found.iter().any(|f| &f.id == *id))
+                .cloned()
+                .collect()
+        });
+        capture_finds.push(CaptureFind {
+            capture: k + 1,
+            image: file.to_string(),
+            spots: per_capture_spots[k],
+            found,
+            missing_planned_ids,
+            extra,
+        });
+    }
+    let mut observations = Vec::new();
+    let found: Vec<FoundBump> = per_id
+        .into_iter()
+        .map(|((row, column), (id, px))| {
+            observations.push(px.len());
+            let (u_px, v_px) = mean_in_order(px);
+            FoundBump {
+                id,
+                row,
+                column,
+                u_px,
+                v_px,
+            }
+        })
+        .collect();
+    if found.len() < 4 {
+        return Err(BoardError::Press {
+            file: union_file,
+            rule: format!(
+                "{} bumps found where their captures press them: at least 4 of the board's {} are needed",
+                found.len(),
+                grid.points.len()
+            ),
+        });
+    }
+    let missing = grid
+        .points
+        .iter()
+        .filter(|g| !found.iter().any(|f| f.id == g.id))
+        .map(|g| g.id.clone())
+        .collect();
+    let mut extra: Vec<ExtraSpot> = capture_finds
+        .iter()
+        .flat_map(|c| {
+            c.extra.iter().map(move |e| ExtraSpot {
+                why: if several {
+                    format!("capture {} ({}): {}", c.capture, c.image, e.why)
+                } else {
+                    e.why.clone()
+                },
+                ..e.clone()
+            })
+        })
+        .collect();
+    extra.sort_by(|a, b| a.v_px.total_cmp(&b.v_px).then(a.u_px.total_cmp(&b.u_px)));
+    Ok(CapturesFind {
+        find: GridFind {
+            found,
+            missing,
+            extra,
+            pitch_px_at_start: walked.pitch_px_at_start,
+            notes: walked.notes,
+        },
+        observations,
+        captures: capture_finds,
+        spots: per_capture_spots.iter().sum(),
+    })
+}
+
+/// The mean of `px`, summed in order of u then v (so that it does not depend on their order).
+fn mean_in_order(mut px: Vec<(f64, f64)>) -> (f64, f64) {
+    px.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    let n = px.len().max(1) as f64;
+    let (su, sv) = px
+        .iter()
+        .fold((0.0, 0.0), |(su, sv), (u, v)| (su + u, sv + v));
+    (su / n, sv / n)
 }
 
 fn board_report(
     job: &BoardJob,
     grid: &BoardGrid,
-    spots: usize,
-    find: &GridFind,
+    found: &CapturesFind,
     bc: &BoardCamera,
     size: (u32, u32),
 ) -> BoardReport {
+    let find = &found.find;
     let bumps: Vec<BumpResidual> = find
         .found
         .iter()
         .zip(&bc.residuals_px)
-        .map(|(b, e)| {
+        .zip(&found.observations)
+        .map(|((b, e), &observations)| {
             let p = grid
                 .at(b.row, b.column)
                 .map_or(Vector3::zeros(), |g| g.point_mm);
@@ -824,6 +1190,7 @@ fn board_report(
                 column: b.column,
                 point_mm: [p.x, p.y, p.z],
                 observed_px: [b.u_px, b.v_px],
+                observations,
                 reprojected_px: [b.u_px + e.x, b.v_px + e.y],
                 reprojection_error_px: e.norm(),
             }
@@ -861,7 +1228,8 @@ fn board_report(
         command_line: job.command_line.clone(),
         points_file: job.points.display().to_string(),
         reference_image: job.reference.display().to_string(),
-        capture_image: job.image.display().to_string(),
+        capture_images: job.images.iter().map(|p| p.display().to_string()).collect(),
+        capture_plan: job.capture_plan.as_ref().map(|p| p.display().to_string()),
         image_size_px: [size.0, size.1],
         grid: GridSummary {
             rows: grid.rows,
@@ -869,11 +1237,12 @@ fn board_report(
             pitch_mm: grid.pitch_mm,
             plane_z_mm: grid.plane_z_mm,
         },
-        spots,
+        spots: found.spots,
         found: find.found.len(),
         missing_ids: find.missing.clone(),
         extra_spots: find.extra.clone(),
         notes: find.notes.clone(),
+        captures: found.captures.clone(),
         rms_reprojection_error_px: bc.rms_px,
         worst_px: worst.map_or(0.0, |w| w.reprojection_error_px),
         worst_id: worst.map_or(String::new(), |w| w.id.clone()),
@@ -901,7 +1270,7 @@ fn board_files(
     report: &BoardReport,
     bc: &BoardCamera,
     grid: &BoardGrid,
-    capture: &std::path::Path,
+    captures: &[std::path::PathBuf],
 ) -> Result<Vec<(String, Vec<u8>)>, BoardError> {
     use crate::camera_file::{write_camera, CameraFileFormat};
     let intr = bc.camera.intrinsics();
@@ -943,17 +1312,34 @@ fn board_files(
         "pixel_to_plane_mm.npy".into(),
         fabkit_export::raster::npy_f32(&[h, w, 2], &pixel_to_plane_mm(bc, grid.plane_z_mm)),
     ));
-    let img = crate::overlay::read_png_rgb8_sized(capture, (w as u32, h as u32)).map_err(|e| {
-        BoardError::Press {
-            file: capture.display().to_string(),
-            rule: e.to_string(),
-        }
-    })?;
+    // the darkest of the captures at each pixel: every capture's imprints show
+    let mut img: Option<crate::overlay::Rgb8> = None;
+    for capture in captures {
+        let next =
+            crate::overlay::read_png_rgb8_sized(capture, (w as u32, h as u32)).map_err(|e| {
+                BoardError::Press {
+                    file: capture.display().to_string(),
+                    rule: e.to_string(),
+                }
+            })?;
+        img = Some(match img {
+            None => next,
+            Some(mut acc) => {
+                for (a, b) in acc.data.iter_mut().zip(&next.data) {
+                    *a = (*a).min(*b);
+                }
+                acc
+            }
+        });
+    }
+    let Some(img) = img else {
+        return Err(BoardError::Solve("no capture to draw on".into()));
+    };
     files.push(("overlay.png".into(), board_overlay(img, report)?));
     Ok(files)
 }
 
-/// The capture with each found bump circled (green) and its id, its reprojection (red cross)
+/// The capture (the darkest of the captures) with each found bump circled (green) and its id, its reprojection (red cross)
 /// and the spots taken for no bump (magenta).
 fn board_overlay(mut img: crate::overlay::Rgb8, r: &BoardReport) -> Result<Vec<u8>, BoardError> {
     const GREEN: [u8; 3] = [0, 220, 0];

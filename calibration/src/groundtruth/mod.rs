@@ -22,6 +22,7 @@ pub mod hits;
 pub mod inputs;
 pub mod mesh;
 pub mod pins;
+pub mod press;
 pub mod raster;
 pub mod rays;
 pub mod shading;
