@@ -27,6 +27,7 @@
 //! makes `A / g` short of the depth), and the darkening has no other cause there (no shading
 //! by the surface's slope: the core's slopes are under `r / R`).
 
+use crate::board::pixel_on_plane as on_plane;
 use crate::camera::CameraModel;
 use crate::imprints::{gaussian_blur, GrayImage};
 use nalgebra::{Isometry3, Matrix4, Vector2, Vector4};
@@ -99,22 +100,6 @@ pub struct PressFit {
     pub core_radius_mm: f64,
     /// The apex's pixel, px.
     pub centre_px: [f64; 2],
-}
-
-/// Where the ray of pixel `px` meets the plane `z = plane_z_mm` (sensor frame), mm.
-fn on_plane(
-    camera: &CameraModel,
-    t_sensor_cam: &Isometry3<f64>,
-    plane_z_mm: f64,
-    px: Vector2<f64>,
-) -> Option<Vector2<f64>> {
-    let d = t_sensor_cam.rotation * camera.unproject(&px).ok()?;
-    let o = t_sensor_cam.translation.vector;
-    let t = (plane_z_mm - o.z) / d.z;
-    (t.is_finite() && t > 0.0).then(|| {
-        let p = o + d * t;
-        Vector2::new(p.x, p.y)
-    })
 }
 
 /// Fits the press of a sphere (`opts.radius_mm`) in `capture` against `reference` (grey

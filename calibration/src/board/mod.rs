@@ -568,42 +568,43 @@ pub fn pixel_to_plane_mm(bc: &BoardCamera, plane_z_mm: f64) -> Vec<f32> {
     let i = bc.camera.intrinsics();
     let (w, h) = (i.image_width_px as usize, i.image_height_px as usize);
     let inv = bc.t_cam_sensor.inverse();
-    let origin = inv.translation.vector;
     let mut out = vec![f32::NAN; w * h * 2];
     for v in 0..h {
         for u in 0..w {
-            let Ok(ray) = bc.camera.unproject(&Vector2::new(u as f64, v as f64)) else {
-                continue;
-            };
-            let d = inv.rotation * ray;
-            if d.z.abs() < 1e-12 {
-                continue;
+            let px = Vector2::new(u as f64, v as f64);
+            if let Some(p) = pixel_on_plane(&bc.camera, &inv, plane_z_mm, px) {
+                out[(v * w + u) * 2] = p.x as f32;
+                out[(v * w + u) * 2 + 1] = p.y as f32;
             }
-            let t = (plane_z_mm - origin.z) / d.z;
-            if t <= 0.0 {
-                continue;
-            }
-            let p = origin + d * t;
-            out[(v * w + u) * 2] = p.x as f32;
-            out[(v * w + u) * 2 + 1] = p.y as f32;
         }
     }
     out
+}
+
+/// Where the ray of pixel `px` meets the plane `z = plane_z_mm`: its (x, y) in the sensor
+/// frame, mm, with `t_sensor_cam` the camera's pose in the sensor frame (the inverse of
+/// T_cam_sensor); `None` when the pixel does not unproject or its ray runs parallel to the
+/// plane or away from it.
+pub fn pixel_on_plane(
+    camera: &CameraModel,
+    t_sensor_cam: &Isometry3<f64>,
+    plane_z_mm: f64,
+    px: Vector2<f64>,
+) -> Option<Vector2<f64>> {
+    let d = t_sensor_cam.rotation * camera.unproject(&px).ok()?;
+    let o = t_sensor_cam.translation.vector;
+    let t = (plane_z_mm - o.z) / d.z;
+    (t.is_finite() && t > 0.0).then(|| {
+        let p = o + d * t;
+        Vector2::new(p.x, p.y)
+    })
 }
 
 /// The plane's scale at pixel `at_px`: the square root of the area on the plane one pixel
 /// covers there (the Jacobian's determinant of the pixel-to-plane map), mm per px.
 pub fn mm_per_px_at(bc: &BoardCamera, plane_z_mm: f64, at_px: Vector2<f64>) -> Option<f64> {
     let inv = bc.t_cam_sensor.inverse();
-    let origin = inv.translation.vector;
-    let on_plane = |px: Vector2<f64>| -> Option<Vector2<f64>> {
-        let d = inv.rotation * bc.camera.unproject(&px).ok()?;
-        let t = (plane_z_mm - origin.z) / d.z;
-        (t > 0.0).then(|| {
-            let p = origin + d * t;
-            Vector2::new(p.x, p.y)
-        })
-    };
+    let on_plane = |px: Vector2<f64>| pixel_on_plane(&bc.camera, &inv, plane_z_mm, px);
     let e = 0.5;
     let du = on_plane(at_px + Vector2::new(e, 0.0))? - on_plane(at_px - Vector2::new(e, 0.0))?;
     let dv = on_plane(at_px + Vector2::new(0.0, e))? - on_plane(at_px - Vector2::new(0.0, e))?;

@@ -338,22 +338,14 @@ fn indentation_depths(
     // how many places either side a contact can reach
     let reach = (press.bump_radius_mm / pitch).ceil() as i64;
     let sensor_cam = t_cam_sensor.inverse();
-    let origin = sensor_cam.translation.vector;
     let (mut depth, mut owner) = (vec![0f32; w * h], vec![None; w * h]);
     for v in 0..h {
         for u in 0..w {
-            let Ok(ray) = camera.unproject(&Vector2::new(u as f64, v as f64)) else {
+            let px = Vector2::new(u as f64, v as f64);
+            let Some(p) = super::pixel_on_plane(camera, &sensor_cam, grid.plane_z_mm, px) else {
                 continue;
             };
-            let d = sensor_cam.rotation * ray;
-            if d.z.abs() < 1e-12 {
-                continue;
-            }
-            let t = (grid.plane_z_mm - origin.z) / d.z;
-            if t <= 0.0 {
-                continue;
-            }
-            let (x, y) = (origin.x + t * d.x, origin.y + t * d.y);
+            let (x, y) = (p.x, p.y);
             let (c0, r0) = (
                 ((x - first.0) / pitch).round() as i64,
                 ((y - first.1) / pitch).round() as i64,
