@@ -13,6 +13,7 @@ pub mod board;
 pub mod camera;
 pub mod camera_file;
 pub mod capture_images;
+pub mod elastic;
 pub mod extrinsics;
 pub mod groundtruth;
 pub mod imprints;

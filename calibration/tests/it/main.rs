@@ -5,6 +5,7 @@ mod board_synthetic;
 mod camera_files;
 mod camera_models;
 mod common;
+mod elastic;
 mod extrinsics_synthetic;
 mod groundtruth_closed_form;
 mod groundtruth_undistort;

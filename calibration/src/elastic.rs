@@ -1,0 +1,257 @@
+//! The elastic contact of rigid indenters with a flat skin, the skin taken as a homogeneous
+//! elastic half-space: the contact pressure on a grid of square cells, the region where the
+//! skin touches the indenters, and the skin's surface displaced everywhere, inside the contact
+//! (where it takes the indenter's shape) and round it (where it sinks smoothly back to the
+//! undeformed plane). The first step of an elastic imprint model (issue 101); a thin layer on
+//! a rigid window (9DTact's 2.8 mm gel) is stiffer than a half-space away from the contact,
+//! which this does not model yet.
+//!
+//! Sources:
+//! - the surface's normal displacement under a uniform pressure `p` on a rectangle
+//!   `|x| <= a, |y| <= b` (Love, 1929; Johnson, Contact Mechanics, 1985, Eq. 3.25, Sec. 3.2):
+//!   `u = p / (pi E*) [ (x + a) ln(...) + ... ]` below, `1 / E* = (1 - nu^2) / E` for a rigid
+//!   indenter;
+//! - the contact problem on the grid, `g = h + u - d >= 0`, `p >= 0`, `p g = 0` (`h` the
+//!   indenter's height above its lowest point, `d` its approach), solved by the conjugate
+//!   gradient of Polonsky and Keer (Wear 231, 1999, 206-219), for a given approach instead of a
+//!   given load;
+//! - the check: a sphere on a half-space (Hertz; Johnson Sec. 4.2): contact radius
+//!   `sqrt(R d)`, load `4/3 E* sqrt(R) d^1.5`, the profile of [`crate::press::hertz_depth_mm`].
+//!
+//! Lengths mm, pressures MPa (N/mm^2), loads N.
+
+/// The grid the pressure lives on: `n x n` square cells of side `cell_mm`, centred on the
+/// origin of the skin's plane (cell `(i, j)` at `x = (i - (n - 1) / 2) cell_mm`, `y` alike).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactGrid {
+    pub n: usize,
+    pub cell_mm: f64,
+}
+
+impl ContactGrid {
+    /// The centre of cell `(i, j)` (column `i` along x, row `j` along y), mm.
+    pub fn centre_mm(&self, i: usize, j: usize) -> (f64, f64) {
+        let c = (self.n as f64 - 1.0) / 2.0;
+        ((i as f64 - c) * self.cell_mm, (j as f64 - c) * self.cell_mm)
+    }
+}
+
+/// The solved contact.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Contact {
+    pub grid: ContactGrid,
+    /// Per cell (row-major, `j * n + i`): the pressure, MPa; the surface's displacement into
+    /// the skin (positive down), mm; in contact (`p > 0`).
+    pub pressure_mpa: Vec<f64>,
+    pub displacement_mm: Vec<f64>,
+    pub in_contact: Vec<bool>,
+    /// The total load, N.
+    pub load_n: f64,
+    pub iterations: usize,
+}
+
+/// Why a contact cannot be solved.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ContactError {
+    #[error("the grid must have 2 to {max} cells a side of a positive size: {n} x {cell_mm} mm")]
+    Grid { n: usize, cell_mm: f64, max: usize },
+    #[error("{0} indenter heights for {1} cells")]
+    Heights(usize, usize),
+    #[error("{name} = {value}: {rule}")]
+    Value {
+        name: &'static str,
+        value: f64,
+        rule: &'static str,
+    },
+    #[error("no convergence in {0} iterations (relative change {1:.2e})")]
+    NoConvergence(usize, f64),
+}
+
+/// Most cells a side (the influence sum is direct: n^4 operations per iteration).
+pub const MAX_CELLS: usize = 128;
+
+/// The displacement at `(x, y)` of a unit pressure on the cell `|x'| <= a, |y'| <= a` times
+/// `pi E*` (Love; Johnson Eq. 3.25).
+fn love(x: f64, y: f64, a: f64) -> f64 {
+    // ln(t + sqrt(s^2 + t^2)), without the cancellation for t < 0 (s != 0 there)
+    let f = |s: f64, t: f64| -> f64 {
+        let r = (s * s + t * t).sqrt();
+        if t >= 0.0 {
+            (t + r).ln()
+        } else {
+            (s * s / (r - t)).ln()
+        }
+    };
+    let (xp, xm, yp, ym) = (x + a, x - a, y + a, y - a);
+    let term = |u: f64, v1: f64, v2: f64| -> f64 {
+        if u == 0.0 {
+            0.0
+        } else {
+            u * (f(u, v1) - f(u, v2))
+        }
+    };
+    term(xp, yp, ym) + term(yp, xp, xm) + term(xm, ym, yp) + term(ym, xm, xp)
+}
+
+/// Solves the contact of an indenter whose height above its lowest point at each cell is
+/// `height_mm` (row-major, as [`Contact`]), pressed `approach_mm` into a half-space of
+/// effective modulus `e_star_mpa` (`E / (1 - nu^2)` for a rigid indenter).
+///
+/// # Errors
+/// [`ContactError`]: a grid out of range, heights of another count, a non-positive modulus or
+/// a negative approach, no convergence.
+pub fn solve_contact(
+    grid: ContactGrid,
+    height_mm: &[f64],
+    approach_mm: f64,
+    e_star_mpa: f64,
+) -> Result<Contact, ContactError> {
+    let n = grid.n;
+    if !((2..=MAX_CELLS).contains(&n) && grid.cell_mm.is_finite() && grid.cell_mm > 0.0) {
+        return Err(ContactError::Grid {
+            n,
+            cell_mm: grid.cell_mm,
+            max: MAX_CELLS,
+        });
+    }
+    if height_mm.len() != n * n {
+        return Err(ContactError::Heights(height_mm.len(), n * n));
+    }
+    if !(e_star_mpa.is_finite() && e_star_mpa > 0.0) {
+        return Err(ContactError::Value {
+            name: "e_star_mpa",
+            value: e_star_mpa,
+            rule: "must be finite and > 0",
+        });
+    }
+    if !(approach_mm.is_finite() && approach_mm >= 0.0) {
+        return Err(ContactError::Value {
+            name: "approach_mm",
+            value: approach_mm,
+            rule: "must be finite and >= 0",
+        });
+    }
+    // the influence of a cell's unit pressure at every offset, (2n - 1)^2
+    let m = 2 * n - 1;
+    let half = grid.cell_mm / 2.0;
+    let scale = 1.0 / (std::f64::consts::PI * e_star_mpa);
+    let mut kernel = vec![0.0; m * m];
+    for dj in 0..m {
+        for di in 0..m {
+            let (x, y) = (
+                (di as f64 - (n as f64 - 1.0)) * grid.cell_mm,
+                (dj as f64 - (n as f64 - 1.0)) * grid.cell_mm,
+            );
+            kernel[dj * m + di] = scale * love(x, y, half);
+        }
+    }
+    let apply = |p: &[f64]| -> Vec<f64> {
+        let mut u = vec![0.0; n * n];
+        for (k, &pk) in p.iter().enumerate() {
+            if pk == 0.0 {
+                continue;
+            }
+            let (i0, j0) = (k % n, k / n);
+            for j in 0..n {
+                let row = (j + n - 1 - j0) * m + (n - 1 - i0);
+                let out = &mut u[j * n..j * n + n];
+                for (i, o) in out.iter_mut().enumerate() {
+                    *o += pk * kernel[row + i];
+                }
+            }
+        }
+        u
+    };
+    // Polonsky and Keer's conjugate gradient, the approach given (no load balance)
+    let mut p: Vec<f64> = height_mm
+        .iter()
+        .map(|&h| {
+            if h < approach_mm {
+                1e-3 * e_star_mpa
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let mut t = vec![0.0; n * n];
+    let (mut g_old, mut delta) = (1.0, 0.0);
+    let max_iter = 10 * n * n;
+    let mut change = f64::INFINITY;
+    for iteration in 1..=max_iter {
+        let u = apply(&p);
+        let g: Vec<f64> = (0..n * n)
+            .map(|k| height_mm[k] + u[k] - approach_mm)
+            .collect();
+        let gg: f64 = (0..n * n)
+            .filter(|&k| p[k] > 0.0)
+            .map(|k| g[k] * g[k])
+            .sum();
+        for k in 0..n * n {
+            t[k] = if p[k] > 0.0 {
+                g[k] + delta * (gg / g_old) * t[k]
+            } else {
+                0.0
+            };
+        }
+        g_old = gg.max(f64::MIN_POSITIVE);
+        let r = apply(&t);
+        let (num, den) = (0..n * n)
+            .filter(|&k| p[k] > 0.0)
+            .fold((0.0, 0.0), |(a, b), k| (a + g[k] * t[k], b + r[k] * t[k]));
+        let tau = if den > 0.0 { num / den } else { 0.0 };
+        let before: f64 = p.iter().sum();
+        let old = p.clone();
+        for k in 0..n * n {
+            if p[k] > 0.0 {
+                p[k] = (p[k] - tau * t[k]).max(0.0);
+            }
+        }
+        // cells off the contact that the indenter now overlaps enter it
+        let mut entered = false;
+        for k in 0..n * n {
+            if old[k] == 0.0 && g[k] < 0.0 {
+                p[k] = -tau * g[k];
+                if p[k] <= 0.0 {
+                    p[k] = 1e-6 * e_star_mpa;
+                }
+                entered = true;
+            }
+        }
+        delta = if entered { 0.0 } else { 1.0 };
+        let moved: f64 = p.iter().zip(&old).map(|(a, b)| (a - b).abs()).sum();
+        change = if before > 0.0 { moved / before } else { 0.0 };
+        if change < 1e-9 && !entered {
+            let u = apply(&p);
+            let area = grid.cell_mm * grid.cell_mm;
+            return Ok(Contact {
+                grid,
+                load_n: p.iter().sum::<f64>() * area,
+                in_contact: p.iter().map(|&x| x > 0.0).collect(),
+                displacement_mm: u,
+                pressure_mpa: p,
+                iterations: iteration,
+            });
+        }
+    }
+    Err(ContactError::NoConvergence(max_iter, change))
+}
+
+/// The heights of a sphere of `radius_mm` centred over `(cx, cy)` mm above its lowest point
+/// at each cell's centre (outside its silhouette: its equator's height plus the distance
+/// beyond it, so that it never touches there).
+pub fn sphere_heights(grid: ContactGrid, radius_mm: f64, cx: f64, cy: f64) -> Vec<f64> {
+    let n = grid.n;
+    let mut h = Vec::with_capacity(n * n);
+    for j in 0..n {
+        for i in 0..n {
+            let (x, y) = grid.centre_mm(i, j);
+            let r = (x - cx).hypot(y - cy);
+            h.push(if r < radius_mm {
+                radius_mm - (radius_mm * radius_mm - r * r).sqrt()
+            } else {
+                radius_mm + (r - radius_mm)
+            });
+        }
+    }
+    h
+}
