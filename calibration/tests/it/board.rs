@@ -5,7 +5,6 @@
 use fabkit_calibration::board::*;
 use fabkit_calibration::imprints::GrayImage;
 use fabkit_calibration::tables::PointTable;
-use nalgebra::Vector3;
 
 fn load(name: &str) -> GrayImage {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -21,21 +20,7 @@ fn load(name: &str) -> GrayImage {
 /// The board's point table as `fabkit fixtures ninedtact` writes it: ids 1..63 row by row
 /// from -y, the contact face at z = 2.8 mm.
 fn ninedtact_board() -> PointTable {
-    let mut rows = Vec::new();
-    for r in 0..7 {
-        for c in 0..9 {
-            let (x, y) = ((c as f64 - 4.0) * 2.5, (r as f64 - 3.0) * 2.5);
-            rows.push((
-                (r * 9 + c + 1).to_string(),
-                Vector3::new(x, y, 2.8),
-                format!("board_table.csv:{}", r * 9 + c + 2),
-            ));
-        }
-    }
-    PointTable {
-        file: "board_table.csv".into(),
-        rows,
-    }
+    crate::common::grid_table("board_table.csv", 7, 9, 2.5, 2.8)
 }
 
 /// The authors' result for this sensor (position_scale.npy): the centre bump's row and

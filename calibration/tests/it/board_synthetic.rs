@@ -29,9 +29,8 @@ use fabkit_calibration::board::{
     BoardCamera, BoardGrid, ExtraSpot, GridFind,
 };
 use fabkit_calibration::imprints::GrayImage;
-use fabkit_calibration::tables::PointTable;
 use fabkit_calibration::{CameraModel, Distortion, Intrinsics};
-use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector2, Vector3};
+use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector2};
 use std::sync::OnceLock;
 
 /// The plane's distance from the lens, mm.
@@ -45,21 +44,13 @@ const TRUE_CENTRE_PX: (f64, f64) = (319.5, 239.5);
 /// The board's point table as `fabkit fixtures` writes it: ids 1..63 row by row from -y,
 /// each row from -x (id = row x 9 + column + 1), the contact face at z = 2.8 mm.
 fn board() -> BoardGrid {
-    let mut rows = Vec::new();
-    for r in 0..7 {
-        for c in 0..9 {
-            let (x, y) = ((c as f64 - 4.0) * 2.5, (r as f64 - 3.0) * 2.5);
-            rows.push((
-                (r * 9 + c + 1).to_string(),
-                Vector3::new(x, y, PLANE_Z_MM),
-                format!("board_table.csv:{}", r * 9 + c + 2),
-            ));
-        }
-    }
-    board_grid(&PointTable {
-        file: "board_table.csv".into(),
-        rows,
-    })
+    board_grid(&crate::common::grid_table(
+        "board_table.csv",
+        7,
+        9,
+        2.5,
+        PLANE_Z_MM,
+    ))
     .unwrap()
 }
 
@@ -538,21 +529,13 @@ const PLATE_CAPTURES: usize = 13;
 
 /// The plate's point table: id = row x 7 + column + 1, x and y from -30 to 30 mm.
 fn plate() -> BoardGrid {
-    let rows = (0..49)
-        .map(|n| {
-            let (r, c) = (n / 7, n % 7);
-            let (x, y) = ((c as f64 - 3.0) * 10.0, (r as f64 - 3.0) * 10.0);
-            (
-                (n + 1).to_string(),
-                Vector3::new(x, y, PLATE_Z_MM),
-                format!("point_table.csv:{}", n + 2),
-            )
-        })
-        .collect();
-    board_grid(&PointTable {
-        file: "point_table.csv".into(),
-        rows,
-    })
+    board_grid(&crate::common::grid_table(
+        "point_table.csv",
+        7,
+        7,
+        10.0,
+        PLATE_Z_MM,
+    ))
     .unwrap()
 }
 

@@ -7,8 +7,6 @@ use fabkit_calibration::imprints::GrayImage;
 use fabkit_calibration::press::{
     fit_sphere_press, synthetic_sphere_press, PressOptions, SyntheticPress,
 };
-use fabkit_calibration::tables::PointTable;
-use nalgebra::Vector3;
 
 fn load(dir: &str, name: &str) -> GrayImage {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -23,22 +21,7 @@ fn load(dir: &str, name: &str) -> GrayImage {
 }
 
 fn board_camera() -> (BoardGrid, BoardCamera) {
-    let mut rows = Vec::new();
-    for r in 0..7u32 {
-        for c in 0..9u32 {
-            let (x, y) = ((c as f64 - 4.0) * 2.5, (r as f64 - 3.0) * 2.5);
-            rows.push((
-                (r * 9 + c + 1).to_string(),
-                Vector3::new(x, y, 2.8),
-                String::new(),
-            ));
-        }
-    }
-    let grid = board_grid(&PointTable {
-        file: "board".into(),
-        rows,
-    })
-    .unwrap();
+    let grid = board_grid(&crate::common::grid_table("board", 7, 9, 2.5, 2.8)).unwrap();
     let (r, s) = (
         load("camera_calibration", "ref.png"),
         load("camera_calibration", "sample.png"),
