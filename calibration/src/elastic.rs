@@ -1,24 +1,126 @@
-//! The elastic contact of rigid indenters with a flat skin, the skin taken as a homogeneous
-//! elastic half-space: the contact pressure on a grid of square cells, the region where the
-//! skin touches the indenters, and the skin's surface displaced everywhere, inside the contact
-//! (where it takes the indenter's shape) and round it (where it sinks smoothly back to the
-//! undeformed plane). The first step of an elastic imprint model (issue 101); a thin layer on
-//! a rigid window (9DTact's 2.8 mm gel) is stiffer than a half-space away from the contact,
-//! which this does not model yet.
+//! The elastic contact of rigid indenters with a flat skin: the contact pressure on a grid of
+//! square cells, the region where the skin touches the indenters, and the skin's surface
+//! displaced everywhere, inside the contact (where it takes the indenter's shape) and round it
+//! (where it sinks smoothly back to the undeformed plane). The skin is either a homogeneous
+//! elastic half-space or an elastic layer bonded to a rigid base (a gel cast on its window:
+//! 9DTact's 2.8 mm gel on acrylic), which is stiffer than a half-space once the contact is
+//! not small against its thickness, and whose surface sinks over a length set by it.
 //!
 //! Sources:
 //! - the surface's normal displacement under a uniform pressure `p` on a rectangle
-//!   `|x| <= a, |y| <= b` (Love, 1929; Johnson, Contact Mechanics, 1985, Eq. 3.25, Sec. 3.2):
-//!   `u = p / (pi E*) [ (x + a) ln(...) + ... ]` below, `1 / E* = (1 - nu^2) / E` for a rigid
-//!   indenter;
+//!   `|x| <= a, |y| <= b` of a half-space (Love, 1929; Johnson, Contact Mechanics, 1985,
+//!   Eq. 3.25, Sec. 3.2): `u = p / (pi E*) [ (x + a) ln(...) + ... ]` below,
+//!   `1 / E* = (1 - nu^2) / E` for a rigid indenter;
+//! - the bonded layer: the surface displacement of a layer of thickness `h` on a rigid base,
+//!   frictionless top, under the pressure's Fourier transform `p(k)`, is
+//!   `u(k) = 2 / (E* k) K(kh) p(k)` with
+//!   `K(t) = ((3 - 4 nu) sinh 2t - 2t) / ((3 - 4 nu) cosh 2t + 2t^2 + 5 - 12 nu + 8 nu^2)`
+//!   ([`layer_factor`]: a pressure `cos(k x)` on the layer is a plane-strain problem along `k`;
+//!   `K` is the solution of Navier's equations with `u = 0` on the base and no shear on the
+//!   top, its closed form checked against a symbolic solution of the same equations), so that a point load's displacement is
+//!   `u(r) = 1 / (pi E*) int_0^inf K(kh) J0(kr) dk`: the half-space's `1 / (pi E* r)` when
+//!   `K = 1`. Its limits, checked in the tests: `K -> 1` for a thick layer; for a thin
+//!   compressible one, `u = p h / M`, `M = E (1 - nu) / ((1 + nu)(1 - 2 nu))` (the constrained
+//!   modulus: each column compressed on its own, a Winkler bed); for a thin incompressible
+//!   one, `u = -h^3 / (3 mu) lap p` (the squeeze film of lubrication theory). A cell's
+//!   influence is Love's rectangle plus the layer's smooth correction
+//!   `1 / (pi E*) int_0^inf (K(kh) - 1) J0(kr) dk` (which decays as `e^(-2kh)` in `k`, so its
+//!   integral converges; Bessel J0 from `libm`) summed over the cell by 3 x 3 Gauss points;
 //! - the contact problem on the grid, `g = h + u - d >= 0`, `p >= 0`, `p g = 0` (`h` the
 //!   indenter's height above its lowest point, `d` its approach), solved by the conjugate
 //!   gradient of Polonsky and Keer (Wear 231, 1999, 206-219), for a given approach instead of a
 //!   given load;
-//! - the check: a sphere on a half-space (Hertz; Johnson Sec. 4.2): contact radius
-//!   `sqrt(R d)`, load `4/3 E* sqrt(R) d^1.5`, the profile of [`crate::press::hertz_depth_mm`].
+//! - the checks: a sphere on a half-space (Hertz; Johnson Sec. 4.2): contact radius
+//!   `sqrt(R d)`, load `4/3 E* sqrt(R) d^1.5`, the profile of [`crate::press::hertz_depth_mm`];
+//!   a paraboloid on a bonded layer against an axisymmetric solution of the same problem (a
+//!   Fredholm equation, in the tests) and Garcia and Garcia's bottom-effect series (Biophys.
+//!   J. 114, 2018, 2923-2932) for a bonded sample; a flat punch on a thin compressible layer
+//!   against the constrained modulus.
 //!
 //! Lengths mm, pressures MPa (N/mm^2), loads N.
+
+/// The skin the indenters press.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Skin {
+    /// A homogeneous elastic half-space of effective modulus `E* = E / (1 - nu^2)`, MPa.
+    HalfSpace { e_star_mpa: f64 },
+    /// An elastic layer of `thickness_mm` bonded to a rigid base (a gel cast on its window),
+    /// its top free of shear: Young's modulus, MPa, and Poisson's ratio in [0, 0.5].
+    BondedLayer {
+        young_mpa: f64,
+        poisson: f64,
+        thickness_mm: f64,
+    },
+}
+
+impl Skin {
+    /// The effective modulus `E / (1 - nu^2)` against a rigid indenter, MPa.
+    pub fn e_star_mpa(&self) -> f64 {
+        match *self {
+            Skin::HalfSpace { e_star_mpa } => e_star_mpa,
+            Skin::BondedLayer {
+                young_mpa, poisson, ..
+            } => young_mpa / (1.0 - poisson * poisson),
+        }
+    }
+}
+
+/// `K(t)`, the bonded layer's surface compliance against a half-space's at the wavenumber
+/// `k = t / h` (`t` = wavenumber times thickness, `nu` Poisson's ratio): 1 for a thick layer,
+/// `t (1 - 2 nu) / (2 (1 - nu)^2)` for a thin compressible one, `2 t^3 / 3` for a thin
+/// incompressible one (module docs).
+pub fn layer_factor(t: f64, nu: f64) -> f64 {
+    1.0 + layer_factor_less_one(t, nu)
+}
+
+/// `K(t) - 1`, without the cancellation for large `t` (`-> 0` as `t^2 e^(-2t)`).
+fn layer_factor_less_one(t: f64, nu: f64) -> f64 {
+    let c = 3.0 - 4.0 * nu;
+    let rest = 5.0 - 12.0 * nu + 8.0 * nu * nu;
+    if t > 300.0 {
+        return 0.0;
+    }
+    let e = (-2.0 * t).exp();
+    // (c sinh 2t - 2t) - (c cosh 2t + 2t^2 + rest) = -c e^(-2t) - 2t - 2t^2 - rest
+    let num = -c * e - 2.0 * t - 2.0 * t * t - rest;
+    // divided through by e^(2t)
+    let den = c * 0.5 * (1.0 + e * e) + (2.0 * t * t + rest) * e;
+    num * e / den
+}
+
+/// The layer's correction to a half-space's point-load displacement at the distances
+/// `0, dr, 2 dr, ...` up to `r_max_mm`, times `pi E*`: `int_0^inf (K(kh) - 1) J0(kr) dk`, by
+/// Simpson's rule fine enough for the oscillation of `J0` at the farthest distance and for
+/// the decay of `K - 1`, up to `k h = 40` (where `K - 1` is below `1e-30`).
+fn layer_correction_table(h: f64, nu: f64, dr: f64, r_max_mm: f64) -> Vec<f64> {
+    use rayon::prelude::*;
+    let k_max = 40.0 / h;
+    let dk_wanted = (0.1 / r_max_mm.max(h)).min(0.02 / h);
+    let mut steps = (k_max / dk_wanted).ceil() as usize;
+    steps += steps % 2;
+    let dk = k_max / steps as f64;
+    let weights: Vec<(f64, f64)> = (0..=steps)
+        .map(|i| {
+            let k = i as f64 * dk;
+            let w = if i == 0 || i == steps {
+                1.0
+            } else if i % 2 == 1 {
+                4.0
+            } else {
+                2.0
+            };
+            (k, w * dk / 3.0 * layer_factor_less_one(k * h, nu))
+        })
+        .collect();
+    let count = (r_max_mm / dr).ceil() as usize + 2;
+    (0..count)
+        .into_par_iter()
+        .map(|j| {
+            let r = j as f64 * dr;
+            weights.iter().map(|&(k, w)| w * libm::j0(k * r)).sum()
+        })
+        .collect()
+}
 
 /// The grid the pressure lives on: `n x n` square cells of side `cell_mm`, centred on the
 /// origin of the skin's plane (cell `(i, j)` at `x = (i - (n - 1) / 2) cell_mm`, `y` alike).
@@ -95,18 +197,64 @@ fn love(x: f64, y: f64, a: f64) -> f64 {
 
 /// Solves the contact of an indenter whose height above its lowest point at each cell is
 /// `height_mm` (row-major, as [`Contact`]), pressed `approach_mm` into a half-space of
-/// effective modulus `e_star_mpa` (`E / (1 - nu^2)` for a rigid indenter).
+/// effective modulus `e_star_mpa` (`E / (1 - nu^2)` for a rigid indenter):
+/// [`solve_skin_contact`] on [`Skin::HalfSpace`].
 ///
 /// # Errors
-/// [`ContactError`]: a grid out of range, heights of another count, a non-positive modulus or
-/// a negative approach, no convergence.
+/// As [`solve_skin_contact`].
 pub fn solve_contact(
     grid: ContactGrid,
     height_mm: &[f64],
     approach_mm: f64,
     e_star_mpa: f64,
 ) -> Result<Contact, ContactError> {
+    solve_skin_contact(grid, height_mm, approach_mm, Skin::HalfSpace { e_star_mpa })
+}
+
+/// Solves the contact of an indenter whose height above its lowest point at each cell is
+/// `height_mm` (row-major, as [`Contact`]), pressed `approach_mm` into `skin`.
+///
+/// # Errors
+/// [`ContactError`]: a grid out of range, heights of another count, a non-positive modulus,
+/// a Poisson's ratio outside [0, 0.5], a layer not thicker than two cells, a negative
+/// approach, no convergence.
+pub fn solve_skin_contact(
+    grid: ContactGrid,
+    height_mm: &[f64],
+    approach_mm: f64,
+    skin: Skin,
+) -> Result<Contact, ContactError> {
     let n = grid.n;
+    if let Skin::BondedLayer {
+        young_mpa,
+        poisson,
+        thickness_mm,
+    } = skin
+    {
+        if !(young_mpa.is_finite() && young_mpa > 0.0) {
+            return Err(ContactError::Value {
+                name: "young_mpa",
+                value: young_mpa,
+                rule: "must be finite and > 0",
+            });
+        }
+        if !(0.0..=0.5).contains(&poisson) {
+            return Err(ContactError::Value {
+                name: "poisson",
+                value: poisson,
+                rule: "must be in [0, 0.5]",
+            });
+        }
+        if !(thickness_mm.is_finite() && thickness_mm >= 2.0 * grid.cell_mm) {
+            return Err(ContactError::Value {
+                name: "thickness_mm",
+                value: thickness_mm,
+                rule: "must be finite and at least two cells (the layer's correction is \
+                       summed over each cell by Gauss points)",
+            });
+        }
+    }
+    let e_star_mpa = skin.e_star_mpa();
     if !((2..=MAX_CELLS).contains(&n) && grid.cell_mm.is_finite() && grid.cell_mm > 0.0) {
         return Err(ContactError::Grid {
             n,
@@ -131,20 +279,8 @@ pub fn solve_contact(
             rule: "must be finite and >= 0",
         });
     }
-    // the influence of a cell's unit pressure at every offset, (2n - 1)^2
+    let kernel = influence(grid, skin);
     let m = 2 * n - 1;
-    let half = grid.cell_mm / 2.0;
-    let scale = 1.0 / (std::f64::consts::PI * e_star_mpa);
-    let mut kernel = vec![0.0; m * m];
-    for dj in 0..m {
-        for di in 0..m {
-            let (x, y) = (
-                (di as f64 - (n as f64 - 1.0)) * grid.cell_mm,
-                (dj as f64 - (n as f64 - 1.0)) * grid.cell_mm,
-            );
-            kernel[dj * m + di] = scale * love(x, y, half);
-        }
-    }
     let apply = |p: &[f64]| -> Vec<f64> {
         let mut u = vec![0.0; n * n];
         for (k, &pk) in p.iter().enumerate() {
@@ -234,6 +370,64 @@ pub fn solve_contact(
         }
     }
     Err(ContactError::NoConvergence(max_iter, change))
+}
+
+/// The displacement into the skin, mm, at the centre of every cell of `grid` under a unit
+/// pressure (1 MPa) on one cell, by the offset between them: `(2n - 1)^2` values, row-major,
+/// offset `(di - (n - 1), dj - (n - 1))` cells at `dj * (2n - 1) + di`. The skin's values
+/// are taken as checked ([`solve_skin_contact`] checks them).
+pub fn influence(grid: ContactGrid, skin: Skin) -> Vec<f64> {
+    let n = grid.n;
+    let e_star_mpa = skin.e_star_mpa();
+    // the influence of a cell's unit pressure at every offset, (2n - 1)^2
+    let m = 2 * n - 1;
+    let half = grid.cell_mm / 2.0;
+    let scale = 1.0 / (std::f64::consts::PI * e_star_mpa);
+    let mut kernel = vec![0.0; m * m];
+    for dj in 0..m {
+        for di in 0..m {
+            let (x, y) = (
+                (di as f64 - (n as f64 - 1.0)) * grid.cell_mm,
+                (dj as f64 - (n as f64 - 1.0)) * grid.cell_mm,
+            );
+            kernel[dj * m + di] = scale * love(x, y, half);
+        }
+    }
+    if let Skin::BondedLayer {
+        poisson,
+        thickness_mm,
+        ..
+    } = skin
+    {
+        // the layer's smooth correction, summed over the source cell by 3 x 3 Gauss points
+        let r_max = std::f64::consts::SQRT_2 * (n as f64 - 1.0) * grid.cell_mm + grid.cell_mm;
+        let dr = (grid.cell_mm / 8.0).min(thickness_mm / 32.0);
+        let table = layer_correction_table(thickness_mm, poisson, dr, r_max);
+        let at = |r: f64| -> f64 {
+            let f = r / dr;
+            let i = (f as usize).min(table.len() - 2);
+            let w = f - i as f64;
+            table[i] * (1.0 - w) + table[i + 1] * w
+        };
+        let node = (0.6f64).sqrt() * half;
+        let gauss = [(-node, 5.0 / 9.0), (0.0, 8.0 / 9.0), (node, 5.0 / 9.0)];
+        for dj in 0..m {
+            for di in 0..m {
+                let (x, y) = (
+                    (di as f64 - (n as f64 - 1.0)) * grid.cell_mm,
+                    (dj as f64 - (n as f64 - 1.0)) * grid.cell_mm,
+                );
+                let mut sum = 0.0;
+                for &(gy, wy) in &gauss {
+                    for &(gx, wx) in &gauss {
+                        sum += wx * wy * at((x - gx).hypot(y - gy));
+                    }
+                }
+                kernel[dj * m + di] += scale * sum * half * half;
+            }
+        }
+    }
+    kernel
 }
 
 /// The heights of a sphere of `radius_mm` centred over `(cx, cy)` mm above its lowest point
