@@ -39,6 +39,8 @@
 //!
 //! Lengths mm, pressures MPa (N/mm^2), loads N.
 
+use rustfft::num_complex::Complex;
+
 /// The skin the indenters press.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Skin {
@@ -169,8 +171,8 @@ pub enum ContactError {
     NoConvergence(usize, f64),
 }
 
-/// Most cells a side (the influence sum is direct: n^4 operations per iteration).
-pub const MAX_CELLS: usize = 128;
+/// Most cells a side (each iteration convolves by FFTs of twice that size a side).
+pub const MAX_CELLS: usize = 512;
 
 /// The displacement at `(x, y)` of a unit pressure on the cell `|x'| <= a, |y'| <= a` times
 /// `pi E*` (Love; Johnson Eq. 3.25).
@@ -279,25 +281,8 @@ pub fn solve_skin_contact(
             rule: "must be finite and >= 0",
         });
     }
-    let kernel = influence(grid, skin);
-    let m = 2 * n - 1;
-    let apply = |p: &[f64]| -> Vec<f64> {
-        let mut u = vec![0.0; n * n];
-        for (k, &pk) in p.iter().enumerate() {
-            if pk == 0.0 {
-                continue;
-            }
-            let (i0, j0) = (k % n, k / n);
-            for j in 0..n {
-                let row = (j + n - 1 - j0) * m + (n - 1 - i0);
-                let out = &mut u[j * n..j * n + n];
-                for (i, o) in out.iter_mut().enumerate() {
-                    *o += pk * kernel[row + i];
-                }
-            }
-        }
-        u
-    };
+    let convolver = Convolver::new(n, &influence(grid, skin));
+    let apply = |p: &[f64]| convolver.apply(p);
     // Polonsky and Keer's conjugate gradient, the approach given (no load balance)
     let mut p: Vec<f64> = height_mm
         .iter()
@@ -370,6 +355,238 @@ pub fn solve_skin_contact(
         }
     }
     Err(ContactError::NoConvergence(max_iter, change))
+}
+
+/// `K_z(s, t)`, the normal displacement at depth `z` under the surface of a bonded layer of
+/// thickness `h` against the surface's of a half-space, at the wavenumber `k`: `s = k z`,
+/// `t = k h` (`t = inf`: a half-space), `nu` Poisson's ratio. From the same solution of
+/// Navier's equations as [`layer_factor`] (its closed form checked against the symbolic
+/// solution): `K_z(0, t) = K(t)`, `K_z(t, t) = 0` (the base holds), and for a half-space
+/// `(2 + s - 2 nu) e^(-s) / (2 (1 - nu))`, Boussinesq's `z^2 / rho^3 + 2 (1 - nu) / rho`
+/// under a point load (Johnson Eq. 3.21c) in Hankel's form.
+pub fn depth_factor(s: f64, t: f64, nu: f64) -> f64 {
+    let c = 4.0 * nu - 3.0;
+    let den0 = -2.0 * (nu - 1.0) * c;
+    if !t.is_finite() || t > 300.0 {
+        return c * (2.0 + s - 2.0 * nu) * (-s).exp() / den0;
+    }
+    let (e2t, e4t) = ((-2.0 * t).exp(), (-4.0 * t).exp());
+    let a =
+        -8.0 * nu * nu - 4.0 * nu * t + 14.0 * nu + 2.0 * s * t - s - 2.0 * t * t + 4.0 * t - 6.0;
+    let b =
+        8.0 * nu * nu - 4.0 * nu * t - 14.0 * nu - 2.0 * s * t - s + 2.0 * t * t + 4.0 * t + 6.0;
+    // numerator and denominator divided by e^(s + 4t)
+    let num = c * (2.0 + s - 2.0 * nu) * (-s).exp()
+        + c * (s + 2.0 * nu - 2.0) * (s - 4.0 * t).exp()
+        + a * (-s - 2.0 * t).exp()
+        + b * (s - 2.0 * t).exp();
+    let den = den0 * (1.0 + e4t)
+        + 4.0 * (nu - 1.0) * (8.0 * nu * nu - 12.0 * nu + 2.0 * t * t + 5.0) * e2t;
+    num / den
+}
+
+/// The displacement into the skin, mm, at `depth_mm` under the surface below the centre of
+/// every cell of `grid`, under a unit pressure (1 MPa) on one cell of the surface, by the
+/// offset between them, as [`influence`]'s: `(1 / (pi E*)) int_0^inf K_z(kz, kh) J0(kr) dk`
+/// ([`depth_factor`]) summed over the loaded cell by 5 x 5 Gauss points. `depth_mm` above 0
+/// (at 0: [`influence`]), and for a layer below its thickness, at least a cell (checked by
+/// [`displacement_at_depth`]).
+pub fn influence_at_depth(grid: ContactGrid, skin: Skin, depth_mm: f64) -> Vec<f64> {
+    use rayon::prelude::*;
+    let n = grid.n;
+    let m = 2 * n - 1;
+    let (nu, thickness_mm) = match skin {
+        Skin::HalfSpace { .. } => (HALF_SPACE_POISSON, f64::INFINITY),
+        Skin::BondedLayer {
+            poisson,
+            thickness_mm,
+            ..
+        } => (poisson, thickness_mm),
+    };
+    let half = grid.cell_mm / 2.0;
+    let r_max = std::f64::consts::SQRT_2 * (n as f64 - 1.0) * grid.cell_mm + grid.cell_mm;
+    let dr = (grid.cell_mm / 8.0).min(depth_mm / 16.0);
+    // Simpson up to k z = 40 (e^-40), fine enough for J0 at the farthest distance
+    let k_max = 40.0 / depth_mm;
+    let dk_wanted = (0.1 / r_max.max(depth_mm)).min(0.02 / depth_mm);
+    let mut steps = (k_max / dk_wanted).ceil() as usize;
+    steps += steps % 2;
+    let dk = k_max / steps as f64;
+    let weights: Vec<(f64, f64)> = (0..=steps)
+        .map(|i| {
+            let k = i as f64 * dk;
+            let w = if i == 0 || i == steps {
+                1.0
+            } else if i % 2 == 1 {
+                4.0
+            } else {
+                2.0
+            };
+            (
+                k,
+                w * dk / 3.0 * depth_factor(k * depth_mm, k * thickness_mm, nu),
+            )
+        })
+        .collect();
+    let count = (r_max / dr).ceil() as usize + 2;
+    let table: Vec<f64> = (0..count)
+        .into_par_iter()
+        .map(|j| {
+            let r = j as f64 * dr;
+            weights.iter().map(|&(k, w)| w * libm::j0(k * r)).sum()
+        })
+        .collect();
+    let at = |r: f64| -> f64 {
+        let f = r / dr;
+        let i = (f as usize).min(table.len() - 2);
+        let w = f - i as f64;
+        table[i] * (1.0 - w) + table[i + 1] * w
+    };
+    // 5-point Gauss-Legendre on [-1, 1]
+    let gauss = [
+        (-0.906_179_845_938_664, 0.236_926_885_056_189),
+        (-0.538_469_310_105_683, 0.478_628_670_499_366),
+        (0.0, 0.568_888_888_888_889),
+        (0.538_469_310_105_683, 0.478_628_670_499_366),
+        (0.906_179_845_938_664, 0.236_926_885_056_189),
+    ];
+    let scale = half * half / (std::f64::consts::PI * skin.e_star_mpa());
+    let mut kernel = vec![0.0; m * m];
+    for dj in 0..m {
+        for di in 0..m {
+            let (x, y) = (
+                (di as f64 - (n as f64 - 1.0)) * grid.cell_mm,
+                (dj as f64 - (n as f64 - 1.0)) * grid.cell_mm,
+            );
+            let mut sum = 0.0;
+            for &(gy, wy) in &gauss {
+                for &(gx, wx) in &gauss {
+                    sum += wx * wy * at((x - gx * half).hypot(y - gy * half));
+                }
+            }
+            kernel[dj * m + di] = scale * sum;
+        }
+    }
+    kernel
+}
+
+/// Poisson's ratio of a half-space's interior ([`Skin::HalfSpace`] gives `E*` only): 0.5, a
+/// silicone's (incompressible; its surface displacement does not depend on it).
+pub const HALF_SPACE_POISSON: f64 = 0.5;
+
+/// The normal displacement into the skin, mm, at `depth_mm` under the surface below each
+/// cell's centre (row-major, as [`Contact`]) under the contact's pressure: the face under a
+/// coat the camera sees (9DTact's black layer: 0.3 mm). At depth 0, the surface's.
+///
+/// # Errors
+/// [`ContactError::Value`] for a depth that is negative, not finite, below a cell (above 0),
+/// or not inside a layer.
+pub fn displacement_at_depth(
+    contact: &Contact,
+    skin: Skin,
+    depth_mm: f64,
+) -> Result<Vec<f64>, ContactError> {
+    if depth_mm == 0.0 {
+        return Ok(contact.displacement_mm.clone());
+    }
+    let inside = match skin {
+        Skin::HalfSpace { .. } => true,
+        Skin::BondedLayer { thickness_mm, .. } => depth_mm < thickness_mm,
+    };
+    if !(depth_mm.is_finite() && depth_mm >= contact.grid.cell_mm && inside) {
+        return Err(ContactError::Value {
+            name: "depth_mm",
+            value: depth_mm,
+            rule: "must be 0 or at least a cell, and inside the layer",
+        });
+    }
+    let kernel = influence_at_depth(contact.grid, skin, depth_mm);
+    Ok(Convolver::new(contact.grid.n, &kernel).apply(&contact.pressure_mpa))
+}
+
+/// The convolution of an `n x n` grid of values with a kernel given at every offset
+/// (`(2n - 1)^2`, as [`influence`]'s), by FFTs of size `2n` a side (circular, padded so that
+/// no offset wraps), with the scalar planner: the same bits on every CPU.
+pub struct Convolver {
+    n: usize,
+    kernel_hat: Vec<Complex<f64>>,
+    forward: std::sync::Arc<dyn rustfft::Fft<f64>>,
+    inverse: std::sync::Arc<dyn rustfft::Fft<f64>>,
+}
+
+impl Convolver {
+    /// The convolver of `kernel` (`(2n - 1)^2` values, offset `(di - (n - 1), dj - (n - 1))`
+    /// at `dj * (2n - 1) + di`).
+    pub fn new(n: usize, kernel: &[f64]) -> Convolver {
+        let big = 2 * n;
+        let m = 2 * n - 1;
+        let mut planner = rustfft::FftPlannerScalar::new();
+        let forward = planner.plan_fft_forward(big);
+        let inverse = planner.plan_fft_inverse(big);
+        let mut buf = vec![Complex::new(0.0, 0.0); big * big];
+        for dj in 0..m {
+            for di in 0..m {
+                let (x, y) = ((di + big + 1 - n) % big, (dj + big + 1 - n) % big);
+                buf[y * big + x] = Complex::new(kernel[dj * m + di], 0.0);
+            }
+        }
+        let mut c = Convolver {
+            n,
+            kernel_hat: Vec::new(),
+            forward,
+            inverse,
+        };
+        c.fft2(&mut buf, false);
+        c.kernel_hat = buf;
+        c
+    }
+
+    /// The 2D FFT of `buf` (`2n x 2n`, row-major) in place: rows, then columns.
+    fn fft2(&self, buf: &mut [Complex<f64>], inverse: bool) {
+        let big = 2 * self.n;
+        let fft = if inverse {
+            &self.inverse
+        } else {
+            &self.forward
+        };
+        fft.process(buf);
+        let mut t = vec![Complex::new(0.0, 0.0); big * big];
+        for y in 0..big {
+            for x in 0..big {
+                t[x * big + y] = buf[y * big + x];
+            }
+        }
+        fft.process(&mut t);
+        for y in 0..big {
+            for x in 0..big {
+                buf[y * big + x] = t[x * big + y];
+            }
+        }
+    }
+
+    /// `u[i] = sum_j values[j] kernel[i - j]` over the `n x n` grid (row-major).
+    pub fn apply(&self, values: &[f64]) -> Vec<f64> {
+        let (n, big) = (self.n, 2 * self.n);
+        let mut buf = vec![Complex::new(0.0, 0.0); big * big];
+        for j in 0..n {
+            for i in 0..n {
+                buf[j * big + i] = Complex::new(values[j * n + i], 0.0);
+            }
+        }
+        self.fft2(&mut buf, false);
+        for (b, k) in buf.iter_mut().zip(&self.kernel_hat) {
+            *b *= k;
+        }
+        self.fft2(&mut buf, true);
+        let scale = 1.0 / (big * big) as f64;
+        let mut u = vec![0.0; n * n];
+        for j in 0..n {
+            for i in 0..n {
+                u[j * n + i] = buf[j * big + i].re * scale;
+            }
+        }
+        u
+    }
 }
 
 /// The displacement into the skin, mm, at the centre of every cell of `grid` under a unit
