@@ -62,6 +62,19 @@ pub struct BoardArgs {
     /// The sensor's design (a YAML file or a library name), for --plane-distance-mm
     #[arg(long, value_name = "DESIGN")]
     pub design: Option<String>,
+    /// The board's grid turned in the image, degrees: 0, 90, 180 or 270 (the camera mounted
+    /// turned about its optical axis). The ids are placed as if the image's u ran along the
+    /// sensor's +x turned by this from u towards v (clockwise as the image is shown): at 90,
+    /// +x runs down the image and +y to its left, and a 7 x 9 board shows 9 tall and 7 wide.
+    /// The board's grid looks the same under a half turn, so the turn cannot be seen in the
+    /// capture: it is given
+    #[arg(
+        long,
+        value_name = "DEG",
+        default_value_t = 0.0,
+        allow_negative_numbers = true
+    )]
+    pub board_turn: f64,
     /// Output folder for extrinsics.json, extrinsics.yaml, camera.yaml (OpenCV), camera_info.yaml
     /// (ROS), camera.json, observations.csv, pixel_to_plane_mm.npy and overlay.png: missing,
     /// empty, or an earlier calibration of the same inputs as fabkit wrote it
@@ -183,7 +196,10 @@ pub fn run(cmd: CalibrateCommand) -> Result<(), Box<dyn Error>> {
 }
 
 fn board(a: BoardArgs) -> Result<(), Box<dyn Error>> {
-    use fabkit_calibration::board::{calibrate_board, plane_distance_of_design, BoardJob};
+    use fabkit_calibration::board::{
+        board_claim, calibrate_board, plane_distance_of_design, BoardJob, BoardTurn,
+    };
+    let board_turn = BoardTurn::from_deg(a.board_turn)?;
     let (plane_distance_mm, plane_distance_from) = match (a.plane_distance_mm, &a.design) {
         (Some(d), _) => (d, "--plane-distance-mm".to_string()),
         (None, given) => {
@@ -205,17 +221,6 @@ fn board(a: BoardArgs) -> Result<(), Box<dyn Error>> {
             })?
         }
     };
-    let inputs: Vec<&std::path::Path> = [a.points.as_path(), a.reference.as_path()]
-        .into_iter()
-        .chain(a.image.iter().map(PathBuf::as_path))
-        .chain(a.capture_plan.as_deref())
-        .collect();
-    let claim = OutputClaim::of_inputs(
-        OutputCommand::CalibrateBoard,
-        "a board press",
-        &inputs,
-        a.force,
-    );
     let job = BoardJob {
         points: a.points,
         points_from: match a.points_from {
@@ -227,9 +232,10 @@ fn board(a: BoardArgs) -> Result<(), Box<dyn Error>> {
         capture_plan: a.capture_plan,
         plane_distance_mm,
         plane_distance_from,
+        board_turn,
         command_line: std::env::args().collect::<Vec<_>>().join(" "),
     };
-    let staged = StagedDir::new(&a.out, claim)?;
+    let staged = StagedDir::new(&a.out, board_claim(&job, a.force))?;
     let out = calibrate_board(&job)?;
     for (name, bytes) in &out.files {
         staged.write(name, bytes)?;
@@ -244,6 +250,13 @@ fn board(a: BoardArgs) -> Result<(), Box<dyn Error>> {
         r.missing_ids.len(),
         r.extra_spots.len()
     );
+    if r.board_turn_deg != 0 {
+        println!(
+            "board turned {} deg in the image: the sensor's +x along the image's {}",
+            r.board_turn_deg,
+            board_turn.axes_in_image().0
+        );
+    }
     for n in &r.notes {
         println!("note: {n}");
     }
@@ -577,23 +590,9 @@ fn plane_names(path: &fabkit_designs::optics::OpticalPath) -> Vec<&str> {
         .collect()
 }
 
-/// The design a point table's sidecar (`<table>.json`, as `fabkit fixtures` writes it) names in
-/// its provenance (`fabkit V, design NAME (SOURCE, sha256 H)`): its name, the `--design`
-/// argument that loads it (the library name for an embedded one) and its sha256.
+/// The design the point table's sidecar names ([`fabkit_calibration::board::point_table_design`]).
 fn provenance_design(points: &std::path::Path) -> Option<(String, String, String)> {
-    let side = points.with_extension("json");
-    let prov = std::fs::read(&side)
-        .ok()
-        .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
-        .and_then(|v| v.get("provenance")?.as_str().map(str::to_string))?;
-    let (name, inside) = prov.split_once(", design ")?.1.split_once(" (")?;
-    let (source, rest) = inside.split_once(", sha256 ")?;
-    let arg = source.strip_prefix("embedded:").unwrap_or(source);
-    Some((
-        name.to_string(),
-        arg.to_string(),
-        rest.trim_end_matches(')').to_string(),
-    ))
+    fabkit_calibration::board::point_table_design(points)
 }
 
 /// [`TableDesign`] of the point table `points`. The design is used only when it reads as it

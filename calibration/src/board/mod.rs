@@ -47,8 +47,93 @@ pub enum BoardError {
     Plan { file: String, rule: String },
     #[error("--plane-distance-mm = {value}: {rule}")]
     PlaneDistance { value: String, rule: String },
+    #[error("--board-turn = {value}: {rule}")]
+    Turn { value: String, rule: String },
     #[error("the camera model: {0}")]
     Solve(String),
+}
+
+/// How the board's grid lies in the image: the camera mounted turned about its optical axis
+/// by a number of quarter turns (`--board-turn`, degrees). With the turn `t` the sensor's +x
+/// runs in the image along `(cos t, sin t)` in (u, v), from u towards v (clockwise as an
+/// image is shown, v down), and +y along `(-sin t, cos t)`: the rotation of T_cam_sensor is
+/// the unturned one followed by `t` about the camera's z (its optical axis). An image of the
+/// unturned camera turned by the image crate's `rotate90` (clockwise) is one of `Deg90`.
+///
+/// The board's grid is symmetric under a half turn (and a square grid under a quarter turn),
+/// so the turn cannot be seen in a capture: it is given, and ids are placed as it says.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum BoardTurn {
+    /// The image's u along the sensor's +x, v along +y.
+    #[default]
+    Deg0,
+    /// u along -y, v along +x.
+    Deg90,
+    /// u along -x, v along -y.
+    Deg180,
+    /// u along +y, v along -x.
+    Deg270,
+}
+
+impl BoardTurn {
+    /// The four turns, in order.
+    pub const ALL: [BoardTurn; 4] = [Self::Deg0, Self::Deg90, Self::Deg180, Self::Deg270];
+
+    /// The turn of `deg` degrees: 0, 90, 180 or 270.
+    ///
+    /// # Errors
+    /// [`BoardError::Turn`] for any other value (a multiple of 90 outside 0..=270 is told its
+    /// equivalent).
+    pub fn from_deg(deg: f64) -> Result<Self, BoardError> {
+        if let Some(t) = Self::ALL.iter().find(|t| f64::from(t.deg()) == deg) {
+            return Ok(*t);
+        }
+        let mut rule = "must be 0, 90, 180 or 270: the board's grid turned in the image by quarter turns, degrees from the image's u towards its v".to_string();
+        if deg.is_finite() && deg % 90.0 == 0.0 {
+            rule += &format!(" ({} is {})", crate::shown_f64(deg), deg.rem_euclid(360.0));
+        }
+        Err(BoardError::Turn {
+            value: crate::shown_f64(deg),
+            rule,
+        })
+    }
+
+    /// The turn, degrees: 0, 90, 180 or 270.
+    pub fn deg(self) -> u32 {
+        match self {
+            Self::Deg0 => 0,
+            Self::Deg90 => 90,
+            Self::Deg180 => 180,
+            Self::Deg270 => 270,
+        }
+    }
+
+    /// (cos t, sin t), exact.
+    fn cos_sin(self) -> (f64, f64) {
+        match self {
+            Self::Deg0 => (1.0, 0.0),
+            Self::Deg90 => (0.0, 1.0),
+            Self::Deg180 => (-1.0, 0.0),
+            Self::Deg270 => (0.0, -1.0),
+        }
+    }
+
+    /// An image vector (u, v), px, turned back by `-t`: where it would lie in the unturned
+    /// camera's image (about the origin; exact, as a quarter turn only swaps and negates).
+    pub fn unturn(self, p: Vector2<f64>) -> Vector2<f64> {
+        let (c, s) = self.cos_sin();
+        Vector2::new(c * p.x + s * p.y, -s * p.x + c * p.y)
+    }
+
+    /// The image's directions along which the sensor's +x and +y run, in words (`"+u"`, ...).
+    pub fn axes_in_image(self) -> (&'static str, &'static str) {
+        match self {
+            Self::Deg0 => ("+u", "+v"),
+            Self::Deg90 => ("+v", "-u"),
+            Self::Deg180 => ("-u", "-v"),
+            Self::Deg270 => ("-v", "+u"),
+        }
+    }
 }
 
 /// One bump of the board: its id (the point table's), its place in the grid and its point on
@@ -222,31 +307,55 @@ pub struct GridFind {
 /// neighbour.
 const STEP_TOLERANCE: f64 = 0.3;
 
-/// Assigns grid ids to `spots` (centres, px): the lattice they form is walked from the spot
-/// nearest their centre, each step predicted from the last one taken in that direction (the
-/// spacing changes across a distorted image), across a missing imprint by a double step.
-/// The image's u runs along the board's x (its columns) and v along its y (its rows): the
-/// camera looks up at the skin along +z with its image's right along +x (docs/conventions.md),
-/// so that the right-handed camera frame has the sensor frame's axes. A walked lattice
-/// smaller than the grid is placed on it so that the imprint nearest the image's centre
-/// `centre_px` is as near the grid's centre as it can be (said in `notes`). The answer does
-/// not depend on the spots' order.
+/// Assigns grid ids to `spots` (centres, px) with the camera unturned: [`assign_grid_turned`]
+/// with [`BoardTurn::Deg0`] (the image's u along the sensor's +x, v along +y).
 ///
 /// # Errors
-/// [`BoardError::Press`] (`file` the capture) when fewer than 4 spots lie on the lattice, or
-/// the lattice is larger than the grid (another board, or the grid turned against the image).
+/// As [`assign_grid_turned`].
 pub fn assign_grid(
     spots: &[(f64, f64)],
     grid: &BoardGrid,
     centre_px: (f64, f64),
     file: &str,
 ) -> Result<GridFind, BoardError> {
+    assign_grid_turned(spots, grid, centre_px, BoardTurn::Deg0, file)
+}
+
+/// Assigns grid ids to `spots` (centres, px): the lattice they form is walked from the spot
+/// nearest their centre, each step predicted from the last one taken in that direction (the
+/// spacing changes across a distorted image), across a missing imprint by a double step.
+/// The board's x (its columns) runs along the image's u turned by `turn` and its y (its rows)
+/// along v turned by `turn` ([`BoardTurn`]): unturned, the camera looks up at the skin along
+/// +z with its image's right along +x (docs/conventions.md), so that the right-handed camera
+/// frame has the sensor frame's axes. The walk runs on the spots turned back by `turn`, so a
+/// 7 x 9 board seen a quarter turned (9 tall and 7 wide in the image) walks as 7 x 9. A walked
+/// lattice smaller than the grid is placed on it so that the imprint nearest the image's
+/// centre `centre_px` is as near the grid's centre as it can be (said in `notes`). The answer
+/// does not depend on the spots' order.
+///
+/// # Errors
+/// [`BoardError::Press`] (`file` the capture) when fewer than 4 spots lie on the lattice, or
+/// the lattice is larger than the grid (another board, or the grid turned against the image
+/// otherwise than `turn` says: the message says which turn fits).
+pub fn assign_grid_turned(
+    spots: &[(f64, f64)],
+    grid: &BoardGrid,
+    centre_px: (f64, f64),
+    turn: BoardTurn,
+    file: &str,
+) -> Result<GridFind, BoardError> {
     let bad = |rule: String| BoardError::Press {
         file: file.to_string(),
         rule,
     };
-    let mut pts: Vec<Vector2<f64>> = spots.iter().map(|&(u, v)| Vector2::new(u, v)).collect();
-    pts.sort_by(|a, b| a.y.total_cmp(&b.y).then(a.x.total_cmp(&b.x)));
+    // (the spot turned back into the unturned image, the spot's pixel), in the unturned
+    // image's order, so that a turned capture walks as the unturned one
+    let mut pairs: Vec<(Vector2<f64>, Vector2<f64>)> = spots
+        .iter()
+        .map(|&(u, v)| (turn.unturn(Vector2::new(u, v)), Vector2::new(u, v)))
+        .collect();
+    pairs.sort_by(|a, b| a.0.y.total_cmp(&b.0.y).then(a.0.x.total_cmp(&b.0.x)));
+    let (pts, pixels): (Vec<Vector2<f64>>, Vec<Vector2<f64>>) = pairs.into_iter().unzip();
     if pts.len() < 4 {
         return Err(bad(format!(
             "{} imprints found: at least 4 of the board's {} are needed",
@@ -324,13 +433,25 @@ pub fn assign_grid(
     let (jmin, jmax) = min_max(walked.iter().map(|(_, p)| p.1));
     let (wide, tall) = ((imax - imin + 1) as u32, (jmax - jmin + 1) as u32);
     if wide > grid.columns || tall > grid.rows {
+        let (x_dir, y_dir) = turn.axes_in_image();
+        let hint = if wide <= grid.rows && tall <= grid.columns {
+            let quarter = |k: u32| (turn.deg() + k) % 360;
+            format!(
+                "the camera turned a quarter turn against the sensor's x otherwise than --board-turn {} says (--board-turn {} or {} fits this lattice)",
+                turn.deg(),
+                quarter(90),
+                quarter(270)
+            )
+        } else {
+            "or a lattice larger than the board".to_string()
+        };
         return Err(bad(format!(
-            "the imprints form a lattice {wide} wide (along u) and {tall} tall (along v), larger than the board's {} columns (along x) and {} rows (along y): another board, or the camera turned against the sensor's x",
+            "the imprints form a lattice {wide} wide (along the image's {x_dir}) and {tall} tall (along its {y_dir}), larger than the board's {} columns (along x) and {} rows (along y): another board, or {hint}",
             grid.columns, grid.rows
         )));
     }
     let mut notes = Vec::new();
-    let centre = Vector2::new(centre_px.0, centre_px.1);
+    let centre = turn.unturn(Vector2::new(centre_px.0, centre_px.1));
     let middle = walked
         .iter()
         .min_by(|a, b| {
@@ -370,8 +491,8 @@ pub fn assign_grid(
                 id: g.id.clone(),
                 row,
                 column,
-                u_px: pts[*k].x,
-                v_px: pts[*k].y,
+                u_px: pixels[*k].x,
+                v_px: pixels[*k].y,
             });
         }
     }
@@ -387,8 +508,8 @@ pub fn assign_grid(
         .enumerate()
         .filter(|(_, p)| p.is_none())
         .map(|(k, _)| ExtraSpot {
-            u_px: pts[k].x,
-            v_px: pts[k].y,
+            u_px: pixels[k].x,
+            v_px: pixels[k].y,
             why: "not on the lattice the other imprints form".into(),
         })
         .collect();
@@ -629,6 +750,9 @@ pub struct BoardJob {
     /// comes from in words.
     pub plane_distance_mm: f64,
     pub plane_distance_from: String,
+    /// The board's grid turned in the images (the camera turned about its optical axis):
+    /// the ids are placed as [`BoardTurn`] says.
+    pub board_turn: BoardTurn,
     pub command_line: String,
 }
 
@@ -643,6 +767,9 @@ pub struct BoardReport {
     pub capture_plan: Option<String>,
     pub image_size_px: [u32; 2],
     pub grid: GridSummary,
+    /// The board's grid turned in the image, degrees (0, 90, 180 or 270; [`BoardTurn`]): the
+    /// sensor's +x runs along the image's u turned this much towards v.
+    pub board_turn_deg: u32,
     /// Spots the detector found.
     pub spots: usize,
     pub found: usize,
@@ -714,6 +841,44 @@ pub struct BoardOutput {
     /// (float32, H x W x 2: x and y on the plane, mm; NaN off it), `overlay.png` (on the
     /// darkest of the captures at each pixel, so that every capture's imprints show).
     pub files: Vec<(String, Vec<u8>)>,
+}
+
+/// The claim on a board calibration's output folder (`--out`): the job is the point table,
+/// the reference, the captures and the capture plan, by content
+/// ([`fabkit_export::OutputClaim::of_inputs`]), so that an earlier calibration in the folder is
+/// replaced only by one of the same inputs (or with `force`).
+pub fn board_claim(job: &BoardJob, force: bool) -> fabkit_export::OutputClaim {
+    let inputs: Vec<&std::path::Path> = [job.points.as_path(), job.reference.as_path()]
+        .into_iter()
+        .chain(job.images.iter().map(std::path::PathBuf::as_path))
+        .chain(job.capture_plan.as_deref())
+        .collect();
+    fabkit_export::OutputClaim::of_inputs(
+        fabkit_export::OutputCommand::CalibrateBoard,
+        "a board press",
+        &inputs,
+        force,
+    )
+}
+
+/// The design a point table's sidecar (`<table>.json`, as `fabkit fixtures` writes it) names in
+/// its provenance (`fabkit V, design NAME (SOURCE, sha256 H)`): its name, the `--design`
+/// argument that loads it (the library name for an embedded one) and its sha256; `None` when
+/// the sidecar is missing or names no design.
+pub fn point_table_design(points: &std::path::Path) -> Option<(String, String, String)> {
+    let side = points.with_extension("json");
+    let prov = std::fs::read(&side)
+        .ok()
+        .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
+        .and_then(|v| v.get("provenance")?.as_str().map(str::to_string))?;
+    let (name, inside) = prov.split_once(", design ")?.1.split_once(" (")?;
+    let (source, rest) = inside.split_once(", sha256 ")?;
+    let arg = source.strip_prefix("embedded:").unwrap_or(source);
+    Some((
+        name.to_string(),
+        arg.to_string(),
+        rest.trim_end_matches(')').to_string(),
+    ))
 }
 
 /// The image size of `path`, px, or why it cannot be read.
@@ -798,7 +963,13 @@ pub fn calibrate_board(job: &BoardJob) -> Result<BoardOutput, BoardError> {
                 })
         })
         .collect::<Result<Vec<_>, _>>()?;
-    let found = find_bumps_in_captures(&reference, &captures, &grid, plan.as_deref())?;
+    let found = find_bumps_in_captures_turned(
+        &reference,
+        &captures,
+        &grid,
+        plan.as_deref(),
+        job.board_turn,
+    )?;
     let bc = solve_board_camera(&grid, &found.find, size, job.plane_distance_mm)?;
     let report = board_report(job, &grid, &found, &bc, size);
     let files = board_files(&report, &bc, &grid, &job.images)?;
@@ -858,6 +1029,7 @@ pub fn find_bumps(
         image_centre_px(capture),
         grid,
         None,
+        BoardTurn::Deg0,
     )?;
     Ok((spots, found.find))
 }
@@ -947,6 +1119,22 @@ pub fn find_bumps_in_captures(
     grid: &BoardGrid,
     plan: Option<&[Vec<String>]>,
 ) -> Result<CapturesFind, BoardError> {
+    find_bumps_in_captures_turned(reference, captures, grid, plan, BoardTurn::Deg0)
+}
+
+/// [`find_bumps_in_captures`] with the board's grid turned in the images by `turn`
+/// ([`BoardTurn`], [`assign_grid_turned`]): the ids placed as if the image's u ran along the
+/// sensor's x turned by `turn`.
+///
+/// # Errors
+/// As [`find_bumps_in_captures`].
+pub fn find_bumps_in_captures_turned(
+    reference: &GrayImage,
+    captures: &[(String, GrayImage)],
+    grid: &BoardGrid,
+    plan: Option<&[Vec<String>]>,
+    turn: BoardTurn,
+) -> Result<CapturesFind, BoardError> {
     let Some((_, first)) = captures.first() else {
         return Err(BoardError::Press {
             file: String::new(),
@@ -957,7 +1145,7 @@ pub fn find_bumps_in_captures(
         .iter()
         .map(|(file, img)| Ok((file.clone(), detect_board_spots(reference, img, file)?)))
         .collect::<Result<Vec<_>, BoardError>>()?;
-    group_and_walk(spots, image_centre_px(first), grid, plan)
+    group_and_walk(spots, image_centre_px(first), grid, plan, turn)
 }
 
 /// A spot under this fraction of the spots' upper quartile area is no imprint.
@@ -969,6 +1157,7 @@ fn group_and_walk(
     centre_px: (f64, f64),
     grid: &BoardGrid,
     plan: Option<&[Vec<String>]>,
+    turn: BoardTurn,
 ) -> Result<CapturesFind, BoardError> {
     let files: Vec<&str> = spots.iter().map(|(f, _)| f.as_str()).collect();
     let union_file = files.join(", ");
@@ -1033,7 +1222,7 @@ fn group_and_walk(
             mean_in_order(members)
         })
         .collect();
-    let walked = assign_grid(&centres, grid, centre_px, &union_file)?;
+    let walked = assign_grid_turned(&centres, grid, centre_px, turn, &union_file)?;
     // the place of each group: the found bump whose pixel is its centre (copied exactly)
     let id_of_group = |g: usize| -> Option<&FoundBump> {
         let c = centres[roots.binary_search(&g).ok()?];
@@ -1238,6 +1427,7 @@ fn board_report(
             pitch_mm: grid.pitch_mm,
             plane_z_mm: grid.plane_z_mm,
         },
+        board_turn_deg: job.board_turn.deg(),
         spots: found.spots,
         found: find.found.len(),
         missing_ids: find.missing.clone(),
