@@ -4,8 +4,10 @@ tactile sensors, from Python.
 The same library the ``fabkit`` command line runs, called in-process: designs (load, read and set
 parameters by path, presets, validation), kits (build, meshes as numpy arrays, pour table,
 export byte-identical to ``fabkit export``), fixtures (point tables as numpy arrays), extrinsics
-calibration from numpy arrays, and ground-truth depth rendered straight into numpy arrays or read
-back from a ``fabkit groundtruth`` folder.
+calibration from numpy arrays, a flat sensor's camera from a board press (``calibrate_board``,
+as ``fabkit calibrate board``), and ground-truth depth rendered straight into numpy arrays or read
+back from a ``fabkit groundtruth`` folder (``GroundTruth``; a real sphere press's folder:
+``PressGroundTruth``).
 
 Units: mm and degrees; image coordinates in px. Frames: docs/conventions.md (sensor frame, camera
 frame x right, y down, z forward). Errors are ``FabkitError`` subclasses whose message is what the
@@ -32,6 +34,7 @@ from ._fabkit import (  # noqa: F401
     build_fixtures,
     Camera,
     solve_extrinsics,
+    calibrate_board,
     ProtrusionSet,
     DepthRenderer,
     read_protrusions,
@@ -40,5 +43,5 @@ from ._fabkit import (  # noqa: F401
     read_photometric,
     GROUNDTRUTH_FILES,
 )
-from .groundtruth import GroundTruth, StitchedPair  # noqa: F401
+from .groundtruth import GroundTruth, PressGroundTruth, StitchedPair  # noqa: F401
 from .sweep import SweepTables, sweep  # noqa: F401

@@ -239,6 +239,32 @@ def solve_extrinsics(
     CalibrationError (a non-finite entry: ``points_mm[i, j] = nan: must be finite``),
     ValueError (shapes)."""
 
+def calibrate_board(
+    points: StrPath,
+    reference: StrPath,
+    images: Union[StrPath, Sequence[StrPath]],
+    out: StrPath,
+    *,
+    plane_distance_mm: Optional[float] = None,
+    design: Union[Design, StrPath, None] = None,
+    capture_plan: Optional[StrPath] = None,
+    board_turn_deg: float = 0,
+    points_from: str = "contact",
+    force: bool = False,
+    command_line: Optional[Sequence[str]] = None,
+) -> Dict[str, Any]:
+    """A flat sensor's camera from a press of its calibration board (one capture, or a grid
+    plate's several with ``capture_plan``), written into ``out`` as ``fabkit calibrate board``
+    writes it (extrinsics.json/.yaml, camera.yaml, camera_info.yaml, camera.json,
+    observations.csv, pixel_to_plane_mm.npy, overlay.png). ``plane_distance_mm`` None: from
+    ``design``'s flat housing (a Design, library name or YAML path) or the design the point
+    table names. ``board_turn_deg`` (0, 90, 180, 270): the board's grid turned in the image
+    (the camera turned about its optical axis; +x along u turned towards v). Returns
+    T_cam_sensor (4, 4), camera (Camera, read back from camera.json), ids, observed_px and
+    residuals_px (n, 2), rms_reprojection_error_px, report (extrinsics.json's content), files,
+    warnings. Raises CalibrationError with the CLI's message, DesignError (a design that does
+    not load), ValueError / TypeError (arguments)."""
+
 class ProtrusionSet:
     """One semi-dome (semi-plate) configuration: a pattern at 0 deg (+x half) or 180 deg;
     or one capture of a pin dome (read_pin_captures)."""

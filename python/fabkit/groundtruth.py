@@ -47,7 +47,7 @@ import numpy as np
 
 from ._fabkit import GROUNDTRUTH_FILES as _F
 
-__all__ = ["GroundTruth", "StitchedPair"]
+__all__ = ["GroundTruth", "PressGroundTruth", "StitchedPair"]
 
 #: Header row of ``pairs.csv``.
 PAIRS_HEADER = list(_F["pairs_header"])
@@ -63,6 +63,8 @@ _NORMALS = _F["normals"]
 _NPY = _F["npy_suffix"]
 _NPZ = _F["arrays_npz"]
 _CONTACT = _F["contact_mask"]
+#: The fit of a press's ground truth (`fabkit groundtruth --press-image`).
+_PRESS_JSON = _F["press_json"]
 
 
 def _png16(map_name: str) -> str:
@@ -113,59 +115,32 @@ class StitchedPair(NamedTuple):
     normals: Optional[np.ndarray]
 
 
-class GroundTruth:
-    """The stitched pairs of a ``fabkit groundtruth`` output folder, as a read-only sequence.
+def _refuse_other_kinds(m: dict, p: str) -> None:
+    """Refuses the folders of ``fabkit groundtruth`` that hold no stitched pairs."""
+    fixtures = m.get("fixtures")
+    if isinstance(fixtures, dict) and "pin_captures" in fixtures:
+        raise ValueError(
+            f"{p}: the ground truth of a pin dome's captures (`fabkit groundtruth "
+            "--pin-captures`) has no stitched pairs; its frames are the folders its "
+            "configurations list (numpy.load each <capture>/range_mm.npy), or render them "
+            "with fabkit.read_pin_captures and DepthRenderer"
+        )
+    if "press" in m and fixtures is None:
+        raise ValueError(
+            f"{p}: the ground truth of a real press (`fabkit groundtruth --press-image`) has "
+            "no stitched pairs: open it with fabkit.PressGroundTruth (its reference and "
+            "pressed frames, the fit of press.json and the captures)"
+        )
 
-    ``len(gt)`` is N*N (N patterns); ``gt[i]`` (negative ``i`` counts from the end; a slice
-    gives a list) loads and stitches pair ``i`` (:class:`StitchedPair`); ``for pair in gt``
-    iterates them in ``pairs.csv`` order. Frames are read from disk when first needed and the
-    last ``cache_frames`` frames are kept.
 
-    Supported ``--format``:
+class _Folder:
+    """What the readers of a ``fabkit groundtruth`` folder share: its manifest's image size,
+    camera and pose, its frames' arrays (read when first needed, the last few kept), the
+    reference frame and the half masks."""
 
-    * ``npy``: ``<frame>/<name>.npy`` float32 maps (exact values);
-    * ``npz``: ``<frame>/arrays.npz`` holding the same float32 maps (exact values);
-    * ``png``: the 16-bit PNGs ``<frame>/<stem>_um.png`` decoded as
-      ``value_mm = (count - offset_counts) * scale_mm_per_count`` (count 0 -> NaN), i.e.
-      quantised to 1 micrometre, and without normals (``normals`` is ``None``).
-
-    Args:
-        folder: the ``--out`` folder of ``fabkit groundtruth``.
-        cache_frames: how many decoded frames to keep in memory (>= 0); 4 by default. Pairs
-            are in right-pattern-major order, so the right frame is reused N times in a row.
-
-    Attributes:
-        folder: the folder (``str``).
-        manifest: ``manifest.json`` as a dict.
-        format: ``"npy"``, ``"npz"`` or ``"png"`` (found from the reference frame's files).
-        shape: ``(H, W)`` of every map.
-        patterns: the pattern names, in ``manifest.json`` order (N of them).
-        pairs: the rows of ``pairs.csv``: ``(index, right_pattern, right_dir, left_pattern,
-            left_dir)``.
-        camera: the manifest's ``camera`` dict (intrinsics: ``fx_px``, ``fy_px``, ``cx_px``,
-            ``cy_px``, ``distortion_model``, ``distortion_coefficients``,
-            ``image_width_px``, ``image_height_px``, the camera file and its sha256).
-        T_cam_sensor: ``(4, 4)`` float64, homogeneous transform mapping sensor-frame points
-            (mm) to camera-frame points (mm).
-        masks: ``(left, right)``, ``(H, W)`` bool arrays (read-only): pixels whose ray meets
-            the reference surface at sensor-frame x < 0, resp. x >= 0. Disjoint; their union
-            is the pixels that see the skin.
-        reference: dict of the reference (undeformed) frame's arrays (read-only):
-            ``range_mm``, ``zdepth_mm`` (``(H, W)`` float32, mm, NaN off the skin) and, for
-            ``npy``/``npz`` folders, ``normals`` (``(H, W, 3)`` float32, camera frame).
-
-    Raises:
-        FileNotFoundError: ``folder``, ``manifest.json``, ``pairs.csv``, a mask or a frame
-            file is missing (the message names the path). Frame files are checked when the
-            folder is opened and again when read.
-        ValueError: the folder is not a ``fabkit groundtruth`` folder or is inconsistent: the
-            manifest is not JSON or is of another kind (no ``configurations``,
-            ``reference``, ...), ``pairs.csv`` has another header, rows out of order, unknown
-            frame folders or not N*N rows, an array or PNG has the wrong shape or dtype or
-            cannot be decoded. The message names the file and the rule.
-    """
-
-    def __init__(self, folder, cache_frames: int = 4):
+    def _open(self, folder, cache_frames, missing_what: str, check_kind) -> None:
+        """Opens ``folder``: the manifest (``check_kind(manifest, path)`` refuses another kind
+        of folder), the image size, camera, pose, frames and format."""
         self.folder = os.fspath(folder)
         if not os.path.isdir(self.folder):
             raise FileNotFoundError(
@@ -176,7 +151,7 @@ class GroundTruth:
         self._cache_size = int(cache_frames)
         self._cache: "OrderedDict[str, Dict[str, np.ndarray]]" = OrderedDict()
 
-        self.manifest = self._read_manifest()
+        self.manifest = self._read_manifest(missing_what, check_kind)
         m = self.manifest
         try:
             h = int(m["image"]["height_px"])
@@ -201,23 +176,24 @@ class GroundTruth:
                 f"{self._path(_MANIFEST)}: extrinsics.T_cam_sensor: must be a 4 x 4 matrix"
             )
         self.T_cam_sensor: np.ndarray = t
-        self.patterns: List[str] = list((m.get("fixtures") or {}).get("patterns") or [])
 
         self._frames: Dict[str, dict] = {}  # frame dir -> {"files": {rel path: entry}}
         ref_dir = m["reference"].get("dir", _F["reference_dir"])
         self._reference_dir = ref_dir
         self._frames[ref_dir] = self._frame_entry(m["reference"])
         for c in m["configurations"]:
-            if "dir" not in c:
+            if not isinstance(c, dict) or "dir" not in c:
                 raise ValueError(
                     f"{self._path(_MANIFEST)}: configurations: an entry has no 'dir'"
                 )
             self._frames[c["dir"]] = self._frame_entry(c)
         self.format: str = self._detect_format(ref_dir)
+        self._reference: Optional[Dict[str, np.ndarray]] = None
 
-        self.pairs: List[Tuple[int, str, str, str, str]] = self._read_pairs()
-        for d in [ref_dir] + sorted({p[2] for p in self.pairs} | {p[4] for p in self.pairs}):
-            for rel in self._frame_files(d, reference=(d == ref_dir)):
+    def _check_frame_files(self, dirs: List[str]) -> None:
+        """Every file read for the frames ``dirs`` is there (FileNotFoundError naming it)."""
+        for d in dirs:
+            for rel in self._frame_files(d, reference=(d == self._reference_dir)):
                 p = self._path(rel)
                 if not os.path.isfile(p):
                     raise FileNotFoundError(
@@ -225,6 +201,7 @@ class GroundTruth:
                         f"(--format {self.format}); the folder is incomplete"
                     )
 
+    def _open_masks(self) -> None:
         left = self._read_mask(_LEFT_MASK)
         right = self._read_mask(_RIGHT_MASK)
         if (left & right).any():
@@ -234,48 +211,6 @@ class GroundTruth:
         left.flags.writeable = False
         right.flags.writeable = False
         self.masks: Tuple[np.ndarray, np.ndarray] = (left, right)
-        self._reference: Optional[Dict[str, np.ndarray]] = None
-
-    # ----------------------------------------------------------------- sequence protocol
-
-    def __len__(self) -> int:
-        return len(self.pairs)
-
-    def __getitem__(self, i):
-        """Pair ``i`` (:class:`StitchedPair`), or a list of pairs for a slice.
-
-        Raises:
-            IndexError: ``i`` outside ``-len(self) .. len(self) - 1``.
-            TypeError: ``i`` is neither an integer nor a slice.
-            FileNotFoundError, ValueError: a frame file is missing or malformed (named).
-        """
-        if isinstance(i, slice):
-            return [self[k] for k in range(*i.indices(len(self)))]
-        try:
-            k = int(i.__index__())
-        except AttributeError:
-            raise TypeError(
-                f"GroundTruth indices must be integers or slices, not {type(i).__name__}"
-            ) from None
-        n = len(self)
-        if k < 0:
-            k += n
-        if not 0 <= k < n:
-            raise IndexError(f"pair index {i} out of range for {n} stitched pairs")
-        return self._stitch(k)
-
-    def __iter__(self):
-        for k in range(len(self)):
-            yield self._stitch(k)
-
-    def __repr__(self) -> str:
-        h, w = self.shape
-        return (
-            f"GroundTruth({self.folder!r}: {len(self)} stitched pairs of {len(self.patterns)} "
-            f"patterns, {w} x {h} px, --format {self.format})"
-        )
-
-    # ----------------------------------------------------------------- public accessors
 
     @property
     def reference(self) -> Dict[str, np.ndarray]:
@@ -293,18 +228,13 @@ class GroundTruth:
             self._reference = arrays
         return self._reference
 
-    # ----------------------------------------------------------------- internals
-
     def _path(self, rel: str) -> str:
         return os.path.join(self.folder, *rel.split("/"))
 
-    def _read_manifest(self) -> dict:
+    def _read_manifest(self, missing_what: str, check_kind) -> dict:
         p = self._path(_MANIFEST)
         if not os.path.isfile(p):
-            raise FileNotFoundError(
-                f"{p}: missing: not a `fabkit groundtruth` output folder "
-                "(it writes manifest.json, pairs.csv, left_mask.png, right_mask.png and a folder per frame)"
-            )
+            raise FileNotFoundError(f"{p}: missing: {missing_what}")
         try:
             with open(p, "rb") as f:
                 m = json.loads(f.read().decode("utf-8"))
@@ -326,14 +256,7 @@ class GroundTruth:
                 f"{p}: configurations must be a list and reference an object "
                 "(the manifest of `fabkit groundtruth`)"
             )
-        fixtures = m.get("fixtures")
-        if isinstance(fixtures, dict) and "pin_captures" in fixtures:
-            raise ValueError(
-                f"{p}: the ground truth of a pin dome's captures (`fabkit groundtruth "
-                "--pin-captures`) has no stitched pairs; its frames are the folders its "
-                "configurations list (numpy.load each <capture>/range_mm.npy), or render them "
-                "with fabkit.read_pin_captures and DepthRenderer"
-            )
+        check_kind(m, p)
         return m
 
     def _frame_entry(self, entry: dict) -> dict:
@@ -370,36 +293,6 @@ class GroundTruth:
         if not reference:
             files.append(f"{d}/{_CONTACT}")
         return files
-
-    def _read_pairs(self) -> List[Tuple[int, str, str, str, str]]:
-        p = self._path(_PAIRS)
-        if not os.path.isfile(p):
-            raise FileNotFoundError(f"{p}: missing: a `fabkit groundtruth` folder lists its stitched pairs there")
-        with open(p, newline="", encoding="utf-8") as f:
-            rows = [r for r in csv.reader(f) if r and not r[0].startswith("#")]
-        if not rows or rows[0] != PAIRS_HEADER:
-            got = ",".join(rows[0]) if rows else "(empty)"
-            raise ValueError(f"{p}:1: header = {got}: must be {','.join(PAIRS_HEADER)}")
-        cfg_dirs = set(self._frames) - {self._reference_dir}
-        pairs = []
-        for k, r in enumerate(rows[1:]):
-            line = k + 2
-            if len(r) != 5:
-                raise ValueError(f"{p}:{line}: {len(r)} columns: must be 5 ({','.join(PAIRS_HEADER)})")
-            if r[0] != str(k):
-                raise ValueError(f"{p}:{line}: pair = {r[0]}: must be {k} (rows numbered from 0 in order)")
-            for col, side in ((2, "right_dir"), (4, "left_dir")):
-                if r[col] not in cfg_dirs:
-                    raise ValueError(
-                        f"{p}:{line}: {side} = {r[col]}: not a configuration of manifest.json"
-                    )
-            pairs.append((k, r[1], r[2], r[3], r[4]))
-        n = len(self.patterns)
-        if n and len(pairs) != n * n:
-            raise ValueError(
-                f"{p}: {len(pairs)} pairs: must be N x N = {n * n} for the manifest's {n} patterns"
-            )
-        return pairs
 
     def _read_mask(self, rel: str) -> np.ndarray:
         a = _read_png(self._path(rel))
@@ -468,6 +361,147 @@ class GroundTruth:
                 self._cache.popitem(last=False)
         return out
 
+
+class GroundTruth(_Folder):
+    """The stitched pairs of a ``fabkit groundtruth`` output folder, as a read-only sequence.
+
+    ``len(gt)`` is N*N (N patterns); ``gt[i]`` (negative ``i`` counts from the end; a slice
+    gives a list) loads and stitches pair ``i`` (:class:`StitchedPair`); ``for pair in gt``
+    iterates them in ``pairs.csv`` order. Frames are read from disk when first needed and the
+    last ``cache_frames`` frames are kept.
+
+    Supported ``--format``:
+
+    * ``npy``: ``<frame>/<name>.npy`` float32 maps (exact values);
+    * ``npz``: ``<frame>/arrays.npz`` holding the same float32 maps (exact values);
+    * ``png``: the 16-bit PNGs ``<frame>/<stem>_um.png`` decoded as
+      ``value_mm = (count - offset_counts) * scale_mm_per_count`` (count 0 -> NaN), i.e.
+      quantised to 1 micrometre, and without normals (``normals`` is ``None``).
+
+    Args:
+        folder: the ``--out`` folder of ``fabkit groundtruth``.
+        cache_frames: how many decoded frames to keep in memory (>= 0); 4 by default. Pairs
+            are in right-pattern-major order, so the right frame is reused N times in a row.
+
+    Attributes:
+        folder: the folder (``str``).
+        manifest: ``manifest.json`` as a dict.
+        format: ``"npy"``, ``"npz"`` or ``"png"`` (found from the reference frame's files).
+        shape: ``(H, W)`` of every map.
+        patterns: the pattern names, in ``manifest.json`` order (N of them).
+        pairs: the rows of ``pairs.csv``: ``(index, right_pattern, right_dir, left_pattern,
+            left_dir)``.
+        camera: the manifest's ``camera`` dict (intrinsics: ``fx_px``, ``fy_px``, ``cx_px``,
+            ``cy_px``, ``distortion_model``, ``distortion_coefficients``,
+            ``image_width_px``, ``image_height_px``, the camera file and its sha256).
+        T_cam_sensor: ``(4, 4)`` float64, homogeneous transform mapping sensor-frame points
+            (mm) to camera-frame points (mm).
+        masks: ``(left, right)``, ``(H, W)`` bool arrays (read-only): pixels whose ray meets
+            the reference surface at sensor-frame x < 0, resp. x >= 0. Disjoint; their union
+            is the pixels that see the skin.
+        reference: dict of the reference (undeformed) frame's arrays (read-only):
+            ``range_mm``, ``zdepth_mm`` (``(H, W)`` float32, mm, NaN off the skin) and, for
+            ``npy``/``npz`` folders, ``normals`` (``(H, W, 3)`` float32, camera frame).
+
+    Raises:
+        FileNotFoundError: ``folder``, ``manifest.json``, ``pairs.csv``, a mask or a frame
+            file is missing (the message names the path). Frame files are checked when the
+            folder is opened and again when read.
+        ValueError: the folder is not a ``fabkit groundtruth`` folder or is inconsistent: the
+            manifest is not JSON or is of another kind (no ``configurations``,
+            ``reference``, ...), ``pairs.csv`` has another header, rows out of order, unknown
+            frame folders or not N*N rows, an array or PNG has the wrong shape or dtype or
+            cannot be decoded. The message names the file and the rule.
+    """
+
+    def __init__(self, folder, cache_frames: int = 4):
+        self._open(
+            folder,
+            cache_frames,
+            "not a `fabkit groundtruth` output folder (it writes manifest.json, pairs.csv, "
+            "left_mask.png, right_mask.png and a folder per frame)",
+            _refuse_other_kinds,
+        )
+        m = self.manifest
+        self.patterns: List[str] = list((m.get("fixtures") or {}).get("patterns") or [])
+        self.pairs: List[Tuple[int, str, str, str, str]] = self._read_pairs()
+        ref_dir = self._reference_dir
+        self._check_frame_files(
+            [ref_dir] + sorted({p[2] for p in self.pairs} | {p[4] for p in self.pairs})
+        )
+        self._open_masks()
+
+    # ----------------------------------------------------------------- sequence protocol
+
+    def __len__(self) -> int:
+        return len(self.pairs)
+
+    def __getitem__(self, i):
+        """Pair ``i`` (:class:`StitchedPair`), or a list of pairs for a slice.
+
+        Raises:
+            IndexError: ``i`` outside ``-len(self) .. len(self) - 1``.
+            TypeError: ``i`` is neither an integer nor a slice.
+            FileNotFoundError, ValueError: a frame file is missing or malformed (named).
+        """
+        if isinstance(i, slice):
+            return [self[k] for k in range(*i.indices(len(self)))]
+        try:
+            k = int(i.__index__())
+        except AttributeError:
+            raise TypeError(
+                f"GroundTruth indices must be integers or slices, not {type(i).__name__}"
+            ) from None
+        n = len(self)
+        if k < 0:
+            k += n
+        if not 0 <= k < n:
+            raise IndexError(f"pair index {i} out of range for {n} stitched pairs")
+        return self._stitch(k)
+
+    def __iter__(self):
+        for k in range(len(self)):
+            yield self._stitch(k)
+
+    def __repr__(self) -> str:
+        h, w = self.shape
+        return (
+            f"GroundTruth({self.folder!r}: {len(self)} stitched pairs of {len(self.patterns)} "
+            f"patterns, {w} x {h} px, --format {self.format})"
+        )
+
+    # ----------------------------------------------------------------- internals
+
+    def _read_pairs(self) -> List[Tuple[int, str, str, str, str]]:
+        p = self._path(_PAIRS)
+        if not os.path.isfile(p):
+            raise FileNotFoundError(f"{p}: missing: a `fabkit groundtruth` folder lists its stitched pairs there")
+        with open(p, newline="", encoding="utf-8") as f:
+            rows = [r for r in csv.reader(f) if r and not r[0].startswith("#")]
+        if not rows or rows[0] != PAIRS_HEADER:
+            got = ",".join(rows[0]) if rows else "(empty)"
+            raise ValueError(f"{p}:1: header = {got}: must be {','.join(PAIRS_HEADER)}")
+        cfg_dirs = set(self._frames) - {self._reference_dir}
+        pairs = []
+        for k, r in enumerate(rows[1:]):
+            line = k + 2
+            if len(r) != 5:
+                raise ValueError(f"{p}:{line}: {len(r)} columns: must be 5 ({','.join(PAIRS_HEADER)})")
+            if r[0] != str(k):
+                raise ValueError(f"{p}:{line}: pair = {r[0]}: must be {k} (rows numbered from 0 in order)")
+            for col, side in ((2, "right_dir"), (4, "left_dir")):
+                if r[col] not in cfg_dirs:
+                    raise ValueError(
+                        f"{p}:{line}: {side} = {r[col]}: not a configuration of manifest.json"
+                    )
+            pairs.append((k, r[1], r[2], r[3], r[4]))
+        n = len(self.patterns)
+        if n and len(pairs) != n * n:
+            raise ValueError(
+                f"{p}: {len(pairs)} pairs: must be N x N = {n * n} for the manifest's {n} patterns"
+            )
+        return pairs
+
     def _stitch(self, k: int) -> StitchedPair:
         index, rp, rdir, lp, ldir = self.pairs[k]
         right = self._load_frame(rdir, reference=False)
@@ -496,6 +530,185 @@ class GroundTruth:
             contact=stitch("contact", False, bool),
             normals=normals,
         )
+
+
+class PressGroundTruth(_Folder):
+    """The ground truth of a real press of a sphere (``fabkit groundtruth DESIGN --press-image
+    CAPTURE --press-reference REF --sphere-radius-mm R --out DIR``): the sphere found in the
+    capture against its reference through the calibrated camera (``press.json``), and the
+    reference and pressed frames rendered with the sphere placed where the fit puts it, beside
+    byte-for-byte copies of the two captures (calibration/src/groundtruth/press.rs).
+
+    The folder holds no stitched pairs (no ``pairs.csv``): one pressed frame, ``press/``, and the
+    reference, ``reference/``, each with its maps as :class:`GroundTruth`'s frames (``--format``
+    ``npy``, ``npz`` or ``png``) and ``capture.png`` (or ``.jpg``), the half masks,
+    ``press.json`` and ``manifest.json``.
+
+    Args:
+        folder: the ``--out`` folder of ``fabkit groundtruth --press-image``.
+
+    Attributes:
+        folder, manifest, format, shape, camera, T_cam_sensor, masks, reference: as
+            :class:`GroundTruth` (``reference``: the unpressed skin's ``range_mm``,
+            ``zdepth_mm`` and, but for ``png``, ``normals``).
+        fit: ``press.json`` as a dict (the fit, its uncertainty, the sphere placed, the files
+            it came from).
+        radius_mm: the sphere's radius, mm (``--sphere-radius-mm``).
+        centre_mm: ``(2,)`` float64, the sphere's centre over the skin's contact face (sensor
+            frame x, y), mm; ``centre_std_mm`` its standard deviations.
+        depth_mm: how far the sphere's lowest point lies below the contact face, mm;
+            ``depth_std_mm`` its standard deviation; ``depth_spread_mm`` how far it moves with
+            the fitted core (a response not linear in depth).
+        sphere_centre_mm: ``(3,)`` float64, the sphere's centre, sensor frame, mm.
+        lowest_point_px: ``(2,)`` float64, the pixel the sphere's lowest point projects to
+            (``None`` if it does not project).
+        capture_file, reference_capture_file: paths of the copies of the press's capture and
+            of its reference (:meth:`capture`, :meth:`reference_capture` decode them).
+
+    Raises:
+        FileNotFoundError: ``folder``, ``manifest.json``, ``press.json``, a mask, a frame file
+            or a capture's copy is missing (named).
+        ValueError: not the folder of a press (another ``fabkit groundtruth`` folder: open it
+            with :class:`GroundTruth`), or an inconsistent one (named, with the rule).
+    """
+
+    def __init__(self, folder, cache_frames: int = 2):
+        self._open(
+            folder,
+            cache_frames,
+            "not a `fabkit groundtruth --press-image` output folder (it writes manifest.json, "
+            "press.json, left_mask.png, right_mask.png, reference/ and press/)",
+            _require_press,
+        )
+        m = self.manifest
+        p = self._path(_MANIFEST)
+        if len(m["configurations"]) != 1:
+            raise ValueError(
+                f"{p}: configurations: {len(m['configurations'])} entries: a press's ground "
+                "truth has one, the pressed frame"
+            )
+        self._press_dir: str = m["configurations"][0]["dir"]
+        self._check_frame_files([self._reference_dir, self._press_dir])
+        self._open_masks()
+        fit_rel = m["press"].get("file", _PRESS_JSON) if isinstance(m["press"], dict) else None
+        if not isinstance(fit_rel, str):
+            raise ValueError(f"{p}: press must be an object naming its file ({_PRESS_JSON})")
+        fp = self._path(fit_rel)
+        if not os.path.isfile(fp):
+            raise FileNotFoundError(f"{fp}: missing: the press's fit (manifest.json names it)")
+        try:
+            with open(fp, "rb") as f:
+                fit = json.loads(f.read().decode("utf-8"))
+        except json.JSONDecodeError as e:
+            raise ValueError(f"{fp}:{e.lineno}:{e.colno}: not JSON: {e.msg}") from None
+        except UnicodeDecodeError as e:
+            raise ValueError(f"{fp}: not UTF-8 text: {e}") from None
+        if not isinstance(fit, dict):
+            raise ValueError(f"{fp}: must be a JSON object (the press's fit)")
+        self.fit: dict = fit
+
+        def number(*keys, shape=()):
+            v = fit
+            try:
+                for k in keys:
+                    v = v[k]
+                a = np.asarray(v, dtype=np.float64)
+            except (KeyError, TypeError, ValueError, IndexError):
+                a = None
+            if a is None or a.shape != shape:
+                want = "a number" if shape == () else f"{shape[0]} numbers"
+                raise ValueError(f"{fp}: {'.'.join(keys)} = {v!r}: must be {want}") from None
+            return float(a) if shape == () else a
+
+        self.radius_mm: float = number("indenter", "radius_mm")
+        self.centre_mm: np.ndarray = number("centre_mm", shape=(2,))
+        self.centre_std_mm: np.ndarray = number("centre_std_mm", shape=(2,))
+        self.depth_mm: float = number("depth_mm")
+        self.depth_std_mm: float = number("depth_std_mm")
+        self.depth_spread_mm: float = number("depth_spread_mm")
+        self.sphere_centre_mm: np.ndarray = number("sphere", "centre_mm", shape=(3,))
+        lowest = (fit.get("sphere") or {}).get("lowest_point_px")
+        self.lowest_point_px: Optional[np.ndarray] = (
+            None if lowest is None else number("sphere", "lowest_point_px", shape=(2,))
+        )
+
+        def copy(which: str) -> str:
+            rel = (fit.get(which) or {}).get("copy")
+            if not isinstance(rel, str):
+                raise ValueError(f"{fp}: {which}.copy = {rel!r}: must name the capture's copy")
+            path = self._path(rel)
+            if not os.path.isfile(path):
+                raise FileNotFoundError(f"{path}: missing: press.json's {which}.copy")
+            return path
+
+        self.capture_file: str = copy("capture")
+        self.reference_capture_file: str = copy("reference")
+        self._press: Optional[Dict[str, np.ndarray]] = None
+
+    @property
+    def press(self) -> Dict[str, np.ndarray]:
+        """The pressed frame: ``range_mm``, ``zdepth_mm`` (complete, (H, W) float32, mm, NaN
+        off the skin), ``delta_range_mm``, ``delta_zdepth_mm`` (pressed minus reference, mm,
+        <= 0 in the contact), ``normals`` ((H, W, 3) float32, camera frame; not in a
+        ``--format png`` folder) and ``contact`` ((H, W) bool: the sphere's intersection with
+        the contact face). Read-only arrays, loaded on first access.
+
+        Raises:
+            FileNotFoundError, ValueError: as :class:`PressGroundTruth`.
+        """
+        if self._press is None:
+            arrays = dict(self._load_frame(self._press_dir, reference=False))
+            for a in arrays.values():
+                a.flags.writeable = False
+            self._press = arrays
+        return self._press
+
+    def capture(self) -> np.ndarray:
+        """The press's real capture (its copy in the folder), decoded: ``(H, W)`` or ``(H, W,
+        C)`` uint8 (uint16 for a 16-bit PNG). A JPEG capture needs Pillow.
+
+        Raises:
+            ValueError: the copy cannot be decoded (named).
+        """
+        return _read_capture(self.capture_file)
+
+    def reference_capture(self) -> np.ndarray:
+        """The reference capture (the unpressed skin, its copy in the folder), decoded as
+        :meth:`capture`."""
+        return _read_capture(self.reference_capture_file)
+
+    def __repr__(self) -> str:
+        h, w = self.shape
+        return (
+            f"PressGroundTruth({self.folder!r}: a {self.radius_mm:g} mm sphere "
+            f"{self.depth_mm:.3f} mm deep at ({self.centre_mm[0]:.3f}, {self.centre_mm[1]:.3f}) "
+            f"mm, {w} x {h} px, --format {self.format})"
+        )
+
+
+def _require_press(m: dict, p: str) -> None:
+    """Refuses a ``fabkit groundtruth`` folder that is not a press's."""
+    if "press" not in m:
+        raise ValueError(
+            f"{p}: no 'press': not the ground truth of a real press (`fabkit groundtruth "
+            "--press-image`); open a folder of protrusion patterns with fabkit.GroundTruth"
+        )
+
+
+def _read_capture(path: str) -> np.ndarray:
+    """A capture's copy: a PNG by this module's decoder, anything else by Pillow."""
+    with open(path, "rb") as f:
+        is_png = f.read(8) == _PNG_SIGNATURE
+    if is_png:
+        return _read_png(path)
+    try:
+        from PIL import Image
+    except ImportError:
+        raise ValueError(
+            f"{path}: not a PNG: decoding a JPEG capture needs Pillow (pip install pillow)"
+        ) from None
+    with Image.open(path) as im:
+        return np.asarray(im)
 
 
 def _np_load(path: str) -> np.ndarray:

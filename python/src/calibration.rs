@@ -1,5 +1,6 @@
-//! `fabkit.Camera` and `fabkit.solve_extrinsics`: camera models and the PnP extrinsics solve of
-//! `fabkit calibrate extrinsics`, from numpy arrays.
+//! `fabkit.Camera`, `fabkit.solve_extrinsics` and `fabkit.calibrate_board`: camera models, the
+//! PnP extrinsics solve of `fabkit calibrate extrinsics` from numpy arrays, and the flat sensor's
+//! camera from a board press of `fabkit calibrate board`.
 
 use fabkit_calibration::nalgebra::{Vector2, Vector3};
 use fabkit_calibration::refraction::OpticalLayers;
@@ -458,8 +459,199 @@ fn result_dict<'py>(
     Ok(out)
 }
 
+/// `images`: one path (str or os.PathLike) or a sequence of them.
+fn paths_of(images: &Bound<'_, PyAny>) -> PyResult<Vec<std::path::PathBuf>> {
+    if images.is_instance_of::<pyo3::types::PyString>()
+        || images.hasattr("__fspath__").unwrap_or(false)
+    {
+        return Ok(vec![images.extract()?]);
+    }
+    images.extract().map_err(|_| {
+        pyo3::exceptions::PyTypeError::new_err(
+            "images: a path or a sequence of paths (str or os.PathLike), one per capture",
+        )
+    })
+}
+
+/// The plane's distance and where it comes from, as `fabkit calibrate board` takes it:
+/// `plane_distance_mm`, else the flat housing of `design` (a Design, or a library name or YAML
+/// path), else of the design the point table's sidecar names.
+fn board_plane_distance(
+    py: Python<'_>,
+    plane_distance_mm: Option<f64>,
+    design: Option<&Bound<'_, PyAny>>,
+    points: &std::path::Path,
+) -> PyResult<(f64, String)> {
+    use fabkit_calibration::board::{plane_distance_of_design, point_table_design};
+    if let Some(d) = plane_distance_mm {
+        return Ok((d, "plane_distance_mm".to_string()));
+    }
+    let (loaded, named) = match design.map(|d| d.cast::<crate::design::Design>()) {
+        Some(Ok(d)) => {
+            let d = d.borrow();
+            (d.design.clone(), d.as_named())
+        }
+        given => {
+            let arg: String = match (given, design) {
+                (Some(Err(_)), Some(d)) => {
+                    let p: std::path::PathBuf = d.extract().map_err(|_| {
+                        pyo3::exceptions::PyTypeError::new_err(
+                            "design: a Design, or a library name or YAML path",
+                        )
+                    })?;
+                    p.to_string_lossy().to_string()
+                }
+                _ => point_table_design(points).map(|(_, arg, _)| arg).ok_or_else(|| {
+                    CalibrationError::new_err(format!(
+                        "plane_distance_mm: not given, and no design to take it from: give it, or design (the point table {} names none)",
+                        points.display()
+                    ))
+                })?,
+            };
+            let rules = fabkit_designs::input_files::DataFileRules::default();
+            let loaded = crate::work(py, || {
+                fabkit_designs::library::load_source_with(&arg, std::path::Path::new(""), &rules)
+            })?
+            .map_err(|e| crate::errors::design_error(&e))?;
+            (loaded.design, arg)
+        }
+    };
+    let materials =
+        fabkit_designs::materials::MaterialsTable::embedded().map_err(CalibrationError::new_err)?;
+    plane_distance_of_design(&loaded, &materials).ok_or_else(|| {
+        CalibrationError::new_err(format!(
+            "plane_distance_mm: not given, and the design {named} has no flat_housing to take it from: give it"
+        ))
+    })
+}
+
+/// Calibrates a flat sensor's camera from a press of its calibration board (or a grid plate
+/// pressed over several captures) and writes the calibration into the folder `out`, as
+/// `fabkit calibrate board` does (the same files, the same bytes but the command line):
+/// `extrinsics.json` and `.yaml`, `camera.yaml` (OpenCV), `camera_info.yaml` (ROS),
+/// `camera.json`, `observations.csv`, `pixel_to_plane_mm.npy` and `overlay.png`.
+///
+/// `points`: the board's point table (points/board_table.csv of `fabkit fixtures`);
+/// `reference`: the skin with no contact; `images`: the press, one path or a list (one per
+/// capture, in `capture_plan`'s order). `plane_distance_mm`: the plane's distance from the lens
+/// in air, mm; when None, from the flat housing of `design` (a Design, a library name or a
+/// YAML path) or of the design the point table names. `board_turn_deg`: the board's grid
+/// turned in the image, 0, 90, 180 or 270 (the camera turned about its optical axis; the
+/// sensor's +x runs along the image's u turned this much towards v). `points_from`: `contact`
+/// or `tip`. `out` is replaced only when it holds a calibration of the same inputs (or with
+/// `force`); files appear only when all are written.
+///
+/// Returns a dict: `T_cam_sensor` (4, 4) float64 (sensor frame -> camera frame, mm),
+/// `camera` (a Camera read back from the written camera.json), `ids` (found bumps, grid
+/// order), `observed_px` and `residuals_px` (n, 2) (reprojected minus observed),
+/// `rms_reprojection_error_px`, `report` (extrinsics.json as a dict), `files` (the files
+/// written, sorted), `warnings`. Raises CalibrationError with the CLI's message (a table that is
+/// no grid, an image of another size, too few imprints, a lattice larger than the board, a
+/// turn other than a quarter turn, an output folder that is not this calibration's, ...),
+/// DesignError for a design that does not load, ValueError or TypeError for a bad argument.
+#[pyfunction]
+#[pyo3(signature = (points, reference, images, out, *, plane_distance_mm=None, design=None,
+                    capture_plan=None, board_turn_deg=0.0, points_from="contact", force=false,
+                    command_line=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn calibrate_board<'py>(
+    py: Python<'py>,
+    points: std::path::PathBuf,
+    reference: std::path::PathBuf,
+    images: &Bound<'py, PyAny>,
+    out: std::path::PathBuf,
+    plane_distance_mm: Option<f64>,
+    design: Option<&Bound<'py, PyAny>>,
+    capture_plan: Option<std::path::PathBuf>,
+    board_turn_deg: f64,
+    points_from: &str,
+    force: bool,
+    command_line: Option<Vec<String>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    use fabkit_calibration::board::{board_claim, calibrate_board, BoardJob, BoardTurn};
+    use fabkit_calibration::tables::PointsFrom;
+    let points_from = match points_from {
+        "contact" => PointsFrom::Contact,
+        "tip" => PointsFrom::Tip,
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "points_from = '{other}': must be 'contact' or 'tip'"
+            )))
+        }
+    };
+    let images = paths_of(images)?;
+    let board_turn =
+        BoardTurn::from_deg(board_turn_deg).map_err(|e| err::<CalibrationError>(&e))?;
+    let (plane_distance_mm, plane_distance_from) =
+        board_plane_distance(py, plane_distance_mm, design, &points)?;
+    let command_line = match command_line {
+        Some(c) => c,
+        None => py.import("sys")?.getattr("argv")?.extract()?,
+    };
+    let job = BoardJob {
+        points,
+        points_from,
+        reference,
+        images,
+        capture_plan,
+        plane_distance_mm,
+        plane_distance_from,
+        board_turn,
+        command_line: command_line.join(" "),
+    };
+    let claim = board_claim(&job, force);
+    let (output, mut files, warnings) = crate::work(py, || -> Result<_, PyErr> {
+        let staged =
+            fabkit_export::StagedDir::new(&out, claim).map_err(|e| err::<CalibrationError>(&e))?;
+        let output = calibrate_board(&job).map_err(|e| err::<CalibrationError>(&e))?;
+        for (name, bytes) in &output.files {
+            staged
+                .write(name, bytes)
+                .map_err(|e| err::<CalibrationError>(&e))?;
+        }
+        let warnings = staged.commit().map_err(|e| err::<CalibrationError>(&e))?;
+        let files: Vec<String> = output.files.iter().map(|(n, _)| n.clone()).collect();
+        Ok((output, files, warnings))
+    })??;
+    files.sort();
+    let r = &output.report;
+    let camera = Camera::read(out.join("camera.json"), None)?;
+    let t = Array2::from_shape_fn((4, 4), |(i, j)| r.t_cam_sensor[i][j]);
+    let n = r.bumps.len();
+    let observed: Vec<f64> = r.bumps.iter().flat_map(|b| b.observed_px).collect();
+    let residuals: Vec<f64> = r
+        .bumps
+        .iter()
+        .flat_map(|b| {
+            [
+                b.reprojected_px[0] - b.observed_px[0],
+                b.reprojected_px[1] - b.observed_px[1],
+            ]
+        })
+        .collect();
+    let shaped = |v: Vec<f64>| {
+        Array2::from_shape_vec((n, 2), v).map_err(|e| PyValueError::new_err(e.to_string()))
+    };
+    let report = serde_json::to_value(r).map_err(|e| CalibrationError::new_err(e.to_string()))?;
+    let d = PyDict::new(py);
+    d.set_item("T_cam_sensor", t.into_pyarray(py))?;
+    d.set_item("camera", Bound::new(py, camera)?)?;
+    d.set_item(
+        "ids",
+        r.bumps.iter().map(|b| b.id.clone()).collect::<Vec<_>>(),
+    )?;
+    d.set_item("observed_px", shaped(observed)?.into_pyarray(py))?;
+    d.set_item("residuals_px", shaped(residuals)?.into_pyarray(py))?;
+    d.set_item("rms_reprojection_error_px", r.rms_reprojection_error_px)?;
+    d.set_item("report", crate::to_py(py, &report)?)?;
+    d.set_item("files", files)?;
+    d.set_item("warnings", warnings)?;
+    Ok(d)
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Camera>()?;
     m.add_function(wrap_pyfunction!(solve_extrinsics, m)?)?;
+    m.add_function(wrap_pyfunction!(calibrate_board, m)?)?;
     Ok(())
 }

@@ -898,6 +898,14 @@ fn groundtruth_files(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
         ("points", files::POINTS),
         ("contact_mask", files::CONTACT_MASK),
         ("image", files::IMAGE),
+        (
+            "press_json",
+            fabkit_calibration::groundtruth::press::PRESS_JSON,
+        ),
+        (
+            "press_dir",
+            fabkit_calibration::groundtruth::press::PRESS_DIR,
+        ),
     ] {
         d.set_item(k, v)?;
     }

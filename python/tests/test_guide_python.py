@@ -1,6 +1,7 @@
 """The user guide's first "From Python" example (arrays, docs/src/guide/python.md) runs as written, on inputs the CLI makes: a camera file
 (cam.yaml), a calibration (calib/extrinsics.json), the R-Tac0 fixtures (out/rtac0_fixtures) and
-a ground-truth folder (gt), in a fresh folder."""
+a ground-truth folder (gt), in a fresh folder; so does the second (a board press and a ball
+press's ground truth), on 9DTact's captures and the folders the CLI makes of them."""
 
 import contextlib
 import io
@@ -15,10 +16,14 @@ from test_groundtruth_render import CAMERA_YAML, pose
 GUIDE = Path(__file__).resolve().parents[2] / "docs" / "src" / "guide" / "python.md"
 
 
-def guide_example():
+def guide_blocks():
     blocks = re.findall(r"```python\n(.*?)```", GUIDE.read_text(), re.S)
-    assert len(blocks) == 2, "the chapter has two Python examples: arrays, then a sweep"
-    return blocks[0]
+    assert len(blocks) == 3, "the chapter has three Python examples: arrays, a board press, a sweep"
+    return blocks
+
+
+def guide_example():
+    return guide_blocks()[0]
 
 
 def test_guide_example_runs(tmp_path, run_cli, monkeypatch):
@@ -54,3 +59,36 @@ def test_guide_example_runs(tmp_path, run_cli, monkeypatch):
     assert len(scope["gt"]) == 4
     assert scope["pair"].index == 3
     assert np.isfinite(scope["depth"]).any() and np.nanmin(scope["target"]) < 0
+
+
+def test_guide_board_example_runs(tmp_path, run_cli, monkeypatch):
+    """The board press example: 63 bumps, the RMS under 1.3 px, the board/ folder the CLI's; the
+    ball press's fit and arrays read from the folder the CLI wrote."""
+    repo = GUIDE.parents[3]
+    (tmp_path / "tests").symlink_to(repo / "tests")
+    data = "tests/data/9dtact_sensor1/"
+    run_cli(tmp_path, "fixtures", "ninedtact", "--out", "fx")
+    run_cli(tmp_path, "calibrate", "board", "--points", "fx/points/board_table.csv",
+            "--reference", data + "camera_calibration/ref.png",
+            "--image", data + "camera_calibration/sample.png", "--out", "board")
+    run_cli(tmp_path, "groundtruth", "ninedtact", "--camera", "board/camera.yaml",
+            "--extrinsics", "board/extrinsics.json",
+            "--press-image", data + "depth_calibration/sample.png",
+            "--press-reference", data + "depth_calibration/ref.png",
+            "--sphere-radius-mm", "4", "--out", "gt_press")
+    cli_report = json.loads((tmp_path / "board" / "extrinsics.json").read_text())
+    monkeypatch.chdir(tmp_path)
+    printed = io.StringIO()
+    scope = {}
+    with contextlib.redirect_stdout(printed):
+        exec(compile(guide_blocks()[1], str(GUIDE), "exec"), scope)
+    found, rms = printed.getvalue().splitlines()[0].split()
+    assert int(found) == 63 and float(rms) < 1.3
+    report = json.loads((tmp_path / "board" / "extrinsics.json").read_text())
+    del report["command_line"], cli_report["command_line"]
+    assert report == cli_report
+    assert scope["camera"].shape == (480, 640) and scope["T_cam_sensor"].shape == (4, 4)
+    press = scope["press"]
+    assert 1.5 < press.depth_mm < 1.8
+    assert abs(np.nanmin(scope["target"]) + press.depth_mm) < 0.01
+    assert scope["normals"].shape == (480, 640, 3) and scope["capture"].shape == (480, 640, 3)
