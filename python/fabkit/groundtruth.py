@@ -539,7 +539,8 @@ class PressGroundTruth(_Folder):
     reference and pressed frames rendered with the sphere placed where the fit puts it, beside
     byte-for-byte copies of the two captures (calibration/src/groundtruth/press.rs).
 
-    The folder holds no stitched pairs (no ``pairs.csv``): one pressed frame, ``press/``, and the
+    The folder holds no stitched pairs (no ``pairs.csv``): one pressed frame, ``press/`` (the
+    indenter's surface; its ``skin/``, the skin as the sphere deforms it: :attr:`skin`), and the
     reference, ``reference/``, each with its maps as :class:`GroundTruth`'s frames (``--format``
     ``npy``, ``npz`` or ``png``) and ``capture.png`` (or ``.jpg``), the half masks,
     ``press.json`` and ``manifest.json``.
@@ -564,6 +565,8 @@ class PressGroundTruth(_Folder):
             (``None`` if it does not project).
         capture_file, reference_capture_file: paths of the copies of the press's capture and
             of its reference (:meth:`capture`, :meth:`reference_capture` decode them).
+        elastic: ``press.json``'s ``elastic`` (the deformed skin's model, its contact radius,
+            its sink round the contact, its assumptions), or ``None``.
 
     Raises:
         FileNotFoundError: ``folder``, ``manifest.json``, ``press.json``, a mask, a frame file
@@ -644,6 +647,13 @@ class PressGroundTruth(_Folder):
         self.capture_file: str = copy("capture")
         self.reference_capture_file: str = copy("reference")
         self._press: Optional[Dict[str, np.ndarray]] = None
+        skin = m["configurations"][0].get("skin")
+        self._skin_dir: Optional[str] = skin.get("dir") if isinstance(skin, dict) else None
+        if self._skin_dir is not None:
+            self._check_frame_files([self._skin_dir])
+        self._skin: Optional[Dict[str, np.ndarray]] = None
+        elastic = fit.get("elastic")
+        self.elastic: Optional[dict] = elastic if isinstance(elastic, dict) else None
 
     @property
     def press(self) -> Dict[str, np.ndarray]:
@@ -662,6 +672,29 @@ class PressGroundTruth(_Folder):
                 a.flags.writeable = False
             self._press = arrays
         return self._press
+
+    @property
+    def skin(self) -> Dict[str, np.ndarray]:
+        """The skin as the sphere deforms it (``press/skin/``: an elastic layer bonded to its
+        base, pressed to the fitted depth; ``elastic`` holds the model and its assumptions):
+        the arrays of :attr:`press`, its ``contact`` where the sphere touches the deformed
+        skin. Read-only arrays, loaded on first access.
+
+        Raises:
+            ValueError: a folder written before the skin was modelled (no ``press/skin/``).
+            FileNotFoundError: as :class:`PressGroundTruth`.
+        """
+        if self._skin_dir is None:
+            raise ValueError(
+                f"{self._path(_MANIFEST)}: configurations[0] has no 'skin': written by a "
+                "fabkit without the elastic skin; render the press again"
+            )
+        if self._skin is None:
+            arrays = dict(self._load_frame(self._skin_dir, reference=False))
+            for a in arrays.values():
+                a.flags.writeable = False
+            self._skin = arrays
+        return self._skin
 
     def capture(self) -> np.ndarray:
         """The press's real capture (its copy in the folder), decoded: ``(H, W)`` or ``(H, W,

@@ -86,6 +86,33 @@ def test_the_frames_hold_the_sphere_where_the_fit_puts_it(folders):
     np.testing.assert_array_equal(left | right, np.isfinite(ref["zdepth_mm"]))
 
 
+def test_the_skin_is_the_deformed_one(folders):
+    """The deformed skin (press/skin/): as deep as the fit at its deepest (0.01 mm); where the
+    sphere touches it, the sphere's surface (the indenter frame's depth within 0.01 mm but for
+    the contact's edge pixels); its contact mask inside the sphere's intersection with the face
+    (elastic.contact_radius_mm 3.16 mm against 3.28, measured); round the contact the skin
+    rises (an incompressible layer's bulge: delta z-depth > 0 somewhere, at most 0.4 mm) and
+    settles within 0.05 mm far from it; elastic names its model and assumptions."""
+    g = fabkit.PressGroundTruth(folders["npy"])
+    s, p = g.skin, g.press
+    assert set(s) == set(p)
+    dz, di = s["delta_zdepth_mm"], p["delta_zdepth_mm"]
+    assert abs(-np.nanmin(dz) - g.depth_mm) < 0.01
+    contact = s["contact"]
+    assert contact.sum() == g.manifest["configurations"][0]["skin"]["contact_pixels"] > 0
+    assert (contact & ~p["contact"]).sum() <= 0.005 * contact.sum()
+    off = np.abs(dz - di)[contact]
+    assert np.median(off) < 1e-4 and (off > 0.01).sum() <= 0.005 * contact.sum()
+    e = g.elastic
+    assert 0.85 * e["geometric_contact_radius_mm"] < e["contact_radius_mm"]
+    assert e["contact_radius_mm"] < e["geometric_contact_radius_mm"]
+    assert e["thickness_mm"] == 2.8 and e["seen_depth_mm"] == 0.3 and e["assumptions"]
+    assert 0.0 < np.nanmax(dz) < 0.4
+    v, u = np.mgrid[:480, :640]
+    r = np.hypot(u - g.lowest_point_px[0], v - g.lowest_point_px[1])
+    assert np.nanmax(np.abs(dz[r > 220])) < 0.05
+
+
 def test_the_captures_are_the_real_ones(folders):
     """The copies are the captures byte for byte, and decode to their pixels (OpenCV's, BGR)."""
     g = fabkit.PressGroundTruth(folders["npy"])

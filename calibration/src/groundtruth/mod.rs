@@ -23,6 +23,7 @@ pub mod inputs;
 pub mod mesh;
 pub mod pins;
 pub mod press;
+pub mod press_skin;
 pub mod raster;
 pub mod rays;
 pub mod shading;

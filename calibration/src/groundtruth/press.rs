@@ -6,21 +6,24 @@
 //!
 //! The sphere is placed where the fit puts it: its centre over (x, y) = `centre_mm` of the
 //! skin's contact face (sensor frame, the face of the design's flat body), its lowest point
-//! `depth_mm` below the face, towards the camera. The indented surface is, as for a fixture's
-//! protrusions, the skin minus the sphere: inside the contact the skin takes the sphere's shape
-//! (what the fit assumes), outside it the skin is left flat, where a real skin sags towards the
-//! press (by `1 / r` outside the contact of a half-space, Johnson, Contact Mechanics, 1985, Eq.
-//! 3.41) or bulges round it (a bonded layer). So the contact mask is the sphere's geometric
-//! intersection with the face, of radius `sqrt(2 R d - d^2)`, where a half-space's elastic
-//! contact is `sqrt(R d)` (Hertz); on the real 9DTact ball press (a bonded gel layer) the
-//! capture's darkening ends at the mask's edge (measured: 5.6 grey levels 64 to 67 px from
-//! the centre, 0.2 at 67 to 70 px, the mask's edge 63.6 to 67.2 px). The rays are the camera's
-//! straight rays (a board press's camera takes the refraction of the flat layers up in its
-//! distortion, which so holds for points on the face; the sphere's points below it are seen
-//! along the same rays).
+//! `depth_mm` below the face, towards the camera. Two surfaces are rendered. The indenter's
+//! (`press/`, as for a fixture's protrusions): the skin minus the sphere, flat outside the
+//! sphere's intersection with the face, of radius `sqrt(2 R d - d^2)` (its contact mask).
+//! The skin's (`press/skin/`): the skin as the sphere deforms it
+//! ([`super::press_skin::PressedSkin`]: an elastic layer bonded to its base at the fitted
+//! depth): the sphere's shape where it touches (its contact mask) and the smooth sink round
+//! it. The rendered image (`--images`) is the face the camera sees (under an opaque coat, its
+//! inner face) as the sphere deforms it. On the real 9DTact ball press (1.715 mm of a 4 mm
+//! ball on 2.8 mm of gel) the capture's darkening ends at 64 to 67 px from the centre (5.6
+//! grey levels inside, 0.2 outside), where the geometric mask's edge is (63.6 to 67.2 px):
+//! the bonded layer's elastic contact is as wide (press.json: elastic). The rays are the
+//! camera's straight rays (a board press's camera takes the refraction of the flat layers up
+//! in its distortion, which so holds for points on the face; the sphere's points below it are
+//! seen along the same rays).
 //!
 //! Layout: `reference/` and `press/` as the frames of [`super::dataset`] (the reference
-//! frame, the pressed one with its differences and contact mask), each with a byte-for-byte
+//! frame, the pressed one with its differences and contact mask; `press/skin/` the deformed
+//! skin's maps, differences and contact mask), each with a byte-for-byte
 //! copy of its real capture (`capture.png` or `capture.jpg`), the half masks, `press.json`
 //! (the fit, its uncertainty and the sphere placed) and `manifest.json`.
 
@@ -40,11 +43,15 @@ use super::exact::ExactPrimitives;
 use super::inputs::{sha256_hex, Configuration, Fixtures, InputError};
 use super::{half_masks, indented_hits, DepthFrame};
 use crate::capture_images::{read_gray, ImageError};
+use super::press_skin::{Face, PressedSkin, SkinModel};
+use crate::elastic::ContactError;
 use crate::press::{fit_sphere_press, PressError, PressFit, PressOptions};
 use crate::CameraModel;
 
 /// The pressed frame's folder.
 pub const PRESS_DIR: &str = "press";
+/// The deformed skin's frame, inside the pressed frame's folder.
+pub const SKIN_DIR: &str = "skin";
 /// The fit and the sphere placed, at the top of the dataset.
 pub const PRESS_JSON: &str = "press.json";
 /// The stem of a frame's copy of its real capture: `capture.png` or `capture.jpg`.
@@ -79,6 +86,15 @@ pub enum PressInputError {
         option: &'static str,
         design: String,
         profile: String,
+    },
+    #[error("the embedded materials table: {0}")]
+    Materials(String),
+    #[error("{option} = {file}: the skin's elastic contact at the fitted depth: {source}")]
+    Elastic {
+        option: &'static str,
+        file: String,
+        #[source]
+        source: ContactError,
     },
     #[error("{option} = {file}: the pose was solved through an optical path (optical_path.planes), but the press is fitted along straight rays (hint: give the extrinsics.json of `fabkit calibrate board`, whose camera takes the flat layers' refraction up in its distortion)")]
     OpticalPath { option: &'static str, file: String },
@@ -124,6 +140,8 @@ impl CaptureFile {
 #[derive(Debug, Clone)]
 pub struct Press {
     pub fit: PressFit,
+    /// The skin as the sphere deforms it (the elastic contact at the fitted depth).
+    pub skin: PressedSkin,
     pub radius_mm: f64,
     pub plane_z_mm: f64,
     pub capture: CaptureFile,
@@ -149,6 +167,45 @@ impl Press {
     pub fn contact_radius_mm(&self) -> f64 {
         let (r, d) = (self.radius_mm, self.fit.depth_mm.min(self.radius_mm));
         (2.0 * r * d - d * d).max(0.0).sqrt()
+    }
+
+    /// press.json's `elastic`: the skin model, its grid, the elastic contact's radius beside
+    /// the geometric one, and how far the skin sinks round the contact.
+    pub fn elastic_json(&self) -> Value {
+        let k = &self.skin;
+        let [cx, cy] = k.centre_mm;
+        // the skin's sink just outside the contact and its largest outside it
+        let outside: Vec<f64> = (0..k.grid.n * k.grid.n)
+            .filter(|&c| !k.in_contact[c])
+            .map(|c| k.surface_mm[c])
+            .collect();
+        let rim = k.contact_radius_mm + 0.5;
+        let (rim_surface, _) = k.sample(Face::Surface, cx + rim, cy);
+        let (rim_seen, _) = k.sample(Face::Seen, cx + rim, cy);
+        let (centre_seen, _) = k.sample(Face::Seen, cx, cy);
+        json!({
+            "model": "the skin's layers as one elastic layer bonded to a rigid base at the base plane, pressed by the rigid, frictionless sphere to the fitted depth (calibration/src/elastic.rs: a bonded layer's influence, Polonsky and Keer's conjugate gradient; calibration/src/groundtruth/press_skin.rs)",
+            "thickness_mm": k.model.thickness_mm,
+            "poisson": k.model.poisson,
+            "seen_face": k.model.seen,
+            "seen_depth_mm": k.model.seen_depth_mm,
+            "grid": {"cells": k.grid.n, "cell_mm": k.grid.cell_mm, "centre_mm": k.centre_mm},
+            "contact_radius_mm": k.contact_radius_mm,
+            "geometric_contact_radius_mm": self.contact_radius_mm(),
+            "sink_mm": {
+                "what": "displacement into the skin, mm",
+                "surface_0.5_mm_past_the_contact": rim_surface,
+                "seen_face_0.5_mm_past_the_contact": rim_seen,
+                "seen_face_at_the_centre": centre_seen,
+                "surface_largest_outside_the_contact": outside.iter().cloned().fold(0.0, f64::max),
+            },
+            "assumptions": [
+                "one material through the skin's layers (a coat stiffer than the gel spreads the dent wider)",
+                "Poisson's ratio 0.5: silicone rubbers are incompressible to within 1e-3; for a given depth the shape does not depend on the modulus",
+                "the base (the window a flat housing seats, or the plate the skin is cast on) rigid",
+                "small strains and no friction (a deep press of a small ball widens the contact somewhat)"
+            ],
+        })
     }
 
     /// The sphere as the caster's solid.
@@ -299,8 +356,23 @@ pub fn fit_press(job: &PressJob<'_>) -> Result<Press, PressInputError> {
         },
         source: Box::new(source),
     })?;
+    let materials = fabkit_designs::materials::MaterialsTable::embedded()
+        .map_err(|e| PressInputError::Materials(e.to_string()))?;
+    let model = SkinModel::of(job.design, &materials).ok_or_else(|| PressInputError::NotFlat {
+        option: job.capture_option,
+        design: job.design.name.clone(),
+        profile: job.design.body.kind().to_string(),
+    })?;
+    let skin = PressedSkin::solve(&model, job.radius_mm, fit.centre_mm, fit.depth_mm).map_err(
+        |source| PressInputError::Elastic {
+            option: job.capture_option,
+            file: job.capture.display().to_string(),
+            source,
+        },
+    )?;
     Ok(Press {
         fit,
+        skin,
         radius_mm: job.radius_mm,
         plane_z_mm,
         capture: capture_file,
@@ -431,6 +503,7 @@ pub fn press_json(press: &Press, m: &ManifestInputs<'_>) -> Value {
             "contact_radius_mm": press.contact_radius_mm(),
             "placed": "centre over centre_mm, lowest point depth_mm below the contact face; the rendered contact is the sphere's intersection with the face, of radius contact_radius_mm = sqrt(2 R d - d^2)",
         },
+        "elastic": press.elastic_json(),
         "capture": {"file": press.capture.file.display().to_string(), "sha256": press.capture.sha256, "copy": press.capture.copy_path(PRESS_DIR)},
         "reference": {"file": press.reference.file.display().to_string(), "sha256": press.reference.sha256, "copy": press.reference.copy_path(files::REFERENCE_DIR)},
         "camera": {"file": m.camera_file, "sha256": m.camera_sha256},
@@ -515,12 +588,16 @@ pub fn write(
         format,
     )?;
     if let Some(im) = imaging {
+        // the image from the face the camera sees, as the sphere deforms it
+        let seen_hits = press
+            .skin
+            .hits(Face::Seen, rays, ref_hits, press.plane_z_mm);
         press_files.push(image_file(
             &cfg.name,
             im,
             rays,
             ref_hits,
-            &hits,
+            &seen_hits,
             Some(&cfg.primitives),
             1,
         )?);
@@ -531,6 +608,22 @@ pub fn write(
         "capture of the press",
     ));
     let press_entries = put(staged, press_files, &mut all)?;
+    // the skin as the sphere deforms it
+    let plane = press.plane_z_mm;
+    let skin_hits = press.skin.hits(Face::Surface, rays, ref_hits, plane);
+    let skin_frame = DepthFrame::new(rays, &skin_hits);
+    let skin_dir = format!("{}/{SKIN_DIR}", cfg.name);
+    let skin_files = frame_files(
+        &skin_dir,
+        &skin_frame,
+        Some(&reference),
+        preview,
+        provenance,
+        format,
+    )?;
+    let skin_entries = put(staged, skin_files, &mut all)?;
+    let skin_contact = skin_frame.contact_mask(&reference);
+    let (skin_dr, skin_dz) = skin_frame.delta(&reference);
     let contact = frame.contact_mask(&reference);
     let (dr, dz) = frame.delta(&reference);
     let deepest = |d: &[f64]| finite_range(d).map_or(0.0, |x| (-x.0).max(0.0));
@@ -542,6 +635,14 @@ pub fn write(
         "max_range_decrease_mm": deepest(&dr),
         "max_zdepth_decrease_mm": deepest(&dz),
         "files": press_entries,
+        "skin": {
+            "dir": skin_dir,
+            "surface": "the skin's outer surface as the sphere deforms it (press.json: elastic)",
+            "contact_pixels": skin_contact.iter().filter(|&&c| c).count(),
+            "max_range_decrease_mm": deepest(&skin_dr),
+            "max_zdepth_decrease_mm": deepest(&skin_dz),
+            "files": skin_entries,
+        },
     });
     progress(2);
 
@@ -595,8 +696,8 @@ pub fn write(
         }
         o.insert("press".into(), fit);
     }
-    m["conventions"]["surface"] = json!("the flat skin's contact face over its outline (its edges continued below the base plane bound the body); indented: the skin minus the fitted sphere");
-    m["conventions"]["not_modelled"] = json!("the skin's deformation outside the contact (the skin is flat there; a real one sags towards the press or bulges round it), so the contact mask is the sphere's geometric intersection with the face, where a half-space's elastic contact is narrower; refraction at the flat layers for points off the contact face (the camera's straight rays, whose distortion holds for points on the face)");
+    m["conventions"]["surface"] = json!("the flat skin's contact face over its outline (its edges continued below the base plane bound the body); press/: the indenter's surface, the skin minus the fitted sphere (its contact mask the sphere's intersection with the face); press/skin/: the skin's outer surface as the sphere deforms it, an elastic layer bonded to its base (press.json: elastic; its contact mask where the sphere touches it); press/image.png (with --images): rendered from the face the camera sees, deformed");
+    m["conventions"]["not_modelled"] = json!("the skin's layers as one material, small strains and no friction (press.json: elastic.assumptions); refraction at the flat layers for points off the contact face (the camera's straight rays, whose distortion holds for points on the face)");
     let mut text = serde_json::to_vec_pretty(&m)?;
     text.push(b'\n');
     staged.write(files::MANIFEST, &text)?;
