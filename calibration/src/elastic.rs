@@ -666,3 +666,34 @@ pub fn sphere_heights(grid: ContactGrid, radius_mm: f64, cx: f64, cy: f64) -> Ve
     }
     h
 }
+
+/// The heights above their lowest point, at each cell's centre, of a board's bumps: each a
+/// cylinder of `radius_mm` capped by a hemisphere, its axis at `(x, y)` of `bumps_mm` (the
+/// grid's frame: cell `(i, j)` at [`ContactGrid::centre_mm`] plus `offset_mm`), standing
+/// `height_mm` on the board's floor (beyond every bump's radius the floor, `height_mm` above
+/// the tips).
+pub fn bump_heights(
+    grid: ContactGrid,
+    offset_mm: [f64; 2],
+    bumps_mm: &[[f64; 2]],
+    radius_mm: f64,
+    height_mm: f64,
+) -> Vec<f64> {
+    let n = grid.n;
+    let mut h = Vec::with_capacity(n * n);
+    for j in 0..n {
+        for i in 0..n {
+            let (x, y) = grid.centre_mm(i, j);
+            let (x, y) = (x + offset_mm[0], y + offset_mm[1]);
+            let mut best = height_mm;
+            for b in bumps_mm {
+                let r = (x - b[0]).hypot(y - b[1]);
+                if r < radius_mm {
+                    best = best.min(radius_mm - (radius_mm * radius_mm - r * r).sqrt());
+                }
+            }
+            h.push(best);
+        }
+    }
+    h
+}

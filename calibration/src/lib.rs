@@ -14,6 +14,7 @@ pub mod camera;
 pub mod camera_file;
 pub mod capture_images;
 pub mod elastic;
+pub mod flat_response;
 pub mod extrinsics;
 pub mod groundtruth;
 pub mod imprints;

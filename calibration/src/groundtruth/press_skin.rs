@@ -105,7 +105,8 @@ pub struct PressedSkin {
     pub in_contact: Vec<bool>,
     /// The radius of a disc of the contact's area, mm.
     pub contact_radius_mm: f64,
-    /// The sphere: its radius and its lowest point's depth under the contact face, mm.
+    /// The sphere's radius, mm (0: other indenters), and the indenters' lowest point's depth
+    /// under the contact face, mm.
     pub sphere_radius_mm: f64,
     pub depth_mm: f64,
 }
@@ -121,9 +122,9 @@ pub enum Face {
 
 impl PressedSkin {
     /// Solves the press of a sphere of `radius_mm` centred over `centre_mm`, its lowest point
-    /// `depth_mm` below the contact face, on `model`'s skin: a grid reaching four thicknesses
-    /// past the sphere's intersection with the face, of cells of [`CELL_MM`] (a quarter of the
-    /// thickness for a thin skin), at most [`MAX_CELLS`] a side (coarser cells past that).
+    /// `depth_mm` below the contact face, on `model`'s skin: on the grid
+    /// ([`PressedSkin::grid_for`]) reaching four thicknesses past the sphere's intersection
+    /// with the face.
     ///
     /// # Errors
     /// [`ContactError`] of the solver (a depth that is not finite or negative).
@@ -135,22 +136,48 @@ impl PressedSkin {
     ) -> Result<PressedSkin, ContactError> {
         let d = depth_mm.min(radius_mm);
         let a = (2.0 * radius_mm * d - d * d).max(0.0).sqrt();
-        let half_width = a + 4.0 * model.thickness_mm;
+        let grid = PressedSkin::grid_for(model, a + 4.0 * model.thickness_mm);
+        let heights = sphere_heights(grid, radius_mm, 0.0, 0.0);
+        let mut k = PressedSkin::solve_heights(model, grid, centre_mm, &heights, depth_mm)?;
+        k.sphere_radius_mm = radius_mm;
+        Ok(k)
+    }
+
+    /// The grid reaching `half_width_mm` from its centre each way, of cells of [`CELL_MM`] (a
+    /// quarter of the thickness for a thin skin, at most the seen face's depth), at most
+    /// [`MAX_CELLS`] a side (coarser cells past that).
+    pub fn grid_for(model: &SkinModel, half_width_mm: f64) -> ContactGrid {
         let mut cell = CELL_MM.min(model.thickness_mm / 4.0);
         if model.seen_depth_mm > 0.0 {
             cell = cell.min(model.seen_depth_mm);
         }
-        let mut n = (2.0 * half_width / cell).ceil() as usize;
+        let mut n = (2.0 * half_width_mm / cell).ceil() as usize;
         if n > MAX_CELLS {
             n = MAX_CELLS;
-            cell = 2.0 * half_width / n as f64;
+            cell = 2.0 * half_width_mm / n as f64;
         }
-        n = n.max(8);
-        let grid = ContactGrid { n, cell_mm: cell };
-        let heights = sphere_heights(grid, radius_mm, 0.0, 0.0);
+        ContactGrid {
+            n: n.max(8),
+            cell_mm: cell,
+        }
+    }
+
+    /// Solves the press of rigid indenters whose height above their lowest point at each cell
+    /// of `grid` (centred over `centre_mm`) is `heights_mm`, pressed `depth_mm` into the skin
+    /// (no sphere: [`PressedSkin::sample`] interpolates the surface in the contact too).
+    ///
+    /// # Errors
+    /// [`ContactError`] of the solver.
+    pub fn solve_heights(
+        model: &SkinModel,
+        grid: ContactGrid,
+        centre_mm: [f64; 2],
+        heights_mm: &[f64],
+        depth_mm: f64,
+    ) -> Result<PressedSkin, ContactError> {
         let skin = model.skin();
-        let contact = solve_skin_contact(grid, &heights, depth_mm, skin)?;
-        let seen_mm = if model.seen_depth_mm >= cell {
+        let contact = solve_skin_contact(grid, heights_mm, depth_mm, skin)?;
+        let seen_mm = if model.seen_depth_mm >= grid.cell_mm {
             displacement_at_depth(&contact, skin, model.seen_depth_mm)?
         } else {
             contact.displacement_mm.clone()
@@ -160,11 +187,12 @@ impl PressedSkin {
             model: model.clone(),
             grid,
             centre_mm,
-            contact_radius_mm: (cells * cell * cell / std::f64::consts::PI).sqrt(),
+            contact_radius_mm: (cells * grid.cell_mm * grid.cell_mm / std::f64::consts::PI)
+                .sqrt(),
             surface_mm: contact.displacement_mm,
             seen_mm,
             in_contact: contact.in_contact,
-            sphere_radius_mm: radius_mm,
+            sphere_radius_mm: 0.0,
             depth_mm,
         })
     }
@@ -174,7 +202,7 @@ impl PressedSkin {
     /// bilinear over the cells' centres (their gradients by central differences); 0 outside
     /// the grid.
     pub fn sample(&self, face: Face, x: f64, y: f64) -> (f64, [f64; 2]) {
-        if face == Face::Surface && self.touching(x, y) {
+        if face == Face::Surface && self.sphere_radius_mm > 0.0 && self.touching(x, y) {
             // in the contact the surface is the sphere's
             let (dx, dy) = (x - self.centre_mm[0], y - self.centre_mm[1]);
             let r = self.sphere_radius_mm;

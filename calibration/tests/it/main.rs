@@ -7,6 +7,7 @@ mod camera_models;
 mod common;
 mod elastic;
 mod extrinsics_synthetic;
+mod flat_response;
 mod groundtruth_closed_form;
 mod groundtruth_undistort;
 mod images_library;
