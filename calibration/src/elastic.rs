@@ -388,7 +388,8 @@ pub fn depth_factor(s: f64, t: f64, nu: f64) -> f64 {
 /// The displacement into the skin, mm, at `depth_mm` under the surface below the centre of
 /// every cell of `grid`, under a unit pressure (1 MPa) on one cell of the surface, by the
 /// offset between them, as [`influence`]'s: `(1 / (pi E*)) int_0^inf K_z(kz, kh) J0(kr) dk`
-/// ([`depth_factor`]) summed over the loaded cell by 5 x 5 Gauss points. `depth_mm` above 0
+/// ([`depth_factor`]), Boussinesq's point load in closed form plus the layer's smooth
+/// correction (a Hankel integral), summed over the loaded cell by 5 x 5 Gauss points. `depth_mm` above 0
 /// (at 0: [`influence`]), and for a layer below its thickness, at least a cell (checked by
 /// [`displacement_at_depth`]).
 pub fn influence_at_depth(grid: ContactGrid, skin: Skin, depth_mm: f64) -> Vec<f64> {
@@ -405,42 +406,59 @@ pub fn influence_at_depth(grid: ContactGrid, skin: Skin, depth_mm: f64) -> Vec<f
     };
     let half = grid.cell_mm / 2.0;
     let r_max = std::f64::consts::SQRT_2 * (n as f64 - 1.0) * grid.cell_mm + grid.cell_mm;
-    let dr = (grid.cell_mm / 8.0).min(depth_mm / 16.0);
-    // Simpson up to k z = 40 (e^-40), fine enough for J0 at the farthest distance
-    let k_max = 40.0 / depth_mm;
-    let dk_wanted = (0.1 / r_max.max(depth_mm)).min(0.02 / depth_mm);
-    let mut steps = (k_max / dk_wanted).ceil() as usize;
-    steps += steps % 2;
-    let dk = k_max / steps as f64;
-    let weights: Vec<(f64, f64)> = (0..=steps)
-        .map(|i| {
-            let k = i as f64 * dk;
-            let w = if i == 0 || i == steps {
-                1.0
-            } else if i % 2 == 1 {
-                4.0
-            } else {
-                2.0
-            };
-            (
-                k,
-                w * dk / 3.0 * depth_factor(k * depth_mm, k * thickness_mm, nu),
-            )
-        })
-        .collect();
-    let count = (r_max / dr).ceil() as usize + 2;
-    let table: Vec<f64> = (0..count)
-        .into_par_iter()
-        .map(|j| {
-            let r = j as f64 * dr;
-            weights.iter().map(|&(k, w)| w * libm::j0(k * r)).sum()
-        })
-        .collect();
-    let at = |r: f64| -> f64 {
+    // the layer's correction to Boussinesq's half-space, int (K_z - K_z,half-space) J0(kr) dk:
+    // it decays as e^(-k (2h - z)), so Simpson up to k h = 40, fine enough for J0 at the
+    // farthest distance
+    let table: Vec<f64> = if thickness_mm.is_finite() {
+        let dr = (grid.cell_mm / 8.0).min(thickness_mm / 32.0);
+        let k_max = 40.0 / thickness_mm;
+        let dk_wanted = (0.1 / r_max.max(thickness_mm)).min(0.02 / thickness_mm);
+        let mut steps = (k_max / dk_wanted).ceil() as usize;
+        steps += steps % 2;
+        let dk = k_max / steps as f64;
+        let weights: Vec<(f64, f64)> = (0..=steps)
+            .map(|i| {
+                let k = i as f64 * dk;
+                let w = if i == 0 || i == steps {
+                    1.0
+                } else if i % 2 == 1 {
+                    4.0
+                } else {
+                    2.0
+                };
+                let s = k * depth_mm;
+                let f = depth_factor(s, k * thickness_mm, nu) - depth_factor(s, f64::INFINITY, nu);
+                (k, w * dk / 3.0 * f)
+            })
+            .collect();
+        let count = (r_max / dr).ceil() as usize + 2;
+        let mut t: Vec<f64> = (0..count)
+            .into_par_iter()
+            .map(|j| {
+                let r = j as f64 * dr;
+                weights.iter().map(|&(k, w)| w * libm::j0(k * r)).sum()
+            })
+            .collect();
+        t.push(dr);
+        t
+    } else {
+        Vec::new()
+    };
+    let correction = |r: f64| -> f64 {
+        let Some((&dr, t)) = table.split_last() else {
+            return 0.0;
+        };
         let f = r / dr;
-        let i = (f as usize).min(table.len() - 2);
+        let i = (f as usize).min(t.len() - 2);
         let w = f - i as f64;
-        table[i] * (1.0 - w) + table[i + 1] * w
+        t[i] * (1.0 - w) + t[i + 1] * w
+    };
+    // Boussinesq's point load at depth z, times pi E*: z^2 / (2 (1 - nu) rho^3) + 1 / rho
+    // (Johnson Eq. 3.21c with 1 / (4 pi G) = 1 / (2 pi E* (1 - nu)))
+    let z2 = depth_mm * depth_mm;
+    let boussinesq = |r: f64| -> f64 {
+        let rho = (r * r + z2).sqrt();
+        z2 / (2.0 * (1.0 - nu) * rho * rho * rho) + 1.0 / rho
     };
     // 5-point Gauss-Legendre on [-1, 1]
     let gauss = [
@@ -461,7 +479,8 @@ pub fn influence_at_depth(grid: ContactGrid, skin: Skin, depth_mm: f64) -> Vec<f
             let mut sum = 0.0;
             for &(gy, wy) in &gauss {
                 for &(gx, wx) in &gauss {
-                    sum += wx * wy * at((x - gx * half).hypot(y - gy * half));
+                    let r = (x - gx * half).hypot(y - gy * half);
+                    sum += wx * wy * (boussinesq(r) + correction(r));
                 }
             }
             kernel[dj * m + di] = scale * sum;
@@ -504,11 +523,30 @@ pub fn displacement_at_depth(
     Ok(Convolver::new(contact.grid.n, &kernel).apply(&contact.pressure_mpa))
 }
 
+/// The least `2^a 3^b 5^c` at least `m`.
+fn smooth_size(m: usize) -> usize {
+    (m.max(1)..)
+        .find(|&k| {
+            let mut r = k;
+            for p in [2, 3, 5] {
+                while r % p == 0 {
+                    r /= p;
+                }
+            }
+            r == 1
+        })
+        .unwrap_or(m)
+}
+
 /// The convolution of an `n x n` grid of values with a kernel given at every offset
-/// (`(2n - 1)^2`, as [`influence`]'s), by FFTs of size `2n` a side (circular, padded so that
-/// no offset wraps), with the scalar planner: the same bits on every CPU.
+/// (`(2n - 1)^2`, as [`influence`]'s), by FFTs of at least `2n - 1` a side (circular, padded
+/// so that no offset wraps; a size of small factors), with the scalar planner: the same bits
+/// on every CPU.
 pub struct Convolver {
     n: usize,
+    /// The FFTs' size a side: the least 2^a 3^b 5^c at least `2n - 1` (fast FFTs; no offset
+    /// wraps).
+    big: usize,
     kernel_hat: Vec<Complex<f64>>,
     forward: std::sync::Arc<dyn rustfft::Fft<f64>>,
     inverse: std::sync::Arc<dyn rustfft::Fft<f64>>,
@@ -518,8 +556,8 @@ impl Convolver {
     /// The convolver of `kernel` (`(2n - 1)^2` values, offset `(di - (n - 1), dj - (n - 1))`
     /// at `dj * (2n - 1) + di`).
     pub fn new(n: usize, kernel: &[f64]) -> Convolver {
-        let big = 2 * n;
         let m = 2 * n - 1;
+        let big = smooth_size(m);
         let mut planner = rustfft::FftPlannerScalar::new();
         let forward = planner.plan_fft_forward(big);
         let inverse = planner.plan_fft_inverse(big);
@@ -532,6 +570,7 @@ impl Convolver {
         }
         let mut c = Convolver {
             n,
+            big,
             kernel_hat: Vec::new(),
             forward,
             inverse,
@@ -543,7 +582,7 @@ impl Convolver {
 
     /// The 2D FFT of `buf` (`2n x 2n`, row-major) in place: rows, then columns.
     fn fft2(&self, buf: &mut [Complex<f64>], inverse: bool) {
-        let big = 2 * self.n;
+        let big = self.big;
         let fft = if inverse {
             &self.inverse
         } else {
@@ -566,7 +605,7 @@ impl Convolver {
 
     /// `u[i] = sum_j values[j] kernel[i - j]` over the `n x n` grid (row-major).
     pub fn apply(&self, values: &[f64]) -> Vec<f64> {
-        let (n, big) = (self.n, 2 * self.n);
+        let (n, big) = (self.n, self.big);
         let mut buf = vec![Complex::new(0.0, 0.0); big * big];
         for j in 0..n {
             for i in 0..n {

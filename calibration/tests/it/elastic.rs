@@ -338,7 +338,9 @@ fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
 /// The displacement at a depth under the surface ([`depth_factor`]): the surface's at depth 0,
 /// none at a bonded layer's base, Boussinesq's under a point load in a half-space
 /// (`P / (4 pi G) (z^2 / rho^3 + 2 (1 - nu) / rho)`, Johnson Eq. 3.21c; a cell's pressure
-/// seen from 1 mm deep matches it within 0.5 % at every offset); under a sphere's contact on
+/// seen from 1 mm deep matches it within 0.5 % at every offset); in a bonded layer a cell
+/// deep, the surface's influence (computed by another route) away from the loaded cell, and
+/// nearly none by the base; under a sphere's contact on
 /// 9DTact's 2.8 mm layer the face 0.3 mm deep sinks less than the surface in the contact and
 /// follows it within 0.02 mm away from it, and bad depths are refused by name.
 #[test]
@@ -376,6 +378,39 @@ fn the_displacement_at_a_depth_is_boussinesqs() {
             (got / want - 1.0).abs() < 0.005,
             "r {r}: {got} against {want}"
         );
+    }
+    // a layer's interior by two routes: a cell deep its influence is the surface's (Love's
+    // rectangles plus the layer's correction to K) away from the loaded cell, within 1 % of the
+    // largest; near the base it vanishes (the base holds)
+    use fabkit_calibration::elastic::influence;
+    let layer = Skin::BondedLayer {
+        young_mpa: 0.1,
+        poisson: 0.5,
+        thickness_mm: 2.8,
+    };
+    let grid = ContactGrid {
+        n: 48,
+        cell_mm: 0.1,
+    };
+    let m = 2 * grid.n - 1;
+    let surface = influence(grid, layer);
+    let shallow = influence_at_depth(grid, layer, 0.1);
+    let deep = influence_at_depth(grid, layer, 2.7);
+    let peak = surface.iter().cloned().fold(0.0, f64::max);
+    for dj in 0..m {
+        for di in 0..m {
+            let (x, y) = (di as f64 - 47.0, dj as f64 - 47.0);
+            let k = dj * m + di;
+            if x.hypot(y) >= 5.0 {
+                assert!(
+                    (shallow[k] - surface[k]).abs() < 0.01 * peak,
+                    "({x}, {y}) cells: {} against {}",
+                    shallow[k],
+                    surface[k]
+                );
+            }
+            assert!(deep[k].abs() < 0.05 * peak, "{}", deep[k]);
+        }
     }
     // a sphere on the layer: the face 0.3 mm deep
     let skin = Skin::BondedLayer {

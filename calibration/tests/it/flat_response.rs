@@ -216,3 +216,4 @@ fn bump_heights_are_capped_cylinders_on_a_floor() {
     assert_eq!(at(32, 20), 1.5);
     assert_eq!(at(20, 30), 1.5);
 }
+
