@@ -214,147 +214,189 @@ pub fn solve_contact(
 }
 
 /// Solves the contact of an indenter whose height above its lowest point at each cell is
-/// `height_mm` (row-major, as [`Contact`]), pressed `approach_mm` into `skin`.
+/// `height_mm` (row-major, as [`Contact`]), pressed `approach_mm` into `skin`:
+/// [`ContactSolver::new`] then [`ContactSolver::solve`].
 ///
 /// # Errors
-/// [`ContactError`]: a grid out of range, heights of another count, a non-positive modulus,
-/// a Poisson's ratio outside [0, 0.5], a layer not thicker than two cells, a negative
-/// approach, no convergence.
+/// As theirs.
 pub fn solve_skin_contact(
     grid: ContactGrid,
     height_mm: &[f64],
     approach_mm: f64,
     skin: Skin,
 ) -> Result<Contact, ContactError> {
-    let n = grid.n;
-    if let Skin::BondedLayer {
-        young_mpa,
-        poisson,
-        thickness_mm,
-    } = skin
-    {
-        if !(young_mpa.is_finite() && young_mpa > 0.0) {
+    ContactSolver::new(grid, skin)?.solve(height_mm, approach_mm)
+}
+
+/// The contact solver of a skin on a grid: its influence, transformed once
+/// ([`Convolver`]), for the presses of any indenters on that grid (a capture's frames).
+pub struct ContactSolver {
+    grid: ContactGrid,
+    skin: Skin,
+    convolver: Convolver,
+}
+
+impl ContactSolver {
+    /// The solver of `skin` on `grid`.
+    ///
+    /// # Errors
+    /// [`ContactError`]: a grid out of range, a non-positive modulus, a Poisson's ratio
+    /// outside [0, 0.5], a layer not thicker than two cells.
+    pub fn new(grid: ContactGrid, skin: Skin) -> Result<ContactSolver, ContactError> {
+        let n = grid.n;
+        if let Skin::BondedLayer {
+            young_mpa,
+            poisson,
+            thickness_mm,
+        } = skin
+        {
+            if !(young_mpa.is_finite() && young_mpa > 0.0) {
+                return Err(ContactError::Value {
+                    name: "young_mpa",
+                    value: young_mpa,
+                    rule: "must be finite and > 0",
+                });
+            }
+            if !(0.0..=0.5).contains(&poisson) {
+                return Err(ContactError::Value {
+                    name: "poisson",
+                    value: poisson,
+                    rule: "must be in [0, 0.5]",
+                });
+            }
+            if !(thickness_mm.is_finite() && thickness_mm >= 2.0 * grid.cell_mm) {
+                return Err(ContactError::Value {
+                    name: "thickness_mm",
+                    value: thickness_mm,
+                    rule: "must be finite and at least two cells (the layer's correction is \
+                       summed over each cell by Gauss points)",
+                });
+            }
+        }
+        let e_star_mpa = skin.e_star_mpa();
+        if !((2..=MAX_CELLS).contains(&n) && grid.cell_mm.is_finite() && grid.cell_mm > 0.0) {
+            return Err(ContactError::Grid {
+                n,
+                cell_mm: grid.cell_mm,
+                max: MAX_CELLS,
+            });
+        }
+        if !(e_star_mpa.is_finite() && e_star_mpa > 0.0) {
             return Err(ContactError::Value {
-                name: "young_mpa",
-                value: young_mpa,
+                name: "e_star_mpa",
+                value: e_star_mpa,
                 rule: "must be finite and > 0",
             });
         }
-        if !(0.0..=0.5).contains(&poisson) {
-            return Err(ContactError::Value {
-                name: "poisson",
-                value: poisson,
-                rule: "must be in [0, 0.5]",
-            });
-        }
-        if !(thickness_mm.is_finite() && thickness_mm >= 2.0 * grid.cell_mm) {
-            return Err(ContactError::Value {
-                name: "thickness_mm",
-                value: thickness_mm,
-                rule: "must be finite and at least two cells (the layer's correction is \
-                       summed over each cell by Gauss points)",
-            });
-        }
-    }
-    let e_star_mpa = skin.e_star_mpa();
-    if !((2..=MAX_CELLS).contains(&n) && grid.cell_mm.is_finite() && grid.cell_mm > 0.0) {
-        return Err(ContactError::Grid {
-            n,
-            cell_mm: grid.cell_mm,
-            max: MAX_CELLS,
-        });
-    }
-    if height_mm.len() != n * n {
-        return Err(ContactError::Heights(height_mm.len(), n * n));
-    }
-    if !(e_star_mpa.is_finite() && e_star_mpa > 0.0) {
-        return Err(ContactError::Value {
-            name: "e_star_mpa",
-            value: e_star_mpa,
-            rule: "must be finite and > 0",
-        });
-    }
-    if !(approach_mm.is_finite() && approach_mm >= 0.0) {
-        return Err(ContactError::Value {
-            name: "approach_mm",
-            value: approach_mm,
-            rule: "must be finite and >= 0",
-        });
-    }
-    let convolver = Convolver::new(n, &influence(grid, skin));
-    let apply = |p: &[f64]| convolver.apply(p);
-    // Polonsky and Keer's conjugate gradient, the approach given (no load balance)
-    let mut p: Vec<f64> = height_mm
-        .iter()
-        .map(|&h| {
-            if h < approach_mm {
-                1e-3 * e_star_mpa
-            } else {
-                0.0
-            }
+        Ok(ContactSolver {
+            grid,
+            skin,
+            convolver: Convolver::new(n, &influence(grid, skin)),
         })
-        .collect();
-    let mut t = vec![0.0; n * n];
-    let (mut g_old, mut delta) = (1.0, 0.0);
-    let max_iter = 10 * n * n;
-    let mut change = f64::INFINITY;
-    for iteration in 1..=max_iter {
-        let u = apply(&p);
-        let g: Vec<f64> = (0..n * n)
-            .map(|k| height_mm[k] + u[k] - approach_mm)
-            .collect();
-        let gg: f64 = (0..n * n)
-            .filter(|&k| p[k] > 0.0)
-            .map(|k| g[k] * g[k])
-            .sum();
-        for k in 0..n * n {
-            t[k] = if p[k] > 0.0 {
-                g[k] + delta * (gg / g_old) * t[k]
-            } else {
-                0.0
-            };
+    }
+
+    /// The skin's grid.
+    pub fn grid(&self) -> ContactGrid {
+        self.grid
+    }
+
+    /// The skin.
+    pub fn skin(&self) -> Skin {
+        self.skin
+    }
+
+    /// Solves the contact of an indenter whose height above its lowest point at each cell is
+    /// `height_mm` (row-major, as [`Contact`]), pressed `approach_mm` into the skin.
+    ///
+    /// # Errors
+    /// [`ContactError`]: heights of another count, a negative approach, no convergence.
+    pub fn solve(&self, height_mm: &[f64], approach_mm: f64) -> Result<Contact, ContactError> {
+        let (grid, n) = (self.grid, self.grid.n);
+        let e_star_mpa = self.skin.e_star_mpa();
+        if height_mm.len() != n * n {
+            return Err(ContactError::Heights(height_mm.len(), n * n));
         }
-        g_old = gg.max(f64::MIN_POSITIVE);
-        let r = apply(&t);
-        let (num, den) = (0..n * n)
-            .filter(|&k| p[k] > 0.0)
-            .fold((0.0, 0.0), |(a, b), k| (a + g[k] * t[k], b + r[k] * t[k]));
-        let tau = if den > 0.0 { num / den } else { 0.0 };
-        let before: f64 = p.iter().sum();
-        let old = p.clone();
-        for k in 0..n * n {
-            if p[k] > 0.0 {
-                p[k] = (p[k] - tau * t[k]).max(0.0);
-            }
-        }
-        // cells off the contact that the indenter now overlaps enter it
-        let mut entered = false;
-        for k in 0..n * n {
-            if old[k] == 0.0 && g[k] < 0.0 {
-                p[k] = -tau * g[k];
-                if p[k] <= 0.0 {
-                    p[k] = 1e-6 * e_star_mpa;
-                }
-                entered = true;
-            }
-        }
-        delta = if entered { 0.0 } else { 1.0 };
-        let moved: f64 = p.iter().zip(&old).map(|(a, b)| (a - b).abs()).sum();
-        change = if before > 0.0 { moved / before } else { 0.0 };
-        if change < 1e-9 && !entered {
-            let u = apply(&p);
-            let area = grid.cell_mm * grid.cell_mm;
-            return Ok(Contact {
-                grid,
-                load_n: p.iter().sum::<f64>() * area,
-                in_contact: p.iter().map(|&x| x > 0.0).collect(),
-                displacement_mm: u,
-                pressure_mpa: p,
-                iterations: iteration,
+        if !(approach_mm.is_finite() && approach_mm >= 0.0) {
+            return Err(ContactError::Value {
+                name: "approach_mm",
+                value: approach_mm,
+                rule: "must be finite and >= 0",
             });
         }
+        let apply = |p: &[f64]| self.convolver.apply(p);
+        // Polonsky and Keer's conjugate gradient, the approach given (no load balance)
+        let mut p: Vec<f64> = height_mm
+            .iter()
+            .map(|&h| {
+                if h < approach_mm {
+                    1e-3 * e_star_mpa
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        let mut t = vec![0.0; n * n];
+        let (mut g_old, mut delta) = (1.0, 0.0);
+        let max_iter = 10 * n * n;
+        let mut change = f64::INFINITY;
+        for iteration in 1..=max_iter {
+            let u = apply(&p);
+            let g: Vec<f64> = (0..n * n)
+                .map(|k| height_mm[k] + u[k] - approach_mm)
+                .collect();
+            let gg: f64 = (0..n * n)
+                .filter(|&k| p[k] > 0.0)
+                .map(|k| g[k] * g[k])
+                .sum();
+            for k in 0..n * n {
+                t[k] = if p[k] > 0.0 {
+                    g[k] + delta * (gg / g_old) * t[k]
+                } else {
+                    0.0
+                };
+            }
+            g_old = gg.max(f64::MIN_POSITIVE);
+            let r = apply(&t);
+            let (num, den) = (0..n * n)
+                .filter(|&k| p[k] > 0.0)
+                .fold((0.0, 0.0), |(a, b), k| (a + g[k] * t[k], b + r[k] * t[k]));
+            let tau = if den > 0.0 { num / den } else { 0.0 };
+            let before: f64 = p.iter().sum();
+            let old = p.clone();
+            for k in 0..n * n {
+                if p[k] > 0.0 {
+                    p[k] = (p[k] - tau * t[k]).max(0.0);
+                }
+            }
+            // cells off the contact that the indenter now overlaps enter it
+            let mut entered = false;
+            for k in 0..n * n {
+                if old[k] == 0.0 && g[k] < 0.0 {
+                    p[k] = -tau * g[k];
+                    if p[k] <= 0.0 {
+                        p[k] = 1e-6 * e_star_mpa;
+                    }
+                    entered = true;
+                }
+            }
+            delta = if entered { 0.0 } else { 1.0 };
+            let moved: f64 = p.iter().zip(&old).map(|(a, b)| (a - b).abs()).sum();
+            change = if before > 0.0 { moved / before } else { 0.0 };
+            if change < 1e-9 && !entered {
+                let u = apply(&p);
+                let area = grid.cell_mm * grid.cell_mm;
+                return Ok(Contact {
+                    grid,
+                    load_n: p.iter().sum::<f64>() * area,
+                    in_contact: p.iter().map(|&x| x > 0.0).collect(),
+                    displacement_mm: u,
+                    pressure_mpa: p,
+                    iterations: iteration,
+                });
+            }
+        }
+        Err(ContactError::NoConvergence(max_iter, change))
     }
-    Err(ContactError::NoConvergence(max_iter, change))
 }
 
 /// `K_z(s, t)`, the normal displacement at depth `z` under the surface of a bonded layer of
