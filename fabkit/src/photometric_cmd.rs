@@ -13,8 +13,9 @@ use fabkit_calibration::groundtruth::rays::PixelRays;
 use fabkit_calibration::groundtruth::{indented_hits, reference_hits, Scene, SurfaceHits};
 use fabkit_calibration::imprints::ids_from_file_name;
 use fabkit_calibration::photometric::{
-    capture_fault, image_fault, read_pins, rms_over_skin, shadow_map, Capture, PhotometricModel,
-    ShadowMap, ShadowRings,
+    capture_fault, image_fault, read_pins, rms_over_skin, shadow_map, Capture, ContactRegion,
+    ImprintMap, PhotometricModel, ShadowMap, ShadowRings, CONTACT_REACH_PX, DARKENING_NOISE_SIGMAS,
+    GAIN_CLEARANCE_PX, GAIN_OUTLIER_SIGMAS,
 };
 use fabkit_export::raster::{npy_f32, png_rgb16, png_rgb8};
 use fabkit_export::{OutputClaim, OutputCommand, StagedDir};
@@ -50,6 +51,10 @@ pub struct PhotometricArgs {
     /// Replace an earlier fit in --out computed from other inputs.
     #[arg(long)]
     force: bool,
+    /// The contact region the fit is judged in first: the skin within this distance of an
+    /// imprint (its nearest pressed pixel), px, from 1 to 100.
+    #[arg(long, value_name = "PX", default_value_t = CONTACT_REACH_PX)]
+    contact_reach_px: f64,
     #[command(flatten)]
     data_files: DataFileArgs,
 }
@@ -63,8 +68,28 @@ struct Posed {
     shadows: ShadowMap,
 }
 
+/// Largest `--contact-reach-px`: the distances are spread from every imprint's rim over a
+/// disc of this radius.
+const MAX_CONTACT_REACH_PX: f64 = 100.0;
+
+/// One capture rendered from a model at its gain: the gain, the RMS over the skin, the
+/// image and its fit within the contact region.
+struct Rendered {
+    gain: f64,
+    rms_counts: f64,
+    image: Vec<[f64; 3]>,
+    contact: ContactRegion,
+}
+
 pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
     let t0 = std::time::Instant::now();
+    let reach = a.contact_reach_px;
+    if !(1.0..=MAX_CONTACT_REACH_PX).contains(&reach) {
+        return Err(format!(
+            "--contact-reach-px = {reach}: must be a distance from 1 to {MAX_CONTACT_REACH_PX} px"
+        )
+        .into());
+    }
     let claim = claim(&a);
     fabkit_export::check_out_dir(&a.out, &claim)?;
     let loaded = load_design(a.design.as_deref(), &a.data_files)?;
@@ -88,24 +113,81 @@ pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
         &all,
         setup.full_scale,
     )?;
-    let loo = leave_one_out(&setup, &posed, &all)?;
+    let fitted: Vec<Rendered> = all
+        .iter()
+        .zip(&model.gains)
+        .map(|(c, &g)| rendered(&setup, &model, c, g, reach))
+        .collect();
+    let loo = leave_one_out(&setup, &posed, &all, reach)?;
 
     let staged = StagedDir::new(&a.out, claim)?;
-    write_outputs(&staged, &a, &loaded, &setup, &posed, &model, &loo)?;
+    write_outputs(
+        &staged,
+        &a,
+        &loaded,
+        &setup,
+        &posed,
+        &model,
+        [&fitted, &loo],
+    )?;
     for w in staged.commit()? {
         eprintln!("warning: {w}");
     }
-    let worst = loo.iter().map(|l| l.0).fold(0.0f64, f64::max);
+    let worst = |r: &[Rendered], f: fn(&Rendered) -> f64| {
+        r.iter()
+            .map(f)
+            .filter(|x| x.is_finite())
+            .fold(0.0f64, f64::max)
+    };
+    let offsets = |r: &Rendered| r.contact.median_offset_px.unwrap_or(f64::NAN);
     out!(
-        "{}: photometric model from {} captures, fit within {:.2} counts RMS, each capture re-rendered from the others within {:.2} -> {} ({:.2} s)",
+        "{}: photometric model from {} captures; within {reach} px of the imprints each capture re-rendered from the others within {:.2} counts RMS (fit {:.2}), median imprint centroid offset at most {:.2} px; over the whole skin within {:.2} (fit {:.2}) -> {} ({:.2} s)",
         design.name,
         posed.len(),
-        model.residual_rms.iter().copied().fold(0.0f64, f64::max),
-        worst,
+        worst(&loo, |r| r.contact.rms_counts),
+        worst(&fitted, |r| r.contact.rms_counts),
+        worst(&loo, offsets),
+        worst(&loo, |r| r.rms_counts),
+        worst(&fitted, |r| r.rms_counts),
         a.out.display(),
         t0.elapsed().as_secs_f64()
     );
+    for ((p, f), l) in posed.iter().zip(&fitted).zip(&loo) {
+        let median = l
+            .contact
+            .median_offset_px
+            .map_or("none".to_string(), |x| format!("{x:.2} px"));
+        out!(
+            "  {}: gain {:.4}; within {reach} px of its {} imprints {:.2} counts RMS (fit {:.2}), centroid offset {median} (median); whole skin {:.2} (fit {:.2})",
+            p.file.display(),
+            l.gain,
+            l.contact.imprints.len(),
+            l.contact.rms_counts,
+            f.contact.rms_counts,
+            l.rms_counts,
+            f.rms_counts
+        );
+    }
     Ok(())
+}
+
+/// `capture` rendered from `model` at `gain` ([`Rendered`]).
+fn rendered(
+    setup: &Setup,
+    model: &PhotometricModel,
+    capture: &Capture,
+    gain: f64,
+    reach_px: f64,
+) -> Rendered {
+    let (rays, reference) = (&setup.rays, &setup.reference);
+    let image = model.render(rays, reference, capture.hits, capture.shadows, gain);
+    let contact = model.contact_region(capture, reference, &image, gain, reach_px);
+    Rendered {
+        gain,
+        rms_counts: rms_over_skin(&image, capture.image),
+        image,
+        contact,
+    }
 }
 
 /// The point table of the pin dome in `--fixtures`.
@@ -342,13 +424,14 @@ fn refuse_blank_frames(
     Ok(())
 }
 
-/// Each capture re-rendered from the model fitted on the others: its RMS difference from the
-/// capture and the image.
+/// Each capture re-rendered from the model fitted on the others, at its gain against that
+/// model's appearance.
 fn leave_one_out(
     setup: &Setup,
     posed: &[Posed],
     all: &[Capture],
-) -> Result<Vec<(f64, Vec<[f64; 3]>)>, Box<dyn Error>> {
+    reach_px: f64,
+) -> Result<Vec<Rendered>, Box<dyn Error>> {
     let (rays, reference) = (&setup.rays, &setup.reference);
     let mut loo = Vec::new();
     for k in 0..posed.len() {
@@ -364,15 +447,14 @@ fn leave_one_out(
             setup.full_scale,
         )
         .map_err(|e| format!("leaving out {}: {e}", posed[k].file.display()))?;
-        let gain = m.gain_of(&posed[k].image, &posed[k].hits);
-        let again = m.render(rays, reference, &posed[k].hits, &posed[k].shadows, gain);
-        loo.push((rms_over_skin(&again, &posed[k].image), again));
+        let gain = m.gain_of(&all[k], reference);
+        loo.push(rendered(setup, &m, &all[k], gain, reach_px));
     }
     Ok(loo)
 }
 
 /// Writes appearance.npy, the re-rendered captures and photometric.json (which lists them)
-/// into `staged`.
+/// into `staged`: each capture rendered from `model` and from the model fitted on the others.
 fn write_outputs(
     staged: &StagedDir,
     a: &PhotometricArgs,
@@ -380,7 +462,7 @@ fn write_outputs(
     setup: &Setup,
     posed: &[Posed],
     model: &PhotometricModel,
-    loo: &[(f64, Vec<[f64; 3]>)],
+    [fitted, loo]: [&[Rendered]; 2],
 ) -> Result<(), Box<dyn Error>> {
     let (w, h) = (setup.rays.width, setup.rays.height);
     let mut files: Vec<Value> = Vec::new();
@@ -403,10 +485,12 @@ fn write_outputs(
             .map(|s| s.to_string_lossy().to_string())
             .unwrap_or_else(|| format!("capture_{k}"));
         let rel = format!("rerendered/{stem}.png");
-        put(&rel, rerendered_png(&loo[k].1, w, h, setup.full_scale)?)?;
+        put(&rel, rerendered_png(&loo[k].image, w, h, setup.full_scale)?)?;
         captures.push(json!({
-            "file": p.file.display().to_string(), "pins": p.ids, "gain": model.gains[k],
-            "fit_rms_counts": model.residual_rms[k], "leave_one_out_rms_counts": loo[k].0,
+            "file": p.file.display().to_string(), "pins": p.ids,
+            "contact_region": contact_json(setup, p, &fitted[k], &loo[k]),
+            "gain": model.gains[k], "leave_one_out_gain": loo[k].gain,
+            "fit_rms_counts": model.residual_rms[k], "leave_one_out_rms_counts": loo[k].rms_counts,
             "rerendered": rel,
         }));
     }
@@ -415,6 +499,74 @@ fn write_outputs(
     text.push(b'\n');
     staged.write("photometric.json", &text)?;
     Ok(())
+}
+
+/// A number for the report: `null` when not finite.
+fn num(x: f64) -> Value {
+    if x.is_finite() {
+        json!(x)
+    } else {
+        Value::Null
+    }
+}
+
+/// The fit of capture `p` within the contact region: the RMS of the fit (`fitted`) and of the
+/// leave-one-out (`loo`), and per imprint (named by the pin whose tip lies nearest the mean of
+/// its pressed surface points) its RMS and the centroids of the real and the leave-one-out
+/// rendering's darkening.
+fn contact_json(setup: &Setup, p: &Posed, fitted: &Rendered, loo: &Rendered) -> Value {
+    let (rays, w, h) = (&setup.rays, setup.rays.width, setup.rays.height);
+    let map = ImprintMap::of(&p.hits.contact, w, h, 0.0);
+    let mut sums = vec![[0.0; 4]; map.centres_px.len()];
+    for i in (0..w * h).filter(|&i| p.hits.contact[i] && p.hits.t_mm[i].is_finite()) {
+        if let Some(j) = map.imprint_near(i, 0.0) {
+            let s = &mut sums[j];
+            for (q, x) in s.iter_mut().take(3).enumerate() {
+                *x += rays.origin_mm[q] + p.hits.t_mm[i] * rays.dirs[i][q];
+            }
+            s[3] += 1.0;
+        }
+    }
+    let pin_of = |s: &[f64; 4]| -> Option<&str> {
+        let m: [f64; 3] = std::array::from_fn(|q| s[q] / s[3]);
+        let d = |tip: &[f64; 3]| (0..3).map(|q| (tip[q] - m[q]).powi(2)).sum::<f64>();
+        setup
+            .pins
+            .rows
+            .iter()
+            .filter(|(id, _, _)| p.ids.contains(id))
+            .min_by(|a, b| d(&a.1).total_cmp(&d(&b.1)))
+            .map(|(id, _, _)| id.as_str())
+    };
+    let px = |x: Option<[f64; 2]>| x.map_or(Value::Null, |x| json!(x));
+    let imprints: Vec<Value> = loo
+        .contact
+        .imprints
+        .iter()
+        .zip(&fitted.contact.imprints)
+        .zip(&sums)
+        .map(|((l, f), s)| {
+            json!({
+                "pin": pin_of(s),
+                "centre_px": l.centre_px,
+                "pressed_pixels": l.pressed_pixels,
+                "fit_rms_counts": num(f.rms_counts),
+                "leave_one_out_rms_counts": num(l.rms_counts),
+                "real_darkening_centroid_px": px(l.real_centroid_px),
+                "rendered_darkening_centroid_px": px(l.rendered_centroid_px),
+                "centroid_offset_px": l.offset_px.map_or(Value::Null, num),
+            })
+        })
+        .collect();
+    json!({
+        "reach_px": loo.contact.reach_px,
+        "pixels": loo.contact.pixels,
+        "fit_rms_counts": num(fitted.contact.rms_counts),
+        "leave_one_out_rms_counts": num(loo.contact.rms_counts),
+        "median_centroid_offset_px": loo.contact.median_offset_px.map_or(Value::Null, num),
+        "darkening_floor_counts": loo.contact.darkening_floor_counts,
+        "imprints": imprints,
+    })
 }
 
 /// A re-rendered capture as a PNG of the captures' bit depth (counts rounded; 0 where not
@@ -458,6 +610,8 @@ fn report_json(
         "extrinsics": {"file": setup.pose_name, "sha256": setup.extrinsics_sha},
         "fixtures": a.fixtures.display().to_string(),
         "model": model.model_json(),
+        "gain": format!("per capture, the least-squares ratio of the capture to the model's appearance (the fit's: to the reference image) over every channel of its skin further than {GAIN_CLEARANCE_PX} px from every imprint (its nearest pressed pixel) and unshadowed, lit and below full scale, values further than {GAIN_OUTLIER_SIGMAS} robust standard deviations from a first estimate left out; applied wherever the capture is rendered (fit RMS, leave-one-out RMS, rerendered/)"),
+        "contact_region": format!("per capture, the RMS of the fit and of the leave-one-out over the skin within reach_px = {} px of an imprint (8-connected pressed pixels of the ground truth; distance to its nearest pressed pixel), beside the whole-skin figures; per imprint, the distance between the centroids of the capture's darkening and of its leave-one-out rendering's (the appearance at the capture's gain minus the image, summed over the channels, each less the floor of {DARKENING_NOISE_SIGMAS} x the capture's noise beyond the reach and clipped at 0) over the pixels within the reach nearest it, and their median", a.contact_reach_px),
         "captures": captures,
         "files": files,
     })

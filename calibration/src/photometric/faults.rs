@@ -2,7 +2,7 @@
 //! ([`ImageFault`]).
 
 use super::model::Capture;
-use super::terms::{gain_of, median, MIN_REFERENCE_COUNTS};
+use super::terms::{median, median_gain, MIN_REFERENCE_COUNTS};
 use crate::groundtruth::hits::SurfaceHits;
 
 /// Why an image cannot serve the fit ([`image_fault`], [`capture_fault`]).
@@ -108,7 +108,7 @@ pub fn capture_fault(
         return Some(f);
     }
     let on_skin = |i: usize| reference.t_mm[i].is_finite();
-    let gain = gain_of(capture.image, reference_image, |i| capture.hits.contact[i]);
+    let gain = median_gain(capture.image, reference_image, |i| capture.hits.contact[i]);
     let shadowed: std::collections::HashSet<u32> =
         capture.shadows.pixels.iter().map(|p| p.pixel).collect();
     let usable = |i: usize| {

@@ -1,11 +1,12 @@
 //! Fitting the model ([`PhotometricModel::fit`]) from the reference image and the captures.
 
+use super::contact::capture_gain;
 use super::faults::{capture_fault, image_fault};
 use super::model::{Capture, PhotometricModel};
 use super::render::rms_over_skin;
 use super::shadows::{ShadowPixel, ShadowRings};
 use super::terms::{
-    features, gain_of, light_features, optical_axis, spatial, COEFFICIENTS, FEATURES, LIGHT_TERMS,
+    features, light_features, optical_axis, spatial, COEFFICIENTS, FEATURES, LIGHT_TERMS,
     MIN_REFERENCE_COUNTS, SHADOW_TERMS, SPATIAL_TERMS,
 };
 use crate::groundtruth::hits::SurfaceHits;
@@ -41,7 +42,7 @@ impl PhotometricModel {
         }
         let gains: Vec<f64> = captures
             .iter()
-            .map(|c| gain_of(c.image, reference_image, |i| c.hits.contact[i]))
+            .map(|c| capture_gain(c, reference_image, reference, w, h, full_scale))
             .collect();
         let appearance = appearance(reference, reference_image, captures, &gains);
         // The response to tilt and the shadows, by least squares on the pressed and the

@@ -28,7 +28,14 @@
 //!   the pixel, beside an imprint or inside it; `b_j` the share of the pixel's light the ring
 //!   stands for;
 //! - `gain`: each capture's global gain against the reference (exposure and LED drift), the
-//!   median ratio over its unpressed skin.
+//!   least-squares ratio over its skin further than [`GAIN_CLEARANCE_PX`] (30 px) from every
+//!   imprint and unshadowed, outliers (moving highlights, specks) left out
+//!   ([`PhotometricModel::gain_of`]); applied wherever a capture is rendered.
+//!
+//! The fit is judged where the pins press as well as over the whole skin
+//! ([`PhotometricModel::contact_region`]): the RMS within [`CONTACT_REACH_PX`] (15 px) of each
+//! imprint, and the distance between the centroids of the capture's and the rendering's
+//! darkening at each imprint.
 //!
 //! Why this form: under Lambertian lights the radiance is a sum of clamped cosines
 //! `max(0, n . l_k)`, a smooth function of the normal. With `n = (1 - c) n0 - a e_a - r e_r`
@@ -54,6 +61,7 @@
 //! test: their weights are divided by all candidates' irradiance, not the unknown lights'.
 //! Penumbrae are those of the sampled rings (24 lights each).
 
+mod contact;
 mod faults;
 mod fit;
 mod model;
@@ -63,6 +71,10 @@ mod shadows;
 mod terms;
 
 pub use crate::groundtruth::pins::{pin_primitives, read_pins, Pins};
+pub use contact::{
+    ContactRegion, ImprintFit, ImprintMap, CONTACT_REACH_PX, DARKENING_NOISE_SIGMAS,
+    GAIN_CLEARANCE_PX, GAIN_OUTLIER_SIGMAS,
+};
 pub use faults::{
     capture_fault, image_fault, ImageFault, IMPRINT_NOISE_FACTOR, MIN_IMPRINT_COUNTS,
 };

@@ -21,7 +21,8 @@ pub struct PhotometricModel {
     /// Per channel, the weight of each candidate ring's shadow ([`ShadowMap`]): the fraction
     /// of a pixel's light its ring stands for.
     pub shadow_coefficients: [[f64; SHADOW_TERMS]; 3],
-    /// The gain of each fitted capture against the reference.
+    /// The gain of each fitted capture against the reference image: the least-squares ratio
+    /// over its skin far from every imprint ([`PhotometricModel::gain_of`]).
     pub gains: Vec<f64>,
     /// The images' full scale, counts: rendered values are clipped to it.
     pub full_scale: f64,

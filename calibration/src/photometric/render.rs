@@ -3,9 +3,7 @@
 
 use super::model::PhotometricModel;
 use super::shadows::{shadow_map, ShadowMap};
-use super::terms::{
-    features, gain_of, light_features, spatial, FEATURES, LIGHT_TERMS, SPATIAL_TERMS,
-};
+use super::terms::{features, light_features, spatial, FEATURES, LIGHT_TERMS, SPATIAL_TERMS};
 use crate::groundtruth::exact::ExactPrimitives;
 use crate::groundtruth::hits::SurfaceHits;
 use crate::groundtruth::rays::PixelRays;
@@ -38,12 +36,6 @@ impl PhotometricModel {
                 })
             })
             .collect()
-    }
-
-    /// The gain of `image` (a capture whose surface is `hits`) against the model's appearance:
-    /// the median ratio over its unpressed skin, for re-rendering it.
-    pub fn gain_of(&self, image: &[[f64; 3]], hits: &SurfaceHits) -> f64 {
-        gain_of(image, &self.reference, |i| hits.contact[i])
     }
 
     /// The image (row-major, per channel, counts clipped to the full scale; NaN off the skin)

@@ -200,9 +200,12 @@ pub(super) fn median(mut v: Vec<f64>) -> Option<f64> {
     Some(*m)
 }
 
-/// The gain of `image` against `reference` over the unpressed skin: the median ratio of the
-/// green channel (or the first channel with light) where the reference is bright enough.
-pub(super) fn gain_of(
+/// A quick gain of `image` against `reference` over the unpressed skin, for the check that a
+/// capture shows its imprints ([`super::faults::capture_fault`], which knows no image size):
+/// the median ratio of the brightest channel where the reference is bright enough. The fit
+/// and the renderings use the least-squares gain far from the imprints
+/// ([`super::contact::capture_gain`]).
+pub(super) fn median_gain(
     image: &[[f64; 3]],
     reference: &[[f64; 3]],
     pressed: impl Fn(usize) -> bool,
