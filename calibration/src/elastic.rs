@@ -90,38 +90,54 @@ fn layer_factor_less_one(t: f64, nu: f64) -> f64 {
     num * e / den
 }
 
-/// The layer's correction to a half-space's point-load displacement at the distances
-/// `0, dr, 2 dr, ...` up to `r_max_mm`, times `pi E*`: `int_0^inf (K(kh) - 1) J0(kr) dk`, by
-/// Simpson's rule fine enough for the oscillation of `J0` at the farthest distance and for
-/// the decay of `K - 1`, up to `k h = 40` (where `K - 1` is below `1e-30`).
-fn layer_correction_table(h: f64, nu: f64, dr: f64, r_max_mm: f64) -> Vec<f64> {
-    use rayon::prelude::*;
-    let k_max = 40.0 / h;
-    let dk_wanted = (0.1 / r_max_mm.max(h)).min(0.02 / h);
-    let mut steps = (k_max / dk_wanted).ceil() as usize;
-    steps += steps % 2;
-    let dk = k_max / steps as f64;
-    let weights: Vec<(f64, f64)> = (0..=steps)
-        .map(|i| {
-            let k = i as f64 * dk;
-            let w = if i == 0 || i == steps {
-                1.0
-            } else if i % 2 == 1 {
-                4.0
-            } else {
-                2.0
-            };
-            (k, w * dk / 3.0 * layer_factor_less_one(k * h, nu))
-        })
-        .collect();
-    let count = (r_max_mm / dr).ceil() as usize + 2;
-    (0..count)
-        .into_par_iter()
-        .map(|j| {
-            let r = j as f64 * dr;
-            weights.iter().map(|&(k, w)| w * libm::j0(k * r)).sum()
-        })
-        .collect()
+/// A radial function tabulated at `0, dr, 2 dr, ...` up to `r_max_mm`:
+/// `int_0^(40/h) f(k) J0(kr) dk` by Simpson's rule, fine enough for the oscillation of `J0`
+/// at the farthest distance and for `f`'s decay over `k ~ 1 / h` (`f` below `1e-30` past
+/// `k h = 40`: the layer's corrections here, which fall as `e^(-2kh)` or `e^(-k(2h - z))`).
+struct HankelTable {
+    dr: f64,
+    values: Vec<f64>,
+}
+
+impl HankelTable {
+    fn new(f: impl Fn(f64) -> f64, h: f64, dr: f64, r_max_mm: f64) -> HankelTable {
+        use rayon::prelude::*;
+        let k_max = 40.0 / h;
+        let dk_wanted = (0.1 / r_max_mm.max(h)).min(0.02 / h);
+        let mut steps = (k_max / dk_wanted).ceil() as usize;
+        steps += steps % 2;
+        let dk = k_max / steps as f64;
+        let weights: Vec<(f64, f64)> = (0..=steps)
+            .map(|i| {
+                let k = i as f64 * dk;
+                let w = if i == 0 || i == steps {
+                    1.0
+                } else if i % 2 == 1 {
+                    4.0
+                } else {
+                    2.0
+                };
+                (k, w * dk / 3.0 * f(k))
+            })
+            .collect();
+        let count = (r_max_mm / dr).ceil() as usize + 2;
+        let values = (0..count)
+            .into_par_iter()
+            .map(|j| {
+                let r = j as f64 * dr;
+                weights.iter().map(|&(k, w)| w * libm::j0(k * r)).sum()
+            })
+            .collect();
+        HankelTable { dr, values }
+    }
+
+    /// The function at `r`, linear between the tabulated distances.
+    fn at(&self, r: f64) -> f64 {
+        let f = r / self.dr;
+        let i = (f as usize).min(self.values.len() - 2);
+        let w = f - i as f64;
+        self.values[i] * (1.0 - w) + self.values[i + 1] * w
+    }
 }
 
 /// The grid the pressure lives on: `n x n` square cells of side `cell_mm`, centred on the
@@ -435,7 +451,6 @@ pub fn depth_factor(s: f64, t: f64, nu: f64) -> f64 {
 /// (at 0: [`influence`]), and for a layer below its thickness, at least a cell (checked by
 /// [`displacement_at_depth`]).
 pub fn influence_at_depth(grid: ContactGrid, skin: Skin, depth_mm: f64) -> Vec<f64> {
-    use rayon::prelude::*;
     let n = grid.n;
     let m = 2 * n - 1;
     let (nu, thickness_mm) = match skin {
@@ -448,53 +463,19 @@ pub fn influence_at_depth(grid: ContactGrid, skin: Skin, depth_mm: f64) -> Vec<f
     };
     let half = grid.cell_mm / 2.0;
     let r_max = std::f64::consts::SQRT_2 * (n as f64 - 1.0) * grid.cell_mm + grid.cell_mm;
-    // the layer's correction to Boussinesq's half-space, int (K_z - K_z,half-space) J0(kr) dk:
-    // it decays as e^(-k (2h - z)), so Simpson up to k h = 40, fine enough for J0 at the
-    // farthest distance
-    let table: Vec<f64> = if thickness_mm.is_finite() {
-        let dr = (grid.cell_mm / 8.0).min(thickness_mm / 32.0);
-        let k_max = 40.0 / thickness_mm;
-        let dk_wanted = (0.1 / r_max.max(thickness_mm)).min(0.02 / thickness_mm);
-        let mut steps = (k_max / dk_wanted).ceil() as usize;
-        steps += steps % 2;
-        let dk = k_max / steps as f64;
-        let weights: Vec<(f64, f64)> = (0..=steps)
-            .map(|i| {
-                let k = i as f64 * dk;
-                let w = if i == 0 || i == steps {
-                    1.0
-                } else if i % 2 == 1 {
-                    4.0
-                } else {
-                    2.0
-                };
+    // the layer's correction to Boussinesq's half-space, int (K_z - K_z,half-space) J0(kr) dk
+    let table = thickness_mm.is_finite().then(|| {
+        HankelTable::new(
+            |k| {
                 let s = k * depth_mm;
-                let f = depth_factor(s, k * thickness_mm, nu) - depth_factor(s, f64::INFINITY, nu);
-                (k, w * dk / 3.0 * f)
-            })
-            .collect();
-        let count = (r_max / dr).ceil() as usize + 2;
-        let mut t: Vec<f64> = (0..count)
-            .into_par_iter()
-            .map(|j| {
-                let r = j as f64 * dr;
-                weights.iter().map(|&(k, w)| w * libm::j0(k * r)).sum()
-            })
-            .collect();
-        t.push(dr);
-        t
-    } else {
-        Vec::new()
-    };
-    let correction = |r: f64| -> f64 {
-        let Some((&dr, t)) = table.split_last() else {
-            return 0.0;
-        };
-        let f = r / dr;
-        let i = (f as usize).min(t.len() - 2);
-        let w = f - i as f64;
-        t[i] * (1.0 - w) + t[i + 1] * w
-    };
+                depth_factor(s, k * thickness_mm, nu) - depth_factor(s, f64::INFINITY, nu)
+            },
+            thickness_mm,
+            (grid.cell_mm / 8.0).min(thickness_mm / 32.0),
+            r_max,
+        )
+    });
+    let correction = |r: f64| table.as_ref().map_or(0.0, |t| t.at(r));
     // Boussinesq's point load at depth z, times pi E*: z^2 / (2 (1 - nu) rho^3) + 1 / rho
     // (Johnson Eq. 3.21c with 1 / (4 pi G) = 1 / (2 pi E* (1 - nu)))
     let z2 = depth_mm * depth_mm;
@@ -700,13 +681,14 @@ pub fn influence(grid: ContactGrid, skin: Skin) -> Vec<f64> {
         // the layer's smooth correction, summed over the source cell by 3 x 3 Gauss points
         let r_max = std::f64::consts::SQRT_2 * (n as f64 - 1.0) * grid.cell_mm + grid.cell_mm;
         let dr = (grid.cell_mm / 8.0).min(thickness_mm / 32.0);
-        let table = layer_correction_table(thickness_mm, poisson, dr, r_max);
-        let at = |r: f64| -> f64 {
-            let f = r / dr;
-            let i = (f as usize).min(table.len() - 2);
-            let w = f - i as f64;
-            table[i] * (1.0 - w) + table[i + 1] * w
-        };
+        // int (K(kh) - 1) J0(kr) dk: the layer's correction to a half-space's point load
+        let table = HankelTable::new(
+            |k| layer_factor_less_one(k * thickness_mm, poisson),
+            thickness_mm,
+            dr,
+            r_max,
+        );
+        let at = |r: f64| table.at(r);
         let node = (0.6f64).sqrt() * half;
         let gauss = [(-node, 5.0 / 9.0), (0.0, 8.0 / 9.0), (node, 5.0 / 9.0)];
         for dj in 0..m {
