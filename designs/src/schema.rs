@@ -189,6 +189,7 @@ pub fn design_json_schema() -> serde_json::Value {
     let generator = schemars::generate::SchemaSettings::draft2020_12().into_generator();
     let mut v = generator.into_root_schema_for::<Design>().to_value();
     unit_bounds(&mut v, Unit::Plain, false);
+    plain_descriptions(&mut v);
     if let serde_json::Value::Object(m) = &mut v {
         m.insert("$id".into(), DESIGN_SCHEMA_ID.into());
         m.insert("title".into(), DESIGN_SCHEMA_TITLE.into());
@@ -203,6 +204,126 @@ pub fn design_json_schema_text() -> String {
         .unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}"));
     s.push('\n');
     s
+}
+
+/// Every `description` of the schema `v` through [`plain_text`], leaving values a design may
+/// hold (`default`, `examples`, `const`, `enum`) as they are; a key named like one of those
+/// (under `properties`) is a schema like any other.
+fn plain_descriptions(v: &mut serde_json::Value) {
+    use serde_json::Value;
+    match v {
+        Value::Object(m) => {
+            for (k, sub) in m.iter_mut() {
+                match (k.as_str(), &mut *sub) {
+                    ("description", Value::String(d)) => *d = plain_text(d),
+                    ("default" | "examples" | "const" | "enum", _) => {}
+                    ("properties" | "patternProperties" | "$defs", Value::Object(named)) => {
+                        named.values_mut().for_each(plain_descriptions);
+                    }
+                    _ => plain_descriptions(sub),
+                }
+            }
+        }
+        Value::Array(a) => a.iter_mut().for_each(plain_descriptions),
+        _ => {}
+    }
+}
+
+/// A doc comment as plain text for a JSON Schema description, which editors show as it is:
+/// rustdoc's links lose their brackets and Rust paths their modules.
+///
+/// - `` [`Foo`] `` and `` [`Foo::bar`] `` keep the code span (`` `Foo` ``, `` `Foo::bar` ``),
+///   without a disambiguator (`fn@`) and without the modules before the first type
+///   (`` [`crate::values::check_values`] `` is `` `check_values` ``);
+/// - `[text](https://...)` is `text (https://...)`;
+/// - `` [`x`](crate::y) `` and `` [`x`][crate::y] `` (a link to a Rust item) are `` `x` ``.
+///
+/// Other brackets (`[0, 10)`, `[a-z0-9_]+`) are left alone.
+///
+/// ```
+/// use fabkit_designs::schema::plain_text;
+/// assert_eq!(plain_text("see [`crate::lasercut::SheetStock`]"), "see `SheetStock`");
+/// assert_eq!(plain_text("[R-Tac](https://example.org/r)"), "R-Tac (https://example.org/r)");
+/// assert_eq!(plain_text("[`fills`](FillingGel::fills), in [0, 10)"), "`fills`, in [0, 10)");
+/// ```
+pub fn plain_text(doc: &str) -> String {
+    let mut out = String::with_capacity(doc.len());
+    let mut rest = doc;
+    while let Some(i) = rest.find('[') {
+        out.push_str(&rest[..i]);
+        let after = &rest[i + 1..];
+        match doc_link(after) {
+            Some((text, used)) => {
+                out.push_str(&text);
+                rest = &after[used..];
+            }
+            None => {
+                out.push('[');
+                rest = after;
+            }
+        }
+    }
+    out.push_str(rest);
+    out
+}
+
+/// The plain text of the rustdoc link that starts just after a `[` in `s`, and the bytes of `s`
+/// it takes; `None` when the bracket opens no link.
+fn doc_link(s: &str) -> Option<(String, usize)> {
+    let close = s.find(']')?;
+    let inner = &s[..close];
+    // an interval (`[0, 10)`) or a character class is no link text
+    if inner.is_empty()
+        || inner.contains('[')
+        || inner.matches('(').count() != inner.matches(')').count()
+    {
+        return None;
+    }
+    let after = &s[close + 1..];
+    // `[text](target)` and `[text][target]`: the target is a URL or a Rust path
+    for (open, shut) in [('(', ')'), ('[', ']')] {
+        let Some(t) = after.strip_prefix(open) else {
+            continue;
+        };
+        let Some(end) = t.find(shut) else { continue };
+        let target = &t[..end];
+        if target.is_empty() || target.contains(char::is_whitespace) {
+            continue;
+        }
+        let inner = code_path(inner).map_or_else(|| inner.to_string(), |c| format!("`{c}`"));
+        let text = if target.contains("://") {
+            format!("{inner} ({target})")
+        } else {
+            inner
+        };
+        return Some((text, close + 1 + 1 + end + 1));
+    }
+    // `[`path`]`: an intra-doc link
+    Some((format!("`{}`", code_path(inner)?), close + 1))
+}
+
+/// The path of a code span that holds one (`` `crate::a::B` `` gives `B`, see [`short_path`]).
+fn code_path(span: &str) -> Option<&str> {
+    let code = span.strip_prefix('`')?.strip_suffix('`')?;
+    if code.is_empty() || code.contains(['`', ' ', '\n', '\t']) {
+        return None;
+    }
+    Some(short_path(code))
+}
+
+/// A Rust path without its disambiguator (`fn@`, `struct@`) and without the modules before its
+/// first type (`crate::profile::BodyProfile::outer` is `BodyProfile::outer`), or its last
+/// segment when it names no type (`crate::values::check_values` is `check_values`).
+fn short_path(path: &str) -> &str {
+    let path = path.split_once('@').map_or(path, |(_, p)| p);
+    let mut start = 0;
+    for seg in path.split("::") {
+        if seg.starts_with(|c: char| c.is_ascii_uppercase()) {
+            return &path[start..];
+        }
+        start += seg.len() + 2;
+    }
+    path.rsplit("::").next().unwrap_or(path)
 }
 
 /// Adds the ranges of [`crate::values::check_values`] to every number of the schema `v`

@@ -277,10 +277,11 @@ pub fn yaml_error(origin: &str, e: &serde_saphyr::Error) -> String {
 }
 
 /// `; did you mean `strategy`?` for the parser's "unknown field `strategi`, expected one of
-/// strategy, ..." (or "unknown variant"), when one of the names it lists is within a third of
-/// the mistyped name's length in edits (optimal string alignment distance: insertions,
-/// deletions, substitutions and swaps of neighbours; at least 1 and at most 3), the nearest and
-/// first in the listed order; `None` otherwise.
+/// strategy, ..." (or "unknown variant"): the listed name nearest the mistyped one in edits
+/// (optimal string alignment distance: insertions, deletions, substitutions and swaps of
+/// neighbours; letter case ignored), the first in the listed order among equally near ones,
+/// when it is at most max(2, a third of the mistyped name's length) edits away; `None`
+/// otherwise.
 fn nearest_name_hint(msg: &str) -> Option<String> {
     let rest = msg
         .split_once("unknown field `")
@@ -294,14 +295,23 @@ fn nearest_name_hint(msg: &str) -> Option<String> {
         },
         |(_, n)| Some(n.split(", ").collect()),
     )?;
-    let limit = (typed.chars().count() / 3).clamp(1, 3);
+    let best = nearest_name(typed, names.iter().map(|n| n.trim().trim_matches('`')))?;
+    Some(format!("; did you mean `{best}`?"))
+}
+
+/// The name of `names` nearest `typed` in edits, letter case ignored (optimal string alignment
+/// distance), the first of equally near ones, when it is at most max(2, a third of `typed`'s
+/// length in characters) edits away.
+fn nearest_name<'a>(typed: &str, names: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
+    let typed_lower = typed.to_lowercase();
+    let limit = (typed.chars().count() / 3).max(2);
+    // min_by_key keeps the first of equal keys: the listed order breaks ties
     let (d, best) = names
-        .iter()
-        .map(|n| n.trim().trim_matches('`'))
+        .into_iter()
         .filter(|n| !n.is_empty())
-        .map(|n| (strsim::osa_distance(typed, n), n))
+        .map(|n| (strsim::osa_distance(&typed_lower, &n.to_lowercase()), n))
         .min_by_key(|(d, _)| *d)?;
-    (d <= limit).then(|| format!("; did you mean `{best}`?"))
+    (d <= limit).then_some(best)
 }
 
 /// The rule and the limit in words for the parser's errors that name its internals (a budget

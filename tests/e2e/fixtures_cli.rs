@@ -289,9 +289,20 @@ fn bad_fixture_parameters_name_the_parameter_and_write_nothing() {
             "pin_dome:\n  rings:\n    - {polar_angle_deg: 20, count: 1000000}\n",
             "pin_dome.rings[0].count = 1000000: must be at most 1000 holes on one ring",
         ),
-        ("pin_dome:\n  pin:\n    length_mm: 2.0\n", "pin_dome.pin.length_mm"),
+        (
+            "pin_dome:\n  pin:\n    length_mm: 2.0\n",
+            "pin_dome.pin.length_mm = 2: the seated tip stops 1.100 mm above the surface: the pins would not reach it (seated with the head on the counterbore's floor, ",
+        ),
         ("semidomes:\n  patterns:\n    - name: edge\n      protrusions:\n        - {polar_angle_deg: 40, azimuth_deg: 88, indentation_depth_mm: 1, shape: {type: sphere, radius_mm: 2}}\n", "semidomes.patterns[0].protrusions[0].azimuth_deg"),
-        ("pin_dome:\n  wall_thicknes_mm: 2\n", "params.yaml:2:"),
+        (
+            "pin_dome:\n  wall_thicknes_mm: 2\n",
+            "params.yaml:2:3: unknown field `wall_thicknes_mm`, expected one of",
+        ),
+        // the nearest valid key, as in a design file
+        (
+            "pin_dome:\n  wall_thicknes_mm: 2\n",
+            "; did you mean `wall_thickness_mm`?",
+        ),
         (
             "pin_dome:\n  hole_numbering: {direction: clockwise, start_azimuth_deg: 10}\n",
             "pin_dome.hole_numbering.start_azimuth_deg = 10: must be the azimuth of a hole in every ring",
@@ -362,6 +373,46 @@ fn bad_fixture_parameters_name_the_parameter_and_write_nothing() {
         );
         assert!(!tmp.path().join("never").exists());
     }
+}
+
+/// The summary says in words how the pins sit, for either seat (it printed the Rust names
+/// `CounterboreFloor` and `Rim`): no CamelCase word and neither variant name in what
+/// `fabkit fixtures` prints.
+#[test]
+fn the_fixtures_summary_is_in_words_not_rust_names() {
+    let tmp = tempfile::tempdir().unwrap();
+    for (preset, seat) in [
+        (None, "seated with the head on the counterbore's floor,"),
+        (
+            Some("rtac0"),
+            "seated with the head on the rim of its hole,",
+        ),
+    ] {
+        let out = format!("fx_{}", preset.unwrap_or("default"));
+        let mut args = vec!["fixtures", "rtac0", "--out", &out];
+        args.extend(preset.map(|p| ["--pins-preset", p]).into_iter().flatten());
+        let o = run(tmp.path(), &args, &[]);
+        assert!(o.status.success(), "{preset:?}: {}", text(&o.stderr));
+        let said = text(&o.stdout);
+        assert!(said.contains(seat), "{preset:?}: {said}");
+        let rust_names: Vec<&str> = said
+            .split(|c: char| !c.is_ascii_alphanumeric())
+            .filter(|w| is_camel_case(w) || ["Rim", "CounterboreFloor"].contains(w))
+            .collect();
+        assert!(
+            rust_names.is_empty(),
+            "{preset:?}: {rust_names:?} in {said}"
+        );
+    }
+    assert!(is_camel_case("CounterboreFloor") && !is_camel_case("FDM") && !is_camel_case("Tac0"));
+}
+
+/// A word with a capital after a lowercase letter (`CounterboreFloor`): a Rust type or variant
+/// name, not an abbreviation (`FDM`) or a word of a sentence.
+fn is_camel_case(w: &str) -> bool {
+    w.as_bytes()
+        .windows(2)
+        .any(|p| p[0].is_ascii_lowercase() && p[1].is_ascii_uppercase())
 }
 
 /// The output folder is checked before anything is built, as `fabkit export` checks it:

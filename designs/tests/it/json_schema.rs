@@ -3,7 +3,9 @@
 //! `values::check_values` bounds it, deterministic text. Validating designs against it is the
 //! end-to-end tests' part (tests/e2e/schema.rs, with an independent validator).
 
-use fabkit_designs::schema::{design_json_schema, design_json_schema_text, DESIGN_SIGNED_MM};
+use fabkit_designs::schema::{
+    design_json_schema, design_json_schema_text, plain_text, DESIGN_SIGNED_MM,
+};
 use fabkit_designs::values::{MAX_ANGLE_DEG, MAX_LENGTH_MM};
 use serde_json::Value;
 
@@ -90,9 +92,53 @@ fn the_schema_descriptions_are_plain_text() {
         descriptions.len()
     );
     for d in &descriptions {
-        assert!(!d.contains("[`") && !d.contains("crate::"), "{d}");
+        assert!(
+            !d.contains("[`") && !d.contains("](") && !d.contains("crate::"),
+            "{d}"
+        );
     }
     assert!(!text.contains("crate::"));
+}
+
+/// The schema's descriptions pass through `plain_text`, which turns rustdoc's links into plain
+/// text and leaves other brackets alone.
+#[test]
+fn rustdoc_links_read_as_plain_text() {
+    for (doc, plain) in [
+        ("a [`Foo`] b", "a `Foo` b"),
+        ("[`Foo::bar`]", "`Foo::bar`"),
+        (
+            "[`crate::profile::BodyProfile::outer`]",
+            "`BodyProfile::outer`",
+        ),
+        ("[`crate::values::check_values`]", "`check_values`"),
+        ("[`crate::lasercut`]", "`lasercut`"),
+        ("[`fn@shipped_printers`]", "`shipped_printers`"),
+        ("[`x`](crate::y)", "`x`"),
+        ("[`x`][crate::y]", "`x`"),
+        ("[`crate::a::B`](crate::a::B)", "`B`"),
+        (
+            "[`crate::a::B`](https://docs.rs/a)",
+            "`B` (https://docs.rs/a)",
+        ),
+        (
+            "[the paper](https://example.org/p?a=1)",
+            "the paper (https://example.org/p?a=1)",
+        ),
+        // several links, across a line break
+        ("[`A`] and\n[`B`](crate::b::B).", "`A` and\n`B`."),
+        // not links
+        ("degrees, [0, 10).", "degrees, [0, 10)."),
+        ("names `[a-z0-9_]+`", "names `[a-z0-9_]+`"),
+        ("in [0, 1) or [`Foo`]", "in [0, 1) or `Foo`"),
+        ("x in [0, 10) (mm)", "x in [0, 10) (mm)"),
+        ("[a, b](c d)", "[a, b](c d)"),
+        ("[`two words`]", "[`two words`]"),
+        ("unclosed [`Foo", "unclosed [`Foo"),
+        ("[]", "[]"),
+    ] {
+        assert_eq!(plain_text(doc), plain, "{doc:?}");
+    }
 }
 
 /// Every section of a design refuses unknown keys (`deny_unknown_fields` on every design type),

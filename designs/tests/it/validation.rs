@@ -633,6 +633,60 @@ fn a_mistyped_key_or_value_names_the_nearest_valid_one() {
     );
 }
 
+/// `body: {profil: ...}` names `profile` at the key's file:line:column; letter case is ignored
+/// (`Profile`); two edits are near even in a short name (`drct`); a far-off key gets no guess.
+#[test]
+fn a_mistyped_body_key_names_the_nearest_one() {
+    let near = [
+        ("  profil: hemisphere_on_cylinder", "profil"),
+        ("  Profile: hemisphere_on_cylinder", "Profile"),
+        ("  PROFLIE: hemisphere_on_cylinder", "PROFLIE"),
+        ("  proifle: hemisphere_on_cylinder", "proifle"),
+    ];
+    for (new, typed) in near {
+        let t = with_line(11, "  profile: hemisphere_on_cylinder", &[new]);
+        let (line, col, msg) = yaml_error(&t);
+        assert_eq!((line, col), (11, 3), "{msg}");
+        assert!(
+            msg.contains(&format!("unknown field `{typed}`, expected one of profile"))
+                && msg.ends_with("; did you mean `profile`?"),
+            "{msg}"
+        );
+    }
+    // the flow form of the example, on one line
+    let t = with_line(
+        10,
+        "body:",
+        &["body: {profil: hemisphere_on_cylinder, radius_mm: 15.0, cylinder_length_mm: 6.0}"],
+    );
+    let t = t.replacen("  profile: hemisphere_on_cylinder\n", "", 1);
+    let t = t.replacen("  radius_mm: 15.0", "#", 1);
+    let t = t.replacen("  cylinder_length_mm: 6.0", "#", 1);
+    let (line, col, msg) = yaml_error(&t);
+    assert_eq!(line, 10, "{msg}");
+    assert!(col > 6, "{msg}");
+    assert!(msg.ends_with("; did you mean `profile`?"), "{msg}");
+    // a short name two edits away (a third of its length would allow one)
+    let t = with_line(37, "  strategy: master", &["  strategy: drct"]);
+    let (_, _, msg) = yaml_error(&t);
+    assert!(
+        msg.contains("; did you mean `direct`? (at mold.strategy)"),
+        "{msg}"
+    );
+    // a key far from every body key: no guess
+    let t = with_line(
+        11,
+        "  profile: hemisphere_on_cylinder",
+        &["  outline: hemisphere"],
+    );
+    let (line, _, msg) = yaml_error(&t);
+    assert_eq!(line, 11, "{msg}");
+    assert!(
+        msg.contains("unknown field `outline`") && !msg.contains("did you mean"),
+        "{msg}"
+    );
+}
+
 #[test]
 fn unknown_key_points_at_its_line() {
     // line 16 is `  description: ...` under `core:`; the new key takes its place
