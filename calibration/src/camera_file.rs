@@ -1,12 +1,19 @@
 //! Camera files: OpenCV FileStorage YAML (`%YAML:1.0` or `%YAML 1.2`, `!!opencv-matrix`) and XML
-//! (`<opencv_storage>`, `type_id="opencv-matrix"`), ROS `camera_info` YAML and fabkit's JSON form.
-//! Reading detects the form; errors name the file, line and field.
+//! (`<opencv_storage>`, `type_id="opencv-matrix"`), ROS `camera_info` YAML (camera_calibration_parsers,
+//! or the `sensor_msgs/CameraInfo` message as `rostopic echo` / `ros2 topic echo` print it) and
+//! fabkit's JSON form, or JSON with the OpenCV keys. Reading detects the form; errors name the
+//! file, line and field.
 //!
-//! Keys (OpenCV and ROS share them): `image_width`, `image_height`, `camera_matrix` (3 x 3,
-//! `[fx 0 cx; 0 fy cy; 0 0 1]`, px; also read as `K` or `cameraMatrix`), `distortion_model`
-//! (`fisheye` or `equidistant`, `plumb_bob`, `rational_polynomial`) and
-//! `distortion_coefficients` (OpenCV order; also read as `D`, `distCoeffs` or `dist_coeffs`). A file without
-//! `distortion_model` is read as `plumb_bob` for 5 coefficients and `rational_polynomial` for 8
+//! Keys (OpenCV and ROS share them): `image_width` (also `width`), `image_height` (also
+//! `height`), `camera_matrix` (3 x 3, `[fx 0 cx; 0 fy cy; 0 0 1]`, px; also read as `K`, `k` or
+//! `cameraMatrix`), `distortion_model` (`fisheye` or `equidistant`, `plumb_bob`,
+//! `rational_polynomial`) and `distortion_coefficients` (OpenCV order; also read as `D`, `d`,
+//! `distCoeffs` or `dist_coeffs`); [`SPELLINGS`]. A matrix is an `opencv-matrix` (or ROS) map of
+//! `rows`, `cols`, `dt`, `data`, or a plain list: 9 numbers row-major or 3 rows of 3 for the
+//! camera matrix, the coefficients flat or as one row or column. Two spellings of one quantity
+//! in a file are an error naming both; [`read_camera_file_keys`] says which were read.
+//!
+//! A file without `distortion_model` is read as `plumb_bob` for 5 coefficients and `rational_polynomial` for 8
 //! (what `cv2.calibrateCamera` writes), or for 12 or 14 (`CALIB_THIN_PRISM_MODEL`,
 //! `CALIB_RATIONAL_MODEL` in OpenCV 5) whose thin-prism and tilt coefficients s1..s4, tauX, tauY
 //! are all 0 (they are not modelled: any other value is an error). 4 coefficients
@@ -124,6 +131,9 @@ pub struct CameraJson {
     pub distortion_coefficients: Vec<f64>,
 }
 
+/// A matrix of a camera file: an OpenCV or ROS map (`rows`, `cols`, `dt`, `data`, row-major)
+/// or a plain list (`[fx, 0, cx, 0, fy, cy, 0, 0, 1]`, or nested by rows as numpy's `tolist()`
+/// writes it).
 #[derive(Deserialize)]
 struct YamlMatrix {
     rows: usize,
@@ -131,31 +141,203 @@ struct YamlMatrix {
     #[serde(default)]
     dt: Option<String>,
     data: Vec<f64>,
+    /// Given as a flat list of numbers (shape `1 x n` until the key says otherwise).
+    #[serde(skip)]
+    flat: bool,
 }
 
+/// One element of a plain-list matrix: a number, or a row of numbers.
+enum ListElement {
+    Number(f64),
+    Row(Vec<f64>),
+}
+
+impl<'de> Deserialize<'de> for ListElement {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> serde::de::Visitor<'de> for V {
+            type Value = ListElement;
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str("a number or a list of numbers")
+            }
+            fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<ListElement, E> {
+                Ok(ListElement::Number(v))
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<ListElement, E> {
+                Ok(ListElement::Number(v as f64))
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<ListElement, E> {
+                Ok(ListElement::Number(v as f64))
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(
+                self,
+                mut seq: A,
+            ) -> Result<ListElement, A::Error> {
+                let mut row = Vec::new();
+                while let Some(v) = seq.next_element::<f64>()? {
+                    row.push(v);
+                }
+                Ok(ListElement::Row(row))
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+/// [`YamlMatrix`] in either form.
+struct AnyMatrix(YamlMatrix);
+
+impl<'de> Deserialize<'de> for AnyMatrix {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> serde::de::Visitor<'de> for V {
+            type Value = AnyMatrix;
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str("a matrix: a map of rows, cols, dt and data, or a list of numbers (flat or by rows)")
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(
+                self,
+                map: A,
+            ) -> Result<AnyMatrix, A::Error> {
+                YamlMatrix::deserialize(serde::de::value::MapAccessDeserializer::new(map))
+                    .map(AnyMatrix)
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(
+                self,
+                mut seq: A,
+            ) -> Result<AnyMatrix, A::Error> {
+                use serde::de::Error;
+                let mut numbers = Vec::new();
+                let mut rows: Vec<Vec<f64>> = Vec::new();
+                while let Some(e) = seq.next_element::<ListElement>()? {
+                    match e {
+                        ListElement::Number(v) => numbers.push(v),
+                        ListElement::Row(r) => rows.push(r),
+                    }
+                }
+                if !numbers.is_empty() && !rows.is_empty() {
+                    return Err(A::Error::custom(
+                        "a list of numbers or a list of rows, not both",
+                    ));
+                }
+                if rows.is_empty() {
+                    return Ok(AnyMatrix(YamlMatrix {
+                        rows: 1,
+                        cols: numbers.len(),
+                        dt: None,
+                        data: numbers,
+                        flat: true,
+                    }));
+                }
+                let cols = rows[0].len();
+                if rows.iter().any(|r| r.len() != cols) {
+                    let lengths: Vec<String> = rows.iter().map(|r| r.len().to_string()).collect();
+                    return Err(A::Error::custom(format!(
+                        "rows of {} numbers: every row must be as long",
+                        lengths.join(", ")
+                    )));
+                }
+                Ok(AnyMatrix(YamlMatrix {
+                    rows: rows.len(),
+                    cols,
+                    dt: None,
+                    data: rows.concat(),
+                    flat: false,
+                }))
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+/// The keys of a YAML or JSON camera file, every spelling ([`SPELLINGS`]) its own field.
 #[derive(Deserialize)]
-struct YamlCamera {
+#[allow(non_snake_case)]
+struct RawCamera {
     image_width: Option<u32>,
+    width: Option<u32>,
     image_height: Option<u32>,
-    /// Also read as `K` or `cameraMatrix` ([`SPELLINGS`]).
-    #[serde(alias = "K", alias = "cameraMatrix")]
-    camera_matrix: Option<YamlMatrix>,
+    height: Option<u32>,
+    camera_matrix: Option<AnyMatrix>,
+    K: Option<AnyMatrix>,
+    k: Option<AnyMatrix>,
+    cameraMatrix: Option<AnyMatrix>,
     distortion_model: Option<String>,
     /// OpenCV's camera_calibration sample: 1 for `cv::fisheye`, 0 otherwise.
     fisheye_model: Option<i64>,
-    /// Also read as `D`, `distCoeffs` or `dist_coeffs` ([`SPELLINGS`]).
-    #[serde(alias = "D", alias = "distCoeffs", alias = "dist_coeffs")]
-    distortion_coefficients: Option<YamlMatrix>,
+    distortion_coefficients: Option<AnyMatrix>,
+    D: Option<AnyMatrix>,
+    d: Option<AnyMatrix>,
+    distCoeffs: Option<AnyMatrix>,
+    dist_coeffs: Option<AnyMatrix>,
 }
 
-/// The other spellings of the matrices' keys that calibration scripts write with
-/// `cv2.FileStorage` (`fs.write("K", K)`; `cameraMatrix` and `distCoeffs` as OpenCV's own
-/// functions name them), read as the OpenCV and ROS keys.
-const SPELLINGS: &[(&str, &[&str])] = &[
-    ("camera_matrix", &["camera_matrix", "K", "cameraMatrix"]),
+impl RawCamera {
+    fn keys(self) -> YamlCamera {
+        fn given<T>(all: Vec<(&'static str, Option<T>)>) -> Vec<(&'static str, T)> {
+            all.into_iter()
+                .filter_map(|(k, v)| v.map(|v| (k, v)))
+                .collect()
+        }
+        let m = |v: Option<AnyMatrix>| v.map(|m| m.0);
+        YamlCamera {
+            image_width: given(vec![
+                ("image_width", self.image_width),
+                ("width", self.width),
+            ]),
+            image_height: given(vec![
+                ("image_height", self.image_height),
+                ("height", self.height),
+            ]),
+            camera_matrix: given(vec![
+                ("camera_matrix", m(self.camera_matrix)),
+                ("K", m(self.K)),
+                ("k", m(self.k)),
+                ("cameraMatrix", m(self.cameraMatrix)),
+            ]),
+            distortion_model: self.distortion_model,
+            fisheye_model: self.fisheye_model,
+            distortion_coefficients: given(vec![
+                ("distortion_coefficients", m(self.distortion_coefficients)),
+                ("D", m(self.D)),
+                ("d", m(self.d)),
+                ("distCoeffs", m(self.distCoeffs)),
+                ("dist_coeffs", m(self.dist_coeffs)),
+            ]),
+        }
+    }
+}
+
+/// The keys of a camera file in any form: each quantity with every spelling the file gives it.
+struct YamlCamera {
+    image_width: Vec<(&'static str, u32)>,
+    image_height: Vec<(&'static str, u32)>,
+    camera_matrix: Vec<(&'static str, YamlMatrix)>,
+    distortion_model: Option<String>,
+    fisheye_model: Option<i64>,
+    distortion_coefficients: Vec<(&'static str, YamlMatrix)>,
+}
+
+/// The spellings of the keys that calibration scripts and ROS write, read as the OpenCV keys:
+/// `K`, `D` (`fs.write("K", K)`, ROS 1 `sensor_msgs/CameraInfo`), `k`, `d` (ROS 2
+/// `sensor_msgs/msg/CameraInfo` as `ros2 topic echo` prints it), `cameraMatrix`, `distCoeffs`
+/// (as OpenCV's functions name them), `dist_coeffs`, and the message's `width` and `height`.
+pub const SPELLINGS: &[(&str, &[&str])] = &[
+    ("image_width", &["image_width", "width"]),
+    ("image_height", &["image_height", "height"]),
+    (
+        "camera_matrix",
+        &["camera_matrix", "K", "k", "cameraMatrix"],
+    ),
     (
         "distortion_coefficients",
-        &["distortion_coefficients", "D", "distCoeffs", "dist_coeffs"],
+        &[
+            "distortion_coefficients",
+            "D",
+            "d",
+            "distCoeffs",
+            "dist_coeffs",
+        ],
     ),
 ];
 
@@ -176,6 +358,36 @@ fn line_of_any(text: &str, key: &str) -> usize {
         .unwrap_or(0)
 }
 
+/// The keys a camera file's values were read from: the spelling of each ([`SPELLINGS`]), or
+/// the fields of fabkit's JSON form.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct KeysRead {
+    /// The intrinsic matrix: `camera_matrix`, `K`, `k` or `cameraMatrix`; `fx_px, fy_px, cx_px,
+    /// cy_px` in fabkit's JSON form.
+    pub intrinsics: &'static str,
+    /// The distortion coefficients: `distortion_coefficients`, `D`, `d`, `distCoeffs` or
+    /// `dist_coeffs`.
+    pub distortion: &'static str,
+}
+
+impl std::fmt::Display for KeysRead {
+    /// `K (intrinsics), D (distortion)`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} (intrinsics), {} (distortion)",
+            self.intrinsics, self.distortion
+        )
+    }
+}
+
+/// A camera file as read: the camera and the keys its values came from.
+#[derive(Debug, Clone)]
+pub struct CameraFileRead {
+    pub camera: CameraModel,
+    pub keys_read: KeysRead,
+}
+
 /// Reads and validates a camera file (form detected from the content).
 ///
 /// # Errors
@@ -194,12 +406,25 @@ pub fn read_camera_file_as(
     path: &Path,
     model: Option<DistortionModelHint>,
 ) -> Result<CameraModel, CameraFileError> {
+    read_camera_file_keys(path, model).map(|r| r.camera)
+}
+
+/// [`read_camera_file_as`] with the keys the values were read from ([`KeysRead`]), for a
+/// caller that says which spellings it took (`camera: K (intrinsics), D (distortion) read from
+/// cam.yaml`).
+///
+/// # Errors
+/// As [`read_camera_file_as`].
+pub fn read_camera_file_keys(
+    path: &Path,
+    model: Option<DistortionModelHint>,
+) -> Result<CameraFileRead, CameraFileError> {
     let file = path.display().to_string();
     let text = crate::read_text(path).map_err(|source| CameraFileError::Io {
         file: file.clone(),
         source,
     })?;
-    parse_camera_as(&text, &file, model)
+    parse_camera_keys(&text, &file, model)
 }
 
 /// Parses and validates camera-file text; `file` names it in errors.
@@ -220,20 +445,37 @@ pub fn parse_camera_as(
     file: &str,
     model: Option<DistortionModelHint>,
 ) -> Result<CameraModel, CameraFileError> {
+    parse_camera_keys(text, file, model).map(|r| r.camera)
+}
+
+/// [`parse_camera_as`] with the keys the values were read from ([`KeysRead`]).
+///
+/// # Errors
+/// [`CameraFileError`] naming the file, the line and the field; also two spellings of one
+/// quantity (`K` and `camera_matrix`), named both.
+pub fn parse_camera_keys(
+    text: &str,
+    file: &str,
+    model: Option<DistortionModelHint>,
+) -> Result<CameraFileRead, CameraFileError> {
     // a file saved by an editor as "UTF-8 with BOM" reads as the same file without one
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let start = text.trim_start();
-    let intr = if start.starts_with('{') {
+    let (intr, keys_read) = if start.starts_with('{') {
         parse_json(text, file, model)?
     } else if start.starts_with('<') {
         parse_xml(text, file, model)?
     } else {
         parse_yaml(text, file, model)?
     };
-    CameraModel::new(intr).map_err(|e| match e {
+    let line_of_field = |field: &str| match key_of_field(field) {
+        "camera_matrix" => line_of(text, keys_read.intrinsics),
+        key => line_of_any(text, key),
+    };
+    let camera = CameraModel::new(intr).map_err(|e| match e {
         crate::camera::CameraError::Invalid { field, value, rule } => CameraFileError::Field {
             file: file.to_string(),
-            line: line_of_any(text, key_of_field(field)),
+            line: line_of_field(field),
             field: field.to_string(),
             value,
             rule: rule.to_string(),
@@ -245,7 +487,8 @@ pub fn parse_camera_as(
             value: String::new(),
             rule: other.to_string(),
         },
-    })
+    })?;
+    Ok(CameraFileRead { camera, keys_read })
 }
 
 fn key_of_field(field: &str) -> &str {
@@ -255,7 +498,8 @@ fn key_of_field(field: &str) -> &str {
     }
 }
 
-/// 1-based line of the first `key:` (YAML), `"key"` (JSON) or `<key>` (XML) in `text`, or 0.
+/// 1-based line of the first `key:` (YAML), `"key":` (JSON, anywhere in a line) or `<key>` (XML)
+/// in `text`, or 0.
 fn line_of(text: &str, key: &str) -> usize {
     let yaml = format!("{key}:");
     let json = format!("\"{key}\"");
@@ -264,7 +508,8 @@ fn line_of(text: &str, key: &str) -> usize {
         .position(|l| {
             let t = l.trim_start();
             t.starts_with(&yaml)
-                || t.starts_with(&json)
+                || t.match_indices(&json)
+                    .any(|(i, _)| t[i + json.len()..].trim_start().starts_with(':'))
                 || (t.starts_with(&xml)
                     && t[xml.len()..].starts_with(|c: char| c == '>' || c.is_whitespace()))
         })
@@ -403,12 +648,15 @@ fn resolve_distortion(
     })
 }
 
+/// fabkit's JSON form ([`CameraJson`], told by its `format` key), or a JSON file with the keys
+/// of the OpenCV and ROS forms (`{"K": [[..], [..], [..]], "D": [..], "image_width": ..}`, as
+/// calibration scripts dump numpy's `tolist()`).
 fn parse_json(
     text: &str,
     file: &str,
     hint: Option<DistortionModelHint>,
-) -> Result<Intrinsics, CameraFileError> {
-    let c: CameraJson = serde_json::from_str(text).map_err(|e| CameraFileError::Syntax {
+) -> Result<(Intrinsics, KeysRead), CameraFileError> {
+    let syntax = |e: serde_json::Error| CameraFileError::Syntax {
         file: file.into(),
         line: e.line(),
         column: e.column(),
@@ -418,7 +666,14 @@ fn parse_json(
             .next()
             .unwrap_or("")
             .to_string(),
-    })?;
+    };
+    let object: serde_json::Map<String, serde_json::Value> =
+        serde_json::from_str(text).map_err(syntax)?;
+    if !object.contains_key("format") {
+        let raw: RawCamera = serde_json::from_str(text).map_err(syntax)?;
+        return camera_of(raw.keys(), file, hint, &|key| line_of(text, key));
+    }
+    let c: CameraJson = serde_json::from_str(text).map_err(syntax)?;
     let field = |f: &str, v: String, rule: String| CameraFileError::Field {
         file: file.into(),
         line: line_of(text, f),
@@ -440,22 +695,28 @@ fn parse_json(
         &c.distortion_coefficients,
         &field,
     )?;
-    Ok(Intrinsics {
-        image_width_px: c.image_width_px,
-        image_height_px: c.image_height_px,
-        fx_px: c.fx_px,
-        fy_px: c.fy_px,
-        cx_px: c.cx_px,
-        cy_px: c.cy_px,
-        distortion,
-    })
+    Ok((
+        Intrinsics {
+            image_width_px: c.image_width_px,
+            image_height_px: c.image_height_px,
+            fx_px: c.fx_px,
+            fy_px: c.fy_px,
+            cx_px: c.cx_px,
+            cy_px: c.cy_px,
+            distortion,
+        },
+        KeysRead {
+            intrinsics: "fx_px, fy_px, cx_px, cy_px",
+            distortion: "distortion_coefficients",
+        },
+    ))
 }
 
 fn parse_yaml(
     text: &str,
     file: &str,
     hint: Option<DistortionModelHint>,
-) -> Result<Intrinsics, CameraFileError> {
+) -> Result<(Intrinsics, KeysRead), CameraFileError> {
     // OpenCV FileStorage: a `%YAML:1.0` directive (not YAML 1.2 syntax) and `!!opencv-matrix`
     // tags. Blank the directive line and the tags, keeping every line and column in place.
     let mut clean = String::with_capacity(text.len());
@@ -467,7 +728,7 @@ fn parse_yaml(
         clean.push_str(&l.replace("!!opencv-matrix", "               "));
         clean.push('\n');
     }
-    let y: YamlCamera = serde_saphyr::from_str(&clean).map_err(|e| {
+    let y: RawCamera = serde_saphyr::from_str(&clean).map_err(|e| {
         let msg = e.to_string();
         let first = msg.lines().next().unwrap_or(&msg).to_string();
         let (line, column) = e
@@ -480,19 +741,66 @@ fn parse_yaml(
             message: first,
         }
     })?;
-    camera_of(y, file, hint, &|key| line_of_any(text, key))
+    camera_of(y.keys(), file, hint, &|key| line_of(text, key))
 }
 
-/// Intrinsics from the keys of an OpenCV or ROS file; `line(key)` is the key's 1-based line.
+/// The one spelling of `quantity` a file gives ([`SPELLINGS`]), or an error naming both when it
+/// gives two; `line(key)` is a key's 1-based line.
+fn one_spelling<T>(
+    quantity: &str,
+    mut given: Vec<(&'static str, T)>,
+    file: &str,
+    line: &dyn Fn(&str) -> usize,
+) -> Result<Option<(&'static str, T)>, CameraFileError> {
+    if given.len() > 1 {
+        let mut keys: Vec<&str> = given.iter().map(|(k, _)| *k).collect();
+        keys.sort_by_key(|k| line(k));
+        return Err(CameraFileError::Field {
+            file: file.into(),
+            line: line(keys[1]),
+            field: quantity.into(),
+            value: keys.join(" and "),
+            rule: format!(
+                "the file gives {} twice, spelled {}: keep one",
+                quantity,
+                keys.join(" and ")
+            ),
+        });
+    }
+    Ok(given.pop())
+}
+
+/// Intrinsics from the keys of an OpenCV or ROS file, and the keys read; `line(key)` is the
+/// 1-based line of `key` as spelled.
 fn camera_of(
     y: YamlCamera,
     file: &str,
     hint: Option<DistortionModelHint>,
     line: &dyn Fn(&str) -> usize,
-) -> Result<Intrinsics, CameraFileError> {
+) -> Result<(Intrinsics, KeysRead), CameraFileError> {
+    let w = one_spelling("image_width", y.image_width, file, line)?;
+    let h = one_spelling("image_height", y.image_height, file, line)?;
+    let k = one_spelling("camera_matrix", y.camera_matrix, file, line)?;
+    let d = one_spelling(
+        "distortion_coefficients",
+        y.distortion_coefficients,
+        file,
+        line,
+    )?;
+    // each quantity's line under the spelling the file gives it
+    let k_spelled = k.as_ref().map(|(s, _)| *s);
+    let d_spelled = d.as_ref().map(|(s, _)| *s);
+    let spelled = |f: &str| -> usize {
+        let key = match f {
+            "camera_matrix" => k_spelled.unwrap_or(f),
+            "distortion_coefficients" => d_spelled.unwrap_or(f),
+            _ => f,
+        };
+        line(key)
+    };
     let field = |f: &str, v: String, rule: String| CameraFileError::Field {
         file: file.into(),
-        line: line(f),
+        line: spelled(f),
         field: f.into(),
         value: v,
         rule,
@@ -502,18 +810,25 @@ fn camera_of(
         field: f,
         hint,
     };
-    let w = y
-        .image_width
-        .ok_or_else(|| missing("image_width", "image width in px"))?;
-    let h = y
-        .image_height
-        .ok_or_else(|| missing("image_height", "image height in px"))?;
-    let k = y.camera_matrix.ok_or_else(|| {
+    let (_, w) =
+        w.ok_or_else(|| missing("image_width", "image width in px; also read as width"))?;
+    let (_, h) =
+        h.ok_or_else(|| missing("image_height", "image height in px; also read as height"))?;
+    let (k_key, mut k) = k.ok_or_else(|| {
         missing(
             "camera_matrix",
-            "3 x 3 [fx 0 cx; 0 fy cy; 0 0 1], px; also read as K or cameraMatrix",
+            "3 x 3 [fx 0 cx; 0 fy cy; 0 0 1], px; read as camera_matrix, K, k or cameraMatrix, an opencv-matrix or a list of 9 numbers or 3 rows",
         )
     })?;
+    let (d_key, d) = d.ok_or_else(|| {
+        missing(
+            "distortion_coefficients",
+            "OpenCV order, e.g. k1, k2, k3, k4 for fisheye; read as distortion_coefficients, D, d, distCoeffs or dist_coeffs",
+        )
+    })?;
+    if k.flat && k.data.len() == 9 {
+        (k.rows, k.cols, k.flat) = (3, 3, false);
+    }
     let check = |name: &str, m: &YamlMatrix| -> Result<(), CameraFileError> {
         if m.rows * m.cols != m.data.len() {
             return Err(field(
@@ -539,6 +854,13 @@ fn camera_of(
         Ok(())
     };
     check("camera_matrix", &k)?;
+    if k.flat {
+        return Err(field(
+            "camera_matrix",
+            format!("a list of {} numbers", k.data.len()),
+            "must be 9 numbers (row-major) or 3 rows of 3".into(),
+        ));
+    }
     if k.rows != 3 || k.cols != 3 {
         return Err(field(
             "camera_matrix",
@@ -554,12 +876,6 @@ fn camera_of(
             "must be [fx 0 cx; 0 fy cy; 0 0 1] (no skew)".into(),
         ));
     }
-    let d = y.distortion_coefficients.ok_or_else(|| {
-        missing(
-            "distortion_coefficients",
-            "OpenCV order, e.g. k1, k2, k3, k4 for fisheye; also read as D, distCoeffs or dist_coeffs",
-        )
-    })?;
     check("distortion_coefficients", &d)?;
     if d.rows != 1 && d.cols != 1 {
         return Err(field(
@@ -575,15 +891,21 @@ fn camera_of(
         &d.data,
         &field,
     )?;
-    Ok(Intrinsics {
-        image_width_px: w,
-        image_height_px: h,
-        fx_px: km[0],
-        fy_px: km[4],
-        cx_px: km[2],
-        cy_px: km[5],
-        distortion,
-    })
+    Ok((
+        Intrinsics {
+            image_width_px: w,
+            image_height_px: h,
+            fx_px: km[0],
+            fy_px: km[4],
+            cx_px: km[2],
+            cy_px: km[5],
+            distortion,
+        },
+        KeysRead {
+            intrinsics: k_key,
+            distortion: d_key,
+        },
+    ))
 }
 
 /// One element of an XML file: name, 1-based line of its start tag, text, child elements.
@@ -680,7 +1002,7 @@ fn parse_xml(
     text: &str,
     file: &str,
     hint: Option<DistortionModelHint>,
-) -> Result<Intrinsics, CameraFileError> {
+) -> Result<(Intrinsics, KeysRead), CameraFileError> {
     let root = xml_tree(text, file)?;
     let field = |line: usize, f: &str, v: String, rule: &str| CameraFileError::Field {
         file: file.into(),
@@ -709,12 +1031,7 @@ fn parse_xml(
         }
         seen.push((&el.name, el.line));
     }
-    let get = |name: &str| {
-        let names = spellings(name);
-        root.children
-            .iter()
-            .find(|el| names.contains(&el.name.as_str()))
-    };
+    let get = |name: &str| root.children.iter().find(|el| el.name == name);
     // OpenCV writes strings with spaces in double quotes inside the element.
     let string = |el: &XmlElement| {
         let t = el.text.trim();
@@ -793,17 +1110,40 @@ fn parse_xml(
                 .find(|c| c.name == "dt")
                 .map(|el| el.text.trim().to_string()),
             data: values,
+            flat: false,
         }))
     };
+    // every spelling the file gives of a quantity ([`SPELLINGS`])
+    let all = |key: &str| -> Vec<&'static str> {
+        SPELLINGS
+            .iter()
+            .find(|(k, _)| *k == key)
+            .map_or_else(Vec::new, |(_, all)| all.to_vec())
+            .into_iter()
+            .filter(|s| get(s).is_some())
+            .collect()
+    };
+    let sizes = |key: &str| -> Result<Vec<(&'static str, u32)>, CameraFileError> {
+        all(key)
+            .into_iter()
+            .filter_map(|s| size(s).transpose().map(|v| v.map(|v| (s, v))))
+            .collect()
+    };
+    let matrices = |key: &str| -> Result<Vec<(&'static str, YamlMatrix)>, CameraFileError> {
+        all(key)
+            .into_iter()
+            .filter_map(|s| matrix(s).transpose().map(|m| m.map(|m| (s, m))))
+            .collect()
+    };
     let y = YamlCamera {
-        image_width: size("image_width")?,
-        image_height: size("image_height")?,
-        camera_matrix: matrix("camera_matrix")?,
+        image_width: sizes("image_width")?,
+        image_height: sizes("image_height")?,
+        camera_matrix: matrices("camera_matrix")?,
         distortion_model: get("distortion_model").map(string),
         fisheye_model: get("fisheye_model")
             .map(|el| whole(el, "fisheye_model"))
             .transpose()?,
-        distortion_coefficients: matrix("distortion_coefficients")?,
+        distortion_coefficients: matrices("distortion_coefficients")?,
     };
     let line = |key: &str| get(key).map_or(0, |el| el.line);
     camera_of(y, file, hint, &line)
@@ -811,7 +1151,7 @@ fn parse_xml(
 
 /// A double as OpenCV FileStorage writes it: `215.` for integral values, else `%.16e`
 /// (`3.1950000000000000e+02`).
-fn cv_double(v: f64) -> String {
+pub(crate) fn cv_double(v: f64) -> String {
     if v.fract() == 0.0 && v.abs() < 1e15 {
         return format!("{}.", v as i64);
     }
@@ -829,7 +1169,7 @@ fn cv_double(v: f64) -> String {
     }
 }
 
-fn cv_matrix(out: &mut String, name: &str, rows: usize, cols: usize, data: &[f64]) {
+pub(crate) fn cv_matrix(out: &mut String, name: &str, rows: usize, cols: usize, data: &[f64]) {
     let vals: Vec<String> = data.iter().map(|v| cv_double(*v)).collect();
     out.push_str(&format!(
         "{name}: !!opencv-matrix\n   rows: {rows}\n   cols: {cols}\n   dt: d\n   data: [ {} ]\n",

@@ -105,7 +105,8 @@ pub enum ExtrinsicsError {
 #[derive(Debug, Clone)]
 pub struct ExtrinsicsOutput {
     pub report: ExtrinsicsReport,
-    /// (file name, bytes), in this order: `extrinsics.json`, `extrinsics.yaml`, given a capture
+    /// (file name, bytes), in this order: `extrinsics.json`, `extrinsics.yaml` (the pose as
+    /// OpenCV matrices), `transform.yaml` (the pose as a ROS `TransformStamped`), given a capture
     /// image `overlay.png`, `residuals.png` (a histogram of the reprojection errors), with
     /// `--refine-intrinsics` the refined camera file, and from capture images
     /// `observations.csv`, its sidecar `observations.json` (what the columns mean) and
@@ -506,6 +507,14 @@ fn output_files(
     let mut files = vec![
         ("extrinsics.json".to_string(), json.into_bytes()),
         ("extrinsics.yaml".to_string(), yaml.into_bytes()),
+        (
+            "transform.yaml".to_string(),
+            crate::report::transform_stamped_yaml(
+                &report.t_cam_sensor,
+                &report.provenance.fabkit_version,
+            )
+            .into_bytes(),
+        ),
     ];
     if let Some(o) = overlay {
         files.push(("overlay.png".into(), o));

@@ -514,22 +514,159 @@ impl ExtrinsicsReport {
         s
     }
 
-    /// The same content as YAML that `cv::FileStorage` reads too (OpenCV's reader is not a full
-    /// YAML parser): a `%YAML 1.2` directive first (OpenCV 4 tells the format from a leading
-    /// `%YAML` and takes any 1.x; PyYAML takes it too), every sequence indented under its key,
-    /// and every string on one line (a multi-line command line double-quoted with `\n`), as
-    /// OpenCV reads neither indentless sequences nor block scalars. OpenCV reads strings of up
-    /// to 4095 bytes.
+    /// The same content as YAML that `cv::FileStorage` reads ([`opencv_yaml`]): `rvec` (3 x 1,
+    /// rad), `tvec_mm` (3 x 1) and `T_cam_sensor` (4 x 4) as `!!opencv-matrix` nodes
+    /// ([`POSE_MATRICES`]), so that `fs.getNode("T_cam_sensor").mat()` is the matrix.
     ///
     /// # Errors
     /// The YAML serialiser's message.
     pub fn to_yaml(&self) -> Result<String, String> {
-        let options = serde_saphyr::ser_options! {
-            prefer_block_scalars: false,
-            compact_list_indent: false,
-        };
-        let body =
-            serde_saphyr::to_string_with_options(self, options).map_err(|e| e.to_string())?;
-        Ok(format!("%YAML 1.2\n---\n{body}"))
+        opencv_yaml(self, POSE_MATRICES)
     }
+}
+
+/// The pose's matrices in `extrinsics.yaml` (key, rows, cols), as OpenCV shapes them: `rvec`
+/// and `tvec_mm` 3 x 1 (what `cv::solvePnP` returns), `T_cam_sensor` 4 x 4.
+pub const POSE_MATRICES: &[(&str, usize, usize)] =
+    &[("rvec", 3, 1), ("tvec_mm", 3, 1), ("T_cam_sensor", 4, 4)];
+
+/// `value` as YAML that `cv::FileStorage` reads as OpenCV writes it: `%YAML:1.0` and `---`
+/// first, the top-level keys of `matrices` (key, rows, cols; the value a list of rows x cols
+/// numbers, flat or by rows) as `!!opencv-matrix` nodes (`rows`, `cols`, `dt: d`, `data`,
+/// each number to 17 significant digits, so they read back exactly), and everything else as
+/// YAML that OpenCV's reader (not a full YAML parser) takes: every sequence indented under its
+/// key and every string on one line (a multi-line string double-quoted with `\n`), as OpenCV
+/// reads neither indentless sequences nor block scalars. OpenCV reads strings of up to 4095
+/// bytes. PyYAML reads the file after the directive line is dropped and a constructor is given
+/// for the `opencv-matrix` tag.
+///
+/// # Errors
+/// The YAML serialiser's message, or a listed key whose value is not rows x cols numbers.
+pub fn opencv_yaml<T: Serialize>(
+    value: &T,
+    matrices: &[(&str, usize, usize)],
+) -> Result<String, String> {
+    let options = serde_saphyr::ser_options! {
+        prefer_block_scalars: false,
+        compact_list_indent: false,
+    };
+    let body = serde_saphyr::to_string_with_options(value, options).map_err(|e| e.to_string())?;
+    let json = serde_json::to_value(value).map_err(|e| e.to_string())?;
+    let mut out = String::from("%YAML:1.0\n---\n");
+    let mut skipping = false;
+    for line in body.lines() {
+        let top_level = !line.starts_with(|c: char| c.is_whitespace() || c == '-');
+        if skipping && !top_level {
+            continue;
+        }
+        skipping = false;
+        let key = line.split_once(':').map(|(k, _)| k);
+        match matrices
+            .iter()
+            .find(|(k, _, _)| top_level && Some(*k) == key)
+        {
+            Some(&(k, rows, cols)) => {
+                let data: Vec<f64> = match &json[k] {
+                    serde_json::Value::Array(a) => a
+                        .iter()
+                        .flat_map(|v| match v {
+                            serde_json::Value::Array(r) => r.clone(),
+                            v => vec![v.clone()],
+                        })
+                        .map(|v| {
+                            v.as_f64()
+                                .ok_or_else(|| format!("{k}: {v} is not a number"))
+                        })
+                        .collect::<Result<_, _>>()?,
+                    v => return Err(format!("{k}: {v} is not a matrix")),
+                };
+                if data.len() != rows * cols {
+                    return Err(format!("{k}: {} numbers, not {rows} x {cols}", data.len()));
+                }
+                crate::camera_file::cv_matrix(&mut out, k, rows, cols, &data);
+                skipping = true;
+            }
+            None => {
+                out.push_str(line);
+                out.push('\n');
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// The camera frame's name in `transform.yaml`: fabkit's camera frame (x right, y down, z
+/// forward) is what ROS (REP 103) calls an optical frame.
+pub const CAMERA_FRAME_ID: &str = "camera_optical_frame";
+/// The sensor frame's name in `transform.yaml` (`docs/conventions.md`).
+pub const SENSOR_FRAME_ID: &str = "sensor";
+
+/// `v` as a YAML float that PyYAML (YAML 1.1, which wants a `.` and a signed exponent) and
+/// YAML 1.2 readers both take, and that reads back exactly.
+fn yaml_float(v: f64) -> String {
+    let s = format!("{v:?}");
+    if s.contains('e') || !s.contains('.') {
+        crate::camera_file::cv_double(v)
+    } else {
+        s
+    }
+}
+
+/// `T_cam_sensor` (4 x 4, mm) as ROS wants a pose: translation in metres `[x, y, z]` and the
+/// rotation as a unit quaternion `[x, y, z, w]` with w >= 0.
+pub fn ros_pose(t_cam_sensor: &[[f64; 4]; 4]) -> ([f64; 3], [f64; 4]) {
+    let m = t_cam_sensor;
+    let r = nalgebra::Matrix3::from_fn(|i, j| m[i][j]);
+    let q = nalgebra::UnitQuaternion::from_rotation_matrix(
+        &nalgebra::Rotation3::from_matrix_unchecked(r),
+    );
+    let q = if q.w < 0.0 {
+        -q.into_inner()
+    } else {
+        q.into_inner()
+    };
+    (
+        [m[0][3] / 1000.0, m[1][3] / 1000.0, m[2][3] / 1000.0],
+        [q.i, q.j, q.k, q.w],
+    )
+}
+
+/// The `ros2 run tf2_ros static_transform_publisher` command that publishes `T_cam_sensor`
+/// ([`ros_pose`]) from [`CAMERA_FRAME_ID`] (the parent, `--frame-id`) to [`SENSOR_FRAME_ID`]
+/// (the child): tf2's transform from parent to child maps child-frame points into the parent
+/// frame, as `T_cam_sensor` maps sensor-frame points into the camera frame.
+pub fn static_transform_publisher(t_cam_sensor: &[[f64; 4]; 4]) -> String {
+    let ([x, y, z], [qx, qy, qz, qw]) = ros_pose(t_cam_sensor);
+    format!(
+        "ros2 run tf2_ros static_transform_publisher --x {x:?} --y {y:?} --z {z:?} --qx {qx:?} --qy {qy:?} --qz {qz:?} --qw {qw:?} --frame-id {CAMERA_FRAME_ID} --child-frame-id {SENSOR_FRAME_ID}"
+    )
+}
+
+/// `transform.yaml`: `T_cam_sensor` as a ROS 2 `geometry_msgs/msg/TransformStamped` message in
+/// YAML, as `ros2 topic echo` prints one (`header.stamp` 0, `header.frame_id` the camera frame
+/// [`CAMERA_FRAME_ID`], `child_frame_id` the sensor frame [`SENSOR_FRAME_ID`],
+/// `transform.translation` in metres, `transform.rotation` a unit quaternion x, y, z, w), with
+/// comments naming its source (`fabkit_version`) and the equivalent
+/// [`static_transform_publisher`] command.
+pub fn transform_stamped_yaml(t_cam_sensor: &[[f64; 4]; 4], fabkit_version: &str) -> String {
+    let ([x, y, z], [qx, qy, qz, qw]) = ros_pose(t_cam_sensor);
+    let f = yaml_float;
+    format!(
+        "# geometry_msgs/msg/TransformStamped: T_cam_sensor of extrinsics.json (fabkit {fabkit_version}),\n\
+         # mapping sensor-frame points into the camera frame (x right, y down, z forward);\n\
+         # translation in metres. Rename the frames to those of your TF tree. The same transform:\n\
+         # {}\n\
+         header:\n  stamp:\n    sec: 0\n    nanosec: 0\n  frame_id: {CAMERA_FRAME_ID}\n\
+         child_frame_id: {SENSOR_FRAME_ID}\n\
+         transform:\n  translation:\n    x: {}\n    y: {}\n    z: {}\n\
+         \x20 rotation:\n    x: {}\n    y: {}\n    z: {}\n    w: {}\n",
+        static_transform_publisher(t_cam_sensor),
+        f(x),
+        f(y),
+        f(z),
+        f(qx),
+        f(qy),
+        f(qz),
+        f(qw)
+    )
 }

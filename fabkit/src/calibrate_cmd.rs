@@ -75,8 +75,8 @@ pub struct BoardArgs {
         allow_negative_numbers = true
     )]
     pub board_turn: f64,
-    /// Output folder for extrinsics.json, extrinsics.yaml, camera.yaml (OpenCV), camera_info.yaml
-    /// (ROS), camera.json, observations.csv, pixel_to_plane_mm.npy and overlay.png: missing,
+    /// Output folder for extrinsics.json, extrinsics.yaml (OpenCV), transform.yaml (ROS
+    /// TransformStamped), camera.yaml (OpenCV), camera_info.yaml (ROS), camera.json, observations.csv, pixel_to_plane_mm.npy and overlay.png: missing,
     /// empty, or an earlier calibration of the same inputs as fabkit wrote it
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
@@ -124,7 +124,8 @@ pub struct ExtrinsicsArgs {
     /// capture's pins.
     #[arg(long, value_name = "PLAN.csv")]
     pub capture_plan: Option<PathBuf>,
-    /// Output folder for extrinsics.json, extrinsics.yaml (overlay.png; from images
+    /// Output folder for extrinsics.json, extrinsics.yaml (OpenCV), transform.yaml (ROS
+    /// TransformStamped), residuals.png (overlay.png; from images
     /// observations.csv and overlays/): missing, empty, or an earlier calibration of the same
     /// inputs as fabkit wrote it (replaced whole; never a folder of the user's own files or
     /// another command's output).
@@ -300,6 +301,7 @@ fn board(a: BoardArgs) -> Result<(), Box<dyn Error>> {
             r.centre_bump_id, r.centre_bump_px[0], r.centre_bump_px[1]
         );
     }
+    print_tf(&r.t_cam_sensor);
     println!("wrote {}", a.out.display());
     for w in &warnings {
         eprintln!("warning: {w}");
@@ -318,6 +320,8 @@ fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
         );
     }
     let out_dir = a.out.clone();
+    let camera_file = a.cam.camera.clone();
+    let camera_model = a.cam.camera_model.map(Into::into);
     let job = job(a, optical_path, optical_path_from);
     // The output folder is checked (and its temporary sibling made) before the solve; nothing
     // appears under --out unless every file is written.
@@ -330,8 +334,19 @@ fn extrinsics(a: ExtrinsicsArgs) -> Result<(), Box<dyn Error>> {
     if let Some(f) = out.found {
         print_found(&f);
     }
+    // which keys of the camera file were read (`K`, `cameraMatrix`, ...); the solve read it
+    if let Ok(read) =
+        fabkit_calibration::camera_file::read_camera_file_keys(&camera_file, camera_model)
+    {
+        println!(
+            "camera: {} read from {}",
+            read.keys_read,
+            camera_file.display()
+        );
+    }
     let r = out.report;
     print_report(&r);
+    print_tf(&r.t_cam_sensor);
     println!("wrote {}", out_dir.display());
     for w in r.warnings.iter().chain(&warnings) {
         eprintln!("warning: {w}");
@@ -460,6 +475,14 @@ fn job(
         }),
         command_line: std::env::args().collect::<Vec<_>>().join(" "),
     }
+}
+
+/// Prints the pose as ROS publishes it (transform.yaml holds the same as a TransformStamped).
+fn print_tf(t_cam_sensor: &[[f64; 4]; 4]) {
+    println!(
+        "ROS (transform.yaml): {}",
+        fabkit_calibration::report::static_transform_publisher(t_cam_sensor)
+    );
 }
 
 /// Prints the pins found in the capture images and what was left out.

@@ -14,7 +14,7 @@ from conftest import cli_message
 
 DATA = Path(__file__).resolve().parents[2] / "tests" / "data" / "9dtact_sensor1" / "camera_calibration"
 REF, SAMPLE = str(DATA / "ref.png"), str(DATA / "sample.png")
-FILES = sorted(["extrinsics.json", "extrinsics.yaml", "camera.yaml", "camera_info.yaml",
+FILES = sorted(["extrinsics.json", "extrinsics.yaml", "transform.yaml", "camera.yaml", "camera_info.yaml",
                 "camera.json", "observations.csv", "pixel_to_plane_mm.npy", "overlay.png"])
 # the plane's distance the design's housing gives: 2.8 mm of air, the 10.4 mm window over
 # n = 1.491, the 2.5 mm translucent gel over 1.41, up to the opaque black gel

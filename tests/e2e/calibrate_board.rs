@@ -77,6 +77,7 @@ fn the_real_board_press_calibrates_the_9dtact_camera() {
         "camera_info.yaml",
         "camera.json",
         "extrinsics.yaml",
+        "transform.yaml",
         "observations.csv",
         "overlay.png",
     ] {

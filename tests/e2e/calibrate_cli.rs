@@ -170,6 +170,35 @@ fn extrinsics_from_a_synthetic_capture_recover_the_pose_and_write_the_report() {
     assert!(o.status.success(), "{}{}", text(&o.stdout), text(&o.stderr));
     let j = json(&dir.join("out/extrinsics.json"));
     let pose = pose_of(&j);
+    // The printout says which keys of the camera file were read, and the pose as tf2 takes it.
+    let stdout = text(&o.stdout);
+    assert!(
+        stdout.contains(
+            "camera: camera_matrix (intrinsics), distortion_coefficients (distortion) read from cam.yaml"
+        ),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("ROS (transform.yaml): ros2 run tf2_ros static_transform_publisher --x ")
+            && stdout.contains(" --frame-id camera_optical_frame --child-frame-id sensor\n"),
+        "{stdout}"
+    );
+    // Issue 102: the same camera with the matrices spelled K/D (as calibration scripts and
+    // ROS 1 write them): the same pose, and the printout names the keys read.
+    let cam = std::fs::read_to_string(dir.join("cam.yaml")).unwrap();
+    let k = cam
+        .replace("\ncamera_matrix:", "\nK:")
+        .replace("\ndistortion_coefficients:", "\nD:");
+    assert_ne!(k, cam);
+    std::fs::write(dir.join("k.yaml"), k).unwrap();
+    let o = run(dir, &extrinsics_args("k.yaml", "out_k", &[]), &[]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(
+        text(&o.stdout).contains("camera: K (intrinsics), D (distortion) read from k.yaml"),
+        "{}",
+        text(&o.stdout)
+    );
+    assert_eq!(json(&dir.join("out_k/extrinsics.json"))["rvec"], j["rvec"]);
     let rot_err = pose.rotation.angle_to(&truth().rotation).to_degrees();
     let t_err = (pose.translation.vector - truth().translation.vector).norm();
     // measured 0.010 deg and 0.0013 mm
@@ -762,7 +791,8 @@ fn extrinsics_out_is_written_whole_and_never_takes_a_users_folder() {
             "extrinsics.json",
             "extrinsics.yaml",
             "overlay.png",
-            "residuals.png"
+            "residuals.png",
+            "transform.yaml"
         ]
     );
     let o = calibrate("out", false);
@@ -773,7 +803,8 @@ fn extrinsics_out_is_written_whole_and_never_takes_a_users_folder() {
             fabkit_export::OUTPUT_MARKER,
             "extrinsics.json",
             "extrinsics.yaml",
-            "residuals.png"
+            "residuals.png",
+            "transform.yaml"
         ]
     );
     // A file the user adds to the output makes it theirs: the next run refuses it.

@@ -350,10 +350,14 @@ fn calibrate_extrinsics_reads_opencvs_fisheye_files() {
     assert!(!dir.join("out").exists());
 }
 
-/// cv2.FileStorage (and PyYAML) read `extrinsics.yaml` whose command line holds a newline (an
-/// `--out` folder named with one): the same rvec, tvec, RMS, T_cam_sensor and command line as
-/// extrinsics.json. (A block scalar, which serde-saphyr writes for multi-line strings, and an
-/// unindented sequence are parse errors for OpenCV.)
+/// Issue 102: cv2.FileStorage reads the pose of `extrinsics.yaml` as OpenCV matrices
+/// (`getNode("T_cam_sensor").mat()` is the 4 x 4 of extrinsics.json to 1e-12, `rvec` and
+/// `tvec_mm` 3 x 1 float64), and its command line holding a newline (an `--out` folder named
+/// with one); PyYAML reads it too with a constructor for the `opencv-matrix` tag. (A block
+/// scalar, which serde-saphyr writes for multi-line strings, and an unindented sequence are
+/// parse errors for OpenCV.) `transform.yaml` is a geometry_msgs/msg/TransformStamped that a
+/// ROS message parser (rosbags' ROS 2 type store) builds and round-trips through CDR: camera
+/// frame to sensor frame, the translation in metres and the rotation of T_cam_sensor.
 #[test]
 fn opencv_filestorage_reads_extrinsics_yaml_with_a_multi_line_command_line() {
     let Some(py) = oracle_python() else {
@@ -374,21 +378,48 @@ fn opencv_filestorage_reads_extrinsics_yaml_with_a_multi_line_command_line() {
     // (cv::FileStorage refuses such a path itself: read a copy.)
     let yaml = dir.join("extrinsics.yaml");
     std::fs::copy(dir.join(out).join("extrinsics.yaml"), &yaml).unwrap();
+    let written = std::fs::read_to_string(&yaml).unwrap();
+    assert!(written.starts_with("%YAML:1.0\n---\n"), "{written}");
+    assert!(
+        written.contains("\nT_cam_sensor: !!opencv-matrix\n   rows: 4\n   cols: 4\n   dt: d\n"),
+        "{written}"
+    );
     let j = json(&dir.join(out).join("extrinsics.json"));
     let cv = camera_files_oracle(&py, &["read-extrinsics".as_ref(), yaml.as_os_str()]);
+    let close = |a: &[f64], b: &[f64], what: &str| {
+        assert_eq!(a.len(), b.len(), "{what}");
+        for (x, y) in a.iter().zip(b) {
+            assert!((x - y).abs() <= 1e-12, "{what}: {a:?} against {b:?}");
+        }
+    };
     for key in ["rvec", "tvec_mm"] {
-        assert_eq!(floats(&cv[key]), floats(&j[key]), "{key}");
+        assert_eq!(cv["shapes"][key], serde_json::json!([3, 1]), "{key}");
+        assert_eq!(cv["dtypes"][key], "float64", "{key}");
+        let column: Vec<f64> = cv[key]
+            .as_array()
+            .unwrap()
+            .iter()
+            .flat_map(floats)
+            .collect();
+        close(&column, &floats(&j[key]), key);
+    }
+    assert_eq!(cv["shapes"]["T_cam_sensor"], serde_json::json!([4, 4]));
+    for i in 0..4 {
+        close(
+            &floats(&cv["T_cam_sensor"][i]),
+            &floats(&j["T_cam_sensor"][i]),
+            "T_cam_sensor",
+        );
+        close(
+            &floats(&cv["pyyaml_T_cam_sensor"][i]),
+            &floats(&j["T_cam_sensor"][i]),
+            "T_cam_sensor (PyYAML)",
+        );
     }
     assert_eq!(
         cv["rms_reprojection_error_px"].as_f64(),
         j["rms_reprojection_error_px"].as_f64()
     );
-    for i in 0..4 {
-        assert_eq!(
-            floats(&cv["T_cam_sensor"][i]),
-            floats(&j["T_cam_sensor"][i])
-        );
-    }
     let command_line = j["provenance"]["command_line"].as_str().unwrap();
     assert!(
         command_line.ends_with(&format!("--out {out}")),
@@ -396,4 +427,45 @@ fn opencv_filestorage_reads_extrinsics_yaml_with_a_multi_line_command_line() {
     );
     assert_eq!(cv["command_line"], command_line);
     assert_eq!(cv["pyyaml_command_line"], command_line);
+
+    // transform.yaml: a TransformStamped by a ROS message parser, the pose of T_cam_sensor
+    let o = std::process::Command::new(&py)
+        .arg(repo_root().join("tests/oracles/ros_messages.py"))
+        .arg("geometry_msgs/msg/TransformStamped")
+        .arg(dir.join(out).join("transform.yaml"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let msg: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(msg["header"]["frame_id"], "camera_optical_frame", "{msg}");
+    assert_eq!(msg["child_frame_id"], "sensor", "{msg}");
+    let t = &msg["transform"]["translation"];
+    let r = &msg["transform"]["rotation"];
+    let f = |v: &serde_json::Value| v.as_f64().unwrap();
+    let q = fabkit_calibration::nalgebra::UnitQuaternion::from_quaternion(
+        fabkit_calibration::nalgebra::Quaternion::new(
+            f(&r["w"]),
+            f(&r["x"]),
+            f(&r["y"]),
+            f(&r["z"]),
+        ),
+    );
+    let m = q.to_rotation_matrix();
+    for i in 0..3 {
+        for k in 0..3 {
+            let want = j["T_cam_sensor"][i][k].as_f64().unwrap();
+            assert!(
+                (m[(i, k)] - want).abs() < 1e-12,
+                "R[{i}][{k}] {} against {want}",
+                m[(i, k)]
+            );
+        }
+    }
+    for (i, axis) in ["x", "y", "z"].into_iter().enumerate() {
+        let want_m = j["T_cam_sensor"][i][3].as_f64().unwrap() / 1000.0;
+        assert!((f(&t[axis]) - want_m).abs() < 1e-15, "translation {axis}");
+    }
+    // the quaternion is a unit one, as ROS wants it
+    let n: f64 = ["x", "y", "z", "w"].iter().map(|a| f(&r[*a]).powi(2)).sum();
+    assert!((n - 1.0).abs() < 1e-12, "|q|^2 = {n}");
 }

@@ -12,8 +12,11 @@ Usage:
       "files": [{"name", "layout", "K": 3 x 3, "D": [...], "width", "height"}]} with the
       numbers OpenCV returned.
   python opencv_camera_files.py read-extrinsics FILE
-      Reads extrinsics.yaml with cv2.FileStorage (and PyYAML); prints JSON: {"rvec", "tvec_mm",
-      "rms_reprojection_error_px", "T_cam_sensor", "command_line", "pyyaml_command_line"}.
+      Reads extrinsics.yaml with cv2.FileStorage (the pose's matrices by FileNode.mat(), as
+      OpenCV matrices) and with PyYAML (the `%YAML:1.0` line dropped, a constructor for the
+      `!!opencv-matrix` tag); prints JSON: {"rvec", "tvec_mm", "T_cam_sensor" (each as .mat()
+      gave it, nested by rows), "shapes" (rows, cols of each), "rms_reprojection_error_px",
+      "command_line", "pyyaml_command_line", "pyyaml_T_cam_sensor"}.
 """
 import json
 import os
@@ -114,20 +117,29 @@ def read_extrinsics(path):
     import yaml
 
     fs = cv2.FileStorage(path, cv2.FILE_STORAGE_READ)
-
-    def seq(node):
-        return [node.at(i).real() for i in range(node.size())]
-
-    out = {
-        "rvec": seq(fs.getNode("rvec")),
-        "tvec_mm": seq(fs.getNode("tvec_mm")),
-        "rms_reprojection_error_px": fs.getNode("rms_reprojection_error_px").real(),
-        "T_cam_sensor": [seq(fs.getNode("T_cam_sensor").at(i)) for i in range(4)],
-        "command_line": fs.getNode("provenance").getNode("command_line").string(),
-    }
+    mats = {k: fs.getNode(k).mat() for k in ("rvec", "tvec_mm", "T_cam_sensor")}
+    out = {k: m.tolist() for k, m in mats.items()}
+    out["shapes"] = {k: list(m.shape) for k, m in mats.items()}
+    out["dtypes"] = {k: str(m.dtype) for k, m in mats.items()}
+    out["rms_reprojection_error_px"] = fs.getNode("rms_reprojection_error_px").real()
+    out["command_line"] = fs.getNode("provenance").getNode("command_line").string()
     fs.release()
+
+    class Loader(yaml.SafeLoader):
+        pass
+
+    def opencv_matrix(loader, node):
+        m = loader.construct_mapping(node, deep=True)
+        return np.array(m["data"], np.float64).reshape(m["rows"], m["cols"])
+
+    Loader.add_constructor("tag:yaml.org,2002:opencv-matrix", opencv_matrix)
     with open(path, encoding="utf-8") as f:
-        out["pyyaml_command_line"] = yaml.safe_load(f)["provenance"]["command_line"]
+        text = f.read()
+    if text.startswith("%YAML:"):  # OpenCV's directive, not YAML's: drop it
+        text = text.split("\n", 1)[1]
+    doc = yaml.load(text, Loader=Loader)
+    out["pyyaml_command_line"] = doc["provenance"]["command_line"]
+    out["pyyaml_T_cam_sensor"] = doc["T_cam_sensor"].tolist()
     json.dump(out, sys.stdout)
 
 

@@ -1468,17 +1468,15 @@ fn board_files(
     let mut json =
         serde_json::to_vec_pretty(report).map_err(|e| BoardError::Solve(e.to_string()))?;
     json.push(b'\n');
-    let options = serde_saphyr::ser_options! {
-        prefer_block_scalars: false,
-        compact_list_indent: false,
-    };
-    let yaml = serde_saphyr::to_string_with_options(report, options)
-        .map_err(|e| BoardError::Solve(e.to_string()))?;
+    let yaml = crate::report::opencv_yaml(report, crate::report::POSE_MATRICES)
+        .map_err(BoardError::Solve)?;
     let mut files = vec![
         ("extrinsics.json".to_string(), json),
+        ("extrinsics.yaml".to_string(), yaml.into_bytes()),
         (
-            "extrinsics.yaml".to_string(),
-            format!("%YAML 1.2\n---\n{yaml}").into_bytes(),
+            "transform.yaml".to_string(),
+            crate::report::transform_stamped_yaml(&report.t_cam_sensor, &report.fabkit_version)
+                .into_bytes(),
         ),
         (
             "camera.yaml".to_string(),

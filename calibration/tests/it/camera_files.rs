@@ -136,9 +136,132 @@ fn common_spellings_of_the_matrices_read_as_the_opencv_keys() {
     let none = OPENCV_CALIBRATE_OUTPUT.replace("camera_matrix:", "intrinsics:");
     let e = parse_camera(&none, "n.yaml").unwrap_err().to_string();
     assert!(
-        e.contains("camera_matrix: missing") && e.contains("K or cameraMatrix"),
+        e.contains("camera_matrix: missing")
+            && e.contains("read as camera_matrix, K, k or cameraMatrix"),
         "{e}"
     );
+}
+
+/// The camera of `text` projects a grid of camera-frame points where the canonical file's does.
+fn same_projections(a: &fabkit_calibration::CameraModel, b: &fabkit_calibration::CameraModel) {
+    for x in [-0.4, 0.0, 0.3] {
+        for y in [-0.3, 0.0, 0.25] {
+            let p = fabkit_calibration::nalgebra::Vector3::new(x, y, 1.0);
+            assert_eq!(a.project(&p), b.project(&p), "{p:?}");
+        }
+    }
+}
+
+/// Issue 102: every spelling of the matrices that calibration scripts and ROS write (`K`/`D`,
+/// ROS 2's `k`/`d`, `cameraMatrix`/`distCoeffs`; `width`/`height` of the CameraInfo message),
+/// as an opencv-matrix, a plain list of 9 numbers or 3 rows, in YAML and JSON, reads as the
+/// same camera as the canonical OpenCV file (same intrinsics, same projections), and says
+/// which keys were read.
+#[test]
+fn every_spelling_and_list_form_reads_as_the_canonical_camera() {
+    use fabkit_calibration::camera_file::parse_camera_keys;
+    let want = parse_camera_keys(OPENCV_CALIBRATE_OUTPUT, "cal.yaml", None).unwrap();
+    assert_eq!(
+        want.keys_read.to_string(),
+        "camera_matrix (intrinsics), distortion_coefficients (distortion)"
+    );
+    let k = "300.12, 0, 320.1, 0, 299.88, 240.3, 0, 0, 1";
+    let k_rows = "[300.12, 0, 320.1], [0, 299.88, 240.3], [0, 0, 1]";
+    let d = "-0.26, 0.07, 0.001, -0.0005, -0.008";
+    for (kk, dk, size) in [
+        (
+            "camera_matrix",
+            "distortion_coefficients",
+            ("image_width", "image_height"),
+        ),
+        ("K", "D", ("width", "height")),
+        ("k", "d", ("width", "height")),
+        (
+            "cameraMatrix",
+            "distCoeffs",
+            ("image_width", "image_height"),
+        ),
+        ("K", "dist_coeffs", ("image_width", "image_height")),
+    ] {
+        let (w, h) = size;
+        let texts = [
+            // opencv-matrix under the spelling
+            OPENCV_CALIBRATE_OUTPUT
+                .replace("camera_matrix:", &format!("{kk}:"))
+                .replace("distortion_coefficients:", &format!("{dk}:"))
+                .replace("image_width:", &format!("{w}:"))
+                .replace("image_height:", &format!("{h}:")),
+            // plain lists, as ROS 1 `rostopic echo` and ROS 2 `ros2 topic echo` print CameraInfo
+            format!("header:\n  frame_id: cam\n{h}: 480\n{w}: 640\ndistortion_model: plumb_bob\n{dk}: [{d}]\n{kk}: [{k}]\nr: [1, 0, 0, 0, 1, 0, 0, 0, 1]\nroi:\n  height: 0\n  width: 0\n"),
+            // 3 rows, as numpy's tolist() writes K
+            format!("{w}: 640\n{h}: 480\n{kk}:\n  - [{k_rows_0}]\n  - [{k_rows_1}]\n  - [{k_rows_2}]\n{dk}: [[{d}]]\n", k_rows_0 = "300.12, 0, 320.1", k_rows_1 = "0, 299.88, 240.3", k_rows_2 = "0, 0, 1"),
+            // JSON with the same keys (json.dump of numpy's tolist())
+            format!("{{\"{w}\": 640, \"{h}\": 480,\n \"{kk}\": [{k_rows}],\n \"{dk}\": [{d}]}}\n"),
+        ];
+        for text in &texts {
+            let got = parse_camera_keys(text, "k.yaml", None)
+                .unwrap_or_else(|e| panic!("{kk} {dk}: {e}\n{text}"));
+            assert_eq!(got.camera.intrinsics(), want.camera.intrinsics(), "{text}");
+            same_projections(&got.camera, &want.camera);
+            assert_eq!(
+                got.keys_read.to_string(),
+                format!("{kk} (intrinsics), {dk} (distortion)")
+            );
+        }
+    }
+}
+
+/// Issue 102: two spellings of one quantity in a file (YAML, XML, JSON) are refused naming
+/// both keys, at the second one's line; a file with neither spelling lists them all.
+#[test]
+fn two_spellings_of_one_matrix_are_refused_naming_both() {
+    let both = OPENCV_CALIBRATE_OUTPUT.replace(
+        "avg_reprojection_error",
+        "K: [300, 0, 320, 0, 300, 240, 0, 0, 1]\navg_reprojection_error",
+    );
+    let line = both.lines().position(|l| l.starts_with("K:")).unwrap() + 1;
+    let e = parse_camera(&both, "two.yaml").unwrap_err().to_string();
+    assert_eq!(
+        e,
+        format!("two.yaml:{line}: camera_matrix = camera_matrix and K: the file gives camera_matrix twice, spelled camera_matrix and K: keep one")
+    );
+    let both = OPENCV_CALIBRATE_OUTPUT.replace(
+        "avg_reprojection_error",
+        "distCoeffs: [0, 0, 0, 0, 0]\navg_reprojection_error",
+    );
+    let e = parse_camera(&both, "two.yaml").unwrap_err().to_string();
+    assert!(
+        e.contains("distortion_coefficients = distortion_coefficients and distCoeffs"),
+        "{e}"
+    );
+    let xml = OPENCV_XML.replace(
+        "<avg_reprojection_error>",
+        "<D type_id=\"opencv-matrix\"><rows>1</rows><cols>5</cols><dt>d</dt><data>0 0 0 0 0</data></D>\n<avg_reprojection_error>",
+    );
+    let e = parse_camera(&xml, "two.xml").unwrap_err().to_string();
+    assert!(
+        e.starts_with("two.xml:")
+            && e.contains("distortion_coefficients = distortion_coefficients and D"),
+        "{e}"
+    );
+    let json = "{\"width\": 640, \"image_width\": 640, \"height\": 480, \"K\": [1, 0, 1, 0, 1, 1, 0, 0, 1], \"D\": [0, 0, 0, 0, 0]}";
+    let e = parse_camera(json, "two.json").unwrap_err().to_string();
+    assert!(
+        e.starts_with("two.json:1: image_width = image_width and width"),
+        "{e}"
+    );
+    // none of the spellings: the error lists them
+    let none = OPENCV_CALIBRATE_OUTPUT.replace("distortion_coefficients:", "distortion:");
+    let e = parse_camera(&none, "n.yaml").unwrap_err().to_string();
+    assert!(
+        e.contains("distortion_coefficients: missing")
+            && e.contains("read as distortion_coefficients, D, d, distCoeffs or dist_coeffs"),
+        "{e}"
+    );
+    // a plain list of the wrong length names the spelling's line
+    let short = "width: 640\nheight: 480\nK: [1, 2, 3]\nD: [0, 0, 0, 0, 0]\n";
+    let e = parse_camera(short, "s.yaml").unwrap_err().to_string();
+    assert_eq!(e, "s.yaml:3: camera_matrix = a list of 3 numbers: must be 9 numbers (row-major) or 3 rows of 3");
 }
 
 #[test]
@@ -194,7 +317,10 @@ fn errors_name_file_line_and_field() {
     // Missing key.
     let bad = ok.replace("image_width: 640\n", "");
     let e = parse_camera(&bad, "cam.yaml").unwrap_err().to_string();
-    assert_eq!(e, "cam.yaml: image_width: missing (image width in px)");
+    assert_eq!(
+        e,
+        "cam.yaml: image_width: missing (image width in px; also read as width)"
+    );
     // JSON: unknown field with line and column.
     let j = write_camera(&all()[0], CameraFileFormat::Json).replace("\"fx_px\"", "\"fx\"");
     let e = parse_camera(&j, "cam.json").unwrap_err().to_string();
@@ -606,7 +732,10 @@ fn xml_errors_name_file_and_line() {
         "{e}"
     );
     let e = err(&OPENCV_XML.replace("<image_height>480</image_height>\n", ""));
-    assert_eq!(e, "cal.xml: image_height: missing (image height in px)");
+    assert_eq!(
+        e,
+        "cal.xml: image_height: missing (image height in px; also read as height)"
+    );
     let e = err(&OPENCV_XML.replace(
         "<image_height>480</image_height>\n",
         "<image_width>640</image_width>\n",
