@@ -41,9 +41,9 @@ use super::dataset::{
 };
 use super::exact::ExactPrimitives;
 use super::inputs::{sha256_hex, Configuration, Fixtures, InputError};
+use super::press_skin::{Face, PressedSkin, SkinModel};
 use super::{half_masks, indented_hits, DepthFrame};
 use crate::capture_images::{read_gray, ImageError};
-use super::press_skin::{Face, PressedSkin, SkinModel};
 use crate::elastic::ContactError;
 use crate::press::{fit_sphere_press, PressError, PressFit, PressOptions};
 use crate::CameraModel;

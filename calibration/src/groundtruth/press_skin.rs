@@ -187,8 +187,7 @@ impl PressedSkin {
             model: model.clone(),
             grid,
             centre_mm,
-            contact_radius_mm: (cells * grid.cell_mm * grid.cell_mm / std::f64::consts::PI)
-                .sqrt(),
+            contact_radius_mm: (cells * grid.cell_mm * grid.cell_mm / std::f64::consts::PI).sqrt(),
             surface_mm: contact.displacement_mm,
             seen_mm,
             in_contact: contact.in_contact,

@@ -207,7 +207,10 @@ fn a_known_response_is_recovered_from_a_synthetic_capture() {
 #[test]
 fn bump_heights_are_capped_cylinders_on_a_floor() {
     use fabkit_calibration::elastic::ContactGrid;
-    let grid = ContactGrid { n: 41, cell_mm: 0.1 };
+    let grid = ContactGrid {
+        n: 41,
+        cell_mm: 0.1,
+    };
     let h = bump_heights(grid, [0.0, 0.0], &[[0.0, 0.0], [2.5, 0.0]], 0.6, 1.5);
     let at = |i: usize, j: usize| h[j * 41 + i];
     assert_eq!(at(20, 20), 0.0);
@@ -216,4 +219,3 @@ fn bump_heights_are_capped_cylinders_on_a_floor() {
     assert_eq!(at(32, 20), 1.5);
     assert_eq!(at(20, 30), 1.5);
 }
-
