@@ -246,11 +246,27 @@ pub fn solve_skin_contact(
 
 /// The contact solver of a skin on a grid: its influence, transformed once
 /// ([`Convolver`]), for the presses of any indenters on that grid (a capture's frames).
+///
+/// The pressure lives where the indenters touch, a small part of the grid for a ball: the
+/// conjugate gradient runs on a window round the cells the indenters overlap (two cells
+/// more, by FFTs of the window's size), and the displacement over the whole grid is checked
+/// once it converges: where the indenters would overlap the displaced skin outside the window,
+/// the window grows to take those cells in and the solve is repeated (at most the whole grid).
+/// The answer is the whole grid's (the contact problem has one solution), to the iteration's
+/// tolerance.
 pub struct ContactSolver {
     grid: ContactGrid,
     skin: Skin,
+    /// The influence at every offset ([`influence`]).
+    kernel: Vec<f64>,
     convolver: Convolver,
+    /// The convolvers of the windows solved so far, by their size a side (few sizes: a
+    /// window is as large as its FFTs allow).
+    windows: std::sync::Mutex<std::collections::BTreeMap<usize, std::sync::Arc<Convolver>>>,
 }
+
+/// The cells a side the window keeps round the overlapped cells.
+const WINDOW_MARGIN: usize = 2;
 
 impl ContactSolver {
     /// The solver of `skin` on `grid`.
@@ -304,10 +320,13 @@ impl ContactSolver {
                 rule: "must be finite and > 0",
             });
         }
+        let kernel = influence(grid, skin);
         Ok(ContactSolver {
             grid,
             skin,
-            convolver: Convolver::new(n, &influence(grid, skin)),
+            convolver: Convolver::new(n, &kernel),
+            kernel,
+            windows: Default::default(),
         })
     }
 
@@ -321,6 +340,23 @@ impl ContactSolver {
         self.skin
     }
 
+    /// The convolver of a `w x w` window (the kernel's offsets up to `w - 1`), made once.
+    fn window_convolver(&self, w: usize) -> std::sync::Arc<Convolver> {
+        let mut windows = self.windows.lock().unwrap_or_else(|e| e.into_inner());
+        windows
+            .entry(w)
+            .or_insert_with(|| {
+                let (n, m, mw) = (self.grid.n, 2 * self.grid.n - 1, 2 * w - 1);
+                let mut crop = Vec::with_capacity(mw * mw);
+                for dj in 0..mw {
+                    let row = (dj + n - w) * m + (n - w);
+                    crop.extend_from_slice(&self.kernel[row..row + mw]);
+                }
+                std::sync::Arc::new(Convolver::new(w, &crop))
+            })
+            .clone()
+    }
+
     /// Solves the contact of an indenter whose height above its lowest point at each cell is
     /// `height_mm` (row-major, as [`Contact`]), pressed `approach_mm` into the skin.
     ///
@@ -328,7 +364,6 @@ impl ContactSolver {
     /// [`ContactError`]: heights of another count, a negative approach, no convergence.
     pub fn solve(&self, height_mm: &[f64], approach_mm: f64) -> Result<Contact, ContactError> {
         let (grid, n) = (self.grid, self.grid.n);
-        let e_star_mpa = self.skin.e_star_mpa();
         if height_mm.len() != n * n {
             return Err(ContactError::Heights(height_mm.len(), n * n));
         }
@@ -339,67 +374,54 @@ impl ContactSolver {
                 rule: "must be finite and >= 0",
             });
         }
-        let apply = |p: &[f64]| self.convolver.apply(p);
-        // Polonsky and Keer's conjugate gradient, the approach given (no load balance)
-        let mut p: Vec<f64> = height_mm
-            .iter()
-            .map(|&h| {
-                if h < approach_mm {
-                    1e-3 * e_star_mpa
-                } else {
-                    0.0
-                }
-            })
-            .collect();
-        let mut t = vec![0.0; n * n];
-        let (mut g_old, mut delta) = (1.0, 0.0);
-        let max_iter = 10 * n * n;
-        let mut change = f64::INFINITY;
-        for iteration in 1..=max_iter {
-            let u = apply(&p);
-            let g: Vec<f64> = (0..n * n)
-                .map(|k| height_mm[k] + u[k] - approach_mm)
+        // the cells to take in: those the indenter overlaps, then those it would overlap on
+        // the displaced skin
+        let mut take: Vec<usize> = (0..n * n).filter(|&k| height_mm[k] < approach_mm).collect();
+        let mut bounds: Option<[usize; 4]> = None;
+        let mut iterations = 0;
+        loop {
+            for &k in &take {
+                let (i, j) = (k % n, k / n);
+                bounds = Some(match bounds {
+                    None => [i, i, j, j],
+                    Some([i0, i1, j0, j1]) => [i0.min(i), i1.max(i), j0.min(j), j1.max(j)],
+                });
+            }
+            let Some(b) = bounds else {
+                // nothing touches
+                return Ok(Contact {
+                    grid,
+                    pressure_mpa: vec![0.0; n * n],
+                    displacement_mm: vec![0.0; n * n],
+                    in_contact: vec![false; n * n],
+                    load_n: 0.0,
+                    iterations: 1,
+                });
+            };
+            let [x0, y0, w] = window(b, n);
+            let sub: Vec<f64> = (0..w * w)
+                .map(|k| height_mm[(y0 + k / w) * n + x0 + k % w])
                 .collect();
-            let gg: f64 = (0..n * n)
-                .filter(|&k| p[k] > 0.0)
-                .map(|k| g[k] * g[k])
-                .sum();
-            for k in 0..n * n {
-                t[k] = if p[k] > 0.0 {
-                    g[k] + delta * (gg / g_old) * t[k]
-                } else {
-                    0.0
-                };
+            let (pw, its) = if w == n {
+                conjugate_gradient(&self.convolver, &sub, approach_mm, self.skin.e_star_mpa())?
+            } else {
+                let c = self.window_convolver(w);
+                conjugate_gradient(&c, &sub, approach_mm, self.skin.e_star_mpa())?
+            };
+            iterations += its;
+            let mut p = vec![0.0; n * n];
+            for (k, &v) in pw.iter().enumerate() {
+                p[(y0 + k / w) * n + x0 + k % w] = v;
             }
-            g_old = gg.max(f64::MIN_POSITIVE);
-            let r = apply(&t);
-            let (num, den) = (0..n * n)
-                .filter(|&k| p[k] > 0.0)
-                .fold((0.0, 0.0), |(a, b), k| (a + g[k] * t[k], b + r[k] * t[k]));
-            let tau = if den > 0.0 { num / den } else { 0.0 };
-            let before: f64 = p.iter().sum();
-            let old = p.clone();
-            for k in 0..n * n {
-                if p[k] > 0.0 {
-                    p[k] = (p[k] - tau * t[k]).max(0.0);
-                }
-            }
-            // cells off the contact that the indenter now overlaps enter it
-            let mut entered = false;
-            for k in 0..n * n {
-                if old[k] == 0.0 && g[k] < 0.0 {
-                    p[k] = -tau * g[k];
-                    if p[k] <= 0.0 {
-                        p[k] = 1e-6 * e_star_mpa;
-                    }
-                    entered = true;
-                }
-            }
-            delta = if entered { 0.0 } else { 1.0 };
-            let moved: f64 = p.iter().zip(&old).map(|(a, b)| (a - b).abs()).sum();
-            change = if before > 0.0 { moved / before } else { 0.0 };
-            if change < 1e-9 && !entered {
-                let u = apply(&p);
+            let u = self.convolver.apply(&p);
+            let inside = |k: usize| {
+                let (i, j) = (k % n, k / n);
+                (x0..x0 + w).contains(&i) && (y0..y0 + w).contains(&j)
+            };
+            take = (0..n * n)
+                .filter(|&k| !inside(k) && height_mm[k] + u[k] - approach_mm < 0.0)
+                .collect();
+            if take.is_empty() {
                 let area = grid.cell_mm * grid.cell_mm;
                 return Ok(Contact {
                     grid,
@@ -407,12 +429,98 @@ impl ContactSolver {
                     in_contact: p.iter().map(|&x| x > 0.0).collect(),
                     displacement_mm: u,
                     pressure_mpa: p,
-                    iterations: iteration,
+                    iterations,
                 });
             }
         }
-        Err(ContactError::NoConvergence(max_iter, change))
     }
+}
+
+/// The square window `[x0, y0, w]` (its first column and row, its size a side) that holds the
+/// cells `[i0, i1] x [j0, j1]` of an `n x n` grid with [`WINDOW_MARGIN`] cells round them, as
+/// large as its FFTs' size allows ([`smooth_size`]), inside the grid.
+fn window([i0, i1, j0, j1]: [usize; 4], n: usize) -> [usize; 3] {
+    let span = (i1 - i0).max(j1 - j0) + 1 + 2 * WINDOW_MARGIN;
+    let w = ((smooth_size(2 * span - 1) + 1) / 2).min(n);
+    let start = |lo: usize, hi: usize| {
+        let centre = (lo + hi + 1) / 2;
+        centre.saturating_sub(w / 2).min(n - w)
+    };
+    [start(i0, i1), start(j0, j1), w]
+}
+
+/// Polonsky and Keer's conjugate gradient on the `w x w` cells of `convolver` (the approach
+/// given: no load balance): the pressure, MPa, per cell, and the iterations taken.
+fn conjugate_gradient(
+    convolver: &Convolver,
+    height_mm: &[f64],
+    approach_mm: f64,
+    e_star_mpa: f64,
+) -> Result<(Vec<f64>, usize), ContactError> {
+    let cells = height_mm.len();
+    let apply = |p: &[f64]| convolver.apply(p);
+    let mut p: Vec<f64> = height_mm
+        .iter()
+        .map(|&h| {
+            if h < approach_mm {
+                1e-3 * e_star_mpa
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let mut t = vec![0.0; cells];
+    let (mut g_old, mut delta) = (1.0, 0.0);
+    let max_iter = 10 * cells;
+    let mut change = f64::INFINITY;
+    for iteration in 1..=max_iter {
+        let u = apply(&p);
+        let g: Vec<f64> = (0..cells)
+            .map(|k| height_mm[k] + u[k] - approach_mm)
+            .collect();
+        let gg: f64 = (0..cells)
+            .filter(|&k| p[k] > 0.0)
+            .map(|k| g[k] * g[k])
+            .sum();
+        for k in 0..cells {
+            t[k] = if p[k] > 0.0 {
+                g[k] + delta * (gg / g_old) * t[k]
+            } else {
+                0.0
+            };
+        }
+        g_old = gg.max(f64::MIN_POSITIVE);
+        let r = apply(&t);
+        let (num, den) = (0..cells)
+            .filter(|&k| p[k] > 0.0)
+            .fold((0.0, 0.0), |(a, b), k| (a + g[k] * t[k], b + r[k] * t[k]));
+        let tau = if den > 0.0 { num / den } else { 0.0 };
+        let before: f64 = p.iter().sum();
+        let old = p.clone();
+        for k in 0..cells {
+            if p[k] > 0.0 {
+                p[k] = (p[k] - tau * t[k]).max(0.0);
+            }
+        }
+        // cells off the contact that the indenter now overlaps enter it
+        let mut entered = false;
+        for k in 0..cells {
+            if old[k] == 0.0 && g[k] < 0.0 {
+                p[k] = -tau * g[k];
+                if p[k] <= 0.0 {
+                    p[k] = 1e-6 * e_star_mpa;
+                }
+                entered = true;
+            }
+        }
+        delta = if entered { 0.0 } else { 1.0 };
+        let moved: f64 = p.iter().zip(&old).map(|(a, b)| (a - b).abs()).sum();
+        change = if before > 0.0 { moved / before } else { 0.0 };
+        if change < 1e-9 && !entered {
+            return Ok((p, iteration));
+        }
+    }
+    Err(ContactError::NoConvergence(max_iter, change))
 }
 
 /// `K_z(s, t)`, the normal displacement at depth `z` under the surface of a bonded layer of

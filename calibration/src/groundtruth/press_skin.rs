@@ -221,24 +221,37 @@ impl PressedSkin {
         }
         let (i0, j0) = (fi as usize, fj as usize);
         let (wx, wy) = (fi - i0 as f64, fj - j0 as f64);
-        let at = |i: usize, j: usize| field[j.min(n - 1) * n + i.min(n - 1)];
-        let grad = |i: usize, j: usize| -> [f64; 2] {
-            let (il, ir) = (i.saturating_sub(1), (i + 1).min(n - 1));
-            let (jl, jr) = (j.saturating_sub(1), (j + 1).min(n - 1));
+        // the 4 x 4 cells round the point (clamped at the grid's edges), read once
+        let col = |d: isize| (i0 as isize + d).clamp(0, n as isize - 1) as usize;
+        let row = |d: isize| (j0 as isize + d).clamp(0, n as isize - 1) as usize;
+        let (cols, rows) = (
+            [col(-1), col(0), col(1), col(2)],
+            [row(-1), row(0), row(1), row(2)],
+        );
+        let mut patch = [[0.0; 4]; 4];
+        for (b, &j) in rows.iter().enumerate() {
+            for (a, &i) in cols.iter().enumerate() {
+                patch[b][a] = field[j * n + i];
+            }
+        }
+        // the central differences at the corners (a, b) in 1..=2 of the patch (one-sided at
+        // the grid's edges)
+        let grad = |a: usize, b: usize| -> [f64; 2] {
             [
-                (at(ir, j) - at(il, j)) / ((ir - il) as f64 * c),
-                (at(i, jr) - at(i, jl)) / ((jr - jl) as f64 * c),
+                (patch[b][a + 1] - patch[b][a - 1]) / ((cols[a + 1] - cols[a - 1]) as f64 * c),
+                (patch[b + 1][a] - patch[b - 1][a]) / ((rows[b + 1] - rows[b - 1]) as f64 * c),
             ]
         };
-        let mix = |f: &dyn Fn(usize, usize) -> f64| {
-            f(i0, j0) * (1.0 - wx) * (1.0 - wy)
-                + f(i0 + 1, j0) * wx * (1.0 - wy)
-                + f(i0, j0 + 1) * (1.0 - wx) * wy
-                + f(i0 + 1, j0 + 1) * wx * wy
+        let (g00, g10, g01, g11) = (grad(1, 1), grad(2, 1), grad(1, 2), grad(2, 2));
+        let mix = |v00: f64, v10: f64, v01: f64, v11: f64| {
+            v00 * (1.0 - wx) * (1.0 - wy)
+                + v10 * wx * (1.0 - wy)
+                + v01 * (1.0 - wx) * wy
+                + v11 * wx * wy
         };
-        let u = mix(&|i, j| at(i, j));
-        let gx = mix(&|i, j| grad(i, j)[0]);
-        let gy = mix(&|i, j| grad(i, j)[1]);
+        let u = mix(patch[1][1], patch[1][2], patch[2][1], patch[2][2]);
+        let gx = mix(g00[0], g10[0], g01[0], g11[0]);
+        let gy = mix(g00[1], g10[1], g01[1], g11[1]);
         (u, [gx, gy])
     }
 

@@ -442,3 +442,52 @@ fn the_displacement_at_a_depth_is_boussinesqs() {
         assert!(err.starts_with("depth_mm"), "{err}");
     }
 }
+
+/// The solver works on a window round the cells the indenters overlap; where the skin's bulge
+/// meets an indenter outside it, the window grows. A pin (a 0.5 mm sphere 0.3 mm into 1 mm of
+/// incompressible gel) under a plate hanging 3 um above the undeformed skin from 1 mm out: the
+/// pin's bulge lifts the skin into the plate, which the first window does not hold. The
+/// answer holds the contact conditions on the whole grid (no overlap anywhere, no gap where
+/// the skin touches, no tension), so it is the whole grid's (the problem has one solution),
+/// and the plate carries load.
+#[test]
+fn the_window_grows_where_the_bulge_meets_an_indenter() {
+    use fabkit_calibration::elastic::{solve_skin_contact, Skin};
+    let n = 64;
+    let grid = ContactGrid { n, cell_mm: 0.1 };
+    let skin = Skin::BondedLayer {
+        young_mpa: 0.1,
+        poisson: 0.5,
+        thickness_mm: 1.0,
+    };
+    let d = 0.3;
+    let pin = sphere_heights(grid, 0.5, 0.0, 0.0);
+    let heights: Vec<f64> = (0..n * n)
+        .map(|k| {
+            let (x, y) = grid.centre_mm(k % n, k / n);
+            if x.hypot(y) > 1.0 {
+                pin[k].min(d + 0.003)
+            } else {
+                pin[k]
+            }
+        })
+        .collect();
+    let c = solve_skin_contact(grid, &heights, d, skin).unwrap();
+    let mut plate_load = 0.0;
+    for k in 0..n * n {
+        let gap = heights[k] + c.displacement_mm[k] - d;
+        assert!(gap > -1e-6, "overlap {gap} at cell {k}");
+        assert!(c.pressure_mpa[k] >= 0.0);
+        if c.in_contact[k] {
+            assert!(gap.abs() < 1e-6, "gap {gap} in contact at cell {k}");
+        }
+        if heights[k] > d {
+            plate_load += c.pressure_mpa[k] * grid.cell_mm * grid.cell_mm;
+        }
+    }
+    assert!(
+        plate_load > 0.01 * c.load_n,
+        "the plate carries {plate_load} N of {} N",
+        c.load_n
+    );
+}
