@@ -22,7 +22,7 @@
 use crate::camera::CameraModel;
 use crate::groundtruth::press_skin::{Face, PressedSkin};
 use crate::imprints::{gaussian_blur, GrayImage};
-use nalgebra::{DMatrix, DVector, Isometry3, Vector2};
+use nalgebra::{DMatrix, DVector, Isometry3};
 use serde::Serialize;
 
 /// A fitted response.
@@ -74,18 +74,11 @@ pub fn sink_per_pixel(
     t_cam_sensor: &Isometry3<f64>,
     plane_z_mm: f64,
 ) -> Vec<f64> {
-    let i = camera.intrinsics();
-    let (w, h) = (i.image_width_px as usize, i.image_height_px as usize);
-    let inv = t_cam_sensor.inverse();
-    (0..w * h)
-        .map(|p| {
-            let px = Vector2::new((p % w) as f64, (p / w) as f64);
-            match crate::board::pixel_on_plane(camera, &inv, plane_z_mm, px) {
-                Some(q) => skin.sample(face, q.x, q.y).0,
-                None => f64::NAN,
-            }
-        })
-        .collect()
+    crate::seating::sink_at(
+        skin,
+        face,
+        &crate::seating::plane_points(camera, t_cam_sensor, plane_z_mm),
+    )
 }
 
 /// `g I_ref + G_sigma * f(u)`: the capture `response` predicts for a reference, a gain and the

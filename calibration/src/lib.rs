@@ -27,6 +27,7 @@ pub mod press;
 pub mod refine;
 pub mod refraction;
 pub mod report;
+pub mod seating;
 pub mod sqpnp;
 pub mod synthetic;
 pub mod tables;

@@ -23,7 +23,7 @@ use serde::Serialize;
 use super::rays::PixelRays;
 use super::SurfaceHits;
 use crate::elastic::{
-    displacement_at_depth, solve_skin_contact, sphere_heights, ContactError, ContactGrid, Skin,
+    influence_at_depth, sphere_heights, ContactError, ContactGrid, ContactSolver, Convolver, Skin,
 };
 
 /// Poisson's ratio of the skin (module docs).
@@ -175,25 +175,7 @@ impl PressedSkin {
         heights_mm: &[f64],
         depth_mm: f64,
     ) -> Result<PressedSkin, ContactError> {
-        let skin = model.skin();
-        let contact = solve_skin_contact(grid, heights_mm, depth_mm, skin)?;
-        let seen_mm = if model.seen_depth_mm >= grid.cell_mm {
-            displacement_at_depth(&contact, skin, model.seen_depth_mm)?
-        } else {
-            contact.displacement_mm.clone()
-        };
-        let cells = contact.in_contact.iter().filter(|&&c| c).count() as f64;
-        Ok(PressedSkin {
-            model: model.clone(),
-            grid,
-            centre_mm,
-            contact_radius_mm: (cells * grid.cell_mm * grid.cell_mm / std::f64::consts::PI).sqrt(),
-            surface_mm: contact.displacement_mm,
-            seen_mm,
-            in_contact: contact.in_contact,
-            sphere_radius_mm: 0.0,
-            depth_mm,
-        })
+        SkinSolver::new(model, grid)?.press(centre_mm, heights_mm, depth_mm)
     }
 
     /// The displacement of `face` into the skin at (x, y) over the contact face (sensor frame,
@@ -312,5 +294,83 @@ impl PressedSkin {
             h.t_exit_mm[p] = t;
         }
         h
+    }
+}
+
+/// The solver of a skin's presses on one grid: the contact's influence and the seen face's
+/// transformed once ([`ContactSolver`], [`Convolver`]), for many presses of the same skin (a
+/// seating's refinement, a capture's frames).
+pub struct SkinSolver {
+    model: SkinModel,
+    contact: ContactSolver,
+    /// The seen face's convolver (none when it is the surface: a seen depth under a cell).
+    seen: Option<Convolver>,
+}
+
+impl SkinSolver {
+    /// The solver of `model`'s skin on `grid`.
+    ///
+    /// # Errors
+    /// [`ContactError`] of [`ContactSolver::new`]; a seen face not inside the layer.
+    pub fn new(model: &SkinModel, grid: ContactGrid) -> Result<SkinSolver, ContactError> {
+        let skin = model.skin();
+        let contact = ContactSolver::new(grid, skin)?;
+        let seen = if model.seen_depth_mm >= grid.cell_mm {
+            if !(model.seen_depth_mm < model.thickness_mm) {
+                return Err(ContactError::Value {
+                    name: "depth_mm",
+                    value: model.seen_depth_mm,
+                    rule: "must be 0 or at least a cell, and inside the layer",
+                });
+            }
+            Some(Convolver::new(
+                grid.n,
+                &influence_at_depth(grid, skin, model.seen_depth_mm),
+            ))
+        } else {
+            None
+        };
+        Ok(SkinSolver {
+            model: model.clone(),
+            contact,
+            seen,
+        })
+    }
+
+    /// The grid.
+    pub fn grid(&self) -> ContactGrid {
+        self.contact.grid()
+    }
+
+    /// The press of rigid indenters whose height above their lowest point at each cell of the
+    /// grid (centred over `centre_mm`) is `heights_mm`, pressed `depth_mm` into the skin (as
+    /// [`PressedSkin::solve_heights`]).
+    ///
+    /// # Errors
+    /// [`ContactError`] of the solver.
+    pub fn press(
+        &self,
+        centre_mm: [f64; 2],
+        heights_mm: &[f64],
+        depth_mm: f64,
+    ) -> Result<PressedSkin, ContactError> {
+        let grid = self.grid();
+        let contact = self.contact.solve(heights_mm, depth_mm)?;
+        let seen_mm = match &self.seen {
+            Some(c) => c.apply(&contact.pressure_mpa),
+            None => contact.displacement_mm.clone(),
+        };
+        let cells = contact.in_contact.iter().filter(|&&c| c).count() as f64;
+        Ok(PressedSkin {
+            model: self.model.clone(),
+            grid,
+            centre_mm,
+            contact_radius_mm: (cells * grid.cell_mm * grid.cell_mm / std::f64::consts::PI).sqrt(),
+            surface_mm: contact.displacement_mm,
+            seen_mm,
+            in_contact: contact.in_contact,
+            sphere_radius_mm: 0.0,
+            depth_mm,
+        })
     }
 }
