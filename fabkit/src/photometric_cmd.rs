@@ -12,6 +12,7 @@ use fabkit_calibration::groundtruth::pins::Pins;
 use fabkit_calibration::groundtruth::rays::PixelRays;
 use fabkit_calibration::groundtruth::{indented_hits, reference_hits, Scene, SurfaceHits};
 use fabkit_calibration::imprints::ids_from_file_name;
+use fabkit_calibration::photometric::seating::{seat_dome, DomeSeating, SEATING_PRIOR};
 use fabkit_calibration::photometric::{
     capture_fault, image_fault, read_pins, rms_over_skin, shadow_map, Capture, ContactRegion,
     ImprintMap, PhotometricModel, ShadowMap, ShadowRings, CONTACT_REACH_PX, DARKENING_NOISE_SIGMAS,
@@ -55,18 +56,28 @@ pub struct PhotometricArgs {
     /// imprint (its nearest pressed pixel), px, from 1 to 100.
     #[arg(long, value_name = "PX", default_value_t = CONTACT_REACH_PX)]
     contact_reach_px: f64,
+    /// Keep the pin dome where the extrinsics put it in every capture: no per-capture seating
+    /// (by default each capture's dome is moved by the small rigid motion its imprints show).
+    #[arg(long)]
+    no_seating: bool,
     #[command(flatten)]
     data_files: DataFileArgs,
 }
 
-/// One capture read and posed: its file, pin ids, image and surface.
+/// One capture read and posed: its file, pin ids, image, the dome's seating and the surface
+/// the seated pins make.
 struct Posed {
     file: PathBuf,
     ids: Vec<String>,
     image: Vec<[f64; 3]>,
+    seating: DomeSeating,
     hits: SurfaceHits,
     shadows: ShadowMap,
 }
+
+/// Rounds of seating: the model fitted, each capture's dome seated from its imprints, the
+/// captures posed again; then the model fitted on the seated captures.
+const SEATING_ROUNDS: usize = 2;
 
 /// Largest `--contact-reach-px`: the distances are spread from every imprint's rim over a
 /// disc of this radius.
@@ -96,16 +107,53 @@ pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
     let design = &loaded.design;
     let setup = Setup::read(&a, design)?;
     let listed = listed_pins(&a.images)?;
-    let posed = pose_captures(&a, &setup, &listed)?;
-    let all: Vec<Capture> = posed
-        .iter()
-        .map(|p| Capture {
-            image: &p.image,
-            hits: &p.hits,
-            shadows: &p.shadows,
-        })
-        .collect();
-    refuse_blank_frames(&a, &setup, &posed, &all)?;
+    let mut posed = pose_captures(&a, &setup, &listed)?;
+    {
+        let all = captures_of(&posed);
+        refuse_blank_frames(&a, &setup, &posed, &all)?;
+    }
+    let rounds = if a.no_seating { 0 } else { SEATING_ROUNDS };
+    for _ in 0..rounds {
+        let all = captures_of(&posed);
+        let model = PhotometricModel::fit(
+            &setup.rays,
+            &setup.reference,
+            &setup.reference_image,
+            &all,
+            setup.full_scale,
+        )?;
+        let seatings: Vec<DomeSeating> = all
+            .iter()
+            .zip(&model.gains)
+            .zip(&posed)
+            .map(|((c, &g), p)| {
+                let r = rendered(&setup, &model, c, g, reach);
+                let pairs: Vec<([f64; 2], [f64; 2])> = r
+                    .contact
+                    .imprints
+                    .iter()
+                    .filter_map(|i| i.rendered_centroid_px.zip(i.real_centroid_px))
+                    .collect();
+                let moved = setup.pins.moved(&p.seating.isometry());
+                let pins: Vec<([f64; 3], [f64; 3])> =
+                    moved.rows.iter().map(|(_, t, a)| (*t, *a)).collect();
+                let step = seat_dome(
+                    &setup.rays,
+                    &setup.reference,
+                    &pairs,
+                    &pins,
+                    p.seating.pivot_mm,
+                    &SEATING_PRIOR,
+                );
+                p.seating.then(&step)
+            })
+            .collect();
+        drop(all);
+        for (p, s) in posed.iter_mut().zip(seatings) {
+            *p = repose(&a, &setup, p, s)?;
+        }
+    }
+    let all = captures_of(&posed);
     let model = PhotometricModel::fit(
         &setup.rays,
         &setup.reference,
@@ -157,15 +205,18 @@ pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
             .contact
             .median_offset_px
             .map_or("none".to_string(), |x| format!("{x:.2} px"));
+        let t = &p.seating;
         out!(
-            "  {}: gain {:.4}; within {reach} px of its {} imprints {:.2} counts RMS (fit {:.2}), centroid offset {median} (median); whole skin {:.2} (fit {:.2})",
+            "  {}: gain {:.4}; within {reach} px of its {} imprints {:.2} counts RMS (fit {:.2}), centroid offset {median} (median); whole skin {:.2} (fit {:.2}); dome seated {:.3} mm aside, turned {:.2} deg",
             p.file.display(),
             l.gain,
             l.contact.imprints.len(),
             l.contact.rms_counts,
             f.contact.rms_counts,
             l.rms_counts,
-            f.rms_counts
+            f.rms_counts,
+            fabkit_calibration::nalgebra::Vector3::from(t.translation_mm).norm(),
+            fabkit_calibration::nalgebra::Vector3::from(t.rotation_deg).norm()
         );
     }
     Ok(())
@@ -359,12 +410,11 @@ fn pose_captures(
     setup: &Setup,
     listed: &[Vec<u32>],
 ) -> Result<Vec<Posed>, Box<dyn Error>> {
-    let rays = &setup.rays;
     let mut posed = Vec::new();
     for (file, ids) in a.images.iter().zip(listed) {
         let name = file.display().to_string();
         let ids: Vec<String> = ids.iter().map(u32::to_string).collect();
-        let prims = setup.pins.primitives(&ids).map_err(|id| {
+        setup.pins.primitives(&ids).map_err(|id| {
             format!(
                 "--images = {name}: pin {id} is not in {}",
                 point_table(a).display()
@@ -380,25 +430,67 @@ fn pose_captures(
             )
             .into());
         }
-        let prims = ExactPrimitives::new(&prims).map_err(|e| format!("--images = {name}: {e}"))?;
-        if prims.contains(rays.origin_mm) {
-            return Err(format!(
-                "{}: the camera centre is inside a pin of {name}",
-                setup.pose_name
-            )
-            .into());
-        }
-        let hits = indented_hits(rays, &setup.reference, &prims, setup.base_z_mm);
-        let shadows = shadow_map(rays, &hits, &prims, &setup.rings);
-        posed.push(Posed {
+        let unseated = Posed {
             file: file.clone(),
             ids,
             image,
-            hits,
-            shadows,
-        });
+            seating: DomeSeating::none(setup.pins.mean_tip_mm()),
+            hits: setup.reference.clone(),
+            shadows: ShadowMap::none(setup.rings),
+        };
+        let seating = unseated.seating;
+        posed.push(repose(a, setup, &unseated, seating)?);
     }
     Ok(posed)
+}
+
+/// The capture `p` with its dome seated `seating`: the pins moved, its surface and shadows
+/// cast again.
+fn repose(
+    a: &PhotometricArgs,
+    setup: &Setup,
+    p: &Posed,
+    seating: DomeSeating,
+) -> Result<Posed, Box<dyn Error>> {
+    let rays = &setup.rays;
+    let name = p.file.display().to_string();
+    let pins = setup.pins.moved(&seating.isometry());
+    let prims = pins.primitives(&p.ids).map_err(|id| {
+        format!(
+            "--images = {name}: pin {id} is not in {}",
+            point_table(a).display()
+        )
+    })?;
+    let prims = ExactPrimitives::new(&prims).map_err(|e| format!("--images = {name}: {e}"))?;
+    if prims.contains(rays.origin_mm) {
+        return Err(format!(
+            "{}: the camera centre is inside a pin of {name}",
+            setup.pose_name
+        )
+        .into());
+    }
+    let hits = indented_hits(rays, &setup.reference, &prims, setup.base_z_mm);
+    let shadows = shadow_map(rays, &hits, &prims, &setup.rings);
+    Ok(Posed {
+        file: p.file.clone(),
+        ids: p.ids.clone(),
+        image: p.image.clone(),
+        seating,
+        hits,
+        shadows,
+    })
+}
+
+/// The captures as the model reads them.
+fn captures_of(posed: &[Posed]) -> Vec<Capture<'_>> {
+    posed
+        .iter()
+        .map(|p| Capture {
+            image: &p.image,
+            hits: &p.hits,
+            shadows: &p.shadows,
+        })
+        .collect()
 }
 
 /// Refuses, by file and before the fit, a frame the camera saw no imprint in.
@@ -489,6 +581,7 @@ fn write_outputs(
         captures.push(json!({
             "file": p.file.display().to_string(), "pins": p.ids,
             "contact_region": contact_json(setup, p, &fitted[k], &loo[k]),
+            "seating": p.seating,
             "gain": model.gains[k], "leave_one_out_gain": loo[k].gain,
             "fit_rms_counts": model.residual_rms[k], "leave_one_out_rms_counts": loo[k].rms_counts,
             "rerendered": rel,
@@ -590,6 +683,18 @@ fn rerendered_png(
     })
 }
 
+/// What photometric.json's per-capture `seating` is.
+fn seating_text(a: &PhotometricArgs) -> String {
+    if a.no_seating {
+        return "none (--no-seating): every capture's pin dome where the extrinsics put it".into();
+    }
+    let p = SEATING_PRIOR;
+    format!(
+        "per capture, the small rigid motion of the pin dome from where the extrinsics put it, X -> pivot_mm + R(rotation_deg) (X - pivot_mm) + translation_mm (sensor frame; rotation_deg a rotation vector, pivot_mm the mean of the dome's pin tips), found from the offsets between the centroids of each imprint's darkening in the capture and in the model's rendering ({SEATING_ROUNDS} rounds: fit, seat, pose again; the model then fitted on the seated captures): the maximum a posteriori motion under a zero-mean Gaussian prior of {} mm per translation component and {} deg per rotation component, centroids of {} px, each pin's move along its own axis held to {} mm (the dome's seat sets the pins' depths), bounded to {} mm and {} deg (bounded: true where it was scaled back); the extrinsics stay one per sensor (calibration/src/photometric/seating.rs)",
+        p.translation_sigma_mm, p.rotation_sigma_deg, p.centroid_sigma_px, p.depth_sigma_mm, p.max_translation_mm, p.max_rotation_deg
+    )
+}
+
 /// photometric.json: provenance, the model, the captures and the files written.
 fn report_json(
     a: &PhotometricArgs,
@@ -611,6 +716,7 @@ fn report_json(
         "fixtures": a.fixtures.display().to_string(),
         "model": model.model_json(),
         "gain": format!("per capture, the least-squares ratio of the capture to the model's appearance (the fit's: to the reference image) over every channel of its skin further than {GAIN_CLEARANCE_PX} px from every imprint (its nearest pressed pixel) and unshadowed, lit and below full scale, values further than {GAIN_OUTLIER_SIGMAS} robust standard deviations from a first estimate left out; applied wherever the capture is rendered (fit RMS, leave-one-out RMS, rerendered/)"),
+        "seating": seating_text(a),
         "contact_region": format!("per capture, the RMS of the fit and of the leave-one-out over the skin within reach_px = {} px of an imprint (8-connected pressed pixels of the ground truth; distance to its nearest pressed pixel), beside the whole-skin figures; per imprint, the distance between the centroids of the capture's darkening and of its leave-one-out rendering's (the appearance at the capture's gain minus the image, summed over the channels, each less the floor of {DARKENING_NOISE_SIGMAS} x the capture's noise beyond the reach and clipped at 0) over the pixels within the reach nearest it, and their median", a.contact_reach_px),
         "captures": captures,
         "files": files,

@@ -1063,3 +1063,161 @@ fn every_model_value_is_refused_by_name_or_renders_under_a_2_gb_limit() {
     eprintln!("{} rendered, {} refused by name", outcomes.0, outcomes.1);
     assert!(outcomes.1 > outcomes.0, "{outcomes:?}");
 }
+
+/// The point table of `from`'s pin dome turned by `deg` about the sensor's z axis (tips and
+/// axes), written as `to`'s (a copy of the fixtures folder): R-Tac0's skin is round about that
+/// axis, so the turned pins press it as deep as before, a dome seated a little turned.
+fn turned_fixtures(dir: &Path, from: &str, to: &str, deg: f64) {
+    let (src, dst) = (dir.join(from), dir.join(to));
+    for entry in walk(&src) {
+        let rel = entry.strip_prefix(&src).unwrap();
+        std::fs::create_dir_all(dst.join(rel).parent().unwrap()).unwrap();
+        std::fs::copy(&entry, dst.join(rel)).unwrap();
+    }
+    let table = std::fs::read_to_string(src.join("points/point_table.csv")).unwrap();
+    let mut lines = table.lines();
+    let head: Vec<&str> = lines.next().unwrap().split(',').map(str::trim).collect();
+    let col = |name: &str| head.iter().position(|c| *c == name).unwrap();
+    let (c, s) = (deg.to_radians().cos(), deg.to_radians().sin());
+    let mut out = vec![head.join(",")];
+    for line in lines {
+        let mut cells: Vec<String> = line.split(',').map(str::to_string).collect();
+        // every point and direction of the row: each x column with its y
+        let pairs = head
+            .iter()
+            .filter(|h| h.contains("_x"))
+            .map(|h| (col(h), col(&h.replacen("_x", "_y", 1))));
+        for (i, j) in pairs {
+            let (a, b): (f64, f64) = (cells[i].parse().unwrap(), cells[j].parse().unwrap());
+            cells[i] = format!("{:.9}", c * a - s * b);
+            cells[j] = format!("{:.9}", s * a + c * b);
+        }
+        out.push(cells.join(","));
+    }
+    std::fs::write(dst.join("points/point_table.csv"), out.join("\n") + "\n").unwrap();
+}
+
+fn walk(dir: &Path) -> Vec<std::path::PathBuf> {
+    let mut out = Vec::new();
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_dir() {
+            out.extend(walk(&p));
+        } else {
+            out.push(p);
+        }
+    }
+    out
+}
+
+/// Issue 101: each capture's dome is seated from its own imprints. Of five synthetic R-Tac0
+/// pin captures, the second and fourth are rendered with the dome turned 1.5 deg about the
+/// skin's axis (its pins 0.1 to 0.3 mm along the skin); `calibrate photometric` with the
+/// dome where the extrinsics put it finds those two turned 1.5 deg about z (within 0.15 deg,
+/// the other rotations and the translation held near 0 by the prior: within 0.2 deg and 0.05
+/// mm), the other three not turned (within 0.15 deg), and re-renders every capture with its
+/// imprints' centroids within 0.3 px (median) as for unturned captures; with `--no-seating`
+/// the turned captures' centroids are more than a pixel off.
+#[test]
+fn each_captures_dome_is_seated_from_its_imprints() {
+    let d = tempfile::tempdir().unwrap();
+    setup(d.path());
+    let names = captures(d.path());
+    turned_fixtures(d.path(), "fx", "fx_turned", 1.5);
+    let o = run(
+        d.path(),
+        &[
+            "groundtruth",
+            "rtac0",
+            "--camera",
+            "cam.yaml",
+            "--extrinsics",
+            "extrinsics.json",
+            "--fixtures",
+            "fx_turned",
+            "--pin-captures",
+            "--images",
+            "--format",
+            "png",
+            "--out",
+            "caps_turned",
+        ],
+        &[],
+    );
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    for name in [&names[1], &names[3]] {
+        let folder = name.trim_end_matches(".png");
+        std::fs::copy(
+            d.path().join("caps_turned").join(folder).join("image.png"),
+            d.path().join(name),
+        )
+        .unwrap();
+    }
+    let read = |out: &str| -> serde_json::Value {
+        serde_json::from_slice(&std::fs::read(d.path().join(out).join("photometric.json")).unwrap())
+            .unwrap()
+    };
+    let o = run(d.path(), &args(&names, "seated"), &[]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    eprintln!("{}", text(&o.stdout));
+    assert!(
+        text(&o.stdout).contains("dome seated"),
+        "{}",
+        text(&o.stdout)
+    );
+    let m = read("seated");
+    assert!(m["seating"].as_str().unwrap().contains("Gaussian prior"));
+    for (k, c) in m["captures"].as_array().unwrap().iter().enumerate() {
+        let s = &c["seating"];
+        let rot: Vec<f64> = (0..3)
+            .map(|i| s["rotation_deg"][i].as_f64().unwrap())
+            .collect();
+        let shift: f64 = (0..3)
+            .map(|i| s["translation_mm"][i].as_f64().unwrap().powi(2))
+            .sum::<f64>()
+            .sqrt();
+        let median = c["contact_region"]["median_centroid_offset_px"]
+            .as_f64()
+            .unwrap();
+        eprintln!(
+            "{}: rotation {rot:?} deg, shift {shift:.4} mm, median offset {median:.3} px",
+            c["file"]
+        );
+        let turn = if k == 1 || k == 3 { 1.5 } else { 0.0 };
+        assert!((rot[2] - turn).abs() < 0.15, "{}: {rot:?}", c["file"]);
+        assert!(
+            rot[0].abs() < 0.2 && rot[1].abs() < 0.2,
+            "{}: {rot:?}",
+            c["file"]
+        );
+        assert!(shift < 0.05, "{}: {shift} mm", c["file"]);
+        assert_eq!(s["bounded"], false);
+        assert!(median < 0.3, "{}: {median} px", c["file"]);
+    }
+    let mut plain = args(&names, "unseated");
+    plain.push("--no-seating");
+    let o = run(d.path(), &plain, &[]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let (m, seated) = (read("unseated"), read("seated"));
+    for k in [1, 3] {
+        let c = &m["captures"][k];
+        let median = c["contact_region"]["median_centroid_offset_px"]
+            .as_f64()
+            .unwrap();
+        assert!(median > 1.0, "{}: {median} px", c["file"]);
+        assert_eq!(c["seating"]["rotation_deg"][2].as_f64(), Some(0.0));
+        // and the imprints re-render better seated (measured 6.5 and 8.3 counts RMS within
+        // 15 px, leave-one-out, against 19.2 and 19.6 unseated)
+        let rms = |m: &serde_json::Value| {
+            m["captures"][k]["contact_region"]["leave_one_out_rms_counts"]
+                .as_f64()
+                .unwrap()
+        };
+        assert!(
+            rms(&seated) < 0.6 * rms(&m),
+            "{} against {}",
+            rms(&seated),
+            rms(&m)
+        );
+    }
+}

@@ -85,6 +85,29 @@ impl Pins {
         }
         Ok(out)
     }
+
+    /// The pins moved by `motion` (sensor frame): each tip moved, each axis turned.
+    pub fn moved(&self, motion: &nalgebra::Isometry3<f64>) -> Pins {
+        let rows = self
+            .rows
+            .iter()
+            .map(|(id, tip, axis)| {
+                let t = motion * nalgebra::Point3::from(*tip);
+                let a = motion.rotation * nalgebra::Vector3::from(*axis);
+                (id.clone(), [t.x, t.y, t.z], [a.x, a.y, a.z])
+            })
+            .collect();
+        Pins {
+            rows,
+            ..self.clone()
+        }
+    }
+
+    /// The mean of the pins' tips, sensor frame, mm (the origin for no pin).
+    pub fn mean_tip_mm(&self) -> [f64; 3] {
+        let n = self.rows.len().max(1) as f64;
+        std::array::from_fn(|k| self.rows.iter().map(|r| r.1[k]).sum::<f64>() / n)
+    }
 }
 
 #[derive(serde::Deserialize)]

@@ -67,6 +67,7 @@ mod fit;
 mod model;
 mod model_file;
 mod render;
+pub mod seating;
 mod shadows;
 mod terms;
 
