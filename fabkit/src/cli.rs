@@ -335,16 +335,32 @@ fn export(args: ExportArgs) -> Result<(), Box<dyn Error>> {
     // The output folder is checked before anything is built.
     fabkit_export::check_out_dir(&out, &opts.claim(&loaded.design.name))?;
     args.mesh.check_csg()?;
-    let spinner = spinner(format!(
+    let building = format!(
         "building {} at {} mm chord tolerance",
         loaded.design.name,
         tol.mm()
-    ));
+    );
+    // a spinner on a terminal, plain lines in a log or a pipe (issue 102)
+    let plain = !std::io::IsTerminal::is_terminal(&std::io::stderr());
+    if plain {
+        eprintln!("export: {building}");
+    }
+    let spinner = spinner(building);
     let t0 = std::time::Instant::now();
     // The work is estimated and bounded before anything is built.
     let kit = build_kit_bounded(&loaded.design, tol, args.mesh.max_triangles);
     spinner.finish_and_clear();
     let kit = kit?;
+    if plain {
+        let (p, c) = (kit.parts.len(), kit.casts.len());
+        eprintln!(
+            "export: built {p} part{} and {c} cast{} in {:.1} s; writing them to {}",
+            if p == 1 { "" } else { "s" },
+            if c == 1 { "" } else { "s" },
+            t0.elapsed().as_secs_f64(),
+            out.display()
+        );
+    }
     // STEP export takes seconds a part: one plain line per part (a terminal, a log or a pipe)
     let step_progress = |i: usize, n: usize, part: &str| eprintln!("STEP {i}/{n}: {part}");
     let summary = write_kit_reporting(&kit, &[], &out, &opts, Some(&step_progress))?;

@@ -107,13 +107,22 @@ pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
     let design = &loaded.design;
     let setup = Setup::read(&a, design)?;
     let listed = listed_pins(&a.images)?;
-    let mut posed = pose_captures(&a, &setup, &listed)?;
+    let n = a.images.len();
+    let progress = crate::progress::Progress::new(
+        "calibrate photometric",
+        &format!("reading and posing {n} captures"),
+        n as u64,
+    );
+    let mut posed = pose_captures(&a, &setup, &listed, &|k| progress.set(k as u64, n as u64))?;
     {
         let all = captures_of(&posed);
         refuse_blank_frames(&a, &setup, &posed, &all)?;
     }
     let rounds = if a.no_seating { 0 } else { SEATING_ROUNDS };
-    for _ in 0..rounds {
+    for round in 1..=rounds {
+        progress.stage(&format!(
+            "fitting the model to {n} captures (seating round {round} of {rounds})"
+        ));
         let all = captures_of(&posed);
         let model = PhotometricModel::fit(
             &setup.rays,
@@ -149,10 +158,16 @@ pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
             })
             .collect();
         drop(all);
-        for (p, s) in posed.iter_mut().zip(seatings) {
+        progress.stage(&format!("seating the pin dome of each of {n} captures"));
+        for (k, (p, s)) in posed.iter_mut().zip(seatings).enumerate() {
             *p = repose(&a, &setup, p, s)?;
+            progress.set(k as u64 + 1, n as u64);
         }
     }
+    progress.stage(&format!(
+        "fitting the model to {n} {}captures",
+        if rounds > 0 { "seated " } else { "" }
+    ));
     let all = captures_of(&posed);
     let model = PhotometricModel::fit(
         &setup.rays,
@@ -166,8 +181,13 @@ pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
         .zip(&model.gains)
         .map(|(c, &g)| rendered(&setup, &model, c, g, reach))
         .collect();
-    let loo = leave_one_out(&setup, &posed, &all, reach)?;
-
+    progress.stage(&format!(
+        "re-rendering each of {n} captures from the model fitted on the others"
+    ));
+    let loo = leave_one_out(&setup, &posed, &all, reach, &|k| {
+        progress.set(k as u64, n as u64)
+    })?;
+    progress.stage(&format!("writing {}", a.out.display()));
     let staged = StagedDir::new(&a.out, claim)?;
     write_outputs(
         &staged,
@@ -178,6 +198,7 @@ pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
         &model,
         [&fitted, &loo],
     )?;
+    progress.finish();
     for w in staged.commit()? {
         eprintln!("warning: {w}");
     }
@@ -409,6 +430,7 @@ fn pose_captures(
     a: &PhotometricArgs,
     setup: &Setup,
     listed: &[Vec<u32>],
+    done: &dyn Fn(usize),
 ) -> Result<Vec<Posed>, Box<dyn Error>> {
     let mut posed = Vec::new();
     for (file, ids) in a.images.iter().zip(listed) {
@@ -440,6 +462,7 @@ fn pose_captures(
         };
         let seating = unseated.seating;
         posed.push(repose(a, setup, &unseated, seating)?);
+        done(posed.len());
     }
     Ok(posed)
 }
@@ -523,6 +546,7 @@ fn leave_one_out(
     posed: &[Posed],
     all: &[Capture],
     reach_px: f64,
+    done: &dyn Fn(usize),
 ) -> Result<Vec<Rendered>, Box<dyn Error>> {
     let (rays, reference) = (&setup.rays, &setup.reference);
     let mut loo = Vec::new();
@@ -541,6 +565,7 @@ fn leave_one_out(
         .map_err(|e| format!("leaving out {}: {e}", posed[k].file.display()))?;
         let gain = m.gain_of(&all[k], reference);
         loo.push(rendered(setup, &m, &all[k], gain, reach_px));
+        done(loo.len());
     }
     Ok(loo)
 }

@@ -15,6 +15,30 @@ pub(crate) struct Progress {
     bar: Option<ProgressBar>,
     /// When the last plain line was printed (None: none yet).
     last_line: Mutex<Option<Instant>>,
+    /// When the current stage started (for the estimate of the time left).
+    stage_start: Mutex<Instant>,
+}
+
+/// `done / total` steps in `elapsed`: the elapsed time and, from the mean step so far, about
+/// how long the rest takes (`3.2 s, about 12 s left`).
+fn timing(done: u64, total: u64, elapsed: Duration) -> String {
+    let secs = elapsed.as_secs_f64();
+    if done == 0 || done >= total {
+        return format!("{secs:.1} s");
+    }
+    let left = secs / done as f64 * (total - done) as f64;
+    format!("{secs:.1} s, about {} left", rounded(left))
+}
+
+/// A time left in words a reader takes at a glance: `5 s`, `40 s`, `3 min`.
+fn rounded(secs: f64) -> String {
+    if secs < 10.0 {
+        format!("{} s", secs.ceil().max(1.0))
+    } else if secs < 90.0 {
+        format!("{} s", (secs / 5.0).ceil() * 5.0)
+    } else {
+        format!("{} min", (secs / 60.0).ceil())
+    }
 }
 
 impl Progress {
@@ -22,9 +46,9 @@ impl Progress {
     pub(crate) fn new(label: &str, what: &str, total: u64) -> Progress {
         let bar = std::io::stderr().is_terminal().then(|| {
             let b = ProgressBar::new(total);
-            if let Ok(style) =
-                ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} ({elapsed})")
-            {
+            if let Ok(style) = ProgressStyle::with_template(
+                "{msg} [{bar:30}] {pos}/{len} ({elapsed}, about {eta} left)",
+            ) {
                 b.set_style(style.progress_chars("=> "));
             }
             b.set_message(format!("{label}: {what}"));
@@ -38,6 +62,7 @@ impl Progress {
             label: label.to_string(),
             bar,
             last_line: Mutex::new(None),
+            stage_start: Mutex::new(Instant::now()),
         }
     }
 
@@ -51,15 +76,24 @@ impl Progress {
         let mut last = self.last_line.lock().unwrap_or_else(|e| e.into_inner());
         let due = last.is_none_or(|t| t.elapsed() >= LINE_INTERVAL);
         if due || done == total {
-            eprintln!("{}: {done}/{total}", self.label);
+            let start = *self.stage_start.lock().unwrap_or_else(|e| e.into_inner());
+            eprintln!(
+                "{}: {done}/{total} ({})",
+                self.label,
+                timing(done, total, start.elapsed())
+            );
             *last = Some(Instant::now());
         }
     }
 
     /// A new stage of the same task (e.g. `writing 105 parts`).
     pub(crate) fn stage(&self, what: &str) {
+        *self.stage_start.lock().unwrap_or_else(|e| e.into_inner()) = Instant::now();
         match &self.bar {
-            Some(b) => b.set_message(format!("{}: {what}", self.label)),
+            Some(b) => {
+                b.reset_eta();
+                b.set_message(format!("{}: {what}", self.label))
+            }
             None => eprintln!("{}: {what}", self.label),
         }
     }

@@ -263,6 +263,26 @@ fn the_photometric_model_re_renders_each_capture_from_the_others() {
     let names = captures(d.path());
     let o = run(d.path(), &args(&names, "ph"), &[]);
     assert!(o.status.success(), "{}", text(&o.stderr));
+    // issue 102: its progress on stderr, plain lines off a terminal, each stage in order with
+    // its count and the time it took
+    let err = text(&o.stderr);
+    let at = |prefix: &str| {
+        err.lines()
+            .position(|l| l.starts_with(prefix))
+            .unwrap_or_else(|| panic!("no `{prefix}` line: {err}"))
+    };
+    let stages = [
+        "calibrate photometric: reading and posing 5 captures",
+        "calibrate photometric: 5/5 (",
+        "calibrate photometric: fitting the model to 5 captures (seating round 1 of 2)",
+        "calibrate photometric: seating the pin dome of each of 5 captures",
+        "calibrate photometric: fitting the model to 5 captures (seating round 2 of 2)",
+        "calibrate photometric: fitting the model to 5 seated captures",
+        "calibrate photometric: re-rendering each of 5 captures from the model fitted on the others",
+        "calibrate photometric: writing ph",
+    ];
+    let lines: Vec<usize> = stages.iter().map(|s| at(s)).collect();
+    assert!(lines.windows(2).all(|w| w[0] < w[1]), "{err}");
     assert!(
         text(&o.stdout).contains("photometric model from 5 captures"),
         "{}",

@@ -199,3 +199,28 @@ fn fixtures_show_progress_off_a_terminal() {
     let writing = at("fixtures: writing 8 parts and ");
     assert!(start < built && built < writing, "{err}");
 }
+
+/// `export` says what it does on stderr when stderr is not a terminal (a log, CI, a pipe):
+/// what it builds, then how long that took and where it writes (issue 102: no silent wait).
+#[test]
+fn export_shows_its_stages_off_a_terminal() {
+    let tmp = tempfile::tempdir().unwrap();
+    let o = run(tmp.path(), &["export", "ninedtact", "--out", "kit"], &[]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let err = text(&o.stderr);
+    let at = |prefix: &str| {
+        err.lines()
+            .position(|l| l.starts_with(prefix))
+            .unwrap_or_else(|| panic!("no `{prefix}` line: {err}"))
+    };
+    let building = at("export: building ninedtact at 0.01 mm chord tolerance");
+    let writing = at("export: built ");
+    assert!(building < writing, "{err}");
+    assert!(
+        err.lines()
+            .nth(writing)
+            .unwrap()
+            .ends_with("; writing them to kit"),
+        "{err}"
+    );
+}
