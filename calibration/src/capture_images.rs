@@ -48,6 +48,12 @@ pub enum ImageError {
         #[source]
         source: std::io::Error,
     },
+    #[error("{option} = {file}: {rule}")]
+    Folder {
+        option: &'static str,
+        file: String,
+        rule: String,
+    },
     #[error("{option} = {file}: not a readable PNG or JPEG image: {message}")]
     Decode {
         option: &'static str,
@@ -92,6 +98,17 @@ fn jpeg_is_complete(bytes: &[u8]) -> bool {
 
 /// Decodes `path` (PNG or JPEG), checking its size against the camera's (`expect_px`, from
 /// the camera file `camera`) before decoding.
+/// What to say when `path`, given as an image, is a folder (`None`: it is not one): give the
+/// images in it, as the shell's `DIR/*.png` lists them.
+pub fn folder_given(path: &Path) -> Option<String> {
+    path.is_dir().then(|| {
+        format!(
+            "is a folder, not an image: give the capture images themselves (as {}/*.png, which the shell expands in name order)",
+            path.display().to_string().trim_end_matches('/')
+        )
+    })
+}
+
 fn decode_checked(
     path: &Path,
     option: &'static str,
@@ -99,6 +116,9 @@ fn decode_checked(
     camera: &str,
 ) -> Result<image::DynamicImage, ImageError> {
     let file = path.display().to_string();
+    if let Some(rule) = folder_given(path) {
+        return Err(ImageError::Folder { option, file, rule });
+    }
     let bytes = crate::read_binary(path).map_err(|source| ImageError::Io {
         option,
         file: file.clone(),
@@ -268,13 +288,14 @@ pub fn observe_images(
     let camera = imaging.camera;
     let intr = camera.intrinsics();
     let size = (intr.image_width_px, intr.image_height_px);
-    if let Some(dir) = input.captures.iter().find(|p| p.is_dir()) {
+    if let Some((dir, rule)) = input
+        .captures
+        .iter()
+        .find_map(|p| folder_given(p).map(|r| (p, r)))
+    {
         return Err(ImageError::Ids {
             file: dir.display().to_string(),
-            rule: format!(
-                "is a folder, not an image: give the capture images themselves (as {}/*.png, which the shell expands in name order)",
-                dir.display().to_string().trim_end_matches('/')
-            ),
+            rule,
         });
     }
     for (k, p) in input.captures.iter().enumerate() {

@@ -391,6 +391,9 @@ fn listed_pins(images: &[PathBuf]) -> Result<Vec<Vec<u32>>, Box<dyn Error>> {
     let mut listed: Vec<Vec<u32>> = Vec::new();
     for file in images {
         let name = file.display().to_string();
+        if let Some(rule) = fabkit_calibration::capture_images::folder_given(file) {
+            return Err(format!("--images = {name}: {rule}").into());
+        }
         let ids = ids_from_file_name(file)
             .filter(|ids| !ids.is_empty())
             .ok_or_else(|| {

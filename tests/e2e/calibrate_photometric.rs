@@ -680,6 +680,11 @@ fn a_capture_without_pins_in_its_name_is_refused_and_nothing_is_written() {
     std::fs::copy(d.path().join(&first), d.path().join("sub").join(&first)).unwrap();
     for (extra, message) in [
         (
+            // issue 102: a folder of captures given as one, named as a folder
+            vec!["sub".to_string()],
+            "--images = sub: is a folder, not an image: give the capture images themselves (as sub/*.png".to_string(),
+        ),
+        (
             vec!["01_01_01_01_01.png".to_string()],
             "--images = 01_01_01_01_01.png: pin 1 listed 5 times".to_string(),
         ),

@@ -94,3 +94,24 @@ fn every_library_design_renders_a_reference_and_an_indented_image() {
         );
     }
 }
+
+/// A folder given where an image is read (a board press's `--images caps`, a reference) is
+/// named as a folder with how to give its images, not as an undecodable file.
+#[test]
+fn a_folder_given_as_an_image_is_named_as_one() {
+    let d = tempfile::tempdir().unwrap();
+    let caps = d.path().join("caps");
+    std::fs::create_dir(&caps).unwrap();
+    let e =
+        fabkit_calibration::capture_images::read_gray(&caps, "--images", (640, 480), "cam.yaml")
+            .unwrap_err()
+            .to_string();
+    assert_eq!(
+        e,
+        format!(
+            "--images = {}: is a folder, not an image: give the capture images themselves (as {}/*.png, which the shell expands in name order)",
+            caps.display(),
+            caps.display()
+        )
+    );
+}
