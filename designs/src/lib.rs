@@ -32,6 +32,7 @@ pub mod markers;
 pub mod materials;
 pub mod optics;
 pub mod parts;
+pub mod plausible;
 pub mod primitives;
 pub mod procedure;
 pub mod profile;

@@ -54,6 +54,12 @@ pub struct LoadedDesign {
 }
 
 impl LoadedDesign {
+    /// The numbers of the design's YAML that are implausible in their key's unit and plausible
+    /// in another ([`crate::plausible::unit_warnings`]), each at its `file:line:column`.
+    pub fn unit_warnings(&self) -> Vec<String> {
+        crate::plausible::unit_warnings(&self.yaml.0, &self.yaml.1)
+    }
+
     /// Applies preset `name` to the design ([`Design::with_preset_in`]): an error names the
     /// preset value's `file:line:column`.
     ///

@@ -133,7 +133,12 @@ pub(crate) type Loaded = library::LoadedDesign;
 
 pub(crate) fn load_design(arg: Option<&str>, data: &DataFileArgs) -> Result<Loaded, DesignError> {
     let arg = arg.unwrap_or(library::DEFAULT_DESIGN);
-    library::load_source_with(arg, Path::new(""), &data.rules())
+    let loaded = library::load_source_with(arg, Path::new(""), &data.rules())?;
+    // a value valid in its unit but likely typed in another (issue 102)
+    for w in loaded.unit_warnings() {
+        eprintln!("warning: {w}");
+    }
+    Ok(loaded)
 }
 
 /// The first bytes of every CSG file fabkit writes (`serde_json` orders the keys).

@@ -958,3 +958,58 @@ fn a_mold_strategy_export_never_silently_replaces_the_default_kit() {
     assert!(o.status.success(), "{}", text(&o.stderr));
     assert_eq!(name("out/rtac0"), "rtac0_mold_direct");
 }
+
+/// A value valid in its unit but likely typed in another is warned about by its
+/// file:line:column, path, value and the likely unit, and the command still runs (issue 102): a
+/// draft angle of 0.035 (radians in a degree field). A clearance of 0.0005 (metres in a
+/// millimetre field) is refused (lengths are 0 or at least a micrometre), and the warning
+/// beside the refusal says what it would be in metres. No library design draws a warning.
+#[test]
+fn values_plausible_in_another_unit_are_warned_about() {
+    let tmp = tempfile::tempdir().unwrap();
+    let yaml = rtac0_yaml().replace("  draft_angle_deg: 2.0", "  draft_angle_deg: 0.035");
+    let line = |y: &str, prefix: &str| y.lines().position(|l| l.starts_with(prefix)).unwrap() + 1;
+    write_design(
+        &tmp.path().join("units.yaml"),
+        &yaml,
+        SchemaVerdict::Accepts,
+    );
+    let o = run(tmp.path(), &["validate", "units.yaml"], &[]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let err = text(&o.stderr);
+    assert!(
+        err.contains(&format!(
+            "warning: units.yaml:{}:20: mold.draft_angle_deg = 0.035: under a fifth of a degree; if it is in radians, that is 2.01 deg",
+            line(&yaml, "  draft_angle_deg")
+        )),
+        "{err}"
+    );
+    let yaml = rtac0_yaml().replace(
+        "  cavity_clearance_mm: 0.0",
+        "  cavity_clearance_mm: 0.0005",
+    );
+    write_design(
+        &tmp.path().join("metres.yaml"),
+        &yaml,
+        SchemaVerdict::Accepts,
+    );
+    let o = run(tmp.path(), &["validate", "metres.yaml"], &[]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = text(&o.stderr);
+    assert!(
+        err.contains(&format!(
+            "warning: metres.yaml:{}:24: mold.cavity_clearance_mm = 0.0005: under a micrometre; if it is in metres, that is 0.5 mm",
+            line(&yaml, "  cavity_clearance_mm")
+        )) && err.contains("mold.cavity_clearance_mm = 0.0005: must be 0 or a length of at least 0.001 mm"),
+        "{err}"
+    );
+    for design in fabkit_designs::library::LIBRARY.iter().map(|(n, _)| *n) {
+        let o = run(tmp.path(), &["validate", design], &[]);
+        assert!(o.status.success(), "{design}");
+        assert!(
+            !text(&o.stderr).contains("warning"),
+            "{design}: {}",
+            text(&o.stderr)
+        );
+    }
+}
