@@ -258,9 +258,21 @@ pub struct CameraArgs {
 
 impl CameraArgs {
     /// The camera of `--camera` (with `--camera-model` for a file that names none).
+    /// Says on stdout which of the file's keys were read (`camera: K (intrinsics), D
+    /// (distortion) read from cam.yaml`): a file in another tool's spelling is read, and the
+    /// reader sees what was taken from it.
     pub fn read(
         &self,
     ) -> Result<fabkit_calibration::CameraModel, fabkit_calibration::CameraFileError> {
-        fabkit_calibration::read_camera_file_as(&self.camera, self.camera_model.map(Into::into))
+        let read = fabkit_calibration::camera_file::read_camera_file_keys(
+            &self.camera,
+            self.camera_model.map(Into::into),
+        )?;
+        out!(
+            "camera: {} read from {}",
+            read.keys_read,
+            self.camera.display()
+        );
+        Ok(read.camera)
     }
 }

@@ -67,7 +67,8 @@ fn groundtruth_renders_one_frame_per_pin_capture_with_the_pins_at_their_tips() {
     let o = pin_captures(d.path(), "gt", "npy");
     assert!(o.status.success(), "{}", text(&o.stderr));
     assert!(
-        text(&o.stdout).contains("reference + 8 pin captures"),
+        text(&o.stdout).contains("reference + 8 pin captures")
+            && text(&o.stdout).contains("camera: camera_matrix (intrinsics), distortion_coefficients (distortion) read from cam.yaml"),
         "{}",
         text(&o.stdout)
     );
@@ -283,6 +284,14 @@ fn the_photometric_model_re_renders_each_capture_from_the_others() {
     ];
     let lines: Vec<usize> = stages.iter().map(|s| at(s)).collect();
     assert!(lines.windows(2).all(|w| w[0] < w[1]), "{err}");
+    // issue 102: which keys of the camera file were read
+    assert!(
+        text(&o.stdout).contains(
+            "camera: camera_matrix (intrinsics), distortion_coefficients (distortion) read from cam.yaml"
+        ),
+        "{}",
+        text(&o.stdout)
+    );
     assert!(
         text(&o.stdout).contains("photometric model from 5 captures"),
         "{}",
