@@ -245,6 +245,12 @@ pub struct ManifestCutPart {
     pub dxf_sha256: String,
     pub svg: String,
     pub svg_sha256: String,
+    /// `cut/preview/<name>.svg`: the part to look at (0.25 mm strokes, its face shaded, its
+    /// name, sheet and count, a scale bar); not for the laser.
+    #[serde(default)]
+    pub preview_svg: String,
+    #[serde(default)]
+    pub preview_svg_sha256: String,
     /// `cut/<name>.stl`: one sheet as a solid (the nominal part extruded by its thickness,
     /// from z = 0), for a sheet with polygonal outlines.
     #[serde(default, skip_serializing_if = "Option::is_none")]

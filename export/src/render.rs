@@ -649,6 +649,9 @@ fn cut_part_files(
         );
         let dxf_bytes = two_d::dxf_bytes(c)?;
         let svg_bytes = two_d::svg_text(c).into_bytes();
+        let material_name = product_name(materials, &c.material);
+        let preview = format!("{CUT_DIR}/preview/{}.svg", c.name);
+        let preview_bytes = two_d::svg_preview_text(c, &material_name).into_bytes();
         // a polygonal sheet also as a solid: the nominal part extruded by its thickness
         let (stl, stl_sha256) =
             match &c.nominal_rings_mm {
@@ -669,7 +672,7 @@ fn cut_part_files(
             name: c.name.clone(),
             description: c.description.clone(),
             material: c.material.clone(),
-            material_name: product_name(materials, &c.material),
+            material_name,
             thickness_mm: c.thickness_mm,
             quantity: c.quantity,
             kerf_mm: c.kerf_mm,
@@ -679,11 +682,14 @@ fn cut_part_files(
             svg_sha256: sha256_hex(&svg_bytes),
             dxf: dxf.clone(),
             svg: svg.clone(),
+            preview_svg_sha256: sha256_hex(&preview_bytes),
+            preview_svg: preview.clone(),
             stl,
             stl_sha256,
         });
         files.push((dxf, dxf_bytes));
         files.push((svg, svg_bytes));
+        files.push((preview, preview_bytes));
     }
     Ok(cut_parts)
 }

@@ -393,9 +393,11 @@ fn laser_cut(s: &mut String, m: &Manifest) {
     }
     s.push_str("## Laser cutting\n\n");
     s.push_str(
-        "DXF (R2000, mm, layer `cut`) and SVG (mm, cut lines red) of each part, centred on the \
-         sensor axis. Where a kerf is given, the paths are offset by half of it away from the \
-         part: set the cutter's kerf compensation to 0.\n\n",
+        "DXF (R2000, mm, layer `cut`) and SVG (mm, cut lines red, hairline) of each part, \
+         centred on the sensor axis, for the laser; `cut/preview/` holds each part's SVG to look \
+         at (visible lines, its name and a scale bar), not to cut. Where a kerf is given, the \
+         paths are offset by half of it away from the part: set the cutter's kerf compensation \
+         to 0.\n\n",
     );
     for c in &m.cut_parts {
         let _ = writeln!(

@@ -126,26 +126,144 @@ fn with_table_handles(text: &str) -> String {
     out.join("\r\n")
 }
 
-/// The SVG of `part`: a `width`/`height` in mm with a viewBox in mm, one group per operation.
+/// The SVG of `part` for the laser: a `width`/`height` in mm with a viewBox in mm, one group
+/// per operation, hairline strokes (0.01 mm: what laser software takes as a vector cut).
 pub fn svg_text(part: &CutPart) -> String {
-    use svg::node::element::{Circle, Group, Path};
-    let extent = part
-        .outlines
-        .iter()
-        .map(|(_, o)| o.extent_mm())
-        .fold(0.0, f64::max)
-        + 1.0;
+    let extent = cut_extent(part);
     let size = 2.0 * extent;
     let mut doc = svg::Document::new()
         .set("width", format!("{size}mm"))
         .set("height", format!("{size}mm"))
         .set("viewBox", (-extent, -extent, size, size));
+    for g in operation_groups(part, 0.01) {
+        doc = doc.add(g);
+    }
+    doc.to_string()
+}
+
+/// The SVG of `part` to look at (a browser, a viewer): its outlines in 0.25 mm strokes over
+/// the part's face shaded, its name, sheet and count under it, and a 10 mm scale bar. Not for
+/// the laser (it would cut the label): `svg_text` is.
+pub fn svg_preview_text(part: &CutPart, material_name: &str) -> String {
+    use svg::node::element::{Line, Path, Text};
+    let extent = cut_extent(part);
+    let size = 2.0 * extent;
+    let label_mm = 3.0;
+    let height = size + 2.0 * label_mm + 1.0;
+    let mut doc = svg::Document::new()
+        .set("width", format!("{size}mm"))
+        .set("height", format!("{height}mm"))
+        .set("viewBox", (-extent, -extent, size, height));
+    // the face: every outline in one path, filled even-odd (the holes open)
+    let face: String = part
+        .outlines
+        .iter()
+        .filter(|(o, _)| *o == Operation::Cut)
+        .map(|(_, outline)| outline_path(outline))
+        .collect::<Vec<_>>()
+        .join(" ");
+    doc = doc.add(
+        Path::new()
+            .set("d", face)
+            .set("fill", "#f2e6d0")
+            .set("fill-rule", "evenodd")
+            .set("stroke", "none"),
+    );
+    for g in operation_groups(part, 0.25) {
+        doc = doc.add(g);
+    }
+    let count = if part.quantity > 1 {
+        format!("{} x ", part.quantity)
+    } else {
+        String::new()
+    };
+    let text = format!(
+        "{count}{}: {material_name}, {} mm sheet",
+        part.name, part.thickness_mm
+    );
+    let font = (label_mm * 0.8).min(size / (0.6 * text.len().max(1) as f64));
+    doc = doc.add(
+        Text::new(text)
+            .set("x", -extent + 0.5)
+            .set("y", extent + label_mm)
+            .set("font-family", "sans-serif")
+            .set("font-size", font)
+            .set("fill", "#202020"),
+    );
+    // a 10 mm scale bar (shorter on a small part), labelled
+    let bar = if size > 24.0 { 10.0 } else { 5.0 };
+    let y = extent + 2.0 * label_mm;
+    doc = doc.add(
+        Line::new()
+            .set("x1", -extent + 0.5)
+            .set("y1", y)
+            .set("x2", -extent + 0.5 + bar)
+            .set("y2", y)
+            .set("stroke", "#202020")
+            .set("stroke-width", 0.35),
+    );
+    doc = doc.add(
+        Text::new(format!("{bar} mm"))
+            .set("x", -extent + 1.0 + bar)
+            .set("y", y + 0.8)
+            .set("font-family", "sans-serif")
+            .set("font-size", font.min(2.0))
+            .set("fill", "#202020"),
+    );
+    doc.to_string()
+}
+
+/// Half the side of the square a cut part's drawing fills, mm: its farthest outline point
+/// from the axis and 1 mm.
+fn cut_extent(part: &CutPart) -> f64 {
+    part.outlines
+        .iter()
+        .map(|(_, o)| o.extent_mm())
+        .fold(0.0, f64::max)
+        + 1.0
+}
+
+/// An outline as SVG path data, y flipped (SVG's y runs down).
+fn outline_path(outline: &Outline) -> String {
+    match outline {
+        Outline::Circle {
+            centre_mm,
+            radius_mm,
+        } => {
+            let (x, y, r) = (centre_mm[0], -centre_mm[1], *radius_mm);
+            format!(
+                "M{},{} A{r},{r} 0 1 0 {},{} A{r},{r} 0 1 0 {},{} Z",
+                x - r,
+                y,
+                x + r,
+                y,
+                x - r,
+                y
+            )
+        }
+        Outline::Polygon { points_mm } => {
+            points_mm
+                .iter()
+                .enumerate()
+                .map(|(i, p)| format!("{}{},{}", if i == 0 { "M" } else { "L" }, p[0], -p[1]))
+                .collect::<Vec<_>>()
+                .join(" ")
+                + " Z"
+        }
+    }
+}
+
+/// One group per operation of `part` (cut red, engrave blue) with strokes `stroke_mm` wide:
+/// circles as circles, polygons as closed paths, y flipped.
+fn operation_groups(part: &CutPart, stroke_mm: f64) -> Vec<svg::node::element::Group> {
+    use svg::node::element::{Circle, Group, Path};
+    let mut out = Vec::new();
     for (op, colour) in [(Operation::Cut, "#ff0000"), (Operation::Engrave, "#0000ff")] {
         let mut g = Group::new()
             .set("id", layer(op))
             .set("fill", "none")
             .set("stroke", colour)
-            .set("stroke-width", 0.01);
+            .set("stroke-width", stroke_mm);
         let mut any = false;
         for (o, outline) in &part.outlines {
             if *o != op {
@@ -161,27 +279,18 @@ pub fn svg_text(part: &CutPart) -> String {
                     .set("cy", -centre_mm[1])
                     .set("r", *radius_mm)
                     .into(),
-                // a closed path of straight segments, y flipped as the circles'
-                Outline::Polygon { points_mm } => {
-                    let d = points_mm
-                        .iter()
-                        .enumerate()
-                        .map(|(i, p)| {
-                            format!("{}{},{}", if i == 0 { "M" } else { "L" }, p[0], -p[1])
-                        })
-                        .collect::<Vec<_>>()
-                        .join(" ")
-                        + " Z";
-                    let node: Box<dyn svg::Node> = Box::new(Path::new().set("d", d));
+                Outline::Polygon { .. } => {
+                    let node: Box<dyn svg::Node> =
+                        Box::new(Path::new().set("d", outline_path(outline)));
                     node
                 }
             });
         }
         if any {
-            doc = doc.add(g);
+            out.push(g);
         }
     }
-    doc.to_string()
+    out
 }
 
 /// The extents of drawing `d` in the model, dimensions included: [x0, x1, z0, z1], mm (the

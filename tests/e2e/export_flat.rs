@@ -131,20 +131,28 @@ for c in m["cut_parts"]:
     polys = [[(x, y) for x, y, *_ in e.get_points()] for e in doc.modelspace().query('LWPOLYLINE[layer=="cut"]')]
     closed = all(e.closed for e in doc.modelspace().query('LWPOLYLINE'))
     ns = {"s": "http://www.w3.org/2000/svg"}
-    svg = ET.parse(d / c["svg"]).getroot()
-    rings = []
-    for g in svg.findall("s:g", ns):
-        if g.get("id") != "cut":
-            continue
-        for path in g.findall("s:path", ns):
-            toks = path.get("d").replace("Z", "").split()
-            rings.append([tuple(float(v) for v in t[1:].split(",")) for t in toks])
+    def cut_rings(root):
+        rings, strokes = [], []
+        for g in root.findall("s:g", ns):
+            if g.get("id") != "cut":
+                continue
+            strokes.append(float(g.get("stroke-width")))
+            for path in g.findall("s:path", ns):
+                toks = path.get("d").replace("Z", "").split()
+                rings.append([tuple(float(v) for v in t[1:].split(",")) for t in toks])
+        return rings, strokes
+    rings, laser_strokes = cut_rings(ET.parse(d / c["svg"]).getroot())
+    preview = ET.parse(d / c["preview_svg"]).getroot()
+    preview_rings, preview_strokes = cut_rings(preview)
+    texts = [t.text for t in preview.iter("{http://www.w3.org/2000/svg}text")]
     raw = (d / c["stl"]).read_bytes()
     n = struct.unpack("<I", raw[80:84])[0]
     tri = np.frombuffer(raw[84:84 + 50 * n], dtype=np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")]))["v"].astype(float)
     vol = float(np.sum(np.einsum("ij,ij->i", tri[:, 0], np.cross(tri[:, 1], tri[:, 2])))) / 6.0
     out.append({"name": c["name"], "dxf_area": region([shoelace(p) for p in polys]),
                 "svg_area": region([shoelace(r) for r in rings]), "stl_volume": vol,
+                "preview_area": region([shoelace(r) for r in preview_rings]),
+                "laser_strokes": laser_strokes, "preview_strokes": preview_strokes, "texts": texts,
                 "errors": len(a.errors), "fixes": len(a.fixes), "closed": closed,
                 "version": doc.dxfversion, "units": doc.units, "measurement": doc.header.get("$MEASUREMENT"),
                 "rings": len(polys)})
@@ -233,6 +241,15 @@ fn soter_laser_cut_sheets_read_back() {
             assert!(
                 (dxf - svg).abs() <= 1e-9 * dxf,
                 "{name}: DXF {dxf} vs SVG {svg}"
+            );
+            // issue 102: the laser's SVG keeps its hairline; its preview draws the same paths
+            // in strokes a browser shows, labelled with the part's name
+            assert_eq!(r["laser_strokes"], serde_json::json!([0.01]), "{r}");
+            assert_eq!(r["preview_strokes"], serde_json::json!([0.25]), "{r}");
+            assert!((f("preview_area") - svg).abs() <= 1e-9 * svg, "{r}");
+            assert!(
+                r["texts"][0].as_str().is_some_and(|t| t.contains(name)),
+                "{r}"
             );
             assert!(
                 (dxf - c["area_mm2"].as_f64().unwrap()).abs() <= 1e-9 * dxf,
