@@ -13,7 +13,8 @@ h1,h2,h3{line-height:1.2}h2{border-bottom:1px solid #ccc;padding-bottom:.2em;mar
 table{border-collapse:collapse;margin:1em 0;font-size:.92em}th,td{border:1px solid #ccc;padding:.3em .6em;\
 vertical-align:top}th{background:#f3f3f3;text-align:left}code{font-family:ui-monospace,Menlo,Consolas,monospace;\
 font-size:.9em;background:#f5f5f5;padding:0 .2em;border-radius:3px}img{max-width:100%;height:auto;\
-border:1px solid #ddd;background:#fafafa}";
+border:1px solid #ddd;background:#fafafa}.swatch{display:inline-block;width:1.6em;height:1em;\
+vertical-align:-.15em;margin-right:.4em;border:1px solid #888;border-radius:2px}";
 
 /// The HTML page of `markdown` titled `title`; an image whose path is one of `files` (export
 /// relative paths and bytes, PNG) is inlined, any other is left as a relative link.
@@ -42,6 +43,11 @@ pub(crate) fn render(markdown: &str, title: &str, files: &[(String, Vec<u8>)]) -
                 id,
             })
         }
+        // a colour written as code (the section view's legend) gets its swatch
+        Event::Code(c) if is_hex_colour(&c) => Event::InlineHtml(
+            format!("<span class=\"swatch\" style=\"background:{c}\"></span><code>{c}</code>")
+                .into(),
+        ),
         other => other,
     });
     let mut body = String::new();
@@ -54,6 +60,11 @@ pub(crate) fn render(markdown: &str, title: &str, files: &[(String, Vec<u8>)]) -
     )
 }
 
+/// `#rrggbb`.
+fn is_hex_colour(s: &str) -> bool {
+    s.len() == 7 && s.starts_with('#') && s[1..].chars().all(|c| c.is_ascii_hexdigit())
+}
+
 fn escape(s: &str) -> String {
     s.replace('&', "&amp;")
         .replace('<', "&lt;")
@@ -64,6 +75,28 @@ fn escape(s: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A colour in a code span (the section view's legend, `#6aa7e8`) is drawn as a swatch
+    /// beside its code; other code is left as it is.
+    #[test]
+    fn colour_codes_get_swatches() {
+        let h = render(
+            "| `#6aa7e8` | `gel` |\n|---|---|\n| `#12345g` | x |\n",
+            "t",
+            &[],
+        );
+        assert!(
+            h.contains(
+                "<span class=\"swatch\" style=\"background:#6aa7e8\"></span><code>#6aa7e8</code>"
+            ),
+            "{h}"
+        );
+        assert!(
+            h.contains("<code>gel</code>") && h.contains("<code>#12345g</code>"),
+            "{h}"
+        );
+        assert_eq!(h.matches("class=\"swatch\"").count(), 1, "{h}");
+    }
 
     #[test]
     fn pictures_of_the_export_are_inlined_and_tables_rendered() {

@@ -17,6 +17,9 @@ pub const PX_PER_MM: f64 = 20.0;
 pub const MAX_SIDE_PX: f64 = 2000.0;
 /// White space around the section, mm.
 const MARGIN_MM: f64 = 2.0;
+/// The band under the section that holds the scale bar, mm, and the bar's thickness, mm.
+const BAR_BAND_MM: f64 = 3.0;
+const BAR_THICKNESS_MM: f64 = 0.6;
 
 /// Where the picture lies and what each colour is.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -31,6 +34,10 @@ pub struct SectionView {
     pub origin_xz_mm: [f64; 2],
     /// One entry per member drawn, in drawing order.
     pub legend: Vec<SectionLegend>,
+    /// The length of the black scale bar in the band under the section (its left end at the
+    /// picture's margin), mm.
+    #[serde(default)]
+    pub scale_bar_mm: f64,
 }
 
 /// A member's colour in the picture.
@@ -137,7 +144,8 @@ pub fn render(members: &[(&str, MemberKind, &Mesh)]) -> (Vec<u8>, SectionView) {
     let extent = (hi[0] - lo[0]).max(hi[1] - lo[1]);
     let px_per_mm = PX_PER_MM.min(MAX_SIDE_PX / extent);
     let width = ((hi[0] - lo[0]) * px_per_mm).ceil() as usize;
-    let height = ((hi[1] - lo[1]) * px_per_mm).ceil() as usize;
+    let section_height = ((hi[1] - lo[1]) * px_per_mm).ceil() as usize;
+    let height = section_height + (BAR_BAND_MM * px_per_mm).ceil() as usize;
     let mut rgb = vec![255u8; 3 * width * height];
     let mut counters = [0usize; 3];
     let mut legend = Vec::with_capacity(members.len());
@@ -150,7 +158,7 @@ pub fn render(members: &[(&str, MemberKind, &Mesh)]) -> (Vec<u8>, SectionView) {
         let c = colour(*kind, counters[k]);
         counters[k] += 1;
         let mut xs: Vec<f64> = Vec::new();
-        for row in 0..height {
+        for row in 0..section_height {
             // z of the row's centre line (row 0 at the top)
             let z = hi[1] - (row as f64 + 0.5) / px_per_mm;
             xs.clear();
@@ -182,6 +190,22 @@ pub fn render(members: &[(&str, MemberKind, &Mesh)]) -> (Vec<u8>, SectionView) {
             area_mm2: enclosed_area(segments),
         });
     }
+    // the scale bar: 10 mm (5 mm under a narrow section), black, in the band under it
+    let scale_bar_mm = if hi[0] - lo[0] >= 10.0 + 2.0 * MARGIN_MM {
+        10.0
+    } else {
+        5.0
+    };
+    let bar_row0 = section_height + ((BAR_BAND_MM - BAR_THICKNESS_MM) / 2.0 * px_per_mm) as usize;
+    let bar_rows = (BAR_THICKNESS_MM * px_per_mm).round().max(1.0) as usize;
+    let col0 = (MARGIN_MM * px_per_mm).round() as usize;
+    let cols = (scale_bar_mm * px_per_mm).round() as usize;
+    for row in bar_row0..(bar_row0 + bar_rows).min(height) {
+        for col in col0..(col0 + cols).min(width) {
+            let i = 3 * (row * width + col);
+            rgb[i..i + 3].copy_from_slice(&[0, 0, 0]);
+        }
+    }
     let view = SectionView {
         file: String::new(),
         sha256: String::new(),
@@ -190,6 +214,7 @@ pub fn render(members: &[(&str, MemberKind, &Mesh)]) -> (Vec<u8>, SectionView) {
         px_per_mm,
         origin_xz_mm: [lo[0], hi[1]],
         legend,
+        scale_bar_mm,
     };
     (rgb, view)
 }

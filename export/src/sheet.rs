@@ -492,9 +492,10 @@ fn section_view(s: &mut String, m: &Manifest) {
     let _ = writeln!(
         s,
         "![The assembled sensor cut through its axis]({})\n\nThe sensor cut by the plane y = 0 \
-         through its axis (x to the right, z up, {:.0} px per mm); bought parts are envelopes. \
-         Check it first: the layers on the core, the seats in the shell.\n",
-        v.file, v.px_per_mm
+         through its axis (x to the right, z up, {:.0} px per mm; the black bar under it is \
+         {} mm long); bought parts are envelopes. Check it first: the layers on the core, the \
+         seats in the shell.\n",
+        v.file, v.px_per_mm, v.scale_bar_mm
     );
     s.push_str("| Colour | Part | Kind | Section area (mm²) |\n|--------|------|------|-------------------:|\n");
     for l in &v.legend {
