@@ -81,17 +81,12 @@ pub fn sink_per_pixel(
     )
 }
 
-/// `g I_ref + G_sigma * f(u)`: the capture `response` predicts for a reference, a gain and the
-/// seen face's displacement per pixel (NaN: no response there).
-pub fn render(
-    response: &FlatResponse,
-    gain: f64,
-    reference: &GrayImage,
-    sink_mm: &[f64],
-) -> GrayImage {
+/// `G_sigma * f(u)`: the response's change of the image, grey levels, for the sink per pixel
+/// (row-major, `width` a row; 0 where the sink is NaN).
+pub fn response_image(response: &FlatResponse, width: usize, sink_mm: &[f64]) -> GrayImage {
     let f = GrayImage {
-        width: reference.width,
-        height: reference.height,
+        width,
+        height: sink_mm.len() / width.max(1),
         data: sink_mm
             .iter()
             .map(|&u| {
@@ -103,7 +98,18 @@ pub fn render(
             })
             .collect(),
     };
-    let b = gaussian_blur(&f, response.blur_px);
+    gaussian_blur(&f, response.blur_px)
+}
+
+/// `g I_ref + G_sigma * f(u)`: the capture `response` predicts for a reference, a gain and the
+/// seen face's displacement per pixel (NaN: no response there).
+pub fn render(
+    response: &FlatResponse,
+    gain: f64,
+    reference: &GrayImage,
+    sink_mm: &[f64],
+) -> GrayImage {
+    let b = response_image(response, reference.width, sink_mm);
     GrayImage {
         width: reference.width,
         height: reference.height,

@@ -22,9 +22,9 @@ use serde::Serialize;
 
 use crate::camera::CameraModel;
 use crate::elastic::{bump_heights, ContactError};
-use crate::flat_response::FlatResponse;
+use crate::flat_response::{response_image, FlatResponse};
 use crate::groundtruth::press_skin::{Face, PressedSkin, SkinSolver};
-use crate::imprints::{gaussian_blur, GrayImage};
+use crate::imprints::GrayImage;
 use nalgebra::{Isometry3, Matrix3, Vector2, Vector3};
 
 /// How a press sits: its indenters' lowest point under the contact face, mm, and their offset
@@ -97,26 +97,6 @@ pub fn sink_at(skin: &PressedSkin, face: Face, points: &[[f64; 2]]) -> Vec<f64> 
             }
         })
         .collect()
-}
-
-/// `G_sigma * f(u)`: the response's change of the image, grey levels, for the sink per pixel
-/// (0 where the sink is NaN).
-pub fn response_image(response: &FlatResponse, width: usize, sink_mm: &[f64]) -> GrayImage {
-    let f = GrayImage {
-        width,
-        height: sink_mm.len() / width.max(1),
-        data: sink_mm
-            .iter()
-            .map(|&u| {
-                if u.is_finite() {
-                    response.at(u) as f32
-                } else {
-                    0.0
-                }
-            })
-            .collect(),
-    };
-    gaussian_blur(&f, response.blur_px)
 }
 
 /// The gain `g` of least squares of `g reference + change - capture` over `mask`.
@@ -273,22 +253,12 @@ pub fn refine_seating(
                 gain = gn;
                 cost = cn;
                 lambda = (lambda / 10.0).max(1e-9);
-                improved = true;
-                if moved < 1e-4 {
-                    return Ok(finish(
-                        start,
-                        seat(&x),
-                        gain,
-                        &r,
-                        jtj,
-                        evaluations,
-                        iterations,
-                    ));
-                }
+                improved = moved >= 1e-4;
                 break;
             }
             lambda *= 10.0;
         }
+        // no step lowered the cost, or the last moved under 0.1 um: converged
         if !improved {
             break;
         }

@@ -119,18 +119,21 @@ pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
         refuse_blank_frames(&a, &setup, &posed, &all)?;
     }
     let rounds = if a.no_seating { 0 } else { SEATING_ROUNDS };
+    let fit = |all: &[Capture]| {
+        PhotometricModel::fit(
+            &setup.rays,
+            &setup.reference,
+            &setup.reference_image,
+            all,
+            setup.full_scale,
+        )
+    };
     for round in 1..=rounds {
         progress.stage(&format!(
             "fitting the model to {n} captures (seating round {round} of {rounds})"
         ));
         let all = captures_of(&posed);
-        let model = PhotometricModel::fit(
-            &setup.rays,
-            &setup.reference,
-            &setup.reference_image,
-            &all,
-            setup.full_scale,
-        )?;
+        let model = fit(&all)?;
         let seatings: Vec<DomeSeating> = all
             .iter()
             .zip(&model.gains)
@@ -169,13 +172,7 @@ pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
         if rounds > 0 { "seated " } else { "" }
     ));
     let all = captures_of(&posed);
-    let model = PhotometricModel::fit(
-        &setup.rays,
-        &setup.reference,
-        &setup.reference_image,
-        &all,
-        setup.full_scale,
-    )?;
+    let model = fit(&all)?;
     let fitted: Vec<Rendered> = all
         .iter()
         .zip(&model.gains)

@@ -17,6 +17,11 @@ use fabkit_calibration::synthetic::benchmark_intrinsics;
 use fabkit_calibration::CameraModel;
 
 fn pin_captures(dir: &Path, out: &str, format: &str) -> std::process::Output {
+    pin_captures_of(dir, "fx", out, format)
+}
+
+/// The pin captures of the pin dome in the fixtures folder `fixtures`.
+fn pin_captures_of(dir: &Path, fixtures: &str, out: &str, format: &str) -> std::process::Output {
     run(
         dir,
         &[
@@ -27,7 +32,7 @@ fn pin_captures(dir: &Path, out: &str, format: &str) -> std::process::Output {
             "--extrinsics",
             "extrinsics.json",
             "--fixtures",
-            "fx",
+            fixtures,
             "--pin-captures",
             "--images",
             "--format",
@@ -1158,26 +1163,7 @@ fn each_captures_dome_is_seated_from_its_imprints() {
     setup(d.path());
     let names = captures(d.path());
     turned_fixtures(d.path(), "fx", "fx_turned", 1.5);
-    let o = run(
-        d.path(),
-        &[
-            "groundtruth",
-            "rtac0",
-            "--camera",
-            "cam.yaml",
-            "--extrinsics",
-            "extrinsics.json",
-            "--fixtures",
-            "fx_turned",
-            "--pin-captures",
-            "--images",
-            "--format",
-            "png",
-            "--out",
-            "caps_turned",
-        ],
-        &[],
-    );
+    let o = pin_captures_of(d.path(), "fx_turned", "caps_turned", "png");
     assert!(o.status.success(), "{}", text(&o.stderr));
     for name in [&names[1], &names[3]] {
         let folder = name.trim_end_matches(".png");
