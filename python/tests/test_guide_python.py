@@ -1,12 +1,16 @@
 """The user guide's first "From Python" example (arrays, docs/src/guide/python.md) runs as written, on inputs the CLI makes: a camera file
 (cam.yaml), a calibration (calib/extrinsics.json), the R-Tac0 fixtures (out/rtac0_fixtures) and
 a ground-truth folder (gt), in a fresh folder; so does the second (a board press and a ball
-press's ground truth), on 9DTact's captures and the folders the CLI makes of them."""
+press's ground truth), on 9DTact's captures and the folders the CLI makes of them; and the third
+(a sweep on a local Dask cluster), saved as a file and run with python as the guide says."""
 
 import contextlib
 import io
 import json
+import os
 import re
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -92,3 +96,28 @@ def test_guide_board_example_runs(tmp_path, run_cli, monkeypatch):
     assert 1.5 < press.depth_mm < 1.8
     assert abs(np.nanmin(scope["target"]) + press.depth_mm) < 0.01
     assert scope["normals"].shape == (480, 640, 3) and scope["capture"].shape == (480, 640, 3)
+
+
+def test_guide_sweep_example_runs_as_a_script(tmp_path):
+    """Issue 102: the sweep example returned 20 infeasible variants (the default layout ignores
+    the spacing) and its process pool crashed without a __main__ guard. Saved as sweep.py and
+    run with python (two Dask worker processes), it prints a progress line per variant and the
+    table; called again, its variants build (the spacing moves the dimple count)."""
+    pytest = __import__("pytest")
+    pytest.importorskip("distributed")
+    script = tmp_path / "sweep.py"
+    script.write_text(guide_blocks()[2])
+    run = subprocess.run([sys.executable, str(script)], cwd=tmp_path, capture_output=True,
+                         text=True, env=dict(os.environ), timeout=600)
+    assert run.returncode == 0, run.stderr
+    assert "status" in run.stdout and "min_wall_mm" in run.stdout, run.stdout
+    scope = {"__name__": "guide_sweep"}
+    exec(compile(guide_blocks()[2], str(GUIDE), "exec"), scope)
+    with contextlib.redirect_stdout(io.StringIO()):
+        table = scope["main"]()
+    assert len(table) == 20
+    ok = table[table["status"] == "ok"]
+    assert len(ok) >= 15, table["status"].value_counts()
+    counts = [c for c in table.columns if c.startswith("markers.") and c.endswith(".count")]
+    spacing = "layers[0].markers[0].pattern.spacing_mm"
+    assert counts and ok.groupby(spacing)[counts[0]].first().nunique() > 1, ok
