@@ -140,8 +140,35 @@ pub fn run(args: FixturesArgs) -> Result<(), Box<dyn Error>> {
         eprintln!("warning: {w}");
     }
     print_summary(&set, &params, &loaded.design, &out, t0.elapsed());
+    print_hints(&set, &args, &loaded.design);
     crate::args::print_parts(&summary.manifest.parts);
     Ok(())
+}
+
+/// Says what the defaults left out that the design's paper has: its published pin dome when
+/// the default one was built (`--pins-preset`), and how to make semi-dome patterns when none
+/// were asked for (issue 102: `fixtures rtac0` made a 13-hole dome and no pattern, silently).
+fn print_hints(
+    set: &fabkit_fixtures::FixtureSet,
+    args: &FixturesArgs,
+    design: &fabkit_designs::Design,
+) {
+    let published = fabkit_fixtures::params::PIN_PRESETS
+        .iter()
+        .find(|(name, _)| *name == design.name);
+    if let (Some(d), Some((name, _)), None, None) =
+        (&set.pin_dome, published, &args.pins_preset, &args.params)
+    {
+        out!(
+            "  hint: this is fabkit's default dome ({} holes); the dome of {}'s paper: --pins-preset {name}",
+            d.table.len(),
+            design.name
+        );
+    }
+    let none = |n: Option<usize>| n == Some(0);
+    if none(set.semidomes.as_ref().map(|s| s.halves.len())) && args.semidomes.is_none() {
+        out!("  hint: no semi-dome pattern was asked for: --semidomes N generates N (the protrusions a ground truth is rendered for)");
+    }
 }
 
 /// Prints what was written: the counts and time, then each fixture's figures and notes, and

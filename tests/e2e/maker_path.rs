@@ -224,3 +224,44 @@ fn export_shows_its_stages_off_a_terminal() {
         "{err}"
     );
 }
+
+/// `fixtures rtac0` with its defaults says what the paper's kit has that the defaults left
+/// out (issue 102): the published 29-hole dome (`--pins-preset rtac0`) and semi-dome patterns
+/// (`--semidomes N`); given both, no hint.
+#[test]
+fn fixtures_name_what_the_defaults_leave_out() {
+    let tmp = tempfile::tempdir().unwrap();
+    let o = run(
+        tmp.path(),
+        &["fixtures", "rtac0", "--format", "stl", "--out", "a"],
+        &[],
+    );
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let out = text(&o.stdout);
+    assert!(
+        out.contains("hint: this is fabkit's default dome (13 holes); the dome of rtac0's paper: --pins-preset rtac0"),
+        "{out}"
+    );
+    assert!(
+        out.contains("hint: no semi-dome pattern was asked for: --semidomes N"),
+        "{out}"
+    );
+    let o = run(
+        tmp.path(),
+        &[
+            "fixtures",
+            "rtac0",
+            "--pins-preset",
+            "rtac0",
+            "--semidomes",
+            "1",
+            "--format",
+            "stl",
+            "--out",
+            "b",
+        ],
+        &[],
+    );
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(!text(&o.stdout).contains("hint:"), "{}", text(&o.stdout));
+}
