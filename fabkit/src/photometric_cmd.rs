@@ -163,7 +163,9 @@ pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
         drop(all);
         progress.stage(&format!("seating the pin dome of each of {n} captures"));
         for (k, (p, s)) in posed.iter_mut().zip(seatings).enumerate() {
-            *p = repose(&a, &setup, p, s)?;
+            // the image moves to the posed capture, not copied
+            let taken = (p.file.clone(), p.ids.clone(), std::mem::take(&mut p.image));
+            *p = pose(&a, &setup, taken, s)?;
             progress.set(k as u64 + 1, n as u64);
         }
     }
@@ -452,33 +454,25 @@ fn pose_captures(
             )
             .into());
         }
-        let unseated = Posed {
-            file: file.clone(),
-            ids,
-            image,
-            seating: DomeSeating::none(setup.pins.mean_tip_mm()),
-            hits: setup.reference.clone(),
-            shadows: ShadowMap::none(setup.rings),
-        };
-        let seating = unseated.seating;
-        posed.push(repose(a, setup, &unseated, seating)?);
+        let seating = DomeSeating::none(setup.pins.mean_tip_mm());
+        posed.push(pose(a, setup, (file.clone(), ids, image), seating)?);
         done(posed.len());
     }
     Ok(posed)
 }
 
-/// The capture `p` with its dome seated `seating`: the pins moved, its surface and shadows
-/// cast again.
-fn repose(
+/// The capture of `file` (its pins `ids`, its `image`) with its dome seated `seating`: the
+/// pins moved, its surface and shadows cast.
+fn pose(
     a: &PhotometricArgs,
     setup: &Setup,
-    p: &Posed,
+    (file, ids, image): (PathBuf, Vec<String>, Vec<[f64; 3]>),
     seating: DomeSeating,
 ) -> Result<Posed, Box<dyn Error>> {
     let rays = &setup.rays;
-    let name = p.file.display().to_string();
+    let name = file.display().to_string();
     let pins = setup.pins.moved(&seating.isometry());
-    let prims = pins.primitives(&p.ids).map_err(|id| {
+    let prims = pins.primitives(&ids).map_err(|id| {
         format!(
             "--images = {name}: pin {id} is not in {}",
             point_table(a).display()
@@ -495,9 +489,9 @@ fn repose(
     let hits = indented_hits(rays, &setup.reference, &prims, setup.base_z_mm);
     let shadows = shadow_map(rays, &hits, &prims, &setup.rings);
     Ok(Posed {
-        file: p.file.clone(),
-        ids: p.ids.clone(),
-        image: p.image.clone(),
+        file,
+        ids,
+        image,
         seating,
         hits,
         shadows,

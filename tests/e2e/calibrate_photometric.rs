@@ -272,11 +272,7 @@ fn the_photometric_model_re_renders_each_capture_from_the_others() {
     // issue 102: its progress on stderr, plain lines off a terminal, each stage in order with
     // its count and the time it took
     let err = text(&o.stderr);
-    let at = |prefix: &str| {
-        err.lines()
-            .position(|l| l.starts_with(prefix))
-            .unwrap_or_else(|| panic!("no `{prefix}` line: {err}"))
-    };
+    let at = |prefix: &str| line_starting(&err, prefix);
     let stages = [
         "calibrate photometric: reading and posing 5 captures",
         "calibrate photometric: 5/5 (",

@@ -558,3 +558,11 @@ pub fn seed_set() -> u64 {
     let set = std::env::var("FABKIT_TEST_SEED_SET").ok();
     set.and_then(|s| s.parse().ok()).unwrap_or(0)
 }
+
+/// The index of the first line of `text` that starts with `prefix` (a progress stage in a
+/// command's stderr); panics naming the prefix and the text when there is none.
+pub fn line_starting(text: &str, prefix: &str) -> usize {
+    text.lines()
+        .position(|l| l.starts_with(prefix))
+        .unwrap_or_else(|| panic!("no `{prefix}` line: {text}"))
+}

@@ -187,13 +187,7 @@ fn fixtures_show_progress_off_a_terminal() {
     );
     assert!(o.status.success(), "{}", text(&o.stderr));
     let err = text(&o.stderr);
-    let lines: Vec<&str> = err.lines().collect();
-    let at = |prefix: &str| {
-        lines
-            .iter()
-            .position(|l| l.starts_with(prefix))
-            .unwrap_or_else(|| panic!("no `{prefix}` line: {err}"))
-    };
+    let at = |prefix: &str| line_starting(&err, prefix);
     let start = at("fixtures: building the 8 parts of rtac0 (about ");
     let built = at("fixtures: 8/8");
     let writing = at("fixtures: writing 8 parts and ");
@@ -208,11 +202,7 @@ fn export_shows_its_stages_off_a_terminal() {
     let o = run(tmp.path(), &["export", "ninedtact", "--out", "kit"], &[]);
     assert!(o.status.success(), "{}", text(&o.stderr));
     let err = text(&o.stderr);
-    let at = |prefix: &str| {
-        err.lines()
-            .position(|l| l.starts_with(prefix))
-            .unwrap_or_else(|| panic!("no `{prefix}` line: {err}"))
-    };
+    let at = |prefix: &str| line_starting(&err, prefix);
     let building = at("export: building ninedtact at 0.01 mm chord tolerance");
     let writing = at("export: built ");
     assert!(building < writing, "{err}");

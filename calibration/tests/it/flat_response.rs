@@ -47,15 +47,21 @@ struct BallPress {
     lit: Vec<bool>,
 }
 
-fn ball_press() -> BallPress {
+/// The real board press (reference, capture), its grid and the camera it calibrates.
+fn board_camera() -> (GrayImage, GrayImage, BoardGrid, BoardCamera) {
     let table = crate::common::grid_table("board_table.csv", 7, 9, 2.5, 2.8);
     let grid = board_grid(&table).unwrap();
-    let (bref, bcap) = (
+    let (reference, capture) = (
         load("camera_calibration", "ref.png"),
         load("camera_calibration", "sample.png"),
     );
-    let (_, find) = find_bumps(&bref, &bcap, &grid, "sample.png").unwrap();
+    let (_, find) = find_bumps(&reference, &capture, &grid, "sample.png").unwrap();
     let bc = solve_board_camera(&grid, &find, (640, 480), 11.548).unwrap();
+    (reference, capture, grid, bc)
+}
+
+fn ball_press() -> BallPress {
+    let (_, _, _, bc) = board_camera();
     let (reference, capture) = (
         load("depth_calibration", "ref.png"),
         load("depth_calibration", "sample.png"),
@@ -238,14 +244,7 @@ struct BoardPress {
 const IMPRINT_REACH_MM: f64 = 1.25;
 
 fn board_press() -> BoardPress {
-    let table = crate::common::grid_table("board_table.csv", 7, 9, 2.5, 2.8);
-    let grid = board_grid(&table).unwrap();
-    let (reference, capture) = (
-        load("camera_calibration", "ref.png"),
-        load("camera_calibration", "sample.png"),
-    );
-    let (_, find) = find_bumps(&reference, &capture, &grid, "sample.png").unwrap();
-    let bc = solve_board_camera(&grid, &find, (640, 480), 11.548).unwrap();
+    let (reference, capture, grid, bc) = board_camera();
     let bumps: Vec<[f64; 2]> = grid
         .points
         .iter()
