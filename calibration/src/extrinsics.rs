@@ -180,7 +180,17 @@ pub fn calibrate_extrinsics(job: &ExtrinsicsJob) -> Result<ExtrinsicsOutput, Ext
         &pairs.pixels_px,
         &opts,
     )
-    .map_err(|source| pnp_error(source, &obs, &table, &obs_paths))?;
+    .map_err(|source| {
+        let mut e = pnp_error(source, &obs, &table, &obs_paths);
+        // found in images: why captures were left out or pins missed says why so few pairs
+        if let (ExtrinsicsError::Pnp { context, .. }, Some(found)) = (&mut e, &from_images) {
+            for n in &found.notes {
+                context.push_str("\n  ");
+                context.push_str(n);
+            }
+        }
+        e
+    })?;
     let mut layers = layers;
     // pins left out: the models that might explain them compared first (crate::models)
     let mut compared = if job.refine_optical_path {

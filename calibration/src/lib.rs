@@ -19,6 +19,7 @@ pub mod flat_response;
 pub mod groundtruth;
 pub mod imprints;
 pub mod models;
+pub mod nominal;
 pub mod overlay;
 pub mod p3p;
 pub mod photometric;

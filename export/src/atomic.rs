@@ -51,6 +51,8 @@ pub enum OutputCommand {
     CalibratePhotometric,
     /// `fabkit calibrate board`.
     CalibrateBoard,
+    /// `fabkit calibrate nominal`.
+    CalibrateNominal,
     /// One variant's folder of `fabkit sweep` (`variants/<id>/`).
     SweepVariant,
 }
@@ -66,6 +68,7 @@ impl OutputCommand {
             OutputCommand::CalibrateExtrinsics => "calibrate extrinsics",
             OutputCommand::CalibratePhotometric => "calibrate photometric",
             OutputCommand::CalibrateBoard => "calibrate board",
+            OutputCommand::CalibrateNominal => "calibrate nominal",
             OutputCommand::SweepVariant => "sweep",
         }
     }

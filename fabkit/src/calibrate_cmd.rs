@@ -26,6 +26,43 @@ pub enum CalibrateCommand {
     /// pose; the focal length held, as one plane seen square on shows it only over the
     /// plane's distance) and the map from pixels to the skin's plane.
     Board(BoardArgs),
+    /// Write the camera the design places, before anything is calibrated: a camera file
+    /// (camera.yaml, an ideal equidistant fisheye of the lens's view angle across the image's
+    /// short side, centred) and its pose (extrinsics.json, extrinsics.yaml, transform.yaml:
+    /// the lens's front on the sensor's axis, looking along +z, with the design's optical
+    /// path). Inputs for `fabkit groundtruth --pin-captures --images` (synthetic pin captures)
+    /// and a first ground truth; a real camera's file and `calibrate extrinsics` replace them
+    Nominal(NominalArgs),
+}
+
+#[derive(clap::Args, Debug)]
+pub struct NominalArgs {
+    /// A design YAML file or the name of a library design (default: rtac0)
+    pub design: Option<String>,
+    /// Apply one of the design's presets
+    #[arg(long)]
+    pub preset: Option<String>,
+    /// The image's width, px (2 to 16384)
+    #[arg(long, value_name = "PX", default_value_t = 640)]
+    pub width_px: u32,
+    /// The image's height, px (2 to 16384)
+    #[arg(long, value_name = "PX", default_value_t = 480)]
+    pub height_px: u32,
+    /// The lens's full view angle, degrees, in (0, 360), across the image's short side.
+    /// Default: the design's (`housing.camera.view_angle_deg`); required for a design that
+    /// gives none
+    #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
+    pub view_angle_deg: Option<f64>,
+    /// Output folder for camera.yaml, extrinsics.json, extrinsics.yaml and transform.yaml.
+    /// Replaced as a whole if it holds an earlier nominal camera of the same design as fabkit
+    /// wrote it; refused if it holds anything else
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Replace an earlier nominal camera in --out of another design or size
+    #[arg(long)]
+    pub force: bool,
+    #[command(flatten)]
+    pub(crate) data_files: crate::args::DataFileArgs,
 }
 
 #[derive(clap::Args, Debug)]
@@ -193,7 +230,65 @@ pub fn run(cmd: CalibrateCommand) -> Result<(), Box<dyn Error>> {
         CalibrateCommand::Extrinsics(a) => extrinsics(a),
         CalibrateCommand::Photometric(a) => crate::photometric_cmd::run(a),
         CalibrateCommand::Board(a) => board(a),
+        CalibrateCommand::Nominal(a) => nominal(a),
     }
+}
+
+fn nominal(a: NominalArgs) -> Result<(), Box<dyn Error>> {
+    use fabkit_calibration::nominal::{nominal_camera, nominal_files};
+    let mut loaded = crate::args::load_design(a.design.as_deref(), &a.data_files)?;
+    if let Some(p) = &a.preset {
+        loaded.apply_preset(p)?;
+    }
+    let n = nominal_camera(&loaded.design, a.width_px, a.height_px, a.view_angle_deg)?;
+    let command_line = std::env::args().collect::<Vec<_>>().join(" ");
+    let files = nominal_files(&n, &command_line)?;
+    let claim = OutputClaim {
+        command: OutputCommand::CalibrateNominal,
+        job: format!(
+            "the nominal camera of design '{}', {} x {} px, view {} deg",
+            n.design, a.width_px, a.height_px, n.view_angle_deg
+        ),
+        force: a.force,
+        inputs: Vec::new(),
+    };
+    let staged = StagedDir::new(&a.out, claim)?;
+    for (name, bytes) in &files {
+        staged.write(name, bytes)?;
+    }
+    let warnings = staged.commit()?;
+    let i = &n.intrinsics;
+    println!(
+        "camera: {} x {} px, equidistant fisheye f = {:.2} px (view {:.1} deg across {} px, from {}), principal point ({:.1}, {:.1}) px",
+        i.image_width_px,
+        i.image_height_px,
+        i.fx_px,
+        n.view_angle_deg,
+        i.image_width_px.min(i.image_height_px),
+        n.view_angle_from,
+        i.cx_px,
+        i.cy_px
+    );
+    println!(
+        "pose: the lens's front at z = {:.3} mm on the sensor's axis, looking along +z ({})",
+        n.lens.front_z_mm, n.lens.what
+    );
+    println!(
+        "optical path: {}",
+        if n.optical_path.planes.is_empty() {
+            "straight rays (no interface in front of the lens)".to_string()
+        } else {
+            plane_names(&n.optical_path).join("; ")
+        }
+    );
+    println!(
+        "nominal, not calibrated: a real camera's file and `fabkit calibrate extrinsics` replace these"
+    );
+    println!("wrote {}", a.out.display());
+    for w in &warnings {
+        eprintln!("warning: {w}");
+    }
+    Ok(())
 }
 
 fn board(a: BoardArgs) -> Result<(), Box<dyn Error>> {

@@ -1254,3 +1254,62 @@ fn the_gel_surface_is_refined_with_the_pose() {
     assert_eq!(o.status.code(), Some(2));
     assert!(text(&o.stderr).contains("--design"), "{}", text(&o.stderr));
 }
+
+/// `fabkit calibrate nominal`: R-Tac0's camera as designed, read back by `calibrate
+/// extrinsics`' reader of camera files and by `groundtruth`'s of extrinsics; the run again
+/// replaces its own folder; a design without a view angle, or a folder of the user's, is
+/// refused with nothing written.
+#[test]
+fn the_nominal_camera_is_written_as_the_other_commands_read_it() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    for _ in 0..2 {
+        let o = crate::common::run(
+            dir,
+            &["calibrate", "nominal", "rtac0", "--out", "nominal"],
+            &[],
+        );
+        assert!(o.status.success(), "{}", text(&o.stderr));
+        let out = text(&o.stdout);
+        assert!(
+            out.contains("f = 171.89 px (view 160.0 deg across 480 px"),
+            "{out}"
+        );
+        assert!(out.contains("z = -17.400 mm"), "{out}");
+    }
+    let cam = fabkit_calibration::camera_file::read_camera_file(&dir.join("nominal/camera.yaml"))
+        .unwrap();
+    assert_eq!(cam.intrinsics().image_width_px, 640);
+    let (pose, _) = fabkit_calibration::groundtruth::inputs::read_extrinsics(
+        &dir.join("nominal/extrinsics.json"),
+    )
+    .unwrap();
+    assert!((pose.translation.vector - Vector3::new(0.0, 0.0, 17.4)).norm() < 1e-9);
+    for f in ["extrinsics.yaml", "transform.yaml"] {
+        assert!(dir.join("nominal").join(f).is_file(), "{f}");
+    }
+    let o = crate::common::run(
+        dir,
+        &["calibrate", "nominal", "shadowtac", "--out", "st"],
+        &[],
+    );
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        text(&o.stderr).contains("give --view-angle-deg"),
+        "{}",
+        text(&o.stderr)
+    );
+    assert!(!dir.join("st").exists());
+    std::fs::create_dir(dir.join("mine")).unwrap();
+    std::fs::write(dir.join("mine/notes.txt"), "mine").unwrap();
+    let o = crate::common::run(
+        dir,
+        &["calibrate", "nominal", "rtac0", "--out", "mine"],
+        &[],
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o.stderr));
+    assert_eq!(
+        std::fs::read_to_string(dir.join("mine/notes.txt")).unwrap(),
+        "mine"
+    );
+}

@@ -12,6 +12,7 @@ mod groundtruth_closed_form;
 mod groundtruth_undistort;
 mod images_library;
 mod imprints;
+mod nominal;
 mod photometric;
 mod press;
 mod refine;
