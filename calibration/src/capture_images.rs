@@ -390,7 +390,7 @@ fn planned_ids(
             .map(|p| {
                 ids_from_file_name(p).ok_or_else(|| ImageError::Ids {
                     file: p.display().to_string(),
-                    rule: "the file name does not list the capture's pin ids in ring order (as 01_02_06_14_22.png for pins 1, 2, 6, 14 and 22); name the images so, or give --capture-plan".into(),
+                    rule: "the file name does not list the capture's pin ids in ring order (as 01_02_06_14_22.png for pins 1, 2, 6, 14 and 22, or image.png in a folder so named); name the images so, or give --capture-plan".into(),
                 })
             })
             .collect::<Result<_, _>>()?,
@@ -512,9 +512,13 @@ impl ImageObservations {
         let r = *t_cam_sensor.rotation.to_rotation_matrix().matrix();
         let t = t_cam_sensor.translation.vector;
         for c in &self.captures {
-            let stem = Path::new(&c.spots.name)
-                .file_stem()
-                .map_or_else(|| "capture".into(), |s| s.to_string_lossy().into_owned());
+            // `01_02_06/image.png` (a ground-truth capture's layout) by its folder's name
+            let path = Path::new(&c.spots.name);
+            let named = match path.file_stem() {
+                Some(s) if s == "image" => path.parent().and_then(Path::file_name).or(Some(s)),
+                s => s,
+            };
+            let stem = named.map_or_else(|| "capture".into(), |s| s.to_string_lossy().into_owned());
             let mut name = stem.clone();
             let mut k = 1;
             while names.contains(&name) {

@@ -1121,11 +1121,21 @@ pub use assign::{
 };
 
 /// The ids a capture's file name lists in ring order (the R-Tac0 authors' convention:
-/// `01_02_06_14_22.png` holds pins 1, 2, 6, 14 and 22): the stem's `_`-separated numbers;
-/// `None` when the stem is not such a list.
+/// `01_02_06_14_22.png` holds pins 1, 2, 6, 14 and 22): the stem's `_`-separated numbers; for
+/// a file whose stem is `image`, its folder's name (`01_02_06_14_22/image.png`, as `fabkit
+/// groundtruth --pin-captures --images` writes a capture). `None` when the name is not such a
+/// list.
 pub fn ids_from_file_name(path: &std::path::Path) -> Option<Vec<u32>> {
     let stem = path.file_stem()?.to_str()?;
-    stem.split('_')
+    if stem == "image" {
+        return ids_of(path.parent()?.file_name()?.to_str()?);
+    }
+    ids_of(stem)
+}
+
+/// The `_`-separated numbers of `name`; `None` when it is not such a list.
+fn ids_of(name: &str) -> Option<Vec<u32>> {
+    name.split('_')
         .map(|t| {
             (!t.is_empty() && t.chars().all(|c| c.is_ascii_digit()))
                 .then(|| t.parse::<u32>().ok())

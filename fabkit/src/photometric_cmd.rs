@@ -396,7 +396,7 @@ fn listed_pins(images: &[PathBuf]) -> Result<Vec<Vec<u32>>, Box<dyn Error>> {
         let ids = ids_from_file_name(file)
             .filter(|ids| !ids.is_empty())
             .ok_or_else(|| {
-                format!("--images = {name}: the file name must list the capture's pins in ring order, e.g. 01_02_06_14_22.png")
+                format!("--images = {name}: the file name must list the capture's pins in ring order, e.g. 01_02_06_14_22.png (or image.png in a folder so named)")
             })?;
         if let Some((id, times)) = fabkit_calibration::imprints::repeated_pin(&ids) {
             return Err(format!(

@@ -772,7 +772,13 @@ impl DepthRenderer {
         let img = crate::work(py, || -> Result<Vec<[u16; 3]>, String> {
             let imaging = self.physical_imaging()?;
             Ok(match protrusions {
-                None => imaging.image(rays, &self.reference_hits, None, frame),
+                None => imaging.image(
+                    rays,
+                    &self.reference_hits,
+                    &self.reference_hits,
+                    None,
+                    frame,
+                ),
                 Some(p) => {
                     let hits = indented_hits(
                         rays,
@@ -780,7 +786,13 @@ impl DepthRenderer {
                         &p.cfg.primitives,
                         self.scene.surface.base_z_mm(),
                     );
-                    imaging.image(rays, &hits, Some(&p.cfg.primitives), frame)
+                    imaging.image(
+                        rays,
+                        &self.reference_hits,
+                        &hits,
+                        Some(&p.cfg.primitives),
+                        frame,
+                    )
                 }
             })
         })?

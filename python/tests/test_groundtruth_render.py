@@ -241,7 +241,8 @@ def test_bad_optics_name_their_path(scene):
     import pathlib
     text = (pathlib.Path(__file__).parents[2] / "designs/library/rtac0.yaml").read_text()
     path = scene["dir"] / "rough.yaml"
-    path.write_text(text + "\noptics:\n  surface:\n    roughness: 0\n")
+    # R-Tac0's own optics section (its skin's darkness mapping) given a bad roughness
+    path.write_text(text.replace("\noptics:\n  surface:\n", "\noptics:\n  surface:\n    roughness: 0\n", 1))
     design = fabkit.Design.load(str(path))
     r = fabkit.DepthRenderer(design, str(scene["dir"] / "cam.yaml"), scene["T"])
     with pytest.raises(fabkit.GroundTruthError, match=r"optics\.surface\.roughness"):

@@ -60,11 +60,11 @@ fn bench(c: &mut Criterion) {
         dimples: Vec::new(),
         dimple_sources: Vec::new(),
     };
-    let rad = pool.install(|| frame_radiance(&rays, &hits, &optics, Some(&prims)));
+    let rad = pool.install(|| frame_radiance(&rays, None, &hits, &optics, Some(&prims)));
     let mut g = c.benchmark_group("images_640x480_one_thread");
     g.sample_size(20);
     g.bench_function("radiance_two_lights_shadows", |b| {
-        b.iter(|| pool.install(|| frame_radiance(&rays, &hits, &optics, Some(&prims))))
+        b.iter(|| pool.install(|| frame_radiance(&rays, None, &hits, &optics, Some(&prims))))
     });
     g.bench_function("expose_8bit", |b| {
         b.iter(|| {
@@ -85,7 +85,7 @@ fn bench(c: &mut Criterion) {
     });
     let imaging = Imaging::new(optics.clone(), [320.0, 240.0], &rays, &reference);
     g.bench_function("frame_image_two_lights_shadows_8bit", |b| {
-        b.iter(|| pool.install(|| imaging.image(&rays, &hits, Some(&prims), 1)))
+        b.iter(|| pool.install(|| imaging.image(&rays, &reference, &hits, Some(&prims), 1)))
     });
     g.bench_function("indented_hits", |b| {
         b.iter(|| indented_hits(&rays, &reference, &prims, surface.base_z_mm()))

@@ -169,13 +169,24 @@ fn every_frame_gets_its_image_the_same_bytes_with_any_thread_count() {
     assert!(bytes <= bound, "{bytes} bytes over the bound {bound}");
 }
 
+/// The library's R-Tac0 with its `optics` section replaced by `optics:` and the lines `extra`.
+fn rtac0_with_optics(extra: &str) -> String {
+    let base = std::fs::read_to_string(repo_root().join("designs/library/rtac0.yaml")).unwrap();
+    let (head, rest) = base
+        .split_once("\noptics:\n")
+        .expect("rtac0.yaml has optics");
+    let (_, tail) = rest
+        .split_once("\n\n")
+        .expect("a blank line ends the section");
+    format!("{head}\n{tail}\noptics:\n{extra}")
+}
+
 /// Another seed, 16 bits, a given gain: other noise, 16-bit PNGs, the gain as given.
 #[test]
 fn the_design_sets_seed_bit_depth_and_gain() {
     let d = tempfile::tempdir().unwrap();
     setup(d.path());
-    let base = std::fs::read_to_string(repo_root().join("designs/library/rtac0.yaml")).unwrap();
-    let design = |extra: &str| format!("{base}\noptics:\n{extra}");
+    let design = |extra: &str| rtac0_with_optics(extra);
     write_design(
         &d.path().join("a.yaml"),
         &design("  camera:\n    seed: 1\n"),
@@ -208,7 +219,6 @@ fn the_design_sets_seed_bit_depth_and_gain() {
 fn bad_optics_are_refused_by_path_and_nothing_is_written() {
     let d = tempfile::tempdir().unwrap();
     setup(d.path());
-    let base = std::fs::read_to_string(repo_root().join("designs/library/rtac0.yaml")).unwrap();
     for (i, (extra, path)) in [
         ("  surface:\n    roughness: 0\n", "optics.surface.roughness"),
         ("  camera:\n    bit_depth: 12\n", "optics.camera.bit_depth"),
@@ -218,7 +228,7 @@ fn bad_optics_are_refused_by_path_and_nothing_is_written() {
     .enumerate()
     {
         let f = format!("bad{i}.yaml");
-        std::fs::write(d.path().join(&f), format!("{base}\noptics:\n{extra}")).unwrap();
+        std::fs::write(d.path().join(&f), rtac0_with_optics(extra)).unwrap();
         let out = format!("gt{i}");
         let o = images(d.path(), &out, "2", &f);
         assert!(!o.status.success(), "{path}");

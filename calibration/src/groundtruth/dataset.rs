@@ -321,7 +321,7 @@ pub fn image_file(
     let full = ((1u32 << bits) - 1) as u16;
     let (img, text) = match src {
         ImageSource::Physical(im) => (
-            im.image(rays, hits, protrusions, frame),
+            im.image(rays, reference, hits, protrusions, frame),
             format!(
                 "fabkit rendered tactile image, frame {frame}: RGB, {bits} bit; the skin lit by the design's lights, exposure gain {}",
                 im.gain
@@ -885,6 +885,11 @@ pub fn manifest(inputs: &ManifestInputs<'_>, rendered: &Rendered) -> Value {
                 IMAGES_REFRACTION,
                 IMAGES_REFRACTION_THROUGH_PATH,
                 1
+            ));
+        }
+        if let Some(k) = im.optics.surface.darkness_per_mm {
+            manifest["images"]["darkness_mapping"] = json!(format!(
+                "optics.surface.darkness_per_mm = {k}: a pressed point returns what its unpressed point returned times 1 - {k} x its sink along that point's normal (mm), at least 0; no protrusion casts a shadow on the skin (its light is scattered within its translucent layer; DTact, Lin et al., ICRA 2023; calibration/src/groundtruth/shading.rs)"
             ));
         }
     }

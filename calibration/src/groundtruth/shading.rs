@@ -465,14 +465,20 @@ impl MarkerMap {
 /// the point to it enters a protrusion of `protrusions` or a dimple. The dimples of `optics`
 /// ([`DimpleField`]) are part of the surface seen: a ray that meets one before the skin sees
 /// the dimple (the depth maps' `hits` do not hold them). The reference skin is
-/// convex: seen from inside it casts no shadow on itself. Pixels are shaded in parallel, each
-/// on its own: the result does not depend on the thread count.
+/// convex: seen from inside it casts no shadow on itself. A darkness-mapping skin
+/// (`optics.surface.darkness_per_mm`, [`darkness`]), where it is pressed (`hits.contact`),
+/// returns what its unpressed point (`reference`, at the same pixel; none given: as any skin)
+/// returned, dimmed by how far it sank along that point's normal, and no protrusion casts a
+/// shadow on it (its light is scattered within its translucent layer). Pixels are shaded in parallel, each on its own: the result does not depend on the
+/// thread count.
 pub fn frame_radiance(
     rays: &super::rays::PixelRays,
+    reference: Option<&super::SurfaceHits>,
     hits: &super::SurfaceHits,
     optics: &fabkit_designs::optics::ResolvedOptics,
     protrusions: Option<&super::exact::ExactPrimitives>,
 ) -> Vec<[f64; 3]> {
+    let darkness_per_mm = optics.surface.darkness_per_mm;
     let lights: Vec<Prepared> = optics.lights.iter().map(Prepared::of).collect();
     let lobe = lobe_of(&optics.surface);
     let markers = MarkerMap::new(&optics.markers, protrusions);
@@ -487,6 +493,26 @@ pub fn frame_radiance(
             }
             // the normal on the camera's side: the elastomer's outward normal reversed
             let n_skin = hits.normal[i].map(|v| -v);
+            // a darkness-mapping skin pressed here: the light the unpressed point returned,
+            // dimmed by how far it sank
+            if let (Some(k), Some(r)) = (darkness_per_mm, reference) {
+                if hits.contact[i] && r.t_mm[i].is_finite() {
+                    let t0 = r.t_mm[i];
+                    let n_out = r.normal[i];
+                    let sink = (t0 - t_skin) * dot(d, n_out);
+                    let p0 = [o[0] + t0 * d[0], o[1] + t0 * d[1], o[2] + t0 * d[2]];
+                    return radiance_prepared(
+                        p0,
+                        n_out.map(|v| -v),
+                        [-d[0], -d[1], -d[2]],
+                        optics.surface.albedo_rgb,
+                        lobe,
+                        &lights,
+                        |_, _| true,
+                    )
+                    .map(|v| v * darkness(k, sink));
+                }
+            }
             // a dimple stands towards the camera: met first, it is the surface seen
             let (t, n) = match dimples.as_ref().and_then(|f| {
                 let w = f.window_mm(d, n_skin);
@@ -500,7 +526,9 @@ pub fn frame_radiance(
                 let to_light = sub(lights[k].position_mm, p);
                 let dist = dot(to_light, to_light).sqrt();
                 let start = [p[0] + 1e-6 * n[0], p[1] + 1e-6 * n[1], p[2] + 1e-6 * n[2]];
-                if let Some(prims) = protrusions {
+                // a darkness-mapping skin's light is scattered within its translucent layer:
+                // a protrusion pressing it casts no shadow
+                if let (Some(prims), None) = (protrusions, darkness_per_mm) {
                     if prims.first_crossing(start, l, dist).is_some() {
                         return false;
                     }
@@ -529,6 +557,16 @@ pub fn frame_radiance(
         .collect()
 }
 
+/// The brightness left to a darkness-mapping skin ([`frame_radiance`]) that sank `sink_mm`
+/// along its normal, losing `per_mm` of its unpressed brightness per mm: `1 - per_mm x sink`,
+/// within [0, 1] (a point raised above its unpressed place is not brightened: the law is
+/// measured on sinks). The law is linear: on 9DTact's real ball press (tests/data/9dtact_sensor1,
+/// MIT; `calibration/src/flat_response.rs`) the darkening is within a few grey levels of linear
+/// in the seen face's sink up to 1.5 mm, 0.22 of the unpressed grey per mm.
+pub fn darkness(per_mm: f64, sink_mm: f64) -> f64 {
+    (1.0 - per_mm * sink_mm.max(0.0)).clamp(0.0, 1.0)
+}
+
 /// How the frames of one ground-truth set are imaged: the optics, the principal point the
 /// vignetting is centred on, and the gain every frame is exposed with.
 #[derive(Debug, Clone)]
@@ -554,7 +592,7 @@ impl Imaging {
         let (gain, auto_exposed) = match optics.camera.gain {
             Some(g) => (g, false),
             None => (
-                auto_gain(&frame_radiance(rays, reference, &optics, None)),
+                auto_gain(&frame_radiance(rays, None, reference, &optics, None)),
                 true,
             ),
         };
@@ -566,16 +604,18 @@ impl Imaging {
         }
     }
 
-    /// The image of frame `frame` (0: the reference) whose surface is `hits`, shadowed by
-    /// `protrusions`: row-major `width x height` RGB values of `optics.camera.bit_depth` bits.
+    /// The image of frame `frame` (0: the reference) whose surface is `hits` (the unpressed
+    /// surface `reference`), shadowed by `protrusions`: row-major `width x height` RGB values
+    /// of `optics.camera.bit_depth` bits.
     pub fn image(
         &self,
         rays: &super::rays::PixelRays,
+        reference: &super::SurfaceHits,
         hits: &super::SurfaceHits,
         protrusions: Option<&super::exact::ExactPrimitives>,
         frame: u64,
     ) -> Vec<[u16; 3]> {
-        let radiance = frame_radiance(rays, hits, &self.optics, protrusions);
+        let radiance = frame_radiance(rays, Some(reference), hits, &self.optics, protrusions);
         expose(
             &radiance,
             rays.width,

@@ -15,18 +15,25 @@ pub enum ImageFault {
     /// (`saturated_share`): an overexposed or white frame.
     Saturated { saturated_share: f64 },
     /// The pressed pixels differ from the reference (at the capture's gain) by `imprint_counts`
-    /// RMS over all channels, no more than [`IMPRINT_NOISE_FACTOR`] times the skin's noise
-    /// elsewhere (`noise_counts`, robust standard deviation) or [`MIN_IMPRINT_COUNTS`]: the
-    /// camera saw no imprint at the pins (a copy of the reference, an unpressed frame).
+    /// RMS over their `values` (pixels x channels), `signal_counts` with the skin's noise
+    /// elsewhere (`noise_counts`, robust standard deviation) taken out in quadrature, which
+    /// is no more than noise alone gives ([`IMPRINT_NOISE_FACTOR`]) or [`MIN_IMPRINT_COUNTS`]:
+    /// the camera saw no imprint at the pins (a copy of the reference, an unpressed frame).
     NoImprint {
         imprint_counts: f64,
+        signal_counts: f64,
         noise_counts: f64,
+        values: usize,
     },
 }
 
-/// How far above the skin's noise a capture's pressed pixels must lie, RMS over the noise's
-/// standard deviation: at 3 an unpressed frame of Gaussian noise passes about once in a few
-/// hundred thousand pixels' worth, and a pin's imprint (tens of counts) is far above it.
+/// How far a capture's pressed pixels must stand out of the skin's noise: their mean square
+/// difference from the reference less the noise's variance `s^2`, in standard deviations of
+/// what an unpressed frame of Gaussian noise gives over `n` values (`s^2 sqrt(2 / n)`, the
+/// chi-square's with `n` degrees of freedom over `n`). At 3 an unpressed frame passes about once
+/// in 700; a darkness-mapping skin's faint imprint (0.1 of its grey under a 0.5 mm pin, over a
+/// hundred pixels) is far above it, where a per-pixel rule (its RMS over 3 noise standard
+/// deviations) refuses it.
 pub const IMPRINT_NOISE_FACTOR: f64 = 3.0;
 
 /// Least RMS difference from the reference over the pressed pixels, in 8-bit counts (scaled
@@ -48,10 +55,12 @@ impl std::fmt::Display for ImageFault {
             ),
             ImageFault::NoImprint {
                 imprint_counts,
+                signal_counts,
                 noise_counts,
+                values,
             } => write!(
                 f,
-                "no imprint at its pins: the pressed pixels differ from the reference by {imprint_counts:.2} counts RMS, within {IMPRINT_NOISE_FACTOR} times the skin's noise elsewhere ({noise_counts:.2} counts) or {MIN_IMPRINT_COUNTS} count; a capture must show its pins pressed into the skin (a copy of the reference or an unpressed frame fits nothing)"
+                "no imprint at its pins: the pressed pixels differ from the reference by {imprint_counts:.2} counts RMS ({signal_counts:.2} with the skin's noise elsewhere, {noise_counts:.2} counts, taken out), within {IMPRINT_NOISE_FACTOR} standard deviations of what that noise gives over their {values} values, or {MIN_IMPRINT_COUNTS} count; a capture must show its pins pressed into the skin (a copy of the reference or an unpressed frame fits nothing)"
             ),
         }
     }
@@ -92,9 +101,10 @@ pub fn image_fault(
 /// Whether `capture` can serve the fit against `reference_image` of the unpressed skin
 /// `reference`: lit, not overexposed ([`image_fault`]), and showing its imprints: over the
 /// pressed pixels (`capture.hits.contact`, lit and below full scale in both images) its
-/// values divided by its gain differ from the reference's by more than
-/// [`IMPRINT_NOISE_FACTOR`] times the noise of the unpressed, unshadowed skin (1.4826 times
-/// the median absolute difference there) and more than [`MIN_IMPRINT_COUNTS`].
+/// values divided by its gain differ from the reference's by more than the noise of the
+/// unpressed, unshadowed skin (1.4826 times the median absolute difference there) gives over
+/// as many values ([`IMPRINT_NOISE_FACTOR`]) and, with that noise taken out, by more than
+/// [`MIN_IMPRINT_COUNTS`] RMS.
 ///
 /// # Errors
 /// The [`ImageFault`] found; none when the capture shows its imprints.
@@ -138,10 +148,16 @@ pub fn capture_fault(
     };
     let noise_counts = median(quiet.iter().map(|x| x.abs()).collect()).unwrap_or(0.0) * 1.4826;
     let floor = MIN_IMPRINT_COUNTS * full_scale / 255.0;
-    (imprint_counts <= (IMPRINT_NOISE_FACTOR * noise_counts).max(floor)).then_some(
+    let noise_var = noise_counts * noise_counts;
+    let excess = imprint_counts * imprint_counts - noise_var;
+    let by_chance = IMPRINT_NOISE_FACTOR * noise_var * (2.0 / (pressed_n.max(1) as f64)).sqrt();
+    let signal_counts = excess.max(0.0).sqrt();
+    (pressed_n == 0 || excess <= by_chance || signal_counts <= floor).then_some(
         ImageFault::NoImprint {
             imprint_counts,
+            signal_counts,
             noise_counts,
+            values: pressed_n,
         },
     )
 }

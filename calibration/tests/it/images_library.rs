@@ -49,8 +49,8 @@ fn every_library_design_renders_a_reference_and_an_indented_image() {
         .unwrap();
         let pressed = indented_hits(&scene.rays, &reference, &tip, scene.surface.base_z_mm());
         let imaging = Imaging::new(optics, [319.5, 239.5], &scene.rays, &reference);
-        let a = imaging.image(&scene.rays, &reference, None, 0);
-        let b = imaging.image(&scene.rays, &pressed, Some(&tip), 1);
+        let a = imaging.image(&scene.rays, &reference, &reference, None, 0);
+        let b = imaging.image(&scene.rays, &reference, &pressed, Some(&tip), 1);
         // the skin is lit: most of the pixels that see it are above the read noise
         let lit = (0..a.len())
             .filter(|&i| reference.t_mm[i].is_finite() && a[i].iter().any(|&c| c > 3))
@@ -66,8 +66,14 @@ fn every_library_design_renders_a_reference_and_an_indented_image() {
         // the imprint shows where the tip pushes the skin in, in the radiance before the
         // camera's noise: changed by more than 2 % on most contact pixels, unchanged on most
         // pixels away from it (bar the tip's shadow)
-        let ra = frame_radiance(&scene.rays, &reference, &imaging.optics, None);
-        let rb = frame_radiance(&scene.rays, &pressed, &imaging.optics, Some(&tip));
+        let ra = frame_radiance(&scene.rays, None, &reference, &imaging.optics, None);
+        let rb = frame_radiance(
+            &scene.rays,
+            Some(&reference),
+            &pressed,
+            &imaging.optics,
+            Some(&tip),
+        );
         let changed = |i: usize| (ra[i][1] - rb[i][1]).abs() > 0.02 * ra[i][1].abs();
         let (mut contact, mut on, mut away, mut off) = (0, 0, 0, 0);
         for i in 0..a.len() {

@@ -260,7 +260,8 @@ fn r_extra_centre(
     render(cam, &pose(), surface, &[pin], &Shading::default(), 0).centres_px[0].unwrap()
 }
 
-/// The authors' file names list a capture's ids in ring order.
+/// The authors' file names list a capture's ids in ring order (or the folder of an
+/// `image.png`, as `fabkit groundtruth --pin-captures --images` writes them).
 #[test]
 fn ids_are_read_from_the_authors_file_names() {
     use fabkit_calibration::imprints::ids_from_file_name;
@@ -271,6 +272,14 @@ fn ids_are_read_from_the_authors_file_names() {
     );
     assert_eq!(ids_from_file_name(Path::new("7.jpg")), Some(vec![7]));
     for bad in ["capture_1.png", "01__02.png", "x.png", "01-02.png"] {
+        assert_eq!(ids_from_file_name(Path::new(bad)), None, "{bad}");
+    }
+    // a ground-truth capture's layout: image.png in a folder named by its pins
+    assert_eq!(
+        ids_from_file_name(Path::new("gt/01_02_06/image.png")),
+        Some(vec![1, 2, 6])
+    );
+    for bad in ["gt/reference/image.png", "image.png", "01_02/photo.png"] {
         assert_eq!(ids_from_file_name(Path::new(bad)), None, "{bad}");
     }
 }

@@ -121,12 +121,18 @@ fn captures(lights: Vec<Light>, pressed: fn(f64) -> (Vec<Pin>, Vec<Primitive>)) 
             albedo_rgb: [0.6, 0.6, 0.6],
             specular: 0.04,
             roughness: 0.5,
+            darkness_per_mm: None,
         },
         ..crate::shading::optics_with(lights)
     };
     let imaging = Imaging::new(optics, [319.5, 239.5], &rays, &reference);
-    let reference_image =
-        counts(imaging.image(&rays, &reference, None, 1000 * crate::common::seed_set()));
+    let reference_image = counts(imaging.image(
+        &rays,
+        &reference,
+        &reference,
+        None,
+        1000 * crate::common::seed_set(),
+    ));
     let turns = [0.0, 40.0, 80.0, 120.0, 160.0];
     let rings = ShadowRings::of(&rays, &reference);
     let scenes = turns
@@ -137,7 +143,7 @@ fn captures(lights: Vec<Light>, pressed: fn(f64) -> (Vec<Pin>, Vec<Primitive>)) 
             let prims = ExactPrimitives::new(&solids).unwrap();
             let hits = indented_hits(&rays, &reference, &prims, surface.base_z_mm());
             let seed = 1000 * crate::common::seed_set() + k as u64 + 1;
-            let image = counts(imaging.image(&rays, &hits, Some(&prims), seed));
+            let image = counts(imaging.image(&rays, &reference, &hits, Some(&prims), seed));
             let shadows = shadow_map(&rays, &hits, &prims, &rings);
             (pins, hits, image, shadows)
         })

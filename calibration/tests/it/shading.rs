@@ -47,6 +47,7 @@ fn a_flat_floor_receives_the_analytic_flux_of_a_point_light() {
         albedo_rgb: [0.8, 0.8, 0.8],
         specular: 0.0,
         roughness: 1.0,
+        darkness_per_mm: None,
     };
     let p = [3.0, 4.0, 0.0];
     let e = irradiance(&light, p, [0.0, 0.0, 1.0]);
@@ -234,6 +235,7 @@ pub(crate) fn optics_with(lights: Vec<Light>) -> ResolvedOptics {
             albedo_rgb: [0.7, 0.7, 0.7],
             specular: 0.0,
             roughness: 1.0,
+            darkness_per_mm: None,
         },
         marker_albedo_rgb: [0.9; 3],
         camera: CameraResponse::default(),
@@ -276,7 +278,7 @@ fn a_sphere_tip_imprint_under_a_distant_light_has_the_analytic_shading() {
         colour_rgb: [1.0, 1.0, 1.0],
         intensity: far * far,
     };
-    let rad = frame_radiance(&rays, &hits, &optics_with(vec![light]), Some(&prims));
+    let rad = frame_radiance(&rays, None, &hits, &optics_with(vec![light]), Some(&prims));
     let mut checked = 0;
     for i in 0..rays.dirs.len() {
         if !hits.contact[i] {
@@ -317,11 +319,12 @@ fn the_tip_shadows_the_skin_where_its_sphere_blocks_the_light() {
     };
     let rad = frame_radiance(
         &rays,
+        None,
         &hits,
         &optics_with(vec![light.clone()]),
         Some(&prims),
     );
-    let unshadowed = frame_radiance(&rays, &hits, &optics_with(vec![light.clone()]), None);
+    let unshadowed = frame_radiance(&rays, None, &hits, &optics_with(vec![light.clone()]), None);
     let (mut shadowed, mut graze) = (0, 0);
     for i in 0..rays.dirs.len() {
         if !hits.t_mm[i].is_finite() || hits.contact[i] || !(unshadowed[i][0] > 0.0) {
@@ -413,8 +416,8 @@ fn markers_move_along_their_normals_and_carry_their_albedo() {
         markers: spots.clone(),
         ..plain.clone()
     };
-    let a = frame_radiance(&rays, &hits, &plain, Some(&prims));
-    let b = frame_radiance(&rays, &hits, &marked, Some(&prims));
+    let a = frame_radiance(&rays, None, &hits, &plain, Some(&prims));
+    let b = frame_radiance(&rays, None, &hits, &marked, Some(&prims));
     let (mut on_marker, mut on_pushed) = (0, 0);
     for i in 0..rays.dirs.len() {
         let t = hits.t_mm[i];
@@ -495,7 +498,7 @@ fn a_dimple_under_a_grazing_light_casts_a_shadow_of_the_analytic_length() {
         }],
         ..optics_with(vec![light])
     };
-    let rad = frame_radiance(&rays, &hits, &optics, None);
+    let rad = frame_radiance(&rays, None, &hits, &optics, None);
     let a = height - r;
     let tip = xb - (r + a * alpha.cos()) / alpha.sin();
     let row = (h / 2) as usize * w as usize;

@@ -43,7 +43,8 @@ impl Default for OpticsParams {
     }
 }
 
-/// The skin's inner surface: Lambertian albedo plus a specular lobe.
+/// The skin's inner surface: Lambertian albedo plus a specular lobe; for a darkness-mapping
+/// skin, the brightness its thinning takes away.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields, default)]
 pub struct Reflectance {
@@ -57,6 +58,17 @@ pub struct Reflectance {
     /// hemisphere. Default 0.5 (a matte paint).
     #[schemars(extend("exclusiveMinimum" = 0, "maximum" = 1))]
     pub roughness: f64,
+    /// A darkness-mapping skin (DTact, Lin et al., ICRA 2023; R-Tac0 Sec. II: "darkness
+    /// mapping through optical reflection of the semitransparent elastomer"): the light the
+    /// camera sees is scattered back from within a translucent layer, so a pressed point's
+    /// brightness follows how far the surface sank there, not its slope: the fraction of
+    /// the unpressed brightness lost per mm of sink along the skin's normal, in (0, 10]
+    /// (brightness `1 - darkness_per_mm x sink`, at least 0). When given, a pressed point is
+    /// shaded with the unpressed skin's normal at its pixel. Not given: the skin is an opaque
+    /// surface whose slope shades it (a GelSight-like coat).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schemars(extend("exclusiveMinimum" = 0, "maximum" = 10))]
+    pub darkness_per_mm: Option<f64>,
 }
 
 impl Default for Reflectance {
@@ -65,6 +77,7 @@ impl Default for Reflectance {
             albedo_rgb: [0.6, 0.6, 0.6],
             specular: 0.04,
             roughness: 0.5,
+            darkness_per_mm: None,
         }
     }
 }
@@ -152,6 +165,15 @@ pub fn check(o: &OpticsParams, errs: &mut Vec<ParamError>) {
             r,
             "must be above 0 and at most 1",
         ));
+    }
+    if let Some(k) = o.surface.darkness_per_mm {
+        if !(k > 0.0 && k <= 10.0) {
+            errs.push(ParamError::new(
+                "optics.surface.darkness_per_mm",
+                k,
+                "must be above 0 and at most 10 (the fraction of the brightness lost per mm of sink)",
+            ));
+        }
     }
     check_rgb("optics.marker_albedo_rgb", o.marker_albedo_rgb, false, errs);
     let c = &o.camera;

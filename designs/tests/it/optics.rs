@@ -167,6 +167,12 @@ fn each_optics_rule_names_its_path() {
         ("optics.surface.roughness", |d| {
             optics(d).surface.roughness = 0.0
         }),
+        ("optics.surface.darkness_per_mm", |d| {
+            optics(d).surface.darkness_per_mm = Some(0.0)
+        }),
+        ("optics.surface.darkness_per_mm", |d| {
+            optics(d).surface.darkness_per_mm = Some(f64::NAN)
+        }),
         ("optics.marker_albedo_rgb[0]", |d| {
             optics(d).marker_albedo_rgb = [2.0, 0.9, 0.9]
         }),
@@ -189,11 +195,13 @@ fn each_optics_rule_names_its_path() {
 #[test]
 fn the_section_reads_from_yaml_with_signed_positions() {
     let text = library::yaml("rtac0").unwrap();
+    // the lights joined to R-Tac0's own optics section (its skin's darkness mapping)
     let with = |extra: &str| {
-        format!("{text}\noptics:\n  lights:\n    - position_mm: [0, 0, -20]\n      direction: [0, 0, 1]\n      cone_half_angle_deg: 60\n      colour_rgb: [1, 1, 1]\n      intensity: 50\n{extra}")
+        text.replacen("\noptics:\n", &format!("\noptics:\n  lights:\n    - position_mm: [0, 0, -20]\n      direction: [0, 0, 1]\n      cone_half_angle_deg: 60\n      colour_rgb: [1, 1, 1]\n      intensity: 50\n{extra}"), 1)
     };
     let d = Design::from_yaml(&with(""), "rtac0.yaml").unwrap();
     assert_eq!(resolved(&d).lights[0].position_mm, [0.0, 0.0, -20.0]);
+    assert_eq!(resolved(&d).surface.darkness_per_mm, Some(0.22));
     let e = Design::from_yaml(&with("      colour: red\n"), "rtac0.yaml").unwrap_err();
     assert!(e.to_string().contains("colour"), "{e}");
 }
