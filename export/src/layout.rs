@@ -95,6 +95,8 @@ pub(crate) fn pack_units(
 pub(crate) struct PlateItem {
     /// Index into the units.
     pub unit: usize,
+    /// Which copy of the unit (0, 1, ...; a unit of `n` copies is placed `n` times).
+    pub copy: usize,
     /// Turned 90 deg about z (counter-clockwise seen from above) before the translation.
     pub turned: bool,
     /// Build-item translation, mm (after the turn).
@@ -123,7 +125,7 @@ const PACK_UNITS_PER_MM: f64 = 100.0;
 /// 90 deg is turned.
 ///
 /// `parts`: (technology, material, box) per part; `units` as from [`units`] (the first
-/// member's technology counts).
+/// member's technology counts), `copies[u]` of unit `u` placed (each its own footprint).
 ///
 /// # Errors
 /// [`ExportError::TooLargeForBed`] naming the unit's first part, its size and the bed.
@@ -131,6 +133,7 @@ pub(crate) fn plates(
     parts: &[(PrintTechnology, &str, Aabb)],
     names: &[&str],
     units: &[Vec<usize>],
+    copies: &[usize],
     printers: &PrinterProfiles,
     gap_mm: f64,
 ) -> Result<Vec<Plate>, ExportError> {
@@ -160,7 +163,7 @@ pub(crate) fn plates(
         let bed = printers.bed(Technology::from(tech));
         let [ux, uy] = bed.usable_xy_mm();
         // each unit's box, turned when it fits only so
-        let mut boxes: Vec<(usize, bool, Aabb)> = Vec::with_capacity(members.len());
+        let mut boxes: Vec<(usize, usize, bool, Aabb)> = Vec::with_capacity(members.len());
         for &u in &members {
             let b = units[u][1..]
                 .iter()
@@ -189,10 +192,12 @@ pub(crate) fn plates(
             } else {
                 b
             };
-            boxes.push((u, turned, b));
+            for copy in 0..copies.get(u).copied().unwrap_or(1).max(1) {
+                boxes.push((u, copy, turned, b));
+            }
         }
         let mut rects: GroupedRectsToPlace<usize, ()> = GroupedRectsToPlace::new();
-        for (k, (_, _, b)) in boxes.iter().enumerate() {
+        for (k, (_, _, _, b)) in boxes.iter().enumerate() {
             let [w, d, _] = b.size();
             rects.push_rect(
                 k,
@@ -209,12 +214,13 @@ pub(crate) fn plates(
         let packed = pack_rects(&rects, &mut bins, &volume_heuristic, &contains_smallest_box)
             .expect("every unit fits a bed of its own (checked above)");
         let mut by_bin: BTreeMap<usize, Vec<PlateItem>> = BTreeMap::new();
-        for (k, (u, turned, b)) in boxes.iter().enumerate() {
+        for (k, (u, copy, turned, b)) in boxes.iter().enumerate() {
             let (bin, loc) = &packed.packed_locations()[&k];
             let x = bed.margin_mm + loc.x() as f64 / PACK_UNITS_PER_MM;
             let y = bed.margin_mm + loc.y() as f64 / PACK_UNITS_PER_MM;
             by_bin.entry(*bin).or_default().push(PlateItem {
                 unit: *u,
+                copy: *copy,
                 turned: *turned,
                 translation_mm: [x - b.min[0], y - b.min[1], -b.min[2]].map(|c| {
                     if c == 0.0 {
@@ -226,7 +232,7 @@ pub(crate) fn plates(
             });
         }
         for (number, (_, mut items)) in by_bin.into_iter().enumerate() {
-            items.sort_by_key(|i| i.unit);
+            items.sort_by_key(|i| (i.unit, i.copy));
             plates.push(Plate {
                 technology: tech,
                 material: material.clone(),
@@ -254,9 +260,9 @@ mod tests {
         Aabb { min, max }
     }
 
-    /// Plates: one technology and material each, every unit once, footprints inside the bed
-    /// less its margin and a gap apart, a unit too long for the bed turned, one too large for
-    /// either way round an error naming it.
+    /// Plates: one technology and material each, every unit as many times as its copies,
+    /// footprints inside the bed less its margin and a gap apart, a unit too long for the bed
+    /// turned, one too large for either way round an error naming it.
     #[test]
     fn plates_split_by_technology_and_material_and_fit_their_beds() {
         use fabkit_designs::schema::PrinterProfiles;
@@ -278,7 +284,13 @@ mod tests {
         let names: Vec<String> = (0..parts.len()).map(|k| format!("p{k}")).collect();
         let names: Vec<&str> = names.iter().map(String::as_str).collect();
         let units: Vec<Vec<usize>> = (0..parts.len()).map(|k| vec![k]).collect();
-        let laid = plates(&parts, &names, &units, &printers, GAP_MM).unwrap();
+        // 29 of the 20 mm resin part (a pin dome's pins): 25 x 25 with the gap, 5 x 5 per
+        // 135 x 135 plate, so two resin plates
+        let copies: Vec<usize> = (0..parts.len())
+            .map(|k| if k == 12 { 29 } else { 1 })
+            .collect();
+        let laid = plates(&parts, &names, &units, &copies, &printers, GAP_MM).unwrap();
+        let mut copies_seen: Vec<usize> = Vec::new();
         let mut seen = vec![0; parts.len()];
         for p in &laid {
             let [ux, uy] = p.bed.usable_xy_mm();
@@ -286,6 +298,9 @@ mod tests {
             let mut placed: Vec<Aabb> = Vec::new();
             for it in &p.items {
                 seen[it.unit] += 1;
+                if it.unit == 12 {
+                    copies_seen.push(it.copy);
+                }
                 let (tech, mat, bx) = parts[it.unit];
                 assert_eq!((tech, mat), (p.technology, p.material.as_str()));
                 let bx = if it.turned {
@@ -317,7 +332,17 @@ mod tests {
                 placed.push(q);
             }
         }
-        assert!(seen.iter().all(|&n| n == 1), "{seen:?}");
+        assert!(
+            seen.iter().enumerate().all(|(k, &n)| n == copies[k]),
+            "{seen:?}"
+        );
+        copies_seen.sort_unstable();
+        assert_eq!(copies_seen, (0..29).collect::<Vec<_>>());
+        let resin: Vec<&Plate> = laid.iter().filter(|p| p.material == "resin").collect();
+        assert_eq!(
+            resin.iter().map(|p| p.items.len()).collect::<Vec<_>>(),
+            [25, 4]
+        );
         // 12 boxes of 60 x 50 (65 x 55 with the gap) and the long one: 3 x 3 per 230 x 190
         // plate, so two PLA plates
         let pla: Vec<&Plate> = laid.iter().filter(|p| p.material == "pla").collect();
@@ -329,14 +354,14 @@ mod tests {
             .find(|it| it.unit == 14)
             .unwrap();
         assert!(long.turned);
-        assert_eq!(laid.len(), 4);
+        assert_eq!(laid.len(), 5);
 
         // too large either way round
         parts.push((sla, "resin", b([0.0, 0.0, 0.0], [150.0, 20.0, 5.0])));
         let names: Vec<String> = (0..parts.len()).map(|k| format!("p{k}")).collect();
         let names: Vec<&str> = names.iter().map(String::as_str).collect();
         let units: Vec<Vec<usize>> = (0..parts.len()).map(|k| vec![k]).collect();
-        let e = plates(&parts, &names, &units, &printers, GAP_MM).unwrap_err();
+        let e = plates(&parts, &names, &units, &[], &printers, GAP_MM).unwrap_err();
         assert!(
             e.to_string().starts_with(
                 "part `p15` (SLA, 150.0 x 20.0 x 5.0 mm) does not fit the formlabs_form2 bed"

@@ -62,7 +62,16 @@ pub(crate) fn render(
             .map(|(p, m)| (p.print_technology, p.material.as_str(), m.bbox_mm))
             .collect();
         let names: Vec<&str> = kit.parts.iter().map(|p| p.name.as_str()).collect();
-        layout::plates(&keyed, &names, &units, &opts.printers, layout::GAP_MM)?
+        // a unit as many times as its first part's copies (the fixtures' pins: one per hole)
+        let copies: Vec<usize> = units.iter().map(|u| kit.parts[u[0]].copies()).collect();
+        layout::plates(
+            &keyed,
+            &names,
+            &units,
+            &copies,
+            &opts.printers,
+            layout::GAP_MM,
+        )?
     } else {
         Vec::new()
     };

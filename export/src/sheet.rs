@@ -136,11 +136,7 @@ One 3MF per printer plate, parts of one technology and material inside the print
                 p.bed_mm[1],
                 p.bed_mm[2],
                 p.margin_mm,
-                p.objects
-                    .iter()
-                    .map(|o| code(&o.name))
-                    .collect::<Vec<_>>()
-                    .join(", ")
+                plate_parts(&p.objects)
             );
         }
         s.push('\n');
@@ -860,4 +856,27 @@ mod tests {
             "fabkit 'a b'"
         );
     }
+}
+
+/// A plate's objects in words: each name once, in order, with its count when the plate holds
+/// several (`` `pin` × 29 ``).
+fn plate_parts(objects: &[crate::manifest::ManifestPlateObject]) -> String {
+    let mut names: Vec<(&str, usize)> = Vec::new();
+    for o in objects {
+        match names.iter_mut().find(|(n, _)| *n == o.name) {
+            Some((_, k)) => *k += 1,
+            None => names.push((&o.name, 1)),
+        }
+    }
+    names
+        .iter()
+        .map(|(n, k)| {
+            if *k > 1 {
+                format!("{} × {k}", code(n))
+            } else {
+                code(n)
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
 }

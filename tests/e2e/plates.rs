@@ -1,6 +1,7 @@
 //! Print plates (`plates/<design>_<technology>_<material>_<n>.3mf`): the guide's examples
-//! give plates that fit their printers (every part on exactly one plate, inside the bed less its
-//! margin, no plate mixing technologies or materials); PrusaSlicer slices the plates of
+//! give plates that fit their printers (every part placed as many times as the kit needs it,
+//! the pin dome's pins one per hole, inside the bed less its margin, no plate mixing
+//! technologies or materials); PrusaSlicer slices the plates of
 //! `fabkit export rtac0` and `fabkit fixtures rtac0 --semidomes 100` with `--dont-arrange` for
 //! their printers, the FDM G-code staying on the bed and the SLA slices holding every part's
 //! volume; lib3mf's strict reader accepts every 3MF, each object carrying its role, material
@@ -19,10 +20,14 @@ fn manifest(dir: &Path) -> serde_json::Value {
     serde_json::from_slice(&std::fs::read(dir.join("manifest.json")).unwrap()).unwrap()
 }
 
-/// Every part on exactly one plate, one technology and material per plate, each footprint
-/// inside the bed less its margin; returns the plates' files.
+/// Every part placed as many times as the kit needs it (once; a fixtures kit's pins once per
+/// hole of its point table), one technology and material per plate, each footprint inside the
+/// bed less its margin; returns the plates' files.
 fn check_plates(dir: &Path) -> Vec<PathBuf> {
     let m = manifest(dir);
+    let holes = std::fs::read_to_string(dir.join("points/point_table.csv"))
+        .map(|t| t.lines().count() - 1)
+        .ok();
     let parts: BTreeMap<&str, (&str, &str)> = m["parts"]
         .as_array()
         .unwrap()
@@ -85,9 +90,13 @@ fn check_plates(dir: &Path) -> Vec<PathBuf> {
         files.push(dir.join(file));
     }
     for name in parts.keys() {
+        let needed = match (*name, holes) {
+            ("pin", Some(n)) => n,
+            _ => 1,
+        };
         assert_eq!(
             placed.get(name).copied().unwrap_or(0),
-            1,
+            needed,
             "{}: part {name}",
             dir.display()
         );

@@ -73,6 +73,15 @@ pub struct SkinVolume {
 }
 
 impl Part {
+    /// How many of the part one kit needs, each placed on the print plates: its parameters'
+    /// `quantity` (the fixtures' calibration pins: one per hole, plus spares), else 1.
+    pub fn copies(&self) -> usize {
+        self.params
+            .get("quantity")
+            .and_then(serde_json::Value::as_u64)
+            .map_or(1, |q| q.max(1) as usize)
+    }
+
     /// The mesh that is written and measured: the solid's mesh with every coordinate rounded to
     /// `f32` ([`crate::Mesh::rounded_to_f32`]). The export's files and manifest numbers
     /// (volume, triangles, genus) and the sweep metrics are all computed from this form, so
