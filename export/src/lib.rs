@@ -610,10 +610,11 @@ fn stl_file(
 
 /// The objects of a 3MF as the preview draws them: their volumes' meshes under their build
 /// items' turn and translation.
-fn placed_objects<'a>(objects: &[three_mf::Object<'a>]) -> Vec<preview::PlacedObject<'a>> {
+fn placed_objects<'a>(objects: &'a [three_mf::Object<'a>]) -> Vec<preview::PlacedObject<'a>> {
     objects
         .iter()
         .map(|o| preview::PlacedObject {
+            name: &o.name,
             meshes: o.volumes.iter().map(|v| v.mesh).collect(),
             turned: o.turned,
             translation_mm: o.translation_mm,

@@ -104,9 +104,10 @@ impl Image {
 
 /// An object placed on a plate as by its 3MF build item: its meshes (the volumes, in part
 /// coordinates), turned 90 deg about z (counter-clockwise from above) when `turned`, then
-/// translated by `translation_mm`.
+/// translated by `translation_mm`; `name` labels it in the plate picture's legend.
 #[derive(Debug, Clone)]
 pub struct PlacedObject<'a> {
+    pub name: &'a str,
     pub meshes: Vec<&'a Mesh>,
     pub turned: bool,
     pub translation_mm: [f64; 3],
@@ -410,7 +411,8 @@ pub fn part_pngs(parts: &[(&str, &Mesh)]) -> Result<Vec<Vec<u8>>, ExportError> {
 
 /// A plate picture ([`PLATE_WIDTH_PX`] x [`PLATE_HEIGHT_PX`] px): `objects` as placed by their
 /// build items, each in its own colour, seen from [`PLATE_VIEW`], on the bed when `bed` is
-/// given (its plate, edge and margin line).
+/// given (its plate, edge and margin line, and a legend in the top-left corner naming the
+/// objects and the bed's size, [`legend_lines`]).
 pub fn render_plate(objects: &[PlacedObject<'_>], bed: Option<BedOutline>) -> Image {
     draw_plate(objects, bed).0.image
 }
@@ -452,15 +454,122 @@ fn draw_plate(objects: &[PlacedObject<'_>], bed: Option<BedOutline>) -> (Canvas,
             canvas.line(&cam, c[k], c[(k + 1) % 4], BED_EDGE);
         }
     }
+    let colours = object_colours(objects);
     for (k, o) in objects.iter().enumerate() {
         let id = u16::try_from(k + 2).unwrap_or(u16::MAX);
-        let colour = PLATE_COLOURS[k % PLATE_COLOURS.len()];
+        let colour = colours[k];
         for m in &o.meshes {
             canvas.mesh(&cam, m, |p| o.place(p), colour, id);
         }
     }
     canvas.silhouettes();
+    // a plate's picture names its parts and its bed (the kit's picture, on no bed, does not)
+    if bed.is_some() {
+        legend(&mut canvas, objects, bed);
+    }
     (canvas, cam)
+}
+
+/// Each object's colour: that of its name, in the order names first appear (the copies of a
+/// part alike, one part's colour per row of the legend).
+fn object_colours(objects: &[PlacedObject<'_>]) -> Vec<[u8; 3]> {
+    let mut names: Vec<&str> = Vec::new();
+    objects
+        .iter()
+        .map(|o| {
+            let k = names.iter().position(|n| *n == o.name).unwrap_or_else(|| {
+                names.push(o.name);
+                names.len() - 1
+            });
+            PLATE_COLOURS[k % PLATE_COLOURS.len()]
+        })
+        .collect()
+}
+
+/// The colour of the legend's text.
+const LABEL: [u8; 3] = [40, 44, 52];
+/// Font pixels per legend glyph pixel ([`fabkit_designs::glyphs`]: 3 x 5).
+const LABEL_SCALE: i64 = 2;
+/// The legend's first row's top-left corner and its rows' pitch, px.
+const LEGEND_AT_PX: i64 = 6;
+const LEGEND_ROW_PX: i64 = 7 * LABEL_SCALE;
+
+/// The lines of a plate picture's legend: one per object name, in order of first appearance,
+/// with its objects' colour ([`object_colours`]) and the name in capitals with its count when the plate
+/// holds several (`PIN x29`); then the bed's size (`BED 250 x 210 mm`, no colour).
+fn legend_lines(
+    objects: &[PlacedObject<'_>],
+    bed: Option<BedOutline>,
+) -> Vec<(Option<[u8; 3]>, String)> {
+    let mut rows: Vec<(&str, usize, [u8; 3])> = Vec::new();
+    for (o, colour) in objects.iter().zip(object_colours(objects)) {
+        match rows.iter_mut().find(|r| r.0 == o.name) {
+            Some(r) => r.1 += 1,
+            None => rows.push((o.name, 1, colour)),
+        }
+    }
+    let mut lines: Vec<(Option<[u8; 3]>, String)> = rows
+        .into_iter()
+        .map(|(name, n, colour)| {
+            let name = name.to_uppercase();
+            (
+                Some(colour),
+                if n > 1 { format!("{name} x{n}") } else { name },
+            )
+        })
+        .collect();
+    if let Some(b) = bed {
+        lines.push((
+            None,
+            format!("BED {} x {} mm", b.size_xy_mm[0], b.size_xy_mm[1]),
+        ));
+    }
+    lines
+}
+
+/// Draws the legend ([`legend_lines`]) over the picture's top-left corner, each line on a box
+/// of the background's colour: a swatch of the object's colour, then its text.
+fn legend(canvas: &mut Canvas, objects: &[PlacedObject<'_>], bed: Option<BedOutline>) {
+    let (w, h) = (canvas.image.width_px as i64, canvas.image.height_px as i64);
+    let fill = |canvas: &mut Canvas, x0: i64, y0: i64, x1: i64, y1: i64, c: [u8; 3]| {
+        for y in y0.max(0)..y1.min(h) {
+            for x in x0.max(0)..x1.min(w) {
+                canvas.set((y * w + x) as usize, c);
+            }
+        }
+    };
+    let glyph_px = 5 * LABEL_SCALE;
+    for (r, (swatch, text)) in legend_lines(objects, bed).iter().enumerate() {
+        let y = LEGEND_AT_PX + r as i64 * LEGEND_ROW_PX;
+        if y + glyph_px > h {
+            break;
+        }
+        let text_x = LEGEND_AT_PX + glyph_px + 2 * LABEL_SCALE;
+        let text_w = 4 * LABEL_SCALE * text.chars().count() as i64;
+        fill(
+            canvas,
+            LEGEND_AT_PX - 2,
+            y - 2,
+            text_x + text_w + 2,
+            y + glyph_px + 2,
+            BACKGROUND,
+        );
+        if let Some(c) = swatch {
+            fill(
+                canvas,
+                LEGEND_AT_PX,
+                y,
+                LEGEND_AT_PX + glyph_px,
+                y + glyph_px,
+                *c,
+            );
+        }
+        fabkit_designs::glyphs::draw_text(text_x, y, text, LABEL_SCALE, |x, y| {
+            if (0..w).contains(&x) && (0..h).contains(&y) {
+                canvas.set((y * w + x) as usize, LABEL);
+            }
+        });
+    }
 }
 
 /// Twice the signed area of the picture-plane triangle (a, b, c) (x and y only).
@@ -552,11 +661,13 @@ mod tests {
         let (a, b) = (cube([0.0; 3], 10.0), cube([0.0; 3], 6.0));
         let objects = [
             PlacedObject {
+                name: "a",
                 meshes: vec![&a],
                 turned: false,
                 translation_mm: [10.0, 10.0, 0.0],
             },
             PlacedObject {
+                name: "b",
                 meshes: vec![&b],
                 turned: true,
                 translation_mm: [80.0, 60.0, 0.0],
@@ -601,5 +712,64 @@ mod tests {
         // without a bed: the objects only
         let bare = render_plate(&objects, None);
         assert!(!bare.rgb.chunks_exact(3).any(|c| c == BED_FILL));
+    }
+
+    /// The plate picture's legend: a row per part name (copies counted, one colour each), then
+    /// the bed's size; each row's swatch in its objects' colour and its text drawn.
+    #[test]
+    fn plate_picture_names_its_parts_and_bed() {
+        let (a, b) = (cube([0.0; 3], 10.0), cube([0.0; 3], 6.0));
+        let at = |name, m, x| PlacedObject {
+            name,
+            meshes: vec![m],
+            turned: false,
+            translation_mm: [x, 40.0, 0.0],
+        };
+        let objects = [
+            at("pin", &a, 20.0),
+            at("dome", &b, 40.0),
+            at("pin", &a, 60.0),
+        ];
+        let bed = BedOutline {
+            size_xy_mm: [145.0, 140.5],
+            margin_mm: 5.0,
+        };
+        let lines = legend_lines(&objects, Some(bed));
+        assert_eq!(
+            lines,
+            vec![
+                (Some(PLATE_COLOURS[0]), "PIN x2".to_string()),
+                (Some(PLATE_COLOURS[1]), "DOME".to_string()),
+                (None, "BED 145 x 140.5 mm".to_string()),
+            ]
+        );
+        let (canvas, _) = draw_plate(&objects, Some(bed));
+        let w = canvas.image.width_px;
+        let px = |x: i64, y: i64| {
+            let i = 3 * (y as usize * w + x as usize);
+            [
+                canvas.image.rgb[i],
+                canvas.image.rgb[i + 1],
+                canvas.image.rgb[i + 2],
+            ]
+        };
+        for (r, (swatch, text)) in lines.iter().enumerate() {
+            let y = LEGEND_AT_PX + r as i64 * LEGEND_ROW_PX;
+            if let Some(c) = swatch {
+                assert_eq!(px(LEGEND_AT_PX + 2, y + 2), *c, "row {r}");
+            }
+            let x0 = LEGEND_AT_PX + 7 * LABEL_SCALE;
+            let x1 = x0 + 4 * LABEL_SCALE * text.chars().count() as i64;
+            let inked = (x0..x1)
+                .flat_map(|x| (y..y + 5 * LABEL_SCALE).map(move |y| (x, y)))
+                .filter(|&(x, y)| px(x, y) == LABEL)
+                .count();
+            assert!(inked > 8 * text.len(), "row {r}: {inked} px of text");
+        }
+        // both pins drawn in the pins' colour
+        assert_eq!(
+            object_colours(&objects),
+            [PLATE_COLOURS[0], PLATE_COLOURS[1], PLATE_COLOURS[0]]
+        );
     }
 }

@@ -359,10 +359,23 @@ fn plate_files<'m>(
     plates
         .par_iter()
         .map(|plate| {
+            let names: Vec<String> = plate
+                .items
+                .iter()
+                .map(|it| {
+                    units[it.unit]
+                        .iter()
+                        .map(|&i| kit.parts[i].name.as_str())
+                        .collect::<Vec<_>>()
+                        .join("+")
+                })
+                .collect();
             let objects: Vec<preview::PlacedObject<'_>> = plate
                 .items
                 .iter()
-                .map(|it| preview::PlacedObject {
+                .zip(&names)
+                .map(|(it, name)| preview::PlacedObject {
+                    name,
                     meshes: units[it.unit].iter().map(|&i| &meshes[i]).collect(),
                     turned: it.turned,
                     translation_mm: it.translation_mm,

@@ -121,6 +121,7 @@ fn bench_pictures(c: &mut Criterion) {
                     .iter()
                     .enumerate()
                     .map(|(k, m)| PlacedObject {
+                        name: "part",
                         meshes: vec![m],
                         turned: false,
                         translation_mm: [60.0 * (k % 4) as f64, 60.0 * (k / 4) as f64, 0.0],
