@@ -513,12 +513,8 @@ impl ImageObservations {
         let t = t_cam_sensor.translation.vector;
         for c in &self.captures {
             // `01_02_06/image.png` (a ground-truth capture's layout) by its folder's name
-            let path = Path::new(&c.spots.name);
-            let named = match path.file_stem() {
-                Some(s) if s == "image" => path.parent().and_then(Path::file_name).or(Some(s)),
-                s => s,
-            };
-            let stem = named.map_or_else(|| "capture".into(), |s| s.to_string_lossy().into_owned());
+            let stem = crate::imprints::capture_name(Path::new(&c.spots.name))
+                .unwrap_or_else(|| "capture".into());
             let mut name = stem.clone();
             let mut k = 1;
             while names.contains(&name) {

@@ -1126,11 +1126,20 @@ pub use assign::{
 /// groundtruth --pin-captures --images` writes a capture). `None` when the name is not such a
 /// list.
 pub fn ids_from_file_name(path: &std::path::Path) -> Option<Vec<u32>> {
-    let stem = path.file_stem()?.to_str()?;
-    if stem == "image" {
-        return ids_of(path.parent()?.file_name()?.to_str()?);
-    }
-    ids_of(stem)
+    ids_of(&capture_name(path)?)
+}
+
+/// A capture's name: its file's stem, or for a file whose stem is `image` its folder's name
+/// (`01_02_06/image.png`: `01_02_06`, as `fabkit groundtruth --pin-captures --images` writes
+/// a capture). Names the files made per capture (overlays, re-rendered captures).
+pub fn capture_name(path: &std::path::Path) -> Option<String> {
+    let stem = path.file_stem()?;
+    let named = if stem == "image" {
+        path.parent()?.file_name()?
+    } else {
+        stem
+    };
+    Some(named.to_string_lossy().into_owned())
 }
 
 /// The `_`-separated numbers of `name`; `None` when it is not such a list.

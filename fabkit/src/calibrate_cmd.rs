@@ -150,7 +150,9 @@ pub struct ExtrinsicsArgs {
     /// capture: the pins' imprints are found against --reference, written to observations.csv
     /// with an overlay per capture (overlays/), and the pose solved from them. Pin ids come from
     /// --capture-plan (images in capture order) or from the file names, which list the
-    /// capture's pins in ring order (01_02_06_14_22.png: pins 1, 2, 6, 14 and 22).
+    /// capture's pins in ring order (01_02_06_14_22.png: pins 1, 2, 6, 14 and 22), or from
+    /// the folder of an image.png (01_02_06_14_22/image.png, as `fabkit groundtruth
+    /// --pin-captures --images` writes a capture).
     #[arg(long, value_name = "CAPTURE.png", num_args = 1.., requires = "reference")]
     pub images: Vec<PathBuf>,
     /// Reference image of the unloaded skin (same camera and lighting as --images).

@@ -42,7 +42,8 @@ pub struct PhotometricArgs {
     #[arg(long, value_name = "REF.png")]
     reference: PathBuf,
     /// Capture images (PNG or JPEG, the camera's size, all of one bit depth), at least two,
-    /// each named by the pins it holds (01_02_06_14_22.png: pins 1, 2, 6, 14 and 22).
+    /// each named by the pins it holds (01_02_06_14_22.png: pins 1, 2, 6, 14 and 22), or an
+    /// image.png in a folder so named (as `fabkit groundtruth --pin-captures --images` writes).
     #[arg(long, value_name = "CAPTURE.png", num_args = 2.., required = true)]
     images: Vec<PathBuf>,
     /// Output folder for photometric.json, appearance.npy and rerendered/: missing, empty, or
@@ -590,10 +591,8 @@ fn write_outputs(
     put("appearance.npy", npy_f32(&[h, w, 3], &appearance))?;
     let mut captures = Vec::new();
     for (k, p) in posed.iter().enumerate() {
-        let stem = p
-            .file
-            .file_stem()
-            .map(|s| s.to_string_lossy().to_string())
+        // `01_02_06/image.png` (a ground-truth capture's layout) by its folder's name
+        let stem = fabkit_calibration::imprints::capture_name(&p.file)
             .unwrap_or_else(|| format!("capture_{k}"));
         let rel = format!("rerendered/{stem}.png");
         put(&rel, rerendered_png(&loo[k].image, w, h, setup.full_scale)?)?;

@@ -1265,3 +1265,29 @@ fn each_captures_dome_is_seated_from_its_imprints() {
         );
     }
 }
+
+/// Captures given where `fabkit groundtruth --pin-captures --images` wrote them
+/// (`caps/01_02_06_14_22/image.png`): each takes its pins from its folder's name and its
+/// re-rendered image is named by it.
+#[test]
+fn captures_in_their_ground_truth_folders_are_named_by_them() {
+    let d = tempfile::tempdir().unwrap();
+    setup(d.path());
+    let names = captures(d.path());
+    let folders: Vec<String> = names[..3]
+        .iter()
+        .map(|n| format!("caps/{}/image.png", n.trim_end_matches(".png")))
+        .collect();
+    let mut a = args(&folders, "ph");
+    let r = a.iter().position(|x| *x == "ref.png").unwrap();
+    a[r] = "caps/reference/image.png";
+    let o = run(d.path(), &a, &[]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    for n in &names[..3] {
+        assert!(d.path().join("ph/rerendered").join(n).is_file(), "{n}");
+    }
+    let m: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.path().join("ph/photometric.json")).unwrap())
+            .unwrap();
+    assert_eq!(m["captures"][0]["file"], folders[0].as_str());
+}
