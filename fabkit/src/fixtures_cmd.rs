@@ -3,7 +3,7 @@
 use crate::args::{DataFileArgs, MeshOutputArgs};
 use crate::progress::Progress;
 use fabkit_export::write_kit_reporting;
-use fabkit_fixtures::params::{from_yaml, resolve};
+use fabkit_fixtures::params::{from_yaml, given_in, resolve, FixtureOptions, Given};
 use fabkit_fixtures::FixtureProgress;
 use std::error::Error;
 use std::path::{Path, PathBuf};
@@ -25,11 +25,14 @@ pub struct FixturesArgs {
     /// defaults where absent.
     #[arg(long)]
     params: Option<PathBuf>,
-    /// Replace the pin dome with an embedded preset (rtac0: the published R-Tac0 fixture).
+    /// Replace the pin dome with an embedded preset (rtac0: the published R-Tac0 fixture), or
+    /// `default` for fabkit's own dome. Default: the dome of the paper the design reproduces
+    /// (R-Tac0's for rtac0), unless --params has a pin_dome.
     #[arg(long)]
     pins_preset: Option<String>,
     /// Generate N protrusion semi-dome patterns (semi-plate patterns on a flat skin), in
-    /// addition to those in --params.
+    /// addition to those in --params; 0 for none. Default: the paper's count (100 for rtac0),
+    /// unless --params sets `generate`.
     #[arg(long)]
     semidomes: Option<u32>,
     /// Seed of the pattern generator.
@@ -51,16 +54,27 @@ pub fn run(args: FixturesArgs) -> Result<(), Box<dyn Error>> {
         args.preset.as_deref(),
         &args.data_files,
     )?;
-    let base = match &args.params {
+    let (base, given) = match &args.params {
         Some(path) => {
             // A regular file of bounded size, as a design file.
             let text = fabkit_designs::input_files::read_design_file(path)?;
-            Some(from_yaml(&text, &path.display().to_string())?)
+            let params = from_yaml(&text, &path.display().to_string())?;
+            (Some(params), given_in(&text))
         }
-        None => None,
+        None => (None, Given::default()),
     };
-    // curved skins: semi-domes; flat skins: semi-plates
-    let params = resolve(base, args.pins_preset.as_deref(), args.semidomes, args.seed)?;
+    // curved skins: semi-domes; flat skins: semi-plates; what neither sets, the design's paper's
+    let resolved = resolve(
+        &loaded.design,
+        base,
+        given,
+        &FixtureOptions {
+            pins_preset: args.pins_preset.as_deref(),
+            patterns: args.semidomes,
+            seed: args.seed,
+        },
+    )?;
+    let params = resolved.params;
     let out = args
         .out
         .clone()
@@ -140,31 +154,17 @@ pub fn run(args: FixturesArgs) -> Result<(), Box<dyn Error>> {
         eprintln!("warning: {w}");
     }
     print_summary(&set, &params, &loaded.design, &out, t0.elapsed());
-    print_hints(&set, &args, &loaded.design);
+    for what in &resolved.from_paper {
+        out!("  from the paper: {what}");
+    }
+    print_hints(&set, &args);
     crate::args::print_parts(&summary.manifest.parts);
     Ok(())
 }
 
-/// Says what the defaults left out that the design's paper has: its published pin dome when
-/// the default one was built (`--pins-preset`), and how to make semi-dome patterns when none
-/// were asked for (issue 102: `fixtures rtac0` made a 13-hole dome and no pattern, silently).
-fn print_hints(
-    set: &fabkit_fixtures::FixtureSet,
-    args: &FixturesArgs,
-    design: &fabkit_designs::Design,
-) {
-    let published = fabkit_fixtures::params::PIN_PRESETS
-        .iter()
-        .find(|(name, _)| *name == design.name);
-    if let (Some(d), Some((name, _)), None, None) =
-        (&set.pin_dome, published, &args.pins_preset, &args.params)
-    {
-        out!(
-            "  hint: this is fabkit's default dome ({} holes); the dome of {}'s paper: --pins-preset {name}",
-            d.table.len(),
-            design.name
-        );
-    }
+/// Says how to make semi-dome patterns when none were asked for and the design's paper gave
+/// none (issue 102: a ground truth of such fixtures renders only the reference frame).
+fn print_hints(set: &fabkit_fixtures::FixtureSet, args: &FixturesArgs) {
     let none = |n: Option<usize>| n == Some(0);
     if none(set.semidomes.as_ref().map(|s| s.halves.len())) && args.semidomes.is_none() {
         out!("  hint: no semi-dome pattern was asked for: --semidomes N generates N (the protrusions a ground truth is rendered for)");

@@ -189,7 +189,9 @@ def build_fixtures(
     max_triangles: int = ...,
     progress: Optional[Progress] = None,
 ) -> Fixtures:
-    """As ``fabkit fixtures`` (``--params``, ``--pins-preset``, ``--semidomes``, ``--seed``)."""
+    """As ``fabkit fixtures`` (``--params``, ``--pins-preset``, ``--semidomes``, ``--seed``).
+    The library's R-Tac0 defaults to its paper's kit: the published dome and 100 semi-domes
+    (``pins_preset="default"`` for fabkit's own dome, ``semidomes=0`` for none)."""
 
 class Camera:
     """Intrinsics (px), image size and lens distortion (``fisheye``, ``plumb_bob``,

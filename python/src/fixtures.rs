@@ -4,7 +4,7 @@
 use std::sync::{Arc, Mutex};
 
 use fabkit_designs::ChordTolerance;
-use fabkit_fixtures::params::{from_yaml, resolve, FixtureParams};
+use fabkit_fixtures::params::{from_yaml, given_in, resolve, FixtureOptions, FixtureParams, Given};
 use fabkit_fixtures::pindome::PointRow;
 use fabkit_fixtures::FixtureProgress;
 use numpy::ndarray::{Array1, Array2};
@@ -98,7 +98,9 @@ impl Fixtures {
 /// `params`: fixture parameters as a dict (the `--params` YAML's form: pin_dome, semidomes,
 /// grid_plate, semiplates, indenters), a path to such a YAML file, or None for the defaults;
 /// `pins_preset`, `semidomes` (generated patterns) and `seed` as the CLI's options of those
-/// names. Refused before anything is built when estimated at more than `max_triangles`.
+/// names. What neither `params` nor those set is the paper's the design reproduces (R-Tac0:
+/// its published dome and 100 semi-domes; `pins_preset="default"` for fabkit's own dome,
+/// `semidomes=0` for none). Refused before anything is built when estimated at more than `max_triangles`.
 /// `progress(done, total, message)` is called as parts finish (from worker threads, with the
 /// GIL taken for the call). Raises DesignError naming every violated parameter.
 #[pyfunction]
@@ -117,10 +119,23 @@ pub fn build_fixtures(
 ) -> PyResult<Fixtures> {
     let tol = crate::kit::tolerance(chord_tolerance_mm)?;
     let limit = crate::kit::max_triangles(max_triangles)?;
-    let base: Option<FixtureParams> = match params {
-        None => None,
+    let (base, given): (Option<FixtureParams>, Given) = match params {
+        None => (None, Given::default()),
         Some(p) if p.is_instance_of::<PyDict>() => {
-            Some(typed_from::<FixtureParams>(value_of(p, "")?, "params")?)
+            let value = value_of(p, "")?;
+            let key = |v: &serde_value::Value, k: &str| match v {
+                serde_value::Value::Map(m) => m.get(&serde_value::Value::String(k.into())).cloned(),
+                _ => None,
+            };
+            let sets = |k: &str| {
+                key(&value, k)
+                    .is_some_and(|s| key(&s, "generate").is_some() || key(&s, "patterns").is_some())
+            };
+            let given = Given {
+                pin_dome: key(&value, "pin_dome").is_some(),
+                patterns: sets("semidomes") || sets("semiplates"),
+            };
+            (Some(typed_from::<FixtureParams>(value, "params")?), given)
         }
         Some(p) => {
             let path: std::path::PathBuf = if p.is_instance_of::<PyString>() {
@@ -130,11 +145,19 @@ pub fn build_fixtures(
             };
             let text = fabkit_designs::input_files::read_design_file(&path)
                 .map_err(|e| design_error(&e))?;
-            Some(from_yaml(&text, &path.display().to_string()).map_err(|e| design_error(&e))?)
+            let params =
+                from_yaml(&text, &path.display().to_string()).map_err(|e| design_error(&e))?;
+            (Some(params), given_in(&text))
         }
     };
-    let params =
-        resolve(base, pins_preset.as_deref(), semidomes, seed).map_err(|e| design_error(&e))?;
+    let options = FixtureOptions {
+        pins_preset: pins_preset.as_deref(),
+        patterns: semidomes,
+        seed,
+    };
+    let params = resolve(&design.design, base, given, &options)
+        .map_err(|e| design_error(&e))?
+        .params;
     let provenance =
         fabkit_fixtures::provenance(&design.design.name, &design.source, &design.sha256);
     let total = Mutex::new(0usize);

@@ -7,6 +7,7 @@ Needs FABKIT_BIN (the CLI binary; see conftest.py) and the built extension on PY
 import csv
 import io
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -111,7 +112,7 @@ def test_fixtures_progress_called(pair):
     _, _, fx, calls = pair
     assert calls, "progress was never called"
     total = len(fx.kit.parts)
-    assert total == 7
+    assert total == 8  # the paper's dome and its ring, pin, holder, empty half, 2 patterns, indenter
     assert calls[0][:2] == (0, total)
     assert all(t == total for _, t, _ in calls)
     dones = [d for d, _, _ in calls[1:]]
@@ -126,19 +127,36 @@ def test_fixture_params_dict_path_and_preset_agree(tmp_path, run_cli):
 
     path = REPO / "fixtures" / "presets" / "rtac0_pins.yaml"
     d = fabkit.Design.load("rtac0")
-    by_path = fabkit.build_fixtures(d, params=str(path))
-    by_dict = fabkit.build_fixtures(d, params=yaml.safe_load(path.read_text()))
-    by_preset = fabkit.build_fixtures(d, pins_preset="rtac0")
+    by_path = fabkit.build_fixtures(d, params=str(path), semidomes=0)
+    by_dict = fabkit.build_fixtures(d, params=yaml.safe_load(path.read_text()), semidomes=0)
+    by_preset = fabkit.build_fixtures(d, pins_preset="rtac0", semidomes=0)
     assert len(by_path.point_table["id"]) == 29  # the pole and 4 + 8 + 8 + 8 holes
     for other in (by_dict, by_preset):
         for k, v in by_path.point_table.items():
             assert np.array_equal(v, other.point_table[k]), k
         assert other.capture_plan == by_path.capture_plan
-    run_cli(tmp_path, "fixtures", "rtac0", "--params", path, "--out", "P")
+    run_cli(tmp_path, "fixtures", "rtac0", "--params", path, "--semidomes", "0", "--out", "P")
     cli = (tmp_path / "P" / "points" / "point_table.csv").read_bytes()
     assert by_path.files["points/point_table.csv"] == cli
-    # the default dome differs (13 holes)
-    assert len(fabkit.build_fixtures(d).point_table["id"]) == 13
+
+
+def test_rtac0s_default_fixtures_are_its_papers():
+    """R-Tac0's default fixtures are its paper's, as `fabkit fixtures rtac0` builds them: the
+    published dome (29 holes) and 100 semi-domes; fabkit's own dome (13 holes) with
+    pins_preset='default'; a params dict's own dome and count win over the paper's."""
+    d = fabkit.Design.load("rtac0")
+    patterns = lambda fx: sum(re.fullmatch(r"protrusions/p\d{3}\.json", f) is not None
+                              for f in fx.files)
+    paper = fabkit.build_fixtures(d)
+    assert len(paper.point_table["id"]) == 29 and patterns(paper) == 100
+    published = fabkit.build_fixtures(d, pins_preset="rtac0", semidomes=0)
+    assert np.array_equal(paper.point_table["tip_mm"], published.point_table["tip_mm"])
+    assert patterns(published) == 0
+    own = fabkit.build_fixtures(d, pins_preset="default", semidomes=0)
+    assert len(own.point_table["id"]) == 13
+    given = fabkit.build_fixtures(
+        d, params={"pin_dome": {"engrave_numbers": True}, "semidomes": {"generate": 1}})
+    assert len(given.point_table["id"]) == 13 and patterns(given) == 1
 
 
 def test_seed_makes_protrusions_deterministic():

@@ -126,10 +126,16 @@ fn library_outputs(extra: &[&str], keep: impl Fn(&str) -> bool) -> BTreeMap<Stri
                 vec!["export".into(), name.clone(), "--preset".into(), p.clone()],
             ));
         }
-        jobs.push((
-            format!("fixtures/{name}"),
-            vec!["fixtures".into(), name.clone()],
-        ));
+        // A design's default fixtures are its paper's: R-Tac0's are its published dome and 100
+        // semi-domes, 100 parts of one generator; two of them keep the STEP run bounded.
+        let mut fixtures = vec!["fixtures".to_string(), name.clone()];
+        if fabkit_fixtures::params::PAPER_KITS
+            .iter()
+            .any(|(d, _)| *d == name)
+        {
+            fixtures.extend(["--semidomes".into(), "2".into()]);
+        }
+        jobs.push((format!("fixtures/{name}"), fixtures));
         for (out, mut args) in jobs {
             args.extend(["--out".into(), out.clone()]);
             args.extend(extra.iter().map(|a| (*a).to_string()));

@@ -188,9 +188,11 @@ fn fixtures_show_progress_off_a_terminal() {
     assert!(o.status.success(), "{}", text(&o.stderr));
     let err = text(&o.stderr);
     let at = |prefix: &str| line_starting(&err, prefix);
-    let start = at("fixtures: building the 8 parts of rtac0 (about ");
-    let built = at("fixtures: 8/8");
-    let writing = at("fixtures: writing 8 parts and ");
+    // the paper's dome (and its holder ring), the pin, the holder, the empty half, three
+    // patterns and the indenter
+    let start = at("fixtures: building the 9 parts of rtac0 (about ");
+    let built = at("fixtures: 9/9");
+    let writing = at("fixtures: writing 9 parts and ");
     assert!(start < built && built < writing, "{err}");
 }
 
@@ -215,43 +217,117 @@ fn export_shows_its_stages_off_a_terminal() {
     );
 }
 
-/// `fixtures rtac0` with its defaults says what the paper's kit has that the defaults left
-/// out (issue 102): the published 29-hole dome (`--pins-preset rtac0`) and semi-dome patterns
-/// (`--semidomes N`); given both, no hint.
+/// `fixtures rtac0` with its defaults builds R-Tac0's paper's kit and says so (issue 102): the
+/// published 29-hole dome (`--pins-preset rtac0`) and the paper's 100 semi-domes; each default
+/// taken from the paper is named with the option that changes it. `--pins-preset default`
+/// and `--semidomes 0` give fabkit's own 13-hole dome and no pattern; a `--params` file's
+/// `pin_dome:` and `semidomes.generate` win over the paper's; a design of one's own started
+/// from R-Tac0 gets fabkit's dome.
 #[test]
-fn fixtures_name_what_the_defaults_leave_out() {
+fn fixtures_default_to_the_papers_kit() {
     let tmp = tempfile::tempdir().unwrap();
-    let o = run(
-        tmp.path(),
-        &["fixtures", "rtac0", "--format", "stl", "--out", "a"],
-        &[],
+    let built = |out: &str, extra: &[&str]| {
+        let mut args = vec!["fixtures", "rtac0", "--format", "stl", "--out", out];
+        args.extend(extra);
+        let o = run(tmp.path(), &args, &[]);
+        assert!(o.status.success(), "{args:?}: {}", text(&o.stderr));
+        let table =
+            std::fs::read_to_string(tmp.path().join(out).join("points/point_table.csv")).unwrap();
+        let patterns = std::fs::read_dir(tmp.path().join(out).join("parts"))
+            .unwrap()
+            .filter(|e| {
+                let name = e
+                    .as_ref()
+                    .unwrap()
+                    .file_name()
+                    .to_string_lossy()
+                    .into_owned();
+                name.starts_with("semidome_")
+                    && !["semidome_holder.stl", "semidome_empty.stl"].contains(&name.as_str())
+            })
+            .count();
+        (text(&o.stdout), table.lines().count() - 1, patterns)
+    };
+    let (said, holes, patterns) = built("a", &[]);
+    assert_eq!((holes, patterns), (29, 100), "{said}");
+    for line in [
+        "  pin dome: 29 holes in 8 captures;",
+        "  semi-domes: 100 patterns + the empty half -> 10000 stitched pairs",
+        "  from the paper: the pin dome of the R-Tac0 paper (--pins-preset rtac0; fabkit's own: --pins-preset default)",
+        "  from the paper: 100 semi-dome patterns, the R-Tac0 paper's count (--semidomes N for another, 0 for none)",
+    ] {
+        assert!(said.contains(line), "{line}\n{said}");
+    }
+    assert!(!said.contains("hint:"), "{said}");
+    // fabkit's own dome and no pattern, asked for: nothing from the paper, no hint
+    let (said, holes, patterns) = built("b", &["--pins-preset", "default", "--semidomes", "0"]);
+    assert_eq!((holes, patterns), (13, 0), "{said}");
+    assert!(
+        !said.contains("from the paper") && !said.contains("hint:"),
+        "{said}"
     );
+    // a parameter file's own dome and count win over the paper's
+    std::fs::write(
+        tmp.path().join("p.yaml"),
+        "pin_dome:\n  engrave_numbers: true\nsemidomes:\n  generate: 2\n",
+    )
+    .unwrap();
+    let (said, holes, patterns) = built("c", &["--params", "p.yaml"]);
+    assert_eq!((holes, patterns), (13, 2), "{said}");
+    assert!(!said.contains("from the paper"), "{said}");
+    // listed patterns are the file's count too (100 more would pass the 100-part cap)
+    std::fs::write(
+        tmp.path().join("q.yaml"),
+        "semidomes:\n  patterns:\n    - name: one\n      protrusions:\n        - {polar_angle_deg: 20, azimuth_deg: 30, indentation_depth_mm: 1, shape: {type: sphere, radius_mm: 2}}\n",
+    )
+    .unwrap();
+    let (said, holes, patterns) = built("d", &["--params", "q.yaml"]);
+    assert_eq!((holes, patterns), (29, 1), "{said}");
+    assert!(
+        said.contains("from the paper: the pin dome") && !said.contains("semi-dome patterns, the"),
+        "{said}"
+    );
+    // a design of one's own that starts from R-Tac0 (its source still cites the paper) gets
+    // fabkit's dome, sized to its skin and camera
+    let o = run(tmp.path(), &["show", "rtac0", "--out", "mine.yaml"], &[]);
     assert!(o.status.success(), "{}", text(&o.stderr));
-    let out = text(&o.stdout);
-    assert!(
-        out.contains("hint: this is fabkit's default dome (13 holes); the dome of rtac0's paper: --pins-preset rtac0"),
-        "{out}"
-    );
-    assert!(
-        out.contains("hint: no semi-dome pattern was asked for: --semidomes N"),
-        "{out}"
-    );
+    let yaml = std::fs::read_to_string(tmp.path().join("mine.yaml")).unwrap();
+    assert!(yaml.contains("\nname: rtac0\n"), "{yaml}");
+    let mine = yaml.replace("\nname: rtac0\n", "\nname: mine\n");
+    std::fs::write(tmp.path().join("mine.yaml"), mine).unwrap();
     let o = run(
         tmp.path(),
         &[
             "fixtures",
-            "rtac0",
-            "--pins-preset",
-            "rtac0",
+            "mine.yaml",
             "--semidomes",
-            "1",
+            "0",
             "--format",
             "stl",
             "--out",
-            "b",
+            "f",
         ],
         &[],
     );
     assert!(o.status.success(), "{}", text(&o.stderr));
-    assert!(!text(&o.stdout).contains("hint:"), "{}", text(&o.stdout));
+    assert!(
+        text(&o.stdout).contains("  pin dome: 13 holes")
+            && !text(&o.stdout).contains("from the paper"),
+        "{}",
+        text(&o.stdout)
+    );
+    // a design that reproduces no paper with a kit keeps fabkit's dome and says how to get
+    // patterns
+    let o = run(
+        tmp.path(),
+        &["fixtures", "shadowtac", "--format", "stl", "--out", "e"],
+        &[],
+    );
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(
+        !text(&o.stdout).contains("from the paper")
+            && text(&o.stdout).contains("hint: no semi-dome pattern was asked for"),
+        "{}",
+        text(&o.stdout)
+    );
 }
