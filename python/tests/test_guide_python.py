@@ -1,8 +1,10 @@
-"""The user guide's first "From Python" example (arrays, docs/src/guide/python.md) runs as written, on inputs the CLI makes: a camera file
-(cam.yaml), a calibration (calib/extrinsics.json), the R-Tac0 fixtures (out/rtac0_fixtures) and
-a ground-truth folder (gt), in a fresh folder; so does the second (a board press and a ball
-press's ground truth), on 9DTact's captures and the folders the CLI makes of them; and the third
-(a sweep on a local Dask cluster), saved as a file and run with python as the guide says."""
+"""The user guide's "From Python" chapter (docs/src/guide/python.md) runs as written, in a
+fresh folder, block by block as the page shows them: the `sh` blocks that make an example's
+inputs (with `fabkit` on the PATH), then its Python blocks in one scope. The first example
+(arrays) reads the nominal camera, R-Tac0's fixtures and a ground truth the CLI makes; the
+board example calibrates 9DTact's board press and reads a ball press's ground truth the CLI
+makes through that camera; the sweep example (a local Dask cluster) is saved as a file and run
+with python as the guide says."""
 
 import contextlib
 import io
@@ -11,53 +13,74 @@ import os
 import re
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 import numpy as np
 
-from test_groundtruth_render import CAMERA_YAML, pose
-
 GUIDE = Path(__file__).resolve().parents[2] / "docs" / "src" / "guide" / "python.md"
 
 
+def blocks():
+    """The chapter's `sh` and `python` blocks, in order: (language, code)."""
+    return re.findall(r"```(sh|python)\n(.*?)```", GUIDE.read_text(), re.S)
+
+
 def guide_blocks():
-    blocks = re.findall(r"```python\n(.*?)```", GUIDE.read_text(), re.S)
-    assert len(blocks) == 3, "the chapter has three Python examples: arrays, a board press, a sweep"
-    return blocks
+    found = [code for lang, code in blocks() if lang == "python"]
+    assert len(found) == 4, "four Python blocks: arrays, a board press and its ball press, a sweep"
+    return found
 
 
-def guide_example():
-    return guide_blocks()[0]
+def run_guide(first, last, cwd, fabkit_bin):
+    """Runs the chapter's blocks from the `sh` blocks just before Python block `first` (the
+    commands that make its inputs; not the install line) to Python block `last`, in `cwd`:
+    `sh` with bash -euo pipefail and `fabkit` on the PATH, Python exec'd in one scope.
+    Returns (scope, what the Python blocks printed)."""
+    bl = blocks()
+    at = [i for i, (lang, _) in enumerate(bl) if lang == "python"]
+    start = at[first]
+    while start > 0 and bl[start - 1][0] == "sh" and "pip install" not in bl[start - 1][1]:
+        start -= 1
+    assert bl[start][0] == "sh", "an example's inputs are made by the commands shown before it"
+    bindir = Path(tempfile.mkdtemp())
+    (bindir / "fabkit").symlink_to(Path(fabkit_bin).resolve())
+    env = dict(os.environ, PATH=f"{bindir}:{os.environ.get('PATH', '')}")
+    scope, printed = {}, io.StringIO()
+    cwd_before = os.getcwd()
+    os.chdir(cwd)
+    try:
+        for lang, code in bl[start:at[last] + 1]:
+            if lang == "sh":
+                run = subprocess.run(["bash", "-euo", "pipefail", "-c", code], cwd=cwd, env=env,
+                                     capture_output=True, text=True, timeout=900)
+                assert run.returncode == 0, f"{code}\n{run.stderr}"
+            else:
+                with contextlib.redirect_stdout(printed):
+                    exec(compile(code, str(GUIDE), "exec"), scope)
+    finally:
+        os.chdir(cwd_before)
+    return scope, printed.getvalue()
 
 
-def test_guide_example_runs(tmp_path, run_cli, monkeypatch):
-    (tmp_path / "cam.yaml").write_text(CAMERA_YAML)
-    (tmp_path / "calib").mkdir()
-    (tmp_path / "calib" / "extrinsics.json").write_text(
-        json.dumps({"T_cam_sensor": pose().tolist()})
-    )
-    run_cli(tmp_path, "fixtures", "rtac0", "--semidomes", "2", "--seed", "3", "--format", "stl",
-            "--out", "out/rtac0_fixtures")
-    run_cli(tmp_path, "groundtruth", "rtac0", "--camera", "cam.yaml", "--extrinsics",
-            "calib/extrinsics.json", "--fixtures", "out/rtac0_fixtures", "--out", "gt")
-    monkeypatch.chdir(tmp_path)
-    printed = io.StringIO()
-    scope = {}
-    with contextlib.redirect_stdout(printed):
-        exec(compile(guide_example(), str(GUIDE), "exec"), scope)
+def test_guide_example_runs(tmp_path, fabkit_bin):
+    scope, printed = run_guide(0, 0, tmp_path, fabkit_bin)
     # what the example made is what it says
-    lines = printed.getvalue().splitlines()
+    lines = printed.splitlines()
     assert (tmp_path / "out" / "rtac0_py" / "manifest.json").is_file()
     manifest = json.loads((tmp_path / "out" / "rtac0_py" / "manifest.json").read_text())
     assert manifest["parts"][0]["volume_mm3"] == scope["kit"].parts[0].numbers()["volume_mm3"]
     # one line per configuration (2 patterns x 2 orientations), each pushed in somewhere
-    frames = [l for l in lines if l.split()[0] in {p.name for p in scope["fabkit"].read_protrusions(
-        "out/rtac0_fixtures", scope["design"])}]
+    names = {p.name for p in scope["fabkit"].read_protrusions(
+        tmp_path / "out" / "rtac0_fixtures", scope["design"])}
+    frames = [l for l in lines if l.split()[0] in names]
     assert len(frames) == 4
     assert all(float(l.split()[1]) < 0 and int(l.split()[2]) > 0 for l in frames)
-    # the pin dome's captures, named by their pins; the first rendered as a capture
+    # the pin dome's captures (the paper's dome, R-Tac0's default: 8 captures), named by their
+    # pins; the first rendered as a capture
     captures = scope["captures"]
-    assert captures and all(c.name == "_".join("%02d" % int(i) for i in c.pins) for c in captures)
+    assert len(captures) == 8
+    assert all(c.name == "_".join("%02d" % int(i) for i in c.pins) for c in captures)
     assert scope["capture_image"].shape == scope["image"].shape
     # the loop visited the 2 x 2 stitched pairs, each with a finite depth and a push somewhere
     assert len(scope["gt"]) == 4
@@ -65,30 +88,21 @@ def test_guide_example_runs(tmp_path, run_cli, monkeypatch):
     assert np.isfinite(scope["depth"]).any() and np.nanmin(scope["target"]) < 0
 
 
-def test_guide_board_example_runs(tmp_path, run_cli, monkeypatch):
-    """The board press example: 63 bumps, the RMS under 1.3 px, the board/ folder the CLI's; the
-    ball press's fit and arrays read from the folder the CLI wrote."""
+def test_guide_board_example_runs(tmp_path, run_cli, fabkit_bin):
+    """The board press example: 63 bumps, the RMS under 1.3 px, the board/ folder the CLI's
+    `calibrate board` writes; the ball press's fit and arrays read from the folder the CLI
+    wrote through that camera."""
     repo = GUIDE.parents[3]
     (tmp_path / "tests").symlink_to(repo / "tests")
+    scope, printed = run_guide(1, 2, tmp_path, fabkit_bin)
+    found, rms = printed.splitlines()[0].split()
+    assert int(found) == 63 and float(rms) < 1.3
     data = "tests/data/9dtact_sensor1/"
-    run_cli(tmp_path, "fixtures", "ninedtact", "--out", "fx")
     run_cli(tmp_path, "calibrate", "board", "--points", "fx/points/board_table.csv",
             "--reference", data + "camera_calibration/ref.png",
-            "--image", data + "camera_calibration/sample.png", "--out", "board")
-    run_cli(tmp_path, "groundtruth", "ninedtact", "--camera", "board/camera.yaml",
-            "--extrinsics", "board/extrinsics.json",
-            "--press-image", data + "depth_calibration/sample.png",
-            "--press-reference", data + "depth_calibration/ref.png",
-            "--sphere-radius-mm", "4", "--out", "gt_press")
-    cli_report = json.loads((tmp_path / "board" / "extrinsics.json").read_text())
-    monkeypatch.chdir(tmp_path)
-    printed = io.StringIO()
-    scope = {}
-    with contextlib.redirect_stdout(printed):
-        exec(compile(guide_blocks()[1], str(GUIDE), "exec"), scope)
-    found, rms = printed.getvalue().splitlines()[0].split()
-    assert int(found) == 63 and float(rms) < 1.3
+            "--image", data + "camera_calibration/sample.png", "--out", "board_cli")
     report = json.loads((tmp_path / "board" / "extrinsics.json").read_text())
+    cli_report = json.loads((tmp_path / "board_cli" / "extrinsics.json").read_text())
     del report["command_line"], cli_report["command_line"]
     assert report == cli_report
     assert scope["camera"].shape == (480, 640) and scope["T_cam_sensor"].shape == (4, 4)
@@ -106,13 +120,13 @@ def test_guide_sweep_example_runs_as_a_script(tmp_path):
     pytest = __import__("pytest")
     pytest.importorskip("distributed")
     script = tmp_path / "sweep.py"
-    script.write_text(guide_blocks()[2])
+    script.write_text(guide_blocks()[3])
     run = subprocess.run([sys.executable, str(script)], cwd=tmp_path, capture_output=True,
                          text=True, env=dict(os.environ), timeout=600)
     assert run.returncode == 0, run.stderr
     assert "status" in run.stdout and "min_wall_mm" in run.stdout, run.stdout
     scope = {"__name__": "guide_sweep"}
-    exec(compile(guide_blocks()[2], str(GUIDE), "exec"), scope)
+    exec(compile(guide_blocks()[3], str(GUIDE), "exec"), scope)
     with contextlib.redirect_stdout(io.StringIO()):
         table = scope["main"]()
     assert len(table) == 20
