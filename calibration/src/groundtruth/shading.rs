@@ -464,13 +464,15 @@ impl MarkerMap {
 /// surface, [`MarkerMap`]) and the skin's elsewhere, a light shadowed where the segment from
 /// the point to it enters a protrusion of `protrusions` or a dimple. The dimples of `optics`
 /// ([`DimpleField`]) are part of the surface seen: a ray that meets one before the skin sees
-/// the dimple (the depth maps' `hits` do not hold them). The reference skin is
-/// convex: seen from inside it casts no shadow on itself. A darkness-mapping skin
-/// (`optics.surface.darkness_per_mm`, [`darkness`]), where it is pressed (`hits.contact`),
-/// returns what its unpressed point (`reference`, at the same pixel; none given: as any skin)
-/// returned, dimmed by how far it sank along that point's normal, and no protrusion casts a
-/// shadow on it (its light is scattered within its translucent layer). Pixels are shaded in parallel, each on its own: the result does not depend on the
-/// thread count.
+/// the dimple (the depth maps' `hits` do not hold them). The reference skin is convex: seen
+/// from inside it casts no shadow on itself.
+///
+/// A darkness-mapping skin (`optics.surface.darkness_per_mm`, [`darkness`]) is lit as its
+/// light scatters within its translucent layer: no protrusion casts a shadow on it, and where
+/// it is pressed (`hits.contact`) it returns what its unpressed point (`reference`, at the
+/// same pixel, with its markers and dimples unmoved; none given: as any skin) returned, dimmed
+/// by how far it sank along that point's normal. Pixels are shaded in parallel, each on its
+/// own: the result does not depend on the thread count.
 pub fn frame_radiance(
     rays: &super::rays::PixelRays,
     reference: Option<&super::SurfaceHits>,
@@ -481,8 +483,57 @@ pub fn frame_radiance(
     let darkness_per_mm = optics.surface.darkness_per_mm;
     let lights: Vec<Prepared> = optics.lights.iter().map(Prepared::of).collect();
     let lobe = lobe_of(&optics.surface);
-    let markers = MarkerMap::new(&optics.markers, protrusions);
-    let dimples = DimpleField::new(&optics.dimples, protrusions);
+    let pressed = Seen {
+        markers: MarkerMap::new(&optics.markers, protrusions),
+        dimples: DimpleField::new(&optics.dimples, protrusions),
+        // a darkness-mapping skin's light is scattered within its translucent layer: a
+        // protrusion pressing it casts no shadow
+        shadows: protrusions.filter(|_| darkness_per_mm.is_none()),
+    };
+    // the unpressed skin a darkness-mapping skin's pressed points return the light of
+    let unpressed = darkness_per_mm.zip(reference).map(|(k, r)| {
+        let seen = Seen {
+            markers: MarkerMap::new(&optics.markers, None),
+            dimples: DimpleField::new(&optics.dimples, None),
+            shadows: None,
+        };
+        (k, r, seen)
+    });
+    let shade = |seen: &Seen, o: [f64; 3], d: [f64; 3], t_skin: f64, n_out: [f64; 3]| {
+        // the normal on the camera's side: the elastomer's outward normal reversed
+        let n_skin = n_out.map(|v| -v);
+        // a dimple stands towards the camera: met first, it is the surface seen
+        let (t, n) = match seen.dimples.as_ref().and_then(|f| {
+            let w = f.window_mm(d, n_skin);
+            f.first_crossing(o, d, (t_skin - w).max(0.0), t_skin)
+        }) {
+            Some(c) => (c.t_mm, c.normal),
+            None => (t_skin, n_skin),
+        };
+        let p = [o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2]];
+        let lit = |k: usize, l: [f64; 3]| {
+            let to_light = sub(lights[k].position_mm, p);
+            let dist = dot(to_light, to_light).sqrt();
+            let start = [p[0] + 1e-6 * n[0], p[1] + 1e-6 * n[1], p[2] + 1e-6 * n[2]];
+            if let Some(prims) = seen.shadows {
+                if prims.first_crossing(start, l, dist).is_some() {
+                    return false;
+                }
+            }
+            match &seen.dimples {
+                Some(f) => f
+                    .first_crossing(start, l, 0.0, dist.min(f.window_mm(l, n_skin)))
+                    .is_none(),
+                None => true,
+            }
+        };
+        let albedo = if seen.markers.covers(p) {
+            optics.marker_albedo_rgb
+        } else {
+            optics.surface.albedo_rgb
+        };
+        radiance_prepared(p, n, [-d[0], -d[1], -d[2]], albedo, lobe, &lights, lit)
+    };
     (0..rays.dirs.len())
         .into_par_iter()
         .map(|i| {
@@ -491,70 +542,26 @@ pub fn frame_radiance(
             if !t_skin.is_finite() {
                 return [f64::NAN; 3];
             }
-            // the normal on the camera's side: the elastomer's outward normal reversed
-            let n_skin = hits.normal[i].map(|v| -v);
             // a darkness-mapping skin pressed here: the light the unpressed point returned,
-            // dimmed by how far it sank
-            if let (Some(k), Some(r)) = (darkness_per_mm, reference) {
+            // dimmed by how far it sank along its normal
+            if let Some((k, r, seen)) = &unpressed {
                 if hits.contact[i] && r.t_mm[i].is_finite() {
-                    let t0 = r.t_mm[i];
-                    let n_out = r.normal[i];
+                    let (t0, n_out) = (r.t_mm[i], r.normal[i]);
                     let sink = (t0 - t_skin) * dot(d, n_out);
-                    let p0 = [o[0] + t0 * d[0], o[1] + t0 * d[1], o[2] + t0 * d[2]];
-                    return radiance_prepared(
-                        p0,
-                        n_out.map(|v| -v),
-                        [-d[0], -d[1], -d[2]],
-                        optics.surface.albedo_rgb,
-                        lobe,
-                        &lights,
-                        |_, _| true,
-                    )
-                    .map(|v| v * darkness(k, sink));
+                    return shade(seen, o, d, t0, n_out).map(|v| v * darkness(*k, sink));
                 }
             }
-            // a dimple stands towards the camera: met first, it is the surface seen
-            let (t, n) = match dimples.as_ref().and_then(|f| {
-                let w = f.window_mm(d, n_skin);
-                f.first_crossing(o, d, (t_skin - w).max(0.0), t_skin)
-            }) {
-                Some(c) => (c.t_mm, c.normal),
-                None => (t_skin, n_skin),
-            };
-            let p = [o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2]];
-            let lit = |k: usize, l: [f64; 3]| {
-                let to_light = sub(lights[k].position_mm, p);
-                let dist = dot(to_light, to_light).sqrt();
-                let start = [p[0] + 1e-6 * n[0], p[1] + 1e-6 * n[1], p[2] + 1e-6 * n[2]];
-                // a darkness-mapping skin's light is scattered within its translucent layer:
-                // a protrusion pressing it casts no shadow
-                if let (Some(prims), None) = (protrusions, darkness_per_mm) {
-                    if prims.first_crossing(start, l, dist).is_some() {
-                        return false;
-                    }
-                }
-                match &dimples {
-                    Some(f) => f
-                        .first_crossing(start, l, 0.0, dist.min(f.window_mm(l, n_skin)))
-                        .is_none(),
-                    None => true,
-                }
-            };
-            radiance_prepared(
-                p,
-                n,
-                [-d[0], -d[1], -d[2]],
-                if markers.covers(p) {
-                    optics.marker_albedo_rgb
-                } else {
-                    optics.surface.albedo_rgb
-                },
-                lobe,
-                &lights,
-                lit,
-            )
+            shade(&pressed, o, d, t_skin, hits.normal[i])
         })
         .collect()
+}
+
+/// What a frame's rays see on the skin besides its surface: the markers and dimples where the
+/// skin put them, and the protrusions that shadow it.
+struct Seen<'a> {
+    markers: MarkerMap,
+    dimples: Option<DimpleField>,
+    shadows: Option<&'a super::exact::ExactPrimitives>,
 }
 
 /// The brightness left to a darkness-mapping skin ([`frame_radiance`]) that sank `sink_mm`
