@@ -9,7 +9,7 @@ pub mod profile2d;
 mod solid;
 pub mod transform;
 
-pub use mesh::{triangle_cross, Aabb, Mesh, TopologyError};
+pub use mesh::{triangle_cross, Aabb, MassProperties, Mesh, TopologyError};
 pub use profile2d::Polyline2;
 pub use solid::{csg_json, rotation_deg, CsgNode, GeometryError, Solid};
 pub use transform::Affine;
