@@ -68,6 +68,7 @@ pub(crate) fn bought(
         nested_by_stack: false,
         features: Default::default(),
         exact: Some(exact),
+        material: None,
     }
 }
 
@@ -144,6 +145,7 @@ pub fn printed_members(parts: &[Part]) -> Vec<Member> {
                 nested_by_stack: matches!(p.role.as_str(), "printed_skin" | "marker_tips"),
                 features: Default::default(),
                 exact: None,
+                material: Some(p.material.clone()),
             })
         })
         .collect()
@@ -211,6 +213,7 @@ fn push_cast_layers(
                     tol,
                 ),
             }),
+            material: Some(l.material.clone()),
         });
     }
     Ok(())
@@ -242,6 +245,7 @@ fn push_core(
         out.push(Member {
             nested_by_stack: true,
             features: Default::default(),
+            material: Some(spec.material.clone()),
             ..bought(
                 "core_envelope",
                 format!("Core (bought): {}", spec.description),
@@ -268,12 +272,15 @@ fn push_backing(
     let zb = design.body.base_z_mm();
     let envelope = crate::parts::axial_cylinder(b.diameter_mm / 2.0, zb - b.thickness_mm, zb, tol)
         .part("backing_envelope")?;
-    out.push(bought(
-        "backing_envelope",
-        format!("Backing plate (bought): {}", b.description),
-        envelope,
-        &["backing.diameter_mm", "backing.thickness_mm"],
-    ));
+    out.push(Member {
+        material: Some(b.material.clone()),
+        ..bought(
+            "backing_envelope",
+            format!("Backing plate (bought): {}", b.description),
+            envelope,
+            &["backing.diameter_mm", "backing.thickness_mm"],
+        )
+    });
     Ok(())
 }
 

@@ -28,6 +28,7 @@ pub mod hold;
 mod html;
 mod layout;
 mod manifest;
+pub mod mass;
 pub mod preview;
 pub mod raster;
 mod render;
@@ -415,16 +416,24 @@ fn assembly_3mf(
     meshes: &[Mesh],
     opts: &ExportOptions,
 ) -> Result<(ManifestAssembly, Vec<u8>), ExportError> {
+    let materials = fabkit_designs::materials::MaterialsTable::embedded().ok();
     let mut members = Vec::with_capacity(meshes.len());
     for (m, mesh) in kit.assembly.iter().zip(meshes) {
+        let density = m
+            .material
+            .as_deref()
+            .and_then(|k| mass::density(materials.as_ref(), k));
         members.push(ManifestMember {
             name: m.name.clone(),
             kind: m.kind,
             description: m.description.clone(),
             volume_mm3: mesh.signed_volume(),
             bbox_mm: bbox_of(&m.name, mesh)?,
+            material: m.material.clone(),
+            mass: density.map(|d| mass::member_mass(mesh, d)),
         });
     }
+    let sensor_mass = mass::sensor_mass(members.iter().map(|m| (m.name.as_str(), m.mass.as_ref())));
     let objects: Vec<three_mf::Object<'_>> = kit
         .assembly
         .iter()
@@ -461,6 +470,7 @@ fn assembly_3mf(
             file: ASSEMBLY_3MF.into(),
             sha256: sha256_hex(&bytes),
             members,
+            mass: sensor_mass,
         },
         bytes,
     ))

@@ -152,6 +152,9 @@ pub struct ManifestAssembly {
     pub sha256: String,
     /// One entry per member, in the 3MF's object order (ids 1, 2, ...).
     pub members: Vec<ManifestMember>,
+    /// The assembled sensor's mass, centre of mass and inertia: its members with a material
+    /// combined ([`crate::mass::sensor_mass`]).
+    pub mass: crate::mass::SensorMass,
 }
 
 /// One member of the assembly.
@@ -165,6 +168,14 @@ pub struct ManifestMember {
     /// Volume of the written mesh, mm^3, and its box in the sensor frame, mm.
     pub volume_mm3: f64,
     pub bbox_mm: Aabb,
+    /// Its material (a key of designs/materials.yaml); absent for a bought item whose
+    /// envelope is not its material (a camera board, an LED PCB).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub material: Option<String>,
+    /// Its mass properties from the written mesh at the material's density; absent without a
+    /// material.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mass: Option<crate::mass::MemberMass>,
 }
 
 /// The assembly STEP file: one STEP assembly named after the design, one component (a named

@@ -26,6 +26,7 @@ mod groundtruth_images;
 mod groundtruth_open3d;
 mod groundtruth_press;
 mod maker_path;
+mod mass;
 mod output_ownership;
 mod plates;
 mod report_html;

@@ -65,7 +65,8 @@ pub(crate) fn build_flat_kit(
             tech,
             wall,
         };
-        let (part, member, v, sheets) = layer_tray(l, i, &tray, tol)?;
+        let (part, mut member, v, sheets) = layer_tray(l, i, &tray, tol)?;
+        member.material = design.layers.get(i).map(|d| d.material.clone());
         parts.push(part);
         assembly.push(member);
         volumes.push(v);
@@ -354,6 +355,7 @@ fn layer_tray(
         nested_by_stack: true,
         features: Default::default(),
         exact: None,
+        material: None,
     };
     Ok((part, member, v, cut_parts))
 }

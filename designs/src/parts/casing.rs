@@ -821,6 +821,7 @@ pub fn members(
                 nested_by_stack: false,
                 features: Default::default(),
                 exact,
+                material: None,
             }
         };
     let cam = &c.camera;

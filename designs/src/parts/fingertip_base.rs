@@ -756,6 +756,7 @@ pub fn members(f: &FingertipBase, input: FamilyInput<'_>) -> Result<Vec<Member>,
                 nested_by_stack: false,
                 features: Default::default(),
                 exact: Some(exact),
+                material: None,
             })
         };
     let p = &f.led_pcb;

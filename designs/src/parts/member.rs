@@ -47,6 +47,10 @@ pub struct Member {
     /// describe it) and for a member that has no exact description (STEP export then sews its
     /// mesh).
     pub exact: Option<ExactShape>,
+    /// The material the member is made of (a key of designs/materials.yaml), whose density
+    /// gives its mass ([`crate::geometry::Mesh::mass_properties`]); `None` for a bought
+    /// item whose envelope is not its material (a camera board, an LED PCB and its parts).
+    pub material: Option<String>,
 }
 
 /// The marker features of a nested member (a cast layer), for the fit check

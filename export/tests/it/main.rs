@@ -2,3 +2,4 @@
 
 mod export_kit;
 mod library_sheets;
+mod mass;

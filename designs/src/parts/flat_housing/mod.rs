@@ -466,6 +466,7 @@ impl FlatFamily for FlatHousingFamily {
                 nested_by_stack: false,
                 features: Default::default(),
                 exact: None,
+                material: Some(material.clone()),
             });
         }
         let w = p.window_outline();
@@ -483,6 +484,8 @@ impl FlatFamily for FlatHousingFamily {
             nested_by_stack: false,
             features: Default::default(),
             exact: None,
+            // "clear acrylic" (the cut list)
+            material: Some("pmma".into()),
         });
         out.cut_parts.push(CutPart {
             name: "window".into(),

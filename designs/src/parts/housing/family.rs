@@ -123,6 +123,7 @@ impl Family for HousingFamily {
                 exact: Some(ExactShape::Revolved {
                     profile_rz_mm: pl.points.clone(),
                 }),
+                material: Some(f.material.clone()),
             });
         }
         out.extend(bought_envelopes(h, &lv, tol)?);

@@ -216,6 +216,7 @@ impl Family for ShaftBodyFamily {
                 nested_by_stack: true,
                 features: Default::default(),
                 exact: None,
+                material: Some(f.material.clone()),
             }),
         }))
     }

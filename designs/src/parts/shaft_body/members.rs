@@ -34,6 +34,7 @@ pub fn members(
         nested_by_stack: false,
         features: Default::default(),
         exact: Some(exact),
+        material: None,
     };
     let l = &sb.led_ring;
     let (ro, ri) = (l.outer_diameter_mm / 2.0, l.inner_diameter_mm / 2.0);
