@@ -29,6 +29,7 @@ mod html;
 mod layout;
 mod manifest;
 pub mod mass;
+pub mod mjcf;
 pub mod preview;
 pub mod raster;
 mod render;
@@ -46,8 +47,8 @@ pub use error::ExportError;
 pub use manifest::{
     Manifest, ManifestAssembly, ManifestAssemblyStep, ManifestCutPart, ManifestDataFile,
     ManifestDesign, ManifestKit3mf, ManifestMachinedPart, ManifestMember, ManifestObject,
-    ManifestPart, ManifestPcbOutline, ManifestPlate, ManifestPlateObject, ManifestStepMember,
-    ManifestVolume, StepGeometry, FRAME,
+    ManifestPart, ManifestPcbOutline, ManifestPlate, ManifestPlateObject, ManifestSim,
+    ManifestStepMember, ManifestVolume, StepGeometry, FRAME,
 };
 
 use fabkit_designs::assembly::{ExactShape, MemberKind};
@@ -65,6 +66,9 @@ pub struct Formats {
     /// `step/<part>.step`, exact B-rep per part through the CadQuery twin, and for a sensor
     /// `assembly.step`, the assembly's members in the sensor frame (see [`step`]).
     pub step: bool,
+    /// `sim/<design>.xml` and `sim/meshes/*.stl`: the assembled sensor for MuJoCo
+    /// ([`mjcf`]).
+    pub mjcf: bool,
 }
 
 impl Default for Formats {
@@ -74,6 +78,7 @@ impl Default for Formats {
             stl: true,
             threemf: true,
             step: false,
+            mjcf: false,
         }
     }
 }
@@ -101,6 +106,8 @@ pub struct ExportOptions {
     /// Replace an earlier output of the same command for another kit or chord tolerance
     /// (`--force`).
     pub force: bool,
+    /// The camera and lights of the simulator files ([`Formats::mjcf`]).
+    pub sim: mjcf::SimScene,
 }
 
 impl ExportOptions {
@@ -126,6 +133,7 @@ impl ExportOptions {
             printers,
             command: OutputCommand::Export,
             force: false,
+            sim: mjcf::SimScene::default(),
         }
     }
 
@@ -409,13 +417,15 @@ fn step_files(
     ))
 }
 
-/// `assembly.3mf`: the kit's assembled sensor, one object per member (`meshes`, checked closed
-/// 2-manifolds, in kit order), in the sensor frame.
-fn assembly_3mf(
+/// The manifest's entry of each assembly member (`meshes`: their written meshes, in kit
+/// order), with its mass where its material is known, and the sensor's mass.
+///
+/// # Errors
+/// [`ExportError::NotManifold`] for a mesh without vertices.
+fn assembly_members(
     kit: &Kit,
     meshes: &[Mesh],
-    opts: &ExportOptions,
-) -> Result<(ManifestAssembly, Vec<u8>), ExportError> {
+) -> Result<(Vec<ManifestMember>, mass::SensorMass), ExportError> {
     let materials = fabkit_designs::materials::MaterialsTable::embedded().ok();
     let mut members = Vec::with_capacity(meshes.len());
     for (m, mesh) in kit.assembly.iter().zip(meshes) {
@@ -434,6 +444,46 @@ fn assembly_3mf(
         });
     }
     let sensor_mass = mass::sensor_mass(members.iter().map(|m| (m.name.as_str(), m.mass.as_ref())));
+    Ok((members, sensor_mass))
+}
+
+/// `sim/`: the MJCF model and its meshes ([`mjcf`]), and their manifest entry.
+///
+/// # Errors
+/// As [`assembly_members`] and the STL writer's.
+pub(crate) fn sim_files(
+    kit: &Kit,
+    meshes: &[Mesh],
+    opts: &ExportOptions,
+) -> Result<(ManifestSim, Vec<(String, Vec<u8>)>), ExportError> {
+    let (members, sensor_mass) = assembly_members(kit, meshes)?;
+    let files = mjcf::files(&kit.design, opts, &members, meshes, &sensor_mass, &opts.sim)?;
+    let entry = |(f, b): &(String, Vec<u8>)| ManifestDataFile {
+        file: f.clone(),
+        sha256: sha256_hex(b),
+    };
+    let Some((model, mesh_files)) = files.split_last() else {
+        unreachable!("mjcf::files ends with the model");
+    };
+    Ok((
+        ManifestSim {
+            mjcf: entry(model),
+            meshes: mesh_files.iter().map(entry).collect(),
+            camera: opts.sim.camera.as_ref().map(|c| c.what.clone()),
+            notes: opts.sim.notes.clone(),
+        },
+        files,
+    ))
+}
+
+/// `assembly.3mf`: the kit's assembled sensor, one object per member (`meshes`, checked closed
+/// 2-manifolds, in kit order), in the sensor frame.
+fn assembly_3mf(
+    kit: &Kit,
+    meshes: &[Mesh],
+    opts: &ExportOptions,
+) -> Result<(ManifestAssembly, Vec<u8>), ExportError> {
+    let (members, sensor_mass) = assembly_members(kit, meshes)?;
     let objects: Vec<three_mf::Object<'_>> = kit
         .assembly
         .iter()
@@ -680,6 +730,7 @@ mod tests {
             printers: Default::default(),
             command: OutputCommand::Export,
             force: false,
+            sim: mjcf::SimScene::default(),
         }
     }
 

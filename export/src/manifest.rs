@@ -40,6 +40,9 @@ pub struct Manifest {
     /// the sensor frame), when STEP was requested and the kit is a sensor.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub assembly_step: Option<ManifestAssemblyStep>,
+    /// `--format mjcf`: the simulator files.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sim: Option<ManifestSim>,
     /// `section.png`, the assembled sensor cut through its axis, and its legend; for a kit
     /// that is a sensor.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -65,6 +68,18 @@ pub struct Manifest {
     /// Data files written beside the meshes (point tables, geometry descriptions), in order.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub data_files: Vec<ManifestDataFile>,
+}
+
+/// The simulator files of the export (`--format mjcf`): the MJCF model and the meshes it
+/// loads, their hashes, where the camera comes from and the notes.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ManifestSim {
+    pub mjcf: ManifestDataFile,
+    pub meshes: Vec<ManifestDataFile>,
+    /// What the camera is (absent: the model has none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub camera: Option<String>,
+    pub notes: Vec<String>,
 }
 
 /// A data file of the export and its hash.

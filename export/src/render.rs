@@ -141,6 +141,13 @@ pub(crate) fn render(
         view
     });
     let cut_parts = cut_part_files(kit, opts, materials.as_ref(), &mut files)?;
+    let sim = if opts.formats.mjcf && !kit.assembly.is_empty() {
+        let (entry, sim_files) = crate::sim_files(kit, &assembly_meshes, opts)?;
+        files.extend(sim_files);
+        Some(entry)
+    } else {
+        None
+    };
     let pcb_outlines = pcb_files(kit, &mut files)?;
     let assembly_3mf = match assembly_3mf_made {
         Some(made) => {
@@ -167,6 +174,7 @@ pub(crate) fn render(
         plates: manifest_plates,
         assembly_3mf,
         assembly_step,
+        sim,
         section_view,
         cut_parts,
         pcb_outlines,

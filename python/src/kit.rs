@@ -48,6 +48,7 @@ pub(crate) fn formats(names: &[String]) -> PyResult<Formats> {
         stl: false,
         threemf: false,
         step: false,
+        mjcf: false,
     };
     for n in names {
         match n.as_str() {

@@ -110,6 +110,7 @@ impl KitWriter for ExportWriter {
                 stl: job.files.stl,
                 threemf: job.files.threemf,
                 step: false,
+                mjcf: false,
             },
             command_line: self.command_line.clone(),
             design_source: job.design_source.clone(),
@@ -119,6 +120,7 @@ impl KitWriter for ExportWriter {
             printers: Default::default(),
             command: OutputCommand::SweepVariant,
             force: false,
+            sim: Default::default(),
         };
         write_kit(kit, &job.dir, &opts)
             .map(|_| ())

@@ -28,6 +28,7 @@ pub fn export_options(design: &str, bench: &str, tol: ChordTolerance) -> ExportO
         printers: Default::default(),
         command: fabkit::export::OutputCommand::Export,
         force: false,
+        sim: Default::default(),
     }
 }
 

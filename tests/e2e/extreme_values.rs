@@ -155,6 +155,7 @@ fn export(
             stl: true,
             threemf: true,
             step: false,
+            mjcf: false,
         },
         vec!["extreme_values".into()],
         case,

@@ -31,6 +31,7 @@ mod output_ownership;
 mod plates;
 mod report_html;
 mod schema;
+mod sim_export;
 mod step_install;
 mod sweep_cli;
 mod tutorial;

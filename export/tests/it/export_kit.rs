@@ -111,6 +111,7 @@ fn opts() -> ExportOptions {
         printers: Default::default(),
         command: fabkit_export::OutputCommand::Export,
         force: false,
+        sim: Default::default(),
     }
 }
 
@@ -622,6 +623,7 @@ fn a_group_is_one_3mf_object_with_a_volume_per_part_and_stls_stay_put() {
         stl: true,
         threemf: false,
         step: false,
+        mjcf: false,
     };
     write_kit(&group_kit(), &stl_only, &o).unwrap();
     let sheet = fs::read_to_string(stl_only.join("FABRICATION.md")).unwrap();
@@ -768,6 +770,7 @@ fn formats_select_the_mesh_files() {
         stl: true,
         threemf: false,
         step: false,
+        mjcf: false,
     };
     write_kit(&test_kit(), &stl_only, &o).unwrap();
     assert!(!stl_only.join("tiny.3mf").exists());
@@ -786,6 +789,7 @@ fn formats_select_the_mesh_files() {
         stl: false,
         threemf: true,
         step: false,
+        mjcf: false,
     };
     let s = write_kit(&test_kit(), &mf_only, &o).unwrap();
     assert_eq!(

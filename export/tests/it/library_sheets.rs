@@ -40,6 +40,7 @@ fn export_as(
             stl: true,
             threemf,
             step: false,
+            mjcf: false,
         },
         command_line: vec!["fabkit".into(), "export".into(), design.into()],
         design_source: format!("library:{design}"),
@@ -49,6 +50,7 @@ fn export_as(
         printers: Default::default(),
         command: fabkit_export::OutputCommand::Export,
         force: false,
+        sim: Default::default(),
     };
     write_kit(&kit, &out, &opts).unwrap();
     let exported = Exported {
