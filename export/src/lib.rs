@@ -35,6 +35,7 @@ pub mod raster;
 mod render;
 pub mod section;
 mod sheet;
+pub mod urdf;
 pub use sheet::{marker_feature_words, marker_formers};
 pub mod step;
 mod stl;
@@ -69,6 +70,9 @@ pub struct Formats {
     /// `sim/<design>.xml` and `sim/meshes/*.stl`: the assembled sensor for MuJoCo
     /// ([`mjcf`]).
     pub mjcf: bool,
+    /// `sim/<design>.urdf` and `sim/meshes/*.stl`: the assembled sensor as a URDF (PyBullet,
+    /// ROS; [`urdf`]).
+    pub urdf: bool,
 }
 
 impl Default for Formats {
@@ -79,6 +83,7 @@ impl Default for Formats {
             threemf: true,
             step: false,
             mjcf: false,
+            urdf: false,
         }
     }
 }
@@ -447,7 +452,8 @@ fn assembly_members(
     Ok((members, sensor_mass))
 }
 
-/// `sim/`: the MJCF model and its meshes ([`mjcf`]), and their manifest entry.
+/// `sim/`: the simulator models, their meshes and the camera file ([`mjcf::files`]), and
+/// their manifest entry.
 ///
 /// # Errors
 /// As [`assembly_members`] and the STL writer's.
@@ -457,18 +463,25 @@ pub(crate) fn sim_files(
     opts: &ExportOptions,
 ) -> Result<(ManifestSim, Vec<(String, Vec<u8>)>), ExportError> {
     let (members, sensor_mass) = assembly_members(kit, meshes)?;
-    let files = mjcf::files(&kit.design, opts, &members, meshes, &sensor_mass, &opts.sim)?;
-    let entry = |(f, b): &(String, Vec<u8>)| ManifestDataFile {
-        file: f.clone(),
-        sha256: sha256_hex(b),
-    };
-    let Some((model, mesh_files)) = files.split_last() else {
-        unreachable!("mjcf::files ends with the model");
-    };
+    let files = mjcf::files(&kit.design, opts, &members, meshes, &sensor_mass)?;
+    let entries: Vec<ManifestDataFile> = files
+        .iter()
+        .map(|(f, b)| ManifestDataFile {
+            file: f.clone(),
+            sha256: sha256_hex(b),
+        })
+        .collect();
+    let pick = |ext: &str| entries.iter().find(|e| e.file.ends_with(ext)).cloned();
     Ok((
         ManifestSim {
-            mjcf: entry(model),
-            meshes: mesh_files.iter().map(entry).collect(),
+            mjcf: pick(".xml"),
+            urdf: pick(".urdf"),
+            camera_file: pick("/camera.yaml"),
+            meshes: entries
+                .iter()
+                .filter(|e| e.file.ends_with(".stl"))
+                .cloned()
+                .collect(),
             camera: opts.sim.camera.as_ref().map(|c| c.what.clone()),
             notes: opts.sim.notes.clone(),
         },

@@ -70,11 +70,16 @@ pub struct Manifest {
     pub data_files: Vec<ManifestDataFile>,
 }
 
-/// The simulator files of the export (`--format mjcf`): the MJCF model and the meshes it
-/// loads, their hashes, where the camera comes from and the notes.
+/// The simulator files of the export (`--format mjcf,urdf`): the models and the meshes they
+/// load, their hashes, the camera file, where the camera comes from and the notes.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ManifestSim {
-    pub mjcf: ManifestDataFile,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mjcf: Option<ManifestDataFile>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub urdf: Option<ManifestDataFile>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub camera_file: Option<ManifestDataFile>,
     pub meshes: Vec<ManifestDataFile>,
     /// What the camera is (absent: the model has none).
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -40,6 +40,9 @@ pub struct SimCamera {
     pub fy_px: f64,
     /// What the camera is and what the pinhole leaves out, for the file's comment.
     pub what: String,
+    /// The camera's own file (OpenCV YAML, its true model), written beside the models as
+    /// `sim/camera.yaml`; `None`: none.
+    pub file: Option<Vec<u8>>,
 }
 
 /// A light an MJCF model carries: a spot light.
@@ -80,7 +83,7 @@ pub fn skin_member(members: &[ManifestMember]) -> Option<usize> {
 
 /// `rgba` of a member: black for a black material, clear for the core and the filling gel,
 /// translucent for a cast layer, grey for a printed part, green for a bought board.
-fn rgba(m: &ManifestMember) -> &'static str {
+pub(crate) fn rgba(m: &ManifestMember) -> &'static str {
     let material = m.material.as_deref().unwrap_or("");
     if material.contains("black") {
         "0.08 0.08 0.08 1"
@@ -96,7 +99,7 @@ fn rgba(m: &ManifestMember) -> &'static str {
 }
 
 /// A number in metres (from mm) or any unit, written to 12 significant digits.
-fn num(v: f64) -> String {
+pub(crate) fn num(v: f64) -> String {
     if v == 0.0 {
         // -0 too
         return "0".into();
@@ -116,7 +119,7 @@ fn num(v: f64) -> String {
     }
 }
 
-fn vec3(v: [f64; 3], scale: f64) -> String {
+pub(crate) fn vec3(v: [f64; 3], scale: f64) -> String {
     format!(
         "{} {} {}",
         num(v[0] * scale),
@@ -125,7 +128,7 @@ fn vec3(v: [f64; 3], scale: f64) -> String {
     )
 }
 
-fn escape(s: &str) -> String {
+pub(crate) fn escape(s: &str) -> String {
     s.replace('&', "&amp;")
         .replace('<', "&lt;")
         .replace('>', "&gt;")
@@ -253,8 +256,9 @@ pub fn model(
     x
 }
 
-/// The files of the MJCF export: `sim/meshes/<member>.stl` (binary STL of each member's
-/// written mesh, mm) and `sim/<design>.xml`, as (relative path, bytes).
+/// The simulator files: `sim/meshes/<member>.stl` (binary STL of each member's written mesh,
+/// mm), `sim/camera.yaml` when the camera has a file, then `sim/<design>.xml` (MJCF, with
+/// `mjcf`) and `sim/<design>.urdf` (with `urdf`), as (relative path, bytes).
 ///
 /// # Errors
 /// As the STL writer's.
@@ -264,8 +268,8 @@ pub(crate) fn files(
     members: &[ManifestMember],
     meshes: &[Mesh],
     mass: &SensorMass,
-    scene: &SimScene,
 ) -> Result<Vec<(String, Vec<u8>)>, crate::ExportError> {
+    let scene = &opts.sim;
     let mut out = Vec::new();
     for (m, mesh) in members.iter().zip(meshes) {
         let head = crate::stl::header(&opts.fabkit_version, design, &m.name, &opts.design_sha256);
@@ -274,19 +278,24 @@ pub(crate) fn files(
             crate::stl::encode(&m.name, mesh, &head)?,
         ));
     }
-    out.push((
-        format!("{SIM_DIR}/{design}.xml"),
-        model(
-            design,
-            &format!(
-                "fabkit {}: design {} ({}, sha256:{})",
-                opts.fabkit_version, design, opts.design_source, opts.design_sha256
-            ),
-            members,
-            mass,
-            scene,
-        )
-        .into_bytes(),
-    ));
+    if let Some(bytes) = scene.camera.as_ref().and_then(|c| c.file.clone()) {
+        out.push((format!("{SIM_DIR}/camera.yaml"), bytes));
+    }
+    let header = format!(
+        "fabkit {}: design {} ({}, sha256:{})",
+        opts.fabkit_version, design, opts.design_source, opts.design_sha256
+    );
+    if opts.formats.mjcf {
+        out.push((
+            format!("{SIM_DIR}/{design}.xml"),
+            model(design, &header, members, mass, scene).into_bytes(),
+        ));
+    }
+    if opts.formats.urdf {
+        out.push((
+            format!("{SIM_DIR}/{design}.urdf"),
+            crate::urdf::model(design, &header, members, mass, scene).into_bytes(),
+        ));
+    }
     Ok(out)
 }

@@ -68,6 +68,7 @@ impl MeshOutputArgs {
                 threemf: format.contains(&Format::ThreeMf),
                 step: format.contains(&Format::Step),
                 mjcf: format.contains(&Format::Mjcf),
+                urdf: format.contains(&Format::Urdf),
             },
             std::env::args().collect(),
             &loaded.source,
@@ -75,7 +76,7 @@ impl MeshOutputArgs {
             tol.mm(),
             loaded.design.printers.clone(),
         );
-        if opts.formats.mjcf {
+        if opts.formats.mjcf || opts.formats.urdf {
             opts.sim = sim_scene(&loaded.design, tol);
         }
         opts
@@ -134,6 +135,9 @@ pub(crate) enum Format {
     /// The assembled sensor for MuJoCo: sim/<design>.xml (MJCF) and sim/meshes/*.stl, with its
     /// mass, inertia, camera and lights.
     Mjcf,
+    /// The assembled sensor as a URDF (PyBullet, ROS): sim/<design>.urdf, sim/meshes/*.stl and
+    /// the camera's file, with its mass, inertia and camera frame.
+    Urdf,
 }
 
 /// The camera and lights of `design`'s simulator files: its nominal camera (`fabkit calibrate
@@ -165,6 +169,10 @@ pub(crate) fn sim_scene(
                     fovy,
                     n.view_angle_deg
                 ),
+                file: fabkit_calibration::nominal::nominal_files(&n, "fabkit export")
+                    .ok()
+                    .and_then(|f| f.into_iter().find(|(name, _)| name == "camera.yaml"))
+                    .map(|(_, bytes)| bytes),
             });
         }
         Err(e) => scene.notes.push(format!("no camera: {e}")),

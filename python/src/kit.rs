@@ -49,6 +49,7 @@ pub(crate) fn formats(names: &[String]) -> PyResult<Formats> {
         threemf: false,
         step: false,
         mjcf: false,
+        urdf: false,
     };
     for n in names {
         match n.as_str() {

@@ -111,6 +111,7 @@ impl KitWriter for ExportWriter {
                 threemf: job.files.threemf,
                 step: false,
                 mjcf: false,
+                urdf: false,
             },
             command_line: self.command_line.clone(),
             design_source: job.design_source.clone(),

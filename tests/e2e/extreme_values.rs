@@ -156,6 +156,7 @@ fn export(
             threemf: true,
             step: false,
             mjcf: false,
+            urdf: false,
         },
         vec!["extreme_values".into()],
         case,

@@ -1,12 +1,16 @@
-//! `fabkit export DESIGN --format mjcf` (issue 103): the assembled sensor as MuJoCo loads it.
-//! For every library design MuJoCo (`mujoco` from PyPI, tests/oracles/mujoco_check.py) loads
-//! `sim/<design>.xml` with its meshes and steps it; the body's mass, centre of mass and full
-//! inertia tensor are the manifest's (`assembly_3mf.mass`, checked against trimesh in
-//! tests/e2e/mass.rs) within 1e-6 relative; there is one mesh per assembly member; where the
-//! design places a camera, MuJoCo's camera sits where `fabkit calibrate nominal` puts it
-//! (position within 1e-9 m, axes within 1e-9: MuJoCo's x right, y up, looking along -z, the
-//! OpenCV frame turned about x), its fovy the pinhole's 2 atan(h / 2 / fy) of the nominal
-//! camera file, and the contact-surface site on the skin's top.
+//! `fabkit export DESIGN --format mjcf,urdf` (issue 103): the assembled sensor as MuJoCo and
+//! PyBullet load it. For every library design MuJoCo (`mujoco` from PyPI,
+//! tests/oracles/mujoco_check.py) loads `sim/<design>.xml` with its meshes and steps it, and
+//! PyBullet (DIRECT, tests/oracles/pybullet_check.py) loads `sim/<design>.urdf` and steps it;
+//! in both the body's mass, centre of mass and full inertia tensor are the manifest's
+//! (`assembly_3mf.mass`, checked against trimesh in tests/e2e/mass.rs) within 1e-6 relative,
+//! and there is one mesh per assembly member; the URDF's frame links weigh nothing. Where the
+//! design places a camera, MuJoCo's camera and the URDF's `camera_optical_frame` sit where
+//! `fabkit calibrate nominal` puts it (in MuJoCo within 1e-9 m, its axes within 1e-9: x right,
+//! y up, looking along -z, the OpenCV frame turned about x; in the URDF's text within 1e-12 m;
+//! in PyBullet, which keeps a link's frame in single precision, within 1e-8 m and 1e-6), MuJoCo's fovy is
+//! the pinhole's 2 atan(h / 2 / fy) of the nominal camera file, `sim/camera.yaml` is that file,
+//! and the contact surface (site, link) is on the skin's top.
 
 use crate::common::{missing, oracle_python, repo_root, run, text};
 use serde_json::Value;
@@ -32,7 +36,7 @@ fn fy_px(camera_yaml: &str) -> f64 {
 }
 
 #[test]
-fn every_library_design_loads_in_mujoco_with_its_mass_and_camera() {
+fn every_library_design_loads_in_mujoco_and_pybullet_with_its_mass_and_camera() {
     let Some(py) = oracle_python() else {
         return missing("the oracle python (mujoco)");
     };
@@ -50,7 +54,14 @@ fn every_library_design_loads_in_mujoco_with_its_mass_and_camera() {
     ] {
         let o = run(
             dir,
-            &["export", design, "--format", "3mf,mjcf", "--out", design],
+            &[
+                "export",
+                design,
+                "--format",
+                "3mf,mjcf,urdf",
+                "--out",
+                design,
+            ],
             &[],
         );
         assert!(o.status.success(), "{design}: {}", text(&o.stderr));
@@ -69,6 +80,18 @@ fn every_library_design_loads_in_mujoco_with_its_mass_and_camera() {
             text(&o.stderr)
         );
         let mj: Value = serde_json::from_slice(&o.stdout).unwrap();
+        let o = std::process::Command::new(&py)
+            .arg(repo_root().join("tests/oracles/pybullet_check.py"))
+            .arg(dir.join(design).join(format!("sim/{design}.urdf")))
+            .output()
+            .unwrap();
+        assert!(
+            o.status.success(),
+            "{design}: {}\n{}",
+            text(&o.stdout),
+            text(&o.stderr)
+        );
+        let pb: Value = serde_json::from_slice(&o.stdout).unwrap();
         let mass = &manifest["assembly_3mf"]["mass"];
         let members = manifest["assembly_3mf"]["members"].as_array().unwrap();
         assert_eq!(
@@ -96,11 +119,15 @@ fn every_library_design_loads_in_mujoco_with_its_mass_and_camera() {
         for i in 0..3 {
             for j in 0..3 {
                 let want = f(&mass["inertia_g_mm2"][i][j]) * 1e-9;
-                let got = f(&mj["body"]["inertia_kg_m2"][i][j]);
-                assert!(
-                    (got - want).abs() < 1e-6 * scale,
-                    "{design} I{i}{j}: {got} vs {want}"
-                );
+                for (what, got) in [
+                    ("MuJoCo", f(&mj["body"]["inertia_kg_m2"][i][j])),
+                    ("PyBullet", f(&pb["base"]["inertia_kg_m2"][i][j])),
+                ] {
+                    assert!(
+                        (got - want).abs() < 1e-6 * scale,
+                        "{design} {what} I{i}{j}: {got} vs {want}"
+                    );
+                }
             }
         }
         // the contact-surface site on the skin's top (above the centre of mass)
@@ -123,6 +150,10 @@ fn every_library_design_loads_in_mujoco_with_its_mass_and_camera() {
         if !nominal.status.success() {
             assert!(mj["camera"].is_null(), "{design}: {mj}");
             assert!(
+                pb["links"]["camera_optical_frame"].is_null(),
+                "{design}: {pb}"
+            );
+            assert!(
                 text(&std::fs::read(dir.join(format!("{design}/sim/{design}.xml"))).unwrap())
                     .contains("<!-- no camera: "),
                 "{design}"
@@ -134,10 +165,37 @@ fn every_library_design_loads_in_mujoco_with_its_mass_and_camera() {
         let t = &ext["T_cam_sensor"];
         let r = |i: usize, j: usize| f(&t[i][j]);
         let cam = &mj["camera"];
+        let frame = &pb["links"]["camera_optical_frame"];
+        // the camera joint's origin as the URDF writes it
+        let urdf =
+            std::fs::read_to_string(dir.join(format!("{design}/sim/{design}.urdf"))).unwrap();
+        let joint = &urdf[urdf
+            .find("<joint name=\"camera_optical_frame_joint\"")
+            .unwrap()..];
+        let xyz = &joint[joint.find("xyz=\"").unwrap() + 5..];
+        let urdf_camera: Vec<f64> = xyz[..xyz.find('"').unwrap()]
+            .split(' ')
+            .map(|v| v.parse().unwrap())
+            .collect();
         for k in 0..3 {
             // the camera's centre in the sensor frame: -R^T t
             let want = -(0..3).map(|i| r(i, k) * f(&t[i][3])).sum::<f64>() * 1e-3;
             assert!((f(&cam["pos_m"][k]) - want).abs() < 1e-9, "{design}: {cam}");
+            // PyBullet keeps link frames in single precision (6e-8 relative); the file's
+            // numbers are checked exactly below
+            assert!(
+                (f(&frame["pos_m"][k]) - want).abs() < 1e-8,
+                "{design}: {frame}"
+            );
+            assert!(
+                (urdf_camera[k] - want).abs() < 1e-12,
+                "{design}: {urdf_camera:?}"
+            );
+            // the optical frame's axes (columns) are OpenCV's: the rows of R
+            for c in 0..3 {
+                let got = f(&frame["R"][k][c]);
+                assert!((got - r(c, k)).abs() < 1e-6, "{design}: {frame}");
+            }
             // MuJoCo's axes: OpenCV's x, -y, -z (the rows of R are OpenCV's axes in the sensor frame)
             for (c, sign) in [(0, 1.0), (1, -1.0), (2, -1.0)] {
                 let want = sign * r(c, k);
@@ -150,6 +208,11 @@ fn every_library_design_loads_in_mujoco_with_its_mass_and_camera() {
         let fovy = 2.0 * (240.0 / fy_px(&camera_yaml)).atan().to_degrees();
         assert!((f(&cam["fovy_deg"]) - fovy).abs() < 1e-9, "{design}: {cam}");
         assert_eq!(cam["resolution"], serde_json::json!([640, 480]), "{design}");
+        assert_eq!(
+            std::fs::read(dir.join(format!("{design}/sim/camera.yaml"))).unwrap(),
+            camera_yaml.as_bytes(),
+            "{design}: sim/camera.yaml is the nominal camera's file"
+        );
     }
     // R-Tac0, UVDtact, the TacTip (and any design that places its lens)
     assert!(cameras >= 2, "{cameras} designs with a camera");

@@ -624,6 +624,7 @@ fn a_group_is_one_3mf_object_with_a_volume_per_part_and_stls_stay_put() {
         threemf: false,
         step: false,
         mjcf: false,
+        urdf: false,
     };
     write_kit(&group_kit(), &stl_only, &o).unwrap();
     let sheet = fs::read_to_string(stl_only.join("FABRICATION.md")).unwrap();
@@ -771,6 +772,7 @@ fn formats_select_the_mesh_files() {
         threemf: false,
         step: false,
         mjcf: false,
+        urdf: false,
     };
     write_kit(&test_kit(), &stl_only, &o).unwrap();
     assert!(!stl_only.join("tiny.3mf").exists());
@@ -790,6 +792,7 @@ fn formats_select_the_mesh_files() {
         threemf: true,
         step: false,
         mjcf: false,
+        urdf: false,
     };
     let s = write_kit(&test_kit(), &mf_only, &o).unwrap();
     assert_eq!(

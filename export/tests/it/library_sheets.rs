@@ -41,6 +41,7 @@ fn export_as(
             threemf,
             step: false,
             mjcf: false,
+            urdf: false,
         },
         command_line: vec!["fabkit".into(), "export".into(), design.into()],
         design_source: format!("library:{design}"),
