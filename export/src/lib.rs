@@ -36,6 +36,7 @@ mod render;
 pub mod section;
 mod sheet;
 pub mod urdf;
+pub mod usd;
 pub use sheet::{marker_feature_words, marker_formers};
 pub mod step;
 mod stl;
@@ -73,6 +74,9 @@ pub struct Formats {
     /// `sim/<design>.urdf` and `sim/meshes/*.stl`: the assembled sensor as a URDF (PyBullet,
     /// ROS; [`urdf`]).
     pub urdf: bool,
+    /// `sim/<design>.usda` and `sim/meshes/*.stl`: the assembled sensor as a USD layer (Isaac
+    /// Sim, Isaac Lab; [`usd`]).
+    pub usd: bool,
 }
 
 impl Default for Formats {
@@ -84,6 +88,7 @@ impl Default for Formats {
             step: false,
             mjcf: false,
             urdf: false,
+            usd: false,
         }
     }
 }
@@ -476,6 +481,7 @@ pub(crate) fn sim_files(
         ManifestSim {
             mjcf: pick(".xml"),
             urdf: pick(".urdf"),
+            usd: pick(".usda"),
             camera_file: pick("/camera.yaml"),
             meshes: entries
                 .iter()

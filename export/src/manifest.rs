@@ -79,6 +79,8 @@ pub struct ManifestSim {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub urdf: Option<ManifestDataFile>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub usd: Option<ManifestDataFile>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub camera_file: Option<ManifestDataFile>,
     pub meshes: Vec<ManifestDataFile>,
     /// What the camera is (absent: the model has none).

@@ -258,7 +258,8 @@ pub fn model(
 
 /// The simulator files: `sim/meshes/<member>.stl` (binary STL of each member's written mesh,
 /// mm), `sim/camera.yaml` when the camera has a file, then `sim/<design>.xml` (MJCF, with
-/// `mjcf`) and `sim/<design>.urdf` (with `urdf`), as (relative path, bytes).
+/// `mjcf`), `sim/<design>.urdf` (with `urdf`) and `sim/<design>.usda` (with `usd`), as
+/// (relative path, bytes).
 ///
 /// # Errors
 /// As the STL writer's.
@@ -295,6 +296,12 @@ pub(crate) fn files(
         out.push((
             format!("{SIM_DIR}/{design}.urdf"),
             crate::urdf::model(design, &header, members, mass, scene).into_bytes(),
+        ));
+    }
+    if opts.formats.usd {
+        out.push((
+            format!("{SIM_DIR}/{design}.usda"),
+            crate::usd::layer(design, &header, members, meshes, mass, scene).into_bytes(),
         ));
     }
     Ok(out)

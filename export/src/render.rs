@@ -141,7 +141,9 @@ pub(crate) fn render(
         view
     });
     let cut_parts = cut_part_files(kit, opts, materials.as_ref(), &mut files)?;
-    let sim = if (opts.formats.mjcf || opts.formats.urdf) && !kit.assembly.is_empty() {
+    let sim = if (opts.formats.mjcf || opts.formats.urdf || opts.formats.usd)
+        && !kit.assembly.is_empty()
+    {
         let (entry, sim_files) = crate::sim_files(kit, &assembly_meshes, opts)?;
         files.extend(sim_files);
         Some(entry)

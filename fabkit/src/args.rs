@@ -69,6 +69,7 @@ impl MeshOutputArgs {
                 step: format.contains(&Format::Step),
                 mjcf: format.contains(&Format::Mjcf),
                 urdf: format.contains(&Format::Urdf),
+                usd: format.contains(&Format::Usd),
             },
             std::env::args().collect(),
             &loaded.source,
@@ -76,7 +77,7 @@ impl MeshOutputArgs {
             tol.mm(),
             loaded.design.printers.clone(),
         );
-        if opts.formats.mjcf || opts.formats.urdf {
+        if opts.formats.mjcf || opts.formats.urdf || opts.formats.usd {
             opts.sim = sim_scene(&loaded.design, tol);
         }
         opts
@@ -138,6 +139,9 @@ pub(crate) enum Format {
     /// The assembled sensor as a URDF (PyBullet, ROS): sim/<design>.urdf, sim/meshes/*.stl and
     /// the camera's file, with its mass, inertia and camera frame.
     Urdf,
+    /// The assembled sensor as a USD layer (Isaac Sim, Isaac Lab): sim/<design>.usda with
+    /// UsdPhysics mass, the meshes, the camera, the LEDs.
+    Usd,
 }
 
 /// The camera and lights of `design`'s simulator files: its nominal camera (`fabkit calibrate

@@ -50,6 +50,7 @@ pub(crate) fn formats(names: &[String]) -> PyResult<Formats> {
         step: false,
         mjcf: false,
         urdf: false,
+        usd: false,
     };
     for n in names {
         match n.as_str() {

@@ -112,6 +112,7 @@ impl KitWriter for ExportWriter {
                 step: false,
                 mjcf: false,
                 urdf: false,
+                usd: false,
             },
             command_line: self.command_line.clone(),
             design_source: job.design_source.clone(),

@@ -157,6 +157,7 @@ fn export(
             step: false,
             mjcf: false,
             urdf: false,
+            usd: false,
         },
         vec!["extreme_values".into()],
         case,

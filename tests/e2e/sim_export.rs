@@ -1,5 +1,5 @@
-//! `fabkit export DESIGN --format mjcf,urdf` (issue 103): the assembled sensor as MuJoCo and
-//! PyBullet load it. For every library design MuJoCo (`mujoco` from PyPI,
+//! `fabkit export DESIGN --format mjcf,urdf,usd` (issue 103): the assembled sensor as MuJoCo,
+//! PyBullet and USD (usd-core, [`check_usd`]) read it. For every library design MuJoCo (`mujoco` from PyPI,
 //! tests/oracles/mujoco_check.py) loads `sim/<design>.xml` with its meshes and steps it, and
 //! PyBullet (DIRECT, tests/oracles/pybullet_check.py) loads `sim/<design>.urdf` and steps it;
 //! in both the body's mass, centre of mass and full inertia tensor are the manifest's
@@ -35,6 +35,65 @@ fn fy_px(camera_yaml: &str) -> f64 {
     numbers[4]
 }
 
+/// The USD layer as usd-core reads it: a stage in metres and kilograms, z up, the design its
+/// default prim with no schema error; its MassAPI the manifest's (mass 1e-6 relative, centre
+/// 1e-8 m, the tensor rebuilt from the principal moments and axes 1e-6 of its largest: the
+/// attributes are single precision); one triangle mesh per member, the skin alone with
+/// CollisionAPI, each authored extent the box of its points and the member's box in the
+/// manifest (1e-8 m).
+fn check_usd(design: &str, usd: &Value, members: &[Value], mass: &Value) {
+    assert_eq!(usd["default_prim"], design, "{usd}");
+    assert_eq!(f(&usd["meters_per_unit"]), 1.0);
+    assert_eq!(f(&usd["kilograms_per_unit"]), 1.0);
+    assert_eq!(usd["up_axis"], "Z");
+    assert_eq!(usd["errors"], serde_json::json!([]), "{design}");
+    let m = f(&mass["mass_g"]) * 1e-3;
+    assert!(
+        (f(&usd["mass"]["mass"]) - m).abs() < 1e-6 * m,
+        "{design}: {usd}"
+    );
+    let scale = (0..3)
+        .map(|k| f(&mass["inertia_g_mm2"][k][k]))
+        .fold(0.0, f64::max);
+    for i in 0..3 {
+        let want = f(&mass["centre_of_mass_mm"][i]) * 1e-3;
+        assert!(
+            (f(&usd["mass"]["center_of_mass"][i]) - want).abs() < 1e-8,
+            "{design}"
+        );
+        for j in 0..3 {
+            let want = f(&mass["inertia_g_mm2"][i][j]);
+            let got = f(&usd["mass"]["inertia"][i][j]) * 1e9;
+            assert!(
+                (got - want).abs() < 1e-6 * scale,
+                "{design} I{i}{j}: {got} vs {want}"
+            );
+        }
+    }
+    let meshes = usd["meshes"].as_object().unwrap();
+    assert_eq!(meshes.len(), members.len(), "{design}");
+    let collisions: Vec<&String> = meshes
+        .iter()
+        .filter(|(_, v)| v["collision"] == true)
+        .map(|(k, _)| k)
+        .collect();
+    assert_eq!(collisions.len(), 1, "{design}: {collisions:?}");
+    for m in members {
+        let mesh = &meshes[m["name"].as_str().unwrap()];
+        for (c, side) in ["min", "max"].iter().enumerate() {
+            for k in 0..3 {
+                let extent = f(&mesh["extent"][c][k]);
+                assert!(
+                    (extent - f(&mesh["points_box"][c][k])).abs() < 1e-9,
+                    "{design}"
+                );
+                let want = f(&m["bbox_mm"][side][k]) * 1e-3;
+                assert!((extent - want).abs() < 1e-8, "{design}: {mesh}");
+            }
+        }
+    }
+}
+
 #[test]
 fn every_library_design_loads_in_mujoco_and_pybullet_with_its_mass_and_camera() {
     let Some(py) = oracle_python() else {
@@ -58,7 +117,7 @@ fn every_library_design_loads_in_mujoco_and_pybullet_with_its_mass_and_camera() 
                 "export",
                 design,
                 "--format",
-                "3mf,mjcf,urdf",
+                "3mf,mjcf,urdf,usd",
                 "--out",
                 design,
             ],
@@ -92,8 +151,21 @@ fn every_library_design_loads_in_mujoco_and_pybullet_with_its_mass_and_camera() 
             text(&o.stderr)
         );
         let pb: Value = serde_json::from_slice(&o.stdout).unwrap();
+        let o = std::process::Command::new(&py)
+            .arg(repo_root().join("tests/oracles/usd_check.py"))
+            .arg(dir.join(design).join(format!("sim/{design}.usda")))
+            .output()
+            .unwrap();
+        assert!(
+            o.status.success(),
+            "{design}: {}\n{}",
+            text(&o.stdout),
+            text(&o.stderr)
+        );
+        let usd: Value = serde_json::from_slice(&o.stdout).unwrap();
         let mass = &manifest["assembly_3mf"]["mass"];
         let members = manifest["assembly_3mf"]["members"].as_array().unwrap();
+        check_usd(design, &usd, members, mass);
         assert_eq!(
             mj["nmesh"].as_u64().unwrap() as usize,
             members.len(),
@@ -153,6 +225,7 @@ fn every_library_design_loads_in_mujoco_and_pybullet_with_its_mass_and_camera() 
                 pb["links"]["camera_optical_frame"].is_null(),
                 "{design}: {pb}"
             );
+            assert!(usd["camera"].is_null(), "{design}: {usd}");
             assert!(
                 text(&std::fs::read(dir.join(format!("{design}/sim/{design}.xml"))).unwrap())
                     .contains("<!-- no camera: "),
@@ -196,6 +269,16 @@ fn every_library_design_loads_in_mujoco_and_pybullet_with_its_mass_and_camera() 
                 let got = f(&frame["R"][k][c]);
                 assert!((got - r(c, k)).abs() < 1e-6, "{design}: {frame}");
             }
+            // USD's camera: rows of its transform are its axes (OpenCV's x, -y, -z), then its
+            // position (double precision)
+            let xf = &usd["camera"]["transform"];
+            assert!((f(&xf[3][k]) - want).abs() < 1e-12, "{design}: {xf}");
+            for (c, sign) in [(0, 1.0), (1, -1.0), (2, -1.0)] {
+                assert!(
+                    (f(&xf[c][k]) - sign * r(c, k)).abs() < 1e-12,
+                    "{design}: {xf}"
+                );
+            }
             // MuJoCo's axes: OpenCV's x, -y, -z (the rows of R are OpenCV's axes in the sensor frame)
             for (c, sign) in [(0, 1.0), (1, -1.0), (2, -1.0)] {
                 let want = sign * r(c, k);
@@ -205,7 +288,14 @@ fn every_library_design_loads_in_mujoco_and_pybullet_with_its_mass_and_camera() 
         }
         let camera_yaml =
             std::fs::read_to_string(dir.join(format!("nom_{design}/camera.yaml"))).unwrap();
-        let fovy = 2.0 * (240.0 / fy_px(&camera_yaml)).atan().to_degrees();
+        let fy = fy_px(&camera_yaml);
+        let fovy = 2.0 * (240.0 / fy).atan().to_degrees();
+        // USD: focal length over aperture is the focal length over the image width
+        let u = &usd["camera"];
+        let fx_usd = f(&u["focal_length"]) / f(&u["horizontal_aperture"]) * 640.0;
+        assert!((fx_usd - fy).abs() < 1e-6 * fy, "{design}: {u}");
+        let ratio = f(&u["vertical_aperture"]) / f(&u["horizontal_aperture"]);
+        assert!((ratio - 0.75).abs() < 1e-6, "{design}: {u}");
         assert!((f(&cam["fovy_deg"]) - fovy).abs() < 1e-9, "{design}: {cam}");
         assert_eq!(cam["resolution"], serde_json::json!([640, 480]), "{design}");
         assert_eq!(

@@ -625,6 +625,7 @@ fn a_group_is_one_3mf_object_with_a_volume_per_part_and_stls_stay_put() {
         step: false,
         mjcf: false,
         urdf: false,
+        usd: false,
     };
     write_kit(&group_kit(), &stl_only, &o).unwrap();
     let sheet = fs::read_to_string(stl_only.join("FABRICATION.md")).unwrap();
@@ -773,6 +774,7 @@ fn formats_select_the_mesh_files() {
         step: false,
         mjcf: false,
         urdf: false,
+        usd: false,
     };
     write_kit(&test_kit(), &stl_only, &o).unwrap();
     assert!(!stl_only.join("tiny.3mf").exists());
@@ -793,6 +795,7 @@ fn formats_select_the_mesh_files() {
         step: false,
         mjcf: false,
         urdf: false,
+        usd: false,
     };
     let s = write_kit(&test_kit(), &mf_only, &o).unwrap();
     assert_eq!(

@@ -42,6 +42,7 @@ fn export_as(
             step: false,
             mjcf: false,
             urdf: false,
+            usd: false,
         },
         command_line: vec!["fabkit".into(), "export".into(), design.into()],
         design_source: format!("library:{design}"),
