@@ -199,6 +199,124 @@ pub(crate) fn sim_scene(
     scene
 }
 
+/// The simulators' camera of a calibration: the intrinsics of `camera_file` as a pinhole (fy
+/// and the image size; a principal point off the centre or a lens distortion is named in the
+/// note, as MJCF's and USD's cameras cannot carry them) where `extrinsics_file` (the
+/// `extrinsics.json` of `fabkit calibrate extrinsics`) puts it; the camera file itself goes
+/// beside the models.
+///
+/// # Errors
+/// Unreadable files, by option; an extrinsics file solved for another design than `design`
+/// (its `optical_path_from`), by option, with both names; a camera file of another image size
+/// than the one the extrinsics were solved with (its `provenance.camera_file`, when that file
+/// is where the calibration read it).
+pub(crate) fn calibrated_sim_camera(
+    design: &str,
+    camera_file: &Path,
+    extrinsics_file: &Path,
+) -> Result<fabkit_export::mjcf::SimCamera, Box<dyn Error>> {
+    let model = fabkit_calibration::camera_file::read_camera_file(camera_file)
+        .map_err(|e| format!("--camera {}: {e}", camera_file.display()))?;
+    let (t_cam_sensor, _) =
+        fabkit_calibration::groundtruth::inputs::read_extrinsics(extrinsics_file)
+            .map_err(|e| format!("--extrinsics {}: {e}", extrinsics_file.display()))?;
+    // `design rtac0, the point table's (...)` or `design 'rtac0'` (calibrate nominal)
+    let text = std::fs::read_to_string(extrinsics_file)
+        .map_err(|e| format!("--extrinsics {}: {e}", extrinsics_file.display()))?;
+    let solved_for = serde_json::from_str::<serde_json::Value>(&text)
+        .ok()
+        .and_then(|v| v["optical_path_from"].as_str().map(str::to_owned))
+        .and_then(|from| {
+            let rest = from.strip_prefix("design ")?;
+            let name: String = rest
+                .trim_start_matches('\'')
+                .chars()
+                .take_while(|c| c.is_alphanumeric() || *c == '_' || *c == '-')
+                .collect();
+            Some(name)
+        });
+    if let Some(other) = solved_for.filter(|n| !n.is_empty() && n != design) {
+        return Err(format!(
+            "--extrinsics {}: solved for design '{other}', not '{design}': its pose is of another sensor",
+            extrinsics_file.display()
+        )
+        .into());
+    }
+    let i = model.intrinsics();
+    // the camera the pose was solved with, when its file is where the calibration read it
+    let solved_with = serde_json::from_str::<serde_json::Value>(&text)
+        .ok()
+        .and_then(|v| v["provenance"]["camera_file"].as_str().map(PathBuf::from))
+        .and_then(|p| {
+            let m = fabkit_calibration::camera_file::read_camera_file(&p).ok()?;
+            Some((p, m))
+        });
+    if let Some((p, m)) = solved_with {
+        let (a, b) = (m.intrinsics(), i);
+        if (a.image_width_px, a.image_height_px) != (b.image_width_px, b.image_height_px) {
+            return Err(format!(
+                "--camera {}: {} x {} px, but {} was solved with {} ({} x {} px): give that camera's file",
+                camera_file.display(),
+                b.image_width_px,
+                b.image_height_px,
+                extrinsics_file.display(),
+                p.display(),
+                a.image_width_px,
+                a.image_height_px
+            )
+            .into());
+        }
+    }
+    let (w, h) = (f64::from(i.image_width_px), f64::from(i.image_height_px));
+    let mut left_out = Vec::new();
+    let (dx, dy) = (i.cx_px - (w - 1.0) / 2.0, i.cy_px - (h - 1.0) / 2.0);
+    if dx.abs() > 1e-9 || dy.abs() > 1e-9 {
+        left_out.push(format!(
+            "its principal point {dx:+.2}, {dy:+.2} px off the image's centre"
+        ));
+    }
+    if (i.fx_px - i.fy_px).abs() > 1e-9 * i.fy_px {
+        left_out.push(format!(
+            "fx {:.2} px (fy {:.2} px is used)",
+            i.fx_px, i.fy_px
+        ));
+    }
+    if i.distortion.coefficients().iter().any(|c| *c != 0.0)
+        || matches!(
+            i.distortion,
+            fabkit_calibration::camera::Distortion::Fisheye(_)
+        )
+    {
+        left_out.push(format!("its {} lens model", i.distortion.name()));
+    }
+    let what = format!(
+        "the calibrated camera: {} placed by {}, as a pinhole of fy {:.2} px on {} x {} px{}",
+        camera_file.display(),
+        extrinsics_file.display(),
+        i.fy_px,
+        i.image_width_px,
+        i.image_height_px,
+        if left_out.is_empty() {
+            String::new()
+        } else {
+            format!(
+                "; the MJCF and USD cameras leave out {} (camera.yaml beside them has it)",
+                left_out.join(", ")
+            )
+        }
+    );
+    let file = std::fs::read(camera_file)
+        .map_err(|e| format!("--camera {}: {e}", camera_file.display()))?;
+    Ok(fabkit_export::mjcf::SimCamera {
+        t_sensor_cam: t_cam_sensor.inverse(),
+        width_px: i.image_width_px,
+        height_px: i.image_height_px,
+        fy_px: i.fy_px,
+        what,
+        file: Some(file),
+    })
+}
+
 /// A design and where it came from.
 pub(crate) type Loaded = library::LoadedDesign;
 

@@ -98,6 +98,15 @@ struct ExportArgs {
     /// cores a stage kept busy.
     #[arg(long)]
     timings: bool,
+    /// With --format mjcf, urdf or usd: a calibrated camera's file (OpenCV or ROS YAML, as
+    /// `calibrate extrinsics` reads it), whose intrinsics the simulators' camera takes in place
+    /// of the design's nominal camera; with --extrinsics.
+    #[arg(long, requires = "extrinsics", value_name = "camera.yaml")]
+    camera: Option<PathBuf>,
+    /// With --format mjcf, urdf or usd: the `extrinsics.json` of `fabkit calibrate extrinsics`
+    /// (T_cam_sensor) that places the simulators' camera; with --camera.
+    #[arg(long, requires = "camera", value_name = "extrinsics.json")]
+    extrinsics: Option<PathBuf>,
     #[command(flatten)]
     data_files: DataFileArgs,
 }
@@ -332,6 +341,21 @@ fn export(args: ExportArgs) -> Result<(), Box<dyn Error>> {
         .unwrap_or_else(|| Path::new("out").join(&loaded.design.name));
     let mut opts = args.mesh.options(&loaded, tol);
     opts.force = args.force;
+    if let (Some(camera), Some(extrinsics)) = (&args.camera, &args.extrinsics) {
+        let f = &opts.formats;
+        if !(f.mjcf || f.urdf || f.usd) {
+            return Err(
+                "--camera and --extrinsics place the simulators' camera: give --format mjcf, urdf or usd"
+                    .into(),
+            );
+        }
+        opts.sim.camera = Some(crate::args::calibrated_sim_camera(
+            &loaded.design.name,
+            camera,
+            extrinsics,
+        )?);
+        opts.sim.notes.retain(|n| !n.starts_with("no camera: "));
+    }
     // The output folder is checked before anything is built.
     fabkit_export::check_out_dir(&out, &opts.claim(&loaded.design.name))?;
     args.mesh.check_csg()?;

@@ -307,3 +307,188 @@ fn every_library_design_loads_in_mujoco_and_pybullet_with_its_mass_and_camera() 
     // R-Tac0, UVDtact, the TacTip (and any design that places its lens)
     assert!(cameras >= 2, "{cameras} designs with a camera");
 }
+
+/// Runs the oracle `script` with `args`; its JSON.
+fn oracle(py: &Path, script: &str, args: &[&Path]) -> Value {
+    let o = std::process::Command::new(py)
+        .arg(repo_root().join("tests/oracles").join(script))
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(
+        o.status.success(),
+        "{script}: {}\n{}",
+        text(&o.stdout),
+        text(&o.stderr)
+    );
+    serde_json::from_slice(&o.stdout).unwrap()
+}
+
+/// With `--camera` and `--extrinsics` (a calibration's files) the simulators' camera is the
+/// calibrated one: a pinhole camera file (fx = fy = 500 px, 640 x 480, centred) and a pose
+/// turned 10 deg about x and 20 deg about z, 0.5 / -0.3 / 17 mm off: MuJoCo's camera, the
+/// URDF's optical frame (PyBullet) and USD's Camera prim sit there (1e-9 m, 1e-8 m in
+/// PyBullet's single precision, 1e-12 m), MuJoCo's fovy is 2 atan(240 / 500), USD's focal
+/// ratio 500 / 640, and sim/camera.yaml is the given file. Refused by option with nothing
+/// written: an extrinsics file solved for another design, a camera file of another size than
+/// the one the extrinsics were solved with, and the options without a simulator format.
+#[test]
+fn a_calibrated_camera_is_placed_where_its_extrinsics_say() {
+    let Some(py) = oracle_python() else {
+        return missing("the oracle python (mujoco, pybullet, usd-core)");
+    };
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let camera = "image_width: 640\nimage_height: 480\ncamera_matrix:\n  rows: 3\n  cols: 3\n  data: [500.0, 0.0, 319.5, 0.0, 500.0, 239.5, 0.0, 0.0, 1.0]\ndistortion_model: plumb_bob\ndistortion_coefficients:\n  rows: 1\n  cols: 5\n  data: [0.0, 0.0, 0.0, 0.0, 0.0]\n";
+    std::fs::write(dir.join("pin.yaml"), camera).unwrap();
+    std::fs::write(
+        dir.join("big.yaml"),
+        camera.replace("image_width: 640", "image_width: 1280"),
+    )
+    .unwrap();
+    // R = Rz(20 deg) Rx(10 deg), t = (0.5, -0.3, 17) mm
+    let (a, b) = (10f64.to_radians(), 20f64.to_radians());
+    let rx = [
+        [1.0, 0.0, 0.0],
+        [0.0, a.cos(), -a.sin()],
+        [0.0, a.sin(), a.cos()],
+    ];
+    let rz = [
+        [b.cos(), -b.sin(), 0.0],
+        [b.sin(), b.cos(), 0.0],
+        [0.0, 0.0, 1.0],
+    ];
+    let r: [[f64; 3]; 3] =
+        std::array::from_fn(|i| std::array::from_fn(|j| (0..3).map(|k| rz[i][k] * rx[k][j]).sum()));
+    let t = [0.5, -0.3, 17.0];
+    let m: Vec<Vec<f64>> = (0..4)
+        .map(|i| {
+            (0..4)
+                .map(|j| match (i, j) {
+                    (3, 3) => 1.0,
+                    (3, _) => 0.0,
+                    (_, 3) => t[i],
+                    _ => r[i][j],
+                })
+                .collect()
+        })
+        .collect();
+    let extrinsics = |design: &str, camera_file: &Path| {
+        serde_json::json!({
+            "T_cam_sensor": m,
+            "optical_path_from": format!("design {design}, the point table's (fx/points/point_table.json)"),
+            "provenance": {"camera_file": camera_file.display().to_string()},
+        })
+        .to_string()
+    };
+    std::fs::write(
+        dir.join("ext.json"),
+        extrinsics("rtac0", &dir.join("pin.yaml")),
+    )
+    .unwrap();
+    let o = run(
+        dir,
+        &[
+            "export",
+            "rtac0",
+            "--format",
+            "3mf,mjcf,urdf,usd",
+            "--camera",
+            "pin.yaml",
+            "--extrinsics",
+            "ext.json",
+            "--out",
+            "k",
+        ],
+        &[],
+    );
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let sim = dir.join("k/sim");
+    let mj = oracle(
+        &py,
+        "mujoco_check.py",
+        &[&sim.join("rtac0.xml"), Path::new("rtac0"), Path::new("1")],
+    );
+    let pb = oracle(&py, "pybullet_check.py", &[&sim.join("rtac0.urdf")]);
+    let usd = oracle(&py, "usd_check.py", &[&sim.join("rtac0.usda")]);
+    // the camera's centre in the sensor frame: -R^T t
+    let centre: [f64; 3] =
+        std::array::from_fn(|k| -(0..3).map(|i| r[i][k] * t[i]).sum::<f64>() * 1e-3);
+    for k in 0..3 {
+        assert!(
+            (f(&mj["camera"]["pos_m"][k]) - centre[k]).abs() < 1e-9,
+            "{mj}"
+        );
+        let frame = &pb["links"]["camera_optical_frame"];
+        assert!((f(&frame["pos_m"][k]) - centre[k]).abs() < 1e-8, "{frame}");
+        let xf = &usd["camera"]["transform"];
+        assert!((f(&xf[3][k]) - centre[k]).abs() < 1e-12, "{xf}");
+        for (c, sign) in [(0, 1.0), (1, -1.0), (2, -1.0)] {
+            // the camera's axes in the sensor frame: the rows of R (OpenCV's), y and z flipped
+            // for MuJoCo and USD
+            let want = sign * r[c][k];
+            assert!(
+                (f(&mj["camera"]["R_body_cam"][k][c]) - want).abs() < 1e-9,
+                "{mj}"
+            );
+            assert!((f(&xf[c][k]) - want).abs() < 1e-12, "{xf}");
+            assert!((f(&frame["R"][k][c]) - r[c][k]).abs() < 1e-6, "{frame}");
+        }
+    }
+    let fovy = 2.0 * (240.0f64 / 500.0).atan().to_degrees();
+    assert!((f(&mj["camera"]["fovy_deg"]) - fovy).abs() < 1e-9, "{mj}");
+    let u = &usd["camera"];
+    let ratio = f(&u["focal_length"]) / f(&u["horizontal_aperture"]);
+    assert!((ratio - 500.0 / 640.0).abs() < 1e-6, "{u}");
+    assert_eq!(
+        std::fs::read(sim.join("camera.yaml")).unwrap(),
+        camera.as_bytes()
+    );
+    // refused by option, nothing written
+    std::fs::write(
+        dir.join("other.json"),
+        extrinsics("shadowtac", &dir.join("pin.yaml")),
+    )
+    .unwrap();
+    for (args, words) in [
+        (
+            vec![
+                "--format",
+                "mjcf",
+                "--camera",
+                "pin.yaml",
+                "--extrinsics",
+                "other.json",
+            ],
+            vec![
+                "--extrinsics other.json",
+                "design 'shadowtac'",
+                "not 'rtac0'",
+            ],
+        ),
+        (
+            vec![
+                "--format",
+                "mjcf",
+                "--camera",
+                "big.yaml",
+                "--extrinsics",
+                "ext.json",
+            ],
+            vec!["--camera big.yaml: 1280 x 480 px", "640 x 480 px"],
+        ),
+        (
+            vec!["--camera", "pin.yaml", "--extrinsics", "ext.json"],
+            vec!["--format mjcf, urdf or usd"],
+        ),
+    ] {
+        let mut all = vec!["export", "rtac0", "--out", "never"];
+        all.extend(&args);
+        let o = run(dir, &all, &[]);
+        assert!(!o.status.success(), "{args:?}");
+        for w in &words {
+            assert!(text(&o.stderr).contains(w), "{w}: {}", text(&o.stderr));
+        }
+        assert!(!dir.join("never").exists(), "{args:?}");
+    }
+}
