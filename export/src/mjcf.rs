@@ -8,8 +8,9 @@
 //!   `compiler inertiafromgeom="false"`: the geoms add nothing). It has no joint: a child of the
 //!   world it is fixed; attach it to a robot's link (MJCF `attach`/`include`).
 //! - Each member is a visual mesh geom (group 1, no contacts) coloured by what it is; the skin
-//!   (the outermost cast layer or the printed skin: [`skin_member`]) is also the collision
-//!   geom (group 3; MuJoCo collides with a mesh's convex hull).
+//!   (the outermost cast layer or the printed skin: [`skin_member`]) is also a collision geom
+//!   (group 3; MuJoCo collides with a mesh's convex hull), and each printed housing member
+//!   collides as a cylinder or a box round it ([`housing_shapes`]).
 //! - The `contact_surface` site sits at the top of the skin's box, on its axis.
 //! - The camera, when the design places one ([`SimCamera`]): MJCF cameras are pinholes looking
 //!   along their -z with y up; the camera frame here is OpenCV's (x right, y down, z forward),
@@ -79,6 +80,39 @@ pub fn skin_member(members: &[ManifestMember]) -> Option<usize> {
         }
     }
     best
+}
+
+/// A simple collision shape standing in for a housing member: a cylinder on the sensor's axis
+/// when the member's box is centred on it and square in x and y (within 1 um), else its box.
+/// Centre and sizes in mm.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum HousingShape {
+    /// Radius, height, centre.
+    Cylinder(f64, f64, [f64; 3]),
+    /// Half extents, centre.
+    Box([f64; 3], [f64; 3]),
+}
+
+/// The housing members (printed, not the skin) with their collision shapes, in assembly order.
+pub fn housing_shapes(members: &[ManifestMember]) -> Vec<(&ManifestMember, HousingShape)> {
+    let skin = skin_member(members);
+    members
+        .iter()
+        .enumerate()
+        .filter(|(i, m)| m.kind == MemberKind::Printed && Some(*i) != skin)
+        .map(|(_, m)| {
+            let (lo, hi) = (m.bbox_mm.min, m.bbox_mm.max);
+            let c: [f64; 3] = std::array::from_fn(|k| (lo[k] + hi[k]) / 2.0);
+            let half: [f64; 3] = std::array::from_fn(|k| (hi[k] - lo[k]) / 2.0);
+            let round = c[0].abs() < 1e-3 && c[1].abs() < 1e-3 && (half[0] - half[1]).abs() < 1e-3;
+            let shape = if round {
+                HousingShape::Cylinder(half[0], 2.0 * half[2], c)
+            } else {
+                HousingShape::Box(half, c)
+            };
+            (m, shape)
+        })
+        .collect()
 }
 
 /// `rgba` of a member: black for a black material, clear for the core and the filling gel,
@@ -206,6 +240,22 @@ pub fn model(
             "      <geom name=\"contact_surface_collision\" type=\"mesh\" mesh=\"{}\" group=\"3\" rgba=\"1 0.5 0 0.2\"/>",
             escape(&m.name)
         );
+        for (h, shape) in housing_shapes(members) {
+            let (kind, size, c) = match shape {
+                HousingShape::Cylinder(r, height, c) => (
+                    "cylinder",
+                    format!("{} {}", num(r * MM), num(height / 2.0 * MM)),
+                    c,
+                ),
+                HousingShape::Box(half, c) => ("box", vec3(half, MM), c),
+            };
+            let _ = writeln!(
+                x,
+                "      <geom name=\"{}_collision\" type=\"{kind}\" size=\"{size}\" pos=\"{}\" group=\"3\" rgba=\"0.5 0.5 1 0.2\"/>",
+                escape(&h.name),
+                vec3(c, MM)
+            );
+        }
         let b = m.bbox_mm;
         let top = [
             (b.min[0] + b.max[0]) / 2.0,

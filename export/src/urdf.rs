@@ -5,7 +5,8 @@
 //!   metres and kilograms: its inertial is the sensor's mass, centre of mass and inertia tensor
 //!   ([`crate::mass::SensorMass`]; URDF's `ixy` is the tensor's entry, minus the product
 //!   integral, as fabkit's), each member a visual mesh with its colour, the skin
-//!   ([`crate::mjcf::skin_member`]) the collision mesh.
+//!   ([`crate::mjcf::skin_member`]) a collision mesh and each printed housing member a collision
+//!   cylinder or box ([`crate::mjcf::housing_shapes`]).
 //! - `camera_optical_frame`: a link fixed to the sensor's at the camera's pose, in ROS's optical
 //!   frame convention (REP 103: z forward, x right, y down, which is OpenCV's camera frame and
 //!   fabkit's), when the design places a camera; its intrinsics are `camera.yaml` beside the
@@ -19,7 +20,7 @@ use std::fmt::Write as _;
 
 use crate::manifest::ManifestMember;
 use crate::mass::SensorMass;
-use crate::mjcf::{escape, num, rgba, skin_member, vec3, SimScene};
+use crate::mjcf::{escape, num, rgba, skin_member, vec3, HousingShape, SimScene};
 
 /// The URDF of `design`'s assembled sensor (see the module docs); `header` for the comment.
 pub fn model(
@@ -88,6 +89,25 @@ pub fn model(
             x,
             "    <collision name=\"contact_surface\"><origin xyz=\"0 0 0\" rpy=\"0 0 0\"/>{}</collision>",
             mesh(&members[s].name)
+        );
+    }
+    for (h, shape) in crate::mjcf::housing_shapes(members) {
+        let (geometry, c) = match shape {
+            HousingShape::Cylinder(r, height, c) => (
+                format!(
+                    "<cylinder radius=\"{}\" length=\"{}\"/>",
+                    num(r * MM),
+                    num(height * MM)
+                ),
+                c,
+            ),
+            HousingShape::Box(half, c) => (format!("<box size=\"{}\"/>", vec3(half, 2.0 * MM)), c),
+        };
+        let _ = writeln!(
+            x,
+            "    <collision name=\"{}\"><origin xyz=\"{}\" rpy=\"0 0 0\"/><geometry>{geometry}</geometry></collision>",
+            escape(&h.name),
+            vec3(c, MM)
         );
     }
     let _ = writeln!(x, "  </link>");

@@ -9,7 +9,8 @@
 //!   columns are its eigenvectors, a quaternion).
 //! - Each member is a Mesh (its written mesh, in metres, triangles, `extent`, display colour and
 //!   opacity); the skin ([`crate::mjcf::skin_member`]) carries CollisionAPI and
-//!   MeshCollisionAPI (convex hull), the others are visual.
+//!   MeshCollisionAPI (convex hull), the others are visual; each printed housing member collides
+//!   as a Cylinder or a scaled Cube round it (purpose `guide`, [`crate::mjcf::housing_shapes`]).
 //! - `camera`, when the design places one: a Camera prim (USD's x right, y up, looking along -z:
 //!   the OpenCV frame turned about x) whose `focalLength` over `horizontalAperture` is the
 //!   pinhole's focal length over the image width (square pixels, the principal point at the
@@ -23,7 +24,7 @@ use nalgebra::{Matrix3, Rotation3, SymmetricEigen, UnitQuaternion, Vector3};
 
 use crate::manifest::ManifestMember;
 use crate::mass::SensorMass;
-use crate::mjcf::{escape, num, rgba, skin_member, SimScene};
+use crate::mjcf::{escape, num, rgba, skin_member, HousingShape, SimScene};
 
 /// The principal moments (ascending) and the rotation whose columns are the principal axes (a
 /// right-handed frame) of the symmetric tensor `i`.
@@ -184,6 +185,40 @@ pub fn layer(
         );
         let _ = writeln!(x, "        float[] primvars:displayOpacity = [{}]", c[3]);
         let _ = writeln!(x, "    }}");
+    }
+    for (h, shape) in crate::mjcf::housing_shapes(members) {
+        let _ = writeln!(x);
+        let (prim, attrs, c) = match shape {
+            HousingShape::Cylinder(r, height, c) => (
+                "Cylinder",
+                format!(
+                    "        uniform token axis = \"Z\"\n        double radius = {}\n        double height = {}",
+                    num(r * MM),
+                    num(height * MM)
+                ),
+                c,
+            ),
+            HousingShape::Box(half, c) => (
+                "Cube",
+                // a unit-size cube scaled to the box
+                format!(
+                    "        double size = 1\n        float3 xformOp:scale = {}",
+                    tuple(half.map(|v| 2.0 * v * MM))
+                ),
+                c,
+            ),
+        };
+        let order = if prim == "Cube" {
+            "[\"xformOp:translate\", \"xformOp:scale\"]"
+        } else {
+            "[\"xformOp:translate\"]"
+        };
+        let _ = writeln!(
+            x,
+            "    def {prim} \"{}_collision\" (\n        prepend apiSchemas = [\"PhysicsCollisionAPI\"]\n    )\n    {{\n        uniform token purpose = \"guide\"\n{attrs}\n        double3 xformOp:translate = {}\n        uniform token[] xformOpOrder = {order}\n    }}",
+            escape(&h.name),
+            tuple(c.map(|v| v * MM))
+        );
     }
     if let Some(c) = &scene.camera {
         let r = c.t_sensor_cam.rotation.to_rotation_matrix();

@@ -4,7 +4,8 @@
 //! PyBullet (DIRECT, tests/oracles/pybullet_check.py) loads `sim/<design>.urdf` and steps it;
 //! in both the body's mass, centre of mass and full inertia tensor are the manifest's
 //! (`assembly_3mf.mass`, checked against trimesh in tests/e2e/mass.rs) within 1e-6 relative,
-//! and there is one mesh per assembly member; the URDF's frame links weigh nothing. Where the
+//! and there is one mesh per assembly member; the URDF's frame links weigh nothing; each
+//! collides with the skin's mesh and a cylinder or box round each printed housing member's box. Where the
 //! design places a camera, MuJoCo's camera and the URDF's `camera_optical_frame` sit where
 //! `fabkit calibrate nominal` puts it (in MuJoCo within 1e-9 m, its axes within 1e-9: x right,
 //! y up, looking along -z, the OpenCV frame turned about x; in the URDF's text within 1e-12 m;
@@ -33,6 +34,14 @@ fn fy_px(camera_yaml: &str) -> f64 {
         .map(|s| s.trim().parse().unwrap())
         .collect();
     numbers[4]
+}
+
+/// The printed housing members (not a printed skin): each collides as a simple shape.
+fn housing(members: &[Value]) -> Vec<&Value> {
+    members
+        .iter()
+        .filter(|m| m["kind"] == "printed" && m["name"] != "skin")
+        .collect()
 }
 
 /// The USD layer as usd-core reads it: a stage in metres and kilograms, z up, the design its
@@ -78,6 +87,12 @@ fn check_usd(design: &str, usd: &Value, members: &[Value], mass: &Value) {
         .map(|(k, _)| k)
         .collect();
     assert_eq!(collisions.len(), 1, "{design}: {collisions:?}");
+    // the skin's mesh and one shape per housing member
+    assert_eq!(
+        usd["collisions"].as_array().unwrap().len(),
+        1 + housing(members).len(),
+        "{design}: {usd}"
+    );
     for m in members {
         let mesh = &meshes[m["name"].as_str().unwrap()];
         for (c, side) in ["min", "max"].iter().enumerate() {
@@ -172,17 +187,69 @@ fn every_library_design_loads_in_mujoco_and_pybullet_with_its_mass_and_camera() 
             "{design}"
         );
         assert_eq!(mj["steps"], 10);
-        let m = f(&mass["mass_g"]) * 1e-3;
-        assert!(
-            (f(&mj["body"]["mass_kg"]) - m).abs() < 1e-6 * m,
-            "{design}: {mj}"
+        assert_eq!(
+            pb["visual_shapes"].as_u64().unwrap() as usize,
+            members.len(),
+            "{design}"
         );
+        assert!(
+            pb["link_masses_kg"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .all(|m| f(m) == 0.0),
+            "{design}: {pb}"
+        );
+        let shapes = housing(members);
+        assert_eq!(
+            pb["collision_shapes"].as_u64().unwrap() as usize,
+            1 + shapes.len(),
+            "{design}: {pb}"
+        );
+        // MuJoCo's collision geoms: the skin's mesh, and a cylinder or box round each housing
+        // member's box (sizes are half extents; a cylinder's radius half its width)
+        let geoms = mj["collision_geoms"].as_object().unwrap();
+        assert_eq!(geoms.len(), 1 + shapes.len(), "{design}: {geoms:?}");
+        for h in &shapes {
+            let g = &geoms[&format!("{}_collision", h["name"].as_str().unwrap())];
+            let (lo, hi) = (&h["bbox_mm"]["min"], &h["bbox_mm"]["max"]);
+            let half = |k: usize| (f(&hi[k]) - f(&lo[k])) / 2.0 * 1e-3;
+            let size = |k: usize| f(&g["size"][k]);
+            match g["type"].as_str().unwrap() {
+                "cylinder" => assert!(
+                    (size(0) - half(0)).abs() < 1e-9 && (size(1) - half(2)).abs() < 1e-9,
+                    "{design}: {g}"
+                ),
+                "box" => {
+                    for k in 0..3 {
+                        assert!((size(k) - half(k)).abs() < 1e-9, "{design}: {g}");
+                    }
+                }
+                other => panic!("{design}: {other}"),
+            }
+            for k in 0..3 {
+                let centre = (f(&hi[k]) + f(&lo[k])) / 2.0 * 1e-3;
+                assert!((f(&g["pos_m"][k]) - centre).abs() < 1e-9, "{design}: {g}");
+            }
+        }
+        let m = f(&mass["mass_g"]) * 1e-3;
+        for (what, got) in [
+            ("MuJoCo", f(&mj["body"]["mass_kg"])),
+            ("PyBullet", f(&pb["base"]["mass_kg"])),
+        ] {
+            assert!((got - m).abs() < 1e-6 * m, "{design} {what}: {got} vs {m}");
+        }
         for k in 0..3 {
             let want = f(&mass["centre_of_mass_mm"][k]) * 1e-3;
-            assert!(
-                (f(&mj["body"]["com_m"][k]) - want).abs() < 1e-9,
-                "{design}: {mj}"
-            );
+            for (what, got) in [
+                ("MuJoCo", f(&mj["body"]["com_m"][k])),
+                ("PyBullet", f(&pb["base"]["com_m"][k])),
+            ] {
+                assert!(
+                    (got - want).abs() < 1e-9,
+                    "{design} {what}: {got} vs {want}"
+                );
+            }
         }
         let scale = (0..3)
             .map(|k| f(&mass["inertia_g_mm2"][k][k]))
@@ -202,10 +269,15 @@ fn every_library_design_loads_in_mujoco_and_pybullet_with_its_mass_and_camera() 
                 }
             }
         }
-        // the contact-surface site on the skin's top (above the centre of mass)
+        // the contact surface on the skin's top (above the centre of mass): MuJoCo's site,
+        // the URDF's link (single precision in PyBullet), USD's Xform
+        let top = f(&mj["site"]["pos_m"][2]);
+        assert!(top > f(&mj["body"]["com_m"][2]), "{design}: {mj}");
+        let link = &pb["links"]["contact_surface"]["pos_m"];
+        assert!((f(&link[2]) - top).abs() < 1e-8, "{design}: {pb}");
         assert!(
-            f(&mj["site"]["pos_m"][2]) > f(&mj["body"]["com_m"][2]),
-            "{design}: {mj}"
+            (f(&usd["contact_surface"][2]) - top).abs() < 1e-12,
+            "{design}: {usd}"
         );
         // the camera, where `calibrate nominal` puts it
         let nominal = run(

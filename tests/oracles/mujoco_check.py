@@ -10,7 +10,8 @@ Prints ONE JSON document (SI units, MuJoCo's own numbers):
    "body": {"mass_kg": float, "com_m": [3], "inertia_kg_m2": [[3], [3], [3]]},
    "camera": null | {"pos_m": [3], "R_body_cam": [[3], [3], [3]], "fovy_deg": float,
                      "resolution": [w, h]},
-   "site": null | {"pos_m": [3]}, "steps": int, "time_s": float}
+   "site": null | {"pos_m": [3]}, "steps": int, "time_s": float,
+   "collision_geoms": {NAME: {"type": "mesh" | "box" | "cylinder", "size": [3], "pos_m": [3]}}}
 
 - body.inertia_kg_m2: the full tensor about the centre of mass in the body's frame, rebuilt from
   MuJoCo's principal moments (body_inertia) and their frame (body_iquat): R diag(I) R^T.
@@ -52,7 +53,15 @@ def main(argv):
         "body": {"mass_kg": float(model.body_mass[b]), "com_m": model.body_ipos[b].tolist(),
                  "inertia_kg_m2": (r @ np.diag(model.body_inertia[b]) @ r.T).tolist()},
         "camera": None, "site": None, "steps": steps, "time_s": float(data.time),
+        "collision_geoms": {},
     }
+    types = {int(mujoco.mjtGeom.mjGEOM_MESH): "mesh", int(mujoco.mjtGeom.mjGEOM_BOX): "box",
+             int(mujoco.mjtGeom.mjGEOM_CYLINDER): "cylinder"}
+    for g in range(model.ngeom):
+        if model.geom_contype[g] or model.geom_conaffinity[g]:
+            out["collision_geoms"][model.geom(g).name] = {
+                "type": types.get(int(model.geom_type[g]), str(int(model.geom_type[g]))),
+                "size": model.geom_size[g].tolist(), "pos_m": model.geom_pos[g].tolist()}
     c = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, "camera")
     if c >= 0:
         out["camera"] = {"pos_m": model.cam_pos[c].tolist(),

@@ -13,7 +13,8 @@ Prints ONE JSON document (the stage's units):
                      "collision": bool}},
    "camera": null | {"transform": [[4] x 4] (row vectors, USD's), "focal_length": float,
                      "horizontal_aperture": float, "vertical_aperture": float},
-   "contact_surface": null | [3], "lights": int, "errors": [str]}
+   "contact_surface": null | [3], "lights": int, "errors": [str],
+   "collisions": [names of the prims with CollisionAPI]}
 
 - mass.inertia: the tensor rebuilt from physics:diagonalInertia in physics:principalAxes,
   R diag(I) R^T.
@@ -60,6 +61,7 @@ def main(argv):
                  "center_of_mass": list(m.GetCenterOfMassAttr().Get()),
                  "inertia": (r @ np.diag(diag) @ r.T).tolist()},
         "meshes": {}, "camera": None, "contact_surface": None, "lights": 0, "errors": errors,
+        "collisions": [p.GetName() for p in root.GetChildren() if p.HasAPI(UsdPhysics.CollisionAPI)],
     }
     for prim in root.GetChildren():
         if prim.IsA(UsdGeom.Mesh):
