@@ -457,6 +457,9 @@ fn assembly_members(
     Ok((members, sensor_mass))
 }
 
+/// Files as (path relative to the output folder, bytes).
+type FileList = Vec<(String, Vec<u8>)>;
+
 /// `sim/`: the simulator models, their meshes and the camera file ([`mjcf::files`]), and
 /// their manifest entry.
 ///
@@ -466,7 +469,7 @@ pub(crate) fn sim_files(
     kit: &Kit,
     meshes: &[Mesh],
     opts: &ExportOptions,
-) -> Result<(ManifestSim, Vec<(String, Vec<u8>)>), ExportError> {
+) -> Result<(ManifestSim, FileList), ExportError> {
     let (members, sensor_mass) = assembly_members(kit, meshes)?;
     let files = mjcf::files(&kit.design, opts, &members, meshes, &sensor_mass)?;
     let entries: Vec<ManifestDataFile> = files

@@ -115,6 +115,30 @@ pub fn housing_shapes(members: &[ManifestMember]) -> Vec<(&ManifestMember, Housi
         .collect()
 }
 
+/// The lines every simulator file opens with, in words (unescaped): `header` (version and
+/// design), the body (`what`: "one rigid body", "one link") with its frame, units and mass, and
+/// the scene's notes.
+pub(crate) fn intro(
+    header: &str,
+    what: &str,
+    members: &[ManifestMember],
+    mass: &SensorMass,
+    scene: &SimScene,
+) -> Vec<String> {
+    let mut lines = vec![
+        header.to_string(),
+        format!(
+            "the assembled sensor as {what} in its sensor frame (docs/conventions.md); metres, kilograms; its mass {:.3} g from {} of {} members ({})",
+            mass.mass_g,
+            mass.counted.len(),
+            members.len(),
+            mass.assumptions.join("; ")
+        ),
+    ];
+    lines.extend(scene.notes.iter().cloned());
+    lines
+}
+
 /// `rgba` of a member: black for a black material, clear for the core and the filling gel,
 /// translucent for a cast layer, grey for a printed part, green for a bought board.
 pub(crate) fn rgba(m: &ManifestMember) -> &'static str {
@@ -183,17 +207,8 @@ pub fn model(
     const MM: f64 = 1e-3;
     let mut x = String::new();
     let _ = writeln!(x, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>");
-    let _ = writeln!(x, "<!-- {} -->", escape(header));
-    let _ = writeln!(
-        x,
-        "<!-- the assembled sensor as one rigid body in its sensor frame (docs/conventions.md); metres, kilograms; its mass {:.3} g from {} of {} members ({}) -->",
-        mass.mass_g,
-        mass.counted.len(),
-        members.len(),
-        escape(&mass.assumptions.join("; "))
-    );
-    for n in &scene.notes {
-        let _ = writeln!(x, "<!-- {} -->", escape(n));
+    for line in intro(header, "one rigid body", members, mass, scene) {
+        let _ = writeln!(x, "<!-- {} -->", escape(&line));
     }
     let _ = writeln!(x, "<mujoco model=\"{}\">", escape(design));
     let _ = writeln!(

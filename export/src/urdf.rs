@@ -34,17 +34,8 @@ pub fn model(
     let d = escape(design);
     let mut x = String::new();
     let _ = writeln!(x, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>");
-    let _ = writeln!(x, "<!-- {} -->", escape(header));
-    let _ = writeln!(
-        x,
-        "<!-- the assembled sensor as one link in its sensor frame (docs/conventions.md); metres, kilograms; its mass {:.3} g from {} of {} members ({}) -->",
-        mass.mass_g,
-        mass.counted.len(),
-        members.len(),
-        escape(&mass.assumptions.join("; "))
-    );
-    for n in &scene.notes {
-        let _ = writeln!(x, "<!-- {} -->", escape(n));
+    for line in crate::mjcf::intro(header, "one link", members, mass, scene) {
+        let _ = writeln!(x, "<!-- {} -->", escape(&line));
     }
     let _ = writeln!(x, "<robot name=\"{d}\">");
     let _ = writeln!(x, "  <link name=\"{d}\">");

@@ -41,6 +41,11 @@ pub fn principal(i: [[f64; 3]; 3]) -> ([f64; 3], UnitQuaternion<f64>) {
     (order.map(|k| e.eigenvalues[k]), q)
 }
 
+/// A USD string's text: no double quote or backslash (USD's string delimiters and escape).
+fn text(s: &str) -> String {
+    s.replace('\\', "/").replace('"', "'")
+}
+
 fn tuple(v: [f64; 3]) -> String {
     format!("({}, {}, {})", num(v[0]), num(v[1]), num(v[2]))
 }
@@ -80,22 +85,8 @@ pub fn layer(
     let mut x = String::new();
     let _ = writeln!(x, "#usda 1.0");
     let _ = writeln!(x, "(");
-    let mut doc = vec![
-        header.to_string(),
-        format!(
-            "the assembled sensor as one rigid body in its sensor frame (docs/conventions.md); metres, kilograms; its mass {:.3} g from {} of {} members ({})",
-            mass.mass_g,
-            mass.counted.len(),
-            members.len(),
-            mass.assumptions.join("; ")
-        ),
-    ];
-    doc.extend(scene.notes.iter().cloned());
-    let _ = writeln!(
-        x,
-        "    doc = \"\"\"{}\"\"\"",
-        escape(&doc.join("\n")).replace('"', "'")
-    );
+    let doc = crate::mjcf::intro(header, "one rigid body", members, mass, scene);
+    let _ = writeln!(x, "    doc = \"\"\"{}\"\"\"", text(&doc.join("\n")));
     let _ = writeln!(x, "    defaultPrim = \"{d}\"");
     let _ = writeln!(x, "    metersPerUnit = 1");
     let _ = writeln!(x, "    kilogramsPerUnit = 1");
@@ -233,7 +224,7 @@ pub fn layer(
         let _ = writeln!(
             x,
             "    def Camera \"camera\" (\n        doc = \"{}\"\n    )\n    {{",
-            escape(&c.what).replace('"', "'")
+            text(&c.what)
         );
         let _ = writeln!(
             x,

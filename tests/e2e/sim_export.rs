@@ -140,44 +140,25 @@ fn every_library_design_loads_in_mujoco_and_pybullet_with_its_mass_and_camera() 
         );
         assert!(o.status.success(), "{design}: {}", text(&o.stderr));
         let manifest = json(&dir.join(design).join("manifest.json"));
-        let o = std::process::Command::new(&py)
-            .arg(repo_root().join("tests/oracles/mujoco_check.py"))
-            .arg(dir.join(design).join(format!("sim/{design}.xml")))
-            .arg(design)
-            .arg("10")
-            .output()
-            .unwrap();
-        assert!(
-            o.status.success(),
-            "{design}: {}\n{}",
-            text(&o.stdout),
-            text(&o.stderr)
+        let mj = oracle(
+            &py,
+            "mujoco_check.py",
+            &[
+                &dir.join(design).join(format!("sim/{design}.xml")),
+                Path::new(design),
+                Path::new("10"),
+            ],
         );
-        let mj: Value = serde_json::from_slice(&o.stdout).unwrap();
-        let o = std::process::Command::new(&py)
-            .arg(repo_root().join("tests/oracles/pybullet_check.py"))
-            .arg(dir.join(design).join(format!("sim/{design}.urdf")))
-            .output()
-            .unwrap();
-        assert!(
-            o.status.success(),
-            "{design}: {}\n{}",
-            text(&o.stdout),
-            text(&o.stderr)
+        let pb = oracle(
+            &py,
+            "pybullet_check.py",
+            &[&dir.join(design).join(format!("sim/{design}.urdf"))],
         );
-        let pb: Value = serde_json::from_slice(&o.stdout).unwrap();
-        let o = std::process::Command::new(&py)
-            .arg(repo_root().join("tests/oracles/usd_check.py"))
-            .arg(dir.join(design).join(format!("sim/{design}.usda")))
-            .output()
-            .unwrap();
-        assert!(
-            o.status.success(),
-            "{design}: {}\n{}",
-            text(&o.stdout),
-            text(&o.stderr)
+        let usd = oracle(
+            &py,
+            "usd_check.py",
+            &[&dir.join(design).join(format!("sim/{design}.usda"))],
         );
-        let usd: Value = serde_json::from_slice(&o.stdout).unwrap();
         let mass = &manifest["assembly_3mf"]["mass"];
         let members = manifest["assembly_3mf"]["members"].as_array().unwrap();
         check_usd(design, &usd, members, mass);
