@@ -10,6 +10,10 @@ import subprocess
 
 import pytest
 
+# MuJoCo's off-screen renderer without a display: EGL (Mesa's llvmpipe on the CPU), chosen when
+# mujoco is first imported
+os.environ.setdefault("MUJOCO_GL", "egl")
+
 
 def _require():
     return os.environ.get("FABKIT_REQUIRE_ORACLES") == "1"

@@ -73,7 +73,7 @@ impl Scene {
         pose_name: &str,
         layers: Option<&crate::refraction::OpticalLayers>,
     ) -> Result<Scene, String> {
-        let surface = ReferenceSurface::of(&design.body).ok_or_else(|| {
+        let surface = ReferenceSurface::of_design(design).ok_or_else(|| {
             format!(
                 "body.profile = {}: no reference surface for this profile",
                 design.body.kind()
@@ -86,14 +86,18 @@ impl Scene {
         };
         let c = rays.origin_mm;
         if !surface.contains(c, 0.0) {
-            let body = match design.body.flat_outline() {
-                Some(o) => format!(
-                    "the {} x {} mm skin's contact face z = {} mm and its edges, continued below the base plane",
-                    o.width_mm,
-                    o.length_mm,
-                    design.body.pole_z_mm(0.0)
+            let body = match surface {
+                ReferenceSurface::Flat {
+                    half_width_mm,
+                    half_length_mm,
+                    top_z_mm,
+                    ..
+                } => format!(
+                    "the {} x {} mm skin's contact face z = {top_z_mm} mm and its edges, continued below the base plane",
+                    2.0 * half_width_mm,
+                    2.0 * half_length_mm,
                 ),
-                None => format!(
+                _ => format!(
                     "skin surface, continued below the base plane z = {} mm at radius {:.3} mm",
                     surface.base_z_mm(),
                     surface.rim_radius_mm()

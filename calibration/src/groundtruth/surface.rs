@@ -89,6 +89,30 @@ impl ReferenceSurface {
         })
     }
 
+    /// The outer skin surface of `design`: [`ReferenceSurface::of`] its body, where a flat
+    /// skin's outline is its outermost layer's (`layers[i].wrap_mm` grows it: 9DTact's black gel
+    /// wraps the translucent gel's sides, its contact face 31.1 x 24.1 mm R1.8 over the body's
+    /// 29.5 x 22.5 mm R1.0), so that the ground truth ranges to the face the assembly and the
+    /// molds give the skin.
+    pub fn of_design(design: &fabkit_designs::Design) -> Option<ReferenceSurface> {
+        let mut surface = ReferenceSurface::of(&design.body)?;
+        if let ReferenceSurface::Flat {
+            half_width_mm,
+            half_length_mm,
+            corner_radius_mm,
+            ..
+        } = &mut surface
+        {
+            let layers = fabkit_designs::stack::flat::flat_layers(design).unwrap_or_default();
+            if let Some(outer) = layers.last() {
+                *half_width_mm = outer.outline.width_mm / 2.0;
+                *half_length_mm = outer.outline.length_mm / 2.0;
+                *corner_radius_mm = outer.outline.corner_radius_mm;
+            }
+        }
+        Some(surface)
+    }
+
     /// z of the base plane, mm.
     pub fn base_z_mm(&self) -> f64 {
         match *self {

@@ -284,3 +284,42 @@ fn plane_through_both_camera_models_matches_the_closed_form_exact_and_meshed() {
         let _ = o;
     }
 }
+
+/// A flat skin's ground truth ranges to its outermost layer's face: 9DTact's black gel wraps
+/// the translucent gel's sides by 0.8 mm (ninedtact.yaml, mold_2's pocket 31.1 x 24.1 R1.8 over
+/// mold_1's 29.5 x 22.5 R1.0), so a ray 15.2 mm out along x (past the body's 14.75 mm, inside
+/// the wrap's 15.55 mm) meets the contact face at z = 2.8 mm, not a side wall; Soter's layers
+/// do not wrap, and its surface is its body's.
+#[test]
+fn a_wrapped_flat_skins_surface_is_its_outer_layers_face() {
+    let nine = fabkit_designs::library::load("ninedtact").unwrap();
+    let s = ReferenceSurface::of_design(&nine).unwrap();
+    let ReferenceSurface::Flat {
+        half_width_mm,
+        half_length_mm,
+        corner_radius_mm,
+        top_z_mm,
+    } = s
+    else {
+        panic!("{s:?}")
+    };
+    for (got, want) in [
+        (half_width_mm, 15.55),
+        (half_length_mm, 12.05),
+        (corner_radius_mm, 1.8),
+        (top_z_mm, 2.8),
+    ] {
+        assert!((got - want).abs() < 1e-12, "{s:?}");
+    }
+    assert_ne!(Some(s), ReferenceSurface::of(&nine.body));
+    // from under the middle, straight up at x = 15.2 mm: the contact face
+    let o = [0.0, 0.0, -10.0];
+    let d = Vector3::new(15.2, 0.0, 12.8).normalize();
+    let e = s.exit(o, [d.x, d.y, d.z]).unwrap();
+    assert!(e.on_skin && (e.normal[2] - 1.0).abs() < 1e-12, "{e:?}");
+    let soter = fabkit_designs::library::load("soter_channels").unwrap();
+    assert_eq!(
+        ReferenceSurface::of_design(&soter),
+        ReferenceSurface::of(&soter.body)
+    );
+}
