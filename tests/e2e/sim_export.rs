@@ -1,8 +1,9 @@
 //! `fabkit export DESIGN --format mjcf,urdf,usd` (issue 103): the assembled sensor as MuJoCo,
 //! PyBullet and USD (usd-core, [`check_usd`]) read it. For every library design MuJoCo (`mujoco` from PyPI,
 //! tests/oracles/mujoco_check.py) loads `sim/<design>.xml` with its meshes and steps it, and
-//! PyBullet (DIRECT, tests/oracles/pybullet_check.py) loads `sim/<design>.urdf` and steps it;
-//! in both the body's mass, centre of mass and full inertia tensor are the manifest's
+//! PyBullet (DIRECT, tests/oracles/pybullet_check.py) loads `sim/<design>.urdf` and steps it,
+//! and yourdfpy validates the URDF and reads it back ([`check_yourdfpy`]; its forward
+//! kinematics put the camera link within 1e-9 m); in all three the body's mass, centre of mass and full inertia tensor are the manifest's
 //! (`assembly_3mf.mass`, checked against trimesh in tests/e2e/mass.rs) within 1e-6 relative,
 //! and there is one mesh per assembly member; the URDF's frame links weigh nothing; each
 //! collides with the skin's mesh and a cylinder or box round each printed housing member's box. Where the
@@ -159,8 +160,14 @@ fn every_library_design_loads_in_mujoco_and_pybullet_with_its_mass_and_camera() 
             "usd_check.py",
             &[&dir.join(design).join(format!("sim/{design}.usda"))],
         );
+        let yu = oracle(
+            &py,
+            "yourdfpy_check.py",
+            &[&dir.join(design).join(format!("sim/{design}.urdf"))],
+        );
         let mass = &manifest["assembly_3mf"]["mass"];
         let members = manifest["assembly_3mf"]["members"].as_array().unwrap();
+        check_yourdfpy(design, &yu, members, mass);
         check_usd(design, &usd, members, mass);
         assert_eq!(
             mj["nmesh"].as_u64().unwrap() as usize,
@@ -292,6 +299,7 @@ fn every_library_design_loads_in_mujoco_and_pybullet_with_its_mass_and_camera() 
         let r = |i: usize, j: usize| f(&t[i][j]);
         let cam = &mj["camera"];
         let frame = &pb["links"]["camera_optical_frame"];
+        let yu_frame = &yu["frames"]["camera_optical_frame"];
         // the camera joint's origin as the URDF writes it
         let urdf =
             std::fs::read_to_string(dir.join(format!("{design}/sim/{design}.urdf"))).unwrap();
@@ -317,6 +325,17 @@ fn every_library_design_loads_in_mujoco_and_pybullet_with_its_mass_and_camera() 
                 (urdf_camera[k] - want).abs() < 1e-12,
                 "{design}: {urdf_camera:?}"
             );
+            // yourdfpy's forward kinematics
+            assert!(
+                (f(&yu_frame[k][3]) - want).abs() < 1e-9,
+                "{design}: {yu_frame}"
+            );
+            for c in 0..3 {
+                assert!(
+                    (f(&yu_frame[k][c]) - r(c, k)).abs() < 1e-9,
+                    "{design}: {yu_frame}"
+                );
+            }
             // the optical frame's axes (columns) are OpenCV's: the rows of R
             for c in 0..3 {
                 let got = f(&frame["R"][k][c]);
@@ -359,6 +378,50 @@ fn every_library_design_loads_in_mujoco_and_pybullet_with_its_mass_and_camera() 
     }
     // R-Tac0, UVDtact, the TacTip (and any design that places its lens)
     assert!(cameras >= 2, "{cameras} designs with a camera");
+}
+
+/// yourdfpy's reading of a design's URDF: valid (no error logged), the design's one root link
+/// with the frame links, a visual mesh per member, and the inertial of the manifest's mass
+/// (mass within 1e-6 relative, centre of mass within 1e-9 m, axes the sensor's, the tensor within
+/// 1e-6 of its largest moment).
+fn check_yourdfpy(design: &str, yu: &Value, members: &[Value], mass: &Value) {
+    assert_eq!(yu["valid"], true, "{design}: {yu}");
+    assert_eq!(yu["errors"], serde_json::json!([]), "{design}: {yu}");
+    assert_eq!(yu["base"], design, "{design}: {yu}");
+    assert_eq!(
+        yu["meshes"].as_u64().unwrap() as usize,
+        members.len(),
+        "{design}: {yu}"
+    );
+    let inertial = &yu["inertial"];
+    let m = f(&mass["mass_g"]) * 1e-3;
+    assert!(
+        (f(&inertial["mass_kg"]) - m).abs() < 1e-6 * m,
+        "{design}: {inertial}"
+    );
+    let scale = (0..3)
+        .map(|k| f(&mass["inertia_g_mm2"][k][k]))
+        .fold(0.0, f64::max)
+        * 1e-9;
+    for i in 0..3 {
+        let com = f(&mass["centre_of_mass_mm"][i]) * 1e-3;
+        assert!(
+            (f(&inertial["origin"][i][3]) - com).abs() < 1e-9,
+            "{design}: {inertial}"
+        );
+        for j in 0..3 {
+            let axis = if i == j { 1.0 } else { 0.0 };
+            assert!(
+                (f(&inertial["origin"][i][j]) - axis).abs() < 1e-12,
+                "{design}: {inertial}"
+            );
+            let want = f(&mass["inertia_g_mm2"][i][j]) * 1e-9;
+            assert!(
+                (f(&inertial["inertia_kg_m2"][i][j]) - want).abs() < 1e-6 * scale,
+                "{design} I{i}{j}: {inertial}"
+            );
+        }
+    }
 }
 
 /// Runs the oracle `script` with `args`; its JSON.
@@ -464,6 +527,8 @@ fn a_calibrated_camera_is_placed_where_its_extrinsics_say() {
     );
     let pb = oracle(&py, "pybullet_check.py", &[&sim.join("rtac0.urdf")]);
     let usd = oracle(&py, "usd_check.py", &[&sim.join("rtac0.usda")]);
+    let yu = oracle(&py, "yourdfpy_check.py", &[&sim.join("rtac0.urdf")]);
+    assert_eq!(yu["valid"], true, "{yu}");
     // the camera's centre in the sensor frame: -R^T t
     let centre: [f64; 3] =
         std::array::from_fn(|k| -(0..3).map(|i| r[i][k] * t[i]).sum::<f64>() * 1e-3);
@@ -474,6 +539,8 @@ fn a_calibrated_camera_is_placed_where_its_extrinsics_say() {
         );
         let frame = &pb["links"]["camera_optical_frame"];
         assert!((f(&frame["pos_m"][k]) - centre[k]).abs() < 1e-8, "{frame}");
+        let yu_frame = &yu["frames"]["camera_optical_frame"];
+        assert!((f(&yu_frame[k][3]) - centre[k]).abs() < 1e-9, "{yu_frame}");
         let xf = &usd["camera"]["transform"];
         assert!((f(&xf[3][k]) - centre[k]).abs() < 1e-12, "{xf}");
         for (c, sign) in [(0, 1.0), (1, -1.0), (2, -1.0)] {
@@ -486,6 +553,7 @@ fn a_calibrated_camera_is_placed_where_its_extrinsics_say() {
             );
             assert!((f(&xf[c][k]) - want).abs() < 1e-12, "{xf}");
             assert!((f(&frame["R"][k][c]) - r[c][k]).abs() < 1e-6, "{frame}");
+            assert!((f(&yu_frame[k][c]) - r[c][k]).abs() < 1e-9, "{yu_frame}");
         }
     }
     let fovy = 2.0 * (240.0f64 / 500.0).atan().to_degrees();
