@@ -218,3 +218,58 @@ pub fn nominal_files(
         ),
     ])
 }
+
+/// The camera and lights of `design`'s simulator files: its nominal camera (`fabkit calibrate
+/// nominal`'s, 640 x 480) as a pinhole of the same focal length, and its lights; what is
+/// missing is said in the notes.
+pub fn sim_scene(
+    design: &fabkit_designs::Design,
+    tol: fabkit_designs::geometry::ChordTolerance,
+) -> fabkit_export::mjcf::SimScene {
+    use fabkit_export::mjcf::{SimCamera, SimLight, SimScene};
+    let mut scene = SimScene::default();
+    match nominal_camera(design, 640, 480, None) {
+        Ok(n) => {
+            let i = &n.intrinsics;
+            let fovy = 2.0
+                * (f64::from(i.image_height_px) / 2.0 / i.fy_px)
+                    .atan()
+                    .to_degrees();
+            scene.camera = Some(SimCamera {
+                t_sensor_cam: n.t_cam_sensor.inverse(),
+                width_px: i.image_width_px,
+                height_px: i.image_height_px,
+                fy_px: i.fy_px,
+                what: format!(
+                    "the design's nominal camera (`fabkit calibrate nominal`: the lens's front on the sensor's axis looking +z, its {:.1} deg view across the image's {} px side as an ideal fisheye, f = {:.2} px) as a pinhole of the same focal length: MuJoCo renders pinholes, so it sees {:.1} deg across that side, not the fisheye's {:.1}; a calibrated camera's pose and pinhole intrinsics replace it",
+                    n.view_angle_deg,
+                    i.image_height_px.min(i.image_width_px),
+                    i.fy_px,
+                    fovy,
+                    n.view_angle_deg
+                ),
+                file: nominal_files(&n, "fabkit export")
+                    .ok()
+                    .and_then(|f| f.into_iter().find(|(name, _)| name == "camera.yaml"))
+                    .map(|(_, bytes)| bytes),
+            });
+        }
+        Err(e) => scene.notes.push(format!("no camera: {e}")),
+    }
+    match fabkit_designs::optics::of_design(design, tol) {
+        Ok(o) => {
+            scene.lights = o
+                .lights
+                .iter()
+                .map(|l| SimLight {
+                    position_mm: l.position_mm,
+                    direction: l.direction,
+                    cone_half_angle_deg: l.cone_half_angle_deg,
+                    colour_rgb: l.colour_rgb,
+                })
+                .collect()
+        }
+        Err(e) => scene.notes.push(format!("no lights: {e}")),
+    }
+    scene
+}

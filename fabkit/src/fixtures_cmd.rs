@@ -80,6 +80,9 @@ pub fn run(args: FixturesArgs) -> Result<(), Box<dyn Error>> {
         .clone()
         .unwrap_or_else(|| Path::new("out").join(fabkit_fixtures::kit_name(&loaded.design.name)));
     let mut opts = args.mesh.options(&loaded, tol);
+    if let Some(sim) = sim_format(&opts.formats) {
+        return Err(format!("--format {sim}: the simulators' files are of the sensor (`fabkit export {} --format {sim}`), not of its fixtures; fixtures take stl, 3mf and step", loaded.design.name).into());
+    }
     opts.command = fabkit_export::OutputCommand::Fixtures;
     opts.force = args.force;
     // The output folder is checked before anything is built, as `fabkit export` checks it.
@@ -257,4 +260,15 @@ fn print_summary(
             ),
         }
     }
+}
+
+/// The first simulator format of `formats` (mjcf, urdf, usd), which fixtures do not write.
+pub(crate) fn sim_format(formats: &fabkit_export::Formats) -> Option<&'static str> {
+    [
+        (formats.mjcf, "mjcf"),
+        (formats.urdf, "urdf"),
+        (formats.usd, "usd"),
+    ]
+    .into_iter()
+    .find_map(|(on, name)| on.then_some(name))
 }

@@ -150,8 +150,11 @@ class Kit:
         progress: Optional[Progress] = None,
     ) -> Dict[str, Any]:
         """Writes the folder ``fabkit export`` (or ``fabkit fixtures``) writes, byte for byte
-        for the same options and ``command_line``; returns the manifest. Raises ExportError;
-        nothing is written then."""
+        for the same options and ``command_line``; returns the manifest. ``formats``: ``stl``,
+        ``3mf``, ``step``, and for a sensor's kit the simulators' ``mjcf``, ``urdf``, ``usd``
+        (the design's nominal camera and lights, as the CLI's). Raises ExportError, or
+        ValueError for an unknown format or a simulator format of fixtures; nothing is written
+        then."""
     def __len__(self) -> int: ...
 
 def build_kit(

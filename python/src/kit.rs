@@ -42,7 +42,8 @@ pub(crate) fn report_progress(
     }
 }
 
-/// The mesh formats named in `formats` (`stl`, `3mf`, `step`), as `--format`.
+/// The formats named in `formats` (`stl`, `3mf`, `step`, and the simulators' `mjcf`, `urdf`,
+/// `usd`), as `--format`.
 pub(crate) fn formats(names: &[String]) -> PyResult<Formats> {
     let mut f = Formats {
         stl: false,
@@ -57,9 +58,12 @@ pub(crate) fn formats(names: &[String]) -> PyResult<Formats> {
             "stl" => f.stl = true,
             "3mf" => f.threemf = true,
             "step" => f.step = true,
+            "mjcf" => f.mjcf = true,
+            "urdf" => f.urdf = true,
+            "usd" => f.usd = true,
             other => {
                 return Err(PyValueError::new_err(format!(
-                    "formats: '{other}' is not a mesh format (stl, 3mf, step)"
+                    "formats: '{other}' is not an export format (stl, 3mf, step, mjcf, urdf, usd)"
                 )))
             }
         }
@@ -260,6 +264,15 @@ impl Kit {
         );
         opts.command = self.command;
         opts.force = force;
+        if self.command == OutputCommand::Fixtures && (f.mjcf || f.urdf || f.usd) {
+            return Err(PyValueError::new_err(
+                "formats: the simulators' files (mjcf, urdf, usd) are of the sensor (build_kit(design).export), not of its fixtures; fixtures take stl, 3mf and step",
+            ));
+        }
+        if f.mjcf || f.urdf || f.usd {
+            // the design's nominal camera and its lights, as `fabkit export --format mjcf`
+            opts.sim = fabkit_calibration::nominal::sim_scene(&self.design.design, self.tol);
+        }
         let step = |i: usize, n: usize, part: &str| {
             report_progress(&progress, i, n, &format!("STEP {i}/{n}: {part}"))
         };

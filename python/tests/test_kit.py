@@ -177,3 +177,27 @@ def test_build_kit_releases_gil():
     # and a call that holds the GIL is told apart: a pure-Python loop of the same thread
     _, during = ran_during(lambda: sum(range(2_000_000)))
     assert not during
+
+
+def test_simulator_formats_same_bytes_as_cli(tmp_path, run_cli):
+    """formats=['mjcf', 'urdf', 'usd'] writes the simulators' files `fabkit export --format
+    mjcf,urdf,usd` writes (the nominal camera, the lights, the meshes), byte for byte; the
+    fixtures' export refuses them before anything is written (as `fabkit fixtures --format
+    mjcf` does)."""
+    run_cli(tmp_path, "export", "uvdtact", "--format", "mjcf,urdf,usd", "--out", "A")
+    manifest = json.loads((tmp_path / "A" / "manifest.json").read_text())
+    kit = fabkit.build_kit(fabkit.Design.load("uvdtact"))
+    kit.export(tmp_path / "B", formats=["mjcf", "urdf", "usd"],
+               command_line=manifest["command_line"])
+    assert_same_tree(tmp_path / "A", tmp_path / "B")
+    sim = sorted(p.relative_to(tmp_path / "B").as_posix()
+                 for p in (tmp_path / "B" / "sim").rglob("*") if p.is_file())
+    assert {"sim/uvdtact.xml", "sim/uvdtact.urdf", "sim/uvdtact.usda", "sim/camera.yaml"} <= set(sim)
+    fixtures = fabkit.build_fixtures(fabkit.Design.load("uvdtact"), semidomes=1)
+    with pytest.raises(ValueError, match="simulators"):
+        fixtures.kit.export(tmp_path / "F", formats=["stl", "mjcf"])
+    assert not (tmp_path / "F").exists()
+    cli = run_cli(tmp_path, "fixtures", "uvdtact", "--semidomes", "1", "--format", "stl,mjcf",
+                  "--out", "G", ok=False)
+    assert "--format mjcf: the simulators' files are of the sensor" in cli.stderr
+    assert not (tmp_path / "G").exists()
