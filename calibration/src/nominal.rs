@@ -225,8 +225,8 @@ pub fn nominal_files(
 pub fn sim_scene(
     design: &fabkit_designs::Design,
     tol: fabkit_designs::geometry::ChordTolerance,
-) -> fabkit_export::mjcf::SimScene {
-    use fabkit_export::mjcf::{SimCamera, SimLight, SimScene};
+) -> fabkit_export::sim::SimScene {
+    use fabkit_export::sim::{SimCamera, SimLight, SimScene};
     let mut scene = SimScene::default();
     match nominal_camera(design, 640, 480, None) {
         Ok(n) => {

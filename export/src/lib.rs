@@ -35,6 +35,7 @@ pub mod raster;
 mod render;
 pub mod section;
 mod sheet;
+pub mod sim;
 pub mod urdf;
 pub mod usd;
 pub use sheet::{marker_feature_words, marker_formers};
@@ -117,7 +118,7 @@ pub struct ExportOptions {
     /// (`--force`).
     pub force: bool,
     /// The camera and lights of the simulator files ([`Formats::mjcf`]).
-    pub sim: mjcf::SimScene,
+    pub sim: sim::SimScene,
 }
 
 impl ExportOptions {
@@ -143,7 +144,7 @@ impl ExportOptions {
             printers,
             command: OutputCommand::Export,
             force: false,
-            sim: mjcf::SimScene::default(),
+            sim: sim::SimScene::default(),
         }
     }
 
@@ -460,7 +461,7 @@ fn assembly_members(
 /// Files as (path relative to the output folder, bytes).
 type FileList = Vec<(String, Vec<u8>)>;
 
-/// `sim/`: the simulator models, their meshes and the camera file ([`mjcf::files`]), and
+/// `sim/`: the simulator models, their meshes and the camera file ([`sim::files`]), and
 /// their manifest entry.
 ///
 /// # Errors
@@ -471,7 +472,7 @@ pub(crate) fn sim_files(
     opts: &ExportOptions,
 ) -> Result<(ManifestSim, FileList), ExportError> {
     let (members, sensor_mass) = assembly_members(kit, meshes)?;
-    let files = mjcf::files(&kit.design, opts, &members, meshes, &sensor_mass)?;
+    let files = sim::files(&kit.design, opts, &members, meshes, &sensor_mass)?;
     let entries: Vec<ManifestDataFile> = files
         .iter()
         .map(|(f, b)| ManifestDataFile {
@@ -752,7 +753,7 @@ mod tests {
             printers: Default::default(),
             command: OutputCommand::Export,
             force: false,
-            sim: mjcf::SimScene::default(),
+            sim: sim::SimScene::default(),
         }
     }
 

@@ -1,12 +1,12 @@
 //! The assembled sensor as a URDF (issue 103): `sim/<design>.urdf`, for PyBullet (TACTO), ROS
-//! and the tools that read URDF, beside the meshes and camera file of [`crate::mjcf::files`].
+//! and the tools that read URDF, beside the meshes and camera file of [`crate::sim::files`].
 //!
 //! - One link named after the design, its frame the sensor frame (docs/conventions.md), in
 //!   metres and kilograms: its inertial is the sensor's mass, centre of mass and inertia tensor
 //!   ([`crate::mass::SensorMass`]; URDF's `ixy` is the tensor's entry, minus the product
 //!   integral, as fabkit's), each member a visual mesh with its colour, the skin
-//!   ([`crate::mjcf::skin_member`]) a collision mesh and each printed housing member a collision
-//!   cylinder or box ([`crate::mjcf::housing_shapes`]).
+//!   ([`crate::sim::skin_member`]) a collision mesh and each printed housing member a collision
+//!   cylinder or box ([`crate::sim::housing_shapes`]).
 //! - `camera_optical_frame`: a link fixed to the sensor's at the camera's pose, in ROS's optical
 //!   frame convention (REP 103: z forward, x right, y down, which is OpenCV's camera frame and
 //!   fabkit's), when the design places a camera; its intrinsics are `camera.yaml` beside the
@@ -20,7 +20,7 @@ use std::fmt::Write as _;
 
 use crate::manifest::ManifestMember;
 use crate::mass::SensorMass;
-use crate::mjcf::{escape, num, rgba, skin_member, vec3, HousingShape, SimScene};
+use crate::sim::{escape, num, rgba, skin_member, vec3, HousingShape, SimScene};
 
 /// The URDF of `design`'s assembled sensor (see the module docs); `header` for the comment.
 pub fn model(
@@ -34,7 +34,7 @@ pub fn model(
     let d = escape(design);
     let mut x = String::new();
     let _ = writeln!(x, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>");
-    for line in crate::mjcf::intro(header, "one link", members, mass, scene) {
+    for line in crate::sim::intro(header, "one link", members, mass, scene) {
         let _ = writeln!(x, "<!-- {} -->", escape(&line));
     }
     let _ = writeln!(x, "<robot name=\"{d}\">");
@@ -82,7 +82,7 @@ pub fn model(
             mesh(&members[s].name)
         );
     }
-    for (h, shape) in crate::mjcf::housing_shapes(members) {
+    for (h, shape) in crate::sim::housing_shapes(members) {
         let (geometry, c) = match shape {
             HousingShape::Cylinder(r, height, c) => (
                 format!(

@@ -1,5 +1,5 @@
 //! The assembled sensor as a USD layer (issue 103): `sim/<design>.usda`, for Isaac Sim / Isaac
-//! Lab and any USD reader, beside the files of [`crate::mjcf::files`].
+//! Lab and any USD reader, beside the files of [`crate::sim::files`].
 //!
 //! - The stage is in metres and kilograms (`metersPerUnit = 1`, `kilogramsPerUnit = 1`), z up.
 //! - The default prim, named after the design, is an Xform in the sensor frame
@@ -8,9 +8,9 @@
 //!   `physics:diagonalInertia` (its eigenvalues) in `physics:principalAxes` (the rotation whose
 //!   columns are its eigenvectors, a quaternion).
 //! - Each member is a Mesh (its written mesh, in metres, triangles, `extent`, display colour and
-//!   opacity); the skin ([`crate::mjcf::skin_member`]) carries CollisionAPI and
+//!   opacity); the skin ([`crate::sim::skin_member`]) carries CollisionAPI and
 //!   MeshCollisionAPI (convex hull), the others are visual; each printed housing member collides
-//!   as a Cylinder or a scaled Cube round it (purpose `guide`, [`crate::mjcf::housing_shapes`]).
+//!   as a Cylinder or a scaled Cube round it (purpose `guide`, [`crate::sim::housing_shapes`]).
 //! - `camera`, when the design places one: a Camera prim (USD's x right, y up, looking along -z:
 //!   the OpenCV frame turned about x) whose `focalLength` over `horizontalAperture` is the
 //!   pinhole's focal length over the image width (square pixels, the principal point at the
@@ -24,7 +24,7 @@ use nalgebra::{Matrix3, Rotation3, SymmetricEigen, UnitQuaternion, Vector3};
 
 use crate::manifest::ManifestMember;
 use crate::mass::SensorMass;
-use crate::mjcf::{escape, num, rgba, skin_member, HousingShape, SimScene};
+use crate::sim::{escape, num, rgba, skin_member, HousingShape, SimScene};
 
 /// The principal moments (ascending) and the rotation whose columns are the principal axes (a
 /// right-handed frame) of the symmetric tensor `i`.
@@ -85,7 +85,7 @@ pub fn layer(
     let mut x = String::new();
     let _ = writeln!(x, "#usda 1.0");
     let _ = writeln!(x, "(");
-    let doc = crate::mjcf::intro(header, "one rigid body", members, mass, scene);
+    let doc = crate::sim::intro(header, "one rigid body", members, mass, scene);
     let _ = writeln!(x, "    doc = \"\"\"{}\"\"\"", text(&doc.join("\n")));
     let _ = writeln!(x, "    defaultPrim = \"{d}\"");
     let _ = writeln!(x, "    metersPerUnit = 1");
@@ -177,7 +177,7 @@ pub fn layer(
         let _ = writeln!(x, "        float[] primvars:displayOpacity = [{}]", c[3]);
         let _ = writeln!(x, "    }}");
     }
-    for (h, shape) in crate::mjcf::housing_shapes(members) {
+    for (h, shape) in crate::sim::housing_shapes(members) {
         let _ = writeln!(x);
         let (prim, attrs, c) = match shape {
             HousingShape::Cylinder(r, height, c) => (

@@ -159,7 +159,7 @@ pub(crate) fn calibrated_sim_camera(
     design: &str,
     camera_file: &Path,
     extrinsics_file: &Path,
-) -> Result<fabkit_export::mjcf::SimCamera, Box<dyn Error>> {
+) -> Result<fabkit_export::sim::SimCamera, Box<dyn Error>> {
     let model = fabkit_calibration::camera_file::read_camera_file(camera_file)
         .map_err(|e| format!("--camera {}: {e}", camera_file.display()))?;
     let (t_cam_sensor, _) =
@@ -252,7 +252,7 @@ pub(crate) fn calibrated_sim_camera(
     );
     let file = std::fs::read(camera_file)
         .map_err(|e| format!("--camera {}: {e}", camera_file.display()))?;
-    Ok(fabkit_export::mjcf::SimCamera {
+    Ok(fabkit_export::sim::SimCamera {
         t_sensor_cam: t_cam_sensor.inverse(),
         width_px: i.image_width_px,
         height_px: i.image_height_px,

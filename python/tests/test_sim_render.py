@@ -80,7 +80,7 @@ def mujoco_skin(xml, skin):
 
 def skin_layers(out):
     """The skin's layers as the manifest's assembly lists them: the cast members (the filling gel
-    aside) and a printed skin (the rule of the MJCF's contact-surface geom, export/src/mjcf.rs
+    aside) and a printed skin (the rule of the MJCF's contact-surface geom, export/src/sim.rs
     skin_member)."""
     members = json.loads((out / "manifest.json").read_text())["assembly_3mf"]["members"]
     return [m["name"] for m in members
