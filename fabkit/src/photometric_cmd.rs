@@ -541,28 +541,35 @@ fn leave_one_out(
     posed: &[Posed],
     all: &[Capture],
     reach_px: f64,
-    done: &dyn Fn(usize),
+    done: &(dyn Fn(usize) + Sync),
 ) -> Result<Vec<Rendered>, Box<dyn Error>> {
+    use rayon::prelude::*;
     let (rays, reference) = (&setup.rays, &setup.reference);
-    let mut loo = Vec::new();
-    for k in 0..posed.len() {
-        let others: Vec<Capture> = (0..posed.len())
-            .filter(|&j| j != k)
-            .map(|j| all[j])
-            .collect();
-        let m = PhotometricModel::fit(
-            rays,
-            reference,
-            &setup.reference_image,
-            &others,
-            setup.full_scale,
-        )
-        .map_err(|e| format!("leaving out {}: {e}", posed[k].file.display()))?;
-        let gain = m.gain_of(&all[k], reference);
-        loo.push(rendered(setup, &m, &all[k], gain, reach_px));
-        done(loo.len());
-    }
-    Ok(loo)
+    let finished = std::sync::atomic::AtomicUsize::new(0);
+    // the fits are independent: in parallel, collected in the captures' order
+    let loo: Vec<Result<Rendered, String>> = (0..posed.len())
+        .into_par_iter()
+        .map(|k| {
+            let others: Vec<Capture> = (0..posed.len())
+                .filter(|&j| j != k)
+                .map(|j| all[j])
+                .collect();
+            let m = PhotometricModel::fit(
+                rays,
+                reference,
+                &setup.reference_image,
+                &others,
+                setup.full_scale,
+            )
+            .map_err(|e| format!("leaving out {}: {e}", posed[k].file.display()))?;
+            let gain = m.gain_of(&all[k], reference);
+            let r = rendered(setup, &m, &all[k], gain, reach_px);
+            done(finished.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1);
+            Ok(r)
+        })
+        .collect();
+    // the first capture's error, as the loop in order reported it
+    Ok(loo.into_iter().collect::<Result<Vec<_>, String>>()?)
 }
 
 /// Writes appearance.npy, the re-rendered captures and photometric.json (which lists them)

@@ -169,6 +169,9 @@ fn appearance(
         .collect()
 }
 
+/// Rows of the fit multiplied at a time into its normal equations.
+const NORMAL_BLOCK: usize = 1024;
+
 /// A row of the fit: (capture, pixel, its shadow if shadowed).
 type FitRow<'a> = (usize, usize, Option<&'a ShadowPixel>);
 
@@ -247,7 +250,15 @@ impl Design<'_> {
         let mut ata = DMatrix::<f64>::zeros(unknowns, unknowns);
         let mut atb = DVector::<f64>::zeros(unknowns);
         let mut row = vec![0.0; unknowns];
-        let mut nonzero: Vec<usize> = Vec::with_capacity(unknowns);
+        // the weighted rows, a block at a time: A^T W A accumulated by matrix products
+        let mut block = DMatrix::<f64>::zeros(NORMAL_BLOCK, unknowns);
+        let mut block_y = DVector::<f64>::zeros(NORMAL_BLOCK);
+        let mut filled = 0;
+        let mut flush = |block: &DMatrix<f64>, block_y: &DVector<f64>, filled: usize| {
+            let b = block.rows(0, filled);
+            ata.gemm_tr(1.0, &b, &b, 1.0);
+            atb.gemv_tr(1.0, &b, &block_y.rows(0, filled), 1.0);
+        };
         for &(k, i, sh) in rows {
             let r = self.appearance[i][ch];
             let y_counts = captures[k].image[i][ch];
@@ -277,20 +288,23 @@ impl Design<'_> {
             for (m, x) in row[tilt_unknowns..].iter_mut().enumerate() {
                 *x = -sh.map_or(0.0, |f| f.rings[m]);
             }
-            // the ratio's change, weighted by the reference so that each row counts in
-            // grey levels
+            // the ratio's change, weighted by the reference (the row and its value times r:
+            // weight r^2) so that each row counts in grey levels
             let y = y_counts / (gains[k] * r) - 1.0;
-            let wgt = r * r;
-            // an unpressed pixel's row has only its shadow terms
-            nonzero.clear();
-            nonzero.extend((0..unknowns).filter(|&a| row[a] != 0.0));
-            for (j, &a) in nonzero.iter().enumerate() {
-                atb[a] += wgt * row[a] * y;
-                for &b in &nonzero[j..] {
-                    ata[(a, b)] += wgt * row[a] * row[b];
-                }
+            for (a, x) in row.iter().enumerate() {
+                block[(filled, a)] = r * x;
+            }
+            block_y[filled] = r * y;
+            filled += 1;
+            if filled == NORMAL_BLOCK {
+                flush(&block, &block_y, filled);
+                filled = 0;
             }
         }
+        if filled > 0 {
+            flush(&block, &block_y, filled);
+        }
+        // exactly symmetric: the upper triangle mirrored
         for a in 0..unknowns {
             for b in 0..a {
                 ata[(a, b)] = ata[(b, a)];
