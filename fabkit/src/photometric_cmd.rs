@@ -23,6 +23,7 @@ use fabkit_export::{OutputClaim, OutputCommand, StagedDir};
 use serde_json::{json, Value};
 
 use crate::args::{load_design, DataFileArgs};
+use rayon::prelude::*;
 
 #[derive(clap::Args, Debug)]
 pub struct PhotometricArgs {
@@ -135,8 +136,9 @@ pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
         ));
         let all = captures_of(&posed);
         let model = fit(&all)?;
+        // each capture's seating on its own: in parallel, collected in order
         let seatings: Vec<DomeSeating> = all
-            .iter()
+            .par_iter()
             .zip(&model.gains)
             .zip(&posed)
             .map(|((c, &g), p)| {
@@ -177,7 +179,7 @@ pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
     let all = captures_of(&posed);
     let model = fit(&all)?;
     let fitted: Vec<Rendered> = all
-        .iter()
+        .par_iter()
         .zip(&model.gains)
         .map(|(c, &g)| rendered(&setup, &model, c, g, reach))
         .collect();
@@ -543,7 +545,6 @@ fn leave_one_out(
     reach_px: f64,
     done: &(dyn Fn(usize) + Sync),
 ) -> Result<Vec<Rendered>, Box<dyn Error>> {
-    use rayon::prelude::*;
     let (rays, reference) = (&setup.rays, &setup.reference);
     let finished = std::sync::atomic::AtomicUsize::new(0);
     // the fits are independent: in parallel, collected in the captures' order

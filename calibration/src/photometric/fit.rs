@@ -12,6 +12,7 @@ use super::terms::{
 use crate::groundtruth::hits::SurfaceHits;
 use crate::groundtruth::rays::PixelRays;
 use nalgebra::{DMatrix, DVector};
+use rayon::prelude::*;
 
 impl PhotometricModel {
     /// Fits the model of the camera whose rays are `rays`, from its `reference_image` of the
@@ -68,8 +69,12 @@ impl PhotometricModel {
         };
         let mut coefficients: [Vec<f64>; 3] = Default::default();
         let mut shadow_coefficients = [[0.0; SHADOW_TERMS]; 3];
-        for (ch, coef) in coefficients.iter_mut().enumerate() {
-            let x = design.solve(ch, &rows);
+        // the channels are independent problems: solved in parallel, kept in channel order
+        let solved: Vec<DVector<f64>> = (0..3)
+            .into_par_iter()
+            .map(|ch| design.solve(ch, &rows))
+            .collect();
+        for (ch, (coef, x)) in coefficients.iter_mut().zip(&solved).enumerate() {
             *coef = x.iter().take(COEFFICIENTS).copied().collect();
             shadow_coefficients[ch] = std::array::from_fn(|m| x[COEFFICIENTS + m]);
         }
@@ -86,7 +91,7 @@ impl PhotometricModel {
             residual_rms: Vec::new(),
         };
         model.residual_rms = captures
-            .iter()
+            .par_iter()
             .zip(&gains)
             .map(|(c, g)| {
                 rms_over_skin(
