@@ -546,20 +546,28 @@ fn leave_one_out(
     done: &(dyn Fn(usize) + Sync),
 ) -> Result<Vec<Rendered>, Box<dyn Error>> {
     let (rays, reference) = (&setup.rays, &setup.reference);
+    // a capture's gain against the reference image is the same in every subset: measured once
+    let gains = PhotometricModel::reference_gains(
+        rays,
+        reference,
+        &setup.reference_image,
+        all,
+        setup.full_scale,
+    );
     let finished = std::sync::atomic::AtomicUsize::new(0);
     // the fits are independent: in parallel, collected in the captures' order
     let loo: Vec<Result<Rendered, String>> = (0..posed.len())
         .into_par_iter()
         .map(|k| {
-            let others: Vec<Capture> = (0..posed.len())
-                .filter(|&j| j != k)
-                .map(|j| all[j])
-                .collect();
-            let m = PhotometricModel::fit(
+            let keep = |&j: &usize| j != k;
+            let others: Vec<Capture> = (0..posed.len()).filter(keep).map(|j| all[j]).collect();
+            let their_gains: Vec<f64> = (0..posed.len()).filter(keep).map(|j| gains[j]).collect();
+            let m = PhotometricModel::fit_with_gains(
                 rays,
                 reference,
                 &setup.reference_image,
                 &others,
+                &their_gains,
                 setup.full_scale,
             )
             .map_err(|e| format!("leaving out {}: {e}", posed[k].file.display()))?;

@@ -31,9 +31,77 @@ impl PhotometricModel {
         captures: &[Capture<'_>],
         full_scale: f64,
     ) -> Result<PhotometricModel, String> {
+        check_inputs(rays, reference, reference_image, captures, full_scale)?;
+        let gains = Self::reference_gains(rays, reference, reference_image, captures, full_scale);
+        Self::fit_checked(
+            rays,
+            reference,
+            reference_image,
+            captures,
+            gains,
+            full_scale,
+        )
+    }
+
+    /// Each capture's gain against `reference_image` ([`capture_gain`]), as [`Self::fit`]
+    /// measures it: one capture's gain does not depend on the others, so a caller fitting
+    /// several subsets of the same captures (the leave-one-out) measures them once.
+    pub fn reference_gains(
+        rays: &PixelRays,
+        reference: &SurfaceHits,
+        reference_image: &[[f64; 3]],
+        captures: &[Capture<'_>],
+        full_scale: f64,
+    ) -> Vec<f64> {
+        let (w, h) = (rays.width, rays.height);
+        captures
+            .par_iter()
+            .map(|c| capture_gain(c, reference_image, reference, w, h, full_scale))
+            .collect()
+    }
+
+    /// [`Self::fit`] with each capture's gain given ([`Self::reference_gains`] of the same
+    /// captures): the same model.
+    ///
+    /// # Errors
+    /// As [`Self::fit`], and when `gains` has not one value per capture.
+    pub fn fit_with_gains(
+        rays: &PixelRays,
+        reference: &SurfaceHits,
+        reference_image: &[[f64; 3]],
+        captures: &[Capture<'_>],
+        gains: &[f64],
+        full_scale: f64,
+    ) -> Result<PhotometricModel, String> {
+        check_inputs(rays, reference, reference_image, captures, full_scale)?;
+        if gains.len() != captures.len() {
+            return Err(format!(
+                "{} gains for {} captures",
+                gains.len(),
+                captures.len()
+            ));
+        }
+        Self::fit_checked(
+            rays,
+            reference,
+            reference_image,
+            captures,
+            gains.to_vec(),
+            full_scale,
+        )
+    }
+
+    /// [`Self::fit`] of checked inputs with their gains.
+    fn fit_checked(
+        rays: &PixelRays,
+        reference: &SurfaceHits,
+        reference_image: &[[f64; 3]],
+        captures: &[Capture<'_>],
+        gains: Vec<f64>,
+        full_scale: f64,
+    ) -> Result<PhotometricModel, String> {
         let (w, h) = (rays.width, rays.height);
         let n = w * h;
-        check_inputs(rays, reference, reference_image, captures, full_scale)?;
         let axis = optical_axis(rays);
         let rings = ShadowRings::of(rays, reference);
         if let Some(k) = captures.iter().position(|c| c.shadows.rings != rings) {
@@ -41,10 +109,6 @@ impl PhotometricModel {
                 "capture {k}: its shadows are of other light rings than this camera's"
             ));
         }
-        let gains: Vec<f64> = captures
-            .iter()
-            .map(|c| capture_gain(c, reference_image, reference, w, h, full_scale))
-            .collect();
         let appearance = appearance(reference, reference_image, captures, &gains);
         // The response to tilt and the shadows, by least squares on the pressed and the
         // shadowed pixels of every capture.
