@@ -82,14 +82,18 @@ def write_header(model, name: str) -> None:
     h.SetAuthorisation(TCollection_HAsciiString(""))
 
 
-def check_against(shape, ref: dict, tol: float) -> None:
+def check_against(shape, ref: dict, tol: float, planar: bool = False) -> None:
     """Raises ValueError unless `shape`'s exact volume is within the chord bound of `ref`'s
-    (volume_mm3, surface_area_mm2) and its bounding box within tol + 1 um of `ref`'s bbox_mm."""
+    (volume_mm3, surface_area_mm2) and its bounding box within tol + 1 um of `ref`'s bbox_mm.
+    `planar`: every face of `shape` is a plane (a sewn mesh), whose volume OCCT's default Gauss
+    integration gives exactly (the integrand is a polynomial of degree 2 over straight-edged
+    faces; 59,256 triangles: the same volume to the last digit in 1.2 s, against 13.6 s for the
+    adaptive integration to 1e-9 the curved twins need)."""
     from OCP.Bnd import Bnd_Box
     from OCP.BRepBndLib import BRepBndLib
     from . import cq_common
 
-    v = cq_common.exact_volume(shape)
+    v = planar_volume(shape) if planar else cq_common.exact_volume(shape)
     bound = ref["surface_area_mm2"] * tol + 1e-6 * abs(v)
     if not abs(v - ref["volume_mm3"]) <= bound:
         raise ValueError(f"the exact twin's volume {v:.4f} mm3 differs from fabkit's "
@@ -101,6 +105,15 @@ def check_against(shape, ref: dict, tol: float) -> None:
               max(abs(a - b) for a, b in zip(hi, ref["bbox_mm"]["max"])))
     if not dev <= tol + 1e-3:
         raise ValueError(f"the exact twin's bounding box is {dev:.4f} mm off fabkit's")
+
+
+def planar_volume(shape) -> float:
+    """Volume of an OCCT shape whose faces are all planes, by OCCT's default integration."""
+    from OCP.BRepGProp import BRepGProp
+    from OCP.GProp import GProp_GProps
+    g = GProp_GProps()
+    BRepGProp.VolumeProperties_s(shape.wrapped, g)
+    return g.Mass()
 
 
 def rigid_inverse(t: list) -> list:
@@ -225,7 +238,9 @@ def check_closed_valid(shape) -> None:
     from OCP.BRep import BRep_Tool
     from OCP.BRepCheck import BRepCheck_Analyzer
 
-    if not BRepCheck_Analyzer(shape.wrapped).IsValid():
+    # geometric controls on, faces checked in parallel (a check: the bytes written do not
+    # depend on it)
+    if not BRepCheck_Analyzer(shape.wrapped, True, True).IsValid():
         raise ValueError("the solid is not valid (BRepCheck)")
     if not all(BRep_Tool.IsClosed_s(s.wrapped) for s in shape.Shells()):
         raise ValueError("a shell of the solid is open")
@@ -332,7 +347,8 @@ def main(argv=None) -> int:
                 shape = sewn_mesh(m["mesh"])
             shape = member_solids(shape, int(m["shells"]))
             check_closed_valid(shape)
-            check_against(shape, m, tol)
+            check_against(shape, m, tol,
+                          planar=m.get("part") is None and m.get("exact") is None)
             built.append((name, shape))
         except Exception as e:  # reported with the member's name, exit 3
             print(f"step_export: member {name}: {type(e).__name__}: {e}", file=sys.stderr)
