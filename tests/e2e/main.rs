@@ -1,12 +1,17 @@
 //! fabkit's end-to-end tests: the CLI binary run on real designs, its outputs read back by
 //! independent consumers (tests/oracles/, printcheck). One test binary (one link), a module per
 //! command or area; `common` holds the shared helpers.
+//!
+//! libtest starts the tests in the order of their names, two at a time here: the longest test
+//! (the CAD twins' full tier, about four minutes) is in `cad_twins` so that it starts among the
+//! first and the short tests fill the other thread, rather than starting last and running alone.
 
 mod common;
 
 mod assembly_step;
 mod authors_cad;
 mod byte_identical;
+mod cad_twins;
 mod calibrate_board;
 mod calibrate_cli;
 mod calibrate_images;
@@ -35,4 +40,3 @@ mod sim_export;
 mod step_install;
 mod sweep_cli;
 mod tutorial;
-mod twins;

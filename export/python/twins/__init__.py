@@ -11,7 +11,7 @@
   one per part and the sensor-frame `assembly.step`.
 
 fabkit embeds the modules STEP export runs (this file, cq_*.py, families.py, step_export.py;
-see export/src/step.rs); the others are the test tools of tests/e2e/twins.rs, run as scripts
+see export/src/step.rs); the others are the test tools of tests/e2e/cad_twins.rs, run as scripts
 (`python export/python/twins/check_twins.py ...`), and m3d_twin.py imports
 tests/oracles/replay_csg.py.
 """

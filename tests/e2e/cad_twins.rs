@@ -100,6 +100,31 @@ fn export_all(dir: &Path, extra: &[&str]) -> Vec<PathBuf> {
     CASES.iter().map(|(name, _)| dir.join(name)).collect()
 }
 
+/// The exports both tiers check, made once per test run: the first tier to ask makes them
+/// (two at a time), the other waits for them. With CadQuery (`FABKIT_CADQUERY_PYTHON`) they are
+/// `--format stl,3mf,step`, whose STL and 3MF files are those of the default formats (the full
+/// tier checks so on R-Tac0), else the default formats. Returns the folder holding them and
+/// each case's folder. The folder is `<target>/tmp/cad_twins-exports` (a static is never
+/// dropped, so a temporary folder would outlive the run): emptied first, left for a look after.
+fn shared_exports() -> (&'static Path, &'static [PathBuf]) {
+    static EXPORTS: std::sync::OnceLock<(PathBuf, Vec<PathBuf>)> = std::sync::OnceLock::new();
+    let (dir, exports) = EXPORTS.get_or_init(|| {
+        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("cad_twins-exports");
+        if dir.exists() {
+            std::fs::remove_dir_all(&dir).expect("the previous run's exports removed");
+        }
+        std::fs::create_dir_all(&dir).unwrap();
+        let extra: &[&str] = if cadquery_python().is_some() {
+            &["--format", "stl,3mf,step"]
+        } else {
+            &[]
+        };
+        let exports = export_all(&dir, extra);
+        (dir, exports)
+    });
+    (dir, exports)
+}
+
 fn report_dir() -> PathBuf {
     let d = std::env::var_os("FABKIT_TWIN_REPORT_DIR")
         .map(PathBuf::from)
@@ -153,9 +178,7 @@ fn manifold3d_twin_agrees_on_every_part() {
     let Some(py) = oracle_python() else {
         return missing("the oracle python (manifold3d + trimesh + libigl)");
     };
-    let t = tempfile::tempdir().unwrap();
-    let exports = export_all(t.path(), &[]);
-    check_twins(&py, "fast", &[], &exports);
+    check_twins(&py, "fast", &[], shared_exports().1);
 }
 
 /// Full tier: the exact CadQuery twin of every part (volume within the chord bound, Hausdorff
@@ -167,10 +190,11 @@ fn cadquery_twin_agrees_on_every_part_and_step_reads_back() {
         eprintln!("SKIPPED: full twin tier (set FABKIT_CADQUERY_PYTHON; .ci/run does)");
         return;
     };
-    let t = tempfile::tempdir().unwrap();
-    let exports = export_all(t.path(), &["--format", "stl,3mf,step"]);
+    // with CadQuery, the shared exports are STL, 3MF and STEP
+    let (dir, exports) = shared_exports();
     // The manifold3d twin of these parts is the fast tier's test (same input, same bytes: the
     // STL files do not depend on --format step, checked here on R-Tac0).
+    let t = tempfile::tempdir().unwrap();
     let plain = run(t.path(), &["export", "rtac0", "--out", "rtac0_stl"], &[]);
     assert!(plain.status.success(), "{}", text(&plain.stderr));
     let stls = |d: &Path| -> Vec<(std::ffi::OsString, Vec<u8>)> {
@@ -188,17 +212,17 @@ fn cadquery_twin_agrees_on_every_part_and_step_reads_back() {
         v.sort();
         v
     };
-    let with_step = stls(&t.path().join("rtac0"));
+    let with_step = stls(&dir.join("rtac0"));
     assert!(!with_step.is_empty());
     assert!(
         with_step == stls(&t.path().join("rtac0_stl")),
         "the STL files of `export rtac0` differ with --format stl,3mf,step"
     );
-    let json = check_twins(&py, "full", &["--skip-manifold3d"], &exports);
+    let json = check_twins(&py, "full", &["--skip-manifold3d"], exports);
     // every folder's STEP files read back in one CadQuery start
     let o = Command::new(&py)
         .arg(repo_root().join("export/python/twins/check_step.py"))
-        .args(&exports)
+        .args(exports)
         .arg("--exact-json")
         .arg(&json)
         .output()
@@ -209,7 +233,7 @@ fn cadquery_twin_agrees_on_every_part_and_step_reads_back() {
         "check_step.py:\n{out}\n{}",
         text(&o.stderr)
     );
-    for d in &exports {
+    for d in exports {
         let name = d.file_name().unwrap().to_str().unwrap();
         assert!(
             out.contains(&format!("check_step: {name}: "))
