@@ -8,6 +8,7 @@ mod estimate;
 mod flat_housing;
 mod flat_skin;
 mod geometry;
+mod glyphs;
 mod hostile_values;
 mod insertion;
 mod json_schema;
