@@ -318,7 +318,7 @@ pub(crate) fn encode(
 /// The whole 3MF package as bytes: `[Content_Types].xml`, `_rels/.rels`, `3D/3dmodel.model`
 /// and, when an object holds a group, [`PRUSA_CONFIG_PATH`], and with `thumbnail` the package
 /// thumbnail [`THUMBNAIL_PATH`] (its root relationship in `_rels/.rels`, the `png` content
-/// type declared); deflated at level 6, every entry dated 1980-01-01 00:00:00 with host system
+/// type declared); deflated at level 4, every entry dated 1980-01-01 00:00:00 with host system
 /// Unix and mode 0644, so the bytes depend only on the input (and the deflate implementation).
 /// The thumbnail (PNG bytes) is drawn by `thumbnail` while the model is written and deflated
 /// (it is the package's last entry), and returned with the package.
@@ -439,13 +439,15 @@ fn escape(s: &str) -> String {
     out
 }
 
-/// The options of every zip entry fabkit writes (3MF, NPZ): deflated at level 6, a fixed
+/// The options of every zip entry fabkit writes (3MF, NPZ): deflated at level 4, a fixed
 /// timestamp and Unix mode 0644, so the same bytes go in and come out; ZIP64 when an entry of
-/// `len` bytes needs it.
+/// `len` bytes needs it. Level 4 rather than zlib's default 6: R-Tac0's export takes 14 % less
+/// CPU (0.81 s against 0.94 s) for 3MF packages 4 % larger (2.39 MB against 2.30 MB; ShadowTac's
+/// 7.03 MB against 6.80 MB); level 1 (zlib-rs's quick deflate) made them 64 % larger.
 pub(crate) fn zip_entry_options(len: usize) -> SimpleFileOptions {
     SimpleFileOptions::default()
         .compression_method(CompressionMethod::Deflated)
-        .compression_level(Some(6))
+        .compression_level(Some(4))
         .last_modified_time(DateTime::default())
         .system(System::Unix)
         .unix_permissions(0o644)
