@@ -338,6 +338,7 @@ def main(argv=None) -> int:
         name = m["name"]
         print(f"step_export: member {name}", file=sys.stderr, flush=True)
         try:
+            planar = False  # a sewn mesh's faces are all planes
             if m.get("part") is not None:
                 shape, params = shapes[m["part"]]
                 shape = cq_common.transformed(shape, rigid_inverse(params["T_print_sensor"]))
@@ -345,10 +346,10 @@ def main(argv=None) -> int:
                 shape = exact_member(m["exact"])
             else:
                 shape = sewn_mesh(m["mesh"])
+                planar = True
             shape = member_solids(shape, int(m["shells"]))
             check_closed_valid(shape)
-            check_against(shape, m, tol,
-                          planar=m.get("part") is None and m.get("exact") is None)
+            check_against(shape, m, tol, planar=planar)
             built.append((name, shape))
         except Exception as e:  # reported with the member's name, exit 3
             print(f"step_export: member {name}: {type(e).__name__}: {e}", file=sys.stderr)
