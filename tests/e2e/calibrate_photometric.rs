@@ -925,7 +925,16 @@ fn every_library_pin_dome_lies_on_its_designs_skin() {
     for name in ["rtac0", "uvdtact", "shadowtac", "digit_pinki"] {
         let o = run(
             d.path(),
-            &["fixtures", name, "--format", "stl", "--out", name],
+            &[
+                "fixtures",
+                name,
+                "--semidomes",
+                "0",
+                "--format",
+                "stl",
+                "--out",
+                name,
+            ],
             &[],
         );
         assert!(o.status.success(), "{name}: {}", text(&o.stderr));

@@ -7,7 +7,7 @@ Usage: published_step.py PUBLISHED.STEP PART.stl T_PRINT_SENSOR T_STEP_SENSOR
 T_PRINT_SENSOR is the part's `params.T_print_sensor` from the manifest, T_STEP_SENSOR the map from
 the sensor frame into the published file's frame; both JSON, 3 x 4 rows. The STL is mapped back
 into the sensor frame and on into the STEP's frame; the STEP is tessellated by OCCT to 0.002 mm.
-Both meshes are subdivided to edges of at most 0.25 mm, and each one's vertices measured to the
+Both meshes are sampled every 0.25 mm or closer (`dense`), and each one's samples measured to the
 other's surface (libigl's exact point-to-triangle distance): the two one-sided distances and their maximum
 (the Hausdorff distance, sampled every 0.25 mm), the worst point of each, and both volumes.
 
@@ -37,8 +37,33 @@ def step_mesh(path):
 
 
 def dense(mesh, edge_mm=0.25):
-    v, _ = trimesh.remesh.subdivide_to_size(mesh.vertices, mesh.faces, max_edge=edge_mm)
-    return v
+    """Points of the mesh's surface no farther than `edge_mm` apart: each triangle in rows
+    parallel to its longest edge, the rows at most edge_mm apart (the base row on that edge, the
+    last on the opposite corner) and each row's points at most edge_mm apart, its ends on the
+    triangle's other two edges. A sliver (a fan of a holed face) gets one or two rows, not the
+    square of its length / edge_mm points an even subdivision gives it."""
+    v = np.asarray(mesh.vertices, dtype=float)
+    f = np.asarray(mesh.faces, dtype=np.int64)
+    tri = v[f]
+    lens = np.linalg.norm(tri[:, [1, 2, 0]] - tri, axis=2)  # edge k: corner k to corner k + 1
+    k = lens.argmax(axis=1)
+    faces = np.arange(len(f))
+    p0, p1, p2 = tri[faces, k], tri[faces, (k + 1) % 3], tri[faces, (k + 2) % 3]
+    base = lens[faces, k]
+    twice_area = np.linalg.norm(np.cross(p1 - p0, p2 - p0), axis=1)
+    height = np.divide(twice_area, base, out=np.zeros_like(base), where=base > 0)
+    m = np.maximum(1, np.ceil(height / edge_mm)).astype(np.int64)
+    # rows r = 0..m of each face, at t = r / m of the way from the base to the opposite corner
+    row_face = np.repeat(faces, m + 1)
+    r = np.arange(len(row_face)) - np.repeat(np.cumsum(m + 1) - (m + 1), m + 1)
+    t = (r / m[row_face])[:, None]
+    a = p0[row_face] + t * (p2 - p0)[row_face]
+    b = p1[row_face] + t * (p2 - p1)[row_face]
+    n = np.maximum(1, np.ceil((1.0 - t[:, 0]) * base[row_face] / edge_mm)).astype(np.int64)
+    pt_row = np.repeat(np.arange(len(n)), n + 1)
+    i = np.arange(len(pt_row)) - np.repeat(np.cumsum(n + 1) - (n + 1), n + 1)
+    s = (i / n[pt_row])[:, None]
+    return a[pt_row] + s * (b - a)[pt_row]
 
 
 def one_sided(points, mesh):
