@@ -45,6 +45,8 @@ pub use fabkit_designs::variant::{
 pub use file::{values_of, FileOutputs, Mode, Output, Parameter, SweepSpec};
 pub use merge::{merge, MergeSummary};
 pub use nearest::nearest_paths;
+#[doc(hidden)]
+pub use plan::{splice_pieces, takes_any_number};
 pub use plan::{
     variant_count, variant_id, Plan, PlanProgress, Shard, Variant, ID_HEX_DIGITS, MAX_VARIANTS,
 };

@@ -416,6 +416,14 @@ impl SweepSpec {
     }
 }
 
+/// For tests (sweep/tests/it/plan.rs): the number of pieces of the splice that plans this
+/// sweep's ids from the base design's JSON form `base_json` (one more than the varied
+/// parameters), or `None` when every variant is resolved in full.
+#[doc(hidden)]
+pub fn splice_pieces(spec: &SweepSpec, base_json: &Value) -> Option<usize> {
+    spec.splice(base_json).map(|s| s.pieces.len())
+}
+
 /// Numbers that a parameter must take, and write back as the same `f64`, for every number to
 /// count as one of its values without setting each into the design ([`takes_any_number`]):
 /// zero, integers, fractions, both signs, the extremes of `f64` and of the integer types,
@@ -449,7 +457,8 @@ pub(crate) fn number_text(n: &serde_json::Number) -> Option<Vec<u8>> {
 /// writes it back as that `f64`, changing nothing else. Then any number is a value of the
 /// parameter, and its text in the resolved design is [`number_text`], without building the
 /// design per value.
-pub(crate) fn takes_any_number(base_json: &Value, path: &str) -> bool {
+#[doc(hidden)]
+pub fn takes_any_number(base_json: &Value, path: &str) -> bool {
     use serde::Deserialize as _;
     let Ok(base) = Design::deserialize(base_json) else {
         return false;
@@ -614,34 +623,5 @@ impl std::str::FromStr for Shard {
 impl std::fmt::Display for Shard {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(f, "{}/{}", self.index, self.count)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn spec(vary: &str) -> SweepSpec {
-        let text = format!("base: shadowtac\npreset: paper_text\nvary:\n{vary}");
-        SweepSpec::parse(&text, "sweep.yaml", std::path::Path::new("")).unwrap()
-    }
-
-    /// The splice (ids without resolving each design) is what plans numbers and text; two
-    /// parameters of the body are resolved one by one.
-    #[test]
-    fn numbers_and_text_are_spliced_and_the_body_is_resolved() {
-        let s = spec(
-            "  layers[0].markers[0].pattern.spacing_mm: [1.3, 1.4]\n  layers[0].markers[0].feature.height_mm: [0.4, 0.5]\n  name: [a, b]\n",
-        );
-        let json = serde_json::to_value(&s.base.design).unwrap();
-        let splice = s.splice(&json).expect("spliced");
-        assert_eq!(splice.pieces.len(), 4);
-        assert!(takes_any_number(
-            &json,
-            "layers[0].markers[0].pattern.spacing_mm"
-        ));
-        assert!(!takes_any_number(&json, "name"));
-        let body = spec("  body.base_diameter_mm: [34.0, 35.0]\n  body.height_mm: [7.5, 8.0]\n");
-        assert!(body.splice(&json).is_none());
     }
 }

@@ -247,3 +247,24 @@ fn a_non_finite_value_is_refused_in_words_at_its_place() {
         );
     }
 }
+
+/// The splice (ids without resolving each design) is what plans numbers and text; two
+/// parameters of the body are resolved one by one.
+#[test]
+fn numbers_and_text_are_spliced_and_the_body_is_resolved() {
+    let s = parse(&sweep(
+        &format!("  {SPACING}: [1.3, 1.4]\n  {HEIGHT}: [0.4, 0.5]\n  name: [a, b]\n"),
+        "",
+    ))
+    .unwrap();
+    let json = serde_json::to_value(&s.base.design).unwrap();
+    assert_eq!(splice_pieces(&s, &json), Some(4));
+    assert!(takes_any_number(&json, SPACING));
+    assert!(!takes_any_number(&json, "name"));
+    let body = parse(&sweep(
+        "  body.base_diameter_mm: [34.0, 35.0]\n  body.height_mm: [7.5, 8.0]\n",
+        "",
+    ))
+    .unwrap();
+    assert_eq!(splice_pieces(&body, &json), None);
+}
