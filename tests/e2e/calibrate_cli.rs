@@ -416,22 +416,7 @@ fn rtac0_fixture_table_and_capture_plan_end_to_end() {
     use fabkit_calibration::tables::{read_capture_plan, read_point_table, PointsFrom};
     let d = tempfile::tempdir().unwrap();
     let dir = d.path();
-    let o = run(
-        dir,
-        // the pin dome's tables only (the paper's 100 semi-domes are not calibrated from)
-        &[
-            "fixtures",
-            "rtac0",
-            "--pins-preset",
-            "rtac0",
-            "--semidomes",
-            "0",
-            "--out",
-            "fx",
-        ],
-        &[],
-    );
-    assert!(o.status.success(), "{}", text(&o.stderr));
+    let o = crate::common::published_pin_dome(dir, "rtac0", "fx");
     // the summary says in words how the pins sit (not a Rust name)
     let said = text(&o.stdout);
     assert!(
@@ -552,21 +537,7 @@ fn the_point_tables_design_gives_the_optical_path_only_when_it_is_the_tables() {
             + "  chamber:\n    housing.filling_gel.fills: chamber\n    housing.camera.lens_height_mm: 4.0\n";
     std::fs::write(dir.join("mine.yaml"), &yaml).unwrap();
     for (design, out) in [("rtac0", "fx"), ("mine.yaml", "fm")] {
-        let o = run(
-            dir,
-            &[
-                "fixtures",
-                design,
-                "--pins-preset",
-                "rtac0",
-                "--semidomes",
-                "0",
-                "--out",
-                out,
-            ],
-            &[],
-        );
-        assert!(o.status.success(), "{}", text(&o.stderr));
+        crate::common::published_pin_dome(dir, design, out);
     }
     std::fs::write(
         dir.join("cam.yaml"),

@@ -101,23 +101,7 @@ impl Scene {
     /// point table's design); cam.yaml holds `camera`.
     fn with(camera: Intrinsics, pose: Isometry3<f64>) -> Scene {
         let dir = tempfile::tempdir().unwrap();
-        // the pin dome's tables only: the paper's 100 semi-domes (R-Tac0's default) are not
-        // calibrated from, and took 9 of the command's 10 CPU-seconds
-        let o = run(
-            dir.path(),
-            &[
-                "fixtures",
-                "rtac0",
-                "--pins-preset",
-                "rtac0",
-                "--semidomes",
-                "0",
-                "--out",
-                "fx",
-            ],
-            &[],
-        );
-        assert!(o.status.success(), "{}", text(&o.stderr));
+        crate::common::published_pin_dome(dir.path(), "rtac0", "fx");
         std::fs::write(
             dir.path().join("cam.yaml"),
             write_camera(&camera, CameraFileFormat::OpenCvYaml),

@@ -22,6 +22,33 @@ pub fn run(cwd: &Path, args: &[&str], envs: &[(&str, &str)]) -> Output {
     c.output().expect("fabkit binary runs")
 }
 
+/// `fabkit fixtures DESIGN --pins-preset rtac0 --semidomes 0 --out OUT` in `cwd`: R-Tac0's
+/// published pin dome with its point table and capture plan, for tests that calibrate from the
+/// tables, without the paper's 100 semi-domes (R-Tac0's default, 9 of the command's 10
+/// CPU-seconds). Panics naming stderr when the command fails; returns its output.
+pub fn published_pin_dome(cwd: &Path, design: &str, out: &str) -> Output {
+    let o = run(
+        cwd,
+        &[
+            "fixtures",
+            design,
+            "--pins-preset",
+            "rtac0",
+            "--semidomes",
+            "0",
+            "--out",
+            out,
+        ],
+        &[],
+    );
+    assert!(
+        o.status.success(),
+        "fixtures {design}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    o
+}
+
 /// Runs fabkit with `args` in `cwd` under an address-space limit of `limit_kib` KiB
 /// (`ulimit -v`), with `envs`: an allocation past the limit fails as it would on a machine of
 /// that memory.
