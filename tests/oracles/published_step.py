@@ -36,6 +36,11 @@ def step_mesh(path):
     return trimesh.Trimesh(v, np.array(tris), process=True), shape.Volume()
 
 
+def ranks(counts):
+    """0, 1, ..., c - 1 for each count c in turn (each entry's place within its group)."""
+    return np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
+
+
 def dense(mesh, edge_mm=0.25):
     """Points of the mesh's surface no farther than `edge_mm` apart: each triangle in rows
     parallel to its longest edge, the rows at most edge_mm apart (the base row on that edge, the
@@ -55,14 +60,12 @@ def dense(mesh, edge_mm=0.25):
     m = np.maximum(1, np.ceil(height / edge_mm)).astype(np.int64)
     # rows r = 0..m of each face, at t = r / m of the way from the base to the opposite corner
     row_face = np.repeat(faces, m + 1)
-    r = np.arange(len(row_face)) - np.repeat(np.cumsum(m + 1) - (m + 1), m + 1)
-    t = (r / m[row_face])[:, None]
+    t = (ranks(m + 1) / m[row_face])[:, None]
     a = p0[row_face] + t * (p2 - p0)[row_face]
     b = p1[row_face] + t * (p2 - p1)[row_face]
     n = np.maximum(1, np.ceil((1.0 - t[:, 0]) * base[row_face] / edge_mm)).astype(np.int64)
     pt_row = np.repeat(np.arange(len(n)), n + 1)
-    i = np.arange(len(pt_row)) - np.repeat(np.cumsum(n + 1) - (n + 1), n + 1)
-    s = (i / n[pt_row])[:, None]
+    s = (ranks(n + 1) / n[pt_row])[:, None]
     return a[pt_row] + s * (b - a)[pt_row]
 
 
