@@ -15,8 +15,8 @@ use fabkit_calibration::imprints::ids_from_file_name;
 use fabkit_calibration::photometric::seating::{seat_dome, DomeSeating, SEATING_PRIOR};
 use fabkit_calibration::photometric::{
     capture_fault, image_fault, read_pins, rms_over_skin, shadow_map, Capture, ContactRegion,
-    ImprintMap, PhotometricModel, ShadowMap, ShadowRings, CONTACT_REACH_PX, DARKENING_NOISE_SIGMAS,
-    GAIN_CLEARANCE_PX, GAIN_OUTLIER_SIGMAS,
+    ImprintMap, LeaveOneOut, PhotometricModel, ShadowMap, ShadowRings, CONTACT_REACH_PX,
+    DARKENING_NOISE_SIGMAS, GAIN_CLEARANCE_PX, GAIN_OUTLIER_SIGMAS,
 };
 use fabkit_export::raster::{npy_f32, png_rgb16, png_rgb8};
 use fabkit_export::{OutputClaim, OutputCommand, StagedDir};
@@ -554,23 +554,22 @@ fn leave_one_out(
         all,
         setup.full_scale,
     );
+    let fits = LeaveOneOut::new(
+        rays,
+        reference,
+        &setup.reference_image,
+        all,
+        &gains,
+        setup.full_scale,
+    )?;
     let finished = std::sync::atomic::AtomicUsize::new(0);
     // the fits are independent: in parallel, collected in the captures' order
     let loo: Vec<Result<Rendered, String>> = (0..posed.len())
         .into_par_iter()
         .map(|k| {
-            let keep = |&j: &usize| j != k;
-            let others: Vec<Capture> = (0..posed.len()).filter(keep).map(|j| all[j]).collect();
-            let their_gains: Vec<f64> = (0..posed.len()).filter(keep).map(|j| gains[j]).collect();
-            let m = PhotometricModel::fit_with_gains(
-                rays,
-                reference,
-                &setup.reference_image,
-                &others,
-                &their_gains,
-                setup.full_scale,
-            )
-            .map_err(|e| format!("leaving out {}: {e}", posed[k].file.display()))?;
+            let m = fits
+                .model(k)
+                .map_err(|e| format!("leaving out {}: {e}", posed[k].file.display()))?;
             let gain = m.gain_of(&all[k], reference);
             let r = rendered(setup, &m, &all[k], gain, reach_px);
             done(finished.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1);

@@ -100,60 +100,19 @@ impl PhotometricModel {
         gains: Vec<f64>,
         full_scale: f64,
     ) -> Result<PhotometricModel, String> {
-        let (w, h) = (rays.width, rays.height);
-        let n = w * h;
-        let axis = optical_axis(rays);
-        let rings = ShadowRings::of(rays, reference);
-        if let Some(k) = captures.iter().position(|c| c.shadows.rings != rings) {
-            return Err(format!(
-                "capture {k}: its shadows are of other light rings than this camera's"
-            ));
-        }
+        let n = rays.width * rays.height;
+        let rings = rings_of(rays, reference, captures)?;
         let appearance = appearance(reference, reference_image, captures, &gains);
-        // The response to tilt and the shadows, by least squares on the pressed and the
-        // shadowed pixels of every capture.
-        let unknowns = COEFFICIENTS + SHADOW_TERMS;
         let (rows, pressed) = fit_rows(reference, captures, n);
-        if pressed < 2 * unknowns {
-            return Err(format!(
-                "the captures press {} pixels of the skin, fewer than the {} the fit needs (twice its {unknowns} unknowns): give captures with more imprints",
-                pressed,
-                2 * unknowns
-            ));
-        }
-        let design = Design {
+        let problem = Problem {
             rays,
             reference,
             captures,
-            appearance: &appearance,
             gains: &gains,
-            axis,
-            lights: rings.point_lights(),
-            full_scale,
-        };
-        let mut coefficients: [Vec<f64>; 3] = Default::default();
-        let mut shadow_coefficients = [[0.0; SHADOW_TERMS]; 3];
-        // the channels are independent problems: solved in parallel, kept in channel order
-        let solved: Vec<DVector<f64>> = (0..3)
-            .into_par_iter()
-            .map(|ch| design.solve(ch, &rows))
-            .collect();
-        for (ch, (coef, x)) in coefficients.iter_mut().zip(&solved).enumerate() {
-            *coef = x.iter().take(COEFFICIENTS).copied().collect();
-            shadow_coefficients[ch] = std::array::from_fn(|m| x[COEFFICIENTS + m]);
-        }
-        let mut model = PhotometricModel {
-            width: w,
-            height: h,
-            reference: appearance,
-            coefficients,
-            axis,
             rings,
-            shadow_coefficients,
-            gains: gains.clone(),
             full_scale,
-            residual_rms: Vec::new(),
         };
+        let mut model = problem.solve(appearance, &rows, pressed, gains.clone())?;
         model.residual_rms = captures
             .par_iter()
             .zip(&gains)
@@ -165,6 +124,248 @@ impl PhotometricModel {
             })
             .collect();
         Ok(model)
+    }
+}
+
+/// The candidate light rings of `rays` over `reference` ([`ShadowRings::of`]).
+///
+/// # Errors
+/// A message naming the first capture whose shadows are of other rings.
+fn rings_of(
+    rays: &PixelRays,
+    reference: &SurfaceHits,
+    captures: &[Capture<'_>],
+) -> Result<ShadowRings, String> {
+    let rings = ShadowRings::of(rays, reference);
+    if let Some(k) = captures.iter().position(|c| c.shadows.rings != rings) {
+        return Err(format!(
+            "capture {k}: its shadows are of other light rings than this camera's"
+        ));
+    }
+    Ok(rings)
+}
+
+/// What a fit of some of `captures` shares with every other: the camera's rays, the
+/// reference surface, each capture's gain, the light rings and the full scale.
+struct Problem<'a> {
+    rays: &'a PixelRays,
+    reference: &'a SurfaceHits,
+    captures: &'a [Capture<'a>],
+    gains: &'a [f64],
+    rings: ShadowRings,
+    full_scale: f64,
+}
+
+impl Problem<'_> {
+    /// The model of `appearance` fitted over `rows` (of which `pressed` are pressed pixels),
+    /// carrying `model_gains`; its `residual_rms` is left empty.
+    ///
+    /// # Errors
+    /// When `pressed` is under twice the unknowns.
+    fn solve(
+        &self,
+        appearance: Vec<[f64; 3]>,
+        rows: &[FitRow<'_>],
+        pressed: usize,
+        model_gains: Vec<f64>,
+    ) -> Result<PhotometricModel, String> {
+        let (rays, rings) = (self.rays, self.rings);
+        // The response to tilt and the shadows, by least squares on the pressed and the
+        // shadowed pixels of every capture.
+        let unknowns = COEFFICIENTS + SHADOW_TERMS;
+        if pressed < 2 * unknowns {
+            return Err(format!(
+                "the captures press {} pixels of the skin, fewer than the {} the fit needs (twice its {unknowns} unknowns): give captures with more imprints",
+                pressed,
+                2 * unknowns
+            ));
+        }
+        let axis = optical_axis(rays);
+        let design = Design {
+            rays,
+            reference: self.reference,
+            captures: self.captures,
+            appearance: &appearance,
+            gains: self.gains,
+            axis,
+            lights: rings.point_lights(),
+            full_scale: self.full_scale,
+        };
+        let mut coefficients: [Vec<f64>; 3] = Default::default();
+        let mut shadow_coefficients = [[0.0; SHADOW_TERMS]; 3];
+        // the channels are independent problems: solved in parallel, kept in channel order
+        let solved: Vec<DVector<f64>> = (0..3)
+            .into_par_iter()
+            .map(|ch| design.solve(ch, rows))
+            .collect();
+        for (ch, (coef, x)) in coefficients.iter_mut().zip(&solved).enumerate() {
+            *coef = x.iter().take(COEFFICIENTS).copied().collect();
+            shadow_coefficients[ch] = std::array::from_fn(|m| x[COEFFICIENTS + m]);
+        }
+        Ok(PhotometricModel {
+            width: rays.width,
+            height: rays.height,
+            reference: appearance,
+            coefficients,
+            axis,
+            rings,
+            shadow_coefficients,
+            gains: model_gains,
+            full_scale: self.full_scale,
+            residual_rms: Vec::new(),
+        })
+    }
+}
+
+/// The leave-one-out of a fit: for each capture, the model fitted on the others
+/// ([`Self::model`]), without refitting from the images. The inputs are checked and each
+/// capture's gain measured once; the appearance's per-pixel medians are sorted once, and
+/// the median without one capture is read from the values around the middle (the same value
+/// as sorting the others); the normal equations are summed over the others' rows.
+pub struct LeaveOneOut<'a> {
+    problem: Problem<'a>,
+    /// Per pixel and channel, the sorted values of the appearance's median ([`appearance`]):
+    /// their number and the three from `(len - 2) / 2` (NaN past the end), and their median.
+    middles: Vec<[Middle; 3]>,
+    rows: Vec<FitRow<'a>>,
+    /// Each capture's pressed pixels among `rows`.
+    pressed: Vec<usize>,
+}
+
+/// The values around the middle of one pixel's and channel's sorted appearance values.
+#[derive(Clone, Copy)]
+struct Middle {
+    len: u32,
+    around: [f64; 3],
+    median: f64,
+}
+
+impl<'a> LeaveOneOut<'a> {
+    /// Prepares the leave-one-out of [`PhotometricModel::fit`] on the same inputs.
+    ///
+    /// # Errors
+    /// As [`PhotometricModel::fit`]'s checks of its inputs.
+    pub fn new(
+        rays: &'a PixelRays,
+        reference: &'a SurfaceHits,
+        reference_image: &[[f64; 3]],
+        captures: &'a [Capture<'a>],
+        gains: &'a [f64],
+        full_scale: f64,
+    ) -> Result<LeaveOneOut<'a>, String> {
+        check_inputs(rays, reference, reference_image, captures, full_scale)?;
+        if gains.len() != captures.len() {
+            return Err(format!(
+                "{} gains for {} captures",
+                gains.len(),
+                captures.len()
+            ));
+        }
+        let rings = rings_of(rays, reference, captures)?;
+        let n = rays.width * rays.height;
+        let middles = (0..n)
+            .into_par_iter()
+            .map(|i| {
+                std::array::from_fn(|ch| {
+                    if !reference.t_mm[i].is_finite() {
+                        return Middle {
+                            len: 0,
+                            around: [f64::NAN; 3],
+                            median: f64::NAN,
+                        };
+                    }
+                    let mut v = appearance_values(i, ch, reference_image, captures, gains);
+                    let median = crate::median_sorting(&mut v);
+                    let from = (v.len().max(2) - 2) / 2;
+                    Middle {
+                        len: v.len() as u32,
+                        around: std::array::from_fn(|q| {
+                            v.get(from + q).copied().unwrap_or(f64::NAN)
+                        }),
+                        median,
+                    }
+                })
+            })
+            .collect();
+        let (rows, _) = fit_rows(reference, captures, n);
+        let mut pressed = vec![0; captures.len()];
+        for &(k, i, _) in &rows {
+            pressed[k] += usize::from(captures[k].hits.contact[i]);
+        }
+        Ok(LeaveOneOut {
+            problem: Problem {
+                rays,
+                reference,
+                captures,
+                gains,
+                rings,
+                full_scale,
+            },
+            middles,
+            rows,
+            pressed,
+        })
+    }
+
+    /// The model [`PhotometricModel::fit_with_gains`] fits on every capture but `k` with
+    /// their gains, the same to the bit, except that its `residual_rms` is empty (the
+    /// others are not rendered).
+    ///
+    /// # Errors
+    /// As that fit's (too few pressed pixels without capture `k`); `k` out of range.
+    pub fn model(&self, k: usize) -> Result<PhotometricModel, String> {
+        let p = &self.problem;
+        let Some(left) = p.captures.get(k) else {
+            return Err(format!("no capture {k} of {}", p.captures.len()));
+        };
+        let gain = p.gains[k];
+        let appearance = self
+            .middles
+            .par_iter()
+            .enumerate()
+            .map(|(i, m)| {
+                std::array::from_fn(|ch| {
+                    let m = &m[ch];
+                    if m.len == 0 || left.hits.contact[i] {
+                        // off the skin, or capture k pressed here: not among the values
+                        return m.median;
+                    }
+                    without(m, left.image[i][ch] / gain)
+                })
+            })
+            .collect();
+        let rows: Vec<FitRow<'a>> = self.rows.iter().filter(|r| r.0 != k).copied().collect();
+        let pressed = self.pressed.iter().sum::<usize>() - self.pressed[k];
+        let gains = (0..p.gains.len())
+            .filter(|&j| j != k)
+            .map(|j| p.gains[j])
+            .collect();
+        p.solve(appearance, &rows, pressed, gains)
+    }
+}
+
+/// The median of the sorted values `m` stands for, with one value equal to `v` taken out
+/// (`v` is among them; at least one remains): the value at position `q` of the rest is
+/// `s[q]` where `s[q] < v`, else `s[q + 1]`, and the rest's middle positions lie within
+/// `m.around`.
+fn without(m: &Middle, v: f64) -> f64 {
+    // the same first position as stored: (len + 1 - 2) / 2 of the whole
+    let from = ((m.len as usize).max(2) - 2) / 2;
+    let len = m.len as usize - 1;
+    // the rest's value at position q (q in from..from + 2)
+    let at = |q: usize| {
+        let s = m.around[q - from];
+        if s.total_cmp(&v).is_lt() {
+            s
+        } else {
+            m.around[q - from + 1]
+        }
+    };
+    let mid = len / 2;
+    if len % 2 == 1 {
+        at(mid)
+    } else {
+        0.5 * (at(mid - 1) + at(mid))
     }
 }
 
@@ -223,18 +424,35 @@ fn appearance(
                 return [f64::NAN; 3];
             }
             std::array::from_fn(|ch| {
-                let mut v: Vec<f64> = std::iter::once(reference_image[i][ch])
-                    .chain(
-                        captures
-                            .iter()
-                            .zip(gains)
-                            .filter(|(c, _)| !c.hits.contact[i])
-                            .map(|(c, g)| c.image[i][ch] / g),
-                    )
-                    .collect();
-                crate::median_sorting(&mut v)
+                crate::median_sorting(&mut appearance_values(
+                    i,
+                    ch,
+                    reference_image,
+                    captures,
+                    gains,
+                ))
             })
         })
+        .collect()
+}
+
+/// The values whose median is the appearance of pixel `i` in channel `ch` ([`appearance`]):
+/// the reference's, then each capture's where it is unpressed, divided by its gain.
+fn appearance_values(
+    i: usize,
+    ch: usize,
+    reference_image: &[[f64; 3]],
+    captures: &[Capture<'_>],
+    gains: &[f64],
+) -> Vec<f64> {
+    std::iter::once(reference_image[i][ch])
+        .chain(
+            captures
+                .iter()
+                .zip(gains)
+                .filter(|(c, _)| !c.hits.contact[i])
+                .map(|(c, g)| c.image[i][ch] / g),
+        )
         .collect()
 }
 

@@ -79,6 +79,7 @@ pub use contact::{
 pub use faults::{
     capture_fault, image_fault, ImageFault, IMPRINT_NOISE_FACTOR, MIN_IMPRINT_COUNTS,
 };
+pub use fit::LeaveOneOut;
 pub use model::{Capture, PhotometricModel};
 pub use model_file::{
     quote_non_finite, FittedWith, APPEARANCE_HEADROOM, MAX_COEFFICIENT, SCALE_RANGE_MM,
