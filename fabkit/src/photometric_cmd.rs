@@ -186,7 +186,7 @@ pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
     progress.stage(&format!(
         "re-rendering each of {n} captures from the model fitted on the others"
     ));
-    let loo = leave_one_out(&setup, &posed, &all, reach, &|k| {
+    let loo = leave_one_out(&setup, &posed, &all, &model.gains, reach, &|k| {
         progress.set(k as u64, n as u64)
     })?;
     progress.stage(&format!("writing {}", a.out.display()));
@@ -537,29 +537,23 @@ fn refuse_blank_frames(
 }
 
 /// Each capture re-rendered from the model fitted on the others, at its gain against that
-/// model's appearance.
+/// model's appearance; `gains` are the captures' gains against the reference image (the
+/// model's fitted on all of them: a capture's gain is the same in every subset).
 fn leave_one_out(
     setup: &Setup,
     posed: &[Posed],
     all: &[Capture],
+    gains: &[f64],
     reach_px: f64,
     done: &(dyn Fn(usize) + Sync),
 ) -> Result<Vec<Rendered>, Box<dyn Error>> {
     let (rays, reference) = (&setup.rays, &setup.reference);
-    // a capture's gain against the reference image is the same in every subset: measured once
-    let gains = PhotometricModel::reference_gains(
-        rays,
-        reference,
-        &setup.reference_image,
-        all,
-        setup.full_scale,
-    );
     let fits = LeaveOneOut::new(
         rays,
         reference,
         &setup.reference_image,
         all,
-        &gains,
+        gains,
         setup.full_scale,
     )?;
     let finished = std::sync::atomic::AtomicUsize::new(0);

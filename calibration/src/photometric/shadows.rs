@@ -134,6 +134,25 @@ pub fn shadow_map(
     let lights: Vec<[[f64; 3]; SHADOW_AZIMUTHS]> =
         (0..SHADOW_TERMS).map(|m| rings.lights(m)).collect();
     let points = rings.point_lights();
+    // the rings of the shadow term, then the point lights' rings (one per height), each as
+    // its bounding sphere: centre and radius, mm
+    let groups: Vec<([f64; 3], f64)> = lights
+        .iter()
+        .map(|ring| ring.as_slice())
+        .chain(points.chunks(LIGHT_AZIMUTHS))
+        .map(|g| {
+            let k = g.len() as f64;
+            let a: [f64; 3] = std::array::from_fn(|q| g.iter().map(|l| l[q]).sum::<f64>() / k);
+            let rad = g
+                .iter()
+                .map(|l| {
+                    let v = [l[0] - a[0], l[1] - a[1], l[2] - a[2]];
+                    dot(v, v).sqrt()
+                })
+                .fold(0.0, f64::max);
+            (a, rad * (1.0 + 1e-9) + 1e-9)
+        })
+        .collect();
     let reach = SHADOW_REACH * rings.scale_mm;
     let o = rays.origin_mm;
     let point = |i: usize| -> [f64; 3] {
@@ -219,8 +238,57 @@ pub fn shadow_map(
                     .is_some();
                 (hit, w)
             };
+            // Only a light whose line from the point passes within a near dent can be
+            // blocked (`to` asks whether the segment does): a superset of those lights, by
+            // the line's distance squared |v x c|^2 / |v|^2 with a margin far above rounding,
+            // without roots or divisions. A ring without one casts no shadow here.
+            let may_block = |l: &[f64; 3]| -> bool {
+                let v = [l[0] - p[0], l[1] - p[1], l[2] - p[2]];
+                let vv = dot(v, v);
+                near.iter().any(|(_, c, r)| {
+                    let q = [c[0] - p[0], c[1] - p[1], c[2] - p[2]];
+                    let x = cross(v, q);
+                    dot(x, x) <= (r * r * (1.0 + 1e-6) + 1e-9) * vv
+                })
+            };
+            // A group of lights (a ring) in a sphere of radius R about a, seen from p within
+            // the angle asin(R / |a - p|) of a - p; a line from p within r of a dent's centre
+            // c runs within asin(r / |c - p|) of c - p (unless p is in that sphere): the
+            // group can be blocked only if the two cones meet, cos(theta) >= cos(alpha +
+            // beta), less a margin far above rounding. A test per group and dent before the
+            // test per light.
+            let cones: Vec<Option<([f64; 3], f64, f64)>> = near
+                .iter()
+                .map(|(_, c, r)| {
+                    let q = [c[0] - p[0], c[1] - p[1], c[2] - p[2]];
+                    let lq = dot(q, q).sqrt();
+                    if lq <= r * (1.0 + 1e-9) + 1e-9 {
+                        return None;
+                    }
+                    let sb = r / lq;
+                    Some((q.map(|x| x / lq), sb, (1.0 - sb * sb).sqrt()))
+                })
+                .collect();
+            let group_may_block = |g: usize| -> bool {
+                let (a, rad) = groups[g];
+                let d = [a[0] - p[0], a[1] - p[1], a[2] - p[2]];
+                let l = dot(d, d).sqrt();
+                if l <= rad {
+                    return true;
+                }
+                let sa = rad / l;
+                let ca = (1.0 - sa * sa).sqrt();
+                let du = d.map(|x| x / l);
+                cones.iter().any(|cone| match cone {
+                    None => true,
+                    Some((q, sb, cb)) => dot(du, *q) >= ca * cb - sa * sb - 1e-6,
+                })
+            };
             let mut f = [0.0; SHADOW_TERMS];
             for (m, ring) in lights.iter().enumerate() {
+                if !group_may_block(m) || !ring.iter().any(may_block) {
+                    continue;
+                }
                 let (mut blocked, mut all) = (0.0, 0.0);
                 for l in ring {
                     let (hit, w) = to(l);
@@ -235,7 +303,7 @@ pub fn shadow_map(
             }
             let mut mask = 0u64;
             for (k, l) in points.iter().enumerate() {
-                if to(l).0 {
+                if group_may_block(SHADOW_TERMS + k / LIGHT_AZIMUTHS) && may_block(l) && to(l).0 {
                     mask |= 1 << k;
                 }
             }
