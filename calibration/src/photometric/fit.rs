@@ -100,10 +100,8 @@ impl PhotometricModel {
         gains: Vec<f64>,
         full_scale: f64,
     ) -> Result<PhotometricModel, String> {
-        let n = rays.width * rays.height;
         let rings = rings_of(rays, reference, captures)?;
         let appearance = appearance(reference, reference_image, captures, &gains);
-        let (rows, pressed) = fit_rows(reference, captures, n);
         let problem = Problem {
             rays,
             reference,
@@ -112,7 +110,8 @@ impl PhotometricModel {
             rings,
             full_scale,
         };
-        let mut model = problem.solve(appearance, &rows, pressed, gains.clone())?;
+        let rows = problem.rows();
+        let mut model = problem.solve(appearance, &rows, None, rows.pressed, gains.clone())?;
         model.residual_rms = captures
             .par_iter()
             .zip(&gains)
@@ -157,15 +156,16 @@ struct Problem<'a> {
 }
 
 impl Problem<'_> {
-    /// The model of `appearance` fitted over `rows` (of which `pressed` are pressed pixels),
-    /// carrying `model_gains`; its `residual_rms` is left empty.
+    /// The model of `appearance` fitted over `rows` but capture `skip`'s (of which `pressed`
+    /// are pressed pixels), carrying `model_gains`; its `residual_rms` is left empty.
     ///
     /// # Errors
     /// When `pressed` is under twice the unknowns.
     fn solve(
         &self,
         appearance: Vec<[f64; 3]>,
-        rows: &[FitRow<'_>],
+        rows: &Rows<'_>,
+        skip: Option<usize>,
         pressed: usize,
         model_gains: Vec<f64>,
     ) -> Result<PhotometricModel, String> {
@@ -180,15 +180,10 @@ impl Problem<'_> {
                 2 * unknowns
             ));
         }
-        let axis = optical_axis(rays);
         let design = Design {
-            rays,
-            reference: self.reference,
             captures: self.captures,
             appearance: &appearance,
             gains: self.gains,
-            axis,
-            lights: rings.point_lights(),
             full_scale: self.full_scale,
         };
         let mut coefficients: [Vec<f64>; 3] = Default::default();
@@ -196,7 +191,7 @@ impl Problem<'_> {
         // the channels are independent problems: solved in parallel, kept in channel order
         let solved: Vec<DVector<f64>> = (0..3)
             .into_par_iter()
-            .map(|ch| design.solve(ch, rows))
+            .map(|ch| design.solve(ch, rows, skip))
             .collect();
         for (ch, (coef, x)) in coefficients.iter_mut().zip(&solved).enumerate() {
             *coef = x.iter().take(COEFFICIENTS).copied().collect();
@@ -207,7 +202,7 @@ impl Problem<'_> {
             height: rays.height,
             reference: appearance,
             coefficients,
-            axis,
+            axis: optical_axis(rays),
             rings,
             shadow_coefficients,
             gains: model_gains,
@@ -215,6 +210,61 @@ impl Problem<'_> {
             residual_rms: Vec::new(),
         })
     }
+}
+
+impl<'a> Problem<'a> {
+    /// The rows of the fit with their terms ([`Rows`]).
+    fn rows(&self) -> Rows<'a> {
+        let (rays, reference, captures) = (self.rays, self.reference, self.captures);
+        let (w, h) = (rays.width, rays.height);
+        let (rows, pressed) = fit_rows(reference, captures, w * h);
+        let (axis, lights) = (optical_axis(rays), self.rings.point_lights());
+        let terms: Vec<Option<[f64; UNKNOWNS]>> = rows
+            .par_iter()
+            .map(|&(k, i, sh)| {
+                let f = features(i, captures[k].hits, reference, axis)?;
+                let mut row = [0.0; UNKNOWNS];
+                let p = spatial(i, w, h);
+                for (a, fa) in f.iter().enumerate() {
+                    for (m, pm) in p.iter().enumerate() {
+                        row[a * SPATIAL_TERMS + m] = fa * pm;
+                    }
+                }
+                let lf = light_features(
+                    i,
+                    rays,
+                    captures[k].hits,
+                    reference,
+                    &lights,
+                    sh.map_or(0, |f| f.blocked),
+                )
+                .unwrap_or([0.0; LIGHT_TERMS]);
+                row[FEATURES * SPATIAL_TERMS..COEFFICIENTS].copy_from_slice(&lf);
+                for (m, x) in row[COEFFICIENTS..].iter_mut().enumerate() {
+                    *x = -sh.map_or(0.0, |f| f.rings[m]);
+                }
+                Some(row)
+            })
+            .collect();
+        Rows {
+            rows,
+            terms,
+            pressed,
+        }
+    }
+}
+
+/// The unknowns of the fit: the response's coefficients, then the shadows' weights.
+const UNKNOWNS: usize = COEFFICIENTS + SHADOW_TERMS;
+
+/// The rows of the fit ([`fit_rows`]) with each row's terms before weighting, the same for
+/// every channel and every subset of the captures: the features times the spatial terms, the
+/// light features and the shadows (negated); `None` where the features are undefined.
+struct Rows<'a> {
+    rows: Vec<FitRow<'a>>,
+    terms: Vec<Option<[f64; UNKNOWNS]>>,
+    /// How many of the rows are pressed pixels.
+    pressed: usize,
 }
 
 /// The leave-one-out of a fit: for each capture, the model fitted on the others
@@ -227,7 +277,7 @@ pub struct LeaveOneOut<'a> {
     /// Per pixel and channel, the sorted values of the appearance's median ([`appearance`]):
     /// their number and the three from `(len - 2) / 2` (NaN past the end), and their median.
     middles: Vec<[Middle; 3]>,
-    rows: Vec<FitRow<'a>>,
+    rows: Rows<'a>,
     /// Each capture's pressed pixels among `rows`.
     pressed: Vec<usize>,
 }
@@ -287,20 +337,21 @@ impl<'a> LeaveOneOut<'a> {
                 })
             })
             .collect();
-        let (rows, _) = fit_rows(reference, captures, n);
+        let problem = Problem {
+            rays,
+            reference,
+            captures,
+            gains,
+            rings,
+            full_scale,
+        };
+        let rows = problem.rows();
         let mut pressed = vec![0; captures.len()];
-        for &(k, i, _) in &rows {
+        for &(k, i, _) in &rows.rows {
             pressed[k] += usize::from(captures[k].hits.contact[i]);
         }
         Ok(LeaveOneOut {
-            problem: Problem {
-                rays,
-                reference,
-                captures,
-                gains,
-                rings,
-                full_scale,
-            },
+            problem,
             middles,
             rows,
             pressed,
@@ -334,13 +385,12 @@ impl<'a> LeaveOneOut<'a> {
                 })
             })
             .collect();
-        let rows: Vec<FitRow<'a>> = self.rows.iter().filter(|r| r.0 != k).copied().collect();
-        let pressed = self.pressed.iter().sum::<usize>() - self.pressed[k];
+        let pressed = self.rows.pressed - self.pressed[k];
         let gains = (0..p.gains.len())
             .filter(|&j| j != k)
             .map(|j| p.gains[j])
             .collect();
-        p.solve(appearance, &rows, pressed, gains)
+        p.solve(appearance, &self.rows, Some(k), pressed, gains)
     }
 }
 
@@ -456,6 +506,24 @@ fn appearance_values(
         .collect()
 }
 
+/// The dot product of `x` and `y` (of one length), summed in four interleaved partial sums
+/// (so that it vectorises), then the rest in order: the same value on every machine.
+fn dot_product(x: &[f64], y: &[f64]) -> f64 {
+    let mut acc = [0.0; 4];
+    let (xs, ys) = (x.chunks_exact(4), y.chunks_exact(4));
+    let (xr, yr) = (xs.remainder(), ys.remainder());
+    for (a, b) in xs.zip(ys) {
+        for q in 0..4 {
+            acc[q] += a[q] * b[q];
+        }
+    }
+    let mut sum = (acc[0] + acc[1]) + (acc[2] + acc[3]);
+    for (a, b) in xr.iter().zip(yr) {
+        sum += a * b;
+    }
+    sum
+}
+
 /// Rows of the fit multiplied at a time into its normal equations.
 const NORMAL_BLOCK: usize = 1024;
 
@@ -496,27 +564,22 @@ fn fit_rows<'a>(
     (rows, pressed)
 }
 
-/// The least-squares problem of the fit, one channel at a time: the camera's rays, the
-/// reference surface, the captures with their gains, the appearance, the optical axis, the
-/// candidate point lights and the full scale.
+/// The least-squares problem of the fit, one channel at a time: the captures with their
+/// gains, the appearance and the full scale.
 struct Design<'a> {
-    rays: &'a PixelRays,
-    reference: &'a SurfaceHits,
     captures: &'a [Capture<'a>],
     appearance: &'a [[f64; 3]],
     gains: &'a [f64],
-    axis: [f64; 3],
-    lights: [[f64; 3]; LIGHT_TERMS],
     full_scale: f64,
 }
 
 impl Design<'_> {
-    /// Channel `ch`'s coefficients over `rows` ([`COEFFICIENTS`] of the response, then
-    /// [`SHADOW_TERMS`] of the shadows): the normal equations solved by Cholesky, else by SVD;
-    /// zero for a channel without light (all pixels below the floor).
-    fn solve(&self, ch: usize, rows: &[FitRow<'_>]) -> DVector<f64> {
-        let unknowns = COEFFICIENTS + SHADOW_TERMS;
-        let (ata, atb) = self.normal_equations(ch, rows);
+    /// Channel `ch`'s coefficients over `rows` but capture `skip`'s ([`COEFFICIENTS`] of
+    /// the response, then [`SHADOW_TERMS`] of the shadows): the normal equations solved by
+    /// Cholesky, else by SVD; zero for a channel without light (all pixels below the floor).
+    fn solve(&self, ch: usize, rows: &Rows<'_>, skip: Option<usize>) -> DVector<f64> {
+        let unknowns = UNKNOWNS;
+        let (ata, atb) = self.normal_equations(ch, rows, skip);
         // a channel without light (all pixels below the floor) keeps zero coefficients
         ata.clone()
             .cholesky()
@@ -525,56 +588,48 @@ impl Design<'_> {
             .unwrap_or_else(|| DVector::zeros(unknowns))
     }
 
-    /// The normal equations `A^T W A x = A^T W y` of channel `ch` over `rows`: each usable
-    /// row (lit, not saturated) the ratio's change `y` against the features times the spatial
-    /// terms, the light features and the shadows, weighted by the reference squared so that
-    /// each row counts in grey levels.
-    fn normal_equations(&self, ch: usize, rows: &[FitRow<'_>]) -> (DMatrix<f64>, DVector<f64>) {
-        let (w, h) = (self.rays.width, self.rays.height);
+    /// The normal equations `A^T W A x = A^T W y` of channel `ch` over `rows` but capture
+    /// `skip`'s: each usable row (lit, not saturated) the ratio's change `y` against the
+    /// row's terms ([`Rows`]), weighted by the reference squared so that each row counts in
+    /// grey levels.
+    fn normal_equations(
+        &self,
+        ch: usize,
+        rows: &Rows<'_>,
+        skip: Option<usize>,
+    ) -> (DMatrix<f64>, DVector<f64>) {
         let (captures, gains, full_scale) = (self.captures, self.gains, self.full_scale);
-        let tilt_unknowns = COEFFICIENTS;
-        let unknowns = tilt_unknowns + SHADOW_TERMS;
+        let unknowns = UNKNOWNS;
         let mut ata = DMatrix::<f64>::zeros(unknowns, unknowns);
         let mut atb = DVector::<f64>::zeros(unknowns);
-        let mut row = vec![0.0; unknowns];
         // the weighted rows, a block at a time: A^T W A accumulated by matrix products
         let mut block = DMatrix::<f64>::zeros(NORMAL_BLOCK, unknowns);
         let mut block_y = DVector::<f64>::zeros(NORMAL_BLOCK);
         let mut filled = 0;
         let mut flush = |block: &DMatrix<f64>, block_y: &DVector<f64>, filled: usize| {
-            let b = block.rows(0, filled);
-            ata.gemm_tr(1.0, &b, &b, 1.0);
-            atb.gemv_tr(1.0, &b, &block_y.rows(0, filled), 1.0);
+            // the upper triangle only, column by column of the (column-major) block
+            let all = block.as_slice();
+            let col = |a: usize| &all[a * NORMAL_BLOCK..a * NORMAL_BLOCK + filled];
+            for c in 0..unknowns {
+                for a in 0..=c {
+                    ata[(a, c)] += dot_product(col(a), col(c));
+                }
+            }
+            atb.gemv_tr(1.0, &block.rows(0, filled), &block_y.rows(0, filled), 1.0);
         };
-        for &(k, i, sh) in rows {
+        for (&(k, i, _), terms) in rows.rows.iter().zip(&rows.terms) {
+            if skip == Some(k) {
+                continue;
+            }
             let r = self.appearance[i][ch];
             let y_counts = captures[k].image[i][ch];
             if !(r >= MIN_REFERENCE_COUNTS) || y_counts >= full_scale || r * gains[k] >= full_scale
             {
                 continue;
             }
-            let Some(f) = features(i, captures[k].hits, self.reference, self.axis) else {
+            let Some(row) = terms else {
                 continue;
             };
-            let p = spatial(i, w, h);
-            for (a, fa) in f.iter().enumerate() {
-                for (m, pm) in p.iter().enumerate() {
-                    row[a * SPATIAL_TERMS + m] = fa * pm;
-                }
-            }
-            let lf = light_features(
-                i,
-                self.rays,
-                captures[k].hits,
-                self.reference,
-                &self.lights,
-                sh.map_or(0, |f| f.blocked),
-            )
-            .unwrap_or([0.0; LIGHT_TERMS]);
-            row[FEATURES * SPATIAL_TERMS..tilt_unknowns].copy_from_slice(&lf);
-            for (m, x) in row[tilt_unknowns..].iter_mut().enumerate() {
-                *x = -sh.map_or(0.0, |f| f.rings[m]);
-            }
             // the ratio's change, weighted by the reference (the row and its value times r:
             // weight r^2) so that each row counts in grey levels
             let y = y_counts / (gains[k] * r) - 1.0;
