@@ -165,19 +165,37 @@ pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
             .collect();
         drop(all);
         progress.stage(&format!("seating the pin dome of each of {n} captures"));
-        for (k, (p, s)) in posed.iter_mut().zip(seatings).enumerate() {
-            // the image moves to the posed capture, not copied
-            let taken = (p.file.clone(), p.ids.clone(), std::mem::take(&mut p.image));
-            *p = pose(&a, &setup, taken, s)?;
-            progress.set(k as u64 + 1, n as u64);
-        }
+        let finished = std::sync::atomic::AtomicUsize::new(0);
+        // each capture on its own: in parallel, the first error in the captures' order
+        let again: Vec<Result<(), String>> = posed
+            .par_iter_mut()
+            .zip(seatings)
+            .map(|(p, s)| {
+                // the image moves to the posed capture, not copied
+                let taken = (p.file.clone(), p.ids.clone(), std::mem::take(&mut p.image));
+                *p = pose(&a, &setup, taken, s).map_err(|e| e.to_string())?;
+                let k = finished.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                progress.set(k as u64, n as u64);
+                Ok(())
+            })
+            .collect();
+        again.into_iter().collect::<Result<Vec<()>, String>>()?;
     }
     progress.stage(&format!(
         "fitting the model to {n} {}captures",
         if rounds > 0 { "seated " } else { "" }
     ));
     let all = captures_of(&posed);
-    let model = fit(&all)?;
+    // the fit on every capture and its leave-one-out share the checks, the gains, the
+    // appearance's sorted values and the rows' terms
+    let fits = LeaveOneOut::new(
+        &setup.rays,
+        &setup.reference,
+        &setup.reference_image,
+        &all,
+        setup.full_scale,
+    )?;
+    let model = fits.all()?;
     let fitted: Vec<Rendered> = all
         .par_iter()
         .zip(&model.gains)
@@ -186,7 +204,7 @@ pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
     progress.stage(&format!(
         "re-rendering each of {n} captures from the model fitted on the others"
     ));
-    let loo = leave_one_out(&setup, &posed, &all, &model.gains, reach, &|k| {
+    let loo = leave_one_out(&setup, &posed, &all, &fits, reach, &|k| {
         progress.set(k as u64, n as u64)
     })?;
     progress.stage(&format!("writing {}", a.out.display()));
@@ -435,33 +453,42 @@ fn pose_captures(
     a: &PhotometricArgs,
     setup: &Setup,
     listed: &[Vec<u32>],
-    done: &dyn Fn(usize),
+    done: &(dyn Fn(usize) + Sync),
 ) -> Result<Vec<Posed>, Box<dyn Error>> {
-    let mut posed = Vec::new();
-    for (file, ids) in a.images.iter().zip(listed) {
-        let name = file.display().to_string();
-        let ids: Vec<String> = ids.iter().map(u32::to_string).collect();
-        setup.pins.primitives(&ids).map_err(|id| {
-            format!(
-                "--images = {name}: pin {id} is not in {}",
-                point_table(a).display()
-            )
-        })?;
-        let (image, scale) = read_rgb(file, "--images", setup.size, &setup.camera_name)?;
-        if scale != setup.full_scale {
-            return Err(format!(
-                "--images = {name}: {} bit, but --reference {} is {} bit; give the images at one bit depth",
-                if scale > 255.0 { 16 } else { 8 },
-                a.reference.display(),
-                if setup.full_scale > 255.0 { 16 } else { 8 }
-            )
-            .into());
-        }
-        let seating = DomeSeating::none(setup.pins.mean_tip_mm());
-        posed.push(pose(a, setup, (file.clone(), ids, image), seating)?);
-        done(posed.len());
-    }
-    Ok(posed)
+    let finished = std::sync::atomic::AtomicUsize::new(0);
+    // each capture on its own: in parallel, collected in order (the first error in the
+    // images' order is the one reported)
+    let posed: Vec<Result<Posed, String>> = a
+        .images
+        .par_iter()
+        .zip(listed)
+        .map(|(file, ids)| {
+            let name = file.display().to_string();
+            let ids: Vec<String> = ids.iter().map(u32::to_string).collect();
+            setup.pins.primitives(&ids).map_err(|id| {
+                format!(
+                    "--images = {name}: pin {id} is not in {}",
+                    point_table(a).display()
+                )
+            })?;
+            let (image, scale) = read_rgb(file, "--images", setup.size, &setup.camera_name)
+                .map_err(|e| e.to_string())?;
+            if scale != setup.full_scale {
+                return Err(format!(
+                    "--images = {name}: {} bit, but --reference {} is {} bit; give the images at one bit depth",
+                    if scale > 255.0 { 16 } else { 8 },
+                    a.reference.display(),
+                    if setup.full_scale > 255.0 { 16 } else { 8 }
+                ));
+            }
+            let seating = DomeSeating::none(setup.pins.mean_tip_mm());
+            let p = pose(a, setup, (file.clone(), ids, image), seating)
+                .map_err(|e| e.to_string())?;
+            done(finished.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1);
+            Ok(p)
+        })
+        .collect();
+    Ok(posed.into_iter().collect::<Result<Vec<_>, String>>()?)
 }
 
 /// The capture of `file` (its pins `ids`, its `image`) with its dome seated `seating`: the
@@ -536,26 +563,17 @@ fn refuse_blank_frames(
     Ok(())
 }
 
-/// Each capture re-rendered from the model fitted on the others, at its gain against that
-/// model's appearance; `gains` are the captures' gains against the reference image (the
-/// model's fitted on all of them: a capture's gain is the same in every subset).
+/// Each capture re-rendered from the model fitted on the others (`fits`), at its gain
+/// against that model's appearance.
 fn leave_one_out(
     setup: &Setup,
     posed: &[Posed],
     all: &[Capture],
-    gains: &[f64],
+    fits: &LeaveOneOut,
     reach_px: f64,
     done: &(dyn Fn(usize) + Sync),
 ) -> Result<Vec<Rendered>, Box<dyn Error>> {
-    let (rays, reference) = (&setup.rays, &setup.reference);
-    let fits = LeaveOneOut::new(
-        rays,
-        reference,
-        &setup.reference_image,
-        all,
-        gains,
-        setup.full_scale,
-    )?;
+    let reference = &setup.reference;
     let finished = std::sync::atomic::AtomicUsize::new(0);
     // the fits are independent: in parallel, collected in the captures' order
     let loo: Vec<Result<Rendered, String>> = (0..posed.len())
@@ -599,12 +617,17 @@ fn write_outputs(
         .collect();
     put("appearance.npy", npy_f32(&[h, w, 3], &appearance))?;
     let mut captures = Vec::new();
-    for (k, p) in posed.iter().enumerate() {
+    // encoded in parallel, written in order
+    let pngs: Vec<Result<Vec<u8>, String>> = loo
+        .par_iter()
+        .map(|r| rerendered_png(&r.image, w, h, setup.full_scale).map_err(|e| e.to_string()))
+        .collect();
+    for ((k, p), png) in posed.iter().enumerate().zip(pngs) {
         // `01_02_06/image.png` (a ground-truth capture's layout) by its folder's name
         let stem = fabkit_calibration::imprints::capture_name(&p.file)
             .unwrap_or_else(|| format!("capture_{k}"));
         let rel = format!("rerendered/{stem}.png");
-        put(&rel, rerendered_png(&loo[k].image, w, h, setup.full_scale)?)?;
+        put(&rel, png?)?;
         captures.push(json!({
             "file": p.file.display().to_string(), "pins": p.ids,
             "contact_region": contact_json(setup, p, &fitted[k], &loo[k]),

@@ -106,23 +106,11 @@ impl PhotometricModel {
             rays,
             reference,
             captures,
-            gains: &gains,
+            gains,
             rings,
             full_scale,
         };
-        let rows = problem.rows();
-        let mut model = problem.solve(appearance, &rows, None, rows.pressed, gains.clone())?;
-        model.residual_rms = captures
-            .par_iter()
-            .zip(&gains)
-            .map(|(c, g)| {
-                rms_over_skin(
-                    &model.render(rays, reference, c.hits, c.shadows, *g),
-                    c.image,
-                )
-            })
-            .collect();
-        Ok(model)
+        problem.with_residuals(problem.solve(appearance, &problem.rows(), None)?)
     }
 }
 
@@ -150,26 +138,29 @@ struct Problem<'a> {
     rays: &'a PixelRays,
     reference: &'a SurfaceHits,
     captures: &'a [Capture<'a>],
-    gains: &'a [f64],
+    gains: Vec<f64>,
     rings: ShadowRings,
     full_scale: f64,
 }
 
 impl Problem<'_> {
-    /// The model of `appearance` fitted over `rows` but capture `skip`'s (of which `pressed`
-    /// are pressed pixels), carrying `model_gains`; its `residual_rms` is left empty.
+    /// The model of `appearance` fitted over `rows` but capture `skip`'s, carrying the gains
+    /// of the captures it is fitted on; its `residual_rms` is left empty.
     ///
     /// # Errors
-    /// When `pressed` is under twice the unknowns.
+    /// When those rows hold fewer pressed pixels than twice the unknowns.
     fn solve(
         &self,
         appearance: Vec<[f64; 3]>,
         rows: &Rows<'_>,
         skip: Option<usize>,
-        pressed: usize,
-        model_gains: Vec<f64>,
     ) -> Result<PhotometricModel, String> {
         let (rays, rings) = (self.rays, self.rings);
+        let pressed = rows.pressed.iter().sum::<usize>() - skip.map_or(0, |k| rows.pressed[k]);
+        let model_gains = (0..self.gains.len())
+            .filter(|&j| Some(j) != skip)
+            .map(|j| self.gains[j])
+            .collect();
         // The response to tilt and the shadows, by least squares on the pressed and the
         // shadowed pixels of every capture.
         let unknowns = COEFFICIENTS + SHADOW_TERMS;
@@ -183,7 +174,7 @@ impl Problem<'_> {
         let design = Design {
             captures: self.captures,
             appearance: &appearance,
-            gains: self.gains,
+            gains: &self.gains,
             full_scale: self.full_scale,
         };
         let mut coefficients: [Vec<f64>; 3] = Default::default();
@@ -213,11 +204,32 @@ impl Problem<'_> {
 }
 
 impl<'a> Problem<'a> {
+    /// `model` (fitted on every capture) with each capture's residual RMS over its skin.
+    fn with_residuals(&self, mut model: PhotometricModel) -> Result<PhotometricModel, String> {
+        let (rays, reference) = (self.rays, self.reference);
+        model.residual_rms = self
+            .captures
+            .par_iter()
+            .zip(&self.gains)
+            .map(|(c, g)| {
+                rms_over_skin(
+                    &model.render(rays, reference, c.hits, c.shadows, *g),
+                    c.image,
+                )
+            })
+            .collect();
+        Ok(model)
+    }
+
     /// The rows of the fit with their terms ([`Rows`]).
     fn rows(&self) -> Rows<'a> {
         let (rays, reference, captures) = (self.rays, self.reference, self.captures);
         let (w, h) = (rays.width, rays.height);
-        let (rows, pressed) = fit_rows(reference, captures, w * h);
+        let (rows, _) = fit_rows(reference, captures, w * h);
+        let mut pressed = vec![0; captures.len()];
+        for &(k, i, _) in &rows {
+            pressed[k] += usize::from(captures[k].hits.contact[i]);
+        }
         let (axis, lights) = (optical_axis(rays), self.rings.point_lights());
         let terms: Vec<Option<[f64; UNKNOWNS]>> = rows
             .par_iter()
@@ -263,8 +275,8 @@ const UNKNOWNS: usize = COEFFICIENTS + SHADOW_TERMS;
 struct Rows<'a> {
     rows: Vec<FitRow<'a>>,
     terms: Vec<Option<[f64; UNKNOWNS]>>,
-    /// How many of the rows are pressed pixels.
-    pressed: usize,
+    /// How many of each capture's rows are pressed pixels.
+    pressed: Vec<usize>,
 }
 
 /// The leave-one-out of a fit: for each capture, the model fitted on the others
@@ -278,8 +290,6 @@ pub struct LeaveOneOut<'a> {
     /// their number and the three from `(len - 2) / 2` (NaN past the end), and their median.
     middles: Vec<[Middle; 3]>,
     rows: Rows<'a>,
-    /// Each capture's pressed pixels among `rows`.
-    pressed: Vec<usize>,
 }
 
 /// The values around the middle of one pixel's and channel's sorted appearance values.
@@ -291,7 +301,9 @@ struct Middle {
 }
 
 impl<'a> LeaveOneOut<'a> {
-    /// Prepares the leave-one-out of [`PhotometricModel::fit`] on the same inputs.
+    /// Prepares the fit of [`PhotometricModel::fit`] on the same inputs ([`Self::all`]) and
+    /// its leave-one-out ([`Self::model`]), each capture's gain measured once against the
+    /// reference image ([`PhotometricModel::reference_gains`]).
     ///
     /// # Errors
     /// As [`PhotometricModel::fit`]'s checks of its inputs.
@@ -300,17 +312,17 @@ impl<'a> LeaveOneOut<'a> {
         reference: &'a SurfaceHits,
         reference_image: &[[f64; 3]],
         captures: &'a [Capture<'a>],
-        gains: &'a [f64],
         full_scale: f64,
     ) -> Result<LeaveOneOut<'a>, String> {
         check_inputs(rays, reference, reference_image, captures, full_scale)?;
-        if gains.len() != captures.len() {
-            return Err(format!(
-                "{} gains for {} captures",
-                gains.len(),
-                captures.len()
-            ));
-        }
+        let gains = PhotometricModel::reference_gains(
+            rays,
+            reference,
+            reference_image,
+            captures,
+            full_scale,
+        );
+        let gains = &gains;
         let rings = rings_of(rays, reference, captures)?;
         let n = rays.width * rays.height;
         let middles = (0..n)
@@ -341,21 +353,26 @@ impl<'a> LeaveOneOut<'a> {
             rays,
             reference,
             captures,
-            gains,
+            gains: gains.clone(),
             rings,
             full_scale,
         };
         let rows = problem.rows();
-        let mut pressed = vec![0; captures.len()];
-        for &(k, i, _) in &rows.rows {
-            pressed[k] += usize::from(captures[k].hits.contact[i]);
-        }
         Ok(LeaveOneOut {
             problem,
             middles,
             rows,
-            pressed,
         })
+    }
+
+    /// The model [`PhotometricModel::fit`] fits on every capture, the same to the bit.
+    ///
+    /// # Errors
+    /// As that fit's (too few pressed pixels).
+    pub fn all(&self) -> Result<PhotometricModel, String> {
+        let appearance = self.middles.iter().map(|m| m.map(|m| m.median)).collect();
+        let p = &self.problem;
+        p.with_residuals(p.solve(appearance, &self.rows, None)?)
     }
 
     /// The model [`PhotometricModel::fit_with_gains`] fits on every capture but `k` with
@@ -385,12 +402,7 @@ impl<'a> LeaveOneOut<'a> {
                 })
             })
             .collect();
-        let pressed = self.rows.pressed - self.pressed[k];
-        let gains = (0..p.gains.len())
-            .filter(|&j| j != k)
-            .map(|j| p.gains[j])
-            .collect();
-        p.solve(appearance, &self.rows, Some(k), pressed, gains)
+        p.solve(appearance, &self.rows, Some(k))
     }
 }
 

@@ -221,7 +221,7 @@ fn leave_one_out_re_renders_each_capture_within_3_grey_levels() {
 /// The leave-one-out without refitting ([`LeaveOneOut::model`]: the appearance's medians
 /// sorted once and read without the left-out capture's value, the normal equations summed
 /// over the others' rows) is the fit on the other captures to the bit, each capture left out
-/// in turn: images of integer counts (ties in the medians) at five gains, so that the values
+/// in turn, and [`LeaveOneOut::all`] is the fit on all of them: images of integer counts (ties in the medians) at five gains, so that the values
 /// divided by their gains differ in their last digits too.
 #[test]
 fn the_leave_one_out_is_the_fit_on_the_others_to_the_bit() {
@@ -234,9 +234,23 @@ fn the_leave_one_out_is_the_fit_on_the_others_to_the_bit() {
     let all = all_captures(&c);
     let (rays, reference, image) = (&c.rays, &c.reference, &c.reference_image);
     let gains = PhotometricModel::reference_gains(rays, reference, image, &all, 255.0);
-    let fits = LeaveOneOut::new(rays, reference, image, &all, &gains, 255.0).unwrap();
+    let fits = LeaveOneOut::new(rays, reference, image, &all, 255.0).unwrap();
     let whole = PhotometricModel::fit(rays, reference, image, &all, 255.0).unwrap();
     let bits = |v: &[[f64; 3]]| -> Vec<u64> { v.iter().flatten().map(|x| x.to_bits()).collect() };
+    let b = |x: &[f64]| -> Vec<u64> { x.iter().map(|v| v.to_bits()).collect() };
+    // the fit on every capture from the same state: the fit's model to the bit
+    let same = fits.all().unwrap();
+    assert!(bits(&same.reference) == bits(&whole.reference));
+    for ch in 0..3 {
+        assert_eq!(b(&same.coefficients[ch]), b(&whole.coefficients[ch]));
+        assert_eq!(
+            b(&same.shadow_coefficients[ch]),
+            b(&whole.shadow_coefficients[ch])
+        );
+    }
+    assert_eq!(b(&same.gains), b(&whole.gains));
+    assert_eq!(b(&same.residual_rms), b(&whole.residual_rms));
+    assert_eq!(b(&gains), b(&whole.gains));
     let mut moved = 0;
     for k in 0..all.len() {
         let keep = |&j: &usize| j != k;
@@ -246,14 +260,13 @@ fn the_leave_one_out_is_the_fit_on_the_others_to_the_bit() {
             PhotometricModel::fit_with_gains(rays, reference, image, &others, &their, 255.0)
                 .unwrap();
         let m = fits.model(k).unwrap();
-        let (a, b) = (bits(&m.reference), bits(&refit.reference));
-        let differ = a.iter().zip(&b).filter(|(x, y)| x != y).count();
+        let (x, y) = (bits(&m.reference), bits(&refit.reference));
+        let differ = x.iter().zip(&y).filter(|(p, q)| p != q).count();
         assert!(
-            a.len() == b.len() && differ == 0,
+            x.len() == y.len() && differ == 0,
             "capture {k}: {differ} values differ"
         );
         for ch in 0..3 {
-            let b = |x: &[f64]| -> Vec<u64> { x.iter().map(|v| v.to_bits()).collect() };
             assert_eq!(
                 b(&m.coefficients[ch]),
                 b(&refit.coefficients[ch]),
