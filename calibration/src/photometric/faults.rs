@@ -119,8 +119,12 @@ pub fn capture_fault(
     }
     let on_skin = |i: usize| reference.t_mm[i].is_finite();
     let gain = median_gain(capture.image, reference_image, |i| capture.hits.contact[i]);
-    let shadowed: std::collections::HashSet<u32> =
-        capture.shadows.pixels.iter().map(|p| p.pixel).collect();
+    let mut shadowed = vec![false; capture.image.len()];
+    for p in &capture.shadows.pixels {
+        if let Some(s) = shadowed.get_mut(p.pixel as usize) {
+            *s = true;
+        }
+    }
     let usable = |i: usize| {
         (0..3).all(|c| {
             let (y, r) = (capture.image[i][c], reference_image[i][c]);
@@ -137,7 +141,7 @@ pub fn capture_fault(
         if capture.hits.contact[i] {
             pressed_sq += d.iter().map(|x| x * x).sum::<f64>();
             pressed_n += 3;
-        } else if !shadowed.contains(&(i as u32)) {
+        } else if !shadowed[i] {
             quiet.extend(d);
         }
     }
