@@ -319,3 +319,171 @@ pub fn shadow_map(
         pixels,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::groundtruth::surface::ReferenceSurface;
+    use crate::groundtruth::synthetic::{benchmark_pose, rtac0_body};
+    use crate::groundtruth::{indented_hits, reference_hits};
+    use crate::photometric::pin_primitives;
+    use crate::synthetic::benchmark_intrinsics;
+    use crate::CameraModel;
+
+    /// [`shadow_map`] as it was before its cone tests: every light traced at every pixel near
+    /// a dent. The reference the prefiltered map must equal.
+    fn every_light_traced(
+        rays: &PixelRays,
+        hits: &SurfaceHits,
+        protrusions: &ExactPrimitives,
+        rings: &ShadowRings,
+    ) -> Vec<(u32, [u64; SHADOW_TERMS], u64)> {
+        let lights: Vec<[[f64; 3]; SHADOW_AZIMUTHS]> =
+            (0..SHADOW_TERMS).map(|m| rings.lights(m)).collect();
+        let points = rings.point_lights();
+        let reach = SHADOW_REACH * rings.scale_mm;
+        let o = rays.origin_mm;
+        let point = |i: usize| -> [f64; 3] {
+            let (t, d) = (hits.t_mm[i], rays.dirs[i]);
+            std::array::from_fn(|q| o[q] + t * d[q])
+        };
+        // the dents, as the map finds them
+        let contact: Vec<[f64; 3]> = (0..hits.t_mm.len())
+            .filter(|&i| hits.contact[i] && hits.t_mm[i].is_finite())
+            .map(point)
+            .collect();
+        let dents: Vec<(usize, [f64; 3], f64)> = (0..protrusions.len())
+            .filter_map(|k| {
+                let (c, r) = protrusions.bounding_sphere_of(k);
+                let inside: Vec<&[f64; 3]> = contact
+                    .iter()
+                    .filter(|q| {
+                        let v = [q[0] - c[0], q[1] - c[1], q[2] - c[2]];
+                        dot(v, v) <= r * r
+                    })
+                    .collect();
+                if inside.is_empty() {
+                    return None;
+                }
+                let n = inside.len() as f64;
+                let m: [f64; 3] =
+                    std::array::from_fn(|q| inside.iter().map(|p| p[q]).sum::<f64>() / n);
+                let rad = inside
+                    .iter()
+                    .map(|p| {
+                        let v = [p[0] - m[0], p[1] - m[1], p[2] - m[2]];
+                        dot(v, v)
+                    })
+                    .fold(0.0, f64::max)
+                    .sqrt();
+                Some((k, m, rad + DENT_MARGIN * rings.scale_mm))
+            })
+            .collect();
+        (0..hits.t_mm.len())
+            .filter_map(|i| {
+                if !hits.t_mm[i].is_finite() {
+                    return None;
+                }
+                let p = point(i);
+                let near: Vec<&(usize, [f64; 3], f64)> = dents
+                    .iter()
+                    .filter(|(_, c, r)| {
+                        let v = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
+                        dot(v, v).sqrt() <= r + reach
+                    })
+                    .collect();
+                if near.is_empty() {
+                    return None;
+                }
+                let n = hits.normal[i].map(|v| -v);
+                let start = [p[0] + 1e-6 * n[0], p[1] + 1e-6 * n[1], p[2] + 1e-6 * n[2]];
+                let to = |l: &[f64; 3]| -> (bool, f64) {
+                    let v = [l[0] - p[0], l[1] - p[1], l[2] - p[2]];
+                    let dist = dot(v, v).sqrt();
+                    let u = v.map(|x| x / dist);
+                    let w = dot(n, u).max(0.0) / (dist * dist);
+                    if w <= 0.0 {
+                        return (false, 0.0);
+                    }
+                    let crossed = near.iter().filter_map(|(k, c, r)| {
+                        let v = [c[0] - p[0], c[1] - p[1], c[2] - p[2]];
+                        let along = dot(v, u).clamp(0.0, dist);
+                        let w = [
+                            v[0] - along * u[0],
+                            v[1] - along * u[1],
+                            v[2] - along * u[2],
+                        ];
+                        (dot(w, w) <= r * r).then_some(*k)
+                    });
+                    let hit = protrusions
+                        .first_crossing_among(start, u, dist, crossed)
+                        .is_some();
+                    (hit, w)
+                };
+                let mut f = [0.0; SHADOW_TERMS];
+                for (m, ring) in lights.iter().enumerate() {
+                    let (mut blocked, mut all) = (0.0, 0.0);
+                    for l in ring {
+                        let (hit, w) = to(l);
+                        all += w;
+                        if hit {
+                            blocked += w;
+                        }
+                    }
+                    if all > 0.0 {
+                        f[m] = blocked / all;
+                    }
+                }
+                let mut mask = 0u64;
+                for (k, l) in points.iter().enumerate() {
+                    if to(l).0 {
+                        mask |= 1 << k;
+                    }
+                }
+                (f.iter().any(|x| *x > 0.0) || mask != 0).then_some((
+                    i as u32,
+                    f.map(f64::to_bits),
+                    mask,
+                ))
+            })
+            .collect()
+    }
+
+    /// The map's cone tests only skip lights that cannot be blocked: on R-Tac0 through the
+    /// benchmark fisheye, pressed by its own five pins (shafts in the skin, deep shadows) in two
+    /// turns, the map is the one that traces every light at every pixel near a dent, to the
+    /// bit.
+    #[test]
+    fn the_cone_tests_skip_only_lights_that_cannot_be_blocked() {
+        let cam = CameraModel::new(benchmark_intrinsics()).unwrap();
+        let rays = PixelRays::new(&cam, &benchmark_pose());
+        let surface = ReferenceSurface::of(&rtac0_body()).unwrap();
+        let reference = reference_hits(&rays, &surface);
+        let rings = ShadowRings::of(&rays, &reference);
+        for turn_deg in [0.0, 47.0] {
+            let mut solids = Vec::new();
+            for p in crate::imprints::synthetic::ring_pins(turn_deg, 1.0) {
+                let l = dot(p.centre_mm, p.centre_mm).sqrt();
+                let axis = p.centre_mm.map(|x| x / l);
+                let tip = axis.map(|x| x * (15.0 - 1.54));
+                solids.extend(pin_primitives(tip, axis, 0.8, 0.8, 5.6));
+            }
+            let prims = ExactPrimitives::new(&solids).unwrap();
+            let hits = indented_hits(&rays, &reference, &prims, surface.base_z_mm());
+            let map = shadow_map(&rays, &hits, &prims, &rings);
+            let got: Vec<(u32, [u64; SHADOW_TERMS], u64)> = map
+                .pixels
+                .iter()
+                .map(|p| (p.pixel, p.rings.map(f64::to_bits), p.blocked))
+                .collect();
+            let want = every_light_traced(&rays, &hits, &prims, &rings);
+            assert!(want.len() > 1000, "{} shadowed pixels", want.len());
+            assert!(
+                got == want,
+                "turned {turn_deg} deg: {} of {} pixels",
+                got.len(),
+                want.len()
+            );
+        }
+    }
+}
