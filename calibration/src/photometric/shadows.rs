@@ -123,6 +123,92 @@ impl ShadowMap {
     }
 }
 
+/// A protrusion's dent in the skin: the primitive, and the sphere (centre, radius, mm) that
+/// bounds the contact points it presses.
+type Dent = (usize, [f64; 3], f64);
+
+/// The surface point of pixel `i`, sensor frame, mm.
+fn surface_point(rays: &PixelRays, hits: &SurfaceHits, i: usize) -> [f64; 3] {
+    let (o, t, d) = (rays.origin_mm, hits.t_mm[i], rays.dirs[i]);
+    std::array::from_fn(|q| o[q] + t * d[q])
+}
+
+/// The dents of `protrusions` in the skin `hits`: only what a protrusion pushes into the skin
+/// can shadow it from lights inside. Each primitive's dent is bounded by the contact points in
+/// its bounding sphere, grown by [`DENT_MARGIN`] times the rings' scale; a primitive with none
+/// does not press the skin.
+fn dents(
+    rays: &PixelRays,
+    hits: &SurfaceHits,
+    protrusions: &ExactPrimitives,
+    rings: &ShadowRings,
+) -> Vec<Dent> {
+    let contact: Vec<[f64; 3]> = (0..hits.t_mm.len())
+        .filter(|&i| hits.contact[i] && hits.t_mm[i].is_finite())
+        .map(|i| surface_point(rays, hits, i))
+        .collect();
+    (0..protrusions.len())
+        .filter_map(|k| {
+            let (c, r) = protrusions.bounding_sphere_of(k);
+            let inside: Vec<&[f64; 3]> = contact
+                .iter()
+                .filter(|q| {
+                    let v = [q[0] - c[0], q[1] - c[1], q[2] - c[2]];
+                    dot(v, v) <= r * r
+                })
+                .collect();
+            if inside.is_empty() {
+                return None;
+            }
+            let n = inside.len() as f64;
+            let m: [f64; 3] = std::array::from_fn(|q| inside.iter().map(|p| p[q]).sum::<f64>() / n);
+            let rad = inside
+                .iter()
+                .map(|p| {
+                    let v = [p[0] - m[0], p[1] - m[1], p[2] - m[2]];
+                    dot(v, v)
+                })
+                .fold(0.0, f64::max)
+                .sqrt();
+            Some((k, m, rad + DENT_MARGIN * rings.scale_mm))
+        })
+        .collect()
+}
+
+/// Whether the segment from the skin point `p` (camera-side normal `n`, the segment starting
+/// at `start` just off the skin) to the light at `l` is blocked by a protrusion whose dent in
+/// `near` it passes through, and the light's weight there (cos / distance^2; 0 behind the
+/// surface, never blocked).
+fn light_seen(
+    protrusions: &ExactPrimitives,
+    near: &[&Dent],
+    (p, n, start): ([f64; 3], [f64; 3], [f64; 3]),
+    l: &[f64; 3],
+) -> (bool, f64) {
+    let v = [l[0] - p[0], l[1] - p[1], l[2] - p[2]];
+    let dist = dot(v, v).sqrt();
+    let u = v.map(|x| x / dist);
+    let w = dot(n, u).max(0.0) / (dist * dist);
+    if w <= 0.0 {
+        return (false, 0.0);
+    }
+    // only a dent the segment passes through can block it
+    let crossed = near.iter().filter_map(|(k, c, r)| {
+        let v = [c[0] - p[0], c[1] - p[1], c[2] - p[2]];
+        let along = dot(v, u).clamp(0.0, dist);
+        let w = [
+            v[0] - along * u[0],
+            v[1] - along * u[1],
+            v[2] - along * u[2],
+        ];
+        (dot(w, w) <= r * r).then_some(*k)
+    });
+    let hit = protrusions
+        .first_crossing_among(start, u, dist, crossed)
+        .is_some();
+    (hit, w)
+}
+
 /// The [`ShadowMap`] of the surface `hits` (seen along `rays`) under `protrusions`. Pixels
 /// are computed in parallel; the map does not depend on the thread count.
 pub fn shadow_map(
@@ -154,44 +240,8 @@ pub fn shadow_map(
         })
         .collect();
     let reach = SHADOW_REACH * rings.scale_mm;
-    let o = rays.origin_mm;
-    let point = |i: usize| -> [f64; 3] {
-        let (t, d) = (hits.t_mm[i], rays.dirs[i]);
-        std::array::from_fn(|q| o[q] + t * d[q])
-    };
-    // Only what a protrusion pushes into the skin can shadow it from lights inside: each
-    // primitive's dent is bounded by the contact points in its bounding sphere; a primitive
-    // with none does not press the skin.
-    let contact: Vec<[f64; 3]> = (0..hits.t_mm.len())
-        .filter(|&i| hits.contact[i] && hits.t_mm[i].is_finite())
-        .map(point)
-        .collect();
-    let dents: Vec<(usize, [f64; 3], f64)> = (0..protrusions.len())
-        .filter_map(|k| {
-            let (c, r) = protrusions.bounding_sphere_of(k);
-            let inside: Vec<&[f64; 3]> = contact
-                .iter()
-                .filter(|q| {
-                    let v = [q[0] - c[0], q[1] - c[1], q[2] - c[2]];
-                    dot(v, v) <= r * r
-                })
-                .collect();
-            if inside.is_empty() {
-                return None;
-            }
-            let n = inside.len() as f64;
-            let m: [f64; 3] = std::array::from_fn(|q| inside.iter().map(|p| p[q]).sum::<f64>() / n);
-            let rad = inside
-                .iter()
-                .map(|p| {
-                    let v = [p[0] - m[0], p[1] - m[1], p[2] - m[2]];
-                    dot(v, v)
-                })
-                .fold(0.0, f64::max)
-                .sqrt();
-            Some((k, m, rad + DENT_MARGIN * rings.scale_mm))
-        })
-        .collect();
+    let point = |i: usize| surface_point(rays, hits, i);
+    let dents = dents(rays, hits, protrusions, rings);
     let pixels = (0..hits.t_mm.len())
         .into_par_iter()
         .filter_map(|i| {
@@ -200,7 +250,7 @@ pub fn shadow_map(
             }
             let p = point(i);
             // the protrusions whose dents are near enough to shadow the point
-            let near: Vec<&(usize, [f64; 3], f64)> = dents
+            let near: Vec<&Dent> = dents
                 .iter()
                 .filter(|(_, c, r)| {
                     let v = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
@@ -213,31 +263,7 @@ pub fn shadow_map(
             // the camera's side of the surface: the elastomer's outward normal reversed
             let n = hits.normal[i].map(|v| -v);
             let start = [p[0] + 1e-6 * n[0], p[1] + 1e-6 * n[1], p[2] + 1e-6 * n[2]];
-            // whether the segment to the light at `l` is blocked, and its weight
-            let to = |l: &[f64; 3]| -> (bool, f64) {
-                let v = [l[0] - p[0], l[1] - p[1], l[2] - p[2]];
-                let dist = dot(v, v).sqrt();
-                let u = v.map(|x| x / dist);
-                let w = dot(n, u).max(0.0) / (dist * dist);
-                if w <= 0.0 {
-                    return (false, 0.0);
-                }
-                // only a dent the segment passes through can block it
-                let crossed = near.iter().filter_map(|(k, c, r)| {
-                    let v = [c[0] - p[0], c[1] - p[1], c[2] - p[2]];
-                    let along = dot(v, u).clamp(0.0, dist);
-                    let w = [
-                        v[0] - along * u[0],
-                        v[1] - along * u[1],
-                        v[2] - along * u[2],
-                    ];
-                    (dot(w, w) <= r * r).then_some(*k)
-                });
-                let hit = protrusions
-                    .first_crossing_among(start, u, dist, crossed)
-                    .is_some();
-                (hit, w)
-            };
+            let to = |l: &[f64; 3]| light_seen(protrusions, &near, (p, n, start), l);
             // Only a light whose line from the point passes within a near dent can be
             // blocked (`to` asks whether the segment does): a superset of those lights, by
             // the line's distance squared |v x c|^2 / |v|^2 with a margin far above rounding,
@@ -330,8 +356,8 @@ mod tests {
     use crate::synthetic::benchmark_intrinsics;
     use crate::CameraModel;
 
-    /// [`shadow_map`] as it was before its cone tests: every light traced at every pixel near
-    /// a dent. The reference the prefiltered map must equal.
+    /// [`shadow_map`] without its cone tests: every light traced ([`light_seen`]) at every
+    /// pixel near a dent. The reference the prefiltered map must equal.
     fn every_light_traced(
         rays: &PixelRays,
         hits: &SurfaceHits,
@@ -342,50 +368,14 @@ mod tests {
             (0..SHADOW_TERMS).map(|m| rings.lights(m)).collect();
         let points = rings.point_lights();
         let reach = SHADOW_REACH * rings.scale_mm;
-        let o = rays.origin_mm;
-        let point = |i: usize| -> [f64; 3] {
-            let (t, d) = (hits.t_mm[i], rays.dirs[i]);
-            std::array::from_fn(|q| o[q] + t * d[q])
-        };
-        // the dents, as the map finds them
-        let contact: Vec<[f64; 3]> = (0..hits.t_mm.len())
-            .filter(|&i| hits.contact[i] && hits.t_mm[i].is_finite())
-            .map(point)
-            .collect();
-        let dents: Vec<(usize, [f64; 3], f64)> = (0..protrusions.len())
-            .filter_map(|k| {
-                let (c, r) = protrusions.bounding_sphere_of(k);
-                let inside: Vec<&[f64; 3]> = contact
-                    .iter()
-                    .filter(|q| {
-                        let v = [q[0] - c[0], q[1] - c[1], q[2] - c[2]];
-                        dot(v, v) <= r * r
-                    })
-                    .collect();
-                if inside.is_empty() {
-                    return None;
-                }
-                let n = inside.len() as f64;
-                let m: [f64; 3] =
-                    std::array::from_fn(|q| inside.iter().map(|p| p[q]).sum::<f64>() / n);
-                let rad = inside
-                    .iter()
-                    .map(|p| {
-                        let v = [p[0] - m[0], p[1] - m[1], p[2] - m[2]];
-                        dot(v, v)
-                    })
-                    .fold(0.0, f64::max)
-                    .sqrt();
-                Some((k, m, rad + DENT_MARGIN * rings.scale_mm))
-            })
-            .collect();
+        let dents = dents(rays, hits, protrusions, rings);
         (0..hits.t_mm.len())
             .filter_map(|i| {
                 if !hits.t_mm[i].is_finite() {
                     return None;
                 }
-                let p = point(i);
-                let near: Vec<&(usize, [f64; 3], f64)> = dents
+                let p = surface_point(rays, hits, i);
+                let near: Vec<&Dent> = dents
                     .iter()
                     .filter(|(_, c, r)| {
                         let v = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
@@ -397,29 +387,7 @@ mod tests {
                 }
                 let n = hits.normal[i].map(|v| -v);
                 let start = [p[0] + 1e-6 * n[0], p[1] + 1e-6 * n[1], p[2] + 1e-6 * n[2]];
-                let to = |l: &[f64; 3]| -> (bool, f64) {
-                    let v = [l[0] - p[0], l[1] - p[1], l[2] - p[2]];
-                    let dist = dot(v, v).sqrt();
-                    let u = v.map(|x| x / dist);
-                    let w = dot(n, u).max(0.0) / (dist * dist);
-                    if w <= 0.0 {
-                        return (false, 0.0);
-                    }
-                    let crossed = near.iter().filter_map(|(k, c, r)| {
-                        let v = [c[0] - p[0], c[1] - p[1], c[2] - p[2]];
-                        let along = dot(v, u).clamp(0.0, dist);
-                        let w = [
-                            v[0] - along * u[0],
-                            v[1] - along * u[1],
-                            v[2] - along * u[2],
-                        ];
-                        (dot(w, w) <= r * r).then_some(*k)
-                    });
-                    let hit = protrusions
-                        .first_crossing_among(start, u, dist, crossed)
-                        .is_some();
-                    (hit, w)
-                };
+                let to = |l: &[f64; 3]| light_seen(protrusions, &near, (p, n, start), l);
                 let mut f = [0.0; SHADOW_TERMS];
                 for (m, ring) in lights.iter().enumerate() {
                     let (mut blocked, mut all) = (0.0, 0.0);
