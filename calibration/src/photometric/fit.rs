@@ -110,7 +110,7 @@ impl PhotometricModel {
             rings,
             full_scale,
         };
-        problem.with_residuals(problem.solve(appearance, &problem.rows(), None)?)
+        Ok(problem.with_residuals(problem.solve(appearance, &problem.rows(), None)?))
     }
 }
 
@@ -205,7 +205,7 @@ impl Problem<'_> {
 
 impl<'a> Problem<'a> {
     /// `model` (fitted on every capture) with each capture's residual RMS over its skin.
-    fn with_residuals(&self, mut model: PhotometricModel) -> Result<PhotometricModel, String> {
+    fn with_residuals(&self, mut model: PhotometricModel) -> PhotometricModel {
         let (rays, reference) = (self.rays, self.reference);
         model.residual_rms = self
             .captures
@@ -218,7 +218,7 @@ impl<'a> Problem<'a> {
                 )
             })
             .collect();
-        Ok(model)
+        model
     }
 
     /// The rows of the fit with their terms ([`Rows`]).
@@ -372,7 +372,7 @@ impl<'a> LeaveOneOut<'a> {
     pub fn all(&self) -> Result<PhotometricModel, String> {
         let appearance = self.middles.iter().map(|m| m.map(|m| m.median)).collect();
         let p = &self.problem;
-        p.with_residuals(p.solve(appearance, &self.rows, None)?)
+        Ok(p.with_residuals(p.solve(appearance, &self.rows, None)?))
     }
 
     /// The model [`PhotometricModel::fit_with_gains`] fits on every capture but `k` with
