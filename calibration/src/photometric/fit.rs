@@ -322,7 +322,6 @@ impl<'a> LeaveOneOut<'a> {
             captures,
             full_scale,
         );
-        let gains = &gains;
         let rings = rings_of(rays, reference, captures)?;
         let n = rays.width * rays.height;
         let middles = (0..n)
@@ -336,9 +335,9 @@ impl<'a> LeaveOneOut<'a> {
                             median: f64::NAN,
                         };
                     }
-                    let mut v = appearance_values(i, ch, reference_image, captures, gains);
+                    let mut v = appearance_values(i, ch, reference_image, captures, &gains);
                     let median = crate::median_sorting(&mut v);
-                    let from = (v.len().max(2) - 2) / 2;
+                    let from = first_around(v.len());
                     Middle {
                         len: v.len() as u32,
                         around: std::array::from_fn(|q| {
@@ -353,7 +352,7 @@ impl<'a> LeaveOneOut<'a> {
             rays,
             reference,
             captures,
-            gains: gains.clone(),
+            gains,
             rings,
             full_scale,
         };
@@ -406,13 +405,18 @@ impl<'a> LeaveOneOut<'a> {
     }
 }
 
+/// The first of the values a [`Middle`] of `len` sorted values keeps: `(len - 2) / 2`, the
+/// position of the lower middle once one value is taken out.
+fn first_around(len: usize) -> usize {
+    (len.max(2) - 2) / 2
+}
+
 /// The median of the sorted values `m` stands for, with one value equal to `v` taken out
 /// (`v` is among them; at least one remains): the value at position `q` of the rest is
 /// `s[q]` where `s[q] < v`, else `s[q + 1]`, and the rest's middle positions lie within
 /// `m.around`.
 fn without(m: &Middle, v: f64) -> f64 {
-    // the same first position as stored: (len + 1 - 2) / 2 of the whole
-    let from = ((m.len as usize).max(2) - 2) / 2;
+    let from = first_around(m.len as usize);
     let len = m.len as usize - 1;
     // the rest's value at position q (q in from..from + 2)
     let at = |q: usize| {
