@@ -555,10 +555,13 @@ fn refuse_blank_frames(
     if let Some(f) = image_fault(reference, image, full_scale) {
         return Err(format!("--reference = {}: {f}", a.reference.display()).into());
     }
-    for (p, c) in posed.iter().zip(all) {
-        if let Some(f) = capture_fault(reference, image, c, full_scale) {
-            return Err(format!("--images = {}: {f}", p.file.display()).into());
-        }
+    // each capture checked on its own, in parallel; the first fault in the images' order
+    let faults: Vec<_> = all
+        .par_iter()
+        .map(|c| capture_fault(reference, image, c, full_scale))
+        .collect();
+    if let Some((p, f)) = posed.iter().zip(faults).find_map(|(p, f)| Some((p, f?))) {
+        return Err(format!("--images = {}: {f}", p.file.display()).into());
     }
     Ok(())
 }

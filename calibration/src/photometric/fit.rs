@@ -467,10 +467,17 @@ fn check_inputs(
     if let Some(f) = image_fault(reference, reference_image, full_scale) {
         return Err(format!("the reference image is {f}"));
     }
-    for (k, c) in captures.iter().enumerate() {
-        if let Some(f) = capture_fault(reference, reference_image, c, full_scale) {
-            return Err(format!("capture {k}: {f}"));
-        }
+    // each capture checked on its own, in parallel; the first fault in the captures' order
+    let faults: Vec<_> = captures
+        .par_iter()
+        .map(|c| capture_fault(reference, reference_image, c, full_scale))
+        .collect();
+    if let Some((k, f)) = faults
+        .into_iter()
+        .enumerate()
+        .find_map(|(k, f)| Some((k, f?)))
+    {
+        return Err(format!("capture {k}: {f}"));
     }
     Ok(())
 }
@@ -485,6 +492,7 @@ fn appearance(
     gains: &[f64],
 ) -> Vec<[f64; 3]> {
     (0..reference_image.len())
+        .into_par_iter()
         .map(|i| {
             if !reference.t_mm[i].is_finite() {
                 return [f64::NAN; 3];
