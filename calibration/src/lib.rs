@@ -75,6 +75,27 @@ pub(crate) fn median_sorting(v: &mut [f64]) -> f64 {
     }
 }
 
+/// [`median_sorting`]'s value (the same bits) by selection: `v` is reordered, not sorted.
+pub(crate) fn median_selecting(v: &mut [f64]) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    let (len, m) = (v.len(), v.len() / 2);
+    let (lower, upper, _) = v.select_nth_unstable_by(m, f64::total_cmp);
+    let upper = *upper;
+    if len % 2 == 1 {
+        upper
+    } else {
+        // the lower middle: the greatest of the values before position m
+        let below = lower
+            .iter()
+            .copied()
+            .max_by(f64::total_cmp)
+            .unwrap_or(upper);
+        0.5 * (below + upper)
+    }
+}
+
 /// A regular file of at most [`MAX_TEXT_INPUT_BYTES`] as UTF-8 text.
 pub(crate) fn read_text(path: &std::path::Path) -> std::io::Result<String> {
     fabkit_designs::input_files::read_text_file(path, MAX_TEXT_INPUT_BYTES)
@@ -83,4 +104,28 @@ pub(crate) fn read_text(path: &std::path::Path) -> std::io::Result<String> {
 /// A regular file of at most [`MAX_BINARY_INPUT_BYTES`].
 pub(crate) fn read_binary(path: &std::path::Path) -> std::io::Result<Vec<u8>> {
     fabkit_designs::input_files::read_regular_file(path, MAX_BINARY_INPUT_BYTES)
+}
+
+#[cfg(test)]
+mod tests {
+    /// The selecting median is the sorting one to the bit: odd and even counts, ties, signed
+    /// zeros, a lone value and the empty slice.
+    #[test]
+    fn the_selecting_median_is_the_sorting_one() {
+        let cases: Vec<Vec<f64>> = vec![
+            vec![],
+            vec![3.5],
+            vec![2.0, 1.0],
+            vec![0.1, 0.7, 0.3],
+            vec![5.0, 5.0, 1.0, 5.0],
+            vec![-0.0, 0.0, -0.0, 0.0],
+            (0..31).map(|k| ((k * 37 % 31) as f64 * 0.1).sin()).collect(),
+            (0..32).map(|k| ((k * 37 % 32) as f64 * 0.1).cos()).collect(),
+        ];
+        for v in cases {
+            let (mut a, mut b) = (v.clone(), v.clone());
+            let (s, q) = (super::median_sorting(&mut a), super::median_selecting(&mut b));
+            assert_eq!(s.to_bits(), q.to_bits(), "{v:?}: sorting {s}, selecting {q}");
+        }
+    }
 }

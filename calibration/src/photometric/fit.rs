@@ -326,7 +326,7 @@ impl<'a> LeaveOneOut<'a> {
         let n = rays.width * rays.height;
         let middles = (0..n)
             .into_par_iter()
-            .map(|i| {
+            .map_init(Vec::new, |v, i| {
                 std::array::from_fn(|ch| {
                     if !reference.t_mm[i].is_finite() {
                         return Middle {
@@ -335,8 +335,8 @@ impl<'a> LeaveOneOut<'a> {
                             median: f64::NAN,
                         };
                     }
-                    let mut v = appearance_values(i, ch, reference_image, captures, &gains);
-                    let median = crate::median_sorting(&mut v);
+                    appearance_values(v, i, ch, reference_image, captures, &gains);
+                    let median = crate::median_sorting(v);
                     let from = first_around(v.len());
                     Middle {
                         len: v.len() as u32,
@@ -493,41 +493,38 @@ fn appearance(
 ) -> Vec<[f64; 3]> {
     (0..reference_image.len())
         .into_par_iter()
-        .map(|i| {
+        .map_init(Vec::new, |v, i| {
             if !reference.t_mm[i].is_finite() {
                 return [f64::NAN; 3];
             }
             std::array::from_fn(|ch| {
-                crate::median_sorting(&mut appearance_values(
-                    i,
-                    ch,
-                    reference_image,
-                    captures,
-                    gains,
-                ))
+                appearance_values(v, i, ch, reference_image, captures, gains);
+                crate::median_selecting(v)
             })
         })
         .collect()
 }
 
-/// The values whose median is the appearance of pixel `i` in channel `ch` ([`appearance`]):
-/// the reference's, then each capture's where it is unpressed, divided by its gain.
+/// The values whose median is the appearance of pixel `i` in channel `ch` ([`appearance`]),
+/// into `v` (emptied first): the reference's, then each capture's where it is unpressed,
+/// divided by its gain.
 fn appearance_values(
+    v: &mut Vec<f64>,
     i: usize,
     ch: usize,
     reference_image: &[[f64; 3]],
     captures: &[Capture<'_>],
     gains: &[f64],
-) -> Vec<f64> {
-    std::iter::once(reference_image[i][ch])
-        .chain(
-            captures
-                .iter()
-                .zip(gains)
-                .filter(|(c, _)| !c.hits.contact[i])
-                .map(|(c, g)| c.image[i][ch] / g),
-        )
-        .collect()
+) {
+    v.clear();
+    v.push(reference_image[i][ch]);
+    v.extend(
+        captures
+            .iter()
+            .zip(gains)
+            .filter(|(c, _)| !c.hits.contact[i])
+            .map(|(c, g)| c.image[i][ch] / g),
+    );
 }
 
 /// The dot product of `x` and `y` (of one length), summed in four interleaved partial sums
