@@ -119,13 +119,24 @@ mod tests {
             vec![0.1, 0.7, 0.3],
             vec![5.0, 5.0, 1.0, 5.0],
             vec![-0.0, 0.0, -0.0, 0.0],
-            (0..31).map(|k| ((k * 37 % 31) as f64 * 0.1).sin()).collect(),
-            (0..32).map(|k| ((k * 37 % 32) as f64 * 0.1).cos()).collect(),
+            (0..31)
+                .map(|k| ((k * 37 % 31) as f64 * 0.1).sin())
+                .collect(),
+            (0..32)
+                .map(|k| ((k * 37 % 32) as f64 * 0.1).cos())
+                .collect(),
         ];
         for v in cases {
             let (mut a, mut b) = (v.clone(), v.clone());
-            let (s, q) = (super::median_sorting(&mut a), super::median_selecting(&mut b));
-            assert_eq!(s.to_bits(), q.to_bits(), "{v:?}: sorting {s}, selecting {q}");
+            let (s, q) = (
+                super::median_sorting(&mut a),
+                super::median_selecting(&mut b),
+            );
+            assert_eq!(
+                s.to_bits(),
+                q.to_bits(),
+                "{v:?}: sorting {s}, selecting {q}"
+            );
         }
     }
 }
