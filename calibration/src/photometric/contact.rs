@@ -174,13 +174,17 @@ pub(super) fn least_squares_gain(
     serve: impl Fn(usize) -> bool,
     full_scale: f64,
 ) -> Option<f64> {
-    let pairs: Vec<(f64, f64)> = (0..image.len().min(appearance.len()))
-        .filter(|&i| serve(i))
-        .flat_map(|i| (0..3).map(move |c| (image[i][c], appearance[i][c])))
-        .filter(|&(a, r)| {
-            a.is_finite() && r >= MIN_REFERENCE_COUNTS && a < full_scale && r < full_scale
-        })
-        .collect();
+    let mut pairs: Vec<(f64, f64)> = Vec::new();
+    for (i, (a, r)) in image.iter().zip(appearance).enumerate() {
+        if !serve(i) {
+            continue;
+        }
+        for (&a, &r) in a.iter().zip(r) {
+            if a.is_finite() && r >= MIN_REFERENCE_COUNTS && a < full_scale && r < full_scale {
+                pairs.push((a, r));
+            }
+        }
+    }
     let ratio = |keep: &dyn Fn(f64, f64) -> bool| {
         let (mut ar, mut rr) = (0.0, 0.0);
         for &(a, r) in pairs.iter().filter(|(a, r)| keep(*a, *r)) {
@@ -222,10 +226,10 @@ pub(super) fn capture_gain(
     let map = ImprintMap::of(&capture.hits.contact, width, height, GAIN_CLEARANCE_PX);
     let shade = shadowed(capture, n);
     let skin = |i: usize| reference.t_mm.get(i).is_some_and(|t| t.is_finite()) && !shade[i];
-    let far = |i: usize| skin(i) && map.beyond_reach(i);
-    let far_count = (0..n).filter(|&i| far(i)).count();
+    let far: Vec<bool> = (0..n).map(|i| skin(i) && map.beyond_reach(i)).collect();
+    let far_count = far.iter().filter(|&&f| f).count();
     let g = if 3 * far_count >= MIN_GAIN_SAMPLES {
-        least_squares_gain(capture.image, appearance, far, full_scale)
+        least_squares_gain(capture.image, appearance, |i| far[i], full_scale)
     } else {
         least_squares_gain(
             capture.image,
