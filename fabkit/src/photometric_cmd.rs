@@ -18,7 +18,7 @@ use fabkit_calibration::photometric::{
     ImprintMap, LeaveOneOut, PhotometricModel, ShadowMap, ShadowRings, CONTACT_REACH_PX,
     DARKENING_NOISE_SIGMAS, GAIN_CLEARANCE_PX, GAIN_OUTLIER_SIGMAS,
 };
-use fabkit_export::raster::{npy_f32, png_rgb16, png_rgb8};
+use fabkit_export::raster::{npy_f32, png_rgb16_fast, png_rgb8_fast};
 use fabkit_export::{OutputClaim, OutputCommand, StagedDir};
 use serde_json::{json, Value};
 
@@ -716,7 +716,7 @@ fn contact_json(setup: &Setup, p: &Posed, fitted: &Rendered, loo: &Rendered) -> 
 }
 
 /// A re-rendered capture as a PNG of the captures' bit depth (counts rounded; 0 where not
-/// finite).
+/// finite), deflated fast: thirty of them are written at the end of the command.
 fn rerendered_png(
     img: &[[f64; 3]],
     w: usize,
@@ -726,13 +726,13 @@ fn rerendered_png(
     let counts = |x: f64| if x.is_finite() { x.round() } else { 0.0 };
     Ok(if full_scale > 255.0 {
         let px: Vec<[u16; 3]> = img.iter().map(|q| q.map(|x| counts(x) as u16)).collect();
-        png_rgb16(w, h, &px, &[])?
+        png_rgb16_fast(w, h, &px, &[])?
     } else {
         let px: Vec<u8> = img
             .iter()
             .flat_map(|q| q.map(|x| counts(x) as u8))
             .collect();
-        png_rgb8(w, h, &px, &[])?
+        png_rgb8_fast(w, h, &px, &[])?
     })
 }
 

@@ -3,3 +3,4 @@
 mod export_kit;
 mod library_sheets;
 mod mass;
+mod raster;
