@@ -635,6 +635,21 @@ fn tile_products<const T: usize>(xs: [&[f64]; T], ys: [&[f64]; T]) -> [[f64; T];
     })
 }
 
+/// Writes the rows `picked` (each row's terms and its weight `r`), each times its weight, into
+/// the first `picked.len()` values of the columns of `block` (column-major, columns `stride`
+/// apart), eight columns at a time so that each row's terms are read once per eight columns
+/// and each column is written in order.
+fn fill_columns(block: &mut [f64], stride: usize, picked: &[(&[f64; UNKNOWNS], f64)]) {
+    for a0 in (0..UNKNOWNS).step_by(8) {
+        let a1 = (a0 + 8).min(UNKNOWNS);
+        for (t, (row, r)) in picked.iter().enumerate() {
+            for (a, x) in row.iter().enumerate().take(a1).skip(a0) {
+                block[a * stride + t] = r * x;
+            }
+        }
+    }
+}
+
 /// Rows of the fit multiplied at a time into its normal equations.
 const NORMAL_BLOCK: usize = 1024;
 
@@ -716,8 +731,13 @@ impl Design<'_> {
         // the weighted rows, a block at a time: A^T W A accumulated by matrix products
         let mut block = DMatrix::<f64>::zeros(NORMAL_BLOCK, unknowns);
         let mut block_y = DVector::<f64>::zeros(NORMAL_BLOCK);
-        let mut filled = 0;
-        let mut flush = |block: &DMatrix<f64>, block_y: &DVector<f64>, filled: usize| {
+        // the block's rows (their terms and weight), written into its columns when it is full
+        let mut picked: Vec<(&[f64; UNKNOWNS], f64)> = Vec::with_capacity(NORMAL_BLOCK);
+        let mut flush = |block: &mut DMatrix<f64>,
+                         block_y: &DVector<f64>,
+                         picked: &[(&[f64; UNKNOWNS], f64)]| {
+            let filled = picked.len();
+            fill_columns(block.as_mut_slice(), NORMAL_BLOCK, picked);
             // the upper triangle only, of the (column-major) block's columns
             add_upper_products(&mut ata, block.as_slice(), NORMAL_BLOCK, filled);
             atb.gemv_tr(1.0, &block.rows(0, filled), &block_y.rows(0, filled), 1.0);
@@ -738,18 +758,15 @@ impl Design<'_> {
             // the ratio's change, weighted by the reference (the row and its value times r:
             // weight r^2) so that each row counts in grey levels
             let y = y_counts / (gains[k] * r) - 1.0;
-            for (a, x) in row.iter().enumerate() {
-                block[(filled, a)] = r * x;
-            }
-            block_y[filled] = r * y;
-            filled += 1;
-            if filled == NORMAL_BLOCK {
-                flush(&block, &block_y, filled);
-                filled = 0;
+            block_y[picked.len()] = r * y;
+            picked.push((row, r));
+            if picked.len() == NORMAL_BLOCK {
+                flush(&mut block, &block_y, &picked);
+                picked.clear();
             }
         }
-        if filled > 0 {
-            flush(&block, &block_y, filled);
+        if !picked.is_empty() {
+            flush(&mut block, &block_y, &picked);
         }
         // exactly symmetric: the upper triangle mirrored
         for a in 0..unknowns {
