@@ -242,24 +242,25 @@ pub fn shadow_map(
     let reach = SHADOW_REACH * rings.scale_mm;
     let point = |i: usize| surface_point(rays, hits, i);
     let dents = dents(rays, hits, protrusions, rings);
+    // each thread's buffers for a pixel's near dents and their cones
+    let buffers = || (Vec::<&Dent>::new(), Vec::new());
     let pixels = (0..hits.t_mm.len())
         .into_par_iter()
-        .filter_map(|i| {
+        .map_init(buffers, |(near, cones), i| {
             if !hits.t_mm[i].is_finite() {
                 return None;
             }
             let p = point(i);
             // the protrusions whose dents are near enough to shadow the point
-            let near: Vec<&Dent> = dents
-                .iter()
-                .filter(|(_, c, r)| {
-                    let v = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
-                    dot(v, v).sqrt() <= r + reach
-                })
-                .collect();
+            near.clear();
+            near.extend(dents.iter().filter(|(_, c, r)| {
+                let v = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
+                dot(v, v).sqrt() <= r + reach
+            }));
             if near.is_empty() {
                 return None;
             }
+            let near: &[&Dent] = near;
             // the camera's side of the surface: the elastomer's outward normal reversed
             let n = hits.normal[i].map(|v| -v);
             let start = [p[0] + 1e-6 * n[0], p[1] + 1e-6 * n[1], p[2] + 1e-6 * n[2]];
@@ -283,18 +284,17 @@ pub fn shadow_map(
             // group can be blocked only if the two cones meet, cos(theta) >= cos(alpha +
             // beta), less a margin far above rounding. A test per group and dent before the
             // test per light.
-            let cones: Vec<Option<([f64; 3], f64, f64)>> = near
-                .iter()
-                .map(|(_, c, r)| {
-                    let q = [c[0] - p[0], c[1] - p[1], c[2] - p[2]];
-                    let lq = dot(q, q).sqrt();
-                    if lq <= r * (1.0 + 1e-9) + 1e-9 {
-                        return None;
-                    }
-                    let sb = r / lq;
-                    Some((q.map(|x| x / lq), sb, (1.0 - sb * sb).sqrt()))
-                })
-                .collect();
+            cones.clear();
+            cones.extend(near.iter().map(|(_, c, r)| {
+                let q = [c[0] - p[0], c[1] - p[1], c[2] - p[2]];
+                let lq = dot(q, q).sqrt();
+                if lq <= r * (1.0 + 1e-9) + 1e-9 {
+                    return None;
+                }
+                let sb = r / lq;
+                Some((q.map(|x| x / lq), sb, (1.0 - sb * sb).sqrt()))
+            }));
+            let cones: &[Option<([f64; 3], f64, f64)>] = cones;
             let group_may_block = |g: usize| -> bool {
                 let (a, rad) = groups[g];
                 let d = [a[0] - p[0], a[1] - p[1], a[2] - p[2]];
@@ -339,6 +339,7 @@ pub fn shadow_map(
                 blocked: mask,
             })
         })
+        .flatten()
         .collect();
     ShadowMap {
         rings: *rings,
