@@ -322,11 +322,15 @@ impl PhotometricModel {
                 && rendered.get(i).is_some()
         };
         let base = |i: usize, c: usize| gain * self.reference[i][c];
-        let noise: Vec<f64> = (0..n)
-            .filter(|&i| skin(i) && !shade[i] && map.beyond_reach(i))
-            .flat_map(|i| (0..3).map(move |c| (image[i][c] - base(i, c)).abs()))
-            .filter(|x| x.is_finite())
-            .collect();
+        let mut noise: Vec<f64> = Vec::new();
+        for i in (0..n).filter(|&i| skin(i) && !shade[i] && map.beyond_reach(i)) {
+            for c in 0..3 {
+                let x = (image[i][c] - base(i, c)).abs();
+                if x.is_finite() {
+                    noise.push(x);
+                }
+            }
+        }
         let floor = DARKENING_NOISE_SIGMAS * 1.4826 * median(noise).unwrap_or(0.0);
         let k = map.centres_px.len();
         // per imprint: squared differences and their count, then the weighted sums of the

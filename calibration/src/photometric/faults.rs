@@ -134,6 +134,7 @@ pub fn capture_fault(
             .any(|&r| r >= MIN_REFERENCE_COUNTS)
     };
     let (mut pressed_sq, mut pressed_n) = (0.0, 0usize);
+    // the magnitudes of the differences on the unpressed, unshadowed skin
     let mut quiet: Vec<f64> = Vec::new();
     for i in (0..capture.image.len()).filter(|&i| on_skin(i) && usable(i)) {
         let d: [f64; 3] =
@@ -142,7 +143,7 @@ pub fn capture_fault(
             pressed_sq += d.iter().map(|x| x * x).sum::<f64>();
             pressed_n += 3;
         } else if !shadowed[i] {
-            quiet.extend(d);
+            quiet.extend(d.map(f64::abs));
         }
     }
     let imprint_counts = if pressed_n == 0 {
@@ -150,7 +151,7 @@ pub fn capture_fault(
     } else {
         (pressed_sq / pressed_n as f64).sqrt()
     };
-    let noise_counts = median(quiet.iter().map(|x| x.abs()).collect()).unwrap_or(0.0) * 1.4826;
+    let noise_counts = median(quiet).unwrap_or(0.0) * 1.4826;
     let floor = MIN_IMPRINT_COUNTS * full_scale / 255.0;
     let noise_var = noise_counts * noise_counts;
     let excess = imprint_counts * imprint_counts - noise_var;
