@@ -121,8 +121,9 @@ pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
         refuse_blank_frames(&a, &setup, &posed, &all)?;
     }
     let rounds = if a.no_seating { 0 } else { SEATING_ROUNDS };
+    // the seating rounds render each capture themselves (`rendered`), so the fit does not
     let fit = |all: &[Capture]| {
-        PhotometricModel::fit(
+        PhotometricModel::fit_unrendered(
             &setup.rays,
             &setup.reference,
             &setup.reference_image,
@@ -195,12 +196,14 @@ pub fn run(a: PhotometricArgs) -> Result<(), Box<dyn Error>> {
         &all,
         setup.full_scale,
     )?;
-    let model = fits.all()?;
+    let mut model = fits.all_unrendered()?;
     let fitted: Vec<Rendered> = all
         .par_iter()
         .zip(&model.gains)
         .map(|(c, &g)| rendered(&setup, &model, c, g, reach))
         .collect();
+    // each capture's residual over its skin, as the fit reports it, from these renderings
+    model.residual_rms = fitted.iter().map(|r| r.rms_counts).collect();
     progress.stage(&format!(
         "re-rendering each of {n} captures from the model fitted on the others"
     ));

@@ -43,6 +43,33 @@ impl PhotometricModel {
         )
     }
 
+    /// [`Self::fit`] without rendering the captures for their residuals: the same model with
+    /// `residual_rms` empty, for a caller that renders each capture with the model itself
+    /// (`calibrate photometric`'s seating rounds and its final fit) and would otherwise render
+    /// every capture twice.
+    ///
+    /// # Errors
+    /// As [`Self::fit`].
+    pub fn fit_unrendered(
+        rays: &PixelRays,
+        reference: &SurfaceHits,
+        reference_image: &[[f64; 3]],
+        captures: &[Capture<'_>],
+        full_scale: f64,
+    ) -> Result<PhotometricModel, String> {
+        check_inputs(rays, reference, reference_image, captures, full_scale)?;
+        let gains = Self::reference_gains(rays, reference, reference_image, captures, full_scale);
+        let (problem, appearance) = Problem::of(
+            rays,
+            reference,
+            reference_image,
+            captures,
+            gains,
+            full_scale,
+        )?;
+        problem.solve(appearance, &problem.rows(), None)
+    }
+
     /// Each capture's gain against `reference_image` ([`capture_gain`]), as [`Self::fit`]
     /// measures it: one capture's gain does not depend on the others, so a caller fitting
     /// several subsets of the same captures (the leave-one-out) measures them once.
@@ -100,16 +127,14 @@ impl PhotometricModel {
         gains: Vec<f64>,
         full_scale: f64,
     ) -> Result<PhotometricModel, String> {
-        let rings = rings_of(rays, reference, captures)?;
-        let appearance = appearance(reference, reference_image, captures, &gains);
-        let problem = Problem {
+        let (problem, appearance) = Problem::of(
             rays,
             reference,
+            reference_image,
             captures,
             gains,
-            rings,
             full_scale,
-        };
+        )?;
         Ok(problem.with_residuals(problem.solve(appearance, &problem.rows(), None)?))
     }
 }
@@ -141,6 +166,34 @@ struct Problem<'a> {
     gains: Vec<f64>,
     rings: ShadowRings,
     full_scale: f64,
+}
+
+impl<'a> Problem<'a> {
+    /// The problem of the fit on checked inputs with their gains, and its appearance
+    /// ([`appearance`]).
+    ///
+    /// # Errors
+    /// When a capture's shadows are of other light rings ([`rings_of`]).
+    fn of(
+        rays: &'a PixelRays,
+        reference: &'a SurfaceHits,
+        reference_image: &[[f64; 3]],
+        captures: &'a [Capture<'a>],
+        gains: Vec<f64>,
+        full_scale: f64,
+    ) -> Result<(Problem<'a>, Vec<[f64; 3]>), String> {
+        let rings = rings_of(rays, reference, captures)?;
+        let appearance = appearance(reference, reference_image, captures, &gains);
+        let problem = Problem {
+            rays,
+            reference,
+            captures,
+            gains,
+            rings,
+            full_scale,
+        };
+        Ok((problem, appearance))
+    }
 }
 
 impl Problem<'_> {
@@ -369,9 +422,16 @@ impl<'a> LeaveOneOut<'a> {
     /// # Errors
     /// As that fit's (too few pressed pixels).
     pub fn all(&self) -> Result<PhotometricModel, String> {
+        Ok(self.problem.with_residuals(self.all_unrendered()?))
+    }
+
+    /// [`Self::all`] with `residual_rms` empty, as [`PhotometricModel::fit_unrendered`].
+    ///
+    /// # Errors
+    /// As [`Self::all`].
+    pub fn all_unrendered(&self) -> Result<PhotometricModel, String> {
         let appearance = self.middles.iter().map(|m| m.map(|m| m.median)).collect();
-        let p = &self.problem;
-        Ok(p.with_residuals(p.solve(appearance, &self.rows, None)?))
+        self.problem.solve(appearance, &self.rows, None)
     }
 
     /// The model [`PhotometricModel::fit_with_gains`] fits on every capture but `k` with

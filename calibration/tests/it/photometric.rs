@@ -251,6 +251,23 @@ fn the_leave_one_out_is_the_fit_on_the_others_to_the_bit() {
     assert_eq!(b(&same.gains), b(&whole.gains));
     assert_eq!(b(&same.residual_rms), b(&whole.residual_rms));
     assert_eq!(b(&gains), b(&whole.gains));
+    // without rendering the captures: the same model, no residuals
+    let bare = [
+        PhotometricModel::fit_unrendered(rays, reference, image, &all, 255.0).unwrap(),
+        fits.all_unrendered().unwrap(),
+    ];
+    for m in &bare {
+        assert!(bits(&m.reference) == bits(&whole.reference));
+        for ch in 0..3 {
+            assert_eq!(b(&m.coefficients[ch]), b(&whole.coefficients[ch]));
+            assert_eq!(
+                b(&m.shadow_coefficients[ch]),
+                b(&whole.shadow_coefficients[ch])
+            );
+        }
+        assert_eq!(b(&m.gains), b(&whole.gains));
+        assert!(m.residual_rms.is_empty());
+    }
     let mut moved = 0;
     for k in 0..all.len() {
         let keep = |&j: &usize| j != k;
