@@ -178,12 +178,14 @@ fn dents(
 /// Whether the segment from the skin point `p` (camera-side normal `n`, the segment starting
 /// at `start` just off the skin) to the light at `l` is blocked by a protrusion whose dent in
 /// `near` it passes through, and the light's weight there (cos / distance^2; 0 behind the
-/// surface, never blocked).
+/// surface, never blocked). With `traced` false the segment is known to pass through no dent
+/// (a conservative test said so): only the weight is computed.
 fn light_seen(
     protrusions: &ExactPrimitives,
     near: &[&Dent],
     (p, n, start): ([f64; 3], [f64; 3], [f64; 3]),
     l: &[f64; 3],
+    traced: bool,
 ) -> (bool, f64) {
     let v = [l[0] - p[0], l[1] - p[1], l[2] - p[2]];
     let dist = dot(v, v).sqrt();
@@ -191,6 +193,9 @@ fn light_seen(
     let w = dot(n, u).max(0.0) / (dist * dist);
     if w <= 0.0 {
         return (false, 0.0);
+    }
+    if !traced {
+        return (false, w);
     }
     // only a dent the segment passes through can block it
     let crossed = near.iter().filter_map(|(k, c, r)| {
@@ -264,7 +269,7 @@ pub fn shadow_map(
             // the camera's side of the surface: the elastomer's outward normal reversed
             let n = hits.normal[i].map(|v| -v);
             let start = [p[0] + 1e-6 * n[0], p[1] + 1e-6 * n[1], p[2] + 1e-6 * n[2]];
-            let to = |l: &[f64; 3]| light_seen(protrusions, &near, (p, n, start), l);
+            let to = |l: &[f64; 3], traced| light_seen(protrusions, near, (p, n, start), l, traced);
             // Only a light whose line from the point passes within a near dent can be
             // blocked (`to` asks whether the segment does): a superset of those lights, by
             // the line's distance squared |v x c|^2 / |v|^2 with a margin far above rounding,
@@ -317,7 +322,9 @@ pub fn shadow_map(
                 }
                 let (mut blocked, mut all) = (0.0, 0.0);
                 for l in ring {
-                    let (hit, w) = to(l);
+                    // a light whose line passes no near dent's sphere cannot be blocked: its
+                    // weight only
+                    let (hit, w) = to(l, may_block(l));
                     all += w;
                     if hit {
                         blocked += w;
@@ -329,7 +336,10 @@ pub fn shadow_map(
             }
             let mut mask = 0u64;
             for (k, l) in points.iter().enumerate() {
-                if group_may_block(SHADOW_TERMS + k / LIGHT_AZIMUTHS) && may_block(l) && to(l).0 {
+                if group_may_block(SHADOW_TERMS + k / LIGHT_AZIMUTHS)
+                    && may_block(l)
+                    && to(l, true).0
+                {
                     mask |= 1 << k;
                 }
             }
@@ -388,7 +398,7 @@ mod tests {
                 }
                 let n = hits.normal[i].map(|v| -v);
                 let start = [p[0] + 1e-6 * n[0], p[1] + 1e-6 * n[1], p[2] + 1e-6 * n[2]];
-                let to = |l: &[f64; 3]| light_seen(protrusions, &near, (p, n, start), l);
+                let to = |l: &[f64; 3]| light_seen(protrusions, &near, (p, n, start), l, true);
                 let mut f = [0.0; SHADOW_TERMS];
                 for (m, ring) in lights.iter().enumerate() {
                     let (mut blocked, mut all) = (0.0, 0.0);
