@@ -317,14 +317,18 @@ pub fn shadow_map(
             };
             let mut f = [0.0; SHADOW_TERMS];
             for (m, ring) in lights.iter().enumerate() {
-                if !group_may_block(m) || !ring.iter().any(may_block) {
+                if !group_may_block(m) {
+                    continue;
+                }
+                // a light whose line passes no near dent's sphere cannot be blocked: its
+                // weight only; a ring without one casts no shadow here
+                let traced: [bool; SHADOW_AZIMUTHS] = std::array::from_fn(|j| may_block(&ring[j]));
+                if !traced.contains(&true) {
                     continue;
                 }
                 let (mut blocked, mut all) = (0.0, 0.0);
-                for l in ring {
-                    // a light whose line passes no near dent's sphere cannot be blocked: its
-                    // weight only
-                    let (hit, w) = to(l, may_block(l));
+                for (l, &traced) in ring.iter().zip(&traced) {
+                    let (hit, w) = to(l, traced);
                     all += w;
                     if hit {
                         blocked += w;
