@@ -733,6 +733,41 @@ fn spacing_statistics_match_brute_force_on_dense_patterns() {
     }
 }
 
+/// `stats` keeps its latest answers per thread: a repeat of the same inputs gets the answer a
+/// thread that has seen nothing computes, and so do the same markers on another surface (the
+/// offset one) and a pattern with one marker moved: each its own answer, never a kept one.
+#[test]
+fn the_kept_stats_answer_only_the_same_inputs() {
+    let body = BodyProfile::HalfEllipsoid {
+        diameter_mm: 18.0,
+        height_mm: 24.0,
+    };
+    let (a, b) = (Surface::new(&body, 0.0), Surface::new(&body, -0.9));
+    let mut p = pattern(Layout::HexGrid);
+    p.spacing_mm = Some(1.6);
+    let m = markers::place(&a, &p, 1.0).unwrap();
+    let fresh = |s: &Surface, m: &[Marker]| {
+        let (s, m) = (s.clone(), m.to_vec());
+        std::thread::spawn(move || markers::stats(&s, &m))
+            .join()
+            .unwrap()
+    };
+    let first = markers::stats(&a, &m);
+    assert_eq!(first, fresh(&a, &m));
+    assert_eq!(markers::stats(&a, &m), first);
+    let on_b = markers::stats(&b, &m);
+    assert_eq!(on_b, fresh(&b, &m));
+    assert_ne!(on_b.min_spacing_mm, first.min_spacing_mm);
+    let mut moved = m.clone();
+    let (i, j) = first.closest_pair.unwrap();
+    moved[j].position_mm =
+        std::array::from_fn(|q| 0.5 * (moved[i].position_mm[q] + moved[j].position_mm[q]));
+    let after = markers::stats(&a, &moved);
+    assert_eq!(after, fresh(&a, &moved));
+    assert_ne!(after, first);
+    assert_eq!(markers::stats(&a, &m), first);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Layer solids with features: topology and volume.
 
