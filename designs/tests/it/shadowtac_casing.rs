@@ -287,3 +287,39 @@ fn each_rule_of_the_casing_names_its_parameter() {
     ];
     assert_each_rule_names_its_path(shadowtac, cases);
 }
+
+/// A thread keeps its last casing build: a design whose casing or whose context differs gets
+/// its own build, and the design built again its first one. The casing is 37 mm wide; one 1 mm
+/// wider is 38 mm wide. A backing plate 0.5 mm thicker leaves the casing as it is (the skin
+/// sits higher) but not the family's summary: the ray to the skin's rim crosses the casing's
+/// top nearer the axis ([`plate_crossing_radius_mm`]: 14.53 mm against 14.95, the ray running
+/// steeper over a longer path in the plate).
+#[test]
+fn the_kept_casing_is_built_anew_when_what_it_reads_changes() {
+    let base = shadowtac();
+    let mut wider = shadowtac();
+    casing(&mut wider).outer_width_mm += 1.0;
+    let mut thicker = shadowtac();
+    thicker.backing.as_mut().unwrap().thickness_mm += 0.5;
+    let built = |d: &Design| {
+        let k = build_kit(d, tol()).unwrap();
+        let crossing = k.summary["camera_view"]["rim_crossing_radius_mm"]
+            .as_f64()
+            .unwrap();
+        (size_mm(&k, "casing"), crossing)
+    };
+    let first = built(&base);
+    close(first.0 .0[0], 37.0, 1e-6, "casing width");
+    assert_eq!(built(&base), first);
+    let w = built(&wider);
+    close(w.0 .0[0], 38.0, 1e-6, "wider casing's width");
+    let t = built(&thicker);
+    assert_eq!(t.0, first.0, "the casing under a thicker plate");
+    assert!(
+        t.1 < first.1 - 0.1,
+        "the rim's ray under a thicker plate: {} vs {}",
+        t.1,
+        first.1
+    );
+    assert_eq!(built(&base), first);
+}
