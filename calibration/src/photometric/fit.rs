@@ -31,16 +31,8 @@ impl PhotometricModel {
         captures: &[Capture<'_>],
         full_scale: f64,
     ) -> Result<PhotometricModel, String> {
-        check_inputs(rays, reference, reference_image, captures, full_scale)?;
-        let gains = Self::reference_gains(rays, reference, reference_image, captures, full_scale);
-        Self::fit_checked(
-            rays,
-            reference,
-            reference_image,
-            captures,
-            gains,
-            full_scale,
-        )
+        let model = Self::fit_unrendered(rays, reference, reference_image, captures, full_scale)?;
+        Ok(model.with_residuals(rays, reference, captures))
     }
 
     /// [`Self::fit`] without rendering the captures for their residuals: the same model with
@@ -135,7 +127,30 @@ impl PhotometricModel {
             gains,
             full_scale,
         )?;
-        Ok(problem.with_residuals(problem.solve(appearance, &problem.rows(), None)?))
+        let model = problem.solve(appearance, &problem.rows(), None)?;
+        Ok(model.with_residuals(rays, reference, captures))
+    }
+
+    /// This model (fitted on every one of `captures`, its `gains` theirs) with each capture's
+    /// residual RMS over its skin.
+    fn with_residuals(
+        mut self,
+        rays: &PixelRays,
+        reference: &SurfaceHits,
+        captures: &[Capture<'_>],
+    ) -> PhotometricModel {
+        let residuals = captures
+            .par_iter()
+            .zip(&self.gains)
+            .map(|(c, g)| {
+                rms_over_skin(
+                    &self.render(rays, reference, c.hits, c.shadows, *g),
+                    c.image,
+                )
+            })
+            .collect();
+        self.residual_rms = residuals;
+        self
     }
 }
 
@@ -257,23 +272,6 @@ impl Problem<'_> {
 }
 
 impl<'a> Problem<'a> {
-    /// `model` (fitted on every capture) with each capture's residual RMS over its skin.
-    fn with_residuals(&self, mut model: PhotometricModel) -> PhotometricModel {
-        let (rays, reference) = (self.rays, self.reference);
-        model.residual_rms = self
-            .captures
-            .par_iter()
-            .zip(&self.gains)
-            .map(|(c, g)| {
-                rms_over_skin(
-                    &model.render(rays, reference, c.hits, c.shadows, *g),
-                    c.image,
-                )
-            })
-            .collect();
-        model
-    }
-
     /// The rows of the fit with their terms ([`Rows`]).
     fn rows(&self) -> Rows<'a> {
         let (rays, reference, captures) = (self.rays, self.reference, self.captures);
@@ -422,7 +420,10 @@ impl<'a> LeaveOneOut<'a> {
     /// # Errors
     /// As that fit's (too few pressed pixels).
     pub fn all(&self) -> Result<PhotometricModel, String> {
-        Ok(self.problem.with_residuals(self.all_unrendered()?))
+        let p = &self.problem;
+        Ok(self
+            .all_unrendered()?
+            .with_residuals(p.rays, p.reference, p.captures))
     }
 
     /// [`Self::all`] with `residual_rms` empty, as [`PhotometricModel::fit_unrendered`].
