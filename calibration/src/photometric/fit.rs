@@ -197,17 +197,30 @@ impl<'a> Problem<'a> {
         gains: Vec<f64>,
         full_scale: f64,
     ) -> Result<(Problem<'a>, Vec<[f64; 3]>), String> {
-        let rings = rings_of(rays, reference, captures)?;
-        let appearance = appearance(reference, reference_image, captures, &gains);
-        let problem = Problem {
+        let problem = Problem::new(rays, reference, captures, gains, full_scale)?;
+        let appearance = appearance(reference, reference_image, captures, &problem.gains);
+        Ok((problem, appearance))
+    }
+
+    /// The problem of `captures` with their gains, and the camera's light rings.
+    ///
+    /// # Errors
+    /// When a capture's shadows are of other light rings ([`rings_of`]).
+    fn new(
+        rays: &'a PixelRays,
+        reference: &'a SurfaceHits,
+        captures: &'a [Capture<'a>],
+        gains: Vec<f64>,
+        full_scale: f64,
+    ) -> Result<Problem<'a>, String> {
+        Ok(Problem {
             rays,
             reference,
             captures,
             gains,
-            rings,
+            rings: rings_of(rays, reference, captures)?,
             full_scale,
-        };
-        Ok((problem, appearance))
+        })
     }
 }
 
@@ -373,7 +386,8 @@ impl<'a> LeaveOneOut<'a> {
             captures,
             full_scale,
         );
-        let rings = rings_of(rays, reference, captures)?;
+        let problem = Problem::new(rays, reference, captures, gains, full_scale)?;
+        let gains = &problem.gains;
         let n = rays.width * rays.height;
         let middles = (0..n)
             .into_par_iter()
@@ -386,7 +400,7 @@ impl<'a> LeaveOneOut<'a> {
                             median: f64::NAN,
                         };
                     }
-                    appearance_values(v, i, ch, reference_image, captures, &gains);
+                    appearance_values(v, i, ch, reference_image, captures, gains);
                     let median = crate::median_sorting(v);
                     let from = first_around(v.len());
                     Middle {
@@ -399,14 +413,6 @@ impl<'a> LeaveOneOut<'a> {
                 })
             })
             .collect();
-        let problem = Problem {
-            rays,
-            reference,
-            captures,
-            gains,
-            rings,
-            full_scale,
-        };
         let rows = problem.rows();
         Ok(LeaveOneOut {
             problem,
