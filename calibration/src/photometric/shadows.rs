@@ -8,7 +8,7 @@ use super::terms::{
 use crate::groundtruth::exact::ExactPrimitives;
 use crate::groundtruth::hits::SurfaceHits;
 use crate::groundtruth::rays::PixelRays;
-use fabkit_designs::primitives::{cross, dot};
+use fabkit_designs::primitives::{cross, dot, sub};
 use rayon::prelude::*;
 
 /// The candidate lights of the shadow term: rings about the camera's optical axis, where a
@@ -247,11 +247,12 @@ pub fn shadow_map(
     let reach = SHADOW_REACH * rings.scale_mm;
     let point = |i: usize| surface_point(rays, hits, i);
     let dents = dents(rays, hits, protrusions, rings);
-    // each thread's buffers for a pixel's near dents and their cones
-    let buffers = || (Vec::<&Dent>::new(), Vec::new());
+    // each thread's buffers for a pixel's near dents, their cones and their primitives'
+    // bounding spheres
+    let buffers = || (Vec::<&Dent>::new(), Vec::new(), Vec::new());
     let pixels = (0..hits.t_mm.len())
         .into_par_iter()
-        .map_init(buffers, |(near, cones), i| {
+        .map_init(buffers, |(near, cones, spheres), i| {
             if !hits.t_mm[i].is_finite() {
                 return None;
             }
@@ -270,18 +271,44 @@ pub fn shadow_map(
             let n = hits.normal[i].map(|v| -v);
             let start = [p[0] + 1e-6 * n[0], p[1] + 1e-6 * n[1], p[2] + 1e-6 * n[2]];
             let to = |l: &[f64; 3], traced| light_seen(protrusions, near, (p, n, start), l, traced);
-            // Only a light whose line from the point passes within a near dent can be
-            // blocked (`to` asks whether the segment does): a superset of those lights, by
-            // the line's distance squared |v x c|^2 / |v|^2 with a margin far above rounding,
-            // without roots or divisions. A ring without one casts no shadow here.
+            // The bounding sphere of each near dent's primitive as the exact test meets it
+            // (ExactPrimitives::first_crossing_among, from `start`): the offset of `start`
+            // from its centre, its radius, and whether `start` is outside it by a margin far
+            // above rounding.
+            spheres.clear();
+            spheres.extend(near.iter().map(|(k, _, _)| {
+                let (c, r) = protrusions.bounding_sphere_of(*k);
+                let oc = sub(start, c);
+                let cc = dot(oc, oc) - r * r;
+                (oc, r, cc > 1e-9 * (r * r + 1e-9))
+            }));
+            let spheres: &[([f64; 3], f64, bool)] = spheres;
+            // Only a light whose segment from the point passes within a near dent can be
+            // blocked (`to` asks whether it does), and only by that dent's primitive, which
+            // the light's ray from `start` must then meet: a superset of those lights without
+            // roots or divisions, with margins far above rounding. The line's distance
+            // squared |v x q|^2 / |v|^2 from the dent's centre and from the primitive's
+            // bounding sphere's; and, with `start` outside that sphere, the sphere not behind
+            // `start` (the exact test refuses a ray leaving it: b >= 0 with c >= 0). A ring
+            // without such a light casts no shadow here.
             let may_block = |l: &[f64; 3]| -> bool {
                 let v = [l[0] - p[0], l[1] - p[1], l[2] - p[2]];
                 let vv = dot(v, v);
-                near.iter().any(|(_, c, r)| {
-                    let q = [c[0] - p[0], c[1] - p[1], c[2] - p[2]];
-                    let x = cross(v, q);
-                    dot(x, x) <= (r * r * (1.0 + 1e-6) + 1e-9) * vv
-                })
+                near.iter()
+                    .zip(spheres)
+                    .any(|((_, c, r), (oc, rb, outside))| {
+                        let q = [c[0] - p[0], c[1] - p[1], c[2] - p[2]];
+                        let x = cross(v, q);
+                        if dot(x, x) > (r * r * (1.0 + 1e-6) + 1e-9) * vv {
+                            return false;
+                        }
+                        let b = dot(*oc, v);
+                        if *outside && b > 0.0 && b * b >= 1e-12 * dot(*oc, *oc) * vv {
+                            return false;
+                        }
+                        let x = cross(v, *oc);
+                        dot(x, x) <= (rb * rb * (1.0 + 1e-6) + 1e-9) * vv
+                    })
             };
             // A group of lights (a ring) in a sphere of radius R about a, seen from p within
             // the angle asin(R / |a - p|) of a - p; a line from p within r of a dent's centre
@@ -339,12 +366,14 @@ pub fn shadow_map(
                 }
             }
             let mut mask = 0u64;
-            for (k, l) in points.iter().enumerate() {
-                if group_may_block(SHADOW_TERMS + k / LIGHT_AZIMUTHS)
-                    && may_block(l)
-                    && to(l, true).0
-                {
-                    mask |= 1 << k;
+            for (g, ring) in points.chunks(LIGHT_AZIMUTHS).enumerate() {
+                if !group_may_block(SHADOW_TERMS + g) {
+                    continue;
+                }
+                for (j, l) in ring.iter().enumerate() {
+                    if may_block(l) && to(l, true).0 {
+                        mask |= 1 << (g * LIGHT_AZIMUTHS + j);
+                    }
                 }
             }
             (f.iter().any(|x| *x > 0.0) || mask != 0).then_some(ShadowPixel {
