@@ -11,10 +11,11 @@ fn main() {
 /// faulted in and zeroed every time. Buffers up to 32 MB (the highest threshold glibc
 /// accepts) now come from the heap, which keeps up to 1 GB free rather than returning it and
 /// grows 64 MB at a time. `calibrate photometric` on 30 captures spends half the system time
-/// (1.37 -> 0.61 CPU-s) and 7 % less wall time, its peak memory 1.5 % higher (1150 -> 1167
-/// MiB; docs/src/benchmarks.md). The memory is the process's until it exits, and every
-/// command is a short process. Nothing changes where the user has set glibc's own settings
-/// (`GLIBC_TUNABLES` or a `MALLOC_*_` variable), nor on other platforms.
+/// (1.29 -> 0.59 CPU-s) and 11 % less wall time (4.65 -> 4.12 s), its peak memory 2 % higher
+/// (1144 -> 1164 MiB; docs/src/benchmarks.md, "The photometric fit"). Freed memory stays with
+/// the process for its next allocations until it exits: the process keeps about its peak, it
+/// does not grow with the number of allocations. Nothing changes where the user has set
+/// glibc's own settings (`GLIBC_TUNABLES` or a `MALLOC_*_` variable), nor on other platforms.
 fn keep_freed_memory() {
     #[cfg(all(target_os = "linux", target_env = "gnu"))]
     {
