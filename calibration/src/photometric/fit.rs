@@ -51,15 +51,14 @@ impl PhotometricModel {
     ) -> Result<PhotometricModel, String> {
         check_inputs(rays, reference, reference_image, captures, full_scale)?;
         let gains = Self::reference_gains(rays, reference, reference_image, captures, full_scale);
-        let (problem, appearance) = Problem::of(
+        Self::fit_checked(
             rays,
             reference,
             reference_image,
             captures,
             gains,
             full_scale,
-        )?;
-        problem.solve(appearance, &problem.rows(), None)
+        )
     }
 
     /// Each capture's gain against `reference_image` ([`capture_gain`]), as [`Self::fit`]
@@ -100,17 +99,18 @@ impl PhotometricModel {
                 captures.len()
             ));
         }
-        Self::fit_checked(
+        let model = Self::fit_checked(
             rays,
             reference,
             reference_image,
             captures,
             gains.to_vec(),
             full_scale,
-        )
+        )?;
+        Ok(model.with_residuals(rays, reference, captures))
     }
 
-    /// [`Self::fit`] of checked inputs with their gains.
+    /// [`Self::fit_unrendered`] of checked inputs with their gains.
     fn fit_checked(
         rays: &PixelRays,
         reference: &SurfaceHits,
@@ -127,8 +127,7 @@ impl PhotometricModel {
             gains,
             full_scale,
         )?;
-        let model = problem.solve(appearance, &problem.rows(), None)?;
-        Ok(model.with_residuals(rays, reference, captures))
+        problem.solve(appearance, &problem.rows(), None)
     }
 
     /// This model (fitted on every one of `captures`, its `gains` theirs) with each capture's
