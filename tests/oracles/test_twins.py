@@ -129,6 +129,59 @@ class ExactTwins(unittest.TestCase):
         self.assertGreater(e2["hausdorff_mm"], K.hausdorff_bound(tol))
 
 
+@unittest.skipUnless(HAS_CQ, "CadQuery not importable")
+class StepReadBack(unittest.TestCase):
+    """check_twins --exact-from-step: the exact solid is the export's STEP file, the one the
+    manifest hashes; a machined part's file against its exact shape."""
+
+    def setUp(self):
+        import hashlib
+        import tempfile
+        from twins import cq_common as C
+        from twins.step_export import write_step
+        self.tmp = tempfile.TemporaryDirectory()
+        self.d = Path(self.tmp.name)
+        (self.d / "step").mkdir()
+        # a ring 10 mm high: outer radius 5, inner 3 (volume pi (25 - 9) 10)
+        self.ring = {"shape": "ring", "outer_radius_mm": 5.0, "inner_radius_mm": 3.0,
+                     "z0_mm": 0.0, "z1_mm": 10.0}
+        write_step(C.cut(C.cylinder_z(5.0, 0.0, 10.0), [C.cylinder_z(3.0, -1.0, 11.0)]),
+                   self.d / "step" / "ring.step", "ring")
+        self.sha = hashlib.sha256((self.d / "step" / "ring.step").read_bytes()).hexdigest()
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def test_the_hashed_file_reads_back_as_the_solid(self):
+        from twins import check_twins, cq_common
+        row = {}
+        entry = {"step_file": "step/ring.step", "step_sha256": self.sha}
+        shape = check_twins.exact_solid(self.d, entry, True, row)
+        self.assertEqual((row["exact_source"], row["step_solids"]), ("step", 1))
+        self.assertAlmostEqual(cq_common.exact_volume(shape), math.pi * 16 * 10, places=6)
+
+    def test_another_file_or_none_is_refused(self):
+        from twins import check_twins
+        with self.assertRaisesRegex(ValueError, "is not the manifest's"):
+            check_twins.read_step(self.d, {"step_file": "step/ring.step",
+                                           "step_sha256": "0" * 64}, {})
+        with self.assertRaisesRegex(ValueError, "no step_file"):
+            check_twins.read_step(self.d, {"step_sha256": self.sha}, {})
+
+    def test_a_machined_part_against_its_exact_shape(self):
+        from twins import check_twins
+        mp = {"name": "ring", "step_file": "step/ring.step", "step_sha256": self.sha,
+              "exact": self.ring}
+        row = check_twins.check_machined(self.d, mp, 0.01, "test")
+        self.assertTrue(row["ok"], row["problems"])
+        self.assertLess(row["step_volume_rel_diff"], 1e-9)
+        # a thicker ring is not this file
+        row = check_twins.check_machined(self.d, dict(mp, exact=dict(self.ring, outer_radius_mm=5.1)),
+                                         0.01, "test")
+        self.assertFalse(row["ok"])
+        self.assertIn("STEP volume", row["problems"][0])
+
+
 if __name__ == "__main__":
     res = unittest.main(exit=False, verbosity=1).result
     print(f"test_twins: {res.testsRun - len(res.failures) - len(res.errors) - len(res.skipped)} passed, "

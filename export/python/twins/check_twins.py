@@ -3,7 +3,7 @@
 
 Usage: python export/python/twins/check_twins.py EXPORT_DIR... --report REPORT.md
                                    [--json OUT.json] [--tier fast|full] [--skip-manifold3d]
-                                   (from any directory)
+                                   [--exact-from-step]   (from any directory)
 
 Each EXPORT_DIR is a `fabkit export` or `fabkit fixtures` output (manifest.json, parts/*.stl)
 with the CSG tree of its parts beside it as EXPORT_DIR.csg.json (`--csg`). Per part:
@@ -15,7 +15,14 @@ with the CSG tree of its parts beside it as EXPORT_DIR.csg.json (`--csg`). Per p
   within tol + 1 um, genus equal, its tessellation watertight once OCCT's zero-area pole facets
   are dropped (see compare.py).
 --skip-manifold3d leaves the manifold3d twin out of the full tier (for exports whose manifold3d
-twin a fast-tier run checks). The written mesh itself must be watertight and consistently
+twin a fast-tier run checks).
+--exact-from-step (full tier, exports made with `--format step`): the exact solid of each part is
+its STEP file read back (CadQuery import) instead of a twin built here: the STEP export built it
+from the same params with the same twin (and checked its volume and box against fabkit's before
+writing), so each twin is built once per export. The file must be the one the manifest hashes
+(step_sha256) and import as a valid shape with at least one solid; its row then holds the same
+comparisons as a twin's. A machined part's STEP file (made to order, no mesh) gets a row of its
+own: valid, one solid, its volume within 1e-6 relative of the exact shape the manifest gives. The written mesh itself must be watertight and consistently
 oriented. One report row per part; exit status 1 when any row is out of bounds, 2 on unreadable
 input.
 """
@@ -39,12 +46,72 @@ from twins import compare as K  # noqa: E402
 from twins import m3d_twin  # noqa: E402
 
 
-def check_export(d: Path, tier: str, log, manifold3d: bool = True) -> list[dict]:
+def read_step(d: Path, entry: dict, row: dict):
+    """The STEP file of a manifest entry (a part or a machined part) read back by CadQuery: the
+    file the manifest names and hashes, a valid shape with at least one solid. Raises ValueError
+    naming what is wrong; records `step_solids` in `row`."""
+    import hashlib
+
+    import cadquery as cq
+    name = entry.get("step_file")
+    if not name:
+        raise ValueError("no step_file in the manifest")
+    path = d / name
+    digest = hashlib.sha256(path.read_bytes()).hexdigest()
+    if digest != entry.get("step_sha256"):
+        raise ValueError(f"{name}: sha256 {digest} is not the manifest's {entry.get('step_sha256')}")
+    shape = cq.importers.importStep(str(path)).val()
+    row["step_solids"] = K._solids(shape)
+    if not shape.isValid():
+        raise ValueError(f"{name}: not a valid shape once read back")
+    if row["step_solids"] < 1:
+        raise ValueError(f"{name}: no solid")
+    return shape
+
+
+def exact_solid(d: Path, part: dict, from_step: bool, row: dict):
+    """The exact solid of `part` in print orientation: its STEP file read back (`from_step`) or
+    the CadQuery twin built from its params."""
+    row["exact_source"] = "step" if from_step else "twin"
+    if from_step:
+        return read_step(d, part, row)
+    from twins import cq_twin
+    return cq_twin.build(part)
+
+
+def check_machined(d: Path, mp: dict, tol: float, design_name: str) -> dict:
+    """A machined part's STEP file (made to order: no mesh, an exact shape in the manifest) read
+    back: valid, one solid, volume within 1e-6 relative of the exact shape."""
+    from twins import cq_common, step_export
+    row = {"design": d.name, "design_name": design_name, "part": mp["name"],
+           "role": "machined", "family": "machined part (exact shape)", "tol_mm": tol,
+           "triangles": None, "genus_fabkit": None, "exact_source": "step", "problems": []}
+    try:
+        shape = read_step(d, mp, row)
+        v_step = cq_common.exact_volume(shape)
+        v_exact = cq_common.exact_volume(step_export.exact_member(mp["exact"]))
+        rel = abs(v_step - v_exact) / abs(v_exact)
+        row.update({"volume_step_mm3": v_step, "volume_exact_mm3": v_exact,
+                    "step_volume_rel_diff": rel})
+        if not rel <= 1e-6:
+            row["problems"].append(f"STEP volume {v_step:.6f} mm3 vs exact {v_exact:.6f} "
+                                   f"(rel {rel:.1e} > 1e-6)")
+        if row["step_solids"] != 1:
+            row["problems"].append(f"{row['step_solids']} solids in the STEP file, not 1")
+    except Exception as ex:
+        row["problems"].append(f"STEP read-back failed: {type(ex).__name__}: {ex}")
+    row["ok"] = not row["problems"]
+    return row
+
+
+def check_export(d: Path, tier: str, log, manifold3d: bool = True,
+                 from_step: bool = False) -> list[dict]:
     man = json.loads((d / "manifest.json").read_text())
     tol = float(man["chord_tolerance_mm"])
     csg_path = Path(str(d) + ".csg.json")
     m3d = m3d_twin.replay(csg_path) if manifold3d and csg_path.exists() else None
     rows = []
+    exact = {}  # part name -> its exact solid (full tier), for the sheets cut from a tray
     for part in man["parts"]:
         name = part["name"]
         row = {"design": d.name, "design_name": man["design"]["name"], "part": name,
@@ -86,7 +153,8 @@ def check_export(d: Path, tier: str, log, manifold3d: bool = True) -> list[dict]
             row["family"] = cq_twin.family(part)
             t0 = time.perf_counter()
             try:
-                shape = cq_twin.build(part)
+                shape = exact_solid(d, part, from_step, row)
+                exact[name] = shape
                 row["cq_build_s"] = time.perf_counter() - t0
                 t1 = time.perf_counter()
                 e = K.compare_exact(fv, ff, shape, tol)
@@ -108,9 +176,10 @@ def check_export(d: Path, tier: str, log, manifold3d: bool = True) -> list[dict]
                 g_f = part["genus"]
                 if e["genus_exact"] != g_f:
                     row["problems"].append(f"genus {g_f} vs exact {e['genus_exact']}")
-            except Exception as ex:  # a twin that cannot be built is a failed row
+            except Exception as ex:  # a twin that cannot be built or read is a failed row
                 row["cq_build_s"] = time.perf_counter() - t0
-                row["problems"].append(f"CadQuery twin failed: {type(ex).__name__}: {ex}")
+                what = "STEP read-back" if from_step else "CadQuery twin"
+                row["problems"].append(f"{what} failed: {type(ex).__name__}: {ex}")
         else:
             from twins.families import family
             row["family"] = family(part)
@@ -118,15 +187,23 @@ def check_export(d: Path, tier: str, log, manifold3d: bool = True) -> list[dict]
         log(f"{'PASS' if row['ok'] else 'FAIL'} {row['design']}/{name}"
             + ("" if row["ok"] else ": " + "; ".join(row["problems"])))
         rows.append(row)
-    rows += _check_sheets(d, man, tol, tier, log, m3d)
+    rows += _check_sheets(d, man, tol, tier, log, m3d, exact)
+    if tier == "full" and from_step:
+        for mp in man.get("machined_parts") or []:
+            row = check_machined(d, mp, tol, man["design"]["name"])
+            log(f"{'PASS' if row['ok'] else 'FAIL'} {row['design']}/{row['part']} (machined)"
+                + ("" if row["ok"] else ": " + "; ".join(row["problems"])))
+            rows.append(row)
     return rows
 
 
-def _check_sheets(d: Path, man: dict, tol: float, tier: str, log, m3d) -> list[dict]:
+def _check_sheets(d: Path, man: dict, tol: float, tier: str, log, m3d,
+                  exact: dict) -> list[dict]:
     """The laser-cut sheets of the trays (`cut/<sheet>.stl`; designs/src/parts/lasercut.rs): each is
     its tray (the union of the sheets) between the planes of its faces, so the twins are the
     tray's twins cut there: manifold3d (the tray's replayed booleans, both tiers) and CadQuery
-    (the tray's exact twin, full tier), with the parts' bounds."""
+    (the tray's exact solid, full tier: `exact`, the part loop's, else its twin built here),
+    with the parts' bounds."""
     sheets = {s["name"]: (p, s) for p in man["parts"]
               for s in ((p.get("params") or {}).get("laser_cut") or {}).get("sheets", [])}
     rows = []
@@ -169,7 +246,7 @@ def _check_sheets(d: Path, man: dict, tol: float, tier: str, log, m3d) -> list[d
                 import cadquery as cq
                 t0 = time.perf_counter()
                 try:
-                    t = cq_twin.build(tray)
+                    t = exact[tray["name"]] if tray["name"] in exact else cq_twin.build(tray)
                     bb = t.BoundingBox()
                     box = cq.Solid.makeBox(bb.xlen + 2.0, bb.ylen + 2.0, z1 - z0,
                                            cq.Vector(bb.xmin - 1.0, bb.ymin - 1.0, z0))
@@ -246,8 +323,8 @@ def _log(s: str) -> None:
     print(s, flush=True)
 
 
-def _check_export_logged(d: Path, tier: str, manifold3d: bool) -> list[dict]:
-    return check_export(d, tier, _log, manifold3d)
+def _check_export_logged(d: Path, tier: str, manifold3d: bool, from_step: bool) -> list[dict]:
+    return check_export(d, tier, _log, manifold3d, from_step)
 
 
 def main(argv=None) -> int:
@@ -259,6 +336,9 @@ def main(argv=None) -> int:
     ap.add_argument("--skip-manifold3d", action="store_true",
                     help="full tier: the CadQuery twin only (for exports whose manifold3d twin "
                          "another run of the fast tier checks)")
+    ap.add_argument("--exact-from-step", action="store_true",
+                    help="full tier: each part's exact solid is its STEP file read back (exports "
+                         "made with --format step), not a twin built here")
     ap.add_argument("--jobs", type=int, default=0,
                     help="exports checked in parallel processes (default: one per CPU)")
     args = ap.parse_args(argv)
@@ -271,18 +351,25 @@ def main(argv=None) -> int:
     if args.skip_manifold3d and args.tier != "full":
         print("check_twins: --skip-manifold3d leaves the fast tier nothing to check", file=sys.stderr)
         return 2
+    if args.exact_from_step and args.tier != "full":
+        print("check_twins: --exact-from-step is for the full tier", file=sys.stderr)
+        return 2
     m3d = not args.skip_manifold3d
+    step = args.exact_from_step
     rows = []
     if jobs <= 1:
         for d in args.exports:
-            rows += check_export(d, args.tier, _log, m3d)
+            rows += check_export(d, args.tier, _log, m3d, step)
     else:
         # one export per task, in the given order; the rows keep that order
         n = len(args.exports)
         with ProcessPoolExecutor(max_workers=jobs) as pool:
-            for r in pool.map(_check_export_logged, args.exports, [args.tier] * n, [m3d] * n):
+            for r in pool.map(_check_export_logged, args.exports, [args.tier] * n, [m3d] * n,
+                              [step] * n):
                 rows += r
     meta = {"seconds": f"{time.perf_counter() - t0:.1f}"}
+    if args.tier == "full":
+        meta["exact solids"] = "the exports' STEP files read back" if step else "twins built here"
     try:
         from importlib import metadata
         meta["manifold3d"] = metadata.version("manifold3d")
