@@ -190,7 +190,11 @@ pub fn build_kit_scoped(
             };
             let fillings = || {
                 let cavity = |i: usize| {
-                    crate::parts::layers::inner_cavity(&design.stack_input(), &stack, i, tol)
+                    let si = design.stack_input();
+                    Ok((
+                        crate::parts::layers::inner_cavity(&si, &stack, i, tol)?,
+                        crate::parts::layers::layer_twin_params(&si, &stack, i, tol),
+                    ))
                 };
                 FAMILIES
                     .iter()

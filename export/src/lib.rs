@@ -377,6 +377,7 @@ fn step_files(
                 match e {
                     ExactShape::Layer { .. } => StepGeometry::ExactLayer,
                     ExactShape::CoreShell { .. } => StepGeometry::ExactCoreShell,
+                    ExactShape::InnerCavity { .. } => StepGeometry::ExactInnerCavity,
                     ExactShape::Revolved { .. } => StepGeometry::RevolvedProfile,
                     ExactShape::Cylinder { .. }
                     | ExactShape::Ring { .. }

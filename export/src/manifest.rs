@@ -246,6 +246,9 @@ pub enum StepGeometry {
     /// The core's exact shell: its outer offset surface and inner surface (a machined core's
     /// `step/<name>.step` holds the same solid).
     ExactCoreShell,
+    /// The exact space inside a layer less its inner features, with the opening a filling gel
+    /// runs down through (a printed TacTip tip's gel, Pestell et al. Sec. III-A).
+    ExactInnerCavity,
     /// The exact solid of revolution of the member's (r, z) profile polygon (planes, cylinders,
     /// cones); the polygon is within half the chord tolerance of the true profile.
     RevolvedProfile,

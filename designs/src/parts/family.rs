@@ -23,8 +23,11 @@ pub const FILLING_GEL: &str = "filling_gel";
 
 /// The inner cavity of layer `i` of the stack, as a solid (the space inside its inner surface
 /// down to the base plane, less its marker features): what a gel poured against the layer
-/// fills. The build passes it to [`Family::filling_pour`].
-pub type InnerCavity<'a> = &'a dyn Fn(usize) -> Result<Solid, GeometryError>;
+/// fills; with the layer's twin parameters
+/// ([`crate::parts::layers::layer_twin_params`]), from which the CadQuery twin builds the
+/// same cavity exactly ([`crate::parts::ExactShape::InnerCavity`]). The build passes it to
+/// [`Family::filling_pour`].
+pub type InnerCavity<'a> = &'a dyn Fn(usize) -> Result<(Solid, serde_json::Value), GeometryError>;
 
 /// A gel poured into the assembled sensor (the filling gel, cast [`FILLING_GEL`]).
 #[derive(Debug, Clone)]

@@ -83,7 +83,7 @@ pub struct FeatureKey(pub Vec<u64>);
 
 /// The exact shape of a non-printed assembly member, from which the CadQuery twin
 /// (`export/python/twins/step_export.py`) builds its B-rep. Sensor frame, mm; serialized with a
-/// `shape` tag (`layer`, `revolved`, `cylinder`, `ring`, `box`, `core_shell`).
+/// `shape` tag (`layer`, `revolved`, `cylinder`, `ring`, `box`, `core_shell`, `inner_cavity`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "shape", rename_all = "snake_case", deny_unknown_fields)]
 pub enum ExactShape {
@@ -115,6 +115,17 @@ pub enum ExactShape {
     /// surface exactly and its inner surface by the rule of
     /// [`crate::profile::BodyProfile::shell_inner_surface`].
     CoreShell { params: serde_json::Value },
+    /// The space inside a layer above the base plane less its inner features, whole (stems
+    /// and tips: [`crate::parts::layers::inner_cavity`]; `params` as for `Layer`, of that
+    /// layer), united with the disc about the z axis of radius `opening_radius_mm` from
+    /// `opening_z0_mm` up to `opening_z1_mm`: a printed TacTip tip's filling gel, which runs
+    /// down through the tip fitting's lip to the lens window (Pestell et al. Sec. III-A).
+    InnerCavity {
+        params: serde_json::Value,
+        opening_radius_mm: f64,
+        opening_z0_mm: f64,
+        opening_z1_mm: f64,
+    },
 }
 
 /// A bought part's envelope about the sensor axis: the cylinder of radius `r_mm` from `z0_mm`

@@ -4,7 +4,7 @@
 //! named interference with its analytic overlap, and one bad value per rule refused by path.
 
 use crate::common::{assert_each_rule_names_its_path, assert_one_interference, RuleCase};
-use fabkit_designs::assembly::{interferences, MemberKind};
+use fabkit_designs::assembly::{interferences, ExactShape, MemberKind};
 use fabkit_designs::materials::MaterialsTable;
 use fabkit_designs::parts::bayonet::band;
 use fabkit_designs::parts::family::FamilyInput;
@@ -154,6 +154,45 @@ fn tactip_kit_has_the_body_and_an_assembly_without_interferences() {
         },
     );
     assert!(narrow < f, "{narrow} vs {f}");
+}
+
+/// The filling gel carries its exact shape (STEP export builds its B-rep from it): the skin
+/// layer's inside round its pins and tips, from the same twin parameters as the printed skin
+/// (offsets, body, markers), and the lip's opening, whose bottom is the gel's lowest point and
+/// whose top reaches into the cavity (the skin's base plane); a gel whose solid is that union
+/// (its volume above the bare opening disc).
+#[test]
+fn the_filling_gel_carries_its_exact_shape() {
+    let k = kit();
+    let gel = k.assembly.iter().find(|m| m.name == "filling_gel").unwrap();
+    let skin = k.parts.iter().find(|p| p.name == "skin").unwrap();
+    let Some(ExactShape::InnerCavity {
+        params,
+        opening_radius_mm: r,
+        opening_z0_mm: z0,
+        opening_z1_mm: z1,
+    }) = &gel.exact
+    else {
+        panic!("filling gel's exact shape: {:?}", gel.exact);
+    };
+    for key in [
+        "layer",
+        "body",
+        "inner_offset_mm",
+        "outer_offset_mm",
+        "markers",
+    ] {
+        assert_eq!(params[key], skin.params[key], "{key}");
+    }
+    let bb = gel.solid.bounding_box().unwrap();
+    assert!((bb.min[2] - z0).abs() < 1e-9, "{} vs {z0}", bb.min[2]);
+    let base_z = tactip().body.base_z_mm();
+    assert!(
+        *z0 < base_z && *z1 > base_z && *z1 - base_z < 0.02,
+        "{z0} {z1} {base_z}"
+    );
+    assert!(*r > 0.0 && bb.max[0] > *r);
+    assert!(gel.solid.volume() > PI * r * r * (z1 - z0));
 }
 
 /// The LED ring's seat bored 0.3 mm under the ring's diameter: one error naming the seat's

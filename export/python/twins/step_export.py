@@ -142,6 +142,9 @@ def exact_member(e: dict):
         return C.box(e["min_mm"], e["max_mm"])
     if shape == "core_shell":
         return cq_layers.core_shell(e["params"])
+    if shape == "inner_cavity":
+        return cq_layers.inner_cavity(e["params"], (e["opening_radius_mm"], e["opening_z0_mm"],
+                                                    e["opening_z1_mm"]))
     raise C.TwinError(f"exact shape {shape!r}: no twin")
 
 

@@ -195,7 +195,7 @@ impl Family for ShaftBodyFamily {
         let Some(f) = &sb.filling_gel else {
             return Ok(None);
         };
-        let gel = cavity(0)
+        let (gel, exact) = cavity(0)
             .and_then(|c| filling_gel_solid(sb, input, c))
             .part(FILLING_GEL)?;
         Ok(Some(FillingPour {
@@ -215,7 +215,7 @@ impl Family for ShaftBodyFamily {
                 // the skin's cavity less its pins and tips: nested with them by construction
                 nested_by_stack: true,
                 features: Default::default(),
-                exact: None,
+                exact: Some(exact),
                 material: Some(f.material.clone()),
             }),
         }))

@@ -10,7 +10,7 @@ use crate::error::{DesignError, GeometryContext};
 use crate::geometry::{cuboid, cylinder, revolve, GeometryError, Polyline2, Solid};
 use crate::parts::family::FamilyInput;
 use crate::parts::placement::{place_posed, with_pose};
-use crate::parts::{Part, PrintTechnology};
+use crate::parts::{ExactShape, Part, PrintTechnology};
 
 /// The fitting's profile of revolution (r, z), closed, counter-clockwise.
 fn fitting_profile(r: &ShaftRadii, lv: &ShaftLevels) -> Polyline2 {
@@ -119,22 +119,27 @@ pub fn build_body(sb: &ShaftBodyParams, input: FamilyInput<'_>) -> Result<Part, 
 
 /// The filling gel's solid, sensor frame: `cavity`, the innermost layer's inside above the
 /// base plane round the pins and their tips (`layers::inner_cavity`), and the lip's opening
-/// down to the window.
+/// down to the window; with its exact shape, from the innermost layer's twin parameters
+/// `cavity_params`.
 ///
 /// # Errors
 /// [`GeometryError`] if the kernel fails.
 pub fn filling_gel_solid(
     sb: &ShaftBodyParams,
     input: FamilyInput<'_>,
-    cavity: Solid,
-) -> Result<Solid, GeometryError> {
+    (cavity, cavity_params): (Solid, serde_json::Value),
+) -> Result<(Solid, ExactShape), GeometryError> {
     let FamilyInput { ctx, stack, tol } = input;
     let r = radii(ctx, sb, stack);
     let lv = levels(ctx, sb);
-    let lip = cylinder(lv.skin_base_z_mm - lv.lip_z_mm + 0.01, r.lip_inner_mm, tol)?.translate([
-        0.0,
-        0.0,
-        lv.lip_z_mm,
-    ]);
-    cavity.union(&lip)
+    // 0.01 mm into the cavity, so that the union has no coplanar faces
+    let (z0, z1) = (lv.lip_z_mm, lv.skin_base_z_mm + 0.01);
+    let lip = cylinder(z1 - z0, r.lip_inner_mm, tol)?.translate([0.0, 0.0, z0]);
+    let exact = ExactShape::InnerCavity {
+        params: cavity_params,
+        opening_radius_mm: r.lip_inner_mm,
+        opening_z0_mm: z0,
+        opening_z1_mm: z1,
+    };
+    Ok((cavity.union(&lip)?, exact))
 }
