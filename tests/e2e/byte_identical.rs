@@ -20,9 +20,11 @@
 //!
 //! `step_files_are_byte_identical_to_the_committed_hashes` does the same with `--format step`
 //! for the STEP files, against `tests/e2e/output_hashes_step.txt` (CadQuery's OCCT writes the
-//! same bytes every run for most files: no time stamp in the header, single-threaded booleans;
-//! not for a compound of many holes or tips, the pin dome's and the TacTip's skin tips'). It
-//! takes 15 minutes, so it is ignored; the suite checks the default design's STEP files
+//! same bytes every run for most files, whatever the size of its thread pool: no time stamp in
+//! the header, booleans that give the same B-rep on any number of threads; not for a compound
+//! of many holes or tips, the pin domes', DIGIT Pinki's `semidome_empty` and the TacTip's skin
+//! tips', which differ between runs single-threaded too). It takes about 4 minutes (214 s on
+//! 2 cores, 2026-11-30), so it is ignored; the suite checks the default design's STEP files
 //! (`the_default_designs_step_files_are_byte_identical_to_the_committed_hashes`):
 //!
 //! ```sh
@@ -199,8 +201,8 @@ fn outputs_are_byte_identical_to_the_committed_hashes() {
 
 /// In the suite (so in CI, where `FABKIT_CADQUERY_PYTHON` is set): the STEP files of the
 /// default design's export against their lines of the committed STEP list. The whole list
-/// takes 15 minutes and is run by hand; R-Tac0's export takes about 10 s, and OCCT writes its
-/// files the same every run (four runs measured). The pin dome's `pin_dome.step` (fixtures) is
+/// takes about 4 minutes and is run by hand; R-Tac0's export takes about 10 s, and OCCT writes
+/// its files the same every run (four runs measured, and four more with parallel booleans). The pin dome's `pin_dome.step` (fixtures) is
 /// not held to it: OCCT writes its compound of many holes differently from run to run (one run
 /// in three measured), as it does the TacTip's `skin_tips`.
 #[test]
@@ -262,7 +264,7 @@ fn on_listed_platform(list: &str) -> bool {
 
 /// The same for the STEP files (`--format step`, through the CadQuery twins): the exact solids
 /// of every part, fixture and assembly. Needs the CadQuery environment
-/// (`scripts/setup-cadquery` or `FABKIT_CADQUERY_PYTHON`); about 15 minutes. OCCT does not always
+/// (`scripts/setup-cadquery` or `FABKIT_CADQUERY_PYTHON`); about 4 minutes. OCCT does not always
 /// write a compound of many solids with the same bytes (the TacTip's `skin_tips`, over a
 /// hundred tips): rerun before believing a change in one such file alone.
 #[test]

@@ -25,7 +25,7 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     from twins import cq_common, cq_twin
     from twins.step_export import write_step
-    cq_common.PARALLEL = False  # as the STEP export runs them
+    cq_common.PARALLEL = True  # as the STEP export runs them
     man = json.loads((args.export / "manifest.json").read_text())
     runs = []
     with tempfile.TemporaryDirectory() as tmp:
