@@ -22,8 +22,8 @@ from the same params with the same twin (and checked its volume and box against 
 writing), so each twin is built once per export. The file must be the one the manifest hashes
 (step_sha256) and import as a valid shape with at least one solid; its row then holds the same
 comparisons as a twin's. A machined part's STEP file (made to order, no mesh) gets a row of its
-own: valid, one solid, its volume within 1e-6 relative of the exact shape the manifest gives. The written mesh itself must be watertight and consistently
-oriented. One report row per part; exit status 1 when any row is out of bounds, 2 on unreadable
+own: valid, one solid, its volume within 1e-6 relative of the exact shape the manifest gives.
+The written mesh itself must be watertight and consistently oriented. One report row per part; exit status 1 when any row is out of bounds, 2 on unreadable
 input.
 """
 

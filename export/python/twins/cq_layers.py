@@ -154,17 +154,14 @@ def printed_skin(params: dict, tips: bool):
     return C.cut(outer, [inner])
 
 
-def inner_cavity(params: dict, opening: tuple | None = None):
+def inner_cavity(params: dict, r: float, z0: float, z1: float):
     """The space inside the layer above the base plane less its inner features, whole (stems
     and tips as one solid each; designs/src/parts/layers.rs `inner_cavity`), united with the
-    disc `opening` = (radius, z0, z1) about the z axis: the filling gel of a printed TacTip
+    disc of radius `r` from `z0` to `z1` about the z axis: the filling gel of a printed TacTip
     tip (Pestell et al. Sec. III-A)."""
     body = C.Body(params["body"])
     cavity = with_features(enclosed(body, params["inner_offset_mm"], 0.0), body,
                            marker_sets(params, "inner"), 1.0)
-    if opening is None:
-        return cavity
-    r, z0, z1 = opening
     return C.fuse(cavity, [C.cylinder_z(r, z0, z1)])
 
 

@@ -30,8 +30,9 @@ and ShadowTac), and every library design's STEP files on 2 threads hash as
 tests/e2e/output_hashes_step.txt lists them but for the files OCCT writes differently from run
 to run single-threaded too (a compound of many holes or tips: the pin domes, DIGIT Pinki's
 semi-dome, the TacTip's skin tips). On 2 cores they take about half the time (UVDtact's parts
-11.3 -> 6.4 s; `fabkit export uvdtact --format step` 31 -> 19 s). Progress goes to stderr, one line as each part starts:
-`step_export: I/N NAME` (part I of N, in the input's order), then `step_export: member NAME`
+11.3 -> 6.4 s; `fabkit export uvdtact --format step` 31 -> 19 s).
+
+Progress goes to stderr, one line as each part starts: `step_export: I/N NAME` (part I of N, in the input's order), then `step_export: member NAME`
 per assembly member. Exit status: 0 written; 2 unreadable input; 3 a twin failed or disagreed
 (the last stderr line names the part, `step_export: part NAME: ...`, or the assembly member,
 `step_export: member NAME: ...`); 4 no CadQuery.
@@ -149,8 +150,8 @@ def exact_member(e: dict):
     if shape == "core_shell":
         return cq_layers.core_shell(e["params"])
     if shape == "inner_cavity":
-        return cq_layers.inner_cavity(e["params"], (e["opening_radius_mm"], e["opening_z0_mm"],
-                                                    e["opening_z1_mm"]))
+        return cq_layers.inner_cavity(e["params"], e["opening_radius_mm"], e["opening_z0_mm"],
+                                      e["opening_z1_mm"])
     raise C.TwinError(f"exact shape {shape!r}: no twin")
 
 
