@@ -4,7 +4,7 @@
 pub mod flat;
 
 use crate::error::{ParamError, ParamErrors};
-use crate::geometry::{revolve, ChordTolerance, Solid};
+use crate::geometry::{revolve, revolve_shell, ChordTolerance, Solid};
 use crate::materials::{MaterialKind, MaterialsTable};
 pub use crate::parts::context::{ResolvedCore, ResolvedLayer, Stack};
 use crate::parts::layer_feature::solid_layer_profile;
@@ -17,7 +17,9 @@ pub use crate::schema::DESIGN_SIGNED_MM;
 use crate::schema::{Design, LayerProcess};
 
 impl Stack {
-    /// The solid of layer `i` (between its inner and outer surfaces, closed on the base plane).
+    /// The solid of layer `i` without its features: between its inner and outer surfaces,
+    /// closed on the base plane (each surface on its own segment count, [`revolve_shell`]), or
+    /// for a solid layer under its outer surface less its seat.
     ///
     /// # Errors
     /// Only on a kernel failure.
@@ -28,19 +30,20 @@ impl Stack {
         tol: ChordTolerance,
     ) -> Result<Solid, crate::geometry::GeometryError> {
         let l = &self.layers[i];
-        let pl = if l.solid {
-            solid_layer_profile(
-                si.ctx.body,
-                l.outer_offset_mm,
-                seat_of(si, i).as_ref(),
-                tol.half(),
-            )
+        let body = si.ctx.body;
+        let mesh = if l.solid {
+            revolve(
+                &solid_layer_profile(body, l.outer_offset_mm, seat_of(si, i).as_ref(), tol.half()),
+                tol,
+            )?
         } else {
-            si.ctx
-                .body
-                .shell_profile(l.inner_offset_mm, l.outer_offset_mm, 0.0, tol.half())
+            revolve_shell(
+                &body.offset_polyline(l.outer_offset_mm, 0.0, tol.half()),
+                &body.offset_polyline(l.inner_offset_mm, 0.0, tol.half()),
+                tol,
+            )?
         };
-        Solid::from_mesh(&revolve(&pl, tol)?)
+        Solid::from_mesh(&mesh)
     }
 }
 

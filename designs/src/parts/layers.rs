@@ -247,6 +247,10 @@ pub fn layer_solid(
     );
     outer.extend(&coat_outer);
     inner.extend(&coat_inner);
+    if outer.is_empty() && inner.is_empty() {
+        // no feature on either surface: the revolved layer itself, no boolean
+        return stack.layer_solid(si, i, tol);
+    }
     if l.solid {
         return solid_enclosed(si, l, &outer, tol, stems_only);
     }

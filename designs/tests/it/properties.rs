@@ -448,6 +448,42 @@ fn check_profile_case(c: &ProfileCase) -> Result<(), TestCaseError> {
         worst
     );
 
+    // The same shell with each surface on its own segment count (what a featureless cast
+    // layer is built from): the same solid as the outer enclosed solid less the inner one
+    // continued under the base, and the same vertices, without the boolean.
+    let (outer, inner) = (
+        b.offset_polyline(c.d_out, c.below_mm, tol.half()),
+        b.offset_polyline(c.d_in, c.below_mm, tol.half()),
+    );
+    let mesh = geometry::revolve_shell(&outer, &inner, tol)
+        .map_err(|e| TestCaseError::fail(e.to_string()))?;
+    let solid = Solid::from_mesh(&mesh).map_err(|e| TestCaseError::fail(e.to_string()))?;
+    check_topology("shell on two counts", &mesh, &solid, 0)?;
+    check_volume(
+        "shell on two counts",
+        &mesh,
+        v_out - v_in,
+        v_out + v_in,
+        c.tol,
+        false,
+    )?;
+    let (_, enclosed_out) = revolve_solid(&b.solid_profile(c.d_out, c.below_mm, tol.half()), tol)?;
+    let (_, enclosed_in) =
+        revolve_solid(&b.solid_profile(c.d_in, c.below_mm + 1.0, tol.half()), tol)?;
+    let difference = enclosed_out
+        .difference(&enclosed_in)
+        .map_err(|e| TestCaseError::fail(e.to_string()))?;
+    prop_assert!(
+        (difference.volume() - solid.volume()).abs() <= 1e-12 * (v_out + v_in),
+        "shell on two counts: volume {} against the boolean's {}",
+        solid.volume(),
+        difference.volume()
+    );
+    prop_assert_eq!(
+        solid.mesh().vertices.len(),
+        difference.mesh().vertices.len()
+    );
+
     // The full solids at both offsets: convex, so the inscribed mesh is not larger.
     for d in [c.d_out, c.d_in] {
         let pl = b.solid_profile(d, c.below_mm, tol.half());
