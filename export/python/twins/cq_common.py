@@ -17,8 +17,8 @@ from OCP.BRepBuilderAPI import BRepBuilderAPI_Transform
 from OCP.gp import gp_Trsf
 from OCP.TopTools import TopTools_ListOfShape
 
-# Booleans on several threads (OCCT's parallel mode); STEP export turns it off so that the same
-# parts give the same bytes.
+# Booleans on several threads (OCCT's parallel mode): the same B-rep as single-threaded, so STEP
+# export keeps it on (step_export.py's docstring says which files vary from run to run anyway).
 PARALLEL = True
 
 # Geometric resolution of the exact twins (B-spline fit of ellipse offsets), mm.

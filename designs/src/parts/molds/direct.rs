@@ -2,7 +2,7 @@
 //! keys, clamp bolt holes and the core holder (R-Tac0 Sec. III-B1, Fig. 4).
 
 use super::frame::sprue_pour_text;
-use super::frame::{material_for, CastMold, MoldFrame, MoldOutput};
+use super::frame::{material_for, CastMold, CoreMold, MoldFrame};
 use super::strategy::{CastPieces, CoreMoldInput, Strategy};
 use super::strategy::{MoldBolts, PourInput};
 use crate::error::{DesignError, GeometryContext};
@@ -23,7 +23,7 @@ pub(crate) fn direct_mold_parts(
     cavity: &Solid,
     tol: ChordTolerance,
     c: CastMold,
-) -> Result<MoldOutput, DesignError> {
+) -> Result<CoreMold, DesignError> {
     let (name, f) = (c.name, &c.f);
     let m = &si.mold;
     let cavity_tech: PrintTechnology = m.cavity_print_technology.into();
@@ -59,12 +59,10 @@ pub(crate) fn direct_mold_parts(
         c.holder_part,
     ];
     let pour_parts = parts.iter().map(|p| p.name.clone()).collect();
-    Ok(MoldOutput {
+    Ok(CoreMold {
         parts,
-        pour_volume_mm3: c.pour_volume,
         silicone_pour: None,
         pour_parts,
-        markers: Vec::new(),
     })
 }
 
@@ -102,14 +100,20 @@ pub(crate) fn direct_halves(
         }
     }
     let bolts = Solid::compose(&bolts);
-    let a = pos
-        .union(&Solid::compose(&key_at(r_key)?))?
-        .difference(&bolts)?;
-    let bh = neg
-        .difference(&Solid::compose(&key_at(
-            r_key + m.registration_key.clearance_mm,
-        )?))?
-        .difference(&bolts)?;
+    // the two halves side by side
+    let (a, bh) = rayon::join(
+        || {
+            pos.union(&Solid::compose(&key_at(r_key)?))?
+                .difference(&bolts)
+        },
+        || {
+            neg.difference(&Solid::compose(&key_at(
+                r_key + m.registration_key.clearance_mm,
+            )?))?
+            .difference(&bolts)
+        },
+    );
+    let (a, bh) = (a?, bh?);
     Ok((
         place_posed(&a, &crate::geometry::rotation_deg(-90.0, 0.0, 0.0)),
         place_posed(&bh, &crate::geometry::rotation_deg(90.0, 0.0, 0.0)),
@@ -163,7 +167,7 @@ impl Strategy for Direct {
         &self,
         input: CoreMoldInput<'_>,
         c: CastMold,
-    ) -> Option<Result<MoldOutput, DesignError>> {
+    ) -> Option<Result<CoreMold, DesignError>> {
         Some(direct_mold_parts(input.si, input.cavity, input.tol, c))
     }
 

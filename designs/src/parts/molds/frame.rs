@@ -243,6 +243,17 @@ pub(crate) fn holder_params(si: &StackInput<'_>, f: &MoldFrame) -> serde_json::V
     })
 }
 
+/// What a core-holding strategy builds for one cast ([`super::strategy::Strategy::core_mold`]):
+/// the mold builder adds the pour's volume, computed beside it, and the marker summary
+/// ([`MoldOutput`]).
+pub struct CoreMold {
+    pub parts: Vec<Part>,
+    /// For the master strategy: (silicone mold volume mm^3, parts that hold the pour).
+    pub silicone_pour: Option<(f64, Vec<String>)>,
+    /// Names of the parts that hold the gel pour.
+    pub pour_parts: Vec<String>,
+}
+
 /// What the mold builder returns for one cast.
 pub struct MoldOutput {
     pub parts: Vec<Part>,
@@ -259,14 +270,13 @@ pub struct MoldOutput {
 
 /// What both strategies of [`build_mold_parts`] build from: the cast layer's `name`, the
 /// mold frame `f`, the parameters `common` to the mold's parts, the core holder (or casting
-/// jig) part and its name, and the volume the gel pour fills, mm^3.
+/// jig) part and its name.
 pub struct CastMold<'a> {
     pub(crate) name: &'a str,
     pub(crate) f: MoldFrame,
     pub(crate) common: serde_json::Value,
     pub(crate) holder_name: String,
     pub(crate) holder_part: Part,
-    pub(crate) pour_volume: f64,
 }
 
 pub(crate) fn material_for(t: PrintTechnology) -> &'static str {

@@ -3,7 +3,7 @@
 
 use super::frame::sprue_text;
 use super::frame::{
-    cavity_profile, material_for, CastMold, CastPlan, MoldFrame, MoldOutput, BOX_FLOOR_MM,
+    cavity_profile, material_for, CastMold, CastPlan, CoreMold, MoldFrame, BOX_FLOOR_MM,
     BOX_FREEBOARD_MM, BOX_WALL_MM, LOCATING_PIN_HEIGHT_MM, LOCATING_PIN_RADIUS_MM,
 };
 use super::strategy::PourInput;
@@ -27,25 +27,31 @@ pub(crate) fn master_mold_parts(
     plan: &CastPlan,
     tol: ChordTolerance,
     c: CastMold,
-    with_features: &dyn Fn(Solid) -> Result<Solid, DesignError>,
-) -> Result<MoldOutput, DesignError> {
+    with_features: &(dyn Fn(Solid) -> Result<Solid, DesignError> + Sync),
+) -> Result<CoreMold, DesignError> {
     let (name, f) = (c.name, &c.f);
     let m = &si.mold;
     let cavity_tech: PrintTechnology = m.cavity_print_technology.into();
     let fixture_tech: PrintTechnology = m.fixture_print_technology.into();
     let cavity_material = material_for(cavity_tech);
     let fixture_material = material_for(fixture_tech);
-    let master = with_features(
-        Solid::from_mesh(
-            &revolve(
-                &cavity_profile(si, f, plan.cavity_offset_mm, true, tol),
-                tol,
+    // The master and the box are independent: built side by side.
+    let (master, mold_box_fill) = rayon::join(
+        || {
+            with_features(
+                Solid::from_mesh(
+                    &revolve(
+                        &cavity_profile(si, f, plan.cavity_offset_mm, true, tol),
+                        tol,
+                    )
+                    .part(name)?,
+                )
+                .part(name)?,
             )
-            .part(name)?,
-        )
-        .part(name)?,
-    )?;
-    let (mold_box, fill) = master_box(si, f, tol).part(name)?;
+        },
+        || master_box(si, f, tol).part(name),
+    );
+    let (master, (mold_box, fill)) = (master?, mold_box_fill?);
     let silicone = fill.difference(&master).part(name)?.volume();
     let mut params = c.common.clone();
     params["master"] = json!({
@@ -87,12 +93,10 @@ pub(crate) fn master_mold_parts(
         },
         c.holder_part,
     ];
-    Ok(MoldOutput {
+    Ok(CoreMold {
         parts,
-        pour_volume_mm3: c.pour_volume,
         silicone_pour: Some((silicone, vec![master_name, box_name])),
         pour_parts: vec![format!("silicone_mold:{name}"), c.holder_name],
-        markers: Vec::new(),
     })
 }
 
@@ -179,7 +183,7 @@ impl Strategy for Master {
         &self,
         input: CoreMoldInput<'_>,
         c: CastMold,
-    ) -> Option<Result<MoldOutput, DesignError>> {
+    ) -> Option<Result<CoreMold, DesignError>> {
         Some(master_mold_parts(
             input.si,
             input.plan,

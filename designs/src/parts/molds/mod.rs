@@ -97,46 +97,57 @@ fn build_mold_parts(
     let features: Vec<_> = features.iter().collect();
     let with_features =
         |s: Solid| crate::parts::layers::apply_features(s, &features, tol, false).part(name);
-    let cavity = with_features(
-        Solid::from_mesh(
-            &revolve(
-                &cavity_profile(si, &f, plan.cavity_offset_mm, false, tol),
-                tol,
+    // The cavity, the holder and what is inside the cavity are independent: built side by side.
+    let inner = || {
+        // The pour fills the cavity, minus what is inside it (core and inner layers), minus
+        // the holder. What the pour lands on: the layers under it down to the base plane, and
+        // below it the core alone (its bore is closed by the holder's pin, so it counts as
+        // solid).
+        let mut inner_pl = si
+            .ctx
+            .body
+            .offset_polyline(plan.core_offset_mm, 0.0, tol.half());
+        inner_pl.push([f.core_outer_radius_mm, f.base_z_mm]);
+        inner_pl.push([f.core_outer_radius_mm, f.core_end_z_mm]);
+        inner_pl.push([0.0, f.core_end_z_mm]);
+        Solid::from_mesh(&revolve(&inner_pl, tol).part(name)?).part(name)
+    };
+    let (cavity, (holder, inner)) = rayon::join(
+        || {
+            with_features(
+                Solid::from_mesh(
+                    &revolve(
+                        &cavity_profile(si, &f, plan.cavity_offset_mm, false, tol),
+                        tol,
+                    )
+                    .part(name)?,
+                )
+                .part(name)?,
             )
-            .part(name)?,
-        )
-        .part(name)?,
-    )?;
-    let holder = core_holder(si, &f, tol)?;
-    // The pour fills the cavity, minus what is inside it (core and inner layers), minus the holder.
-    // What the pour lands on: the layers under it down to the base plane, and below it the
-    // core alone (its bore is closed by the holder's pin, so it counts as solid).
-    let mut inner_pl = si
-        .ctx
-        .body
-        .offset_polyline(plan.core_offset_mm, 0.0, tol.half());
-    inner_pl.push([f.core_outer_radius_mm, f.base_z_mm]);
-    inner_pl.push([f.core_outer_radius_mm, f.core_end_z_mm]);
-    inner_pl.push([0.0, f.core_end_z_mm]);
-    let inner = Solid::from_mesh(&revolve(&inner_pl, tol).part(name)?).part(name)?;
-    let void = cavity
-        .difference(&holder.union(&inner).part(name)?)
-        .part(name)?;
-    // a coat over features follows them (crate::parts::layers::taken_features)
-    let sprayed_volume: f64 = plan
-        .sprayed
-        .iter()
-        .map(|&i| {
-            if features.is_empty() {
-                stack.layer_solid(si, i, tol)
-            } else {
-                crate::parts::layers::layer_solid(si, stack, i, tol)
-            }
-            .map(|s| s.volume())
-        })
-        .sum::<Result<f64, _>>()
-        .part(name)?;
-    let pour_volume = void.volume() - sprayed_volume;
+        },
+        || rayon::join(|| core_holder(si, &f, tol), inner),
+    );
+    let (cavity, holder, inner) = (cavity?, holder?, inner?);
+    let pour_volume = || -> Result<f64, DesignError> {
+        let void = cavity
+            .difference(&holder.union(&inner).part(name)?)
+            .part(name)?;
+        // a coat over features follows them (crate::parts::layers::taken_features)
+        let sprayed_volume: f64 = plan
+            .sprayed
+            .iter()
+            .map(|&i| {
+                if features.is_empty() {
+                    stack.layer_solid(si, i, tol)
+                } else {
+                    crate::parts::layers::layer_solid(si, stack, i, tol)
+                }
+                .map(|s| s.volume())
+            })
+            .sum::<Result<f64, _>>()
+            .part(name)?;
+        Ok(void.volume() - sprayed_volume)
+    };
 
     let mut common = json!({
         "layer": name,
@@ -181,7 +192,6 @@ fn build_mold_parts(
         common,
         holder_name,
         holder_part,
-        pour_volume,
     };
     let input = CoreMoldInput {
         si,
@@ -190,9 +200,21 @@ fn build_mold_parts(
         with_features: &with_features,
         tol,
     };
-    let mut out = strategy_of(plan.strategy)
-        .core_mold(input, c)
-        .expect("cast_plans plans the pours of core-holding strategies only")?;
+    // The pour's volume (a boolean of its own) beside the strategy's parts.
+    let (pour_volume, mold) = rayon::join(pour_volume, || {
+        strategy_of(plan.strategy)
+            .core_mold(input, c)
+            .expect("cast_plans plans the pours of core-holding strategies only")
+    });
+    // the errors in the order of a sequential build
+    let (pour_volume_mm3, mold) = (pour_volume?, mold?);
+    let mut out = MoldOutput {
+        parts: mold.parts,
+        pour_volume_mm3,
+        silicone_pour: mold.silicone_pour,
+        pour_parts: mold.pour_parts,
+        markers: Vec::new(),
+    };
     let placed = crate::parts::layers::place_layer_markers(si, layer, tol);
     out.markers = crate::parts::layers::marker_summary(
         layer,

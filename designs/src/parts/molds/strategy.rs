@@ -13,7 +13,7 @@ use crate::parts::stack_input::StackInput;
 use crate::profile::BodyProfile;
 use crate::schema::MoldStrategy;
 
-use super::frame::{CastMold, CastPlan, MoldOutput};
+use super::frame::{CastMold, CastPlan, CoreMold};
 
 /// What a core-holding strategy's parts are built from besides the [`CastMold`]: the design,
 /// the pour's plan, the cavity solid with its features, and the function that adds the
@@ -22,7 +22,7 @@ pub struct CoreMoldInput<'a> {
     pub si: &'a StackInput<'a>,
     pub plan: &'a CastPlan,
     pub cavity: &'a Solid,
-    pub with_features: &'a dyn Fn(Solid) -> Result<Solid, DesignError>,
+    pub with_features: &'a (dyn Fn(Solid) -> Result<Solid, DesignError> + Sync),
     pub tol: ChordTolerance,
 }
 
@@ -201,7 +201,7 @@ pub trait Strategy: Sync {
         &self,
         _input: CoreMoldInput<'_>,
         _c: CastMold,
-    ) -> Option<Result<MoldOutput, DesignError>> {
+    ) -> Option<Result<CoreMold, DesignError>> {
         None
     }
 
