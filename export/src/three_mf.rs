@@ -220,21 +220,29 @@ pub(crate) fn model_xml(objects: &[Object<'_>], metadata: &[(&str, String)]) -> 
             x.push_str("   </metadatagroup>\n");
         }
         x.push_str("   <mesh>\n    <vertices>\n");
+        // The bulk of the file: pushed piece by piece rather than through `write!`.
+        let mut num = Numbers::default();
         for v in o.volumes.iter().flat_map(|v| &v.mesh.vertices) {
-            let _ = writeln!(
-                x,
-                "     <vertex x=\"{}\" y=\"{}\" z=\"{}\"/>",
-                coord_text(v[0]),
-                coord_text(v[1]),
-                coord_text(v[2])
-            );
+            x.push_str("     <vertex x=\"");
+            x.push_str(num.coord(v[0]));
+            x.push_str("\" y=\"");
+            x.push_str(num.coord(v[1]));
+            x.push_str("\" z=\"");
+            x.push_str(num.coord(v[2]));
+            x.push_str("\"/>\n");
         }
         x.push_str("    </vertices>\n    <triangles>\n");
         let mut base = 0usize;
         for v in &o.volumes {
             for t in &v.mesh.triangles {
                 let [a, b, c] = t.map(|i| i as usize + base);
-                let _ = writeln!(x, "     <triangle v1=\"{a}\" v2=\"{b}\" v3=\"{c}\"/>");
+                x.push_str("     <triangle v1=\"");
+                x.push_str(num.index(a));
+                x.push_str("\" v2=\"");
+                x.push_str(num.index(b));
+                x.push_str("\" v3=\"");
+                x.push_str(num.index(c));
+                x.push_str("\"/>\n");
             }
             base += v.mesh.vertices.len();
         }
@@ -407,9 +415,50 @@ fn model_entries(
 }
 
 /// The coordinate rounded to f32, as the shortest decimal that reads back to that value as
-/// f64 (and so also as f32); `0` for both zeros.
+/// f64 (and so also as f32); `0` for both zeros. The mesh lines' text ([`Numbers::coord`]).
+#[cfg(test)]
 fn coord_text(c: f64) -> String {
-    f64_text(f64::from(c as f32))
+    Numbers::default().coord(c).to_owned()
+}
+
+/// Number formatting for the mesh lines, coordinates and vertex indices, without the `fmt`
+/// machinery or an allocation per number.
+#[derive(Default)]
+struct Numbers {
+    float: zmij::Buffer,
+    int: itoa::Buffer,
+    fallback: String,
+}
+
+impl Numbers {
+    /// `c` rounded to f32, as the shortest decimal that reads back to that value as f64 (and
+    /// so also as f32); `0` for both zeros. zmij's shortest round-trip digits (Schubfach),
+    /// written in positional notation as std writes floats (no `.0` on an integer; std's own
+    /// text for the exponent form zmij uses below 1e-5 and from 1e16, and for non-finite
+    /// values). The digits are std's but for a value exactly halfway between two shortest
+    /// decimals, where zmij takes the even last digit and std the one above (0.61f32 as f64,
+    /// 0.61100006103515625, is `0.6110000610351562` here): the same f64 either way.
+    fn coord(&mut self, c: f64) -> &str {
+        let c = f64::from(c as f32);
+        if c == 0.0 {
+            return "0";
+        }
+        if !c.is_finite() {
+            self.fallback = c.to_string();
+            return &self.fallback;
+        }
+        let s = self.float.format_finite(c);
+        if s.contains('e') {
+            self.fallback = c.to_string();
+            return &self.fallback;
+        }
+        s.strip_suffix(".0").unwrap_or(s)
+    }
+
+    /// `i` in decimal.
+    fn index(&mut self, i: usize) -> &str {
+        self.int.format(i)
+    }
 }
 
 /// Shortest decimal that reads back to the same f64; `0` for both zeros.
@@ -468,6 +517,68 @@ mod tests {
         assert_eq!(coord_text(12.5), "12.5");
         assert_eq!(coord_text(1e-7).parse::<f32>().unwrap(), 1e-7f32);
         assert_eq!(f64_text(-0.0), "0");
+    }
+
+    /// The mesh lines' numbers read back to the very f32 value, as f64 and as f32, with as few
+    /// digits as std's shortest text, which they equal but for the last digit of a halfway
+    /// value: coordinates spread over every magnitude a mesh can hold (and the exponent forms
+    /// beyond), both signs, f32 neighbours of round numbers; and the integers.
+    #[test]
+    fn the_mesh_lines_numbers_are_shortest_and_exact() {
+        let mut num = Numbers::default();
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut cases: Vec<f64> = vec![
+            0.0, -0.0, 1.0, -1.0, 0.1, 12.5, 1e-7, 3e-5, 1e15, 1e16, 2e17,
+        ];
+        for k in -3..=4 {
+            for m in 1..=1000 {
+                let round = f64::from(m) * 10f64.powi(k) / 1000.0;
+                let f = round as f32;
+                cases.extend([f, f.next_up(), f.next_down()].map(f64::from));
+            }
+        }
+        for _ in 0..200_000 {
+            // a fixed sequence (xorshift), every magnitude from 1e-9 to 1e9 mm
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            let mantissa = (state >> 11) as f64 / (1u64 << 53) as f64;
+            let exponent = ((state & 0xff) as i32 % 19) - 9;
+            let sign = if state & 0x100 == 0 { 1.0 } else { -1.0 };
+            cases.push(sign * mantissa * 10f64.powi(exponent));
+        }
+        let (mut halfway, total) = (0, cases.len());
+        for c in cases {
+            let f = f64::from(c as f32);
+            let (ours, std) = (num.coord(c).to_owned(), f64_text(f));
+            assert_eq!(ours.parse::<f64>().unwrap(), f, "{c:e}: {ours}");
+            assert_eq!(ours.parse::<f32>().unwrap(), c as f32, "{c:e}: {ours}");
+            assert!(!ours.contains('e') || std.contains('e'), "{c:e}: {ours}");
+            if ours != std {
+                // a halfway value: the same length, the last digit one apart
+                let (a, b) = (ours.as_bytes(), std.as_bytes());
+                assert_eq!(a.len(), b.len(), "{c:e}: {ours} against {std}");
+                assert_eq!(
+                    a[..a.len() - 1],
+                    b[..b.len() - 1],
+                    "{c:e}: {ours} against {std}"
+                );
+                assert_eq!(
+                    a[a.len() - 1].abs_diff(b[b.len() - 1]),
+                    1,
+                    "{c:e}: {ours} against {std}"
+                );
+                halfway += 1;
+            }
+        }
+        // about 1 % of f32 values are halfway at f64's 17th digit
+        assert!(
+            halfway > 0 && halfway * 20 < total,
+            "{halfway} halfway values of {total}"
+        );
+        for i in [0usize, 7, 10, 99, 12_345, 4_294_967_295] {
+            assert_eq!(num.index(i), i.to_string());
+        }
     }
 
     fn tetra(x: f64) -> Mesh {
