@@ -29,6 +29,29 @@ impl Stack {
         i: usize,
         tol: ChordTolerance,
     ) -> Result<Solid, crate::geometry::GeometryError> {
+        Solid::from_mesh(&self.layer_mesh(si, i, tol)?)
+    }
+
+    /// The volume of [`Self::layer_solid`], mm^3, from its mesh (without building the solid).
+    ///
+    /// # Errors
+    /// On a profile the revolve refuses.
+    pub fn layer_volume_mm3(
+        &self,
+        si: &StackInput<'_>,
+        i: usize,
+        tol: ChordTolerance,
+    ) -> Result<f64, crate::geometry::GeometryError> {
+        Ok(self.layer_mesh(si, i, tol)?.signed_volume())
+    }
+
+    /// The closed mesh [`Self::layer_solid`] is built from.
+    fn layer_mesh(
+        &self,
+        si: &StackInput<'_>,
+        i: usize,
+        tol: ChordTolerance,
+    ) -> Result<crate::geometry::Mesh, crate::geometry::GeometryError> {
         let l = &self.layers[i];
         let body = si.ctx.body;
         let mesh = if l.solid {
@@ -43,7 +66,7 @@ impl Stack {
                 tol,
             )?
         };
-        Solid::from_mesh(&mesh)
+        Ok(mesh)
     }
 }
 

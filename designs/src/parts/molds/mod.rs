@@ -138,11 +138,10 @@ fn build_mold_parts(
             .iter()
             .map(|&i| {
                 if features.is_empty() {
-                    stack.layer_solid(si, i, tol)
+                    stack.layer_volume_mm3(si, i, tol)
                 } else {
-                    crate::parts::layers::layer_solid(si, stack, i, tol)
+                    crate::parts::layers::layer_solid(si, stack, i, tol).map(|s| s.volume())
                 }
-                .map(|s| s.volume())
             })
             .sum::<Result<f64, _>>()
             .part(name)?;
