@@ -54,7 +54,7 @@ impl Stack {
     ) -> Result<crate::geometry::Mesh, crate::geometry::GeometryError> {
         let l = &self.layers[i];
         let body = si.ctx.body;
-        let mesh = if l.solid {
+        Ok(if l.solid {
             revolve(
                 &solid_layer_profile(body, l.outer_offset_mm, seat_of(si, i).as_ref(), tol.half()),
                 tol,
@@ -65,8 +65,7 @@ impl Stack {
                 &body.offset_polyline(l.inner_offset_mm, 0.0, tol.half()),
                 tol,
             )?
-        };
-        Ok(mesh)
+        })
     }
 }
 
