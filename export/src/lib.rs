@@ -43,6 +43,7 @@ pub mod step;
 mod stl;
 mod three_mf;
 pub mod two_d;
+mod zip_package;
 
 pub use atomic::{check_out_dir, free_bytes, OutputClaim, OutputCommand, StagedDir, OUTPUT_MARKER};
 pub use check::check_printable_mesh;
@@ -528,6 +529,7 @@ fn assembly_3mf(
                 ),
                 ("description", m.description.clone()),
             ],
+            mesh_deflated: None,
         })
         .collect();
     let metadata = package_metadata(

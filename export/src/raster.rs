@@ -36,12 +36,25 @@ pub fn npz(arrays: &[(&str, &[u8])]) -> Result<Vec<u8>, ExportError> {
                 "array name '{name}' must be [A-Za-z0-9_]+ and unique"
             )));
         }
-        let opts = crate::three_mf::zip_entry_options(bytes.len());
+        let opts = zip_entry_options(bytes.len());
         zip.start_file(format!("{name}.npy"), opts)
             .map_err(|e| err(e.to_string()))?;
         zip.write_all(bytes).map_err(|e| err(e.to_string()))?;
     }
     Ok(zip.finish().map_err(|e| err(e.to_string()))?.into_inner())
+}
+
+/// The options of every NPZ entry: deflated at level 4 (as the 3MF packages,
+/// [`crate::zip_package`]), a fixed timestamp and Unix mode 0644, so the same bytes go in and
+/// come out; ZIP64 when an entry of `len` bytes needs it.
+fn zip_entry_options(len: usize) -> zip::write::SimpleFileOptions {
+    zip::write::SimpleFileOptions::default()
+        .compression_method(zip::CompressionMethod::Deflated)
+        .compression_level(Some(4))
+        .last_modified_time(zip::DateTime::default())
+        .system(zip::System::Unix)
+        .unix_permissions(0o644)
+        .large_file(len as u64 >= u64::from(u32::MAX))
 }
 
 /// A float32 array as an NPY file (format version 1.0, little endian `<f4`, C order): what

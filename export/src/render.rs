@@ -6,6 +6,7 @@
 
 use crate::layout::{self, Plate};
 use crate::section::SectionView;
+use crate::zip_package::Deflated;
 use crate::{
     assembly_3mf, bbox_of, check_printable_mesh, check_printable_meshes, html, package_metadata,
     part_entry, placed_objects, preview, product_name, raster, section, sha256_hex, sheet, step,
@@ -80,17 +81,23 @@ pub(crate) fn render(
     // made in parallel, then filed in this order. Each is deterministic, so the bytes do not
     // depend on the thread count.
     let t = fabkit_designs::timings::stage("kit 3MF, pictures and section view (in parallel)");
-    let ((assembly_made, kit_3mf_made), (plate_pngs, part_pngs)) = rayon::join(
+    let ((assembly_made, part_pngs), (kit_3mf_made, plate_pngs)) = rayon::join(
         || {
             rayon::join(
                 || assembly_section(kit, opts),
-                || kit_3mf(kit, meshes, &parts, &units, opts),
+                || part_pictures(kit, meshes, opts),
             )
         },
         || {
+            // each unit's mesh element deflated once, for the kit 3MF and its plate
+            let unit_meshes = match unit_meshes(kit, meshes, &units, opts) {
+                Ok(m) => m,
+                // reported as the kit 3MF's (filed first)
+                Err(e) => return (Err(e), Ok(Vec::new())),
+            };
             rayon::join(
-                || plate_files(kit, meshes, &plates, &units, opts),
-                || part_pictures(kit, meshes, opts),
+                || kit_3mf(kit, meshes, &parts, &units, &unit_meshes, opts),
+                || plate_files(kit, meshes, &plates, &units, &unit_meshes, opts),
             )
         },
     );
@@ -231,14 +238,34 @@ fn part_files(
     Ok(parts)
 }
 
+/// Each unit's `<mesh>` element deflated (in parallel), when 3MF is written: the kit 3MF and
+/// the unit's plate hold the same element.
+fn unit_meshes(
+    kit: &Kit,
+    meshes: &[Mesh],
+    units: &[Vec<usize>],
+    opts: &ExportOptions,
+) -> Result<Vec<Deflated>, ExportError> {
+    use rayon::prelude::*;
+    if !opts.formats.threemf {
+        return Ok(Vec::new());
+    }
+    units
+        .par_iter()
+        .map(|u| three_mf::mesh_deflated(&unit_object(kit, meshes, u, [0.0; 3], false, None)))
+        .collect()
+}
+
 /// A unit's 3MF object: its parts (`members`, indices into the kit's parts) as volumes, with
-/// their role, material and technology, at translation `t`, turned or not.
+/// their role, material and technology, at translation `t`, turned or not; its mesh element
+/// deflated beforehand when given.
 fn unit_object<'m>(
     kit: &'m Kit,
     meshes: &'m [Mesh],
     members: &[usize],
     t: [f64; 3],
     turned: bool,
+    mesh_deflated: Option<&'m Deflated>,
 ) -> three_mf::Object<'m> {
     let first = &kit.parts[members[0]];
     let joined = |f: &dyn Fn(&fabkit_designs::kit::Part) -> String| {
@@ -272,6 +299,7 @@ fn unit_object<'m>(
             ("material", joined(&|p| p.material.clone())),
             ("technology", joined(&|p| p.print_technology.to_string())),
         ],
+        mesh_deflated,
     }
 }
 
@@ -281,6 +309,7 @@ fn kit_3mf<'m>(
     meshes: &'m [Mesh],
     parts: &[ManifestPart],
     units: &[Vec<usize>],
+    unit_meshes: &[Deflated],
     opts: &ExportOptions,
 ) -> Result<Kit3mf<'m>, ExportError> {
     if !opts.formats.threemf {
@@ -288,10 +317,17 @@ fn kit_3mf<'m>(
     }
     let boxes: Vec<_> = parts.iter().map(|p| p.bbox_mm).collect();
     let translations = layout::pack_units(&boxes, units, layout::ROW_WIDTH_MM, layout::GAP_MM);
-    let objects: Vec<three_mf::Object<'_>> = units
+    let objects: Vec<three_mf::Object<'m>> = units
         .iter()
         .zip(&translations)
-        .map(|(members, t)| unit_object(kit, meshes, members, *t, false))
+        .map(|(members, t)| unit_object(kit, meshes, members, *t, false, None))
+        .collect();
+    // the same objects with their mesh elements deflated beforehand, for the package
+    let packaged: Vec<three_mf::Object<'_>> = units
+        .iter()
+        .zip(&translations)
+        .zip(unit_meshes)
+        .map(|((members, t), d)| unit_object(kit, meshes, members, *t, false, Some(d)))
         .collect();
     let metadata = package_metadata(
         format!("fabkit kit {}", kit.design),
@@ -311,7 +347,7 @@ fn kit_3mf<'m>(
             kit.design
         ))
     };
-    let (bytes, _) = three_mf::encode_drawn(&objects, &metadata, Some(thumbnail))?;
+    let (bytes, _) = three_mf::encode_drawn(&packaged, &metadata, Some(thumbnail))?;
     Ok(Some((objects, bytes)))
 }
 
@@ -363,6 +399,7 @@ fn plate_files<'m>(
     meshes: &'m [Mesh],
     plates: &[Plate],
     units: &[Vec<usize>],
+    unit_meshes: &[Deflated],
     opts: &ExportOptions,
 ) -> Result<PlateFiles<'m>, ExportError> {
     use rayon::prelude::*;
@@ -401,13 +438,26 @@ fn plate_files<'m>(
                     plate.technology, plate.number, kit.design, plate.material, plate.bed.name
                 ))
             };
-            let objects: Vec<three_mf::Object<'_>> = plate
+            let object = |it: &layout::PlateItem, d| {
+                let u = &units[it.unit];
+                unit_object(kit, meshes, u, it.translation_mm, it.turned, d)
+            };
+            // with their mesh elements deflated beforehand for the package
+            let packaged: Vec<three_mf::Object<'_>> = plate
                 .items
                 .iter()
-                .map(|it| unit_object(kit, meshes, &units[it.unit], it.translation_mm, it.turned))
+                .map(|it| object(it, unit_meshes.get(it.unit)))
                 .collect();
             let (bytes, png) =
-                three_mf::encode_drawn(&objects, &plate_metadata(kit, plate, opts), Some(png))?;
+                three_mf::encode_drawn(&packaged, &plate_metadata(kit, plate, opts), Some(png))?;
+            let objects: Vec<three_mf::Object<'m>> = plate
+                .items
+                .iter()
+                .map(|it| {
+                    let u = &units[it.unit];
+                    unit_object(kit, meshes, u, it.translation_mm, it.turned, None)
+                })
+                .collect();
             Ok((png.unwrap_or_default(), bytes, objects))
         })
         .collect()
