@@ -529,7 +529,6 @@ fn assembly_3mf(
                 ),
                 ("description", m.description.clone()),
             ],
-            mesh_deflated: None,
         })
         .collect();
     let metadata = package_metadata(

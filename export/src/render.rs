@@ -252,20 +252,18 @@ fn unit_meshes(
     }
     units
         .par_iter()
-        .map(|u| three_mf::mesh_deflated(&unit_object(kit, meshes, u, [0.0; 3], false, None)))
+        .map(|u| three_mf::mesh_deflated(&unit_object(kit, meshes, u, [0.0; 3], false)))
         .collect()
 }
 
 /// A unit's 3MF object: its parts (`members`, indices into the kit's parts) as volumes, with
-/// their role, material and technology, at translation `t`, turned or not; its mesh element
-/// deflated beforehand when given.
+/// their role, material and technology, at translation `t`, turned or not.
 fn unit_object<'m>(
     kit: &'m Kit,
     meshes: &'m [Mesh],
     members: &[usize],
     t: [f64; 3],
     turned: bool,
-    mesh_deflated: Option<&'m Deflated>,
 ) -> three_mf::Object<'m> {
     let first = &kit.parts[members[0]];
     let joined = |f: &dyn Fn(&fabkit_designs::kit::Part) -> String| {
@@ -299,7 +297,6 @@ fn unit_object<'m>(
             ("material", joined(&|p| p.material.clone())),
             ("technology", joined(&|p| p.print_technology.to_string())),
         ],
-        mesh_deflated,
     }
 }
 
@@ -317,17 +314,10 @@ fn kit_3mf<'m>(
     }
     let boxes: Vec<_> = parts.iter().map(|p| p.bbox_mm).collect();
     let translations = layout::pack_units(&boxes, units, layout::ROW_WIDTH_MM, layout::GAP_MM);
-    let objects: Vec<three_mf::Object<'m>> = units
+    let objects: Vec<three_mf::Object<'_>> = units
         .iter()
         .zip(&translations)
-        .map(|(members, t)| unit_object(kit, meshes, members, *t, false, None))
-        .collect();
-    // the same objects with their mesh elements deflated beforehand, for the package
-    let packaged: Vec<three_mf::Object<'_>> = units
-        .iter()
-        .zip(&translations)
-        .zip(unit_meshes)
-        .map(|((members, t), d)| unit_object(kit, meshes, members, *t, false, Some(d)))
+        .map(|(members, t)| unit_object(kit, meshes, members, *t, false))
         .collect();
     let metadata = package_metadata(
         format!("fabkit kit {}", kit.design),
@@ -347,7 +337,8 @@ fn kit_3mf<'m>(
             kit.design
         ))
     };
-    let (bytes, _) = three_mf::encode_drawn(&packaged, &metadata, Some(thumbnail))?;
+    let premade: Vec<&Deflated> = unit_meshes.iter().collect();
+    let (bytes, _) = three_mf::encode_drawn(&objects, &premade, &metadata, Some(thumbnail))?;
     Ok(Some((objects, bytes)))
 }
 
@@ -438,26 +429,27 @@ fn plate_files<'m>(
                     plate.technology, plate.number, kit.design, plate.material, plate.bed.name
                 ))
             };
-            let object = |it: &layout::PlateItem, d| {
-                let u = &units[it.unit];
-                unit_object(kit, meshes, u, it.translation_mm, it.turned, d)
-            };
-            // with their mesh elements deflated beforehand for the package
-            let packaged: Vec<three_mf::Object<'_>> = plate
-                .items
-                .iter()
-                .map(|it| object(it, unit_meshes.get(it.unit)))
-                .collect();
-            let (bytes, png) =
-                three_mf::encode_drawn(&packaged, &plate_metadata(kit, plate, opts), Some(png))?;
-            let objects: Vec<three_mf::Object<'m>> = plate
+            let objects: Vec<three_mf::Object<'_>> = plate
                 .items
                 .iter()
                 .map(|it| {
                     let u = &units[it.unit];
-                    unit_object(kit, meshes, u, it.translation_mm, it.turned, None)
+                    unit_object(kit, meshes, u, it.translation_mm, it.turned)
                 })
                 .collect();
+            // each item's mesh element as deflated for the kit 3MF
+            let premade: Vec<&Deflated> = plate
+                .items
+                .iter()
+                .map(|it| unit_meshes.get(it.unit))
+                .collect::<Option<_>>()
+                .unwrap_or_default();
+            let (bytes, png) = three_mf::encode_drawn(
+                &objects,
+                &premade,
+                &plate_metadata(kit, plate, opts),
+                Some(png),
+            )?;
             Ok((png.unwrap_or_default(), bytes, objects))
         })
         .collect()

@@ -153,10 +153,6 @@ pub(crate) struct Object<'a> {
     /// Object metadata in the `fabkit:` namespace ([`FABKIT_NS`]): (key, value), e.g.
     /// (`role`, `mold_half`); keys unique.
     pub metadata: Vec<(&'static str, String)>,
-    /// The object's `<mesh>` element ([`mesh_xml`] of its volumes) already deflated, when
-    /// another package holds the same element (a part in the kit 3MF and on its plate);
-    /// `None`: deflated with the package.
-    pub mesh_deflated: Option<&'a Deflated>,
 }
 
 /// The namespace of fabkit's object metadata (`fabkit:role`, `fabkit:material`,
@@ -363,6 +359,7 @@ pub(crate) fn encode(
 ) -> Result<Vec<u8>, ExportError> {
     encode_drawn(
         objects,
+        &[],
         metadata,
         None::<fn() -> Result<Vec<u8>, ExportError>>,
     )
@@ -375,41 +372,49 @@ pub(crate) fn encode(
 /// type declared); deflated at level 4, every entry dated 1980-01-01 00:00:00 with host system
 /// Unix and mode 0644, so the bytes depend only on the input (and the deflate implementation).
 /// The model is deflated in pieces ([`crate::zip_package`]): each object's `<mesh>` element
-/// on its own, or taken from [`Object::mesh_deflated`], and the text between them. The
-/// thumbnail (PNG bytes) is drawn by `thumbnail` while the model is written and deflated (it
-/// is the package's last entry), and returned with the package.
+/// on its own, and the text between them. `premade` is empty, or holds every object's
+/// [`mesh_deflated`] made beforehand (when another package holds the same elements: a part in
+/// the kit 3MF and on its plate). The thumbnail (PNG bytes) is drawn by `thumbnail` while the
+/// model is written and deflated (it is the package's last entry), and returned with the
+/// package.
 ///
 /// # Errors
-/// [`ExportError::ThreeMf`] if the deflater fails or the package has too many entries; the
-/// thumbnail's own error first.
+/// [`ExportError::ThreeMf`] if the deflater fails, the package has too many entries or
+/// `premade` is neither empty nor one per object; the thumbnail's own error first.
 pub(crate) fn encode_drawn<F>(
     objects: &[Object<'_>],
+    premade: &[&Deflated],
     metadata: &[(&str, String)],
     thumbnail: Option<F>,
 ) -> Result<(Vec<u8>, Option<Vec<u8>>), ExportError>
 where
     F: FnOnce() -> Result<Vec<u8>, ExportError> + Send,
 {
+    if !premade.is_empty() && premade.len() != objects.len() {
+        return Err(ExportError::ThreeMf {
+            reason: format!(
+                "{} deflated meshes for {} objects",
+                premade.len(),
+                objects.len()
+            ),
+        });
+    }
     let with_thumbnail = thumbnail.is_some();
     let (entries, png) = rayon::join(
-        || model_entries(objects, metadata, with_thumbnail),
+        || model_entries(objects, premade.is_empty(), metadata, with_thumbnail),
         || thumbnail.map(|f| f()),
     );
     // the thumbnail's error first, as when it is drawn before the package
     let png = png.transpose()?;
     let entries = entries?;
     let png_deflated = png.as_deref().map(Deflated::of).transpose()?;
-    let own = &entries.own_meshes;
+    let meshes: Vec<&Deflated> = if premade.is_empty() {
+        entries.meshes.iter().collect()
+    } else {
+        premade.to_vec()
+    };
     let mut model: Vec<&Deflated> = vec![&entries.texts[0]];
-    let mut next_own = 0;
-    for (o, text) in objects.iter().zip(&entries.texts[1..]) {
-        let mesh = match o.mesh_deflated {
-            Some(d) => d,
-            None => {
-                next_own += 1;
-                &own[next_own - 1]
-            }
-        };
+    for (mesh, text) in meshes.into_iter().zip(&entries.texts[1..]) {
         model.extend([mesh, text]);
     }
     let mut parts: Vec<(&str, Vec<&Deflated>)> = vec![
@@ -427,23 +432,25 @@ where
 }
 
 /// A package's entries up to the thumbnail, deflated: content types and relationships
-/// (naming the thumbnail when asked), the model's texts and the meshes of the objects without
-/// [`Object::mesh_deflated`] (in object order), and PrusaSlicer's config.
+/// (naming the thumbnail when asked), the model's texts, the objects' meshes (in object order;
+/// none when they were made beforehand) and PrusaSlicer's config.
 struct ModelEntries {
     content_types: Deflated,
     rels: Deflated,
     texts: Vec<Deflated>,
-    own_meshes: Vec<Deflated>,
+    meshes: Vec<Deflated>,
     config: Option<Deflated>,
 }
 
 fn model_entries(
     objects: &[Object<'_>],
+    with_meshes: bool,
     metadata: &[(&str, String)],
     with_thumbnail: bool,
 ) -> Result<ModelEntries, ExportError> {
     use rayon::prelude::*;
-    let content_types = if prusa_config_xml(objects).is_some() {
+    let config = prusa_config_xml(objects);
+    let content_types = if config.is_some() {
         CONTENT_TYPES_WITH_CONFIG
     } else {
         CONTENT_TYPES
@@ -459,11 +466,14 @@ fn model_entries(
         RELS
     };
     // the largest first: the meshes, each deflated in parallel pieces
-    let own_meshes = objects
-        .par_iter()
-        .filter(|o| o.mesh_deflated.is_none())
-        .map(mesh_deflated)
-        .collect::<Result<Vec<_>, _>>()?;
+    let meshes = if with_meshes {
+        objects
+            .par_iter()
+            .map(mesh_deflated)
+            .collect::<Result<Vec<_>, _>>()?
+    } else {
+        Vec::new()
+    };
     let texts = model_texts(objects, metadata)
         .iter()
         .map(|t| Deflated::of(t.as_bytes()))
@@ -472,10 +482,8 @@ fn model_entries(
         content_types: Deflated::of(content_types.as_bytes())?,
         rels: Deflated::of(rels.as_bytes())?,
         texts,
-        own_meshes,
-        config: prusa_config_xml(objects)
-            .map(|c| Deflated::of(c.as_bytes()))
-            .transpose()?,
+        meshes,
+        config: config.map(|c| Deflated::of(c.as_bytes())).transpose()?,
     })
 }
 
@@ -644,23 +652,22 @@ mod tests {
     fn a_mesh_deflated_beforehand_gives_the_same_package() {
         use std::io::Read;
         let (a, b) = (tetra(0.0), tetra(5.0));
-        let object = |mesh, name: &str, d| Object {
+        let object = |mesh, name: &str| Object {
             name: name.into(),
             group: None,
             volumes: vec![Volume { name: "x", mesh }],
             translation_mm: [1.0, 2.0, 0.0],
             turned: true,
             metadata: vec![("role", "mold & half".into())],
-            mesh_deflated: d,
         };
-        let plain = [object(&a, "a", None), object(&b, "b", None)];
-        let shared = mesh_deflated(&plain[1]).unwrap();
-        let given = [object(&a, "a", None), object(&b, "b", Some(&shared))];
+        let plain = [object(&a, "a"), object(&b, "b")];
+        let made: Vec<Deflated> = plain.iter().map(|o| mesh_deflated(o).unwrap()).collect();
         let meta = [("Title", "t <1>".to_owned())];
         let png = || Ok(vec![137u8, 80, 78, 71]);
-        let (bytes, _) = encode_drawn(&plain, &meta, Some(png)).unwrap();
-        let (again, thumb) = encode_drawn(&given, &meta, Some(png)).unwrap();
+        let (bytes, _) = encode_drawn(&plain, &[], &meta, Some(png)).unwrap();
+        let (again, thumb) = encode_drawn(&plain, &[&made[0], &made[1]], &meta, Some(png)).unwrap();
         assert_eq!(bytes, again);
+        assert!(encode_drawn(&plain, &[&made[0]], &meta, Some(png)).is_err());
         assert_eq!(thumb.as_deref(), Some(&[137u8, 80, 78, 71][..]));
         let mut zip = zip::ZipArchive::new(std::io::Cursor::new(&bytes)).unwrap();
         let mut model = String::new();
@@ -695,7 +702,6 @@ mod tests {
                 translation_mm: [1.0, 2.0, 0.0],
                 turned: false,
                 metadata: Vec::new(),
-                mesh_deflated: None,
             },
             Object {
                 name: "a+b".into(),
@@ -713,7 +719,6 @@ mod tests {
                 translation_mm: [0.5, 0.0, 0.0],
                 turned: false,
                 metadata: Vec::new(),
-                mesh_deflated: None,
             },
         ];
         assert_eq!(objects[1].triangle_ranges(), [(0, 3), (4, 7)]);

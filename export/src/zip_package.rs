@@ -48,13 +48,10 @@ impl Deflated {
     /// [`ExportError::ThreeMf`] if the deflater fails (it writes to memory).
     pub(crate) fn of(text: &[u8]) -> Result<Deflated, ExportError> {
         use rayon::prelude::*;
-        let pieces: Vec<Vec<u8>> = if text.len() <= PIECE_BYTES {
-            vec![deflate_piece(text)?]
-        } else {
-            text.par_chunks(PIECE_BYTES)
-                .map(deflate_piece)
-                .collect::<Result<_, _>>()?
-        };
+        let pieces: Vec<Vec<u8>> = text
+            .par_chunks(PIECE_BYTES)
+            .map(deflate_piece)
+            .collect::<Result<_, _>>()?;
         Ok(Deflated {
             data: pieces.concat(),
             crc32: crc32fast::hash(text),
