@@ -29,7 +29,9 @@ fn export_step(cwd: &Path, out: &str, python: &Path) -> serde_json::Value {
 /// to the member's mesh volume within the chord-tolerance bound (surface area x tolerance), in
 /// the sensor frame: the collar's top face on the body's base plane z = -6 mm, the diffuser
 /// between the collar (z = -9) and the tube (z = -11), the base below the tube. The manifest
-/// records the file's sha256, and a second export writes the same bytes. The reader also sews
+/// records the file's sha256, and a second export writes the same bytes. The first export is
+/// the twins' shared one of R-Tac0 ([`crate::cad_twins::shared_step_export`]: `--format
+/// stl,3mf,step`, whose STEP files are those of `--format step`). The reader also sews
 /// an octahedron through fabkit's mesh-sewing path (members without an exact shape).
 #[test]
 fn assembly_step_of_rtac0_has_one_valid_solid_per_member_in_the_sensor_frame() {
@@ -38,8 +40,10 @@ fn assembly_step_of_rtac0_has_one_valid_solid_per_member_in_the_sensor_frame() {
         return;
     };
     let t = tempfile::tempdir().unwrap();
-    let m = export_step(t.path(), "a", &python);
-    let bytes = std::fs::read(t.path().join("a/assembly.step")).unwrap();
+    let shared = crate::cad_twins::shared_step_export("rtac0").expect("CadQuery is set");
+    let m: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(shared.join("manifest.json")).unwrap()).unwrap();
+    let bytes = std::fs::read(shared.join("assembly.step")).unwrap();
     assert!(bytes.starts_with(b"ISO-10303-21;"));
     let a = &m["assembly_step"];
     assert_eq!(a["file"], "assembly.step");
@@ -57,7 +61,7 @@ fn assembly_step_of_rtac0_has_one_valid_solid_per_member_in_the_sensor_frame() {
 
     let o = std::process::Command::new(&python)
         .arg(repo_root().join("tests/oracles/read_assembly_step.py"))
-        .arg(t.path().join("a/assembly.step"))
+        .arg(shared.join("assembly.step"))
         .output()
         .expect("the CadQuery python runs");
     assert!(

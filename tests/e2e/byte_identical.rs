@@ -201,8 +201,10 @@ fn outputs_are_byte_identical_to_the_committed_hashes() {
 
 /// In the suite (so in CI, where `FABKIT_CADQUERY_PYTHON` is set): the STEP files of the
 /// default design's export against their lines of the committed STEP list. The whole list
-/// takes about 4 minutes and is run by hand; R-Tac0's export takes about 10 s, and OCCT writes
-/// its files the same every run (four runs measured, and four more with parallel booleans). The pin dome's `pin_dome.step` (fixtures) is
+/// takes about 4 minutes and is run by hand; R-Tac0's export is the twins' shared one
+/// ([`crate::cad_twins::shared_step_export`]), and OCCT writes its files the same every run
+/// (four runs measured, and four more with parallel booleans). The pin dome's `pin_dome.step`
+/// (fixtures) is
 /// not held to it: OCCT writes its compound of many holes differently from run to run (one run
 /// in three measured), as it does the TacTip's `skin_tips`.
 #[test]
@@ -214,15 +216,17 @@ fn the_default_designs_step_files_are_byte_identical_to_the_committed_hashes() {
     if !on_listed_platform(STEP_LIST) {
         return;
     }
-    let dir = tempfile::tempdir().unwrap();
+    // R-Tac0's STEP export of the twins' shared exports (`--format stl,3mf,step`: the same
+    // STEP files as `--format step`, whose hashes the list holds under `export/rtac0/`)
     let out = "export/rtac0";
-    fabkit_on_path(
-        dir.path(),
-        &["export", "rtac0", "--format", "step", "--out", out],
-    );
-    let mut hashes = BTreeMap::new();
-    hash_tree(dir.path(), &dir.path().join(out), &mut hashes);
-    hashes.retain(|f, _| f.ends_with(".step"));
+    let shared = crate::cad_twins::shared_step_export("rtac0").expect("CadQuery is set");
+    let mut found = BTreeMap::new();
+    hash_tree(shared, shared, &mut found);
+    let hashes: BTreeMap<String, String> = found
+        .into_iter()
+        .filter(|(f, _)| f.ends_with(".step"))
+        .map(|(f, h)| (format!("{out}/{f}"), h))
+        .collect();
     let committed = std::fs::read_to_string(repo_root().join(STEP_LIST)).unwrap();
     let listed: BTreeMap<String, String> = committed
         .lines()

@@ -125,6 +125,21 @@ fn shared_exports() -> (&'static Path, &'static [PathBuf]) {
     (dir, exports)
 }
 
+/// The folder of the shared export of case `name` (one of [`CASES`]) when it holds STEP files
+/// (the CadQuery Python is set; `None` without it), waiting for the shared exports if they are
+/// being made: the tests that read a design's STEP files take them from here, so that each
+/// design's STEP export is made once per run, not once per test.
+pub(crate) fn shared_step_export(name: &str) -> Option<&'static Path> {
+    cadquery_python()?;
+    let (_, exports) = shared_exports();
+    let found = exports
+        .iter()
+        .find(|d| d.file_name().is_some_and(|n| n == name))
+        .map(PathBuf::as_path);
+    assert!(found.is_some(), "{name} is no case of the shared exports");
+    found
+}
+
 fn report_dir() -> PathBuf {
     let d = std::env::var_os("FABKIT_TWIN_REPORT_DIR")
         .map(PathBuf::from)

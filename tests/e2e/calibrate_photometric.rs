@@ -62,8 +62,7 @@ fn captures(dir: &Path) -> Vec<String> {
 
 /// [`captures`] rendered with the design `design`.
 fn captures_in(dir: &Path, design: &str) -> Vec<String> {
-    let o = pin_captures_in(dir, design, "fx", "caps", "png");
-    assert!(o.status.success(), "{}", text(&o.stderr));
+    render_caps(dir, design);
     std::fs::copy(dir.join("caps/reference/image.png"), dir.join("ref.png")).unwrap();
     let m: serde_json::Value =
         serde_json::from_slice(&std::fs::read(dir.join("caps/manifest.json")).unwrap()).unwrap();
@@ -79,6 +78,68 @@ fn captures_in(dir: &Path, design: &str) -> Vec<String> {
         names.push(name);
     }
     names
+}
+
+/// The pin captures of `design` (a library name or a design file in `dir`) with `dir`'s camera,
+/// extrinsics and fixtures `fx`, in `dir/caps` ([`pin_captures_in`]), rendered once per run for
+/// each distinct set of those inputs (most tests [`setup`] the same folder): the first test to
+/// need them renders them and keeps a copy in `<target>/tmp/shared-pin-captures`, the others
+/// copy it (each render took about 1.5 s).
+fn render_caps(dir: &Path, design: &str) {
+    use sha2::{Digest, Sha256};
+    use std::sync::{Arc, Mutex, OnceLock};
+    type Renders = Mutex<std::collections::BTreeMap<String, Arc<OnceLock<std::path::PathBuf>>>>;
+    static RENDERS: OnceLock<Renders> = OnceLock::new();
+    let mut h = Sha256::new();
+    h.update(design.as_bytes());
+    h.update([0]);
+    for input in [design, "cam.yaml", "extrinsics.json"] {
+        let bytes = std::fs::read(dir.join(input)).unwrap_or_default();
+        h.update((bytes.len() as u64).to_le_bytes());
+        h.update(&bytes);
+    }
+    for (path, bytes) in snapshot(&dir.join("fx")) {
+        h.update(path.as_bytes());
+        h.update([0]);
+        h.update((bytes.len() as u64).to_le_bytes());
+        h.update(&bytes);
+    }
+    let key: String = h.finalize()[..8]
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect();
+    let renders = RENDERS.get_or_init(|| {
+        let root = Path::new(env!("CARGO_TARGET_TMPDIR")).join("shared-pin-captures");
+        if root.exists() {
+            std::fs::remove_dir_all(&root).expect("the previous run's captures removed");
+        }
+        Mutex::default()
+    });
+    let cell = renders
+        .lock()
+        .unwrap()
+        .entry(key.clone())
+        .or_default()
+        .clone();
+    let mut rendered_here = false;
+    let shared = cell.get_or_init(|| {
+        let o = pin_captures_in(dir, design, "fx", "caps", "png");
+        assert!(o.status.success(), "{}", text(&o.stderr));
+        rendered_here = true;
+        let shared = Path::new(env!("CARGO_TARGET_TMPDIR"))
+            .join("shared-pin-captures")
+            .join(&key);
+        std::fs::create_dir_all(shared.parent().unwrap()).unwrap();
+        copy_tree(&dir.join("caps"), &shared);
+        shared
+    });
+    if !rendered_here {
+        let caps = dir.join("caps");
+        if caps.exists() {
+            std::fs::remove_dir_all(&caps).unwrap();
+        }
+        copy_tree(shared, &caps);
+    }
 }
 
 #[test]

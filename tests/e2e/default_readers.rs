@@ -130,29 +130,21 @@ fn csv_ply_stl_and_step_open_in_default_readers_with_default_arguments() {
         .collect();
     assert!(!ply.is_empty());
 
-    // export: STL headers always; STEP product names with the CadQuery python
-    let python = cadquery_python();
-    let formats = if python.is_some() {
-        "stl,3mf,step"
-    } else {
-        eprintln!("SKIPPED: STEP product names (set FABKIT_CADQUERY_PYTHON)");
-        "stl,3mf"
+    // export: STL headers always; STEP product names with the CadQuery python, from the twins'
+    // shared export of R-Tac0 (`--format stl,3mf,step`)
+    let export = match crate::cad_twins::shared_step_export("rtac0") {
+        Some(shared) => shared.to_path_buf(),
+        None => {
+            eprintln!("SKIPPED: STEP product names (set FABKIT_CADQUERY_PYTHON)");
+            let o = run(
+                d,
+                &["export", "rtac0", "--format", "stl,3mf", "--out", "ex"],
+                &[],
+            );
+            assert!(o.status.success(), "{}{}", text(&o.stdout), text(&o.stderr));
+            d.join("ex")
+        }
     };
-    let py = python
-        .as_ref()
-        .map(|p| p.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let envs: Vec<(&str, &str)> = if python.is_some() {
-        vec![("FABKIT_CADQUERY_PYTHON", py.as_str())]
-    } else {
-        vec![]
-    };
-    let o = run(
-        d,
-        &["export", "rtac0", "--format", formats, "--out", "ex"],
-        &envs,
-    );
-    assert!(o.status.success(), "{}{}", text(&o.stdout), text(&o.stderr));
 
-    default_readers_check(d, &json!({"csv": csvs, "ply": ply, "export": d.join("ex")}));
+    default_readers_check(d, &json!({"csv": csvs, "ply": ply, "export": export}));
 }

@@ -11,26 +11,45 @@ use fabkit_calibration::nalgebra::Vector2;
 use fabkit_calibration::synthetic::benchmark_intrinsics;
 use fabkit_calibration::{write_camera, CameraFileFormat, CameraModel};
 
+/// The output of `fabkit fixtures rtac0 --pins-preset rtac0 --semidomes 2 --seed 3 --format stl
+/// --out fx`, made once per test run (in `<target>/tmp/shared-pin-fixtures`, emptied first) for
+/// the tests that [`setup`] a folder with it: about 30 tests took it, 0.45 s each.
+fn shared_pin_fixtures() -> &'static Path {
+    static FX: std::sync::OnceLock<std::path::PathBuf> = std::sync::OnceLock::new();
+    FX.get_or_init(|| {
+        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("shared-pin-fixtures");
+        if dir.exists() {
+            std::fs::remove_dir_all(&dir).expect("the previous run's fixtures removed");
+        }
+        std::fs::create_dir_all(&dir).unwrap();
+        let o = run(
+            &dir,
+            &[
+                "fixtures",
+                "rtac0",
+                "--pins-preset",
+                "rtac0",
+                "--semidomes",
+                "2",
+                "--seed",
+                "3",
+                "--format",
+                "stl",
+                "--out",
+                "fx",
+            ],
+            &[],
+        );
+        assert!(o.status.success(), "{}", text(&o.stderr));
+        dir.join("fx")
+    })
+}
+
+/// Prepares `dir` for a ground-truth run of R-Tac0: the fixtures folder `fx` (a copy of
+/// [`shared_pin_fixtures`]: two semi-dome patterns and the pin dome), the benchmark camera
+/// `cam.yaml` and `extrinsics.json`.
 pub(crate) fn setup(dir: &Path) {
-    let o = run(
-        dir,
-        &[
-            "fixtures",
-            "rtac0",
-            "--pins-preset",
-            "rtac0",
-            "--semidomes",
-            "2",
-            "--seed",
-            "3",
-            "--format",
-            "stl",
-            "--out",
-            "fx",
-        ],
-        &[],
-    );
-    assert!(o.status.success(), "{}", text(&o.stderr));
+    copy_tree(shared_pin_fixtures(), &dir.join("fx"));
     std::fs::write(
         dir.join("cam.yaml"),
         write_camera(&benchmark_intrinsics(), CameraFileFormat::OpenCvYaml),
