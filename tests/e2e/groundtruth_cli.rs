@@ -13,7 +13,7 @@ use fabkit_calibration::{write_camera, CameraFileFormat, CameraModel};
 
 /// The output of `fabkit fixtures rtac0 --pins-preset rtac0 --semidomes 2 --seed 3 --format stl
 /// --out fx`, made once per test run (in `<target>/tmp/shared-pin-fixtures`, emptied first) for
-/// the tests that [`setup`] a folder with it: about 30 tests took it, 0.45 s each.
+/// the tests that [`setup`] a folder with it (22 runs of the suite made it, 0.45 s each).
 fn shared_pin_fixtures() -> &'static Path {
     static FX: std::sync::OnceLock<std::path::PathBuf> = std::sync::OnceLock::new();
     FX.get_or_init(|| {
