@@ -6,7 +6,9 @@
 //! The Markdown report (one row per part) goes to `$FABKIT_TWIN_REPORT_DIR` (default
 //! `<temp dir>/fabkit-twins`), outside the repository; any row out of bounds fails the test.
 
-use crate::common::{cadquery_python, fabkit, missing, oracle_python, repo_root, run, text};
+use crate::common::{
+    cadquery_python, fabkit, missing, oracle_python, repo_root, run, shared_dir, text,
+};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -109,11 +111,7 @@ fn export_all(dir: &Path, extra: &[&str]) -> Vec<PathBuf> {
 fn shared_exports() -> (&'static Path, &'static [PathBuf]) {
     static EXPORTS: std::sync::OnceLock<(PathBuf, Vec<PathBuf>)> = std::sync::OnceLock::new();
     let (dir, exports) = EXPORTS.get_or_init(|| {
-        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("cad_twins-exports");
-        if dir.exists() {
-            std::fs::remove_dir_all(&dir).expect("the previous run's exports removed");
-        }
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = shared_dir("cad_twins-exports");
         let extra: &[&str] = if cadquery_python().is_some() {
             &["--format", "stl,3mf,step"]
         } else {

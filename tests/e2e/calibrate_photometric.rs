@@ -88,7 +88,10 @@ fn captures_in(dir: &Path, design: &str) -> Vec<String> {
 fn render_caps(dir: &Path, design: &str) {
     use sha2::{Digest, Sha256};
     use std::sync::{Arc, Mutex, OnceLock};
-    type Renders = Mutex<std::collections::BTreeMap<String, Arc<OnceLock<std::path::PathBuf>>>>;
+    type Renders = (
+        std::path::PathBuf,
+        Mutex<std::collections::BTreeMap<String, Arc<OnceLock<std::path::PathBuf>>>>,
+    );
     static RENDERS: OnceLock<Renders> = OnceLock::new();
     let mut h = Sha256::new();
     h.update(design.as_bytes());
@@ -108,13 +111,8 @@ fn render_caps(dir: &Path, design: &str) {
         .iter()
         .map(|b| format!("{b:02x}"))
         .collect();
-    let renders = RENDERS.get_or_init(|| {
-        let root = Path::new(env!("CARGO_TARGET_TMPDIR")).join("shared-pin-captures");
-        if root.exists() {
-            std::fs::remove_dir_all(&root).expect("the previous run's captures removed");
-        }
-        Mutex::default()
-    });
+    let (root, renders) =
+        RENDERS.get_or_init(|| (shared_dir("shared-pin-captures"), Mutex::default()));
     let cell = renders
         .lock()
         .unwrap()
@@ -126,10 +124,7 @@ fn render_caps(dir: &Path, design: &str) {
         let o = pin_captures_in(dir, design, "fx", "caps", "png");
         assert!(o.status.success(), "{}", text(&o.stderr));
         rendered_here = true;
-        let shared = Path::new(env!("CARGO_TARGET_TMPDIR"))
-            .join("shared-pin-captures")
-            .join(&key);
-        std::fs::create_dir_all(shared.parent().unwrap()).unwrap();
+        let shared = root.join(&key);
         copy_tree(&dir.join("caps"), &shared);
         shared
     });

@@ -32,11 +32,7 @@ pub fn published_pin_dome(cwd: &Path, design: &str, out: &str) -> Output {
     if (design, out) == ("rtac0", "fx") {
         static SHARED: std::sync::OnceLock<(PathBuf, Output)> = std::sync::OnceLock::new();
         let (dir, o) = SHARED.get_or_init(|| {
-            let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("shared-published-pin-dome");
-            if dir.exists() {
-                std::fs::remove_dir_all(&dir).expect("the previous run's pin dome removed");
-            }
-            std::fs::create_dir_all(&dir).unwrap();
+            let dir = shared_dir("shared-published-pin-dome");
             let o = published_pin_dome_run(&dir, design, out);
             (dir.join(out), o)
         });
@@ -569,6 +565,19 @@ pub fn snapshot(dir: &std::path::Path) -> std::collections::BTreeMap<String, Vec
         }
     }
     files
+}
+
+/// `<target>/tmp/<name>`, emptied of a previous run's files: where an output that several tests
+/// read is made once per test run (called once, from the `OnceLock` that holds the output; a
+/// static is never dropped, so a temporary folder would outlive the run).
+pub fn shared_dir(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+    if dir.exists() {
+        std::fs::remove_dir_all(&dir)
+            .unwrap_or_else(|e| panic!("the previous run's {}: {e}", dir.display()));
+    }
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
 }
 
 /// Copies the folder `from` with everything in it to `to` (which must not exist): a test's own

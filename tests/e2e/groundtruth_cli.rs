@@ -17,11 +17,7 @@ use fabkit_calibration::{write_camera, CameraFileFormat, CameraModel};
 fn shared_pin_fixtures() -> &'static Path {
     static FX: std::sync::OnceLock<std::path::PathBuf> = std::sync::OnceLock::new();
     FX.get_or_init(|| {
-        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("shared-pin-fixtures");
-        if dir.exists() {
-            std::fs::remove_dir_all(&dir).expect("the previous run's fixtures removed");
-        }
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = shared_dir("shared-pin-fixtures");
         let o = run(
             &dir,
             &[
