@@ -17,6 +17,7 @@ pub use crate::build::AssemblyScope;
 use crate::error::{DesignError, GeometryContext, ParamError, ParamErrors};
 use crate::geometry::{revolve, ChordTolerance, GeometryError, Solid};
 use crate::parts::context::Stack;
+use crate::parts::layers::SharedFeatureSolids;
 use crate::parts::registry::FAMILIES;
 use crate::parts::Part;
 pub use crate::parts::{ExactShape, FeatureKey, Member, MemberFeatures, MemberKind};
@@ -101,7 +102,13 @@ pub fn members(
     tol: ChordTolerance,
 ) -> Result<Vec<Member>, DesignError> {
     let mut out = printed_members(parts);
-    out.extend(unprinted_members(design, stack, tol, AssemblyScope::Whole)?);
+    out.extend(unprinted_members(
+        design,
+        stack,
+        tol,
+        AssemblyScope::Whole,
+        None,
+    )?);
     Ok(out)
 }
 
@@ -117,9 +124,10 @@ pub fn unprinted_members(
     stack: &Stack,
     tol: ChordTolerance,
     scope: AssemblyScope,
+    shared: Option<&SharedFeatureSolids>,
 ) -> Result<Vec<Member>, DesignError> {
     let mut out = Vec::new();
-    push_cast_layers(&mut out, design, stack, tol, scope)?;
+    push_cast_layers(&mut out, design, stack, tol, scope, shared)?;
     push_core(&mut out, design, stack, tol)?;
     push_backing(&mut out, design, tol)?;
     Ok(out)
@@ -162,7 +170,9 @@ fn push_cast_layers(
     stack: &Stack,
     tol: ChordTolerance,
     scope: AssemblyScope,
+    shared: Option<&SharedFeatureSolids>,
 ) -> Result<(), DesignError> {
+    let si = design.stack_input().sharing(shared);
     // The layers' solids in parallel (each single-threaded, collected in order: the same
     // members whatever the thread count).
     use rayon::prelude::*;
@@ -174,21 +184,12 @@ fn push_cast_layers(
         .map(|&i| {
             let name = &stack.layers[i].name;
             let mut features =
-                crate::parts::layers::layer_features(&design.stack_input(), stack, i, tol)
-                    .part(name)?;
+                crate::parts::layers::layer_features(&si, stack, i, tol).part(name)?;
             let solid = match scope {
-                AssemblyScope::Whole => {
-                    crate::parts::layers::layer_solid(&design.stack_input(), stack, i, tol)
-                }
+                AssemblyScope::Whole => crate::parts::layers::layer_solid(&si, stack, i, tol),
                 AssemblyScope::FitCheck => {
                     features.stand_in_for_layer = Some(i);
-                    crate::parts::layers::layer_stand_in(
-                        &design.stack_input(),
-                        stack,
-                        i,
-                        &features,
-                        tol,
-                    )
+                    crate::parts::layers::layer_stand_in(&si, stack, i, &features, tol)
                 }
             }
             .part(name)?;

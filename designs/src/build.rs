@@ -8,6 +8,7 @@ use crate::geometry::ChordTolerance;
 use crate::kit::Kit;
 use crate::materials::{pour, MaterialsTable};
 use crate::parts::family::FillingPour;
+use crate::parts::layers::SharedFeatureSolids;
 use crate::parts::molds::{build_mold, cast_plans, strategy_of, CastPlan};
 use crate::parts::registry::{SectionInput, FAMILIES};
 use crate::schema::{Design, LayerProcess};
@@ -42,8 +43,20 @@ pub fn build_layer(
     i: usize,
     tol: ChordTolerance,
 ) -> Result<crate::parts::layers::LayerOutput, DesignError> {
+    build_layer_sharing(design, stack, i, tol, None)
+}
+
+/// [`build_layer`] with the feature compositions of a kit build.
+fn build_layer_sharing(
+    design: &Design,
+    stack: &Stack,
+    i: usize,
+    tol: ChordTolerance,
+    shared: Option<&SharedFeatureSolids>,
+) -> Result<crate::parts::layers::LayerOutput, DesignError> {
     let with_skin = || crate::parts::registry::printed_with_skin(design, stack, tol);
-    crate::parts::molds::build_layer(&design.stack_input(), stack, i, tol, &with_skin)
+    let si = design.stack_input().sharing(shared);
+    crate::parts::molds::build_layer(&si, stack, i, tol, &with_skin)
 }
 
 /// Validates `design` as `fabkit validate` does and returns its resolved layer stack: for a
@@ -154,32 +167,43 @@ pub fn build_kit_scoped(
     };
     // The assembly's members that come from no part (the cast layers, the core's and backing's
     // envelopes, the families' bought and cut members) and the filling gels' pours build
-    // alongside the parts.
-    let (((molds, others), sections), (unprinted, fillings)) = rayon::join(
+    // alongside the parts. The layers' marker features are composed once first, for the molds,
+    // the printed layers and the assembly's cast layers to share, while the families build.
+    let (((molds, others), cast_members), ((sections, family_members), fillings)) = rayon::join(
         || {
+            let shared =
+                crate::parts::layers::share_feature_solids(&design.stack_input(), &stack, tol);
+            let shared = Some(&shared);
             rayon::join(
                 || {
                     rayon::join(
                         || {
                             held.par_iter()
-                                .map(|plan| build_mold(&design.stack_input(), &stack, plan, tol))
+                                .map(|plan| {
+                                    build_mold(
+                                        &design.stack_input().sharing(shared),
+                                        &stack,
+                                        plan,
+                                        tol,
+                                    )
+                                })
                                 .collect::<Vec<_>>()
                         },
                         || {
                             other
                                 .par_iter()
-                                .map(|&i| build_layer(design, &stack, i, tol))
+                                .map(|&i| build_layer_sharing(design, &stack, i, tol, shared))
                                 .collect::<Vec<_>>()
                         },
                     )
                 },
-                || FAMILIES.par_iter().map(|f| f.build(at)).collect::<Vec<_>>(),
+                || crate::assembly::unprinted_members(design, &stack, tol, scope, shared),
             )
         },
         || {
-            let members = || {
+            let families = || {
                 rayon::join(
-                    || crate::assembly::unprinted_members(design, &stack, tol, scope),
+                    || FAMILIES.par_iter().map(|f| f.build(at)).collect::<Vec<_>>(),
                     || {
                         FAMILIES
                             .par_iter()
@@ -201,9 +225,10 @@ pub fn build_kit_scoped(
                     .map(|f| f.filling_pour(at, &cavity))
                     .collect::<Vec<_>>()
             };
-            rayon::join(members, fillings)
+            rayon::join(families, fillings)
         },
     );
+    let unprinted = (cast_members, family_members);
     let layer_markers = gather_layer_outputs(
         &other,
         others,

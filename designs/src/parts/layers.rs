@@ -63,6 +63,111 @@ fn feature_solids(
         .collect())
 }
 
+/// What [`feature_solids`] reads of a group of marker sets, to the bit: each set's feature
+/// (all its fields), direction, dilation, depth behind the surface and every marker's position
+/// and normal, with the chord tolerance and `stems_only`. Two groups with equal keys compose
+/// to the same solid.
+#[derive(Debug, PartialEq)]
+struct ComposeKey {
+    features: Vec<String>,
+    bits: Vec<u64>,
+}
+
+fn compose_key(sets: &[&PlacedMarkers], tol: ChordTolerance, stems_only: bool) -> ComposeKey {
+    let mut bits = vec![tol.mm().to_bits(), u64::from(stems_only), sets.len() as u64];
+    let mut features = Vec::with_capacity(sets.len());
+    for pm in sets {
+        features.push(serde_json::to_string(&pm.spec.feature).unwrap_or_default());
+        bits.extend([
+            pm.direction.to_bits(),
+            pm.dilation_mm.to_bits(),
+            pm.embed_mm.to_bits(),
+            pm.markers.len() as u64,
+        ]);
+        for m in &pm.markers {
+            bits.extend(m.position_mm.iter().chain(&m.normal).map(|c| c.to_bits()));
+        }
+    }
+    ComposeKey { features, bits }
+}
+
+/// The marker feature compositions of a kit build, made once before its molds, printed layers
+/// and the assembly's cast layers are built ([`share_feature_solids`]), and read through
+/// [`StackInput::shared`]: a mold strategy that forms the same features (the pins of
+/// ShadowTac's cavity block are its skin's dimples; UVDtact's boundary molds and their layers
+/// share the 85 slots) and the assembly's layer then read one composition instead of each
+/// making its own (ShadowTac's 469 pins took about 0.14 CPU-s a composition).
+///
+/// Why a build makes them before anything reads them, rather than whoever comes first: the
+/// kernel orders an exported mesh's triangles by the order in which its source solids were
+/// made, so every reader must find its composition made before its own solids, whatever the
+/// thread count; a composition made beside the readers would be found or not by timing.
+#[derive(Debug, Default)]
+pub struct SharedFeatureSolids(Vec<(ComposeKey, Solid)>);
+
+impl SharedFeatureSolids {
+    fn get(&self, key: &ComposeKey) -> Option<&Solid> {
+        self.0.iter().find(|(k, _)| k == key).map(|(_, s)| s)
+    }
+}
+
+/// The feature solids of `sets` ([`feature_solids`] of each, in order) as one solid
+/// ([`Solid::compose`]): `shared`'s when it holds that composition, else composed here.
+fn composed_features<'s>(
+    sets: &[&PlacedMarkers],
+    tol: ChordTolerance,
+    stems_only: bool,
+    shared: Option<&'s SharedFeatureSolids>,
+) -> Result<std::borrow::Cow<'s, Solid>, GeometryError> {
+    if let Some(s) = shared.and_then(|sh| sh.get(&compose_key(sets, tol, stems_only))) {
+        return Ok(std::borrow::Cow::Borrowed(s));
+    }
+    let mut parts = Vec::new();
+    for pm in sets {
+        parts.extend(feature_solids(pm, tol, stems_only)?);
+    }
+    Ok(std::borrow::Cow::Owned(Solid::compose(&parts)))
+}
+
+/// Composes, once, the feature solids that [`layer_solid`] adds to and cuts from each layer
+/// of `stack` (its own markers and the coats' it takes, each surface's outward and inward
+/// sets apart) and those [`layer_features`] composes set by set, for a kit build to share
+/// ([`SharedFeatureSolids`]). A composition that fails is left out: whoever needs it composes
+/// it and reports the error.
+pub fn share_feature_solids(
+    si: &StackInput<'_>,
+    stack: &Stack,
+    tol: ChordTolerance,
+) -> SharedFeatureSolids {
+    let mut shared = SharedFeatureSolids::default();
+    let mut add = |group: &[&PlacedMarkers], stems_only: bool| {
+        let key = compose_key(group, tol, stems_only);
+        if shared.get(&key).is_none() {
+            if let Ok(s) = composed_features(group, tol, stems_only, None) {
+                shared.0.push((key, s.into_owned()));
+            }
+        }
+    };
+    for i in 0..stack.layers.len() {
+        let (outer, inner, stems_only) = layer_feature_sets(si, stack, i, tol);
+        for sets in [&outer, &inner] {
+            for outward in [true, false] {
+                let group: Vec<&PlacedMarkers> = sets
+                    .iter()
+                    .filter(|pm| (pm.direction > 0.0) == outward)
+                    .collect();
+                if !group.is_empty() {
+                    add(&group, stems_only);
+                }
+            }
+            for pm in sets {
+                add(&[pm], stems_only);
+            }
+        }
+    }
+    shared
+}
+
 /// A plain cylinder from `embed` behind the surface to `height` beyond it.
 fn stem_solid(
     shape: &markers::FeatureShape,
@@ -148,39 +253,33 @@ pub(crate) fn features_top_z_mm(
 
 /// Adds the outward features and removes the inward ones: one compose and one boolean each.
 pub(crate) fn apply_features(
+    shared: Option<&SharedFeatureSolids>,
     base: Solid,
     sets: &[&PlacedMarkers],
     tol: ChordTolerance,
     stems_only: bool,
 ) -> Result<Solid, GeometryError> {
-    apply_features_signed(base, sets, tol, stems_only, 1.0)
+    apply_features_signed(shared, base, sets, tol, stems_only, 1.0)
 }
 
 /// As [`apply_features`] for `sign` = 1; with `sign` = -1 for the complement of the enclosed
 /// solid (a mold around it): outward features are cut, inward ones added.
 pub(crate) fn apply_features_signed(
+    shared: Option<&SharedFeatureSolids>,
     base: Solid,
     sets: &[&PlacedMarkers],
     tol: ChordTolerance,
     stems_only: bool,
     sign: f64,
 ) -> Result<Solid, GeometryError> {
-    let mut add = Vec::new();
-    let mut cut = Vec::new();
-    for pm in sets {
-        let f = feature_solids(pm, tol, stems_only)?;
-        if pm.direction * sign > 0.0 {
-            add.extend(f);
-        } else {
-            cut.extend(f);
-        }
-    }
+    let (add, cut): (Vec<&PlacedMarkers>, Vec<&PlacedMarkers>) =
+        sets.iter().partition(|pm| pm.direction * sign > 0.0);
     let mut s = base;
     if !add.is_empty() {
-        s = s.union(&Solid::compose(&add))?;
+        s = s.union(&*composed_features(&add, tol, stems_only, shared)?)?;
     }
     if !cut.is_empty() {
-        s = s.difference(&Solid::compose(&cut))?;
+        s = s.difference(&*composed_features(&cut, tol, stems_only, shared)?)?;
     }
     Ok(s)
 }
@@ -201,7 +300,7 @@ fn enclosed(
             .solid_profile(offset_mm, below_base_mm, tol.half()),
         tol,
     )?)?;
-    apply_features(base, sets, tol, stems_only)
+    apply_features(si.shared, base, sets, tol, stems_only)
 }
 
 /// The solid that solid layer `l` fills, with the features `sets` of its outer surface: the
@@ -219,6 +318,7 @@ fn solid_enclosed(
     };
     let pl = solid_layer_profile(si.ctx.body, l.outer_offset_mm, Some(&r), tol.half());
     apply_features(
+        si.shared,
         Solid::from_mesh(&revolve(&pl, tol)?)?,
         sets,
         tol,
@@ -238,15 +338,9 @@ pub fn layer_solid(
     tol: ChordTolerance,
 ) -> Result<Solid, GeometryError> {
     let l = &stack.layers[i];
-    let placed = place_layer_markers(si, l, tol);
-    let stems_only = placed.iter().any(|p| p.spec.tip_material.is_some());
-    let (coat_outer, coat_inner) = taken_features(si, stack, i, tol);
-    let (mut outer, mut inner) = (
-        on_surface(&placed, MarkerSurface::Outer),
-        on_surface(&placed, MarkerSurface::Inner),
-    );
-    outer.extend(&coat_outer);
-    inner.extend(&coat_inner);
+    let (outer, inner, stems_only) = layer_feature_sets(si, stack, i, tol);
+    let outer: Vec<&PlacedMarkers> = outer.iter().collect();
+    let inner: Vec<&PlacedMarkers> = inner.iter().collect();
     if outer.is_empty() && inner.is_empty() {
         // no feature on either surface: the revolved layer itself, no boolean
         return stack.layer_solid(si, i, tol);
@@ -257,6 +351,26 @@ pub fn layer_solid(
     let o = enclosed(si, l.outer_offset_mm, 0.0, &outer, tol, stems_only)?;
     let inn = enclosed(si, l.inner_offset_mm, 1.0, &inner, tol, stems_only)?;
     o.difference(&inn)
+}
+
+/// The marker sets [`layer_solid`] gives layer `i`: on its outer surface, on its inner
+/// surface (its own, then those it takes from the coats: [`taken_features`]), and whether only
+/// the stems are built (printed tips).
+fn layer_feature_sets(
+    si: &StackInput<'_>,
+    stack: &Stack,
+    i: usize,
+    tol: ChordTolerance,
+) -> (Vec<PlacedMarkers>, Vec<PlacedMarkers>, bool) {
+    let placed = place_layer_markers(si, &stack.layers[i], tol);
+    let stems_only = placed.iter().any(|p| p.spec.tip_material.is_some());
+    let (coat_outer, coat_inner) = taken_features(si, stack, i, tol);
+    let (mut outer, mut inner): (Vec<PlacedMarkers>, Vec<PlacedMarkers>) = placed
+        .into_iter()
+        .partition(|p| p.spec.surface == MarkerSurface::Outer);
+    outer.extend(coat_outer);
+    inner.extend(coat_inner);
+    (outer, inner, stems_only)
 }
 
 /// The marker features of layer `i` for the fit check ([`MemberFeatures`]): the sets that grow
@@ -291,8 +405,10 @@ pub fn layer_features(
         };
         let key = feature_key(pm, stems_only);
         if grows {
-            out.grow
-                .push((key, Solid::compose(&feature_solids(pm, tol, stems_only)?)));
+            out.grow.push((
+                key,
+                composed_features(&[pm], tol, stems_only, si.shared)?.into_owned(),
+            ));
         } else {
             out.cut.push(key);
         }

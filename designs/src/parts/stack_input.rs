@@ -3,6 +3,7 @@
 //! parameters; never another section, so that no layer module depends on a family.
 
 use crate::parts::context::Context;
+use crate::parts::layers::SharedFeatureSolids;
 use crate::schema::mold::MoldParams;
 use crate::schema::{Design, Layer};
 
@@ -17,6 +18,16 @@ pub struct StackInput<'a> {
     pub layers: &'a [Layer],
     /// The mold parameters (`mold`).
     pub mold: &'a MoldParams,
+    /// The marker feature compositions a kit build made once for its molds and layers to
+    /// share ([`crate::parts::layers::share_feature_solids`]); `None` outside a kit build.
+    pub shared: Option<&'a SharedFeatureSolids>,
+}
+
+impl<'a> StackInput<'a> {
+    /// The same input, reading the feature compositions `shared` holds.
+    pub fn sharing(self, shared: Option<&'a SharedFeatureSolids>) -> Self {
+        Self { shared, ..self }
+    }
 }
 
 impl Design {
@@ -26,6 +37,7 @@ impl Design {
             ctx: self.context(),
             layers: &self.layers,
             mold: &self.mold,
+            shared: None,
         }
     }
 }

@@ -1580,3 +1580,68 @@ fn recesses_from_both_surfaces_leave_a_wall() {
         }
     }
 }
+
+/// Each solid's triangles, each rotated to start at its least vertex (orientation kept), by
+/// their coordinates' bits, sorted: equal lists are the same surface, vertex for vertex.
+fn triangle_set(s: &fabkit_designs::Solid) -> Vec<[[u64; 3]; 3]> {
+    let m = s.mesh();
+    let mut out: Vec<[[u64; 3]; 3]> = m
+        .triangles
+        .iter()
+        .map(|t| {
+            let v = t.map(|i| m.vertices[i as usize].map(f64::to_bits));
+            let k = (0..3).min_by_key(|&k| v[k]).unwrap();
+            [v[k], v[(k + 1) % 3], v[(k + 2) % 3]]
+        })
+        .collect();
+    out.sort_unstable();
+    out
+}
+
+/// A kit build composes each marker set once and lets the molds that form it and the
+/// assembly's layers read that composition (`layers::share_feature_solids`): ShadowTac's
+/// cavity block and its skin read one composition of the 469 dimple pins, UVDtact's boundary
+/// molds and layers one of the 85 slots. The solids are the very ones each builds alone,
+/// triangle for triangle: the kit's mold parts against `build::build_layer` (every
+/// composition its own), the assembly's cast layers against `layers::layer_solid`.
+#[test]
+fn shared_feature_compositions_build_the_same_molds_and_layers() {
+    let tol = ChordTolerance::new(0.01).unwrap();
+    let materials = fabkit_designs::materials::MaterialsTable::embedded().unwrap();
+    for name in ["shadowtac", "uvdtact"] {
+        let d = fabkit_designs::library::load(name).unwrap();
+        let stack = fabkit_designs::stack::validate(&d, &materials, tol).unwrap();
+        let kit = fabkit_designs::build_kit(&d, tol).unwrap();
+        let mut molds = 0;
+        let mut layers = 0;
+        for (i, l) in stack.layers.iter().enumerate() {
+            if l.process != fabkit_designs::schema::LayerProcess::Cast {
+                continue;
+            }
+            let alone = fabkit_designs::build::build_layer(&d, &stack, i, tol).unwrap();
+            for p in &alone.parts {
+                let in_kit = kit.parts.iter().find(|k| k.name == p.name).unwrap();
+                assert_eq!(
+                    triangle_set(&in_kit.solid),
+                    triangle_set(&p.solid),
+                    "{name}: {}",
+                    p.name
+                );
+                molds += 1;
+            }
+            let member = kit.assembly.iter().find(|m| m.name == l.name).unwrap();
+            let solid = layers::layer_solid(&d.stack_input(), &stack, i, tol).unwrap();
+            assert_eq!(
+                triangle_set(&member.solid),
+                triangle_set(&solid),
+                "{name}: layer {}",
+                l.name
+            );
+            layers += 1;
+        }
+        assert!(
+            molds >= 2 && layers >= 1,
+            "{name}: {molds} molds, {layers} layers"
+        );
+    }
+}

@@ -44,7 +44,7 @@ pub(crate) fn build_boundary_layer(b: LayerBuild) -> Result<LayerOutput, DesignE
         pl.push(p);
     }
     let master_base = g(revolve(&pl, tol).and_then(|mesh| Solid::from_mesh(&mesh)))?;
-    let master = g(apply_features(master_base, &b.outer, tol, false))?;
+    let master = g(apply_features(si.shared, master_base, &b.outer, tol, false))?;
     let pole = master.bounding_box().map(|b| b.max[2]).unwrap_or(0.0);
     let (mold_box, fill) = crate::parts::molds::drafted_box(si, r_p, z_lo, pole, tol).part(name)?;
     let silicone_outer = g(fill.difference(&master))?.volume();
@@ -62,7 +62,7 @@ pub(crate) fn build_boundary_layer(b: LayerBuild) -> Result<LayerOutput, DesignE
     };
     let core_pos = g(revolve(&inner_pl, tol)
         .and_then(|mesh| Solid::from_mesh(&mesh))
-        .and_then(|s| apply_features(s, &b.inner, tol, false)))?;
+        .and_then(|s| apply_features(si.shared, s, &b.inner, tol, false)))?;
     let top = core_pos.bounding_box().map(|b| b.max[2]).unwrap_or(0.0) + BOUNDARY_CUP_FLOOR_MM;
     let cup_r = r_p + BOUNDARY_CUP_WALL_MM;
     let cup =

@@ -95,8 +95,9 @@ fn build_mold_parts(
     let features =
         crate::parts::layers::cavity_features(si, stack, plan.layer, plan.cavity_offset_mm, tol);
     let features: Vec<_> = features.iter().collect();
-    let with_features =
-        |s: Solid| crate::parts::layers::apply_features(s, &features, tol, false).part(name);
+    let with_features = |s: Solid| {
+        crate::parts::layers::apply_features(si.shared, s, &features, tol, false).part(name)
+    };
     // The cavity, the holder and what is inside the cavity are independent: built side by side.
     let inner = || {
         // The pour fills the cavity, minus what is inside it (core and inner layers), minus

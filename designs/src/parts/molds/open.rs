@@ -46,7 +46,7 @@ pub(crate) fn build_open_mold_layer(b: LayerBuild) -> Result<LayerOutput, Design
     ))?;
     let mold = g(block
         .difference(&plain)
-        .and_then(|b| apply_features_signed(b, outer, tol, false, -1.0)))?;
+        .and_then(|b| apply_features_signed(si.shared, b, outer, tol, false, -1.0)))?;
     // the features' inserts set in the open face (the optic's seat)
     let inserts = open_mold_inserts(
         si,

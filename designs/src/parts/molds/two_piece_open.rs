@@ -339,6 +339,7 @@ pub(crate) fn build_two_piece_open_layer(b: LayerBuild) -> Result<LayerOutput, D
         .and_then(|b| b.difference(&pocket))
         .and_then(|b| b.difference(&bolts)))?;
     let bottom = g(apply_features_signed(
+        si.shared,
         bare.clone(),
         &b.outer,
         tol,
