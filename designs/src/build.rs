@@ -171,8 +171,25 @@ pub fn build_kit_scoped(
     // the printed layers and the assembly's cast layers to share, while the families build.
     let (((molds, others), cast_members), ((sections, family_members), fillings)) = rayon::join(
         || {
-            let shared =
-                crate::parts::layers::share_feature_solids(&design.stack_input(), &stack, tol);
+            // the layers a mold reads whole and the assembly puts in whole: built once
+            let read_twice: Vec<usize> = match scope {
+                AssemblyScope::Whole => stack
+                    .layers
+                    .iter()
+                    .filter(|l| {
+                        l.process == LayerProcess::Cast
+                            && strategy_of(l.mold_strategy).reads_layer_solid()
+                    })
+                    .map(|l| l.index)
+                    .collect(),
+                AssemblyScope::FitCheck => Vec::new(),
+            };
+            let shared = crate::parts::layers::share_feature_solids(
+                &design.stack_input(),
+                &stack,
+                tol,
+                &read_twice,
+            );
             let shared = Some(&shared);
             rayon::join(
                 || {

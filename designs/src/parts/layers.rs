@@ -102,12 +102,28 @@ fn compose_key(sets: &[&PlacedMarkers], tol: ChordTolerance, stems_only: bool) -
 /// kernel orders an exported mesh's triangles by the order in which its source solids were
 /// made, so every reader must find its composition made before its own solids, whatever the
 /// thread count; a composition made beside the readers would be found or not by timing.
+///
+/// It also holds the whole solids ([`layer_solid`]) of the layers that both a mold and the
+/// assembly read (UVDtact's boundary molds read each layer's solid for the gel's volume:
+/// about 0.17 CPU-s a layer), by layer index: one value serves one design's stack at one chord
+/// tolerance.
 #[derive(Debug, Default)]
-pub struct SharedFeatureSolids(Vec<(ComposeKey, Solid)>);
+pub struct SharedFeatureSolids {
+    composed: Vec<(ComposeKey, Solid)>,
+    tol: Option<ChordTolerance>,
+    layers: Vec<(usize, Solid)>,
+}
 
 impl SharedFeatureSolids {
     fn get(&self, key: &ComposeKey) -> Option<&Solid> {
-        self.0.iter().find(|(k, _)| k == key).map(|(_, s)| s)
+        self.composed.iter().find(|(k, _)| k == key).map(|(_, s)| s)
+    }
+
+    fn layer(&self, i: usize, tol: ChordTolerance) -> Option<&Solid> {
+        if self.tol != Some(tol) {
+            return None;
+        }
+        self.layers.iter().find(|(j, _)| *j == i).map(|(_, s)| s)
     }
 }
 
@@ -131,20 +147,24 @@ fn composed_features<'s>(
 
 /// Composes, once, the feature solids that [`layer_solid`] adds to and cuts from each layer
 /// of `stack` (its own markers and the coats' it takes, each surface's outward and inward
-/// sets apart) and those [`layer_features`] composes set by set, for a kit build to share
-/// ([`SharedFeatureSolids`]). A composition that fails is left out: whoever needs it composes
-/// it and reports the error.
+/// sets apart) and those [`layer_features`] composes set by set, then builds the whole solids
+/// of the layers `layers` (in parallel), for a kit build to share ([`SharedFeatureSolids`]).
+/// A solid that fails is left out: whoever needs it builds it and reports the error.
 pub fn share_feature_solids(
     si: &StackInput<'_>,
     stack: &Stack,
     tol: ChordTolerance,
+    layers: &[usize],
 ) -> SharedFeatureSolids {
-    let mut shared = SharedFeatureSolids::default();
+    let mut shared = SharedFeatureSolids {
+        tol: Some(tol),
+        ..SharedFeatureSolids::default()
+    };
     let mut add = |group: &[&PlacedMarkers], stems_only: bool| {
         let key = compose_key(group, tol, stems_only);
         if shared.get(&key).is_none() {
             if let Ok(s) = composed_features(group, tol, stems_only, None) {
-                shared.0.push((key, s.into_owned()));
+                shared.composed.push((key, s.into_owned()));
             }
         }
     };
@@ -165,6 +185,13 @@ pub fn share_feature_solids(
             }
         }
     }
+    use rayon::prelude::*;
+    let si = si.sharing(Some(&shared));
+    let solids: Vec<(usize, Solid)> = layers
+        .par_iter()
+        .filter_map(|&i| Some((i, layer_solid(&si, stack, i, tol).ok()?)))
+        .collect();
+    shared.layers = solids;
     shared
 }
 
@@ -337,6 +364,9 @@ pub fn layer_solid(
     i: usize,
     tol: ChordTolerance,
 ) -> Result<Solid, GeometryError> {
+    if let Some(s) = si.shared.and_then(|sh| sh.layer(i, tol)) {
+        return Ok(s.clone());
+    }
     let l = &stack.layers[i];
     let (outer, inner, stems_only) = layer_feature_sets(si, stack, i, tol);
     let outer: Vec<&PlacedMarkers> = outer.iter().collect();

@@ -145,6 +145,11 @@ impl Strategy for Boundary {
         Kind::Boundary
     }
 
+    /// The gel's volume is the layer's ([`crate::parts::layers::layer_solid`]).
+    fn reads_layer_solid(&self) -> bool {
+        true
+    }
+
     /// The outer silicone mold poured, the inner one (or the layers cast so far on it) pressed
     /// in (UVDtact Sec. III).
     fn pour_steps(&self, p: PourInput<'_>) -> Vec<ProcedureStep> {

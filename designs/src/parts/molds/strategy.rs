@@ -189,6 +189,14 @@ pub trait Strategy: Sync {
         0.0
     }
 
+    /// Whether its parts of a layer read the layer's whole solid
+    /// ([`crate::parts::layers::layer_solid`]: boundary, for the gel's volume); a kit build
+    /// that also puts the layer into its assembly then makes that solid once for both
+    /// ([`crate::parts::layers::share_feature_solids`]). False by default.
+    fn reads_layer_solid(&self) -> bool {
+        false
+    }
+
     /// The parts of a layer cast in it, for a strategy that casts without a core; `None` for
     /// a core-holding one ([`Strategy::core_mold`]).
     fn build_layer(&self, _b: LayerBuild<'_>) -> Option<Result<LayerOutput, DesignError>> {
