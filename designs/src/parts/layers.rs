@@ -168,9 +168,9 @@ pub fn share_feature_solids(
             }
         }
     };
-    for i in 0..stack.layers.len() {
+    for (i, l) in stack.layers.iter().enumerate() {
         let (outer, inner, stems_only) = layer_feature_sets(si, stack, i, tol);
-        for sets in [&outer, &inner] {
+        for (sets, on_outer) in [(&outer, true), (&inner, false)] {
             for outward in [true, false] {
                 let group: Vec<&PlacedMarkers> = sets
                     .iter()
@@ -180,8 +180,12 @@ pub fn share_feature_solids(
                     add(&group, stems_only);
                 }
             }
-            for pm in sets {
-                add(&[pm], stems_only);
+            // the sets that grow a cast or sprayed layer, one by one, as layer_features
+            // composes them for the assembly
+            if l.process != LayerProcess::Printed && (on_outer || !l.solid) {
+                for pm in sets.iter().filter(|pm| (pm.direction > 0.0) == on_outer) {
+                    add(&[pm], stems_only);
+                }
             }
         }
     }
