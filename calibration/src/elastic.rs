@@ -441,9 +441,9 @@ impl ContactSolver {
 /// large as its FFTs' size allows ([`smooth_size`]), inside the grid.
 fn window([i0, i1, j0, j1]: [usize; 4], n: usize) -> [usize; 3] {
     let span = (i1 - i0).max(j1 - j0) + 1 + 2 * WINDOW_MARGIN;
-    let w = ((smooth_size(2 * span - 1) + 1) / 2).min(n);
+    let w = smooth_size(2 * span - 1).div_ceil(2).min(n);
     let start = |lo: usize, hi: usize| {
-        let centre = (lo + hi + 1) / 2;
+        let centre = (lo + hi).div_ceil(2);
         centre.saturating_sub(w / 2).min(n - w)
     };
     [start(i0, i1), start(j0, j1), w]

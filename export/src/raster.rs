@@ -537,7 +537,7 @@ mod tests {
         let mut short = npy_f32(&[2, 3], &data);
         short.pop();
         assert!(read_npy_f32(&short).unwrap_err().contains("needs 24"));
-        let f8 = npy_f32(&[2, 3], &data).iter().copied().collect::<Vec<u8>>();
+        let f8 = npy_f32(&[2, 3], &data).to_vec();
         let text = String::from_utf8_lossy(&f8[10..74]).replace("<f4", "<f8");
         let mut bad = f8[..10].to_vec();
         bad.extend_from_slice(text.as_bytes());

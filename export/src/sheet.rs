@@ -842,22 +842,6 @@ pub(crate) fn shell_words(args: &[String]) -> String {
         .join(" ")
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn table_cells_stay_in_their_column() {
-        assert_eq!(text("a|b\nc"), "a\\|b c");
-        assert_eq!(code("x`y"), "x`y");
-        assert_eq!(code("x|y"), "x\\|y");
-        assert_eq!(
-            shell_words(&["fabkit".into(), "a b".into()]),
-            "fabkit 'a b'"
-        );
-    }
-}
-
 /// A plate's objects in words: each name once, in order, with its count when the plate holds
 /// several (`` `pin` × 29 ``).
 fn plate_parts(objects: &[crate::manifest::ManifestPlateObject]) -> String {
@@ -879,4 +863,20 @@ fn plate_parts(objects: &[crate::manifest::ManifestPlateObject]) -> String {
         })
         .collect::<Vec<_>>()
         .join(", ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn table_cells_stay_in_their_column() {
+        assert_eq!(text("a|b\nc"), "a\\|b c");
+        assert_eq!(code("x`y"), "x`y");
+        assert_eq!(code("x|y"), "x\\|y");
+        assert_eq!(
+            shell_words(&["fabkit".into(), "a b".into()]),
+            "fabkit 'a b'"
+        );
+    }
 }

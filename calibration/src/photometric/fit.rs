@@ -673,10 +673,8 @@ fn add_upper_products_tiled<const T: usize>(
 fn tile_products<const T: usize>(xs: [&[f64]; T], ys: [&[f64]; T]) -> [[f64; T]; T] {
     let len = xs[0].len();
     let n4 = len / 4;
-    let (xc, yc): ([&[[f64; 4]]; T], [&[[f64; 4]]; T]) = (
-        std::array::from_fn(|i| &xs[i][..len].as_chunks::<4>().0[..n4]),
-        std::array::from_fn(|j| &ys[j][..len].as_chunks::<4>().0[..n4]),
-    );
+    let xc: [&[[f64; 4]]; T] = std::array::from_fn(|i| &xs[i][..len].as_chunks::<4>().0[..n4]);
+    let yc: [&[[f64; 4]]; T] = std::array::from_fn(|j| &ys[j][..len].as_chunks::<4>().0[..n4]);
     let mut acc = [[[0.0f64; 4]; T]; T];
     for t in 0..n4 {
         let x: [[f64; 4]; T] = std::array::from_fn(|i| xc[i][t]);
